@@ -1,0 +1,14 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The list of subcommands, one file each (cmd_*.cpp).
+#include "commands.hpp"
+
+#include <CLI/CLI.hpp>
+
+namespace opencnc::cli {
+
+void register_all(CLI::App& app, Registry& registry) {
+  (void)app;
+  (void)registry;
+}
+
+}  // namespace opencnc::cli

@@ -1,0 +1,30 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Subcommand registration for the opencnc command line.
+#pragma once
+
+#include <functional>
+
+namespace CLI {
+class App;
+}
+
+namespace opencnc::cli {
+
+inline constexpr int kExitOk = 0;       ///< success
+inline constexpr int kExitProgram = 1;  ///< the program (G-code, machine) has an error
+inline constexpr int kExitUsage = 2;    ///< wrong command line, unreadable file
+
+/// Holds the exit code of the subcommand that ran.
+class Registry {
+ public:
+  void set_result(int rc) { result_ = rc; }
+  int result() const { return result_; }
+
+ private:
+  int result_ = kExitOk;
+};
+
+/// Adds every subcommand to `app`; each callback stores its exit code in `registry`.
+void register_all(CLI::App& app, Registry& registry);
+
+}  // namespace opencnc::cli

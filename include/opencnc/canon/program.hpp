@@ -1,0 +1,163 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// canon::Program — the expanded motions of a program in machine coordinates, with the
+// non-motion actions between them and a source map. Cheap to hold a million segments.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "opencnc/canon/source_map.hpp"
+#include "opencnc/canon/types.hpp"
+#include "opencnc/core/axes.hpp"
+#include "opencnc/core/chunked_vector.hpp"
+
+namespace opencnc::canon {
+
+enum class MoveKind : std::uint8_t {
+  Traverse,   ///< G0: at rapid rate
+  Feed,       ///< G1 (and straight segments of cycles, cutter compensation, ...)
+  Arc,        ///< G2/G3 arc or helix; details in Program::arc()
+  Probe,      ///< G38.x straight probe
+  RigidTap,   ///< G33.1: feed to the end, reverse spindle, return
+};
+
+/// Bits of Move::flags.
+enum MoveFlag : std::uint8_t {
+  kInverseTime = 1u << 0,      ///< feed is 1/minutes for this move (G93)
+  kPerRevolution = 1u << 1,    ///< feed is per spindle revolution (G95)
+  kSpindleSynced = 1u << 2,    ///< position locked to the spindle (G33, G76, G33.1)
+};
+
+/// One motion, 16 bytes. The end pose is stored separately (Program::end()); the start is
+/// the previous motion's end (or Program::start() for the first).
+struct Move {
+  MoveKind kind = MoveKind::Feed;
+  std::uint8_t flags = 0;
+  std::uint16_t reserved = 0;
+  std::uint32_t context = 0;  ///< SourceMap context (call stack); its body file is the source file
+  std::uint32_t line = 0;     ///< source line of the block that produced the move
+  std::uint32_t param = 0;    ///< Arc: index into arcs; others: index into feeds
+};
+static_assert(sizeof(Move) == 16);
+
+/// Geometry of an arc or helix in machine coordinates (mm), in the plane's axis triple
+/// (X,Y,Z for XY/YZ/XZ; U,V,W for UV/VW/UW).
+struct ArcGeometry {
+  double center[3] = {0, 0, 0};  ///< on the plane through the start point
+  double normal[3] = {0, 0, 1};  ///< unit normal; rotation is counterclockwise about it
+  std::int32_t turns = 1;        ///< LinuxCNC's rotation: |turns|-1 extra full circles; sign = direction
+  Plane plane = Plane::XY;
+  std::uint32_t feed = 0;        ///< index into feeds
+};
+
+/// A feed value as programmed (converted to mm where it is a length rate).
+struct FeedValue {
+  double value = 0;  ///< mm/min, mm/rev, or 1/min (inverse time)
+};
+
+enum class ActionKind : std::uint8_t {
+  Dwell,               ///< value = seconds
+  SpindleSpeed,        ///< index = spindle, value = rpm (or surface speed under CSS)
+  SpindleCw, SpindleCcw, SpindleStop,   ///< index = spindle
+  SpindleMode,         ///< value = css max rpm, 0 = G97
+  SpindleOrient,       ///< value = degrees, index2 = direction
+  SelectTool, ChangeTool, ChangeToolNumber,  ///< index = tool
+  ToolLengthOffset,    ///< pose = offset (mm)
+  WorkOffset,          ///< index = 1..9, pose = G5x offset (mm)
+  G92Offset,           ///< pose = G92/G52 offset (mm)
+  XyRotation,          ///< value = degrees
+  MotionControl,       ///< index = MotionControl, value = tolerance (mm)
+  NaiveCamTolerance,   ///< value = mm
+  SpeedFeedSyncStart,  ///< value = mm per revolution, index2 = velocity mode
+  SpeedFeedSyncStop,
+  MistOn, MistOff, FloodOn, FloodOff,
+  FeedOverrideEnable, FeedOverrideDisable,
+  SpeedOverrideEnable, SpeedOverrideDisable,   ///< index = spindle
+  AdaptiveFeedEnable, AdaptiveFeedDisable,
+  FeedHoldEnable, FeedHoldDisable,
+  MotionOutputBit,     ///< index = output, index2 = 1 set / 0 clear (synchronised with motion)
+  AuxOutputBit,        ///< index = output, index2 = 1 set / 0 clear (immediate)
+  MotionOutputValue, AuxOutputValue,  ///< index = output, value
+  WaitInput,           ///< index = input, index2 = mode (L), value = timeout s; text = "digital"/"analog"
+  ProbeOn, ProbeOff,
+  Message,             ///< text
+  Comment,             ///< text
+  ProgramStop, OptionalStop, PalletShuttle, ProgramEnd,
+};
+
+/// A non-motion action executed before move `before_move` (== move count: after the last).
+struct Action {
+  ActionKind kind = ActionKind::Comment;
+  std::int32_t index = 0;
+  std::int32_t index2 = 0;
+  std::uint32_t before_move = 0;
+  std::uint32_t context = 0;
+  std::uint32_t line = 0;
+  double value = 0;
+  std::uint32_t text = 0;   ///< index into texts (Message/Comment)
+  std::uint32_t pose = 0;   ///< index into poses of actions (offsets)
+};
+
+/// The expanded program. Positions in machine coordinates (mm, degrees) with every offset,
+/// unit conversion and rotation applied. Built by canon::ProgramBuilder; read by the planner,
+/// the summary, the path index and the plotter. Non-real-time; not thread-safe while built,
+/// safe to share read-only afterwards.
+class Program {
+ public:
+  explicit Program(AxisMask axes = kXyzabc);
+
+  AxisMask axes() const noexcept { return axes_; }
+  /// Number of stored axis values per pose (the axes in the mask).
+  int stride() const noexcept { return stride_; }
+
+  std::size_t size() const noexcept { return moves_.size(); }
+  bool empty() const noexcept { return moves_.empty(); }
+  const Move& move(SegmentId id) const noexcept { return moves_[id]; }
+  /// End pose of move `id` (axes outside the mask are 0).
+  Pose end(SegmentId id) const noexcept;
+  /// Start pose of move `id`.
+  Pose start_of(SegmentId id) const noexcept { return id == 0 ? start_ : end(id - 1); }
+  const Pose& start() const noexcept { return start_; }
+  const ArcGeometry& arc(SegmentId id) const noexcept { return arcs_[moves_[id].param]; }
+  double feed(SegmentId id) const noexcept;
+
+  const std::vector<Action>& actions() const noexcept { return actions_; }
+  const std::string& text(std::uint32_t index) const { return texts_.at(index); }
+  const Pose& action_pose(std::uint32_t index) const { return action_poses_.at(index); }
+
+  const SourceMap& sources() const noexcept { return *sources_; }
+  std::shared_ptr<const SourceMap> sources_ptr() const noexcept { return sources_; }
+  /// Source file index of a move (the body file of its context, or the main file).
+  std::uint32_t file_of(SegmentId id) const;
+
+  /// Bytes held by the program's storage (moves, poses, arcs, feeds, actions).
+  std::size_t memory_bytes() const noexcept;
+
+  // --- building (used by ProgramBuilder) ----------------------------------------------
+  void set_start(const Pose& p) noexcept { start_ = p; }
+  void set_sources(std::shared_ptr<const SourceMap> s) noexcept { sources_ = std::move(s); }
+  SegmentId append(const Move& m, const Pose& end);
+  std::uint32_t add_arc(const ArcGeometry& a);
+  std::uint32_t add_feed(double value);
+  void add_action(const Action& a) { actions_.push_back(a); }
+  std::uint32_t add_text(std::string s);
+  std::uint32_t add_action_pose(const Pose& p);
+
+ private:
+  AxisMask axes_;
+  int stride_ = 0;
+  std::uint8_t axis_slots_[kAxisCount] = {};  ///< stored slot of each axis in the mask
+  Pose start_{};
+  ChunkedVector<Move> moves_;
+  ChunkedVector<double, 16> coords_;
+  ChunkedVector<ArcGeometry, 12> arcs_;
+  std::vector<double> feeds_;
+  std::vector<Action> actions_;
+  std::vector<std::string> texts_;
+  std::vector<Pose> action_poses_;
+  std::shared_ptr<const SourceMap> sources_;
+};
+
+}  // namespace opencnc::canon

@@ -1,0 +1,63 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Value types of the canonical machining interface (between interpreter and everything else).
+#pragma once
+
+#include <cstdint>
+#include <limits>
+
+#include "opencnc/core/axes.hpp"
+
+namespace opencnc::canon {
+
+/// Ordinal of a motion in execution order (0 = the first motion of the program).
+using SegmentId = std::uint64_t;
+inline constexpr SegmentId kNoSegment = std::numeric_limits<SegmentId>::max();
+
+enum class Units : std::uint8_t { Mm, Inch };
+constexpr double mm_per_unit(Units u) noexcept { return u == Units::Inch ? 25.4 : 1.0; }
+
+/// Canonical planes. XY/YZ/XZ are G17/G19/G18; UV/VW/UW are G17.1/G19.1/G18.1.
+enum class Plane : std::uint8_t { XY, YZ, XZ, UV, VW, UW };
+
+/// G93 / G94 / G95.
+enum class FeedMode : std::uint8_t { UnitsPerMinute, InverseTime, UnitsPerRevolution };
+
+/// G61 / G61.1 / G64.
+enum class MotionControl : std::uint8_t { ExactStop, ExactPath, Continuous };
+
+enum class FeedReference : std::uint8_t { Workpiece, Xyz };
+
+enum class SpindleDirection : std::uint8_t { Stopped, Clockwise, Counterclockwise };
+
+/// Where a canonical call came from: the block being executed.
+struct BlockOrigin {
+  std::uint32_t file = 0;     ///< index into the SourceMap's file table
+  std::uint32_t line = 0;     ///< 1-based source line of the block, 0 = none (start/end of run)
+  std::uint32_t context = 0;  ///< interned call stack (SourceMap context), 0 = main program
+  /// The block's leading N word as written ("0150" keeps its zeros), for rs274-style
+  /// listings; `n_present` is false when the block does not start with N.
+  bool n_present = false;
+  std::uint8_t n_length = 0;
+  char n_digits[14] = {};
+};
+
+/// ARC_FEED arguments as LinuxCNC's canonical interface defines them: the end point in the
+/// active plane (first, second), the centre in the plane, the signed turn count (positive =
+/// counterclockwise seen from the plane normal, e.g. G3 = +1, G2 = -1) and the end point along
+/// the plane normal, plus the end of every other axis in `end`. `end` is the full end pose
+/// (it repeats first/second/normal for convenience).
+struct ArcFeed {
+  Plane plane = Plane::XY;
+  double first_end = 0, second_end = 0;
+  double first_center = 0, second_center = 0;
+  int rotation = 1;
+  double axis_end = 0;
+  Pose end;
+};
+
+/// A NURBS control point in the XY plane with its weight.
+struct NurbsPoint {
+  double x = 0, y = 0, weight = 1;
+};
+
+}  // namespace opencnc::canon

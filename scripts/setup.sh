@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-3.0-or-later
+# Installs the Debian 12 packages opencnc needs (idempotent; apt-get only).
+#   scripts/setup.sh            build + run dependencies
+#   scripts/setup.sh --tests    also what the test suite needs (clang for fuzzing, LinuxCNC's
+#                               rs274 as the conformance oracle and its sample programs)
+set -euo pipefail
+
+packages=(
+  cmake ninja-build g++ pkg-config
+  libfmt-dev            # formatting
+  libcli11-dev          # command line parsing
+  nlohmann-json3-dev    # JSON reports and API
+  libtomlplusplus-dev   # machine profiles
+  libsqlite3-dev        # tool tables, history (store layer)
+  python3               # helper scripts (program generators, golden regeneration)
+)
+test_packages=(
+  libgtest-dev libgmock-dev   # unit, golden, scenario and fault tests
+  libbenchmark-dev            # benchmarks
+  clang libclang-rt-14-dev    # libFuzzer + sanitizer runtime for the fuzz target
+  linuxcnc-uspace             # rs274 (oracle) and /usr/share/linuxcnc/ncfiles
+)
+
+if [[ "${1:-}" == "--tests" ]]; then
+  packages+=("${test_packages[@]}")
+fi
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+if ((${#missing[@]} == 0)); then
+  echo "setup: all ${#packages[@]} packages present"
+  exit 0
+fi
+
+sudo_cmd=()
+if [[ $(id -u) -ne 0 ]]; then sudo_cmd=(sudo); fi
+echo "setup: installing ${missing[*]}"
+"${sudo_cmd[@]}" apt-get update -qq
+DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"

@@ -1,0 +1,231 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Canonical calls → machine-coordinate program (units, offsets, rotation, tool offset).
+#include "opencnc/canon/program_builder.hpp"
+
+#include <cmath>
+#include <numbers>
+
+namespace opencnc::canon {
+
+namespace {
+bool is_linear(int axis) { return !is_rotary(static_cast<Axis>(axis)); }
+}  // namespace
+
+ProgramBuilder::ProgramBuilder(AxisMask axes, const Pose& start) : program_(axes), position_(start) {
+  program_.set_start(start);
+}
+
+Pose ProgramBuilder::offset_to_mm(const Pose& offset) const noexcept {
+  Pose out = offset;
+  const double k = mm_per_unit(units_);
+  for (int i = 0; i < kAxisCount; ++i) {
+    if (is_linear(i)) out[i] *= k;
+  }
+  return out;
+}
+
+Pose ProgramBuilder::to_machine(const Pose& canonical) const noexcept {
+  Pose p = offset_to_mm(canonical);
+  for (int i = 0; i < kAxisCount; ++i) p[i] += g92_[i];
+  const double x = p[0], y = p[1];
+  p[0] = x * rot_cos_ - y * rot_sin_;
+  p[1] = x * rot_sin_ + y * rot_cos_;
+  for (int i = 0; i < kAxisCount; ++i) p[i] += g5x_[i] + tool_[i];
+  return p;
+}
+
+void ProgramBuilder::set_g5x_offset(int index, const Pose& offset) {
+  g5x_ = offset_to_mm(offset);
+  Action a = make(ActionKind::WorkOffset, index);
+  a.pose = program_.add_action_pose(g5x_);
+  program_.add_action(a);
+}
+
+void ProgramBuilder::set_g92_offset(const Pose& offset) {
+  g92_ = offset_to_mm(offset);
+  Action a = make(ActionKind::G92Offset);
+  a.pose = program_.add_action_pose(g92_);
+  program_.add_action(a);
+}
+
+void ProgramBuilder::set_xy_rotation(double degrees) {
+  rotation_deg_ = degrees;
+  const double r = degrees * std::numbers::pi / 180.0;
+  rot_cos_ = std::cos(r);
+  rot_sin_ = std::sin(r);
+  program_.add_action(make(ActionKind::XyRotation, 0, 0, degrees));
+}
+
+void ProgramBuilder::use_tool_length_offset(const Pose& offset) {
+  tool_ = offset_to_mm(offset);
+  Action a = make(ActionKind::ToolLengthOffset);
+  a.pose = program_.add_action_pose(tool_);
+  program_.add_action(a);
+}
+
+Action ProgramBuilder::make(ActionKind kind, int index, int index2, double value) const {
+  Action a;
+  a.kind = kind;
+  a.index = index;
+  a.index2 = index2;
+  a.value = value;
+  a.before_move = static_cast<std::uint32_t>(program_.size());
+  a.context = origin_.context;
+  a.line = origin_.line;
+  return a;
+}
+
+std::uint8_t ProgramBuilder::move_flags() const noexcept {
+  std::uint8_t f = 0;
+  if (feed_mode_ == FeedMode::InverseTime) f |= kInverseTime;
+  if (feed_mode_ == FeedMode::UnitsPerRevolution) f |= kPerRevolution;
+  if (synced_) f |= kSpindleSynced;
+  return f;
+}
+
+std::uint32_t ProgramBuilder::current_feed_index() {
+  // Inverse-time feeds are 1/min whatever the units; length feeds convert to mm.
+  const double mm = feed_mode_ == FeedMode::InverseTime ? feed_ : feed_ * mm_per_unit(units_);
+  if (mm != last_feed_mm_) {
+    last_feed_index_ = program_.add_feed(mm);
+    last_feed_mm_ = mm;
+  }
+  return last_feed_index_;
+}
+
+void ProgramBuilder::append(MoveKind kind, SegmentId id, const Pose& machine_end, std::uint32_t param) {
+  (void)id;  // ids are ordinals: the builder's own count matches the interpreter's
+  Move m;
+  m.kind = kind;
+  m.flags = kind == MoveKind::Traverse ? 0 : move_flags();
+  m.context = origin_.context;
+  m.line = origin_.line;
+  m.param = param;
+  program_.append(m, machine_end);
+  position_ = machine_end;
+}
+
+void ProgramBuilder::straight_traverse(SegmentId id, const Pose& end) {
+  append(MoveKind::Traverse, id, to_machine(end), 0);
+}
+
+void ProgramBuilder::straight_feed(SegmentId id, const Pose& end) {
+  append(MoveKind::Feed, id, to_machine(end), current_feed_index());
+}
+
+void ProgramBuilder::straight_probe(SegmentId id, const Pose& end) {
+  append(MoveKind::Probe, id, to_machine(end), current_feed_index());
+}
+
+void ProgramBuilder::rigid_tap(SegmentId id, const Pose& end, double /*scale*/) {
+  append(MoveKind::RigidTap, id, to_machine(end), current_feed_index());
+}
+
+void ProgramBuilder::arc_feed(SegmentId id, const ArcFeed& arc) {
+  // Axis indices of the plane: first, second, normal (first × second = +normal).
+  int first = 0, second = 1, normal = 2;
+  switch (arc.plane) {
+    case Plane::XY: first = 0; second = 1; normal = 2; break;
+    case Plane::YZ: first = 1; second = 2; normal = 0; break;
+    case Plane::XZ: first = 2; second = 0; normal = 1; break;
+    case Plane::UV: first = 6; second = 7; normal = 8; break;
+    case Plane::VW: first = 7; second = 8; normal = 6; break;
+    case Plane::UW: first = 8; second = 6; normal = 7; break;
+  }
+  const Pose machine_end = to_machine(arc.end);
+  Pose center_c = arc.end;
+  center_c[first] = arc.first_center;
+  center_c[second] = arc.second_center;
+  const Pose center_m = to_machine(center_c);
+
+  const int base = (arc.plane == Plane::XY || arc.plane == Plane::YZ || arc.plane == Plane::XZ) ? 0 : 6;
+  double n[3] = {0, 0, 0};
+  n[normal - base] = 1.0;
+  if (base == 0) {  // the XY rotation turns the plane's normal about Z
+    const double nx = n[0], ny = n[1];
+    n[0] = nx * rot_cos_ - ny * rot_sin_;
+    n[1] = nx * rot_sin_ + ny * rot_cos_;
+  }
+  // The centre lies on the plane through the start point (the helix rises along the normal).
+  double c[3], s[3];
+  for (int k = 0; k < 3; ++k) {
+    c[k] = center_m[base + k];
+    s[k] = position_[base + k];
+  }
+  const double d = (c[0] - s[0]) * n[0] + (c[1] - s[1]) * n[1] + (c[2] - s[2]) * n[2];
+  ArcGeometry g;
+  for (int k = 0; k < 3; ++k) {
+    g.center[k] = c[k] - d * n[k];
+    g.normal[k] = n[k];
+  }
+  g.turns = arc.rotation;
+  g.plane = arc.plane;
+  g.feed = current_feed_index();
+  append(MoveKind::Arc, id, machine_end, program_.add_arc(g));
+}
+
+void ProgramBuilder::dwell(double seconds) { program_.add_action(make(ActionKind::Dwell, 0, 0, seconds)); }
+
+void ProgramBuilder::set_feed_mode(int /*spindle*/, FeedMode mode) { feed_mode_ = mode; }
+
+void ProgramBuilder::set_motion_control_mode(MotionControl mode, double tolerance) {
+  program_.add_action(make(ActionKind::MotionControl, static_cast<int>(mode), 0, tolerance * mm_per_unit(units_)));
+}
+
+void ProgramBuilder::set_naivecam_tolerance(double tolerance) {
+  program_.add_action(make(ActionKind::NaiveCamTolerance, 0, 0, tolerance * mm_per_unit(units_)));
+}
+
+void ProgramBuilder::start_speed_feed_synch(int spindle, double feed_per_rev, bool velocity_mode) {
+  synced_ = true;
+  program_.add_action(
+      make(ActionKind::SpeedFeedSyncStart, spindle, velocity_mode ? 1 : 0, feed_per_rev * mm_per_unit(units_)));
+}
+
+void ProgramBuilder::stop_speed_feed_synch() {
+  synced_ = false;
+  simple(ActionKind::SpeedFeedSyncStop);
+}
+
+void ProgramBuilder::set_spindle_speed(int spindle, double rpm) {
+  program_.add_action(make(ActionKind::SpindleSpeed, spindle, 0, rpm));
+}
+void ProgramBuilder::start_spindle_clockwise(int spindle) { simple(ActionKind::SpindleCw, spindle); }
+void ProgramBuilder::start_spindle_counterclockwise(int spindle) { simple(ActionKind::SpindleCcw, spindle); }
+void ProgramBuilder::stop_spindle_turning(int spindle) { simple(ActionKind::SpindleStop, spindle); }
+void ProgramBuilder::set_spindle_mode(int spindle, double css_max) {
+  program_.add_action(make(ActionKind::SpindleMode, spindle, 0, css_max));
+}
+void ProgramBuilder::orient_spindle(int spindle, double degrees, int direction) {
+  program_.add_action(make(ActionKind::SpindleOrient, spindle, direction, degrees));
+}
+
+void ProgramBuilder::select_tool(int tool) { simple(ActionKind::SelectTool, tool); }
+void ProgramBuilder::change_tool(int tool) { simple(ActionKind::ChangeTool, tool); }
+void ProgramBuilder::change_tool_number(int tool) { simple(ActionKind::ChangeToolNumber, tool); }
+
+void ProgramBuilder::set_motion_output_value(int index, double value) {
+  program_.add_action(make(ActionKind::MotionOutputValue, index, 0, value));
+}
+void ProgramBuilder::set_aux_output_value(int index, double value) {
+  program_.add_action(make(ActionKind::AuxOutputValue, index, 0, value));
+}
+void ProgramBuilder::wait_for_input(int index, bool digital, int mode, double timeout_s) {
+  Action a = make(ActionKind::WaitInput, index, mode, timeout_s);
+  a.text = program_.add_text(digital ? "digital" : "analog");
+  program_.add_action(a);
+}
+
+void ProgramBuilder::comment(std::string_view text) {
+  Action a = make(ActionKind::Comment);
+  a.text = program_.add_text(std::string(text));
+  program_.add_action(a);
+}
+
+void ProgramBuilder::message(std::string_view text) {
+  Action a = make(ActionKind::Message);
+  a.text = program_.add_text(std::string(text));
+  program_.add_action(a);
+}
+
+}  // namespace opencnc::canon

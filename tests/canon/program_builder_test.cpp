@@ -1,0 +1,133 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// ProgramBuilder: canonical (program units, work coordinates) → machine mm, as LinuxCNC's canon.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "opencnc/canon/program_builder.hpp"
+
+using namespace opencnc;
+using namespace opencnc::canon;
+
+namespace {
+Pose xyz(double x, double y, double z) {
+  Pose p;
+  p[Axis::X] = x;
+  p[Axis::Y] = y;
+  p[Axis::Z] = z;
+  return p;
+}
+}  // namespace
+
+TEST(ProgramBuilder, AppliesOffsetsRotationAndUnitsInLinuxCncOrder) {
+  ProgramBuilder b;
+  b.use_length_units(Units::Inch);
+  b.set_g5x_offset(1, xyz(1, 0, 0));   // 25.4 mm
+  b.set_g92_offset(xyz(0, 1, 0));      // 25.4 mm, applied before the rotation
+  b.set_xy_rotation(90);
+  b.use_tool_length_offset(xyz(0, 0, 0.5));
+  b.straight_feed(0, xyz(1, 0, 0));
+  const Program& p = b.program();
+  ASSERT_EQ(p.size(), 1u);
+  Pose e = p.end(0);
+  // (1,0)+(0,1) = (1,1) inch, rotated 90° → (-1,1), + g5x (1,0) → (0,1) inch.
+  EXPECT_NEAR(e[Axis::X], 0.0, 1e-12);
+  EXPECT_NEAR(e[Axis::Y], 25.4, 1e-12);
+  EXPECT_NEAR(e[Axis::Z], 12.7, 1e-12);
+}
+
+TEST(ProgramBuilder, OffsetsKeepTheirMillimetresWhenUnitsChange) {
+  ProgramBuilder b;
+  b.use_length_units(Units::Inch);
+  b.set_g5x_offset(1, xyz(1, 0, 0));
+  b.use_length_units(Units::Mm);
+  b.straight_traverse(0, xyz(0, 0, 0));
+  EXPECT_DOUBLE_EQ(b.program().end(0)[Axis::X], 25.4);
+}
+
+TEST(ProgramBuilder, ArcCentreLiesInThePlaneOfTheStartPoint) {
+  ProgramBuilder b(kXyzabc, xyz(10, 0, 5));
+  ArcFeed a;
+  a.plane = Plane::XY;
+  a.first_end = 0;
+  a.second_end = 10;
+  a.first_center = 0;
+  a.second_center = 0;
+  a.rotation = 1;
+  a.axis_end = 0;  // helix down to z = 0
+  a.end = xyz(0, 10, 0);
+  b.set_feed_rate(100);
+  b.arc_feed(0, a);
+  const Program& p = b.program();
+  ASSERT_EQ(p.size(), 1u);
+  EXPECT_EQ(p.move(0).kind, MoveKind::Arc);
+  const ArcGeometry& g = p.arc(0);
+  EXPECT_DOUBLE_EQ(g.center[2], 5.0);
+  EXPECT_DOUBLE_EQ(g.normal[2], 1.0);
+  EXPECT_EQ(g.turns, 1);
+  EXPECT_DOUBLE_EQ(p.feed(0), 100.0);
+}
+
+TEST(ProgramBuilder, RotationTurnsTheNormalOfAnXzArc) {
+  ProgramBuilder b;
+  b.set_xy_rotation(90);
+  ArcFeed a;
+  a.plane = Plane::XZ;  // first = Z, second = X, normal = +Y
+  a.first_end = 0;
+  a.second_end = 2;
+  a.first_center = 0;
+  a.second_center = 1;
+  a.rotation = -1;
+  a.end = xyz(2, 0, 0);
+  b.arc_feed(0, a);
+  const ArcGeometry& g = b.program().arc(0);
+  EXPECT_NEAR(g.normal[0], -1.0, 1e-12);  // +Y rotated by 90° about Z is -X
+  EXPECT_NEAR(g.normal[1], 0.0, 1e-12);
+  EXPECT_NEAR(g.center[1], 1.0, 1e-12);   // centre (x=1) rotated to y=1
+}
+
+TEST(ProgramBuilder, FeedsConvertToMillimetresExceptInverseTime) {
+  ProgramBuilder b;
+  b.use_length_units(Units::Inch);
+  b.set_feed_rate(10);
+  b.straight_feed(0, xyz(1, 0, 0));
+  b.set_feed_mode(0, FeedMode::InverseTime);
+  b.set_feed_rate(2);
+  b.straight_feed(1, xyz(2, 0, 0));
+  const Program& p = b.program();
+  EXPECT_DOUBLE_EQ(p.feed(0), 254.0);
+  EXPECT_DOUBLE_EQ(p.feed(1), 2.0);
+  EXPECT_TRUE(p.move(1).flags & kInverseTime);
+}
+
+TEST(ProgramBuilder, ActionsKeepTheirPlaceBetweenMoves) {
+  ProgramBuilder b;
+  b.set_spindle_speed(0, 1000);
+  b.start_spindle_clockwise(0);
+  b.straight_traverse(0, xyz(1, 0, 0));
+  b.dwell(0.5);
+  b.straight_traverse(1, xyz(2, 0, 0));
+  b.program_end();
+  const auto& acts = b.program().actions();
+  ASSERT_EQ(acts.size(), 4u);
+  EXPECT_EQ(acts[0].kind, ActionKind::SpindleSpeed);
+  EXPECT_EQ(acts[0].before_move, 0u);
+  EXPECT_EQ(acts[2].kind, ActionKind::Dwell);
+  EXPECT_EQ(acts[2].before_move, 1u);
+  EXPECT_EQ(acts[3].before_move, 2u);
+}
+
+TEST(ProgramBuilder, StoresOnlyTheConfiguredAxes) {
+  ProgramBuilder b(AxisMask::from_letters("XYZ"));
+  b.straight_feed(0, xyz(1, 2, 3));
+  EXPECT_EQ(b.program().stride(), 3);
+  EXPECT_EQ(b.program().end(0), xyz(1, 2, 3));
+}
+
+TEST(ProgramBuilder, MillionMovesStayCompact) {
+  ProgramBuilder b;
+  b.set_feed_rate(1000);
+  for (int i = 0; i < 1'000'000; ++i) b.straight_feed(static_cast<SegmentId>(i), xyz(i * 0.001, 0, 0));
+  // 16-byte move + 6 doubles per pose: well under the 100 MB budget of a million-line program.
+  EXPECT_LT(b.program().memory_bytes(), 70u * 1024 * 1024);
+}

@@ -1,0 +1,19 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// ChunkedVector keeps order and element addresses across chunk boundaries.
+#include <gtest/gtest.h>
+
+#include "opencnc/core/chunked_vector.hpp"
+
+TEST(ChunkedVector, StoresAcrossChunks) {
+  opencnc::ChunkedVector<int, 4> v;  // 16 elements per chunk
+  const int* first = &v.push_back(7);
+  for (int i = 1; i < 1000; ++i) v.push_back(i * 3);
+  EXPECT_EQ(v.size(), 1000u);
+  EXPECT_EQ(&v[0], first);
+  EXPECT_EQ(v[0], 7);
+  EXPECT_EQ(v[999], 2997);
+  EXPECT_EQ(v.back(), 2997);
+  EXPECT_EQ(v.capacity_bytes(), 63u * 16 * sizeof(int));
+  v.clear();
+  EXPECT_TRUE(v.empty());
+}
