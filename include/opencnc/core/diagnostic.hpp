@@ -17,6 +17,9 @@ struct Diagnostic {
   std::uint32_t line = 0;
   std::uint32_t col = 0;
   std::string message;
+  /// Stable machine-readable id of the problem (e.g. "gcode.feed-zero"); empty when none.
+  /// Tests and front ends match on it, never on the wording.
+  std::string code;
 
   /// `file:line:col: error: message` (the parts that are unknown are left out).
   std::string format() const;
