@@ -9,13 +9,13 @@ using opencnc::Diagnostics;
 using opencnc::Severity;
 
 TEST(Diagnostic, FormatsFullPosition) {
-  Diagnostic d{Severity::Error, "part.ngc", 12, 5, "bad character 'q'"};
+  Diagnostic d{Severity::Error, "part.ngc", 12, 5, "bad character 'q'", "gcode.bad-character"};
   EXPECT_EQ(d.format(), "part.ngc:12:5: error: bad character 'q'");
 }
 
 TEST(Diagnostic, LeavesOutUnknownParts) {
-  EXPECT_EQ((Diagnostic{Severity::Warning, "a.ngc", 3, 0, "m"}).format(), "a.ngc:3: warning: m");
-  EXPECT_EQ((Diagnostic{Severity::Error, "", 0, 0, "m"}).format(), "error: m");
+  EXPECT_EQ((Diagnostic{Severity::Warning, "a.ngc", 3, 0, "m", ""}).format(), "a.ngc:3: warning: m");
+  EXPECT_EQ((Diagnostic{Severity::Error, "", 0, 0, "m", ""}).format(), "error: m");
 }
 
 TEST(Diagnostics, CountsBySeverity) {

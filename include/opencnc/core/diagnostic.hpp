@@ -29,11 +29,13 @@ struct Diagnostic {
 class Diagnostics {
  public:
   void add(Diagnostic d) { items_.push_back(std::move(d)); }
-  void error(std::string file, std::uint32_t line, std::uint32_t col, std::string message) {
-    add({Severity::Error, std::move(file), line, col, std::move(message)});
+  void error(std::string file, std::uint32_t line, std::uint32_t col, std::string message,
+             std::string code = {}) {
+    add({Severity::Error, std::move(file), line, col, std::move(message), std::move(code)});
   }
-  void warning(std::string file, std::uint32_t line, std::uint32_t col, std::string message) {
-    add({Severity::Warning, std::move(file), line, col, std::move(message)});
+  void warning(std::string file, std::uint32_t line, std::uint32_t col, std::string message,
+               std::string code = {}) {
+    add({Severity::Warning, std::move(file), line, col, std::move(message), std::move(code)});
   }
   bool has_errors() const noexcept;
   std::size_t error_count() const noexcept;
