@@ -7,8 +7,7 @@
 namespace opencnc::cli {
 
 void register_all(CLI::App& app, Registry& registry) {
-  (void)app;
-  (void)registry;
+  add_latency_command(app, registry);
 }
 
 }  // namespace opencnc::cli

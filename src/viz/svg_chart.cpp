@@ -87,6 +87,8 @@ class PanelRenderer {
     }
     xr_.pad();
     yr_.pad();
+    // On a log axis a count of 1 sits at log 0: lower the floor so single counts stay visible.
+    if (p_.log_y) yr_.lo -= 0.3;
     pw_ = w_ - kMarginLeft - kMarginRight;
     ph_ = h_ - kMarginTop - kMarginBottom;
     if (p_.equal_scale) {
@@ -109,7 +111,11 @@ class PanelRenderer {
 
   void axes(std::string& out) const {
     const auto xt = nice_ticks(xr_.lo, xr_.hi);
-    const auto yt = nice_ticks(yr_.lo, yr_.hi);
+    auto yt = nice_ticks(yr_.lo, yr_.hi);
+    if (p_.log_y) {  // decades only: 1, 10, 100 ... read at a glance
+      yt.clear();
+      for (double e = std::ceil(yr_.lo); e <= yr_.hi; e += 1) yt.push_back(e);
+    }
     const double xstep = xt.size() > 1 ? xt[1] - xt[0] : 1, ystep = yt.size() > 1 ? yt[1] - yt[0] : 1;
     for (double t : xt) {
       out += fmt::format("<line x1=\"{0:.1f}\" y1=\"{1}\" x2=\"{0:.1f}\" y2=\"{2}\" stroke=\"#eee\"/>"
