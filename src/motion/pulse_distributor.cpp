@@ -36,7 +36,9 @@ struct TreeShape {
   std::array<std::array<std::uint8_t, 2>, PulseDistributor::kMaxPairNodes> children{};
 };
 
-constexpr std::uint8_t leaf(int axis) { return static_cast<std::uint8_t>(axis | kLeafBit); }
+constexpr std::uint8_t leaf(int axis) {
+  return static_cast<std::uint8_t>(axis | kLeafBit);
+}
 
 // Appends the node over pairs [lo, hi) (pair p = leaves 2p and 2p+1) and returns its index. The
 // smaller half goes first, which gives the paper's layouts: six axes = a pair and a group of four,
@@ -66,7 +68,9 @@ constexpr StepCount round_share(StepCount done, StepCount part, StepCount whole)
   return static_cast<StepCount>((Int128{done} * part + whole / 2) / whole);
 }
 
-constexpr bool in_range(Int128 steps) noexcept { return steps >= -kMaxPulseSteps && steps <= kMaxPulseSteps; }
+constexpr bool in_range(Int128 steps) noexcept {
+  return steps >= -kMaxPulseSteps && steps <= kMaxPulseSteps;
+}
 
 }  // namespace
 
@@ -141,8 +145,9 @@ StepPulses PulseDistributor::step() noexcept {
 }
 
 std::uint16_t PulseDistributor::step_vector() noexcept {
-  std::uint8_t code = 0;  // the root
-  for (int level = 0; level < node_count_; ++level) {  // a root-to-leaf path is never longer
+  // Walk from the root (node 0) to a leaf; a path never has more nodes than the tree.
+  std::uint8_t code = 0;
+  for (int level = 0; level < node_count_; ++level) {
     PairNode& node = nodes_[code];
     if (node.deviation <= node.threshold) {
       node.deviation += node.second_total;

@@ -21,7 +21,9 @@ using opencnc::motion::StepCount;
 
 __extension__ using Int128 = __int128;
 
-Int128 abs128(Int128 v) { return v < 0 ? -v : v; }
+Int128 abs128(Int128 v) {
+  return v < 0 ? -v : v;
+}
 
 // mt19937_64 is fully specified by the standard and the mapping to ranges is ours, so the cases
 // are the same with every standard library.
@@ -48,7 +50,9 @@ std::vector<StepCount> random_move(Rng& rng, int axes, int max_bits) {
   return move;
 }
 
-StepCount length(StepCount inc) { return inc < 0 ? -inc : inc; }
+StepCount length(StepCount inc) {
+  return inc < 0 ? -inc : inc;
+}
 
 // One node on an axis's path from the root: the step total of the child that leads to the axis
 // and that of its sibling.
@@ -108,7 +112,8 @@ class ReferenceTree {
     nodes_.push_back({lo, mid, -1, -1, sum(lo, mid), sum(mid, hi), 0});
     const StepCount a = nodes_.back().a;
     const StepCount b = nodes_.back().b;
-    for (int i = lo; i < hi; ++i) paths_[static_cast<std::size_t>(i)].push_back(i < mid ? Level{a, b} : Level{b, a});
+    for (int i = lo; i < hi; ++i)
+      paths_[static_cast<std::size_t>(i)].push_back(i < mid ? Level{a, b} : Level{b, a});
     if (pairs > 1) {
       const int first = build(lo, mid);
       const int second = build(mid, hi);
@@ -123,13 +128,31 @@ class ReferenceTree {
   std::vector<std::vector<Level>> paths_;
 };
 
-// The documented bound for an axis of length L, in exact integers. After k of K feed steps the
-// axis is at p, the ideal line at L*k/K, and
+// |p - L*k/K| * K: how far an axis of length L at p after k of K feed steps is from the line.
+Int128 scaled_error(StepCount p, StepCount k, StepCount length, StepCount total) {
+  return abs128(Int128{p} * total - Int128{length} * k);
+}
+
+// Nodes on an axis's path whose sibling total is nonzero: each may add half a step.
+int active_depth(const std::vector<Level>& path) {
+  return static_cast<int>(
+      std::count_if(path.begin(), path.end(), [](const Level& l) { return l.sibling != 0; }));
+}
+
+// The corollary of the bound below: |p - L*k/K| <= depth/2 (<= 1 up to four axes). Exact for any move.
+bool within_depth_bound(StepCount p, StepCount k, StepCount length, StepCount total, int depth) {
+  return 2 * scaled_error(p, k, length, total) <= Int128{depth} * total;
+}
+
+// The documented bound for an axis of length L, in exact integers:
 //   |p - L*k/K| <= B = Σ over the nodes on its path whose sibling total is nonzero of L / (2*own).
-// Multiplying by 2*K*P, P = Π own: 2*|p*K - L*k| * P <= K * L * Σ P/own.
+// Multiplying by 2*K*P, P = Π own: 2*|p*K - L*k| * P <= K * L * Σ P/own. The products fit 128 bits
+// for moves of up to 2^20 feed steps.
 class VectorBound {
  public:
-  VectorBound(StepCount length, StepCount total, const std::vector<Level>& path) : length_(length), total_(total) {
+  VectorBound(StepCount length, StepCount total, const std::vector<Level>& path)
+      : length_(length), total_(total), depth_(active_depth(path)) {
+    EXPECT_LE(total, StepCount{1} << 20) << "too long for the exact bound in 128 bits";
     if (length == 0) return;  // B = 0: the axis never moves
     for (const Level& level : path) {
       if (level.sibling != 0) product_ *= level.own;
@@ -137,24 +160,23 @@ class VectorBound {
     Int128 sum = 0;
     for (const Level& level : path) {
       if (level.sibling != 0) sum += product_ / level.own;
-      if (level.sibling != 0) ++depth_;
     }
     rhs_ = Int128{total_} * length_ * sum;
   }
-  bool holds(StepCount p, StepCount k) const { return 2 * error(p, k) * product_ <= rhs_; }
-  // The corollary: each node adds at most half a step, so |p - L*k/K| <= depth/2 (<= 1 up to 4 axes).
-  bool holds_depth(StepCount p, StepCount k) const { return 2 * error(p, k) <= Int128{depth_} * total_; }
+  bool holds(StepCount p, StepCount k) const {
+    return 2 * scaled_error(p, k, length_, total_) * product_ <= rhs_;
+  }
+  bool holds_depth(StepCount p, StepCount k) const {
+    return within_depth_bound(p, k, length_, total_, depth_);
+  }
   int depth() const { return depth_; }
 
  private:
-  // |p - L*k/K| * K
-  Int128 error(StepCount p, StepCount k) const { return abs128(Int128{p} * total_ - Int128{length_} * k); }
-
   StepCount length_;
   StepCount total_;
+  int depth_;
   Int128 product_ = 1;
   Int128 rhs_ = 0;
-  int depth_ = 0;
 };
 
 // Steps a whole vector-method move and checks every feed step against the reference tree and the
@@ -232,7 +254,8 @@ void check_dda_move(const std::vector<StepCount>& move) {
       const StepCount len = length(move[i]);
       const StepCount p = length(d.position(i));
       const Int128 ideal = Int128{k} * len;
-      if (p != static_cast<StepCount>((ideal + longest / 2) / longest) || 2 * abs128(Int128{p} * longest - ideal) > longest) {
+      if (p != static_cast<StepCount>((ideal + longest / 2) / longest) ||
+          2 * scaled_error(p, k, len, longest) > longest) {
         ADD_FAILURE() << "axis " << i << " off at feed step " << k;
         return;
       }
@@ -263,12 +286,19 @@ void check_advance_matches_stepping(Rng& rng, PulseMethod method, const std::vec
   for (int op = 0; op < 40 && !mixed.done(); ++op) {
     const StepCount before = mixed.feed_steps_done();
     switch (rng.below(4)) {
-      case 0: ASSERT_EQ(mixed.step(), stepped.step()); break;
-      case 1: mixed.advance(static_cast<StepCount>(rng.below(static_cast<std::uint64_t>(total) / 4 + 2))); break;
-      case 2: mixed.advance_to(static_cast<StepCount>(rng.below(static_cast<std::uint64_t>(total) + 1))); break;
+      case 0:
+        ASSERT_EQ(mixed.step(), stepped.step());
+        break;
+      case 1:
+        mixed.advance(static_cast<StepCount>(rng.below(static_cast<std::uint64_t>(total) / 4 + 2)));
+        break;
+      case 2:
+        mixed.advance_to(static_cast<StepCount>(rng.below(static_cast<std::uint64_t>(total) + 1)));
+        break;
       default: {
         const auto den = static_cast<StepCount>(1 + rng.below(1000));
-        mixed.advance_to_fraction(static_cast<StepCount>(rng.below(static_cast<std::uint64_t>(den) + 1)), den);
+        mixed.advance_to_fraction(static_cast<StepCount>(rng.below(static_cast<std::uint64_t>(den) + 1)),
+                                  den);
       }
     }
     ASSERT_GE(mixed.feed_steps_done(), before);
@@ -312,10 +342,10 @@ TEST(PulseDistributorProperty, HugeMovesStayExact) {
         for (int i = 0; i < static_cast<int>(move.size()); ++i) {
           const StepCount p = length(stepped.position(i));
           ASSERT_EQ(jumped.position(i), stepped.position(i));
-          const VectorBound bound(length(move[i]), total, ref.path(i));
+          const StepCount len = length(move[i]);
           const bool within = method == PulseMethod::Vector
-                                  ? bound.holds_depth(p, k)
-                                  : 2 * abs128(Int128{p} * total - Int128{length(move[i])} * k) <= total;
+                                  ? within_depth_bound(p, k, len, total, active_depth(ref.path(i)))
+                                  : 2 * scaled_error(p, k, len, total) <= total;
           ASSERT_TRUE(within) << "axis " << i << " at feed step " << k;
         }
       }

@@ -136,7 +136,7 @@ TEST(PulseDistributor, FeedStepTotals) {
   const std::vector<StepCount> move{4, -9, 0, 2, -1};
   ASSERT_EQ(v.start(move), PulseStatus::Ok);
   ASSERT_EQ(dda.start(move), PulseStatus::Ok);
-  EXPECT_EQ(v.feed_steps_total(), 16);  // one axis per feed step: Σ|ai|
+  EXPECT_EQ(v.feed_steps_total(), 16);   // one axis per feed step: Σ|ai|
   EXPECT_EQ(dda.feed_steps_total(), 9);  // one DDA iteration per feed step: max|ai|
   EXPECT_EQ(v.axis_count(), 5);
 }

@@ -89,7 +89,6 @@ class PulseDistributor {
   static constexpr int kMaxPairNodes = kMaxLeaves - 1;
 
  private:
-
   // One 2-axis least-deviation interpolator of the vector method. Its children are axes or
   // other nodes; x and y count the feed steps each child has taken.
   struct PairNode {
@@ -115,11 +114,11 @@ class PulseDistributor {
   std::uint16_t negative_mask_ = 0;
   StepCount total_ = 0;
   StepCount done_ = 0;
-  std::array<StepCount, kMaxPulseAxes> origin_{};    // position at the start of the move
-  std::array<StepCount, kMaxLeaves> length_{};       // |increment|; slot N is the zero pad axis
-  std::array<StepCount, kMaxLeaves> progress_{};     // steps taken, toward |increment|
+  std::array<StepCount, kMaxPulseAxes> origin_{};       // position at the start of the move
+  std::array<StepCount, kMaxLeaves> length_{};          // |increment|; slot N is the zero pad axis
+  std::array<StepCount, kMaxLeaves> progress_{};        // steps taken, toward |increment|
   std::array<StepCount, kMaxPulseAxes> accumulator_{};  // Dda: remainder of k*|ai| + max/2
-  std::array<PairNode, kMaxPairNodes> nodes_{};      // Vector: pair tree in preorder, root first
+  std::array<PairNode, kMaxPairNodes> nodes_{};         // Vector: pair tree in preorder, root first
 };
 
 }  // namespace opencnc::motion
