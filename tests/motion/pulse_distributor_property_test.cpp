@@ -214,6 +214,25 @@ void check_vector_move(const std::vector<StepCount>& move) {
   EXPECT_EQ(d.step().step_mask, 0u);
 }
 
+// The worst depth bound per axis count, as the table in docs/pulse-distribution.md gives it:
+// slot by slot, d/2 with every axis moving.
+TEST(PulseDistributorProperty, TreeDepthsMatchTheDocumentedTable) {
+  const std::vector<std::vector<int>> depths{{0},
+                                             {1, 1},
+                                             {2, 2, 1},
+                                             {2, 2, 2, 2},
+                                             {2, 2, 3, 3, 2},
+                                             {2, 2, 3, 3, 3, 3},
+                                             {3, 3, 3, 3, 3, 3, 2},
+                                             {3, 3, 3, 3, 3, 3, 3, 3},
+                                             {3, 3, 3, 3, 3, 3, 4, 4, 3}};
+  for (int axes = 1; axes <= kMaxPulseAxes; ++axes) {
+    const ReferenceTree ref(std::vector<StepCount>(static_cast<std::size_t>(axes), 1));
+    for (int i = 0; i < axes; ++i)
+      EXPECT_EQ(active_depth(ref.path(i)), depths[axes - 1][i]) << axes << " axes, slot " << i;
+  }
+}
+
 TEST(PulseDistributorProperty, VectorIsLeastDeviationWithinBound) {
   Rng rng(20240611);
   for (int c = 0; c < 20'000; ++c) {
@@ -247,6 +266,7 @@ void check_dda_move(const std::vector<StepCount>& move) {
   EXPECT_EQ(d.feed_steps_total(), longest) << "one DDA iteration per feed step";
   StepCount pulses = 0;
   for (StepCount k = 1; k <= longest; ++k) {
+    EXPECT_FALSE(d.done());
     const unsigned mask = d.step().step_mask;
     pulses += std::popcount(mask);
     EXPECT_TRUE(mask & (1u << major)) << "the longest axis steps on every feed step";

@@ -73,7 +73,7 @@ class PulseDistributor {
   /// progress carries on relative to it.
   PulseStatus set_position(int axis, StepCount steps) noexcept;
 
-  /// Any thread that owns a consistent copy; real-time safe. Accessors.
+  /// Owner thread (or any reader of a consistent copy); real-time safe. Accessors.
   PulseMethod method() const noexcept { return method_; }
   int axis_count() const noexcept { return axis_count_; }
   /// Feed steps of the current move: Σ|ai| for Vector, max|ai| for Dda.
