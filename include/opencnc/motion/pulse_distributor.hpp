@@ -117,7 +117,7 @@ class PulseDistributor {
   std::array<StepCount, kMaxPulseAxes> origin_{};       // position at the start of the move
   std::array<StepCount, kMaxLeaves> length_{};          // |increment|; slot N is the zero pad axis
   std::array<StepCount, kMaxLeaves> progress_{};        // steps taken, toward |increment|
-  std::array<StepCount, kMaxPulseAxes> accumulator_{};  // Dda: remainder of k*|ai| + max/2
+  std::array<StepCount, kMaxPulseAxes> accumulator_{};  // Dda: (k*|ai| + floor(n/2)) mod n, n = max|ai|
   std::array<PairNode, kMaxPairNodes> nodes_{};         // Vector: pair tree in preorder, root first
 };
 
