@@ -20,7 +20,11 @@ double units_per_si(bool rotary) { return rotary ? 180.0 / std::numbers::pi : 10
 
 }  // namespace
 
-PitchErrorTable::PitchErrorTable(std::vector<PitchPoint> points) : points_(std::move(points)) {}
+PitchErrorTable::PitchErrorTable(std::vector<PitchPoint> points) : points_(std::move(points)) {
+  for (std::size_t i = 0; i + 1 < points_.size(); ++i) {
+    slopes_.push_back((points_[i + 1].error - points_[i].error) / (points_[i + 1].position - points_[i].position));
+  }
+}
 
 double PitchErrorTable::at(double s) const noexcept {
   const std::size_t n = points_.size();
@@ -31,8 +35,7 @@ double PitchErrorTable::at(double s) const noexcept {
   while (segment_ > 0 && s < points_[segment_].position) --segment_;
   while (segment_ + 2 < n && s >= points_[segment_ + 1].position) ++segment_;
   const PitchPoint& a = points_[segment_];
-  const PitchPoint& b = points_[segment_ + 1];
-  return a.error + (b.error - a.error) * (s - a.position) / (b.position - a.position);
+  return a.error + slopes_[segment_] * (s - a.position);
 }
 
 SimJoint::SimJoint(const SimJointConfig& config, double servo_period_s, int substeps)
@@ -43,6 +46,7 @@ SimJoint::SimJoint(const SimJointConfig& config, double servo_period_s, int subs
       home_(config.switches.home, config.switches.hysteresis, config.switches.noise),
       decel_(config.switches.decel, config.switches.hysteresis, config.switches.noise),
       h_(servo_period_s / substeps),
+      unit_per_count_(1.0 / config.counts_per_unit),
       substeps_(substeps),
       period_s_(servo_period_s) {
   const SimJointModel& m = config.model;
@@ -91,13 +95,27 @@ double SimJoint::feedback_raw() const noexcept {
 }
 
 // An incremental encoder counts whole lines: floor(x · counts_per_unit). The truncating cast
-// plus a correction is floor() without a libm call on baseline x86-64.
-double SimJoint::quantise(double position) const noexcept {
+// plus a correction is floor() without a libm call on baseline x86-64. Positions beyond
+// ±2^62 counts (or NaN) are clamped rather than overflowing the cast.
+std::int64_t SimJoint::counts(double position) const noexcept {
+  constexpr double kLimit = 0x1.0p62;
   const double q = position * config_.counts_per_unit;
-  if (!(std::abs(q) < 0x1.0p62)) return position;  // out of range or NaN: leave it alone
-  auto counts = static_cast<std::int64_t>(q);
-  if (static_cast<double>(counts) > q) --counts;
-  return static_cast<double>(counts) / config_.counts_per_unit;
+  if (!(q > -kLimit)) return -static_cast<std::int64_t>(kLimit);
+  if (!(q < kLimit)) return static_cast<std::int64_t>(kLimit);
+  auto c = static_cast<std::int64_t>(q);
+  if (static_cast<double>(c) > q) --c;
+  return c;
+}
+
+/// The encoder reading as reported: counts / counts_per_unit, correctly rounded.
+double SimJoint::quantise(double position) const noexcept {
+  return static_cast<double>(counts(position)) / config_.counts_per_unit;
+}
+
+/// The same reading for the drive's own loop, by a multiplication: it differs from quantise()
+/// by at most an ulp and keeps the division off each sub-step's dependency chain.
+double SimJoint::quantise_fast(double position) const noexcept {
+  return static_cast<double>(counts(position)) * unit_per_count_;
 }
 
 void SimJoint::begin_period(const JointOutputs& cmd, bool powered, double external_effort) noexcept {
@@ -129,7 +147,7 @@ void SimJoint::substep(int i) noexcept {
 void SimJoint::servo_substep(double t_s) noexcept {
   if (powered_) {
     const SimJointModel& m = config_.model;
-    const double error = cmd_.position + cmd_.velocity_ff * t_s - quantise(feedback_raw());
+    const double error = cmd_.position + cmd_.velocity_ff * t_s - quantise_fast(feedback_raw());
     double v_ref = m.feed_forward * cmd_.velocity_ff + m.position_gain * error + m.position_integral * position_integral_;
     if (m.velocity_limit > 0 && std::abs(v_ref) > m.velocity_limit) {
       v_ref = std::copysign(m.velocity_limit, v_ref);

@@ -25,6 +25,7 @@ class PitchErrorTable {
 
  private:
   std::vector<PitchPoint> points_;
+  std::vector<double> slopes_;  // error change per unit along each segment
   mutable std::size_t segment_ = 0;  // points_[segment_] ≤ s < points_[segment_ + 1] last time
 };
 
@@ -65,7 +66,9 @@ class SimJoint {
 
  private:
   double feedback_raw() const noexcept;
+  std::int64_t counts(double position) const noexcept;
   double quantise(double position) const noexcept;
+  double quantise_fast(double position) const noexcept;
   void servo_substep(double t_s) noexcept;
   void stepper_substep(int i) noexcept;
   void integrate_mechanics(double drive_effort) noexcept;
@@ -77,6 +80,7 @@ class SimJoint {
   SimSwitch limit_neg_, limit_pos_, home_, decel_;
   // Derived constants.
   double h_ = 0;              // sub-step, s
+  double unit_per_count_ = 0;  // 1 / counts_per_unit
   int substeps_ = 1;
   double period_s_ = 0;
   double accel_per_effort_ = 0;  // (units/s²) per N: scale / inertia

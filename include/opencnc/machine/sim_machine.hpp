@@ -52,7 +52,7 @@ class SimMachine final : public MachineIO {
   const MachineOutputs& last_outputs() const noexcept { return outputs_; }
   /// True while the drives have power: e-stop chain closed, released, DC link above minimum.
   bool drives_powered() const noexcept;
-  double ups_remaining_s() const noexcept { return ups_remaining_s_; }
+  double ups_remaining_s() const noexcept { return static_cast<double>(ups_periods_left_) * config_.servo_period_s; }
 
  private:
   void advance() noexcept;
@@ -77,7 +77,8 @@ class SimMachine final : public MachineIO {
   std::array<double, kAnalogChannels> analog_in_{};
   // Power supply: DC link, UPS, and the undervoltage fault each drive latches.
   double dc_link_v_ = 0;
-  double ups_remaining_s_ = 0;
+  std::uint64_t ups_periods_left_ = 0;
+  bool on_battery_ = false;  // the UPS held the link during the last period
   bool undervoltage_ = false;
   std::array<bool, kMaxJoints> undervoltage_fault_{};
   // Auxiliary timers, in whole periods, and the periods each one needs.
