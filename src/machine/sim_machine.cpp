@@ -46,7 +46,7 @@ MachineCapabilities SimMachine::capabilities() const noexcept {
   for (int j = 0; j < config_.joint_count; ++j) c.joints[static_cast<std::size_t>(j)] = joint(j).capabilities();
   c.spindle = config_.spindle;
   c.spindle_encoder = config_.spindle && config_.spindle_config.encoder_counts_per_rev > 0;
-  c.spindle_orient = config_.spindle;
+  c.spindle_orient = config_.spindle && config_.spindle_config.orient;
   c.power_monitor = config_.power_monitor;
   c.ups = config_.power_monitor && config_.power.ups;
   c.probe = config_.probe.joint >= 0;

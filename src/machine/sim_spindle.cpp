@@ -39,7 +39,7 @@ double SimSpindle::orient_target_speed() const noexcept {
 }
 
 void SimSpindle::substep() noexcept {
-  const double target = powered_ && cmd_.orient ? orient_target_speed() : target_rps_;
+  const double target = orienting() ? orient_target_speed() : target_rps_;
   const double next = speed_rps_ + std::clamp(target - speed_rps_, -max_step_rps_, max_step_rps_);
   position_rev_ += 0.5 * (speed_rps_ + next) * h_;
   speed_rps_ = next;
@@ -63,10 +63,10 @@ void SimSpindle::sample(SpindleInputs& in) const noexcept {
   in.index_count = cpr > 0 ? index_count_ : 0;
   in.index_position_rev = cpr > 0 ? index_position_rev_ : 0.0;
   const double cmd_rpm = target_rps_ * 60.0;
-  in.at_speed = powered_ && !cmd_.orient && std::abs(in.speed_rpm - cmd_rpm) <= config_.at_speed_tolerance * std::abs(cmd_rpm);
+  in.at_speed = powered_ && !orienting() && std::abs(in.speed_rpm - cmd_rpm) <= config_.at_speed_tolerance * std::abs(cmd_rpm);
   double error_deg = cmd_.orient_angle_deg - 360.0 * (position_rev_ - std::floor(position_rev_));
   error_deg -= 360.0 * std::floor(error_deg / 360.0 + 0.5);
-  in.orient_done = powered_ && cmd_.orient && std::abs(error_deg) <= config_.orient_tolerance_deg &&
+  in.orient_done = orienting() && std::abs(error_deg) <= config_.orient_tolerance_deg &&
                    std::abs(speed_rps_) * 360.0 * period_s_ <= config_.orient_tolerance_deg;
   in.fault = fault_;
 }

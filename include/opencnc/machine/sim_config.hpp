@@ -83,6 +83,7 @@ struct SimSpindleConfig {
   double acceleration_rpm_s = 2000;  ///< ramp limit of the spindle drive
   double encoder_counts_per_rev = 0;  ///< 0 = no encoder
   double at_speed_tolerance = 0.02;  ///< at_speed when |speed − command| ≤ this × command
+  bool orient = true;                 ///< the drive can orient (M19); else requests are ignored
   double orient_rpm = 60;             ///< speed limit while orienting
   double orient_tolerance_deg = 0.5;  ///< orient_done within this angle
 };

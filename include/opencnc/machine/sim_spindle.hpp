@@ -30,6 +30,7 @@ class SimSpindle {
   double speed_rps() const noexcept { return speed_rps_; }        ///< true speed, rev/s
 
  private:
+  bool orienting() const noexcept { return powered_ && cmd_.orient && config_.orient; }
   double orient_target_speed() const noexcept;
 
   SimSpindleConfig config_{};
