@@ -27,4 +27,6 @@ class Registry {
 /// Adds every subcommand to `app`; each callback stores its exit code in `registry`.
 void register_all(CLI::App& app, Registry& registry);
 
+void register_profile(CLI::App& app, Registry& registry);  ///< cmd_profile.cpp
+
 }  // namespace opencnc::cli
