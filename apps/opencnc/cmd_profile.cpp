@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // `opencnc profile`: check a machine profile, summarise it, and move one simulated axis.
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <CLI/CLI.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -30,9 +30,10 @@ void print_summary(const config::MachineProfile& p) {
   fmt::print("{}: {} axes, servo period {} s, sim {} sub-steps\n", p.name, p.axes.size(), p.servo_period_s,
              p.sim_substeps);
   for (const config::AxisProfile& a : p.axes) {
-    fmt::print("  {} joint {}: {} {}, v {} a {} j {}, limits [{}, {}], {} counts/unit\n", letter(a.axis), a.joint,
-               a.rotary ? "rotary" : "linear", a.drive == machine::JointDrive::Servo ? "servo" : "stepper",
-               a.max_velocity, a.max_acceleration, a.max_jerk, a.min_limit, a.max_limit, a.counts_per_unit);
+    fmt::print("  {} joint {}: {} {}, v {} a {} j {}, limits [{}, {}], {} counts/unit\n", letter(a.axis),
+               a.joint, a.rotary ? "rotary" : "linear",
+               a.drive == machine::JointDrive::Servo ? "servo" : "stepper", a.max_velocity,
+               a.max_acceleration, a.max_jerk, a.min_limit, a.max_limit, a.counts_per_unit);
   }
   if (p.spindle.present) fmt::print("  spindle: {}–{} rpm\n", p.spindle.min_rpm, p.spindle.max_rpm);
 }
@@ -74,7 +75,8 @@ int run_move(const config::MachineProfile& p, const ProfileOptions& o) {
   machine::MachineOutputs out;
   out.estop_release = true;
   for (const config::AxisProfile& each : p.axes) {
-    out.joints[static_cast<std::size_t>(each.joint)] = {in.joints[static_cast<std::size_t>(each.joint)].position, 0, 0, true};
+    out.joints[static_cast<std::size_t>(each.joint)] = {
+        in.joints[static_cast<std::size_t>(each.joint)].position, 0, 0, true};
   }
   const auto j = static_cast<std::size_t>(a->joint);
   const double start = in.joints[j].position, sign = distance < 0 ? -1 : 1;
@@ -100,13 +102,15 @@ int run_move(const config::MachineProfile& p, const ProfileOptions& o) {
     if (std::abs(error) > worst) worst = std::abs(error), worst_t = t;
     if (csv) {
       csv << fmt::format("{:.4f},{:.6f},{:.6f},{:.6f},{:.6f},{:.3f}\n", t, out.joints[j].position,
-                         in.joints[j].position, m.joint(a->joint).table_position(), error, in.joints[j].effort);
+                         in.joints[j].position, m.joint(a->joint).table_position(), error,
+                         in.joints[j].effort);
     }
     m.write(out);
   }
   m.read(in);
-  fmt::print("{} {:+} in {:.3f} s: max following error {:.4f} at t = {:.3f} s; final error {:.4f}\n", letter(a->axis),
-             distance, move.duration(), worst, worst_t, out.joints[j].position - in.joints[j].position);
+  fmt::print("{} {:+} in {:.3f} s: max following error {:.4f} at t = {:.3f} s; final error {:.4f}\n",
+             letter(a->axis), distance, move.duration(), worst, worst_t,
+             out.joints[j].position - in.joints[j].position);
   return kExitOk;
 }
 
@@ -114,7 +118,8 @@ int run_profile(const ProfileOptions& o) {
   const config::ProfileLoad load = config::load_profile(o.file, o.sets);
   for (const Diagnostic& d : load.diagnostics.items()) fmt::print(stderr, "{}\n", d.format());
   if (!load.ok()) {
-    const bool unreadable = !load.diagnostics.items().empty() && load.diagnostics.items()[0].code == "config.file";
+    const bool unreadable =
+        !load.diagnostics.items().empty() && load.diagnostics.items()[0].code == "config.file";
     return unreadable ? kExitUsage : kExitProgram;
   }
   print_summary(*load.profile);
@@ -125,13 +130,15 @@ int run_profile(const ProfileOptions& o) {
 
 void register_profile(CLI::App& app, Registry& registry) {
   auto opts = std::make_shared<ProfileOptions>();
-  CLI::App* cmd = app.add_subcommand("profile", "Check a machine profile (TOML) and try its simulated machine");
+  CLI::App* cmd =
+      app.add_subcommand("profile", "Check a machine profile (TOML) and try its simulated machine");
   cmd->add_option("file", opts->file, "Machine profile, e.g. configs/mill-3axis.toml")->required();
   cmd->add_option("--set", opts->sets, "Override a key: --set axis.x.max_velocity=200 (repeatable)")
       ->expected(1)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   cmd->add_option("--move", opts->move, "Move one simulated axis from its start, e.g. --move x=100");
-  cmd->add_option("--csv", opts->csv, "With --move: write t, command, feedback, table, error, effort per period");
+  cmd->add_option("--csv", opts->csv,
+                  "With --move: write t, command, feedback, table, error, effort per period");
   cmd->callback([opts, &registry] { registry.set_result(run_profile(*opts)); });
 }
 

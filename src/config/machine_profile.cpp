@@ -36,7 +36,8 @@ machine::SimMachineConfig sim_machine_config(const MachineProfile& profile) {
   c.power_monitor = profile.power.monitor;
   c.power = profile.power.sim;
   if (profile.probe.present && profile.probe.sim_joint >= 0) {
-    c.probe = {profile.probe.sim_joint, profile.probe.sim_trip, profile.probe.sim_hysteresis, profile.probe.sim_noise};
+    c.probe = {profile.probe.sim_joint, profile.probe.sim_trip, profile.probe.sim_hysteresis,
+               profile.probe.sim_noise};
   }
   c.tool_changer = profile.tool_changer_sim;
   c.process = profile.process;

@@ -17,7 +17,8 @@ constexpr std::string_view kSource = "--set";
 bool same_letters(std::string_view a, std::string_view b) {
   if (a.size() != b.size()) return false;
   for (std::size_t i = 0; i < a.size(); ++i) {
-    if (std::tolower(static_cast<unsigned char>(a[i])) != std::tolower(static_cast<unsigned char>(b[i]))) return false;
+    if (std::tolower(static_cast<unsigned char>(a[i])) != std::tolower(static_cast<unsigned char>(b[i])))
+      return false;
   }
   return true;
 }
@@ -34,7 +35,10 @@ std::string resolve_key(const toml::table& table, std::string_view key, bool fol
 }
 
 void merge(toml::table& into, toml::table& from, bool at_root, bool fold_case) {
-  for (auto&& [key, node] : from) {
+  for (auto&& entry : from) {
+    // Named references, not a structured binding: lambdas capture them in every compiler.
+    const toml::key& key = entry.first;
+    toml::node& node = entry.second;
     const std::string target = resolve_key(into, key.str(), fold_case);
     toml::node* existing = into.get(target);
     if (existing != nullptr && existing->is_table() && node.is_table()) {
@@ -102,10 +106,13 @@ bool apply_overrides(toml::table& root, std::span<const std::string> overrides, 
     // A bare word (fanuc, stepper, a path) is a string; what looks like TOML stays an error.
     const std::string_view value = std::string_view(text).substr(eq + 1);
     const auto start = value.find_first_not_of(" \t");
-    const bool bare = start != std::string_view::npos && std::string_view("[{\"'").find(value[start]) == std::string_view::npos;
-    if (!doc && bare) doc = parse_line(quoted(std::string_view(text).substr(0, eq), value.substr(start)), line, nullptr);
+    const bool bare = start != std::string_view::npos &&
+                      std::string_view("[{\"'").find(value[start]) == std::string_view::npos;
+    if (!doc && bare)
+      doc = parse_line(quoted(std::string_view(text).substr(0, eq), value.substr(start)), line, nullptr);
     if (!doc) {
-      reporter.error(&first.where, fmt::format("override '{}' is not valid TOML: {}", text, first.description),
+      reporter.error(&first.where,
+                     fmt::format("override '{}' is not valid TOML: {}", text, first.description),
                      "config.override");
       ok = false;
       continue;

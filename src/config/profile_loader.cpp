@@ -30,16 +30,18 @@ void read_identity(Section& top, MachineProfile& p) {
   p.description = top.string("description").value_or("");
   p.servo_period_s = top.number_or("servo_period_s", p.servo_period_s, Bound::Positive);
   if (p.servo_period_s < 1e-5 || p.servo_period_s > 0.1) {
-    top.error("servo_period_s", fmt::format("servo_period_s must be between 0.00001 and 0.1 s (it is {})",
-                                            detail::show(p.servo_period_s)), "config.range");
+    top.error("servo_period_s",
+              fmt::format("servo_period_s must be between 0.00001 and 0.1 s (it is {})",
+                          detail::show(p.servo_period_s)),
+              "config.range");
     p.servo_period_s = 0.001;  // go on checking the rest against a sane period
   }
 }
 
 MachineProfile read_profile(const toml::table& root, Reporter& r, const std::filesystem::path& base_dir) {
   Section top(root, "",
-              {"name", "description", "servo_period_s", "axis", "spindle", "power", "probe", "tool_changer", "process",
-               "io", "interpreter", "planner", "sim"},
+              {"name", "description", "servo_period_s", "axis", "spindle", "power", "probe", "tool_changer",
+               "process", "io", "interpreter", "planner", "sim"},
               r);
   MachineProfile p;
   read_identity(top, p);
@@ -58,8 +60,8 @@ MachineProfile read_profile(const toml::table& root, Reporter& r, const std::fil
 
 }  // namespace
 
-ProfileLoad parse_profile(std::string_view text, std::string_view source_name, std::span<const std::string> overrides,
-                          const std::filesystem::path& base_dir) {
+ProfileLoad parse_profile(std::string_view text, std::string_view source_name,
+                          std::span<const std::string> overrides, const std::filesystem::path& base_dir) {
   ProfileLoad out;
   Reporter r(out.diagnostics, std::string(source_name));
   toml::table root;
@@ -81,8 +83,8 @@ ProfileLoad load_profile(const std::filesystem::path& file, std::span<const std:
   std::ifstream in(file, std::ios::binary);
   if (!in) {
     ProfileLoad out;
-    out.diagnostics.error(file.string(), 0, 0, fmt::format("cannot read the profile: {}", std::strerror(errno)),
-                          "config.file");
+    out.diagnostics.error(file.string(), 0, 0,
+                          fmt::format("cannot read the profile: {}", std::strerror(errno)), "config.file");
     return out;
   }
   std::ostringstream text;

@@ -33,17 +33,26 @@ void Reporter::warning(const toml::source_region* at, std::string message, std::
 
 std::string_view type_name(const toml::node& node) noexcept {
   switch (node.type()) {
-    case toml::node_type::table: return "a table";
-    case toml::node_type::array: return "an array";
-    case toml::node_type::string: return "a string";
-    case toml::node_type::integer: return "an integer";
-    case toml::node_type::floating_point: return "a number";
-    case toml::node_type::boolean: return "a boolean";
-    default: return "a date or time";
+    case toml::node_type::table:
+      return "a table";
+    case toml::node_type::array:
+      return "an array";
+    case toml::node_type::string:
+      return "a string";
+    case toml::node_type::integer:
+      return "an integer";
+    case toml::node_type::floating_point:
+      return "a number";
+    case toml::node_type::boolean:
+      return "a boolean";
+    default:
+      return "a date or time";
   }
 }
 
-std::string show(double value) { return fmt::format("{}", value); }
+std::string show(double value) {
+  return fmt::format("{}", value);
+}
 
 Section::Section(const toml::table& table, std::string path, std::initializer_list<std::string_view> allowed,
                  Reporter& reporter)
@@ -53,7 +62,8 @@ Section::Section(const toml::table& table, std::string path, std::initializer_li
     std::string list;
     for (std::string_view a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
     const std::string where = path_.empty() ? "at the top level" : "in [" + path_ + "]";
-    reporter_.error(&key.source(), fmt::format("unknown key '{}' {}; allowed keys: {}", key.str(), where, list),
+    reporter_.error(&key.source(),
+                    fmt::format("unknown key '{}' {}; allowed keys: {}", key.str(), where, list),
                     "config.unknown-key");
   }
 }

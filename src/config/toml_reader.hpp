@@ -19,7 +19,8 @@ namespace opencnc::config::detail {
 /// Collects diagnostics, placing each at a TOML source position.
 class Reporter {
  public:
-  Reporter(Diagnostics& out, std::string fallback_file) : out_(out), fallback_file_(std::move(fallback_file)) {}
+  Reporter(Diagnostics& out, std::string fallback_file)
+      : out_(out), fallback_file_(std::move(fallback_file)) {}
 
   /// `at` may be null (no position known).
   void error(const toml::source_region* at, std::string message, std::string code);

@@ -16,13 +16,16 @@ constexpr double kTwoPi = 2.0 * std::numbers::pi;
 
 /// Axis units per SI unit: mm per m for linear joints, degrees per radian for rotary ones.
 /// Accelerations come out of F/m in SI and are wanted in axis units.
-double units_per_si(bool rotary) { return rotary ? 180.0 / std::numbers::pi : 1000.0; }
+double units_per_si(bool rotary) {
+  return rotary ? 180.0 / std::numbers::pi : 1000.0;
+}
 
 }  // namespace
 
 PitchErrorTable::PitchErrorTable(std::vector<PitchPoint> points) : points_(std::move(points)) {
   for (std::size_t i = 0; i + 1 < points_.size(); ++i) {
-    slopes_.push_back((points_[i + 1].error - points_[i].error) / (points_[i + 1].position - points_[i].position));
+    slopes_.push_back((points_[i + 1].error - points_[i].error) /
+                      (points_[i + 1].position - points_[i].position));
   }
 }
 
@@ -78,19 +81,22 @@ JointCapabilities SimJoint::capabilities() const noexcept {
   JointCapabilities c;
   c.drive = config_.drive;
   const SwitchLayout& s = config_.switches;
-  c.switches = static_cast<std::uint8_t>((s.limit_neg.present ? kSwitchLimitNeg : 0) |
-                                         (s.limit_pos.present ? kSwitchLimitPos : 0) |
-                                         (s.home.present ? kSwitchHome : 0) | (s.decel.present ? kSwitchDecel : 0));
+  c.switches = static_cast<std::uint8_t>(
+      (s.limit_neg.present ? kSwitchLimitNeg : 0) | (s.limit_pos.present ? kSwitchLimitPos : 0) |
+      (s.home.present ? kSwitchHome : 0) | (s.decel.present ? kSwitchDecel : 0));
   const bool servo = config_.drive == JointDrive::Servo;
   c.index = servo && config_.model.index_spacing > 0;
   c.effort = servo;
   return c;
 }
 
-double SimJoint::table_position() const noexcept { return screw_ + pitch_.at(screw_); }
+double SimJoint::table_position() const noexcept {
+  return screw_ + pitch_.at(screw_);
+}
 
 double SimJoint::feedback_raw() const noexcept {
-  if (config_.drive == JointDrive::Stepper) return static_cast<double>(steps_emitted_) / config_.counts_per_unit;
+  if (config_.drive == JointDrive::Stepper)
+    return static_cast<double>(steps_emitted_) / config_.counts_per_unit;
   return config_.model.feedback == FeedbackSource::Table ? table_position() : motor_;
 }
 
@@ -148,7 +154,8 @@ void SimJoint::servo_substep(double t_s) noexcept {
   if (powered_) {
     const SimJointModel& m = config_.model;
     const double error = cmd_.position + cmd_.velocity_ff * t_s - quantise_fast(feedback_raw());
-    double v_ref = m.feed_forward * cmd_.velocity_ff + m.position_gain * error + m.position_integral * position_integral_;
+    double v_ref = m.feed_forward * cmd_.velocity_ff + m.position_gain * error +
+                   m.position_integral * position_integral_;
     if (m.velocity_limit > 0 && std::abs(v_ref) > m.velocity_limit) {
       v_ref = std::copysign(m.velocity_limit, v_ref);
     } else {
@@ -211,7 +218,8 @@ void SimJoint::stepper_substep(int i) noexcept {
 
 void SimJoint::end_period() noexcept {
   if (config_.drive == JointDrive::Stepper) {
-    velocity_ = static_cast<double>(steps_emitted_ - steps_at_period_start_) / config_.counts_per_unit / period_s_;
+    velocity_ =
+        static_cast<double>(steps_emitted_ - steps_at_period_start_) / config_.counts_per_unit / period_s_;
   }
   if (config_.drive == JointDrive::Servo && config_.model.index_spacing > 0) {
     update_index(feedback_at_period_start_, feedback_raw());

@@ -21,7 +21,9 @@ std::uint64_t periods_for(double delay_s, double period_s) {
   return std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::max(0.0, n)));
 }
 
-std::uint64_t low_bits(int n) { return n >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << n) - 1; }
+std::uint64_t low_bits(int n) {
+  return n >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << n) - 1;
+}
 
 }  // namespace
 
@@ -31,9 +33,13 @@ SimMachine::SimMachine(const SimMachineConfig& config) : config_(config), rng_(c
     joints_[uj] = SimJoint(config.joints[uj], config.servo_period_s, config.substeps);
   }
   if (config.spindle) spindle_ = SimSpindle(config.spindle_config, config.servo_period_s, config.substeps);
-  if (config.probe.joint >= 0) probe_ = SimSwitch(config.probe.trip, config.probe.hysteresis, config.probe.noise);
+  if (config.probe.joint >= 0)
+    probe_ = SimSwitch(config.probe.trip, config.probe.hysteresis, config.probe.noise);
   dc_link_v_ = config.power.dc_link_nominal_v;
-  ups_periods_left_ = config.power.ups ? static_cast<std::uint64_t>(std::llround(config.power.ups_runtime_s / config.servo_period_s)) : 0;
+  ups_periods_left_ =
+      config.power.ups
+          ? static_cast<std::uint64_t>(std::llround(config.power.ups_runtime_s / config.servo_period_s))
+          : 0;
   arc_needed_ = periods_for(config.process.arc_delay_s, config.servo_period_s);
   prepare_needed_ = periods_for(config.tool_changer.prepare_time_s, config.servo_period_s);
   change_needed_ = periods_for(config.tool_changer.change_time_s, config.servo_period_s);
@@ -43,7 +49,8 @@ SimMachine::SimMachine(const SimMachineConfig& config) : config_(config), rng_(c
 MachineCapabilities SimMachine::capabilities() const noexcept {
   MachineCapabilities c;
   c.joint_count = config_.joint_count;
-  for (int j = 0; j < config_.joint_count; ++j) c.joints[static_cast<std::size_t>(j)] = joint(j).capabilities();
+  for (int j = 0; j < config_.joint_count; ++j)
+    c.joints[static_cast<std::size_t>(j)] = joint(j).capabilities();
   c.spindle = config_.spindle;
   c.spindle_encoder = config_.spindle && config_.spindle_config.encoder_counts_per_rev > 0;
   c.spindle_orient = config_.spindle && config_.spindle_config.orient;
@@ -60,7 +67,9 @@ MachineCapabilities SimMachine::capabilities() const noexcept {
   return c;
 }
 
-void SimMachine::read(MachineInputs& in) noexcept { in = inputs_; }
+void SimMachine::read(MachineInputs& in) noexcept {
+  in = inputs_;
+}
 
 void SimMachine::write(const MachineOutputs& out) noexcept {
   outputs_ = out;
@@ -130,7 +139,8 @@ void SimMachine::update_power(double energy_j) noexcept {
   } else {
     const double c = p.dc_link_capacitance_f;
     const double stored_j = 0.5 * c * dc_link_v_ * dc_link_v_ - p.idle_power_w * period - energy_j;
-    dc_link_v_ = std::min(std::sqrt(std::max(0.0, 2.0 * stored_j / c)), kBrakeChopperRatio * p.dc_link_nominal_v);
+    dc_link_v_ =
+        std::min(std::sqrt(std::max(0.0, 2.0 * stored_j / c)), kBrakeChopperRatio * p.dc_link_nominal_v);
   }
   undervoltage_ = dc_link_v_ < p.dc_link_min_v;
   // A drive that sees undervoltage while enabled latches the fault until it is disabled.
@@ -161,15 +171,18 @@ void SimMachine::sample() noexcept {
   inputs_.power.dc_link_v = dc_link_v_;
   if (config_.spindle) spindle_.sample(inputs_.spindle);
   if (config_.probe.joint >= 0) {
-    inputs_.probe = probe_.update(joints_[static_cast<std::size_t>(config_.probe.joint)].table_position(), rng_);
+    inputs_.probe =
+        probe_.update(joints_[static_cast<std::size_t>(config_.probe.joint)].table_position(), rng_);
   }
   inputs_.process.arc_ok = arc_periods_ >= arc_needed_;
-  inputs_.process.gap_voltage_v = config_.process.generator && outputs_.process.generator_on ? gap_voltage_v_ : 0.0;
+  inputs_.process.gap_voltage_v =
+      config_.process.generator && outputs_.process.generator_on ? gap_voltage_v_ : 0.0;
   inputs_.tool.prepared = prepare_periods_ >= prepare_needed_;
   inputs_.tool.changed = change_periods_ >= change_needed_;
   inputs_.digital_in = digital_in_ & low_bits(config_.digital_inputs);
   for (int k = 0; k < kAnalogChannels; ++k) {
-    inputs_.analog_in[static_cast<std::size_t>(k)] = k < config_.analog_inputs ? analog_in_[static_cast<std::size_t>(k)] : 0.0;
+    inputs_.analog_in[static_cast<std::size_t>(k)] =
+        k < config_.analog_inputs ? analog_in_[static_cast<std::size_t>(k)] : 0.0;
   }
 }
 

@@ -20,9 +20,15 @@ void SimSpindle::begin_period(const SpindleOutputs& cmd, bool powered) noexcept 
   position_at_period_start_ = position_rev_;
   const double rps = std::min(cmd.speed_rpm, config_.max_rpm) / 60.0;
   switch (cmd.direction) {
-    case SpindleDirection::Clockwise: target_rps_ = rps; break;
-    case SpindleDirection::Counterclockwise: target_rps_ = -rps; break;
-    case SpindleDirection::Stopped: target_rps_ = 0; break;
+    case SpindleDirection::Clockwise:
+      target_rps_ = rps;
+      break;
+    case SpindleDirection::Counterclockwise:
+      target_rps_ = -rps;
+      break;
+    case SpindleDirection::Stopped:
+      target_rps_ = 0;
+      break;
   }
   if (!powered_) target_rps_ = 0;
 }
@@ -63,7 +69,8 @@ void SimSpindle::sample(SpindleInputs& in) const noexcept {
   in.index_count = cpr > 0 ? index_count_ : 0;
   in.index_position_rev = cpr > 0 ? index_position_rev_ : 0.0;
   const double cmd_rpm = target_rps_ * 60.0;
-  in.at_speed = powered_ && !orienting() && std::abs(in.speed_rpm - cmd_rpm) <= config_.at_speed_tolerance * std::abs(cmd_rpm);
+  in.at_speed = powered_ && !orienting() &&
+                std::abs(in.speed_rpm - cmd_rpm) <= config_.at_speed_tolerance * std::abs(cmd_rpm);
   double error_deg = cmd_.orient_angle_deg - 360.0 * (position_rev_ - std::floor(position_rev_));
   error_deg -= 360.0 * std::floor(error_deg / 360.0 + 0.5);
   in.orient_done = orienting() && std::abs(error_deg) <= config_.orient_tolerance_deg &&

@@ -123,7 +123,9 @@ TEST_P(BadProfile, IsRejectedAtThePlaceOfTheProblem) {
   EXPECT_EQ(first_error(load), c.expected) << all_messages(load.diagnostics);
 }
 
-std::string with(const std::string& extra) { return kBase + extra; }
+std::string with(const std::string& extra) {
+  return kBase + extra;
+}
 std::string replaced(const std::string& from, const std::string& to) {
   std::string s = kBase;
   s.replace(s.find(from), from.size(), to);
@@ -133,29 +135,48 @@ std::string replaced(const std::string& from, const std::string& to) {
 INSTANTIATE_TEST_SUITE_P(
     Cases, BadProfile,
     ::testing::Values(
-        BadCase{"NegativeAcceleration", replaced("max_acceleration = 1000", "max_acceleration = -5"),
+        BadCase{"NegativeAcceleration",
+                replaced("max_acceleration = 1000", "max_acceleration = -5"),
                 {"config.range", "bad.toml", 4, 20}},
         BadCase{"UnknownKey", with("max_vel = 3\n"), {"config.unknown-key", "bad.toml", 7, 1}},
-        BadCase{"DuplicateAxis", with("[axis.X]\nmax_velocity = 1\n"), {"config.duplicate-axis", "bad.toml", 7, 7}},
-        BadCase{"LimitsReversed", replaced("min_limit = -10", "min_limit = 400"), {"config.limits", "bad.toml", 5, 13}},
-        BadCase{"WrongType", replaced("max_velocity = 100", "max_velocity = \"fast\""), {"config.type", "bad.toml", 3, 16}},
+        BadCase{"DuplicateAxis",
+                with("[axis.X]\nmax_velocity = 1\n"),
+                {"config.duplicate-axis", "bad.toml", 7, 7}},
+        BadCase{"LimitsReversed",
+                replaced("min_limit = -10", "min_limit = 400"),
+                {"config.limits", "bad.toml", 5, 13}},
+        BadCase{"WrongType",
+                replaced("max_velocity = 100", "max_velocity = \"fast\""),
+                {"config.type", "bad.toml", 3, 16}},
         BadCase{"MissingKey", replaced("max_velocity = 100\n", ""), {"config.missing-key", "bad.toml", 2, 1}},
         BadCase{"Syntax", with("max_jerk = = 3\n"), {"config.syntax", "bad.toml", 7, 12}},
         BadCase{"NotAnAxis", with("[axis.q]\nmax_velocity = 1\n"), {"config.axis-letter", "bad.toml", 7, 7}},
-        BadCase{"RotaryKeyOnLinearAxis", with("[axis.x.sim]\ninertia_kg_m2 = 1\n"), {"config.not-applicable", "bad.toml", 8, 17}},
-        BadCase{"StepperKeyOnServo", with("steps_per_unit = 200\n"), {"config.not-applicable", "bad.toml", 7, 18}},
+        BadCase{"RotaryKeyOnLinearAxis",
+                with("[axis.x.sim]\ninertia_kg_m2 = 1\n"),
+                {"config.not-applicable", "bad.toml", 8, 17}},
+        BadCase{"StepperKeyOnServo",
+                with("steps_per_unit = 200\n"),
+                {"config.not-applicable", "bad.toml", 7, 18}},
         BadCase{"HomingWithoutSwitch",
                 with("[axis.x.homing]\nmethod = \"switch\"\nsearch_velocity = 10\nlatch_velocity = -1\n"),
                 {"config.homing", "bad.toml", 7, 1}},
-        BadCase{"HomeOutsideLimits", with("[axis.x.homing]\nposition = 500\n"), {"config.homing", "bad.toml", 7, 1}},
-        BadCase{"SubstepDoesNotDivide", with("[sim]\nsubstep_s = 0.0003\n"), {"config.range", "bad.toml", 8, 13}},
-        BadCase{"PitchTableNotIncreasing", with("[axis.x.sim]\npitch_error = [[0, 0], [10, 0.001], [5, 0]]\n"),
+        BadCase{"HomeOutsideLimits",
+                with("[axis.x.homing]\nposition = 500\n"),
+                {"config.homing", "bad.toml", 7, 1}},
+        BadCase{
+            "SubstepDoesNotDivide", with("[sim]\nsubstep_s = 0.0003\n"), {"config.range", "bad.toml", 8, 13}},
+        BadCase{"PitchTableNotIncreasing",
+                with("[axis.x.sim]\npitch_error = [[0, 0], [10, 0.001], [5, 0]]\n"),
                 {"config.range", "bad.toml", 8, 37}},
-        BadCase{"ProbeOnMissingAxis", with("[probe.sim]\naxis = \"z\"\ntrip = [-inf, -5]\n"),
+        BadCase{"ProbeOnMissingAxis",
+                with("[probe.sim]\naxis = \"z\"\ntrip = [-inf, -5]\n"),
                 {"config.range", "bad.toml", 8, 8}},
-        BadCase{"UnstablePositionLoop", with("[axis.x.sim]\nposition_gain = 500\n"), {"config.range", "bad.toml", 8, 17}},
+        BadCase{"UnstablePositionLoop",
+                with("[axis.x.sim]\nposition_gain = 500\n"),
+                {"config.range", "bad.toml", 8, 17}},
         BadCase{"NoName", replaced("name = \"test\"\n", ""), {"config.missing-key", "bad.toml", 1, 1}},
-        BadCase{"FrictionOrder", with("[axis.x.sim]\ncoulomb_friction_n = 50\nstatic_friction_n = 40\n"),
+        BadCase{"FrictionOrder",
+                with("[axis.x.sim]\ncoulomb_friction_n = 50\nstatic_friction_n = 40\n"),
                 {"config.range", "bad.toml", 9, 21}}),
     [](const auto& param_info) { return std::string(param_info.param.name); });
 
@@ -175,7 +196,8 @@ TEST(MachineProfile, ReportsEveryProblemInOnePass) {
 }
 
 TEST(MachineProfile, NoisySwitchesAreAWarningOnly) {
-  const ProfileLoad load = parse_profile(with("[axis.x.switches]\nhome = [290, inf]\nhysteresis = 0.01\nnoise = 0.01\n"), "w.toml");
+  const ProfileLoad load = parse_profile(
+      with("[axis.x.switches]\nhome = [290, inf]\nhysteresis = 0.01\nnoise = 0.01\n"), "w.toml");
   ASSERT_TRUE(load.ok()) << all_messages(load.diagnostics);
   ASSERT_EQ(load.diagnostics.warning_count(), 1u);
   EXPECT_EQ(load.diagnostics.items()[0].code, "config.switch-chatter");
@@ -223,7 +245,9 @@ pitch_error = [[0, 0], [100, 0.01], [200, 0.015]]
 
 // --- overrides -------------------------------------------------------------------------
 
-ProfileLoad with_overrides(std::vector<std::string> sets) { return load_profile(kMill, sets); }
+ProfileLoad with_overrides(std::vector<std::string> sets) {
+  return load_profile(kMill, sets);
+}
 
 TEST(ProfileOverride, ReplacesValues) {
   const ProfileLoad load = with_overrides({"axis.x.max_velocity=200", "interpreter.dialect=fanuc",
@@ -252,7 +276,8 @@ TEST(ProfileOverride, IsValidatedWhereItWasWritten) {
 TEST(ProfileOverride, UnknownKeyIsReportedAtTheOverride) {
   const ProfileLoad load = with_overrides({"axis.x.max_velocty=150"});
   EXPECT_FALSE(load.ok());
-  EXPECT_EQ(first_error(load), (Where{"config.unknown-key", "--set", 1, 8})) << all_messages(load.diagnostics);
+  EXPECT_EQ(first_error(load), (Where{"config.unknown-key", "--set", 1, 8}))
+      << all_messages(load.diagnostics);
 }
 
 TEST(ProfileOverride, MalformedOverridesAreRejected) {
@@ -298,13 +323,29 @@ TEST(ProfileFile, RelativePathsAreResolvedAgainstTheProfileFolder) {
 // --- property: random overrides never crash and every error has a place ------------------
 
 TEST(ProfileOverride, RandomOverridesAreAlwaysAnsweredPrecisely) {
-  const std::vector<std::string> keys = {
-      "servo_period_s", "axis.x.max_velocity", "axis.x.min_limit", "axis.y.max_limit", "axis.z.max_acceleration",
-      "axis.x.sim.mass_kg", "axis.y.sim.position_gain", "axis.z.sim.velocity_bandwidth_hz", "axis.x.switches.noise",
-      "axis.x.homing.method", "sim.substep_s", "spindle.max_rpm", "io.digital_inputs", "planner.lookahead",
-      "probe.sim.trip", "axis.x.drive", "axis.y.sim.pitch_error", "axis.x", "name", "axis.w.max_velocity"};
-  const std::vector<std::string> values = {"0", "-1", "1e300", "0.5", "3", "\"text\"", "word", "true", "[1, 2]",
-                                           "[[0, 0], [1, 1]]", "inf", "nan", "1000", "{}", "\"stepper\""};
+  const std::vector<std::string> keys = {"servo_period_s",
+                                         "axis.x.max_velocity",
+                                         "axis.x.min_limit",
+                                         "axis.y.max_limit",
+                                         "axis.z.max_acceleration",
+                                         "axis.x.sim.mass_kg",
+                                         "axis.y.sim.position_gain",
+                                         "axis.z.sim.velocity_bandwidth_hz",
+                                         "axis.x.switches.noise",
+                                         "axis.x.homing.method",
+                                         "sim.substep_s",
+                                         "spindle.max_rpm",
+                                         "io.digital_inputs",
+                                         "planner.lookahead",
+                                         "probe.sim.trip",
+                                         "axis.x.drive",
+                                         "axis.y.sim.pitch_error",
+                                         "axis.x",
+                                         "name",
+                                         "axis.w.max_velocity"};
+  const std::vector<std::string> values = {"0",        "-1",   "1e300", "0.5",    "3",
+                                           "\"text\"", "word", "true",  "[1, 2]", "[[0, 0], [1, 1]]",
+                                           "inf",      "nan",  "1000",  "{}",     "\"stepper\""};
   machine::SplitMix64 rng(2024);
   int ok = 0;
   for (int n = 0; n < 400; ++n) {

@@ -170,7 +170,7 @@ TEST(SimJoint, StaticFrictionHoldsSmallStepsWithoutIntegrators) {
   for (int k = 0; k < 500; ++k) large.period(10 * dead_band);
   const double stuck_error = 10 * dead_band - large.joint.motor_position();
   EXPECT_GT(large.joint.motor_position(), 0.0);
-  EXPECT_GT(stuck_error, 0.0);  // stopped short …
+  EXPECT_GT(stuck_error, 0.0);               // stopped short …
   EXPECT_LE(stuck_error, dead_band + 1e-4);  // … inside the dead band
   EXPECT_EQ(large.joint.velocity(), 0.0);
 

@@ -73,8 +73,10 @@ class Fingerprint {
     }
     add(in.estop_ok), add(in.power.mains_ok), add(in.power.ups_on_battery), add(in.power.dc_link_v);
     add(in.spindle.position_rev), add(in.spindle.speed_rpm), add_bits(in.spindle.index_count);
-    add(in.spindle.index_position_rev), add(in.spindle.at_speed), add(in.spindle.orient_done), add(in.spindle.fault);
-    add(in.probe), add(in.process.arc_ok), add(in.process.gap_voltage_v), add(in.tool.prepared), add(in.tool.changed);
+    add(in.spindle.index_position_rev), add(in.spindle.at_speed), add(in.spindle.orient_done),
+        add(in.spindle.fault);
+    add(in.probe), add(in.process.arc_ok), add(in.process.gap_voltage_v), add(in.tool.prepared),
+        add(in.tool.changed);
     add_bits(in.digital_in);
     for (double a : in.analog_in) add(a);
   }
@@ -103,7 +105,7 @@ TEST(SimMachine, TwoRunsAreBitIdentical) {
   int edges = 0;
   const std::uint64_t a = run_fingerprint(1, 20000, &edges);
   EXPECT_EQ(a, run_fingerprint(1, 20000));
-  EXPECT_GE(edges, 2);  // the run really crosses a noisy switch
+  EXPECT_GE(edges, 2);                      // the run really crosses a noisy switch
   EXPECT_NE(a, run_fingerprint(2, 20000));  // and the seed drives its noise
 }
 
@@ -130,7 +132,9 @@ TEST(SimMachine, FollowsCommandsAndCountsVirtualTime) {
   EXPECT_DOUBLE_EQ(m.time_s(), 3.0);
   const MachineOutputs next = run_outputs(3000);
   for (int j = 0; j < 3; ++j) {
-    EXPECT_NEAR(in.joints[static_cast<std::size_t>(j)].position, next.joints[static_cast<std::size_t>(j)].position, 5e-3) << j;
+    EXPECT_NEAR(in.joints[static_cast<std::size_t>(j)].position,
+                next.joints[static_cast<std::size_t>(j)].position, 5e-3)
+        << j;
   }
   EXPECT_NEAR(in.spindle.speed_rpm, 2000, 1e-6);
   EXPECT_TRUE(in.spindle.at_speed);

@@ -70,8 +70,9 @@ TEST(SimSpindle, EncoderIsQuantisedAndIndexCountsTurns) {
   }
   const double end = rig.spindle.position_rev();
   EXPECT_LT(end, turns);
-  EXPECT_EQ(rig.in.index_count - before, static_cast<std::uint32_t>((std::floor(farthest) - std::floor(turns)) +
-                                                                     (std::floor(farthest) - std::floor(end))));
+  EXPECT_EQ(rig.in.index_count - before,
+            static_cast<std::uint32_t>((std::floor(farthest) - std::floor(turns)) +
+                                       (std::floor(farthest) - std::floor(end))));
   EXPECT_EQ(rig.in.index_position_rev, std::floor(end) + 1);
 }
 

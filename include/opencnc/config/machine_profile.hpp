@@ -34,8 +34,8 @@ struct HomingProfile {
 struct AxisProfile {
   Axis axis = Axis::X;
   int joint = 0;
-  bool rotary = false;   ///< A, B, C: degrees; the others mm
-  bool wrapped = false;  ///< rotary axis that turns without end (no soft limits)
+  bool rotary = false;          ///< A, B, C: degrees; the others mm
+  bool wrapped = false;         ///< rotary axis that turns without end (no soft limits)
   double max_velocity = 0;      ///< units/s
   double max_acceleration = 0;  ///< units/s²
   double max_jerk = 0;          ///< units/s³; 0 = no jerk limit
@@ -57,7 +57,7 @@ struct SpindleProfile {
 };
 
 struct PowerProfile {
-  bool monitor = false;  ///< the machine reports mains, UPS and DC link
+  bool monitor = false;         ///< the machine reports mains, UPS and DC link
   machine::SimPowerConfig sim;  ///< ups, voltages, and the simulated supply
 };
 
@@ -84,7 +84,7 @@ struct InterpreterOptions {
 };
 
 struct PlannerOptions {
-  int lookahead = 200;             ///< moves in the look-ahead window
+  int lookahead = 200;              ///< moves in the look-ahead window
   double default_tolerance = 0.01;  ///< mm: path tolerance while a program sets no G64 P
 };
 

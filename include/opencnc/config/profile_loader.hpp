@@ -31,6 +31,7 @@ ProfileLoad load_profile(const std::filesystem::path& file, std::span<const std:
 /// The same for profile text already in memory; `source_name` names it in diagnostics and
 /// relative paths are resolved against `base_dir`. Non-real-time; does not throw.
 ProfileLoad parse_profile(std::string_view text, std::string_view source_name,
-                          std::span<const std::string> overrides = {}, const std::filesystem::path& base_dir = {});
+                          std::span<const std::string> overrides = {},
+                          const std::filesystem::path& base_dir = {});
 
 }  // namespace opencnc::config

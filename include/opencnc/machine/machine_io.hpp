@@ -78,7 +78,7 @@ struct MachineOutputs {
   SpindleOutputs spindle{};
   ProcessOutputs process{};
   ToolChangerOutputs tool{};
-  std::uint64_t digital_out = 0;  ///< bit i = generic digital output i (M62–M65)
+  std::uint64_t digital_out = 0;                     ///< bit i = generic digital output i (M62–M65)
   std::array<double, kAnalogChannels> analog_out{};  ///< generic analog outputs (M67/M68)
 };
 
@@ -108,12 +108,12 @@ struct SpindleInputs {
   /// Spindle encoder position in revolutions, continuous (integer part = turns since start,
   /// + = clockwise), quantised to the encoder's counts per revolution. Optional (encoder).
   double position_rev = 0;
-  double speed_rpm = 0;             ///< measured speed, signed (+ = clockwise)
-  std::uint32_t index_count = 0;    ///< index pulses seen since start; wraps (encoder)
-  double index_position_rev = 0;    ///< position_rev of the last index pulse (encoder)
-  bool at_speed = false;            ///< drive reports speed within tolerance of command
-  bool orient_done = false;         ///< orient requested and reached (capability)
-  bool fault = false;               ///< spindle drive fault
+  double speed_rpm = 0;           ///< measured speed, signed (+ = clockwise)
+  std::uint32_t index_count = 0;  ///< index pulses seen since start; wraps (encoder)
+  double index_position_rev = 0;  ///< position_rev of the last index pulse (encoder)
+  bool at_speed = false;          ///< drive reports speed within tolerance of command
+  bool orient_done = false;       ///< orient requested and reached (capability)
+  bool fault = false;             ///< spindle drive fault
 };
 
 /// Power supply monitoring; optional (capability `power_monitor`).
@@ -124,7 +124,7 @@ struct PowerInputs {
 };
 
 struct ProcessInputs {
-  bool arc_ok = false;     ///< torch arc/flame established (optional)
+  bool arc_ok = false;       ///< torch arc/flame established (optional)
   double gap_voltage_v = 0;  ///< EDM gap voltage, V (optional)
 };
 
@@ -145,7 +145,7 @@ struct MachineInputs {
   bool probe = false;  ///< probe input active (optional)
   ProcessInputs process{};
   ToolChangerInputs tool{};
-  std::uint64_t digital_in = 0;  ///< bit i = generic digital input i (M66 P)
+  std::uint64_t digital_in = 0;                     ///< bit i = generic digital input i (M66 P)
   std::array<double, kAnalogChannels> analog_in{};  ///< generic analog inputs (M66 E)
 };
 
@@ -179,8 +179,8 @@ struct MachineCapabilities {
   bool ups = false;            ///< ups_on_battery is valid
   bool probe = false;
   bool tool_changer = false;
-  bool torch = false;      ///< torch_on / arc_ok
-  bool generator = false;  ///< generator_on / gap_voltage_v
+  bool torch = false;                           ///< torch_on / arc_ok
+  bool generator = false;                       ///< generator_on / gap_voltage_v
   int digital_inputs = 0, digital_outputs = 0;  ///< generic channels 0 … n-1 exist
   int analog_inputs = 0, analog_outputs = 0;
 };

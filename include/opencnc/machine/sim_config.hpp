@@ -46,26 +46,26 @@ struct PitchPoint {
 /// Mechanics and drive of one simulated servo joint. Linear joints: kg, N, mm; rotary joints:
 /// kg·m², N·m, degrees. (`inertia` and the efforts take the unit of the joint kind.)
 struct SimJointModel {
-  double inertia = 100;          ///< moving mass kg / inertia kg·m², referred to the table
-  double peak_effort = 3000;     ///< drive force/torque limit, N or N·m
-  double coulomb_friction = 40;  ///< sliding friction, N or N·m
-  double static_friction = 50;   ///< breakaway friction, N or N·m (≥ coulomb)
+  double inertia = 100;            ///< moving mass kg / inertia kg·m², referred to the table
+  double peak_effort = 3000;       ///< drive force/torque limit, N or N·m
+  double coulomb_friction = 40;    ///< sliding friction, N or N·m
+  double static_friction = 50;     ///< breakaway friction, N or N·m (≥ coulomb)
   double viscous_friction = 0.05;  ///< N per mm/s, or N·m per deg/s
   // Drive: position loop (P or PI + velocity feed-forward) → velocity loop (PI) → current
   // loop (first-order lag) → force with saturation.
-  double position_gain = 60;          ///< Kp, 1/s
-  double position_integral = 0;       ///< Ki, 1/s² (0 = P position loop)
-  double feed_forward = 1;            ///< fraction of velocity_ff added to the velocity reference
+  double position_gain = 60;           ///< Kp, 1/s
+  double position_integral = 0;        ///< Ki, 1/s² (0 = P position loop)
+  double feed_forward = 1;             ///< fraction of velocity_ff added to the velocity reference
   double velocity_bandwidth_hz = 150;  ///< velocity loop crossover
   double velocity_integral_hz = 30;    ///< velocity loop PI corner (0 = P velocity loop)
   double current_bandwidth_hz = 1000;  ///< current (force) loop first-order lag
-  double velocity_limit = 0;          ///< drive velocity clamp, units/s (0 = none)
+  double velocity_limit = 0;           ///< drive velocity clamp, units/s (0 = none)
   // Transmission and feedback.
-  double backlash = 0;  ///< lost motion between motor and table, units
+  double backlash = 0;                  ///< lost motion between motor and table, units
   std::vector<PitchPoint> pitch_error;  ///< sorted by position; empty = perfect screw
   FeedbackSource feedback = FeedbackSource::Motor;
-  double index_spacing = 0;  ///< distance between encoder index marks, units (0 = no index)
-  double index_offset = 0;   ///< position of one index mark, units
+  double index_spacing = 0;   ///< distance between encoder index marks, units (0 = no index)
+  double index_offset = 0;    ///< position of one index mark, units
   double start_position = 0;  ///< motor (and table) position at power-up, units
 };
 
@@ -79,10 +79,10 @@ struct SimJointConfig {
 };
 
 struct SimSpindleConfig {
-  double max_rpm = 0;              ///< command is clamped to this
-  double acceleration_rpm_s = 2000;  ///< ramp limit of the spindle drive
+  double max_rpm = 0;                 ///< command is clamped to this
+  double acceleration_rpm_s = 2000;   ///< ramp limit of the spindle drive
   double encoder_counts_per_rev = 0;  ///< 0 = no encoder
-  double at_speed_tolerance = 0.02;  ///< at_speed when |speed − command| ≤ this × command
+  double at_speed_tolerance = 0.02;   ///< at_speed when |speed − command| ≤ this × command
   bool orient = true;                 ///< the drive can orient (M19); else requests are ignored
   double orient_rpm = 60;             ///< speed limit while orienting
   double orient_tolerance_deg = 0.5;  ///< orient_done within this angle
@@ -90,12 +90,12 @@ struct SimSpindleConfig {
 
 /// Mains, UPS and DC link.
 struct SimPowerConfig {
-  double dc_link_nominal_v = 560;   ///< DC link with mains on (rectified 400 V three-phase)
+  double dc_link_nominal_v = 560;  ///< DC link with mains on (rectified 400 V three-phase)
   double dc_link_min_v = 400;      ///< drives trip on undervoltage below this
   double dc_link_capacitance_f = 0.002;
-  double idle_power_w = 150;       ///< load on the DC link when no axis moves
+  double idle_power_w = 150;  ///< load on the DC link when no axis moves
   bool ups = false;
-  double ups_runtime_s = 300;      ///< battery time after mains loss
+  double ups_runtime_s = 300;  ///< battery time after mains loss
 };
 
 /// The probe: a switch on one joint's table position.

@@ -25,7 +25,7 @@ class PitchErrorTable {
 
  private:
   std::vector<PitchPoint> points_;
-  std::vector<double> slopes_;  // error change per unit along each segment
+  std::vector<double> slopes_;       // error change per unit along each segment
   mutable std::size_t segment_ = 0;  // points_[segment_] ≤ s < points_[segment_ + 1] last time
 };
 
@@ -57,7 +57,7 @@ class SimJoint {
   // Ground truth, for tests and plots.
   double motor_position() const noexcept { return motor_; }
   double screw_position() const noexcept { return screw_; }  ///< after backlash
-  double table_position() const noexcept;                   ///< after backlash and pitch error
+  double table_position() const noexcept;                    ///< after backlash and pitch error
   double velocity() const noexcept { return velocity_; }     ///< motor velocity, units/s
   double effort() const noexcept { return effort_; }
   /// Mechanical energy the drive put into the axis during the last period, J (negative when
@@ -79,14 +79,14 @@ class SimJoint {
   PitchErrorTable pitch_;
   SimSwitch limit_neg_, limit_pos_, home_, decel_;
   // Derived constants.
-  double h_ = 0;              // sub-step, s
+  double h_ = 0;               // sub-step, s
   double unit_per_count_ = 0;  // 1 / counts_per_unit
   int substeps_ = 1;
   double period_s_ = 0;
-  double accel_per_effort_ = 0;  // (units/s²) per N: scale / inertia
-  double velocity_gain_ = 0;     // N per (units/s)
-  double velocity_integral_ = 0;  // 1/s
-  double current_alpha_ = 1;     // first-order lag factor per sub-step
+  double accel_per_effort_ = 0;           // (units/s²) per N: scale / inertia
+  double velocity_gain_ = 0;              // N per (units/s)
+  double velocity_integral_ = 0;          // 1/s
+  double current_alpha_ = 1;              // first-order lag factor per sub-step
   double power_per_effort_velocity_ = 0;  // W per (N · units/s)
   double half_backlash_ = 0;
   // Latched command.

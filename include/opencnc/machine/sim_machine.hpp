@@ -52,7 +52,9 @@ class SimMachine final : public MachineIO {
   const MachineOutputs& last_outputs() const noexcept { return outputs_; }
   /// True while the drives have power: e-stop chain closed, released, DC link above minimum.
   bool drives_powered() const noexcept;
-  double ups_remaining_s() const noexcept { return static_cast<double>(ups_periods_left_) * config_.servo_period_s; }
+  double ups_remaining_s() const noexcept {
+    return static_cast<double>(ups_periods_left_) * config_.servo_period_s;
+  }
 
  private:
   void advance() noexcept;

@@ -20,9 +20,7 @@ class SplitMix64 {
     return z ^ (z >> 31);
   }
   /// Uniform in [-1, 1): the top 53 bits as a fraction, doubled and shifted.
-  constexpr double symmetric() noexcept {
-    return static_cast<double>(next() >> 11) * 0x1.0p-52 - 1.0;
-  }
+  constexpr double symmetric() noexcept { return static_cast<double>(next() >> 11) * 0x1.0p-52 - 1.0; }
 
  private:
   std::uint64_t state_;
