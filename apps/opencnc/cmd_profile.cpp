@@ -128,7 +128,7 @@ int run_profile(const ProfileOptions& o) {
 
 }  // namespace
 
-void register_profile(CLI::App& app, Registry& registry) {
+void add_profile_command(CLI::App& app, Registry& registry) {
   auto opts = std::make_shared<ProfileOptions>();
   CLI::App* cmd =
       app.add_subcommand("profile", "Check a machine profile (TOML) and try its simulated machine");

@@ -7,9 +7,7 @@
 namespace opencnc::cli {
 
 void register_all(CLI::App& app, Registry& registry) {
-  (void)app;
-  (void)registry;
-  register_profile(app, registry);
+  add_profile_command(app, registry);
 }
 
 }  // namespace opencnc::cli

@@ -27,6 +27,7 @@ class Registry {
 /// Adds every subcommand to `app`; each callback stores its exit code in `registry`.
 void register_all(CLI::App& app, Registry& registry);
 
-void register_profile(CLI::App& app, Registry& registry);  ///< cmd_profile.cpp
+// One function per subcommand (cmd_<name>.cpp).
+void add_profile_command(CLI::App& app, Registry& registry);
 
 }  // namespace opencnc::cli

@@ -243,6 +243,58 @@ pitch_error = [[0, 0], [100, 0.01], [200, 0.015]]
   EXPECT_TRUE(sim.joints[2].rotary);
 }
 
+// From TOML to the simulated machine's inputs: a stepper axis with a deceleration dog and a
+// home switch for decel_home homing; its switches change where the profile puts them.
+TEST(MachineProfile, SwitchesFromTheProfileDriveTheSimulatedInputs) {
+  const ProfileLoad load = parse_profile(R"(name = "drill"
+[axis.x]
+drive = "stepper"
+steps_per_unit = 1000
+max_velocity = 50
+max_acceleration = 500
+min_limit = 0
+max_limit = 300
+[axis.x.homing]
+method = "decel_home"
+position = 300
+search_velocity = 20
+latch_velocity = 1
+[axis.x.switches]
+decel = [290, 303]
+home = [301, 302]
+limit_max = 305
+hysteresis = 0.01
+noise = 0
+[axis.x.sim]
+start_position = 280
+)",
+                                         "drill.toml");
+  ASSERT_TRUE(load.ok()) << all_messages(load.diagnostics);
+  const AxisProfile& x = *load.profile->find(Axis::X);
+  EXPECT_EQ(x.homing.method, HomingMethod::DecelHome);
+  EXPECT_EQ(x.homing.search_velocity, 20);
+  machine::SimMachine m(sim_machine_config(*load.profile));
+  EXPECT_EQ(m.capabilities().joints[0].switches,
+            machine::kSwitchDecel | machine::kSwitchHome | machine::kSwitchLimitPos);
+  machine::MachineOutputs out;
+  out.estop_release = true;
+  out.joints[0].enable = true;
+  machine::MachineInputs in;
+  double decel_at = -1, home_at = -1, limit_at = -1;
+  for (std::int64_t steps = 280000; steps <= 306000; steps += 10) {  // 10 µm per period
+    out.joints[0].step_position = steps;
+    m.write(out);
+    m.read(in);
+    if (in.joints[0].decel && decel_at < 0) decel_at = in.joints[0].position;
+    if (in.joints[0].home && home_at < 0) home_at = in.joints[0].position;
+    if (in.joints[0].limit_pos && limit_at < 0) limit_at = in.joints[0].position;
+  }
+  EXPECT_DOUBLE_EQ(decel_at, 290.0);
+  EXPECT_DOUBLE_EQ(home_at, 301.0);
+  EXPECT_DOUBLE_EQ(limit_at, 305.0);
+  EXPECT_FALSE(in.joints[0].decel);  // passed the end of the dog
+}
+
 // --- overrides -------------------------------------------------------------------------
 
 ProfileLoad with_overrides(std::vector<std::string> sets) {
