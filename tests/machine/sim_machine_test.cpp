@@ -212,7 +212,9 @@ TEST(SimMachine, UpsHoldsTheLinkForItsRuntime) {
   SimMachine m(c);
   m.set_mains_ok(false);
   MachineInputs in;
-  for (int k = 0; k < 500; ++k) m.write(holding());
+  for (int k = 0; k < 200; ++k) m.write(holding());
+  EXPECT_NEAR(m.ups_remaining_s(), 0.3, 1e-12);
+  for (int k = 0; k < 300; ++k) m.write(holding());
   m.read(in);
   EXPECT_TRUE(in.power.ups_on_battery);
   EXPECT_EQ(in.power.dc_link_v, 560.0);
@@ -243,6 +245,35 @@ TEST(SimMachine, MovingAxesDrainTheLink) {
   const double idle = link_after(false);
   const double moving = link_after(true);
   EXPECT_LT(moving, idle - 0.01);
+}
+
+// A process load (broach, cut) shows as drive effort: the velocity loop's integrator takes it.
+TEST(SimMachine, ExternalLoadAppearsAsDriveEffort) {
+  SimMachine m(machine_config());
+  MachineInputs in;
+  for (int k = 0; k < 500; ++k) m.write(holding());
+  m.read(in);
+  const double idle = in.joints[1].effort;
+  m.set_external_effort(1, -800.0);  // pushes the table towards −
+  for (int k = 0; k < 500; ++k) m.write(holding());
+  m.read(in);
+  // At rest friction takes anything up to its static value, so the drive carries 800 N ± 50 N.
+  EXPECT_NEAR(in.joints[1].effort - idle, 800.0, 50.0);
+  EXPECT_NEAR(in.joints[1].position, 0.0, 2e-4);  // and the axis holds its place
+}
+
+TEST(SimMachine, SpindleFaultStopsTheSpindle) {
+  SimMachine m(machine_config());
+  MachineOutputs out = holding();
+  out.spindle = {1200, SpindleDirection::Clockwise};
+  for (int k = 0; k < 1000; ++k) m.write(out);
+  m.set_spindle_fault(true);
+  for (int k = 0; k < 100; ++k) m.write(out);
+  MachineInputs in;
+  m.read(in);
+  EXPECT_TRUE(in.spindle.fault);
+  EXPECT_FALSE(in.spindle.at_speed);
+  EXPECT_NEAR(in.spindle.speed_rpm, 1200 - 2000 * 0.1, 1e-6);  // running down at the ramp limit
 }
 
 TEST(SimMachine, ProbeTripsAtTheSurface) {

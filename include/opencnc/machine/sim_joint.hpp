@@ -50,13 +50,11 @@ class SimJoint {
 
   /// An injected drive fault: the drive drops its force and reports amp_fault.
   void set_fault(bool fault) noexcept { injected_fault_ = fault; }
-  bool fault() const noexcept { return injected_fault_; }
 
   JointCapabilities capabilities() const noexcept;
 
   // Ground truth, for tests and plots.
   double motor_position() const noexcept { return motor_; }
-  double screw_position() const noexcept { return screw_; }  ///< after backlash
   double table_position() const noexcept;                    ///< after backlash and pitch error
   double velocity() const noexcept { return velocity_; }     ///< motor velocity, units/s
   double effort() const noexcept { return effort_; }

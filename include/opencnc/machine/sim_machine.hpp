@@ -49,7 +49,6 @@ class SimMachine final : public MachineIO {
   double time_s() const noexcept { return static_cast<double>(inputs_.cycle) * config_.servo_period_s; }
   const SimJoint& joint(int j) const noexcept { return joints_[static_cast<std::size_t>(j)]; }
   const SimSpindle& spindle() const noexcept { return spindle_; }
-  const MachineOutputs& last_outputs() const noexcept { return outputs_; }
   /// True while the drives have power: e-stop chain closed, released, DC link above minimum.
   bool drives_powered() const noexcept;
   double ups_remaining_s() const noexcept {
