@@ -29,5 +29,6 @@ void register_all(CLI::App& app, Registry& registry);
 
 // One function per subcommand (cmd_<name>.cpp).
 void add_latency_command(CLI::App& app, Registry& registry);
+void add_profile_command(CLI::App& app, Registry& registry);
 
 }  // namespace opencnc::cli

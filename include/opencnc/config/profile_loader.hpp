@@ -1,0 +1,37 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Loading a machine profile from TOML, with `--set key=value` overrides and validation.
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+
+#include "opencnc/config/machine_profile.hpp"
+#include "opencnc/core/diagnostic.hpp"
+
+namespace opencnc::config {
+
+/// The outcome of a load: the profile if there was no error, and every error and warning
+/// found (`file:line:col: message`, with stable codes `config.*`; see docs/machine.md).
+struct ProfileLoad {
+  std::optional<MachineProfile> profile;
+  Diagnostics diagnostics;
+  bool ok() const noexcept { return profile.has_value(); }
+};
+
+/// Reads, overrides and validates the profile in `file`. Each override is `dotted.key=value`
+/// with a TOML value (a bare word is taken as a string), applied before validation and
+/// validated the same way; its diagnostics name the file `--set` and the line is the
+/// override's number (1 = first). Relative paths in the profile are resolved against the
+/// file's folder. Non-real-time; does not throw.
+ProfileLoad load_profile(const std::filesystem::path& file, std::span<const std::string> overrides = {});
+
+/// The same for profile text already in memory; `source_name` names it in diagnostics and
+/// relative paths are resolved against `base_dir`. Non-real-time; does not throw.
+ProfileLoad parse_profile(std::string_view text, std::string_view source_name,
+                          std::span<const std::string> overrides = {},
+                          const std::filesystem::path& base_dir = {});
+
+}  // namespace opencnc::config

@@ -1,0 +1,138 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Parameters of the simulated machine: plain structs the profile loader fills (non-real-time).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "opencnc/machine/machine_io.hpp"
+
+namespace opencnc::machine {
+
+inline constexpr double kInf = std::numeric_limits<double>::infinity();
+
+/// A switch that is active while the table position is inside [from, to] (either end may be
+/// infinite, e.g. a limit switch is [-inf, p] or [p, inf]).
+struct SwitchWindow {
+  bool present = false;
+  double from = -kInf;
+  double to = kInf;
+};
+
+/// The switches of one joint, at table positions (mm or degrees).
+struct SwitchLayout {
+  SwitchWindow limit_neg, limit_pos, home, decel;
+  /// Differential travel: once active, a switch releases only this far outside its window.
+  double hysteresis = 0.01;
+  /// Each sample moves the switching points by a uniform random amount in ±noise (seeded).
+  double noise = 0.001;
+};
+
+/// Where the position the drive closes its loop on (and reports) is measured.
+enum class FeedbackSource : std::uint8_t {
+  Motor,  ///< rotary encoder on the motor: pitch error and backlash are invisible to it
+  Table,  ///< linear scale on the table: sees everything the table does
+};
+
+/// A point of a lead-screw pitch error table: at nominal screw position `position` the table
+/// is at `position + error`.
+struct PitchPoint {
+  double position = 0;
+  double error = 0;
+};
+
+/// Mechanics and drive of one simulated servo joint. Linear joints: kg, N, mm; rotary joints:
+/// kg·m², N·m, degrees. (`inertia` and the efforts take the unit of the joint kind.)
+struct SimJointModel {
+  double inertia = 100;            ///< moving mass kg / inertia kg·m², referred to the table
+  double peak_effort = 3000;       ///< drive force/torque limit, N or N·m
+  double coulomb_friction = 40;    ///< sliding friction, N or N·m
+  double static_friction = 50;     ///< breakaway friction, N or N·m (≥ coulomb)
+  double viscous_friction = 0.05;  ///< N per mm/s, or N·m per deg/s
+  // Drive: position loop (P or PI + velocity feed-forward) → velocity loop (PI) → current
+  // loop (first-order lag) → force with saturation.
+  double position_gain = 60;           ///< Kp, 1/s
+  double position_integral = 0;        ///< Ki, 1/s² (0 = P position loop)
+  double feed_forward = 1;             ///< fraction of velocity_ff added to the velocity reference
+  double velocity_bandwidth_hz = 150;  ///< velocity loop crossover
+  double velocity_integral_hz = 30;    ///< velocity loop PI corner (0 = P velocity loop)
+  double current_bandwidth_hz = 1000;  ///< current (force) loop first-order lag
+  double velocity_limit = 0;           ///< drive velocity clamp, units/s (0 = none)
+  // Transmission and feedback.
+  double backlash = 0;                  ///< lost motion between motor and table, units
+  std::vector<PitchPoint> pitch_error;  ///< sorted by position; empty = perfect screw
+  FeedbackSource feedback = FeedbackSource::Motor;
+  double index_spacing = 0;   ///< distance between encoder index marks, units (0 = no index)
+  double index_offset = 0;    ///< position of one index mark, units
+  double start_position = 0;  ///< motor (and table) position at power-up, units
+};
+
+struct SimJointConfig {
+  JointDrive drive = JointDrive::Servo;
+  bool rotary = false;
+  /// Servo: encoder counts per unit (quantisation of feedback). Stepper: steps per unit.
+  double counts_per_unit = 1000;
+  SimJointModel model;
+  SwitchLayout switches;
+};
+
+struct SimSpindleConfig {
+  double max_rpm = 0;                 ///< command is clamped to this
+  double acceleration_rpm_s = 2000;   ///< ramp limit of the spindle drive
+  double encoder_counts_per_rev = 0;  ///< 0 = no encoder
+  double at_speed_tolerance = 0.02;   ///< at_speed when |speed − command| ≤ this × command
+  bool orient = true;                 ///< the drive can orient (M19); else requests are ignored
+  double orient_rpm = 60;             ///< speed limit while orienting
+  double orient_tolerance_deg = 0.5;  ///< orient_done within this angle
+};
+
+/// Mains, UPS and DC link.
+struct SimPowerConfig {
+  double dc_link_nominal_v = 560;  ///< DC link with mains on (rectified 400 V three-phase)
+  double dc_link_min_v = 400;      ///< drives trip on undervoltage below this
+  double dc_link_capacitance_f = 0.002;
+  double idle_power_w = 150;  ///< load on the DC link when no axis moves
+  bool ups = false;
+  double ups_runtime_s = 300;  ///< battery time after mains loss
+};
+
+/// The probe: a switch on one joint's table position.
+struct SimProbeConfig {
+  int joint = -1;  ///< -1 = no probe
+  SwitchWindow trip;
+  double hysteresis = 0.002;
+  double noise = 0.0005;
+};
+
+struct SimToolChangerConfig {
+  bool present = false;
+  double prepare_time_s = 0.5;
+  double change_time_s = 2.0;
+};
+
+struct SimProcessConfig {
+  bool torch = false;
+  double arc_delay_s = 0.5;  ///< torch_on to arc_ok
+  bool generator = false;
+};
+
+struct SimMachineConfig {
+  double servo_period_s = 0.001;
+  int substeps = 10;  ///< integration sub-steps per servo period
+  std::uint64_t seed = 1;
+  int joint_count = 0;
+  std::array<SimJointConfig, kMaxJoints> joints{};
+  bool spindle = false;
+  SimSpindleConfig spindle_config;
+  bool power_monitor = true;
+  SimPowerConfig power;
+  SimProbeConfig probe;
+  SimToolChangerConfig tool_changer;
+  SimProcessConfig process;
+  int digital_inputs = 0, digital_outputs = 0;
+  int analog_inputs = 0, analog_outputs = 0;
+};
+
+}  // namespace opencnc::machine

@@ -1,0 +1,105 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// One simulated joint: drive loops, mass with friction, backlash, pitch error, encoder, switches.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "opencnc/machine/machine_io.hpp"
+#include "opencnc/machine/sim_config.hpp"
+#include "opencnc/machine/sim_switch.hpp"
+
+namespace opencnc::machine {
+
+/// Lead-screw pitch error: linear interpolation between sorted points, the end values held
+/// beyond the ends. Construction allocates (non-real-time); at() is real-time safe.
+class PitchErrorTable {
+ public:
+  PitchErrorTable() = default;
+  explicit PitchErrorTable(std::vector<PitchPoint> points);
+
+  bool empty() const noexcept { return points_.empty(); }
+  /// Error at nominal screw position `s`. Remembers the last segment, so a slowly moving
+  /// axis costs O(1) per call; the result does not depend on that memory.
+  double at(double s) const noexcept;
+
+ private:
+  std::vector<PitchPoint> points_;
+  std::vector<double> slopes_;       // error change per unit along each segment
+  mutable std::size_t segment_ = 0;  // points_[segment_] ≤ s < points_[segment_ + 1] last time
+};
+
+/// A joint of the simulated machine. The owner calls begin_period(), then substep() for
+/// i = 0 … substeps-1, then end_period(), once per servo period; sample() fills the inputs.
+/// Everything but the constructor is real-time safe and allocation-free.
+class SimJoint {
+ public:
+  SimJoint() = default;
+  /// Non-real-time. `config` must be valid (the profile loader checks it).
+  SimJoint(const SimJointConfig& config, double servo_period_s, int substeps);
+
+  /// Latches this period's command. `powered`: the drive has power (e-stop chain closed,
+  /// DC link above undervoltage, no fault). `external_effort` acts on the table, N or N·m.
+  void begin_period(const JointOutputs& cmd, bool powered, double external_effort) noexcept;
+  /// Integrates sub-step `i` of the period.
+  void substep(int i) noexcept;
+  /// Finishes the period: index marks, velocity of a stepper.
+  void end_period() noexcept;
+  /// Feedback, index and switches as the inputs of the next servo tick.
+  void sample(JointInputs& in, SplitMix64& rng) noexcept;
+
+  /// An injected drive fault: the drive drops its force and reports amp_fault.
+  void set_fault(bool fault) noexcept { injected_fault_ = fault; }
+
+  JointCapabilities capabilities() const noexcept;
+
+  // Ground truth, for tests and plots.
+  double motor_position() const noexcept { return motor_; }
+  double table_position() const noexcept;                    ///< after backlash and pitch error
+  double velocity() const noexcept { return velocity_; }     ///< motor velocity, units/s
+  double effort() const noexcept { return effort_; }
+  /// Mechanical energy the drive put into the axis during the last period, J (negative when
+  /// braking). Feeds the DC link model.
+  double energy_j() const noexcept { return energy_j_; }
+
+ private:
+  double feedback_raw() const noexcept;
+  std::int64_t counts(double position) const noexcept;
+  double quantise(double position) const noexcept;
+  double quantise_fast(double position) const noexcept;
+  void servo_substep(double t_s) noexcept;
+  void stepper_substep(int i) noexcept;
+  void integrate_mechanics(double drive_effort) noexcept;
+  void take_up_backlash() noexcept;
+  void update_index(double before, double after) noexcept;
+
+  SimJointConfig config_{};
+  PitchErrorTable pitch_;
+  SimSwitch limit_neg_, limit_pos_, home_, decel_;
+  // Derived constants.
+  double h_ = 0;               // sub-step, s
+  double unit_per_count_ = 0;  // 1 / counts_per_unit
+  int substeps_ = 1;
+  double period_s_ = 0;
+  double accel_per_effort_ = 0;           // (units/s²) per N: scale / inertia
+  double velocity_gain_ = 0;              // N per (units/s)
+  double velocity_integral_ = 0;          // 1/s
+  double current_alpha_ = 1;              // first-order lag factor per sub-step
+  double power_per_effort_velocity_ = 0;  // W per (N · units/s)
+  double half_backlash_ = 0;
+  // Latched command.
+  JointOutputs cmd_{};
+  bool powered_ = false;
+  double external_effort_ = 0;
+  bool injected_fault_ = false;
+  // State.
+  double motor_ = 0, velocity_ = 0, effort_ = 0, screw_ = 0;
+  double position_integral_ = 0, velocity_error_integral_ = 0;
+  std::int64_t steps_emitted_ = 0, steps_at_period_start_ = 0;
+  double feedback_at_period_start_ = 0;
+  double energy_j_ = 0;
+  std::uint32_t index_count_ = 0;
+  double index_position_ = 0;
+};
+
+}  // namespace opencnc::machine

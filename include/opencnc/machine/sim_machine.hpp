@@ -1,0 +1,90 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// SimMachine: the embedded default MachineIO backend, a deterministic machine in virtual time.
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "opencnc/machine/machine_io.hpp"
+#include "opencnc/machine/sim_config.hpp"
+#include "opencnc/machine/sim_joint.hpp"
+#include "opencnc/machine/sim_spindle.hpp"
+#include "opencnc/machine/sim_switch.hpp"
+
+namespace opencnc::machine {
+
+/// A simulated machine. Each write() advances virtual time by exactly one servo period in
+/// `substeps` fixed sub-steps and samples the inputs the next read() returns, so two runs
+/// with the same configuration, seed and outputs are bit-for-bit identical.
+///
+/// Fault and process injection (set_*) and the ground-truth accessors are for tests,
+/// scenarios and plots: call them between periods from the thread that drives the machine;
+/// they are real-time safe. Injected inputs show from the next write() on.
+class SimMachine final : public MachineIO {
+ public:
+  /// Non-real-time (copies pitch tables). `config` must be valid (the profile loader checks).
+  explicit SimMachine(const SimMachineConfig& config);
+
+  MachineCapabilities capabilities() const noexcept override;
+  void read(MachineInputs& in) noexcept override;
+  void write(const MachineOutputs& out) noexcept override;
+
+  // --- injection ---------------------------------------------------------------------
+  void set_estop_pressed(bool pressed) noexcept { estop_pressed_ = pressed; }
+  void set_mains_ok(bool ok) noexcept { mains_ok_ = ok; }
+  /// An amplifier fault on `joint` (0-based); ignored for joints that do not exist.
+  void set_amp_fault(int joint, bool fault) noexcept;
+  /// Process load on `joint`'s table (cutting force, broach load, gravity), N or N·m.
+  void set_external_effort(int joint, double effort) noexcept;
+  void set_spindle_fault(bool fault) noexcept { spindle_.set_fault(fault); }
+  void set_digital_input(int channel, bool value) noexcept;
+  void set_analog_input(int channel, double value) noexcept;
+  /// Whether the torch can light (false: gas out, no arc; arc_ok never comes).
+  void set_arc_available(bool available) noexcept { arc_available_ = available; }
+  /// EDM gap voltage reported while the generator is on.
+  void set_gap_voltage(double volts) noexcept { gap_voltage_v_ = volts; }
+
+  // --- ground truth ------------------------------------------------------------------
+  std::uint64_t cycle() const noexcept { return inputs_.cycle; }
+  double time_s() const noexcept { return static_cast<double>(inputs_.cycle) * config_.servo_period_s; }
+  const SimJoint& joint(int j) const noexcept { return joints_[static_cast<std::size_t>(j)]; }
+  const SimSpindle& spindle() const noexcept { return spindle_; }
+  /// True while the drives have power: e-stop chain closed, released, DC link above minimum.
+  bool drives_powered() const noexcept;
+  double ups_remaining_s() const noexcept {
+    return static_cast<double>(ups_periods_left_) * config_.servo_period_s;
+  }
+
+ private:
+  void advance() noexcept;
+  void update_power(double energy_j) noexcept;
+  void update_auxiliaries() noexcept;
+  void sample() noexcept;
+
+  SimMachineConfig config_;
+  std::array<SimJoint, kMaxJoints> joints_{};
+  SimSpindle spindle_;
+  SimSwitch probe_;
+  SplitMix64 rng_;
+  MachineOutputs outputs_{};
+  MachineInputs inputs_{};
+  // Injected world.
+  bool estop_pressed_ = false;
+  bool mains_ok_ = true;
+  bool arc_available_ = true;
+  double gap_voltage_v_ = 0;
+  std::array<double, kMaxJoints> external_effort_{};
+  std::uint64_t digital_in_ = 0;
+  std::array<double, kAnalogChannels> analog_in_{};
+  // Power supply: DC link, UPS, and the undervoltage fault each drive latches.
+  double dc_link_v_ = 0;
+  std::uint64_t ups_periods_left_ = 0;
+  bool on_battery_ = false;  // the UPS held the link during the last period
+  bool undervoltage_ = false;
+  std::array<bool, kMaxJoints> undervoltage_fault_{};
+  // Auxiliary timers, in whole periods, and the periods each one needs.
+  std::uint64_t arc_periods_ = 0, prepare_periods_ = 0, change_periods_ = 0;
+  std::uint64_t arc_needed_ = 0, prepare_needed_ = 0, change_needed_ = 0;
+};
+
+}  // namespace opencnc::machine

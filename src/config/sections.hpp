@@ -1,0 +1,36 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Readers of the profile's sections, each filling its part of a MachineProfile.
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <string_view>
+#include <utility>
+
+#include "opencnc/config/machine_profile.hpp"
+#include "toml_reader.hpp"
+
+namespace opencnc::config::detail {
+
+/// [sim]: sub-step and seed. Needs servo_period_s.
+void read_sim(Section& top, MachineProfile& profile);
+/// [axis.<letter>] with homing, switches and sim. Needs servo_period_s and sim_substeps.
+void read_axes(Section& top, MachineProfile& profile);
+void read_spindle(Section& top, MachineProfile& profile);
+void read_power(Section& top, MachineProfile& profile);
+/// [probe]. Needs the axes.
+void read_probe(Section& top, MachineProfile& profile);
+void read_tool_changer(Section& top, MachineProfile& profile);
+void read_process(Section& top, MachineProfile& profile);
+void read_io(Section& top, MachineProfile& profile);
+void read_interpreter(Section& top, MachineProfile& profile, const std::filesystem::path& base_dir);
+void read_planner(Section& top, MachineProfile& profile);
+
+/// `node` as an array of exactly two numbers (integers or floats, inf allowed), else nullopt.
+std::optional<std::pair<double, double>> number_pair(const toml::node& node);
+/// `key` as a switch window [from, to] (±inf allowed, from ≤ to); nullopt if absent or bad.
+std::optional<machine::SwitchWindow> read_window(Section& section, std::string_view key);
+/// The axis a one-letter key names (either case), if it is one.
+std::optional<Axis> axis_from_letter(std::string_view letter) noexcept;
+
+}  // namespace opencnc::config::detail

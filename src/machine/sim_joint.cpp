@@ -1,0 +1,257 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Simulated joint: cascaded drive loops, rigid mass with Coulomb/static/viscous friction,
+// backlash as a play operator, pitch error table, quantised encoder, index marks, switches.
+#include "opencnc/machine/sim_joint.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <utility>
+
+namespace opencnc::machine {
+
+namespace {
+
+constexpr double kTwoPi = 2.0 * std::numbers::pi;
+
+/// Axis units per SI unit: mm per m for linear joints, degrees per radian for rotary ones.
+/// Accelerations come out of F/m in SI and are wanted in axis units.
+double units_per_si(bool rotary) {
+  return rotary ? 180.0 / std::numbers::pi : 1000.0;
+}
+
+}  // namespace
+
+PitchErrorTable::PitchErrorTable(std::vector<PitchPoint> points) : points_(std::move(points)) {
+  for (std::size_t i = 0; i + 1 < points_.size(); ++i) {
+    slopes_.push_back((points_[i + 1].error - points_[i].error) /
+                      (points_[i + 1].position - points_[i].position));
+  }
+}
+
+double PitchErrorTable::at(double s) const noexcept {
+  const std::size_t n = points_.size();
+  if (n == 0) return 0.0;
+  if (s <= points_.front().position) return points_.front().error;
+  if (s >= points_.back().position) return points_.back().error;
+  // Here n ≥ 2 and front < s < back; walk from the last segment (bounded by n).
+  while (segment_ > 0 && s < points_[segment_].position) --segment_;
+  while (segment_ + 2 < n && s >= points_[segment_ + 1].position) ++segment_;
+  const PitchPoint& a = points_[segment_];
+  return a.error + slopes_[segment_] * (s - a.position);
+}
+
+SimJoint::SimJoint(const SimJointConfig& config, double servo_period_s, int substeps)
+    : config_(config),
+      pitch_(config.model.pitch_error),
+      limit_neg_(config.switches.limit_neg, config.switches.hysteresis, config.switches.noise),
+      limit_pos_(config.switches.limit_pos, config.switches.hysteresis, config.switches.noise),
+      home_(config.switches.home, config.switches.hysteresis, config.switches.noise),
+      decel_(config.switches.decel, config.switches.hysteresis, config.switches.noise),
+      h_(servo_period_s / substeps),
+      unit_per_count_(1.0 / config.counts_per_unit),
+      substeps_(substeps),
+      period_s_(servo_period_s) {
+  const SimJointModel& m = config.model;
+  const double scale = units_per_si(config.rotary);
+  accel_per_effort_ = scale / m.inertia;
+  // The velocity loop sees the plant v = scale·F/(inertia·s); a gain of ω·inertia/scale puts
+  // its crossover at ω, whatever the mass.
+  velocity_gain_ = kTwoPi * m.velocity_bandwidth_hz * m.inertia / scale;
+  velocity_integral_ = kTwoPi * m.velocity_integral_hz;
+  // Exact discretisation of dF/dt = ωc (F_cmd − F) with F_cmd held over one sub-step.
+  current_alpha_ = m.current_bandwidth_hz > 0 ? 1.0 - std::exp(-kTwoPi * m.current_bandwidth_hz * h_) : 1.0;
+  power_per_effort_velocity_ = 1.0 / scale;
+  half_backlash_ = m.backlash / 2;
+
+  if (config.drive == JointDrive::Stepper) {
+    steps_emitted_ = std::llround(m.start_position * config.counts_per_unit);
+    motor_ = static_cast<double>(steps_emitted_) / config.counts_per_unit;
+  } else {
+    motor_ = m.start_position;
+  }
+  screw_ = motor_;
+  steps_at_period_start_ = steps_emitted_;
+  cmd_.position = motor_;
+  cmd_.step_position = steps_emitted_;
+  feedback_at_period_start_ = feedback_raw();
+}
+
+JointCapabilities SimJoint::capabilities() const noexcept {
+  JointCapabilities c;
+  c.drive = config_.drive;
+  const SwitchLayout& s = config_.switches;
+  c.switches = static_cast<std::uint8_t>(
+      (s.limit_neg.present ? kSwitchLimitNeg : 0) | (s.limit_pos.present ? kSwitchLimitPos : 0) |
+      (s.home.present ? kSwitchHome : 0) | (s.decel.present ? kSwitchDecel : 0));
+  const bool servo = config_.drive == JointDrive::Servo;
+  c.index = servo && config_.model.index_spacing > 0;
+  c.effort = servo;
+  return c;
+}
+
+double SimJoint::table_position() const noexcept {
+  return screw_ + pitch_.at(screw_);
+}
+
+double SimJoint::feedback_raw() const noexcept {
+  if (config_.drive == JointDrive::Stepper)
+    return static_cast<double>(steps_emitted_) / config_.counts_per_unit;
+  return config_.model.feedback == FeedbackSource::Table ? table_position() : motor_;
+}
+
+// An incremental encoder counts whole lines: floor(x · counts_per_unit). The truncating cast
+// plus a correction is floor() without a libm call on baseline x86-64. Positions beyond
+// ±2^62 counts (or NaN) are clamped rather than overflowing the cast.
+std::int64_t SimJoint::counts(double position) const noexcept {
+  constexpr double kLimit = 0x1.0p62;
+  const double q = position * config_.counts_per_unit;
+  if (!(q > -kLimit)) return -static_cast<std::int64_t>(kLimit);
+  if (!(q < kLimit)) return static_cast<std::int64_t>(kLimit);
+  auto c = static_cast<std::int64_t>(q);
+  if (static_cast<double>(c) > q) --c;
+  return c;
+}
+
+/// The encoder reading as reported: counts / counts_per_unit, correctly rounded.
+double SimJoint::quantise(double position) const noexcept {
+  return static_cast<double>(counts(position)) / config_.counts_per_unit;
+}
+
+/// The same reading for the drive's own loop, by a multiplication: it differs from quantise()
+/// by at most an ulp and keeps the division off each sub-step's dependency chain.
+double SimJoint::quantise_fast(double position) const noexcept {
+  return static_cast<double>(counts(position)) * unit_per_count_;
+}
+
+void SimJoint::begin_period(const JointOutputs& cmd, bool powered, double external_effort) noexcept {
+  cmd_ = cmd;
+  powered_ = powered && cmd.enable && !injected_fault_;
+  external_effort_ = external_effort;
+  steps_at_period_start_ = steps_emitted_;
+  feedback_at_period_start_ = feedback_raw();
+  energy_j_ = 0;
+  if (!powered_) {
+    effort_ = 0;
+    position_integral_ = 0;
+    velocity_error_integral_ = 0;
+  }
+}
+
+void SimJoint::substep(int i) noexcept {
+  if (config_.drive == JointDrive::Stepper) {
+    stepper_substep(i);
+  } else {
+    servo_substep(h_ * i);
+  }
+}
+
+// Drive cascade (see docs/machine.md): the position reference is the command extrapolated
+// with the feed-forward velocity; P(I) position loop → velocity reference (clamped) → PI
+// velocity loop → force command (clamped to peak) → first-order current loop. The
+// integrators stop while their loop's output saturates.
+void SimJoint::servo_substep(double t_s) noexcept {
+  if (powered_) {
+    const SimJointModel& m = config_.model;
+    const double error = cmd_.position + cmd_.velocity_ff * t_s - quantise_fast(feedback_raw());
+    double v_ref = m.feed_forward * cmd_.velocity_ff + m.position_gain * error +
+                   m.position_integral * position_integral_;
+    if (m.velocity_limit > 0 && std::abs(v_ref) > m.velocity_limit) {
+      v_ref = std::copysign(m.velocity_limit, v_ref);
+    } else {
+      position_integral_ += error * h_;
+    }
+    const double v_error = v_ref - velocity_;
+    double f_cmd = velocity_gain_ * (v_error + velocity_integral_ * velocity_error_integral_);
+    if (std::abs(f_cmd) > m.peak_effort) {
+      f_cmd = std::copysign(m.peak_effort, f_cmd);
+    } else {
+      velocity_error_integral_ += v_error * h_;
+    }
+    effort_ += current_alpha_ * (f_cmd - effort_);
+  }
+  integrate_mechanics(effort_);
+  take_up_backlash();
+}
+
+// Rigid body with friction, semi-implicit Euler. At rest the body sticks while the applied
+// effort stays within static friction; moving, Coulomb and viscous friction oppose the
+// velocity, and a sign change inside a sub-step ends at rest (the next sub-step decides
+// whether it sticks) so that friction never drives the body.
+void SimJoint::integrate_mechanics(double drive_effort) noexcept {
+  const SimJointModel& m = config_.model;
+  const double applied = drive_effort + external_effort_;
+  double v = velocity_;
+  if (v == 0.0) {
+    if (std::abs(applied) <= m.static_friction) return;
+    v = accel_per_effort_ * (applied - std::copysign(m.coulomb_friction, applied)) * h_;
+  } else {
+    const double net = applied - m.viscous_friction * v - std::copysign(m.coulomb_friction, v);
+    const double v_next = v + accel_per_effort_ * net * h_;
+    v = (v_next > 0) == (v > 0) ? v_next : 0.0;
+  }
+  velocity_ = v;
+  motor_ += v * h_;
+  energy_j_ += drive_effort * v * h_ * power_per_effort_velocity_;
+}
+
+// Backlash as a play operator: the nut (screw_) follows the motor only once the motor has
+// taken up half the lost motion on either side.
+void SimJoint::take_up_backlash() noexcept {
+  const double slack = motor_ - screw_;
+  if (slack > half_backlash_) {
+    screw_ = motor_ - half_backlash_;
+  } else if (slack < -half_backlash_) {
+    screw_ = motor_ + half_backlash_;
+  }
+}
+
+// The step generator spreads this period's steps evenly; sub-step i has emitted the share
+// up to its end. An unpowered stepper emits nothing (and so loses its place).
+void SimJoint::stepper_substep(int i) noexcept {
+  if (!powered_) return;
+  const std::int64_t delta = cmd_.step_position - steps_at_period_start_;
+  steps_emitted_ = steps_at_period_start_ + delta * (i + 1) / substeps_;
+  motor_ = static_cast<double>(steps_emitted_) / config_.counts_per_unit;
+  take_up_backlash();
+}
+
+void SimJoint::end_period() noexcept {
+  if (config_.drive == JointDrive::Stepper) {
+    velocity_ =
+        static_cast<double>(steps_emitted_ - steps_at_period_start_) / config_.counts_per_unit / period_s_;
+  }
+  if (config_.drive == JointDrive::Servo && config_.model.index_spacing > 0) {
+    update_index(feedback_at_period_start_, feedback_raw());
+  }
+}
+
+// Index marks sit at index_offset + k·index_spacing on the feedback scale. A period moves far
+// less than one spacing, so comparing the mark numbers at its ends finds the marks passed.
+void SimJoint::update_index(double before, double after) noexcept {
+  const double spacing = config_.model.index_spacing;
+  const double offset = config_.model.index_offset;
+  const double k_before = std::floor((before - offset) / spacing);
+  const double k_after = std::floor((after - offset) / spacing);
+  if (k_before == k_after) return;
+  index_count_ += static_cast<std::uint32_t>(std::abs(k_after - k_before));
+  const double last_mark = k_after > k_before ? k_after : k_after + 1;
+  index_position_ = quantise(offset + last_mark * spacing);
+}
+
+void SimJoint::sample(JointInputs& in, SplitMix64& rng) noexcept {
+  const bool servo = config_.drive == JointDrive::Servo;
+  in.position = servo ? quantise(feedback_raw()) : feedback_raw();
+  in.velocity = velocity_;
+  in.effort = servo ? effort_ : 0.0;
+  in.index_count = index_count_;
+  in.index_position = index_position_;
+  in.amp_fault = injected_fault_;
+  const double x = table_position();
+  in.limit_neg = limit_neg_.update(x, rng);
+  in.limit_pos = limit_pos_.update(x, rng);
+  in.home = home_.update(x, rng);
+  in.decel = decel_.update(x, rng);
+}
+
+}  // namespace opencnc::machine

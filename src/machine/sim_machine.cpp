@@ -1,0 +1,189 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// SimMachine: one servo period = latch outputs, integrate joints and spindle in fixed
+// sub-steps, update the power supply and auxiliaries, sample the inputs.
+#include "opencnc/machine/sim_machine.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace opencnc::machine {
+
+namespace {
+
+/// Regenerated energy lifts the DC link until the brake chopper burns it off at this ratio
+/// of the nominal voltage.
+constexpr double kBrakeChopperRatio = 1.15;
+
+/// Whole periods a delay takes (at least one: the acknowledgement comes with a later sample
+/// than the request at the earliest).
+std::uint64_t periods_for(double delay_s, double period_s) {
+  const double n = std::ceil(delay_s / period_s - 1e-9);
+  return std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::max(0.0, n)));
+}
+
+std::uint64_t low_bits(int n) {
+  return n >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << n) - 1;
+}
+
+}  // namespace
+
+SimMachine::SimMachine(const SimMachineConfig& config) : config_(config), rng_(config.seed) {
+  for (int j = 0; j < config.joint_count; ++j) {
+    const auto uj = static_cast<std::size_t>(j);
+    joints_[uj] = SimJoint(config.joints[uj], config.servo_period_s, config.substeps);
+  }
+  if (config.spindle) spindle_ = SimSpindle(config.spindle_config, config.servo_period_s, config.substeps);
+  if (config.probe.joint >= 0)
+    probe_ = SimSwitch(config.probe.trip, config.probe.hysteresis, config.probe.noise);
+  dc_link_v_ = config.power.dc_link_nominal_v;
+  ups_periods_left_ =
+      config.power.ups
+          ? static_cast<std::uint64_t>(std::llround(config.power.ups_runtime_s / config.servo_period_s))
+          : 0;
+  arc_needed_ = periods_for(config.process.arc_delay_s, config.servo_period_s);
+  prepare_needed_ = periods_for(config.tool_changer.prepare_time_s, config.servo_period_s);
+  change_needed_ = periods_for(config.tool_changer.change_time_s, config.servo_period_s);
+  sample();
+}
+
+MachineCapabilities SimMachine::capabilities() const noexcept {
+  MachineCapabilities c;
+  c.joint_count = config_.joint_count;
+  for (int j = 0; j < config_.joint_count; ++j)
+    c.joints[static_cast<std::size_t>(j)] = joint(j).capabilities();
+  c.spindle = config_.spindle;
+  c.spindle_encoder = config_.spindle && config_.spindle_config.encoder_counts_per_rev > 0;
+  c.spindle_orient = config_.spindle && config_.spindle_config.orient;
+  c.power_monitor = config_.power_monitor;
+  c.ups = config_.power_monitor && config_.power.ups;
+  c.probe = config_.probe.joint >= 0;
+  c.tool_changer = config_.tool_changer.present;
+  c.torch = config_.process.torch;
+  c.generator = config_.process.generator;
+  c.digital_inputs = config_.digital_inputs;
+  c.digital_outputs = config_.digital_outputs;
+  c.analog_inputs = config_.analog_inputs;
+  c.analog_outputs = config_.analog_outputs;
+  return c;
+}
+
+void SimMachine::read(MachineInputs& in) noexcept {
+  in = inputs_;
+}
+
+void SimMachine::write(const MachineOutputs& out) noexcept {
+  outputs_ = out;
+  advance();
+  ++inputs_.cycle;
+  sample();
+}
+
+bool SimMachine::drives_powered() const noexcept {
+  return !estop_pressed_ && outputs_.estop_release && !undervoltage_;
+}
+
+void SimMachine::set_amp_fault(int joint, bool fault) noexcept {
+  if (joint >= 0 && joint < config_.joint_count) joints_[static_cast<std::size_t>(joint)].set_fault(fault);
+}
+
+void SimMachine::set_external_effort(int joint, double effort) noexcept {
+  if (joint >= 0 && joint < config_.joint_count) external_effort_[static_cast<std::size_t>(joint)] = effort;
+}
+
+void SimMachine::set_digital_input(int channel, bool value) noexcept {
+  if (channel < 0 || channel >= kDigitalChannels) return;
+  const std::uint64_t bit = std::uint64_t{1} << channel;
+  digital_in_ = value ? (digital_in_ | bit) : (digital_in_ & ~bit);
+}
+
+void SimMachine::set_analog_input(int channel, double value) noexcept {
+  if (channel >= 0 && channel < kAnalogChannels) analog_in_[static_cast<std::size_t>(channel)] = value;
+}
+
+void SimMachine::advance() noexcept {
+  const bool powered = drives_powered();
+  const int n = config_.joint_count;
+  for (int j = 0; j < n; ++j) {
+    const auto uj = static_cast<std::size_t>(j);
+    joints_[uj].begin_period(outputs_.joints[uj], powered && !undervoltage_fault_[uj], external_effort_[uj]);
+  }
+  if (config_.spindle) spindle_.begin_period(outputs_.spindle, powered);
+  // Sub-steps outside, joints inside: the joints' dependency chains are independent, so the
+  // CPU overlaps them (measured: about twice as fast as one joint after the other).
+  for (int i = 0; i < config_.substeps; ++i) {
+    for (int j = 0; j < n; ++j) joints_[static_cast<std::size_t>(j)].substep(i);
+    if (config_.spindle) spindle_.substep();
+  }
+  double energy_j = 0;
+  for (int j = 0; j < n; ++j) {
+    joints_[static_cast<std::size_t>(j)].end_period();
+    energy_j += joints_[static_cast<std::size_t>(j)].energy_j();
+  }
+  if (config_.spindle) spindle_.end_period();
+  update_power(energy_j);
+  update_auxiliaries();
+}
+
+// Mains on: the rectifier holds the DC link at nominal. Mains off with a charged UPS: the
+// UPS does. Otherwise the link capacitor alone feeds the idle load and the axes:
+// ½·C·V² loses idle_power·T + E_axes per period (braking axes give energy back).
+void SimMachine::update_power(double energy_j) noexcept {
+  const SimPowerConfig& p = config_.power;
+  const double period = config_.servo_period_s;
+  on_battery_ = !mains_ok_ && ups_periods_left_ > 0;
+  if (mains_ok_) {
+    dc_link_v_ = p.dc_link_nominal_v;
+  } else if (on_battery_) {
+    --ups_periods_left_;
+    dc_link_v_ = p.dc_link_nominal_v;
+  } else {
+    const double c = p.dc_link_capacitance_f;
+    const double stored_j = 0.5 * c * dc_link_v_ * dc_link_v_ - p.idle_power_w * period - energy_j;
+    dc_link_v_ =
+        std::min(std::sqrt(std::max(0.0, 2.0 * stored_j / c)), kBrakeChopperRatio * p.dc_link_nominal_v);
+  }
+  undervoltage_ = dc_link_v_ < p.dc_link_min_v;
+  // A drive that sees undervoltage while enabled latches the fault until it is disabled.
+  for (int j = 0; j < config_.joint_count; ++j) {
+    const auto uj = static_cast<std::size_t>(j);
+    const bool enabled = outputs_.joints[uj].enable;
+    if (undervoltage_ && enabled) undervoltage_fault_[uj] = true;
+    if (!enabled && !undervoltage_) undervoltage_fault_[uj] = false;
+  }
+}
+
+void SimMachine::update_auxiliaries() noexcept {
+  const bool changer = config_.tool_changer.present;
+  prepare_periods_ = changer && outputs_.tool.prepare ? prepare_periods_ + 1 : 0;
+  change_periods_ = changer && outputs_.tool.change ? change_periods_ + 1 : 0;
+  arc_periods_ = config_.process.torch && outputs_.process.torch_on && arc_available_ ? arc_periods_ + 1 : 0;
+}
+
+void SimMachine::sample() noexcept {
+  inputs_.estop_ok = !estop_pressed_;
+  for (int j = 0; j < config_.joint_count; ++j) {
+    const auto uj = static_cast<std::size_t>(j);
+    joints_[uj].sample(inputs_.joints[uj], rng_);
+    inputs_.joints[uj].amp_fault = inputs_.joints[uj].amp_fault || undervoltage_fault_[uj];
+  }
+  inputs_.power.mains_ok = mains_ok_;
+  inputs_.power.ups_on_battery = on_battery_;
+  inputs_.power.dc_link_v = dc_link_v_;
+  if (config_.spindle) spindle_.sample(inputs_.spindle);
+  if (config_.probe.joint >= 0) {
+    inputs_.probe =
+        probe_.update(joints_[static_cast<std::size_t>(config_.probe.joint)].table_position(), rng_);
+  }
+  inputs_.process.arc_ok = arc_periods_ >= arc_needed_;
+  inputs_.process.gap_voltage_v =
+      config_.process.generator && outputs_.process.generator_on ? gap_voltage_v_ : 0.0;
+  inputs_.tool.prepared = prepare_periods_ >= prepare_needed_;
+  inputs_.tool.changed = change_periods_ >= change_needed_;
+  inputs_.digital_in = digital_in_ & low_bits(config_.digital_inputs);
+  for (int k = 0; k < kAnalogChannels; ++k) {
+    inputs_.analog_in[static_cast<std::size_t>(k)] =
+        k < config_.analog_inputs ? analog_in_[static_cast<std::size_t>(k)] : 0.0;
+  }
+}
+
+}  // namespace opencnc::machine

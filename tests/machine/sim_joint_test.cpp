@@ -1,0 +1,343 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// SimJoint: step response, following error against gains, friction stick, quantisation,
+// backlash, pitch error, index marks, stepper joints, rotary units.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "opencnc/machine/sim_joint.hpp"
+
+namespace opencnc::machine {
+namespace {
+
+constexpr double kPeriod = 0.001;
+constexpr int kSubsteps = 10;
+
+SimJointConfig servo_config() {
+  SimJointConfig c;
+  c.counts_per_unit = 10000;  // 0.1 µm
+  c.model.inertia = 100;
+  c.model.coulomb_friction = 0;
+  c.model.static_friction = 0;
+  c.model.viscous_friction = 0;
+  c.switches.noise = 0;
+  return c;
+}
+
+/// Drives a joint through whole periods with one command.
+struct JointRig {
+  SimJoint joint;
+  SplitMix64 rng{7};
+  JointInputs in{};
+
+  explicit JointRig(const SimJointConfig& c) : joint(c, kPeriod, kSubsteps) { joint.sample(in, rng); }
+
+  void period(double position, double velocity_ff = 0, bool enable = true, double external = 0) {
+    JointOutputs out;
+    out.position = position;
+    out.velocity_ff = velocity_ff;
+    out.enable = enable;
+    joint.begin_period(out, true, external);
+    for (int i = 0; i < kSubsteps; ++i) joint.substep(i);
+    joint.end_period();
+    joint.sample(in, rng);
+  }
+  void steps(std::int64_t step_position, bool enable = true) {
+    JointOutputs out;
+    out.step_position = step_position;
+    out.enable = enable;
+    joint.begin_period(out, true, 0);
+    for (int i = 0; i < kSubsteps; ++i) joint.substep(i);
+    joint.end_period();
+    joint.sample(in, rng);
+  }
+};
+
+// With the velocity loop ~15× faster than the position loop, a step answers like a first-
+// order lag with time constant 1/Kp: 63 % after 1/Kp, within 0.1 µm after ~16/Kp.
+TEST(SimJoint, StepResponseIsFirstOrderWithPositionGain) {
+  for (double kp : {30.0, 60.0}) {
+    SimJointConfig c = servo_config();
+    c.model.position_gain = kp;
+    JointRig rig(c);
+    const int tau_periods = static_cast<int>(std::lround(1.0 / kp / kPeriod));
+    for (int k = 0; k < tau_periods; ++k) rig.period(1.0);
+    EXPECT_NEAR(rig.joint.motor_position(), 1.0 - std::exp(-1.0), 0.05) << "Kp " << kp;
+    double peak = 0;
+    for (int k = 0; k < 15 * tau_periods; ++k) {
+      rig.period(1.0);
+      peak = std::max(peak, rig.joint.motor_position());
+    }
+    EXPECT_NEAR(rig.in.position, 1.0, 2e-4) << "Kp " << kp;
+    EXPECT_LT(peak, 1.01) << "overshoot with Kp " << kp;
+  }
+}
+
+// Following error as the servo tick measures it: the next command minus the feedback
+// sampled at the end of this period.
+
+// Ramp without feed-forward: the staircase reference lags the ramp by T/2 on average and the
+// P position loop adds v/Kp, so the error is v·(1/Kp + T/2) (plus v·h/2 from the drive's own
+// sampling). The model must produce this, and halve the 1/Kp part when the gain doubles.
+TEST(SimJoint, FollowingErrorWithoutFeedForwardIsVelocityOverGain) {
+  const double v = 50.0;  // mm/s
+  for (double kp : {25.0, 50.0, 100.0}) {
+    SimJointConfig c = servo_config();
+    c.model.position_gain = kp;
+    c.model.feed_forward = 0;
+    JointRig rig(c);
+    double cmd = 0;
+    for (int k = 0; k < 1000; ++k) {
+      rig.period(cmd);
+      cmd += v * kPeriod;
+    }
+    const double expected = v * (1.0 / kp + kPeriod / 2);
+    EXPECT_NEAR(cmd - rig.in.position, expected, 0.01 * expected) << "Kp " << kp;
+  }
+}
+
+// With velocity feed-forward the reference is continuous and the velocity loop's integrator
+// supplies the friction force, so the steady error is the encoder count, not v/Kp.
+TEST(SimJoint, FeedForwardRemovesSteadyFollowingError) {
+  SimJointConfig c = servo_config();
+  c.model.coulomb_friction = 40;
+  c.model.static_friction = 50;
+  c.model.viscous_friction = 0.05;
+  JointRig rig(c);
+  const double v = 100.0;
+  double cmd = 0;
+  double max_late = 0;
+  for (int k = 0; k < 1500; ++k) {
+    rig.period(cmd, v);
+    cmd += v * kPeriod;
+    if (k > 1000) max_late = std::max(max_late, std::abs(cmd - rig.in.position));
+  }
+  EXPECT_LT(max_late, 2e-4);  // vs v/Kp = 1.7 mm without feed-forward
+}
+
+// Following error while accelerating emerges from the loops: the feed-forward velocity is
+// held over the period while the needed velocity ramps on, and the velocity loop must build
+// the force m·a through its error. It is proportional to the acceleration (a linear system),
+// shrinks with a higher position gain, and is far larger without feed-forward.
+TEST(SimJoint, FollowingErrorDuringAccelerationFollowsGains) {
+  auto max_error = [](double accel, double kp, double ff) {
+    SimJointConfig c = servo_config();
+    c.model.position_gain = kp;
+    c.model.feed_forward = ff;
+    JointRig rig(c);
+    double worst = 0;
+    for (int k = 0; k < 300; ++k) {
+      const double t = k * kPeriod;
+      rig.period(0.5 * accel * t * t, accel * t);
+      worst = std::max(worst, std::abs(0.5 * accel * (t + kPeriod) * (t + kPeriod) - rig.in.position));
+    }
+    return worst;
+  };
+  const double base = max_error(1000, 60, 1);
+  EXPECT_GT(base, 1e-3);  // microns, not a constant zero
+  EXPECT_NEAR(max_error(2000, 60, 1), 2 * base, 0.05 * base);
+  EXPECT_LT(max_error(1000, 120, 1), 0.8 * base);
+  EXPECT_GT(max_error(1000, 60, 0), 10 * base);
+}
+
+TEST(SimJoint, VelocityLimitOfDriveBoundsSpeed) {
+  SimJointConfig c = servo_config();
+  c.model.velocity_limit = 20;
+  JointRig rig(c);
+  for (int k = 0; k < 200; ++k) rig.period(100.0);
+  EXPECT_NEAR(rig.joint.velocity(), 20.0, 0.05);
+}
+
+// P position and P velocity loop: force = Kv·Kp·error, so the axis cannot start while that is
+// below static friction: a dead band of Fs/(Kv·Kp).
+TEST(SimJoint, StaticFrictionHoldsSmallStepsWithoutIntegrators) {
+  SimJointConfig c = servo_config();
+  c.model.coulomb_friction = 40;
+  c.model.static_friction = 50;
+  c.model.velocity_integral_hz = 0;
+  c.model.position_integral = 0;
+  const double kv = 2 * std::numbers::pi * c.model.velocity_bandwidth_hz * c.model.inertia / 1000.0;
+  const double dead_band = c.model.static_friction / (kv * c.model.position_gain);
+
+  JointRig small(c);
+  for (int k = 0; k < 500; ++k) small.period(0.5 * dead_band);
+  EXPECT_EQ(small.joint.motor_position(), 0.0);  // never moved at all
+  EXPECT_EQ(small.joint.velocity(), 0.0);
+
+  JointRig large(c);
+  for (int k = 0; k < 500; ++k) large.period(10 * dead_band);
+  const double stuck_error = 10 * dead_band - large.joint.motor_position();
+  EXPECT_GT(large.joint.motor_position(), 0.0);
+  EXPECT_GT(stuck_error, 0.0);               // stopped short …
+  EXPECT_LE(stuck_error, dead_band + 1e-4);  // … inside the dead band
+  EXPECT_EQ(large.joint.velocity(), 0.0);
+
+  // With a PI velocity loop the integrator winds up until it breaks the axis loose; it then
+  // creeps towards the target in stick-slip steps.
+  c.model.velocity_integral_hz = 30;
+  JointRig pi(c);
+  for (int k = 0; k < 2000; ++k) pi.period(0.5 * dead_band);
+  EXPECT_NEAR(pi.joint.motor_position(), 0.5 * dead_band, 0.1 * dead_band);
+}
+
+TEST(SimJoint, ExternalEffortMustBreakStaticFriction) {
+  SimJointConfig c = servo_config();
+  c.model.coulomb_friction = 40;
+  c.model.static_friction = 50;
+  c.model.viscous_friction = 0;
+  JointRig held(c);
+  for (int k = 0; k < 100; ++k) held.period(0, 0, false, 49.0);
+  EXPECT_EQ(held.joint.motor_position(), 0.0);
+
+  JointRig pushed(c);
+  for (int k = 0; k < 100; ++k) pushed.period(0, 0, false, 60.0);
+  // (60 − 40) N / 100 kg = 0.2 m/s² = 200 mm/s² for 0.1 s.
+  EXPECT_NEAR(pushed.joint.velocity(), 20.0, 0.01);
+  EXPECT_NEAR(pushed.joint.motor_position(), 0.5 * 200 * 0.1 * 0.1, 0.01);
+}
+
+TEST(SimJoint, RotaryJointWorksInDegrees) {
+  SimJointConfig c = servo_config();
+  c.rotary = true;
+  c.model.inertia = 0.5;  // kg·m²
+  JointRig rig(c);
+  for (int k = 0; k < 100; ++k) rig.period(0, 0, false, 1.0);  // 1 N·m
+  // 2 rad/s² = 114.59 °/s² for 0.1 s.
+  EXPECT_NEAR(rig.joint.velocity(), 2.0 * 180.0 / std::numbers::pi * 0.1, 1e-6);
+}
+
+TEST(SimJoint, FeedbackIsQuantisedByTheEncoder) {
+  SimJointConfig c = servo_config();
+  c.counts_per_unit = 200;  // 5 µm
+  JointRig rig(c);
+  for (int k = 0; k < 400; ++k) {
+    rig.period(0.3 * std::sin(k * 0.02));
+    const double counts = rig.in.position * 200;
+    EXPECT_NEAR(counts, std::round(counts), 1e-9);
+    EXPECT_LE(rig.in.position, rig.joint.motor_position());
+    EXPECT_GT(rig.in.position, rig.joint.motor_position() - 1.0 / 200);
+  }
+}
+
+// The play operator, seen exactly through a stepper (its motor sits on the step grid).
+TEST(SimJoint, BacklashIsLostOnReversal) {
+  SimJointConfig c;
+  c.drive = JointDrive::Stepper;
+  c.counts_per_unit = 1000;
+  c.model.backlash = 0.02;
+  JointRig rig(c);
+  rig.steps(1000);
+  EXPECT_DOUBLE_EQ(rig.joint.table_position(), 1.0 - 0.01);
+  rig.steps(985);  // back by less than the backlash: the table stays
+  EXPECT_DOUBLE_EQ(rig.joint.table_position(), 1.0 - 0.01);
+  rig.steps(500);
+  EXPECT_DOUBLE_EQ(rig.joint.table_position(), 0.5 + 0.01);
+  rig.steps(1500);
+  EXPECT_DOUBLE_EQ(rig.joint.table_position(), 1.5 - 0.01);
+}
+
+// A servo on a motor encoder closes its loop around the backlash: the motor reaches the
+// command and the table ends about half the backlash behind, on the side it came from (the
+// motor's small overshoot on stopping takes back a little of it).
+TEST(SimJoint, ServoOnMotorEncoderLeavesBacklashInTheTable) {
+  SimJointConfig c = servo_config();
+  c.model.backlash = 0.02;
+  JointRig rig(c);
+  for (int k = 0; k < 1000; ++k) rig.period(std::min(1.0, k * 0.002), k < 500 ? 2 : 0);
+  EXPECT_NEAR(rig.joint.motor_position(), 1.0, 1e-4);
+  EXPECT_NEAR(rig.joint.table_position(), 0.99, 0.002);
+  for (int k = 0; k < 1000; ++k) rig.period(std::max(0.0, 1.0 - k * 0.002), k < 500 ? -2 : 0);
+  EXPECT_NEAR(rig.joint.motor_position(), 0.0, 1e-4);
+  EXPECT_NEAR(rig.joint.table_position(), 0.01, 0.002);
+}
+
+TEST(SimJoint, MotorEncoderDoesNotSeePitchErrorButTableScaleDoes) {
+  SimJointConfig c = servo_config();
+  c.model.pitch_error = {{0, 0}, {100, 0.010}, {200, -0.004}};
+  JointRig motor(c);
+  c.model.feedback = FeedbackSource::Table;
+  JointRig table(c);
+  for (int k = 0; k < 3000; ++k) {
+    const double cmd = std::min(150.0, 0.1 * k);
+    motor.period(cmd, k * 0.1 < 150 ? 100 : 0);
+    table.period(cmd, k * 0.1 < 150 ? 100 : 0);
+  }
+  EXPECT_NEAR(motor.in.position, 150.0, 2e-4);
+  EXPECT_NEAR(motor.joint.table_position(), 150.0 + 0.003, 2e-4);
+  EXPECT_NEAR(table.in.position, 150.0, 2e-4);
+  EXPECT_NEAR(table.joint.table_position(), 150.0, 2e-4);
+  EXPECT_NEAR(table.joint.motor_position(), 150.0 - 0.003, 2e-4);
+}
+
+TEST(PitchErrorTable, InterpolatesLinearlyAndHoldsEnds) {
+  PitchErrorTable t({{-10, 0.002}, {0, 0}, {50, 0.005}});
+  EXPECT_EQ(t.at(-20), 0.002);
+  EXPECT_EQ(t.at(-10), 0.002);
+  EXPECT_EQ(t.at(0), 0.0);
+  EXPECT_DOUBLE_EQ(t.at(25), 0.0025);
+  EXPECT_DOUBLE_EQ(t.at(-5), 0.001);
+  EXPECT_EQ(t.at(80), 0.005);
+  EXPECT_EQ(PitchErrorTable().at(3), 0.0);
+}
+
+// The segment memory must not change results: random jumps agree with a fresh table.
+TEST(PitchErrorTable, RandomQueriesMatchAFreshLookup) {
+  std::vector<PitchPoint> pts;
+  for (int i = 0; i <= 40; ++i) pts.push_back({i * 10.0, 0.001 * std::sin(i)});
+  PitchErrorTable walking(pts);
+  SplitMix64 rng(42);
+  for (int n = 0; n < 20000; ++n) {
+    const double s = 210 + 230 * rng.symmetric();
+    PitchErrorTable fresh(pts);
+    ASSERT_EQ(walking.at(s), fresh.at(s)) << s;
+  }
+}
+
+TEST(SimJoint, IndexMarksAreCountedAndLatched) {
+  SimJointConfig c = servo_config();
+  c.model.index_spacing = 5.0;
+  c.model.index_offset = 1.25;
+  JointRig rig(c);
+  double cmd = 0;
+  for (int k = 0; k < 2000; ++k) rig.period(cmd += 0.02, 20);  // 0 → 40 mm
+  // Marks at 1.25, 6.25, …, 36.25 have been passed (the axis lags the command a little).
+  EXPECT_EQ(rig.in.index_count, 8u);
+  EXPECT_EQ(rig.in.index_position, 36.25);
+  for (int k = 0; k < 500; ++k) rig.period(cmd -= 0.02, -20);  // back to 30 mm
+  EXPECT_EQ(rig.in.index_count, 10u);
+  EXPECT_EQ(rig.in.index_position, 31.25);
+}
+
+TEST(SimJoint, StepperFollowsStepsAndLosesThemWhenDisabled) {
+  SimJointConfig c;
+  c.drive = JointDrive::Stepper;
+  c.counts_per_unit = 400;  // steps per mm
+  c.model.start_position = 1.0;
+  JointRig rig(c);
+  EXPECT_EQ(rig.in.position, 1.0);
+  rig.steps(400 + 40);
+  EXPECT_EQ(rig.in.position, 1.1);
+  EXPECT_DOUBLE_EQ(rig.in.velocity, 0.1 / kPeriod);
+  rig.steps(400 + 80, false);
+  EXPECT_EQ(rig.in.position, 1.1);  // nothing emitted
+  EXPECT_EQ(rig.joint.capabilities().drive, JointDrive::Stepper);
+  EXPECT_FALSE(rig.joint.capabilities().index);
+}
+
+TEST(SimJoint, DisabledOrFaultedDriveProducesNoForce) {
+  SimJointConfig c = servo_config();
+  JointRig rig(c);
+  rig.joint.set_fault(true);
+  for (int k = 0; k < 100; ++k) rig.period(1.0);
+  EXPECT_EQ(rig.joint.motor_position(), 0.0);
+  EXPECT_TRUE(rig.in.amp_fault);
+  rig.joint.set_fault(false);
+  for (int k = 0; k < 100; ++k) rig.period(1.0, 0, false);
+  EXPECT_EQ(rig.joint.motor_position(), 0.0);
+  EXPECT_EQ(rig.in.effort, 0.0);
+}
+
+}  // namespace
+}  // namespace opencnc::machine
