@@ -78,7 +78,8 @@ run_rs274() {
     args+=(-i "$tmp/run.ini")
   fi
   set +e
-  (cd "$dir" && "$rs274" "${args[@]}" -g "$file" </dev/null >"$tmp/out" 2>"$tmp/err.raw")
+  # rs274 keeps the tool table in $HOME/.tool.mmap: a private HOME keeps parallel runs apart.
+  (cd "$dir" && HOME=$tmp "$rs274" "${args[@]}" -g "$file" </dev/null >"$tmp/out" 2>"$tmp/err.raw")
   echo $? >"$tmp/rc"
   set -e
   grep -v -x 'executing' "$tmp/err.raw" | sed "s#$programs#@programs#g" >"$tmp/err" || true
