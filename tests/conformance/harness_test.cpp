@@ -273,9 +273,11 @@ TEST(Runner, Rs274CommandLineAndTwins) {
   EXPECT_EQ(twin.cwd, fs::path("/src/tests/conformance/twins/fanuc"));
   EXPECT_EQ(twin.argv.back(), "m98.ngc");
   EXPECT_TRUE(rs274_can_run(c));
-  c.golden = "-";
-  EXPECT_FALSE(rs274_can_run(c));
   c.set = "corpus";
+  c.program = "fanuc-style.nc";
+  EXPECT_EQ(rs274_invocation(c, roots, "rs274", scratch).argv.back(), "fanuc-style.nc");  // no twin
+  EXPECT_TRUE(rs274_can_run(c));
+  c.golden = "-";
   EXPECT_FALSE(rs274_can_run(c));
 }
 

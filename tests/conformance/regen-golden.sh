@@ -233,6 +233,8 @@ done <"$corpus/MANIFEST.tsv"
 if ((check)); then
   stale=0
   diff -q "$here/cases.tsv" "$out_root/cases.tsv" >/dev/null || { echo "stale: cases.tsv" >&2; stale=1; }
+  "$here/update-docs.sh" "$out_root/cases.tsv" "$tmp/conformance.md"
+  diff -q "$repo/docs/conformance.md" "$tmp/conformance.md" >/dev/null || { echo "stale: docs/conformance.md tables" >&2; stale=1; }
   while IFS= read -r f; do
     r=${f#"$golden"/}
     if [[ $f == *.xz ]]; then
@@ -247,5 +249,6 @@ if ((check)); then
   ((stale == 0)) && echo "golden files are up to date" >&2
   exit $stale
 fi
+"$here/update-docs.sh"
 ((failures == 0)) || { echo "regen-golden: $failures problem(s); golden files written anyway" >&2; exit 1; }
 echo "regen-golden: $(grep -vc '^#' "$out_root/cases.tsv") rows in cases.tsv, $(find "$golden" -type f | wc -l) golden files" >&2

@@ -80,14 +80,18 @@ Invocation opencnc_invocation(const Case& c, const Roots& roots, const std::file
   return inv;
 }
 
-bool rs274_can_run(const Case& c) { return c.dialect == "linuxcnc" || (c.set == "own" && c.golden != "-"); }
+namespace {
+// Own Fanuc-dialect programs are represented by their hand-written LinuxCNC twin.
+bool uses_twin(const Case& c) { return c.set == "own" && c.dialect != "linuxcnc"; }
+}  // namespace
+
+bool rs274_can_run(const Case& c) { return c.golden != "-"; }
 
 Invocation rs274_invocation(const Case& c, const Roots& roots, const std::filesystem::path& rs274,
                             const std::filesystem::path& scratch) {
   auto program = roots.program(c);
   std::string subpath = c.subpath;
-  if (c.dialect != "linuxcnc") {
-    // Own Fanuc-dialect programs are represented by their LinuxCNC twin, run without a search path.
+  if (uses_twin(c)) {
     program = roots.conf / "twins" / std::filesystem::path(c.program).replace_extension(".ngc");
     subpath = "-";
   }

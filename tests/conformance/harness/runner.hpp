@@ -49,7 +49,9 @@ Invocation opencnc_invocation(const Case& c, const Roots& roots, const std::file
 Invocation rs274_invocation(const Case& c, const Roots& roots, const std::filesystem::path& rs274,
                             const std::filesystem::path& scratch);
 
-/// Whether rs274 can run the case at all (it has no Fanuc dialect; twins stand in for own cases).
+/// Whether rs274 has a golden output for the case to be checked against (every case but the
+/// Fanuc-dialect error programs; own Fanuc-dialect programs run as their twins, Fanuc-style corpus
+/// files as LinuxCNC programs, which rs274 rejects).
 bool rs274_can_run(const Case& c);
 
 /// rs274's standard error as the golden files keep it: without "executing", with the absolute
