@@ -169,6 +169,9 @@ std::optional<std::string> missing_root(const Case& c) {
     return fmt::format("the real-world corpus is not at {} (set OPENCNC_CORPUS)", roots.corpus.string());
   }
   if (!fs::exists(roots.program(c))) return "program not found: " + roots.program(c).string();
+  for (const auto& dir : search_path(c, roots, roots.program(c).parent_path())) {
+    if (!fs::is_directory(dir)) return "subprogram folder not found: " + dir.string();
+  }
   return std::nullopt;
 }
 

@@ -12,7 +12,9 @@
 #
 # How each set runs (the harness runs rs274 and opencnc the same way, from cases.tsv):
 #   own      programs/<area>/*.ngc. Working directory = the program's folder; tool table
-#            tools/standard.tbl; an INI file sets SUBROUTINE_PATH = <area>/lib (if present) : programs/lib.
+#            tools/standard.tbl; an INI file sets SUBROUTINE_PATH = <area>/lib (if present) : programs/lib,
+#            or the folders of a `; subroutine-path:` line (programs/ngcgui drives LinuxCNC's ngcgui
+#            subroutines in OPENCNC_NCFILES, the way LinuxCNC's sample configurations set it up).
 #            errors/ programs must be rejected, every other area accepted (the script stops otherwise).
 #            programs/fanuc and programs/transforms are Fanuc-dialect programs: rs274 cannot run them,
 #            their expected output is rs274's output of a hand-written LinuxCNC twin (twins/<area>/),
@@ -74,6 +76,7 @@ run_rs274() {
   local dir=$1 file=$2 table=$3 subpath=$4 args=()
   [[ $table != - ]] && args+=(-t "$table")
   if [[ $subpath != - ]]; then
+    subpath=${subpath//@ncfiles/$ncfiles}
     printf '[RS274NGC]\nSUBROUTINE_PATH = %s\n' "$subpath" >"$tmp/run.ini"
     args+=(-i "$tmp/run.ini")
   fi
@@ -82,7 +85,7 @@ run_rs274() {
   (cd "$dir" && HOME=$tmp "$rs274" "${args[@]}" -g "$file" </dev/null >"$tmp/out" 2>"$tmp/err.raw")
   echo $? >"$tmp/rc"
   set -e
-  grep -v -x 'executing' "$tmp/err.raw" | sed "s#$programs#@programs#g" >"$tmp/err" || true
+  grep -v -x 'executing' "$tmp/err.raw" | sed "s#$programs#@programs#g; s#$ncfiles#@ncfiles#g" >"$tmp/err" || true
 }
 
 # First line of rs274's error message (the line before the offending block).
@@ -124,6 +127,9 @@ while IFS= read -r path; do
   name=$(case_name own "$rel")
   subpath=../lib
   [[ -d $dir/lib ]] && subpath=lib:../lib
+  # `; subroutine-path: @ncfiles/a @ncfiles/b` replaces the default (drivers of LinuxCNC's sample subroutines).
+  sp=$(directive "$path" subroutine-path)
+  [[ -n $sp ]] && subpath=$(tr ' ' ':' <<<"$sp")
   args=$(directive "$path" opencnc-args)
   [[ -z $args ]] && args=-
   table=@conf/tools/standard.tbl

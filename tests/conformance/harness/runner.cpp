@@ -52,6 +52,16 @@ std::filesystem::path Roots::resolve(const std::string& token_path) const {
   throw std::runtime_error("path without a root token in cases.tsv: " + token_path);
 }
 
+std::vector<std::filesystem::path> search_path(const Case& c, const Roots& roots,
+                                               const std::filesystem::path& folder) {
+  std::vector<std::filesystem::path> dirs;
+  if (c.subpath == "-") return dirs;
+  for (const auto& dir : split(c.subpath, ':')) {
+    dirs.push_back(dir[0] == '@' ? roots.resolve(dir) : (folder / dir).lexically_normal());
+  }
+  return dirs;
+}
+
 Roots roots_from_environment(const std::filesystem::path& source_dir, const std::filesystem::path& shared_dir) {
   Roots r;
   r.conf = source_dir / "tests" / "conformance";
@@ -69,10 +79,8 @@ Invocation opencnc_invocation(const Case& c, const Roots& roots, const std::file
     inv.argv.insert(inv.argv.end(), {"--tool-table", table.string()});
   }
   inv.argv.insert(inv.argv.end(), {"--subroutine-path", inv.cwd.string()});
-  if (c.subpath != "-") {
-    for (const auto& dir : split(c.subpath, ':')) {
-      inv.argv.insert(inv.argv.end(), {"--subroutine-path", (inv.cwd / dir).lexically_normal().string()});
-    }
+  for (const auto& dir : search_path(c, roots, inv.cwd)) {
+    inv.argv.insert(inv.argv.end(), {"--subroutine-path", dir.string()});
   }
   if (c.args != "-") {
     for (const auto& a : split(c.args, ' ')) inv.argv.push_back(a);
@@ -101,7 +109,11 @@ Invocation rs274_invocation(const Case& c, const Roots& roots, const std::filesy
   }
   if (subpath != "-") {
     const auto ini = scratch / fmt::format("subpath-{:016x}.ini", std::hash<std::string>{}(subpath));
-    std::ofstream(ini) << "[RS274NGC]\nSUBROUTINE_PATH = " << subpath << "\n";
+    std::string joined;
+    for (const auto& dir : split(subpath, ':')) {
+      joined += (joined.empty() ? "" : ":") + (dir[0] == '@' ? roots.resolve(dir).string() : dir);
+    }
+    std::ofstream(ini) << "[RS274NGC]\nSUBROUTINE_PATH = " << joined << "\n";
     inv.argv.insert(inv.argv.end(), {"-i", ini.string()});
   }
   inv.argv.insert(inv.argv.end(), {"-g", program.filename().string()});
@@ -110,7 +122,9 @@ Invocation rs274_invocation(const Case& c, const Roots& roots, const std::filesy
 
 std::vector<std::string> rs274_error_lines(const std::string& err, const Roots& roots) {
   std::error_code ec;
-  const auto programs = std::filesystem::canonical(roots.conf / "programs", ec).string();
+  const std::pair<std::string, const char*> replacements[] = {
+      {std::filesystem::canonical(roots.conf / "programs", ec).string(), "@programs"},
+      {std::filesystem::canonical(roots.ncfiles, ec).string(), "@ncfiles"}};
   std::vector<std::string> lines;
   std::size_t start = 0;
   while (start < err.size()) {
@@ -118,8 +132,10 @@ std::vector<std::string> rs274_error_lines(const std::string& err, const Roots& 
     std::string line = err.substr(start, eol - start);
     start = eol + 1;
     if (line == "executing") continue;
-    for (std::size_t at = 0; !programs.empty() && (at = line.find(programs, at)) != std::string::npos;) {
-      line.replace(at, programs.size(), "@programs");
+    for (const auto& [path, token] : replacements) {
+      for (std::size_t at = 0; !path.empty() && (at = line.find(path, at)) != std::string::npos;) {
+        line.replace(at, path.size(), token);
+      }
     }
     lines.push_back(line);
   }

@@ -30,6 +30,10 @@ struct Roots {
 /// with the environment overrides applied.
 Roots roots_from_environment(const std::filesystem::path& source_dir, const std::filesystem::path& shared_dir);
 
+/// The case's SUBROUTINE_PATH entries as absolute folders (relative ones are relative to
+/// `folder`, the program's folder; "@ncfiles/..." ones to the roots).
+std::vector<std::filesystem::path> search_path(const Case& c, const Roots& roots, const std::filesystem::path& folder);
+
 /// A command line, the folder it runs in and changes to its environment ("KEY=VALUE").
 struct Invocation {
   std::vector<std::string> argv;
@@ -55,7 +59,7 @@ Invocation rs274_invocation(const Case& c, const Roots& roots, const std::filesy
 bool rs274_can_run(const Case& c);
 
 /// rs274's standard error as the golden files keep it: without "executing", with the absolute
-/// programs folder written as @programs.
+/// programs and ncfiles folders written as @programs and @ncfiles.
 std::vector<std::string> rs274_error_lines(const std::string& err, const Roots& roots);
 
 }  // namespace opencnc::conformance
