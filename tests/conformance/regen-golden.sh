@@ -133,7 +133,7 @@ while IFS= read -r path; do
   args=$(directive "$path" opencnc-args)
   [[ -z $args ]] && args=-
   table=@conf/tools/standard.tbl
-  note=$(sed -n -E '1{s/^[;(][[:space:]]*//; s/\)[[:space:]]*$//; p}' "$path")
+  note=$(sed -n -E '/^[;(]/{s/^[;(][[:space:]]*//; s/\)?[[:space:]]*\r?$//; p; q}' "$path")
   if [[ $area == fanuc || $area == transforms ]]; then
     code=$(directive "$path" expect-error)
     if [[ -n $code ]]; then

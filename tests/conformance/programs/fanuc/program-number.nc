@@ -1,7 +1,7 @@
+%
 (Checks a percent-delimited program with an O program number and N sequence numbers.)
 (items: fanuc.o-numbers)
 (expected: rs274 output of twins/fanuc/program-number.ngc, the same moves written for LinuxCNC)
-%
 O0001 (SIMPLE PROFILE)
 N10 G21 G90 G17
 N20 G0 X0 Y0
