@@ -16,7 +16,6 @@
 #include <optional>
 #include <set>
 #include <sstream>
-#include <unistd.h>
 
 #include <fmt/format.h>
 
@@ -136,26 +135,22 @@ const Capabilities& capabilities() {
   return caps;
 }
 
-// Why opencnc cannot be asked about this case yet, if it cannot.
-std::optional<std::string> opencnc_missing(const Case& c, bool need_check) {
+// Why opencnc cannot be asked about this case yet, if it cannot: a missing subcommand, or an
+// option of the case's command line that the subcommand's --help does not mention.
+std::optional<std::string> opencnc_missing(const Case& c, const char* subcommand) {
   const auto& caps = capabilities();
+  const bool check = std::string_view(subcommand) == "check";
   if (!caps.canon) {
     return fmt::format("{} has no `canon` subcommand yet (the interpreter is not merged); "
                        "OPENCNC_CONFORMANCE_IUT=rs274 runs the harness against rs274 instead",
                        opencnc_binary().string());
   }
-  if (need_check && !caps.check) return std::string("opencnc has no `check` subcommand yet");
-  const std::string& help = need_check ? caps.check_help : caps.canon_help;
-  std::vector<std::string> options;
-  if (c.dialect != "linuxcnc") options.emplace_back("--dialect");
-  if (c.args != "-") {
-    std::istringstream words(c.args);
-    for (std::string w; words >> w;) {
-      if (w.rfind("--", 0) == 0) options.push_back(w);
+  if (check && !caps.check) return std::string("opencnc has no `check` subcommand yet");
+  const std::string& help = check ? caps.check_help : caps.canon_help;
+  for (const auto& arg : opencnc_invocation(c, suite().roots, opencnc_binary(), subcommand).argv) {
+    if (arg.rfind("--", 0) == 0 && help.find(arg) == std::string::npos) {
+      return fmt::format("opencnc {} has no {} option yet", subcommand, arg);
     }
-  }
-  for (const auto& o : options) {
-    if (help.find(o) == std::string::npos) return fmt::format("opencnc has no {} option yet", o);
   }
   return std::nullopt;
 }
@@ -316,12 +311,13 @@ TEST_P(Conformance, Program) {
   // Checked first, so that stale goldens show even before the interpreter lands.
   const auto ref = reference_of(c);
   const bool needs_check = c.expect == Expect::Reject || c.expect == Expect::Unsupported;
+  const char* subcommand = needs_check ? "check" : "canon";
   if (iut_is_rs274()) {
     if (c.dialect != "linuxcnc") GTEST_SKIP() << "rs274 has no Fanuc dialect";
     if (c.expect == Expect::Unsupported && c.code.rfind("dialect.", 0) == 0) {
       GTEST_SKIP() << "rs274 does not recognise other controllers' syntax (" << c.code << ")";
     }
-  } else if (auto why = opencnc_missing(c, needs_check)) {
+  } else if (auto why = opencnc_missing(c, subcommand)) {
     GTEST_SKIP() << *why;
   }
   switch (c.expect) {
@@ -399,6 +395,37 @@ TEST(ConformanceData, EveryGoldenMatchesItsCase) {
           << c.golden << ": no error-codes.tsv row matches: " << g.message();
     }
   }
+}
+
+// cases.tsv carries corpus-dialects.tsv's classes (regen-golden.sh copies them); they must agree.
+TEST(ConformanceData, CorpusCasesFollowTheirDialectClass) {
+  std::map<std::string, const Case*> corpus;
+  for (const auto& c : suite().cases) {
+    if (c.set == "corpus") corpus[c.program] = &c;
+  }
+  std::ifstream in(suite().roots.conf / "corpus-dialects.tsv");
+  int rows = 0;
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    const auto f = split_tabs(line);
+    ASSERT_EQ(f.size(), 5u) << line;
+    ++rows;
+    const auto it = corpus.find(f[0]);
+    ASSERT_NE(it, corpus.end()) << f[0] << " is classified but has no case";
+    const Case& c = *it->second;
+    if (f[1] == "fanuc") {
+      EXPECT_TRUE(c.expect == Expect::Run && c.dialect == "fanuc") << c.name;
+    } else if (f[1] == "unsupported") {
+      EXPECT_TRUE(c.expect == Expect::Unsupported && c.code == f[3] && c.construct == f[2]) << c.name;
+    } else {
+      EXPECT_EQ(f[1], "error") << line;
+      EXPECT_TRUE(c.expect == Expect::Reject && c.dialect == "linuxcnc") << c.name;
+    }
+  }
+  const auto rejected = std::count_if(corpus.begin(), corpus.end(), [](const auto& kv) {
+    return kv.second->expect != Expect::Accept;
+  });
+  EXPECT_EQ(rows, rejected) << "every corpus program rs274 rejects needs a class in corpus-dialects.tsv";
 }
 
 TEST(ConformanceData, EveryItemHasProgramsAndErrorCases) {

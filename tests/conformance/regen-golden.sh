@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: GPL-3.0-or-later
-# Regenerates the conformance golden files with LinuxCNC's rs274 and rewrites cases.tsv.
+# Regenerates the conformance golden files with LinuxCNC's rs274, rewrites cases.tsv and the generated
+# tables of docs/conformance.md (update-docs.sh). About 45 s.
 #
 # Usage: tests/conformance/regen-golden.sh [--check]
 #   --check   regenerate into a scratch folder and report what differs from the committed files
@@ -15,7 +16,8 @@
 #            tools/standard.tbl; an INI file sets SUBROUTINE_PATH = <area>/lib (if present) : programs/lib,
 #            or the folders of a `; subroutine-path:` line (programs/ngcgui drives LinuxCNC's ngcgui
 #            subroutines in OPENCNC_NCFILES, the way LinuxCNC's sample configurations set it up).
-#            errors/ programs must be rejected, every other area accepted (the script stops otherwise).
+#            errors/ programs must be rejected, every other area accepted (else the script says so and
+#            exits 1), and every rejection must match a row of error-codes.tsv.
 #            programs/fanuc and programs/transforms are Fanuc-dialect programs: rs274 cannot run them,
 #            their expected output is rs274's output of a hand-written LinuxCNC twin (twins/<area>/),
 #            or, for err-*.nc, the problem code named in their `(expect-error: CODE)` line.
@@ -30,7 +32,9 @@
 #
 # Golden file: header lines starting with "# " (command, exit status, rs274's stderr without its
 # "executing" line), a line "# ---", then rs274's standard output unchanged. Absolute paths of the
-# programs folder in rs274's messages are written as @programs. Goldens over 64 KiB are xz-compressed.
+# programs and ncfiles folders in rs274's messages are written as @programs and @ncfiles. Goldens over
+# 64 KiB are xz-compressed. rs274 runs with a private HOME: it keeps the tool table in $HOME/.tool.mmap,
+# which parallel rs274 runs (other scripts, ctest -j2) would otherwise overwrite under each other.
 set -euo pipefail
 export LC_ALL=C
 
