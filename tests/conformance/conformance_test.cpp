@@ -117,11 +117,18 @@ struct Capabilities {
   bool check = false;
 };
 
+// `opencnc SUB --help`, and whether SUB exists: CLI11 answers `opencnc nosuch --help` with the
+// top-level help, so the subcommand must appear as a word of the "Usage:" line.
 std::string subcommand_help(const char* sub, bool& present) {
   const auto r = run_process({opencnc_binary().string(), sub, "--help"}, fs::current_path(), 30);
-  // CLI11 answers `opencnc nosuch --help` with the top-level help, so look for the usage line.
-  present = r.exit_status == 0 && r.out.find(fmt::format(" {} ", sub)) != std::string::npos &&
-            r.out.find("Usage:") != std::string::npos;
+  present = false;
+  std::istringstream lines(r.out);
+  for (std::string line; r.exit_status == 0 && std::getline(lines, line);) {
+    if (line.rfind("Usage:", 0) != 0) continue;
+    std::istringstream words(line);
+    for (std::string w; words >> w;) present = present || w == sub;
+    break;
+  }
   return r.out;
 }
 
@@ -198,8 +205,10 @@ void expect_fresh(const Case& c, const Golden& g, const ProcessResult& live) {
   if (live.out != g.listing) {
     const auto a = parse_listing(g.listing);
     const auto b = parse_listing(live.out);
+    const auto cmp = compare_calls(a, b, 0.0, "golden", "rs274");
     ADD_FAILURE() << "stale golden " << c.golden << " (" << regen << "):\n"
-                   << compare_calls(a, b, 0.0, "golden", "rs274").report;
+                  << (cmp.equal ? std::string("the listings differ outside the canonical calls (PRINT output)\n")
+                                : cmp.report);
   }
 }
 

@@ -75,7 +75,7 @@ Golden parse_golden(const std::string& text) {
 Golden load_golden(const std::filesystem::path& path) {
   try {
     return parse_golden(read_file(path));
-  } catch (const std::runtime_error& e) {
+  } catch (const std::exception& e) {  // also std::stoi's invalid_argument on a bad exit line
     throw std::runtime_error(path.string() + ": " + e.what());
   }
 }
