@@ -17,6 +17,7 @@ packages=(
 )
 test_packages=(
   libgtest-dev libgmock-dev   # unit, golden, scenario and fault tests
+  liblzma-dev xz-utils        # compressed golden files of the conformance suite
   libbenchmark-dev            # benchmarks
   clang libclang-rt-14-dev    # libFuzzer + sanitizer runtime for the fuzz target
   linuxcnc-uspace             # rs274 (oracle) and /usr/share/linuxcnc/ncfiles
