@@ -1,0 +1,48 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// plan_run — motion time and trace metrics of the reference programs in virtual time.
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+
+#include <fmt/format.h>
+
+#include "opencnc/analysis/reference_programs.hpp"
+#include "opencnc/analysis/simulate.hpp"
+
+using namespace opencnc;
+
+namespace {
+
+std::string g_only;
+
+void run(const std::string& name, const canon::Program& p, const plan::MachineLimits& lim) {
+  if (!g_only.empty() && name.find(g_only) == std::string::npos) return;
+  analysis::SimulationOptions opt;
+  opt.check = std::getenv("NOCHECK") == nullptr;
+  const auto t0 = std::chrono::steady_clock::now();
+  const analysis::SimulationResult r = analysis::simulate(p, lim, opt);
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  fmt::print("{:28} motion {:9.3f} s  finished {}  blocks {}  blends {}  merged {}  wall {:.3f} s\n  {}\n", name,
+             r.motion_time_s, r.finished, r.plan.blocks, r.plan.blends, r.plan.merged_moves, wall,
+             r.report.summary());
+  for (const auto& d : r.diagnostics.items()) fmt::print("  {}\n", d.format());
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc > 1) g_only = argv[1];
+  const plan::MachineLimits lim = plan::MachineLimits::uniform(AxisMask::from_letters("XYZ"), 100, 1000);
+  using analysis::PathMode;
+  const PathMode g64{canon::MotionControl::Continuous, 0.01, 0.01};
+  const PathMode g64q0{canon::MotionControl::Continuous, 0.01, 0};
+  const PathMode g61{canon::MotionControl::ExactStop, 0, 0};
+  run("square G61", analysis::square_program(100, 6000, g61), lim);
+  run("square G64 P0.01", analysis::square_program(100, 6000, g64), lim);
+  run("spiral 20k G64 P0.01", analysis::spiral_program(20000, 6000, g64), lim);
+  run("spiral 20k G64 P0.01 Q0", analysis::spiral_program(20000, 6000, g64q0), lim);
+  run("small arcs 90deg G64 P0.1", analysis::small_arcs_program(2000, 0.3, 90, 3000, {canon::MotionControl::Continuous, 0.1, 0.1}), lim);
+  run("small arcs 180deg G64 P0.1", analysis::small_arcs_program(2000, 0.3, 180, 3000, {canon::MotionControl::Continuous, 0.1, 0.1}), lim);
+  return 0;
+}

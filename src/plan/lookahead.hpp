@@ -1,0 +1,92 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The look-ahead window: blocks waiting to be published, their widened limits, the braking prefix
+// and the backward pass that makes each block's entry speed final.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <deque>
+
+#include "opencnc/traj/block_queue.hpp"
+
+namespace opencnc::plan::detail {
+
+/// A block in the window with the planner's working values.
+struct PlannedBlock {
+  traj::MotionBlock b;   ///< geometry, identity, class, nominal speed
+  double cap_raw = 0;    ///< speed cap of the block itself
+  double accel_raw = 0;  ///< acceleration budget of the block itself
+  double junction = 0;   ///< speed limit at the block's start (a point), +∞ when none
+  // Working values.
+  double start_s = 0;    ///< s of the block's start since the run began
+  double cap = 0;        ///< cap widened by the moving average (≤ cap_raw)
+  double accel = 0;      ///< budget widened by the moving average (≤ accel_raw)
+  double local = 0;      ///< largest entry speed from the block's own limits
+  double entry = 0;      ///< backward pass result
+  double prefix = 0;     ///< C at the start
+};
+
+/// Holds planned blocks until their entry speed can no longer change.
+///
+/// With a moving average of length T on s (jerk limits), the speed and acceleration commanded at
+/// a point are averages of the generator's values over the last T, which spans at most v·T of
+/// path. The generator therefore runs against limits widened over that distance: each block's
+/// cap applies from cap·T before it to cap·T after it, each budget over v_bound·T, each junction
+/// limit v_j over ±v_j·T. See docs/planner.md.
+class Lookahead {
+ public:
+  /// `filter_s` = T (0: no widening); `v_bound` bounds every speed along s.
+  Lookahead(double filter_s, double v_bound) noexcept : filter_s_(filter_s), reach_(v_bound * filter_s) {}
+
+  void push(const PlannedBlock& block);
+  /// No more blocks will come: everything becomes final.
+  void finish();
+  bool finished() const noexcept { return finished_; }
+
+  std::size_t size() const noexcept { return window_.size(); }
+  bool empty() const noexcept { return window_.empty(); }
+  /// Blocks at the front whose published values are final.
+  std::size_t publishable() {
+    refresh();
+    return pinned_;
+  }
+  /// Blocks at the front whose widened limits are final (a forced publish may take these).
+  std::size_t settled() {
+    refresh();
+    return settled_;
+  }
+
+  /// The front block as it goes to the queue with sequence number `seq`.
+  traj::MotionBlock front_for_queue(std::uint64_t seq);
+  /// Removes the front block (publishable() or settled() > 0).
+  void pop_front();
+
+ private:
+  void widen(std::size_t m);
+  void refresh() {
+    if (dirty_) settle();
+    dirty_ = false;
+  }
+  void settle();
+  void backward_pass(std::size_t from_new);
+  std::uint64_t soft_link(std::uint64_t seq);
+  std::uint64_t find_soft_link(std::uint64_t seq) const;
+
+  double filter_s_ = 0;
+  double reach_ = 0;
+  std::deque<PlannedBlock> window_;
+  double total_s_ = 0;            ///< s at the end of the last pushed block
+  std::size_t settled_ = 0;       ///< front blocks with final widened limits, prefix and local
+  std::size_t pinned_ = 0;        ///< front blocks with a final entry speed
+  double next_prefix_ = 0;        ///< C at the end of the settled blocks
+  double prev_path_cap_ = 0;      ///< cap of the last settled path block (for the next junction)
+  bool prev_stop_ = true;         ///< the last settled block was a stop (or nothing yet)
+  bool finished_ = false;
+  bool dirty_ = false;            ///< blocks pushed since the last settle()
+  // The last soft link handed out: blocks with the same class and nominal speed share it.
+  std::uint64_t last_link_ = traj::kNoBlock;
+  traj::FeedClass last_link_class_ = traj::FeedClass::Feed;
+  double last_link_feed_ = -1;
+};
+
+}  // namespace opencnc::plan::detail
