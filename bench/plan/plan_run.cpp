@@ -44,5 +44,11 @@ int main(int argc, char** argv) {
   run("spiral 20k G64 P0.01 Q0", analysis::spiral_program(20000, 6000, g64q0), lim);
   run("small arcs 90deg G64 P0.1", analysis::small_arcs_program(2000, 0.3, 90, 3000, {canon::MotionControl::Continuous, 0.1, 0.1}), lim);
   run("small arcs 180deg G64 P0.1", analysis::small_arcs_program(2000, 0.3, 180, 3000, {canon::MotionControl::Continuous, 0.1, 0.1}), lim);
+  const plan::MachineLimits jl = plan::MachineLimits::uniform(AxisMask::from_letters("XYZ"), 100, 1000, 1e5);
+  run("jerk square G61", analysis::square_program(100, 6000, g61), jl);
+  run("jerk square G64 P0.01", analysis::square_program(100, 6000, g64), jl);
+  run("jerk spiral 20k G64 P0.01", analysis::spiral_program(20000, 6000, g64), jl);
+  run("jerk spiral 20k G64 P0.01 Q0", analysis::spiral_program(20000, 6000, g64q0), jl);
+  run("jerk small arcs 90deg G64 P0.1", analysis::small_arcs_program(2000, 0.3, 90, 3000, {canon::MotionControl::Continuous, 0.1, 0.1}), jl);
   return 0;
 }

@@ -144,16 +144,14 @@ RawLimits block_limits(const MotionBlock& b, double v_commanded_max, const Limit
   return {kInf, kInf};
 }
 
-double curvature_step_limit(const MotionBlock& prev, const MotionBlock& next, const LimitParams& p) noexcept {
-  if (p.filter_s <= 0) return kInf;
+Pose curvature_step(const MotionBlock& prev, const MotionBlock& next) noexcept {
   const Pose c1 = traj::curvature_at(prev, prev.length), c2 = traj::curvature_at(next, 0.0);
-  double v = kInf;
+  Pose step;
   for (int i = 0; i < kAxisCount; ++i) {
-    const double step = std::fabs(c2[i] - c1[i]);
-    if (step < 1e-12 || !limited_jerk(p, i)) continue;
-    v = std::min(v, std::sqrt(p.step_share * p.machine[i].max_jerk * p.period_s / step));
+    const double d = std::fabs(c2[i] - c1[i]);
+    step[i] = d > 1e-12 ? d : 0.0;
   }
-  return v;
+  return step;
 }
 
 }  // namespace opencnc::plan::detail

@@ -27,9 +27,8 @@ struct RawLimits {
 /// Limits of a path block whose speed will never be commanded above `v_commanded_max`.
 RawLimits block_limits(const traj::MotionBlock& b, double v_commanded_max, const LimitParams& p) noexcept;
 
-/// Speed limit where `prev` ends and `next` starts (tangent there): the step of curvature must
-/// stay within the jerk share reserved for it at the servo period. +∞ without jerk limits.
-double curvature_step_limit(const traj::MotionBlock& prev, const traj::MotionBlock& next,
-                            const LimitParams& p) noexcept;
+/// Per-axis |Δg''| where `prev` ends and `next` starts: the step of curvature that makes the
+/// acceleration jump by v²·|Δg''| there.
+Pose curvature_step(const traj::MotionBlock& prev, const traj::MotionBlock& next) noexcept;
 
 }  // namespace opencnc::plan::detail

@@ -1,10 +1,13 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Look-ahead window: widening for the moving average, braking prefix, backward pass, soft links.
+// Look-ahead window: widening for the moving average, curvature-step density, braking prefix,
+// backward pass, soft links.
 #include "lookahead.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
+
+#include "path_geometry.hpp"
 
 namespace opencnc::plan::detail {
 
@@ -15,9 +18,19 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr std::size_t kSoftScan = 64;
+constexpr double kMinPiece = 1e-4;  ///< blocks are not split into pieces shorter than this
+constexpr double kSplitGain = 1e-3; ///< nor for a limit less than this much (relative) lower
 
+bool is_marker(const PlannedBlock& p) { return p.b.kind == BlockKind::Marker; }
 bool is_stop(const traj::MotionBlock& b) {
   return b.kind == BlockKind::Marker && b.marker != traj::MarkerKind::Report;
+}
+double end_s(const PlannedBlock& p) { return p.start_s + p.b.length; }
+bool has_step(const Pose& s) {
+  for (double v : s.v) {
+    if (v > 0) return true;
+  }
+  return false;
 }
 
 }  // namespace
@@ -27,35 +40,106 @@ void Lookahead::push(const PlannedBlock& block) {
   pb.start_s = total_s_;
   pb.cap = pb.cap_raw;
   pb.accel = pb.accel_raw;
+  pb.step_sum = pb.step;
   total_s_ += pb.b.length;
   window_.push_back(pb);
-  if (filter_s_ > 0 && pb.b.kind != BlockKind::Marker) widen(window_.size() - 1);
+  if (widening() && !is_marker(pb)) {
+    add_steps(window_.size() - 1);
+    widen_last();
+  }
   dirty_ = true;
 }
 
-void Lookahead::finish() {
-  finished_ = true;
-  dirty_ = true;
-}
-
-// Applies the widened limits between the new block m and the blocks within reach before it
-// (blocks further back are unaffected both ways, and those are the settled ones).
-void Lookahead::widen(std::size_t m) {
+// Curvature steps closer than three servo periods of travel add up in a sampled jerk, so each
+// step's speed limit uses the sum of the steps around it: v² · Σ|Δg''| ≤ (4/3)·η·J·T_servo.
+void Lookahead::add_steps(std::size_t m) {
   PlannedBlock& nb = window_[m];
-  const double T = filter_s_;
-  if (nb.junction > 0 && nb.junction < kInf) nb.cap = std::min(nb.cap, nb.junction);
+  if (!has_step(nb.step)) return;
+  const auto limit = [this](const Pose& sum) {
+    double v = kInf;
+    for (int i = 0; i < kAxisCount; ++i) {
+      const double budget = p_.step_budget[static_cast<std::size_t>(i)];
+      if (budget > 0 && sum[i] > 0) v = std::min(v, std::sqrt(budget / sum[i]));
+    }
+    return v;
+  };
+  lowered_.clear();
   for (std::size_t j = m; j-- > 0;) {
     PlannedBlock& jb = window_[j];
-    const double gap = nb.start_s - (jb.start_s + jb.b.length);
-    if (gap >= reach_) break;
-    if (jb.b.kind == BlockKind::Marker) continue;
-    if (gap < nb.cap_raw * T) jb.cap = std::min(jb.cap, nb.cap_raw);
-    if (gap < jb.cap_raw * T) nb.cap = std::min(nb.cap, jb.cap_raw);
-    if (nb.junction > 0 && gap < nb.junction * T) jb.cap = std::min(jb.cap, nb.junction);
-    if (jb.junction > 0 && nb.start_s - jb.start_s < jb.junction * T) nb.cap = std::min(nb.cap, jb.junction);
-    jb.accel = std::min(jb.accel, nb.accel_raw);
-    nb.accel = std::min(nb.accel, jb.accel_raw);
+    if (nb.start_s - jb.start_s > p_.step_window_s) break;
+    if (is_marker(jb) || !has_step(jb.step)) continue;
+    for (int i = 0; i < kAxisCount; ++i) {
+      jb.step_sum[i] += nb.step[i];
+      nb.step_sum[i] += jb.step[i];
+    }
+    const double v = limit(jb.step_sum);
+    if (v < jb.junction) {
+      jb.junction = v;
+      lowered_.push_back({jb.start_s, v});
+    }
   }
+  nb.junction = std::min(nb.junction, limit(nb.step_sum));
+  // Widen the lowered junction limits only now: splitting blocks moves them in the deque.
+  for (const auto& [at, v] : lowered_) limit_range(at - v * p_.filter_s, at + v * p_.filter_s, v, kInf);
+}
+
+// The limits of the new last block reach back over the blocks before it, and theirs reach
+// forward over it.
+void Lookahead::widen_last() {
+  const PlannedBlock m = window_.back();
+  const double T = p_.filter_s;
+  const double start = m.start_s, end = end_s(m);
+  for (std::size_t j = window_.size(); j-- > 0;) {
+    const PlannedBlock jb = window_[j];
+    if (jb.start_s >= start) continue;  // the new block (or a piece of it)
+    if (start - end_s(jb) >= reach_) break;
+    if (is_marker(jb)) continue;
+    limit_range(start, end_s(jb) + jb.cap_raw * T, jb.cap_raw, jb.accel_raw);
+    if (jb.junction > 0 && jb.junction < kInf) limit_range(start, jb.start_s + jb.junction * T, jb.junction, kInf);
+  }
+  limit_range(start - m.cap_raw * T, end, m.cap_raw, m.accel_raw);
+  if (m.junction > 0 && m.junction < kInf) limit_range(start - m.junction * T, start + m.junction * T, m.junction, kInf);
+}
+
+// Lowers cap and budget of the path between s = from and s = to, splitting blocks that reach
+// beyond it (only unsettled blocks are ever in range).
+void Lookahead::limit_range(double from, double to, double cap, double accel) {
+  if (!(to > from)) return;
+  for (std::size_t k = window_.size(); k-- > settled_;) {
+    const double s0 = window_[k].start_s, s1 = end_s(window_[k]);
+    if (s1 <= from) break;
+    if (s0 >= to || is_marker(window_[k])) continue;
+    const double lo = std::max(from, s0), hi = std::min(to, s1);
+    if (!(hi > lo)) continue;
+    PlannedBlock& whole = window_[k];
+    if (!(cap < whole.cap * (1 - kSplitGain) || accel < whole.accel * (1 - kSplitGain))) {
+      whole.cap = std::min(whole.cap, cap);  // too small a change to be worth a split
+      whole.accel = std::min(whole.accel, accel);
+      continue;
+    }
+    if (s1 - hi > kMinPiece && hi - s0 > kMinPiece) split(k, hi - s0);
+    std::size_t target = k;
+    if (lo - s0 > kMinPiece) {
+      split(k, lo - s0);
+      target = k + 1;
+    }
+    PlannedBlock& t = window_[target];
+    t.cap = std::min(t.cap, cap);
+    t.accel = std::min(t.accel, accel);
+  }
+}
+
+void Lookahead::split(std::size_t k, double x) {
+  PlannedBlock tail = window_[k];
+  PlannedBlock& head = window_[k];
+  trim_end(head.b, head.b.length - x);
+  trim_start(tail.b, x);
+  rebase(tail.b, end_point(head.b));
+  tail.start_s = head.start_s + x;
+  tail.junction = kInf;
+  tail.step = Pose{};
+  tail.step_sum = Pose{};
+  window_.insert(window_.begin() + static_cast<std::ptrdiff_t>(k + 1), tail);
 }
 
 // Blocks whose widened limits can no longer change get their prefix and own entry limit.
@@ -63,9 +147,9 @@ void Lookahead::settle() {
   const std::size_t first_new = settled_;
   while (settled_ < window_.size()) {
     PlannedBlock& pb = window_[settled_];
-    if (!finished_ && filter_s_ > 0 && total_s_ - (pb.start_s + pb.b.length) < reach_) break;
+    if (!finished_ && widening() && total_s_ - end_s(pb) < reach_) break;
     pb.prefix = next_prefix_;
-    if (pb.b.kind == BlockKind::Marker) {
+    if (is_marker(pb)) {
       pb.local = is_stop(pb.b) ? 0.0 : kInf;
       pb.accel = 0;
       pb.cap = 0;

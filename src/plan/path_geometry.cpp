@@ -145,8 +145,36 @@ double feed_length_ratio(const Pose& start, const Pose& end, const MotionBlock& 
   return feed_len > 1e-12 ? b.length / feed_len : 1.0;
 }
 
+namespace {
+
+// Splits a cubic Bézier at t (de Casteljau): the head keeps [0, t], the tail [t, 1]. The path
+// parameter keeps its scale (head length L·t, tail L·(1 − t)), so s runs on unchanged.
+void split_bezier(const MotionBlock& b, double t, MotionBlock* head, MotionBlock* tail) {
+  const auto lerp = [t](const Pose& a, const Pose& c) { return a + t * (c - a); };
+  const Pose p01 = lerp(b.base, b.u), p12 = lerp(b.u, b.w), p23 = lerp(b.w, b.lin);
+  const Pose p012 = lerp(p01, p12), p123 = lerp(p12, p23), mid = lerp(p012, p123);
+  if (head != nullptr) {
+    head->u = p01;
+    head->w = p012;
+    head->lin = mid;
+    head->length = b.length * t;
+  }
+  if (tail != nullptr) {
+    tail->base = mid;
+    tail->u = p123;
+    tail->w = p23;
+    tail->length = b.length * (1 - t);
+  }
+}
+
+}  // namespace
+
 void trim_start(MotionBlock& b, double d) noexcept {
   if (d <= 0) return;
+  if (b.kind == BlockKind::Bezier) {
+    split_bezier(b, d / b.length, nullptr, &b);
+    return;
+  }
   const Pose p = traj::position_at(b, d);
   if (b.kind == BlockKind::Arc) {
     const double phi = b.omega * d, c = std::cos(phi), s = std::sin(phi);
@@ -159,7 +187,12 @@ void trim_start(MotionBlock& b, double d) noexcept {
 }
 
 void trim_end(MotionBlock& b, double d) noexcept {
-  if (d > 0) b.length -= d;
+  if (d <= 0) return;
+  if (b.kind == BlockKind::Bezier) {
+    split_bezier(b, (b.length - d) / b.length, &b, nullptr);
+    return;
+  }
+  b.length -= d;
 }
 
 void rebase(MotionBlock& b, const Pose& p) noexcept {

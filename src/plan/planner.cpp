@@ -137,12 +137,12 @@ void Planner::Impl::emit_path(MotionBlock b, double junction) {
   if (b.length < detail::kMinLength) return;
   const detail::RawLimits r = detail::block_limits(b, commanded_max(b), params);
   if (b.feed_class == FeedClass::Rapid) b.feed = r.cap;
-  if (last_path != nullptr && junction > 0) junction = std::min(junction, detail::curvature_step_limit(prev, b, params));
   PlannedBlock pb;
   pb.b = b;
   pb.cap_raw = r.cap;
   pb.accel_raw = r.accel;
   pb.junction = junction;
+  if (last_path != nullptr && junction > 0 && params.filter_s > 0) pb.step = detail::curvature_step(prev, b);
   window->push(pb);
   prev = b;
   last_path = &prev;
@@ -265,11 +265,19 @@ bool Planner::start(const canon::Program& program) {
   if (m.failed) return false;
   m.program = &program;
   m.reader.emplace(program);
-  double v_bound = 0;
+  detail::WindowParams wp;
+  wp.filter_s = m.params.filter_s;
   for (int i = 0; i < kAxisCount; ++i) {
-    if (m.limits.axes.has(static_cast<Axis>(i))) v_bound += m.limits[i].max_velocity * m.limits[i].max_velocity;
+    if (!m.limits.axes.has(static_cast<Axis>(i))) continue;
+    const AxisLimits& l = m.limits[i];
+    wp.v_bound += l.max_velocity * l.max_velocity;
+    if (wp.filter_s > 0 && l.max_jerk > 0) {
+      wp.step_budget[static_cast<std::size_t>(i)] = 4.0 / 3.0 * m.config.jerk_step_share * l.max_jerk * m.config.servo_period_s;
+    }
   }
-  m.window.emplace(m.params.filter_s, std::sqrt(v_bound));
+  wp.v_bound = std::sqrt(wp.v_bound);
+  wp.step_window_s = 3.0 * wp.v_bound * m.config.servo_period_s;
+  m.window.emplace(wp);
   m.reading_done = false;
   m.pending.reset();
   m.reports.clear();

@@ -162,6 +162,8 @@ bool Interpolator::step_piece(const TickInput& in, const MotionBlock& b, std::si
     if (!(t1 <= t)) t1 = t;
     integral += piece_integral(s_u_, v, a, t1);
     v_u_ = std::max(0.0, v + a * t1);
+    // Where the next block must be entered at rest the limits brought v to zero; drop the rounding.
+    if (index + 1 < avail && queue_->peek(index + 1).v_entry == 0) v_u_ = 0;
     tau -= t1;
     u_start_ += b.length;
     s_u_ = u_start_;
@@ -204,6 +206,9 @@ double Interpolator::advance_unfiltered(const TickInput& in) noexcept {
       ++u_seq_;
       continue;
     }
+    // A corner passed at zero speed: the moving average must reach it before the motion goes on,
+    // or the commanded path would round it off.
+    if (b.v_entry == 0 && s_u_ == u_start_ && v_u_ == 0 && still_ticks_ < config_.filter_ticks) break;
     step_piece(in, b, index, tau, integral);
   }
   if (tau > 0) integral += s_u_ * tau;
