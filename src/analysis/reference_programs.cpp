@@ -32,8 +32,8 @@ void set_mode(canon::ProgramBuilder& b, const PathMode& m) {
 canon::Program square_program(double side_mm, double feed_mm_min, PathMode mode) {
   canon::ProgramBuilder b(AxisMask::from_letters("XYZ"));
   canon::SegmentId id = 0;
-  b.straight_traverse(id++, xyz(0, 0));
   set_mode(b, mode);
+  b.straight_traverse(id++, xyz(0, 0));
   b.set_feed_rate(feed_mm_min);
   b.straight_feed(id++, xyz(side_mm, 0));
   b.straight_feed(id++, xyz(side_mm, side_mm));
@@ -47,8 +47,8 @@ canon::Program spiral_program(int segments, double feed_mm_min, PathMode mode, s
   constexpr double r0 = 50.0, dr_per_rev = -0.5;
   canon::ProgramBuilder b(AxisMask::from_letters("XYZ"));
   canon::SegmentId id = 0;
-  b.straight_traverse(id++, xyz(r0, 0));
   set_mode(b, mode);
+  b.straight_traverse(id++, xyz(r0, 0));
   b.set_feed_rate(feed_mm_min);
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> length(0.05, 0.2);
@@ -66,8 +66,8 @@ canon::Program small_arcs_program(int arcs, double radius_mm, double sweep_deg, 
                                   PathMode mode) {
   canon::ProgramBuilder b(AxisMask::from_letters("XYZ"));
   canon::SegmentId id = 0;
-  b.straight_traverse(id++, xyz(0, 0));
   set_mode(b, mode);
+  b.straight_traverse(id++, xyz(0, 0));
   b.set_feed_rate(feed_mm_min);
   const double sweep = sweep_deg * std::numbers::pi / 180.0;
   double x = 0, y = 0, heading = 0;  // direction of travel, radians

@@ -313,6 +313,7 @@ void Interpolator::commit_single_block_stop(std::size_t available) noexcept {
     const MotionBlock& prev = queue_->peek(k - 1);
     const MotionBlock& next = queue_->peek(k);
     if (next.seq <= step_from_seq_ || prev.segment == next.segment) continue;
+    if (is_stop_marker(next)) return;  // the motion stops there anyway
     if (v_u_ * v_u_ <= next.brake_prefix - c_s) {
       stop_seq_ = next.seq;
       return;

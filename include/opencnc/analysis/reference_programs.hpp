@@ -10,7 +10,8 @@
 
 namespace opencnc::analysis {
 
-/// Path control of a reference program: G61, G61.1 or G64 with P and Q (mm, 0 = not given).
+/// Path control of a reference program: G61, G61.1 or G64 with P and Q (mm, 0 = not given). The
+/// programs set it before their first move, so that every corner has the same tolerance.
 struct PathMode {
   canon::MotionControl mode = canon::MotionControl::Continuous;
   double p = 0;
