@@ -179,6 +179,7 @@ bool ProgramReader::make_element(canon::SegmentId id, Element& e) const {
   } else if (m.flags & canon::kSpindleSynced) {
     b.feed_class = FeedClass::SpindleSync;
     b.feed = sync_per_rev_ * ratio;
+    b.flags &= static_cast<std::uint8_t>(~(traj::kFeedHoldAllowed | traj::kFeedOverrideAllowed));
   } else if (m.flags & canon::kPerRevolution) {
     b.feed_class = FeedClass::PerRevolution;
     b.feed = f * ratio;

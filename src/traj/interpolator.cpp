@@ -60,6 +60,9 @@ void Interpolator::restart(const Pose& start) noexcept {
   step_from_seq_ = 0;
   dwell_ticks_left_ = 0;
   shown_ = Shown{};
+  sync_ = Sync::Off;
+  sync_target_ = sync_lag_ = prev_revs_ = 0;
+  sync_lost_ = false;
 }
 
 double Interpolator::target_speed(const TickInput& in, const MotionBlock& b) const noexcept {
@@ -104,6 +107,9 @@ bool Interpolator::step_piece(const TickInput& in, const MotionBlock& b, std::si
   double v_tgt = target_speed(in, b);
   if (aborting_ || (hold_ && (b.flags & kFeedHoldAllowed) != 0)) v_tgt = 0;
   double a = std::clamp((v_tgt - v) / tau, -A, A);
+  const bool follow = b.feed_class == FeedClass::SpindleSync && !aborting_;
+  if (follow) a = sync_acceleration(b, tau);
+  const double a_follow = a;
   const auto limit = [&](double K, bool at_block_end, double vq) {
     const double ve = end_speed_limit(K, v, A, tau);
     double aq;
@@ -148,6 +154,8 @@ bool Interpolator::step_piece(const TickInput& in, const MotionBlock& b, std::si
     if (si < avail) limit(queue_->peek(si).brake_prefix - c_s, si == index + 1, 0.0);
   }
   a = std::clamp(a, -A, A);
+  // Braking for a limit ahead (the end of the thread): the motion leaves the spindle.
+  if (follow && sync_ == Sync::Locked && a < a_follow) sync_ = Sync::CatchUp;
 
   double t = tau;
   bool stops = false;
@@ -181,6 +189,50 @@ bool Interpolator::step_piece(const TickInput& in, const MotionBlock& b, std::si
   return false;
 }
 
+// G33: the spindle encoder sets the target. Waiting at the start of a synchronised run for the
+// index (the encoder crossing a whole revolution) makes every pass of a thread start at the same
+// spindle angle; then the motion speeds up to the spindle's rate and keeps the distance it lags
+// by from then on, so that the pitch is exact and the phase the same on every pass.
+void Interpolator::update_sync(const TickInput& in) noexcept {
+  const double revs = in.spindle_revs;
+  const double turned = std::fabs(revs - prev_revs_);
+  const std::size_t index = index_of(u_seq_);
+  const bool in_sync_block = index < queue_->available() && queue_->peek(index).kind != BlockKind::Marker &&
+                             queue_->peek(index).feed_class == FeedClass::SpindleSync;
+  if (!in_sync_block) {
+    sync_ = Sync::Off;
+  } else {
+    const MotionBlock& b = queue_->peek(index);
+    if (sync_ == Sync::Off && v_u_ == 0) sync_ = Sync::WaitIndex;
+    if (sync_ == Sync::WaitIndex) {
+      if (std::floor(revs) != std::floor(prev_revs_)) {
+        const double index_rev = revs > prev_revs_ ? std::floor(revs) : std::ceil(revs);
+        sync_target_ = s_u_ + b.feed * std::fabs(revs - index_rev);
+        sync_ = Sync::CatchUp;
+      }
+    } else if (sync_ != Sync::Off) {
+      sync_target_ += b.feed * turned;
+    }
+  }
+  prev_revs_ = revs;
+}
+
+double Interpolator::sync_acceleration(const MotionBlock& b, double tau) noexcept {
+  const double A = b.accel, v = v_u_, s = s_u_;
+  const double v_t = b.feed * std::fabs(sync_rev_s_);
+  if (sync_ == Sync::CatchUp && std::fabs(v_t - v) <= A * tau) {
+    sync_ = Sync::Locked;
+    sync_lag_ = sync_target_ - (s + 0.5 * (v + v_t) * tau);
+  }
+  if (sync_ != Sync::Locked) return std::clamp((v_t - v) / tau, -A, A);
+  const double a = 2.0 * (sync_target_ - sync_lag_ - s - v * tau) / (tau * tau);
+  if (std::fabs(a) > A) {  // the spindle changed speed faster than the axes can follow
+    sync_lost_ = true;
+    sync_ = Sync::CatchUp;
+  }
+  return std::clamp(a, -A, A);
+}
+
 double Interpolator::advance_unfiltered(const TickInput& in) noexcept {
   double tau = config_.period_s, integral = 0;
   const double s_before = s_u_;
@@ -209,6 +261,7 @@ double Interpolator::advance_unfiltered(const TickInput& in) noexcept {
     // A corner passed at zero speed: the moving average must reach it before the motion goes on,
     // or the commanded path would round it off.
     if (b.v_entry == 0 && s_u_ == u_start_ && v_u_ == 0 && still_ticks_ < config_.filter_ticks) break;
+    if (b.feed_class == FeedClass::SpindleSync && (sync_ == Sync::Off || sync_ == Sync::WaitIndex)) break;
     step_piece(in, b, index, tau, integral);
   }
   if (tau > 0) integral += s_u_ * tau;
@@ -362,6 +415,8 @@ void Interpolator::fill_output(TickOutput& out, double s_prev) noexcept {
   out.line = shown_.line;
   out.context = shown_.context;
   out.block_offset = shown_.offset;
+  out.spindle_synced = sync_ == Sync::Locked;
+  out.sync_lost = sync_lost_;
 }
 
 void Interpolator::tick(const TickInput& in, TickOutput& out) noexcept {
@@ -377,6 +432,9 @@ void Interpolator::tick(const TickInput& in, TickOutput& out) noexcept {
   if (avail > 0) started_ = true;
   if (in.single_block && stop_seq_ == kNoBlock && !aborting_) commit_single_block_stop(avail);
 
+  if (ticks_ == 1) prev_revs_ = in.spindle_revs;
+  sync_rev_s_ = in.spindle_rev_s;
+  update_sync(in);
   const double s_prev = s_f_;
   const double integral = advance_unfiltered(in);
   s_f_ = filter(integral);

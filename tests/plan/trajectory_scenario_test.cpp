@@ -4,11 +4,13 @@
 // mid-move, and bit-for-bit repeatability.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <memory>
 #include <vector>
 
 #include "opencnc/analysis/reference_programs.hpp"
 #include "opencnc/analysis/simulate.hpp"
+#include "opencnc/canon/program_builder.hpp"
 
 using namespace opencnc;
 using analysis::PathMode;
@@ -116,4 +118,47 @@ TEST(TrajectoryScenario, VirtualTimeRunsAreBitForBitRepeatable) {
     ASSERT_EQ(a.size(), b.size());
     EXPECT_TRUE(a == b);  // exact equality of every coordinate of every sample
   }
+}
+
+// G33: the motion waits for the spindle index, catches up, then follows the encoder exactly;
+// the thread's phase is the same whatever the spindle's angle when the move was reached.
+TEST(TrajectoryScenario, SpindleSynchronisedMotionFollowsTheEncoderWithARepeatablePhase) {
+  const auto program = [] {
+    canon::ProgramBuilder b(AxisMask::from_letters("XYZ"));
+    Pose p;
+    p[Axis::X] = 10;
+    b.straight_traverse(0, p);
+    b.set_spindle_speed(0, 600);
+    b.start_spindle_clockwise(0);
+    b.start_speed_feed_synch(0, 1.5, false);  // G33 K1.5
+    p[Axis::Z] = -20;
+    b.straight_feed(1, p);
+    b.stop_speed_feed_synch();
+    p[Axis::Z] = 5;
+    b.straight_traverse(2, p);
+    b.program_end();
+    return b.take();
+  }();
+  const auto pass = [&](double phase) {
+    analysis::SimulationOptions o;
+    o.inputs = [phase](std::uint64_t n, const traj::TickOutput&, traj::TickInput& in) {
+      in.spindle_rev_s = 10;  // 600 rpm
+      in.spindle_revs = phase + 10 * static_cast<double>(n) * 1e-3;
+    };
+    double locked_constant = 0, worst = 0;
+    int locked = 0;
+    o.observe = [&](std::uint64_t n, const traj::TickOutput& out) {
+      if (!out.spindle_synced) return;
+      const double c = out.position[Axis::Z] + 1.5 * (phase + 10 * static_cast<double>(n) * 1e-3);
+      if (locked++ == 0) locked_constant = c;
+      worst = std::max(worst, std::fabs(c - locked_constant));
+    };
+    const analysis::SimulationResult r = analysis::simulate(program, kMill, o);
+    EXPECT_TRUE(r.finished);
+    EXPECT_EQ(r.report.limit_violations, 0u) << r.report.summary();
+    EXPECT_GT(locked, 1000);  // most of the 20 mm at 15 mm/s
+    EXPECT_LT(worst, 1e-9);   // z + pitch · revolutions stays constant: exact pitch
+    return std::fmod(locked_constant + 1500, 1.5);
+  };
+  EXPECT_NEAR(pass(0.1), pass(0.73), 1e-9);
 }

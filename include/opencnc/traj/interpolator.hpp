@@ -76,6 +76,8 @@ struct TickOutput {
   double block_offset = 0;     ///< s within that block
   int event_count = 0;
   std::array<TickEvent, kMaxTickEvents> events{};
+  bool spindle_synced = false;  ///< following the spindle (G33) with a constant lag
+  bool sync_lost = false;       ///< a limit forced the motion off the spindle during this run
 };
 
 /// Consumes motion blocks and computes the commanded position every servo period.
@@ -121,6 +123,8 @@ class Interpolator {
   void release_marker() noexcept;
   void pop_and_rebase() noexcept;
   void fill_output(TickOutput& out, double s_prev) noexcept;
+  void update_sync(const TickInput& in) noexcept;
+  double sync_acceleration(const MotionBlock& b, double tau) noexcept;
   std::size_t index_of(std::uint64_t seq) const noexcept {
     return static_cast<std::size_t>(seq - queue_->popped());
   }
@@ -150,6 +154,15 @@ class Interpolator {
   std::uint64_t step_from_seq_ = 0;        ///< single-block stops only after this block
   std::uint64_t dwell_ticks_left_ = 0;
   bool waiting_ = false;                   ///< at a stop marker, action not finished
+
+  // Spindle-synchronised motion (G33): wait for the index, catch up, then follow the encoder.
+  enum class Sync : std::uint8_t { Off, WaitIndex, CatchUp, Locked };
+  Sync sync_ = Sync::Off;
+  double sync_target_ = 0;   ///< s the spindle position asks for (global s)
+  double sync_lag_ = 0;      ///< constant distance behind it once locked
+  double prev_revs_ = 0;
+  double sync_rev_s_ = 0;    ///< spindle speed of this tick
+  bool sync_lost_ = false;
 
   struct Shown {  // the block at the commanded position, kept once it has been popped
     std::uint64_t seq = 0, segment = 0, segment_first = 0, segment_last = 0;
