@@ -7,8 +7,12 @@
 
 #include <fmt/format.h>
 
+#include <fstream>
+
 #include "opencnc/analysis/reference_programs.hpp"
 #include "opencnc/analysis/simulate.hpp"
+#include "opencnc/canon/program_builder.hpp"
+#include "rs274_canon.hpp"
 
 using namespace opencnc;
 
@@ -20,6 +24,7 @@ void run(const std::string& name, const canon::Program& p, const plan::MachineLi
   if (!g_only.empty() && name.find(g_only) == std::string::npos) return;
   analysis::SimulationOptions opt;
   opt.check = std::getenv("NOCHECK") == nullptr;
+  opt.max_time_s = 24 * 3600;
   const auto t0 = std::chrono::steady_clock::now();
   const analysis::SimulationResult r = analysis::simulate(p, lim, opt);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -32,8 +37,18 @@ void run(const std::string& name, const canon::Program& p, const plan::MachineLi
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc > 1) g_only = argv[1];
   const plan::MachineLimits lim = plan::MachineLimits::uniform(AxisMask::from_letters("XYZ"), 100, 1000);
+  if (argc > 2 && std::string(argv[1]) == "--canon") {
+    // plan_run --canon LISTING...: each file is the output of `rs274 -g PROGRAM`.
+    for (int i = 2; i < argc; ++i) {
+      std::ifstream in(argv[i]);
+      canon::ProgramBuilder b(kXyzabc);
+      bench::read_rs274_listing(in, b);
+      run(argv[i], b.take(), plan::MachineLimits::uniform(kXyzabc, 100, 1000));
+    }
+    return 0;
+  }
+  if (argc > 1) g_only = argv[1];
   using analysis::PathMode;
   const PathMode g64{canon::MotionControl::Continuous, 0.01, 0.01};
   const PathMode g64q0{canon::MotionControl::Continuous, 0.01, 0};

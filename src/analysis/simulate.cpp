@@ -29,9 +29,26 @@ SimulationResult simulate(const canon::Program& program, const plan::MachineLimi
   Pose last = program.start();
   std::uint64_t first_move = 0, last_move = 0;
   bool moved = false;
+  double rpm = 0, direction = 0, revs = 0;
   for (std::uint64_t n = 0; n < max_ticks; ++n) {
     if (status == plan::PlanStatus::Working) status = planner.pump(*queue);
     traj::TickInput in;
+    if (options.ideal_controller) {
+      for (int e = 0; e < out.event_count; ++e) {
+        const std::uint32_t k = out.events[static_cast<std::size_t>(e)].action;
+        if (k >= program.actions().size()) continue;
+        const canon::Action& a = program.actions()[k];
+        if (a.kind == canon::ActionKind::SpindleSpeed) rpm = a.value;
+        if (a.kind == canon::ActionKind::SpindleCw) direction = 1;
+        if (a.kind == canon::ActionKind::SpindleCcw) direction = -1;
+        if (a.kind == canon::ActionKind::SpindleStop) direction = 0;
+      }
+      in.spindle_rev_s = direction * rpm / 60.0;
+      revs += in.spindle_rev_s * ic.period_s;
+      in.spindle_revs = revs;
+      in.sync_done = out.state == traj::RunState::WaitingSync;
+      in.cycle_start = out.state == traj::RunState::WaitingCycleStart;
+    }
     if (options.inputs) options.inputs(n, out, in);
     interp.tick(in, out);
     if (checker) checker->add(out.position, out.segment_first, out.segment_last);

@@ -253,19 +253,31 @@ double distance_to(const MotionBlock& b, const Pose& p) noexcept {
 
 namespace {
 
+/// Radius for which a circle in the plane of unit vectors `t` and `n` can be run at the needed
+/// speed: v²·√(t_i² + n_i²)/R ≤ share·A_i on every axis.
+double needed_radius(const Pose& t, const Pose& n, const BlendNeed& need) {
+  double r = 0;
+  for (int i = 0; i < kAxisCount; ++i) {
+    const double a = need.accel[static_cast<std::size_t>(i)];
+    if (a > 0) r = std::max(r, need.speed * need.speed * std::hypot(t[i], n[i]) / (need.share * a));
+  }
+  return r;
+}
+
 bool line_line_blend(const MotionBlock& in, double avail_in, const MotionBlock& out, double avail_out,
-                     double tolerance, double theta, const Pose& ta, const Pose& tb, Blend& result) {
+                     double tolerance, const BlendNeed& need, double theta, const Pose& ta, const Pose& tb,
+                     Blend& result) {
   // Circular fillet tangent to both lines: tangent length d, radius R = d / tan(θ/2), largest
-  // distance from the two lines R·(1 − cos(θ/2)) = d·tan(θ/2)·... ≤ tolerance.
+  // distance from the lines R·(1 − cos(θ/2)) ≤ tolerance, and no larger than the speed needs.
   const double t2 = std::tan(0.5 * theta);
   const double s4 = std::sin(0.25 * theta);
-  double d = std::min(avail_in, avail_out);
-  if (tolerance > 0) d = std::min(d, tolerance * t2 / (2.0 * s4 * s4));
-  if (!(d >= kMinLength)) return false;
-  const double radius = d / t2;
   Pose n = tb - ta;
   n = n - dot(n, ta) * ta;
   n = (1.0 / norm(n)) * n;
+  double d = std::min({avail_in, avail_out, needed_radius(ta, n, need) * t2});
+  if (tolerance > 0) d = std::min(d, tolerance * t2 / (2.0 * s4 * s4));
+  if (!(d >= kMinLength)) return false;
+  const double radius = d / t2;
   MotionBlock& c = result.curve;
   c = in;
   c.kind = BlockKind::Arc;
@@ -316,8 +328,15 @@ double bezier_deviation(const MotionBlock& c, const MotionBlock& in, const Motio
 }
 
 bool bezier_blend(const MotionBlock& in, double avail_in, const MotionBlock& out, double avail_out,
-                  double tolerance, Blend& result) {
-  const double d_max = std::min(avail_in, avail_out);
+                  double tolerance, const BlendNeed& need, double theta, const Pose& ta, const Pose& tb,
+                  Blend& result) {
+  // A cubic's curvature peaks above that of the circular fillet it imitates: allow it twice the
+  // fillet's tangent length before the speed no longer needs more.
+  Pose n = tb - ta;
+  n = n - dot(n, ta) * ta;
+  n = (1.0 / norm(n)) * n;
+  const double d_need = 2.0 * needed_radius(ta, n, need) * std::tan(0.5 * theta);
+  const double d_max = std::min({avail_in, avail_out, d_need});
   if (!(d_max >= kMinLength)) return false;
   const auto ok = [&](double d) {
     bezier_at(in, out, d, result.curve);
@@ -342,14 +361,14 @@ bool bezier_blend(const MotionBlock& in, double avail_in, const MotionBlock& out
 }  // namespace
 
 bool blend_corner(const MotionBlock& in, double avail_in, const MotionBlock& out, double avail_out,
-                  double tolerance, Blend& result) {
+                  double tolerance, const BlendNeed& need, Blend& result) {
   const Pose ta = end_tangent(in), tb = start_tangent(out);
   const double theta = angle_between(ta, tb);
   if (theta <= kTangentAngle || theta >= kReversalAngle) return false;
   if (in.kind == BlockKind::Line && out.kind == BlockKind::Line) {
-    return line_line_blend(in, avail_in, out, avail_out, tolerance, theta, ta, tb, result);
+    return line_line_blend(in, avail_in, out, avail_out, tolerance, need, theta, ta, tb, result);
   }
-  return bezier_blend(in, avail_in, out, avail_out, tolerance, result);
+  return bezier_blend(in, avail_in, out, avail_out, tolerance, need, theta, ta, tb, result);
 }
 
 }  // namespace opencnc::plan::detail

@@ -3,6 +3,7 @@
 // tolerance (circular arcs between lines, cubic Béziers where an arc is involved).
 #pragma once
 
+#include <array>
 #include <string>
 
 #include "opencnc/canon/program.hpp"
@@ -48,11 +49,20 @@ struct Blend {
   double trim_in = 0, trim_out = 0;
 };
 
+/// How big a blend needs to be: no larger than what lets the corner be taken at `speed` with the
+/// centripetal acceleration within `share` × `accel[i]` on every axis.
+struct BlendNeed {
+  double speed = 0;
+  double share = 0.95;
+  std::array<double, kAxisCount> accel{};
+};
+
 /// Blends the corner between `in` (ending at the corner) and `out` (starting there). At most
 /// `avail_in` / `avail_out` may be taken from each; the curve stays within `tolerance` of the
-/// two blocks (0 = no limit). False when no useful blend exists (the motion must stop).
+/// two blocks (0 = no limit) and is no larger than `need` asks. False when no useful blend exists
+/// (the motion must stop).
 bool blend_corner(const MotionBlock& in, double avail_in, const MotionBlock& out, double avail_out,
-                  double tolerance, Blend& result);
+                  double tolerance, const BlendNeed& need, Blend& result);
 
 /// Distance from `p` to the block's curve (lines and arcs exact; others by sampling).
 double distance_to(const MotionBlock& b, const Pose& p) noexcept;

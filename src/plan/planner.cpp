@@ -94,6 +94,7 @@ struct Planner::Impl {
   void flush_pending();
   bool corner(Element& a, Element& e);
   double commanded_max(const MotionBlock& b) const;
+  detail::BlendNeed blend_need(const MotionBlock& a, const MotionBlock& e) const;
   bool read_one();
 };
 
@@ -130,6 +131,20 @@ void Planner::Impl::check_config() {
 
 double Planner::Impl::commanded_max(const MotionBlock& b) const {
   return b.feed_class == FeedClass::Feed ? b.feed * config.max_feed_override : kInf;
+}
+
+// The fastest the corner will be asked to go: the lower of the two moves' top speeds (feed at
+// the largest override, or the rapid rate), within the axis velocity limits.
+detail::BlendNeed Planner::Impl::blend_need(const MotionBlock& a, const MotionBlock& e) const {
+  detail::BlendNeed need;
+  need.share = config.normal_accel_share;
+  need.speed = std::min(commanded_max(a), commanded_max(e));
+  if (!(need.speed < kInf)) need.speed = std::min(detail::block_limits(a, kInf, params).cap,
+                                                  detail::block_limits(e, kInf, params).cap);
+  for (int i = 0; i < kAxisCount; ++i) {
+    if (limits.axes.has(static_cast<Axis>(i))) need.accel[static_cast<std::size_t>(i)] = limits[i].max_acceleration;
+  }
+  return need;
 }
 
 void Planner::Impl::emit_path(MotionBlock b, double junction) {
@@ -184,7 +199,7 @@ bool Planner::Impl::corner(Element& a, Element& e) {
   detail::Blend blend;
   const double avail_a = std::min(0.5 * a.orig_length, a.b.length);
   const double avail_e = std::min(0.5 * e.orig_length, e.b.length);
-  if (!detail::blend_corner(a.b, avail_a, e.b, avail_e, tol, blend)) return false;
+  if (!detail::blend_corner(a.b, avail_a, e.b, avail_e, tol, blend_need(a.b, e.b), blend)) return false;
   detail::trim_end(a.b, blend.trim_in);
   emit_path(a.b, a.junction);
   emit_reports();

@@ -19,6 +19,10 @@ struct SimulationOptions {
   plan::PlannerConfig planner;
   double max_time_s = 7200;  ///< give up after this much virtual time
   bool check = true;         ///< run the TraceChecker on every sample
+  /// Stand in for the rest of the controller: acknowledge Sync markers and program stops at once,
+  /// and give the spindle the programmed speed as soon as S/M3/M4/M5 pass (an ideal spindle).
+  /// The `inputs` hook runs after this and may override it.
+  bool ideal_controller = true;
   /// Sets the inputs of tick `n` (overrides, feed hold, cycle start, spindle, ...). Optional.
   std::function<void(std::uint64_t n, const traj::TickOutput& previous, traj::TickInput& in)> inputs;
   /// Sees every tick's output. Optional.
