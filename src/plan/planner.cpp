@@ -95,6 +95,7 @@ struct Planner::Impl {
   bool corner(Element& a, Element& e);
   double commanded_max(const MotionBlock& b) const;
   detail::BlendNeed blend_need(const MotionBlock& a, const MotionBlock& e) const;
+  bool blend_pays(const Element& a, const Element& e, const detail::Blend& blend) const;
   bool read_one();
 };
 
@@ -200,6 +201,7 @@ bool Planner::Impl::corner(Element& a, Element& e) {
   const double avail_a = std::min(0.5 * a.orig_length, a.b.length);
   const double avail_e = std::min(0.5 * e.orig_length, e.b.length);
   if (!detail::blend_corner(a.b, avail_a, e.b, avail_e, tol, blend_need(a.b, e.b), blend)) return false;
+  if (!blend_pays(a, e, blend)) return false;
   detail::trim_end(a.b, blend.trim_in);
   emit_path(a.b, a.junction);
   emit_reports();
@@ -220,6 +222,40 @@ bool Planner::Impl::corner(Element& a, Element& e) {
   detail::trim_start(e.b, blend.trim_out);
   ++stats.blends;
   return true;
+}
+
+// G64 should never be slower than stopping. Compare both from where the stopping motion has
+// slowed to the blend's speed limit v_b (v_b²/2A before the corner) to where it is back at v_b:
+// stopping takes 2·v_b/A; blending covers that distance with the corner cut (blend length L
+// instead of the two legs 2·d) at v_b, i.e. v_b/A + (L − 2d)/v_b. With the moving average of
+// length T, a stop also waits T at the corner, and the blend's speed limit holds over v_b·T of
+// extra path on each side (2·T more). Blend when (L − 2d)/v_b + T < v_b/A. Without jerk limits
+// (T = 0) that always holds, as L < 2d. The estimate assumes moves on both sides long enough to
+// get back to full speed; between short moves (dense paths) the blend is always kept.
+bool Planner::Impl::blend_pays(const Element& ea, const Element& ee, const detail::Blend& blend) const {
+  if (params.filter_s <= 0) return true;
+  const MotionBlock& a = ea.b;
+  const MotionBlock& e = ee.b;
+  const MotionBlock& c = blend.curve;
+  double v_b = detail::block_limits(c, std::min(commanded_max(a), commanded_max(e)), params).cap;
+  if (params.filter_s > 0) {
+    MotionBlock in = a, out = e;
+    detail::trim_end(in, blend.trim_in);
+    detail::trim_start(out, blend.trim_out);
+    for (const Pose& step : {detail::curvature_step(in, c), detail::curvature_step(c, out)}) {
+      for (int i = 0; i < kAxisCount; ++i) {
+        if (step[i] > 0 && limits[i].max_jerk > 0) {
+          v_b = std::min(v_b, std::sqrt(config.jerk_step_share * limits[i].max_jerk * config.servo_period_s / step[i]));
+        }
+      }
+    }
+  }
+  const detail::RawLimits la = detail::block_limits(a, commanded_max(a), params);
+  const detail::RawLimits le = detail::block_limits(e, commanded_max(e), params);
+  const double v_adjacent = std::min(std::min(la.cap, le.cap), std::min(commanded_max(a), commanded_max(e)));
+  const double accel = std::min(la.accel, le.accel);
+  if (std::min(ea.orig_length, ee.orig_length) < v_adjacent * v_adjacent / accel) return true;
+  return v_b > 0 && (c.length - blend.trim_in - blend.trim_out) / v_b + params.filter_s < v_b / accel;
 }
 
 void Planner::Impl::on_element(Element e) {
