@@ -168,10 +168,9 @@ TEST(Planner, NaiveCamToleranceMergesNearlyCollinearFeedLines) {
   ASSERT_EQ(merged.size(), 1u);
   EXPECT_EQ(merged[0].segment_first, 0u);
   EXPECT_EQ(merged[0].segment_last, 9u);
-  // Unmerged: nine blends, each taking half of the lines on both sides, so only the outer halves
-  // of the first and the last line remain.
+  // Unmerged: ten lines and nine small blends (just large enough for 2 × F10 mm/s).
   const auto separate = path_blocks(plan_all(build(0)));
-  EXPECT_EQ(separate.size(), 11u);
+  EXPECT_EQ(separate.size(), 19u);
 }
 
 TEST(Planner, ActionsBecomeMarkersInProgramOrder) {
