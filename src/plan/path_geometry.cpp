@@ -259,7 +259,7 @@ double needed_radius(const Pose& t, const Pose& n, const BlendNeed& need) {
   double r = 0;
   for (int i = 0; i < kAxisCount; ++i) {
     const double a = need.accel[static_cast<std::size_t>(i)];
-    if (a > 0) r = std::max(r, need.speed * need.speed * std::hypot(t[i], n[i]) / (need.share * a));
+    if (a > 0) r = std::max(r, need.speed * need.speed * std::sqrt(t[i] * t[i] + n[i] * n[i]) / (need.share * a));
   }
   return r;
 }

@@ -16,6 +16,7 @@ using canon::ActionKind;
 using canon::MoveKind;
 using traj::FeedClass;
 using traj::MarkerKind;
+using traj::MotionBlock;
 
 namespace {
 
@@ -195,7 +196,29 @@ bool ProgramReader::make_element(canon::SegmentId id, Element& e) const {
   e.mode = mode_;
   e.tolerance = tolerance_;
   e.stop_after = m.kind == MoveKind::Probe;
+  if (m.kind == MoveKind::Arc) chord_small_arc(start, end, f, e);
   return true;
+}
+
+// G64 Q, as LinuxCNC's naive-CAM detector: a flat arc that never leaves its chord by more than
+// the tolerance is the chord (tiny arcs from CAM output), and may then be merged with others.
+void ProgramReader::chord_small_arc(const Pose& start, const Pose& end, double feed, Element& e) const {
+  if (e.mode != canon::MotionControl::Continuous || naive_tolerance_ <= 0 || e.b.feed_class != FeedClass::Feed) return;
+  if (norm(e.b.lin) > 1e-12) return;  // helix or other axes: not a flat arc
+  const double sweep = std::fabs(e.b.omega) * e.b.length;
+  if (sweep > 3.14159265358979323846) return;
+  const double sagitta = norm(e.b.u) * (1 - std::cos(0.5 * sweep));
+  if (sagitta > merge_budget()) return;
+  MotionBlock line = e.b;
+  if (!make_line(start, end, line)) return;
+  line.feed = feed / 60.0 * feed_length_ratio(start, end, line);
+  e.b = line;
+  e.orig_length = line.length;
+  e.merge_deviation = sagitta;
+}
+
+double ProgramReader::merge_budget() const noexcept {
+  return tolerance_ > 0 ? std::min(naive_tolerance_, tolerance_) : naive_tolerance_;
 }
 
 // G64 Q: a run of feed lines whose inner vertices all lie within Q of the line from the run's
@@ -207,7 +230,12 @@ bool ProgramReader::can_extend_run(const Element& e) const {
   if (e.b.kind != traj::BlockKind::Line || e.b.feed_class != FeedClass::Feed || e.stop_after) return false;
   if (e.mode != run_.mode || e.tolerance != run_.tolerance || e.b.flags != run_.b.flags) return false;
   if (program_->feed(e.b.segment_first) != run_feed_) return false;
-  const double q = run_.tolerance > 0 ? std::min(naive_tolerance_, 0.5 * run_.tolerance) : naive_tolerance_;
+  // Vertices within Q (at most P/2, to leave the blends room), and all of it within the budget
+  // together with what chorded arcs already deviate.
+  const double floor = std::max(run_floor_, e.merge_deviation);
+  const double q_vertex = run_.tolerance > 0 ? std::min(naive_tolerance_, 0.5 * run_.tolerance) : naive_tolerance_;
+  const double q = std::min(q_vertex, merge_budget() - floor);
+  if (q < 0) return false;
   const Pose end = end_point(e.b);
   const Pose chord = end - run_start_;
   const double len = norm(chord);
@@ -241,7 +269,7 @@ void ProgramReader::flush_run() {
       const double t = dot(p - run_start_, e.b.lin);
       dev = std::max(dev, norm(p - (run_start_ + t * e.b.lin)));
     }
-    e.merge_deviation = dev;
+    e.merge_deviation = dev + run_floor_;
   }
   run_points_.clear();
   Item it;
@@ -256,6 +284,7 @@ void ProgramReader::push_element(const Element& e) {
     run_.b.base = e.b.base;  // the run's current last line, for end_point()
     run_.b.lin = e.b.lin;
     run_.b.length = e.b.length;
+    run_floor_ = std::max(run_floor_, e.merge_deviation);
     ++merged_;
     return;
   }
@@ -267,6 +296,7 @@ void ProgramReader::push_element(const Element& e) {
     run_ = e;
     run_start_ = e.b.base;
     run_feed_ = program_->feed(e.b.segment_first);
+    run_floor_ = e.merge_deviation;
     return;
   }
   Item it;
@@ -319,7 +349,7 @@ bool ProgramReader::next(Item& out) {
   // Keep a run open until something else arrives, so that merging can look ahead.
   while (ready_.empty() && !done_) read_more();
   if (ready_.empty()) return false;
-  out = ready_.front();
+  out = std::move(ready_.front());
   ready_.pop_front();
   return true;
 }

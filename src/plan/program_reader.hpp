@@ -56,6 +56,8 @@ class ProgramReader {
   bool make_element(canon::SegmentId id, Element& e) const;
   void push_element(const Element& e);
   bool can_extend_run(const Element& e) const;
+  void chord_small_arc(const Pose& start, const Pose& end, double feed, Element& e) const;
+  double merge_budget() const noexcept;
   void flush_run();
   std::uint8_t flags() const noexcept;
 
@@ -76,6 +78,7 @@ class ProgramReader {
   Element run_;
   Pose run_start_{};
   double run_feed_ = 0;
+  double run_floor_ = 0;          ///< largest deviation of a chorded arc in the run
   std::vector<Pose> run_points_;  ///< inner vertices of the run
 };
 
