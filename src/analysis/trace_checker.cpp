@@ -36,6 +36,22 @@ double segment_distance(const Pose& a, const Pose& b, const Pose& p) {
   return std::sqrt(s);
 }
 
+/// Smallest f(a) for a within a quarter turn of a0 and inside [0, sweep] (golden section).
+template <typename F>
+double nearest_angle(F f, double a0, double sweep) {
+  double lo = std::max(0.0, a0 - 0.25 * std::numbers::pi), hi = std::min(sweep, a0 + 0.25 * std::numbers::pi);
+  const double g = 0.5 * (std::sqrt(5.0) - 1);
+  double x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo), f1 = f(x1), f2 = f(x2);
+  for (int i = 0; i < 40 && hi - lo > 1e-12; ++i) {
+    if (f1 < f2) {
+      hi = x2, x2 = x1, f2 = f1, x1 = hi - g * (hi - lo), f1 = f(x1);
+    } else {
+      lo = x1, x1 = x2, f1 = f2, x2 = lo + g * (hi - lo), f2 = f(x2);
+    }
+  }
+  return std::min({f1, f2, f(a0)});
+}
+
 struct V3 {
   double x, y, z;
 };
@@ -44,8 +60,9 @@ V3 sub(V3 a, V3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
 V3 scale(double k, V3 a) { return {k * a.x, k * a.y, k * a.z}; }
 
 // Distance to a programmed arc as LinuxCNC draws it: the radius changes linearly with the angle
-// from the start radius to the end radius, the axial and other axes move linearly. Taken at the
-// angle of the point (an upper bound of the true distance, exact for a circle in its plane).
+// from the start radius to the end radius, the axial and other axes move linearly. The angle of
+// the point gives the candidate (exact for a circle in its plane); where the arc also moves
+// along its axis or changes radius, a golden-section search around it finds the nearest point.
 double arc_distance(const canon::ArcGeometry& g, const Pose& start, const Pose& end, const Pose& p) {
   const int b0 = (g.plane == canon::Plane::XY || g.plane == canon::Plane::YZ || g.plane == canon::Plane::XZ) ? 0 : 6;
   const V3 n{g.normal[0], g.normal[1], g.normal[2]}, c{g.center[0], g.center[1], g.center[2]};
@@ -69,20 +86,34 @@ double arc_distance(const canon::ArcGeometry& g, const Pose& start, const Pose& 
   double phi = std::atan2(dot(q, e2), dot(q, e1));
   if (!ccw) phi = -phi;
   if (phi < 0) phi += kTwoPi;
-  double best = std::min(linear_distance(start, p), linear_distance(end, p));
-  for (double a = phi; a <= sweep; a += kTwoPi) {
+  const auto point_at = [&](double a) {  // the arc at angle a ∈ [0, sweep]
     const double f = a / sweep;
     const double r = r0 + (r1 - r0) * f, ang = ccw ? a : -a;
     Pose x;
     for (int i = 0; i < kAxisCount; ++i) x[i] = start[i] + f * (end[i] - start[i]);
     const V3 axial = scale(dot(sub(V3{x[b0], x[b0 + 1], x[b0 + 2]}, c), n), n);
-    const V3 pt{c.x + r * (std::cos(ang) * e1.x + std::sin(ang) * e2.x) + axial.x,
-                c.y + r * (std::cos(ang) * e1.y + std::sin(ang) * e2.y) + axial.y,
-                c.z + r * (std::cos(ang) * e1.z + std::sin(ang) * e2.z) + axial.z};
-    x[b0] = pt.x;
-    x[b0 + 1] = pt.y;
-    x[b0 + 2] = pt.z;
-    best = std::min(best, linear_distance(x, p));
+    x[b0] = c.x + r * (std::cos(ang) * e1.x + std::sin(ang) * e2.x) + axial.x;
+    x[b0 + 1] = c.y + r * (std::cos(ang) * e1.y + std::sin(ang) * e2.y) + axial.y;
+    x[b0 + 2] = c.z + r * (std::cos(ang) * e1.z + std::sin(ang) * e2.z) + axial.z;
+    return linear_distance(x, p);
+  };
+  double rest = 0;  // motion besides the circle: helix rise, other axes, radius change
+  for (int i : kLinear) {
+    if (i < b0 || i > b0 + 2) rest += std::fabs(end[i] - start[i]);
+  }
+  const V3 rise = sub(V3{end[b0], end[b0 + 1], end[b0 + 2]}, V3{start[b0], start[b0 + 1], start[b0 + 2]});
+  rest += std::fabs(dot(rise, n)) + std::fabs(r1 - r0);
+  double best = std::min(linear_distance(start, p), linear_distance(end, p));
+  for (double a = phi; a <= sweep; a += kTwoPi) {
+    const double same_angle = point_at(a);  // an upper bound; on the helix itself it is 0
+    best = std::min(best, rest > 1e-12 && same_angle > 1e-9 ? nearest_angle(point_at, a, sweep) : same_angle);
+  }
+  if (best <= 1e-9) return best;
+  if (rest > 1e-12) {  // near the ends the nearest point of a helix may be at another angle
+    const double quarter = 0.25 * std::numbers::pi;
+    if (phi < quarter || phi > kTwoPi - quarter) best = std::min(best, nearest_angle(point_at, 0.0, sweep));
+    const double to_end = std::remainder(phi - sweep, kTwoPi);
+    if (std::fabs(to_end) < quarter) best = std::min(best, nearest_angle(point_at, sweep, sweep));
   }
   return best;
 }

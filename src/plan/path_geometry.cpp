@@ -222,14 +222,48 @@ Pose start_tangent(const MotionBlock& b) noexcept {
   return (1.0 / norm(t)) * t;
 }
 
+namespace {
+
+/// Smallest distance from p to block b for s within a quarter turn of `s0`: Newton's method on
+/// the derivative of the squared distance, golden section where that is not convex.
+double nearest_on(const MotionBlock& b, const Pose& p, double s0) noexcept {
+  const double reach = 0.25 * kPi / std::fabs(b.omega);
+  double s = s0;
+  for (int i = 0; i < 8; ++i) {
+    const Pose r = p - traj::position_at(b, s);
+    const Pose t = traj::tangent_at(b, s);
+    const double g1 = -dot(r, t), g2 = dot(t, t) - dot(r, traj::curvature_at(b, s));
+    if (!(g2 > 0)) break;
+    const double next = std::clamp(s - g1 / g2, std::max(0.0, s0 - reach), std::min(b.length, s0 + reach));
+    if (std::fabs(next - s) < 1e-13 * (1 + b.length)) {
+      return std::min(norm(p - traj::position_at(b, next)), norm(p - traj::position_at(b, s0)));
+    }
+    s = next;
+  }
+  double lo = std::max(0.0, s0 - reach), hi = std::min(b.length, s0 + reach);
+  const double g = 0.5 * (std::sqrt(5.0) - 1);
+  const auto d = [&](double x) { return norm(p - traj::position_at(b, x)); };
+  double x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo), f1 = d(x1), f2 = d(x2);
+  for (int i = 0; i < 60 && hi - lo > 1e-12; ++i) {
+    if (f1 < f2) {
+      hi = x2, x2 = x1, f2 = f1, x1 = hi - g * (hi - lo), f1 = d(x1);
+    } else {
+      lo = x1, x1 = x2, f1 = f2, x2 = lo + g * (hi - lo), f2 = d(x2);
+    }
+  }
+  return std::min({f1, f2, d(s0)});
+}
+
+}  // namespace
+
 double distance_to(const MotionBlock& b, const Pose& p) noexcept {
   if (b.kind == BlockKind::Line) {
     const double t = std::clamp(dot(p - b.base, b.lin), 0.0, b.length);
     return norm(p - (b.base + t * b.lin));
   }
   if (b.kind == BlockKind::Arc) {
-    // The angle of p about the axis picks the parameter; for planar arcs the result is exact,
-    // for helices it is an upper bound (the point at that angle), which is what callers need.
+    // The angle of p about the axis picks the parameter (exact for a planar arc); on a helix the
+    // nearest point is near there, and a golden-section search around it finds it.
     const double r = norm(b.u);
     const Pose centre = b.base + b.u;
     const Pose q = p - centre;
@@ -240,9 +274,13 @@ double distance_to(const MotionBlock& b, const Pose& p) noexcept {
     if (phi < 0) phi += 2 * kPi;
     const double span = std::fabs(sweep);
     double best = std::min(norm(p - b.base), norm(p - end_point(b)));
+    const bool helix = norm(b.lin) > 1e-12;
     for (double a = phi; a <= span; a += 2 * kPi) {
-      best = std::min(best, norm(p - traj::position_at(b, a / std::fabs(b.omega))));
+      const double s = a / std::fabs(b.omega);
+      const double same_angle = norm(p - traj::position_at(b, s));
+      best = std::min(best, helix && same_angle > 1e-9 ? nearest_on(b, p, s) : same_angle);
     }
+    if (helix && best > 1e-9) best = std::min({best, nearest_on(b, p, 0.0), nearest_on(b, p, b.length)});
     return best;
   }
   // Bézier: sampled (only used for short blend curves).
