@@ -195,7 +195,7 @@ std::uint64_t Lookahead::soft_link(std::uint64_t seq) {
   if (f.kind == BlockKind::Marker) return traj::kNoBlock;
   // Same class and nominal speed as the block before: the first lower one further on is the same.
   if (last_link_ != traj::kNoBlock && last_link_ > seq && f.feed_class == last_link_class_ &&
-      f.feed == last_link_feed_ && f.feed_class != FeedClass::SpindleSync) {
+      f.feed == last_link_feed_) {
     return last_link_;
   }
   last_link_class_ = f.feed_class;
@@ -210,7 +210,7 @@ std::uint64_t Lookahead::find_soft_link(std::uint64_t seq) const {
   for (std::size_t k = 1; k < n; ++k) {
     const traj::MotionBlock& q = window_[k].b;
     if (q.kind == BlockKind::Marker) continue;
-    if (q.feed_class != f.feed_class || q.feed_class == FeedClass::SpindleSync || q.feed < f.feed) return seq + k;
+    if (q.feed_class != f.feed_class || q.feed < f.feed) return seq + k;
   }
   if (finished_ && n == window_.size()) return traj::kNoBlock;
   return seq + n;  // not decided yet: the tick continues the walk from that block's own link

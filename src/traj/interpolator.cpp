@@ -94,8 +94,8 @@ void Interpolator::handle_commands(const TickInput& in) noexcept {
 
 // One piece of constant acceleration inside block `b` (at queue index `index`): chooses the
 // acceleration from the target speed and every braking limit, then moves until the block end or
-// the end of the period. Returns true when the block end was reached.
-bool Interpolator::step_piece(const TickInput& in, const MotionBlock& b, std::size_t index, double& tau,
+// the end of the period.
+void Interpolator::step_piece(const TickInput& in, const MotionBlock& b, std::size_t index, double& tau,
                               double& integral) noexcept {
   const std::size_t avail = queue_->available();
   const double x = s_u_ - u_start_;
@@ -155,7 +155,7 @@ bool Interpolator::step_piece(const TickInput& in, const MotionBlock& b, std::si
   }
   a = std::clamp(a, -A, A);
   // Braking for a limit ahead (the end of the thread): the motion leaves the spindle.
-  if (follow && sync_ == Sync::Locked && a < a_follow) sync_ = Sync::CatchUp;
+  if (follow && sync_ == Sync::Locked && a < a_follow - 1e-9 * A) sync_ = Sync::CatchUp;
 
   double t = tau;
   bool stops = false;
@@ -176,7 +176,7 @@ bool Interpolator::step_piece(const TickInput& in, const MotionBlock& b, std::si
     u_start_ += b.length;
     s_u_ = u_start_;
     ++u_seq_;
-    return true;
+    return;
   }
   integral += piece_integral(s_u_, v, a, t);
   s_u_ += ds;
@@ -186,7 +186,6 @@ bool Interpolator::step_piece(const TickInput& in, const MotionBlock& b, std::si
     integral += s_u_ * tau;
     tau = 0;
   }
-  return false;
 }
 
 // G33: the spindle encoder sets the target. Waiting at the start of a synchronised run for the
@@ -388,6 +387,7 @@ void Interpolator::pop_and_rebase() noexcept {
   u_start_ -= shift;
   s_f_ -= shift;
   f_start_ -= shift;
+  sync_target_ -= shift;
   const double shift_dt = shift * config_.period_s;
   for (int i = 0; i < config_.filter_ticks; ++i) history_[static_cast<std::size_t>(i)] -= shift_dt;
 }

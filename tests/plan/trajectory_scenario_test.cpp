@@ -130,12 +130,14 @@ TEST(TrajectoryScenario, SpindleSynchronisedMotionFollowsTheEncoderWithARepeatab
     b.straight_traverse(0, p);
     b.set_spindle_speed(0, 600);
     b.start_spindle_clockwise(0);
-    b.start_speed_feed_synch(0, 1.5, false);  // G33 K1.5
-    p[Axis::Z] = -20;
+    b.start_speed_feed_synch(0, 1.5, false);  // G33 K1.5, in two moves: the lock holds across them
+    p[Axis::Z] = -8;
     b.straight_feed(1, p);
+    p[Axis::Z] = -20;
+    b.straight_feed(2, p);
     b.stop_speed_feed_synch();
     p[Axis::Z] = 5;
-    b.straight_traverse(2, p);
+    b.straight_traverse(3, p);
     b.program_end();
     return b.take();
   }();

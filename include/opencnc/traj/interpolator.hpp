@@ -108,13 +108,10 @@ class Interpolator {
   std::uint64_t ticks() const noexcept { return ticks_; }
 
  private:
-  struct Limit;  // one braking constraint (see interpolator.cpp)
-
   void handle_commands(const TickInput& in) noexcept;
   double advance_unfiltered(const TickInput& in) noexcept;
-  bool step_piece(const TickInput& in, const MotionBlock& b, std::size_t index, double& tau,
+  void step_piece(const TickInput& in, const MotionBlock& b, std::size_t index, double& tau,
                   double& integral) noexcept;
-  bool at_stop_marker(const TickInput& in, const MotionBlock& b) noexcept;
   void commit_single_block_stop(std::size_t available) noexcept;
   double target_speed(const TickInput& in, const MotionBlock& b) const noexcept;
   double filter(double integral) noexcept;
