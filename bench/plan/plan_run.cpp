@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // plan_run — motion time and trace metrics of the reference programs (or of `rs274 -g` listings
 // with --canon) in virtual time, and the CPU time that took (NOCHECK=1: without the checker).
-#include <ctime>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <string>
 
 #include <fmt/format.h>
@@ -36,9 +36,11 @@ void run(const std::string& name, const canon::Program& p, const plan::MachineLi
   const double t0 = cpu_seconds();
   const analysis::SimulationResult r = analysis::simulate(p, lim, opt);
   const double cpu = cpu_seconds() - t0;
-  fmt::print("{:28} motion {:9.3f} s  finished {}  blocks {}  blends {}  merged {}  cpu {:.3f} s ({:.0f}x real time)\n  {}\n",
-             name, r.motion_time_s, r.finished, r.plan.blocks, r.plan.blends, r.plan.merged_moves, cpu,
-             r.motion_time_s / cpu, r.report.summary());
+  fmt::print(
+      "{:28} motion {:9.3f} s  finished {}  blocks {}  blends {}  merged {}  cpu {:.3f} s ({:.0f}x real "
+      "time)\n  {}\n",
+      name, r.motion_time_s, r.finished, r.plan.blocks, r.plan.blends, r.plan.merged_moves, cpu,
+      r.motion_time_s / cpu, r.report.summary());
   for (const auto& d : r.diagnostics.items()) fmt::print("  {}\n", d.format());
 }
 
@@ -65,13 +67,16 @@ int main(int argc, char** argv) {
   run("square G64 P0.01", analysis::square_program(100, 6000, g64), lim);
   run("spiral 20k G64 P0.01", analysis::spiral_program(20000, 6000, g64), lim);
   run("spiral 20k G64 P0.01 Q0", analysis::spiral_program(20000, 6000, g64q0), lim);
-  run("small arcs 90deg G64 P0.1", analysis::small_arcs_program(2000, 0.3, 90, 3000, {canon::MotionControl::Continuous, 0.1, 0.1}), lim);
-  run("small arcs 180deg G64 P0.1", analysis::small_arcs_program(2000, 0.3, 180, 3000, {canon::MotionControl::Continuous, 0.1, 0.1}), lim);
+  run("small arcs 90deg G64 P0.1",
+      analysis::small_arcs_program(2000, 0.3, 90, 3000, {canon::MotionControl::Continuous, 0.1, 0.1}), lim);
+  run("small arcs 180deg G64 P0.1",
+      analysis::small_arcs_program(2000, 0.3, 180, 3000, {canon::MotionControl::Continuous, 0.1, 0.1}), lim);
   const plan::MachineLimits jl = plan::MachineLimits::uniform(AxisMask::from_letters("XYZ"), 100, 1000, 1e5);
   run("jerk square G61", analysis::square_program(100, 6000, g61), jl);
   run("jerk square G64 P0.01", analysis::square_program(100, 6000, g64), jl);
   run("jerk spiral 20k G64 P0.01", analysis::spiral_program(20000, 6000, g64), jl);
   run("jerk spiral 20k G64 P0.01 Q0", analysis::spiral_program(20000, 6000, g64q0), jl);
-  run("jerk small arcs 90deg G64 P0.1", analysis::small_arcs_program(2000, 0.3, 90, 3000, {canon::MotionControl::Continuous, 0.1, 0.1}), jl);
+  run("jerk small arcs 90deg G64 P0.1",
+      analysis::small_arcs_program(2000, 0.3, 90, 3000, {canon::MotionControl::Continuous, 0.1, 0.1}), jl);
   return 0;
 }

@@ -15,11 +15,11 @@ bool split_call(std::string_view line, std::string_view& name, std::vector<std::
   // "   12 N0040  STRAIGHT_FEED(1.0000, ...)": skip the counter and the N field.
   std::size_t p = line.find_first_not_of(' ');
   if (p == std::string_view::npos) return false;
-  p = line.find(' ', p);                           // after the counter
+  p = line.find(' ', p);  // after the counter
   if (p == std::string_view::npos) return false;
   p = line.find_first_not_of(' ', p);
   if (p == std::string_view::npos || line[p] != 'N') return false;
-  p = line.find(' ', p);                           // after the N field
+  p = line.find(' ', p);  // after the N field
   p = line.find_first_not_of(' ', p);
   const std::size_t open = line.find('(', p);
   if (p == std::string_view::npos || open == std::string_view::npos) return false;
@@ -42,11 +42,14 @@ bool split_call(std::string_view line, std::string_view& name, std::vector<std::
   return true;
 }
 
-double num(std::string_view s) { return std::strtod(std::string(s).c_str(), nullptr); }
+double num(std::string_view s) {
+  return std::strtod(std::string(s).c_str(), nullptr);
+}
 
 Pose pose6(const std::vector<std::string_view>& a, std::size_t first) {
   Pose p;
-  for (int i = 0; i < 6 && first + static_cast<std::size_t>(i) < a.size(); ++i) p[i] = num(a[first + static_cast<std::size_t>(i)]);
+  for (int i = 0; i < 6 && first + static_cast<std::size_t>(i) < a.size(); ++i)
+    p[i] = num(a[first + static_cast<std::size_t>(i)]);
   return p;
 }
 
@@ -97,7 +100,8 @@ std::size_t read_rs274_listing(std::istream& in, canon::Sink& sink) {
       plane = plane_of(a[0]);
       sink.select_plane(plane);
     } else if (name == "USE_LENGTH_UNITS" && !a.empty()) {
-      sink.use_length_units(a[0].find("INCH") != std::string_view::npos ? canon::Units::Inch : canon::Units::Mm);
+      sink.use_length_units(a[0].find("INCH") != std::string_view::npos ? canon::Units::Inch
+                                                                        : canon::Units::Mm);
     } else if (name == "SET_G5X_OFFSET" && a.size() >= 7) {
       sink.set_g5x_offset(static_cast<int>(num(a[0])), pose6(a, 1));
     } else if (name == "SET_G92_OFFSET" && a.size() >= 6) {
@@ -107,11 +111,13 @@ std::size_t read_rs274_listing(std::istream& in, canon::Sink& sink) {
     } else if (name == "SET_FEED_RATE" && !a.empty()) {
       sink.set_feed_rate(num(a[0]));
     } else if (name == "SET_FEED_MODE" && a.size() >= 2) {
-      sink.set_feed_mode(0, num(a[1]) != 0 ? canon::FeedMode::UnitsPerRevolution : canon::FeedMode::UnitsPerMinute);
+      sink.set_feed_mode(
+          0, num(a[1]) != 0 ? canon::FeedMode::UnitsPerRevolution : canon::FeedMode::UnitsPerMinute);
     } else if (name == "SET_MOTION_CONTROL_MODE" && !a.empty()) {  // the tolerance only with G64
-      const canon::MotionControl m = a[0].find("EXACT_STOP") != std::string_view::npos ? canon::MotionControl::ExactStop
-                                     : a[0].find("EXACT_PATH") != std::string_view::npos ? canon::MotionControl::ExactPath
-                                                                                          : canon::MotionControl::Continuous;
+      const canon::MotionControl m =
+          a[0].find("EXACT_STOP") != std::string_view::npos   ? canon::MotionControl::ExactStop
+          : a[0].find("EXACT_PATH") != std::string_view::npos ? canon::MotionControl::ExactPath
+                                                              : canon::MotionControl::Continuous;
       sink.set_motion_control_mode(m, a.size() > 1 ? num(a[1]) : 0.0);
     } else if (name == "SET_NAIVECAM_TOLERANCE" && !a.empty()) {
       sink.set_naivecam_tolerance(num(a[0]));

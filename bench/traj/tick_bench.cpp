@@ -89,15 +89,21 @@ void tick_bench(benchmark::State& state, double jerk) {
     }
   }
   std::sort(ns.begin(), ns.end());
-  const auto pct = [&](double q) { return ns.empty() ? 0.0 : ns[static_cast<std::size_t>(q * (ns.size() - 1))]; };
+  const auto pct = [&](double q) {
+    return ns.empty() ? 0.0 : ns[static_cast<std::size_t>(q * (ns.size() - 1))];
+  };
   state.counters["p50_ns"] = pct(0.50);
   state.counters["p99_ns"] = pct(0.99);
   state.counters["p999_ns"] = pct(0.999);
   state.counters["max_ns"] = ns.empty() ? 0.0 : ns.back();
 }
 
-void BM_Tick6Axes(benchmark::State& state) { tick_bench(state, 0); }
-void BM_Tick6AxesJerkLimited(benchmark::State& state) { tick_bench(state, 1e5); }
+void BM_Tick6Axes(benchmark::State& state) {
+  tick_bench(state, 0);
+}
+void BM_Tick6AxesJerkLimited(benchmark::State& state) {
+  tick_bench(state, 1e5);
+}
 
 }  // namespace
 

@@ -20,7 +20,9 @@ Pose xyz(double x, double y, double z = 0) {
   return p;
 }
 
-double round4(double v) { return std::round(v * 1e4) / 1e4; }
+double round4(double v) {
+  return std::round(v * 1e4) / 1e4;
+}
 
 void set_mode(canon::ProgramBuilder& b, const PathMode& m) {
   b.set_motion_control_mode(m.mode, m.p);
@@ -72,7 +74,7 @@ canon::Program small_arcs_program(int arcs, double radius_mm, double sweep_deg, 
   const double sweep = sweep_deg * std::numbers::pi / 180.0;
   double x = 0, y = 0, heading = 0;  // direction of travel, radians
   for (int i = 0; i < arcs; ++i) {
-    const int turn = i % 2 == 0 ? 1 : -1;  // G3 then G2
+    const int turn = i % 2 == 0 ? 1 : -1;                                        // G3 then G2
     const double nx = -std::sin(heading) * turn, ny = std::cos(heading) * turn;  // toward the centre
     const double cx = x + radius_mm * nx, cy = y + radius_mm * ny;
     const double a0 = std::atan2(y - cy, x - cx), a1 = a0 + turn * sweep;

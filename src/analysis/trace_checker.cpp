@@ -55,16 +55,23 @@ double nearest_angle(F f, double a0, double sweep) {
 struct V3 {
   double x, y, z;
 };
-double dot(V3 a, V3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-V3 sub(V3 a, V3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-V3 scale(double k, V3 a) { return {k * a.x, k * a.y, k * a.z}; }
+double dot(V3 a, V3 b) {
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
+V3 sub(V3 a, V3 b) {
+  return {a.x - b.x, a.y - b.y, a.z - b.z};
+}
+V3 scale(double k, V3 a) {
+  return {k * a.x, k * a.y, k * a.z};
+}
 
 // Distance to a programmed arc as LinuxCNC draws it: the radius changes linearly with the angle
 // from the start radius to the end radius, the axial and other axes move linearly. The angle of
 // the point gives the candidate (exact for a circle in its plane); where the arc also moves
 // along its axis or changes radius, a golden-section search around it finds the nearest point.
 double arc_distance(const canon::ArcGeometry& g, const Pose& start, const Pose& end, const Pose& p) {
-  const int b0 = (g.plane == canon::Plane::XY || g.plane == canon::Plane::YZ || g.plane == canon::Plane::XZ) ? 0 : 6;
+  const int b0 =
+      (g.plane == canon::Plane::XY || g.plane == canon::Plane::YZ || g.plane == canon::Plane::XZ) ? 0 : 6;
   const V3 n{g.normal[0], g.normal[1], g.normal[2]}, c{g.center[0], g.center[1], g.center[2]};
   const auto in_plane = [&](const Pose& q) {
     const V3 v = sub(V3{q[b0], q[b0 + 1], q[b0 + 2]}, c);
@@ -121,14 +128,14 @@ double arc_distance(const canon::ArcGeometry& g, const Pose& start, const Pose& 
 }  // namespace
 
 std::string TraceReport::summary() const {
-  std::string s = fmt::format("time {:.3f} s, path {:.3f} mm, max contour error {:.6f} mm at {:.3f} s, "
-                              "{} limit violations",
-                              machining_time_s, path_length_mm, max_contour_error_mm, contour_error_time_s,
-                              limit_violations);
+  std::string s = fmt::format(
+      "time {:.3f} s, path {:.3f} mm, max contour error {:.6f} mm at {:.3f} s, "
+      "{} limit violations",
+      machining_time_s, path_length_mm, max_contour_error_mm, contour_error_time_s, limit_violations);
   if (limit_violations > 0) {
-    s += fmt::format(" (first at {:.3f} s: axis {} derivative {} = {:.6g}, limit {:.6g})", first_violation.time_s,
-                     kAxisLetters[static_cast<std::size_t>(first_violation.axis)], first_violation.derivative,
-                     first_violation.value, first_violation.limit);
+    s += fmt::format(" (first at {:.3f} s: axis {} derivative {} = {:.6g}, limit {:.6g})",
+                     first_violation.time_s, kAxisLetters[static_cast<std::size_t>(first_violation.axis)],
+                     first_violation.derivative, first_violation.value, first_violation.limit);
   }
   for (int i = 0; i < kAxisCount; ++i) {
     const AxisStats& a = axes[static_cast<std::size_t>(i)];
@@ -184,7 +191,8 @@ void TraceChecker::add(const Pose& position, canon::SegmentId first, canon::Segm
     const canon::SegmentId lo = first > 0 ? first - 1 : 0;
     const canon::SegmentId hi = std::min<canon::SegmentId>(last + 1, n - 1);
     double best = 1e300;
-    for (canon::SegmentId id = lo; id <= hi && id < n; ++id) best = std::min(best, distance_to_move(id, position));
+    for (canon::SegmentId id = lo; id <= hi && id < n; ++id)
+      best = std::min(best, distance_to_move(id, position));
     if (best < 1e300 && best > report_.max_contour_error_mm) {
       report_.max_contour_error_mm = best;
       report_.contour_error_time_s = report_.machining_time_s;

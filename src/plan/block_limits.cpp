@@ -24,7 +24,9 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kJerkCapShare = 0.5;  ///< part of the continuous jerk share v³·|g'''| may use
 
-bool limited_jerk(const LimitParams& p, int i) { return p.filter_s > 0 && p.machine[i].max_jerk > 0; }
+bool limited_jerk(const LimitParams& p, int i) {
+  return p.filter_s > 0 && p.machine[i].max_jerk > 0;
+}
 
 RawLimits line_limits(const MotionBlock& b, double v_max, const LimitParams& p) {
   RawLimits r{v_max, kInf};
@@ -34,7 +36,8 @@ RawLimits line_limits(const MotionBlock& b, double v_max, const LimitParams& p) 
     const AxisLimits& l = p.machine[i];
     r.cap = std::min(r.cap, l.max_velocity / d);
     r.accel = std::min(r.accel, l.max_acceleration / d);
-    if (limited_jerk(p, i)) r.accel = std::min(r.accel, (1 - p.step_share) * l.max_jerk * p.filter_s / (2 * d));
+    if (limited_jerk(p, i))
+      r.accel = std::min(r.accel, (1 - p.step_share) * l.max_jerk * p.filter_s / (2 * d));
   }
   return r;
 }

@@ -18,14 +18,18 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr std::size_t kSoftScan = 64;
-constexpr double kMinPiece = 1e-4;  ///< blocks are not split into pieces shorter than this
-constexpr double kSplitGain = 1e-3; ///< nor for a limit less than this much (relative) lower
+constexpr double kMinPiece = 1e-4;   ///< blocks are not split into pieces shorter than this
+constexpr double kSplitGain = 1e-3;  ///< nor for a limit less than this much (relative) lower
 
-bool is_marker(const PlannedBlock& p) { return p.b.kind == BlockKind::Marker; }
+bool is_marker(const PlannedBlock& p) {
+  return p.b.kind == BlockKind::Marker;
+}
 bool is_stop(const traj::MotionBlock& b) {
   return b.kind == BlockKind::Marker && b.marker != traj::MarkerKind::Report;
 }
-double end_s(const PlannedBlock& p) { return p.start_s + p.b.length; }
+double end_s(const PlannedBlock& p) {
+  return p.start_s + p.b.length;
+}
 bool has_step(const Pose& s) {
   for (double v : s.v) {
     if (v > 0) return true;
@@ -95,10 +99,12 @@ void Lookahead::widen_last() {
     if (start - end_s(jb) >= reach_) break;
     if (is_marker(jb)) continue;
     limit_range(start, end_s(jb) + jb.cap_raw * T, jb.cap_raw, jb.accel_raw);
-    if (jb.junction > 0 && jb.junction < kInf) limit_range(start, jb.start_s + jb.junction * T, jb.junction, kInf);
+    if (jb.junction > 0 && jb.junction < kInf)
+      limit_range(start, jb.start_s + jb.junction * T, jb.junction, kInf);
   }
   limit_range(start - m.cap_raw * T, end, m.cap_raw, m.accel_raw);
-  if (m.junction > 0 && m.junction < kInf) limit_range(start - m.junction * T, start + m.junction * T, m.junction, kInf);
+  if (m.junction > 0 && m.junction < kInf)
+    limit_range(start - m.junction * T, start + m.junction * T, m.junction, kInf);
 }
 
 // Lowers cap and budget of the path between s = from and s = to, splitting blocks that reach

@@ -23,13 +23,13 @@ struct PlannedBlock {
   double junction = 0;   ///< speed limit where the block starts (0: stop there, +∞: none)
   Pose step{};           ///< per axis |Δg''| where the block starts (curvature step, jerk only)
   // Working values.
-  double start_s = 0;    ///< s of the block's start since the run began
-  double cap = 0;        ///< cap widened by the moving average (≤ cap_raw)
-  double accel = 0;      ///< budget widened by the moving average (≤ accel_raw)
-  double local = 0;      ///< largest entry speed from the block's own limits
-  double entry = 0;      ///< backward pass result
-  double prefix = 0;     ///< braking prefix C at the start
-  Pose step_sum{};       ///< curvature steps within one jerk window of this one
+  double start_s = 0;  ///< s of the block's start since the run began
+  double cap = 0;      ///< cap widened by the moving average (≤ cap_raw)
+  double accel = 0;    ///< budget widened by the moving average (≤ accel_raw)
+  double local = 0;    ///< largest entry speed from the block's own limits
+  double entry = 0;    ///< backward pass result
+  double prefix = 0;   ///< braking prefix C at the start
+  Pose step_sum{};     ///< curvature steps within one jerk window of this one
 };
 
 /// What the window needs to know about the moving average and the jerk limits.
@@ -52,7 +52,8 @@ struct WindowParams {
 /// See docs/planner.md.
 class Lookahead {
  public:
-  explicit Lookahead(const WindowParams& p) : p_(p), reach_(std::max(p.v_bound * p.filter_s, p.step_window_s)) {}
+  explicit Lookahead(const WindowParams& p)
+      : p_(p), reach_(std::max(p.v_bound * p.filter_s, p.step_window_s)) {}
 
   void push(const PlannedBlock& block);
   /// No more blocks will come: everything becomes final.
@@ -95,16 +96,16 @@ class Lookahead {
   std::uint64_t find_soft_link(std::uint64_t seq) const;
 
   WindowParams p_;
-  double reach_ = 0;              ///< the widest range any limit is widened over
+  double reach_ = 0;  ///< the widest range any limit is widened over
   std::deque<PlannedBlock> window_;
-  double total_s_ = 0;            ///< s at the end of the last pushed block
-  std::size_t settled_ = 0;       ///< front blocks with final widened limits, prefix and local
-  std::size_t pinned_ = 0;        ///< front blocks with a final entry speed
-  double next_prefix_ = 0;        ///< C at the end of the settled blocks
-  double prev_path_cap_ = 0;      ///< cap of the last settled path block (for the next junction)
-  bool prev_stop_ = true;         ///< the last settled block was a stop (or nothing yet)
+  double total_s_ = 0;        ///< s at the end of the last pushed block
+  std::size_t settled_ = 0;   ///< front blocks with final widened limits, prefix and local
+  std::size_t pinned_ = 0;    ///< front blocks with a final entry speed
+  double next_prefix_ = 0;    ///< C at the end of the settled blocks
+  double prev_path_cap_ = 0;  ///< cap of the last settled path block (for the next junction)
+  bool prev_stop_ = true;     ///< the last settled block was a stop (or nothing yet)
   bool finished_ = false;
-  bool dirty_ = false;            ///< blocks pushed since the last settle()
+  bool dirty_ = false;  ///< blocks pushed since the last settle()
   // The last soft link handed out: blocks with the same class and nominal speed share it.
   std::uint64_t last_link_ = traj::kNoBlock;
   traj::FeedClass last_link_class_ = traj::FeedClass::Feed;

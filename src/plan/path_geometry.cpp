@@ -26,13 +26,25 @@ int plane_base(canon::Plane p) noexcept {
 struct Vec3 {
   double x = 0, y = 0, z = 0;
 };
-Vec3 sub3(Vec3 a, Vec3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-Vec3 add3(Vec3 a, Vec3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-Vec3 mul3(double k, Vec3 a) { return {k * a.x, k * a.y, k * a.z}; }
-double dot3(Vec3 a, Vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-Vec3 cross3(Vec3 a, Vec3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+Vec3 sub3(Vec3 a, Vec3 b) {
+  return {a.x - b.x, a.y - b.y, a.z - b.z};
+}
+Vec3 add3(Vec3 a, Vec3 b) {
+  return {a.x + b.x, a.y + b.y, a.z + b.z};
+}
+Vec3 mul3(double k, Vec3 a) {
+  return {k * a.x, k * a.y, k * a.z};
+}
+double dot3(Vec3 a, Vec3 b) {
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
+Vec3 cross3(Vec3 a, Vec3 b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
 
-Vec3 take3(const Pose& p, int base) { return {p[base], p[base + 1], p[base + 2]}; }
+Vec3 take3(const Pose& p, int base) {
+  return {p[base], p[base + 1], p[base + 2]};
+}
 void put3(Pose& p, int base, Vec3 v) {
   p[base] = v.x;
   p[base + 1] = v.y;
@@ -89,8 +101,10 @@ bool make_arc(const Pose& start, const Pose& end, const canon::ArcGeometry& arc,
   const double ex = dot3(re, e1), ey = dot3(re, e2);
   const double r_end = std::hypot(ex, ey);
   if (std::fabs(r_end - r) > 0.01 + 1e-4 * r) {
-    error = fmt::format("the arc's end point is {:.4f} mm off its circle (radius {:.4f} mm at the start, "
-                        "{:.4f} mm at the end)", std::fabs(r_end - r), r, r_end);
+    error = fmt::format(
+        "the arc's end point is {:.4f} mm off its circle (radius {:.4f} mm at the start, "
+        "{:.4f} mm at the end)",
+        std::fabs(r_end - r), r, r_end);
     return false;
   }
   // Slightly different radii (rounded coordinates): move the centre onto the perpendicular
@@ -210,7 +224,9 @@ void rebase(MotionBlock& b, const Pose& p) noexcept {
   b.base = p;
 }
 
-Pose end_point(const MotionBlock& b) noexcept { return traj::position_at(b, b.length); }
+Pose end_point(const MotionBlock& b) noexcept {
+  return traj::position_at(b, b.length);
+}
 
 Pose end_tangent(const MotionBlock& b) noexcept {
   const Pose t = traj::tangent_at(b, b.length);
@@ -297,7 +313,8 @@ double needed_radius(const Pose& t, const Pose& n, const BlendNeed& need) {
   double r = 0;
   for (int i = 0; i < kAxisCount; ++i) {
     const double a = need.accel[static_cast<std::size_t>(i)];
-    if (a > 0) r = std::max(r, need.speed * need.speed * std::sqrt(t[i] * t[i] + n[i] * n[i]) / (need.share * a));
+    if (a > 0)
+      r = std::max(r, need.speed * need.speed * std::sqrt(t[i] * t[i] + n[i] * n[i]) / (need.share * a));
   }
   return r;
 }

@@ -30,7 +30,9 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-bool bad(double v) { return !std::isfinite(v); }
+bool bad(double v) {
+  return !std::isfinite(v);
+}
 
 /// Moving-average length in servo periods: long enough that 2·A/T ≤ (1 − η)·J on every axis.
 int filter_ticks(const MachineLimits& m, const PlannerConfig& c) {
@@ -52,7 +54,8 @@ bool validate(const MachineLimits& limits, Diagnostics& diags) {
     const AxisLimits& l = limits[i];
     const auto check = [&](double v, bool zero_ok, const char* what) {
       if (bad(v) || v < 0 || (!zero_ok && v == 0)) {
-        diags.error("", 0, 0, fmt::format("axis {}: {} must be a positive number, not {}", kAxisLetters[i], what, v),
+        diags.error("", 0, 0,
+                    fmt::format("axis {}: {} must be a positive number, not {}", kAxisLetters[i], what, v),
                     "plan.limits");
         ok = false;
       }
@@ -78,10 +81,10 @@ struct Planner::Impl {
   std::optional<detail::ProgramReader> reader;
   std::optional<detail::Lookahead> window;
   bool reading_done = false;
-  std::optional<Element> pending;         ///< last element; its end is decided by the next one
-  std::vector<MotionBlock> reports;       ///< Report markers waiting after `pending`
-  Pose last_end{};                        ///< exact end of the last emitted path block
-  const MotionBlock* last_path = nullptr; ///< for curvature-step limits (points into `prev`)
+  std::optional<Element> pending;          ///< last element; its end is decided by the next one
+  std::vector<MotionBlock> reports;        ///< Report markers waiting after `pending`
+  Pose last_end{};                         ///< exact end of the last emitted path block
+  const MotionBlock* last_path = nullptr;  ///< for curvature-step limits (points into `prev`)
   MotionBlock prev;
 
   Impl(const MachineLimits& l, const PlannerConfig& c);
@@ -109,10 +112,12 @@ Planner::Impl::Impl(const MachineLimits& l, const PlannerConfig& c) : limits(l),
   params.period_s = config.servo_period_s;
   params.filter_s = ticks > 1 ? ticks * config.servo_period_s : 0.0;
   if (ticks > traj::kMaxFilterTicks) {
-    diags.error("", 0, 0,
-                fmt::format("the jerk limits need a {:.3f} s moving average, longer than the {} servo periods "
-                            "supported; raise max_jerk", params.filter_s, traj::kMaxFilterTicks),
-                "plan.config");
+    diags.error(
+        "", 0, 0,
+        fmt::format("the jerk limits need a {:.3f} s moving average, longer than the {} servo periods "
+                    "supported; raise max_jerk",
+                    params.filter_s, traj::kMaxFilterTicks),
+        "plan.config");
     config_ok = false;
   }
 }
@@ -125,8 +130,10 @@ void Planner::Impl::check_config() {
   };
   if (bad(config.servo_period_s) || config.servo_period_s <= 0) err("servo_period_s must be positive");
   if (config.lookahead_moves < 2) err("lookahead_moves must be at least 2");
-  if (bad(config.max_feed_override) || config.max_feed_override < 1) err("max_feed_override must be at least 1");
-  if (!(config.normal_accel_share > 0 && config.normal_accel_share < 1)) err("normal_accel_share must be in (0, 1)");
+  if (bad(config.max_feed_override) || config.max_feed_override < 1)
+    err("max_feed_override must be at least 1");
+  if (!(config.normal_accel_share > 0 && config.normal_accel_share < 1))
+    err("normal_accel_share must be in (0, 1)");
   if (!(config.jerk_step_share > 0 && config.jerk_step_share < 1)) err("jerk_step_share must be in (0, 1)");
 }
 
@@ -140,10 +147,12 @@ detail::BlendNeed Planner::Impl::blend_need(const MotionBlock& a, const MotionBl
   detail::BlendNeed need;
   need.share = config.normal_accel_share;
   need.speed = std::min(commanded_max(a), commanded_max(e));
-  if (!(need.speed < kInf)) need.speed = std::min(detail::block_limits(a, kInf, params).cap,
-                                                  detail::block_limits(e, kInf, params).cap);
+  if (!(need.speed < kInf))
+    need.speed =
+        std::min(detail::block_limits(a, kInf, params).cap, detail::block_limits(e, kInf, params).cap);
   for (int i = 0; i < kAxisCount; ++i) {
-    if (limits.axes.has(static_cast<Axis>(i))) need.accel[static_cast<std::size_t>(i)] = limits[i].max_acceleration;
+    if (limits.axes.has(static_cast<Axis>(i)))
+      need.accel[static_cast<std::size_t>(i)] = limits[i].max_acceleration;
   }
   return need;
 }
@@ -245,7 +254,8 @@ bool Planner::Impl::blend_pays(const Element& ea, const Element& ee, const detai
     for (const Pose& step : {detail::curvature_step(in, c), detail::curvature_step(c, out)}) {
       for (int i = 0; i < kAxisCount; ++i) {
         if (step[i] > 0 && limits[i].max_jerk > 0) {
-          v_b = std::min(v_b, std::sqrt(config.jerk_step_share * limits[i].max_jerk * config.servo_period_s / step[i]));
+          v_b = std::min(
+              v_b, std::sqrt(config.jerk_step_share * limits[i].max_jerk * config.servo_period_s / step[i]));
         }
       }
     }
@@ -323,7 +333,8 @@ bool Planner::start(const canon::Program& program) {
     const AxisLimits& l = m.limits[i];
     wp.v_bound += l.max_velocity * l.max_velocity;
     if (wp.filter_s > 0 && l.max_jerk > 0) {
-      wp.step_budget[static_cast<std::size_t>(i)] = 4.0 / 3.0 * m.config.jerk_step_share * l.max_jerk * m.config.servo_period_s;
+      wp.step_budget[static_cast<std::size_t>(i)] =
+          4.0 / 3.0 * m.config.jerk_step_share * l.max_jerk * m.config.servo_period_s;
     }
   }
   wp.v_bound = std::sqrt(wp.v_bound);
@@ -374,7 +385,11 @@ PlanStatus Planner::pump(traj::BlockQueue& queue) {
   }
 }
 
-const Diagnostics& Planner::diagnostics() const noexcept { return impl_->diags; }
-const PlanStats& Planner::stats() const noexcept { return impl_->stats; }
+const Diagnostics& Planner::diagnostics() const noexcept {
+  return impl_->diags;
+}
+const PlanStats& Planner::stats() const noexcept {
+  return impl_->stats;
+}
 
 }  // namespace opencnc::plan

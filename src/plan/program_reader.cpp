@@ -38,14 +38,19 @@ bool finite_pose(const Pose& p) {
 /// motion), report it when passed, or stop there.
 MarkerKind marker_for(ActionKind k) {
   switch (k) {
-    case ActionKind::Dwell: return MarkerKind::Dwell;
-    case ActionKind::ProgramStop: return MarkerKind::ProgramStop;
-    case ActionKind::OptionalStop: return MarkerKind::OptionalStop;
-    case ActionKind::ProgramEnd: return MarkerKind::ProgramEnd;
+    case ActionKind::Dwell:
+      return MarkerKind::Dwell;
+    case ActionKind::ProgramStop:
+      return MarkerKind::ProgramStop;
+    case ActionKind::OptionalStop:
+      return MarkerKind::OptionalStop;
+    case ActionKind::ProgramEnd:
+      return MarkerKind::ProgramEnd;
     case ActionKind::ChangeTool:
     case ActionKind::WaitInput:
     case ActionKind::PalletShuttle:
-    case ActionKind::SpindleOrient: return MarkerKind::Sync;
+    case ActionKind::SpindleOrient:
+      return MarkerKind::Sync;
     case ActionKind::SpindleSpeed:
     case ActionKind::SpindleCw:
     case ActionKind::SpindleCcw:
@@ -65,8 +70,10 @@ MarkerKind marker_for(ActionKind k) {
     case ActionKind::AuxOutputValue:
     case ActionKind::ProbeOn:
     case ActionKind::ProbeOff:
-    case ActionKind::Message: return MarkerKind::Report;
-    default: return MarkerKind::None;
+    case ActionKind::Message:
+      return MarkerKind::Report;
+    default:
+      return MarkerKind::None;
   }
 }
 
@@ -142,18 +149,32 @@ void ProgramReader::read_actions_before(std::uint32_t move) {
         mode_ = static_cast<canon::MotionControl>(a.index);
         tolerance_ = a.value;
         break;
-      case ActionKind::NaiveCamTolerance: naive_tolerance_ = a.value; break;
-      case ActionKind::FeedOverrideEnable: override_enabled_ = true; break;
-      case ActionKind::FeedOverrideDisable: override_enabled_ = false; break;
-      case ActionKind::FeedHoldEnable: hold_enabled_ = true; break;
-      case ActionKind::FeedHoldDisable: hold_enabled_ = false; break;
-      case ActionKind::SpeedFeedSyncStart: sync_per_rev_ = a.value; break;
-      default: break;
+      case ActionKind::NaiveCamTolerance:
+        naive_tolerance_ = a.value;
+        break;
+      case ActionKind::FeedOverrideEnable:
+        override_enabled_ = true;
+        break;
+      case ActionKind::FeedOverrideDisable:
+        override_enabled_ = false;
+        break;
+      case ActionKind::FeedHoldEnable:
+        hold_enabled_ = true;
+        break;
+      case ActionKind::FeedHoldDisable:
+        hold_enabled_ = false;
+        break;
+      case ActionKind::SpeedFeedSyncStart:
+        sync_per_rev_ = a.value;
+        break;
+      default:
+        break;
     }
     const MarkerKind kind = marker_for(a.kind);
     if (kind != MarkerKind::None) add_marker(a, kind);
     // The tick stops for the spindle to reach speed before the motion that follows a start.
-    if (a.kind == ActionKind::SpindleCw || a.kind == ActionKind::SpindleCcw) add_marker(a, MarkerKind::SpindleWait);
+    if (a.kind == ActionKind::SpindleCw || a.kind == ActionKind::SpindleCcw)
+      add_marker(a, MarkerKind::SpindleWait);
   }
 }
 
@@ -203,7 +224,9 @@ bool ProgramReader::make_element(canon::SegmentId id, Element& e) const {
 // G64 Q, as LinuxCNC's naive-CAM detector: a flat arc that never leaves its chord by more than
 // the tolerance is the chord (tiny arcs from CAM output), and may then be merged with others.
 void ProgramReader::chord_small_arc(const Pose& start, const Pose& end, double feed, Element& e) const {
-  if (e.mode != canon::MotionControl::Continuous || naive_tolerance_ <= 0 || e.b.feed_class != FeedClass::Feed) return;
+  if (e.mode != canon::MotionControl::Continuous || naive_tolerance_ <= 0 ||
+      e.b.feed_class != FeedClass::Feed)
+    return;
   if (norm(e.b.lin) > 1e-12) return;  // helix or other axes: not a flat arc
   const double sweep = std::fabs(e.b.omega) * e.b.length;
   if (sweep > 3.14159265358979323846) return;
@@ -233,7 +256,8 @@ bool ProgramReader::can_extend_run(const Element& e) const {
   // Vertices within Q (at most P/2, to leave the blends room), and all of it within the budget
   // together with what chorded arcs already deviate.
   const double floor = std::max(run_floor_, e.merge_deviation);
-  const double q_vertex = run_.tolerance > 0 ? std::min(naive_tolerance_, 0.5 * run_.tolerance) : naive_tolerance_;
+  const double q_vertex =
+      run_.tolerance > 0 ? std::min(naive_tolerance_, 0.5 * run_.tolerance) : naive_tolerance_;
   const double q = std::min(q_vertex, merge_budget() - floor);
   if (q < 0) return false;
   const Pose end = end_point(e.b);
@@ -290,7 +314,8 @@ void ProgramReader::push_element(const Element& e) {
   }
   flush_run();
   const bool mergeable = naive_tolerance_ > 0 && e.mode == canon::MotionControl::Continuous &&
-                         e.b.kind == traj::BlockKind::Line && e.b.feed_class == FeedClass::Feed && !e.stop_after;
+                         e.b.kind == traj::BlockKind::Line && e.b.feed_class == FeedClass::Feed &&
+                         !e.stop_after;
   if (mergeable) {
     run_active_ = true;
     run_ = e;

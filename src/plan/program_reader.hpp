@@ -17,13 +17,13 @@ namespace opencnc::plan::detail {
 
 /// A programmed move (or a merged run of them) ready for corner processing.
 struct Element {
-  traj::MotionBlock b;            ///< geometry, identity, class, flags, nominal speed
-  double orig_length = 0;         ///< length before any blend trimmed it
-  double merge_deviation = 0;     ///< largest distance of merged vertices from the line
+  traj::MotionBlock b;         ///< geometry, identity, class, flags, nominal speed
+  double orig_length = 0;      ///< length before any blend trimmed it
+  double merge_deviation = 0;  ///< largest distance of merged vertices from the line
   canon::MotionControl mode = canon::MotionControl::Continuous;  ///< for the corner at its end
-  double tolerance = 0;           ///< G64 P (mm), 0 = none
-  bool stop_after = false;        ///< the motion must stop at its end (probe moves)
-  double junction = 0;            ///< speed limit where it starts (0: from rest, +∞: none)
+  double tolerance = 0;                                          ///< G64 P (mm), 0 = none
+  bool stop_after = false;  ///< the motion must stop at its end (probe moves)
+  double junction = 0;      ///< speed limit where it starts (0: from rest, +∞: none)
 };
 
 /// One item of the program in execution order.

@@ -28,7 +28,9 @@ inline double dot(const Pose& a, const Pose& b) noexcept {
   for (int i = 0; i < kAxisCount; ++i) s += a[i] * b[i];
   return s;
 }
-inline double norm(const Pose& a) noexcept { return std::sqrt(dot(a, a)); }
+inline double norm(const Pose& a) noexcept {
+  return std::sqrt(dot(a, a));
+}
 
 /// Angle between two unit vectors, accurate for small angles.
 inline double angle_between(const Pose& a, const Pose& b) noexcept {

@@ -322,9 +322,10 @@ void Interpolator::update_waiting(const TickInput& in) noexcept {
   if (!is_stop_marker(m) || released_seq_ == m.seq) return;
   if (!waiting_) {
     waiting_ = true;
-    dwell_ticks_left_ = m.marker == MarkerKind::Dwell
-                            ? static_cast<std::uint64_t>(std::llround(std::max(0.0, m.value) / config_.period_s))
-                            : 0;
+    dwell_ticks_left_ =
+        m.marker == MarkerKind::Dwell
+            ? static_cast<std::uint64_t>(std::llround(std::max(0.0, m.value) / config_.period_s))
+            : 0;
   }
   switch (m.marker) {
     case MarkerKind::Dwell:

@@ -35,7 +35,9 @@ Pose xyz(double x, double y, double z = 0) {
 std::vector<MotionBlock> plan_all(const canon::Program& p, const plan::MachineLimits& limits = kMill,
                                   const plan::PlannerConfig& config = {}) {
   plan::Planner planner(limits, config);
-  EXPECT_TRUE(planner.start(p)) << (planner.diagnostics().empty() ? "" : planner.diagnostics().items()[0].format());
+  EXPECT_TRUE(planner.start(p)) << (planner.diagnostics().empty()
+                                        ? ""
+                                        : planner.diagnostics().items()[0].format());
   auto q = std::make_unique<traj::BlockQueue>();
   while (planner.pump(*q) == plan::PlanStatus::Working) {
   }
@@ -92,27 +94,34 @@ TEST(Planner, RejectsBadProgramsWithTheMovesLineAndPublishesNothing) {
     EXPECT_EQ(first_code(planner), code);
     EXPECT_EQ(planner.diagnostics().items()[0].line, line);
   };
-  check([](canon::ProgramBuilder& b) {
-    Pose e = xyz(1, 0);
-    e[Axis::A] = 10;  // the machine has no A axis
-    b.straight_feed(0, e);
-  }, "plan.axis-not-configured", 3);
-  check([](canon::ProgramBuilder& b) {
-    b.set_feed_rate(0);
-    b.straight_feed(0, xyz(1, 0));
-  }, "plan.feed-zero", 4);
+  check(
+      [](canon::ProgramBuilder& b) {
+        Pose e = xyz(1, 0);
+        e[Axis::A] = 10;  // the machine has no A axis
+        b.straight_feed(0, e);
+      },
+      "plan.axis-not-configured", 3);
+  check(
+      [](canon::ProgramBuilder& b) {
+        b.set_feed_rate(0);
+        b.straight_feed(0, xyz(1, 0));
+      },
+      "plan.feed-zero", 4);
   check([](canon::ProgramBuilder& b) { b.rigid_tap(0, xyz(0, 0, -5), 1.0); }, "plan.unsupported-move", 5);
-  check([](canon::ProgramBuilder& b) {
-    canon::ArcFeed a;
-    a.first_end = 10;
-    a.end = xyz(10, 0);
-    a.first_center = 0;  // centre on the start point
-    b.arc_feed(0, a);
-  }, "plan.bad-arc", 6);
+  check(
+      [](canon::ProgramBuilder& b) {
+        canon::ArcFeed a;
+        a.first_end = 10;
+        a.end = xyz(10, 0);
+        a.first_center = 0;  // centre on the start point
+        b.arc_feed(0, a);
+      },
+      "plan.bad-arc", 6);
 }
 
 TEST(Planner, ExactStopCornersHaveZeroEntrySpeedAndNoBlends) {
-  const auto blocks = path_blocks(plan_all(analysis::square_program(100, 6000, {canon::MotionControl::ExactStop})));
+  const auto blocks =
+      path_blocks(plan_all(analysis::square_program(100, 6000, {canon::MotionControl::ExactStop})));
   ASSERT_EQ(blocks.size(), 4u);
   for (const MotionBlock& b : blocks) {
     EXPECT_EQ(b.kind, BlockKind::Line);
@@ -125,7 +134,8 @@ TEST(Planner, ExactStopCornersHaveZeroEntrySpeedAndNoBlends) {
 
 TEST(Planner, ContinuousCornersGetArcsWithinTheTolerance) {
   const double P = 0.01;
-  const auto blocks = path_blocks(plan_all(analysis::square_program(100, 6000, {canon::MotionControl::Continuous, P})));
+  const auto blocks =
+      path_blocks(plan_all(analysis::square_program(100, 6000, {canon::MotionControl::Continuous, P})));
   ASSERT_EQ(blocks.size(), 7u);  // four lines, three corner arcs
   for (std::size_t i = 1; i < blocks.size(); i += 2) {
     const MotionBlock& arc = blocks[i];
@@ -161,7 +171,8 @@ TEST(Planner, NaiveCamToleranceMergesNearlyCollinearFeedLines) {
     b.set_motion_control_mode(canon::MotionControl::Continuous, 0.1);
     b.set_naivecam_tolerance(q);
     b.set_feed_rate(600);
-    for (int i = 1; i <= 10; ++i) b.straight_feed(static_cast<canon::SegmentId>(i - 1), xyz(i, i % 2 ? 0.004 : 0));
+    for (int i = 1; i <= 10; ++i)
+      b.straight_feed(static_cast<canon::SegmentId>(i - 1), xyz(i, i % 2 ? 0.004 : 0));
     return b.take();
   };
   const auto merged = path_blocks(plan_all(build(0.01)));
@@ -191,9 +202,9 @@ TEST(Planner, ActionsBecomeMarkersInProgramOrder) {
   for (const MotionBlock& m : blocks) {
     if (m.kind == BlockKind::Marker) markers.push_back(m.marker);
   }
-  const std::vector<MarkerKind> expected = {MarkerKind::Report,      MarkerKind::Dwell,       MarkerKind::Sync,
-                                            MarkerKind::Report,      MarkerKind::SpindleWait, MarkerKind::ProgramStop,
-                                            MarkerKind::OptionalStop, MarkerKind::ProgramEnd};
+  const std::vector<MarkerKind> expected = {
+      MarkerKind::Report,      MarkerKind::Dwell,       MarkerKind::Sync,         MarkerKind::Report,
+      MarkerKind::SpindleWait, MarkerKind::ProgramStop, MarkerKind::OptionalStop, MarkerKind::ProgramEnd};
   EXPECT_EQ(markers, expected);
   for (const MotionBlock& m : blocks) {
     if (m.kind == BlockKind::Marker && m.marker == MarkerKind::Dwell) {
@@ -207,15 +218,15 @@ TEST(Planner, ActionsBecomeMarkersInProgramOrder) {
 TEST(Planner, FeedModesGiveTheNominalSpeedAlongThePath) {
   canon::ProgramBuilder b;
   b.set_motion_control_mode(canon::MotionControl::ExactStop, 0);
-  b.set_feed_rate(600);                                 // 10 mm/s
+  b.set_feed_rate(600);  // 10 mm/s
   b.straight_feed(0, xyz(10, 0));
   b.set_feed_mode(0, canon::FeedMode::InverseTime);
-  b.set_feed_rate(30);                                  // 2 s for the move
+  b.set_feed_rate(30);  // 2 s for the move
   b.straight_feed(1, xyz(10, 10));
   b.set_feed_mode(0, canon::FeedMode::UnitsPerMinute);
   b.set_feed_rate(600);
   Pose e = xyz(10, 20);
-  e[Axis::C] = 90;                                      // rotary motion along: feed applies to XYZ
+  e[Axis::C] = 90;  // rotary motion along: feed applies to XYZ
   b.straight_feed(2, e);
   e[Axis::X] = 30;
   e[Axis::Y] = 0;

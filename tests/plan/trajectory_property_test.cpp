@@ -34,7 +34,7 @@ Case random_case(std::uint32_t seed) {
   c.limits.axes = AxisMask::from_letters("XYZ");
   for (int i = 0; i < 3; ++i) {
     c.limits.axis[static_cast<std::size_t>(i)] = {log_uniform(rng, 20, 200), log_uniform(rng, 200, 5000),
-                                                   jerk ? log_uniform(rng, 2e4, 2e6) : 0.0};
+                                                  jerk ? log_uniform(rng, 2e4, 2e6) : 0.0};
   }
   canon::ProgramBuilder b(AxisMask::from_letters("XYZ"));
   const int mode = static_cast<int>(u(rng) * 4);

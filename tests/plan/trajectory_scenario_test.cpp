@@ -18,7 +18,8 @@ using analysis::PathMode;
 namespace {
 
 const plan::MachineLimits kMill = plan::MachineLimits::uniform(AxisMask::from_letters("XYZ"), 100, 1000);
-const plan::MachineLimits kMillJerk = plan::MachineLimits::uniform(AxisMask::from_letters("XYZ"), 100, 1000, 1e5);
+const plan::MachineLimits kMillJerk =
+    plan::MachineLimits::uniform(AxisMask::from_letters("XYZ"), 100, 1000, 1e5);
 constexpr PathMode kG64{canon::MotionControl::Continuous, 0.01, 0.01};
 constexpr PathMode kG64Q0{canon::MotionControl::Continuous, 0.01, 0};
 
@@ -32,7 +33,8 @@ void expect_clean(const analysis::SimulationResult& r, double tolerance) {
 
 TEST(TrajectoryScenario, DenseSpiralRunsAtTheFeedWithAndWithoutMerging) {
   for (const PathMode& mode : {kG64, kG64Q0}) {
-    const analysis::SimulationResult r = analysis::simulate(analysis::spiral_program(20000, 6000, mode), kMill);
+    const analysis::SimulationResult r =
+        analysis::simulate(analysis::spiral_program(20000, 6000, mode), kMill);
     expect_clean(r, mode.p);
     const double lower_bound = r.report.path_length_mm / 100.0;
     EXPECT_LE(r.motion_time_s, 1.03 * lower_bound) << "Q " << mode.q;
@@ -52,7 +54,8 @@ TEST(TrajectoryScenario, SquareContinuousIsNeverSlowerThanExactStop) {
 
 TEST(TrajectoryScenario, SmallAlternatingArcsKeepTheAccelerationLimit) {
   const PathMode p01{canon::MotionControl::Continuous, 0.1, 0.1};
-  const analysis::SimulationResult r = analysis::simulate(analysis::small_arcs_program(2000, 0.3, 90, 3000, p01), kMill);
+  const analysis::SimulationResult r =
+      analysis::simulate(analysis::small_arcs_program(2000, 0.3, 90, 3000, p01), kMill);
   expect_clean(r, p01.p);
   EXPECT_LE(r.motion_time_s, 73.715);  // LinuxCNC 2.9 (which overshoots its limits there)
   const analysis::SimulationResult j =
@@ -78,7 +81,9 @@ TEST(TrajectoryScenario, HoldsInsideBlendsAndOnTinySegmentsResumeOnThePath) {
       if (*hold_from != 0 && n >= *hold_from + 300) *hold_from = 0;
     };
     bool saw_held = false;
-    o.observe = [&](std::uint64_t, const traj::TickOutput& out) { saw_held = saw_held || out.state == traj::RunState::Held; };
+    o.observe = [&](std::uint64_t, const traj::TickOutput& out) {
+      saw_held = saw_held || out.state == traj::RunState::Held;
+    };
     const analysis::SimulationResult r = analysis::simulate(spiral, lim, o);
     expect_clean(r, kG64Q0.p);
     EXPECT_TRUE(saw_held);

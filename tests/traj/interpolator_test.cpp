@@ -60,11 +60,12 @@ std::vector<MotionBlock> plan(std::vector<MotionBlock> blocks, double junction =
     if (b.kind == BlockKind::Marker) b.base = end;
     b.brake_prefix = c;
     c += 2 * b.accel * b.length;
-    if (b.kind != BlockKind::Marker) end = [&] {
-      Pose e = b.base;
-      for (int i = 0; i < kAxisCount; ++i) e[i] += b.length * b.lin[i];
-      return e;
-    }();
+    if (b.kind != BlockKind::Marker)
+      end = [&] {
+        Pose e = b.base;
+        for (int i = 0; i < kAxisCount; ++i) e[i] += b.length * b.lin[i];
+        return e;
+      }();
   }
   double after = 0;
   bool prev_stop = true;
@@ -72,7 +73,8 @@ std::vector<MotionBlock> plan(std::vector<MotionBlock> blocks, double junction =
   for (std::size_t k = 0; k < blocks.size(); ++k) {
     const MotionBlock& b = blocks[k];
     const bool stop = b.kind == BlockKind::Marker && b.marker != MarkerKind::Report;
-    local[k] = b.kind == BlockKind::Marker ? (stop ? 0.0 : 1e300) : (prev_stop ? 0.0 : std::min(junction, b.v_cap));
+    local[k] =
+        b.kind == BlockKind::Marker ? (stop ? 0.0 : 1e300) : (prev_stop ? 0.0 : std::min(junction, b.v_cap));
     if (b.kind != BlockKind::Marker) prev_stop = false;
     if (stop) prev_stop = true;
   }
@@ -117,8 +119,9 @@ struct Rig {
   double max_accel_x() const {
     double a = 0;
     for (std::size_t i = 2; i < trace.size(); ++i) {
-      a = std::max(a, std::fabs(trace[i].position[0] - 2 * trace[i - 1].position[0] + trace[i - 2].position[0]) /
-                          (kDt * kDt));
+      a = std::max(a,
+                   std::fabs(trace[i].position[0] - 2 * trace[i - 1].position[0] + trace[i - 2].position[0]) /
+                       (kDt * kDt));
     }
     return a;
   }
@@ -182,11 +185,12 @@ TEST(Interpolator, FeedHoldStopsOnThePathAndResumes) {
 
 TEST(Interpolator, MarkersStopWaitAndReport) {
   Rig rig;
-  rig.publish(plan({line(at(0), at(10), 100, 1000, 0), marker(MarkerKind::Dwell, 0.25, 1), line(at(10), at(20), 100, 1000, 1),
-                    marker(MarkerKind::Report, 0, 2), line(at(20), at(30), 100, 1000, 2),
-                    marker(MarkerKind::ProgramStop, 0, 3), line(at(30), at(40), 100, 1000, 3),
-                    marker(MarkerKind::Sync, 0, 4), marker(MarkerKind::OptionalStop, 0, 5),
-                    line(at(40), at(50), 100, 1000, 4), marker(MarkerKind::ProgramEnd, 0, 6)}));
+  rig.publish(plan({line(at(0), at(10), 100, 1000, 0), marker(MarkerKind::Dwell, 0.25, 1),
+                    line(at(10), at(20), 100, 1000, 1), marker(MarkerKind::Report, 0, 2),
+                    line(at(20), at(30), 100, 1000, 2), marker(MarkerKind::ProgramStop, 0, 3),
+                    line(at(30), at(40), 100, 1000, 3), marker(MarkerKind::Sync, 0, 4),
+                    marker(MarkerKind::OptionalStop, 0, 5), line(at(40), at(50), 100, 1000, 4),
+                    marker(MarkerKind::ProgramEnd, 0, 6)}));
   EXPECT_GT(rig.run_until(RunState::Dwelling), 0);
   EXPECT_EQ(rig.trace.back().position[0], 10.0);
   const int dwell = rig.run_until(RunState::Running);
@@ -227,8 +231,9 @@ TEST(Interpolator, AbortStopsUnderControlAndDropsTheQueue) {
 
 TEST(Interpolator, StopsAtTheEndOfTheQueuedDataAndGoesOnWhenMoreArrives) {
   Rig rig;
-  std::vector<MotionBlock> blocks = plan({line(at(0), at(50), 100, 1000, 0), line(at(50), at(100), 100, 1000, 1),
-                                          marker(MarkerKind::ProgramEnd)});
+  std::vector<MotionBlock> blocks =
+      plan({line(at(0), at(50), 100, 1000, 0), line(at(50), at(100), 100, 1000, 1),
+            marker(MarkerKind::ProgramEnd)});
   rig.publish({blocks[0]});
   EXPECT_GT(rig.run_until(RunState::Starved), 0);
   EXPECT_EQ(rig.trace.back().position[0], 50.0);
@@ -259,8 +264,8 @@ TEST(Interpolator, MovingAverageLimitsJerkAndSettlesOnTheEndPoint) {
   EXPECT_GT(n, 1100 + kTicks - 2);
   double jerk = 0;
   for (std::size_t i = 3; i < rig.trace.size(); ++i) {
-    const double* x[4] = {&rig.trace[i].position[0], &rig.trace[i - 1].position[0], &rig.trace[i - 2].position[0],
-                          &rig.trace[i - 3].position[0]};
+    const double* x[4] = {&rig.trace[i].position[0], &rig.trace[i - 1].position[0],
+                          &rig.trace[i - 2].position[0], &rig.trace[i - 3].position[0]};
     jerk = std::max(jerk, std::fabs(*x[0] - 3 * *x[1] + 3 * *x[2] - *x[3]) / (kDt * kDt * kDt));
   }
   EXPECT_LE(jerk, 2 * 1000 / (kTicks * kDt) * (1 + 1e-6));

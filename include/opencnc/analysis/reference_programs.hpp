@@ -28,6 +28,7 @@ canon::Program spiral_program(int segments, double feed_mm_min, PathMode mode, s
 
 /// `arcs` tangent arcs of `radius` mm sweeping `sweep_deg` each, alternating G3 and G2, at `feed`.
 /// With 90° they climb a staircase, with 180° they form a wave.
-canon::Program small_arcs_program(int arcs, double radius_mm, double sweep_deg, double feed_mm_min, PathMode mode);
+canon::Program small_arcs_program(int arcs, double radius_mm, double sweep_deg, double feed_mm_min,
+                                  PathMode mode);
 
 }  // namespace opencnc::analysis

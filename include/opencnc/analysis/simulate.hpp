@@ -30,15 +30,15 @@ struct SimulationOptions {
 };
 
 struct SimulationResult {
-  bool finished = false;           ///< the program end was reached
+  bool finished = false;  ///< the program end was reached
   traj::RunState state = traj::RunState::Idle;
   std::uint64_t ticks = 0;
   /// From the first to the last period in which the commanded position changed (what LinuxCNC's
   /// harness calls the motion time).
   double motion_time_s = 0;
-  TraceReport report;              ///< when options.check
+  TraceReport report;  ///< when options.check
   plan::PlanStats plan;
-  Diagnostics diagnostics;         ///< planner errors, if it refused the program
+  Diagnostics diagnostics;  ///< planner errors, if it refused the program
 };
 
 /// Plans `program` for a machine with `limits` and runs it tick by tick, pumping the planner

@@ -31,10 +31,10 @@ struct Violation {
 
 /// What `opencnc run` reports for a trajectory.
 struct TraceReport {
-  double machining_time_s = 0;     ///< samples × period
-  double path_length_mm = 0;       ///< sum of XYZ (and UVW) distances between samples
-  double max_contour_error_mm = 0; ///< largest distance of a sample to the programmed path
-  double contour_error_time_s = 0; ///< when it happened
+  double machining_time_s = 0;      ///< samples × period
+  double path_length_mm = 0;        ///< sum of XYZ (and UVW) distances between samples
+  double max_contour_error_mm = 0;  ///< largest distance of a sample to the programmed path
+  double contour_error_time_s = 0;  ///< when it happened
   std::array<AxisStats, kAxisCount> axes{};
   std::uint64_t limit_violations = 0;  ///< samples × axes × derivatives above a limit
   Violation first_violation{};

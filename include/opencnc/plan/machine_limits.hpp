@@ -26,7 +26,8 @@ struct MachineLimits {
     MachineLimits m;
     m.axes = mask;
     for (int i = 0; i < kAxisCount; ++i) {
-      if (mask.has(static_cast<Axis>(i))) m.axis[static_cast<std::size_t>(i)] = {velocity, acceleration, jerk};
+      if (mask.has(static_cast<Axis>(i)))
+        m.axis[static_cast<std::size_t>(i)] = {velocity, acceleration, jerk};
     }
     return m;
   }

@@ -17,9 +17,9 @@ namespace opencnc::plan {
 
 /// Planner settings (the machine profile's [trajectory] part).
 struct PlannerConfig {
-  double servo_period_s = 1e-3;     ///< must equal the interpolator's period
+  double servo_period_s = 1e-3;        ///< must equal the interpolator's period
   std::size_t lookahead_moves = 1000;  ///< most programmed moves held ahead of the queue (≥ 2)
-  double max_feed_override = 2.0;   ///< the largest feed override the operator can set
+  double max_feed_override = 2.0;      ///< the largest feed override the operator can set
   /// Largest share of an axis's acceleration that the centripetal part may take on arcs and
   /// blends; the rest stays available along the path. In (0, 1).
   double normal_accel_share = 0.95;
@@ -36,10 +36,10 @@ enum class PlanStatus : std::uint8_t {
 
 /// Counters of a planning run, for reports and tests.
 struct PlanStats {
-  std::uint64_t moves = 0;          ///< programmed moves read
-  std::uint64_t merged_moves = 0;   ///< moves folded into a previous line by G64 Q
-  std::uint64_t blends = 0;         ///< corners replaced by a blend curve
-  std::uint64_t blocks = 0;         ///< blocks published (path blocks and markers)
+  std::uint64_t moves = 0;         ///< programmed moves read
+  std::uint64_t merged_moves = 0;  ///< moves folded into a previous line by G64 Q
+  std::uint64_t blends = 0;        ///< corners replaced by a blend curve
+  std::uint64_t blocks = 0;        ///< blocks published (path blocks and markers)
 };
 
 /// The non-real-time half of the trajectory. One planner per run; not thread-safe; the program

@@ -18,25 +18,25 @@ inline constexpr int kMaxTickEvents = 16;
 
 /// Fixed at start-up; must match the planner that fills the queue (plan::Planner gives it).
 struct InterpolatorConfig {
-  double period_s = 1e-3;         ///< servo period
-  int filter_ticks = 1;           ///< moving-average length on s in periods (1 = none: no jerk limit)
-  double max_feed_override = 2.0; ///< feed override inputs are clamped to [0, this]
+  double period_s = 1e-3;          ///< servo period
+  int filter_ticks = 1;            ///< moving-average length on s in periods (1 = none: no jerk limit)
+  double max_feed_override = 2.0;  ///< feed override inputs are clamped to [0, this]
 };
 
 /// Inputs sampled once per tick. Levels stay as long as the condition holds; `cycle_start`,
 /// `abort` and `sync_done` are read as edges (true for one tick is enough).
 struct TickInput {
-  double feed_override = 1.0;   ///< 0 … max_feed_override (1 = 100 %)
-  double rapid_override = 1.0;  ///< 0 … 1
-  bool feed_hold = false;       ///< decelerate on the path and stay (level)
-  bool cycle_start = false;     ///< continue after M0, M1 or a single-block stop (edge)
-  bool abort = false;           ///< controlled stop on the path, then drop the queue (edge)
-  bool single_block = false;    ///< stop at the end of every programmed move (level)
-  bool optional_stop = false;   ///< M1 waits for cycle start while this is on (level)
-  bool sync_done = false;       ///< the controller finished a Sync marker's action (edge)
-  bool spindle_at_speed = true; ///< spindle at its commanded speed (for SpindleWait markers)
-  double spindle_revs = 0;      ///< spindle encoder position, revolutions (G33)
-  double spindle_rev_s = 0;     ///< spindle speed, revolutions per second (G95, G33)
+  double feed_override = 1.0;    ///< 0 … max_feed_override (1 = 100 %)
+  double rapid_override = 1.0;   ///< 0 … 1
+  bool feed_hold = false;        ///< decelerate on the path and stay (level)
+  bool cycle_start = false;      ///< continue after M0, M1 or a single-block stop (edge)
+  bool abort = false;            ///< controlled stop on the path, then drop the queue (edge)
+  bool single_block = false;     ///< stop at the end of every programmed move (level)
+  bool optional_stop = false;    ///< M1 waits for cycle start while this is on (level)
+  bool sync_done = false;        ///< the controller finished a Sync marker's action (edge)
+  bool spindle_at_speed = true;  ///< spindle at its commanded speed (for SpindleWait markers)
+  double spindle_revs = 0;       ///< spindle encoder position, revolutions (G33)
+  double spindle_rev_s = 0;      ///< spindle speed, revolutions per second (G95, G33)
 };
 
 /// What the interpolator is doing.
@@ -57,23 +57,23 @@ enum class RunState : std::uint8_t {
 
 /// A marker the commanded position reached in this tick.
 struct TickEvent {
-  std::uint64_t seq = 0;       ///< block seq of the marker
+  std::uint64_t seq = 0;  ///< block seq of the marker
   MarkerKind kind = MarkerKind::None;
-  std::uint32_t action = 0;    ///< index into canon::Program::actions()
+  std::uint32_t action = 0;  ///< index into canon::Program::actions()
 };
 
 /// Everything one tick produces. Plain data.
 struct TickOutput {
-  Pose position{};             ///< commanded position of every axis (mm, degrees)
-  double path_velocity = 0;    ///< ds/dt of the commanded position (s-units/s)
+  Pose position{};           ///< commanded position of every axis (mm, degrees)
+  double path_velocity = 0;  ///< ds/dt of the commanded position (s-units/s)
   RunState state = RunState::Idle;
-  std::uint64_t block_seq = 0; ///< block at the commanded position
-  std::uint64_t segment = 0;       ///< canon segment id of the move being executed
-  std::uint64_t segment_first = 0; ///< the programmed moves the block stands for (merges, blends)
+  std::uint64_t block_seq = 0;      ///< block at the commanded position
+  std::uint64_t segment = 0;        ///< canon segment id of the move being executed
+  std::uint64_t segment_first = 0;  ///< the programmed moves the block stands for (merges, blends)
   std::uint64_t segment_last = 0;
-  std::uint32_t line = 0;      ///< its source line
-  std::uint32_t context = 0;   ///< its SourceMap context
-  double block_offset = 0;     ///< s within that block
+  std::uint32_t line = 0;     ///< its source line
+  std::uint32_t context = 0;  ///< its SourceMap context
+  double block_offset = 0;    ///< s within that block
   int event_count = 0;
   std::array<TickEvent, kMaxTickEvents> events{};
   bool spindle_synced = false;  ///< following the spindle (G33) with a constant lag
@@ -136,7 +136,7 @@ class Interpolator {
   // Unfiltered generator: block, global s of its start, s and ds/dt.
   std::uint64_t u_seq_ = 0;
   double u_start_ = 0, s_u_ = 0, v_u_ = 0;
-  int still_ticks_ = 0;            ///< consecutive ticks without unfiltered motion
+  int still_ticks_ = 0;  ///< consecutive ticks without unfiltered motion
   // Filtered (commanded) position: block and global s of its start, s.
   std::uint64_t f_seq_ = 0, report_seq_ = 0;
   double f_start_ = 0, s_f_ = 0;
@@ -150,15 +150,15 @@ class Interpolator {
   std::uint64_t stop_seq_ = kNoBlock;      ///< committed single-block stop (start of that block)
   std::uint64_t step_from_seq_ = 0;        ///< single-block stops only after this block
   std::uint64_t dwell_ticks_left_ = 0;
-  bool waiting_ = false;                   ///< at a stop marker, action not finished
+  bool waiting_ = false;  ///< at a stop marker, action not finished
 
   // Spindle-synchronised motion (G33): wait for the index, catch up, then follow the encoder.
   enum class Sync : std::uint8_t { Off, WaitIndex, CatchUp, Locked };
   Sync sync_ = Sync::Off;
-  double sync_target_ = 0;   ///< s the spindle position asks for (global s)
-  double sync_lag_ = 0;      ///< constant distance behind it once locked
+  double sync_target_ = 0;  ///< s the spindle position asks for (global s)
+  double sync_lag_ = 0;     ///< constant distance behind it once locked
   double prev_revs_ = 0;
-  double sync_rev_s_ = 0;    ///< spindle speed of this tick
+  double sync_rev_s_ = 0;  ///< spindle speed of this tick
   bool sync_lost_ = false;
 
   struct Shown {  // the block at the commanded position, kept once it has been popped

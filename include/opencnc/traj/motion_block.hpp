@@ -72,21 +72,21 @@ struct MotionBlock {
   MarkerKind marker = MarkerKind::None;
   FeedClass feed_class = FeedClass::Feed;
   std::uint8_t flags = 0;
-  std::uint32_t action = 0;         ///< Marker: index into Program::actions()
+  std::uint32_t action = 0;  ///< Marker: index into Program::actions()
 
   // --- geometry ----------------------------------------------------------------------------
-  double length = 0;                ///< s range [0, length]; 0 for markers
-  double omega = 0;                 ///< Arc: rad per unit of s
-  Pose base{}, u{}, w{}, lin{};     ///< see BlockKind
+  double length = 0;             ///< s range [0, length]; 0 for markers
+  double omega = 0;              ///< Arc: rad per unit of s
+  Pose base{}, u{}, w{}, lin{};  ///< see BlockKind
 
   // --- limits ------------------------------------------------------------------------------
-  double v_cap = 0;          ///< hard speed limit along s (s-units/s)
-  double feed = 0;           ///< nominal speed at 100 % (see FeedClass)
-  double accel = 0;          ///< acceleration budget along s (s-units/s²), > 0 for path blocks
-  double v_entry = 0;        ///< largest speed allowed at s = 0 (backward pass)
-  double brake_prefix = 0;   ///< C at s = 0
+  double v_cap = 0;                    ///< hard speed limit along s (s-units/s)
+  double feed = 0;                     ///< nominal speed at 100 % (see FeedClass)
+  double accel = 0;                    ///< acceleration budget along s (s-units/s²), > 0 for path blocks
+  double v_entry = 0;                  ///< largest speed allowed at s = 0 (backward pass)
+  double brake_prefix = 0;             ///< C at s = 0
   std::uint64_t next_soft = kNoBlock;  ///< first later block whose nominal speed may be lower
-  double value = 0;          ///< Marker: dwell seconds
+  double value = 0;                    ///< Marker: dwell seconds
 };
 
 static_assert(std::is_trivially_copyable_v<MotionBlock>);

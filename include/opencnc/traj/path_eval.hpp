@@ -50,7 +50,8 @@ inline Pose tangent_at(const MotionBlock& b, double s) noexcept {
     case BlockKind::Bezier: {
       const double t = b.length > 0 ? s / b.length : 0.0, r = 1.0 - t, k = 3.0 / b.length;
       for (int i = 0; i < kAxisCount; ++i) {
-        d[i] = k * (r * r * (b.u[i] - b.base[i]) + 2 * r * t * (b.w[i] - b.u[i]) + t * t * (b.lin[i] - b.w[i]));
+        d[i] =
+            k * (r * r * (b.u[i] - b.base[i]) + 2 * r * t * (b.w[i] - b.u[i]) + t * t * (b.lin[i] - b.w[i]));
       }
       break;
     }
