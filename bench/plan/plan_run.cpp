@@ -62,7 +62,7 @@ int main(int argc, char** argv) {
   using analysis::PathMode;
   const PathMode g64{canon::MotionControl::Continuous, 0.01, 0.01};
   const PathMode g64q0{canon::MotionControl::Continuous, 0.01, 0};
-  const PathMode g61{canon::MotionControl::ExactStop, 0, 0};
+  const PathMode g61{canon::MotionControl::ExactPath, 0, 0};  // LinuxCNC prints G61 as CANON_EXACT_PATH
   run("square G61", analysis::square_program(100, 6000, g61), lim);
   run("square G64 P0.01", analysis::square_program(100, 6000, g64), lim);
   run("spiral 20k G64 P0.01", analysis::spiral_program(20000, 6000, g64), lim);

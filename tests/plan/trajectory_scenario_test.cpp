@@ -43,7 +43,7 @@ TEST(TrajectoryScenario, DenseSpiralRunsAtTheFeedWithAndWithoutMerging) {
 
 TEST(TrajectoryScenario, SquareContinuousIsNeverSlowerThanExactStop) {
   const analysis::SimulationResult g61 =
-      analysis::simulate(analysis::square_program(100, 6000, {canon::MotionControl::ExactStop}), kMill);
+      analysis::simulate(analysis::square_program(100, 6000, {canon::MotionControl::ExactPath}), kMill);  // G61
   const analysis::SimulationResult g64 = analysis::simulate(analysis::square_program(100, 6000, kG64), kMill);
   expect_clean(g61, 1e-9);
   expect_clean(g64, kG64.p);
