@@ -152,6 +152,27 @@ TraceChecker::TraceChecker(const canon::Program& program, const plan::MachineLim
   past_.fill(program.start());
 }
 
+// Distance from p to a box that holds move `id` (a lower bound of the distance to the move).
+double TraceChecker::box_distance(canon::SegmentId id, const Pose& p) const {
+  const Pose a = program_->start_of(id), b = program_->end(id);
+  double grow = 0;
+  if (program_->move(id).kind == canon::MoveKind::Arc) {
+    const canon::ArcGeometry& g = program_->arc(id);
+    const int b0 =
+        (g.plane == canon::Plane::XY || g.plane == canon::Plane::YZ || g.plane == canon::Plane::XZ) ? 0 : 6;
+    double r2 = 0;
+    for (int k = 0; k < 3; ++k) r2 += (a[b0 + k] - g.center[k]) * (a[b0 + k] - g.center[k]);
+    grow = 2 * std::sqrt(r2);  // the whole circle fits in the end points' box grown by its diameter
+  }
+  double s = 0;
+  for (int i : kLinear) {
+    const double lo = std::min(a[i], b[i]) - grow, hi = std::max(a[i], b[i]) + grow;
+    const double d = p[i] < lo ? lo - p[i] : (p[i] > hi ? p[i] - hi : 0.0);
+    s += d * d;
+  }
+  return std::sqrt(s);
+}
+
 double TraceChecker::distance_to_move(canon::SegmentId id, const Pose& p) const {
   const Pose start = program_->start_of(id), end = program_->end(id);
   if (program_->move(id).kind == canon::MoveKind::Arc) return arc_distance(program_->arc(id), start, end, p);
@@ -190,9 +211,18 @@ void TraceChecker::add(const Pose& position, canon::SegmentId first, canon::Segm
     const canon::SegmentId n = program_->size();
     const canon::SegmentId lo = first > 0 ? first - 1 : 0;
     const canon::SegmentId hi = std::min<canon::SegmentId>(last + 1, n - 1);
+    // Merged blocks stand for hundreds of moves: start with the move that was nearest last time
+    // and skip those whose bounding box is already farther than the best distance.
     double best = 1e300;
-    for (canon::SegmentId id = lo; id <= hi && id < n; ++id)
-      best = std::min(best, distance_to_move(id, position));
+    if (nearest_ >= lo && nearest_ <= hi) best = distance_to_move(nearest_, position);
+    for (canon::SegmentId id = lo; id <= hi && id < n; ++id) {
+      if (id == nearest_ || box_distance(id, position) >= best) continue;
+      const double d = distance_to_move(id, position);
+      if (d < best) {
+        best = d;
+        nearest_ = id;
+      }
+    }
     if (best < 1e300 && best > report_.max_contour_error_mm) {
       report_.max_contour_error_mm = best;
       report_.contour_error_time_s = report_.machining_time_s;

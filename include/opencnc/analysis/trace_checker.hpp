@@ -65,12 +65,14 @@ class TraceChecker {
 
  private:
   void check_limits(const Pose& x);
+  double box_distance(canon::SegmentId id, const Pose& p) const;
 
   const canon::Program* program_;
   plan::MachineLimits limits_;
   double period_s_;
   double tolerance_;
-  std::array<Pose, 3> past_{};  ///< the three previous samples, newest first
+  std::array<Pose, 3> past_{};    ///< the three previous samples, newest first
+  canon::SegmentId nearest_ = 0;  ///< the move nearest to the last sample
   TraceReport report_;
 };
 
