@@ -84,8 +84,8 @@ struct Planner::Impl {
   std::optional<Element> pending;          ///< last element; its end is decided by the next one
   std::vector<MotionBlock> reports;        ///< Report markers waiting after `pending`
   Pose last_end{};                         ///< exact end of the last emitted path block
-  const MotionBlock* last_path = nullptr;  ///< for curvature-step limits (points into `prev`)
-  MotionBlock prev;
+  bool continues = false;                  ///< `prev` runs on into the next path block (no stop)
+  MotionBlock prev;                        ///< the last emitted path block
 
   Impl(const MachineLimits& l, const PlannerConfig& c);
   void check_config();
@@ -167,10 +167,10 @@ void Planner::Impl::emit_path(MotionBlock b, double junction) {
   pb.cap_raw = r.cap;
   pb.accel_raw = r.accel;
   pb.junction = junction;
-  if (last_path != nullptr && junction > 0 && params.filter_s > 0) pb.step = detail::curvature_step(prev, b);
+  if (continues && junction > 0 && params.filter_s > 0) pb.step = detail::curvature_step(prev, b);
   window->push(pb);
   prev = b;
-  last_path = &prev;
+  continues = true;
   last_end = detail::end_point(b);
 }
 
@@ -181,7 +181,7 @@ void Planner::Impl::emit_marker(MotionBlock m) {
   pb.b = m;
   pb.junction = kInf;
   window->push(pb);
-  if (m.marker != MarkerKind::Report) last_path = nullptr;
+  if (m.marker != MarkerKind::Report) continues = false;
 }
 
 void Planner::Impl::emit_reports() {
@@ -344,7 +344,7 @@ bool Planner::start(const canon::Program& program) {
   m.pending.reset();
   m.reports.clear();
   m.last_end = program.start();
-  m.last_path = nullptr;
+  m.continues = false;
   m.stats = {};
   return true;
 }
