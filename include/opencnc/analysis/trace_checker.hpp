@@ -1,0 +1,79 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// TraceChecker — metrics of a commanded trajectory sampled every servo period: per-axis velocity,
+// acceleration and jerk by finite differences, limit violations, contour error against the
+// programmed path, path length and time.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+
+#include "opencnc/canon/program.hpp"
+#include "opencnc/core/axes.hpp"
+#include "opencnc/plan/machine_limits.hpp"
+
+namespace opencnc::analysis {
+
+/// Largest magnitudes seen on one axis (mm or degrees per s, s², s³).
+struct AxisStats {
+  double max_velocity = 0;
+  double max_acceleration = 0;
+  double max_jerk = 0;
+};
+
+/// The first limit violation, to say where to look.
+struct Violation {
+  double time_s = 0;
+  int axis = 0;
+  int derivative = 0;  ///< 1 velocity, 2 acceleration, 3 jerk
+  double value = 0, limit = 0;
+};
+
+/// What `opencnc run` reports for a trajectory.
+struct TraceReport {
+  double machining_time_s = 0;      ///< samples × period
+  double path_length_mm = 0;        ///< sum of XYZ (and UVW) distances between samples
+  double max_contour_error_mm = 0;  ///< largest distance of a sample to the programmed path
+  double contour_error_time_s = 0;  ///< when it happened
+  std::array<AxisStats, kAxisCount> axes{};
+  std::uint64_t limit_violations = 0;  ///< samples × axes × derivatives above a limit
+  Violation first_violation{};
+  std::uint64_t samples = 0;
+
+  /// One line per metric, for logs and test failure messages.
+  std::string summary() const;
+};
+
+/// Accumulates samples and computes a TraceReport. Finite differences are backward, one servo
+/// period apart: v = (x₀ − x₁)/T, a = (x₀ − 2x₁ + x₂)/T², j = (x₀ − 3x₁ + 3x₂ − x₃)/T³; before the
+/// first sample the machine is taken to be at rest there. A value counts as a violation when it
+/// exceeds the limit by more than `relative_tolerance` (jerk only where a jerk limit is set).
+/// The contour error of a sample is its distance to the nearest programmed move within one move
+/// of the segments the sample's block covers. Non-real-time; one checker per run.
+class TraceChecker {
+ public:
+  TraceChecker(const canon::Program& program, const plan::MachineLimits& limits, double period_s,
+               double relative_tolerance = 1e-6);
+
+  /// One commanded sample; `first`..`last` are the segment ids of the block it lies on.
+  void add(const Pose& position, canon::SegmentId first, canon::SegmentId last);
+  /// The metrics so far.
+  const TraceReport& report() const noexcept { return report_; }
+
+  /// Distance from `p` (linear axes) to programmed move `id`. Non-real-time.
+  double distance_to_move(canon::SegmentId id, const Pose& p) const;
+
+ private:
+  void check_limits(const Pose& x);
+  double box_distance(canon::SegmentId id, const Pose& p) const;
+
+  const canon::Program* program_;
+  plan::MachineLimits limits_;
+  double period_s_;
+  double tolerance_;
+  std::array<Pose, 3> past_{};    ///< the three previous samples, newest first
+  canon::SegmentId nearest_ = 0;  ///< the move nearest to the last sample
+  TraceReport report_;
+};
+
+}  // namespace opencnc::analysis

@@ -1,0 +1,77 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// plan::Planner — turns a canon::Program into motion blocks for the servo tick: geometry with
+// corner blends, per-block speed and acceleration limits from the axis limits, look-ahead.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+
+#include "opencnc/canon/program.hpp"
+#include "opencnc/core/diagnostic.hpp"
+#include "opencnc/plan/machine_limits.hpp"
+#include "opencnc/traj/block_queue.hpp"
+#include "opencnc/traj/interpolator.hpp"
+
+namespace opencnc::plan {
+
+/// Planner settings (the machine profile's [trajectory] part).
+struct PlannerConfig {
+  double servo_period_s = 1e-3;        ///< must equal the interpolator's period
+  std::size_t lookahead_moves = 1000;  ///< most programmed moves held ahead of the queue (≥ 2)
+  double max_feed_override = 2.0;      ///< the largest feed override the operator can set
+  /// Largest share of an axis's acceleration that the centripetal part may take on arcs and
+  /// blends; the rest stays available along the path. In (0, 1).
+  double normal_accel_share = 0.95;
+  /// With jerk limits: share of each axis's jerk reserved for the curvature steps where a line
+  /// meets an arc (sampled at the servo period). In (0, 1).
+  double jerk_step_share = 0.5;
+};
+
+enum class PlanStatus : std::uint8_t {
+  Working,   ///< more blocks to come: call pump() again
+  Finished,  ///< every block of the program is in the queue
+  Failed,    ///< the program or the configuration was rejected: see diagnostics()
+};
+
+/// Counters of a planning run, for reports and tests.
+struct PlanStats {
+  std::uint64_t moves = 0;         ///< programmed moves read
+  std::uint64_t merged_moves = 0;  ///< moves folded into a previous line by G64 Q
+  std::uint64_t blends = 0;        ///< corners replaced by a blend curve
+  std::uint64_t blocks = 0;        ///< blocks published (path blocks and markers)
+};
+
+/// The non-real-time half of the trajectory. One planner per run; not thread-safe; the program
+/// must outlive the run. See docs/planner.md for the algorithm.
+class Planner {
+ public:
+  /// Checks `limits` and `config`; problems end up in diagnostics() and make start() fail.
+  /// Non-real-time.
+  explicit Planner(const MachineLimits& limits, const PlannerConfig& config = {});
+  ~Planner();
+  Planner(const Planner&) = delete;
+  Planner& operator=(const Planner&) = delete;
+
+  /// The settings the interpolator must use with this planner's blocks. Any thread.
+  traj::InterpolatorConfig interpolator_config() const noexcept;
+
+  /// Checks the whole program, then prepares to plan it. On any error nothing is planned,
+  /// diagnostics() holds `file:line: message` entries and false is returned. Non-real-time.
+  bool start(const canon::Program& program);
+
+  /// Plans ahead and pushes every block that is final into `queue`, as far as it has room.
+  /// The queue's block numbering continues from its pushed() count. Non-real-time.
+  PlanStatus pump(traj::BlockQueue& queue);
+
+  /// Problems found so far. Non-real-time.
+  const Diagnostics& diagnostics() const noexcept;
+  /// Counters of the current run. Non-real-time.
+  const PlanStats& stats() const noexcept;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace opencnc::plan

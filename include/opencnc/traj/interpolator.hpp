@@ -1,0 +1,171 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Interpolator — the real-time half of the trajectory: every servo period it advances along the
+// queued motion blocks and returns the commanded position of every axis.
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "opencnc/core/axes.hpp"
+#include "opencnc/traj/block_queue.hpp"
+
+namespace opencnc::traj {
+
+/// Longest moving-average filter (servo periods) the interpolator supports.
+inline constexpr int kMaxFilterTicks = 2048;
+/// Most marker events one tick reports; the rest follow in the next ticks.
+inline constexpr int kMaxTickEvents = 16;
+
+/// Fixed at start-up; must match the planner that fills the queue (plan::Planner gives it).
+struct InterpolatorConfig {
+  double period_s = 1e-3;          ///< servo period
+  int filter_ticks = 1;            ///< moving-average length on s in periods (1 = none: no jerk limit)
+  double max_feed_override = 2.0;  ///< feed override inputs are clamped to [0, this]
+};
+
+/// Inputs sampled once per tick. Levels stay as long as the condition holds; `cycle_start`,
+/// `abort` and `sync_done` are read as edges (true for one tick is enough).
+struct TickInput {
+  double feed_override = 1.0;    ///< 0 … max_feed_override (1 = 100 %)
+  double rapid_override = 1.0;   ///< 0 … 1
+  bool feed_hold = false;        ///< decelerate on the path and stay (level)
+  bool cycle_start = false;      ///< continue after M0, M1 or a single-block stop (edge)
+  bool abort = false;            ///< controlled stop on the path, then drop the queue (edge)
+  bool single_block = false;     ///< stop at the end of every programmed move (level)
+  bool optional_stop = false;    ///< M1 waits for cycle start while this is on (level)
+  bool sync_done = false;        ///< the controller finished a Sync marker's action (edge)
+  bool spindle_at_speed = true;  ///< spindle at its commanded speed (for SpindleWait markers)
+  double spindle_revs = 0;       ///< spindle encoder position, revolutions (G33)
+  double spindle_rev_s = 0;      ///< spindle speed, revolutions per second (G95, G33)
+};
+
+/// What the interpolator is doing.
+enum class RunState : std::uint8_t {
+  Idle,               ///< nothing queued yet
+  Running,            ///< moving, or about to
+  Holding,            ///< decelerating for a feed hold
+  Held,               ///< stopped on the path by a feed hold
+  Starved,            ///< stopped at the end of the queued blocks; the program goes on
+  Dwelling,           ///< G4
+  WaitingCycleStart,  ///< M0, M1 with optional stop on, or a single-block stop
+  WaitingSpindle,     ///< spindle not yet at speed
+  WaitingSync,        ///< waiting for the controller (tool change, M66, ...)
+  Aborting,           ///< decelerating after an abort
+  Aborted,            ///< stopped and queue dropped; restart() to run again
+  Finished,           ///< program end reached and settled
+};
+
+/// A marker the commanded position reached in this tick.
+struct TickEvent {
+  std::uint64_t seq = 0;  ///< block seq of the marker
+  MarkerKind kind = MarkerKind::None;
+  std::uint32_t action = 0;  ///< index into canon::Program::actions()
+};
+
+/// Everything one tick produces. Plain data.
+struct TickOutput {
+  Pose position{};           ///< commanded position of every axis (mm, degrees)
+  double path_velocity = 0;  ///< ds/dt of the commanded position (s-units/s)
+  RunState state = RunState::Idle;
+  std::uint64_t block_seq = 0;      ///< block at the commanded position
+  std::uint64_t segment = 0;        ///< canon segment id of the move being executed
+  std::uint64_t segment_first = 0;  ///< the programmed moves the block stands for (merges, blends)
+  std::uint64_t segment_last = 0;
+  std::uint32_t line = 0;     ///< its source line
+  std::uint32_t context = 0;  ///< its SourceMap context
+  double block_offset = 0;    ///< s within that block
+  int event_count = 0;
+  std::array<TickEvent, kMaxTickEvents> events{};
+  bool spindle_synced = false;  ///< following the spindle (G33) with a constant lag
+  bool sync_lost = false;       ///< a limit forced the motion off the spindle during this run
+};
+
+/// Consumes motion blocks and computes the commanded position every servo period.
+///
+/// Along the path parameter s it runs a one-dimensional generator with piecewise-constant
+/// acceleration (exact within each period): speed ≤ the block's cap × override, |acceleration|
+/// ≤ the block's budget, and braking curves v² ≤ v_q² + C(q) − C(s) toward the next junction,
+/// the end of the queued data, lower nominal speeds further on and dynamic stops (feed hold,
+/// single block). When jerk is limited, a moving average of length filter_ticks turns that
+/// trapezoidal profile into an S-curve; the planner has widened the limits accordingly.
+/// See docs/planner.md. All methods are for the tick thread and real-time safe; nothing
+/// allocates after construction.
+class Interpolator {
+ public:
+  /// `queue` must outlive the interpolator. `start` is the machine position.
+  Interpolator(BlockQueue& queue, const InterpolatorConfig& config, const Pose& start) noexcept;
+
+  /// Advances by one servo period. Tick thread; real-time safe, noexcept, no allocation.
+  void tick(const TickInput& in, TickOutput& out) noexcept;
+
+  /// Forgets all motion state and starts again from `start` (after Finished or Aborted, once the
+  /// owner has reset the queue). Tick thread; real-time safe.
+  void restart(const Pose& start) noexcept;
+
+  /// Tick thread; real-time safe.
+  const InterpolatorConfig& config() const noexcept { return config_; }
+  /// Number of ticks since construction or restart(). Tick thread; real-time safe.
+  std::uint64_t ticks() const noexcept { return ticks_; }
+
+ private:
+  void handle_commands(const TickInput& in) noexcept;
+  double advance_unfiltered(const TickInput& in) noexcept;
+  void step_piece(const TickInput& in, const MotionBlock& b, std::size_t index, double& tau,
+                  double& integral) noexcept;
+  void commit_single_block_stop(std::size_t available) noexcept;
+  double target_speed(const TickInput& in, const MotionBlock& b) const noexcept;
+  double filter(double integral) noexcept;
+  void advance_filtered(TickOutput& out) noexcept;
+  void update_waiting(const TickInput& in) noexcept;
+  void release_marker() noexcept;
+  void pop_and_rebase() noexcept;
+  void fill_output(TickOutput& out, double s_prev) noexcept;
+  void update_sync(const TickInput& in) noexcept;
+  double sync_acceleration(const MotionBlock& b, double tau) noexcept;
+  std::size_t index_of(std::uint64_t seq) const noexcept {
+    return static_cast<std::size_t>(seq - queue_->popped());
+  }
+
+  BlockQueue* queue_;
+  InterpolatorConfig config_;
+  Pose position_{};
+  std::uint64_t ticks_ = 0;
+  RunState state_ = RunState::Idle;
+  bool started_ = false;
+
+  // Unfiltered generator: block, global s of its start, s and ds/dt.
+  std::uint64_t u_seq_ = 0;
+  double u_start_ = 0, s_u_ = 0, v_u_ = 0;
+  int still_ticks_ = 0;  ///< consecutive ticks without unfiltered motion
+  // Filtered (commanded) position: block and global s of its start, s.
+  std::uint64_t f_seq_ = 0, report_seq_ = 0;
+  double f_start_ = 0, s_f_ = 0;
+  // Moving-average history: ∫ s dt over each of the last filter_ticks periods.
+  std::array<double, kMaxFilterTicks> history_{};
+  int history_pos_ = 0;
+
+  // Operator state.
+  bool hold_ = false, aborting_ = false;
+  std::uint64_t released_seq_ = kNoBlock;  ///< stop marker already dealt with
+  std::uint64_t stop_seq_ = kNoBlock;      ///< committed single-block stop (start of that block)
+  std::uint64_t step_from_seq_ = 0;        ///< single-block stops only after this block
+  std::uint64_t dwell_ticks_left_ = 0;
+  bool waiting_ = false;  ///< at a stop marker, action not finished
+
+  // Spindle-synchronised motion (G33): wait for the index, catch up, then follow the encoder.
+  enum class Sync : std::uint8_t { Off, WaitIndex, CatchUp, Locked };
+  Sync sync_ = Sync::Off;
+  double sync_target_ = 0;  ///< s the spindle position asks for (global s)
+  double sync_lag_ = 0;     ///< constant distance behind it once locked
+  double prev_revs_ = 0;
+  double sync_rev_s_ = 0;  ///< spindle speed of this tick
+  bool sync_lost_ = false;
+
+  struct Shown {  // the block at the commanded position, kept once it has been popped
+    std::uint64_t seq = 0, segment = 0, segment_first = 0, segment_last = 0;
+    std::uint32_t line = 0, context = 0;
+    double offset = 0;
+  } shown_;
+};
+
+}  // namespace opencnc::traj

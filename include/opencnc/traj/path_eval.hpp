@@ -1,0 +1,87 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Closed-form evaluation of a motion block's geometry at a path parameter: position and its first
+// and second derivatives with respect to s.
+#pragma once
+
+#include <cmath>
+
+#include "opencnc/traj/motion_block.hpp"
+
+namespace opencnc::traj {
+
+/// Position of block `b` at path parameter s ∈ [0, b.length]. Any thread; real-time safe.
+inline Pose position_at(const MotionBlock& b, double s) noexcept {
+  Pose p;
+  switch (b.kind) {
+    case BlockKind::Line:
+      for (int i = 0; i < kAxisCount; ++i) p[i] = b.base[i] + s * b.lin[i];
+      break;
+    case BlockKind::Arc: {
+      // 1 − cos x written as 2·sin²(x/2): no cancellation for the huge radii of near-straight blends.
+      const double sn = std::sin(b.omega * s), h = std::sin(0.5 * b.omega * s), vers = 2.0 * h * h;
+      for (int i = 0; i < kAxisCount; ++i) p[i] = b.base[i] + sn * b.w[i] + vers * b.u[i] + s * b.lin[i];
+      break;
+    }
+    case BlockKind::Bezier: {
+      const double t = b.length > 0 ? s / b.length : 0.0, r = 1.0 - t;
+      const double k0 = r * r * r, k1 = 3 * r * r * t, k2 = 3 * r * t * t, k3 = t * t * t;
+      for (int i = 0; i < kAxisCount; ++i) p[i] = k0 * b.base[i] + k1 * b.u[i] + k2 * b.w[i] + k3 * b.lin[i];
+      break;
+    }
+    case BlockKind::Marker:
+      p = b.base;
+      break;
+  }
+  return p;
+}
+
+/// dp/ds of block `b` at s (unit length for lines and arcs). Any thread; real-time safe.
+inline Pose tangent_at(const MotionBlock& b, double s) noexcept {
+  Pose d;
+  switch (b.kind) {
+    case BlockKind::Line:
+      d = b.lin;
+      break;
+    case BlockKind::Arc: {
+      const double c = std::cos(b.omega * s), sn = std::sin(b.omega * s);
+      for (int i = 0; i < kAxisCount; ++i) d[i] = b.omega * (c * b.w[i] + sn * b.u[i]) + b.lin[i];
+      break;
+    }
+    case BlockKind::Bezier: {
+      const double t = b.length > 0 ? s / b.length : 0.0, r = 1.0 - t, k = 3.0 / b.length;
+      for (int i = 0; i < kAxisCount; ++i) {
+        d[i] =
+            k * (r * r * (b.u[i] - b.base[i]) + 2 * r * t * (b.w[i] - b.u[i]) + t * t * (b.lin[i] - b.w[i]));
+      }
+      break;
+    }
+    case BlockKind::Marker:
+      break;
+  }
+  return d;
+}
+
+/// d²p/ds² of block `b` at s. Any thread; real-time safe.
+inline Pose curvature_at(const MotionBlock& b, double s) noexcept {
+  Pose d;
+  switch (b.kind) {
+    case BlockKind::Line:
+    case BlockKind::Marker:
+      break;
+    case BlockKind::Arc: {
+      const double c = std::cos(b.omega * s), sn = std::sin(b.omega * s), w2 = b.omega * b.omega;
+      for (int i = 0; i < kAxisCount; ++i) d[i] = w2 * (c * b.u[i] - sn * b.w[i]);
+      break;
+    }
+    case BlockKind::Bezier: {
+      const double t = b.length > 0 ? s / b.length : 0.0, r = 1.0 - t, k = 6.0 / (b.length * b.length);
+      for (int i = 0; i < kAxisCount; ++i) {
+        d[i] = k * (r * (b.w[i] - 2 * b.u[i] + b.base[i]) + t * (b.lin[i] - 2 * b.w[i] + b.u[i]));
+      }
+      break;
+    }
+  }
+  return d;
+}
+
+}  // namespace opencnc::traj

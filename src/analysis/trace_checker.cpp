@@ -1,0 +1,236 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Trajectory metrics: finite-difference derivatives, limit violations, contour error.
+#include "opencnc/analysis/trace_checker.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include <fmt/format.h>
+
+namespace opencnc::analysis {
+
+namespace {
+
+constexpr double kTwoPi = 2 * std::numbers::pi;
+constexpr int kLinear[] = {0, 1, 2, 6, 7, 8};
+
+double linear_distance(const Pose& a, const Pose& b) {
+  double s = 0;
+  for (int i : kLinear) s += (a[i] - b[i]) * (a[i] - b[i]);
+  return std::sqrt(s);
+}
+
+double segment_distance(const Pose& a, const Pose& b, const Pose& p) {
+  double ab2 = 0, t = 0;
+  for (int i : kLinear) {
+    ab2 += (b[i] - a[i]) * (b[i] - a[i]);
+    t += (p[i] - a[i]) * (b[i] - a[i]);
+  }
+  t = ab2 > 0 ? std::clamp(t / ab2, 0.0, 1.0) : 0.0;
+  double s = 0;
+  for (int i : kLinear) {
+    const double q = a[i] + t * (b[i] - a[i]) - p[i];
+    s += q * q;
+  }
+  return std::sqrt(s);
+}
+
+/// Smallest f(a) for a within a quarter turn of a0 and inside [0, sweep] (golden section).
+template <typename F>
+double nearest_angle(F f, double a0, double sweep) {
+  double lo = std::max(0.0, a0 - 0.25 * std::numbers::pi), hi = std::min(sweep, a0 + 0.25 * std::numbers::pi);
+  const double g = 0.5 * (std::sqrt(5.0) - 1);
+  double x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo), f1 = f(x1), f2 = f(x2);
+  for (int i = 0; i < 40 && hi - lo > 1e-12; ++i) {
+    if (f1 < f2) {
+      hi = x2, x2 = x1, f2 = f1, x1 = hi - g * (hi - lo), f1 = f(x1);
+    } else {
+      lo = x1, x1 = x2, f1 = f2, x2 = lo + g * (hi - lo), f2 = f(x2);
+    }
+  }
+  return std::min({f1, f2, f(a0)});
+}
+
+struct V3 {
+  double x, y, z;
+};
+double dot(V3 a, V3 b) {
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
+V3 sub(V3 a, V3 b) {
+  return {a.x - b.x, a.y - b.y, a.z - b.z};
+}
+V3 scale(double k, V3 a) {
+  return {k * a.x, k * a.y, k * a.z};
+}
+
+// Distance to a programmed arc as LinuxCNC draws it: the radius changes linearly with the angle
+// from the start radius to the end radius, the axial and other axes move linearly. The angle of
+// the point gives the candidate (exact for a circle in its plane); where the arc also moves
+// along its axis or changes radius, a golden-section search around it finds the nearest point.
+double arc_distance(const canon::ArcGeometry& g, const Pose& start, const Pose& end, const Pose& p) {
+  const int b0 =
+      (g.plane == canon::Plane::XY || g.plane == canon::Plane::YZ || g.plane == canon::Plane::XZ) ? 0 : 6;
+  const V3 n{g.normal[0], g.normal[1], g.normal[2]}, c{g.center[0], g.center[1], g.center[2]};
+  const auto in_plane = [&](const Pose& q) {
+    const V3 v = sub(V3{q[b0], q[b0 + 1], q[b0 + 2]}, c);
+    return sub(v, scale(dot(v, n), n));
+  };
+  const V3 rs = in_plane(start), re = in_plane(end);
+  const double r0 = std::sqrt(dot(rs, rs)), r1 = std::sqrt(dot(re, re));
+  if (r0 <= 0) return linear_distance(start, p);
+  const V3 e1 = scale(1 / r0, rs);
+  const V3 e2{n.y * e1.z - n.z * e1.y, n.z * e1.x - n.x * e1.z, n.x * e1.y - n.y * e1.x};
+  const double phi_end = std::atan2(dot(re, e2), dot(re, e1));
+  const bool ccw = g.turns >= 0;
+  const bool full = std::fabs(phi_end) < 1e-9;
+  double sweep = ccw ? (full ? kTwoPi : (phi_end > 0 ? phi_end : phi_end + kTwoPi))
+                     : (full ? kTwoPi : (phi_end < 0 ? -phi_end : kTwoPi - phi_end));
+  sweep += kTwoPi * std::max(0, std::abs(g.turns) - 1);
+
+  const V3 q = in_plane(p);
+  double phi = std::atan2(dot(q, e2), dot(q, e1));
+  if (!ccw) phi = -phi;
+  if (phi < 0) phi += kTwoPi;
+  const auto point_at = [&](double a) {  // the arc at angle a ∈ [0, sweep]
+    const double f = a / sweep;
+    const double r = r0 + (r1 - r0) * f, ang = ccw ? a : -a;
+    Pose x;
+    for (int i = 0; i < kAxisCount; ++i) x[i] = start[i] + f * (end[i] - start[i]);
+    const V3 axial = scale(dot(sub(V3{x[b0], x[b0 + 1], x[b0 + 2]}, c), n), n);
+    x[b0] = c.x + r * (std::cos(ang) * e1.x + std::sin(ang) * e2.x) + axial.x;
+    x[b0 + 1] = c.y + r * (std::cos(ang) * e1.y + std::sin(ang) * e2.y) + axial.y;
+    x[b0 + 2] = c.z + r * (std::cos(ang) * e1.z + std::sin(ang) * e2.z) + axial.z;
+    return linear_distance(x, p);
+  };
+  double rest = 0;  // motion besides the circle: helix rise, other axes, radius change
+  for (int i : kLinear) {
+    if (i < b0 || i > b0 + 2) rest += std::fabs(end[i] - start[i]);
+  }
+  const V3 rise = sub(V3{end[b0], end[b0 + 1], end[b0 + 2]}, V3{start[b0], start[b0 + 1], start[b0 + 2]});
+  rest += std::fabs(dot(rise, n)) + std::fabs(r1 - r0);
+  double best = std::min(linear_distance(start, p), linear_distance(end, p));
+  for (double a = phi; a <= sweep; a += kTwoPi) {
+    const double same_angle = point_at(a);  // an upper bound; on the helix itself it is 0
+    best = std::min(best, rest > 1e-12 && same_angle > 1e-9 ? nearest_angle(point_at, a, sweep) : same_angle);
+  }
+  if (best <= 1e-9) return best;
+  if (rest > 1e-12) {  // near the ends the nearest point of a helix may be at another angle
+    const double quarter = 0.25 * std::numbers::pi;
+    if (phi < quarter || phi > kTwoPi - quarter) best = std::min(best, nearest_angle(point_at, 0.0, sweep));
+    const double to_end = std::remainder(phi - sweep, kTwoPi);
+    if (std::fabs(to_end) < quarter) best = std::min(best, nearest_angle(point_at, sweep, sweep));
+  }
+  return best;
+}
+
+}  // namespace
+
+std::string TraceReport::summary() const {
+  std::string s = fmt::format(
+      "time {:.3f} s, path {:.3f} mm, max contour error {:.6f} mm at {:.3f} s, "
+      "{} limit violations",
+      machining_time_s, path_length_mm, max_contour_error_mm, contour_error_time_s, limit_violations);
+  if (limit_violations > 0) {
+    s += fmt::format(" (first at {:.3f} s: axis {} derivative {} = {:.6g}, limit {:.6g})",
+                     first_violation.time_s, kAxisLetters[static_cast<std::size_t>(first_violation.axis)],
+                     first_violation.derivative, first_violation.value, first_violation.limit);
+  }
+  for (int i = 0; i < kAxisCount; ++i) {
+    const AxisStats& a = axes[static_cast<std::size_t>(i)];
+    if (a.max_velocity == 0 && a.max_acceleration == 0) continue;
+    s += fmt::format("\n  {}: v {:.6g}  a {:.6g}  j {:.6g}", kAxisLetters[static_cast<std::size_t>(i)],
+                     a.max_velocity, a.max_acceleration, a.max_jerk);
+  }
+  return s;
+}
+
+TraceChecker::TraceChecker(const canon::Program& program, const plan::MachineLimits& limits, double period_s,
+                           double relative_tolerance)
+    : program_(&program), limits_(limits), period_s_(period_s), tolerance_(relative_tolerance) {
+  past_.fill(program.start());
+}
+
+// Distance from p to a box that holds move `id` (a lower bound of the distance to the move).
+double TraceChecker::box_distance(canon::SegmentId id, const Pose& p) const {
+  const Pose a = program_->start_of(id), b = program_->end(id);
+  double grow = 0;
+  if (program_->move(id).kind == canon::MoveKind::Arc) {
+    const canon::ArcGeometry& g = program_->arc(id);
+    const int b0 =
+        (g.plane == canon::Plane::XY || g.plane == canon::Plane::YZ || g.plane == canon::Plane::XZ) ? 0 : 6;
+    double r2 = 0;
+    for (int k = 0; k < 3; ++k) r2 += (a[b0 + k] - g.center[k]) * (a[b0 + k] - g.center[k]);
+    grow = 2 * std::sqrt(r2);  // the whole circle fits in the end points' box grown by its diameter
+  }
+  double s = 0;
+  for (int i : kLinear) {
+    const double lo = std::min(a[i], b[i]) - grow, hi = std::max(a[i], b[i]) + grow;
+    const double d = p[i] < lo ? lo - p[i] : (p[i] > hi ? p[i] - hi : 0.0);
+    s += d * d;
+  }
+  return std::sqrt(s);
+}
+
+double TraceChecker::distance_to_move(canon::SegmentId id, const Pose& p) const {
+  const Pose start = program_->start_of(id), end = program_->end(id);
+  if (program_->move(id).kind == canon::MoveKind::Arc) return arc_distance(program_->arc(id), start, end, p);
+  return segment_distance(start, end, p);
+}
+
+void TraceChecker::check_limits(const Pose& x) {
+  const double t = period_s_, t2 = t * t, t3 = t2 * t;
+  for (int i = 0; i < kAxisCount; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    const double x1 = past_[0][i], x2 = past_[1][i], x3 = past_[2][i];
+    const double v = std::fabs(x[i] - x1) / t;
+    const double a = std::fabs(x[i] - 2 * x1 + x2) / t2;
+    const double j = std::fabs(x[i] - 3 * x1 + 3 * x2 - x3) / t3;
+    AxisStats& st = report_.axes[k];
+    st.max_velocity = std::max(st.max_velocity, v);
+    st.max_acceleration = std::max(st.max_acceleration, a);
+    st.max_jerk = std::max(st.max_jerk, j);
+    const plan::AxisLimits& l = limits_[i];
+    const double values[3] = {v, a, j}, caps[3] = {l.max_velocity, l.max_acceleration, l.max_jerk};
+    for (int d = 0; d < 3; ++d) {
+      if (caps[d] <= 0 || values[d] <= caps[d] * (1 + tolerance_)) continue;
+      if (report_.limit_violations++ == 0) {
+        report_.first_violation = {static_cast<double>(report_.samples) * t, i, d + 1, values[d], caps[d]};
+      }
+    }
+  }
+}
+
+void TraceChecker::add(const Pose& position, canon::SegmentId first, canon::SegmentId last) {
+  ++report_.samples;
+  report_.machining_time_s = static_cast<double>(report_.samples) * period_s_;
+  check_limits(position);
+  report_.path_length_mm += linear_distance(position, past_[0]);
+  if (program_->size() > 0) {
+    const canon::SegmentId n = program_->size();
+    const canon::SegmentId lo = first > 0 ? first - 1 : 0;
+    const canon::SegmentId hi = std::min<canon::SegmentId>(last + 1, n - 1);
+    // Merged blocks stand for hundreds of moves: start with the move that was nearest last time
+    // and skip those whose bounding box is already farther than the best distance.
+    double best = 1e300;
+    if (nearest_ >= lo && nearest_ <= hi) best = distance_to_move(nearest_, position);
+    for (canon::SegmentId id = lo; id <= hi && id < n; ++id) {
+      if (id == nearest_ || box_distance(id, position) >= best) continue;
+      const double d = distance_to_move(id, position);
+      if (d < best) {
+        best = d;
+        nearest_ = id;
+      }
+    }
+    if (best < 1e300 && best > report_.max_contour_error_mm) {
+      report_.max_contour_error_mm = best;
+      report_.contour_error_time_s = report_.machining_time_s;
+    }
+  }
+  past_[2] = past_[1];
+  past_[1] = past_[0];
+  past_[0] = position;
+}
+
+}  // namespace opencnc::analysis

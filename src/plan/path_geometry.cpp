@@ -1,0 +1,429 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Planner geometry: lines and arcs in nine axes, trimming, tolerance-bounded corner blends.
+#include "path_geometry.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include <fmt/format.h>
+
+#include "opencnc/traj/path_eval.hpp"
+#include "vec.hpp"
+
+namespace opencnc::plan::detail {
+
+using traj::BlockKind;
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+int plane_base(canon::Plane p) noexcept {
+  return (p == canon::Plane::XY || p == canon::Plane::YZ || p == canon::Plane::XZ) ? 0 : 6;
+}
+
+struct Vec3 {
+  double x = 0, y = 0, z = 0;
+};
+Vec3 sub3(Vec3 a, Vec3 b) {
+  return {a.x - b.x, a.y - b.y, a.z - b.z};
+}
+Vec3 add3(Vec3 a, Vec3 b) {
+  return {a.x + b.x, a.y + b.y, a.z + b.z};
+}
+Vec3 mul3(double k, Vec3 a) {
+  return {k * a.x, k * a.y, k * a.z};
+}
+double dot3(Vec3 a, Vec3 b) {
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
+Vec3 cross3(Vec3 a, Vec3 b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+
+Vec3 take3(const Pose& p, int base) {
+  return {p[base], p[base + 1], p[base + 2]};
+}
+void put3(Pose& p, int base, Vec3 v) {
+  p[base] = v.x;
+  p[base + 1] = v.y;
+  p[base + 2] = v.z;
+}
+
+/// Arc sweep (signed radians) from the end point's angle `phi` ∈ (−π, π] in the frame of the
+/// start point, the direction and LinuxCNC's turn count (|turns| − 1 extra full circles).
+double arc_sweep(double phi, int turns) noexcept {
+  const bool ccw = turns >= 0;
+  const double full = std::fabs(phi) < 1e-9;  // end on start: a whole circle
+  double sweep;
+  if (ccw) {
+    sweep = full ? 2 * kPi : (phi > 0 ? phi : phi + 2 * kPi);
+  } else {
+    sweep = full ? -2 * kPi : (phi < 0 ? phi : phi - 2 * kPi);
+  }
+  const int extra = std::max(0, std::abs(turns) - 1);
+  return sweep + (ccw ? 1.0 : -1.0) * 2 * kPi * extra;
+}
+
+}  // namespace
+
+bool make_line(const Pose& a, const Pose& b, MotionBlock& out) noexcept {
+  const Pose d = b - a;
+  const double len = norm(d);
+  if (!(len >= kMinLength)) return false;
+  out.kind = BlockKind::Line;
+  out.base = a;
+  out.lin = (1.0 / len) * d;
+  out.u = Pose{};
+  out.w = Pose{};
+  out.omega = 0;
+  out.length = len;
+  return true;
+}
+
+bool make_arc(const Pose& start, const Pose& end, const canon::ArcGeometry& arc, MotionBlock& out,
+              std::string& error) {
+  const int b0 = plane_base(arc.plane);
+  const Vec3 n{arc.normal[0], arc.normal[1], arc.normal[2]};
+  const Vec3 c{arc.center[0], arc.center[1], arc.center[2]};
+  const Vec3 s3 = take3(start, b0), e3 = take3(end, b0);
+  Vec3 rs = sub3(s3, c);
+  rs = sub3(rs, mul3(dot3(rs, n), n));
+  const double r = std::sqrt(dot3(rs, rs));
+  if (!(r >= 1e-9)) {
+    error = "the arc's start point lies on its centre (radius zero)";
+    return false;
+  }
+  const Vec3 e1 = mul3(1.0 / r, rs), e2 = cross3(n, e1);
+  Vec3 re = sub3(e3, c);
+  re = sub3(re, mul3(dot3(re, n), n));
+  const double ex = dot3(re, e1), ey = dot3(re, e2);
+  const double r_end = std::hypot(ex, ey);
+  if (std::fabs(r_end - r) > 0.01 + 1e-4 * r) {
+    error = fmt::format(
+        "the arc's end point is {:.4f} mm off its circle (radius {:.4f} mm at the start, "
+        "{:.4f} mm at the end)",
+        std::fabs(r_end - r), r, r_end);
+    return false;
+  }
+  // Slightly different radii (rounded coordinates): move the centre onto the perpendicular
+  // bisector of the two end points, so that the circle passes through both.
+  double cx = 0, cy = 0;
+  const double dx = ex - r, dy = ey, dd = dx * dx + dy * dy;
+  if (dd > 1e-24) {
+    const double k = 0.5 * (r_end * r_end - r * r) / dd;
+    cx = k * dx;
+    cy = k * dy;
+  }
+  const Vec3 c2 = add3(c, add3(mul3(cx, e1), mul3(cy, e2)));
+  const Vec3 rs2 = sub3(s3, c2);
+  const double r2 = std::sqrt(dot3(rs2, rs2));
+  const Vec3 f1 = mul3(1.0 / r2, rs2), f2 = cross3(n, f1);
+  const Vec3 re2 = sub3(re, add3(mul3(cx, e1), mul3(cy, e2)));
+  const double phi = std::atan2(dot3(re2, f2), dot3(re2, f1));
+  const double sweep = arc_sweep(phi, arc.turns == 0 ? 1 : arc.turns);
+
+  Pose U{}, W{};
+  put3(U, b0, mul3(-r2, f1));  // toward the centre
+  put3(W, b0, mul3(r2, f2));   // counterclockwise tangent, length r
+  const Pose circle = std::sin(sweep) * W + (1.0 - std::cos(sweep)) * U;
+  const Pose rest = end - start - circle;  // helix rise and every other axis, moved linearly
+  const double len = std::hypot(r2 * sweep, norm(rest));
+  out.kind = BlockKind::Arc;
+  out.base = start;
+  out.u = U;
+  out.w = W;
+  out.length = len;
+  out.omega = sweep / len;
+  out.lin = (1.0 / len) * rest;
+  return true;
+}
+
+double feed_length_ratio(const Pose& start, const Pose& end, const MotionBlock& b) noexcept {
+  const auto part = [](const Pose& v, int first) {
+    return std::sqrt(v[first] * v[first] + v[first + 1] * v[first + 1] + v[first + 2] * v[first + 2]);
+  };
+  double feed_len = 0;
+  if (b.kind == BlockKind::Arc) {
+    // The circle's plane holds XYZ or UVW; the helix length in that triple carries the feed.
+    const int first = (std::fabs(b.u[6]) + std::fabs(b.u[7]) + std::fabs(b.u[8]) > 0) ? 6 : 0;
+    const double circle = std::fabs(b.omega) * norm(b.u) * b.length;
+    feed_len = std::hypot(circle, part(b.lin, first) * b.length);
+  } else {
+    const Pose d = end - start;
+    feed_len = part(d, 0);
+    if (feed_len < 1e-12) feed_len = part(d, 6);
+    if (feed_len < 1e-12) feed_len = part(d, 3);
+  }
+  return feed_len > 1e-12 ? b.length / feed_len : 1.0;
+}
+
+namespace {
+
+// Splits a cubic Bézier at t (de Casteljau): the head keeps [0, t], the tail [t, 1]. The path
+// parameter keeps its scale (head length L·t, tail L·(1 − t)), so s runs on unchanged.
+void split_bezier(const MotionBlock& b, double t, MotionBlock* head, MotionBlock* tail) {
+  const auto lerp = [t](const Pose& a, const Pose& c) { return a + t * (c - a); };
+  const Pose p01 = lerp(b.base, b.u), p12 = lerp(b.u, b.w), p23 = lerp(b.w, b.lin);
+  const Pose p012 = lerp(p01, p12), p123 = lerp(p12, p23), mid = lerp(p012, p123);
+  if (head != nullptr) {
+    head->u = p01;
+    head->w = p012;
+    head->lin = mid;
+    head->length = b.length * t;
+  }
+  if (tail != nullptr) {
+    tail->base = mid;
+    tail->u = p123;
+    tail->w = p23;
+    tail->length = b.length * (1 - t);
+  }
+}
+
+}  // namespace
+
+void trim_start(MotionBlock& b, double d) noexcept {
+  if (d <= 0) return;
+  if (b.kind == BlockKind::Bezier) {
+    split_bezier(b, d / b.length, nullptr, &b);
+    return;
+  }
+  const Pose p = traj::position_at(b, d);
+  if (b.kind == BlockKind::Arc) {
+    const double phi = b.omega * d, c = std::cos(phi), s = std::sin(phi);
+    const Pose u = c * b.u - s * b.w, w = s * b.u + c * b.w;
+    b.u = u;
+    b.w = w;
+  }
+  b.base = p;
+  b.length -= d;
+}
+
+void trim_end(MotionBlock& b, double d) noexcept {
+  if (d <= 0) return;
+  if (b.kind == BlockKind::Bezier) {
+    split_bezier(b, (b.length - d) / b.length, &b, nullptr);
+    return;
+  }
+  b.length -= d;
+}
+
+void rebase(MotionBlock& b, const Pose& p) noexcept {
+  if (b.kind == BlockKind::Line) {
+    const Pose end = end_point(b);
+    const Pose d = end - p;
+    const double len = norm(d);
+    b.base = p;
+    if (len > 0) {
+      b.lin = (1.0 / len) * d;
+      b.length = len;
+    }
+    return;
+  }
+  b.base = p;
+}
+
+Pose end_point(const MotionBlock& b) noexcept {
+  return traj::position_at(b, b.length);
+}
+
+Pose end_tangent(const MotionBlock& b) noexcept {
+  const Pose t = traj::tangent_at(b, b.length);
+  return (1.0 / norm(t)) * t;
+}
+
+Pose start_tangent(const MotionBlock& b) noexcept {
+  const Pose t = traj::tangent_at(b, 0.0);
+  return (1.0 / norm(t)) * t;
+}
+
+namespace {
+
+/// Smallest distance from p to block b for s within a quarter turn of `s0`: Newton's method on
+/// the derivative of the squared distance, golden section where that is not convex.
+double nearest_on(const MotionBlock& b, const Pose& p, double s0) noexcept {
+  const double reach = 0.25 * kPi / std::fabs(b.omega);
+  double s = s0;
+  for (int i = 0; i < 8; ++i) {
+    const Pose r = p - traj::position_at(b, s);
+    const Pose t = traj::tangent_at(b, s);
+    const double g1 = -dot(r, t), g2 = dot(t, t) - dot(r, traj::curvature_at(b, s));
+    if (!(g2 > 0)) break;
+    const double next = std::clamp(s - g1 / g2, std::max(0.0, s0 - reach), std::min(b.length, s0 + reach));
+    if (std::fabs(next - s) < 1e-13 * (1 + b.length)) {
+      return std::min(norm(p - traj::position_at(b, next)), norm(p - traj::position_at(b, s0)));
+    }
+    s = next;
+  }
+  double lo = std::max(0.0, s0 - reach), hi = std::min(b.length, s0 + reach);
+  const double g = 0.5 * (std::sqrt(5.0) - 1);
+  const auto d = [&](double x) { return norm(p - traj::position_at(b, x)); };
+  double x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo), f1 = d(x1), f2 = d(x2);
+  for (int i = 0; i < 60 && hi - lo > 1e-12; ++i) {
+    if (f1 < f2) {
+      hi = x2, x2 = x1, f2 = f1, x1 = hi - g * (hi - lo), f1 = d(x1);
+    } else {
+      lo = x1, x1 = x2, f1 = f2, x2 = lo + g * (hi - lo), f2 = d(x2);
+    }
+  }
+  return std::min({f1, f2, d(s0)});
+}
+
+}  // namespace
+
+double distance_to(const MotionBlock& b, const Pose& p) noexcept {
+  if (b.kind == BlockKind::Line) {
+    const double t = std::clamp(dot(p - b.base, b.lin), 0.0, b.length);
+    return norm(p - (b.base + t * b.lin));
+  }
+  if (b.kind == BlockKind::Arc) {
+    // The angle of p about the axis picks the parameter (exact for a planar arc); on a helix the
+    // nearest point is near there, and a golden-section search around it finds it.
+    const double r = norm(b.u);
+    const Pose centre = b.base + b.u;
+    const Pose q = p - centre;
+    const double qa = -dot(q, b.u) / r, qb = dot(q, b.w) / r;
+    double phi = std::atan2(qb, qa);  // angle from the start direction, counterclockwise
+    const double sweep = b.omega * b.length;
+    if (sweep < 0) phi = -phi;
+    if (phi < 0) phi += 2 * kPi;
+    const double span = std::fabs(sweep);
+    double best = std::min(norm(p - b.base), norm(p - end_point(b)));
+    const bool helix = norm(b.lin) > 1e-12;
+    for (double a = phi; a <= span; a += 2 * kPi) {
+      const double s = a / std::fabs(b.omega);
+      const double same_angle = norm(p - traj::position_at(b, s));
+      best = std::min(best, helix && same_angle > 1e-9 ? nearest_on(b, p, s) : same_angle);
+    }
+    if (helix && best > 1e-9) best = std::min({best, nearest_on(b, p, 0.0), nearest_on(b, p, b.length)});
+    return best;
+  }
+  // Bézier: sampled (only used for short blend curves).
+  double best = 1e300;
+  for (int k = 0; k <= 64; ++k) best = std::min(best, norm(p - traj::position_at(b, b.length * k / 64.0)));
+  return best;
+}
+
+namespace {
+
+/// Radius for which a circle in the plane of unit vectors `t` and `n` can be run at the needed
+/// speed: v²·√(t_i² + n_i²)/R ≤ share·A_i on every axis.
+double needed_radius(const Pose& t, const Pose& n, const BlendNeed& need) {
+  double r = 0;
+  for (int i = 0; i < kAxisCount; ++i) {
+    const double a = need.accel[static_cast<std::size_t>(i)];
+    if (a > 0)
+      r = std::max(r, need.speed * need.speed * std::sqrt(t[i] * t[i] + n[i] * n[i]) / (need.share * a));
+  }
+  return r;
+}
+
+bool line_line_blend(const MotionBlock& in, double avail_in, const MotionBlock& out, double avail_out,
+                     double tolerance, const BlendNeed& need, double theta, const Pose& ta, const Pose& tb,
+                     Blend& result) {
+  // Circular fillet tangent to both lines: tangent length d, radius R = d / tan(θ/2), largest
+  // distance from the lines R·(1 − cos(θ/2)) ≤ tolerance, and no larger than the speed needs.
+  const double t2 = std::tan(0.5 * theta);
+  const double s4 = std::sin(0.25 * theta);
+  Pose n = tb - ta;
+  n = n - dot(n, ta) * ta;
+  n = (1.0 / norm(n)) * n;
+  double d = std::min({avail_in, avail_out, needed_radius(ta, n, need) * t2});
+  if (tolerance > 0) d = std::min(d, tolerance * t2 / (2.0 * s4 * s4));
+  if (!(d >= kMinLength)) return false;
+  const double radius = d / t2;
+  MotionBlock& c = result.curve;
+  c = in;
+  c.kind = BlockKind::Arc;
+  c.base = end_point(in) - d * ta;
+  c.w = radius * ta;
+  c.u = radius * n;
+  c.lin = Pose{};
+  c.length = radius * theta;
+  c.omega = 1.0 / radius;
+  result.trim_in = d;
+  result.trim_out = d;
+  (void)out;
+  return true;
+}
+
+/// Cubic Bézier from the point `d` before the corner on `in` to the point `d` after it on
+/// `out`, tangent to both, with arms that make it close to a circular fillet.
+void bezier_at(const MotionBlock& in, const MotionBlock& out, double d, MotionBlock& c) {
+  const Pose p0 = traj::position_at(in, in.length - d);
+  const Pose p3 = traj::position_at(out, d);
+  Pose ta = traj::tangent_at(in, in.length - d), tb = traj::tangent_at(out, d);
+  ta = (1.0 / norm(ta)) * ta;
+  tb = (1.0 / norm(tb)) * tb;
+  const double theta = angle_between(ta, tb);
+  const double cq = std::cos(0.25 * theta);
+  const double h = norm(p3 - p0) / (3.0 * cq * cq);
+  c = in;
+  c.kind = BlockKind::Bezier;
+  c.base = p0;
+  c.u = p0 + h * ta;
+  c.w = p3 - h * tb;
+  c.lin = p3;
+  c.length = 3.0 * h;
+  c.omega = 0;
+}
+
+/// Largest distance from the Bézier to the two programmed blocks (sampled, plus the most the
+/// curve can move between samples).
+double bezier_deviation(const MotionBlock& c, const MotionBlock& in, const MotionBlock& out) {
+  constexpr int kSamples = 32;
+  const double arm = std::max({norm(c.u - c.base), norm(c.w - c.u), norm(c.lin - c.w)});
+  double worst = 0;
+  for (int k = 1; k < kSamples; ++k) {
+    const Pose p = traj::position_at(c, c.length * k / kSamples);
+    worst = std::max(worst, std::min(distance_to(in, p), distance_to(out, p)));
+  }
+  return worst + 3.0 * arm / (2.0 * kSamples);
+}
+
+bool bezier_blend(const MotionBlock& in, double avail_in, const MotionBlock& out, double avail_out,
+                  double tolerance, const BlendNeed& need, double theta, const Pose& ta, const Pose& tb,
+                  Blend& result) {
+  // A cubic's curvature peaks above that of the circular fillet it imitates: allow it twice the
+  // fillet's tangent length before the speed no longer needs more.
+  Pose n = tb - ta;
+  n = n - dot(n, ta) * ta;
+  n = (1.0 / norm(n)) * n;
+  const double d_need = 2.0 * needed_radius(ta, n, need) * std::tan(0.5 * theta);
+  const double d_max = std::min({avail_in, avail_out, d_need});
+  if (!(d_max >= kMinLength)) return false;
+  const auto ok = [&](double d) {
+    bezier_at(in, out, d, result.curve);
+    if (result.curve.length < kMinLength) return false;
+    return tolerance <= 0 || bezier_deviation(result.curve, in, out) <= tolerance;
+  };
+  double d = d_max;
+  if (!ok(d)) {
+    double lo = 0, hi = d_max;
+    for (int i = 0; i < 40 && hi - lo > 1e-9 * d_max; ++i) {
+      const double mid = 0.5 * (lo + hi);
+      (ok(mid) ? lo : hi) = mid;
+    }
+    d = lo;
+    if (!(d >= kMinLength) || !ok(d)) return false;
+  }
+  result.trim_in = d;
+  result.trim_out = d;
+  return true;
+}
+
+}  // namespace
+
+bool blend_corner(const MotionBlock& in, double avail_in, const MotionBlock& out, double avail_out,
+                  double tolerance, const BlendNeed& need, Blend& result) {
+  const Pose ta = end_tangent(in), tb = start_tangent(out);
+  const double theta = angle_between(ta, tb);
+  if (theta <= kTangentAngle || theta >= kReversalAngle) return false;
+  if (in.kind == BlockKind::Line && out.kind == BlockKind::Line) {
+    return line_line_blend(in, avail_in, out, avail_out, tolerance, need, theta, ta, tb, result);
+  }
+  return bezier_blend(in, avail_in, out, avail_out, tolerance, need, theta, ta, tb, result);
+}
+
+}  // namespace opencnc::plan::detail

@@ -1,0 +1,395 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// plan::Planner: program reader → corners (blend, tangent or stop) → block limits → look-ahead →
+// queue.
+#include "opencnc/plan/planner.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "block_limits.hpp"
+#include "lookahead.hpp"
+#include "path_geometry.hpp"
+#include "program_reader.hpp"
+#include "vec.hpp"
+
+namespace opencnc::plan {
+
+using detail::Element;
+using detail::PlannedBlock;
+using traj::BlockKind;
+using traj::FeedClass;
+using traj::MarkerKind;
+using traj::MotionBlock;
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+bool bad(double v) {
+  return !std::isfinite(v);
+}
+
+/// Moving-average length in servo periods: long enough that 2·A/T ≤ (1 − η)·J on every axis.
+int filter_ticks(const MachineLimits& m, const PlannerConfig& c) {
+  double t = 0;
+  for (int i = 0; i < kAxisCount; ++i) {
+    if (!m.axes.has(static_cast<Axis>(i)) || m[i].max_jerk <= 0) continue;
+    t = std::max(t, 2.0 * m[i].max_acceleration / ((1.0 - c.jerk_step_share) * m[i].max_jerk));
+  }
+  if (t <= 0) return 1;
+  return std::max(2, static_cast<int>(std::ceil(t / c.servo_period_s - 1e-9)));
+}
+
+}  // namespace
+
+bool validate(const MachineLimits& limits, Diagnostics& diags) {
+  bool ok = true;
+  for (int i = 0; i < kAxisCount; ++i) {
+    if (!limits.axes.has(static_cast<Axis>(i))) continue;
+    const AxisLimits& l = limits[i];
+    const auto check = [&](double v, bool zero_ok, const char* what) {
+      if (bad(v) || v < 0 || (!zero_ok && v == 0)) {
+        diags.error("", 0, 0,
+                    fmt::format("axis {}: {} must be a positive number, not {}", kAxisLetters[i], what, v),
+                    "plan.limits");
+        ok = false;
+      }
+    };
+    check(l.max_velocity, false, "max_velocity");
+    check(l.max_acceleration, false, "max_acceleration");
+    check(l.max_jerk, true, "max_jerk");
+  }
+  return ok;
+}
+
+struct Planner::Impl {
+  MachineLimits limits;
+  PlannerConfig config;
+  detail::LimitParams params;
+  int ticks = 1;
+  Diagnostics diags;
+  PlanStats stats;
+  bool config_ok = true;
+  bool failed = false;
+
+  const canon::Program* program = nullptr;
+  std::optional<detail::ProgramReader> reader;
+  std::optional<detail::Lookahead> window;
+  bool reading_done = false;
+  std::optional<Element> pending;          ///< last element; its end is decided by the next one
+  std::vector<MotionBlock> reports;        ///< Report markers waiting after `pending`
+  Pose last_end{};                         ///< exact end of the last emitted path block
+  bool continues = false;                  ///< `prev` runs on into the next path block (no stop)
+  MotionBlock prev;                        ///< the last emitted path block
+
+  Impl(const MachineLimits& l, const PlannerConfig& c);
+  void check_config();
+  void emit_path(MotionBlock b, double junction);
+  void emit_marker(MotionBlock m);
+  void emit_reports();
+  void on_element(Element e);
+  void on_marker(const MotionBlock& m);
+  void flush_pending();
+  bool corner(Element& a, Element& e);
+  double commanded_max(const MotionBlock& b) const;
+  detail::BlendNeed blend_need(const MotionBlock& a, const MotionBlock& e) const;
+  bool blend_pays(const Element& a, const Element& e, const detail::Blend& blend) const;
+  bool read_one();
+};
+
+Planner::Impl::Impl(const MachineLimits& l, const PlannerConfig& c) : limits(l), config(c) {
+  check_config();
+  if (!config_ok) return;
+  ticks = filter_ticks(limits, config);
+  params.machine = limits;
+  params.normal_share = config.normal_accel_share;
+  params.step_share = config.jerk_step_share;
+  params.period_s = config.servo_period_s;
+  params.filter_s = ticks > 1 ? ticks * config.servo_period_s : 0.0;
+  if (ticks > traj::kMaxFilterTicks) {
+    diags.error(
+        "", 0, 0,
+        fmt::format("the jerk limits need a {:.3f} s moving average, longer than the {} servo periods "
+                    "supported; raise max_jerk",
+                    params.filter_s, traj::kMaxFilterTicks),
+        "plan.config");
+    config_ok = false;
+  }
+}
+
+void Planner::Impl::check_config() {
+  config_ok = validate(limits, diags);
+  const auto err = [&](const std::string& msg) {
+    diags.error("", 0, 0, msg, "plan.config");
+    config_ok = false;
+  };
+  if (bad(config.servo_period_s) || config.servo_period_s <= 0) err("servo_period_s must be positive");
+  if (config.lookahead_moves < 2) err("lookahead_moves must be at least 2");
+  if (bad(config.max_feed_override) || config.max_feed_override < 1)
+    err("max_feed_override must be at least 1");
+  if (!(config.normal_accel_share > 0 && config.normal_accel_share < 1))
+    err("normal_accel_share must be in (0, 1)");
+  if (!(config.jerk_step_share > 0 && config.jerk_step_share < 1)) err("jerk_step_share must be in (0, 1)");
+}
+
+double Planner::Impl::commanded_max(const MotionBlock& b) const {
+  return b.feed_class == FeedClass::Feed ? b.feed * config.max_feed_override : kInf;
+}
+
+// The fastest the corner will be asked to go: the lower of the two moves' top speeds (feed at
+// the largest override, or the rapid rate), within the axis velocity limits.
+detail::BlendNeed Planner::Impl::blend_need(const MotionBlock& a, const MotionBlock& e) const {
+  detail::BlendNeed need;
+  need.share = config.normal_accel_share;
+  need.speed = std::min(commanded_max(a), commanded_max(e));
+  if (!(need.speed < kInf))
+    need.speed =
+        std::min(detail::block_limits(a, kInf, params).cap, detail::block_limits(e, kInf, params).cap);
+  for (int i = 0; i < kAxisCount; ++i) {
+    if (limits.axes.has(static_cast<Axis>(i)))
+      need.accel[static_cast<std::size_t>(i)] = limits[i].max_acceleration;
+  }
+  return need;
+}
+
+void Planner::Impl::emit_path(MotionBlock b, double junction) {
+  detail::rebase(b, last_end);
+  if (b.length < detail::kMinLength) return;
+  const detail::RawLimits r = detail::block_limits(b, commanded_max(b), params);
+  if (b.feed_class == FeedClass::Rapid) b.feed = r.cap;
+  PlannedBlock pb;
+  pb.b = b;
+  pb.cap_raw = r.cap;
+  pb.accel_raw = r.accel;
+  pb.junction = junction;
+  if (continues && junction > 0 && params.filter_s > 0) pb.step = detail::curvature_step(prev, b);
+  window->push(pb);
+  prev = b;
+  continues = true;
+  last_end = detail::end_point(b);
+}
+
+void Planner::Impl::emit_marker(MotionBlock m) {
+  m.base = last_end;
+  m.length = 0;
+  PlannedBlock pb;
+  pb.b = m;
+  pb.junction = kInf;
+  window->push(pb);
+  if (m.marker != MarkerKind::Report) continues = false;
+}
+
+void Planner::Impl::emit_reports() {
+  for (const MotionBlock& m : reports) emit_marker(m);
+  reports.clear();
+}
+
+/// The curve between two elements: returns true when it blended (or the corner is tangent), false
+/// when the motion has to stop at the corner. Emits `a` (trimmed) and the blend.
+bool Planner::Impl::corner(Element& a, Element& e) {
+  if (a.stop_after || a.mode == canon::MotionControl::ExactStop) return false;
+  if ((a.b.feed_class == FeedClass::SpindleSync) != (e.b.feed_class == FeedClass::SpindleSync)) return false;
+  const double theta = detail::angle_between(detail::end_tangent(a.b), detail::start_tangent(e.b));
+  if (theta <= detail::kTangentAngle) {
+    emit_path(a.b, a.junction);
+    emit_reports();
+    return true;
+  }
+  if (a.mode != canon::MotionControl::Continuous) return false;
+  double tol = 0;
+  if (a.tolerance > 0) {
+    tol = a.tolerance - std::max(a.merge_deviation, e.merge_deviation);
+    if (tol <= 0) return false;
+  }
+  detail::Blend blend;
+  const double avail_a = std::min(0.5 * a.orig_length, a.b.length);
+  const double avail_e = std::min(0.5 * e.orig_length, e.b.length);
+  if (!detail::blend_corner(a.b, avail_a, e.b, avail_e, tol, blend_need(a.b, e.b), blend)) return false;
+  if (!blend_pays(a, e, blend)) return false;
+  detail::trim_end(a.b, blend.trim_in);
+  emit_path(a.b, a.junction);
+  emit_reports();
+  MotionBlock& c = blend.curve;
+  c.flags = static_cast<std::uint8_t>((a.b.flags & e.b.flags) | traj::kBlend);
+  c.segment = a.b.segment_last;
+  c.segment_first = a.b.segment_first;
+  c.segment_last = e.b.segment_last;
+  if (a.b.feed_class == e.b.feed_class) {
+    c.feed_class = a.b.feed_class;
+    c.feed = std::min(a.b.feed, e.b.feed);
+  } else {  // rapid into feed or back: the feed side rules the blend
+    const MotionBlock& f = a.b.feed_class == FeedClass::Rapid ? e.b : a.b;
+    c.feed_class = f.feed_class;
+    c.feed = f.feed;
+  }
+  emit_path(c, kInf);
+  detail::trim_start(e.b, blend.trim_out);
+  ++stats.blends;
+  return true;
+}
+
+// G64 should never be slower than stopping. Compare both from where the stopping motion has
+// slowed to the blend's speed limit v_b (v_b²/2A before the corner) to where it is back at v_b:
+// stopping takes 2·v_b/A; blending covers that distance with the corner cut (blend length L
+// instead of the two legs 2·d) at v_b, i.e. v_b/A + (L − 2d)/v_b. With the moving average of
+// length T, a stop also waits T at the corner, and the blend's speed limit holds over v_b·T of
+// extra path on each side (2·T more). Blend when (L − 2d)/v_b + T < v_b/A. Without jerk limits
+// (T = 0) that always holds, as L < 2d. The estimate assumes moves on both sides long enough to
+// get back to full speed; between short moves (dense paths) the blend is always kept.
+bool Planner::Impl::blend_pays(const Element& ea, const Element& ee, const detail::Blend& blend) const {
+  if (params.filter_s <= 0) return true;
+  const MotionBlock& a = ea.b;
+  const MotionBlock& e = ee.b;
+  const MotionBlock& c = blend.curve;
+  double v_b = detail::block_limits(c, std::min(commanded_max(a), commanded_max(e)), params).cap;
+  if (params.filter_s > 0) {
+    MotionBlock in = a, out = e;
+    detail::trim_end(in, blend.trim_in);
+    detail::trim_start(out, blend.trim_out);
+    for (const Pose& step : {detail::curvature_step(in, c), detail::curvature_step(c, out)}) {
+      for (int i = 0; i < kAxisCount; ++i) {
+        if (step[i] > 0 && limits[i].max_jerk > 0) {
+          v_b = std::min(
+              v_b, std::sqrt(config.jerk_step_share * limits[i].max_jerk * config.servo_period_s / step[i]));
+        }
+      }
+    }
+  }
+  const detail::RawLimits la = detail::block_limits(a, commanded_max(a), params);
+  const detail::RawLimits le = detail::block_limits(e, commanded_max(e), params);
+  const double v_adjacent = std::min(std::min(la.cap, le.cap), std::min(commanded_max(a), commanded_max(e)));
+  const double accel = std::min(la.accel, le.accel);
+  if (std::min(ea.orig_length, ee.orig_length) < v_adjacent * v_adjacent / accel) return true;
+  return v_b > 0 && (c.length - blend.trim_in - blend.trim_out) / v_b + params.filter_s < v_b / accel;
+}
+
+void Planner::Impl::on_element(Element e) {
+  if (pending) {
+    e.junction = corner(*pending, e) ? kInf : 0.0;
+    if (e.junction == 0) {  // no blend: `pending` ends with a stop at the corner
+      emit_path(pending->b, pending->junction);
+      emit_reports();
+    }
+  }
+  pending = e;
+}
+
+void Planner::Impl::flush_pending() {
+  if (pending) emit_path(pending->b, pending->junction);
+  pending.reset();
+  emit_reports();
+}
+
+void Planner::Impl::on_marker(const MotionBlock& m) {
+  if (m.marker == MarkerKind::Report && pending) {
+    reports.push_back(m);  // placed where `pending` ends, i.e. where a blend would start
+    return;
+  }
+  flush_pending();
+  emit_marker(m);
+}
+
+bool Planner::Impl::read_one() {
+  detail::Item it;
+  if (!reader->next(it)) return false;
+  if (it.is_marker) {
+    on_marker(it.marker);
+  } else {
+    on_element(it.element);
+  }
+  stats.moves = reader->moves_read();
+  stats.merged_moves = reader->merged();
+  return true;
+}
+
+Planner::Planner(const MachineLimits& limits, const PlannerConfig& config)
+    : impl_(std::make_unique<Impl>(limits, config)) {}
+
+Planner::~Planner() = default;
+
+traj::InterpolatorConfig Planner::interpolator_config() const noexcept {
+  traj::InterpolatorConfig c;
+  c.period_s = impl_->config.servo_period_s;
+  c.filter_ticks = impl_->ticks;
+  c.max_feed_override = impl_->config.max_feed_override;
+  return c;
+}
+
+bool Planner::start(const canon::Program& program) {
+  Impl& m = *impl_;
+  m.failed = !m.config_ok || !detail::check_program(program, m.limits, m.diags);
+  if (m.failed) return false;
+  m.program = &program;
+  m.reader.emplace(program);
+  detail::WindowParams wp;
+  wp.filter_s = m.params.filter_s;
+  for (int i = 0; i < kAxisCount; ++i) {
+    if (!m.limits.axes.has(static_cast<Axis>(i))) continue;
+    const AxisLimits& l = m.limits[i];
+    wp.v_bound += l.max_velocity * l.max_velocity;
+    if (wp.filter_s > 0 && l.max_jerk > 0) {
+      wp.step_budget[static_cast<std::size_t>(i)] =
+          4.0 / 3.0 * m.config.jerk_step_share * l.max_jerk * m.config.servo_period_s;
+    }
+  }
+  wp.v_bound = std::sqrt(wp.v_bound);
+  wp.step_window_s = 3.0 * wp.v_bound * m.config.servo_period_s;
+  m.window.emplace(wp);
+  m.reading_done = false;
+  m.pending.reset();
+  m.reports.clear();
+  m.last_end = program.start();
+  m.continues = false;
+  m.stats = {};
+  return true;
+}
+
+PlanStatus Planner::pump(traj::BlockQueue& queue) {
+  Impl& m = *impl_;
+  if (m.failed || m.program == nullptr) return PlanStatus::Failed;
+  detail::Lookahead& w = *m.window;
+  const std::size_t max_window = 2 * m.config.lookahead_moves + 16;
+  for (;;) {
+    while (queue.free_slots() > 0 && w.publishable() > 0) {
+      queue.try_push(w.front_for_queue(queue.pushed()));
+      w.pop_front();
+      ++m.stats.blocks;
+    }
+    if (queue.free_slots() == 0) return PlanStatus::Working;
+    if (m.reading_done && w.empty()) return PlanStatus::Finished;
+    if (m.reading_done) continue;  // finish() made everything publishable
+    if (w.size() >= max_window) {
+      // The window is full and nothing is final: publish the front with the entry speed it
+      // has (a stop at the window's end is assumed, so it is on the safe side).
+      if (w.settled() == 0) return PlanStatus::Working;
+      queue.try_push(w.front_for_queue(queue.pushed()));
+      w.pop_front();
+      ++m.stats.blocks;
+      continue;
+    }
+    // Read a batch before looking for final blocks again: the backward pass then runs once
+    // per batch instead of once per block.
+    for (int i = 0; i < 64 && w.size() < max_window; ++i) {
+      if (!m.read_one()) {
+        m.flush_pending();
+        w.finish();
+        m.reading_done = true;
+        break;
+      }
+    }
+  }
+}
+
+const Diagnostics& Planner::diagnostics() const noexcept {
+  return impl_->diags;
+}
+const PlanStats& Planner::stats() const noexcept {
+  return impl_->stats;
+}
+
+}  // namespace opencnc::plan

@@ -1,0 +1,382 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// canon::Program → path elements and markers, with modal path-control state and G64 Q merging.
+#include "program_reader.hpp"
+
+#include <cmath>
+#include <string>
+
+#include <fmt/format.h>
+
+#include "path_geometry.hpp"
+#include "vec.hpp"
+
+namespace opencnc::plan::detail {
+
+using canon::ActionKind;
+using canon::MoveKind;
+using traj::FeedClass;
+using traj::MarkerKind;
+using traj::MotionBlock;
+
+namespace {
+
+constexpr std::size_t kMaxRunPoints = 512;
+
+std::string file_name(const canon::Program& p, canon::SegmentId id) {
+  const std::uint32_t f = p.file_of(id);
+  return f < p.sources().file_count() ? p.sources().file(f) : std::string();
+}
+
+bool finite_pose(const Pose& p) {
+  for (double v : p.v) {
+    if (!std::isfinite(v)) return false;
+  }
+  return true;
+}
+
+/// What the tick does for each action kind: nothing (the planner applies it or it needs no
+/// motion), report it when passed, or stop there.
+MarkerKind marker_for(ActionKind k) {
+  switch (k) {
+    case ActionKind::Dwell:
+      return MarkerKind::Dwell;
+    case ActionKind::ProgramStop:
+      return MarkerKind::ProgramStop;
+    case ActionKind::OptionalStop:
+      return MarkerKind::OptionalStop;
+    case ActionKind::ProgramEnd:
+      return MarkerKind::ProgramEnd;
+    case ActionKind::ChangeTool:
+    case ActionKind::WaitInput:
+    case ActionKind::PalletShuttle:
+    case ActionKind::SpindleOrient:
+      return MarkerKind::Sync;
+    case ActionKind::SpindleSpeed:
+    case ActionKind::SpindleCw:
+    case ActionKind::SpindleCcw:
+    case ActionKind::SpindleStop:
+    case ActionKind::SpindleMode:
+    case ActionKind::SelectTool:
+    case ActionKind::ChangeToolNumber:
+    case ActionKind::MistOn:
+    case ActionKind::MistOff:
+    case ActionKind::FloodOn:
+    case ActionKind::FloodOff:
+    case ActionKind::SpeedOverrideEnable:
+    case ActionKind::SpeedOverrideDisable:
+    case ActionKind::MotionOutputBit:
+    case ActionKind::AuxOutputBit:
+    case ActionKind::MotionOutputValue:
+    case ActionKind::AuxOutputValue:
+    case ActionKind::ProbeOn:
+    case ActionKind::ProbeOff:
+    case ActionKind::Message:
+      return MarkerKind::Report;
+    default:
+      return MarkerKind::None;
+  }
+}
+
+}  // namespace
+
+bool check_program(const canon::Program& program, const MachineLimits& limits, Diagnostics& diags) {
+  const std::size_t before = diags.error_count();
+  const auto fail = [&](canon::SegmentId id, std::string msg, const char* code) {
+    diags.error(file_name(program, id), program.move(id).line, 0, std::move(msg), code);
+  };
+  for (canon::SegmentId id = 0; id < program.size(); ++id) {
+    const canon::Move& m = program.move(id);
+    const Pose start = program.start_of(id), end = program.end(id);
+    if (!finite_pose(start) || !finite_pose(end)) {
+      fail(id, "the move's end point is not a finite number", "plan.not-finite");
+      continue;
+    }
+    if (m.kind == MoveKind::RigidTap) {
+      fail(id, "rigid tapping (G33.1) is not supported by the planner yet", "plan.unsupported-move");
+      continue;
+    }
+    for (int i = 0; i < kAxisCount; ++i) {
+      if (end[i] != start[i] && !limits.axes.has(static_cast<Axis>(i))) {
+        fail(id, fmt::format("the move drives axis {}, which this machine does not have", kAxisLetters[i]),
+             "plan.axis-not-configured");
+        break;
+      }
+    }
+    if (m.kind == MoveKind::Arc) {
+      traj::MotionBlock b;
+      std::string why;
+      if (!make_arc(start, end, program.arc(id), b, why)) fail(id, why, "plan.bad-arc");
+    }
+    if (m.kind != MoveKind::Traverse && !(m.flags & canon::kSpindleSynced) && !(program.feed(id) > 0)) {
+      fail(id, "feed move with a zero feed rate", "plan.feed-zero");
+    }
+  }
+  return diags.error_count() == before;
+}
+
+ProgramReader::ProgramReader(const canon::Program& program) : program_(&program) {}
+
+std::uint8_t ProgramReader::flags() const noexcept {
+  std::uint8_t f = 0;
+  if (override_enabled_) f |= traj::kFeedOverrideAllowed;
+  if (hold_enabled_) f |= traj::kFeedHoldAllowed;
+  return f;
+}
+
+void ProgramReader::add_marker(const canon::Action& a, MarkerKind kind) {
+  Item it;
+  it.is_marker = true;
+  traj::MotionBlock& m = it.marker;
+  m.kind = traj::BlockKind::Marker;
+  m.marker = kind;
+  m.action = static_cast<std::uint32_t>(&a - program_->actions().data());
+  m.segment = m.segment_first = m.segment_last = a.before_move;
+  m.line = a.line;
+  m.context = a.context;
+  m.value = a.value;
+  m.flags = flags();
+  if (kind == MarkerKind::ProgramEnd) ended_ = true;
+  flush_run();
+  ready_.push_back(it);
+}
+
+void ProgramReader::read_actions_before(std::uint32_t move) {
+  const auto& actions = program_->actions();
+  while (next_action_ < actions.size() && actions[next_action_].before_move <= move) {
+    const canon::Action& a = actions[next_action_++];
+    switch (a.kind) {
+      case ActionKind::MotionControl:
+        mode_ = static_cast<canon::MotionControl>(a.index);
+        tolerance_ = a.value;
+        break;
+      case ActionKind::NaiveCamTolerance:
+        naive_tolerance_ = a.value;
+        break;
+      case ActionKind::FeedOverrideEnable:
+        override_enabled_ = true;
+        break;
+      case ActionKind::FeedOverrideDisable:
+        override_enabled_ = false;
+        break;
+      case ActionKind::FeedHoldEnable:
+        hold_enabled_ = true;
+        break;
+      case ActionKind::FeedHoldDisable:
+        hold_enabled_ = false;
+        break;
+      case ActionKind::SpeedFeedSyncStart:
+        sync_per_rev_ = a.value;
+        break;
+      default:
+        break;
+    }
+    const MarkerKind kind = marker_for(a.kind);
+    if (kind != MarkerKind::None) add_marker(a, kind);
+    // The tick stops for the spindle to reach speed before the motion that follows a start.
+    if (a.kind == ActionKind::SpindleCw || a.kind == ActionKind::SpindleCcw)
+      add_marker(a, MarkerKind::SpindleWait);
+  }
+}
+
+bool ProgramReader::make_element(canon::SegmentId id, Element& e) const {
+  const canon::Move& m = program_->move(id);
+  const Pose start = program_->start_of(id), end = program_->end(id);
+  traj::MotionBlock& b = e.b;
+  if (m.kind == MoveKind::Arc) {
+    std::string why;
+    if (!make_arc(start, end, program_->arc(id), b, why)) return false;  // rejected by the check
+  } else if (!make_line(start, end, b)) {
+    return false;  // no motion
+  }
+  b.segment = b.segment_first = b.segment_last = id;
+  b.line = m.line;
+  b.context = m.context;
+  b.flags = flags();
+  if (m.kind == MoveKind::Probe) b.flags |= traj::kProbe;
+  const double f = program_->feed(id);
+  const double ratio = feed_length_ratio(start, end, b);
+  if (m.kind == MoveKind::Traverse) {
+    b.feed_class = FeedClass::Rapid;
+    b.feed = 0;  // the rapid rate comes from the limits
+  } else if (m.flags & canon::kSpindleSynced) {
+    b.feed_class = FeedClass::SpindleSync;
+    b.feed = sync_per_rev_ * ratio;
+    b.flags &= static_cast<std::uint8_t>(~(traj::kFeedHoldAllowed | traj::kFeedOverrideAllowed));
+  } else if (m.flags & canon::kPerRevolution) {
+    b.feed_class = FeedClass::PerRevolution;
+    b.feed = f * ratio;
+  } else if (m.flags & canon::kInverseTime) {
+    b.feed_class = FeedClass::Feed;
+    b.feed = b.length * f / 60.0;  // the move takes 1/F minutes
+  } else {
+    b.feed_class = FeedClass::Feed;
+    b.feed = f / 60.0 * ratio;
+  }
+  e.orig_length = b.length;
+  e.merge_deviation = 0;
+  e.mode = mode_;
+  e.tolerance = tolerance_;
+  e.stop_after = m.kind == MoveKind::Probe;
+  if (m.kind == MoveKind::Arc) chord_small_arc(start, end, f, e);
+  return true;
+}
+
+// G64 Q, as LinuxCNC's naive-CAM detector: a flat arc that never leaves its chord by more than
+// the tolerance is the chord (tiny arcs from CAM output), and may then be merged with others.
+void ProgramReader::chord_small_arc(const Pose& start, const Pose& end, double feed, Element& e) const {
+  if (e.mode != canon::MotionControl::Continuous || naive_tolerance_ <= 0 ||
+      e.b.feed_class != FeedClass::Feed)
+    return;
+  if (norm(e.b.lin) > 1e-12) return;  // helix or other axes: not a flat arc
+  const double sweep = std::fabs(e.b.omega) * e.b.length;
+  if (sweep > 3.14159265358979323846) return;
+  const double sagitta = norm(e.b.u) * (1 - std::cos(0.5 * sweep));
+  if (sagitta > merge_budget()) return;
+  MotionBlock line = e.b;
+  if (!make_line(start, end, line)) return;
+  line.feed = feed / 60.0 * feed_length_ratio(start, end, line);
+  e.b = line;
+  e.orig_length = line.length;
+  e.merge_deviation = sagitta;
+}
+
+double ProgramReader::merge_budget() const noexcept {
+  return tolerance_ > 0 ? std::min(naive_tolerance_, tolerance_) : naive_tolerance_;
+}
+
+// G64 Q: a run of feed lines whose inner vertices all lie within Q of the line from the run's
+// start to the candidate end (and in order along it) becomes that one line. With a blend
+// tolerance P the merge uses at most P/2, and the blends then keep within P minus the merge's
+// deviation, so the path stays within P of the programmed one.
+bool ProgramReader::can_extend_run(const Element& e) const {
+  if (!run_active_ || run_points_.size() >= kMaxRunPoints) return false;
+  if (e.b.kind != traj::BlockKind::Line || e.b.feed_class != FeedClass::Feed || e.stop_after) return false;
+  if (e.mode != run_.mode || e.tolerance != run_.tolerance || e.b.flags != run_.b.flags) return false;
+  if (program_->feed(e.b.segment_first) != run_feed_) return false;
+  // Vertices within Q (at most P/2, to leave the blends room), and all of it within the budget
+  // together with what chorded arcs already deviate.
+  const double floor = std::max(run_floor_, e.merge_deviation);
+  const double q_vertex =
+      run_.tolerance > 0 ? std::min(naive_tolerance_, 0.5 * run_.tolerance) : naive_tolerance_;
+  const double q = std::min(q_vertex, merge_budget() - floor);
+  if (q < 0) return false;
+  const Pose end = end_point(e.b);
+  const Pose chord = end - run_start_;
+  const double len = norm(chord);
+  if (len < kMinLength) return false;
+  const Pose dir = (1.0 / len) * chord;
+  double last = 0;
+  const auto inside = [&](const Pose& p) {
+    const Pose rel = p - run_start_;
+    const double t = dot(rel, dir);
+    if (t < last || t > len) return false;
+    last = t;
+    return norm(rel - t * dir) <= q;
+  };
+  for (const Pose& p : run_points_) {
+    if (!inside(p)) return false;
+  }
+  return inside(e.b.base);
+}
+
+void ProgramReader::flush_run() {
+  if (!run_active_) return;
+  run_active_ = false;
+  Element e = run_;
+  if (!run_points_.empty()) {
+    const Pose end = end_point(run_.b);
+    make_line(run_start_, end, e.b);
+    e.b.feed = run_feed_ / 60.0 * feed_length_ratio(run_start_, end, e.b);
+    e.orig_length = e.b.length;
+    double dev = 0;
+    for (const Pose& p : run_points_) {
+      const double t = dot(p - run_start_, e.b.lin);
+      dev = std::max(dev, norm(p - (run_start_ + t * e.b.lin)));
+    }
+    e.merge_deviation = dev + run_floor_;
+  }
+  run_points_.clear();
+  Item it;
+  it.element = e;
+  ready_.push_back(it);
+}
+
+void ProgramReader::push_element(const Element& e) {
+  if (can_extend_run(e)) {
+    run_points_.push_back(e.b.base);
+    run_.b.segment_last = e.b.segment_last;
+    run_.b.base = e.b.base;  // the run's current last line, for end_point()
+    run_.b.lin = e.b.lin;
+    run_.b.length = e.b.length;
+    run_floor_ = std::max(run_floor_, e.merge_deviation);
+    ++merged_;
+    return;
+  }
+  flush_run();
+  const bool mergeable = naive_tolerance_ > 0 && e.mode == canon::MotionControl::Continuous &&
+                         e.b.kind == traj::BlockKind::Line && e.b.feed_class == FeedClass::Feed &&
+                         !e.stop_after;
+  if (mergeable) {
+    run_active_ = true;
+    run_ = e;
+    run_start_ = e.b.base;
+    run_feed_ = program_->feed(e.b.segment_first);
+    run_floor_ = e.merge_deviation;
+    return;
+  }
+  Item it;
+  it.element = e;
+  ready_.push_back(it);
+}
+
+void ProgramReader::read_move(canon::SegmentId id) {
+  ++moves_read_;
+  Element e;
+  if (!make_element(id, e)) return;
+  push_element(e);
+  if (e.stop_after) {  // the controller reads the probe result before anything goes on
+    flush_run();
+    Item it;
+    it.is_marker = true;
+    it.marker.kind = traj::BlockKind::Marker;
+    it.marker.marker = MarkerKind::Sync;
+    it.marker.segment = it.marker.segment_first = it.marker.segment_last = id + 1;
+    it.marker.line = e.b.line;
+    it.marker.context = e.b.context;
+    it.marker.action = static_cast<std::uint32_t>(program_->actions().size());  // none
+    ready_.push_back(it);
+  }
+}
+
+void ProgramReader::read_more() {
+  const std::size_t n = program_->size();
+  if (next_move_ < n) {
+    read_actions_before(static_cast<std::uint32_t>(next_move_));
+    read_move(next_move_++);
+    return;
+  }
+  read_actions_before(static_cast<std::uint32_t>(n));
+  flush_run();
+  if (!ended_) {  // a program without M2/M30 still ends with a stop
+    Item it;
+    it.is_marker = true;
+    it.marker.kind = traj::BlockKind::Marker;
+    it.marker.marker = MarkerKind::ProgramEnd;
+    it.marker.segment = it.marker.segment_first = it.marker.segment_last = n;
+    it.marker.action = static_cast<std::uint32_t>(program_->actions().size());
+    ready_.push_back(it);
+    ended_ = true;
+  }
+  done_ = true;
+}
+
+bool ProgramReader::next(Item& out) {
+  // Keep a run open until something else arrives, so that merging can look ahead.
+  while (ready_.empty() && !done_) read_more();
+  if (ready_.empty()) return false;
+  out = std::move(ready_.front());
+  ready_.pop_front();
+  return true;
+}
+
+}  // namespace opencnc::plan::detail

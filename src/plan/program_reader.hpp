@@ -1,0 +1,85 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Reads a canon::Program in execution order: moves become path elements (with their feed class,
+// nominal speed and modal path-control settings), actions become markers; G64 Q merges
+// nearly collinear feed lines.
+#pragma once
+
+#include <cstdint>
+#include <deque>
+#include <vector>
+
+#include "opencnc/canon/program.hpp"
+#include "opencnc/core/diagnostic.hpp"
+#include "opencnc/plan/machine_limits.hpp"
+#include "opencnc/traj/motion_block.hpp"
+
+namespace opencnc::plan::detail {
+
+/// A programmed move (or a merged run of them) ready for corner processing.
+struct Element {
+  traj::MotionBlock b;         ///< geometry, identity, class, flags, nominal speed
+  double orig_length = 0;      ///< length before any blend trimmed it
+  double merge_deviation = 0;  ///< largest distance of merged vertices from the line
+  canon::MotionControl mode = canon::MotionControl::Continuous;  ///< for the corner at its end
+  double tolerance = 0;                                          ///< G64 P (mm), 0 = none
+  bool stop_after = false;  ///< the motion must stop at its end (probe moves)
+  double junction = 0;      ///< speed limit where it starts (0: from rest, +∞: none)
+};
+
+/// One item of the program in execution order.
+struct Item {
+  bool is_marker = false;
+  Element element;           ///< when !is_marker
+  traj::MotionBlock marker;  ///< when is_marker (position filled in later)
+};
+
+/// Checks every move of `program` against the machine: finite coordinates, configured axes,
+/// positive feeds, valid arcs, supported move kinds. Errors go to `diags` with the move's source
+/// position. Returns true when the program can be planned. Non-real-time.
+bool check_program(const canon::Program& program, const MachineLimits& limits, Diagnostics& diags);
+
+/// Streams the items of a checked program.
+class ProgramReader {
+ public:
+  explicit ProgramReader(const canon::Program& program);
+
+  /// Next item; false after the last one (the program end marker).
+  bool next(Item& out);
+  std::uint64_t moves_read() const noexcept { return moves_read_; }
+  std::uint64_t merged() const noexcept { return merged_; }
+
+ private:
+  void read_more();
+  void read_actions_before(std::uint32_t move);
+  void add_marker(const canon::Action& a, traj::MarkerKind kind);
+  void read_move(canon::SegmentId id);
+  bool make_element(canon::SegmentId id, Element& e) const;
+  void push_element(const Element& e);
+  bool can_extend_run(const Element& e) const;
+  void chord_small_arc(const Pose& start, const Pose& end, double feed, Element& e) const;
+  double merge_budget() const noexcept;
+  void flush_run();
+  std::uint8_t flags() const noexcept;
+
+  const canon::Program* program_;
+  std::size_t next_move_ = 0, next_action_ = 0;
+  bool done_ = false, ended_ = false;
+  std::deque<Item> ready_;
+  std::uint64_t moves_read_ = 0, merged_ = 0;
+
+  // Modal state from the actions read so far.
+  canon::MotionControl mode_ = canon::MotionControl::Continuous;
+  double tolerance_ = 0, naive_tolerance_ = 0;
+  bool override_enabled_ = true, hold_enabled_ = true;
+  double sync_per_rev_ = 0;
+
+  // The run of feed lines being merged (G64 Q).
+  bool run_active_ = false;
+  Element run_;
+  Pose run_start_{};
+  double run_feed_ = 0;
+  double run_floor_ = 0;          ///< largest deviation of a chorded arc in the run
+  std::vector<Pose> run_points_;  ///< inner vertices of the run
+};
+
+}  // namespace opencnc::plan::detail
