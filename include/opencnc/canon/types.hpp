@@ -22,7 +22,8 @@ enum class Plane : std::uint8_t { XY, YZ, XZ, UV, VW, UW };
 /// G93 / G94 / G95.
 enum class FeedMode : std::uint8_t { UnitsPerMinute, InverseTime, UnitsPerRevolution };
 
-/// G61 / G61.1 / G64.
+/// Path control modes: G61 is exact *path* (LinuxCNC's CANON_EXACT_PATH), G61.1 exact *stop*
+/// (CANON_EXACT_STOP), G64 continuous with a tolerance.
 enum class MotionControl : std::uint8_t { ExactStop, ExactPath, Continuous };
 
 enum class FeedReference : std::uint8_t { Workpiece, Xyz };
