@@ -306,10 +306,39 @@ void Rs274Printer::set_aux_output_value(int index, double value) {
 }
 
 void Rs274Printer::print(std::string_view text) {
-  // rs274 writes (PRINT,...) text straight to stderr, outside the numbered stream.
+  // rs274 prints (PRINT,...) text as a plain line, outside the numbered stream.
   if (print_stream_ == nullptr) return;
+  if (print_stream_ == out_) {
+    buf_.append(text);
+    end_line();
+    return;
+  }
+  flush();
   std::fwrite(text.data(), 1, text.size(), print_stream_);
   std::fputc('\n', print_stream_);
+}
+
+void Rs274Printer::set_tool_table_entry(int index, int tool, const Pose& offset, double /*diameter*/,
+                                        double front_angle, double back_angle, int orientation) {
+  // rs274 leaves the diameter out of this line.
+  prefix();
+  buf_.append("SET_TOOL_TABLE_ENTRY(");
+  integer(index);
+  buf_.append(", ");
+  integer(tool);
+  buf_.append(", ");
+  for (int i = 0; i < 9; ++i) {
+    if (i > 0) buf_.push_back(' ');
+    num(offset[i]);
+  }
+  buf_.append(", ");
+  num(front_angle);
+  buf_.append(", ");
+  num(back_angle);
+  buf_.append(", ");
+  integer(orientation);
+  buf_.push_back(')');
+  end_line();
 }
 
 }  // namespace opencnc::canon

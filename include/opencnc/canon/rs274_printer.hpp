@@ -11,10 +11,11 @@ namespace opencnc::canon {
 
 /// Writes `    7 N..... STRAIGHT_FEED(1.0000, ...)` lines, byte-compatible with LinuxCNC 2.9's
 /// standalone interpreter, to a FILE (buffered internally; call flush() at the end).
-/// `(PRINT,...)` text goes to `print_stream` (stderr in rs274). Non-real-time.
+/// `(PRINT,...)` text goes to `print_stream` unnumbered; rs274 writes it to stdout, in order
+/// with the calls (pass the same stream as `out` for that). Non-real-time.
 class Rs274Printer final : public Sink {
  public:
-  explicit Rs274Printer(std::FILE* out, std::FILE* print_stream = stderr);
+  explicit Rs274Printer(std::FILE* out, std::FILE* print_stream = stdout);
   ~Rs274Printer() override;
   Rs274Printer(const Rs274Printer&) = delete;
   Rs274Printer& operator=(const Rs274Printer&) = delete;
@@ -60,6 +61,8 @@ class Rs274Printer final : public Sink {
   void change_tool(int tool) override { indexed("CHANGE_TOOL(", tool); }
   void change_tool_number(int tool) override { indexed("CHANGE_TOOL_NUMBER(", tool); }
   void use_tool_length_offset(const Pose& offset) override;
+  void set_tool_table_entry(int index, int tool, const Pose& offset, double diameter, double front_angle,
+                            double back_angle, int orientation) override;
 
   void mist_on() override { simple("MIST_ON()"); }
   void mist_off() override { simple("MIST_OFF()"); }
