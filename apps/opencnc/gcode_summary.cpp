@@ -131,11 +131,12 @@ struct Totals {
 Totals measure(const canon::Program& prog) {
   Totals t;
   if (prog.empty()) return t;
-  const Pose s0 = prog.start();
-  t.box.add(s0[0], s0[1], s0[2]);
-  for (canon::SegmentId id = 0; id < prog.size(); ++id) {
+  Pose s = prog.start();
+  t.box.add(s[0], s[1], s[2]);
+  Pose e;
+  for (canon::SegmentId id = 0; id < prog.size(); ++id, s = e) {
     const canon::Move& m = prog.move(id);
-    const Pose s = prog.start_of(id), e = prog.end(id);
+    e = prog.end(id);
     double len;
     if (m.kind == canon::MoveKind::Arc) {
       const canon::ArcGeometry& g = prog.arc(id);

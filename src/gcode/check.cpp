@@ -105,6 +105,12 @@ void Engine::check_other_codes() {
   const bool user_m = b.m[kGroupUser] != -1;
   const bool lathe = is_lathe_cycle(motion);
   if (user_m) return;   // user M codes take any words
+  // Most blocks carry axis words and F/S only: none of the rules below can apply.
+  constexpr auto bit = [](char c) { return 1u << (c - 'a'); };
+  constexpr std::uint32_t kRuledWords = bit('d') | bit('e') | bit('h') | bit('i') | bit('j') | bit('k') | bit('l') |
+                                        bit('p') | bit('q') | bit('r');
+  if ((b.words & kRuledWords) == 0 && !is_cycle(motion) && g14 != 960 && motion != 330 && motion != 331 && motion != 760)
+    return;
   for (char c : {'a', 'b', 'c'}) {
     if (b.has(c) && is_cycle(motion)) fail(ErrorCode::UnusedWord, "{} word in a canned cycle", static_cast<char>(c - 32));
   }

@@ -38,6 +38,7 @@ void Engine::execute_block() {
 }
 
 void Engine::convert_m() {
+  if (block_.m_count == 0) return;
   convert_io();
   convert_tool_change_group();
   convert_spindle_group();

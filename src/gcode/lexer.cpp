@@ -2,6 +2,7 @@
 // Blank removal, lower-casing and comment checks on one line of G-code.
 #include "lexer.hpp"
 
+#include <array>
 #include <cstring>
 
 #include "gcode_error.hpp"
@@ -20,30 +21,53 @@ std::string_view trim_raw_line(std::string_view raw) noexcept {
   return raw;
 }
 
+namespace {
+// Normalisation of a byte outside comments: the byte it becomes and whether it is kept.
+// (', ';' and NUL stop the fast loop; NUL never reaches here, trim_raw_line cut it.)
+struct CharMap {
+  std::array<char, 256> to{};
+  std::array<unsigned char, 256> keep{};
+  std::array<unsigned char, 256> stop{};
+};
+constexpr CharMap make_map() {
+  CharMap m;
+  for (int c = 0; c < 256; ++c) {
+    m.to[static_cast<std::size_t>(c)] = static_cast<char>(c >= 'A' && c <= 'Z' ? c + ('a' - 'A') : c);
+    m.keep[static_cast<std::size_t>(c)] = (c == ' ' || c == '\t' || c == '\r') ? 0 : 1;
+  }
+  m.stop[static_cast<unsigned char>('(')] = 1;
+  m.stop[static_cast<unsigned char>(';')] = 1;
+  return m;
+}
+constexpr CharMap kMap = make_map();
+}  // namespace
+
 std::size_t normalize_line(std::string_view raw, char* out) {
   std::size_t n = 0;
-  bool in_comment = false;
-  for (std::size_t i = 0; i < raw.size(); ++i) {
-    const char c = raw[i];
-    if (!in_comment && c == ';') {
-      // Everything after ';' is a comment and kept verbatim.
-      std::memcpy(out + n, raw.data() + i, raw.size() - i);
-      return n + (raw.size() - i);
-    }
-    if (in_comment) {
-      if (c == '(') fail_at(static_cast<int>(n), ErrorCode::NestedComment, "'(' inside a comment (comments do not nest)");
-      out[n++] = c;
-      if (c == ')') in_comment = false;
-    } else if (c == ' ' || c == '\t' || c == '\r') {
+  const std::size_t size = raw.size();
+  for (std::size_t i = 0; i < size; ++i) {
+    const auto u = static_cast<unsigned char>(raw[i]);
+    if (!kMap.stop[u]) {
+      // Branch-free: letters, digits and blanks alternate unpredictably in G-code.
+      out[n] = kMap.to[u];
+      n += kMap.keep[u];
       continue;
-    } else if (c >= 'A' && c <= 'Z') {
-      out[n++] = static_cast<char>(c + ('a' - 'A'));
-    } else {
-      if (c == '(') in_comment = true;
-      out[n++] = c;
+    }
+    if (u == ';') {
+      // Everything after ';' is a comment and kept verbatim.
+      std::memcpy(out + n, raw.data() + i, size - i);
+      return n + (size - i);
+    }
+    // A ( ) comment: copied as is; '(' may not appear inside it.
+    out[n++] = '(';
+    for (++i;; ++i) {
+      if (i >= size) fail(ErrorCode::UnclosedComment, "comment opened with '(' is not closed on this line");
+      const char d = raw[i];
+      if (d == '(') fail_at(static_cast<int>(n), ErrorCode::NestedComment, "'(' inside a comment (comments do not nest)");
+      out[n++] = d;
+      if (d == ')') break;
     }
   }
-  if (in_comment) fail(ErrorCode::UnclosedComment, "comment opened with '(' is not closed on this line");
   return n;
 }
 

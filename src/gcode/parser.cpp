@@ -270,15 +270,38 @@ void Parser::read_word(Cursor& c, Block& b, char letter) {
   b.words |= 1u << (letter - 'a');
 }
 
+// A plain code like "1", "17.1" or "64" read directly (code ten times the number), as the
+// general path below would read it; -1 when the text has any other form.
+int Parser::plain_code(Cursor& c) noexcept {
+  const std::string_view t = c.text;
+  std::size_t i = c.pos;
+  int code = 0;
+  const std::size_t first = i;
+  while (i < t.size() && is_digit(t[i]) && i - first < 2) code = code * 10 + (t[i++] - '0');
+  if (i == first) return -1;
+  code *= 10;
+  if (i < t.size() && t[i] == '.') {
+    if (i + 1 >= t.size() || !is_digit(t[i + 1])) return -1;
+    code += t[i + 1] - '0';
+    i += 2;
+  }
+  if (i < t.size() && (is_digit(t[i]) || t[i] == '.')) return -1;
+  c.pos = i;
+  return code;
+}
+
 void Parser::read_g(Cursor& c, Block& b) {
   const int pos = static_cast<int>(c.pos);
   ++c.pos;
-  const double v10 = 10.0 * real_value(c);
-  int code = static_cast<int>(std::floor(v10));
-  if (v10 - code > 0.999) code = static_cast<int>(std::ceil(v10));
-  else if (v10 - code > 0.001) fail_at(pos, ErrorCode::GCodeOutOfRange, "G{} is not a G code (at most one decimal)", v10 / 10.0);
-  if (code > 999 || !(v10 < 1e4)) fail_at(pos, ErrorCode::GCodeOutOfRange, "G{} is out of range", v10 / 10.0);
-  if (code < 0) fail_at(pos, ErrorCode::GCodeOutOfRange, "G code must not be negative");
+  int code = plain_code(c);
+  if (code < 0) {
+    const double v10 = 10.0 * real_value(c);
+    code = static_cast<int>(std::floor(v10));
+    if (v10 - code > 0.999) code = static_cast<int>(std::ceil(v10));
+    else if (v10 - code > 0.001) fail_at(pos, ErrorCode::GCodeOutOfRange, "G{} is not a G code (at most one decimal)", v10 / 10.0);
+    if (code > 999 || !(v10 < 1e4)) fail_at(pos, ErrorCode::GCodeOutOfRange, "G{} is out of range", v10 / 10.0);
+    if (code < 0) fail_at(pos, ErrorCode::GCodeOutOfRange, "G code must not be negative");
+  }
   const int group = g_group(code);
   if (group < 0) {
     if (code % 10) fail_at(pos, ErrorCode::UnknownGCode, "G{}.{} is not a known G code", code / 10, code % 10);
@@ -354,41 +377,79 @@ double Parser::real_value(Cursor& c) {
   } else if (ch >= 'a' && ch <= 'z') {
     v = unary(c);
   } else {
-    v = real_number(c);
+    return real_number(c);   // finite: no exponent, and overlong digit strings are refused
   }
   if (std::isnan(v)) fail_at(pos, ErrorCode::NotANumber, "the calculation gives 'not a number'");
   if (std::isinf(v)) fail_at(pos, ErrorCode::Infinity, "the calculation gives infinity");
   return v;
 }
 
+namespace {
+
+// Reads digits from p (not past `limit`) into `value`, which wraps after 19 digits (callers
+// only use it for short numbers). Returns the end.
+const char* read_digits(const char* p, const char* limit, std::uint64_t& value) noexcept {
+  while (p < limit && is_digit(*p)) value = value * 10 + static_cast<std::uint64_t>(*p++ - '0');
+  return p;
+}
+
+}  // namespace
+
 double Parser::real_number(Cursor& c) {
-  const std::size_t start = c.pos;
-  std::size_t i = start;
-  while (i < c.text.size() && (c.text[i] == '+' || c.text[i] == '-')) ++i;
-  const std::size_t signs = i - start;
-  const std::size_t mant = i;
-  while (i < c.text.size() && (is_digit(c.text[i]) || c.text[i] == '.')) ++i;
-  c.pos = i;
-  const std::string_view span = c.text.substr(start, i - start);
-  // Mantissa: digits, at most one '.', at least one digit.
-  std::size_t k = mant, digits = 0;
-  while (k < i && is_digit(c.text[k])) ++k, ++digits;
-  if (k < i && c.text[k] == '.') {
-    ++k;
-    while (k < i && is_digit(c.text[k])) ++k, ++digits;
+  const char* const text = c.text.data();
+  const char* const limit = text + c.text.size();
+  const char* const start = text + c.pos;
+  const char* p = start;
+  while (p < limit && (*p == '+' || *p == '-')) ++p;
+  const auto signs = p - start;
+  const char* const mant = p;
+  // Mantissa: digits, at most one '.', at least one digit. Accumulated on the way for the
+  // common short number (exact below 2^53 with at most 22 decimals: one correctly rounded
+  // division gives the same double as any correct conversion).
+  std::uint64_t value = 0;
+  const char* const int_end = read_digits(p, limit, value);
+  const char* end = int_end;   // end of the mantissa
+  std::ptrdiff_t decimals = 0;
+  if (end < limit && *end == '.') {
+    end = read_digits(end + 1, limit, value);
+    decimals = end - (int_end + 1);
   }
-  if (signs > 1 || digits == 0)
-    fail_at(static_cast<int>(start), ErrorCode::BadNumber, "'{}' is not a number", span);
-  if (k < i) fail_at(static_cast<int>(start), ErrorCode::BadNumber, "'{}' is not a number (extra characters after it)", span);
-  double v = 0;
-  const auto [ptr, ec] = std::from_chars(c.text.data() + mant, c.text.data() + k, v);
-  if (ec != std::errc() || ptr != c.text.data() + k)
-    fail_at(static_cast<int>(start), ErrorCode::BadNumber, "'{}' is not a number", span);
-  return (signs == 1 && c.text[start] == '-') ? -v : v;
+  const auto digits = (int_end - mant) + decimals;
+  const char* after = end;
+  while (after < limit && (is_digit(*after) || *after == '.')) ++after;
+  c.pos = static_cast<std::size_t>(after - text);
+  if (signs > 1 || digits == 0 || end < after) bad_number(start, after, text, digits == 0 || signs > 1);
+  static constexpr double kPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8,  1e9,  1e10, 1e11,
+                                      1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+  double v;
+  if (digits <= 15 && decimals <= 22) {
+    v = static_cast<double>(value) / kPow10[decimals];
+  } else {   // `value` may have wrapped: let the library convert
+    const auto [ptr, ec] = std::from_chars(mant, end, v);
+    if (ec != std::errc() || ptr != end) bad_number(start, after, text, true);
+  }
+  return (signs == 1 && *start == '-') ? -v : v;
+}
+
+void Parser::bad_number(const char* start, const char* after, const char* text, bool malformed) {
+  const std::string_view span(start, static_cast<std::size_t>(after - start));
+  const auto at = static_cast<int>(start - text);
+  if (malformed) fail_at(at, ErrorCode::BadNumber, "'{}' is not a number", span);
+  fail_at(at, ErrorCode::BadNumber, "'{}' is not a number (extra characters after it)", span);
 }
 
 int Parser::integer_value(Cursor& c) {
   const int pos = static_cast<int>(c.pos);
+  {
+    // Fast path: up to nine plain digits, the common "M3" or "T12".
+    std::size_t i = c.pos;
+    int v = 0;
+    while (i < c.text.size() && is_digit(c.text[i]) && i - c.pos < 9) v = v * 10 + (c.text[i++] - '0');
+    if (i > c.pos && (i >= c.text.size() || (!is_digit(c.text[i]) && c.text[i] != '.'))) {
+      c.pos = i;
+      return v;
+    }
+  }
   const double v = real_value(c);
   if (!(std::fabs(v) < 2147483647.0)) fail_at(pos, ErrorCode::NotAnInteger, "{} is too large for a whole number", v);
   int i = static_cast<int>(std::floor(v));

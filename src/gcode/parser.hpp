@@ -73,7 +73,9 @@ class Parser {
 
   double real_value(Cursor& c);
   int integer_value(Cursor& c);
+  static int plain_code(Cursor& c) noexcept;
   double real_number(Cursor& c);
+  [[noreturn, gnu::cold]] static void bad_number(const char* start, const char* after, const char* text, bool malformed);
   double expression(Cursor& c);
   double parameter(Cursor& c, bool exists_only);
   double unary(Cursor& c);
