@@ -11,6 +11,7 @@
 #include "gcode_summary.hpp"
 #include "opencnc/canon/rs274_printer.hpp"
 #include "opencnc/gcode/interpreter.hpp"
+#include "opencnc/gcode/rs274_driver.hpp"
 
 namespace opencnc::cli {
 
@@ -81,18 +82,7 @@ int run_canon(const std::string& file, const InterpArgs& args) {
     return kExitUsage;
   }
   canon::Rs274Printer printer(stdout, stdout);
-  // rs274 prints ON_RESET once after start-up and twice at the end (its driver's resets).
-  if (interp.start(printer) == gcode::RunStatus::Error) {
-    printer.flush();
-    print_diagnostics(interp.diagnostics());
-    return kExitProgram;
-  }
-  printer.begin_block(canon::BlockOrigin{});
-  printer.on_reset();
-  const gcode::RunStatus status = interp.run(printer);
-  printer.begin_block(canon::BlockOrigin{});
-  printer.on_reset();
-  printer.on_reset();
+  const gcode::RunStatus status = gcode::run_like_rs274(interp, printer);
   printer.flush();
   print_diagnostics(interp.diagnostics());
   return status == gcode::RunStatus::Error ? kExitProgram : kExitOk;

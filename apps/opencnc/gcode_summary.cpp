@@ -172,8 +172,9 @@ void print_box(const char* name, const Box& b) {
     std::printf("%-22s (no motion)\n", name);
     return;
   }
-  std::printf("%-22s X %.4f .. %.4f  Y %.4f .. %.4f  Z %.4f .. %.4f\n", name, b.lo[0], b.hi[0], b.lo[1], b.hi[1],
-              b.lo[2], b.hi[2]);
+  // (+ 0.0 turns a negative zero into zero: "-0.0000" would puzzle the reader)
+  std::printf("%-22s X %.4f .. %.4f  Y %.4f .. %.4f  Z %.4f .. %.4f\n", name, b.lo[0] + 0.0, b.hi[0] + 0.0,
+              b.lo[1] + 0.0, b.hi[1] + 0.0, b.lo[2] + 0.0, b.hi[2] + 0.0);
 }
 
 }  // namespace

@@ -268,7 +268,7 @@ void Engine::o_elseif() {
   const LabelInfo* l = find_label(block_.o_name);
   if (l == nullptr) fail(ErrorCode::LabelUndefined, "elseif with no 'o{} if' before it", plain(block_.o_name));
   if (l->kind != LabelKind::If)
-    fail(ErrorCode::LabelMismatch, "elseif for o{}, which is a '{}' (line {})", plain(block_.o_name), kind_name(l->kind), l->at.line);
+    fail(ErrorCode::LabelMismatch, "elseif for o{} does not match its '{}' on line {}", plain(block_.o_name), kind_name(l->kind), l->at.line);
   if (c.executed_if) {
     c.skipping_to = block_.o_name;
     c.skip_start_line = line_;
@@ -285,7 +285,7 @@ void Engine::o_else() {
   const LabelInfo* l = find_label(block_.o_name);
   if (l == nullptr) fail(ErrorCode::LabelUndefined, "else with no 'o{} if' before it", plain(block_.o_name));
   if (l->kind != LabelKind::If)
-    fail(ErrorCode::LabelMismatch, "else for o{}, which is a '{}' (line {})", plain(block_.o_name), kind_name(l->kind), l->at.line);
+    fail(ErrorCode::LabelMismatch, "else for o{} does not match its '{}' on line {}", plain(block_.o_name), kind_name(l->kind), l->at.line);
   if (c.executed_if) {
     c.skipping_to = block_.o_name;
     c.skip_start_line = line_;
@@ -302,7 +302,7 @@ void Engine::o_endif() {
   const LabelInfo* l = find_label(block_.o_name);
   if (l == nullptr) fail(ErrorCode::LabelUndefined, "endif with no 'o{} if' before it", plain(block_.o_name));
   if (l->kind != LabelKind::If)
-    fail(ErrorCode::LabelMismatch, "endif for o{}, which is a '{}' (line {})", plain(block_.o_name), kind_name(l->kind), l->at.line);
+    fail(ErrorCode::LabelMismatch, "endif for o{} does not match its '{}' on line {}", plain(block_.o_name), kind_name(l->kind), l->at.line);
   c.skipping_to.clear();
   c.executed_if = true;
 }
@@ -313,7 +313,7 @@ void Engine::o_break_continue(bool is_break) {
   const LabelInfo* l = find_label(block_.o_name);
   if (l == nullptr) fail(ErrorCode::LabelUndefined, "{} with no loop o{} around it", what, plain(block_.o_name));
   if (l->kind != LabelKind::While && l->kind != LabelKind::Do)
-    fail(ErrorCode::LabelMismatch, "{} for o{}, which is a '{}' (line {})", what, plain(block_.o_name), kind_name(l->kind),
+    fail(ErrorCode::LabelMismatch, "{} for o{} does not match its '{}' on line {}", what, plain(block_.o_name), kind_name(l->kind),
          l->at.line);
   if (!is_break && c.skipping_to == block_.o_name) return;
   c.skipping_to = block_.o_name;
@@ -328,7 +328,7 @@ void Engine::o_end_loop() {
   const LabelInfo* l = find_label(block_.o_name);
   if (l == nullptr) fail(ErrorCode::LabelUndefined, "{} with no loop o{} before it", repeat ? "endrepeat" : "endwhile", plain(block_.o_name));
   if ((repeat && l->kind != LabelKind::Repeat) || (!repeat && l->kind != LabelKind::While))
-    fail(ErrorCode::LabelMismatch, "{} for o{}, which is a '{}' (line {})", repeat ? "endrepeat" : "endwhile",
+    fail(ErrorCode::LabelMismatch, "{} for o{} does not match its '{}' on line {}", repeat ? "endrepeat" : "endwhile",
          plain(block_.o_name), kind_name(l->kind), l->at.line);
   if (c.skipping_to == block_.o_name) {
     c.skipping_to.clear();
