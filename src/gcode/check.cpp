@@ -63,12 +63,14 @@ void Engine::check_block() {
   if (block_.m_count > 4) fail(ErrorCode::TooManyMCodes, "more than four M codes in one block");
   check_other_codes();
   if (ext_ == nullptr) return;
-  for (int group = 0; group < kGGroupCount; ++group) {
-    const int code = block_.g[static_cast<std::size_t>(group)];
-    if (code >= 0 && ext_->g[static_cast<std::size_t>(code)]) ext_->g[static_cast<std::size_t>(code)]->check(block_, code, st_);
-  }
-  if (block_.motion >= 0 && block_.motion != block_.g[kGroupMotion] && ext_->g[static_cast<std::size_t>(block_.motion)])
-    ext_->g[static_cast<std::size_t>(block_.motion)]->check(block_, block_.motion, st_);
+  for (int group = 0; group < kGGroupCount; ++group) check_extension(block_.g[static_cast<std::size_t>(group)]);
+  if (block_.motion != block_.g[kGroupMotion]) check_extension(block_.motion);
+}
+
+void Engine::check_extension(int code) {
+  if (code < 0 || !ext_->g[static_cast<std::size_t>(code)]) return;
+  if (auto problem = ext_->g[static_cast<std::size_t>(code)]->check(block_, code, st_))
+    fail(problem->code, "{}", problem->message);
 }
 
 void Engine::check_g_codes() {

@@ -93,6 +93,7 @@ class Engine final : public ParamHost, public ExecContext {
   void check_block();
   void check_g_codes();
   void check_other_codes();
+  void check_extension(int code);
 
   // execute.cpp: order of execution within a block
   void execute_block();

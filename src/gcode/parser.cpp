@@ -637,7 +637,7 @@ void Parser::read_o_word(Cursor& c, Block& b) {
       return;
     case OWord::EndSub:
     case OWord::Return:
-      if (skipping_other) return;
+      if (skipping_other || env.defining_sub) return;   // values are evaluated when run
       if (c.at() == '[') {
         b.o_value = expression(c);
         b.o_has_value = true;

@@ -7,6 +7,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "opencnc/canon/sink.hpp"
@@ -57,9 +58,17 @@ class ExecContext {
 class CodeHandler {
  public:
   virtual ~CodeHandler() = default;
+  /// A problem found by check().
+  struct Rejection {
+    ErrorCode code;
+    std::string message;
+  };
   /// Checks of the block's words that LinuxCNC makes while reading (before anything
-  /// executes); the default accepts every block.
-  virtual void check(const Block& /*block*/, int /*code*/, const InterpState& /*state*/) {}
+  /// executes). Returns the problem, which ends the run as a G-code error on the block;
+  /// the default accepts every block.
+  virtual std::optional<Rejection> check(const Block& /*block*/, int /*code*/, const InterpState& /*state*/) const {
+    return std::nullopt;
+  }
   virtual void execute(ExecContext& ctx, const Block& block, int code) = 0;
 };
 
