@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "engine.hpp"
+#include "numeric.hpp"
 
 namespace opencnc::gcode {
 
@@ -11,7 +12,8 @@ namespace {
 
 bool is_cycle(int motion) noexcept { return motion == 730 || motion == 740 || (motion >= 810 && motion <= 890); }
 bool is_lathe_cycle(int motion) noexcept { return motion >= 700 && motion <= 722; }
-int round_to_int(double x) noexcept { return static_cast<int>(x < 0.0 ? x - 0.5 : x + 0.5); }
+// Where a word starts, for the column of an error about it.
+int word_at(const Block& b, char letter) noexcept { return b.at[static_cast<std::size_t>(letter - 'a')]; }
 
 }  // namespace
 
@@ -82,7 +84,7 @@ void Engine::check_g_codes() {
     if (mode1 == 20 || mode1 == 30) fail(ErrorCode::MissingWord, "G4 cannot share a block with G2/G3 (both use P)");
   } else if (mode0 == 100) {
     const double p = b.p_or(-1.0);
-    const int p_int = p >= 0 ? static_cast<int>(p + 0.5) : static_cast<int>(p - 0.5);
+    const int p_int = round_to_int(p);
     const int l = b.has('l') ? static_cast<int>(b.get('l')) : -1;
     if (l != 1 && l != 2 && l != 10 && l != 11 && l != 20)
       fail(ErrorCode::G10Usage, "G10 needs L1, L2, L10, L11 or L20");
@@ -114,52 +116,52 @@ void Engine::check_other_codes() {
   if ((b.words & kRuledWords) == 0 && !is_cycle(motion) && g14 != 960 && motion != 330 && motion != 331 && motion != 760)
     return;
   for (char c : {'a', 'b', 'c'}) {
-    if (b.has(c) && is_cycle(motion)) fail(ErrorCode::UnusedWord, "{} word in a canned cycle", static_cast<char>(c - 32));
+    if (b.has(c) && is_cycle(motion)) fail_at(word_at(b, c), ErrorCode::UnusedWord, "{} word in a canned cycle", static_cast<char>(c - 32));
   }
   if (b.has('d') && g7 != 410 && g7 != 420 && g7 != 411 && g7 != 421 && g14 != 960 && !lathe)
-    fail(ErrorCode::UnusedWord, "D word with no G41, G41.1, G42, G42.1, G7x or G96 to use it");
+    fail_at(word_at(b, 'd'), ErrorCode::UnusedWord, "D word with no G41, G41.1, G42, G42.1, G7x or G96 to use it");
   if (b.has('e') && motion != 760 && motion != 700 && m5 != 66 && m5 != 67 && m5 != 68)
-    fail(ErrorCode::UnusedWord, "E word with no G70, G76, M66, M67 or M68 to use it");
+    fail_at(word_at(b, 'e'), ErrorCode::UnusedWord, "E word with no G70, G76, M66, M67 or M68 to use it");
   if (b.has('h') && g8 != 430 && motion != 760 && g8 != 432)
-    fail(ErrorCode::UnusedWord, "H word with no G43, G43.2 or G76 to use it");
+    fail_at(word_at(b, 'h'), ErrorCode::UnusedWord, "H word with no G43, G43.2 or G76 to use it");
   const bool arcish = motion == 20 || motion == 30 || motion == 50 || motion == 51 || motion == 760 || motion == 870;
   if (b.has('i') && !arcish && motion != 331 && g0 != 100 && !lathe)
-    fail(ErrorCode::UnusedWord, "I word with no G2, G3, G5, G5.1, G10, G33.1, G76 or G87 to use it");
+    fail_at(word_at(b, 'i'), ErrorCode::UnusedWord, "I word with no G2, G3, G5, G5.1, G10, G33.1, G76 or G87 to use it");
   if (b.has('j') && !arcish && g0 != 100 && !lathe)
-    fail(ErrorCode::UnusedWord, "J word with no G2, G3, G5, G5.1, G10, G76 or G87 to use it");
+    fail_at(word_at(b, 'j'), ErrorCode::UnusedWord, "J word with no G2, G3, G5, G5.1, G10, G76 or G87 to use it");
   if (b.has('k') && motion != 20 && motion != 30 && motion != 330 && motion != 331 && motion != 760 && motion != 870 && !lathe)
-    fail(ErrorCode::UnusedWord, "K word with no G2, G3, G33, G33.1, G76 or G87 to use it");
+    fail_at(word_at(b, 'k'), ErrorCode::UnusedWord, "K word with no G2, G3, G33, G33.1, G76 or G87 to use it");
   if (b.has('l') && !(motion >= 810 && motion <= 890) && motion != 760 && motion != 52 && motion != 730 && motion != 740 &&
       !lathe && g0 != 100 && g7 != 410 && g7 != 411 && g7 != 420 && g7 != 421 && m5 != 66)
-    fail(ErrorCode::UnusedWord, "L word with no G10, cutter compensation, canned cycle, M66 or NURBS code to use it");
+    fail_at(word_at(b, 'l'), ErrorCode::UnusedWord, "L word with no G10, cutter compensation, canned cycle, M66 or NURBS code to use it");
   if (b.has('p')) {
     if (g0 != 100 && g0 != 40 && g13 != 640 && motion != 760 && motion != 820 && motion != 860 && motion != 880 &&
         motion != 890 && motion != 50 && motion != 52 && motion != 20 && motion != 30 && !lathe && motion != 740 &&
         motion != 840 && !(m9 >= 50 && m9 <= 53) && !(m5 >= 62 && m5 <= 66) && m7 != 19)
-      fail(ErrorCode::UnusedWord, "P word with no G2, G3, G4, G10, G64, G5, G5.2, G76, G82, G86, G88, G89 or "
+      fail_at(word_at(b, 'p'), ErrorCode::UnusedWord, "P word with no G2, G3, G4, G10, G64, G5, G5.2, G76, G82, G86, G88, G89 or "
                                   "M50-M53, M62-M66 to use it");
     const double p = b.get('p');
     const int p_value = round_to_int(p);
     if ((motion == 20 || motion == 30 || m7 == 19) && std::fabs(p_value - p) > 0.001)
-      fail(ErrorCode::BadWordValue, "P must be a whole number with G2, G3 and M19");
-    if (m7 == 19 && (p_value > 2 || p_value < 0)) fail(ErrorCode::BadWordValue, "P must be 0, 1 or 2 with M19");
-    if ((motion == 20 || motion == 30) && p_value < 1) fail(ErrorCode::BadWordValue, "P (turns) must be 1 or more with G2/G3");
+      fail_at(word_at(b, 'p'), ErrorCode::BadWordValue, "P must be a whole number with G2, G3 and M19");
+    if (m7 == 19 && (p_value > 2 || p_value < 0)) fail_at(word_at(b, 'p'), ErrorCode::BadWordValue, "P must be 0, 1 or 2 with M19");
+    if ((motion == 20 || motion == 30) && p_value < 1) fail_at(word_at(b, 'p'), ErrorCode::BadWordValue, "P (turns) must be 1 or more with G2/G3");
   }
   if (b.has('q') && b.get('q') != -1.0) {
     if (motion != 830 && motion != 730 && motion != 50 && !lathe && motion != 760 && m5 != 66 && m5 != 67 && m5 != 68 &&
         g0 != 100 && m6 != 61 && g13 != 640 && m7 != 19)
-      fail(ErrorCode::UnusedWord, "Q word with no G5, G10, G64, G73, G76, G83, M19, M61, M66, M67 or M68 to use it");
+      fail_at(word_at(b, 'q'), ErrorCode::UnusedWord, "Q word with no G5, G10, G64, G73, G76, G83, M19, M61, M66, M67 or M68 to use it");
   }
   if (b.has('r')) {
     if (motion != 20 && motion != 30 && motion != 760 && !(motion >= 810 && motion <= 890) && motion != 730 && !lathe &&
         motion != 740 && g7 != 411 && g7 != 421 && g0 != 100 && m7 != 19)
-      fail(ErrorCode::UnusedWord, "R word with no G code that uses it");
-    if (m7 == 19 && (b.get('r') > 360.0 || b.get('r') < 0.0)) fail(ErrorCode::BadWordValue, "R must be within 0..360 with M19");
+      fail_at(word_at(b, 'r'), ErrorCode::UnusedWord, "R word with no G code that uses it");
+    if (m7 == 19 && (b.get('r') > 360.0 || b.get('r') < 0.0)) fail_at(word_at(b, 'r'), ErrorCode::BadWordValue, "R must be within 0..360 with M19");
   }
   if (!b.has('s') && g14 == 960) fail(ErrorCode::MissingWord, "G96 needs an S word (surface speed)");
   if (motion == 330 || motion == 331) {
     if (!b.has('k')) fail(ErrorCode::MissingWord, "G33/G33.1 need a K word (distance per revolution)");
-    if (b.has('f')) fail(ErrorCode::UnusedWord, "F word cannot be used with G33/G33.1");
+    if (b.has('f')) fail_at(word_at(b, 'f'), ErrorCode::UnusedWord, "F word cannot be used with G33/G33.1");
   }
   if (motion == 760) {
     if (b.p_or(-1.0) == -1.0) fail(ErrorCode::MissingWord, "G76 needs a P word (pitch)");

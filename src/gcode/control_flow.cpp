@@ -5,11 +5,11 @@
 #include <cmath>
 
 #include "engine.hpp"
+#include "numeric.hpp"
 
 namespace opencnc::gcode {
 
 namespace {
-int round_to_int(double x) noexcept { return static_cast<int>(x < 0.0 ? x - 0.5 : x + 0.5); }
 
 const char* kind_name(LabelKind k) noexcept {
   switch (k) {

@@ -81,6 +81,7 @@ void Engine::jump_to(const SourcePosition& pos) {
 
 void Engine::start() {
   started_ = true;
+  if (opt_.dialect != Dialect::LinuxCnc) fail(ErrorCode::Unsupported, "the Fanuc dialect is not supported yet");
   out_.set_origin(canon::BlockOrigin{});
   // The canonical setup LinuxCNC's interpreter makes when it initialises.
   const int system = st_.modal.coord_system;
@@ -315,6 +316,25 @@ void Engine::report(const GcodeError& e) {
   }
   const std::string file = line_file_ < sources_->file_count() ? sources_->file(line_file_) : std::string();
   diags_.error(file, line_, line_ == 0 ? 0 : col, e.message(), std::string(error_id(e.code())));
+}
+
+void Engine::warn_once(bool& done, ErrorCode code, std::string_view message) {
+  if (done) return;
+  done = true;
+  const std::size_t first = raw_.find_first_not_of(" \t");
+  const auto col = first == std::string::npos ? 1u : static_cast<std::uint32_t>(first + 1);
+  const std::string file = line_file_ < sources_->file_count() ? sources_->file(line_file_) : std::string();
+  diags_.warning(file, line_, col, std::string(message), std::string(error_id(code)));
+}
+
+// Habits of a program that LinuxCNC accepts but a preflight should point out (once each).
+void Engine::check_motion_habits(bool feed) {
+  if (in_mdi_) return;
+  if (!units_programmed_)
+    warn_once(warned_units_, ErrorCode::UnitsNotProgrammed,
+              "motion before any G20/G21: the program relies on the machine's default units");
+  if (feed && st_.modal.spindle == canon::SpindleDirection::Stopped)
+    warn_once(warned_spindle_, ErrorCode::FeedWithSpindleStopped, "feed move while the spindle is stopped");
 }
 
 // --- sync points --------------------------------------------------------------------------

@@ -81,6 +81,8 @@ class Engine final : public ParamHost, public ExecContext {
   bool read_line();
   bool process_line();
   void report(const GcodeError& e);
+  void warn_once(bool& done, ErrorCode code, std::string_view message);
+  void check_motion_habits(bool feed);
   void set_origin_from_line();
   SourceFile& current_file();
   void jump_to(const SourcePosition& pos);
@@ -219,8 +221,10 @@ class Engine final : public ParamHost, public ExecContext {
   std::uint32_t mdi_file_ = 0;
   bool in_mdi_file_ = false;        ///< "<mdi>" is registered in the source map
   std::uint64_t skipped_lines_ = 0; ///< lines passed over while seeking a label
+  bool units_programmed_ = false;   ///< a G20/G21 was met (for the units warning)
+  bool warned_units_ = false;
+  bool warned_spindle_ = false;
   double user_to_program_factor_ = 1.0;
-  double test_value_ = 0;
   std::uint32_t line_ = 0;          ///< line number of the block being executed
   std::uint32_t line_file_ = 0;     ///< its file
   std::uint64_t line_offset_ = 0;   ///< its byte offset

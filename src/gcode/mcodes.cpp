@@ -4,13 +4,10 @@
 #include <cmath>
 
 #include "engine.hpp"
+#include "numeric.hpp"
 #include "lexer.hpp"
 
 namespace opencnc::gcode {
-
-namespace {
-int round_to_int(double x) noexcept { return static_cast<int>(x < 0.0 ? x - 0.5 : x + 0.5); }
-}  // namespace
 
 void Engine::convert_io() {
   const Block& b = block_;
@@ -157,7 +154,7 @@ void Engine::convert_spindle_group() {
     case 19:
       st_.modal.spindle = canon::SpindleDirection::Stopped;
       if (b.has('r') || b.has('p'))
-        out_.orient_spindle(0, b.has('r') ? b.get('r') : 0.0, b.has('p') ? static_cast<int>(b.get('p')) : 0);
+        out_.orient_spindle(0, b.has('r') ? b.get('r') : 0.0, b.has('p') ? trunc_to_int(b.get('p')) : 0);
       if (b.has('q')) {
         if (b.get('q') <= 0.0) fail(ErrorCode::SpindleUsage, "M19 Q (timeout) must be greater than 0");
         out_.wait_spindle_orient_complete(0, b.get('q'));

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "engine.hpp"
+#include "numeric.hpp"
 
 namespace opencnc::gcode {
 
@@ -22,7 +23,6 @@ constexpr double kRadiusToleranceInch = 0.00005;
 constexpr double kRadiusToleranceMm = 0.00005 * 25.4;
 constexpr double kTiny = 1e-12;
 
-int round_to_int(double x) noexcept { return static_cast<int>(x < 0.0 ? x - 0.5 : x + 0.5); }
 
 // Angle in radians swept from (x1,y1) to (x2,y2) about (cx,cy) with LinuxCNC's turn count.
 double find_turn(double x1, double y1, double cx, double cy, int turn, double x2, double y2) {
@@ -198,6 +198,7 @@ void Engine::convert_straight(int motion) {
   }
   st_.modal.motion = motion;
   const Pose end = find_ends(b);
+  check_motion_habits(motion == 10);
   if (motion == 10) inverse_time_straight(end);
   if (st_.modal.cutter_comp != CutterComp::Off && st_.modal.comp_radius > 0.0 && b.g[kGroupNonModal] == 530)
     fail(ErrorCode::G53Usage, "G53 cannot be used while cutter compensation is on");
@@ -274,6 +275,7 @@ void Engine::convert_arc(int motion) {
     if (missing) fail(ErrorCode::ArcEndpointMissing, "radius-format arc needs an end point in the plane (full circles need I/J/K)");
   }
   const Pose end = find_ends(b);
+  check_motion_habits(true);
   st_.modal.motion = motion;
   // Plane axes: first, second, normal.
   int a1 = 0, a2 = 1, a3 = 2;

@@ -4,13 +4,14 @@
 #include <cmath>
 
 #include "engine.hpp"
+#include "numeric.hpp"
 
 namespace opencnc::gcode {
 
 namespace {
 bool linear(int axis) noexcept { return !is_rotary(static_cast<Axis>(axis)); }
 bool near_int(int& result, double v) noexcept {
-  result = static_cast<int>(v + 0.5);
+  result = trunc_to_int(v + 0.5);
   return std::fabs(result - v) < 0.0001;
 }
 }  // namespace
@@ -20,7 +21,10 @@ void Engine::update_unit_factor() noexcept {
 }
 
 void Engine::set_units(int code) {
+  if (st_.modal.cutter_comp != CutterComp::Off)
+    fail(ErrorCode::ModalContext, "the units cannot change while cutter compensation is on");
   const canon::Units units = code == 200 ? canon::Units::Inch : canon::Units::Mm;
+  units_programmed_ = true;
   out_.use_length_units(units);
   if (st_.modal.units == units) return;
   const double k = units == canon::Units::Inch ? 1.0 / 25.4 : 25.4;
@@ -142,7 +146,7 @@ void Engine::g10_coordinate_system() {
   auto& par = st_.parameters;
   PositionState& s = st_.position;
   const bool l20 = b.get('l') == 20;
-  int p = static_cast<int>(b.get('p') + 0.0001);
+  int p = trunc_to_int(b.get('p') + 0.0001);
   if (p == 0) p = st_.modal.coord_system;
   const bool active = p == st_.modal.coord_system;
   if (st_.modal.cutter_comp != CutterComp::Off && active)

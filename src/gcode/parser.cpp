@@ -267,6 +267,7 @@ void Parser::read_word(Cursor& c, Block& b, char letter) {
       break;
   }
   b.value[static_cast<std::size_t>(letter - 'a')] = v;
+  b.at[static_cast<std::size_t>(letter - 'a')] = static_cast<std::uint8_t>(pos < 255 ? pos : 255);
   b.words |= 1u << (letter - 'a');
 }
 
@@ -296,10 +297,13 @@ void Parser::read_g(Cursor& c, Block& b) {
   int code = plain_code(c);
   if (code < 0) {
     const double v10 = 10.0 * real_value(c);
+    // (range first: only then does the value fit an int)
+    if (!(v10 < 1e4)) fail_at(pos, ErrorCode::GCodeOutOfRange, "G{} is out of range", v10 / 10.0);
+    if (v10 <= -1e4) fail_at(pos, ErrorCode::GCodeOutOfRange, "G code must not be negative");
     code = static_cast<int>(std::floor(v10));
     if (v10 - code > 0.999) code = static_cast<int>(std::ceil(v10));
     else if (v10 - code > 0.001) fail_at(pos, ErrorCode::GCodeOutOfRange, "G{} is not a G code (at most one decimal)", v10 / 10.0);
-    if (code > 999 || !(v10 < 1e4)) fail_at(pos, ErrorCode::GCodeOutOfRange, "G{} is out of range", v10 / 10.0);
+    if (code > 999) fail_at(pos, ErrorCode::GCodeOutOfRange, "G{} is out of range", v10 / 10.0);
     if (code < 0) fail_at(pos, ErrorCode::GCodeOutOfRange, "G code must not be negative");
   }
   const int group = g_group(code);

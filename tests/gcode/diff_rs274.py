@@ -107,7 +107,8 @@ def main():
             msg = [ln for ln in err1.splitlines() if ln != "executing"]
             msg = msg[0] if msg else ""
             want = next((code for rx, code in errors if rx.search(msg)), "?")
-            got = re.findall(r"\[(gcode\.[a-z0-9-]+|tools\.[a-z0-9-]+)\]", err2)
+            errs = "\n".join(ln for ln in err2.splitlines() if ": error: " in ln)
+            got = re.findall(r"\[(gcode\.[a-z0-9-]+|tools\.[a-z0-9-]+)\]", errs)
             got = got[0] if got else "-"
             problem = f"  rs274: {msg!r} -> {want}; opencnc: {got}"
             status = status and want == got

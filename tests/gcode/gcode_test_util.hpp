@@ -20,7 +20,13 @@ struct Result {
   std::vector<std::string> labels;  ///< the N label column of those calls
   Diagnostics diagnostics;
   InterpState state;
-  std::string code() const { return diagnostics.items().empty() ? "" : diagnostics.items().front().code; }
+  /// Code of the first error ("" if none).
+  std::string code() const {
+    for (const auto& d : diagnostics.items()) {
+      if (d.severity == Severity::Error) return d.code;
+    }
+    return "";
+  }
 };
 
 inline Result collect(Interpreter& interp, RunStatus status, const std::string& text) {

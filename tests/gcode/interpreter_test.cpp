@@ -59,9 +59,17 @@ RunStatus run_into(Interpreter& interp, canon::Sink& sink, std::string_view text
   return interp.run(sink);
 }
 
+// The first error (warnings may come before it).
+const Diagnostic* first_error(const Interpreter& interp) {
+  for (const auto& d : interp.diagnostics().items()) {
+    if (d.severity == Severity::Error) return &d;
+  }
+  return nullptr;
+}
+
 std::string first_code(const Interpreter& interp) {
-  const auto& items = interp.diagnostics().items();
-  return items.empty() ? std::string() : items.front().code;
+  const Diagnostic* d = first_error(interp);
+  return d == nullptr ? std::string() : d->code;
 }
 
 // A scratch directory for subprogram files, removed at the end of the test.
@@ -160,14 +168,37 @@ TEST(Interpreter, ErrorsCarryFileLineAndColumn) {
   Interpreter interp;
   canon::Sink quiet;
   EXPECT_EQ(run_into(interp, quiet, "G21\n  G1 X1 Q\nM2\n", "bad.ngc"), RunStatus::Error);
-  ASSERT_EQ(interp.diagnostics().items().size(), 1u);
-  const auto& d = interp.diagnostics().items().front();
+  ASSERT_EQ(interp.diagnostics().error_count(), 1u);
+  const auto& d = *first_error(interp);
   EXPECT_EQ(d.code, "gcode.missing-value");
   EXPECT_EQ(d.file, "bad.ngc");
   EXPECT_EQ(d.line, 2u);
   EXPECT_EQ(d.col, 10u);   // the end of the line, where the value is missing
   // The run cannot continue after an error.
   EXPECT_EQ(interp.run(quiet), RunStatus::Error);
+  // A word nothing uses is pointed at.
+  Interpreter words;
+  EXPECT_EQ(run_into(words, quiet, "G21\nG0 X 1  I5\nM2\n"), RunStatus::Error);
+  ASSERT_NE(first_error(words), nullptr);
+  EXPECT_EQ(first_error(words)->code, "gcode.unused-word");
+  EXPECT_EQ(first_error(words)->col, 9u);
+}
+
+TEST(Interpreter, WarnsOnceAboutHabitsLinuxCncAccepts) {
+  Interpreter interp;
+  canon::Sink quiet;
+  ASSERT_EQ(run_into(interp, quiet, "F100\nG0 X1\nG1 X2\nG1 X3\nM3 S100\nG21 G1 X4\nM2\n"), RunStatus::Finished);
+  const auto& items = interp.diagnostics().items();
+  ASSERT_EQ(items.size(), 2u);
+  EXPECT_EQ(items[0].severity, Severity::Warning);
+  EXPECT_EQ(items[0].code, "gcode.units-not-programmed");
+  EXPECT_EQ(items[0].line, 2u);
+  EXPECT_EQ(items[1].code, "gcode.feed-with-spindle-stopped");
+  EXPECT_EQ(items[1].line, 3u);
+  EXPECT_FALSE(interp.diagnostics().has_errors());
+  Interpreter careful;
+  ASSERT_EQ(run_into(careful, quiet, "G21 F100 M3 S1000\nG1 X1\nG2 X2 I0.5\nM2\n"), RunStatus::Finished);
+  EXPECT_TRUE(careful.diagnostics().empty());
 }
 
 // --- stepping, MDI and sync points ---------------------------------------------------------
@@ -322,7 +353,7 @@ Trace trace(std::string_view program, canon::SegmentId quiet) {
     interp.start(nowhere);
     t.status = interp.run(tee);
   }
-  if (!interp.diagnostics().items().empty()) t.error = interp.diagnostics().items().front().format();
+  if (const Diagnostic* d = first_error(interp)) t.error = d->format();
   const std::string text = out.text();
   std::size_t pos = 0;
   while (pos < text.size()) {
@@ -425,7 +456,7 @@ std::string run_with_limits(std::string_view program, const Limits& limits, std:
   canon::Sink quiet;
   interp.open_text("limits.ngc", std::string(program));
   EXPECT_EQ(interp.run(quiet), RunStatus::Error);
-  if (line != nullptr && !interp.diagnostics().items().empty()) *line = interp.diagnostics().items().front().line;
+  if (line != nullptr && first_error(interp) != nullptr) *line = first_error(interp)->line;
   return first_code(interp);
 }
 
@@ -500,10 +531,18 @@ TEST(InterpreterExtensions, UnsupportedFeaturesNameTheirCode) {
     canon::Sink quiet;
     EXPECT_EQ(run_into(interp, quiet, program), RunStatus::Error) << program;
     EXPECT_EQ(first_code(interp), "gcode.unsupported") << program;
-    ASSERT_FALSE(interp.diagnostics().items().empty());
-    EXPECT_NE(interp.diagnostics().items().front().message.find(std::string(code) + " "), std::string::npos)
-        << interp.diagnostics().items().front().message;
+    ASSERT_NE(first_error(interp), nullptr);
+    EXPECT_NE(first_error(interp)->message.find(std::string(code) + " "), std::string::npos) << first_error(interp)->message;
   }
+}
+
+TEST(InterpreterExtensions, TheFanucDialectIsNotThereYet) {
+  Options options;
+  options.dialect = Dialect::Fanuc;
+  Interpreter interp(options);
+  canon::Sink quiet;
+  EXPECT_EQ(run_into(interp, quiet, "O1000\nG0 X1\nM30\n"), RunStatus::Error);
+  EXPECT_EQ(first_code(interp), "gcode.unsupported");
 }
 
 namespace {

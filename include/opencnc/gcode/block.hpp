@@ -40,6 +40,7 @@ enum class OWord : std::uint8_t {
 struct Block {
   std::uint32_t words = 0;                  ///< bit (letter - 'a') set per letter word present
   std::array<double, 26> value{};           ///< value of each letter word
+  std::array<std::uint8_t, 26> at{};        ///< where each letter word starts in the normalised line
   std::array<std::int16_t, kGGroupCount> g{};   ///< G code ×10 by group, -1 = none
   std::array<std::int16_t, kMGroupCount> m{};   ///< M code by group, -1 = none
   int m_count = 0;

@@ -103,7 +103,10 @@ namespace opencnc::gcode {
   X(LimitSkippedLines, "gcode.limit-skipped-lines")                          \
   /* interface use */                                                        \
   X(NoProgram, "gcode.no-program")                                           \
-  X(AwaitingSync, "gcode.awaiting-sync")
+  X(AwaitingSync, "gcode.awaiting-sync")                                     \
+  /* warnings (the program runs; opencnc check and scan report them) */     \
+  X(UnitsNotProgrammed, "gcode.units-not-programmed")                        \
+  X(FeedWithSpindleStopped, "gcode.feed-with-spindle-stopped")
 
 enum class ErrorCode : std::uint16_t {
 #define OPENCNC_GCODE_ENUM(e, id) e,
