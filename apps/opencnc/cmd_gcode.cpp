@@ -111,7 +111,7 @@ int run_check(const std::vector<std::string>& files, const InterpArgs& args) {
 
 }  // namespace
 
-void register_gcode_commands(CLI::App& app, Registry& registry) {
+void add_gcode_commands(CLI::App& app, Registry& registry) {
   static InterpArgs check_args, canon_args, scan_args;
   static std::vector<std::string> check_files;
   static std::string canon_file, scan_file;

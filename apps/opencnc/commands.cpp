@@ -1,12 +1,13 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The list of subcommands, one file each (cmd_*.cpp).
 #include "commands.hpp"
-#include "gcode_summary.hpp"
 
 #include <CLI/CLI.hpp>
 
 namespace opencnc::cli {
 
-void register_all(CLI::App& app, Registry& registry) { register_gcode_commands(app, registry); }
+void register_all(CLI::App& app, Registry& registry) {
+  add_gcode_commands(app, registry);
+}
 
 }  // namespace opencnc::cli

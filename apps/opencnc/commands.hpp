@@ -27,4 +27,7 @@ class Registry {
 /// Adds every subcommand to `app`; each callback stores its exit code in `registry`.
 void register_all(CLI::App& app, Registry& registry);
 
+// One function per subcommand group (cmd_<name>.cpp).
+void add_gcode_commands(CLI::App& app, Registry& registry);   ///< check, canon, scan
+
 }  // namespace opencnc::cli

@@ -12,7 +12,4 @@ namespace opencnc::cli {
 /// Scans `file` and prints its summary (text or JSON); returns the exit code.
 int run_scan(const std::string& file, const gcode::Options& options, bool json, double rapid_rate_mm_min);
 
-/// Registers check, canon and scan (cmd_gcode.cpp).
-void register_gcode_commands(CLI::App& app, Registry& registry);
-
 }  // namespace opencnc::cli

@@ -184,8 +184,6 @@ RunStatus Engine::mdi(std::string_view line, canon::Sink& sink) {
   return s == RunStatus::Finished ? RunStatus::Ok : s;
 }
 
-std::uint32_t Engine::letters_allowed() const noexcept { return letters_; }
-
 ParseEnv Engine::parse_env() const noexcept {
   ParseEnv env;
   env.parameters = st_.parameters.data();

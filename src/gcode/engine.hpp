@@ -86,7 +86,6 @@ class Engine final : public ParamHost, public ExecContext {
   void set_origin_from_line();
   SourceFile& current_file();
   void jump_to(const SourcePosition& pos);
-  std::uint32_t letters_allowed() const noexcept;
   ParseEnv parse_env() const noexcept;
   void apply_sync(const SyncValues& values);
 
@@ -188,7 +187,6 @@ class Engine final : public ParamHost, public ExecContext {
   LabelInfo* find_label(const std::string& name);
   void save_label(LabelKind kind);
   void jump_to_label(const std::string& name);
-  void seek_sub(const std::string& name);
   bool open_sub_file(const std::string& name);
   void count_loop();
   void leave_frame();

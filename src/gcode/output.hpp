@@ -33,7 +33,6 @@ class Output final : public canon::Sink {
   const canon::BlockOrigin& origin() const noexcept { return origin_; }
   /// Motions emitted so far (the next segment id).
   std::uint64_t segments() const noexcept { return segments_; }
-  void set_segments(std::uint64_t n) noexcept { segments_ = n; }
 
   void open_queue() noexcept { queueing_ = true; }
   void flush_queue();
