@@ -11,6 +11,7 @@
 #include "gcode_summary.hpp"
 #include "opencnc/canon/rs274_printer.hpp"
 #include "opencnc/gcode/interpreter.hpp"
+#include "opencnc/gcode/standard_extensions.hpp"
 #include "opencnc/gcode/rs274_driver.hpp"
 
 namespace opencnc::cli {
@@ -55,6 +56,7 @@ std::shared_ptr<tools::ToolTable> rs274_default_tools() {
 // Builds interpreter options; returns false (after printing why) on a bad tool table.
 bool make_options(const InterpArgs& a, gcode::Options& o) {
   o.axes = AxisMask::from_letters(a.axes);
+  o.extensions = gcode::standard_extensions(o.dialect);
   o.block_delete = a.block_delete;
   o.subroutine_path = a.subroutine_path.empty() ? std::vector<std::string>{"."} : a.subroutine_path;
   if (!a.tool_table.empty()) {
