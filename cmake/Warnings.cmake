@@ -1,8 +1,13 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 # Warning flags shared by every opencnc target.
 add_library(opencnc_warnings INTERFACE)
-target_compile_options(opencnc_warnings INTERFACE -Wall -Wextra -Wpedantic -Wshadow=local
-  -Wnon-virtual-dtor -Wimplicit-fallthrough)
+target_compile_options(opencnc_warnings INTERFACE -Wall -Wextra -Wpedantic -Wnon-virtual-dtor
+  -Wimplicit-fallthrough)
+if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
+  target_compile_options(opencnc_warnings INTERFACE -Wshadow=local)
+else()
+  target_compile_options(opencnc_warnings INTERFACE -Wshadow-uncaptured-local)
+endif()
 if(OPENCNC_WERROR)
   target_compile_options(opencnc_warnings INTERFACE -Werror)
 endif()

@@ -10,9 +10,11 @@ for target in build-fuzz/fuzz/*/fuzz_*; do
   name=$(basename "$target")
   area=$(basename "$(dirname "$target")")
   seeds="fuzz/$area/corpus"
+  dict=()
+  [[ -f "fuzz/$area/$area.dict" ]] && dict=(-dict="fuzz/$area/$area.dict")
   work=$(mktemp -d)
   echo "-- $name: ${seconds}s, seeds from $seeds"
-  if ! "$target" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
+  if ! "$target" "${dict[@]}" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
       -artifact_prefix="$work/" "$work" "$seeds" 2>"$work/log"; then
     tail -n 40 "$work/log"
     echo "fuzz: $name found a problem; artifacts in $work"
