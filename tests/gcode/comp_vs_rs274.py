@@ -71,7 +71,18 @@ class Gen:
         self.lines.append(s)
 
     def point(self, scale=30):
+        if self.inch:
+            scale /= 25.4
         return self.r.uniform(-scale, scale), self.r.uniform(-scale, scale)
+
+    def ride(self):
+        """Words of axes riding along: the normal axis (a helix) or A."""
+        k = self.r.random()
+        if k < 0.05:
+            return " %s%s" % (self.n, fmt(self.r.uniform(-3, 3)))
+        if k < 0.1:
+            return " A%s" % fmt(self.r.uniform(0, 90))
+        return ""
 
     def extras(self):
         r = self.r
@@ -88,6 +99,10 @@ class Gen:
             self.emit("G4 P0.5")
         elif k < 0.13 and not self.xz:
             self.emit("G0 Z%s" % fmt(r.uniform(0, 3)))
+        elif k < 0.14:
+            # a change of units scales what compensation holds (and the tool radius)
+            self.inch = not self.inch
+            self.emit("G20" if self.inch else "G21")
 
     def arc(self, cur, end):
         """A G2/G3 from cur to end, centre on the bisector (I/J/K or R)."""
@@ -104,14 +119,16 @@ class Gen:
             rad = math.hypot(cx - cur[0], cy - cur[1])
             rad = max(rad, d / 2 + 0.01)
             sign = "-" if r.random() < 0.3 else ""
-            return "%s %s%s %s%s R%s%s" % (g, self.a, fmt(end[0]), self.b, fmt(end[1]), sign, fmt(rad))
+            return "%s %s%s %s%s R%s%s%s" % (g, self.a, fmt(end[0]), self.b, fmt(end[1]), sign, fmt(rad), self.ride())
         # snap the end onto the circle so the radius check passes
         rad = math.hypot(cx - cur[0], cy - cur[1])
         ang = math.atan2(end[1] - cy, end[0] - cx)
         ex, ey = cx + rad * math.cos(ang), cy + rad * math.sin(ang)
         p = " P2" if r.random() < 0.05 else ""
-        return "%s %s%s %s%s %s%s %s%s%s" % (g, self.a, fmt(ex), self.b, fmt(ey), self.ia, fmt(cx - cur[0]),
-                                               self.ib, fmt(cy - cur[1]), p)
+        if r.random() < 0.05:   # a full circle
+            ex, ey = cur
+        return "%s %s%s %s%s %s%s %s%s%s%s" % (g, self.a, fmt(ex), self.b, fmt(ey), self.ia, fmt(cx - cur[0]),
+                                                 self.ib, fmt(cy - cur[1]), p, self.ride())
 
     def program(self):
         r = self.r
@@ -166,12 +183,17 @@ class Gen:
                     cur = (float(m.group(1)), float(m.group(2)))
                     continue
             if incremental:
-                self.emit("G1 %s%s %s%s" % (self.a, fmt(nxt[0] - cur[0]), self.b, fmt(nxt[1] - cur[1])))
+                self.emit("G1 %s%s %s%s%s" % (self.a, fmt(nxt[0] - cur[0]), self.b, fmt(nxt[1] - cur[1]), self.ride()))
+            elif r.random() < 0.03:
+                self.emit("G93 G1 %s%s %s%s F2" % (self.a, fmt(nxt[0]), self.b, fmt(nxt[1])))
+                self.emit("G94 F200")
             else:
-                self.emit("G%d %s%s %s%s" % (r.choice((0, 1, 1, 1)), self.a, fmt(nxt[0]), self.b, fmt(nxt[1])))
+                self.emit("G%d %s%s %s%s%s" % (r.choice((0, 1, 1, 1)), self.a, fmt(nxt[0]), self.b, fmt(nxt[1]),
+                                               self.ride()))
             cur = nxt
         if incremental:
             self.emit("G90")
+        self.lines.append("F200")
         if r.random() < 0.8:
             cur = self.point()
             self.emit("G40 G1 %s%s %s%s" % (self.a, fmt(cur[0]), self.b, fmt(cur[1])))
