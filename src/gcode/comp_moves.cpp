@@ -73,7 +73,7 @@ PlanePoint arc_arc_corner(const CompPath& path, const CompQueuedMove& prev, doub
   const double new_radius = tool_inside_arc(path.left(), turn) ? arc_radius - path.radius() : arc_radius + path.radius();
   const double centres = std::hypot(prev.center2 - c2, prev.center1 - c1);
   if (held_radius == 0 || centres == 0)
-    fail(ErrorCode::CompDegenerateCorner, "cutter compensation cannot join two arcs with the same centre");
+    fail(ErrorCode::CompConcentricArcs, "cutter compensation cannot join two arcs with the same centre");
   const double a = (held_radius * held_radius + centres * centres - new_radius * new_radius) / (2 * held_radius * centres);
   if (a > 1.0 || a < -1.0) fail(ErrorCode::CompGouge, "the tool cannot fit in the corner between these two arcs without gouging");
   const double pullback = std::acos(a);
@@ -150,10 +150,9 @@ void straight_next(CompPath& path, bool rapid, const Pose& end) {
       path.release();
       path.set_start(m1, m2);
     } else if (concave && path.front().kind != CompQueuedMove::Kind::Arc) {
-      // Line into line: back the held line's end up to where the offsets cross.
+      // Line into line: back the held line's end up to where the offsets cross. (beta is at
+      // least -π/2 here, so half the inside corner is never zero.)
       const double half_corner = static_cast<double>((b + kPiL) / 2.0);
-      if (half_corner == 0.0)
-        fail(ErrorCode::CompDegenerateCorner, "cutter compensation cannot follow a corner of zero degrees");
       const double retreat = r / std::tan(half_corner);
       path.settle(c1 + retreat * std::cos(theta + gamma), c2 + retreat * std::sin(theta + gamma));
     } else if (concave) {

@@ -87,7 +87,7 @@ namespace opencnc::gcode {
   X(CompEntryTooShort, "gcode.comp-entry-too-short")                         \
   X(CompArcTooSmall, "gcode.comp-arc-too-small")                             \
   X(CompGouge, "gcode.comp-gouge")                                           \
-  X(CompDegenerateCorner, "gcode.comp-degenerate-corner")                    \
+  X(CompConcentricArcs, "gcode.comp-concentric-arcs")                        \
   X(CompArcOffCircle, "gcode.comp-arc-off-circle")                           \
   X(CompInternal, "gcode.comp-internal")                                     \
   X(CompExitArc, "gcode.comp-exit-arc")                                      \
