@@ -128,9 +128,10 @@ void Output::scale_queue(double k) noexcept {
 void Output::flush_queue() {
   queueing_ = false;
   const canon::BlockOrigin current = origin_;
-  std::vector<Queued> pending;
-  pending.swap(queue_);
-  for (const Queued& q : pending) {
+  // Swap with a second buffer rather than a new vector: compensation flushes after nearly
+  // every move, and both buffers keep their capacity.
+  flushing_.swap(queue_);
+  for (const Queued& q : flushing_) {
     set_origin(q.origin);
     using K = Queued::Kind;
     switch (q.kind) {
@@ -154,6 +155,7 @@ void Output::flush_queue() {
       case K::Comment: comment(q.text); break;
     }
   }
+  flushing_.clear();
   set_origin(current);
 }
 

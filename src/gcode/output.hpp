@@ -167,6 +167,7 @@ class Output final : public canon::Sink {
   std::shared_ptr<CoordinateTransform> transform_;
   bool queueing_ = false;
   std::vector<Queued> queue_;
+  std::vector<Queued> flushing_;
 };
 
 }  // namespace opencnc::gcode
