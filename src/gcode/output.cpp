@@ -162,10 +162,10 @@ void Output::flush_queue() {
 // --- representation --------------------------------------------------------------------
 
 void Output::use_length_units(canon::Units u) {
-  if (u != view_units_) scale_queue(u == canon::Units::Inch ? 1.0 / 25.4 : 25.4);
-  if (view_ != nullptr && u != view_units_) {
+  if (u != view_units_) {
     const double k = u == canon::Units::Inch ? 1.0 / 25.4 : 25.4;
-    for (int i = 0; i < 3; ++i) {
+    scale_queue(k);
+    for (int i = 0; view_ != nullptr && i < 3; ++i) {
       view_->canon_position[i] *= k;
       view_->canon_g5x[i] *= k;
       view_->canon_g92[i] *= k;
