@@ -30,8 +30,10 @@ class ContourFile {
     for (int i = 0; i < kMoves; ++i) {
       const double a = 2 * 3.14159265358979 * (i % kPerTurn) / kPerTurn;
       const double r = 200 + 20 * std::sin(7 * a);
-      if (i % 4 == 3) std::fprintf(f, "G3 X%.4f Y%.4f R%.4f\n", r * std::cos(a), r * std::sin(a), 150.0);
-      else std::fprintf(f, "G1 X%.4f Y%.4f\n", r * std::cos(a), r * std::sin(a));
+      if (i % 4 == 3)
+        std::fprintf(f, "G3 X%.4f Y%.4f R%.4f\n", r * std::cos(a), r * std::sin(a), 150.0);
+      else
+        std::fprintf(f, "G1 X%.4f Y%.4f\n", r * std::cos(a), r * std::sin(a));
     }
     std::fprintf(f, "%sM2\n", comp ? "G40 G1 X0 Y0\n" : "");
     std::fclose(f);
@@ -56,13 +58,18 @@ void run_contour(benchmark::State& state, bool comp) {
     if (interp.run(sink) != gcode::RunStatus::Finished) state.SkipWithError("the program did not finish");
     blocks = interp.state().blocks_executed;
   }
-  state.counters["lines/s"] = benchmark::Counter(static_cast<double>(blocks), benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["lines/s"] =
+      benchmark::Counter(static_cast<double>(blocks), benchmark::Counter::kIsIterationInvariantRate);
 }
 
-void BM_ContourPlain(benchmark::State& state) { run_contour(state, false); }
+void BM_ContourPlain(benchmark::State& state) {
+  run_contour(state, false);
+}
 BENCHMARK(BM_ContourPlain)->Unit(benchmark::kMillisecond);
 
-void BM_ContourCompensated(benchmark::State& state) { run_contour(state, true); }
+void BM_ContourCompensated(benchmark::State& state) {
+  run_contour(state, true);
+}
 BENCHMARK(BM_ContourCompensated)->Unit(benchmark::kMillisecond);
 
 }  // namespace

@@ -19,20 +19,24 @@ constexpr double kSpiralToleranceInch = 2 * 0.001 * 1.41421356237309504880;
 constexpr double kSpiralToleranceMm = 2 * 0.01 * 1.41421356237309504880;
 constexpr double kEqualTolerance = 0.0001;
 
-bool clockwise(int motion) noexcept { return motion == 20; }
+bool clockwise(int motion) noexcept {
+  return motion == 20;
+}
 
 // The tool cuts on the inside of the programmed arc (G3 on the left, G2 on the right).
-bool inside_by_motion(bool left, int motion) noexcept { return left != clockwise(motion); }
+bool inside_by_motion(bool left, int motion) noexcept {
+  return left != clockwise(motion);
+}
 
 [[noreturn]] void arc_too_small(double arc_radius, double tool_radius) {
-  fail(ErrorCode::CompArcTooSmall, "the tool (radius {:.4f}) does not fit inside this arc (radius {:.4f})", tool_radius,
-       arc_radius);
+  fail(ErrorCode::CompArcTooSmall, "the tool (radius {:.4f}) does not fit inside this arc (radius {:.4f})",
+       tool_radius, arc_radius);
 }
 
 // The point of the held move's circle where the tool, offset from a following line, meets
 // it (an arc into a concave corner with a line).
-PlanePoint arc_line_corner(const CompPath& path, const CompQueuedMove& prev, double op1, double op2, double p1,
-                           double p2) {
+PlanePoint arc_line_corner(const CompPath& path, const CompQueuedMove& prev, double op1, double op2,
+                           double p1, double p2) {
   const double r = path.radius();
   const double held_radius = std::hypot(prev.center2 - prev.end2, prev.center1 - prev.end1);
   const double base_dir = std::atan2(p2 - op2, p1 - op1);
@@ -43,7 +47,8 @@ PlanePoint arc_line_corner(const CompPath& path, const CompQueuedMove& prev, dou
   // Distance from the arc centre to the offset line, in units of the held radius.
   const double d = programmed_radius * std::cos(theta - phi);
   const double l = (inside ? d - r : d + r) / held_radius;
-  if (l > 1.0 || l < -1.0) fail(ErrorCode::CompGouge, "the tool cannot fit in the corner between this arc and line without gouging");
+  if (l > 1.0 || l < -1.0)
+    fail(ErrorCode::CompGouge, "the tool cannot fit in the corner between this arc and line without gouging");
   const bool plus = inside ? prev.turn <= 0 : prev.turn > 0;
   const double angle = add_long((plus ? std::acos(l) : -std::acos(l)) + theta, kPiL);
   return {prev.center1 + held_radius * std::cos(angle), prev.center2 + held_radius * std::sin(angle)};
@@ -51,31 +56,38 @@ PlanePoint arc_line_corner(const CompPath& path, const CompQueuedMove& prev, dou
 
 // Where a line's offset meets the offset of a following arc (centre c, radius arc_radius)
 // in a concave corner; theta is the normal of the held line towards the tool.
-PlanePoint line_arc_corner(const CompPath& path, double theta, double beta, double c1, double c2, double arc_radius,
-                           int turn) {
+PlanePoint line_arc_corner(const CompPath& path, double theta, double beta, double c1, double c2,
+                           double arc_radius, int turn) {
   const double r = path.radius();
   const double cy = static_cast<double>(arc_radius * std::sin(static_cast<long double>(beta) - kHalfPiL));
   const bool inside = tool_inside_arc(path.left(), turn);
   const double dist = inside ? arc_radius - r : arc_radius + r;
   const double l = (inside ? cy + r : cy - r) / dist;
-  if (l > 1.0 || l < -1.0) fail(ErrorCode::CompGouge, "the tool cannot reach the inside corner before this arc without gouging");
+  if (l > 1.0 || l < -1.0)
+    fail(ErrorCode::CompGouge, "the tool cannot reach the inside corner before this arc without gouging");
   double angle;
-  if (inside) angle = turn > 0 ? theta + std::asin(l) : theta - std::asin(l);
-  else angle = static_cast<double>(static_cast<long double>(theta) + kPiL + (turn > 0 ? -std::asin(l) : std::asin(l)));
+  if (inside)
+    angle = turn > 0 ? theta + std::asin(l) : theta - std::asin(l);
+  else
+    angle = static_cast<double>(static_cast<long double>(theta) + kPiL +
+                                (turn > 0 ? -std::asin(l) : std::asin(l)));
   return {c1 + dist * std::cos(angle), c2 + dist * std::sin(angle)};
 }
 
 // Where the offsets of two arcs meet in a concave corner: on the held arc's offset circle at
 // the distance of the new arc's offset radius from the new centre (law of cosines).
-PlanePoint arc_arc_corner(const CompPath& path, const CompQueuedMove& prev, double c1, double c2, double arc_radius,
-                          int turn) {
+PlanePoint arc_arc_corner(const CompPath& path, const CompQueuedMove& prev, double c1, double c2,
+                          double arc_radius, int turn) {
   const double held_radius = std::hypot(prev.center2 - prev.end2, prev.center1 - prev.end1);
-  const double new_radius = tool_inside_arc(path.left(), turn) ? arc_radius - path.radius() : arc_radius + path.radius();
+  const double new_radius =
+      tool_inside_arc(path.left(), turn) ? arc_radius - path.radius() : arc_radius + path.radius();
   const double centres = std::hypot(prev.center2 - c2, prev.center1 - c1);
   if (held_radius == 0 || centres == 0)
     fail(ErrorCode::CompConcentricArcs, "cutter compensation cannot join two arcs with the same centre");
-  const double a = (held_radius * held_radius + centres * centres - new_radius * new_radius) / (2 * held_radius * centres);
-  if (a > 1.0 || a < -1.0) fail(ErrorCode::CompGouge, "the tool cannot fit in the corner between these two arcs without gouging");
+  const double a =
+      (held_radius * held_radius + centres * centres - new_radius * new_radius) / (2 * held_radius * centres);
+  if (a > 1.0 || a < -1.0)
+    fail(ErrorCode::CompGouge, "the tool cannot fit in the corner between these two arcs without gouging");
   const double pullback = std::acos(a);
   const double cc_dir = std::atan2(c2 - prev.center2, c1 - prev.center1);
   const bool plus = tool_inside_arc(path.left(), prev.turn) == (turn > 0);
@@ -93,7 +105,8 @@ void straight_first(CompPath& path, bool rapid, const Pose& end) {
   const double r = path.radius();
   const double distance = std::hypot(p1 - c1, p2 - c2);
   if (distance <= r)
-    fail(ErrorCode::CompEntryTooShort, "the move that starts cutter compensation ({:.4f}) must be longer than the tool radius ({:.4f})",
+    fail(ErrorCode::CompEntryTooShort,
+         "the move that starts cutter compensation ({:.4f}) must be longer than the tool radius ({:.4f})",
          distance, r);
   const double alpha = add_long(std::atan2(p2 - c2, p1 - c1), path.left() ? kHalfPiL : -kHalfPiL);
   const double e1 = p1 + r * std::cos(alpha);
@@ -137,7 +150,8 @@ void straight_next(CompPath& path, bool rapid, const Pose& end) {
     bool concave = b < -kCornerTolerance || b > kPiL + kCornerTolerance;
     // Over the top of a convex arc into a line that doubles back ("h" shape): stay outside.
     const CompQueuedMove* held = path.held_front();
-    if (!concave && b > kPiL - kCornerTolerance && held != nullptr && held->kind == CompQueuedMove::Kind::Arc) {
+    if (!concave && b > kPiL - kCornerTolerance && held != nullptr &&
+        held->kind == CompQueuedMove::Kind::Arc) {
       concave = (!left && held->turn > 0) || (left && held->turn < 0);
     }
     if (!concave && beta > kCornerTolerance) {
@@ -145,8 +159,10 @@ void straight_next(CompPath& path, bool rapid, const Pose& end) {
       const double m1 = op1 + r * std::cos(alpha + gamma);
       const double m2 = op2 + r * std::sin(alpha + gamma);
       path.settle(c1, c2);
-      if (rapid) path.queue_line(true, 0, 0, m1, m2, c3, end);   // no arc at rapid rate
-      else path.queue_arc(0.0, m1, m2, op1, op2, left ? -1 : 1, c3, end);
+      if (rapid)
+        path.queue_line(true, 0, 0, m1, m2, c3, end);  // no arc at rapid rate
+      else
+        path.queue_arc(0.0, m1, m2, op1, op2, left ? -1 : 1, c3, end);
       path.release();
       path.set_start(m1, m2);
     } else if (concave && path.front().kind != CompQueuedMove::Kind::Arc) {
@@ -179,13 +195,15 @@ void arc_first(CompPath& path, ExecContext& ctx, const Block& block, int motion,
   const double r = path.radius();
   const InterpState& st = ctx.state();
   if (std::hypot(e1 - c1, e2 - c2) <= r)
-    fail(ErrorCode::CompEntryTooShort, "the arc that starts cutter compensation must end more than the tool radius ({:.4f}) away", r);
-  if (block.has('r') && std::fabs(block.get('r')) <= r && inside_by_motion(left, motion)) arc_too_small(std::fabs(block.get('r')), r);
+    fail(ErrorCode::CompEntryTooShort,
+         "the arc that starts cutter compensation must end more than the tool radius ({:.4f}) away", r);
+  if (block.has('r') && std::fabs(block.get('r')) <= r && inside_by_motion(left, motion))
+    arc_too_small(std::fabs(block.get('r')), r);
   const ArcCentre centre = ctx.arc_centre(block, motion, st.position.current, end);
   const double arc_radius = std::hypot(centre.first - c1, centre.second - c2);
   if (!block.has('r') && arc_radius <= r && inside_by_motion(left, motion)) arc_too_small(arc_radius, r);
   const double gamma = tool_inside_arc(left, centre.turn) ? std::atan2(centre.second - e2, centre.first - e1)
-                                                           : std::atan2(e2 - centre.second, e1 - centre.first);
+                                                          : std::atan2(e2 - centre.second, e1 - centre.first);
   path.first_move_done();
   path.set_programmed(e1, e2, e3);
   const double n1 = e1 + r * std::cos(gamma);
@@ -229,8 +247,10 @@ void arc_next(CompPath& path, ExecContext& ctx, const Block& block, int motion, 
   double delta = std::atan2(k2 - op2, k1 - op1);
   const double alpha = add_long(delta, clockwise(motion) ? kHalfPiL : -kHalfPiL);
   double beta = left ? theta - alpha : alpha - theta;
-  if (beta > 1.5 * kPiL) beta = add_long(beta, -2 * kPiL);
-  else if (beta < -kHalfPiL) beta = add_long(beta, 2 * kPiL);
+  if (beta > 1.5 * kPiL)
+    beta = add_long(beta, -2 * kPiL);
+  else if (beta < -kHalfPiL)
+    beta = add_long(beta, 2 * kPiL);
   double gamma;
   if (inside_by_motion(left, motion)) {
     gamma = std::atan2(k2 - e2, k1 - e1);

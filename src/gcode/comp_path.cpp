@@ -20,7 +20,9 @@ CompPath::CompPath(ExecContext& ctx)
       left_(st_.modal.cutter_comp == CutterComp::Left),
       radius_(st_.modal.comp_radius) {}
 
-void CompPath::current(double& c1, double& c2, double& c3) const noexcept { split(st_.position.current, c1, c2, c3); }
+void CompPath::current(double& c1, double& c2, double& c3) const noexcept {
+  split(st_.position.current, c1, c2, c3);
+}
 
 void CompPath::programmed(double& p1, double& p2, double& p3) const noexcept {
   const auto& p = st_.position.programmed;
@@ -74,19 +76,22 @@ void CompPath::lathe_shift(double& s1, double& s2) const noexcept {
   if (plane_ != canon::Plane::XZ) return;
   const int o = st_.modal.comp_orientation;
   const double r = radius_;
-  if (o == 2 || o == 7 || o == 3) s1 = -r;   // Z
+  if (o == 2 || o == 7 || o == 3) s1 = -r;  // Z
   if (o == 1 || o == 5 || o == 4) s1 = r;
-  if (o == 2 || o == 6 || o == 1) s2 = -r;   // X
+  if (o == 2 || o == 6 || o == 1) s2 = -r;  // X
   if (o == 3 || o == 8 || o == 4) s2 = r;
 }
 
-void CompPath::queue_line(bool rapid, double dir1, double dir2, double e1, double e2, double e3, const Pose& others) {
+void CompPath::queue_line(bool rapid, double dir1, double dir2, double e1, double e2, double e3,
+                          const Pose& others) {
   double s1, s2;
   lathe_shift(s1, s2);
   const Pose end = pose(e1 + s1, e2 + s2, e3, others);
   ctx_.open_queue();
-  if (rapid) ctx_.output().straight_traverse(0, end);
-  else ctx_.output().straight_feed(0, end);
+  if (rapid)
+    ctx_.output().straight_traverse(0, end);
+  else
+    ctx_.output().straight_feed(0, end);
   CompQueuedMove q;
   q.kind = rapid ? CompQueuedMove::Kind::Traverse : CompQueuedMove::Kind::Feed;
   q.dir1 = dir1;
@@ -147,7 +152,8 @@ void CompPath::settle(double p1, double p2) {
       const double sweep = find_turn(cs.start1, cs.start2, q.center1, q.center2, q.turn, p1, p2);
       if (std::fabs(r_old - r_new) > 0.01)
         fail(ErrorCode::CompArcOffCircle,
-             "cutter compensation cannot end the arc before this corner on its circle (radius {:.4f}, corner at {:.4f})",
+             "cutter compensation cannot end the arc before this corner on its circle (radius {:.4f}, corner "
+             "at {:.4f})",
              r_old, r_new);
       if (q.sweep != 0 && cs.start_valid && std::fabs(sweep) > std::fabs(q.sweep) + sweep_slack)
         fail(ErrorCode::CompGouge, "the tool cannot reach the inside corner after this arc without gouging");

@@ -17,7 +17,9 @@ struct PlanePoint {
 };
 
 /// True when the tool runs inside an arc of signed turn `turn` (G3 > 0) on `left`.
-constexpr bool tool_inside_arc(bool left, int turn) noexcept { return (left && turn > 0) || (!left && turn < 0); }
+constexpr bool tool_inside_arc(bool left, int turn) noexcept {
+  return (left && turn > 0) || (!left && turn < 0);
+}
 
 /// Wraps the ExecContext for one compensated block. Coordinates are in the comp plane
 /// (first, second, normal); everything it keeps between blocks lives in InterpState::comp,
@@ -53,7 +55,8 @@ class CompPath {
   /// Holds a straight move to (e1, e2, e3) whose programmed direction is (dir1, dir2).
   void queue_line(bool rapid, double dir1, double dir2, double e1, double e2, double e3, const Pose& others);
   /// Holds an arc; `sweep` is the programmed sweep (0 for an arc that rounds a corner).
-  void queue_arc(double sweep, double e1, double e2, double c1, double c2, int turn, double e3, const Pose& others);
+  void queue_arc(double sweep, double e1, double e2, double c1, double c2, int turn, double e3,
+                 const Pose& others);
   /// Releases every held move as it stands (LinuxCNC's dequeue).
   void release();
   /// The held moves start at `p` (their gouge checks measure from here).

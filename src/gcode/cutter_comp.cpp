@@ -38,14 +38,16 @@ void radius_from_tool(ExecContext& ctx, const Block& b, int code, double& radius
   if (b.has('d')) {
     const double d = b.get('d');
     const int tool = trunc_to_int(d + 0.5);
-    if (std::fabs(tool - d) >= 0.0001) fail(ErrorCode::CompToolNumber, "G{} needs a whole tool number in D (got {})", code / 10, d);
+    if (std::fabs(tool - d) >= 0.0001)
+      fail(ErrorCode::CompToolNumber, "G{} needs a whole tool number in D (got {})", code / 10, d);
     index = tool_index(st, tool);
   }
   const tools::ToolEntry& t = st.tool.table[index];
   radius = user_to_program_length(t.diameter, ctx.options().user_units, st.modal.units) / 2.0;
   orientation = t.orientation;
   if (st.modal.plane != canon::Plane::XZ && orientation != 0 && orientation != 9)
-    fail(ErrorCode::CompWrongPlane, "G{} with a lathe tool (orientation {}) needs the XZ plane (G18)", code / 10, orientation);
+    fail(ErrorCode::CompWrongPlane, "G{} with a lathe tool (orientation {}) needs the XZ plane (G18)",
+         code / 10, orientation);
 }
 
 // The held moves end where the tool is (checked for gouges) and go out.
@@ -66,17 +68,20 @@ class CompOn final : public CodeHandler {
     ModalState& m = st.modal;
     if (m.plane != canon::Plane::XY && m.plane != canon::Plane::XZ)
       fail(ErrorCode::CompWrongPlane, "cutter compensation works only in the XY (G17) and XZ (G18) planes");
-    if (m.cutter_comp != CutterComp::Off) fail(ErrorCode::CompAlreadyOn, "cutter compensation is already on (G40 ends it)");
+    if (m.cutter_comp != CutterComp::Off)
+      fail(ErrorCode::CompAlreadyOn, "cutter compensation is already on (G40 ends it)");
     const bool dynamic = code % 10 == 1;
     bool left = code / 10 == 41;
     double radius = 0;
     int orientation = 0;
     if (dynamic) {
-      if (!b.has('d')) fail(ErrorCode::CompDiameterMissing, "G{}.1 needs the tool diameter in a D word", code / 10);
+      if (!b.has('d'))
+        fail(ErrorCode::CompDiameterMissing, "G{}.1 needs the tool diameter in a D word", code / 10);
       radius = b.get('d') / 2.0;
       if (b.has('l')) {
         if (m.plane != canon::Plane::XZ)
-          fail(ErrorCode::CompWrongPlane, "G{}.1 with a lathe tool orientation (L) needs the XZ plane (G18)", code / 10);
+          fail(ErrorCode::CompWrongPlane, "G{}.1 with a lathe tool orientation (L) needs the XZ plane (G18)",
+               code / 10);
         orientation = round_to_int(b.get('l'));
       }
     } else {
@@ -105,8 +110,9 @@ class CompOff final : public CodeHandler {
     ModalState& m = st.modal;
     if (m.cutter_comp != CutterComp::Off && m.comp_radius > 0.0 && !m.comp_first_move) {
       release_at_tool(ctx);
-      for (int i = 0; i < 3; ++i) st.position.current[i] = st.position.programmed[static_cast<std::size_t>(i)];
-      m.arc_not_allowed = true;   // the move after G40 has no corner to join: a line
+      for (int i = 0; i < 3; ++i)
+        st.position.current[i] = st.position.programmed[static_cast<std::size_t>(i)];
+      m.arc_not_allowed = true;  // the move after G40 has no corner to join: a line
     }
     m.cutter_comp = CutterComp::Off;
     m.comp_first_move = true;
@@ -117,13 +123,17 @@ class Compensator final : public MotionStage {
  public:
   void straight(ExecContext& ctx, bool rapid, const Pose& end) override {
     comp::CompPath path(ctx);
-    if (ctx.state().modal.comp_first_move) comp::straight_first(path, rapid, end);
-    else comp::straight_next(path, rapid, end);
+    if (ctx.state().modal.comp_first_move)
+      comp::straight_first(path, rapid, end);
+    else
+      comp::straight_next(path, rapid, end);
   }
   void arc(ExecContext& ctx, const Block& block, int motion, const Pose& end) override {
     comp::CompPath path(ctx);
-    if (ctx.state().modal.comp_first_move) comp::arc_first(path, ctx, block, motion, end);
-    else comp::arc_next(path, ctx, block, motion, end);
+    if (ctx.state().modal.comp_first_move)
+      comp::arc_first(path, ctx, block, motion, end);
+    else
+      comp::arc_next(path, ctx, block, motion, end);
   }
   // M0, M1, M2, M30, M60: the held moves end where the tool is (checked for gouges) and go
   // out; compensation stays on, from the tool's position.

@@ -14,11 +14,11 @@
 
 #include <fmt/format.h>
 
+#include "gcode_test_util.hpp"
 #include "opencnc/canon/rs274_printer.hpp"
 #include "opencnc/canon/tee_sink.hpp"
 #include "opencnc/gcode/interpreter.hpp"
 #include "opencnc/gcode/standard_extensions.hpp"
-#include "gcode_test_util.hpp"
 
 using namespace opencnc;
 using namespace opencnc::gcode;
@@ -26,26 +26,44 @@ using namespace opencnc::gcode;
 namespace {
 
 constexpr double kPi = std::numbers::pi;
-using Pt = std::array<double, 2>;   // (first, second) of the comp plane: XY = (x, y), XZ = (z, x)
+using Pt = std::array<double, 2>;  // (first, second) of the comp plane: XY = (x, y), XZ = (z, x)
 
-Pt operator-(Pt a, Pt b) { return {a[0] - b[0], a[1] - b[1]}; }
-Pt operator+(Pt a, Pt b) { return {a[0] + b[0], a[1] + b[1]}; }
-Pt operator*(double k, Pt a) { return {k * a[0], k * a[1]}; }
-double dot(Pt a, Pt b) { return a[0] * b[0] + a[1] * b[1]; }
-double cross(Pt a, Pt b) { return a[0] * b[1] - a[1] * b[0]; }
-double norm(Pt a) { return std::hypot(a[0], a[1]); }
-Pt unit(Pt a) { return (1.0 / norm(a)) * a; }
-Pt left_normal(Pt d) { return {-d[1], d[0]}; }
+Pt operator-(Pt a, Pt b) {
+  return {a[0] - b[0], a[1] - b[1]};
+}
+Pt operator+(Pt a, Pt b) {
+  return {a[0] + b[0], a[1] + b[1]};
+}
+Pt operator*(double k, Pt a) {
+  return {k * a[0], k * a[1]};
+}
+double dot(Pt a, Pt b) {
+  return a[0] * b[0] + a[1] * b[1];
+}
+double cross(Pt a, Pt b) {
+  return a[0] * b[1] - a[1] * b[0];
+}
+double norm(Pt a) {
+  return std::hypot(a[0], a[1]);
+}
+Pt unit(Pt a) {
+  return (1.0 / norm(a)) * a;
+}
+Pt left_normal(Pt d) {
+  return {-d[1], d[0]};
+}
 
 // A line or an arc of a planar path (turn: G3 = +1, G2 = -1).
 struct Element {
   bool arc = false;
   Pt a{}, b{}, c{};
   int turn = 0;
-  std::uint32_t line = 0;   // source line (output elements)
+  std::uint32_t line = 0;  // source line (output elements)
 };
 
-double radius(const Element& e) { return norm(e.a - e.c); }
+double radius(const Element& e) {
+  return norm(e.a - e.c);
+}
 
 // Signed sweep (rad) of an arc from a to b (a full circle when they coincide).
 double sweep(const Element& e) {
@@ -126,9 +144,9 @@ class PathSink : public canon::Sink {
 // written as a compensated program: entry from the origin to the middle M of the closing
 // line, the contour from M round to M, once more to the first vertex, then G40 back.
 struct Contour {
-  std::vector<Element> elements;   // programmed, M -> v0 -> ... -> M
+  std::vector<Element> elements;  // programmed, M -> v0 -> ... -> M
   std::string program;
-  std::uint32_t first_checked = 0, last_checked = 0;   // source lines whose output must be at r
+  std::uint32_t first_checked = 0, last_checked = 0;  // source lines whose output must be at r
   double r = 0;
   bool left = true;
   canon::Plane plane = canon::Plane::XY;
@@ -195,9 +213,10 @@ Contour random_contour(std::mt19937& rng) {
   std::uniform_real_distribution<double> u01(0.0, 1.0);
   Contour c;
   std::vector<Element> edges = random_outline(rng);
-  if (rng() % 2) {   // clockwise: the same outline backwards
+  if (rng() % 2) {  // clockwise: the same outline backwards
     std::vector<Element> back;
-    for (auto it = edges.rbegin(); it != edges.rend(); ++it) back.push_back({it->arc, it->b, it->a, it->c, -it->turn, 0});
+    for (auto it = edges.rbegin(); it != edges.rend(); ++it)
+      back.push_back({it->arc, it->b, it->a, it->c, -it->turn, 0});
     // keep the closing line last
     std::rotate(back.begin(), back.begin() + 1, back.end());
     edges = back;
@@ -217,13 +236,14 @@ Contour random_contour(std::mt19937& rng) {
                                     fmt::format("G4{}.1 D{:.12f}", c.left ? 1 : 2, 2 * c.r), "G1 " + at(m)};
   auto move = [&](const Element& e) {
     if (!e.arc) return "G1 " + at(e.b);
-    return fmt::format("G{} {} {}{:.12f} {}{:.12f}", e.turn > 0 ? 3 : 2, at(e.b), i1, e.c[0] - e.a[0], i2, e.c[1] - e.a[1]);
+    return fmt::format("G{} {} {}{:.12f} {}{:.12f}", e.turn > 0 ? 3 : 2, at(e.b), i1, e.c[0] - e.a[0], i2,
+                       e.c[1] - e.a[1]);
   };
   for (const Element& e : c.elements) lines.push_back(move(e));
   // Lines are 1-based; the first contour move is line 5 (M -> v0), its corner is not checked.
   c.first_checked = 6;
   c.last_checked = static_cast<std::uint32_t>(lines.size());
-  lines.push_back("G1 " + at(c.elements.front().b));   // once more to v0: the last corner is a real one
+  lines.push_back("G1 " + at(c.elements.front().b));  // once more to v0: the last corner is a real one
   lines.push_back("G40 G1 " + at({0, 0}));
   lines.push_back("M2");
   for (const auto& l : lines) c.program += l + "\n";
@@ -257,13 +277,15 @@ CompRun run_comp(const std::string& program, canon::Plane plane) {
 
 // Every point of the output from `first` to `last` (source lines) lies exactly r from the
 // programmed contour.
-void expect_offset_by_r(const Contour& c, const std::vector<Element>& path, std::uint32_t first, std::uint32_t last) {
+void expect_offset_by_r(const Contour& c, const std::vector<Element>& path, std::uint32_t first,
+                        std::uint32_t last) {
   int checked = 0;
   for (const Element& e : path) {
     if (e.line < first || e.line > last) continue;
     for (int k = 0; k <= 8; ++k) {
       const Pt q = point_at(e, k / 8.0);
-      ASSERT_NEAR(distance(c.elements, q), c.r, 1e-7) << "output of line " << e.line << " at " << q[0] << "," << q[1];
+      ASSERT_NEAR(distance(c.elements, q), c.r, 1e-7)
+          << "output of line " << e.line << " at " << q[0] << "," << q[1];
     }
     ++checked;
   }
@@ -283,7 +305,8 @@ void expect_linuxcnc_corners(const Contour& c, const std::vector<Element>& path)
     bool found = false;
     for (const Element& e : path) {
       if (convex) {
-        found |= e.arc && norm(e.c - v) < 1e-9 && std::fabs(radius(e) - c.r) < 1e-9 && e.turn == (c.left ? -1 : 1);
+        found |=
+            e.arc && norm(e.c - v) < 1e-9 && std::fabs(radius(e) - c.r) < 1e-9 && e.turn == (c.left ? -1 : 1);
       } else {
         const Pt n1 = (c.left ? 1.0 : -1.0) * left_normal(unit(in.b - in.a));
         const Pt n2 = (c.left ? 1.0 : -1.0) * left_normal(unit(out.b - out.a));
@@ -335,8 +358,8 @@ TEST(CutterCompProperty, SlotsNarrowerThanTheToolAreReportedNeverCut) {
     const double depth = (2.5 + 3 * u01(rng)) * r;
     const double x = 10 + 30 * u01(rng);
     // A pocket 60 x 40 cut anticlockwise with the tool inside (G41); the slot opens upwards.
-    const std::vector<Pt> v = {{30, 0}, {60, 0}, {60, 40}, {x + w, 40}, {x + w, 40 + depth}, {x, 40 + depth},
-                               {x, 40}, {0, 40}, {0, 0}, {30, 0}};
+    const std::vector<Pt> v = {{30, 0},         {60, 0}, {60, 40}, {x + w, 40}, {x + w, 40 + depth},
+                               {x, 40 + depth}, {x, 40}, {0, 40},  {0, 0},      {30, 0}};
     Contour c;
     c.r = r;
     std::string p = fmt::format("G17 G21 G90 F100\nG0 X30 Y20\nG41.1 D{:.12f}\nG1 X30 Y0\n", 2 * r);
@@ -350,7 +373,7 @@ TEST(CutterCompProperty, SlotsNarrowerThanTheToolAreReportedNeverCut) {
     if (narrow) {
       ASSERT_EQ(run.status, RunStatus::Error);
       EXPECT_EQ(run.code, "gcode.comp-gouge");
-      EXPECT_EQ(run.error_line, 10u);   // the wall back down closes the corner after the end wall
+      EXPECT_EQ(run.error_line, 10u);  // the wall back down closes the corner after the end wall
       const Element& end_wall = c.elements[4];
       for (const Element& e : run.path) {
         EXPECT_LT(e.line, 9u);
@@ -392,7 +415,8 @@ TEST(CutterComp, ANegativeDiameterOffsetsToTheOtherSide) {
     if (neg.calls[i].starts_with("COMMENT")) continue;
     EXPECT_EQ(neg.calls[i], pos.calls[i]);
   }
-  EXPECT_NE(std::find(neg.calls.begin(), neg.calls.end(), "COMMENT(\"interpreter: cutter radius compensation on right\")"),
+  EXPECT_NE(std::find(neg.calls.begin(), neg.calls.end(),
+                      "COMMENT(\"interpreter: cutter radius compensation on right\")"),
             neg.calls.end());
 }
 
@@ -402,8 +426,10 @@ TEST(CutterComp, AZeroRadiusLeavesThePathAsProgrammed) {
   const auto plain = run_text("G21 F100\nG0 X-10 Y-10\nT5 M6\n" + body);
   ASSERT_EQ(comp.status, RunStatus::Finished);
   std::vector<std::string> a, b;
-  for (const auto& c : comp.calls) if (!c.starts_with("COMMENT")) a.push_back(c);
-  for (const auto& c : plain.calls) if (!c.starts_with("COMMENT")) b.push_back(c);
+  for (const auto& c : comp.calls)
+    if (!c.starts_with("COMMENT")) a.push_back(c);
+  for (const auto& c : plain.calls)
+    if (!c.starts_with("COMMENT")) b.push_back(c);
   EXPECT_EQ(a, b);
 }
 
@@ -411,20 +437,21 @@ TEST(CutterComp, HeldMovesAreInTheInterpreterState) {
   Options options;
   options.extensions = standard_extensions(Dialect::LinuxCnc);
   Interpreter interp(options);
-  interp.open_text("held.ngc", "G21 F100\nG0 X-10 Y-10\nG41.1 D2\nG1 X0 Y0\nG1 X30\nF50\nG40 G1 X40 Y-10\nM2\n");
+  interp.open_text("held.ngc",
+                   "G21 F100\nG0 X-10 Y-10\nG41.1 D2\nG1 X0 Y0\nG1 X30\nF50\nG40 G1 X40 Y-10\nM2\n");
   canon::Sink quiet;
   for (int i = 0; i < 4; ++i) ASSERT_EQ(interp.step(quiet), RunStatus::Ok);
   InterpState s = interp.state();
-  ASSERT_EQ(s.comp.queued.size(), 1u);   // the entry move, waiting for its corner
+  ASSERT_EQ(s.comp.queued.size(), 1u);  // the entry move, waiting for its corner
   EXPECT_EQ(s.comp.queued[0].kind, CompQueuedMove::Kind::Feed);
   EXPECT_TRUE(s.comp.start_valid);
   EXPECT_EQ(s.position.programmed[0], 0.0);
   const std::uint64_t before = s.digest();
-  ASSERT_EQ(interp.step(quiet), RunStatus::Ok);   // G1 X30: the entry is released, X30 held
+  ASSERT_EQ(interp.step(quiet), RunStatus::Ok);  // G1 X30: the entry is released, X30 held
   s = interp.state();
   ASSERT_EQ(s.comp.queued.size(), 1u);
   EXPECT_NE(s.digest(), before);
-  EXPECT_EQ(s.position.current[1], 1.0);          // left of +X by the radius
+  EXPECT_EQ(s.position.current[1], 1.0);  // left of +X by the radius
   ASSERT_EQ(interp.run(quiet), RunStatus::Finished);
   EXPECT_TRUE(interp.state().comp.queued.empty());
 }
@@ -467,14 +494,15 @@ TEST(CutterComp, ErrorsNameTheirProblem) {
 namespace {
 
 struct Replay {
-  std::vector<std::string> lines;      // printed calls without the sequence number
-  std::vector<InterpState> states;     // state as each motion arrived
+  std::vector<std::string> lines;   // printed calls without the sequence number
+  std::vector<InterpState> states;  // state as each motion arrived
   RunStatus status = RunStatus::Ok;
 };
 
 class StateAtMotion : public canon::Sink {
  public:
-  StateAtMotion(const Interpreter& interp, std::vector<InterpState>& states) : interp_(interp), states_(states) {}
+  StateAtMotion(const Interpreter& interp, std::vector<InterpState>& states)
+      : interp_(interp), states_(states) {}
   void straight_traverse(canon::SegmentId id, const Pose&) override { capture(id); }
   void straight_feed(canon::SegmentId id, const Pose&) override { capture(id); }
   void arc_feed(canon::SegmentId id, const canon::ArcFeed&) override { capture(id); }
