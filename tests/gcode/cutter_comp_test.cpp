@@ -163,6 +163,7 @@ double turn_between(const Element& in, const Element& out) {
 // its ends every element keeps clear of the others.
 bool wide(const std::vector<Element>& edges) {
   const std::size_t n = edges.size();
+  if (norm(0.5 * (edges.back().a + edges.back().b)) < 6.0) return false;  // room for the entry move
   for (std::size_t i = 0; i < n; ++i) {
     const double t = std::fabs(turn_between(edges[i], edges[(i + 1) % n]));
     if (t < 0.1 || t > kPi - 0.3) return false;
@@ -180,10 +181,10 @@ std::vector<Element> random_outline(std::mt19937& rng) {
   std::uniform_real_distribution<double> u01(0.0, 1.0);
   for (;;) {
     const int n = 3 + static_cast<int>(rng() % 6);
-    std::vector<double> angles;
-    for (int i = 0; i < n; ++i) angles.push_back((i + 0.15 + 0.7 * u01(rng)) * 2 * kPi / n);
+    // Vertices at increasing angles round the origin, 25..40 from it.
     std::vector<Pt> v;
-    for (double a : angles) {
+    for (int i = 0; i < n; ++i) {
+      const double a = (i + 0.15 + 0.7 * u01(rng)) * 2 * kPi / n;
       const double rad = 25 + 15 * u01(rng);
       v.push_back({rad * std::cos(a), rad * std::sin(a)});
     }
