@@ -9,6 +9,10 @@ namespace opencnc::gcode {
 
 inline constexpr long double kPiL = 3.141592653589793238462643383279502884L;
 
+/// LinuxCNC's default tolerance of an arc's end radius against its start radius (absolute).
+inline constexpr double kSpiralToleranceInch = 2 * 0.001 * 1.41421356237309504880;
+inline constexpr double kSpiralToleranceMm = 2 * 0.01 * 1.41421356237309504880;
+
 /// `angle + offset` computed in long double and rounded, as LinuxCNC does with M_PIl terms.
 inline double add_long(double angle, long double offset) noexcept {
   return static_cast<double>(static_cast<long double>(angle) + offset);

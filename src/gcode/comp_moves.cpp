@@ -14,9 +14,8 @@ namespace opencnc::gcode::comp {
 namespace {
 
 constexpr long double kHalfPiL = kPiL / 2;
-// Arc tolerances of the interpreter (LinuxCNC's defaults), for the check of the entry arc.
-constexpr double kSpiralToleranceInch = 2 * 0.001 * 1.41421356237309504880;
-constexpr double kSpiralToleranceMm = 2 * 0.01 * 1.41421356237309504880;
+// LinuxCNC's "equal" tolerance: an entry arc whose chord is this close to perpendicular to
+// the centre line cannot be re-centred.
 constexpr double kEqualTolerance = 0.0001;
 
 bool clockwise(int motion) noexcept {

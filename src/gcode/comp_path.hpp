@@ -31,7 +31,6 @@ class CompPath {
 
   bool left() const noexcept { return left_; }
   double radius() const noexcept { return radius_; }
-  canon::Plane plane() const noexcept { return plane_; }
   /// Where the tool is (its centre) and where the program is, (first, second, normal).
   void current(double& c1, double& c2, double& c3) const noexcept;
   void programmed(double& p1, double& p2, double& p3) const noexcept;

@@ -14,10 +14,9 @@ namespace {
 
 constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
 
-// Arc tolerances (LinuxCNC's defaults): end radius vs start radius, absolute and relative;
-// the smallest radius; the slack allowed for a radius-format semicircle.
-constexpr double kSpiralToleranceInch = 2 * 0.001 * 1.41421356237309504880;
-constexpr double kSpiralToleranceMm = 2 * 0.01 * 1.41421356237309504880;
+// Arc tolerances (LinuxCNC's defaults): end radius vs start radius, relative (the absolute
+// ones are in arc_math.hpp); the smallest radius; the slack allowed for a radius-format
+// semicircle.
 constexpr double kSpiralRelativeTolerance = 0.001;
 constexpr double kRadiusToleranceInch = 0.00005;
 constexpr double kRadiusToleranceMm = 0.00005 * 25.4;
