@@ -66,9 +66,13 @@ class Engine final : public ParamHost, public ExecContext {
   canon::Sink& output() override { return out_; }
   void straight(bool rapid, const Pose& end) override;
   void arc(const canon::ArcFeed& arc) override;
+  ArcCentre arc_centre(const Block& block, int motion, const Pose& start, const Pose& end) override;
   void open_queue() override { out_.open_queue(); }
   void flush_queue() override { out_.flush_queue(); }
   std::size_t queued() const override { return out_.queued(); }
+  void move_queued_end(canon::Plane plane, double first, double second) override {
+    out_.move_queued_end(plane, first, second);
+  }
   void request_sync(const SyncValues& assumed) override;
   [[noreturn]] void error(ErrorCode code, const std::string& message) override { throw GcodeError(code, message); }
 

@@ -102,8 +102,8 @@ void Engine::set_plane(int code) {
   const canon::Plane p = st_.modal.plane;
   if (comp && ((code == 170 && p != canon::Plane::XY) || (code == 180 && p != canon::Plane::XZ) ||
                (code == 190 && p != canon::Plane::YZ)))
-    fail(ErrorCode::ModalContext, "the plane cannot change while cutter compensation is on");
-  if (comp && code == 190) fail(ErrorCode::ModalContext, "cutter compensation works only in the XY and XZ planes");
+    fail(ErrorCode::CompPlaneChange, "the plane cannot change while cutter compensation is on");
+  if (comp && code == 190) fail(ErrorCode::CompWrongPlane, "cutter compensation works only in the XY and XZ planes");
   canon::Plane plane = canon::Plane::XY;
   switch (code) {
     case 170: plane = canon::Plane::XY; break;
@@ -133,6 +133,7 @@ void Engine::set_lathe_mode(int code) {
 
 void Engine::set_cutter_comp(int code) {
   if (code == 400) {
+    if (run_extension_g(code)) return;   // the compensation module ends its own moves
     out_.comment("interpreter: cutter radius compensation off");
     if (st_.modal.cutter_comp != CutterComp::Off && ext_ != nullptr && ext_->compensator) {
       ext_->compensator->finish(*this);

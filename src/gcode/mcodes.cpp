@@ -94,7 +94,7 @@ void Engine::set_tool_parameters() {
 void Engine::change_tool() {
   if (st_.tool.selected_index < 0) fail(ErrorCode::ToolNotPrepared, "M6 with no tool prepared (program a T word first)");
   if (st_.modal.cutter_comp != CutterComp::Off)
-    fail(ErrorCode::ModalContext, "tools cannot be changed while cutter compensation is on");
+    fail(ErrorCode::CompToolChange, "tools cannot be changed while cutter compensation is on");
   out_.start_change();
   out_.stop_spindle_turning(0);
   st_.modal.spindle = canon::SpindleDirection::Stopped;

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "arc_math.hpp"
 #include "engine.hpp"
 #include "numeric.hpp"
 
@@ -11,32 +12,15 @@ namespace opencnc::gcode {
 
 namespace {
 
-constexpr long double kPi = 3.141592653589793238462643383279502884L;
 constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
 
-// Arc tolerances (LinuxCNC's defaults): end radius vs start radius, absolute and relative;
-// the smallest radius; the slack allowed for a radius-format semicircle.
-constexpr double kSpiralToleranceInch = 2 * 0.001 * 1.41421356237309504880;
-constexpr double kSpiralToleranceMm = 2 * 0.01 * 1.41421356237309504880;
+// Arc tolerances (LinuxCNC's defaults): end radius vs start radius, relative (the absolute
+// ones are in arc_math.hpp); the smallest radius; the slack allowed for a radius-format
+// semicircle.
 constexpr double kSpiralRelativeTolerance = 0.001;
 constexpr double kRadiusToleranceInch = 0.00005;
 constexpr double kRadiusToleranceMm = 0.00005 * 25.4;
 constexpr double kTiny = 1e-12;
-
-
-// Angle in radians swept from (x1,y1) to (x2,y2) about (cx,cy) with LinuxCNC's turn count.
-double find_turn(double x1, double y1, double cx, double cy, int turn, double x2, double y2) {
-  if (turn == 0) return 0.0;
-  const long double two_pi = 2 * kPi;
-  double alpha = std::atan2(y1 - cy, x1 - cx);
-  double beta = std::atan2(y2 - cy, x2 - cx);
-  if (turn > 0) {
-    if (beta <= alpha) beta = static_cast<double>(beta + two_pi);
-    return static_cast<double>((beta - alpha) + (turn - 1) * two_pi);
-  }
-  if (alpha <= beta) alpha = static_cast<double>(alpha + two_pi);
-  return static_cast<double>((beta - alpha) + (turn + 1) * two_pi);
-}
 
 char plane_letter(canon::Plane p, int which) {
   switch (p) {
@@ -201,13 +185,17 @@ void Engine::convert_straight(int motion) {
   check_motion_habits(motion == 10);
   if (motion == 10) inverse_time_straight(end);
   if (st_.modal.cutter_comp != CutterComp::Off && st_.modal.comp_radius > 0.0 && b.g[kGroupNonModal] == 530)
-    fail(ErrorCode::G53Usage, "G53 cannot be used while cutter compensation is on");
+    fail(ErrorCode::CompG53, "G53 cannot be used while cutter compensation is on");
   emit_straight(motion == 0, end);
 }
 
 void Engine::inverse_time_straight(const Pose& end) {
   if (st_.modal.feed_mode != canon::FeedMode::InverseTime) return;
-  const Pose& c = st_.position.current;
+  // While compensation runs, the length is the programmed one (LinuxCNC's rule).
+  Pose c = st_.position.current;
+  if (st_.modal.cutter_comp != CutterComp::Off && st_.modal.comp_radius > 0.0 && !st_.modal.comp_first_move) {
+    for (int i = 0; i < 3; ++i) c[i] = st_.position.programmed[static_cast<std::size_t>(i)];
+  }
   constexpr double tiny = 1e-7;
   auto moved = [&](int a, int b2, int d) {
     return std::fabs(c[a] - end[a]) > tiny || std::fabs(c[b2] - end[b2]) > tiny || std::fabs(c[d] - end[d]) > tiny;
@@ -235,7 +223,7 @@ void Engine::inverse_time_arc(double x1, double y1, double z1, double cx, double
 void Engine::convert_arc(int motion) {
   Block& b = block_;
   const ModalState& m = st_.modal;
-  if (m.arc_not_allowed) fail(ErrorCode::ModalContext, "the move right after G40 must be straight, not an arc");
+  if (m.arc_not_allowed) fail(ErrorCode::CompExitArc, "the move right after G40 must be straight, not an arc");
   const bool ijk = b.has('i') || b.has('j') || b.has('k');
   if (m.plane == canon::Plane::UV || m.plane == canon::Plane::VW || m.plane == canon::Plane::UW)
     fail(ErrorCode::ArcPlane, "arcs are not possible in the G17.1, G18.1 and G19.1 planes");
@@ -281,31 +269,37 @@ void Engine::convert_arc(int motion) {
   int a1 = 0, a2 = 1, a3 = 2;
   if (m.plane == canon::Plane::XZ) a1 = 2, a2 = 0, a3 = 1;
   if (m.plane == canon::Plane::YZ) a1 = 1, a2 = 2, a3 = 0;
-  // Offsets in the plane's axis order (XZ: K then I).
-  const double off1 = m.plane == canon::Plane::XZ ? b.get('k') : b.get(l1);
-  const double off2 = m.plane == canon::Plane::XZ ? b.get('i') : b.get(l2);
-  const Pose& cur = st_.position.current;
   if (st_.modal.cutter_comp != CutterComp::Off && st_.modal.comp_radius > 0.0 && m.plane != canon::Plane::YZ &&
       ext_ != nullptr && ext_->compensator) {
     ext_->compensator->arc(*this, b, motion, end);
     return;
   }
-  const int turns = b.has('p') ? round_to_int(b.get('p')) : 1;
-  double c1, c2;
-  int turn;
-  if (b.has('r')) arc_center_r(motion, cur[a1], cur[a2], end[a1], end[a2], b.get('r'), turns, c1, c2, turn);
-  else arc_center_ijk(motion, cur[a1], cur[a2], end[a1], end[a2], off1, off2, turns, c1, c2, turn);
-  inverse_time_arc(cur[a1], cur[a2], cur[a3], c1, c2, turn, end[a1], end[a2], end[a3]);
+  const ArcCentre c = arc_centre(b, motion, st_.position.current, end);
   canon::ArcFeed arc;
   arc.plane = m.plane;
   arc.first_end = end[a1];
   arc.second_end = end[a2];
-  arc.first_center = c1;
-  arc.second_center = c2;
-  arc.rotation = turn;
+  arc.first_center = c.first;
+  arc.second_center = c.second;
+  arc.rotation = c.turn;
   arc.axis_end = end[a3];
   arc.end = end;
   emit_arc(arc);
+}
+
+ArcCentre Engine::arc_centre(const Block& b, int motion, const Pose& start, const Pose& end) {
+  const canon::Plane p = st_.modal.plane;
+  // Plane axes (first, second, normal) and the centre offsets in that order (XZ: K then I).
+  int a1 = 0, a2 = 1, a3 = 2;
+  double off1 = b.get('i'), off2 = b.get('j');
+  if (p == canon::Plane::XZ) a1 = 2, a2 = 0, a3 = 1, off1 = b.get('k'), off2 = b.get('i');
+  if (p == canon::Plane::YZ) a1 = 1, a2 = 2, a3 = 0, off1 = b.get('j'), off2 = b.get('k');
+  const int turns = b.has('p') ? round_to_int(b.get('p')) : 1;
+  ArcCentre c;
+  if (b.has('r')) arc_center_r(motion, start[a1], start[a2], end[a1], end[a2], b.get('r'), turns, c.first, c.second, c.turn);
+  else arc_center_ijk(motion, start[a1], start[a2], end[a1], end[a2], off1, off2, turns, c.first, c.second, c.turn);
+  inverse_time_arc(start[a1], start[a2], start[a3], c.first, c.second, c.turn, end[a1], end[a2], end[a3]);
+  return c;
 }
 
 void Engine::arc_center_ijk(int motion, double cur1, double cur2, double end1, double end2, double off1, double off2,
@@ -353,8 +347,8 @@ void Engine::arc_center_r(int motion, double cur1, double cur2, double end1, dou
   // The direction is a double; ±π/2 is added in long double and the sum rounded (LinuxCNC's
   // arithmetic, kept so that centres on a coordinate axis come out with the same sign).
   const double dir = std::atan2(end2 - cur2, end1 - cur1);
-  const double theta = static_cast<double>(((motion == 20 && radius > 0) || (motion == 30 && radius < 0)) ? dir - kPi / 2
-                                                                                                           : dir + kPi / 2);
+  const double theta = static_cast<double>(((motion == 20 && radius > 0) || (motion == 30 && radius < 0)) ? dir - kPiL / 2
+                                                                                                           : dir + kPiL / 2);
   const double turn2 = std::asin(half_length / abs_radius);
   const double offset = abs_radius * std::cos(turn2);
   c1 = mid1 + offset * std::cos(theta);

@@ -21,8 +21,6 @@ void Engine::update_unit_factor() noexcept {
 }
 
 void Engine::set_units(int code) {
-  if (st_.modal.cutter_comp != CutterComp::Off)
-    fail(ErrorCode::ModalContext, "the units cannot change while cutter compensation is on");
   const canon::Units units = code == 200 ? canon::Units::Inch : canon::Units::Mm;
   units_programmed_ = true;
   out_.use_length_units(units);
@@ -36,6 +34,8 @@ void Engine::set_units(int code) {
   }
   for (double& v : p.programmed) v *= k;
   st_.modal.comp_radius *= k;
+  // Compensation may run on (as in LinuxCNC): what it holds between blocks changes units too.
+  if (st_.modal.cutter_comp != CutterComp::Off && ext_ != nullptr && ext_->compensator) ext_->compensator->rescale(*this, k);
   // LinuxCNC rereads the tool offset and the feed rate from its canon, which keeps the values
   // it was given: neither is converted.
   st_.modal.units = units;
@@ -82,7 +82,7 @@ Pose Engine::machine_to_program(const Pose& m) const {
 
 void Engine::set_coordinate_system(int code) {
   if (st_.modal.cutter_comp != CutterComp::Off)
-    fail(ErrorCode::ModalContext, "the coordinate system cannot change while cutter compensation is on");
+    fail(ErrorCode::CompCoordinateSystem, "the coordinate system cannot change while cutter compensation is on");
   int origin = 1;
   switch (code) {
     case 540: origin = 1; break;
@@ -150,7 +150,7 @@ void Engine::g10_coordinate_system() {
   if (p == 0) p = st_.modal.coord_system;
   const bool active = p == st_.modal.coord_system;
   if (st_.modal.cutter_comp != CutterComp::Off && active)
-    fail(ErrorCode::ModalContext, "the active coordinate system cannot change while cutter compensation is on");
+    fail(ErrorCode::CompCoordinateSystem, "the active coordinate system cannot change while cutter compensation is on");
   const Pose c = current_in_system(p, false);
   const std::size_t base = static_cast<std::size_t>(5200 + 20 * p);
   double r;
@@ -334,7 +334,7 @@ void Engine::axis_offsets(int code) {
 void Engine::go_home(int code) {
   Pose end = find_ends(block_);
   if (st_.modal.cutter_comp != CutterComp::Off)
-    fail(ErrorCode::ModalContext, "G28/G30 cannot be used while cutter compensation is on");
+    fail(ErrorCode::CompG28G30, "G28/G30 cannot be used while cutter compensation is on");
   out_.straight_traverse(0, end);
   st_.position.current = end;
   Pose home_machine;
@@ -365,7 +365,7 @@ void Engine::save_home(int code) {
 
 void Engine::tool_length_offset(int code) {
   if (st_.modal.cutter_comp != CutterComp::Off)
-    fail(ErrorCode::ModalContext, "the tool offset cannot change while cutter compensation is on");
+    fail(ErrorCode::CompToolOffset, "the tool offset cannot change while cutter compensation is on");
   const Block& b = block_;
   PositionState& s = st_.position;
   Pose offset{};

@@ -96,14 +96,42 @@ bool Output::enqueue(Queued&& q) {
   return true;
 }
 
+void Output::move_queued_end(canon::Plane plane, double first, double second) noexcept {
+  const auto axes = plane_axes(plane);
+  for (Queued& q : queue_) {
+    if (q.kind == Queued::Kind::Arc) {
+      q.arc.first_end = first;
+      q.arc.second_end = second;
+      q.arc.end[axes[0]] = first;
+      q.arc.end[axes[1]] = second;
+    } else if (q.kind == Queued::Kind::Traverse || q.kind == Queued::Kind::Feed) {
+      q.pose[axes[0]] = first;
+      q.pose[axes[1]] = second;
+    }
+  }
+}
+
+// A change of length units converts the queued motions (held in program units) too.
+void Output::scale_queue(double k) noexcept {
+  constexpr int kLinear[] = {0, 1, 2, 6, 7, 8};
+  for (Queued& q : queue_) {
+    if (q.kind == Queued::Kind::Arc) {
+      for (double* v : {&q.arc.first_end, &q.arc.second_end, &q.arc.first_center, &q.arc.second_center, &q.arc.axis_end})
+        *v *= k;
+      for (int i : kLinear) q.arc.end[i] *= k;
+    } else if (q.kind == Queued::Kind::Traverse || q.kind == Queued::Kind::Feed) {
+      for (int i : kLinear) q.pose[i] *= k;
+    }
+  }
+}
+
 void Output::flush_queue() {
   queueing_ = false;
-  PositionState* view = view_;
-  view_ = nullptr;   // queued motions were tracked when they were queued
   const canon::BlockOrigin current = origin_;
-  std::vector<Queued> pending;
-  pending.swap(queue_);
-  for (const Queued& q : pending) {
+  // Swap with a second buffer rather than a new vector: compensation flushes after nearly
+  // every move, and both buffers keep their capacity.
+  flushing_.swap(queue_);
+  for (const Queued& q : flushing_) {
     set_origin(q.origin);
     using K = Queued::Kind;
     switch (q.kind) {
@@ -127,16 +155,17 @@ void Output::flush_queue() {
       case K::Comment: comment(q.text); break;
     }
   }
+  flushing_.clear();
   set_origin(current);
-  view_ = view;
 }
 
 // --- representation --------------------------------------------------------------------
 
 void Output::use_length_units(canon::Units u) {
-  if (view_ != nullptr && u != view_units_) {
+  if (u != view_units_) {
     const double k = u == canon::Units::Inch ? 1.0 / 25.4 : 25.4;
-    for (int i = 0; i < 3; ++i) {
+    scale_queue(k);
+    for (int i = 0; view_ != nullptr && i < 3; ++i) {
       view_->canon_position[i] *= k;
       view_->canon_g5x[i] *= k;
       view_->canon_g92[i] *= k;
@@ -172,39 +201,39 @@ void Output::set_feed_reference(canon::FeedReference r) {
 // --- motion ----------------------------------------------------------------------------
 
 void Output::straight_traverse(canon::SegmentId, const Pose& end) {
-  track_motion(end);
   if (queueing_) {
     Queued q = queued(Queued::Kind::Traverse);
     q.pose = end;
     enqueue(std::move(q));
     return;
   }
+  track_motion(end);
   canon::SegmentId id;
   const Pose p = motion_pose(end);
   if (auto* s = live_motion(id)) s->straight_traverse(id, p);
 }
 
 void Output::straight_feed(canon::SegmentId, const Pose& end) {
-  track_motion(end);
   if (queueing_) {
     Queued q = queued(Queued::Kind::Feed);
     q.pose = end;
     enqueue(std::move(q));
     return;
   }
+  track_motion(end);
   canon::SegmentId id;
   const Pose p = motion_pose(end);
   if (auto* s = live_motion(id)) s->straight_feed(id, p);
 }
 
 void Output::arc_feed(canon::SegmentId, const canon::ArcFeed& arc) {
-  track_motion(arc.end);
   if (queueing_) {
     Queued q = queued(Queued::Kind::Arc);
     q.arc = arc;
     enqueue(std::move(q));
     return;
   }
+  track_motion(arc.end);
   canon::ArcFeed a = arc;
   if (transform_ && transform_->active()) transform_->arc(a);
   map_arc(a);

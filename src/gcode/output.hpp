@@ -37,6 +37,9 @@ class Output final : public canon::Sink {
   void open_queue() noexcept { queueing_ = true; }
   void flush_queue();
   std::size_t queued() const noexcept { return queue_.size(); }
+  /// Moves the end of every queued motion to (first, second) of `plane` (cutter compensation
+  /// settling a corner).
+  void move_queued_end(canon::Plane plane, double first, double second) noexcept;
 
   // --- canon::Sink ----------------------------------------------------------------------
   void begin_block(const canon::BlockOrigin& origin) override { set_origin(origin); }
@@ -145,6 +148,7 @@ class Output final : public canon::Sink {
   void map_arc(canon::ArcFeed& arc) const;
   Pose motion_pose(const Pose& p) const;
   bool enqueue(Queued&& q);
+  void scale_queue(double k) noexcept;
 
   void track_motion(const Pose& end) noexcept {
     if (view_ != nullptr) view_->canon_position = end;
@@ -163,6 +167,7 @@ class Output final : public canon::Sink {
   std::shared_ptr<CoordinateTransform> transform_;
   bool queueing_ = false;
   std::vector<Queued> queue_;
+  std::vector<Queued> flushing_;
 };
 
 }  // namespace opencnc::gcode

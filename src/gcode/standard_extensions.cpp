@@ -2,11 +2,14 @@
 // Registers the interpreter modules: one line per module, in the order they take effect.
 #include "opencnc/gcode/standard_extensions.hpp"
 
+#include "opencnc/gcode/cutter_comp.hpp"
+
 namespace opencnc::gcode {
 
 std::shared_ptr<const Extensions> standard_extensions(Dialect dialect) {
   auto ext = std::make_shared<Extensions>();
   (void)dialect;
+  add_cutter_compensation(*ext);
   return ext;
 }
 

@@ -99,6 +99,12 @@ void hash_saved(Fnv& h, const SavedContext& s) noexcept {
   h.f64(s.speed);
 }
 
+void hash_comp_move(Fnv& h, const CompQueuedMove& q) noexcept {
+  h.u64(static_cast<std::uint64_t>(q.kind));
+  for (double v : {q.dir1, q.dir2, q.center1, q.center2, q.end1, q.end2, q.sweep}) h.f64(v);
+  h.i64(q.turn);
+}
+
 }  // namespace
 
 std::uint64_t InterpState::digest() const noexcept {
@@ -140,6 +146,12 @@ std::uint64_t InterpState::digest() const noexcept {
   h.str(control.defining_name);
   for (bool b : {control.executed_if, control.doing_break, control.doing_continue, control.value_returned}) h.flag(b);
   h.f64(control.return_value);
+  h.f64(comp.start1);
+  h.f64(comp.start2);
+  h.flag(comp.start_valid);
+  h.u64(comp.queued.size());
+  for (const CompQueuedMove& q : comp.queued) hash_comp_move(h, q);
+  hash_comp_move(h, comp.last_first);
   h.pos(next);
   h.flag(percent_delimited);
   h.flag(ended);

@@ -79,6 +79,24 @@ namespace opencnc::gcode {
   X(ModalContext, "gcode.modal-context")                                     \
   X(SpindleUsage, "gcode.spindle-usage")                                     \
   X(CoordinateSystem, "gcode.coordinate-system")                             \
+  /* cutter radius compensation */                                          \
+  X(CompWrongPlane, "gcode.comp-wrong-plane")                                \
+  X(CompAlreadyOn, "gcode.comp-already-on")                                  \
+  X(CompDiameterMissing, "gcode.comp-diameter-missing")                      \
+  X(CompToolNumber, "gcode.comp-tool-number")                                \
+  X(CompEntryTooShort, "gcode.comp-entry-too-short")                         \
+  X(CompArcTooSmall, "gcode.comp-arc-too-small")                             \
+  X(CompGouge, "gcode.comp-gouge")                                           \
+  X(CompConcentricArcs, "gcode.comp-concentric-arcs")                        \
+  X(CompArcOffCircle, "gcode.comp-arc-off-circle")                           \
+  X(CompInternal, "gcode.comp-internal")                                     \
+  X(CompExitArc, "gcode.comp-exit-arc")                                      \
+  X(CompPlaneChange, "gcode.comp-plane-change")                              \
+  X(CompCoordinateSystem, "gcode.comp-coordinate-system")                    \
+  X(CompG28G30, "gcode.comp-g28-g30")                                        \
+  X(CompG53, "gcode.comp-g53")                                               \
+  X(CompToolChange, "gcode.comp-tool-change")                                \
+  X(CompToolOffset, "gcode.comp-tool-offset")                                \
   /* program structure and O-words */                                        \
   X(FileEndedNoPercent, "gcode.file-ended-without-percent")                  \
   X(FileEndedNoEnd, "gcode.file-ended-without-end")                          \

@@ -19,6 +19,12 @@
 
 namespace opencnc::gcode {
 
+/// Centre and signed turn count of a programmed arc, in the active plane's coordinates.
+struct ArcCentre {
+  double first = 0, second = 0;
+  int turn = 0;   ///< G3: +turns, G2: -turns
+};
+
 /// What an extension may do while the interpreter executes a block. Implemented by the
 /// interpreter; valid only during the call it is passed to. Interpreter thread only.
 class ExecContext {
@@ -39,11 +45,18 @@ class ExecContext {
   virtual void straight(bool rapid, const Pose& end) = 0;
   /// An arc with final geometry, straight to output; updates the current position.
   virtual void arc(const canon::ArcFeed& arc) = 0;
+  /// Centre and turn of the arc `block` programs (motion 20/30) from `start` to `end`, by
+  /// LinuxCNC's rules: R or I/J/K words of the active plane, P turns, its tolerances and
+  /// errors. In inverse-time mode it also sets the feed rate for that arc.
+  virtual ArcCentre arc_centre(const Block& block, int motion, const Pose& start, const Pose& end) = 0;
   /// LinuxCNC keeps a queue of canonical calls while cutter compensation is on so that a
   /// move's end can still be changed; open it, then flush it when the moves are final.
   virtual void open_queue() = 0;
   virtual void flush_queue() = 0;
   virtual std::size_t queued() const = 0;
+  /// Moves the end of every queued motion, in `plane`, to (first, second): a compensated
+  /// move into a corner is settled only when the move out of it is known.
+  virtual void move_queued_end(canon::Plane plane, double first, double second) = 0;
   /// The block needs machine feedback before the next one (a probe move, an input wait).
   /// Execute mode: the interpreter stops until Interpreter::sync(); scan mode: `assumed`
   /// is applied at once, as the stand-alone rs274 would.
@@ -83,8 +96,12 @@ class MotionStage {
   /// A programmed G2/G3 (`motion` 20/30) to `end`; the centre comes from the block's R or
   /// I/J/K words, relative to state().position.programmed (LinuxCNC's convention).
   virtual void arc(ExecContext& ctx, const Block& block, int motion, const Pose& end) = 0;
-  /// Finish pending moves (G40, M2/M30, a tool change).
+  /// Release pending moves as they stand (M0, M1, M2, M30, M60; G40 is a CodeHandler).
   virtual void finish(ExecContext& ctx) = 0;
+  /// The length units changed while compensating (G20/G21); lengths held between blocks
+  /// (InterpState::comp) must be multiplied by `factor`. The output queue is converted by
+  /// the interpreter.
+  virtual void rescale(ExecContext& /*ctx*/, double /*factor*/) {}
 };
 
 /// Rotation, scaling and mirroring (Fanuc G68/G51/G51.1), applied to motion end points and

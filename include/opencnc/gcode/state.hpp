@@ -151,6 +151,33 @@ struct ControlState {
   bool operator==(const ControlState&) const = default;
 };
 
+/// A motion that cutter compensation holds in the output queue until the corner after it is
+/// known (LinuxCNC's queued canonical motion, reduced to what the corner rules read). Plane
+/// coordinates: (first, second) of the active comp plane (XY: x y; XZ: z x), before the lathe
+/// tool origin shift.
+struct CompQueuedMove {
+  enum class Kind : std::uint8_t { Traverse, Feed, Arc };
+  Kind kind = Kind::Feed;
+  double dir1 = 0, dir2 = 0;         ///< lines: programmed direction (a reversed end is a gouge)
+  double center1 = 0, center2 = 0;   ///< arcs: centre
+  double end1 = 0, end2 = 0;         ///< arcs: end (with the centre, the compensated radius)
+  int turn = 0;                      ///< arcs: signed turns (G3 > 0)
+  double sweep = 0;                  ///< arcs: programmed sweep (rad); 0 = corner arc
+  bool operator==(const CompQueuedMove&) const = default;
+};
+
+/// Cutter compensation between blocks, beyond the modal flags: where the queued moves start
+/// and what they are. Plain data, so that replay or a resume restores it exactly.
+struct CompState {
+  double start1 = 0, start2 = 0;     ///< plane point the queued moves start from
+  bool start_valid = false;          ///< false: gouge checks of the queued moves are skipped
+  std::vector<CompQueuedMove> queued;
+  /// The first move of the last non-empty queue. LinuxCNC reads the queue's first entry
+  /// without checking that there is one; after a stop released the queue it reads this one.
+  CompQueuedMove last_first;
+  bool operator==(const CompState&) const = default;
+};
+
 /// The exact interpreter state. Returned by Interpreter::state(); compare with == or by
 /// digest(). Non-real-time (holds strings and maps); cheap enough to take per block.
 struct InterpState {
@@ -161,6 +188,7 @@ struct InterpState {
   NamedParameters globals;                             ///< #<_name>
   std::vector<CallFrame> frames;                       ///< [0] = main program
   ControlState control;
+  CompState comp;                                      ///< cutter compensation's held moves
   SourcePosition next;                                 ///< next line to read
   bool percent_delimited = false;                      ///< file started with '%'
   bool ended = false;                                  ///< M2/M30 or closing '%' reached
