@@ -63,7 +63,7 @@ std::string Engine::expand_parameters(std::string_view text) {
         if (!std::isspace(static_cast<unsigned char>(text[i]))) name += static_cast<char>(std::tolower(static_cast<unsigned char>(text[i])));
         ++i;
       }
-      if (i >= text.size() || text[i] != '>') fail(ErrorCode::NameNotTerminated, "#< in a comment has no closing '>'");
+      if (i >= text.size() || text[i] != '>') fail(ErrorCode::NameNotTerminated, "#< in this comment is not closed: add '>' after the name");
       ++i;
       double v = 0;
       const bool found = named_value(name, v);

@@ -224,7 +224,7 @@ TEST(Interpreter, MdiLinesRunWithoutAProgramAndSurviveErrors) {
   Recorder rec;
   EXPECT_EQ(interp.execute_mdi("G21 G0 X1 Y2", rec), RunStatus::Ok);
   EXPECT_EQ(interp.execute_mdi("G1 X3", rec), RunStatus::Error);   // no feed rate yet
-  EXPECT_EQ(first_code(interp), "gcode.zero-feed-rate");
+  EXPECT_EQ(first_code(interp), "gcode.feed-zero");
   EXPECT_EQ(interp.execute_mdi("G1 X3 F100", rec), RunStatus::Ok);
   EXPECT_EQ(interp.execute_mdi("o<hop> call [5]", rec), RunStatus::Ok);
   ASSERT_EQ(rec.motions.size(), 4u);
@@ -474,7 +474,7 @@ TEST(InterpreterLimits, EndlessLoopStopsAtTheIterationLimit) {
 TEST(InterpreterLimits, RecursionStopsAtTheCallDepth) {
   Limits l;
   std::uint32_t line = 0;
-  EXPECT_EQ(run_with_limits("o<r> sub\n  o<r> call\no<r> endsub\nG21\no<r> call\nM2\n", l, &line), "gcode.call-depth");
+  EXPECT_EQ(run_with_limits("o<r> sub\n  o<r> call\no<r> endsub\nG21\no<r> call\nM2\n", l, &line), "gcode.limit-call-depth");
   EXPECT_EQ(line, 2u);
 }
 
@@ -552,7 +552,7 @@ namespace {
 class ToyDrill : public CodeHandler {
  public:
   std::optional<Rejection> check(const Block& block, int, const InterpState&) const override {
-    if (!block.has('r')) return Rejection{ErrorCode::MissingWord, "the toy cycle needs R"};
+    if (!block.has('r')) return Rejection{ErrorCode::MissingValue, "the toy cycle needs R"};
     return std::nullopt;
   }
   void execute(ExecContext& ctx, const Block& block, int code) override {
@@ -617,8 +617,9 @@ TEST(InterpreterExtensions, RegisteredHandlersRunInPlaceOfTheCore) {
   // The handler's own checks run before the block executes.
   Interpreter again(options);
   Recorder none;
-  EXPECT_EQ(run_into(again, none, "G21 F100\nG0 Z5\nG81 X1 Y2 Z-3\nM2\n"), RunStatus::Error);
-  EXPECT_EQ(first_code(again), "gcode.missing-word");
+  EXPECT_EQ(run_into(again, none, "G21 F100\nG0 Z5\nN30 G81 X1 Y2 Z-3\nM2\n"), RunStatus::Error);
+  EXPECT_EQ(first_code(again), "gcode.missing-value");
+  EXPECT_EQ(first_error(again)->col, 5u);   // a handler's rejection points at its code
   EXPECT_EQ(none.motions.size(), 1u);
 }
 
