@@ -115,6 +115,8 @@ std::string describe_char(char c) {
 std::uint8_t position_byte(std::size_t pos) noexcept { return static_cast<std::uint8_t>(pos < 255 ? pos : 255); }
 
 constexpr std::string_view kAxisLetters = "xyzabcuvw";
+constexpr std::string_view kOwordKeywords =
+    "sub endsub call return do while endwhile repeat endrepeat if elseif else endif break continue";
 
 // "X Y Z A B C": the axis letters a line may use.
 std::string axis_list(std::uint32_t letters) {
@@ -230,8 +232,14 @@ void Parser::parse(std::string_view text, const ParseEnv& env, Block& b) {
         read_comment(c, b);
         continue;
       }
+      std::size_t end = c.pos + 1;
+      while (end < text.size() && (is_digit(text[end]) || text[end] == '.')) ++end;
+      std::string word(text.substr(c.pos, end - c.pos));
+      if (word[0] >= 'a' && word[0] <= 'z') word[0] = static_cast<char>(word[0] - 'a' + 'A');
       fail_at(static_cast<int>(c.pos), ErrorCode::OwordSyntax,
-              "'{}' after the O-word statement: an O-word line holds only the statement and comments", describe_char(c.at()));
+              "{} after the O-word statement: an O-word line holds only the statement and comments, so put it on a line "
+              "of its own",
+              word);
     }
     return;
   }
@@ -294,6 +302,18 @@ void Parser::read_item(Cursor& c, Block& b) {
     default:
       fail_at(pos, ErrorCode::BadCharacter, "'{}' starts no word: remove it or put it in a comment", describe_char(ch));
   }
+}
+
+// "o1 callsub": a keyword with more letters after it (blanks are gone, so "o1 endif g1" reads
+// "endifg1": one letter and a number after the keyword is the next word, not a misspelling).
+void Parser::misspelt_keyword(const Cursor& c, std::size_t keyword_at) {
+  std::size_t end = c.pos;
+  while (end < c.text.size() && c.text[end] >= 'a' && c.text[end] <= 'z') ++end;
+  if (end == c.pos) return;
+  const char after = end < c.text.size() ? c.text[end] : '\0';
+  if (end - c.pos == 1 && (is_digit(after) || after == '.' || after == '[' || after == '#' || after == '-')) return;
+  fail_at(static_cast<int>(keyword_at), ErrorCode::OwordSyntax, "'{}' is a misspelt O-word keyword ({})",
+          c.text.substr(keyword_at, end - keyword_at), kOwordKeywords);
 }
 
 void Parser::letter_without_word(const Cursor& c, char letter) {
@@ -695,7 +715,13 @@ double Parser::parameter(Cursor& c, bool exists_only) {
     double v = 0;
     const bool found = c.env.host->named_value(name, v);
     if (exists_only) return found ? 1.0 : 0.0;
-    if (!found) fail_at(pos, ErrorCode::NamedParameterUndefined, "#<{}> is read before any value is assigned to it", name);
+    if (!found) {
+      // LinuxCNC reads HAL pins and INI entries through these names; this interpreter has neither.
+      if (name.starts_with("_hal[") || name.starts_with("_ini["))
+        fail_at(pos, ErrorCode::NamedParameterUndefined, "#<{}> reads LinuxCNC's {} here, which this interpreter has no access to",
+                name, name[1] == 'h' ? "HAL" : "INI file");
+      fail_at(pos, ErrorCode::NamedParameterUndefined, "#<{}> is read before any value is assigned to it", name);
+    }
     return v;
   }
   const int index = integer_value(c, "a parameter number");
@@ -724,6 +750,7 @@ void Parser::read_o_word(Cursor& c, Block& b) {
       {"else", OWord::Else}, {"endif", OWord::EndIf}, {"break", OWord::Break}, {"continue", OWord::Continue},
       {"endwhile", OWord::EndWhile}, {"endrepeat", OWord::EndRepeat}, {"return", OWord::Return}};
   OWord type = OWord::None;
+  const std::size_t keyword_at = c.pos;
   for (const auto& [word, kind] : kKeywords) {
     if (starts_with(c.text, c.pos, word)) {
       type = kind;
@@ -733,12 +760,15 @@ void Parser::read_o_word(Cursor& c, Block& b) {
   }
   if (type == OWord::None) {
     const char next = c.at();
-    if (next != '(' && next != ';' && next != '\0')
-      fail_at(static_cast<int>(c.pos), ErrorCode::OwordUnknownKeyword,
-              "o{} is followed by no O-word keyword (sub endsub call return do while endwhile repeat endrepeat if elseif else "
-              "endif break continue)",
-              name);
+    if (next != '(' && next != ';' && next != '\0') {
+      std::size_t end = c.pos;
+      while (end < c.text.size() && c.text[end] >= 'a' && c.text[end] <= 'z') ++end;
+      fail_at(static_cast<int>(c.pos), ErrorCode::OwordUnknownKeyword, "'{}' after o{} is not an O-word keyword ({})",
+              end > c.pos ? c.text.substr(c.pos, end - c.pos) : c.text.substr(c.pos, 1), name, kOwordKeywords);
+    }
     type = OWord::Program;   // "O1234" alone: a program number
+  } else {
+    misspelt_keyword(c, keyword_at);
   }
   const ParseEnv& env = c.env;
   const bool global = type == OWord::Sub || type == OWord::EndSub || type == OWord::Call || type == OWord::Return ||

@@ -64,6 +64,7 @@ class Parser {
   void read_line_number(Cursor& c, Block& b);
   void read_item(Cursor& c, Block& b);
   [[noreturn, gnu::cold]] static void letter_without_word(const Cursor& c, char letter);
+  static void misspelt_keyword(const Cursor& c, std::size_t keyword_at);
   void read_o_word(Cursor& c, Block& b);
   void read_word(Cursor& c, Block& b, char letter);
   void read_g(Cursor& c, Block& b);

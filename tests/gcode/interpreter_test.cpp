@@ -39,8 +39,10 @@ class Recorder : public canon::Sink {
   }
   void dwell(double s) override { dwells.push_back(s); }
   void comment(std::string_view text) override { comments.emplace_back(text); }
+  void message(std::string_view text) override { messages.emplace_back(text); }
 
   std::vector<Motion> motions;
+  std::vector<std::string> messages;
   std::vector<canon::ArcFeed> arcs;
   std::vector<double> dwells;
   std::vector<std::string> comments;
@@ -182,6 +184,60 @@ TEST(Interpreter, ErrorsCarryFileLineAndColumn) {
   ASSERT_NE(first_error(words), nullptr);
   EXPECT_EQ(first_error(words)->code, "gcode.unused-word");
   EXPECT_EQ(first_error(words)->col, 9u);
+}
+
+// Each error names its problem and points at the word to change (line and column of the raw
+// text, blanks included).
+TEST(Interpreter, ErrorsPointAtTheOffendingWord) {
+  struct Case {
+    const char* program;
+    const char* code;
+    std::uint32_t line, col;
+  };
+  const std::string long_line = "G0 X1 (" + std::string(300, 'x') + ")\n";
+  const Case cases[] = {
+      {"G21 F10\nG2 X2 Y0 R0.1\nM2\n", "gcode.arc-radius-too-small", 2, 10},
+      {"G21 F10\nG2 X2 Y0 I1 J0 R1\nM2\n", "gcode.arc-mixed-format", 2, 16},
+      {"G21 F10\nG2 X2 Y0 I1 K1\nM2\n", "gcode.arc-offset-wrong-plane", 2, 13},
+      {"G21 F10\nG3 X10 Y0.6 I5 J0\nM2\n", "gcode.arc-end-off-circle", 2, 13},
+      {"G21\n  G1 Y2 Y3\nM2\n", "gcode.repeated-word", 2, 9},
+      {"G21\nG0 X1 G1 Y2\nM2\n", "gcode.modal-group-conflict", 2, 7},
+      {"G21\nM3 M7 M48 M62 P1 M0\nM2\n", "gcode.too-many-m-codes", 2, 18},
+      {"G21\nG1 F10 X1\nG94\n  X2\nM2\n", "gcode.feed-zero", 4, 3},
+      {"G21\nG91 G1 F10 @1\nM2\n", "gcode.polar-at-origin", 2, 12},
+      {"G21\nG43 H7\nM2\n", "gcode.tool-not-found", 2, 5},
+      {"G21\nG10 L2 P12 X1\nM2\n", "gcode.g10-p-range", 2, 8},
+      {"G21\nM66 P1 L2\nM2\n", "gcode.io-m66-timeout-missing", 2, 8},
+      {"G21\nG0 X1 Q1\nM2\n", "gcode.unused-word", 2, 7},
+      {"G21\nG0 U1\nM2\n", "gcode.axis-not-available", 2, 4},
+      {"G21\nG1 X[1 + 2 F100\nM2\n", "gcode.unclosed-expression", 2, 12},
+      {"G21\nG1 X F100\nM2\n", "gcode.missing-value", 2, 4},
+      {"G21\n  o<nope> call\nM2\n", "gcode.oword-sub-not-found", 2, 3},
+      {"G21\n#1=0\n  o1 if [#1]\nG0 X1\nM2\n", "gcode.oword-unclosed", 3, 3},
+      {"G21\nG0 X1\n", "gcode.missing-program-end", 3, 1},
+      {long_line.c_str(), "gcode.line-too-long", 1, 254},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.program);
+    Interpreter interp;
+    canon::Sink quiet;
+    EXPECT_EQ(run_into(interp, quiet, c.program), RunStatus::Error);
+    const Diagnostic* d = first_error(interp);
+    ASSERT_NE(d, nullptr);
+    EXPECT_EQ(d->code, c.code) << d->message;
+    EXPECT_EQ(d->line, c.line) << d->message;
+    EXPECT_EQ(d->col, c.col) << d->message;
+    EXPECT_FALSE(d->message.empty());
+  }
+}
+
+// rs274 ends a DEBUG text at a #< that is never closed (and then prints bytes it never set):
+// opencnc keeps the text before it and goes on, without an error.
+TEST(Interpreter, AnUnclosedNameEndsACommentsText) {
+  Interpreter interp;
+  Recorder rec;
+  ASSERT_EQ(run_into(interp, rec, "G21\n#<foo>=3\n(DEBUG, value #<foo> then #<foo never closed)\nM2\n"), RunStatus::Finished);
+  EXPECT_EQ(rec.messages, (std::vector<std::string>{" value 3.000000 then "}));
 }
 
 TEST(Interpreter, WarnsOnceAboutHabitsLinuxCncAccepts) {
