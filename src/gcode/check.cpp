@@ -146,9 +146,9 @@ void Engine::check_g_codes() {
   } else if (mode0 == 53) {
     if (mode1 != 520 && mode1 != -1) fail(ErrorCode::Unsupported, "G5.3 is not supported yet");
   } else if (mode0 == 530) {
+    if (b.motion == -1) fail_at(at0, ErrorCode::G53Motion, "G53 needs a G0 or G1 move on its line (in machine coordinates)");
     if (b.motion != 0 && b.motion != 10)
-      fail_at(at0, ErrorCode::G53Motion, "G53 moves in machine coordinates with G0 or G1 only, not {}",
-              b.motion == -1 ? std::string("without a motion") : g_name(b.motion));
+      fail_at(at0, ErrorCode::G53Motion, "G53 moves in machine coordinates with G0 or G1 only, not {}", g_name(b.motion));
     if (b.g[kGroupDistance] == 910 || (b.g[kGroupDistance] != 900 && st_.modal.distance == DistanceMode::Incremental))
       fail_at(at0, ErrorCode::G53Incremental, "G53 takes absolute machine coordinates: it cannot be used in G91 (add G90)");
   }
