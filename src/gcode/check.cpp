@@ -17,20 +17,6 @@ bool is_lathe_cycle(int motion) noexcept { return motion >= 700 && motion <= 722
 bool is_arc(int motion) noexcept { return motion == 20 || motion == 30; }
 char upper(char letter) noexcept { return static_cast<char>(letter - 'a' + 'A'); }
 
-// The later of two positions in the line (the second of two conflicting words).
-int later(int a, int b) noexcept { return a > b ? a : b; }
-
-// Where the motion of a block is named: its G code, else (modal motion) its first axis word.
-int motion_position(const Block& b) noexcept {
-  const int g = b.g_position(kGroupMotion);
-  return g != -1 ? g : b.first_axis_position();
-}
-
-int polar_position(const Block& b) noexcept {
-  if (b.radius_flag && b.theta_flag) return b.radius_at < b.theta_at ? b.radius_at : b.theta_at;
-  return b.radius_flag ? b.radius_at : b.theta_at;
-}
-
 // The fifth M code of the line (the first one too many).
 int fifth_m_position(const Block& b) noexcept {
   std::array<int, kMGroupCount> at{};
@@ -53,7 +39,7 @@ void Engine::enhance_block() {
   Block& b = block_;
   const bool polar = b.radius_flag || b.theta_flag;
   if (polar) {
-    const int at = polar_position(b);
+    const int at = b.polar_position();
     if (!((letters_ >> ('x' - 'a')) & 1u) || !((letters_ >> ('y' - 'a')) & 1u))
       fail_at(at, ErrorCode::PolarNotAvailable, "polar coordinates (@ ^) need both an X and a Y axis, which this machine lacks");
     if (st_.modal.plane != canon::Plane::XY)
@@ -71,7 +57,7 @@ void Engine::enhance_block() {
   const bool covets = mode0 == 100 || mode0 == 280 || mode0 == 300 || mode0 == 520 || mode0 == 920;
   auto no_polar_offset = [&] {
     if (polar && mode0 == 920)
-      fail_at(polar_position(b), ErrorCode::PolarWithoutMotion, "polar coordinates (@ ^) with G92: they give motion end points only");
+      fail_at(b.polar_position(), ErrorCode::PolarWithoutMotion, "polar coordinates (@ ^) with G92: they give motion end points only");
   };
   auto need_offset_axes = [&] {
     if (!axis && (mode0 == 520 || mode0 == 920))
@@ -89,7 +75,7 @@ void Engine::enhance_block() {
       // G70-G72 take their profile from other blocks; their words are checked by the cycle.
     } else {
       if (covets)
-        fail_at(later(b.g_position(kGroupNonModal), b.g_position(kGroupMotion)), ErrorCode::AxisWordsConflict,
+        fail_at(std::max(b.g_position(kGroupNonModal), b.g_position(kGroupMotion)), ErrorCode::AxisWordsConflict,
                 "{} and {} both take the axis words: put them on separate lines", g_name(mode0), g_name(mode1));
       if (!axis && !polar && mode1 != 0 && mode1 != 10 && mode1 != 20 && mode1 != 30 && mode1 != 52)
         fail_at(b.g_position(kGroupMotion), ErrorCode::AxisWordsMissing, "{} needs at least one axis word: the end point",
@@ -110,7 +96,7 @@ void Engine::enhance_block() {
     b.motion = st_.modal.motion;
   }
   if (polar && b.motion == -1)
-    fail_at(polar_position(b), ErrorCode::PolarWithoutMotion, "polar coordinates (@ ^) give motion end points, and this line has no motion");
+    fail_at(b.polar_position(), ErrorCode::PolarWithoutMotion, "polar coordinates (@ ^) give motion end points, and this line has no motion");
 }
 
 void Engine::check_block() {
@@ -139,7 +125,7 @@ void Engine::check_g_codes() {
     if (b.get('p') == -1.0)
       fail_at(b.word_position('p'), ErrorCode::DwellMissing, "G4 P-1 reads as no dwell time: give the seconds to wait");
     if (is_arc(mode1))
-      fail_at(later(at0, b.g_position(kGroupMotion)), ErrorCode::DwellWithArc,
+      fail_at(std::max(at0, b.g_position(kGroupMotion)), ErrorCode::DwellWithArc,
               "G4 and {} on one line: both take P (dwell seconds, arc turns); put them on separate lines", g_name(mode1));
   } else if (mode0 == 100) {
     check_g10();
@@ -232,16 +218,16 @@ void Engine::check_other_codes() {
     fail_at(b.g_position(kGroupSpindleMode), ErrorCode::SurfaceSpeedMissing, "G96 needs an S word: the surface speed");
   if (motion == 330 || motion == 331) {
     if (!b.has('k'))
-      fail_at(motion_position(b), ErrorCode::ThreadPitchMissing, "{} needs a K word: the distance moved per spindle turn",
+      fail_at(b.motion_position(), ErrorCode::ThreadPitchMissing, "{} needs a K word: the distance moved per spindle turn",
               g_name(motion));
     if (b.has('f'))
       fail_at(b.word_position('f'), ErrorCode::ThreadFeedWord,
               "F word on a {} line: the feed follows the spindle (K per turn), so remove F", g_name(motion));
   }
   if (motion == 760) {
-    if (b.p_or(-1.0) == -1.0) fail_at(motion_position(b), ErrorCode::ThreadG76WordMissing, "G76 needs a P word: the thread pitch");
+    if (b.p_or(-1.0) == -1.0) fail_at(b.motion_position(), ErrorCode::ThreadG76WordMissing, "G76 needs a P word: the thread pitch");
     if (!b.has('i') || !b.has('j') || !b.has('k'))
-      fail_at(motion_position(b), ErrorCode::ThreadG76WordMissing,
+      fail_at(b.motion_position(), ErrorCode::ThreadG76WordMissing,
               "G76 needs I, J and K words (thread offset, first cut depth, full thread depth): {}{}{}missing", b.has('i') ? "" : "I ",
               b.has('j') ? "" : "J ", b.has('k') ? "" : "K ");
   }

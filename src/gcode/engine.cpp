@@ -359,14 +359,16 @@ void Engine::unclosed_block() {
   if (l == nullptr) fail(ErrorCode::OwordUnclosed, "the file ends inside an O-word block that is never closed");
   const char* kind = label_kind_name(l->kind);
   const std::string label = label_text(key);
-  // The column of the opening line: its first word (re-read from the file).
+  // The column of the opening line: its first word (re-read from the file; the run is over).
   std::uint32_t col = 0;
-  SourceFile& f = current_file();
-  f.seek(l->at.offset);
-  need_seek_ = true;
-  if (RawLine opening; f.next(opening)) {
-    const std::size_t first = opening.text.find_first_not_of(" \t");
-    col = first == std::string_view::npos ? 1 : static_cast<std::uint32_t>(first + 1);
+  if (l->at.file == st_.next.file) {
+    SourceFile& f = current_file();
+    f.seek(l->at.offset);
+    need_seek_ = true;
+    if (RawLine opening; f.next(opening)) {
+      const std::size_t first = opening.text.find_first_not_of(" \t");
+      col = first == std::string_view::npos ? 1 : static_cast<std::uint32_t>(first + 1);
+    }
   }
   throw GcodeError(ErrorCode::OwordUnclosed,
                    fmt::format("'{} {}' is never closed: the file ends before '{} {}'", label, kind, label,

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // M codes: I/O (M62-M68), tools (T, M6, M61), spindle (M3-M5, M19), modal state save and
 // restore (M70-M73), coolant (M7-M9), overrides (M48-M53), stops and program end.
+#include <algorithm>
 #include <cmath>
 
 #include "engine.hpp"
@@ -8,10 +9,6 @@
 #include "lexer.hpp"
 
 namespace opencnc::gcode {
-
-namespace {
-int later(int a, int b) noexcept { return a > b ? a : b; }
-}  // namespace
 
 void Engine::convert_io() {
   const Block& b = block_;
@@ -35,7 +32,7 @@ void Engine::convert_io() {
   }
   if (m == 66) {
     if (b.has('p') && b.has('e'))
-      fail_at(later(b.word_position('p'), b.word_position('e')), ErrorCode::IoM66BothInputs,
+      fail_at(std::max(b.word_position('p'), b.word_position('e')), ErrorCode::IoM66BothInputs,
               "M66 with both P (a digital input) and E (an analog input): give one of them");
     const int l = b.has('l') ? round_to_int(b.get('l')) : 0;
     if (b.q_or(-1.0) <= 0 && b.has('l') && l > 0)

@@ -38,12 +38,6 @@ double find_turn(double x1, double y1, double cx, double cy, int turn, double x2
   return static_cast<double>((beta - alpha) + (turn + 1) * two_pi);
 }
 
-// Where a block's motion is named: its G code, else (modal motion) its first axis word.
-int motion_position(const Block& b) noexcept {
-  const int g = b.g_position(kGroupMotion);
-  return g != -1 ? g : b.first_axis_position();
-}
-
 // The first centre offset word (I, J or K) of an arc, -1 if none.
 int first_offset_position(const Block& b) noexcept {
   int first = -1;
@@ -52,11 +46,6 @@ int first_offset_position(const Block& b) noexcept {
     if (p != -1 && (first == -1 || p < first)) first = p;
   }
   return first;
-}
-
-int polar_position(const Block& b) noexcept {
-  if (b.radius_flag && b.theta_flag) return b.radius_at < b.theta_at ? b.radius_at : b.theta_at;
-  return b.radius_flag ? b.radius_at : b.theta_at;
 }
 
 const char* plane_name(canon::Plane p) noexcept {
@@ -97,7 +86,7 @@ void Engine::polar_with_xy(const Block& b) {
 }
 
 void Engine::polar_at_origin(const Block& b) {
-  fail_at(polar_position(b), ErrorCode::PolarAtOrigin,
+  fail_at(b.polar_position(), ErrorCode::PolarAtOrigin,
           "incremental polar motion (G91) from the origin: the direction is undefined there, move off it first");
 }
 
@@ -109,7 +98,7 @@ Pose Engine::find_ends(const Block& b) {
   if (b.g[kGroupNonModal] == 530) {
     // Machine coordinates: remove every offset from the words given.
     if (b.radius_flag || b.theta_flag)
-      fail_at(polar_position(b), ErrorCode::PolarWithG53, "polar coordinates (@ ^) cannot be used with G53: give X and Y");
+      fail_at(b.polar_position(), ErrorCode::PolarWithG53, "polar coordinates (@ ^) cannot be used with G53: give X and Y");
     double cx = s.current[0] + s.axis_offset[0];
     double cy = s.current[1] + s.axis_offset[1];
     rotate(cx, cy, s.rotation_xy_deg);
@@ -205,13 +194,13 @@ void Engine::convert_motion(int motion) {
       st_.modal.motion = 800;
       return;
     default:
-      if (!run_extension_g(motion)) unsupported_g(motion, motion_position(block_));
+      if (!run_extension_g(motion)) unsupported_g(motion, block_.motion_position());
   }
 }
 
 void Engine::emit_straight(bool rapid, const Pose& end) {
   if (st_.modal.cutter_comp != CutterComp::Off && st_.modal.comp_radius > 0.0 && ext_ != nullptr && ext_->compensator) {
-    const ExtensionSite site(*this, motion_position(block_));
+    const ExtensionSite site(*this, block_.motion_position());
     ext_->compensator->straight(*this, rapid, end);
     return;
   }
@@ -240,7 +229,7 @@ void Engine::convert_straight(int motion) {
 
 // A feed move needs a feed rate in its feed mode (and a turning spindle per revolution).
 void Engine::check_feed(std::string_view what) const {
-  const int at = motion_position(block_);
+  const int at = block_.motion_position();
   switch (st_.modal.feed_mode) {
     case canon::FeedMode::UnitsPerMinute:
       if (st_.modal.feed_rate == 0.0) fail_at(at, ErrorCode::FeedZero, "{} needs a feed rate, and none is set: program an F word", what);
@@ -290,7 +279,7 @@ void Engine::inverse_time_arc(double x1, double y1, double z1, double cx, double
 void Engine::convert_arc(int motion) {
   Block& b = block_;
   const ModalState& m = st_.modal;
-  const int at = motion_position(b);
+  const int at = b.motion_position();
   const std::string name = g_name(motion);
   if (m.arc_not_allowed)
     fail_at(at, ErrorCode::CompExitArc, "the move right after G40 must be a straight line, not an arc: add a G1 move first");

@@ -767,7 +767,7 @@ void Parser::read_o_word(Cursor& c, Block& b) {
               end > c.pos ? c.text.substr(c.pos, end - c.pos) : c.text.substr(c.pos, 1), name, kOwordKeywords);
     }
     type = OWord::Program;   // "O1234" alone: a program number
-  } else {
+  } else if (c.env.skipping_to.empty()) {   // lines passed over are not checked further (LinuxCNC)
     misspelt_keyword(c, keyword_at);
   }
   const ParseEnv& env = c.env;

@@ -88,6 +88,16 @@ struct Block {
     if (theta_flag) take(theta_at);
     return first;
   }
+  /// The first polar word (@ or ^), -1 if none.
+  int polar_position() const noexcept {
+    if (radius_flag && theta_flag) return radius_at < theta_at ? radius_at : theta_at;
+    return radius_flag ? radius_at : theta_flag ? theta_at : -1;
+  }
+  /// Where the block's motion is named: its motion G code, else (a modal motion) its first axis word.
+  int motion_position() const noexcept {
+    const int code = g_position(kGroupMotion);
+    return code != -1 ? code : first_axis_position();
+  }
 
   /// Bits of the nine axis letters x y z a b c u v w.
   static constexpr std::uint32_t kAxisWordBits =
