@@ -472,7 +472,13 @@ void Parser::read_assignment(Cursor& c) {
 double Parser::real_value(Cursor& c) {
   const char ch = c.at();
   const int pos = static_cast<int>(c.pos);
-  if (ch == '\0') fail_at(pos, ErrorCode::MissingValue, "the line ends where a value should follow");
+  if (ch == '\0') {
+    const char before = pos > 0 ? c.text[static_cast<std::size_t>(pos - 1)] : '\0';
+    if (before >= 'a' && before <= 'z')
+      fail_at(pos - 1, ErrorCode::MissingValue, "{} has no value: the line ends right after the letter",
+              static_cast<char>(before - 'a' + 'A'));
+    fail_at(pos, ErrorCode::MissingValue, "the line ends where a value should follow");
+  }
   const char next = c.at(1);
   double v;
   if (ch == '[') {

@@ -175,7 +175,7 @@ TEST(Interpreter, ErrorsCarryFileLineAndColumn) {
   EXPECT_EQ(d.code, "gcode.missing-value");
   EXPECT_EQ(d.file, "bad.ngc");
   EXPECT_EQ(d.line, 2u);
-  EXPECT_EQ(d.col, 10u);   // the end of the line, where the value is missing
+  EXPECT_EQ(d.col, 9u);   // the Q that has no value
   // The run cannot continue after an error.
   EXPECT_EQ(interp.run(quiet), RunStatus::Error);
   // A word nothing uses is pointed at.
