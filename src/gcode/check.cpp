@@ -14,8 +14,12 @@ namespace {
 
 bool is_cycle(int motion) noexcept { return motion == 730 || motion == 740 || (motion >= 810 && motion <= 890); }
 bool is_lathe_cycle(int motion) noexcept { return motion >= 700 && motion <= 722; }
-bool is_arc(int motion) noexcept { return motion == 20 || motion == 30; }
-char upper(char letter) noexcept { return static_cast<char>(letter - 'a' + 'A'); }
+bool is_arc(int motion) noexcept {
+  return motion == 20 || motion == 30;
+}
+char upper(char letter) noexcept {
+  return static_cast<char>(letter - 'a' + 'A');
+}
 
 // The fifth M code of the line (the first one too many).
 int fifth_m_position(const Block& b) noexcept {
@@ -29,8 +33,8 @@ int fifth_m_position(const Block& b) noexcept {
 }
 
 [[noreturn]] void unused_word(const Block& b, char letter, std::string_view users) {
-  fail_at(b.word_position(letter), ErrorCode::UnusedWord, "{} word used by no code on this line: {} belongs with {}", upper(letter),
-          upper(letter), users);
+  fail_at(b.word_position(letter), ErrorCode::UnusedWord,
+          "{} word used by no code on this line: {} belongs with {}", upper(letter), upper(letter), users);
 }
 
 }  // namespace
@@ -41,13 +45,16 @@ void Engine::enhance_block() {
   if (polar) {
     const int at = b.polar_position();
     if (!((letters_ >> ('x' - 'a')) & 1u) || !((letters_ >> ('y' - 'a')) & 1u))
-      fail_at(at, ErrorCode::PolarNotAvailable, "polar coordinates (@ ^) need both an X and a Y axis, which this machine lacks");
+      fail_at(at, ErrorCode::PolarNotAvailable,
+              "polar coordinates (@ ^) need both an X and a Y axis, which this machine lacks");
     if (st_.modal.plane != canon::Plane::XY)
-      fail_at(at, ErrorCode::PolarNotAvailable, "polar coordinates (@ ^) work only in the XY plane: select G17 first");
+      fail_at(at, ErrorCode::PolarNotAvailable,
+              "polar coordinates (@ ^) work only in the XY plane: select G17 first");
     for (char c : {'x', 'y'}) {
       if (b.has(c))
         fail_at(b.word_position(c), ErrorCode::PolarWithXy,
-                "{} word beside a polar coordinate: give the point either as @ and ^ or as X and Y", upper(c));
+                "{} word beside a polar coordinate: give the point either as @ and ^ or as X and Y",
+                upper(c));
     }
   }
   const bool axis = b.any_axis();
@@ -57,12 +64,13 @@ void Engine::enhance_block() {
   const bool covets = mode0 == 100 || mode0 == 280 || mode0 == 300 || mode0 == 520 || mode0 == 920;
   auto no_polar_offset = [&] {
     if (polar && mode0 == 920)
-      fail_at(b.polar_position(), ErrorCode::PolarWithoutMotion, "polar coordinates (@ ^) with G92: they give motion end points only");
+      fail_at(b.polar_position(), ErrorCode::PolarWithoutMotion,
+              "polar coordinates (@ ^) with G92: they give motion end points only");
   };
   auto need_offset_axes = [&] {
     if (!axis && (mode0 == 520 || mode0 == 920))
-      fail_at(b.g_position(kGroupNonModal), ErrorCode::AxisWordsMissing, "{} needs at least one axis word: the axes to offset",
-              g_name(mode0));
+      fail_at(b.g_position(kGroupNonModal), ErrorCode::AxisWordsMissing,
+              "{} needs at least one axis word: the axes to offset", g_name(mode0));
   };
   if (mode1 != -1) {
     if (mode1 == 800) {
@@ -75,11 +83,12 @@ void Engine::enhance_block() {
       // G70-G72 take their profile from other blocks; their words are checked by the cycle.
     } else {
       if (covets)
-        fail_at(std::max(b.g_position(kGroupNonModal), b.g_position(kGroupMotion)), ErrorCode::AxisWordsConflict,
-                "{} and {} both take the axis words: put them on separate lines", g_name(mode0), g_name(mode1));
+        fail_at(
+            std::max(b.g_position(kGroupNonModal), b.g_position(kGroupMotion)), ErrorCode::AxisWordsConflict,
+            "{} and {} both take the axis words: put them on separate lines", g_name(mode0), g_name(mode1));
       if (!axis && !polar && mode1 != 0 && mode1 != 10 && mode1 != 20 && mode1 != 30 && mode1 != 52)
-        fail_at(b.g_position(kGroupMotion), ErrorCode::AxisWordsMissing, "{} needs at least one axis word: the end point",
-                g_name(mode1));
+        fail_at(b.g_position(kGroupMotion), ErrorCode::AxisWordsMissing,
+                "{} needs at least one axis word: the end point", g_name(mode1));
     }
     b.motion = mode1;
   } else if (covets) {
@@ -90,22 +99,26 @@ void Engine::enhance_block() {
     const bool tool_offset_axes = b.g[kGroupToolLength] == 431 || b.g[kGroupToolLength] == 432;
     if ((st_.modal.motion == -1 || st_.modal.motion == 800) && !tool_offset_axes)
       fail_at(b.first_axis_position(), ErrorCode::AxisWordsUnused,
-              "axis words, but no motion mode is active (G80) and no code on this line uses them: program G0, G1, G2 or G3");
+              "axis words, but no motion mode is active (G80) and no code on this line uses them: program "
+              "G0, G1, G2 or G3");
     if (!tool_offset_axes) b.motion = st_.modal.motion;
   } else if (ijk && is_arc(st_.modal.motion)) {
     b.motion = st_.modal.motion;
   }
   if (polar && b.motion == -1)
-    fail_at(b.polar_position(), ErrorCode::PolarWithoutMotion, "polar coordinates (@ ^) give motion end points, and this line has no motion");
+    fail_at(b.polar_position(), ErrorCode::PolarWithoutMotion,
+            "polar coordinates (@ ^) give motion end points, and this line has no motion");
 }
 
 void Engine::check_block() {
   check_g_codes();
   if (block_.m_count > 4)
-    fail_at(fifth_m_position(block_), ErrorCode::TooManyMCodes, "a fifth M code on this line: a line may hold four at most");
+    fail_at(fifth_m_position(block_), ErrorCode::TooManyMCodes,
+            "a fifth M code on this line: a line may hold four at most");
   check_other_codes();
   if (ext_ == nullptr) return;
-  for (int group = 0; group < kGGroupCount; ++group) check_extension(block_.g[static_cast<std::size_t>(group)], block_.g_position(group));
+  for (int group = 0; group < kGGroupCount; ++group)
+    check_extension(block_.g[static_cast<std::size_t>(group)], block_.g_position(group));
   if (block_.motion != block_.g[kGroupMotion]) check_extension(block_.motion, block_.first_axis_position());
 }
 
@@ -123,20 +136,25 @@ void Engine::check_g_codes() {
   if (mode0 == 40) {
     if (!b.has('p')) fail_at(at0, ErrorCode::DwellMissing, "G4 needs a P word: the dwell time in seconds");
     if (b.get('p') == -1.0)
-      fail_at(b.word_position('p'), ErrorCode::DwellMissing, "G4 P-1 reads as no dwell time: give the seconds to wait");
+      fail_at(b.word_position('p'), ErrorCode::DwellMissing,
+              "G4 P-1 reads as no dwell time: give the seconds to wait");
     if (is_arc(mode1))
       fail_at(std::max(at0, b.g_position(kGroupMotion)), ErrorCode::DwellWithArc,
-              "G4 and {} on one line: both take P (dwell seconds, arc turns); put them on separate lines", g_name(mode1));
+              "G4 and {} on one line: both take P (dwell seconds, arc turns); put them on separate lines",
+              g_name(mode1));
   } else if (mode0 == 100) {
     check_g10();
   } else if (mode0 == 53) {
     if (mode1 != 520 && mode1 != -1) fail(ErrorCode::Unsupported, "G5.3 is not supported yet");
   } else if (mode0 == 530) {
-    if (b.motion == -1) fail_at(at0, ErrorCode::G53Motion, "G53 needs a G0 or G1 move on its line (in machine coordinates)");
+    if (b.motion == -1)
+      fail_at(at0, ErrorCode::G53Motion, "G53 needs a G0 or G1 move on its line (in machine coordinates)");
     if (b.motion != 0 && b.motion != 10)
-      fail_at(at0, ErrorCode::G53Motion, "G53 moves in machine coordinates with G0 or G1 only, not {}", g_name(b.motion));
+      fail_at(at0, ErrorCode::G53Motion, "G53 moves in machine coordinates with G0 or G1 only, not {}",
+              g_name(b.motion));
     if (b.g[kGroupDistance] == 910 || (b.g[kGroupDistance] != 900 && st_.modal.distance == DistanceMode::Incremental))
-      fail_at(at0, ErrorCode::G53Incremental, "G53 takes absolute machine coordinates: it cannot be used in G91 (add G90)");
+      fail_at(at0, ErrorCode::G53Incremental,
+              "G53 takes absolute machine coordinates: it cannot be used in G91 (add G90)");
   }
 }
 
@@ -146,15 +164,22 @@ void Engine::check_g10() {
   const int p_int = round_to_int(p);
   const int l = b.has('l') ? static_cast<int>(b.get('l')) : -1;
   const int at_p = b.has('p') ? b.word_position('p') : b.g_position(kGroupNonModal);
-  if (l == 0) fail_at(b.word_position('l'), ErrorCode::Unsupported, "G10 L0 (reload the tool table) is not supported");
+  if (l == 0)
+    fail_at(b.word_position('l'), ErrorCode::Unsupported, "G10 L0 (reload the tool table) is not supported");
   if (l != 1 && l != 2 && l != 10 && l != 11 && l != 20) {
-    if (l == -1) fail_at(b.g_position(kGroupNonModal), ErrorCode::G10LInvalid, "G10 needs an L word: L1, L2, L10, L11 or L20");
+    if (l == -1)
+      fail_at(b.g_position(kGroupNonModal), ErrorCode::G10LInvalid,
+              "G10 needs an L word: L1, L2, L10, L11 or L20");
     fail_at(b.word_position('l'), ErrorCode::G10LInvalid, "G10 L{}: L must be 1, 2, 10, 11 or 20", l);
   }
-  if ((p + 0.0001) - p_int > 0.0002) fail_at(at_p, ErrorCode::G10PNotInteger, "G10 P{}: P must be a whole number", p);
+  if ((p + 0.0001) - p_int > 0.0002)
+    fail_at(at_p, ErrorCode::G10PNotInteger, "G10 P{}: P must be a whole number", p);
   if ((l == 2 || l == 20) && (p_int < 0 || p_int > 9)) {
-    if (!b.has('p')) fail_at(at_p, ErrorCode::G10PRange, "G10 L{} needs P: the coordinate system, 1 to 9 (0 = the active one)", l);
-    fail_at(at_p, ErrorCode::G10PRange, "G10 L{} P{}: the coordinate system is 1 to 9 (0 = the active one)", l, p_int);
+    if (!b.has('p'))
+      fail_at(at_p, ErrorCode::G10PRange,
+              "G10 L{} needs P: the coordinate system, 1 to 9 (0 = the active one)", l);
+    fail_at(at_p, ErrorCode::G10PRange, "G10 L{} P{}: the coordinate system is 1 to 9 (0 = the active one)",
+            l, p_int);
   }
   if ((l == 1 || l == 10 || l == 11) && p_int < 1) {
     if (!b.has('p')) fail_at(at_p, ErrorCode::G10PRange, "G10 L{} needs P: the tool number, 1 or more", l);
@@ -171,10 +196,11 @@ void Engine::check_other_codes() {
   const bool user_m = b.m[kGroupUser] != -1;
   const bool lathe = is_lathe_cycle(motion);
   if (user_m) return;   // user M codes take any words
-  if (b.dollar_flag && !b.has('s') && m7 != 3 && m7 != 4 && m7 != 5 && m7 != 19 && m9 != 51 && motion != 330 &&
-      motion != 331 && motion != 760)
+  if (b.dollar_flag && !b.has('s') && m7 != 3 && m7 != 4 && m7 != 5 && m7 != 19 && m9 != 51 &&
+      motion != 330 && motion != 331 && motion != 760)
     fail_at(b.dollar_at, ErrorCode::UnusedWord,
-            "$ word (spindle number) used by no code on this line: $ belongs with S, M3, M4, M5, M19, M51, G33, G33.1 or G76");
+            "$ word (spindle number) used by no code on this line: $ belongs with S, M3, M4, M5, M19, M51, "
+            "G33, G33.1 or G76");
   // Most blocks carry axis words and F/S only: none of the rules below can apply.
   constexpr auto bit = [](char c) { return 1u << (c - 'a'); };
   constexpr std::uint32_t kRuledWords = bit('d') | bit('e') | bit('h') | bit('i') | bit('j') | bit('k') | bit('l') |
@@ -183,8 +209,8 @@ void Engine::check_other_codes() {
     return;
   for (char c : {'a', 'b', 'c'}) {
     if (b.has(c) && is_cycle(motion))
-      fail_at(b.word_position(c), ErrorCode::CycleRotaryAxis, "{} word in a canned cycle: cycles move the linear axes only",
-              upper(c));
+      fail_at(b.word_position(c), ErrorCode::CycleRotaryAxis,
+              "{} word in a canned cycle: cycles move the linear axes only", upper(c));
   }
   if (b.has('d') && g7 != 410 && g7 != 420 && g7 != 411 && g7 != 421 && g14 != 960 && !lathe)
     unused_word(b, 'd', "G41, G41.1, G42, G42.1, G96 or a lathe cycle");
@@ -194,8 +220,10 @@ void Engine::check_other_codes() {
   const bool arcish = is_arc(motion) || motion == 50 || motion == 51 || motion == 760 || motion == 870;
   if (b.has('i') && !arcish && motion != 331 && g0 != 100 && !lathe)
     unused_word(b, 'i', "G2, G3, G5, G5.1, G10, G33.1, G76, G87 or a lathe cycle");
-  if (b.has('j') && !arcish && g0 != 100 && !lathe) unused_word(b, 'j', "G2, G3, G5, G5.1, G10, G76, G87 or a lathe cycle");
-  if (b.has('k') && !is_arc(motion) && motion != 330 && motion != 331 && motion != 760 && motion != 870 && !lathe)
+  if (b.has('j') && !arcish && g0 != 100 && !lathe)
+    unused_word(b, 'j', "G2, G3, G5, G5.1, G10, G76, G87 or a lathe cycle");
+  if (b.has('k') && !is_arc(motion) && motion != 330 && motion != 331 && motion != 760 && motion != 870 &&
+      !lathe)
     unused_word(b, 'k', "G2, G3, G33, G33.1, G76, G87 or a lathe cycle");
   if (b.has('l') && !(motion >= 810 && motion <= 890) && motion != 760 && motion != 52 && motion != 730 && motion != 740 &&
       !lathe && g0 != 100 && g7 != 410 && g7 != 411 && g7 != 420 && g7 != 421 && m5 != 66)
@@ -211,25 +239,27 @@ void Engine::check_other_codes() {
         motion != 740 && g7 != 411 && g7 != 421 && g0 != 100 && m7 != 19)
       unused_word(b, 'r', "G2, G3, G10, G41.1, G42.1, a canned cycle, G76, M19 or a lathe cycle");
     if (m7 == 19 && (b.get('r') > 360.0 || b.get('r') < 0.0))
-      fail_at(b.word_position('r'), ErrorCode::M19Angle, "M19 R{}: the orientation angle must lie within 0..360 degrees",
-              b.get('r'));
+      fail_at(b.word_position('r'), ErrorCode::M19Angle,
+              "M19 R{}: the orientation angle must lie within 0..360 degrees", b.get('r'));
   }
   if (!b.has('s') && g14 == 960)
-    fail_at(b.g_position(kGroupSpindleMode), ErrorCode::SurfaceSpeedMissing, "G96 needs an S word: the surface speed");
+    fail_at(b.g_position(kGroupSpindleMode), ErrorCode::SurfaceSpeedMissing,
+            "G96 needs an S word: the surface speed");
   if (motion == 330 || motion == 331) {
     if (!b.has('k'))
-      fail_at(b.motion_position(), ErrorCode::ThreadPitchMissing, "{} needs a K word: the distance moved per spindle turn",
-              g_name(motion));
+      fail_at(b.motion_position(), ErrorCode::ThreadPitchMissing,
+              "{} needs a K word: the distance moved per spindle turn", g_name(motion));
     if (b.has('f'))
       fail_at(b.word_position('f'), ErrorCode::ThreadFeedWord,
               "F word on a {} line: the feed follows the spindle (K per turn), so remove F", g_name(motion));
   }
   if (motion == 760) {
-    if (b.p_or(-1.0) == -1.0) fail_at(b.motion_position(), ErrorCode::ThreadG76WordMissing, "G76 needs a P word: the thread pitch");
+    if (b.p_or(-1.0) == -1.0)
+      fail_at(b.motion_position(), ErrorCode::ThreadG76WordMissing, "G76 needs a P word: the thread pitch");
     if (!b.has('i') || !b.has('j') || !b.has('k'))
       fail_at(b.motion_position(), ErrorCode::ThreadG76WordMissing,
-              "G76 needs I, J and K words (thread offset, first cut depth, full thread depth): {}{}{}missing", b.has('i') ? "" : "I ",
-              b.has('j') ? "" : "J ", b.has('k') ? "" : "K ");
+              "G76 needs I, J and K words (thread offset, first cut depth, full thread depth): {}{}{}missing",
+              b.has('i') ? "" : "I ", b.has('j') ? "" : "J ", b.has('k') ? "" : "K ");
   }
 }
 
@@ -239,18 +269,24 @@ void Engine::check_p_word() {
   const int motion = b.motion;
   const int m5 = b.m[kGroupIo], m7 = b.m[kGroupSpindle], m9 = b.m[kGroupOverride];
   const int g0 = b.g[kGroupNonModal], g13 = b.g[kGroupControl];
-  if (g0 != 100 && g0 != 40 && g13 != 640 && motion != 760 && motion != 820 && motion != 860 && motion != 880 &&
-      motion != 890 && motion != 50 && motion != 52 && !is_arc(motion) && !is_lathe_cycle(motion) && motion != 740 &&
-      motion != 840 && !(m9 >= 50 && m9 <= 53) && !(m5 >= 62 && m5 <= 66) && m7 != 19)
-    unused_word(b, 'p', "G2, G3, G4, G5, G5.2, G10, G64, G74, G76, G82, G84, G86, G88, G89, M19, M50-M53, M62-M66 or a lathe cycle");
+  if (g0 != 100 && g0 != 40 && g13 != 640 && motion != 760 && motion != 820 && motion != 860 &&
+      motion != 880 && motion != 890 && motion != 50 && motion != 52 && !is_arc(motion) &&
+      !is_lathe_cycle(motion) && motion != 740 && motion != 840 && !(m9 >= 50 && m9 <= 53) &&
+      !(m5 >= 62 && m5 <= 66) && m7 != 19)
+    unused_word(b, 'p',
+                "G2, G3, G4, G5, G5.2, G10, G64, G74, G76, G82, G84, G86, G88, G89, M19, M50-M53, M62-M66 or "
+                "a lathe cycle");
   const double p = b.get('p');
   const int p_value = round_to_int(p);
   const int at = b.word_position('p');
   const bool whole = std::fabs(p_value - p) <= 0.001;
-  if (is_arc(motion) && !whole) fail_at(at, ErrorCode::ArcTurnsNotInteger, "P{}: the number of arc turns must be a whole number", p);
+  if (is_arc(motion) && !whole)
+    fail_at(at, ErrorCode::ArcTurnsNotInteger, "P{}: the number of arc turns must be a whole number", p);
   if (m7 == 19 && (!whole || p_value > 2 || p_value < 0))
-    fail_at(at, ErrorCode::M19Direction, "M19 P{}: the direction is 0 (either), 1 (clockwise) or 2 (counterclockwise)", p);
-  if (is_arc(motion) && p_value < 1) fail_at(at, ErrorCode::ArcTurnsRange, "P{}: an arc makes 1 or more turns", p_value);
+    fail_at(at, ErrorCode::M19Direction,
+            "M19 P{}: the direction is 0 (either), 1 (clockwise) or 2 (counterclockwise)", p);
+  if (is_arc(motion) && p_value < 1)
+    fail_at(at, ErrorCode::ArcTurnsRange, "P{}: an arc makes 1 or more turns", p_value);
 }
 
 }  // namespace opencnc::gcode

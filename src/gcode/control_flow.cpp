@@ -23,11 +23,16 @@ const char* label_kind_name(LabelKind k) noexcept {
 
 const char* label_end_keyword(LabelKind k) noexcept {
   switch (k) {
-    case LabelKind::Sub: return "endsub";
-    case LabelKind::Do: return "while [...]";
-    case LabelKind::While: return "endwhile";
-    case LabelKind::Repeat: return "endrepeat";
-    case LabelKind::If: return "endif";
+    case LabelKind::Sub:
+      return "endsub";
+    case LabelKind::Do:
+      return "while [...]";
+    case LabelKind::While:
+      return "endwhile";
+    case LabelKind::Repeat:
+      return "endrepeat";
+    case LabelKind::If:
+      return "endif";
   }
   return "?";
 }
@@ -40,7 +45,9 @@ std::string label_text(std::string_view key) {
 }
 
 namespace {
-std::string plain(std::string_view key) { return label_text(key); }
+std::string plain(std::string_view key) {
+  return label_text(key);
+}
 }  // namespace
 
 LabelInfo* Engine::find_label(const std::string& name) {
@@ -92,7 +99,8 @@ void Engine::control_flow() {
       // A program number line: nothing to do in the main program (Fanuc subprograms, which
       // it would start, are not supported yet).
       if (st_.frames.size() > 1)
-        fail(ErrorCode::Unsupported, "O{} program numbers inside a subprogram (Fanuc style) are not supported yet", block_.o_name);
+        fail(ErrorCode::Unsupported,
+             "O{} program numbers inside a subprogram (Fanuc style) are not supported yet", block_.o_name);
       return;
     case OWord::None: return;
   }
@@ -104,9 +112,10 @@ void Engine::o_sub() {
     if (const LabelInfo* old = find_label(block_.o_name)) {
       if (old->at.line == line_ && old->at.file == line_file_)
         fail(ErrorCode::OwordSubRedefined,
-             "{} sub is read a second time: a subprogram cannot be defined inside a loop or an if", plain(block_.o_name));
-      fail(ErrorCode::OwordSubRedefined, "{} is defined twice (first at {}:{}): rename one of them", plain(block_.o_name),
-           sources_->file(old->at.file), old->at.line);
+             "{} sub is read a second time: a subprogram cannot be defined inside a loop or an if",
+             plain(block_.o_name));
+      fail(ErrorCode::OwordSubRedefined, "{} is defined twice (first at {}:{}): rename one of them",
+           plain(block_.o_name), sources_->file(old->at.file), old->at.line);
     }
     save_label(LabelKind::Sub);
   };
@@ -118,8 +127,8 @@ void Engine::o_sub() {
   c.seeking_sub.clear();
   if (st_.frames.size() > 1) return;   // entering the body of a call
   if (c.defining_sub)
-    fail(ErrorCode::OwordSubNested, "{} sub inside the definition of {}: end that one with endsub first", plain(block_.o_name),
-         plain(c.defining_name));
+    fail(ErrorCode::OwordSubNested, "{} sub inside the definition of {}: end that one with endsub first",
+         plain(block_.o_name), plain(c.defining_name));
   define();
   // A definition in the flow of the program: pass over its body.
   c.skipping_to = block_.o_name;
@@ -133,8 +142,8 @@ void Engine::o_return() {
   c.return_value = block_.o_has_value ? block_.o_value : 0.0;
   c.value_returned = block_.o_has_value;
   if (st_.frames.size() == 1 && !c.defining_sub)
-    fail(ErrorCode::OwordNotInSub, "{} {} outside a subprogram: it belongs between 'sub' and 'endsub'", plain(block_.o_name),
-         block_.o_type == OWord::EndSub ? "endsub" : "return");
+    fail(ErrorCode::OwordNotInSub, "{} {} outside a subprogram: it belongs between 'sub' and 'endsub'",
+         plain(block_.o_name), block_.o_type == OWord::EndSub ? "endsub" : "return");
   if (!c.skipping_to.empty() && block_.o_type == OWord::EndSub) c.skipping_to.clear();
   if (st_.frames.size() > 1) {
     CallFrame& f = st_.frames.back();
@@ -160,8 +169,8 @@ void Engine::o_call() {
   const std::uint32_t depth = static_cast<std::uint32_t>(st_.frames.size());
   const std::uint32_t max_depth = opt_.limits.max_call_depth == 0 ? 10 : opt_.limits.max_call_depth;
   if (depth >= max_depth)
-    fail(ErrorCode::LimitCallDepth, "{} call nests subprograms deeper than {} levels (limit max_call_depth)", plain(block_.o_name),
-         max_depth - 1);
+    fail(ErrorCode::LimitCallDepth, "{} call nests subprograms deeper than {} levels (limit max_call_depth)",
+         plain(block_.o_name), max_depth - 1);
   ControlState& c = st_.control;
   c.skipping_to.clear();
   CallFrame frame;
@@ -181,7 +190,8 @@ void Engine::o_call() {
     jump_to(l->at);
   } else {
     if (!open_sub_file(name) && in_mdi_)
-      fail(ErrorCode::OwordSubNotFound, "o<{}> is not defined, and no file {}.ngc is on the subroutine path", name, name);
+      fail(ErrorCode::OwordSubNotFound, "o<{}> is not defined, and no file {}.ngc is on the subroutine path",
+           name, name);
     c.skipping_to = name;
     c.seeking_sub = name;
     c.skip_start_line = line_;
@@ -214,8 +224,8 @@ void Engine::o_while() {
   LabelInfo* l = find_label(block_.o_name);
   if (l != nullptr) {
     if (l->kind != LabelKind::Do && l->at.line != line_)
-      fail(ErrorCode::OwordLabelDuplicate, "{} is already used on line {}: give this {} its own label", plain(block_.o_name),
-           l->at.line, "while");
+      fail(ErrorCode::OwordLabelDuplicate, "{} is already used on line {}: give this {} its own label",
+           plain(block_.o_name), l->at.line, "while");
   } else {
     save_label(LabelKind::While);
     l = find_label(block_.o_name);
@@ -242,8 +252,8 @@ void Engine::o_repeat() {
   LabelInfo* l = find_label(block_.o_name);
   if (l != nullptr) {
     if (l->at.line != line_)
-      fail(ErrorCode::OwordLabelDuplicate, "{} is already used on line {}: give this {} its own label", plain(block_.o_name),
-           l->at.line, "repeat");
+      fail(ErrorCode::OwordLabelDuplicate, "{} is already used on line {}: give this {} its own label",
+           plain(block_.o_name), l->at.line, "repeat");
   } else {
     save_label(LabelKind::Repeat);
     l = find_label(block_.o_name);
@@ -270,8 +280,8 @@ void Engine::o_if() {
   ControlState& c = st_.control;
   if (const LabelInfo* l = find_label(block_.o_name)) {
     if (l->at.line != line_)
-      fail(ErrorCode::OwordLabelDuplicate, "{} is already used on line {}: give this {} its own label", plain(block_.o_name),
-           l->at.line, "if");
+      fail(ErrorCode::OwordLabelDuplicate, "{} is already used on line {}: give this {} its own label",
+           plain(block_.o_name), l->at.line, "if");
   } else {
     save_label(LabelKind::If);
   }
@@ -287,15 +297,17 @@ void Engine::o_if() {
 
 void Engine::unmatched(const char* keyword, const char* opener, const char* other_opener) const {
   const std::string l = plain(block_.o_name);
-  const std::string openers = other_opener == nullptr ? fmt::format("'{} {}'", l, opener)
-                                                      : fmt::format("'{} {}' or '{} {}'", l, opener, l, other_opener);
-  fail(ErrorCode::OwordUnmatched, "'{} {}' has no {} before it: correct the label, or open the block first", l, keyword, openers);
+  const std::string openers = other_opener == nullptr
+                                  ? fmt::format("'{} {}'", l, opener)
+                                  : fmt::format("'{} {}' or '{} {}'", l, opener, l, other_opener);
+  fail(ErrorCode::OwordUnmatched, "'{} {}' has no {} before it: correct the label, or open the block first",
+       l, keyword, openers);
 }
 
 void Engine::mismatched(const char* keyword, const LabelInfo& label) const {
   const std::string l = plain(block_.o_name);
-  fail(ErrorCode::OwordMismatched, "'{} {}' does not fit '{} {}' (line {}): that block ends with '{} {}'", l, keyword, l,
-       label_kind_name(label.kind), label.at.line, l, label_end_keyword(label.kind));
+  fail(ErrorCode::OwordMismatched, "'{} {}' does not fit '{} {}' (line {}): that block ends with '{} {}'", l,
+       keyword, l, label_kind_name(label.kind), label.at.line, l, label_end_keyword(label.kind));
 }
 
 void Engine::o_elseif() {
@@ -358,7 +370,8 @@ void Engine::o_end_loop() {
   const LabelInfo* l = find_label(block_.o_name);
   const char* what = repeat ? "endrepeat" : "endwhile";
   if (l == nullptr) unmatched(what, repeat ? "repeat" : "while");
-  if ((repeat && l->kind != LabelKind::Repeat) || (!repeat && l->kind != LabelKind::While)) mismatched(what, *l);
+  if ((repeat && l->kind != LabelKind::Repeat) || (!repeat && l->kind != LabelKind::While))
+    mismatched(what, *l);
   if (c.skipping_to == block_.o_name) {
     c.skipping_to.clear();
     if (!c.doing_continue) return;   // the loop is over

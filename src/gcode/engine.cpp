@@ -231,7 +231,8 @@ bool Engine::read_line() {
 
 // Points at the first character beyond the limit.
 void Engine::line_too_long() const {
-  throw GcodeError(ErrorCode::LineTooLong, fmt::format("a line longer than {} characters: split it", kMaxLineLength - 1), -1,
+  throw GcodeError(ErrorCode::LineTooLong,
+                   fmt::format("a line longer than {} characters: split it", kMaxLineLength - 1), -1,
                    Where{line_file_, line_, static_cast<std::uint32_t>(kMaxLineLength)});
 }
 
@@ -261,7 +262,8 @@ bool Engine::process_line() {
     if (st_.percent_delimited)
       fail(ErrorCode::MissingClosingPercent,
            "the file ends without the closing '%' line that its opening '%' (line 1) calls for");
-    fail(ErrorCode::MissingProgramEnd, "the file ends without a program end: finish the program with M2 or M30");
+    fail(ErrorCode::MissingProgramEnd,
+         "the file ends without a program end: finish the program with M2 or M30");
   }
   if (norm_.size() < raw_.size() + 1) norm_.resize(raw_.size() + 1);
   set_origin_from_line();
@@ -290,7 +292,8 @@ bool Engine::process_line() {
   }
   if (block_.o_type != OWord::None) {
     if (in_mdi_ && block_.o_type != OWord::Call)
-      fail(ErrorCode::OwordInMdi, "only 'call' O-words can be used in MDI: control flow needs a program file");
+      fail(ErrorCode::OwordInMdi,
+           "only 'call' O-words can be used in MDI: control flow needs a program file");
     control_flow();
     if (in_mdi_) {
       // An MDI call runs its subprogram to the end here.
@@ -325,7 +328,7 @@ void Engine::reject_foreign_syntax(std::string_view text) const {
     fail_at(0, ErrorCode::DialectUnsupported, "'{}' is {}, not G-code of the LinuxCNC dialect", token, what);
   };
   if (text.front() == '%') {
-    if (text.size() == 1 || text[1] == '(' || text[1] == ';') return;   // the parser judges a lone '%'
+    if (text.size() == 1 || text[1] == '(' || text[1] == ';') return;  // the parser judges a lone '%'
     if (text.starts_with("%_n_")) foreign("a Siemens Sinumerik program header");
     foreign("the program header of another controller");
   }
@@ -343,20 +346,22 @@ void Engine::sub_not_found() {
   const std::string searched = sources_->file(st_.next.file);
   const canon::SourceRef call = sources_->context_info(st_.frames.back().context).call_site;
   const bool own_file = call.file == st_.next.file;
-  throw GcodeError(ErrorCode::OwordSubNotFound,
-                   own_file ? fmt::format("o<{}> call: no 'o<{}> sub' follows in this file, and no {}.ngc is on the "
-                                          "subroutine path",
-                                          name, name, name)
-                            : fmt::format("o<{}> call: {} does not define o<{}> (its sub line must name it)", name,
-                                          searched, name),
-                   -1, Where{call.file, call.line, call.col});
+  throw GcodeError(
+      ErrorCode::OwordSubNotFound,
+      own_file ? fmt::format("o<{}> call: no 'o<{}> sub' follows in this file, and no {}.ngc is on the "
+                             "subroutine path",
+                             name, name, name)
+               : fmt::format("o<{}> call: {} does not define o<{}> (its sub line must name it)", name,
+                             searched, name),
+      -1, Where{call.file, call.line, call.col});
 }
 
 // The file ended while passing over a block to its end label: the block was never closed.
 void Engine::unclosed_block() {
   const std::string& key = st_.control.skipping_to;
   const LabelInfo* l = find_label(key);
-  if (l == nullptr) fail(ErrorCode::OwordUnclosed, "the file ends inside an O-word block that is never closed");
+  if (l == nullptr)
+    fail(ErrorCode::OwordUnclosed, "the file ends inside an O-word block that is never closed");
   const char* kind = label_kind_name(l->kind);
   const std::string label = label_text(key);
   // The column of the opening line: its first word (re-read from the file; the run is over).

@@ -191,7 +191,7 @@ class Engine final : public ParamHost, public ExecContext {
   void set_tool_number(int tool);
   void load_spindle(int index);
   void set_tool_parameters();
-  int tool_index(int tool, int at) const;   ///< `at`: where the word naming the tool starts
+  int tool_index(int tool, int at) const;  ///< `at`: where the word naming the tool starts
   int pocket_of(int index) const noexcept;
   void convert_stop();
   void end_program(int code);
@@ -219,7 +219,8 @@ class Engine final : public ParamHost, public ExecContext {
   void o_break_continue(bool is_break);
   void o_end_loop();
   LabelInfo* find_label(const std::string& name);
-  [[noreturn]] void unmatched(const char* keyword, const char* opener, const char* other_opener = nullptr) const;
+  [[noreturn]] void unmatched(const char* keyword, const char* opener,
+                              const char* other_opener = nullptr) const;
   [[noreturn]] void mismatched(const char* keyword, const LabelInfo& label) const;
   void save_label(LabelKind kind);
   void jump_to_label(const std::string& name);
@@ -252,7 +253,7 @@ class Engine final : public ParamHost, public ExecContext {
   SyncValues block_sync_;           ///< scan mode: feedback assumed at the end of this block
   bool block_sync_pending_ = false;
   std::uint32_t letters_ = 0;       ///< letter words with a reader (axis mask applied)
-  int extension_at_ = -1;           ///< where the code of the running extension starts (its errors point there)
+  int extension_at_ = -1;  ///< where the code of the running extension starts (its errors point there)
   std::uint32_t mdi_file_ = 0;
   bool in_mdi_file_ = false;        ///< "<mdi>" is registered in the source map
   std::uint64_t skipped_lines_ = 0; ///< lines passed over while seeking a label

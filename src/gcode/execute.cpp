@@ -16,7 +16,8 @@ void Engine::apply_assignments() {
 void Engine::execute_block() {
   const Block& b = block_;
   if (b.has_comment && !b.comment.empty()) convert_comment(b.comment);
-  if (b.dollar_flag && (b.g[kGroupSpindleMode] != -1 || b.g[kGroupFeedMode] != -1)) check_spindle_number(false);
+  if (b.dollar_flag && (b.g[kGroupSpindleMode] != -1 || b.g[kGroupFeedMode] != -1))
+    check_spindle_number(false);
   if (b.g[kGroupSpindleMode] != -1) set_spindle_mode();
   if (b.g[kGroupFeedMode] != -1) set_feed_mode(b.g[kGroupFeedMode]);
   if (b.has('f') && st_.modal.feed_mode != canon::FeedMode::InverseTime) {
@@ -50,8 +51,8 @@ void Engine::convert_m() {
   convert_coolant();
   convert_overrides();
   if (const int m = block_.m[kGroupUser]; m != -1 && !run_extension_m(m))
-    fail_at(block_.m_position(kGroupUser), ErrorCode::UnknownMCode, "M{} is not defined: no user M code of that number is installed",
-            m);
+    fail_at(block_.m_position(kGroupUser), ErrorCode::UnknownMCode,
+            "M{} is not defined: no user M code of that number is installed", m);
 }
 
 void Engine::convert_g() {
@@ -109,9 +110,11 @@ void Engine::set_plane(int code) {
   const int at = block_.g_position(kGroupPlane);
   if (comp && ((code == 170 && p != canon::Plane::XY) || (code == 180 && p != canon::Plane::XZ) ||
                (code == 190 && p != canon::Plane::YZ)))
-    fail_at(at, ErrorCode::CompPlaneChange, "{} cannot change the plane while cutter compensation is on: G40 first", g_name(code));
+    fail_at(at, ErrorCode::CompPlaneChange,
+            "{} cannot change the plane while cutter compensation is on: G40 first", g_name(code));
   if (comp && code == 190)
-    fail_at(at, ErrorCode::CompYzPlane, "cutter compensation works in the XY and XZ planes only, not in G19 (YZ)");
+    fail_at(at, ErrorCode::CompYzPlane,
+            "cutter compensation works in the XY and XZ planes only, not in G19 (YZ)");
   canon::Plane plane = canon::Plane::XY;
   switch (code) {
     case 170: plane = canon::Plane::XY; break;
@@ -156,7 +159,8 @@ void Engine::set_cutter_comp(int code) {
 void Engine::set_control_mode(int code) {
   if (st_.modal.cutter_comp != CutterComp::Off)
     fail_at(block_.g_position(kGroupControl), ErrorCode::CompControlMode,
-            "{} cannot change the path control mode while cutter compensation is on: G40 first", g_name(code));
+            "{} cannot change the path control mode while cutter compensation is on: G40 first",
+            g_name(code));
   if (code == 610) {
     out_.set_motion_control_mode(canon::MotionControl::ExactPath, 0);
     st_.modal.control = canon::MotionControl::ExactPath;
@@ -194,7 +198,8 @@ void Engine::set_ijk_mode(int code) {
 void Engine::set_retract_mode(int code) {
   if (st_.modal.cutter_comp != CutterComp::Off)
     fail_at(block_.g_position(kGroupRetract), ErrorCode::CompRetractMode,
-            "{} cannot change the canned cycle return mode while cutter compensation is on: G40 first", g_name(code));
+            "{} cannot change the canned cycle return mode while cutter compensation is on: G40 first",
+            g_name(code));
   if (code == 980) {
     out_.comment("interpreter: retract mode set to old_z");
     st_.modal.retract = RetractMode::OldZ;

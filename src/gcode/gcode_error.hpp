@@ -27,7 +27,8 @@ struct Where {
 /// elsewhere in the program that the error belongs to.
 class GcodeError : public std::exception {
  public:
-  GcodeError(ErrorCode code, std::string message, int position = -1, std::optional<Where> where = std::nullopt)
+  GcodeError(ErrorCode code, std::string message, int position = -1,
+             std::optional<Where> where = std::nullopt)
       : code_(code), message_(std::move(message)), position_(position), where_(where) {}
   const char* what() const noexcept override { return message_.c_str(); }
   ErrorCode code() const noexcept { return code_; }

@@ -18,11 +18,13 @@ void Engine::convert_io() {
   const bool comp = st_.modal.cutter_comp != CutterComp::Off;
   const int at = b.m_position(kGroupIo);
   auto no_comp = [&] {
-    if (comp) fail_at(at, ErrorCode::CompIo, "M{} cannot be used while cutter compensation is on: G40 first", m);
+    if (comp)
+      fail_at(at, ErrorCode::CompIo, "M{} cannot be used while cutter compensation is on: G40 first", m);
   };
   if (m >= 62 && m <= 65) {
     no_comp();
-    if (!b.has('p')) fail_at(at, ErrorCode::IoOutputMissing, "M{} needs a P word: the number of the output", m);
+    if (!b.has('p'))
+      fail_at(at, ErrorCode::IoOutputMissing, "M{} needs a P word: the number of the output", m);
     const int p = round_to_int(b.get('p'));
     if (m == 62) out_.set_motion_output_bit(p);
     else if (m == 63) out_.clear_motion_output_bit(p);
@@ -36,13 +38,15 @@ void Engine::convert_io() {
               "M66 with both P (a digital input) and E (an analog input): give one of them");
     const int l = b.has('l') ? round_to_int(b.get('l')) : 0;
     if (b.q_or(-1.0) <= 0 && b.has('l') && l > 0)
-      fail_at(b.word_position('l'), ErrorCode::IoM66TimeoutMissing, "M66 L{} waits for the input: give a timeout Q greater than 0",
-              l);
+      fail_at(b.word_position('l'), ErrorCode::IoM66TimeoutMissing,
+              "M66 L{} waits for the input: give a timeout Q greater than 0", l);
     if (b.has('e') && b.has('l') && l != 0)
-      fail_at(b.word_position('l'), ErrorCode::IoM66AnalogWait, "M66 E (an analog input) reads the input at once only: use L0");
+      fail_at(b.word_position('l'), ErrorCode::IoM66AnalogWait,
+              "M66 E (an analog input) reads the input at once only: use L0");
     if ((b.has('p') && round_to_int(b.get('p')) < 0) || (b.has('e') && round_to_int(b.get('e')) < 0) ||
         (!b.has('p') && !b.has('e')))
-      fail_at(at, ErrorCode::IoM66InputMissing, "M66 needs the input to read: P (digital) or E (analog), numbered from 0");
+      fail_at(at, ErrorCode::IoM66InputMissing,
+              "M66 needs the input to read: P (digital) or E (analog), numbered from 0");
     no_comp();
     const bool digital = b.has('p');
     const int index = round_to_int(digital ? b.get('p') : b.get('e'));
@@ -58,7 +62,8 @@ void Engine::convert_io() {
   }
   no_comp();
   if (!b.has('e') || round_to_int(b.get('e')) < 0)
-    fail_at(at, ErrorCode::IoAnalogOutputMissing, "M{} needs an E word: the number of the analog output, 0 or more", m);
+    fail_at(at, ErrorCode::IoAnalogOutputMissing,
+            "M{} needs an E word: the number of the analog output, 0 or more", m);
   if (m == 67) out_.set_motion_output_value(round_to_int(b.get('e')), b.q_or(-1.0));
   else out_.set_aux_output_value(round_to_int(b.get('e')), b.q_or(-1.0));
 }
@@ -70,7 +75,8 @@ int Engine::tool_index(int tool, int at) const {
   if (opt_.tool_table) {
     if (const auto index = opt_.tool_table->find(tool)) return static_cast<int>(*index);
   }
-  if (!opt_.tool_table) fail_at(at, ErrorCode::ToolNotFound, "tool {} is not in the tool table (no tool table is loaded)", tool);
+  if (!opt_.tool_table)
+    fail_at(at, ErrorCode::ToolNotFound, "tool {} is not in the tool table (no tool table is loaded)", tool);
   fail_at(at, ErrorCode::ToolNotFound, "tool {} is not in the tool table", tool);
 }
 
@@ -105,9 +111,11 @@ void Engine::set_tool_parameters() {
 
 void Engine::change_tool() {
   const int at = block_.m_position(kGroupToolChange);
-  if (st_.tool.selected_index < 0) fail_at(at, ErrorCode::ToolNotPrepared, "M6 with no tool selected: program a T word first");
+  if (st_.tool.selected_index < 0)
+    fail_at(at, ErrorCode::ToolNotPrepared, "M6 with no tool selected: program a T word first");
   if (st_.modal.cutter_comp != CutterComp::Off)
-    fail_at(at, ErrorCode::CompToolChange, "M6 cannot change tools while cutter compensation is on: G40 first");
+    fail_at(at, ErrorCode::CompToolChange,
+            "M6 cannot change tools while cutter compensation is on: G40 first");
   out_.start_change();
   out_.stop_spindle_turning(0);
   st_.modal.spindle = canon::SpindleDirection::Stopped;
@@ -142,8 +150,10 @@ void Engine::convert_tool_change_group() {
   const int tool = round_to_int(block_.q_or(-1.0));
   if (tool < 0) {
     if (!block_.has('q'))
-      fail_at(block_.m_position(kGroupToolChange), ErrorCode::M61QMissing, "M61 needs a Q word: the number of the tool in the spindle");
-    fail_at(block_.word_position('q'), ErrorCode::M61QMissing, "M61 Q{}: the tool number must be 0 or more", block_.get('q'));
+      fail_at(block_.m_position(kGroupToolChange), ErrorCode::M61QMissing,
+              "M61 needs a Q word: the number of the tool in the spindle");
+    fail_at(block_.word_position('q'), ErrorCode::M61QMissing, "M61 Q{}: the tool number must be 0 or more",
+            block_.get('q'));
   }
   set_tool_number(tool);
 }
@@ -175,8 +185,8 @@ void Engine::convert_spindle_group() {
         out_.orient_spindle(0, b.has('r') ? b.get('r') : 0.0, b.has('p') ? trunc_to_int(b.get('p')) : 0);
       if (b.has('q')) {
         if (b.get('q') <= 0.0)
-          fail_at(b.word_position('q'), ErrorCode::M19Timeout, "M19 Q{}: the time to wait for the orientation must be above 0",
-                  b.get('q'));
+          fail_at(b.word_position('q'), ErrorCode::M19Timeout,
+                  "M19 Q{}: the time to wait for the orientation must be above 0", b.get('q'));
         out_.wait_spindle_orient_complete(0, b.get('q'));
       }
       return;

@@ -50,12 +50,18 @@ int first_offset_position(const Block& b) noexcept {
 
 const char* plane_name(canon::Plane p) noexcept {
   switch (p) {
-    case canon::Plane::XY: return "XY";
-    case canon::Plane::YZ: return "YZ";
-    case canon::Plane::XZ: return "XZ";
-    case canon::Plane::UV: return "UV";
-    case canon::Plane::VW: return "VW";
-    case canon::Plane::UW: return "UW";
+    case canon::Plane::XY:
+      return "XY";
+    case canon::Plane::YZ:
+      return "YZ";
+    case canon::Plane::XZ:
+      return "XZ";
+    case canon::Plane::UV:
+      return "UV";
+    case canon::Plane::VW:
+      return "VW";
+    case canon::Plane::UW:
+      return "UW";
   }
   return "?";
 }
@@ -82,12 +88,14 @@ void Engine::rotate(double& x, double& y, double degrees) const noexcept {
 void Engine::polar_with_xy(const Block& b) {
   const char letter = b.has('x') ? 'x' : 'y';
   fail_at(b.word_position(letter), ErrorCode::PolarWithXy,
-          "{} word beside a polar coordinate: give the point either as @ and ^ or as X and Y", letter == 'x' ? 'X' : 'Y');
+          "{} word beside a polar coordinate: give the point either as @ and ^ or as X and Y",
+          letter == 'x' ? 'X' : 'Y');
 }
 
 void Engine::polar_at_origin(const Block& b) {
-  fail_at(b.polar_position(), ErrorCode::PolarAtOrigin,
-          "incremental polar motion (G91) from the origin: the direction is undefined there, move off it first");
+  fail_at(
+      b.polar_position(), ErrorCode::PolarAtOrigin,
+      "incremental polar motion (G91) from the origin: the direction is undefined there, move off it first");
 }
 
 Pose Engine::find_ends(const Block& b) {
@@ -98,7 +106,8 @@ Pose Engine::find_ends(const Block& b) {
   if (b.g[kGroupNonModal] == 530) {
     // Machine coordinates: remove every offset from the words given.
     if (b.radius_flag || b.theta_flag)
-      fail_at(b.polar_position(), ErrorCode::PolarWithG53, "polar coordinates (@ ^) cannot be used with G53: give X and Y");
+      fail_at(b.polar_position(), ErrorCode::PolarWithG53,
+              "polar coordinates (@ ^) cannot be used with G53: give X and Y");
     double cx = s.current[0] + s.axis_offset[0];
     double cy = s.current[1] + s.axis_offset[1];
     rotate(cx, cy, s.rotation_xy_deg);
@@ -134,7 +143,8 @@ Pose Engine::find_ends(const Block& b) {
         y = b.radius * std::sin(b.theta * kDegToRad);
       } else if (b.radius_flag) {
         if (x == 0 && y == 0)
-          fail_at(b.radius_at, ErrorCode::PolarAtOrigin, "a polar radius @ without an angle ^ at the origin: the direction is undefined");
+          fail_at(b.radius_at, ErrorCode::PolarAtOrigin,
+                  "a polar radius @ without an angle ^ at the origin: the direction is undefined");
         const double t = std::atan2(y, x);
         x = b.radius * std::cos(t);
         y = b.radius * std::sin(t);
@@ -223,7 +233,8 @@ void Engine::convert_straight(int motion) {
   check_motion_habits(motion == 10);
   if (motion == 10) inverse_time_straight(end);
   if (st_.modal.cutter_comp != CutterComp::Off && st_.modal.comp_radius > 0.0 && b.g[kGroupNonModal] == 530)
-    fail_at(b.g_position(kGroupNonModal), ErrorCode::CompG53, "G53 cannot be used while cutter compensation is on: G40 first");
+    fail_at(b.g_position(kGroupNonModal), ErrorCode::CompG53,
+            "G53 cannot be used while cutter compensation is on: G40 first");
   emit_straight(motion == 0, end);
 }
 
@@ -232,19 +243,22 @@ void Engine::check_feed(std::string_view what) const {
   const int at = block_.motion_position();
   switch (st_.modal.feed_mode) {
     case canon::FeedMode::UnitsPerMinute:
-      if (st_.modal.feed_rate == 0.0) fail_at(at, ErrorCode::FeedZero, "{} needs a feed rate, and none is set: program an F word", what);
+      if (st_.modal.feed_rate == 0.0)
+        fail_at(at, ErrorCode::FeedZero, "{} needs a feed rate, and none is set: program an F word", what);
       break;
     case canon::FeedMode::UnitsPerRevolution:
       if (st_.modal.feed_rate == 0.0)
-        fail_at(at, ErrorCode::FeedZero, "{} in feed per revolution (G95) needs a feed rate, and none is set: program an F word",
+        fail_at(at, ErrorCode::FeedZero,
+                "{} in feed per revolution (G95) needs a feed rate, and none is set: program an F word",
                 what);
       if (st_.modal.spindle_speed == 0.0)
-        fail_at(at, ErrorCode::SpindleSpeedZero, "{} in feed per revolution (G95) with the spindle speed at 0: program an S word",
-                what);
+        fail_at(at, ErrorCode::SpindleSpeedZero,
+                "{} in feed per revolution (G95) with the spindle speed at 0: program an S word", what);
       break;
     case canon::FeedMode::InverseTime:
       if (!block_.has('f'))
-        fail_at(at, ErrorCode::InverseTimeFeedMissing, "{} in inverse time mode (G93) needs its own F word on this line", what);
+        fail_at(at, ErrorCode::InverseTimeFeedMissing,
+                "{} in inverse time mode (G93) needs its own F word on this line", what);
       break;
   }
 }
@@ -282,13 +296,16 @@ void Engine::convert_arc(int motion) {
   const int at = b.motion_position();
   const std::string name = g_name(motion);
   if (m.arc_not_allowed)
-    fail_at(at, ErrorCode::CompExitArc, "the move right after G40 must be a straight line, not an arc: add a G1 move first");
+    fail_at(at, ErrorCode::CompExitArc,
+            "the move right after G40 must be a straight line, not an arc: add a G1 move first");
   const bool ijk = b.has('i') || b.has('j') || b.has('k');
   if (m.plane == canon::Plane::UV || m.plane == canon::Plane::VW || m.plane == canon::Plane::UW)
-    fail_at(at, ErrorCode::ArcUvwPlane, "{} in the {} plane: arcs are possible only in the XY, XZ and YZ planes (G17, G18, G19)",
-            name, plane_name(m.plane));
+    fail_at(at, ErrorCode::ArcUvwPlane,
+            "{} in the {} plane: arcs are possible only in the XY, XZ and YZ planes (G17, G18, G19)", name,
+            plane_name(m.plane));
   if (!b.has('r') && !ijk)
-    fail_at(at, ErrorCode::ArcCentreMissing, "{} needs either R (the radius) or I/J/K (the centre offsets)", name);
+    fail_at(at, ErrorCode::ArcCentreMissing, "{} needs either R (the radius) or I/J/K (the centre offsets)",
+            name);
   if (b.has('r') && ijk)
     fail_at(b.word_position('r'), ErrorCode::ArcMixedFormat,
             "R together with I/J/K: give an arc either its radius or its centre, not both");
@@ -300,13 +317,16 @@ void Engine::convert_arc(int motion) {
   if (m.plane == canon::Plane::XZ) l1 = 'i', l2 = 'k', bad = 'j';
   if (ijk) {
     if (b.has(bad))
-      fail_at(b.word_position(bad), ErrorCode::ArcOffsetWrongPlane, "{} word in an arc of the {} plane: its centre offsets are {} and {}",
-              static_cast<char>(bad - 32), plane_name(m.plane), static_cast<char>(l1 - 32), static_cast<char>(l2 - 32));
+      fail_at(b.word_position(bad), ErrorCode::ArcOffsetWrongPlane,
+              "{} word in an arc of the {} plane: its centre offsets are {} and {}",
+              static_cast<char>(bad - 32), plane_name(m.plane), static_cast<char>(l1 - 32),
+              static_cast<char>(l2 - 32));
     for (char need : {l1, l2}) {
       if (b.has(need)) continue;
       if (absolute_ijk)
-        fail_at(at, ErrorCode::ArcCentreIncomplete, "{} without {}: with absolute arc centres (G90.1) both {} and {} are needed",
-                name, static_cast<char>(need - 32), static_cast<char>(l1 - 32), static_cast<char>(l2 - 32));
+        fail_at(at, ErrorCode::ArcCentreIncomplete,
+                "{} without {}: with absolute arc centres (G90.1) both {} and {} are needed", name,
+                static_cast<char>(need - 32), static_cast<char>(l1 - 32), static_cast<char>(l2 - 32));
       b.value[static_cast<std::size_t>(need - 'a')] = 0.0;
       break;   // LinuxCNC defaults only the first missing offset
     }
@@ -316,7 +336,8 @@ void Engine::convert_arc(int motion) {
                                                        : !b.has('x') && !b.has('z');
     if (missing)
       fail_at(at, ErrorCode::ArcEndpointMissing,
-              "{} with R but no end point in the {} plane: give the end point (a full circle needs I/J/K)", name, plane_name(m.plane));
+              "{} with R but no end point in the {} plane: give the end point (a full circle needs I/J/K)",
+              name, plane_name(m.plane));
   }
   const Pose end = find_ends(b);
   check_motion_habits(true);
@@ -371,14 +392,17 @@ void Engine::arc_center_ijk(int motion, double cur1, double cur2, double end1, d
   const char a = plane_letter(p, 0), b = plane_letter(p, 1);
   const int at = first_offset_position(block_);
   if (r1 < radius_tol)
-    fail_at(at, ErrorCode::ArcZeroRadius, "zero-radius arc: its centre ({}{:.4f}, {}{:.4f}) is the start point", a, c1, b, c2);
+    fail_at(at, ErrorCode::ArcZeroRadius,
+            "zero-radius arc: its centre ({}{:.4f}, {}{:.4f}) is the start point", a, c1, b, c2);
   if (r2 < radius_tol)
-    fail_at(at, ErrorCode::ArcZeroRadius, "zero-radius arc: its centre ({}{:.4f}, {}{:.4f}) is the end point", a, c1, b, c2);
+    fail_at(at, ErrorCode::ArcZeroRadius, "zero-radius arc: its centre ({}{:.4f}, {}{:.4f}) is the end point",
+            a, c1, b, c2);
   const double abs_err = std::fabs(r1 - r2);
   const double rel_err = abs_err / std::max(r1, r2);
   if (abs_err > spiral_tol && rel_err > kSpiralRelativeTolerance)
     fail_at(at, ErrorCode::ArcEndOffCircle,
-            "the arc's end ({}{:.4f}, {}{:.4f}) is not on its circle: around the centre ({}{:.4f}, {}{:.4f}) the start is "
+            "the arc's end ({}{:.4f}, {}{:.4f}) is not on its circle: around the centre ({}{:.4f}, {}{:.4f}) "
+            "the start is "
             "{:.4f} away and the end {:.4f}; correct the end point or the centre",
             a, end1, b, end2, a, c1, b, c2, r1, r2);
   turn = motion == 20 ? -turns : turns;
@@ -390,14 +414,16 @@ void Engine::arc_center_r(int motion, double cur1, double cur2, double end1, dou
   const int at = block_.word_position('r');
   if (end1 == cur1 && end2 == cur2)
     fail_at(at, ErrorCode::ArcRadiusFullCircle,
-            "an R arc that ends where it starts: R cannot give a full circle, give the centre with I/J/K instead");
+            "an R arc that ends where it starts: R cannot give a full circle, give the centre with I/J/K "
+            "instead");
   const double abs_radius = std::fabs(radius);
   const double mid1 = (end1 + cur1) / 2.0;
   const double mid2 = (end2 + cur2) / 2.0;
   double half_length = std::hypot(mid1 - end1, mid2 - end2);
   if (half_length - abs_radius > tolerance)
-    fail_at(at, ErrorCode::ArcRadiusTooSmall, "arc radius {:.4f} is smaller than half the chord {:.4f} between start and end",
-            abs_radius, half_length);
+    fail_at(at, ErrorCode::ArcRadiusTooSmall,
+            "arc radius {:.4f} is smaller than half the chord {:.4f} between start and end", abs_radius,
+            half_length);
   if (half_length / abs_radius > 1 - kTiny) half_length = abs_radius;   // allow a semicircle's rounding
   // The direction is a double; ±π/2 is added in long double and the sum rounded (LinuxCNC's
   // arithmetic, kept so that centres on a coordinate axis come out with the same sign).

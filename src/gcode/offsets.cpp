@@ -82,7 +82,8 @@ Pose Engine::machine_to_program(const Pose& m) const {
 void Engine::set_coordinate_system(int code) {
   if (st_.modal.cutter_comp != CutterComp::Off)
     fail_at(block_.g_position(kGroupCoordSystem), ErrorCode::CompCoordinateSystem,
-            "{} cannot change the coordinate system while cutter compensation is on: G40 first", g_name(code));
+            "{} cannot change the coordinate system while cutter compensation is on: G40 first",
+            g_name(code));
   int origin = 1;
   switch (code) {
     case 540: origin = 1; break;
@@ -144,7 +145,8 @@ void Engine::g10_coordinate_system() {
   const Block& b = block_;
   if (b.has('i') || b.has('j'))
     fail_at(b.word_position(b.has('i') ? 'i' : 'j'), ErrorCode::G10IjWords,
-            "I and J cannot be used with G10 L{}: they set tool angles (G10 L1)", static_cast<int>(b.get('l')));
+            "I and J cannot be used with G10 L{}: they set tool angles (G10 L1)",
+            static_cast<int>(b.get('l')));
   auto& par = st_.parameters;
   PositionState& s = st_.position;
   const bool l20 = b.get('l') == 20;
@@ -152,14 +154,17 @@ void Engine::g10_coordinate_system() {
   if (p == 0) p = st_.modal.coord_system;
   const bool active = p == st_.modal.coord_system;
   if (st_.modal.cutter_comp != CutterComp::Off && active)
-    fail_at(b.g_position(kGroupNonModal), ErrorCode::CompActiveSystemOffset,
-            "G10 L{} cannot move the active coordinate system (P{}) while cutter compensation is on: G40 first",
-            static_cast<int>(b.get('l')), p);
+    fail_at(
+        b.g_position(kGroupNonModal), ErrorCode::CompActiveSystemOffset,
+        "G10 L{} cannot move the active coordinate system (P{}) while cutter compensation is on: G40 first",
+        static_cast<int>(b.get('l')), p);
   const Pose c = current_in_system(p, false);
   const std::size_t base = static_cast<std::size_t>(5200 + 20 * p);
   double r;
   if (b.has('r')) {
-    if (l20) fail_at(b.word_position('r'), ErrorCode::G10L20Rotation, "R (rotation) cannot be used with G10 L20: set it with G10 L2");
+    if (l20)
+      fail_at(b.word_position('r'), ErrorCode::G10L20Rotation,
+              "R (rotation) cannot be used with G10 L20: set it with G10 L2");
     r = b.get('r');
     par[base + 10] = r;
   } else {
@@ -226,7 +231,8 @@ void Engine::g10_tool() {
   const bool any = b.any_axis() || b.has('r') || b.has('q') || b.has('i') || b.has('j');
   if (!any)
     fail_at(b.g_position(kGroupNonModal), ErrorCode::G10NoOffsets,
-            "G10 L{} without any value changes nothing: give axis words, R, I, J or Q", static_cast<int>(b.get('l')));
+            "G10 L{} without any value changes nothing: give axis words, R, I, J or Q",
+            static_cast<int>(b.get('l')));
   tools::ToolEntry e = st_.tool.table[static_cast<std::size_t>(index)];
   const int l = static_cast<int>(b.get('l'));
   if (l == 1) {
@@ -281,8 +287,10 @@ void Engine::g10_tool() {
   if (b.q_or(-1.0) != -1.0) {
     int q;
     if (!near_int(q, b.get('q')))
-      fail_at(b.word_position('q'), ErrorCode::G10Orientation, "Q{}: the tool orientation must be a whole number, 0 to 9", b.get('q'));
-    if (q > 9) fail_at(b.word_position('q'), ErrorCode::G10Orientation, "Q{}: the tool orientation must be 0 to 9", q);
+      fail_at(b.word_position('q'), ErrorCode::G10Orientation,
+              "Q{}: the tool orientation must be a whole number, 0 to 9", b.get('q'));
+    if (q > 9)
+      fail_at(b.word_position('q'), ErrorCode::G10Orientation, "Q{}: the tool orientation must be 0 to 9", q);
     e.orientation = q;
   }
   st_.tool.table[static_cast<std::size_t>(index)] = e;
@@ -377,7 +385,8 @@ void Engine::tool_length_offset(int code) {
   const Block& b = block_;
   if (st_.modal.cutter_comp != CutterComp::Off)
     fail_at(b.g_position(kGroupToolLength), ErrorCode::CompToolOffset,
-            "{} cannot change the tool length offset while cutter compensation is on: G40 first", g_name(code));
+            "{} cannot change the tool length offset while cutter compensation is on: G40 first",
+            g_name(code));
   PositionState& s = st_.position;
   Pose offset{};
   auto from_table = [&](int index) {
@@ -400,7 +409,8 @@ void Engine::tool_length_offset(int code) {
     // (rs274 looks up a tool -1), so G43.2 always needs H and takes no axis words.
     const int at = b.g_position(kGroupToolLength);
     if (b.has('h') && b.any_axis())
-      fail_at(b.first_axis_position(), ErrorCode::G43_2AxisWords, "G43.2 takes an H word only: remove the axis words");
+      fail_at(b.first_axis_position(), ErrorCode::G43_2AxisWords,
+              "G43.2 takes an H word only: remove the axis words");
     if (!b.has('h'))
       fail_at(at, ErrorCode::G43_2HMissing, "G43.2 needs an H word: the tool whose length offset it adds{}",
               b.any_axis() ? " (axis words cannot replace it)" : "");

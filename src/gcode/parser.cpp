@@ -50,7 +50,8 @@ double apply_binary(double a, int op, double b, int pos) {
     }
     case kPower:
       if (a < 0.0 && std::floor(b) != b)
-        fail_at(pos, ErrorCode::PowerDomain, "{} ** {}: a negative number has no power with a fractional exponent", a, b);
+        fail_at(pos, ErrorCode::PowerDomain,
+                "{} ** {}: a negative number has no power with a fractional exponent", a, b);
       return std::pow(a, b);
     case kAnd: return (a == 0.0 || b == 0.0) ? 0.0 : 1.0;
     case kOr: return (a != 0.0 || b != 0.0) ? 1.0 : 0.0;
@@ -78,10 +79,12 @@ double apply_unary(int op, double x, int pos) {
   switch (op) {
     case kAbs: return std::fabs(x);
     case kAcos:
-      if (x < -1.0 || x > 1.0) fail_at(pos, ErrorCode::TrigDomain, "ACOS[{}]: the argument must lie within -1..1", x);
+      if (x < -1.0 || x > 1.0)
+        fail_at(pos, ErrorCode::TrigDomain, "ACOS[{}]: the argument must lie within -1..1", x);
       return static_cast<double>(std::acos(x) * 180.0L / kPi);
     case kAsin:
-      if (x < -1.0 || x > 1.0) fail_at(pos, ErrorCode::TrigDomain, "ASIN[{}]: the argument must lie within -1..1", x);
+      if (x < -1.0 || x > 1.0)
+        fail_at(pos, ErrorCode::TrigDomain, "ASIN[{}]: the argument must lie within -1..1", x);
       return static_cast<double>(std::asin(x) * 180.0L / kPi);
     case kCos: return static_cast<double>(std::cos(xl * kPi / 180.0L));
     case kSin: return static_cast<double>(std::sin(xl * kPi / 180.0L));
@@ -90,7 +93,8 @@ double apply_unary(int op, double x, int pos) {
     case kFix: return std::floor(x);
     case kFup: return std::ceil(x);
     case kLn:
-      if (x <= 0.0) fail_at(pos, ErrorCode::LnNonPositive, "LN[{}]: the logarithm needs an argument greater than 0", x);
+      if (x <= 0.0)
+        fail_at(pos, ErrorCode::LnNonPositive, "LN[{}]: the logarithm needs an argument greater than 0", x);
       return std::log(x);
     case kRound: {
       // LinuxCNC rounds half away from zero through an int.
@@ -112,7 +116,9 @@ std::string describe_char(char c) {
 }
 
 // Positions kept in a Block are bytes; lines are shorter than that (kMaxLineLength).
-std::uint8_t position_byte(std::size_t pos) noexcept { return static_cast<std::uint8_t>(pos < 255 ? pos : 255); }
+std::uint8_t position_byte(std::size_t pos) noexcept {
+  return static_cast<std::uint8_t>(pos < 255 ? pos : 255);
+}
 
 constexpr std::string_view kAxisLetters = "xyzabcuvw";
 constexpr std::string_view kOwordKeywords =
@@ -131,34 +137,57 @@ std::string axis_list(std::uint32_t letters) {
 
 const char* g_group_name(int group) noexcept {
   switch (group) {
-    case kGroupNonModal: return "non-modal";
-    case kGroupMotion: return "motion";
-    case kGroupPlane: return "plane selection";
-    case kGroupDistance: return "distance mode";
-    case kGroupIjkDistance: return "arc centre distance mode";
-    case kGroupFeedMode: return "feed mode";
-    case kGroupUnits: return "units";
-    case kGroupCutterComp: return "cutter compensation";
-    case kGroupToolLength: return "tool length offset";
-    case kGroupRetract: return "canned cycle return";
-    case kGroupCoordSystem: return "coordinate system";
-    case kGroupControl: return "path control";
-    case kGroupSpindleMode: return "spindle speed mode";
-    case kGroupLatheDiameter: return "lathe diameter mode";
-    default: return "?";
+    case kGroupNonModal:
+      return "non-modal";
+    case kGroupMotion:
+      return "motion";
+    case kGroupPlane:
+      return "plane selection";
+    case kGroupDistance:
+      return "distance mode";
+    case kGroupIjkDistance:
+      return "arc centre distance mode";
+    case kGroupFeedMode:
+      return "feed mode";
+    case kGroupUnits:
+      return "units";
+    case kGroupCutterComp:
+      return "cutter compensation";
+    case kGroupToolLength:
+      return "tool length offset";
+    case kGroupRetract:
+      return "canned cycle return";
+    case kGroupCoordSystem:
+      return "coordinate system";
+    case kGroupControl:
+      return "path control";
+    case kGroupSpindleMode:
+      return "spindle speed mode";
+    case kGroupLatheDiameter:
+      return "lathe diameter mode";
+    default:
+      return "?";
   }
 }
 
 const char* m_group_name(int group) noexcept {
   switch (group) {
-    case kGroupStop: return "stopping";
-    case kGroupIo: return "input/output";
-    case kGroupToolChange: return "tool change";
-    case kGroupSpindle: return "spindle";
-    case kGroupCoolant: return "coolant";
-    case kGroupOverride: return "override";
-    case kGroupUser: return "user-defined";
-    default: return "?";
+    case kGroupStop:
+      return "stopping";
+    case kGroupIo:
+      return "input/output";
+    case kGroupToolChange:
+      return "tool change";
+    case kGroupSpindle:
+      return "spindle";
+    case kGroupCoolant:
+      return "coolant";
+    case kGroupOverride:
+      return "override";
+    case kGroupUser:
+      return "user-defined";
+    default:
+      return "?";
   }
 }
 
@@ -237,7 +266,8 @@ void Parser::parse(std::string_view text, const ParseEnv& env, Block& b) {
       std::string word(text.substr(c.pos, end - c.pos));
       if (word[0] >= 'a' && word[0] <= 'z') word[0] = static_cast<char>(word[0] - 'a' + 'A');
       fail_at(static_cast<int>(c.pos), ErrorCode::OwordSyntax,
-              "{} after the O-word statement: an O-word line holds only the statement and comments, so put it on a line "
+              "{} after the O-word statement: an O-word line holds only the statement and comments, so put "
+              "it on a line "
               "of its own",
               word);
     }
@@ -251,11 +281,15 @@ void Parser::read_line_number(Cursor& c, Block& b) {
   ++c.pos;
   const std::size_t start = c.pos;
   while (is_digit(c.at())) ++c.pos;
-  if (c.pos == start) fail_at(static_cast<int>(start), ErrorCode::BadLineNumber, "N without digits: a line number is N followed by digits");
+  if (c.pos == start)
+    fail_at(static_cast<int>(start), ErrorCode::BadLineNumber,
+            "N without digits: a line number is N followed by digits");
   if (c.at() == '.') {   // fractional line numbers are read and ignored
     const std::size_t frac = ++c.pos;
     while (is_digit(c.at())) ++c.pos;
-    if (c.pos == frac) fail_at(static_cast<int>(frac), ErrorCode::BadLineNumber, "the line number has no digits after its '.'");
+    if (c.pos == frac)
+      fail_at(static_cast<int>(frac), ErrorCode::BadLineNumber,
+              "the line number has no digits after its '.'");
   }
   b.n_present = true;
 }
@@ -287,7 +321,8 @@ void Parser::read_item(Cursor& c, Block& b) {
       return;
     case '$':
       ++c.pos;
-      if (b.dollar_flag) fail_at(pos, ErrorCode::RepeatedWord, "a second $ word on this line: give the spindle number once");
+      if (b.dollar_flag)
+        fail_at(pos, ErrorCode::RepeatedWord, "a second $ word on this line: give the spindle number once");
       b.dollar = real_value(c);
       b.dollar_flag = true;
       b.dollar_at = position_byte(static_cast<std::size_t>(pos));
@@ -295,12 +330,16 @@ void Parser::read_item(Cursor& c, Block& b) {
     case '%':
       if (c.text == "%")
         fail_at(pos, ErrorCode::PercentMisplaced,
-                "a '%' line in a program whose first line is not '%': delete it, or open the program with a '%' line too");
-      fail_at(pos, ErrorCode::PercentMisplaced, "'%' must stand alone on its line (it opens or closes a program)");
+                "a '%' line in a program whose first line is not '%': delete it, or open the program with a "
+                "'%' line too");
+      fail_at(pos, ErrorCode::PercentMisplaced,
+              "'%' must stand alone on its line (it opens or closes a program)");
     case ']':
-      fail_at(pos, ErrorCode::BadCharacter, "this ']' closes no '[': remove it or add the '[' that opens the expression");
+      fail_at(pos, ErrorCode::BadCharacter,
+              "this ']' closes no '[': remove it or add the '[' that opens the expression");
     default:
-      fail_at(pos, ErrorCode::BadCharacter, "'{}' starts no word: remove it or put it in a comment", describe_char(ch));
+      fail_at(pos, ErrorCode::BadCharacter, "'{}' starts no word: remove it or put it in a comment",
+              describe_char(ch));
   }
 }
 
@@ -311,7 +350,8 @@ void Parser::misspelt_keyword(const Cursor& c, std::size_t keyword_at) {
   while (end < c.text.size() && c.text[end] >= 'a' && c.text[end] <= 'z') ++end;
   if (end == c.pos) return;
   const char after = end < c.text.size() ? c.text[end] : '\0';
-  if (end - c.pos == 1 && (is_digit(after) || after == '.' || after == '[' || after == '#' || after == '-')) return;
+  if (end - c.pos == 1 && (is_digit(after) || after == '.' || after == '[' || after == '#' || after == '-'))
+    return;
   fail_at(static_cast<int>(keyword_at), ErrorCode::OwordSyntax, "'{}' is a misspelt O-word keyword ({})",
           c.text.substr(keyword_at, end - keyword_at), kOwordKeywords);
 }
@@ -320,12 +360,14 @@ void Parser::letter_without_word(const Cursor& c, char letter) {
   const int pos = static_cast<int>(c.pos);
   const char upper = static_cast<char>(letter - 'a' + 'A');
   if (kAxisLetters.find(letter) != std::string_view::npos)
-    fail_at(pos, ErrorCode::AxisNotAvailable, "{} word: this machine has no {} axis (its axes are {})", upper, upper,
-            axis_list(c.env.letters));
+    fail_at(pos, ErrorCode::AxisNotAvailable, "{} word: this machine has no {} axis (its axes are {})", upper,
+            upper, axis_list(c.env.letters));
   if (letter == 'n')
-    fail_at(pos, ErrorCode::LineNumberNotFirst, "N word after other words: a line number must be the first word of its line");
+    fail_at(pos, ErrorCode::LineNumberNotFirst,
+            "N word after other words: a line number must be the first word of its line");
   if (letter == 'o')
-    fail_at(pos, ErrorCode::BadCharacter, "O-word after other words: an O-word statement must begin its line");
+    fail_at(pos, ErrorCode::BadCharacter,
+            "O-word after other words: an O-word statement must begin its line");
   fail_at(pos, ErrorCode::BadCharacter, "'{}' starts no word: remove it or put it in a comment", letter);
 }
 
@@ -343,7 +385,8 @@ void Parser::read_word(Cursor& c, Block& b, char letter) {
   const bool seen = b.has(letter);
   // P and Q count as repeated only when the earlier value is > -1 (LinuxCNC's rule).
   if (seen && ((letter != 'p' && letter != 'q') || b.get(letter) > -1.0))
-    fail_at(pos, ErrorCode::RepeatedWord, "a second {} word on this line: give each word once", static_cast<char>(letter - 32));
+    fail_at(pos, ErrorCode::RepeatedWord, "a second {} word on this line: give each word once",
+            static_cast<char>(letter - 32));
   double v;
   switch (letter) {
     case 'h':
@@ -360,8 +403,10 @@ void Parser::read_word(Cursor& c, Block& b, char letter) {
       break;
     default:
       v = real_value(c);
-      if (letter == 'f' && v < 0.0) fail_at(pos, ErrorCode::FeedNegative, "F{}: a feed rate cannot be negative", v);
-      if (letter == 's' && v < 0.0) fail_at(pos, ErrorCode::SpeedNegative, "S{}: a spindle speed cannot be negative", v);
+      if (letter == 'f' && v < 0.0)
+        fail_at(pos, ErrorCode::FeedNegative, "F{}: a feed rate cannot be negative", v);
+      if (letter == 's' && v < 0.0)
+        fail_at(pos, ErrorCode::SpeedNegative, "S{}: a spindle speed cannot be negative", v);
       if (letter == 'x' && c.env.lathe_diameter) v /= 2.0;
       break;
   }
@@ -397,11 +442,14 @@ void Parser::read_g(Cursor& c, Block& b) {
   if (code < 0) {
     const double v10 = 10.0 * real_value(c);
     // (range first: only then does the value fit an int)
-    if (!(v10 < 1e4)) fail_at(pos, ErrorCode::GCodeOutOfRange, "G{}: G numbers go from 0 to 99.9", v10 / 10.0);
-    if (v10 <= -1e4) fail_at(pos, ErrorCode::GCodeOutOfRange, "G{}: G numbers cannot be negative", v10 / 10.0);
+    if (!(v10 < 1e4))
+      fail_at(pos, ErrorCode::GCodeOutOfRange, "G{}: G numbers go from 0 to 99.9", v10 / 10.0);
+    if (v10 <= -1e4)
+      fail_at(pos, ErrorCode::GCodeOutOfRange, "G{}: G numbers cannot be negative", v10 / 10.0);
     code = static_cast<int>(std::floor(v10));
     if (v10 - code > 0.999) code = static_cast<int>(std::ceil(v10));
-    else if (v10 - code > 0.001) fail_at(pos, ErrorCode::GCodeOutOfRange, "G{}: a G number has at most one decimal", v10 / 10.0);
+    else if (v10 - code > 0.001)
+      fail_at(pos, ErrorCode::GCodeOutOfRange, "G{}: a G number has at most one decimal", v10 / 10.0);
     if (code > 999) fail_at(pos, ErrorCode::GCodeOutOfRange, "G{}: G numbers go from 0 to 99.9", v10 / 10.0);
     if (code < 0) fail_at(pos, ErrorCode::GCodeOutOfRange, "G{}: G numbers cannot be negative", v10 / 10.0);
   }
@@ -410,8 +458,9 @@ void Parser::read_g(Cursor& c, Block& b) {
   auto& slot = b.g[static_cast<std::size_t>(group)];
   if (code == 800 && slot != -1) return;   // G80 beside another motion code is ignored
   if (slot != -1 && slot != 800)
-    fail_at(pos, ErrorCode::ModalGroupConflict, "{} and {} are both {} codes: a line may hold only one of them", g_name(slot),
-            g_name(code), g_group_name(group));
+    fail_at(pos, ErrorCode::ModalGroupConflict,
+            "{} and {} are both {} codes: a line may hold only one of them", g_name(slot), g_name(code),
+            g_group_name(group));
   slot = static_cast<std::int16_t>(code);
   b.g_at[static_cast<std::size_t>(group)] = position_byte(static_cast<std::size_t>(pos));
 }
@@ -426,7 +475,8 @@ void Parser::read_m(Cursor& c, Block& b) {
   if (group < 0) fail_at(pos, ErrorCode::UnknownMCode, "M{} is not an M code of this dialect", code);
   auto& slot = b.m[static_cast<std::size_t>(group)];
   if (slot != -1)
-    fail_at(pos, ErrorCode::ModalGroupConflict, "M{} and M{} are both {} codes: a line may hold only one of them", slot, code,
+    fail_at(pos, ErrorCode::ModalGroupConflict,
+            "M{} and M{} are both {} codes: a line may hold only one of them", slot, code,
             m_group_name(group));
   slot = static_cast<std::int16_t>(code);
   b.m_at[static_cast<std::size_t>(group)] = position_byte(static_cast<std::size_t>(pos));
@@ -437,7 +487,8 @@ std::string Parser::read_name(Cursor& c) {
   const std::size_t start = ++c.pos;   // after '<'
   while (c.pos < c.text.size() && c.text[c.pos] != '>') ++c.pos;
   if (c.pos >= c.text.size())
-    fail_at(static_cast<int>(start - 1), ErrorCode::NameNotTerminated, "the name after '<' is not closed: add '>' after it");
+    fail_at(static_cast<int>(start - 1), ErrorCode::NameNotTerminated,
+            "the name after '<' is not closed: add '>' after it");
   std::string name(c.text.substr(start, c.pos - start));
   ++c.pos;
   return name;
@@ -450,7 +501,8 @@ void Parser::read_assignment(Cursor& c) {
     std::string name = read_name(c);
     c.env.host->declare_named(name);
     if (c.at() != '=')
-      fail_at(static_cast<int>(c.pos), ErrorCode::EqualSignMissing, "#<{}> is not followed by '=': write #<{}>=value", name, name);
+      fail_at(static_cast<int>(c.pos), ErrorCode::EqualSignMissing,
+              "#<{}> is not followed by '=': write #<{}>=value", name, name);
     ++c.pos;
     const double v = real_value(c);
     named_assignments.emplace_back(std::move(name), v);
@@ -463,7 +515,8 @@ void Parser::read_assignment(Cursor& c) {
     fail_at(pos, ErrorCode::ParameterReadOnly, "parameter #{} is read-only: it reports the current {}", index,
             index < 5420 ? "tool" : "position");
   if (c.at() != '=')
-    fail_at(static_cast<int>(c.pos), ErrorCode::EqualSignMissing, "#{} is not followed by '=': write #{}=value", index, index);
+    fail_at(static_cast<int>(c.pos), ErrorCode::EqualSignMissing,
+            "#{} is not followed by '=': write #{}=value", index, index);
   ++c.pos;
   const double v = real_value(c);
   numbered_assignments.emplace_back(index, v);
@@ -494,8 +547,10 @@ double Parser::real_value(Cursor& c) {
   } else {
     return real_number(c);   // finite: no exponent, and overlong digit strings are refused
   }
-  if (std::isnan(v)) fail_at(pos, ErrorCode::ResultNotANumber, "this value is not a number (its calculation is undefined)");
-  if (std::isinf(v)) fail_at(pos, ErrorCode::ResultInfinite, "this value is infinite (its calculation overflows)");
+  if (std::isnan(v))
+    fail_at(pos, ErrorCode::ResultNotANumber, "this value is not a number (its calculation is undefined)");
+  if (std::isinf(v))
+    fail_at(pos, ErrorCode::ResultInfinite, "this value is infinite (its calculation overflows)");
   return v;
 }
 
@@ -550,7 +605,9 @@ void Parser::bad_number(const char* start, const char* after, const char* text, 
   const std::string_view span(start, static_cast<std::size_t>(after - start));
   const auto at = static_cast<int>(start - text);
   if (span.empty()) fail_at(at, ErrorCode::BadNumber, "a number is missing here");
-  if (malformed) fail_at(at, ErrorCode::BadNumber, "'{}' is not a number (digits with at most one point, after at most one sign)", span);
+  if (malformed)
+    fail_at(at, ErrorCode::BadNumber,
+            "'{}' is not a number (digits with at most one point, after at most one sign)", span);
   fail_at(at, ErrorCode::BadNumber, "'{}' is not a number: a number has at most one decimal point", span);
 }
 
@@ -567,10 +624,12 @@ int Parser::integer_value(Cursor& c, const char* what) {
     }
   }
   const double v = real_value(c);
-  if (!(std::fabs(v) < 2147483647.0)) fail_at(pos, ErrorCode::NotAnInteger, "{} is too large for {}", v, what);
+  if (!(std::fabs(v) < 2147483647.0))
+    fail_at(pos, ErrorCode::NotAnInteger, "{} is too large for {}", v, what);
   int i = static_cast<int>(std::floor(v));
   if (v - i > 0.9999) i = static_cast<int>(std::ceil(v));
-  else if (v - i > 0.0001) fail_at(pos, ErrorCode::NotAnInteger, "{} is not a whole number, which {} must be", v, what);
+  else if (v - i > 0.0001)
+    fail_at(pos, ErrorCode::NotAnInteger, "{} is not a whole number, which {} must be", v, what);
   return i;
 }
 
@@ -634,18 +693,22 @@ int Parser::binary_operator(Cursor& c) {
     case 'n': if (n1 == 'e') return word(kNe, 1); break;
     case 'g': if (n1 == 'e') return word(kGe, 1); if (n1 == 't') return word(kGt, 1); break;
     case 'l': if (n1 == 'e') return word(kLe, 1); if (n1 == 't') return word(kLt, 1); break;
-    case '\0': fail_at(pos, ErrorCode::UnclosedExpression, "the line ends inside an expression: close it with ']'");
+    case '\0':
+      fail_at(pos, ErrorCode::UnclosedExpression, "the line ends inside an expression: close it with ']'");
     default:
       if (ch < 'a' || ch > 'z')
-        fail_at(pos, ErrorCode::UnknownOperator, "'{}' is not an operator (+ - * / ** MOD AND OR XOR EQ NE GT GE LT LE) nor ']'",
+        fail_at(pos, ErrorCode::UnknownOperator,
+                "'{}' is not an operator (+ - * / ** MOD AND OR XOR EQ NE GT GE LT LE) nor ']'",
                 describe_char(ch));
       break;
   }
   // A letter with a value after it is the next word of the line: the ']' before it is missing.
   if (is_digit(n1) || n1 == '.' || n1 == '[' || n1 == '#' || n1 == '-' || n1 == '+')
-    fail_at(pos, ErrorCode::UnclosedExpression, "the expression is not closed before the {} word: add ']' before it",
+    fail_at(pos, ErrorCode::UnclosedExpression,
+            "the expression is not closed before the {} word: add ']' before it",
             static_cast<char>(ch - 'a' + 'A'));
-  fail_at(pos, ErrorCode::UnknownOperator, "no operator starts with '{}' (+ - * / ** MOD AND OR XOR EQ NE GT GE LT LE)", ch);
+  fail_at(pos, ErrorCode::UnknownOperator,
+          "no operator starts with '{}' (+ - * / ** MOD AND OR XOR EQ NE GT GE LT LE)", ch);
 }
 
 double Parser::unary(Cursor& c) {
@@ -674,38 +737,48 @@ double Parser::unary(Cursor& c) {
   if (op < 0) {
     // "X F100": the letter before has no value, and the next word follows at once.
     const char before = pos > 0 ? c.text[static_cast<std::size_t>(pos - 1)] : '\0';
-    const char after = c.text.size() > static_cast<std::size_t>(pos) + 1 ? c.text[static_cast<std::size_t>(pos) + 1] : '\0';
+    const char after =
+        c.text.size() > static_cast<std::size_t>(pos) + 1 ? c.text[static_cast<std::size_t>(pos) + 1] : '\0';
     if (before >= 'a' && before <= 'z' && (is_digit(after) || after == '.'))
-      fail_at(pos - 1, ErrorCode::MissingValue, "{} has no value: a number, [expression] or #parameter must follow the letter",
+      fail_at(pos - 1, ErrorCode::MissingValue,
+              "{} has no value: a number, [expression] or #parameter must follow the letter",
               static_cast<char>(before - 'a' + 'A'));
     std::size_t end = static_cast<std::size_t>(pos);
     while (end < c.text.size() && c.text[end] >= 'a' && c.text[end] <= 'z') ++end;
     if (end - static_cast<std::size_t>(pos) > 1) {
       std::string name(c.text.substr(static_cast<std::size_t>(pos), end - static_cast<std::size_t>(pos)));
       for (char& k : name) k = static_cast<char>(k - 'a' + 'A');
-      fail_at(pos, ErrorCode::UnknownWord, "{} is not a function (ABS ACOS ASIN ATAN COS EXISTS EXP FIX FUP LN ROUND SIN SQRT TAN)",
-              name);
+      fail_at(pos, ErrorCode::UnknownWord,
+              "{} is not a function (ABS ACOS ASIN ATAN COS EXISTS EXP FIX FUP LN ROUND SIN SQRT TAN)", name);
     }
-    fail_at(pos, ErrorCode::UnknownWord, "'{}' cannot start a value: write a number, [expression], #parameter or a function", ch);
+    fail_at(pos, ErrorCode::UnknownWord,
+            "'{}' cannot start a value: write a number, [expression], #parameter or a function", ch);
   }
   if (c.at() != '[') {
     std::string name(c.text.substr(static_cast<std::size_t>(pos), c.pos - static_cast<std::size_t>(pos)));
     for (char& k : name) k = static_cast<char>(k - 'a' + 'A');
-    fail_at(static_cast<int>(c.pos), ErrorCode::FunctionBracketMissing, "{} takes its argument in brackets: {}[...]", name, name);
+    fail_at(static_cast<int>(c.pos), ErrorCode::FunctionBracketMissing,
+            "{} takes its argument in brackets: {}[...]", name, name);
   }
   if (op == kExists) {
     ++c.pos;
-    if (c.at() != '#') fail_at(static_cast<int>(c.pos), ErrorCode::ExistsSyntax, "EXISTS takes a parameter: EXISTS[#<name>]");
+    if (c.at() != '#')
+      fail_at(static_cast<int>(c.pos), ErrorCode::ExistsSyntax, "EXISTS takes a parameter: EXISTS[#<name>]");
     const double v = parameter(c, true);
-    if (c.at() != ']') fail_at(static_cast<int>(c.pos), ErrorCode::ExistsSyntax, "EXISTS takes one parameter only: EXISTS[#<name>]");
+    if (c.at() != ']')
+      fail_at(static_cast<int>(c.pos), ErrorCode::ExistsSyntax,
+              "EXISTS takes one parameter only: EXISTS[#<name>]");
     ++c.pos;
     return v;
   }
   const double arg = expression(c);
   if (op == kAtan) {
-    if (c.at() != '/') fail_at(static_cast<int>(c.pos), ErrorCode::AtanSyntax, "ATAN takes two arguments: write ATAN[y]/[x]");
+    if (c.at() != '/')
+      fail_at(static_cast<int>(c.pos), ErrorCode::AtanSyntax, "ATAN takes two arguments: write ATAN[y]/[x]");
     ++c.pos;
-    if (c.at() != '[') fail_at(static_cast<int>(c.pos), ErrorCode::AtanSyntax, "ATAN's second argument goes in brackets: ATAN[y]/[x]");
+    if (c.at() != '[')
+      fail_at(static_cast<int>(c.pos), ErrorCode::AtanSyntax,
+              "ATAN's second argument goes in brackets: ATAN[y]/[x]");
     const double x = expression(c);
     return static_cast<double>(std::atan2(arg, x) * 180.0L / kPi);   // double atan2, long double scaling
 
@@ -724,9 +797,11 @@ double Parser::parameter(Cursor& c, bool exists_only) {
     if (!found) {
       // LinuxCNC reads HAL pins and INI entries through these names; this interpreter has neither.
       if (name.starts_with("_hal[") || name.starts_with("_ini["))
-        fail_at(pos, ErrorCode::NamedParameterUndefined, "#<{}> reads LinuxCNC's {} here, which this interpreter has no access to",
-                name, name[1] == 'h' ? "HAL" : "INI file");
-      fail_at(pos, ErrorCode::NamedParameterUndefined, "#<{}> is read before any value is assigned to it", name);
+        fail_at(pos, ErrorCode::NamedParameterUndefined,
+                "#<{}> reads LinuxCNC's {} here, which this interpreter has no access to", name,
+                name[1] == 'h' ? "HAL" : "INI file");
+      fail_at(pos, ErrorCode::NamedParameterUndefined, "#<{}> is read before any value is assigned to it",
+              name);
     }
     return v;
   }
@@ -735,8 +810,8 @@ double Parser::parameter(Cursor& c, bool exists_only) {
   if (index < 1 || index >= kParameterCount)
     fail_at(pos, ErrorCode::ParameterOutOfRange, "parameter #{} does not exist (1..{})", index, kParameterCount - 1);
   if (index >= 5420 && index <= 5428 && c.env.comp_on)
-    fail_at(pos, ErrorCode::CompPositionRead, "#{} (the current position) cannot be read while cutter compensation is on: G40 first",
-            index);
+    fail_at(pos, ErrorCode::CompPositionRead,
+            "#{} (the current position) cannot be read while cutter compensation is on: G40 first", index);
   return c.env.parameters[index];
 }
 
@@ -769,11 +844,13 @@ void Parser::read_o_word(Cursor& c, Block& b) {
     if (next != '(' && next != ';' && next != '\0') {
       std::size_t end = c.pos;
       while (end < c.text.size() && c.text[end] >= 'a' && c.text[end] <= 'z') ++end;
-      fail_at(static_cast<int>(c.pos), ErrorCode::OwordUnknownKeyword, "'{}' after o{} is not an O-word keyword ({})",
-              end > c.pos ? c.text.substr(c.pos, end - c.pos) : c.text.substr(c.pos, 1), name, kOwordKeywords);
+      fail_at(static_cast<int>(c.pos), ErrorCode::OwordUnknownKeyword,
+              "'{}' after o{} is not an O-word keyword ({})",
+              end > c.pos ? c.text.substr(c.pos, end - c.pos) : c.text.substr(c.pos, 1), name,
+              kOwordKeywords);
     }
     type = OWord::Program;   // "O1234" alone: a program number
-  } else if (c.env.skipping_to.empty()) {   // lines passed over are not checked further (LinuxCNC)
+  } else if (c.env.skipping_to.empty()) {  // lines passed over are not checked further (LinuxCNC)
     misspelt_keyword(c, keyword_at);
   }
   const ParseEnv& env = c.env;
@@ -793,8 +870,9 @@ void Parser::read_o_word(Cursor& c, Block& b) {
     case OWord::Sub:
     case OWord::Program:
       if (env.defining_sub)
-        fail_at(pos, ErrorCode::OwordSubNested, "o<{}> sub inside the definition of o<{}>: end that one with endsub first",
-                b.o_name, env.defining_name);
+        fail_at(pos, ErrorCode::OwordSubNested,
+                "o<{}> sub inside the definition of o<{}>: end that one with endsub first", b.o_name,
+                env.defining_name);
       return;
     case OWord::EndSub:
     case OWord::Return:
@@ -823,8 +901,8 @@ void Parser::read_o_word(Cursor& c, Block& b) {
           continue;
         }
         if (b.arg_count >= kSubArgumentCount)
-          fail_at(static_cast<int>(c.pos), ErrorCode::OwordTooManyArgs, "o<{}> call passes more than {} arguments", b.o_name,
-                  kSubArgumentCount);
+          fail_at(static_cast<int>(c.pos), ErrorCode::OwordTooManyArgs,
+                  "o<{}> call passes more than {} arguments", b.o_name, kSubArgumentCount);
         b.args[static_cast<std::size_t>(b.arg_count++)] = expression(c);
       }
       return;
@@ -835,8 +913,9 @@ void Parser::read_o_word(Cursor& c, Block& b) {
       if (skipping_other) return;
       if (c.at() != '[') {
         static constexpr const char* kNames[] = {"", "", "", "", "", "while", "if", "elseif", "", "", "", "", "", "", "repeat"};
-        fail_at(static_cast<int>(c.pos), ErrorCode::OwordConditionMissing, "'{}' needs its {} in brackets: o{} {} [...]",
-                kNames[static_cast<int>(type)], type == OWord::Repeat ? "count" : "condition", name, kNames[static_cast<int>(type)]);
+        fail_at(static_cast<int>(c.pos), ErrorCode::OwordConditionMissing,
+                "'{}' needs its {} in brackets: o{} {} [...]", kNames[static_cast<int>(type)],
+                type == OWord::Repeat ? "count" : "condition", name, kNames[static_cast<int>(type)]);
       }
       b.o_value = expression(c);
       b.o_has_value = true;

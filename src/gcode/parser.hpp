@@ -74,7 +74,7 @@ class Parser {
   std::string read_name(Cursor& c);
 
   double real_value(Cursor& c);
-  int integer_value(Cursor& c, const char* what);   ///< `what`: "L", "a parameter number" (for messages)
+  int integer_value(Cursor& c, const char* what);  ///< `what`: "L", "a parameter number" (for messages)
   static int plain_code(Cursor& c) noexcept;
   double real_number(Cursor& c);
   [[noreturn, gnu::cold]] static void bad_number(const char* start, const char* after, const char* text, bool malformed);

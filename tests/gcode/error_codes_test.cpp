@@ -52,8 +52,9 @@ std::set<std::string> mapped_ids() {
 
 // Feature modules own the codes of their area until they raise them from the core's enum.
 bool feature_code(std::string_view id) {
-  constexpr std::array<std::string_view, 6> kAreas = {"gcode.comp-", "gcode.cycle-", "gcode.thread-",
-                                                      "gcode.probe-", "gcode.lathe-", "gcode.spindle-stopped"};
+  constexpr std::array<std::string_view, 6> kAreas = {"gcode.comp-",   "gcode.cycle-",
+                                                      "gcode.thread-", "gcode.probe-",
+                                                      "gcode.lathe-",  "gcode.spindle-stopped"};
   for (std::string_view area : kAreas) {
     if (id.substr(0, area.size()) == area) return true;
   }
@@ -76,14 +77,15 @@ TEST(ErrorCodeIds, AreUniqueAndWellFormed) {
 TEST(ErrorCodeIds, EveryCoreCodeIsDocumented) {
   const auto documented = documented_ids();
   ASSERT_FALSE(documented.empty()) << "docs/error-codes.md has no code table";
-  for (const auto& id : core_ids()) EXPECT_TRUE(documented.count(id)) << id << " is missing from docs/error-codes.md";
+  for (const auto& id : core_ids())
+    EXPECT_TRUE(documented.count(id)) << id << " is missing from docs/error-codes.md";
 }
 
 TEST(ErrorCodeIds, DocumentedCodesAreRaisedOrMapped) {
   const auto core = core_ids();
   const auto mapped = mapped_ids();
   for (const auto& id : documented_ids()) {
-    if (id.rfind("gcode.", 0) != 0) continue;   // fanuc.* and dialect.* have no rs274 message
+    if (id.rfind("gcode.", 0) != 0) continue;  // fanuc.* and dialect.* have no rs274 message
     EXPECT_TRUE(core.count(id) || mapped.count(id)) << id << " is documented but neither raised nor mapped";
   }
 }
@@ -93,6 +95,7 @@ TEST(ErrorCodeIds, TheConformanceTableMapsOnlyKnownCodes) {
   const auto mapped = mapped_ids();
   ASSERT_GT(mapped.size(), 50u);
   for (const auto& id : mapped) {
-    EXPECT_TRUE(core.count(id) || feature_code(id)) << id << " is mapped in error-codes.tsv but the interpreter has no such code";
+    EXPECT_TRUE(core.count(id) || feature_code(id))
+        << id << " is mapped in error-codes.tsv but the interpreter has no such code";
   }
 }

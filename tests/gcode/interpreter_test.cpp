@@ -175,7 +175,7 @@ TEST(Interpreter, ErrorsCarryFileLineAndColumn) {
   EXPECT_EQ(d.code, "gcode.missing-value");
   EXPECT_EQ(d.file, "bad.ngc");
   EXPECT_EQ(d.line, 2u);
-  EXPECT_EQ(d.col, 9u);   // the Q that has no value
+  EXPECT_EQ(d.col, 9u);  // the Q that has no value
   // The run cannot continue after an error.
   EXPECT_EQ(interp.run(quiet), RunStatus::Error);
   // A word nothing uses is pointed at.
@@ -236,7 +236,8 @@ TEST(Interpreter, ErrorsPointAtTheOffendingWord) {
 TEST(Interpreter, AnUnclosedNameEndsACommentsText) {
   Interpreter interp;
   Recorder rec;
-  ASSERT_EQ(run_into(interp, rec, "G21\n#<foo>=3\n(DEBUG, value #<foo> then #<foo never closed)\nM2\n"), RunStatus::Finished);
+  ASSERT_EQ(run_into(interp, rec, "G21\n#<foo>=3\n(DEBUG, value #<foo> then #<foo never closed)\nM2\n"),
+            RunStatus::Finished);
   EXPECT_EQ(rec.messages, (std::vector<std::string>{" value 3.000000 then "}));
 }
 
@@ -530,7 +531,8 @@ TEST(InterpreterLimits, EndlessLoopStopsAtTheIterationLimit) {
 TEST(InterpreterLimits, RecursionStopsAtTheCallDepth) {
   Limits l;
   std::uint32_t line = 0;
-  EXPECT_EQ(run_with_limits("o<r> sub\n  o<r> call\no<r> endsub\nG21\no<r> call\nM2\n", l, &line), "gcode.limit-call-depth");
+  EXPECT_EQ(run_with_limits("o<r> sub\n  o<r> call\no<r> endsub\nG21\no<r> call\nM2\n", l, &line),
+            "gcode.limit-call-depth");
   EXPECT_EQ(line, 2u);
 }
 
@@ -675,7 +677,7 @@ TEST(InterpreterExtensions, RegisteredHandlersRunInPlaceOfTheCore) {
   Recorder none;
   EXPECT_EQ(run_into(again, none, "G21 F100\nG0 Z5\nN30 G81 X1 Y2 Z-3\nM2\n"), RunStatus::Error);
   EXPECT_EQ(first_code(again), "gcode.missing-value");
-  EXPECT_EQ(first_error(again)->col, 5u);   // a handler's rejection points at its code
+  EXPECT_EQ(first_error(again)->col, 5u);  // a handler's rejection points at its code
   EXPECT_EQ(none.motions.size(), 1u);
 }
 

@@ -116,7 +116,7 @@ TEST_F(ParserTest, ReadsNumbersTheLinuxCncWay) {
   EXPECT_EQ(fails("x1.2.3"), ErrorCode::BadNumber);
   EXPECT_EQ(fails("x*2"), ErrorCode::BadNumber);
   EXPECT_EQ(fails("x"), ErrorCode::MissingValue);
-  EXPECT_EQ(fails("g1 xf1"), ErrorCode::MissingValue);   // X has no value; F1 follows
+  EXPECT_EQ(fails("g1 xf1"), ErrorCode::MissingValue);  // X has no value; F1 follows
   EXPECT_EQ(fails("g1 xfoo"), ErrorCode::UnknownWord);
 }
 
@@ -216,7 +216,7 @@ TEST_F(ParserTest, ReportsExpressionErrorsWithTheirCodes) {
   EXPECT_EQ(fails("xacos[2]"), ErrorCode::TrigDomain);
   EXPECT_EQ(fails("xasin[-2]"), ErrorCode::TrigDomain);
   EXPECT_EQ(fails("x[1+2"), ErrorCode::UnclosedExpression);
-  EXPECT_EQ(fails("x[1+2 f100"), ErrorCode::UnclosedExpression);   // the F word follows: the ']' is missing
+  EXPECT_EQ(fails("x[1+2 f100"), ErrorCode::UnclosedExpression);  // the F word follows: the ']' is missing
   EXPECT_EQ(fails("x[1?2]"), ErrorCode::UnknownOperator);
   EXPECT_EQ(fails("x[1 an 2]"), ErrorCode::UnknownOperator);
   EXPECT_EQ(fails("xsin 30"), ErrorCode::FunctionBracketMissing);

@@ -54,8 +54,8 @@ struct Block {
   double radius = 0, theta = 0;
   bool dollar_flag = false;                 ///< $ spindle selector
   double dollar = 0;
-  std::uint8_t radius_at = 0, theta_at = 0, dollar_at = 0;   ///< where @, ^ and $ start
-  std::uint8_t o_at = 0;                    ///< where the O-word starts
+  std::uint8_t radius_at = 0, theta_at = 0, dollar_at = 0;  ///< where @, ^ and $ start
+  std::uint8_t o_at = 0;                                    ///< where the O-word starts
 
   OWord o_type = OWord::None;
   std::string o_name;                       ///< label key ("sub#100") or sub name
@@ -72,7 +72,9 @@ struct Block {
   bool any_axis() const noexcept { return (words & kAxisWordBits) != 0; }
 
   // Where things start in the normalised line, for the column of an error (-1 = absent).
-  int word_position(char letter) const noexcept { return has(letter) ? at[static_cast<std::size_t>(letter - 'a')] : -1; }
+  int word_position(char letter) const noexcept {
+    return has(letter) ? at[static_cast<std::size_t>(letter - 'a')] : -1;
+  }
   int g_position(int group) const noexcept {
     return g[static_cast<std::size_t>(group)] == -1 ? -1 : g_at[static_cast<std::size_t>(group)];
   }
