@@ -44,12 +44,6 @@ std::string label_text(std::string_view key) {
   return number ? fmt::format("o{}", name) : fmt::format("o<{}>", name);
 }
 
-namespace {
-std::string plain(std::string_view key) {
-  return label_text(key);
-}
-}  // namespace
-
 LabelInfo* Engine::find_label(const std::string& name) {
   auto it = st_.control.labels.find(name);
   return it == st_.control.labels.end() ? nullptr : &it->second;
@@ -70,7 +64,7 @@ void Engine::count_loop() {
 
 void Engine::jump_to_label(const std::string& name) {
   const LabelInfo* l = find_label(name);
-  if (l == nullptr) fail(ErrorCode::OwordUnmatched, "{} is not defined", plain(name));
+  if (l == nullptr) fail(ErrorCode::OwordUnmatched, "{} is not defined", label_text(name));
   jump_to(l->at);
 }
 
@@ -113,9 +107,9 @@ void Engine::o_sub() {
       if (old->at.line == line_ && old->at.file == line_file_)
         fail(ErrorCode::OwordSubRedefined,
              "{} sub is read a second time: a subprogram cannot be defined inside a loop or an if",
-             plain(block_.o_name));
+             label_text(block_.o_name));
       fail(ErrorCode::OwordSubRedefined, "{} is defined twice (first at {}:{}): rename one of them",
-           plain(block_.o_name), sources_->file(old->at.file), old->at.line);
+           label_text(block_.o_name), sources_->file(old->at.file), old->at.line);
     }
     save_label(LabelKind::Sub);
   };
@@ -128,7 +122,7 @@ void Engine::o_sub() {
   if (st_.frames.size() > 1) return;   // entering the body of a call
   if (c.defining_sub)
     fail(ErrorCode::OwordSubNested, "{} sub inside the definition of {}: end that one with endsub first",
-         plain(block_.o_name), plain(c.defining_name));
+         label_text(block_.o_name), label_text(c.defining_name));
   define();
   // A definition in the flow of the program: pass over its body.
   c.skipping_to = block_.o_name;
@@ -143,7 +137,7 @@ void Engine::o_return() {
   c.value_returned = block_.o_has_value;
   if (st_.frames.size() == 1 && !c.defining_sub)
     fail(ErrorCode::OwordNotInSub, "{} {} outside a subprogram: it belongs between 'sub' and 'endsub'",
-         plain(block_.o_name), block_.o_type == OWord::EndSub ? "endsub" : "return");
+         label_text(block_.o_name), block_.o_type == OWord::EndSub ? "endsub" : "return");
   if (!c.skipping_to.empty() && block_.o_type == OWord::EndSub) c.skipping_to.clear();
   if (st_.frames.size() > 1) {
     CallFrame& f = st_.frames.back();
@@ -170,7 +164,7 @@ void Engine::o_call() {
   const std::uint32_t max_depth = opt_.limits.max_call_depth == 0 ? 10 : opt_.limits.max_call_depth;
   if (depth >= max_depth)
     fail(ErrorCode::LimitCallDepth, "{} call nests subprograms deeper than {} levels (limit max_call_depth)",
-         plain(block_.o_name), max_depth - 1);
+         label_text(block_.o_name), max_depth - 1);
   ControlState& c = st_.control;
   c.skipping_to.clear();
   CallFrame frame;
@@ -225,7 +219,7 @@ void Engine::o_while() {
   if (l != nullptr) {
     if (l->kind != LabelKind::Do && l->at.line != line_)
       fail(ErrorCode::OwordLabelDuplicate, "{} is already used on line {}: give this {} its own label",
-           plain(block_.o_name), l->at.line, "while");
+           label_text(block_.o_name), l->at.line, "while");
   } else {
     save_label(LabelKind::While);
     l = find_label(block_.o_name);
@@ -253,7 +247,7 @@ void Engine::o_repeat() {
   if (l != nullptr) {
     if (l->at.line != line_)
       fail(ErrorCode::OwordLabelDuplicate, "{} is already used on line {}: give this {} its own label",
-           plain(block_.o_name), l->at.line, "repeat");
+           label_text(block_.o_name), l->at.line, "repeat");
   } else {
     save_label(LabelKind::Repeat);
     l = find_label(block_.o_name);
@@ -281,7 +275,7 @@ void Engine::o_if() {
   if (const LabelInfo* l = find_label(block_.o_name)) {
     if (l->at.line != line_)
       fail(ErrorCode::OwordLabelDuplicate, "{} is already used on line {}: give this {} its own label",
-           plain(block_.o_name), l->at.line, "if");
+           label_text(block_.o_name), l->at.line, "if");
   } else {
     save_label(LabelKind::If);
   }
@@ -296,7 +290,7 @@ void Engine::o_if() {
 }
 
 void Engine::unmatched(const char* keyword, const char* opener, const char* other_opener) const {
-  const std::string l = plain(block_.o_name);
+  const std::string l = label_text(block_.o_name);
   const std::string openers = other_opener == nullptr
                                   ? fmt::format("'{} {}'", l, opener)
                                   : fmt::format("'{} {}' or '{} {}'", l, opener, l, other_opener);
@@ -305,7 +299,7 @@ void Engine::unmatched(const char* keyword, const char* opener, const char* othe
 }
 
 void Engine::mismatched(const char* keyword, const LabelInfo& label) const {
-  const std::string l = plain(block_.o_name);
+  const std::string l = label_text(block_.o_name);
   fail(ErrorCode::OwordMismatched, "'{} {}' does not fit '{} {}' (line {}): that block ends with '{} {}'", l,
        keyword, l, label_kind_name(label.kind), label.at.line, l, label_end_keyword(label.kind));
 }
