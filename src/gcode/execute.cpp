@@ -224,7 +224,8 @@ bool Engine::run_extension_g(int code) {
 
 bool Engine::run_extension_m(int code) {
   if (ext_ == nullptr || code < 0 || code >= 200 || !ext_->m[static_cast<std::size_t>(code)]) return false;
-  const ExtensionSite site(*this, block_.m_position(m_group(code)));
+  const int group = m_group(code);
+  const ExtensionSite site(*this, group >= 0 ? block_.m_position(group) : -1);
   ext_->m[static_cast<std::size_t>(code)]->execute(*this, block_, code);
   return true;
 }
