@@ -284,7 +284,8 @@ bool Engine::process_line() {
   } else if (opt_.limits.max_blocks != 0 && ++st_.blocks_executed > opt_.limits.max_blocks) {
     fail(ErrorCode::LimitBlocks, "more than {} blocks executed (limit max_blocks)", opt_.limits.max_blocks);
   }
-  if (!skipping && (text.front() == '%' || text.front() == '$')) reject_foreign_syntax(text);
+  if (!skipping && (text.front() == '%' || text.front() == '$') && opt_.dialect == Dialect::LinuxCnc)
+    reject_foreign_syntax(text);
   parser_.parse(text, parse_env(), block_);
   if (!skipping) {
     enhance_block();
