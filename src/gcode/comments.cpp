@@ -63,7 +63,8 @@ std::string Engine::expand_parameters(std::string_view text) {
         if (!std::isspace(static_cast<unsigned char>(text[i]))) name += static_cast<char>(std::tolower(static_cast<unsigned char>(text[i])));
         ++i;
       }
-      if (i >= text.size() || text[i] != '>') fail(ErrorCode::NameNotTerminated, "#< in a comment has no closing '>'");
+      // A name never closed ends the text there (LinuxCNC prints what came before it).
+      if (i >= text.size() || text[i] != '>') break;
       ++i;
       double v = 0;
       const bool found = named_value(name, v);

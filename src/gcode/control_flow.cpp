@@ -5,13 +5,12 @@
 #include <cmath>
 
 #include "engine.hpp"
+#include "lexer.hpp"
 #include "numeric.hpp"
 
 namespace opencnc::gcode {
 
-namespace {
-
-const char* kind_name(LabelKind k) noexcept {
+const char* label_kind_name(LabelKind k) noexcept {
   switch (k) {
     case LabelKind::Sub: return "sub";
     case LabelKind::Do: return "do";
@@ -22,12 +21,28 @@ const char* kind_name(LabelKind k) noexcept {
   return "?";
 }
 
-// The label as the program wrote it (without the "sub#" scope prefix).
-std::string_view plain(std::string_view key) noexcept {
-  const std::size_t hash = key.find('#');
-  return hash == std::string_view::npos ? key : key.substr(hash + 1);
+const char* label_end_keyword(LabelKind k) noexcept {
+  switch (k) {
+    case LabelKind::Sub:
+      return "endsub";
+    case LabelKind::Do:
+      return "while [...]";
+    case LabelKind::While:
+      return "endwhile";
+    case LabelKind::Repeat:
+      return "endrepeat";
+    case LabelKind::If:
+      return "endif";
+  }
+  return "?";
 }
-}  // namespace
+
+std::string label_text(std::string_view key) {
+  const std::size_t hash = key.find('#');
+  const std::string_view name = hash == std::string_view::npos ? key : key.substr(hash + 1);
+  const bool number = !name.empty() && name.find_first_not_of("0123456789") == std::string_view::npos;
+  return number ? fmt::format("o{}", name) : fmt::format("o<{}>", name);
+}
 
 LabelInfo* Engine::find_label(const std::string& name) {
   auto it = st_.control.labels.find(name);
@@ -49,7 +64,7 @@ void Engine::count_loop() {
 
 void Engine::jump_to_label(const std::string& name) {
   const LabelInfo* l = find_label(name);
-  if (l == nullptr) fail(ErrorCode::LabelUndefined, "o{} is not defined", plain(name));
+  if (l == nullptr) fail(ErrorCode::OwordUnmatched, "{} is not defined", label_text(name));
   jump_to(l->at);
 }
 
@@ -77,7 +92,9 @@ void Engine::control_flow() {
     case OWord::Program:
       // A program number line: nothing to do in the main program (Fanuc subprograms, which
       // it would start, are not supported yet).
-      if (st_.frames.size() > 1) fail(ErrorCode::Unsupported, "O{} program numbers inside a subprogram (Fanuc style) are not supported yet", block_.o_name);
+      if (st_.frames.size() > 1)
+        fail(ErrorCode::Unsupported,
+             "O{} program numbers inside a subprogram (Fanuc style) are not supported yet", block_.o_name);
       return;
     case OWord::None: return;
   }
@@ -88,10 +105,11 @@ void Engine::o_sub() {
   auto define = [&] {
     if (const LabelInfo* old = find_label(block_.o_name)) {
       if (old->at.line == line_ && old->at.file == line_file_)
-        fail(ErrorCode::SubRedefined, "o<{}> sub is read a second time (a definition inside a loop or an if?)",
-             block_.o_name);
-      fail(ErrorCode::SubRedefined, "o<{}> is already defined ({}:{})", block_.o_name, sources_->file(old->at.file),
-           old->at.line);
+        fail(ErrorCode::OwordSubRedefined,
+             "{} sub is read a second time: a subprogram cannot be defined inside a loop or an if",
+             label_text(block_.o_name));
+      fail(ErrorCode::OwordSubRedefined, "{} is defined twice (first at {}:{}): rename one of them",
+           label_text(block_.o_name), sources_->file(old->at.file), old->at.line);
     }
     save_label(LabelKind::Sub);
   };
@@ -102,7 +120,9 @@ void Engine::o_sub() {
   }
   c.seeking_sub.clear();
   if (st_.frames.size() > 1) return;   // entering the body of a call
-  if (c.defining_sub) fail(ErrorCode::NestedSub, "o<{}> sub inside the definition of o<{}>", block_.o_name, c.defining_name);
+  if (c.defining_sub)
+    fail(ErrorCode::OwordSubNested, "{} sub inside the definition of {}: end that one with endsub first",
+         label_text(block_.o_name), label_text(c.defining_name));
   define();
   // A definition in the flow of the program: pass over its body.
   c.skipping_to = block_.o_name;
@@ -116,8 +136,8 @@ void Engine::o_return() {
   c.return_value = block_.o_has_value ? block_.o_value : 0.0;
   c.value_returned = block_.o_has_value;
   if (st_.frames.size() == 1 && !c.defining_sub)
-    fail(ErrorCode::NotInSub, "o<{}> {} outside a subprogram", block_.o_name,
-         block_.o_type == OWord::EndSub ? "endsub" : "return");
+    fail(ErrorCode::OwordNotInSub, "{} {} outside a subprogram: it belongs between 'sub' and 'endsub'",
+         label_text(block_.o_name), block_.o_type == OWord::EndSub ? "endsub" : "return");
   if (!c.skipping_to.empty() && block_.o_type == OWord::EndSub) c.skipping_to.clear();
   if (st_.frames.size() > 1) {
     CallFrame& f = st_.frames.back();
@@ -143,8 +163,8 @@ void Engine::o_call() {
   const std::uint32_t depth = static_cast<std::uint32_t>(st_.frames.size());
   const std::uint32_t max_depth = opt_.limits.max_call_depth == 0 ? 10 : opt_.limits.max_call_depth;
   if (depth >= max_depth)
-    fail(ErrorCode::CallDepth, "o<{}> call nests subprograms deeper than {} levels (limit max_call_depth)", block_.o_name,
-         max_depth - 1);
+    fail(ErrorCode::LimitCallDepth, "{} call nests subprograms deeper than {} levels (limit max_call_depth)",
+         label_text(block_.o_name), max_depth - 1);
   ControlState& c = st_.control;
   c.skipping_to.clear();
   CallFrame frame;
@@ -155,7 +175,7 @@ void Engine::o_call() {
     st_.parameters[static_cast<std::size_t>(1 + i)] = i < block_.arg_count ? block_.args[static_cast<std::size_t>(i)] : 0.0;
   }
   const std::uint32_t parent_context = st_.frames.back().context;
-  const canon::SourceRef call_site{line_file_, line_, 1};
+  const canon::SourceRef call_site{line_file_, line_, raw_column(raw_, block_.o_at)};
   st_.frames.push_back(std::move(frame));
   // Find the body: a sub met before, a file <name>.ngc on the search path, or later in this file.
   std::string name = block_.o_name;
@@ -164,7 +184,8 @@ void Engine::o_call() {
     jump_to(l->at);
   } else {
     if (!open_sub_file(name) && in_mdi_)
-      fail(ErrorCode::SubNotFound, "o<{}> is not defined and no {}.ngc is on the subroutine path", name, name);
+      fail(ErrorCode::OwordSubNotFound, "o<{}> is not defined, and no file {}.ngc is on the subroutine path",
+           name, name);
     c.skipping_to = name;
     c.seeking_sub = name;
     c.skip_start_line = line_;
@@ -197,7 +218,8 @@ void Engine::o_while() {
   LabelInfo* l = find_label(block_.o_name);
   if (l != nullptr) {
     if (l->kind != LabelKind::Do && l->at.line != line_)
-      fail(ErrorCode::LabelDuplicate, "o{} is already used on line {}", plain(block_.o_name), l->at.line);
+      fail(ErrorCode::OwordLabelDuplicate, "{} is already used on line {}: give this {} its own label",
+           label_text(block_.o_name), l->at.line, "while");
   } else {
     save_label(LabelKind::While);
     l = find_label(block_.o_name);
@@ -223,7 +245,9 @@ void Engine::o_repeat() {
   ControlState& c = st_.control;
   LabelInfo* l = find_label(block_.o_name);
   if (l != nullptr) {
-    if (l->at.line != line_) fail(ErrorCode::LabelDuplicate, "o{} is already used on line {}", plain(block_.o_name), l->at.line);
+    if (l->at.line != line_)
+      fail(ErrorCode::OwordLabelDuplicate, "{} is already used on line {}: give this {} its own label",
+           label_text(block_.o_name), l->at.line, "repeat");
   } else {
     save_label(LabelKind::Repeat);
     l = find_label(block_.o_name);
@@ -249,7 +273,9 @@ void Engine::o_repeat() {
 void Engine::o_if() {
   ControlState& c = st_.control;
   if (const LabelInfo* l = find_label(block_.o_name)) {
-    if (l->at.line != line_) fail(ErrorCode::LabelDuplicate, "o{} is already used on line {}", plain(block_.o_name), l->at.line);
+    if (l->at.line != line_)
+      fail(ErrorCode::OwordLabelDuplicate, "{} is already used on line {}: give this {} its own label",
+           label_text(block_.o_name), l->at.line, "if");
   } else {
     save_label(LabelKind::If);
   }
@@ -263,12 +289,26 @@ void Engine::o_if() {
   }
 }
 
+void Engine::unmatched(const char* keyword, const char* opener, const char* other_opener) const {
+  const std::string l = label_text(block_.o_name);
+  const std::string openers = other_opener == nullptr
+                                  ? fmt::format("'{} {}'", l, opener)
+                                  : fmt::format("'{} {}' or '{} {}'", l, opener, l, other_opener);
+  fail(ErrorCode::OwordUnmatched, "'{} {}' has no {} before it: correct the label, or open the block first",
+       l, keyword, openers);
+}
+
+void Engine::mismatched(const char* keyword, const LabelInfo& label) const {
+  const std::string l = label_text(block_.o_name);
+  fail(ErrorCode::OwordMismatched, "'{} {}' does not fit '{} {}' (line {}): that block ends with '{} {}'", l,
+       keyword, l, label_kind_name(label.kind), label.at.line, l, label_end_keyword(label.kind));
+}
+
 void Engine::o_elseif() {
   ControlState& c = st_.control;
   const LabelInfo* l = find_label(block_.o_name);
-  if (l == nullptr) fail(ErrorCode::LabelUndefined, "elseif with no 'o{} if' before it", plain(block_.o_name));
-  if (l->kind != LabelKind::If)
-    fail(ErrorCode::LabelMismatch, "elseif for o{} does not match its '{}' on line {}", plain(block_.o_name), kind_name(l->kind), l->at.line);
+  if (l == nullptr) unmatched("elseif", "if");
+  if (l->kind != LabelKind::If) mismatched("elseif", *l);
   if (c.executed_if) {
     c.skipping_to = block_.o_name;
     c.skip_start_line = line_;
@@ -283,9 +323,8 @@ void Engine::o_elseif() {
 void Engine::o_else() {
   ControlState& c = st_.control;
   const LabelInfo* l = find_label(block_.o_name);
-  if (l == nullptr) fail(ErrorCode::LabelUndefined, "else with no 'o{} if' before it", plain(block_.o_name));
-  if (l->kind != LabelKind::If)
-    fail(ErrorCode::LabelMismatch, "else for o{} does not match its '{}' on line {}", plain(block_.o_name), kind_name(l->kind), l->at.line);
+  if (l == nullptr) unmatched("else", "if");
+  if (l->kind != LabelKind::If) mismatched("else", *l);
   if (c.executed_if) {
     c.skipping_to = block_.o_name;
     c.skip_start_line = line_;
@@ -300,9 +339,8 @@ void Engine::o_else() {
 void Engine::o_endif() {
   ControlState& c = st_.control;
   const LabelInfo* l = find_label(block_.o_name);
-  if (l == nullptr) fail(ErrorCode::LabelUndefined, "endif with no 'o{} if' before it", plain(block_.o_name));
-  if (l->kind != LabelKind::If)
-    fail(ErrorCode::LabelMismatch, "endif for o{} does not match its '{}' on line {}", plain(block_.o_name), kind_name(l->kind), l->at.line);
+  if (l == nullptr) unmatched("endif", "if");
+  if (l->kind != LabelKind::If) mismatched("endif", *l);
   c.skipping_to.clear();
   c.executed_if = true;
 }
@@ -311,10 +349,8 @@ void Engine::o_break_continue(bool is_break) {
   ControlState& c = st_.control;
   const char* what = is_break ? "break" : "continue";
   const LabelInfo* l = find_label(block_.o_name);
-  if (l == nullptr) fail(ErrorCode::LabelUndefined, "{} with no loop o{} around it", what, plain(block_.o_name));
-  if (l->kind != LabelKind::While && l->kind != LabelKind::Do)
-    fail(ErrorCode::LabelMismatch, "{} for o{} does not match its '{}' on line {}", what, plain(block_.o_name), kind_name(l->kind),
-         l->at.line);
+  if (l == nullptr) unmatched(what, "while", "do");
+  if (l->kind != LabelKind::While && l->kind != LabelKind::Do) mismatched(what, *l);
   if (!is_break && c.skipping_to == block_.o_name) return;
   c.skipping_to = block_.o_name;
   c.skip_start_line = line_;
@@ -326,10 +362,10 @@ void Engine::o_end_loop() {
   ControlState& c = st_.control;
   const bool repeat = block_.o_type == OWord::EndRepeat;
   const LabelInfo* l = find_label(block_.o_name);
-  if (l == nullptr) fail(ErrorCode::LabelUndefined, "{} with no loop o{} before it", repeat ? "endrepeat" : "endwhile", plain(block_.o_name));
+  const char* what = repeat ? "endrepeat" : "endwhile";
+  if (l == nullptr) unmatched(what, repeat ? "repeat" : "while");
   if ((repeat && l->kind != LabelKind::Repeat) || (!repeat && l->kind != LabelKind::While))
-    fail(ErrorCode::LabelMismatch, "{} for o{} does not match its '{}' on line {}", repeat ? "endrepeat" : "endwhile",
-         plain(block_.o_name), kind_name(l->kind), l->at.line);
+    mismatched(what, *l);
   if (c.skipping_to == block_.o_name) {
     c.skipping_to.clear();
     if (!c.doing_continue) return;   // the loop is over

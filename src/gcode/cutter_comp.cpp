@@ -67,7 +67,7 @@ class CompOn final : public CodeHandler {
     InterpState& st = ctx.state();
     ModalState& m = st.modal;
     if (m.plane != canon::Plane::XY && m.plane != canon::Plane::XZ)
-      fail(ErrorCode::CompWrongPlane, "cutter compensation works only in the XY (G17) and XZ (G18) planes");
+      fail(ErrorCode::CompYzPlane, "cutter compensation works only in the XY (G17) and XZ (G18) planes");
     if (m.cutter_comp != CutterComp::Off)
       fail(ErrorCode::CompAlreadyOn, "cutter compensation is already on (G40 ends it)");
     const bool dynamic = code % 10 == 1;

@@ -2,6 +2,7 @@
 // The interpreter's main loop: start-up, reading lines, dispatching blocks, errors, sync.
 #include "engine.hpp"
 
+#include <algorithm>
 #include <cstring>
 
 #include "lexer.hpp"
@@ -103,17 +104,18 @@ void Engine::start() {
   // A program whose first non-blank line is a lone '%' must end with another '%'.
   SourceFile& f = current_file();
   f.seek(0);
+  line_file_ = st_.next.file;
   RawLine line;
   std::uint32_t n = 0;
   for (;;) {
     if (!f.next(line)) {
       line_ = n;
-      fail(ErrorCode::FileEndedNoPercent, "the program file is empty");
+      fail(ErrorCode::ProgramEmpty, "the program file is empty{}", n == 0 ? "" : " (blank lines only)");
     }
     ++n;
     if (line.text.size() + (line.newline ? 1 : 0) > kMaxLineLength) {
       line_ = n;
-      fail(ErrorCode::LineTooLong, "line longer than {} characters", kMaxLineLength - 1);
+      line_too_long();
     }
     if (!trim_raw_line(line.text).empty()) break;
   }
@@ -207,7 +209,7 @@ bool Engine::read_line() {
     line_ = 1;
     line_offset_ = 0;
     raw_.assign(trim_raw_line(mdi_line_));
-    if (mdi_line_.size() > kMaxLineLength) fail(ErrorCode::LineTooLong, "line longer than {} characters", kMaxLineLength - 1);
+    if (mdi_line_.size() > kMaxLineLength) line_too_long();
     return true;
   }
   SourceFile& f = current_file();
@@ -223,9 +225,15 @@ bool Engine::read_line() {
   st_.next.offset = f.tell();
   ++st_.next.line;
   raw_.assign(trim_raw_line(line.text));
-  if (line.text.size() + (line.newline ? 1 : 0) > kMaxLineLength)
-    fail(ErrorCode::LineTooLong, "line longer than {} characters", kMaxLineLength - 1);
+  if (line.text.size() + (line.newline ? 1 : 0) > kMaxLineLength) line_too_long();
   return true;
+}
+
+// Points at the first character beyond the limit.
+void Engine::line_too_long() const {
+  throw GcodeError(ErrorCode::LineTooLong,
+                   fmt::format("a line longer than {} characters: split it", kMaxLineLength - 1), -1,
+                   Where{line_file_, line_, static_cast<std::uint32_t>(kMaxLineLength)});
 }
 
 void Engine::set_origin_from_line() {
@@ -246,12 +254,16 @@ void Engine::set_origin_from_line() {
 // Reads and executes one line. Returns when the line is done (or the program ended).
 bool Engine::process_line() {
   if (!read_line()) {
+    line_file_ = st_.next.file;
     line_ = st_.next.line;
-    if (!st_.control.seeking_sub.empty())
-      fail(ErrorCode::SubNotFound, "end of {} while looking for o<{}> (called on line {})",
-           sources_->file(st_.next.file), st_.control.seeking_sub, st_.control.skip_start_line);
-    if (st_.percent_delimited) fail(ErrorCode::FileEndedNoPercent, "the file ends without the closing '%'");
-    fail(ErrorCode::FileEndedNoEnd, "the file ends without M2, M30 or a closing '%'");
+    raw_.clear();
+    if (!st_.control.seeking_sub.empty()) sub_not_found();
+    if (!st_.control.skipping_to.empty()) unclosed_block();
+    if (st_.percent_delimited)
+      fail(ErrorCode::MissingClosingPercent,
+           "the file ends without the closing '%' line that its opening '%' (line 1) calls for");
+    fail(ErrorCode::MissingProgramEnd,
+         "the file ends without a program end: finish the program with M2 or M30");
   }
   if (norm_.size() < raw_.size() + 1) norm_.resize(raw_.size() + 1);
   set_origin_from_line();
@@ -272,6 +284,8 @@ bool Engine::process_line() {
   } else if (opt_.limits.max_blocks != 0 && ++st_.blocks_executed > opt_.limits.max_blocks) {
     fail(ErrorCode::LimitBlocks, "more than {} blocks executed (limit max_blocks)", opt_.limits.max_blocks);
   }
+  if (!skipping && (text.front() == '%' || text.front() == '$') && opt_.dialect == Dialect::LinuxCnc)
+    reject_foreign_syntax(text);
   parser_.parse(text, parse_env(), block_);
   if (!skipping) {
     enhance_block();
@@ -279,7 +293,8 @@ bool Engine::process_line() {
   }
   if (block_.o_type != OWord::None) {
     if (in_mdi_ && block_.o_type != OWord::Call)
-      fail(ErrorCode::OWordSyntax, "only 'call' O-words can be used in MDI");
+      fail(ErrorCode::OwordInMdi,
+           "only 'call' O-words can be used in MDI: control flow needs a program file");
     control_flow();
     if (in_mdi_) {
       // An MDI call runs its subprogram to the end here.
@@ -304,16 +319,85 @@ bool Engine::process_line() {
 
 // --- errors -------------------------------------------------------------------------------
 
-void Engine::report(const GcodeError& e) {
+// Program headers and commands of other controllers, which no line of this dialect starts
+// with: named, so that the reader knows the file is not LinuxCNC G-code at all.
+void Engine::reject_foreign_syntax(std::string_view text) const {
+  std::string_view raw = raw_;
+  raw.remove_prefix(std::min(raw.size(), raw.find_first_not_of(" \t")));
+  const std::string_view token = raw.substr(0, raw.find_first_of(" \t(;"));
+  auto foreign = [&](std::string_view what) {
+    fail_at(0, ErrorCode::DialectUnsupported, "'{}' is {}, not G-code of the LinuxCNC dialect", token, what);
+  };
+  if (text.front() == '%') {
+    if (text.size() == 1 || text[1] == '(' || text[1] == ';') return;  // the parser judges a lone '%'
+    if (text.starts_with("%_n_")) foreign("a Siemens Sinumerik program header");
+    foreign("the program header of another controller");
+  }
+  const char next = text.size() > 1 ? text[1] : '\0';
+  std::size_t digits = 1;
+  while (digits < text.size() && text[digits] >= '0' && text[digits] <= '9') ++digits;
+  if (text.back() == '%' && next >= 'a' && next <= 'z') foreign("an Okuma OSP program header");
+  if ((next >= 'a' && next <= 'z') || next == '$' || next == '#') foreign("a grbl command");
+  if (digits > 1 && digits < text.size() && text[digits] == '=') foreign("a grbl setting");
+}
+
+// The file ended while a call looked for its subprogram: the error belongs to the call.
+void Engine::sub_not_found() {
+  const std::string& name = st_.control.seeking_sub;
+  const std::string searched = sources_->file(st_.next.file);
+  const canon::SourceRef call = sources_->context_info(st_.frames.back().context).call_site;
+  const bool own_file = call.file == st_.next.file;
+  throw GcodeError(
+      ErrorCode::OwordSubNotFound,
+      own_file ? fmt::format("o<{}> call: no 'o<{}> sub' follows in this file, and no {}.ngc is on the "
+                             "subroutine path",
+                             name, name, name)
+               : fmt::format("o<{}> call: {} does not define o<{}> (its sub line must name it)", name,
+                             searched, name),
+      -1, Where{call.file, call.line, call.col});
+}
+
+// The file ended while passing over a block to its end label: the block was never closed.
+void Engine::unclosed_block() {
+  const std::string& key = st_.control.skipping_to;
+  const LabelInfo* l = find_label(key);
+  if (l == nullptr)
+    fail(ErrorCode::OwordUnclosed, "the file ends inside an O-word block that is never closed");
+  const char* kind = label_kind_name(l->kind);
+  const std::string label = label_text(key);
+  // The column of the opening line: its first word (re-read from the file; the run is over).
   std::uint32_t col = 0;
-  if (e.position() >= 0) {
+  if (l->at.file == st_.next.file) {
+    SourceFile& f = current_file();
+    f.seek(l->at.offset);
+    need_seek_ = true;
+    if (RawLine opening; f.next(opening)) {
+      const std::size_t first = opening.text.find_first_not_of(" \t");
+      col = first == std::string_view::npos ? 1 : static_cast<std::uint32_t>(first + 1);
+    }
+  }
+  throw GcodeError(ErrorCode::OwordUnclosed,
+                   fmt::format("'{} {}' is never closed: the file ends before '{} {}'", label, kind, label,
+                               label_end_keyword(l->kind)),
+                   -1, Where{l->at.file, l->at.line, col});
+}
+
+void Engine::report(const GcodeError& e) {
+  std::uint32_t file_index = line_file_;
+  std::uint32_t line = line_;
+  std::uint32_t col = 0;
+  if (const auto& w = e.where()) {
+    file_index = w->file;
+    line = w->line;
+    col = w->col;
+  } else if (e.position() >= 0) {
     col = raw_column(raw_, e.position());
   } else {
     const std::size_t first = raw_.find_first_not_of(" \t");
     col = first == std::string::npos ? 1 : static_cast<std::uint32_t>(first + 1);
   }
-  const std::string file = line_file_ < sources_->file_count() ? sources_->file(line_file_) : std::string();
-  diags_.error(file, line_, line_ == 0 ? 0 : col, e.message(), std::string(error_id(e.code())));
+  const std::string file = file_index < sources_->file_count() ? sources_->file(file_index) : std::string();
+  diags_.error(file, line, line == 0 ? 0 : col, e.message(), std::string(error_id(e.code())));
 }
 
 void Engine::warn_once(bool& done, ErrorCode code, std::string_view message) {

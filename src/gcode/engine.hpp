@@ -36,6 +36,12 @@ constexpr int axis_of_letter(char c) noexcept {
 }
 inline constexpr char kAxisWordLetters[kAxisCount] = {'x', 'y', 'z', 'a', 'b', 'c', 'u', 'v', 'w'};
 
+/// "sub", "while", ... for a label kind; the keyword that ends its block; "o100" or
+/// "o<name>" for a label key ("sub#100").
+const char* label_kind_name(LabelKind k) noexcept;
+const char* label_end_keyword(LabelKind k) noexcept;
+std::string label_text(std::string_view key);
+
 class Engine final : public ParamHost, public ExecContext {
  public:
   explicit Engine(Options options);
@@ -74,9 +80,27 @@ class Engine final : public ParamHost, public ExecContext {
     out_.move_queued_end(plane, first, second);
   }
   void request_sync(const SyncValues& assumed) override;
-  [[noreturn]] void error(ErrorCode code, const std::string& message) override { throw GcodeError(code, message); }
+  [[noreturn]] void error(ErrorCode code, const std::string& message) override {
+    throw GcodeError(code, message, extension_at_);
+  }
 
  private:
+  // Points the errors an extension raises through error() at `at` while it runs (an outer
+  // site, such as the code handler that made a move, takes precedence).
+  class ExtensionSite {
+   public:
+    ExtensionSite(Engine& e, int at) noexcept : slot_(e.extension_at_), saved_(e.extension_at_) {
+      if (slot_ == -1) slot_ = at;
+    }
+    ~ExtensionSite() { slot_ = saved_; }
+    ExtensionSite(const ExtensionSite&) = delete;
+    ExtensionSite& operator=(const ExtensionSite&) = delete;
+
+   private:
+    int& slot_;
+    int saved_;
+  };
+
   // engine.cpp: start, lines, errors
   void start();
   RunStatus guarded(canon::Sink& sink, bool (Engine::*body)());
@@ -85,6 +109,10 @@ class Engine final : public ParamHost, public ExecContext {
   bool read_line();
   bool process_line();
   void report(const GcodeError& e);
+  [[noreturn]] void sub_not_found();
+  [[noreturn]] void unclosed_block();
+  void reject_foreign_syntax(std::string_view text) const;
+  [[noreturn]] void line_too_long() const;
   void warn_once(bool& done, ErrorCode code, std::string_view message);
   void check_motion_habits(bool feed);
   void set_origin_from_line();
@@ -97,8 +125,10 @@ class Engine final : public ParamHost, public ExecContext {
   void enhance_block();
   void check_block();
   void check_g_codes();
+  void check_g10();
   void check_other_codes();
-  void check_extension(int code);
+  void check_p_word();
+  void check_extension(int code, int position);
 
   // execute.cpp: order of execution within a block
   void execute_block();
@@ -117,10 +147,14 @@ class Engine final : public ParamHost, public ExecContext {
   void set_cutter_comp(int code);
   bool run_extension_g(int code);
   bool run_extension_m(int code);
-  [[noreturn]] void unsupported_g(int code);
+  [[noreturn]] void unsupported_g(int code, int at);
+  void check_spindle_number(bool all_allowed) const;
 
   // motion.cpp
   Pose find_ends(const Block& b);
+  [[noreturn]] static void polar_with_xy(const Block& b);
+  [[noreturn]] static void polar_at_origin(const Block& b);
+  void check_feed(std::string_view what) const;
   void convert_motion(int motion);
   void convert_straight(int motion);
   void convert_arc(int motion);
@@ -161,7 +195,7 @@ class Engine final : public ParamHost, public ExecContext {
   void set_tool_number(int tool);
   void load_spindle(int index);
   void set_tool_parameters();
-  int tool_index(int tool) const;
+  int tool_index(int tool, int at) const;  ///< `at`: where the word naming the tool starts
   int pocket_of(int index) const noexcept;
   void convert_stop();
   void end_program(int code);
@@ -189,6 +223,9 @@ class Engine final : public ParamHost, public ExecContext {
   void o_break_continue(bool is_break);
   void o_end_loop();
   LabelInfo* find_label(const std::string& name);
+  [[noreturn]] void unmatched(const char* keyword, const char* opener,
+                              const char* other_opener = nullptr) const;
+  [[noreturn]] void mismatched(const char* keyword, const LabelInfo& label) const;
   void save_label(LabelKind kind);
   void jump_to_label(const std::string& name);
   bool open_sub_file(const std::string& name);
@@ -220,6 +257,7 @@ class Engine final : public ParamHost, public ExecContext {
   SyncValues block_sync_;           ///< scan mode: feedback assumed at the end of this block
   bool block_sync_pending_ = false;
   std::uint32_t letters_ = 0;       ///< letter words with a reader (axis mask applied)
+  int extension_at_ = -1;  ///< where the code of the running extension starts (its errors point there)
   std::uint32_t mdi_file_ = 0;
   bool in_mdi_file_ = false;        ///< "<mdi>" is registered in the source map
   std::uint64_t skipped_lines_ = 0; ///< lines passed over while seeking a label

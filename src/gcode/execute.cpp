@@ -16,9 +16,8 @@ void Engine::apply_assignments() {
 void Engine::execute_block() {
   const Block& b = block_;
   if (b.has_comment && !b.comment.empty()) convert_comment(b.comment);
-  if (b.dollar_flag && (b.g[kGroupSpindleMode] != -1 || b.g[kGroupFeedMode] != -1) &&
-      (b.dollar < 0 || b.dollar >= 1))
-    fail(ErrorCode::SpindleUsage, "spindle ${} does not exist (this machine has spindle 0)", b.dollar);
+  if (b.dollar_flag && (b.g[kGroupSpindleMode] != -1 || b.g[kGroupFeedMode] != -1))
+    check_spindle_number(false);
   if (b.g[kGroupSpindleMode] != -1) set_spindle_mode();
   if (b.g[kGroupFeedMode] != -1) set_feed_mode(b.g[kGroupFeedMode]);
   if (b.has('f') && st_.modal.feed_mode != canon::FeedMode::InverseTime) {
@@ -26,8 +25,7 @@ void Engine::execute_block() {
     out_.set_feed_rate(b.get('f'));
   }
   if (b.has('s')) {
-    if (b.dollar_flag && (b.dollar < -1 || b.dollar >= 1))
-      fail(ErrorCode::SpindleUsage, "spindle ${} does not exist (this machine has spindle 0)", b.dollar);
+    if (b.dollar_flag) check_spindle_number(true);
     out_.set_spindle_speed(0, b.get('s'));
     st_.modal.spindle_speed = b.get('s');
   }
@@ -35,6 +33,14 @@ void Engine::execute_block() {
   convert_m();
   convert_g();
   if (b.m[kGroupStop] != -1) convert_stop();
+}
+
+// This machine has spindle 0; $-1 means every spindle where a code can address them all.
+void Engine::check_spindle_number(bool all_allowed) const {
+  const double d = block_.dollar;
+  if (d >= 1 || d < (all_allowed ? -1 : 0))
+    fail_at(block_.dollar_at, ErrorCode::SpindleNumber, "${}: this machine has spindle $0 only{}", d,
+            all_allowed ? " ($-1 addresses every spindle)" : "");
 }
 
 void Engine::convert_m() {
@@ -45,7 +51,8 @@ void Engine::convert_m() {
   convert_coolant();
   convert_overrides();
   if (const int m = block_.m[kGroupUser]; m != -1 && !run_extension_m(m))
-    fail(ErrorCode::UnknownMCode, "M{} is not defined (no user M code of that number)", m);
+    fail_at(block_.m_position(kGroupUser), ErrorCode::UnknownMCode,
+            "M{} is not defined: no user M code of that number is installed", m);
 }
 
 void Engine::convert_g() {
@@ -100,10 +107,14 @@ void Engine::set_feed_mode(int code) {
 void Engine::set_plane(int code) {
   const bool comp = st_.modal.cutter_comp != CutterComp::Off;
   const canon::Plane p = st_.modal.plane;
+  const int at = block_.g_position(kGroupPlane);
   if (comp && ((code == 170 && p != canon::Plane::XY) || (code == 180 && p != canon::Plane::XZ) ||
                (code == 190 && p != canon::Plane::YZ)))
-    fail(ErrorCode::CompPlaneChange, "the plane cannot change while cutter compensation is on");
-  if (comp && code == 190) fail(ErrorCode::CompWrongPlane, "cutter compensation works only in the XY and XZ planes");
+    fail_at(at, ErrorCode::CompPlaneChange,
+            "{} cannot change the plane while cutter compensation is on: G40 first", g_name(code));
+  if (comp && code == 190)
+    fail_at(at, ErrorCode::CompYzPlane,
+            "cutter compensation works in the XY and XZ planes only, not in G19 (YZ)");
   canon::Plane plane = canon::Plane::XY;
   switch (code) {
     case 170: plane = canon::Plane::XY; break;
@@ -136,18 +147,21 @@ void Engine::set_cutter_comp(int code) {
     if (run_extension_g(code)) return;   // the compensation module ends its own moves
     out_.comment("interpreter: cutter radius compensation off");
     if (st_.modal.cutter_comp != CutterComp::Off && ext_ != nullptr && ext_->compensator) {
+      const ExtensionSite site(*this, block_.g_position(kGroupCutterComp));
       ext_->compensator->finish(*this);
     }
     st_.modal.cutter_comp = CutterComp::Off;
     st_.modal.comp_first_move = true;
     return;
   }
-  if (!run_extension_g(code)) unsupported_g(code);
+  if (!run_extension_g(code)) unsupported_g(code, block_.g_position(kGroupCutterComp));
 }
 
 void Engine::set_control_mode(int code) {
   if (st_.modal.cutter_comp != CutterComp::Off)
-    fail(ErrorCode::ModalContext, "the path control mode cannot change while cutter compensation is on");
+    fail_at(block_.g_position(kGroupControl), ErrorCode::CompControlMode,
+            "{} cannot change the path control mode while cutter compensation is on: G40 first",
+            g_name(code));
   if (code == 610) {
     out_.set_motion_control_mode(canon::MotionControl::ExactPath, 0);
     st_.modal.control = canon::MotionControl::ExactPath;
@@ -184,7 +198,9 @@ void Engine::set_ijk_mode(int code) {
 
 void Engine::set_retract_mode(int code) {
   if (st_.modal.cutter_comp != CutterComp::Off)
-    fail(ErrorCode::ModalContext, "the retract mode cannot change while cutter compensation is on");
+    fail_at(block_.g_position(kGroupRetract), ErrorCode::CompRetractMode,
+            "{} cannot change the canned cycle return mode while cutter compensation is on: G40 first",
+            g_name(code));
   if (code == 980) {
     out_.comment("interpreter: retract mode set to old_z");
     st_.modal.retract = RetractMode::OldZ;
@@ -196,19 +212,26 @@ void Engine::set_retract_mode(int code) {
 
 // --- extensions ---------------------------------------------------------------------------
 
+// An extension's errors point at its code's word (or, for a modal motion, the first axis word).
 bool Engine::run_extension_g(int code) {
   if (ext_ == nullptr || code < 0 || code >= 1000 || !ext_->g[static_cast<std::size_t>(code)]) return false;
+  const int group = g_group(code);
+  const ExtensionSite site(*this, group >= 0 && block_.g[static_cast<std::size_t>(group)] == code
+                                      ? block_.g_position(group)
+                                      : block_.first_axis_position());
   ext_->g[static_cast<std::size_t>(code)]->execute(*this, block_, code);
   return true;
 }
 
 bool Engine::run_extension_m(int code) {
   if (ext_ == nullptr || code < 0 || code >= 200 || !ext_->m[static_cast<std::size_t>(code)]) return false;
+  const int group = m_group(code);
+  const ExtensionSite site(*this, group >= 0 ? block_.m_position(group) : -1);
   ext_->m[static_cast<std::size_t>(code)]->execute(*this, block_, code);
   return true;
 }
 
-void Engine::unsupported_g(int code) {
+void Engine::unsupported_g(int code, int at) {
   const char* what = "this G code";
   if (code == 410 || code == 420 || code == 411 || code == 421) what = "cutter radius compensation";
   else if (code == 730 || code == 740 || (code >= 810 && code <= 890)) what = "canned cycles";
@@ -216,8 +239,7 @@ void Engine::unsupported_g(int code) {
   else if (code >= 382 && code <= 385) what = "probing";
   else if (code >= 50 && code <= 53) what = "splines";
   else if (code >= 700 && code <= 722) what = "lathe cycles";
-  if (code % 10) fail(ErrorCode::Unsupported, "G{}.{} ({}) is not supported yet", code / 10, code % 10, what);
-  fail(ErrorCode::Unsupported, "G{} ({}) is not supported yet", code / 10, what);
+  fail_at(at, ErrorCode::Unsupported, "{} ({}) is not supported yet", g_name(code), what);
 }
 
 }  // namespace opencnc::gcode

@@ -59,11 +59,15 @@ std::size_t normalize_line(std::string_view raw, char* out) {
       return n + (size - i);
     }
     // A ( ) comment: copied as is; '(' may not appear inside it.
+    const int open = static_cast<int>(n);
     out[n++] = '(';
     for (++i;; ++i) {
-      if (i >= size) fail(ErrorCode::UnclosedComment, "comment opened with '(' is not closed on this line");
+      if (i >= size)
+        fail_at(open, ErrorCode::UnclosedComment,
+                "this '(' opens a comment that is not closed on its line: add ')'");
       const char d = raw[i];
-      if (d == '(') fail_at(static_cast<int>(n), ErrorCode::NestedComment, "'(' inside a comment (comments do not nest)");
+      if (d == '(')
+        fail_at(static_cast<int>(n), ErrorCode::NestedComment, "'(' inside a comment: comments do not nest");
       out[n++] = d;
       if (d == ')') break;
     }

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // M codes: I/O (M62-M68), tools (T, M6, M61), spindle (M3-M5, M19), modal state save and
 // restore (M70-M73), coolant (M7-M9), overrides (M48-M53), stops and program end.
+#include <algorithm>
 #include <cmath>
 
 #include "engine.hpp"
@@ -15,9 +16,15 @@ void Engine::convert_io() {
   if (m == -1) return;
   if (run_extension_m(m)) return;
   const bool comp = st_.modal.cutter_comp != CutterComp::Off;
+  const int at = b.m_position(kGroupIo);
+  auto no_comp = [&] {
+    if (comp)
+      fail_at(at, ErrorCode::CompIo, "M{} cannot be used while cutter compensation is on: G40 first", m);
+  };
   if (m >= 62 && m <= 65) {
-    if (comp) fail(ErrorCode::ModalContext, "M{} cannot be used while cutter compensation is on", m);
-    if (!b.has('p')) fail(ErrorCode::IoUsage, "M{} needs a P word (output number)", m);
+    no_comp();
+    if (!b.has('p'))
+      fail_at(at, ErrorCode::IoOutputMissing, "M{} needs a P word: the number of the output", m);
     const int p = round_to_int(b.get('p'));
     if (m == 62) out_.set_motion_output_bit(p);
     else if (m == 63) out_.clear_motion_output_bit(p);
@@ -26,14 +33,21 @@ void Engine::convert_io() {
     return;
   }
   if (m == 66) {
-    if (b.has('p') && b.has('e')) fail(ErrorCode::IoUsage, "M66 takes a digital (P) or an analog (E) input, not both");
+    if (b.has('p') && b.has('e'))
+      fail_at(std::max(b.word_position('p'), b.word_position('e')), ErrorCode::IoM66BothInputs,
+              "M66 with both P (a digital input) and E (an analog input): give one of them");
     const int l = b.has('l') ? round_to_int(b.get('l')) : 0;
-    if (b.q_or(-1.0) <= 0 && b.has('l') && l > 0) fail(ErrorCode::IoUsage, "M66 with a wait mode L{} needs a timeout Q > 0", l);
-    if (b.has('e') && b.has('l') && l != 0) fail(ErrorCode::IoUsage, "M66 on an analog input waits immediately only (L0)");
+    if (b.q_or(-1.0) <= 0 && b.has('l') && l > 0)
+      fail_at(b.word_position('l'), ErrorCode::IoM66TimeoutMissing,
+              "M66 L{} waits for the input: give a timeout Q greater than 0", l);
+    if (b.has('e') && b.has('l') && l != 0)
+      fail_at(b.word_position('l'), ErrorCode::IoM66AnalogWait,
+              "M66 E (an analog input) reads the input at once only: use L0");
     if ((b.has('p') && round_to_int(b.get('p')) < 0) || (b.has('e') && round_to_int(b.get('e')) < 0) ||
         (!b.has('p') && !b.has('e')))
-      fail(ErrorCode::IoUsage, "M66 needs a valid P (digital) or E (analog) input number");
-    if (comp) fail(ErrorCode::ModalContext, "M66 cannot be used while cutter compensation is on");
+      fail_at(at, ErrorCode::IoM66InputMissing,
+              "M66 needs the input to read: P (digital) or E (analog), numbered from 0");
+    no_comp();
     const bool digital = b.has('p');
     const int index = round_to_int(digital ? b.get('p') : b.get('e'));
     const double timeout = digital && b.q_or(-1.0) > 0 ? b.get('q') : 0.0;
@@ -46,20 +60,24 @@ void Engine::convert_io() {
     request_sync(assumed);
     return;
   }
-  if (comp) fail(ErrorCode::ModalContext, "M{} cannot be used while cutter compensation is on", m);
-  if (!b.has('e') || round_to_int(b.get('e')) < 0) fail(ErrorCode::IoUsage, "M{} needs an E word (analog output number)", m);
+  no_comp();
+  if (!b.has('e') || round_to_int(b.get('e')) < 0)
+    fail_at(at, ErrorCode::IoAnalogOutputMissing,
+            "M{} needs an E word: the number of the analog output, 0 or more", m);
   if (m == 67) out_.set_motion_output_value(round_to_int(b.get('e')), b.q_or(-1.0));
   else out_.set_aux_output_value(round_to_int(b.get('e')), b.q_or(-1.0));
 }
 
 // --- tools -------------------------------------------------------------------------------
 
-int Engine::tool_index(int tool) const {
+int Engine::tool_index(int tool, int at) const {
   if (tool == 0) return 0;   // T0: no tool (the empty spindle)
   if (opt_.tool_table) {
     if (const auto index = opt_.tool_table->find(tool)) return static_cast<int>(*index);
   }
-  fail(ErrorCode::ToolNotFound, "tool {} is not in the tool table", tool);
+  if (!opt_.tool_table)
+    fail_at(at, ErrorCode::ToolNotFound, "tool {} is not in the tool table (no tool table is loaded)", tool);
+  fail_at(at, ErrorCode::ToolNotFound, "tool {} is not in the tool table", tool);
 }
 
 int Engine::pocket_of(int index) const noexcept {
@@ -68,7 +86,7 @@ int Engine::pocket_of(int index) const noexcept {
 }
 
 void Engine::select_tool(int tool) {
-  const int index = tool_index(tool);
+  const int index = tool_index(tool, block_.word_position('t'));
   out_.select_tool(tool);
   st_.tool.selected_index = index;
   st_.tool.selected_tool = tool;
@@ -92,9 +110,12 @@ void Engine::set_tool_parameters() {
 }
 
 void Engine::change_tool() {
-  if (st_.tool.selected_index < 0) fail(ErrorCode::ToolNotPrepared, "M6 with no tool prepared (program a T word first)");
+  const int at = block_.m_position(kGroupToolChange);
+  if (st_.tool.selected_index < 0)
+    fail_at(at, ErrorCode::ToolNotPrepared, "M6 with no tool selected: program a T word first");
   if (st_.modal.cutter_comp != CutterComp::Off)
-    fail(ErrorCode::CompToolChange, "tools cannot be changed while cutter compensation is on");
+    fail_at(at, ErrorCode::CompToolChange,
+            "M6 cannot change tools while cutter compensation is on: G40 first");
   out_.start_change();
   out_.stop_spindle_turning(0);
   st_.modal.spindle = canon::SpindleDirection::Stopped;
@@ -107,7 +128,7 @@ void Engine::change_tool() {
 }
 
 void Engine::set_tool_number(int tool) {
-  const int index = tool_index(tool);
+  const int index = tool_index(tool, block_.word_position('q'));
   out_.change_tool_number(index);
   // The tool becomes current, but (as in rs274) the spindle entry and #5400.. keep the tool
   // of the last M6 until the next one.
@@ -127,7 +148,13 @@ void Engine::convert_tool_change_group() {
     return;
   }
   const int tool = round_to_int(block_.q_or(-1.0));
-  if (tool < 0) fail(ErrorCode::ToolOffsetUsage, "M61 needs a Q word with a tool number (0 or more)");
+  if (tool < 0) {
+    if (!block_.has('q'))
+      fail_at(block_.m_position(kGroupToolChange), ErrorCode::M61QMissing,
+              "M61 needs a Q word: the number of the tool in the spindle");
+    fail_at(block_.word_position('q'), ErrorCode::M61QMissing, "M61 Q{}: the tool number must be 0 or more",
+            block_.get('q'));
+  }
   set_tool_number(tool);
 }
 
@@ -138,6 +165,7 @@ void Engine::convert_spindle_group() {
   const int m = b.m[kGroupSpindle];
   if (m == -1) return;
   if (run_extension_m(m)) return;
+  if (b.dollar_flag && (m == 3 || m == 4 || m == 5 || m == 19)) check_spindle_number(true);
   switch (m) {
     case 3:
       out_.start_spindle_clockwise(0);
@@ -156,7 +184,9 @@ void Engine::convert_spindle_group() {
       if (b.has('r') || b.has('p'))
         out_.orient_spindle(0, b.has('r') ? b.get('r') : 0.0, b.has('p') ? trunc_to_int(b.get('p')) : 0);
       if (b.has('q')) {
-        if (b.get('q') <= 0.0) fail(ErrorCode::SpindleUsage, "M19 Q (timeout) must be greater than 0");
+        if (b.get('q') <= 0.0)
+          fail_at(b.word_position('q'), ErrorCode::M19Timeout,
+                  "M19 Q{}: the time to wait for the orientation must be above 0", b.get('q'));
         out_.wait_spindle_orient_complete(0, b.get('q'));
       }
       return;
@@ -169,7 +199,8 @@ void Engine::convert_spindle_group() {
       return;
     case 72:
       if (!st_.frames.back().saved.valid)
-        fail(ErrorCode::ContextRestore, "M72 with no state saved at this call level (M70 or M73 first)");
+        fail_at(b.m_position(kGroupSpindle), ErrorCode::RestoreWithoutSave,
+                "M72 restores the modal state saved by M70 or M73, and none is saved at this call level");
       restore_context(st_.frames.back().saved);
       return;
     default:
@@ -286,7 +317,8 @@ void Engine::convert_overrides() {
   if (m == -1) return;
   if (run_extension_m(m)) return;
   if (st_.modal.cutter_comp != CutterComp::Off)
-    fail(ErrorCode::ModalContext, "overrides cannot be switched while cutter compensation is on");
+    fail_at(block_.m_position(kGroupOverride), ErrorCode::CompOverrides,
+            "M{} cannot switch overrides while cutter compensation is on: G40 first", m);
   // M50..M53: P0 disables, any other P (or none) enables.
   const bool enable = m == 48 || (m != 49 && block_.p_or(-1.0) != 0.0);
   ModalState& s = st_.modal;
@@ -326,8 +358,10 @@ void Engine::convert_overrides() {
 void Engine::convert_stop() {
   const int m = block_.m[kGroupStop];
   if (run_extension_m(m)) return;
-  if (st_.modal.cutter_comp != CutterComp::Off && ext_ != nullptr && ext_->compensator)
+  if (st_.modal.cutter_comp != CutterComp::Off && ext_ != nullptr && ext_->compensator) {
+    const ExtensionSite site(*this, block_.m_position(kGroupStop));
     ext_->compensator->finish(*this);
+  }
   switch (m) {
     case 0:
       out_.program_stop();

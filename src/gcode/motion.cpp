@@ -22,6 +22,35 @@ constexpr double kRadiusToleranceInch = 0.00005;
 constexpr double kRadiusToleranceMm = 0.00005 * 25.4;
 constexpr double kTiny = 1e-12;
 
+
+// The first centre offset word (I, J or K) of an arc, -1 if none.
+int first_offset_position(const Block& b) noexcept {
+  int first = -1;
+  for (char c : {'i', 'j', 'k'}) {
+    const int p = b.word_position(c);
+    if (p != -1 && (first == -1 || p < first)) first = p;
+  }
+  return first;
+}
+
+const char* plane_name(canon::Plane p) noexcept {
+  switch (p) {
+    case canon::Plane::XY:
+      return "XY";
+    case canon::Plane::YZ:
+      return "YZ";
+    case canon::Plane::XZ:
+      return "XZ";
+    case canon::Plane::UV:
+      return "UV";
+    case canon::Plane::VW:
+      return "VW";
+    case canon::Plane::UW:
+      return "UW";
+  }
+  return "?";
+}
+
 char plane_letter(canon::Plane p, int which) {
   switch (p) {
     case canon::Plane::XY: return which == 0 ? 'X' : 'Y';
@@ -41,6 +70,19 @@ void Engine::rotate(double& x, double& y, double degrees) const noexcept {
   y = yy;
 }
 
+void Engine::polar_with_xy(const Block& b) {
+  const char letter = b.has('x') ? 'x' : 'y';
+  fail_at(b.word_position(letter), ErrorCode::PolarWithXy,
+          "{} word beside a polar coordinate: give the point either as @ and ^ or as X and Y",
+          letter == 'x' ? 'X' : 'Y');
+}
+
+void Engine::polar_at_origin(const Block& b) {
+  fail_at(
+      b.polar_position(), ErrorCode::PolarAtOrigin,
+      "incremental polar motion (G91) from the origin: the direction is undefined there, move off it first");
+}
+
 Pose Engine::find_ends(const Block& b) {
   const PositionState& s = st_.position;
   const bool comp = st_.modal.cutter_comp != CutterComp::Off;
@@ -48,7 +90,9 @@ Pose Engine::find_ends(const Block& b) {
   Pose end = s.current;
   if (b.g[kGroupNonModal] == 530) {
     // Machine coordinates: remove every offset from the words given.
-    if (b.radius_flag || b.theta_flag) fail(ErrorCode::PolarCoordinates, "polar coordinates cannot be used with G53");
+    if (b.radius_flag || b.theta_flag)
+      fail_at(b.polar_position(), ErrorCode::PolarWithG53,
+              "polar coordinates (@ ^) cannot be used with G53: give X and Y");
     double cx = s.current[0] + s.axis_offset[0];
     double cy = s.current[1] + s.axis_offset[1];
     rotate(cx, cy, s.rotation_xy_deg);
@@ -78,12 +122,14 @@ Pose Engine::find_ends(const Block& b) {
     double x = b.has('x') ? b.get('x') : from_x;
     double y = b.has('y') ? b.get('y') : from_y;
     if (b.radius_flag || b.theta_flag) {
-      if (b.has('x') || b.has('y')) fail(ErrorCode::PolarCoordinates, "X or Y word beside a polar coordinate");
+      if (b.has('x') || b.has('y')) polar_with_xy(b);
       if (b.radius_flag && b.theta_flag) {
         x = b.radius * std::cos(b.theta * kDegToRad);
         y = b.radius * std::sin(b.theta * kDegToRad);
       } else if (b.radius_flag) {
-        if (x == 0 && y == 0) fail(ErrorCode::PolarCoordinates, "a polar radius alone needs an angle when at the origin");
+        if (x == 0 && y == 0)
+          fail_at(b.radius_at, ErrorCode::PolarAtOrigin,
+                  "a polar radius @ without an angle ^ at the origin: the direction is undefined");
         const double t = std::atan2(y, x);
         x = b.radius * std::cos(t);
         y = b.radius * std::sin(t);
@@ -104,16 +150,16 @@ Pose Engine::find_ends(const Block& b) {
   double x = from_x + (b.has('x') ? b.get('x') : 0.0);
   double y = from_y + (b.has('y') ? b.get('y') : 0.0);
   if (b.radius_flag) {
-    if (b.has('x') || b.has('y')) fail(ErrorCode::PolarCoordinates, "X or Y word beside a polar coordinate");
-    if (x == 0 && y == 0) fail(ErrorCode::PolarCoordinates, "incremental polar motion is undefined at the origin");
+    if (b.has('x') || b.has('y')) polar_with_xy(b);
+    if (x == 0 && y == 0) polar_at_origin(b);
     const double t = std::atan2(y, x);
     const double r = std::hypot(y, x) + b.radius;
     x = r * std::cos(t);
     y = r * std::sin(t);
   }
   if (b.theta_flag) {
-    if (b.has('x') || b.has('y')) fail(ErrorCode::PolarCoordinates, "X or Y word beside a polar coordinate");
-    if (x == 0 && y == 0) fail(ErrorCode::PolarCoordinates, "incremental polar motion is undefined at the origin");
+    if (b.has('x') || b.has('y')) polar_with_xy(b);
+    if (x == 0 && y == 0) polar_at_origin(b);
     const double t = std::atan2(y, x) + b.theta * kDegToRad;
     const double r = std::hypot(y, x);
     x = r * std::cos(t);
@@ -143,12 +189,13 @@ void Engine::convert_motion(int motion) {
       st_.modal.motion = 800;
       return;
     default:
-      if (!run_extension_g(motion)) unsupported_g(motion);
+      if (!run_extension_g(motion)) unsupported_g(motion, block_.motion_position());
   }
 }
 
 void Engine::emit_straight(bool rapid, const Pose& end) {
   if (st_.modal.cutter_comp != CutterComp::Off && st_.modal.comp_radius > 0.0 && ext_ != nullptr && ext_->compensator) {
+    const ExtensionSite site(*this, block_.motion_position());
     ext_->compensator->straight(*this, rapid, end);
     return;
   }
@@ -165,28 +212,40 @@ void Engine::emit_arc(const canon::ArcFeed& arc) {
 void Engine::convert_straight(int motion) {
   const Block& b = block_;
   st_.modal.arc_not_allowed = false;
-  if (motion == 10) {
-    switch (st_.modal.feed_mode) {
-      case canon::FeedMode::UnitsPerMinute:
-        if (st_.modal.feed_rate == 0.0) fail(ErrorCode::ZeroFeedRate, "G1 with zero feed rate (program an F word)");
-        break;
-      case canon::FeedMode::UnitsPerRevolution:
-        if (st_.modal.feed_rate == 0.0) fail(ErrorCode::ZeroFeedRate, "G1 with zero feed rate (program an F word)");
-        if (st_.modal.spindle_speed == 0.0)
-          fail(ErrorCode::ZeroSpindleSpeed, "feed per revolution (G95) with zero spindle speed");
-        break;
-      case canon::FeedMode::InverseTime:
-        if (!b.has('f')) fail(ErrorCode::InverseTimeFeedMissing, "G1 in inverse time mode (G93) needs an F word");
-        break;
-    }
-  }
+  if (motion == 10) check_feed("G1");
   st_.modal.motion = motion;
   const Pose end = find_ends(b);
   check_motion_habits(motion == 10);
   if (motion == 10) inverse_time_straight(end);
   if (st_.modal.cutter_comp != CutterComp::Off && st_.modal.comp_radius > 0.0 && b.g[kGroupNonModal] == 530)
-    fail(ErrorCode::CompG53, "G53 cannot be used while cutter compensation is on");
+    fail_at(b.g_position(kGroupNonModal), ErrorCode::CompG53,
+            "G53 cannot be used while cutter compensation is on: G40 first");
   emit_straight(motion == 0, end);
+}
+
+// A feed move needs a feed rate in its feed mode (and a turning spindle per revolution).
+void Engine::check_feed(std::string_view what) const {
+  const int at = block_.motion_position();
+  switch (st_.modal.feed_mode) {
+    case canon::FeedMode::UnitsPerMinute:
+      if (st_.modal.feed_rate == 0.0)
+        fail_at(at, ErrorCode::FeedZero, "{} needs a feed rate, and none is set: program an F word", what);
+      break;
+    case canon::FeedMode::UnitsPerRevolution:
+      if (st_.modal.feed_rate == 0.0)
+        fail_at(at, ErrorCode::FeedZero,
+                "{} in feed per revolution (G95) needs a feed rate, and none is set: program an F word",
+                what);
+      if (st_.modal.spindle_speed == 0.0)
+        fail_at(at, ErrorCode::SpindleSpeedZero,
+                "{} in feed per revolution (G95) with the spindle speed at 0: program an S word", what);
+      break;
+    case canon::FeedMode::InverseTime:
+      if (!block_.has('f'))
+        fail_at(at, ErrorCode::InverseTimeFeedMissing,
+                "{} in inverse time mode (G93) needs its own F word on this line", what);
+      break;
+  }
 }
 
 void Engine::inverse_time_straight(const Pose& end) {
@@ -223,24 +282,23 @@ void Engine::inverse_time_arc(double x1, double y1, double z1, double cx, double
 void Engine::convert_arc(int motion) {
   Block& b = block_;
   const ModalState& m = st_.modal;
-  if (m.arc_not_allowed) fail(ErrorCode::CompExitArc, "the move right after G40 must be straight, not an arc");
+  const int at = b.motion_position();
+  const std::string name = g_name(motion);
+  if (m.arc_not_allowed)
+    fail_at(at, ErrorCode::CompExitArc,
+            "the move right after G40 must be a straight line, not an arc: add a G1 move first");
   const bool ijk = b.has('i') || b.has('j') || b.has('k');
   if (m.plane == canon::Plane::UV || m.plane == canon::Plane::VW || m.plane == canon::Plane::UW)
-    fail(ErrorCode::ArcPlane, "arcs are not possible in the G17.1, G18.1 and G19.1 planes");
-  if (!b.has('r') && !ijk) fail(ErrorCode::ArcFormat, "arc needs an R word or centre offsets (I, J, K)");
-  if (b.has('r') && ijk) fail(ErrorCode::ArcFormat, "arc has both R and I/J/K (use one format)");
-  switch (m.feed_mode) {
-    case canon::FeedMode::UnitsPerMinute:
-      if (m.feed_rate == 0.0) fail(ErrorCode::ZeroFeedRate, "arc with zero feed rate (program an F word)");
-      break;
-    case canon::FeedMode::UnitsPerRevolution:
-      if (m.feed_rate == 0.0) fail(ErrorCode::ZeroFeedRate, "arc with zero feed rate (program an F word)");
-      if (m.spindle_speed == 0.0) fail(ErrorCode::ZeroSpindleSpeed, "feed per revolution (G95) with zero spindle speed");
-      break;
-    case canon::FeedMode::InverseTime:
-      if (!b.has('f')) fail(ErrorCode::InverseTimeFeedMissing, "arc in inverse time mode (G93) needs an F word");
-      break;
-  }
+    fail_at(at, ErrorCode::ArcUvwPlane,
+            "{} in the {} plane: arcs are possible only in the XY, XZ and YZ planes (G17, G18, G19)", name,
+            plane_name(m.plane));
+  if (!b.has('r') && !ijk)
+    fail_at(at, ErrorCode::ArcCentreMissing, "{} needs either R (the radius) or I/J/K (the centre offsets)",
+            name);
+  if (b.has('r') && ijk)
+    fail_at(b.word_position('r'), ErrorCode::ArcMixedFormat,
+            "R together with I/J/K: give an arc either its radius or its centre, not both");
+  check_feed(name);
   const bool absolute_ijk = m.ijk_distance == DistanceMode::Absolute;
   // Letters of the plane's first and second axis offsets, and the one not allowed.
   char l1 = 'i', l2 = 'j', bad = 'k';
@@ -248,11 +306,16 @@ void Engine::convert_arc(int motion) {
   if (m.plane == canon::Plane::XZ) l1 = 'i', l2 = 'k', bad = 'j';
   if (ijk) {
     if (b.has(bad))
-      fail(ErrorCode::ArcFormat, "{} word in an arc in the {} plane", static_cast<char>(bad - 32),
-           m.plane == canon::Plane::XY ? "XY" : m.plane == canon::Plane::YZ ? "YZ" : "XZ");
+      fail_at(b.word_position(bad), ErrorCode::ArcOffsetWrongPlane,
+              "{} word in an arc of the {} plane: its centre offsets are {} and {}",
+              static_cast<char>(bad - 32), plane_name(m.plane), static_cast<char>(l1 - 32),
+              static_cast<char>(l2 - 32));
     for (char need : {l1, l2}) {
       if (b.has(need)) continue;
-      if (absolute_ijk) fail(ErrorCode::ArcFormat, "{} word missing in an absolute-centre arc (G90.1)", static_cast<char>(need - 32));
+      if (absolute_ijk)
+        fail_at(at, ErrorCode::ArcCentreIncomplete,
+                "{} without {}: with absolute arc centres (G90.1) both {} and {} are needed", name,
+                static_cast<char>(need - 32), static_cast<char>(l1 - 32), static_cast<char>(l2 - 32));
       b.value[static_cast<std::size_t>(need - 'a')] = 0.0;
       break;   // LinuxCNC defaults only the first missing offset
     }
@@ -260,7 +323,10 @@ void Engine::convert_arc(int motion) {
     const bool missing = m.plane == canon::Plane::XY   ? !b.has('x') && !b.has('y') && !b.radius_flag && !b.theta_flag
                          : m.plane == canon::Plane::YZ ? !b.has('y') && !b.has('z')
                                                        : !b.has('x') && !b.has('z');
-    if (missing) fail(ErrorCode::ArcEndpointMissing, "radius-format arc needs an end point in the plane (full circles need I/J/K)");
+    if (missing)
+      fail_at(at, ErrorCode::ArcEndpointMissing,
+              "{} with R but no end point in the {} plane: give the end point (a full circle needs I/J/K)",
+              name, plane_name(m.plane));
   }
   const Pose end = find_ends(b);
   check_motion_habits(true);
@@ -271,6 +337,7 @@ void Engine::convert_arc(int motion) {
   if (m.plane == canon::Plane::YZ) a1 = 1, a2 = 2, a3 = 0;
   if (st_.modal.cutter_comp != CutterComp::Off && st_.modal.comp_radius > 0.0 && m.plane != canon::Plane::YZ &&
       ext_ != nullptr && ext_->compensator) {
+    const ExtensionSite site(*this, at);
     ext_->compensator->arc(*this, b, motion, end);
     return;
   }
@@ -318,31 +385,40 @@ void Engine::arc_center_ijk(int motion, double cur1, double cur2, double end1, d
   const double r2 = std::hypot(c1 - end1, c2 - end2);
   const canon::Plane p = st_.modal.plane;
   const char a = plane_letter(p, 0), b = plane_letter(p, 1);
-  if (r1 < radius_tol || r2 < radius_tol)
-    fail(ErrorCode::ArcZeroRadius, "zero-radius arc: start ({}{:.4f}, {}{:.4f}), centre ({}{:.4f}, {}{:.4f})", a, cur1, b,
-         cur2, a, c1, b, c2);
+  const int at = first_offset_position(block_);
+  if (r1 < radius_tol)
+    fail_at(at, ErrorCode::ArcZeroRadius,
+            "zero-radius arc: its centre ({}{:.4f}, {}{:.4f}) is the start point", a, c1, b, c2);
+  if (r2 < radius_tol)
+    fail_at(at, ErrorCode::ArcZeroRadius, "zero-radius arc: its centre ({}{:.4f}, {}{:.4f}) is the end point",
+            a, c1, b, c2);
   const double abs_err = std::fabs(r1 - r2);
   const double rel_err = abs_err / std::max(r1, r2);
   if (abs_err > spiral_tol && rel_err > kSpiralRelativeTolerance)
-    fail(ErrorCode::ArcRadiusMismatch,
-         "arc end is not on the circle: start ({}{:.4f}, {}{:.4f}), centre ({}{:.4f}, {}{:.4f}), end ({}{:.4f}, {}{:.4f}); "
-         "radius {:.4f} at the start, {:.4f} at the end",
-         a, cur1, b, cur2, a, c1, b, c2, a, end1, b, end2, r1, r2);
+    fail_at(at, ErrorCode::ArcEndOffCircle,
+            "the arc's end ({}{:.4f}, {}{:.4f}) is not on its circle: around the centre ({}{:.4f}, {}{:.4f}) "
+            "the start is "
+            "{:.4f} away and the end {:.4f}; correct the end point or the centre",
+            a, end1, b, end2, a, c1, b, c2, r1, r2);
   turn = motion == 20 ? -turns : turns;
 }
 
 void Engine::arc_center_r(int motion, double cur1, double cur2, double end1, double end2, double radius, int turns,
                           double& c1, double& c2, int& turn) const {
   const double tolerance = st_.modal.units == canon::Units::Inch ? kRadiusToleranceInch : kRadiusToleranceMm;
+  const int at = block_.word_position('r');
   if (end1 == cur1 && end2 == cur2)
-    fail(ErrorCode::ArcSameEndpoint, "radius-format arc ends where it starts (use I/J/K for a full circle)");
+    fail_at(at, ErrorCode::ArcRadiusFullCircle,
+            "an R arc that ends where it starts: R cannot give a full circle, give the centre with I/J/K "
+            "instead");
   const double abs_radius = std::fabs(radius);
   const double mid1 = (end1 + cur1) / 2.0;
   const double mid2 = (end2 + cur2) / 2.0;
   double half_length = std::hypot(mid1 - end1, mid2 - end2);
   if (half_length - abs_radius > tolerance)
-    fail(ErrorCode::ArcRadiusTooSmall, "arc radius {:.4f} is too small to reach the end point (half chord {:.4f})",
-         abs_radius, half_length);
+    fail_at(at, ErrorCode::ArcRadiusTooSmall,
+            "arc radius {:.4f} is smaller than half the chord {:.4f} between start and end", abs_radius,
+            half_length);
   if (half_length / abs_radius > 1 - kTiny) half_length = abs_radius;   // allow a semicircle's rounding
   // The direction is a double; ±π/2 is added in long double and the sum rounded (LinuxCNC's
   // arithmetic, kept so that centres on a coordinate axis come out with the same sign).

@@ -21,6 +21,7 @@ void Engine::update_unit_factor() noexcept {
 }
 
 void Engine::set_units(int code) {
+  // LinuxCNC lets the units change while compensation is on; the radius is converted below.
   const canon::Units units = code == 200 ? canon::Units::Inch : canon::Units::Mm;
   units_programmed_ = true;
   out_.use_length_units(units);
@@ -82,7 +83,9 @@ Pose Engine::machine_to_program(const Pose& m) const {
 
 void Engine::set_coordinate_system(int code) {
   if (st_.modal.cutter_comp != CutterComp::Off)
-    fail(ErrorCode::CompCoordinateSystem, "the coordinate system cannot change while cutter compensation is on");
+    fail_at(block_.g_position(kGroupCoordSystem), ErrorCode::CompCoordinateSystem,
+            "{} cannot change the coordinate system while cutter compensation is on: G40 first",
+            g_name(code));
   int origin = 1;
   switch (code) {
     case 540: origin = 1; break;
@@ -142,7 +145,10 @@ void Engine::convert_modal_0(int code) {
 
 void Engine::g10_coordinate_system() {
   const Block& b = block_;
-  if (b.has('i') || b.has('j')) fail(ErrorCode::G10Usage, "I and J words cannot be used with G10 L2/L20");
+  if (b.has('i') || b.has('j'))
+    fail_at(b.word_position(b.has('i') ? 'i' : 'j'), ErrorCode::G10IjWords,
+            "I and J cannot be used with G10 L{}: they set tool angles (G10 L1)",
+            static_cast<int>(b.get('l')));
   auto& par = st_.parameters;
   PositionState& s = st_.position;
   const bool l20 = b.get('l') == 20;
@@ -150,12 +156,17 @@ void Engine::g10_coordinate_system() {
   if (p == 0) p = st_.modal.coord_system;
   const bool active = p == st_.modal.coord_system;
   if (st_.modal.cutter_comp != CutterComp::Off && active)
-    fail(ErrorCode::CompCoordinateSystem, "the active coordinate system cannot change while cutter compensation is on");
+    fail_at(
+        b.g_position(kGroupNonModal), ErrorCode::CompActiveSystemOffset,
+        "G10 L{} cannot move the active coordinate system (P{}) while cutter compensation is on: G40 first",
+        static_cast<int>(b.get('l')), p);
   const Pose c = current_in_system(p, false);
   const std::size_t base = static_cast<std::size_t>(5200 + 20 * p);
   double r;
   if (b.has('r')) {
-    if (l20) fail(ErrorCode::G10Usage, "R (rotation) cannot be used with G10 L20");
+    if (l20)
+      fail_at(b.word_position('r'), ErrorCode::G10L20Rotation,
+              "R (rotation) cannot be used with G10 L20: set it with G10 L2");
     r = b.get('r');
     par[base + 10] = r;
   } else {
@@ -218,9 +229,12 @@ void Engine::g10_tool() {
   const Block& b = block_;
   int toolno;
   near_int(toolno, b.get('p'));
-  const int index = tool_index(toolno);
+  const int index = tool_index(toolno, b.word_position('p'));
   const bool any = b.any_axis() || b.has('r') || b.has('q') || b.has('i') || b.has('j');
-  if (!any) fail(ErrorCode::G10Usage, "G10 L{} without offsets changes nothing", static_cast<int>(b.get('l')));
+  if (!any)
+    fail_at(b.g_position(kGroupNonModal), ErrorCode::G10NoOffsets,
+            "G10 L{} without any value changes nothing: give axis words, R, I, J or Q",
+            static_cast<int>(b.get('l')));
   tools::ToolEntry e = st_.tool.table[static_cast<std::size_t>(index)];
   const int l = static_cast<int>(b.get('l'));
   if (l == 1) {
@@ -274,8 +288,11 @@ void Engine::g10_tool() {
   if (b.has('j')) e.back_angle = b.get('j');
   if (b.q_or(-1.0) != -1.0) {
     int q;
-    if (!near_int(q, b.get('q'))) fail(ErrorCode::G10Usage, "Q (tool orientation) must be a whole number");
-    if (q > 9) fail(ErrorCode::G10Usage, "tool orientation Q{} is not 0..9", q);
+    if (!near_int(q, b.get('q')))
+      fail_at(b.word_position('q'), ErrorCode::G10Orientation,
+              "Q{}: the tool orientation must be a whole number, 0 to 9", b.get('q'));
+    if (q > 9)
+      fail_at(b.word_position('q'), ErrorCode::G10Orientation, "Q{}: the tool orientation must be 0 to 9", q);
     e.orientation = q;
   }
   st_.tool.table[static_cast<std::size_t>(index)] = e;
@@ -291,7 +308,8 @@ void Engine::g10_tool() {
 
 void Engine::axis_offsets(int code) {
   if (st_.modal.cutter_comp != CutterComp::Off)
-    fail(ErrorCode::ModalContext, "axis offsets cannot change while cutter compensation is on");
+    fail_at(block_.g_position(kGroupNonModal), ErrorCode::CompAxisOffsets,
+            "{} cannot change the axis offsets while cutter compensation is on: G40 first", g_name(code));
   const Block& b = block_;
   auto& par = st_.parameters;
   PositionState& s = st_.position;
@@ -334,7 +352,8 @@ void Engine::axis_offsets(int code) {
 void Engine::go_home(int code) {
   Pose end = find_ends(block_);
   if (st_.modal.cutter_comp != CutterComp::Off)
-    fail(ErrorCode::CompG28G30, "G28/G30 cannot be used while cutter compensation is on");
+    fail_at(block_.g_position(kGroupNonModal), ErrorCode::CompG28G30,
+            "{} cannot be used while cutter compensation is on: G40 first", g_name(code));
   out_.straight_traverse(0, end);
   st_.position.current = end;
   Pose home_machine;
@@ -354,7 +373,8 @@ void Engine::go_home(int code) {
 
 void Engine::save_home(int code) {
   if (st_.modal.cutter_comp != CutterComp::Off)
-    fail(ErrorCode::ModalContext, "a reference point cannot be set while cutter compensation is on");
+    fail_at(block_.g_position(kGroupNonModal), ErrorCode::CompReferencePoint,
+            "{} cannot store a reference point while cutter compensation is on: G40 first", g_name(code));
   const PositionState& s = st_.position;
   const std::size_t base = code == 281 ? 5161 : 5181;
   for (int i = 0; i < kAxisCount; ++i) {
@@ -364,9 +384,11 @@ void Engine::save_home(int code) {
 }
 
 void Engine::tool_length_offset(int code) {
-  if (st_.modal.cutter_comp != CutterComp::Off)
-    fail(ErrorCode::CompToolOffset, "the tool offset cannot change while cutter compensation is on");
   const Block& b = block_;
+  if (st_.modal.cutter_comp != CutterComp::Off)
+    fail_at(b.g_position(kGroupToolLength), ErrorCode::CompToolOffset,
+            "{} cannot change the tool length offset while cutter compensation is on: G40 first",
+            g_name(code));
   PositionState& s = st_.position;
   Pose offset{};
   auto from_table = [&](int index) {
@@ -376,7 +398,7 @@ void Engine::tool_length_offset(int code) {
     return o;
   };
   if (code == 430) {
-    const int index = b.has('h') ? tool_index(static_cast<int>(b.get('h')))
+    const int index = b.has('h') ? tool_index(static_cast<int>(b.get('h')), b.word_position('h'))
                                  : (block_.m[kGroupToolChange] != -1 ? st_.tool.current_index : 0);
     offset = from_table(index);
   } else if (code == 431) {
@@ -385,17 +407,18 @@ void Engine::tool_length_offset(int code) {
       if (b.has(kAxisWordLetters[i])) offset[i] = b.get(kAxisWordLetters[i]);
     }
   } else if (code == 432) {
-    if (b.has('h') && b.any_axis()) fail(ErrorCode::ToolOffsetUsage, "G43.2 takes either an H word or axis words, not both");
-    if (!b.has('h') && !b.any_axis()) fail(ErrorCode::ToolOffsetUsage, "G43.2 needs an H word or axis words");
+    // LinuxCNC 2.9 adds the offset of the tool H names; axis words do not replace H there
+    // (rs274 looks up a tool -1), so G43.2 always needs H and takes no axis words.
+    const int at = b.g_position(kGroupToolLength);
+    if (b.has('h') && b.any_axis())
+      fail_at(b.first_axis_position(), ErrorCode::G43_2AxisWords,
+              "G43.2 takes an H word only: remove the axis words");
+    if (!b.has('h'))
+      fail_at(at, ErrorCode::G43_2HMissing, "G43.2 needs an H word: the tool whose length offset it adds{}",
+              b.any_axis() ? " (axis words cannot replace it)" : "");
     offset = s.tool_offset;
-    if (b.has('h')) {
-      const Pose add = from_table(tool_index(static_cast<int>(b.get('h'))));
-      for (int i = 0; i < kAxisCount; ++i) offset[i] += add[i];
-    } else {
-      for (int i = 0; i < kAxisCount; ++i) {
-        if (b.has(kAxisWordLetters[i])) offset[i] += b.get(kAxisWordLetters[i]);
-      }
-    }
+    const Pose add = from_table(tool_index(static_cast<int>(b.get('h')), b.word_position('h')));
+    for (int i = 0; i < kAxisCount; ++i) offset[i] += add[i];
   }
   out_.use_tool_length_offset(offset);
   // The controlled point stays where it is: its coordinates change by the offset change.

@@ -147,7 +147,9 @@ void Engine::declare_named(std::string_view name) {
 }
 
 void Engine::store_named(const std::string& name, double value) {
-  if (is_predefined(name)) fail(ErrorCode::ParameterReadOnly, "#<{}> is read-only", name);
+  if (is_predefined(name))
+    fail(ErrorCode::ParameterReadOnly, "#<{}> is read-only: the interpreter sets it (choose another name)",
+         name);
   NamedParameters& scope = (!name.empty() && name.front() == '_') ? st_.globals : st_.frames.back().locals;
   NamedValue& v = scope[name];
   v.value = value;

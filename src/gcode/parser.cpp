@@ -40,7 +40,7 @@ double apply_binary(double a, int op, double b, int pos) {
     case kMinus: return a - b;
     case kTimes: return a * b;
     case kDivide:
-      if (b == 0.0) fail_at(pos, ErrorCode::DivideByZero, "division by zero");
+      if (b == 0.0) fail_at(pos, ErrorCode::DivideByZero, "division by zero: {} / 0", a);
       return a / b;
     case kModulo: {
       // The result takes the sign of the divisor's magnitude: always >= 0 (LinuxCNC).
@@ -50,7 +50,8 @@ double apply_binary(double a, int op, double b, int pos) {
     }
     case kPower:
       if (a < 0.0 && std::floor(b) != b)
-        fail_at(pos, ErrorCode::NegativeToNonIntegerPower, "{} ** {}: a negative number raised to a non-integer power", a, b);
+        fail_at(pos, ErrorCode::PowerDomain,
+                "{} ** {}: a negative number has no power with a fractional exponent", a, b);
       return std::pow(a, b);
     case kAnd: return (a == 0.0 || b == 0.0) ? 0.0 : 1.0;
     case kOr: return (a != 0.0 || b != 0.0) ? 1.0 : 0.0;
@@ -78,10 +79,12 @@ double apply_unary(int op, double x, int pos) {
   switch (op) {
     case kAbs: return std::fabs(x);
     case kAcos:
-      if (x < -1.0 || x > 1.0) fail_at(pos, ErrorCode::AcosRange, "ACOS of {} (must be within -1..1)", x);
+      if (x < -1.0 || x > 1.0)
+        fail_at(pos, ErrorCode::TrigDomain, "ACOS[{}]: the argument must lie within -1..1", x);
       return static_cast<double>(std::acos(x) * 180.0L / kPi);
     case kAsin:
-      if (x < -1.0 || x > 1.0) fail_at(pos, ErrorCode::AsinRange, "ASIN of {} (must be within -1..1)", x);
+      if (x < -1.0 || x > 1.0)
+        fail_at(pos, ErrorCode::TrigDomain, "ASIN[{}]: the argument must lie within -1..1", x);
       return static_cast<double>(std::asin(x) * 180.0L / kPi);
     case kCos: return static_cast<double>(std::cos(xl * kPi / 180.0L));
     case kSin: return static_cast<double>(std::sin(xl * kPi / 180.0L));
@@ -90,7 +93,8 @@ double apply_unary(int op, double x, int pos) {
     case kFix: return std::floor(x);
     case kFup: return std::ceil(x);
     case kLn:
-      if (x <= 0.0) fail_at(pos, ErrorCode::LnDomain, "LN of {} (must be positive)", x);
+      if (x <= 0.0)
+        fail_at(pos, ErrorCode::LnNonPositive, "LN[{}]: the logarithm needs an argument greater than 0", x);
       return std::log(x);
     case kRound: {
       // LinuxCNC rounds half away from zero through an int.
@@ -99,7 +103,7 @@ double apply_unary(int op, double x, int pos) {
       return static_cast<double>(static_cast<int>(r));
     }
     case kSqrt:
-      if (x < 0.0) fail_at(pos, ErrorCode::SqrtNegative, "SQRT of {} (negative)", x);
+      if (x < 0.0) fail_at(pos, ErrorCode::SqrtNegative, "SQRT[{}]: the square root of a negative number", x);
       return std::sqrt(x);
     default: return x;
   }
@@ -109,6 +113,82 @@ std::string describe_char(char c) {
   const auto u = static_cast<unsigned char>(c);
   if (u < 0x21 || u > 0x7e) return fmt::format("\\{:03o}", static_cast<unsigned>(u));
   return std::string(1, c);
+}
+
+// Positions kept in a Block are bytes; lines are shorter than that (kMaxLineLength).
+std::uint8_t position_byte(std::size_t pos) noexcept {
+  return static_cast<std::uint8_t>(pos < 255 ? pos : 255);
+}
+
+constexpr std::string_view kAxisLetters = "xyzabcuvw";
+constexpr std::string_view kOwordKeywords =
+    "sub endsub call return do while endwhile repeat endrepeat if elseif else endif break continue";
+
+// "X Y Z A B C": the axis letters a line may use.
+std::string axis_list(std::uint32_t letters) {
+  std::string s;
+  for (char a : kAxisLetters) {
+    if (!((letters >> (a - 'a')) & 1u)) continue;
+    if (!s.empty()) s += ' ';
+    s += static_cast<char>(a - 'a' + 'A');
+  }
+  return s;
+}
+
+const char* g_group_name(int group) noexcept {
+  switch (group) {
+    case kGroupNonModal:
+      return "non-modal";
+    case kGroupMotion:
+      return "motion";
+    case kGroupPlane:
+      return "plane selection";
+    case kGroupDistance:
+      return "distance mode";
+    case kGroupIjkDistance:
+      return "arc centre distance mode";
+    case kGroupFeedMode:
+      return "feed mode";
+    case kGroupUnits:
+      return "units";
+    case kGroupCutterComp:
+      return "cutter compensation";
+    case kGroupToolLength:
+      return "tool length offset";
+    case kGroupRetract:
+      return "canned cycle return";
+    case kGroupCoordSystem:
+      return "coordinate system";
+    case kGroupControl:
+      return "path control";
+    case kGroupSpindleMode:
+      return "spindle speed mode";
+    case kGroupLatheDiameter:
+      return "lathe diameter mode";
+    default:
+      return "?";
+  }
+}
+
+const char* m_group_name(int group) noexcept {
+  switch (group) {
+    case kGroupStop:
+      return "stopping";
+    case kGroupIo:
+      return "input/output";
+    case kGroupToolChange:
+      return "tool change";
+    case kGroupSpindle:
+      return "spindle";
+    case kGroupCoolant:
+      return "coolant";
+    case kGroupOverride:
+      return "override";
+    case kGroupUser:
+      return "user-defined";
+    default:
+      return "?";
+  }
 }
 
 }  // namespace
@@ -140,6 +220,10 @@ int g_group(int code) noexcept {
   }
 }
 
+std::string g_name(int code) {
+  return code % 10 ? fmt::format("G{}.{}", code / 10, code % 10) : fmt::format("G{}", code / 10);
+}
+
 int m_group(int code) noexcept {
   switch (code) {
     case 0: case 1: case 2: case 30: case 60: case 99: return kGroupStop;
@@ -163,7 +247,7 @@ void Parser::parse(std::string_view text, const ParseEnv& env, Block& b) {
   // M98 / M99 (Fanuc subprograms) start an O-word line in LinuxCNC.
   if (c.at() == 'm' && (starts_with(text, c.pos + 1, "98") || (starts_with(text, c.pos + 1, "99") && env.call_level > 0))) {
     Cursor probe{text, c.pos + 1, env};
-    const int m = integer_value(probe);
+    const int m = integer_value(probe, "an M code");
     if (m == 98 || (m == 99 && env.call_level > 0))
       fail_at(static_cast<int>(c.pos), ErrorCode::Unsupported, "M{} subprograms (Fanuc style) are not supported yet", m);
   }
@@ -177,8 +261,15 @@ void Parser::parse(std::string_view text, const ParseEnv& env, Block& b) {
         read_comment(c, b);
         continue;
       }
-      fail_at(static_cast<int>(c.pos), ErrorCode::OWordSyntax, "unexpected '{}' after the O-word statement",
-              describe_char(c.at()));
+      std::size_t end = c.pos + 1;
+      while (end < text.size() && (is_digit(text[end]) || text[end] == '.')) ++end;
+      std::string word(text.substr(c.pos, end - c.pos));
+      if (word[0] >= 'a' && word[0] <= 'z') word[0] = static_cast<char>(word[0] - 'a' + 'A');
+      fail_at(static_cast<int>(c.pos), ErrorCode::OwordSyntax,
+              "{} after the O-word statement: an O-word line holds only the statement and comments, so put "
+              "it on a line "
+              "of its own",
+              word);
     }
     return;
   }
@@ -190,11 +281,15 @@ void Parser::read_line_number(Cursor& c, Block& b) {
   ++c.pos;
   const std::size_t start = c.pos;
   while (is_digit(c.at())) ++c.pos;
-  if (c.pos == start) fail_at(static_cast<int>(start), ErrorCode::BadLineNumber, "N must be followed by digits");
+  if (c.pos == start)
+    fail_at(static_cast<int>(start), ErrorCode::BadLineNumber,
+            "N without digits: a line number is N followed by digits");
   if (c.at() == '.') {   // fractional line numbers are read and ignored
     const std::size_t frac = ++c.pos;
     while (is_digit(c.at())) ++c.pos;
-    if (c.pos == frac) fail_at(static_cast<int>(frac), ErrorCode::BadLineNumber, "N number has no digits after '.'");
+    if (c.pos == frac)
+      fail_at(static_cast<int>(frac), ErrorCode::BadLineNumber,
+              "the line number has no digits after its '.'");
   }
   b.n_present = true;
 }
@@ -203,7 +298,7 @@ void Parser::read_item(Cursor& c, Block& b) {
   const char ch = c.at();
   const int pos = static_cast<int>(c.pos);
   if (ch >= 'a' && ch <= 'z') {
-    if (!((c.env.letters >> (ch - 'a')) & 1u)) fail_at(pos, ErrorCode::BadCharacter, "unexpected '{}' here", ch);
+    if (!((c.env.letters >> (ch - 'a')) & 1u)) letter_without_word(c, ch);
     if (ch == 'g') return read_g(c, b);
     if (ch == 'm') return read_m(c, b);
     return read_word(c, b, ch);
@@ -216,21 +311,64 @@ void Parser::read_item(Cursor& c, Block& b) {
       ++c.pos;
       b.radius = real_value(c);
       b.radius_flag = true;
+      b.radius_at = position_byte(static_cast<std::size_t>(pos));
       return;
     case '^':
       ++c.pos;
       b.theta = real_value(c);
       b.theta_flag = true;
+      b.theta_at = position_byte(static_cast<std::size_t>(pos));
       return;
     case '$':
       ++c.pos;
-      if (b.dollar_flag) fail_at(pos, ErrorCode::RepeatedWord, "more than one $ word on the line");
+      if (b.dollar_flag)
+        fail_at(pos, ErrorCode::RepeatedWord, "a second $ word on this line: give the spindle number once");
       b.dollar = real_value(c);
       b.dollar_flag = true;
+      b.dollar_at = position_byte(static_cast<std::size_t>(pos));
       return;
+    case '%':
+      if (c.text == "%")
+        fail_at(pos, ErrorCode::PercentMisplaced,
+                "a '%' line in a program whose first line is not '%': delete it, or open the program with a "
+                "'%' line too");
+      fail_at(pos, ErrorCode::PercentMisplaced,
+              "'%' must stand alone on its line (it opens or closes a program)");
+    case ']':
+      fail_at(pos, ErrorCode::BadCharacter,
+              "this ']' closes no '[': remove it or add the '[' that opens the expression");
     default:
-      fail_at(pos, ErrorCode::BadCharacter, "unexpected '{}' here", describe_char(ch));
+      fail_at(pos, ErrorCode::BadCharacter, "'{}' starts no word: remove it or put it in a comment",
+              describe_char(ch));
   }
+}
+
+// "o1 callsub": a keyword with more letters after it (blanks are gone, so "o1 endif g1" reads
+// "endifg1": one letter and a number after the keyword is the next word, not a misspelling).
+void Parser::misspelt_keyword(const Cursor& c, std::size_t keyword_at) {
+  std::size_t end = c.pos;
+  while (end < c.text.size() && c.text[end] >= 'a' && c.text[end] <= 'z') ++end;
+  if (end == c.pos) return;
+  const char after = end < c.text.size() ? c.text[end] : '\0';
+  if (end - c.pos == 1 && (is_digit(after) || after == '.' || after == '[' || after == '#' || after == '-'))
+    return;
+  fail_at(static_cast<int>(keyword_at), ErrorCode::OwordSyntax, "'{}' is a misspelt O-word keyword ({})",
+          c.text.substr(keyword_at, end - keyword_at), kOwordKeywords);
+}
+
+void Parser::letter_without_word(const Cursor& c, char letter) {
+  const int pos = static_cast<int>(c.pos);
+  const char upper = static_cast<char>(letter - 'a' + 'A');
+  if (kAxisLetters.find(letter) != std::string_view::npos)
+    fail_at(pos, ErrorCode::AxisNotAvailable, "{} word: this machine has no {} axis (its axes are {})", upper,
+            upper, axis_list(c.env.letters));
+  if (letter == 'n')
+    fail_at(pos, ErrorCode::LineNumberNotFirst,
+            "N word after other words: a line number must be the first word of its line");
+  if (letter == 'o')
+    fail_at(pos, ErrorCode::BadCharacter,
+            "O-word after other words: an O-word statement must begin its line");
+  fail_at(pos, ErrorCode::BadCharacter, "'{}' starts no word: remove it or put it in a comment", letter);
 }
 
 void Parser::read_comment(Cursor& c, Block& b) {
@@ -247,27 +385,33 @@ void Parser::read_word(Cursor& c, Block& b, char letter) {
   const bool seen = b.has(letter);
   // P and Q count as repeated only when the earlier value is > -1 (LinuxCNC's rule).
   if (seen && ((letter != 'p' && letter != 'q') || b.get(letter) > -1.0))
-    fail_at(pos, ErrorCode::RepeatedWord, "more than one {} word on the line", static_cast<char>(letter - 32));
+    fail_at(pos, ErrorCode::RepeatedWord, "a second {} word on this line: give each word once",
+            static_cast<char>(letter - 32));
   double v;
   switch (letter) {
     case 'h':
-    case 'l':
-    case 't': {
-      const int i = integer_value(c);
-      if ((letter == 'h' && i < -1) || (letter != 'h' && i < 0))
-        fail_at(pos, ErrorCode::NegativeValue, "{} word must not be negative", static_cast<char>(letter - 32));
-      v = i;
+      v = integer_value(c, "H");
+      if (v < -1) fail_at(pos, ErrorCode::HWordNegative, "H{}: the tool number of an offset is 0 or more", v);
       break;
-    }
+    case 'l':
+      v = integer_value(c, "L");
+      if (v < 0) fail_at(pos, ErrorCode::LWordNegative, "L{}: an L number cannot be negative", v);
+      break;
+    case 't':
+      v = integer_value(c, "T");
+      if (v < 0) fail_at(pos, ErrorCode::ToolNegative, "T{}: tool numbers are 0 or more", v);
+      break;
     default:
       v = real_value(c);
-      if ((letter == 'f' || letter == 's') && v < 0.0)
-        fail_at(pos, ErrorCode::NegativeValue, "{} word must not be negative", static_cast<char>(letter - 32));
+      if (letter == 'f' && v < 0.0)
+        fail_at(pos, ErrorCode::FeedNegative, "F{}: a feed rate cannot be negative", v);
+      if (letter == 's' && v < 0.0)
+        fail_at(pos, ErrorCode::SpeedNegative, "S{}: a spindle speed cannot be negative", v);
       if (letter == 'x' && c.env.lathe_diameter) v /= 2.0;
       break;
   }
   b.value[static_cast<std::size_t>(letter - 'a')] = v;
-  b.at[static_cast<std::size_t>(letter - 'a')] = static_cast<std::uint8_t>(pos < 255 ? pos : 255);
+  b.at[static_cast<std::size_t>(letter - 'a')] = position_byte(static_cast<std::size_t>(pos));
   b.words |= 1u << (letter - 'a');
 }
 
@@ -298,36 +442,44 @@ void Parser::read_g(Cursor& c, Block& b) {
   if (code < 0) {
     const double v10 = 10.0 * real_value(c);
     // (range first: only then does the value fit an int)
-    if (!(v10 < 1e4)) fail_at(pos, ErrorCode::GCodeOutOfRange, "G{} is out of range", v10 / 10.0);
-    if (v10 <= -1e4) fail_at(pos, ErrorCode::GCodeOutOfRange, "G code must not be negative");
+    if (!(v10 < 1e4))
+      fail_at(pos, ErrorCode::GCodeOutOfRange, "G{}: G numbers go from 0 to 99.9", v10 / 10.0);
+    if (v10 <= -1e4)
+      fail_at(pos, ErrorCode::GCodeOutOfRange, "G{}: G numbers cannot be negative", v10 / 10.0);
     code = static_cast<int>(std::floor(v10));
     if (v10 - code > 0.999) code = static_cast<int>(std::ceil(v10));
-    else if (v10 - code > 0.001) fail_at(pos, ErrorCode::GCodeOutOfRange, "G{} is not a G code (at most one decimal)", v10 / 10.0);
-    if (code > 999) fail_at(pos, ErrorCode::GCodeOutOfRange, "G{} is out of range", v10 / 10.0);
-    if (code < 0) fail_at(pos, ErrorCode::GCodeOutOfRange, "G code must not be negative");
+    else if (v10 - code > 0.001)
+      fail_at(pos, ErrorCode::GCodeOutOfRange, "G{}: a G number has at most one decimal", v10 / 10.0);
+    if (code > 999) fail_at(pos, ErrorCode::GCodeOutOfRange, "G{}: G numbers go from 0 to 99.9", v10 / 10.0);
+    if (code < 0) fail_at(pos, ErrorCode::GCodeOutOfRange, "G{}: G numbers cannot be negative", v10 / 10.0);
   }
   const int group = g_group(code);
-  if (group < 0) {
-    if (code % 10) fail_at(pos, ErrorCode::UnknownGCode, "G{}.{} is not a known G code", code / 10, code % 10);
-    fail_at(pos, ErrorCode::UnknownGCode, "G{} is not a known G code", code / 10);
-  }
+  if (group < 0) fail_at(pos, ErrorCode::UnknownGCode, "{} is not a G code of this dialect", g_name(code));
   auto& slot = b.g[static_cast<std::size_t>(group)];
   if (code == 800 && slot != -1) return;   // G80 beside another motion code is ignored
-  if (slot != -1 && slot != 800) fail_at(pos, ErrorCode::TwoGCodesSameGroup, "two G codes of the same modal group");
+  if (slot != -1 && slot != 800)
+    fail_at(pos, ErrorCode::ModalGroupConflict,
+            "{} and {} are both {} codes: a line may hold only one of them", g_name(slot), g_name(code),
+            g_group_name(group));
   slot = static_cast<std::int16_t>(code);
+  b.g_at[static_cast<std::size_t>(group)] = position_byte(static_cast<std::size_t>(pos));
 }
 
 void Parser::read_m(Cursor& c, Block& b) {
   const int pos = static_cast<int>(c.pos);
   ++c.pos;
-  const int code = integer_value(c);
-  if (code < 0) fail_at(pos, ErrorCode::MCodeOutOfRange, "M code must not be negative");
-  if (code > 199) fail_at(pos, ErrorCode::MCodeOutOfRange, "M{} is above M199", code);
+  const int code = integer_value(c, "an M code");
+  if (code < 0) fail_at(pos, ErrorCode::MCodeOutOfRange, "M{}: M numbers cannot be negative", code);
+  if (code > 199) fail_at(pos, ErrorCode::MCodeOutOfRange, "M{}: M numbers go from 0 to 199", code);
   const int group = m_group(code);
-  if (group < 0) fail_at(pos, ErrorCode::UnknownMCode, "M{} is not a known M code", code);
+  if (group < 0) fail_at(pos, ErrorCode::UnknownMCode, "M{} is not an M code of this dialect", code);
   auto& slot = b.m[static_cast<std::size_t>(group)];
-  if (slot != -1) fail_at(pos, ErrorCode::TwoMCodesSameGroup, "two M codes of the same modal group");
+  if (slot != -1)
+    fail_at(pos, ErrorCode::ModalGroupConflict,
+            "M{} and M{} are both {} codes: a line may hold only one of them", slot, code,
+            m_group_name(group));
   slot = static_cast<std::int16_t>(code);
+  b.m_at[static_cast<std::size_t>(group)] = position_byte(static_cast<std::size_t>(pos));
   ++b.m_count;
 }
 
@@ -335,7 +487,8 @@ std::string Parser::read_name(Cursor& c) {
   const std::size_t start = ++c.pos;   // after '<'
   while (c.pos < c.text.size() && c.text[c.pos] != '>') ++c.pos;
   if (c.pos >= c.text.size())
-    fail_at(static_cast<int>(start - 1), ErrorCode::NameNotTerminated, "name started with '<' has no closing '>'");
+    fail_at(static_cast<int>(start - 1), ErrorCode::NameNotTerminated,
+            "the name after '<' is not closed: add '>' after it");
   std::string name(c.text.substr(start, c.pos - start));
   ++c.pos;
   return name;
@@ -347,18 +500,23 @@ void Parser::read_assignment(Cursor& c) {
   if (c.at() == '<') {
     std::string name = read_name(c);
     c.env.host->declare_named(name);
-    if (c.at() != '=') fail_at(static_cast<int>(c.pos), ErrorCode::EqualSignMissing, "'=' expected after #<{}>", name);
+    if (c.at() != '=')
+      fail_at(static_cast<int>(c.pos), ErrorCode::EqualSignMissing,
+              "#<{}> is not followed by '=': write #<{}>=value", name, name);
     ++c.pos;
     const double v = real_value(c);
     named_assignments.emplace_back(std::move(name), v);
     return;
   }
-  const int index = integer_value(c);
+  const int index = integer_value(c, "a parameter number");
   if (index < 1 || index >= kParameterCount)
     fail_at(pos, ErrorCode::ParameterOutOfRange, "parameter #{} does not exist (1..{})", index, kParameterCount - 1);
   if ((index >= 5400 && index <= 5413) || (index >= 5420 && index <= 5428))
-    fail_at(pos, ErrorCode::ParameterReadOnly, "parameter #{} is read-only", index);
-  if (c.at() != '=') fail_at(static_cast<int>(c.pos), ErrorCode::EqualSignMissing, "'=' expected after #{}", index);
+    fail_at(pos, ErrorCode::ParameterReadOnly, "parameter #{} is read-only: it reports the current {}", index,
+            index < 5420 ? "tool" : "position");
+  if (c.at() != '=')
+    fail_at(static_cast<int>(c.pos), ErrorCode::EqualSignMissing,
+            "#{} is not followed by '=': write #{}=value", index, index);
   ++c.pos;
   const double v = real_value(c);
   numbered_assignments.emplace_back(index, v);
@@ -367,7 +525,13 @@ void Parser::read_assignment(Cursor& c) {
 double Parser::real_value(Cursor& c) {
   const char ch = c.at();
   const int pos = static_cast<int>(c.pos);
-  if (ch == '\0') fail_at(pos, ErrorCode::MissingValue, "a value is missing at the end of the line");
+  if (ch == '\0') {
+    const char before = pos > 0 ? c.text[static_cast<std::size_t>(pos - 1)] : '\0';
+    if (before >= 'a' && before <= 'z')
+      fail_at(pos - 1, ErrorCode::MissingValue, "{} has no value: the line ends right after the letter",
+              static_cast<char>(before - 'a' + 'A'));
+    fail_at(pos, ErrorCode::MissingValue, "the line ends where a value should follow");
+  }
   const char next = c.at(1);
   double v;
   if (ch == '[') {
@@ -383,8 +547,10 @@ double Parser::real_value(Cursor& c) {
   } else {
     return real_number(c);   // finite: no exponent, and overlong digit strings are refused
   }
-  if (std::isnan(v)) fail_at(pos, ErrorCode::NotANumber, "the calculation gives 'not a number'");
-  if (std::isinf(v)) fail_at(pos, ErrorCode::Infinity, "the calculation gives infinity");
+  if (std::isnan(v))
+    fail_at(pos, ErrorCode::ResultNotANumber, "this value is not a number (its calculation is undefined)");
+  if (std::isinf(v))
+    fail_at(pos, ErrorCode::ResultInfinite, "this value is infinite (its calculation overflows)");
   return v;
 }
 
@@ -438,11 +604,14 @@ double Parser::real_number(Cursor& c) {
 void Parser::bad_number(const char* start, const char* after, const char* text, bool malformed) {
   const std::string_view span(start, static_cast<std::size_t>(after - start));
   const auto at = static_cast<int>(start - text);
-  if (malformed) fail_at(at, ErrorCode::BadNumber, "'{}' is not a number", span);
-  fail_at(at, ErrorCode::BadNumber, "'{}' is not a number (extra characters after it)", span);
+  if (span.empty()) fail_at(at, ErrorCode::BadNumber, "a number is missing here");
+  if (malformed)
+    fail_at(at, ErrorCode::BadNumber,
+            "'{}' is not a number (digits with at most one point, after at most one sign)", span);
+  fail_at(at, ErrorCode::BadNumber, "'{}' is not a number: a number has at most one decimal point", span);
 }
 
-int Parser::integer_value(Cursor& c) {
+int Parser::integer_value(Cursor& c, const char* what) {
   const int pos = static_cast<int>(c.pos);
   {
     // Fast path: up to nine plain digits, the common "M3" or "T12".
@@ -455,10 +624,12 @@ int Parser::integer_value(Cursor& c) {
     }
   }
   const double v = real_value(c);
-  if (!(std::fabs(v) < 2147483647.0)) fail_at(pos, ErrorCode::NotAnInteger, "{} is too large for a whole number", v);
+  if (!(std::fabs(v) < 2147483647.0))
+    fail_at(pos, ErrorCode::NotAnInteger, "{} is too large for {}", v, what);
   int i = static_cast<int>(std::floor(v));
   if (v - i > 0.9999) i = static_cast<int>(std::ceil(v));
-  else if (v - i > 0.0001) fail_at(pos, ErrorCode::NotAnInteger, "{} is not a whole number", v);
+  else if (v - i > 0.0001)
+    fail_at(pos, ErrorCode::NotAnInteger, "{} is not a whole number, which {} must be", v, what);
   return i;
 }
 
@@ -522,10 +693,22 @@ int Parser::binary_operator(Cursor& c) {
     case 'n': if (n1 == 'e') return word(kNe, 1); break;
     case 'g': if (n1 == 'e') return word(kGe, 1); if (n1 == 't') return word(kGt, 1); break;
     case 'l': if (n1 == 'e') return word(kLe, 1); if (n1 == 't') return word(kLt, 1); break;
-    case '\0': fail_at(pos, ErrorCode::UnclosedExpression, "expression not closed with ']'");
-    default: fail_at(pos, ErrorCode::UnknownOperation, "'{}' is not an operator", describe_char(ch));
+    case '\0':
+      fail_at(pos, ErrorCode::UnclosedExpression, "the line ends inside an expression: close it with ']'");
+    default:
+      if (ch < 'a' || ch > 'z')
+        fail_at(pos, ErrorCode::UnknownOperator,
+                "'{}' is not an operator (+ - * / ** MOD AND OR XOR EQ NE GT GE LT LE) nor ']'",
+                describe_char(ch));
+      break;
   }
-  fail_at(pos, ErrorCode::UnknownOperation, "unknown operator starting with '{}'", ch);
+  // A letter with a value after it is the next word of the line: the ']' before it is missing.
+  if (is_digit(n1) || n1 == '.' || n1 == '[' || n1 == '#' || n1 == '-' || n1 == '+')
+    fail_at(pos, ErrorCode::UnclosedExpression,
+            "the expression is not closed before the {} word: add ']' before it",
+            static_cast<char>(ch - 'a' + 'A'));
+  fail_at(pos, ErrorCode::UnknownOperator,
+          "no operator starts with '{}' (+ - * / ** MOD AND OR XOR EQ NE GT GE LT LE)", ch);
 }
 
 double Parser::unary(Cursor& c) {
@@ -549,23 +732,53 @@ double Parser::unary(Cursor& c) {
     case 's': take("in", kSin); take("qrt", kSqrt); break;
     case 't': take("an", kTan); break;
     default:
-      fail_at(pos, ErrorCode::UnknownWord, "'{}' cannot start a value (expected a number, [, # or a function)", ch);
+      break;
   }
-  if (op < 0) fail_at(pos, ErrorCode::UnknownWord, "unknown function starting with '{}'", ch);
-  if (c.at() != '[') fail_at(static_cast<int>(c.pos), ErrorCode::BracketMissing, "'[' expected after the function name");
+  if (op < 0) {
+    // "X F100": the letter before has no value, and the next word follows at once.
+    const char before = pos > 0 ? c.text[static_cast<std::size_t>(pos - 1)] : '\0';
+    const char after =
+        c.text.size() > static_cast<std::size_t>(pos) + 1 ? c.text[static_cast<std::size_t>(pos) + 1] : '\0';
+    if (before >= 'a' && before <= 'z' && (is_digit(after) || after == '.'))
+      fail_at(pos - 1, ErrorCode::MissingValue,
+              "{} has no value: a number, [expression] or #parameter must follow the letter",
+              static_cast<char>(before - 'a' + 'A'));
+    std::size_t end = static_cast<std::size_t>(pos);
+    while (end < c.text.size() && c.text[end] >= 'a' && c.text[end] <= 'z') ++end;
+    if (end - static_cast<std::size_t>(pos) > 1) {
+      std::string name(c.text.substr(static_cast<std::size_t>(pos), end - static_cast<std::size_t>(pos)));
+      for (char& k : name) k = static_cast<char>(k - 'a' + 'A');
+      fail_at(pos, ErrorCode::UnknownWord,
+              "{} is not a function (ABS ACOS ASIN ATAN COS EXISTS EXP FIX FUP LN ROUND SIN SQRT TAN)", name);
+    }
+    fail_at(pos, ErrorCode::UnknownWord,
+            "'{}' cannot start a value: write a number, [expression], #parameter or a function", ch);
+  }
+  if (c.at() != '[') {
+    std::string name(c.text.substr(static_cast<std::size_t>(pos), c.pos - static_cast<std::size_t>(pos)));
+    for (char& k : name) k = static_cast<char>(k - 'a' + 'A');
+    fail_at(static_cast<int>(c.pos), ErrorCode::FunctionBracketMissing,
+            "{} takes its argument in brackets: {}[...]", name, name);
+  }
   if (op == kExists) {
     ++c.pos;
-    if (c.at() != '#') fail_at(static_cast<int>(c.pos), ErrorCode::BracketedParameter, "EXISTS needs a parameter: EXISTS[#<name>]");
+    if (c.at() != '#')
+      fail_at(static_cast<int>(c.pos), ErrorCode::ExistsSyntax, "EXISTS takes a parameter: EXISTS[#<name>]");
     const double v = parameter(c, true);
-    if (c.at() != ']') fail_at(static_cast<int>(c.pos), ErrorCode::BracketedParameter, "']' expected after the EXISTS parameter");
+    if (c.at() != ']')
+      fail_at(static_cast<int>(c.pos), ErrorCode::ExistsSyntax,
+              "EXISTS takes one parameter only: EXISTS[#<name>]");
     ++c.pos;
     return v;
   }
   const double arg = expression(c);
   if (op == kAtan) {
-    if (c.at() != '/') fail_at(static_cast<int>(c.pos), ErrorCode::AtanSlashMissing, "ATAN needs two arguments: ATAN[y]/[x]");
+    if (c.at() != '/')
+      fail_at(static_cast<int>(c.pos), ErrorCode::AtanSyntax, "ATAN takes two arguments: write ATAN[y]/[x]");
     ++c.pos;
-    if (c.at() != '[') fail_at(static_cast<int>(c.pos), ErrorCode::BracketMissing, "'[' expected after 'ATAN[...]/'");
+    if (c.at() != '[')
+      fail_at(static_cast<int>(c.pos), ErrorCode::AtanSyntax,
+              "ATAN's second argument goes in brackets: ATAN[y]/[x]");
     const double x = expression(c);
     return static_cast<double>(std::atan2(arg, x) * 180.0L / kPi);   // double atan2, long double scaling
 
@@ -581,26 +794,36 @@ double Parser::parameter(Cursor& c, bool exists_only) {
     double v = 0;
     const bool found = c.env.host->named_value(name, v);
     if (exists_only) return found ? 1.0 : 0.0;
-    if (!found) fail_at(pos, ErrorCode::NamedParameterUndefined, "#<{}> is used before it is given a value", name);
+    if (!found) {
+      // LinuxCNC reads HAL pins and INI entries through these names; this interpreter has neither.
+      if (name.starts_with("_hal[") || name.starts_with("_ini["))
+        fail_at(pos, ErrorCode::NamedParameterUndefined,
+                "#<{}> reads LinuxCNC's {} here, which this interpreter has no access to", name,
+                name[1] == 'h' ? "HAL" : "INI file");
+      fail_at(pos, ErrorCode::NamedParameterUndefined, "#<{}> is read before any value is assigned to it",
+              name);
+    }
     return v;
   }
-  const int index = integer_value(c);
+  const int index = integer_value(c, "a parameter number");
   if (exists_only) return (index >= 1 && index < kParameterCount) ? 1.0 : 0.0;
   if (index < 1 || index >= kParameterCount)
     fail_at(pos, ErrorCode::ParameterOutOfRange, "parameter #{} does not exist (1..{})", index, kParameterCount - 1);
   if (index >= 5420 && index <= 5428 && c.env.comp_on)
-    fail_at(pos, ErrorCode::ModalContext, "#{} (current position) cannot be read while cutter compensation is on", index);
+    fail_at(pos, ErrorCode::CompPositionRead,
+            "#{} (the current position) cannot be read while cutter compensation is on: G40 first", index);
   return c.env.parameters[index];
 }
 
 void Parser::read_o_word(Cursor& c, Block& b) {
   const int pos = static_cast<int>(c.pos);
+  b.o_at = position_byte(c.pos);
   ++c.pos;
   std::string name;
   if (c.at() == '<') {
     name = read_name(c);
   } else {
-    name = std::to_string(integer_value(c));
+    name = std::to_string(integer_value(c, "an O-word number"));
   }
   static constexpr std::pair<std::string_view, OWord> kKeywords[] = {
       {"sub", OWord::Sub}, {"endsub", OWord::EndSub}, {"call", OWord::Call}, {"do", OWord::Do},
@@ -608,6 +831,7 @@ void Parser::read_o_word(Cursor& c, Block& b) {
       {"else", OWord::Else}, {"endif", OWord::EndIf}, {"break", OWord::Break}, {"continue", OWord::Continue},
       {"endwhile", OWord::EndWhile}, {"endrepeat", OWord::EndRepeat}, {"return", OWord::Return}};
   OWord type = OWord::None;
+  const std::size_t keyword_at = c.pos;
   for (const auto& [word, kind] : kKeywords) {
     if (starts_with(c.text, c.pos, word)) {
       type = kind;
@@ -617,9 +841,17 @@ void Parser::read_o_word(Cursor& c, Block& b) {
   }
   if (type == OWord::None) {
     const char next = c.at();
-    if (next != '(' && next != ';' && next != '\0')
-      fail_at(static_cast<int>(c.pos), ErrorCode::OWordSyntax, "unknown O-word statement after o{}", name);
+    if (next != '(' && next != ';' && next != '\0') {
+      std::size_t end = c.pos;
+      while (end < c.text.size() && c.text[end] >= 'a' && c.text[end] <= 'z') ++end;
+      fail_at(static_cast<int>(c.pos), ErrorCode::OwordUnknownKeyword,
+              "'{}' after o{} is not an O-word keyword ({})",
+              end > c.pos ? c.text.substr(c.pos, end - c.pos) : c.text.substr(c.pos, 1), name,
+              kOwordKeywords);
+    }
     type = OWord::Program;   // "O1234" alone: a program number
+  } else if (c.env.skipping_to.empty()) {  // lines passed over are not checked further (LinuxCNC)
+    misspelt_keyword(c, keyword_at);
   }
   const ParseEnv& env = c.env;
   const bool global = type == OWord::Sub || type == OWord::EndSub || type == OWord::Call || type == OWord::Return ||
@@ -637,7 +869,10 @@ void Parser::read_o_word(Cursor& c, Block& b) {
   switch (type) {
     case OWord::Sub:
     case OWord::Program:
-      if (env.defining_sub) fail_at(pos, ErrorCode::NestedSub, "o<{}> sub inside the definition of o<{}>", b.o_name, env.defining_name);
+      if (env.defining_sub)
+        fail_at(pos, ErrorCode::OwordSubNested,
+                "o<{}> sub inside the definition of o<{}>: end that one with endsub first", b.o_name,
+                env.defining_name);
       return;
     case OWord::EndSub:
     case OWord::Return:
@@ -666,7 +901,8 @@ void Parser::read_o_word(Cursor& c, Block& b) {
           continue;
         }
         if (b.arg_count >= kSubArgumentCount)
-          fail_at(static_cast<int>(c.pos), ErrorCode::TooManyArguments, "a call takes at most {} arguments", kSubArgumentCount);
+          fail_at(static_cast<int>(c.pos), ErrorCode::OwordTooManyArgs,
+                  "o<{}> call passes more than {} arguments", b.o_name, kSubArgumentCount);
         b.args[static_cast<std::size_t>(b.arg_count++)] = expression(c);
       }
       return;
@@ -677,7 +913,9 @@ void Parser::read_o_word(Cursor& c, Block& b) {
       if (skipping_other) return;
       if (c.at() != '[') {
         static constexpr const char* kNames[] = {"", "", "", "", "", "while", "if", "elseif", "", "", "", "", "", "", "repeat"};
-        fail_at(static_cast<int>(c.pos), ErrorCode::BracketMissing, "'[' expected after '{}'", kNames[static_cast<int>(type)]);
+        fail_at(static_cast<int>(c.pos), ErrorCode::OwordConditionMissing,
+                "'{}' needs its {} in brackets: o{} {} [...]", kNames[static_cast<int>(type)],
+                type == OWord::Repeat ? "count" : "condition", name, kNames[static_cast<int>(type)]);
       }
       b.o_value = expression(c);
       b.o_has_value = true;

@@ -63,6 +63,8 @@ class Parser {
 
   void read_line_number(Cursor& c, Block& b);
   void read_item(Cursor& c, Block& b);
+  [[noreturn, gnu::cold]] static void letter_without_word(const Cursor& c, char letter);
+  static void misspelt_keyword(const Cursor& c, std::size_t keyword_at);
   void read_o_word(Cursor& c, Block& b);
   void read_word(Cursor& c, Block& b, char letter);
   void read_g(Cursor& c, Block& b);
@@ -72,7 +74,7 @@ class Parser {
   std::string read_name(Cursor& c);
 
   double real_value(Cursor& c);
-  int integer_value(Cursor& c);
+  int integer_value(Cursor& c, const char* what);  ///< `what`: "L", "a parameter number" (for messages)
   static int plain_code(Cursor& c) noexcept;
   double real_number(Cursor& c);
   [[noreturn, gnu::cold]] static void bad_number(const char* start, const char* after, const char* text, bool malformed);
@@ -85,5 +87,7 @@ class Parser {
 /// G code (×10) → modal group, -1 if unknown. M code → group, -1 if unknown.
 int g_group(int code) noexcept;
 int m_group(int code) noexcept;
+/// "G1", "G17.1": a G code (×10) as a program writes it, for messages.
+std::string g_name(int code);
 
 }  // namespace opencnc::gcode

@@ -463,7 +463,7 @@ TEST(CutterComp, ErrorsNameTheirProblem) {
     const char* code;
   };
   const Case cases[] = {
-      {"G21 G19 F100\nG41.1 D2\nM2\n", "gcode.comp-wrong-plane"},
+      {"G21 G19 F100\nG41.1 D2\nM2\n", "gcode.comp-yz-plane"},
       {"G21 F100\nG41.1 D2 L3\nM2\n", "gcode.comp-wrong-plane"},
       {"G21 F100\nT7 M6\nG41\nM2\n", "gcode.comp-wrong-plane"},
       {"G21 F100\nG41.1 D2\nG42.1 D2\nM2\n", "gcode.comp-already-on"},

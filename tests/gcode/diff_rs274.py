@@ -14,6 +14,7 @@ import os
 import re
 import subprocess
 import sys
+import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 MOTION = ("STRAIGHT_TRAVERSE", "STRAIGHT_FEED", "ARC_FEED", "DWELL", "SET_FEED_RATE", "SELECT_PLANE",
@@ -23,13 +24,14 @@ NUM = re.compile(r"-?\d+\.\d+|-?\d+")
 
 
 def load_error_map():
-    """rs274 message regex -> opencnc error code (tests/gcode/rs274_errors.tsv)."""
+    """rs274 message pattern -> opencnc problem code, from tests/conformance/error-codes.tsv (the
+    conformance suite's table: whole-message patterns, first match wins)."""
     table = []
-    with open(os.path.join(HERE, "rs274_errors.tsv")) as f:
+    with open(os.path.join(HERE, "..", "conformance", "error-codes.tsv")) as f:
         for line in f:
             if not line.strip() or line.startswith("#"):
                 continue
-            code, pattern = line.rstrip("\n").split("\t", 1)
+            pattern, code, _ = line.rstrip("\n").split("\t", 2)
             table.append((re.compile(pattern), code))
     return table
 
@@ -55,21 +57,16 @@ def same_call(a, b, tol=1e-4):
     return all(abs(float(x) - float(y)) <= tol for x, y in zip(na, nb))
 
 
-def run(cmd, cwd):
-    p = subprocess.run(cmd, cwd=cwd, capture_output=True, text=True, errors="replace", timeout=600)
+def run(cmd, cwd, env=None):
+    p = subprocess.run(cmd, cwd=cwd, capture_output=True, text=True, errors="replace", timeout=600, env=env)
     return p.returncode, p.stdout.splitlines(), p.stderr
 
 
-def run_stable(cmd, cwd):
-    """rs274 keeps its tool table in shared memory, so runs of other users at the same time
-    can disturb it (crashes, missing tools): repeat until two runs agree."""
-    last = run(cmd, cwd)
-    for _ in range(6):
-        now = run(cmd, cwd)
-        if now == last and now[0] >= 0:
-            return now
-        last = now
-    return last
+def run_rs274(cmd, cwd):
+    """rs274 keeps its tool table in $HOME/.tool.mmap and truncates it on start: a private HOME
+    keeps it apart from other runs at the same time."""
+    with tempfile.TemporaryDirectory() as home:
+        return run(cmd, cwd, dict(os.environ, HOME=home))
 
 
 def main():
@@ -96,7 +93,7 @@ def main():
         if args.manifest and manifest.get(name, "") != "ok" and os.path.exists(os.path.join(cwd, "tools.tbl")):
             tools = os.path.join(cwd, "tools.tbl")
         topt = ["-t", os.path.abspath(tools)] if tools else []
-        rc1, out1, err1 = run_stable(["rs274"] + topt + ["-g", path], cwd)
+        rc1, out1, err1 = run_rs274(["rs274"] + topt + ["-g", path], cwd)
         rc2, out2, err2 = run([opencnc, "canon", path] + topt, cwd)
         full = out1 == out2
         m1, m2 = motion_calls(out1), motion_calls(out2)
@@ -106,7 +103,7 @@ def main():
         if rc1 != 0:
             msg = [ln for ln in err1.splitlines() if ln != "executing"]
             msg = msg[0] if msg else ""
-            want = next((code for rx, code in errors if rx.search(msg)), "?")
+            want = next((code for rx, code in errors if rx.fullmatch(msg)), "?")
             errs = "\n".join(ln for ln in err2.splitlines() if ": error: " in ln)
             got = re.findall(r"\[(gcode\.[a-z0-9-]+|tools\.[a-z0-9-]+)\]", errs)
             got = got[0] if got else "-"

@@ -39,8 +39,10 @@ class Recorder : public canon::Sink {
   }
   void dwell(double s) override { dwells.push_back(s); }
   void comment(std::string_view text) override { comments.emplace_back(text); }
+  void message(std::string_view text) override { messages.emplace_back(text); }
 
   std::vector<Motion> motions;
+  std::vector<std::string> messages;
   std::vector<canon::ArcFeed> arcs;
   std::vector<double> dwells;
   std::vector<std::string> comments;
@@ -173,7 +175,7 @@ TEST(Interpreter, ErrorsCarryFileLineAndColumn) {
   EXPECT_EQ(d.code, "gcode.missing-value");
   EXPECT_EQ(d.file, "bad.ngc");
   EXPECT_EQ(d.line, 2u);
-  EXPECT_EQ(d.col, 10u);   // the end of the line, where the value is missing
+  EXPECT_EQ(d.col, 9u);  // the Q that has no value
   // The run cannot continue after an error.
   EXPECT_EQ(interp.run(quiet), RunStatus::Error);
   // A word nothing uses is pointed at.
@@ -182,6 +184,61 @@ TEST(Interpreter, ErrorsCarryFileLineAndColumn) {
   ASSERT_NE(first_error(words), nullptr);
   EXPECT_EQ(first_error(words)->code, "gcode.unused-word");
   EXPECT_EQ(first_error(words)->col, 9u);
+}
+
+// Each error names its problem and points at the word to change (line and column of the raw
+// text, blanks included).
+TEST(Interpreter, ErrorsPointAtTheOffendingWord) {
+  struct Case {
+    const char* program;
+    const char* code;
+    std::uint32_t line, col;
+  };
+  const std::string long_line = "G0 X1 (" + std::string(300, 'x') + ")\n";
+  const Case cases[] = {
+      {"G21 F10\nG2 X2 Y0 R0.1\nM2\n", "gcode.arc-radius-too-small", 2, 10},
+      {"G21 F10\nG2 X2 Y0 I1 J0 R1\nM2\n", "gcode.arc-mixed-format", 2, 16},
+      {"G21 F10\nG2 X2 Y0 I1 K1\nM2\n", "gcode.arc-offset-wrong-plane", 2, 13},
+      {"G21 F10\nG3 X10 Y0.6 I5 J0\nM2\n", "gcode.arc-end-off-circle", 2, 13},
+      {"G21\n  G1 Y2 Y3\nM2\n", "gcode.repeated-word", 2, 9},
+      {"G21\nG0 X1 G1 Y2\nM2\n", "gcode.modal-group-conflict", 2, 7},
+      {"G21\nM3 M7 M48 M62 P1 M0\nM2\n", "gcode.too-many-m-codes", 2, 18},
+      {"G21\nG1 F10 X1\nG94\n  X2\nM2\n", "gcode.feed-zero", 4, 3},
+      {"G21\nG91 G1 F10 @1\nM2\n", "gcode.polar-at-origin", 2, 12},
+      {"G21\nG43 H7\nM2\n", "gcode.tool-not-found", 2, 5},
+      {"G21\nG10 L2 P12 X1\nM2\n", "gcode.g10-p-range", 2, 8},
+      {"G21\nM66 P1 L2\nM2\n", "gcode.io-m66-timeout-missing", 2, 8},
+      {"G21\nG0 X1 Q1\nM2\n", "gcode.unused-word", 2, 7},
+      {"G21\nG0 U1\nM2\n", "gcode.axis-not-available", 2, 4},
+      {"G21\nG1 X[1 + 2 F100\nM2\n", "gcode.unclosed-expression", 2, 12},
+      {"G21\nG1 X F100\nM2\n", "gcode.missing-value", 2, 4},
+      {"G21\n  o<nope> call\nM2\n", "gcode.oword-sub-not-found", 2, 3},
+      {"G21\n#1=0\n  o1 if [#1]\nG0 X1\nM2\n", "gcode.oword-unclosed", 3, 3},
+      {"G21\nG0 X1\n", "gcode.missing-program-end", 3, 1},
+      {long_line.c_str(), "gcode.line-too-long", 1, 254},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.program);
+    Interpreter interp;
+    canon::Sink quiet;
+    EXPECT_EQ(run_into(interp, quiet, c.program), RunStatus::Error);
+    const Diagnostic* d = first_error(interp);
+    ASSERT_NE(d, nullptr);
+    EXPECT_EQ(d->code, c.code) << d->message;
+    EXPECT_EQ(d->line, c.line) << d->message;
+    EXPECT_EQ(d->col, c.col) << d->message;
+    EXPECT_FALSE(d->message.empty());
+  }
+}
+
+// rs274 ends a DEBUG text at a #< that is never closed (and then prints bytes it never set):
+// opencnc keeps the text before it and goes on, without an error.
+TEST(Interpreter, AnUnclosedNameEndsACommentsText) {
+  Interpreter interp;
+  Recorder rec;
+  ASSERT_EQ(run_into(interp, rec, "G21\n#<foo>=3\n(DEBUG, value #<foo> then #<foo never closed)\nM2\n"),
+            RunStatus::Finished);
+  EXPECT_EQ(rec.messages, (std::vector<std::string>{" value 3.000000 then "}));
 }
 
 TEST(Interpreter, WarnsOnceAboutHabitsLinuxCncAccepts) {
@@ -224,7 +281,7 @@ TEST(Interpreter, MdiLinesRunWithoutAProgramAndSurviveErrors) {
   Recorder rec;
   EXPECT_EQ(interp.execute_mdi("G21 G0 X1 Y2", rec), RunStatus::Ok);
   EXPECT_EQ(interp.execute_mdi("G1 X3", rec), RunStatus::Error);   // no feed rate yet
-  EXPECT_EQ(first_code(interp), "gcode.zero-feed-rate");
+  EXPECT_EQ(first_code(interp), "gcode.feed-zero");
   EXPECT_EQ(interp.execute_mdi("G1 X3 F100", rec), RunStatus::Ok);
   EXPECT_EQ(interp.execute_mdi("o<hop> call [5]", rec), RunStatus::Ok);
   ASSERT_EQ(rec.motions.size(), 4u);
@@ -474,7 +531,8 @@ TEST(InterpreterLimits, EndlessLoopStopsAtTheIterationLimit) {
 TEST(InterpreterLimits, RecursionStopsAtTheCallDepth) {
   Limits l;
   std::uint32_t line = 0;
-  EXPECT_EQ(run_with_limits("o<r> sub\n  o<r> call\no<r> endsub\nG21\no<r> call\nM2\n", l, &line), "gcode.call-depth");
+  EXPECT_EQ(run_with_limits("o<r> sub\n  o<r> call\no<r> endsub\nG21\no<r> call\nM2\n", l, &line),
+            "gcode.limit-call-depth");
   EXPECT_EQ(line, 2u);
 }
 
@@ -552,7 +610,7 @@ namespace {
 class ToyDrill : public CodeHandler {
  public:
   std::optional<Rejection> check(const Block& block, int, const InterpState&) const override {
-    if (!block.has('r')) return Rejection{ErrorCode::MissingWord, "the toy cycle needs R"};
+    if (!block.has('r')) return Rejection{ErrorCode::MissingValue, "the toy cycle needs R"};
     return std::nullopt;
   }
   void execute(ExecContext& ctx, const Block& block, int code) override {
@@ -617,8 +675,9 @@ TEST(InterpreterExtensions, RegisteredHandlersRunInPlaceOfTheCore) {
   // The handler's own checks run before the block executes.
   Interpreter again(options);
   Recorder none;
-  EXPECT_EQ(run_into(again, none, "G21 F100\nG0 Z5\nG81 X1 Y2 Z-3\nM2\n"), RunStatus::Error);
-  EXPECT_EQ(first_code(again), "gcode.missing-word");
+  EXPECT_EQ(run_into(again, none, "G21 F100\nG0 Z5\nN30 G81 X1 Y2 Z-3\nM2\n"), RunStatus::Error);
+  EXPECT_EQ(first_code(again), "gcode.missing-value");
+  EXPECT_EQ(first_error(again)->col, 5u);  // a handler's rejection points at its code
   EXPECT_EQ(none.motions.size(), 1u);
 }
 

@@ -116,7 +116,8 @@ TEST_F(ParserTest, ReadsNumbersTheLinuxCncWay) {
   EXPECT_EQ(fails("x1.2.3"), ErrorCode::BadNumber);
   EXPECT_EQ(fails("x*2"), ErrorCode::BadNumber);
   EXPECT_EQ(fails("x"), ErrorCode::MissingValue);
-  EXPECT_EQ(fails("g1 xf1"), ErrorCode::UnknownWord);
+  EXPECT_EQ(fails("g1 xf1"), ErrorCode::MissingValue);  // X has no value; F1 follows
+  EXPECT_EQ(fails("g1 xfoo"), ErrorCode::UnknownWord);
 }
 
 TEST_F(ParserTest, StoresWordsAndRejectsRepeats) {
@@ -128,17 +129,24 @@ TEST_F(ParserTest, StoresWordsAndRejectsRepeats) {
   EXPECT_TRUE(b.has('q'));
   EXPECT_FALSE(b.has('z'));
   EXPECT_EQ(fails("G1 X1 X2"), ErrorCode::RepeatedWord);
-  EXPECT_EQ(fails("G1 F-1"), ErrorCode::NegativeValue);
+  EXPECT_EQ(fails("G1 F-1"), ErrorCode::FeedNegative);
+  EXPECT_EQ(fails("S-1"), ErrorCode::SpeedNegative);
+  EXPECT_EQ(fails("T-1"), ErrorCode::ToolNegative);
+  EXPECT_EQ(fails("G43 H-2"), ErrorCode::HWordNegative);
+  EXPECT_EQ(fails("G81 L-1"), ErrorCode::LWordNegative);
   EXPECT_EQ(fails("T1.5"), ErrorCode::NotAnInteger);
-  EXPECT_EQ(fails("G1 X1 N20"), ErrorCode::BadCharacter);
-  EXPECT_EQ(fails("G1 X1 %"), ErrorCode::BadCharacter);
+  EXPECT_EQ(fails("G1 X1 N20"), ErrorCode::LineNumberNotFirst);
+  EXPECT_EQ(fails("G1 X1 %"), ErrorCode::PercentMisplaced);
+  EXPECT_EQ(fails("%"), ErrorCode::PercentMisplaced);
+  EXPECT_EQ(fails("G1 X1 ?"), ErrorCode::BadCharacter);
+  EXPECT_EQ(fails("G1 X1 ]"), ErrorCode::BadCharacter);
   // P may repeat when the first P is -1 or less (LinuxCNC's rule).
   EXPECT_DOUBLE_EQ(parse("G4 P-2 P3").get('p'), 3);
 }
 
 TEST_F(ParserTest, ChecksAxisLettersAgainstTheMachine) {
   env_.letters &= ~(1u << ('w' - 'a'));
-  EXPECT_EQ(fails("G1 W1"), ErrorCode::BadCharacter);
+  EXPECT_EQ(fails("G1 W1"), ErrorCode::AxisNotAvailable);
   env_.lathe_diameter = true;
   EXPECT_DOUBLE_EQ(parse("G1 X10").get('x'), 5.0);
 }
@@ -154,11 +162,11 @@ TEST_F(ParserTest, ReadsGAndMCodesIntoTheirGroups) {
   EXPECT_EQ(parse("G59.3").g[kGroupCoordSystem], 593);
   EXPECT_EQ(parse("G80 G1").g[kGroupMotion], 10);   // G80 beside a motion code is ignored
   EXPECT_EQ(parse("G1 G80").g[kGroupMotion], 10);
-  EXPECT_EQ(fails("G0 G1"), ErrorCode::TwoGCodesSameGroup);
+  EXPECT_EQ(fails("G0 G1"), ErrorCode::ModalGroupConflict);
   EXPECT_EQ(fails("G1.5"), ErrorCode::UnknownGCode);
   EXPECT_EQ(fails("G1.25"), ErrorCode::GCodeOutOfRange);
   EXPECT_EQ(fails("G100"), ErrorCode::GCodeOutOfRange);
-  EXPECT_EQ(fails("M3 M4"), ErrorCode::TwoMCodesSameGroup);
+  EXPECT_EQ(fails("M3 M4"), ErrorCode::ModalGroupConflict);
   EXPECT_EQ(fails("M200"), ErrorCode::MCodeOutOfRange);
   EXPECT_EQ(fails("M10"), ErrorCode::UnknownMCode);
 }
@@ -202,20 +210,23 @@ TEST_F(ParserTest, EvaluatesFunctionsInDegrees) {
 
 TEST_F(ParserTest, ReportsExpressionErrorsWithTheirCodes) {
   EXPECT_EQ(fails("x[1/0]"), ErrorCode::DivideByZero);
-  EXPECT_EQ(fails("x[-2**0.5]"), ErrorCode::NegativeToNonIntegerPower);
+  EXPECT_EQ(fails("x[-2**0.5]"), ErrorCode::PowerDomain);
   EXPECT_EQ(fails("xsqrt[-1]"), ErrorCode::SqrtNegative);
-  EXPECT_EQ(fails("xln[0]"), ErrorCode::LnDomain);
-  EXPECT_EQ(fails("xacos[2]"), ErrorCode::AcosRange);
-  EXPECT_EQ(fails("xasin[-2]"), ErrorCode::AsinRange);
+  EXPECT_EQ(fails("xln[0]"), ErrorCode::LnNonPositive);
+  EXPECT_EQ(fails("xacos[2]"), ErrorCode::TrigDomain);
+  EXPECT_EQ(fails("xasin[-2]"), ErrorCode::TrigDomain);
   EXPECT_EQ(fails("x[1+2"), ErrorCode::UnclosedExpression);
-  EXPECT_EQ(fails("x[1?2]"), ErrorCode::UnknownOperation);
-  EXPECT_EQ(fails("x[1 an 2]"), ErrorCode::UnknownOperation);
-  EXPECT_EQ(fails("xsin 30"), ErrorCode::BracketMissing);
-  EXPECT_EQ(fails("xsine[30]"), ErrorCode::BracketMissing);
+  EXPECT_EQ(fails("x[1+2 f100"), ErrorCode::UnclosedExpression);  // the F word follows: the ']' is missing
+  EXPECT_EQ(fails("x[1?2]"), ErrorCode::UnknownOperator);
+  EXPECT_EQ(fails("x[1 an 2]"), ErrorCode::UnknownOperator);
+  EXPECT_EQ(fails("xsin 30"), ErrorCode::FunctionBracketMissing);
+  EXPECT_EQ(fails("xsine[30]"), ErrorCode::FunctionBracketMissing);
   EXPECT_EQ(fails("xfoo[1]"), ErrorCode::UnknownWord);
-  EXPECT_EQ(fails("xatan[1]"), ErrorCode::AtanSlashMissing);
-  EXPECT_EQ(fails("x[10**400]"), ErrorCode::Infinity);
-  EXPECT_EQ(fails("xexists[1]"), ErrorCode::BracketedParameter);
+  EXPECT_EQ(fails("xatan[1]"), ErrorCode::AtanSyntax);
+  EXPECT_EQ(fails("xatan[1]/2"), ErrorCode::AtanSyntax);
+  EXPECT_EQ(fails("x[10**400]"), ErrorCode::ResultInfinite);
+  EXPECT_EQ(fails("xexists[1]"), ErrorCode::ExistsSyntax);
+  EXPECT_EQ(fails("xexists[#<a>"), ErrorCode::ExistsSyntax);
 }
 
 TEST_F(ParserTest, ReadsParametersAndBuffersAssignments) {
@@ -240,7 +251,7 @@ TEST_F(ParserTest, ReadsParametersAndBuffersAssignments) {
   EXPECT_EQ(fails("#5400=1"), ErrorCode::ParameterReadOnly);
   EXPECT_EQ(fails("#1 2"), ErrorCode::EqualSignMissing);
   env_.comp_on = true;
-  EXPECT_EQ(fails("x#5420"), ErrorCode::ModalContext);
+  EXPECT_EQ(fails("x#5420"), ErrorCode::CompPositionRead);
 }
 
 TEST_F(ParserTest, ReadsOWordsWithScopedLabels) {
@@ -258,12 +269,12 @@ TEST_F(ParserTest, ReadsOWordsWithScopedLabels) {
   EXPECT_EQ(parse("o7 while [1]").o_name, "sub#7");
   EXPECT_EQ(parse("o<sub> endsub [4]").o_value, 4);
   EXPECT_EQ(parse("O1234").o_type, OWord::Program);
-  EXPECT_EQ(fails("o100 while 1"), ErrorCode::BracketMissing);
-  EXPECT_EQ(fails("o100 frobnicate"), ErrorCode::OWordSyntax);
-  EXPECT_EQ(fails("o100 endif G1"), ErrorCode::OWordSyntax);
+  EXPECT_EQ(fails("o100 while 1"), ErrorCode::OwordConditionMissing);
+  EXPECT_EQ(fails("o100 frobnicate"), ErrorCode::OwordUnknownKeyword);
+  EXPECT_EQ(fails("o100 endif G1"), ErrorCode::OwordSyntax);
   std::string many = "o<s> call";
   for (int i = 0; i < 31; ++i) many += " [1]";
-  EXPECT_EQ(fails(many), ErrorCode::TooManyArguments);
+  EXPECT_EQ(fails(many), ErrorCode::OwordTooManyArgs);
 }
 
 TEST_F(ParserTest, SkippingLinesAreNotEvaluated) {

@@ -43,6 +43,8 @@ struct Block {
   std::array<std::uint8_t, 26> at{};        ///< where each letter word starts in the normalised line
   std::array<std::int16_t, kGGroupCount> g{};   ///< G code ×10 by group, -1 = none
   std::array<std::int16_t, kMGroupCount> m{};   ///< M code by group, -1 = none
+  std::array<std::uint8_t, kGGroupCount> g_at{};  ///< where each group's G code starts (when present)
+  std::array<std::uint8_t, kMGroupCount> m_at{};  ///< where each group's M code starts (when present)
   int m_count = 0;
   int motion = -1;                          ///< motion to perform (G ×10), -1 = none
   bool n_present = false;
@@ -52,6 +54,8 @@ struct Block {
   double radius = 0, theta = 0;
   bool dollar_flag = false;                 ///< $ spindle selector
   double dollar = 0;
+  std::uint8_t radius_at = 0, theta_at = 0, dollar_at = 0;  ///< where @, ^ and $ start
+  std::uint8_t o_at = 0;                                    ///< where the O-word starts
 
   OWord o_type = OWord::None;
   std::string o_name;                       ///< label key ("sub#100") or sub name
@@ -66,6 +70,36 @@ struct Block {
   double p_or(double absent) const noexcept { return has('p') ? get('p') : absent; }
   double q_or(double absent) const noexcept { return has('q') ? get('q') : absent; }
   bool any_axis() const noexcept { return (words & kAxisWordBits) != 0; }
+
+  // Where things start in the normalised line, for the column of an error (-1 = absent).
+  int word_position(char letter) const noexcept {
+    return has(letter) ? at[static_cast<std::size_t>(letter - 'a')] : -1;
+  }
+  int g_position(int group) const noexcept {
+    return g[static_cast<std::size_t>(group)] == -1 ? -1 : g_at[static_cast<std::size_t>(group)];
+  }
+  int m_position(int group) const noexcept {
+    return m[static_cast<std::size_t>(group)] == -1 ? -1 : m_at[static_cast<std::size_t>(group)];
+  }
+  /// The first axis word or polar word of the line, -1 if none.
+  int first_axis_position() const noexcept {
+    int first = -1;
+    auto take = [&first](int p) { first = (first == -1 || (p != -1 && p < first)) ? p : first; };
+    for (char c : {'x', 'y', 'z', 'a', 'b', 'c', 'u', 'v', 'w'}) take(word_position(c));
+    if (radius_flag) take(radius_at);
+    if (theta_flag) take(theta_at);
+    return first;
+  }
+  /// The first polar word (@ or ^), -1 if none.
+  int polar_position() const noexcept {
+    if (radius_flag && theta_flag) return radius_at < theta_at ? radius_at : theta_at;
+    return radius_flag ? radius_at : theta_flag ? theta_at : -1;
+  }
+  /// Where the block's motion is named: its motion G code, else (a modal motion) its first axis word.
+  int motion_position() const noexcept {
+    const int code = g_position(kGroupMotion);
+    return code != -1 ? code : first_axis_position();
+  }
 
   /// Bits of the nine axis letters x y z a b c u v w.
   static constexpr std::uint32_t kAxisWordBits =

@@ -7,79 +7,133 @@
 
 namespace opencnc::gcode {
 
-// X(enumerator, stable id). The ids never change meaning; tests and front ends match on them.
+// X(enumerator, stable id). One id per problem a person can act on; ids never change meaning
+// (tests and front ends match on them). docs/error-codes.md describes each in one line, and
+// tests/conformance/error-codes.tsv maps LinuxCNC's messages onto them.
 #define OPENCNC_GCODE_ERRORS(X)                                              \
   /* reading a line */                                                       \
   X(LineTooLong, "gcode.line-too-long")                                      \
   X(UnclosedComment, "gcode.unclosed-comment")                               \
   X(NestedComment, "gcode.nested-comment")                                   \
   X(BadCharacter, "gcode.bad-character")                                     \
+  X(AxisNotAvailable, "gcode.axis-not-available")                            \
+  X(LineNumberNotFirst, "gcode.line-number-not-first")                       \
+  X(PercentMisplaced, "gcode.percent-misplaced")                             \
+  X(BadLineNumber, "gcode.bad-line-number")                                  \
   X(BadNumber, "gcode.bad-number")                                           \
   X(MissingValue, "gcode.missing-value")                                     \
   X(UnknownWord, "gcode.unknown-word")                                       \
-  X(UnknownOperation, "gcode.unknown-operation")                             \
-  X(UnclosedExpression, "gcode.unclosed-expression")                         \
-  X(BracketMissing, "gcode.bracket-missing")                                 \
-  X(AtanSlashMissing, "gcode.atan-slash-missing")                            \
-  X(NotANumber, "gcode.not-a-number")                                        \
-  X(Infinity, "gcode.infinity")                                              \
-  X(DivideByZero, "gcode.divide-by-zero")                                    \
-  X(NegativeToNonIntegerPower, "gcode.negative-power")                       \
-  X(AcosRange, "gcode.acos-range")                                           \
-  X(AsinRange, "gcode.asin-range")                                           \
-  X(LnDomain, "gcode.ln-domain")                                             \
-  X(SqrtNegative, "gcode.sqrt-negative")                                     \
-  X(NotAnInteger, "gcode.not-an-integer")                                    \
   X(RepeatedWord, "gcode.repeated-word")                                     \
-  X(NegativeValue, "gcode.negative-value")                                   \
-  X(BadLineNumber, "gcode.bad-line-number")                                  \
+  /* expressions */                                                          \
+  X(UnknownOperator, "gcode.unknown-operator")                               \
+  X(UnclosedExpression, "gcode.unclosed-expression")                         \
+  X(FunctionBracketMissing, "gcode.function-bracket-missing")                \
+  X(AtanSyntax, "gcode.atan-syntax")                                         \
+  X(ExistsSyntax, "gcode.exists-syntax")                                     \
+  X(DivideByZero, "gcode.divide-by-zero")                                    \
+  X(PowerDomain, "gcode.power-domain")                                       \
+  X(SqrtNegative, "gcode.sqrt-negative")                                     \
+  X(LnNonPositive, "gcode.ln-non-positive")                                  \
+  X(TrigDomain, "gcode.trig-domain")                                         \
+  X(ResultNotANumber, "gcode.result-not-a-number")                           \
+  X(ResultInfinite, "gcode.result-infinite")                                 \
+  X(NotAnInteger, "gcode.not-an-integer")                                    \
   /* parameters */                                                           \
   X(ParameterOutOfRange, "gcode.parameter-out-of-range")                     \
   X(ParameterReadOnly, "gcode.parameter-read-only")                          \
   X(EqualSignMissing, "gcode.equal-sign-missing")                            \
   X(NameNotTerminated, "gcode.name-not-terminated")                          \
   X(NamedParameterUndefined, "gcode.named-parameter-undefined")              \
-  X(BracketedParameter, "gcode.bracketed-parameter")                         \
-  /* codes and modal groups */                                               \
+  /* G and M codes, modal groups */                                          \
   X(GCodeOutOfRange, "gcode.g-code-out-of-range")                            \
   X(UnknownGCode, "gcode.unknown-g-code")                                    \
-  X(TwoGCodesSameGroup, "gcode.two-g-codes-same-group")                      \
   X(MCodeOutOfRange, "gcode.m-code-out-of-range")                            \
   X(UnknownMCode, "gcode.unknown-m-code")                                    \
-  X(TwoMCodesSameGroup, "gcode.two-m-codes-same-group")                      \
+  X(ModalGroupConflict, "gcode.modal-group-conflict")                        \
   X(TooManyMCodes, "gcode.too-many-m-codes")                                 \
   X(Unsupported, "gcode.unsupported")                                        \
-  /* block consistency */                                                    \
+  /* words of a block */                                                     \
   X(AxisWordsWithG80, "gcode.axis-words-with-g80")                           \
   X(AxisWordsMissing, "gcode.axis-words-missing")                            \
-  X(TwoAxisGCodes, "gcode.two-axis-g-codes")                                 \
-  X(AxisWordsWithoutMotion, "gcode.axis-words-without-motion")               \
-  X(PolarCoordinates, "gcode.polar-coordinates")                             \
+  X(AxisWordsConflict, "gcode.axis-words-conflict")                          \
+  X(AxisWordsUnused, "gcode.axis-words-unused")                              \
   X(UnusedWord, "gcode.unused-word")                                         \
-  X(MissingWord, "gcode.missing-word")                                       \
-  X(BadWordValue, "gcode.bad-word-value")                                    \
-  X(G53Usage, "gcode.g53-usage")                                             \
-  X(G10Usage, "gcode.g10-usage")                                             \
-  /* motion */                                                               \
-  X(ZeroFeedRate, "gcode.zero-feed-rate")                                    \
-  X(ZeroSpindleSpeed, "gcode.zero-spindle-speed")                            \
+  X(PolarNotAvailable, "gcode.polar-not-available")                          \
+  X(PolarWithXy, "gcode.polar-with-xy")                                      \
+  X(PolarAtOrigin, "gcode.polar-at-origin")                                  \
+  X(PolarWithG53, "gcode.polar-with-g53")                                    \
+  X(PolarWithoutMotion, "gcode.polar-without-motion")                        \
+  /* dwell, G10, G53 */                                                      \
+  X(DwellMissing, "gcode.dwell-missing")                                     \
+  X(DwellWithArc, "gcode.dwell-with-arc")                                    \
+  X(G10LInvalid, "gcode.g10-l-invalid")                                      \
+  X(G10PNotInteger, "gcode.g10-p-not-integer")                               \
+  X(G10PRange, "gcode.g10-p-range")                                          \
+  X(G10IjWords, "gcode.g10-ij-words")                                        \
+  X(G10L20Rotation, "gcode.g10-l20-rotation")                                \
+  X(G10NoOffsets, "gcode.g10-no-offsets")                                    \
+  X(G10Orientation, "gcode.g10-orientation")                                 \
+  X(G53Motion, "gcode.g53-motion")                                           \
+  X(G53Incremental, "gcode.g53-incremental")                                 \
+  /* feeds and spindle */                                                    \
+  X(FeedZero, "gcode.feed-zero")                                             \
+  X(FeedNegative, "gcode.feed-negative")                                     \
   X(InverseTimeFeedMissing, "gcode.inverse-time-feed-missing")               \
-  X(ArcFormat, "gcode.arc-format")                                           \
+  X(SpindleSpeedZero, "gcode.spindle-speed-zero")                            \
+  X(SpeedNegative, "gcode.speed-negative")                                   \
+  X(SurfaceSpeedMissing, "gcode.surface-speed-missing")                      \
+  X(SpindleNumber, "gcode.spindle-number")                                   \
+  X(M19Direction, "gcode.m19-direction")                                     \
+  X(M19Angle, "gcode.m19-angle")                                             \
+  X(M19Timeout, "gcode.m19-timeout")                                         \
+  /* arcs */                                                                 \
+  X(ArcCentreMissing, "gcode.arc-centre-missing")                            \
+  X(ArcMixedFormat, "gcode.arc-mixed-format")                                \
+  X(ArcOffsetWrongPlane, "gcode.arc-offset-wrong-plane")                     \
+  X(ArcCentreIncomplete, "gcode.arc-centre-incomplete")                      \
   X(ArcEndpointMissing, "gcode.arc-endpoint-missing")                        \
   X(ArcZeroRadius, "gcode.arc-zero-radius")                                  \
-  X(ArcRadiusMismatch, "gcode.arc-radius-mismatch")                          \
+  X(ArcEndOffCircle, "gcode.arc-end-off-circle")                             \
   X(ArcRadiusTooSmall, "gcode.arc-radius-too-small")                         \
-  X(ArcSameEndpoint, "gcode.arc-same-endpoint")                              \
-  X(ArcPlane, "gcode.arc-plane")                                             \
-  /* tools and machine I/O */                                                \
+  X(ArcRadiusFullCircle, "gcode.arc-radius-full-circle")                     \
+  X(ArcUvwPlane, "gcode.arc-uvw-plane")                                      \
+  X(ArcTurnsNotInteger, "gcode.arc-turns-not-integer")                       \
+  X(ArcTurnsRange, "gcode.arc-turns-range")                                  \
+  /* tools */                                                                \
   X(ToolNotFound, "gcode.tool-not-found")                                    \
+  X(ToolNegative, "gcode.tool-negative")                                     \
   X(ToolNotPrepared, "gcode.tool-not-prepared")                              \
-  X(ToolOffsetUsage, "gcode.tool-offset-usage")                              \
-  X(IoUsage, "gcode.io-usage")                                               \
-  X(ModalContext, "gcode.modal-context")                                     \
-  X(SpindleUsage, "gcode.spindle-usage")                                     \
-  X(CoordinateSystem, "gcode.coordinate-system")                             \
-  /* cutter radius compensation */                                          \
+  X(HWordNegative, "gcode.h-word-negative")                                  \
+  X(LWordNegative, "gcode.l-word-negative")                                  \
+  X(M61QMissing, "gcode.m61-q-missing")                                      \
+  X(G43_2HMissing, "gcode.g43-2-h-missing")                                  \
+  X(G43_2AxisWords, "gcode.g43-2-axis-words")                                \
+  /* machine I/O and saved modal state */                                    \
+  X(IoOutputMissing, "gcode.io-output-missing")                              \
+  X(IoAnalogOutputMissing, "gcode.io-analog-output-missing")                 \
+  X(IoM66BothInputs, "gcode.io-m66-both-inputs")                             \
+  X(IoM66InputMissing, "gcode.io-m66-input-missing")                         \
+  X(IoM66TimeoutMissing, "gcode.io-m66-timeout-missing")                     \
+  X(IoM66AnalogWait, "gcode.io-m66-analog-wait")                             \
+  X(RestoreWithoutSave, "gcode.restore-without-save")                        \
+  /* rules of cutter compensation that the core checks */                    \
+  X(CompCoordinateSystem, "gcode.comp-coordinate-system")                    \
+  X(CompActiveSystemOffset, "gcode.comp-active-system-offset")               \
+  X(CompAxisOffsets, "gcode.comp-axis-offsets")                              \
+  X(CompPlaneChange, "gcode.comp-plane-change")                              \
+  X(CompYzPlane, "gcode.comp-yz-plane")                                      \
+  X(CompToolChange, "gcode.comp-tool-change")                                \
+  X(CompToolOffset, "gcode.comp-tool-offset")                                \
+  X(CompG28G30, "gcode.comp-g28-g30")                                        \
+  X(CompReferencePoint, "gcode.comp-reference-point")                        \
+  X(CompG53, "gcode.comp-g53")                                               \
+  X(CompRetractMode, "gcode.comp-retract-mode")                              \
+  X(CompControlMode, "gcode.comp-control-mode")                              \
+  X(CompIo, "gcode.comp-io")                                                 \
+  X(CompOverrides, "gcode.comp-overrides")                                   \
+  X(CompPositionRead, "gcode.comp-position-read")                            \
+  X(CompExitArc, "gcode.comp-exit-arc")                                      \
+  /* cutter radius compensation module */                                    \
   X(CompWrongPlane, "gcode.comp-wrong-plane")                                \
   X(CompAlreadyOn, "gcode.comp-already-on")                                  \
   X(CompDiameterMissing, "gcode.comp-diameter-missing")                      \
@@ -90,38 +144,42 @@ namespace opencnc::gcode {
   X(CompConcentricArcs, "gcode.comp-concentric-arcs")                        \
   X(CompArcOffCircle, "gcode.comp-arc-off-circle")                           \
   X(CompInternal, "gcode.comp-internal")                                     \
-  X(CompExitArc, "gcode.comp-exit-arc")                                      \
-  X(CompPlaneChange, "gcode.comp-plane-change")                              \
-  X(CompCoordinateSystem, "gcode.comp-coordinate-system")                    \
-  X(CompG28G30, "gcode.comp-g28-g30")                                        \
-  X(CompG53, "gcode.comp-g53")                                               \
-  X(CompToolChange, "gcode.comp-tool-change")                                \
-  X(CompToolOffset, "gcode.comp-tool-offset")                                \
-  /* program structure and O-words */                                        \
-  X(FileEndedNoPercent, "gcode.file-ended-without-percent")                  \
-  X(FileEndedNoEnd, "gcode.file-ended-without-end")                          \
+  /* codes of feature modules whose read-time rules the core checks */       \
+  X(CycleRotaryAxis, "gcode.cycle-rotary-axis")                              \
+  X(ThreadPitchMissing, "gcode.thread-pitch-missing")                        \
+  X(ThreadFeedWord, "gcode.thread-feed-word")                                \
+  X(ThreadG76WordMissing, "gcode.thread-g76-word-missing")                   \
+  /* program structure */                                                    \
+  X(ProgramEmpty, "gcode.program-empty")                                     \
+  X(MissingClosingPercent, "gcode.missing-closing-percent")                  \
+  X(MissingProgramEnd, "gcode.missing-program-end")                          \
   X(CannotOpenFile, "gcode.cannot-open-file")                                \
-  X(OWordSyntax, "gcode.o-word-syntax")                                      \
-  X(SubNotFound, "gcode.sub-not-found")                                      \
-  X(LabelUndefined, "gcode.label-undefined")                                 \
-  X(LabelMismatch, "gcode.label-mismatch")                                   \
-  X(LabelDuplicate, "gcode.label-duplicate")                                 \
-  X(SubRedefined, "gcode.sub-redefined")                                     \
-  X(NestedSub, "gcode.nested-sub")                                           \
-  X(NotInSub, "gcode.not-in-sub")                                            \
-  X(TooManyArguments, "gcode.too-many-arguments")                            \
-  X(CallDepth, "gcode.call-depth")                                           \
-  X(ContextRestore, "gcode.context-restore")                                 \
   X(Abort, "gcode.abort")                                                    \
+  /* O-words */                                                              \
+  X(OwordSyntax, "gcode.oword-syntax")                                       \
+  X(OwordUnknownKeyword, "gcode.oword-unknown-keyword")                      \
+  X(OwordConditionMissing, "gcode.oword-condition-missing")                  \
+  X(OwordSubNotFound, "gcode.oword-sub-not-found")                           \
+  X(OwordUnmatched, "gcode.oword-unmatched")                                 \
+  X(OwordMismatched, "gcode.oword-mismatched")                               \
+  X(OwordUnclosed, "gcode.oword-unclosed")                                   \
+  X(OwordLabelDuplicate, "gcode.oword-label-duplicate")                      \
+  X(OwordSubRedefined, "gcode.oword-sub-redefined")                          \
+  X(OwordSubNested, "gcode.oword-sub-nested")                                \
+  X(OwordNotInSub, "gcode.oword-not-in-sub")                                 \
+  X(OwordTooManyArgs, "gcode.oword-too-many-args")                           \
+  X(OwordInMdi, "gcode.oword-in-mdi")                                        \
   /* runaway protection */                                                   \
+  X(LimitCallDepth, "gcode.limit-call-depth")                                \
   X(LimitBlocks, "gcode.limit-blocks")                                       \
   X(LimitLoopIterations, "gcode.limit-loop-iterations")                      \
   X(LimitRepeatCount, "gcode.limit-repeat-count")                            \
   X(LimitSegments, "gcode.limit-segments")                                   \
   X(LimitSkippedLines, "gcode.limit-skipped-lines")                          \
+  /* another controller's syntax in this dialect */                          \
+  X(DialectUnsupported, "dialect.unsupported")                               \
   /* interface use */                                                        \
   X(NoProgram, "gcode.no-program")                                           \
-  X(AwaitingSync, "gcode.awaiting-sync")                                     \
   /* warnings (the program runs; opencnc check and scan report them) */     \
   X(UnitsNotProgrammed, "gcode.units-not-programmed")                        \
   X(FeedWithSpindleStopped, "gcode.feed-with-spindle-stopped")
@@ -134,5 +192,13 @@ enum class ErrorCode : std::uint16_t {
 
 /// The stable id of an error code ("gcode.bad-character"). Any thread; real-time safe.
 std::string_view error_id(ErrorCode code) noexcept;
+
+/// Every error code, in declaration order (for tests and documentation checks). Any thread;
+/// real-time safe.
+inline constexpr ErrorCode kAllErrorCodes[] = {
+#define OPENCNC_GCODE_LIST(e, id) ErrorCode::e,
+    OPENCNC_GCODE_ERRORS(OPENCNC_GCODE_LIST)
+#undef OPENCNC_GCODE_LIST
+};
 
 }  // namespace opencnc::gcode

@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 # Regenerates the expected output (NAME.rs274) of every case from LinuxCNC's `rs274 -g`, the
 # oracle; checks that rs274 fails exactly on the cases that expect an error, with the problem
-# the case names (via ../rs274_errors.tsv).
+# the case names (via tests/conformance/error-codes.tsv).
 """usage: regen.py [CASE.ngc ...]   (default: every case in this directory)
 
 Directives on ";" lines of a case (ignored by both interpreters):
@@ -33,26 +33,22 @@ def directives(path):
 
 
 def error_map():
+    """rs274 message pattern -> problem code: the conformance suite's table (first match wins)."""
     table = []
-    with open(os.path.join(HERE, "..", "rs274_errors.tsv")) as f:
+    with open(os.path.join(HERE, "..", "..", "conformance", "error-codes.tsv")) as f:
         for line in f:
             if line.strip() and not line.startswith("#"):
-                code, pattern = line.rstrip("\n").split("\t", 1)
+                pattern, code, _ = line.rstrip("\n").split("\t", 2)
                 table.append((re.compile(pattern), code))
     return table
 
 
 def run_rs274(args):
-    # rs274 keeps its tool table in shared memory, which concurrent runs can disturb:
-    # repeat until two runs agree.
-    last = None
-    for _ in range(8):
-        p = subprocess.run(args, cwd=HERE, capture_output=True, text=True)
-        now = (p.returncode, p.stdout, p.stderr)
-        if now == last:
-            return now
-        last = now
-    return last
+    # rs274 keeps its tool table in $HOME/.tool.mmap and truncates it on start: a private HOME
+    # keeps concurrent runs apart.
+    with tempfile.TemporaryDirectory() as home:
+        p = subprocess.run(args, cwd=HERE, capture_output=True, text=True, env=dict(os.environ, HOME=home))
+    return p.returncode, p.stdout, p.stderr
 
 
 def main():
@@ -72,7 +68,7 @@ def main():
         os.unlink(ini.name)
         message = next((ln for ln in err.splitlines() if ln.strip() and ln != "executing"), "")
         want = d.get("error")
-        got = next((code for rx, code in errors if rx.search(message)), None) if rc != 0 else None
+        got = next((code for rx, code in errors if rx.fullmatch(message)), None) if rc != 0 else None
         if want != got:
             print(f"{case}: expects {want or 'success'}, rs274 gave {got or 'success'} ({message!r})")
             bad += 1
