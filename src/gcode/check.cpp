@@ -116,7 +116,9 @@ void Engine::check_other_codes() {
   if ((b.words & kRuledWords) == 0 && !is_cycle(motion) && g14 != 960 && motion != 330 && motion != 331 && motion != 760)
     return;
   for (char c : {'a', 'b', 'c'}) {
-    if (b.has(c) && is_cycle(motion)) fail_at(word_at(b, c), ErrorCode::UnusedWord, "{} word in a canned cycle", static_cast<char>(c - 32));
+    if (b.has(c) && is_cycle(motion))
+      fail_at(word_at(b, c), ErrorCode::CycleRotaryAxis, "{} word in a canned cycle (rotary axes cannot move in a cycle)",
+              static_cast<char>(c - 32));
   }
   if (b.has('d') && g7 != 410 && g7 != 420 && g7 != 411 && g7 != 421 && g14 != 960 && !lathe)
     fail_at(word_at(b, 'd'), ErrorCode::UnusedWord, "D word with no G41, G41.1, G42, G42.1, G7x or G96 to use it");
@@ -160,12 +162,12 @@ void Engine::check_other_codes() {
   }
   if (!b.has('s') && g14 == 960) fail(ErrorCode::MissingWord, "G96 needs an S word (surface speed)");
   if (motion == 330 || motion == 331) {
-    if (!b.has('k')) fail(ErrorCode::MissingWord, "G33/G33.1 need a K word (distance per revolution)");
+    if (!b.has('k')) fail(ErrorCode::ThreadPitchMissing, "G33/G33.1 need a K word (distance per revolution)");
     if (b.has('f')) fail_at(word_at(b, 'f'), ErrorCode::UnusedWord, "F word cannot be used with G33/G33.1");
   }
   if (motion == 760) {
-    if (b.p_or(-1.0) == -1.0) fail(ErrorCode::MissingWord, "G76 needs a P word (pitch)");
-    if (!b.has('i') || !b.has('j') || !b.has('k')) fail(ErrorCode::MissingWord, "G76 needs I, J and K words");
+    if (b.p_or(-1.0) == -1.0) fail(ErrorCode::ThreadG76WordMissing, "G76 needs a P word (pitch)");
+    if (!b.has('i') || !b.has('j') || !b.has('k')) fail(ErrorCode::ThreadG76WordMissing, "G76 needs I, J and K words");
   }
 }
 

@@ -214,6 +214,7 @@ class Engine final : public ParamHost, public ExecContext {
   std::string mdi_line_;
   SyncKind pending_sync_ = SyncKind::None;
   SyncValues block_sync_;           ///< scan mode: feedback assumed at the end of this block
+  SyncValues sync_request_;         ///< execute mode: what the pending sync point asked for
   bool block_sync_pending_ = false;
   std::uint32_t letters_ = 0;       ///< letter words with a reader (axis mask applied)
   std::uint32_t mdi_file_ = 0;

@@ -2,11 +2,18 @@
 // Registers the interpreter modules: one line per module, in the order they take effect.
 #include "opencnc/gcode/standard_extensions.hpp"
 
+#include "opencnc/gcode/canned_cycles.hpp"
+#include "opencnc/gcode/probing.hpp"
+#include "opencnc/gcode/threading.hpp"
+
 namespace opencnc::gcode {
 
 std::shared_ptr<const Extensions> standard_extensions(Dialect dialect) {
   auto ext = std::make_shared<Extensions>();
   (void)dialect;
+  add_canned_cycles(*ext);
+  add_threading(*ext);
+  add_probing(*ext);
   return ext;
 }
 

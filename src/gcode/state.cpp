@@ -140,6 +140,8 @@ std::uint64_t InterpState::digest() const noexcept {
   h.str(control.defining_name);
   for (bool b : {control.executed_if, control.doing_break, control.doing_continue, control.value_returned}) h.flag(b);
   h.f64(control.return_value);
+  for (double v : {cycle.r, cycle.bottom, cycle.p, cycle.q, cycle.i, cycle.j, cycle.k, cycle.initial_level}) h.f64(v);
+  h.flag(cycle.initial_level_valid);
   h.pos(next);
   h.flag(percent_delimited);
   h.flag(ended);

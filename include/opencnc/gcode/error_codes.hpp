@@ -79,6 +79,31 @@ namespace opencnc::gcode {
   X(ModalContext, "gcode.modal-context")                                     \
   X(SpindleUsage, "gcode.spindle-usage")                                     \
   X(CoordinateSystem, "gcode.coordinate-system")                             \
+  /* canned cycles, threading and probing (ids of error-codes.tsv) */        \
+  X(CompCannedCycle, "gcode.comp-canned-cycle")                              \
+  X(CycleInverseTime, "gcode.cycle-inverse-time")                            \
+  X(CycleRMissing, "gcode.cycle-r-missing")                                  \
+  X(CycleRBelowBottom, "gcode.cycle-r-below-bottom")                         \
+  X(CycleBottomMissing, "gcode.cycle-bottom-missing")                        \
+  X(CycleQMissing, "gcode.cycle-q-missing")                                  \
+  X(CycleQNotPositive, "gcode.cycle-q-not-positive")                         \
+  X(CycleRepeatZero, "gcode.cycle-repeat-zero")                              \
+  X(CycleDwellMissing, "gcode.cycle-dwell-missing")                          \
+  X(CycleG87WordMissing, "gcode.cycle-g87-word-missing")                     \
+  X(CycleRotaryAxis, "gcode.cycle-rotary-axis")                              \
+  X(CycleTappingPlane, "gcode.cycle-tapping-plane")                          \
+  X(SpindleStopped, "gcode.spindle-stopped")                                 \
+  X(SpindleWrongDirection, "gcode.spindle-wrong-direction")                  \
+  X(CompSpindleSync, "gcode.comp-spindle-sync")                              \
+  X(ThreadPitchMissing, "gcode.thread-pitch-missing")                        \
+  X(ThreadG76WordMissing, "gcode.thread-g76-word-missing")                   \
+  X(ThreadG76Depth, "gcode.thread-g76-depth")                                \
+  X(ThreadG76Word, "gcode.thread-g76-word")                                  \
+  X(ThreadG76RotaryAxis, "gcode.thread-g76-rotary-axis")                     \
+  X(CompProbe, "gcode.comp-probe")                                           \
+  X(ProbeFeedPerRevolution, "gcode.probe-feed-per-revolution")               \
+  X(ProbeStartTooClose, "gcode.probe-start-too-close")                       \
+  X(ProbeNoContact, "gcode.probe-no-contact")                                \
   /* program structure and O-words */                                        \
   X(FileEndedNoPercent, "gcode.file-ended-without-percent")                  \
   X(FileEndedNoEnd, "gcode.file-ended-without-end")                          \
