@@ -133,7 +133,7 @@ void Engine::check_other_codes() {
     fail_at(word_at(b, 'j'), ErrorCode::UnusedWord, "J word with no G2, G3, G5, G5.1, G10, G76 or G87 to use it");
   if (b.has('k') && motion != 20 && motion != 30 && motion != 330 && motion != 331 && motion != 760 && motion != 870 && !lathe)
     fail_at(word_at(b, 'k'), ErrorCode::UnusedWord, "K word with no G2, G3, G33, G33.1, G76 or G87 to use it");
-  if (b.has('l') && !(motion >= 810 && motion <= 890) && motion != 760 && motion != 52 && motion != 730 && motion != 740 &&
+  if (b.has('l') && !(motion >= 810 && motion <= 890) && motion != 760 && motion != 52 && motion != 730 &&
       !lathe && g0 != 100 && g7 != 410 && g7 != 411 && g7 != 420 && g7 != 421 && m5 != 66)
     fail_at(word_at(b, 'l'), ErrorCode::UnusedWord, "L word with no G10, cutter compensation, canned cycle, M66 or NURBS code to use it");
   if (b.has('p')) {
