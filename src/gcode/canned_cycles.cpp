@@ -48,6 +48,7 @@ struct CycleBlock {
   double aa = 0, bb = 0;    // hole position before the first repeat's increment
   double aa_inc = 0, bb_inc = 0, radius_inc = 0, theta_inc = 0;   // G91 increments per repeat
   double r = 0;             // R plane
+  double r_word = 0, bottom_word = 0;   // R and bottom as programmed (what carries over)
   double bottom = 0;        // bottom of the hole
   double clear = 0;         // retract height (G98: initial level or R, G99: R)
   double current_cc = 0;    // drilling-axis position when the first hole is approached
@@ -271,16 +272,15 @@ void resolve_geometry(ExecContext& ctx, const Block& b, bool same, CycleBlock& c
               fmt::format("the first block of a canned cycle in the {} plane needs {} (the bottom)", ax.name, upper(lc)));
   }
   const double bottom_word = b.has(lc) ? b.get(lc) : st.cycle.bottom;
-  st.cycle.bottom = bottom_word;
+  cb.bottom_word = bottom_word;
   const Pose& cur = st.position.current;
   cb.current_cc = cur[ax.c];
   if (!st.cycle.initial_level_valid) {
     st.cycle.initial_level = cb.current_cc;
     st.cycle.initial_level_valid = true;
   }
-  const double level = st.cycle.initial_level;
-  const double r_word = cb.r;
   if (st.modal.distance == DistanceMode::Absolute) {
+    cb.r = cb.r_word;
     cb.bottom = bottom_word;
     cb.aa = b.has(la) ? b.get(la) : cur[ax.a];
     cb.bb = b.has(lb) ? b.get(lb) : cur[ax.b];
@@ -296,7 +296,7 @@ void resolve_geometry(ExecContext& ctx, const Block& b, bool same, CycleBlock& c
     cb.bb_inc = b.has(lb) ? b.get(lb) : 0.0;
     cb.radius_inc = b.radius_flag ? b.radius : 0.0;
     cb.theta_inc = b.theta_flag ? b.theta * kPi / 180.0 : 0.0;
-    cb.r = r_word + level;
+    cb.r = cb.r_word + st.cycle.initial_level;
     cb.bottom = cb.r + bottom_word;
     cb.aa = cur[ax.a];
     cb.bb = cur[ax.b];
@@ -307,19 +307,20 @@ void resolve_geometry(ExecContext& ctx, const Block& b, bool same, CycleBlock& c
 }
 
 // The words only some cycles use (P dwell, Q peck, G87 I J K), from the block or, while the
-// same cycle stays active, from the sticky state.
+// same cycle stays active, from the sticky state. I J K carry over from here, P and Q once the
+// block has run (LinuxCNC's order).
 void resolve_cycle_words(ExecContext& ctx, const Block& b, bool same, CycleBlock& cb) {
   CycleState& sticky = ctx.state().cycle;
   const int code = cb.code;
   const double p = b.p_or(-1.0), q = b.q_or(-1.0);
   if (code == 820 || code == 860 || code == 880 || code == 890) {
     if (!same && p == -1.0) ctx.error(ErrorCode::CycleDwellMissing, fmt::format("G{} needs a P word (dwell in seconds)", code / 10));
-    cb.dwell = sticky.p = p == -1.0 ? sticky.p : p;
+    cb.dwell = p == -1.0 ? sticky.p : p;
   } else if (code == 740 || code == 840) {
-    cb.dwell = sticky.p = p == -1.0 ? sticky.p : p;
+    cb.dwell = p == -1.0 ? sticky.p : p;
   } else if (code == 730 || code == 830) {
     if (!same && q == -1.0) ctx.error(ErrorCode::CycleQMissing, fmt::format("G{} needs a Q word (peck increment)", code / 10));
-    cb.peck = sticky.q = q == -1.0 ? sticky.q : q;
+    cb.peck = q == -1.0 ? sticky.q : q;
     cb.rapid_delta = 0.010;   // inch (LinuxCNC's G83_RAPID_DELTA)
     if (ctx.state().modal.units == canon::Units::Mm) cb.rapid_delta = cb.rapid_delta * 25.4;
   } else if (code == 870) {
@@ -377,8 +378,7 @@ void CannedCycle::execute(ExecContext& ctx, const Block& block, int code) {
   cb.base = st.position.current;
   cb.spindle = st.modal.spindle;
   if (!block.has('r') && !same) ctx.error(ErrorCode::CycleRMissing, "a canned cycle needs an R word (the R plane) in its first block");
-  const double r_word = block.has('r') ? block.get('r') : st.cycle.r;
-  cb.r = r_word;
+  cb.r_word = block.has('r') ? block.get('r') : st.cycle.r;
   if (block.has('l') && block.get('l') == 0) ctx.error(ErrorCode::CycleRepeatZero, "L0: a canned cycle must run at least once");
   cb.repeats = block.has('l') ? static_cast<int>(block.get('l')) : 1;
   check_plane_words(ctx, block, cb.ax);
@@ -398,7 +398,7 @@ void CannedCycle::execute(ExecContext& ctx, const Block& block, int code) {
 
   const PathMode saved = enter_exact_path(ctx);
   resolve_cycle_words(ctx, block, same, cb);
-  const ModalState modal = st.modal;
+  const ModalState& modal = st.modal;
   double a = cb.aa, b = cb.bb;
   for (int repeat = cb.repeats; repeat > 0; --repeat) {
     step_hole(ctx, cb, a, b);
@@ -418,7 +418,11 @@ void CannedCycle::execute(ExecContext& ctx, const Block& block, int code) {
   cur[cb.ax.b] = b;
   cur[cb.ax.c] = cb.clear;   // also after G88, whose retract is left to the operator
   restore_path_mode(ctx, saved);
-  st.cycle.r = r_word;
+  CycleState& sticky = st.cycle;
+  sticky.r = cb.r_word;
+  sticky.bottom = cb.bottom_word;
+  if (code == 730 || code == 830) sticky.q = cb.peck;
+  if (code == 740 || code == 840 || code == 820 || code == 860 || code == 880 || code == 890) sticky.p = cb.dwell;
   st.modal.motion = code;
 }
 
