@@ -4,6 +4,7 @@
 #include "opencnc/gcode/threading.hpp"
 
 #include <cmath>
+#include <cstdint>
 #include <memory>
 #include <string>
 
@@ -173,13 +174,15 @@ class ThreadCycle final : public CodeHandler {
       ctx.error(ErrorCode::ThreadG76Depth, "G76 needs K (full thread depth) greater than J (first pass)");
     const ThreadPlan t = plan_thread(ctx, b, end);
     double depth = t.full_dia_depth + t.cut_increment;
-    int pass = 1;
+    // A huge R makes the depth grow too slowly to end: the segment limit stops such a cycle,
+    // and the pass count is 64-bit so that it cannot overflow before.
+    std::int64_t pass = 1;
     while (depth < t.end_depth) {
       threading_pass(ctx, t, depth, (depth - t.full_dia_depth) * std::tan(t.compound));
-      depth = t.full_dia_depth + t.cut_increment * std::pow(++pass, 1.0 / t.degression);
+      depth = t.full_dia_depth + t.cut_increment * std::pow(static_cast<double>(++pass), 1.0 / t.degression);
     }
     depth = t.end_depth;
-    for (int i = 0; i < t.spring_cuts + 1; ++i)
+    for (std::int64_t i = 0; i <= t.spring_cuts; ++i)
       threading_pass(ctx, t, depth, (depth - t.full_dia_depth) * std::tan(t.compound));
     ctx.straight(true, end);
   }
