@@ -73,7 +73,9 @@ class Interpreter {
   RunStatus execute_mdi(std::string_view line, canon::Sink& sink);
   /// What the pending sync point waits for (None when not waiting).
   SyncKind pending_sync() const noexcept;
-  /// Supplies machine feedback and releases the sync point. Interpreter thread.
+  /// Supplies machine feedback and releases the sync point. A G38.2/G38.4 result without
+  /// contact ends the run (`gcode.probe-no-contact`; the next run() returns Error).
+  /// Interpreter thread.
   void sync(const SyncValues& values);
 
   /// The exact state now (copy). Interpreter thread; non-real-time.

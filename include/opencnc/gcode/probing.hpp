@@ -7,7 +7,7 @@
 namespace opencnc::gcode {
 
 /// The distance LinuxCNC's stand-alone interpreter backs off from the probe point towards the
-/// start after a probe move: 0.01 inch, or 0.254 mm in a G21 program. Any thread.
+/// start after a probe move: 0.01 inch, or 0.254 mm in a G21 program. Any thread; real-time safe.
 constexpr double probe_backoff(canon::Units units) noexcept { return units == canon::Units::Mm ? 0.254 : 0.01; }
 
 /// Registers G38.2-G38.5 in `ext`: TURN_PROBE_ON, STRAIGHT_PROBE, TURN_PROBE_OFF, then a
