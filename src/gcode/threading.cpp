@@ -53,7 +53,8 @@ class RigidTap final : public CodeHandler {
     ctx.output().start_speed_feed_synch(0, b.get('k'), false);
     ctx.output().rigid_tap(0, end, b.has('i') ? b.get('i') : 1.0);
     ctx.output().stop_speed_feed_synch();
-    // LinuxCNC takes the end of the other axes as reached (the tap does not move them).
+    // The tap does not move the other axes, yet LinuxCNC records their end as reached: a
+    // following move starts from there.
     for (int axis = 3; axis < kAxisCount; ++axis) st.position.current[axis] = end[axis];
   }
 };
