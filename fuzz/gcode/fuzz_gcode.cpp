@@ -29,6 +29,7 @@ gcode::Options fuzz_options(std::uint8_t flags) {
   static const auto extensions = gcode::standard_extensions(gcode::Dialect::LinuxCnc);
   o.extensions = extensions;   // the modules built on the core are fuzzed with it
   o.tool_table = fuzz_tools();
+  o.extensions = gcode::standard_extensions(gcode::Dialect::LinuxCnc);
   o.mode = (flags & 1) ? gcode::Mode::Execute : gcode::Mode::Scan;
   o.block_delete = (flags & 2) != 0;
   o.initial_units = (flags & 4) ? canon::Units::Inch : canon::Units::Mm;

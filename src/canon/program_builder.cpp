@@ -122,7 +122,10 @@ void ProgramBuilder::straight_probe(SegmentId id, const Pose& end) {
 }
 
 void ProgramBuilder::rigid_tap(SegmentId id, const Pose& end, double /*scale*/) {
+  // The tap reverses at `end` and comes back: the machine ends where the tap started.
+  const Pose start = position_;
   append(MoveKind::RigidTap, id, to_machine(end), current_feed_index());
+  position_ = start;
 }
 
 void ProgramBuilder::arc_feed(SegmentId id, const ArcFeed& arc) {

@@ -225,7 +225,7 @@ void Engine::check_other_codes() {
   if (b.has('k') && !is_arc(motion) && motion != 330 && motion != 331 && motion != 760 && motion != 870 &&
       !lathe)
     unused_word(b, 'k', "G2, G3, G33, G33.1, G76, G87 or a lathe cycle");
-  if (b.has('l') && !(motion >= 810 && motion <= 890) && motion != 760 && motion != 52 && motion != 730 && motion != 740 &&
+  if (b.has('l') && !(motion >= 810 && motion <= 890) && motion != 760 && motion != 52 && motion != 730 &&
       !lathe && g0 != 100 && g7 != 410 && g7 != 411 && g7 != 420 && g7 != 421 && m5 != 66)
     unused_word(b, 'l', "G10, G41, G42, a canned cycle, G5.2, G76 or M66");
   if (b.has('p')) check_p_word();

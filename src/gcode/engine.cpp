@@ -424,6 +424,7 @@ void Engine::check_motion_habits(bool feed) {
 void Engine::request_sync(const SyncValues& assumed) {
   if (opt_.mode == Mode::Execute) {
     pending_sync_ = assumed.kind;
+    sync_request_ = assumed;
     return;
   }
   // Scan mode: the assumed feedback arrives when the block is done (LinuxCNC reads it
@@ -436,6 +437,11 @@ void Engine::sync(const SyncValues& values) {
   if (pending_sync_ == SyncKind::None) return;
   apply_sync(values);
   pending_sync_ = SyncKind::None;
+  if (sync_request_.kind == SyncKind::Probe && sync_request_.contact_required && !values.probe_tripped) {
+    // The probe block is still the current line: the error points at it.
+    report(GcodeError(ErrorCode::ProbeNoContact, "the probe move ended without the probe changing state"));
+    failed_ = true;
+  }
 }
 
 void Engine::apply_sync(const SyncValues& values) {
@@ -445,6 +451,7 @@ void Engine::apply_sync(const SyncValues& values) {
       for (int i = 0; i < kAxisCount; ++i) p[static_cast<std::size_t>(5061 + i)] = values.probe_position[i];
       p[5070] = values.probe_tripped ? 1.0 : 0.0;
       st_.position.current = values.position;
+      st_.position.canon_position = values.position;
       break;
     case SyncKind::Input:
       p[5399] = values.input_value;

@@ -255,6 +255,7 @@ class Engine final : public ParamHost, public ExecContext {
   std::string mdi_line_;
   SyncKind pending_sync_ = SyncKind::None;
   SyncValues block_sync_;           ///< scan mode: feedback assumed at the end of this block
+  SyncValues sync_request_;         ///< execute mode: what the pending sync point asked for
   bool block_sync_pending_ = false;
   std::uint32_t letters_ = 0;       ///< letter words with a reader (axis mask applied)
   int extension_at_ = -1;  ///< where the code of the running extension starts (its errors point there)

@@ -175,6 +175,9 @@ Pose Engine::find_ends(const Block& b) {
 }
 
 void Engine::convert_motion(int motion) {
+  // A run of canned-cycle blocks keeps its initial level until a block moves otherwise.
+  const bool cycle = motion == 730 || motion == 740 || (motion >= 810 && motion <= 890);
+  if (!cycle) st_.cycle.initial_level_valid = false;
   switch (motion) {
     case 0:
     case 10:

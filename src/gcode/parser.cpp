@@ -60,8 +60,8 @@ double apply_binary(double a, int op, double b, int pos) {
     case kGt: return a > b ? 1.0 : 0.0;
     case kEq: return std::fabs(a - b) < kEqualTolerance ? 1.0 : 0.0;
     case kNe: return std::fabs(a - b) >= kEqualTolerance ? 1.0 : 0.0;
-    case kLe: return (std::fabs(a - b) < kEqualTolerance || a <= b) ? 1.0 : 0.0;
-    case kGe: return (std::fabs(a - b) < kEqualTolerance || a >= b) ? 1.0 : 0.0;
+    case kLe: return a <= b ? 1.0 : 0.0;   // rs274 2.9: no tolerance, unlike EQ and NE
+    case kGe: return a >= b ? 1.0 : 0.0;
     default: return 0.0;
   }
 }

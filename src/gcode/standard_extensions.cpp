@@ -3,6 +3,9 @@
 #include "opencnc/gcode/standard_extensions.hpp"
 
 #include "opencnc/gcode/cutter_comp.hpp"
+#include "opencnc/gcode/canned_cycles.hpp"
+#include "opencnc/gcode/probing.hpp"
+#include "opencnc/gcode/threading.hpp"
 
 namespace opencnc::gcode {
 
@@ -10,6 +13,9 @@ std::shared_ptr<const Extensions> standard_extensions(Dialect dialect) {
   auto ext = std::make_shared<Extensions>();
   (void)dialect;
   add_cutter_compensation(*ext);
+  add_canned_cycles(*ext);
+  add_threading(*ext);
+  add_probing(*ext);
   return ext;
 }
 

@@ -152,6 +152,8 @@ std::uint64_t InterpState::digest() const noexcept {
   h.u64(comp.queued.size());
   for (const CompQueuedMove& q : comp.queued) hash_comp_move(h, q);
   hash_comp_move(h, comp.last_first);
+  for (double v : {cycle.r, cycle.bottom, cycle.p, cycle.q, cycle.i, cycle.j, cycle.k, cycle.initial_level}) h.f64(v);
+  h.flag(cycle.initial_level_valid);
   h.pos(next);
   h.flag(percent_delimited);
   h.flag(ended);

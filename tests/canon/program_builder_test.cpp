@@ -68,6 +68,22 @@ TEST(ProgramBuilder, ArcCentreLiesInThePlaneOfTheStartPoint) {
   EXPECT_DOUBLE_EQ(p.feed(0), 100.0);
 }
 
+TEST(ProgramBuilder, ARigidTapEndsWhereItStarted) {
+  ProgramBuilder b;
+  b.straight_traverse(0, xyz(1, 2, 5));
+  b.rigid_tap(1, xyz(1, 2, -10), 1.0);
+  ASSERT_EQ(b.program().size(), 2u);
+  EXPECT_EQ(b.program().move(1).kind, MoveKind::RigidTap);
+  EXPECT_EQ(b.program().end(1)[Axis::Z], -10.0);   // the bottom of the tap
+  EXPECT_EQ(b.position()[Axis::Z], 5.0);           // the machine is back at the start
+  // A helix after the tap has its centre in the plane of the real start point.
+  ArcFeed a;
+  a.first_end = 3, a.second_end = 2, a.first_center = 2, a.second_center = 2, a.rotation = 1, a.axis_end = 4;
+  a.end = xyz(3, 2, 4);
+  b.arc_feed(2, a);
+  EXPECT_EQ(b.program().arc(2).center[2], 5.0);
+}
+
 TEST(ProgramBuilder, RotationTurnsTheNormalOfAnXzArc) {
   ProgramBuilder b;
   b.set_xy_rotation(90);

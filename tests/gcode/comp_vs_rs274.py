@@ -32,8 +32,7 @@ T8 P8 Z0.1 D0.06 Q3
 
 
 def error_map():
-    """rs274 message -> codes opencnc may report: the conformance suite's code, or (for
-    problems outside compensation, until the codes are reconciled) the interpreter's own."""
+    """rs274 message -> the code opencnc reports for the same problem (the conformance suite's table)."""
     rows = []
     with open(os.path.join(ROOT, "tests", "conformance", "error-codes.tsv")) as f:
         for line in f:
@@ -41,13 +40,6 @@ def error_map():
                 continue
             pattern, code = line.rstrip("\n").split("\t")[:2]
             rows.append((re.compile(pattern), code))
-    with open(os.path.join(HERE, "rs274_errors.tsv")) as f:
-        for line in f:
-            if line.startswith("#") or not line.strip():
-                continue
-            code, pattern = line.rstrip("\n").split("\t", 1)
-            if not code.startswith("gcode.comp-"):
-                rows.append((re.compile(pattern), code))
     return rows
 
 

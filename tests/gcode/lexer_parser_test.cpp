@@ -183,6 +183,8 @@ TEST_F(ParserTest, EvaluatesExpressionsWithLinuxCncPrecedence) {
   EXPECT_DOUBLE_EQ(eval("[1 + 1 EQ 2]"), 1);
   EXPECT_DOUBLE_EQ(eval("[0 OR 3 XOR 1]"), 0);
   EXPECT_DOUBLE_EQ(eval("[3 LE 3.00001]"), 1);
+  EXPECT_DOUBLE_EQ(eval("[3.00001 LE 3]"), 0);   // LE and GE are exact in rs274 (threading.ngc's loop)
+  EXPECT_DOUBLE_EQ(eval("[2.99999 GE 3]"), 0);
   EXPECT_DOUBLE_EQ(eval("[2 LT 2]"), 0);
 }
 

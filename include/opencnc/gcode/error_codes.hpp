@@ -149,6 +149,28 @@ namespace opencnc::gcode {
   X(ThreadPitchMissing, "gcode.thread-pitch-missing")                        \
   X(ThreadFeedWord, "gcode.thread-feed-word")                                \
   X(ThreadG76WordMissing, "gcode.thread-g76-word-missing")                   \
+  /* canned cycles, threading and probing */                                 \
+  X(CompCannedCycle, "gcode.comp-canned-cycle")                              \
+  X(CycleInverseTime, "gcode.cycle-inverse-time")                            \
+  X(CycleRMissing, "gcode.cycle-r-missing")                                  \
+  X(CycleRBelowBottom, "gcode.cycle-r-below-bottom")                         \
+  X(CycleBottomMissing, "gcode.cycle-bottom-missing")                        \
+  X(CycleQMissing, "gcode.cycle-q-missing")                                  \
+  X(CycleQNotPositive, "gcode.cycle-q-not-positive")                         \
+  X(CycleRepeatZero, "gcode.cycle-repeat-zero")                              \
+  X(CycleDwellMissing, "gcode.cycle-dwell-missing")                          \
+  X(CycleG87WordMissing, "gcode.cycle-g87-word-missing")                     \
+  X(CycleTappingPlane, "gcode.cycle-tapping-plane")                          \
+  X(SpindleStopped, "gcode.spindle-stopped")                                 \
+  X(SpindleWrongDirection, "gcode.spindle-wrong-direction")                  \
+  X(CompSpindleSync, "gcode.comp-spindle-sync")                              \
+  X(ThreadG76Depth, "gcode.thread-g76-depth")                                \
+  X(ThreadG76Word, "gcode.thread-g76-word")                                  \
+  X(ThreadG76RotaryAxis, "gcode.thread-g76-rotary-axis")                     \
+  X(CompProbe, "gcode.comp-probe")                                           \
+  X(ProbeFeedPerRevolution, "gcode.probe-feed-per-revolution")               \
+  X(ProbeStartTooClose, "gcode.probe-start-too-close")                       \
+  X(ProbeNoContact, "gcode.probe-no-contact")                                \
   /* program structure */                                                    \
   X(ProgramEmpty, "gcode.program-empty")                                     \
   X(MissingClosingPercent, "gcode.missing-closing-percent")                  \

@@ -34,9 +34,14 @@ enum class SyncKind : std::uint8_t { None, Probe, Input, ToolChange };
 struct SyncValues {
   SyncKind kind = SyncKind::None;
   Pose probe_position{};     ///< Probe: where the probe tripped (or the move ended)
+  /// Probe: the probe changed state as the move asked (contact for G38.2/G38.3, loss of
+  /// contact for G38.4/G38.5); becomes #5070.
   bool probe_tripped = false;
   Pose position{};           ///< Probe/ToolChange: where the machine stands now
   double input_value = 0;    ///< Input: the value read by M66 (digital 0/1 or analog)
+  /// Set by the interpreter in the request (G38.2, G38.4): a sync() without probe_tripped
+  /// ends the run with `gcode.probe-no-contact` on the probe block. Ignored in sync() values.
+  bool contact_required = false;
 };
 
 /// One interpreter run. Non-real-time; one thread at a time (the planner's feeder thread).
@@ -68,7 +73,9 @@ class Interpreter {
   RunStatus execute_mdi(std::string_view line, canon::Sink& sink);
   /// What the pending sync point waits for (None when not waiting).
   SyncKind pending_sync() const noexcept;
-  /// Supplies machine feedback and releases the sync point. Interpreter thread.
+  /// Supplies machine feedback and releases the sync point. A G38.2/G38.4 result without
+  /// contact ends the run (`gcode.probe-no-contact`; the next run() returns Error).
+  /// Interpreter thread.
   void sync(const SyncValues& values);
 
   /// The exact state now (copy). Interpreter thread; non-real-time.

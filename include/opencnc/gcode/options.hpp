@@ -23,8 +23,8 @@ enum class Dialect : std::uint8_t { LinuxCnc, Fanuc };
 
 /// Execute: stop before a block that needs machine feedback (probe result, M66 input,
 /// tool change) until the caller supplies it with Interpreter::sync(). Scan: never stop;
-/// assume what LinuxCNC's stand-alone `rs274` assumes (the probe trips at the programmed end
-/// point, inputs read 0).
+/// assume what LinuxCNC's stand-alone `rs274` assumes (a probe reports the programmed end
+/// with #5070 = 0 and backs off towards the start, inputs read 0).
 enum class Mode : std::uint8_t { Scan, Execute };
 
 /// Runaway protection: exceeding any limit ends the run with a `gcode.limit-*` error that

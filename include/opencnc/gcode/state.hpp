@@ -86,6 +86,22 @@ struct ToolState {
   bool operator==(const ToolState&) const = default;
 };
 
+/// Canned-cycle values that carry over from block to block (LinuxCNC's `cycle_*` settings):
+/// a block that repeats the active cycle may leave out R, the bottom, P, Q and I/J/K. All in
+/// program units, as the program gave them (an incremental bottom stays incremental).
+struct CycleState {
+  double r = 0;              ///< R plane
+  double bottom = 0;         ///< bottom word of the plane's drilling axis (Z in G17)
+  double p = 0;              ///< dwell (G82 G86 G88 G89, G74/G84)
+  double q = 0;              ///< peck increment (G73 G83)
+  double i = 0, j = 0, k = 0;   ///< G87 back-boring offsets and top
+  /// Drilling-axis position before the first of a run of cycle blocks (the G98 retract
+  /// height and the base of an incremental R); valid until a block moves with another code.
+  double initial_level = 0;
+  bool initial_level_valid = false;
+  bool operator==(const CycleState&) const = default;
+};
+
 /// A named parameter (#<name>); names are stored lowercase, as the program reads them.
 struct NamedValue {
   double value = 0;
@@ -189,6 +205,7 @@ struct InterpState {
   std::vector<CallFrame> frames;                       ///< [0] = main program
   ControlState control;
   CompState comp;                                      ///< cutter compensation's held moves
+  CycleState cycle;
   SourcePosition next;                                 ///< next line to read
   bool percent_delimited = false;                      ///< file started with '%'
   bool ended = false;                                  ///< M2/M30 or closing '%' reached
