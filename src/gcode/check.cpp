@@ -92,7 +92,7 @@ void Engine::check_g_codes() {
     if ((l == 2 || l == 20) && (p_int < 0 || p_int > 9)) fail(ErrorCode::G10Usage, "G10 L{} needs P0..P9", l);
     if ((l == 1 || l == 10 || l == 11) && p_int < 1) fail(ErrorCode::G10Usage, "G10 L{} needs a tool number P1 or more", l);
   } else if (mode0 == 53) {
-    if (mode1 != 520 && mode1 != -1) fail(ErrorCode::Unsupported, "G5.3 is not supported yet");
+    if (mode1 != 52 && mode1 != -1) fail(ErrorCode::NurbsBlockCodes, "G5.3 can share a block only with G5.2");
   } else if (mode0 == 530) {
     if (b.motion != 0 && b.motion != 10) fail(ErrorCode::G53Usage, "G53 needs G0 or G1");
     if (b.g[kGroupDistance] == 910 || (b.g[kGroupDistance] != 900 && st_.modal.distance == DistanceMode::Incremental))

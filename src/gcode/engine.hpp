@@ -66,6 +66,9 @@ class Engine final : public ParamHost, public ExecContext {
   canon::Sink& output() override { return out_; }
   void straight(bool rapid, const Pose& end) override;
   void arc(const canon::ArcFeed& arc) override;
+  void programmed_move(int motion, const Block& words) override;
+  void read_subprogram(const std::string& name, std::uint32_t extra_letters,
+                       const std::function<void(const Block&)>& visit) override;
   void open_queue() override { out_.open_queue(); }
   void flush_queue() override { out_.flush_queue(); }
   std::size_t queued() const override { return out_.queued(); }
@@ -79,6 +82,8 @@ class Engine final : public ParamHost, public ExecContext {
   bool step_block();
   bool nothing() { return true; }
   bool read_line();
+  enum class LineKind : std::uint8_t { Block, Empty, ProgramEnd };
+  LineKind read_block();
   bool process_line();
   void report(const GcodeError& e);
   void warn_once(bool& done, ErrorCode code, std::string_view message);

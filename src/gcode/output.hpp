@@ -163,6 +163,7 @@ class Output final : public canon::Sink {
   std::shared_ptr<CoordinateTransform> transform_;
   bool queueing_ = false;
   std::vector<Queued> queue_;
+  std::vector<canon::NurbsPoint> mapped_points_;   ///< control points after transform and axis map
 };
 
 }  // namespace opencnc::gcode

@@ -2,11 +2,16 @@
 // Registers the interpreter modules: one line per module, in the order they take effect.
 #include "opencnc/gcode/standard_extensions.hpp"
 
+#include "opencnc/gcode/lathe_cycles.hpp"
+#include "opencnc/gcode/splines.hpp"
+
 namespace opencnc::gcode {
 
 std::shared_ptr<const Extensions> standard_extensions(Dialect dialect) {
   auto ext = std::make_shared<Extensions>();
   (void)dialect;
+  add_splines(*ext);
+  add_lathe_cycles(*ext);
   return ext;
 }
 

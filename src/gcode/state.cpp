@@ -140,6 +140,15 @@ std::uint64_t InterpState::digest() const noexcept {
   h.str(control.defining_name);
   for (bool b : {control.executed_if, control.doing_break, control.doing_continue, control.value_returned}) h.flag(b);
   h.f64(control.return_value);
+  h.u64(spline.points.size());
+  for (const canon::NurbsPoint& p : spline.points) {
+    h.f64(p.x);
+    h.f64(p.y);
+    h.f64(p.weight);
+  }
+  h.i64(spline.order);
+  h.f64(spline.g5_i);
+  h.f64(spline.g5_j);
   h.pos(next);
   h.flag(percent_delimited);
   h.flag(ended);
