@@ -15,7 +15,7 @@ namespace {
 constexpr double kTol = 1e-6;     // same height, same point, on an arc
 constexpr double kTiny = 1e-3;    // elements this short vanish; arc moves this short are skipped
 constexpr double kGap = 1e-2;     // offset neighbours further apart than this get a joining arc
-constexpr std::uint64_t kMaxSteps = 20'000'000;   // runaway protection of the layer loop
+constexpr std::uint64_t kMaxSteps = 5'000'000;   // runaway protection of the layer loop
 
 const Point kJ{0, 1};
 
@@ -189,10 +189,10 @@ struct Work {
   int frame = 0;
 
   void rotate() {
-    for (Piece& p : pieces) {
-      p.a *= -kJ;
-      p.b *= -kJ;
-      p.c *= -kJ;
+    for (Piece& p : pieces) {   // written -p·j, not p·(-j): the signed zeros differ
+      p.a = -p.a * kJ;
+      p.b = -p.b * kJ;
+      p.c = -p.c * kJ;
     }
     frame ^= 4;
   }
@@ -301,7 +301,12 @@ void Work::tidy_after_offset() {
   std::size_t i = 0;
   while (i + 1 < pieces.size()) {
     if (!monotonic(pieces[i])) {
-      if (i == 0 || extent(pieces[i]) < extent(pieces[i - 1])) pieces.erase(pieces.begin() + static_cast<std::ptrdiff_t>(i));
+      // LinuxCNC drops the shorter of this piece and the one before; for the first piece it
+      // reads before the start of its list (undefined; rs274 crashes), so that is an error here.
+      if (i == 0)
+        throw RoughingError(RoughingError::Kind::LostPath,
+                            "the finishing allowance turns the start of the profile round (make D smaller)");
+      if (extent(pieces[i]) < extent(pieces[i - 1])) pieces.erase(pieces.begin() + static_cast<std::ptrdiff_t>(i));
       else pieces.erase(pieces.begin() + static_cast<std::ptrdiff_t>(i - 1));
       i = 0;
       if (pieces.size() < 2) break;
@@ -328,12 +333,19 @@ class FramedSink {
   void arc(Point end, Point center, bool ccw) { out_.arc(map(end), map(center), mirrored() ? !ccw : ccw); }
 
  private:
-  // Inverse of: rotate (p -> -jp) first, then mirror X (conj), then mirror Z (-conj).
+  // Inverse of: rotate (p -> -jp) first, then mirror X (conj), then mirror Z (-conj); one
+  // expression per frame so that signed zeros come out as LinuxCNC prints them.
   Point map(Point p) const {
-    if (frame_ & 1) p = -std::conj(p);
-    if (frame_ & 2) p = std::conj(p);
-    if (frame_ & 4) p = kJ * p;
-    return p;
+    switch (frame_) {
+      case 1: return -std::conj(p);
+      case 2: return std::conj(p);
+      case 3: return -p;
+      case 4: return kJ * p;
+      case 5: return std::conj(kJ * p);
+      case 6: return -std::conj(kJ * p);
+      case 7: return -kJ * p;
+      default: return p;
+    }
   }
   bool mirrored() const { return ((frame_ & 1) != 0) != ((frame_ & 2) != 0); }
 
@@ -469,8 +481,18 @@ class Layers {
   // One pocket from piece i; returns true when the next pocket starts (at, i updated).
   bool pocket(bool follow_only, bool pockets_only, Point& at, std::size_t& i) {
     double x = starts_.back().imag();
+    // The loop is deterministic: coming back to the same place, height and piece means it
+    // would repeat for ever (LinuxCNC hangs there).
+    Point last_at(NAN, NAN);
+    double last_x = NAN;
+    std::size_t last_i = p_.size();
     while (i < p_.size()) {
       count();
+      if (at == last_at && x == last_x && i == last_i)
+        throw RoughingError(RoughingError::Kind::NoProgress, "the roughing passes stopped advancing along the profile");
+      last_at = at;
+      last_x = x;
+      last_i = i;
       while (x - kTol > at.imag()) {
         count();
         x -= delta_;
