@@ -13,6 +13,7 @@
 
 #include "gcode_test_util.hpp"
 #include "opencnc/gcode/rs274_driver.hpp"
+#include "opencnc/gcode/standard_extensions.hpp"
 
 namespace fs = std::filesystem;
 using namespace opencnc;
@@ -86,6 +87,7 @@ TEST(Rs274Cases, EveryCaseMatchesRs274) {
     SCOPED_TRACE(ngc.filename().string());
     const Case c = read_case(ngc);
     Options options;
+    options.extensions = standard_extensions(Dialect::LinuxCnc);
     if (c.tools) options.tool_table = tools;
     options.subroutine_path = {(kCases / (c.subroutine_path.empty() ? "." : c.subroutine_path)).string()};
     Interpreter interp(options);
