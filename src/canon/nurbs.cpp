@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// NURBS evaluation (de Boor) and chord splitting (Bezier decomposition by knot insertion,
+// NURBS evaluation (de Boor) and chord splitting (Bezier pieces from the blossom of each span,
 // then de Casteljau halving until each piece's control points hug its chord).
 #include "opencnc/canon/nurbs.hpp"
 
@@ -28,24 +28,29 @@ double distance_to_segment(const CurvePoint& p, const CurvePoint& a, const Curve
   return std::hypot(p.x - (a.x + t * dx), p.y - (a.y + t * dy));
 }
 
-// Inserts knot u once (Boehm's algorithm); u must lie strictly inside the knot range.
-void insert_knot(std::vector<double>& knots, std::vector<H>& cp, int degree, double u) {
-  const auto it = std::upper_bound(knots.begin(), knots.end(), u);
-  const std::size_t s = static_cast<std::size_t>(it - knots.begin()) - 1;   // knots[s] <= u < knots[s+1]
-  const std::size_t p = static_cast<std::size_t>(degree);
-  std::vector<H> out(cp.size() + 1);
-  for (std::size_t i = 0; i < out.size(); ++i) {
-    if (i + p <= s) {
-      out[i] = cp[i];
-    } else if (i <= s) {
-      const double a = (u - knots[i]) / (knots[i + p] - knots[i]);
-      out[i] = lerp(cp[i - 1], cp[i], a);
-    } else {
-      out[i] = cp[i - 1];
+// The blossom (polar form) of the curve on span s at the parameters t[0..p-1]: de Boor's
+// algorithm with a different parameter on each level. With all t equal it is the curve point.
+H blossom(const std::vector<H>& cp, const std::vector<double>& knots, std::size_t p, std::size_t s,
+          const double* t, std::vector<H>& d) {
+  for (std::size_t j = 0; j <= p; ++j) d[j] = cp[j + s - p];
+  for (std::size_t r = 1; r <= p; ++r) {
+    for (std::size_t j = p; j >= r; --j) {
+      const double lo = knots[j + s - p], hi = knots[j + 1 + s - r];
+      d[j] = lerp(d[j - 1], d[j], (t[r - 1] - lo) / (hi - lo));
     }
   }
-  cp.swap(out);
-  knots.insert(knots.begin() + static_cast<std::ptrdiff_t>(s + 1), u);
+  return d[p];
+}
+
+// The Bezier control points of span s (knots[s] < knots[s+1]): b_i is the blossom at
+// (a, ..., a, b, ..., b) with i copies of b. O(p^3) per span, independent of the curve's length.
+void bezier_of_span(const std::vector<H>& cp, const std::vector<double>& knots, std::size_t p, std::size_t s,
+                    std::vector<H>& piece, std::vector<H>& work) {
+  std::vector<double> t(p);
+  for (std::size_t i = 0; i <= p; ++i) {
+    for (std::size_t k = 0; k < p; ++k) t[k] = k < p - i ? knots[s] : knots[s + 1];
+    piece[i] = blossom(cp, knots, p, s, t.data(), work);
+  }
 }
 
 // Halves a rational Bezier piece on [u0, u1] until its control points are within `tol` of
@@ -119,23 +124,22 @@ CurvePoint nurbs_point(std::span<const NurbsPoint> points, int order, double u) 
 std::vector<CurvePoint> tessellate_nurbs(std::span<const NurbsPoint> points, int order, double tolerance) {
   if (points.size() < 2) return {};
   const bool positive = std::all_of(points.begin(), points.end(), [](const NurbsPoint& q) { return q.weight > 0; });
-  if (!positive || order < 2 || static_cast<std::size_t>(order) > points.size()) return control_polygon(points);
-  const int degree = order - 1;
-  std::vector<double> knots = nurbs_knots(points.size(), order);
+  // Above order 64 the pieces cost O(order^3) each (LinuxCNC's own evaluation is exponential
+  // in the order): the control polygon then.
+  if (!positive || order < 2 || order > 64 || static_cast<std::size_t>(order) > points.size())
+    return control_polygon(points);
+  const std::size_t p = static_cast<std::size_t>(order - 1);
+  const std::vector<double> knots = nurbs_knots(points.size(), order);
   std::vector<H> cp;
   cp.reserve(points.size());
   for (const NurbsPoint& q : points) cp.push_back(homogeneous(q));
-  // Interior knots to multiplicity `degree`: the control points fall into Bezier pieces.
   const double last = knots.back();
-  for (int knot = 1; knot < static_cast<int>(last); ++knot) {
-    for (int m = 1; m < degree; ++m) insert_knot(knots, cp, degree, knot);
-  }
   std::vector<CurvePoint> out;
-  std::vector<H> piece(static_cast<std::size_t>(degree) + 1);
-  for (int span = 0; span < static_cast<int>(last); ++span) {
-    const std::size_t first = static_cast<std::size_t>(span) * static_cast<std::size_t>(degree);
-    std::copy_n(cp.begin() + static_cast<std::ptrdiff_t>(first), piece.size(), piece.begin());
-    flatten(piece, span, span + 1.0, tolerance, 0, out);
+  std::vector<H> piece(p + 1), work(p + 1);
+  for (std::size_t s = p; s + 1 < knots.size() - p; ++s) {   // the spans [s, s+1] of positive length
+    if (!(knots[s] < knots[s + 1])) continue;
+    bezier_of_span(cp, knots, p, s, piece, work);
+    flatten(piece, knots[s], knots[s + 1], tolerance, 0, out);
   }
   out.back() = {points.back().x, points.back().y, last};
   return out;

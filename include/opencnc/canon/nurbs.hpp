@@ -33,13 +33,14 @@ CurvePoint nurbs_point(std::span<const NurbsPoint> points, int order, double u);
 /// within `tolerance` of the chord of its parameter interval (from the previous vertex's u to
 /// this one's), and the last vertex is exactly the last control point.
 ///
-/// How: knot insertion turns the curve into rational Bezier pieces; de Casteljau halves a
+/// How: the blossom of each knot span gives its rational Bezier piece; de Casteljau halves a
 /// piece until all its control points lie within `tolerance` of the chord between its ends.
 /// With positive weights a rational Bezier piece lies in the convex hull of its control
 /// points, and every point of that hull is within `tolerance` of the chord, which bounds
 /// the error. Weights that are not all positive (LinuxCNC accepts a first G5.2 point with no
 /// P, weight -1) give no such bound; the control polygon is returned then, as it is for
-/// orders outside 2..points.size(). Non-real-time (allocates); any thread.
+/// orders outside 2..min(64, points.size()). O(points · order³). Non-real-time (allocates);
+/// any thread.
 std::vector<CurvePoint> tessellate_nurbs(std::span<const NurbsPoint> points, int order, double tolerance);
 
 }  // namespace opencnc::canon
