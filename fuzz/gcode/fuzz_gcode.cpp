@@ -11,6 +11,7 @@
 
 #include "opencnc/canon/rs274_printer.hpp"
 #include "opencnc/gcode/interpreter.hpp"
+#include "opencnc/gcode/standard_extensions.hpp"
 
 using namespace opencnc;
 
@@ -25,6 +26,7 @@ std::shared_ptr<const tools::ToolTable> fuzz_tools() {
 
 gcode::Options fuzz_options(std::uint8_t flags) {
   gcode::Options o;
+  o.extensions = gcode::standard_extensions(gcode::Dialect::LinuxCnc);
   o.tool_table = fuzz_tools();
   o.mode = (flags & 1) ? gcode::Mode::Execute : gcode::Mode::Scan;
   o.block_delete = (flags & 2) != 0;

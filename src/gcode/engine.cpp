@@ -422,12 +422,12 @@ void Engine::read_subprogram(const std::string& name, std::uint32_t extra_letter
   } saved{*this, block_, raw_, std::exchange(norm_, std::vector<char>(norm_.size())), norm_len_, line_, line_file_,
           letters_, line_offset_, out_.origin(), in_mdi_};   // the block's comment views the moved buffer
   letters_ |= extra_letters;
-  in_mdi_ = false;   // the sub's lines come from its file, also when MDI calls the cycle
   const std::size_t depth = st_.frames.size();
   block_.clear();
   block_.o_type = OWord::Call;
   block_.o_name = name;
-  o_call();
+  o_call();          // from MDI, a sub neither defined nor on the search path fails here
+  in_mdi_ = false;   // the sub's lines come from its file, also when MDI calls the cycle
   while (st_.frames.size() > depth) {
     const LineKind kind = read_block();
     if (kind == LineKind::ProgramEnd) fail(ErrorCode::FileEndedNoEnd, "the program ends inside the subprogram o<{}>", name);

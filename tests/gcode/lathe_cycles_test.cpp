@@ -171,6 +171,7 @@ TEST(LatheCycles, RunFromMdiWithAProfileFile) {
   ASSERT_EQ(interp.execute_mdi("G0 X12 Z2", rec), RunStatus::Ok);
   ASSERT_EQ(interp.execute_mdi("G71 Q500 D0.2 I1", rec), RunStatus::Ok);
   EXPECT_GT(rec.motions.size(), 10u);
+  EXPECT_EQ(interp.execute_mdi("G71 Q501 D0.2 I1", rec), RunStatus::Error);   // no such sub: an error, no read
   EXPECT_EQ(interp.execute_mdi("G1 U1", rec), RunStatus::Error);
   EXPECT_EQ(interp.execute_mdi("G0 X20", rec), RunStatus::Ok);
   std::filesystem::remove_all(dir);
