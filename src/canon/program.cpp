@@ -2,6 +2,8 @@
 // Storage of the expanded program: 16-byte moves, strided poses, side tables.
 #include "opencnc/canon/program.hpp"
 
+#include <algorithm>
+
 namespace opencnc::canon {
 
 Program::Program(AxisMask axes) : axes_(axes), sources_(std::make_shared<SourceMap>()) {
@@ -61,10 +63,41 @@ std::uint32_t Program::add_action_pose(const Pose& p) {
   return static_cast<std::uint32_t>(action_poses_.size() - 1);
 }
 
+void Program::note_split(SegmentId segment, std::size_t first_move, std::size_t moves) {
+  if (moves <= 1) return;
+  const std::size_t before = splits_.empty() ? 0 : splits_.back().extra;
+  splits_.push_back({segment, first_move, moves, before + moves - 1});
+}
+
+SegmentId Program::segment_of(std::size_t move) const noexcept {
+  // The last split that starts at or before `move`.
+  const auto it = std::upper_bound(splits_.begin(), splits_.end(), move,
+                                   [](std::size_t m, const Split& s) { return m < s.first_move; });
+  if (it == splits_.begin()) return first_segment_ + move;
+  const Split& s = *(it - 1);
+  if (move < s.first_move + s.moves) return s.segment;
+  return first_segment_ + move - s.extra;
+}
+
+std::size_t Program::first_move_of(SegmentId segment) const noexcept {
+  const auto it = std::upper_bound(splits_.begin(), splits_.end(), segment,
+                                   [](SegmentId id, const Split& s) { return id < s.segment; });
+  if (it == splits_.begin()) return static_cast<std::size_t>(segment - first_segment_);
+  const Split& s = *(it - 1);
+  if (segment == s.segment) return s.first_move;
+  return static_cast<std::size_t>(segment - first_segment_) + s.extra;
+}
+
+std::size_t Program::moves_of(SegmentId segment) const noexcept {
+  const auto it = std::lower_bound(splits_.begin(), splits_.end(), segment,
+                                   [](const Split& s, SegmentId id) { return s.segment < id; });
+  return it != splits_.end() && it->segment == segment ? it->moves : 1;
+}
+
 std::size_t Program::memory_bytes() const noexcept {
   std::size_t bytes = moves_.capacity_bytes() + coords_.capacity_bytes() + arcs_.capacity_bytes();
   bytes += feeds_.capacity() * sizeof(double) + actions_.capacity() * sizeof(Action);
-  bytes += action_poses_.capacity() * sizeof(Pose);
+  bytes += action_poses_.capacity() * sizeof(Pose) + splits_.capacity() * sizeof(Split);
   for (const auto& t : texts_) bytes += t.capacity() + sizeof(std::string);
   return bytes;
 }

@@ -4,6 +4,9 @@
 
 #include <cmath>
 #include <numbers>
+#include <vector>
+
+#include "opencnc/canon/nurbs.hpp"
 
 namespace opencnc::canon {
 
@@ -97,11 +100,14 @@ std::uint32_t ProgramBuilder::current_feed_index() {
   return last_feed_index_;
 }
 
-void ProgramBuilder::append(MoveKind kind, SegmentId id, const Pose& machine_end, std::uint32_t param) {
-  (void)id;  // ids are ordinals: the builder's own count matches the interpreter's
+void ProgramBuilder::append(MoveKind kind, SegmentId id, const Pose& machine_end, std::uint32_t param,
+                            std::uint8_t extra_flags) {
+  // Ids are ordinals: after the first move, the program's count follows the interpreter's
+  // except where a segment is split (recorded by note_split).
+  if (program_.empty()) program_.set_first_segment(id);
   Move m;
   m.kind = kind;
-  m.flags = kind == MoveKind::Traverse ? 0 : move_flags();
+  m.flags = static_cast<std::uint8_t>((kind == MoveKind::Traverse ? 0 : move_flags()) | extra_flags);
   m.context = origin_.context;
   m.line = origin_.line;
   m.param = param;
@@ -169,6 +175,32 @@ void ProgramBuilder::arc_feed(SegmentId id, const ArcFeed& arc) {
   g.plane = arc.plane;
   g.feed = current_feed_index();
   append(MoveKind::Arc, id, machine_end, program_.add_arc(g));
+}
+
+void ProgramBuilder::nurbs_feed(SegmentId id, int order, std::span<const NurbsPoint> points) {
+  if (points.empty()) return;
+  // Units, G92, the rotation about Z, G5x and tool offsets are affine in XY, and a NURBS maps
+  // under an affine map by mapping its control points (weights unchanged).
+  std::vector<NurbsPoint> machine(points.begin(), points.end());
+  for (NurbsPoint& q : machine) {
+    Pose c{};
+    c[0] = q.x;
+    c[1] = q.y;
+    const Pose m = to_machine(c);
+    q.x = m[0];
+    q.y = m[1];
+  }
+  std::vector<CurvePoint> chords = tessellate_nurbs(machine, order, kCurveToleranceMm);
+  if (chords.empty()) chords.push_back({machine.back().x, machine.back().y, 0});
+  const std::size_t first = program_.size();
+  const std::uint32_t feed = current_feed_index();
+  for (const CurvePoint& v : chords) {
+    Pose end = position_;
+    end[0] = v.x;
+    end[1] = v.y;
+    append(MoveKind::Feed, id, end, feed, kCurveChord);
+  }
+  program_.note_split(id, first, chords.size());
 }
 
 void ProgramBuilder::dwell(double seconds) { program_.add_action(make(ActionKind::Dwell, 0, 0, seconds)); }

@@ -188,10 +188,11 @@ void Rs274Printer::rigid_tap(SegmentId, const Pose& end, double /*scale*/) {
   end_line();
 }
 
-void Rs274Printer::nurbs_feed(SegmentId, int order, std::span<const NurbsPoint>) {
+void Rs274Printer::nurbs_feed(SegmentId, int /*order*/, std::span<const NurbsPoint> points) {
+  // rs274 prints the number of control points, not the order.
   prefix();
   buf_.append("NURBS_FEED(");
-  integer(order);
+  integer(static_cast<int>(points.size()));
   buf_.append(", ...)");
   end_line();
 }

@@ -145,7 +145,7 @@ void Engine::check_g_codes() {
   } else if (mode0 == 100) {
     check_g10();
   } else if (mode0 == 53) {
-    if (mode1 != 520 && mode1 != -1) fail(ErrorCode::Unsupported, "G5.3 is not supported yet");
+    if (mode1 != 52 && mode1 != -1) fail(ErrorCode::NurbsBlockCodes, "G5.3 can share a block only with G5.2");
   } else if (mode0 == 530) {
     if (b.motion == -1)
       fail_at(at0, ErrorCode::G53Motion, "G53 needs a G0 or G1 move on its line (in machine coordinates)");

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <utility>
 
 #include "lexer.hpp"
 
@@ -251,8 +252,8 @@ void Engine::set_origin_from_line() {
   out_.set_origin(o);
 }
 
-// Reads and executes one line. Returns when the line is done (or the program ended).
-bool Engine::process_line() {
+// Reads the next line into block_ (parsed and checked unless a label is being sought).
+Engine::LineKind Engine::read_block() {
   if (!read_line()) {
     line_file_ = st_.next.file;
     line_ = st_.next.line;
@@ -269,12 +270,8 @@ bool Engine::process_line() {
   set_origin_from_line();
   norm_len_ = normalize_line(raw_, norm_.data());
   const std::string_view text(norm_.data(), norm_len_);
-  if (text == "%" && st_.percent_delimited && !in_mdi_) {
-    out_.finish();
-    st_.ended = true;
-    return false;
-  }
-  if (text.empty() || (text.front() == '/' && opt_.block_delete)) return true;
+  if (text == "%" && st_.percent_delimited && !in_mdi_) return LineKind::ProgramEnd;
+  if (text.empty() || (text.front() == '/' && opt_.block_delete)) return LineKind::Empty;
 
   const bool skipping = !st_.control.skipping_to.empty();
   if (skipping) {
@@ -290,6 +287,19 @@ bool Engine::process_line() {
   if (!skipping) {
     enhance_block();
     check_block();
+  }
+  return LineKind::Block;
+}
+
+// Reads and executes one line. Returns when the line is done (or the program ended).
+bool Engine::process_line() {
+  switch (read_block()) {
+    case LineKind::ProgramEnd:
+      out_.finish();
+      st_.ended = true;
+      return false;
+    case LineKind::Empty: return true;
+    case LineKind::Block: break;
   }
   if (block_.o_type != OWord::None) {
     if (in_mdi_ && block_.o_type != OWord::Call)
@@ -468,6 +478,74 @@ void Engine::apply_sync(const SyncValues& values) {
 
 void Engine::straight(bool rapid, const Pose& end) { emit_straight(rapid, end); }
 void Engine::arc(const canon::ArcFeed& a) { emit_arc(a); }
+
+void Engine::programmed_move(int motion, const Block& words) {
+  if (motion != 0 && motion != 10 && motion != 20 && motion != 30)
+    fail(ErrorCode::Unsupported, "G{} cannot be programmed by an extension", motion / 10.0);
+  // The handler's block is block_: lend block_ to the move and give it back afterwards.
+  struct Restore {
+    Block& target;
+    Block saved;
+    ~Restore() { target = std::move(saved); }
+  } restore{block_, block_};
+  block_ = words;
+  block_.motion = motion;
+  convert_motion(motion);
+}
+
+void Engine::read_subprogram(const std::string& name, std::uint32_t extra_letters,
+                             const std::function<void(const Block&)>& visit) {
+  // The executing block's line: the cycle's moves and errors belong to it afterwards.
+  struct Saved {
+    Engine& e;
+    Block block;
+    std::string raw;
+    std::vector<char> norm;
+    std::size_t norm_len;
+    std::uint32_t line, file, letters;
+    std::uint64_t offset;
+    canon::BlockOrigin origin;
+    bool mdi;
+    ~Saved() {   // also on errors: an MDI session goes on with the machine's letters
+      e.letters_ = letters;
+      e.in_mdi_ = mdi;
+    }
+  } saved{*this, block_, raw_, std::exchange(norm_, std::vector<char>(norm_.size())), norm_len_, line_, line_file_,
+          letters_, line_offset_, out_.origin(), in_mdi_};   // the block's comment views the moved buffer
+  letters_ |= extra_letters;
+  const std::size_t depth = st_.frames.size();
+  block_.clear();
+  block_.o_type = OWord::Call;
+  block_.o_name = name;
+  o_call();          // from MDI, a sub neither defined nor on the search path fails here
+  in_mdi_ = false;   // the sub's lines come from its file, also when MDI calls the cycle
+  while (st_.frames.size() > depth) {
+    const LineKind kind = read_block();
+    if (kind == LineKind::ProgramEnd) fail(ErrorCode::MissingProgramEnd, "the program ends inside the subprogram o<{}>", name);
+    if (kind == LineKind::Empty) continue;
+    if (block_.o_type != OWord::None) {
+      control_flow();
+      continue;
+    }
+    if (!st_.control.skipping_to.empty()) continue;
+    apply_assignments();
+    visit(block_);
+  }
+  // rs274 labels the cycle's moves with the N word of the last line it read.
+  canon::BlockOrigin origin = saved.origin;
+  const canon::BlockOrigin& last = out_.origin();
+  origin.n_present = last.n_present;
+  origin.n_length = last.n_length;
+  std::memcpy(origin.n_digits, last.n_digits, sizeof origin.n_digits);
+  block_ = std::move(saved.block);
+  raw_ = std::move(saved.raw);
+  norm_ = std::move(saved.norm);
+  norm_len_ = saved.norm_len;
+  line_ = saved.line;
+  line_file_ = saved.file;
+  line_offset_ = saved.offset;
+  out_.set_origin(origin);
+}
 
 InterpState Engine::snapshot() const {
   InterpState s = st_;

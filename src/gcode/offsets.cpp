@@ -138,6 +138,9 @@ void Engine::convert_modal_0(int code) {
     case 923:
       axis_offsets(code);
       return;
+    case 53:   // G5.3 ends a NURBS before the block's motion (the splines module)
+      if (!run_extension_g(code)) unsupported_g(code, block_.g_position(kGroupNonModal));
+      return;
     default:
       return;   // G4 and G53 are handled in their own steps
   }

@@ -255,8 +255,31 @@ void Output::rigid_tap(canon::SegmentId, const Pose& end, double scale) {
 }
 
 void Output::nurbs_feed(canon::SegmentId, int order, std::span<const canon::NurbsPoint> points) {
+  if (points.empty()) return;
+  const Pose base = view_ != nullptr ? view_->canon_position : Pose{};
+  if (view_ != nullptr) {
+    view_->canon_position[0] = points.back().x;
+    view_->canon_position[1] = points.back().y;
+  }
+  std::span<const canon::NurbsPoint> out = points;
+  if (!identity_map_ || (transform_ && transform_->active())) {
+    // The curve is planar and its control points transform like points (rotation, scaling,
+    // mirroring, axis exchange within XY are affine), but it must stay in the XY plane.
+    if ((axis_map_[0] != Axis::X && axis_map_[0] != Axis::Y) || (axis_map_[1] != Axis::X && axis_map_[1] != Axis::Y))
+      fail(ErrorCode::Unsupported, "the axis map moves this spline out of the XY plane");
+    mapped_points_.assign(points.begin(), points.end());
+    for (canon::NurbsPoint& q : mapped_points_) {
+      Pose p = base;
+      p[0] = q.x;
+      p[1] = q.y;
+      const Pose m = motion_pose(p);
+      q.x = m[0];
+      q.y = m[1];
+    }
+    out = mapped_points_;
+  }
   canon::SegmentId id;
-  if (auto* s = live_motion(id)) s->nurbs_feed(id, order, points);
+  if (auto* s = live_motion(id)) s->nurbs_feed(id, order, out);
 }
 
 void Output::dwell(double seconds) {

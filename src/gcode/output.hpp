@@ -168,6 +168,7 @@ class Output final : public canon::Sink {
   bool queueing_ = false;
   std::vector<Queued> queue_;
   std::vector<Queued> flushing_;
+  std::vector<canon::NurbsPoint> mapped_points_;   ///< control points after transform and axis map
 };
 
 }  // namespace opencnc::gcode

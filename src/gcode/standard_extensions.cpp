@@ -6,6 +6,8 @@
 #include "opencnc/gcode/canned_cycles.hpp"
 #include "opencnc/gcode/probing.hpp"
 #include "opencnc/gcode/threading.hpp"
+#include "opencnc/gcode/lathe_cycles.hpp"
+#include "opencnc/gcode/splines.hpp"
 
 namespace opencnc::gcode {
 
@@ -16,6 +18,8 @@ std::shared_ptr<const Extensions> standard_extensions(Dialect dialect) {
   add_canned_cycles(*ext);
   add_threading(*ext);
   add_probing(*ext);
+  add_splines(*ext);
+  add_lathe_cycles(*ext);
   return ext;
 }
 

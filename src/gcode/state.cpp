@@ -154,6 +154,15 @@ std::uint64_t InterpState::digest() const noexcept {
   hash_comp_move(h, comp.last_first);
   for (double v : {cycle.r, cycle.bottom, cycle.p, cycle.q, cycle.i, cycle.j, cycle.k, cycle.initial_level}) h.f64(v);
   h.flag(cycle.initial_level_valid);
+  h.u64(spline.points.size());
+  for (const canon::NurbsPoint& p : spline.points) {
+    h.f64(p.x);
+    h.f64(p.y);
+    h.f64(p.weight);
+  }
+  h.i64(spline.order);
+  h.f64(spline.g5_i);
+  h.f64(spline.g5_j);
   h.pos(next);
   h.flag(percent_delimited);
   h.flag(ended);

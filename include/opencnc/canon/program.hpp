@@ -28,6 +28,7 @@ enum MoveFlag : std::uint8_t {
   kInverseTime = 1u << 0,      ///< feed is 1/minutes for this move (G93)
   kPerRevolution = 1u << 1,    ///< feed is per spindle revolution (G95)
   kSpindleSynced = 1u << 2,    ///< position locked to the spindle (G33, G76, G33.1)
+  kCurveChord = 1u << 3,       ///< a chord of a spline (NURBS_FEED) split by ProgramBuilder
 };
 
 /// One motion, 16 bytes. The end pose is stored separately (Program::end()); the start is
@@ -127,6 +128,16 @@ class Program {
   const std::string& text(std::uint32_t index) const { return texts_.at(index); }
   const Pose& action_pose(std::uint32_t index) const { return action_poses_.at(index); }
 
+  /// Segment ids and move indices. The interpreter numbers its motions (segment ids, what
+  /// replay and breakpoints use); the program numbers its moves. They differ where one
+  /// segment became several moves (a spline split into chords) and by the id of the first
+  /// move (replay to segment k starts at k). Both are O(log e), e = number of split segments.
+  SegmentId segment_of(std::size_t move) const noexcept;
+  /// First move of segment `segment` (moves of a split segment follow it in order).
+  std::size_t first_move_of(SegmentId segment) const noexcept;
+  /// Number of moves segment `segment` became (1 unless it was split).
+  std::size_t moves_of(SegmentId segment) const noexcept;
+
   const SourceMap& sources() const noexcept { return *sources_; }
   std::shared_ptr<const SourceMap> sources_ptr() const noexcept { return sources_; }
   /// Source file index of a move (the body file of its context, or the main file).
@@ -144,6 +155,11 @@ class Program {
   void add_action(const Action& a) { actions_.push_back(a); }
   std::uint32_t add_text(std::string s);
   std::uint32_t add_action_pose(const Pose& p);
+  /// The segment id of the first move (default 0).
+  void set_first_segment(SegmentId id) noexcept { first_segment_ = id; }
+  /// Segment `segment` was appended as `moves` moves starting at move index `first_move`
+  /// (call in segment order, after appending them).
+  void note_split(SegmentId segment, std::size_t first_move, std::size_t moves);
 
  private:
   AxisMask axes_;
@@ -159,6 +175,16 @@ class Program {
   std::vector<std::string> texts_;
   std::vector<Pose> action_poses_;
   std::shared_ptr<const SourceMap> sources_;
+  // A segment split into several moves; `extra` counts the moves added by it and all splits
+  // before it, so that later ids map by subtraction.
+  struct Split {
+    SegmentId segment;
+    std::size_t first_move;
+    std::size_t moves;
+    std::size_t extra;
+  };
+  std::vector<Split> splits_;
+  SegmentId first_segment_ = 0;
 };
 
 }  // namespace opencnc::canon

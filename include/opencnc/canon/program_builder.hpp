@@ -16,6 +16,9 @@ namespace opencnc::canon {
 /// Non-real-time; one builder per run.
 class ProgramBuilder final : public Sink {
  public:
+  /// Largest distance between a spline and the chords it is split into (0.5 µm).
+  static constexpr double kCurveToleranceMm = 0.0005;
+
   /// `start` is the machine position (mm) the program starts from.
   explicit ProgramBuilder(AxisMask axes = kXyzabc, const Pose& start = {});
 
@@ -39,6 +42,10 @@ class ProgramBuilder final : public Sink {
   void arc_feed(SegmentId id, const ArcFeed& arc) override;
   void straight_probe(SegmentId id, const Pose& end) override;
   void rigid_tap(SegmentId id, const Pose& end, double scale) override;
+  /// A NURBS (G5, G5.1, G5.2/G5.3) becomes feed moves along chords no further than
+  /// kCurveToleranceMm from the curve, flagged kCurveChord, the last ending exactly on the
+  /// curve's end; they all belong to segment `id` (Program::segment_of / first_move_of).
+  void nurbs_feed(SegmentId id, int order, std::span<const NurbsPoint> points) override;
   void dwell(double seconds) override;
 
   void set_feed_rate(double rate) override { feed_ = rate; }
@@ -95,7 +102,7 @@ class ProgramBuilder final : public Sink {
   Action make(ActionKind kind, int index = 0, int index2 = 0, double value = 0) const;
   void simple(ActionKind kind, int index = 0, int index2 = 0) { program_.add_action(make(kind, index, index2)); }
   Pose offset_to_mm(const Pose& offset) const noexcept;
-  void append(MoveKind kind, SegmentId id, const Pose& machine_end, std::uint32_t param);
+  void append(MoveKind kind, SegmentId id, const Pose& machine_end, std::uint32_t param, std::uint8_t extra_flags = 0);
   std::uint32_t current_feed_index();
   std::uint8_t move_flags() const noexcept;
 

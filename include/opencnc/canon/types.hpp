@@ -59,6 +59,7 @@ struct ArcFeed {
 /// A NURBS control point in the XY plane with its weight.
 struct NurbsPoint {
   double x = 0, y = 0, weight = 1;
+  bool operator==(const NurbsPoint&) const = default;
 };
 
 }  // namespace opencnc::canon

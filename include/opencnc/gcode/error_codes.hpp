@@ -99,6 +99,28 @@ namespace opencnc::gcode {
   X(ArcUvwPlane, "gcode.arc-uvw-plane")                                      \
   X(ArcTurnsNotInteger, "gcode.arc-turns-not-integer")                       \
   X(ArcTurnsRange, "gcode.arc-turns-range")                                  \
+  /* lathe cycles (G70-G72) and splines (G5-G5.3) */                         \
+  X(LatheProfileMissing, "gcode.lathe-profile-missing")                      \
+  X(LathePlane, "gcode.lathe-plane")                                         \
+  X(LatheCompensation, "gcode.lathe-comp-on")                                \
+  X(LatheDepth, "gcode.lathe-depth-not-positive")                            \
+  X(LatheWordConflict, "gcode.lathe-profile-word-conflict")                  \
+  X(LatheIncrementalUW, "gcode.lathe-profile-uw-incremental")                \
+  X(LatheArcCentre, "gcode.lathe-profile-arc-centre-missing")                \
+  X(LatheNotMonotonic, "gcode.lathe-profile-not-monotonic")                  \
+  X(LatheParallel, "gcode.lathe-profile-parallel")                           \
+  X(LatheCornerFinish, "gcode.lathe-corner-finish")                          \
+  X(LatheLostProfile, "gcode.lathe-profile-lost")                            \
+  X(LatheNoProgress, "gcode.lathe-no-progress")                              \
+  X(SplinePlane, "gcode.spline-plane")                                       \
+  X(SplineAxes, "gcode.spline-axes")                                         \
+  X(SplineCompensation, "gcode.spline-comp-on")                              \
+  X(SplineWords, "gcode.spline-words-missing")                               \
+  X(NurbsPoint, "gcode.nurbs-point-xy")                                      \
+  X(NurbsWeight, "gcode.nurbs-weight")                                       \
+  X(NurbsNotStarted, "gcode.nurbs-not-started")                              \
+  X(NurbsTooFewPoints, "gcode.nurbs-too-few-points")                         \
+  X(NurbsBlockCodes, "gcode.nurbs-block-codes")                              \
   /* tools */                                                                \
   X(ToolNotFound, "gcode.tool-not-found")                                    \
   X(ToolNegative, "gcode.tool-negative")                                     \

@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -49,6 +50,21 @@ class ExecContext {
   /// LinuxCNC's rules: R or I/J/K words of the active plane, P turns, its tolerances and
   /// errors. In inverse-time mode it also sets the feed rate for that arc.
   virtual ArcCentre arc_centre(const Block& block, int motion, const Pose& start, const Pose& end) = 0;
+  /// The core's G0, G1, G2 or G3 (`motion` 0, 10, 20, 30) with the words of `words`, as if a
+  /// block had programmed them under the current modes: the core's checks (feed rate, arc
+  /// centre and radius, inverse time), end points by the distance modes, and the motion
+  /// stage while compensation is on. LinuxCNC's G70-G72 make their moves this way.
+  virtual void programmed_move(int motion, const Block& words) = 0;
+  /// Reads subprogram `name` the way LinuxCNC's G70-G72 read their profile: the sub is called,
+  /// its O-word lines run (loops, conditions, nested calls) and parameter assignments take
+  /// effect, and every other block is parsed and checked, then handed to `visit` instead of
+  /// being executed. Returns when the sub returns; reading then goes on after the current
+  /// block. `extra_letters` (bit letter - 'a') are letter words accepted while reading
+  /// whatever the machine's axes (LinuxCNC reads A, C, U and W there). Afterwards the output
+  /// belongs to the current block again, with the N label of the last line read (as rs274
+  /// prints it); `block` passed to the handler is valid again.
+  virtual void read_subprogram(const std::string& name, std::uint32_t extra_letters,
+                               const std::function<void(const Block&)>& visit) = 0;
   /// LinuxCNC keeps a queue of canonical calls while cutter compensation is on so that a
   /// move's end can still be changed; open it, then flush it when the moves are final.
   virtual void open_queue() = 0;

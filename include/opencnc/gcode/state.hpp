@@ -194,6 +194,17 @@ struct CompState {
   bool operator==(const CompState&) const = default;
 };
 
+/// Spline state kept between blocks: the G5.2 control points collected so far (the first is
+/// where the curve starts; LinuxCNC keeps them, stale ones included, until the next G5.2
+/// sequence or G5.3) and the first control offset a G5 without I/J uses (minus the last
+/// G5's P and Q).
+struct SplineState {
+  std::vector<canon::NurbsPoint> points;
+  int order = 3;
+  double g5_i = 0, g5_j = 0;
+  bool operator==(const SplineState&) const = default;
+};
+
 /// The exact interpreter state. Returned by Interpreter::state(); compare with == or by
 /// digest(). Non-real-time (holds strings and maps); cheap enough to take per block.
 struct InterpState {
@@ -206,6 +217,7 @@ struct InterpState {
   ControlState control;
   CompState comp;                                      ///< cutter compensation's held moves
   CycleState cycle;
+  SplineState spline;
   SourcePosition next;                                 ///< next line to read
   bool percent_delimited = false;                      ///< file started with '%'
   bool ended = false;                                  ///< M2/M30 or closing '%' reached
