@@ -2,6 +2,7 @@
 // Block consistency rules applied after reading, before anything executes (LinuxCNC's
 // enhance_block and check_items): which motion the block performs and which words are used.
 #include <cmath>
+#include <optional>
 
 #include "engine.hpp"
 #include "numeric.hpp"
@@ -32,7 +33,9 @@ void Engine::enhance_block() {
   const bool ijk = b.has('i') || b.has('j') || b.has('k');
   const int mode0 = b.g[kGroupNonModal];
   const int mode1 = b.g[kGroupMotion];
-  const bool covets = mode0 == 100 || mode0 == 280 || mode0 == 300 || mode0 == 520 || mode0 == 920;
+  bool extension_axes = false;
+  extension_words(extension_axes);
+  const bool covets = mode0 == 100 || mode0 == 280 || mode0 == 300 || mode0 == 520 || mode0 == 920 || extension_axes;
   if (mode1 != -1) {
     if (mode1 == 800) {
       if ((polar || axis) && !covets) fail(ErrorCode::AxisWordsWithG80, "axis words with G80 and no G code that uses them");
@@ -69,6 +72,22 @@ void Engine::check_block() {
   if (block_.motion != block_.g[kGroupMotion]) check_extension(block_.motion);
 }
 
+// The words that extension codes of the block take (their Traits), and whether one of them
+// takes the axis words as its data.
+std::uint32_t Engine::extension_words(bool& axis_words) const {
+  axis_words = false;
+  if (ext_ == nullptr) return 0;
+  std::uint32_t words = 0;
+  for (int group = kGroupScaling; group < kGGroupCount; ++group) {
+    const int code = block_.g[static_cast<std::size_t>(group)];
+    if (code < 0 || !ext_->g[static_cast<std::size_t>(code)]) continue;
+    const CodeHandler::Traits t = ext_->g[static_cast<std::size_t>(code)]->traits(code);
+    words |= t.words;
+    axis_words = axis_words || t.axis_words;
+  }
+  return words;
+}
+
 void Engine::check_extension(int code) {
   if (code < 0 || !ext_->g[static_cast<std::size_t>(code)]) return;
   if (auto problem = ext_->g[static_cast<std::size_t>(code)]->check(block_, code, st_))
@@ -101,7 +120,15 @@ void Engine::check_g_codes() {
 }
 
 void Engine::check_other_codes() {
-  const Block& b = block_;
+  // Words that extension codes take are theirs to check: the rules see the block without them.
+  bool extension_axes = false;
+  const std::uint32_t claimed = extension_words(extension_axes);
+  std::optional<Block> without_claimed;
+  if (claimed != 0) {
+    without_claimed.emplace(block_);
+    without_claimed->words &= ~claimed;
+  }
+  const Block& b = without_claimed ? *without_claimed : block_;
   const int motion = b.motion;
   const int m5 = b.m[kGroupIo], m6 = b.m[kGroupToolChange], m7 = b.m[kGroupSpindle], m9 = b.m[kGroupOverride];
   const int g0 = b.g[kGroupNonModal], g7 = b.g[kGroupCutterComp], g8 = b.g[kGroupToolLength];

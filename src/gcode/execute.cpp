@@ -61,6 +61,11 @@ void Engine::convert_g() {
   if (b.g[kGroupDistance] != -1) set_distance_mode(b.g[kGroupDistance]);
   if (b.g[kGroupIjkDistance] != -1) set_ijk_mode(b.g[kGroupIjkDistance]);
   if (b.g[kGroupRetract] != -1) set_retract_mode(b.g[kGroupRetract]);
+  // Codes only extensions know (Fanuc mirroring, scaling, rotation), in Fanuc's order.
+  for (int group : {kGroupMirror, kGroupScaling, kGroupRotation}) {
+    const int code = b.g[static_cast<std::size_t>(group)];
+    if (code != -1 && !run_extension_g(code)) unsupported_g(code);
+  }
   if (b.g[kGroupNonModal] != -1) convert_modal_0(b.g[kGroupNonModal]);
   if (b.motion != -1) convert_motion(b.motion);
 }

@@ -326,6 +326,19 @@ void Engine::convert_overrides() {
 void Engine::convert_stop() {
   const int m = block_.m[kGroupStop];
   if (run_extension_m(m)) return;
+  if (fanuc() && m == 98) {   // after the block's motion, as Fanuc calls
+    const int p = round_to_int(fanuc_p_);
+    if (p < 1) fail(ErrorCode::MissingWord, "M98 needs P (the program number)");
+    // More than four digits: the Fanuc 0 form P<count><program>, e.g. P0031002.
+    if (p > 9999 && fanuc_l_ >= 0) fail(ErrorCode::BadWordValue, "M98 P{} already holds a repeat count: no L with it", p);
+    const int count = p > 9999 ? p / 10000 : (fanuc_l_ >= 0 ? round_to_int(fanuc_l_) : 1);
+    fanuc_call(static_cast<std::uint32_t>(p > 9999 ? p % 10000 : p), count, false);
+    return;
+  }
+  if (fanuc() && m == 99) {
+    fanuc_return();
+    return;
+  }
   if (st_.modal.cutter_comp != CutterComp::Off && ext_ != nullptr && ext_->compensator)
     ext_->compensator->finish(*this);
   switch (m) {

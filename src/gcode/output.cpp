@@ -75,7 +75,7 @@ void Output::map_arc(canon::ArcFeed& arc) const {
 }
 
 Pose Output::motion_pose(const Pose& p) const {
-  if (transform_ && transform_->active()) return map_pose(transform_->point(p));
+  if (transforming()) return map_pose(transform_->point(*state_, p));
   return map_pose(p);
 }
 
@@ -206,7 +206,7 @@ void Output::arc_feed(canon::SegmentId, const canon::ArcFeed& arc) {
     return;
   }
   canon::ArcFeed a = arc;
-  if (transform_ && transform_->active()) transform_->arc(a);
+  if (transforming()) transform_->arc(*state_, a);
   map_arc(a);
   canon::SegmentId id;
   if (auto* s = live_motion(id)) s->arc_feed(id, a);

@@ -2,11 +2,13 @@
 // Registers the interpreter modules: one line per module, in the order they take effect.
 #include "opencnc/gcode/standard_extensions.hpp"
 
+#include "fanuc_codes.hpp"
+
 namespace opencnc::gcode {
 
 std::shared_ptr<const Extensions> standard_extensions(Dialect dialect) {
   auto ext = std::make_shared<Extensions>();
-  (void)dialect;
+  if (dialect == Dialect::Fanuc) add_fanuc_codes(*ext);
   return ext;
 }
 

@@ -3,6 +3,7 @@
 #include "opencnc/gcode/state.hpp"
 
 #include <bit>
+#include <bitset>
 #include <cstring>
 #include <string_view>
 
@@ -99,6 +100,44 @@ void hash_saved(Fnv& h, const SavedContext& s) noexcept {
   h.f64(s.speed);
 }
 
+void hash_transform(Fnv& h, const TransformState& t) noexcept {
+  h.u64(t.mirror_axes);
+  h.pose(t.mirror_at);
+  h.flag(t.scaling);
+  h.pose(t.scale_centre);
+  for (double v : t.scale) h.f64(v);
+  h.flag(t.rotating);
+  h.u64(static_cast<std::uint64_t>(t.rotation_plane));
+  h.f64(t.rotation_centre1);
+  h.f64(t.rotation_centre2);
+  h.f64(t.rotation_deg);
+}
+
+template <std::size_t N>
+void hash_bits(Fnv& h, const std::bitset<N>& b) noexcept {
+  for (std::size_t i = 0; i < N; i += 64) {
+    std::uint64_t word = 0;
+    for (std::size_t k = 0; k < 64 && i + k < N; ++k) word |= static_cast<std::uint64_t>(b[i + k]) << k;
+    h.u64(word);
+  }
+}
+
+void hash_fanuc_frame(Fnv& h, const FanucFrame& f) noexcept {
+  h.pos(f.body);
+  h.u64(f.program);
+  h.u64(f.repeats_left);
+  h.flag(f.macro);
+  h.flag(f.started);
+  for (double v : f.saved_locals) h.f64(v);
+  hash_bits(h, f.saved_vacant);
+  h.u64(f.loops.size());
+  for (const FanucLoop& l : f.loops) {
+    h.i64(l.id);
+    h.pos(l.start);
+    h.pos(l.after_end);
+  }
+}
+
 }  // namespace
 
 std::uint64_t InterpState::digest() const noexcept {
@@ -125,6 +164,7 @@ std::uint64_t InterpState::digest() const noexcept {
     h.pos(f.return_to);
     h.u64(f.context);
     hash_saved(h, f.saved);
+    hash_fanuc_frame(h, f.fanuc);
   }
   h.u64(control.labels.size());
   for (const auto& [name, l] : control.labels) {
@@ -140,6 +180,9 @@ std::uint64_t InterpState::digest() const noexcept {
   h.str(control.defining_name);
   for (bool b : {control.executed_if, control.doing_break, control.doing_continue, control.value_returned}) h.flag(b);
   h.f64(control.return_value);
+  hash_transform(h, fanuc.transform);
+  hash_bits(h, fanuc.vacant);
+  h.f64(fanuc.spindle_clamp_rpm);
   h.pos(next);
   h.flag(percent_delimited);
   h.flag(ended);

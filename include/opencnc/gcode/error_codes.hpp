@@ -95,6 +95,25 @@ namespace opencnc::gcode {
   X(CallDepth, "gcode.call-depth")                                           \
   X(ContextRestore, "gcode.context-restore")                                 \
   X(Abort, "gcode.abort")                                                    \
+  X(AxisNotAvailable, "gcode.axis-not-available")                           \
+  /* Fanuc dialect and coordinate transforms */                              \
+  X(FanucGotoTargetMissing, "fanuc.goto-target-missing")                     \
+  X(FanucEndWithoutDo, "fanuc.end-without-do")                               \
+  X(FanucDoWithoutEnd, "fanuc.do-without-end")                               \
+  X(FanucLoopStructure, "fanuc.loop-structure")                              \
+  X(FanucIfSyntax, "fanuc.if-syntax")                                        \
+  X(FanucProgramNotFound, "fanuc.program-not-found")                         \
+  X(FanucProgramEndMissing, "fanuc.program-end-missing")                     \
+  X(FanucReadOnlyVariable, "fanuc.read-only-variable")                       \
+  X(FanucVariableUnavailable, "fanuc.variable-unavailable")                  \
+  X(FanucAlarm, "fanuc.alarm")                                               \
+  X(FanucMirrorAxesMissing, "fanuc.mirror-axes-missing")                     \
+  X(FanucScaleZero, "fanuc.scale-zero")                                      \
+  X(FanucRotationPlaneChange, "fanuc.rotation-plane-change")                 \
+  X(FanucArcNonUniformScale, "fanuc.arc-nonuniform-scale")                   \
+  X(FanucTransformActive, "fanuc.transform-active")                          \
+  /* other controllers' syntax */                                            \
+  X(DialectUnsupported, "dialect.unsupported")                               \
   /* runaway protection */                                                   \
   X(LimitBlocks, "gcode.limit-blocks")                                       \
   X(LimitLoopIterations, "gcode.limit-loop-iterations")                      \

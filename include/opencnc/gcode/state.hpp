@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <bitset>
 #include <cstdint>
 #include <map>
 #include <string>
@@ -114,6 +115,60 @@ struct SavedContext {
   bool operator==(const SavedContext&) const = default;
 };
 
+/// Fanuc coordinate transforms (G51.1 mirroring, G51 scaling, G68 rotation). Motion passes
+/// through them in Fanuc's order, mirror then scale then rotate, each about a centre fixed in
+/// that stage's input coordinates when it was programmed (docs/dialects.md).
+struct TransformState {
+  std::uint16_t mirror_axes = 0;   ///< bit per axis (Axis order) mirrored by G51.1
+  Pose mirror_at{};                ///< the mirror line (coordinate) of each mirrored axis
+  bool scaling = false;            ///< G51
+  Pose scale_centre{};
+  std::array<double, 3> scale{1.0, 1.0, 1.0};   ///< X Y Z factors (negative mirrors)
+  bool rotating = false;           ///< G68
+  canon::Plane rotation_plane = canon::Plane::XY;
+  double rotation_centre1 = 0;     ///< centre in the plane's first and second axis
+  double rotation_centre2 = 0;
+  double rotation_deg = 0;         ///< counterclockwise from the first axis toward the second
+  bool active() const noexcept { return mirror_axes != 0 || scaling || rotating; }
+  bool operator==(const TransformState&) const = default;
+};
+
+/// A Fanuc WHILE/DO loop being run: its DO number, where its WHILE (or DO) line starts and
+/// where reading continues after its END line.
+struct FanucLoop {
+  int id = 0;
+  SourcePosition start;
+  SourcePosition after_end;
+  bool operator==(const FanucLoop&) const = default;
+};
+
+inline constexpr int kFanucLocalCount = 33;   ///< #1..#33, local to a G65 macro level
+
+/// The Fanuc dialect's part of one call level (the main program or an M98/G65 call).
+struct FanucFrame {
+  SourcePosition body;              ///< start of the program (its O line, or the file start)
+  std::uint32_t program = 0;        ///< its O number (0: the main program without one)
+  std::uint32_t repeats_left = 0;   ///< M98/G65 L: runs still to come after this one
+  bool macro = false;               ///< G65: own local variables #1..#33
+  bool started = false;             ///< a block other than its O line has run
+  std::array<double, kFanucLocalCount> saved_locals{};   ///< G65: the caller's #1..#33
+  std::bitset<kFanucLocalCount + 1> saved_vacant;         ///< ... and which were vacant
+  std::vector<FanucLoop> loops;     ///< DO loops running at this level, innermost last
+  bool operator==(const FanucFrame&) const = default;
+};
+
+inline constexpr int kFanucVariableCount = 1000;   ///< #0..#999 can be vacant
+
+/// The Fanuc dialect's program-wide state.
+struct FanucState {
+  TransformState transform;
+  /// Macro variables without a value (Fanuc's <vacant>): #0 always, #1..#33 and #100..#999
+  /// until assigned. Vacant reads as 0 in arithmetic (docs/dialects.md).
+  std::bitset<kFanucVariableCount> vacant;
+  double spindle_clamp_rpm = 0;     ///< G50 S / G92 S: highest spindle speed (0: none)
+  bool operator==(const FanucState&) const = default;
+};
+
 /// One level of the subprogram call stack.
 struct CallFrame {
   std::string sub;                                 ///< name of the running subprogram
@@ -122,6 +177,7 @@ struct CallFrame {
   SourcePosition return_to;                        ///< where the caller continues
   std::uint32_t context = 0;                       ///< SourceMap context of this level
   SavedContext saved;
+  FanucFrame fanuc;                                ///< Fanuc dialect only
   bool operator==(const CallFrame&) const = default;
 };
 
@@ -161,6 +217,7 @@ struct InterpState {
   NamedParameters globals;                             ///< #<_name>
   std::vector<CallFrame> frames;                       ///< [0] = main program
   ControlState control;
+  FanucState fanuc;                                    ///< Fanuc dialect only
   SourcePosition next;                                 ///< next line to read
   bool percent_delimited = false;                      ///< file started with '%'
   bool ended = false;                                  ///< M2/M30 or closing '%' reached
