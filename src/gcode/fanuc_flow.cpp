@@ -5,6 +5,8 @@
 // lines; FanucIndex says where a program's sequence numbers and loop ends are.
 #include <fmt/format.h>
 
+#include <cstdlib>
+
 #include "engine.hpp"
 #include "numeric.hpp"
 
@@ -12,10 +14,12 @@ namespace opencnc::gcode {
 
 void Engine::fanuc_start() {
   if (opt_.machine != MachineKind::Lathe) return;
-  // Fanuc lathes work in the ZX plane and read X as a diameter from the start.
+  // Fanuc lathes start in the ZX plane, with X as a diameter and feed per revolution (G99).
   st_.modal.plane = canon::Plane::XZ;
   out_.select_plane(canon::Plane::XZ);
   st_.modal.lathe_diameter = true;
+  st_.modal.feed_mode = canon::FeedMode::UnitsPerRevolution;
+  out_.set_feed_mode(0, canon::FeedMode::UnitsPerRevolution);
 }
 
 std::string Engine::fanuc_program_name(const FanucFrame& f) const {
@@ -41,11 +45,12 @@ void Engine::fanuc_end_of_file() {
 // next program, which the running one must not fall into.
 void Engine::fanuc_program_line() {
   FanucFrame& f = st_.frames.back().fanuc;
+  const auto number = static_cast<std::uint32_t>(std::strtoul(block_.o_name.c_str(), nullptr, 10));
   if (!f.started) {
-    if (st_.frames.size() == 1) f.program = static_cast<std::uint32_t>(std::stoul(block_.o_name));
+    if (st_.frames.size() == 1) f.program = number;
     return;
   }
-  fail(ErrorCode::FanucProgramEndMissing, "O{} starts the next program: {} ends without M30, M02 or M99", block_.o_name,
+  fail(ErrorCode::FanucProgramEndMissing, "O{:04} starts the next program: {} ends without M30, M02 or M99", number,
        fanuc_program_name(f));
 }
 
@@ -74,14 +79,14 @@ SourcePosition Engine::fanuc_sequence(const SourcePosition& program_start, std::
     for (const CallFrame& c : st_.frames) {
       if (c.fanuc.body == program_start) owner = &c.fanuc;
     }
-    fail(ErrorCode::FanucGotoTargetMissing, "{} {}: no block is numbered N{} in {}", what, n, n,
+    fail(ErrorCode::FanucGotoTargetMissing, "{}{}: no block is numbered N{} in {}", what, n, n,
          owner != nullptr ? fanuc_program_name(*owner) : std::string("the program"));
   }
   return it->second;
 }
 
 void Engine::fanuc_goto(std::int64_t n) {
-  const SourcePosition to = fanuc_sequence(st_.frames.back().fanuc.body, n, "GOTO");
+  const SourcePosition to = fanuc_sequence(st_.frames.back().fanuc.body, n, "GOTO ");
   // Loops the jump leaves are over (GOTO may leave loops, not enter them).
   auto& loops = st_.frames.back().fanuc.loops;
   while (!loops.empty() && !(loops.back().start.offset <= to.offset && to.offset < loops.back().after_end.offset))
@@ -217,6 +222,7 @@ void Engine::fanuc_return() {
 // file, or a file O<program>.nc on the subroutine path.
 SourcePosition Engine::fanuc_find_program(std::uint32_t program) {
   for (const std::uint32_t file : {line_file_, st_.frames.front().fanuc.body.file}) {
+    if (file >= files_.size() || (in_mdi_file_ && file == mdi_file_)) continue;   // MDI lines: no file
     const auto& programs = fanuc_index_.programs(file, source_at(file));
     need_seek_ = true;
     for (const FanucIndex::Program& p : programs) {
