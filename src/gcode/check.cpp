@@ -33,16 +33,16 @@ void Engine::enhance_block() {
   const bool ijk = b.has('i') || b.has('j') || b.has('k');
   const int mode0 = b.g[kGroupNonModal];
   const int mode1 = b.g[kGroupMotion];
-  bool extension_axes = false;
-  extension_words(extension_axes);
-  const bool covets = mode0 == 100 || mode0 == 280 || mode0 == 300 || mode0 == 520 || mode0 == 920 || extension_axes;
+  const ExtensionClaims claims = extension_claims();
+  const bool covets = mode0 == 100 || mode0 == 280 || mode0 == 300 || mode0 == 520 || mode0 == 920 || claims.axis_words;
   if (mode1 != -1) {
     if (mode1 == 800) {
       if ((polar || axis) && !covets) fail(ErrorCode::AxisWordsWithG80, "axis words with G80 and no G code that uses them");
       if (polar && mode0 == 920) fail(ErrorCode::PolarCoordinates, "polar coordinates are for motion only");
       if (!axis && (mode0 == 520 || mode0 == 920)) fail(ErrorCode::AxisWordsMissing, "G52 and G92 need at least one axis word");
-    } else if (is_lathe_cycle(mode1)) {
-      // G70-G72 take their profile from other blocks; their words are checked by the cycle.
+    } else if (is_lathe_cycle(mode1) || claims.all_words) {
+      // G70-G72 take their profile from other blocks; their words are checked by the cycle
+      // (so are those of an extension's cycle that checks its own).
     } else {
       if (covets) fail(ErrorCode::TwoAxisGCodes, "two G codes in the block both use the axis words");
       if (!axis && !polar && mode1 != 0 && mode1 != 10 && mode1 != 20 && mode1 != 30 && mode1 != 52)
@@ -72,20 +72,22 @@ void Engine::check_block() {
   if (block_.motion != block_.g[kGroupMotion]) check_extension(block_.motion);
 }
 
-// The words that extension codes of the block take (their Traits), and whether one of them
-// takes the axis words as its data.
-std::uint32_t Engine::extension_words(bool& axis_words) const {
-  axis_words = false;
-  if (ext_ == nullptr) return 0;
-  std::uint32_t words = 0;
-  for (int group = kGroupScaling; group < kGGroupCount; ++group) {
-    const int code = block_.g[static_cast<std::size_t>(group)];
-    if (code < 0 || !ext_->g[static_cast<std::size_t>(code)]) continue;
+// What the extension codes of the block claim (their Traits): words they take, the axis
+// words as their data, or all of their block's words. The motion code and the codes of the
+// groups only extensions know are asked.
+Engine::ExtensionClaims Engine::extension_claims() const {
+  ExtensionClaims claims;
+  if (ext_ == nullptr) return claims;
+  auto ask = [&](int code) {
+    if (code < 0 || !ext_->g[static_cast<std::size_t>(code)]) return;
     const CodeHandler::Traits t = ext_->g[static_cast<std::size_t>(code)]->traits(code);
-    words |= t.words;
-    axis_words = axis_words || t.axis_words;
-  }
-  return words;
+    claims.words |= t.words;
+    claims.axis_words = claims.axis_words || t.axis_words;
+    claims.all_words = claims.all_words || t.all_words;
+  };
+  for (int group = kGroupScaling; group < kGGroupCount; ++group) ask(block_.g[static_cast<std::size_t>(group)]);
+  ask(block_.g[kGroupMotion] != -1 ? block_.g[kGroupMotion] : block_.motion);
+  return claims;
 }
 
 void Engine::check_extension(int code) {
@@ -121,8 +123,9 @@ void Engine::check_g_codes() {
 
 void Engine::check_other_codes() {
   // Words that extension codes take are theirs to check: the rules see the block without them.
-  bool extension_axes = false;
-  const std::uint32_t claimed = extension_words(extension_axes);
+  const ExtensionClaims claims = extension_claims();
+  if (claims.all_words) return;
+  const std::uint32_t claimed = claims.words;
   std::optional<Block> without_claimed;
   if (claimed != 0) {
     without_claimed.emplace(block_);

@@ -100,7 +100,12 @@ class Engine final : public ParamHost, public ExecContext {
   void check_g_codes();
   void check_other_codes();
   void check_extension(int code);
-  std::uint32_t extension_words(bool& axis_words) const;
+  struct ExtensionClaims {
+    std::uint32_t words = 0;
+    bool axis_words = false;
+    bool all_words = false;
+  };
+  ExtensionClaims extension_claims() const;
 
   // execute.cpp: order of execution within a block
   void execute_block();

@@ -10,6 +10,9 @@ namespace opencnc::gcode {
 /// them (transforms.cpp).
 void add_transform_codes(Extensions& ext);
 
+/// The Fanuc lathe cycles of their own: G75 grooving and G76 threading (fanuc_lathe.cpp).
+void add_fanuc_lathe_cycles(Extensions& ext);
+
 /// Everything the Fanuc dialect adds: the transforms, M31 (parts counter) and the machine
 /// builder's M codes (fanuc_codes.cpp).
 void add_fanuc_codes(Extensions& ext);

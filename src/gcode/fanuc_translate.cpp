@@ -98,6 +98,18 @@ void Engine::fanuc_lathe_codes() {
       b.g[kGroupNonModal] = 920;
     }
   }
+  // Fanuc lathe cycles this controller does not have (G-code system A's single cycles and
+  // G73/G74), named rather than run as the mill codes of the same number.
+  const bool axes = b.any_axis() || b.has('u') || b.has('w');
+  const int motion = b.g[kGroupMotion];
+  const int distance = b.g[kGroupDistance], feed = b.g[kGroupFeedMode];
+  const char* missing = motion == 730   ? "G73 (pattern repeating)"
+                        : motion == 740 ? "G74 (face peck drilling)"
+                        : distance == 900 && axes ? "G90 X Z (turning cycle)"
+                        : feed == 940 && axes     ? "G94 X Z (facing cycle)"
+                        : b.g[kGroupNonModal] == 920 && b.has('f') ? "G92 X Z F (threading cycle)"
+                                                                   : nullptr;
+  if (missing != nullptr) fail(ErrorCode::Unsupported, "{} of Fanuc lathes is not supported", missing);
   // G92 S alone (Fanuc system B): the spindle clamp.
   if (b.g[kGroupNonModal] == 920 && b.has('s') && !b.any_axis() && !b.has('u') && !b.has('w')) {
     b.g[kGroupNonModal] = -1;
@@ -119,6 +131,8 @@ void Engine::fanuc_lathe_codes() {
 void Engine::fanuc_lathe_words() {
   Block& b = block_;
   if (b.g[kGroupNonModal] == 40) return;   // G4 U: a dwell time
+  const int motion = b.g[kGroupMotion];
+  if (motion >= 700 && motion <= 730) return;   // G70-G73: U and W are finishing allowances
   const PositionState& s = st_.position;
   const bool middle = st_.modal.cutter_comp != CutterComp::Off && !st_.modal.comp_first_move;
   const std::pair<char, char> pairs[] = {{'u', 'x'}, {'w', 'z'}};

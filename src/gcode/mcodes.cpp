@@ -96,8 +96,11 @@ void Engine::change_tool() {
   if (st_.modal.cutter_comp != CutterComp::Off)
     fail(ErrorCode::ModalContext, "tools cannot be changed while cutter compensation is on");
   out_.start_change();
-  out_.stop_spindle_turning(0);
-  st_.modal.spindle = canon::SpindleDirection::Stopped;
+  // A lathe turret indexes with the spindle turning (the Fanuc dialect's T0101).
+  if (!(fanuc() && opt_.machine == MachineKind::Lathe)) {
+    out_.stop_spindle_turning(0);
+    st_.modal.spindle = canon::SpindleDirection::Stopped;
+  }
   out_.change_tool(st_.tool.selected_index);
   load_spindle(st_.tool.selected_index);
   SyncValues assumed;

@@ -181,6 +181,11 @@ std::uint64_t InterpState::digest() const noexcept {
   for (bool b : {control.executed_if, control.doing_break, control.doing_continue, control.value_returned}) h.flag(b);
   h.f64(control.return_value);
   hash_transform(h, fanuc.transform);
+  for (double v : {fanuc.cycles.rough_depth, fanuc.cycles.rough_retract, fanuc.cycles.groove_retract,
+                   fanuc.cycles.thread_chamfer, fanuc.cycles.thread_angle_deg, fanuc.cycles.thread_min_depth,
+                   fanuc.cycles.thread_allowance})
+    h.f64(v);
+  h.i64(fanuc.cycles.thread_finish_passes);
   hash_bits(h, fanuc.vacant);
   h.f64(fanuc.spindle_clamp_rpm);
   h.pos(next);

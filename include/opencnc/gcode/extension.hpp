@@ -73,12 +73,15 @@ class CodeHandler {
 
   /// What the core needs to read a code it does not know itself (a dialect's own codes, such
   /// as Fanuc's G68): its modal group (GGroup or MGroup; -1 = unknown), the letter words it
-  /// takes (bit letter - 'a'; the core's rules for unused words skip them) and whether the
-  /// block's axis words are its data (as for G92) rather than a motion.
+  /// takes (bit letter - 'a'; the core's rules for unused words skip them), whether the
+  /// block's axis words are its data (as for G92) rather than a motion, and whether the
+  /// handler checks all of its block's words itself (the core's word and axis rules are
+  /// skipped, as for a dialect's own version of a cycle the core knows, such as Fanuc's G76).
   struct Traits {
     int group = -1;
     std::uint32_t words = 0;
     bool axis_words = false;
+    bool all_words = false;
   };
   virtual Traits traits(int /*code*/) const { return {}; }
 };

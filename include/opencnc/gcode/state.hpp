@@ -159,9 +159,23 @@ struct FanucFrame {
 
 inline constexpr int kFanucVariableCount = 1000;   ///< #0..#999 can be vacant
 
+/// What the first block of a Fanuc two-block lathe cycle sets for the blocks after it.
+struct FanucCycleSettings {
+  double rough_depth = 0;        ///< G71 U(d) / G72 W(d): depth of cut (0: not set)
+  double rough_retract = 0;      ///< G71/G72 R(e): retract after each cut
+  double groove_retract = 0;     ///< G75 R(e): retract after each peck (0: not set)
+  int thread_finish_passes = 1;  ///< G76 P(m): finishing passes
+  double thread_chamfer = 0;     ///< G76 P(r): pull-out length in tenths of the lead
+  double thread_angle_deg = 60;  ///< G76 P(a): tool angle (infeed along half of it)
+  double thread_min_depth = 0;   ///< G76 Q(dmin): smallest depth of cut
+  double thread_allowance = 0;   ///< G76 R(d): finishing allowance
+  bool operator==(const FanucCycleSettings&) const = default;
+};
+
 /// The Fanuc dialect's program-wide state.
 struct FanucState {
   TransformState transform;
+  FanucCycleSettings cycles;
   /// Macro variables without a value (Fanuc's <vacant>): #0 always, #1..#33 and #100..#999
   /// until assigned. Vacant reads as 0 in arithmetic (docs/dialects.md).
   std::bitset<kFanucVariableCount> vacant;
