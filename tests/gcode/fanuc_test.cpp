@@ -3,6 +3,7 @@
 // vacancy, system variables, lathe conventions, transforms through the interpreter, replay.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -357,6 +358,55 @@ TEST(FanucCodes, LatheWordsToolsClampAndFeedModes) {
   EXPECT_EQ(rec.feed_modes.back(), canon::FeedMode::UnitsPerMinute);
   EXPECT_EQ(rec.dwells, std::vector<double>{0.5});
   EXPECT_EQ(error_of("O1\nG21 G1 X1 U1 F1\nM30\n", fanuc(MachineKind::Lathe)), "gcode.repeated-word");
+}
+
+TEST(FanucCodes, G76ThreadsWithEqualChipAreaPassesAlongTheFlank) {
+  Recorder rec;
+  const Outcome r = run(rec, "O1\nG21 M3 S500\nG0 X12 Z2\nG76 P010060 Q100 R0.05\nG76 X8 Z-10 P1000 Q400 F1.5\nM30\n",
+                    fanuc(MachineKind::Lathe));
+  ASSERT_EQ(r.status, RunStatus::Finished) << r.message;
+  // Depths 0.4 * sqrt(n) (at least 0.1 more each time) up to 1.0 - 0.05, then one pass at 1.0.
+  const double depths[] = {0.4, 0.4 * std::sqrt(2.0), 0.4 * std::sqrt(3.0), 0.8, 0.9, 0.95, 1.0};   // 0.894 is < 0.1 deeper
+  std::vector<Recorder::Motion> cuts;
+  for (const auto& m : rec.motions) {
+    if (m.kind == 'f') cuts.push_back(m);
+  }
+  ASSERT_EQ(cuts.size(), std::size(depths));
+  for (std::size_t i = 0; i < cuts.size(); ++i) {
+    EXPECT_NEAR(cuts[i].end[Axis::X], 4.0 + (1.0 - depths[i]), 1e-12);   // root radius 4, height 1
+    EXPECT_EQ(cuts[i].end[Axis::Z], -10.0);
+  }
+  // Each pass starts further along Z by depth * tan(30 degrees) (infeed along the flank).
+  std::vector<double> starts;
+  for (std::size_t i = 1; i < rec.motions.size(); ++i) {
+    if (rec.motions[i].kind == 'f') starts.push_back(rec.motions[i - 1].end[Axis::Z]);
+  }
+  EXPECT_NEAR(starts[0], 2.0 - 0.4 * std::tan(3.14159265358979323846 / 6), 1e-12);
+  EXPECT_EQ(rec.motions.back().end[Axis::X], 6.0);   // back at the start point
+  EXPECT_EQ(rec.motions.back().end[Axis::Z], 2.0);
+  EXPECT_EQ(error_of("O1\nG21 G0 X12 Z2\nG76 X8 Z-10 P1000 Q400 F1.5\nM30\n", fanuc(MachineKind::Lathe)),
+            "gcode.spindle-usage");
+  EXPECT_EQ(error_of("O1\nG21 M3 S100 G0 X12 Z2\nG76 X8 Z-10 Q400 F1.5\nM30\n", fanuc(MachineKind::Lathe)),
+            "gcode.missing-word");
+}
+
+TEST(FanucCodes, G75PecksAndStepsAcrossTheGroove) {
+  Recorder rec;
+  const Outcome r = run(rec, "O1\nG21 M3 S500\nG0 X20 Z-2\nG75 R0.5\nG75 X10 Z-8 P2000 Q3000 F0.1\nM30\n",
+                    fanuc(MachineKind::Lathe));
+  ASSERT_EQ(r.status, RunStatus::Finished) << r.message;
+  // Per plunge: pecks of 2 (radius) to 8, 6, then 5, backing off 0.5 between; out to 10.
+  const std::vector<double> plunge = {8, 8.5, 6, 6.5, 5, 10};
+  std::vector<double> expect_x = {10};   // the G0
+  for (int j = 0; j < 3; ++j) {
+    if (j > 0) expect_x.push_back(10);
+    expect_x.insert(expect_x.end(), plunge.begin(), plunge.end());
+  }
+  expect_x.push_back(10);
+  EXPECT_EQ(rec.xs(), expect_x);
+  EXPECT_EQ(rec.zs().back(), -2.0);
+  EXPECT_EQ(rec.motions[8].end[Axis::Z], -5.0);
+  EXPECT_EQ(rec.motions[rec.motions.size() - 3].end[Axis::Z], -8.0);
 }
 
 TEST(FanucCodes, G50IsScalingCancelOnAMill) {
