@@ -84,7 +84,8 @@ void Engine::control_flow() {
     case OWord::Goto:
     case OWord::FanucWhile:
     case OWord::FanucEnd:
-    case OWord::MacroCall: return fanuc_control_flow();
+    case OWord::MacroCall:
+    case OWord::BlockRange: return fanuc_control_flow();
     case OWord::None: return;
   }
 }

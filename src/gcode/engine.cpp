@@ -304,6 +304,7 @@ bool Engine::process_line() {
     if (in_mdi_ && block_.o_type != OWord::Call && block_.o_type != OWord::MacroCall)
       fail(ErrorCode::OWordSyntax, "only subprogram calls can be used in MDI");
     control_flow();
+    if (fanuc() && block_.o_type != OWord::BlockRange) fanuc_block_done();
     if (in_mdi_) finish_mdi_call();
     return true;
   }
@@ -313,6 +314,7 @@ bool Engine::process_line() {
   execute_block();
   if (fanuc()) {
     fanuc_after_block();
+    fanuc_block_done();
     if (in_mdi_) finish_mdi_call();
   }
   if (block_sync_pending_) {

@@ -213,6 +213,8 @@ class Engine final : public ParamHost, public ExecContext {
   void fanuc_while();
   void fanuc_end();
   void fanuc_call(std::uint32_t program, int count, bool macro);
+  void fanuc_range();
+  void fanuc_block_done();
   void fanuc_return();
   SourcePosition fanuc_find_program(std::uint32_t program);
   bool fanuc_program_file(std::uint32_t program, SourcePosition& at);

@@ -60,6 +60,7 @@ void Engine::fanuc_control_flow() {
     case OWord::FanucWhile: return fanuc_while();
     case OWord::FanucEnd: return fanuc_end();
     case OWord::MacroCall: return fanuc_call(static_cast<std::uint32_t>(block_.o_value), block_.repeat, true);
+    case OWord::BlockRange: return fanuc_range();
     default: return;
   }
 }
@@ -173,6 +174,48 @@ void Engine::fanuc_call(std::uint32_t program, int count, bool macro) {
   frame.context = sources_->context(parent, canon::SourceRef{line_file_, line_, 1}, at.file, frame.sub);
   st_.frames.push_back(std::move(frame));
   jump_to(at);
+}
+
+// G70 P Q (finishing): the blocks numbered P to Q of this program run as written (their F,
+// S, T and compensation included), then the tool goes back to where G70 started and the
+// program continues after the G70 block.
+void Engine::fanuc_range() {
+  const FanucFrame& caller = st_.frames.back().fanuc;
+  const auto first = static_cast<std::int64_t>(block_.args[0]), last = static_cast<std::int64_t>(block_.args[1]);
+  const SourcePosition from = fanuc_sequence(caller.body, first, "G70 P");
+  const SourcePosition to = fanuc_sequence(caller.body, last, "G70 Q");
+  if (to.file != from.file || to.offset < from.offset)
+    fail(ErrorCode::FanucGotoTargetMissing, "G70 P{} Q{}: block N{} comes before N{}", first, last, last, first);
+  const auto depth = static_cast<std::uint32_t>(st_.frames.size());
+  const std::uint32_t max_depth = opt_.limits.max_call_depth == 0 ? 10 : opt_.limits.max_call_depth;
+  if (depth >= max_depth) fail(ErrorCode::CallDepth, "G70 nested deeper than {} levels (limit max_call_depth)", max_depth - 1);
+  if ((block_.arg_given & 4u) != 0) {
+    st_.modal.feed_rate = block_.args[2];
+    out_.set_feed_rate(block_.args[2]);
+  }
+  CallFrame frame;
+  frame.sub = "G70";
+  frame.return_to = st_.next;
+  frame.fanuc = FanucFrame{};
+  frame.fanuc.body = caller.body;
+  frame.fanuc.program = caller.program;
+  frame.fanuc.started = true;
+  frame.fanuc.range = true;
+  frame.fanuc.range_end = to;
+  frame.fanuc.range_return = st_.position.current;
+  frame.context = sources_->context(st_.frames.back().context, canon::SourceRef{line_file_, line_, 1}, from.file, "G70");
+  st_.frames.push_back(std::move(frame));
+  jump_to(from);
+}
+
+// After each block: the end of a G70 run.
+void Engine::fanuc_block_done() {
+  if (st_.frames.size() < 2) return;
+  const FanucFrame& f = st_.frames.back().fanuc;
+  if (!f.range || line_file_ != f.range_end.file || line_offset_ != f.range_end.offset) return;
+  emit_straight(true, f.range_return);
+  jump_to(st_.frames.back().return_to);
+  leave_frame();
 }
 
 // M99: the next run of an M98 L / G65 L repeat, or back to the caller (to its block N P with

@@ -44,6 +44,20 @@ void Engine::fanuc_translate() {
     drop_word(b, 'p');
     drop_word(b, 'l');
   }
+  if (opt_.machine == MachineKind::Lathe && b.g[kGroupMotion] == 700) {
+    // G70 P Q [F]: a run of the program's own blocks (fanuc_range).
+    if (!b.has('p') || !b.has('q')) fail(ErrorCode::MissingWord, "G70 needs P and Q (the first and last block numbers of the profile)");
+    b.o_type = OWord::BlockRange;
+    b.args[0] = b.get('p');
+    b.args[1] = b.get('q');
+    if (b.has('f')) {
+      b.args[2] = b.get('f');
+      b.arg_given = 4u;
+    }
+    b.g[kGroupMotion] = -1;
+    b.words = 0;
+    return;
+  }
   if (opt_.machine == MachineKind::Lathe) {
     fanuc_lathe_codes();
     fanuc_lathe_words();

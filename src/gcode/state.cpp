@@ -130,6 +130,9 @@ void hash_fanuc_frame(Fnv& h, const FanucFrame& f) noexcept {
   h.flag(f.started);
   for (double v : f.saved_locals) h.f64(v);
   hash_bits(h, f.saved_vacant);
+  h.flag(f.range);
+  h.pos(f.range_end);
+  h.pose(f.range_return);
   h.u64(f.loops.size());
   for (const FanucLoop& l : f.loops) {
     h.i64(l.id);

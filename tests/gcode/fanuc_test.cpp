@@ -409,6 +409,20 @@ TEST(FanucCodes, G75PecksAndStepsAcrossTheGroove) {
   EXPECT_EQ(rec.motions[rec.motions.size() - 3].end[Axis::Z], -8.0);
 }
 
+TEST(FanucCodes, G70RunsTheProfileBlocksAndReturnsToItsStart) {
+  Recorder rec;
+  const Outcome r = run(rec,
+                    "O1\nG21 M3 S500\nG0 X30 Z2\nG70 P10 Q20 F0.1\nG0 X40\nM30\n"
+                    "N10 G0 X10\nG1 Z-5\nN20 X30 Z-10\n",
+                    fanuc(MachineKind::Lathe));
+  ASSERT_EQ(r.status, RunStatus::Finished) << r.message;
+  EXPECT_EQ(rec.xs(), (std::vector<double>{15, 5, 5, 15, 15, 20}));
+  EXPECT_EQ(rec.zs(), (std::vector<double>{2, 2, -5, -10, 2, 2}));
+  EXPECT_EQ(r.state.modal.feed_rate, 0.0);   // M30 ended it; the profile ran at F0.1
+  EXPECT_EQ(error_of("O1\nG21 G70 P10 Q30\nM30\nN10 G0 X1\n", fanuc(MachineKind::Lathe)), "fanuc.goto-target-missing");
+  EXPECT_EQ(error_of("O1\nG21 G70 P10\nM30\nN10 G0 X1\n", fanuc(MachineKind::Lathe)), "gcode.missing-word");
+}
+
 TEST(FanucCodes, G50IsScalingCancelOnAMill) {
   Recorder rec;
   const Outcome r = run(rec, "O1\nG21 F100\nG51 X0 Y0 P2\nG1 X1 Y1\nG50 S1000\nG1 X1 Y1\nM30\n");

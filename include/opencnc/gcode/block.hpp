@@ -40,6 +40,7 @@ enum class OWord : std::uint8_t {
   FanucWhile,  ///< WHILE [..] DO m, or DO m alone (o_value = condition, loop_id = m)
   FanucEnd,    ///< END m (loop_id = m)
   MacroCall,   ///< G65 P.. L.. with arguments (o_value = program, args by local variable)
+  BlockRange,  ///< Fanuc lathe G70 P Q: run the blocks numbered P to Q (args[0], args[1]; F in args[2])
 };
 
 /// One parsed block. Letter words are stored by letter; integer words (H, L, M, T) are

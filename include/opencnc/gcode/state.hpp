@@ -154,6 +154,9 @@ struct FanucFrame {
   std::array<double, kFanucLocalCount> saved_locals{};   ///< G65: the caller's #1..#33
   std::bitset<kFanucLocalCount + 1> saved_vacant;         ///< ... and which were vacant
   std::vector<FanucLoop> loops;     ///< DO loops running at this level, innermost last
+  bool range = false;               ///< G70: a run of the caller's blocks N P .. N Q
+  SourcePosition range_end;         ///< G70: the block N Q (the run ends after it)
+  Pose range_return{};              ///< G70: where the tool goes back to afterwards
   bool operator==(const FanucFrame&) const = default;
 };
 
