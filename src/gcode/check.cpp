@@ -2,7 +2,6 @@
 // Block consistency rules applied after reading, before anything executes (LinuxCNC's
 // enhance_block and check_items): which motion the block performs and which words are used.
 #include <cmath>
-#include <optional>
 
 #include "engine.hpp"
 #include "numeric.hpp"
@@ -33,7 +32,7 @@ void Engine::enhance_block() {
   const bool ijk = b.has('i') || b.has('j') || b.has('k');
   const int mode0 = b.g[kGroupNonModal];
   const int mode1 = b.g[kGroupMotion];
-  const ExtensionClaims claims = extension_claims();
+  const ExtensionClaims claims = ext_ != nullptr ? extension_claims() : ExtensionClaims{};
   const bool covets = mode0 == 100 || mode0 == 280 || mode0 == 300 || mode0 == 520 || mode0 == 920 || claims.axis_words;
   if (mode1 != -1) {
     if (mode1 == 800) {
@@ -85,7 +84,9 @@ Engine::ExtensionClaims Engine::extension_claims() const {
     claims.axis_words = claims.axis_words || t.axis_words;
     claims.all_words = claims.all_words || t.all_words;
   };
-  for (int group = kGroupScaling; group < kGGroupCount; ++group) ask(block_.g[static_cast<std::size_t>(group)]);
+  if (block_.extension_groups) {
+    for (int group = kGroupScaling; group < kGGroupCount; ++group) ask(block_.g[static_cast<std::size_t>(group)]);
+  }
   ask(block_.g[kGroupMotion] != -1 ? block_.g[kGroupMotion] : block_.motion);
   return claims;
 }
@@ -123,15 +124,19 @@ void Engine::check_g_codes() {
 
 void Engine::check_other_codes() {
   // Words that extension codes take are theirs to check: the rules see the block without them.
-  const ExtensionClaims claims = extension_claims();
-  if (claims.all_words) return;
-  const std::uint32_t claimed = claims.words;
-  std::optional<Block> without_claimed;
-  if (claimed != 0) {
-    without_claimed.emplace(block_);
-    without_claimed->words &= ~claimed;
+  if (ext_ != nullptr) {
+    const ExtensionClaims claims = extension_claims();
+    if (claims.all_words) return;
+    if (claims.words != 0) {
+      Block without_claimed = block_;
+      without_claimed.words &= ~claims.words;
+      return check_word_rules(without_claimed);
+    }
   }
-  const Block& b = without_claimed ? *without_claimed : block_;
+  check_word_rules(block_);
+}
+
+void Engine::check_word_rules(const Block& b) {
   const int motion = b.motion;
   const int m5 = b.m[kGroupIo], m6 = b.m[kGroupToolChange], m7 = b.m[kGroupSpindle], m9 = b.m[kGroupOverride];
   const int g0 = b.g[kGroupNonModal], g7 = b.g[kGroupCutterComp], g8 = b.g[kGroupToolLength];

@@ -71,8 +71,6 @@ void Engine::open_text(std::string name, std::string text) {
   has_program_ = true;
 }
 
-SourceFile& Engine::current_file() { return source_at(st_.next.file); }
-
 SourceFile& Engine::source_at(std::uint32_t file) {
   auto& f = files_.at(file);
   if (!f) {
@@ -284,7 +282,7 @@ bool Engine::process_line() {
     return false;
   }
   if (text.empty() || (text.front() == '/' && opt_.block_delete)) return true;
-  check_foreign_syntax();
+  if (text.front() == '$' || text.front() == '%') check_foreign_syntax();
 
   const bool skipping = !st_.control.skipping_to.empty();
   if (skipping) {

@@ -88,7 +88,10 @@ class Engine final : public ParamHost, public ExecContext {
   void check_motion_habits(bool feed);
   void set_origin_from_line();
   void check_foreign_syntax();
-  SourceFile& current_file();
+  SourceFile& current_file() {
+    const std::uint32_t file = st_.next.file;
+    return file < files_.size() && files_[file] ? *files_[file] : source_at(file);
+  }
   SourceFile& source_at(std::uint32_t file);
   void jump_to(const SourcePosition& pos);
   ParseEnv parse_env() const noexcept;
@@ -99,6 +102,7 @@ class Engine final : public ParamHost, public ExecContext {
   void check_block();
   void check_g_codes();
   void check_other_codes();
+  void check_word_rules(const Block& b);
   void check_extension(int code);
   struct ExtensionClaims {
     std::uint32_t words = 0;
@@ -124,6 +128,7 @@ class Engine final : public ParamHost, public ExecContext {
   void set_cutter_comp(int code);
   bool run_extension_g(int code);
   bool run_extension_m(int code);
+  void convert_extension_groups();
   [[noreturn]] void unsupported_g(int code);
 
   // motion.cpp

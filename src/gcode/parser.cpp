@@ -347,6 +347,7 @@ void Parser::read_g(Cursor& c, Block& b) {
     fail_at(pos, ErrorCode::UnknownGCode, "G{} is not a known G code", code / 10);
   }
   auto& slot = b.g[static_cast<std::size_t>(group)];
+  b.extension_groups = b.extension_groups || group >= kGroupScaling;
   if (code == 800 && slot != -1) return;   // G80 beside another motion code is ignored
   if (slot != -1 && slot != 800) fail_at(pos, ErrorCode::TwoGCodesSameGroup, "two G codes of the same modal group");
   slot = static_cast<std::int16_t>(code);

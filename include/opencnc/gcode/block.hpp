@@ -54,6 +54,7 @@ struct Block {
   int m_count = 0;
   int motion = -1;                          ///< motion to perform (G ×10), -1 = none
   bool n_present = false;
+  bool extension_groups = false;            ///< a code in a group only extensions know (>= kGroupScaling)
   std::int64_t n_number = -1;               ///< the N word's whole number (-1: none or too long)
   std::uint32_t decimal = 0;                ///< Fanuc: bit per letter word written with a decimal point
   std::string_view comment;                 ///< text of the last ( ) comment
@@ -93,6 +94,7 @@ struct Block {
     m_count = 0;
     motion = -1;
     n_present = false;
+    extension_groups = false;
     n_number = -1;
     decimal = 0;
     has_comment = false;
