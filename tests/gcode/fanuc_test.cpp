@@ -181,6 +181,24 @@ TEST(FanucPrograms, SubprogramFilesComeFromTheSearchPath) {
   EXPECT_EQ(error_of("O1\nM98 P46\nM30\n", o), "fanuc.program-not-found");
 }
 
+TEST(FanucPrograms, MdiCallsRunTheirProgramToTheEnd) {
+  TempDir dir;
+  dir.write("O0007.nc", "O0007\nG91 G1 X#1\nG90\nM99\n");
+  Options o = fanuc();
+  o.subroutine_path = {dir.str()};
+  Interpreter interp(o);
+  Recorder rec;
+  EXPECT_EQ(interp.execute_mdi("G21 F100", rec), RunStatus::Ok);
+  EXPECT_EQ(interp.execute_mdi("G65 P7 A2", rec), RunStatus::Ok);
+  EXPECT_EQ(interp.execute_mdi("#1 = 3", rec), RunStatus::Ok);
+  EXPECT_EQ(interp.execute_mdi("M98 P7 L2", rec), RunStatus::Ok);
+  EXPECT_EQ(rec.xs(), (std::vector<double>{2, 5, 8}));
+  EXPECT_EQ(interp.state().frames.size(), 1u);
+  EXPECT_EQ(interp.execute_mdi("GOTO 10", rec), RunStatus::Error);   // flow needs a program
+  EXPECT_EQ(interp.execute_mdi("M98 P8", rec), RunStatus::Error);
+  EXPECT_EQ(interp.execute_mdi("G1 X0", rec), RunStatus::Ok);        // the session goes on
+}
+
 TEST(FanucPrograms, ProgramsMustEndBeforeTheNextOne) {
   EXPECT_EQ(error_of("O1\nG21\nM98 P2\nM30\nO2\nG0 X1\nO3\nM99\n"), "fanuc.program-end-missing");
   EXPECT_EQ(error_of("O1\nG21\nM98 P2\nM30\nO2\nG0 X1\n"), "fanuc.program-end-missing");
