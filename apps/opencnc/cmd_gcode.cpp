@@ -10,6 +10,8 @@
 #include "commands.hpp"
 #include "gcode_summary.hpp"
 #include "opencnc/canon/rs274_printer.hpp"
+#include "opencnc/core/axis_map.hpp"
+#include "opencnc/gcode/dialect.hpp"
 #include "opencnc/gcode/interpreter.hpp"
 #include "opencnc/gcode/standard_extensions.hpp"
 #include "opencnc/gcode/rs274_driver.hpp"
@@ -24,6 +26,9 @@ struct InterpArgs {
   bool block_delete = false;
   bool no_default_tools = false;
   std::string axes = "XYZABC";
+  std::string dialect;    ///< empty: the program's own marker, else LinuxCNC
+  std::string machine;    ///< empty: guessed from a Fanuc program
+  std::string axis_map;
 };
 
 void add_interp_options(CLI::App* cmd, InterpArgs& a) {
@@ -34,6 +39,12 @@ void add_interp_options(CLI::App* cmd, InterpArgs& a) {
   cmd->add_option("--axes", a.axes, "axes of the machine (default XYZABC, as rs274)");
   cmd->add_flag("--no-default-tools", a.no_default_tools,
                 "without --tool-table, use an empty table instead of rs274's built-in tools T1-T3");
+  cmd->add_option("--dialect", a.dialect,
+                  "linuxcnc or fanuc (default: the program's '(dialect: ...)' comment, else linuxcnc)")
+      ->check(CLI::IsMember({"linuxcnc", "fanuc"}, CLI::ignore_case));
+  cmd->add_option("--machine", a.machine, "mill or lathe, for Fanuc programs (default: guessed from the program's axis words)")
+      ->check(CLI::IsMember({"mill", "lathe"}, CLI::ignore_case));
+  cmd->add_option("--axis-map", a.axis_map, "axis exchange, program letter = machine axis (e.g. X=Y,Y=X)");
 }
 
 // rs274's built-in tool table (used when it is given no -t): tools 1..3, lengths and
@@ -53,9 +64,18 @@ std::shared_ptr<tools::ToolTable> rs274_default_tools() {
   return t;
 }
 
-// Builds interpreter options; returns false (after printing why) on a bad tool table.
-bool make_options(const InterpArgs& a, gcode::Options& o) {
+// Builds interpreter options for `file`; returns false (after printing why) on a bad tool
+// table or axis map.
+bool make_options(const InterpArgs& a, const std::string& file, gcode::Options& o) {
   o.axes = AxisMask::from_letters(a.axes);
+  o.dialect = a.dialect.empty() ? gcode::dialect_marker(file).value_or(gcode::Dialect::LinuxCnc)
+                                : *gcode::dialect_from_name(a.dialect);
+  if (!a.machine.empty()) o.machine = *gcode::machine_kind_from_name(a.machine);
+  else if (o.dialect == gcode::Dialect::Fanuc) o.machine = gcode::guess_machine_kind(file);
+  if (const std::string problem = parse_axis_map(a.axis_map, o.axis_map); !problem.empty()) {
+    std::fprintf(stderr, "--axis-map: %s\n", problem.c_str());
+    return false;
+  }
   o.extensions = gcode::standard_extensions(o.dialect);
   o.block_delete = a.block_delete;
   o.subroutine_path = a.subroutine_path.empty() ? std::vector<std::string>{"."} : a.subroutine_path;
@@ -77,7 +97,7 @@ void print_diagnostics(const Diagnostics& diags) {
 
 int run_canon(const std::string& file, const InterpArgs& args) {
   gcode::Options options;
-  if (!make_options(args, options)) return kExitUsage;
+  if (!make_options(args, file, options)) return kExitUsage;
   gcode::Interpreter interp(options);
   if (!interp.open(file)) {
     print_diagnostics(interp.diagnostics());
@@ -92,11 +112,11 @@ int run_canon(const std::string& file, const InterpArgs& args) {
 
 // Runs every file without output; reports each problem as file:line:col.
 int run_check(const std::vector<std::string>& files, const InterpArgs& args) {
-  gcode::Options options;
-  if (!make_options(args, options)) return kExitUsage;
   bool errors = false;
   bool unreadable = false;
   for (const std::string& file : files) {
+    gcode::Options options;
+    if (!make_options(args, file, options)) return kExitUsage;
     gcode::Interpreter interp(options);
     canon::Sink quiet;
     if (!interp.open(file)) {
@@ -137,7 +157,7 @@ void add_gcode_commands(CLI::App& app, Registry& registry) {
   add_interp_options(scan, scan_args);
   scan->callback([&registry] {
     gcode::Options options;
-    if (!make_options(scan_args, options)) {
+    if (!make_options(scan_args, scan_file, options)) {
       registry.set_result(kExitUsage);
       return;
     }

@@ -36,6 +36,11 @@ gcode::Options fuzz_options(std::uint8_t flags) {
   if (flags & 8) o.axes = AxisMask::from_letters("XYZUVW");
   if (flags & 16) std::swap(o.axis_map[0], o.axis_map[2]);
   o.quiet_until_segment = (flags & 32) ? 3 : 0;
+  if (flags & 128) {
+    o.dialect = gcode::Dialect::Fanuc;
+    o.machine = (flags & 8) ? gcode::MachineKind::Lathe : gcode::MachineKind::Mill;
+  }
+  o.extensions = gcode::standard_extensions(o.dialect);
   // No subprogram files: the fuzzer must not read the disk. Small limits: no input may run
   // for long or grow memory without bound.
   o.subroutine_path.clear();

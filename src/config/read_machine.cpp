@@ -206,10 +206,15 @@ std::string resolve(const std::filesystem::path& base_dir, const std::string& pa
 void read_interpreter(Section& top, MachineProfile& profile, const std::filesystem::path& base_dir) {
   const toml::table* t = top.subtable("interpreter");
   if (t == nullptr) return;
-  Section s(*t, "interpreter", {"dialect", "subroutine_path", "tool_table"}, top.reporter());
+  Section s(*t, "interpreter", {"dialect", "machine", "axis_map", "subroutine_path", "tool_table"}, top.reporter());
   InterpreterOptions& o = profile.interpreter;
   o.dialect =
       s.choice<Dialect>("dialect", {{"linuxcnc", Dialect::LinuxCnc}, {"fanuc", Dialect::Fanuc}}, o.dialect);
+  o.machine = s.choice<MachineKind>("machine", {{"mill", MachineKind::Mill}, {"lathe", MachineKind::Lathe}}, o.machine);
+  if (const auto map = s.string("axis_map")) {
+    if (const std::string problem = parse_axis_map(*map, o.axis_map); !problem.empty())
+      s.error("axis_map", "interpreter.axis_map: " + problem, "config.range");
+  }
   if (const toml::node* n = s.find("subroutine_path")) {
     const toml::array* list = n->as_array();
     const bool all_strings = list != nullptr && list->is_homogeneous(toml::node_type::string);

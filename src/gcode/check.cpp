@@ -61,7 +61,9 @@ void Engine::enhance_block() {
   const bool ijk = b.has('i') || b.has('j') || b.has('k');
   const int mode0 = b.g[kGroupNonModal];
   const int mode1 = b.g[kGroupMotion];
-  const bool covets = mode0 == 100 || mode0 == 280 || mode0 == 300 || mode0 == 520 || mode0 == 920;
+  const ExtensionClaims claims = ext_ != nullptr ? extension_claims() : ExtensionClaims{};
+  const bool covets =
+      mode0 == 100 || mode0 == 280 || mode0 == 300 || mode0 == 520 || mode0 == 920 || claims.axis_words;
   auto no_polar_offset = [&] {
     if (polar && mode0 == 920)
       fail_at(b.polar_position(), ErrorCode::PolarWithoutMotion,
@@ -79,8 +81,9 @@ void Engine::enhance_block() {
                 "axis words with G80: G80 cancels the motion mode, so nothing on this line uses them");
       no_polar_offset();
       need_offset_axes();
-    } else if (is_lathe_cycle(mode1)) {
-      // G70-G72 take their profile from other blocks; their words are checked by the cycle.
+    } else if (is_lathe_cycle(mode1) || claims.all_words) {
+      // G70-G72 take their profile from other blocks; their words are checked by the cycle
+      // (so are those of an extension's cycle that checks its own).
     } else {
       if (covets)
         fail_at(
@@ -120,6 +123,26 @@ void Engine::check_block() {
   for (int group = 0; group < kGGroupCount; ++group)
     check_extension(block_.g[static_cast<std::size_t>(group)], block_.g_position(group));
   if (block_.motion != block_.g[kGroupMotion]) check_extension(block_.motion, block_.first_axis_position());
+}
+
+// What the extension codes of the block claim (their Traits): words they take, the axis
+// words as their data, or all of their block's words. The motion code and the codes of the
+// groups only extensions know are asked.
+Engine::ExtensionClaims Engine::extension_claims() const {
+  ExtensionClaims claims;
+  if (ext_ == nullptr) return claims;
+  auto ask = [&](int code) {
+    if (code < 0 || !ext_->g[static_cast<std::size_t>(code)]) return;
+    const CodeHandler::Traits t = ext_->g[static_cast<std::size_t>(code)]->traits(code);
+    claims.words |= t.words;
+    claims.axis_words = claims.axis_words || t.axis_words;
+    claims.all_words = claims.all_words || t.all_words;
+  };
+  if (block_.extension_groups) {
+    for (int group = kGroupScaling; group < kGGroupCount; ++group) ask(block_.g[static_cast<std::size_t>(group)]);
+  }
+  ask(block_.g[kGroupMotion] != -1 ? block_.g[kGroupMotion] : block_.motion);
+  return claims;
 }
 
 void Engine::check_extension(int code, int position) {
@@ -188,7 +211,20 @@ void Engine::check_g10() {
 }
 
 void Engine::check_other_codes() {
-  const Block& b = block_;
+  // Words that extension codes take are theirs to check: the rules see the block without them.
+  if (ext_ != nullptr) {
+    const ExtensionClaims claims = extension_claims();
+    if (claims.all_words) return;
+    if (claims.words != 0) {
+      Block without_claimed = block_;
+      without_claimed.words &= ~claims.words;
+      return check_word_rules(without_claimed);
+    }
+  }
+  check_word_rules(block_);
+}
+
+void Engine::check_word_rules(const Block& b) {
   const int motion = b.motion;
   const int m5 = b.m[kGroupIo], m6 = b.m[kGroupToolChange], m7 = b.m[kGroupSpindle], m9 = b.m[kGroupOverride];
   const int g0 = b.g[kGroupNonModal], g7 = b.g[kGroupCutterComp], g8 = b.g[kGroupToolLength];

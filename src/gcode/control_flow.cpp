@@ -90,12 +90,18 @@ void Engine::control_flow() {
     case OWord::EndWhile:
     case OWord::EndRepeat: return o_end_loop();
     case OWord::Program:
-      // A program number line: nothing to do in the main program (Fanuc subprograms, which
-      // it would start, are not supported yet).
+      if (fanuc()) return fanuc_program_line();
+      // A program number line: nothing to do in the main program; Fanuc subprograms are read
+      // by the Fanuc dialect.
       if (st_.frames.size() > 1)
         fail(ErrorCode::Unsupported,
-             "O{} program numbers inside a subprogram (Fanuc style) are not supported yet", block_.o_name);
+             "O{} program numbers inside a subprogram are Fanuc style: choose the Fanuc dialect", block_.o_name);
       return;
+    case OWord::Goto:
+    case OWord::FanucWhile:
+    case OWord::FanucEnd:
+    case OWord::MacroCall:
+    case OWord::BlockRange: return fanuc_control_flow();
     case OWord::None: return;
   }
 }

@@ -14,6 +14,7 @@ Engine::Engine(Options options) : opt_(std::move(options)), sources_(std::make_s
   ext_ = opt_.extensions.get();
   out_.configure(opt_);
   out_.track(&st_.position);
+  out_.transform_state(&st_);
   norm_.resize(1 << 12);
   raw_.reserve(512);
   st_.modal.units = opt_.initial_units;
@@ -29,8 +30,17 @@ Engine::Engine(Options options) : opt_(std::move(options)), sources_(std::make_s
   set_tool_parameters();
   letters_ = 0;
   for (char c : std::string_view("defghijklmpqrst")) letters_ |= 1u << (c - 'a');
+  // A program letter reads if the machine has the axis the axis map sends it to.
   for (int i = 0; i < kAxisCount; ++i) {
-    if (opt_.axes.has(static_cast<Axis>(i))) letters_ |= 1u << (kAxisWordLetters[i] - 'a');
+    const std::uint32_t bit = 1u << (kAxisWordLetters[i] - 'a');
+    if (opt_.axes.has(opt_.axis_map[static_cast<std::size_t>(i)])) letters_ |= bit;
+    else if (opt_.axes.has(static_cast<Axis>(i))) mapped_away_ |= bit;
+  }
+  if (fanuc()) {
+    // #0, the locals and the commons start vacant; on a lathe U and W are incremental X and Z.
+    st_.fanuc.vacant.set();
+    for (int i = 34; i < 100; ++i) st_.fanuc.vacant.reset(static_cast<std::size_t>(i));
+    if (opt_.machine == MachineKind::Lathe) letters_ |= (1u << ('u' - 'a')) | (1u << ('w' - 'a'));
   }
 }
 
@@ -63,12 +73,12 @@ void Engine::open_text(std::string name, std::string text) {
   has_program_ = true;
 }
 
-SourceFile& Engine::current_file() {
-  auto& f = files_.at(st_.next.file);
+SourceFile& Engine::source_at(std::uint32_t file) {
+  auto& f = files_.at(file);
   if (!f) {
     // A file left earlier (a subprogram's caller): open it again.
-    f = SourceFile::open(sources_->file(st_.next.file));
-    if (!f) fail(ErrorCode::CannotOpenFile, "cannot reopen {}", sources_->file(st_.next.file));
+    f = SourceFile::open(sources_->file(file));
+    if (!f) fail(ErrorCode::CannotOpenFile, "cannot reopen {}", sources_->file(file));
     need_seek_ = true;
   }
   return *f;
@@ -83,7 +93,6 @@ void Engine::jump_to(const SourcePosition& pos) {
 
 void Engine::start() {
   started_ = true;
-  if (opt_.dialect != Dialect::LinuxCnc) fail(ErrorCode::Unsupported, "the Fanuc dialect is not supported yet");
   out_.set_origin(canon::BlockOrigin{});
   // The canonical setup LinuxCNC's interpreter makes when it initialises.
   const int system = st_.modal.coord_system;
@@ -101,6 +110,7 @@ void Engine::start() {
   out_.set_g92_offset(st_.position.axis_offset);
   out_.set_xy_rotation(st_.position.rotation_xy_deg);
   out_.set_feed_reference(canon::FeedReference::Xyz);
+  if (fanuc()) fanuc_start();
   if (!has_program_) return;
   // A program whose first non-blank line is a lone '%' must end with another '%'.
   SourceFile& f = current_file();
@@ -126,8 +136,11 @@ void Engine::start() {
     st_.percent_delimited = true;
     st_.next = {st_.next.file, f.tell(), 2};   // LinuxCNC counts the '%' line as line 1
   } else {
+    // Fanuc: "%O1000(NAME)" opens the tape and numbers the program on one line.
+    st_.percent_delimited = fanuc() && first.front() == '%' && fanuc_program_number(first).has_value();
     st_.next = {st_.next.file, 0, 1};
   }
+  st_.frames.front().fanuc.body = st_.next;
   need_seek_ = true;
 }
 
@@ -192,6 +205,7 @@ ParseEnv Engine::parse_env() const noexcept {
   env.parameters = st_.parameters.data();
   env.host = const_cast<Engine*>(this);
   env.letters = letters_;
+  env.mapped_away = mapped_away_;
   env.lathe_diameter = st_.modal.lathe_diameter;
   env.comp_on = st_.modal.cutter_comp != CutterComp::Off;
   env.call_level = static_cast<int>(st_.frames.size()) - 1;
@@ -199,6 +213,9 @@ ParseEnv Engine::parse_env() const noexcept {
   env.defining_sub = st_.control.defining_sub;
   env.defining_name = st_.control.defining_name;
   env.skipping_to = st_.control.skipping_to;
+  env.dialect = opt_.dialect;
+  env.ext = ext_;
+  env.vacant = &st_.fanuc.vacant;
   return env;
 }
 
@@ -258,6 +275,7 @@ Engine::LineKind Engine::read_block() {
     line_file_ = st_.next.file;
     line_ = st_.next.line;
     raw_.clear();
+    if (fanuc()) fanuc_end_of_file();
     if (!st_.control.seeking_sub.empty()) sub_not_found();
     if (!st_.control.skipping_to.empty()) unclosed_block();
     if (st_.percent_delimited)
@@ -268,10 +286,12 @@ Engine::LineKind Engine::read_block() {
   }
   if (norm_.size() < raw_.size() + 1) norm_.resize(raw_.size() + 1);
   set_origin_from_line();
-  norm_len_ = normalize_line(raw_, norm_.data());
+  norm_len_ = normalize_line(raw_, norm_.data(), fanuc());
   const std::string_view text(norm_.data(), norm_len_);
+  if (text == "%" && fanuc() && !in_mdi_ && fanuc_percent_line()) return LineKind::Empty;
   if (text == "%" && st_.percent_delimited && !in_mdi_) return LineKind::ProgramEnd;
   if (text.empty() || (text.front() == '/' && opt_.block_delete)) return LineKind::Empty;
+  if (fanuc() && (text.front() == '$' || text.front() == '%')) check_foreign_syntax();
 
   const bool skipping = !st_.control.skipping_to.empty();
   if (skipping) {
@@ -284,6 +304,7 @@ Engine::LineKind Engine::read_block() {
   if (!skipping && (text.front() == '%' || text.front() == '$') && opt_.dialect == Dialect::LinuxCnc)
     reject_foreign_syntax(text);
   parser_.parse(text, parse_env(), block_);
+  if (fanuc()) fanuc_translate();
   if (!skipping) {
     enhance_block();
     check_block();
@@ -302,29 +323,56 @@ bool Engine::process_line() {
     case LineKind::Block: break;
   }
   if (block_.o_type != OWord::None) {
-    if (in_mdi_ && block_.o_type != OWord::Call)
+    if (in_mdi_ && block_.o_type != OWord::Call && block_.o_type != OWord::MacroCall)
       fail(ErrorCode::OwordInMdi,
-           "only 'call' O-words can be used in MDI: control flow needs a program file");
+           "only 'call' O-words and subprogram calls can be used in MDI: control flow needs a program file");
     control_flow();
-    if (in_mdi_) {
-      // An MDI call runs its subprogram to the end here.
-      while (st_.frames.size() > 1 && !failed_) {
-        in_mdi_ = false;
-        process_line();
-        in_mdi_ = true;
-      }
-    }
+    if (fanuc() && block_.o_type != OWord::BlockRange) fanuc_block_done();
+    if (in_mdi_) finish_mdi_call();
     return true;
   }
   if (!st_.control.skipping_to.empty()) return true;
-  apply_assignments();
+  if (fanuc()) fanuc_assignments();
+  else apply_assignments();
   execute_block();
+  if (fanuc()) {
+    fanuc_after_block();
+    fanuc_block_done();
+    if (in_mdi_) finish_mdi_call();
+  }
   if (block_sync_pending_) {
     block_sync_pending_ = false;
     if (block_sync_.kind == SyncKind::ToolChange) block_sync_.position = st_.position.canon_position;
     apply_sync(block_sync_);
   }
   return true;
+}
+
+// An MDI line that called a subprogram runs it to the end before returning.
+void Engine::finish_mdi_call() {
+  while (st_.frames.size() > 1 && !failed_ && !st_.ended) {
+    in_mdi_ = false;
+    process_line();
+    in_mdi_ = true;
+  }
+}
+
+// Lines that start like another controller's program header or command ("%PM",
+// "%_N_PART_MPF", "$H", "$BR0137.MIN%") are named as such instead of failing on a character.
+void Engine::check_foreign_syntax() {
+  const std::size_t first = raw_.find_first_not_of(" \t");
+  if (first == std::string::npos) return;
+  const char c = raw_[first];
+  const char next = first + 1 < raw_.size() ? raw_[first + 1] : '\0';
+  const bool dollar = c == '$' && ((next >= 'A' && next <= 'Z') || (next >= 'a' && next <= 'z'));
+  const bool percent = c == '%' && next != '\0' && next != ' ' && next != '\t' &&
+                       !(fanuc() && fanuc_program_number(raw_).has_value());
+  if (!dollar && !percent) return;
+  const std::size_t end = raw_.find_first_of(" \t(", first);
+  const std::string construct = raw_.substr(first, end == std::string::npos ? std::string::npos : end - first);
+  fail(ErrorCode::DialectUnsupported, "'{}' is another controller's syntax ({}), not {} G-code", construct,
+       dollar ? "a command or program header starting with '$'" : "a program header starting with '%'",
+       fanuc() ? "Fanuc" : "LinuxCNC");
 }
 
 // --- errors -------------------------------------------------------------------------------
@@ -401,7 +449,7 @@ void Engine::report(const GcodeError& e) {
     line = w->line;
     col = w->col;
   } else if (e.position() >= 0) {
-    col = raw_column(raw_, e.position());
+    col = raw_column(raw_, e.position(), fanuc());
   } else {
     const std::size_t first = raw_.find_first_not_of(" \t");
     col = first == std::string::npos ? 1 : static_cast<std::uint32_t>(first + 1);

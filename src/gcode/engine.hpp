@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -18,6 +19,7 @@
 #include "opencnc/gcode/interpreter.hpp"
 #include "opencnc/gcode/options.hpp"
 #include "opencnc/gcode/state.hpp"
+#include "fanuc_index.hpp"
 #include "gcode_error.hpp"
 #include "output.hpp"
 #include "parser.hpp"
@@ -65,6 +67,7 @@ class Engine final : public ParamHost, public ExecContext {
   // --- ParamHost (params.cpp) ------------------------------------------------------------
   bool named_value(std::string_view name, double& value) override;
   void declare_named(std::string_view name) override;
+  bool fanuc_variable(int index, double& value) override;   // fanuc_vars.cpp
 
   // --- ExecContext (extension facade, engine.cpp) ----------------------------------------
   InterpState& state() override { return st_; }
@@ -123,7 +126,12 @@ class Engine final : public ParamHost, public ExecContext {
   void warn_once(bool& done, ErrorCode code, std::string_view message);
   void check_motion_habits(bool feed);
   void set_origin_from_line();
-  SourceFile& current_file();
+  void check_foreign_syntax();
+  SourceFile& current_file() {
+    const std::uint32_t file = st_.next.file;
+    return file < files_.size() && files_[file] ? *files_[file] : source_at(file);
+  }
+  SourceFile& source_at(std::uint32_t file);
   void jump_to(const SourcePosition& pos);
   ParseEnv parse_env() const noexcept;
   void apply_sync(const SyncValues& values);
@@ -136,6 +144,13 @@ class Engine final : public ParamHost, public ExecContext {
   void check_other_codes();
   void check_p_word();
   void check_extension(int code, int position);
+  void check_word_rules(const Block& b);
+  struct ExtensionClaims {
+    std::uint32_t words = 0;
+    bool axis_words = false;
+    bool all_words = false;
+  };
+  ExtensionClaims extension_claims() const;
 
   // execute.cpp: order of execution within a block
   void execute_block();
@@ -156,6 +171,7 @@ class Engine final : public ParamHost, public ExecContext {
   bool run_extension_m(int code);
   [[noreturn]] void unsupported_g(int code, int at);
   void check_spindle_number(bool all_allowed) const;
+  void convert_extension_groups();
 
   // motion.cpp
   Pose find_ends(const Block& b);
@@ -239,6 +255,42 @@ class Engine final : public ParamHost, public ExecContext {
   void count_loop();
   void leave_frame();
 
+  // fanuc_flow.cpp: the Fanuc dialect's programs, calls and loops
+  bool fanuc() const noexcept { return opt_.dialect == Dialect::Fanuc; }
+  void fanuc_start();
+  bool fanuc_percent_line();
+  void fanuc_end_of_file();
+  void fanuc_control_flow();
+  void fanuc_program_line();
+  void fanuc_goto(std::int64_t n);
+  void fanuc_while();
+  void fanuc_end();
+  void fanuc_call(std::uint32_t program, int count, bool macro);
+  void fanuc_range();
+  void fanuc_block_done();
+  void fanuc_return();
+  SourcePosition fanuc_find_program(std::uint32_t program);
+  bool fanuc_program_file(std::uint32_t program, SourcePosition& at);
+  const FanucIndex::Region& fanuc_region(const SourcePosition& start);
+  SourcePosition fanuc_sequence(const SourcePosition& program_start, std::int64_t n, std::string_view what);
+  std::string fanuc_program_name(const FanucFrame& f) const;
+  void finish_mdi_call();
+
+  // fanuc_translate.cpp: Fanuc words and codes rewritten into the core's before the checks
+  void fanuc_translate();
+  void fanuc_lathe_words();
+  void fanuc_lathe_tool();
+  void fanuc_lathe_codes();
+  void fanuc_dwell();
+  void fanuc_transform_conflicts();
+  void fanuc_after_block();
+  bool block_has_content() const noexcept;
+
+  // fanuc_vars.cpp: system variables, vacancy, #3000 alarms and #3006 stops
+  double fanuc_computed(int index) const;
+  double fanuc_modal(int group) const;
+  void fanuc_assignments();
+
   // params.cpp
   bool predefined_value(std::string_view name, double& value) const;
   bool is_predefined(std::string_view name) const noexcept;
@@ -266,6 +318,7 @@ class Engine final : public ParamHost, public ExecContext {
   bool block_sync_pending_ = false;
   std::uint32_t letters_ = 0;       ///< letter words with a reader (axis mask applied)
   int extension_at_ = -1;  ///< where the code of the running extension starts (its errors point there)
+  std::uint32_t mapped_away_ = 0;   ///< axis letters the axis map sends to a missing axis
   std::uint32_t mdi_file_ = 0;
   bool in_mdi_file_ = false;        ///< "<mdi>" is registered in the source map
   std::uint64_t skipped_lines_ = 0; ///< lines passed over while seeking a label
@@ -277,6 +330,12 @@ class Engine final : public ParamHost, public ExecContext {
   std::uint32_t line_file_ = 0;     ///< its file
   std::uint64_t line_offset_ = 0;   ///< its byte offset
   std::string raw_;                 ///< the raw line (for messages and N labels)
+  // Fanuc dialect
+  FanucIndex fanuc_index_;          ///< program lines, sequence numbers, loops of the files read
+  std::map<std::uint32_t, SourcePosition> fanuc_programs_;   ///< O number → program line found
+  double fanuc_p_ = -1;             ///< M98/M99 P of the block (taken out before the checks)
+  double fanuc_l_ = -1;             ///< M98 L of the block
+  double fanuc_clamp_ = -1;         ///< G50 S / G92 S of the block
   std::vector<char> norm_;          ///< normalised text of the line
   std::size_t norm_len_ = 0;
 };

@@ -68,6 +68,7 @@ void Engine::convert_g() {
   if (b.g[kGroupDistance] != -1) set_distance_mode(b.g[kGroupDistance]);
   if (b.g[kGroupIjkDistance] != -1) set_ijk_mode(b.g[kGroupIjkDistance]);
   if (b.g[kGroupRetract] != -1) set_retract_mode(b.g[kGroupRetract]);
+  if (b.extension_groups) convert_extension_groups();
   if (b.g[kGroupNonModal] != -1) convert_modal_0(b.g[kGroupNonModal]);
   if (b.motion != -1) convert_motion(b.motion);
 }
@@ -229,6 +230,15 @@ bool Engine::run_extension_m(int code) {
   const ExtensionSite site(*this, group >= 0 ? block_.m_position(group) : -1);
   ext_->m[static_cast<std::size_t>(code)]->execute(*this, block_, code);
   return true;
+}
+
+// Codes of the groups only extensions know (Fanuc mirroring, scaling, rotation), in Fanuc's
+// order.
+void Engine::convert_extension_groups() {
+  for (const int group : {kGroupMirror, kGroupScaling, kGroupRotation}) {
+    const int code = block_.g[static_cast<std::size_t>(group)];
+    if (code != -1 && !run_extension_g(code)) unsupported_g(code, block_.g_position(group));
+  }
 }
 
 void Engine::unsupported_g(int code, int at) {

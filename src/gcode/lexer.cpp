@@ -42,7 +42,7 @@ constexpr CharMap make_map() {
 constexpr CharMap kMap = make_map();
 }  // namespace
 
-std::size_t normalize_line(std::string_view raw, char* out) {
+std::size_t normalize_line(std::string_view raw, char* out, bool nested_comments) {
   std::size_t n = 0;
   const std::size_t size = raw.size();
   for (std::size_t i = 0; i < size; ++i) {
@@ -58,35 +58,39 @@ std::size_t normalize_line(std::string_view raw, char* out) {
       std::memcpy(out + n, raw.data() + i, size - i);
       return n + (size - i);
     }
-    // A ( ) comment: copied as is; '(' may not appear inside it.
+    // A ( ) comment: copied as is; '(' may not appear inside it unless comments nest.
     const int open = static_cast<int>(n);
     out[n++] = '(';
+    int depth = 1;
     for (++i;; ++i) {
       if (i >= size)
         fail_at(open, ErrorCode::UnclosedComment,
                 "this '(' opens a comment that is not closed on its line: add ')'");
       const char d = raw[i];
-      if (d == '(')
-        fail_at(static_cast<int>(n), ErrorCode::NestedComment, "'(' inside a comment: comments do not nest");
+      if (d == '(') {
+        if (!nested_comments)
+          fail_at(static_cast<int>(n), ErrorCode::NestedComment, "'(' inside a comment: comments do not nest");
+        ++depth;
+      }
       out[n++] = d;
-      if (d == ')') break;
+      if (d == ')' && --depth == 0) break;
     }
   }
   return n;
 }
 
-std::uint32_t raw_column(std::string_view raw, int index) noexcept {
+std::uint32_t raw_column(std::string_view raw, int index, bool nested_comments) noexcept {
   if (index < 0) return 0;
   int n = 0;
-  bool in_comment = false;
+  int depth = 0;   // comment nesting (at most 1 unless comments nest)
   for (std::size_t i = 0; i < raw.size(); ++i) {
     const char c = raw[i];
-    const bool dropped = !in_comment && (c == ' ' || c == '\t' || c == '\r');
+    const bool dropped = depth == 0 && (c == ' ' || c == '\t' || c == '\r');
     if (dropped) continue;
     if (n == index) return static_cast<std::uint32_t>(i + 1);
-    if (!in_comment && c == ';') return static_cast<std::uint32_t>(i + 1 + static_cast<std::size_t>(index - n));
-    if (in_comment && c == ')') in_comment = false;
-    else if (!in_comment && c == '(') in_comment = true;
+    if (depth == 0 && c == ';') return static_cast<std::uint32_t>(i + 1 + static_cast<std::size_t>(index - n));
+    if (depth > 0 && c == ')') --depth;
+    else if (c == '(' && (depth == 0 || nested_comments)) ++depth;
     ++n;
   }
   return static_cast<std::uint32_t>(raw.size() + 1);

@@ -17,11 +17,12 @@ std::string_view trim_raw_line(std::string_view raw) noexcept;
 
 /// Writes the normalised form of `raw` into `out` (at least raw.size() bytes) and returns its
 /// length. Outside comments: spaces, tabs and CRs are dropped, A-Z lowered; after ';' the rest
-/// is copied as is. Throws GcodeError (nested or unclosed comment).
-std::size_t normalize_line(std::string_view raw, char* out);
+/// is copied as is. Throws GcodeError (unclosed comment; a nested one unless
+/// `nested_comments`, as the Fanuc dialect allows).
+std::size_t normalize_line(std::string_view raw, char* out, bool nested_comments = false);
 
 /// Column (1-based) in `raw` of the normalised character at `index`, for error messages.
-std::uint32_t raw_column(std::string_view raw, int index) noexcept;
+std::uint32_t raw_column(std::string_view raw, int index, bool nested_comments = false) noexcept;
 
 /// The digits of a leading N word as the stand-alone rs274 shows them: after leading blanks
 /// and '/', an 'N' and the digits that follow it directly. Returns false if no N.

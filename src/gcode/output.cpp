@@ -75,7 +75,7 @@ void Output::map_arc(canon::ArcFeed& arc) const {
 }
 
 Pose Output::motion_pose(const Pose& p) const {
-  if (transform_ && transform_->active()) return map_pose(transform_->point(p));
+  if (transforming()) return map_pose(transform_->point(*state_, p));
   return map_pose(p);
 }
 
@@ -235,7 +235,7 @@ void Output::arc_feed(canon::SegmentId, const canon::ArcFeed& arc) {
   }
   track_motion(arc.end);
   canon::ArcFeed a = arc;
-  if (transform_ && transform_->active()) transform_->arc(a);
+  if (transforming()) transform_->arc(*state_, a);
   map_arc(a);
   canon::SegmentId id;
   if (auto* s = live_motion(id)) s->arc_feed(id, a);
@@ -262,7 +262,7 @@ void Output::nurbs_feed(canon::SegmentId, int order, std::span<const canon::Nurb
     view_->canon_position[1] = points.back().y;
   }
   std::span<const canon::NurbsPoint> out = points;
-  if (!identity_map_ || (transform_ && transform_->active())) {
+  if (!identity_map_ || transforming()) {
     // The curve is planar and its control points transform like points (rotation, scaling,
     // mirroring, axis exchange within XY are affine), but it must stay in the XY plane.
     if ((axis_map_[0] != Axis::X && axis_map_[0] != Axis::Y) || (axis_map_[1] != Axis::X && axis_map_[1] != Axis::Y))

@@ -25,6 +25,8 @@ class Output final : public canon::Sink {
   void attach(canon::Sink* sink) noexcept { sink_ = sink; }
   /// Where to keep the canonical view of the position (PositionState::canon_position).
   void track(PositionState* view) noexcept { view_ = view; }
+  /// The state the coordinate transform reads (what G68, G51, G51.1 set).
+  void transform_state(const InterpState* state) noexcept { state_ = state; }
   /// The block the next calls belong to; announced to the sink before its first call.
   void set_origin(const canon::BlockOrigin& origin) noexcept {
     origin_ = origin;
@@ -147,6 +149,7 @@ class Output final : public canon::Sink {
   Pose map_pose(const Pose& p) const noexcept;
   void map_arc(canon::ArcFeed& arc) const;
   Pose motion_pose(const Pose& p) const;
+  bool transforming() const { return transform_ && state_ != nullptr && transform_->active(*state_); }
   bool enqueue(Queued&& q);
   void scale_queue(double k) noexcept;
 
@@ -156,6 +159,7 @@ class Output final : public canon::Sink {
 
   canon::Sink* sink_ = nullptr;
   PositionState* view_ = nullptr;
+  const InterpState* state_ = nullptr;
   canon::Units view_units_ = canon::Units::Mm;
   canon::BlockOrigin origin_;
   bool announced_ = false;

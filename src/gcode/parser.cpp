@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "gcode_error.hpp"
+#include "opencnc/gcode/extension.hpp"
 
 namespace opencnc::gcode {
 
@@ -240,19 +241,27 @@ void Parser::parse(std::string_view text, const ParseEnv& env, Block& b) {
   b.clear();
   numbered_assignments.clear();
   named_assignments.clear();
+  vacant_assignments.clear();
   Cursor c{text, 0, env};
   if (c.at() == '/') ++c.pos;
+  const bool fanuc = env.fanuc();
+  // Fanuc program numbers: "O1000", ":1000" and "%O1000" on the first line of a file.
+  if (fanuc && c.at() == '%' && (c.at(1) == 'o' || c.at(1) == ':')) ++c.pos;
   if (c.at() == 'n') read_line_number(c, b);
 
-  // M98 / M99 (Fanuc subprograms) start an O-word line in LinuxCNC.
-  if (c.at() == 'm' && (starts_with(text, c.pos + 1, "98") || (starts_with(text, c.pos + 1, "99") && env.call_level > 0))) {
+  if (fanuc) {
+    if (read_fanuc_statement(c, b)) return;
+  } else if (c.at() == 'm' && env.skipping_to.empty() &&   // lines passed over are not read (LinuxCNC)
+             (starts_with(text, c.pos + 1, "98") || (starts_with(text, c.pos + 1, "99") && env.call_level > 0))) {
+    // M98 / M99 (Fanuc subprograms) start an O-word line in LinuxCNC.
     Cursor probe{text, c.pos + 1, env};
     const int m = integer_value(probe, "an M code");
     if (m == 98 || (m == 99 && env.call_level > 0))
-      fail_at(static_cast<int>(c.pos), ErrorCode::Unsupported, "M{} subprograms (Fanuc style) are not supported yet", m);
+      fail_at(static_cast<int>(c.pos), ErrorCode::Unsupported,
+              "M{} subprograms are Fanuc style: run the program with the Fanuc dialect", m);
   }
 
-  if (c.at() == 'o') {
+  if (c.at() == 'o' || (fanuc && c.at() == ':')) {
     read_o_word(c, b);
     if (!env.skipping_to.empty()) return;
     while (c.pos < text.size()) {
@@ -280,10 +289,15 @@ void Parser::parse(std::string_view text, const ParseEnv& env, Block& b) {
 void Parser::read_line_number(Cursor& c, Block& b) {
   ++c.pos;
   const std::size_t start = c.pos;
-  while (is_digit(c.at())) ++c.pos;
+  std::int64_t n = 0;
+  while (is_digit(c.at())) {
+    if (c.pos - start < 18) n = n * 10 + (c.at() - '0');
+    ++c.pos;
+  }
   if (c.pos == start)
     fail_at(static_cast<int>(start), ErrorCode::BadLineNumber,
             "N without digits: a line number is N followed by digits");
+  b.n_number = c.pos - start <= 18 ? n : -1;
   if (c.at() == '.') {   // fractional line numbers are read and ignored
     const std::size_t frac = ++c.pos;
     while (is_digit(c.at())) ++c.pos;
@@ -298,7 +312,12 @@ void Parser::read_item(Cursor& c, Block& b) {
   const char ch = c.at();
   const int pos = static_cast<int>(c.pos);
   if (ch >= 'a' && ch <= 'z') {
-    if (!((c.env.letters >> (ch - 'a')) & 1u)) letter_without_word(c, ch);
+    if (!((c.env.letters >> (ch - 'a')) & 1u)) {
+      if ((c.env.mapped_away >> (ch - 'a')) & 1u)
+        fail_at(pos, ErrorCode::AxisNotAvailable, "{} word: the axis map sends {} to an axis this machine does not have",
+                static_cast<char>(ch - 32), static_cast<char>(ch - 32));
+      letter_without_word(c, ch);
+    }
     if (ch == 'g') return read_g(c, b);
     if (ch == 'm') return read_m(c, b);
     return read_word(c, b, ch);
@@ -373,7 +392,12 @@ void Parser::letter_without_word(const Cursor& c, char letter) {
 
 void Parser::read_comment(Cursor& c, Block& b) {
   const std::size_t start = ++c.pos;
-  while (c.pos < c.text.size() && c.text[c.pos] != ')') ++c.pos;
+  int depth = 1;   // Fanuc comments may nest (the lexer checked the parentheses)
+  for (; c.pos < c.text.size(); ++c.pos) {
+    const char ch = c.text[c.pos];
+    if (ch == '(' && c.env.fanuc()) ++depth;
+    if (ch == ')' && --depth == 0) break;
+  }
   b.comment = c.text.substr(start, c.pos - start);
   b.has_comment = true;
   ++c.pos;   // the lexer guarantees the ')'
@@ -388,27 +412,40 @@ void Parser::read_word(Cursor& c, Block& b, char letter) {
     fail_at(pos, ErrorCode::RepeatedWord, "a second {} word on this line: give each word once",
             static_cast<char>(letter - 32));
   double v;
+  value_vacant_ = false;
   switch (letter) {
     case 'h':
       v = integer_value(c, "H");
+      if (value_vacant_ && c.env.fanuc()) return;
       if (v < -1) fail_at(pos, ErrorCode::HWordNegative, "H{}: the tool number of an offset is 0 or more", v);
       break;
     case 'l':
       v = integer_value(c, "L");
+      if (value_vacant_ && c.env.fanuc()) return;
       if (v < 0) fail_at(pos, ErrorCode::LWordNegative, "L{}: an L number cannot be negative", v);
       break;
     case 't':
       v = integer_value(c, "T");
+      if (value_vacant_ && c.env.fanuc()) return;
       if (v < 0) fail_at(pos, ErrorCode::ToolNegative, "T{}: tool numbers are 0 or more", v);
       break;
-    default:
+    default: {
+      const std::size_t start = c.pos;
       v = real_value(c);
+      if (c.env.fanuc()) {
+        if (value_vacant_) return;   // Fanuc: a word whose value is a vacant variable is left out
+        const char first = c.text[start];
+        if ((is_digit(first) || first == '.' || first == '-' || first == '+') &&
+            c.text.substr(start, c.pos - start).find('.') != std::string_view::npos)
+          b.decimal |= 1u << (letter - 'a');
+      }
       if (letter == 'f' && v < 0.0)
         fail_at(pos, ErrorCode::FeedNegative, "F{}: a feed rate cannot be negative", v);
       if (letter == 's' && v < 0.0)
         fail_at(pos, ErrorCode::SpeedNegative, "S{}: a spindle speed cannot be negative", v);
       if (letter == 'x' && c.env.lathe_diameter) v /= 2.0;
       break;
+    }
   }
   b.value[static_cast<std::size_t>(letter - 'a')] = v;
   b.at[static_cast<std::size_t>(letter - 'a')] = position_byte(static_cast<std::size_t>(pos));
@@ -453,9 +490,10 @@ void Parser::read_g(Cursor& c, Block& b) {
     if (code > 999) fail_at(pos, ErrorCode::GCodeOutOfRange, "G{}: G numbers go from 0 to 99.9", v10 / 10.0);
     if (code < 0) fail_at(pos, ErrorCode::GCodeOutOfRange, "G{}: G numbers cannot be negative", v10 / 10.0);
   }
-  const int group = g_group(code);
+  const int group = code_group(code, false, c.env);
   if (group < 0) fail_at(pos, ErrorCode::UnknownGCode, "{} is not a G code of this dialect", g_name(code));
   auto& slot = b.g[static_cast<std::size_t>(group)];
+  b.extension_groups = b.extension_groups || group >= kGroupScaling;
   if (code == 800 && slot != -1) return;   // G80 beside another motion code is ignored
   if (slot != -1 && slot != 800)
     fail_at(pos, ErrorCode::ModalGroupConflict,
@@ -465,13 +503,29 @@ void Parser::read_g(Cursor& c, Block& b) {
   b.g_at[static_cast<std::size_t>(group)] = position_byte(static_cast<std::size_t>(pos));
 }
 
+// The modal group of a G (×10) or M code: the core's, M98 in the Fanuc dialect, or the one an
+// extension gives a code the core does not know.
+int Parser::code_group(int code, bool m_code, const ParseEnv& env) const noexcept {
+  const int group = m_code ? m_group(code) : g_group(code);
+  if (group >= 0) return group;
+  if (m_code && code == 98 && env.fanuc()) return kGroupStop;
+  if (env.ext == nullptr || code < 0) return -1;
+  const CodeHandler* h = nullptr;
+  if (m_code && code < static_cast<int>(env.ext->m.size())) h = env.ext->m[static_cast<std::size_t>(code)].get();
+  if (!m_code && code < static_cast<int>(env.ext->g.size())) h = env.ext->g[static_cast<std::size_t>(code)].get();
+  if (h == nullptr) return -1;
+  const int own = h->traits(code).group;
+  if (own >= 0) return own;
+  return m_code ? kGroupUser : -1;
+}
+
 void Parser::read_m(Cursor& c, Block& b) {
   const int pos = static_cast<int>(c.pos);
   ++c.pos;
   const int code = integer_value(c, "an M code");
   if (code < 0) fail_at(pos, ErrorCode::MCodeOutOfRange, "M{}: M numbers cannot be negative", code);
   if (code > 199) fail_at(pos, ErrorCode::MCodeOutOfRange, "M{}: M numbers go from 0 to 199", code);
-  const int group = m_group(code);
+  const int group = code_group(code, true, c.env);
   if (group < 0) fail_at(pos, ErrorCode::UnknownMCode, "M{} is not an M code of this dialect", code);
   auto& slot = b.m[static_cast<std::size_t>(group)];
   if (slot != -1)
@@ -509,15 +563,27 @@ void Parser::read_assignment(Cursor& c) {
     return;
   }
   const int index = integer_value(c, "a parameter number");
-  if (index < 1 || index >= kParameterCount)
-    fail_at(pos, ErrorCode::ParameterOutOfRange, "parameter #{} does not exist (1..{})", index, kParameterCount - 1);
-  if ((index >= 5400 && index <= 5413) || (index >= 5420 && index <= 5428))
-    fail_at(pos, ErrorCode::ParameterReadOnly, "parameter #{} is read-only: it reports the current {}", index,
-            index < 5420 ? "tool" : "position");
+  if (c.env.fanuc()) {
+    check_fanuc_assignment(index, pos);
+  } else {
+    if (index < 1 || index >= kParameterCount)
+      fail_at(pos, ErrorCode::ParameterOutOfRange, "parameter #{} does not exist (1..{})", index, kParameterCount - 1);
+    if ((index >= 5400 && index <= 5413) || (index >= 5420 && index <= 5428))
+      fail_at(pos, ErrorCode::ParameterReadOnly, "parameter #{} is read-only: it reports the current {}", index,
+              index < 5420 ? "tool" : "position");
+  }
   if (c.at() != '=')
     fail_at(static_cast<int>(c.pos), ErrorCode::EqualSignMissing,
             "#{} is not followed by '=': write #{}=value", index, index);
   ++c.pos;
+  if (c.env.fanuc()) {
+    // Fanuc: the right-hand side is an expression without brackets (#1 = #1 + 1); a bare
+    // vacant variable makes the target vacant too.
+    const double v = expression(c, true);
+    numbered_assignments.emplace_back(index, v);
+    if (value_vacant_) vacant_assignments.push_back(index);
+    return;
+  }
   const double v = real_value(c);
   numbered_assignments.emplace_back(index, v);
 }
@@ -534,10 +600,12 @@ double Parser::real_value(Cursor& c) {
   }
   const char next = c.at(1);
   double v;
+  bool vacant = false;
   if (ch == '[') {
     v = expression(c);
   } else if (ch == '#') {
     v = parameter(c, false);
+    vacant = value_vacant_;
   } else if ((ch == '+' || ch == '-') && next != '\0' && !is_digit(next) && next != '.') {
     ++c.pos;
     v = real_value(c);
@@ -545,12 +613,14 @@ double Parser::real_value(Cursor& c) {
   } else if (ch >= 'a' && ch <= 'z') {
     v = unary(c);
   } else {
+    value_vacant_ = false;
     return real_number(c);   // finite: no exponent, and overlong digit strings are refused
   }
   if (std::isnan(v))
     fail_at(pos, ErrorCode::ResultNotANumber, "this value is not a number (its calculation is undefined)");
   if (std::isinf(v))
     fail_at(pos, ErrorCode::ResultInfinite, "this value is infinite (its calculation overflows)");
+  value_vacant_ = vacant;
   return v;
 }
 
@@ -640,40 +710,57 @@ double Parser::expression(std::string_view text, std::size_t& pos, const ParseEn
   return v;
 }
 
-double Parser::expression(Cursor& c) {
+double Parser::expression(Cursor& c, bool open) {
   // Operator-precedence evaluation with an explicit stack, left to right within a level;
-  // operands are evaluated as they are read, exactly in LinuxCNC's order.
+  // operands are evaluated as they are read, exactly in LinuxCNC's order. The Fanuc dialect
+  // compares vacant values with EQ/NE as unequal to any number (they are 0 elsewhere).
   double values[8];
+  bool vacant[8];
   int ops[8];
   int op_pos[8];
-  ++c.pos;   // '['
+  const bool fanuc = c.env.fanuc();
+  if (!open) ++c.pos;   // '['
   values[0] = real_value(c);
+  vacant[0] = value_vacant_;
   op_pos[0] = static_cast<int>(c.pos);
-  ops[0] = binary_operator(c);
+  ops[0] = binary_operator(c, open);
+  const bool single = ops[0] == kRightBracket;
   int top = 1;
   while (ops[0] != kRightBracket) {
     values[top] = real_value(c);
+    vacant[top] = value_vacant_;
     op_pos[top] = static_cast<int>(c.pos);
-    ops[top] = binary_operator(c);
+    ops[top] = binary_operator(c, open);
     if (precedence(ops[top]) > precedence(ops[top - 1])) {
       ++top;
       continue;
     }
     for (;;) {
-      values[top - 1] = apply_binary(values[top - 1], ops[top - 1], values[top], op_pos[top - 1]);
+      const int op = ops[top - 1];
+      if (fanuc && (op == kEq || op == kNe) && (vacant[top - 1] || vacant[top])) {
+        const bool same = vacant[top - 1] && vacant[top];
+        values[top - 1] = (op == kEq) == same ? 1.0 : 0.0;
+      } else {
+        values[top - 1] = apply_binary(values[top - 1], op, values[top], op_pos[top - 1]);
+      }
+      vacant[top - 1] = false;
       ops[top - 1] = ops[top];
       op_pos[top - 1] = op_pos[top];
       if (top > 1 && precedence(ops[top - 1]) <= precedence(ops[top - 2])) --top;
       else break;
     }
   }
+  value_vacant_ = open && single && vacant[0];
   return values[0];
 }
 
-int Parser::binary_operator(Cursor& c) {
+int Parser::binary_operator(Cursor& c, bool open) {
   const int pos = static_cast<int>(c.pos);
   const char ch = c.at();
   const char n1 = c.at(1), n2 = c.at(2);
+  // An open expression ends with the line or at a comment (nothing is consumed).
+  if (open && (ch == '\0' || ch == '(' || ch == ';')) return kRightBracket;
+  if (open && ch == ']') fail_at(pos, ErrorCode::UnknownOperator, "']' without its '['");
   ++c.pos;
   auto word = [&](int op, std::size_t extra) {
     c.pos += extra;
@@ -771,6 +858,25 @@ double Parser::unary(Cursor& c) {
     ++c.pos;
     return v;
   }
+  const bool fanuc = c.env.fanuc();
+  if (op == kAtan && fanuc && c.at() == '[') {
+    // Fanuc also writes ATAN[y,x]: read the two halves as open expressions.
+    std::size_t depth = 0, comma = std::string_view::npos, close = c.pos;
+    for (; close < c.text.size(); ++close) {
+      const char ch2 = c.text[close];
+      if (ch2 == '[') ++depth;
+      else if (ch2 == ']' && --depth == 0) break;
+      else if (ch2 == ',' && depth == 1 && comma == std::string_view::npos) comma = close;
+    }
+    if (comma != std::string_view::npos && close < c.text.size()) {
+      Cursor y_part{c.text.substr(0, comma), c.pos + 1, c.env};
+      const double y = expression(y_part, true);
+      Cursor x_part{c.text.substr(0, close), comma + 1, c.env};
+      const double x = expression(x_part, true);
+      c.pos = close + 1;
+      return fanuc_unary(kAtan, static_cast<double>(std::atan2(y, x) * 180.0L / kPi), pos);
+    }
+  }
   const double arg = expression(c);
   if (op == kAtan) {
     if (c.at() != '/')
@@ -780,10 +886,27 @@ double Parser::unary(Cursor& c) {
       fail_at(static_cast<int>(c.pos), ErrorCode::AtanSyntax,
               "ATAN's second argument goes in brackets: ATAN[y]/[x]");
     const double x = expression(c);
-    return static_cast<double>(std::atan2(arg, x) * 180.0L / kPi);   // double atan2, long double scaling
-
+    const double angle = static_cast<double>(std::atan2(arg, x) * 180.0L / kPi);   // double atan2, long double scaling
+    return fanuc ? fanuc_unary(kAtan, angle, pos) : angle;
   }
-  return apply_unary(op, arg, pos);
+  return fanuc ? fanuc_unary(op, arg, pos) : apply_unary(op, arg, pos);
+}
+
+// The Fanuc functions that differ from LinuxCNC's (Fanuc's defaults): FIX drops the fraction
+// and FUP raises the magnitude (both toward and away from zero, not floor and ceiling);
+// ATAN answers 0..360 degrees and ASIN 270..90 (through 0) instead of negative angles.
+// `x` is the argument, or for ATAN the angle LinuxCNC's rule gives.
+double Parser::fanuc_unary(int op, double x, int pos) const {
+  switch (op) {
+    case kFix: return std::trunc(x);
+    case kFup: return x < 0.0 ? -std::ceil(-x) : std::ceil(x);
+    case kAtan: return x < 0.0 ? x + 360.0 : x;
+    case kAsin: {
+      const double a = apply_unary(kAsin, x, pos);
+      return a < 0.0 ? a + 360.0 : a;
+    }
+    default: return apply_unary(op, x, pos);
+  }
 }
 
 double Parser::parameter(Cursor& c, bool exists_only) {
@@ -807,6 +930,25 @@ double Parser::parameter(Cursor& c, bool exists_only) {
   }
   const int index = integer_value(c, "a parameter number");
   if (exists_only) return (index >= 1 && index < kParameterCount) ? 1.0 : 0.0;
+  if (c.env.fanuc()) {
+    // Fanuc: #0 and unassigned locals and commons are vacant (0 in arithmetic); some system
+    // variables are computed from the state.
+    if (index < 0 || index >= kParameterCount)
+      fail_at(pos, ErrorCode::ParameterOutOfRange, "variable #{} does not exist", index);
+    if (index < kFanucVariableCount && (index == 0 || (c.env.vacant != nullptr && (*c.env.vacant)[static_cast<std::size_t>(index)]))) {
+      value_vacant_ = true;
+      return 0.0;
+    }
+    value_vacant_ = false;
+    double v = 0;
+    try {
+      if (c.env.host->fanuc_variable(index, v)) return v;
+    } catch (GcodeError& e) {
+      e.set_position(pos);
+      throw;
+    }
+    return c.env.parameters[index];
+  }
   if (index < 1 || index >= kParameterCount)
     fail_at(pos, ErrorCode::ParameterOutOfRange, "parameter #{} does not exist (1..{})", index, kParameterCount - 1);
   if (index >= 5420 && index <= 5428 && c.env.comp_on)
@@ -821,6 +963,8 @@ void Parser::read_o_word(Cursor& c, Block& b) {
   ++c.pos;
   std::string name;
   if (c.at() == '<') {
+    if (c.env.fanuc())
+      fail_at(pos, ErrorCode::DialectUnsupported, "o<name> is LinuxCNC syntax: Fanuc programs are numbered (O1000)");
     name = read_name(c);
   } else {
     name = std::to_string(integer_value(c, "an O-word number"));
@@ -850,6 +994,9 @@ void Parser::read_o_word(Cursor& c, Block& b) {
               kOwordKeywords);
     }
     type = OWord::Program;   // "O1234" alone: a program number
+  } else if (c.env.fanuc()) {
+    fail_at(pos, ErrorCode::DialectUnsupported,
+            "O-word statements are LinuxCNC syntax: the Fanuc dialect uses M98/M99, G65, GOTO, IF and WHILE");
   } else if (c.env.skipping_to.empty()) {  // lines passed over are not checked further (LinuxCNC)
     misspelt_keyword(c, keyword_at);
   }

@@ -10,8 +10,11 @@
 #include <vector>
 
 #include "opencnc/gcode/block.hpp"
+#include "opencnc/gcode/options.hpp"
 
 namespace opencnc::gcode {
+
+struct Extensions;
 
 /// What the parser needs from the interpreter to read parameters. Implemented by the engine.
 class ParamHost {
@@ -21,6 +24,10 @@ class ParamHost {
   virtual bool named_value(std::string_view name, double& value) = 0;
   /// #<name>=... declares the name while the line is read (LinuxCNC does the same).
   virtual void declare_named(std::string_view name) = 0;
+  /// Fanuc dialect: the value of system variable #index when it is computed rather than
+  /// stored (modal information, positions); false for stored variables. Throws GcodeError
+  /// for variables the dialect does not provide.
+  virtual bool fanuc_variable(int /*index*/, double& /*value*/) { return false; }
 };
 
 /// Interpreter facts that change how a line reads.
@@ -28,6 +35,7 @@ struct ParseEnv {
   const double* parameters = nullptr;   ///< kParameterCount numbered parameters
   ParamHost* host = nullptr;
   std::uint32_t letters = 0;            ///< bit (letter - 'a') per letter word allowed
+  std::uint32_t mapped_away = 0;        ///< axis letters the axis map sends to an axis the machine lacks
   bool lathe_diameter = false;          ///< G7: X words are diameters
   bool comp_on = false;                 ///< cutter compensation active (#5420-5428 unreadable)
   int call_level = 0;
@@ -35,6 +43,11 @@ struct ParseEnv {
   bool defining_sub = false;            ///< passing over `o<name> sub` .. `endsub`
   std::string_view defining_name;
   std::string_view skipping_to;         ///< label being skipped to ("" = not skipping)
+  Dialect dialect = Dialect::LinuxCnc;
+  const Extensions* ext = nullptr;      ///< modal groups of codes the core does not know
+  /// Fanuc: variables #0..#999 without a value.
+  const std::bitset<kFanucVariableCount>* vacant = nullptr;
+  bool fanuc() const noexcept { return dialect == Dialect::Fanuc; }
 };
 
 /// Reads blocks. Reuses its buffers; after warm-up a block allocates nothing unless it has
@@ -50,6 +63,8 @@ class Parser {
 
   std::vector<std::pair<int, double>> numbered_assignments;
   std::vector<std::pair<std::string, double>> named_assignments;
+  /// Fanuc: numbered assignments whose value is vacant (`#2 = #0`, `#2 = #1` with #1 vacant).
+  std::vector<int> vacant_assignments;
 
  private:
   // One parse in progress.
@@ -78,10 +93,26 @@ class Parser {
   static int plain_code(Cursor& c) noexcept;
   double real_number(Cursor& c);
   [[noreturn, gnu::cold]] static void bad_number(const char* start, const char* after, const char* text, bool malformed);
-  double expression(Cursor& c);
+  /// A bracketed expression; `open`: a Fanuc assignment's right-hand side, which runs to the
+  /// end of the line or a comment without brackets.
+  double expression(Cursor& c, bool open = false);
   double parameter(Cursor& c, bool exists_only);
   double unary(Cursor& c);
-  int binary_operator(Cursor& c);
+  int binary_operator(Cursor& c, bool open);
+  int code_group(int code, bool m_code, const ParseEnv& env) const noexcept;
+
+  // fanuc_parse.cpp: the Fanuc dialect's statements
+  bool read_fanuc_statement(Cursor& c, Block& b);
+  void read_goto(Cursor& c, Block& b);
+  void read_if(Cursor& c, Block& b);
+  void read_while(Cursor& c, Block& b, bool with_condition);
+  void read_macro_call(Cursor& c, Block& b);
+  void read_statement_tail(Cursor& c, Block& b);
+  int loop_number(Cursor& c);
+  void check_fanuc_assignment(int index, int pos) const;
+  double fanuc_unary(int op, double x, int pos) const;
+
+  bool value_vacant_ = false;   ///< Fanuc: the last real_value was a bare vacant variable
 };
 
 /// G code (×10) → modal group, -1 if unknown. M code → group, -1 if unknown.

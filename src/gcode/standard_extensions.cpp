@@ -8,18 +8,19 @@
 #include "opencnc/gcode/threading.hpp"
 #include "opencnc/gcode/lathe_cycles.hpp"
 #include "opencnc/gcode/splines.hpp"
+#include "fanuc_codes.hpp"
 
 namespace opencnc::gcode {
 
 std::shared_ptr<const Extensions> standard_extensions(Dialect dialect) {
   auto ext = std::make_shared<Extensions>();
-  (void)dialect;
   add_cutter_compensation(*ext);
   add_canned_cycles(*ext);
   add_threading(*ext);
   add_probing(*ext);
   add_splines(*ext);
   add_lathe_cycles(*ext);
+  if (dialect == Dialect::Fanuc) add_fanuc_codes(*ext);
   return ext;
 }
 

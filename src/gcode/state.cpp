@@ -3,6 +3,7 @@
 #include "opencnc/gcode/state.hpp"
 
 #include <bit>
+#include <bitset>
 #include <cstring>
 #include <string_view>
 
@@ -105,6 +106,47 @@ void hash_comp_move(Fnv& h, const CompQueuedMove& q) noexcept {
   h.i64(q.turn);
 }
 
+void hash_transform(Fnv& h, const TransformState& t) noexcept {
+  h.u64(t.mirror_axes);
+  h.pose(t.mirror_at);
+  h.flag(t.scaling);
+  h.pose(t.scale_centre);
+  for (double v : t.scale) h.f64(v);
+  h.flag(t.rotating);
+  h.u64(static_cast<std::uint64_t>(t.rotation_plane));
+  h.f64(t.rotation_centre1);
+  h.f64(t.rotation_centre2);
+  h.f64(t.rotation_deg);
+}
+
+template <std::size_t N>
+void hash_bits(Fnv& h, const std::bitset<N>& b) noexcept {
+  for (std::size_t i = 0; i < N; i += 64) {
+    std::uint64_t word = 0;
+    for (std::size_t k = 0; k < 64 && i + k < N; ++k) word |= static_cast<std::uint64_t>(b[i + k]) << k;
+    h.u64(word);
+  }
+}
+
+void hash_fanuc_frame(Fnv& h, const FanucFrame& f) noexcept {
+  h.pos(f.body);
+  h.u64(f.program);
+  h.u64(f.repeats_left);
+  h.flag(f.macro);
+  h.flag(f.started);
+  for (double v : f.saved_locals) h.f64(v);
+  hash_bits(h, f.saved_vacant);
+  h.flag(f.range);
+  h.pos(f.range_end);
+  h.pose(f.range_return);
+  h.u64(f.loops.size());
+  for (const FanucLoop& l : f.loops) {
+    h.i64(l.id);
+    h.pos(l.start);
+    h.pos(l.after_end);
+  }
+}
+
 }  // namespace
 
 std::uint64_t InterpState::digest() const noexcept {
@@ -131,6 +173,7 @@ std::uint64_t InterpState::digest() const noexcept {
     h.pos(f.return_to);
     h.u64(f.context);
     hash_saved(h, f.saved);
+    hash_fanuc_frame(h, f.fanuc);
   }
   h.u64(control.labels.size());
   for (const auto& [name, l] : control.labels) {
@@ -163,6 +206,14 @@ std::uint64_t InterpState::digest() const noexcept {
   h.i64(spline.order);
   h.f64(spline.g5_i);
   h.f64(spline.g5_j);
+  hash_transform(h, fanuc.transform);
+  for (double v : {fanuc.cycles.rough_depth, fanuc.cycles.rough_retract, fanuc.cycles.groove_retract,
+                   fanuc.cycles.thread_chamfer, fanuc.cycles.thread_angle_deg, fanuc.cycles.thread_min_depth,
+                   fanuc.cycles.thread_allowance})
+    h.f64(v);
+  h.i64(fanuc.cycles.thread_finish_passes);
+  hash_bits(h, fanuc.vacant);
+  h.f64(fanuc.spindle_clamp_rpm);
   h.pos(next);
   h.flag(percent_delimited);
   h.flag(ended);

@@ -175,6 +175,12 @@ INSTANTIATE_TEST_SUITE_P(
                 with("[axis.x.sim]\nposition_gain = 500\n"),
                 {"config.range", "bad.toml", 8, 17}},
         BadCase{"NoName", replaced("name = \"test\"\n", ""), {"config.missing-key", "bad.toml", 1, 1}},
+        BadCase{"AxisMapNotAnExchange",
+                with("[interpreter]\naxis_map = \"X=Z,Y=Z\"\n"),
+                {"config.range", "bad.toml", 8, 12}},
+        BadCase{"UnknownMachineKind",
+                with("[interpreter]\nmachine = \"router\"\n"),
+                {"config.range", "bad.toml", 8, 11}},
         BadCase{"FrictionOrder",
                 with("[axis.x.sim]\ncoulomb_friction_n = 50\nstatic_friction_n = 40\n"),
                 {"config.range", "bad.toml", 9, 21}}),
@@ -310,6 +316,16 @@ TEST(ProfileOverride, ReplacesValues) {
   EXPECT_EQ(load.profile->find(Axis::Y)->sim.inertia, 300.0);
   EXPECT_EQ(load.profile->interpreter.dialect, Dialect::Fanuc);
   EXPECT_EQ(load.profile->spindle.sim.acceleration_rpm_s, 1000.0);
+}
+
+TEST(ProfileOverride, FanucLatheWithAnAxisExchange) {
+  const ProfileLoad load = with_overrides({"interpreter.dialect=fanuc", "interpreter.machine=lathe",
+                                           "interpreter.axis_map=\"X=Y\""});
+  ASSERT_TRUE(load.ok()) << all_messages(load.diagnostics);
+  const InterpreterOptions& o = load.profile->interpreter;
+  EXPECT_EQ(o.machine, MachineKind::Lathe);
+  EXPECT_EQ(o.axis_map[index(Axis::X)], Axis::Y);
+  EXPECT_EQ(o.axis_map[index(Axis::Y)], Axis::X);
 }
 
 TEST(ProfileOverride, AddsKeys) {

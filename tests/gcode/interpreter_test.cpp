@@ -594,12 +594,10 @@ TEST(InterpreterExtensions, UnsupportedFeaturesNameTheirCode) {
   }
 }
 
-TEST(InterpreterExtensions, TheFanucDialectIsNotThereYet) {
-  Options options;
-  options.dialect = Dialect::Fanuc;
-  Interpreter interp(options);
+TEST(InterpreterExtensions, FanucSubprogramsAreRefusedInTheLinuxCncDialect) {
+  Interpreter interp;
   canon::Sink quiet;
-  EXPECT_EQ(run_into(interp, quiet, "O1000\nG0 X1\nM30\n"), RunStatus::Error);
+  EXPECT_EQ(run_into(interp, quiet, "G21\nM98 P1000\nM30\n"), RunStatus::Error);
   EXPECT_EQ(first_code(interp), "gcode.unsupported");
 }
 
@@ -639,15 +637,15 @@ class CountingM : public CodeHandler {
 // Scales every motion by 2 (a stand-in for G51 scaling).
 class Doubling : public CoordinateTransform {
  public:
-  bool active() const override { return true; }
-  Pose point(const Pose& p) const override {
+  bool active(const InterpState&) const override { return true; }
+  Pose point(const InterpState&, const Pose& p) const override {
     Pose q = p;
     for (int i = 0; i < 3; ++i) q[i] *= 2;
     return q;
   }
-  void arc(canon::ArcFeed& a) const override {
+  void arc(const InterpState& s, canon::ArcFeed& a) const override {
     a.first_end *= 2, a.second_end *= 2, a.first_center *= 2, a.second_center *= 2, a.axis_end *= 2;
-    a.end = point(a.end);
+    a.end = point(s, a.end);
   }
 };
 

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "opencnc/core/axes.hpp"
+#include "opencnc/core/axis_map.hpp"
 #include "opencnc/machine/machine_io.hpp"
 #include "opencnc/machine/sim_config.hpp"
 
@@ -76,9 +77,13 @@ struct IoProfile {
 };
 
 enum class Dialect : std::uint8_t { LinuxCnc, Fanuc };
+/// How Fanuc programs read: lathe conventions (X diameter, U/W, T0101, G50 S) or a mill's.
+enum class MachineKind : std::uint8_t { Mill, Lathe };
 
 struct InterpreterOptions {
   Dialect dialect = Dialect::LinuxCnc;
+  MachineKind machine = MachineKind::Mill;
+  AxisMap axis_map = identity_axis_map();    ///< program axis letter → machine axis
   std::vector<std::string> subroutine_path;  ///< folders searched for O-word subroutines
   std::string tool_table;                    ///< tool table file; empty = none
 };

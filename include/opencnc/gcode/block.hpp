@@ -20,7 +20,9 @@ enum GGroup : int {
   kGroupNonModal = 0, kGroupMotion = 1, kGroupPlane = 2, kGroupDistance = 3, kGroupIjkDistance = 4,
   kGroupFeedMode = 5, kGroupUnits = 6, kGroupCutterComp = 7, kGroupToolLength = 8,
   kGroupRetract = 10, kGroupCoordSystem = 12, kGroupControl = 13, kGroupSpindleMode = 14,
-  kGroupLatheDiameter = 15, kGGroupCount = 16
+  kGroupLatheDiameter = 15,
+  // Groups of codes only extensions know (the Fanuc dialect's G50/G51, G50.1/G51.1, G68/G69).
+  kGroupScaling = 16, kGroupMirror = 17, kGroupRotation = 18, kGGroupCount = 19
 };
 /// LinuxCNC's M modal groups (indices into Block::m).
 enum MGroup : int {
@@ -32,7 +34,13 @@ enum MGroup : int {
 enum class OWord : std::uint8_t {
   None, Sub, EndSub, Call, Do, While, If, ElseIf, Else, EndIf, Break, Continue, EndWhile,
   Return, Repeat, EndRepeat,
-  Program   ///< a bare O number (Fanuc program number line)
+  Program,     ///< a bare O number (Fanuc program number line)
+  // Fanuc macro statements (docs/dialects.md):
+  Goto,        ///< GOTO n, or IF [..] GOTO n whose condition holds (o_value = n)
+  FanucWhile,  ///< WHILE [..] DO m, or DO m alone (o_value = condition, loop_id = m)
+  FanucEnd,    ///< END m (loop_id = m)
+  MacroCall,   ///< G65 P.. L.. with arguments (o_value = program, args by local variable)
+  BlockRange,  ///< Fanuc lathe G70 P Q: run the blocks numbered P to Q (args[0], args[1]; F in args[2])
 };
 
 /// One parsed block. Letter words are stored by letter; integer words (H, L, M, T) are
@@ -48,6 +56,9 @@ struct Block {
   int m_count = 0;
   int motion = -1;                          ///< motion to perform (G ×10), -1 = none
   bool n_present = false;
+  bool extension_groups = false;            ///< a code in a group only extensions know (>= kGroupScaling)
+  std::int64_t n_number = -1;               ///< the N word's whole number (-1: none or too long)
+  std::uint32_t decimal = 0;                ///< Fanuc: bit per letter word written with a decimal point
   std::string_view comment;                 ///< text of the last ( ) comment
   bool has_comment = false;
   bool radius_flag = false, theta_flag = false;   ///< polar @ and ^ words
@@ -61,8 +72,11 @@ struct Block {
   std::string o_name;                       ///< label key ("sub#100") or sub name
   std::array<double, kSubArgumentCount> args{};   ///< `call` arguments
   int arg_count = 0;
+  std::uint32_t arg_given = 0;              ///< G65: bit k set when local #k+1 is an argument
   double o_value = 0;                       ///< condition of if/while/repeat, value of return
   bool o_has_value = false;
+  int loop_id = 0;                          ///< Fanuc DO/END number
+  int repeat = 1;                           ///< G65 L: times the macro runs
 
   bool has(char letter) const noexcept { return (words >> (letter - 'a')) & 1u; }
   double get(char letter) const noexcept { return value[static_cast<std::size_t>(letter - 'a')]; }
@@ -114,12 +128,18 @@ struct Block {
     m_count = 0;
     motion = -1;
     n_present = false;
+    extension_groups = false;
+    n_number = -1;
+    decimal = 0;
     has_comment = false;
     comment = {};
     radius_flag = theta_flag = dollar_flag = false;
     o_type = OWord::None;
     arg_count = 0;
+    arg_given = 0;
     o_has_value = false;
+    loop_id = 0;
+    repeat = 1;
   }
 };
 

@@ -213,6 +213,30 @@ namespace opencnc::gcode {
   X(OwordNotInSub, "gcode.oword-not-in-sub")                                 \
   X(OwordTooManyArgs, "gcode.oword-too-many-args")                           \
   X(OwordInMdi, "gcode.oword-in-mdi")                                        \
+  /* Fanuc dialect and coordinate transforms */                              \
+  X(FanucGotoTargetMissing, "fanuc.goto-target-missing")                     \
+  X(FanucEndWithoutDo, "fanuc.end-without-do")                               \
+  X(FanucDoWithoutEnd, "fanuc.do-without-end")                               \
+  X(FanucLoopStructure, "fanuc.loop-structure")                              \
+  X(FanucIfSyntax, "fanuc.if-syntax")                                        \
+  X(FanucProgramNotFound, "fanuc.program-not-found")                         \
+  X(FanucCallProgramMissing, "fanuc.call-program-missing")                   \
+  X(FanucCallCountConflict, "fanuc.call-count-conflict")                     \
+  X(FanucStatementSyntax, "fanuc.statement-syntax")                          \
+  X(FanucCycleWordMissing, "fanuc.cycle-word-missing")                       \
+  X(FanucCycleWordValue, "fanuc.cycle-word-value")                           \
+  X(FanucScaleWords, "fanuc.scale-words")                                    \
+  X(FanucRotationAngleMissing, "fanuc.rotation-angle-missing")               \
+  X(FanucRotationPlane, "fanuc.rotation-plane")                              \
+  X(FanucProgramEndMissing, "fanuc.program-end-missing")                     \
+  X(FanucReadOnlyVariable, "fanuc.read-only-variable")                       \
+  X(FanucVariableUnavailable, "fanuc.variable-unavailable")                  \
+  X(FanucAlarm, "fanuc.alarm")                                               \
+  X(FanucMirrorAxesMissing, "fanuc.mirror-axes-missing")                     \
+  X(FanucScaleZero, "fanuc.scale-zero")                                      \
+  X(FanucRotationPlaneChange, "fanuc.rotation-plane-change")                 \
+  X(FanucArcNonUniformScale, "fanuc.arc-nonuniform-scale")                   \
+  X(FanucTransformActive, "fanuc.transform-active")                          \
   /* runaway protection */                                                   \
   X(LimitCallDepth, "gcode.limit-call-depth")                                \
   X(LimitBlocks, "gcode.limit-blocks")                                       \

@@ -99,6 +99,20 @@ class CodeHandler {
     return std::nullopt;
   }
   virtual void execute(ExecContext& ctx, const Block& block, int code) = 0;
+
+  /// What the core needs to read a code it does not know itself (a dialect's own codes, such
+  /// as Fanuc's G68): its modal group (GGroup or MGroup; -1 = unknown), the letter words it
+  /// takes (bit letter - 'a'; the core's rules for unused words skip them), whether the
+  /// block's axis words are its data (as for G92) rather than a motion, and whether the
+  /// handler checks all of its block's words itself (the core's word and axis rules are
+  /// skipped, as for a dialect's own version of a cycle the core knows, such as Fanuc's G76).
+  struct Traits {
+    int group = -1;
+    std::uint32_t words = 0;
+    bool axis_words = false;
+    bool all_words = false;
+  };
+  virtual Traits traits(int /*code*/) const { return {}; }
 };
 
 /// Where cutter radius compensation sits: every programmed straight and arc move in the
@@ -121,14 +135,16 @@ class MotionStage {
 };
 
 /// Rotation, scaling and mirroring (Fanuc G68/G51/G51.1), applied to motion end points and
-/// arcs in program coordinates before axis mapping and canonical output.
+/// arcs in program coordinates before axis mapping and canonical output. The transform keeps
+/// no state of its own: what G68 and the like set lives in the InterpState it is given, so
+/// one Extensions object serves any number of interpreters.
 class CoordinateTransform {
  public:
   virtual ~CoordinateTransform() = default;
-  virtual bool active() const = 0;
-  virtual Pose point(const Pose& p) const = 0;
+  virtual bool active(const InterpState& state) const = 0;
+  virtual Pose point(const InterpState& state, const Pose& p) const = 0;
   /// Transforms an arc in place; may throw GcodeError when the arc cannot stay an arc.
-  virtual void arc(canon::ArcFeed& arc) const = 0;
+  virtual void arc(const InterpState& state, canon::ArcFeed& arc) const = 0;
 };
 
 /// The registry handed to the interpreter through Options::extensions.

@@ -16,10 +16,15 @@ namespace opencnc::gcode {
 
 struct Extensions;
 
-/// The G-code language the interpreter reads. Only LinuxCNC is implemented; a Fanuc dialect
-/// (O-numbered programs, M98/M99, GOTO, IF/WHILE, G68/G51/G51.1) plugs in through
-/// extension.hpp and selects itself here.
+/// The G-code language the interpreter reads: LinuxCNC 2.9's RS274/NGC, or Fanuc-style
+/// G-code (O-numbered programs, M98/M99, G65, GOTO/IF/WHILE, macro variables, G68/G51/G51.1;
+/// docs/dialects.md). The Fanuc dialect's codes come with standard_extensions(Dialect::Fanuc).
 enum class Dialect : std::uint8_t { LinuxCnc, Fanuc };
+
+/// The kind of machine a program is for. Fanuc programs read differently on lathes: X words
+/// are diameters, U and W are incremental X and Z, T0101 names tool and offset, G50 S clamps
+/// the spindle, G98/G99 are feed per minute/revolution and ZX (G18) is the default plane.
+enum class MachineKind : std::uint8_t { Mill, Lathe };
 
 /// Execute: stop before a block that needs machine feedback (probe result, M66 input,
 /// tool change) until the caller supplies it with Interpreter::sync(). Scan: never stop;
@@ -41,6 +46,7 @@ struct Limits {
 /// Everything the interpreter is configured with. Plain data; copy freely.
 struct Options {
   Dialect dialect = Dialect::LinuxCnc;
+  MachineKind machine = MachineKind::Mill;   ///< used by the Fanuc dialect
   Mode mode = Mode::Scan;
   /// Axes the machine has; an axis word outside the mask is an error (as in rs274, whose
   /// default is XYZABC).

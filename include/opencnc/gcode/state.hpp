@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <bitset>
 #include <cstdint>
 #include <map>
 #include <string>
@@ -130,6 +131,77 @@ struct SavedContext {
   bool operator==(const SavedContext&) const = default;
 };
 
+/// Fanuc coordinate transforms (G51.1 mirroring, G51 scaling, G68 rotation). Motion passes
+/// through them in Fanuc's order, mirror then scale then rotate, each about a centre fixed in
+/// that stage's input coordinates when it was programmed (docs/dialects.md).
+struct TransformState {
+  std::uint16_t mirror_axes = 0;   ///< bit per axis (Axis order) mirrored by G51.1
+  Pose mirror_at{};                ///< the mirror line (coordinate) of each mirrored axis
+  bool scaling = false;            ///< G51
+  Pose scale_centre{};
+  std::array<double, 3> scale{1.0, 1.0, 1.0};   ///< X Y Z factors (negative mirrors)
+  bool rotating = false;           ///< G68
+  canon::Plane rotation_plane = canon::Plane::XY;
+  double rotation_centre1 = 0;     ///< centre in the plane's first and second axis
+  double rotation_centre2 = 0;
+  double rotation_deg = 0;         ///< counterclockwise from the first axis toward the second
+  bool active() const noexcept { return mirror_axes != 0 || scaling || rotating; }
+  bool operator==(const TransformState&) const = default;
+};
+
+/// A Fanuc WHILE/DO loop being run: its DO number, where its WHILE (or DO) line starts and
+/// where reading continues after its END line.
+struct FanucLoop {
+  int id = 0;
+  SourcePosition start;
+  SourcePosition after_end;
+  bool operator==(const FanucLoop&) const = default;
+};
+
+inline constexpr int kFanucLocalCount = 33;   ///< #1..#33, local to a G65 macro level
+
+/// The Fanuc dialect's part of one call level (the main program or an M98/G65 call).
+struct FanucFrame {
+  SourcePosition body;              ///< start of the program (its O line, or the file start)
+  std::uint32_t program = 0;        ///< its O number (0: the main program without one)
+  std::uint32_t repeats_left = 0;   ///< M98/G65 L: runs still to come after this one
+  bool macro = false;               ///< G65: own local variables #1..#33
+  bool started = false;             ///< a block other than its O line has run
+  std::array<double, kFanucLocalCount> saved_locals{};   ///< G65: the caller's #1..#33
+  std::bitset<kFanucLocalCount + 1> saved_vacant;         ///< ... and which were vacant
+  std::vector<FanucLoop> loops;     ///< DO loops running at this level, innermost last
+  bool range = false;               ///< G70: a run of the caller's blocks N P .. N Q
+  SourcePosition range_end;         ///< G70: the block N Q (the run ends after it)
+  Pose range_return{};              ///< G70: where the tool goes back to afterwards
+  bool operator==(const FanucFrame&) const = default;
+};
+
+inline constexpr int kFanucVariableCount = 1000;   ///< #0..#999 can be vacant
+
+/// What the first block of a Fanuc two-block lathe cycle sets for the blocks after it.
+struct FanucCycleSettings {
+  double rough_depth = 0;        ///< G71 U(d) / G72 W(d): depth of cut (0: not set)
+  double rough_retract = 0;      ///< G71/G72 R(e): retract after each cut
+  double groove_retract = 0;     ///< G75 R(e): retract after each peck (0: not set)
+  int thread_finish_passes = 1;  ///< G76 P(m): finishing passes
+  double thread_chamfer = 0;     ///< G76 P(r): pull-out length in tenths of the lead
+  double thread_angle_deg = 60;  ///< G76 P(a): tool angle (infeed along half of it)
+  double thread_min_depth = 0;   ///< G76 Q(dmin): smallest depth of cut
+  double thread_allowance = 0;   ///< G76 R(d): finishing allowance
+  bool operator==(const FanucCycleSettings&) const = default;
+};
+
+/// The Fanuc dialect's program-wide state.
+struct FanucState {
+  TransformState transform;
+  FanucCycleSettings cycles;
+  /// Macro variables without a value (Fanuc's <vacant>): #0 always, #1..#33 and #100..#999
+  /// until assigned. Vacant reads as 0 in arithmetic (docs/dialects.md).
+  std::bitset<kFanucVariableCount> vacant;
+  double spindle_clamp_rpm = 0;     ///< G50 S / G92 S: highest spindle speed (0: none)
+  bool operator==(const FanucState&) const = default;
+};
+
 /// One level of the subprogram call stack.
 struct CallFrame {
   std::string sub;                                 ///< name of the running subprogram
@@ -138,6 +210,7 @@ struct CallFrame {
   SourcePosition return_to;                        ///< where the caller continues
   std::uint32_t context = 0;                       ///< SourceMap context of this level
   SavedContext saved;
+  FanucFrame fanuc;                                ///< Fanuc dialect only
   bool operator==(const CallFrame&) const = default;
 };
 
@@ -218,6 +291,7 @@ struct InterpState {
   CompState comp;                                      ///< cutter compensation's held moves
   CycleState cycle;
   SplineState spline;
+  FanucState fanuc;                                    ///< Fanuc dialect only
   SourcePosition next;                                 ///< next line to read
   bool percent_delimited = false;                      ///< file started with '%'
   bool ended = false;                                  ///< M2/M30 or closing '%' reached
