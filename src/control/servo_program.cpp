@@ -45,6 +45,7 @@ traj::TickInput Servo::program_inputs() noexcept {
   in.rapid_override = rapid_override_;
   in.feed_hold = hold_;
   in.cycle_start = take(cycle_start_edge_);
+  released_ = in.cycle_start;
   in.abort = take(abort_edge_);
   in.single_block = single_block_;
   in.optional_stop = optional_stop_;
@@ -93,7 +94,7 @@ void Servo::map_program_state() noexcept {
     set_state(State::Running);
   } else if (hold_) {
     set_state(State::Held);
-  } else if (tick_out_.state == traj::RunState::WaitingCycleStart) {
+  } else if (tick_out_.state == traj::RunState::WaitingCycleStart && !released_) {
     const traj::MotionBlock* b = block(tick_out_.block_seq);
     const traj::MarkerKind k = b != nullptr ? b->marker : traj::MarkerKind::None;
     set_state(State::Stopped);

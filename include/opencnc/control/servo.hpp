@@ -164,6 +164,7 @@ class Servo final : public Tickable {
   Mode run_mode_ = Mode::Auto;
   bool hold_ = false;
   bool cycle_start_edge_ = false, abort_edge_ = false, sync_done_edge_ = false;
+  bool released_ = false;  ///< cycle start reached the interpolator this period
   bool aborting_ = false;
   double feed_override_ = 1, rapid_override_ = 1, spindle_override_ = 1;
   bool single_block_ = false, optional_stop_ = false;
