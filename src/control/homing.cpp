@@ -16,6 +16,7 @@ void JointHoming::start(const HomeConfig& c, const HomingInputs& in) noexcept {
   stopping_ = false;
   latch_on_release_ = false;
   index_count_ = in.index_count;
+  previous_feedback_ = in.feedback;
   switch (c.method) {
     case HomeMethod::Immediate:
       phase_ = HomingPhase::Latch;
@@ -39,8 +40,7 @@ void JointHoming::cancel(AxisMover& mover) noexcept {
   stopping_ = false;
 }
 
-bool JointHoming::trigger(const HomeConfig& c, const HomingInputs& in) const noexcept {
-  (void)c;
+bool JointHoming::trigger(const HomingInputs& in) const noexcept {
   return latch_on_release_ ? !in.home_switch : in.home_switch;
 }
 
@@ -61,6 +61,11 @@ void JointHoming::after_switch_latch(const HomeConfig& c, AxisMover& mover) noex
 }
 
 void JointHoming::tick(const HomeConfig& c, const HomingInputs& in, AxisMover& mover, double& offset) noexcept {
+  step(c, in, mover, offset);
+  previous_feedback_ = in.feedback;
+}
+
+void JointHoming::step(const HomeConfig& c, const HomingInputs& in, AxisMover& mover, double& offset) noexcept {
   if (stopping_) {
     if (!mover.settled()) return;
     stopping_ = false;
@@ -112,8 +117,10 @@ void JointHoming::tick(const HomeConfig& c, const HomingInputs& in, AxisMover& m
         break;
       }
       mover.run_at(c.latch_velocity);
-      if (trigger(c, in)) {
-        if (c.method != HomeMethod::SwitchIndex) latch(c, in.feedback, offset);
+      if (trigger(in)) {
+        // The edge came between the last sample and this one: take the middle, which halves
+        // the error the sampling adds (latch velocity × period).
+        if (c.method != HomeMethod::SwitchIndex) latch(c, 0.5 * (in.feedback + previous_feedback_), offset);
         index_count_ = in.index_count;
         after_switch_latch(c, mover);
       }

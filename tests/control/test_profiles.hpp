@@ -90,7 +90,7 @@ method = "decel_home"
 position = -5.0
 switch_position = 0.0
 search_velocity = 30.0
-latch_velocity = 1.0
+latch_velocity = 0.5
 sequence = 0
 [axis.z.switches]
 decel = [40.0, inf]

@@ -59,13 +59,15 @@ class JointHoming {
  private:
   void latch(const HomeConfig& config, double joint_position, double& offset) noexcept;
   void after_switch_latch(const HomeConfig& config, AxisMover& mover) noexcept;
-  bool trigger(const HomeConfig& config, const HomingInputs& in) const noexcept;
+  void step(const HomeConfig& config, const HomingInputs& in, AxisMover& mover, double& offset) noexcept;
+  bool trigger(const HomingInputs& in) const noexcept;
 
   HomingPhase phase_ = HomingPhase::Idle;
   bool stopping_ = false;         ///< waiting for the mover to settle before the next phase
   bool latch_on_release_ = false;  ///< Latch waits for the switch to release
   std::uint32_t index_count_ = 0;  ///< index count when Index began
   double latched_at_ = 0;
+  double previous_feedback_ = 0;  ///< feedback of the last period, for the latch
   double offset_ = 0;  ///< the latched offset, for the final move
 };
 
