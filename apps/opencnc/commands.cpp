@@ -9,6 +9,7 @@ namespace opencnc::cli {
 void register_all(CLI::App& app, Registry& registry) {
   add_latency_command(app, registry);
   add_profile_command(app, registry);
+  add_gcode_commands(app, registry);
 }
 
 }  // namespace opencnc::cli

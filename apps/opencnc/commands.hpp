@@ -30,5 +30,7 @@ void register_all(CLI::App& app, Registry& registry);
 // One function per subcommand (cmd_<name>.cpp).
 void add_latency_command(CLI::App& app, Registry& registry);
 void add_profile_command(CLI::App& app, Registry& registry);
+// One function per subcommand group (cmd_<name>.cpp).
+void add_gcode_commands(CLI::App& app, Registry& registry);   ///< check, canon, scan
 
 }  // namespace opencnc::cli

@@ -7,7 +7,9 @@ namespace opencnc::canon {
 Program::Program(AxisMask axes) : axes_(axes), sources_(std::make_shared<SourceMap>()) {
   int slot = 0;
   for (int i = 0; i < kAxisCount; ++i) {
-    if (axes_.has(static_cast<Axis>(i))) axis_slots_[i] = static_cast<std::uint8_t>(slot++);
+    if (!axes_.has(static_cast<Axis>(i))) continue;
+    axis_slots_[i] = static_cast<std::uint8_t>(slot);
+    slot_axes_[slot++] = static_cast<std::uint8_t>(i);
   }
   stride_ = slot;
 }
@@ -15,9 +17,7 @@ Program::Program(AxisMask axes) : axes_(axes), sources_(std::make_shared<SourceM
 Pose Program::end(SegmentId id) const noexcept {
   Pose p{};
   const std::size_t base = static_cast<std::size_t>(id) * static_cast<std::size_t>(stride_);
-  for (int i = 0; i < kAxisCount; ++i) {
-    if (axes_.has(static_cast<Axis>(i))) p[i] = coords_[base + axis_slots_[i]];
-  }
+  for (int s = 0; s < stride_; ++s) p[slot_axes_[s]] = coords_[base + static_cast<std::size_t>(s)];
   return p;
 }
 
@@ -35,9 +35,9 @@ std::uint32_t Program::file_of(SegmentId id) const {
 
 SegmentId Program::append(const Move& m, const Pose& end) {
   moves_.push_back(m);
-  for (int i = 0; i < kAxisCount; ++i) {
-    if (axes_.has(static_cast<Axis>(i))) coords_.push_back(end[i]);
-  }
+  double values[kAxisCount];
+  for (int s = 0; s < stride_; ++s) values[s] = end[slot_axes_[s]];
+  coords_.append(values, static_cast<std::size_t>(stride_));
   return moves_.size() - 1;
 }
 

@@ -25,11 +25,15 @@ Pose ProgramBuilder::offset_to_mm(const Pose& offset) const noexcept {
 }
 
 Pose ProgramBuilder::to_machine(const Pose& canonical) const noexcept {
-  Pose p = offset_to_mm(canonical);
-  for (int i = 0; i < kAxisCount; ++i) p[i] += g92_[i];
-  const double x = p[0], y = p[1];
-  p[0] = x * rot_cos_ - y * rot_sin_;
-  p[1] = x * rot_sin_ + y * rot_cos_;
+  // Once per move: one pass per stage, no temporaries.
+  Pose p;
+  const double k = mm_per_unit(units_);
+  for (int i = 0; i < kAxisCount; ++i) p[i] = (is_linear(i) ? canonical[i] * k : canonical[i]) + g92_[i];
+  if (rotation_deg_ != 0) {
+    const double x = p[0], y = p[1];
+    p[0] = x * rot_cos_ - y * rot_sin_;
+    p[1] = x * rot_sin_ + y * rot_cos_;
+  }
   for (int i = 0; i < kAxisCount; ++i) p[i] += g5x_[i] + tool_[i];
   return p;
 }

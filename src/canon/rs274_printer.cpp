@@ -24,10 +24,27 @@ void Rs274Printer::flush() {
   if (out_ != nullptr) std::fflush(out_);
 }
 
+namespace {
+// Decimal digits of v (v >= 0) right-aligned ending at `end`; returns the first digit.
+char* digits_before(char* end, unsigned long v) {
+  do {
+    *--end = static_cast<char>('0' + v % 10);
+    v /= 10;
+  } while (v != 0);
+  return end;
+}
+}  // namespace
+
 void Rs274Printer::prefix() {
-  char seq[16];
-  int n = std::snprintf(seq, sizeof seq, "%5d ", sequence_++);
-  buf_.append(seq, static_cast<std::size_t>(n));
+  // "%5d " without printf: this runs once per printed line.
+  char seq[24];
+  char* end = seq + sizeof seq - 1;
+  *end = ' ';
+  const int n = sequence_++;
+  char* first = digits_before(end, static_cast<unsigned long>(n < 0 ? -static_cast<long>(n) : n));
+  if (n < 0) *--first = '-';
+  while (end - first < 5) *--first = ' ';
+  buf_.append(first, static_cast<std::size_t>(end - first + 1));
   if (origin_.n_present) {
     // rs274 copies the N word's digits as written and pads them to six characters.
     buf_.push_back('N');
@@ -46,12 +63,17 @@ void Rs274Printer::end_line() {
   }
 }
 
-void Rs274Printer::num(double v, int decimals) { append_fixed(buf_, v, decimals); }
+void Rs274Printer::num(double v, int decimals) {
+  char tmp[kFixedBufferSize];
+  buf_.append(tmp, format_fixed(tmp, v, decimals));
+}
 
 void Rs274Printer::integer(long v) {
   char tmp[24];
-  int n = std::snprintf(tmp, sizeof tmp, "%ld", v);
-  buf_.append(tmp, static_cast<std::size_t>(n));
+  char* end = tmp + sizeof tmp;
+  char* first = digits_before(end, v < 0 ? 0ul - static_cast<unsigned long>(v) : static_cast<unsigned long>(v));
+  if (v < 0) *--first = '-';
+  buf_.append(first, static_cast<std::size_t>(end - first));
 }
 
 void Rs274Printer::simple(const char* call) {
@@ -306,10 +328,39 @@ void Rs274Printer::set_aux_output_value(int index, double value) {
 }
 
 void Rs274Printer::print(std::string_view text) {
-  // rs274 writes (PRINT,...) text straight to stderr, outside the numbered stream.
+  // rs274 prints (PRINT,...) text as a plain line, outside the numbered stream.
   if (print_stream_ == nullptr) return;
+  if (print_stream_ == out_) {
+    buf_.append(text);
+    end_line();
+    return;
+  }
+  flush();
   std::fwrite(text.data(), 1, text.size(), print_stream_);
   std::fputc('\n', print_stream_);
+}
+
+void Rs274Printer::set_tool_table_entry(int index, int tool, const Pose& offset, double /*diameter*/,
+                                        double front_angle, double back_angle, int orientation) {
+  // rs274 leaves the diameter out of this line.
+  prefix();
+  buf_.append("SET_TOOL_TABLE_ENTRY(");
+  integer(index);
+  buf_.append(", ");
+  integer(tool);
+  buf_.append(", ");
+  for (int i = 0; i < 9; ++i) {
+    if (i > 0) buf_.push_back(' ');
+    num(offset[i]);
+  }
+  buf_.append(", ");
+  num(front_angle);
+  buf_.append(", ");
+  num(back_angle);
+  buf_.append(", ");
+  integer(orientation);
+  buf_.push_back(')');
+  end_line();
 }
 
 }  // namespace opencnc::canon

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstring>
 
 namespace opencnc {
 
@@ -27,29 +28,45 @@ std::size_t format_fixed(char* out, double value, int decimals) noexcept {
     int n = std::snprintf(out, kFixedBufferSize, "%.*f", decimals, value);
     return n > 0 ? static_cast<std::size_t>(n) : 0;
   }
-  std::uint64_t r = static_cast<std::uint64_t>(std::floor(scaled + 0.5));
-  const std::uint64_t int_part = r / kPow10i[decimals];
+  const std::uint64_t r = static_cast<std::uint64_t>(std::floor(scaled + 0.5));
+  std::uint64_t int_part = r / kPow10i[decimals];
   std::uint64_t frac_part = r % kPow10i[decimals];
 
-  char digits[24];
-  int nd = 0;
-  std::uint64_t ip = int_part;
-  do {
-    digits[nd++] = static_cast<char>('0' + ip % 10);
-    ip /= 10;
-  } while (ip != 0);
-
+  // Digits right to left, two at a time.
+  static constexpr char kPairs[] =
+      "0001020304050607080910111213141516171819202122232425262728293031323334353637383940414243444546474849"
+      "5051525354555657585960616263646566676869707172737475767778798081828384858687888990919293949596979899";
+  char digits[32];
+  char* p = digits + sizeof digits;
+  for (int i = decimals; i > 0;) {
+    if (i >= 2) {
+      p -= 2;
+      std::memcpy(p, kPairs + 2 * (frac_part % 100), 2);
+      frac_part /= 100;
+      i -= 2;
+    } else {
+      *--p = static_cast<char>('0' + frac_part % 10);
+      frac_part /= 10;
+      --i;
+    }
+  }
+  if (decimals > 0) *--p = '.';
+  while (int_part >= 100) {
+    p -= 2;
+    std::memcpy(p, kPairs + 2 * (int_part % 100), 2);
+    int_part /= 100;
+  }
+  if (int_part >= 10) {
+    p -= 2;
+    std::memcpy(p, kPairs + 2 * int_part, 2);
+  } else {
+    *--p = static_cast<char>('0' + int_part);
+  }
   std::size_t pos = 0;
   if (std::signbit(value)) out[pos++] = '-';
-  while (nd > 0) out[pos++] = digits[--nd];
-  if (decimals > 0) {
-    out[pos++] = '.';
-    for (int i = decimals - 1; i >= 0; --i) {
-      out[pos + static_cast<std::size_t>(i)] = static_cast<char>('0' + frac_part % 10);
-      frac_part /= 10;
-    }
-    pos += static_cast<std::size_t>(decimals);
-  }
+  const auto n = static_cast<std::size_t>(digits + sizeof digits - p);
+  std::memcpy(out + pos, p, n);
+  pos += n;
   out[pos] = '\0';
   return pos;
 }

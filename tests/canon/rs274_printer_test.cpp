@@ -122,3 +122,42 @@ TEST(Rs274Printer, FormatsModeAndIoCalls) {
             "   11 N..... MESSAGE(\"hello world\")\n"
             "   12 N..... SELECT_PLANE(CANON_PLANE_UNKNOWN)\n");
 }
+
+TEST(Rs274Printer, FormatsToolTableEntriesAsRs274) {
+  Capture cap;
+  {
+    Rs274Printer p(cap.file(), nullptr);
+    Pose offset;
+    offset[Axis::X] = 0.25;
+    offset[Axis::Z] = 1.5;
+    p.set_tool_table_entry(2, 2, offset, 0.2, 10, 20, 3);   // the diameter is not printed
+  }
+  EXPECT_EQ(cap.text(),
+            "    1 N..... SET_TOOL_TABLE_ENTRY(2, 2, 0.2500 0.0000 1.5000 0.0000 0.0000 0.0000 0.0000 0.0000 0.0000, "
+            "10.0000, 20.0000, 3)\n");
+}
+
+TEST(Rs274Printer, PrintTextKeepsItsPlaceAndLongLabelsRunOn) {
+  Capture cap;
+  {
+    Rs274Printer p(cap.file(), cap.file());   // one stream, as `opencnc canon` prints
+    p.use_length_units(Units::Inch);
+    p.print("hello");
+    p.begin_block(with_n("123456789012"));
+    p.straight_traverse(0, Pose{});
+  }
+  EXPECT_EQ(cap.text(),
+            "    1 N..... USE_LENGTH_UNITS(CANON_UNITS_INCHES)\n"
+            "hello\n"
+            "    2 N123456789012STRAIGHT_TRAVERSE(0.0000, 0.0000, 0.0000, 0.0000, 0.0000, 0.0000)\n");
+}
+
+TEST(Rs274Printer, SequenceNumbersWidenPastFiveDigits) {
+  Capture cap;
+  {
+    Rs274Printer p(cap.file(), nullptr);
+    for (int i = 0; i < 100000; ++i) p.flood_off();
+  }
+  const std::string text = cap.text();
+  EXPECT_NE(text.find("\n99999 N..... FLOOD_OFF()\n100000 N..... FLOOD_OFF()\n"), std::string::npos);
+}

@@ -149,6 +149,7 @@ class Program {
   AxisMask axes_;
   int stride_ = 0;
   std::uint8_t axis_slots_[kAxisCount] = {};  ///< stored slot of each axis in the mask
+  std::uint8_t slot_axes_[kAxisCount] = {};   ///< axis stored in each slot
   Pose start_{};
   ChunkedVector<Move> moves_;
   ChunkedVector<double, 16> coords_;

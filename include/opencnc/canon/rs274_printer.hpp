@@ -3,7 +3,10 @@
 #pragma once
 
 #include <cstdio>
+#include <cstring>
+#include <memory>
 #include <string>
+#include <string_view>
 
 #include "opencnc/canon/sink.hpp"
 
@@ -11,10 +14,11 @@ namespace opencnc::canon {
 
 /// Writes `    7 N..... STRAIGHT_FEED(1.0000, ...)` lines, byte-compatible with LinuxCNC 2.9's
 /// standalone interpreter, to a FILE (buffered internally; call flush() at the end).
-/// `(PRINT,...)` text goes to `print_stream` (stderr in rs274). Non-real-time.
+/// `(PRINT,...)` text goes to `print_stream` unnumbered; rs274 writes it to stdout, in order
+/// with the calls (pass the same stream as `out` for that). Non-real-time.
 class Rs274Printer final : public Sink {
  public:
-  explicit Rs274Printer(std::FILE* out, std::FILE* print_stream = stderr);
+  explicit Rs274Printer(std::FILE* out, std::FILE* print_stream = stdout);
   ~Rs274Printer() override;
   Rs274Printer(const Rs274Printer&) = delete;
   Rs274Printer& operator=(const Rs274Printer&) = delete;
@@ -60,6 +64,8 @@ class Rs274Printer final : public Sink {
   void change_tool(int tool) override { indexed("CHANGE_TOOL(", tool); }
   void change_tool_number(int tool) override { indexed("CHANGE_TOOL_NUMBER(", tool); }
   void use_tool_length_offset(const Pose& offset) override;
+  void set_tool_table_entry(int index, int tool, const Pose& offset, double diameter, double front_angle,
+                            double back_angle, int orientation) override;
 
   void mist_on() override { simple("MIST_ON()"); }
   void mist_off() override { simple("MIST_OFF()"); }
@@ -110,9 +116,41 @@ class Rs274Printer final : public Sink {
   void quoted(const char* open, std::string_view text);
   void pose_call(const char* open, const Pose& p);
 
+  // Output buffer: inline appends with memcpy (the printer writes a line per motion).
+  class Buffer {
+   public:
+    void reserve(std::size_t n) {
+      if (n <= cap_) return;
+      auto bigger = std::make_unique<char[]>(n);
+      if (len_ > 0) std::memcpy(bigger.get(), data_.get(), len_);
+      data_ = std::move(bigger);
+      cap_ = n;
+    }
+    void append(const char* s, std::size_t n) {
+      if (len_ + n > cap_) reserve(2 * (len_ + n));
+      std::memcpy(data_.get() + len_, s, n);
+      len_ += n;
+    }
+    void append(std::string_view s) { append(s.data(), s.size()); }
+    void append(const char* s) { append(s, std::strlen(s)); }
+    void push_back(char c) {
+      if (len_ + 1 > cap_) reserve(2 * (len_ + 1));
+      data_[len_++] = c;
+    }
+    const char* data() const noexcept { return data_.get(); }
+    std::size_t size() const noexcept { return len_; }
+    bool empty() const noexcept { return len_ == 0; }
+    void clear() noexcept { len_ = 0; }
+
+   private:
+    std::unique_ptr<char[]> data_;
+    std::size_t len_ = 0;
+    std::size_t cap_ = 0;
+  };
+
   std::FILE* out_;
   std::FILE* print_stream_;
-  std::string buf_;
+  Buffer buf_;
   BlockOrigin origin_;
   int sequence_ = 1;
 };

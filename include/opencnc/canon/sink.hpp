@@ -68,6 +68,10 @@ class Sink {
   virtual void change_tool(int /*tool*/) {}
   virtual void change_tool_number(int /*tool*/) {}
   virtual void use_tool_length_offset(const Pose& /*offset*/) {}
+  /// G10 L1/L10/L11 changed entry `index` of the tool table (0 = the spindle): tool number,
+  /// offsets, diameter, lathe angles and orientation, in the table's units.
+  virtual void set_tool_table_entry(int /*index*/, int /*tool*/, const Pose& /*offset*/, double /*diameter*/,
+                                    double /*front_angle*/, double /*back_angle*/, int /*orientation*/) {}
 
   // --- coolant -----------------------------------------------------------------------
   virtual void mist_on() {}

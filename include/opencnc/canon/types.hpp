@@ -39,7 +39,7 @@ struct BlockOrigin {
   /// listings; `n_present` is false when the block does not start with N.
   bool n_present = false;
   std::uint8_t n_length = 0;
-  char n_digits[14] = {};
+  char n_digits[22] = {};   ///< longer N words are cut (rs274 prints them whole)
 };
 
 /// ARC_FEED arguments as LinuxCNC's canonical interface defines them: the end point in the

@@ -3,6 +3,7 @@
 // stays at the data size (a doubling vector needs up to 3x while it reallocates).
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <memory>
 #include <vector>
@@ -24,6 +25,16 @@ class ChunkedVector {
     slot = value;
     ++size_;
     return slot;
+  }
+  /// Appends `n` values at once (one copy when they fit in the current chunk).
+  void append(const T* values, std::size_t n) {
+    const std::size_t offset = size_ & (kChunk - 1);
+    if (offset != 0 && offset + n <= kChunk) {
+      std::copy_n(values, n, chunks_.back().get() + offset);
+      size_ += n;
+      return;
+    }
+    for (std::size_t i = 0; i < n; ++i) push_back(values[i]);
   }
   const T& operator[](std::size_t i) const noexcept { return chunks_[i >> kChunkShift][i & (kChunk - 1)]; }
   T& operator[](std::size_t i) noexcept { return chunks_[i >> kChunkShift][i & (kChunk - 1)]; }

@@ -1,0 +1,148 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// `opencnc check`, `opencnc canon` and `opencnc scan`: the G-code interpreter on files.
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "commands.hpp"
+#include "gcode_summary.hpp"
+#include "opencnc/canon/rs274_printer.hpp"
+#include "opencnc/gcode/interpreter.hpp"
+#include "opencnc/gcode/standard_extensions.hpp"
+#include "opencnc/gcode/rs274_driver.hpp"
+
+namespace opencnc::cli {
+
+namespace {
+
+struct InterpArgs {
+  std::string tool_table;
+  std::vector<std::string> subroutine_path;
+  bool block_delete = false;
+  bool no_default_tools = false;
+  std::string axes = "XYZABC";
+};
+
+void add_interp_options(CLI::App* cmd, InterpArgs& a) {
+  cmd->add_option("--tool-table,-t", a.tool_table, "LinuxCNC tool table (.tbl)")->check(CLI::ExistingFile);
+  cmd->add_option("--subroutine-path", a.subroutine_path,
+                  "directories searched for o<name> subprogram files (default: the current directory)");
+  cmd->add_flag("--block-delete,-b", a.block_delete, "skip blocks that start with '/'");
+  cmd->add_option("--axes", a.axes, "axes of the machine (default XYZABC, as rs274)");
+  cmd->add_flag("--no-default-tools", a.no_default_tools,
+                "without --tool-table, use an empty table instead of rs274's built-in tools T1-T3");
+}
+
+// rs274's built-in tool table (used when it is given no -t): tools 1..3, lengths and
+// diameters in inches.
+std::shared_ptr<tools::ToolTable> rs274_default_tools() {
+  auto t = std::make_shared<tools::ToolTable>();
+  const double z[] = {0.511, 0.1, 1.273};
+  const double d[] = {0.125, 0.0625, 0.201};
+  for (int i = 0; i < 3; ++i) {
+    tools::ToolEntry e;
+    e.tool = i + 1;
+    e.pocket = i + 1;
+    e.offset[Axis::Z] = z[i];
+    e.diameter = d[i];
+    t->add(e);
+  }
+  return t;
+}
+
+// Builds interpreter options; returns false (after printing why) on a bad tool table.
+bool make_options(const InterpArgs& a, gcode::Options& o) {
+  o.axes = AxisMask::from_letters(a.axes);
+  o.extensions = gcode::standard_extensions(o.dialect);
+  o.block_delete = a.block_delete;
+  o.subroutine_path = a.subroutine_path.empty() ? std::vector<std::string>{"."} : a.subroutine_path;
+  if (!a.tool_table.empty()) {
+    Diagnostics diags;
+    auto table = tools::ToolTable::load(a.tool_table, diags);
+    for (const auto& d : diags.items()) std::fprintf(stderr, "%s [%s]\n", d.format().c_str(), d.code.c_str());
+    if (!table || diags.has_errors()) return false;
+    o.tool_table = std::make_shared<tools::ToolTable>(std::move(*table));
+  } else if (!a.no_default_tools) {
+    o.tool_table = rs274_default_tools();
+  }
+  return true;
+}
+
+void print_diagnostics(const Diagnostics& diags) {
+  for (const auto& d : diags.items()) std::fprintf(stderr, "%s [%s]\n", d.format().c_str(), d.code.c_str());
+}
+
+int run_canon(const std::string& file, const InterpArgs& args) {
+  gcode::Options options;
+  if (!make_options(args, options)) return kExitUsage;
+  gcode::Interpreter interp(options);
+  if (!interp.open(file)) {
+    print_diagnostics(interp.diagnostics());
+    return kExitUsage;
+  }
+  canon::Rs274Printer printer(stdout, stdout);
+  const gcode::RunStatus status = gcode::run_like_rs274(interp, printer);
+  printer.flush();
+  print_diagnostics(interp.diagnostics());
+  return status == gcode::RunStatus::Error ? kExitProgram : kExitOk;
+}
+
+// Runs every file without output; reports each problem as file:line:col.
+int run_check(const std::vector<std::string>& files, const InterpArgs& args) {
+  gcode::Options options;
+  if (!make_options(args, options)) return kExitUsage;
+  bool errors = false;
+  bool unreadable = false;
+  for (const std::string& file : files) {
+    gcode::Interpreter interp(options);
+    canon::Sink quiet;
+    if (!interp.open(file)) {
+      unreadable = true;
+    } else {
+      interp.run(quiet);
+    }
+    for (const auto& d : interp.diagnostics().items()) std::printf("%s [%s]\n", d.format().c_str(), d.code.c_str());
+    errors = errors || interp.diagnostics().has_errors();
+  }
+  if (unreadable) return kExitUsage;
+  return errors ? kExitProgram : kExitOk;
+}
+
+}  // namespace
+
+void add_gcode_commands(CLI::App& app, Registry& registry) {
+  static InterpArgs check_args, canon_args, scan_args;
+  static std::vector<std::string> check_files;
+  static std::string canon_file, scan_file;
+  static bool scan_json = false;
+  static double rapid_rate = 0;
+
+  CLI::App* check = app.add_subcommand("check", "Check G-code programs without moving anything");
+  check->add_option("files", check_files, "programs to check")->required();
+  add_interp_options(check, check_args);
+  check->callback([&registry] { registry.set_result(run_check(check_files, check_args)); });
+
+  CLI::App* canon_cmd = app.add_subcommand("canon", "Print the canonical machining calls of a program (rs274 -g format)");
+  canon_cmd->add_option("file", canon_file, "program")->required();
+  add_interp_options(canon_cmd, canon_args);
+  canon_cmd->callback([&registry] { registry.set_result(run_canon(canon_file, canon_args)); });
+
+  CLI::App* scan = app.add_subcommand("scan", "Summarise a program: moves, length, extents, time, tools, offsets");
+  scan->add_option("file", scan_file, "program")->required();
+  scan->add_flag("--json", scan_json, "print the summary as JSON");
+  scan->add_option("--rapid-rate", rapid_rate, "rapid rate in mm/min for the time estimate (default: rapids not timed)");
+  add_interp_options(scan, scan_args);
+  scan->callback([&registry] {
+    gcode::Options options;
+    if (!make_options(scan_args, options)) {
+      registry.set_result(kExitUsage);
+      return;
+    }
+    registry.set_result(run_scan(scan_file, options, scan_json, rapid_rate));
+  });
+}
+
+}  // namespace opencnc::cli

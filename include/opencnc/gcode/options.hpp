@@ -1,0 +1,71 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Interpreter options: dialect, axes, axis-letter map, search path, tools, runaway limits.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "opencnc/canon/types.hpp"
+#include "opencnc/core/axes.hpp"
+#include "opencnc/tools/tool_table.hpp"
+
+namespace opencnc::gcode {
+
+struct Extensions;
+
+/// The G-code language the interpreter reads. Only LinuxCNC is implemented; a Fanuc dialect
+/// (O-numbered programs, M98/M99, GOTO, IF/WHILE, G68/G51/G51.1) plugs in through
+/// extension.hpp and selects itself here.
+enum class Dialect : std::uint8_t { LinuxCnc, Fanuc };
+
+/// Execute: stop before a block that needs machine feedback (probe result, M66 input,
+/// tool change) until the caller supplies it with Interpreter::sync(). Scan: never stop;
+/// assume what LinuxCNC's stand-alone `rs274` assumes (the probe trips at the programmed end
+/// point, inputs read 0).
+enum class Mode : std::uint8_t { Scan, Execute };
+
+/// Runaway protection: exceeding any limit ends the run with a `gcode.limit-*` error that
+/// names the limit and the line. Zero means "use the default".
+struct Limits {
+  std::uint64_t max_blocks = 200'000'000;           ///< blocks executed (loop bodies count each time)
+  std::uint64_t max_loop_iterations = 50'000'000;   ///< jumps back to a loop start, whole run
+  std::uint32_t max_call_depth = 10;                ///< nested subprogram calls (LinuxCNC allows 10)
+  std::uint64_t max_repeat_count = 10'000'000;      ///< the count of one `repeat [n]`
+  std::uint64_t max_segments = 500'000'000;         ///< motions emitted
+  std::uint64_t max_skipped_lines = 200'000'000;    ///< lines read while seeking a label or a sub
+};
+
+/// Everything the interpreter is configured with. Plain data; copy freely.
+struct Options {
+  Dialect dialect = Dialect::LinuxCnc;
+  Mode mode = Mode::Scan;
+  /// Axes the machine has; an axis word outside the mask is an error (as in rs274, whose
+  /// default is XYZABC).
+  AxisMask axes = kXyzabc;
+  /// Program axis letter → machine axis (axis exchange). Identity by default. Applied to
+  /// canonical output only; the program's own coordinates are unaffected.
+  std::array<Axis, kAxisCount> axis_map = {Axis::X, Axis::Y, Axis::Z, Axis::A, Axis::B,
+                                           Axis::C, Axis::U, Axis::V, Axis::W};
+  /// Directories searched for `name.ngc` when `o<name> call` names no sub defined so far.
+  std::vector<std::string> subroutine_path;
+  /// Tools; shared, never modified by the interpreter (G10 L1 edits a private copy).
+  std::shared_ptr<const tools::ToolTable> tool_table;
+  /// Units of the tool table and of stored offsets/parameters (#5221.., #5161.., #54xx):
+  /// LinuxCNC's machine units. The stand-alone `rs274` uses inches.
+  canon::Units user_units = canon::Units::Inch;
+  /// Length units at program start (before any G20/G21).
+  canon::Units initial_units = canon::Units::Mm;
+  Limits limits;
+  bool block_delete = false;   ///< skip blocks starting with '/'
+  bool optional_stop = true;   ///< M1 stops
+  /// Drop all canonical output until the motion with this segment id (replay to segment k);
+  /// the interpreter state evolves exactly as in a full run. 0 = drop nothing.
+  canon::SegmentId quiet_until_segment = 0;
+  /// Code handlers, compensator and transform of the modules built on the core (extension.hpp).
+  std::shared_ptr<const Extensions> extensions;
+};
+
+}  // namespace opencnc::gcode

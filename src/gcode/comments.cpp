@@ -1,0 +1,106 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Comments: plain comments, (MSG,) (DEBUG,) (PRINT,) (LOG*,) (ABORT,) with parameter
+// values substituted where LinuxCNC substitutes them.
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+
+#include "engine.hpp"
+
+namespace opencnc::gcode {
+
+namespace {
+
+bool starts_with_nocase(std::string_view text, std::string_view prefix) noexcept {
+  if (text.size() < prefix.size()) return false;
+  for (std::size_t i = 0; i < prefix.size(); ++i) {
+    if (std::tolower(static_cast<unsigned char>(text[i])) != prefix[i]) return false;
+  }
+  return true;
+}
+
+void append_value(std::string& out, bool found, double value) {
+  if (!found) {
+    out += "######";
+    return;
+  }
+  if (std::fabs(value) < 1e-4) value = 0.0;   // no "-0.000000" for values that print as zero
+  char buf[64];
+  const int n = std::snprintf(buf, sizeof buf, "%f", value);
+  if (n < 0 || n >= 30) out += "######";
+  else out.append(buf, static_cast<std::size_t>(n));
+}
+
+}  // namespace
+
+std::string Engine::expand_parameters(std::string_view text) {
+  std::string out;
+  std::size_t i = 0;
+  while (i < text.size()) {
+    const char c = text[i];
+    if (c != '#') {
+      out += c;
+      ++i;
+      continue;
+    }
+    ++i;
+    if (i >= text.size()) {
+      out += "######";
+      break;
+    }
+    if (std::isdigit(static_cast<unsigned char>(text[i]))) {
+      long n = 0;
+      while (i < text.size() && std::isdigit(static_cast<unsigned char>(text[i]))) {
+        if (n < 1000000) n = n * 10 + (text[i] - '0');
+        ++i;
+      }
+      const bool found = n >= 0 && n < kParameterCount;
+      append_value(out, found, found ? st_.parameters[static_cast<std::size_t>(n)] : 0.0);
+    } else if (text[i] == '<') {
+      ++i;
+      std::string name;
+      while (i < text.size() && text[i] != '>' && text[i] != ')') {
+        if (!std::isspace(static_cast<unsigned char>(text[i]))) name += static_cast<char>(std::tolower(static_cast<unsigned char>(text[i])));
+        ++i;
+      }
+      if (i >= text.size() || text[i] != '>') fail(ErrorCode::NameNotTerminated, "#< in a comment has no closing '>'");
+      ++i;
+      double v = 0;
+      const bool found = named_value(name, v);
+      append_value(out, found, v);
+    } else {
+      out += '#';
+    }
+  }
+  return out;
+}
+
+void Engine::convert_comment(std::string_view comment) {
+  std::size_t start = 0;
+  while (start < comment.size() && std::isspace(static_cast<unsigned char>(comment[start]))) ++start;
+  const std::string_view c = comment.substr(start);
+  if (starts_with_nocase(c, "msg,")) {
+    out_.message(c.substr(4));
+  } else if (starts_with_nocase(c, "debug,")) {
+    const std::string text = expand_parameters(c.substr(6));
+    if (st_.parameters[5599] > 0.0) out_.message(text);
+  } else if (starts_with_nocase(c, "print,")) {
+    out_.print(expand_parameters(c.substr(6)));
+  } else if (starts_with_nocase(c, "log,")) {
+    out_.log(expand_parameters(c.substr(4)));
+  } else if (starts_with_nocase(c, "logopen,")) {
+    out_.log_open(c.substr(8));
+  } else if (starts_with_nocase(c, "logappend,")) {
+    out_.log_append(c.substr(10));
+  } else if (starts_with_nocase(c, "abort,")) {
+    fail(ErrorCode::Abort, "{}", expand_parameters(c.substr(6)));
+  } else if (starts_with_nocase(c, "py,") || starts_with_nocase(c, "pyrun,") || starts_with_nocase(c, "pyreload")) {
+    fail(ErrorCode::Unsupported, "embedded Python comments are not supported");
+  } else if (c.size() == 8 && starts_with_nocase(c, "logclose")) {
+    out_.log_close();
+  } else {
+    out_.comment(c);
+  }
+}
+
+}  // namespace opencnc::gcode

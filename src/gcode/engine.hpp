@@ -1,0 +1,234 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Engine — the interpreter's internals: reading, checking and executing blocks. Its
+// member functions are split by stage over the files of this folder (see
+// docs/interpreter.md for the order a block goes through them).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "opencnc/canon/source_map.hpp"
+#include "opencnc/core/diagnostic.hpp"
+#include "opencnc/gcode/block.hpp"
+#include "opencnc/gcode/extension.hpp"
+#include "opencnc/gcode/interpreter.hpp"
+#include "opencnc/gcode/options.hpp"
+#include "opencnc/gcode/state.hpp"
+#include "gcode_error.hpp"
+#include "output.hpp"
+#include "parser.hpp"
+#include "source_file.hpp"
+
+namespace opencnc::gcode {
+
+/// Axis index (0..8) of an axis word letter, -1 for other letters.
+constexpr int axis_of_letter(char c) noexcept {
+  switch (c) {
+    case 'x': return 0; case 'y': return 1; case 'z': return 2;
+    case 'a': return 3; case 'b': return 4; case 'c': return 5;
+    case 'u': return 6; case 'v': return 7; case 'w': return 8;
+    default: return -1;
+  }
+}
+inline constexpr char kAxisWordLetters[kAxisCount] = {'x', 'y', 'z', 'a', 'b', 'c', 'u', 'v', 'w'};
+
+class Engine final : public ParamHost, public ExecContext {
+ public:
+  explicit Engine(Options options);
+  ~Engine() override;
+
+  // --- driving (engine.cpp) --------------------------------------------------------------
+  bool open_file(const std::string& path);
+  void open_text(std::string name, std::string text);
+  RunStatus begin(canon::Sink& sink);
+  RunStatus run(canon::Sink& sink);
+  RunStatus step(canon::Sink& sink);
+  RunStatus mdi(std::string_view line, canon::Sink& sink);
+  SyncKind pending_sync() const noexcept { return pending_sync_; }
+  void sync(const SyncValues& values);
+  InterpState snapshot() const;
+  std::uint64_t segments() const noexcept { return out_.segments(); }
+  const Diagnostics& diagnostics() const noexcept { return diags_; }
+  std::shared_ptr<canon::SourceMap> sources() const noexcept { return sources_; }
+  const Options& options() const override { return opt_; }
+
+  // --- ParamHost (params.cpp) ------------------------------------------------------------
+  bool named_value(std::string_view name, double& value) override;
+  void declare_named(std::string_view name) override;
+
+  // --- ExecContext (extension facade, engine.cpp) ----------------------------------------
+  InterpState& state() override { return st_; }
+  Pose end_point(const Block& block) override { return find_ends(block); }
+  canon::Sink& output() override { return out_; }
+  void straight(bool rapid, const Pose& end) override;
+  void arc(const canon::ArcFeed& arc) override;
+  void open_queue() override { out_.open_queue(); }
+  void flush_queue() override { out_.flush_queue(); }
+  std::size_t queued() const override { return out_.queued(); }
+  void request_sync(const SyncValues& assumed) override;
+  [[noreturn]] void error(ErrorCode code, const std::string& message) override { throw GcodeError(code, message); }
+
+ private:
+  // engine.cpp: start, lines, errors
+  void start();
+  RunStatus guarded(canon::Sink& sink, bool (Engine::*body)());
+  bool step_block();
+  bool nothing() { return true; }
+  bool read_line();
+  bool process_line();
+  void report(const GcodeError& e);
+  void warn_once(bool& done, ErrorCode code, std::string_view message);
+  void check_motion_habits(bool feed);
+  void set_origin_from_line();
+  SourceFile& current_file();
+  void jump_to(const SourcePosition& pos);
+  ParseEnv parse_env() const noexcept;
+  void apply_sync(const SyncValues& values);
+
+  // check.cpp: LinuxCNC's checks after reading a block
+  void enhance_block();
+  void check_block();
+  void check_g_codes();
+  void check_other_codes();
+  void check_extension(int code);
+
+  // execute.cpp: order of execution within a block
+  void execute_block();
+  void apply_assignments();
+  void convert_g();
+  void convert_m();
+  void set_plane(int code);
+  void set_units(int code);
+  void set_lathe_mode(int code);
+  void set_control_mode(int code);
+  void set_distance_mode(int code);
+  void set_ijk_mode(int code);
+  void set_retract_mode(int code);
+  void set_feed_mode(int code);
+  void set_spindle_mode();
+  void set_cutter_comp(int code);
+  bool run_extension_g(int code);
+  bool run_extension_m(int code);
+  [[noreturn]] void unsupported_g(int code);
+
+  // motion.cpp
+  Pose find_ends(const Block& b);
+  void convert_motion(int motion);
+  void convert_straight(int motion);
+  void convert_arc(int motion);
+  void arc_center_ijk(int motion, double cur1, double cur2, double end1, double end2, double off1, double off2,
+                      int turns, double& c1, double& c2, int& turn) const;
+  void arc_center_r(int motion, double cur1, double cur2, double end1, double end2, double radius, int turns,
+                    double& c1, double& c2, int& turn) const;
+  void inverse_time_straight(const Pose& end);
+  void inverse_time_arc(double c1, double c2, double c3, double cx, double cy, int turn, double e1, double e2,
+                        double e3);
+  void emit_straight(bool rapid, const Pose& end);
+  void emit_arc(const canon::ArcFeed& arc);
+
+  // offsets.cpp: coordinate systems, G10, G92/G52, G28/G30, tool length offset
+  void convert_modal_0(int code);
+  void set_coordinate_system(int code);
+  void g10_coordinate_system();
+  void g10_tool();
+  void axis_offsets(int code);
+  void go_home(int code);
+  void save_home(int code);
+  void tool_length_offset(int code);
+  Pose current_in_system(int system, bool without_tlo) const;
+  Pose machine_to_program(const Pose& machine_user) const;
+  void rotate(double& x, double& y, double degrees) const noexcept;
+  double user_to_program(double v) const noexcept { return v * user_to_program_factor_; }
+  double program_to_user(double v) const noexcept { return v / user_to_program_factor_; }
+  void update_unit_factor() noexcept;
+
+  // mcodes.cpp: M codes, tools, program stop/end
+  void convert_io();
+  void convert_tool_change_group();
+  void convert_spindle_group();
+  void convert_coolant();
+  void convert_overrides();
+  void select_tool(int tool);
+  void change_tool();
+  void set_tool_number(int tool);
+  void load_spindle(int index);
+  void set_tool_parameters();
+  int tool_index(int tool) const;
+  int pocket_of(int index) const noexcept;
+  void convert_stop();
+  void end_program(int code);
+  SavedContext active_context() const;
+  void save_context(bool restore_on_return);
+  void restore_context(const SavedContext& saved);
+  void execute_text(std::string_view text);
+
+  // comments.cpp
+  void convert_comment(std::string_view comment);
+  std::string expand_parameters(std::string_view text);
+
+  // control_flow.cpp: O-words
+  void control_flow();
+  void o_sub();
+  void o_return();
+  void o_call();
+  void o_do();
+  void o_while();
+  void o_repeat();
+  void o_if();
+  void o_elseif();
+  void o_else();
+  void o_endif();
+  void o_break_continue(bool is_break);
+  void o_end_loop();
+  LabelInfo* find_label(const std::string& name);
+  void save_label(LabelKind kind);
+  void jump_to_label(const std::string& name);
+  bool open_sub_file(const std::string& name);
+  void count_loop();
+  void leave_frame();
+
+  // params.cpp
+  bool predefined_value(std::string_view name, double& value) const;
+  bool is_predefined(std::string_view name) const noexcept;
+  void store_named(const std::string& name, double value);
+  void update_position_parameters();
+
+  Options opt_;
+  const Extensions* ext_ = nullptr;
+  InterpState st_;
+  Output out_;
+  Parser parser_;
+  Block block_;
+  Diagnostics diags_;
+  std::shared_ptr<canon::SourceMap> sources_;
+  std::vector<std::unique_ptr<SourceFile>> files_;   ///< by SourceMap file index
+  bool started_ = false;
+  bool has_program_ = false;
+  bool need_seek_ = true;
+  bool failed_ = false;
+  bool in_mdi_ = false;
+  std::string mdi_line_;
+  SyncKind pending_sync_ = SyncKind::None;
+  SyncValues block_sync_;           ///< scan mode: feedback assumed at the end of this block
+  bool block_sync_pending_ = false;
+  std::uint32_t letters_ = 0;       ///< letter words with a reader (axis mask applied)
+  std::uint32_t mdi_file_ = 0;
+  bool in_mdi_file_ = false;        ///< "<mdi>" is registered in the source map
+  std::uint64_t skipped_lines_ = 0; ///< lines passed over while seeking a label
+  bool units_programmed_ = false;   ///< a G20/G21 was met (for the units warning)
+  bool warned_units_ = false;
+  bool warned_spindle_ = false;
+  double user_to_program_factor_ = 1.0;
+  std::uint32_t line_ = 0;          ///< line number of the block being executed
+  std::uint32_t line_file_ = 0;     ///< its file
+  std::uint64_t line_offset_ = 0;   ///< its byte offset
+  std::string raw_;                 ///< the raw line (for messages and N labels)
+  std::vector<char> norm_;          ///< normalised text of the line
+  std::size_t norm_len_ = 0;
+};
+
+}  // namespace opencnc::gcode

@@ -1,0 +1,428 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// M codes: I/O (M62-M68), tools (T, M6, M61), spindle (M3-M5, M19), modal state save and
+// restore (M70-M73), coolant (M7-M9), overrides (M48-M53), stops and program end.
+#include <cmath>
+
+#include "engine.hpp"
+#include "numeric.hpp"
+#include "lexer.hpp"
+
+namespace opencnc::gcode {
+
+void Engine::convert_io() {
+  const Block& b = block_;
+  const int m = b.m[kGroupIo];
+  if (m == -1) return;
+  if (run_extension_m(m)) return;
+  const bool comp = st_.modal.cutter_comp != CutterComp::Off;
+  if (m >= 62 && m <= 65) {
+    if (comp) fail(ErrorCode::ModalContext, "M{} cannot be used while cutter compensation is on", m);
+    if (!b.has('p')) fail(ErrorCode::IoUsage, "M{} needs a P word (output number)", m);
+    const int p = round_to_int(b.get('p'));
+    if (m == 62) out_.set_motion_output_bit(p);
+    else if (m == 63) out_.clear_motion_output_bit(p);
+    else if (m == 64) out_.set_aux_output_bit(p);
+    else out_.clear_aux_output_bit(p);
+    return;
+  }
+  if (m == 66) {
+    if (b.has('p') && b.has('e')) fail(ErrorCode::IoUsage, "M66 takes a digital (P) or an analog (E) input, not both");
+    const int l = b.has('l') ? round_to_int(b.get('l')) : 0;
+    if (b.q_or(-1.0) <= 0 && b.has('l') && l > 0) fail(ErrorCode::IoUsage, "M66 with a wait mode L{} needs a timeout Q > 0", l);
+    if (b.has('e') && b.has('l') && l != 0) fail(ErrorCode::IoUsage, "M66 on an analog input waits immediately only (L0)");
+    if ((b.has('p') && round_to_int(b.get('p')) < 0) || (b.has('e') && round_to_int(b.get('e')) < 0) ||
+        (!b.has('p') && !b.has('e')))
+      fail(ErrorCode::IoUsage, "M66 needs a valid P (digital) or E (analog) input number");
+    if (comp) fail(ErrorCode::ModalContext, "M66 cannot be used while cutter compensation is on");
+    const bool digital = b.has('p');
+    const int index = round_to_int(digital ? b.get('p') : b.get('e'));
+    const double timeout = digital && b.q_or(-1.0) > 0 ? b.get('q') : 0.0;
+    out_.wait_for_input(index, digital, digital ? l : 0, timeout);
+    SyncValues assumed;
+    assumed.kind = SyncKind::Input;
+    // What rs274 reads back: a digital input keeps its truth value, an analog one its value.
+    const double old = st_.parameters[5399];
+    assumed.input_value = digital ? (old != 0.0 ? 1.0 : 0.0) : old;
+    request_sync(assumed);
+    return;
+  }
+  if (comp) fail(ErrorCode::ModalContext, "M{} cannot be used while cutter compensation is on", m);
+  if (!b.has('e') || round_to_int(b.get('e')) < 0) fail(ErrorCode::IoUsage, "M{} needs an E word (analog output number)", m);
+  if (m == 67) out_.set_motion_output_value(round_to_int(b.get('e')), b.q_or(-1.0));
+  else out_.set_aux_output_value(round_to_int(b.get('e')), b.q_or(-1.0));
+}
+
+// --- tools -------------------------------------------------------------------------------
+
+int Engine::tool_index(int tool) const {
+  if (tool == 0) return 0;   // T0: no tool (the empty spindle)
+  if (opt_.tool_table) {
+    if (const auto index = opt_.tool_table->find(tool)) return static_cast<int>(*index);
+  }
+  fail(ErrorCode::ToolNotFound, "tool {} is not in the tool table", tool);
+}
+
+int Engine::pocket_of(int index) const noexcept {
+  if (index < 1 || static_cast<std::size_t>(index) >= st_.tool.table.size()) return -1;
+  return st_.tool.table[static_cast<std::size_t>(index)].pocket;
+}
+
+void Engine::select_tool(int tool) {
+  const int index = tool_index(tool);
+  out_.select_tool(tool);
+  st_.tool.selected_index = index;
+  st_.tool.selected_tool = tool;
+}
+
+void Engine::load_spindle(int index) {
+  st_.tool.current_index = index;
+  st_.tool.table[0] = index == 0 ? tools::ToolEntry{} : st_.tool.table[static_cast<std::size_t>(index)];
+  set_tool_parameters();
+}
+
+void Engine::set_tool_parameters() {
+  const tools::ToolEntry& t = st_.tool.table[0];
+  auto& p = st_.parameters;
+  p[5400] = t.tool > 0 ? t.tool : 0;
+  for (int i = 0; i < kAxisCount; ++i) p[static_cast<std::size_t>(5401 + i)] = t.offset[i];
+  p[5410] = t.diameter;
+  p[5411] = t.front_angle;
+  p[5412] = t.back_angle;
+  p[5413] = t.orientation;
+}
+
+void Engine::change_tool() {
+  if (st_.tool.selected_index < 0) fail(ErrorCode::ToolNotPrepared, "M6 with no tool prepared (program a T word first)");
+  if (st_.modal.cutter_comp != CutterComp::Off)
+    fail(ErrorCode::ModalContext, "tools cannot be changed while cutter compensation is on");
+  out_.start_change();
+  out_.stop_spindle_turning(0);
+  st_.modal.spindle = canon::SpindleDirection::Stopped;
+  out_.change_tool(st_.tool.selected_index);
+  load_spindle(st_.tool.selected_index);
+  SyncValues assumed;
+  assumed.kind = SyncKind::ToolChange;
+  assumed.position = st_.position.canon_position;
+  request_sync(assumed);
+}
+
+void Engine::set_tool_number(int tool) {
+  const int index = tool_index(tool);
+  out_.change_tool_number(index);
+  // The tool becomes current, but (as in rs274) the spindle entry and #5400.. keep the tool
+  // of the last M6 until the next one.
+  st_.tool.current_index = index;
+  SyncValues assumed;
+  assumed.kind = SyncKind::ToolChange;
+  assumed.position = st_.position.canon_position;
+  request_sync(assumed);
+}
+
+void Engine::convert_tool_change_group() {
+  const int m = block_.m[kGroupToolChange];
+  if (m == -1) return;
+  if (run_extension_m(m)) return;
+  if (m == 6) {
+    change_tool();
+    return;
+  }
+  const int tool = round_to_int(block_.q_or(-1.0));
+  if (tool < 0) fail(ErrorCode::ToolOffsetUsage, "M61 needs a Q word with a tool number (0 or more)");
+  set_tool_number(tool);
+}
+
+// --- spindle, context, coolant, overrides -------------------------------------------------
+
+void Engine::convert_spindle_group() {
+  const Block& b = block_;
+  const int m = b.m[kGroupSpindle];
+  if (m == -1) return;
+  if (run_extension_m(m)) return;
+  switch (m) {
+    case 3:
+      out_.start_spindle_clockwise(0);
+      st_.modal.spindle = canon::SpindleDirection::Clockwise;
+      return;
+    case 4:
+      out_.start_spindle_counterclockwise(0);
+      st_.modal.spindle = canon::SpindleDirection::Counterclockwise;
+      return;
+    case 5:
+      out_.stop_spindle_turning(0);
+      st_.modal.spindle = canon::SpindleDirection::Stopped;
+      return;
+    case 19:
+      st_.modal.spindle = canon::SpindleDirection::Stopped;
+      if (b.has('r') || b.has('p'))
+        out_.orient_spindle(0, b.has('r') ? b.get('r') : 0.0, b.has('p') ? trunc_to_int(b.get('p')) : 0);
+      if (b.has('q')) {
+        if (b.get('q') <= 0.0) fail(ErrorCode::SpindleUsage, "M19 Q (timeout) must be greater than 0");
+        out_.wait_spindle_orient_complete(0, b.get('q'));
+      }
+      return;
+    case 70:
+    case 73:
+      save_context(m == 73 && st_.frames.size() > 1);
+      return;
+    case 71:
+      st_.frames.back().saved.valid = false;
+      return;
+    case 72:
+      if (!st_.frames.back().saved.valid)
+        fail(ErrorCode::ContextRestore, "M72 with no state saved at this call level (M70 or M73 first)");
+      restore_context(st_.frames.back().saved);
+      return;
+    default:
+      return;
+  }
+}
+
+SavedContext Engine::active_context() const {
+  const ModalState& m = st_.modal;
+  SavedContext c;
+  c.g.fill(-1);
+  c.m.fill(-1);
+  static constexpr int kPlaneCodes[] = {170, 190, 180, 171, 191, 181};   // XY YZ XZ UV VW UW
+  c.g[3] = kPlaneCodes[static_cast<int>(m.plane)];
+  c.g[4] = m.cutter_comp == CutterComp::Right ? 420 : m.cutter_comp == CutterComp::Left ? 410 : 400;
+  c.g[5] = m.units == canon::Units::Inch ? 200 : 210;
+  c.g[6] = m.distance == DistanceMode::Absolute ? 900 : 910;
+  c.g[7] = m.feed_mode == canon::FeedMode::InverseTime ? 930 : m.feed_mode == canon::FeedMode::UnitsPerMinute ? 940 : 950;
+  c.g[8] = m.coord_system < 7 ? 530 + 10 * m.coord_system : 584 + m.coord_system;
+  bool offset = false;
+  for (int i = 0; i < kAxisCount; ++i) offset = offset || st_.position.tool_offset[i] != 0.0;
+  c.g[9] = offset ? 430 : 490;
+  c.g[10] = m.retract == RetractMode::OldZ ? 980 : 990;
+  c.g[11] = m.control == canon::MotionControl::Continuous ? 640 : m.control == canon::MotionControl::ExactPath ? 610 : 611;
+  c.g[13] = m.spindle_mode == SpindleMode::Rpm ? 970 : 960;
+  c.g[14] = m.ijk_distance == DistanceMode::Absolute ? 901 : 911;
+  c.g[15] = m.lathe_diameter ? 70 : 80;
+  c.m[2] = m.spindle == canon::SpindleDirection::Stopped ? 5 : m.spindle == canon::SpindleDirection::Clockwise ? 3 : 4;
+  c.m[4] = m.mist ? 7 : (m.flood ? -1 : 9);
+  c.m[5] = m.flood ? 8 : -1;
+  c.m[6] = m.feed_override ? (m.speed_override ? 48 : 50) : (m.speed_override ? 51 : 49);
+  c.m[7] = m.adaptive_feed ? 52 : -1;
+  c.m[8] = m.feed_hold ? 53 : -1;
+  c.feed = m.feed_rate;
+  c.speed = m.spindle_speed;
+  return c;
+}
+
+void Engine::save_context(bool restore_on_return) {
+  SavedContext c = active_context();
+  c.valid = true;
+  c.restore_on_return = restore_on_return;
+  st_.frames.back().saved = c;
+}
+
+// Restores modes by executing the G-code that re-establishes them, as LinuxCNC does, so that
+// the same canonical calls are made: units first, then F/S and M codes, then G codes.
+void Engine::restore_context(const SavedContext& saved) {
+  const SavedContext now = active_context();
+  if (now.g[5] != saved.g[5]) execute_text(saved.g[5] == 200 ? "G20" : "G21");
+  std::string cmd;
+  if (saved.feed != now.feed) cmd += fmt::format(" F{:.1f}", saved.feed);
+  if (saved.speed != now.speed) cmd += fmt::format(" S{:.0f}", saved.speed);
+  for (int i = 2; i <= 8; ++i) {
+    if (i == 3 || saved.m[static_cast<std::size_t>(i)] == now.m[static_cast<std::size_t>(i)]) continue;
+    if (saved.m[static_cast<std::size_t>(i)] != -1) cmd += fmt::format("M{}\n", saved.m[static_cast<std::size_t>(i)]);
+  }
+  for (int i : {3, 4, 6, 7, 8, 9, 10, 11, 13, 14, 15}) {
+    const int v = saved.g[static_cast<std::size_t>(i)];
+    if (v == now.g[static_cast<std::size_t>(i)] || v == -1) continue;
+    cmd += v % 10 ? fmt::format(" G{}.{}", v / 10, v % 10) : fmt::format(" G{}", v / 10);
+  }
+  std::string_view rest = cmd;
+  while (!rest.empty()) {
+    const std::size_t nl = rest.find('\n');
+    const std::string_view piece = rest.substr(0, nl);
+    if (!piece.empty()) execute_text(piece);
+    if (nl == std::string_view::npos) break;
+    rest.remove_prefix(nl + 1);
+  }
+}
+
+void Engine::execute_text(std::string_view text) {
+  const Block saved_block = block_;
+  const std::string saved_raw = raw_;
+  auto saved_numbered = parser_.numbered_assignments;
+  auto saved_named = parser_.named_assignments;
+  raw_.assign(text);
+  if (norm_.size() < raw_.size() + 1) norm_.resize(raw_.size() + 1);
+  std::vector<char> saved_norm(norm_.begin(), norm_.begin() + static_cast<std::ptrdiff_t>(norm_len_));
+  const std::size_t n = normalize_line(raw_, norm_.data());
+  parser_.parse(std::string_view(norm_.data(), n), parse_env(), block_);
+  enhance_block();
+  check_block();
+  apply_assignments();
+  execute_block();
+  block_ = saved_block;
+  raw_ = saved_raw;
+  std::copy(saved_norm.begin(), saved_norm.end(), norm_.begin());
+  parser_.numbered_assignments = std::move(saved_numbered);
+  parser_.named_assignments = std::move(saved_named);
+}
+
+void Engine::convert_coolant() {
+  const int m = block_.m[kGroupCoolant];
+  if (m == -1) return;
+  if (run_extension_m(m)) return;
+  if (m == 7) {
+    out_.mist_on();
+    st_.modal.mist = true;
+  } else if (m == 8) {
+    out_.flood_on();
+    st_.modal.flood = true;
+  } else {
+    out_.mist_off();
+    st_.modal.mist = false;
+    out_.flood_off();
+    st_.modal.flood = false;
+  }
+}
+
+void Engine::convert_overrides() {
+  const int m = block_.m[kGroupOverride];
+  if (m == -1) return;
+  if (run_extension_m(m)) return;
+  if (st_.modal.cutter_comp != CutterComp::Off)
+    fail(ErrorCode::ModalContext, "overrides cannot be switched while cutter compensation is on");
+  // M50..M53: P0 disables, any other P (or none) enables.
+  const bool enable = m == 48 || (m != 49 && block_.p_or(-1.0) != 0.0);
+  ModalState& s = st_.modal;
+  switch (m) {
+    case 48:
+    case 49:
+      if (enable) {
+        out_.enable_feed_override();
+        out_.enable_speed_override(0);
+      } else {
+        out_.disable_feed_override();
+        out_.disable_speed_override(0);
+      }
+      s.feed_override = s.speed_override = enable;
+      return;
+    case 50:
+      enable ? out_.enable_feed_override() : out_.disable_feed_override();
+      s.feed_override = enable;
+      return;
+    case 51:
+      enable ? out_.enable_speed_override(0) : out_.disable_speed_override(0);
+      s.speed_override = enable;
+      return;
+    case 52:
+      enable ? out_.enable_adaptive_feed() : out_.disable_adaptive_feed();
+      s.adaptive_feed = enable;
+      return;
+    default:
+      enable ? out_.enable_feed_hold() : out_.disable_feed_hold();
+      s.feed_hold = enable;
+      return;
+  }
+}
+
+// --- stops and end ------------------------------------------------------------------------
+
+void Engine::convert_stop() {
+  const int m = block_.m[kGroupStop];
+  if (run_extension_m(m)) return;
+  if (st_.modal.cutter_comp != CutterComp::Off && ext_ != nullptr && ext_->compensator)
+    ext_->compensator->finish(*this);
+  switch (m) {
+    case 0:
+      out_.program_stop();
+      return;
+    case 60:
+      out_.pallet_shuttle();
+      out_.program_stop();
+      return;
+    case 1:
+      out_.optional_program_stop();
+      return;
+    case 2:
+    case 30:
+      end_program(m);
+      return;
+    default:
+      fail(ErrorCode::Unsupported, "M99 (Fanuc-style program repeat) is not supported yet");
+  }
+}
+
+void Engine::end_program(int code) {
+  ModalState& m = st_.modal;
+  PositionState& s = st_.position;
+  auto& par = st_.parameters;
+  // Back to G54: the current point is re-expressed in its coordinates.
+  for (int i = 0; i < kAxisCount; ++i) s.current[i] += s.origin_offset[i];
+  rotate(s.current[0], s.current[1], s.rotation_xy_deg);
+  m.coord_system = 1;
+  par[5220] = 1.0;
+  for (int i = 0; i < kAxisCount; ++i) {
+    const double o = par[static_cast<std::size_t>(5221 + i)];
+    s.origin_offset[i] = is_rotary(static_cast<Axis>(i)) ? o : user_to_program(o);
+  }
+  s.rotation_xy_deg = par[5230];
+  rotate(s.current[0], s.current[1], -s.rotation_xy_deg);
+  for (int i = 0; i < kAxisCount; ++i) s.current[i] -= s.origin_offset[i];
+  out_.set_g5x_offset(1, s.origin_offset);
+  out_.set_xy_rotation(s.rotation_xy_deg);
+  if (m.plane != canon::Plane::XY) {
+    out_.select_plane(canon::Plane::XY);
+    m.plane = canon::Plane::XY;
+  }
+  m.distance = DistanceMode::Absolute;
+  m.feed_mode = canon::FeedMode::UnitsPerMinute;
+  out_.set_feed_mode(0, canon::FeedMode::UnitsPerMinute);
+  m.feed_rate = 0;
+  out_.set_feed_rate(0);
+  if (!m.feed_override) {
+    out_.enable_feed_override();
+    m.feed_override = true;
+  }
+  if (!m.speed_override) {
+    out_.enable_speed_override(0);
+    m.speed_override = true;
+  }
+  m.cutter_comp = CutterComp::Off;
+  m.comp_first_move = true;
+  out_.stop_spindle_turning(0);
+  m.spindle = canon::SpindleDirection::Stopped;
+  out_.set_spindle_mode(0, 0);
+  m.motion = 10;
+  if (m.mist) {
+    out_.mist_off();
+    m.mist = false;
+  }
+  if (m.flood) {
+    out_.flood_off();
+    m.flood = false;
+  }
+  if (code == 30) out_.pallet_shuttle();
+  out_.program_end();
+  if (st_.percent_delimited && !in_mdi_) {
+    // A '%'-delimited file should still have its closing '%' after M2/M30.
+    SourceFile& f = current_file();
+    if (need_seek_) {
+      f.seek(st_.next.offset);
+      need_seek_ = false;
+    }
+    RawLine line;
+    bool found = false;
+    while (f.next(line)) {
+      std::string_view t = trim_raw_line(line.text);
+      while (!t.empty() && (t.front() == ' ' || t.front() == '\t')) t.remove_prefix(1);
+      if (t == "%") {
+        found = true;
+        break;
+      }
+    }
+    if (!found) out_.comment("interpreter: percent sign missing from end of file");
+  }
+  st_.frames.resize(1);
+  st_.control.skipping_to.clear();
+  st_.control.seeking_sub.clear();
+  st_.control.defining_sub = false;
+  st_.ended = true;
+}
+
+}  // namespace opencnc::gcode

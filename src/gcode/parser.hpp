@@ -1,0 +1,89 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Parser — reads one normalised block into a Block: words, G/M codes, comments, parameter
+// assignments, O-words and expressions, with LinuxCNC's syntax and error rules.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "opencnc/gcode/block.hpp"
+
+namespace opencnc::gcode {
+
+/// What the parser needs from the interpreter to read parameters. Implemented by the engine.
+class ParamHost {
+ public:
+  virtual ~ParamHost() = default;
+  /// Value of #<name> (name lowercase, without <>); false if it is not defined.
+  virtual bool named_value(std::string_view name, double& value) = 0;
+  /// #<name>=... declares the name while the line is read (LinuxCNC does the same).
+  virtual void declare_named(std::string_view name) = 0;
+};
+
+/// Interpreter facts that change how a line reads.
+struct ParseEnv {
+  const double* parameters = nullptr;   ///< kParameterCount numbered parameters
+  ParamHost* host = nullptr;
+  std::uint32_t letters = 0;            ///< bit (letter - 'a') per letter word allowed
+  bool lathe_diameter = false;          ///< G7: X words are diameters
+  bool comp_on = false;                 ///< cutter compensation active (#5420-5428 unreadable)
+  int call_level = 0;
+  std::string_view call_sub;            ///< subprogram running at this call level
+  bool defining_sub = false;            ///< passing over `o<name> sub` .. `endsub`
+  std::string_view defining_name;
+  std::string_view skipping_to;         ///< label being skipped to ("" = not skipping)
+};
+
+/// Reads blocks. Reuses its buffers; after warm-up a block allocates nothing unless it has
+/// named parameters or O-words. Not thread-safe.
+class Parser {
+ public:
+  /// Parses `text` (normalised, non-empty) into `block` (cleared first) and the assignment
+  /// buffers. Throws GcodeError with the position in `text`.
+  void parse(std::string_view text, const ParseEnv& env, Block& block);
+
+  /// Evaluates a bracketed expression starting at `text[pos]` == '['; advances `pos`.
+  double expression(std::string_view text, std::size_t& pos, const ParseEnv& env);
+
+  std::vector<std::pair<int, double>> numbered_assignments;
+  std::vector<std::pair<std::string, double>> named_assignments;
+
+ private:
+  // One parse in progress.
+  struct Cursor {
+    std::string_view text;
+    std::size_t pos;
+    const ParseEnv& env;
+    char at() const noexcept { return pos < text.size() ? text[pos] : '\0'; }
+    char at(std::size_t ahead) const noexcept { return pos + ahead < text.size() ? text[pos + ahead] : '\0'; }
+  };
+
+  void read_line_number(Cursor& c, Block& b);
+  void read_item(Cursor& c, Block& b);
+  void read_o_word(Cursor& c, Block& b);
+  void read_word(Cursor& c, Block& b, char letter);
+  void read_g(Cursor& c, Block& b);
+  void read_m(Cursor& c, Block& b);
+  void read_comment(Cursor& c, Block& b);
+  void read_assignment(Cursor& c);
+  std::string read_name(Cursor& c);
+
+  double real_value(Cursor& c);
+  int integer_value(Cursor& c);
+  static int plain_code(Cursor& c) noexcept;
+  double real_number(Cursor& c);
+  [[noreturn, gnu::cold]] static void bad_number(const char* start, const char* after, const char* text, bool malformed);
+  double expression(Cursor& c);
+  double parameter(Cursor& c, bool exists_only);
+  double unary(Cursor& c);
+  int binary_operator(Cursor& c);
+};
+
+/// G code (×10) → modal group, -1 if unknown. M code → group, -1 if unknown.
+int g_group(int code) noexcept;
+int m_group(int code) noexcept;
+
+}  // namespace opencnc::gcode
