@@ -149,7 +149,6 @@ Refusal Servo::start_run(const Command& c) noexcept {
   run_mode_ = c.run_mode;
   hold_ = cycle_start_edge_ = abort_edge_ = sync_done_edge_ = aborting_ = false;
   sync_step_ = SyncStep::None;
-  probe_tripped_ = false;
   activity_ = Activity::Program;
   set_state(State::Running);
   return Refusal::None;

@@ -97,6 +97,10 @@ void Servo::map_program_state() noexcept {
   } else if (tick_out_.state == traj::RunState::WaitingCycleStart && !released_) {
     const traj::MotionBlock* b = block(tick_out_.block_seq);
     const traj::MarkerKind k = b != nullptr ? b->marker : traj::MarkerKind::None;
+    if (k == traj::MarkerKind::OptionalStop && !optional_stop_) {  // the interpolator lets it pass
+      set_state(State::Running);
+      return;
+    }
     set_state(State::Stopped);
     stop_reason_ = k == traj::MarkerKind::ProgramStop    ? StopReason::ProgramStop
                    : k == traj::MarkerKind::OptionalStop ? StopReason::OptionalStop
@@ -143,6 +147,7 @@ void Servo::apply_action(const MachineAction& a) noexcept {
       orient_ = false;
       break;
     case ActionCode::SelectTool:
+      selected_tool_ = a.index;
       preparing_tool_ = a.index;
       preparing_ = caps_.tool_changer;
       if (!caps_.tool_changer) prepared_tool_ = a.index;
@@ -217,8 +222,7 @@ void Servo::begin_sync() noexcept {
       sync_step_ = caps_.tool_changer ? SyncStep::ToolChanger : SyncStep::ManualTool;
       wait_ = caps_.tool_changer ? Wait::ToolChanger : Wait::ManualToolChange;
       manual_tool_done_ = false;
-      preparing_tool_ = a.index;
-      out_.tool.prepare_tool = a.index;
+      out_.tool.prepare_tool = selected_tool_;
       break;
     case ActionCode::WaitInput: {
       sync_step_ = SyncStep::Input;
@@ -247,12 +251,12 @@ bool Servo::step_sync() noexcept {
   switch (sync_step_) {
     case SyncStep::ToolChanger:
       if (!in_.tool.changed) return false;
-      tool_ = sync_action_.index;
+      tool_ = selected_tool_;  // M6 puts the tool the T word selected into the spindle
       prepared_tool_ = 0;
       return true;
     case SyncStep::ManualTool:
       if (!manual_tool_done_) return false;
-      tool_ = sync_action_.index;
+      tool_ = selected_tool_;
       prepared_tool_ = 0;
       return true;
     case SyncStep::Input:
@@ -306,9 +310,14 @@ bool Servo::step_wait_input() noexcept {
 // A probe move (G38.x) stops when the probe trips: the position is latched and the run ends
 // with a controlled stop; the controller continues the program from where the machine stopped.
 void Servo::check_probe() noexcept {
-  if (!caps_.probe || !in_.probe || probe_tripped_ || aborting_) return;
+  if (!caps_.probe || aborting_) return;
   const traj::MotionBlock* b = block(tick_out_.block_seq);
   if (b == nullptr || (b->flags & traj::kProbe) == 0) return;
+  if (b->seq != probe_seq_) {  // a new probe move: its result starts afresh
+    probe_seq_ = b->seq;
+    probe_tripped_ = false;
+  }
+  if (!in_.probe || probe_tripped_) return;
   probe_tripped_ = true;
   for (int j = 0; j < config_.joint_count; ++j) {
     const auto uj = static_cast<std::size_t>(j);

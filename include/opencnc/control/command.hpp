@@ -146,7 +146,7 @@ enum class ActionCode : std::uint8_t {
   SpindleCcw,
   SpindleStop,
   SelectTool,      ///< index = tool: prepare it
-  ChangeTool,      ///< index = tool (M6)
+  ChangeTool,      ///< M6: the selected tool into the spindle (index = its table index)
   SetToolNumber,   ///< index = tool (M61)
   FloodOn,
   FloodOff,

@@ -175,6 +175,7 @@ class Servo final : public Tickable {
   bool sync_input_before_ = false;
   bool manual_tool_done_ = false;
   bool probe_tripped_ = false;
+  std::uint64_t probe_seq_ = traj::kNoBlock;  ///< the probe move whose result probe_tripped_ is
   Pose probe_position_{};
   double input_value_ = 0;
 
@@ -185,7 +186,7 @@ class Servo final : public Tickable {
   bool orient_ = false;
   double orient_angle_ = 0;
   bool flood_ = false, mist_ = false;
-  std::int32_t tool_ = 0, prepared_tool_ = 0, preparing_tool_ = 0;
+  std::int32_t tool_ = 0, selected_tool_ = 0, prepared_tool_ = 0, preparing_tool_ = 0;
   bool preparing_ = false;
   std::uint64_t digital_out_ = 0;
   std::array<double, machine::kAnalogChannels> analog_out_{};
