@@ -225,6 +225,7 @@ Refusal Servo::manual_spindle_or_coolant(const Command& c) noexcept {
       if (!(c.value > 0 && c.value <= std::max(config_.spindle_max_rpm, 0.0))) return Refusal::BadValue;
       spindle_rpm_ = c.value;
       spindle_direction_ = c.flag ? machine::SpindleDirection::Clockwise : machine::SpindleDirection::Counterclockwise;
+      spindle_changed_tick_ = tick_;
       orient_ = false;
       return Refusal::None;
     case CommandKind::SpindleOff:

@@ -10,6 +10,9 @@ namespace opencnc::control {
 
 namespace {
 
+/// Blocks looked at ahead of the interpolator for a spindle wait (a bounded loop).
+constexpr std::uint64_t kMarkerScan = 64;
+
 bool take(bool& edge) noexcept {
   const bool was = edge;
   edge = false;
@@ -25,10 +28,33 @@ const traj::MotionBlock* Servo::block(std::uint64_t seq) const noexcept {
   return &q.peek(static_cast<std::size_t>(seq - first));
 }
 
+// The drive's at-speed signal refers to the command it had when it sampled: only from the period
+// after a change on does it speak about the new one.
 bool Servo::spindle_at_speed() const noexcept {
   if (!caps_.spindle) return true;
   if (spindle_direction_ == machine::SpindleDirection::Stopped) return true;
-  return in_.spindle.at_speed;
+  return in_.spindle.at_speed && tick_ > spindle_changed_tick_;
+}
+
+// The interpolator reports the markers it passes and may reach a spindle-wait marker in the same
+// period; the M3/M4 before that wait is applied only after the period. So while the next
+// action record still to be applied is a spindle one and a spindle wait for it (or later) comes
+// before any other stop, the spindle is not at speed yet.
+bool Servo::spindle_change_pending() const noexcept {
+  const auto& ring = channels_->actions;
+  if (ring.available() == 0) return false;
+  const MachineAction& next = ring.front();
+  const bool spindle = next.code == ActionCode::SpindleCw || next.code == ActionCode::SpindleCcw ||
+                       next.code == ActionCode::SpindleSpeed || next.code == ActionCode::SpindleStop;
+  if (!spindle) return false;
+  const traj::BlockQueue& q = channels_->blocks;
+  const std::uint64_t first = std::max(q.popped(), tick_out_.block_seq);
+  for (std::uint64_t seq = first, n = 0; n < kMarkerScan && block(seq) != nullptr; ++seq, ++n) {
+    const traj::MotionBlock& b = *block(seq);
+    if (b.kind != traj::BlockKind::Marker || b.marker == traj::MarkerKind::Report) continue;
+    return b.marker == traj::MarkerKind::SpindleWait && b.action >= next.action;
+  }
+  return false;
 }
 
 void Servo::stop_spindle_and_coolant() noexcept {
@@ -50,7 +76,7 @@ traj::TickInput Servo::program_inputs() noexcept {
   in.single_block = single_block_;
   in.optional_stop = optional_stop_;
   in.sync_done = take(sync_done_edge_);
-  in.spindle_at_speed = spindle_at_speed();
+  in.spindle_at_speed = spindle_at_speed() && !spindle_change_pending();
   in.spindle_revs = in_.spindle.position_rev;
   in.spindle_rev_s = in_.spindle.speed_rpm / 60.0;
   return in;
@@ -135,15 +161,18 @@ void Servo::apply_action(const MachineAction& a) noexcept {
   switch (a.code) {
     case ActionCode::SpindleSpeed:
       spindle_rpm_ = a.value;
+      spindle_changed_tick_ = tick_;
       break;
     case ActionCode::SpindleCw:
     case ActionCode::SpindleCcw:
       spindle_direction_ =
           a.code == ActionCode::SpindleCw ? machine::SpindleDirection::Clockwise : machine::SpindleDirection::Counterclockwise;
+      spindle_changed_tick_ = tick_;
       orient_ = false;
       break;
     case ActionCode::SpindleStop:
       spindle_direction_ = machine::SpindleDirection::Stopped;
+      spindle_changed_tick_ = tick_;
       orient_ = false;
       break;
     case ActionCode::SelectTool:

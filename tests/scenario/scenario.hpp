@@ -111,6 +111,7 @@ class Scenario {
   SimRig& rig() { return *rig_; }
   machine::SimMachine& sim() { return rig_->machine(); }
   const std::vector<TraceSample>& samples() const { return samples_; }
+  void forget_samples() { samples_.clear(); }
   const std::string& message() const { return last_message_; }
 
  private:

@@ -110,6 +110,7 @@ class Servo final : public Tickable {
   void end_run(RunEnd why) noexcept;
   const traj::MotionBlock* block(std::uint64_t seq) const noexcept;
   bool spindle_at_speed() const noexcept;
+  bool spindle_change_pending() const noexcept;
   void stop_spindle_and_coolant() noexcept;
 
   ServoConfig config_;
@@ -182,6 +183,7 @@ class Servo final : public Tickable {
   // Machine outputs the program and the operator set.
   double spindle_rpm_ = 0;
   machine::SpindleDirection spindle_direction_ = machine::SpindleDirection::Stopped;
+  std::uint64_t spindle_changed_tick_ = 0;  ///< period of the last change of speed or direction
   bool spindle_override_enabled_ = true;
   bool orient_ = false;
   double orient_angle_ = 0;
