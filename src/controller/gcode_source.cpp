@@ -94,12 +94,11 @@ LoadedProgram GcodeProgramSource::load(const std::string& path, const Pose& star
   canon::TeeSink sink(builder, tolerance);
   builder.set_motion_control_mode(canon::MotionControl::Continuous, default_tolerance_);
   LoadedProgram out;
-  // The file first: it is file 0 of the source map, the main program of every move.
-  gcode::RunStatus status = interp.start(sink);
-  if (status != gcode::RunStatus::Error && interp.open(path) && place(interp, start, out.diagnostics)) {
+  // The file first (file 0 of the source map, the main program of every move; start() checks
+  // its head), then the start-up calls, then the position.
+  gcode::RunStatus status = gcode::RunStatus::Error;
+  if (interp.open(path) && interp.start(sink) != gcode::RunStatus::Error && place(interp, start, out.diagnostics)) {
     status = interp.run(sink);
-  } else {
-    status = gcode::RunStatus::Error;
   }
   for (const Diagnostic& d : interp.diagnostics().items()) out.diagnostics.add(d);
   if (status != gcode::RunStatus::Error && !out.diagnostics.has_errors())

@@ -52,28 +52,46 @@ bool passes(double alpha, double lo, double hi) {
   return alpha + kTwoPi * m <= hi;
 }
 
-void widen_by_arc(const canon::ArcGeometry& g, const Pose& start, const Pose& end, Extent& e) {
-  const int base = (g.plane == canon::Plane::XY || g.plane == canon::Plane::YZ || g.plane == canon::Plane::XZ) ? 0 : 6;
-  const V3 c{{g.center[0], g.center[1], g.center[2]}}, n{{g.normal[0], g.normal[1], g.normal[2]}};
-  const V3 rs = in_plane(start, base, c, n), re = in_plane(end, base, c, n);
+/// An arc in its plane: centre, start direction e1, e2 = n × e1, radius, signed sweep.
+struct ArcFrame {
+  int base = 0;
+  V3 c, e1, e2;
+  double radius = 0, sweep = 0;
+};
+
+bool arc_frame(const canon::ArcGeometry& g, const Pose& start, const Pose& end, ArcFrame& f) {
+  f.base = (g.plane == canon::Plane::XY || g.plane == canon::Plane::YZ || g.plane == canon::Plane::XZ) ? 0 : 6;
+  f.c = V3{{g.center[0], g.center[1], g.center[2]}};
+  const V3 n{{g.normal[0], g.normal[1], g.normal[2]}};
+  const V3 rs = in_plane(start, f.base, f.c, n), re = in_plane(end, f.base, f.c, n);
   const double r = std::sqrt(dot(rs, rs));
-  if (!(r > 0)) return;
-  V3 e1;
-  for (int k = 0; k < 3; ++k) e1.v[k] = rs.v[k] / r;
-  const V3 e2 = cross(n, e1);
-  const double sweep = sweep_of(std::atan2(dot(re, e2), dot(re, e1)), g.turns == 0 ? 1 : g.turns);
-  const double radius = std::max(r, std::sqrt(dot(re, re)));
-  const double lo = std::min(0.0, sweep), hi = std::max(0.0, sweep);
+  if (!(r > 0)) return false;
+  for (int k = 0; k < 3; ++k) f.e1.v[k] = rs.v[k] / r;
+  f.e2 = cross(n, f.e1);
+  f.sweep = sweep_of(std::atan2(dot(re, f.e2), dot(re, f.e1)), g.turns == 0 ? 1 : g.turns);
+  f.radius = std::max(r, std::sqrt(dot(re, re)));
+  return true;
+}
+
+void widen_by_arc(const canon::ArcGeometry& g, const Pose& start, const Pose& end, Extent& e) {
+  ArcFrame f;
+  if (!arc_frame(g, start, end, f)) return;
+  const double lo = std::min(0.0, f.sweep), hi = std::max(0.0, f.sweep);
   // Along axis k the circle is c_k + r·A·cos(θ − α), A = |(e1_k, e2_k)|, α = atan2(e2_k, e1_k):
   // its largest value at θ = α, its smallest at θ = α + π, where the sweep passes them.
   for (int k = 0; k < 3; ++k) {
-    const double amp = std::hypot(e1.v[k], e2.v[k]);
+    const double amp = std::hypot(f.e1.v[k], f.e2.v[k]);
     if (amp < 1e-12) continue;
-    const double alpha = std::atan2(e2.v[k], e1.v[k]);
-    const int axis = base + k;
-    if (passes(alpha, lo, hi)) e.max[axis] = std::max(e.max[axis], c.v[k] + radius * amp);
-    if (passes(alpha + std::numbers::pi, lo, hi)) e.min[axis] = std::min(e.min[axis], c.v[k] - radius * amp);
+    const double alpha = std::atan2(f.e2.v[k], f.e1.v[k]);
+    const int axis = f.base + k;
+    if (passes(alpha, lo, hi)) e.max[axis] = std::max(e.max[axis], f.c.v[k] + f.radius * amp);
+    if (passes(alpha + std::numbers::pi, lo, hi)) e.min[axis] = std::min(e.min[axis], f.c.v[k] - f.radius * amp);
   }
+}
+
+double linear_length(const Pose& d) {
+  const double xyz = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+  return xyz > 0 ? xyz : std::sqrt(d[6] * d[6] + d[7] * d[7] + d[8] * d[8]);
 }
 
 /// The file a move came from, or "" when the program has no file table.
@@ -93,6 +111,19 @@ Extent move_extent(const canon::Program& program, canon::SegmentId id) {
   }
   if (program.move(id).kind == canon::MoveKind::Arc) widen_by_arc(program.arc(id), a, b, e);
   return e;
+}
+
+double move_length(const canon::Program& program, canon::SegmentId id) {
+  const Pose a = program.start_of(id), b = program.end(id);
+  Pose d;
+  for (int i = 0; i < kAxisCount; ++i) d[i] = b[i] - a[i];
+  ArcFrame f;
+  if (program.move(id).kind != canon::MoveKind::Arc || !arc_frame(program.arc(id), a, b, f)) return linear_length(d);
+  // The helix rise: the part of the move along the plane normal.
+  const canon::ArcGeometry& g = program.arc(id);
+  double rise = 0;
+  for (int k = 0; k < 3; ++k) rise += d[f.base + k] * g.normal[k];
+  return std::hypot(f.radius * std::fabs(f.sweep), rise);
 }
 
 bool check_soft_limits(const canon::Program& program, const ServoConfig& config, Diagnostics& diags) {

@@ -20,6 +20,10 @@ struct Extent {
 /// extent (the circle's extreme points in the plane where the sweep passes them). Non-real-time.
 Extent move_extent(const canon::Program& program, canon::SegmentId id);
 
+/// The length of move `id` along X Y Z (U V W for moves without XYZ motion): the distance for a
+/// line, the helix length for an arc. Non-real-time.
+double move_length(const canon::Program& program, canon::SegmentId id);
+
 /// Checks every move of `program` (from its start) against the soft limits of the joints in
 /// `config` (wrapped rotary joints have none). Adds one `control.soft-limit` error per move and
 /// axis that would cross a limit, with the move's file and line, and returns false if there was
