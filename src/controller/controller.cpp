@@ -96,7 +96,9 @@ std::optional<Outcome> Controller::outcome(std::uint64_t id) const {
 
 ControllerStatus Controller::status() const {
   std::lock_guard lock(out_mutex_);
-  return published_;
+  ControllerStatus s = published_;
+  s.servo = channels_->status.front();  // stable until the next update(), which takes the lock
+  return s;
 }
 
 std::vector<Note> Controller::take_notes() {
@@ -125,21 +127,26 @@ void Controller::service() {
 
   std::lock_guard lock(out_mutex_);
   ControllerStatus& p = published_;
-  p.servo = servo_;
   p.program_name = program_name_;
   p.program_moves = program_ ? program_->size() : 0;
   p.run_active = run_ != nullptr;
   const bool auto_run = run_ && run_->mode == Mode::Auto;
-  p.run_segment = auto_run ? run_->segment_offset + servo_.segment : 0;
+  p.run_segment = auto_run ? run_->segment_offset + servo().segment : 0;
   p.progress = auto_run && p.program_moves > 0
                    ? std::min(1.0, static_cast<double>(p.run_segment) / static_cast<double>(p.program_moves))
                    : 0.0;
-  p.fault_text = servo_.fault.kind == FaultKind::None ? std::string() : describe(servo_.fault);
+  if (servo().fault.tick != described_fault_tick_ || servo().fault.kind == FaultKind::None) {
+    p.fault_text = servo().fault.kind == FaultKind::None ? std::string() : describe(servo().fault);
+    described_fault_tick_ = servo().fault.tick;
+  }
   p.runs_finished = runs_finished_;
 }
 
 void Controller::read_servo() {
-  if (channels_->status.update()) servo_ = channels_->status.front();
+  {
+    std::lock_guard lock(out_mutex_);  // status() copies the front slot under it
+    channels_->status.update();
+  }
   ServoEvent e;
   while (channels_->events.try_pop(e)) on_event(e);
 }
@@ -233,18 +240,19 @@ std::unique_ptr<plan::Planner> Controller::prepare(const canon::Program& program
 
 void Controller::open(std::uint64_t id, Request& r) {
   if (run_) return finish(id, Refusal::Busy, "a program is running");
-  if (servo_.mode != Mode::Auto) return finish(id, Refusal::WrongMode, "programs are opened in Auto mode");
+  if (servo().mode != Mode::Auto) return finish(id, Refusal::WrongMode, "programs are opened in Auto mode");
   LoadedProgram lp;
   if (r.program) {
     lp.program = r.program;
   } else if (!source_) {
     return finish(id, Refusal::ProgramError, "this controller has no G-code interpreter");
   } else {
-    lp = source_->load(r.text, servo_.commanded, {block_delete_});
+    lp = source_->load(r.text, servo().commanded, {block_delete_});
   }
   if (!lp.program) return finish(id, Refusal::ProgramError, "the program has errors", std::move(lp.diagnostics));
   Diagnostics& d = lp.diagnostics;
-  if (!prepare(*lp.program, d)) {
+  auto planner = prepare(*lp.program, d);
+  if (!planner) {
     const Refusal why = has_code(d, "control.soft-limit") ? Refusal::SoftLimit : Refusal::ProgramError;
     return finish(id, why, refusal_text(why), std::move(d));
   }
@@ -252,6 +260,8 @@ void Controller::open(std::uint64_t id, Request& r) {
     std::lock_guard lock(out_mutex_);
     program_ = lp.program;
   }
+  prepared_ = std::move(planner);  // the first run from here uses it
+  prepared_program_ = lp.program;
   program_name_ = r.text;
   program_path_ = r.program ? std::string() : r.text;
   program_block_delete_ = block_delete_;
@@ -260,36 +270,42 @@ void Controller::open(std::uint64_t id, Request& r) {
 
 void Controller::mdi(std::uint64_t id, const Request& r) {
   if (run_) return finish(id, Refusal::Busy, "something is running");
-  if (servo_.mode != Mode::Mdi) return finish(id, Refusal::WrongMode, "MDI lines need MDI mode");
-  if (servo_.state != State::Idle) return finish(id, not_idle(servo_.state), refusal_text(not_idle(servo_.state)));
+  if (servo().mode != Mode::Mdi) return finish(id, Refusal::WrongMode, "MDI lines need MDI mode");
+  if (servo().state != State::Idle) return finish(id, not_idle(servo().state), refusal_text(not_idle(servo().state)));
   if (!source_) return finish(id, Refusal::ProgramError, "this controller has no G-code interpreter");
-  LoadedProgram lp = source_->mdi(r.text, servo_.commanded);
+  LoadedProgram lp = source_->mdi(r.text, servo().commanded);
   if (!lp.program) return finish(id, Refusal::ProgramError, "the line has errors", std::move(lp.diagnostics));
   start_run(id, lp.program, Mode::Mdi, 0);
 }
 
 void Controller::cycle_start(std::uint64_t id, const Request& r) {
-  if (run_ || servo_.mode != Mode::Auto) return forward(id, r);  // the servo continues or says no
+  if (run_ || servo().mode != Mode::Auto) return forward(id, r);  // the servo continues or says no
   if (!program_) return finish(id, Refusal::NoProgram, refusal_text(Refusal::NoProgram));
-  if (servo_.state != State::Idle) return finish(id, not_idle(servo_.state), refusal_text(not_idle(servo_.state)));
+  if (servo().state != State::Idle) return finish(id, not_idle(servo().state), refusal_text(not_idle(servo().state)));
   std::shared_ptr<const canon::Program> program = program_;
-  const bool moved = program->start() != servo_.commanded;
+  const bool moved = program->start() != servo().commanded;
   if (!program_path_.empty() && source_ && (moved || program_block_delete_ != block_delete_)) {
-    LoadedProgram lp = source_->load(program_path_, servo_.commanded, {block_delete_});
+    LoadedProgram lp = source_->load(program_path_, servo().commanded, {block_delete_});
     if (!lp.program) return finish(id, Refusal::ProgramError, "the program has errors", std::move(lp.diagnostics));
     program = lp.program;
   } else if (moved) {
-    program = program_tail(*program, 0, servo_.commanded);
+    program = program_tail(*program, 0, servo().commanded);
   }
   start_run(id, program, Mode::Auto, 0);
 }
 
 void Controller::start_run(std::uint64_t id, std::shared_ptr<const canon::Program> program, Mode mode,
                            canon::SegmentId segment_offset) {
-  if (servo_config_.homing_required && !servo_.all_homed)
+  if (servo_config_.homing_required && !servo().all_homed)
     return finish(id, Refusal::NotHomed, refusal_text(Refusal::NotHomed));
   Diagnostics d;
-  auto planner = prepare(*program, d);
+  std::unique_ptr<plan::Planner> planner;
+  if (program == prepared_program_ && prepared_) {
+    planner = std::move(prepared_);
+  } else {
+    planner = prepare(*program, d);
+  }
+  prepared_program_.reset();
   if (!planner) {
     const Refusal why = has_code(d, "control.soft-limit") ? Refusal::SoftLimit : Refusal::ProgramError;
     return finish(id, why, refusal_text(why), std::move(d));
@@ -323,7 +339,7 @@ void Controller::continue_after_probe() {
     std::lock_guard lock(inbox_mutex_);
     id = next_id_++;
   }
-  start_run(id, program_tail(*done->program, next, servo_.commanded), done->mode, done->segment_offset + next);
+  start_run(id, program_tail(*done->program, next, servo().commanded), done->mode, done->segment_offset + next);
 }
 
 // --- feeding the servo -----------------------------------------------------------------------
@@ -370,7 +386,7 @@ void Controller::finish(std::uint64_t id, Refusal refusal, std::string message, 
 
 void Controller::note(Severity s, std::string code, std::string text) {
   std::lock_guard lock(out_mutex_);
-  notes_.push_back(Note{servo_.tick, s, std::move(code), std::move(text)});
+  notes_.push_back(Note{servo().tick, s, std::move(code), std::move(text)});
 }
 
 std::string Controller::describe(const Fault& f) const {

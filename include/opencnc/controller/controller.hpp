@@ -188,8 +188,14 @@ class Controller {
   ControllerStatus published_;
 
   // Controller thread only.
-  ServoStatus servo_{};
+  /// The servo's status as last read (the triple buffer's reader slot).
+  const ServoStatus& servo() const noexcept { return channels_->status.front(); }
+  std::uint64_t described_fault_tick_ = ~std::uint64_t{0};
   std::shared_ptr<const canon::Program> program_;  ///< the open program
+  /// The planner started when the program was opened, for its first run (a program is checked
+  /// once, not at open and again at cycle start).
+  std::unique_ptr<plan::Planner> prepared_;
+  std::shared_ptr<const canon::Program> prepared_program_;
   std::string program_name_;
   std::string program_path_;  ///< "" when given as a canon::Program
   bool program_block_delete_ = false;
