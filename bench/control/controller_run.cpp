@@ -77,6 +77,11 @@ void run(const config::MachineProfile& profile, const Job& job, bool report) {
   TraceSample s;
   for (std::uint64_t n = 0; n < 100'000'000; ++n) {
     rig.step();
+    if ((n & 255) == 0) {  // no operator: continue program stops and manual tool changes
+      const ServoStatus& v = rig.status().servo;
+      if (v.state == State::Stopped) rig.controller().submit(Request::simple(CommandKind::CycleStart));
+      if (v.wait == Wait::ManualToolChange) rig.controller().submit(Request::simple(CommandKind::ToolChanged));
+    }
     if (rec) {
       while (rig.channels().trace.try_pop(s)) {
         if (s.activity == Activity::Program) rec->add(s);

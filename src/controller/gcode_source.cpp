@@ -18,15 +18,19 @@ namespace {
 /// profile's default tolerance: the planner reads the later of two settings at the same move.
 class DefaultTolerance final : public canon::Sink {
  public:
-  DefaultTolerance(canon::ProgramBuilder& b, double tolerance) : b_(b), tolerance_(tolerance) {}
+  DefaultTolerance(canon::ProgramBuilder& b, double tolerance_mm, canon::Units units)
+      : b_(b), tolerance_mm_(tolerance_mm), units_(units) {}
+  void use_length_units(canon::Units u) override { units_ = u; }
   void set_motion_control_mode(canon::MotionControl mode, double tolerance) override {
-    if (mode == canon::MotionControl::Continuous && tolerance <= 0 && tolerance_ > 0)
-      b_.set_motion_control_mode(mode, tolerance_);
+    // The builder takes tolerances in program units.
+    if (mode == canon::MotionControl::Continuous && tolerance <= 0 && tolerance_mm_ > 0)
+      b_.set_motion_control_mode(mode, tolerance_mm_ / canon::mm_per_unit(units_));
   }
 
  private:
   canon::ProgramBuilder& b_;
-  double tolerance_;
+  double tolerance_mm_;
+  canon::Units units_;
 };
 
 std::vector<Diagnostic> since(const Diagnostics& d, std::size_t first) {
@@ -90,9 +94,9 @@ LoadedProgram GcodeProgramSource::load(const std::string& path, const Pose& star
   gcode::Interpreter interp(o);
   canon::ProgramBuilder builder(o.axes, start);
   builder.program().set_sources(interp.sources());
-  DefaultTolerance tolerance(builder, default_tolerance_);
+  DefaultTolerance tolerance(builder, default_tolerance_, canon::Units::Mm);
   canon::TeeSink sink(builder, tolerance);
-  builder.set_motion_control_mode(canon::MotionControl::Continuous, default_tolerance_);
+  builder.set_motion_control_mode(canon::MotionControl::Continuous, default_tolerance_);  // in mm yet
   LoadedProgram out;
   // The file first (file 0 of the source map, the main program of every move; start() checks
   // its head), then the start-up calls, then the position.
@@ -119,8 +123,9 @@ void GcodeProgramSource::replay_state(const gcode::InterpState& s, canon::Progra
   b.select_plane(m.plane);
   b.set_feed_mode(0, m.feed_mode);
   b.set_feed_rate(m.feed_rate);
-  const double tol = m.control == canon::MotionControl::Continuous && m.path_tolerance <= 0 ? default_tolerance_
-                                                                                          : m.path_tolerance;
+  const double tol = m.control == canon::MotionControl::Continuous && m.path_tolerance <= 0
+                        ? default_tolerance_ / canon::mm_per_unit(m.units)  // the builder scales by the units
+                        : m.path_tolerance;
   b.set_motion_control_mode(m.control, tol);
   b.set_naivecam_tolerance(m.naivecam_tolerance);
   if (!m.feed_override) b.disable_feed_override();
@@ -142,7 +147,7 @@ LoadedProgram GcodeProgramSource::mdi(std::string_view line, const Pose& start) 
   canon::ProgramBuilder builder(options_.axes, start);
   builder.program().set_sources(mdi_->sources());
   replay_state(mdi_->state(), builder);
-  DefaultTolerance tolerance(builder, default_tolerance_);
+  DefaultTolerance tolerance(builder, default_tolerance_, mdi_->state().modal.units);
   canon::TeeSink sink(builder, tolerance);
   const std::size_t first = mdi_->diagnostics().items().size();
   const gcode::RunStatus status = mdi_->execute_mdi(line, sink);

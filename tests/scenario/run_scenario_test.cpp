@@ -7,6 +7,8 @@
 
 #include <cmath>
 #include <cstring>
+
+#include <fmt/format.h>
 #include <string>
 
 #include "../control/test_profiles.hpp"
@@ -64,6 +66,21 @@ TEST(RunScenario, ProgramRunsToTheEndWithinTheLimits) {
   bool seen_on = false;
   for (const TraceSample& t : s.samples()) seen_on = seen_on || t.line == 7;
   EXPECT_TRUE(seen_on);
+}
+
+// G64 without P takes the profile's default tolerance (0.01 mm on the mill), in an inch program
+// as in a metric one.
+TEST(RunScenario, DefaultToleranceAppliesInInchProgramsToo) {
+  for (const char* units : {"G21", "G20"}) {
+    Scenario s(mill());
+    const double side = std::string(units) == "G20" ? 2.0 : 50.8;
+    TempProgram p("sq.ngc", fmt::format("{} G90 G64\nG0 X0 Y0\nG1 X{} F200\nY{}\nX0\nY0\nM2\n", units, side, side));
+    s.on(Mode::Auto);
+    ASSERT_TRUE(s.run_file(p.path())) << s.message();
+    const RunReport r = s.report(*s.rig().controller().open_program());
+    EXPECT_LE(r.max_command_contour_error_mm, 0.01 + 1e-6) << units;
+    EXPECT_GT(r.max_command_contour_error_mm, 0.005) << units;  // the corners were blended
+  }
 }
 
 TEST(RunScenario, OutputsFollowThePathMarkers) {
