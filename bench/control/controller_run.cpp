@@ -3,12 +3,15 @@
 // time: the figures of docs/controller.md (time, following and contour error, limits) and the
 // speed of virtual time (machine seconds per CPU second of this thread).
 //
-//   controller_run [--profile FILE] [--set key=value]... [--no-report] [G-code files...]
+//   controller_run [--profile FILE] [--set key=value]... [--no-report] [--service-every N] [files...]
+//
+// --service-every N: the controller's work between every N servo periods (default 1).
 //
 // Without files it runs the reference programs built from canonical calls (square G61/G64,
 // dense spiral with and without G64 Q, small arcs).
 #include <ctime>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <memory>
 #include <string>
@@ -49,9 +52,9 @@ bool ask(SimRig& rig, Request r, std::string& why) {
   return o.accepted;
 }
 
-void run(const config::MachineProfile& profile, const Job& job, bool report) {
+void run(const config::MachineProfile& profile, const Job& job, bool report, int service_every) {
   Diagnostics diags;
-  SimRig rig(profile, GcodeProgramSource::create(profile, diags));
+  SimRig rig(profile, GcodeProgramSource::create(profile, diags), service_every);
   std::string why;
   if (!ask(rig, Request::simple(CommandKind::MachineOn), why) || !ask(rig, Request::set_mode(Mode::Auto), why)) {
     fmt::print("{:<28} refused: {}\n", job.name, why);
@@ -127,12 +130,15 @@ int main(int argc, char** argv) {
   std::vector<std::string> sets;
   std::vector<Job> jobs;
   bool report = true;
+  int service_every = 1;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--profile" && i + 1 < argc) {
       profile_file = argv[++i];
     } else if (a == "--set" && i + 1 < argc) {
       sets.emplace_back(argv[++i]);
+    } else if (a == "--service-every" && i + 1 < argc) {
+      service_every = std::atoi(argv[++i]);
     } else if (a == "--no-report") {
       report = false;
     } else {
@@ -147,6 +153,6 @@ int main(int argc, char** argv) {
     fmt::print("{:<28} {:>9} {:>9} {:>8} {:>8} {:>8} {:>6} {:>7} {:>7}\n", "program", "time [s]", "motion", "FE [mm]",
                "contour", "cmd ctr", "viol.", "v max", "a max");
   }
-  for (const Job& j : jobs) run(*load.profile, j, report);
+  for (const Job& j : jobs) run(*load.profile, j, report, service_every);
   return 0;
 }

@@ -41,6 +41,8 @@ bool Servo::spindle_at_speed() const noexcept {
 // action record still to be applied is a spindle one and a spindle wait for it (or later) comes
 // before any other stop, the spindle is not at speed yet.
 bool Servo::spindle_change_pending() const noexcept {
+  // A wait is only decided with the motion at rest (it is a stop): while moving, nothing to do.
+  if (tick_out_.path_velocity != 0) return false;
   const auto& ring = channels_->actions;
   if (ring.available() == 0) return false;
   const MachineAction& next = ring.front();
