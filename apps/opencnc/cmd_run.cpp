@@ -5,8 +5,9 @@
 #include <nlohmann/json.hpp>
 #include <unistd.h>
 
-#include <cmath>
+#include <algorithm>
 #include <cstdio>
+#include <fstream>
 #include <memory>
 #include <optional>
 #include <string>
@@ -112,6 +113,10 @@ nlohmann::json report_json(const control::RunReport& r, const RunOptions& o, con
 }
 
 int run(const RunOptions& o) {
+  if (!o.trace.empty() && !std::ofstream(o.trace)) {  // before the run, not after it
+    fmt::print(stderr, "error: cannot write the trace {}\n", o.trace);
+    return kExitUsage;
+  }
   std::optional<control::RunRecorder> recorder;
   std::optional<control::TraceCsvWriter> csv;
   std::optional<ProgressBar> bar;

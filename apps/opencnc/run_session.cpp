@@ -73,7 +73,6 @@ class RealtimeDriver final : public Driver {
   }
   control::Controller& controller() override { return *controller_; }
   control::ServoChannels& channels() override { return *channels_; }
-  const control::RealtimeClock& clock() const { return clock_; }
 
  private:
   std::unique_ptr<control::ServoChannels> channels_;

@@ -110,9 +110,9 @@ void JointHoming::step(const HomeConfig& c, const HomingInputs& in, AxisMover& m
       }
       break;
     case HomingPhase::Latch:
-      if (c.method == HomeMethod::Immediate) {
-        latch(c, in.feedback, offset);
-        offset = c.position - in.feedback;  // no edge: the present position is `position`
+      if (c.method == HomeMethod::Immediate) {  // no edge: the present position is `position`
+        latched_at_ = in.feedback;
+        offset_ = offset = c.position - in.feedback;
         phase_ = HomingPhase::Done;
         break;
       }

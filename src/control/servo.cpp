@@ -236,7 +236,8 @@ void Servo::write_joint(int j) noexcept {
   const bool servo = config_.joints[uj].drive == machine::JointDrive::Servo;
   // Feed-forward from the last two commands: the drive extrapolates the reference with it over
   // the period (one period behind the true derivative, an error of a·T², 1 µm at 1000 mm/s²).
-  velocity_ff_[uj] = drives_enabled_ && servo ? (joint_cmd_[uj] - o.position) / config_.period_s : 0.0;
+  joint_velocity_[uj] = drives_enabled_ ? (joint_cmd_[uj] - o.position) / config_.period_s : 0.0;
+  velocity_ff_[uj] = servo ? joint_velocity_[uj] : 0.0;
   reference_[uj] = joint_cmd_[uj] + velocity_ff_[uj] * config_.period_s;
   o.position = joint_cmd_[uj];
   o.velocity_ff = velocity_ff_[uj];
@@ -321,7 +322,7 @@ void Servo::fill_status(ServoStatus& s) const noexcept {
     js.commanded = commanded_[config_.joints[uj].axis];
     js.actual = feedback_[uj] + offset_[uj];
     js.following_error = following_error_[uj];
-    js.velocity = velocity_ff_[uj];
+    js.velocity = joint_velocity_[uj];
     js.homed = homed_[uj];
     js.homing = (homing_active_ | homing_pending_) & (1u << j);
     js.limit_neg = ji.limit_neg;

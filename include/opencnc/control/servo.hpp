@@ -139,7 +139,8 @@ class Servo final : public Tickable {
   Pose commanded_{};        ///< every axis, machine coordinates
   Joints joint_cmd_{};      ///< after coupling and compensation, joint coordinates
   Joints reference_{};      ///< what the drive aims at by the end of the period (cmd + ff·T)
-  Joints velocity_ff_{};    ///< joint units/s
+  Joints joint_velocity_{};  ///< commanded, joint units/s (last two commands)
+  Joints velocity_ff_{};     ///< what servo drives get of it (steppers: none)
   Joints feedback_{};       ///< joint coordinates
   Joints following_error_{};
   Joints offset_{};
