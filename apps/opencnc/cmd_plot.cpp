@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // `opencnc plot`: the toolpath (XY, XZ, YZ, isometric) and the velocity, acceleration and
 // following-error profiles of a run, as SVG — from a program (run in virtual time) or a trace CSV.
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <CLI/CLI.hpp>
 
 #include <algorithm>
 #include <array>
@@ -79,7 +79,8 @@ bool read_trace(const std::string& path, Trace& trace, std::string& error) {
   while (std::getline(in, line)) {
     ++row;
     v.clear();
-    for (std::stringstream ss(line); std::getline(ss, line, ',');) v.push_back(std::strtod(line.c_str(), nullptr));
+    for (std::stringstream ss(line); std::getline(ss, line, ',');)
+      v.push_back(std::strtod(line.c_str(), nullptr));
     if (v.size() != head.size()) {
       error = fmt::format("{}:{}: {} fields, the header has {}", path, row, v.size(), head.size());
       return false;
@@ -89,8 +90,10 @@ bool read_trace(const std::string& path, Trace& trace, std::string& error) {
     s.rapid = rapid_col >= 0 && v[static_cast<std::size_t>(rapid_col)] != 0;
     s.path_velocity = v_col >= 0 ? v[static_cast<std::size_t>(v_col)] : 0;
     for (int i = 0; i < kAxisCount; ++i) {
-      if (cmd_col[static_cast<std::size_t>(i)] >= 0) s.cmd[i] = v[static_cast<std::size_t>(cmd_col[static_cast<std::size_t>(i)])];
-      if (ferr_col[static_cast<std::size_t>(i)] >= 0) s.ferr[i] = v[static_cast<std::size_t>(ferr_col[static_cast<std::size_t>(i)])];
+      if (cmd_col[static_cast<std::size_t>(i)] >= 0)
+        s.cmd[i] = v[static_cast<std::size_t>(cmd_col[static_cast<std::size_t>(i)])];
+      if (ferr_col[static_cast<std::size_t>(i)] >= 0)
+        s.ferr[i] = v[static_cast<std::size_t>(ferr_col[static_cast<std::size_t>(i)])];
     }
     trace.samples.push_back(s);
   }
@@ -102,12 +105,13 @@ bool read_trace(const std::string& path, Trace& trace, std::string& error) {
 
 constexpr const char* kFeedColor = "#1f77b4";
 constexpr const char* kRapidColor = "#e8590c";
-constexpr const char* kAxisColors[] = {"#1f77b4", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2",
-                                       "#7f7f7f", "#bcbd22", "#17becf"};
+constexpr const char* kAxisColors[] = {"#1f77b4", "#2ca02c", "#d62728", "#9467bd", "#8c564b",
+                                       "#e377c2", "#7f7f7f", "#bcbd22", "#17becf"};
 
 /// A toolpath view: one polyline per stretch of feed or rapid moves, rapids in their own colour.
 template <typename Project>
-viz::Panel toolpath(const Trace& tr, std::string title, std::string x_label, std::string y_label, Project project) {
+viz::Panel toolpath(const Trace& tr, std::string title, std::string x_label, std::string y_label,
+                    Project project) {
   viz::Panel p;
   p.title = std::move(title);
   p.x_label = std::move(x_label);
@@ -195,13 +199,14 @@ viz::Panel velocities(const Trace& tr) {
   p.title = "velocity" + peaks_note(tr);
   p.x_label = "time (s)";
   p.y_label = "velocity (mm/s, deg/s)";
-  p.series.push_back(envelope(tr, "path", "#000000", [&](std::size_t i) { return tr.samples[i].path_velocity; }));
+  p.series.push_back(
+      envelope(tr, "path", "#000000", [&](std::size_t i) { return tr.samples[i].path_velocity; }));
   for (int a = 0; a < kAxisCount; ++a) {
     if (!tr.axes.has(static_cast<Axis>(a))) continue;
-    p.series.push_back(envelope(tr, std::string(1, kAxisLetters[static_cast<std::size_t>(a)]), kAxisColors[a],
-                                [&](std::size_t i) {
-                                  return i == 0 ? 0.0 : (tr.samples[i].cmd[a] - tr.samples[i - 1].cmd[a]) / tr.period_s;
-                                }));
+    p.series.push_back(envelope(
+        tr, std::string(1, kAxisLetters[static_cast<std::size_t>(a)]), kAxisColors[a], [&](std::size_t i) {
+          return i == 0 ? 0.0 : (tr.samples[i].cmd[a] - tr.samples[i - 1].cmd[a]) / tr.period_s;
+        }));
   }
   return p;
 }
@@ -245,7 +250,9 @@ bool draw(const Trace& tr, const std::string& title, const std::string& out, std
   chart.add_panel(toolpath(tr, "toolpath YZ (side)", "Y (mm)", "Z (mm)", xy(1, 2)));
   const double c30 = std::sqrt(3.0) / 2, s30 = 0.5;
   chart.add_panel(toolpath(tr, "toolpath isometric", "(X − Y)·cos 30° (mm)", "(X + Y)·sin 30° + Z (mm)",
-                           [&](const Pose& q) { return std::pair{(q[0] - q[1]) * c30, (q[0] + q[1]) * s30 + q[2]}; }));
+                           [&](const Pose& q) {
+                             return std::pair{(q[0] - q[1]) * c30, (q[0] + q[1]) * s30 + q[2]};
+                           }));
   chart.add_panel(velocities(tr));
   chart.add_panel(accelerations(tr));
   chart.add_panel(following_errors(tr));
@@ -272,8 +279,8 @@ int plot(const PlotOptions& o) {
       tr.period_s = p.servo_period_s;
     };
     hooks.sample = [&](const control::TraceSample& s) {
-      tr.samples.push_back(Sample{static_cast<double>(s.tick) * tr.period_s, s.rapid, s.path_velocity, s.commanded,
-                                  s.following_error});
+      tr.samples.push_back(Sample{static_cast<double>(s.tick) * tr.period_s, s.rapid, s.path_velocity,
+                                  s.commanded, s.following_error});
     };
     const SessionEnd end = run_session(o.session, hooks);
     if (tr.samples.empty()) return end.exit_code == kExitOk ? kExitProgram : end.exit_code;
@@ -294,7 +301,8 @@ int plot(const PlotOptions& o) {
 
 void add_plot_command(CLI::App& app, Registry& registry) {
   auto opts = std::make_shared<PlotOptions>();
-  CLI::App* cmd = app.add_subcommand("plot", "Draw a run's toolpath and velocity profile as SVG (from a program or a trace)");
+  CLI::App* cmd = app.add_subcommand(
+      "plot", "Draw a run's toolpath and velocity profile as SVG (from a program or a trace)");
   cmd->add_option("file", opts->session.file, "G-code program to run in virtual time");
   cmd->add_option("--trace", opts->trace, "Trace CSV written by `opencnc run --trace`");
   cmd->add_option("--machine,-m", opts->session.machine, "Machine profile (with a program)");

@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // `opencnc run`: a program on the simulated machine, with a progress bar, a report, a trace.
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
-#include <nlohmann/json.hpp>
 #include <unistd.h>
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cstdio>
@@ -48,8 +48,10 @@ class ProgressBar {
     const double elapsed = st.servo.time_s - run_start_s;
     const int width = 30, filled = static_cast<int>(done * width + 0.5);
     const std::string left = done > 0.01 ? fmt::format("~{:.1f} s left", elapsed * (1 - done) / done) : "";
-    fmt::print("\r[{}{}] {:5.1f} %  line {:<6}  {:.1f} s  {:<16}", std::string(static_cast<std::size_t>(filled), '#'),
-               std::string(static_cast<std::size_t>(width - filled), '.'), 100 * done, st.servo.line, elapsed, left);
+    fmt::print("\r[{}{}] {:5.1f} %  line {:<6}  {:.1f} s  {:<16}",
+               std::string(static_cast<std::size_t>(filled), '#'),
+               std::string(static_cast<std::size_t>(width - filled), '.'), 100 * done, st.servo.line, elapsed,
+               left);
     std::fflush(stdout);
   }
   void finish() { fmt::print("\n"); }
@@ -72,12 +74,14 @@ void print_report(const control::RunReport& r, const config::MachineProfile& pro
   fmt::print("axis  max velocity  max acceleration  max jerk\n");
   for (const config::AxisProfile& a : profile.axes) {
     const analysis::AxisStats& s = r.axes[static_cast<std::size_t>(index(a.axis))];
-    fmt::print("  {}   {:10.3f}    {:12.1f}    {:12.0f}\n", letter(a.axis), s.max_velocity, s.max_acceleration,
-               s.max_jerk);
+    fmt::print("  {}   {:10.3f}    {:12.1f}    {:12.0f}\n", letter(a.axis), s.max_velocity,
+               s.max_acceleration, s.max_jerk);
   }
-  fmt::print("limit violations    {}{}\n", r.limit_violations, end.limit_touched ? " (and a limit stopped the run)" : "");
+  fmt::print("limit violations    {}{}\n", r.limit_violations,
+             end.limit_touched ? " (and a limit stopped the run)" : "");
   if (end.wall_s > 0) {
-    fmt::print("wall time           {:.3f} s ({:.0f}x real time)\n", end.wall_s, r.machining_time_s / end.wall_s);
+    fmt::print("wall time           {:.3f} s ({:.0f}x real time)\n", end.wall_s,
+               r.machining_time_s / end.wall_s);
   }
 }
 
@@ -162,11 +166,14 @@ void add_run_command(CLI::App& app, Registry& registry) {
   auto opts = std::make_shared<RunOptions>();
   CLI::App* cmd = app.add_subcommand("run", "Run a G-code program on the simulated machine and report on it");
   cmd->add_option("file", opts->session.file, "G-code program")->required();
-  cmd->add_option("--machine,-m", opts->session.machine, "Machine profile, e.g. configs/mill-3axis.toml")->required();
-  cmd->add_option("--set", opts->session.sets, "Override a profile key: --set axis.x.max_velocity=200 (repeatable)")
+  cmd->add_option("--machine,-m", opts->session.machine, "Machine profile, e.g. configs/mill-3axis.toml")
+      ->required();
+  cmd->add_option("--set", opts->session.sets,
+                  "Override a profile key: --set axis.x.max_velocity=200 (repeatable)")
       ->expected(1)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
-  cmd->add_flag("--realtime", opts->session.realtime, "Tick in a real-time periodic thread instead of virtual time");
+  cmd->add_flag("--realtime", opts->session.realtime,
+                "Tick in a real-time periodic thread instead of virtual time");
   cmd->add_option("--trace", opts->trace, "Write one CSV row per servo period (docs/controller.md)");
   cmd->add_option("--report", opts->report, "Write the report as JSON");
   cmd->callback([opts, &registry] { registry.set_result(run(*opts)); });

@@ -43,7 +43,8 @@ class Driver {
 
 class VirtualDriver final : public Driver {
  public:
-  VirtualDriver(const config::MachineProfile& p, std::shared_ptr<control::ProgramSource> s) : rig_(p, std::move(s)) {}
+  VirtualDriver(const config::MachineProfile& p, std::shared_ptr<control::ProgramSource> s)
+      : rig_(p, std::move(s)) {}
   void advance() override { rig_.step(); }
   control::Controller& controller() override { return rig_.controller(); }
   control::ServoChannels& channels() override { return rig_.channels(); }
@@ -113,7 +114,8 @@ void print_notes(control::Controller& c) {
 
 bool home_if_needed(Driver& d, const control::ServoConfig& sc) {
   if (!sc.homing_required) return true;
-  if (!must(d, Request::set_mode(control::Mode::Manual)) || !must(d, Request::on_axis(CommandKind::Home, -1))) return false;
+  if (!must(d, Request::set_mode(control::Mode::Manual)) || !must(d, Request::on_axis(CommandKind::Home, -1)))
+    return false;
   const double limit_s = 600;
   for (double t = 0; t < limit_s; t += sc.period_s) {
     d.advance();
@@ -151,8 +153,9 @@ void follow(Driver& d, const SessionHooks& hooks, SessionEnd& end) {
     end.wall_s = wall;
     end.finished = st.runs_finished > finished_before;
     if (!end.finished) {
-      end.fault = st.fault_text.empty() ? fmt::format("the run ended in state {}", control::to_string(st.servo.state))
-                                        : st.fault_text;
+      end.fault = st.fault_text.empty()
+                      ? fmt::format("the run ended in state {}", control::to_string(st.servo.state))
+                      : st.fault_text;
       end.limit_touched = st.servo.fault.kind == control::FaultKind::SoftLimit ||
                           st.servo.fault.kind == control::FaultKind::LimitSwitch;
     }
@@ -169,7 +172,8 @@ SessionEnd run_session(const SessionOptions& o, const SessionHooks& hooks) {
   const config::ProfileLoad load = config::load_profile(o.machine, o.sets);
   print(load.diagnostics);
   if (!load.ok()) {
-    const bool unreadable = !load.diagnostics.items().empty() && load.diagnostics.items()[0].code == "config.file";
+    const bool unreadable =
+        !load.diagnostics.items().empty() && load.diagnostics.items()[0].code == "config.file";
     end.exit_code = unreadable ? kExitUsage : kExitProgram;
     return end;
   }

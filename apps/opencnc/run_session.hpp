@@ -24,11 +24,11 @@ struct SessionOptions {
 
 /// What a session ended with.
 struct SessionEnd {
-  int exit_code = 0;       ///< kExitOk, kExitProgram or kExitUsage
-  bool finished = false;   ///< the program reached its end
-  std::string fault;       ///< why it stopped early, in words ("" = it did not)
+  int exit_code = 0;           ///< kExitOk, kExitProgram or kExitUsage
+  bool finished = false;       ///< the program reached its end
+  std::string fault;           ///< why it stopped early, in words ("" = it did not)
   bool limit_touched = false;  ///< a soft limit or a limit switch stopped it
-  double wall_s = 0;       ///< wall-clock time of the run
+  double wall_s = 0;           ///< wall-clock time of the run
   std::shared_ptr<const canon::Program> program;
   config::MachineProfile profile;
 };

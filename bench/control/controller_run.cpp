@@ -9,10 +9,10 @@
 //
 // Without files it runs the reference programs built from canonical calls (square G61/G64,
 // dense spiral with and without G64 Q, small arcs).
-#include <ctime>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
 #include <memory>
 #include <string>
 #include <vector>
@@ -56,7 +56,8 @@ void run(const config::MachineProfile& profile, const Job& job, bool report, int
   Diagnostics diags;
   SimRig rig(profile, GcodeProgramSource::create(profile, diags), service_every);
   std::string why;
-  if (!ask(rig, Request::simple(CommandKind::MachineOn), why) || !ask(rig, Request::set_mode(Mode::Auto), why)) {
+  if (!ask(rig, Request::simple(CommandKind::MachineOn), why) ||
+      !ask(rig, Request::set_mode(Mode::Auto), why)) {
     fmt::print("{:<28} refused: {}\n", job.name, why);
     return;
   }
@@ -83,7 +84,8 @@ void run(const config::MachineProfile& profile, const Job& job, bool report, int
     if ((n & 255) == 0) {  // no operator: continue program stops and manual tool changes
       const ServoStatus& v = rig.status().servo;
       if (v.state == State::Stopped) rig.controller().submit(Request::simple(CommandKind::CycleStart));
-      if (v.wait == Wait::ManualToolChange) rig.controller().submit(Request::simple(CommandKind::ToolChanged));
+      if (v.wait == Wait::ManualToolChange)
+        rig.controller().submit(Request::simple(CommandKind::ToolChanged));
     }
     if (rec) {
       while (rig.channels().trace.try_pop(s)) {
@@ -96,23 +98,26 @@ void run(const config::MachineProfile& profile, const Job& job, bool report, int
   const double machine_s = static_cast<double>(rig.ticks() - t0) * profile.servo_period_s;
   const ControllerStatus st = rig.status();
   if (!rec) {
-    fmt::print("{:<28} {:9.3f} s machine  {:7.3f} s CPU  {:6.0f}x  {}\n", job.name, machine_s, cpu, machine_s / cpu,
-               st.runs_finished > 0 ? "finished" : st.fault_text);
+    fmt::print("{:<28} {:9.3f} s machine  {:7.3f} s CPU  {:6.0f}x  {}\n", job.name, machine_s, cpu,
+               machine_s / cpu, st.runs_finished > 0 ? "finished" : st.fault_text);
     return;
   }
   const RunReport r = rec->report();
   double vmax = 0, amax = 0;
-  for (const auto& a : r.axes) vmax = std::max(vmax, a.max_velocity), amax = std::max(amax, a.max_acceleration);
-  fmt::print("{:<28} {:9.3f} {:9.3f} {:8.4f} {:8.4f} {:8.4f} {:6} {:7.1f} {:7.1f}  {}\n", job.name, r.machining_time_s,
-             r.motion_time_s, r.max_following_error_mm, r.max_contour_error_mm, r.max_command_contour_error_mm,
-             r.limit_violations, vmax, amax, st.runs_finished > 0 ? "finished" : st.fault_text);
+  for (const auto& a : r.axes)
+    vmax = std::max(vmax, a.max_velocity), amax = std::max(amax, a.max_acceleration);
+  fmt::print("{:<28} {:9.3f} {:9.3f} {:8.4f} {:8.4f} {:8.4f} {:6} {:7.1f} {:7.1f}  {}\n", job.name,
+             r.machining_time_s, r.motion_time_s, r.max_following_error_mm, r.max_contour_error_mm,
+             r.max_command_contour_error_mm, r.limit_violations, vmax, amax,
+             st.runs_finished > 0 ? "finished" : st.fault_text);
 }
 
 std::vector<Job> reference_jobs() {
   using analysis::PathMode;
   const auto p = [](canon::Program prog) { return std::make_shared<const canon::Program>(std::move(prog)); };
   // G64 P0.01 merges as LinuxCNC does with Q = P; Q0 merges nothing.
-  const PathMode g64{canon::MotionControl::Continuous, 0.01, 0.01}, g64q0{canon::MotionControl::Continuous, 0.01, 0};
+  const PathMode g64{canon::MotionControl::Continuous, 0.01, 0.01},
+      g64q0{canon::MotionControl::Continuous, 0.01, 0};
   const PathMode g61{canon::MotionControl::ExactPath, 0, 0}, arcs{canon::MotionControl::Continuous, 0.1, 0.1};
   return {
       {"square G64 P0.01", p(analysis::square_program(100, 6000, g64)), ""},
@@ -150,8 +155,8 @@ int main(int argc, char** argv) {
   if (!load.ok()) return 2;
   if (jobs.empty()) jobs = reference_jobs();
   if (report) {
-    fmt::print("{:<28} {:>9} {:>9} {:>8} {:>8} {:>8} {:>6} {:>7} {:>7}\n", "program", "time [s]", "motion", "FE [mm]",
-               "contour", "cmd ctr", "viol.", "v max", "a max");
+    fmt::print("{:<28} {:>9} {:>9} {:>8} {:>8} {:>8} {:>6} {:>7} {:>7}\n", "program", "time [s]", "motion",
+               "FE [mm]", "contour", "cmd ctr", "viol.", "v max", "a max");
   }
   for (const Job& j : jobs) run(*load.profile, j, report, service_every);
   return 0;

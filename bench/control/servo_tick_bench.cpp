@@ -71,7 +71,8 @@ class LoopbackMachine final : public machine::MachineIO {
   void write(const machine::MachineOutputs& out) noexcept override {
     ++in_.cycle;
     in_.estop_ok = true;
-    for (int j = 0; j < joints_; ++j) in_.joints[static_cast<std::size_t>(j)].position = out.joints[static_cast<std::size_t>(j)].position;
+    for (int j = 0; j < joints_; ++j)
+      in_.joints[static_cast<std::size_t>(j)].position = out.joints[static_cast<std::size_t>(j)].position;
   }
 
  private:
@@ -124,7 +125,8 @@ void servo_tick(benchmark::State& state, std::unique_ptr<Machine> machine) {
     return o && o->accepted;
   };
   if (!submit(Request::simple(CommandKind::MachineOn)) || !submit(Request::set_mode(Mode::Auto)) ||
-      !submit(Request::open(six_axis_program(), "six-axis")) || !submit(Request::simple(CommandKind::CycleStart))) {
+      !submit(Request::open(six_axis_program(), "six-axis")) ||
+      !submit(Request::simple(CommandKind::CycleStart))) {
     state.SkipWithError("the program does not start");
     return;
   }
@@ -151,7 +153,9 @@ void servo_tick(benchmark::State& state, std::unique_ptr<Machine> machine) {
     ns.push_back(dt * 1e9);
   }
   std::sort(ns.begin(), ns.end());
-  const auto pct = [&](double p) { return ns.empty() ? 0.0 : ns[static_cast<std::size_t>(p * static_cast<double>(ns.size() - 1))]; };
+  const auto pct = [&](double p) {
+    return ns.empty() ? 0.0 : ns[static_cast<std::size_t>(p * static_cast<double>(ns.size() - 1))];
+  };
   state.counters["p50_ns"] = pct(0.5);
   state.counters["p99_ns"] = pct(0.99);
   state.counters["p999_ns"] = pct(0.999);

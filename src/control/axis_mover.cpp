@@ -7,7 +7,8 @@
 
 namespace opencnc::control {
 
-void AxisMover::configure(double period_s, double max_acceleration, double max_jerk, double position) noexcept {
+void AxisMover::configure(double period_s, double max_acceleration, double max_jerk,
+                          double position) noexcept {
   period_ = period_s;
   accel_ = max_acceleration;
   int m = 1;

@@ -29,7 +29,8 @@ void JointHoming::start(const HomeConfig& c, const HomingInputs& in) noexcept {
       phase_ = in.home_switch ? HomingPhase::Clear : HomingPhase::Search;
       break;
     case HomeMethod::DecelHome:
-      phase_ = in.home_switch ? HomingPhase::Clear : (in.decel_switch ? HomingPhase::Latch : HomingPhase::Search);
+      phase_ =
+          in.home_switch ? HomingPhase::Clear : (in.decel_switch ? HomingPhase::Latch : HomingPhase::Search);
       break;
   }
 }
@@ -60,12 +61,14 @@ void JointHoming::after_switch_latch(const HomeConfig& c, AxisMover& mover) noex
   phase_ = HomingPhase::Final;
 }
 
-void JointHoming::tick(const HomeConfig& c, const HomingInputs& in, AxisMover& mover, double& offset) noexcept {
+void JointHoming::tick(const HomeConfig& c, const HomingInputs& in, AxisMover& mover,
+                       double& offset) noexcept {
   step(c, in, mover, offset);
   previous_feedback_ = in.feedback;
 }
 
-void JointHoming::step(const HomeConfig& c, const HomingInputs& in, AxisMover& mover, double& offset) noexcept {
+void JointHoming::step(const HomeConfig& c, const HomingInputs& in, AxisMover& mover,
+                       double& offset) noexcept {
   if (stopping_) {
     if (!mover.settled()) return;
     stopping_ = false;

@@ -36,15 +36,15 @@ Servo::Servo(const ServoConfig& config, ServoChannels& channels, machine::Machin
 // The servo period. Its stages, in the order DESIGN.md fixes:
 bool Servo::tick() noexcept {
   ++tick_;
-  read_inputs();       // machine inputs (feedback, switches, power, spindle, I/O)
-  check_safety();      // e-stop, limit switches, amplifier faults, following error, power monitor
-  handle_commands();   // operator and controller commands: the explicit state transitions
-  run_active_mode();   // homing / jog (movers) or MDI / auto (interpolator, machine handshakes)
-  couple_axes();       // axes → joints (identity until coupling laws come)
-  compensate();        // pitch error and backlash (zero until compensation comes)
-  check_soft_limits(); // every commanded joint within its soft limits
-  write_outputs();     // position commands or step counts, enables, spindle, coolant, I/O
-  publish();           // status snapshot, trace sample
+  read_inputs();        // machine inputs (feedback, switches, power, spindle, I/O)
+  check_safety();       // e-stop, limit switches, amplifier faults, following error, power monitor
+  handle_commands();    // operator and controller commands: the explicit state transitions
+  run_active_mode();    // homing / jog (movers) or MDI / auto (interpolator, machine handshakes)
+  couple_axes();        // axes → joints (identity until coupling laws come)
+  compensate();         // pitch error and backlash (zero until compensation comes)
+  check_soft_limits();  // every commanded joint within its soft limits
+  write_outputs();      // position commands or step counts, enables, spindle, coolant, I/O
+  publish();            // status snapshot, trace sample
   return true;
 }
 
@@ -113,8 +113,8 @@ void Servo::check_joint_faults() noexcept {
     if (ji.amp_fault) {
       enter_fault({FaultKind::AmpFault, jc.axis, actual, 0, tick_});
     } else if (limit_rising_[uj]) {
-      enter_fault({activity_ == Activity::Homing ? FaultKind::Homing : FaultKind::LimitSwitch, jc.axis, actual,
-                   0, tick_});
+      enter_fault({activity_ == Activity::Homing ? FaultKind::Homing : FaultKind::LimitSwitch, jc.axis,
+                   actual, 0, tick_});
     } else if (std::fabs(following_error_[uj]) > jc.max_following_error) {
       enter_fault({FaultKind::FollowingError, jc.axis, following_error_[uj], jc.max_following_error, tick_});
     }
@@ -212,7 +212,7 @@ void Servo::check_soft_limits() noexcept {
     const JointConfig& jc = config_.joints[uj];
     if (!homed_[uj] || jc.wrapped || activity_ == Activity::Homing) continue;
     const double x = commanded_[jc.axis];
-    const bool low = x < jc.min_limit - kSoftLimitSlack, high = x > jc.max_limit + kSoftLimitSlack;
+    const bool low = x<jc.min_limit - kSoftLimitSlack, high = x> jc.max_limit + kSoftLimitSlack;
     if (low || high) {
       enter_fault({FaultKind::SoftLimit, jc.axis, x, low ? jc.min_limit : jc.max_limit, tick_});
       couple_axes();
@@ -253,11 +253,12 @@ void Servo::write_steppers() noexcept {
     const auto uj = static_cast<std::size_t>(j);
     const int slot = stepper_slot_[uj];
     if (slot < 0) continue;
-    const auto target = static_cast<motion::StepCount>(std::llround(joint_cmd_[uj] * config_.joints[uj].counts_per_unit));
+    const auto target =
+        static_cast<motion::StepCount>(std::llround(joint_cmd_[uj] * config_.joints[uj].counts_per_unit));
     inc[static_cast<std::size_t>(slot)] = drives_enabled_ ? target - pulses_.position(slot) : 0;
   }
-  if (pulses_.start(std::span<const motion::StepCount>(inc.data(), static_cast<std::size_t>(stepper_count_))) ==
-      motion::PulseStatus::Ok) {
+  if (pulses_.start(std::span<const motion::StepCount>(
+          inc.data(), static_cast<std::size_t>(stepper_count_))) == motion::PulseStatus::Ok) {
     pulses_.advance(pulses_.feed_steps_total());
   }
   for (int j = 0; j < config_.joint_count; ++j) {

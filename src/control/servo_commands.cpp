@@ -93,7 +93,8 @@ Refusal Servo::reset() noexcept {
   }
   if (state_ != State::Faulted) return Refusal::NotApplicable;
   const int j = joint_of(fault_.axis);
-  const bool amp = fault_.kind == FaultKind::AmpFault && j >= 0 && in_.joints[static_cast<std::size_t>(j)].amp_fault;
+  const bool amp =
+      fault_.kind == FaultKind::AmpFault && j >= 0 && in_.joints[static_cast<std::size_t>(j)].amp_fault;
   const bool power = fault_.kind == FaultKind::PowerLoss && caps_.power_monitor &&
                      (!in_.power.mains_ok || (caps_.ups && in_.power.ups_on_battery));
   if (amp || power) return Refusal::FaultPersists;
@@ -131,9 +132,8 @@ Refusal Servo::start_run(const Command& c) noexcept {
   if (config_.homing_required && !all_homed()) return Refusal::NotHomed;
   if (any_limit_switch()) return Refusal::LimitSwitch;
   // Blocks and actions below the fences belong to runs that have ended.
-  channels_->blocks.pop(static_cast<std::size_t>(
-      std::min<std::uint64_t>(c.first_block - std::min(c.first_block, channels_->blocks.popped()),
-                              channels_->blocks.available())));
+  channels_->blocks.pop(static_cast<std::size_t>(std::min<std::uint64_t>(
+      c.first_block - std::min(c.first_block, channels_->blocks.popped()), channels_->blocks.available())));
   channels_->actions.drop_until(c.first_action);
   if (channels_->blocks.popped() == c.first_block && channels_->blocks.available() > 0) {
     const traj::MotionBlock& first = channels_->blocks.peek(0);
@@ -224,7 +224,8 @@ Refusal Servo::manual_spindle_or_coolant(const Command& c) noexcept {
     case CommandKind::SpindleOn:
       if (!(c.value > 0 && c.value <= std::max(config_.spindle_max_rpm, 0.0))) return Refusal::BadValue;
       spindle_rpm_ = c.value;
-      spindle_direction_ = c.flag ? machine::SpindleDirection::Clockwise : machine::SpindleDirection::Counterclockwise;
+      spindle_direction_ =
+          c.flag ? machine::SpindleDirection::Clockwise : machine::SpindleDirection::Counterclockwise;
       spindle_changed_tick_ = tick_;
       orient_ = false;
       return Refusal::None;

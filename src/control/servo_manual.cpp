@@ -124,7 +124,8 @@ Refusal Servo::home(int axis) noexcept {
 void Servo::start_next_homing_group() noexcept {
   int lowest = std::numeric_limits<int>::max();
   for (int j = 0; j < config_.joint_count; ++j) {
-    if (homing_pending_ & (1u << j)) lowest = std::min(lowest, config_.joints[static_cast<std::size_t>(j)].home.sequence);
+    if (homing_pending_ & (1u << j))
+      lowest = std::min(lowest, config_.joints[static_cast<std::size_t>(j)].home.sequence);
   }
   for (int j = 0; j < config_.joint_count; ++j) {
     const auto uj = static_cast<std::size_t>(j);
@@ -132,7 +133,8 @@ void Servo::start_next_homing_group() noexcept {
     homing_pending_ = static_cast<std::uint16_t>(homing_pending_ & ~(1u << j));
     homing_active_ = static_cast<std::uint16_t>(homing_active_ | (1u << j));
     const machine::JointInputs& ji = in_.joints[uj];
-    homing_[uj].start(config_.joints[uj].home, {feedback_[uj], ji.home, ji.decel, ji.index_count, ji.index_position});
+    homing_[uj].start(config_.joints[uj].home,
+                      {feedback_[uj], ji.home, ji.decel, ji.index_count, ji.index_position});
   }
 }
 

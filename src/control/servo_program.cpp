@@ -167,8 +167,8 @@ void Servo::apply_action(const MachineAction& a) noexcept {
       break;
     case ActionCode::SpindleCw:
     case ActionCode::SpindleCcw:
-      spindle_direction_ =
-          a.code == ActionCode::SpindleCw ? machine::SpindleDirection::Clockwise : machine::SpindleDirection::Counterclockwise;
+      spindle_direction_ = a.code == ActionCode::SpindleCw ? machine::SpindleDirection::Clockwise
+                                                           : machine::SpindleDirection::Counterclockwise;
       spindle_changed_tick_ = tick_;
       orient_ = false;
       break;
@@ -313,11 +313,21 @@ bool Servo::step_wait_input() noexcept {
   } else {
     const bool now = (in_.digital_in >> std::clamp(a.index, 0, 63)) & 1u;
     switch (a.index2) {
-      case 1: done = now && !sync_input_before_; break;
-      case 2: done = !now && sync_input_before_; break;
-      case 3: done = now; break;
-      case 4: done = !now; break;
-      default: done = true; break;
+      case 1:
+        done = now && !sync_input_before_;
+        break;
+      case 2:
+        done = !now && sync_input_before_;
+        break;
+      case 3:
+        done = now;
+        break;
+      case 4:
+        done = !now;
+        break;
+      default:
+        done = true;
+        break;
     }
     sync_input_before_ = now;
     result = now ? 1.0 : 0.0;
@@ -378,7 +388,8 @@ void Servo::end_run(RunEnd why) noexcept {
   sync_step_ = SyncStep::None;
   wait_ = Wait::None;
   reset_movers();
-  if (why == RunEnd::Finished || why == RunEnd::Aborted || why == RunEnd::ProbeTripped) set_state(State::Idle);
+  if (why == RunEnd::Finished || why == RunEnd::Aborted || why == RunEnd::ProbeTripped)
+    set_state(State::Idle);
 }
 
 }  // namespace opencnc::control

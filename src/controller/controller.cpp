@@ -17,22 +17,38 @@ constexpr std::size_t kKeptOutcomes = 4096;
 
 std::string refusal_text(Refusal r) {
   switch (r) {
-    case Refusal::None: return "";
-    case Refusal::EStopActive: return "the machine is e-stopped: reset it first";
-    case Refusal::EStopInput: return "the e-stop chain is still open";
-    case Refusal::MachineOff: return "the machine is off: turn it on first";
-    case Refusal::Faulted: return "a fault stopped the machine: reset it first";
-    case Refusal::FaultPersists: return "the cause of the fault is still there";
-    case Refusal::WrongMode: return "not possible in this mode";
-    case Refusal::Busy: return "something is running or held";
-    case Refusal::NotHomed: return "the machine must be homed first";
-    case Refusal::NotApplicable: return "nothing to do in this state";
-    case Refusal::BadValue: return "a value is out of range";
-    case Refusal::LimitSwitch: return "a limit switch is active";
-    case Refusal::NoProgram: return "no program is open";
-    case Refusal::ProgramError: return "the program has errors";
-    case Refusal::SoftLimit: return "the program would cross a soft limit";
-    case Refusal::StartMismatch: return "the motion does not start where the machine is";
+    case Refusal::None:
+      return "";
+    case Refusal::EStopActive:
+      return "the machine is e-stopped: reset it first";
+    case Refusal::EStopInput:
+      return "the e-stop chain is still open";
+    case Refusal::MachineOff:
+      return "the machine is off: turn it on first";
+    case Refusal::Faulted:
+      return "a fault stopped the machine: reset it first";
+    case Refusal::FaultPersists:
+      return "the cause of the fault is still there";
+    case Refusal::WrongMode:
+      return "not possible in this mode";
+    case Refusal::Busy:
+      return "something is running or held";
+    case Refusal::NotHomed:
+      return "the machine must be homed first";
+    case Refusal::NotApplicable:
+      return "nothing to do in this state";
+    case Refusal::BadValue:
+      return "a value is out of range";
+    case Refusal::LimitSwitch:
+      return "a limit switch is active";
+    case Refusal::NoProgram:
+      return "no program is open";
+    case Refusal::ProgramError:
+      return "the program has errors";
+    case Refusal::SoftLimit:
+      return "the program would cross a soft limit";
+    case Refusal::StartMismatch:
+      return "the motion does not start where the machine is";
   }
   return "refused";
 }
@@ -40,10 +56,14 @@ std::string refusal_text(Refusal r) {
 /// The refusal the servo would give for a run in `state`.
 Refusal not_idle(State s) {
   switch (s) {
-    case State::EStopped: return Refusal::EStopActive;
-    case State::Off: return Refusal::MachineOff;
-    case State::Faulted: return Refusal::Faulted;
-    default: return Refusal::Busy;
+    case State::EStopped:
+      return Refusal::EStopActive;
+    case State::Off:
+      return Refusal::MachineOff;
+    case State::Faulted:
+      return Refusal::Faulted;
+    default:
+      return Refusal::Busy;
   }
 }
 
@@ -249,7 +269,8 @@ void Controller::open(std::uint64_t id, Request& r) {
   } else {
     lp = source_->load(r.text, servo().commanded, {block_delete_});
   }
-  if (!lp.program) return finish(id, Refusal::ProgramError, "the program has errors", std::move(lp.diagnostics));
+  if (!lp.program)
+    return finish(id, Refusal::ProgramError, "the program has errors", std::move(lp.diagnostics));
   Diagnostics& d = lp.diagnostics;
   auto planner = prepare(*lp.program, d);
   if (!planner) {
@@ -271,7 +292,8 @@ void Controller::open(std::uint64_t id, Request& r) {
 void Controller::mdi(std::uint64_t id, const Request& r) {
   if (run_) return finish(id, Refusal::Busy, "something is running");
   if (servo().mode != Mode::Mdi) return finish(id, Refusal::WrongMode, "MDI lines need MDI mode");
-  if (servo().state != State::Idle) return finish(id, not_idle(servo().state), refusal_text(not_idle(servo().state)));
+  if (servo().state != State::Idle)
+    return finish(id, not_idle(servo().state), refusal_text(not_idle(servo().state)));
   if (!source_) return finish(id, Refusal::ProgramError, "this controller has no G-code interpreter");
   LoadedProgram lp = source_->mdi(r.text, servo().commanded);
   if (!lp.program) return finish(id, Refusal::ProgramError, "the line has errors", std::move(lp.diagnostics));
@@ -281,12 +303,14 @@ void Controller::mdi(std::uint64_t id, const Request& r) {
 void Controller::cycle_start(std::uint64_t id, const Request& r) {
   if (run_ || servo().mode != Mode::Auto) return forward(id, r);  // the servo continues or says no
   if (!program_) return finish(id, Refusal::NoProgram, refusal_text(Refusal::NoProgram));
-  if (servo().state != State::Idle) return finish(id, not_idle(servo().state), refusal_text(not_idle(servo().state)));
+  if (servo().state != State::Idle)
+    return finish(id, not_idle(servo().state), refusal_text(not_idle(servo().state)));
   std::shared_ptr<const canon::Program> program = program_;
   const bool moved = program->start() != servo().commanded;
   if (!program_path_.empty() && source_ && (moved || program_block_delete_ != block_delete_)) {
     LoadedProgram lp = source_->load(program_path_, servo().commanded, {block_delete_});
-    if (!lp.program) return finish(id, Refusal::ProgramError, "the program has errors", std::move(lp.diagnostics));
+    if (!lp.program)
+      return finish(id, Refusal::ProgramError, "the program has errors", std::move(lp.diagnostics));
     program = lp.program;
   } else if (moved) {
     program = program_tail(*program, 0, servo().commanded);
@@ -339,7 +363,8 @@ void Controller::continue_after_probe() {
     std::lock_guard lock(inbox_mutex_);
     id = next_id_++;
   }
-  start_run(id, program_tail(*done->program, next, servo().commanded), done->mode, done->segment_offset + next);
+  start_run(id, program_tail(*done->program, next, servo().commanded), done->mode,
+            done->segment_offset + next);
 }
 
 // --- feeding the servo -----------------------------------------------------------------------
@@ -360,7 +385,8 @@ void Controller::pump() {
       break;
     case plan::PlanStatus::Failed: {
       run_->pumping = false;
-      for (const Diagnostic& d : run_->planner->diagnostics().items()) note(Severity::Error, d.code, d.format());
+      for (const Diagnostic& d : run_->planner->diagnostics().items())
+        note(Severity::Error, d.code, d.format());
       std::uint64_t id;
       {
         std::lock_guard lock(inbox_mutex_);
@@ -393,7 +419,8 @@ std::string Controller::describe(const Fault& f) const {
   const char axis = f.axis >= 0 && f.axis < kAxisCount ? kAxisLetters[static_cast<std::size_t>(f.axis)] : '?';
   const JointConfig* jc = nullptr;
   for (int j = 0; j < servo_config_.joint_count; ++j) {
-    if (servo_config_.joints[static_cast<std::size_t>(j)].axis == f.axis) jc = &servo_config_.joints[static_cast<std::size_t>(j)];
+    if (servo_config_.joints[static_cast<std::size_t>(j)].axis == f.axis)
+      jc = &servo_config_.joints[static_cast<std::size_t>(j)];
   }
   const char* unit = jc != nullptr && jc->rotary ? "deg" : "mm";
   switch (f.kind) {
@@ -410,9 +437,10 @@ std::string Controller::describe(const Fault& f) const {
       return fmt::format("{} was commanded to {:.4f} {}, beyond its soft limit of {} {}", axis, f.value, unit,
                          f.limit, unit);
     case FaultKind::PowerLoss:
-      return fmt::format("power failure: mains lost or running on the UPS (DC link {:.0f} V); the motion was "
-                         "stopped on the path",
-                         f.value);
+      return fmt::format(
+          "power failure: mains lost or running on the UPS (DC link {:.0f} V); the motion was "
+          "stopped on the path",
+          f.value);
     case FaultKind::Homing:
       return fmt::format("homing {} ran into a limit switch at {:.4f} {}", axis, f.value, unit);
   }

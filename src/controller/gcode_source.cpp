@@ -34,7 +34,8 @@ class DefaultTolerance final : public canon::Sink {
 };
 
 std::vector<Diagnostic> since(const Diagnostics& d, std::size_t first) {
-  return {d.items().begin() + static_cast<std::ptrdiff_t>(std::min(first, d.items().size())), d.items().end()};
+  return {d.items().begin() + static_cast<std::ptrdiff_t>(std::min(first, d.items().size())),
+          d.items().end()};
 }
 
 }  // namespace
@@ -42,7 +43,8 @@ std::vector<Diagnostic> since(const Diagnostics& d, std::size_t first) {
 std::shared_ptr<GcodeProgramSource> GcodeProgramSource::create(const config::MachineProfile& profile,
                                                                Diagnostics& diags) {
   gcode::Options o;
-  o.dialect = profile.interpreter.dialect == config::Dialect::Fanuc ? gcode::Dialect::Fanuc : gcode::Dialect::LinuxCnc;
+  o.dialect = profile.interpreter.dialect == config::Dialect::Fanuc ? gcode::Dialect::Fanuc
+                                                                    : gcode::Dialect::LinuxCnc;
   o.mode = gcode::Mode::Scan;
   o.axes = profile.axis_mask();
   o.subroutine_path = profile.interpreter.subroutine_path;
@@ -56,7 +58,8 @@ std::shared_ptr<GcodeProgramSource> GcodeProgramSource::create(const config::Mac
     if (!table || diags.error_count() > before) return nullptr;
     o.tool_table = std::make_shared<tools::ToolTable>(std::move(*table));
   }
-  return std::shared_ptr<GcodeProgramSource>(new GcodeProgramSource(std::move(o), profile.planner.default_tolerance));
+  return std::shared_ptr<GcodeProgramSource>(
+      new GcodeProgramSource(std::move(o), profile.planner.default_tolerance));
 }
 
 GcodeProgramSource::GcodeProgramSource(gcode::Options options, double default_tolerance)
@@ -79,7 +82,8 @@ bool GcodeProgramSource::place(gcode::Interpreter& interp, const Pose& machine, 
   std::size_t start = 0;
   while (start < line.size()) {
     const std::size_t end = std::min(line.find('\n', start), line.size());
-    if (interp.execute_mdi(std::string_view(line).substr(start, end - start), quiet) == gcode::RunStatus::Error) {
+    if (interp.execute_mdi(std::string_view(line).substr(start, end - start), quiet) ==
+        gcode::RunStatus::Error) {
       diags.error("", 0, 0, "the interpreter cannot be placed at the machine position", "control.program");
       return false;
     }
@@ -88,7 +92,8 @@ bool GcodeProgramSource::place(gcode::Interpreter& interp, const Pose& machine, 
   return true;
 }
 
-LoadedProgram GcodeProgramSource::load(const std::string& path, const Pose& start, const LoadOptions& options) {
+LoadedProgram GcodeProgramSource::load(const std::string& path, const Pose& start,
+                                       const LoadOptions& options) {
   gcode::Options o = options_;
   o.block_delete = options.block_delete;
   gcode::Interpreter interp(o);
@@ -101,7 +106,8 @@ LoadedProgram GcodeProgramSource::load(const std::string& path, const Pose& star
   // The file first (file 0 of the source map, the main program of every move; start() checks
   // its head), then the start-up calls, then the position.
   gcode::RunStatus status = gcode::RunStatus::Error;
-  if (interp.open(path) && interp.start(sink) != gcode::RunStatus::Error && place(interp, start, out.diagnostics)) {
+  if (interp.open(path) && interp.start(sink) != gcode::RunStatus::Error &&
+      place(interp, start, out.diagnostics)) {
     status = interp.run(sink);
   }
   for (const Diagnostic& d : interp.diagnostics().items()) out.diagnostics.add(d);
@@ -123,9 +129,10 @@ void GcodeProgramSource::replay_state(const gcode::InterpState& s, canon::Progra
   b.select_plane(m.plane);
   b.set_feed_mode(0, m.feed_mode);
   b.set_feed_rate(m.feed_rate);
-  const double tol = m.control == canon::MotionControl::Continuous && m.path_tolerance <= 0
-                        ? default_tolerance_ / canon::mm_per_unit(m.units)  // the builder scales by the units
-                        : m.path_tolerance;
+  const double tol =
+      m.control == canon::MotionControl::Continuous && m.path_tolerance <= 0
+          ? default_tolerance_ / canon::mm_per_unit(m.units)  // the builder scales by the units
+          : m.path_tolerance;
   b.set_motion_control_mode(m.control, tol);
   b.set_naivecam_tolerance(m.naivecam_tolerance);
   if (!m.feed_override) b.disable_feed_override();

@@ -13,7 +13,7 @@ namespace opencnc::control {
 namespace {
 
 constexpr double kTwoPi = 2 * std::numbers::pi;
-constexpr double kSlack = 1e-7;    ///< as the tick's check
+constexpr double kSlack = 1e-7;   ///< as the tick's check
 constexpr int kMaxReported = 20;  ///< errors listed before the rest are summed up
 
 struct V3 {
@@ -25,7 +25,8 @@ double dot(const V3& a, const V3& b) {
 }
 
 V3 cross(const V3& a, const V3& b) {
-  return {{a.v[1] * b.v[2] - a.v[2] * b.v[1], a.v[2] * b.v[0] - a.v[0] * b.v[2], a.v[0] * b.v[1] - a.v[1] * b.v[0]}};
+  return {{a.v[1] * b.v[2] - a.v[2] * b.v[1], a.v[2] * b.v[0] - a.v[0] * b.v[2],
+           a.v[0] * b.v[1] - a.v[1] * b.v[0]}};
 }
 
 /// The part of `q − c` in the plane with unit normal n.
@@ -42,7 +43,8 @@ V3 in_plane(const Pose& q, int base, const V3& c, const V3& n) {
 double sweep_of(double phi, int turns) {
   const bool ccw = turns >= 0;
   const bool full = std::fabs(phi) < 1e-9;
-  double s = ccw ? (full ? kTwoPi : (phi > 0 ? phi : phi + kTwoPi)) : (full ? -kTwoPi : (phi < 0 ? phi : phi - kTwoPi));
+  double s = ccw ? (full ? kTwoPi : (phi > 0 ? phi : phi + kTwoPi))
+                 : (full ? -kTwoPi : (phi < 0 ? phi : phi - kTwoPi));
   return s + (ccw ? 1.0 : -1.0) * kTwoPi * std::max(0, std::abs(turns) - 1);
 }
 
@@ -60,7 +62,8 @@ struct ArcFrame {
 };
 
 bool arc_frame(const canon::ArcGeometry& g, const Pose& start, const Pose& end, ArcFrame& f) {
-  f.base = (g.plane == canon::Plane::XY || g.plane == canon::Plane::YZ || g.plane == canon::Plane::XZ) ? 0 : 6;
+  f.base =
+      (g.plane == canon::Plane::XY || g.plane == canon::Plane::YZ || g.plane == canon::Plane::XZ) ? 0 : 6;
   f.c = V3{{g.center[0], g.center[1], g.center[2]}};
   const V3 n{{g.normal[0], g.normal[1], g.normal[2]}};
   const V3 rs = in_plane(start, f.base, f.c, n), re = in_plane(end, f.base, f.c, n);
@@ -85,7 +88,8 @@ void widen_by_arc(const canon::ArcGeometry& g, const Pose& start, const Pose& en
     const double alpha = std::atan2(f.e2.v[k], f.e1.v[k]);
     const int axis = f.base + k;
     if (passes(alpha, lo, hi)) e.max[axis] = std::max(e.max[axis], f.c.v[k] + f.radius * amp);
-    if (passes(alpha + std::numbers::pi, lo, hi)) e.min[axis] = std::min(e.min[axis], f.c.v[k] - f.radius * amp);
+    if (passes(alpha + std::numbers::pi, lo, hi))
+      e.min[axis] = std::min(e.min[axis], f.c.v[k] - f.radius * amp);
   }
 }
 
@@ -118,7 +122,8 @@ double move_length(const canon::Program& program, canon::SegmentId id) {
   Pose d;
   for (int i = 0; i < kAxisCount; ++i) d[i] = b[i] - a[i];
   ArcFrame f;
-  if (program.move(id).kind != canon::MoveKind::Arc || !arc_frame(program.arc(id), a, b, f)) return linear_length(d);
+  if (program.move(id).kind != canon::MoveKind::Arc || !arc_frame(program.arc(id), a, b, f))
+    return linear_length(d);
   // The helix rise: the part of the move along the plane normal.
   const canon::ArcGeometry& g = program.arc(id);
   double rise = 0;
@@ -138,15 +143,17 @@ bool check_soft_limits(const canon::Program& program, const ServoConfig& config,
       if (++errors > kMaxReported) continue;
       const canon::Move& m = program.move(id);
       const char* unit = jc.rotary ? "deg" : "mm";
-      diags.error(file_of(program, id), m.line, 0,
-                  fmt::format("this move takes {} to {:.4f} {}, beyond its {} soft limit of {} {}",
-                              kAxisLetters[static_cast<std::size_t>(jc.axis)], high ? e.max[jc.axis] : e.min[jc.axis],
-                              unit, high ? "maximum" : "minimum", high ? jc.max_limit : jc.min_limit, unit),
-                  "control.soft-limit");
+      diags.error(
+          file_of(program, id), m.line, 0,
+          fmt::format("this move takes {} to {:.4f} {}, beyond its {} soft limit of {} {}",
+                      kAxisLetters[static_cast<std::size_t>(jc.axis)], high ? e.max[jc.axis] : e.min[jc.axis],
+                      unit, high ? "maximum" : "minimum", high ? jc.max_limit : jc.min_limit, unit),
+          "control.soft-limit");
     }
   }
   if (errors > kMaxReported) {
-    diags.error("", 0, 0, fmt::format("{} more moves cross a soft limit", errors - kMaxReported), "control.soft-limit");
+    diags.error("", 0, 0, fmt::format("{} more moves cross a soft limit", errors - kMaxReported),
+                "control.soft-limit");
   }
   return errors == 0;
 }

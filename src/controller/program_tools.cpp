@@ -30,7 +30,8 @@ bool is_setting(ActionKind k) {
 /// Copies an action's text and pose into `to` (new indices).
 canon::Action copy_action(const canon::Program& from, canon::Program& to, canon::Action a,
                           std::unordered_map<std::uint32_t, std::uint32_t>& texts) {
-  const bool has_text = a.kind == ActionKind::Message || a.kind == ActionKind::Comment || a.kind == ActionKind::WaitInput;
+  const bool has_text =
+      a.kind == ActionKind::Message || a.kind == ActionKind::Comment || a.kind == ActionKind::WaitInput;
   if (has_text) {
     auto it = texts.find(a.text);
     if (it == texts.end()) it = texts.emplace(a.text, to.add_text(from.text(a.text))).first;
@@ -44,7 +45,8 @@ canon::Action copy_action(const canon::Program& from, canon::Program& to, canon:
 
 }  // namespace
 
-std::shared_ptr<canon::Program> program_tail(const canon::Program& program, canon::SegmentId from, const Pose& start) {
+std::shared_ptr<canon::Program> program_tail(const canon::Program& program, canon::SegmentId from,
+                                             const Pose& start) {
   auto out = std::make_shared<canon::Program>(program.axes());
   out->set_sources(program.sources_ptr());
   out->set_start(start);
@@ -83,33 +85,71 @@ std::optional<MachineAction> machine_action(const canon::Program& program, std::
   m.index2 = a.index2;
   m.value = a.value;
   switch (a.kind) {
-    case ActionKind::SpindleSpeed: m.code = ActionCode::SpindleSpeed; break;
-    case ActionKind::SpindleCw: m.code = ActionCode::SpindleCw; break;
-    case ActionKind::SpindleCcw: m.code = ActionCode::SpindleCcw; break;
-    case ActionKind::SpindleStop: m.code = ActionCode::SpindleStop; break;
-    case ActionKind::SelectTool: m.code = ActionCode::SelectTool; break;
-    case ActionKind::ChangeTool: m.code = ActionCode::ChangeTool; break;
-    case ActionKind::ChangeToolNumber: m.code = ActionCode::SetToolNumber; break;
-    case ActionKind::FloodOn: m.code = ActionCode::FloodOn; break;
-    case ActionKind::FloodOff: m.code = ActionCode::FloodOff; break;
-    case ActionKind::MistOn: m.code = ActionCode::MistOn; break;
-    case ActionKind::MistOff: m.code = ActionCode::MistOff; break;
-    case ActionKind::SpeedOverrideEnable: m.code = ActionCode::SpindleOverrideEnable; break;
-    case ActionKind::SpeedOverrideDisable: m.code = ActionCode::SpindleOverrideDisable; break;
+    case ActionKind::SpindleSpeed:
+      m.code = ActionCode::SpindleSpeed;
+      break;
+    case ActionKind::SpindleCw:
+      m.code = ActionCode::SpindleCw;
+      break;
+    case ActionKind::SpindleCcw:
+      m.code = ActionCode::SpindleCcw;
+      break;
+    case ActionKind::SpindleStop:
+      m.code = ActionCode::SpindleStop;
+      break;
+    case ActionKind::SelectTool:
+      m.code = ActionCode::SelectTool;
+      break;
+    case ActionKind::ChangeTool:
+      m.code = ActionCode::ChangeTool;
+      break;
+    case ActionKind::ChangeToolNumber:
+      m.code = ActionCode::SetToolNumber;
+      break;
+    case ActionKind::FloodOn:
+      m.code = ActionCode::FloodOn;
+      break;
+    case ActionKind::FloodOff:
+      m.code = ActionCode::FloodOff;
+      break;
+    case ActionKind::MistOn:
+      m.code = ActionCode::MistOn;
+      break;
+    case ActionKind::MistOff:
+      m.code = ActionCode::MistOff;
+      break;
+    case ActionKind::SpeedOverrideEnable:
+      m.code = ActionCode::SpindleOverrideEnable;
+      break;
+    case ActionKind::SpeedOverrideDisable:
+      m.code = ActionCode::SpindleOverrideDisable;
+      break;
     case ActionKind::MotionOutputBit:
-    case ActionKind::AuxOutputBit: m.code = ActionCode::DigitalOutput; break;
+    case ActionKind::AuxOutputBit:
+      m.code = ActionCode::DigitalOutput;
+      break;
     case ActionKind::MotionOutputValue:
-    case ActionKind::AuxOutputValue: m.code = ActionCode::AnalogOutput; break;
+    case ActionKind::AuxOutputValue:
+      m.code = ActionCode::AnalogOutput;
+      break;
     case ActionKind::WaitInput:
       m.code = ActionCode::WaitInput;
       m.digital = program.text(a.text) != "analog";
       break;
-    case ActionKind::SpindleOrient: m.code = ActionCode::SpindleOrient; break;
-    case ActionKind::PalletShuttle: m.code = ActionCode::PalletShuttle; break;
-    case ActionKind::Message: m.code = ActionCode::Message; break;
+    case ActionKind::SpindleOrient:
+      m.code = ActionCode::SpindleOrient;
+      break;
+    case ActionKind::PalletShuttle:
+      m.code = ActionCode::PalletShuttle;
+      break;
+    case ActionKind::Message:
+      m.code = ActionCode::Message;
+      break;
     case ActionKind::SpindleMode:
     case ActionKind::ProbeOn:
-    case ActionKind::ProbeOff: m.code = ActionCode::Ignore; break;
+    case ActionKind::ProbeOff:
+      m.code = ActionCode::Ignore;
+      break;
     default:
       return std::nullopt;  // no marker, or a marker the interpolator handles alone (dwell, stops)
   }

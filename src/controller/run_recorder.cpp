@@ -12,18 +12,30 @@ namespace {
 
 const char* motion_name(traj::RunState s) {
   switch (s) {
-    case traj::RunState::Idle: return "idle";
-    case traj::RunState::Running: return "running";
-    case traj::RunState::Holding: return "holding";
-    case traj::RunState::Held: return "held";
-    case traj::RunState::Starved: return "starved";
-    case traj::RunState::Dwelling: return "dwelling";
-    case traj::RunState::WaitingCycleStart: return "waiting-cycle-start";
-    case traj::RunState::WaitingSpindle: return "waiting-spindle";
-    case traj::RunState::WaitingSync: return "waiting-sync";
-    case traj::RunState::Aborting: return "aborting";
-    case traj::RunState::Aborted: return "aborted";
-    case traj::RunState::Finished: return "finished";
+    case traj::RunState::Idle:
+      return "idle";
+    case traj::RunState::Running:
+      return "running";
+    case traj::RunState::Holding:
+      return "holding";
+    case traj::RunState::Held:
+      return "held";
+    case traj::RunState::Starved:
+      return "starved";
+    case traj::RunState::Dwelling:
+      return "dwelling";
+    case traj::RunState::WaitingCycleStart:
+      return "waiting-cycle-start";
+    case traj::RunState::WaitingSpindle:
+      return "waiting-spindle";
+    case traj::RunState::WaitingSync:
+      return "waiting-sync";
+    case traj::RunState::Aborting:
+      return "aborting";
+    case traj::RunState::Aborted:
+      return "aborted";
+    case traj::RunState::Finished:
+      return "finished";
   }
   return "?";
 }
@@ -87,8 +99,9 @@ TraceCsvWriter::TraceCsvWriter(const std::string& path, AxisMask axes, double pe
 
 void TraceCsvWriter::add(const TraceSample& s) {
   row_.clear();
-  fmt::format_to(std::back_inserter(row_), "{:.4f},{},{},{},{},{},{:.6g}", static_cast<double>(s.tick) * period_s_,
-                 to_string(s.state), motion_name(s.motion), s.rapid ? 1 : 0, s.line, s.segment, s.path_velocity);
+  fmt::format_to(std::back_inserter(row_), "{:.4f},{},{},{},{},{},{:.6g}",
+                 static_cast<double>(s.tick) * period_s_, to_string(s.state), motion_name(s.motion),
+                 s.rapid ? 1 : 0, s.line, s.segment, s.path_velocity);
   for (int i = 0; i < kAxisCount; ++i) {
     if (!axes_.has(static_cast<Axis>(i))) continue;
     fmt::format_to(std::back_inserter(row_), ",{:.6f},{:.6f},{:.6f}", s.commanded[i], s.actual[i],

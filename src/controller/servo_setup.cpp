@@ -10,11 +10,16 @@ namespace {
 
 HomeMethod home_method(config::HomingMethod m) {
   switch (m) {
-    case config::HomingMethod::Immediate: return HomeMethod::Immediate;
-    case config::HomingMethod::Switch: return HomeMethod::Switch;
-    case config::HomingMethod::SwitchIndex: return HomeMethod::SwitchIndex;
-    case config::HomingMethod::Index: return HomeMethod::Index;
-    case config::HomingMethod::DecelHome: return HomeMethod::DecelHome;
+    case config::HomingMethod::Immediate:
+      return HomeMethod::Immediate;
+    case config::HomingMethod::Switch:
+      return HomeMethod::Switch;
+    case config::HomingMethod::SwitchIndex:
+      return HomeMethod::SwitchIndex;
+    case config::HomingMethod::Index:
+      return HomeMethod::Index;
+    case config::HomingMethod::DecelHome:
+      return HomeMethod::DecelHome;
   }
   return HomeMethod::Immediate;
 }
@@ -56,8 +61,12 @@ ServoConfig servo_config(const config::MachineProfile& profile) {
     j.max_limit = a.max_limit;
     j.max_following_error = a.max_following_error;
     const config::HomingProfile& h = a.homing;
-    j.home = {home_method(h.method), h.position,       h.switch_position, h.search_velocity,
-              h.latch_velocity,      h.final_velocity > 0 ? h.final_velocity : a.max_velocity,
+    j.home = {home_method(h.method),
+              h.position,
+              h.switch_position,
+              h.search_velocity,
+              h.latch_velocity,
+              h.final_velocity > 0 ? h.final_velocity : a.max_velocity,
               h.sequence};
     if (j.home.method != HomeMethod::Immediate) s.homing_required = true;
   }

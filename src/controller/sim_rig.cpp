@@ -6,7 +6,8 @@
 
 namespace opencnc::control {
 
-SimRig::SimRig(const config::MachineProfile& profile, std::shared_ptr<ProgramSource> source, int service_every)
+SimRig::SimRig(const config::MachineProfile& profile, std::shared_ptr<ProgramSource> source,
+               int service_every)
     : channels_(std::make_unique<ServoChannels>()),
       machine_(std::make_unique<machine::SimMachine>(config::sim_machine_config(profile))),
       servo_(std::make_unique<Servo>(servo_config(profile), *channels_, *machine_)),

@@ -44,7 +44,8 @@ class ServoHarness {
     EXPECT_TRUE(channels_->commands.try_push(c));
     tick();
     for (const ServoEvent& e : events_) {
-      if ((e.kind == EventKind::Accepted || e.kind == EventKind::Refused) && e.command_id == c.id) return e.refusal;
+      if ((e.kind == EventKind::Accepted || e.kind == EventKind::Refused) && e.command_id == c.id)
+        return e.refusal;
     }
     ADD_FAILURE() << "no answer to " << to_string(c.kind);
     return Refusal::BadValue;

@@ -87,7 +87,8 @@ TEST(Homing, IsRepeatableToTheMicrometre) {
     for (double x : v) w = std::max(w, std::fabs(x - mean));
     return w;
   };
-  std::printf("home reference spread from the mean: X %.3g Y %.3g Z %.3g mm\n", worst(offsets[kX]), worst(offsets[kY]), worst(offsets[kZ]));
+  std::printf("home reference spread from the mean: X %.3g Y %.3g Z %.3g mm\n", worst(offsets[kX]),
+              worst(offsets[kY]), worst(offsets[kZ]));
   EXPECT_LE(worst(offsets[kX]), 1e-3);
   EXPECT_LE(worst(offsets[kY]), 1.0 / 13107.2);  // the index mark: within an encoder count
   EXPECT_LE(worst(offsets[kZ]), 1e-3);

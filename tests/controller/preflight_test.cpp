@@ -43,7 +43,7 @@ void arc(canon::ProgramBuilder& b, canon::SegmentId id, double ex, double ey, do
 TEST(Preflight, QuarterArcReachesItsExtremeOnlyWhereTheSweepPasses) {
   canon::ProgramBuilder b(AxisMask::from_letters("XYZ"), xyz(10, 0));
   b.set_feed_rate(1000);
-  arc(b, 0, 0, 10, 0, 0, 1, 0);  // counterclockwise from +X to +Y: passes no axis extreme
+  arc(b, 0, 0, 10, 0, 0, 1, 0);   // counterclockwise from +X to +Y: passes no axis extreme
   arc(b, 1, 0, -10, 0, 0, 1, 0);  // on through −X to −Y: passes X = −10
   const canon::Program p = b.take();
   const Extent e0 = move_extent(p, 0), e1 = move_extent(p, 1);

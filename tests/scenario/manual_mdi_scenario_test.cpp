@@ -31,7 +31,8 @@ TEST(MdiScenario, LinesRunOneAfterAnotherWithTheirModalState) {
   EXPECT_NEAR(s.status().servo.commanded[Axis::X], 15.0, 1e-9);
   double fastest = 0;  // still F600: 10 mm/s
   for (std::size_t i = 1; i < s.samples().size(); ++i)
-    fastest = std::max(fastest, std::fabs(s.samples()[i].commanded[Axis::X] - s.samples()[i - 1].commanded[Axis::X]) / 1e-3);
+    fastest = std::max(
+        fastest, std::fabs(s.samples()[i].commanded[Axis::X] - s.samples()[i - 1].commanded[Axis::X]) / 1e-3);
   EXPECT_NEAR(fastest, 10.0, 1e-6);
   s.must(Request::mdi("S2000 M3"));  // the line ends once the spindle is at speed (0.5 s)
   ASSERT_TRUE(s.idle(20000));
@@ -114,7 +115,8 @@ TEST(ManualScenario, FaultsAreReportedInWordsNamingTheAxis) {
   EXPECT_EQ(st.servo.state, State::Faulted);
   EXPECT_NE(st.fault_text.find("Y drive"), std::string::npos) << st.fault_text;
   bool noted = false;
-  for (const Note& n : s.rig().controller().take_notes()) noted = noted || n.code == "control.fault.amplifier";
+  for (const Note& n : s.rig().controller().take_notes())
+    noted = noted || n.code == "control.fault.amplifier";
   EXPECT_TRUE(noted);
   s.sim().set_amp_fault(1, false);
   s.ticks(2);

@@ -56,7 +56,7 @@ TEST(RunScenario, ProgramRunsToTheEndWithinTheLimits) {
     EXPECT_LE(r.axes[static_cast<std::size_t>(i)].max_acceleration, 1000 * (1 + 1e-6));
   }
   EXPECT_LE(r.max_command_contour_error_mm, 0.01 + 1e-6);  // G64 P0.01
-  EXPECT_LE(r.max_contour_error_mm, 0.05);                // the drives follow within tens of µm
+  EXPECT_LE(r.max_contour_error_mm, 0.05);                 // the drives follow within tens of µm
   EXPECT_LE(r.max_following_error_mm, 0.05);
   EXPECT_GT(r.max_following_error_mm, 0.0);
   // The spindle ran up (2 s to 3000 rpm at 4000 rpm/s is 0.75 s) before the first cut, and the
@@ -74,7 +74,8 @@ TEST(RunScenario, DefaultToleranceAppliesInInchProgramsToo) {
   for (const char* units : {"G21", "G20"}) {
     Scenario s(mill());
     const double side = std::string(units) == "G20" ? 2.0 : 50.8;
-    TempProgram p("sq.ngc", fmt::format("{} G90 G64\nG0 X0 Y0\nG1 X{} F200\nY{}\nX0\nY0\nM2\n", units, side, side));
+    TempProgram p("sq.ngc",
+                  fmt::format("{} G90 G64\nG0 X0 Y0\nG1 X{} F200\nY{}\nX0\nY0\nM2\n", units, side, side));
     s.on(Mode::Auto);
     ASSERT_TRUE(s.run_file(p.path())) << s.message();
     const RunReport r = s.report(*s.rig().controller().open_program());
@@ -248,7 +249,17 @@ TEST(RunScenario, SingleBlockStopsAfterEveryMove) {
   s.must(Request::flag_of(CommandKind::SetSingleBlock, true));
   s.must(Request::open(p.path()));
   s.must(Request::simple(CommandKind::CycleStart));
-  const Pose ends[] = {[] { Pose q; q[0] = 10; return q; }(), [] { Pose q; q[0] = 10; q[1] = 10; return q; }()};
+  const Pose ends[] = {[] {
+                         Pose q;
+                         q[0] = 10;
+                         return q;
+                       }(),
+                       [] {
+                         Pose q;
+                         q[0] = 10;
+                         q[1] = 10;
+                         return q;
+                       }()};
   for (const Pose& end : ends) {
     ASSERT_TRUE(s.until([&] { return s.status().servo.state == State::Stopped; }, 10000));
     EXPECT_EQ(s.status().servo.stop_reason, StopReason::SingleBlock);

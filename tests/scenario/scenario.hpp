@@ -18,7 +18,9 @@
 
 namespace opencnc::control::test {
 
-inline std::ostream& operator<<(std::ostream& os, State s) { return os << to_string(s); }
+inline std::ostream& operator<<(std::ostream& os, State s) {
+  return os << to_string(s);
+}
 
 /// A G-code file in a folder of its own; removed with the object.
 class TempProgram {

@@ -34,8 +34,8 @@ class AxisMover {
   /// Advances one period; returns the commanded position. Tick thread.
   double tick() noexcept;
 
-  double position() const noexcept { return out_; }   ///< commanded (filtered)
-  double velocity() const noexcept { return vel_; }   ///< of the unfiltered generator
+  double position() const noexcept { return out_; }  ///< commanded (filtered)
+  double velocity() const noexcept { return vel_; }  ///< of the unfiltered generator
   /// At rest, goal reached and the average settled: the commanded position no longer changes.
   bool settled() const noexcept { return vel_ == 0 && still_ >= filter_ticks_ && !pending(); }
   /// Distance the generator needs to stop from its present speed. Tick thread.
@@ -44,7 +44,9 @@ class AxisMover {
 
  private:
   enum class Goal : std::uint8_t { Velocity, Position };
-  bool pending() const noexcept { return goal_ == Goal::Position ? raw_ != goal_position_ : goal_velocity_ != 0; }
+  bool pending() const noexcept {
+    return goal_ == Goal::Position ? raw_ != goal_position_ : goal_velocity_ != 0;
+  }
   void step_velocity() noexcept;
   void step_position() noexcept;
   double filter() noexcept;

@@ -72,8 +72,8 @@ enum class CommandKind : std::uint8_t {
   SpindleOff,          ///< manual
   Coolant,             ///< manual: `axis` 0 = flood, 1 = mist; `flag` on/off
   // --- handled by the controller (non-real-time) and never sent to the servo ----------------
-  OpenProgram,  ///< a program file (or a canon::Program) for Auto mode
-  Mdi,          ///< one line of G-code in MDI mode
+  OpenProgram,     ///< a program file (or a canon::Program) for Auto mode
+  Mdi,             ///< one line of G-code in MDI mode
   SetBlockDelete,  ///< `flag`: skip lines starting with '/' in programs loaded from now on
 };
 
@@ -141,26 +141,26 @@ struct Command {
 
 /// What a program's marker asks the machine to do (canon actions, in a form the tick can apply).
 enum class ActionCode : std::uint8_t {
-  SpindleSpeed,    ///< value = rpm
+  SpindleSpeed,  ///< value = rpm
   SpindleCw,
   SpindleCcw,
   SpindleStop,
-  SelectTool,      ///< index = tool: prepare it
-  ChangeTool,      ///< M6: the selected tool into the spindle (index = its table index)
-  SetToolNumber,   ///< index = tool (M61)
+  SelectTool,     ///< index = tool: prepare it
+  ChangeTool,     ///< M6: the selected tool into the spindle (index = its table index)
+  SetToolNumber,  ///< index = tool (M61)
   FloodOn,
   FloodOff,
   MistOn,
   MistOff,
   SpindleOverrideEnable,
   SpindleOverrideDisable,
-  DigitalOutput,   ///< index = channel, index2 = 1 on / 0 off (M62–M65)
-  AnalogOutput,    ///< index = channel, value (M67/M68)
-  WaitInput,       ///< index = channel, index2 = mode (L0–L4), value = timeout s, digital = flag
-  SpindleOrient,   ///< value = degrees
+  DigitalOutput,  ///< index = channel, index2 = 1 on / 0 off (M62–M65)
+  AnalogOutput,   ///< index = channel, value (M67/M68)
+  WaitInput,      ///< index = channel, index2 = mode (L0–L4), value = timeout s, digital = flag
+  SpindleOrient,  ///< value = degrees
   PalletShuttle,
-  Message,         ///< the controller shows the text (action index)
-  Ignore,          ///< nothing for the machine (probe on/off, spindle mode)
+  Message,  ///< the controller shows the text (action index)
+  Ignore,   ///< nothing for the machine (probe on/off, spindle mode)
 };
 
 /// The machine side of marker `action` (Program::actions() index) of the current run. The

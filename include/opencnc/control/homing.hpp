@@ -21,12 +21,12 @@ struct HomingInputs {
 
 enum class HomingPhase : std::uint8_t {
   Idle,
-  Clear,     ///< the switch is already active: move off it against the search direction
-  Search,    ///< at search velocity toward the switch (or the deceleration dog)
-  BackOff,   ///< off the switch again, to approach it slowly
-  Latch,     ///< at latch velocity until the edge (rising, or falling when latching away)
-  Index,     ///< at latch velocity until the next encoder index mark
-  Final,     ///< to the home position
+  Clear,    ///< the switch is already active: move off it against the search direction
+  Search,   ///< at search velocity toward the switch (or the deceleration dog)
+  BackOff,  ///< off the switch again, to approach it slowly
+  Latch,    ///< at latch velocity until the edge (rising, or falling when latching away)
+  Index,    ///< at latch velocity until the next encoder index mark
+  Final,    ///< to the home position
   Done,
 };
 
@@ -63,12 +63,12 @@ class JointHoming {
   bool trigger(const HomingInputs& in) const noexcept;
 
   HomingPhase phase_ = HomingPhase::Idle;
-  bool stopping_ = false;         ///< waiting for the mover to settle before the next phase
+  bool stopping_ = false;          ///< waiting for the mover to settle before the next phase
   bool latch_on_release_ = false;  ///< Latch waits for the switch to release
   std::uint32_t index_count_ = 0;  ///< index count when Index began
   double latched_at_ = 0;
   double previous_feedback_ = 0;  ///< feedback of the last period, for the latch
-  double offset_ = 0;  ///< the latched offset, for the final move
+  double offset_ = 0;             ///< the latched offset, for the final move
 };
 
 }  // namespace opencnc::control

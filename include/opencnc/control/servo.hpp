@@ -136,12 +136,12 @@ class Servo final : public Tickable {
   std::uint64_t accepted_ = 0, refused_ = 0, events_dropped_ = 0, trace_dropped_ = 0;
 
   // Positions. Machine coordinates = joint coordinates + offset (set by homing).
-  Pose commanded_{};        ///< every axis, machine coordinates
-  Joints joint_cmd_{};      ///< after coupling and compensation, joint coordinates
-  Joints reference_{};      ///< what the drive aims at by the end of the period (cmd + ff·T)
+  Pose commanded_{};         ///< every axis, machine coordinates
+  Joints joint_cmd_{};       ///< after coupling and compensation, joint coordinates
+  Joints reference_{};       ///< what the drive aims at by the end of the period (cmd + ff·T)
   Joints joint_velocity_{};  ///< commanded, joint units/s (last two commands)
   Joints velocity_ff_{};     ///< what servo drives get of it (steppers: none)
-  Joints feedback_{};       ///< joint coordinates
+  Joints feedback_{};        ///< joint coordinates
   Joints following_error_{};
   Joints offset_{};
   std::array<bool, machine::kMaxJoints> homed_{};

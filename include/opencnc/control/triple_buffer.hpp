@@ -28,7 +28,8 @@ class TripleBuffer {
   T& back() noexcept { return slots_[back_]; }
   /// Publishes the writer's slot. Writer thread; real-time safe.
   void publish() noexcept {
-    const std::uint8_t old = middle_.exchange(static_cast<std::uint8_t>(back_ | kFresh), std::memory_order_acq_rel);
+    const std::uint8_t old =
+        middle_.exchange(static_cast<std::uint8_t>(back_ | kFresh), std::memory_order_acq_rel);
     back_ = static_cast<std::uint8_t>(old & kIndex);
   }
   /// Copies `v` into the writer's slot and publishes it. Writer thread; real-time safe.

@@ -113,12 +113,12 @@ struct Note {
 /// The status a front end shows: the servo's snapshot plus what this side knows.
 struct ControllerStatus {
   ServoStatus servo;
-  std::string program_name;     ///< the open program ("" = none)
+  std::string program_name;  ///< the open program ("" = none)
   std::uint64_t program_moves = 0;
-  bool run_active = false;      ///< a run was started and has not ended
-  std::uint64_t run_segment = 0;  ///< segment of the open program at the commanded position
-  double progress = 0;          ///< 0 … 1 of the open program's moves
-  std::string fault_text;       ///< servo.fault in words ("" = none)
+  bool run_active = false;          ///< a run was started and has not ended
+  std::uint64_t run_segment = 0;    ///< segment of the open program at the commanded position
+  double progress = 0;              ///< 0 … 1 of the open program's moves
+  std::string fault_text;           ///< servo.fault in words ("" = none)
   std::uint64_t runs_finished = 0;  ///< runs that reached their program end
 };
 

@@ -25,7 +25,8 @@ namespace opencnc::control {
 class GcodeProgramSource final : public ProgramSource {
  public:
   /// Reads the profile's tool table; its problems land in `diags` (errors: nullptr).
-  static std::shared_ptr<GcodeProgramSource> create(const config::MachineProfile& profile, Diagnostics& diags);
+  static std::shared_ptr<GcodeProgramSource> create(const config::MachineProfile& profile,
+                                                    Diagnostics& diags);
 
   LoadedProgram load(const std::string& path, const Pose& start, const LoadOptions& options) override;
   LoadedProgram mdi(std::string_view line, const Pose& start) override;

@@ -16,7 +16,8 @@ namespace opencnc::control {
 /// override settings made before `from` are kept (at its start), other earlier actions are
 /// dropped. Used to run a program from where the machine stands (after a probe trip, or when
 /// it has moved since the program was loaded). Non-real-time; O(size).
-std::shared_ptr<canon::Program> program_tail(const canon::Program& program, canon::SegmentId from, const Pose& start);
+std::shared_ptr<canon::Program> program_tail(const canon::Program& program, canon::SegmentId from,
+                                             const Pose& start);
 
 /// The machine side of action `index` of `program` when the planner turns it into a marker the
 /// servo must act on (a Report or Sync marker), else nothing. Non-real-time.

@@ -24,8 +24,8 @@ struct RunReport {
   double path_length_mm = 0;    ///< commanded, XYZ (and UVW)
   double max_following_error_mm = 0;
   int max_following_error_axis = -1;
-  double max_contour_error_mm = 0;          ///< actual (feedback) position to the programmed path
-  double max_command_contour_error_mm = 0;  ///< commanded position to the programmed path
+  double max_contour_error_mm = 0;                     ///< actual (feedback) position to the programmed path
+  double max_command_contour_error_mm = 0;             ///< commanded position to the programmed path
   std::array<analysis::AxisStats, kAxisCount> axes{};  ///< of the commanded trajectory
   std::uint64_t limit_violations = 0;  ///< commanded samples × axes × derivatives above a limit
   std::uint64_t samples = 0;
