@@ -79,17 +79,17 @@ void Servo::start_up() noexcept {
       pulses_.set_position(stepper_slot_[uj], std::llround(feedback_[uj] * jc.counts_per_unit));
   }
   follow_feedback();
+  reset_movers();
   state_ = published_state_ = in_.estop_ok ? State::Off : State::EStopped;
 }
 
 // While the drives are off the commanded position follows the machine, so that enabling them
-// again moves nothing.
+// again moves nothing (the movers are reset where the motion starts again: machine on, halt).
 void Servo::follow_feedback() noexcept {
   for (int j = 0; j < config_.joint_count; ++j) {
     const auto uj = static_cast<std::size_t>(j);
     commanded_[config_.joints[uj].axis] = feedback_[uj] + offset_[uj];
   }
-  reset_movers();
 }
 
 // --- safety ----------------------------------------------------------------------------------
@@ -139,6 +139,7 @@ void Servo::check_power() noexcept {
         movers_[static_cast<std::size_t>(j)].stop();
       }
       homing_pending_ = homing_active_ = 0;
+      activity_ = Activity::Jog;  // the movers bring the joints to rest, then the fault
       break;
     case Activity::None:
       break;

@@ -107,6 +107,7 @@ Refusal Servo::reset() noexcept {
 Refusal Servo::machine_on() noexcept {
   if (state_ != State::Off) return on_state(state_) ? Refusal::NotApplicable : need_on();
   follow_feedback();
+  reset_movers();
   drives_enabled_ = true;
   set_state(State::Idle);
   return Refusal::None;
@@ -262,6 +263,7 @@ void Servo::halt(RunEnd why) noexcept {
     if (stepper_slot_[uj] >= 0 && config_.joints[uj].home.method != HomeMethod::Immediate) homed_[uj] = false;
   }
   follow_feedback();
+  reset_movers();
   stop_spindle_and_coolant();
 }
 

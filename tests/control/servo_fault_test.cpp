@@ -152,5 +152,28 @@ TEST(Faults, MainsLossIsAControlledStopOnThePath) {
   EXPECT_EQ(h.send(CommandKind::Reset), Refusal::None);
 }
 
+TEST(Faults, MainsLossDuringAJogDeceleratesBeforeTheDrivesGoOff) {
+  ServoHarness h(mill({"power.ups=true"}));
+  ASSERT_EQ(h.send(CommandKind::MachineOn), Refusal::None);
+  ASSERT_EQ(h.send_mode(Mode::Manual), Refusal::None);
+  ASSERT_EQ(h.jog(Axis::X, 80), Refusal::None);
+  h.tick(300);
+  h.sim().set_mains_ok(false);
+  std::vector<double> x;
+  for (int i = 0; i < 2000 && h.state() != State::Faulted; ++i) {
+    h.tick();
+    if (h.state() != State::Faulted) {
+      EXPECT_TRUE(h.status().drives_enabled);
+      x.push_back(h.status().commanded[Axis::X]);
+    }
+  }
+  ASSERT_EQ(h.state(), State::Faulted);
+  EXPECT_EQ(h.status().fault.kind, FaultKind::PowerLoss);
+  ASSERT_GT(x.size(), 50u);  // 80 mm/s at 1000 mm/s² take 80 periods to stop
+  for (std::size_t i = 2; i < x.size(); ++i) {
+    EXPECT_LE(std::fabs(x[i] - 2 * x[i - 1] + x[i - 2]) / 1e-6, 1000 * (1 + 1e-6)) << i;
+  }
+}
+
 }  // namespace
 }  // namespace opencnc::control::test
