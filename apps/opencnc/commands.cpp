@@ -10,6 +10,8 @@ void register_all(CLI::App& app, Registry& registry) {
   add_latency_command(app, registry);
   add_profile_command(app, registry);
   add_gcode_commands(app, registry);
+  add_run_command(app, registry);
+  add_plot_command(app, registry);
 }
 
 }  // namespace opencnc::cli

@@ -32,5 +32,7 @@ void add_latency_command(CLI::App& app, Registry& registry);
 void add_profile_command(CLI::App& app, Registry& registry);
 // One function per subcommand group (cmd_<name>.cpp).
 void add_gcode_commands(CLI::App& app, Registry& registry);   ///< check, canon, scan
+void add_run_command(CLI::App& app, Registry& registry);
+void add_plot_command(CLI::App& app, Registry& registry);
 
 }  // namespace opencnc::cli

@@ -55,6 +55,8 @@ class TraceChecker {
   TraceChecker(const canon::Program& program, const plan::MachineLimits& limits, double period_s,
                double relative_tolerance = 1e-6);
 
+  /// Where the machine rests before the first sample (the origin unless said). Before add().
+  void start_at(const Pose& position) { past_.fill(position); }
   /// One commanded sample; `first`..`last` are the segment ids of the block it lies on.
   void add(const Pose& position, canon::SegmentId first, canon::SegmentId last);
   /// The metrics so far.

@@ -1,0 +1,316 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// `opencnc plot`: the toolpath (XY, XZ, YZ, isometric) and the velocity, acceleration and
+// following-error profiles of a run, as SVG — from a program (run in virtual time) or a trace CSV.
+#include <fmt/format.h>
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <fstream>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "commands.hpp"
+#include "opencnc/core/axes.hpp"
+#include "opencnc/viz/svg_chart.hpp"
+#include "run_session.hpp"
+
+namespace opencnc::cli {
+
+namespace {
+
+struct PlotOptions {
+  SessionOptions session;
+  std::string trace;
+  std::string out;
+};
+
+/// What a plot needs of one servo period.
+struct Sample {
+  double t = 0;
+  bool rapid = false;
+  double path_velocity = 0;
+  Pose cmd{};
+  Pose ferr{};
+};
+
+struct Trace {
+  AxisMask axes;
+  double period_s = 1e-3;
+  std::vector<Sample> samples;
+};
+
+// --- reading a trace CSV (the columns TraceCsvWriter writes) ---------------------------------
+
+bool read_trace(const std::string& path, Trace& trace, std::string& error) {
+  std::ifstream in(path);
+  if (!in) {
+    error = "cannot read the trace " + path;
+    return false;
+  }
+  std::string line;
+  std::getline(in, line);
+  std::vector<std::string> head;
+  for (std::stringstream ss(line); std::getline(ss, line, ',');) head.push_back(line);
+  int t_col = -1, rapid_col = -1, v_col = -1;
+  std::array<int, kAxisCount> cmd_col{}, ferr_col{};
+  cmd_col.fill(-1);
+  ferr_col.fill(-1);
+  for (int c = 0; c < static_cast<int>(head.size()); ++c) {
+    const std::string& h = head[static_cast<std::size_t>(c)];
+    if (h == "time_s") t_col = c;
+    if (h == "rapid") rapid_col = c;
+    if (h == "path_velocity") v_col = c;
+    for (int i = 0; i < kAxisCount; ++i) {
+      const std::string a(1, kAxisLetters[static_cast<std::size_t>(i)]);
+      if (h == "cmd_" + a) cmd_col[static_cast<std::size_t>(i)] = c, trace.axes.set(static_cast<Axis>(i));
+      if (h == "ferr_" + a) ferr_col[static_cast<std::size_t>(i)] = c;
+    }
+  }
+  if (t_col < 0 || trace.axes.count() == 0) {
+    error = path + " is not an opencnc trace (no time_s or cmd_ columns)";
+    return false;
+  }
+  std::vector<double> v;
+  std::size_t row = 1;
+  while (std::getline(in, line)) {
+    ++row;
+    v.clear();
+    for (std::stringstream ss(line); std::getline(ss, line, ',');)
+      v.push_back(std::strtod(line.c_str(), nullptr));
+    if (v.size() != head.size()) {
+      error = fmt::format("{}:{}: {} fields, the header has {}", path, row, v.size(), head.size());
+      return false;
+    }
+    Sample s;
+    s.t = v[static_cast<std::size_t>(t_col)];
+    s.rapid = rapid_col >= 0 && v[static_cast<std::size_t>(rapid_col)] != 0;
+    s.path_velocity = v_col >= 0 ? v[static_cast<std::size_t>(v_col)] : 0;
+    for (int i = 0; i < kAxisCount; ++i) {
+      if (cmd_col[static_cast<std::size_t>(i)] >= 0)
+        s.cmd[i] = v[static_cast<std::size_t>(cmd_col[static_cast<std::size_t>(i)])];
+      if (ferr_col[static_cast<std::size_t>(i)] >= 0)
+        s.ferr[i] = v[static_cast<std::size_t>(ferr_col[static_cast<std::size_t>(i)])];
+    }
+    trace.samples.push_back(s);
+  }
+  if (trace.samples.size() > 1) trace.period_s = trace.samples[1].t - trace.samples[0].t;
+  return true;
+}
+
+// --- panels ----------------------------------------------------------------------------------
+
+constexpr const char* kFeedColor = "#1f77b4";
+constexpr const char* kRapidColor = "#e8590c";
+constexpr const char* kAxisColors[] = {"#1f77b4", "#2ca02c", "#d62728", "#9467bd", "#8c564b",
+                                       "#e377c2", "#7f7f7f", "#bcbd22", "#17becf"};
+
+/// A toolpath view: one polyline per stretch of feed or rapid moves, rapids in their own colour.
+template <typename Project>
+viz::Panel toolpath(const Trace& tr, std::string title, std::string x_label, std::string y_label,
+                    Project project) {
+  viz::Panel p;
+  p.title = std::move(title);
+  p.x_label = std::move(x_label);
+  p.y_label = std::move(y_label);
+  p.equal_scale = true;
+  bool have_feed = false, have_rapid = false;
+  for (std::size_t i = 0; i < tr.samples.size(); ++i) {
+    const Sample& s = tr.samples[i];
+    if (p.series.empty() || (i > 0 && s.rapid != tr.samples[i - 1].rapid)) {
+      viz::Series series;
+      series.color = s.rapid ? kRapidColor : kFeedColor;
+      series.width = s.rapid ? 0.8 : 1.2;
+      bool& labelled = s.rapid ? have_rapid : have_feed;
+      if (!labelled) series.label = s.rapid ? "rapid (G0)" : "feed";
+      labelled = true;
+      if (i > 0) {  // join the stretches
+        const auto [x0, y0] = project(tr.samples[i - 1].cmd);
+        series.x.push_back(x0);
+        series.y.push_back(y0);
+      }
+      p.series.push_back(std::move(series));
+    }
+    const auto [x, y] = project(s.cmd);
+    p.series.back().x.push_back(x);
+    p.series.back().y.push_back(y);
+  }
+  return p;
+}
+
+/// Columns a time plot has room for.
+constexpr std::size_t kColumns = 1200;
+/// Long runs: more than this many periods per column are drawn as peaks (see envelope()), over
+/// wider columns so that motions that come and go (raster steps) read as a level, not a comb.
+constexpr std::size_t kPeaksFrom = 16;
+constexpr std::size_t kPeakColumns = 300;
+
+/// Periods per column of a time plot, and whether it shows peaks.
+std::pair<std::size_t, bool> columns(const Trace& tr) {
+  const std::size_t n = tr.samples.size();
+  if (n / kColumns <= kPeaksFrom) return {std::max<std::size_t>(1, n / kColumns), false};
+  return {n / kPeakColumns, true};
+}
+
+/// `value(i)` over time in about kColumns columns. Short runs: the smallest and largest value of
+/// each column, in order (the signed curve). Long runs, where that would be a solid band: the
+/// largest |value| of each column, which keeps the peaks and the trend readable.
+template <typename Value>
+viz::Series envelope(const Trace& tr, std::string label, const char* color, Value value) {
+  viz::Series s;
+  s.label = std::move(label);
+  s.color = color;
+  s.width = 1.0;
+  const std::size_t n = tr.samples.size();
+  const auto [per, peaks] = columns(tr);
+  for (std::size_t b = 0; b < n; b += per) {
+    double lo = 1e300, hi = -1e300;
+    std::size_t at_lo = b, at_hi = b;
+    for (std::size_t i = b; i < std::min(n, b + per); ++i) {
+      const double v = peaks ? std::fabs(value(i)) : value(i);
+      if (v < lo) lo = v, at_lo = i;
+      if (v > hi) hi = v, at_hi = i;
+    }
+    if (peaks) {
+      s.x.push_back(tr.samples[b].t);
+      s.y.push_back(hi);
+      continue;
+    }
+    for (std::size_t i : {std::min(at_lo, at_hi), std::max(at_lo, at_hi)}) {
+      s.x.push_back(tr.samples[i].t);
+      s.y.push_back(i == at_lo ? lo : hi);
+    }
+  }
+  return s;
+}
+
+/// " (largest |value| per 0.24 s)" when envelope() draws peaks.
+std::string peaks_note(const Trace& tr) {
+  const auto [per, peaks] = columns(tr);
+  if (!peaks) return "";
+  return fmt::format(" — largest |value| per {:.2g} s", static_cast<double>(per) * tr.period_s);
+}
+
+viz::Panel velocities(const Trace& tr) {
+  viz::Panel p;
+  p.title = "velocity" + peaks_note(tr);
+  p.x_label = "time (s)";
+  p.y_label = "velocity (mm/s, deg/s)";
+  p.series.push_back(
+      envelope(tr, "path", "#000000", [&](std::size_t i) { return tr.samples[i].path_velocity; }));
+  for (int a = 0; a < kAxisCount; ++a) {
+    if (!tr.axes.has(static_cast<Axis>(a))) continue;
+    p.series.push_back(envelope(
+        tr, std::string(1, kAxisLetters[static_cast<std::size_t>(a)]), kAxisColors[a], [&](std::size_t i) {
+          return i == 0 ? 0.0 : (tr.samples[i].cmd[a] - tr.samples[i - 1].cmd[a]) / tr.period_s;
+        }));
+  }
+  return p;
+}
+
+viz::Panel accelerations(const Trace& tr) {
+  viz::Panel p;
+  p.title = "acceleration (commanded)" + peaks_note(tr);
+  p.x_label = "time (s)";
+  p.y_label = "acceleration (mm/s², deg/s²)";
+  const double t2 = tr.period_s * tr.period_s;
+  for (int a = 0; a < kAxisCount; ++a) {
+    if (!tr.axes.has(static_cast<Axis>(a))) continue;
+    p.series.push_back(envelope(tr, std::string(1, kAxisLetters[static_cast<std::size_t>(a)]), kAxisColors[a],
+                                [&](std::size_t i) {
+                                  if (i < 2) return 0.0;
+                                  const auto& x = tr.samples;
+                                  return (x[i].cmd[a] - 2 * x[i - 1].cmd[a] + x[i - 2].cmd[a]) / t2;
+                                }));
+  }
+  return p;
+}
+
+viz::Panel following_errors(const Trace& tr) {
+  viz::Panel p;
+  p.title = "following error" + peaks_note(tr);
+  p.x_label = "time (s)";
+  p.y_label = "following error (µm, mdeg)";
+  for (int a = 0; a < kAxisCount; ++a) {
+    if (!tr.axes.has(static_cast<Axis>(a))) continue;
+    p.series.push_back(envelope(tr, std::string(1, kAxisLetters[static_cast<std::size_t>(a)]), kAxisColors[a],
+                                [&](std::size_t i) { return 1000.0 * tr.samples[i].ferr[a]; }));
+  }
+  return p;
+}
+
+bool draw(const Trace& tr, const std::string& title, const std::string& out, std::string& error) {
+  viz::SvgChart chart(title, 2, 640, 430);
+  const auto xy = [](int a, int b) { return [a, b](const Pose& q) { return std::pair{q[a], q[b]}; }; };
+  chart.add_panel(toolpath(tr, "toolpath XY (top)", "X (mm)", "Y (mm)", xy(0, 1)));
+  chart.add_panel(toolpath(tr, "toolpath XZ (front)", "X (mm)", "Z (mm)", xy(0, 2)));
+  chart.add_panel(toolpath(tr, "toolpath YZ (side)", "Y (mm)", "Z (mm)", xy(1, 2)));
+  const double c30 = std::sqrt(3.0) / 2, s30 = 0.5;
+  chart.add_panel(toolpath(tr, "toolpath isometric", "(X − Y)·cos 30° (mm)", "(X + Y)·sin 30° + Z (mm)",
+                           [&](const Pose& q) {
+                             return std::pair{(q[0] - q[1]) * c30, (q[0] + q[1]) * s30 + q[2]};
+                           }));
+  chart.add_panel(velocities(tr));
+  chart.add_panel(accelerations(tr));
+  chart.add_panel(following_errors(tr));
+  return chart.write(out, &error);
+}
+
+int plot(const PlotOptions& o) {
+  Trace tr;
+  std::string error, title;
+  if (!o.trace.empty()) {
+    if (!read_trace(o.trace, tr, error)) {
+      fmt::print(stderr, "error: {}\n", error);
+      return kExitUsage;
+    }
+    title = "opencnc trace " + o.trace;
+  } else {
+    if (o.session.file.empty() || o.session.machine.empty()) {
+      fmt::print(stderr, "error: plot wants a program and --machine, or --trace\n");
+      return kExitUsage;
+    }
+    SessionHooks hooks;
+    hooks.opened = [&](const config::MachineProfile& p, const canon::Program&) {
+      tr.axes = p.axis_mask();
+      tr.period_s = p.servo_period_s;
+    };
+    hooks.sample = [&](const control::TraceSample& s) {
+      tr.samples.push_back(Sample{static_cast<double>(s.tick) * tr.period_s, s.rapid, s.path_velocity,
+                                  s.commanded, s.following_error});
+    };
+    const SessionEnd end = run_session(o.session, hooks);
+    if (tr.samples.empty()) return end.exit_code == kExitOk ? kExitProgram : end.exit_code;
+    title = fmt::format("opencnc {} on {}", o.session.file, end.profile.name);
+  }
+  if (tr.samples.empty()) {
+    fmt::print(stderr, "error: nothing to plot\n");
+    return kExitProgram;
+  }
+  if (!draw(tr, title, o.out, error)) {
+    fmt::print(stderr, "error: {}\n", error);
+    return kExitUsage;
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+void add_plot_command(CLI::App& app, Registry& registry) {
+  auto opts = std::make_shared<PlotOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "plot", "Draw a run's toolpath and velocity profile as SVG (from a program or a trace)");
+  cmd->add_option("file", opts->session.file, "G-code program to run in virtual time");
+  cmd->add_option("--trace", opts->trace, "Trace CSV written by `opencnc run --trace`");
+  cmd->add_option("--machine,-m", opts->session.machine, "Machine profile (with a program)");
+  cmd->add_option("--set", opts->session.sets, "Override a profile key (repeatable)")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  cmd->add_option("-o,--output", opts->out, "SVG file to write")->required();
+  cmd->callback([opts, &registry] { registry.set_result(plot(*opts)); });
+}
+
+}  // namespace opencnc::cli

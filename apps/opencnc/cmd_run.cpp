@@ -1,0 +1,182 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// `opencnc run`: a program on the simulated machine, with a progress bar, a report, a trace.
+#include <fmt/format.h>
+#include <unistd.h>
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "commands.hpp"
+#include "opencnc/controller/preflight.hpp"
+#include "opencnc/controller/run_recorder.hpp"
+#include "opencnc/controller/servo_setup.hpp"
+#include "opencnc/core/atomic_file.hpp"
+#include "run_session.hpp"
+
+namespace opencnc::cli {
+
+namespace {
+
+struct RunOptions {
+  SessionOptions session;
+  std::string trace;
+  std::string report;
+};
+
+/// Programmed length up to the end of each move (for the progress bar).
+std::vector<double> cumulative_lengths(const canon::Program& p) {
+  std::vector<double> out(p.size() + 1, 0.0);
+  for (canon::SegmentId id = 0; id < p.size(); ++id) out[id + 1] = out[id] + control::move_length(p, id);
+  return out;
+}
+
+/// "[#########...........]  42.1 %  line 123  12.3 s  ~17.0 s left" on one terminal line.
+class ProgressBar {
+ public:
+  explicit ProgressBar(const canon::Program& p) : lengths_(cumulative_lengths(p)) {}
+  void show(const control::ControllerStatus& st, double run_start_s) {
+    const double total = lengths_.back();
+    const std::size_t seg = std::min<std::size_t>(st.run_segment, lengths_.size() - 1);
+    const double done = total > 0 ? lengths_[seg] / total : st.progress;
+    const double elapsed = st.servo.time_s - run_start_s;
+    const int width = 30, filled = static_cast<int>(done * width + 0.5);
+    const std::string left = done > 0.01 ? fmt::format("~{:.1f} s left", elapsed * (1 - done) / done) : "";
+    fmt::print("\r[{}{}] {:5.1f} %  line {:<6}  {:.1f} s  {:<16}",
+               std::string(static_cast<std::size_t>(filled), '#'),
+               std::string(static_cast<std::size_t>(width - filled), '.'), 100 * done, st.servo.line, elapsed,
+               left);
+    std::fflush(stdout);
+  }
+  void finish() { fmt::print("\n"); }
+
+ private:
+  std::vector<double> lengths_;
+};
+
+std::string axis_name(int i) {
+  return std::string(1, kAxisLetters[static_cast<std::size_t>(i)]);
+}
+
+void print_report(const control::RunReport& r, const config::MachineProfile& profile, const SessionEnd& end) {
+  fmt::print("machining time      {:.3f} s (motion {:.3f} s)\n", r.machining_time_s, r.motion_time_s);
+  fmt::print("path length         {:.3f} mm\n", r.path_length_mm);
+  fmt::print("max following error {:.4f} mm{}\n", r.max_following_error_mm,
+             r.max_following_error_axis >= 0 ? " (" + axis_name(r.max_following_error_axis) + ")" : "");
+  fmt::print("max contour error   {:.4f} mm actual, {:.4f} mm commanded\n", r.max_contour_error_mm,
+             r.max_command_contour_error_mm);
+  fmt::print("axis  max velocity  max acceleration  max jerk\n");
+  for (const config::AxisProfile& a : profile.axes) {
+    const analysis::AxisStats& s = r.axes[static_cast<std::size_t>(index(a.axis))];
+    fmt::print("  {}   {:10.3f}    {:12.1f}    {:12.0f}\n", letter(a.axis), s.max_velocity,
+               s.max_acceleration, s.max_jerk);
+  }
+  fmt::print("limit violations    {}{}\n", r.limit_violations,
+             end.limit_touched ? " (and a limit stopped the run)" : "");
+  if (end.wall_s > 0) {
+    fmt::print("wall time           {:.3f} s ({:.0f}x real time)\n", end.wall_s,
+               r.machining_time_s / end.wall_s);
+  }
+}
+
+nlohmann::json report_json(const control::RunReport& r, const RunOptions& o, const SessionEnd& end) {
+  nlohmann::json j;
+  j["program"] = o.session.file;
+  j["machine"] = end.profile.name;
+  j["realtime"] = o.session.realtime;
+  j["finished"] = end.finished;
+  j["fault"] = end.fault.empty() ? nlohmann::json(nullptr) : nlohmann::json(end.fault);
+  j["machining_time_s"] = r.machining_time_s;
+  j["motion_time_s"] = r.motion_time_s;
+  j["path_length_mm"] = r.path_length_mm;
+  j["max_following_error_mm"] = r.max_following_error_mm;
+  j["max_contour_error_mm"] = r.max_contour_error_mm;
+  j["max_command_contour_error_mm"] = r.max_command_contour_error_mm;
+  nlohmann::json v, a, k;
+  for (const config::AxisProfile& ax : end.profile.axes) {
+    const analysis::AxisStats& s = r.axes[static_cast<std::size_t>(index(ax.axis))];
+    const std::string name = axis_name(index(ax.axis));
+    v[name] = s.max_velocity;
+    a[name] = s.max_acceleration;
+    k[name] = s.max_jerk;
+  }
+  j["max_velocity"] = v;
+  j["max_acceleration"] = a;
+  j["max_jerk"] = k;
+  j["limit_violations"] = r.limit_violations;
+  j["limit_touched"] = r.limit_violations > 0 || end.limit_touched;
+  j["samples"] = r.samples;
+  j["wall_time_s"] = end.wall_s;
+  return j;
+}
+
+int run(const RunOptions& o) {
+  if (!o.trace.empty() && !std::ofstream(o.trace)) {  // before the run, not after it
+    fmt::print(stderr, "error: cannot write the trace {}\n", o.trace);
+    return kExitUsage;
+  }
+  std::optional<control::RunRecorder> recorder;
+  std::optional<control::TraceCsvWriter> csv;
+  std::optional<ProgressBar> bar;
+  const bool tty = ::isatty(STDOUT_FILENO) != 0;
+  double run_start_s = -1;
+  SessionHooks hooks;
+  hooks.opened = [&](const config::MachineProfile& profile, const canon::Program& program) {
+    recorder.emplace(program, control::machine_limits(profile), profile.servo_period_s);
+    if (!o.trace.empty()) csv.emplace(o.trace, profile.axis_mask(), profile.servo_period_s);
+    if (tty) bar.emplace(program);
+  };
+  hooks.sample = [&](const control::TraceSample& s) {
+    recorder->add(s);
+    if (csv) csv->add(s);
+  };
+  hooks.progress = [&](const control::ControllerStatus& st, double) {
+    if (run_start_s < 0) run_start_s = st.servo.time_s;
+    if (bar) bar->show(st, run_start_s);
+  };
+  const SessionEnd end = run_session(o.session, hooks);
+  if (bar) bar->finish();
+  if (!recorder) return end.exit_code;  // nothing ran
+  int rc = end.exit_code;
+  if (csv && !csv->close()) {
+    fmt::print(stderr, "error: cannot write the trace {}\n", o.trace);
+    rc = kExitUsage;
+  }
+  const control::RunReport r = recorder->report();
+  print_report(r, end.profile, end);
+  if (!o.report.empty()) {
+    std::string err;
+    if (!write_file_atomically(o.report, report_json(r, o, end).dump(2) + "\n", &err)) {
+      fmt::print(stderr, "error: {}\n", err);
+      rc = kExitUsage;
+    }
+  }
+  return rc;
+}
+
+}  // namespace
+
+void add_run_command(CLI::App& app, Registry& registry) {
+  auto opts = std::make_shared<RunOptions>();
+  CLI::App* cmd = app.add_subcommand("run", "Run a G-code program on the simulated machine and report on it");
+  cmd->add_option("file", opts->session.file, "G-code program")->required();
+  cmd->add_option("--machine,-m", opts->session.machine, "Machine profile, e.g. configs/mill-3axis.toml")
+      ->required();
+  cmd->add_option("--set", opts->session.sets,
+                  "Override a profile key: --set axis.x.max_velocity=200 (repeatable)")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  cmd->add_flag("--realtime", opts->session.realtime,
+                "Tick in a real-time periodic thread instead of virtual time");
+  cmd->add_option("--trace", opts->trace, "Write one CSV row per servo period (docs/controller.md)");
+  cmd->add_option("--report", opts->report, "Write the report as JSON");
+  cmd->callback([opts, &registry] { registry.set_result(run(*opts)); });
+}
+
+}  // namespace opencnc::cli

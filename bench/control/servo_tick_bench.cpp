@@ -1,0 +1,178 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// servo_tick_bench — the cost of one full Servo::tick() (safety, commands, interpolation,
+// coupling, compensation, limits, outputs, status and trace), six axes, with percentiles.
+// Each iteration is one tick timed on its own; the controller's work between ticks is not timed.
+// Two machines: a loopback (feedback = command, nearly free: the servo alone) and the simulated
+// machine (the servo plus the machine's period).
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <vector>
+
+#include "opencnc/canon/program_builder.hpp"
+#include "opencnc/config/profile_loader.hpp"
+#include "opencnc/control/servo.hpp"
+#include "opencnc/controller/controller.hpp"
+#include "opencnc/controller/servo_setup.hpp"
+#include "opencnc/machine/sim_machine.hpp"
+
+using namespace opencnc;
+using namespace opencnc::control;
+
+namespace {
+
+const char* kSixAxes = R"(name = "six-axis"
+servo_period_s = 0.001
+[axis.x]
+max_velocity = 100.0
+max_acceleration = 1000.0
+min_limit = -500.0
+max_limit = 500.0
+[axis.y]
+max_velocity = 100.0
+max_acceleration = 1000.0
+min_limit = -500.0
+max_limit = 500.0
+[axis.z]
+max_velocity = 100.0
+max_acceleration = 1000.0
+min_limit = -500.0
+max_limit = 500.0
+[axis.a]
+max_velocity = 360.0
+max_acceleration = 3600.0
+min_limit = -3600.0
+max_limit = 3600.0
+[axis.b]
+max_velocity = 360.0
+max_acceleration = 3600.0
+min_limit = -3600.0
+max_limit = 3600.0
+[axis.c]
+max_velocity = 360.0
+max_acceleration = 3600.0
+min_limit = -36000.0
+max_limit = 36000.0
+)";
+
+/// Feedback = the last command, switches quiet, e-stop chain closed: the cost of the servo alone.
+class LoopbackMachine final : public machine::MachineIO {
+ public:
+  explicit LoopbackMachine(int joints) : joints_(joints) { in_.estop_ok = true; }
+  machine::MachineCapabilities capabilities() const noexcept override {
+    machine::MachineCapabilities c;
+    c.joint_count = joints_;
+    return c;
+  }
+  void read(machine::MachineInputs& in) noexcept override { in = in_; }
+  void write(const machine::MachineOutputs& out) noexcept override {
+    ++in_.cycle;
+    in_.estop_ok = true;
+    for (int j = 0; j < joints_; ++j)
+      in_.joints[static_cast<std::size_t>(j)].position = out.joints[static_cast<std::size_t>(j)].position;
+  }
+
+ private:
+  int joints_;
+  machine::MachineInputs in_{};
+};
+
+/// A spiral of short lines and helical arcs in XY, Z waving, A B C turning: all six axes move.
+std::shared_ptr<canon::Program> six_axis_program() {
+  canon::ProgramBuilder b(kXyzabc);
+  b.set_motion_control_mode(canon::MotionControl::Continuous, 0.01);
+  b.set_feed_rate(3000);
+  canon::SegmentId id = 0;
+  double th = 0;
+  for (int i = 0; i < 30000; ++i) {
+    const double r = 30 + 8 * std::sin(i * 0.002);
+    th += (0.3 + 0.7 * ((i * 7919) % 97) / 97.0) / r;  // 0.3–1 mm pseudo-random lengths
+    Pose p;
+    p[Axis::X] = r * std::cos(th);
+    p[Axis::Y] = r * std::sin(th);
+    p[Axis::Z] = 3 * std::sin(th * 2);
+    p[Axis::A] = 20 * std::sin(th);
+    p[Axis::B] = 15 * std::cos(th * 3);
+    p[Axis::C] = th * 20;
+    b.straight_feed(id++, p);
+  }
+  b.program_end();
+  auto prog = std::make_shared<canon::Program>(b.take());
+  return prog;
+}
+
+template <typename Machine>
+void servo_tick(benchmark::State& state, std::unique_ptr<Machine> machine) {
+  const config::ProfileLoad load = config::parse_profile(kSixAxes, "six-axis.toml");
+  if (!load.ok()) {
+    state.SkipWithError("profile");
+    return;
+  }
+  auto channels = std::make_unique<ServoChannels>();
+  channels->trace_enabled = true;
+  Servo servo(servo_config(*load.profile), *channels, *machine);
+  Controller controller(*load.profile, *channels);
+  const auto submit = [&](Request r) {
+    const std::uint64_t id = controller.submit(std::move(r));
+    for (int i = 0; i < 100 && !controller.outcome(id); ++i) {
+      controller.service();
+      servo.tick();
+    }
+    const auto o = controller.outcome(id);
+    return o && o->accepted;
+  };
+  if (!submit(Request::simple(CommandKind::MachineOn)) || !submit(Request::set_mode(Mode::Auto)) ||
+      !submit(Request::open(six_axis_program(), "six-axis")) ||
+      !submit(Request::simple(CommandKind::CycleStart))) {
+    state.SkipWithError("the program does not start");
+    return;
+  }
+  std::vector<double> ns;
+  ns.reserve(1 << 22);
+  TraceSample t;
+  std::uint64_t n = 0;
+  for (auto _ : state) {
+    controller.service();
+    while (channels->trace.try_pop(t)) {
+    }
+    if (++n % 4000 == 0) {  // an override change now and then
+      controller.submit(Request::value_of(CommandKind::SetFeedOverride, (n / 4000) % 2 ? 0.8 : 1.0));
+    }
+    if (!controller.status().run_active && !submit(Request::simple(CommandKind::CycleStart))) {
+      state.SkipWithError("the run ended and does not start again");
+      break;
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    servo.tick();
+    const auto t1 = std::chrono::steady_clock::now();
+    const double dt = std::chrono::duration<double>(t1 - t0).count();
+    state.SetIterationTime(dt);
+    ns.push_back(dt * 1e9);
+  }
+  std::sort(ns.begin(), ns.end());
+  const auto pct = [&](double p) {
+    return ns.empty() ? 0.0 : ns[static_cast<std::size_t>(p * static_cast<double>(ns.size() - 1))];
+  };
+  state.counters["p50_ns"] = pct(0.5);
+  state.counters["p99_ns"] = pct(0.99);
+  state.counters["p999_ns"] = pct(0.999);
+  state.counters["max_ns"] = ns.empty() ? 0.0 : ns.back();
+}
+
+void BM_ServoTickLoopback(benchmark::State& state) {
+  servo_tick(state, std::make_unique<LoopbackMachine>(6));
+}
+
+void BM_ServoTickSimMachine(benchmark::State& state) {
+  const config::ProfileLoad load = config::parse_profile(kSixAxes, "six-axis.toml");
+  servo_tick(state, std::make_unique<machine::SimMachine>(config::sim_machine_config(*load.profile)));
+}
+
+}  // namespace
+
+BENCHMARK(BM_ServoTickLoopback)->UseManualTime()->Iterations(200000)->Unit(benchmark::kNanosecond);
+BENCHMARK(BM_ServoTickSimMachine)->UseManualTime()->Iterations(200000)->Unit(benchmark::kNanosecond);
+BENCHMARK_MAIN();

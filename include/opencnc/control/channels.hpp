@@ -1,0 +1,43 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// ServoChannels — the only things the real-time servo and the non-real-time controller share:
+// fixed-size lock-free queues and the status buffer, without pointers (shared-memory ready).
+#pragma once
+
+#include <atomic>
+#include <type_traits>
+
+#include "opencnc/control/command.hpp"
+#include "opencnc/control/spsc_ring.hpp"
+#include "opencnc/control/status.hpp"
+#include "opencnc/control/triple_buffer.hpp"
+#include "opencnc/traj/block_queue.hpp"
+
+namespace opencnc::control {
+
+/// Every queue has exactly one producer and one consumer:
+///
+/// | member     | producer                  | consumer   |
+/// |------------|---------------------------|------------|
+/// | commands   | controller                | servo tick |
+/// | blocks     | planner (controller)      | servo tick |
+/// | actions    | controller                | servo tick |
+/// | events     | servo tick                | controller |
+/// | status     | servo tick                | controller |
+/// | trace      | servo tick (when enabled) | recorder   |
+///
+/// About 4 MB; construct it on the heap or in shared memory (standard layout, lock-free atomics).
+struct ServoChannels {
+  SpscRing<Command, 256> commands;
+  traj::BlockQueue blocks;
+  /// The machine side of the markers of the current run, in action order; as many as blocks
+  /// can be queued, so the record of every queued marker is always there.
+  SpscRing<MachineAction, traj::BlockQueue::kCapacity> actions;
+  SpscRing<ServoEvent, 1024> events;
+  TripleBuffer<ServoStatus> status;
+  SpscRing<TraceSample, 8192> trace;
+  std::atomic<bool> trace_enabled{false};
+};
+
+static_assert(std::is_standard_layout_v<ServoChannels>);
+
+}  // namespace opencnc::control

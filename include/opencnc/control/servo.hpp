@@ -1,0 +1,203 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Servo — the real-time half of the controller: one tick() per servo period, from the machine's
+// inputs to its outputs, in a fixed order of stages. Fixed-size state, no allocation, noexcept.
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "opencnc/control/axis_mover.hpp"
+#include "opencnc/control/channels.hpp"
+#include "opencnc/control/clock.hpp"
+#include "opencnc/control/homing.hpp"
+#include "opencnc/control/servo_config.hpp"
+#include "opencnc/machine/machine_io.hpp"
+#include "opencnc/motion/pulse_distributor.hpp"
+#include "opencnc/traj/interpolator.hpp"
+
+namespace opencnc::control {
+
+/// The servo tick. It owns the modes and state machines that must act within a period —
+/// safety, homing, jogging, the interpolator of Auto and MDI runs, the machine handshakes of a
+/// program's markers — and talks to the rest of the controller only through ServoChannels
+/// (commands and motion blocks in; events, status and trace out). The state table it follows is
+/// in docs/controller.md. It does not know which clock drives it.
+class Servo final : public Tickable {
+ public:
+  /// Setup thread, before the first tick. `channels` and `machine` must outlive the servo.
+  Servo(const ServoConfig& config, ServoChannels& channels, machine::MachineIO& machine) noexcept;
+  Servo(const Servo&) = delete;
+  Servo& operator=(const Servo&) = delete;
+
+  /// One servo period, stage by stage (see the body). Servo thread; real-time safe, noexcept,
+  /// allocates nothing. Always returns true (the clock decides when to stop).
+  bool tick() noexcept override;
+
+  /// Periods run. Servo thread (or any thread once the servo has stopped).
+  std::uint64_t ticks() const noexcept { return tick_; }
+  const ServoConfig& config() const noexcept { return config_; }
+
+ private:
+  using Joints = std::array<double, machine::kMaxJoints>;
+
+  // --- stages of a period (servo.cpp) -------------------------------------------------------
+  void read_inputs() noexcept;
+  void check_safety() noexcept;
+  void handle_commands() noexcept;
+  void run_active_mode() noexcept;
+  void couple_axes() noexcept;
+  void compensate() noexcept;
+  void check_soft_limits() noexcept;
+  void write_outputs() noexcept;
+  void publish() noexcept;
+
+  void start_up() noexcept;
+  void check_joint_faults() noexcept;
+  void check_power() noexcept;
+  void follow_feedback() noexcept;
+  void write_joint(int j) noexcept;
+  void write_steppers() noexcept;
+  void write_machine_outputs() noexcept;
+  void fill_status(ServoStatus& s) const noexcept;
+  void push_trace() noexcept;
+
+  // --- transitions (servo_commands.cpp) -----------------------------------------------------
+  Refusal apply(const Command& c) noexcept;
+  Refusal need_on() const noexcept;
+  Refusal reset() noexcept;
+  Refusal machine_on() noexcept;
+  Refusal machine_off() noexcept;
+  Refusal set_mode(Mode m) noexcept;
+  Refusal start_run(const Command& c) noexcept;
+  Refusal cycle_start() noexcept;
+  Refusal feed_hold() noexcept;
+  Refusal resume() noexcept;
+  Refusal abort() noexcept;
+  Refusal set_override(double& target, double value, double max) noexcept;
+  Refusal manual_spindle_or_coolant(const Command& c) noexcept;
+  Refusal tool_changed() noexcept;
+  void enter_estop() noexcept;
+  void enter_fault(const Fault& f) noexcept;
+  void halt(RunEnd why) noexcept;
+  void set_state(State s) noexcept;
+  void emit(const ServoEvent& e) noexcept;
+
+  // --- manual mode: jogs and homing (servo_manual.cpp) --------------------------------------
+  Refusal jog(const Command& c) noexcept;
+  Refusal jog_stop(int axis) noexcept;
+  Refusal home(int axis) noexcept;
+  void run_movers() noexcept;
+  void run_homing() noexcept;
+  void start_next_homing_group() noexcept;
+  void reset_movers() noexcept;
+  int joint_of(int axis) const noexcept;
+  bool toward_active_limit(int j, double direction) const noexcept;
+  bool any_limit_switch() const noexcept;
+  bool all_homed() const noexcept;
+
+  // --- Auto and MDI runs (servo_program.cpp) ------------------------------------------------
+  void run_program() noexcept;
+  traj::TickInput program_inputs() noexcept;
+  void apply_reports() noexcept;
+  void apply_action(const MachineAction& a) noexcept;
+  bool take_action(std::uint32_t action, MachineAction& out) noexcept;
+  void run_sync() noexcept;
+  void begin_sync() noexcept;
+  bool step_sync() noexcept;
+  bool step_wait_input() noexcept;
+  void check_probe() noexcept;
+  void map_program_state() noexcept;
+  void end_run(RunEnd why) noexcept;
+  const traj::MotionBlock* block(std::uint64_t seq) const noexcept;
+  bool spindle_at_speed() const noexcept;
+  bool spindle_change_pending() const noexcept;
+  void stop_spindle_and_coolant() noexcept;
+
+  ServoConfig config_;
+  ServoChannels* channels_;
+  machine::MachineIO* machine_;
+  machine::MachineCapabilities caps_{};
+  machine::MachineInputs in_{};
+  machine::MachineOutputs out_{};
+  std::uint64_t tick_ = 0;
+  bool started_ = false;
+
+  // State machine.
+  State state_ = State::Off;
+  State published_state_ = State::Off;
+  Mode mode_ = Mode::Manual;
+  Activity activity_ = Activity::None;
+  Wait wait_ = Wait::None;
+  StopReason stop_reason_ = StopReason::None;
+  Fault fault_{};
+  bool power_stop_ = false;  ///< a controlled stop for a power failure is under way
+  std::uint64_t last_command_id_ = 0;
+  Refusal last_refusal_ = Refusal::None;
+  std::uint64_t accepted_ = 0, refused_ = 0, events_dropped_ = 0, trace_dropped_ = 0;
+
+  // Positions. Machine coordinates = joint coordinates + offset (set by homing).
+  Pose commanded_{};         ///< every axis, machine coordinates
+  Joints joint_cmd_{};       ///< after coupling and compensation, joint coordinates
+  Joints reference_{};       ///< what the drive aims at by the end of the period (cmd + ff·T)
+  Joints joint_velocity_{};  ///< commanded, joint units/s (last two commands)
+  Joints velocity_ff_{};     ///< what servo drives get of it (steppers: none)
+  Joints feedback_{};        ///< joint coordinates
+  Joints following_error_{};
+  Joints offset_{};
+  std::array<bool, machine::kMaxJoints> homed_{};
+  std::array<bool, machine::kMaxJoints> limit_active_{};  ///< either limit switch active
+  std::array<bool, machine::kMaxJoints> limit_rising_{};  ///< ... and not in the last period
+  bool drives_enabled_ = false;
+  /// Compensation stage (pitch error, backlash): the correction each joint gets and its last
+  /// direction of motion, which backlash compensation will need. Zero for now.
+  Joints compensation_{};
+  std::array<std::int8_t, machine::kMaxJoints> direction_{};
+
+  // Manual mode.
+  std::array<AxisMover, machine::kMaxJoints> movers_{};
+  std::array<JointHoming, machine::kMaxJoints> homing_{};
+  std::uint16_t homing_pending_ = 0;  ///< joints still to home, by bit
+  std::uint16_t homing_active_ = 0;   ///< joints homing now
+
+  // Runs.
+  traj::Interpolator interp_;
+  traj::TickOutput tick_out_{};
+  std::uint32_t run_id_ = 0;
+  Mode run_mode_ = Mode::Auto;
+  bool hold_ = false;
+  bool cycle_start_edge_ = false, abort_edge_ = false, sync_done_edge_ = false;
+  bool released_ = false;  ///< cycle start reached the interpolator this period
+  bool aborting_ = false;
+  double feed_override_ = 1, rapid_override_ = 1, spindle_override_ = 1;
+  bool single_block_ = false, optional_stop_ = false;
+  enum class SyncStep : std::uint8_t { None, ToolChanger, ManualTool, Input, Orient };
+  SyncStep sync_step_ = SyncStep::None;
+  MachineAction sync_action_{};
+  std::uint64_t sync_started_tick_ = 0;
+  bool sync_input_before_ = false;
+  bool manual_tool_done_ = false;
+  bool probe_tripped_ = false;
+  std::uint64_t probe_seq_ = traj::kNoBlock;  ///< the probe move whose result probe_tripped_ is
+  Pose probe_position_{};
+  double input_value_ = 0;
+
+  // Machine outputs the program and the operator set.
+  double spindle_rpm_ = 0;
+  machine::SpindleDirection spindle_direction_ = machine::SpindleDirection::Stopped;
+  std::uint64_t spindle_changed_tick_ = 0;  ///< period of the last change of speed or direction
+  bool spindle_override_enabled_ = true;
+  bool orient_ = false;
+  double orient_angle_ = 0;
+  bool flood_ = false, mist_ = false;
+  std::int32_t tool_ = 0, selected_tool_ = 0, prepared_tool_ = 0, preparing_tool_ = 0;
+  bool preparing_ = false;
+  std::uint64_t digital_out_ = 0;
+  std::array<double, machine::kAnalogChannels> analog_out_{};
+
+  // Stepper joints: one pulse distributor over all of them, slot per joint (−1 = servo).
+  motion::PulseDistributor pulses_{motion::PulseMethod::Vector};
+  std::array<std::int8_t, machine::kMaxJoints> stepper_slot_{};
+  int stepper_count_ = 0;
+};
+
+}  // namespace opencnc::control

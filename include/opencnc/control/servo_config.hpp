@@ -1,0 +1,64 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// ServoConfig — everything the servo tick needs to know about the machine, as fixed-size plain
+// data (built from a machine profile by the non-real-time side, see controller/servo_setup.hpp).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <type_traits>
+
+#include "opencnc/machine/machine_io.hpp"
+#include "opencnc/traj/interpolator.hpp"
+
+namespace opencnc::control {
+
+/// How a joint finds its home (the profile's homing methods, docs/machine.md).
+enum class HomeMethod : std::uint8_t {
+  Immediate,    ///< no motion: the present position becomes `position` (done at start-up too)
+  Switch,       ///< search the home switch, then latch one of its edges at latch velocity
+  SwitchIndex,  ///< as Switch, then latch the next encoder index mark
+  Index,        ///< latch the next encoder index mark at latch velocity
+  DecelHome,    ///< fast to the deceleration dog, then slowly to the home switch
+};
+
+struct HomeConfig {
+  HomeMethod method = HomeMethod::Immediate;
+  double position = 0;         ///< machine position once homed
+  double switch_position = 0;  ///< machine position of the latched edge or index mark
+  double search_velocity = 0;  ///< units/s, signed: direction of the search
+  double latch_velocity = 0;   ///< units/s, signed: direction of the latch move
+  double final_velocity = 0;   ///< units/s to `position` (> 0; servo_config() puts max_velocity for 0)
+  int sequence = 0;            ///< lower sequences home first; equal ones together
+};
+
+/// One joint. The machine layer numbers joints in axis order, one joint per axis.
+struct JointConfig {
+  std::int8_t axis = 0;  ///< Axis index (X = 0 … W = 8) this joint moves
+  bool rotary = false;
+  bool wrapped = false;  ///< rotary without end: no soft limits
+  machine::JointDrive drive = machine::JointDrive::Servo;
+  double counts_per_unit = 1000;  ///< encoder counts (servo) or steps (stepper) per unit
+  double max_velocity = 0;        ///< units/s
+  double max_acceleration = 0;    ///< units/s²
+  double max_jerk = 0;            ///< units/s³, 0 = none
+  double min_limit = 0;           ///< soft limits, machine coordinates
+  double max_limit = 0;
+  double max_following_error = 1;  ///< units
+  HomeConfig home;
+};
+
+/// The machine as the tick sees it.
+struct ServoConfig {
+  double period_s = 1e-3;
+  int joint_count = 0;
+  std::array<JointConfig, machine::kMaxJoints> joints{};
+  traj::InterpolatorConfig interpolator;  ///< must match the planner (Planner::interpolator_config)
+  double max_spindle_override = 2.0;
+  double spindle_max_rpm = 0;
+  /// Auto and MDI need every joint homed (true when some joint homes by a method that moves).
+  bool homing_required = false;
+};
+
+static_assert(std::is_trivially_copyable_v<ServoConfig>);
+
+}  // namespace opencnc::control

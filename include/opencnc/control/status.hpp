@@ -1,0 +1,102 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// ServoStatus — the snapshot the servo publishes every period, and TraceSample, the per-period
+// record for traces and run reports. Plain fixed-size data.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <type_traits>
+
+#include "opencnc/control/command.hpp"
+#include "opencnc/core/axes.hpp"
+#include "opencnc/machine/machine_io.hpp"
+#include "opencnc/traj/interpolator.hpp"
+
+namespace opencnc::control {
+
+struct JointStatus {
+  double commanded = 0;        ///< machine coordinates
+  double actual = 0;           ///< feedback in machine coordinates
+  double following_error = 0;  ///< reference − feedback, units
+  double velocity = 0;         ///< commanded, units/s
+  bool homed = false;
+  bool homing = false;
+  bool limit_neg = false, limit_pos = false, home_switch = false, amp_fault = false;
+};
+
+struct ServoStatus {
+  std::uint64_t tick = 0;
+  double time_s = 0;  ///< tick × period
+  State state = State::Off;
+  Mode mode = Mode::Manual;
+  Activity activity = Activity::None;
+  Wait wait = Wait::None;
+  StopReason stop_reason = StopReason::None;
+  bool aborting = false;
+  bool estop_input_ok = false;
+  bool drives_enabled = false;
+
+  int joint_count = 0;
+  std::array<JointStatus, machine::kMaxJoints> joints{};
+  Pose commanded{};  ///< every axis, machine coordinates
+  Pose actual{};
+  bool all_homed = false;
+
+  // The run (Auto program or MDI line).
+  std::uint32_t run_id = 0;  ///< the last run started (0 = none yet)
+  Mode run_mode = Mode::Auto;
+  bool run_active = false;
+  traj::RunState motion = traj::RunState::Idle;  ///< the interpolator's state
+  std::uint64_t segment = 0;                     ///< canon segment id at the commanded position
+  std::uint32_t line = 0;                        ///< its source line
+  std::uint32_t context = 0;
+  double path_velocity = 0;  ///< along the path, s-units/s
+
+  // Operator switches.
+  double feed_override = 1, rapid_override = 1, spindle_override = 1;
+  bool single_block = false, optional_stop = false;
+
+  // Machine outputs and what came back.
+  double spindle_rpm = 0;  ///< commanded (after override)
+  machine::SpindleDirection spindle_direction = machine::SpindleDirection::Stopped;
+  double spindle_rpm_actual = 0;
+  bool spindle_at_speed = false;
+  bool flood = false, mist = false;
+  std::int32_t tool = 0;           ///< tool in the spindle
+  std::int32_t prepared_tool = 0;  ///< tool brought to the change position
+  std::uint64_t digital_out = 0;
+  std::array<double, machine::kAnalogChannels> analog_out{};
+  bool mains_ok = true, on_battery = false;
+  double dc_link_v = 0;
+
+  // Answers.
+  Fault fault{};  ///< the fault that made the state Faulted (kind None otherwise)
+  std::uint64_t last_command_id = 0;
+  Refusal last_refusal = Refusal::None;
+  std::uint64_t commands_accepted = 0, commands_refused = 0;
+  std::uint64_t events_dropped = 0, trace_dropped = 0;
+  bool probe_tripped = false;  ///< during the last probe move
+  Pose probe_position{};       ///< actual position when it tripped
+  double input_value = 0;      ///< the last M66 result (−1: timed out)
+};
+
+/// One servo period, for traces and run reports (docs/controller.md, "Trace CSV").
+struct TraceSample {
+  std::uint64_t tick = 0;
+  State state = State::Off;
+  Activity activity = Activity::None;
+  traj::RunState motion = traj::RunState::Idle;
+  bool rapid = false;  ///< the block at the commanded position is a rapid (G0)
+  std::uint32_t run_id = 0;
+  std::uint32_t line = 0;
+  std::uint64_t segment = 0, segment_first = 0, segment_last = 0;
+  double path_velocity = 0;
+  Pose commanded{};        ///< machine coordinates, every axis
+  Pose actual{};           ///< feedback in machine coordinates
+  Pose following_error{};  ///< per axis
+};
+
+static_assert(std::is_trivially_copyable_v<ServoStatus>);
+static_assert(std::is_trivially_copyable_v<TraceSample>);
+
+}  // namespace opencnc::control

@@ -1,0 +1,33 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Preflight: the whole program checked against the soft limits before any motion starts.
+#pragma once
+
+#include <array>
+
+#include "opencnc/canon/program.hpp"
+#include "opencnc/control/servo_config.hpp"
+#include "opencnc/core/axes.hpp"
+#include "opencnc/core/diagnostic.hpp"
+
+namespace opencnc::control {
+
+/// Axis-aligned extent of a move, every axis, machine coordinates.
+struct Extent {
+  Pose min{}, max{};
+};
+
+/// The extent of move `id` of `program`: the end points of a line; for an arc or helix its true
+/// extent (the circle's extreme points in the plane where the sweep passes them). Non-real-time.
+Extent move_extent(const canon::Program& program, canon::SegmentId id);
+
+/// The length of move `id` along X Y Z (U V W for moves without XYZ motion): the distance for a
+/// line, the helix length for an arc. Non-real-time.
+double move_length(const canon::Program& program, canon::SegmentId id);
+
+/// Checks every move of `program` (from its start) against the soft limits of the joints in
+/// `config` (wrapped rotary joints have none). Adds one `control.soft-limit` error per move and
+/// axis that would cross a limit, with the move's file and line, and returns false if there was
+/// any. Non-real-time; O(moves).
+bool check_soft_limits(const canon::Program& program, const ServoConfig& config, Diagnostics& diags);
+
+}  // namespace opencnc::control

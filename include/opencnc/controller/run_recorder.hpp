@@ -1,0 +1,72 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// RunRecorder — the report of a run from its per-period trace samples: machining time, path
+// length, following error, contour error against the programmed path, per-axis velocity,
+// acceleration and jerk, limit violations. And the trace CSV writer.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <fstream>
+#include <optional>
+#include <string>
+
+#include "opencnc/analysis/trace_checker.hpp"
+#include "opencnc/canon/program.hpp"
+#include "opencnc/control/status.hpp"
+#include "opencnc/plan/machine_limits.hpp"
+
+namespace opencnc::control {
+
+/// What `opencnc run` reports (docs/controller.md lists the JSON keys).
+struct RunReport {
+  double machining_time_s = 0;  ///< periods of the run × period (start to program end)
+  double motion_time_s = 0;     ///< first to last period in which the commanded position changed
+  double path_length_mm = 0;    ///< commanded, XYZ (and UVW)
+  double max_following_error_mm = 0;
+  int max_following_error_axis = -1;
+  double max_contour_error_mm = 0;                     ///< actual (feedback) position to the programmed path
+  double max_command_contour_error_mm = 0;             ///< commanded position to the programmed path
+  std::array<analysis::AxisStats, kAxisCount> axes{};  ///< of the commanded trajectory
+  std::uint64_t limit_violations = 0;  ///< commanded samples × axes × derivatives above a limit
+  std::uint64_t samples = 0;
+};
+
+/// Accumulates the samples of one run. Non-real-time; the program must outlive the recorder.
+class RunRecorder {
+ public:
+  RunRecorder(const canon::Program& program, const plan::MachineLimits& limits, double period_s);
+
+  /// One period of the run (call for the run's samples only, in order).
+  void add(const TraceSample& s);
+  RunReport report() const;
+
+ private:
+  plan::MachineLimits limits_;
+  double period_s_;
+  analysis::TraceChecker commanded_;
+  analysis::TraceChecker actual_;
+  RunReport r_;
+  Pose last_{};
+  std::uint64_t first_move_ = 0, last_move_ = 0;
+  bool moved_ = false;
+};
+
+/// Writes trace samples as CSV, one row per period (columns in docs/controller.md).
+/// Non-real-time.
+class TraceCsvWriter {
+ public:
+  /// Opens `path` for the axes in `axes`; check ok().
+  TraceCsvWriter(const std::string& path, AxisMask axes, double period_s);
+  bool ok() const { return static_cast<bool>(out_); }
+  void add(const TraceSample& s);
+  /// Flushes and closes; false if anything failed.
+  bool close();
+
+ private:
+  std::ofstream out_;
+  AxisMask axes_;
+  double period_s_;
+  std::string row_;
+};
+
+}  // namespace opencnc::control

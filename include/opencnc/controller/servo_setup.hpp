@@ -1,0 +1,22 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// From a machine profile to the settings of the servo tick and of the planner that feeds it.
+#pragma once
+
+#include "opencnc/config/machine_profile.hpp"
+#include "opencnc/control/servo_config.hpp"
+#include "opencnc/plan/machine_limits.hpp"
+#include "opencnc/plan/planner.hpp"
+
+namespace opencnc::control {
+
+/// Axis limits for the planner (velocity, acceleration, jerk of every axis). Non-real-time.
+plan::MachineLimits machine_limits(const config::MachineProfile& profile);
+
+/// Planner settings: the profile's servo period and look-ahead. Non-real-time.
+plan::PlannerConfig planner_config(const config::MachineProfile& profile);
+
+/// The servo's view of the machine. The interpolator settings are those of a planner made with
+/// machine_limits() and planner_config(), so blocks and tick agree. Non-real-time.
+ServoConfig servo_config(const config::MachineProfile& profile);
+
+}  // namespace opencnc::control

@@ -1,0 +1,407 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Servo: the stages of one servo period, in order, and the inputs/safety/outputs around them.
+#include "opencnc/control/servo.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace opencnc::control {
+
+namespace {
+
+/// Soft limits are checked with this slack (units), so that a move that ends exactly on a limit
+/// is not a violation because of the last bit of rounding.
+constexpr double kSoftLimitSlack = 1e-7;
+/// Commands taken per period; the rest wait for the next one.
+constexpr int kCommandsPerTick = 16;
+
+}  // namespace
+
+Servo::Servo(const ServoConfig& config, ServoChannels& channels, machine::MachineIO& machine) noexcept
+    : config_(config),
+      channels_(&channels),
+      machine_(&machine),
+      caps_(machine.capabilities()),
+      interp_(channels.blocks, config.interpolator, Pose{}) {
+  config_.joint_count = std::clamp(std::min(config_.joint_count, caps_.joint_count), 0, machine::kMaxJoints);
+  stepper_slot_.fill(-1);
+  for (int j = 0; j < config_.joint_count; ++j) {
+    const JointConfig& jc = config_.joints[static_cast<std::size_t>(j)];
+    movers_[static_cast<std::size_t>(j)].configure(config_.period_s, jc.max_acceleration, jc.max_jerk, 0);
+    if (jc.drive == machine::JointDrive::Stepper)
+      stepper_slot_[static_cast<std::size_t>(j)] = static_cast<std::int8_t>(stepper_count_++);
+  }
+}
+
+// The servo period. Its stages, in the order DESIGN.md fixes:
+bool Servo::tick() noexcept {
+  ++tick_;
+  read_inputs();        // machine inputs (feedback, switches, power, spindle, I/O)
+  check_safety();       // e-stop, limit switches, amplifier faults, following error, power monitor
+  handle_commands();    // operator and controller commands: the explicit state transitions
+  run_active_mode();    // homing / jog (movers) or MDI / auto (interpolator, machine handshakes)
+  couple_axes();        // axes → joints (identity until coupling laws come)
+  compensate();         // pitch error and backlash (zero until compensation comes)
+  check_soft_limits();  // every commanded joint within its soft limits
+  write_outputs();      // position commands or step counts, enables, spindle, coolant, I/O
+  publish();            // status snapshot, trace sample
+  return true;
+}
+
+// --- read inputs -----------------------------------------------------------------------------
+
+void Servo::read_inputs() noexcept {
+  machine_->read(in_);
+  for (int j = 0; j < config_.joint_count; ++j) {
+    const auto uj = static_cast<std::size_t>(j);
+    const machine::JointInputs& ji = in_.joints[uj];
+    feedback_[uj] = ji.position;
+    following_error_[uj] = reference_[uj] - feedback_[uj];
+    const bool limit = ji.limit_neg || ji.limit_pos;
+    limit_rising_[uj] = limit && !limit_active_[uj];
+    limit_active_[uj] = limit;
+  }
+  if (!started_) start_up();
+}
+
+// First period: the machine's power-up position is the commanded one; joints that home
+// immediately are homed where they stand; step counters start from the motors' counts.
+void Servo::start_up() noexcept {
+  started_ = true;
+  for (int j = 0; j < config_.joint_count; ++j) {
+    const auto uj = static_cast<std::size_t>(j);
+    const JointConfig& jc = config_.joints[uj];
+    if (jc.home.method == HomeMethod::Immediate) {
+      offset_[uj] = jc.home.position - feedback_[uj];
+      homed_[uj] = true;
+    }
+    if (stepper_slot_[uj] >= 0)
+      pulses_.set_position(stepper_slot_[uj], std::llround(feedback_[uj] * jc.counts_per_unit));
+  }
+  follow_feedback();
+  reset_movers();
+  state_ = published_state_ = in_.estop_ok ? State::Off : State::EStopped;
+}
+
+// While the drives are off the commanded position follows the machine, so that enabling them
+// again moves nothing (the movers are reset where the motion starts again: machine on, halt).
+void Servo::follow_feedback() noexcept {
+  for (int j = 0; j < config_.joint_count; ++j) {
+    const auto uj = static_cast<std::size_t>(j);
+    commanded_[config_.joints[uj].axis] = feedback_[uj] + offset_[uj];
+  }
+}
+
+// --- safety ----------------------------------------------------------------------------------
+
+void Servo::check_safety() noexcept {
+  if (!in_.estop_ok) {
+    if (state_ != State::EStopped) enter_estop();
+    return;
+  }
+  if (!drives_enabled_) return;
+  check_joint_faults();
+  if (drives_enabled_) check_power();
+}
+
+void Servo::check_joint_faults() noexcept {
+  for (int j = 0; j < config_.joint_count && drives_enabled_; ++j) {
+    const auto uj = static_cast<std::size_t>(j);
+    const machine::JointInputs& ji = in_.joints[uj];
+    const JointConfig& jc = config_.joints[uj];
+    const double actual = feedback_[uj] + offset_[uj];
+    if (ji.amp_fault) {
+      enter_fault({FaultKind::AmpFault, jc.axis, actual, 0, tick_});
+    } else if (limit_rising_[uj]) {
+      enter_fault({activity_ == Activity::Homing ? FaultKind::Homing : FaultKind::LimitSwitch, jc.axis,
+                   actual, 0, tick_});
+    } else if (std::fabs(following_error_[uj]) > jc.max_following_error) {
+      enter_fault({FaultKind::FollowingError, jc.axis, following_error_[uj], jc.max_following_error, tick_});
+    }
+  }
+}
+
+// Mains lost or the UPS on battery: a controlled stop of whatever moves, then Faulted.
+void Servo::check_power() noexcept {
+  if (!caps_.power_monitor) return;
+  const bool lost = !in_.power.mains_ok || (caps_.ups && in_.power.ups_on_battery);
+  if (!lost || power_stop_) return;
+  power_stop_ = true;
+  switch (activity_) {
+    case Activity::Program:
+      hold_ = false;
+      abort_edge_ = aborting_ = true;
+      break;
+    case Activity::Homing:
+    case Activity::Jog:
+      for (int j = 0; j < config_.joint_count; ++j) {
+        homing_[static_cast<std::size_t>(j)].cancel(movers_[static_cast<std::size_t>(j)]);
+        movers_[static_cast<std::size_t>(j)].stop();
+      }
+      homing_pending_ = homing_active_ = 0;
+      activity_ = Activity::Jog;  // the movers bring the joints to rest, then the fault
+      break;
+    case Activity::None:
+      break;
+  }
+}
+
+// --- commands --------------------------------------------------------------------------------
+
+void Servo::handle_commands() noexcept {
+  Command c;
+  for (int n = 0; n < kCommandsPerTick && channels_->commands.try_pop(c); ++n) {
+    const Refusal r = apply(c);
+    last_command_id_ = c.id;
+    last_refusal_ = r;
+    ServoEvent e;
+    e.kind = r == Refusal::None ? EventKind::Accepted : EventKind::Refused;
+    e.command_id = c.id;
+    e.command = c.kind;
+    e.refusal = r;
+    e.state = state_;
+    e.run_id = c.run_id;
+    emit(e);
+    (r == Refusal::None ? accepted_ : refused_) += 1;
+  }
+}
+
+// --- active mode -----------------------------------------------------------------------------
+
+void Servo::run_active_mode() noexcept {
+  switch (activity_) {
+    case Activity::Program:
+      run_program();
+      break;
+    case Activity::Homing:
+      run_homing();
+      break;
+    case Activity::Jog:
+      run_movers();
+      break;
+    case Activity::None:
+      if (!drives_enabled_) follow_feedback();
+      break;
+  }
+  if (power_stop_ && activity_ == Activity::None && drives_enabled_) {
+    enter_fault({FaultKind::PowerLoss, -1, in_.power.dc_link_v, 0, tick_});
+  }
+}
+
+// --- axes to joints --------------------------------------------------------------------------
+
+void Servo::couple_axes() noexcept {
+  for (int j = 0; j < config_.joint_count; ++j) {
+    const auto uj = static_cast<std::size_t>(j);
+    joint_cmd_[uj] = commanded_[config_.joints[uj].axis] - offset_[uj];
+  }
+}
+
+void Servo::compensate() noexcept {
+  for (int j = 0; j < config_.joint_count; ++j) {
+    const auto uj = static_cast<std::size_t>(j);
+    const double step = joint_cmd_[uj] + compensation_[uj] - out_.joints[uj].position;
+    if (step != 0) direction_[uj] = step > 0 ? 1 : -1;
+    joint_cmd_[uj] += compensation_[uj];
+  }
+}
+
+void Servo::check_soft_limits() noexcept {
+  if (!drives_enabled_) return;
+  for (int j = 0; j < config_.joint_count; ++j) {
+    const auto uj = static_cast<std::size_t>(j);
+    const JointConfig& jc = config_.joints[uj];
+    if (!homed_[uj] || jc.wrapped || activity_ == Activity::Homing) continue;
+    const double x = commanded_[jc.axis];
+    const bool low = x<jc.min_limit - kSoftLimitSlack, high = x> jc.max_limit + kSoftLimitSlack;
+    if (low || high) {
+      enter_fault({FaultKind::SoftLimit, jc.axis, x, low ? jc.min_limit : jc.max_limit, tick_});
+      couple_axes();
+      return;
+    }
+  }
+}
+
+// --- outputs ---------------------------------------------------------------------------------
+
+void Servo::write_outputs() noexcept {
+  for (int j = 0; j < config_.joint_count; ++j) write_joint(j);
+  if (stepper_count_ > 0) write_steppers();
+  write_machine_outputs();
+  machine_->write(out_);
+}
+
+void Servo::write_joint(int j) noexcept {
+  const auto uj = static_cast<std::size_t>(j);
+  machine::JointOutputs& o = out_.joints[uj];
+  const bool servo = config_.joints[uj].drive == machine::JointDrive::Servo;
+  // Feed-forward from the last two commands: the drive extrapolates the reference with it over
+  // the period (one period behind the true derivative, an error of a·T², 1 µm at 1000 mm/s²).
+  joint_velocity_[uj] = drives_enabled_ ? (joint_cmd_[uj] - o.position) / config_.period_s : 0.0;
+  velocity_ff_[uj] = servo ? joint_velocity_[uj] : 0.0;
+  reference_[uj] = joint_cmd_[uj] + velocity_ff_[uj] * config_.period_s;
+  o.position = joint_cmd_[uj];
+  o.velocity_ff = velocity_ff_[uj];
+  o.enable = drives_enabled_;
+}
+
+// Stepper joints: this period's whole-step increments are one straight move of the pulse
+// distributor, run to its end (a step generator that pulls feed steps inside the period would
+// call step() instead); the absolute counts go to the machine.
+void Servo::write_steppers() noexcept {
+  std::array<motion::StepCount, motion::kMaxPulseAxes> inc{};
+  for (int j = 0; j < config_.joint_count; ++j) {
+    const auto uj = static_cast<std::size_t>(j);
+    const int slot = stepper_slot_[uj];
+    if (slot < 0) continue;
+    const auto target =
+        static_cast<motion::StepCount>(std::llround(joint_cmd_[uj] * config_.joints[uj].counts_per_unit));
+    inc[static_cast<std::size_t>(slot)] = drives_enabled_ ? target - pulses_.position(slot) : 0;
+  }
+  if (pulses_.start(std::span<const motion::StepCount>(
+          inc.data(), static_cast<std::size_t>(stepper_count_))) == motion::PulseStatus::Ok) {
+    pulses_.advance(pulses_.feed_steps_total());
+  }
+  for (int j = 0; j < config_.joint_count; ++j) {
+    const auto uj = static_cast<std::size_t>(j);
+    if (stepper_slot_[uj] >= 0) out_.joints[uj].step_position = pulses_.position(stepper_slot_[uj]);
+  }
+}
+
+void Servo::write_machine_outputs() noexcept {
+  out_.estop_release = state_ != State::EStopped;
+  const bool on = drives_enabled_;
+  double rpm = spindle_rpm_ * (spindle_override_enabled_ ? spindle_override_ : 1.0);
+  if (config_.spindle_max_rpm > 0) rpm = std::min(rpm, config_.spindle_max_rpm);
+  out_.spindle.speed_rpm = on ? rpm : 0.0;
+  out_.spindle.direction = on ? spindle_direction_ : machine::SpindleDirection::Stopped;
+  out_.spindle.orient = on && orient_;
+  out_.spindle.orient_angle_deg = orient_angle_;
+  out_.process.flood = on && flood_;
+  out_.process.mist = on && mist_;
+  if (preparing_ && in_.tool.prepared) {
+    preparing_ = false;
+    prepared_tool_ = preparing_tool_;
+  }
+  out_.tool.prepare = on && preparing_;
+  out_.tool.prepare_tool = preparing_ ? preparing_tool_ : out_.tool.prepare_tool;
+  out_.tool.change = on && sync_step_ == SyncStep::ToolChanger;
+  out_.digital_out = digital_out_;
+  out_.analog_out = analog_out_;
+}
+
+// --- status ----------------------------------------------------------------------------------
+
+void Servo::publish() noexcept {
+  if (state_ != published_state_) {
+    published_state_ = state_;
+    ServoEvent e;
+    e.kind = EventKind::StateChanged;
+    e.state = state_;
+    emit(e);
+  }
+  fill_status(channels_->status.back());
+  channels_->status.publish();
+  if (channels_->trace_enabled.load(std::memory_order_relaxed)) push_trace();
+}
+
+void Servo::fill_status(ServoStatus& s) const noexcept {
+  s.tick = tick_;
+  s.time_s = static_cast<double>(tick_) * config_.period_s;
+  s.state = state_;
+  s.mode = mode_;
+  s.activity = activity_;
+  s.wait = wait_;
+  s.stop_reason = stop_reason_;
+  s.aborting = aborting_ || power_stop_;
+  s.estop_input_ok = in_.estop_ok;
+  s.drives_enabled = drives_enabled_;
+  s.joint_count = config_.joint_count;
+  for (int j = 0; j < config_.joint_count; ++j) {
+    const auto uj = static_cast<std::size_t>(j);
+    const machine::JointInputs& ji = in_.joints[uj];
+    JointStatus& js = s.joints[uj];
+    js.commanded = commanded_[config_.joints[uj].axis];
+    js.actual = feedback_[uj] + offset_[uj];
+    js.following_error = following_error_[uj];
+    js.velocity = joint_velocity_[uj];
+    js.homed = homed_[uj];
+    js.homing = (homing_active_ | homing_pending_) & (1u << j);
+    js.limit_neg = ji.limit_neg;
+    js.limit_pos = ji.limit_pos;
+    js.home_switch = ji.home;
+    js.amp_fault = ji.amp_fault;
+    s.actual[config_.joints[uj].axis] = js.actual;
+  }
+  s.commanded = commanded_;
+  s.all_homed = all_homed();
+  s.run_id = run_id_;
+  s.run_mode = run_mode_;
+  s.run_active = activity_ == Activity::Program;
+  s.motion = tick_out_.state;
+  s.segment = tick_out_.segment;
+  s.line = tick_out_.line;
+  s.context = tick_out_.context;
+  s.path_velocity = activity_ == Activity::Program ? tick_out_.path_velocity : 0.0;
+  s.feed_override = feed_override_;
+  s.rapid_override = rapid_override_;
+  s.spindle_override = spindle_override_;
+  s.single_block = single_block_;
+  s.optional_stop = optional_stop_;
+  s.spindle_rpm = out_.spindle.speed_rpm;
+  s.spindle_direction = out_.spindle.direction;
+  s.spindle_rpm_actual = in_.spindle.speed_rpm;
+  s.spindle_at_speed = spindle_at_speed();
+  s.flood = out_.process.flood;
+  s.mist = out_.process.mist;
+  s.tool = tool_;
+  s.prepared_tool = prepared_tool_;
+  s.digital_out = digital_out_;
+  s.analog_out = analog_out_;
+  s.mains_ok = in_.power.mains_ok;
+  s.on_battery = in_.power.ups_on_battery;
+  s.dc_link_v = in_.power.dc_link_v;
+  s.fault = fault_;
+  s.last_command_id = last_command_id_;
+  s.last_refusal = last_refusal_;
+  s.commands_accepted = accepted_;
+  s.commands_refused = refused_;
+  s.events_dropped = events_dropped_;
+  s.trace_dropped = trace_dropped_;
+  s.probe_tripped = probe_tripped_;
+  s.probe_position = probe_position_;
+  s.input_value = input_value_;
+}
+
+void Servo::push_trace() noexcept {
+  TraceSample t;
+  t.tick = tick_;
+  t.state = state_;
+  t.activity = activity_;
+  t.run_id = run_id_;
+  const bool program = activity_ == Activity::Program;
+  t.motion = program ? tick_out_.state : traj::RunState::Idle;
+  const traj::MotionBlock* b = program ? block(tick_out_.block_seq) : nullptr;
+  t.rapid = b != nullptr && b->kind != traj::BlockKind::Marker && b->feed_class == traj::FeedClass::Rapid;
+  t.line = program ? tick_out_.line : 0;
+  t.segment = tick_out_.segment;
+  t.segment_first = tick_out_.segment_first;
+  t.segment_last = tick_out_.segment_last;
+  t.path_velocity = program ? tick_out_.path_velocity : 0.0;
+  t.commanded = commanded_;
+  for (int j = 0; j < config_.joint_count; ++j) {
+    const auto uj = static_cast<std::size_t>(j);
+    const int axis = config_.joints[uj].axis;
+    t.actual[axis] = feedback_[uj] + offset_[uj];
+    t.following_error[axis] = following_error_[uj];
+  }
+  if (!channels_->trace.try_push(t)) ++trace_dropped_;
+}
+
+void Servo::emit(const ServoEvent& e) noexcept {
+  ServoEvent copy = e;
+  copy.tick = tick_;
+  if (!channels_->events.try_push(copy)) ++events_dropped_;
+}
+
+}  // namespace opencnc::control

@@ -1,0 +1,395 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Servo, Auto and MDI runs: the interpolator's inputs and outputs, the machine side of the
+// program's markers (spindle, coolant, outputs, tool change, M66, M19), probing, run end.
+#include <algorithm>
+#include <cmath>
+
+#include "opencnc/control/servo.hpp"
+
+namespace opencnc::control {
+
+namespace {
+
+/// Blocks looked at ahead of the interpolator for a spindle wait (a bounded loop).
+constexpr std::uint64_t kMarkerScan = 64;
+
+bool take(bool& edge) noexcept {
+  const bool was = edge;
+  edge = false;
+  return was;
+}
+
+}  // namespace
+
+const traj::MotionBlock* Servo::block(std::uint64_t seq) const noexcept {
+  const traj::BlockQueue& q = channels_->blocks;
+  const std::uint64_t first = q.popped();
+  if (seq < first || seq - first >= q.available()) return nullptr;
+  return &q.peek(static_cast<std::size_t>(seq - first));
+}
+
+// The drive's at-speed signal refers to the command it had when it sampled: only from the period
+// after a change on does it speak about the new one.
+bool Servo::spindle_at_speed() const noexcept {
+  if (!caps_.spindle) return true;
+  if (spindle_direction_ == machine::SpindleDirection::Stopped) return true;
+  return in_.spindle.at_speed && tick_ > spindle_changed_tick_;
+}
+
+// The interpolator reports the markers it passes and may reach a spindle-wait marker in the same
+// period; the M3/M4 before that wait is applied only after the period. So while the next
+// action record still to be applied is a spindle one and a spindle wait for it (or later) comes
+// before any other stop, the spindle is not at speed yet.
+bool Servo::spindle_change_pending() const noexcept {
+  // A wait is only decided with the motion at rest (it is a stop): while moving, nothing to do.
+  if (tick_out_.path_velocity != 0) return false;
+  const auto& ring = channels_->actions;
+  if (ring.available() == 0) return false;
+  const MachineAction& next = ring.front();
+  const bool spindle = next.code == ActionCode::SpindleCw || next.code == ActionCode::SpindleCcw ||
+                       next.code == ActionCode::SpindleSpeed || next.code == ActionCode::SpindleStop;
+  if (!spindle) return false;
+  const traj::BlockQueue& q = channels_->blocks;
+  const std::uint64_t first = std::max(q.popped(), tick_out_.block_seq);
+  for (std::uint64_t seq = first, n = 0; n < kMarkerScan && block(seq) != nullptr; ++seq, ++n) {
+    const traj::MotionBlock& b = *block(seq);
+    if (b.kind != traj::BlockKind::Marker || b.marker == traj::MarkerKind::Report) continue;
+    return b.marker == traj::MarkerKind::SpindleWait && b.action >= next.action;
+  }
+  return false;
+}
+
+void Servo::stop_spindle_and_coolant() noexcept {
+  spindle_direction_ = machine::SpindleDirection::Stopped;
+  orient_ = false;
+  flood_ = mist_ = false;
+  preparing_ = false;
+  sync_step_ = SyncStep::None;
+}
+
+traj::TickInput Servo::program_inputs() noexcept {
+  traj::TickInput in;
+  in.feed_override = feed_override_;
+  in.rapid_override = rapid_override_;
+  in.feed_hold = hold_;
+  in.cycle_start = take(cycle_start_edge_);
+  released_ = in.cycle_start;
+  in.abort = take(abort_edge_);
+  in.single_block = single_block_;
+  in.optional_stop = optional_stop_;
+  in.sync_done = take(sync_done_edge_);
+  in.spindle_at_speed = spindle_at_speed() && !spindle_change_pending();
+  in.spindle_revs = in_.spindle.position_rev;
+  in.spindle_rev_s = in_.spindle.speed_rpm / 60.0;
+  return in;
+}
+
+void Servo::run_program() noexcept {
+  interp_.tick(program_inputs(), tick_out_);
+  for (int j = 0; j < config_.joint_count; ++j) {
+    const int axis = config_.joints[static_cast<std::size_t>(j)].axis;
+    commanded_[axis] = tick_out_.position[axis];
+  }
+  apply_reports();
+  check_probe();
+  if (tick_out_.state == traj::RunState::WaitingSync) {
+    run_sync();
+  } else {
+    sync_step_ = SyncStep::None;
+  }
+  map_program_state();
+  if (tick_out_.state == traj::RunState::Finished) end_run(RunEnd::Finished);
+  if (tick_out_.state == traj::RunState::Aborted) end_run(power_stop_ ? RunEnd::Faulted : RunEnd::Aborted);
+}
+
+void Servo::map_program_state() noexcept {
+  switch (tick_out_.state) {
+    case traj::RunState::Dwelling:
+      wait_ = Wait::Dwell;
+      break;
+    case traj::RunState::WaitingSpindle:
+      wait_ = Wait::Spindle;
+      break;
+    case traj::RunState::Starved:
+      wait_ = Wait::Starved;
+      break;
+    case traj::RunState::WaitingSync:
+      break;  // run_sync() says what for
+    default:
+      wait_ = Wait::None;
+  }
+  if (aborting_) {
+    set_state(State::Running);
+  } else if (hold_) {
+    set_state(State::Held);
+  } else if (tick_out_.state == traj::RunState::WaitingCycleStart && !released_) {
+    const traj::MotionBlock* b = block(tick_out_.block_seq);
+    const traj::MarkerKind k = b != nullptr ? b->marker : traj::MarkerKind::None;
+    if (k == traj::MarkerKind::OptionalStop && !optional_stop_) {  // the interpolator lets it pass
+      set_state(State::Running);
+      return;
+    }
+    set_state(State::Stopped);
+    stop_reason_ = k == traj::MarkerKind::ProgramStop    ? StopReason::ProgramStop
+                   : k == traj::MarkerKind::OptionalStop ? StopReason::OptionalStop
+                                                         : StopReason::SingleBlock;
+  } else {
+    set_state(State::Running);
+  }
+}
+
+// Records are pushed in action order and consumed in that order; one that is older than the
+// marker asking is a marker that was passed without one (cannot happen with the planner's
+// markers, but a stale record must never block the run).
+bool Servo::take_action(std::uint32_t action, MachineAction& out) noexcept {
+  auto& ring = channels_->actions;
+  while (ring.available() > 0 && ring.front().action < action) ring.pop();
+  if (ring.available() == 0 || ring.front().action != action) return false;
+  ring.try_pop(out);
+  return true;
+}
+
+void Servo::apply_reports() noexcept {
+  for (int e = 0; e < tick_out_.event_count; ++e) {
+    const traj::TickEvent& ev = tick_out_.events[static_cast<std::size_t>(e)];
+    if (ev.kind != traj::MarkerKind::Report) continue;
+    MachineAction a;
+    if (take_action(ev.action, a)) apply_action(a);
+  }
+}
+
+void Servo::apply_action(const MachineAction& a) noexcept {
+  const auto channel_ok = [](int i, int n) { return i >= 0 && i < n; };
+  switch (a.code) {
+    case ActionCode::SpindleSpeed:
+      spindle_rpm_ = a.value;
+      spindle_changed_tick_ = tick_;
+      break;
+    case ActionCode::SpindleCw:
+    case ActionCode::SpindleCcw:
+      spindle_direction_ = a.code == ActionCode::SpindleCw ? machine::SpindleDirection::Clockwise
+                                                           : machine::SpindleDirection::Counterclockwise;
+      spindle_changed_tick_ = tick_;
+      orient_ = false;
+      break;
+    case ActionCode::SpindleStop:
+      spindle_direction_ = machine::SpindleDirection::Stopped;
+      spindle_changed_tick_ = tick_;
+      orient_ = false;
+      break;
+    case ActionCode::SelectTool:
+      selected_tool_ = a.index;
+      preparing_tool_ = a.index;
+      preparing_ = caps_.tool_changer;
+      if (!caps_.tool_changer) prepared_tool_ = a.index;
+      break;
+    case ActionCode::SetToolNumber:
+      tool_ = a.index;
+      break;
+    case ActionCode::FloodOn:
+    case ActionCode::FloodOff:
+      flood_ = a.code == ActionCode::FloodOn;
+      break;
+    case ActionCode::MistOn:
+    case ActionCode::MistOff:
+      mist_ = a.code == ActionCode::MistOn;
+      break;
+    case ActionCode::SpindleOverrideEnable:
+    case ActionCode::SpindleOverrideDisable:
+      spindle_override_enabled_ = a.code == ActionCode::SpindleOverrideEnable;
+      break;
+    case ActionCode::DigitalOutput:
+      if (channel_ok(a.index, caps_.digital_outputs)) {
+        const std::uint64_t bit = std::uint64_t{1} << a.index;
+        digital_out_ = a.index2 != 0 ? (digital_out_ | bit) : (digital_out_ & ~bit);
+      }
+      break;
+    case ActionCode::AnalogOutput:
+      if (channel_ok(a.index, caps_.analog_outputs)) analog_out_[static_cast<std::size_t>(a.index)] = a.value;
+      break;
+    case ActionCode::Message: {
+      ServoEvent e;
+      e.kind = EventKind::Message;
+      e.run_id = run_id_;
+      e.action = a.action;
+      emit(e);
+      break;
+    }
+    case ActionCode::ChangeTool:
+    case ActionCode::WaitInput:
+    case ActionCode::SpindleOrient:
+    case ActionCode::PalletShuttle:
+    case ActionCode::Ignore:
+      break;  // handshakes are Sync markers (run_sync); the rest needs nothing from the machine
+  }
+}
+
+// --- Sync markers: the program waits until the machine has done something -------------------
+
+void Servo::run_sync() noexcept {
+  if (sync_done_edge_) return;  // done; the interpolator sees it this tick
+  if (sync_step_ == SyncStep::None) {
+    begin_sync();
+  } else if (step_sync()) {
+    sync_step_ = SyncStep::None;
+    sync_done_edge_ = true;
+  }
+}
+
+void Servo::begin_sync() noexcept {
+  // Reports passed in this very tick may still be queued behind a full event list: wait a tick.
+  if (tick_out_.event_count == traj::kMaxTickEvents) return;
+  const traj::MotionBlock* m = block(tick_out_.block_seq);
+  MachineAction a;
+  if (m == nullptr || !take_action(m->action, a)) {  // a probe move's end: nothing to do here
+    wait_ = Wait::Probe;
+    sync_done_edge_ = true;
+    return;
+  }
+  sync_action_ = a;
+  sync_started_tick_ = tick_;
+  switch (a.code) {
+    case ActionCode::ChangeTool:
+      sync_step_ = caps_.tool_changer ? SyncStep::ToolChanger : SyncStep::ManualTool;
+      wait_ = caps_.tool_changer ? Wait::ToolChanger : Wait::ManualToolChange;
+      manual_tool_done_ = false;
+      out_.tool.prepare_tool = selected_tool_;
+      break;
+    case ActionCode::WaitInput: {
+      sync_step_ = SyncStep::Input;
+      wait_ = Wait::Input;
+      sync_input_before_ = (in_.digital_in >> std::clamp(a.index, 0, 63)) & 1u;
+      break;
+    }
+    case ActionCode::SpindleOrient:
+      orient_ = true;
+      orient_angle_ = a.value;
+      sync_step_ = caps_.spindle_orient ? SyncStep::Orient : SyncStep::None;
+      wait_ = Wait::Orient;
+      if (!caps_.spindle_orient) sync_done_edge_ = true;
+      break;
+    default:  // pallet shuttle and anything else without a handshake here
+      sync_done_edge_ = true;
+      break;
+  }
+  if (sync_step_ != SyncStep::None && step_sync()) {
+    sync_step_ = SyncStep::None;
+    sync_done_edge_ = true;
+  }
+}
+
+bool Servo::step_sync() noexcept {
+  switch (sync_step_) {
+    case SyncStep::ToolChanger:
+      if (!in_.tool.changed) return false;
+      tool_ = selected_tool_;  // M6 puts the tool the T word selected into the spindle
+      prepared_tool_ = 0;
+      return true;
+    case SyncStep::ManualTool:
+      if (!manual_tool_done_) return false;
+      tool_ = selected_tool_;
+      prepared_tool_ = 0;
+      return true;
+    case SyncStep::Input:
+      return step_wait_input();
+    case SyncStep::Orient:
+      return in_.spindle.orient_done;
+    case SyncStep::None:
+      return true;
+  }
+  return true;
+}
+
+// M66: L0 reads at once; L1 waits for a rising edge, L2 a falling one, L3 a high level, L4 a low
+// one, at most `value` seconds (then the result is −1, as LinuxCNC's #5399).
+bool Servo::step_wait_input() noexcept {
+  const MachineAction& a = sync_action_;
+  double result = 0;
+  bool done = false;
+  if (!a.digital) {
+    const int ch = std::clamp(a.index, 0, machine::kAnalogChannels - 1);
+    result = in_.analog_in[static_cast<std::size_t>(ch)];
+    done = true;
+  } else {
+    const bool now = (in_.digital_in >> std::clamp(a.index, 0, 63)) & 1u;
+    switch (a.index2) {
+      case 1:
+        done = now && !sync_input_before_;
+        break;
+      case 2:
+        done = !now && sync_input_before_;
+        break;
+      case 3:
+        done = now;
+        break;
+      case 4:
+        done = !now;
+        break;
+      default:
+        done = true;
+        break;
+    }
+    sync_input_before_ = now;
+    result = now ? 1.0 : 0.0;
+  }
+  const double waited = static_cast<double>(tick_ - sync_started_tick_) * config_.period_s;
+  if (!done && a.value > 0 && waited >= a.value) {
+    result = -1;
+    done = true;
+  }
+  if (!done) return false;
+  input_value_ = result;
+  ServoEvent e;
+  e.kind = EventKind::InputRead;
+  e.run_id = run_id_;
+  e.action = a.action;
+  e.value = result;
+  emit(e);
+  return true;
+}
+
+// A probe move (G38.x) stops when the probe trips: the position is latched and the run ends
+// with a controlled stop; the controller continues the program from where the machine stopped.
+void Servo::check_probe() noexcept {
+  if (!caps_.probe || aborting_) return;
+  const traj::MotionBlock* b = block(tick_out_.block_seq);
+  if (b == nullptr || (b->flags & traj::kProbe) == 0) return;
+  if (b->seq != probe_seq_) {  // a new probe move: its result starts afresh
+    probe_seq_ = b->seq;
+    probe_tripped_ = false;
+  }
+  if (!in_.probe || probe_tripped_) return;
+  probe_tripped_ = true;
+  for (int j = 0; j < config_.joint_count; ++j) {
+    const auto uj = static_cast<std::size_t>(j);
+    probe_position_[config_.joints[uj].axis] = feedback_[uj] + offset_[uj];
+  }
+  abort_edge_ = aborting_ = true;
+  ServoEvent e;
+  e.kind = EventKind::ProbeTripped;
+  e.run_id = run_id_;
+  e.segment = tick_out_.segment;
+  emit(e);
+}
+
+void Servo::end_run(RunEnd why) noexcept {
+  traj::BlockQueue& q = channels_->blocks;
+  q.pop(q.available());
+  channels_->actions.drop_until(~std::uint64_t{0});
+  if (why == RunEnd::Aborted && probe_tripped_) why = RunEnd::ProbeTripped;
+  ServoEvent e;
+  e.kind = EventKind::RunEnded;
+  e.run_id = run_id_;
+  e.run_end = why;
+  e.segment = tick_out_.segment;
+  emit(e);
+  activity_ = Activity::None;
+  hold_ = aborting_ = cycle_start_edge_ = abort_edge_ = sync_done_edge_ = false;
+  sync_step_ = SyncStep::None;
+  wait_ = Wait::None;
+  reset_movers();
+  if (why == RunEnd::Finished || why == RunEnd::Aborted || why == RunEnd::ProbeTripped)
+    set_state(State::Idle);
+}
+
+}  // namespace opencnc::control

@@ -1,0 +1,139 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Servo::tick() must not allocate: this executable replaces operator new and counts the calls
+// made inside the tick while the whole controller runs homing, jogs, MDI, a program with every
+// kind of marker, holds, overrides, faults and an e-stop (the controller's work between ticks
+// may allocate).
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <new>
+
+#include "opencnc/controller/gcode_source.hpp"
+#include "opencnc/controller/sim_rig.hpp"
+#include "test_profiles.hpp"
+
+namespace {
+std::atomic<bool> g_armed{false};
+std::atomic<long> g_allocations{0};
+
+void* counted_alloc(std::size_t n) {
+  if (g_armed.load(std::memory_order_relaxed)) g_allocations.fetch_add(1, std::memory_order_relaxed);
+  if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
+  throw std::bad_alloc();
+}
+}  // namespace
+
+void* operator new(std::size_t n) {
+  return counted_alloc(n);
+}
+void* operator new[](std::size_t n) {
+  return counted_alloc(n);
+}
+void operator delete(void* p) noexcept {
+  std::free(p);
+}
+void operator delete[](void* p) noexcept {
+  std::free(p);
+}
+void operator delete(void* p, std::size_t) noexcept {
+  std::free(p);
+}
+void operator delete[](void* p, std::size_t) noexcept {
+  std::free(p);
+}
+
+namespace opencnc::control::test {
+namespace {
+
+/// The whole controller, with only the servo's ticks armed.
+class Armed {
+ public:
+  explicit Armed(const config::MachineProfile& p) {
+    Diagnostics d;
+    rig_ = std::make_unique<SimRig>(p, GcodeProgramSource::create(p, d));
+    rig_->channels().trace_enabled = true;
+  }
+  void tick() {
+    rig_->controller().service();
+    TraceSample t;
+    while (rig_->channels().trace.try_pop(t)) {
+    }
+    g_armed = true;
+    rig_->servo().tick();
+    g_armed = false;
+  }
+  bool until(const std::function<bool()>& done, int max) {
+    for (int i = 0; i < max; ++i) {
+      tick();
+      if (done()) return true;
+    }
+    return false;
+  }
+  void ask(Request r) {
+    const std::uint64_t id = rig_->controller().submit(std::move(r));
+    until([&] { return rig_->controller().outcome(id).has_value(); }, 100);
+  }
+  State state() const { return rig_->status().servo.state; }
+  bool idle() {
+    return until([&] { return state() == State::Idle && !rig_->status().run_active; }, 200000);
+  }
+  SimRig& rig() { return *rig_; }
+
+ private:
+  std::unique_ptr<SimRig> rig_;
+};
+
+TEST(ServoAllocations, NoneInsideTheTick) {
+  const auto dir = std::filesystem::temp_directory_path() / "opencnc-noalloc";
+  std::filesystem::create_directories(dir);
+  const std::string program = (dir / "all.ngc").string(), tools = (dir / "tools.tbl").string();
+  std::ofstream(tools) << "T2 P2 Z0\n";
+  std::ofstream(program) << "G21 G90 G64 P0.05\nS2000 M3\nM8\nT2 M6\nG0 X250 Y20 Z-10\nG1 X260 F3000\n"
+                            "M62 P1\nG2 X270 Y30 I0 J10\nM1\nG3 X260 Y40 Z-12 I-10 J0\nM63 P1\nM66 P0 L0\n"
+                            "G4 P0.05\nM0\nG1 X250 Y20\nM9\nM5\nM2\n";
+  g_allocations = 0;
+  Armed a(homing_mill({"interpreter.tool_table=\"" + tools + "\""}));
+  a.ask(Request::simple(CommandKind::MachineOn));
+  a.ask(Request::set_mode(Mode::Manual));
+  a.ask(Request::on_axis(CommandKind::Home, -1));
+  ASSERT_TRUE(a.idle());
+  a.ask(Request::jog(Axis::X, -30));
+  a.until([] { return false; }, 300);
+  a.ask(Request::on_axis(CommandKind::JogStop, -1));
+  ASSERT_TRUE(a.idle());
+  a.ask(Request::set_mode(Mode::Mdi));
+  a.ask(Request::mdi("G91 G1 Y2 F600"));
+  ASSERT_TRUE(a.idle());
+  a.ask(Request::set_mode(Mode::Auto));
+  a.ask(Request::flag_of(CommandKind::SetOptionalStop, true));
+  a.ask(Request::open(program));
+  a.ask(Request::simple(CommandKind::CycleStart));
+  int n = 0;
+  ASSERT_TRUE(a.until(
+      [&] {
+        ++n;
+        if (n == 900) a.ask(Request::value_of(CommandKind::SetFeedOverride, 1.7));
+        if (n == 2000) a.ask(Request::simple(CommandKind::FeedHold));
+        if (n == 2300) a.ask(Request::simple(CommandKind::Resume));
+        if (a.state() == State::Stopped) a.ask(Request::simple(CommandKind::CycleStart));
+        return a.state() == State::Idle && !a.rig().status().run_active;
+      },
+      200000));
+  EXPECT_EQ(a.rig().status().runs_finished, 2u);  // the MDI line and the program
+  EXPECT_NEAR(a.rig().status().servo.commanded[Axis::X], 250.0, 1e-9);
+  EXPECT_EQ(a.rig().status().servo.tool, 2);
+  a.rig().machine().set_amp_fault(0, true);
+  a.until([] { return false; }, 5);
+  a.rig().machine().set_estop_pressed(true);
+  a.until([] { return false; }, 5);
+  EXPECT_EQ(a.state(), State::EStopped);
+  EXPECT_EQ(g_allocations.load(), 0);
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace opencnc::control::test

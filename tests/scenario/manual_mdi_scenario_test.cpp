@@ -1,0 +1,132 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The controller's API in Manual and MDI mode: jogs and homing through requests, MDI lines that
+// keep their modal state and start where the machine stands, faults reported in words.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "../control/test_profiles.hpp"
+#include "scenario.hpp"
+
+namespace opencnc::control::test {
+namespace {
+
+TEST(MdiScenario, LinesRunOneAfterAnotherWithTheirModalState) {
+  Scenario s(mill());
+  s.on(Mode::Mdi);
+  s.must(Request::mdi("G21 G90 G0 X10 Y5"));
+  ASSERT_TRUE(s.idle());
+  EXPECT_NEAR(s.status().servo.commanded[Axis::X], 10.0, 1e-9);
+  EXPECT_NEAR(s.status().servo.commanded[Axis::Y], 5.0, 1e-9);
+  s.must(Request::mdi("G1 X20 F600"));
+  ASSERT_TRUE(s.idle());
+  EXPECT_NEAR(s.status().servo.commanded[Axis::X], 20.0, 1e-9);
+  s.must(Request::mdi("G91"));  // modal: the next line is incremental
+  ASSERT_TRUE(s.idle());
+  s.forget_samples();
+  s.must(Request::mdi("X-5"));  // and still G1 at F600
+  ASSERT_TRUE(s.idle());
+  EXPECT_NEAR(s.status().servo.commanded[Axis::X], 15.0, 1e-9);
+  double fastest = 0;  // still F600: 10 mm/s
+  for (std::size_t i = 1; i < s.samples().size(); ++i)
+    fastest = std::max(
+        fastest, std::fabs(s.samples()[i].commanded[Axis::X] - s.samples()[i - 1].commanded[Axis::X]) / 1e-3);
+  EXPECT_NEAR(fastest, 10.0, 1e-6);
+  s.must(Request::mdi("S2000 M3"));  // the line ends once the spindle is at speed (0.5 s)
+  ASSERT_TRUE(s.idle(20000));
+  EXPECT_EQ(s.status().servo.spindle_direction, machine::SpindleDirection::Clockwise);
+  EXPECT_TRUE(s.status().servo.spindle_at_speed);
+  EXPECT_NEAR(s.status().servo.spindle_rpm_actual, 2000, 2000 * 0.02);
+}
+
+TEST(MdiScenario, AfterAJogIncrementalLinesStartWhereTheMachineIs) {
+  Scenario s(mill());
+  s.on(Mode::Mdi);
+  s.must(Request::mdi("G91 G1 X1 F600"));
+  ASSERT_TRUE(s.idle());
+  s.must(Request::set_mode(Mode::Manual));
+  s.must(Request::jog_by(Axis::X, 10, 50));
+  ASSERT_TRUE(s.idle());
+  s.must(Request::set_mode(Mode::Mdi));
+  s.must(Request::mdi("X1"));  // G91 G1 still: 11 + 1
+  ASSERT_TRUE(s.idle());
+  EXPECT_NEAR(s.status().servo.commanded[Axis::X], 12.0, 1e-9);
+}
+
+TEST(MdiScenario, BadLinesAndWrongModesAreRefused) {
+  Scenario s(mill());
+  s.on(Mode::Manual);
+  EXPECT_EQ(s.ask(Request::mdi("G0 X1")).refusal, Refusal::WrongMode);
+  s.must(Request::set_mode(Mode::Mdi));
+  const Outcome o = s.ask(Request::mdi("G1 X1 Q"));
+  EXPECT_EQ(o.refusal, Refusal::ProgramError);
+  ASSERT_FALSE(o.diagnostics.items().empty());
+  EXPECT_EQ(o.diagnostics.items().front().file, "<mdi>");
+  const Outcome far = s.ask(Request::mdi("G0 X5000"));  // beyond the 2000 mm soft limit
+  EXPECT_EQ(far.refusal, Refusal::SoftLimit);
+  s.ticks(50);
+  EXPECT_EQ(s.status().servo.commanded, Pose{});
+  EXPECT_EQ(s.ask(Request::jog(Axis::X, 10)).refusal, Refusal::WrongMode);
+}
+
+TEST(ManualScenario, JogThroughTheControllerAndStopAtTheLimit) {
+  Scenario s(mill({"axis.y.max_limit=12.0"}));
+  s.on(Mode::Manual);
+  s.must(Request::jog(Axis::Y, 40));
+  ASSERT_TRUE(s.idle(5000));
+  EXPECT_EQ(s.status().servo.commanded[Axis::Y], 12.0);
+  s.must(Request::jog(Axis::Y, -40));
+  s.ticks(100);
+  s.must(Request::on_axis(CommandKind::JogStop, index(Axis::Y)));
+  ASSERT_TRUE(s.idle(5000));
+  EXPECT_LT(s.status().servo.commanded[Axis::Y], 12.0);
+  s.must(Request::jog_by(Axis::Y, 100, 40));  // clamped at the limit
+  ASSERT_TRUE(s.idle(5000));
+  EXPECT_EQ(s.status().servo.commanded[Axis::Y], 12.0);
+}
+
+TEST(ManualScenario, ManualSpindleAndCoolant) {
+  Scenario s(mill());
+  s.on(Mode::Manual);
+  Request on = Request::value_of(CommandKind::SpindleOn, 1200);
+  on.flag = true;
+  s.must(on);
+  Request flood = Request::flag_of(CommandKind::Coolant, true);
+  flood.axis = 0;
+  s.must(flood);
+  s.ticks(2000);
+  EXPECT_NEAR(s.status().servo.spindle_rpm_actual, 1200, 30);
+  EXPECT_TRUE(s.status().servo.flood);
+  s.must(Request::simple(CommandKind::SpindleOff));
+  s.must(Request::simple(CommandKind::EStop));  // e-stop also stops coolant
+  s.ticks(2);
+  EXPECT_FALSE(s.status().servo.flood);
+  EXPECT_EQ(s.status().servo.spindle_direction, machine::SpindleDirection::Stopped);
+}
+
+TEST(ManualScenario, FaultsAreReportedInWordsNamingTheAxis) {
+  Scenario s(mill({"power.ups=true"}));
+  s.on(Mode::Manual);
+  s.sim().set_amp_fault(1, true);
+  s.ticks(3);
+  const ControllerStatus st = s.status();
+  EXPECT_EQ(st.servo.state, State::Faulted);
+  EXPECT_NE(st.fault_text.find("Y drive"), std::string::npos) << st.fault_text;
+  bool noted = false;
+  for (const Note& n : s.rig().controller().take_notes())
+    noted = noted || n.code == "control.fault.amplifier";
+  EXPECT_TRUE(noted);
+  s.sim().set_amp_fault(1, false);
+  s.ticks(2);
+  s.must(Request::simple(CommandKind::Reset));
+  s.must(Request::simple(CommandKind::MachineOn));
+  s.sim().set_mains_ok(false);
+  s.ticks(3);
+  EXPECT_EQ(s.status().servo.fault.kind, FaultKind::PowerLoss);
+  EXPECT_NE(s.status().fault_text.find("power failure"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace opencnc::control::test

@@ -1,0 +1,425 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Whole programs through the whole controller on the simulated machine: to the end within the
+// limits, feed hold in a blend, abort, e-stop, soft-limit preflight, overrides, single block,
+// M1, machine I/O of the program (spindle, coolant, outputs, tool change, M66), probing, and
+// bit-for-bit repeatable runs.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+
+#include <fmt/format.h>
+#include <string>
+
+#include "../control/test_profiles.hpp"
+#include "opencnc/canon/program_builder.hpp"
+#include "scenario.hpp"
+
+namespace opencnc::control::test {
+namespace {
+
+/// Square, arc, helix, spindle, coolant, an output, a dwell.
+const char* kPart = R"(G21 G90 G17 G64 P0.01
+S3000 M3
+M8
+G0 X10 Y10 Z5
+G1 Z-1 F600
+M62 P1
+G1 X60 F3000
+G2 X80 Y30 I0 J20
+G3 X60 Y50 Z-2 I-20 J0
+G1 X10
+M63 P1
+G4 P0.2
+G1 Y10
+G0 Z5
+M9
+M5
+M2
+)";
+
+TEST(RunScenario, ProgramRunsToTheEndWithinTheLimits) {
+  Scenario s(mill());
+  TempProgram p("part.ngc", kPart);
+  s.on(Mode::Auto);
+  ASSERT_TRUE(s.run_file(p.path())) << s.message();
+  const ControllerStatus st = s.status();
+  EXPECT_EQ(st.servo.state, State::Idle);
+  EXPECT_NEAR(st.servo.commanded[Axis::Z], 5.0, 1e-9);
+  EXPECT_FALSE(st.servo.flood);
+  EXPECT_EQ(st.servo.digital_out, 0u);
+  const auto program = s.rig().controller().open_program();
+  const RunReport r = s.report(*program);
+  EXPECT_EQ(r.limit_violations, 0u);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_LE(r.axes[static_cast<std::size_t>(i)].max_velocity, 100 * (1 + 1e-6));
+    EXPECT_LE(r.axes[static_cast<std::size_t>(i)].max_acceleration, 1000 * (1 + 1e-6));
+  }
+  EXPECT_LE(r.max_command_contour_error_mm, 0.01 + 1e-6);  // G64 P0.01
+  EXPECT_LE(r.max_contour_error_mm, 0.05);                 // the drives follow within tens of µm
+  EXPECT_LE(r.max_following_error_mm, 0.05);
+  EXPECT_GT(r.max_following_error_mm, 0.0);
+  // The spindle ran up (2 s to 3000 rpm at 4000 rpm/s is 0.75 s) before the first cut, and the
+  // dwell waited: the run takes longer than its moves.
+  EXPECT_GT(r.machining_time_s, r.motion_time_s);
+  // M62 P1 switched output 1 on exactly while the cut from X10 to X60 ... X10 ran.
+  bool seen_on = false;
+  for (const TraceSample& t : s.samples()) seen_on = seen_on || t.line == 7;
+  EXPECT_TRUE(seen_on);
+}
+
+// G64 without P takes the profile's default tolerance (0.01 mm on the mill), in an inch program
+// as in a metric one.
+TEST(RunScenario, DefaultToleranceAppliesInInchProgramsToo) {
+  for (const char* units : {"G21", "G20"}) {
+    Scenario s(mill());
+    const double side = std::string(units) == "G20" ? 2.0 : 50.8;
+    TempProgram p("sq.ngc",
+                  fmt::format("{} G90 G64\nG0 X0 Y0\nG1 X{} F200\nY{}\nX0\nY0\nM2\n", units, side, side));
+    s.on(Mode::Auto);
+    ASSERT_TRUE(s.run_file(p.path())) << s.message();
+    const RunReport r = s.report(*s.rig().controller().open_program());
+    EXPECT_LE(r.max_command_contour_error_mm, 0.01 + 1e-6) << units;
+    EXPECT_GT(r.max_command_contour_error_mm, 0.005) << units;  // the corners were blended
+  }
+}
+
+TEST(RunScenario, OutputsFollowThePathMarkers) {
+  Scenario s(mill());
+  TempProgram p("io.ngc", "G0 X0 Y0\nF3000\nM64 P2\nG1 X10\nM62 P0\nG1 X20\nM63 P0\nG1 X30\nM65 P2\nM2\n");
+  s.on(Mode::Auto);
+  s.must(Request::open(p.path()));
+  s.must(Request::simple(CommandKind::CycleStart));
+  std::vector<std::pair<double, std::uint64_t>> changes;
+  std::uint64_t last = 0;
+  ASSERT_TRUE(s.until(
+      [&] {
+        const ServoStatus& v = s.status().servo;
+        if (v.digital_out != last) changes.emplace_back(v.commanded[Axis::X], v.digital_out);
+        last = v.digital_out;
+        return !s.status().run_active && v.state == State::Idle;
+      },
+      20000));
+  ASSERT_EQ(changes.size(), 4u);
+  EXPECT_NEAR(changes[0].first, 0.0, 0.01);  // M64 P2 before the first move
+  EXPECT_EQ(changes[0].second, 4u);
+  EXPECT_NEAR(changes[1].first, 10.0, 0.01);  // M62 P0 as the path passes X10
+  EXPECT_EQ(changes[1].second, 5u);
+  EXPECT_NEAR(changes[2].first, 20.0, 0.05);
+  EXPECT_EQ(changes[2].second, 4u);
+  EXPECT_EQ(changes[3].second, 0u);
+}
+
+// Feed hold in the blend of a corner: the motion stops on the blended path and goes on from
+// there; the commanded position never jumps.
+TEST(RunScenario, FeedHoldInABlendThenResumeStaysOnThePath) {
+  Scenario s(mill());
+  TempProgram p("sq.ngc", "G21 G90 G64 P0.5\nG0 X0 Y0\nF1200\nG1 X100\nY100\nM2\n");
+  s.on(Mode::Auto);
+  s.must(Request::open(p.path()));
+  s.must(Request::simple(CommandKind::CycleStart));
+  // At 20 mm/s the corner is a fillet of about 0.42 mm radius (the speed's centripetal limit):
+  // hold as the path enters it, so that the stop (0.2 mm) lands inside.
+  ASSERT_TRUE(s.until([&] { return s.status().servo.commanded[Axis::X] > 99.6; }, 10000));
+  s.must(Request::simple(CommandKind::FeedHold));
+  ASSERT_TRUE(s.until([&] { return s.status().servo.motion == traj::RunState::Held; }, 5000));
+  EXPECT_EQ(s.status().servo.state, State::Held);
+  const Pose held = s.status().servo.commanded;
+  EXPECT_GT(held[Axis::Y], 0.0);  // inside the blend
+  EXPECT_LT(held[Axis::X], 100.0);
+  s.ticks(300);
+  EXPECT_EQ(s.status().servo.commanded, held);
+  s.must(Request::simple(CommandKind::Resume));
+  ASSERT_TRUE(s.idle(20000));
+  EXPECT_NEAR(s.status().servo.commanded[Axis::Y], 100.0, 1e-9);
+  const RunReport r = s.report(*s.rig().controller().open_program());
+  EXPECT_EQ(r.limit_violations, 0u);
+  EXPECT_LE(r.max_command_contour_error_mm, 0.5 + 1e-6);
+  for (std::size_t i = 1; i < s.samples().size(); ++i) {  // continuous: at most v·T per period
+    const Pose& a = s.samples()[i - 1].commanded;
+    const Pose& b = s.samples()[i].commanded;
+    EXPECT_LE(std::hypot(b[0] - a[0], b[1] - a[1]), 0.02 * (1 + 1e-6)) << i;
+  }
+}
+
+TEST(RunScenario, AbortIsAControlledStopOnThePath) {
+  Scenario s(mill());
+  TempProgram p("line.ngc", "G0 X0 Y0\nG1 X100 Y50 F6000\nM2\n");
+  s.on(Mode::Auto);
+  s.must(Request::open(p.path()));
+  s.must(Request::simple(CommandKind::CycleStart));
+  ASSERT_TRUE(s.until([&] { return s.status().servo.commanded[Axis::X] > 30; }, 10000));
+  s.must(Request::simple(CommandKind::Abort));
+  ASSERT_TRUE(s.idle(5000));
+  const Pose at = s.status().servo.commanded;
+  EXPECT_LT(at[Axis::X], 100.0);
+  EXPECT_NEAR(at[Axis::Y], at[Axis::X] / 2, 1e-9);  // on the line
+  EXPECT_FALSE(s.status().run_active);
+  EXPECT_EQ(s.rig().channels().blocks.available(), 0u);
+  const RunReport r = s.report(*s.rig().controller().open_program());
+  EXPECT_EQ(r.limit_violations, 0u);
+  // Cycle start runs the program again, from where the machine stands.
+  ASSERT_TRUE(s.start_and_finish());
+  EXPECT_NEAR(s.status().servo.commanded[Axis::X], 100.0, 1e-9);
+}
+
+TEST(RunScenario, EstopMidMoveRefusesMotionUntilReset) {
+  Scenario s(mill());
+  TempProgram p("line.ngc", "G1 X100 F3000\nM2\n");
+  s.on(Mode::Auto);
+  s.must(Request::open(p.path()));
+  s.must(Request::simple(CommandKind::CycleStart));
+  s.ticks(300);
+  s.must(Request::simple(CommandKind::EStop));
+  s.ticks(2);
+  EXPECT_EQ(s.status().servo.state, State::EStopped);
+  EXPECT_FALSE(s.status().run_active);
+  const Outcome o = s.ask(Request::simple(CommandKind::CycleStart));
+  EXPECT_FALSE(o.accepted);
+  EXPECT_EQ(o.refusal, Refusal::EStopActive);
+  s.ticks(2000);  // the axes coast to rest without power; the command follows them
+  EXPECT_NEAR(s.status().servo.commanded[Axis::X], s.status().servo.actual[Axis::X], 1e-9);
+  EXPECT_EQ(s.rig().machine().joint(0).velocity(), 0.0);
+  s.must(Request::simple(CommandKind::Reset));
+  s.must(Request::simple(CommandKind::MachineOn));
+  ASSERT_TRUE(s.start_and_finish());
+}
+
+TEST(RunScenario, SoftLimitPreflightRejectsTheProgramAndNothingMoves) {
+  Scenario s(mill({"axis.x.max_limit=45.0"}));
+  // The arc's end points are inside, its extent is not: centre (40, 10), radius 10 reaches X50.
+  TempProgram p("bulge.ngc", "G0 X40 Y0\nG3 X40 Y20 I0 J10 F1000\nM2\n");
+  s.on(Mode::Auto);
+  const Outcome o = s.ask(Request::open(p.path()));
+  EXPECT_FALSE(o.accepted);
+  EXPECT_EQ(o.refusal, Refusal::SoftLimit);
+  const Diagnostic* err = nullptr;
+  for (const Diagnostic& x : o.diagnostics.items()) {
+    if (x.severity == Severity::Error && err == nullptr) err = &x;
+  }
+  ASSERT_NE(err, nullptr);
+  const Diagnostic& d = *err;
+  EXPECT_EQ(d.code, "control.soft-limit");
+  EXPECT_EQ(d.line, 2u);
+  EXPECT_NE(d.file.find("bulge.ngc"), std::string::npos);
+  EXPECT_EQ(s.ask(Request::simple(CommandKind::CycleStart)).refusal, Refusal::NoProgram);
+  s.ticks(100);
+  for (const TraceSample& t : s.samples()) EXPECT_EQ(t.commanded, Pose{});
+}
+
+TEST(RunScenario, FeedOverrideScalesTheFeedAndZeroHolds) {
+  Scenario s(mill());
+  TempProgram p("slow.ngc", "G1 X20 F600\nM2\n");  // 10 mm/s: 2 s
+  s.on(Mode::Auto);
+  s.must(Request::open(p.path()));
+  s.must(Request::value_of(CommandKind::SetFeedOverride, 0.5));
+  ASSERT_TRUE(s.start_and_finish());
+  const RunReport half = s.report(*s.rig().controller().open_program());
+  EXPECT_NEAR(half.motion_time_s, 4.0, 0.02);
+  EXPECT_NEAR(half.axes[0].max_velocity, 5.0, 1e-6);
+  s.must(Request::value_of(CommandKind::SetFeedOverride, 2.0));
+  ASSERT_TRUE(s.run_file(p.path()));  // from X20 back... no: the same absolute end, so no motion
+  s.must(Request::value_of(CommandKind::SetFeedOverride, 0.0));
+  TempProgram back("back.ngc", "G1 X0 F600\nM2\n");
+  s.must(Request::open(back.path()));
+  s.must(Request::simple(CommandKind::CycleStart));
+  s.ticks(500);
+  EXPECT_EQ(s.status().servo.commanded[Axis::X], 20.0);  // 0 %: nothing moves
+  s.must(Request::value_of(CommandKind::SetFeedOverride, 2.0));
+  ASSERT_TRUE(s.idle(5000));
+  const RunReport twice = s.report(*s.rig().controller().open_program());
+  EXPECT_NEAR(twice.axes[0].max_velocity, 20.0, 1e-6);
+  EXPECT_EQ(s.ask(Request::value_of(CommandKind::SetFeedOverride, 2.5)).refusal, Refusal::BadValue);
+}
+
+TEST(RunScenario, RapidOverrideScalesRapids) {
+  Scenario s(mill());
+  TempProgram p("rapid.ngc", "G0 X50\nM2\n");
+  s.on(Mode::Auto);
+  s.must(Request::value_of(CommandKind::SetRapidOverride, 0.25));
+  ASSERT_TRUE(s.run_file(p.path()));
+  const RunReport r = s.report(*s.rig().controller().open_program());
+  EXPECT_NEAR(r.axes[0].max_velocity, 25.0, 1e-6);
+}
+
+TEST(RunScenario, SingleBlockStopsAfterEveryMove) {
+  Scenario s(mill());
+  TempProgram p("three.ngc", "G61\nG1 X10 F3000\nY10\nX0\nM2\n");  // exact path: stops at the ends
+  s.on(Mode::Auto);
+  s.must(Request::flag_of(CommandKind::SetSingleBlock, true));
+  s.must(Request::open(p.path()));
+  s.must(Request::simple(CommandKind::CycleStart));
+  const Pose ends[] = {[] {
+                         Pose q;
+                         q[0] = 10;
+                         return q;
+                       }(),
+                       [] {
+                         Pose q;
+                         q[0] = 10;
+                         q[1] = 10;
+                         return q;
+                       }()};
+  for (const Pose& end : ends) {
+    ASSERT_TRUE(s.until([&] { return s.status().servo.state == State::Stopped; }, 10000));
+    EXPECT_EQ(s.status().servo.stop_reason, StopReason::SingleBlock);
+    EXPECT_NEAR(s.status().servo.commanded[Axis::X], end[Axis::X], 1e-9);
+    EXPECT_NEAR(s.status().servo.commanded[Axis::Y], end[Axis::Y], 1e-9);
+    s.must(Request::simple(CommandKind::CycleStart));
+  }
+  s.must(Request::flag_of(CommandKind::SetSingleBlock, false));
+  ASSERT_TRUE(s.idle(10000));
+  EXPECT_NEAR(s.status().servo.commanded[Axis::X], 0.0, 1e-9);
+}
+
+TEST(RunScenario, OptionalStopWaitsOnlyWhenTheSwitchIsOn) {
+  TempProgram p("m1.ngc", "G1 X5 F3000\nM1\nG1 X10\nM2\n");
+  for (const bool on : {false, true}) {
+    Scenario s(mill());
+    s.on(Mode::Auto);
+    s.must(Request::flag_of(CommandKind::SetOptionalStop, on));
+    s.must(Request::open(p.path()));
+    s.must(Request::simple(CommandKind::CycleStart));
+    const bool stopped = s.until([&] { return s.status().servo.state == State::Stopped; }, 3000);
+    EXPECT_EQ(stopped, on);
+    if (on) {
+      EXPECT_EQ(s.status().servo.stop_reason, StopReason::OptionalStop);
+      EXPECT_NEAR(s.status().servo.commanded[Axis::X], 5.0, 1e-9);
+      s.must(Request::simple(CommandKind::CycleStart));
+    }
+    ASSERT_TRUE(s.idle(5000));
+    EXPECT_NEAR(s.status().servo.commanded[Axis::X], 10.0, 1e-9);
+  }
+}
+
+TEST(RunScenario, ProgramStopAndBlockDelete) {
+  Scenario s(mill());
+  TempProgram p("m0.ngc", "G1 X5 F3000\n/G1 Y5\nM0\nG1 X10\nM2\n");
+  s.on(Mode::Auto);
+  s.must(Request::flag_of(CommandKind::SetBlockDelete, true));
+  s.must(Request::open(p.path()));
+  s.must(Request::simple(CommandKind::CycleStart));
+  ASSERT_TRUE(s.until([&] { return s.status().servo.state == State::Stopped; }, 5000));
+  EXPECT_EQ(s.status().servo.stop_reason, StopReason::ProgramStop);
+  EXPECT_EQ(s.status().servo.commanded[Axis::Y], 0.0);  // the '/' line was skipped
+  s.must(Request::simple(CommandKind::CycleStart));
+  ASSERT_TRUE(s.idle(5000));
+  EXPECT_NEAR(s.status().servo.commanded[Axis::X], 10.0, 1e-9);
+}
+
+/// A tool table with tools 3 and 7, as a profile override.
+std::string tool_table(const TempProgram& t) {
+  return "interpreter.tool_table=\"" + t.path() + "\"";
+}
+
+TEST(RunScenario, ManualToolChangeWaitsForTheOperator) {
+  TempProgram tools("tools.tbl", "T3 P3 Z0\nT7 P7 Z0\n");
+  Scenario s(mill({tool_table(tools)}));
+  TempProgram p("tool.ngc", "T3 M6\nG1 X5 F3000\nM2\n");
+  s.on(Mode::Auto);
+  s.must(Request::open(p.path()));
+  s.must(Request::simple(CommandKind::CycleStart));
+  ASSERT_TRUE(s.until([&] { return s.status().servo.wait == Wait::ManualToolChange; }, 2000));
+  s.ticks(500);
+  EXPECT_EQ(s.status().servo.commanded[Axis::X], 0.0);
+  s.must(Request::simple(CommandKind::ToolChanged));
+  ASSERT_TRUE(s.idle(5000));
+  EXPECT_EQ(s.status().servo.tool, 3);
+  EXPECT_NEAR(s.status().servo.commanded[Axis::X], 5.0, 1e-9);
+}
+
+TEST(RunScenario, WaitForInputReadsTheMachine) {
+  Scenario s(mill());
+  // M66 P1 L3 Q5: wait up to 5 s for input 1 high; then M66 P2 L1 Q0.1 times out.
+  TempProgram p("m66.ngc", "M66 P1 L3 Q5\nG1 X5 F3000\nM66 P2 L1 Q0.1\nG1 X6\nM2\n");
+  s.on(Mode::Auto);
+  s.must(Request::open(p.path()));
+  s.must(Request::simple(CommandKind::CycleStart));
+  ASSERT_TRUE(s.until([&] { return s.status().servo.wait == Wait::Input; }, 2000));
+  s.ticks(300);
+  EXPECT_EQ(s.status().servo.commanded[Axis::X], 0.0);
+  s.sim().set_digital_input(1, true);
+  ASSERT_TRUE(s.idle(10000));
+  EXPECT_NEAR(s.status().servo.commanded[Axis::X], 6.0, 1e-9);
+  EXPECT_EQ(s.status().servo.input_value, -1.0);  // the second wait timed out
+}
+
+TEST(RunScenario, ToolChangerHandshake) {
+  TempProgram tools("tools.tbl", "T3 P3 Z0\nT7 P7 Z0\n");
+  Scenario s(homing_mill({tool_table(tools)}));
+  s.on(Mode::Manual);
+  s.must(Request::on_axis(CommandKind::Home, -1));
+  ASSERT_TRUE(s.idle(120000));
+  s.must(Request::set_mode(Mode::Auto));
+  TempProgram p("tc.ngc", "T7\nG1 X280 F3000\nM6\nG1 X270\nM2\n");
+  s.must(Request::open(p.path()));
+  ASSERT_TRUE(s.start_and_finish());
+  EXPECT_EQ(s.status().servo.tool, 7);
+  EXPECT_EQ(s.sim().cycle() > 0, true);
+}
+
+TEST(RunScenario, AutoIsRefusedUntilHomedThenRuns) {
+  Scenario s(homing_mill());
+  TempProgram p("p.ngc", "G1 X280 F3000\nM2\n");
+  s.on(Mode::Auto);
+  s.must(Request::open(p.path()));
+  EXPECT_EQ(s.ask(Request::simple(CommandKind::CycleStart)).refusal, Refusal::NotHomed);
+  s.must(Request::set_mode(Mode::Manual));
+  s.must(Request::on_axis(CommandKind::Home, -1));
+  ASSERT_TRUE(s.idle(120000));
+  s.must(Request::set_mode(Mode::Auto));
+  ASSERT_TRUE(s.start_and_finish());
+  EXPECT_NEAR(s.status().servo.commanded[Axis::X], 280.0, 1e-9);
+}
+
+// A probe move (G38.2, built from canonical calls: the interpreter's probing module is still to
+// come) toward a part whose top the probe meets at machine Z −145 (the sim's probe window is at
+// table −100, and homing put machine Z at table − 45): the move stops there, the position is
+// latched, and the rest of the program runs from where the machine stopped.
+TEST(RunScenario, ProbeTripStopsTheMoveAndTheProgramGoesOn) {
+  Scenario s(homing_mill());
+  s.on(Mode::Manual);
+  s.must(Request::on_axis(CommandKind::Home, -1));
+  ASSERT_TRUE(s.idle(120000));
+  s.must(Request::set_mode(Mode::Auto));
+  canon::ProgramBuilder b(AxisMask::from_letters("XYZ"), s.status().servo.commanded);
+  Pose at = s.status().servo.commanded;
+  b.set_feed_rate(300);
+  at[Axis::Z] = -180;
+  b.straight_probe(0, at);
+  at[Axis::Z] = -100;
+  b.straight_traverse(1, at);
+  at[Axis::X] = 280;
+  b.straight_traverse(2, at);
+  b.program_end();
+  s.must(Request::open(std::make_shared<canon::Program>(b.take()), "probe"));
+  ASSERT_TRUE(s.start_and_finish());
+  const ServoStatus& v = s.status().servo;
+  ASSERT_TRUE(v.probe_tripped);
+  EXPECT_NEAR(v.probe_position[Axis::Z], -145.0, 0.01);
+  double lowest = 0;
+  for (const TraceSample& t : s.samples()) lowest = std::min(lowest, t.commanded[Axis::Z]);
+  EXPECT_GT(lowest, -145.0 - 0.05);  // stopped within the braking distance at 5 mm/s
+  EXPECT_NEAR(v.commanded[Axis::Z], -100.0, 1e-9);
+  EXPECT_NEAR(v.commanded[Axis::X], 280.0, 1e-9);
+}
+
+TEST(RunScenario, VirtualTimeRunsAreBitForBitRepeatable) {
+  TempProgram p("part.ngc", kPart);
+  std::vector<TraceSample> first;
+  for (int run = 0; run < 2; ++run) {
+    Scenario s(mill());
+    s.on(Mode::Auto);
+    s.must(Request::value_of(CommandKind::SetFeedOverride, 1.3));
+    ASSERT_TRUE(s.run_file(p.path()));
+    if (run == 0) {
+      first = s.samples();
+      continue;
+    }
+    ASSERT_EQ(s.samples().size(), first.size());
+    EXPECT_EQ(std::memcmp(s.samples().data(), first.data(), first.size() * sizeof(TraceSample)), 0);
+  }
+}
+
+}  // namespace
+}  // namespace opencnc::control::test

@@ -1,0 +1,131 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Scenario harness: the whole controller (G-code source, controller, servo, simulated machine)
+// in virtual time, with the run's trace recorded, and G-code programs written to a temp folder.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "opencnc/controller/gcode_source.hpp"
+#include "opencnc/controller/run_recorder.hpp"
+#include "opencnc/controller/servo_setup.hpp"
+#include "opencnc/controller/sim_rig.hpp"
+
+namespace opencnc::control::test {
+
+inline std::ostream& operator<<(std::ostream& os, State s) {
+  return os << to_string(s);
+}
+
+/// A G-code file in a folder of its own; removed with the object.
+class TempProgram {
+ public:
+  TempProgram(const std::string& name, const std::string& text) {
+    dir_ = std::filesystem::temp_directory_path() /
+           ("opencnc-scenario-" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "-" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    std::filesystem::create_directories(dir_);
+    path_ = (dir_ / name).string();
+    std::ofstream(path_) << text;
+  }
+  ~TempProgram() {
+    std::error_code ec;
+    std::filesystem::remove_all(dir_, ec);
+  }
+  const std::string& path() const { return path_; }
+
+ private:
+  std::filesystem::path dir_;
+  std::string path_;
+};
+
+class Scenario {
+ public:
+  explicit Scenario(const config::MachineProfile& profile) : profile_(profile) {
+    Diagnostics d;
+    auto source = GcodeProgramSource::create(profile, d);
+    EXPECT_TRUE(source != nullptr);
+    rig_ = std::make_unique<SimRig>(profile, source);
+    rig_->channels().trace_enabled = true;
+  }
+
+  Outcome ask(Request r) {
+    const Outcome o = rig_->request(std::move(r));
+    std::string why = o.message;
+    for (const auto& d : o.diagnostics.items()) why += "\n  " + d.format();
+    last_message_ = why;
+    return o;
+  }
+  /// Asserting form: the request must be accepted.
+  void must(Request r) {
+    const CommandKind k = r.kind;
+    const Outcome o = ask(std::move(r));
+    ASSERT_TRUE(o.accepted) << to_string(k) << ": " << last_message_;
+  }
+  void on(Mode m) {
+    must(Request::simple(CommandKind::MachineOn));
+    must(Request::set_mode(m));
+  }
+
+  /// Ticks until `done` (checked after each), recording the trace; whether it held.
+  template <typename F>
+  bool until(F done, std::uint64_t max_ticks) {
+    for (std::uint64_t i = 0; i < max_ticks; ++i) {
+      rig_->step();
+      drain();
+      if (done()) return true;
+    }
+    return false;
+  }
+  void ticks(std::uint64_t n) {
+    until([] { return false; }, n);
+  }
+  /// Opens `path` and runs it to its end (or `max_ticks`).
+  bool run_file(const std::string& path, std::uint64_t max_ticks = 200000) {
+    must(Request::open(path));
+    return start_and_finish(max_ticks);
+  }
+  bool start_and_finish(std::uint64_t max_ticks = 200000) {
+    const std::uint64_t finished = status().runs_finished;
+    samples_.clear();
+    must(Request::simple(CommandKind::CycleStart));
+    return until([&] { return !status().run_active && status().runs_finished > finished; }, max_ticks);
+  }
+  bool idle(std::uint64_t max_ticks = 100000) {
+    return until([&] { return status().servo.state == State::Idle && !status().run_active; }, max_ticks);
+  }
+
+  /// The report of the samples recorded while a run was active (against `program`).
+  RunReport report(const canon::Program& program) const {
+    RunRecorder r(program, machine_limits(profile_), profile_.servo_period_s);
+    for (const TraceSample& s : samples_) {
+      if (s.activity == Activity::Program) r.add(s);
+    }
+    return r.report();
+  }
+
+  ControllerStatus status() const { return rig_->status(); }
+  SimRig& rig() { return *rig_; }
+  machine::SimMachine& sim() { return rig_->machine(); }
+  const std::vector<TraceSample>& samples() const { return samples_; }
+  void forget_samples() { samples_.clear(); }
+  const std::string& message() const { return last_message_; }
+
+ private:
+  void drain() {
+    TraceSample t;
+    while (rig_->channels().trace.try_pop(t)) samples_.push_back(t);
+  }
+
+  config::MachineProfile profile_;
+  std::unique_ptr<SimRig> rig_;
+  std::vector<TraceSample> samples_;
+  std::string last_message_;
+};
+
+}  // namespace opencnc::control::test
