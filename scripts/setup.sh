@@ -12,7 +12,6 @@ packages=(
   libcli11-dev          # command line parsing
   nlohmann-json3-dev    # JSON reports and API
   libtomlplusplus-dev   # machine profiles
-  libsqlite3-dev        # tool tables, history (store layer)
   python3               # helper scripts (program generators, golden regeneration)
 )
 test_packages=(
