@@ -30,10 +30,11 @@ void print_summary(const config::MachineProfile& p) {
   fmt::print("{}: {} axes, servo period {} s, sim {} sub-steps\n", p.name, p.axes.size(), p.servo_period_s,
              p.sim_substeps);
   for (const config::AxisProfile& a : p.axes) {
-    fmt::print("  {} joint {}: {} {}, v {} a {} j {}, limits [{}, {}], {} counts/unit\n", letter(a.axis),
-               a.joint, a.rotary ? "rotary" : "linear",
-               a.drive == machine::JointDrive::Servo ? "servo" : "stepper", a.max_velocity,
-               a.max_acceleration, a.max_jerk, a.min_limit, a.max_limit, a.counts_per_unit);
+    const std::string limits =
+        a.wrapped ? std::string("turns without end") : fmt::format("limits [{}, {}]", a.min_limit, a.max_limit);
+    fmt::print("  {} joint {}: {} {}, v {} a {} j {}, {}, {} counts/unit\n", letter(a.axis), a.joint,
+               a.rotary ? "rotary" : "linear", a.drive == machine::JointDrive::Servo ? "servo" : "stepper",
+               a.max_velocity, a.max_acceleration, a.max_jerk, limits, a.counts_per_unit);
   }
   if (p.spindle.present) fmt::print("  spindle: {}–{} rpm\n", p.spindle.min_rpm, p.spindle.max_rpm);
 }
