@@ -80,7 +80,9 @@ double Engine::fanuc_computed(int index) const {
   // Positions by Fanuc axis number: block end / work position, machine position, tool length
   // offset, servo lag (none). X reads as a diameter while lathe diameter mode is on.
   const int block = (index - 5001) / 20;
-  const int axis = (lathe ? kLatheAxes : kMillAxes)[(index - 5001) % 20];
+  const int slot = (index - 5001) % 20;
+  if (slot >= kAxisCount) return 0.0;   // numbers past the ninth axis of a block
+  const int axis = lathe ? kLatheAxes[slot] : kMillAxes[slot];
   double v = 0;
   switch (block) {
     case 0:

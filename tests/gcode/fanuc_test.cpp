@@ -323,6 +323,16 @@ TEST(FanucVariables, SystemVariablesReadTheState) {
   EXPECT_EQ(rec.zs().back(), 4.0);
 }
 
+TEST(FanucVariables, PositionNumbersPastTheNinthAxisReadZero) {
+  // #5010..#5020 lie between the blocks of nine axes (#5001-#5009, #5021-#5029): they name no axis.
+  Recorder rec;
+  const Outcome r = run(rec, "O1\nG21 G1 X3 Y4 F250\n#1 = #5010\n#2 = #5020\n#3 = #5021\nG1 X#1 Y#2 Z#3\nM30\n");
+  ASSERT_EQ(r.status, RunStatus::Finished) << r.message;
+  EXPECT_EQ(rec.xs().back(), 0.0);
+  EXPECT_EQ(rec.ys().back(), 0.0);
+  EXPECT_EQ(rec.zs().back(), 3.0);   // #5021: machine X
+}
+
 TEST(FanucVariables, AlarmsStopAndMessagesPause) {
   Recorder rec;
   const Outcome r = run(rec, "O1\nG21 F100\nG1 X1\n#3006 = 1 (CHECK PART)\nG1 X2\n#3000 = 15 (TOOL LIFE)\nG1 X3\nM30\n");
