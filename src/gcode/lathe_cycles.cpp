@@ -90,27 +90,12 @@ class ProfileReader {
   bool incremental_ijk_;
 };
 
-// Cutter compensation suspended for one move (restored also when the move fails).
-struct CompensationOff {
-  explicit CompensationOff(ModalState& m) : modal(m), saved(m.cutter_comp) { m.cutter_comp = CutterComp::Off; }
-  ~CompensationOff() { modal.cutter_comp = saved; }
-  CompensationOff(const CompensationOff&) = delete;
-  CompensationOff& operator=(const CompensationOff&) = delete;
-  ModalState& modal;
-  CutterComp saved;
-};
-
 // The cycle's moves as the core's G0/G1/G2/G3 (absolute XZ words: the cycle runs in G90 and
 // G90.1 like LinuxCNC's).
 class CycleMoves final : public lathe::PathSink {
  public:
   explicit CycleMoves(ExecContext& ctx) : ctx_(ctx) {}
   void rapid(Point end) override { move(0, end); }
-  void approach(Point end) override {
-    // LinuxCNC starts each finishing pass with compensation off for this one move.
-    const CompensationOff off(ctx_.state().modal);
-    move(0, end);
-  }
   void feed(Point end) override { move(10, end); }
   void arc(Point end, Point centre, bool ccw) override {
     // Arcs that end where they start are left out (LinuxCNC compares with its 0.0001 EQ tolerance).
@@ -195,25 +180,24 @@ void LatheCycle::execute(ExecContext& ctx, const Block& block, int code) {
   st.modal.distance = DistanceMode::Absolute;
   st.modal.ijk_distance = DistanceMode::Absolute;
   const bool incremental = modes.distance == DistanceMode::Incremental;
-  const Pose before = st.position.current;
-  Point start(before[2], before[0]);
+  Point start(st.position.current[2], st.position.current[0]);
   if (block.has('x')) start.imag(incremental ? start.imag() + block.get('x') : block.get('x'));
   if (block.has('z')) start.real(incremental ? start.real() + block.get('z') : block.get('z'));
 
   // The rapid to the cycle's start: the block's own words, read as absolute (LinuxCNC does
-  // so even in G91), with compensation off.
-  {
-    const CompensationOff off(st.modal);
-    ctx.programmed_move(0, words.block);
-  }
+  // so even in G91). Under G70 with compensation on it is an ordinary compensated move (the
+  // entry move if compensation has just been turned on), as in rs274 2.9.
+  ctx.programmed_move(0, words.block);
 
   ProfileReader reader(start, incremental, modes.ijk == DistanceMode::Incremental);
   constexpr std::uint32_t kProfileLetters = letter_bit('a') | letter_bit('c') | letter_bit('u') | letter_bit('w');
   ctx.read_subprogram(sub_name(ctx, words.block.get('q')), kProfileLetters,
                       [&](const Block& b) { reader.add(ctx, b); });
-  if (reader.profile.size() <= 1) return;   // LinuxCNC leaves the position at the profile's end
-  st.position.current[0] = before[0];
-  st.position.current[2] = before[2];
+  // Reading the profile leaves the position at its end, and rs274 2.9 starts the passes from
+  // there. Only compensation can tell: its tool then stands at the profile's end, so the
+  // pass's rapid to the start point, which the entry move has already reached as programmed,
+  // is a move without motion in the plane and goes to that position.
+  if (reader.profile.size() <= 1) return;
   if (words.i <= 0) ctx.error(ErrorCode::LatheDepth, "I (depth of cut) must be greater than zero");
   run(ctx, words, code, reader.profile, start);
 }

@@ -328,7 +328,6 @@ class FramedSink {
  public:
   FramedSink(PathSink& out, int frame) : out_(out), frame_(frame) {}
   void rapid(Point p) { out_.rapid(map(p)); }
-  void approach(Point p) { out_.approach(map(p)); }
   void feed(Point p) { out_.feed(map(p)); }
   void arc(Point end, Point center, bool ccw) { out_.arc(map(end), map(center), mirrored() ? !ccw : ccw); }
 
@@ -654,7 +653,7 @@ void finish(const Profile& profile, const FinishingParams& params, PathSink& out
         (pass - 1) * (params.first_allowance - params.last_allowance) / params.passes + params.last_allowance;
     Work path = w;
     path.offset_profile(distance);
-    framed.approach(path.pieces.front().a);
+    framed.rapid(path.pieces.front().a);
     framed.rapid(path.pieces.front().b);
     for (std::size_t i = 1; i < path.pieces.size(); ++i) {
       const Piece& p = path.pieces[i];

@@ -14,7 +14,7 @@ using namespace opencnc::gcode::lathe;
 namespace {
 
 struct Move {
-  char kind;   // 'r' rapid, 'a' approach, 'f' feed, 'c' arc
+  char kind;   // 'r' rapid, 'f' feed, 'c' arc
   Point end, center;
   bool ccw = false;
 };
@@ -22,7 +22,6 @@ struct Move {
 class Recorder final : public PathSink {
  public:
   void rapid(Point e) override { moves.push_back({'r', e, {}, false}); }
-  void approach(Point e) override { moves.push_back({'a', e, {}, false}); }
   void feed(Point e) override { moves.push_back({'f', e, {}, false}); }
   void arc(Point e, Point c, bool ccw) override { moves.push_back({'c', e, c, ccw}); }
   std::vector<Move> moves;
@@ -284,9 +283,15 @@ TEST(LatheRoughingProperty, FinishingPassesStepTheAllowance) {
     } catch (const RoughingError&) {
       continue;
     }
-    int approaches = 0;
-    for (const auto& m : out.moves) approaches += m.kind == 'a';
-    EXPECT_EQ(approaches, 1 + trial % 3);
+    // Each pass: a rapid to the start point, a rapid to the pass's first point, then feeds.
+    int rapids = 0, to_start = 0;
+    for (const auto& m : out.moves) {
+      if (m.kind != 'r') continue;
+      to_start += rapids % 2 == 0 && near(m.end, start);
+      ++rapids;
+    }
+    EXPECT_EQ(rapids, 2 * (1 + trial % 3)) << "trial " << trial;
+    EXPECT_EQ(to_start, 1 + trial % 3) << "trial " << trial;
     // The last pass ends where the contour ends.
     EXPECT_TRUE(near(out.moves.back().end, p.back().end, 1e-9)) << "trial " << trial;
     EXPECT_TRUE(near(out.moves.front().end, start)) << "trial " << trial;

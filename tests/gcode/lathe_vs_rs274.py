@@ -3,7 +3,9 @@
 # Differential test of the lathe cycles against LinuxCNC's rs274: seeded random profiles
 # (lines, R arcs, fillets, chamfers, pockets, all four quadrants) through G70/G71/G72 and their
 # .1/.2 variants; compares the motion calls (numbers within 1e-4) and which programs fail.
-"""usage: lathe_vs_rs274.py --opencnc PATH [--seed N] [--count N] [--keep DIR] [--verbose]
+# With --comp: G70 only, under cutter compensation (G41/G42 from a tool table of lathe tools,
+# G41.1/G42.1 with D and L), entered by the cycle's own rapid or by a move before it.
+"""usage: lathe_vs_rs274.py --opencnc PATH [--comp] [--seed N] [--count N] [--keep DIR] [--verbose]
 
 Exit status 0 when every program agrees. Disagreeing programs are written to --keep DIR.
 """
@@ -107,6 +109,59 @@ def program(rng):
     return f"G21 G18 G90 G8 F100\nG0 X{fmt(sx)} Z{fmt(sz)}\no100 sub\n{body}\no100 endsub\n{cycle} Q100 {words}\nG0 X{fmt(sx)} Z{fmt(sz)}\nM2\n"
 
 
+# Lathe tools for --comp: nose diameter D (in inches, rs274's machine units without an ini
+# file; the programs are metric) and orientation Q.
+TOOLS = """T1 P1 D0.016 Q2
+T2 P2 D0.008 Q3
+T3 P3 D0.031 Q9
+T4 P4 D0.012 Q6
+T5 P5 D0.012
+T6 P6 D0.02 Q8
+"""
+
+
+def program_comp(rng):
+    """G70 under compensation: radius and orientation at random, mostly on the side away from
+    the material (the other side often gouges, and both interpreters must say so)."""
+    lines, top, zend = profile(rng)
+    facing = rng.random() < 0.5
+    mirror_x, mirror_z = rng.random() < 0.3, rng.random() < 0.3
+    if facing:
+        lines = transpose(lines)
+        top, zend = -zend, -top
+    lines = transform(lines, mirror_x, mirror_z)
+    sx = (top + rng.uniform(0.5, 3.0)) * (-1 if mirror_x else 1)
+    sz = rng.uniform(0.5, 3.0) * (-1 if mirror_z else 1)
+    # The tool belongs on the start point's side of the contour (its first to last point), in
+    # the (Z, X) plane of G18: left is G41.
+    lx = float(re.search(r"X(-?\d+\.\d+)", lines[-1]).group(1))
+    lz = float(re.search(r"Z(-?\d+\.\d+)", lines[-1]).group(1))
+    fx = float(re.search(r"X(-?\d+\.\d+)", lines[0]).group(1))
+    fz = float(re.search(r"Z(-?\d+\.\d+)", lines[0]).group(1))
+    outside = "G41" if (lz - fz) * (sx - fx) - (lx - fx) * (sz - fz) > 0 else "G42"
+    side = outside if rng.random() < 0.8 else ("G41" if outside == "G42" else "G42")
+    if rng.random() < 0.5:
+        comp = f"{side} D{rng.randint(1, 6)}"
+    else:
+        comp = f"{side}.1 D{fmt(rng.uniform(0.05, 0.8))}"
+        if rng.random() < 0.8:
+            comp += f" L{rng.randint(0, 9)}"
+    # Where the tool waits: where a G71 or G72 over the same profile would have left it (level
+    # with the start point, beside the contour's end), or anywhere near the start point.
+    wx, wz = rng.choice([(sx, lz), (lx, sz), (sx + rng.choice([-1, 1]) * rng.uniform(1.0, 4.0),
+                                                sz + rng.choice([-1, 1]) * rng.uniform(1.0, 4.0))])
+    entry = ""
+    if rng.random() < 0.4:   # compensation entered before the cycle: its rapid is a corner
+        ex, ez = wx + rng.uniform(-2, 2), wz + rng.uniform(1.5, 4)
+        entry = f"G{rng.choice([0, 1])} X{fmt(ex)} Z{fmt(ez)}\n"
+    words = f"X{fmt(sx)} Z{fmt(sz)} D{fmt(rng.uniform(0, 1))} E{fmt(rng.uniform(0, 0.3))} P{rng.randint(1, 3)}"
+    body = "\n".join("  " + ln for ln in lines)
+    after = rng.choice(["G40\nG0 X{0} Z{1}\n", "G0 X{0} Z{1}\nG40\n", ""]).format(fmt(wx), fmt(wz + 1))
+    diameter = "G7" if rng.random() < 0.2 else "G8"
+    return (f"G21 G18 G90 {diameter} F100\nT{rng.randint(1, 6)} M6\nG0 X{fmt(wx)} Z{fmt(wz)}\no100 sub\n{body}\n"
+            f"o100 endsub\n{comp}\n{entry}G70 Q100 {words}\n{after}M2\n")
+
+
 def run(cmd, cwd):
     """(status, stdout lines, stderr); status None when the program did not finish in 10 s."""
     try:
@@ -165,12 +220,15 @@ def expected_code(message):
     return "?"
 
 
-def compare(opencnc, text, work):
+def compare(opencnc, text, work, comp=False):
     path = os.path.join(work, "p.ngc")
     with open(path, "w") as f:
         f.write(text)
-    rc1, out1, err1 = run(["rs274", "-g", "p.ngc"], work)
-    rc2, out2, err2 = run([opencnc, "canon", "p.ngc"], work)
+    tools = os.path.join(work, "tools.tbl")
+    with open(tools, "w") as f:
+        f.write(TOOLS)
+    rc1, out1, err1 = run(["rs274", "-t", tools, "-g", "p.ngc"], work)
+    rc2, out2, err2 = run([opencnc, "canon", "p.ngc", "--tool-table", tools], work)
     if rc1 is None:   # rs274 loops for ever on some profiles; opencnc must stop with an error
         return rc2 not in (0, None), "both failed: rs274 hangs, opencnc " + err2.strip()[-60:]
     if rc1 < 0:   # rs274 crashes (undefined behaviour in its offsetting); opencnc must stop with an error
@@ -182,7 +240,11 @@ def compare(opencnc, text, work):
         return False, f"failure differs: rs274 {message} / opencnc {err2.strip()[:300]}"
     if failed1:
         code = expected_code(message)
-        if code.startswith("gcode.lathe") and f"[{code}]" not in err2:
+        # What was printed before the error must agree too (compensation holds moves back, and
+        # both must hold back the same ones).
+        if comp and (len(m1) != len(m2) or not all(same(a, b) for a, b in zip(m1, m2))):
+            return False, f"motions before the error differ ({len(m1)} vs {len(m2)}): {message}"
+        if (code.startswith("gcode.lathe") or code.startswith("gcode.comp")) and f"[{code}]" not in err2:
             return False, f"rs274 '{message}' ({code}) / opencnc {err2.strip()[:300]}"
         return True, "both failed: " + code
     if len(m1) != len(m2):
@@ -196,6 +258,7 @@ def compare(opencnc, text, work):
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--opencnc", required=True)
+    ap.add_argument("--comp", action="store_true", help="G70 under cutter compensation")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--count", type=int, default=200)
     ap.add_argument("--keep")
@@ -207,8 +270,8 @@ def main():
     reasons = {}
     with tempfile.TemporaryDirectory() as work:
         for i in range(args.count):
-            text = program(rng)
-            ok, why = compare(os.path.abspath(args.opencnc), text, work)
+            text = program_comp(rng) if args.comp else program(rng)
+            ok, why = compare(os.path.abspath(args.opencnc), text, work, args.comp)
             if why.startswith("both failed"):
                 both_failed += 1
                 reasons[why] = reasons.get(why, 0) + 1

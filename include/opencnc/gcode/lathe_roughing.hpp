@@ -71,9 +71,6 @@ class PathSink {
  public:
   virtual ~PathSink() = default;
   virtual void rapid(Point end) = 0;
-  /// The rapid to the start of a finishing pass, which LinuxCNC makes with cutter
-  /// compensation off so that compensation starts on the pass's first element.
-  virtual void approach(Point end) { rapid(end); }
   virtual void feed(Point end) = 0;
   virtual void arc(Point end, Point center, bool ccw) = 0;
 };
