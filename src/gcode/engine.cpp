@@ -602,21 +602,19 @@ void Engine::read_subprogram(const std::string& name, std::uint32_t extra_letter
 // Fanuc G71/G72 P Q: the shape's blocks read, not run (ExecContext::read_block_range).
 void Engine::read_block_range(std::int64_t first, std::int64_t last, std::string_view what,
                               const std::function<void(const Block&)>& visit) {
+  if (in_mdi_)
+    fail(ErrorCode::OwordInMdi, "{} P Q reads the program's own blocks: it cannot run from MDI (as G70 P Q cannot)", what);
   const SourcePosition body = st_.frames.back().fanuc.body;
   const SourcePosition from = fanuc_sequence(body, first, fmt::format("{} P", what));
   const SourcePosition to = fanuc_sequence(body, last, fmt::format("{} Q", what));
   if (to.file != from.file || to.offset < from.offset)
     fail(ErrorCode::FanucGotoTargetMissing, "{} P{} Q{}: block N{} comes before N{}", what, first, last, last, first);
-  // Errors of the shape's blocks point at them, not at the cycle's code; MDI reads the program.
-  struct Modes {
-    Engine& e;
-    int at;
-    bool mdi;
-    ~Modes() {
-      e.extension_at_ = at;
-      e.in_mdi_ = mdi;
-    }
-  } modes{*this, std::exchange(extension_at_, -1), std::exchange(in_mdi_, false)};
+  // Errors of the shape's blocks point at them, not at the cycle's code.
+  struct Site {
+    int& slot;
+    int saved;
+    ~Site() { slot = saved; }
+  } site{extension_at_, std::exchange(extension_at_, -1)};
   const SourcePosition resume = st_.next;
   SavedLine saved = save_line();
   jump_to(from);
@@ -635,7 +633,7 @@ void Engine::read_block_range(std::int64_t first, std::int64_t last, std::string
   }
   const SourcePosition after = st_.next;
   restore_line(saved, saved.origin);
-  jump_to(!modes.mdi && only_comments_between(resume, from) ? after : resume);
+  jump_to(only_comments_between(resume, from) ? after : resume);
 }
 
 InterpState Engine::snapshot() const {

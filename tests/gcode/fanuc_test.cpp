@@ -635,6 +635,16 @@ TEST(FanucRoughing, ProblemsHaveTheirCodes) {
   EXPECT_EQ(error_of(head + "G71 P10 Q20 D1. F0.2\nN10 G0 X10\nG1 Z-10\nX16\nZ-5\nN20 X30\nM30\n", lathe),
             "gcode.lathe-profile-not-monotonic");
   EXPECT_EQ(error_of(head + "G71 P10 Q20 D1. F0.2\nN10 G0 X10\nN20 M8\nM30\n", lathe), "fanuc.profile-block");
+  // From MDI the shape cannot be read (as G70 P Q cannot run); the settings block can.
+  Interpreter mdi(lathe);
+  mdi.open_text("shape.nc", "O1\nG21\nM30\n" + std::string(kShaft));
+  Recorder rec;
+  EXPECT_EQ(mdi.execute_mdi("G21 G0 X30 Z2 F0.2", rec), RunStatus::Ok);
+  EXPECT_EQ(mdi.execute_mdi("G71 U2 R0.5", rec), RunStatus::Ok);
+  EXPECT_EQ(mdi.execute_mdi("G71 P10 Q20", rec), RunStatus::Error);
+  EXPECT_EQ(mdi.diagnostics().items().back().code, "gcode.oword-in-mdi");
+  EXPECT_EQ(mdi.execute_mdi("G0 X40", rec), RunStatus::Ok);
+  EXPECT_EQ(rec.motions.back().end[Axis::X], 20.0);
 }
 
 TEST(FanucCodes, G50IsScalingCancelOnAMill) {
@@ -727,8 +737,7 @@ class StateAtMotion : public canon::Sink {
   Trace& trace_;
 };
 
-Trace trace(std::string_view program, canon::SegmentId quiet) {
-  Options o = fanuc();
+Trace trace(std::string_view program, canon::SegmentId quiet, Options o = fanuc()) {
   o.quiet_until_segment = quiet;
   Interpreter interp(o);
   interp.open_text("replay.nc", std::string(program));
@@ -794,6 +803,25 @@ TEST(FanucReplay, SeededRandomProgramsReplayExactly) {
       ASSERT_LE(part.lines.size(), full.lines.size());
       EXPECT_TRUE(std::equal(part.lines.begin(), part.lines.end(), full.lines.end() - static_cast<std::ptrdiff_t>(part.lines.size())));
     }
+  }
+}
+
+// A roughing cycle (its settings, the shape read and passed over, G70 after it) replays to
+// any of its moves exactly.
+TEST(FanucReplay, RoughingCyclesReplayExactly) {
+  const std::string p = std::string("%\nO1\nG21 M3 S500\nG0 X30 Z2\nG71 U2 R0.5\nG71 P10 Q20 U1 W0.5 F0.2\n") + kShaft +
+                        "G70 P10 Q20\nG0 X40\nG72 P30 Q40 D1.5 F0.2\nN30 G0 Z-6\nG1 X24\nN40 X0\nG0 X50\nM30\n%\n";
+  const Trace full = trace(p, 0, fanuc(MachineKind::Lathe));
+  ASSERT_EQ(full.status, RunStatus::Finished);
+  ASSERT_GT(full.states.size(), 40u);
+  for (canon::SegmentId k = 1; k < full.states.size(); k += 3) {
+    const Trace part = trace(p, k, fanuc(MachineKind::Lathe));
+    ASSERT_EQ(part.status, RunStatus::Finished);
+    ASSERT_EQ(part.states.size(), full.states.size());
+    EXPECT_EQ(part.states[k], full.states[k]) << "segment " << k;
+    EXPECT_EQ(part.states[k].digest(), full.states[k].digest());
+    ASSERT_LE(part.lines.size(), full.lines.size());
+    EXPECT_TRUE(std::equal(part.lines.begin(), part.lines.end(), full.lines.end() - static_cast<std::ptrdiff_t>(part.lines.size())));
   }
 }
 

@@ -431,3 +431,47 @@ TEST(LatheRoughing, FanucLeavesOutTheRetractAtTheContoursEnd) {
   Recorder c;
   EXPECT_THROW(rough(tail, params, c), RoughingError);
 }
+
+// Fanuc's reading in the other frames: a bore (the profile mirrored about the axis, U negative)
+// gives the mirrored passes, and G72 on a profile turned by 90° the turned passes; the
+// allowance is turned and mirrored with the profile, so it keeps its meaning in each.
+TEST(LatheRoughingProperty, FanucBoringAndFacingAreTurningMirroredAndTurned) {
+  std::mt19937_64 rng(6060);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  int compared = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    Point start;
+    const Profile p = random_contour(rng, true, start);
+    RoughingParams t;
+    t.convention = Convention::Fanuc;
+    t.start = start;
+    t.shift = Point(0.3 * unit(rng), 0.3 * unit(rng));
+    t.depth = 0.4 + unit(rng);
+    t.retract = 0.3;
+    RoughingParams bore = t;
+    bore.start = std::conj(start);
+    bore.shift = std::conj(t.shift);
+    RoughingParams face = t;
+    face.direction = Direction::Facing;
+    face.start = start * Point(0, 1);
+    face.shift = t.shift * Point(0, 1);
+    Profile facing = p;
+    for (auto& e : facing) e.start *= Point(0, 1), e.end *= Point(0, 1), e.center *= Point(0, 1);
+    Recorder a, b, c;
+    bool ok_a = true, ok_b = true, ok_c = true;
+    try { rough(p, t, a); } catch (const RoughingError&) { ok_a = false; }
+    try { rough(mirrored_x(p), bore, b); } catch (const RoughingError&) { ok_b = false; }
+    try { rough(facing, face, c); } catch (const RoughingError&) { ok_c = false; }
+    ASSERT_EQ(ok_a, ok_b) << "trial " << trial;
+    ASSERT_EQ(ok_a, ok_c) << "trial " << trial;
+    if (!ok_a) continue;
+    ASSERT_EQ(a.moves.size(), b.moves.size()) << "trial " << trial;
+    ASSERT_EQ(a.moves.size(), c.moves.size()) << "trial " << trial;
+    for (std::size_t i = 0; i < a.moves.size(); ++i) {
+      EXPECT_TRUE(near(std::conj(a.moves[i].end), b.moves[i].end)) << "trial " << trial << " move " << i;
+      EXPECT_TRUE(near(a.moves[i].end * Point(0, 1), c.moves[i].end)) << "trial " << trial << " move " << i;
+    }
+    ++compared;
+  }
+  EXPECT_GT(compared, 200);
+}
