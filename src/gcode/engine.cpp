@@ -617,6 +617,7 @@ void Engine::read_block_range(std::int64_t first, std::int64_t last, std::string
   } site{extension_at_, std::exchange(extension_at_, -1)};
   const SourcePosition resume = st_.next;
   SavedLine saved = save_line();
+  const double p = fanuc_p_, l = fanuc_l_, clamp = fanuc_clamp_;   // the block's own, reset per line read
   jump_to(from);
   for (;;) {
     const LineKind kind = read_block();
@@ -633,6 +634,7 @@ void Engine::read_block_range(std::int64_t first, std::int64_t last, std::string
   }
   const SourcePosition after = st_.next;
   restore_line(saved, saved.origin);
+  fanuc_p_ = p, fanuc_l_ = l, fanuc_clamp_ = clamp;
   jump_to(only_comments_between(resume, from) ? after : resume);
 }
 
