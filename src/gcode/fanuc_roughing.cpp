@@ -12,7 +12,7 @@
 #include <string>
 
 #include "fanuc_codes.hpp"
-#include "lathe_moves.hpp"
+#include "lathe_errors.hpp"
 #include "opencnc/gcode/lathe_roughing.hpp"
 #include "parser.hpp"
 
@@ -86,6 +86,41 @@ class ShapeReader {
   ExecContext& ctx_;
   const char* cycle_;
   Pose at_;
+};
+
+constexpr std::uint32_t bit(char letter) noexcept { return 1u << (letter - 'a'); }
+
+// The passes as the core's G0/G1/G2/G3 with absolute X (radius) and Z words, under the
+// program's transforms and checks. Moves that would not move are left out (the engine's first
+// rapid goes to the start point, where the tool is); so are arcs shorter than 0.0001, which
+// the core would read as full circles (LinuxCNC's cycle leaves them out the same way).
+class FanucMoves final : public lathe::PathSink {
+ public:
+  explicit FanucMoves(ExecContext& ctx) : ctx_(ctx) {}
+  void rapid(Point end) override { move(0, end, {}); }
+  void feed(Point end) override { move(10, end, {}); }
+  void arc(Point end, Point centre, bool ccw) override {
+    const Point at = zx(ctx_.state().position.current);
+    if (std::fabs(at.real() - end.real()) < 1e-4 && std::fabs(at.imag() - end.imag()) < 1e-4) return;
+    move(ccw ? 30 : 20, end, centre);
+  }
+
+ private:
+  void move(int motion, Point end, Point centre) {
+    if (zx(ctx_.state().position.current) == end) return;
+    Block b;
+    b.clear();
+    const auto set = [&b](char letter, double v) {
+      b.words |= bit(letter);
+      b.value[static_cast<std::size_t>(letter - 'a')] = v;
+    };
+    set('x', end.imag());
+    set('z', end.real());
+    if (motion == 20 || motion == 30) set('i', centre.imag()), set('k', centre.real());
+    ctx_.programmed_move(motion, b);
+  }
+
+  ExecContext& ctx_;
 };
 
 // The distance modes the cycle's moves are made in (absolute), restored also after an error.
@@ -199,7 +234,7 @@ void FanucRoughing::rough(ExecContext& ctx, const Cut& cut, const char* name, bo
   p.retract = cut.retract;
   p.shift = cut.allowance;
   const AbsoluteModes absolute(st.modal);
-  CycleMoves moves(ctx, true);
+  FanucMoves moves(ctx);
   try {
     lathe::rough(reader.profile, p, moves);
   } catch (const lathe::RoughingError& e) {

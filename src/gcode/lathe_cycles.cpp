@@ -8,7 +8,7 @@
 #include <string>
 
 #include "opencnc/gcode/lathe_roughing.hpp"
-#include "lathe_moves.hpp"
+#include "lathe_errors.hpp"
 
 namespace opencnc::gcode {
 
@@ -17,11 +17,6 @@ namespace {
 using lathe::Point;
 
 constexpr std::uint32_t letter_bit(char c) noexcept { return 1u << (c - 'a'); }
-
-void set_word(Block& b, char letter, double v) {
-  b.words |= letter_bit(letter);
-  b.value[static_cast<std::size_t>(letter - 'a')] = v;
-}
 
 // Turns the blocks of the profile subprogram into profile elements, as LinuxCNC reads them:
 // X/Z absolute (or incremental when the cycle was programmed in G91), U/W incremental, arcs
@@ -94,6 +89,55 @@ class ProfileReader {
   Point at_;
   bool incremental_;
   bool incremental_ijk_;
+};
+
+// Cutter compensation suspended for one move (restored also when the move fails).
+struct CompensationOff {
+  explicit CompensationOff(ModalState& m) : modal(m), saved(m.cutter_comp) { m.cutter_comp = CutterComp::Off; }
+  ~CompensationOff() { modal.cutter_comp = saved; }
+  CompensationOff(const CompensationOff&) = delete;
+  CompensationOff& operator=(const CompensationOff&) = delete;
+  ModalState& modal;
+  CutterComp saved;
+};
+
+// The cycle's moves as the core's G0/G1/G2/G3 (absolute XZ words: the cycle runs in G90 and
+// G90.1 like LinuxCNC's).
+class CycleMoves final : public lathe::PathSink {
+ public:
+  explicit CycleMoves(ExecContext& ctx) : ctx_(ctx) {}
+  void rapid(Point end) override { move(0, end); }
+  void approach(Point end) override {
+    // LinuxCNC starts each finishing pass with compensation off for this one move.
+    const CompensationOff off(ctx_.state().modal);
+    move(0, end);
+  }
+  void feed(Point end) override { move(10, end); }
+  void arc(Point end, Point centre, bool ccw) override {
+    // Arcs that end where they start are left out (LinuxCNC compares with its 0.0001 EQ tolerance).
+    const Pose& at = ctx_.state().position.current;
+    if (std::fabs(at[2] - end.real()) < 1e-4 && std::fabs(at[0] - end.imag()) < 1e-4) return;
+    Block b = words(end);
+    set(b, 'i', centre.imag());
+    set(b, 'k', centre.real());
+    ctx_.programmed_move(ccw ? 30 : 20, b);
+  }
+
+ private:
+  static void set(Block& b, char letter, double v) {
+    b.words |= letter_bit(letter);
+    b.value[static_cast<std::size_t>(letter - 'a')] = v;
+  }
+  static Block words(Point end) {
+    Block b;
+    b.clear();
+    set(b, 'x', end.imag());
+    set(b, 'z', end.real());
+    return b;
+  }
+  void move(int motion, Point end) { ctx_.programmed_move(motion, words(end)); }
+
+  ExecContext& ctx_;
 };
 
 // LinuxCNC names the sub "O<q>": Q printed with six decimals, then read as a whole number.
@@ -202,35 +246,6 @@ void LatheCycle::run(ExecContext& ctx, const CycleWords& w, int code, const lath
 }
 
 }  // namespace
-
-void CycleMoves::approach(Point end) {
-  // LinuxCNC starts each finishing pass with compensation off for this one move.
-  const CompensationOff off(ctx_.state().modal);
-  move(0, end);
-}
-
-void CycleMoves::arc(Point end, Point centre, bool ccw) {
-  // Arcs that end where they start are left out (LinuxCNC compares with its 0.0001 EQ tolerance).
-  const Pose& at = ctx_.state().position.current;
-  if (std::fabs(at[2] - end.real()) < 1e-4 && std::fabs(at[0] - end.imag()) < 1e-4) return;
-  Block b;
-  b.clear();
-  set_word(b, 'x', end.imag());
-  set_word(b, 'z', end.real());
-  set_word(b, 'i', centre.imag());
-  set_word(b, 'k', centre.real());
-  ctx_.programmed_move(ccw ? 30 : 20, b);
-}
-
-void CycleMoves::move(int motion, Point end) {
-  const Pose& at = ctx_.state().position.current;
-  if (skip_still_ && at[2] == end.real() && at[0] == end.imag()) return;
-  Block b;
-  b.clear();
-  set_word(b, 'x', end.imag());
-  set_word(b, 'z', end.real());
-  ctx_.programmed_move(motion, b);
-}
 
 ErrorCode roughing_error_code(lathe::RoughingError::Kind kind) noexcept {
   using K = lathe::RoughingError::Kind;
