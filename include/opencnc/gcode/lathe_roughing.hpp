@@ -54,9 +54,10 @@ enum class Convention : std::uint8_t {
   /// Fanuc's G71/G72 P Q: the stock side from the approach (from the start point towards the
   /// contour's first point, across the passes), so that a contour may start with a face that
   /// falls towards the axis; `shift` (Fanuc's W and U/2) moves the contour, not the start
-  /// point, in the program's frame; straight elements at the contour's end that lie at or
-  /// beyond the start point's depth (where the start point says there is no stock, such as a
-  /// retract back to the start) are left out.
+  /// point, in the program's frame; the approach stays as programmed; straight elements at
+  /// the contour's end that lie at or beyond the start point's depth (where the start point
+  /// says there is no stock, such as a retract back to the start) are left out; the first
+  /// layer is one depth below the start point, not at its height.
   Fanuc,
 };
 
