@@ -541,25 +541,40 @@ void Engine::programmed_move(int motion, const Block& words) {
   convert_motion(motion);
 }
 
+Engine::SavedLine Engine::save_line() {
+  // The block's comment views the old buffer: it moves out with it.
+  return SavedLine{block_, raw_, std::exchange(norm_, std::vector<char>(norm_.size())), norm_len_, line_, line_file_,
+                   line_offset_, out_.origin()};
+}
+
+void Engine::restore_line(SavedLine& saved, const canon::BlockOrigin& n_from) {
+  canon::BlockOrigin origin = saved.origin;
+  origin.n_present = n_from.n_present;
+  origin.n_length = n_from.n_length;
+  std::memcpy(origin.n_digits, n_from.n_digits, sizeof origin.n_digits);
+  block_ = std::move(saved.block);
+  raw_ = std::move(saved.raw);
+  norm_ = std::move(saved.norm);
+  norm_len_ = saved.norm_len;
+  line_ = saved.line;
+  line_file_ = saved.file;
+  line_offset_ = saved.offset;
+  out_.set_origin(origin);
+}
+
 void Engine::read_subprogram(const std::string& name, std::uint32_t extra_letters,
                              const std::function<void(const Block&)>& visit) {
   // The executing block's line: the cycle's moves and errors belong to it afterwards.
-  struct Saved {
+  struct Modes {
     Engine& e;
-    Block block;
-    std::string raw;
-    std::vector<char> norm;
-    std::size_t norm_len;
-    std::uint32_t line, file, letters;
-    std::uint64_t offset;
-    canon::BlockOrigin origin;
+    std::uint32_t letters;
     bool mdi;
-    ~Saved() {   // also on errors: an MDI session goes on with the machine's letters
+    ~Modes() {   // also on errors: an MDI session goes on with the machine's letters
       e.letters_ = letters;
       e.in_mdi_ = mdi;
     }
-  } saved{*this, block_, raw_, std::exchange(norm_, std::vector<char>(norm_.size())), norm_len_, line_, line_file_,
-          letters_, line_offset_, out_.origin(), in_mdi_};   // the block's comment views the moved buffer
+  } modes{*this, letters_, in_mdi_};
+  SavedLine saved = save_line();
   letters_ |= extra_letters;
   const std::size_t depth = st_.frames.size();
   block_.clear();
@@ -580,19 +595,47 @@ void Engine::read_subprogram(const std::string& name, std::uint32_t extra_letter
     visit(block_);
   }
   // rs274 labels the cycle's moves with the N word of the last line it read.
-  canon::BlockOrigin origin = saved.origin;
-  const canon::BlockOrigin& last = out_.origin();
-  origin.n_present = last.n_present;
-  origin.n_length = last.n_length;
-  std::memcpy(origin.n_digits, last.n_digits, sizeof origin.n_digits);
-  block_ = std::move(saved.block);
-  raw_ = std::move(saved.raw);
-  norm_ = std::move(saved.norm);
-  norm_len_ = saved.norm_len;
-  line_ = saved.line;
-  line_file_ = saved.file;
-  line_offset_ = saved.offset;
-  out_.set_origin(origin);
+  const canon::BlockOrigin last = out_.origin();
+  restore_line(saved, last);
+}
+
+// Fanuc G71/G72 P Q: the shape's blocks read, not run (ExecContext::read_block_range).
+void Engine::read_block_range(std::int64_t first, std::int64_t last, std::string_view what,
+                              const std::function<void(const Block&)>& visit) {
+  if (in_mdi_)
+    fail(ErrorCode::OwordInMdi, "{} P Q reads the program's own blocks: it cannot run from MDI (as G70 P Q cannot)", what);
+  const SourcePosition body = st_.frames.back().fanuc.body;
+  const SourcePosition from = fanuc_sequence(body, first, fmt::format("{} P", what));
+  const SourcePosition to = fanuc_sequence(body, last, fmt::format("{} Q", what));
+  if (to.file != from.file || to.offset < from.offset)
+    fail(ErrorCode::FanucGotoTargetMissing, "{} P{} Q{}: block N{} comes before N{}", what, first, last, last, first);
+  // Errors of the shape's blocks point at them, not at the cycle's code.
+  struct Site {
+    int& slot;
+    int saved;
+    ~Site() { slot = saved; }
+  } site{extension_at_, std::exchange(extension_at_, -1)};
+  const SourcePosition resume = st_.next;
+  SavedLine saved = save_line();
+  const double p = fanuc_p_, l = fanuc_l_, clamp = fanuc_clamp_;   // the block's own, reset per line read
+  jump_to(from);
+  for (;;) {
+    const LineKind kind = read_block();
+    if (kind == LineKind::ProgramEnd)
+      fail(ErrorCode::MissingProgramEnd, "the program ends inside the shape of {} P{} Q{}", what, first, last);
+    if (kind == LineKind::Block) {
+      if (block_.o_type != OWord::None || !parser_.numbered_assignments.empty() || !parser_.named_assignments.empty())
+        fail(ErrorCode::FanucProfileBlock,
+             "the shape of {} P{} Q{} cannot hold macro statements, assignments, calls or G70 (only its moves are read)",
+             what, first, last);
+      visit(block_);
+    }
+    if (line_file_ == to.file && line_offset_ == to.offset) break;
+  }
+  const SourcePosition after = st_.next;
+  restore_line(saved, saved.origin);
+  fanuc_p_ = p, fanuc_l_ = l, fanuc_clamp_ = clamp;
+  jump_to(only_comments_between(resume, from) ? after : resume);
 }
 
 InterpState Engine::snapshot() const {

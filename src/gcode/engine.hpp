@@ -79,6 +79,8 @@ class Engine final : public ParamHost, public ExecContext {
   void programmed_move(int motion, const Block& words) override;
   void read_subprogram(const std::string& name, std::uint32_t extra_letters,
                        const std::function<void(const Block&)>& visit) override;
+  void read_block_range(std::int64_t first, std::int64_t last, std::string_view what,
+                        const std::function<void(const Block&)>& visit) override;
   void open_queue() override { out_.open_queue(); }
   void flush_queue() override { out_.flush_queue(); }
   std::size_t queued() const override { return out_.queued(); }
@@ -106,6 +108,20 @@ class Engine final : public ParamHost, public ExecContext {
     int& slot_;
     int saved_;
   };
+
+  // The executing block's line, put aside while an extension reads other lines (the G7x
+  // profiles) and put back afterwards with the N label `n_from` (engine.cpp).
+  struct SavedLine {
+    Block block;
+    std::string raw;
+    std::vector<char> norm;
+    std::size_t norm_len = 0;
+    std::uint32_t line = 0, file = 0;
+    std::uint64_t offset = 0;
+    canon::BlockOrigin origin;
+  };
+  SavedLine save_line();
+  void restore_line(SavedLine& saved, const canon::BlockOrigin& n_from);
 
   // engine.cpp: start, lines, errors
   void start();
@@ -274,6 +290,7 @@ class Engine final : public ParamHost, public ExecContext {
   const FanucIndex::Region& fanuc_region(const SourcePosition& start);
   SourcePosition fanuc_sequence(const SourcePosition& program_start, std::int64_t n, std::string_view what);
   std::string fanuc_program_name(const FanucFrame& f) const;
+  bool only_comments_between(const SourcePosition& from, const SourcePosition& to);
   void finish_mdi_call();
 
   // fanuc_translate.cpp: Fanuc words and codes rewritten into the core's before the checks

@@ -39,6 +39,7 @@ class MachineFunction final : public CodeHandler {
 void add_fanuc_codes(Extensions& ext) {
   add_transform_codes(ext);
   add_fanuc_lathe_cycles(ext);
+  add_fanuc_roughing_cycles(ext);
   auto machine = std::make_shared<MachineFunction>();
   for (int code = 0; code < 100; ++code) {
     if (m_group(code) < 0 && code != 98 && !ext.m[static_cast<std::size_t>(code)]) ext.m[static_cast<std::size_t>(code)] = machine;

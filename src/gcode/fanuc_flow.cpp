@@ -208,6 +208,26 @@ void Engine::fanuc_range() {
   jump_to(from);
 }
 
+// True when the lines from `from` up to `to` (same file, `to` not before `from`) hold
+// nothing but blanks and comments.
+bool Engine::only_comments_between(const SourcePosition& from, const SourcePosition& to) {
+  if (from.file != to.file || to.offset < from.offset) return false;
+  SourceFile& f = source_at(from.file);
+  f.seek(from.offset);
+  need_seek_ = true;
+  RawLine l;
+  while (f.next(l) && l.offset < to.offset) {
+    int depth = 0;
+    for (const char c : l.text) {
+      if (c == '(') ++depth;
+      else if (c == ')' && depth > 0) --depth;
+      else if (depth == 0 && c == ';') break;
+      else if (depth == 0 && c != ' ' && c != '\t' && c != '\r') return false;
+    }
+  }
+  return true;
+}
+
 // After each block: the end of a G70 run.
 void Engine::fanuc_block_done() {
   if (st_.frames.size() < 2) return;

@@ -17,16 +17,6 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr int kMaxPasses = 10000;   // a thread or groove needing more is a programming error
 
-constexpr std::uint32_t bit(char letter) noexcept { return 1u << (letter - 'a'); }
-
-// A length word: Fanuc reads P, Q (and the like) written without a decimal point in least
-// increments (0.001 mm, 0.0001 in), with one as a length.
-double length_word(ExecContext& ctx, const Block& b, char letter) {
-  const double v = b.get(letter);
-  if ((b.decimal & bit(letter)) != 0) return v;
-  return v * (ctx.state().modal.units == canon::Units::Inch ? 0.0001 : 0.001);
-}
-
 double sign(double v) noexcept { return v < 0.0 ? -1.0 : 1.0; }
 
 Pose xz(const Pose& base, double x, double z) {
@@ -34,12 +24,6 @@ Pose xz(const Pose& base, double x, double z) {
   p[Axis::X] = x;
   p[Axis::Z] = z;
   return p;
-}
-
-void require_lathe(ExecContext& ctx, int code) {
-  if (ctx.options().machine != MachineKind::Lathe)
-    ctx.error(ErrorCode::Unsupported,
-              fmt::format("G{} is a Fanuc lathe cycle (on a Fanuc mill it is a canned cycle this controller does not have)", code / 10));
 }
 
 // Plain data of one threading job, in radius coordinates.
@@ -236,6 +220,18 @@ class FanucGrooving final : public CodeHandler {
 };
 
 }  // namespace
+
+double length_word(ExecContext& ctx, const Block& b, char letter) {
+  const double v = b.get(letter);
+  if ((b.decimal & (1u << (letter - 'a'))) != 0) return v;
+  return v * (ctx.state().modal.units == canon::Units::Inch ? 0.0001 : 0.001);
+}
+
+void require_lathe(ExecContext& ctx, int code) {
+  if (ctx.options().machine != MachineKind::Lathe)
+    ctx.error(ErrorCode::Unsupported,
+              fmt::format("G{} is a Fanuc lathe cycle (on a Fanuc mill it is a canned cycle this controller does not have)", code / 10));
+}
 
 void add_fanuc_lathe_cycles(Extensions& ext) {
   ext.g[750] = std::make_shared<FanucGrooving>();

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "opencnc/gcode/lathe_roughing.hpp"
+#include "lathe_errors.hpp"
 
 namespace opencnc::gcode {
 
@@ -224,20 +225,23 @@ void LatheCycle::run(ExecContext& ctx, const CycleWords& w, int code, const lath
     p.shift = Point(w.w, w.u);
     lathe::rough(profile, p, moves);
   } catch (const lathe::RoughingError& e) {
-    using K = lathe::RoughingError::Kind;
-    ErrorCode code_of = ErrorCode::LatheLostProfile;
-    switch (e.kind()) {
-      case K::NotMonotonic: code_of = ErrorCode::LatheNotMonotonic; break;
-      case K::ParallelLines: code_of = ErrorCode::LatheParallel; break;
-      case K::CornerFinish: code_of = ErrorCode::LatheCornerFinish; break;
-      case K::LostPath: code_of = ErrorCode::LatheLostProfile; break;
-      case K::NoProgress: code_of = ErrorCode::LatheNoProgress; break;
-    }
-    ctx.error(code_of, e.what());
+    ctx.error(roughing_error_code(e.kind()), e.what());
   }
 }
 
 }  // namespace
+
+ErrorCode roughing_error_code(lathe::RoughingError::Kind kind) noexcept {
+  using K = lathe::RoughingError::Kind;
+  switch (kind) {
+    case K::NotMonotonic: return ErrorCode::LatheNotMonotonic;
+    case K::ParallelLines: return ErrorCode::LatheParallel;
+    case K::CornerFinish: return ErrorCode::LatheCornerFinish;
+    case K::LostPath: return ErrorCode::LatheLostProfile;
+    case K::NoProgress: return ErrorCode::LatheNoProgress;
+  }
+  return ErrorCode::LatheLostProfile;
+}
 
 void add_lathe_cycles(Extensions& ext) {
   const auto handler = std::make_shared<LatheCycle>();

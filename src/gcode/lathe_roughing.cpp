@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <span>
+#include <utility>
 
 namespace opencnc::gcode::lathe {
 
@@ -216,18 +218,49 @@ struct Work {
     if (d.imag() > 0) mirror_x();
     if (d.real() < 0) mirror_z();
   }
+  // Fanuc: the approach (start point to the contour's first point) goes into the stock, so it
+  // must fall in X; an approach along Z alone leaves the choice to the end points.
+  void orient_from_approach() {
+    const Piece& a = pieces.front();
+    const double across = a.b.imag() - a.a.imag();
+    if (across > 0 || (across == 0 && a.b.imag() > pieces.back().b.imag())) mirror_x();
+  }
+  // Fanuc: lines at the contour's end that lie at or above the start height run where the
+  // start point says there is no stock (a retract to the start, a move along the bar's
+  // surface); the cycle has nothing to cut there.
+  void drop_stockless_tail() {
+    const double top = pieces.front().a.imag();
+    while (pieces.size() > 2) {
+      const Piece& p = pieces.back();
+      if (p.round || p.chamfer || std::min(p.a.imag(), p.b.imag()) < top - kTol) break;
+      pieces.pop_back();
+    }
+  }
+  // A vector of the program's frame in the working frame (the same turn and mirrors).
+  Point to_frame(Point v) const {
+    if ((frame & 4) != 0) v = -v * kJ;
+    if ((frame & 2) != 0) v = std::conj(v);
+    if ((frame & 1) != 0) v = -std::conj(v);
+    return v;
+  }
+  // Fanuc's U/W: the contour moves, the start point stays; the approach follows the contour.
+  void shift_contour(Point d) {
+    for (std::size_t i = 1; i < pieces.size(); ++i) pieces[i].a += d, pieces[i].b += d, pieces[i].c += d;
+    pieces.front().b = pieces[1].a;
+  }
   void resolve_corners() {
     for (std::size_t i = 1; i + 1 < pieces.size(); ++i) {
       if (pieces[i].fillet || pieces[i].chamfer) resolve_corner(pieces[i], pieces[i - 1], pieces[i + 1]);
     }
     std::erase_if(pieces, [](const Piece& p) { return extent(p) < kTiny; });
   }
-  // The first element may dive on the wrong side; LinuxCNC straightens it, then requires
-  // every element to be monotonic.
-  void require_monotonic() {
+  // The first element may dive on the wrong side; LinuxCNC straightens it (moving the start
+  // point), then requires every element to be monotonic. Fanuc's start point is where the
+  // tool is: the approach stays as programmed and only the contour must be monotonic.
+  void require_monotonic(bool keep_approach = false) {
     Piece& f = pieces.front();
-    if (std::real(f.b - f.a) > 0) f.a.real(f.b.real());
-    for (const Piece& p : pieces) {
+    if (!keep_approach && std::real(f.b - f.a) > 0) f.a.real(f.b.real());
+    for (const Piece& p : std::span(pieces).subspan(keep_approach ? 1 : 0)) {
       if (!monotonic(p))
         throw RoughingError(RoughingError::Kind::NotMonotonic,
                             "the profile is not monotonic: it turns back in the cutting direction (use a type II "
@@ -461,7 +494,10 @@ class Layers {
   Layers(const std::vector<Piece>& pieces, FramedSink& out, double delta, Point escape)
       : p_(pieces), out_(out), delta_(delta), escape_(escape) {}
 
-  void run(Pockets mode, Point start) {
+  // `below_start`: the first layer one depth below the start point (Fanuc's first cut)
+  // rather than at its height (LinuxCNC's, which cuts nothing when the start clears the stock).
+  void run(Pockets mode, Point start, bool below_start) {
+    below_start_ = below_start;
     starts_.push_back(start);
     std::size_t i = 0;
     Point at = start;
@@ -480,6 +516,7 @@ class Layers {
   // One pocket from piece i; returns true when the next pocket starts (at, i updated).
   bool pocket(bool follow_only, bool pockets_only, Point& at, std::size_t& i) {
     double x = starts_.back().imag();
+    if (std::exchange(below_start_, false)) x -= delta_;
     // The loop is deterministic: coming back to the same place, height and piece means it
     // would repeat for ever (LinuxCNC hangs there).
     Point last_at(NAN, NAN);
@@ -564,6 +601,7 @@ class Layers {
   Point escape_;
   std::vector<Point> starts_;   // where the pockets being cut started (their top height)
   std::uint64_t steps_ = 0;
+  bool below_start_ = false;
 };
 
 // --- from the caller's profile ---------------------------------------------------------------------
@@ -605,11 +643,19 @@ void rough(const Profile& profile, const RoughingParams& params, PathSink& out) 
   w.pieces = to_pieces(profile);
   w.pieces.front().a = params.start;
   if (params.direction == Direction::Facing) w.rotate();
-  w.normalise();
+  const bool fanuc = params.convention == Convention::Fanuc;
+  if (fanuc) {
+    w.orient_from_approach();
+    w.drop_stockless_tail();
+    if (w.pieces.front().b.real() < w.pieces.back().b.real()) w.mirror_z();
+  } else {
+    w.normalise();
+  }
   w.resolve_corners();
-  w.require_monotonic();
+  w.require_monotonic(fanuc);
   w.offset_profile(params.allowance);
-  w.translate(params.shift);
+  if (fanuc) w.shift_contour(w.to_frame(params.shift));
+  else w.translate(params.shift);
   FramedSink framed(out, w.frame);
   const double delta = std::max(params.depth, 2 * kTol);
   const Point escape = params.retract * Point(1, 1);
@@ -622,7 +668,7 @@ void rough(const Profile& profile, const RoughingParams& params, PathSink& out) 
     up.b = Point(up.a.real(), start.imag());
     w.pieces.push_back(up);
   }
-  Layers(w.pieces, framed, delta, escape).run(params.pockets, start);
+  Layers(w.pieces, framed, delta, escape).run(params.pockets, start, fanuc);
 }
 
 void finish(const Profile& profile, const FinishingParams& params, PathSink& out) {

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <random>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "gcode_test_util.hpp"
@@ -451,6 +452,211 @@ TEST(FanucCodes, G70RunsTheProfileBlocksAndReturnsToItsStart) {
   EXPECT_EQ(error_of("O1\nG21 G70 P10\nM30\nN10 G0 X1\n", fanuc(MachineKind::Lathe)), "fanuc.cycle-word-missing");
 }
 
+// --- G71/G72 stock removal (fanuc_roughing.cpp) ------------------------------------------------
+
+namespace {
+
+// Motions as (kind, X radius, Z), for exact expectations.
+using Step = std::tuple<char, double, double>;
+
+void expect_motions(const Recorder& rec, const std::vector<Step>& want, const std::string& what) {
+  ASSERT_EQ(rec.motions.size(), want.size()) << what;
+  for (std::size_t i = 0; i < want.size(); ++i) {
+    const auto& [kind, x, z] = want[i];
+    EXPECT_EQ(rec.motions[i].kind, kind) << what << ": move " << i;
+    EXPECT_NEAR(rec.motions[i].end[Axis::X], x, 1e-12) << what << ": move " << i;
+    EXPECT_NEAR(rec.motions[i].end[Axis::Z], z, 1e-12) << what << ": move " << i;
+  }
+}
+
+bool same_motions(const Recorder& a, const Recorder& b) {
+  if (a.motions.size() != b.motions.size()) return false;
+  for (std::size_t i = 0; i < a.motions.size(); ++i) {
+    if (a.motions[i].kind != b.motions[i].kind) return false;
+    for (const Axis axis : {Axis::X, Axis::Z}) {
+      if (std::fabs(a.motions[i].end[axis] - b.motions[i].end[axis]) > 1e-12) return false;
+    }
+  }
+  return true;
+}
+
+// A stepped shaft: face to X10, Z-10, taper to X20 at Z-15, Z-25, up to X30 (diameters).
+constexpr const char* kShaft = "N10 G0 X10\nG1 Z-10\nX20 Z-15\nZ-25\nN20 X30\n";
+
+}  // namespace
+
+TEST(FanucRoughing, G71TwoBlockFormCutsLayersDownToTheShiftedShapeAndReturns) {
+  Recorder rec;
+  const Outcome r = run(rec, std::string("O1\nG21 M3 S500\nG0 X30 Z2\nG71 U2 R0.5\nG71 P10 Q20 U1 W0.5 F0.2\n") + kShaft +
+                                 "G0 X40\nM30\n",
+                        fanuc(MachineKind::Lathe));
+  ASSERT_EQ(r.status, RunStatus::Finished) << r.message;
+  // Traced by hand (radii). Start X15 Z2; the shape moves by U/2 = 0.5 and W = 0.5, so the
+  // approach runs from the start to X5.5 Z2.5, and each layer starts on it:
+  const auto on_approach = [](double x) { return 2 + (15 - x) / 9.5 * 0.5; };
+  std::vector<Step> want{{'t', 15, 2}};
+  // Layers X13 and X11 reach the shoulder at Z-24.5, X9 and X7 the taper (Z-13, Z-11); each
+  // lifts off 0.5 at 45°, returns above its start and drops back to it.
+  for (const auto& [x, end] : {std::pair{13.0, -24.5}, {11.0, -24.5}, {9.0, -13.0}, {7.0, -11.0}}) {
+    const double z = on_approach(x);
+    want.insert(want.end(), {{'t', x, z}, {'f', x, end}, {'t', x + 0.5, end + 0.5}, {'t', x + 0.5, z - 0.5}, {'t', x, z}});
+  }
+  // Below the shape's first point the last pass follows the shape, then back to the start.
+  want.insert(want.end(), {{'t', 5.5, 2.5}, {'f', 5.5, -9.5}, {'f', 10.5, -14.5}, {'f', 10.5, -24.5}, {'f', 15.5, -24.5},
+                           {'t', 15, 2}, {'t', 20, 2}});   // the block after N20: G0 X40
+  expect_motions(rec, want, "G71");
+  EXPECT_EQ(r.state.fanuc.cycles.rough_depth, 2.0);
+  EXPECT_EQ(r.state.fanuc.cycles.rough_retract, 0.5);
+}
+
+TEST(FanucRoughing, HaasOneBlockFormTakesTheDepthFromD) {
+  const std::string head = "O1\nG21 M3 S500\nG0 X30 Z2\n";
+  const std::string tail = std::string(kShaft) + "G0 X40\nM30\n";
+  Recorder two, haas, increments;
+  ASSERT_EQ(run(two, head + "G71 U2 R0.5\nG71 P10 Q20 U1 W0.5 F0.2\n" + tail, fanuc(MachineKind::Lathe)).status,
+            RunStatus::Finished);
+  // Without R the retract is 0.5 mm (here also the two-block program's).
+  const Outcome r = run(haas, head + "G71 P10 Q20 U1 W0.5 D2. F0.2\n" + tail, fanuc(MachineKind::Lathe));
+  ASSERT_EQ(r.status, RunStatus::Finished) << r.message;
+  EXPECT_TRUE(same_motions(two, haas));
+  // D without a decimal point counts 0.001 mm, as Fanuc 0's one-block form writes it.
+  ASSERT_EQ(run(increments, head + "G71 P10 Q20 U1 W0.5 D2000 F0.2\n" + tail, fanuc(MachineKind::Lathe)).status,
+            RunStatus::Finished);
+  EXPECT_TRUE(same_motions(two, increments));
+}
+
+TEST(FanucRoughing, G72FacesInLayersAlongZ) {
+  Recorder rec;
+  const Outcome r = run(rec,
+                        "O1\nG21 M3 S500\nG0 X44 Z2\nG72 W1.5 R0.5\nG72 P10 Q20 F0.2\n"
+                        "N10 G0 Z-6\nG1 X24\nZ-2\nN20 X0\nG0 X50\nM30\n",
+                        fanuc(MachineKind::Lathe));
+  ASSERT_EQ(r.status, RunStatus::Finished) << r.message;
+  // Traced by hand: start X22 Z2 (radius); the shape is a shoulder face at Z-6 down to X12, a
+  // stub X12 to Z-2 and its end face to the axis. Layers every 1.5 in Z from Z0.5 run inwards
+  // from X22 to the axis (in front of the stub) or to the stub; each lifts off 0.5 towards
+  // +Z and +X and returns outside.
+  std::vector<Step> want{{'t', 22, 2}};
+  for (const auto& [z, end] : {std::pair{0.5, 0.0}, {-1.0, 0.0}, {-2.5, 12.0}, {-4.0, 12.0}, {-5.5, 12.0}})
+    want.insert(want.end(), {{'t', 22, z}, {'f', end, z}, {'t', end + 0.5, z + 0.5}, {'t', 21.5, z + 0.5}, {'t', 22, z}});
+  // The last pass: along the shape, then along the axis to the start's Z; back to the start.
+  want.insert(want.end(),
+              {{'t', 22, -6}, {'f', 12, -6}, {'f', 12, -2}, {'f', 0, -2}, {'f', 0, 2}, {'t', 22, 2}, {'t', 25, 2}});
+  expect_motions(rec, want, "G72");
+}
+
+// U and W leave stock by moving the shape: roughing with them is roughing the moved shape.
+TEST(FanucRoughing, AllowancesMoveTheShapeInTheProgramsFrame) {
+  const auto passes = [](const std::string& cycle, const std::string& shape) {
+    Recorder rec;
+    const Outcome r = run(rec, "O1\nG21 M3 S500\nG0 X44 Z2\n" + cycle + "\n" + shape + "G0 X50\nM30\n", fanuc(MachineKind::Lathe));
+    EXPECT_EQ(r.status, RunStatus::Finished) << cycle << ": " << r.message;
+    return rec;
+  };
+  EXPECT_TRUE(same_motions(passes("G71 P10 Q20 U2 W0.5 D1.5 F0.2", "N10 G0 X10\nG1 Z-10\nG2 X20 Z-15 R5\nN20 G1 X44\n"),
+                           passes("G71 P10 Q20 D1.5 F0.2", "N10 G0 X12 Z2.5\nG1 Z-9.5\nG2 X22 Z-14.5 R5\nN20 G1 X46\n")));
+  EXPECT_TRUE(same_motions(passes("G72 P10 Q20 U1 W0.4 D1.5 F0.2", "N10 G0 Z-6\nG1 X24\nG3 X14 Z-1 R5\nN20 G1 X0\n"),
+                           passes("G72 P10 Q20 D1.5 F0.2", "N10 G0 X45 Z-5.6\nG1 X25\nG3 X15 Z-0.6 R5\nN20 G1 X1\n")));
+  // Negative allowances (inside work) move it the other way.
+  EXPECT_TRUE(same_motions(passes("G71 P10 Q20 U-2 W0.5 D1.5 F0.2", "N10 G0 X10\nG1 Z-10\nN20 X30\n"),
+                           passes("G71 P10 Q20 D1.5 F0.2", "N10 G0 X8 Z2.5\nG1 Z-9.5\nN20 X28\n")));
+}
+
+// The layers end on the arcs of the shape (moved by the allowance); the last pass runs them.
+TEST(FanucRoughing, ArcsOfTheShapeBoundTheLayers) {
+  Recorder rec;
+  const Outcome r = run(rec,
+                        "O1\nG21 M3 S500\nG0 X40 Z2\nG71 P10 Q20 U0.4 W0.1 D1. F0.2\n"
+                        "N10 G0 X0\nG1 Z0\nG3 X20 Z-10 R10\nN20 G1 Z-20\nG0 X50\nM30\n",
+                        fanuc(MachineKind::Lathe));
+  ASSERT_EQ(r.status, RunStatus::Finished) << r.message;
+  // The sphere's centre X0 Z-10, moved by U/2 = 0.2 and W = 0.1.
+  const double cx = 0.2, cz = -9.9;
+  int on_arc = 0;
+  for (std::size_t i = 1; i + 1 < rec.motions.size(); ++i) {
+    const auto& m = rec.motions[i];
+    const double d = std::hypot(m.end[Axis::X] - cx, m.end[Axis::Z] - cz);
+    // A layer: a feed along Z followed by the lift-off.
+    const bool layer = m.kind == 'f' && m.end[Axis::X] == rec.motions[i - 1].end[Axis::X] && rec.motions[i + 1].kind == 't';
+    if (layer && m.end[Axis::Z] > cz && m.end[Axis::X] < 10.2 - 1e-9) {
+      EXPECT_NEAR(d, 10.0, 1e-9) << "layer " << i << " ends off the arc";
+      ++on_arc;
+    }
+  }
+  EXPECT_EQ(on_arc, 10);   // layers X19 .. X1 end on the arc (X10.2 and above reach Z-19.9)
+  ASSERT_EQ(rec.arcs.size(), 1u);
+  EXPECT_NEAR(rec.arcs[0].first_center, cz, 1e-9);    // Z
+  EXPECT_NEAR(rec.arcs[0].second_center, cx, 1e-9);   // X
+}
+
+// After roughing the program goes on after N Q when the shape follows the cycle, else after
+// the cycle; G70 then finishes along the shape.
+TEST(FanucRoughing, TheShapeIsPassedOverAndG70FinishesIt) {
+  Recorder inline_shape, shape_after_m30;
+  ASSERT_EQ(run(inline_shape,
+                std::string("O1\nG21 M3 S500\nG0 X30 Z2\nG71 P10 Q20 D2. F0.2\n(SHAPE)\n\n") + kShaft + "G0 X40\nM30\n",
+                fanuc(MachineKind::Lathe))
+                .status,
+            RunStatus::Finished);
+  ASSERT_EQ(run(shape_after_m30, std::string("O1\nG21 M3 S500\nG0 X30 Z2\nG71 P10 Q20 D2. F0.2\nG0 X40\nM30\n") + kShaft,
+                fanuc(MachineKind::Lathe))
+                .status,
+            RunStatus::Finished);
+  EXPECT_TRUE(same_motions(inline_shape, shape_after_m30));
+  EXPECT_EQ(inline_shape.motions.back().end[Axis::X], 20.0);
+  Recorder finish;
+  const Outcome r = run(finish,
+                        std::string("O1\nG21 M3 S500\nG0 X30 Z2\nG71 P10 Q20 U1 W0.5 D2. F0.2\n") + kShaft +
+                            "G70 P10 Q20 F0.1\nG0 X40\nM30\n",
+                        fanuc(MachineKind::Lathe));
+  ASSERT_EQ(r.status, RunStatus::Finished) << r.message;
+  const std::vector<Step> tail{{'t', 15, 2},  {'t', 5, 2},    {'f', 5, -10}, {'f', 10, -15},
+                               {'f', 10, -25}, {'f', 15, -25}, {'t', 15, 2},  {'t', 20, 2}};
+  ASSERT_GT(finish.motions.size(), tail.size());
+  Recorder last;
+  last.motions.assign(finish.motions.end() - static_cast<std::ptrdiff_t>(tail.size()), finish.motions.end());
+  expect_motions(last, tail, "G70 after G71");
+}
+
+TEST(FanucRoughing, ProblemsHaveTheirCodes) {
+  const Options lathe = fanuc(MachineKind::Lathe);
+  const std::string head = "O1\nG21 M3 S500\nG0 X30 Z2\n";
+  const std::string tail = std::string(kShaft) + "M30\n";
+  EXPECT_EQ(error_of(head + "G71 P10 Q20 F0.2\n" + tail, lathe), "fanuc.cycle-word-missing");   // no depth
+  EXPECT_EQ(error_of(head + "G71 P10 D1. F0.2\n" + tail, lathe), "fanuc.cycle-word-missing");
+  EXPECT_EQ(error_of(head + "G71 U0 R1\n" + tail, lathe), "fanuc.cycle-word-value");
+  EXPECT_EQ(error_of(head + "G71 P10 Q20 D-1 F0.2\n" + tail, lathe), "fanuc.cycle-word-value");
+  EXPECT_EQ(error_of(head + "G71 X20 P10 Q20 D1. F0.2\n" + tail, lathe), "fanuc.cycle-word-value");
+  EXPECT_EQ(error_of(head + "G71 P10 Q30 D1. F0.2\n" + tail, lathe), "fanuc.goto-target-missing");
+  EXPECT_EQ(error_of(head + "G71 P20 Q10 D1. F0.2\n" + tail, lathe), "fanuc.goto-target-missing");
+  EXPECT_EQ(error_of(head + "G71 P10 Q20 I1 D1. F0.2\n" + tail, lathe), "gcode.unsupported");
+  EXPECT_EQ(error_of("O1\nG21 M3 S500\nG0 X30 Z2\nG71 P10 Q20 D1.\n" + tail, lathe), "gcode.feed-zero");
+  EXPECT_EQ(error_of("O1\nG21 G0 X30 Z2\nG71 P10 Q20 D1. F0.2\n" + tail), "gcode.unsupported");   // a mill
+  EXPECT_EQ(error_of(head + "T0101\nG41 G0 X32\nG71 P10 Q20 D1. F0.2\n" + tail, lathe), "gcode.lathe-comp-on");
+  // The shape: only moves, compensation, feed and spindle modes; no statements or calls.
+  for (const char* block : {"G4 P1", "M98 P2", "#1 = 2", "GOTO 20", "G70 P10 Q20", "M30", "G54"}) {
+    Recorder rec;
+    const Outcome r =
+        run(rec, head + "G71 P10 Q20 D1. F0.2\nN10 G0 X10\nG1 Z-10\n" + block + "\nN20 X30\nM30\n", lathe);
+    EXPECT_EQ(r.code, "fanuc.profile-block") << block;
+    EXPECT_EQ(r.line, 7u) << block << ": the error points at the shape's block";
+  }
+  // A shape that turns back along Z; one that never leaves its first point.
+  EXPECT_EQ(error_of(head + "G71 P10 Q20 D1. F0.2\nN10 G0 X10\nG1 Z-10\nX16\nZ-5\nN20 X30\nM30\n", lathe),
+            "gcode.lathe-profile-not-monotonic");
+  EXPECT_EQ(error_of(head + "G71 P10 Q20 D1. F0.2\nN10 G0 X10\nN20 M8\nM30\n", lathe), "fanuc.profile-block");
+  // From MDI the shape cannot be read (as G70 P Q cannot run); the settings block can.
+  Interpreter mdi(lathe);
+  mdi.open_text("shape.nc", "O1\nG21\nM30\n" + std::string(kShaft));
+  Recorder rec;
+  EXPECT_EQ(mdi.execute_mdi("G21 G0 X30 Z2 F0.2", rec), RunStatus::Ok);
+  EXPECT_EQ(mdi.execute_mdi("G71 U2 R0.5", rec), RunStatus::Ok);
+  EXPECT_EQ(mdi.execute_mdi("G71 P10 Q20", rec), RunStatus::Error);
+  EXPECT_EQ(mdi.diagnostics().items().back().code, "gcode.oword-in-mdi");
+  EXPECT_EQ(mdi.execute_mdi("G0 X40", rec), RunStatus::Ok);
+  EXPECT_EQ(rec.motions.back().end[Axis::X], 20.0);
+}
+
 TEST(FanucCodes, G50IsScalingCancelOnAMill) {
   Recorder rec;
   const Outcome r = run(rec, "O1\nG21 F100\nG51 X0 Y0 P2\nG1 X1 Y1\nG50 S1000\nG1 X1 Y1\nM30\n");
@@ -541,8 +747,7 @@ class StateAtMotion : public canon::Sink {
   Trace& trace_;
 };
 
-Trace trace(std::string_view program, canon::SegmentId quiet) {
-  Options o = fanuc();
+Trace trace(std::string_view program, canon::SegmentId quiet, Options o = fanuc()) {
   o.quiet_until_segment = quiet;
   Interpreter interp(o);
   interp.open_text("replay.nc", std::string(program));
@@ -608,6 +813,25 @@ TEST(FanucReplay, SeededRandomProgramsReplayExactly) {
       ASSERT_LE(part.lines.size(), full.lines.size());
       EXPECT_TRUE(std::equal(part.lines.begin(), part.lines.end(), full.lines.end() - static_cast<std::ptrdiff_t>(part.lines.size())));
     }
+  }
+}
+
+// A roughing cycle (its settings, the shape read and passed over, G70 after it) replays to
+// any of its moves exactly.
+TEST(FanucReplay, RoughingCyclesReplayExactly) {
+  const std::string p = std::string("%\nO1\nG21 M3 S500\nG0 X30 Z2\nG71 U2 R0.5\nG71 P10 Q20 U1 W0.5 F0.2\n") + kShaft +
+                        "G70 P10 Q20\nG0 X40\nG72 P30 Q40 D1.5 F0.2\nN30 G0 Z-6\nG1 X24\nN40 X0\nG0 X50\nM30\n%\n";
+  const Trace full = trace(p, 0, fanuc(MachineKind::Lathe));
+  ASSERT_EQ(full.status, RunStatus::Finished);
+  ASSERT_GT(full.states.size(), 40u);
+  for (canon::SegmentId k = 1; k < full.states.size(); k += 3) {
+    const Trace part = trace(p, k, fanuc(MachineKind::Lathe));
+    ASSERT_EQ(part.status, RunStatus::Finished);
+    ASSERT_EQ(part.states.size(), full.states.size());
+    EXPECT_EQ(part.states[k], full.states[k]) << "segment " << k;
+    EXPECT_EQ(part.states[k].digest(), full.states[k].digest());
+    ASSERT_LE(part.lines.size(), full.lines.size());
+    EXPECT_TRUE(std::equal(part.lines.begin(), part.lines.end(), full.lines.end() - static_cast<std::ptrdiff_t>(part.lines.size())));
   }
 }
 

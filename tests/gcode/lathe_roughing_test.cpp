@@ -297,3 +297,186 @@ TEST(LatheRoughingProperty, FinishingPassesStepTheAllowance) {
     EXPECT_TRUE(near(out.moves.front().end, start)) << "trial " << trial;
   }
 }
+
+// --- Fanuc's reading of the profile (Convention::Fanuc) ------------------------------------
+
+namespace {
+
+// The highest point of a line contour over z (lines only), -inf where none is.
+double height(const Profile& p, double z) {
+  double h = -1e300;
+  for (std::size_t k = 1; k < p.size(); ++k) {
+    const Point a = p[k].start, b = p[k].end;
+    if (z < std::min(a.real(), b.real()) || z > std::max(a.real(), b.real())) continue;
+    if (a.real() == b.real()) h = std::max({h, a.imag(), b.imag()});
+    else h = std::max(h, a.imag() + (z - a.real()) / (b.real() - a.real()) * (b.imag() - a.imag()));
+  }
+  return h;
+}
+
+// True when q lies inside the part below the contour (not just on its boundary).
+bool inside_part(const Profile& p, Point q, double tol) {
+  const double z0 = p.back().end.real(), z1 = p[1].start.real();
+  if (q.real() <= z0 + tol || q.real() >= z1 - tol) return false;
+  return q.imag() < std::min(height(p, q.real() - tol), height(p, q.real() + tol)) - tol;
+}
+
+Profile shifted(Profile p, Point d) {
+  for (std::size_t k = 1; k < p.size(); ++k) p[k].start += d, p[k].end += d;
+  p.front().end = p[1].start;
+  return p;
+}
+
+}  // namespace
+
+// Fanuc's U/W move the contour: no move of the roughing passes (rapids included, sampled
+// along their length) enters the part grown by them; every cut runs on a layer one or more
+// depths below the start point; the passes start at the start point itself.
+TEST(LatheRoughingProperty, FanucAllowancesShiftTheContourAndNothingCutsIntoIt) {
+  std::mt19937_64 rng(5150);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  int checked = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    Point start;
+    const Profile p = random_contour(rng, false, start);
+    RoughingParams params;
+    params.convention = Convention::Fanuc;
+    params.start = start;
+    params.shift = Point(0.4 * unit(rng), 0.4 * unit(rng));
+    params.depth = 0.3 + unit(rng);
+    params.retract = 0.1 + 0.4 * unit(rng);
+    Recorder out;
+    try {
+      rough(p, params, out);
+    } catch (const RoughingError&) {
+      continue;
+    }
+    const Profile part = shifted(p, params.shift);
+    EXPECT_EQ(out.moves.front().end, start);
+    Point at = start;
+    for (std::size_t i = 0; i < out.moves.size(); ++i) {
+      const Move& m = out.moves[i];
+      ASSERT_NE(m.kind, 'c') << "a line contour gives no arcs";
+      for (int s = 0; s <= 16; ++s) {
+        const Point q = at + (m.end - at) * (s / 16.0);
+        EXPECT_FALSE(inside_part(part, q, 1e-9)) << "trial " << trial << " move " << i << " at " << q;
+      }
+      EXPECT_LE(m.end.imag(), start.imag() + params.retract + 1e-9);
+      const bool layer = m.kind == 'f' && at.imag() == m.end.imag() && i + 1 < out.moves.size() && out.moves[i + 1].kind == 'r';
+      if (layer) {
+        const double k = (start.imag() - m.end.imag()) / params.depth;
+        EXPECT_NEAR(k, std::round(k), 1e-9) << "trial " << trial << " move " << i;
+        EXPECT_GE(std::round(k), 1.0) << "the first cut is one depth below the start point";
+      }
+      at = m.end;
+    }
+    ++checked;
+  }
+  EXPECT_GT(checked, 300);
+}
+
+// A contour that starts with a face falling towards the axis ends lower than it starts;
+// LinuxCNC's rule reads it as a bore, Fanuc's takes the side from the approach: the same
+// passes as the contour without its first face, plus the face.
+TEST(LatheRoughing, FanucTakesTheStockSideFromTheApproach) {
+  // Start X10 Z1; approach to X6 Z1, Z0, face down to X2, then X4 at Z-5 (below X6).
+  const Profile p{line(xz(10, 1), xz(6, 1)), line(xz(6, 1), xz(6, 0)), line(xz(6, 0), xz(2, 0)),
+                  line(xz(2, 0), xz(4, -5))};
+  RoughingParams params;
+  params.convention = Convention::Fanuc;
+  params.start = xz(10, 1);
+  params.depth = 2;
+  params.retract = 0.5;
+  Recorder out;
+  rough(p, params, out);
+  // Traced by hand: the layer at X8 runs from the approach to Z-5 (where the contour ends,
+  // closed upwards). At X6 the approach ends on the flat: the tool follows it to the face,
+  // where a pocket starts; its layers (X6, X4) run from the face to Z-5, lift off at 45° and
+  // come back at feed (inside the pocket). At X2, the face's foot, the last pass follows the
+  // contour and goes up at Z-5.
+  const std::vector<std::pair<char, Point>> want{
+      {'r', xz(10, 1)},    {'r', xz(8, 1)},     {'f', xz(8, -5)},   {'r', xz(8.5, -4.5)}, {'r', xz(8.5, 0.5)},
+      {'r', xz(8, 1)},     {'r', xz(6, 1)},     {'f', xz(6, 0)},    {'f', xz(6, 0)},      {'f', xz(6, -5)},
+      {'r', xz(6.5, -4.5)}, {'r', xz(6.5, -0.5)}, {'f', xz(6, 0)},  {'f', xz(4, 0)},      {'f', xz(4, -5)},
+      {'r', xz(4.5, -4.5)}, {'r', xz(4.5, -0.5)}, {'f', xz(4, 0)},  {'f', xz(2, 0)},      {'f', xz(4, -5)},
+      {'f', xz(10, -5)}};
+  ASSERT_EQ(out.moves.size(), want.size());
+  for (std::size_t i = 0; i < want.size(); ++i) {
+    EXPECT_EQ(out.moves[i].kind, want[i].first) << "move " << i;
+    EXPECT_TRUE(near(out.moves[i].end, want[i].second, 1e-12)) << "move " << i << ": " << out.moves[i].end;
+  }
+  params.convention = Convention::LinuxCnc;   // mirrored: cuts on the wrong side (or fails)
+  Recorder linuxcnc;
+  try {
+    rough(p, params, linuxcnc);
+    EXPECT_NE(linuxcnc.moves.size(), want.size());
+  } catch (const RoughingError&) {
+  }
+}
+
+// Lines at the contour's end along or above the start height (a retract to the start point)
+// cut nothing: the passes are those of the contour without them.
+TEST(LatheRoughing, FanucLeavesOutTheRetractAtTheContoursEnd) {
+  const Profile core{line(xz(10, 1), xz(2, 0)), line(xz(2, 0), xz(2, -5)), line(xz(2, -5), xz(6, -5)),
+                     line(xz(6, -5), xz(6, -10)), line(xz(6, -10), xz(10, -10))};
+  Profile tail = core;
+  tail.push_back(line(xz(10, -10), xz(10, 1)));   // back to the start at its height
+  RoughingParams params;
+  params.convention = Convention::Fanuc;
+  params.start = xz(10, 1);
+  params.depth = 1.5;
+  params.shift = Point(0.2, 0.3);
+  Recorder a, b;
+  rough(core, params, a);
+  rough(tail, params, b);
+  ASSERT_EQ(a.moves.size(), b.moves.size());
+  for (std::size_t i = 0; i < a.moves.size(); ++i) EXPECT_TRUE(near(a.moves[i].end, b.moves[i].end)) << "move " << i;
+  // LinuxCNC's reading keeps the element, which turns back along Z.
+  params.convention = Convention::LinuxCnc;
+  Recorder c;
+  EXPECT_THROW(rough(tail, params, c), RoughingError);
+}
+
+// Fanuc's reading in the other frames: a bore (the profile mirrored about the axis, U negative)
+// gives the mirrored passes, and G72 on a profile turned by 90° the turned passes; the
+// allowance is turned and mirrored with the profile, so it keeps its meaning in each.
+TEST(LatheRoughingProperty, FanucBoringAndFacingAreTurningMirroredAndTurned) {
+  std::mt19937_64 rng(6060);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  int compared = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    Point start;
+    const Profile p = random_contour(rng, true, start);
+    RoughingParams t;
+    t.convention = Convention::Fanuc;
+    t.start = start;
+    t.shift = Point(0.3 * unit(rng), 0.3 * unit(rng));
+    t.depth = 0.4 + unit(rng);
+    t.retract = 0.3;
+    RoughingParams bore = t;
+    bore.start = std::conj(start);
+    bore.shift = std::conj(t.shift);
+    RoughingParams face = t;
+    face.direction = Direction::Facing;
+    face.start = start * Point(0, 1);
+    face.shift = t.shift * Point(0, 1);
+    Profile facing = p;
+    for (auto& e : facing) e.start *= Point(0, 1), e.end *= Point(0, 1), e.center *= Point(0, 1);
+    Recorder a, b, c;
+    bool ok_a = true, ok_b = true, ok_c = true;
+    try { rough(p, t, a); } catch (const RoughingError&) { ok_a = false; }
+    try { rough(mirrored_x(p), bore, b); } catch (const RoughingError&) { ok_b = false; }
+    try { rough(facing, face, c); } catch (const RoughingError&) { ok_c = false; }
+    ASSERT_EQ(ok_a, ok_b) << "trial " << trial;
+    ASSERT_EQ(ok_a, ok_c) << "trial " << trial;
+    if (!ok_a) continue;
+    ASSERT_EQ(a.moves.size(), b.moves.size()) << "trial " << trial;
+    ASSERT_EQ(a.moves.size(), c.moves.size()) << "trial " << trial;
+    for (std::size_t i = 0; i < a.moves.size(); ++i) {
+      EXPECT_TRUE(near(std::conj(a.moves[i].end), b.moves[i].end)) << "trial " << trial << " move " << i;
+      EXPECT_TRUE(near(a.moves[i].end * Point(0, 1), c.moves[i].end)) << "trial " << trial << " move " << i;
+    }
+    ++compared;
+  }
+  EXPECT_GT(compared, 200);
+}

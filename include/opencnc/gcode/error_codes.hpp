@@ -225,6 +225,7 @@ namespace opencnc::gcode {
   X(FanucStatementSyntax, "fanuc.statement-syntax")                          \
   X(FanucCycleWordMissing, "fanuc.cycle-word-missing")                       \
   X(FanucCycleWordValue, "fanuc.cycle-word-value")                           \
+  X(FanucProfileBlock, "fanuc.profile-block")                                \
   X(FanucScaleWords, "fanuc.scale-words")                                    \
   X(FanucRotationAngleMissing, "fanuc.rotation-angle-missing")               \
   X(FanucRotationPlane, "fanuc.rotation-plane")                              \

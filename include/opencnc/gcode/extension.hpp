@@ -10,6 +10,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include "opencnc/canon/sink.hpp"
 #include "opencnc/gcode/block.hpp"
@@ -65,6 +66,18 @@ class ExecContext {
   /// prints it); `block` passed to the handler is valid again.
   virtual void read_subprogram(const std::string& name, std::uint32_t extra_letters,
                                const std::function<void(const Block&)>& visit) = 0;
+  /// Reads the blocks numbered N`first` to N`last` of the running program the way Fanuc's
+  /// G71/G72 read their finishing shape (Fanuc dialect): each block is parsed, its Fanuc words
+  /// translated (U/W from the current position, which the visitor keeps at the shape's point)
+  /// and checked, then handed to `visit` instead of being executed. Macro statements,
+  /// assignments and calls in the range are errors; so is a range whose N`last` comes before
+  /// N`first` (`what` names the cycle in messages). Errors raised while a block is visited
+  /// point at that block. Afterwards the output belongs to the current block again, and the
+  /// program goes on after N`last` when the range follows the current block with nothing but
+  /// blank and comment lines between them (Fanuc passes over the shape after roughing), else
+  /// after the current block.
+  virtual void read_block_range(std::int64_t first, std::int64_t last, std::string_view what,
+                                const std::function<void(const Block&)>& visit) = 0;
   /// LinuxCNC keeps a queue of canonical calls while cutter compensation is on so that a
   /// move's end can still be changed; open it, then flush it when the moves are final.
   virtual void open_queue() = 0;

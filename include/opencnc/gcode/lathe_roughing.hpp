@@ -45,6 +45,22 @@ enum class Pockets : std::uint8_t { All = 0, None = 1, OnlyPockets = 2 };
 /// G71 (turning: passes along Z, depth steps in X) or G72 (facing: passes along X, steps in Z).
 enum class Direction : std::uint8_t { Turning, Facing };
 
+/// Whose reading of the profile the cycle follows. The two differ where a profile leaves
+/// the choice open; on ordinary profiles they cut the same.
+enum class Convention : std::uint8_t {
+  /// LinuxCNC's G7x: the cutting side from where the contour's first point lies against its
+  /// last; `shift` applies in the working frame and moves the start point with the contour.
+  LinuxCnc,
+  /// Fanuc's G71/G72 P Q: the stock side from the approach (from the start point towards the
+  /// contour's first point, across the passes), so that a contour may start with a face that
+  /// falls towards the axis; `shift` (Fanuc's W and U/2) moves the contour, not the start
+  /// point, in the program's frame; the approach stays as programmed; straight elements at
+  /// the contour's end that lie at or beyond the start point's depth (where the start point
+  /// says there is no stock, such as a retract back to the start) are left out; the first
+  /// layer is one depth below the start point, not at its height.
+  Fanuc,
+};
+
 struct RoughingParams {
   Direction direction = Direction::Turning;
   Pockets pockets = Pockets::All;
@@ -52,11 +68,13 @@ struct RoughingParams {
   double allowance = 0;      ///< D: finishing allowance, an offset normal to the profile (≥ 0)
   double depth = 1;          ///< I: depth of cut of each pass (> 0)
   double retract = 0.5;      ///< R: lift-off at 45° after each pass
-  /// W (real) and U (imaginary): the roughing profile is moved by this after it has been
-  /// mirrored or rotated into the cycle's working frame (cutting towards -Z, X rising along
-  /// the profile). For outside turning towards -Z, positive values leave stock on the outside
-  /// and on faces that look towards +Z, as Fanuc's U and W do (U here is a radius).
+  /// W (real) and U (imaginary): the roughing profile is moved by this. LinuxCnc: after it
+  /// has been mirrored or rotated into the cycle's working frame (cutting towards -Z, X rising
+  /// along the profile); for outside turning towards -Z, positive values leave stock on the
+  /// outside and on faces that look towards +Z. Fanuc: in the program's frame, as Fanuc's W
+  /// and U/2 (U here is a radius), the start point staying where it is.
   Point shift = 0;
+  Convention convention = Convention::LinuxCnc;
 };
 
 struct FinishingParams {

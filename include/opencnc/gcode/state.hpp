@@ -181,7 +181,7 @@ inline constexpr int kFanucVariableCount = 1000;   ///< #0..#999 can be vacant
 /// What the first block of a Fanuc two-block lathe cycle sets for the blocks after it.
 struct FanucCycleSettings {
   double rough_depth = 0;        ///< G71 U(d) / G72 W(d): depth of cut (0: not set)
-  double rough_retract = 0;      ///< G71/G72 R(e): retract after each cut
+  double rough_retract = -1;     ///< G71/G72 R(e): retract after each cut (-1: not set)
   double groove_retract = 0;     ///< G75 R(e): retract after each peck (0: not set)
   int thread_finish_passes = 1;  ///< G76 P(m): finishing passes
   double thread_chamfer = 0;     ///< G76 P(r): pull-out length in tenths of the lead
