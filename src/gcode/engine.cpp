@@ -196,8 +196,31 @@ RunStatus Engine::mdi(std::string_view line, canon::Sink& sink) {
   st_.ended = false;   // MDI also works after a program end
   const RunStatus s = guarded(sink, &Engine::process_line);
   in_mdi_ = false;
-  if (s == RunStatus::Error) failed_ = false;   // an MDI error does not end the session
+  if (s == RunStatus::Error) {   // an MDI error does not end the session
+    failed_ = false;
+    abandon_calls();
+  }
   return s == RunStatus::Finished ? RunStatus::Ok : s;
+}
+
+// An MDI line failed inside the subprogram it called: every call is left as if it had returned
+// (arguments or macro locals back as they were), so the next line runs in the session's frame.
+void Engine::abandon_calls() {
+  while (st_.frames.size() > 1) {
+    const CallFrame& f = st_.frames.back();
+    if (f.fanuc.macro) {
+      for (std::size_t i = 1; i <= kFanucLocalCount; ++i) {
+        st_.parameters[i] = f.fanuc.saved_locals[i - 1];
+        st_.fanuc.vacant[i] = f.fanuc.saved_vacant[i];
+      }
+    } else if (!fanuc()) {
+      for (int i = 0; i < kSubArgumentCount; ++i)
+        st_.parameters[static_cast<std::size_t>(1 + i)] = f.saved_args[static_cast<std::size_t>(i)];
+    }
+    leave_frame();
+  }
+  st_.control.skipping_to.clear();
+  st_.control.seeking_sub.clear();
 }
 
 ParseEnv Engine::parse_env() const noexcept {
@@ -351,6 +374,10 @@ bool Engine::process_line() {
 // An MDI line that called a subprogram runs it to the end before returning.
 void Engine::finish_mdi_call() {
   while (st_.frames.size() > 1 && !failed_ && !st_.ended) {
+    // A call the MDI line could not place in a file (a LinuxCNC G70 profile sub in the Fanuc
+    // dialect, say) has nothing to read: an error, not a read past the open files.
+    if (st_.next.file >= files_.size())
+      fail(ErrorCode::OwordSubNotFound, "the subprogram this MDI line calls is in no file that can be read");
     in_mdi_ = false;
     process_line();
     in_mdi_ = true;

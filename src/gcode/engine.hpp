@@ -292,6 +292,7 @@ class Engine final : public ParamHost, public ExecContext {
   std::string fanuc_program_name(const FanucFrame& f) const;
   bool only_comments_between(const SourcePosition& from, const SourcePosition& to);
   void finish_mdi_call();
+  void abandon_calls();
 
   // fanuc_translate.cpp: Fanuc words and codes rewritten into the core's before the checks
   void fanuc_translate();

@@ -200,6 +200,16 @@ TEST(FanucPrograms, MdiCallsRunTheirProgramToTheEnd) {
   EXPECT_EQ(interp.execute_mdi("G1 X0", rec), RunStatus::Ok);        // the session goes on
 }
 
+TEST(FanucPrograms, MdiCallToASubprogramInNoFileFails) {
+  // LinuxCNC's G70 Q (a profile subprogram) from Fanuc MDI, with no program open: an error
+  // (found by the fuzzer as a read past the open files), and the session goes on.
+  Interpreter interp(fanuc());
+  Recorder rec;
+  EXPECT_EQ(interp.execute_mdi("G18 G70 Q2", rec), RunStatus::Error);
+  EXPECT_EQ(interp.execute_mdi("G21 G0 X1", rec), RunStatus::Ok);
+  EXPECT_EQ(rec.xs().back(), 1.0);
+}
+
 TEST(FanucPrograms, ProgramsMustEndBeforeTheNextOne) {
   EXPECT_EQ(error_of("O1\nG21\nM98 P2\nM30\nO2\nG0 X1\nO3\nM99\n"), "fanuc.program-end-missing");
   EXPECT_EQ(error_of("O1\nG21\nM98 P2\nM30\nO2\nG0 X1\n"), "fanuc.program-end-missing");
