@@ -30,9 +30,10 @@ std::uint64_t low_bits(int n) {
 SimMachine::SimMachine(const SimMachineConfig& config) : config_(config), rng_(config.seed) {
   for (int j = 0; j < config.joint_count; ++j) {
     const auto uj = static_cast<std::size_t>(j);
-    joints_[uj] = SimJoint(config.joints[uj], config.servo_period_s, config.substeps);
+    joints_[uj] = SimJoint(config.joints[uj], config.servo_period_s, config.substeps, config.linear_periods);
   }
-  if (config.spindle) spindle_ = SimSpindle(config.spindle_config, config.servo_period_s, config.substeps);
+  if (config.spindle)
+    spindle_ = SimSpindle(config.spindle_config, config.servo_period_s, config.substeps, config.linear_periods);
   if (config.probe.joint >= 0)
     probe_ = SimSwitch(config.probe.trip, config.probe.hysteresis, config.probe.noise);
   dc_link_v_ = config.power.dc_link_nominal_v;
@@ -103,31 +104,32 @@ void SimMachine::set_analog_input(int channel, double value) noexcept {
 void SimMachine::advance() noexcept {
   const bool powered = drives_powered();
   const int n = config_.joint_count;
+  bool substeps = false;  // begin_period() integrates what it can at once
   for (int j = 0; j < n; ++j) {
     const auto uj = static_cast<std::size_t>(j);
     joints_[uj].begin_period(outputs_.joints[uj], powered && !undervoltage_fault_[uj], external_effort_[uj]);
+    substeps = substeps || joints_[uj].needs_substeps();
   }
-  if (config_.spindle) spindle_.begin_period(outputs_.spindle, powered);
+  if (config_.spindle) {
+    spindle_.begin_period(outputs_.spindle, powered);
+    substeps = substeps || spindle_.needs_substeps();
+  }
   // Sub-steps outside, joints inside: the joints' dependency chains are independent, so the
   // CPU overlaps them (measured: about twice as fast as one joint after the other).
-  for (int i = 0; i < config_.substeps; ++i) {
+  for (int i = 0; substeps && i < config_.substeps; ++i) {
     for (int j = 0; j < n; ++j) joints_[static_cast<std::size_t>(j)].substep(i);
     if (config_.spindle) spindle_.substep();
   }
-  double energy_j = 0;
-  for (int j = 0; j < n; ++j) {
-    joints_[static_cast<std::size_t>(j)].end_period();
-    energy_j += joints_[static_cast<std::size_t>(j)].energy_j();
-  }
+  for (int j = 0; j < n; ++j) joints_[static_cast<std::size_t>(j)].end_period();
   if (config_.spindle) spindle_.end_period();
-  update_power(energy_j);
+  update_power();
   update_auxiliaries();
 }
 
 // Mains on: the rectifier holds the DC link at nominal. Mains off with a charged UPS: the
 // UPS does. Otherwise the link capacitor alone feeds the idle load and the axes:
 // ½·C·V² loses idle_power·T + E_axes per period (braking axes give energy back).
-void SimMachine::update_power(double energy_j) noexcept {
+void SimMachine::update_power() noexcept {
   const SimPowerConfig& p = config_.power;
   const double period = config_.servo_period_s;
   on_battery_ = !mains_ok_ && ups_periods_left_ > 0;
@@ -137,6 +139,8 @@ void SimMachine::update_power(double energy_j) noexcept {
     --ups_periods_left_;
     dc_link_v_ = p.dc_link_nominal_v;
   } else {
+    double energy_j = 0;  // what the axes took from the link in this period
+    for (int j = 0; j < config_.joint_count; ++j) energy_j += joints_[static_cast<std::size_t>(j)].energy_j();
     const double c = p.dc_link_capacitance_f;
     const double stored_j = 0.5 * c * dc_link_v_ * dc_link_v_ - p.idle_power_w * period - energy_j;
     dc_link_v_ =

@@ -57,7 +57,7 @@ class SimMachine final : public MachineIO {
 
  private:
   void advance() noexcept;
-  void update_power(double energy_j) noexcept;
+  void update_power() noexcept;
   void update_auxiliaries() noexcept;
   void sample() noexcept;
 
