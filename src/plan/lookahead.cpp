@@ -145,7 +145,7 @@ void Lookahead::split(std::size_t k, double x) {
   tail.junction = kInf;
   tail.step = Pose{};
   tail.step_sum = Pose{};
-  window_.insert(window_.begin() + static_cast<std::ptrdiff_t>(k + 1), tail);
+  window_.insert(k + 1, tail);
 }
 
 // Blocks whose widened limits can no longer change get their prefix and own entry limit.

@@ -7,11 +7,11 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
-#include <deque>
 #include <utility>
 #include <vector>
 
 #include "opencnc/traj/block_queue.hpp"
+#include "ring.hpp"
 
 namespace opencnc::plan::detail {
 
@@ -97,7 +97,7 @@ class Lookahead {
 
   WindowParams p_;
   double reach_ = 0;  ///< the widest range any limit is widened over
-  std::deque<PlannedBlock> window_;
+  Ring<PlannedBlock> window_;
   double total_s_ = 0;        ///< s at the end of the last pushed block
   std::size_t settled_ = 0;   ///< front blocks with final widened limits, prefix and local
   std::size_t pinned_ = 0;    ///< front blocks with a final entry speed

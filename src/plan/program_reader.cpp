@@ -2,6 +2,7 @@
 // canon::Program → path elements and markers, with modal path-control state and G64 Q merging.
 #include "program_reader.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -260,23 +261,36 @@ bool ProgramReader::can_extend_run(const Element& e) const {
       run_.tolerance > 0 ? std::min(naive_tolerance_, 0.5 * run_.tolerance) : naive_tolerance_;
   const double q = std::min(q_vertex, merge_budget() - floor);
   if (q < 0) return false;
-  const Pose end = end_point(e.b);
-  const Pose chord = end - run_start_;
+  const Pose chord = end_point(e.b) - run_start_;
   const double len = norm(chord);
   if (len < kMinLength) return false;
   const Pose dir = (1.0 / len) * chord;
+  // A vertex at r from the start lies t = r·dir along the chord and √(|r|² − t²) from it. Every
+  // run is checked again for each new end, so this is the planner's inner loop on dense paths.
   double last = 0;
-  const auto inside = [&](const Pose& p) {
-    const Pose rel = p - run_start_;
-    const double t = dot(rel, dir);
+  const auto inside = [&](double t, double r_squared) {
     if (t < last || t > len) return false;
     last = t;
-    return norm(rel - t * dir) <= q;
+    return r_squared - t * t <= q * q;
   };
-  for (const Pose& p : run_points_) {
-    if (!inside(p)) return false;
+  for (std::size_t k = 0; k < run_points_.size(); ++k) {
+    const Pose& r = run_points_[k];
+    double t = 0;
+    for (int a = 0; a < run_axis_count_; ++a) t += r[run_axes_[static_cast<std::size_t>(a)]] * dir[run_axes_[static_cast<std::size_t>(a)]];
+    if (!inside(t, run_squares_[k])) return false;
   }
-  return inside(e.b.base);
+  const Pose r = e.b.base - run_start_;
+  return inside(dot(r, dir), dot(r, r));
+}
+
+void ProgramReader::add_run_point(const Pose& rel) {
+  run_points_.push_back(rel);
+  run_squares_.push_back(dot(rel, rel));
+  for (int i = 0; i < kAxisCount; ++i) {
+    if (rel[i] == 0) continue;
+    const auto end = run_axes_.begin() + run_axis_count_;
+    if (std::find(run_axes_.begin(), end, i) == end) run_axes_[static_cast<std::size_t>(run_axis_count_++)] = i;
+  }
 }
 
 void ProgramReader::flush_run() {
@@ -289,13 +303,12 @@ void ProgramReader::flush_run() {
     e.b.feed = run_feed_ / 60.0 * feed_length_ratio(run_start_, end, e.b);
     e.orig_length = e.b.length;
     double dev = 0;
-    for (const Pose& p : run_points_) {
-      const double t = dot(p - run_start_, e.b.lin);
-      dev = std::max(dev, norm(p - (run_start_ + t * e.b.lin)));
-    }
+    for (const Pose& r : run_points_) dev = std::max(dev, norm(r - dot(r, e.b.lin) * e.b.lin));
     e.merge_deviation = dev + run_floor_;
   }
   run_points_.clear();
+  run_squares_.clear();
+  run_axis_count_ = 0;
   Item it;
   it.element = e;
   ready_.push_back(it);
@@ -303,7 +316,7 @@ void ProgramReader::flush_run() {
 
 void ProgramReader::push_element(const Element& e) {
   if (can_extend_run(e)) {
-    run_points_.push_back(e.b.base);
+    add_run_point(e.b.base - run_start_);
     run_.b.segment_last = e.b.segment_last;
     run_.b.base = e.b.base;  // the run's current last line, for end_point()
     run_.b.lin = e.b.lin;

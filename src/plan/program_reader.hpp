@@ -4,6 +4,7 @@
 // nearly collinear feed lines.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <deque>
 #include <vector>
@@ -79,7 +80,13 @@ class ProgramReader {
   Pose run_start_{};
   double run_feed_ = 0;
   double run_floor_ = 0;          ///< largest deviation of a chorded arc in the run
-  std::vector<Pose> run_points_;  ///< inner vertices of the run
+  /// Inner vertices of the run relative to its start, their squared lengths, and the axes on
+  /// which any of them differs from the start (the only ones their dot products need).
+  std::vector<Pose> run_points_;
+  std::vector<double> run_squares_;
+  std::array<int, kAxisCount> run_axes_{};
+  int run_axis_count_ = 0;
+  void add_run_point(const Pose& rel);
 };
 
 }  // namespace opencnc::plan::detail
