@@ -55,7 +55,10 @@ class Lookahead {
   explicit Lookahead(const WindowParams& p)
       : p_(p), reach_(std::max(p.v_bound * p.filter_s, p.step_window_s)) {}
 
-  void push(const PlannedBlock& block);
+  /// The slot for the next block, its working values cleared: fill `b` and the raw limits,
+  /// then add it with push_next().
+  PlannedBlock& next_slot();
+  void push_next();
   /// No more blocks will come: everything becomes final.
   void finish() noexcept {
     finished_ = true;
@@ -75,8 +78,8 @@ class Lookahead {
     return settled_;
   }
 
-  /// The front block as it goes to the queue with sequence number `seq`.
-  traj::MotionBlock front_for_queue(std::uint64_t seq);
+  /// Writes the front block as it goes to the queue with sequence number `seq`.
+  void front_for_queue(std::uint64_t seq, traj::MotionBlock& out);
   /// Removes the front block (publishable() or settled() > 0).
   void pop_front();
 

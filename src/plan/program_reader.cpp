@@ -124,11 +124,18 @@ std::uint8_t ProgramReader::flags() const noexcept {
   return f;
 }
 
-void ProgramReader::add_marker(const canon::Action& a, MarkerKind kind) {
-  Item it;
+// A marker item at the end of ready_, every field set.
+traj::MotionBlock& ProgramReader::new_marker() {
+  Item& it = ready_.append();
   it.is_marker = true;
-  traj::MotionBlock& m = it.marker;
-  m.kind = traj::BlockKind::Marker;
+  it.element = Element{};
+  it.element.b.kind = traj::BlockKind::Marker;
+  return it.element.b;
+}
+
+void ProgramReader::add_marker(const canon::Action& a, MarkerKind kind) {
+  flush_run();
+  traj::MotionBlock& m = new_marker();
   m.marker = kind;
   m.action = static_cast<std::uint32_t>(&a - program_->actions().data());
   m.segment = m.segment_first = m.segment_last = a.before_move;
@@ -137,8 +144,6 @@ void ProgramReader::add_marker(const canon::Action& a, MarkerKind kind) {
   m.value = a.value;
   m.flags = flags();
   if (kind == MarkerKind::ProgramEnd) ended_ = true;
-  flush_run();
-  ready_.push_back(it);
 }
 
 void ProgramReader::read_actions_before(std::uint32_t move) {
@@ -309,9 +314,9 @@ void ProgramReader::flush_run() {
   run_points_.clear();
   run_squares_.clear();
   run_axis_count_ = 0;
-  Item it;
+  Item& it = ready_.append();
+  it.is_marker = false;
   it.element = e;
-  ready_.push_back(it);
 }
 
 void ProgramReader::push_element(const Element& e) {
@@ -337,9 +342,9 @@ void ProgramReader::push_element(const Element& e) {
     run_floor_ = e.merge_deviation;
     return;
   }
-  Item it;
+  Item& it = ready_.append();
+  it.is_marker = false;
   it.element = e;
-  ready_.push_back(it);
 }
 
 void ProgramReader::read_move(canon::SegmentId id) {
@@ -349,15 +354,12 @@ void ProgramReader::read_move(canon::SegmentId id) {
   push_element(e);
   if (e.stop_after) {  // the controller reads the probe result before anything goes on
     flush_run();
-    Item it;
-    it.is_marker = true;
-    it.marker.kind = traj::BlockKind::Marker;
-    it.marker.marker = MarkerKind::Sync;
-    it.marker.segment = it.marker.segment_first = it.marker.segment_last = id + 1;
-    it.marker.line = e.b.line;
-    it.marker.context = e.b.context;
-    it.marker.action = static_cast<std::uint32_t>(program_->actions().size());  // none
-    ready_.push_back(it);
+    traj::MotionBlock& m = new_marker();
+    m.marker = MarkerKind::Sync;
+    m.segment = m.segment_first = m.segment_last = id + 1;
+    m.line = e.b.line;
+    m.context = e.b.context;
+    m.action = static_cast<std::uint32_t>(program_->actions().size());  // none
   }
 }
 
@@ -371,25 +373,21 @@ void ProgramReader::read_more() {
   read_actions_before(static_cast<std::uint32_t>(n));
   flush_run();
   if (!ended_) {  // a program without M2/M30 still ends with a stop
-    Item it;
-    it.is_marker = true;
-    it.marker.kind = traj::BlockKind::Marker;
-    it.marker.marker = MarkerKind::ProgramEnd;
-    it.marker.segment = it.marker.segment_first = it.marker.segment_last = n;
-    it.marker.action = static_cast<std::uint32_t>(program_->actions().size());
-    ready_.push_back(it);
+    traj::MotionBlock& m = new_marker();
+    m.marker = MarkerKind::ProgramEnd;
+    m.segment = m.segment_first = m.segment_last = n;
+    m.action = static_cast<std::uint32_t>(program_->actions().size());
     ended_ = true;
   }
   done_ = true;
 }
 
-bool ProgramReader::next(Item& out) {
+Item* ProgramReader::next() {
+  if (handed_out_) ready_.pop_front();
   // Keep a run open until something else arrives, so that merging can look ahead.
   while (ready_.empty() && !done_) read_more();
-  if (ready_.empty()) return false;
-  out = std::move(ready_.front());
-  ready_.pop_front();
-  return true;
+  handed_out_ = !ready_.empty();
+  return handed_out_ ? &ready_.front() : nullptr;
 }
 
 }  // namespace opencnc::plan::detail

@@ -25,11 +25,18 @@ class Ring {
   T& back() noexcept { return (*this)[size_ - 1]; }
   const T& back() const noexcept { return (*this)[size_ - 1]; }
 
+  /// The slot after the last element, holding whatever it held before, to be filled in place
+  /// and then added with commit_spare().
+  T& spare() {
+    if (size_ == slots_.size()) grow();
+    return (*this)[size_];
+  }
+  void commit_spare() noexcept { ++size_; }
   /// A new last element, holding whatever the slot held before: the caller sets every field.
   T& append() {
-    if (size_ == slots_.size()) grow();
-    ++size_;
-    return back();
+    T& slot = spare();
+    commit_spare();
+    return slot;
   }
   void push_back(const T& v) { append() = v; }
   void pop_front() noexcept {
