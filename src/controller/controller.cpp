@@ -104,6 +104,7 @@ std::uint64_t Controller::submit(Request r) {
   std::lock_guard lock(inbox_mutex_);
   const std::uint64_t id = next_id_++;
   inbox_.emplace_back(id, std::move(r));
+  inbox_filled_.store(true, std::memory_order_release);
   return id;
 }
 
@@ -137,12 +138,15 @@ std::shared_ptr<const canon::Program> Controller::open_program() const {
 
 void Controller::service() {
   read_servo();
-  std::deque<std::pair<std::uint64_t, Request>> requests;
-  {
-    std::lock_guard lock(inbox_mutex_);
-    requests.swap(inbox_);
+  if (inbox_filled_.load(std::memory_order_acquire)) {
+    {
+      std::lock_guard lock(inbox_mutex_);
+      requests_.swap(inbox_);
+      inbox_filled_.store(false, std::memory_order_relaxed);
+    }
+    for (auto& [id, r] : requests_) handle(id, r);
+    requests_.clear();
   }
-  for (auto& [id, r] : requests) handle(id, r);
   pump();
 
   std::lock_guard lock(out_mutex_);
