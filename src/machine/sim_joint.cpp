@@ -232,31 +232,21 @@ enum MapCoord : int {
   kEncoderBias,    // feedback position − encoder reading
 };
 
-double dot(const Row& a, const Row& b) noexcept {
-  double sum = 0;
-  for (std::size_t k = 0; k < a.size(); ++k) sum += a[k] * b[k];
-  return sum;
-}
-
-double dot_abs(const Row& a, const Row& b) noexcept {
-  double sum = 0;
-  for (std::size_t k = 0; k < a.size(); ++k) sum += a[k] * std::abs(b[k]);
-  return sum;
-}
-
-SimPeriodMap::Span span_of(const std::vector<Row>& rows) {
-  SimPeriodMap::Span s;
-  s.first = rows.front();
-  s.last = rows.back();
+/// Per coefficient, the largest deviation of rows[i] from the chord between the first and the
+/// last row.
+Row bend_of(const std::vector<Row>& rows) {
+  Row bend{};
+  const Row& first = rows.front();
+  const Row& last = rows.back();
   const double steps = static_cast<double>(rows.size() - 1);
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const double f = steps > 0 ? static_cast<double>(i) / steps : 0.0;
-    for (std::size_t k = 0; k < s.bend.size(); ++k) {
-      const double chord = s.first[k] + f * (s.last[k] - s.first[k]);
-      s.bend[k] = std::max(s.bend[k], std::abs(rows[i][k] - chord));
+    for (std::size_t k = 0; k < bend.size(); ++k) {
+      const double chord = first[k] + f * (last[k] - first[k]);
+      bend[k] = std::max(bend[k], std::abs(rows[i][k] - chord));
     }
   }
-  return s;
+  return bend;
 }
 
 }  // namespace
@@ -268,7 +258,7 @@ SimPeriodMap::Span span_of(const std::vector<Row>& rows) {
 // quantisation error being uniform over a count at any speed. A period is then a linear map
 // of z, the product of the sub-step maps: running the sub-step equations on each unit vector
 // of z gives its columns, and the coefficients of the clamped quantities in every sub-step
-// give the spans that tell whether a period stays linear.
+// give the bounds that tell whether a period stays linear.
 SimPeriodMap SimJoint::build_period_map(bool held) const {
   const SimJointModel& m = config_.model;
   constexpr int n = SimPeriodMap::kSize;
@@ -313,29 +303,57 @@ SimPeriodMap SimJoint::build_period_map(bool held) const {
       for (int l = 0; l < n; ++l) p.energy[k][l] += force[k] * v_after[l] * h_ * power_per_effort_velocity_;
     }
   }
-  p.next = s;
-  p.velocity = span_of(velocity);
-  p.force_command = span_of(force_command);
-  p.velocity_reference = span_of(velocity_reference);
+  const Row bends[] = {bend_of(velocity), bend_of(force_command), bend_of(velocity_reference)};
+  for (std::size_t k = 0; k < n; ++k) {
+    auto& out = p.outputs[k];
+    for (std::size_t r = 0; r < SimPeriodMap::kStates; ++r) out[r] = s[r][k];
+    out[SimPeriodMap::kForceCommandFirst] = force_command.front()[k];
+    out[SimPeriodMap::kForceCommandLast] = force_command.back()[k];
+    out[SimPeriodMap::kVelRefFirst] = velocity_reference.front()[k];
+    out[SimPeriodMap::kVelRefLast] = velocity_reference.back()[k];
+    for (std::size_t b = 0; b < SimPeriodMap::kBends; ++b) p.bends[k][b] = bends[b][k];
+  }
   return p;
 }
 
-// The largest |value| of a span's quantity over the period from z_.
-double SimJoint::largest(const SimPeriodMap::Span& span) const noexcept {
-  return std::max(std::abs(dot(span.first, z_)), std::abs(dot(span.last, z_))) + dot_abs(span.bend, z_);
+/// A period map applied to z_: its outputs and bends.
+struct SimJoint::MapValues {
+  std::array<double, SimPeriodMap::kOutputs + 1> y{};
+  std::array<double, SimPeriodMap::kBends + 1> bend{};
+  double next(int state) const noexcept { return y[static_cast<std::size_t>(state)]; }
+  double largest(int first, int bend_index) const noexcept {
+    const auto f = static_cast<std::size_t>(first);
+    return std::max(std::abs(y[f]), std::abs(y[f + 1])) + bend[static_cast<std::size_t>(bend_index)];
+  }
+};
+
+// Column by column into local sums, so that the compiler keeps them in registers and runs the
+// rows side by side (two to an SSE2 register).
+SimJoint::MapValues SimJoint::evaluate(const SimPeriodMap& map) const noexcept {
+  std::array<double, SimPeriodMap::kOutputs + 1> y{};
+  std::array<double, SimPeriodMap::kBends + 1> bend{};
+  for (std::size_t k = 0; k < SimPeriodMap::kSize; ++k) {
+    const double zk = z_[k], ak = std::abs(z_[k]);
+#pragma GCC unroll 16
+    for (std::size_t r = 0; r < y.size(); ++r) y[r] += map.outputs[k][r] * zk;
+#pragma GCC unroll 16
+    for (std::size_t r = 0; r < bend.size(); ++r) bend[r] += map.bends[k][r] * ak;
+  }
+  return MapValues{y, bend};
 }
 
-// No sub-step of the period from z_ clamps the force command or the velocity reference.
-bool SimJoint::within_limits(const SimPeriodMap& map) const noexcept {
+// No sub-step of the period clamps the force command or the velocity reference.
+bool SimJoint::within_limits(const MapValues& y) const noexcept {
   const SimJointModel& m = config_.model;
-  return largest(map.force_command) <= m.peak_effort &&
-         (m.velocity_limit <= 0 || largest(map.velocity_reference) <= m.velocity_limit);
+  return y.largest(SimPeriodMap::kForceCommandFirst, SimPeriodMap::kForceCommandBend) <= m.peak_effort &&
+         (m.velocity_limit <= 0 ||
+          y.largest(SimPeriodMap::kVelRefFirst, SimPeriodMap::kVelRefBend) <= m.velocity_limit);
 }
 
-std::array<double, SimPeriodMap::kStates> SimJoint::next_state(const SimPeriodMap& map) const noexcept {
-  std::array<double, SimPeriodMap::kStates> next{};
-  for (std::size_t r = 0; r < next.size(); ++r) next[r] = dot(map.next[r], z_);
-  return next;
+void SimJoint::take_state(const MapValues& y) noexcept {
+  effort_ = y.next(kForce);
+  position_integral_ = y.next(kPosIntegral);
+  velocity_error_integral_ = y.next(kVelIntegral);
 }
 
 void SimJoint::load_state() noexcept {
@@ -348,23 +366,21 @@ void SimJoint::load_state() noexcept {
 }
 
 // Moving one way all period: the velocity at the start and at the end have the same sign and
-// the chord between them stays further from zero than the velocity can bend away from it.
-// The motor moves one way, so the backlash is taken up once at the end.
+// the chord between them stays further from zero (by a count per period) than the velocity can
+// bend away from it. The motor moves one way, so the backlash is taken up once at the end.
 bool SimJoint::integrate_moving_period() noexcept {
   load_state();
   z_[kConstantForce] = external_effort_ - std::copysign(config_.model.coulomb_friction, velocity_);
   z_[kEncoderBias] = encoder_bias_;
-  const auto next = next_state(moving_map_);
-  const double v_end = cmd_.velocity_ff + next[kRelVelocity];
-  const double v_min = std::min(std::abs(velocity_), std::abs(v_end));
-  if (!((v_end > 0) == (velocity_ > 0) && v_min > dot_abs(moving_map_.velocity.bend, z_)) ||
-      !within_limits(moving_map_))
+  const MapValues y = evaluate(moving_map_);
+  const double v_end = cmd_.velocity_ff + y.next(kRelVelocity);
+  // The mean encoder error stands for the real one only while the motion crosses counts.
+  const double v_min = std::min(std::abs(velocity_), std::abs(v_end)) - unit_per_count_ / period_s_;
+  if (!((v_end > 0) == (velocity_ > 0) && v_min > y.bend[SimPeriodMap::kVelocityBend]) || !within_limits(y))
     return false;
-  motor_ = cmd_.position + next[kRelPosition];
+  motor_ = cmd_.position + y.next(kRelPosition);
   velocity_ = v_end;
-  effort_ = next[kForce];
-  position_integral_ = next[kPosIntegral];
-  velocity_error_integral_ = next[kVelIntegral];
+  take_state(y);
   take_up_backlash();
   period_moving_ = true;
   return true;
@@ -378,18 +394,14 @@ bool SimJoint::integrate_held_period() noexcept {
   load_state();
   z_[kConstantForce] = 0;
   z_[kEncoderBias] = z_[kRelPosition] + cmd_.position - quantise_fast(feedback_raw());
-  const SimPeriodMap::Span& f = held_map_.force_command;
-  const double bend = dot_abs(f.bend, z_);
+  const MapValues y = evaluate(held_map_);
   const double load = external_effort_;
-  if (!(std::abs(effort_ + load) <= m.static_friction &&
-        std::max(std::abs(dot(f.first, z_) + load), std::abs(dot(f.last, z_) + load)) + bend <=
-            m.static_friction &&
-        within_limits(held_map_)))
+  const double command = std::max(std::abs(y.y[SimPeriodMap::kForceCommandFirst] + load),
+                                  std::abs(y.y[SimPeriodMap::kForceCommandLast] + load)) +
+                         y.bend[SimPeriodMap::kForceCommandBend];
+  if (!(std::abs(effort_ + load) <= m.static_friction && command <= m.static_friction && within_limits(y)))
     return false;
-  const auto next = next_state(held_map_);
-  effort_ = next[kForce];
-  position_integral_ = next[kPosIntegral];
-  velocity_error_integral_ = next[kVelIntegral];
+  take_state(y);
   return true;
 }
 

@@ -40,15 +40,16 @@ struct SimPeriodMap {
   static constexpr int kSize = 8;
   static constexpr int kStates = 5;
   using Row = std::array<double, kSize>;
-  /// A quantity over the sub-steps of a period: its coefficients at the first and the last
-  /// sub-step, and per coefficient the largest deviation from the chord between them; so every
-  /// sub-step's value lies within Σ_k bend_k·|z_k| of the chord from first·z to last·z.
-  struct Span {
-    Row first{}, last{}, bend{};
-  };
-  std::array<Row, kStates> next{};  ///< the state at the end of the period
-  Span velocity;                    ///< at the start and after each sub-step
-  Span force_command, velocity_reference;
+  /// What a period needs that is linear in z: rows 0–4 the state at its end, then the force
+  /// command (5, 6) and the velocity reference (7, 8) at the first and the last sub-step.
+  enum Output : int { kForceCommandFirst = kStates, kForceCommandLast, kVelRefFirst, kVelRefLast, kOutputs };
+  /// How far from the chord between first and last sub-step a quantity can bend, per |z_k|:
+  /// the velocity, the force command, the velocity reference (every sub-step's value lies
+  /// within Σ_k bend_k·|z_k| of that chord).
+  enum Bend : int { kVelocityBend, kForceCommandBend, kVelRefBend, kBends };
+  /// Column k holds z_k's coefficients (one product for all of them), padded to even lengths.
+  std::array<std::array<double, kOutputs + 1>, kSize> outputs{};
+  std::array<std::array<double, kBends + 1>, kSize> bends{};
   std::array<Row, kSize> energy{};  ///< energy_j = zᵀ·energy·z
 };
 
@@ -105,9 +106,10 @@ class SimJoint {
   bool integrate_moving_period() noexcept;
   bool integrate_held_period() noexcept;
   void load_state() noexcept;
-  bool within_limits(const SimPeriodMap& map) const noexcept;
-  double largest(const SimPeriodMap::Span& span) const noexcept;
-  std::array<double, SimPeriodMap::kStates> next_state(const SimPeriodMap& map) const noexcept;
+  struct MapValues;
+  MapValues evaluate(const SimPeriodMap& map) const noexcept;
+  bool within_limits(const MapValues& y) const noexcept;
+  void take_state(const MapValues& y) noexcept;
 
   SimJointConfig config_{};
   PitchErrorTable pitch_;
