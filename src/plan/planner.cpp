@@ -207,8 +207,8 @@ void Planner::Impl::emit_reports() {
 bool Planner::Impl::corner(Element& a, Element& e) {
   if (a.stop_after || a.mode == canon::MotionControl::ExactStop) return false;
   if ((a.b.feed_class == FeedClass::SpindleSync) != (e.b.feed_class == FeedClass::SpindleSync)) return false;
-  const double theta = detail::angle_between(detail::end_tangent(a.b), detail::start_tangent(e.b));
-  if (theta <= detail::kTangentAngle) {
+  const detail::CornerTurn turn = detail::corner_turn(a.b, e.b);
+  if (turn.angle <= detail::kTangentAngle) {
     emit_path(a.b, a.junction);
     emit_reports();
     return true;
@@ -222,7 +222,7 @@ bool Planner::Impl::corner(Element& a, Element& e) {
   detail::Blend blend;
   const double avail_a = std::min(0.5 * a.orig_length, a.b.length);
   const double avail_e = std::min(0.5 * e.orig_length, e.b.length);
-  if (!detail::blend_corner(a.b, avail_a, e.b, avail_e, tol, blend_need(a.b, e.b), blend)) return false;
+  if (!detail::blend_corner(a.b, avail_a, e.b, avail_e, turn, tol, blend_need(a.b, e.b), blend)) return false;
   if (!blend_pays(a, e, blend)) return false;
   detail::trim_end(a.b, blend.trim_in);
   emit_path(a.b, a.junction);
