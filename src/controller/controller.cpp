@@ -85,6 +85,7 @@ struct Controller::Run {
   canon::SegmentId segment_offset = 0;  ///< run segment k = open program segment offset + k
   std::unique_ptr<plan::Planner> planner;
   bool pumping = true;
+  bool pumped_once = false;  ///< the first pump of a run fills the queue, whatever is free
   std::uint32_t next_action = 0;  ///< next program action to consider for a MachineAction record
   canon::SegmentId program_tripped_segment = 0;  ///< the probe move that tripped
 };
@@ -373,6 +374,9 @@ void Controller::continue_after_probe() {
 
 // --- feeding the servo -----------------------------------------------------------------------
 
+// The planner refills the queue in batches, once a quarter of it is free (thousands of blocks,
+// seconds of motion, are still queued then): planning many blocks in a row keeps its code and
+// data in the cache, where a block or two every period did not.
 void Controller::pump() {
   if (!run_ || !run_->pumping) return;
   const canon::Program& p = *run_->program;
@@ -381,6 +385,9 @@ void Controller::pump() {
     if (a && !channels_->actions.try_push(*a)) break;
     ++run_->next_action;
   }
+  constexpr std::size_t kRefillSlots = traj::BlockQueue::kCapacity / 4;
+  if (run_->pumped_once && channels_->blocks.free_slots() < kRefillSlots) return;
+  run_->pumped_once = true;
   switch (run_->planner->pump(channels_->blocks)) {
     case plan::PlanStatus::Working:
       break;
