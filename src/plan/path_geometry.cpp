@@ -320,17 +320,19 @@ double needed_radius(const Pose& t, const Pose& n, const BlendNeed& need) {
 }
 
 bool line_line_blend(const MotionBlock& in, double avail_in, const MotionBlock& out, double avail_out,
-                     double tolerance, const BlendNeed& need, double theta, const Pose& ta, const Pose& tb,
-                     Blend& result) {
+                     double tolerance, const BlendNeed& need, const CornerTurn& turn, Blend& result) {
   // Circular fillet tangent to both lines: tangent length d, radius R = d / tan(θ/2), largest
   // distance from the lines R·(1 − cos(θ/2)) ≤ tolerance, and no larger than the speed needs.
-  const double t2 = std::tan(0.5 * theta);
-  const double s4 = std::sin(0.25 * theta);
-  Pose n = tb - ta;
+  // From s = sin(θ/2) and c = cos(θ/2): tan(θ/2) = s/c and 1 − c = s²/(1 + c), without
+  // cancellation at small angles, so d ≤ tolerance·(1 + c)/(s·c).
+  const double theta = turn.angle, s = turn.half_sine, c2 = std::sqrt(1.0 - s * s);
+  const double t2 = s / c2;
+  const Pose& ta = turn.in;
+  Pose n = turn.out - ta;
   n = n - dot(n, ta) * ta;
   n = (1.0 / norm(n)) * n;
   double d = std::min({avail_in, avail_out, needed_radius(ta, n, need) * t2});
-  if (tolerance > 0) d = std::min(d, tolerance * t2 / (2.0 * s4 * s4));
+  if (tolerance > 0) d = std::min(d, tolerance * (1.0 + c2) / (s * c2));
   if (!(d >= kMinLength)) return false;
   const double radius = d / t2;
   MotionBlock& c = result.curve;  // the caller sets identity, class and feed
@@ -421,7 +423,8 @@ CornerTurn corner_turn(const MotionBlock& in, const MotionBlock& out) noexcept {
   CornerTurn t;
   t.in = end_tangent(in);
   t.out = start_tangent(out);
-  t.angle = angle_between(t.in, t.out);
+  t.half_sine = std::min(0.5 * norm(t.out - t.in), 1.0);  // as in angle_between()
+  t.angle = 2.0 * std::asin(t.half_sine);
   return t;
 }
 
@@ -432,7 +435,7 @@ bool blend_corner(const MotionBlock& in, double avail_in, const MotionBlock& out
   const double theta = turn.angle;
   if (theta <= kTangentAngle || theta >= kReversalAngle) return false;
   if (in.kind == BlockKind::Line && out.kind == BlockKind::Line) {
-    return line_line_blend(in, avail_in, out, avail_out, tolerance, need, theta, ta, tb, result);
+    return line_line_blend(in, avail_in, out, avail_out, tolerance, need, turn, result);
   }
   return bezier_blend(in, avail_in, out, avail_out, tolerance, need, theta, ta, tb, result);
 }

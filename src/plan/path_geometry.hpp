@@ -58,10 +58,11 @@ struct BlendNeed {
 };
 
 /// The directions at a corner: unit tangents at the end of the incoming block and the start of
-/// the outgoing one, and the angle between them.
+/// the outgoing one, the angle θ between them and sin(θ/2) (half the chord between the tangents).
 struct CornerTurn {
   Pose in{}, out{};
   double angle = 0;
+  double half_sine = 0;
 };
 CornerTurn corner_turn(const MotionBlock& in, const MotionBlock& out) noexcept;
 
