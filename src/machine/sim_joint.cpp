@@ -303,43 +303,51 @@ SimPeriodMap SimJoint::build_period_map(bool held) const {
       for (int l = 0; l < n; ++l) p.energy[k][l] += force[k] * v_after[l] * h_ * power_per_effort_velocity_;
     }
   }
-  const Row bends[] = {bend_of(velocity), bend_of(force_command), bend_of(velocity_reference)};
+  const Row bends[] = {bend_of(force_command), bend_of(velocity_reference), bend_of(velocity)};
   for (std::size_t k = 0; k < n; ++k) {
     auto& out = p.outputs[k];
-    for (std::size_t r = 0; r < SimPeriodMap::kStates; ++r) out[r] = s[r][k];
+    out[SimPeriodMap::kNextForce] = s[kForce][k];
+    out[SimPeriodMap::kNextPosIntegral] = s[kPosIntegral][k];
+    out[SimPeriodMap::kNextVelIntegral] = s[kVelIntegral][k];
     out[SimPeriodMap::kForceCommandFirst] = force_command.front()[k];
     out[SimPeriodMap::kForceCommandLast] = force_command.back()[k];
     out[SimPeriodMap::kVelRefFirst] = velocity_reference.front()[k];
     out[SimPeriodMap::kVelRefLast] = velocity_reference.back()[k];
+    out[SimPeriodMap::kNextRelPosition] = s[kRelPosition][k];
+    out[SimPeriodMap::kNextRelVelocity] = s[kRelVelocity][k];
     for (std::size_t b = 0; b < SimPeriodMap::kBends; ++b) p.bends[k][b] = bends[b][k];
   }
   return p;
 }
 
-/// A period map applied to z_: its outputs and bends.
+/// A period map applied to z_: its outputs and bends (those not evaluated are zero).
 struct SimJoint::MapValues {
   std::array<double, SimPeriodMap::kOutputs + 1> y{};
   std::array<double, SimPeriodMap::kBends + 1> bend{};
-  double next(int state) const noexcept { return y[static_cast<std::size_t>(state)]; }
+  double operator[](int output) const noexcept { return y[static_cast<std::size_t>(output)]; }
   double largest(int first, int bend_index) const noexcept {
     const auto f = static_cast<std::size_t>(first);
     return std::max(std::abs(y[f]), std::abs(y[f + 1])) + bend[static_cast<std::size_t>(bend_index)];
   }
 };
 
-// Column by column into local sums, so that the compiler keeps them in registers and runs the
-// rows side by side (two to an SSE2 register).
+// The first Rows outputs and Bends bends, column by column into local sums, so that the compiler
+// keeps them in registers and runs the rows side by side (two to an SSE2 register).
+template <std::size_t Rows, std::size_t Bends>
 SimJoint::MapValues SimJoint::evaluate(const SimPeriodMap& map) const noexcept {
-  std::array<double, SimPeriodMap::kOutputs + 1> y{};
-  std::array<double, SimPeriodMap::kBends + 1> bend{};
+  std::array<double, Rows> y{};
+  std::array<double, Bends> bend{};
   for (std::size_t k = 0; k < SimPeriodMap::kSize; ++k) {
     const double zk = z_[k], ak = std::abs(z_[k]);
 #pragma GCC unroll 16
-    for (std::size_t r = 0; r < y.size(); ++r) y[r] += map.outputs[k][r] * zk;
+    for (std::size_t r = 0; r < Rows; ++r) y[r] += map.outputs[k][r] * zk;
 #pragma GCC unroll 16
-    for (std::size_t r = 0; r < bend.size(); ++r) bend[r] += map.bends[k][r] * ak;
+    for (std::size_t r = 0; r < Bends; ++r) bend[r] += map.bends[k][r] * ak;
   }
-  return MapValues{y, bend};
+  MapValues v;
+  std::copy(y.begin(), y.end(), v.y.begin());
+  std::copy(bend.begin(), bend.end(), v.bend.begin());
+  return v;
 }
 
 // No sub-step of the period clamps the force command or the velocity reference.
@@ -351,13 +359,13 @@ bool SimJoint::within_limits(const MapValues& y) const noexcept {
 }
 
 void SimJoint::take_state(const MapValues& y) noexcept {
-  effort_ = y.next(kForce);
-  position_integral_ = y.next(kPosIntegral);
-  velocity_error_integral_ = y.next(kVelIntegral);
+  effort_ = y[SimPeriodMap::kNextForce];
+  position_integral_ = y[SimPeriodMap::kNextPosIntegral];
+  velocity_error_integral_ = y[SimPeriodMap::kNextVelIntegral];
 }
 
-void SimJoint::load_state() noexcept {
-  z_[kRelPosition] = feedback_raw() - cmd_.position;
+void SimJoint::load_state(double feedback) noexcept {
+  z_[kRelPosition] = feedback - cmd_.position;
   z_[kRelVelocity] = velocity_ - cmd_.velocity_ff;
   z_[kForce] = effort_;
   z_[kPosIntegral] = position_integral_;
@@ -369,16 +377,16 @@ void SimJoint::load_state() noexcept {
 // the chord between them stays further from zero (by a count per period) than the velocity can
 // bend away from it. The motor moves one way, so the backlash is taken up once at the end.
 bool SimJoint::integrate_moving_period() noexcept {
-  load_state();
+  load_state(feedback_raw());
   z_[kConstantForce] = external_effort_ - std::copysign(config_.model.coulomb_friction, velocity_);
   z_[kEncoderBias] = encoder_bias_;
-  const MapValues y = evaluate(moving_map_);
-  const double v_end = cmd_.velocity_ff + y.next(kRelVelocity);
+  const MapValues y = evaluate<SimPeriodMap::kOutputs + 1, SimPeriodMap::kBends + 1>(moving_map_);
+  const double v_end = cmd_.velocity_ff + y[SimPeriodMap::kNextRelVelocity];
   // The mean encoder error stands for the real one only while the motion crosses counts.
   const double v_min = std::min(std::abs(velocity_), std::abs(v_end)) - unit_per_count_ / period_s_;
   if (!((v_end > 0) == (velocity_ > 0) && v_min > y.bend[SimPeriodMap::kVelocityBend]) || !within_limits(y))
     return false;
-  motor_ = cmd_.position + y.next(kRelPosition);
+  motor_ = cmd_.position + y[SimPeriodMap::kNextRelPosition];
   velocity_ = v_end;
   take_state(y);
   take_up_backlash();
@@ -391,10 +399,12 @@ bool SimJoint::integrate_moving_period() noexcept {
 // the two), so it stays within static friction when it starts there and the command does.
 bool SimJoint::integrate_held_period() noexcept {
   const SimJointModel& m = config_.model;
-  load_state();
+  const double feedback = feedback_raw();
+  load_state(feedback);
   z_[kConstantForce] = 0;
-  z_[kEncoderBias] = z_[kRelPosition] + cmd_.position - quantise_fast(feedback_raw());
-  const MapValues y = evaluate(held_map_);
+  z_[kEncoderBias] = feedback - quantise_fast(feedback);
+  const MapValues y = m.velocity_limit > 0 ? evaluate<SimPeriodMap::kVelRefLast + 1, 2>(held_map_)
+                                           : evaluate<SimPeriodMap::kForceCommandLast + 1, 1>(held_map_);
   const double load = external_effort_;
   const double command = std::max(std::abs(y.y[SimPeriodMap::kForceCommandFirst] + load),
                                   std::abs(y.y[SimPeriodMap::kForceCommandLast] + load)) +

@@ -73,14 +73,17 @@ void SimMachine::read(MachineInputs& in) noexcept {
 }
 
 void SimMachine::write(const MachineOutputs& out) noexcept {
-  outputs_ = out;
-  advance();
+  // What the next periods need of the outputs; the joints and the spindle latch their own.
+  estop_release_ = out.estop_release;
+  process_ = out.process;
+  tool_ = out.tool;
+  advance(out);
   ++inputs_.cycle;
   sample();
 }
 
 bool SimMachine::drives_powered() const noexcept {
-  return !estop_pressed_ && outputs_.estop_release && !undervoltage_;
+  return !estop_pressed_ && estop_release_ && !undervoltage_;
 }
 
 void SimMachine::set_amp_fault(int joint, bool fault) noexcept {
@@ -101,17 +104,17 @@ void SimMachine::set_analog_input(int channel, double value) noexcept {
   if (channel >= 0 && channel < kAnalogChannels) analog_in_[static_cast<std::size_t>(channel)] = value;
 }
 
-void SimMachine::advance() noexcept {
+void SimMachine::advance(const MachineOutputs& out) noexcept {
   const bool powered = drives_powered();
   const int n = config_.joint_count;
   bool substeps = false;  // begin_period() integrates what it can at once
   for (int j = 0; j < n; ++j) {
     const auto uj = static_cast<std::size_t>(j);
-    joints_[uj].begin_period(outputs_.joints[uj], powered && !undervoltage_fault_[uj], external_effort_[uj]);
+    joints_[uj].begin_period(out.joints[uj], powered && !undervoltage_fault_[uj], external_effort_[uj]);
     substeps = substeps || joints_[uj].needs_substeps();
   }
   if (config_.spindle) {
-    spindle_.begin_period(outputs_.spindle, powered);
+    spindle_.begin_period(out.spindle, powered);
     substeps = substeps || spindle_.needs_substeps();
   }
   // Sub-steps outside, joints inside: the joints' dependency chains are independent, so the
@@ -122,14 +125,14 @@ void SimMachine::advance() noexcept {
   }
   for (int j = 0; j < n; ++j) joints_[static_cast<std::size_t>(j)].end_period();
   if (config_.spindle) spindle_.end_period();
-  update_power();
+  update_power(out);
   update_auxiliaries();
 }
 
 // Mains on: the rectifier holds the DC link at nominal. Mains off with a charged UPS: the
 // UPS does. Otherwise the link capacitor alone feeds the idle load and the axes:
 // ½·C·V² loses idle_power·T + E_axes per period (braking axes give energy back).
-void SimMachine::update_power() noexcept {
+void SimMachine::update_power(const MachineOutputs& out) noexcept {
   const SimPowerConfig& p = config_.power;
   const double period = config_.servo_period_s;
   on_battery_ = !mains_ok_ && ups_periods_left_ > 0;
@@ -150,7 +153,7 @@ void SimMachine::update_power() noexcept {
   // A drive that sees undervoltage while enabled latches the fault until it is disabled.
   for (int j = 0; j < config_.joint_count; ++j) {
     const auto uj = static_cast<std::size_t>(j);
-    const bool enabled = outputs_.joints[uj].enable;
+    const bool enabled = out.joints[uj].enable;
     if (undervoltage_ && enabled) undervoltage_fault_[uj] = true;
     if (!enabled && !undervoltage_) undervoltage_fault_[uj] = false;
   }
@@ -158,9 +161,9 @@ void SimMachine::update_power() noexcept {
 
 void SimMachine::update_auxiliaries() noexcept {
   const bool changer = config_.tool_changer.present;
-  prepare_periods_ = changer && outputs_.tool.prepare ? prepare_periods_ + 1 : 0;
-  change_periods_ = changer && outputs_.tool.change ? change_periods_ + 1 : 0;
-  arc_periods_ = config_.process.torch && outputs_.process.torch_on && arc_available_ ? arc_periods_ + 1 : 0;
+  prepare_periods_ = changer && tool_.prepare ? prepare_periods_ + 1 : 0;
+  change_periods_ = changer && tool_.change ? change_periods_ + 1 : 0;
+  arc_periods_ = config_.process.torch && process_.torch_on && arc_available_ ? arc_periods_ + 1 : 0;
 }
 
 void SimMachine::sample() noexcept {
@@ -180,7 +183,7 @@ void SimMachine::sample() noexcept {
   }
   inputs_.process.arc_ok = arc_periods_ >= arc_needed_;
   inputs_.process.gap_voltage_v =
-      config_.process.generator && outputs_.process.generator_on ? gap_voltage_v_ : 0.0;
+      config_.process.generator && process_.generator_on ? gap_voltage_v_ : 0.0;
   inputs_.tool.prepared = prepare_periods_ >= prepare_needed_;
   inputs_.tool.changed = change_periods_ >= change_needed_;
   inputs_.digital_in = digital_in_ & low_bits(config_.digital_inputs);

@@ -40,13 +40,24 @@ struct SimPeriodMap {
   static constexpr int kSize = 8;
   static constexpr int kStates = 5;
   using Row = std::array<double, kSize>;
-  /// What a period needs that is linear in z: rows 0–4 the state at its end, then the force
-  /// command (5, 6) and the velocity reference (7, 8) at the first and the last sub-step.
-  enum Output : int { kForceCommandFirst = kStates, kForceCommandLast, kVelRefFirst, kVelRefLast, kOutputs };
-  /// How far from the chord between first and last sub-step a quantity can bend, per |z_k|:
-  /// the velocity, the force command, the velocity reference (every sub-step's value lies
-  /// within Σ_k bend_k·|z_k| of that chord).
-  enum Bend : int { kVelocityBend, kForceCommandBend, kVelRefBend, kBends };
+  /// What a period needs that is linear in z: the state at its end, the force command and the
+  /// velocity reference at the first and the last sub-step. Held periods need the first rows only
+  /// (the first five, seven with a velocity limit).
+  enum Output : int {
+    kNextForce,
+    kNextPosIntegral,
+    kNextVelIntegral,
+    kForceCommandFirst,
+    kForceCommandLast,
+    kVelRefFirst,
+    kVelRefLast,
+    kNextRelPosition,
+    kNextRelVelocity,
+    kOutputs
+  };
+  /// How far from the chord between first and last sub-step a quantity can bend, per |z_k|
+  /// (every sub-step's value lies within Σ_k bend_k·|z_k| of that chord).
+  enum Bend : int { kForceCommandBend, kVelRefBend, kVelocityBend, kBends };
   /// Column k holds z_k's coefficients (one product for all of them), padded to even lengths.
   std::array<std::array<double, kOutputs + 1>, kSize> outputs{};
   std::array<std::array<double, kBends + 1>, kSize> bends{};
@@ -105,8 +116,9 @@ class SimJoint {
   bool integrate_period() noexcept;
   bool integrate_moving_period() noexcept;
   bool integrate_held_period() noexcept;
-  void load_state() noexcept;
+  void load_state(double feedback) noexcept;
   struct MapValues;
+  template <std::size_t Rows, std::size_t Bends>
   MapValues evaluate(const SimPeriodMap& map) const noexcept;
   bool within_limits(const MapValues& y) const noexcept;
   void take_state(const MapValues& y) noexcept;
