@@ -120,6 +120,11 @@ void BM_MillPeriod(benchmark::State& state) {
   }
   run_periods(state, machine, outs);
 }
-BENCHMARK(BM_MillPeriod)->ArgNames({"still", "linear"})->Args({0, 0})->Args({0, 1})->Args({1, 0})->Args({1, 1});
+BENCHMARK(BM_MillPeriod)
+    ->ArgNames({"still", "linear"})
+    ->Args({0, 0})
+    ->Args({0, 1})
+    ->Args({1, 0})
+    ->Args({1, 1});
 
 }  // namespace

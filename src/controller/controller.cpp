@@ -85,7 +85,7 @@ struct Controller::Run {
   canon::SegmentId segment_offset = 0;  ///< run segment k = open program segment offset + k
   std::unique_ptr<plan::Planner> planner;
   bool pumping = true;
-  bool pumped_once = false;  ///< the first pump of a run fills the queue, whatever is free
+  bool pumped_once = false;       ///< the first pump of a run fills the queue, whatever is free
   std::uint32_t next_action = 0;  ///< next program action to consider for a MachineAction record
   canon::SegmentId program_tripped_segment = 0;  ///< the probe move that tripped
 };

@@ -66,8 +66,8 @@ SimJoint::SimJoint(const SimJointConfig& config, double servo_period_s, int subs
   half_backlash_ = m.backlash / 2;
   linear_periods_ = linear_periods && config.drive == JointDrive::Servo;
   // With a linear scale the loop closes around backlash and pitch error, which are not linear.
-  linear_moving_ = linear_periods_ &&
-                   (m.feedback == FeedbackSource::Motor || (m.backlash == 0 && m.pitch_error.empty()));
+  linear_moving_ =
+      linear_periods_ && (m.feedback == FeedbackSource::Motor || (m.backlash == 0 && m.pitch_error.empty()));
   encoder_bias_ = 0.5 * unit_per_count_;
   if (linear_periods_) {
     moving_map_ = build_period_map(false);

@@ -33,7 +33,8 @@ SimMachine::SimMachine(const SimMachineConfig& config) : config_(config), rng_(c
     joints_[uj] = SimJoint(config.joints[uj], config.servo_period_s, config.substeps, config.linear_periods);
   }
   if (config.spindle)
-    spindle_ = SimSpindle(config.spindle_config, config.servo_period_s, config.substeps, config.linear_periods);
+    spindle_ =
+        SimSpindle(config.spindle_config, config.servo_period_s, config.substeps, config.linear_periods);
   if (config.probe.joint >= 0)
     probe_ = SimSwitch(config.probe.trip, config.probe.hysteresis, config.probe.noise);
   dc_link_v_ = config.power.dc_link_nominal_v;
@@ -182,8 +183,7 @@ void SimMachine::sample() noexcept {
         probe_.update(joints_[static_cast<std::size_t>(config_.probe.joint)].table_position(), rng_);
   }
   inputs_.process.arc_ok = arc_periods_ >= arc_needed_;
-  inputs_.process.gap_voltage_v =
-      config_.process.generator && process_.generator_on ? gap_voltage_v_ : 0.0;
+  inputs_.process.gap_voltage_v = config_.process.generator && process_.generator_on ? gap_voltage_v_ : 0.0;
   inputs_.tool.prepared = prepare_periods_ >= prepare_needed_;
   inputs_.tool.changed = change_periods_ >= change_needed_;
   inputs_.digital_in = digital_in_ & low_bits(config_.digital_inputs);

@@ -8,7 +8,8 @@
 
 namespace opencnc::machine {
 
-SimSpindle::SimSpindle(const SimSpindleConfig& config, double servo_period_s, int substeps, bool linear_periods)
+SimSpindle::SimSpindle(const SimSpindleConfig& config, double servo_period_s, int substeps,
+                       bool linear_periods)
     : config_(config),
       h_(servo_period_s / substeps),
       period_s_(servo_period_s),

@@ -279,9 +279,11 @@ bool ProgramReader::can_extend_run(const Element& e) const {
     return r_squared - t * t <= q * q;
   };
   for (std::size_t k = 0; k < run_points_.size(); ++k) {
-    const Pose& r = run_points_[k];
     double t = 0;
-    for (int a = 0; a < run_axis_count_; ++a) t += r[run_axes_[static_cast<std::size_t>(a)]] * dir[run_axes_[static_cast<std::size_t>(a)]];
+    for (int a = 0; a < run_axis_count_; ++a) {
+      const int i = run_axes_[static_cast<std::size_t>(a)];
+      t += run_points_[k][i] * dir[i];
+    }
     if (!inside(t, run_squares_[k])) return false;
   }
   const Pose r = e.b.base - run_start_;
@@ -294,7 +296,8 @@ void ProgramReader::add_run_point(const Pose& rel) {
   for (int i = 0; i < kAxisCount; ++i) {
     if (rel[i] == 0) continue;
     const auto end = run_axes_.begin() + run_axis_count_;
-    if (std::find(run_axes_.begin(), end, i) == end) run_axes_[static_cast<std::size_t>(run_axis_count_++)] = i;
+    if (std::find(run_axes_.begin(), end, i) == end)
+      run_axes_[static_cast<std::size_t>(run_axis_count_++)] = i;
   }
 }
 

@@ -304,8 +304,9 @@ TEST(SimJoint, WholePeriodsFollowTheSubSteps) {
     while (std::abs(target - x) > 1e-12 || v != 0) {
       const double dir = target > x ? 1.0 : -1.0;
       const double brake = v * v / 2000;
-      double v_next = std::abs(target - x) <= brake + std::abs(v) * kPeriod ? std::max(0.0, std::abs(v) - 1.0)
-                                                                            : std::min(peak, std::abs(v) + 1.0);
+      double v_next = std::abs(target - x) <= brake + std::abs(v) * kPeriod
+                          ? std::max(0.0, std::abs(v) - 1.0)
+                          : std::min(peak, std::abs(v) + 1.0);
       v_next *= dir;
       x += 0.5 * (v + v_next) * kPeriod;
       if ((target - x) * dir < 0 || v_next == 0) x = target, v_next = 0;
@@ -313,13 +314,15 @@ TEST(SimJoint, WholePeriodsFollowTheSubSteps) {
       fast.period(x, v, true, load);
       exact.period(x, v, true, load);
       energy_fast += fast.joint.energy_j(), energy_exact += exact.joint.energy_j();
-      worst_position = std::max(worst_position, std::abs(fast.joint.motor_position() - exact.joint.motor_position()));
+      worst_position =
+          std::max(worst_position, std::abs(fast.joint.motor_position() - exact.joint.motor_position()));
       worst_error = std::max(worst_error, std::abs((x - fast.in.position) - (x - exact.in.position)));
       ++periods;
     }
     for (int k = 0; k < 300; ++k) {
       fast.period(x, 0, true, load), exact.period(x, 0, true, load);
-      worst_position = std::max(worst_position, std::abs(fast.joint.motor_position() - exact.joint.motor_position()));
+      worst_position =
+          std::max(worst_position, std::abs(fast.joint.motor_position() - exact.joint.motor_position()));
       ++periods;
     }
   }

@@ -40,7 +40,9 @@ class BlockQueue {
   /// The slot the next block goes into, to be written in place and then published with
   /// commit(); only while free_slots() > 0. Saves a copy of the 408-byte record. Producer
   /// thread; real-time safe.
-  MotionBlock& next_slot() noexcept { return slots_[head_.load(std::memory_order_relaxed) & (kCapacity - 1)]; }
+  MotionBlock& next_slot() noexcept {
+    return slots_[head_.load(std::memory_order_relaxed) & (kCapacity - 1)];
+  }
   /// Publishes the block written into next_slot(). Producer thread; real-time safe.
   void commit() noexcept {
     head_.store(head_.load(std::memory_order_relaxed) + 1, std::memory_order_release);
