@@ -66,8 +66,8 @@ struct SimPeriodMap {
 
 /// A joint of the simulated machine. The owner calls begin_period(), then substep() for
 /// i = 0 … substeps-1, then end_period(), once per servo period; sample() fills the inputs.
-/// begin_period() integrates a whole period at once where that gives the same motion
-/// (needs_substeps() is then false and substep() does nothing).
+/// begin_period() integrates a whole period at once where the drive stays linear all period
+/// (SimPeriodMap; needs_substeps() is then false and substep() does nothing).
 /// Everything but the constructor is real-time safe and allocation-free.
 class SimJoint {
  public:
