@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Cost of one servo period of the simulated machine (write + read) for 3, 6 and 9 joints.
+// Cost of one servo period of the simulated machine (write + read) for 3, 6 and 9 joints, with
+// and without whole periods, and of mill-3axis moving and standing.
 #include <benchmark/benchmark.h>
 
 #include <cmath>
@@ -13,10 +14,12 @@ using namespace opencnc::machine;
 
 // Every feature that costs something is on: friction, backlash, a pitch table, table
 // feedback on every other joint, index marks, four noisy switches per joint, the spindle.
-SimMachineConfig bench_config(int joints, int substeps) {
+// `linear_periods` off: every sub-step one by one.
+SimMachineConfig bench_config(int joints, int substeps, bool linear_periods) {
   SimMachineConfig c;
   c.joint_count = joints;
   c.substeps = substeps;
+  c.linear_periods = linear_periods;
   for (int j = 0; j < joints; ++j) {
     SimJointConfig& jc = c.joints[static_cast<std::size_t>(j)];
     jc.counts_per_unit = 13107.2;
@@ -51,11 +54,32 @@ std::vector<MachineOutputs> trajectory(int joints) {
   return outs;
 }
 
-void BM_SimMachinePeriod(benchmark::State& state) {
-  const int joints = static_cast<int>(state.range(0));
-  const int substeps = static_cast<int>(state.range(1));
-  SimMachine machine(bench_config(joints, substeps));
-  const std::vector<MachineOutputs> outs = trajectory(joints);
+// mill-3axis as shipped: motor encoders, no backlash or pitch table, two limit switches per
+// axis, the spindle. Its drives run whole periods at once while they move one way or stand.
+SimMachineConfig mill_config(bool linear_periods) {
+  SimMachineConfig c;
+  c.joint_count = 3;
+  c.linear_periods = linear_periods;
+  const double mass[] = {150, 250, 120}, coulomb[] = {40, 60, 50}, stiction[] = {50, 75, 65};
+  for (std::size_t j = 0; j < 3; ++j) {
+    SimJointConfig& jc = c.joints[j];
+    jc.counts_per_unit = 13107.2;
+    jc.model.inertia = mass[j];
+    jc.model.peak_effort = 4000;
+    jc.model.coulomb_friction = coulomb[j];
+    jc.model.static_friction = stiction[j];
+    jc.switches.limit_neg = {true, -kInf, -2002};
+    jc.switches.limit_pos = {true, 2002, kInf};
+    jc.switches.hysteresis = 0.02;
+    jc.switches.noise = 0.003;
+  }
+  c.spindle = true;
+  c.spindle_config.max_rpm = 8000;
+  c.spindle_config.encoder_counts_per_rev = 4096;
+  return c;
+}
+
+void run_periods(benchmark::State& state, SimMachine& machine, const std::vector<MachineOutputs>& outs) {
   MachineInputs in;
   std::size_t k = 0;
   for (auto _ : state) {
@@ -64,9 +88,43 @@ void BM_SimMachinePeriod(benchmark::State& state) {
     machine.write(outs[k]);
     k = k + 1 == outs.size() ? 0 : k + 1;
   }
+}
+
+void BM_SimMachinePeriod(benchmark::State& state) {
+  const int joints = static_cast<int>(state.range(0));
+  const int substeps = static_cast<int>(state.range(1));
+  SimMachine machine(bench_config(joints, substeps, state.range(2) != 0));
+  run_periods(state, machine, trajectory(joints));
   state.counters["joints"] = joints;
   state.counters["substeps"] = substeps;
 }
-BENCHMARK(BM_SimMachinePeriod)->Args({3, 10})->Args({6, 10})->Args({9, 10})->Args({6, 5})->Args({6, 20});
+BENCHMARK(BM_SimMachinePeriod)
+    ->ArgNames({"joints", "substeps", "linear"})
+    ->Args({3, 10, 0})
+    ->Args({3, 10, 1})
+    ->Args({6, 10, 0})
+    ->Args({6, 10, 1})
+    ->Args({9, 10, 1})
+    ->Args({6, 5, 1})
+    ->Args({6, 20, 1});
+
+// Circles at 100 mm/s (range 0) or standing still (range 1) on mill-3axis.
+void BM_MillPeriod(benchmark::State& state) {
+  SimMachine machine(mill_config(state.range(1) != 0));
+  std::vector<MachineOutputs> outs = trajectory(3);
+  if (state.range(0) == 1) {
+    for (MachineOutputs& o : outs) {
+      o = outs.front();
+      for (JointOutputs& j : o.joints) j.velocity_ff = 0;
+    }
+  }
+  run_periods(state, machine, outs);
+}
+BENCHMARK(BM_MillPeriod)
+    ->ArgNames({"still", "linear"})
+    ->Args({0, 0})
+    ->Args({0, 1})
+    ->Args({1, 0})
+    ->Args({1, 1});
 
 }  // namespace

@@ -21,6 +21,7 @@ machine::SimMachineConfig sim_machine_config(const MachineProfile& profile) {
   machine::SimMachineConfig c;
   c.servo_period_s = profile.servo_period_s;
   c.substeps = profile.sim_substeps;
+  c.linear_periods = profile.sim_linear_periods;
   c.seed = profile.sim_seed;
   c.joint_count = static_cast<int>(profile.axes.size());
   for (const AxisProfile& a : profile.axes) {

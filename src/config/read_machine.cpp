@@ -48,7 +48,7 @@ void read_sim(Section& top, MachineProfile& profile) {
   profile.sim_substeps = std::max(1, static_cast<int>(std::lround(period / kDefaultSubstep)));
   const toml::table* t = top.subtable("sim");
   if (t == nullptr) return;
-  Section s(*t, "sim", {"substep_s", "seed"}, top.reporter());
+  Section s(*t, "sim", {"substep_s", "seed", "linear_periods"}, top.reporter());
   if (const auto h = s.number("substep_s", Bound::Positive)) {
     const double n = period / *h;
     const double whole = std::round(n);
@@ -63,6 +63,7 @@ void read_sim(Section& top, MachineProfile& profile) {
   }
   profile.sim_seed =
       static_cast<std::uint64_t>(s.integer("seed", 0, std::numeric_limits<std::int64_t>::max()).value_or(1));
+  profile.sim_linear_periods = s.boolean_or("linear_periods", true);
 }
 
 void read_spindle(Section& top, MachineProfile& profile) {

@@ -85,6 +85,7 @@ struct Controller::Run {
   canon::SegmentId segment_offset = 0;  ///< run segment k = open program segment offset + k
   std::unique_ptr<plan::Planner> planner;
   bool pumping = true;
+  bool pumped_once = false;       ///< the first pump of a run fills the queue, whatever is free
   std::uint32_t next_action = 0;  ///< next program action to consider for a MachineAction record
   canon::SegmentId program_tripped_segment = 0;  ///< the probe move that tripped
 };
@@ -104,6 +105,7 @@ std::uint64_t Controller::submit(Request r) {
   std::lock_guard lock(inbox_mutex_);
   const std::uint64_t id = next_id_++;
   inbox_.emplace_back(id, std::move(r));
+  inbox_filled_.store(true, std::memory_order_release);
   return id;
 }
 
@@ -137,12 +139,15 @@ std::shared_ptr<const canon::Program> Controller::open_program() const {
 
 void Controller::service() {
   read_servo();
-  std::deque<std::pair<std::uint64_t, Request>> requests;
-  {
-    std::lock_guard lock(inbox_mutex_);
-    requests.swap(inbox_);
+  if (inbox_filled_.load(std::memory_order_acquire)) {
+    {
+      std::lock_guard lock(inbox_mutex_);
+      requests_.swap(inbox_);
+      inbox_filled_.store(false, std::memory_order_relaxed);
+    }
+    for (auto& [id, r] : requests_) handle(id, r);
+    requests_.clear();
   }
-  for (auto& [id, r] : requests) handle(id, r);
   pump();
 
   std::lock_guard lock(out_mutex_);
@@ -369,6 +374,9 @@ void Controller::continue_after_probe() {
 
 // --- feeding the servo -----------------------------------------------------------------------
 
+// The planner refills the queue in batches, once a quarter of it is free (thousands of blocks,
+// seconds of motion, are still queued then): planning many blocks in a row keeps its code and
+// data in the cache, where a block or two every period did not.
 void Controller::pump() {
   if (!run_ || !run_->pumping) return;
   const canon::Program& p = *run_->program;
@@ -377,6 +385,9 @@ void Controller::pump() {
     if (a && !channels_->actions.try_push(*a)) break;
     ++run_->next_action;
   }
+  constexpr std::size_t kRefillSlots = traj::BlockQueue::kCapacity / 4;
+  if (run_->pumped_once && channels_->blocks.free_slots() < kRefillSlots) return;
+  run_->pumped_once = true;
   switch (run_->planner->pump(channels_->blocks)) {
     case plan::PlanStatus::Working:
       break;

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <numbers>
 #include <utility>
+#include <vector>
 
 namespace opencnc::machine {
 
@@ -41,7 +42,7 @@ double PitchErrorTable::at(double s) const noexcept {
   return a.error + slopes_[segment_] * (s - a.position);
 }
 
-SimJoint::SimJoint(const SimJointConfig& config, double servo_period_s, int substeps)
+SimJoint::SimJoint(const SimJointConfig& config, double servo_period_s, int substeps, bool linear_periods)
     : config_(config),
       pitch_(config.model.pitch_error),
       limit_neg_(config.switches.limit_neg, config.switches.hysteresis, config.switches.noise),
@@ -63,6 +64,15 @@ SimJoint::SimJoint(const SimJointConfig& config, double servo_period_s, int subs
   current_alpha_ = m.current_bandwidth_hz > 0 ? 1.0 - std::exp(-kTwoPi * m.current_bandwidth_hz * h_) : 1.0;
   power_per_effort_velocity_ = 1.0 / scale;
   half_backlash_ = m.backlash / 2;
+  linear_periods_ = linear_periods && config.drive == JointDrive::Servo;
+  // With a linear scale the loop closes around backlash and pitch error, which are not linear.
+  linear_moving_ =
+      linear_periods_ && (m.feedback == FeedbackSource::Motor || (m.backlash == 0 && m.pitch_error.empty()));
+  encoder_bias_ = 0.5 * unit_per_count_;
+  if (linear_periods_) {
+    moving_map_ = build_period_map(false);
+    held_map_ = build_period_map(true);
+  }
 
   if (config.drive == JointDrive::Stepper) {
     steps_emitted_ = std::llround(m.start_position * config.counts_per_unit);
@@ -136,9 +146,41 @@ void SimJoint::begin_period(const JointOutputs& cmd, bool powered, double extern
     position_integral_ = 0;
     velocity_error_integral_ = 0;
   }
+  period_moving_ = false;
+  period_done_ = integrate_period();
+}
+
+double SimJoint::energy_j() const noexcept {
+  if (!period_moving_) return energy_j_;
+  double e = 0;
+  for (int k = 0; k < SimPeriodMap::kSize; ++k) {
+    double row = 0;
+    for (int l = 0; l < SimPeriodMap::kSize; ++l) row += moving_map_.energy[k][l] * z_[l];
+    e += z_[k] * row;
+  }
+  return e;
+}
+
+// Whole periods whose sub-steps can be summed up exactly: a stepper's steps (monotone within
+// the period, so the play operator can be applied once at the end), a joint that stands
+// without power and without a load that breaks it loose, and a linear drive.
+bool SimJoint::integrate_period() noexcept {
+  if (config_.drive == JointDrive::Stepper) {
+    if (powered_) {
+      steps_emitted_ = cmd_.step_position;
+      motor_ = static_cast<double>(steps_emitted_) / config_.counts_per_unit;
+      take_up_backlash();
+    }
+    return true;
+  }
+  if (!powered_) return velocity_ == 0.0 && std::abs(external_effort_) <= config_.model.static_friction;
+  if (!linear_periods_) return false;
+  if (velocity_ == 0.0) return integrate_held_period();
+  return linear_moving_ && integrate_moving_period();
 }
 
 void SimJoint::substep(int i) noexcept {
+  if (period_done_) return;
   if (config_.drive == JointDrive::Stepper) {
     stepper_substep(i);
   } else {
@@ -172,6 +214,205 @@ void SimJoint::servo_substep(double t_s) noexcept {
   }
   integrate_mechanics(effort_);
   take_up_backlash();
+}
+
+namespace {
+
+using Row = SimPeriodMap::Row;
+
+// Coordinates of the period map (SimPeriodMap::z).
+enum MapCoord : int {
+  kRelPosition,    // feedback position − command position
+  kRelVelocity,    // velocity − feed-forward velocity
+  kForce,          // drive force
+  kPosIntegral,    // position loop integrator
+  kVelIntegral,    // velocity loop integrator
+  kFeedForward,    // feed-forward velocity
+  kConstantForce,  // external effort − Coulomb friction in the direction of motion
+  kEncoderBias,    // feedback position − encoder reading
+};
+
+/// Per coefficient, the largest deviation of rows[i] from the chord between the first and the
+/// last row.
+Row bend_of(const std::vector<Row>& rows) {
+  Row bend{};
+  const Row& first = rows.front();
+  const Row& last = rows.back();
+  const double steps = static_cast<double>(rows.size() - 1);
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const double f = steps > 0 ? static_cast<double>(i) / steps : 0.0;
+    for (std::size_t k = 0; k < bend.size(); ++k) {
+      const double chord = first[k] + f * (last[k] - first[k]);
+      bend[k] = std::max(bend[k], std::abs(rows[i][k] - chord));
+    }
+  }
+  return bend;
+}
+
+}  // namespace
+
+// servo_substep() and integrate_mechanics() are linear in z while no clamp acts and either
+// the velocity keeps its sign (friction is then a constant force) or the axis is held by
+// static friction all period (it does not move; the encoder reading is then exact). While
+// moving, the encoder reading is taken as the position less half a count: its mean, the
+// quantisation error being uniform over a count at any speed. A period is then a linear map
+// of z, the product of the sub-step maps: running the sub-step equations on each unit vector
+// of z gives its columns, and the coefficients of the clamped quantities in every sub-step
+// give the bounds that tell whether a period stays linear.
+SimPeriodMap SimJoint::build_period_map(bool held) const {
+  const SimJointModel& m = config_.model;
+  constexpr int n = SimPeriodMap::kSize;
+  std::array<Row, SimPeriodMap::kStates> s{};  // s[state][k]: coefficient of z_k
+  for (int k = 0; k < SimPeriodMap::kStates; ++k) s[k][k] = 1.0;
+  std::vector<Row> velocity(1), force_command, velocity_reference;
+  velocity[0][kRelVelocity] = velocity[0][kFeedForward] = 1.0;
+  SimPeriodMap p;
+  for (int i = 0; i < substeps_; ++i) {
+    const double t = h_ * i;
+    Row v_after{}, f_cmd_row{}, v_ref_row{}, force{};
+    for (int k = 0; k < n; ++k) {
+      const double vff = k == kFeedForward ? 1.0 : 0.0;
+      const double load = k == kConstantForce ? 1.0 : 0.0;
+      const double bias = k == kEncoderBias ? 1.0 : 0.0;
+      double& d = s[kRelPosition][k];
+      double& w = s[kRelVelocity][k];
+      double& f = s[kForce][k];
+      double& ip = s[kPosIntegral][k];
+      double& iv = s[kVelIntegral][k];
+      const double v = w + vff;
+      const double error = vff * t - d + bias;
+      const double v_ref = m.feed_forward * vff + m.position_gain * error + m.position_integral * ip;
+      ip += error * h_;
+      const double v_error = v_ref - v;
+      const double f_cmd = velocity_gain_ * (v_error + velocity_integral_ * iv);
+      iv += v_error * h_;
+      f += current_alpha_ * (f_cmd - f);
+      const double v_next = held ? 0.0 : v + accel_per_effort_ * (f + load - m.viscous_friction * v) * h_;
+      d += v_next * h_;
+      w = v_next - vff;
+      v_after[k] = v_next;
+      f_cmd_row[k] = f_cmd;
+      v_ref_row[k] = v_ref;
+      force[k] = f;
+    }
+    velocity.push_back(v_after);
+    force_command.push_back(f_cmd_row);
+    velocity_reference.push_back(v_ref_row);
+    // energy_j += F·v·h per sub-step, both linear in z.
+    for (int k = 0; k < n; ++k) {
+      for (int l = 0; l < n; ++l) p.energy[k][l] += force[k] * v_after[l] * h_ * power_per_effort_velocity_;
+    }
+  }
+  const Row bends[] = {bend_of(force_command), bend_of(velocity_reference), bend_of(velocity)};
+  for (std::size_t k = 0; k < n; ++k) {
+    auto& out = p.outputs[k];
+    out[SimPeriodMap::kNextForce] = s[kForce][k];
+    out[SimPeriodMap::kNextPosIntegral] = s[kPosIntegral][k];
+    out[SimPeriodMap::kNextVelIntegral] = s[kVelIntegral][k];
+    out[SimPeriodMap::kForceCommandFirst] = force_command.front()[k];
+    out[SimPeriodMap::kForceCommandLast] = force_command.back()[k];
+    out[SimPeriodMap::kVelRefFirst] = velocity_reference.front()[k];
+    out[SimPeriodMap::kVelRefLast] = velocity_reference.back()[k];
+    out[SimPeriodMap::kNextRelPosition] = s[kRelPosition][k];
+    out[SimPeriodMap::kNextRelVelocity] = s[kRelVelocity][k];
+    for (std::size_t b = 0; b < SimPeriodMap::kBends; ++b) p.bends[k][b] = bends[b][k];
+  }
+  return p;
+}
+
+/// A period map applied to z_: its outputs and bends (those not evaluated are zero).
+struct SimJoint::MapValues {
+  std::array<double, SimPeriodMap::kOutputs + 1> y{};
+  std::array<double, SimPeriodMap::kBends + 1> bend{};
+  double operator[](int output) const noexcept { return y[static_cast<std::size_t>(output)]; }
+  double largest(int first, int bend_index) const noexcept {
+    const auto f = static_cast<std::size_t>(first);
+    return std::max(std::abs(y[f]), std::abs(y[f + 1])) + bend[static_cast<std::size_t>(bend_index)];
+  }
+};
+
+// The first Rows outputs and Bends bends, column by column into local sums, so that the compiler
+// keeps them in registers and runs the rows side by side (two to an SSE2 register).
+template <std::size_t Rows, std::size_t Bends>
+SimJoint::MapValues SimJoint::evaluate(const SimPeriodMap& map) const noexcept {
+  std::array<double, Rows> y{};
+  std::array<double, Bends> bend{};
+  for (std::size_t k = 0; k < SimPeriodMap::kSize; ++k) {
+    const double zk = z_[k], ak = std::abs(z_[k]);
+#pragma GCC unroll 16
+    for (std::size_t r = 0; r < Rows; ++r) y[r] += map.outputs[k][r] * zk;
+#pragma GCC unroll 16
+    for (std::size_t r = 0; r < Bends; ++r) bend[r] += map.bends[k][r] * ak;
+  }
+  MapValues v;
+  std::copy(y.begin(), y.end(), v.y.begin());
+  std::copy(bend.begin(), bend.end(), v.bend.begin());
+  return v;
+}
+
+// No sub-step of the period clamps the force command or the velocity reference.
+bool SimJoint::within_limits(const MapValues& y) const noexcept {
+  const SimJointModel& m = config_.model;
+  return y.largest(SimPeriodMap::kForceCommandFirst, SimPeriodMap::kForceCommandBend) <= m.peak_effort &&
+         (m.velocity_limit <= 0 ||
+          y.largest(SimPeriodMap::kVelRefFirst, SimPeriodMap::kVelRefBend) <= m.velocity_limit);
+}
+
+void SimJoint::take_state(const MapValues& y) noexcept {
+  effort_ = y[SimPeriodMap::kNextForce];
+  position_integral_ = y[SimPeriodMap::kNextPosIntegral];
+  velocity_error_integral_ = y[SimPeriodMap::kNextVelIntegral];
+}
+
+void SimJoint::load_state(double feedback) noexcept {
+  z_[kRelPosition] = feedback - cmd_.position;
+  z_[kRelVelocity] = velocity_ - cmd_.velocity_ff;
+  z_[kForce] = effort_;
+  z_[kPosIntegral] = position_integral_;
+  z_[kVelIntegral] = velocity_error_integral_;
+  z_[kFeedForward] = cmd_.velocity_ff;
+}
+
+// Moving one way all period: the velocity at the start and at the end have the same sign and
+// the chord between them stays further from zero (by a count per period) than the velocity can
+// bend away from it. The motor moves one way, so the backlash is taken up once at the end.
+bool SimJoint::integrate_moving_period() noexcept {
+  load_state(feedback_raw());
+  z_[kConstantForce] = external_effort_ - std::copysign(config_.model.coulomb_friction, velocity_);
+  z_[kEncoderBias] = encoder_bias_;
+  const MapValues y = evaluate<SimPeriodMap::kOutputs + 1, SimPeriodMap::kBends + 1>(moving_map_);
+  const double v_end = cmd_.velocity_ff + y[SimPeriodMap::kNextRelVelocity];
+  // The mean encoder error stands for the real one only while the motion crosses counts.
+  const double v_min = std::min(std::abs(velocity_), std::abs(v_end)) - unit_per_count_ / period_s_;
+  if (!((v_end > 0) == (velocity_ > 0) && v_min > y.bend[SimPeriodMap::kVelocityBend]) || !within_limits(y))
+    return false;
+  motor_ = cmd_.position + y[SimPeriodMap::kNextRelPosition];
+  velocity_ = v_end;
+  take_state(y);
+  take_up_backlash();
+  period_moving_ = true;
+  return true;
+}
+
+// Held by static friction all period: the feedback does not change and its reading is exact.
+// The force is a first-order lag of the force command (each sub-step a convex combination of
+// the two), so it stays within static friction when it starts there and the command does.
+bool SimJoint::integrate_held_period() noexcept {
+  const SimJointModel& m = config_.model;
+  const double feedback = feedback_raw();
+  load_state(feedback);
+  z_[kConstantForce] = 0;
+  z_[kEncoderBias] = feedback - quantise_fast(feedback);
+  const MapValues y = m.velocity_limit > 0 ? evaluate<SimPeriodMap::kVelRefLast + 1, 2>(held_map_)
+                                           : evaluate<SimPeriodMap::kForceCommandLast + 1, 1>(held_map_);
+  const double load = external_effort_;
+  const double command = std::max(std::abs(y.y[SimPeriodMap::kForceCommandFirst] + load),
+                                  std::abs(y.y[SimPeriodMap::kForceCommandLast] + load)) +
+                         y.bend[SimPeriodMap::kForceCommandBend];
+  if (!(std::abs(effort_ + load) <= m.static_friction && command <= m.static_friction && within_limits(y)))
+    return false;
+  take_state(y);
+  return true;
 }
 
 // Rigid body with friction, semi-implicit Euler. At rest the body sticks while the applied

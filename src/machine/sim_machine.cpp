@@ -30,9 +30,11 @@ std::uint64_t low_bits(int n) {
 SimMachine::SimMachine(const SimMachineConfig& config) : config_(config), rng_(config.seed) {
   for (int j = 0; j < config.joint_count; ++j) {
     const auto uj = static_cast<std::size_t>(j);
-    joints_[uj] = SimJoint(config.joints[uj], config.servo_period_s, config.substeps);
+    joints_[uj] = SimJoint(config.joints[uj], config.servo_period_s, config.substeps, config.linear_periods);
   }
-  if (config.spindle) spindle_ = SimSpindle(config.spindle_config, config.servo_period_s, config.substeps);
+  if (config.spindle)
+    spindle_ =
+        SimSpindle(config.spindle_config, config.servo_period_s, config.substeps, config.linear_periods);
   if (config.probe.joint >= 0)
     probe_ = SimSwitch(config.probe.trip, config.probe.hysteresis, config.probe.noise);
   dc_link_v_ = config.power.dc_link_nominal_v;
@@ -72,14 +74,17 @@ void SimMachine::read(MachineInputs& in) noexcept {
 }
 
 void SimMachine::write(const MachineOutputs& out) noexcept {
-  outputs_ = out;
-  advance();
+  // What the next periods need of the outputs; the joints and the spindle latch their own.
+  estop_release_ = out.estop_release;
+  process_ = out.process;
+  tool_ = out.tool;
+  advance(out);
   ++inputs_.cycle;
   sample();
 }
 
 bool SimMachine::drives_powered() const noexcept {
-  return !estop_pressed_ && outputs_.estop_release && !undervoltage_;
+  return !estop_pressed_ && estop_release_ && !undervoltage_;
 }
 
 void SimMachine::set_amp_fault(int joint, bool fault) noexcept {
@@ -100,34 +105,35 @@ void SimMachine::set_analog_input(int channel, double value) noexcept {
   if (channel >= 0 && channel < kAnalogChannels) analog_in_[static_cast<std::size_t>(channel)] = value;
 }
 
-void SimMachine::advance() noexcept {
+void SimMachine::advance(const MachineOutputs& out) noexcept {
   const bool powered = drives_powered();
   const int n = config_.joint_count;
+  bool substeps = false;  // begin_period() integrates what it can at once
   for (int j = 0; j < n; ++j) {
     const auto uj = static_cast<std::size_t>(j);
-    joints_[uj].begin_period(outputs_.joints[uj], powered && !undervoltage_fault_[uj], external_effort_[uj]);
+    joints_[uj].begin_period(out.joints[uj], powered && !undervoltage_fault_[uj], external_effort_[uj]);
+    substeps = substeps || joints_[uj].needs_substeps();
   }
-  if (config_.spindle) spindle_.begin_period(outputs_.spindle, powered);
+  if (config_.spindle) {
+    spindle_.begin_period(out.spindle, powered);
+    substeps = substeps || spindle_.needs_substeps();
+  }
   // Sub-steps outside, joints inside: the joints' dependency chains are independent, so the
   // CPU overlaps them (measured: about twice as fast as one joint after the other).
-  for (int i = 0; i < config_.substeps; ++i) {
+  for (int i = 0; substeps && i < config_.substeps; ++i) {
     for (int j = 0; j < n; ++j) joints_[static_cast<std::size_t>(j)].substep(i);
     if (config_.spindle) spindle_.substep();
   }
-  double energy_j = 0;
-  for (int j = 0; j < n; ++j) {
-    joints_[static_cast<std::size_t>(j)].end_period();
-    energy_j += joints_[static_cast<std::size_t>(j)].energy_j();
-  }
+  for (int j = 0; j < n; ++j) joints_[static_cast<std::size_t>(j)].end_period();
   if (config_.spindle) spindle_.end_period();
-  update_power(energy_j);
+  update_power(out);
   update_auxiliaries();
 }
 
 // Mains on: the rectifier holds the DC link at nominal. Mains off with a charged UPS: the
 // UPS does. Otherwise the link capacitor alone feeds the idle load and the axes:
 // ½·C·V² loses idle_power·T + E_axes per period (braking axes give energy back).
-void SimMachine::update_power(double energy_j) noexcept {
+void SimMachine::update_power(const MachineOutputs& out) noexcept {
   const SimPowerConfig& p = config_.power;
   const double period = config_.servo_period_s;
   on_battery_ = !mains_ok_ && ups_periods_left_ > 0;
@@ -137,6 +143,8 @@ void SimMachine::update_power(double energy_j) noexcept {
     --ups_periods_left_;
     dc_link_v_ = p.dc_link_nominal_v;
   } else {
+    double energy_j = 0;  // what the axes took from the link in this period
+    for (int j = 0; j < config_.joint_count; ++j) energy_j += joints_[static_cast<std::size_t>(j)].energy_j();
     const double c = p.dc_link_capacitance_f;
     const double stored_j = 0.5 * c * dc_link_v_ * dc_link_v_ - p.idle_power_w * period - energy_j;
     dc_link_v_ =
@@ -146,7 +154,7 @@ void SimMachine::update_power(double energy_j) noexcept {
   // A drive that sees undervoltage while enabled latches the fault until it is disabled.
   for (int j = 0; j < config_.joint_count; ++j) {
     const auto uj = static_cast<std::size_t>(j);
-    const bool enabled = outputs_.joints[uj].enable;
+    const bool enabled = out.joints[uj].enable;
     if (undervoltage_ && enabled) undervoltage_fault_[uj] = true;
     if (!enabled && !undervoltage_) undervoltage_fault_[uj] = false;
   }
@@ -154,9 +162,9 @@ void SimMachine::update_power(double energy_j) noexcept {
 
 void SimMachine::update_auxiliaries() noexcept {
   const bool changer = config_.tool_changer.present;
-  prepare_periods_ = changer && outputs_.tool.prepare ? prepare_periods_ + 1 : 0;
-  change_periods_ = changer && outputs_.tool.change ? change_periods_ + 1 : 0;
-  arc_periods_ = config_.process.torch && outputs_.process.torch_on && arc_available_ ? arc_periods_ + 1 : 0;
+  prepare_periods_ = changer && tool_.prepare ? prepare_periods_ + 1 : 0;
+  change_periods_ = changer && tool_.change ? change_periods_ + 1 : 0;
+  arc_periods_ = config_.process.torch && process_.torch_on && arc_available_ ? arc_periods_ + 1 : 0;
 }
 
 void SimMachine::sample() noexcept {
@@ -175,8 +183,7 @@ void SimMachine::sample() noexcept {
         probe_.update(joints_[static_cast<std::size_t>(config_.probe.joint)].table_position(), rng_);
   }
   inputs_.process.arc_ok = arc_periods_ >= arc_needed_;
-  inputs_.process.gap_voltage_v =
-      config_.process.generator && outputs_.process.generator_on ? gap_voltage_v_ : 0.0;
+  inputs_.process.gap_voltage_v = config_.process.generator && process_.generator_on ? gap_voltage_v_ : 0.0;
   inputs_.tool.prepared = prepare_periods_ >= prepare_needed_;
   inputs_.tool.changed = change_periods_ >= change_needed_;
   inputs_.digital_in = digital_in_ & low_bits(config_.digital_inputs);

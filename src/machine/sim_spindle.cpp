@@ -8,11 +8,13 @@
 
 namespace opencnc::machine {
 
-SimSpindle::SimSpindle(const SimSpindleConfig& config, double servo_period_s, int substeps)
+SimSpindle::SimSpindle(const SimSpindleConfig& config, double servo_period_s, int substeps,
+                       bool linear_periods)
     : config_(config),
       h_(servo_period_s / substeps),
       period_s_(servo_period_s),
-      max_step_rps_(config.acceleration_rpm_s / 60.0 * h_) {}
+      max_step_rps_(config.acceleration_rpm_s / 60.0 * h_),
+      linear_periods_(linear_periods) {}
 
 void SimSpindle::begin_period(const SpindleOutputs& cmd, bool powered) noexcept {
   cmd_ = cmd;
@@ -31,6 +33,9 @@ void SimSpindle::begin_period(const SpindleOutputs& cmd, bool powered) noexcept 
       break;
   }
   if (!powered_) target_rps_ = 0;
+  // At the target speed every sub-step adds speed·h: the period is speed·T.
+  period_done_ = linear_periods_ && !orienting() && speed_rps_ == target_rps_;
+  if (period_done_) position_rev_ += speed_rps_ * period_s_;
 }
 
 // Orient: head for the target angle the short way round, never faster than the speed from
@@ -45,8 +50,12 @@ double SimSpindle::orient_target_speed() const noexcept {
 }
 
 void SimSpindle::substep() noexcept {
+  if (period_done_) return;
   const double target = orienting() ? orient_target_speed() : target_rps_;
-  const double next = speed_rps_ + std::clamp(target - speed_rps_, -max_step_rps_, max_step_rps_);
+  // Lands on the target exactly (speed + (target − speed) may miss it by an ulp).
+  const double next = std::abs(target - speed_rps_) <= max_step_rps_
+                          ? target
+                          : speed_rps_ + std::copysign(max_step_rps_, target - speed_rps_);
   position_rev_ += 0.5 * (speed_rps_ + next) * h_;
   speed_rps_ = next;
 }

@@ -67,9 +67,10 @@ double largest_within(F f, double budget, double a_hi) {
 // k·√(a² + v⁴ω²) and the in-plane jerk k·√((j + v³ω²)² + (3·v·a·ω)²).
 RawLimits arc_limits(const MotionBlock& b, double v_max, const LimitParams& p) {
   const double om = std::fabs(b.omega);
+  double ks[kAxisCount];
   double cap = v_max;
   for (int i = 0; i < kAxisCount; ++i) {
-    const double k = om * std::sqrt(b.u[i] * b.u[i] + b.w[i] * b.w[i]), lam = std::fabs(b.lin[i]);
+    const double k = ks[i] = om * std::sqrt(b.u[i] * b.u[i] + b.w[i] * b.w[i]), lam = std::fabs(b.lin[i]);
     if (k + lam < 1e-15) continue;
     const AxisLimits& l = p.machine[i];
     cap = std::min(cap, l.max_velocity / (k + lam));
@@ -81,7 +82,7 @@ RawLimits arc_limits(const MotionBlock& b, double v_max, const LimitParams& p) {
   double accel = kInf;
   const double q = cap * cap * om;
   for (int i = 0; i < kAxisCount; ++i) {
-    const double k = om * std::sqrt(b.u[i] * b.u[i] + b.w[i] * b.w[i]), lam = std::fabs(b.lin[i]);
+    const double k = ks[i], lam = std::fabs(b.lin[i]);
     if (k + lam < 1e-15) continue;
     const AxisLimits& l = p.machine[i];
     double a = arc_accel(k, lam, q, l.max_acceleration);

@@ -39,14 +39,22 @@ bool has_step(const Pose& s) {
 
 }  // namespace
 
-void Lookahead::push(const PlannedBlock& block) {
-  PlannedBlock pb = block;
+PlannedBlock& Lookahead::next_slot() {
+  PlannedBlock& pb = window_.spare();
+  pb.cap_raw = pb.accel_raw = pb.junction = 0;
+  pb.step = Pose{};
+  return pb;
+}
+
+void Lookahead::push_next() {
+  PlannedBlock& pb = window_.spare();
   pb.start_s = total_s_;
   pb.cap = pb.cap_raw;
   pb.accel = pb.accel_raw;
+  pb.local = pb.entry = pb.prefix = 0;
   pb.step_sum = pb.step;
   total_s_ += pb.b.length;
-  window_.push_back(pb);
+  window_.commit_spare();
   if (widening() && !is_marker(pb)) {
     add_steps(window_.size() - 1);
     widen_last();
@@ -145,7 +153,7 @@ void Lookahead::split(std::size_t k, double x) {
   tail.junction = kInf;
   tail.step = Pose{};
   tail.step_sum = Pose{};
-  window_.insert(window_.begin() + static_cast<std::ptrdiff_t>(k + 1), tail);
+  window_.insert(k + 1, tail);
 }
 
 // Blocks whose widened limits can no longer change get their prefix and own entry limit.
@@ -222,16 +230,15 @@ std::uint64_t Lookahead::find_soft_link(std::uint64_t seq) const {
   return seq + n;  // not decided yet: the tick continues the walk from that block's own link
 }
 
-traj::MotionBlock Lookahead::front_for_queue(std::uint64_t seq) {
+void Lookahead::front_for_queue(std::uint64_t seq, traj::MotionBlock& out) {
   const PlannedBlock& pb = window_.front();
-  traj::MotionBlock b = pb.b;
-  b.seq = seq;
-  b.v_cap = pb.cap;
-  b.accel = pb.accel;
-  b.v_entry = pb.entry;
-  b.brake_prefix = pb.prefix;
-  b.next_soft = soft_link(seq);
-  return b;
+  out = pb.b;
+  out.seq = seq;
+  out.v_cap = pb.cap;
+  out.accel = pb.accel;
+  out.v_entry = pb.entry;
+  out.brake_prefix = pb.prefix;
+  out.next_soft = soft_link(seq);
 }
 
 void Lookahead::pop_front() {

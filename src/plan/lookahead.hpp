@@ -7,11 +7,11 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
-#include <deque>
 #include <utility>
 #include <vector>
 
 #include "opencnc/traj/block_queue.hpp"
+#include "ring.hpp"
 
 namespace opencnc::plan::detail {
 
@@ -55,7 +55,10 @@ class Lookahead {
   explicit Lookahead(const WindowParams& p)
       : p_(p), reach_(std::max(p.v_bound * p.filter_s, p.step_window_s)) {}
 
-  void push(const PlannedBlock& block);
+  /// The slot for the next block, its working values cleared: fill `b` and the raw limits,
+  /// then add it with push_next().
+  PlannedBlock& next_slot();
+  void push_next();
   /// No more blocks will come: everything becomes final.
   void finish() noexcept {
     finished_ = true;
@@ -75,8 +78,8 @@ class Lookahead {
     return settled_;
   }
 
-  /// The front block as it goes to the queue with sequence number `seq`.
-  traj::MotionBlock front_for_queue(std::uint64_t seq);
+  /// Writes the front block as it goes to the queue with sequence number `seq`.
+  void front_for_queue(std::uint64_t seq, traj::MotionBlock& out);
   /// Removes the front block (publishable() or settled() > 0).
   void pop_front();
 
@@ -97,7 +100,7 @@ class Lookahead {
 
   WindowParams p_;
   double reach_ = 0;  ///< the widest range any limit is widened over
-  std::deque<PlannedBlock> window_;
+  Ring<PlannedBlock> window_;
   double total_s_ = 0;        ///< s at the end of the last pushed block
   std::size_t settled_ = 0;   ///< front blocks with final widened limits, prefix and local
   std::size_t pinned_ = 0;    ///< front blocks with a final entry speed

@@ -308,33 +308,36 @@ double distance_to(const MotionBlock& b, const Pose& p) noexcept {
 namespace {
 
 /// Radius for which a circle in the plane of unit vectors `t` and `n` can be run at the needed
-/// speed: v²·√(t_i² + n_i²)/R ≤ share·A_i on every axis.
+/// speed: v²·√(t_i² + n_i²)/R ≤ share·A_i on every axis, i.e. R = v²/share · max_i √(t_i² + n_i²)/A_i
+/// (one square root of the largest square).
 double needed_radius(const Pose& t, const Pose& n, const BlendNeed& need) {
-  double r = 0;
+  double worst = 0;
   for (int i = 0; i < kAxisCount; ++i) {
     const double a = need.accel[static_cast<std::size_t>(i)];
-    if (a > 0)
-      r = std::max(r, need.speed * need.speed * std::sqrt(t[i] * t[i] + n[i] * n[i]) / (need.share * a));
+    if (a > 0) worst = std::max(worst, (t[i] * t[i] + n[i] * n[i]) / (a * a));
   }
-  return r;
+  return need.speed * need.speed * std::sqrt(worst) / need.share;
 }
 
 bool line_line_blend(const MotionBlock& in, double avail_in, const MotionBlock& out, double avail_out,
-                     double tolerance, const BlendNeed& need, double theta, const Pose& ta, const Pose& tb,
-                     Blend& result) {
+                     double tolerance, const BlendNeed& need, const CornerTurn& turn, Blend& result) {
   // Circular fillet tangent to both lines: tangent length d, radius R = d / tan(θ/2), largest
   // distance from the lines R·(1 − cos(θ/2)) ≤ tolerance, and no larger than the speed needs.
-  const double t2 = std::tan(0.5 * theta);
-  const double s4 = std::sin(0.25 * theta);
-  Pose n = tb - ta;
+  // From s = sin(θ/2) and c = cos(θ/2): tan(θ/2) = s/c and 1 − c = s²/(1 + c), without
+  // cancellation at small angles, so d ≤ tolerance·(1 + c)/(s·c).
+  const double theta = turn.angle, s = turn.half_sine, c2 = std::sqrt(1.0 - s * s);
+  const double t2 = s / c2;
+  const Pose& ta = turn.in;
+  Pose n = turn.out - ta;
   n = n - dot(n, ta) * ta;
   n = (1.0 / norm(n)) * n;
   double d = std::min({avail_in, avail_out, needed_radius(ta, n, need) * t2});
-  if (tolerance > 0) d = std::min(d, tolerance * t2 / (2.0 * s4 * s4));
+  if (tolerance > 0) d = std::min(d, tolerance * (1.0 + c2) / (s * c2));
   if (!(d >= kMinLength)) return false;
   const double radius = d / t2;
-  MotionBlock& c = result.curve;
-  c = in;
+  MotionBlock& c = result.curve;  // the caller sets identity, class and feed
+  c.line = in.line;
+  c.context = in.context;
   c.kind = BlockKind::Arc;
   c.base = end_point(in) - d * ta;
   c.w = radius * ta;
@@ -359,7 +362,8 @@ void bezier_at(const MotionBlock& in, const MotionBlock& out, double d, MotionBl
   const double theta = angle_between(ta, tb);
   const double cq = std::cos(0.25 * theta);
   const double h = norm(p3 - p0) / (3.0 * cq * cq);
-  c = in;
+  c.line = in.line;  // the caller sets identity, class and feed
+  c.context = in.context;
   c.kind = BlockKind::Bezier;
   c.base = p0;
   c.u = p0 + h * ta;
@@ -415,13 +419,23 @@ bool bezier_blend(const MotionBlock& in, double avail_in, const MotionBlock& out
 
 }  // namespace
 
+CornerTurn corner_turn(const MotionBlock& in, const MotionBlock& out) noexcept {
+  CornerTurn t;
+  t.in = end_tangent(in);
+  t.out = start_tangent(out);
+  t.half_sine = std::min(0.5 * norm(t.out - t.in), 1.0);  // as in angle_between()
+  t.angle = 2.0 * std::asin(t.half_sine);
+  return t;
+}
+
 bool blend_corner(const MotionBlock& in, double avail_in, const MotionBlock& out, double avail_out,
-                  double tolerance, const BlendNeed& need, Blend& result) {
-  const Pose ta = end_tangent(in), tb = start_tangent(out);
-  const double theta = angle_between(ta, tb);
+                  const CornerTurn& turn, double tolerance, const BlendNeed& need, Blend& result) {
+  const Pose& ta = turn.in;
+  const Pose& tb = turn.out;
+  const double theta = turn.angle;
   if (theta <= kTangentAngle || theta >= kReversalAngle) return false;
   if (in.kind == BlockKind::Line && out.kind == BlockKind::Line) {
-    return line_line_blend(in, avail_in, out, avail_out, tolerance, need, theta, ta, tb, result);
+    return line_line_blend(in, avail_in, out, avail_out, tolerance, need, turn, result);
   }
   return bezier_blend(in, avail_in, out, avail_out, tolerance, need, theta, ta, tb, result);
 }

@@ -57,12 +57,21 @@ struct BlendNeed {
   std::array<double, kAxisCount> accel{};
 };
 
-/// Blends the corner between `in` (ending at the corner) and `out` (starting there). At most
-/// `avail_in` / `avail_out` may be taken from each; the curve stays within `tolerance` of the
-/// two blocks (0 = no limit) and is no larger than `need` asks. False when no useful blend exists
-/// (the motion must stop).
+/// The directions at a corner: unit tangents at the end of the incoming block and the start of
+/// the outgoing one, the angle θ between them and sin(θ/2) (half the chord between the tangents).
+struct CornerTurn {
+  Pose in{}, out{};
+  double angle = 0;
+  double half_sine = 0;
+};
+CornerTurn corner_turn(const MotionBlock& in, const MotionBlock& out) noexcept;
+
+/// Blends the corner between `in` (ending at the corner) and `out` (starting there), which turns
+/// by `turn`. At most `avail_in` / `avail_out` may be taken from each; the curve stays within
+/// `tolerance` of the two blocks (0 = no limit) and is no larger than `need` asks. False when no
+/// useful blend exists (the motion must stop).
 bool blend_corner(const MotionBlock& in, double avail_in, const MotionBlock& out, double avail_out,
-                  double tolerance, const BlendNeed& need, Blend& result);
+                  const CornerTurn& turn, double tolerance, const BlendNeed& need, Blend& result);
 
 /// Distance from `p` to the block's curve (lines and arcs exact; others by sampling).
 double distance_to(const MotionBlock& b, const Pose& p) noexcept;

@@ -85,14 +85,15 @@ struct Planner::Impl {
   std::vector<MotionBlock> reports;        ///< Report markers waiting after `pending`
   Pose last_end{};                         ///< exact end of the last emitted path block
   bool continues = false;                  ///< `prev` runs on into the next path block (no stop)
-  MotionBlock prev;                        ///< the last emitted path block
+  MotionBlock prev;                        ///< the last emitted path block (with jerk limits)
 
   Impl(const MachineLimits& l, const PlannerConfig& c);
   void check_config();
-  void emit_path(MotionBlock b, double junction);
-  void emit_marker(MotionBlock m);
+  void emit_path(const MotionBlock& b, double junction);
+  void emit_marker(const MotionBlock& m);
   void emit_reports();
-  void on_element(Element e);
+  void publish_front(traj::BlockQueue& queue);
+  void on_element(Element& e);
   void on_marker(const MotionBlock& m);
   void flush_pending();
   bool corner(Element& a, Element& e);
@@ -157,31 +158,43 @@ detail::BlendNeed Planner::Impl::blend_need(const MotionBlock& a, const MotionBl
   return need;
 }
 
-void Planner::Impl::emit_path(MotionBlock b, double junction) {
+// Blocks are written into the window's slot in place: a MotionBlock is 408 bytes, and on dense
+// paths copying them was much of the planner's time.
+void Planner::Impl::emit_path(const MotionBlock& block, double junction) {
+  PlannedBlock& pb = window->next_slot();
+  MotionBlock& b = pb.b;
+  b = block;
   detail::rebase(b, last_end);
   if (b.length < detail::kMinLength) return;
   const detail::RawLimits r = detail::block_limits(b, commanded_max(b), params);
   if (b.feed_class == FeedClass::Rapid) b.feed = r.cap;
-  PlannedBlock pb;
-  pb.b = b;
   pb.cap_raw = r.cap;
   pb.accel_raw = r.accel;
   pb.junction = junction;
-  if (continues && junction > 0 && params.filter_s > 0) pb.step = detail::curvature_step(prev, b);
-  window->push(pb);
-  prev = b;
+  if (params.filter_s > 0) {  // the curvature steps matter with jerk limits only
+    if (continues && junction > 0) pb.step = detail::curvature_step(prev, b);
+    prev = b;
+  }
   continues = true;
   last_end = detail::end_point(b);
+  window->push_next();
 }
 
-void Planner::Impl::emit_marker(MotionBlock m) {
-  m.base = last_end;
-  m.length = 0;
-  PlannedBlock pb;
+void Planner::Impl::emit_marker(const MotionBlock& m) {
+  PlannedBlock& pb = window->next_slot();
   pb.b = m;
+  pb.b.base = last_end;
+  pb.b.length = 0;
   pb.junction = kInf;
-  window->push(pb);
+  window->push_next();
   if (m.marker != MarkerKind::Report) continues = false;
+}
+
+void Planner::Impl::publish_front(traj::BlockQueue& queue) {
+  window->front_for_queue(queue.pushed(), queue.next_slot());
+  queue.commit();
+  window->pop_front();
+  ++stats.blocks;
 }
 
 void Planner::Impl::emit_reports() {
@@ -194,8 +207,8 @@ void Planner::Impl::emit_reports() {
 bool Planner::Impl::corner(Element& a, Element& e) {
   if (a.stop_after || a.mode == canon::MotionControl::ExactStop) return false;
   if ((a.b.feed_class == FeedClass::SpindleSync) != (e.b.feed_class == FeedClass::SpindleSync)) return false;
-  const double theta = detail::angle_between(detail::end_tangent(a.b), detail::start_tangent(e.b));
-  if (theta <= detail::kTangentAngle) {
+  const detail::CornerTurn turn = detail::corner_turn(a.b, e.b);
+  if (turn.angle <= detail::kTangentAngle) {
     emit_path(a.b, a.junction);
     emit_reports();
     return true;
@@ -209,7 +222,7 @@ bool Planner::Impl::corner(Element& a, Element& e) {
   detail::Blend blend;
   const double avail_a = std::min(0.5 * a.orig_length, a.b.length);
   const double avail_e = std::min(0.5 * e.orig_length, e.b.length);
-  if (!detail::blend_corner(a.b, avail_a, e.b, avail_e, tol, blend_need(a.b, e.b), blend)) return false;
+  if (!detail::blend_corner(a.b, avail_a, e.b, avail_e, turn, tol, blend_need(a.b, e.b), blend)) return false;
   if (!blend_pays(a, e, blend)) return false;
   detail::trim_end(a.b, blend.trim_in);
   emit_path(a.b, a.junction);
@@ -268,7 +281,7 @@ bool Planner::Impl::blend_pays(const Element& ea, const Element& ee, const detai
   return v_b > 0 && (c.length - blend.trim_in - blend.trim_out) / v_b + params.filter_s < v_b / accel;
 }
 
-void Planner::Impl::on_element(Element e) {
+void Planner::Impl::on_element(Element& e) {
   if (pending) {
     e.junction = corner(*pending, e) ? kInf : 0.0;
     if (e.junction == 0) {  // no blend: `pending` ends with a stop at the corner
@@ -295,12 +308,12 @@ void Planner::Impl::on_marker(const MotionBlock& m) {
 }
 
 bool Planner::Impl::read_one() {
-  detail::Item it;
-  if (!reader->next(it)) return false;
-  if (it.is_marker) {
-    on_marker(it.marker);
+  detail::Item* it = reader->next();
+  if (it == nullptr) return false;
+  if (it->is_marker) {
+    on_marker(it->element.b);
   } else {
-    on_element(it.element);
+    on_element(it->element);
   }
   stats.moves = reader->moves_read();
   stats.merged_moves = reader->merged();
@@ -355,11 +368,7 @@ PlanStatus Planner::pump(traj::BlockQueue& queue) {
   detail::Lookahead& w = *m.window;
   const std::size_t max_window = 2 * m.config.lookahead_moves + 16;
   for (;;) {
-    while (queue.free_slots() > 0 && w.publishable() > 0) {
-      queue.try_push(w.front_for_queue(queue.pushed()));
-      w.pop_front();
-      ++m.stats.blocks;
-    }
+    while (queue.free_slots() > 0 && w.publishable() > 0) m.publish_front(queue);
     if (queue.free_slots() == 0) return PlanStatus::Working;
     if (m.reading_done && w.empty()) return PlanStatus::Finished;
     if (m.reading_done) continue;  // finish() made everything publishable
@@ -367,9 +376,7 @@ PlanStatus Planner::pump(traj::BlockQueue& queue) {
       // The window is full and nothing is final: publish the front with the entry speed it
       // has (a stop at the window's end is assumed, so it is on the safe side).
       if (w.settled() == 0) return PlanStatus::Working;
-      queue.try_push(w.front_for_queue(queue.pushed()));
-      w.pop_front();
-      ++m.stats.blocks;
+      m.publish_front(queue);
       continue;
     }
     // Read a batch before looking for final blocks again: the backward pass then runs once

@@ -2,6 +2,7 @@
 // canon::Program → path elements and markers, with modal path-control state and G64 Q merging.
 #include "program_reader.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -123,11 +124,18 @@ std::uint8_t ProgramReader::flags() const noexcept {
   return f;
 }
 
-void ProgramReader::add_marker(const canon::Action& a, MarkerKind kind) {
-  Item it;
+// A marker item at the end of ready_, every field set.
+traj::MotionBlock& ProgramReader::new_marker() {
+  Item& it = ready_.append();
   it.is_marker = true;
-  traj::MotionBlock& m = it.marker;
-  m.kind = traj::BlockKind::Marker;
+  it.element = Element{};
+  it.element.b.kind = traj::BlockKind::Marker;
+  return it.element.b;
+}
+
+void ProgramReader::add_marker(const canon::Action& a, MarkerKind kind) {
+  flush_run();
+  traj::MotionBlock& m = new_marker();
   m.marker = kind;
   m.action = static_cast<std::uint32_t>(&a - program_->actions().data());
   m.segment = m.segment_first = m.segment_last = a.before_move;
@@ -136,8 +144,6 @@ void ProgramReader::add_marker(const canon::Action& a, MarkerKind kind) {
   m.value = a.value;
   m.flags = flags();
   if (kind == MarkerKind::ProgramEnd) ended_ = true;
-  flush_run();
-  ready_.push_back(it);
 }
 
 void ProgramReader::read_actions_before(std::uint32_t move) {
@@ -260,23 +266,39 @@ bool ProgramReader::can_extend_run(const Element& e) const {
       run_.tolerance > 0 ? std::min(naive_tolerance_, 0.5 * run_.tolerance) : naive_tolerance_;
   const double q = std::min(q_vertex, merge_budget() - floor);
   if (q < 0) return false;
-  const Pose end = end_point(e.b);
-  const Pose chord = end - run_start_;
+  const Pose chord = end_point(e.b) - run_start_;
   const double len = norm(chord);
   if (len < kMinLength) return false;
   const Pose dir = (1.0 / len) * chord;
+  // A vertex at r from the start lies t = r·dir along the chord and √(|r|² − t²) from it. Every
+  // run is checked again for each new end, so this is the planner's inner loop on dense paths.
   double last = 0;
-  const auto inside = [&](const Pose& p) {
-    const Pose rel = p - run_start_;
-    const double t = dot(rel, dir);
+  const auto inside = [&](double t, double r_squared) {
     if (t < last || t > len) return false;
     last = t;
-    return norm(rel - t * dir) <= q;
+    return r_squared - t * t <= q * q;
   };
-  for (const Pose& p : run_points_) {
-    if (!inside(p)) return false;
+  for (std::size_t k = 0; k < run_points_.size(); ++k) {
+    double t = 0;
+    for (int a = 0; a < run_axis_count_; ++a) {
+      const int i = run_axes_[static_cast<std::size_t>(a)];
+      t += run_points_[k][i] * dir[i];
+    }
+    if (!inside(t, run_squares_[k])) return false;
   }
-  return inside(e.b.base);
+  const Pose r = e.b.base - run_start_;
+  return inside(dot(r, dir), dot(r, r));
+}
+
+void ProgramReader::add_run_point(const Pose& rel) {
+  run_points_.push_back(rel);
+  run_squares_.push_back(dot(rel, rel));
+  for (int i = 0; i < kAxisCount; ++i) {
+    if (rel[i] == 0) continue;
+    const auto end = run_axes_.begin() + run_axis_count_;
+    if (std::find(run_axes_.begin(), end, i) == end)
+      run_axes_[static_cast<std::size_t>(run_axis_count_++)] = i;
+  }
 }
 
 void ProgramReader::flush_run() {
@@ -289,21 +311,20 @@ void ProgramReader::flush_run() {
     e.b.feed = run_feed_ / 60.0 * feed_length_ratio(run_start_, end, e.b);
     e.orig_length = e.b.length;
     double dev = 0;
-    for (const Pose& p : run_points_) {
-      const double t = dot(p - run_start_, e.b.lin);
-      dev = std::max(dev, norm(p - (run_start_ + t * e.b.lin)));
-    }
+    for (const Pose& r : run_points_) dev = std::max(dev, norm(r - dot(r, e.b.lin) * e.b.lin));
     e.merge_deviation = dev + run_floor_;
   }
   run_points_.clear();
-  Item it;
+  run_squares_.clear();
+  run_axis_count_ = 0;
+  Item& it = ready_.append();
+  it.is_marker = false;
   it.element = e;
-  ready_.push_back(it);
 }
 
 void ProgramReader::push_element(const Element& e) {
   if (can_extend_run(e)) {
-    run_points_.push_back(e.b.base);
+    add_run_point(e.b.base - run_start_);
     run_.b.segment_last = e.b.segment_last;
     run_.b.base = e.b.base;  // the run's current last line, for end_point()
     run_.b.lin = e.b.lin;
@@ -324,9 +345,9 @@ void ProgramReader::push_element(const Element& e) {
     run_floor_ = e.merge_deviation;
     return;
   }
-  Item it;
+  Item& it = ready_.append();
+  it.is_marker = false;
   it.element = e;
-  ready_.push_back(it);
 }
 
 void ProgramReader::read_move(canon::SegmentId id) {
@@ -336,15 +357,12 @@ void ProgramReader::read_move(canon::SegmentId id) {
   push_element(e);
   if (e.stop_after) {  // the controller reads the probe result before anything goes on
     flush_run();
-    Item it;
-    it.is_marker = true;
-    it.marker.kind = traj::BlockKind::Marker;
-    it.marker.marker = MarkerKind::Sync;
-    it.marker.segment = it.marker.segment_first = it.marker.segment_last = id + 1;
-    it.marker.line = e.b.line;
-    it.marker.context = e.b.context;
-    it.marker.action = static_cast<std::uint32_t>(program_->actions().size());  // none
-    ready_.push_back(it);
+    traj::MotionBlock& m = new_marker();
+    m.marker = MarkerKind::Sync;
+    m.segment = m.segment_first = m.segment_last = id + 1;
+    m.line = e.b.line;
+    m.context = e.b.context;
+    m.action = static_cast<std::uint32_t>(program_->actions().size());  // none
   }
 }
 
@@ -358,25 +376,21 @@ void ProgramReader::read_more() {
   read_actions_before(static_cast<std::uint32_t>(n));
   flush_run();
   if (!ended_) {  // a program without M2/M30 still ends with a stop
-    Item it;
-    it.is_marker = true;
-    it.marker.kind = traj::BlockKind::Marker;
-    it.marker.marker = MarkerKind::ProgramEnd;
-    it.marker.segment = it.marker.segment_first = it.marker.segment_last = n;
-    it.marker.action = static_cast<std::uint32_t>(program_->actions().size());
-    ready_.push_back(it);
+    traj::MotionBlock& m = new_marker();
+    m.marker = MarkerKind::ProgramEnd;
+    m.segment = m.segment_first = m.segment_last = n;
+    m.action = static_cast<std::uint32_t>(program_->actions().size());
     ended_ = true;
   }
   done_ = true;
 }
 
-bool ProgramReader::next(Item& out) {
+Item* ProgramReader::next() {
+  if (handed_out_) ready_.pop_front();
   // Keep a run open until something else arrives, so that merging can look ahead.
   while (ready_.empty() && !done_) read_more();
-  if (ready_.empty()) return false;
-  out = std::move(ready_.front());
-  ready_.pop_front();
-  return true;
+  handed_out_ = !ready_.empty();
+  return handed_out_ ? &ready_.front() : nullptr;
 }
 
 }  // namespace opencnc::plan::detail

@@ -4,14 +4,15 @@
 // nearly collinear feed lines.
 #pragma once
 
+#include <array>
 #include <cstdint>
-#include <deque>
 #include <vector>
 
 #include "opencnc/canon/program.hpp"
 #include "opencnc/core/diagnostic.hpp"
 #include "opencnc/plan/machine_limits.hpp"
 #include "opencnc/traj/motion_block.hpp"
+#include "ring.hpp"
 
 namespace opencnc::plan::detail {
 
@@ -26,11 +27,11 @@ struct Element {
   double junction = 0;      ///< speed limit where it starts (0: from rest, +∞: none)
 };
 
-/// One item of the program in execution order.
+/// One item of the program in execution order: a path element, or a marker (in element.b, its
+/// position filled in later).
 struct Item {
   bool is_marker = false;
-  Element element;           ///< when !is_marker
-  traj::MotionBlock marker;  ///< when is_marker (position filled in later)
+  Element element;
 };
 
 /// Checks every move of `program` against the machine: finite coordinates, configured axes,
@@ -43,8 +44,9 @@ class ProgramReader {
  public:
   explicit ProgramReader(const canon::Program& program);
 
-  /// Next item; false after the last one (the program end marker).
-  bool next(Item& out);
+  /// Next item, valid (and the caller's to change) until the following call; null after the
+  /// last one (the program end marker).
+  Item* next();
   std::uint64_t moves_read() const noexcept { return moves_read_; }
   std::uint64_t merged() const noexcept { return merged_; }
 
@@ -52,6 +54,7 @@ class ProgramReader {
   void read_more();
   void read_actions_before(std::uint32_t move);
   void add_marker(const canon::Action& a, traj::MarkerKind kind);
+  traj::MotionBlock& new_marker();
   void read_move(canon::SegmentId id);
   bool make_element(canon::SegmentId id, Element& e) const;
   void push_element(const Element& e);
@@ -64,7 +67,8 @@ class ProgramReader {
   const canon::Program* program_;
   std::size_t next_move_ = 0, next_action_ = 0;
   bool done_ = false, ended_ = false;
-  std::deque<Item> ready_;
+  Ring<Item> ready_;
+  bool handed_out_ = false;  // ready_.front() was returned by next()
   std::uint64_t moves_read_ = 0, merged_ = 0;
 
   // Modal state from the actions read so far.
@@ -79,7 +83,13 @@ class ProgramReader {
   Pose run_start_{};
   double run_feed_ = 0;
   double run_floor_ = 0;          ///< largest deviation of a chorded arc in the run
-  std::vector<Pose> run_points_;  ///< inner vertices of the run
+  /// Inner vertices of the run relative to its start, their squared lengths, and the axes on
+  /// which any of them differs from the start (the only ones their dot products need).
+  std::vector<Pose> run_points_;
+  std::vector<double> run_squares_;
+  std::array<int, kAxisCount> run_axes_{};
+  int run_axis_count_ = 0;
+  void add_run_point(const Pose& rel);
 };
 
 }  // namespace opencnc::plan::detail

@@ -71,7 +71,7 @@ TEST(MachineProfile, MillLoadsCleanly) {
   EXPECT_EQ(p.spindle.sim.encoder_counts_per_rev, 4096);
   EXPECT_EQ(p.probe.sim_joint, 2);
   EXPECT_EQ(p.interpreter.dialect, Dialect::LinuxCnc);
-  EXPECT_EQ(p.planner.default_tolerance, 0.01);
+  EXPECT_EQ(p.planner.default_tolerance, 0.0);  // G64 without P: no bound, as in LinuxCNC
 }
 
 // The profile's machine moves X 100 mm with the profile's limits (trapezoid at 100 mm/s and

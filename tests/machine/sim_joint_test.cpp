@@ -32,7 +32,12 @@ struct JointRig {
   SplitMix64 rng{7};
   JointInputs in{};
 
-  explicit JointRig(const SimJointConfig& c) : joint(c, kPeriod, kSubsteps) { joint.sample(in, rng); }
+  int whole_periods = 0;  // periods begin_period() integrated at once
+
+  explicit JointRig(const SimJointConfig& c, bool linear_periods = true)
+      : joint(c, kPeriod, kSubsteps, linear_periods) {
+    joint.sample(in, rng);
+  }
 
   void period(double position, double velocity_ff = 0, bool enable = true, double external = 0) {
     JointOutputs out;
@@ -40,6 +45,7 @@ struct JointRig {
     out.velocity_ff = velocity_ff;
     out.enable = enable;
     joint.begin_period(out, true, external);
+    whole_periods += joint.needs_substeps() ? 0 : 1;
     for (int i = 0; i < kSubsteps; ++i) joint.substep(i);
     joint.end_period();
     joint.sample(in, rng);
@@ -269,6 +275,63 @@ TEST(SimJoint, MotorEncoderDoesNotSeePitchErrorButTableScaleDoes) {
   EXPECT_NEAR(table.in.position, 150.0, 2e-4);
   EXPECT_NEAR(table.joint.table_position(), 150.0, 2e-4);
   EXPECT_NEAR(table.joint.motor_position(), 150.0 - 0.003, 2e-4);
+}
+
+// Whole periods at once (SimPeriodMap) against every sub-step with the quantised encoder, on
+// mill-3axis's X drive: rests (held by static friction, creeping out of it), accelerations at
+// the axis limit, reversals through zero speed, a load step, seeded random moves. The two must
+// tell the same story: positions and following errors within a few encoder counts, the same
+// energy, and most periods done at once.
+TEST(SimJoint, WholePeriodsFollowTheSubSteps) {
+  SimJointConfig c;
+  c.counts_per_unit = 13107.2;
+  c.model.inertia = 150;
+  c.model.peak_effort = 4000;
+  c.model.coulomb_friction = 40;
+  c.model.static_friction = 50;
+  c.model.viscous_friction = 0.05;
+  c.model.backlash = 0.004;
+  c.switches.noise = 0;
+  JointRig fast(c, true), exact(c, false);
+  SplitMix64 rng(2024);
+  double x = 0, v = 0, worst_position = 0, worst_error = 0, energy_fast = 0, energy_exact = 0;
+  int periods = 0;
+  for (int move = 0; move < 40; ++move) {
+    // A rest-to-rest move at up to 100 mm/s and 1000 mm/s² (a trapezoid), then a rest.
+    const double target = 50 * rng.symmetric();
+    const double peak = 20 + 80 * std::abs(rng.symmetric());
+    const double load = move % 7 == 3 ? 300.0 : 0.0;
+    while (std::abs(target - x) > 1e-12 || v != 0) {
+      const double dir = target > x ? 1.0 : -1.0;
+      const double brake = v * v / 2000;
+      double v_next = std::abs(target - x) <= brake + std::abs(v) * kPeriod
+                          ? std::max(0.0, std::abs(v) - 1.0)
+                          : std::min(peak, std::abs(v) + 1.0);
+      v_next *= dir;
+      x += 0.5 * (v + v_next) * kPeriod;
+      if ((target - x) * dir < 0 || v_next == 0) x = target, v_next = 0;
+      v = v_next;
+      fast.period(x, v, true, load);
+      exact.period(x, v, true, load);
+      energy_fast += fast.joint.energy_j(), energy_exact += exact.joint.energy_j();
+      worst_position =
+          std::max(worst_position, std::abs(fast.joint.motor_position() - exact.joint.motor_position()));
+      worst_error = std::max(worst_error, std::abs((x - fast.in.position) - (x - exact.in.position)));
+      ++periods;
+    }
+    for (int k = 0; k < 300; ++k) {
+      fast.period(x, 0, true, load), exact.period(x, 0, true, load);
+      worst_position =
+          std::max(worst_position, std::abs(fast.joint.motor_position() - exact.joint.motor_position()));
+      ++periods;
+    }
+  }
+  const double count = 1 / c.counts_per_unit;  // 0.076 µm
+  EXPECT_LT(worst_position, 0.4 * count);
+  EXPECT_LE(worst_error, count + 1e-12);  // the reading may fall on the next count
+  EXPECT_NEAR(energy_fast, energy_exact, 1e-4 * std::abs(energy_exact));
+  EXPECT_EQ(exact.whole_periods, 0);
+  EXPECT_GT(fast.whole_periods, periods * 9 / 10);
 }
 
 TEST(PitchErrorTable, InterpolatesLinearlyAndHoldsEnds) {

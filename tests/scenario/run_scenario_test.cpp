@@ -68,11 +68,11 @@ TEST(RunScenario, ProgramRunsToTheEndWithinTheLimits) {
   EXPECT_TRUE(seen_on);
 }
 
-// G64 without P takes the profile's default tolerance (0.01 mm on the mill), in an inch program
-// as in a metric one.
+// G64 without P takes the profile's default tolerance (here 0.01 mm), in an inch program as in a
+// metric one.
 TEST(RunScenario, DefaultToleranceAppliesInInchProgramsToo) {
   for (const char* units : {"G21", "G20"}) {
-    Scenario s(mill());
+    Scenario s(mill({"planner.default_tolerance=0.01"}));
     const double side = std::string(units) == "G20" ? 2.0 : 50.8;
     TempProgram p("sq.ngc",
                   fmt::format("{} G90 G64\nG0 X0 Y0\nG1 X{} F200\nY{}\nX0\nY0\nM2\n", units, side, side));
@@ -82,6 +82,18 @@ TEST(RunScenario, DefaultToleranceAppliesInInchProgramsToo) {
     EXPECT_LE(r.max_command_contour_error_mm, 0.01 + 1e-6) << units;
     EXPECT_GT(r.max_command_contour_error_mm, 0.005) << units;  // the corners were blended
   }
+}
+
+// The shipped mill has no default tolerance: G64 without P blends as large as the moves and the
+// speed ask (as LinuxCNC does), within every limit.
+TEST(RunScenario, ShippedMillBlendsWithoutABoundUnderG64WithoutP) {
+  Scenario s(mill());
+  TempProgram p("sq.ngc", "G21 G90 G64\nG0 X0 Y0\nG1 X50 F6000\nY50\nX0\nY0\nM2\n");
+  s.on(Mode::Auto);
+  ASSERT_TRUE(s.run_file(p.path())) << s.message();
+  const RunReport r = s.report(*s.rig().controller().open_program());
+  EXPECT_GT(r.max_command_contour_error_mm, 0.5);  // a blend of several mm at 100 mm/s
+  EXPECT_EQ(r.limit_violations, 0u);
 }
 
 TEST(RunScenario, OutputsFollowThePathMarkers) {

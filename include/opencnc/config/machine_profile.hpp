@@ -109,6 +109,7 @@ struct MachineProfile {
   InterpreterOptions interpreter;
   PlannerOptions planner;
   int sim_substeps = 10;  ///< integration sub-steps per servo period
+  bool sim_linear_periods = true;  ///< see machine::SimMachineConfig::linear_periods
   std::uint64_t sim_seed = 1;
 
   /// The axis with this letter, or nullptr. Any thread.

@@ -5,8 +5,8 @@
 // servo reports into words.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
-#include <deque>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -179,7 +179,10 @@ class Controller {
   std::shared_ptr<ProgramSource> source_;
 
   mutable std::mutex inbox_mutex_;
-  std::deque<std::pair<std::uint64_t, Request>> inbox_;
+  std::vector<std::pair<std::uint64_t, Request>> inbox_;
+  /// Set with every submit(): service() takes the lock only when there is something to take.
+  std::atomic<bool> inbox_filled_{false};
+  std::vector<std::pair<std::uint64_t, Request>> requests_;  ///< controller thread: being handled
   std::uint64_t next_id_ = 1;
 
   mutable std::mutex out_mutex_;  ///< outcomes, notes, the published status

@@ -121,6 +121,10 @@ struct SimProcessConfig {
 struct SimMachineConfig {
   double servo_period_s = 0.001;
   int substeps = 10;  ///< integration sub-steps per servo period
+  /// Integrate the periods in which a servo drive is linear, and those of a spindle at speed,
+  /// at once (docs/machine.md); false: every sub-step one by one, the encoder quantised in the
+  /// drive's loop (the reference the fast path is compared with).
+  bool linear_periods = true;
   std::uint64_t seed = 1;
   int joint_count = 0;
   std::array<SimJointConfig, kMaxJoints> joints{};

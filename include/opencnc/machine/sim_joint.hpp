@@ -2,6 +2,7 @@
 // One simulated joint: drive loops, mass with friction, backlash, pitch error, encoder, switches.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -29,18 +30,57 @@ class PitchErrorTable {
   mutable std::size_t segment_ = 0;  // points_[segment_] ≤ s < points_[segment_ + 1] last time
 };
 
+/// A servo drive and its mechanics over one whole period while they are linear (moving one way,
+/// or held by static friction): the product of the sub-step maps, in coordinates relative to
+/// the period's command (docs/machine.md, "Whole periods at once"). Built by the joint's
+/// constructor.
+struct SimPeriodMap {
+  /// z: feedback − command, velocity − feed-forward, force, the two integrators (the state),
+  /// then feed-forward velocity, constant force (load − Coulomb friction) and encoder bias.
+  static constexpr int kSize = 8;
+  static constexpr int kStates = 5;
+  using Row = std::array<double, kSize>;
+  /// What a period needs that is linear in z: the state at its end, the force command and the
+  /// velocity reference at the first and the last sub-step. Held periods need the first rows only
+  /// (the first five, seven with a velocity limit).
+  enum Output : int {
+    kNextForce,
+    kNextPosIntegral,
+    kNextVelIntegral,
+    kForceCommandFirst,
+    kForceCommandLast,
+    kVelRefFirst,
+    kVelRefLast,
+    kNextRelPosition,
+    kNextRelVelocity,
+    kOutputs
+  };
+  /// How far from the chord between first and last sub-step a quantity can bend, per |z_k|
+  /// (every sub-step's value lies within Σ_k bend_k·|z_k| of that chord).
+  enum Bend : int { kForceCommandBend, kVelRefBend, kVelocityBend, kBends };
+  /// Column k holds z_k's coefficients (one product for all of them), padded to even lengths.
+  std::array<std::array<double, kOutputs + 1>, kSize> outputs{};
+  std::array<std::array<double, kBends + 1>, kSize> bends{};
+  std::array<Row, kSize> energy{};  ///< energy_j = zᵀ·energy·z
+};
+
 /// A joint of the simulated machine. The owner calls begin_period(), then substep() for
 /// i = 0 … substeps-1, then end_period(), once per servo period; sample() fills the inputs.
+/// begin_period() integrates a whole period at once where the drive stays linear all period
+/// (SimPeriodMap; needs_substeps() is then false and substep() does nothing).
 /// Everything but the constructor is real-time safe and allocation-free.
 class SimJoint {
  public:
   SimJoint() = default;
-  /// Non-real-time. `config` must be valid (the profile loader checks it).
-  SimJoint(const SimJointConfig& config, double servo_period_s, int substeps);
+  /// Non-real-time. `config` must be valid (the profile loader checks it). `linear_periods`:
+  /// integrate the periods in which the drive and the mechanics are linear at once.
+  SimJoint(const SimJointConfig& config, double servo_period_s, int substeps, bool linear_periods = true);
 
   /// Latches this period's command. `powered`: the drive has power (e-stop chain closed,
   /// DC link above undervoltage, no fault). `external_effort` acts on the table, N or N·m.
   void begin_period(const JointOutputs& cmd, bool powered, double external_effort) noexcept;
+  /// False when begin_period() has integrated the whole period already.
+  bool needs_substeps() const noexcept { return !period_done_; }
   /// Integrates sub-step `i` of the period.
   void substep(int i) noexcept;
   /// Finishes the period: index marks, velocity of a stepper.
@@ -60,7 +100,7 @@ class SimJoint {
   double effort() const noexcept { return effort_; }
   /// Mechanical energy the drive put into the axis during the last period, J (negative when
   /// braking). Feeds the DC link model.
-  double energy_j() const noexcept { return energy_j_; }
+  double energy_j() const noexcept;
 
  private:
   double feedback_raw() const noexcept;
@@ -72,6 +112,16 @@ class SimJoint {
   void integrate_mechanics(double drive_effort) noexcept;
   void take_up_backlash() noexcept;
   void update_index(double before, double after) noexcept;
+  SimPeriodMap build_period_map(bool held) const;
+  bool integrate_period() noexcept;
+  bool integrate_moving_period() noexcept;
+  bool integrate_held_period() noexcept;
+  void load_state(double feedback) noexcept;
+  struct MapValues;
+  template <std::size_t Rows, std::size_t Bends>
+  MapValues evaluate(const SimPeriodMap& map) const noexcept;
+  bool within_limits(const MapValues& y) const noexcept;
+  void take_state(const MapValues& y) noexcept;
 
   SimJointConfig config_{};
   PitchErrorTable pitch_;
@@ -87,6 +137,10 @@ class SimJoint {
   double current_alpha_ = 1;              // first-order lag factor per sub-step
   double power_per_effort_velocity_ = 0;  // W per (N · units/s)
   double half_backlash_ = 0;
+  bool linear_periods_ = false;  // integrate linear periods at once (servo joints)
+  bool linear_moving_ = false;   // … also while moving (the loop is not closed around backlash)
+  double encoder_bias_ = 0;      // mean of position − encoder reading: half a count
+  SimPeriodMap moving_map_{}, held_map_{};
   // Latched command.
   JointOutputs cmd_{};
   bool powered_ = false;
@@ -98,6 +152,9 @@ class SimJoint {
   std::int64_t steps_emitted_ = 0, steps_at_period_start_ = 0;
   double feedback_at_period_start_ = 0;
   double energy_j_ = 0;
+  bool period_done_ = false;    // begin_period() integrated the period
+  bool period_moving_ = false;  // … by the moving map, from z_ (for energy_j())
+  SimPeriodMap::Row z_{};
   std::uint32_t index_count_ = 0;
   double index_position_ = 0;
 };

@@ -56,8 +56,8 @@ class SimMachine final : public MachineIO {
   }
 
  private:
-  void advance() noexcept;
-  void update_power(double energy_j) noexcept;
+  void advance(const MachineOutputs& out) noexcept;
+  void update_power(const MachineOutputs& out) noexcept;
   void update_auxiliaries() noexcept;
   void sample() noexcept;
 
@@ -66,7 +66,10 @@ class SimMachine final : public MachineIO {
   SimSpindle spindle_;
   SimSwitch probe_;
   SplitMix64 rng_;
-  MachineOutputs outputs_{};
+  // The outputs latched by the last write() that the machine uses between writes.
+  bool estop_release_ = false;
+  ProcessOutputs process_{};
+  ToolChangerOutputs tool_{};
   MachineInputs inputs_{};
   // Injected world.
   bool estop_pressed_ = false;

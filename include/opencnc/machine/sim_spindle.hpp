@@ -15,11 +15,14 @@ class SimSpindle {
  public:
   SimSpindle() = default;
   /// Non-real-time. `config` must be valid.
-  SimSpindle(const SimSpindleConfig& config, double servo_period_s, int substeps);
+  /// `linear_periods`: a period at constant speed is integrated at once.
+  SimSpindle(const SimSpindleConfig& config, double servo_period_s, int substeps, bool linear_periods = true);
 
   /// `powered`: the spindle drive has power and no fault; without it the spindle coasts
   /// down at the ramp limit (a drive that lost power brakes on its own resistor).
   void begin_period(const SpindleOutputs& cmd, bool powered) noexcept;
+  /// False when begin_period() has integrated the whole period (constant speed).
+  bool needs_substeps() const noexcept { return !period_done_; }
   void substep() noexcept;
   void end_period() noexcept;
   void sample(SpindleInputs& in) const noexcept;
@@ -37,6 +40,8 @@ class SimSpindle {
   double h_ = 0;
   double period_s_ = 0;
   double max_step_rps_ = 0;  // speed change per sub-step, rev/s
+  bool linear_periods_ = true;
+  bool period_done_ = false;
   SpindleOutputs cmd_{};
   bool powered_ = false;
   bool fault_ = false;
