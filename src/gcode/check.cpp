@@ -120,9 +120,14 @@ void Engine::check_block() {
             "a fifth M code on this line: a line may hold four at most");
   check_other_codes();
   if (ext_ == nullptr) return;
-  for (int group = 0; group < kGGroupCount; ++group)
-    check_extension(block_.g[static_cast<std::size_t>(group)], block_.g_position(group));
-  if (block_.motion != block_.g[kGroupMotion]) check_extension(block_.motion, block_.first_axis_position());
+  // (the test for a handler stays here: a call per group costs more than the checks of a
+  // typical block put together)
+  for (int group = 0; group < kGGroupCount; ++group) {
+    const int code = block_.g[static_cast<std::size_t>(group)];
+    if (extension_handler(code) != nullptr) check_extension(code, block_.g_position(group));
+  }
+  if (block_.motion != block_.g[kGroupMotion] && extension_handler(block_.motion) != nullptr)
+    check_extension(block_.motion, block_.first_axis_position());
 }
 
 // What the extension codes of the block claim (their Traits): words they take, the axis
@@ -132,8 +137,9 @@ Engine::ExtensionClaims Engine::extension_claims() const {
   ExtensionClaims claims;
   if (ext_ == nullptr) return claims;
   auto ask = [&](int code) {
-    if (code < 0 || !ext_->g[static_cast<std::size_t>(code)]) return;
-    const CodeHandler::Traits t = ext_->g[static_cast<std::size_t>(code)]->traits(code);
+    const CodeHandler* h = extension_handler(code);
+    if (h == nullptr) return;
+    const CodeHandler::Traits t = h->traits(code);
     claims.words |= t.words;
     claims.axis_words = claims.axis_words || t.axis_words;
     claims.all_words = claims.all_words || t.all_words;
@@ -146,8 +152,7 @@ Engine::ExtensionClaims Engine::extension_claims() const {
 }
 
 void Engine::check_extension(int code, int position) {
-  if (code < 0 || !ext_->g[static_cast<std::size_t>(code)]) return;
-  if (auto problem = ext_->g[static_cast<std::size_t>(code)]->check(block_, code, st_))
+  if (auto problem = extension_handler(code)->check(block_, code, st_))
     throw GcodeError(problem->code, problem->message, position);
 }
 

@@ -143,7 +143,11 @@ class Engine final : public ParamHost, public ExecContext {
   void check_g10();
   void check_other_codes();
   void check_p_word();
-  void check_extension(int code, int position);
+  void check_extension(int code, int position);   ///< `code` must have a handler
+  /// The extension's handler of G code `code` (×10), nullptr if none (or code < 0).
+  const CodeHandler* extension_handler(int code) const noexcept {
+    return code >= 0 && ext_ != nullptr ? ext_->g[static_cast<std::size_t>(code)].get() : nullptr;
+  }
   void check_word_rules(const Block& b);
   struct ExtensionClaims {
     std::uint32_t words = 0;
