@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 
+#include "digits.hpp"
 #include "gcode_error.hpp"
 #include "opencnc/gcode/extension.hpp"
 
@@ -431,7 +432,10 @@ void Parser::read_word(Cursor& c, Block& b, char letter) {
       break;
     default: {
       const std::size_t start = c.pos;
-      v = real_value(c);
+      // A plain number (what real_value would pass on to real_number) read directly.
+      const char c0 = c.at(), c1 = c.at(1);
+      const bool plain = is_digit(c0) || c0 == '.' || ((c0 == '-' || c0 == '+') && (is_digit(c1) || c1 == '.'));
+      v = plain ? real_number(c) : real_value(c);
       if (c.env.fanuc()) {
         if (value_vacant_) return;   // Fanuc: a word whose value is a vacant variable is left out
         const char first = c.text[start];
@@ -624,17 +628,6 @@ double Parser::real_value(Cursor& c) {
   return v;
 }
 
-namespace {
-
-// Reads digits from p (not past `limit`) into `value`, which wraps after 19 digits (callers
-// only use it for short numbers). Returns the end.
-const char* read_digits(const char* p, const char* limit, std::uint64_t& value) noexcept {
-  while (p < limit && is_digit(*p)) value = value * 10 + static_cast<std::uint64_t>(*p++ - '0');
-  return p;
-}
-
-}  // namespace
-
 double Parser::real_number(Cursor& c) {
   const char* const text = c.text.data();
   const char* const limit = text + c.text.size();
@@ -647,12 +640,12 @@ double Parser::real_number(Cursor& c) {
   // common short number (exact below 2^53 with at most 22 decimals: one correctly rounded
   // division gives the same double as any correct conversion).
   std::uint64_t value = 0;
-  const char* const int_end = read_digits(p, limit, value);
+  const char* const int_end = mant + read_digit_run(mant, text, limit, value);
   const char* end = int_end;   // end of the mantissa
   std::ptrdiff_t decimals = 0;
   if (end < limit && *end == '.') {
-    end = read_digits(end + 1, limit, value);
-    decimals = end - (int_end + 1);
+    decimals = static_cast<std::ptrdiff_t>(read_digit_run(end + 1, text, limit, value));
+    end += 1 + decimals;
   }
   const auto digits = (int_end - mant) + decimals;
   const char* after = end;

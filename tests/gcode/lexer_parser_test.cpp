@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
+#include <cstring>
 #include <map>
 #include <random>
 #include <string>
@@ -118,6 +120,28 @@ TEST_F(ParserTest, ReadsNumbersTheLinuxCncWay) {
   EXPECT_EQ(fails("x"), ErrorCode::MissingValue);
   EXPECT_EQ(fails("g1 xf1"), ErrorCode::MissingValue);  // X has no value; F1 follows
   EXPECT_EQ(fails("g1 xfoo"), ErrorCode::UnknownWord);
+}
+
+// Numbers of every length, wherever they stand on the line (the reader looks at eight bytes at
+// a time and must not look past the line), convert to exactly the double strtod gives.
+TEST_F(ParserTest, RandomNumbersReadBitIdenticalToStrtod) {
+  std::mt19937_64 rng(7);
+  auto digits = [&](std::size_t n) {
+    std::string d;
+    for (std::size_t i = 0; i < n; ++i) d += static_cast<char>('0' + rng() % 10);
+    return d;
+  };
+  for (int i = 0; i < 20000; ++i) {
+    std::string number = rng() % 2 ? "-" : (rng() % 4 ? "" : "+");
+    const std::size_t whole = rng() % 21, fraction = rng() % 21;
+    number += digits(whole);
+    if (fraction > 0 || rng() % 2) number += "." + digits(fraction);
+    if (whole + fraction == 0) number += "0";
+    const std::string tail = rng() % 2 ? "" : (rng() % 2 ? " y1" : " g1 f100.5 s12345678");
+    const Block b = parse("x" + number + tail);
+    const double expected = std::strtod(number.c_str(), nullptr);
+    ASSERT_EQ(std::memcmp(&expected, &b.value['x' - 'a'], sizeof(double)), 0) << number << tail;
+  }
 }
 
 TEST_F(ParserTest, StoresWordsAndRejectsRepeats) {
