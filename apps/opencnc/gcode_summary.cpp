@@ -86,9 +86,71 @@ double arc_extent(const double start[3], const double end[3], const double cente
   return std::hypot(r * sweep, end[n] - start[n]);
 }
 
-// Watches the canonical stream in work coordinates: extents, tools, coordinate systems.
+struct Totals {
+  std::size_t feeds = 0, rapids = 0, arcs = 0;
+  double feed_length = 0, rapid_length = 0;
+  double feed_time_min = 0;
+  bool untimed = false;   // per-revolution feeds: no time without a spindle model
+  Box box;
+};
+
+// Counts, lengths, machine extents and feed time of a program's moves, taken as they are
+// appended (while they are still in the cache) instead of in a second pass over a program
+// of maybe a million moves. Moves are measured in order, one at a time.
+class MoveMeter {
+ public:
+  explicit MoveMeter(const canon::Program& prog) : prog_(prog) {}
+  /// Measures the moves appended since the last call.
+  void catch_up() {
+    for (; next_ < prog_.size(); ++next_) measure(next_);
+  }
+  const Totals& totals() const { return t_; }
+
+ private:
+  void measure(canon::SegmentId id) {
+    if (id == 0) {
+      last_ = prog_.start();
+      t_.box.add(last_[0], last_[1], last_[2]);
+    }
+    const Pose& s = last_;
+    const canon::Move& m = prog_.move(id);
+    const Pose e = prog_.end(id);
+    double len;
+    if (m.kind == canon::MoveKind::Arc) {
+      const canon::ArcGeometry& g = prog_.arc(id);
+      const double a[3] = {s[0], s[1], s[2]}, b[3] = {e[0], e[1], e[2]};
+      len = arc_extent(a, b, g.center, g.plane, g.turns, t_.box);
+      ++t_.arcs;
+    } else {
+      len = std::sqrt((e[0] - s[0]) * (e[0] - s[0]) + (e[1] - s[1]) * (e[1] - s[1]) + (e[2] - s[2]) * (e[2] - s[2]));
+      t_.box.add(e[0], e[1], e[2]);
+    }
+    last_ = e;
+    if (m.kind == canon::MoveKind::Traverse) {
+      ++t_.rapids;
+      t_.rapid_length += len;
+      return;
+    }
+    ++t_.feeds;
+    t_.feed_length += len;
+    const double f = prog_.feed(id);
+    if (m.flags & canon::kInverseTime) t_.feed_time_min += f > 0 ? 1.0 / f : 0;
+    else if (m.flags & canon::kPerRevolution) t_.untimed = true;
+    else if (f > 0) t_.feed_time_min += len / f;
+  }
+
+  const canon::Program& prog_;
+  canon::SegmentId next_ = 0;
+  Pose last_{};
+  Totals t_;
+};
+
+// Watches the canonical stream in work coordinates (extents, tools, coordinate systems); after
+// each motion, which the builder ahead of it in the tee has just appended, it has `meter`
+// measure the new moves.
 class WorkWatcher final : public canon::Sink {
  public:
+  explicit WorkWatcher(MoveMeter& meter) : meter_(meter) {}
   void straight_traverse(canon::SegmentId, const Pose& end) override { move(end); }
   void straight_feed(canon::SegmentId, const Pose& end) override { move(end); }
   void arc_feed(canon::SegmentId, const canon::ArcFeed& arc) override {
@@ -100,6 +162,7 @@ class WorkWatcher final : public canon::Sink {
     c[n] = s[n];
     arc_extent(s, e, c, arc.plane, arc.rotation, box_);
     pos_ = arc.end;
+    meter_.catch_up();
   }
   void change_tool(int index) override { tool_changes.insert(index); }
   void change_tool_number(int index) override { tool_changes.insert(index); }
@@ -115,52 +178,12 @@ class WorkWatcher final : public canon::Sink {
   void move(const Pose& end) {
     box_.add(end[0], end[1], end[2]);
     pos_ = end;
+    meter_.catch_up();
   }
+  MoveMeter& meter_;
   Pose pos_{};
   Box box_;
 };
-
-struct Totals {
-  std::size_t feeds = 0, rapids = 0, arcs = 0;
-  double feed_length = 0, rapid_length = 0;
-  double feed_time_min = 0;
-  bool untimed = false;   // per-revolution feeds: no time without a spindle model
-  Box box;
-};
-
-Totals measure(const canon::Program& prog) {
-  Totals t;
-  if (prog.empty()) return t;
-  Pose s = prog.start();
-  t.box.add(s[0], s[1], s[2]);
-  Pose e;
-  for (canon::SegmentId id = 0; id < prog.size(); ++id, s = e) {
-    const canon::Move& m = prog.move(id);
-    e = prog.end(id);
-    double len;
-    if (m.kind == canon::MoveKind::Arc) {
-      const canon::ArcGeometry& g = prog.arc(id);
-      const double a[3] = {s[0], s[1], s[2]}, b[3] = {e[0], e[1], e[2]};
-      len = arc_extent(a, b, g.center, g.plane, g.turns, t.box);
-      ++t.arcs;
-    } else {
-      len = std::sqrt((e[0] - s[0]) * (e[0] - s[0]) + (e[1] - s[1]) * (e[1] - s[1]) + (e[2] - s[2]) * (e[2] - s[2]));
-      t.box.add(e[0], e[1], e[2]);
-    }
-    if (m.kind == canon::MoveKind::Traverse) {
-      ++t.rapids;
-      t.rapid_length += len;
-      continue;
-    }
-    ++t.feeds;
-    t.feed_length += len;
-    const double f = prog.feed(id);
-    if (m.flags & canon::kInverseTime) t.feed_time_min += f > 0 ? 1.0 / f : 0;
-    else if (m.flags & canon::kPerRevolution) t.untimed = true;
-    else if (f > 0) t.feed_time_min += len / f;
-  }
-  return t;
-}
 
 nlohmann::json box_json(const Box& b) {
   if (b.empty()) return nullptr;
@@ -187,11 +210,13 @@ int run_scan(const std::string& file, const gcode::Options& options, bool json, 
   }
   canon::ProgramBuilder builder(options.axes);
   builder.program().set_sources(interp.sources());
-  WorkWatcher watch;
-  canon::TeeSink tee(builder, watch);
-  const gcode::RunStatus status = interp.run(tee);
   const canon::Program& prog = builder.program();
-  const Totals t = measure(prog);
+  MoveMeter meter(prog);
+  WorkWatcher watch(meter);
+  canon::TeeSink tee(builder, watch);   // the builder first: the watcher's meter reads its moves
+  const gcode::RunStatus status = interp.run(tee);
+  meter.catch_up();   // moves of calls the watcher does not follow (probes, taps, splines)
+  const Totals& t = meter.totals();
   const gcode::InterpState st = interp.state();
   const double rapid_min = rapid_rate_mm_min > 0 ? t.rapid_length / rapid_rate_mm_min : 0.0;
   const auto& diags = interp.diagnostics();
