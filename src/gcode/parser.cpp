@@ -6,7 +6,6 @@
 #include <cmath>
 #include <limits>
 
-#include "digits.hpp"
 #include "gcode_error.hpp"
 #include "opencnc/gcode/extension.hpp"
 
@@ -628,24 +627,38 @@ double Parser::real_value(Cursor& c) {
   return v;
 }
 
+namespace {
+
+// Reads digits from p (not past `limit`) into `value`, which wraps after 19 digits (callers
+// only use it for short numbers). Returns the end.
+const char* read_digits(const char* p, const char* limit, std::uint64_t& value) noexcept {
+  while (p < limit && is_digit(*p)) value = value * 10 + static_cast<std::uint64_t>(*p++ - '0');
+  return p;
+}
+
+}  // namespace
+
 double Parser::real_number(Cursor& c) {
   const char* const text = c.text.data();
   const char* const limit = text + c.text.size();
   const char* const start = text + c.pos;
-  const char* p = start;
+  // The sign is taken without a branch (it is as random as the coordinates); a second one is
+  // malformed (reported below).
+  const char* p = start + (start < limit && (*start == '+' || *start == '-'));
   while (p < limit && (*p == '+' || *p == '-')) ++p;
   const auto signs = p - start;
+  const bool negative = start < limit && *start == '-';   // (signs > 1 does not return)
   const char* const mant = p;
   // Mantissa: digits, at most one '.', at least one digit. Accumulated on the way for the
   // common short number (exact below 2^53 with at most 22 decimals: one correctly rounded
   // division gives the same double as any correct conversion).
   std::uint64_t value = 0;
-  const char* const int_end = mant + read_digit_run(mant, text, limit, value);
+  const char* const int_end = read_digits(p, limit, value);
   const char* end = int_end;   // end of the mantissa
   std::ptrdiff_t decimals = 0;
   if (end < limit && *end == '.') {
-    decimals = static_cast<std::ptrdiff_t>(read_digit_run(end + 1, text, limit, value));
-    end += 1 + decimals;
+    end = read_digits(end + 1, limit, value);
+    decimals = end - (int_end + 1);
   }
   const auto digits = (int_end - mant) + decimals;
   const char* after = end;
@@ -661,7 +674,8 @@ double Parser::real_number(Cursor& c) {
     const auto [ptr, ec] = std::from_chars(mant, end, v);
     if (ec != std::errc() || ptr != end) bad_number(start, after, text, true);
   }
-  return (signs == 1 && *start == '-') ? -v : v;
+  static constexpr double kSign[] = {1.0, -1.0};   // (exact: the same as negating)
+  return v * kSign[negative];
 }
 
 void Parser::bad_number(const char* start, const char* after, const char* text, bool malformed) {
