@@ -3,6 +3,7 @@
 // enhance_block and check_items): which motion the block performs and which words are used.
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 
 #include "engine.hpp"
@@ -120,9 +121,10 @@ void Engine::check_block() {
             "a fifth M code on this line: a line may hold four at most");
   check_other_codes();
   if (ext_ == nullptr) return;
-  // (the test for a handler stays here: a call per group costs more than the checks of a
-  // typical block put together)
-  for (int group = 0; group < kGGroupCount; ++group) {
+  // Only groups that can hold an extension's code are looked at, and the test for a handler
+  // stays here: a call per group would cost more than the checks of a typical block together.
+  for (std::uint32_t groups = extension_groups_; groups != 0; groups &= groups - 1) {
+    const int group = std::countr_zero(groups);
     const int code = block_.g[static_cast<std::size_t>(group)];
     if (extension_handler(code) != nullptr) check_extension(code, block_.g_position(group));
   }

@@ -12,6 +12,13 @@ namespace opencnc::gcode {
 
 Engine::Engine(Options options) : opt_(std::move(options)), sources_(std::make_shared<canon::SourceMap>()) {
   ext_ = opt_.extensions.get();
+  // The G groups where a code with an extension handler can stand (its core group, else the
+  // one its traits name): check_block looks for handlers in these only.
+  for (int code = 0; ext_ != nullptr && code < static_cast<int>(ext_->g.size()); ++code) {
+    const CodeHandler* h = ext_->g[static_cast<std::size_t>(code)].get();
+    const int group = h == nullptr ? -1 : g_group(code) >= 0 ? g_group(code) : h->traits(code).group;
+    if (group >= 0) extension_groups_ |= 1u << group;
+  }
   out_.configure(opt_);
   out_.track(&st_.position);
   out_.transform_state(&st_);
@@ -254,19 +261,22 @@ void Engine::line_too_long() const {
                    Where{line_file_, line_, static_cast<std::uint32_t>(kMaxLineLength)});
 }
 
+// Written in place: an origin built on the stack and copied costs a failed store forwarding
+// (a wide load of narrow stores just made) on every line.
 void Engine::set_origin_from_line() {
-  canon::BlockOrigin o;
+  canon::BlockOrigin& o = out_.new_origin();
   o.file = line_file_;
   o.line = line_;
   o.context = st_.frames.back().context;
+  std::memset(o.n_digits, 0, sizeof o.n_digits);
   std::string_view digits;
-  if (leading_n_digits(raw_, digits)) {
-    o.n_present = true;
+  o.n_present = leading_n_digits(raw_, digits);
+  o.n_length = 0;
+  if (o.n_present) {
     const std::size_t n = std::min(digits.size(), sizeof(o.n_digits));
     std::memcpy(o.n_digits, digits.data(), n);
     o.n_length = static_cast<std::uint8_t>(n);
   }
-  out_.set_origin(o);
 }
 
 // Reads the next line into block_ (parsed and checked unless a label is being sought).

@@ -303,6 +303,7 @@ class Engine final : public ParamHost, public ExecContext {
 
   Options opt_;
   const Extensions* ext_ = nullptr;
+  std::uint32_t extension_groups_ = 0;   ///< bit per G group that can hold a code with a handler
   InterpState st_;
   Output out_;
   Parser parser_;

@@ -33,6 +33,11 @@ class Output final : public canon::Sink {
     announced_ = false;
   }
   const canon::BlockOrigin& origin() const noexcept { return origin_; }
+  /// set_origin() for a caller that fills in the fields itself: returns the origin to fill.
+  canon::BlockOrigin& new_origin() noexcept {
+    announced_ = false;
+    return origin_;
+  }
   /// Motions emitted so far (the next segment id).
   std::uint64_t segments() const noexcept { return segments_; }
 
