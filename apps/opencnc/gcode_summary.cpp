@@ -109,10 +109,11 @@ class MoveMeter {
  private:
   void measure(canon::SegmentId id) {
     if (id == 0) {
-      last_ = prog_.start();
+      const Pose& start = prog_.start();
+      for (int i = 0; i < 3; ++i) last_[i] = start[i];
       t_.box.add(last_[0], last_[1], last_[2]);
     }
-    const Pose& s = last_;
+    const double* s = last_;
     const canon::Move& m = prog_.move(id);
     const Pose e = prog_.end(id);
     double len;
@@ -125,7 +126,7 @@ class MoveMeter {
       len = std::sqrt((e[0] - s[0]) * (e[0] - s[0]) + (e[1] - s[1]) * (e[1] - s[1]) + (e[2] - s[2]) * (e[2] - s[2]));
       t_.box.add(e[0], e[1], e[2]);
     }
-    last_ = e;
+    for (int i = 0; i < 3; ++i) last_[i] = e[i];   // (X, Y, Z only: a whole pose copied costs more)
     if (m.kind == canon::MoveKind::Traverse) {
       ++t_.rapids;
       t_.rapid_length += len;
@@ -141,7 +142,7 @@ class MoveMeter {
 
   const canon::Program& prog_;
   canon::SegmentId next_ = 0;
-  Pose last_{};
+  double last_[3] = {0, 0, 0};   // X, Y, Z where the last move measured ended
   Totals t_;
 };
 
@@ -161,7 +162,7 @@ class WorkWatcher final : public canon::Sink {
     c[b] = arc.second_center;
     c[n] = s[n];
     arc_extent(s, e, c, arc.plane, arc.rotation, box_);
-    pos_ = arc.end;
+    for (int i = 0; i < 3; ++i) pos_[i] = arc.end[i];
     meter_.catch_up();
   }
   void change_tool(int index) override { tool_changes.insert(index); }
@@ -177,11 +178,11 @@ class WorkWatcher final : public canon::Sink {
  private:
   void move(const Pose& end) {
     box_.add(end[0], end[1], end[2]);
-    pos_ = end;
+    for (int i = 0; i < 3; ++i) pos_[i] = end[i];
     meter_.catch_up();
   }
   MoveMeter& meter_;
-  Pose pos_{};
+  double pos_[3] = {0, 0, 0};   // X, Y, Z of the last motion's end (work coordinates)
   Box box_;
 };
 

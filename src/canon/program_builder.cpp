@@ -28,8 +28,13 @@ Pose ProgramBuilder::offset_to_mm(const Pose& offset) const noexcept {
 }
 
 Pose ProgramBuilder::to_machine(const Pose& canonical) const noexcept {
-  // Once per move: one pass per stage, no temporaries.
   Pose p;
+  to_machine(canonical, p);
+  return p;
+}
+
+// Once per move: one pass per stage, written in place (position_ for a move).
+void ProgramBuilder::to_machine(const Pose& canonical, Pose& p) const noexcept {
   const double k = mm_per_unit(units_);
   for (int i = 0; i < kAxisCount; ++i) p[i] = (is_linear(i) ? canonical[i] * k : canonical[i]) + g92_[i];
   if (rotation_deg_ != 0) {
@@ -38,7 +43,6 @@ Pose ProgramBuilder::to_machine(const Pose& canonical) const noexcept {
     p[1] = x * rot_sin_ + y * rot_cos_;
   }
   for (int i = 0; i < kAxisCount; ++i) p[i] += g5x_[i] + tool_[i];
-  return p;
 }
 
 void ProgramBuilder::set_g5x_offset(int index, const Pose& offset) {
@@ -100,37 +104,39 @@ std::uint32_t ProgramBuilder::current_feed_index() {
   return last_feed_index_;
 }
 
-void ProgramBuilder::append(MoveKind kind, SegmentId id, const Pose& machine_end, std::uint32_t param,
-                            std::uint8_t extra_flags) {
+void ProgramBuilder::append(MoveKind kind, SegmentId id, std::uint32_t param, std::uint8_t extra_flags) {
   // Ids are ordinals: after the first move, the program's count follows the interpreter's
   // except where a segment is split (recorded by note_split).
   if (program_.empty()) program_.set_first_segment(id);
-  Move m;
+  Move& m = program_.append(position_);
   m.kind = kind;
   m.flags = static_cast<std::uint8_t>((kind == MoveKind::Traverse ? 0 : move_flags()) | extra_flags);
+  m.reserved = 0;
   m.context = origin_.context;
   m.line = origin_.line;
   m.param = param;
-  program_.append(m, machine_end);
-  position_ = machine_end;
 }
 
 void ProgramBuilder::straight_traverse(SegmentId id, const Pose& end) {
-  append(MoveKind::Traverse, id, to_machine(end), 0);
+  to_machine(end, position_);
+  append(MoveKind::Traverse, id, 0);
 }
 
 void ProgramBuilder::straight_feed(SegmentId id, const Pose& end) {
-  append(MoveKind::Feed, id, to_machine(end), current_feed_index());
+  to_machine(end, position_);
+  append(MoveKind::Feed, id, current_feed_index());
 }
 
 void ProgramBuilder::straight_probe(SegmentId id, const Pose& end) {
-  append(MoveKind::Probe, id, to_machine(end), current_feed_index());
+  to_machine(end, position_);
+  append(MoveKind::Probe, id, current_feed_index());
 }
 
 void ProgramBuilder::rigid_tap(SegmentId id, const Pose& end, double /*scale*/) {
   // The tap reverses at `end` and comes back: the machine ends where the tap started.
   const Pose start = position_;
-  append(MoveKind::RigidTap, id, to_machine(end), current_feed_index());
+  to_machine(end, position_);
+  append(MoveKind::RigidTap, id, current_feed_index());
   position_ = start;
 }
 
@@ -174,7 +180,8 @@ void ProgramBuilder::arc_feed(SegmentId id, const ArcFeed& arc) {
   g.turns = arc.rotation;
   g.plane = arc.plane;
   g.feed = current_feed_index();
-  append(MoveKind::Arc, id, machine_end, program_.add_arc(g));
+  position_ = machine_end;
+  append(MoveKind::Arc, id, program_.add_arc(g));
 }
 
 void ProgramBuilder::nurbs_feed(SegmentId id, int order, std::span<const NurbsPoint> points) {
@@ -195,10 +202,9 @@ void ProgramBuilder::nurbs_feed(SegmentId id, int order, std::span<const NurbsPo
   const std::size_t first = program_.size();
   const std::uint32_t feed = current_feed_index();
   for (const CurvePoint& v : chords) {
-    Pose end = position_;
-    end[0] = v.x;
-    end[1] = v.y;
-    append(MoveKind::Feed, id, end, feed, kCurveChord);
+    position_[0] = v.x;
+    position_[1] = v.y;
+    append(MoveKind::Feed, id, feed, kCurveChord);
   }
   program_.note_split(id, first, chords.size());
 }

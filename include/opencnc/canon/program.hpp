@@ -150,6 +150,9 @@ class Program {
   void set_start(const Pose& p) noexcept { start_ = p; }
   void set_sources(std::shared_ptr<const SourceMap> s) noexcept { sources_ = std::move(s); }
   SegmentId append(const Move& m, const Pose& end);
+  /// Appends a move ending at `end` and returns it for the caller to fill in (every member):
+  /// ProgramBuilder's way, which spares copying a Move it has just built.
+  Move& append(const Pose& end);
   std::uint32_t add_arc(const ArcGeometry& a);
   std::uint32_t add_feed(double value);
   void add_action(const Action& a) { actions_.push_back(a); }

@@ -102,7 +102,9 @@ class ProgramBuilder final : public Sink {
   Action make(ActionKind kind, int index = 0, int index2 = 0, double value = 0) const;
   void simple(ActionKind kind, int index = 0, int index2 = 0) { program_.add_action(make(kind, index, index2)); }
   Pose offset_to_mm(const Pose& offset) const noexcept;
-  void append(MoveKind kind, SegmentId id, const Pose& machine_end, std::uint32_t param, std::uint8_t extra_flags = 0);
+  void to_machine(const Pose& canonical, Pose& machine) const noexcept;
+  /// Appends the move to position_ (the machine position it ends at, already set).
+  void append(MoveKind kind, SegmentId id, std::uint32_t param, std::uint8_t extra_flags = 0);
   std::uint32_t current_feed_index();
   std::uint8_t move_flags() const noexcept;
 

@@ -18,23 +18,33 @@ class ChunkedVector {
   static constexpr std::size_t kChunk = std::size_t{1} << kChunkShift;
 
   T& push_back(const T& value) {
+    T& slot = append_slot();
+    slot = value;
+    return slot;
+  }
+  /// Appends an element and returns it to be filled in place; it holds whatever its storage
+  /// held, so the caller assigns every member. (Filling in place spares copying a value the
+  /// caller has just built member by member, a wide load of narrow stores still in flight.)
+  T& append_slot() {
     if ((size_ & (kChunk - 1)) == 0 && (size_ >> kChunkShift) == chunks_.size()) {
       chunks_.push_back(std::make_unique_for_overwrite<T[]>(kChunk));
     }
     T& slot = chunks_[size_ >> kChunkShift][size_ & (kChunk - 1)];
-    slot = value;
     ++size_;
     return slot;
   }
-  /// Appends `n` values at once (one copy when they fit in the current chunk).
-  void append(const T* values, std::size_t n) {
+  /// Appends the `n` values value_of(0) .. value_of(n - 1), written in place (in one run when
+  /// they fit in the current chunk).
+  template <typename ValueOf>
+  void append_with(std::size_t n, ValueOf value_of) {
     const std::size_t offset = size_ & (kChunk - 1);
     if (offset != 0 && offset + n <= kChunk) {
-      std::copy_n(values, n, chunks_.back().get() + offset);
+      T* out = chunks_.back().get() + offset;
+      for (std::size_t i = 0; i < n; ++i) out[i] = value_of(i);
       size_ += n;
       return;
     }
-    for (std::size_t i = 0; i < n; ++i) push_back(values[i]);
+    for (std::size_t i = 0; i < n; ++i) push_back(value_of(i));
   }
   const T& operator[](std::size_t i) const noexcept { return chunks_[i >> kChunkShift][i & (kChunk - 1)]; }
   T& operator[](std::size_t i) noexcept { return chunks_[i >> kChunkShift][i & (kChunk - 1)]; }
