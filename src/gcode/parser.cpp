@@ -642,47 +642,51 @@ double Parser::real_number(Cursor& c) {
   const char* const text = c.text.data();
   const char* const limit = text + c.text.size();
   const char* const start = text + c.pos;
-  // The sign is taken without a branch (it is as random as the coordinates); a second one is
-  // malformed (reported below).
-  const char* p = start + (start < limit && (*start == '+' || *start == '-'));
-  while (p < limit && (*p == '+' || *p == '-')) ++p;
-  const auto signs = p - start;
-  const bool negative = start < limit && *start == '-';   // (signs > 1 does not return)
-  const char* const mant = p;
+  // One sign, taken without a branch (signs are as random as the coordinates); a second one
+  // leaves the mantissa without digits.
+  const bool sign = start < limit && (*start == '+' || *start == '-');
+  const bool negative = start < limit && *start == '-';
+  const char* const mant = start + sign;
   // Mantissa: digits, at most one '.', at least one digit. Accumulated on the way for the
-  // common short number (exact below 2^53 with at most 22 decimals: one correctly rounded
+  // common short number (exact below 2^53 with at most 15 digits: one correctly rounded
   // division gives the same double as any correct conversion).
   std::uint64_t value = 0;
-  const char* const int_end = read_digits(p, limit, value);
+  const char* const int_end = read_digits(mant, limit, value);
   const char* end = int_end;   // end of the mantissa
-  std::ptrdiff_t decimals = 0;
-  if (end < limit && *end == '.') {
-    end = read_digits(end + 1, limit, value);
-    decimals = end - (int_end + 1);
-  }
+  if (end < limit && *end == '.') end = read_digits(end + 1, limit, value);
+  const auto decimals = end - int_end - (end != int_end);   // (the point is not a digit)
   const auto digits = (int_end - mant) + decimals;
-  const char* after = end;
-  while (after < limit && (is_digit(*after) || *after == '.')) ++after;
-  c.pos = static_cast<std::size_t>(after - text);
-  if (signs > 1 || digits == 0 || end < after) bad_number(start, after, text, digits == 0 || signs > 1);
-  static constexpr double kPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8,  1e9,  1e10, 1e11,
-                                      1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+  if (digits == 0 || (end < limit && *end == '.')) bad_number(start, limit, text, false);
+  c.pos = static_cast<std::size_t>(end - text);
+  static constexpr double kPow10[] = {1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15};
   double v;
-  if (digits <= 15 && decimals <= 22) {
+  if (digits <= 15) {
     v = static_cast<double>(value) / kPow10[decimals];
   } else {   // `value` may have wrapped: let the library convert
     const auto [ptr, ec] = std::from_chars(mant, end, v);
-    if (ec != std::errc() || ptr != end) bad_number(start, after, text, true);
+    if (ec != std::errc() || ptr != end) bad_number(start, limit, text, true);
   }
   static constexpr double kSign[] = {1.0, -1.0};   // (exact: the same as negating)
   return v * kSign[negative];
 }
 
-void Parser::bad_number(const char* start, const char* after, const char* text, bool malformed) {
+// Says why the text at `start` is not a number, reading it again as real_number did (which
+// keeps nothing it does not need on the way). `unreadable`: the digits could not be converted.
+void Parser::bad_number(const char* start, const char* limit, const char* text, bool unreadable) {
+  const char* p = start;
+  while (p < limit && (*p == '+' || *p == '-')) ++p;
+  const bool signs = p - start > 1;
+  std::size_t digits = 0;
+  for (; p < limit && is_digit(*p); ++p) ++digits;
+  if (p < limit && *p == '.') {
+    for (++p; p < limit && is_digit(*p); ++p) ++digits;
+  }
+  const char* after = p;
+  while (after < limit && (is_digit(*after) || *after == '.')) ++after;
   const std::string_view span(start, static_cast<std::size_t>(after - start));
   const auto at = static_cast<int>(start - text);
   if (span.empty()) fail_at(at, ErrorCode::BadNumber, "a number is missing here");
-  if (malformed)
+  if (unreadable || digits == 0 || signs)
     fail_at(at, ErrorCode::BadNumber,
             "'{}' is not a number (digits with at most one point, after at most one sign)", span);
   fail_at(at, ErrorCode::BadNumber, "'{}' is not a number: a number has at most one decimal point", span);

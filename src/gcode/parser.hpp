@@ -92,7 +92,7 @@ class Parser {
   int integer_value(Cursor& c, const char* what);  ///< `what`: "L", "a parameter number" (for messages)
   static int plain_code(Cursor& c) noexcept;
   double real_number(Cursor& c);
-  [[noreturn, gnu::cold]] static void bad_number(const char* start, const char* after, const char* text, bool malformed);
+  [[noreturn, gnu::cold]] static void bad_number(const char* start, const char* limit, const char* text, bool unreadable);
   /// A bracketed expression; `open`: a Fanuc assignment's right-hand side, which runs to the
   /// end of the line or a comment without brackets.
   double expression(Cursor& c, bool open = false);
