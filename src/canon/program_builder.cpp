@@ -16,6 +16,12 @@ bool is_linear(int axis) { return !is_rotary(static_cast<Axis>(axis)); }
 
 ProgramBuilder::ProgramBuilder(AxisMask axes, const Pose& start) : program_(axes), position_(start) {
   program_.set_start(start);
+  use_length_units(units_);
+}
+
+void ProgramBuilder::use_length_units(Units u) {
+  units_ = u;
+  for (int i = 0; i < kAxisCount; ++i) unit_scale_[i] = is_linear(i) ? mm_per_unit(u) : 1.0;
 }
 
 Pose ProgramBuilder::offset_to_mm(const Pose& offset) const noexcept {
@@ -35,8 +41,8 @@ Pose ProgramBuilder::to_machine(const Pose& canonical) const noexcept {
 
 // Once per move: one pass per stage, written in place (position_ for a move).
 void ProgramBuilder::to_machine(const Pose& canonical, Pose& p) const noexcept {
-  const double k = mm_per_unit(units_);
-  for (int i = 0; i < kAxisCount; ++i) p[i] = (is_linear(i) ? canonical[i] * k : canonical[i]) + g92_[i];
+  // (a rotary axis is scaled by 1.0, which leaves it exactly as it is)
+  for (int i = 0; i < kAxisCount; ++i) p[i] = canonical[i] * unit_scale_[i] + g92_[i];
   if (rotation_deg_ != 0) {
     const double x = p[0], y = p[1];
     p[0] = x * rot_cos_ - y * rot_sin_;

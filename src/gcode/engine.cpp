@@ -170,27 +170,39 @@ RunStatus Engine::guarded(canon::Sink& sink, bool (Engine::*body)()) {
   }
 }
 
-RunStatus Engine::step(canon::Sink& sink) {
+void Engine::require_program() {
   if (!has_program_ && !failed_) {
     diags_.error("", 0, 0, "no program is open", std::string(error_id(ErrorCode::NoProgram)));
     failed_ = true;
   }
+}
+
+RunStatus Engine::step(canon::Sink& sink) {
+  require_program();
   return guarded(sink, &Engine::step_block);
 }
 
 RunStatus Engine::begin(canon::Sink& sink) { return guarded(sink, &Engine::nothing); }
 
 RunStatus Engine::run(canon::Sink& sink) {
-  for (;;) {
-    const RunStatus s = step(sink);
-    if (s != RunStatus::Ok) return s;
-  }
+  require_program();
+  return guarded(sink, &Engine::run_blocks);
 }
 
 bool Engine::step_block() {
   if (st_.ended) return false;
   process_line();
   return !st_.ended;
+}
+
+// What run() does: step_block() until the end or a sync point, inside one guarded() (whose
+// checks a step repeats for every block).
+bool Engine::run_blocks() {
+  while (!st_.ended) {
+    process_line();
+    if (pending_sync_ != SyncKind::None) return true;
+  }
+  return false;
 }
 
 RunStatus Engine::mdi(std::string_view line, canon::Sink& sink) {

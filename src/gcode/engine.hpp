@@ -109,8 +109,10 @@ class Engine final : public ParamHost, public ExecContext {
 
   // engine.cpp: start, lines, errors
   void start();
+  void require_program();
   RunStatus guarded(canon::Sink& sink, bool (Engine::*body)());
   bool step_block();
+  bool run_blocks();
   bool nothing() { return true; }
   bool read_line();
   enum class LineKind : std::uint8_t { Block, Empty, ProgramEnd };

@@ -154,6 +154,8 @@ class Output final : public canon::Sink {
   Pose map_pose(const Pose& p) const noexcept;
   void map_arc(canon::ArcFeed& arc) const;
   Pose motion_pose(const Pose& p) const;
+  /// A straight motion to `end` (program coordinates) forwarded as (sink->*call)(id, pose).
+  void straight_motion(void (canon::Sink::*call)(canon::SegmentId, const Pose&), const Pose& end);
   bool transforming() const { return transform_ && state_ != nullptr && transform_->active(*state_); }
   bool enqueue(Queued&& q);
   void scale_queue(double k) noexcept;

@@ -31,7 +31,7 @@ class ProgramBuilder final : public Sink {
   Pose to_machine(const Pose& canonical) const noexcept;
 
   void begin_block(const BlockOrigin& origin) override { origin_ = origin; }
-  void use_length_units(Units u) override { units_ = u; }
+  void use_length_units(Units u) override;
   void set_g5x_offset(int index, const Pose& offset) override;
   void set_g92_offset(const Pose& offset) override;
   void set_xy_rotation(double degrees) override;
@@ -111,6 +111,7 @@ class ProgramBuilder final : public Sink {
   Program program_;
   BlockOrigin origin_;
   Units units_ = Units::Mm;
+  double unit_scale_[kAxisCount] = {};   ///< mm per program unit by axis (1 for rotary axes)
   Plane plane_ = Plane::XY;
   Pose g5x_{}, g92_{}, tool_{};   ///< mm (converted when received, like LinuxCNC's canon)
   double rotation_deg_ = 0, rot_cos_ = 1, rot_sin_ = 0;
