@@ -82,6 +82,10 @@ class Parser {
   static void misspelt_keyword(const Cursor& c, std::size_t keyword_at);
   void read_o_word(Cursor& c, Block& b);
   void read_word(Cursor& c, Block& b, char letter);
+  [[gnu::cold]] static void repeated_word(const Block& b, char letter, int pos);
+  double integer_word(Cursor& c, char letter, int pos);
+  [[noreturn, gnu::cold]] static void negative_rate(char letter, double v, int pos);
+  static void note_decimal_point(const Cursor& c, Block& b, char letter, std::size_t start);
   void read_g(Cursor& c, Block& b);
   void read_m(Cursor& c, Block& b);
   void read_comment(Cursor& c, Block& b);
