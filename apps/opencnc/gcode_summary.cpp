@@ -25,12 +25,10 @@ struct Box {
                   std::numeric_limits<double>::infinity()};
   double hi[3] = {-std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(),
                   -std::numeric_limits<double>::infinity()};
-  void add(double x, double y, double z) {
-    const double p[3] = {x, y, z};
-    for (int i = 0; i < 3; ++i) {
-      lo[i] = std::min(lo[i], p[i]);
-      hi[i] = std::max(hi[i], p[i]);
-    }
+  void add(double x, double y, double z) {   // (written out: it runs twice per move)
+    lo[0] = std::min(lo[0], x), hi[0] = std::max(hi[0], x);
+    lo[1] = std::min(lo[1], y), hi[1] = std::max(hi[1], y);
+    lo[2] = std::min(lo[2], z), hi[2] = std::max(hi[2], z);
   }
   bool empty() const { return !(lo[0] <= hi[0]); }
 };
@@ -115,7 +113,7 @@ class MoveMeter {
     }
     const double* s = last_;
     const canon::Move& m = prog_.move(id);
-    const Pose e = prog_.end(id);
+    const double e[3] = {prog_.end_coord(id, Axis::X), prog_.end_coord(id, Axis::Y), prog_.end_coord(id, Axis::Z)};
     double len;
     if (m.kind == canon::MoveKind::Arc) {
       const canon::ArcGeometry& g = prog_.arc(id);

@@ -137,7 +137,8 @@ void Engine::check_block() {
 // groups only extensions know are asked.
 Engine::ExtensionClaims Engine::extension_claims() const {
   ExtensionClaims claims;
-  if (ext_ == nullptr) return claims;
+  const int motion = block_.g[kGroupMotion] != -1 ? block_.g[kGroupMotion] : block_.motion;
+  if (!block_.extension_groups && extension_handler(motion) == nullptr) return claims;   // most blocks
   auto ask = [&](int code) {
     const CodeHandler* h = extension_handler(code);
     if (h == nullptr) return;
@@ -149,7 +150,7 @@ Engine::ExtensionClaims Engine::extension_claims() const {
   if (block_.extension_groups) {
     for (int group = kGroupScaling; group < kGGroupCount; ++group) ask(block_.g[static_cast<std::size_t>(group)]);
   }
-  ask(block_.g[kGroupMotion] != -1 ? block_.g[kGroupMotion] : block_.motion);
+  ask(motion);
   return claims;
 }
 

@@ -492,10 +492,11 @@ void Engine::warn_once(bool& done, ErrorCode code, std::string_view message) {
 // Habits of a program that LinuxCNC accepts but a preflight should point out (once each).
 void Engine::check_motion_habits(bool feed) {
   if (in_mdi_) return;
-  if (!units_programmed_)
+  // (warn_once tests `done` too; testing it first spares a call on every later move)
+  if (!units_programmed_ && !warned_units_)
     warn_once(warned_units_, ErrorCode::UnitsNotProgrammed,
               "motion before any G20/G21: the program relies on the machine's default units");
-  if (feed && st_.modal.spindle == canon::SpindleDirection::Stopped)
+  if (feed && !warned_spindle_ && st_.modal.spindle == canon::SpindleDirection::Stopped)
     warn_once(warned_spindle_, ErrorCode::FeedWithSpindleStopped, "feed move while the spindle is stopped");
 }
 
