@@ -95,7 +95,7 @@ class Parser {
   double real_value(Cursor& c);
   int integer_value(Cursor& c, const char* what);  ///< `what`: "L", "a parameter number" (for messages)
   static int plain_code(Cursor& c) noexcept;
-  double real_number(Cursor& c);
+  [[gnu::always_inline]] inline double real_number(Cursor& c);
   [[noreturn, gnu::cold]] static void bad_number(const char* start, const char* limit, const char* text, bool unreadable);
   /// A bracketed expression; `open`: a Fanuc assignment's right-hand side, which runs to the
   /// end of the line or a comment without brackets.
