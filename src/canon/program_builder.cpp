@@ -42,17 +42,24 @@ Pose ProgramBuilder::to_machine(const Pose& canonical) const noexcept {
 // Once per move: one pass per stage, written in place (position_ for a move).
 void ProgramBuilder::to_machine(const Pose& canonical, Pose& p) const noexcept {
   // (a rotary axis is scaled by 1.0, which leaves it exactly as it is)
-  for (int i = 0; i < kAxisCount; ++i) p[i] = canonical[i] * unit_scale_[i] + g92_[i];
-  if (rotation_deg_ != 0) {
-    const double x = p[0], y = p[1];
-    p[0] = x * rot_cos_ - y * rot_sin_;
-    p[1] = x * rot_sin_ + y * rot_cos_;
+  if (rotation_deg_ == 0) {   // one pass, the same sums in the same order
+    for (int i = 0; i < kAxisCount; ++i) p[i] = (canonical[i] * unit_scale_[i] + g92_[i]) + work_offset_[i];
+    return;
   }
-  for (int i = 0; i < kAxisCount; ++i) p[i] += g5x_[i] + tool_[i];
+  for (int i = 0; i < kAxisCount; ++i) p[i] = canonical[i] * unit_scale_[i] + g92_[i];
+  const double x = p[0], y = p[1];
+  p[0] = x * rot_cos_ - y * rot_sin_;
+  p[1] = x * rot_sin_ + y * rot_cos_;
+  for (int i = 0; i < kAxisCount; ++i) p[i] += work_offset_[i];
+}
+
+void ProgramBuilder::update_work_offset() noexcept {
+  for (int i = 0; i < kAxisCount; ++i) work_offset_[i] = g5x_[i] + tool_[i];
 }
 
 void ProgramBuilder::set_g5x_offset(int index, const Pose& offset) {
   g5x_ = offset_to_mm(offset);
+  update_work_offset();
   Action a = make(ActionKind::WorkOffset, index);
   a.pose = program_.add_action_pose(g5x_);
   program_.add_action(a);
@@ -75,6 +82,7 @@ void ProgramBuilder::set_xy_rotation(double degrees) {
 
 void ProgramBuilder::use_tool_length_offset(const Pose& offset) {
   tool_ = offset_to_mm(offset);
+  update_work_offset();
   Action a = make(ActionKind::ToolLengthOffset);
   a.pose = program_.add_action_pose(tool_);
   program_.add_action(a);

@@ -657,7 +657,11 @@ namespace {
 // Reads digits from p (not past `limit`) into `value`, which wraps after 19 digits (callers
 // only use it for short numbers). Returns the end.
 const char* read_digits(const char* p, const char* limit, std::uint64_t& value) noexcept {
-  while (p < limit && is_digit(*p)) value = value * 10 + static_cast<std::uint64_t>(*p++ - '0');
+  for (; p < limit; ++p) {
+    const unsigned digit = static_cast<unsigned char>(*p) - unsigned{'0'};   // (wraps for bytes below '0')
+    if (digit > 9) break;
+    value = value * 10 + digit;
+  }
   return p;
 }
 
