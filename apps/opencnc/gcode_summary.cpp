@@ -117,8 +117,7 @@ class MoveMeter {
     double len;
     if (m.kind == canon::MoveKind::Arc) {
       const canon::ArcGeometry& g = prog_.arc(id);
-      const double a[3] = {s[0], s[1], s[2]}, b[3] = {e[0], e[1], e[2]};
-      len = arc_extent(a, b, g.center, g.plane, g.turns, t_.box);
+      len = arc_extent(s, e, g.center, g.plane, g.turns, t_.box);
       ++t_.arcs;
     } else {
       len = std::sqrt((e[0] - s[0]) * (e[0] - s[0]) + (e[1] - s[1]) * (e[1] - s[1]) + (e[2] - s[2]) * (e[2] - s[2]));
