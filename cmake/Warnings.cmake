@@ -17,4 +17,10 @@ function(opencnc_add_library name)
   add_library(${name} STATIC ${ARGN})
   target_include_directories(${name} PUBLIC ${PROJECT_SOURCE_DIR}/include PRIVATE ${CMAKE_CURRENT_SOURCE_DIR})
   target_link_libraries(${name} PRIVATE opencnc_warnings)
+  # Position-independent code makes GCC assume that any exported function may be replaced at
+  # load time, so it would not inline a call to one even within its own file; nothing of ours
+  # is meant to be interposed (opencnc scan: ~8 % faster). Clang assumes this already.
+  if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
+    target_compile_options(${name} PRIVATE -fno-semantic-interposition)
+  endif()
 endfunction()

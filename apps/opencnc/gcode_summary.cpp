@@ -25,12 +25,10 @@ struct Box {
                   std::numeric_limits<double>::infinity()};
   double hi[3] = {-std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(),
                   -std::numeric_limits<double>::infinity()};
-  void add(double x, double y, double z) {
-    const double p[3] = {x, y, z};
-    for (int i = 0; i < 3; ++i) {
-      lo[i] = std::min(lo[i], p[i]);
-      hi[i] = std::max(hi[i], p[i]);
-    }
+  void add(double x, double y, double z) {   // (written out: it runs twice per move)
+    lo[0] = std::min(lo[0], x), hi[0] = std::max(hi[0], x);
+    lo[1] = std::min(lo[1], y), hi[1] = std::max(hi[1], y);
+    lo[2] = std::min(lo[2], z), hi[2] = std::max(hi[2], z);
   }
   bool empty() const { return !(lo[0] <= hi[0]); }
 };
@@ -86,9 +84,71 @@ double arc_extent(const double start[3], const double end[3], const double cente
   return std::hypot(r * sweep, end[n] - start[n]);
 }
 
-// Watches the canonical stream in work coordinates: extents, tools, coordinate systems.
+struct Totals {
+  std::size_t feeds = 0, rapids = 0, arcs = 0;
+  double feed_length = 0, rapid_length = 0;
+  double feed_time_min = 0;
+  bool untimed = false;   // per-revolution feeds: no time without a spindle model
+  Box box;
+};
+
+// Counts, lengths, machine extents and feed time of a program's moves, taken as they are
+// appended (while they are still in the cache) instead of in a second pass over a program
+// of maybe a million moves. Moves are measured in order, one at a time.
+class MoveMeter {
+ public:
+  explicit MoveMeter(const canon::Program& prog) : prog_(prog) {}
+  /// Measures the moves appended since the last call.
+  void catch_up() {
+    for (; next_ < prog_.size(); ++next_) measure(next_);
+  }
+  const Totals& totals() const { return t_; }
+
+ private:
+  void measure(canon::SegmentId id) {
+    if (id == 0) {
+      const Pose& start = prog_.start();
+      for (int i = 0; i < 3; ++i) last_[i] = start[i];
+      t_.box.add(last_[0], last_[1], last_[2]);
+    }
+    const double* s = last_;
+    const canon::Move& m = prog_.move(id);
+    const double e[3] = {prog_.end_coord(id, Axis::X), prog_.end_coord(id, Axis::Y), prog_.end_coord(id, Axis::Z)};
+    double len;
+    if (m.kind == canon::MoveKind::Arc) {
+      const canon::ArcGeometry& g = prog_.arc(id);
+      len = arc_extent(s, e, g.center, g.plane, g.turns, t_.box);
+      ++t_.arcs;
+    } else {
+      len = std::sqrt((e[0] - s[0]) * (e[0] - s[0]) + (e[1] - s[1]) * (e[1] - s[1]) + (e[2] - s[2]) * (e[2] - s[2]));
+      t_.box.add(e[0], e[1], e[2]);
+    }
+    for (int i = 0; i < 3; ++i) last_[i] = e[i];   // (X, Y, Z only: a whole pose copied costs more)
+    if (m.kind == canon::MoveKind::Traverse) {
+      ++t_.rapids;
+      t_.rapid_length += len;
+      return;
+    }
+    ++t_.feeds;
+    t_.feed_length += len;
+    const double f = prog_.feed(id);
+    if (m.flags & canon::kInverseTime) t_.feed_time_min += f > 0 ? 1.0 / f : 0;
+    else if (m.flags & canon::kPerRevolution) t_.untimed = true;
+    else if (f > 0) t_.feed_time_min += len / f;
+  }
+
+  const canon::Program& prog_;
+  canon::SegmentId next_ = 0;
+  double last_[3] = {0, 0, 0};   // X, Y, Z where the last move measured ended
+  Totals t_;
+};
+
+// Watches the canonical stream in work coordinates (extents, tools, coordinate systems); after
+// each motion, which the builder ahead of it in the tee has just appended, it has `meter`
+// measure the new moves.
 class WorkWatcher final : public canon::Sink {
  public:
+  explicit WorkWatcher(MoveMeter& meter) : meter_(meter) {}
   void straight_traverse(canon::SegmentId, const Pose& end) override { move(end); }
   void straight_feed(canon::SegmentId, const Pose& end) override { move(end); }
   void arc_feed(canon::SegmentId, const canon::ArcFeed& arc) override {
@@ -99,7 +159,8 @@ class WorkWatcher final : public canon::Sink {
     c[b] = arc.second_center;
     c[n] = s[n];
     arc_extent(s, e, c, arc.plane, arc.rotation, box_);
-    pos_ = arc.end;
+    for (int i = 0; i < 3; ++i) pos_[i] = arc.end[i];
+    meter_.catch_up();
   }
   void change_tool(int index) override { tool_changes.insert(index); }
   void change_tool_number(int index) override { tool_changes.insert(index); }
@@ -114,53 +175,13 @@ class WorkWatcher final : public canon::Sink {
  private:
   void move(const Pose& end) {
     box_.add(end[0], end[1], end[2]);
-    pos_ = end;
+    for (int i = 0; i < 3; ++i) pos_[i] = end[i];
+    meter_.catch_up();
   }
-  Pose pos_{};
+  MoveMeter& meter_;
+  double pos_[3] = {0, 0, 0};   // X, Y, Z of the last motion's end (work coordinates)
   Box box_;
 };
-
-struct Totals {
-  std::size_t feeds = 0, rapids = 0, arcs = 0;
-  double feed_length = 0, rapid_length = 0;
-  double feed_time_min = 0;
-  bool untimed = false;   // per-revolution feeds: no time without a spindle model
-  Box box;
-};
-
-Totals measure(const canon::Program& prog) {
-  Totals t;
-  if (prog.empty()) return t;
-  Pose s = prog.start();
-  t.box.add(s[0], s[1], s[2]);
-  Pose e;
-  for (canon::SegmentId id = 0; id < prog.size(); ++id, s = e) {
-    const canon::Move& m = prog.move(id);
-    e = prog.end(id);
-    double len;
-    if (m.kind == canon::MoveKind::Arc) {
-      const canon::ArcGeometry& g = prog.arc(id);
-      const double a[3] = {s[0], s[1], s[2]}, b[3] = {e[0], e[1], e[2]};
-      len = arc_extent(a, b, g.center, g.plane, g.turns, t.box);
-      ++t.arcs;
-    } else {
-      len = std::sqrt((e[0] - s[0]) * (e[0] - s[0]) + (e[1] - s[1]) * (e[1] - s[1]) + (e[2] - s[2]) * (e[2] - s[2]));
-      t.box.add(e[0], e[1], e[2]);
-    }
-    if (m.kind == canon::MoveKind::Traverse) {
-      ++t.rapids;
-      t.rapid_length += len;
-      continue;
-    }
-    ++t.feeds;
-    t.feed_length += len;
-    const double f = prog.feed(id);
-    if (m.flags & canon::kInverseTime) t.feed_time_min += f > 0 ? 1.0 / f : 0;
-    else if (m.flags & canon::kPerRevolution) t.untimed = true;
-    else if (f > 0) t.feed_time_min += len / f;
-  }
-  return t;
-}
 
 nlohmann::json box_json(const Box& b) {
   if (b.empty()) return nullptr;
@@ -187,11 +208,13 @@ int run_scan(const std::string& file, const gcode::Options& options, bool json, 
   }
   canon::ProgramBuilder builder(options.axes);
   builder.program().set_sources(interp.sources());
-  WorkWatcher watch;
-  canon::TeeSink tee(builder, watch);
-  const gcode::RunStatus status = interp.run(tee);
   const canon::Program& prog = builder.program();
-  const Totals t = measure(prog);
+  MoveMeter meter(prog);
+  WorkWatcher watch(meter);
+  canon::TeeSink tee(builder, watch);   // the builder first: the watcher's meter reads its moves
+  const gcode::RunStatus status = interp.run(tee);
+  meter.catch_up();   // moves of calls the watcher does not follow (probes, taps, splines)
+  const Totals& t = meter.totals();
   const gcode::InterpState st = interp.state();
   const double rapid_min = rapid_rate_mm_min > 0 ? t.rapid_length / rapid_rate_mm_min : 0.0;
   const auto& diags = interp.diagnostics();

@@ -11,6 +11,7 @@
 #include "opencnc/canon/program_builder.hpp"
 #include "opencnc/canon/rs274_printer.hpp"
 #include "opencnc/gcode/interpreter.hpp"
+#include "opencnc/gcode/standard_extensions.hpp"
 
 namespace {
 
@@ -47,10 +48,12 @@ const ProgramFile& program_file() {
 template <typename MakeSink>
 void run_program(benchmark::State& state, MakeSink make_sink) {
   const std::string& path = program_file().path();
+  const auto extensions = gcode::standard_extensions(gcode::Dialect::LinuxCnc);
   std::uint64_t blocks = 0;
   for (auto _ : state) {
     gcode::Options options;
     options.mode = gcode::Mode::Scan;
+    options.extensions = extensions;   // the modules `opencnc scan` and `opencnc canon` run with
     gcode::Interpreter interp(options);
     if (!interp.open(path)) state.SkipWithError("cannot open the program");
     auto sink = make_sink();

@@ -36,11 +36,15 @@ std::uint32_t Program::file_of(SegmentId id) const {
 }
 
 SegmentId Program::append(const Move& m, const Pose& end) {
-  moves_.push_back(m);
-  double values[kAxisCount];
-  for (int s = 0; s < stride_; ++s) values[s] = end[slot_axes_[s]];
-  coords_.append(values, static_cast<std::size_t>(stride_));
+  append(end) = m;
   return moves_.size() - 1;
+}
+
+// In place: a move or pose built by the caller and then copied whole costs a failed store
+// forwarding on every move (the wide loads of the copy meet narrow stores still in flight).
+Move& Program::append(const Pose& end) {
+  coords_.append_with(static_cast<std::size_t>(stride_), [&](std::size_t s) { return end[slot_axes_[s]]; });
+  return moves_.append_slot();
 }
 
 std::uint32_t Program::add_arc(const ArcGeometry& a) {

@@ -16,6 +16,12 @@ bool is_linear(int axis) { return !is_rotary(static_cast<Axis>(axis)); }
 
 ProgramBuilder::ProgramBuilder(AxisMask axes, const Pose& start) : program_(axes), position_(start) {
   program_.set_start(start);
+  use_length_units(units_);
+}
+
+void ProgramBuilder::use_length_units(Units u) {
+  units_ = u;
+  for (int i = 0; i < kAxisCount; ++i) unit_scale_[i] = is_linear(i) ? mm_per_unit(u) : 1.0;
 }
 
 Pose ProgramBuilder::offset_to_mm(const Pose& offset) const noexcept {
@@ -28,21 +34,32 @@ Pose ProgramBuilder::offset_to_mm(const Pose& offset) const noexcept {
 }
 
 Pose ProgramBuilder::to_machine(const Pose& canonical) const noexcept {
-  // Once per move: one pass per stage, no temporaries.
   Pose p;
-  const double k = mm_per_unit(units_);
-  for (int i = 0; i < kAxisCount; ++i) p[i] = (is_linear(i) ? canonical[i] * k : canonical[i]) + g92_[i];
-  if (rotation_deg_ != 0) {
-    const double x = p[0], y = p[1];
-    p[0] = x * rot_cos_ - y * rot_sin_;
-    p[1] = x * rot_sin_ + y * rot_cos_;
-  }
-  for (int i = 0; i < kAxisCount; ++i) p[i] += g5x_[i] + tool_[i];
+  to_machine(canonical, p);
   return p;
+}
+
+// Once per move: one pass per stage, written in place (position_ for a move).
+void ProgramBuilder::to_machine(const Pose& canonical, Pose& p) const noexcept {
+  // (a rotary axis is scaled by 1.0, which leaves it exactly as it is)
+  if (rotation_deg_ == 0) {   // one pass, the same sums in the same order
+    for (int i = 0; i < kAxisCount; ++i) p[i] = (canonical[i] * unit_scale_[i] + g92_[i]) + work_offset_[i];
+    return;
+  }
+  for (int i = 0; i < kAxisCount; ++i) p[i] = canonical[i] * unit_scale_[i] + g92_[i];
+  const double x = p[0], y = p[1];
+  p[0] = x * rot_cos_ - y * rot_sin_;
+  p[1] = x * rot_sin_ + y * rot_cos_;
+  for (int i = 0; i < kAxisCount; ++i) p[i] += work_offset_[i];
+}
+
+void ProgramBuilder::update_work_offset() noexcept {
+  for (int i = 0; i < kAxisCount; ++i) work_offset_[i] = g5x_[i] + tool_[i];
 }
 
 void ProgramBuilder::set_g5x_offset(int index, const Pose& offset) {
   g5x_ = offset_to_mm(offset);
+  update_work_offset();
   Action a = make(ActionKind::WorkOffset, index);
   a.pose = program_.add_action_pose(g5x_);
   program_.add_action(a);
@@ -65,6 +82,7 @@ void ProgramBuilder::set_xy_rotation(double degrees) {
 
 void ProgramBuilder::use_tool_length_offset(const Pose& offset) {
   tool_ = offset_to_mm(offset);
+  update_work_offset();
   Action a = make(ActionKind::ToolLengthOffset);
   a.pose = program_.add_action_pose(tool_);
   program_.add_action(a);
@@ -100,37 +118,39 @@ std::uint32_t ProgramBuilder::current_feed_index() {
   return last_feed_index_;
 }
 
-void ProgramBuilder::append(MoveKind kind, SegmentId id, const Pose& machine_end, std::uint32_t param,
-                            std::uint8_t extra_flags) {
+void ProgramBuilder::append(MoveKind kind, SegmentId id, std::uint32_t param, std::uint8_t extra_flags) {
   // Ids are ordinals: after the first move, the program's count follows the interpreter's
   // except where a segment is split (recorded by note_split).
   if (program_.empty()) program_.set_first_segment(id);
-  Move m;
+  Move& m = program_.append(position_);
   m.kind = kind;
   m.flags = static_cast<std::uint8_t>((kind == MoveKind::Traverse ? 0 : move_flags()) | extra_flags);
+  m.reserved = 0;
   m.context = origin_.context;
   m.line = origin_.line;
   m.param = param;
-  program_.append(m, machine_end);
-  position_ = machine_end;
 }
 
 void ProgramBuilder::straight_traverse(SegmentId id, const Pose& end) {
-  append(MoveKind::Traverse, id, to_machine(end), 0);
+  to_machine(end, position_);
+  append(MoveKind::Traverse, id, 0);
 }
 
 void ProgramBuilder::straight_feed(SegmentId id, const Pose& end) {
-  append(MoveKind::Feed, id, to_machine(end), current_feed_index());
+  to_machine(end, position_);
+  append(MoveKind::Feed, id, current_feed_index());
 }
 
 void ProgramBuilder::straight_probe(SegmentId id, const Pose& end) {
-  append(MoveKind::Probe, id, to_machine(end), current_feed_index());
+  to_machine(end, position_);
+  append(MoveKind::Probe, id, current_feed_index());
 }
 
 void ProgramBuilder::rigid_tap(SegmentId id, const Pose& end, double /*scale*/) {
   // The tap reverses at `end` and comes back: the machine ends where the tap started.
   const Pose start = position_;
-  append(MoveKind::RigidTap, id, to_machine(end), current_feed_index());
+  to_machine(end, position_);
+  append(MoveKind::RigidTap, id, current_feed_index());
   position_ = start;
 }
 
@@ -174,7 +194,8 @@ void ProgramBuilder::arc_feed(SegmentId id, const ArcFeed& arc) {
   g.turns = arc.rotation;
   g.plane = arc.plane;
   g.feed = current_feed_index();
-  append(MoveKind::Arc, id, machine_end, program_.add_arc(g));
+  position_ = machine_end;
+  append(MoveKind::Arc, id, program_.add_arc(g));
 }
 
 void ProgramBuilder::nurbs_feed(SegmentId id, int order, std::span<const NurbsPoint> points) {
@@ -195,10 +216,9 @@ void ProgramBuilder::nurbs_feed(SegmentId id, int order, std::span<const NurbsPo
   const std::size_t first = program_.size();
   const std::uint32_t feed = current_feed_index();
   for (const CurvePoint& v : chords) {
-    Pose end = position_;
-    end[0] = v.x;
-    end[1] = v.y;
-    append(MoveKind::Feed, id, end, feed, kCurveChord);
+    position_[0] = v.x;
+    position_[1] = v.y;
+    append(MoveKind::Feed, id, feed, kCurveChord);
   }
   program_.note_split(id, first, chords.size());
 }

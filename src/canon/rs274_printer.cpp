@@ -36,15 +36,17 @@ char* digits_before(char* end, unsigned long v) {
 }  // namespace
 
 void Rs274Printer::prefix() {
-  // "%5d " without printf: this runs once per printed line.
-  char seq[24];
-  char* end = seq + sizeof seq - 1;
+  // "%5d " without printf: this runs once per printed line. The text ends mid-buffer so that
+  // a fixed 24 bytes can be copied (a copy of variable length is a library call).
+  char seq[48];
+  char* const end = seq + 23;
   *end = ' ';
   const int n = sequence_++;
   char* first = digits_before(end, static_cast<unsigned long>(n < 0 ? -static_cast<long>(n) : n));
   if (n < 0) *--first = '-';
   while (end - first < 5) *--first = ' ';
-  buf_.append(first, static_cast<std::size_t>(end - first + 1));
+  std::memcpy(buf_.room(24), first, 24);
+  buf_.grow(static_cast<std::size_t>(end - first + 1));
   if (origin_.n_present) {
     // rs274 copies the N word's digits as written and pads them to six characters.
     buf_.push_back('N');
@@ -64,8 +66,7 @@ void Rs274Printer::end_line() {
 }
 
 void Rs274Printer::num(double v, int decimals) {
-  char tmp[kFixedBufferSize];
-  buf_.append(tmp, format_fixed(tmp, v, decimals));
+  buf_.grow(format_fixed(buf_.room(kFixedBufferSize), v, decimals));   // in place: no copy
 }
 
 void Rs274Printer::integer(long v) {

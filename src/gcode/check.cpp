@@ -3,6 +3,7 @@
 // enhance_block and check_items): which motion the block performs and which words are used.
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 
 #include "engine.hpp"
@@ -120,9 +121,15 @@ void Engine::check_block() {
             "a fifth M code on this line: a line may hold four at most");
   check_other_codes();
   if (ext_ == nullptr) return;
-  for (int group = 0; group < kGGroupCount; ++group)
-    check_extension(block_.g[static_cast<std::size_t>(group)], block_.g_position(group));
-  if (block_.motion != block_.g[kGroupMotion]) check_extension(block_.motion, block_.first_axis_position());
+  // Only groups that can hold an extension's code are looked at, and the test for a handler
+  // stays here: a call per group would cost more than the checks of a typical block together.
+  for (std::uint32_t groups = extension_groups_; groups != 0; groups &= groups - 1) {
+    const int group = std::countr_zero(groups);
+    const int code = block_.g[static_cast<std::size_t>(group)];
+    if (extension_handler(code) != nullptr) check_extension(code, block_.g_position(group));
+  }
+  if (block_.motion != block_.g[kGroupMotion] && extension_handler(block_.motion) != nullptr)
+    check_extension(block_.motion, block_.first_axis_position());
 }
 
 // What the extension codes of the block claim (their Traits): words they take, the axis
@@ -130,10 +137,12 @@ void Engine::check_block() {
 // groups only extensions know are asked.
 Engine::ExtensionClaims Engine::extension_claims() const {
   ExtensionClaims claims;
-  if (ext_ == nullptr) return claims;
+  const int motion = block_.g[kGroupMotion] != -1 ? block_.g[kGroupMotion] : block_.motion;
+  if (!block_.extension_groups && extension_handler(motion) == nullptr) return claims;   // most blocks
   auto ask = [&](int code) {
-    if (code < 0 || !ext_->g[static_cast<std::size_t>(code)]) return;
-    const CodeHandler::Traits t = ext_->g[static_cast<std::size_t>(code)]->traits(code);
+    const CodeHandler* h = extension_handler(code);
+    if (h == nullptr) return;
+    const CodeHandler::Traits t = h->traits(code);
     claims.words |= t.words;
     claims.axis_words = claims.axis_words || t.axis_words;
     claims.all_words = claims.all_words || t.all_words;
@@ -141,13 +150,12 @@ Engine::ExtensionClaims Engine::extension_claims() const {
   if (block_.extension_groups) {
     for (int group = kGroupScaling; group < kGGroupCount; ++group) ask(block_.g[static_cast<std::size_t>(group)]);
   }
-  ask(block_.g[kGroupMotion] != -1 ? block_.g[kGroupMotion] : block_.motion);
+  ask(motion);
   return claims;
 }
 
 void Engine::check_extension(int code, int position) {
-  if (code < 0 || !ext_->g[static_cast<std::size_t>(code)]) return;
-  if (auto problem = ext_->g[static_cast<std::size_t>(code)]->check(block_, code, st_))
+  if (auto problem = extension_handler(code)->check(block_, code, st_))
     throw GcodeError(problem->code, problem->message, position);
 }
 

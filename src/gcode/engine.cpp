@@ -12,6 +12,13 @@ namespace opencnc::gcode {
 
 Engine::Engine(Options options) : opt_(std::move(options)), sources_(std::make_shared<canon::SourceMap>()) {
   ext_ = opt_.extensions.get();
+  // The G groups where a code with an extension handler can stand (its core group, else the
+  // one its traits name): check_block looks for handlers in these only.
+  for (int code = 0; ext_ != nullptr && code < static_cast<int>(ext_->g.size()); ++code) {
+    const CodeHandler* h = ext_->g[static_cast<std::size_t>(code)].get();
+    const int group = h == nullptr ? -1 : g_group(code) >= 0 ? g_group(code) : h->traits(code).group;
+    if (group >= 0) extension_groups_ |= 1u << group;
+  }
   out_.configure(opt_);
   out_.track(&st_.position);
   out_.transform_state(&st_);
@@ -163,27 +170,39 @@ RunStatus Engine::guarded(canon::Sink& sink, bool (Engine::*body)()) {
   }
 }
 
-RunStatus Engine::step(canon::Sink& sink) {
+void Engine::require_program() {
   if (!has_program_ && !failed_) {
     diags_.error("", 0, 0, "no program is open", std::string(error_id(ErrorCode::NoProgram)));
     failed_ = true;
   }
+}
+
+RunStatus Engine::step(canon::Sink& sink) {
+  require_program();
   return guarded(sink, &Engine::step_block);
 }
 
 RunStatus Engine::begin(canon::Sink& sink) { return guarded(sink, &Engine::nothing); }
 
 RunStatus Engine::run(canon::Sink& sink) {
-  for (;;) {
-    const RunStatus s = step(sink);
-    if (s != RunStatus::Ok) return s;
-  }
+  require_program();
+  return guarded(sink, &Engine::run_blocks);
 }
 
 bool Engine::step_block() {
   if (st_.ended) return false;
   process_line();
   return !st_.ended;
+}
+
+// What run() does: step_block() until the end or a sync point, inside one guarded() (whose
+// checks a step repeats for every block).
+bool Engine::run_blocks() {
+  while (!st_.ended) {
+    process_line();
+    if (pending_sync_ != SyncKind::None) return true;
+  }
+  return false;
 }
 
 RunStatus Engine::mdi(std::string_view line, canon::Sink& sink) {
@@ -277,19 +296,22 @@ void Engine::line_too_long() const {
                    Where{line_file_, line_, static_cast<std::uint32_t>(kMaxLineLength)});
 }
 
+// Written in place: an origin built on the stack and copied costs a failed store forwarding
+// (a wide load of narrow stores just made) on every line.
 void Engine::set_origin_from_line() {
-  canon::BlockOrigin o;
+  canon::BlockOrigin& o = out_.new_origin();
   o.file = line_file_;
   o.line = line_;
   o.context = st_.frames.back().context;
+  std::memset(o.n_digits, 0, sizeof o.n_digits);
   std::string_view digits;
-  if (leading_n_digits(raw_, digits)) {
-    o.n_present = true;
+  o.n_present = leading_n_digits(raw_, digits);
+  o.n_length = 0;
+  if (o.n_present) {
     const std::size_t n = std::min(digits.size(), sizeof(o.n_digits));
     std::memcpy(o.n_digits, digits.data(), n);
     o.n_length = static_cast<std::uint8_t>(n);
   }
-  out_.set_origin(o);
 }
 
 // Reads the next line into block_ (parsed and checked unless a label is being sought).
@@ -497,10 +519,11 @@ void Engine::warn_once(bool& done, ErrorCode code, std::string_view message) {
 // Habits of a program that LinuxCNC accepts but a preflight should point out (once each).
 void Engine::check_motion_habits(bool feed) {
   if (in_mdi_) return;
-  if (!units_programmed_)
+  // (warn_once tests `done` too; testing it first spares a call on every later move)
+  if (!units_programmed_ && !warned_units_)
     warn_once(warned_units_, ErrorCode::UnitsNotProgrammed,
               "motion before any G20/G21: the program relies on the machine's default units");
-  if (feed && st_.modal.spindle == canon::SpindleDirection::Stopped)
+  if (feed && !warned_spindle_ && st_.modal.spindle == canon::SpindleDirection::Stopped)
     warn_once(warned_spindle_, ErrorCode::FeedWithSpindleStopped, "feed move while the spindle is stopped");
 }
 

@@ -125,8 +125,10 @@ class Engine final : public ParamHost, public ExecContext {
 
   // engine.cpp: start, lines, errors
   void start();
+  void require_program();
   RunStatus guarded(canon::Sink& sink, bool (Engine::*body)());
   bool step_block();
+  bool run_blocks();
   bool nothing() { return true; }
   bool read_line();
   enum class LineKind : std::uint8_t { Block, Empty, ProgramEnd };
@@ -159,7 +161,11 @@ class Engine final : public ParamHost, public ExecContext {
   void check_g10();
   void check_other_codes();
   void check_p_word();
-  void check_extension(int code, int position);
+  void check_extension(int code, int position);   ///< `code` must have a handler
+  /// The extension's handler of G code `code` (×10), nullptr if none (or code < 0).
+  const CodeHandler* extension_handler(int code) const noexcept {
+    return code >= 0 && ext_ != nullptr ? ext_->g[static_cast<std::size_t>(code)].get() : nullptr;
+  }
   void check_word_rules(const Block& b);
   struct ExtensionClaims {
     std::uint32_t words = 0;
@@ -317,6 +323,7 @@ class Engine final : public ParamHost, public ExecContext {
 
   Options opt_;
   const Extensions* ext_ = nullptr;
+  std::uint32_t extension_groups_ = 0;   ///< bit per G group that can hold a code with a handler
   InterpState st_;
   Output out_;
   Parser parser_;

@@ -21,6 +21,9 @@ constexpr double kSpiralRelativeTolerance = 0.001;
 constexpr double kRadiusToleranceInch = 0.00005;
 constexpr double kRadiusToleranceMm = 0.00005 * 25.4;
 constexpr double kTiny = 1e-12;
+// A B C U V W: most blocks have none of them, and find_ends then skips their loop.
+constexpr std::uint32_t kOtherAxisWordBits =
+    Block::kAxisWordBits & ~((1u << ('x' - 'a')) | (1u << ('y' - 'a')) | (1u << ('z' - 'a')));
 
 
 // The first centre offset word (I, J or K) of an arc, -1 if none.
@@ -142,6 +145,7 @@ Pose Engine::find_ends(const Block& b) {
     end[0] = x;
     end[1] = y;
     end[2] = b.has('z') ? b.get('z') : from_z;
+    if ((b.words & kOtherAxisWordBits) == 0) return end;
     for (int i = 3; i < kAxisCount; ++i) {
       if (b.has(kAxisWordLetters[i])) end[i] = b.get(kAxisWordLetters[i]);
     }
@@ -168,6 +172,7 @@ Pose Engine::find_ends(const Block& b) {
   end[0] = x;
   end[1] = y;
   end[2] = from_z + (b.has('z') ? b.get('z') : 0.0);
+  if ((b.words & kOtherAxisWordBits) == 0) return end;
   for (int i = 3; i < kAxisCount; ++i) {
     if (b.has(kAxisWordLetters[i])) end[i] += b.get(kAxisWordLetters[i]);
   }

@@ -207,10 +207,7 @@ void Output::straight_traverse(canon::SegmentId, const Pose& end) {
     enqueue(std::move(q));
     return;
   }
-  track_motion(end);
-  canon::SegmentId id;
-  const Pose p = motion_pose(end);
-  if (auto* s = live_motion(id)) s->straight_traverse(id, p);
+  straight_motion(&canon::Sink::straight_traverse, end);
 }
 
 void Output::straight_feed(canon::SegmentId, const Pose& end) {
@@ -220,10 +217,18 @@ void Output::straight_feed(canon::SegmentId, const Pose& end) {
     enqueue(std::move(q));
     return;
   }
+  straight_motion(&canon::Sink::straight_feed, end);
+}
+
+void Output::straight_motion(void (canon::Sink::*call)(canon::SegmentId, const Pose&), const Pose& end) {
   track_motion(end);
   canon::SegmentId id;
+  if (identity_map_ && !transforming()) {   // the usual case: the pose goes out as it is
+    if (auto* s = live_motion(id)) (s->*call)(id, end);
+    return;
+  }
   const Pose p = motion_pose(end);
-  if (auto* s = live_motion(id)) s->straight_feed(id, p);
+  if (auto* s = live_motion(id)) (s->*call)(id, p);
 }
 
 void Output::arc_feed(canon::SegmentId, const canon::ArcFeed& arc) {
@@ -241,12 +246,7 @@ void Output::arc_feed(canon::SegmentId, const canon::ArcFeed& arc) {
   if (auto* s = live_motion(id)) s->arc_feed(id, a);
 }
 
-void Output::straight_probe(canon::SegmentId, const Pose& end) {
-  track_motion(end);
-  canon::SegmentId id;
-  const Pose p = motion_pose(end);
-  if (auto* s = live_motion(id)) s->straight_probe(id, p);
-}
+void Output::straight_probe(canon::SegmentId, const Pose& end) { straight_motion(&canon::Sink::straight_probe, end); }
 
 void Output::rigid_tap(canon::SegmentId, const Pose& end, double scale) {
   canon::SegmentId id;

@@ -33,6 +33,11 @@ class Output final : public canon::Sink {
     announced_ = false;
   }
   const canon::BlockOrigin& origin() const noexcept { return origin_; }
+  /// set_origin() for a caller that fills in the fields itself: returns the origin to fill.
+  canon::BlockOrigin& new_origin() noexcept {
+    announced_ = false;
+    return origin_;
+  }
   /// Motions emitted so far (the next segment id).
   std::uint64_t segments() const noexcept { return segments_; }
 
@@ -149,6 +154,8 @@ class Output final : public canon::Sink {
   Pose map_pose(const Pose& p) const noexcept;
   void map_arc(canon::ArcFeed& arc) const;
   Pose motion_pose(const Pose& p) const;
+  /// A straight motion to `end` (program coordinates) forwarded as (sink->*call)(id, pose).
+  void straight_motion(void (canon::Sink::*call)(canon::SegmentId, const Pose&), const Pose& end);
   bool transforming() const { return transform_ && state_ != nullptr && transform_->active(*state_); }
   bool enqueue(Queued&& q);
   void scale_queue(double k) noexcept;

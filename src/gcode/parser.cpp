@@ -2,6 +2,7 @@
 // Words, numbers, expressions and O-words of one block, read as LinuxCNC reads them.
 #include "parser.hpp"
 
+#include <array>
 #include <charconv>
 #include <cmath>
 #include <limits>
@@ -194,7 +195,9 @@ const char* m_group_name(int group) noexcept {
 
 }  // namespace
 
-int g_group(int code) noexcept {
+namespace {
+
+constexpr int g_group_by_switch(int code) noexcept {
   switch (code) {
     case 0: case 10: case 20: case 30: case 50: case 51: case 52: case 330: case 331:
     case 382: case 383: case 384: case 385: case 700: case 710: case 711: case 712: case 720:
@@ -219,6 +222,19 @@ int g_group(int code) noexcept {
     case 980: case 990: return kGroupRetract;
     default: return -1;
   }
+}
+
+// The switch above as a table (read once per G word).
+constexpr auto kGGroups = [] {
+  std::array<std::int8_t, 1000> t{};
+  for (int code = 0; code < 1000; ++code) t[static_cast<std::size_t>(code)] = static_cast<std::int8_t>(g_group_by_switch(code));
+  return t;
+}();
+
+}  // namespace
+
+int g_group(int code) noexcept {
+  return code >= 0 && code < 1000 ? kGGroups[static_cast<std::size_t>(code)] : -1;
 }
 
 std::string g_name(int code) {
@@ -406,50 +422,62 @@ void Parser::read_comment(Cursor& c, Block& b) {
 void Parser::read_word(Cursor& c, Block& b, char letter) {
   const int pos = static_cast<int>(c.pos);
   ++c.pos;
-  const bool seen = b.has(letter);
-  // P and Q count as repeated only when the earlier value is > -1 (LinuxCNC's rule).
-  if (seen && ((letter != 'p' && letter != 'q') || b.get(letter) > -1.0))
-    fail_at(pos, ErrorCode::RepeatedWord, "a second {} word on this line: give each word once",
-            static_cast<char>(letter - 32));
-  double v;
+  if (b.has(letter)) repeated_word(b, letter, pos);
   value_vacant_ = false;
-  switch (letter) {
-    case 'h':
-      v = integer_value(c, "H");
-      if (value_vacant_ && c.env.fanuc()) return;
-      if (v < -1) fail_at(pos, ErrorCode::HWordNegative, "H{}: the tool number of an offset is 0 or more", v);
-      break;
-    case 'l':
-      v = integer_value(c, "L");
-      if (value_vacant_ && c.env.fanuc()) return;
-      if (v < 0) fail_at(pos, ErrorCode::LWordNegative, "L{}: an L number cannot be negative", v);
-      break;
-    case 't':
-      v = integer_value(c, "T");
-      if (value_vacant_ && c.env.fanuc()) return;
-      if (v < 0) fail_at(pos, ErrorCode::ToolNegative, "T{}: tool numbers are 0 or more", v);
-      break;
-    default: {
-      const std::size_t start = c.pos;
-      v = real_value(c);
-      if (c.env.fanuc()) {
-        if (value_vacant_) return;   // Fanuc: a word whose value is a vacant variable is left out
-        const char first = c.text[start];
-        if ((is_digit(first) || first == '.' || first == '-' || first == '+') &&
-            c.text.substr(start, c.pos - start).find('.') != std::string_view::npos)
-          b.decimal |= 1u << (letter - 'a');
-      }
-      if (letter == 'f' && v < 0.0)
-        fail_at(pos, ErrorCode::FeedNegative, "F{}: a feed rate cannot be negative", v);
-      if (letter == 's' && v < 0.0)
-        fail_at(pos, ErrorCode::SpeedNegative, "S{}: a spindle speed cannot be negative", v);
-      if (letter == 'x' && c.env.lathe_diameter) v /= 2.0;
-      break;
+  double v;
+  constexpr std::uint32_t kIntegerLetters = (1u << ('h' - 'a')) | (1u << ('l' - 'a')) | (1u << ('t' - 'a'));
+  if ((kIntegerLetters >> (letter - 'a')) & 1u) {
+    v = integer_word(c, letter, pos);
+    if (value_vacant_ && c.env.fanuc()) return;
+  } else {
+    const std::size_t start = c.pos;
+    // A plain number (what real_value would pass on to real_number) read directly.
+    const char c0 = c.at(), c1 = c.at(1);
+    const bool plain = is_digit(c0) || c0 == '.' || ((c0 == '-' || c0 == '+') && (is_digit(c1) || c1 == '.'));
+    v = plain ? real_number(c) : real_value(c);
+    if (c.env.fanuc()) {
+      if (value_vacant_) return;   // Fanuc: a word whose value is a vacant variable is left out
+      note_decimal_point(c, b, letter, start);
     }
+    if (v < 0.0 && (letter == 'f' || letter == 's')) negative_rate(letter, v, pos);
+    if (letter == 'x' && c.env.lathe_diameter) v /= 2.0;
   }
   b.value[static_cast<std::size_t>(letter - 'a')] = v;
   b.at[static_cast<std::size_t>(letter - 'a')] = position_byte(static_cast<std::size_t>(pos));
   b.words |= 1u << (letter - 'a');
+}
+
+// A second word of a letter: P and Q count as repeated only when the earlier value is > -1
+// (LinuxCNC's rule), and are then overwritten.
+void Parser::repeated_word(const Block& b, char letter, int pos) {
+  if ((letter != 'p' && letter != 'q') || b.get(letter) > -1.0)
+    fail_at(pos, ErrorCode::RepeatedWord, "a second {} word on this line: give each word once",
+            static_cast<char>(letter - 32));
+}
+
+// H, L and T: integers with their own lower bounds.
+double Parser::integer_word(Cursor& c, char letter, int pos) {
+  const char name[2] = {static_cast<char>(letter - 32), '\0'};
+  const double v = integer_value(c, name);
+  if (value_vacant_ && c.env.fanuc()) return v;
+  if (letter == 'h' && v < -1) fail_at(pos, ErrorCode::HWordNegative, "H{}: the tool number of an offset is 0 or more", v);
+  if (letter == 'l' && v < 0) fail_at(pos, ErrorCode::LWordNegative, "L{}: an L number cannot be negative", v);
+  if (letter == 't' && v < 0) fail_at(pos, ErrorCode::ToolNegative, "T{}: tool numbers are 0 or more", v);
+  return v;
+}
+
+void Parser::negative_rate(char letter, double v, int pos) {
+  if (letter == 'f') fail_at(pos, ErrorCode::FeedNegative, "F{}: a feed rate cannot be negative", v);
+  fail_at(pos, ErrorCode::SpeedNegative, "S{}: a spindle speed cannot be negative", v);
+}
+
+// Fanuc: notes a number written with a decimal point (Block::decimal), which some words read
+// differently (G4 P counts milliseconds without one).
+void Parser::note_decimal_point(const Cursor& c, Block& b, char letter, std::size_t start) {
+  const char first = c.text[start];
+  if ((is_digit(first) || first == '.' || first == '-' || first == '+') &&
+      c.text.substr(start, c.pos - start).find('.') != std::string_view::npos)
+    b.decimal |= 1u << (letter - 'a');
 }
 
 // A plain code like "1", "17.1" or "64" read directly (code ten times the number), as the
@@ -629,7 +657,11 @@ namespace {
 // Reads digits from p (not past `limit`) into `value`, which wraps after 19 digits (callers
 // only use it for short numbers). Returns the end.
 const char* read_digits(const char* p, const char* limit, std::uint64_t& value) noexcept {
-  while (p < limit && is_digit(*p)) value = value * 10 + static_cast<std::uint64_t>(*p++ - '0');
+  for (; p < limit; ++p) {
+    const unsigned digit = static_cast<unsigned char>(*p) - unsigned{'0'};   // (wraps for bytes below '0')
+    if (digit > 9) break;
+    value = value * 10 + digit;
+  }
   return p;
 }
 
@@ -639,43 +671,51 @@ double Parser::real_number(Cursor& c) {
   const char* const text = c.text.data();
   const char* const limit = text + c.text.size();
   const char* const start = text + c.pos;
-  const char* p = start;
-  while (p < limit && (*p == '+' || *p == '-')) ++p;
-  const auto signs = p - start;
-  const char* const mant = p;
+  // One sign, taken without a branch (signs are as random as the coordinates); a second one
+  // leaves the mantissa without digits.
+  const bool sign = start < limit && (*start == '+' || *start == '-');
+  const bool negative = start < limit && *start == '-';
+  const char* const mant = start + sign;
   // Mantissa: digits, at most one '.', at least one digit. Accumulated on the way for the
-  // common short number (exact below 2^53 with at most 22 decimals: one correctly rounded
+  // common short number (exact below 2^53 with at most 15 digits: one correctly rounded
   // division gives the same double as any correct conversion).
   std::uint64_t value = 0;
-  const char* const int_end = read_digits(p, limit, value);
+  const char* const int_end = read_digits(mant, limit, value);
   const char* end = int_end;   // end of the mantissa
-  std::ptrdiff_t decimals = 0;
-  if (end < limit && *end == '.') {
-    end = read_digits(end + 1, limit, value);
-    decimals = end - (int_end + 1);
-  }
+  if (end < limit && *end == '.') end = read_digits(end + 1, limit, value);
+  const auto decimals = end - int_end - (end != int_end);   // (the point is not a digit)
   const auto digits = (int_end - mant) + decimals;
-  const char* after = end;
-  while (after < limit && (is_digit(*after) || *after == '.')) ++after;
-  c.pos = static_cast<std::size_t>(after - text);
-  if (signs > 1 || digits == 0 || end < after) bad_number(start, after, text, digits == 0 || signs > 1);
-  static constexpr double kPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8,  1e9,  1e10, 1e11,
-                                      1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+  if (digits == 0 || (end < limit && *end == '.')) bad_number(start, limit, text, false);
+  c.pos = static_cast<std::size_t>(end - text);
+  static constexpr double kPow10[] = {1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15};
   double v;
-  if (digits <= 15 && decimals <= 22) {
+  if (digits <= 15) {
     v = static_cast<double>(value) / kPow10[decimals];
   } else {   // `value` may have wrapped: let the library convert
     const auto [ptr, ec] = std::from_chars(mant, end, v);
-    if (ec != std::errc() || ptr != end) bad_number(start, after, text, true);
+    if (ec != std::errc() || ptr != end) bad_number(start, limit, text, true);
   }
-  return (signs == 1 && *start == '-') ? -v : v;
+  static constexpr double kSign[] = {1.0, -1.0};   // (exact: the same as negating)
+  return v * kSign[negative];
 }
 
-void Parser::bad_number(const char* start, const char* after, const char* text, bool malformed) {
+// Says why the text at `start` is not a number, reading it again as real_number did (which
+// keeps nothing it does not need on the way). `unreadable`: the digits could not be converted.
+void Parser::bad_number(const char* start, const char* limit, const char* text, bool unreadable) {
+  const char* p = start;
+  while (p < limit && (*p == '+' || *p == '-')) ++p;
+  const bool signs = p - start > 1;
+  std::size_t digits = 0;
+  for (; p < limit && is_digit(*p); ++p) ++digits;
+  if (p < limit && *p == '.') {
+    for (++p; p < limit && is_digit(*p); ++p) ++digits;
+  }
+  const char* after = p;
+  while (after < limit && (is_digit(*after) || *after == '.')) ++after;
   const std::string_view span(start, static_cast<std::size_t>(after - start));
   const auto at = static_cast<int>(start - text);
   if (span.empty()) fail_at(at, ErrorCode::BadNumber, "a number is missing here");
-  if (malformed)
+  if (unreadable || digits == 0 || signs)
     fail_at(at, ErrorCode::BadNumber,
             "'{}' is not a number (digits with at most one point, after at most one sign)", span);
   fail_at(at, ErrorCode::BadNumber, "'{}' is not a number: a number has at most one decimal point", span);

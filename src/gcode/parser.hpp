@@ -82,6 +82,10 @@ class Parser {
   static void misspelt_keyword(const Cursor& c, std::size_t keyword_at);
   void read_o_word(Cursor& c, Block& b);
   void read_word(Cursor& c, Block& b, char letter);
+  [[gnu::cold]] static void repeated_word(const Block& b, char letter, int pos);
+  double integer_word(Cursor& c, char letter, int pos);
+  [[noreturn, gnu::cold]] static void negative_rate(char letter, double v, int pos);
+  static void note_decimal_point(const Cursor& c, Block& b, char letter, std::size_t start);
   void read_g(Cursor& c, Block& b);
   void read_m(Cursor& c, Block& b);
   void read_comment(Cursor& c, Block& b);
@@ -91,8 +95,8 @@ class Parser {
   double real_value(Cursor& c);
   int integer_value(Cursor& c, const char* what);  ///< `what`: "L", "a parameter number" (for messages)
   static int plain_code(Cursor& c) noexcept;
-  double real_number(Cursor& c);
-  [[noreturn, gnu::cold]] static void bad_number(const char* start, const char* after, const char* text, bool malformed);
+  [[gnu::always_inline]] inline double real_number(Cursor& c);
+  [[noreturn, gnu::cold]] static void bad_number(const char* start, const char* limit, const char* text, bool unreadable);
   /// A bracketed expression; `open`: a Fanuc assignment's right-hand side, which runs to the
   /// end of the line or a comment without brackets.
   double expression(Cursor& c, bool open = false);

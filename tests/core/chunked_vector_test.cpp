@@ -17,3 +17,15 @@ TEST(ChunkedVector, StoresAcrossChunks) {
   v.clear();
   EXPECT_TRUE(v.empty());
 }
+
+TEST(ChunkedVector, AppendsRunsAndSlotsAcrossChunks) {
+  opencnc::ChunkedVector<int, 3> v;  // 8 elements per chunk: runs of 3 straddle chunk ends
+  int next = 0;
+  for (int run = 0; run < 20; ++run) {
+    v.append_slot() = next++;
+    v.append_with(3, [&](std::size_t i) { return next + static_cast<int>(i); });
+    next += 3;
+  }
+  ASSERT_EQ(v.size(), 80u);
+  for (std::size_t i = 0; i < v.size(); ++i) EXPECT_EQ(v[i], static_cast<int>(i));
+}

@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
+#include <cstring>
 #include <map>
 #include <random>
 #include <string>
@@ -84,6 +86,35 @@ TEST(Lexer, DropsBlanksLowersCaseAndKeepsComments) {
   EXPECT_EQ(error_of([] { normalize("G1 (open"); }), ErrorCode::UnclosedComment);
 }
 
+// Lines of random bytes (blanks, letters of both cases, bytes above 0x7F, comments) of every
+// length normalise exactly as a plain reading of the rules says.
+TEST(Lexer, RandomLinesNormaliseByTheRules) {
+  auto reference = [](std::string_view raw) {
+    std::string out;
+    bool comment = false;
+    for (std::size_t i = 0; i < raw.size(); ++i) {
+      const char c = raw[i];
+      if (!comment && c == ';') return out + std::string(raw.substr(i));
+      if (comment || c == '(') {
+        comment = c != ')';
+        out += c;
+      } else if (c != ' ' && c != '\t' && c != '\r') {
+        out += (c >= 'A' && c <= 'Z') ? static_cast<char>(c - 'A' + 'a') : c;
+      }
+    }
+    return out;
+  };
+  const std::string alphabet = "GXYZgxyz0123456789.-  \t\r@[]#\x7f\x80\xc3\xff\x1a";
+  std::mt19937_64 rng(11);
+  for (int i = 0; i < 20000; ++i) {
+    std::string raw;
+    const std::size_t length = rng() % 70;
+    for (std::size_t k = 0; k < length; ++k) raw += alphabet[rng() % alphabet.size()];
+    if (rng() % 4 == 0) raw.insert(rng() % (raw.size() + 1), rng() % 2 ? "(Com Ment)" : "; Tail ( X");
+    ASSERT_EQ(normalize(raw), reference(raw)) << raw;
+  }
+}
+
 TEST(Lexer, TrimsTheRawLineAsCStringReadingSeesIt) {
   EXPECT_EQ(trim_raw_line("G1 X1  \r"), "G1 X1");
   EXPECT_EQ(trim_raw_line(std::string_view("G1\0X2", 5)), "G1");
@@ -118,6 +149,28 @@ TEST_F(ParserTest, ReadsNumbersTheLinuxCncWay) {
   EXPECT_EQ(fails("x"), ErrorCode::MissingValue);
   EXPECT_EQ(fails("g1 xf1"), ErrorCode::MissingValue);  // X has no value; F1 follows
   EXPECT_EQ(fails("g1 xfoo"), ErrorCode::UnknownWord);
+}
+
+// Numbers of every length, wherever they stand on the line (the reader looks at eight bytes at
+// a time and must not look past the line), convert to exactly the double strtod gives.
+TEST_F(ParserTest, RandomNumbersReadBitIdenticalToStrtod) {
+  std::mt19937_64 rng(7);
+  auto digits = [&](std::size_t n) {
+    std::string d;
+    for (std::size_t i = 0; i < n; ++i) d += static_cast<char>('0' + rng() % 10);
+    return d;
+  };
+  for (int i = 0; i < 20000; ++i) {
+    std::string number = rng() % 2 ? "-" : (rng() % 4 ? "" : "+");
+    const std::size_t whole = rng() % 21, fraction = rng() % 21;
+    number += digits(whole);
+    if (fraction > 0 || rng() % 2) number += "." + digits(fraction);
+    if (whole + fraction == 0) number += "0";
+    const std::string tail = rng() % 2 ? "" : (rng() % 2 ? " y1" : " g1 f100.5 s12345678");
+    const Block b = parse("x" + number + tail);
+    const double expected = std::strtod(number.c_str(), nullptr);
+    ASSERT_EQ(std::memcmp(&expected, &b.value['x' - 'a'], sizeof(double)), 0) << number << tail;
+  }
 }
 
 TEST_F(ParserTest, StoresWordsAndRejectsRepeats) {

@@ -118,6 +118,11 @@ class Program {
   const Move& move(SegmentId id) const noexcept { return moves_[id]; }
   /// End pose of move `id` (axes outside the mask are 0).
   Pose end(SegmentId id) const noexcept;
+  /// One coordinate of end(id), without building the pose.
+  double end_coord(SegmentId id, Axis axis) const noexcept {
+    if (!axes_.has(axis)) return 0.0;
+    return coords_[static_cast<std::size_t>(id) * static_cast<std::size_t>(stride_) + axis_slots_[index(axis)]];
+  }
   /// Start pose of move `id`.
   Pose start_of(SegmentId id) const noexcept { return id == 0 ? start_ : end(id - 1); }
   const Pose& start() const noexcept { return start_; }
@@ -150,6 +155,9 @@ class Program {
   void set_start(const Pose& p) noexcept { start_ = p; }
   void set_sources(std::shared_ptr<const SourceMap> s) noexcept { sources_ = std::move(s); }
   SegmentId append(const Move& m, const Pose& end);
+  /// Appends a move ending at `end` and returns it for the caller to fill in (every member):
+  /// ProgramBuilder's way, which spares copying a Move it has just built.
+  Move& append(const Pose& end);
   std::uint32_t add_arc(const ArcGeometry& a);
   std::uint32_t add_feed(double value);
   void add_action(const Action& a) { actions_.push_back(a); }

@@ -31,7 +31,7 @@ class ProgramBuilder final : public Sink {
   Pose to_machine(const Pose& canonical) const noexcept;
 
   void begin_block(const BlockOrigin& origin) override { origin_ = origin; }
-  void use_length_units(Units u) override { units_ = u; }
+  void use_length_units(Units u) override;
   void set_g5x_offset(int index, const Pose& offset) override;
   void set_g92_offset(const Pose& offset) override;
   void set_xy_rotation(double degrees) override;
@@ -102,15 +102,20 @@ class ProgramBuilder final : public Sink {
   Action make(ActionKind kind, int index = 0, int index2 = 0, double value = 0) const;
   void simple(ActionKind kind, int index = 0, int index2 = 0) { program_.add_action(make(kind, index, index2)); }
   Pose offset_to_mm(const Pose& offset) const noexcept;
-  void append(MoveKind kind, SegmentId id, const Pose& machine_end, std::uint32_t param, std::uint8_t extra_flags = 0);
+  void to_machine(const Pose& canonical, Pose& machine) const noexcept;
+  void update_work_offset() noexcept;
+  /// Appends the move to position_ (the machine position it ends at, already set).
+  void append(MoveKind kind, SegmentId id, std::uint32_t param, std::uint8_t extra_flags = 0);
   std::uint32_t current_feed_index();
   std::uint8_t move_flags() const noexcept;
 
   Program program_;
   BlockOrigin origin_;
   Units units_ = Units::Mm;
+  double unit_scale_[kAxisCount] = {};   ///< mm per program unit by axis (1 for rotary axes)
   Plane plane_ = Plane::XY;
   Pose g5x_{}, g92_{}, tool_{};   ///< mm (converted when received, like LinuxCNC's canon)
+  Pose work_offset_{};            ///< g5x_ + tool_, added to every point
   double rotation_deg_ = 0, rot_cos_ = 1, rot_sin_ = 0;
   double feed_ = 0;
   FeedMode feed_mode_ = FeedMode::UnitsPerMinute;

@@ -132,6 +132,12 @@ class Rs274Printer final : public Sink {
       len_ += n;
     }
     void append(std::string_view s) { append(s.data(), s.size()); }
+    /// Room for `n` more characters at the end, to write there and then count with grow().
+    char* room(std::size_t n) {
+      if (len_ + n > cap_) reserve(2 * (len_ + n));
+      return data_.get() + len_;
+    }
+    void grow(std::size_t n) noexcept { len_ += n; }
     void append(const char* s) { append(s, std::strlen(s)); }
     void push_back(char c) {
       if (len_ + 1 > cap_) reserve(2 * (len_ + 1));
