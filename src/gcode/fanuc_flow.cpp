@@ -56,7 +56,7 @@ void Engine::fanuc_program_line() {
 
 void Engine::fanuc_control_flow() {
   switch (block_.o_type) {
-    case OWord::Goto: return fanuc_goto(static_cast<std::int64_t>(block_.o_value));
+    case OWord::Goto: return fanuc_goto(trunc_to_int(block_.o_value));
     case OWord::FanucWhile: return fanuc_while();
     case OWord::FanucEnd: return fanuc_end();
     case OWord::MacroCall: return fanuc_call(static_cast<std::uint32_t>(block_.o_value), block_.repeat, true);
@@ -181,7 +181,8 @@ void Engine::fanuc_call(std::uint32_t program, int count, bool macro) {
 // program continues after the G70 block.
 void Engine::fanuc_range() {
   const FanucFrame& caller = st_.frames.back().fanuc;
-  const auto first = static_cast<std::int64_t>(block_.args[0]), last = static_cast<std::int64_t>(block_.args[1]);
+  // Saturated: a number past the int range names no block and fails as a missing target.
+  const std::int64_t first = trunc_to_int(block_.args[0]), last = trunc_to_int(block_.args[1]);
   const SourcePosition from = fanuc_sequence(caller.body, first, "G70 P");
   const SourcePosition to = fanuc_sequence(caller.body, last, "G70 Q");
   if (to.file != from.file || to.offset < from.offset)

@@ -13,6 +13,7 @@
 
 #include "fanuc_codes.hpp"
 #include "lathe_errors.hpp"
+#include "numeric.hpp"
 #include "opencnc/gcode/lathe_roughing.hpp"
 #include "parser.hpp"
 
@@ -192,8 +193,8 @@ FanucRoughing::Cut FanucRoughing::cut_of(ExecContext& ctx, const Block& b, const
   if (b.has('i') || b.has('k'))
     ctx.error(ErrorCode::Unsupported, fmt::format("{} I/K (Haas's allowances of the last roughing pass) are not supported", name));
   Cut cut;
-  cut.first = static_cast<std::int64_t>(b.get('p'));
-  cut.last = static_cast<std::int64_t>(b.get('q'));
+  cut.first = trunc_to_int(b.get('p'));   // saturated: too large a number names no block
+  cut.last = trunc_to_int(b.get('q'));
   cut.depth = b.has('d') ? length_word(ctx, b, 'd') : set.rough_depth;
   if (b.has('d') && cut.depth <= 0)
     ctx.error(ErrorCode::FanucCycleWordValue, fmt::format("{} D: the depth of cut must be greater than zero", name));

@@ -460,6 +460,10 @@ TEST(FanucCodes, G70RunsTheProfileBlocksAndReturnsToItsStart) {
   EXPECT_EQ(r.state.modal.feed_rate, 0.0);   // M30 ended it; the profile ran at F0.1
   EXPECT_EQ(error_of("O1\nG21 G70 P10 Q30\nM30\nN10 G0 X1\n", fanuc(MachineKind::Lathe)), "fanuc.goto-target-missing");
   EXPECT_EQ(error_of("O1\nG21 G70 P10\nM30\nN10 G0 X1\n", fanuc(MachineKind::Lathe)), "fanuc.cycle-word-missing");
+  // Past the int range (found by the fuzzer as an undefined conversion): names no block.
+  EXPECT_EQ(error_of("O1\nG21 G70 P16666666666666666666666 Q10\nM30\nN10 G0 X1\n", fanuc(MachineKind::Lathe)),
+            "fanuc.goto-target-missing");
+  EXPECT_EQ(error_of("O1\nGOTO 99999999999999999999\nM30\n"), "gcode.not-an-integer");   // read as an int: refused
 }
 
 // --- G71/G72 stock removal (fanuc_roughing.cpp) ------------------------------------------------
