@@ -3,6 +3,7 @@
 // block by block; the passes come from lathe_roughing and run as the core's G0/G1/G2/G3.
 #include "opencnc/gcode/lathe_cycles.hpp"
 
+#include <fmt/format.h>
 #include <cmath>
 #include <memory>
 #include <string>
@@ -131,7 +132,7 @@ std::string sub_name(ExecContext& ctx, double q) {
   double whole = std::floor(v);
   if (v - whole > 0.9999) whole = std::ceil(v);
   else if (v - whole > 0.0001) ctx.error(ErrorCode::NotAnInteger, "Q (the profile subprogram) must be a whole number");
-  return std::to_string(static_cast<long long>(whole));
+  return fmt::format("{:.0f}", whole);   // exact for any size (no conversion to an integer type)
 }
 
 // The G7x words, read before the profile lends the block to the profile's lines.
