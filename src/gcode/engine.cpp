@@ -81,7 +81,10 @@ void Engine::open_text(std::string name, std::string text) {
 }
 
 SourceFile& Engine::source_at(std::uint32_t file) {
-  auto& f = files_.at(file);
+  // Lines of no open file: a jump from an MDI line (M99 P, GOTO) or a call it could not place.
+  if (file >= files_.size())
+    fail(ErrorCode::OwordInMdi, "this needs the lines of a program file, and an MDI line has none");
+  auto& f = files_[file];
   if (!f) {
     // A file left earlier (a subprogram's caller): open it again.
     f = SourceFile::open(sources_->file(file));

@@ -200,6 +200,21 @@ TEST(FanucPrograms, MdiCallsRunTheirProgramToTheEnd) {
   EXPECT_EQ(interp.execute_mdi("G1 X0", rec), RunStatus::Ok);        // the session goes on
 }
 
+TEST(FanucPrograms, MdiCalledReturnToASequenceNumberFails) {
+  // M99 P returns to a block of the caller; an MDI line has no blocks to return to (found by the
+  // fuzzer as a read past the open files).
+  TempDir dir;
+  dir.write("O0007.nc", "O0007\nG91 G1 X1\nG90\nM99 P5\n");
+  Options o = fanuc();
+  o.subroutine_path = {dir.str()};
+  Interpreter interp(o);
+  Recorder rec;
+  EXPECT_EQ(interp.execute_mdi("G21 F100", rec), RunStatus::Ok);
+  EXPECT_EQ(interp.execute_mdi("M98 P7", rec), RunStatus::Error);
+  EXPECT_EQ(interp.state().frames.size(), 1u);
+  EXPECT_EQ(interp.execute_mdi("G1 X0", rec), RunStatus::Ok);
+}
+
 TEST(FanucPrograms, MdiCallToASubprogramInNoFileFails) {
   // LinuxCNC's G70 Q (a profile subprogram) from Fanuc MDI, with no program open: an error
   // (found by the fuzzer as a read past the open files), and the session goes on.
