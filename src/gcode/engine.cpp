@@ -399,10 +399,6 @@ bool Engine::process_line() {
 // An MDI line that called a subprogram runs it to the end before returning.
 void Engine::finish_mdi_call() {
   while (st_.frames.size() > 1 && !failed_ && !st_.ended) {
-    // A call the MDI line could not place in a file (a LinuxCNC G70 profile sub in the Fanuc
-    // dialect, say) has nothing to read: an error, not a read past the open files.
-    if (st_.next.file >= files_.size())
-      fail(ErrorCode::OwordSubNotFound, "the subprogram this MDI line calls is in no file that can be read");
     in_mdi_ = false;
     process_line();
     in_mdi_ = true;
