@@ -128,7 +128,8 @@ int run(const RunOptions& o) {
   double run_start_s = -1;
   SessionHooks hooks;
   hooks.opened = [&](const config::MachineProfile& profile, const canon::Program& program) {
-    recorder.emplace(program, control::machine_limits(profile), profile.servo_period_s);
+    const plan::MachineLimits axes = control::axis_limits(profile);
+    recorder.emplace(program, control::machine_limits(profile), profile.servo_period_s, &axes);
     if (!o.trace.empty()) csv.emplace(o.trace, profile.axis_mask(), profile.servo_period_s);
     if (tty) bar.emplace(program);
   };

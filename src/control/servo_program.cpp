@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Servo, Auto and MDI runs: the interpolator's inputs and outputs, the machine side of the
-// program's markers (spindle, coolant, outputs, tool change, M66, M19), probing, run end.
+// program's markers (spindle, coolant, outputs, tool change, M66, M19, hand-axis waits), probing,
+// run end (and homing again after a part where the profile asks for it).
 #include <algorithm>
 #include <cmath>
 
@@ -88,10 +89,11 @@ void Servo::run_program() noexcept {
   interp_.tick(program_inputs(), tick_out_);
   for (int j = 0; j < config_.joint_count; ++j) {
     const int axis = config_.joints[static_cast<std::size_t>(j)].axis;
-    commanded_[axis] = tick_out_.position[axis];
+    if (!manual(j)) commanded_[axis] = tick_out_.position[axis];
   }
   apply_reports();
   check_probe();
+  check_hand_guard();
   if (tick_out_.state == traj::RunState::WaitingSync) {
     run_sync();
   } else {
@@ -108,7 +110,10 @@ void Servo::map_program_state() noexcept {
       wait_ = Wait::Dwell;
       break;
     case traj::RunState::WaitingSpindle:
-      wait_ = Wait::Spindle;
+      // A start an interlock rule holds back is a wait of its own (status: interlock_rule).
+      wait_ = spindle_direction_ != machine::SpindleDirection::Stopped && !spindle_running_ && spindle_blocked_
+                  ? Wait::Interlock
+                  : Wait::Spindle;
       break;
     case traj::RunState::Starved:
       wait_ = Wait::Starved;
@@ -219,6 +224,7 @@ void Servo::apply_action(const MachineAction& a) noexcept {
     case ActionCode::WaitInput:
     case ActionCode::SpindleOrient:
     case ActionCode::PalletShuttle:
+    case ActionCode::HandAxisWait:
     case ActionCode::Ignore:
       break;  // handshakes are Sync markers (run_sync); the rest needs nothing from the machine
   }
@@ -268,6 +274,18 @@ void Servo::begin_sync() noexcept {
       wait_ = Wait::Orient;
       if (!caps_.spindle_orient) sync_done_edge_ = true;
       break;
+    case ActionCode::HandAxisWait: {
+      const int j = joint_of(a.index);
+      hand_wait_.axis = static_cast<std::int8_t>(a.index);
+      hand_wait_.target = a.value;
+      hand_wait_.at_least = a.index2 > 0;
+      hand_wait_.tolerance = j >= 0 ? config_.joints[static_cast<std::size_t>(j)].hand_tolerance : 0.0;
+      hand_guard_ = false;
+      sync_step_ = j >= 0 ? SyncStep::HandAxis : SyncStep::None;
+      wait_ = Wait::HandAxis;
+      if (j < 0) sync_done_edge_ = true;
+      break;
+    }
     default:  // pallet shuttle and anything else without a handshake here
       sync_done_edge_ = true;
       break;
@@ -294,10 +312,42 @@ bool Servo::step_sync() noexcept {
       return step_wait_input();
     case SyncStep::Orient:
       return in_.spindle.orient_done;
+    case SyncStep::HandAxis:
+      if (!step_hand_wait()) return false;
+      hand_guard_ = true;  // from now on the run needs the axis to stay there
+      return true;
     case SyncStep::None:
       return true;
   }
   return true;
+}
+
+double Servo::hand_position(int axis) const noexcept {
+  const int j = joint_of(axis);
+  return j >= 0 ? position_[static_cast<std::size_t>(j)] + offset_[static_cast<std::size_t>(j)] : 0.0;
+}
+
+// The hand axis is where the wait asks: at or above target − tolerance (retracted), or within
+// the tolerance of the target.
+bool Servo::step_hand_wait() noexcept {
+  const double x = hand_position(hand_wait_.axis);
+  const double lo = hand_wait_.target - hand_wait_.tolerance, hi = hand_wait_.target + hand_wait_.tolerance;
+  return hand_wait_.at_least ? x >= lo : (x >= lo && x <= hi);
+}
+
+// While the automatic axes move after a hand-axis wait, the hand axis must stay where that wait
+// put it (the drill must not come down while the table travels): if it leaves, feed hold; resume
+// and cycle start are refused until it is back.
+void Servo::check_hand_guard() noexcept {
+  if (!hand_guard_ || aborting_ || hold_ || tick_out_.path_velocity == 0 || step_hand_wait()) return;
+  hold_ = true;
+  set_state(State::Held);
+  ServoEvent e;
+  e.kind = EventKind::HandAxisMoved;
+  e.axis = hand_wait_.axis;
+  e.value = hand_position(hand_wait_.axis);
+  e.run_id = run_id_;
+  emit(e);
 }
 
 // M66: L0 reads at once; L1 waits for a rising edge, L2 a falling one, L3 a high level, L4 a low
@@ -387,9 +437,21 @@ void Servo::end_run(RunEnd why) noexcept {
   hold_ = aborting_ = cycle_start_edge_ = abort_edge_ = sync_done_edge_ = false;
   sync_step_ = SyncStep::None;
   wait_ = Wait::None;
+  hand_wait_ = HandWait{};
+  hand_guard_ = false;
   reset_movers();
   if (why == RunEnd::Finished || why == RunEnd::Aborted || why == RunEnd::ProbeTripped)
     set_state(State::Idle);
+  // Back to the origin after every part where the profile asks (the seed's way of keeping lost
+  // steps from adding up): the joints home again, and the status tells how far the origin moved.
+  if (why == RunEnd::Finished && run_mode_ == Mode::Auto) {
+    std::uint16_t again = 0;
+    for (int j = 0; j < config_.joint_count; ++j) {
+      if (config_.joints[static_cast<std::size_t>(j)].home.return_after_program && !manual(j))
+        again = static_cast<std::uint16_t>(again | (1u << j));
+    }
+    if (again != 0) start_homing(again);
+  }
 }
 
 }  // namespace opencnc::control

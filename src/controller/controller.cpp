@@ -49,6 +49,10 @@ std::string refusal_text(Refusal r) {
       return "the program would cross a soft limit";
     case Refusal::StartMismatch:
       return "the motion does not start where the machine is";
+    case Refusal::Interlock:
+      return "an interlock rule of the machine forbids it now";
+    case Refusal::HandAxis:
+      return "the axis is moved by hand (or is not where the program needs it)";
   }
   return "refused";
 }
@@ -204,6 +208,11 @@ void Controller::on_event(const ServoEvent& e) {
       break;
     case EventKind::ProbeTripped:
       if (run_ && e.run_id == run_->id) run_->program_tripped_segment = e.segment;
+      break;
+    case EventKind::Interlock:
+    case EventKind::HandAxisMoved:
+      note(Severity::Warning, e.kind == EventKind::Interlock ? "control.interlock" : "control.hand-axis",
+           interlock_text(e));
       break;
     case EventKind::InputRead:
     case EventKind::StateChanged:
@@ -426,6 +435,22 @@ void Controller::note(Severity s, std::string code, std::string text) {
   notes_.push_back(Note{servo().tick, s, std::move(code), std::move(text)});
 }
 
+std::string Controller::interlock_text(const ServoEvent& e) const {
+  if (e.kind == EventKind::HandAxisMoved) {
+    const char axis = e.axis >= 0 && e.axis < kAxisCount ? kAxisLetters[static_cast<std::size_t>(e.axis)] : '?';
+    return fmt::format("{} left the position the program needs ({:.4f} mm) while the table moved: feed hold", axis,
+                       e.value);
+  }
+  const auto& texts = profile_.interlocks.rule_texts;
+  const std::string rule = e.action < texts.size() ? texts[e.action] : std::string("?");
+  const char* what = e.command == CommandKind::SpindleOff ? "stopped the spindle"
+                     : e.command == CommandKind::Coolant  ? "stopped the coolant"
+                     : e.command == CommandKind::FeedHold ? "held the motion"
+                     : e.command == CommandKind::JogStop  ? "stopped the jog"
+                                                          : "e-stopped the machine";
+  return fmt::format("interlock \"{}\" {}", rule, what);
+}
+
 std::string Controller::describe(const Fault& f) const {
   const char axis = f.axis >= 0 && f.axis < kAxisCount ? kAxisLetters[static_cast<std::size_t>(f.axis)] : '?';
   const JointConfig* jc = nullptr;
@@ -453,7 +478,12 @@ std::string Controller::describe(const Fault& f) const {
           "stopped on the path",
           f.value);
     case FaultKind::Homing:
-      return fmt::format("homing {} ran into a limit switch at {:.4f} {}", axis, f.value, unit);
+      return fmt::format("homing {} failed at {:.4f} {}: a limit switch, or the home sensor not on the "
+                         "deceleration dog",
+                         axis, f.value, unit);
+    case FaultKind::Stall:
+      return fmt::format("the {} stepper stalled at {:.4f} {}: steps were lost, home it again", axis, f.value,
+                         unit);
   }
   return "fault";
 }

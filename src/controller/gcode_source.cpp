@@ -59,11 +59,11 @@ std::shared_ptr<GcodeProgramSource> GcodeProgramSource::create(const config::Mac
     o.tool_table = std::make_shared<tools::ToolTable>(std::move(*table));
   }
   return std::shared_ptr<GcodeProgramSource>(
-      new GcodeProgramSource(std::move(o), profile.planner.default_tolerance));
+      new GcodeProgramSource(std::move(o), profile.planner.default_tolerance, hand_axes(profile)));
 }
 
-GcodeProgramSource::GcodeProgramSource(gcode::Options options, double default_tolerance)
-    : options_(std::move(options)), default_tolerance_(default_tolerance) {}
+GcodeProgramSource::GcodeProgramSource(gcode::Options options, double default_tolerance, HandAxes hand)
+    : options_(std::move(options)), default_tolerance_(default_tolerance), hand_(hand) {}
 
 // A rapid in machine coordinates to where the machine is, without output: the interpreter's
 // position follows (in its units and work coordinates). G90 for it, G91 back if it was on.
@@ -112,7 +112,7 @@ LoadedProgram GcodeProgramSource::load(const std::string& path, const Pose& star
   }
   for (const Diagnostic& d : interp.diagnostics().items()) out.diagnostics.add(d);
   if (status != gcode::RunStatus::Error && !out.diagnostics.has_errors())
-    out.program = std::make_shared<canon::Program>(builder.take());
+    out.program = hand_axis_program(std::make_shared<canon::Program>(builder.take()), hand_, out.diagnostics);
   return out;
 }
 
@@ -161,7 +161,7 @@ LoadedProgram GcodeProgramSource::mdi(std::string_view line, const Pose& start) 
   for (const Diagnostic& d : since(mdi_->diagnostics(), first)) out.diagnostics.add(d);
   if (status == gcode::RunStatus::Error || out.diagnostics.has_errors()) return out;
   mdi_end_ = builder.position();
-  out.program = std::make_shared<canon::Program>(builder.take());
+  out.program = hand_axis_program(std::make_shared<canon::Program>(builder.take()), hand_, out.diagnostics);
   return out;
 }
 

@@ -2,6 +2,7 @@
 // Run reports from trace samples (two trace checkers: commanded and actual), and the trace CSV.
 #include "opencnc/controller/run_recorder.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -42,19 +43,34 @@ const char* motion_name(traj::RunState s) {
 
 }  // namespace
 
-RunRecorder::RunRecorder(const canon::Program& program, const plan::MachineLimits& limits, double period_s)
+RunRecorder::RunRecorder(const canon::Program& program, const plan::MachineLimits& limits, double period_s,
+                         const plan::MachineLimits* output_limits)
     : limits_(limits),
       period_s_(period_s),
       commanded_(program, limits, period_s),
       actual_(program, limits, period_s),
+      output_(program, output_limits != nullptr ? *output_limits : limits, period_s),
+      start_(program.start()),
       last_(program.start()) {
   commanded_.start_at(program.start());
   actual_.start_at(program.start());
+  output_.start_at(program.start());
 }
 
 void RunRecorder::add(const TraceSample& s) {
+  // Before the run the drives' commands rested at the start plus the correction they had then.
+  if (r_.samples == 0) {
+    Pose rest = start_;
+    for (int i = 0; i < kAxisCount; ++i) rest[i] += s.output[i] - s.commanded[i];
+    output_.start_at(rest);
+  }
   commanded_.add(s.commanded, s.segment_first, s.segment_last);
   actual_.add(s.actual, s.segment_first, s.segment_last);
+  output_.add(s.output, s.segment_first, s.segment_last);
+  for (int i = 0; i < kAxisCount; ++i) {
+    if (limits_.axes.has(static_cast<Axis>(i)) && !is_rotary(static_cast<Axis>(i)))
+      r_.max_compensation_mm = std::max(r_.max_compensation_mm, std::fabs(s.output[i] - s.commanded[i]));
+  }
   for (int i = 0; i < kAxisCount; ++i) {
     if (!limits_.axes.has(static_cast<Axis>(i))) continue;
     const double e = std::fabs(s.following_error[i]);
@@ -81,7 +97,8 @@ RunReport RunRecorder::report() const {
   r.max_command_contour_error_mm = c.max_contour_error_mm;
   r.max_contour_error_mm = actual_.report().max_contour_error_mm;
   r.axes = c.axes;
-  r.limit_violations = c.limit_violations;
+  r.output_limit_violations = output_.report().limit_violations;
+  r.limit_violations = c.limit_violations + r.output_limit_violations;
   return r;
 }
 
@@ -92,7 +109,7 @@ TraceCsvWriter::TraceCsvWriter(const std::string& path, AxisMask axes, double pe
   for (int i = 0; i < kAxisCount; ++i) {
     if (!axes_.has(static_cast<Axis>(i))) continue;
     const char a = kAxisLetters[static_cast<std::size_t>(i)];
-    head += fmt::format(",cmd_{0},act_{0},ferr_{0}", a);
+    head += fmt::format(",cmd_{0},act_{0},ferr_{0},out_{0},phase_{0},level_{0}", a);
   }
   out_ << head << '\n';
 }
@@ -104,8 +121,9 @@ void TraceCsvWriter::add(const TraceSample& s) {
                  s.rapid ? 1 : 0, s.line, s.segment, s.path_velocity);
   for (int i = 0; i < kAxisCount; ++i) {
     if (!axes_.has(static_cast<Axis>(i))) continue;
-    fmt::format_to(std::back_inserter(row_), ",{:.6f},{:.6f},{:.6f}", s.commanded[i], s.actual[i],
-                   s.following_error[i]);
+    fmt::format_to(std::back_inserter(row_), ",{:.6f},{:.6f},{:.6f},{:.6f},{},{:.4f}", s.commanded[i], s.actual[i],
+                   s.following_error[i], s.output[i], to_string(s.homing_phase[static_cast<std::size_t>(i)]),
+                   s.home_level[i]);
   }
   row_ += '\n';
   out_ << row_;

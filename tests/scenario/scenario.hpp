@@ -102,7 +102,8 @@ class Scenario {
 
   /// The report of the samples recorded while a run was active (against `program`).
   RunReport report(const canon::Program& program) const {
-    RunRecorder r(program, machine_limits(profile_), profile_.servo_period_s);
+    const plan::MachineLimits axes = axis_limits(profile_);
+    RunRecorder r(program, machine_limits(profile_), profile_.servo_period_s, &axes);
     for (const TraceSample& s : samples_) {
       if (s.activity == Activity::Program) r.add(s);
     }

@@ -86,6 +86,10 @@ enum class ActionKind : std::uint8_t {
   Message,             ///< text
   Comment,             ///< text
   ProgramStop, OptionalStop, PalletShuttle, ProgramEnd,
+  /// Not from the interpreter: the controller's hand-axis pass (control::hand_axis_program) puts
+  /// it where a move of a hand-fed axis was. index = axis, value = machine position, index2 = +1:
+  /// at or beyond it in + (retracted), 0: at it.
+  HandAxisWait,
 };
 
 /// A non-motion action executed before move `before_move` (== move count: after the last).

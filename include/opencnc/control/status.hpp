@@ -8,11 +8,32 @@
 #include <type_traits>
 
 #include "opencnc/control/command.hpp"
+#include "opencnc/control/homing.hpp"
 #include "opencnc/core/axes.hpp"
 #include "opencnc/machine/machine_io.hpp"
 #include "opencnc/traj/interpolator.hpp"
 
 namespace opencnc::control {
+
+/// One joint's homing as the status shows it.
+struct HomingStatus {
+  HomingPhase phase = HomingPhase::Idle;
+  bool measured = false;     ///< DecelMidpoint: the edges below are from the last homing
+  double rising_edge = 0;    ///< interpolated edges, joint coordinates
+  double falling_edge = 0;
+  double width = 0;          ///< S = falling − rising
+  /// What the last homing moved the origin by: the machine position the old origin had in the
+  /// new one (≠ 0 when steps were lost or the reference drifted). 0 after the first homing.
+  double origin_shift = 0;
+};
+
+/// A program waiting for a hand-fed axis (Wait::HandAxis).
+struct HandWait {
+  std::int8_t axis = -1;  ///< Axis index, −1 = none
+  double target = 0;      ///< machine position
+  bool at_least = false;  ///< true: at or above target − tolerance (retracted); false: within it
+  double tolerance = 0;
+};
 
 struct JointStatus {
   double commanded = 0;        ///< machine coordinates
@@ -78,6 +99,15 @@ struct ServoStatus {
   bool probe_tripped = false;  ///< during the last probe move
   Pose probe_position{};       ///< actual position when it tripped
   double input_value = 0;      ///< the last M66 result (−1: timed out)
+
+  // Homing, compensation, hand axes, interlocks, handwheel (the drill retrofit).
+  std::array<HomingStatus, machine::kMaxJoints> homing{};
+  std::array<double, machine::kMaxJoints> compensation{};  ///< correction each joint gets now, units
+  HandWait hand_wait{};          ///< what a Wait::HandAxis waits for
+  std::int8_t interlock_rule = -1;  ///< the rule holding back the next step (Wait::Interlock)
+  std::uint32_t interlocks_true = 0;  ///< bit per rule whose condition holds
+  std::int8_t handwheel_axis = -1;    ///< the axis the handwheel moves (−1 = none)
+  double handwheel_step = 0;          ///< units per count
 };
 
 /// One servo period, for traces and run reports (docs/controller.md, "Trace CSV").
@@ -94,6 +124,9 @@ struct TraceSample {
   Pose commanded{};        ///< machine coordinates, every axis
   Pose actual{};           ///< feedback in machine coordinates
   Pose following_error{};  ///< per axis
+  Pose output{};           ///< what the drives were told, machine coordinates (with compensation)
+  std::array<HomingPhase, kAxisCount> homing_phase{};  ///< per axis
+  Pose home_level{};       ///< the home proximity sensor's level, per axis
 };
 
 static_assert(std::is_trivially_copyable_v<ServoStatus>);

@@ -170,6 +170,7 @@ class Controller {
   void finish(std::uint64_t id, Refusal refusal, std::string message = {}, Diagnostics diags = {});
   void note(Severity s, std::string code, std::string text);
   std::string describe(const Fault& f) const;
+  std::string interlock_text(const ServoEvent& e) const;
 
   config::MachineProfile profile_;
   ServoConfig servo_config_;

@@ -9,6 +9,7 @@
 
 #include "opencnc/canon/program_builder.hpp"
 #include "opencnc/config/machine_profile.hpp"
+#include "opencnc/controller/hand_axis.hpp"
 #include "opencnc/controller/program_source.hpp"
 #include "opencnc/gcode/interpreter.hpp"
 #include "opencnc/gcode/options.hpp"
@@ -21,6 +22,7 @@ namespace opencnc::control {
 /// has moved since the last one, the interpreter is told where the machine is (a G53 G0 to it,
 /// run without output), so that incremental moves and arcs start from there; in MDI an arc or
 /// canned-cycle motion mode is then cancelled (G80) rather than left for a line without G code.
+/// On a machine with hand-fed axes the programs go through the hand-axis pass (hand_axis.hpp).
 /// Non-real-time; one thread.
 class GcodeProgramSource final : public ProgramSource {
  public:
@@ -32,12 +34,13 @@ class GcodeProgramSource final : public ProgramSource {
   LoadedProgram mdi(std::string_view line, const Pose& start) override;
 
  private:
-  GcodeProgramSource(gcode::Options options, double default_tolerance);
+  GcodeProgramSource(gcode::Options options, double default_tolerance, HandAxes hand);
   bool place(gcode::Interpreter& interp, const Pose& machine, Diagnostics& diags) const;
   void replay_state(const gcode::InterpState& s, canon::ProgramBuilder& b) const;
 
   gcode::Options options_;
   double default_tolerance_;
+  HandAxes hand_;
   std::unique_ptr<gcode::Interpreter> mdi_;  ///< the MDI session: modal state lives on
   Pose mdi_end_{};                           ///< where the last MDI line left the machine
   bool mdi_placed_ = false;

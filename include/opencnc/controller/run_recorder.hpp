@@ -27,14 +27,22 @@ struct RunReport {
   double max_contour_error_mm = 0;                     ///< actual (feedback) position to the programmed path
   double max_command_contour_error_mm = 0;             ///< commanded position to the programmed path
   std::array<analysis::AxisStats, kAxisCount> axes{};  ///< of the commanded trajectory
-  std::uint64_t limit_violations = 0;  ///< commanded samples × axes × derivatives above a limit
+  /// Samples × axes × derivatives above a limit: of the commanded trajectory against the planning
+  /// limits, and of the drives' commands (with compensation) against the axes' own limits.
+  std::uint64_t limit_violations = 0;
+  std::uint64_t output_limit_violations = 0;  ///< the drives' commands' share of them
+  double max_compensation_mm = 0;             ///< largest |output − commanded| of a linear axis
   std::uint64_t samples = 0;
 };
 
 /// Accumulates the samples of one run. Non-real-time; the program must outlive the recorder.
 class RunRecorder {
  public:
-  RunRecorder(const canon::Program& program, const plan::MachineLimits& limits, double period_s);
+  /// `limits`: what the commanded trajectory was planned within (control::machine_limits);
+  /// `output_limits`: what the drives' commands must stay within (control::axis_limits; by default
+  /// the same).
+  RunRecorder(const canon::Program& program, const plan::MachineLimits& limits, double period_s,
+              const plan::MachineLimits* output_limits = nullptr);
 
   /// One period of the run (call for the run's samples only, in order).
   void add(const TraceSample& s);
@@ -45,6 +53,8 @@ class RunRecorder {
   double period_s_;
   analysis::TraceChecker commanded_;
   analysis::TraceChecker actual_;
+  analysis::TraceChecker output_;
+  Pose start_{};
   RunReport r_;
   Pose last_{};
   std::uint64_t first_move_ = 0, last_move_ = 0;
