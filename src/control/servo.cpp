@@ -399,7 +399,7 @@ void Servo::fill_status(ServoStatus& s) const noexcept {
   s.mist = out_.process.mist;
   s.tool = tool_;
   s.prepared_tool = prepared_tool_;
-  s.digital_out = digital_out_;
+  s.digital_out = out_.digital_out;  // what the machine is told (rules' outputs included)
   s.analog_out = analog_out_;
   s.mains_ok = in_.power.mains_ok;
   s.on_battery = in_.power.ups_on_battery;

@@ -85,7 +85,7 @@ struct ServoStatus {
   bool flood = false, mist = false;
   std::int32_t tool = 0;           ///< tool in the spindle
   std::int32_t prepared_tool = 0;  ///< tool brought to the change position
-  std::uint64_t digital_out = 0;
+  std::uint64_t digital_out = 0;  ///< as written to the machine (the interlock rules' outputs included)
   std::array<double, machine::kAnalogChannels> analog_out{};
   bool mains_ok = true, on_battery = false;
   double dc_link_v = 0;
