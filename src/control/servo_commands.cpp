@@ -154,6 +154,7 @@ Refusal Servo::start_run(const Command& c) noexcept {
   run_mode_ = c.run_mode;
   hold_ = cycle_start_edge_ = abort_edge_ = sync_done_edge_ = aborting_ = false;
   sync_step_ = SyncStep::None;
+  sync_seq_ = traj::kNoBlock;
   hand_wait_ = HandWait{};
   hand_guard_ = false;
   activity_ = Activity::Program;
@@ -166,7 +167,7 @@ Refusal Servo::cycle_start() noexcept {
   if (activity_ != Activity::Program || aborting_) return Refusal::NotApplicable;
   if (state_ != State::Held && state_ != State::Stopped) return Refusal::NotApplicable;
   if (motion_blocked_) return Refusal::Interlock;
-  if (hand_guard_ && !step_hand_wait()) return Refusal::HandAxis;
+  if (hand_guard_ && !hand_axis_there(true)) return Refusal::HandAxis;
   hold_ = false;
   cycle_start_edge_ = true;
   set_state(State::Running);
@@ -187,7 +188,7 @@ Refusal Servo::resume() noexcept {
   if (state_ == State::Stopped) return cycle_start();
   if (state_ != State::Held) return Refusal::NotApplicable;
   if (motion_blocked_) return Refusal::Interlock;
-  if (hand_guard_ && !step_hand_wait()) return Refusal::HandAxis;
+  if (hand_guard_ && !hand_axis_there(true)) return Refusal::HandAxis;
   hold_ = false;
   set_state(State::Running);
   return Refusal::None;

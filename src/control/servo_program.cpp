@@ -234,6 +234,8 @@ void Servo::apply_action(const MachineAction& a) noexcept {
 
 void Servo::run_sync() noexcept {
   if (sync_done_edge_) return;  // done; the interpolator sees it this tick
+  // Released last tick: the interpolator waits at the next marker, which shows from the next tick.
+  if (sync_step_ == SyncStep::None && tick_out_.block_seq == sync_seq_) return;
   if (sync_step_ == SyncStep::None) {
     begin_sync();
   } else if (step_sync()) {
@@ -246,6 +248,7 @@ void Servo::begin_sync() noexcept {
   // Reports passed in this very tick may still be queued behind a full event list: wait a tick.
   if (tick_out_.event_count == traj::kMaxTickEvents) return;
   const traj::MotionBlock* m = block(tick_out_.block_seq);
+  sync_seq_ = tick_out_.block_seq;
   MachineAction a;
   if (m == nullptr || !take_action(m->action, a)) {  // a probe move's end: nothing to do here
     wait_ = Wait::Probe;
@@ -278,7 +281,7 @@ void Servo::begin_sync() noexcept {
       const int j = joint_of(a.index);
       hand_wait_.axis = static_cast<std::int8_t>(a.index);
       hand_wait_.target = a.value;
-      hand_wait_.at_least = a.index2 > 0;
+      hand_wait_.retract = a.index2 > 0;
       hand_wait_.tolerance = j >= 0 ? config_.joints[static_cast<std::size_t>(j)].hand_tolerance : 0.0;
       hand_guard_ = false;
       sync_step_ = j >= 0 ? SyncStep::HandAxis : SyncStep::None;
@@ -313,7 +316,7 @@ bool Servo::step_sync() noexcept {
     case SyncStep::Orient:
       return in_.spindle.orient_done;
     case SyncStep::HandAxis:
-      if (!step_hand_wait()) return false;
+      if (!hand_axis_there(false)) return false;
       hand_guard_ = true;  // from now on the run needs the axis to stay there
       return true;
     case SyncStep::None:
@@ -327,19 +330,20 @@ double Servo::hand_position(int axis) const noexcept {
   return j >= 0 ? position_[static_cast<std::size_t>(j)] + offset_[static_cast<std::size_t>(j)] : 0.0;
 }
 
-// The hand axis is where the wait asks: at or above target − tolerance (retracted), or within
-// the tolerance of the target.
-bool Servo::step_hand_wait() noexcept {
+// The hand axis is where the wait asks (HandWait): a retract at or above target − tolerance; a
+// plunge reached at or below target + tolerance, and held within the tolerance of the target.
+bool Servo::hand_axis_there(bool holding) const noexcept {
   const double x = hand_position(hand_wait_.axis);
   const double lo = hand_wait_.target - hand_wait_.tolerance, hi = hand_wait_.target + hand_wait_.tolerance;
-  return hand_wait_.at_least ? x >= lo : (x >= lo && x <= hi);
+  if (hand_wait_.retract) return x >= lo;
+  return x <= hi && (!holding || x >= lo);
 }
 
 // While the automatic axes move after a hand-axis wait, the hand axis must stay where that wait
 // put it (the drill must not come down while the table travels): if it leaves, feed hold; resume
 // and cycle start are refused until it is back.
 void Servo::check_hand_guard() noexcept {
-  if (!hand_guard_ || aborting_ || hold_ || tick_out_.path_velocity == 0 || step_hand_wait()) return;
+  if (!hand_guard_ || aborting_ || hold_ || tick_out_.path_velocity == 0 || hand_axis_there(true)) return;
   hold_ = true;
   set_state(State::Held);
   ServoEvent e;

@@ -88,7 +88,7 @@ enum class ActionKind : std::uint8_t {
   ProgramStop, OptionalStop, PalletShuttle, ProgramEnd,
   /// Not from the interpreter: the controller's hand-axis pass (control::hand_axis_program) puts
   /// it where a move of a hand-fed axis was. index = axis, value = machine position, index2 = +1:
-  /// at or beyond it in + (retracted), 0: at it.
+  /// a retract (the move went in +), 0: a plunge.
   HandAxisWait,
 };
 

@@ -167,8 +167,8 @@ enum class ActionCode : std::uint8_t {
   PalletShuttle,
   Message,  ///< the controller shows the text (action index)
   Ignore,   ///< nothing for the machine (probe on/off, spindle mode)
-  /// Wait until the operator has brought hand axis `index` to `value`: index2 = +1 at or beyond
-  /// it in + (retracted), 0 within the axis' hand tolerance of it.
+  /// Wait until the operator has brought hand axis `index` to `value`: index2 = +1 a retract (at
+  /// or above it), 0 a plunge (down to it); see HandWait in status.hpp.
   HandAxisWait,
 };
 

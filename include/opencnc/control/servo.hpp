@@ -125,7 +125,7 @@ class Servo final : public Tickable {
   bool step_sync() noexcept;
   bool step_wait_input() noexcept;
   void check_probe() noexcept;
-  bool step_hand_wait() noexcept;
+  bool hand_axis_there(bool holding) const noexcept;
   void check_hand_guard() noexcept;
   double hand_position(int axis) const noexcept;
   void map_program_state() noexcept;
@@ -201,6 +201,9 @@ class Servo final : public Tickable {
   bool single_block_ = false, optional_stop_ = false;
   enum class SyncStep : std::uint8_t { None, ToolChanger, ManualTool, Input, Orient, HandAxis };
   SyncStep sync_step_ = SyncStep::None;
+  /// The Sync marker handled last: the tick after its release the commanded position may still
+  /// show it while the interpolator already waits at the next one.
+  std::uint64_t sync_seq_ = traj::kNoBlock;
   MachineAction sync_action_{};
   std::uint64_t sync_started_tick_ = 0;
   bool sync_input_before_ = false;

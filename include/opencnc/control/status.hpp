@@ -22,16 +22,20 @@ struct HomingStatus {
   double rising_edge = 0;    ///< interpolated edges, joint coordinates
   double falling_edge = 0;
   double width = 0;          ///< S = falling − rising
-  /// What the last homing moved the origin by: the machine position the old origin had in the
-  /// new one (≠ 0 when steps were lost or the reference drifted). 0 after the first homing.
+  /// How far the positions before the last homing were off: where the controller believed the
+  /// axis was less where that homing found it (+ = believed further in +). Lost steps, or a
+  /// reference that drifted, show here; 0 after the first homing.
   double origin_shift = 0;
 };
 
-/// A program waiting for a hand-fed axis (Wait::HandAxis).
+/// A program waiting for a hand-fed axis (Wait::HandAxis), and then holding it there while the
+/// table moves. A retract (the program moved the axis in +) is reached and held at or above
+/// target − tolerance; a plunge is reached at or below target + tolerance and then held within
+/// the tolerance of the target.
 struct HandWait {
   std::int8_t axis = -1;  ///< Axis index, −1 = none
   double target = 0;      ///< machine position
-  bool at_least = false;  ///< true: at or above target − tolerance (retracted); false: within it
+  bool retract = false;   ///< the move went in + (up, away from the work)
   double tolerance = 0;
 };
 

@@ -26,8 +26,9 @@ HandAxes hand_axes(const config::MachineProfile& profile);
 /// A copy of `program` whose moves never change a hand axis: each move keeps its number, its hand
 /// coordinates are those of the program's start (nothing commands them), and where it moved a
 /// hand axis to h a HandAxisWait action stands instead — the servo waits there until the operator
-/// has brought the axis to h (moving in +: at or above h less the axis' tolerance, a retract;
-/// moving in −: within the tolerance of h). A move that also moves driven axes is split by
+/// has brought the axis to h (moving in +, a retract: at or above h less the axis' tolerance;
+/// moving in −, a plunge: down to h plus the tolerance), and then holds the run while the axis
+/// leaves h (control::HandWait). A move that also moves driven axes is split by
 /// safety: a retract is waited for before the table moves, a plunge after it. Arcs, probes and
 /// spindle-synchronised moves cannot move a hand axis, and a target beyond the axis' soft limits
 /// is refused: both are errors at the move's line (code control.hand-axis). Without hand axes
