@@ -50,23 +50,20 @@ RunRecorder::RunRecorder(const canon::Program& program, const plan::MachineLimit
       commanded_(program, limits, period_s),
       actual_(program, limits, period_s),
       output_(program, output_limits != nullptr ? *output_limits : limits, period_s),
-      start_(program.start()),
       last_(program.start()) {
   commanded_.start_at(program.start());
   actual_.start_at(program.start());
-  output_.start_at(program.start());
 }
 
 void RunRecorder::add(const TraceSample& s) {
-  // Before the run the drives' commands rested at the start plus the correction they had then.
-  if (r_.samples == 0) {
-    Pose rest = start_;
-    for (int i = 0; i < kAxisCount; ++i) rest[i] += s.output[i] - s.commanded[i];
-    output_.start_at(rest);
-  }
+  // The compensation may still be taking something up when the run starts (the table switched
+  // on at homing a moment ago): the drives' commands are checked from the third period on, with
+  // the first two as their history.
+  if (r_.samples == 1) output_.start_moving(s.output, output_lead_);
+  if (r_.samples == 0) output_lead_ = s.output;
   commanded_.add(s.commanded, s.segment_first, s.segment_last);
   actual_.add(s.actual, s.segment_first, s.segment_last);
-  output_.add(s.output, s.segment_first, s.segment_last);
+  if (r_.samples >= 2) output_.add(s.output, s.segment_first, s.segment_last);
   for (int i = 0; i < kAxisCount; ++i) {
     if (limits_.axes.has(static_cast<Axis>(i)) && !is_rotary(static_cast<Axis>(i)))
       r_.max_compensation_mm = std::max(r_.max_compensation_mm, std::fabs(s.output[i] - s.commanded[i]));
@@ -98,6 +95,7 @@ RunReport RunRecorder::report() const {
   r.max_contour_error_mm = actual_.report().max_contour_error_mm;
   r.axes = c.axes;
   r.output_limit_violations = output_.report().limit_violations;
+  r.first_output_violation = output_.report().first_violation;
   r.limit_violations = c.limit_violations + r.output_limit_violations;
   return r;
 }

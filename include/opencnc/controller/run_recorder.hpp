@@ -31,6 +31,7 @@ struct RunReport {
   /// limits, and of the drives' commands (with compensation) against the axes' own limits.
   std::uint64_t limit_violations = 0;
   std::uint64_t output_limit_violations = 0;  ///< the drives' commands' share of them
+  analysis::Violation first_output_violation{};  ///< where to look when there are some
   double max_compensation_mm = 0;             ///< largest |output − commanded| of a linear axis
   std::uint64_t samples = 0;
 };
@@ -54,7 +55,7 @@ class RunRecorder {
   analysis::TraceChecker commanded_;
   analysis::TraceChecker actual_;
   analysis::TraceChecker output_;
-  Pose start_{};
+  Pose output_lead_{};  ///< the first sample's output, until the second starts the output check
   RunReport r_;
   Pose last_{};
   std::uint64_t first_move_ = 0, last_move_ = 0;
