@@ -74,6 +74,10 @@ void print_report(const control::RunReport& r, const config::MachineProfile& pro
   fmt::print("axis  max velocity  max acceleration  max jerk\n");
   for (const config::AxisProfile& a : profile.axes) {
     const analysis::AxisStats& s = r.axes[static_cast<std::size_t>(index(a.axis))];
+    if (a.manual()) {
+      fmt::print("  {}   moved by hand\n", letter(a.axis));
+      continue;
+    }
     fmt::print("  {}   {:10.3f}    {:12.1f}    {:12.0f}\n", letter(a.axis), s.max_velocity,
                s.max_acceleration, s.max_jerk);
   }

@@ -39,6 +39,7 @@ class Driver {
   virtual void advance() = 0;
   virtual control::Controller& controller() = 0;
   virtual control::ServoChannels& channels() = 0;
+  virtual machine::SimMachine& machine() = 0;
 };
 
 class VirtualDriver final : public Driver {
@@ -48,6 +49,7 @@ class VirtualDriver final : public Driver {
   void advance() override { rig_.step(); }
   control::Controller& controller() override { return rig_.controller(); }
   control::ServoChannels& channels() override { return rig_.channels(); }
+  machine::SimMachine& machine() override { return rig_.machine(); }
 
  private:
   control::SimRig rig_;
@@ -74,6 +76,7 @@ class RealtimeDriver final : public Driver {
   }
   control::Controller& controller() override { return *controller_; }
   control::ServoChannels& channels() override { return *channels_; }
+  machine::SimMachine& machine() override { return *sim_; }
 
  private:
   std::unique_ptr<control::ServoChannels> channels_;
@@ -106,6 +109,8 @@ void print_notes(control::Controller& c) {
   for (const control::Note& n : c.take_notes()) {
     if (n.severity == Severity::Note) {
       fmt::print(stderr, "message: {}\n", n.text);
+    } else if (n.severity == Severity::Warning) {
+      fmt::print(stderr, "warning: {}{}\n", n.text, n.code.empty() ? "" : fmt::format(" [{}]", n.code));
     } else {
       fmt::print(stderr, "error: {}{}\n", n.text, n.code.empty() ? "" : fmt::format(" [{}]", n.code));
     }
@@ -127,7 +132,19 @@ bool home_if_needed(Driver& d, const control::ServoConfig& sc) {
   return false;
 }
 
-/// Follows the run until it ends; continues program stops and manual tool changes at once.
+/// The operator of a simulated machine with hand-fed axes: brings one where the program waits for
+/// it (retracts quickly, feeds down at 2 mm/s). Only in virtual time it is instant enough to be
+/// "at once"; the machine's own hand model moves the axis.
+void bring_hand_axis(Driver& d, const control::ServoStatus& s) {
+  if (s.wait != control::Wait::HandAxis || s.hand_wait.axis < 0) return;
+  for (int j = 0; j < s.joint_count; ++j) {
+    if (d.controller().servo_config().joints[static_cast<std::size_t>(j)].axis == s.hand_wait.axis)
+      d.machine().set_hand_target(j, s.hand_wait.target, s.hand_wait.retract ? 40.0 : 2.0);
+  }
+}
+
+/// Follows the run until it ends; continues program stops and manual tool changes at once, and
+/// brings hand-fed axes where the program waits for them.
 void follow(Driver& d, const SessionHooks& hooks, SessionEnd& end) {
   const auto t0 = std::chrono::steady_clock::now();
   const std::uint64_t finished_before = d.controller().status().runs_finished;
@@ -143,6 +160,7 @@ void follow(Driver& d, const SessionHooks& hooks, SessionEnd& end) {
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (hooks.progress && (++n % 256 == 0)) hooks.progress(st, wall);
     print_notes(d.controller());
+    bring_hand_axis(d, st.servo);
     const bool waiting = st.servo.state == State::Stopped || st.servo.wait == control::Wait::ManualToolChange;
     if (waiting && !nudged) {
       d.controller().submit(Request::simple(st.servo.state == State::Stopped ? CommandKind::CycleStart

@@ -42,7 +42,8 @@ struct SessionHooks {
 };
 
 /// Runs `o.file` on the simulated machine of `o.machine`; prints problems to stderr. Program
-/// stops (M0, M1) and manual tool changes are continued at once (there is no operator).
+/// stops (M0, M1) and manual tool changes are continued at once, and a hand-fed axis is brought
+/// where the program waits for it (there is no operator).
 SessionEnd run_session(const SessionOptions& o, const SessionHooks& hooks);
 
 }  // namespace opencnc::cli

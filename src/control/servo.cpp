@@ -83,6 +83,7 @@ void Servo::start_up() noexcept {
     if (stepper_slot_[uj] >= 0)
       pulses_.set_position(stepper_slot_[uj], std::llround(feedback_[uj] * jc.counts_per_unit));
     reference_[uj] = feedback_[uj];
+    following_error_[uj] = 0;
   }
   handwheel_last_ = in_.handwheel_count;
   follow_feedback();

@@ -50,12 +50,26 @@ RunRecorder::RunRecorder(const canon::Program& program, const plan::MachineLimit
       commanded_(program, limits, period_s),
       actual_(program, limits, period_s),
       output_(program, output_limits != nullptr ? *output_limits : limits, period_s),
+      start_(program.start()),
       last_(program.start()) {
   commanded_.start_at(program.start());
   actual_.start_at(program.start());
 }
 
-void RunRecorder::add(const TraceSample& s) {
+// Axes nothing plans (hand-fed ones) move as the operator moves them: the path, its contour and
+// the limits are those of the planned axes, so the others are held at the program's start.
+TraceSample RunRecorder::planned_axes(const TraceSample& in) const {
+  TraceSample s = in;
+  for (int i = 0; i < kAxisCount; ++i) {
+    if (limits_.axes.has(static_cast<Axis>(i))) continue;
+    s.commanded[i] = s.actual[i] = s.output[i] = start_[i];
+    s.following_error[i] = 0;
+  }
+  return s;
+}
+
+void RunRecorder::add(const TraceSample& in) {
+  const TraceSample s = planned_axes(in);
   // The compensation may still be taking something up when the run starts (the table switched
   // on at homing a moment ago): the drives' commands are checked from the third period on, with
   // the first two as their history.

@@ -45,17 +45,20 @@ class RunRecorder {
   RunRecorder(const canon::Program& program, const plan::MachineLimits& limits, double period_s,
               const plan::MachineLimits* output_limits = nullptr);
 
-  /// One period of the run (call for the run's samples only, in order).
+  /// One period of the run (call for the run's samples only, in order). Axes outside `limits`
+  /// (hand-fed ones) do not count: they are taken to stay at the program's start.
   void add(const TraceSample& s);
   RunReport report() const;
 
  private:
+  TraceSample planned_axes(const TraceSample& s) const;
   plan::MachineLimits limits_;
   double period_s_;
   analysis::TraceChecker commanded_;
   analysis::TraceChecker actual_;
   analysis::TraceChecker output_;
   Pose output_lead_{};  ///< the first sample's output, until the second starts the output check
+  Pose start_{};
   RunReport r_;
   Pose last_{};
   std::uint64_t first_move_ = 0, last_move_ = 0;
