@@ -50,8 +50,11 @@ class Pass {
     return diags_.error_count() == errors_before_ ? out_ : nullptr;
   }
 
+  std::size_t waits() const { return waits_; }
+
  private:
   void emit(const std::vector<Action>& waits) {
+    waits_ += waits.size();
     for (Action a : waits) {
       a.before_move = static_cast<std::uint32_t>(out_->size());
       out_->add_action(a);
@@ -86,13 +89,15 @@ class Pass {
       if (from[i] == to[i]) continue;
       (hand_.axes.has(static_cast<Axis>(i)) ? hand : driven) = true;
     }
+    // An arc in a plane of a hand axis moves it even when it ends where it started.
+    const bool hand_plane = m.kind == MoveKind::Arc && in_plane(in_.arc(id).plane);
+    hand = hand || hand_plane;
     if (!hand) return w;
-    const bool hand_plane = m.kind == MoveKind::Arc && in_.arc(id).plane != canon::Plane::XY;
     if (m.kind == MoveKind::Arc || m.kind == MoveKind::Probe || m.kind == MoveKind::RigidTap ||
         (m.flags & canon::kSpindleSynced)) {
       fail(id, fmt::format("this {} moves the hand-fed axis {}: only straight moves of a hand axis can be "
                            "waited for",
-                           m.kind == MoveKind::Arc ? (hand_plane ? "arc" : "helix") : "move", axis_letters(from, to)));
+                           m.kind == MoveKind::Arc ? (hand_plane ? "arc" : "helix") : "move", axis_letters(from, to, id)));
       return w;
     }
     for (int i = 0; i < kAxisCount; ++i) {
@@ -118,10 +123,33 @@ class Pass {
     return w;
   }
 
-  std::string axis_letters(const Pose& from, const Pose& to) const {
+  /// Whether an arc in `plane` moves a hand axis along its circle.
+  bool in_plane(canon::Plane plane) const {
+    const auto has = [&](Axis a) { return hand_.axes.has(a); };
+    switch (plane) {
+      case canon::Plane::XY:
+        return has(Axis::X) || has(Axis::Y);
+      case canon::Plane::YZ:
+        return has(Axis::Y) || has(Axis::Z);
+      case canon::Plane::XZ:
+        return has(Axis::X) || has(Axis::Z);
+      case canon::Plane::UV:
+        return has(Axis::U) || has(Axis::V);
+      case canon::Plane::VW:
+        return has(Axis::V) || has(Axis::W);
+      case canon::Plane::UW:
+        return has(Axis::U) || has(Axis::W);
+    }
+    return false;
+  }
+
+  std::string axis_letters(const Pose& from, const Pose& to, canon::SegmentId id) const {
     std::string s;
     for (int i = 0; i < kAxisCount; ++i) {
-      if (hand_.axes.has(static_cast<Axis>(i)) && from[i] != to[i]) s += letter(static_cast<Axis>(i));
+      const auto a = static_cast<Axis>(i);
+      if (!hand_.axes.has(a)) continue;
+      const bool on_circle = in_.move(id).kind == MoveKind::Arc && in_plane(in_.arc(id).plane);
+      if (from[i] != to[i] || on_circle) s += letter(a);
     }
     return s;
   }
@@ -155,6 +183,7 @@ class Pass {
   std::unordered_map<std::uint32_t, std::uint32_t> texts_;
   double last_feed_ = -1;
   std::uint32_t feed_index_ = 0;
+  std::size_t waits_ = 0;
 };
 
 }  // namespace
@@ -173,13 +202,10 @@ HandAxes hand_axes(const config::MachineProfile& profile) {
 std::shared_ptr<const canon::Program> hand_axis_program(std::shared_ptr<const canon::Program> program,
                                                         const HandAxes& hand, Diagnostics& diags) {
   if (!program || !hand.any()) return program;
-  bool moves_hand = false;
-  for (canon::SegmentId id = 0; id < program->size() && !moves_hand; ++id) {
-    const Pose from = program->start_of(id), to = program->end(id);
-    for (int i = 0; i < kAxisCount; ++i) moves_hand = moves_hand || (hand.axes.has(static_cast<Axis>(i)) && from[i] != to[i]);
-  }
-  if (!moves_hand) return program;
-  return Pass(*program, hand, diags).run();
+  Pass pass(*program, hand, diags);
+  std::shared_ptr<canon::Program> out = pass.run();
+  if (out && pass.waits() == 0) return program;  // nothing of it was the operator's
+  return out;
 }
 
 }  // namespace opencnc::control
