@@ -95,19 +95,20 @@ void print_homing(const control::HomingSpread& h) {
   }
 }
 
-void print_positioning(const control::Positioning& before, const control::Positioning& after,
-                       const control::PositioningOptions& o) {
+void print_positioning(const control::Positioning& before, const control::Positioning& profile,
+                       const control::Positioning& after, const control::PositioningOptions& o) {
   fmt::print("positioning (ISO 230-2 style): targets every {} mm, {} approaches from each direction\n", o.interval,
              o.approaches);
   for (int i = 0; i < kAxisCount; ++i) {
     if (!before.axes.has(static_cast<Axis>(i))) continue;
     const auto ui = static_cast<std::size_t>(i);
     const auto line = [&](const char* what, const control::AxisPositioning& a) {
-      fmt::print("  {}  {:<6}  accuracy {:7.1f} µm   repeatability {:7.1f} µm   reversal {:7.1f} µm\n",
+      fmt::print("  {}  {:<7}  accuracy {:7.1f} µm   repeatability {:7.1f} µm   reversal {:7.1f} µm\n",
                  what[0] == 'b' ? letter(static_cast<Axis>(i)) : ' ', what, um(a.accuracy), um(a.repeatability),
                  um(a.reversal));
     };
     line("before", before.axis[ui]);
+    if (profile.axes.has(static_cast<Axis>(i))) line("profile", profile.axis[ui]);
     line("after", after.axis[ui]);
   }
 }
@@ -216,6 +217,14 @@ int calibrate(const CalibrateOptions& o) {
       po.axes = *axes;
       po.seed = o.seed;
       const control::Positioning before = control::measure_positioning(control::without_compensation(profile), po);
+      // With the profile's own tables too, where it has some: how good they are.
+      control::PositioningOptions with_own = po;
+      with_own.axes = AxisMask{};
+      for (const config::AxisProfile& a : profile.axes) {
+        if (po.axes.has(a.axis) && a.compensation.present) with_own.axes.set(a.axis);
+      }
+      const control::Positioning own =
+          with_own.axes.count() > 0 ? control::measure_positioning(profile, with_own) : control::Positioning{};
       config::MachineProfile compensated = profile;
       std::vector<std::pair<Axis, config::CompensationProfile>> tables;
       for (config::AxisProfile& a : compensated.axes) {
@@ -224,12 +233,14 @@ int calibrate(const CalibrateOptions& o) {
         tables.emplace_back(a.axis, a.compensation);
       }
       const control::Positioning after = control::measure_positioning(compensated, po);
-      if (!o.json) print_positioning(before, after, po);
+      if (!o.json) print_positioning(before, own, after, po);
       nlohmann::json& j = out["positioning"] = nlohmann::json::object();
       for (int i = 0; i < kAxisCount; ++i) {
         if (!before.axes.has(static_cast<Axis>(i))) continue;
         const auto ui = static_cast<std::size_t>(i);
-        j[axis_key(static_cast<Axis>(i))] = {{"before", figures(before.axis[ui])}, {"after", figures(after.axis[ui])}};
+        nlohmann::json& a = j[axis_key(static_cast<Axis>(i))];
+        a = {{"before", figures(before.axis[ui])}, {"after", figures(after.axis[ui])}};
+        if (own.axes.has(static_cast<Axis>(i))) a["profile"] = figures(own.axis[ui]);
       }
       if (o.write_table) {
         if (!write_tables(o, profile, tables, why)) {
