@@ -340,6 +340,8 @@ void Servo::fill_status(ServoStatus& s) const noexcept {
   s.run_active = activity_ == Activity::Program;
   s.motion = tick_out_.state;
   s.segment = tick_out_.segment;
+  s.segment_first = tick_out_.segment_first;
+  s.segment_offset = tick_out_.segment_offset;
   s.line = tick_out_.line;
   s.context = tick_out_.context;
   s.path_velocity = activity_ == Activity::Program ? tick_out_.path_velocity : 0.0;

@@ -91,6 +91,7 @@ void Servo::run_program() noexcept {
     commanded_[axis] = tick_out_.position[axis];
   }
   apply_reports();
+  report_sync_points();
   check_probe();
   if (tick_out_.state == traj::RunState::WaitingSync) {
     run_sync();
@@ -142,6 +143,7 @@ void Servo::map_program_state() noexcept {
 // marker asking is a marker that was passed without one (cannot happen with the planner's
 // markers, but a stale record must never block the run).
 bool Servo::take_action(std::uint32_t action, MachineAction& out) noexcept {
+  if (action == traj::kNoAction) return false;  // a marker of the planner's own (probe end)
   auto& ring = channels_->actions;
   while (ring.available() > 0 && ring.front().action < action) ring.pop();
   if (ring.available() == 0 || ring.front().action != action) return false;
@@ -155,6 +157,24 @@ void Servo::apply_reports() noexcept {
     if (ev.kind != traj::MarkerKind::Report) continue;
     MachineAction a;
     if (take_action(ev.action, a)) apply_action(a);
+  }
+}
+
+// The controller's interpreter waits at sync points (probe, M66, M6, program stops) until the
+// machine is past them: say so when the commanded position moves on from one.
+void Servo::report_sync_points() noexcept {
+  for (int e = 0; e < tick_out_.event_count; ++e) {
+    const traj::TickEvent& ev = tick_out_.events[static_cast<std::size_t>(e)];
+    const bool sync_point = ev.kind == traj::MarkerKind::Sync || ev.kind == traj::MarkerKind::ProgramStop ||
+                            ev.kind == traj::MarkerKind::OptionalStop;
+    if (!sync_point) continue;
+    ServoEvent out;
+    out.kind = EventKind::SyncPassed;
+    out.run_id = run_id_;
+    out.action = ev.action;
+    out.segment = tick_out_.segment;
+    out.value = input_value_;
+    emit(out);
   }
 }
 

@@ -64,6 +64,13 @@ class Lookahead {
     finished_ = true;
     dirty_ = true;
   }
+  /// After finish() and once every block has been published: blocks may come again, the first
+  /// from rest (a stream's sync point).
+  void reopen() noexcept {
+    finished_ = false;
+    prev_stop_ = true;
+    settled_ = pinned_ = 0;
+  }
 
   std::size_t size() const noexcept { return window_.size(); }
   bool empty() const noexcept { return window_.empty(); }

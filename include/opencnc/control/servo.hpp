@@ -99,6 +99,7 @@ class Servo final : public Tickable {
   void run_program() noexcept;
   traj::TickInput program_inputs() noexcept;
   void apply_reports() noexcept;
+  void report_sync_points() noexcept;
   void apply_action(const MachineAction& a) noexcept;
   bool take_action(std::uint32_t action, MachineAction& out) noexcept;
   void run_sync() noexcept;
