@@ -380,9 +380,13 @@ void Servo::check_probe() noexcept {
   }
   if (!in_.probe || probe_tripped_) return;
   probe_tripped_ = true;
+  // Where the probe tripped: the machine's latch of the edge when it has one, else the middle of
+  // the last two samples (the edge lies between them: half the error of either).
+  const bool latched = probe_edge_latched_;
   for (int j = 0; j < config_.joint_count; ++j) {
     const auto uj = static_cast<std::size_t>(j);
-    probe_position_[config_.joints[uj].axis] = feedback_[uj] + offset_[uj];
+    const double at = latched ? in_.probe_latch[uj] : 0.5 * (previous_feedback_[uj] + feedback_[uj]);
+    probe_position_[config_.joints[uj].axis] = at + offset_[uj];
   }
   abort_edge_ = aborting_ = true;
   ServoEvent e;

@@ -338,16 +338,17 @@ class Scan {
   bool ok_ = true, done_ = false;
 };
 
-/// Whether move k is the same in two scans: kind, line, end point, feed and (arcs) geometry.
+/// Whether move k is the same in two scans: kind, line, end points, feed and (arcs) geometry.
 bool same_move(const canon::Program& a, const canon::Program& b, canon::SegmentId k) {
   const canon::Move& ma = a.move(k);
   const canon::Move& mb = b.move(k);
   if (ma.kind != mb.kind || ma.line != mb.line || ma.context != mb.context || ma.flags != mb.flags) return false;
-  if (a.end(k) != b.end(k) || a.feed(k) != b.feed(k)) return false;
+  // The start too: a move from an assumed point to a certain one still crosses what lies between.
+  if (a.start_of(k) != b.start_of(k) || a.end(k) != b.end(k) || a.feed(k) != b.feed(k)) return false;
   if (ma.kind != canon::MoveKind::Arc) return true;
   const canon::ArcGeometry& ga = a.arc(k);
   const canon::ArcGeometry& gb = b.arc(k);
-  return a.start_of(k) == b.start_of(k) && ga.turns == gb.turns && ga.plane == gb.plane &&
+  return ga.turns == gb.turns && ga.plane == gb.plane &&
          std::equal(std::begin(ga.center), std::end(ga.center), std::begin(gb.center)) &&
          std::equal(std::begin(ga.normal), std::end(ga.normal), std::begin(gb.normal));
 }
@@ -383,8 +384,7 @@ class PreflightRun {
                                                                    p.move(checked_).line);
       bool assumed = false;
       if (other != nullptr) {
-        assumed = diverged_ || checked_ >= other->program().size() ||
-                  !same_move(p, other->program(), checked_);
+        assumed = diverged_ || checked_ >= other->program().size() || !same_move(p, other->program(), checked_);
         if (assumed && checked_ >= other->program().size()) diverged_ = true;
       }
       check_move(p, checked_, assumed);

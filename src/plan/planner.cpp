@@ -443,7 +443,7 @@ PlanStatus Planner::pump(traj::BlockQueue& queue) {
   detail::Lookahead& w = *m.window;
   const std::size_t max_window = 2 * m.config.lookahead_moves + 16;
   for (;;) {
-    while (queue.free_slots() > 0 && w.publishable() > 0) m.publish_front(queue);
+    while (queue.free_slots() > 0 && w.publishable() > 0 && w.front_link_decided()) m.publish_front(queue);
     if (queue.free_slots() == 0) return PlanStatus::Working;
     if (m.reading_done && w.empty()) return PlanStatus::Finished;
     if (m.reading_done) continue;  // finish() made everything publishable

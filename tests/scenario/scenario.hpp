@@ -68,11 +68,10 @@ class SampleKeeper final : public ControllerObserver {
 
 class Scenario {
  public:
-  explicit Scenario(const config::MachineProfile& profile) : profile_(profile) {
-    Diagnostics d;
-    auto source = GcodeProgramSource::create(profile, d);
-    EXPECT_TRUE(source != nullptr);
-    rig_ = std::make_unique<SimRig>(profile, source);
+  explicit Scenario(const config::MachineProfile& profile) : Scenario(profile, make_source(profile)) {}
+  /// With a program source of the test's own (a tool table in memory, code modules).
+  Scenario(const config::MachineProfile& profile, std::shared_ptr<ProgramSource> source) : profile_(profile) {
+    rig_ = std::make_unique<SimRig>(profile, std::move(source));
     keeper_ = std::make_shared<SampleKeeper>(machine_limits(profile), profile.servo_period_s);
     rig_->controller().attach(keeper_, ObserverOptions{0, true});
     rig_->step();  // the observer is attached from here on
@@ -134,6 +133,13 @@ class Scenario {
   const std::string& message() const { return last_message_; }
 
  private:
+  static std::shared_ptr<ProgramSource> make_source(const config::MachineProfile& profile) {
+    Diagnostics d;
+    auto source = GcodeProgramSource::create(profile, d);
+    EXPECT_TRUE(source != nullptr);
+    return source;
+  }
+
   config::MachineProfile profile_;
   std::unique_ptr<SimRig> rig_;
   std::shared_ptr<SampleKeeper> keeper_;
