@@ -104,7 +104,8 @@ Controller::Controller(const config::MachineProfile& profile, ServoChannels& cha
       planner_config_(control::planner_config(profile)),
       channels_(&channels),
       source_(std::move(source)),
-      check_(std::make_unique<MachineMoveCheck>(servo_config_, limits_)) {}
+      check_(std::make_unique<MachineMoveCheck>(servo_config_, limits_)),
+      location_every_(static_cast<std::uint64_t>(kLocationRefreshS / servo_config_.period_s) + 1) {}
 
 Controller::~Controller() = default;
 
@@ -390,6 +391,7 @@ void Controller::open_file(std::uint64_t id, const std::string& path) {
   open_at_ = servo().commanded;
   open_block_delete_ = block_delete_;
   open_stamp_ = file_stamp(path);
+  open_version_ = source_->version();
   ControllerEvent e;
   e.kind = ControllerEventKind::ProgramOpened;
   e.text = path;
@@ -435,12 +437,14 @@ void Controller::cycle_start(std::uint64_t id, const Request& r) {
   if (!op) return finish(id, Refusal::NoProgram, refusal_text(Refusal::NoProgram));
   if (!ready_for_job(id, Mode::Auto, "programs")) return;
   if (op->program) {
-    start_job(id, JobKind::Program, op->name, Mode::Auto, canon_stream(op->program, servo().commanded));
+    const bool same_start = op->program->start() == servo().commanded;
+    start_job(id, JobKind::Program, op->name, Mode::Auto, canon_stream(op->program, servo().commanded), same_start);
     return;
   }
   // The preflight holds for the position, the switches and the file it was made with: anything
   // else, and the program is checked again before it may start.
-  if (servo().commanded != open_at_ || block_delete_ != open_block_delete_ || file_stamp(op->path) != open_stamp_) {
+  if (servo().commanded != open_at_ || block_delete_ != open_block_delete_ || file_stamp(op->path) != open_stamp_ ||
+      source_->version() != open_version_) {
     Preflight pf = preflight_file(op->path);
     if (!pf.ok())
       return finish(id, program_refusal(pf.diagnostics), refusal_text(program_refusal(pf.diagnostics)),
@@ -448,10 +452,13 @@ void Controller::cycle_start(std::uint64_t id, const Request& r) {
     open_at_ = servo().commanded;
     open_block_delete_ = block_delete_;
     open_stamp_ = file_stamp(op->path);
+    open_version_ = source_->version();
     std::lock_guard lock(out_mutex_);
     if (open_) open_->preflight = std::move(pf);
   }
-  start_job(id, JobKind::Program, op->name, Mode::Auto, source_->execute(op->path, servo().commanded, {block_delete_}));
+  // Up to its first sync point the program is the one the preflight checked.
+  start_job(id, JobKind::Program, op->name, Mode::Auto, source_->execute(op->path, servo().commanded, {block_delete_}),
+            true);
 }
 
 void Controller::run_auxiliary(std::uint64_t id, const requests::RunAuxiliary& r) {
@@ -462,12 +469,14 @@ void Controller::run_auxiliary(std::uint64_t id, const requests::RunAuxiliary& r
     if (!pf.ok())
       return finish(id, program_refusal(pf.diagnostics), refusal_text(program_refusal(pf.diagnostics)),
                     pf.diagnostics);
-    return start_job(id, JobKind::Auxiliary, name, Mode::Auto, canon_stream(r.program, servo().commanded));
+    const bool same_start = r.program->start() == servo().commanded;
+    return start_job(id, JobKind::Auxiliary, name, Mode::Auto, canon_stream(r.program, servo().commanded), same_start);
   }
   Preflight pf = preflight_file(r.path);
   if (!pf.ok())
     return finish(id, program_refusal(pf.diagnostics), refusal_text(program_refusal(pf.diagnostics)), pf.diagnostics);
-  start_job(id, JobKind::Auxiliary, name, Mode::Auto, source_->execute(r.path, servo().commanded, {block_delete_}));
+  start_job(id, JobKind::Auxiliary, name, Mode::Auto, source_->execute(r.path, servo().commanded, {block_delete_}),
+            true);
 }
 
 void Controller::feature(std::uint64_t id, const requests::Feature& r) {
@@ -489,7 +498,7 @@ void Controller::feature(std::uint64_t id, const requests::Feature& r) {
 // --- jobs ------------------------------------------------------------------------------------
 
 void Controller::start_job(std::uint64_t id, JobKind kind, std::string name, Mode mode,
-                           std::unique_ptr<ProgramStream> stream) {
+                           std::unique_ptr<ProgramStream> stream, bool prechecked) {
   detail::JobHost host;
   host.channels = channels_;
   host.servo = &servo_config_;
@@ -498,6 +507,7 @@ void Controller::start_job(std::uint64_t id, JobKind kind, std::string name, Mod
   host.check = check_.get();
   host.readahead_moves = static_cast<std::size_t>(std::max(1, profile_.interpreter.readahead_moves));
   host.readahead_s = profile_.interpreter.readahead_s;
+  host.prechecked = prechecked;
   host.next_command_id = [this] { return new_id(); };
   host.log = [this](ControllerEvent e) { log(std::move(e)); };
   host.send = [this](const Command& c) { return channels_->commands.try_push(c); };
@@ -541,7 +551,7 @@ void Controller::end_job() {
 void Controller::publish() {
   std::lock_guard lock(out_mutex_);
   ControllerStatus& p = published_;
-  p.program_name = open_ ? open_->name : std::string();
+  if (open_ ? p.program_name != open_->name : !p.program_name.empty()) p.program_name = open_ ? open_->name : "";
   p.program_moves = open_ ? open_->preflight.summary.moves : 0;
   p.program_length_mm = open_ ? open_->preflight.summary.path_length_mm : 0;
   p.run_active = job_ != nullptr;
@@ -566,9 +576,16 @@ void Controller::publish() {
     p.progress = 0;
     p.sync_wait = SyncKind::None;
   }
-  p.wait_text = wait_text();
-  if (s.fault.tick != described_fault_tick_ || s.fault.kind == FaultKind::None) {
-    p.fault_text = s.fault.kind == FaultKind::None ? std::string() : describe(s.fault);
+  // What the run waits for, in words: only when one of the things it is made of changed.
+  const WaitKey key{s.state, s.wait, s.stop_reason, p.sync_wait, s.line, s.context, job_ != nullptr};
+  if (!(key == wait_key_)) {
+    p.wait_text = wait_text();
+    wait_key_ = key;
+  }
+  if (s.fault.kind == FaultKind::None) {
+    if (!p.fault_text.empty()) p.fault_text.clear();
+  } else if (s.fault.tick != described_fault_tick_) {
+    p.fault_text = describe(s.fault);
     described_fault_tick_ = s.fault.tick;
   }
   p.runs_finished = runs_finished_;
@@ -585,9 +602,8 @@ void Controller::update_locations() {
     located_line_ = s.line;
     located_run_ = s.run_id;
   }
-  const auto every = static_cast<std::uint64_t>(kLocationRefreshS / servo_config_.period_s) + 1;
   const bool waiting = p.sync_wait != SyncKind::None;
-  if (interpreter_seen_ == ~std::uint64_t{0} || s.tick >= interpreter_seen_ + every || waiting) {
+  if (interpreter_seen_ == ~std::uint64_t{0} || s.tick >= interpreter_seen_ + location_every_ || waiting) {
     p.interpreter = job_->interpreter_location();
     p.sync_location = waiting ? job_->sync_location() : SourceLocation{};
     interpreter_seen_ = s.tick;

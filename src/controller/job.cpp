@@ -32,7 +32,13 @@ SyncAnswer at_rest(SyncKind kind, const ServoStatus& s) {
 
 Job::Job(JobKind kind, std::uint32_t id, std::string name, Mode mode, std::unique_ptr<ProgramStream> stream,
          JobHost host)
-    : kind_(kind), id_(id), name_(std::move(name)), mode_(mode), stream_(std::move(stream)), host_(std::move(host)) {}
+    : kind_(kind),
+      id_(id),
+      name_(std::move(name)),
+      mode_(mode),
+      stream_(std::move(stream)),
+      host_(std::move(host)),
+      prechecked_(host_.prechecked) {}
 
 Job::~Job() = default;
 
@@ -60,6 +66,7 @@ bool Job::begin_leg(std::uint64_t command_id, Diagnostics& diags) {
   }
   leg_.time_to.push_back(0.0);  // the time to the end of "move −1": the start
   leg_.time_first = 0;
+  released_to_ = 0;
   waiting_ = false;
   const ServoStatus& s = host_.channels->status.front();
   read_ahead(s);
@@ -130,7 +137,7 @@ void Job::check_new_moves() {
   const canon::Program& p = stream_->program();
   Diagnostics d;
   while (!failing_ && leg_.checked < p.size()) {
-    if (!host_.check->check(p, leg_.checked, d)) {
+    if (!prechecked_ && !host_.check->check(p, leg_.checked, d)) {
       fail(d);
       break;
     }
@@ -181,6 +188,7 @@ std::uint32_t Job::sync_action() const {
 
 void Job::enter_sync() {
   const SyncRequest& r = stream_->sync_request();
+  prechecked_ = false;  // what follows may rest on the machine's answer
   const std::uint32_t action = sync_action();
   if (r.kind != SyncKind::Probe && action == traj::kNoAction) {
     // M61 names the tool in the spindle: nothing for the machine to do, nothing to wait for.
@@ -350,7 +358,9 @@ void Job::release(const ServoStatus& s) {
   std::size_t move = std::min(leg_.checked, leg_.planner->oldest_move_needed());
   if (s.run_id == leg_.run_id) move = std::min(move, static_cast<std::size_t>(s.segment_first));
   else move = 0;  // the run has not started yet
-  if (move <= p.first_held_move() + 1) return;
+  // Whole chunks are freed: looking every few hundred moves is enough.
+  if (move < released_to_ + 256) return;
+  released_to_ = move;
   std::size_t action = std::min<std::size_t>(leg_.next_action, leg_.planner->oldest_action_needed());
   // Messages are looked up when the servo passes them: keep the actions of the moves kept.
   std::size_t lo = p.first_held_action(), hi = action;

@@ -30,6 +30,11 @@ struct JobHost {
   MoveCheck* check = nullptr;
   std::size_t readahead_moves = 2000;
   double readahead_s = 5;
+  /// The preflight checked this very program from this very start with these very tools: its
+  /// moves up to the first sync point are the ones it checked (interpretation is deterministic),
+  /// so they are not checked twice. After a sync point the real answers may differ from the
+  /// assumed ones: every move is checked again.
+  bool prechecked = false;
   std::function<std::uint64_t()> next_command_id;
   std::function<void(ControllerEvent)> log;
   /// Sends a servo command; false when the queue is full.
@@ -119,6 +124,8 @@ class Job {
   std::uint32_t waiting_action_ = 0;   ///< the action of that sync point in the leg
   double input_value_ = 0;             ///< the last M66 result of the run
   bool failing_ = false;               ///< an error: stop at the end of the good moves, then abort
+  bool prechecked_ = false;            ///< JobHost::prechecked, until the first sync point
+  std::size_t released_to_ = 0;        ///< the move release() last freed up to
   bool abort_sent_ = false;
   bool ended_ = false;
   JobEnd end_ = JobEnd::Finished;

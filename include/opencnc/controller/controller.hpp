@@ -111,7 +111,8 @@ class Controller final : private FeatureHost {
   bool ready_for_job(std::uint64_t id, Mode mode, const char* what);
   Preflight preflight_file(const std::string& path);
   Preflight preflight_canon(const canon::Program& program);
-  void start_job(std::uint64_t id, JobKind kind, std::string name, Mode mode, std::unique_ptr<ProgramStream> stream);
+  void start_job(std::uint64_t id, JobKind kind, std::string name, Mode mode, std::unique_ptr<ProgramStream> stream,
+                 bool prechecked = false);
   void end_job();
   void forward(std::uint64_t id, const Command& c);
   void finish(std::uint64_t id, Refusal refusal, std::string message = {}, Diagnostics diags = {});
@@ -157,6 +158,7 @@ class Controller final : private FeatureHost {
   Pose open_at_{};               ///< where the machine stood when the open program was checked
   bool open_block_delete_ = false;
   std::string open_stamp_;       ///< the open file's size and change time when it was checked
+  std::uint64_t open_version_ = 0;  ///< the source's version when it was checked
   bool block_delete_ = false;
   std::unique_ptr<detail::Job> job_;
   std::unique_ptr<detail::Job> retired_;  ///< the job that ended last (its last samples may come)
@@ -166,6 +168,17 @@ class Controller final : private FeatureHost {
   // Status details that cost strings, refreshed when they change.
   std::uint32_t located_context_ = ~0u, located_line_ = ~0u, located_run_ = ~0u;
   std::uint64_t interpreter_seen_ = ~std::uint64_t{0};
+  std::uint64_t location_every_ = 1;  ///< servo periods between refreshes of the interpreter's place
+  struct WaitKey {
+    State state = State::Off;
+    Wait wait = Wait::None;
+    StopReason stop = StopReason::None;
+    SyncKind sync = SyncKind::None;
+    std::uint32_t line = 0, context = 0;
+    bool job = false;
+    bool operator==(const WaitKey&) const = default;
+  };
+  WaitKey wait_key_{State::Off, Wait::None, StopReason::None, SyncKind::None, ~0u, ~0u, false};
 };
 
 }  // namespace opencnc::control

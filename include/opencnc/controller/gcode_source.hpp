@@ -55,6 +55,7 @@ class GcodeProgramSource final : public ProgramSource {
   std::unique_ptr<ProgramStream> execute(const std::string& path, const Pose& start,
                                          const LoadOptions& options) override;
   std::unique_ptr<ProgramStream> mdi(std::string_view line, const Pose& start) override;
+  std::uint64_t version() const override { return config_.tools ? config_.tools->version() : 0; }
 
   /// The tool table G-code reads and writes (null: none). Any thread.
   const std::shared_ptr<tools::ToolTableService>& tools() const noexcept { return config_.tools; }

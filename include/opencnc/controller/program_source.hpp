@@ -143,6 +143,9 @@ class ProgramSource {
                                                  const LoadOptions& options) = 0;
   /// One MDI line from `start`, continuing the modal state the earlier lines left.
   virtual std::unique_ptr<ProgramStream> mdi(std::string_view line, const Pose& start) = 0;
+  /// Changes whenever something a program reads besides its file changes (the tool table): a
+  /// preflight holds for the version it was made with.
+  virtual std::uint64_t version() const { return 0; }
 };
 
 /// The location of a block: `line` in the body file of `context` (the main file for context 0),
