@@ -317,3 +317,44 @@ TEST(SyncScenario, StreamingMovesExactlyAsTheWholeProgram) {
 
 }  // namespace
 }  // namespace opencnc::control::test
+
+namespace opencnc::control::test {
+namespace {
+
+/// The most moves a run's program window held at once.
+class WindowWatch final : public ControllerObserver {
+ public:
+  void on_trace(const TraceSample&, const TraceContext& c) override {
+    if (c.program == nullptr) return;
+    most = std::max(most, c.program->size() - c.program->first_held_move());
+    moves = std::max<std::uint64_t>(moves, c.first_move + c.program->size());
+  }
+  std::size_t most = 0;
+  std::uint64_t moves = 0;
+};
+
+// A program far longer than the read-ahead runs in a window of the moves around the machine: what
+// the machine has passed is freed as it goes.
+TEST(StreamScenario, ALongProgramRunsInABoundedWindow) {
+  Scenario s(mill());
+  TempProgram p("long.ngc",
+                "G21 G90 G64 P0.01 F6000\n"
+                "#1 = 0\n"
+                "o1 while [#1 lt 120000]\n"
+                "  G1 X[#1 mod 2] Y[#1 * 0.001]\n"
+                "  #1 = [#1 + 1]\n"
+                "o1 endwhile\n"
+                "M2\n");
+  auto watch = std::make_shared<WindowWatch>();
+  s.rig().controller().attach(watch, ObserverOptions{0, true});
+  s.on(Mode::Auto);
+  ASSERT_TRUE(s.run_file(p.path(), 2'000'000)) << s.message();
+  EXPECT_EQ(watch->moves, 120000u) << watch->most;
+  EXPECT_GT(watch->most, 2000u);   // the read-ahead and the planner's window
+  EXPECT_LT(watch->most, 60000u);  // far from all of it: released chunk by chunk
+  const std::optional<OpenProgram> open = s.rig().controller().open_program();
+  EXPECT_EQ(open->preflight.summary.moves, 120000u);
+}
+
+}  // namespace
+}  // namespace opencnc::control::test
