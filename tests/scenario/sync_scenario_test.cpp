@@ -358,3 +358,29 @@ TEST(StreamScenario, ALongProgramRunsInABoundedWindow) {
 
 }  // namespace
 }  // namespace opencnc::control::test
+
+namespace opencnc::control::test {
+namespace {
+
+// The program's own dialect comment wins over the profile's default, and an O-numbered Fanuc
+// program runs as `opencnc check --dialect fanuc` reads it (nothing is put in front of it).
+TEST(DialectScenario, RunReadsTheProgramInItsOwnDialect) {
+  const char* fanuc = "%\nO0001 (BRACKET)\nG21 G90 G54\nG0 X10. Y5.\nG1 X20. F600\nM30\n%\n";
+  {
+    Scenario s(mill({"interpreter.dialect=\"fanuc\""}));
+    TempProgram p("o0001.nc", fanuc);
+    s.on(Mode::Auto);
+    ASSERT_TRUE(s.run_file(p.path())) << s.message();
+    EXPECT_NEAR(s.status().servo.commanded[Axis::X], 20.0, 1e-9);
+  }
+  {
+    Scenario s(mill());  // LinuxCNC by default: the comment says Fanuc
+    TempProgram p("marked.nc", std::string("(dialect: fanuc)\n") + (fanuc + 2));
+    s.on(Mode::Auto);
+    ASSERT_TRUE(s.run_file(p.path())) << s.message();
+    EXPECT_NEAR(s.status().servo.commanded[Axis::Y], 5.0, 1e-9);
+  }
+}
+
+}  // namespace
+}  // namespace opencnc::control::test
