@@ -384,3 +384,56 @@ TEST(DialectScenario, RunReadsTheProgramInItsOwnDialect) {
 
 }  // namespace
 }  // namespace opencnc::control::test
+
+namespace opencnc::control::test {
+namespace {
+
+// Status says exactly where in the program the machine is: the move, the path length into it, the
+// line and the calls that led there (what a breakpoint journal records).
+TEST(StatusScenario, SaysTheMoveThePlaceInItAndTheCallStack) {
+  Scenario s(mill());
+  TempProgram p("calls.ngc",
+                "o<side> sub\n"
+                "  G1 X[#1] F600\n"
+                "o<side> endsub\n"
+                "G21 G90\n"
+                "G0 X0 Y0\n"
+                "o<side> call [40]\n"
+                "M2\n");
+  s.on(Mode::Auto);
+  s.must(Request::open(p.path()));
+  s.must(Request::simple(CommandKind::CycleStart));
+  ASSERT_TRUE(s.until([&] { return s.status().servo.commanded[Axis::X] > 10.0; }, 20000));
+  const ControllerStatus st = s.status();
+  EXPECT_EQ(st.job, JobKind::Program);
+  EXPECT_EQ(st.run_segment, 1u);  // the second move: the G0 was the first
+  EXPECT_NEAR(st.segment_offset, st.servo.commanded[Axis::X], 1e-9);  // the move starts at X0
+  EXPECT_EQ(st.location.line, 2u);
+  ASSERT_EQ(st.location.calls.size(), 1u);
+  EXPECT_NE(st.location.calls[0].find("calls.ngc:6"), std::string::npos) << st.location.calls[0];
+  EXPECT_NE(to_string(st.location).find("calls.ngc:2"), std::string::npos) << to_string(st.location);
+  ASSERT_TRUE(s.idle(20000));
+}
+
+}  // namespace
+}  // namespace opencnc::control::test
+
+namespace opencnc::control::test {
+namespace {
+
+// MDI lines meet the machine too: a probe typed by the operator sets #5063 for the next line.
+TEST(MdiSyncScenario, AProbeInMdiSetsItsParameters) {
+  Scenario s(mill());
+  s.on(Mode::Mdi);
+  s.must(Request::mdi("G21 G90 G0 X5 Y5 Z0"));
+  ASSERT_TRUE(s.idle(20000));
+  s.must(Request::mdi("G38.2 Z-100 F300"));
+  ASSERT_TRUE(s.idle(50000));
+  EXPECT_TRUE(s.status().servo.probe_tripped);
+  s.must(Request::mdi("G0 Z[#5063+5]"));
+  ASSERT_TRUE(s.idle(20000));
+  EXPECT_NEAR(s.status().servo.commanded[Axis::Z], -45.0, 0.001);
+}
+
+}  // namespace
+}  // namespace opencnc::control::test
