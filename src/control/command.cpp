@@ -150,12 +150,6 @@ const char* to_string(CommandKind k) noexcept {
       return "coolant";
     case CommandKind::SetHandwheel:
       return "handwheel";
-    case CommandKind::OpenProgram:
-      return "open-program";
-    case CommandKind::Mdi:
-      return "mdi";
-    case CommandKind::SetBlockDelete:
-      return "block-delete";
   }
   return "?";
 }

@@ -31,17 +31,22 @@ double spread(const std::vector<double>& v) {
   return *hi - *lo;
 }
 
-/// Runs `rig` until `done` holds, draining the trace into `trace` when given; throws with the
-/// machine's fault when it faults or when `max_ticks` pass.
+/// Hands every servo period's sample (homing included) to a function.
+class TraceForward final : public ControllerObserver {
+ public:
+  explicit TraceForward(std::function<void(const TraceSample&)> f) : f_(std::move(f)) {}
+  void on_trace(const TraceSample& s, const TraceContext&) override { f_(s); }
+
+ private:
+  std::function<void(const TraceSample&)> f_;
+};
+
+/// Runs `rig` until `done` holds; throws with the machine's fault when it faults or when
+/// `max_ticks` pass.
 template <typename F>
-void run_until(SimRig& rig, F done, std::uint64_t max_ticks, const char* what,
-               const std::function<void(const TraceSample&)>* trace = nullptr) {
-  TraceSample t;
+void run_until(SimRig& rig, F done, std::uint64_t max_ticks, const char* what) {
   for (std::uint64_t i = 0; i < max_ticks; ++i) {
     rig.step();
-    while (rig.channels().trace.try_pop(t)) {
-      if (trace != nullptr && *trace) (*trace)(t);
-    }
     const ControllerStatus s = rig.status();
     if (s.servo.state == State::Faulted || s.servo.state == State::EStopped)
       throw std::runtime_error(fmt::format("{}: the machine stopped: {}", what, s.fault_text));
@@ -59,14 +64,14 @@ void must(SimRig& rig, Request r, const char* what) {
   throw std::runtime_error(fmt::format("{}: {}", what, why));
 }
 
-void home(SimRig& rig, const std::function<void(const TraceSample&)>* trace = nullptr) {
+void home(SimRig& rig) {
   must(rig, Request::simple(CommandKind::MachineOn), "machine on");
   if (!rig.controller().servo_config().homing_required) return;
   must(rig, Request::set_mode(Mode::Manual), "manual mode");
-  must(rig, Request::on_axis(CommandKind::Home, -1), "home");
+  must(rig, Request::home(), "home");
   run_until(
       rig, [](const ControllerStatus& s) { return s.servo.state == State::Idle && s.servo.all_homed; }, 2'000'000,
-      "homing", trace);
+      "homing");
 }
 
 /// ISO 230-2 figures of one axis from its deviations (targets × approaches, each direction).
@@ -161,9 +166,11 @@ HomingSpread homing_spread(const config::MachineProfile& profile, const HomingSp
     r.temperature_min_c = std::min(r.temperature_min_c, p.sim_temperature_c);
     r.temperature_max_c = std::max(r.temperature_max_c, p.sim_temperature_c);
     SimRig rig(p);
-    const bool traced = run == 0 && o.trace;
-    rig.channels().trace_enabled = traced;
-    home(rig, traced ? &o.trace : nullptr);
+    if (run == 0 && o.trace) {
+      rig.controller().attach(std::make_shared<TraceForward>(o.trace), ObserverOptions{0, true});
+      rig.step();  // attached from here on
+    }
+    home(rig);
     const ServoStatus s = rig.status().servo;
     for (const config::AxisProfile& a : p.axes) {
       if (!r.axes.has(a.axis)) continue;

@@ -43,21 +43,35 @@ const char* motion_name(traj::RunState s) {
 
 }  // namespace
 
-RunRecorder::RunRecorder(const canon::Program& program, const plan::MachineLimits& limits, double period_s,
+RunRecorder::RunRecorder(const plan::MachineLimits& limits, double period_s,
                          const plan::MachineLimits* output_limits)
     : limits_(limits),
       period_s_(period_s),
-      commanded_(program, limits, period_s),
-      actual_(program, limits, period_s),
-      output_(program, output_limits != nullptr ? *output_limits : limits, period_s),
-      start_(program.start()),
-      last_(program.start()) {
-  commanded_.start_at(program.start());
-  actual_.start_at(program.start());
+      commanded_(limits, period_s),
+      actual_(limits, period_s),
+      output_(output_limits != nullptr ? *output_limits : limits, period_s) {}
+
+RunRecorder::RunRecorder(const canon::Program& program, const plan::MachineLimits& limits, double period_s,
+                         const plan::MachineLimits* output_limits)
+    : RunRecorder(limits, period_s, output_limits) {
+  fixed_ = &program;
+  commanded_.set_program(&program);
+  actual_.set_program(&program);
+  output_.set_program(&program);
+  begin(program.start());
+}
+
+// Before the first sample the machine stands where the run starts.
+void RunRecorder::begin(const Pose& start) {
+  commanded_.start_at(start);
+  actual_.start_at(start);
+  last_ = start;
+  start_ = start;
+  started_ = true;
 }
 
 // Axes nothing plans (hand-fed ones) move as the operator moves them: the path, its contour and
-// the limits are those of the planned axes, so the others are held at the program's start.
+// the limits are those of the planned axes, so the others are held where the run started.
 TraceSample RunRecorder::planned_axes(const TraceSample& in) const {
   TraceSample s = in;
   for (int i = 0; i < kAxisCount; ++i) {
@@ -68,7 +82,18 @@ TraceSample RunRecorder::planned_axes(const TraceSample& in) const {
   return s;
 }
 
+void RunRecorder::add(const TraceSample& s, const TraceContext& c) {
+  if (c.program != commanded_.program()) {
+    commanded_.set_program(c.program);
+    actual_.set_program(c.program);
+    output_.set_program(c.program);
+  }
+  if (!started_) begin(c.program != nullptr ? c.program->start() : s.commanded);
+  add(s);
+}
+
 void RunRecorder::add(const TraceSample& in) {
+  if (!started_) begin(in.commanded);
   const TraceSample s = planned_axes(in);
   // The compensation may still be taking something up when the run starts (the table switched
   // on at homing a moment ago): the drives' commands are checked from the third period on, with

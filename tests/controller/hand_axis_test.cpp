@@ -13,6 +13,7 @@
 #include "opencnc/config/profile_loader.hpp"
 #include "opencnc/controller/gcode_source.hpp"
 #include "opencnc/controller/hand_axis.hpp"
+#include "opencnc/controller/program_source.hpp"
 
 namespace opencnc::control {
 namespace {
@@ -23,8 +24,21 @@ config::MachineProfile drill() {
   return *load.profile;
 }
 
-/// `text` loaded as a program file on the drill, starting at X0 Y0 with the quill at `z`.
-LoadedProgram load(const std::string& text, double z = 0) {
+/// `text` executed as a program file on the drill from X0 Y0 with the quill at `z`, read to its
+/// end (the interpreter never waits here: no sync points), and preflighted.
+struct Loaded {
+  std::unique_ptr<ProgramStream> stream;
+  const canon::Program* program = nullptr;  ///< null when the stream failed
+  Diagnostics diagnostics;                   ///< the stream's
+  Preflight preflight;
+};
+
+class AcceptAll final : public MoveCheck {
+ public:
+  bool check(const canon::Program&, canon::SegmentId, Diagnostics&) override { return true; }
+};
+
+Loaded load(const std::string& text, double z = 0) {
   const auto dir = std::filesystem::temp_directory_path() /
                    ("opencnc-hand-" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
   std::filesystem::create_directories(dir);
@@ -34,7 +48,14 @@ LoadedProgram load(const std::string& text, double z = 0) {
   auto source = GcodeProgramSource::create(drill(), d);
   Pose start;
   start[Axis::Z] = z;
-  LoadedProgram out = source->load(path, start, {});
+  Loaded out;
+  AcceptAll accept;
+  out.preflight = source->preflight(path, start, {}, accept);
+  out.stream = source->execute(path, start, {});
+  while (out.stream->read(1000) == StreamState::Reading) {
+  }
+  out.diagnostics = out.stream->diagnostics();
+  if (out.stream->state() == StreamState::Finished) out.program = &out.stream->program();
   std::filesystem::remove_all(dir);
   return out;
 }
@@ -47,7 +68,8 @@ struct Wait {
 
 std::vector<Wait> waits(const canon::Program& p) {
   std::vector<Wait> out;
-  for (const canon::Action& a : p.actions()) {
+  for (std::size_t i = 0; i < p.action_count(); ++i) {
+    const canon::Action& a = p.action(i);
     if (a.kind == canon::ActionKind::HandAxisWait) {
       EXPECT_EQ(a.index, index(Axis::Z));
       out.push_back({a.before_move, a.value, a.index2 > 0});
@@ -58,8 +80,9 @@ std::vector<Wait> waits(const canon::Program& p) {
 
 TEST(HandAxisPass, QuillMovesBecomeWaitsAndTheTableMovesAlone) {
   // A hole: down to R, feed to depth, back to R; then the table moves to the next hole.
-  const LoadedProgram lp = load("G21 G90 G0 X10 Y20\nZ-57\nG1 Z-88 F80\nG0 Z-57\nX50\nM2\n");
-  ASSERT_TRUE(lp.program) << lp.diagnostics.items().front().format();
+  const Loaded lp = load("G21 G90 G0 X10 Y20\nZ-57\nG1 Z-88 F80\nG0 Z-57\nX50\nM2\n");
+  ASSERT_TRUE(lp.program != nullptr);
+  EXPECT_TRUE(lp.preflight.ok());
   const canon::Program& p = *lp.program;
   ASSERT_EQ(p.size(), 5u);  // every move keeps its number
   for (canon::SegmentId id = 0; id < p.size(); ++id) EXPECT_EQ(p.end(id)[Axis::Z], 0.0) << id;
@@ -74,8 +97,8 @@ TEST(HandAxisPass, QuillMovesBecomeWaitsAndTheTableMovesAlone) {
 }
 
 TEST(HandAxisPass, ARetractComesBeforeTheTableAPlungeAfterIt) {
-  const LoadedProgram lp = load("G21 G90 G0 X10 Z-20\nX30 Z-5\nM2\n", -10);
-  ASSERT_TRUE(lp.program);
+  const Loaded lp = load("G21 G90 G0 X10 Z-20\nX30 Z-5\nM2\n", -10);
+  ASSERT_TRUE(lp.program != nullptr);
   const std::vector<Wait> w = waits(*lp.program);
   ASSERT_EQ(w.size(), 2u);
   EXPECT_EQ(w[0].before_move, 1u);  // the first move goes down: after the table's part (move 0)
@@ -87,13 +110,11 @@ TEST(HandAxisPass, ARetractComesBeforeTheTableAPlungeAfterIt) {
   EXPECT_EQ(w[1].target, -5.0);
 }
 
-TEST(HandAxisPass, ProgramsThatDoNotMoveTheQuillAreLeftAlone) {
-  Diagnostics d;
-  auto program = std::make_shared<const canon::Program>(AxisMask::from_letters("XYZ"));
-  EXPECT_EQ(hand_axis_program(program, hand_axes(drill()), d), program);
-  const LoadedProgram lp = load("G21 G90 G1 X10 Y5 F600\nM2\n");
-  ASSERT_TRUE(lp.program);
+TEST(HandAxisPass, ProgramsThatDoNotMoveTheQuillHaveNoWaits) {
+  const Loaded lp = load("G21 G90 G1 X10 Y5 F600\nM2\n");
+  ASSERT_TRUE(lp.program != nullptr);
   EXPECT_TRUE(waits(*lp.program).empty());
+  EXPECT_EQ(lp.program->end(0)[Axis::X], 10.0);
 }
 
 TEST(HandAxisPass, ArcsHelicesAndTargetsBeyondTheStrokeAreRefusedAtTheirLine) {
@@ -106,17 +127,19 @@ TEST(HandAxisPass, ArcsHelicesAndTargetsBeyondTheStrokeAreRefusedAtTheirLine) {
       {"G21 G90\nG0 X5\nG1 Z-200 F50\nM2\n", 3},            // below the quill's stroke (−160)
   };
   for (const auto& c : cases) {
-    const LoadedProgram lp = load(c.text);
-    EXPECT_FALSE(lp.program) << c.text;
-    const Diagnostic* error = nullptr;
-    for (const Diagnostic& d : lp.diagnostics.items()) {
-      if (d.severity == Severity::Error && error == nullptr) error = &d;
+    const Loaded lp = load(c.text);
+    EXPECT_TRUE(lp.program == nullptr) << c.text;
+    // The stream and the preflight both say where.
+    for (const Diagnostics* diags : {&lp.diagnostics, &lp.preflight.diagnostics}) {
+      const Diagnostic* error = nullptr;
+      for (const Diagnostic& d : diags->items()) {
+        if (d.severity == Severity::Error && error == nullptr) error = &d;
+      }
+      ASSERT_NE(error, nullptr) << c.text;
+      EXPECT_EQ(error->code, "control.hand-axis") << error->format();
+      EXPECT_EQ(error->line, c.line) << error->format();
+      EXPECT_NE(error->file.find("p.ngc"), std::string::npos) << error->format();
     }
-    ASSERT_NE(error, nullptr) << c.text;
-    const Diagnostic& d = *error;
-    EXPECT_EQ(d.code, "control.hand-axis") << d.format();
-    EXPECT_EQ(d.line, c.line) << d.format();
-    EXPECT_NE(d.file.find("p.ngc"), std::string::npos) << d.format();
   }
 }
 

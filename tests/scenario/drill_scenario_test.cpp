@@ -66,7 +66,7 @@ double table_y(Scenario& s) {
 
 void home(Scenario& s) {
   s.on(Mode::Manual);
-  s.must(Request::on_axis(CommandKind::Home, -1));
+  s.must(Request::home());
   ASSERT_TRUE(s.until([&] { return s.status().servo.state == State::Idle && s.status().servo.all_homed; }, 100000));
 }
 
@@ -85,11 +85,12 @@ TEST(DrillScenario, BearingCapHolesWithinFiveMicrometres) {
   std::vector<Hole> holes{{150.0, 140.0}, {530.0, 140.0}};
   int interlock_stops = 0;
   bool down = false;
+  EventCursor events(s.rig().controller().events());
   s.must(Request::simple(CommandKind::CycleStart));
   const bool finished = s.until(
       [&] {
         op.act();
-        for (const Note& n : s.rig().controller().take_notes()) interlock_stops += n.code == "control.interlock";
+        for (const ControllerEvent& e : events.next()) interlock_stops += e.code == "control.interlock";
         const double z = s.status().servo.joints[kZ].actual;
         const bool in_part = z < -60.0 - 1.0;  // the tool below the cap's face
         if (in_part) {
@@ -113,7 +114,7 @@ TEST(DrillScenario, BearingCapHolesWithinFiveMicrometres) {
   }
   // The PLC stopped the spindle each time the quill came back to its top stop with it running.
   EXPECT_GE(interlock_stops, 3);
-  const RunReport r = s.report(*s.rig().controller().open_program());
+  const RunReport r = s.report();
   EXPECT_EQ(r.limit_violations, 0u) << "output: " << r.output_limit_violations << " first at "
                                     << r.first_output_violation.time_s << " s, axis " << r.first_output_violation.axis
                                     << " derivative " << r.first_output_violation.derivative << " "
@@ -200,7 +201,7 @@ TEST(DrillScenario, EStopDuringAProgramStopsAndRefusesMotionUntilResetAndHomed) 
   EXPECT_FALSE(s.status().servo.all_homed);
   EXPECT_EQ(s.ask(Request::simple(CommandKind::CycleStart)).refusal, Refusal::NotHomed);
   s.must(Request::set_mode(Mode::Manual));
-  s.must(Request::on_axis(CommandKind::Home, -1));
+  s.must(Request::home());
   ASSERT_TRUE(s.until([&] { return s.status().servo.state == State::Idle && s.status().servo.all_homed; }, 100000));
   s.must(Request::set_mode(Mode::Auto));
   EXPECT_TRUE(s.start_and_finish());
@@ -241,7 +242,7 @@ TEST(DrillScenario, EveryHardLimitStopsTheMachineAndRefusesMotionPastIt) {
     ASSERT_TRUE(s.until([&] { return !s.status().servo.joints[static_cast<std::size_t>(j)].limit_neg &&
                                      !s.status().servo.joints[static_cast<std::size_t>(j)].limit_pos; },
                         20000));
-    s.must(Request::on_axis(CommandKind::JogStop, -1));
+    s.must(Request::jog_stop());
     ASSERT_TRUE(s.until([&] { return s.status().servo.state == State::Idle; }, 20000));
     s.must(Request::set_mode(Mode::Mdi));
     EXPECT_EQ(s.ask(Request::mdi("G0 X10 Y10")).refusal, Refusal::NotHomed);
