@@ -92,7 +92,9 @@ void Servo::act_on_rule(int index, const machine::InterlockRule& r, bool now, bo
   const bool rising = now && !before;
   switch (r.action) {
     case InterlockAction::StopSpindle:
-      if (rising && spindle_direction_ != machine::SpindleDirection::Stopped) {
+      // A turning spindle: a start that a block holds back is a later wish (an M3 given with the
+      // quill down starts once the quill is up, though the quill's arrival stops a turning one).
+      if (rising && spindle_running_) {
         spindle_direction_ = machine::SpindleDirection::Stopped;
         spindle_changed_tick_ = tick_;
         orient_ = false;

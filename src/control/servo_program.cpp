@@ -30,10 +30,12 @@ const traj::MotionBlock* Servo::block(std::uint64_t seq) const noexcept {
 }
 
 // The drive's at-speed signal refers to the command it had when it sampled: only from the period
-// after a change on does it speak about the new one.
+// after a change on does it speak about the new one. A start an interlock holds back is not at
+// speed, whatever the drive says of the standing spindle it was told to keep still.
 bool Servo::spindle_at_speed() const noexcept {
   if (!caps_.spindle) return true;
   if (spindle_direction_ == machine::SpindleDirection::Stopped) return true;
+  if (!spindle_running_) return false;
   return in_.spindle.at_speed && tick_ > spindle_changed_tick_;
 }
 

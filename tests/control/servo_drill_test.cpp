@@ -249,6 +249,46 @@ TEST(Interlocks, TheDoorHoldsMotionAndTheLampShowsReady) {
   EXPECT_EQ(h.status().digital_out & 1u, 0u);
 }
 
+// "block motion when door_open" refuses every start but lets what moves go on; "estop when
+// stop_button" e-stops and refuses reset while it holds.
+TEST(Interlocks, BlockedMotionAndAnEStopRule) {
+  ServoHarness h(drill({"interlocks.inputs.stop_button=2",
+                        "interlocks.rules=[\"block motion when door_open\", \"estop when stop_button\"]"}));
+  home_all(h);
+  ASSERT_EQ(h.jog(Axis::Y, 20.0), Refusal::None);
+  h.tick(100);
+  h.sim().set_digital_input(1, true);  // the guard opens while Y moves
+  h.tick(100);
+  EXPECT_EQ(h.state(), State::Running);  // a block holds back starts, not what already moves
+  EXPECT_GT(h.status().joints[kY].velocity, 19.0);
+  ASSERT_EQ(h.send(Command{0, CommandKind::JogStop}), Refusal::None);
+  settle(h);
+  EXPECT_EQ(h.jog(Axis::X, 10.0), Refusal::Interlock);
+  EXPECT_EQ(h.home(), Refusal::Interlock);
+  EXPECT_EQ(h.send_mode(Mode::Auto), Refusal::None);
+  Command run;
+  run.kind = CommandKind::StartRun;
+  run.run_mode = Mode::Auto;
+  EXPECT_EQ(h.send(run), Refusal::Interlock);
+  EXPECT_EQ(h.send_mode(Mode::Manual), Refusal::None);
+  h.sim().set_digital_input(1, false);
+  h.tick(2);
+  EXPECT_EQ(h.jog(Axis::X, 10.0), Refusal::None);
+  h.tick(50);
+  h.sim().set_digital_input(2, true);  // "estop when stop_button"
+  h.tick(2);
+  EXPECT_EQ(h.state(), State::EStopped);
+  EXPECT_FALSE(h.status().drives_enabled);
+  const auto e = h.last(EventKind::Interlock);
+  ASSERT_TRUE(e.has_value());
+  EXPECT_EQ(e->action, 1u);
+  EXPECT_EQ(h.send(CommandKind::Reset), Refusal::Interlock);
+  h.sim().set_digital_input(2, false);
+  h.tick(2);
+  EXPECT_EQ(h.send(CommandKind::Reset), Refusal::None);
+  EXPECT_EQ(h.state(), State::Off);
+}
+
 TEST(Stall, ADetectedStallFaultsAndTheAxisMustHomeAgain) {
   ServoHarness h(drill());
   home_all(h);

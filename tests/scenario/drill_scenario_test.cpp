@@ -161,6 +161,68 @@ TEST(DrillScenario, HomingAfterThePartFindsLostSteps) {
   EXPECT_NEAR(table_y(s), s.status().servo.joints[kY].actual, 0.003);
 }
 
+// The table moves only with the quill where the program left it: brought down while the table
+// traverses, the run holds (with a warning naming the axis), cycle start is refused until the
+// quill is back up, and then the run goes on to its end.
+TEST(DrillScenario, TheQuillLeavingItsPlaceHoldsTheTable) {
+  Scenario s(drill());
+  home(s);
+  s.must(Request::set_mode(Mode::Auto));
+  TempProgram p("q.ngc", "G21 G90\nG0 X20 Y20\nG1 Z-5 F100\nG0 Z0\nG0 X300\nM30\n");
+  s.must(Request::open(p.path()));
+  Operator op(s);
+  EventCursor events(s.rig().controller().events());
+  s.must(Request::simple(CommandKind::CycleStart));
+  bool pushed = false;
+  ASSERT_TRUE(s.until(
+      [&] {
+        op.act();
+        const ServoStatus& v = s.status().servo;
+        if (!pushed && v.commanded[Axis::X] > 100.0) {
+          s.sim().set_hand_target(kZ, -2.0, 20.0);  // the operator lowers the quill on the way
+          pushed = true;
+        }
+        return v.state == State::Held;
+      },
+      200000));
+  int warnings = 0;
+  for (const ControllerEvent& e : events.next()) warnings += e.code == "control.hand-axis";
+  EXPECT_EQ(warnings, 1);
+  ASSERT_TRUE(s.until([&] { return s.status().servo.path_velocity == 0; }, 5000));
+  EXPECT_EQ(s.ask(Request::simple(CommandKind::CycleStart)).refusal, Refusal::HandAxis);
+  s.sim().set_hand_target(kZ, 0.0, 20.0);
+  s.ticks(1000);
+  s.must(Request::simple(CommandKind::CycleStart));
+  ASSERT_TRUE(s.until([&] { return !s.status().run_active; }, 100000));
+  EXPECT_EQ(s.status().runs_finished, 1u) << s.status().fault_text;
+  EXPECT_EQ(s.status().servo.commanded[Axis::X], 300.0);
+}
+
+// "block spindle unless tool_up and …": an M3 with the quill down waits before the move
+// (Wait::Interlock, the rule in status) and starts the spindle once the quill is back at the top
+// ("stop spindle when tool_up" stops a turning spindle, not a start that waits), then the move.
+TEST(DrillScenario, ASpindleStartWaitsForItsInterlock) {
+  Scenario s(drill());
+  home(s);
+  s.sim().set_hand_target(kZ, -5.0, 20.0);
+  s.ticks(1000);
+  s.must(Request::set_mode(Mode::Mdi));
+  s.must(Request::mdi("M3 S600 G1 X30 F300"));
+  ASSERT_TRUE(s.until([&] { return s.status().servo.wait == Wait::Interlock; }, 5000));
+  EXPECT_EQ(s.status().servo.interlock_rule, 2);
+  s.ticks(500);
+  EXPECT_EQ(s.status().servo.wait, Wait::Interlock);
+  EXPECT_EQ(s.status().servo.commanded[Axis::X], 0.0);
+  EXPECT_EQ(s.sim().spindle().speed_rps(), 0.0);
+  s.sim().set_hand_target(kZ, 0.0, 20.0);
+  ASSERT_TRUE(s.until([&] { return !s.status().run_active; }, 20000));
+  EXPECT_EQ(s.status().runs_finished, 1u) << s.status().fault_text;
+  EXPECT_EQ(s.status().servo.commanded[Axis::X], 30.0);
+  EXPECT_EQ(s.status().servo.spindle_direction, machine::SpindleDirection::Clockwise);
+  s.ticks(5);  // the table at rest again: the rule no longer holds
+  EXPECT_EQ(s.status().servo.interlock_rule, -1);
+}
+
 /// How far a table coasting at `v` mm/s stops on its friction alone (drives without power), and
 /// one period of travel before anything reacts.
 double coast_bound(const config::MachineProfile& p, Axis a, double v) {

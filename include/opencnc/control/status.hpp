@@ -110,7 +110,7 @@ struct ServoStatus {
   std::array<HomingStatus, machine::kMaxJoints> homing{};
   std::array<double, machine::kMaxJoints> compensation{};  ///< correction each joint gets now, units
   HandWait hand_wait{};          ///< what a Wait::HandAxis waits for
-  std::int8_t interlock_rule = -1;  ///< the rule holding back the next step (Wait::Interlock)
+  std::int8_t interlock_rule = -1;  ///< the first `block spindle` rule holding now (what Wait::Interlock waits on)
   std::uint32_t interlocks_true = 0;  ///< bit per rule whose condition holds
   std::int8_t handwheel_axis = -1;    ///< the axis the handwheel moves (−1 = none)
   double handwheel_step = 0;          ///< units per count
