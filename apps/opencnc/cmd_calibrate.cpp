@@ -114,12 +114,10 @@ void print_positioning(const control::Positioning& before, const control::Positi
 }
 
 /// Writes the measured tables into the profile file: never half-written (a temporary file renamed
-/// over it), never when the file changed since it was read, and only a text that reads back as
-/// the same profile with those tables.
-bool write_tables(const CalibrateOptions& o, const config::MachineProfile& profile,
+/// over it), never when the file is no longer `original` (the text the measured profile came
+/// from), and only a text that reads back as the same profile with those tables.
+bool write_tables(const CalibrateOptions& o, const std::string& original,
                   const std::vector<std::pair<Axis, config::CompensationProfile>>& tables, std::string& why) {
-  std::string original;
-  if (!read_file(o.profile, original, &why)) return false;
   std::string text = original;
   for (const auto& [axis, table] : tables) {
     std::optional<std::string> next = config::with_compensation(text, axis, table, why);
@@ -144,7 +142,6 @@ bool write_tables(const CalibrateOptions& o, const config::MachineProfile& profi
       return false;
     }
   }
-  (void)profile;
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode) || ::access(path.c_str(), W_OK) != 0) {
     why = fmt::format("{} is not a regular file we may write", path.string());
@@ -171,7 +168,20 @@ int calibrate(const CalibrateOptions& o) {
                        "measured (no --set)\n");
     return kExitUsage;
   }
-  const config::ProfileLoad load = config::load_profile(o.profile, o.sets);
+  // With --write-table the machine is measured from the text that will be edited, read once: if
+  // the file changes meanwhile, nothing is written.
+  std::string original;
+  if (o.write_table) {
+    std::string why;
+    if (!read_file(o.profile, original, &why)) {
+      fmt::print(stderr, "error: {}\n", why);
+      return kExitUsage;
+    }
+  }
+  const std::filesystem::path file(o.profile);
+  const config::ProfileLoad load = o.write_table
+                                       ? config::parse_profile(original, o.profile, {}, file.parent_path())
+                                       : config::load_profile(o.profile, o.sets);
   for (const Diagnostic& d : load.diagnostics.items()) fmt::print(stderr, "{} [{}]\n", d.format(), d.code);
   if (!load.ok()) {
     const bool unreadable = !load.diagnostics.items().empty() && load.diagnostics.items()[0].code == "config.file";
@@ -243,7 +253,7 @@ int calibrate(const CalibrateOptions& o) {
         if (own.axes.has(static_cast<Axis>(i))) a["profile"] = figures(own.axis[ui]);
       }
       if (o.write_table) {
-        if (!write_tables(o, profile, tables, why)) {
+        if (!write_tables(o, original, tables, why)) {
           fmt::print(stderr, "error: --write-table: {}\n", why);
           return kExitUsage;
         }
