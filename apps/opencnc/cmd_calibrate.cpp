@@ -81,31 +81,33 @@ bool writable_output(const std::string& out, const std::string& input, std::stri
 }
 
 nlohmann::json figures(const control::AxisPositioning& a) {
-  return {{"accuracy_um", um(a.accuracy)}, {"repeatability_um", um(a.repeatability)}, {"reversal_um", um(a.reversal)}};
+  return {{"accuracy_um", um(a.accuracy)},
+          {"repeatability_um", um(a.repeatability)},
+          {"reversal_um", um(a.reversal)}};
 }
 
 void print_homing(const control::HomingSpread& h) {
-  fmt::print("homing: {} runs from random start positions, {:.1f} to {:.1f} °C\n", h.runs, h.temperature_min_c,
-             h.temperature_max_c);
+  fmt::print("homing: {} runs from random start positions, {:.1f} to {:.1f} °C\n", h.runs,
+             h.temperature_min_c, h.temperature_max_c);
   for (int i = 0; i < kAxisCount; ++i) {
     if (!h.axes.has(static_cast<Axis>(i))) continue;
     const auto ui = static_cast<std::size_t>(i);
-    fmt::print("  {}  midpoint spread {:7.2f} µm   single edge spread {:7.2f} µm\n", letter(static_cast<Axis>(i)),
-               1000 * h.midpoint_spread[ui], 1000 * h.single_edge_spread[ui]);
+    fmt::print("  {}  midpoint spread {:7.2f} µm   single edge spread {:7.2f} µm\n",
+               letter(static_cast<Axis>(i)), 1000 * h.midpoint_spread[ui], 1000 * h.single_edge_spread[ui]);
   }
 }
 
 void print_positioning(const control::Positioning& before, const control::Positioning& profile,
                        const control::Positioning& after, const control::PositioningOptions& o) {
-  fmt::print("positioning (ISO 230-2 style): targets every {} mm, {} approaches from each direction\n", o.interval,
-             o.approaches);
+  fmt::print("positioning (ISO 230-2 style): targets every {} mm, {} approaches from each direction\n",
+             o.interval, o.approaches);
   for (int i = 0; i < kAxisCount; ++i) {
     if (!before.axes.has(static_cast<Axis>(i))) continue;
     const auto ui = static_cast<std::size_t>(i);
     const auto line = [&](const char* what, const control::AxisPositioning& a) {
       fmt::print("  {}  {:<7}  accuracy {:7.1f} µm   repeatability {:7.1f} µm   reversal {:7.1f} µm\n",
-                 what[0] == 'b' ? letter(static_cast<Axis>(i)) : ' ', what, um(a.accuracy), um(a.repeatability),
-                 um(a.reversal));
+                 what[0] == 'b' ? letter(static_cast<Axis>(i)) : ' ', what, um(a.accuracy),
+                 um(a.repeatability), um(a.reversal));
     };
     line("before", before.axis[ui]);
     if (profile.axes.has(static_cast<Axis>(i))) line("profile", profile.axis[ui]);
@@ -134,7 +136,8 @@ bool write_tables(const CalibrateOptions& o, const std::string& original,
     const config::CompensationProfile& got = check.profile->find(axis)->compensation;
     bool same = got.positions.size() == table.positions.size();
     for (std::size_t i = 0; same && i < table.positions.size(); ++i) {
-      same = std::abs(got.forward[i] - table.forward[i]) < 1e-6 && std::abs(got.reverse[i] - table.reverse[i]) < 1e-6 &&
+      same = std::abs(got.forward[i] - table.forward[i]) < 1e-6 &&
+             std::abs(got.reverse[i] - table.reverse[i]) < 1e-6 &&
              std::abs(got.positions[i] - table.positions[i]) < 1e-6;
     }
     if (!same) {
@@ -164,8 +167,9 @@ int calibrate(const CalibrateOptions& o) {
     return kExitUsage;
   }
   if (o.write_table && (!o.positioning || !o.sets.empty())) {
-    fmt::print(stderr, "error: --write-table needs --positioning, and writes only what the profile as written "
-                       "measured (no --set)\n");
+    fmt::print(stderr,
+               "error: --write-table needs --positioning, and writes only what the profile as written "
+               "measured (no --set)\n");
     return kExitUsage;
   }
   // With --write-table the machine is measured from the text that will be edited, read once: if
@@ -184,7 +188,8 @@ int calibrate(const CalibrateOptions& o) {
                                        : config::load_profile(o.profile, o.sets);
   for (const Diagnostic& d : load.diagnostics.items()) fmt::print(stderr, "{} [{}]\n", d.format(), d.code);
   if (!load.ok()) {
-    const bool unreadable = !load.diagnostics.items().empty() && load.diagnostics.items()[0].code == "config.file";
+    const bool unreadable =
+        !load.diagnostics.items().empty() && load.diagnostics.items()[0].code == "config.file";
     return unreadable ? kExitUsage : kExitProgram;
   }
   const config::MachineProfile& profile = *load.profile;
@@ -213,28 +218,32 @@ int calibrate(const CalibrateOptions& o) {
         fmt::print(stderr, "error: cannot write the trace {}\n", o.trace);
         return kExitUsage;
       }
-      if (h.axes.count() == 0) fmt::print(stderr, "warning: no axis homes by decel_midpoint: no homing figures\n");
+      if (h.axes.count() == 0)
+        fmt::print(stderr, "warning: no axis homes by decel_midpoint: no homing figures\n");
       if (!o.json) print_homing(h);
       nlohmann::json& j = out["homing"] = nlohmann::json::object();
       for (int i = 0; i < kAxisCount; ++i) {
         if (!h.axes.has(static_cast<Axis>(i))) continue;
-        j[axis_key(static_cast<Axis>(i))] = {{"midpoint_spread_um", um(h.midpoint_spread[static_cast<std::size_t>(i)])},
-                                             {"single_edge_spread_um", um(h.single_edge_spread[static_cast<std::size_t>(i)])}};
+        j[axis_key(static_cast<Axis>(i))] = {
+            {"midpoint_spread_um", um(h.midpoint_spread[static_cast<std::size_t>(i)])},
+            {"single_edge_spread_um", um(h.single_edge_spread[static_cast<std::size_t>(i)])}};
       }
     }
     if (o.positioning) {
       control::PositioningOptions po;
       po.axes = *axes;
       po.seed = o.seed;
-      const control::Positioning before = control::measure_positioning(control::without_compensation(profile), po);
+      const control::Positioning before =
+          control::measure_positioning(control::without_compensation(profile), po);
       // With the profile's own tables too, where it has some: how good they are.
       control::PositioningOptions with_own = po;
       with_own.axes = AxisMask{};
       for (const config::AxisProfile& a : profile.axes) {
         if (po.axes.has(a.axis) && a.compensation.present) with_own.axes.set(a.axis);
       }
-      const control::Positioning own =
-          with_own.axes.count() > 0 ? control::measure_positioning(profile, with_own) : control::Positioning{};
+      const control::Positioning own = with_own.axes.count() > 0
+                                           ? control::measure_positioning(profile, with_own)
+                                           : control::Positioning{};
       config::MachineProfile compensated = profile;
       std::vector<std::pair<Axis, config::CompensationProfile>> tables;
       for (config::AxisProfile& a : compensated.axes) {
@@ -273,7 +282,8 @@ int calibrate(const CalibrateOptions& o) {
 void add_calibrate_command(CLI::App& app, Registry& registry) {
   auto opts = std::make_shared<CalibrateOptions>();
   CLI::App* cmd = app.add_subcommand(
-      "calibrate", "Measure the simulated machine: homing repeatability, positioning before and after compensation");
+      "calibrate",
+      "Measure the simulated machine: homing repeatability, positioning before and after compensation");
   cmd->add_option("profile", opts->profile, "Machine profile, e.g. configs/drill-retrofit.toml")->required();
   cmd->add_option("--set", opts->sets, "Override a profile key (repeatable; not with --write-table)")
       ->expected(1)
@@ -283,7 +293,8 @@ void add_calibrate_command(CLI::App& app, Registry& registry) {
       ->check(CLI::Range(1, 10000));
   cmd->add_flag("--positioning", opts->positioning,
                 "Positioning test (ISO 230-2 style) before and after compensation with the measured table");
-  cmd->add_flag("--write-table", opts->write_table, "Write the measured tables into the profile (atomically)");
+  cmd->add_flag("--write-table", opts->write_table,
+                "Write the measured tables into the profile (atomically)");
   cmd->add_option("--axes", opts->axes, "Axes to position, e.g. XY (default: every driven axis)");
   cmd->add_flag("--json", opts->json, "Print the figures as JSON");
   cmd->add_option("--seed", opts->seed, "Seed of the random start positions, temperatures and machine noise");

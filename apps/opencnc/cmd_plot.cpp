@@ -268,9 +268,9 @@ viz::Panel following_errors(const Trace& tr) {
 
 // --- homing traces ----------------------------------------------------------------------------
 
-constexpr const char* kPhaseColors[] = {"#999999", "#8c564b", "#1f77b4", "#17becf", "#9467bd", "#bcbd22",
-                                        "#e8590c", "#2ca02c", "#d62728", "#e377c2", "#7f7f7f", "#000000",
-                                        "#ff0000"};
+constexpr const char* kPhaseColors[] = {"#999999", "#8c564b", "#1f77b4", "#17becf", "#9467bd",
+                                        "#bcbd22", "#e8590c", "#2ca02c", "#d62728", "#e377c2",
+                                        "#7f7f7f", "#000000", "#ff0000"};
 
 bool homes(const Trace& tr, int a) {
   for (const Sample& s : tr.samples) {
@@ -365,8 +365,8 @@ class PlotRecorder final : public control::ControllerObserver {
   explicit PlotRecorder(Trace& tr) : tr_(tr) {}
   void on_trace(const control::TraceSample& s, const control::TraceContext&) override {
     if (s.activity != control::Activity::Program) return;
-    tr_.samples.push_back(Sample{static_cast<double>(s.tick) * tr_.period_s, s.rapid, s.path_velocity, s.commanded,
-                                 s.following_error, s.actual, s.home_level, s.homing_phase});
+    tr_.samples.push_back(Sample{static_cast<double>(s.tick) * tr_.period_s, s.rapid, s.path_velocity,
+                                 s.commanded, s.following_error, s.actual, s.home_level, s.homing_phase});
   }
 
  private:

@@ -138,7 +138,8 @@ int run(const RunOptions& o) {
   hooks.opened = [&](const config::MachineProfile& profile, const control::OpenProgram& program) {
     std::vector<std::pair<std::shared_ptr<control::ControllerObserver>, control::ObserverOptions>> out;
     const plan::MachineLimits axes = control::axis_limits(profile);  // the drives' commands: the axes' own
-    recorder = std::make_shared<control::RunRecorder>(control::machine_limits(profile), profile.servo_period_s, &axes);
+    recorder = std::make_shared<control::RunRecorder>(control::machine_limits(profile),
+                                                      profile.servo_period_s, &axes);
     out.emplace_back(recorder, control::ObserverOptions{0, true});
     if (!o.trace.empty()) {
       csv.emplace(o.trace, profile.axis_mask(), profile.servo_period_s);

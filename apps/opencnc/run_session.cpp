@@ -83,7 +83,9 @@ class HandedSimMachine final : public machine::MachineIO {
     sim_.write(out);
   }
   /// Controller thread.
-  void set_hand_target(int joint, double target, double speed) noexcept { hand_.write({joint, target, speed}); }
+  void set_hand_target(int joint, double target, double speed) noexcept {
+    hand_.write({joint, target, speed});
+  }
 
  private:
   machine::SimMachine sim_;

@@ -73,7 +73,8 @@ MotionReserve compensation_reserve(const AxisProfile& axis, double servo_period_
   }
   MotionReserve r;
   r.velocity = c.takeup_velocity + slope * axis.max_velocity;
-  r.acceleration = c.takeup_acceleration + slope * axis.max_acceleration + bend * axis.max_velocity / servo_period_s;
+  r.acceleration =
+      c.takeup_acceleration + slope * axis.max_acceleration + bend * axis.max_velocity / servo_period_s;
   return r;
 }
 

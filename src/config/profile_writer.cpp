@@ -15,7 +15,7 @@ namespace opencnc::config {
 namespace {
 
 struct Line {
-  std::string_view text;  ///< without its line ending
+  std::string_view text;           ///< without its line ending
   std::size_t begin = 0, end = 0;  ///< byte range in the whole text, line ending included
 };
 
@@ -90,7 +90,8 @@ bool same_but_compensation(toml::table a, toml::table b, char letter) {
   for (toml::table* t : {&a, &b}) {
     if (toml::table* axes = (*t)["axis"].as_table()) {
       for (auto&& [k, v] : *axes) {
-        if (k.str().size() == 1 && std::tolower(static_cast<unsigned char>(k.str()[0])) == letter && v.is_table())
+        if (k.str().size() == 1 && std::tolower(static_cast<unsigned char>(k.str()[0])) == letter &&
+            v.is_table())
           v.as_table()->erase("compensation");
       }
     }
@@ -153,9 +154,10 @@ std::optional<std::string> with_compensation(std::string_view text, Axis axis, c
   try {
     const toml::table before = toml::parse(text), after = toml::parse(out);
     if (!same_but_compensation(before, after, l)) {
-      error = fmt::format("the compensation of {} is not a table of its own in the profile ([axis.{}.compensation]); "
-                          "edit it by hand",
-                          letter(axis), l);
+      error = fmt::format(
+          "the compensation of {} is not a table of its own in the profile ([axis.{}.compensation]); "
+          "edit it by hand",
+          letter(axis), l);
       return std::nullopt;
     }
   } catch (const toml::parse_error& e) {

@@ -54,12 +54,13 @@ void read_midpoint_homing(Section& h, const AxisProfile& a, HomingProfile& hp) {
               "config.homing");
     } else if (std::abs(*v) > a.max_velocity) {
       h.error("return_velocity",
-              fmt::format("{} ({}) exceeds the axis' max_velocity ({})", h.key_path("return_velocity"), show(*v),
-                          show(a.max_velocity)),
+              fmt::format("{} ({}) exceeds the axis' max_velocity ({})", h.key_path("return_velocity"),
+                          show(*v), show(a.max_velocity)),
               "config.range");
     }
   }
-  if (hp.latch_velocity != 0 && hp.return_velocity != 0 && (hp.latch_velocity > 0) != (hp.return_velocity > 0)) {
+  if (hp.latch_velocity != 0 && hp.return_velocity != 0 &&
+      (hp.latch_velocity > 0) != (hp.return_velocity > 0)) {
     h.error("latch_velocity",
             fmt::format("{} ({}) must run the same way as return_velocity ({})", h.key_path("latch_velocity"),
                         show(hp.latch_velocity), show(hp.return_velocity)),
@@ -151,12 +152,13 @@ void read_home_sensor(Section& switches, machine::SwitchLayout& s) {
   }
   if (ps.noise > 0 && ps.noise >= ps.hysteresis / 2) {
     p.warning("noise",
-              fmt::format("{}: noise ({}) of half the hysteresis ({}) or more makes the sensor chatter", p.path(),
-                          show(ps.noise), show(ps.hysteresis)),
+              fmt::format("{}: noise ({}) of half the hysteresis ({}) or more makes the sensor chatter",
+                          p.path(), show(ps.noise), show(ps.hysteresis)),
               "config.switch-chatter");
   }
   if (!s.home.present) {
-    p.error("ramp", fmt::format("{} describes the home switch: {}.home is missing", p.path(), switches.path()),
+    p.error("ramp",
+            fmt::format("{} describes the home switch: {}.home is missing", p.path(), switches.path()),
             "config.missing-key");
   }
 }
@@ -319,17 +321,17 @@ void read_drive(Section& m, const AxisProfile& a, double substep_s, machine::Sim
 void read_stepper_mechanics(Section& m, const AxisProfile& a, machine::SimJointModel& model) {
   for (const auto& [name, value] : m.table()) {
     const std::string_view k = name.str();
-    const bool stepper_key = k == "backlash" || k == "pitch_error" || k == "start_position" || k == "mass_kg" ||
-                             k == "coulomb_friction_n" || k == "static_friction_n" ||
-                             k == "viscous_friction_n_per_mm_s" || k == "inertia_kg_m2" ||
-                             k == "coulomb_friction_nm" || k == "static_friction_nm" ||
-                             k == "viscous_friction_nm_per_deg_s" || k == "pullout_force_n" || k == "pullout_speed";
+    const bool stepper_key =
+        k == "backlash" || k == "pitch_error" || k == "start_position" || k == "mass_kg" ||
+        k == "coulomb_friction_n" || k == "static_friction_n" || k == "viscous_friction_n_per_mm_s" ||
+        k == "inertia_kg_m2" || k == "coulomb_friction_nm" || k == "static_friction_nm" ||
+        k == "viscous_friction_nm_per_deg_s" || k == "pullout_force_n" || k == "pullout_speed";
     if (!stepper_key) m.reject(k, "applies to servo axes only (a stepper follows its steps)");
   }
   if (a.rotary) m.reject("pullout_force_n", "applies to linear axes (a rotary stepper is ideal for now)");
   if (!m.has("pullout_force_n")) {
-    for (std::string_view k : {"mass_kg", "coulomb_friction_n", "static_friction_n", "viscous_friction_n_per_mm_s",
-                               "pullout_speed"})
+    for (std::string_view k : {"mass_kg", "coulomb_friction_n", "static_friction_n",
+                               "viscous_friction_n_per_mm_s", "pullout_speed"})
       m.reject(k, "needs pullout_force_n (without it the stepper is ideal)");
     return;
   }
@@ -337,8 +339,10 @@ void read_stepper_mechanics(Section& m, const AxisProfile& a, machine::SimJointM
   model.pullout_speed = m.number_or("pullout_speed", 0, Bound::NonNegative);
   model.inertia = m.number_or("mass_kg", model.inertia, Bound::Positive);
   model.coulomb_friction = m.number_or("coulomb_friction_n", model.coulomb_friction, Bound::NonNegative);
-  model.static_friction = m.number("static_friction_n", Bound::NonNegative).value_or(1.25 * model.coulomb_friction);
-  model.viscous_friction = m.number_or("viscous_friction_n_per_mm_s", model.viscous_friction, Bound::NonNegative);
+  model.static_friction =
+      m.number("static_friction_n", Bound::NonNegative).value_or(1.25 * model.coulomb_friction);
+  model.viscous_friction =
+      m.number_or("viscous_friction_n_per_mm_s", model.viscous_friction, Bound::NonNegative);
   if (model.static_friction < model.coulomb_friction) {
     m.error("static_friction_n",
             fmt::format("{} ({}) must be at least coulomb_friction_n ({})", m.key_path("static_friction_n"),
@@ -405,7 +409,8 @@ void read_sim_model(Section& axis_section, AxisProfile& a, double substep_s) {
     read_stepper_mechanics(m, a, model);
   } else {
     for (const auto& [name, value] : m.table()) {
-      if (name.str() != "start_position") m.reject(name.str(), "does not apply to a manual axis (a hand moves it)");
+      if (name.str() != "start_position")
+        m.reject(name.str(), "does not apply to a manual axis (a hand moves it)");
     }
   }
   model.start_position = m.number_or("start_position", model.start_position);
@@ -416,7 +421,8 @@ void read_sim_model(Section& axis_section, AxisProfile& a, double substep_s) {
 
 void read_drive_kind(Section& s, AxisProfile& a) {
   a.drive = s.choice<JointDrive>(
-      "drive", {{"servo", JointDrive::Servo}, {"stepper", JointDrive::Stepper}, {"manual", JointDrive::Manual}},
+      "drive",
+      {{"servo", JointDrive::Servo}, {"stepper", JointDrive::Stepper}, {"manual", JointDrive::Manual}},
       JointDrive::Servo);
   if (a.drive != JointDrive::Stepper) {
     // Servo: the encoder; manual: the scale the hand-fed axis is read with.
@@ -512,12 +518,11 @@ void check_resolution(Section& s, const AxisProfile& a) {
 
 AxisProfile read_axis(const toml::table& table, const std::string& path, Axis axis, double substep_s,
                       Reporter& r) {
-  Section s(
-      table, path,
-      {"type", "drive", "max_velocity", "max_acceleration", "max_jerk", "min_limit", "max_limit", "wrapped",
-       "max_following_error", "encoder_counts_per_unit", "steps_per_unit", "homing", "switches", "sim",
-       "compensation", "stall_detector", "hand_tolerance"},
-      r);
+  Section s(table, path,
+            {"type", "drive", "max_velocity", "max_acceleration", "max_jerk", "min_limit", "max_limit",
+             "wrapped", "max_following_error", "encoder_counts_per_unit", "steps_per_unit", "homing",
+             "switches", "sim", "compensation", "stall_detector", "hand_tolerance"},
+            r);
   AxisProfile a;
   a.axis = axis;
   a.rotary = is_rotary(axis);

@@ -31,7 +31,8 @@ bool read_numbers(Section& s, std::string_view key, std::vector<double>& out) {
   for (const toml::node& e : *a) {
     const std::optional<double> v = e.value<double>();
     if (!v || !std::isfinite(*v)) {
-      s.reporter().error(&e.source(), fmt::format("{} must hold finite numbers", s.key_path(key)), "config.type");
+      s.reporter().error(&e.source(), fmt::format("{} must hold finite numbers", s.key_path(key)),
+                         "config.type");
       return false;
     }
     out.push_back(*v);
@@ -84,21 +85,25 @@ void read_comp_file(Section& s, const std::filesystem::path& path, int type, Com
     std::istringstream fields(text);
     double nominal = 0, up = 0, down = 0;
     std::string extra;
-    if (!(fields >> nominal >> up >> down) || (fields >> extra) || !std::isfinite(nominal) || !std::isfinite(up) ||
-        !std::isfinite(down)) {
+    if (!(fields >> nominal >> up >> down) || (fields >> extra) || !std::isfinite(nominal) ||
+        !std::isfinite(up) || !std::isfinite(down)) {
       const auto where = at_line(file, line, static_cast<std::uint32_t>(first + 1));
-      r.error(&where, "a comp file line must be three numbers: nominal, forward, reverse", "config.comp-file");
+      r.error(&where, "a comp file line must be three numbers: nominal, forward, reverse",
+              "config.comp-file");
       return;
     }
     if (!c.positions.empty() && nominal <= c.positions.back()) {
       const auto where = at_line(file, line, static_cast<std::uint32_t>(first + 1));
-      r.error(&where, fmt::format("nominal positions must increase ({} follows {})", show(nominal), show(c.positions.back())),
+      r.error(&where,
+              fmt::format("nominal positions must increase ({} follows {})", show(nominal),
+                          show(c.positions.back())),
               "config.comp-file");
       return;
     }
     if (c.positions.size() == static_cast<std::size_t>(kMaxCompensationPoints)) {
       const auto where = at_line(file, line, static_cast<std::uint32_t>(first + 1));
-      r.error(&where, fmt::format("a comp file holds at most {} points", kMaxCompensationPoints), "config.comp-file");
+      r.error(&where, fmt::format("a comp file holds at most {} points", kMaxCompensationPoints),
+              "config.comp-file");
       return;
     }
     c.positions.push_back(nominal);
@@ -115,7 +120,8 @@ void read_comp_file(Section& s, const std::filesystem::path& path, int type, Com
 void read_table(Section& s, CompensationProfile& c) {
   const bool one = s.has("errors"), two = s.has("forward") || s.has("reverse");
   if (one && two) {
-    s.error("errors", fmt::format("{}: give errors (both directions) or forward and reverse, not both", s.path()),
+    s.error("errors",
+            fmt::format("{}: give errors (both directions) or forward and reverse, not both", s.path()),
             "config.not-applicable");
     return;
   }
@@ -130,15 +136,16 @@ void read_table(Section& s, CompensationProfile& c) {
     if (!read_numbers(s, "forward", c.forward) || !read_numbers(s, "reverse", c.reverse)) return;
     if (c.forward.size() != c.reverse.size()) {
       s.error("reverse",
-              fmt::format("{}: forward has {} values and reverse {}; they are errors at the same points", s.path(),
-                          c.forward.size(), c.reverse.size()),
+              fmt::format("{}: forward has {} values and reverse {}; they are errors at the same points",
+                          s.path(), c.forward.size(), c.reverse.size()),
               "config.range");
       return;
     }
   }
   if (c.forward.empty() || c.forward.size() > static_cast<std::size_t>(kMaxCompensationPoints)) {
     s.error(one ? "errors" : "forward",
-            fmt::format("{}: a table has 1 to {} points (it has {})", s.path(), kMaxCompensationPoints, c.forward.size()),
+            fmt::format("{}: a table has 1 to {} points (it has {})", s.path(), kMaxCompensationPoints,
+                        c.forward.size()),
             "config.range");
     return;
   }
@@ -151,18 +158,20 @@ void check_slopes(Section& s, std::string_view key, const CompensationProfile& c
     for (const std::vector<double>* t : {&c.forward, &c.reverse}) {
       const double slope = ((*t)[i + 1] - (*t)[i]) / (c.positions[i + 1] - c.positions[i]);
       if (std::abs(slope) > kMaxSlope) {
-        s.error(key,
-                fmt::format("{}: the error changes by {:.4g} per unit between {} and {}, more than a lead-screw "
-                            "error can ({}); is the table in the axis' units?",
-                            s.path(), slope, show(c.positions[i]), show(c.positions[i + 1]), kMaxSlope),
-                "config.range");
+        s.error(
+            key,
+            fmt::format("{}: the error changes by {:.4g} per unit between {} and {}, more than a lead-screw "
+                        "error can ({}); is the table in the axis' units?",
+                        s.path(), slope, show(c.positions[i]), show(c.positions[i + 1]), kMaxSlope),
+            "config.range");
         return;
       }
     }
   }
 }
 
-void read_axis_compensation(Section& s, AxisProfile& a, double period_s, const std::filesystem::path& base_dir) {
+void read_axis_compensation(Section& s, AxisProfile& a, double period_s,
+                            const std::filesystem::path& base_dir) {
   CompensationProfile& c = a.compensation;
   c.present = true;
   c.backlash = s.number_or("backlash", 0, Bound::NonNegative);
@@ -182,7 +191,8 @@ void read_axis_compensation(Section& s, AxisProfile& a, double period_s, const s
     if (s.has("errors") || s.has("forward") || s.has("reverse")) {
       read_table(s, c);
     } else {
-      for (std::string_view k : {"start", "interval"}) s.reject(k, "needs a table (errors, or forward and reverse)");
+      for (std::string_view k : {"start", "interval"})
+        s.reject(k, "needs a table (errors, or forward and reverse)");
     }
   }
   check_slopes(s, s.has("comp_file") ? "comp_file" : (s.has("errors") ? "errors" : "forward"), c);
@@ -195,12 +205,13 @@ void read_axis_compensation(Section& s, AxisProfile& a, double period_s, const s
   }
   const MotionReserve r = compensation_reserve(a, period_s);
   if (r.velocity > 0.5 * a.max_velocity || r.acceleration > 0.5 * a.max_acceleration) {
-    s.error(s.has("takeup_velocity") ? "takeup_velocity" : "backlash",
-            fmt::format("{}: the compensation would take {} of the axis' {} velocity and {} of its {} acceleration "
-                        "(at most half of each)",
-                        s.path(), show(r.velocity), show(a.max_velocity), show(r.acceleration),
-                        show(a.max_acceleration)),
-            "config.range");
+    s.error(
+        s.has("takeup_velocity") ? "takeup_velocity" : "backlash",
+        fmt::format(
+            "{}: the compensation would take {} of the axis' {} velocity and {} of its {} acceleration "
+            "(at most half of each)",
+            s.path(), show(r.velocity), show(a.max_velocity), show(r.acceleration), show(a.max_acceleration)),
+        "config.range");
   }
 }
 
@@ -230,7 +241,8 @@ void read_compensation(Section& top, MachineProfile& profile, const std::filesys
                "reverse", "comp_file", "comp_file_type"},
               top.reporter());
     if (a->manual()) {
-      top.reporter().error(&c->source(), fmt::format("{} does not apply to a manual axis (nothing drives it)", path),
+      top.reporter().error(&c->source(),
+                           fmt::format("{} does not apply to a manual axis (nothing drives it)", path),
                            "config.not-applicable");
       continue;
     }

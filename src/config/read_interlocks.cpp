@@ -101,7 +101,8 @@ class RuleCompiler {
   }
   bool emit(RuleToken t) {
     if (tokens_.size() == static_cast<std::size_t>(machine::kMaxRuleTokens)) {
-      return fail(0, fmt::format("a rule's condition has at most {} signals and operators", machine::kMaxRuleTokens));
+      return fail(
+          0, fmt::format("a rule's condition has at most {} signals and operators", machine::kMaxRuleTokens));
     }
     tokens_.push_back(t);
     return true;
@@ -139,8 +140,9 @@ class RuleCompiler {
                                  : fmt::format("'{}' is not an output of [interlocks.outputs]", name));
       return false;
     }
-    fail(at, "a rule starts with an action: stop spindle, stop coolant, block spindle, block motion, hold "
-             "motion, estop or set OUTPUT");
+    fail(at,
+         "a rule starts with an action: stop spindle, stop coolant, block spindle, block motion, hold "
+         "motion, estop or set OUTPUT");
     return false;
   }
   static bool set(machine::InterlockRule& r, InterlockAction a) {
@@ -201,15 +203,16 @@ class RuleCompiler {
       if (w == name) return RuleToken{TokenOp::Signal, kind, 0};
     }
     for (const NamedSignal& in : p_.interlocks.inputs) {
-      if (w == in.name) return RuleToken{TokenOp::Signal, SignalKind::DigitalInput, static_cast<std::uint8_t>(in.channel)};
+      if (w == in.name)
+        return RuleToken{TokenOp::Signal, SignalKind::DigitalInput, static_cast<std::uint8_t>(in.channel)};
     }
     for (const NamedSignal& out : p_.interlocks.outputs) {
       if (w == out.name)
         return RuleToken{TokenOp::Signal, SignalKind::DigitalOutput, static_cast<std::uint8_t>(out.channel)};
     }
     static constexpr std::pair<std::string_view, SignalKind> kPerAxis[] = {
-        {"_homed", SignalKind::AxisHomed},           {"_moving", SignalKind::AxisMoving},
-        {"_limit_min", SignalKind::AxisLimitMin},    {"_limit_max", SignalKind::AxisLimitMax},
+        {"_homed", SignalKind::AxisHomed},        {"_moving", SignalKind::AxisMoving},
+        {"_limit_min", SignalKind::AxisLimitMin}, {"_limit_max", SignalKind::AxisLimitMax},
         {"_home", SignalKind::AxisHomeSwitch},
     };
     for (const AxisProfile& a : p_.axes) {
@@ -235,7 +238,8 @@ class RuleCompiler {
 bool valid_name(const std::string& n) {
   if (n.empty() || !std::isalpha(static_cast<unsigned char>(n[0]))) return false;
   for (char c : n) {
-    if (!(std::islower(static_cast<unsigned char>(c)) || std::isdigit(static_cast<unsigned char>(c)) || c == '_'))
+    if (!(std::islower(static_cast<unsigned char>(c)) || std::isdigit(static_cast<unsigned char>(c)) ||
+          c == '_'))
       return false;
   }
   return true;
@@ -252,7 +256,8 @@ void read_names(Section& s, std::string_view key, int channels, bool inputs, Mac
     const std::string path = s.key_path(key) + "." + name;
     if (!valid_name(name)) {
       r.error(&name_key.source(),
-              fmt::format("{}: a signal name is lower case letters, digits and '_', starting with a letter", path),
+              fmt::format("{}: a signal name is lower case letters, digits and '_', starting with a letter",
+                          path),
               "config.range");
       continue;
     }
@@ -261,8 +266,9 @@ void read_names(Section& s, std::string_view key, int channels, bool inputs, Mac
     if (const auto* i = node.as_integer()) {
       channel = i->get();
     } else if (const toml::table* entry = node.as_table()) {
-      Section e(*entry, path, inputs ? std::initializer_list<std::string_view>{"channel", "sim"}
-                                     : std::initializer_list<std::string_view>{"channel"},
+      Section e(*entry, path,
+                inputs ? std::initializer_list<std::string_view>{"channel", "sim"}
+                       : std::initializer_list<std::string_view>{"channel"},
                 r);
       channel = e.integer("channel", 0, machine::kDigitalChannels - 1);
       if (!channel && !e.has("channel")) e.missing("channel");
@@ -357,7 +363,8 @@ void read_interlocks(Section& top, MachineProfile& p) {
       s.reporter().error(&at, fmt::format("interlock rule \"{}\": {}", rule, c.error()), "config.interlock");
       continue;
     }
-    machine::InterlockRule& slot = p.interlocks.rules.rules[static_cast<std::size_t>(p.interlocks.rules.count++)];
+    machine::InterlockRule& slot =
+        p.interlocks.rules.rules[static_cast<std::size_t>(p.interlocks.rules.count++)];
     slot = *compiled;
     slot.line = static_cast<std::uint16_t>(n.source().begin.line);
     p.interlocks.rule_texts.push_back(rule);

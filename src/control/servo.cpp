@@ -255,8 +255,9 @@ void Servo::check_soft_limits() noexcept {
 void Servo::write_outputs() noexcept {
   bool moved = false;
   for (int j = 0; j < config_.joint_count; ++j) {
-    moved = moved || (!manual(j) && drives_enabled_ &&
-                      joint_cmd_[static_cast<std::size_t>(j)] != out_.joints[static_cast<std::size_t>(j)].position);
+    moved = moved ||
+            (!manual(j) && drives_enabled_ &&
+             joint_cmd_[static_cast<std::size_t>(j)] != out_.joints[static_cast<std::size_t>(j)].position);
     write_joint(j);
   }
   moved_last_ = moved;

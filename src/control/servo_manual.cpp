@@ -109,7 +109,8 @@ void Servo::run_movers() noexcept {
 void Servo::run_handwheel() noexcept {
   const std::int32_t counts = in_.handwheel_count - handwheel_last_;
   handwheel_last_ = in_.handwheel_count;
-  if (counts == 0 || handwheel_axis_ < 0 || !drives_enabled_ || mode_ != Mode::Manual || motion_blocked_) return;
+  if (counts == 0 || handwheel_axis_ < 0 || !drives_enabled_ || mode_ != Mode::Manual || motion_blocked_)
+    return;
   if (activity_ != Activity::None && activity_ != Activity::Jog) return;
   const int j = joint_of(handwheel_axis_);
   if (j < 0) return;
@@ -119,7 +120,8 @@ void Servo::run_handwheel() noexcept {
   if (toward_active_limit(j, distance)) return;
   AxisMover& m = movers_[uj];
   double target = m.goal() + distance;
-  if (homed_[uj] && !jc.wrapped) target = std::clamp(target, jc.min_limit - offset_[uj], jc.max_limit - offset_[uj]);
+  if (homed_[uj] && !jc.wrapped)
+    target = std::clamp(target, jc.min_limit - offset_[uj], jc.max_limit - offset_[uj]);
   m.move_to(target, jc.max_velocity);
   if (activity_ == Activity::None) {
     activity_ = Activity::Jog;

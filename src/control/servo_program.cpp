@@ -114,9 +114,10 @@ void Servo::map_program_state() noexcept {
       break;
     case traj::RunState::WaitingSpindle:
       // A start an interlock rule holds back is a wait of its own (status: interlock_rule).
-      wait_ = spindle_direction_ != machine::SpindleDirection::Stopped && !spindle_running_ && spindle_blocked_
-                  ? Wait::Interlock
-                  : Wait::Spindle;
+      wait_ =
+          spindle_direction_ != machine::SpindleDirection::Stopped && !spindle_running_ && spindle_blocked_
+              ? Wait::Interlock
+              : Wait::Spindle;
       break;
     case traj::RunState::Starved:
       wait_ = Wait::Starved;

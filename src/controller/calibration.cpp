@@ -70,8 +70,8 @@ void home(SimRig& rig) {
   must(rig, Request::set_mode(Mode::Manual), "manual mode");
   must(rig, Request::home(), "home");
   run_until(
-      rig, [](const ControllerStatus& s) { return s.servo.state == State::Idle && s.servo.all_homed; }, 2'000'000,
-      "homing");
+      rig, [](const ControllerStatus& s) { return s.servo.state == State::Idle && s.servo.all_homed; },
+      2'000'000, "homing");
 }
 
 /// ISO 230-2 figures of one axis from its deviations (targets × approaches, each direction).
@@ -110,15 +110,17 @@ AxisPositioning measure_axis(SimRig& rig, const config::AxisProfile& ax, const P
   const auto k0 = static_cast<long>(std::ceil((ax.min_limit + o.overrun - home) / o.interval - 1e-9));
   const auto k1 = static_cast<long>(std::floor((ax.max_limit - o.overrun - home) / o.interval + 1e-9));
   for (long k = k0; k <= k1; ++k) a.targets.push_back(home + static_cast<double>(k) * o.interval);
-  if (a.targets.empty()) throw std::runtime_error(fmt::format("axis {}: no target fits its travel", letter(ax.axis)));
+  if (a.targets.empty())
+    throw std::runtime_error(fmt::format("axis {}: no target fits its travel", letter(ax.axis)));
   const auto period = rig.servo().config().period_s;
   const auto dwell = static_cast<std::uint64_t>(std::llround(o.dwell_s / period));
   const machine::SimJoint& joint = rig.machine().joint(ax.joint);
   const auto move = [&](double x) {
-    must(rig, Request::mdi(fmt::format("G90 G1 {}{:.6f} F{}", letter(ax.axis), x, o.feed)), "positioning move");
+    must(rig, Request::mdi(fmt::format("G90 G1 {}{:.6f} F{}", letter(ax.axis), x, o.feed)),
+         "positioning move");
     run_until(
-        rig, [](const ControllerStatus& s) { return !s.run_active && s.servo.state == State::Idle; }, 10'000'000,
-        "positioning move");
+        rig, [](const ControllerStatus& s) { return !s.run_active && s.servo.state == State::Idle; },
+        10'000'000, "positioning move");
     rig.run(dwell);
   };
   const auto read = [&] { return std::round(joint.table_position() / o.resolution) * o.resolution; };
@@ -200,7 +202,8 @@ Positioning measure_positioning(const config::MachineProfile& profile, const Pos
   Positioning r;
   for (const config::AxisProfile& ax : p.axes) {
     if (!o.axes.has(ax.axis)) continue;
-    if (ax.manual()) throw std::runtime_error(fmt::format("axis {} is moved by hand: nothing to position", letter(ax.axis)));
+    if (ax.manual())
+      throw std::runtime_error(fmt::format("axis {} is moved by hand: nothing to position", letter(ax.axis)));
     r.axes.set(ax.axis);
     r.axis[static_cast<std::size_t>(index(ax.axis))] = measure_axis(rig, ax, o);
   }

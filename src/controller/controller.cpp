@@ -653,9 +653,10 @@ std::string Controller::wait_text() const {
       return "the planner";
     case Wait::HandAxis: {
       const HandWait& h = s.hand_wait;
-      const char axis = h.axis >= 0 && h.axis < kAxisCount ? kAxisLetters[static_cast<std::size_t>(h.axis)] : '?';
-      return fmt::format("the operator to bring the hand-fed {} {} {:.3f} mm", axis, h.retract ? "up to" : "down to",
-                         h.target);
+      const char axis =
+          h.axis >= 0 && h.axis < kAxisCount ? kAxisLetters[static_cast<std::size_t>(h.axis)] : '?';
+      return fmt::format("the operator to bring the hand-fed {} {} {:.3f} mm", axis,
+                         h.retract ? "up to" : "down to", h.target);
     }
     case Wait::Interlock: {
       const auto& texts = profile_.interlocks.rule_texts;
@@ -727,9 +728,10 @@ void Controller::finish(std::uint64_t id, Refusal refusal, std::string message, 
 
 std::string Controller::interlock_text(const ServoEvent& e) const {
   if (e.kind == EventKind::HandAxisMoved) {
-    const char axis = e.axis >= 0 && e.axis < kAxisCount ? kAxisLetters[static_cast<std::size_t>(e.axis)] : '?';
-    return fmt::format("{} left the position the program needs ({:.4f} mm) while the table moved: feed hold", axis,
-                       e.value);
+    const char axis =
+        e.axis >= 0 && e.axis < kAxisCount ? kAxisLetters[static_cast<std::size_t>(e.axis)] : '?';
+    return fmt::format("{} left the position the program needs ({:.4f} mm) while the table moved: feed hold",
+                       axis, e.value);
   }
   const auto& texts = profile_.interlocks.rule_texts;
   const std::string rule = e.action < texts.size() ? texts[e.action] : std::string("?");
@@ -768,9 +770,10 @@ std::string Controller::describe(const Fault& f) const {
           "stopped on the path",
           f.value);
     case FaultKind::Homing:
-      return fmt::format("homing {} failed at {:.4f} {}: a limit switch, or the home sensor not on the "
-                         "deceleration dog",
-                         axis, f.value, unit);
+      return fmt::format(
+          "homing {} failed at {:.4f} {}: a limit switch, or the home sensor not on the "
+          "deceleration dog",
+          axis, f.value, unit);
     case FaultKind::Stall:
       return fmt::format("the {} stepper stalled at {:.4f} {}: steps were lost, home it again", axis, f.value,
                          unit);

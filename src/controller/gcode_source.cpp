@@ -99,7 +99,11 @@ class Pipeline {
  public:
   Pipeline(gcode::Interpreter& interp, const Pose& start, double tolerance_mm, tools::ToolTableService* tools,
            const HandAxes& hand)
-      : interp_(&interp), tolerance_mm_(tolerance_mm), writer_(tools), hand_(hand), hand_axes_any_(hand.any()) {
+      : interp_(&interp),
+        tolerance_mm_(tolerance_mm),
+        writer_(tools),
+        hand_(hand),
+        hand_axes_any_(hand.any()) {
     auto b = std::make_unique<canon::ProgramBuilder>(interp.options().axes, start);
     b->program().set_sources(interp.sources());
     attach(std::move(b), interp.state().modal.units);
@@ -179,8 +183,11 @@ class GcodeStream final : public ProgramStream {
   /// An MDI line on the session's interpreter (already placed and up to date).
   GcodeStream(gcode::Interpreter& session, std::string line, const Pose& start, double tolerance_mm,
               std::shared_ptr<tools::ToolTableService> tools, const HandAxes& hand)
-      : interp_(&session), tools_(std::move(tools)), pipe_(session, start, tolerance_mm, tools_.get(), hand),
-        mdi_line_(std::move(line)), mdi_(true) {
+      : interp_(&session),
+        tools_(std::move(tools)),
+        pipe_(session, start, tolerance_mm, tools_.get(), hand),
+        mdi_line_(std::move(line)),
+        mdi_(true) {
     tools_version_ = tools_ ? tools_->version() : 0;
     first_diagnostic_ = interp_->diagnostics().items().size();
     replay_state();
@@ -327,7 +334,8 @@ class GcodeStream final : public ProgramStream {
 /// One scan of a file (gcode::Mode::Scan) into a window of moves.
 class Scan {
  public:
-  Scan(const gcode::Options& o, const std::string& path, const Pose& start, double tolerance_mm, const HandAxes& hand)
+  Scan(const gcode::Options& o, const std::string& path, const Pose& start, double tolerance_mm,
+       const HandAxes& hand)
       : interp_(o), pipe_(interp_, start, tolerance_mm, nullptr, hand) {
     ok_ = begin_program(interp_, pipe_, path, start, tolerance_mm);
     done_ = !ok_;
@@ -478,8 +486,8 @@ class PreflightRun {
 };
 
 /// One preflight pass; with `classify`, a second scan with other answers runs in step with it.
-Preflight preflight_pass(const gcode::Options& o, const std::string& path, const Pose& start, double tolerance_mm,
-                         const HandAxes& hand, MoveCheck& check, bool classify) {
+Preflight preflight_pass(const gcode::Options& o, const std::string& path, const Pose& start,
+                         double tolerance_mm, const HandAxes& hand, MoveCheck& check, bool classify) {
   Preflight out;
   gcode::Options main = o;
   main.mode = gcode::Mode::Scan;
@@ -564,7 +572,8 @@ std::unique_ptr<ProgramStream> GcodeProgramSource::execute(const std::string& pa
                                                            const LoadOptions& options) {
   gcode::Options o = options_for(path, options);
   o.mode = gcode::Mode::Execute;
-  return std::make_unique<GcodeStream>(o, path, start, config_.default_tolerance_mm, config_.tools, config_.hand);
+  return std::make_unique<GcodeStream>(o, path, start, config_.default_tolerance_mm, config_.tools,
+                                       config_.hand);
 }
 
 std::unique_ptr<ProgramStream> GcodeProgramSource::mdi(std::string_view line, const Pose& start) {
@@ -581,9 +590,8 @@ std::unique_ptr<ProgramStream> GcodeProgramSource::mdi(std::string_view line, co
     mdi_tools_version_ = config_.tools->version();
   }
   mdi_->set_machine_position(start);
-  auto stream =
-      std::make_unique<GcodeStream>(*mdi_, std::string(line), start, config_.default_tolerance_mm, config_.tools,
-                                    config_.hand);
+  auto stream = std::make_unique<GcodeStream>(*mdi_, std::string(line), start, config_.default_tolerance_mm,
+                                              config_.tools, config_.hand);
   return stream;
 }
 

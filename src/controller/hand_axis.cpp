@@ -96,8 +96,9 @@ void HandAxisFilter::process_move(canon::Program& program, canon::SegmentId id) 
       (m.flags & canon::kSpindleSynced)) {
     const char* what = m.kind == MoveKind::Arc ? (arc_in_plane ? "arc" : "helix") : "move";
     fail(program, id,
-         fmt::format("this {} moves the hand-fed axis {}: only straight moves of a hand axis can be waited for", what,
-                     letters));
+         fmt::format(
+             "this {} moves the hand-fed axis {}: only straight moves of a hand axis can be waited for", what,
+             letters));
     return;
   }
   std::array<Action, kAxisCount> after{};

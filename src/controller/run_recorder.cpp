@@ -158,9 +158,9 @@ void TraceCsvWriter::add(const TraceSample& s) {
                  s.rapid ? 1 : 0, s.line, s.segment, s.path_velocity);
   for (int i = 0; i < kAxisCount; ++i) {
     if (!axes_.has(static_cast<Axis>(i))) continue;
-    fmt::format_to(std::back_inserter(row_), ",{:.6f},{:.6f},{:.6f},{:.6f},{},{:.4f}", s.commanded[i], s.actual[i],
-                   s.following_error[i], s.output[i], to_string(s.homing_phase[static_cast<std::size_t>(i)]),
-                   s.home_level[i]);
+    fmt::format_to(std::back_inserter(row_), ",{:.6f},{:.6f},{:.6f},{:.6f},{},{:.4f}", s.commanded[i],
+                   s.actual[i], s.following_error[i], s.output[i],
+                   to_string(s.homing_phase[static_cast<std::size_t>(i)]), s.home_level[i]);
   }
   row_ += '\n';
   out_ << row_;

@@ -104,7 +104,8 @@ ServoConfig servo_config(const config::MachineProfile& profile) {
     j.home.switch_position = h.switch_position;
     j.home.search_velocity = h.search_velocity;
     j.home.latch_velocity = h.latch_velocity;
-    j.home.final_velocity = std::min(h.final_velocity > 0 ? h.final_velocity : a.max_velocity, j.max_velocity);
+    j.home.final_velocity =
+        std::min(h.final_velocity > 0 ? h.final_velocity : a.max_velocity, j.max_velocity);
     j.home.sequence = h.sequence;
     j.home.return_velocity = h.return_velocity;
     j.home.overrun = h.overrun;
@@ -118,7 +119,8 @@ ServoConfig servo_config(const config::MachineProfile& profile) {
   s.compensation.period_s = profile.servo_period_s;
   s.interlocks = profile.interlocks.rules;
   if (profile.handwheel.present) {
-    s.handwheel_step_count = static_cast<int>(std::min<std::size_t>(profile.handwheel.steps.size(), kMaxHandwheelSteps));
+    s.handwheel_step_count =
+        static_cast<int>(std::min<std::size_t>(profile.handwheel.steps.size(), kMaxHandwheelSteps));
     for (int k = 0; k < s.handwheel_step_count; ++k)
       s.handwheel_steps[static_cast<std::size_t>(k)] = profile.handwheel.steps[static_cast<std::size_t>(k)];
   }

@@ -481,13 +481,14 @@ bool SimJoint::integrate_stepper_period() noexcept {
       powered_ ? static_cast<double>(cmd_.step_position - steps_emitted_) / spu / period_s_ : 0.0;
   if (powered_) steps_emitted_ = cmd_.step_position;
   if (powered_ && !stalled_ && in_step_) {
-    const double smoothed = step_velocity_ + (v_steps - step_velocity_) * period_s_ / (period_s_ + kRotorLag_s);
+    const double smoothed =
+        step_velocity_ + (v_steps - step_velocity_) * period_s_ / (period_s_ + kRotorLag_s);
     const double accel = (smoothed - step_velocity_) / period_s_;
-    const double need =
-        v_steps != 0.0
-            ? accel / accel_per_effort_ + std::copysign(m.coulomb_friction, v_steps) +
-                  m.viscous_friction * v_steps - external_effort_
-            : std::max(0.0, std::abs(external_effort_) - m.static_friction) + std::abs(accel / accel_per_effort_);
+    const double need = v_steps != 0.0
+                            ? accel / accel_per_effort_ + std::copysign(m.coulomb_friction, v_steps) +
+                                  m.viscous_friction * v_steps - external_effort_
+                            : std::max(0.0, std::abs(external_effort_) - m.static_friction) +
+                                  std::abs(accel / accel_per_effort_);
     const double reach = m.pullout_speed > 0 ? std::max(0.0, 1.0 - std::abs(v_steps) / m.pullout_speed) : 1.0;
     step_velocity_ = smoothed;
     if (std::abs(need) <= m.pullout_effort * reach) {

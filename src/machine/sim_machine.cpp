@@ -219,7 +219,8 @@ void SimMachine::sample() noexcept {
   std::uint64_t switched = 0;  // inputs wired to switches on the machine
   for (std::size_t k = 0; k < input_switches_.size(); ++k) {
     const SimInputSwitch& w = config_.input_switches[k];
-    if (w.channel < 0 || w.joint < 0 || w.joint >= config_.joint_count || w.channel >= kDigitalChannels) continue;
+    if (w.channel < 0 || w.joint < 0 || w.joint >= config_.joint_count || w.channel >= kDigitalChannels)
+      continue;
     if (input_switches_[k].update(joints_[static_cast<std::size_t>(w.joint)].table_position(), rng_))
       switched |= std::uint64_t{1} << w.channel;
   }

@@ -107,7 +107,8 @@ TEST(DrillProfile, CompensationReserve) {
 
 TEST(DrillProfile, TablesPerDirection) {
   const ProfileLoad load = parse(
-      "[axis.x.compensation]\nstart = -10\ninterval = 100\nforward = [0, 0.01, 0.02]\nreverse = [0.005, 0.02, "
+      "[axis.x.compensation]\nstart = -10\ninterval = 100\nforward = [0, 0.01, 0.02]\nreverse = [0.005, "
+      "0.02, "
       "0.03]\n");
   ASSERT_TRUE(load.ok()) << all_messages(load.diagnostics);
   const CompensationProfile& c = load.profile->find(Axis::X)->compensation;
@@ -144,7 +145,8 @@ class CompFile {
 // Type 0: where the axis actually is moving up and moving down; type 1: the trims LinuxCNC adds
 // to the command (the negative of the error). Both read into errors.
 TEST(DrillProfile, LinuxCncCompFilesOfBothTypes) {
-  const CompFile f("# nominal forward reverse\n-10 -10.001  -9.999\n\n  0  -0.003   0.002\n 10   9.999  10.000\n");
+  const CompFile f(
+      "# nominal forward reverse\n-10 -10.001  -9.999\n\n  0  -0.003   0.002\n 10   9.999  10.000\n");
   const ProfileLoad t0 = f.load(0);
   ASSERT_TRUE(t0.ok()) << all_messages(t0.diagnostics);
   const CompensationProfile& c0 = t0.profile->find(Axis::X)->compensation;
@@ -189,31 +191,39 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"UnknownSignal",
                 "[interlocks]\nrules = [\"stop spindle when tool_upp\"]\n",
                 {"config.interlock", "p.toml", 16, 29}},
-        BadCase{"UnknownAction", "[interlocks]\nrules = [\"halt spindle when estop\"]\n",
+        BadCase{"UnknownAction",
+                "[interlocks]\nrules = [\"halt spindle when estop\"]\n",
                 {"config.interlock", "p.toml", 16, 11}},
-        BadCase{"MissingWhen", "[interlocks]\nrules = [\"stop spindle estop\"]\n",
+        BadCase{"MissingWhen",
+                "[interlocks]\nrules = [\"stop spindle estop\"]\n",
                 {"config.interlock", "p.toml", 16, 24}},
         BadCase{"UnclosedParenthesis",
                 "[interlocks]\nrules = [\"block motion when (estop or x_homed\"]\n",
                 {"config.interlock", "p.toml", 16, 46}},
-        BadCase{"UnknownOutput", "[interlocks]\nrules = [\"set lamp when machine_on\"]\n",
+        BadCase{"UnknownOutput",
+                "[interlocks]\nrules = [\"set lamp when machine_on\"]\n",
                 {"config.interlock", "p.toml", 16, 15}},
-        BadCase{"SecondRuleOnItsOwnLine",
-                "[interlocks.inputs]\ntool_up = 0\n[interlocks]\nrules = [\n  \"stop spindle when tool_up\",\n  "
-                "\"block spindle unless z_homed and tool_dwn\",\n]\n",
-                {"config.interlock", "p.toml", 20, 37}},
-        BadCase{"InputChannelMissing", "[interlocks.inputs]\ntool_up = 7\n", {"config.range", "p.toml", 16, 11}},
+        BadCase{
+            "SecondRuleOnItsOwnLine",
+            "[interlocks.inputs]\ntool_up = 0\n[interlocks]\nrules = [\n  \"stop spindle when tool_up\",\n  "
+            "\"block spindle unless z_homed and tool_dwn\",\n]\n",
+            {"config.interlock", "p.toml", 20, 37}},
+        BadCase{
+            "InputChannelMissing", "[interlocks.inputs]\ntool_up = 7\n", {"config.range", "p.toml", 16, 11}},
         BadCase{"SlopeOfAWrongPitch",
                 "[axis.x.compensation]\ninterval = 10\nerrors = [0, 0.5]\n",
                 {"config.range", "p.toml", 17, 10}},
         BadCase{"TablesOfDifferentLengths",
                 "[axis.x.compensation]\ninterval = 10\nforward = [0, 0.001]\nreverse = [0]\n",
                 {"config.range", "p.toml", 18, 11}},
-        BadCase{"TableWithoutInterval", "[axis.x.compensation]\nerrors = [0, 0.001]\n",
+        BadCase{"TableWithoutInterval",
+                "[axis.x.compensation]\nerrors = [0, 0.001]\n",
                 {"config.missing-key", "p.toml", 15, 1}},
-        BadCase{"CompensationOfAHandAxis", "[axis.z.compensation]\nbacklash = 0.01\n",
+        BadCase{"CompensationOfAHandAxis",
+                "[axis.z.compensation]\nbacklash = 0.01\n",
                 {"config.not-applicable", "p.toml", 15, 1}},
-        BadCase{"TakeUpEatsTheAxis", "[axis.x.compensation]\nbacklash = 0.01\ntakeup_velocity = 40\n",
+        BadCase{"TakeUpEatsTheAxis",
+                "[axis.x.compensation]\nbacklash = 0.01\ntakeup_velocity = 40\n",
                 {"config.range", "p.toml", 17, 19}},
         BadCase{"MidpointReturnsTheWrongWay",
                 "[axis.x.homing]\nmethod = \"decel_midpoint\"\nsearch_velocity = -40\nreturn_velocity = -1\n"
@@ -231,10 +241,12 @@ INSTANTIATE_TEST_SUITE_P(
                 "[axis.z.homing]\nmethod = \"switch\"\nsearch_velocity = 5\nlatch_velocity = 1\n",
                 {"config.homing", "p.toml", 15, 1}},
         BadCase{"PullOutOnAServo",
-                "[axis.y]\nmax_velocity = 50\nmax_acceleration = 300\nmin_limit = 0\nmax_limit = 1\n[axis.y.sim]\n"
+                "[axis.y]\nmax_velocity = 50\nmax_acceleration = 300\nmin_limit = 0\nmax_limit = "
+                "1\n[axis.y.sim]\n"
                 "pullout_force_n = 100\n",
                 {"config.not-applicable", "p.toml", 21, 19}},
-        BadCase{"StepperMassWithoutPullOut", "[axis.x.sim]\nmass_kg = 100\n",
+        BadCase{"StepperMassWithoutPullOut",
+                "[axis.x.sim]\nmass_kg = 100\n",
                 {"config.not-applicable", "p.toml", 16, 11}},
         BadCase{"HandwheelSteps", "[handwheel]\nsteps = [0.01, -1]\n", {"config.range", "p.toml", 16, 9}}),
     [](const auto& param_info) { return std::string(param_info.param.name); });

@@ -56,9 +56,9 @@ TEST(MidpointHoming, GoesThroughTheSeedsStepsToTheMiddleOfTheSensor) {
       },
       60000));
   // Power-up at 0 is on the dog and the sensor: off them first, then the seed's sequence.
-  const std::vector<HomingPhase> expected{HomingPhase::Idle,    HomingPhase::Clear,   HomingPhase::Search,
-                                          HomingPhase::Overrun, HomingPhase::Return,  HomingPhase::Measure,
-                                          HomingPhase::Center,  HomingPhase::Final,   HomingPhase::Done};
+  const std::vector<HomingPhase> expected{HomingPhase::Idle,    HomingPhase::Clear,  HomingPhase::Search,
+                                          HomingPhase::Overrun, HomingPhase::Return, HomingPhase::Measure,
+                                          HomingPhase::Center,  HomingPhase::Final,  HomingPhase::Done};
   EXPECT_EQ(phases, expected);
   const HomingStatus& x = h.status().homing[kX];
   EXPECT_TRUE(x.measured);
@@ -82,7 +82,8 @@ TEST(MidpointHoming, MiddleStaysWhileTheEdgesDriftWithTemperature) {
   const double temperatures[] = {12.0, 20.0, 28.0, 36.0};
   const char* starts[] = {"0.0", "150.0", "37.5", "420.0"};
   for (int run = 0; run < 4; ++run) {
-    ServoHarness h(drill({"sim.seed=" + std::to_string(31 + run), std::string("axis.x.sim.start_position=") + starts[run]}));
+    ServoHarness h(drill(
+        {"sim.seed=" + std::to_string(31 + run), std::string("axis.x.sim.start_position=") + starts[run]}));
     h.sim().set_temperature(temperatures[run]);
     home_all(h);
     const HomingStatus& x = h.status().homing[kX];
@@ -208,7 +209,7 @@ TEST(Interlocks, SpindleStartsWithTheToolUpAndStopsWhenItComesBackUp) {
   h.sim().set_hand_target(kZ, -20.0, 30.0);  // the operator drills
   h.tick(2000);
   EXPECT_EQ(h.status().spindle_direction, machine::SpindleDirection::Clockwise);  // a running one runs on
-  h.sim().set_hand_target(kZ, 0.0, 30.0);  // and comes back to the top
+  h.sim().set_hand_target(kZ, 0.0, 30.0);                                         // and comes back to the top
   h.tick(2000);
   EXPECT_EQ(h.status().spindle_direction, machine::SpindleDirection::Stopped);
   const auto e = h.last(EventKind::Interlock);

@@ -104,7 +104,8 @@ TEST(ProfileWriter, ReplacesTheTableAndKeepsEverythingElse) {
   ASSERT_TRUE(text) << error;
   EXPECT_EQ(text->find("the old table"), std::string::npos);
   EXPECT_NE(text->find("# a comment that stays"), std::string::npos);
-  EXPECT_NE(text->find("# Y: comments that lead into the next table stay with it\n[axis.y]"), std::string::npos);
+  EXPECT_NE(text->find("# Y: comments that lead into the next table stay with it\n[axis.y]"),
+            std::string::npos);
   const config::ProfileLoad load = config::parse_profile(*text, "t.toml");
   ASSERT_TRUE(load.ok()) << *text;
   const config::CompensationProfile& c = load.profile->find(Axis::X)->compensation;
@@ -127,8 +128,9 @@ TEST(ProfileWriter, AddsATableAfterTheAxis) {
 TEST(ProfileWriter, RefusesWhatItCannotEditSafely) {
   std::string error;
   // The compensation written as dotted keys in [axis.x]: a second definition would not read back.
-  const std::string dotted = "name = \"t\"\n[axis.x]\nmax_velocity = 50\nmax_acceleration = 300\nmin_limit = 0\n"
-                             "max_limit = 100\ncompensation.backlash = 0.01\n";
+  const std::string dotted =
+      "name = \"t\"\n[axis.x]\nmax_velocity = 50\nmax_acceleration = 300\nmin_limit = 0\n"
+      "max_limit = 100\ncompensation.backlash = 0.01\n";
   EXPECT_FALSE(config::with_compensation(dotted, Axis::X, table(), error));
   EXPECT_NE(error.find("read back"), std::string::npos) << error;
   EXPECT_FALSE(config::with_compensation(kProfileText, Axis::Z, table(), error));

@@ -29,7 +29,7 @@ config::MachineProfile drill() {
 struct Loaded {
   std::unique_ptr<ProgramStream> stream;
   const canon::Program* program = nullptr;  ///< null when the stream failed
-  Diagnostics diagnostics;                   ///< the stream's
+  Diagnostics diagnostics;                  ///< the stream's
   Preflight preflight;
 };
 
@@ -39,8 +39,9 @@ class AcceptAll final : public MoveCheck {
 };
 
 Loaded load(const std::string& text, double z = 0) {
-  const auto dir = std::filesystem::temp_directory_path() /
-                   ("opencnc-hand-" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+  const auto dir =
+      std::filesystem::temp_directory_path() /
+      ("opencnc-hand-" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
   std::filesystem::create_directories(dir);
   const std::string path = (dir / "p.ngc").string();
   std::ofstream(path) << text;

@@ -16,7 +16,8 @@ namespace {
 
 /// The X table of the drill retrofit paper: error (mm) every 50 mm from the origin.
 PitchTable seed_table() {
-  const double errors[] = {0, 0.003, 0.006, 0.010, 0.015, 0.018, 0.022, 0.027, 0.028, 0.030, 0.033, 0.037, 0.040};
+  const double errors[] = {0,     0.003, 0.006, 0.010, 0.015, 0.018, 0.022,
+                           0.027, 0.028, 0.030, 0.033, 0.037, 0.040};
   PitchTable t;
   t.count = 13;
   for (int i = 0; i < t.count; ++i) {
@@ -101,9 +102,9 @@ TEST(Compensation, TakesUpBacklashWithinItsLimits) {
   const double backlash = 0.02, v = 5, a = 200;
   Compensation comp(one_joint(PitchTable{}, backlash, v, a));
   std::vector<double> path;
-  for (int k = 0; k <= 1000; ++k) path.push_back(0.05 * k);        // + at 50 mm/s
-  for (int k = 1; k <= 1000; ++k) path.push_back(50 - 0.05 * k);   // reverse
-  for (int k = 0; k < 100; ++k) path.push_back(0);                 // rest
+  for (int k = 0; k <= 1000; ++k) path.push_back(0.05 * k);       // + at 50 mm/s
+  for (int k = 1; k <= 1000; ++k) path.push_back(50 - 0.05 * k);  // reverse
+  for (int k = 0; k < 100; ++k) path.push_back(0);                // rest
   const Trace r = run(comp, path, false);
   EXPECT_NEAR(r.c[1000], backlash / 2, 1e-12);  // taken up while moving +
   EXPECT_EQ(r.c.back(), -backlash / 2);         // and exactly the other way after the reversal

@@ -67,7 +67,8 @@ double table_y(Scenario& s) {
 void home(Scenario& s) {
   s.on(Mode::Manual);
   s.must(Request::home());
-  ASSERT_TRUE(s.until([&] { return s.status().servo.state == State::Idle && s.status().servo.all_homed; }, 100000));
+  ASSERT_TRUE(
+      s.until([&] { return s.status().servo.state == State::Idle && s.status().servo.all_homed; }, 100000));
 }
 
 struct Hole {
@@ -84,6 +85,7 @@ TEST(DrillScenario, BearingCapHolesWithinFiveMicrometres) {
   // While the quill is down in a hole the table must stand where the program put it.
   std::vector<Hole> holes{{150.0, 140.0}, {530.0, 140.0}};
   int interlock_stops = 0;
+  int cutting_without_spindle = 0;  // periods with the tool in the part and the spindle not at speed
   bool down = false;
   EventCursor events(s.rig().controller().events());
   s.must(Request::simple(CommandKind::CycleStart));
@@ -94,6 +96,7 @@ TEST(DrillScenario, BearingCapHolesWithinFiveMicrometres) {
         const double z = s.status().servo.joints[kZ].actual;
         const bool in_part = z < -60.0 - 1.0;  // the tool below the cap's face
         if (in_part) {
+          cutting_without_spindle += s.status().servo.spindle_at_speed ? 0 : 1;
           for (Hole& h : holes) {
             if (std::abs(table_x(s) - h.x) > 1.0) continue;
             h.worst = std::max({h.worst, std::abs(table_x(s) - h.x), std::abs(table_y(s) - h.y)});
@@ -112,16 +115,21 @@ TEST(DrillScenario, BearingCapHolesWithinFiveMicrometres) {
     std::printf("hole at X%.0f Y%.0f: table within %.2f µm of it while the tools were in it\n", h.x, h.y,
                 1000 * h.worst);
   }
-  // The PLC stopped the spindle each time the quill came back to its top stop with it running.
+  // The PLC stopped the spindle each time the quill came back to its top stop with it running, and
+  // held each start back until the table stood still: no tool entered the part without it.
   EXPECT_GE(interlock_stops, 3);
+  EXPECT_EQ(cutting_without_spindle, 0);
   const RunReport r = s.report();
   EXPECT_EQ(r.limit_violations, 0u) << "output: " << r.output_limit_violations << " first at "
-                                    << r.first_output_violation.time_s << " s, axis " << r.first_output_violation.axis
-                                    << " derivative " << r.first_output_violation.derivative << " "
-                                    << r.first_output_violation.value << " > " << r.first_output_violation.limit;
+                                    << r.first_output_violation.time_s << " s, axis "
+                                    << r.first_output_violation.axis << " derivative "
+                                    << r.first_output_violation.derivative << " "
+                                    << r.first_output_violation.value << " > "
+                                    << r.first_output_violation.limit;
   EXPECT_GT(r.max_compensation_mm, 0.03);
   // After the part the machine homes again: nothing was lost, the origin is where it was.
-  ASSERT_TRUE(s.until([&] { return s.status().servo.state == State::Idle && s.status().servo.all_homed; }, 100000));
+  ASSERT_TRUE(
+      s.until([&] { return s.status().servo.state == State::Idle && s.status().servo.all_homed; }, 100000));
   EXPECT_LE(std::abs(s.status().servo.homing[kX].origin_shift), 0.001);
   EXPECT_LE(std::abs(s.status().servo.homing[kY].origin_shift), 0.001);
   EXPECT_EQ(s.status().servo.commanded[Axis::X], 0.0);
@@ -153,7 +161,8 @@ TEST(DrillScenario, HomingAfterThePartFindsLostSteps) {
   ASSERT_EQ(s.status().runs_finished, 1u) << s.status().fault_text;
   const double lost_mm = static_cast<double>(s.sim().joint(kY).lost_steps()) / 640.0;
   EXPECT_GT(lost_mm, 1.0);
-  ASSERT_TRUE(s.until([&] { return s.status().servo.state == State::Idle && s.status().servo.all_homed; }, 100000));
+  ASSERT_TRUE(
+      s.until([&] { return s.status().servo.state == State::Idle && s.status().servo.all_homed; }, 100000));
   EXPECT_NEAR(s.status().servo.homing[kY].origin_shift, lost_mm, 0.002);
   EXPECT_LE(std::abs(s.status().servo.homing[kX].origin_shift), 0.001);
   // Homed again, the table stands where the controller says.
@@ -264,7 +273,8 @@ TEST(DrillScenario, EStopDuringAProgramStopsAndRefusesMotionUntilResetAndHomed) 
   EXPECT_EQ(s.ask(Request::simple(CommandKind::CycleStart)).refusal, Refusal::NotHomed);
   s.must(Request::set_mode(Mode::Manual));
   s.must(Request::home());
-  ASSERT_TRUE(s.until([&] { return s.status().servo.state == State::Idle && s.status().servo.all_homed; }, 100000));
+  ASSERT_TRUE(
+      s.until([&] { return s.status().servo.state == State::Idle && s.status().servo.all_homed; }, 100000));
   s.must(Request::set_mode(Mode::Auto));
   EXPECT_TRUE(s.start_and_finish());
 }
@@ -301,9 +311,12 @@ TEST(DrillScenario, EveryHardLimitStopsTheMachineAndRefusesMotionPastIt) {
     s.must(Request::simple(CommandKind::MachineOn));
     EXPECT_EQ(s.ask(Request::jog(c.axis, c.direction * 10.0)).refusal, Refusal::LimitSwitch);
     s.must(Request::jog(c.axis, -c.direction * 10.0));  // off the switch
-    ASSERT_TRUE(s.until([&] { return !s.status().servo.joints[static_cast<std::size_t>(j)].limit_neg &&
-                                     !s.status().servo.joints[static_cast<std::size_t>(j)].limit_pos; },
-                        20000));
+    ASSERT_TRUE(s.until(
+        [&] {
+          return !s.status().servo.joints[static_cast<std::size_t>(j)].limit_neg &&
+                 !s.status().servo.joints[static_cast<std::size_t>(j)].limit_pos;
+        },
+        20000));
     s.must(Request::jog_stop());
     ASSERT_TRUE(s.until([&] { return s.status().servo.state == State::Idle; }, 20000));
     s.must(Request::set_mode(Mode::Mdi));

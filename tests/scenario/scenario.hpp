@@ -76,7 +76,8 @@ class Scenario {
   /// With a program source of the test's own (a tool table in memory, code modules).
   Scenario(const config::MachineProfile& profile, std::shared_ptr<ProgramSource> source) : profile_(profile) {
     rig_ = std::make_unique<SimRig>(profile, std::move(source));
-    keeper_ = std::make_shared<SampleKeeper>(machine_limits(profile), axis_limits(profile), profile.servo_period_s);
+    keeper_ =
+        std::make_shared<SampleKeeper>(machine_limits(profile), axis_limits(profile), profile.servo_period_s);
     rig_->controller().attach(keeper_, ObserverOptions{0, true});
     rig_->step();  // the observer is attached from here on
   }

@@ -87,7 +87,7 @@ enum class ActionKind : std::uint8_t {
   Message,             ///< text
   Comment,             ///< text
   ProgramStop, OptionalStop, PalletShuttle, ProgramEnd,
-  /// Not from the interpreter: the controller's hand-axis pass (control::hand_axis_program) puts
+  /// Not from the interpreter: the controller's hand-axis pass (control::HandAxisFilter) puts
   /// it where a move of a hand-fed axis was. index = axis, value = machine position, index2 = +1:
   /// a retract (the move went in +), 0: a plunge.
   HandAxisWait,

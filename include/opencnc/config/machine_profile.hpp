@@ -34,8 +34,8 @@ struct HomingProfile {
   int sequence = 0;            ///< lower sequences home first; equal ones together
   // decel_midpoint: search_velocity is Vc toward the dog, return_velocity Vm the other way (the
   // working feed's direction), latch_velocity Vp the same way as Vm.
-  double return_velocity = 0;  ///< units/s, signed, opposite to search_velocity
-  double overrun = 0;          ///< units travelled past the dog's edge before reversing
+  double return_velocity = 0;         ///< units/s, signed, opposite to search_velocity
+  double overrun = 0;                 ///< units travelled past the dog's edge before reversing
   bool return_after_program = false;  ///< home again after every program that ends (M2/M30)
 };
 
@@ -49,9 +49,9 @@ struct CompensationProfile {
   double backlash = 0;             ///< units
   double takeup_velocity = 0;      ///< limit of the correction's own motion, units/s
   double takeup_acceleration = 0;  ///< units/s²
-  std::vector<double> positions;     ///< increasing; empty = no pitch table
-  std::vector<double> forward;       ///< error moving in +
-  std::vector<double> reverse;       ///< error moving in − (== forward for one table)
+  std::vector<double> positions;   ///< increasing; empty = no pitch table
+  std::vector<double> forward;     ///< error moving in +
+  std::vector<double> reverse;     ///< error moving in − (== forward for one table)
 };
 
 /// One axis (= one joint: joints are numbered in axis order X Y Z A B C U V W).

@@ -209,8 +209,8 @@ enum class EventKind : std::uint8_t {
   /// stop (M0, M1) — `action` (traj::kNoAction for the end of a probe move that did not trip),
   /// `segment`; the controller's interpreter may read on from there.
   SyncPassed,
-  Interlock,     ///< interlock rule `action` (its index) acted (`command`: what it did, see below)
-  HandAxisMoved, ///< hand axis `axis` left the position the run needs while it moved: feed hold
+  Interlock,      ///< interlock rule `action` (its index) acted (`command`: what it did, see below)
+  HandAxisMoved,  ///< hand axis `axis` left the position the run needs while it moved: feed hold
 };
 
 struct ServoEvent {

@@ -33,7 +33,7 @@ enum class HomingPhase : std::uint8_t {
   Center,   ///< DecelMidpoint: back half the measured width, to the middle of the zone
   Final,    ///< to the home position
   Done,
-  Failed,   ///< the switch or sensor was not where it must be (a fault)
+  Failed,  ///< the switch or sensor was not where it must be (a fault)
 };
 
 /// Name of a phase for traces and logs ("search", "measure", …). Any thread; real-time safe.
@@ -99,7 +99,8 @@ class JointHoming {
   void latch(const HomeConfig& config, double joint_position, double& offset) noexcept;
   void after_switch_latch(const HomeConfig& config, AxisMover& mover) noexcept;
   void step(const HomeConfig& config, const HomingInputs& in, AxisMover& mover, double& offset) noexcept;
-  void step_midpoint(const HomeConfig& config, const HomingInputs& in, AxisMover& mover, double& offset) noexcept;
+  void step_midpoint(const HomeConfig& config, const HomingInputs& in, AxisMover& mover,
+                     double& offset) noexcept;
   bool trigger(const HomingInputs& in) const noexcept;
 
   HomingPhase phase_ = HomingPhase::Idle;

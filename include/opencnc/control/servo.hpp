@@ -174,7 +174,7 @@ class Servo final : public Tickable {
   bool drives_enabled_ = false;
   /// Compensation stage (pitch error, backlash): the correction each joint gets.
   motion::Compensation comp_;
-  Joints compensation_{};  ///< the correction in the last outputs (feedback reflects it)
+  Joints compensation_{};    ///< the correction in the last outputs (feedback reflects it)
   bool moved_last_ = false;  ///< a driven joint's command changed in the last period
 
   // Manual mode.

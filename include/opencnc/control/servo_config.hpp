@@ -35,10 +35,10 @@ struct HomeConfig {
   double final_velocity = 0;   ///< units/s to `position` (> 0; servo_config() puts max_velocity for 0)
   int sequence = 0;            ///< lower sequences home first; equal ones together
   // DecelMidpoint.
-  double return_velocity = 0;  ///< Vm, signed (the working feed's direction)
-  double overrun = 0;          ///< units past the dog's edge before reversing
-  double level_on = 0.5;       ///< the sensor's level at which it switches on …
-  double level_off = 0.45;     ///< … and off (its comparator, from the profile)
+  double return_velocity = 0;         ///< Vm, signed (the working feed's direction)
+  double overrun = 0;                 ///< units past the dog's edge before reversing
+  double level_on = 0.5;              ///< the sensor's level at which it switches on …
+  double level_off = 0.45;            ///< … and off (its comparator, from the profile)
   bool return_after_program = false;  ///< home again when an Auto program ends (M2/M30)
 };
 

@@ -18,10 +18,10 @@ namespace opencnc::control {
 /// One joint's homing as the status shows it.
 struct HomingStatus {
   HomingPhase phase = HomingPhase::Idle;
-  bool measured = false;     ///< DecelMidpoint: the edges below are from the last homing
-  double rising_edge = 0;    ///< interpolated edges, joint coordinates
+  bool measured = false;   ///< DecelMidpoint: the edges below are from the last homing
+  double rising_edge = 0;  ///< interpolated edges, joint coordinates
   double falling_edge = 0;
-  double width = 0;          ///< S = falling − rising
+  double width = 0;  ///< S = falling − rising
   /// How far the positions before the last homing were off: where the controller believed the
   /// axis was less where that homing found it (+ = believed further in +). Lost steps, or a
   /// reference that drifted, show here; 0 after the first homing.
@@ -91,7 +91,7 @@ struct ServoStatus {
   bool flood = false, mist = false;
   std::int32_t tool = 0;           ///< tool in the spindle
   std::int32_t prepared_tool = 0;  ///< tool brought to the change position
-  std::uint64_t digital_out = 0;  ///< as written to the machine (the interlock rules' outputs included)
+  std::uint64_t digital_out = 0;   ///< as written to the machine (the interlock rules' outputs included)
   std::array<double, machine::kAnalogChannels> analog_out{};
   bool mains_ok = true, on_battery = false;
   double dc_link_v = 0;
@@ -109,8 +109,9 @@ struct ServoStatus {
   // Homing, compensation, hand axes, interlocks, handwheel (the drill retrofit).
   std::array<HomingStatus, machine::kMaxJoints> homing{};
   std::array<double, machine::kMaxJoints> compensation{};  ///< correction each joint gets now, units
-  HandWait hand_wait{};          ///< what a Wait::HandAxis waits for
-  std::int8_t interlock_rule = -1;  ///< the first `block spindle` rule holding now (what Wait::Interlock waits on)
+  HandWait hand_wait{};                                    ///< what a Wait::HandAxis waits for
+  /// The first `block spindle` rule holding now (what a Wait::Interlock waits on), −1 = none.
+  std::int8_t interlock_rule = -1;
   std::uint32_t interlocks_true = 0;  ///< bit per rule whose condition holds
   std::int8_t handwheel_axis = -1;    ///< the axis the handwheel moves (−1 = none)
   double handwheel_step = 0;          ///< units per count
@@ -132,7 +133,7 @@ struct TraceSample {
   Pose following_error{};  ///< per axis
   Pose output{};           ///< what the drives were told, machine coordinates (with compensation)
   std::array<HomingPhase, kAxisCount> homing_phase{};  ///< per axis
-  Pose home_level{};       ///< the home proximity sensor's level, per axis
+  Pose home_level{};                                   ///< the home proximity sensor's level, per axis
 };
 
 static_assert(std::is_trivially_copyable_v<ServoStatus>);

@@ -44,14 +44,14 @@ HomingSpread homing_spread(const config::MachineProfile& profile, const HomingSp
 
 /// What `measure_positioning` does.
 struct PositioningOptions {
-  AxisMask axes;              ///< axes to measure (driven, homed ones)
-  double interval = 50;       ///< targets every this many units from the home position …
-  double overrun = 5;         ///< … within the soft limits less this; each is approached from this far
-  int approaches = 5;         ///< per target and direction
-  double feed = 1500;         ///< units/min of the approaches (G1)
-  double dwell_s = 0.25;      ///< settling before each reading
-  double resolution = 1e-4;   ///< of the simulated scale (a laser), units
-  std::uint64_t seed = 1;     ///< of the simulated machine
+  AxisMask axes;             ///< axes to measure (driven, homed ones)
+  double interval = 50;      ///< targets every this many units from the home position …
+  double overrun = 5;        ///< … within the soft limits less this; each is approached from this far
+  int approaches = 5;        ///< per target and direction
+  double feed = 1500;        ///< units/min of the approaches (G1)
+  double dwell_s = 0.25;     ///< settling before each reading
+  double resolution = 1e-4;  ///< of the simulated scale (a laser), units
+  std::uint64_t seed = 1;    ///< of the simulated machine
 };
 
 /// One axis' positioning: per target the mean and standard deviation of the deviations (actual −
@@ -84,6 +84,7 @@ config::MachineProfile without_compensation(const config::MachineProfile& profil
 /// The compensation a measurement gives: its mean deviations as the tables of each direction (the
 /// reversal, hence the backlash, is in them: backlash 0), the take-up limits of `previous` (or
 /// the defaults).
-config::CompensationProfile compensation_from(const AxisPositioning& measured, const config::AxisProfile& axis);
+config::CompensationProfile compensation_from(const AxisPositioning& measured,
+                                              const config::AxisProfile& axis);
 
 }  // namespace opencnc::control

@@ -71,7 +71,9 @@ class HandAxisSink final : public canon::Sink {
   void arc_feed(canon::SegmentId, const canon::ArcFeed&) override { filter_.process(*program_); }
   void straight_probe(canon::SegmentId, const Pose&) override { filter_.process(*program_); }
   void rigid_tap(canon::SegmentId, const Pose&, double) override { filter_.process(*program_); }
-  void nurbs_feed(canon::SegmentId, int, std::span<const canon::NurbsPoint>) override { filter_.process(*program_); }
+  void nurbs_feed(canon::SegmentId, int, std::span<const canon::NurbsPoint>) override {
+    filter_.process(*program_);
+  }
 
  private:
   HandAxisFilter& filter_;

@@ -31,9 +31,9 @@ struct RunReport {
   /// Samples × axes × derivatives above a limit: of the commanded trajectory against the planning
   /// limits, and of the drives' commands (with compensation) against the axes' own limits.
   std::uint64_t limit_violations = 0;
-  std::uint64_t output_limit_violations = 0;  ///< the drives' commands' share of them
+  std::uint64_t output_limit_violations = 0;     ///< the drives' commands' share of them
   analysis::Violation first_output_violation{};  ///< where to look when there are some
-  double max_compensation_mm = 0;             ///< largest |output − commanded| of a linear axis
+  double max_compensation_mm = 0;                ///< largest |output − commanded| of a linear axis
   std::uint64_t samples = 0;
 };
 
@@ -45,7 +45,8 @@ class RunRecorder final : public ControllerObserver {
   /// `output_limits`: what the drives' commands, with the compensation, must stay within
   /// (control::axis_limits; by default `limits`). Axes outside `limits` (hand-fed ones) do not
   /// count: they are taken to stay where the run started.
-  RunRecorder(const plan::MachineLimits& limits, double period_s, const plan::MachineLimits* output_limits = nullptr);
+  RunRecorder(const plan::MachineLimits& limits, double period_s,
+              const plan::MachineLimits* output_limits = nullptr);
   /// For samples of one whole program (its moves numbered as in `program`, which must outlive
   /// the recorder).
   RunRecorder(const canon::Program& program, const plan::MachineLimits& limits, double period_s,

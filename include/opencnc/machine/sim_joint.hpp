@@ -171,11 +171,11 @@ class SimJoint {
   std::uint32_t index_count_ = 0;
   double index_position_ = 0;
   // Stepper with a pull-out curve.
-  bool stepper_dynamic_ = false;   // the rotor is a mass that can stall
-  bool stalled_ = false;           // dropped out of step under power (what a stall detector sees)
-  bool in_step_ = true;            // the rotor follows the steps (false: it coasts)
-  std::int64_t lost_steps_ = 0;    // emitted − made
-  double step_velocity_ = 0;       // the step rate as the rotor feels it (lagged), units/s
+  bool stepper_dynamic_ = false;  // the rotor is a mass that can stall
+  bool stalled_ = false;          // dropped out of step under power (what a stall detector sees)
+  bool in_step_ = true;           // the rotor follows the steps (false: it coasts)
+  std::int64_t lost_steps_ = 0;   // emitted − made
+  double step_velocity_ = 0;      // the step rate as the rotor feels it (lagged), units/s
   // Manual joint: where the operator's hand is heading.
   double hand_target_ = 0, hand_speed_ = 0;
   SimProximity home_sensor_;
