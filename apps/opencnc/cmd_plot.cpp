@@ -6,13 +6,17 @@
 
 #include <algorithm>
 #include <array>
+#include <cerrno>
+#include <charconv>
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <memory>
-#include <sstream>
 #include <string>
+#include <string_view>
 #include <vector>
 
+#include "cli_files.hpp"
 #include "commands.hpp"
 #include "opencnc/core/axes.hpp"
 #include "opencnc/viz/svg_chart.hpp"
@@ -45,56 +49,95 @@ struct Trace {
 
 // --- reading a trace CSV (the columns TraceCsvWriter writes) ---------------------------------
 
+/// Largest magnitude a trace value may have (mm, degrees, s, mm/s): beyond it a chart's scale
+/// overflows, and no machine travels a million kilometres.
+constexpr double kMaxTraceValue = 1e9;
+
+/// The columns a plot reads, by index in the header (-1: absent).
+struct TraceColumns {
+  int t = -1, rapid = -1, v = -1;
+  std::array<int, kAxisCount> cmd{}, ferr{};
+};
+
+TraceColumns find_columns(const std::vector<std::string>& head, AxisMask& axes) {
+  TraceColumns c;
+  c.cmd.fill(-1);
+  c.ferr.fill(-1);
+  for (int k = 0; k < static_cast<int>(head.size()); ++k) {
+    const std::string& h = head[static_cast<std::size_t>(k)];
+    if (h == "time_s") c.t = k;
+    if (h == "rapid") c.rapid = k;
+    if (h == "path_velocity") c.v = k;
+    for (int i = 0; i < kAxisCount; ++i) {
+      const std::string a(1, kAxisLetters[static_cast<std::size_t>(i)]);
+      if (h == "cmd_" + a) c.cmd[static_cast<std::size_t>(i)] = k, axes.set(static_cast<Axis>(i));
+      if (h == "ferr_" + a) c.ferr[static_cast<std::size_t>(i)] = k;
+    }
+  }
+  return c;
+}
+
+std::vector<std::string_view> split_fields(std::string_view line) {
+  std::vector<std::string_view> out;
+  for (std::size_t start = 0;;) {
+    const std::size_t comma = line.find(',', start);
+    out.push_back(
+        line.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start));
+    if (comma == std::string_view::npos) return out;
+    start = comma + 1;
+  }
+}
+
+/// Field `k` of a row as a number a chart can take; `error` says file:row:col otherwise.
+bool number_field(const std::vector<std::string_view>& fields, std::string_view line, int k,
+                  const std::string& where, double& out, std::string& error) {
+  const std::string_view f = fields[static_cast<std::size_t>(k)];
+  const auto col = static_cast<std::size_t>(f.data() - line.data()) + 1;
+  const auto [end, ec] = std::from_chars(f.data(), f.data() + f.size(), out);
+  if (ec == std::errc() && end == f.data() + f.size() && std::isfinite(out) &&
+      std::fabs(out) <= kMaxTraceValue)
+    return true;
+  if (ec == std::errc::invalid_argument || end != f.data() + f.size())
+    error = fmt::format("{}:{}: '{}' is not a number", where, col, f);
+  else
+    error = fmt::format("{}:{}: {} is out of range (a plot takes finite values up to {:g} in magnitude)",
+                        where, col, f, kMaxTraceValue);
+  return false;
+}
+
 bool read_trace(const std::string& path, Trace& trace, std::string& error) {
   std::ifstream in(path);
   if (!in) {
-    error = "cannot read the trace " + path;
+    error = fmt::format("cannot read the trace {}: {}", path, std::strerror(errno));
     return false;
   }
   std::string line;
   std::getline(in, line);
   std::vector<std::string> head;
-  for (std::stringstream ss(line); std::getline(ss, line, ',');) head.push_back(line);
-  int t_col = -1, rapid_col = -1, v_col = -1;
-  std::array<int, kAxisCount> cmd_col{}, ferr_col{};
-  cmd_col.fill(-1);
-  ferr_col.fill(-1);
-  for (int c = 0; c < static_cast<int>(head.size()); ++c) {
-    const std::string& h = head[static_cast<std::size_t>(c)];
-    if (h == "time_s") t_col = c;
-    if (h == "rapid") rapid_col = c;
-    if (h == "path_velocity") v_col = c;
-    for (int i = 0; i < kAxisCount; ++i) {
-      const std::string a(1, kAxisLetters[static_cast<std::size_t>(i)]);
-      if (h == "cmd_" + a) cmd_col[static_cast<std::size_t>(i)] = c, trace.axes.set(static_cast<Axis>(i));
-      if (h == "ferr_" + a) ferr_col[static_cast<std::size_t>(i)] = c;
-    }
-  }
-  if (t_col < 0 || trace.axes.count() == 0) {
+  for (const std::string_view h : split_fields(line)) head.emplace_back(h);
+  const TraceColumns c = find_columns(head, trace.axes);
+  if (c.t < 0 || trace.axes.count() == 0) {
     error = path + " is not an opencnc trace (no time_s or cmd_ columns)";
     return false;
   }
-  std::vector<double> v;
   std::size_t row = 1;
   while (std::getline(in, line)) {
     ++row;
-    v.clear();
-    for (std::stringstream ss(line); std::getline(ss, line, ',');)
-      v.push_back(std::strtod(line.c_str(), nullptr));
+    const std::vector<std::string_view> v = split_fields(line);
+    const std::string where = fmt::format("{}:{}", path, row);
     if (v.size() != head.size()) {
-      error = fmt::format("{}:{}: {} fields, the header has {}", path, row, v.size(), head.size());
+      error = fmt::format("{}: {} fields, the header has {}", where, v.size(), head.size());
       return false;
     }
     Sample s;
-    s.t = v[static_cast<std::size_t>(t_col)];
-    s.rapid = rapid_col >= 0 && v[static_cast<std::size_t>(rapid_col)] != 0;
-    s.path_velocity = v_col >= 0 ? v[static_cast<std::size_t>(v_col)] : 0;
-    for (int i = 0; i < kAxisCount; ++i) {
-      if (cmd_col[static_cast<std::size_t>(i)] >= 0)
-        s.cmd[i] = v[static_cast<std::size_t>(cmd_col[static_cast<std::size_t>(i)])];
-      if (ferr_col[static_cast<std::size_t>(i)] >= 0)
-        s.ferr[i] = v[static_cast<std::size_t>(ferr_col[static_cast<std::size_t>(i)])];
-    }
+    double rapid = 0;
+    auto field = [&](int k, double& out) { return k < 0 || number_field(v, line, k, where, out, error); };
+    bool ok = field(c.t, s.t) && field(c.rapid, rapid) && field(c.v, s.path_velocity);
+    for (int i = 0; ok && i < kAxisCount; ++i)
+      ok = field(c.cmd[static_cast<std::size_t>(i)], s.cmd[i]) &&
+           field(c.ferr[static_cast<std::size_t>(i)], s.ferr[i]);
+    if (!ok) return false;
+    s.rapid = rapid != 0;
     trace.samples.push_back(s);
   }
   if (trace.samples.size() > 1) trace.period_s = trace.samples[1].t - trace.samples[0].t;
@@ -242,7 +285,8 @@ viz::Panel following_errors(const Trace& tr) {
   return p;
 }
 
-bool draw(const Trace& tr, const std::string& title, const std::string& out, std::string& error) {
+/// The whole page as an SVG document.
+std::string draw(const Trace& tr, const std::string& title) {
   viz::SvgChart chart(title, 2, 640, 430);
   const auto xy = [](int a, int b) { return [a, b](const Pose& q) { return std::pair{q[a], q[b]}; }; };
   chart.add_panel(toolpath(tr, "toolpath XY (top)", "X (mm)", "Y (mm)", xy(0, 1)));
@@ -256,10 +300,31 @@ bool draw(const Trace& tr, const std::string& title, const std::string& out, std
   chart.add_panel(velocities(tr));
   chart.add_panel(accelerations(tr));
   chart.add_panel(following_errors(tr));
-  return chart.write(out, &error);
+  return chart.render();
+}
+
+/// A plot draws a trace or runs a program; given both it could only guess which was meant.
+bool check_sources(const PlotOptions& o) {
+  const bool program = !o.session.file.empty() || !o.session.machine.empty() || !o.session.sets.empty();
+  if (!o.trace.empty() && program) {
+    fmt::print(stderr, "error: plot draws a trace (--trace) or runs a program (with --machine), not both\n");
+    return false;
+  }
+  if (o.trace.empty() && (o.session.file.empty() || o.session.machine.empty())) {
+    fmt::print(stderr, "error: plot wants a program and --machine, or --trace\n");
+    return false;
+  }
+  return true;
 }
 
 int plot(const PlotOptions& o) {
+  if (!check_sources(o)) return kExitUsage;
+  const std::vector<NamedPath> inputs =
+      o.trace.empty() ? session_inputs(o.session) : std::vector<NamedPath>{{"the trace", o.trace}};
+  const NamedPath outputs[] = {{"-o", o.out}};
+  if (!check_inputs(inputs)) return kExitUsage;
+  const auto files = open_outputs(inputs, outputs);
+  if (files.empty()) return kExitUsage;
   Trace tr;
   std::string error, title;
   if (!o.trace.empty()) {
@@ -269,10 +334,6 @@ int plot(const PlotOptions& o) {
     }
     title = "opencnc trace " + o.trace;
   } else {
-    if (o.session.file.empty() || o.session.machine.empty()) {
-      fmt::print(stderr, "error: plot wants a program and --machine, or --trace\n");
-      return kExitUsage;
-    }
     SessionHooks hooks;
     hooks.opened = [&](const config::MachineProfile& p, const canon::Program&) {
       tr.axes = p.axis_mask();
@@ -290,11 +351,7 @@ int plot(const PlotOptions& o) {
     fmt::print(stderr, "error: nothing to plot\n");
     return kExitProgram;
   }
-  if (!draw(tr, title, o.out, error)) {
-    fmt::print(stderr, "error: {}\n", error);
-    return kExitUsage;
-  }
-  return kExitOk;
+  return write_and_commit(*files[0], draw(tr, title)) ? kExitOk : kExitUsage;
 }
 
 }  // namespace

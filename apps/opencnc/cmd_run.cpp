@@ -7,17 +7,16 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <fstream>
 #include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "cli_files.hpp"
 #include "commands.hpp"
 #include "opencnc/controller/preflight.hpp"
 #include "opencnc/controller/run_recorder.hpp"
 #include "opencnc/controller/servo_setup.hpp"
-#include "opencnc/core/atomic_file.hpp"
 #include "run_session.hpp"
 
 namespace opencnc::cli {
@@ -116,11 +115,26 @@ nlohmann::json report_json(const control::RunReport& r, const RunOptions& o, con
   return j;
 }
 
+/// Commits the trace; a failure names the reason and how much of the trace is whole.
+bool commit_trace(OutputFile& trace) {
+  std::string error;
+  if (trace.commit(&error)) return true;
+  const std::uint64_t rows = trace.records() > 0 ? trace.records() - 1 : 0;
+  fmt::print(stderr, "error: {}; {}\n", error,
+             trace.records() > 0 ? fmt::format("the trace keeps its first {} whole rows", rows)
+                                 : std::string("the trace was not written"));
+  return false;
+}
+
 int run(const RunOptions& o) {
-  if (!o.trace.empty() && !std::ofstream(o.trace)) {  // before the run, not after it
-    fmt::print(stderr, "error: cannot write the trace {}\n", o.trace);
-    return kExitUsage;
-  }
+  // Every output is checked (and created) before anything runs.
+  const std::vector<NamedPath> inputs = session_inputs(o.session);
+  const NamedPath outputs[] = {{"--trace", o.trace}, {"--report", o.report}};
+  if (!check_inputs(inputs)) return kExitUsage;
+  const auto files = open_outputs(inputs, outputs);
+  if (files.empty()) return kExitUsage;
+  OutputFile* const trace_file = files[0].get();
+  OutputFile* const report_file = files[1].get();
   std::optional<control::RunRecorder> recorder;
   std::optional<control::TraceCsvWriter> csv;
   std::optional<ProgressBar> bar;
@@ -129,7 +143,7 @@ int run(const RunOptions& o) {
   SessionHooks hooks;
   hooks.opened = [&](const config::MachineProfile& profile, const canon::Program& program) {
     recorder.emplace(program, control::machine_limits(profile), profile.servo_period_s);
-    if (!o.trace.empty()) csv.emplace(o.trace, profile.axis_mask(), profile.servo_period_s);
+    if (trace_file != nullptr) csv.emplace(*trace_file, profile.axis_mask(), profile.servo_period_s);
     if (tty) bar.emplace(program);
   };
   hooks.sample = [&](const control::TraceSample& s) {
@@ -142,21 +156,13 @@ int run(const RunOptions& o) {
   };
   const SessionEnd end = run_session(o.session, hooks);
   if (bar) bar->finish();
-  if (!recorder) return end.exit_code;  // nothing ran
+  if (!recorder) return end.exit_code;  // nothing ran; the outputs are left as they were
   int rc = end.exit_code;
-  if (csv && !csv->close()) {
-    fmt::print(stderr, "error: cannot write the trace {}\n", o.trace);
-    rc = kExitUsage;
-  }
+  if (trace_file != nullptr && !commit_trace(*trace_file)) rc = kExitUsage;
   const control::RunReport r = recorder->report();
   print_report(r, end.profile, end);
-  if (!o.report.empty()) {
-    std::string err;
-    if (!write_file_atomically(o.report, report_json(r, o, end).dump(2) + "\n", &err)) {
-      fmt::print(stderr, "error: {}\n", err);
-      rc = kExitUsage;
-    }
-  }
+  if (report_file != nullptr && !write_and_commit(*report_file, report_json(r, o, end).dump(2) + "\n"))
+    rc = kExitUsage;
   return rc;
 }
 
