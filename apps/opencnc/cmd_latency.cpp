@@ -12,6 +12,7 @@
 
 #include "cli_files.hpp"
 #include "commands.hpp"
+#include "numeric_options.hpp"
 #include "opencnc/control/clock.hpp"
 #include "opencnc/viz/svg_chart.hpp"
 
@@ -136,10 +137,11 @@ int run_latency(const LatencyOptions& o) {
 void add_latency_command(CLI::App& app, Registry& registry) {
   auto opts = std::make_shared<LatencyOptions>();
   CLI::App* cmd = app.add_subcommand("latency", "Measure the wake-up jitter of the periodic servo thread");
-  cmd->add_option("--seconds", opts->seconds, "How long to measure")->check(CLI::Range(0.1, 86400.0));
-  cmd->add_option("--period-us", opts->period_us, "Thread period in microseconds")->check(CLI::Range(50.0, 100000.0));
+  cmd->add_option("--seconds", opts->seconds, "How long to measure")->check(finite_range(0.1, 86400.0));
+  cmd->add_option("--period-us", opts->period_us, "Thread period in microseconds")
+      ->check(finite_range(50.0, 100000.0));
   cmd->add_option("--priority", opts->priority, "SCHED_FIFO priority")->check(CLI::Range(1, 99));
-  cmd->add_option("--cpu", opts->cpu, "Pin the thread to this CPU");
+  cmd->add_option("--cpu", opts->cpu, "Pin the thread to this CPU")->check(CLI::Range(0, 1023));
   cmd->add_option("--csv", opts->csv, "Write the histogram as CSV");
   cmd->add_option("--svg", opts->svg, "Draw the histogram as SVG");
   cmd->callback([opts, &registry] { registry.set_result(run_latency(*opts)); });

@@ -7,7 +7,10 @@
 #include <cstdio>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <set>
+
+#include <fmt/format.h>
 
 #include <nlohmann/json.hpp>
 
@@ -15,6 +18,7 @@
 #include "opencnc/canon/program_builder.hpp"
 #include "opencnc/canon/tee_sink.hpp"
 #include "opencnc/gcode/interpreter.hpp"
+#include "progress.hpp"
 
 namespace opencnc::cli {
 
@@ -90,33 +94,56 @@ struct Totals {
   double feed_time_min = 0;
   bool untimed = false;   // per-revolution feeds: no time without a spindle model
   Box box;
+  std::optional<Diagnostic> out_of_reach;  // the first move no machine could make
 };
 
+/// Farthest a move may end from the machine origin (mm): beyond it lengths and times stop
+/// meaning anything (10**300 overflows them to inf) and no machine travels that far.
+constexpr double kMaxReachMm = 1e9;
+
+bool within_reach(const double p[3]) {
+  return std::fabs(p[0]) <= kMaxReachMm && std::fabs(p[1]) <= kMaxReachMm && std::fabs(p[2]) <= kMaxReachMm;
+}
+
+/// Moves the builder keeps before the meter has it start over: the summary needs each move
+/// once, so a program of any length (a loop that never ends) scans in bounded memory.
+constexpr std::size_t kKeptMoves = std::size_t{1} << 16;
+
 // Counts, lengths, machine extents and feed time of a program's moves, taken as they are
-// appended (while they are still in the cache) instead of in a second pass over a program
-// of maybe a million moves. Moves are measured in order, one at a time.
+// appended (while they are still in the cache) instead of in a second pass. Moves are measured
+// in order, one at a time; every kKeptMoves the builder drops the moves measured.
 class MoveMeter {
  public:
-  explicit MoveMeter(const canon::Program& prog) : prog_(prog) {}
+  explicit MoveMeter(canon::ProgramBuilder& builder) : builder_(builder) {}
   /// Measures the moves appended since the last call.
   void catch_up() {
-    for (; next_ < prog_.size(); ++next_) measure(next_);
+    const canon::Program& prog = builder_.program();
+    for (; next_ < prog.size(); ++next_) measure(prog, next_);
+    if (next_ >= kKeptMoves) {
+      builder_.restart();
+      next_ = 0;
+    }
   }
   const Totals& totals() const { return t_; }
 
  private:
-  void measure(canon::SegmentId id) {
-    if (id == 0) {
-      const Pose& start = prog_.start();
+  void measure(const canon::Program& prog, canon::SegmentId id) {
+    if (id == 0) {  // (after a restart the start is where the last move measured ended)
+      const Pose& start = prog.start();
       for (int i = 0; i < 3; ++i) last_[i] = start[i];
       t_.box.add(last_[0], last_[1], last_[2]);
     }
     const double* s = last_;
-    const canon::Move& m = prog_.move(id);
-    const double e[3] = {prog_.end_coord(id, Axis::X), prog_.end_coord(id, Axis::Y), prog_.end_coord(id, Axis::Z)};
+    const canon::Move& m = prog.move(id);
+    const double e[3] = {prog.end_coord(id, Axis::X), prog.end_coord(id, Axis::Y),
+                         prog.end_coord(id, Axis::Z)};
+    if (!within_reach(e)) {
+      out_of_reach(prog, id, e);
+      return;
+    }
     double len;
     if (m.kind == canon::MoveKind::Arc) {
-      const canon::ArcGeometry& g = prog_.arc(id);
+      const canon::ArcGeometry& g = prog.arc(id);
       len = arc_extent(s, e, g.center, g.plane, g.turns, t_.box);
       ++t_.arcs;
     } else {
@@ -131,13 +158,29 @@ class MoveMeter {
     }
     ++t_.feeds;
     t_.feed_length += len;
-    const double f = prog_.feed(id);
+    const double f = prog.feed(id);
     if (m.flags & canon::kInverseTime) t_.feed_time_min += f > 0 ? 1.0 / f : 0;
     else if (m.flags & canon::kPerRevolution) t_.untimed = true;
     else if (f > 0) t_.feed_time_min += len / f;
   }
 
-  const canon::Program& prog_;
+  // A move beyond any machine's reach is left out of the totals and reported (the first one).
+  void out_of_reach(const canon::Program& prog, canon::SegmentId id, const double e[3]) {
+    if (t_.out_of_reach) return;
+    const int axis = !(std::fabs(e[0]) <= kMaxReachMm) ? 0 : !(std::fabs(e[1]) <= kMaxReachMm) ? 1 : 2;
+    const std::uint32_t file = prog.file_of(id);
+    t_.out_of_reach =
+        Diagnostic{Severity::Error,
+                   file < prog.sources().file_count() ? prog.sources().file(file) : std::string(),
+                   prog.move(id).line,
+                   0,
+                   fmt::format("this move ends at {} {:g} mm, beyond any machine's reach (more than "
+                               "{:g} mm from the origin): lengths and times would mean nothing",
+                               kAxisLetters[static_cast<std::size_t>(axis)], e[axis], kMaxReachMm),
+                   "scan.out-of-reach"};
+  }
+
+  canon::ProgramBuilder& builder_;
   canon::SegmentId next_ = 0;
   double last_[3] = {0, 0, 0};   // X, Y, Z where the last move measured ended
   Totals t_;
@@ -158,7 +201,8 @@ class WorkWatcher final : public canon::Sink {
     c[a] = arc.first_center;
     c[b] = arc.second_center;
     c[n] = s[n];
-    arc_extent(s, e, c, arc.plane, arc.rotation, box_);
+    if (within_reach(s) && within_reach(e) && within_reach(c))
+      arc_extent(s, e, c, arc.plane, arc.rotation, box_);
     for (int i = 0; i < 3; ++i) pos_[i] = arc.end[i];
     meter_.catch_up();
   }
@@ -174,7 +218,8 @@ class WorkWatcher final : public canon::Sink {
 
  private:
   void move(const Pose& end) {
-    box_.add(end[0], end[1], end[2]);
+    // (a move beyond any machine's reach is reported by the meter, and would swamp the box)
+    if (within_reach(end.v.data())) box_.add(end[0], end[1], end[2]);
     for (int i = 0; i < 3; ++i) pos_[i] = end[i];
     meter_.catch_up();
   }
@@ -200,7 +245,7 @@ void print_box(const char* name, const Box& b) {
 
 }  // namespace
 
-int run_scan(const std::string& file, const gcode::Options& options, bool json, double rapid_rate_mm_min) {
+int run_scan(const std::string& file, const gcode::Options& options, const ScanOutput& out) {
   gcode::Interpreter interp(options);
   if (!interp.open(file)) {
     for (const auto& d : interp.diagnostics().items()) std::fprintf(stderr, "%s [%s]\n", d.format().c_str(), d.code.c_str());
@@ -208,20 +253,23 @@ int run_scan(const std::string& file, const gcode::Options& options, bool json, 
   }
   canon::ProgramBuilder builder(options.axes);
   builder.program().set_sources(interp.sources());
-  const canon::Program& prog = builder.program();
-  MoveMeter meter(prog);
+  MoveMeter meter(builder);
   WorkWatcher watch(meter);
   canon::TeeSink tee(builder, watch);   // the builder first: the watcher's meter reads its moves
-  const gcode::RunStatus status = interp.run(tee);
+  InterpreterProgress progress("scan " + file, out.progress);
+  const gcode::RunStatus status = progress.run(interp, tee);
   meter.catch_up();   // moves of calls the watcher does not follow (probes, taps, splines)
   const Totals& t = meter.totals();
   const gcode::InterpState st = interp.state();
+  const double rapid_rate_mm_min = out.rapid_rate_mm_min;
   const double rapid_min = rapid_rate_mm_min > 0 ? t.rapid_length / rapid_rate_mm_min : 0.0;
-  const auto& diags = interp.diagnostics();
-  if (json) {
+  Diagnostics diags = interp.diagnostics();
+  if (t.out_of_reach) diags.add(*t.out_of_reach);
+  const bool ok = status != gcode::RunStatus::Error && !t.out_of_reach;
+  if (out.json) {
     nlohmann::json j;
     j["file"] = file;
-    j["ok"] = status != gcode::RunStatus::Error;
+    j["ok"] = ok;
     j["blocks"] = st.blocks_executed;
     j["segments"] = {{"feed", t.feeds}, {"rapid", t.rapids}, {"arcs", t.arcs}};
     j["length_mm"] = {{"feed", t.feed_length}, {"rapid", t.rapid_length}};
@@ -231,7 +279,6 @@ int run_scan(const std::string& file, const gcode::Options& options, bool json, 
     j["tools"] = {{"selected", watch.tools_selected}, {"changed_index", watch.tool_changes}};
     j["coordinate_systems"] = watch.systems;
     j["tool_length_offsets"] = watch.tool_offsets;
-    j["program_memory_bytes"] = prog.memory_bytes();
     nlohmann::json d = nlohmann::json::array();
     for (const auto& x : diags.items()) d.push_back({{"text", x.format()}, {"code", x.code}});
     j["diagnostics"] = d;
@@ -257,7 +304,7 @@ int run_scan(const std::string& file, const gcode::Options& options, bool json, 
     std::printf("\n%-22s %d\n", "tool length offsets", watch.tool_offsets);
     for (const auto& x : diags.items()) std::printf("%s [%s]\n", x.format().c_str(), x.code.c_str());
   }
-  return status == gcode::RunStatus::Error ? kExitProgram : kExitOk;
+  return ok ? kExitOk : kExitProgram;
 }
 
 }  // namespace opencnc::cli

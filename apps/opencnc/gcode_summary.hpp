@@ -9,7 +9,15 @@
 
 namespace opencnc::cli {
 
-/// Scans `file` and prints its summary (text or JSON); returns the exit code.
-int run_scan(const std::string& file, const gcode::Options& options, bool json, double rapid_rate_mm_min);
+/// How `opencnc scan` prints.
+struct ScanOutput {
+  bool json = false;             ///< the summary as JSON
+  double rapid_rate_mm_min = 0;  ///< > 0: rapids are timed at this rate
+  bool progress = false;         ///< progress on stderr also when it is not a terminal
+};
+
+/// Scans `file` in bounded memory (every move is measured once, then dropped) and prints its
+/// summary; returns the exit code. CLI thread.
+int run_scan(const std::string& file, const gcode::Options& options, const ScanOutput& out);
 
 }  // namespace opencnc::cli
