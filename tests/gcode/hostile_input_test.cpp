@@ -141,3 +141,29 @@ TEST(HostileInput, FinishingPassesBeyondTheLimitAreRefused) {
 
 }  // namespace
 }  // namespace opencnc::gcode
+
+namespace opencnc::gcode {
+namespace {
+
+// rs274 refuses G95 with the speed at 0 only; with the spindle stopped LinuxCNC's motion waits
+// for revolutions for ever. The preflight refuses it (issue 7).
+TEST(HostileInput, FeedPerRevolutionWithTheSpindleStoppedIsRefused) {
+  for (const char* move : {"G1 X10", "G2 X10 Y0 I5 J0"}) {
+    const test::Result r = run(std::string("G21 G90 S1000 G95 F0.1\n") + move + "\nM2\n");
+    ASSERT_EQ(r.status, RunStatus::Error) << move;
+    const Diagnostic* e = first_error(r);
+    ASSERT_NE(e, nullptr);
+    EXPECT_EQ(e->code, "gcode.spindle-stopped") << e->format();
+    EXPECT_EQ(e->line, 2u);
+    EXPECT_NE(e->message.find("with the spindle stopped: start it with M3 or M4"), std::string::npos);
+  }
+  EXPECT_EQ(run("G21 G90 S1000 M3 G95 F0.1\nG1 X10\nM5\nM2\n").status, RunStatus::Finished);
+  const test::Result after_m5 = run("G21 G90 S1000 M3 G95 F0.1\nG1 X10\nM5\nG1 X0\nM2\n");
+  ASSERT_NE(first_error(after_m5), nullptr);
+  EXPECT_EQ(first_error(after_m5)->line, 4u);
+  // Feed per minute needs no spindle (a warning only, as before).
+  EXPECT_EQ(run("G21 G90 F100\nG1 X10\nM2\n").status, RunStatus::Finished);
+}
+
+}  // namespace
+}  // namespace opencnc::gcode
