@@ -122,7 +122,9 @@ void Engine::fanuc_assignments() {
   }
   for (int index : parser_.vacant_assignments) {
     st_.parameters[static_cast<std::size_t>(index)] = 0.0;
-    vacant.set(static_cast<std::size_t>(index));
+    // Only #0..#999 can be vacant (system variables such as #3006 cannot; the fuzzer found the
+    // bitset's out_of_range here).
+    if (index < kFanucVariableCount) vacant.set(static_cast<std::size_t>(index));
   }
   for (const auto& [name, value] : parser_.named_assignments) store_named(name, value);
 }

@@ -126,6 +126,16 @@ TEST(HostileInput, AFanucAlarmNumberOutOfRangeIsNamed) {
       << first_error(ok)->message;
 }
 
+// Fuzzer finding (this campaign): a vacant value assigned to a system variable
+// (`#3006 = #0`) threw std::out_of_range from the vacancy bitset, out of the interpreter.
+TEST(HostileInput, AVacantValueForASystemVariableIsNoCrash) {
+  Options o;
+  o.dialect = Dialect::Fanuc;
+  o.extensions = standard_extensions(Dialect::Fanuc);
+  const test::Result r = run("O1\nG21 F100\n#3006 = #0\n#500 = #0\nG1 X1\nM30\n", o);
+  EXPECT_EQ(r.status, RunStatus::Finished) << (first_error(r) ? first_error(r)->format() : "");
+}
+
 TEST(HostileInput, FinishingPassesBeyondTheLimitAreRefused) {
   Options o;
   o.extensions = standard_extensions(Dialect::LinuxCnc);
