@@ -17,12 +17,15 @@
 
 namespace opencnc::cli {
 
-std::vector<NamedPath> session_inputs(const SessionOptions& o) {
+std::optional<config::MachineProfile> quiet_profile(const SessionOptions& o) {
+  if (o.machine.empty()) return std::nullopt;
+  return config::load_profile(o.machine, o.sets).profile;
+}
+
+std::vector<NamedPath> session_inputs(const SessionOptions& o, const config::MachineProfile* profile) {
   std::vector<NamedPath> in = {{"the program", o.file}, {"the profile", o.machine}};
-  if (o.machine.empty()) return in;
-  const config::ProfileLoad load = config::load_profile(o.machine, o.sets);
-  if (load.ok() && !load.profile->interpreter.tool_table.empty())
-    in.push_back({"the tool table", load.profile->interpreter.tool_table});
+  if (profile != nullptr && !profile->interpreter.tool_table.empty())
+    in.push_back({"the tool table", profile->interpreter.tool_table});
   return in;
 }
 

@@ -3,19 +3,25 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
 
+#include "opencnc/config/machine_profile.hpp"
 #include "opencnc/core/output_file.hpp"
 
 namespace opencnc::cli {
 
 struct SessionOptions;
 
-/// The files a run reads: the program, the profile and the tool table the profile names
-/// (read quietly here; the run reports the profile's problems itself). CLI thread.
-std::vector<NamedPath> session_inputs(const SessionOptions& o);
+/// The session's profile with its overrides, read quietly: nullopt if it has errors (the run
+/// reports them itself). CLI thread.
+std::optional<config::MachineProfile> quiet_profile(const SessionOptions& o);
+
+/// The files a run reads: the program, the profile and the tool table `profile` names (if
+/// given). CLI thread.
+std::vector<NamedPath> session_inputs(const SessionOptions& o, const config::MachineProfile* profile);
 
 /// Says (on stderr) which input cannot be read and why — missing, unreadable (`strerror`), a
 /// folder — and returns false; true if every non-empty path can be read. CLI thread.

@@ -12,6 +12,7 @@
 #include <cstring>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -319,8 +320,11 @@ bool check_sources(const PlotOptions& o) {
 
 int plot(const PlotOptions& o) {
   if (!check_sources(o)) return kExitUsage;
-  const std::vector<NamedPath> inputs =
-      o.trace.empty() ? session_inputs(o.session) : std::vector<NamedPath>{{"the trace", o.trace}};
+  const std::optional<config::MachineProfile> profile =
+      o.trace.empty() ? quiet_profile(o.session) : std::nullopt;
+  const std::vector<NamedPath> inputs = o.trace.empty()
+                                            ? session_inputs(o.session, profile ? &*profile : nullptr)
+                                            : std::vector<NamedPath>{{"the trace", o.trace}};
   const NamedPath outputs[] = {{"-o", o.out}};
   if (!check_inputs(inputs)) return kExitUsage;
   const auto files = open_outputs(inputs, outputs);

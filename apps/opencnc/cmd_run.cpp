@@ -14,20 +14,55 @@
 
 #include "cli_files.hpp"
 #include "commands.hpp"
+#include "gcode_summary.hpp"
+#include "numeric_options.hpp"
 #include "opencnc/controller/preflight.hpp"
 #include "opencnc/controller/run_recorder.hpp"
 #include "opencnc/controller/servo_setup.hpp"
 #include "run_session.hpp"
+#include "stop_signals.hpp"
 
 namespace opencnc::cli {
 
 namespace {
 
+/// Default of --max-time: a day of machining. Longer programs exist (moulds), and say so.
+constexpr double kDefaultMaxTimeS = 86400;
+
 struct RunOptions {
   SessionOptions session;
   std::string trace;
   std::string report;
+  double max_time_s = kDefaultMaxTimeS;  ///< 0: no limit
 };
+
+/// "3.2 h", "19.0 years": a duration a person reads at a glance.
+std::string human_duration(double s) {
+  if (s < 120) return fmt::format("{:.1f} s", s);
+  if (s < 7200) return fmt::format("{:.1f} min", s / 60);
+  if (s < 2 * 86400) return fmt::format("{:.1f} h", s / 3600);
+  if (s < 2 * 365.25 * 86400) return fmt::format("{:.1f} days", s / 86400);
+  return fmt::format("{:.3g} years", s / (365.25 * 86400));
+}
+
+/// Refuses (with the reason, and the slowest move) a program that needs more machining time than
+/// --max-time before it runs: F0.000001 would otherwise run for years. A program the scan cannot
+/// finish is left to the run, which reports its errors.
+bool within_max_time(const RunOptions& o, const config::MachineProfile& profile) {
+  if (o.max_time_s <= 0) return true;
+  const TimeEstimate e = estimate_machining_time(o.session.file, profile);
+  if (!e.complete || e.total_s() <= o.max_time_s) return true;
+  fmt::print(
+      stderr,
+      "error: {} needs at least {} of machining (feed {:.6g} s, rapid {:.6g} s, dwell {:.6g} s), more than "
+      "--max-time {:g} s ({}){}; raise --max-time (0: no limit) if that is meant\n",
+      o.session.file, human_duration(e.total_s()), e.feed_s, e.rapid_s, e.dwell_s, o.max_time_s,
+      human_duration(o.max_time_s),
+      e.slowest_move_at.empty() ? std::string()
+                                : fmt::format("; the slowest move, {}, takes {}", e.slowest_move_at,
+                                              human_duration(e.slowest_move_s)));
+  return false;
+}
 
 /// Programmed length up to the end of each move (for the progress bar).
 std::vector<double> cumulative_lengths(const canon::Program& p) {
@@ -91,6 +126,8 @@ nlohmann::json report_json(const control::RunReport& r, const RunOptions& o, con
   j["realtime"] = o.session.realtime;
   j["finished"] = end.finished;
   j["fault"] = end.fault.empty() ? nlohmann::json(nullptr) : nlohmann::json(end.fault);
+  j["stopped_by"] =
+      end.stopped_by != 0 ? nlohmann::json(signal_name(end.stopped_by)) : nlohmann::json(nullptr);
   j["machining_time_s"] = r.machining_time_s;
   j["motion_time_s"] = r.motion_time_s;
   j["path_length_mm"] = r.path_length_mm;
@@ -128,9 +165,11 @@ bool commit_trace(OutputFile& trace) {
 
 int run(const RunOptions& o) {
   // Every output is checked (and created) before anything runs.
-  const std::vector<NamedPath> inputs = session_inputs(o.session);
+  const std::optional<config::MachineProfile> profile = quiet_profile(o.session);
+  const std::vector<NamedPath> inputs = session_inputs(o.session, profile ? &*profile : nullptr);
   const NamedPath outputs[] = {{"--trace", o.trace}, {"--report", o.report}};
   if (!check_inputs(inputs)) return kExitUsage;
+  if (profile && !within_max_time(o, *profile)) return kExitProgram;
   const auto files = open_outputs(inputs, outputs);
   if (files.empty()) return kExitUsage;
   OutputFile* const trace_file = files[0].get();
@@ -141,9 +180,9 @@ int run(const RunOptions& o) {
   const bool tty = ::isatty(STDOUT_FILENO) != 0;
   double run_start_s = -1;
   SessionHooks hooks;
-  hooks.opened = [&](const config::MachineProfile& profile, const canon::Program& program) {
-    recorder.emplace(program, control::machine_limits(profile), profile.servo_period_s);
-    if (trace_file != nullptr) csv.emplace(*trace_file, profile.axis_mask(), profile.servo_period_s);
+  hooks.opened = [&](const config::MachineProfile& machine, const canon::Program& program) {
+    recorder.emplace(program, control::machine_limits(machine), machine.servo_period_s);
+    if (trace_file != nullptr) csv.emplace(*trace_file, machine.axis_mask(), machine.servo_period_s);
     if (tty) bar.emplace(program);
   };
   hooks.sample = [&](const control::TraceSample& s) {
@@ -154,7 +193,10 @@ int run(const RunOptions& o) {
     if (run_start_s < 0) run_start_s = st.servo.time_s;
     if (bar) bar->show(st, run_start_s);
   };
-  const SessionEnd end = run_session(o.session, hooks);
+  const StopSignals signals;  // Ctrl-C: a controlled stop, and the report says so
+  SessionOptions session = o.session;
+  session.stop = &StopSignals::requested();
+  const SessionEnd end = run_session(session, hooks);
   if (bar) bar->finish();
   if (!recorder) return end.exit_code;  // nothing ran; the outputs are left as they were
   int rc = end.exit_code;
@@ -182,6 +224,11 @@ void add_run_command(CLI::App& app, Registry& registry) {
                 "Tick in a real-time periodic thread instead of virtual time");
   cmd->add_option("--trace", opts->trace, "Write one CSV row per servo period (docs/controller.md)");
   cmd->add_option("--report", opts->report, "Write the report as JSON");
+  cmd->add_option(
+         "--max-time", opts->max_time_s,
+         "Refuse a program that needs more machining time than this, in seconds (default 86400, a day; "
+         "0: no limit)")
+      ->check(finite_range(0, 1e12));
   cmd->callback([opts, &registry] { registry.set_result(run(*opts)); });
 }
 

@@ -18,6 +18,8 @@
 #include "opencnc/canon/program_builder.hpp"
 #include "opencnc/canon/tee_sink.hpp"
 #include "opencnc/gcode/interpreter.hpp"
+#include "opencnc/gcode/standard_extensions.hpp"
+#include "opencnc/tools/tool_table.hpp"
 #include "progress.hpp"
 
 namespace opencnc::cli {
@@ -93,6 +95,8 @@ struct Totals {
   double feed_length = 0, rapid_length = 0;
   double feed_time_min = 0;
   bool untimed = false;   // per-revolution feeds: no time without a spindle model
+  double slowest_min = 0;  // the feed move that takes longest, and where it is
+  std::uint32_t slowest_file = 0, slowest_line = 0;
   Box box;
   std::optional<Diagnostic> out_of_reach;  // the first move no machine could make
 };
@@ -159,9 +163,18 @@ class MoveMeter {
     ++t_.feeds;
     t_.feed_length += len;
     const double f = prog.feed(id);
-    if (m.flags & canon::kInverseTime) t_.feed_time_min += f > 0 ? 1.0 / f : 0;
+    double minutes = 0;
+    if (m.flags & canon::kInverseTime)
+      minutes = f > 0 ? 1.0 / f : 0;
     else if (m.flags & canon::kPerRevolution) t_.untimed = true;
-    else if (f > 0) t_.feed_time_min += len / f;
+    else if (f > 0)
+      minutes = len / f;
+    t_.feed_time_min += minutes;
+    if (minutes > t_.slowest_min) {
+      t_.slowest_min = minutes;
+      t_.slowest_file = prog.file_of(id);
+      t_.slowest_line = m.line;
+    }
   }
 
   // A move beyond any machine's reach is left out of the totals and reported (the first one).
@@ -211,10 +224,12 @@ class WorkWatcher final : public canon::Sink {
   void select_tool(int tool) override { tools_selected.insert(tool); }
   void set_g5x_offset(int index, const Pose&) override { systems.insert(index); }
   void use_tool_length_offset(const Pose&) override { ++tool_offsets; }
+  void dwell(double seconds) override { dwell_s += seconds; }
 
   const Box& box() const { return box_; }
   std::set<int> tool_changes, tools_selected, systems;
   int tool_offsets = 0;
+  double dwell_s = 0;
 
  private:
   void move(const Pose& end) {
@@ -243,27 +258,57 @@ void print_box(const char* name, const Box& b) {
               b.lo[1] + 0.0, b.hi[1] + 0.0, b.lo[2] + 0.0, b.hi[2] + 0.0);
 }
 
+/// One scan of a program: the interpreter into the builder (which drops what the meter has
+/// measured) and the watcher, through a tee.
+class ProgramScan {
+ public:
+  explicit ProgramScan(const gcode::Options& options)
+      : interp_(options), builder_(options.axes), meter_(builder_), watch_(meter_), tee_(builder_, watch_) {}
+  /// False (with the diagnostic in the interpreter's) if the file cannot be opened.
+  bool open(const std::string& file) {
+    if (!interp_.open(file)) return false;
+    builder_.program().set_sources(interp_.sources());
+    return true;
+  }
+  gcode::RunStatus run(InterpreterProgress& progress) {
+    const gcode::RunStatus status = progress.run(interp_, tee_);
+    meter_.catch_up();  // moves of calls the watcher does not follow (probes, taps, splines)
+    return status;
+  }
+  const Totals& totals() const { return meter_.totals(); }
+  const WorkWatcher& watcher() const { return watch_; }
+  const gcode::Interpreter& interpreter() const { return interp_; }
+  /// "file:line" of a move.
+  std::string where(std::uint32_t file, std::uint32_t line) const {
+    const canon::SourceMap& sources = *interp_.sources();
+    return fmt::format("{}:{}", file < sources.file_count() ? sources.file(file) : std::string("?"), line);
+  }
+
+ private:
+  gcode::Interpreter interp_;
+  canon::ProgramBuilder builder_;
+  MoveMeter meter_;
+  WorkWatcher watch_;
+  canon::TeeSink tee_;  // the builder first: the watcher's meter reads its moves
+};
+
 }  // namespace
 
 int run_scan(const std::string& file, const gcode::Options& options, const ScanOutput& out) {
-  gcode::Interpreter interp(options);
-  if (!interp.open(file)) {
-    for (const auto& d : interp.diagnostics().items()) std::fprintf(stderr, "%s [%s]\n", d.format().c_str(), d.code.c_str());
+  ProgramScan scan(options);
+  if (!scan.open(file)) {
+    for (const auto& d : scan.interpreter().diagnostics().items())
+      std::fprintf(stderr, "%s [%s]\n", d.format().c_str(), d.code.c_str());
     return kExitUsage;
   }
-  canon::ProgramBuilder builder(options.axes);
-  builder.program().set_sources(interp.sources());
-  MoveMeter meter(builder);
-  WorkWatcher watch(meter);
-  canon::TeeSink tee(builder, watch);   // the builder first: the watcher's meter reads its moves
   InterpreterProgress progress("scan " + file, out.progress);
-  const gcode::RunStatus status = progress.run(interp, tee);
-  meter.catch_up();   // moves of calls the watcher does not follow (probes, taps, splines)
-  const Totals& t = meter.totals();
-  const gcode::InterpState st = interp.state();
+  const gcode::RunStatus status = scan.run(progress);
+  const WorkWatcher& watch = scan.watcher();
+  const Totals& t = scan.totals();
+  const gcode::InterpState st = scan.interpreter().state();
   const double rapid_rate_mm_min = out.rapid_rate_mm_min;
   const double rapid_min = rapid_rate_mm_min > 0 ? t.rapid_length / rapid_rate_mm_min : 0.0;
-  Diagnostics diags = interp.diagnostics();
+  Diagnostics diags = scan.interpreter().diagnostics();
   if (t.out_of_reach) diags.add(*t.out_of_reach);
   const bool ok = status != gcode::RunStatus::Error && !t.out_of_reach;
   if (out.json) {
@@ -274,7 +319,9 @@ int run_scan(const std::string& file, const gcode::Options& options, const ScanO
     j["segments"] = {{"feed", t.feeds}, {"rapid", t.rapids}, {"arcs", t.arcs}};
     j["length_mm"] = {{"feed", t.feed_length}, {"rapid", t.rapid_length}};
     j["bounding_box"] = {{"machine_mm", box_json(t.box)}, {"work", box_json(watch.box())}};
-    j["time_s"] = {{"feed", t.feed_time_min * 60.0}, {"rapid", rapid_rate_mm_min > 0 ? nlohmann::json(rapid_min * 60.0) : nullptr},
+    j["time_s"] = {{"feed", t.feed_time_min * 60.0},
+                   {"rapid", rapid_rate_mm_min > 0 ? nlohmann::json(rapid_min * 60.0) : nullptr},
+                   {"dwell", watch.dwell_s},
                    {"per_revolution_untimed", t.untimed}};
     j["tools"] = {{"selected", watch.tools_selected}, {"changed_index", watch.tool_changes}};
     j["coordinate_systems"] = watch.systems;
@@ -293,6 +340,7 @@ int run_scan(const std::string& file, const gcode::Options& options, const ScanO
     std::printf("%-22s %.1f s at programmed feeds%s", "time", t.feed_time_min * 60.0,
                 t.untimed ? " (feed-per-revolution moves not timed)" : "");
     if (rapid_rate_mm_min > 0) std::printf(" + %.1f s rapid", rapid_min * 60.0);
+    if (watch.dwell_s > 0) std::printf(" + %.1f s dwell", watch.dwell_s);
     std::printf("\n");
     std::printf("%-22s", "tools selected");
     for (int x : watch.tools_selected) std::printf(" T%d", x);
@@ -305,6 +353,53 @@ int run_scan(const std::string& file, const gcode::Options& options, const ScanO
     for (const auto& x : diags.items()) std::printf("%s [%s]\n", x.format().c_str(), x.code.c_str());
   }
   return ok ? kExitOk : kExitProgram;
+}
+
+namespace {
+
+/// The interpreter's options for `profile`, as the controller's GcodeProgramSource sets them.
+std::optional<gcode::Options> run_options(const config::MachineProfile& profile) {
+  gcode::Options o;
+  o.dialect = profile.interpreter.dialect == config::Dialect::Fanuc ? gcode::Dialect::Fanuc
+                                                                    : gcode::Dialect::LinuxCnc;
+  o.axes = profile.axis_mask();
+  o.subroutine_path = profile.interpreter.subroutine_path;
+  o.user_units = canon::Units::Mm;
+  o.initial_units = canon::Units::Mm;
+  o.optional_stop = true;
+  o.extensions = gcode::standard_extensions(o.dialect);
+  if (!profile.interpreter.tool_table.empty()) {
+    Diagnostics diags;
+    auto table = tools::ToolTable::load(profile.interpreter.tool_table, diags);
+    if (!table || diags.has_errors()) return std::nullopt;
+    o.tool_table = std::make_shared<tools::ToolTable>(std::move(*table));
+  }
+  return o;
+}
+
+}  // namespace
+
+TimeEstimate estimate_machining_time(const std::string& file, const config::MachineProfile& profile) {
+  TimeEstimate e;
+  const std::optional<gcode::Options> options = run_options(profile);
+  if (!options) return e;
+  ProgramScan scan(*options);
+  if (!scan.open(file)) return e;
+  InterpreterProgress progress("checking the machining time of " + file, false);
+  e.complete = scan.run(progress) != gcode::RunStatus::Error && !scan.totals().out_of_reach;
+  double rapid_mm_s = 0;
+  for (const config::AxisProfile& a : profile.axes) {
+    if (a.axis == Axis::X || a.axis == Axis::Y || a.axis == Axis::Z)
+      rapid_mm_s += a.max_velocity * a.max_velocity;
+  }
+  rapid_mm_s = std::sqrt(rapid_mm_s);
+  const Totals& t = scan.totals();
+  e.feed_s = 60 * t.feed_time_min;
+  e.rapid_s = rapid_mm_s > 0 ? t.rapid_length / rapid_mm_s : 0;
+  e.dwell_s = scan.watcher().dwell_s;
+  e.slowest_move_s = 60 * t.slowest_min;
+  if (t.slowest_min > 0) e.slowest_move_at = scan.where(t.slowest_file, t.slowest_line);
+  return e;
 }
 
 }  // namespace opencnc::cli

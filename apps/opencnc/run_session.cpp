@@ -16,6 +16,7 @@
 #include "opencnc/controller/gcode_source.hpp"
 #include "opencnc/controller/servo_setup.hpp"
 #include "opencnc/controller/sim_rig.hpp"
+#include "stop_signals.hpp"
 
 namespace opencnc::cli {
 
@@ -127,13 +128,14 @@ bool home_if_needed(Driver& d, const control::ServoConfig& sc) {
   return false;
 }
 
-/// Follows the run until it ends; continues program stops and manual tool changes at once.
-void follow(Driver& d, const SessionHooks& hooks, SessionEnd& end) {
+/// Follows the run until it ends; continues program stops and manual tool changes at once. A stop
+/// asked through `stop` holds the feed on the path, then aborts once the machine is at rest.
+void follow(Driver& d, const SessionHooks& hooks, const std::atomic<int>* stop, SessionEnd& end) {
   const auto t0 = std::chrono::steady_clock::now();
   const std::uint64_t finished_before = d.controller().status().runs_finished;
   control::TraceSample sample;
   std::uint64_t n = 0;
-  bool nudged = false;
+  bool nudged = false, held = false, aborted = false;
   for (;;) {
     d.advance();
     while (d.channels().trace.try_pop(sample)) {
@@ -144,7 +146,16 @@ void follow(Driver& d, const SessionHooks& hooks, SessionEnd& end) {
     if (hooks.progress && (++n % 256 == 0)) hooks.progress(st, wall);
     print_notes(d.controller());
     const bool waiting = st.servo.state == State::Stopped || st.servo.wait == control::Wait::ManualToolChange;
-    if (waiting && !nudged) {
+    if (stop != nullptr && stop->load(std::memory_order_relaxed) != 0 && !aborted) {
+      end.stopped_by = stop->load(std::memory_order_relaxed);
+      if (!held)
+        d.controller().submit(Request::simple(CommandKind::FeedHold));
+      else if (st.servo.path_velocity == 0)
+        d.controller().submit(Request::simple(CommandKind::Abort));
+      aborted = held && st.servo.path_velocity == 0;
+      held = true;
+    }
+    if (waiting && !nudged && end.stopped_by == 0) {
       d.controller().submit(Request::simple(st.servo.state == State::Stopped ? CommandKind::CycleStart
                                                                              : CommandKind::ToolChanged));
     }
@@ -153,9 +164,15 @@ void follow(Driver& d, const SessionHooks& hooks, SessionEnd& end) {
     end.wall_s = wall;
     end.finished = st.runs_finished > finished_before;
     if (!end.finished) {
-      end.fault = st.fault_text.empty()
-                      ? fmt::format("the run ended in state {}", control::to_string(st.servo.state))
-                      : st.fault_text;
+      // (a fault was printed as its note already)
+      if (!st.fault_text.empty())
+        end.fault = st.fault_text;
+      else if (end.stopped_by != 0)
+        end.fault =
+            fmt::format("stopped by {} (feed hold on the path, then abort)", signal_name(end.stopped_by));
+      else
+        end.fault = fmt::format("the run ended in state {}", control::to_string(st.servo.state));
+      if (st.fault_text.empty()) fmt::print(stderr, "error: {}\n", end.fault);
       end.limit_touched = st.servo.fault.kind == control::FaultKind::SoftLimit ||
                           st.servo.fault.kind == control::FaultKind::LimitSwitch;
     }
@@ -210,9 +227,8 @@ SessionEnd run_session(const SessionOptions& o, const SessionHooks& hooks) {
   if (hooks.opened) hooks.opened(end.profile, *end.program);
   d.channels().trace_enabled = true;
   if (!must(d, Request::simple(CommandKind::CycleStart))) return end;
-  follow(d, hooks, end);
-  if (!end.finished) fmt::print(stderr, "error: {}\n", end.fault);
-  end.exit_code = end.finished ? kExitOk : kExitProgram;
+  follow(d, hooks, o.stop, end);
+  end.exit_code = end.finished ? kExitOk : end.stopped_by != 0 ? 128 + end.stopped_by : kExitProgram;
   return end;
 }
 

@@ -3,6 +3,7 @@
 // load the profile, home if needed, open, cycle start, follow the run to its end.
 #pragma once
 
+#include <atomic>
 #include <functional>
 #include <memory>
 #include <string>
@@ -20,6 +21,8 @@ struct SessionOptions {
   std::string machine;
   std::vector<std::string> sets;
   bool realtime = false;  ///< a real-time periodic thread instead of virtual time
+  /// Polled during the run: a signal number there stops it on the path (feed hold, then abort).
+  const std::atomic<int>* stop = nullptr;
 };
 
 /// What a session ended with.
@@ -28,6 +31,7 @@ struct SessionEnd {
   bool finished = false;       ///< the program reached its end
   std::string fault;           ///< why it stopped early, in words ("" = it did not)
   bool limit_touched = false;  ///< a soft limit or a limit switch stopped it
+  int stopped_by = 0;          ///< the signal that stopped it (SessionOptions::stop), 0 if none
   double wall_s = 0;           ///< wall-clock time of the run
   std::shared_ptr<const canon::Program> program;
   config::MachineProfile profile;
