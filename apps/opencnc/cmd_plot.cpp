@@ -332,9 +332,9 @@ int plot(const PlotOptions& o) {
   Trace tr;
   std::string error, title;
   if (!o.trace.empty()) {
-    if (!read_trace(o.trace, tr, error)) {
+    if (!read_trace(o.trace, tr, error)) {  // (check_inputs said it can be read: its data is bad)
       fmt::print(stderr, "error: {}\n", error);
-      return kExitUsage;
+      return kExitProgram;
     }
     title = "opencnc trace " + o.trace;
   } else {
