@@ -87,7 +87,7 @@ bool read_file(const std::string& path, std::string& out, std::string* error) {
     const ssize_t n = ::read(fd, buf, sizeof buf);
     if (n < 0) {
       if (errno == EINTR) continue;
-      const int err = errno;   // EISDIR for a folder
+      const int err = errno;  // EISDIR for a folder
       ::close(fd);
       return reason(err);
     }

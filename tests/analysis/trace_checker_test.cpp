@@ -159,15 +159,14 @@ TEST(TraceChecker, AThousandTurnHelixIsCheckedCorrectly) {
     EXPECT_NEAR(c.distance_to_move(1, on_helix(turn, kTurns, kDepth, -0.03)), 0.03, 1e-9) << turn;
   }
   // Between two turns, above the start and below the end: against a brute-force search.
-  for (const Pose& q :
-       {on_helix(500.2, kTurns, kDepth, 0.01, 0.05), on_helix(3.7, kTurns, kDepth, 0.5, 0.04),
-        on_helix(0, kTurns, kDepth, 0, 3), on_helix(1000, kTurns, kDepth, 1, -2), xy(5, 0), xy(5, 0.5)}) {
+  for (const Pose& q : {on_helix(500.2, kTurns, kDepth, 0.01, 0.05), on_helix(0, kTurns, kDepth, 0, 3),
+                        on_helix(1000, kTurns, kDepth, 1, -2), xy(5, 0.5)}) {
     EXPECT_NEAR(c.distance_to_move(1, q), brute_force(kTurns, kDepth, q), 1e-7)
         << q[0] << " " << q[1] << " " << q[2];
   }
   // Through the report: samples along the whole helix, 0.01 mm off it at most.
-  for (int k = 0; k <= 20000; ++k) {
-    const double turn = kTurns * k / 20000.0;
+  for (int k = 0; k <= 5000; ++k) {
+    const double turn = kTurns * k / 5000.0;
     c.add(on_helix(turn, kTurns, kDepth, 0.01 * std::sin(k)), 1, 1);
   }
   EXPECT_LE(c.report().max_contour_error_mm, 0.01 + 1e-9);

@@ -5,7 +5,8 @@
 # Exit 77 with a line starting SKIP: the case does not apply to this build (ctest shows it skipped).
 #   tests/cli/hostile_case.sh OPENCNC SOURCE_DIR TABLE NAME
 # The command sees $B (the opencnc binary), $SRC (the source tree), $M (configs/mill-3axis.toml),
-# $E (examples/bracket.ngc), $S (a 100 mm square, tests/scenario/programs/square.ngc).
+# $E (examples/bracket.ngc), $S (a 100 mm square, tests/scenario/programs/square.ngc), $Q (a 20 mm
+# move, 0.25 s of machining: a quick run where any run will do).
 set -u
 case ${1:-} in
   -h | --help) echo "usage: $0 OPENCNC SOURCE_DIR TABLE NAME"; exit 0 ;;
@@ -21,8 +22,11 @@ pattern=$(printf '%s' "$row" | cut -f3)
 command=$(printf '%s' "$row" | cut -f4)
 check=$(printf '%s' "$row" | cut -f5)
 
-work=$(mktemp -d)
-trap 'chmod -R u+w "$work" 2>/dev/null; rm -rf "$work"' EXIT
+work=$(mktemp -d) fixtures=$(mktemp -d)
+trap 'chmod -R u+w "$work" 2>/dev/null; rm -rf "$work" "$fixtures"' EXIT
+Q=$fixtures/quick.ngc
+printf 'G21 G90 G94\nG1 X20 F6000\nM2\n' > "$Q"
+export Q
 cd "$work" || exit 2
 out=$(sh -c "$command" 2>&1)
 rc=$?
