@@ -318,6 +318,20 @@ bool check_sources(const PlotOptions& o) {
   return true;
 }
 
+/// The program run's samples, as the plot draws them.
+class PlotRecorder final : public control::ControllerObserver {
+ public:
+  explicit PlotRecorder(Trace& tr) : tr_(tr) {}
+  void on_trace(const control::TraceSample& s, const control::TraceContext&) override {
+    if (s.activity != control::Activity::Program) return;
+    tr_.samples.push_back(Sample{static_cast<double>(s.tick) * tr_.period_s, s.rapid, s.path_velocity, s.commanded,
+                                 s.following_error});
+  }
+
+ private:
+  Trace& tr_;
+};
+
 int plot(const PlotOptions& o) {
   if (!check_sources(o)) return kExitUsage;
   const std::optional<config::MachineProfile> profile =
@@ -339,15 +353,16 @@ int plot(const PlotOptions& o) {
     title = "opencnc trace " + o.trace;
   } else {
     SessionHooks hooks;
-    hooks.opened = [&](const config::MachineProfile& p, const canon::Program&) {
+    hooks.opened = [&](const config::MachineProfile& p, const control::OpenProgram&) {
       tr.axes = p.axis_mask();
       tr.period_s = p.servo_period_s;
+      std::vector<std::pair<std::shared_ptr<control::ControllerObserver>, control::ObserverOptions>> out;
+      out.emplace_back(std::make_shared<PlotRecorder>(tr), control::ObserverOptions{0, true});
+      return out;
     };
-    hooks.sample = [&](const control::TraceSample& s) {
-      tr.samples.push_back(Sample{static_cast<double>(s.tick) * tr.period_s, s.rapid, s.path_velocity,
-                                  s.commanded, s.following_error});
-    };
-    const SessionEnd end = run_session(o.session, hooks);
+    SessionOptions session = o.session;
+    session.unattended = true;  // a drawing: program stops and tool changes go on by themselves
+    const SessionEnd end = run_session(session, hooks);
     if (tr.samples.empty()) return end.exit_code == kExitOk ? kExitProgram : end.exit_code;
     title = fmt::format("opencnc {} on {}", o.session.file, end.profile.name);
   }

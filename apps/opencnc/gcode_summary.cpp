@@ -17,9 +17,8 @@
 #include "commands.hpp"
 #include "opencnc/canon/program_builder.hpp"
 #include "opencnc/canon/tee_sink.hpp"
+#include "opencnc/controller/gcode_source.hpp"
 #include "opencnc/gcode/interpreter.hpp"
-#include "opencnc/gcode/standard_extensions.hpp"
-#include "opencnc/tools/tool_table.hpp"
 #include "progress.hpp"
 
 namespace opencnc::cli {
@@ -355,35 +354,13 @@ int run_scan(const std::string& file, const gcode::Options& options, const ScanO
   return ok ? kExitOk : kExitProgram;
 }
 
-namespace {
-
-/// The interpreter's options for `profile`, as the controller's GcodeProgramSource sets them.
-std::optional<gcode::Options> run_options(const config::MachineProfile& profile) {
-  gcode::Options o;
-  o.dialect = profile.interpreter.dialect == config::Dialect::Fanuc ? gcode::Dialect::Fanuc
-                                                                    : gcode::Dialect::LinuxCnc;
-  o.axes = profile.axis_mask();
-  o.subroutine_path = profile.interpreter.subroutine_path;
-  o.user_units = canon::Units::Mm;
-  o.initial_units = canon::Units::Mm;
-  o.optional_stop = true;
-  o.extensions = gcode::standard_extensions(o.dialect);
-  if (!profile.interpreter.tool_table.empty()) {
-    Diagnostics diags;
-    auto table = tools::ToolTable::load(profile.interpreter.tool_table, diags);
-    if (!table || diags.has_errors()) return std::nullopt;
-    o.tool_table = std::make_shared<tools::ToolTable>(std::move(*table));
-  }
-  return o;
-}
-
-}  // namespace
-
 TimeEstimate estimate_machining_time(const std::string& file, const config::MachineProfile& profile) {
   TimeEstimate e;
-  const std::optional<gcode::Options> options = run_options(profile);
-  if (!options) return e;
-  ProgramScan scan(*options);
+  // The options the run's own source gives this file (dialect comment, modules, tool table).
+  Diagnostics diags;
+  const auto source = control::GcodeProgramSource::create(profile, diags);
+  if (!source) return e;
+  ProgramScan scan(source->options_for(file, {}));
   if (!scan.open(file)) return e;
   InterpreterProgress progress("checking the machining time of " + file, false);
   e.complete = scan.run(progress) != gcode::RunStatus::Error && !scan.totals().out_of_reach;

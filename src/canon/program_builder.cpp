@@ -70,14 +70,14 @@ void ProgramBuilder::set_g5x_offset(int index, const Pose& offset) {
   update_work_offset();
   Action a = make(ActionKind::WorkOffset, index);
   a.pose = program_.add_action_pose(g5x_);
-  program_.add_action(a);
+  add(a);
 }
 
 void ProgramBuilder::set_g92_offset(const Pose& offset) {
   g92_ = offset_to_mm(offset);
   Action a = make(ActionKind::G92Offset);
   a.pose = program_.add_action_pose(g92_);
-  program_.add_action(a);
+  add(a);
 }
 
 void ProgramBuilder::set_xy_rotation(double degrees) {
@@ -85,7 +85,7 @@ void ProgramBuilder::set_xy_rotation(double degrees) {
   const double r = degrees * std::numbers::pi / 180.0;
   rot_cos_ = std::cos(r);
   rot_sin_ = std::sin(r);
-  program_.add_action(make(ActionKind::XyRotation, 0, 0, degrees));
+  add(make(ActionKind::XyRotation, 0, 0, degrees));
 }
 
 void ProgramBuilder::use_tool_length_offset(const Pose& offset) {
@@ -93,7 +93,63 @@ void ProgramBuilder::use_tool_length_offset(const Pose& offset) {
   update_work_offset();
   Action a = make(ActionKind::ToolLengthOffset);
   a.pose = program_.add_action_pose(tool_);
+  add(a);
+}
+
+void ProgramBuilder::add(const Action& a) {
+  int setting = -1;
+  switch (a.kind) {
+    case ActionKind::MotionControl:
+      setting = kPathControl;
+      break;
+    case ActionKind::NaiveCamTolerance:
+      setting = kNaiveCam;
+      break;
+    case ActionKind::FeedOverrideEnable:
+    case ActionKind::FeedOverrideDisable:
+      setting = kFeedOverride;
+      break;
+    case ActionKind::FeedHoldEnable:
+    case ActionKind::FeedHoldDisable:
+      setting = kFeedHold;
+      break;
+    case ActionKind::SpeedFeedSyncStart:
+    case ActionKind::SpeedFeedSyncStop:
+      setting = kSpindleSync;
+      break;
+    default:
+      break;
+  }
+  if (setting >= 0) {
+    settings_[setting] = a;
+    has_setting_[setting] = true;
+  }
   program_.add_action(a);
+}
+
+std::unique_ptr<ProgramBuilder> ProgramBuilder::continuation(const Pose& start) const {
+  auto next = std::make_unique<ProgramBuilder>(program_.axes(), start);
+  next->program_.set_sources(program_.sources_ptr());
+  next->origin_ = origin_;
+  next->use_length_units(units_);
+  next->plane_ = plane_;
+  next->g5x_ = g5x_;
+  next->g92_ = g92_;
+  next->tool_ = tool_;
+  next->work_offset_ = work_offset_;
+  next->rotation_deg_ = rotation_deg_;
+  next->rot_cos_ = rot_cos_;
+  next->rot_sin_ = rot_sin_;
+  next->feed_ = feed_;
+  next->feed_mode_ = feed_mode_;
+  next->synced_ = synced_;
+  for (int k = 0; k < kSettings; ++k) {
+    if (!has_setting_[k]) continue;
+    Action a = settings_[k];
+    a.before_move = 0;
+    next->add(a);
+  }
+  return next;
 }
 
 Action ProgramBuilder::make(ActionKind kind, int index, int index2, double value) const {
@@ -231,21 +287,21 @@ void ProgramBuilder::nurbs_feed(SegmentId id, int order, std::span<const NurbsPo
   program_.note_split(id, first, chords.size());
 }
 
-void ProgramBuilder::dwell(double seconds) { program_.add_action(make(ActionKind::Dwell, 0, 0, seconds)); }
+void ProgramBuilder::dwell(double seconds) { add(make(ActionKind::Dwell, 0, 0, seconds)); }
 
 void ProgramBuilder::set_feed_mode(int /*spindle*/, FeedMode mode) { feed_mode_ = mode; }
 
 void ProgramBuilder::set_motion_control_mode(MotionControl mode, double tolerance) {
-  program_.add_action(make(ActionKind::MotionControl, static_cast<int>(mode), 0, tolerance * mm_per_unit(units_)));
+  add(make(ActionKind::MotionControl, static_cast<int>(mode), 0, tolerance * mm_per_unit(units_)));
 }
 
 void ProgramBuilder::set_naivecam_tolerance(double tolerance) {
-  program_.add_action(make(ActionKind::NaiveCamTolerance, 0, 0, tolerance * mm_per_unit(units_)));
+  add(make(ActionKind::NaiveCamTolerance, 0, 0, tolerance * mm_per_unit(units_)));
 }
 
 void ProgramBuilder::start_speed_feed_synch(int spindle, double feed_per_rev, bool velocity_mode) {
   synced_ = true;
-  program_.add_action(
+  add(
       make(ActionKind::SpeedFeedSyncStart, spindle, velocity_mode ? 1 : 0, feed_per_rev * mm_per_unit(units_)));
 }
 
@@ -255,16 +311,16 @@ void ProgramBuilder::stop_speed_feed_synch() {
 }
 
 void ProgramBuilder::set_spindle_speed(int spindle, double rpm) {
-  program_.add_action(make(ActionKind::SpindleSpeed, spindle, 0, rpm));
+  add(make(ActionKind::SpindleSpeed, spindle, 0, rpm));
 }
 void ProgramBuilder::start_spindle_clockwise(int spindle) { simple(ActionKind::SpindleCw, spindle); }
 void ProgramBuilder::start_spindle_counterclockwise(int spindle) { simple(ActionKind::SpindleCcw, spindle); }
 void ProgramBuilder::stop_spindle_turning(int spindle) { simple(ActionKind::SpindleStop, spindle); }
 void ProgramBuilder::set_spindle_mode(int spindle, double css_max) {
-  program_.add_action(make(ActionKind::SpindleMode, spindle, 0, css_max));
+  add(make(ActionKind::SpindleMode, spindle, 0, css_max));
 }
 void ProgramBuilder::orient_spindle(int spindle, double degrees, int direction) {
-  program_.add_action(make(ActionKind::SpindleOrient, spindle, direction, degrees));
+  add(make(ActionKind::SpindleOrient, spindle, direction, degrees));
 }
 
 void ProgramBuilder::select_tool(int tool) { simple(ActionKind::SelectTool, tool); }
@@ -272,27 +328,27 @@ void ProgramBuilder::change_tool(int tool) { simple(ActionKind::ChangeTool, tool
 void ProgramBuilder::change_tool_number(int tool) { simple(ActionKind::ChangeToolNumber, tool); }
 
 void ProgramBuilder::set_motion_output_value(int index, double value) {
-  program_.add_action(make(ActionKind::MotionOutputValue, index, 0, value));
+  add(make(ActionKind::MotionOutputValue, index, 0, value));
 }
 void ProgramBuilder::set_aux_output_value(int index, double value) {
-  program_.add_action(make(ActionKind::AuxOutputValue, index, 0, value));
+  add(make(ActionKind::AuxOutputValue, index, 0, value));
 }
 void ProgramBuilder::wait_for_input(int index, bool digital, int mode, double timeout_s) {
   Action a = make(ActionKind::WaitInput, index, mode, timeout_s);
   a.text = program_.add_text(digital ? "digital" : "analog");
-  program_.add_action(a);
+  add(a);
 }
 
 void ProgramBuilder::comment(std::string_view text) {
   Action a = make(ActionKind::Comment);
   a.text = program_.add_text(std::string(text));
-  program_.add_action(a);
+  add(a);
 }
 
 void ProgramBuilder::message(std::string_view text) {
   Action a = make(ActionKind::Message);
   a.text = program_.add_text(std::string(text));
-  program_.add_action(a);
+  add(a);
 }
 
 }  // namespace opencnc::canon

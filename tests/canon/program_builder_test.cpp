@@ -124,13 +124,13 @@ TEST(ProgramBuilder, ActionsKeepTheirPlaceBetweenMoves) {
   b.dwell(0.5);
   b.straight_traverse(1, xyz(2, 0, 0));
   b.program_end();
-  const auto& acts = b.program().actions();
-  ASSERT_EQ(acts.size(), 4u);
-  EXPECT_EQ(acts[0].kind, ActionKind::SpindleSpeed);
-  EXPECT_EQ(acts[0].before_move, 0u);
-  EXPECT_EQ(acts[2].kind, ActionKind::Dwell);
-  EXPECT_EQ(acts[2].before_move, 1u);
-  EXPECT_EQ(acts[3].before_move, 2u);
+  const Program& p = b.program();
+  ASSERT_EQ(p.action_count(), 4u);
+  EXPECT_EQ(p.action(0).kind, ActionKind::SpindleSpeed);
+  EXPECT_EQ(p.action(0).before_move, 0u);
+  EXPECT_EQ(p.action(2).kind, ActionKind::Dwell);
+  EXPECT_EQ(p.action(2).before_move, 1u);
+  EXPECT_EQ(p.action(3).before_move, 2u);
 }
 
 TEST(ProgramBuilder, StoresOnlyTheConfiguredAxes) {
