@@ -161,6 +161,7 @@ class Engine final : public ParamHost, public ExecContext {
   void check_g10();
   void check_other_codes();
   void check_p_word();
+  void check_m98(const Block& b);
   void check_extension(int code, int position);   ///< `code` must have a handler
   /// The extension's handler of G code `code` (×10), nullptr if none (or code < 0).
   const CodeHandler* extension_handler(int code) const noexcept {
@@ -267,6 +268,12 @@ class Engine final : public ParamHost, public ExecContext {
   void o_endif();
   void o_break_continue(bool is_break);
   void o_end_loop();
+  void o_program();
+  void o_m98();
+  void o_m99();
+  void enter_sub(CallFrame frame, std::string name, std::string_view context_name);
+  [[noreturn]] void mixed_styles(const char* what) const;
+  void repeat_main();
   LabelInfo* find_label(const std::string& name);
   [[noreturn]] void unmatched(const char* keyword, const char* opener,
                               const char* other_opener = nullptr) const;

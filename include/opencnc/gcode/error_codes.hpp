@@ -213,6 +213,7 @@ namespace opencnc::gcode {
   X(OwordNotInSub, "gcode.oword-not-in-sub")                                 \
   X(OwordTooManyArgs, "gcode.oword-too-many-args")                           \
   X(OwordInMdi, "gcode.oword-in-mdi")                                        \
+  X(OwordMixedStyles, "gcode.oword-mixed-styles")                            \
   /* Fanuc dialect and coordinate transforms */                              \
   X(FanucGotoTargetMissing, "fanuc.goto-target-missing")                     \
   X(FanucEndWithoutDo, "fanuc.end-without-do")                               \
@@ -245,6 +246,7 @@ namespace opencnc::gcode {
   X(LimitRepeatCount, "gcode.limit-repeat-count")                            \
   X(LimitSegments, "gcode.limit-segments")                                   \
   X(LimitSkippedLines, "gcode.limit-skipped-lines")                          \
+  X(LimitMainRepeats, "gcode.limit-main-repeats")                            \
   /* another controller's syntax in this dialect */                          \
   X(DialectUnsupported, "dialect.unsupported")                               \
   /* interface use */                                                        \
