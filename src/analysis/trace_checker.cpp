@@ -160,9 +160,14 @@ double TraceChecker::box_distance(canon::SegmentId id, const Pose& p) const {
     const canon::ArcGeometry& g = program_->arc(id);
     const int b0 =
         (g.plane == canon::Plane::XY || g.plane == canon::Plane::YZ || g.plane == canon::Plane::XZ) ? 0 : 6;
-    double r2 = 0;
-    for (int k = 0; k < 3; ++k) r2 += (a[b0 + k] - g.center[k]) * (a[b0 + k] - g.center[k]);
-    grow = 2 * std::sqrt(r2);  // the whole circle fits in the end points' box grown by its diameter
+    double r2 = 0, e2 = 0;
+    for (int k = 0; k < 3; ++k) {
+      r2 += (a[b0 + k] - g.center[k]) * (a[b0 + k] - g.center[k]);
+      e2 += (b[b0 + k] - g.center[k]) * (b[b0 + k] - g.center[k]);
+    }
+    // The whole circle (or spiral, between its two radii) fits in the end points' box grown by
+    // its largest diameter.
+    grow = 2 * std::sqrt(std::max(r2, e2));
   }
   double s = 0;
   for (int i : kLinear) {

@@ -236,7 +236,11 @@ void ProgramReader::chord_small_arc(const Pose& start, const Pose& end, double f
   if (norm(e.b.lin) > 1e-12) return;  // helix or other axes: not a flat arc
   const double sweep = std::fabs(e.b.omega) * e.b.length;
   if (sweep > 3.14159265358979323846) return;
-  const double sagitta = norm(e.b.u) * (1 - std::cos(0.5 * sweep));
+  // A spiral lies within its largest radius's sagitta of the chord between the points at that
+  // radius, and its ends are within the radius change of those points: the sum bounds it.
+  const double r0 = norm(e.b.u), r_end = r0 * (1 + e.b.spiral * e.b.omega * e.b.length);
+  const double r_max = std::max(r0, r_end);
+  const double sagitta = r_max * (1 - std::cos(0.5 * sweep)) + 2 * std::fabs(r_end - r0);
   if (sagitta > merge_budget()) return;
   MotionBlock line = e.b;
   if (!make_line(start, end, line)) return;

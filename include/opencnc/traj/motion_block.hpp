@@ -18,6 +18,9 @@ enum class BlockKind : std::uint8_t {
            ///< (u from the start toward the centre, w = radius × tangent, both of length r)
   Bezier,  ///< cubic Bézier with control points base, u, w, lin at t = s / length
   Marker,  ///< a point on the path where the tick stops or reports something
+  Spiral,  ///< p(s) = base + sin θ·w + (1 − cos θ)·u + ρθ·(sin θ·w − cos θ·u) + s·lin, θ = ωs,
+           ///< ρ = `spiral`: an arc whose radius goes linearly with the angle from r = |u| to
+           ///< r·(1 + ρθ_end) (LinuxCNC's arcs whose end is off the start circle)
 };
 
 /// What the tick does at a marker.
@@ -76,7 +79,8 @@ struct MotionBlock {
 
   // --- geometry ----------------------------------------------------------------------------
   double length = 0;             ///< s range [0, length]; 0 for markers
-  double omega = 0;              ///< Arc: rad per unit of s
+  double omega = 0;              ///< Arc, Spiral: rad per unit of s
+  double spiral = 0;             ///< Spiral: relative change of the radius per radian
   Pose base{}, u{}, w{}, lin{};  ///< see BlockKind
 
   // --- limits ------------------------------------------------------------------------------
