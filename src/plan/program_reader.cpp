@@ -93,8 +93,17 @@ bool check_program(const canon::Program& program, const MachineLimits& limits, D
       continue;
     }
     if (m.kind == MoveKind::RigidTap) {
-      fail(id, "rigid tapping (G33.1) is not supported by the planner yet", "plan.unsupported-move");
-      continue;
+      // A tap is a pair: in to the bottom, then (kTapReturn) out, both following the spindle.
+      const bool out = (m.flags & canon::kTapReturn) != 0;
+      const bool paired = out ? id > 0 && program.move(id - 1).kind == MoveKind::RigidTap &&
+                                    !(program.move(id - 1).flags & canon::kTapReturn)
+                              : id + 1 < program.size() && program.move(id + 1).kind == MoveKind::RigidTap &&
+                                    (program.move(id + 1).flags & canon::kTapReturn);
+      if (!paired || !(m.flags & canon::kSpindleSynced)) {
+        fail(id, "a rigid tap needs its way out and spindle synchronisation (START_SPEED_FEED_SYNCH) around it",
+             "plan.unsupported-move");
+        continue;
+      }
     }
     for (int i = 0; i < kAxisCount; ++i) {
       if (end[i] != start[i] && !limits.axes.has(static_cast<Axis>(i))) {
@@ -199,6 +208,11 @@ bool ProgramReader::make_element(canon::SegmentId id, Element& e) const {
   b.context = m.context;
   b.flags = flags();
   if (m.kind == MoveKind::Probe) b.flags |= traj::kProbe;
+  if (m.kind == MoveKind::RigidTap) {
+    b.flags |= traj::kRigidTap;
+    if (m.flags & canon::kTapReturn) b.flags |= traj::kTapReturn;
+    b.tap_scale = program_->feed(id);   // the way out's spindle speed factor (G33.1 I)
+  }
   const double f = program_->feed(id);
   const double ratio = feed_length_ratio(start, end, b);
   if (m.kind == MoveKind::Traverse) {

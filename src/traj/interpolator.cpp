@@ -63,6 +63,10 @@ void Interpolator::restart(const Pose& start) noexcept {
   sync_ = Sync::Off;
   sync_target_ = sync_lag_ = prev_revs_ = 0;
   sync_lost_ = false;
+  tap_ = Tap::Off;
+  tap_locked_ = tap_reverse_ = false;
+  tap_depth_ = tap_v_ = tap_lag_ = tap_rev0_ = tap_revs_ = 0;
+  tap_dir_ = 1;
 }
 
 double Interpolator::target_speed(const TickInput& in, const MotionBlock& b) const noexcept {
@@ -197,7 +201,8 @@ void Interpolator::update_sync(const TickInput& in) noexcept {
   const double turned = std::fabs(revs - prev_revs_);
   const std::size_t index = index_of(u_seq_);
   const bool in_sync_block = index < queue_->available() && queue_->peek(index).kind != BlockKind::Marker &&
-                             queue_->peek(index).feed_class == FeedClass::SpindleSync;
+                             queue_->peek(index).feed_class == FeedClass::SpindleSync &&
+                             (queue_->peek(index).flags & kRigidTap) == 0;   // the tap follows on its own
   if (!in_sync_block) {
     sync_ = Sync::Off;
   } else {
@@ -260,6 +265,10 @@ double Interpolator::advance_unfiltered(const TickInput& in) noexcept {
     // A corner passed at zero speed: the moving average must reach it before the motion goes on,
     // or the commanded path would round it off.
     if (b.v_entry == 0 && s_u_ == u_start_ && v_u_ == 0 && still_ticks_ < config_.filter_ticks) break;
+    if (b.flags & kRigidTap) {  // reached at rest; run_tap() moves the tap
+      v_u_ = 0;
+      break;
+    }
     if (b.feed_class == FeedClass::SpindleSync && (sync_ == Sync::Off || sync_ == Sync::WaitIndex)) break;
     step_piece(in, b, index, tau, integral);
   }
@@ -418,6 +427,8 @@ void Interpolator::fill_output(TickOutput& out, double s_prev) noexcept {
   out.block_offset = shown_.offset;
   out.spindle_synced = sync_ == Sync::Locked;
   out.sync_lost = sync_lost_;
+  out.tap_reverse = false;
+  out.tap_speed_scale = 1;
 }
 
 void Interpolator::tick(const TickInput& in, TickOutput& out) noexcept {
@@ -436,12 +447,14 @@ void Interpolator::tick(const TickInput& in, TickOutput& out) noexcept {
   if (ticks_ == 1) prev_revs_ = in.spindle_revs;
   sync_rev_s_ = in.spindle_rev_s;
   update_sync(in);
-  const double s_prev = s_f_;
-  const double integral = advance_unfiltered(in);
+  double s_prev = s_f_;
+  const bool tapping = run_tap(in);   // a rigid tap moves on its own; the path waits
+  if (tapping && tap_ == Tap::Off) s_prev = s_f_;   // it ended: s moved past it, the tool did not
+  const double integral = tapping ? s_u_ * config_.period_s : advance_unfiltered(in);
   s_f_ = filter(integral);
   advance_filtered(out);
 
-  const bool settled = v_u_ == 0 && still_ticks_ >= config_.filter_ticks;
+  const bool settled = tap_ == Tap::Off && v_u_ == 0 && still_ticks_ >= config_.filter_ticks;
   const std::size_t index = index_of(u_seq_);
   const bool moving = !settled;
   if (aborting_) {
@@ -463,6 +476,7 @@ void Interpolator::tick(const TickInput& in, TickOutput& out) noexcept {
     update_waiting(in);
   }
   fill_output(out, s_prev);
+  if (tap_ != Tap::Off) show_tap(out);
   pop_and_rebase();
 }
 
