@@ -10,4 +10,4 @@ cmake --build --preset default -j "${OPENCNC_JOBS:-2}" --target opencnc
 # A bracket (pocket, compensated profile, peck-drilled holes) on the simulated three-axis mill:
 # interpreted, checked against the soft limits, planned and run in virtual time; the report
 # follows (machining time, path length, following and contour error, axis maxima, violations).
-build/opencnc run examples/bracket.ngc --machine configs/mill-3axis.toml
+build/opencnc run examples/bracket.ngc --machine configs/mill-3axis.toml --unattended

@@ -259,6 +259,20 @@ bool draw(const Trace& tr, const std::string& title, const std::string& out, std
   return chart.write(out, &error);
 }
 
+/// The program run's samples, as the plot draws them.
+class PlotRecorder final : public control::ControllerObserver {
+ public:
+  explicit PlotRecorder(Trace& tr) : tr_(tr) {}
+  void on_trace(const control::TraceSample& s, const control::TraceContext&) override {
+    if (s.activity != control::Activity::Program) return;
+    tr_.samples.push_back(Sample{static_cast<double>(s.tick) * tr_.period_s, s.rapid, s.path_velocity, s.commanded,
+                                 s.following_error});
+  }
+
+ private:
+  Trace& tr_;
+};
+
 int plot(const PlotOptions& o) {
   Trace tr;
   std::string error, title;
@@ -274,15 +288,16 @@ int plot(const PlotOptions& o) {
       return kExitUsage;
     }
     SessionHooks hooks;
-    hooks.opened = [&](const config::MachineProfile& p, const canon::Program&) {
+    hooks.opened = [&](const config::MachineProfile& p, const control::OpenProgram&) {
       tr.axes = p.axis_mask();
       tr.period_s = p.servo_period_s;
+      std::vector<std::pair<std::shared_ptr<control::ControllerObserver>, control::ObserverOptions>> out;
+      out.emplace_back(std::make_shared<PlotRecorder>(tr), control::ObserverOptions{0, true});
+      return out;
     };
-    hooks.sample = [&](const control::TraceSample& s) {
-      tr.samples.push_back(Sample{static_cast<double>(s.tick) * tr.period_s, s.rapid, s.path_velocity,
-                                  s.commanded, s.following_error});
-    };
-    const SessionEnd end = run_session(o.session, hooks);
+    SessionOptions session = o.session;
+    session.unattended = true;  // a drawing: program stops and tool changes go on by themselves
+    const SessionEnd end = run_session(session, hooks);
     if (tr.samples.empty()) return end.exit_code == kExitOk ? kExitProgram : end.exit_code;
     title = fmt::format("opencnc {} on {}", o.session.file, end.profile.name);
   }

@@ -30,21 +30,13 @@ struct RunOptions {
   std::string report;
 };
 
-/// Programmed length up to the end of each move (for the progress bar).
-std::vector<double> cumulative_lengths(const canon::Program& p) {
-  std::vector<double> out(p.size() + 1, 0.0);
-  for (canon::SegmentId id = 0; id < p.size(); ++id) out[id + 1] = out[id] + control::move_length(p, id);
-  return out;
-}
-
-/// "[#########...........]  42.1 %  line 123  12.3 s  ~17.0 s left" on one terminal line.
+/// "[#########...........]  42.1 %  line 123  12.3 s  ~17.0 s left" on one terminal line: the
+/// path run so far against the preflight's length of the whole program.
 class ProgressBar {
  public:
-  explicit ProgressBar(const canon::Program& p) : lengths_(cumulative_lengths(p)) {}
-  void show(const control::ControllerStatus& st, double run_start_s) {
-    const double total = lengths_.back();
-    const std::size_t seg = std::min<std::size_t>(st.run_segment, lengths_.size() - 1);
-    const double done = total > 0 ? lengths_[seg] / total : st.progress;
+  explicit ProgressBar(double total_mm) : total_mm_(total_mm) {}
+  void show(const control::ControllerStatus& st, double run_start_s, double done_mm) {
+    const double done = total_mm_ > 0 ? std::min(1.0, done_mm / total_mm_) : st.progress;
     const double elapsed = st.servo.time_s - run_start_s;
     const int width = 30, filled = static_cast<int>(done * width + 0.5);
     const std::string left = done > 0.01 ? fmt::format("~{:.1f} s left", elapsed * (1 - done) / done) : "";
@@ -57,7 +49,19 @@ class ProgressBar {
   void finish() { fmt::print("\n"); }
 
  private:
-  std::vector<double> lengths_;
+  double total_mm_;
+};
+
+/// The trace CSV, one row per period of the program run.
+class TraceObserver final : public control::ControllerObserver {
+ public:
+  explicit TraceObserver(control::TraceCsvWriter& w) : w_(w) {}
+  void on_trace(const control::TraceSample& s, const control::TraceContext&) override {
+    if (s.activity == control::Activity::Program) w_.add(s);
+  }
+
+ private:
+  control::TraceCsvWriter& w_;
 };
 
 std::string axis_name(int i) {
@@ -121,24 +125,26 @@ int run(const RunOptions& o) {
     fmt::print(stderr, "error: cannot write the trace {}\n", o.trace);
     return kExitUsage;
   }
-  std::optional<control::RunRecorder> recorder;
+  std::shared_ptr<control::RunRecorder> recorder;
   std::optional<control::TraceCsvWriter> csv;
   std::optional<ProgressBar> bar;
   const bool tty = ::isatty(STDOUT_FILENO) != 0;
   double run_start_s = -1;
   SessionHooks hooks;
-  hooks.opened = [&](const config::MachineProfile& profile, const canon::Program& program) {
-    recorder.emplace(program, control::machine_limits(profile), profile.servo_period_s);
-    if (!o.trace.empty()) csv.emplace(o.trace, profile.axis_mask(), profile.servo_period_s);
-    if (tty) bar.emplace(program);
-  };
-  hooks.sample = [&](const control::TraceSample& s) {
-    recorder->add(s);
-    if (csv) csv->add(s);
+  hooks.opened = [&](const config::MachineProfile& profile, const control::OpenProgram& program) {
+    std::vector<std::pair<std::shared_ptr<control::ControllerObserver>, control::ObserverOptions>> out;
+    recorder = std::make_shared<control::RunRecorder>(control::machine_limits(profile), profile.servo_period_s);
+    out.emplace_back(recorder, control::ObserverOptions{0, true});
+    if (!o.trace.empty()) {
+      csv.emplace(o.trace, profile.axis_mask(), profile.servo_period_s);
+      out.emplace_back(std::make_shared<TraceObserver>(*csv), control::ObserverOptions{0, true});
+    }
+    if (tty) bar.emplace(program.preflight.summary.path_length_mm);
+    return out;
   };
   hooks.progress = [&](const control::ControllerStatus& st, double) {
     if (run_start_s < 0) run_start_s = st.servo.time_s;
-    if (bar) bar->show(st, run_start_s);
+    if (bar) bar->show(st, run_start_s, recorder->report().path_length_mm);
   };
   const SessionEnd end = run_session(o.session, hooks);
   if (bar) bar->finish();
@@ -174,6 +180,9 @@ void add_run_command(CLI::App& app, Registry& registry) {
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   cmd->add_flag("--realtime", opts->session.realtime,
                 "Tick in a real-time periodic thread instead of virtual time");
+  cmd->add_flag("--unattended", opts->session.unattended,
+                "Go on by itself at program stops (M0, M1) and manual tool changes instead of asking the "
+                "operator on the terminal");
   cmd->add_option("--trace", opts->trace, "Write one CSV row per servo period (docs/controller.md)");
   cmd->add_option("--report", opts->report, "Write the report as JSON");
   cmd->callback([opts, &registry] { registry.set_result(run(*opts)); });

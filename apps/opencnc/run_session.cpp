@@ -2,9 +2,14 @@
 // One program run for the command line, in virtual time (SimRig) or with a real-time servo thread.
 #include "run_session.hpp"
 
+#include <poll.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <thread>
 
 #include <fmt/format.h>
@@ -22,6 +27,8 @@ namespace opencnc::cli {
 namespace {
 
 using control::CommandKind;
+using control::ControllerEvent;
+using control::ControllerEventKind;
 using control::Request;
 using control::State;
 
@@ -38,7 +45,8 @@ class Driver {
   virtual ~Driver() = default;
   virtual void advance() = 0;
   virtual control::Controller& controller() = 0;
-  virtual control::ServoChannels& channels() = 0;
+  /// Whether time goes on by itself (a real-time servo) while the session waits for the operator.
+  virtual bool ticks_by_itself() const = 0;
 };
 
 class VirtualDriver final : public Driver {
@@ -47,7 +55,7 @@ class VirtualDriver final : public Driver {
       : rig_(p, std::move(s)) {}
   void advance() override { rig_.step(); }
   control::Controller& controller() override { return rig_.controller(); }
-  control::ServoChannels& channels() override { return rig_.channels(); }
+  bool ticks_by_itself() const override { return false; }
 
  private:
   control::SimRig rig_;
@@ -73,7 +81,7 @@ class RealtimeDriver final : public Driver {
     std::this_thread::sleep_for(period_);
   }
   control::Controller& controller() override { return *controller_; }
-  control::ServoChannels& channels() override { return *channels_; }
+  bool ticks_by_itself() const override { return true; }
 
  private:
   std::unique_ptr<control::ServoChannels> channels_;
@@ -95,27 +103,16 @@ control::Outcome ask(Driver& d, Request r) {
 }
 
 bool must(Driver& d, Request r) {
-  const CommandKind k = r.kind;
+  const std::string name = r.name();
   const control::Outcome o = ask(d, std::move(r));
   print(o.diagnostics);
-  if (!o.accepted) fmt::print(stderr, "error: {}: {}\n", control::to_string(k), o.message);
+  if (!o.accepted) fmt::print(stderr, "error: {}: {}\n", name, o.message);
   return o.accepted;
-}
-
-void print_notes(control::Controller& c) {
-  for (const control::Note& n : c.take_notes()) {
-    if (n.severity == Severity::Note) {
-      fmt::print(stderr, "message: {}\n", n.text);
-    } else {
-      fmt::print(stderr, "error: {}{}\n", n.text, n.code.empty() ? "" : fmt::format(" [{}]", n.code));
-    }
-  }
 }
 
 bool home_if_needed(Driver& d, const control::ServoConfig& sc) {
   if (!sc.homing_required) return true;
-  if (!must(d, Request::set_mode(control::Mode::Manual)) || !must(d, Request::on_axis(CommandKind::Home, -1)))
-    return false;
+  if (!must(d, Request::set_mode(control::Mode::Manual)) || !must(d, Request::home())) return false;
   const double limit_s = 600;
   for (double t = 0; t < limit_s; t += sc.period_s) {
     d.advance();
@@ -127,40 +124,128 @@ bool home_if_needed(Driver& d, const control::ServoConfig& sc) {
   return false;
 }
 
-/// Follows the run until it ends; continues program stops and manual tool changes at once.
-void follow(Driver& d, const SessionHooks& hooks, SessionEnd& end) {
+/// Lines typed by the operator on stdin (a terminal or a pipe), read without blocking the run.
+class OperatorInput {
+ public:
+  /// The next whole line, waiting at most `timeout_ms` (−1: as long as it takes); nothing when
+  /// none came in time or stdin is closed (closed() tells).
+  std::optional<std::string> line(int timeout_ms) {
+    for (;;) {
+      if (const auto nl = buffer_.find('\n'); nl != std::string::npos) {
+        std::string l = buffer_.substr(0, nl);
+        buffer_.erase(0, nl + 1);
+        return l;
+      }
+      if (closed_) return std::nullopt;
+      pollfd p{STDIN_FILENO, POLLIN, 0};
+      const int n = ::poll(&p, 1, timeout_ms);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) return std::nullopt;
+      char chunk[256];
+      const ssize_t got = ::read(STDIN_FILENO, chunk, sizeof chunk);
+      if (got < 0 && errno == EINTR) continue;
+      if (got <= 0) {
+        closed_ = true;
+        if (!buffer_.empty()) {  // a last line without its newline
+          std::string l = std::move(buffer_);
+          buffer_.clear();
+          return l;
+        }
+        return std::nullopt;
+      }
+      buffer_.append(chunk, static_cast<std::size_t>(got));
+    }
+  }
+  bool closed() const noexcept { return closed_; }
+
+ private:
+  std::string buffer_;
+  bool closed_ = false;
+};
+
+/// What the run waits for the operator for, if anything: the question and the request that
+/// answers "go on".
+struct OperatorWait {
+  std::string question;
+  Request go_on = Request::simple(CommandKind::CycleStart);
+};
+
+std::optional<OperatorWait> operator_wait(const control::ControllerStatus& st) {
+  if (st.servo.state == State::Stopped) return OperatorWait{st.wait_text, Request::simple(CommandKind::CycleStart)};
+  if (st.servo.wait == control::Wait::ManualToolChange)
+    return OperatorWait{st.wait_text, Request::simple(CommandKind::ToolChanged)};
+  return std::nullopt;
+}
+
+void print_event(const ControllerEvent& e) {
+  if (e.kind != ControllerEventKind::Note) return;
+  if (e.severity == Severity::Note) {
+    fmt::print(stderr, "message: {}\n", e.text);
+  } else {
+    fmt::print(stderr, "{}: {}{}\n", e.severity == Severity::Warning ? "warning" : "error", e.text,
+               e.code.empty() ? "" : fmt::format(" [{}]", e.code));
+  }
+}
+
+/// Follows the job started by cycle start until it ends, with the operator where it waits.
+void follow(Driver& d, control::EventCursor& cursor, const SessionOptions& o, const SessionHooks& hooks,
+            SessionEnd& end) {
   const auto t0 = std::chrono::steady_clock::now();
-  const std::uint64_t finished_before = d.controller().status().runs_finished;
-  control::TraceSample sample;
+  OperatorInput input;
+  std::uint32_t job = 0;
+  std::uint64_t asked_tick = ~std::uint64_t{0};  // the wait already answered (by its start tick)
   std::uint64_t n = 0;
-  bool nudged = false;
   for (;;) {
     d.advance();
-    while (d.channels().trace.try_pop(sample)) {
-      if (sample.activity == control::Activity::Program && hooks.sample) hooks.sample(sample);
+    std::optional<ControllerEvent> ended;
+    for (const ControllerEvent& e : cursor.next()) {
+      print_event(e);
+      if (e.kind == ControllerEventKind::JobStarted && job == 0 && e.job == control::JobKind::Program) job = e.job_id;
+      if (e.kind == ControllerEventKind::JobEnded && e.job_id == job) ended = e;
     }
     const control::ControllerStatus st = d.controller().status();
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (hooks.progress && (++n % 256 == 0)) hooks.progress(st, wall);
-    print_notes(d.controller());
-    const bool waiting = st.servo.state == State::Stopped || st.servo.wait == control::Wait::ManualToolChange;
-    if (waiting && !nudged) {
-      d.controller().submit(Request::simple(st.servo.state == State::Stopped ? CommandKind::CycleStart
-                                                                             : CommandKind::ToolChanged));
+    if (ended) {
+      end.wall_s = wall;
+      end.finished = ended->end == control::JobEnd::Finished;
+      if (!end.finished) {
+        end.fault = !st.fault_text.empty() ? st.fault_text
+                                           : fmt::format("the program ended: {}", control::to_string(ended->end));
+        end.limit_touched = st.servo.fault.kind == control::FaultKind::SoftLimit ||
+                            st.servo.fault.kind == control::FaultKind::LimitSwitch;
+      }
+      if (hooks.progress) hooks.progress(st, wall);
+      return;
     }
-    nudged = waiting;
-    if (st.run_active) continue;
-    end.wall_s = wall;
-    end.finished = st.runs_finished > finished_before;
-    if (!end.finished) {
-      end.fault = st.fault_text.empty()
-                      ? fmt::format("the run ended in state {}", control::to_string(st.servo.state))
-                      : st.fault_text;
-      end.limit_touched = st.servo.fault.kind == control::FaultKind::SoftLimit ||
-                          st.servo.fault.kind == control::FaultKind::LimitSwitch;
+    const std::optional<OperatorWait> wait = operator_wait(st);
+    if (!wait) {
+      asked_tick = ~std::uint64_t{0};
+      continue;
     }
-    if (hooks.progress) hooks.progress(st, wall);
-    return;
+    if (asked_tick != ~std::uint64_t{0}) continue;  // answered: waiting for the machine to go on
+    asked_tick = st.servo.tick;
+    if (o.unattended) {
+      d.controller().submit(wait->go_on);
+      continue;
+    }
+    fmt::print(stderr, "\nwaiting for {}: press Enter to continue, or a and Enter to abort\n", wait->question);
+    std::optional<std::string> answer;
+    while (!answer && !input.closed()) {
+      answer = input.line(d.ticks_by_itself() ? 10 : -1);
+      if (!answer && d.ticks_by_itself()) d.advance();
+    }
+    if (!answer) {
+      fmt::print(stderr,
+                 "error: the program waits for {} and no one can answer (stdin is closed): run it with "
+                 "--unattended to let it go on by itself\n",
+                 wait->question);
+      d.controller().submit(Request::simple(CommandKind::Abort));
+    } else if (*answer == "a" || *answer == "A") {
+      d.controller().submit(Request::simple(CommandKind::Abort));
+    } else {
+      d.controller().submit(wait->go_on);
+    }
   }
 }
 
@@ -207,10 +292,13 @@ SessionEnd run_session(const SessionOptions& o, const SessionHooks& hooks) {
     return end;
   }
   end.program = d.controller().open_program();
-  if (hooks.opened) hooks.opened(end.profile, *end.program);
-  d.channels().trace_enabled = true;
+  if (hooks.opened) {
+    for (auto& [observer, options] : hooks.opened(end.profile, *end.program))
+      d.controller().attach(observer, options);
+  }
+  control::EventCursor cursor(d.controller().events());
   if (!must(d, Request::simple(CommandKind::CycleStart))) return end;
-  follow(d, hooks, end);
+  follow(d, cursor, o, hooks, end);
   if (!end.finished) fmt::print(stderr, "error: {}\n", end.fault);
   end.exit_code = end.finished ? kExitOk : kExitProgram;
   return end;

@@ -1,14 +1,15 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // A program run on the simulated machine for the command line (`opencnc run`, `opencnc plot`):
-// load the profile, home if needed, open, cycle start, follow the run to its end.
+// load the profile, home if needed, open, cycle start, follow the run to its end, with the
+// operator at the terminal where the program waits for one.
 #pragma once
 
 #include <functional>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
-#include "opencnc/canon/program.hpp"
 #include "opencnc/config/machine_profile.hpp"
 #include "opencnc/control/status.hpp"
 #include "opencnc/controller/controller.hpp"
@@ -19,7 +20,8 @@ struct SessionOptions {
   std::string file;
   std::string machine;
   std::vector<std::string> sets;
-  bool realtime = false;  ///< a real-time periodic thread instead of virtual time
+  bool realtime = false;    ///< a real-time periodic thread instead of virtual time
+  bool unattended = false;  ///< continue program stops and manual tool changes without asking
 };
 
 /// What a session ended with.
@@ -29,20 +31,24 @@ struct SessionEnd {
   std::string fault;           ///< why it stopped early, in words ("" = it did not)
   bool limit_touched = false;  ///< a soft limit or a limit switch stopped it
   double wall_s = 0;           ///< wall-clock time of the run
-  std::shared_ptr<const canon::Program> program;
   config::MachineProfile profile;
+  std::optional<control::OpenProgram> program;  ///< the program as opened (its preflight)
 };
 
-/// Called once the program is open (before it starts), for every servo period of the run, and
-/// now and then with the status (for progress).
+/// Observers attached before the program starts (a run recorder, a trace writer), and progress.
 struct SessionHooks {
-  std::function<void(const config::MachineProfile&, const canon::Program&)> opened;
-  std::function<void(const control::TraceSample&)> sample;
+  /// Called once the program is open and checked, before it starts: return the observers to
+  /// attach (with their options) for the run.
+  std::function<std::vector<std::pair<std::shared_ptr<control::ControllerObserver>, control::ObserverOptions>>(
+      const config::MachineProfile&, const control::OpenProgram&)>
+      opened;
+  /// Now and then with the status (for progress).
   std::function<void(const control::ControllerStatus&, double elapsed_wall_s)> progress;
 };
 
-/// Runs `o.file` on the simulated machine of `o.machine`; prints problems to stderr. Program
-/// stops (M0, M1) and manual tool changes are continued at once (there is no operator).
+/// Runs `o.file` on the simulated machine of `o.machine`; prints problems and program messages
+/// to stderr. At program stops (M0, M1) and manual tool changes it asks the operator on the
+/// terminal (stdin: Enter continues, `a` aborts), or continues at once when `o.unattended`.
 SessionEnd run_session(const SessionOptions& o, const SessionHooks& hooks);
 
 }  // namespace opencnc::cli

@@ -68,17 +68,15 @@ void run(const config::MachineProfile& profile, const Job& job, bool report, int
     fmt::print("{:<28} refused: {}\n", job.name, why);
     return;
   }
-  const auto program = rig.controller().open_program();
-  std::optional<RunRecorder> rec;
+  std::shared_ptr<RunRecorder> rec;
   if (report) {
-    rec.emplace(*program, machine_limits(profile), profile.servo_period_s);
-    rig.channels().trace_enabled = true;
+    rec = std::make_shared<RunRecorder>(machine_limits(profile), profile.servo_period_s);
+    rig.controller().attach(rec, ObserverOptions{0, true});
   }
   if (!ask(rig, Request::simple(CommandKind::CycleStart), why)) {
     fmt::print("{:<28} refused: {}\n", job.name, why);
     return;
   }
-  TraceSample s;
   for (std::uint64_t n = 0; n < 100'000'000; ++n) {
     rig.step();
     if ((n & 255) == 0) {  // no operator: continue program stops and manual tool changes
@@ -86,11 +84,6 @@ void run(const config::MachineProfile& profile, const Job& job, bool report, int
       if (v.state == State::Stopped) rig.controller().submit(Request::simple(CommandKind::CycleStart));
       if (v.wait == Wait::ManualToolChange)
         rig.controller().submit(Request::simple(CommandKind::ToolChanged));
-    }
-    if (rec) {
-      while (rig.channels().trace.try_pop(s)) {
-        if (s.activity == Activity::Program) rec->add(s);
-      }
     }
     if ((n & 63) == 0 && !rig.status().run_active) break;
   }

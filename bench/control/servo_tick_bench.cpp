@@ -139,7 +139,7 @@ void servo_tick(benchmark::State& state, std::unique_ptr<Machine> machine) {
     while (channels->trace.try_pop(t)) {
     }
     if (++n % 4000 == 0) {  // an override change now and then
-      controller.submit(Request::value_of(CommandKind::SetFeedOverride, (n / 4000) % 2 ? 0.8 : 1.0));
+      controller.submit(Request::feed_override((n / 4000) % 2 ? 0.8 : 1.0));
     }
     if (!controller.status().run_active && !submit(Request::simple(CommandKind::CycleStart))) {
       state.SkipWithError("the run ended and does not start again");

@@ -36,8 +36,8 @@ SimulationResult simulate(const canon::Program& program, const plan::MachineLimi
     if (options.ideal_controller) {
       for (int e = 0; e < out.event_count; ++e) {
         const std::uint32_t k = out.events[static_cast<std::size_t>(e)].action;
-        if (k >= program.actions().size()) continue;
-        const canon::Action& a = program.actions()[k];
+        if (k >= program.action_count()) continue;
+        const canon::Action& a = program.action(k);
         if (a.kind == canon::ActionKind::SpindleSpeed) rpm = a.value;
         if (a.kind == canon::ActionKind::SpindleCw) direction = 1;
         if (a.kind == canon::ActionKind::SpindleCcw) direction = -1;

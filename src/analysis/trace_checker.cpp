@@ -168,6 +168,9 @@ TraceChecker::TraceChecker(const canon::Program& program, const plan::MachineLim
   past_.fill(program.start());
 }
 
+TraceChecker::TraceChecker(const plan::MachineLimits& limits, double period_s, double relative_tolerance)
+    : program_(nullptr), limits_(limits), period_s_(period_s), tolerance_(relative_tolerance) {}
+
 // Distance from p to a box that holds move `id` (a lower bound of the distance to the move).
 double TraceChecker::box_distance(canon::SegmentId id, const Pose& p) const {
   const Pose a = program_->start_of(id), b = program_->end(id);
@@ -233,7 +236,7 @@ void TraceChecker::add(const Pose& position, canon::SegmentId first, canon::Segm
   report_.machining_time_s = static_cast<double>(report_.samples) * period_s_;
   check_limits(position);
   report_.path_length_mm += linear_distance(position, past_[0]);
-  if (program_->size() > 0) {
+  if (program_ != nullptr && program_->size() > 0) {
     const canon::SegmentId n = program_->size();
     const canon::SegmentId lo = first > 0 ? first - 1 : 0;
     const canon::SegmentId hi = std::min<canon::SegmentId>(last + 1, n - 1);

@@ -43,6 +43,8 @@ SegmentId Program::append(const Move& m, const Pose& end) {
 // In place: a move or pose built by the caller and then copied whole costs a failed store
 // forwarding on every move (the wide loads of the copy meet narrow stores still in flight).
 Move& Program::append(const Pose& end) {
+  if ((moves_.size() & (decltype(moves_)::kChunk - 1)) == 0)
+    move_floors_.push_back({arcs_.empty() ? 0 : arcs_.size() - 1, feeds_.empty() ? 0 : feeds_.size() - 1});
   coords_.append_with(static_cast<std::size_t>(stride_), [&](std::size_t s) { return end[slot_axes_[s]]; });
   return moves_.append_slot();
 }
@@ -59,12 +61,42 @@ std::uint32_t Program::add_feed(double value) {
 
 std::uint32_t Program::add_text(std::string s) {
   texts_.push_back(std::move(s));
-  return static_cast<std::uint32_t>(texts_.size() - 1);
+  return static_cast<std::uint32_t>(first_text_ + texts_.size() - 1);
 }
 
 std::uint32_t Program::add_action_pose(const Pose& p) {
   action_poses_.push_back(p);
   return static_cast<std::uint32_t>(action_poses_.size() - 1);
+}
+
+void Program::add_action(const Action& a) {
+  if ((actions_.size() & (decltype(actions_)::kChunk - 1)) == 0) {
+    const std::size_t texts = first_text_ + texts_.size();
+    action_floors_.push_back({texts == 0 ? 0 : texts - 1, action_poses_.empty() ? 0 : action_poses_.size() - 1});
+  }
+  actions_.push_back(a);
+}
+
+void Program::release_before(std::size_t move, std::size_t action) {
+  // Keep the predecessor of the first move kept: its end is that move's start.
+  const std::size_t keep_move = move == 0 ? 0 : std::min(move, moves_.size()) - 1;
+  const std::size_t held = moves_.release_before(keep_move);
+  coords_.release_before(held * static_cast<std::size_t>(stride_));
+  const std::size_t chunk = held / decltype(moves_)::kChunk;
+  if (chunk < move_floors_.size()) {
+    arcs_.release_before(move_floors_[chunk].arc);
+    feeds_.release_before(move_floors_[chunk].feed);
+  }
+  const std::size_t held_actions = actions_.release_before(std::min(action, actions_.size()));
+  const std::size_t action_chunk = held_actions / decltype(actions_)::kChunk;
+  if (action_chunk < action_floors_.size()) {
+    const ActionFloor& f = action_floors_[action_chunk];
+    while (first_text_ < f.text && !texts_.empty()) {
+      texts_.pop_front();
+      ++first_text_;
+    }
+    action_poses_.release_before(f.pose);
+  }
 }
 
 void Program::note_split(SegmentId segment, std::size_t first_move, std::size_t moves) {
@@ -100,8 +132,8 @@ std::size_t Program::moves_of(SegmentId segment) const noexcept {
 
 std::size_t Program::memory_bytes() const noexcept {
   std::size_t bytes = moves_.capacity_bytes() + coords_.capacity_bytes() + arcs_.capacity_bytes();
-  bytes += feeds_.capacity() * sizeof(double) + actions_.capacity() * sizeof(Action);
-  bytes += action_poses_.capacity() * sizeof(Pose) + splits_.capacity() * sizeof(Split);
+  bytes += feeds_.capacity_bytes() + actions_.capacity_bytes();
+  bytes += action_poses_.capacity_bytes() + splits_.capacity() * sizeof(Split);
   for (const auto& t : texts_) bytes += t.capacity() + sizeof(std::string);
   return bytes;
 }

@@ -62,7 +62,7 @@ void ProgramBuilder::set_g5x_offset(int index, const Pose& offset) {
   update_work_offset();
   Action a = make(ActionKind::WorkOffset, index);
   a.pose = program_.add_action_pose(g5x_);
-  program_.add_action(a);
+  add(a);
   if (css_max_rpm_ > 0) add_spindle_speed(0);   // the spindle axis moved (LinuxCNC's canon)
 }
 
@@ -70,7 +70,7 @@ void ProgramBuilder::set_g92_offset(const Pose& offset) {
   g92_ = offset_to_mm(offset);
   Action a = make(ActionKind::G92Offset);
   a.pose = program_.add_action_pose(g92_);
-  program_.add_action(a);
+  add(a);
   if (css_max_rpm_ > 0) add_spindle_speed(0);
 }
 
@@ -79,7 +79,7 @@ void ProgramBuilder::set_xy_rotation(double degrees) {
   const double r = degrees * std::numbers::pi / 180.0;
   rot_cos_ = std::cos(r);
   rot_sin_ = std::sin(r);
-  program_.add_action(make(ActionKind::XyRotation, 0, 0, degrees));
+  add(make(ActionKind::XyRotation, 0, 0, degrees));
 }
 
 void ProgramBuilder::use_tool_length_offset(const Pose& offset) {
@@ -87,7 +87,65 @@ void ProgramBuilder::use_tool_length_offset(const Pose& offset) {
   update_work_offset();
   Action a = make(ActionKind::ToolLengthOffset);
   a.pose = program_.add_action_pose(tool_);
+  add(a);
+}
+
+void ProgramBuilder::add(const Action& a) {
+  int setting = -1;
+  switch (a.kind) {
+    case ActionKind::MotionControl:
+      setting = kPathControl;
+      break;
+    case ActionKind::NaiveCamTolerance:
+      setting = kNaiveCam;
+      break;
+    case ActionKind::FeedOverrideEnable:
+    case ActionKind::FeedOverrideDisable:
+      setting = kFeedOverride;
+      break;
+    case ActionKind::FeedHoldEnable:
+    case ActionKind::FeedHoldDisable:
+      setting = kFeedHold;
+      break;
+    case ActionKind::SpeedFeedSyncStart:
+    case ActionKind::SpeedFeedSyncStop:
+      setting = kSpindleSync;
+      break;
+    default:
+      break;
+  }
+  if (setting >= 0) {
+    settings_[setting] = a;
+    has_setting_[setting] = true;
+  }
   program_.add_action(a);
+}
+
+std::unique_ptr<ProgramBuilder> ProgramBuilder::continuation(const Pose& start) const {
+  auto next = std::make_unique<ProgramBuilder>(program_.axes(), start);
+  next->program_.set_sources(program_.sources_ptr());
+  next->origin_ = origin_;
+  next->use_length_units(units_);
+  next->plane_ = plane_;
+  next->g5x_ = g5x_;
+  next->g92_ = g92_;
+  next->tool_ = tool_;
+  next->work_offset_ = work_offset_;
+  next->rotation_deg_ = rotation_deg_;
+  next->rot_cos_ = rot_cos_;
+  next->rot_sin_ = rot_sin_;
+  next->feed_ = feed_;
+  next->feed_mode_ = feed_mode_;
+  next->synced_ = synced_;
+  next->css_max_rpm_ = css_max_rpm_;
+  next->spindle_speed_ = spindle_speed_;
+  for (int k = 0; k < kSettings; ++k) {
+    if (!has_setting_[k]) continue;
+    Action a = settings_[k];
+    a.before_move = 0;
+    next->add(a);
+  }
+  return next;
 }
 
 Action ProgramBuilder::make(ActionKind kind, int index, int index2, double value) const {
@@ -153,6 +211,7 @@ void ProgramBuilder::rigid_tap(SegmentId id, const Pose& end, double scale) {
   // next move starts where the tap started. Their feed is the way out's speed factor.
   const Pose start = position_;
   const std::uint32_t factor = program_.add_feed(scale);
+  last_feed_mm_ = -1;   // later moves refer to a feed added after this one (streams release in order)
   const std::size_t first = program_.size();
   to_machine(end, position_);
   append(MoveKind::RigidTap, id, factor);
@@ -230,21 +289,21 @@ void ProgramBuilder::nurbs_feed(SegmentId id, int order, std::span<const NurbsPo
   program_.note_split(id, first, chords.size());
 }
 
-void ProgramBuilder::dwell(double seconds) { program_.add_action(make(ActionKind::Dwell, 0, 0, seconds)); }
+void ProgramBuilder::dwell(double seconds) { add(make(ActionKind::Dwell, 0, 0, seconds)); }
 
 void ProgramBuilder::set_feed_mode(int /*spindle*/, FeedMode mode) { feed_mode_ = mode; }
 
 void ProgramBuilder::set_motion_control_mode(MotionControl mode, double tolerance) {
-  program_.add_action(make(ActionKind::MotionControl, static_cast<int>(mode), 0, tolerance * mm_per_unit(units_)));
+  add(make(ActionKind::MotionControl, static_cast<int>(mode), 0, tolerance * mm_per_unit(units_)));
 }
 
 void ProgramBuilder::set_naivecam_tolerance(double tolerance) {
-  program_.add_action(make(ActionKind::NaiveCamTolerance, 0, 0, tolerance * mm_per_unit(units_)));
+  add(make(ActionKind::NaiveCamTolerance, 0, 0, tolerance * mm_per_unit(units_)));
 }
 
 void ProgramBuilder::start_speed_feed_synch(int spindle, double feed_per_rev, bool velocity_mode) {
   synced_ = true;
-  program_.add_action(
+  add(
       make(ActionKind::SpeedFeedSyncStart, spindle, velocity_mode ? 1 : 0, feed_per_rev * mm_per_unit(units_)));
 }
 
@@ -263,7 +322,7 @@ void ProgramBuilder::set_spindle_speed(int spindle, double rpm) {
 // (G5x, G92 and tool offsets, as LinuxCNC's canon sends them; rotation left out, as there).
 void ProgramBuilder::add_spindle_speed(int spindle) {
   if (css_max_rpm_ <= 0) {
-    program_.add_action(make(ActionKind::SpindleSpeed, spindle, 0, spindle_speed_));
+    add(make(ActionKind::SpindleSpeed, spindle, 0, spindle_speed_));
     return;
   }
   const double per_min = units_ == Units::Inch ? 12.0 * 25.4 : 1000.0;
@@ -271,17 +330,17 @@ void ProgramBuilder::add_spindle_speed(int spindle) {
   Pose axis{};
   axis[0] = g5x_[0] + g92_[0] + tool_[0];
   a.pose = program_.add_action_pose(axis);
-  program_.add_action(a);
+  add(a);
 }
 void ProgramBuilder::start_spindle_clockwise(int spindle) { simple(ActionKind::SpindleCw, spindle); }
 void ProgramBuilder::start_spindle_counterclockwise(int spindle) { simple(ActionKind::SpindleCcw, spindle); }
 void ProgramBuilder::stop_spindle_turning(int spindle) { simple(ActionKind::SpindleStop, spindle); }
 void ProgramBuilder::set_spindle_mode(int spindle, double css_max) {
   css_max_rpm_ = std::fabs(css_max);
-  program_.add_action(make(ActionKind::SpindleMode, spindle, 0, css_max_rpm_));
+  add(make(ActionKind::SpindleMode, spindle, 0, css_max_rpm_));
 }
 void ProgramBuilder::orient_spindle(int spindle, double degrees, int direction) {
-  program_.add_action(make(ActionKind::SpindleOrient, spindle, direction, degrees));
+  add(make(ActionKind::SpindleOrient, spindle, direction, degrees));
 }
 
 void ProgramBuilder::select_tool(int tool) { simple(ActionKind::SelectTool, tool); }
@@ -289,27 +348,27 @@ void ProgramBuilder::change_tool(int tool) { simple(ActionKind::ChangeTool, tool
 void ProgramBuilder::change_tool_number(int tool) { simple(ActionKind::ChangeToolNumber, tool); }
 
 void ProgramBuilder::set_motion_output_value(int index, double value) {
-  program_.add_action(make(ActionKind::MotionOutputValue, index, 0, value));
+  add(make(ActionKind::MotionOutputValue, index, 0, value));
 }
 void ProgramBuilder::set_aux_output_value(int index, double value) {
-  program_.add_action(make(ActionKind::AuxOutputValue, index, 0, value));
+  add(make(ActionKind::AuxOutputValue, index, 0, value));
 }
 void ProgramBuilder::wait_for_input(int index, bool digital, int mode, double timeout_s) {
   Action a = make(ActionKind::WaitInput, index, mode, timeout_s);
   a.text = program_.add_text(digital ? "digital" : "analog");
-  program_.add_action(a);
+  add(a);
 }
 
 void ProgramBuilder::comment(std::string_view text) {
   Action a = make(ActionKind::Comment);
   a.text = program_.add_text(std::string(text));
-  program_.add_action(a);
+  add(a);
 }
 
 void ProgramBuilder::message(std::string_view text) {
   Action a = make(ActionKind::Message);
   a.text = program_.add_text(std::string(text));
-  program_.add_action(a);
+  add(a);
 }
 
 }  // namespace opencnc::canon

@@ -207,7 +207,9 @@ std::string resolve(const std::filesystem::path& base_dir, const std::string& pa
 void read_interpreter(Section& top, MachineProfile& profile, const std::filesystem::path& base_dir) {
   const toml::table* t = top.subtable("interpreter");
   if (t == nullptr) return;
-  Section s(*t, "interpreter", {"dialect", "machine", "axis_map", "subroutine_path", "tool_table"}, top.reporter());
+  Section s(*t, "interpreter",
+            {"dialect", "machine", "axis_map", "subroutine_path", "tool_table", "readahead_moves", "readahead_s"},
+            top.reporter());
   InterpreterOptions& o = profile.interpreter;
   o.dialect =
       s.choice<Dialect>("dialect", {{"linuxcnc", Dialect::LinuxCnc}, {"fanuc", Dialect::Fanuc}}, o.dialect);
@@ -236,6 +238,8 @@ void read_interpreter(Section& top, MachineProfile& profile, const std::filesyst
     }
   }
   if (const auto table = s.string("tool_table")) o.tool_table = resolve(base_dir, *table);
+  o.readahead_moves = static_cast<int>(s.integer("readahead_moves", 1, 10'000'000).value_or(o.readahead_moves));
+  o.readahead_s = s.number_or("readahead_s", o.readahead_s, Bound::Positive);
 }
 
 void read_planner(Section& top, MachineProfile& profile) {

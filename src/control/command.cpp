@@ -142,12 +142,6 @@ const char* to_string(CommandKind k) noexcept {
       return "spindle-off";
     case CommandKind::Coolant:
       return "coolant";
-    case CommandKind::OpenProgram:
-      return "open-program";
-    case CommandKind::Mdi:
-      return "mdi";
-    case CommandKind::SetBlockDelete:
-      return "block-delete";
   }
   return "?";
 }

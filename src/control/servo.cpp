@@ -55,12 +55,15 @@ void Servo::read_inputs() noexcept {
   for (int j = 0; j < config_.joint_count; ++j) {
     const auto uj = static_cast<std::size_t>(j);
     const machine::JointInputs& ji = in_.joints[uj];
+    previous_feedback_[uj] = feedback_[uj];
     feedback_[uj] = ji.position;
     following_error_[uj] = reference_[uj] - feedback_[uj];
     const bool limit = ji.limit_neg || ji.limit_pos;
     limit_rising_[uj] = limit && !limit_active_[uj];
     limit_active_[uj] = limit;
   }
+  probe_edge_latched_ = in_.probe_edges != probe_edges_seen_;
+  probe_edges_seen_ = in_.probe_edges;
   if (!started_) start_up();
 }
 
@@ -362,6 +365,8 @@ void Servo::fill_status(ServoStatus& s) const noexcept {
   s.run_active = activity_ == Activity::Program;
   s.motion = tick_out_.state;
   s.segment = tick_out_.segment;
+  s.segment_first = tick_out_.segment_first;
+  s.segment_offset = tick_out_.segment_offset;
   s.line = tick_out_.line;
   s.context = tick_out_.context;
   s.path_velocity = activity_ == Activity::Program ? tick_out_.path_velocity : 0.0;

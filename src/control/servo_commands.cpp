@@ -64,10 +64,6 @@ Refusal Servo::apply(const Command& c) noexcept {
     case CommandKind::SpindleOff:
     case CommandKind::Coolant:
       return manual_spindle_or_coolant(c);
-    case CommandKind::OpenProgram:
-    case CommandKind::Mdi:
-    case CommandKind::SetBlockDelete:
-      return Refusal::NotApplicable;  // the controller's, never the servo's
   }
   return Refusal::BadValue;
 }
@@ -236,8 +232,8 @@ Refusal Servo::manual_spindle_or_coolant(const Command& c) noexcept {
       orient_ = false;
       return Refusal::None;
     default:
-      if (c.axis != 0 && c.axis != 1) return Refusal::BadValue;
-      (c.axis == 0 ? flood_ : mist_) = c.flag;
+      if (c.coolant != Coolant::Flood && c.coolant != Coolant::Mist) return Refusal::BadValue;
+      (c.coolant == Coolant::Flood ? flood_ : mist_) = c.flag;
       return Refusal::None;
   }
 }

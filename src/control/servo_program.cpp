@@ -92,6 +92,7 @@ void Servo::run_program() noexcept {
     commanded_[axis] = tick_out_.position[axis];
   }
   apply_reports();
+  report_sync_points();
   check_probe();
   if (tick_out_.state == traj::RunState::WaitingSync) {
     run_sync();
@@ -143,6 +144,7 @@ void Servo::map_program_state() noexcept {
 // marker asking is a marker that was passed without one (cannot happen with the planner's
 // markers, but a stale record must never block the run).
 bool Servo::take_action(std::uint32_t action, MachineAction& out) noexcept {
+  if (action == traj::kNoAction) return false;  // a marker of the planner's own (probe end)
   auto& ring = channels_->actions;
   while (ring.available() > 0 && ring.front().action < action) ring.pop();
   if (ring.available() == 0 || ring.front().action != action) return false;
@@ -156,6 +158,24 @@ void Servo::apply_reports() noexcept {
     if (ev.kind != traj::MarkerKind::Report) continue;
     MachineAction a;
     if (take_action(ev.action, a)) apply_action(a);
+  }
+}
+
+// The controller's interpreter waits at sync points (probe, M66, M6, program stops) until the
+// machine is past them: say so when the commanded position moves on from one.
+void Servo::report_sync_points() noexcept {
+  for (int e = 0; e < tick_out_.event_count; ++e) {
+    const traj::TickEvent& ev = tick_out_.events[static_cast<std::size_t>(e)];
+    const bool sync_point = ev.kind == traj::MarkerKind::Sync || ev.kind == traj::MarkerKind::ProgramStop ||
+                            ev.kind == traj::MarkerKind::OptionalStop;
+    if (!sync_point) continue;
+    ServoEvent out;
+    out.kind = EventKind::SyncPassed;
+    out.run_id = run_id_;
+    out.action = ev.action;
+    out.segment = tick_out_.segment;
+    out.value = input_value_;
+    emit(out);
   }
 }
 
@@ -370,9 +390,13 @@ void Servo::check_probe() noexcept {
   }
   if (!in_.probe || probe_tripped_) return;
   probe_tripped_ = true;
+  // Where the probe tripped: the machine's latch of the edge when it has one, else the middle of
+  // the last two samples (the edge lies between them: half the error of either).
+  const bool latched = probe_edge_latched_;
   for (int j = 0; j < config_.joint_count; ++j) {
     const auto uj = static_cast<std::size_t>(j);
-    probe_position_[config_.joints[uj].axis] = feedback_[uj] + offset_[uj];
+    const double at = latched ? in_.probe_latch[uj] : 0.5 * (previous_feedback_[uj] + feedback_[uj]);
+    probe_position_[config_.joints[uj].axis] = at + offset_[uj];
   }
   abort_edge_ = aborting_ = true;
   ServoEvent e;

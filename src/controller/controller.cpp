@@ -1,12 +1,16 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Controller: requests → checks → servo commands; programs → preflight → planner → block queue;
-// servo events → outcomes and notes.
+// Controller: requests → checks → servo commands and jobs; servo events → answers, notes and the
+// event log; the observers and features told in order.
 #include "opencnc/controller/controller.hpp"
+
+#include <algorithm>
+#include <filesystem>
+#include <variant>
 
 #include <fmt/format.h>
 
+#include "job.hpp"
 #include "opencnc/controller/preflight.hpp"
-#include "opencnc/controller/program_tools.hpp"
 #include "opencnc/controller/servo_setup.hpp"
 
 namespace opencnc::control {
@@ -14,6 +18,8 @@ namespace opencnc::control {
 namespace {
 
 constexpr std::size_t kKeptOutcomes = 4096;
+/// Status details that cost strings (where the interpreter is) refresh at most this often.
+constexpr double kLocationRefreshS = 0.01;
 
 std::string refusal_text(Refusal r) {
   switch (r) {
@@ -69,26 +75,26 @@ Refusal not_idle(State s) {
 
 bool has_code(const Diagnostics& d, const char* code) {
   for (const Diagnostic& x : d.items()) {
-    if (x.code == code) return true;
+    if (x.code == code && x.severity == Severity::Error) return true;
   }
   return false;
 }
 
-}  // namespace
+Refusal program_refusal(const Diagnostics& d) {
+  return has_code(d, "control.soft-limit") ? Refusal::SoftLimit : Refusal::ProgramError;
+}
 
-/// A run of the servo: its program, its planner, and how far the controller has fed it.
-struct Controller::Run {
-  std::uint32_t id = 0;
-  Mode mode = Mode::Auto;
-  std::uint64_t command_id = 0;
-  std::shared_ptr<const canon::Program> program;
-  canon::SegmentId segment_offset = 0;  ///< run segment k = open program segment offset + k
-  std::unique_ptr<plan::Planner> planner;
-  bool pumping = true;
-  bool pumped_once = false;       ///< the first pump of a run fills the queue, whatever is free
-  std::uint32_t next_action = 0;  ///< next program action to consider for a MachineAction record
-  canon::SegmentId program_tripped_segment = 0;  ///< the probe move that tripped
-};
+/// A file's size and change time: a program that changed on disk since its preflight is checked again.
+std::string file_stamp(const std::string& path) {
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(path, ec);
+  if (ec) return {};
+  const auto time = std::filesystem::last_write_time(path, ec);
+  if (ec) return {};
+  return fmt::format("{}:{}", size, time.time_since_epoch().count());
+}
+
+}  // namespace
 
 Controller::Controller(const config::MachineProfile& profile, ServoChannels& channels,
                        std::shared_ptr<ProgramSource> source)
@@ -97,7 +103,9 @@ Controller::Controller(const config::MachineProfile& profile, ServoChannels& cha
       limits_(machine_limits(profile)),
       planner_config_(control::planner_config(profile)),
       channels_(&channels),
-      source_(std::move(source)) {}
+      source_(std::move(source)),
+      check_(std::make_unique<MachineMoveCheck>(servo_config_, limits_)),
+      location_every_(static_cast<std::uint64_t>(kLocationRefreshS / servo_config_.period_s) + 1) {}
 
 Controller::~Controller() = default;
 
@@ -107,6 +115,11 @@ std::uint64_t Controller::submit(Request r) {
   inbox_.emplace_back(id, std::move(r));
   inbox_filled_.store(true, std::memory_order_release);
   return id;
+}
+
+std::uint64_t Controller::new_id() {
+  std::lock_guard lock(inbox_mutex_);
+  return next_id_++;
 }
 
 std::optional<Outcome> Controller::outcome(std::uint64_t id) const {
@@ -123,16 +136,40 @@ ControllerStatus Controller::status() const {
   return s;
 }
 
-std::vector<Note> Controller::take_notes() {
+std::optional<OpenProgram> Controller::open_program() const {
   std::lock_guard lock(out_mutex_);
-  std::vector<Note> out;
-  out.swap(notes_);
-  return out;
+  return open_;
 }
 
-std::shared_ptr<const canon::Program> Controller::open_program() const {
-  std::lock_guard lock(out_mutex_);
-  return program_;
+std::uint64_t Controller::attach(std::shared_ptr<ControllerObserver> observer, ObserverOptions options) {
+  std::lock_guard lock(inbox_mutex_);
+  const std::uint64_t id = next_id_++;
+  to_attach_.push_back(Attached{id, std::move(observer), options, 0, 0});
+  inbox_filled_.store(true, std::memory_order_release);
+  return id;
+}
+
+void Controller::detach(std::uint64_t id) {
+  std::lock_guard lock(inbox_mutex_);
+  to_detach_.push_back(id);
+  inbox_filled_.store(true, std::memory_order_release);
+}
+
+bool Controller::add_feature(std::shared_ptr<Feature> feature, ObserverOptions options) {
+  std::lock_guard lock(inbox_mutex_);
+  const std::string name(feature->name());
+  for (const auto& f : features_to_add_) {
+    if (f->name() == name) return false;
+  }
+  {
+    // features_ is the controller thread's; a name added earlier is in one of the two lists.
+    std::lock_guard out(out_mutex_);
+    if (features_.count(name) != 0) return false;
+  }
+  features_to_add_.push_back(feature);
+  to_attach_.push_back(Attached{next_id_++, std::move(feature), options, 0, 0});
+  inbox_filled_.store(true, std::memory_order_release);
+  return true;
 }
 
 // --- the periodic work -----------------------------------------------------------------------
@@ -140,6 +177,7 @@ std::shared_ptr<const canon::Program> Controller::open_program() const {
 void Controller::service() {
   read_servo();
   if (inbox_filled_.load(std::memory_order_acquire)) {
+    take_attachments();
     {
       std::lock_guard lock(inbox_mutex_);
       requests_.swap(inbox_);
@@ -148,23 +186,42 @@ void Controller::service() {
     for (auto& [id, r] : requests_) handle(id, r);
     requests_.clear();
   }
-  pump();
-
-  std::lock_guard lock(out_mutex_);
-  ControllerStatus& p = published_;
-  p.program_name = program_name_;
-  p.program_moves = program_ ? program_->size() : 0;
-  p.run_active = run_ != nullptr;
-  const bool auto_run = run_ && run_->mode == Mode::Auto;
-  p.run_segment = auto_run ? run_->segment_offset + servo().segment : 0;
-  p.progress = auto_run && p.program_moves > 0
-                   ? std::min(1.0, static_cast<double>(p.run_segment) / static_cast<double>(p.program_moves))
-                   : 0.0;
-  if (servo().fault.tick != described_fault_tick_ || servo().fault.kind == FaultKind::None) {
-    p.fault_text = servo().fault.kind == FaultKind::None ? std::string() : describe(servo().fault);
-    described_fault_tick_ = servo().fault.tick;
+  if (job_) {
+    job_->service(servo());
+    if (job_->ended()) end_job();
   }
-  p.runs_finished = runs_finished_;
+  publish();
+  tell_observers();
+}
+
+void Controller::take_attachments() {
+  std::vector<Attached> attach;
+  std::vector<std::uint64_t> detach;
+  std::vector<std::shared_ptr<Feature>> features;
+  {
+    std::lock_guard lock(inbox_mutex_);
+    attach.swap(to_attach_);
+    detach.swap(to_detach_);
+    features.swap(features_to_add_);
+  }
+  for (Attached& a : attach) {
+    a.cursor = log_.last();  // from now on
+    a.next_status = servo().tick;
+    observers_.push_back(std::move(a));
+  }
+  for (std::uint64_t id : detach) {
+    std::erase_if(observers_, [id](const Attached& a) { return a.id == id; });
+  }
+  for (auto& f : features) {
+    {
+      std::lock_guard out(out_mutex_);
+      features_.emplace(std::string(f->name()), f);
+    }
+    f->attached(*this);
+  }
+  bool trace = false;
+  for (const Attached& a : observers_) trace = trace || a.options.trace;
+  channels_->trace_enabled.store(trace, std::memory_order_relaxed);
 }
 
 void Controller::read_servo() {
@@ -172,258 +229,479 @@ void Controller::read_servo() {
     std::lock_guard lock(out_mutex_);  // status() copies the front slot under it
     channels_->status.update();
   }
+  deliver_trace();
   ServoEvent e;
   while (channels_->events.try_pop(e)) on_event(e);
 }
 
+// Every sample goes to the observers that trace, with the program window of its run: its moves are
+// still held (they are freed only after this, in the job's service).
+void Controller::deliver_trace() {
+  if (!channels_->trace_enabled.load(std::memory_order_relaxed)) return;
+  TraceSample s;
+  while (channels_->trace.try_pop(s)) {
+    TraceContext c;
+    if (job_ && s.run_id == job_->run_id()) {
+      c = job_->trace_context(s.run_id);
+    } else if (retired_ && s.run_id == retired_->run_id()) {
+      c = retired_->trace_context(s.run_id);
+    }
+    for (Attached& a : observers_) {
+      if (!a.options.trace) continue;
+      try {
+        a.observer->on_trace(s, c);
+      } catch (const std::exception& ex) {
+        note(Severity::Error, "control.observer", fmt::format("an observer failed and was detached: {}", ex.what()));
+        a.observer.reset();
+      }
+    }
+    std::erase_if(observers_, [](const Attached& a) { return !a.observer; });
+  }
+}
+
 void Controller::on_event(const ServoEvent& e) {
+  ControllerEvent ce;
+  ce.kind = ControllerEventKind::Servo;
+  ce.servo = e;
+  ce.segment = e.segment;
+  log(ce);
   switch (e.kind) {
     case EventKind::Accepted:
     case EventKind::Refused:
-      if (e.command == CommandKind::StartRun && run_ && e.command_id == run_->command_id &&
-          e.kind == EventKind::Refused) {
-        run_.reset();
-      }
       finish(e.command_id, e.refusal);
-      break;
-    case EventKind::RunEnded:
-      if (!run_ || e.run_id != run_->id) break;
-      if (e.run_end == RunEnd::Finished) ++runs_finished_;
-      if (e.run_end == RunEnd::ProbeTripped) {
-        continue_after_probe();
-      } else {
-        run_.reset();
-      }
       break;
     case EventKind::Fault:
       note(Severity::Error, fault_code(e.fault.kind), describe(e.fault));
       break;
     case EventKind::Message:
-      if (run_ && e.run_id == run_->id && e.action < run_->program->actions().size())
-        note(Severity::Note, "", run_->program->text(run_->program->actions()[e.action].text));
+      if (job_) {
+        if (const auto text = job_->message(e.run_id, e.action)) note(Severity::Note, "", *text);
+      }
       break;
-    case EventKind::ProbeTripped:
-      if (run_ && e.run_id == run_->id) run_->program_tripped_segment = e.segment;
+    default:
       break;
-    case EventKind::InputRead:
-    case EventKind::StateChanged:
-    case EventKind::Homed:
-      break;
+  }
+  if (job_) {
+    job_->on_servo_event(e, servo());
+    if (job_->ended()) end_job();
   }
 }
 
 // --- requests --------------------------------------------------------------------------------
 
 void Controller::handle(std::uint64_t id, Request& r) {
-  switch (r.kind) {
-    case CommandKind::OpenProgram:
-      open(id, r);
-      return;
-    case CommandKind::Mdi:
-      mdi(id, r);
-      return;
-    case CommandKind::SetBlockDelete:
-      block_delete_ = r.flag;
-      finish(id, Refusal::None);
-      return;
-    case CommandKind::CycleStart:
-      cycle_start(id, r);
-      return;
-    case CommandKind::StartRun:
-      finish(id, Refusal::BadValue, "start-run is the controller's own command");
-      return;
-    case CommandKind::Abort:
-      if (run_) run_->pumping = false;  // no more blocks: the servo drops what it has
-      forward(id, r);
-      return;
-    default:
-      forward(id, r);
-  }
+  std::visit(
+      [&](auto& body) {
+        using T = std::decay_t<decltype(body)>;
+        if constexpr (std::is_same_v<T, requests::OpenFile>) {
+          open_file(id, body.path);
+        } else if constexpr (std::is_same_v<T, requests::OpenCanon>) {
+          open_canon(id, body.program, body.name);
+        } else if constexpr (std::is_same_v<T, requests::Mdi>) {
+          mdi(id, body.line);
+        } else if constexpr (std::is_same_v<T, requests::RunAuxiliary>) {
+          run_auxiliary(id, body);
+        } else if constexpr (std::is_same_v<T, requests::Feature>) {
+          feature(id, body);
+        } else if constexpr (std::is_same_v<T, requests::SetSwitch>) {
+          if (body.which == SwitchKind::BlockDelete) {
+            block_delete_ = body.on;
+            finish(id, Refusal::None);
+          } else {
+            handle_servo(id, r);
+          }
+        } else {
+          handle_servo(id, r);
+        }
+      },
+      r.body);
 }
 
-void Controller::forward(std::uint64_t id, const Request& r, const Command& extra) {
-  Command c = extra;
+void Controller::handle_servo(std::uint64_t id, const Request& r) {
+  if (const auto* s = std::get_if<requests::Servo>(&r.body)) {
+    if (s->kind == CommandKind::CycleStart) return cycle_start(id, r);
+    if (s->kind == CommandKind::StartRun) return finish(id, Refusal::BadValue, "start-run is the controller's own command");
+  }
+  const std::optional<Command> c = to_command(r);
+  if (!c) return finish(id, Refusal::BadValue, "this request has no servo command");
+  forward(id, *c);
+}
+
+void Controller::forward(std::uint64_t id, const Command& command) {
+  Command c = command;
   c.id = id;
-  c.kind = r.kind;
-  c.mode = r.mode;
-  c.axis = static_cast<std::int8_t>(r.axis);
-  c.flag = r.flag;
-  c.value = r.value;
-  c.value2 = r.value2;
   if (!channels_->commands.try_push(c)) finish(id, Refusal::Busy, "the servo's command queue is full");
 }
 
-std::unique_ptr<plan::Planner> Controller::prepare(const canon::Program& program, Diagnostics& diags) const {
-  if (!check_soft_limits(program, servo_config_, diags)) return nullptr;
-  auto planner = std::make_unique<plan::Planner>(limits_, planner_config_);
-  if (!planner->start(program)) {
-    for (const Diagnostic& d : planner->diagnostics().items()) diags.add(d);
-    return nullptr;
+bool Controller::ready_for_job(std::uint64_t id, Mode mode, const char* what) {
+  if (job_) {
+    finish(id, Refusal::Busy, "a program is running");
+    return false;
   }
-  return planner;
+  if (servo().mode != mode) {
+    finish(id, Refusal::WrongMode, fmt::format("{} need{} {} mode", what, std::string_view(what).ends_with('s') ? "" : "s",
+                                               to_string(mode)));
+    return false;
+  }
+  if (servo().state != State::Idle) {
+    finish(id, not_idle(servo().state), refusal_text(not_idle(servo().state)));
+    return false;
+  }
+  if (servo_config_.homing_required && !servo().all_homed) {
+    finish(id, Refusal::NotHomed, refusal_text(Refusal::NotHomed));
+    return false;
+  }
+  return true;
 }
 
-void Controller::open(std::uint64_t id, Request& r) {
-  if (run_) return finish(id, Refusal::Busy, "a program is running");
+Preflight Controller::preflight_file(const std::string& path) {
+  if (!source_) {
+    Preflight p;
+    p.diagnostics.error(path, 0, 0, "this controller has no G-code interpreter", "control.program");
+    return p;
+  }
+  return source_->preflight(path, servo().commanded, {block_delete_}, *check_);
+}
+
+Preflight Controller::preflight_canon(const canon::Program& program) {
+  Preflight p;
+  for (canon::SegmentId id = 0; id < program.size(); ++id) {
+    check_->check(program, id, p.diagnostics);
+    ++p.summary.moves;
+    p.summary.path_length_mm += move_length(program, id);
+  }
+  check_->finish(p.diagnostics);
+  return p;
+}
+
+void Controller::open_file(std::uint64_t id, const std::string& path) {
+  if (job_) return finish(id, Refusal::Busy, "a program is running");
   if (servo().mode != Mode::Auto) return finish(id, Refusal::WrongMode, "programs are opened in Auto mode");
-  LoadedProgram lp;
-  if (r.program) {
-    lp.program = r.program;
-  } else if (!source_) {
-    return finish(id, Refusal::ProgramError, "this controller has no G-code interpreter");
-  } else {
-    lp = source_->load(r.text, servo().commanded, {block_delete_});
-  }
-  if (!lp.program)
-    return finish(id, Refusal::ProgramError, "the program has errors", std::move(lp.diagnostics));
-  Diagnostics& d = lp.diagnostics;
-  auto planner = prepare(*lp.program, d);
-  if (!planner) {
-    const Refusal why = has_code(d, "control.soft-limit") ? Refusal::SoftLimit : Refusal::ProgramError;
-    return finish(id, why, refusal_text(why), std::move(d));
-  }
+  Preflight pf = preflight_file(path);
+  if (!pf.ok()) return finish(id, program_refusal(pf.diagnostics), refusal_text(program_refusal(pf.diagnostics)),
+                              pf.diagnostics);
+  OpenProgram op;
+  op.name = path;
+  op.path = path;
+  op.preflight = pf;
   {
     std::lock_guard lock(out_mutex_);
-    program_ = lp.program;
+    open_ = std::move(op);
   }
-  prepared_ = std::move(planner);  // the first run from here uses it
-  prepared_program_ = lp.program;
-  program_name_ = r.text;
-  program_path_ = r.program ? std::string() : r.text;
-  program_block_delete_ = block_delete_;
-  finish(id, Refusal::None, {}, std::move(d));
+  open_at_ = servo().commanded;
+  open_block_delete_ = block_delete_;
+  open_stamp_ = file_stamp(path);
+  open_version_ = source_->version();
+  ControllerEvent e;
+  e.kind = ControllerEventKind::ProgramOpened;
+  e.text = path;
+  log(std::move(e));
+  finish(id, Refusal::None, {}, std::move(pf.diagnostics));
 }
 
-void Controller::mdi(std::uint64_t id, const Request& r) {
-  if (run_) return finish(id, Refusal::Busy, "something is running");
-  if (servo().mode != Mode::Mdi) return finish(id, Refusal::WrongMode, "MDI lines need MDI mode");
-  if (servo().state != State::Idle)
-    return finish(id, not_idle(servo().state), refusal_text(not_idle(servo().state)));
+void Controller::open_canon(std::uint64_t id, std::shared_ptr<const canon::Program> program, std::string name) {
+  if (job_) return finish(id, Refusal::Busy, "a program is running");
+  if (servo().mode != Mode::Auto) return finish(id, Refusal::WrongMode, "programs are opened in Auto mode");
+  if (!program) return finish(id, Refusal::BadValue, "no program given");
+  Preflight pf = preflight_canon(*program);
+  if (!pf.ok()) return finish(id, program_refusal(pf.diagnostics), refusal_text(program_refusal(pf.diagnostics)),
+                              pf.diagnostics);
+  OpenProgram op;
+  op.name = name;
+  op.program = std::move(program);
+  op.preflight = pf;
+  {
+    std::lock_guard lock(out_mutex_);
+    open_ = std::move(op);
+  }
+  open_at_ = servo().commanded;
+  ControllerEvent e;
+  e.kind = ControllerEventKind::ProgramOpened;
+  e.text = name;
+  log(std::move(e));
+  finish(id, Refusal::None, {}, std::move(pf.diagnostics));
+}
+
+void Controller::mdi(std::uint64_t id, const std::string& line) {
+  if (!ready_for_job(id, Mode::Mdi, "MDI lines")) return;
   if (!source_) return finish(id, Refusal::ProgramError, "this controller has no G-code interpreter");
-  LoadedProgram lp = source_->mdi(r.text, servo().commanded);
-  if (!lp.program) return finish(id, Refusal::ProgramError, "the line has errors", std::move(lp.diagnostics));
-  start_run(id, lp.program, Mode::Mdi, 0);
+  start_job(id, JobKind::Mdi, line, Mode::Mdi, source_->mdi(line, servo().commanded));
 }
 
 void Controller::cycle_start(std::uint64_t id, const Request& r) {
-  if (run_ || servo().mode != Mode::Auto) return forward(id, r);  // the servo continues or says no
-  if (!program_) return finish(id, Refusal::NoProgram, refusal_text(Refusal::NoProgram));
-  if (servo().state != State::Idle)
-    return finish(id, not_idle(servo().state), refusal_text(not_idle(servo().state)));
-  std::shared_ptr<const canon::Program> program = program_;
-  const bool moved = program->start() != servo().commanded;
-  if (!program_path_.empty() && source_ && (moved || program_block_delete_ != block_delete_)) {
-    LoadedProgram lp = source_->load(program_path_, servo().commanded, {block_delete_});
-    if (!lp.program)
-      return finish(id, Refusal::ProgramError, "the program has errors", std::move(lp.diagnostics));
-    program = lp.program;
-  } else if (moved) {
-    program = program_tail(*program, 0, servo().commanded);
+  if (job_ || servo().mode != Mode::Auto) {  // the servo continues (M0, hold) or says no
+    const std::optional<Command> c = to_command(r);
+    return forward(id, *c);
   }
-  start_run(id, program, Mode::Auto, 0);
+  std::optional<OpenProgram> op = open_program();
+  if (!op) return finish(id, Refusal::NoProgram, refusal_text(Refusal::NoProgram));
+  if (!ready_for_job(id, Mode::Auto, "programs")) return;
+  if (op->program) {
+    const bool same_start = op->program->start() == servo().commanded;
+    start_job(id, JobKind::Program, op->name, Mode::Auto, canon_stream(op->program, servo().commanded), same_start);
+    return;
+  }
+  // The preflight holds for the position, the switches and the file it was made with: anything
+  // else, and the program is checked again before it may start.
+  if (servo().commanded != open_at_ || block_delete_ != open_block_delete_ || file_stamp(op->path) != open_stamp_ ||
+      source_->version() != open_version_) {
+    Preflight pf = preflight_file(op->path);
+    if (!pf.ok())
+      return finish(id, program_refusal(pf.diagnostics), refusal_text(program_refusal(pf.diagnostics)),
+                    pf.diagnostics);
+    open_at_ = servo().commanded;
+    open_block_delete_ = block_delete_;
+    open_stamp_ = file_stamp(op->path);
+    open_version_ = source_->version();
+    std::lock_guard lock(out_mutex_);
+    if (open_) open_->preflight = std::move(pf);
+  }
+  // Up to its first sync point the program is the one the preflight checked.
+  start_job(id, JobKind::Program, op->name, Mode::Auto, source_->execute(op->path, servo().commanded, {block_delete_}),
+            true);
 }
 
-void Controller::start_run(std::uint64_t id, std::shared_ptr<const canon::Program> program, Mode mode,
-                           canon::SegmentId segment_offset) {
-  if (servo_config_.homing_required && !servo().all_homed)
-    return finish(id, Refusal::NotHomed, refusal_text(Refusal::NotHomed));
-  Diagnostics d;
-  std::unique_ptr<plan::Planner> planner;
-  if (program == prepared_program_ && prepared_) {
-    planner = std::move(prepared_);
-  } else {
-    planner = prepare(*program, d);
+void Controller::run_auxiliary(std::uint64_t id, const requests::RunAuxiliary& r) {
+  if (!ready_for_job(id, Mode::Auto, "auxiliary programs")) return;
+  const std::string name = r.name.empty() ? (r.path.empty() ? "auxiliary" : r.path) : r.name;
+  if (r.program) {
+    Preflight pf = preflight_canon(*r.program);
+    if (!pf.ok())
+      return finish(id, program_refusal(pf.diagnostics), refusal_text(program_refusal(pf.diagnostics)),
+                    pf.diagnostics);
+    const bool same_start = r.program->start() == servo().commanded;
+    return start_job(id, JobKind::Auxiliary, name, Mode::Auto, canon_stream(r.program, servo().commanded), same_start);
   }
-  prepared_program_.reset();
-  if (!planner) {
-    const Refusal why = has_code(d, "control.soft-limit") ? Refusal::SoftLimit : Refusal::ProgramError;
+  Preflight pf = preflight_file(r.path);
+  if (!pf.ok())
+    return finish(id, program_refusal(pf.diagnostics), refusal_text(program_refusal(pf.diagnostics)), pf.diagnostics);
+  start_job(id, JobKind::Auxiliary, name, Mode::Auto, source_->execute(r.path, servo().commanded, {block_delete_}),
+            true);
+}
+
+void Controller::feature(std::uint64_t id, const requests::Feature& r) {
+  const auto it = features_.find(r.feature);
+  if (it == features_.end())
+    return finish(id, Refusal::BadValue, fmt::format("there is no feature named '{}'", r.feature));
+  Outcome o;
+  try {
+    o = it->second->handle(r, *this);
+  } catch (const std::exception& ex) {
+    o.accepted = false;
+    o.refusal = Refusal::BadValue;
+    o.message = fmt::format("{}: {}", r.feature, ex.what());
+  }
+  finish(id, o.accepted ? Refusal::None : (o.refusal == Refusal::None ? Refusal::BadValue : o.refusal), o.message,
+         std::move(o.diagnostics));
+}
+
+// --- jobs ------------------------------------------------------------------------------------
+
+void Controller::start_job(std::uint64_t id, JobKind kind, std::string name, Mode mode,
+                           std::unique_ptr<ProgramStream> stream, bool prechecked) {
+  detail::JobHost host;
+  host.channels = channels_;
+  host.servo = &servo_config_;
+  host.limits = &limits_;
+  host.planner = &planner_config_;
+  host.check = check_.get();
+  host.readahead_moves = static_cast<std::size_t>(std::max(1, profile_.interpreter.readahead_moves));
+  host.readahead_s = profile_.interpreter.readahead_s;
+  host.prechecked = prechecked;
+  host.next_command_id = [this] { return new_id(); };
+  host.log = [this](ControllerEvent e) { log(std::move(e)); };
+  host.send = [this](const Command& c) { return channels_->commands.try_push(c); };
+  host.next_run_id = [this] { return ++run_counter_; };
+  auto job = std::make_unique<detail::Job>(kind, ++job_counter_, name, mode, std::move(stream), std::move(host));
+  Diagnostics d;
+  if (!job->start(id, d)) {
+    const Refusal why = program_refusal(d);
     return finish(id, why, refusal_text(why), std::move(d));
   }
-  auto run = std::make_unique<Run>();
-  run->id = ++run_counter_;
-  run->mode = mode;
-  run->command_id = id;
-  run->program = std::move(program);
-  run->segment_offset = segment_offset;
-  run->planner = std::move(planner);
-  Command c;
-  c.run_id = run->id;
-  c.run_mode = mode;
-  c.first_block = channels_->blocks.pushed();
-  c.first_action = channels_->actions.pushed();
-  run_ = std::move(run);
-  pump();  // blocks first, so that the servo finds them when it starts
-  forward(id, Request::simple(CommandKind::StartRun), c);
+  job_ = std::move(job);
+  ControllerEvent e;
+  e.kind = ControllerEventKind::JobStarted;
+  e.job = kind;
+  e.job_id = job_->id();
+  e.text = name;
+  log(std::move(e));
+  // The answer is the servo's to the StartRun sent with this id.
 }
 
-// The servo stopped after a probe trip, inside the probe move. The rest of the program runs from
-// where the machine stands (the moves were interpreted up front, so the probe result does not
-// change them; see docs/controller.md).
-void Controller::continue_after_probe() {
-  const std::unique_ptr<Run> done = std::move(run_);
-  const canon::SegmentId next = done->program_tripped_segment + 1;
-  if (next >= done->program->size()) return;
-  std::uint64_t id;
-  {
-    std::lock_guard lock(inbox_mutex_);
-    id = next_id_++;
+void Controller::end_job() {
+  const detail::Job& j = *job_;
+  for (const Diagnostic& d : j.errors().items()) {
+    note(d.severity, d.code, d.format());
   }
-  start_run(id, program_tail(*done->program, next, servo().commanded), done->mode,
-            done->segment_offset + next);
+  if (j.end_reason() == JobEnd::Finished) ++runs_finished_;
+  ControllerEvent e;
+  e.kind = ControllerEventKind::JobEnded;
+  e.job = j.kind();
+  e.job_id = j.id();
+  e.end = j.end_reason();
+  e.segment = j.job_segment(servo().segment);
+  e.text = fmt::format("{} {}", j.name(), to_string(j.end_reason()));
+  e.severity = j.end_reason() == JobEnd::Error ? Severity::Error : Severity::Note;
+  log(std::move(e));
+  retired_ = std::move(job_);
 }
 
-// --- feeding the servo -----------------------------------------------------------------------
+// --- status ----------------------------------------------------------------------------------
 
-// The planner refills the queue in batches, once a quarter of it is free (thousands of blocks,
-// seconds of motion, are still queued then): planning many blocks in a row keeps its code and
-// data in the cache, where a block or two every period did not.
-void Controller::pump() {
-  if (!run_ || !run_->pumping) return;
-  const canon::Program& p = *run_->program;
-  while (run_->next_action < p.actions().size()) {
-    const auto a = machine_action(p, run_->next_action);
-    if (a && !channels_->actions.try_push(*a)) break;
-    ++run_->next_action;
+void Controller::publish() {
+  std::lock_guard lock(out_mutex_);
+  ControllerStatus& p = published_;
+  if (open_ ? p.program_name != open_->name : !p.program_name.empty()) p.program_name = open_ ? open_->name : "";
+  p.program_moves = open_ ? open_->preflight.summary.moves : 0;
+  p.program_length_mm = open_ ? open_->preflight.summary.path_length_mm : 0;
+  p.run_active = job_ != nullptr;
+  const ServoStatus& s = servo();
+  if (job_) {
+    const bool same_run = s.run_id == job_->run_id();
+    p.job = job_->kind();
+    p.job_id = job_->id();
+    if (p.job_name != job_->name()) p.job_name = job_->name();
+    p.run_segment = same_run ? job_->job_segment(s.segment) : 0;
+    p.segment_offset = same_run ? s.segment_offset : 0;
+    p.progress = job_->kind() == JobKind::Program && p.program_moves > 0
+                     ? std::min(1.0, static_cast<double>(p.run_segment) / static_cast<double>(p.program_moves))
+                     : 0.0;
+    p.interpreter_moves = job_->moves_read();
+    p.sync_wait = job_->sync_wait();
+    update_locations();
+  } else {
+    p.job = JobKind::None;
+    p.run_segment = 0;
+    p.segment_offset = 0;
+    p.progress = 0;
+    p.sync_wait = SyncKind::None;
   }
-  constexpr std::size_t kRefillSlots = traj::BlockQueue::kCapacity / 4;
-  if (run_->pumped_once && channels_->blocks.free_slots() < kRefillSlots) return;
-  run_->pumped_once = true;
-  switch (run_->planner->pump(channels_->blocks)) {
-    case plan::PlanStatus::Working:
-      break;
-    case plan::PlanStatus::Finished:
-      run_->pumping = false;
-      break;
-    case plan::PlanStatus::Failed: {
-      run_->pumping = false;
-      for (const Diagnostic& d : run_->planner->diagnostics().items())
-        note(Severity::Error, d.code, d.format());
-      std::uint64_t id;
-      {
-        std::lock_guard lock(inbox_mutex_);
-        id = next_id_++;
+  // What the run waits for, in words: only when one of the things it is made of changed.
+  const WaitKey key{s.state, s.wait, s.stop_reason, p.sync_wait, s.line, s.context, job_ != nullptr};
+  if (!(key == wait_key_)) {
+    p.wait_text = wait_text();
+    wait_key_ = key;
+  }
+  if (s.fault.kind == FaultKind::None) {
+    if (!p.fault_text.empty()) p.fault_text.clear();
+  } else if (s.fault.tick != described_fault_tick_) {
+    p.fault_text = describe(s.fault);
+    described_fault_tick_ = s.fault.tick;
+  }
+  p.runs_finished = runs_finished_;
+}
+
+// Strings, so only when they change: the source at the commanded position, and (at most every
+// kLocationRefreshS of servo time) where the interpreter reads.
+void Controller::update_locations() {
+  ControllerStatus& p = published_;
+  const ServoStatus& s = servo();
+  if (s.run_id == job_->run_id() && (s.context != located_context_ || s.line != located_line_ || s.run_id != located_run_)) {
+    p.location = job_->locate_servo(s.context, s.line);
+    located_context_ = s.context;
+    located_line_ = s.line;
+    located_run_ = s.run_id;
+  }
+  const bool waiting = p.sync_wait != SyncKind::None;
+  if (interpreter_seen_ == ~std::uint64_t{0} || s.tick >= interpreter_seen_ + location_every_ || waiting) {
+    p.interpreter = job_->interpreter_location();
+    p.sync_location = waiting ? job_->sync_location() : SourceLocation{};
+    interpreter_seen_ = s.tick;
+  }
+}
+
+std::string Controller::wait_text() const {
+  const ServoStatus& s = servo();
+  if (!job_) return {};
+  if (s.state == State::Stopped) {
+    const char* why = s.stop_reason == StopReason::SingleBlock    ? "single block"
+                      : s.stop_reason == StopReason::OptionalStop ? "M1"
+                                                                  : "M0";
+    return fmt::format("the operator's cycle start ({} at {})", why, to_string(published_.location));
+  }
+  if (s.state == State::Held) return "the operator's resume (feed hold)";
+  switch (s.wait) {
+    case Wait::None:
+      return {};
+    case Wait::Dwell:
+      return "a dwell";
+    case Wait::Spindle:
+      return "the spindle to reach its speed";
+    case Wait::ToolChanger:
+      return fmt::format("the tool changer (T{})", s.prepared_tool);
+    case Wait::ManualToolChange:
+      return fmt::format("the operator to put tool T{} in the spindle and confirm", s.prepared_tool);
+    case Wait::Input:
+      return "an input (M66)";
+    case Wait::Orient:
+      return "the spindle orientation (M19)";
+    case Wait::Probe:
+      return "the probe";
+    case Wait::Starved:
+      if (published_.sync_wait != SyncKind::None)
+        return fmt::format("the interpreter, at the {} of {}", to_string(published_.sync_wait),
+                           to_string(published_.sync_location));
+      return "the planner";
+  }
+  return {};
+}
+
+// --- observers and the log -------------------------------------------------------------------
+
+void Controller::log(ControllerEvent e) {
+  e.tick = servo().tick;
+  log_.append(std::move(e));
+}
+
+void Controller::tell_observers() {
+  if (observers_.empty()) return;
+  const std::uint64_t last = log_.last();
+  for (Attached& a : observers_) {
+    try {
+      if (a.cursor < last) {
+        std::uint64_t lost = 0;
+        for (const ControllerEvent& e : log_.read_after(a.cursor, last - a.cursor, &lost)) a.observer->on_event(e);
+        a.cursor = last;
       }
-      forward(id, Request::simple(CommandKind::Abort));
-      break;
+      if (a.options.status_period_s > 0 && servo().tick >= a.next_status) {
+        a.observer->on_status(status());
+        a.next_status = servo().tick + static_cast<std::uint64_t>(a.options.status_period_s / servo_config_.period_s);
+      }
+    } catch (const std::exception& ex) {
+      a.observer.reset();
+      note(Severity::Error, "control.observer", fmt::format("an observer failed and was detached: {}", ex.what()));
     }
   }
-}
-
-// --- answers ---------------------------------------------------------------------------------
-
-void Controller::finish(std::uint64_t id, Refusal refusal, std::string message, Diagnostics diags) {
-  std::lock_guard lock(out_mutex_);
-  Outcome& o = outcomes_[id];
-  o.accepted = refusal == Refusal::None;
-  o.refusal = refusal;
-  o.message = message.empty() ? refusal_text(refusal) : std::move(message);
-  o.diagnostics = std::move(diags);
-  while (outcomes_.size() > kKeptOutcomes) outcomes_.erase(outcomes_.begin());
+  std::erase_if(observers_, [](const Attached& a) { return !a.observer; });
 }
 
 void Controller::note(Severity s, std::string code, std::string text) {
-  std::lock_guard lock(out_mutex_);
-  notes_.push_back(Note{servo().tick, s, std::move(code), std::move(text)});
+  ControllerEvent e;
+  e.kind = ControllerEventKind::Note;
+  e.severity = s;
+  e.code = std::move(code);
+  e.text = std::move(text);
+  log(std::move(e));
+}
+
+void Controller::finish(std::uint64_t id, Refusal refusal, std::string message, Diagnostics diags) {
+  ControllerEvent e;
+  e.kind = ControllerEventKind::Answer;
+  e.request_id = id;
+  e.accepted = refusal == Refusal::None;
+  e.code = refusal_code(refusal);
+  e.severity = e.accepted ? Severity::Note : Severity::Error;
+  {
+    std::lock_guard lock(out_mutex_);
+    Outcome& o = outcomes_[id];
+    o.accepted = refusal == Refusal::None;
+    o.refusal = refusal;
+    o.message = message.empty() ? refusal_text(refusal) : std::move(message);
+    o.diagnostics = std::move(diags);
+    e.text = o.message;
+    while (outcomes_.size() > kKeptOutcomes) outcomes_.erase(outcomes_.begin());
+  }
+  log(std::move(e));
 }
 
 std::string Controller::describe(const Fault& f) const {

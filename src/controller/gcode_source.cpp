@@ -1,21 +1,34 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Programs and MDI lines: interpreter → (default tolerance) → ProgramBuilder.
+// G-code as streams of moves: the interpreter (execute mode) → default tolerance, tool table →
+// ProgramBuilder, leg by leg; and the preflight scan (scan mode) that checks every move in bounded
+// memory and, for programs with sync points, finds the moves that rest on an assumed answer.
 #include "opencnc/controller/gcode_source.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <fmt/format.h>
 
+#include "opencnc/canon/program_builder.hpp"
 #include "opencnc/canon/tee_sink.hpp"
+#include "opencnc/controller/preflight.hpp"
+#include "opencnc/gcode/dialect.hpp"
 #include "opencnc/gcode/standard_extensions.hpp"
-#include "opencnc/tools/tool_table.hpp"
 
 namespace opencnc::control {
 
 namespace {
 
-/// Passes every call on to the builder (through a TeeSink) and follows a G64 without P with the
-/// profile's default tolerance: the planner reads the later of two settings at the same move.
+/// Blocks executed per call of the interpreter while streaming; a read() stops after
+/// kReadBlockBudget blocks even without moves (a long computation), so that the controller's
+/// service stays short; it reads on at the next service.
+constexpr std::uint64_t kBlocksPerCall = 64;
+constexpr std::uint64_t kReadBlockBudget = 20000;
+/// Moves a preflight scan reads before it checks them and frees what it has checked.
+constexpr std::size_t kScanBatch = 4096;
+
+/// Follows a G64 without P with the profile's default tolerance: the planner reads the later of
+/// two settings at the same move.
 class DefaultTolerance final : public canon::Sink {
  public:
   DefaultTolerance(canon::ProgramBuilder& b, double tolerance_mm, canon::Units units)
@@ -33,136 +46,564 @@ class DefaultTolerance final : public canon::Sink {
   canon::Units units_;
 };
 
-std::vector<Diagnostic> since(const Diagnostics& d, std::size_t first) {
-  return {d.items().begin() + static_cast<std::ptrdiff_t>(std::min(first, d.items().size())),
-          d.items().end()};
+/// G10 L1/L10/L11 of a running program reach the machine's tool table (pocket and comment kept).
+/// A change that cannot be stored is an error: the program stops rather than cut with tool data
+/// the table does not hold.
+class ToolTableWriter final : public canon::Sink {
+ public:
+  explicit ToolTableWriter(tools::ToolTableService* tools) : tools_(tools) {}
+  void set_tool_table_entry(int index, int tool, const Pose& offset, double diameter, double front_angle,
+                            double back_angle, int orientation) override {
+    if (tools_ == nullptr || index <= 0) return;  // entry 0 is the interpreter's copy of the spindle
+    const auto table = tools_->snapshot();
+    if (static_cast<std::size_t>(index) > table->size()) return;
+    tools::ToolEntry e = table->at_index(static_cast<std::size_t>(index));
+    e.tool = tool;
+    e.offset = offset;
+    e.diameter = diameter;
+    e.front_angle = front_angle;
+    e.back_angle = back_angle;
+    e.orientation = orientation;
+    tools_->update(static_cast<std::size_t>(index), e, tools::ChangeSource::Program, failures_);
+  }
+  Diagnostics& failures() noexcept { return failures_; }
+
+ private:
+  tools::ToolTableService* tools_;
+  Diagnostics failures_;
+};
+
+SyncKind from_gcode(gcode::SyncKind k) {
+  switch (k) {
+    case gcode::SyncKind::Probe:
+      return SyncKind::Probe;
+    case gcode::SyncKind::Input:
+      return SyncKind::Input;
+    case gcode::SyncKind::ToolChange:
+      return SyncKind::ToolChange;
+    case gcode::SyncKind::ProgramStop:
+      return SyncKind::ProgramStop;
+    case gcode::SyncKind::None:
+      break;
+  }
+  return SyncKind::None;
+}
+
+void append(Diagnostics& to, const Diagnostics& from, std::size_t first = 0) {
+  for (std::size_t i = first; i < from.items().size(); ++i) to.add(from.items()[i]);
+}
+
+/// The interpreter, its builder and sinks for one program (or the MDI session's line): what a
+/// stream and a preflight scan share.
+class Pipeline {
+ public:
+  Pipeline(gcode::Interpreter& interp, const Pose& start, double tolerance_mm, tools::ToolTableService* tools)
+      : interp_(&interp), tolerance_mm_(tolerance_mm), writer_(tools) {
+    auto b = std::make_unique<canon::ProgramBuilder>(interp.options().axes, start);
+    b->program().set_sources(interp.sources());
+    attach(std::move(b), interp.state().modal.units);
+  }
+
+  canon::ProgramBuilder& builder() noexcept { return *builder_; }
+  const canon::ProgramBuilder& builder() const noexcept { return *builder_; }
+  const canon::Program& program() const noexcept { return builder_->program(); }
+  canon::Sink& sink() noexcept { return *outer_; }
+  ToolTableWriter& writer() noexcept { return writer_; }
+
+  /// A new leg at `start`: the builder's continuation; the old one is kept until the next leg
+  /// (a run's last trace samples may still refer to its moves).
+  void restart(const Pose& start) {
+    auto next = builder_->continuation(start);
+    previous_ = std::move(builder_);
+    attach(std::move(next), interp_->state().modal.units);
+  }
+
+ private:
+  void attach(std::unique_ptr<canon::ProgramBuilder> b, canon::Units units) {
+    builder_ = std::move(b);
+    tolerance_ = std::make_unique<DefaultTolerance>(*builder_, tolerance_mm_, units);
+    inner_ = std::make_unique<canon::TeeSink>(*builder_, *tolerance_);
+    outer_ = std::make_unique<canon::TeeSink>(*inner_, writer_);
+  }
+
+  gcode::Interpreter* interp_;
+  double tolerance_mm_;
+  ToolTableWriter writer_;
+  std::unique_ptr<canon::ProgramBuilder> builder_, previous_;
+  std::unique_ptr<DefaultTolerance> tolerance_;
+  std::unique_ptr<canon::TeeSink> inner_, outer_;
+};
+
+/// Where the interpreter is placed for a program: the start-up calls, the profile's default
+/// tolerance while none is programmed, then the machine position. False (with diagnostics in the
+/// interpreter) when the file cannot be read or its head is wrong.
+bool begin_program(gcode::Interpreter& interp, Pipeline& p, const std::string& path, const Pose& start,
+                   double tolerance_mm) {
+  if (!interp.open(path)) return false;
+  // The file first (file 0 of the source map, the main program of every move), then the
+  // start-up calls, then the position.
+  p.builder().set_motion_control_mode(canon::MotionControl::Continuous, tolerance_mm);  // in mm yet
+  if (interp.start(p.sink()) == gcode::RunStatus::Error) return false;
+  interp.set_machine_position(start);
+  return true;
+}
+
+// --- execution ---------------------------------------------------------------------------------
+
+/// A file or an MDI line executed as a stream (gcode::Mode::Execute).
+class GcodeStream final : public ProgramStream {
+ public:
+  /// A file: owns its interpreter.
+  GcodeStream(const gcode::Options& o, const std::string& path, const Pose& start, double tolerance_mm,
+              std::shared_ptr<tools::ToolTableService> tools)
+      : owned_(std::make_unique<gcode::Interpreter>(o)),
+        interp_(owned_.get()),
+        tools_(std::move(tools)),
+        pipe_(*interp_, start, tolerance_mm, tools_.get()) {
+    tools_version_ = tools_ ? tools_->version() : 0;
+    if (!begin_program(*interp_, pipe_, path, start, tolerance_mm)) fail();
+  }
+  /// An MDI line on the session's interpreter (already placed and up to date).
+  GcodeStream(gcode::Interpreter& session, std::string line, const Pose& start, double tolerance_mm,
+              std::shared_ptr<tools::ToolTableService> tools)
+      : interp_(&session), tools_(std::move(tools)), pipe_(session, start, tolerance_mm, tools_.get()),
+        mdi_line_(std::move(line)), mdi_(true) {
+    tools_version_ = tools_ ? tools_->version() : 0;
+    first_diagnostic_ = interp_->diagnostics().items().size();
+    replay_state();
+  }
+
+  const canon::Program& program() const override { return pipe_.program(); }
+  StreamState state() const override { return state_; }
+  const SyncRequest& sync_request() const override { return sync_; }
+  const Diagnostics& diagnostics() const override { return diags_; }
+
+  StreamState read(std::size_t more_moves) override {
+    if (state_ != StreamState::Reading) return state_;
+    if (mdi_) return read_mdi();
+    const std::size_t target = program().size() + more_moves;
+    std::uint64_t blocks = 0;
+    while (state_ == StreamState::Reading && program().size() < target && blocks < kReadBlockBudget) {
+      blocks += kBlocksPerCall;
+      on_status(interp_->run(pipe_.sink(), kBlocksPerCall));
+    }
+    return state_;
+  }
+
+  void answer(const SyncAnswer& a) override {
+    if (state_ != StreamState::Sync) return;
+    gcode::SyncValues v;
+    v.kind = interp_->pending_sync();
+    v.probe_tripped = a.probe_tripped;
+    v.probe_position = interp_->program_position(a.probe_position);
+    v.position = interp_->program_position(a.position);
+    v.input_value = a.input_value;
+    // What the operator changed in the tool table while the program waited counts from here on.
+    if (tools_ && tools_->version() != tools_version_) {
+      interp_->set_tool_table(tools_->snapshot());
+      tools_version_ = tools_->version();
+    }
+    interp_->sync(v);
+    sync_ = SyncRequest{};
+    state_ = StreamState::Reading;
+    if (interp_->pending_sync() != gcode::SyncKind::None) enter_sync();  // a stop after the feedback
+  }
+
+  void restart_at(const Pose& start, std::size_t /*from_move*/) override { pipe_.restart(start); }
+
+  void release(std::size_t move, std::size_t action) override {
+    pipe_.builder().program().release_before(move, action);
+  }
+
+  SourceLocation location() const override {
+    const canon::BlockOrigin& o = pipe_.builder().origin();
+    return locate(program().sources(), o.context, o.line);
+  }
+  SourceLocation location_of(std::size_t move) const override {
+    const canon::Move& m = program().move(move);
+    return locate(program().sources(), m.context, m.line);
+  }
+
+ private:
+  StreamState read_mdi() {
+    const gcode::RunStatus s =
+        mdi_started_ ? interp_->continue_mdi(pipe_.sink()) : interp_->execute_mdi(mdi_line_, pipe_.sink());
+    mdi_started_ = true;
+    // The line is done once it ran through (an MDI error leaves the session usable).
+    on_status(s == gcode::RunStatus::Ok ? gcode::RunStatus::Finished : s);
+    return state_;
+  }
+
+  void on_status(gcode::RunStatus s) {
+    if (!pipe_.writer().failures().items().empty()) {
+      append(diags_, pipe_.writer().failures());
+      state_ = StreamState::Error;
+      return;
+    }
+    switch (s) {
+      case gcode::RunStatus::Ok:
+        return;
+      case gcode::RunStatus::Finished:
+        state_ = StreamState::Finished;
+        collect_diagnostics();
+        return;
+      case gcode::RunStatus::NeedSync:
+        enter_sync();
+        return;
+      case gcode::RunStatus::Error:
+        fail();
+        return;
+    }
+  }
+
+  void enter_sync() {
+    state_ = StreamState::Sync;
+    sync_.kind = from_gcode(interp_->pending_sync());
+    sync_.where = location();
+    sync_.contact_required = interp_->sync_request().contact_required;
+  }
+
+  void fail() {
+    state_ = StreamState::Error;
+    collect_diagnostics();
+    if (!diags_.has_errors()) diags_.error("", 0, 0, "the program cannot be read", "control.program");
+  }
+
+  void collect_diagnostics() {
+    append(diags_, interp_->diagnostics(), first_diagnostic_);
+    first_diagnostic_ = interp_->diagnostics().items().size();
+  }
+
+  // The builder of an MDI line starts from the state the session's earlier lines left: units,
+  // offsets, rotation, plane, feed, path control (the interpreter repeats a setting only when it
+  // changes, and every line gets a fresh program).
+  void replay_state() {
+    const gcode::InterpState s = interp_->state();
+    const gcode::ModalState& m = s.modal;
+    canon::ProgramBuilder& b = pipe_.builder();
+    b.use_length_units(m.units);
+    b.set_g5x_offset(m.coord_system, s.position.origin_offset);
+    b.set_g92_offset(s.position.axis_offset);
+    b.set_xy_rotation(s.position.rotation_xy_deg);
+    b.use_tool_length_offset(s.position.tool_offset);
+    b.select_plane(m.plane);
+    b.set_feed_mode(0, m.feed_mode);
+    b.set_feed_rate(m.feed_rate);
+    pipe_.sink().set_motion_control_mode(m.control, m.path_tolerance);  // the default tolerance, if it applies
+    b.set_naivecam_tolerance(m.naivecam_tolerance);
+    if (!m.feed_override) b.disable_feed_override();
+    if (!m.feed_hold) b.disable_feed_hold();
+  }
+
+  std::unique_ptr<gcode::Interpreter> owned_;
+  gcode::Interpreter* interp_;
+  std::shared_ptr<tools::ToolTableService> tools_;
+  std::uint64_t tools_version_ = 0;
+  Pipeline pipe_;
+  StreamState state_ = StreamState::Reading;
+  SyncRequest sync_;
+  Diagnostics diags_;
+  std::size_t first_diagnostic_ = 0;
+  std::string mdi_line_;
+  bool mdi_ = false, mdi_started_ = false;
+};
+
+// --- the preflight scan --------------------------------------------------------------------------
+
+/// One scan of a file (gcode::Mode::Scan) into a window of moves.
+class Scan {
+ public:
+  Scan(const gcode::Options& o, const std::string& path, const Pose& start, double tolerance_mm)
+      : interp_(o), pipe_(interp_, start, tolerance_mm, nullptr) {
+    ok_ = begin_program(interp_, pipe_, path, start, tolerance_mm);
+    done_ = !ok_;
+  }
+  /// Reads until `moves` moves exist or the scan ends.
+  void read_to(std::size_t moves) {
+    while (!done_ && program().size() < moves) {
+      const gcode::RunStatus s = interp_.run(pipe_.sink(), kBlocksPerCall);
+      if (s == gcode::RunStatus::Error) ok_ = false;
+      if (s == gcode::RunStatus::Error || s == gcode::RunStatus::Finished) done_ = true;
+    }
+  }
+  const canon::Program& program() const noexcept { return pipe_.program(); }
+  bool done() const noexcept { return done_; }
+  bool ok() const noexcept { return ok_; }
+  const Diagnostics& diagnostics() const noexcept { return interp_.diagnostics(); }
+  void release(std::size_t move, std::size_t action) { pipe_.builder().program().release_before(move, action); }
+
+ private:
+  gcode::Interpreter interp_;
+  Pipeline pipe_;
+  bool ok_ = true, done_ = false;
+};
+
+/// Whether move k is the same in two scans: kind, line, end points, feed and (arcs) geometry.
+bool same_move(const canon::Program& a, const canon::Program& b, canon::SegmentId k) {
+  const canon::Move& ma = a.move(k);
+  const canon::Move& mb = b.move(k);
+  if (ma.kind != mb.kind || ma.line != mb.line || ma.context != mb.context || ma.flags != mb.flags) return false;
+  // The start too: a move from an assumed point to a certain one still crosses what lies between.
+  if (a.start_of(k) != b.start_of(k) || a.end(k) != b.end(k) || a.feed(k) != b.feed(k)) return false;
+  if (ma.kind != canon::MoveKind::Arc) return true;
+  const canon::ArcGeometry& ga = a.arc(k);
+  const canon::ArcGeometry& gb = b.arc(k);
+  return ga.turns == gb.turns && ga.plane == gb.plane &&
+         std::equal(std::begin(ga.center), std::end(ga.center), std::begin(gb.center)) &&
+         std::equal(std::begin(ga.normal), std::end(ga.normal), std::begin(gb.normal));
+}
+
+/// The sync point an action or a move stands for (None if it is none).
+SyncKind sync_of(canon::ActionKind k) {
+  switch (k) {
+    case canon::ActionKind::WaitInput:
+      return SyncKind::Input;
+    case canon::ActionKind::ChangeTool:
+      return SyncKind::ToolChange;
+    case canon::ActionKind::ProgramStop:
+    case canon::ActionKind::OptionalStop:
+      return SyncKind::ProgramStop;
+    default:
+      return SyncKind::None;
+  }
+}
+
+/// Checks the moves of a scan as they come, adds them up, notes the sync points; with a second
+/// scan that assumes other answers, tells the moves that rest on an assumed answer.
+class PreflightRun {
+ public:
+  PreflightRun(MoveCheck& check, Preflight& out) : check_(check), out_(out) {}
+
+  /// Handles moves [checked, scan.size()) and the actions before them; `other` (may be null)
+  /// is the scan with other answers, read at least as far where it can.
+  void take(Scan& scan, Scan* other) {
+    const canon::Program& p = scan.program();
+    for (; checked_ < p.size(); ++checked_) {
+      note_actions(p, checked_);
+      if (p.move(checked_).kind == canon::MoveKind::Probe) note_sync(p, SyncKind::Probe, p.move(checked_).context,
+                                                                   p.move(checked_).line);
+      bool assumed = false;
+      if (other != nullptr) {
+        assumed = diverged_ || checked_ >= other->program().size() || !same_move(p, other->program(), checked_);
+        if (assumed && checked_ >= other->program().size()) diverged_ = true;
+      }
+      check_move(p, checked_, assumed);
+      add_to_summary(p, checked_);
+    }
+    note_actions(p, p.size());
+  }
+
+  std::size_t checked() const noexcept { return checked_; }
+  std::size_t actions_seen() const noexcept { return next_action_; }
+
+ private:
+  void note_sync(const canon::Program& p, SyncKind k, std::uint32_t context, std::uint32_t line) {
+    PreflightSummary& s = out_.summary;
+    ++s.sync_points;
+    last_sync_ = locate(p.sources(), context, line);
+    last_sync_kind_ = k;
+    if (s.sync_list.size() < PreflightSummary::kMaxListed) s.sync_list.emplace_back(k, last_sync_);
+  }
+
+  void note_actions(const canon::Program& p, std::size_t before_move) {
+    while (next_action_ < p.action_count() && p.action(next_action_).before_move <= before_move) {
+      const canon::Action& a = p.action(next_action_++);
+      if (const SyncKind k = sync_of(a.kind); k != SyncKind::None) note_sync(p, k, a.context, a.line);
+    }
+  }
+
+  void check_move(const canon::Program& p, canon::SegmentId k, bool assumed) {
+    if (!assumed) {
+      check_.check(p, k, out_.diagnostics);
+      return;
+    }
+    ++out_.summary.assumed_moves;
+    const canon::Move& m = p.move(k);
+    const SourceLocation where = locate(p.sources(), m.context, m.line);
+    if (where.line != last_assumed_line_ || where.file != last_assumed_file_) {
+      last_assumed_line_ = where.line;
+      last_assumed_file_ = where.file;
+      if (out_.summary.assumed_lines.size() < PreflightSummary::kMaxListed) out_.summary.assumed_lines.push_back(where);
+    }
+    // What fails under the assumed answer may pass with the real one: a warning now, the check
+    // again (an error then) before the move runs.
+    Diagnostics d;
+    check_.check(p, k, d);
+    for (Diagnostic x : d.items()) {
+      if (x.severity == Severity::Error) {
+        x.severity = Severity::Warning;
+        x.message += fmt::format(" — with the {} assumed at {}; checked again with the machine's answer before the "
+                                 "move runs",
+                                 to_string(last_sync_kind_), to_string(last_sync_));
+      }
+      out_.diagnostics.add(std::move(x));
+    }
+  }
+
+  void add_to_summary(const canon::Program& p, canon::SegmentId k) {
+    PreflightSummary& s = out_.summary;
+    ++s.moves;
+    s.path_length_mm += move_length(p, k);
+    const Extent e = move_extent(p, k);
+    for (int i = 0; i < kAxisCount; ++i) {
+      s.min[i] = s.has_moves ? std::min(s.min[i], e.min[i]) : e.min[i];
+      s.max[i] = s.has_moves ? std::max(s.max[i], e.max[i]) : e.max[i];
+    }
+    s.has_moves = true;
+  }
+
+  MoveCheck& check_;
+  Preflight& out_;
+  std::size_t checked_ = 0, next_action_ = 0;
+  bool diverged_ = false;
+  SourceLocation last_sync_;
+  SyncKind last_sync_kind_ = SyncKind::None;
+  std::uint32_t last_assumed_line_ = 0;
+  std::string last_assumed_file_;
+};
+
+/// One preflight pass; with `classify`, a second scan with other answers runs in step with it.
+Preflight preflight_pass(const gcode::Options& o, const std::string& path, const Pose& start, double tolerance_mm,
+                         MoveCheck& check, bool classify) {
+  Preflight out;
+  gcode::Options main = o;
+  main.mode = gcode::Mode::Scan;
+  main.scan_assumption = gcode::ScanAssumption::Rs274;
+  Scan scan(main, path, start, tolerance_mm);
+  std::unique_ptr<Scan> other;
+  if (classify) {
+    gcode::Options alt = main;
+    alt.scan_assumption = gcode::ScanAssumption::Other;
+    other = std::make_unique<Scan>(alt, path, start, tolerance_mm);
+  }
+  PreflightRun run(check, out);
+  while (!scan.done() || run.checked() < scan.program().size()) {
+    scan.read_to(scan.program().size() + kScanBatch);
+    if (other) other->read_to(scan.program().size());
+    run.take(scan, other.get());
+    // Everything checked is summed up: keep one move for the next one's start.
+    scan.release(run.checked(), run.actions_seen());
+    if (other) other->release(std::min(run.checked(), other->program().size()), other->program().action_count());
+    if (scan.done() && run.checked() >= scan.program().size()) break;
+  }
+  append(out.diagnostics, scan.diagnostics());
+  if (!scan.ok() && !out.diagnostics.has_errors())
+    out.diagnostics.error(path, 0, 0, "the program cannot be read", "control.program");
+  check.finish(out.diagnostics);
+  return out;
 }
 
 }  // namespace
 
+// --- the source ------------------------------------------------------------------------------
+
 std::shared_ptr<GcodeProgramSource> GcodeProgramSource::create(const config::MachineProfile& profile,
                                                                Diagnostics& diags) {
-  gcode::Options o;
+  GcodeSourceConfig c;
+  gcode::Options& o = c.options;
   o.dialect = profile.interpreter.dialect == config::Dialect::Fanuc ? gcode::Dialect::Fanuc
                                                                     : gcode::Dialect::LinuxCnc;
-  o.mode = gcode::Mode::Scan;
+  o.machine = profile.interpreter.machine == config::MachineKind::Lathe ? gcode::MachineKind::Lathe
+                                                                        : gcode::MachineKind::Mill;
   o.axes = profile.axis_mask();
+  o.axis_map = profile.interpreter.axis_map;
   o.subroutine_path = profile.interpreter.subroutine_path;
   o.user_units = canon::Units::Mm;
   o.initial_units = canon::Units::Mm;
   o.optional_stop = true;  // M1 always reaches the servo, which decides with the live switch
-  o.extensions = gcode::standard_extensions(o.dialect);
   if (!profile.interpreter.tool_table.empty()) {
-    const std::size_t before = diags.error_count();
-    auto table = tools::ToolTable::load(profile.interpreter.tool_table, diags);
-    if (!table || diags.error_count() > before) return nullptr;
-    o.tool_table = std::make_shared<tools::ToolTable>(std::move(*table));
+    c.tools = tools::FileToolTable::open(profile.interpreter.tool_table, diags);
+    if (!c.tools) return nullptr;
   }
-  return std::shared_ptr<GcodeProgramSource>(
-      new GcodeProgramSource(std::move(o), profile.planner.default_tolerance));
+  c.default_tolerance_mm = profile.planner.default_tolerance;
+  return std::make_shared<GcodeProgramSource>(std::move(c));
 }
 
-GcodeProgramSource::GcodeProgramSource(gcode::Options options, double default_tolerance)
-    : options_(std::move(options)), default_tolerance_(default_tolerance) {}
+GcodeProgramSource::GcodeProgramSource(GcodeSourceConfig config) : config_(std::move(config)) {}
 
-// A rapid in machine coordinates to where the machine is, without output: the interpreter's
-// position follows (in its units and work coordinates). G90 for it, G91 back if it was on.
-bool GcodeProgramSource::place(gcode::Interpreter& interp, const Pose& machine, Diagnostics& diags) const {
-  const gcode::ModalState m = interp.state().modal;
-  if (m.cutter_comp != gcode::CutterComp::Off) return true;  // it cannot have moved under compensation
-  const double unit = m.units == canon::Units::Inch ? 25.4 : 1.0;
-  std::string line = "G90 G53 G0";
-  for (int i = 0; i < kAxisCount; ++i) {
-    if (options_.axes.has(static_cast<Axis>(i)))
-      line += fmt::format(" {}{:.9f}", kAxisLetters[static_cast<std::size_t>(i)], machine[i] / unit);
-  }
-  if (m.distance == gcode::DistanceMode::Incremental) line += "\nG91";
-  line += m.motion == 10 && m.feed_rate > 0 ? "\nG1" : (m.motion == 0 ? "" : "\nG80");
-  canon::Sink quiet;
-  std::size_t start = 0;
-  while (start < line.size()) {
-    const std::size_t end = std::min(line.find('\n', start), line.size());
-    if (interp.execute_mdi(std::string_view(line).substr(start, end - start), quiet) ==
-        gcode::RunStatus::Error) {
-      diags.error("", 0, 0, "the interpreter cannot be placed at the machine position", "control.program");
-      return false;
-    }
-    start = end + 1;
-  }
-  return true;
-}
+GcodeProgramSource::~GcodeProgramSource() = default;
 
-LoadedProgram GcodeProgramSource::load(const std::string& path, const Pose& start,
-                                       const LoadOptions& options) {
-  gcode::Options o = options_;
+gcode::Options GcodeProgramSource::options_for(const std::string& path, const LoadOptions& options) const {
+  gcode::Options o = config_.options;
+  if (!path.empty()) o.dialect = gcode::dialect_marker(path).value_or(o.dialect);
+  o.extensions = config_.extensions ? config_.extensions(o.dialect) : gcode::standard_extensions(o.dialect);
   o.block_delete = options.block_delete;
-  gcode::Interpreter interp(o);
-  canon::ProgramBuilder builder(o.axes, start);
-  builder.program().set_sources(interp.sources());
-  DefaultTolerance tolerance(builder, default_tolerance_, canon::Units::Mm);
-  canon::TeeSink sink(builder, tolerance);
-  builder.set_motion_control_mode(canon::MotionControl::Continuous, default_tolerance_);  // in mm yet
-  LoadedProgram out;
-  // The file first (file 0 of the source map, the main program of every move; start() checks
-  // its head), then the start-up calls, then the position.
-  gcode::RunStatus status = gcode::RunStatus::Error;
-  if (interp.open(path) && interp.start(sink) != gcode::RunStatus::Error &&
-      place(interp, start, out.diagnostics)) {
-    status = interp.run(sink);
-  }
-  for (const Diagnostic& d : interp.diagnostics().items()) out.diagnostics.add(d);
-  if (status != gcode::RunStatus::Error && !out.diagnostics.has_errors())
-    out.program = std::make_shared<canon::Program>(builder.take());
-  return out;
+  if (config_.tools) o.tool_table = config_.tools->snapshot();
+  return o;
 }
 
-// The builder of each line starts from the state the session's earlier lines left: units,
-// offsets, rotation, plane, feed, path control (the interpreter repeats a setting only when it
-// changes, and every line gets a fresh program).
-void GcodeProgramSource::replay_state(const gcode::InterpState& s, canon::ProgramBuilder& b) const {
-  const gcode::ModalState& m = s.modal;
-  b.use_length_units(m.units);
-  b.set_g5x_offset(m.coord_system, s.position.origin_offset);
-  b.set_g92_offset(s.position.axis_offset);
-  b.set_xy_rotation(s.position.rotation_xy_deg);
-  b.use_tool_length_offset(s.position.tool_offset);
-  b.select_plane(m.plane);
-  b.set_feed_mode(0, m.feed_mode);
-  b.set_feed_rate(m.feed_rate);
-  const double tol =
-      m.control == canon::MotionControl::Continuous && m.path_tolerance <= 0
-          ? default_tolerance_ / canon::mm_per_unit(m.units)  // the builder scales by the units
-          : m.path_tolerance;
-  b.set_motion_control_mode(m.control, tol);
-  b.set_naivecam_tolerance(m.naivecam_tolerance);
-  if (!m.feed_override) b.disable_feed_override();
-  if (!m.feed_hold) b.disable_feed_hold();
+Preflight GcodeProgramSource::preflight(const std::string& path, const Pose& start, const LoadOptions& options,
+                                        MoveCheck& check) {
+  const gcode::Options o = options_for(path, options);
+  Preflight first = preflight_pass(o, path, start, config_.default_tolerance_mm, check, false);
+  if (first.summary.sync_points == 0) return first;
+  // Sync points: the checks of the moves after them rest on assumed answers. A second pass, beside
+  // a scan with other answers, tells which moves those are.
+  Preflight second = preflight_pass(o, path, start, config_.default_tolerance_mm, check, true);
+  return second;
 }
 
-LoadedProgram GcodeProgramSource::mdi(std::string_view line, const Pose& start) {
-  LoadedProgram out;
+std::unique_ptr<ProgramStream> GcodeProgramSource::execute(const std::string& path, const Pose& start,
+                                                           const LoadOptions& options) {
+  gcode::Options o = options_for(path, options);
+  o.mode = gcode::Mode::Execute;
+  return std::make_unique<GcodeStream>(o, path, start, config_.default_tolerance_mm, config_.tools);
+}
+
+std::unique_ptr<ProgramStream> GcodeProgramSource::mdi(std::string_view line, const Pose& start) {
   if (!mdi_) {
-    mdi_ = std::make_unique<gcode::Interpreter>(options_);
+    gcode::Options o = options_for("", {});
+    o.mode = gcode::Mode::Execute;
+    mdi_ = std::make_unique<gcode::Interpreter>(o);
     canon::Sink quiet;
     mdi_->start(quiet);
-    mdi_placed_ = false;
+    mdi_tools_version_ = config_.tools ? config_.tools->version() : 0;
   }
-  if (!mdi_placed_ || mdi_end_ != start) {
-    if (!place(*mdi_, start, out.diagnostics)) return out;
-    mdi_placed_ = true;
+  if (config_.tools && config_.tools->version() != mdi_tools_version_) {
+    mdi_->set_tool_table(config_.tools->snapshot());
+    mdi_tools_version_ = config_.tools->version();
   }
-  canon::ProgramBuilder builder(options_.axes, start);
-  builder.program().set_sources(mdi_->sources());
-  replay_state(mdi_->state(), builder);
-  DefaultTolerance tolerance(builder, default_tolerance_, mdi_->state().modal.units);
-  canon::TeeSink sink(builder, tolerance);
-  const std::size_t first = mdi_->diagnostics().items().size();
-  const gcode::RunStatus status = mdi_->execute_mdi(line, sink);
-  for (const Diagnostic& d : since(mdi_->diagnostics(), first)) out.diagnostics.add(d);
-  if (status == gcode::RunStatus::Error || out.diagnostics.has_errors()) return out;
-  mdi_end_ = builder.position();
-  out.program = std::make_shared<canon::Program>(builder.take());
+  mdi_->set_machine_position(start);
+  auto stream =
+      std::make_unique<GcodeStream>(*mdi_, std::string(line), start, config_.default_tolerance_mm, config_.tools);
+  return stream;
+}
+
+// --- locations -------------------------------------------------------------------------------
+
+SourceLocation locate(const canon::SourceMap& map, std::uint32_t context, std::uint32_t line) {
+  SourceLocation l;
+  l.line = line;
+  const std::uint32_t file = context == 0 ? 0 : map.context_info(context).body_file;
+  if (file < map.file_count()) l.file = map.file(file);
+  for (std::uint32_t c : map.stack(context)) {
+    const canon::SourceMap::Context& info = map.context_info(c);
+    const std::string site = info.call_site.file < map.file_count() ? map.file(info.call_site.file) : "?";
+    l.calls.push_back(fmt::format("{} called at {}:{}", info.name, site, info.call_site.line));
+  }
+  return l;
+}
+
+std::string to_string(const SourceLocation& l) {
+  std::string out = fmt::format("{}:{}", l.file, l.line);
+  for (auto it = l.calls.rbegin(); it != l.calls.rend(); ++it) out += fmt::format(" (in {})", *it);
   return out;
+}
+
+const char* to_string(SyncKind k) noexcept {
+  switch (k) {
+    case SyncKind::None:
+      return "";
+    case SyncKind::Probe:
+      return "probe result";
+    case SyncKind::Input:
+      return "input value";
+    case SyncKind::ToolChange:
+      return "tool change";
+    case SyncKind::ProgramStop:
+      return "program stop";
+  }
+  return "";
 }
 
 }  // namespace opencnc::control

@@ -8,6 +8,8 @@
 
 #include <fmt/format.h>
 
+#include "opencnc/plan/planner.hpp"
+
 namespace opencnc::control {
 
 namespace {
@@ -131,31 +133,57 @@ double move_length(const canon::Program& program, canon::SegmentId id) {
   return std::hypot(f.radius * std::fabs(f.sweep), rise);
 }
 
-bool check_soft_limits(const canon::Program& program, const ServoConfig& config, Diagnostics& diags) {
-  int errors = 0;
-  for (canon::SegmentId id = 0; id < program.size(); ++id) {
-    const Extent e = move_extent(program, id);
-    for (int j = 0; j < config.joint_count; ++j) {
-      const JointConfig& jc = config.joints[static_cast<std::size_t>(j)];
-      if (jc.wrapped) continue;
-      const bool high = e.max[jc.axis] > jc.max_limit + kSlack, low = e.min[jc.axis] < jc.min_limit - kSlack;
-      if (!high && !low) continue;
-      if (++errors > kMaxReported) continue;
-      const canon::Move& m = program.move(id);
-      const char* unit = jc.rotary ? "deg" : "mm";
-      diags.error(
-          file_of(program, id), m.line, 0,
-          fmt::format("this move takes {} to {:.4f} {}, beyond its {} soft limit of {} {}",
-                      kAxisLetters[static_cast<std::size_t>(jc.axis)], high ? e.max[jc.axis] : e.min[jc.axis],
-                      unit, high ? "maximum" : "minimum", high ? jc.max_limit : jc.min_limit, unit),
-          "control.soft-limit");
-    }
+namespace {
+
+/// One move against the soft limits; `errors` counts every crossing, the first kMaxReported are
+/// listed. Returns whether the move stays inside.
+bool check_move_limits(const canon::Program& program, canon::SegmentId id, const ServoConfig& config,
+                       Diagnostics& diags, int& errors) {
+  const Extent e = move_extent(program, id);
+  bool inside = true;
+  for (int j = 0; j < config.joint_count; ++j) {
+    const JointConfig& jc = config.joints[static_cast<std::size_t>(j)];
+    if (jc.wrapped) continue;
+    const bool high = e.max[jc.axis] > jc.max_limit + kSlack, low = e.min[jc.axis] < jc.min_limit - kSlack;
+    if (!high && !low) continue;
+    inside = false;
+    if (++errors > kMaxReported) continue;
+    const canon::Move& m = program.move(id);
+    const char* unit = jc.rotary ? "deg" : "mm";
+    diags.error(file_of(program, id), m.line, 0,
+                fmt::format("this move takes {} to {:.4f} {}, beyond its {} soft limit of {} {}",
+                            kAxisLetters[static_cast<std::size_t>(jc.axis)], high ? e.max[jc.axis] : e.min[jc.axis],
+                            unit, high ? "maximum" : "minimum", high ? jc.max_limit : jc.min_limit, unit),
+                "control.soft-limit");
   }
+  return inside;
+}
+
+void report_unlisted(int errors, Diagnostics& diags) {
   if (errors > kMaxReported) {
     diags.error("", 0, 0, fmt::format("{} more moves cross a soft limit", errors - kMaxReported),
                 "control.soft-limit");
   }
+}
+
+}  // namespace
+
+bool check_soft_limits(const canon::Program& program, const ServoConfig& config, Diagnostics& diags) {
+  int errors = 0;
+  for (canon::SegmentId id = 0; id < program.size(); ++id) check_move_limits(program, id, config, diags, errors);
+  report_unlisted(errors, diags);
   return errors == 0;
+}
+
+bool MachineMoveCheck::check(const canon::Program& program, canon::SegmentId move, Diagnostics& diags) {
+  const bool planner_ok = plan::check_move(program, move, limits_, diags);
+  // A move the planner cannot make (not finite, a bad arc) has no extent worth checking.
+  return planner_ok && check_move_limits(program, move, config_, diags, soft_limit_errors_);
+}
+
+void MachineMoveCheck::finish(Diagnostics& diags) {
+  report_unlisted(soft_limit_errors_, diags);
+  soft_limit_errors_ = 0;
 }
 
 }  // namespace opencnc::control

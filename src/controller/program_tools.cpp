@@ -51,7 +51,8 @@ std::shared_ptr<canon::Program> program_tail(const canon::Program& program, cano
   out->set_sources(program.sources_ptr());
   out->set_start(start);
   std::unordered_map<std::uint32_t, std::uint32_t> texts;
-  for (canon::Action a : program.actions()) {
+  for (std::size_t i = 0; i < program.action_count(); ++i) {
+    canon::Action a = program.action(i);
     if (a.before_move < from && !is_setting(a.kind)) continue;
     a.before_move = a.before_move < from ? 0 : static_cast<std::uint32_t>(a.before_move - from);
     out->add_action(copy_action(program, *out, a, texts));
@@ -78,7 +79,7 @@ std::shared_ptr<canon::Program> program_tail(const canon::Program& program, cano
 }
 
 std::optional<MachineAction> machine_action(const canon::Program& program, std::uint32_t index) {
-  const canon::Action& a = program.actions()[index];
+  const canon::Action& a = program.action(index);
   MachineAction m;
   m.action = index;
   m.index = a.index;

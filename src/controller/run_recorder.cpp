@@ -42,17 +42,36 @@ const char* motion_name(traj::RunState s) {
 
 }  // namespace
 
+RunRecorder::RunRecorder(const plan::MachineLimits& limits, double period_s)
+    : limits_(limits), period_s_(period_s), commanded_(limits, period_s), actual_(limits, period_s) {}
+
 RunRecorder::RunRecorder(const canon::Program& program, const plan::MachineLimits& limits, double period_s)
-    : limits_(limits),
-      period_s_(period_s),
-      commanded_(program, limits, period_s),
-      actual_(program, limits, period_s),
-      last_(program.start()) {
-  commanded_.start_at(program.start());
-  actual_.start_at(program.start());
+    : RunRecorder(limits, period_s) {
+  fixed_ = &program;
+  commanded_.set_program(&program);
+  actual_.set_program(&program);
+  begin(program.start());
+}
+
+// Before the first sample the machine stands where the run starts.
+void RunRecorder::begin(const Pose& start) {
+  commanded_.start_at(start);
+  actual_.start_at(start);
+  last_ = start;
+  started_ = true;
+}
+
+void RunRecorder::add(const TraceSample& s, const TraceContext& c) {
+  if (c.program != commanded_.program()) {
+    commanded_.set_program(c.program);
+    actual_.set_program(c.program);
+  }
+  if (!started_) begin(c.program != nullptr ? c.program->start() : s.commanded);
+  add(s);
 }
 
 void RunRecorder::add(const TraceSample& s) {
+  if (!started_) begin(s.commanded);
   commanded_.add(s.commanded, s.segment_first, s.segment_last);
   actual_.add(s.actual, s.segment_first, s.segment_last);
   for (int i = 0; i < kAxisCount; ++i) {

@@ -242,6 +242,11 @@ void hole(CycleMoves& m, const CycleBlock& cb, const ModalState& modal, double a
       out.dwell(cb.dwell);
       out.stop_spindle_turning(0);
       out.program_stop();
+      {
+        SyncValues stop;  // the operator retracts by hand: the interpreter waits for the go-on
+        stop.kind = SyncKind::ProgramStop;
+        m.ctx().request_sync(stop);
+      }
       start_spindle(out, cb.spindle);
       return;
     case 890:   // bore, dwell, feed out

@@ -202,6 +202,34 @@ RunStatus Engine::run(canon::Sink& sink) {
   return guarded(sink, &Engine::run_blocks);
 }
 
+RunStatus Engine::run_some(canon::Sink& sink, std::uint64_t max_blocks) {
+  require_program();
+  block_budget_ = max_blocks;
+  return guarded(sink, &Engine::run_budget);
+}
+
+// run_blocks() with a budget: a caller that streams the program asks for so much at a time.
+bool Engine::run_budget() {
+  while (!st_.ended && block_budget_ > 0) {
+    --block_budget_;
+    process_line();
+    if (pending_sync_ != SyncKind::None) return true;
+  }
+  return !st_.ended;
+}
+
+// After a sync point inside a subprogram an MDI line called: the call runs on to its return.
+RunStatus Engine::mdi_continue(canon::Sink& sink) {
+  in_mdi_ = true;
+  const RunStatus s = guarded(sink, &Engine::continue_mdi_call);
+  in_mdi_ = false;
+  if (s == RunStatus::Error) {
+    failed_ = false;
+    abandon_calls();
+  }
+  return s == RunStatus::Finished ? RunStatus::Ok : s;
+}
+
 bool Engine::step_block() {
   if (st_.ended) return false;
   process_line();
@@ -412,7 +440,7 @@ bool Engine::process_line() {
 
 // An MDI line that called a subprogram runs it to the end before returning.
 void Engine::finish_mdi_call() {
-  while (st_.frames.size() > 1 && !failed_ && !st_.ended) {
+  while (st_.frames.size() > 1 && !failed_ && !st_.ended && pending_sync_ == SyncKind::None) {
     in_mdi_ = false;
     process_line();
     in_mdi_ = true;
@@ -551,10 +579,22 @@ void Engine::check_motion_habits(bool feed) {
 
 void Engine::request_sync(const SyncValues& assumed) {
   if (opt_.mode == Mode::Execute) {
+    // A block may stop after asking for feedback (M66 P0 M0): the feedback first, then the stop.
+    if (assumed.kind == SyncKind::ProgramStop) {
+      if (pending_sync_ == SyncKind::None) {
+        pending_sync_ = SyncKind::ProgramStop;
+        sync_request_ = assumed;
+      } else {
+        stop_after_sync_ = true;
+      }
+      return;
+    }
+    if (pending_sync_ == SyncKind::ProgramStop) stop_after_sync_ = true;
     pending_sync_ = assumed.kind;
     sync_request_ = assumed;
     return;
   }
+  if (assumed.kind == SyncKind::ProgramStop) return;  // nothing to assume: the scan goes on
   // Scan mode: the assumed feedback arrives when the block is done (LinuxCNC reads it
   // before the next block), so later codes of the same block do not see it.
   block_sync_ = assumed;
@@ -564,11 +604,19 @@ void Engine::request_sync(const SyncValues& assumed) {
 void Engine::sync(const SyncValues& values) {
   if (pending_sync_ == SyncKind::None) return;
   apply_sync(values);
-  pending_sync_ = SyncKind::None;
-  if (sync_request_.kind == SyncKind::Probe && sync_request_.contact_required && !values.probe_tripped) {
+  const bool no_contact =
+      sync_request_.kind == SyncKind::Probe && sync_request_.contact_required && !values.probe_tripped;
+  const bool seeks_contact = sync_request_.seeks_contact;
+  pending_sync_ = stop_after_sync_ ? SyncKind::ProgramStop : SyncKind::None;
+  if (stop_after_sync_) sync_request_ = SyncValues{SyncKind::ProgramStop};
+  stop_after_sync_ = false;
+  if (no_contact) {
     // The probe block is still the current line: the error points at it.
-    report(GcodeError(ErrorCode::ProbeNoContact, "the probe move ended without the probe changing state"));
+    // LinuxCNC's words for it.
+    report(GcodeError(ErrorCode::ProbeNoContact, seeks_contact ? "G38.2 move finished without making contact"
+                                                               : "G38.4 move finished without breaking contact"));
     failed_ = true;
+    pending_sync_ = SyncKind::None;
   }
 }
 
@@ -587,9 +635,49 @@ void Engine::apply_sync(const SyncValues& values) {
     case SyncKind::ToolChange:
       st_.position.current = values.position;
       break;
+    case SyncKind::ProgramStop:
     case SyncKind::None:
       break;
   }
+}
+
+void Engine::request_stop_sync() {
+  SyncValues stop;
+  stop.kind = SyncKind::ProgramStop;
+  request_sync(stop);
+}
+
+// The machine's axes, mm → the program's letters and units, then every offset off.
+Pose Engine::program_position(const Pose& machine_mm) const {
+  const double unit = canon::mm_per_unit(st_.modal.units);
+  Pose m;
+  for (int i = 0; i < kAxisCount; ++i) {
+    const double v = machine_mm[opt_.axis_map[static_cast<std::size_t>(i)]];
+    const bool linear = i < 3 || i >= 6;
+    m[i] = linear ? v / unit : v;
+  }
+  return machine_to_program(m);
+}
+
+void Engine::set_machine_position(const Pose& machine_mm) {
+  if (st_.modal.cutter_comp != CutterComp::Off) return;  // it cannot have moved under compensation
+  const Pose p = program_position(machine_mm);
+  st_.position.current = p;
+  st_.position.canon_position = p;
+}
+
+void Engine::set_tool_table(const std::shared_ptr<const tools::ToolTable>& table) {
+  auto& t = st_.tool.table;
+  t.resize(1);
+  if (table) {
+    for (const auto& e : table->entries()) t.push_back(e);
+  }
+  // The spindle's entry follows its tool's new values (a tool measured while the program waited).
+  const int index = st_.tool.current_index;
+  if (index > 0 && static_cast<std::size_t>(index) < t.size() && t[static_cast<std::size_t>(index)].tool == t[0].tool)
+    t[0] = t[static_cast<std::size_t>(index)];
+  opt_.tool_table = table;
+  set_tool_parameters();
 }
 
 // --- extension facade ---------------------------------------------------------------------

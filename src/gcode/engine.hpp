@@ -56,8 +56,17 @@ class Engine final : public ParamHost, public ExecContext {
   RunStatus run(canon::Sink& sink);
   RunStatus step(canon::Sink& sink);
   RunStatus mdi(std::string_view line, canon::Sink& sink);
+  RunStatus run_some(canon::Sink& sink, std::uint64_t max_blocks);
+  RunStatus mdi_continue(canon::Sink& sink);
   SyncKind pending_sync() const noexcept { return pending_sync_; }
+  const SyncValues& sync_request() const noexcept { return sync_request_; }
   void sync(const SyncValues& values);
+  void set_machine_position(const Pose& machine_mm);
+  Pose program_position(const Pose& machine_mm) const;
+  void set_tool_table(const std::shared_ptr<const tools::ToolTable>& table);
+  /// M0, M1, M60 and the stops inside cycles: in execute mode the interpreter waits for the
+  /// operator's cycle start there (offsets and tools may change meanwhile).
+  void request_stop_sync();
   InterpState snapshot() const;
   std::uint64_t segments() const noexcept { return out_.segments(); }
   const Diagnostics& diagnostics() const noexcept { return diags_; }
@@ -129,7 +138,12 @@ class Engine final : public ParamHost, public ExecContext {
   RunStatus guarded(canon::Sink& sink, bool (Engine::*body)());
   bool step_block();
   bool run_blocks();
+  bool run_budget();
   bool nothing() { return true; }
+  bool continue_mdi_call() {
+    finish_mdi_call();
+    return true;
+  }
   bool read_line();
   enum class LineKind : std::uint8_t { Block, Empty, ProgramEnd };
   // Inlined into its two callers in engine.cpp: as a call it cost 2-3 % of gcode_bench's
@@ -347,6 +361,8 @@ class Engine final : public ParamHost, public ExecContext {
   SyncKind pending_sync_ = SyncKind::None;
   SyncValues block_sync_;           ///< scan mode: feedback assumed at the end of this block
   SyncValues sync_request_;         ///< execute mode: what the pending sync point asked for
+  bool stop_after_sync_ = false;    ///< execute mode: a program stop follows the pending sync
+  std::uint64_t block_budget_ = 0;  ///< run_some(): blocks left to execute
   bool block_sync_pending_ = false;
   std::uint32_t letters_ = 0;       ///< letter words with a reader (axis mask applied)
   int extension_at_ = -1;  ///< where the code of the running extension starts (its errors point there)

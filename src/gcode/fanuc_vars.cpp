@@ -107,6 +107,7 @@ void Engine::fanuc_assignments() {
     if (kind == FanucVariable::StopMessage) {
       out_.message(text.empty() ? fmt::format("#3006 = {}", value) : text);
       out_.program_stop();
+      request_stop_sync();
     }
     st_.parameters[static_cast<std::size_t>(index)] = value;
     if (index < kFanucVariableCount) vacant.reset(static_cast<std::size_t>(index));

@@ -57,6 +57,7 @@ void Engine::convert_io() {
     // What rs274 reads back: a digital input keeps its truth value, an analog one its value.
     const double old = st_.parameters[5399];
     assumed.input_value = digital ? (old != 0.0 ? 1.0 : 0.0) : old;
+    if (opt_.scan_assumption == ScanAssumption::Other) assumed.input_value = digital ? 1.0 - assumed.input_value : old + 1;
     request_sync(assumed);
     return;
   }
@@ -381,13 +382,16 @@ void Engine::convert_stop() {
   switch (m) {
     case 0:
       out_.program_stop();
+      request_stop_sync();
       return;
     case 60:
       out_.pallet_shuttle();
       out_.program_stop();
+      request_stop_sync();
       return;
     case 1:
       out_.optional_program_stop();
+      request_stop_sync();
       return;
     case 2:
     case 30:

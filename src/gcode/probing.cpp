@@ -54,6 +54,14 @@ class Probe final : public CodeHandler {
     assumed.probe_tripped = false;   // rs274 reports #5070 = 0
     assumed.position = backed_off(start, end, m.units);
     assumed.contact_required = contact_required;
+    if (ctx.options().scan_assumption == ScanAssumption::Other) {  // a trip halfway
+      Pose half = st.position.current;
+      for (int i = 0; i < kAxisCount; ++i) half[i] = 0.5 * (half[i] + end[i]);
+      assumed.probe_position = half;
+      assumed.probe_tripped = true;
+      assumed.position = half;
+    }
+    assumed.seeks_contact = code == 382 || code == 383;
     ctx.request_sync(assumed);
   }
 };

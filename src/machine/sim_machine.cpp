@@ -35,8 +35,10 @@ SimMachine::SimMachine(const SimMachineConfig& config) : config_(config), rng_(c
   if (config.spindle)
     spindle_ =
         SimSpindle(config.spindle_config, config.servo_period_s, config.substeps, config.linear_periods);
-  if (config.probe.joint >= 0)
+  if (config.probe.joint >= 0) {
     probe_ = SimSwitch(config.probe.trip, config.probe.hysteresis, config.probe.noise);
+    probe_table_ = joints_[static_cast<std::size_t>(config.probe.joint)].table_position();
+  }
   dc_link_v_ = config.power.dc_link_nominal_v;
   ups_periods_left_ =
       config.power.ups
@@ -171,6 +173,7 @@ void SimMachine::sample() noexcept {
   inputs_.estop_ok = !estop_pressed_;
   for (int j = 0; j < config_.joint_count; ++j) {
     const auto uj = static_cast<std::size_t>(j);
+    previous_feedback_[uj] = inputs_.joints[uj].position;
     joints_[uj].sample(inputs_.joints[uj], rng_);
     inputs_.joints[uj].amp_fault = inputs_.joints[uj].amp_fault || undervoltage_fault_[uj];
   }
@@ -179,8 +182,20 @@ void SimMachine::sample() noexcept {
   inputs_.power.dc_link_v = dc_link_v_;
   if (config_.spindle) spindle_.sample(inputs_.spindle);
   if (config_.probe.joint >= 0) {
-    inputs_.probe =
-        probe_.update(joints_[static_cast<std::size_t>(config_.probe.joint)].table_position(), rng_);
+    // The encoders are latched where the table crossed the switching point, as a probe latch
+    // input does in hardware: between the last two samples, in proportion.
+    const double before = probe_table_, now = joints_[static_cast<std::size_t>(config_.probe.joint)].table_position();
+    const bool was = inputs_.probe;
+    inputs_.probe = probe_.update(now, rng_);
+    if (inputs_.probe != was) {
+      const double f = now != before ? std::clamp((probe_.edge() - before) / (now - before), 0.0, 1.0) : 1.0;
+      for (int j = 0; j < config_.joint_count; ++j) {
+        const auto uj = static_cast<std::size_t>(j);
+        inputs_.probe_latch[uj] = previous_feedback_[uj] + f * (inputs_.joints[uj].position - previous_feedback_[uj]);
+      }
+      ++inputs_.probe_edges;
+    }
+    probe_table_ = now;
   }
   inputs_.process.arc_ok = arc_periods_ >= arc_needed_;
   inputs_.process.gap_voltage_v = config_.process.generator && process_.generator_on ? gap_voltage_v_ : 0.0;

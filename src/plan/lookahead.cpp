@@ -233,6 +233,18 @@ std::uint64_t Lookahead::find_soft_link(std::uint64_t seq) const {
   return seq + n;  // not decided yet: the tick continues the walk from that block's own link
 }
 
+bool Lookahead::front_link_decided() const {
+  if (finished_ || window_.size() > kSoftScan || window_.empty()) return true;
+  const traj::MotionBlock& f = window_.front().b;
+  if (f.kind == BlockKind::Marker) return true;
+  for (std::size_t k = 1; k < window_.size(); ++k) {
+    const traj::MotionBlock& q = window_[k].b;
+    if (q.kind == BlockKind::Marker) continue;
+    if (q.feed_class != f.feed_class || q.feed < f.feed) return true;
+  }
+  return false;
+}
+
 void Lookahead::front_for_queue(std::uint64_t seq, traj::MotionBlock& out) {
   const PlannedBlock& pb = window_.front();
   out = pb.b;

@@ -64,6 +64,13 @@ class Lookahead {
     finished_ = true;
     dirty_ = true;
   }
+  /// After finish() and once every block has been published: blocks may come again, the first
+  /// from rest (a stream's sync point).
+  void reopen() noexcept {
+    finished_ = false;
+    prev_stop_ = true;
+    settled_ = pinned_ = 0;
+  }
 
   std::size_t size() const noexcept { return window_.size(); }
   bool empty() const noexcept { return window_.empty(); }
@@ -78,6 +85,10 @@ class Lookahead {
     return settled_;
   }
 
+  /// Whether the front block's soft link can be decided now: the window holds enough blocks
+  /// after it (or a lower one among them, or nothing more comes). Its link then does not depend
+  /// on how far the program had been read when it was published (a stream's pieces).
+  bool front_link_decided() const;
   /// Writes the front block as it goes to the queue with sequence number `seq`.
   void front_for_queue(std::uint64_t seq, traj::MotionBlock& out);
   /// Removes the front block (publishable() or settled() > 0).

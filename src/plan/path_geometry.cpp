@@ -287,6 +287,7 @@ void split_bezier(const MotionBlock& b, double t, MotionBlock* head, MotionBlock
 
 void trim_start(MotionBlock& b, double d) noexcept {
   if (d <= 0) return;
+  b.segment_offset += d;
   if (b.kind == BlockKind::Bezier) {
     split_bezier(b, d / b.length, nullptr, &b);
     return;

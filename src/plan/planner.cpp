@@ -81,6 +81,11 @@ struct Planner::Impl {
   std::optional<detail::ProgramReader> reader;
   std::optional<detail::Lookahead> window;
   bool reading_done = false;
+  // Streams (start_stream): the program grows while it is planned.
+  bool streaming = false;
+  bool flush_asked = false;   ///< stream_flush(): plan what is readable to a stop
+  bool flushing = false;      ///< a flush is being published; reading waits until it is
+  bool input_waiting = false; ///< everything readable has been read
   std::optional<Element> pending;          ///< last element; its end is decided by the next one
   std::vector<MotionBlock> reports;        ///< Report markers waiting after `pending`
   Pose last_end{};                         ///< exact end of the last emitted path block
@@ -101,6 +106,9 @@ struct Planner::Impl {
   detail::BlendNeed blend_need(const MotionBlock& a, const MotionBlock& e) const;
   bool blend_pays(const Element& a, const Element& e, const detail::Blend& blend) const;
   bool read_one();
+  bool begin(const canon::Program& program, bool stream);
+  /// The reader has nothing for now: ends the program, a flush, or waits for input.
+  void out_of_input();
 };
 
 Planner::Impl::Impl(const MachineLimits& l, const PlannerConfig& c) : limits(l), config(c) {
@@ -232,6 +240,8 @@ bool Planner::Impl::corner(Element& a, Element& e) {
   c.segment = a.b.segment_last;
   c.segment_first = a.b.segment_first;
   c.segment_last = e.b.segment_last;
+  // Where the blend leaves its move (exact unless `a` is a G64 Q merge of several).
+  c.segment_offset = a.b.segment == a.b.segment_last ? a.b.segment_offset + a.b.length : 0.0;
   if (a.b.feed_class == e.b.feed_class) {
     c.feed_class = a.b.feed_class;
     c.feed = std::min(a.b.feed, e.b.feed);
@@ -337,8 +347,51 @@ bool Planner::start(const canon::Program& program) {
   Impl& m = *impl_;
   m.failed = !m.config_ok || !detail::check_program(program, m.limits, m.diags);
   if (m.failed) return false;
+  return m.begin(program, false);
+}
+
+bool Planner::start_stream(const canon::Program& program) {
+  Impl& m = *impl_;
+  m.failed = !m.config_ok;
+  if (m.failed) return false;
+  return m.begin(program, true);
+}
+
+void Planner::stream_readable(std::size_t moves) noexcept {
+  if (impl_->reader) impl_->reader->readable(moves);
+  impl_->input_waiting = false;
+}
+
+void Planner::stream_flush() noexcept {
+  impl_->flush_asked = true;
+  impl_->input_waiting = false;
+}
+
+void Planner::stream_end() noexcept {
+  if (impl_->reader) impl_->reader->seal();
+  impl_->streaming = false;
+  impl_->input_waiting = false;
+}
+
+bool Planner::wants_input() const noexcept {
+  const Impl& m = *impl_;
+  return m.streaming && m.input_waiting && !m.flushing && !m.flush_asked && !m.failed;
+}
+
+std::size_t Planner::oldest_move_needed() const noexcept {
+  return impl_->reader ? impl_->reader->oldest_move_needed() : 0;
+}
+
+std::size_t Planner::oldest_action_needed() const noexcept {
+  return impl_->reader ? impl_->reader->oldest_action_needed() : 0;
+}
+
+bool Planner::Impl::begin(const canon::Program& program, bool stream) {
+  Impl& m = *this;
+  m.streaming = stream;
+  m.flush_asked = m.flushing = m.input_waiting = false;
   m.program = &program;
-  m.reader.emplace(program);
+  m.reader.emplace(program, stream);
   detail::WindowParams wp;
   wp.filter_s = m.params.filter_s;
   for (int i = 0; i < kAxisCount; ++i) {
@@ -362,16 +415,49 @@ bool Planner::start(const canon::Program& program) {
   return true;
 }
 
+void Planner::Impl::out_of_input() {
+  if (!streaming) {  // the program's end marker has been read
+    flush_pending();
+    window->finish();
+    reading_done = true;
+    return;
+  }
+  if (flush_asked) {
+    // A sync point: the motion stops at the end of what is readable. What the reader held back
+    // for a G64 Q merge comes out first.
+    flush_asked = false;
+    reader->flush();
+    while (read_one()) {
+    }
+    flush_pending();
+    window->finish();
+    flushing = true;
+    return;
+  }
+  input_waiting = true;
+}
+
 PlanStatus Planner::pump(traj::BlockQueue& queue) {
   Impl& m = *impl_;
   if (m.failed || m.program == nullptr) return PlanStatus::Failed;
   detail::Lookahead& w = *m.window;
   const std::size_t max_window = 2 * m.config.lookahead_moves + 16;
   for (;;) {
-    while (queue.free_slots() > 0 && w.publishable() > 0) m.publish_front(queue);
+    while (queue.free_slots() > 0 && w.publishable() > 0 && w.front_link_decided()) m.publish_front(queue);
     if (queue.free_slots() == 0) return PlanStatus::Working;
     if (m.reading_done && w.empty()) return PlanStatus::Finished;
     if (m.reading_done) continue;  // finish() made everything publishable
+    if (m.flushing) {
+      if (!w.empty()) continue;  // finish() made everything publishable
+      // Published up to the sync point, where the motion stops: what follows starts afresh.
+      w.reopen();
+      m.flushing = false;
+      m.continues = false;
+    }
+    if (m.input_waiting) {
+      if (!m.flush_asked) return PlanStatus::Working;
+      m.input_waiting = false;
+    }
     if (w.size() >= max_window) {
       // The window is full and nothing is final: publish the front with the entry speed it
       // has (a stop at the window's end is assumed, so it is on the safe side).
@@ -383,9 +469,7 @@ PlanStatus Planner::pump(traj::BlockQueue& queue) {
     // per batch instead of once per block.
     for (int i = 0; i < 64 && w.size() < max_window; ++i) {
       if (!m.read_one()) {
-        m.flush_pending();
-        w.finish();
-        m.reading_done = true;
+        m.out_of_input();
         break;
       }
     }

@@ -80,51 +80,83 @@ MarkerKind marker_for(ActionKind k) {
 
 }  // namespace
 
-bool check_program(const canon::Program& program, const MachineLimits& limits, Diagnostics& diags) {
+}  // namespace opencnc::plan::detail
+
+namespace opencnc::plan {
+
+bool check_move(const canon::Program& program, canon::SegmentId id, const MachineLimits& limits,
+                Diagnostics& diags) {
+  using detail::file_name;
+  using detail::finite_pose;
+  using detail::make_arc;
+  using canon::MoveKind;
   const std::size_t before = diags.error_count();
-  const auto fail = [&](canon::SegmentId id, std::string msg, const char* code) {
+  const auto fail = [&](std::string msg, const char* code) {
     diags.error(file_name(program, id), program.move(id).line, 0, std::move(msg), code);
   };
-  for (canon::SegmentId id = 0; id < program.size(); ++id) {
-    const canon::Move& m = program.move(id);
-    const Pose start = program.start_of(id), end = program.end(id);
-    if (!finite_pose(start) || !finite_pose(end)) {
-      fail(id, "the move's end point is not a finite number", "plan.not-finite");
-      continue;
+  const canon::Move& m = program.move(id);
+  const Pose start = program.start_of(id), end = program.end(id);
+  if (!finite_pose(start) || !finite_pose(end)) {
+    fail("the move's end point is not a finite number", "plan.not-finite");
+    return false;
+  }
+  if (m.kind == MoveKind::RigidTap) {
+    // A tap is a pair, appended together: in to the bottom, then (kTapReturn) back out, both
+    // following the spindle. (A way out whose way in a stream has released was checked with it.)
+    const bool out = (m.flags & canon::kTapReturn) != 0;
+    bool paired;
+    if (out) {
+      paired = id > 0 && (id - 1 < program.first_held_move() ||
+                          (program.move(id - 1).kind == MoveKind::RigidTap &&
+                           !(program.move(id - 1).flags & canon::kTapReturn)));
+    } else {
+      paired = id + 1 < program.size() && program.move(id + 1).kind == MoveKind::RigidTap &&
+               (program.move(id + 1).flags & canon::kTapReturn);
     }
-    if (m.kind == MoveKind::RigidTap) {
-      // A tap is a pair: in to the bottom, then (kTapReturn) out, both following the spindle.
-      const bool out = (m.flags & canon::kTapReturn) != 0;
-      const bool paired = out ? id > 0 && program.move(id - 1).kind == MoveKind::RigidTap &&
-                                    !(program.move(id - 1).flags & canon::kTapReturn)
-                              : id + 1 < program.size() && program.move(id + 1).kind == MoveKind::RigidTap &&
-                                    (program.move(id + 1).flags & canon::kTapReturn);
-      if (!paired || !(m.flags & canon::kSpindleSynced)) {
-        fail(id, "a rigid tap needs its way out and spindle synchronisation (START_SPEED_FEED_SYNCH) around it",
-             "plan.unsupported-move");
-        continue;
-      }
+    if (!paired || !(m.flags & canon::kSpindleSynced)) {
+      fail("a rigid tap needs its way out and spindle synchronisation (START_SPEED_FEED_SYNCH) around it",
+           "plan.unsupported-move");
+      return false;
     }
-    for (int i = 0; i < kAxisCount; ++i) {
-      if (end[i] != start[i] && !limits.axes.has(static_cast<Axis>(i))) {
-        fail(id, fmt::format("the move drives axis {}, which this machine does not have", kAxisLetters[i]),
-             "plan.axis-not-configured");
-        break;
-      }
+  }
+  for (int i = 0; i < kAxisCount; ++i) {
+    if (end[i] != start[i] && !limits.axes.has(static_cast<Axis>(i))) {
+      fail(fmt::format("the move drives axis {}, which this machine does not have", kAxisLetters[i]),
+           "plan.axis-not-configured");
+      break;
     }
-    if (m.kind == MoveKind::Arc) {
-      traj::MotionBlock b;
-      std::string why;
-      if (!make_arc(start, end, program.arc(id), b, why)) fail(id, why, "plan.bad-arc");
-    }
-    if (m.kind != MoveKind::Traverse && !(m.flags & canon::kSpindleSynced) && !(program.feed(id) > 0)) {
-      fail(id, "feed move with a zero feed rate", "plan.feed-zero");
-    }
+  }
+  if (m.kind == MoveKind::Arc) {
+    traj::MotionBlock b;
+    std::string why;
+    if (!make_arc(start, end, program.arc(id), b, why)) fail(why, "plan.bad-arc");
+  }
+  if (m.kind != MoveKind::Traverse && !(m.flags & canon::kSpindleSynced) && !(program.feed(id) > 0)) {
+    fail("feed move with a zero feed rate", "plan.feed-zero");
   }
   return diags.error_count() == before;
 }
 
-ProgramReader::ProgramReader(const canon::Program& program) : program_(&program) {}
+}  // namespace opencnc::plan
+
+namespace opencnc::plan::detail {
+
+bool check_program(const canon::Program& program, const MachineLimits& limits, Diagnostics& diags) {
+  bool ok = true;
+  for (canon::SegmentId id = 0; id < program.size(); ++id) ok = check_move(program, id, limits, diags) && ok;
+  return ok;
+}
+
+ProgramReader::ProgramReader(const canon::Program& program, bool streaming)
+    : program_(&program), streaming_(streaming), gated_(streaming) {}
+
+std::size_t ProgramReader::readable_limit() const noexcept {
+  return gated_ ? std::min(readable_, program_->size()) : program_->size();
+}
+
+std::size_t ProgramReader::oldest_move_needed() const noexcept {
+  return next_move_ == 0 ? 0 : next_move_ - 1;  // the end of the move before is the next one's start
+}
 
 std::uint8_t ProgramReader::flags() const noexcept {
   std::uint8_t f = 0;
@@ -142,11 +174,12 @@ traj::MotionBlock& ProgramReader::new_marker() {
   return it.element.b;
 }
 
-void ProgramReader::add_marker(const canon::Action& a, MarkerKind kind) {
+void ProgramReader::add_marker(std::size_t index, MarkerKind kind) {
+  const canon::Action& a = program_->action(index);
   flush_run();
   traj::MotionBlock& m = new_marker();
   m.marker = kind;
-  m.action = static_cast<std::uint32_t>(&a - program_->actions().data());
+  m.action = static_cast<std::uint32_t>(index);
   m.segment = m.segment_first = m.segment_last = a.before_move;
   m.line = a.line;
   m.context = a.context;
@@ -156,9 +189,9 @@ void ProgramReader::add_marker(const canon::Action& a, MarkerKind kind) {
 }
 
 void ProgramReader::read_actions_before(std::uint32_t move) {
-  const auto& actions = program_->actions();
-  while (next_action_ < actions.size() && actions[next_action_].before_move <= move) {
-    const canon::Action& a = actions[next_action_++];
+  while (next_action_ < program_->action_count() && program_->action(next_action_).before_move <= move) {
+    const std::size_t index = next_action_++;
+    const canon::Action& a = program_->action(index);
     switch (a.kind) {
       case ActionKind::MotionControl:
         mode_ = static_cast<canon::MotionControl>(a.index);
@@ -186,10 +219,10 @@ void ProgramReader::read_actions_before(std::uint32_t move) {
         break;
     }
     const MarkerKind kind = marker_for(a.kind);
-    if (kind != MarkerKind::None) add_marker(a, kind);
+    if (kind != MarkerKind::None) add_marker(index, kind);
     // The tick stops for the spindle to reach speed before the motion that follows a start.
     if (a.kind == ActionKind::SpindleCw || a.kind == ActionKind::SpindleCcw)
-      add_marker(a, MarkerKind::SpindleWait);
+      add_marker(index, MarkerKind::SpindleWait);
   }
 }
 
@@ -380,16 +413,28 @@ void ProgramReader::read_move(canon::SegmentId id) {
     m.segment = m.segment_first = m.segment_last = id + 1;
     m.line = e.b.line;
     m.context = e.b.context;
-    m.action = static_cast<std::uint32_t>(program_->actions().size());  // none
+    m.action = traj::kNoAction;
   }
 }
 
-void ProgramReader::read_more() {
-  const std::size_t n = program_->size();
+// Reads the next move (with the actions before it), or at the end of a stream what can be read
+// for now; returns false when nothing could be.
+bool ProgramReader::read_more() {
+  const std::size_t n = readable_limit();
   if (next_move_ < n) {
     read_actions_before(static_cast<std::uint32_t>(next_move_));
     read_move(next_move_++);
-    return;
+    return true;
+  }
+  if (streaming_) {
+    // The actions after the last readable move are complete: they come before whatever follows.
+    const std::size_t before = ready_.size();
+    read_actions_before(static_cast<std::uint32_t>(n));
+    if (flush_) {
+      flush_ = false;
+      flush_run();
+    }
+    return ready_.size() != before;
   }
   read_actions_before(static_cast<std::uint32_t>(n));
   flush_run();
@@ -397,16 +442,19 @@ void ProgramReader::read_more() {
     traj::MotionBlock& m = new_marker();
     m.marker = MarkerKind::ProgramEnd;
     m.segment = m.segment_first = m.segment_last = n;
-    m.action = static_cast<std::uint32_t>(program_->actions().size());
+    m.action = traj::kNoAction;
     ended_ = true;
   }
   done_ = true;
+  return true;
 }
 
 Item* ProgramReader::next() {
   if (handed_out_) ready_.pop_front();
   // Keep a run open until something else arrives, so that merging can look ahead.
-  while (ready_.empty() && !done_) read_more();
+  while (ready_.empty() && !done_) {
+    if (!read_more()) break;
+  }
   handed_out_ = !ready_.empty();
   return handed_out_ ? &ready_.front() : nullptr;
 }

@@ -39,21 +39,35 @@ struct Item {
 /// position. Returns true when the program can be planned. Non-real-time.
 bool check_program(const canon::Program& program, const MachineLimits& limits, Diagnostics& diags);
 
-/// Streams the items of a checked program.
+/// Streams the items of a checked program. The program may be a stream that grows while it is
+/// read: then only the moves made readable are read, and the end of the readable part is not
+/// the program's end until seal().
 class ProgramReader {
  public:
-  explicit ProgramReader(const canon::Program& program);
+  /// `streaming`: the program grows; nothing is read until readable() says how far.
+  explicit ProgramReader(const canon::Program& program, bool streaming = false);
 
   /// Next item, valid (and the caller's to change) until the following call; null after the
-  /// last one (the program end marker).
+  /// last one (the program end marker), or when a stream has nothing more to read for now.
   Item* next();
+  /// Streams: moves [0, moves) may be read (their actions too, and the actions after them).
+  void readable(std::size_t moves) noexcept { readable_ = moves; }
+  /// Streams: no more moves will come; the end of the readable part is the program's end.
+  void seal() noexcept { streaming_ = false; }
+  /// Streams: hand out what is held back for the next move to decide (a G64 Q merge), as at
+  /// a stop: the motion stops at the end of what is readable (a sync point).
+  void flush() noexcept { flush_ = true; }
+  /// The first move (action) index the reader may still look at.
+  std::size_t oldest_move_needed() const noexcept;
+  std::size_t oldest_action_needed() const noexcept { return next_action_; }
   std::uint64_t moves_read() const noexcept { return moves_read_; }
   std::uint64_t merged() const noexcept { return merged_; }
 
  private:
-  void read_more();
+  std::size_t readable_limit() const noexcept;
+  bool read_more();
   void read_actions_before(std::uint32_t move);
-  void add_marker(const canon::Action& a, traj::MarkerKind kind);
+  void add_marker(std::size_t action, traj::MarkerKind kind);
   traj::MotionBlock& new_marker();
   void read_move(canon::SegmentId id);
   bool make_element(canon::SegmentId id, Element& e) const;
@@ -67,6 +81,10 @@ class ProgramReader {
   const canon::Program* program_;
   std::size_t next_move_ = 0, next_action_ = 0;
   bool done_ = false, ended_ = false;
+  bool streaming_ = false;  ///< more moves may come (until seal())
+  bool gated_ = false;      ///< built for a stream: only readable() moves are read
+  bool flush_ = false;
+  std::size_t readable_ = 0;
   Ring<Item> ready_;
   bool handed_out_ = false;  // ready_.front() was returned by next()
   std::uint64_t moves_read_ = 0, merged_ = 0;

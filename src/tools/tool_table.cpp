@@ -166,6 +166,23 @@ std::optional<ToolTable> ToolTable::load(const std::string& path, Diagnostics& d
   return parse(ss.str(), path, diags);
 }
 
+std::string ToolTable::format() const {
+  std::string out;
+  for (const ToolEntry& e : entries_) {
+    out += fmt::format("T{} P{}", e.tool, e.pocket);
+    for (int i = 0; i < kAxisCount; ++i) {
+      if (e.offset[i] != 0) out += fmt::format(" {}{}", kAxisLetters[static_cast<std::size_t>(i)], e.offset[i]);
+    }
+    if (e.diameter != 0) out += fmt::format(" D{}", e.diameter);
+    if (e.front_angle != 0) out += fmt::format(" I{}", e.front_angle);
+    if (e.back_angle != 0) out += fmt::format(" J{}", e.back_angle);
+    if (e.orientation != 0) out += fmt::format(" Q{}", e.orientation);
+    if (!e.comment.empty()) out += fmt::format(" ;{}", e.comment);
+    out += '\n';
+  }
+  return out;
+}
+
 std::optional<std::size_t> ToolTable::find(int tool) const noexcept {
   auto it = std::lower_bound(by_tool_.begin(), by_tool_.end(), std::pair<int, std::size_t>{tool, 0});
   if (it == by_tool_.end() || it->first != tool) return std::nullopt;

@@ -409,11 +409,12 @@ void Interpolator::fill_output(TickOutput& out, double s_prev) noexcept {
     const MotionBlock& b = queue_->peek(index);
     const double x = std::clamp(s_f_ - f_start_, 0.0, b.length);
     position_ = position_at(b, x);
-    shown_ = Shown{b.seq, b.segment, b.segment_first, b.segment_last, b.line, b.context, x};
+    shown_ = Shown{b.seq, b.segment, b.segment_first, b.segment_last, b.line, b.context, x, b.segment_offset};
   } else if (index == avail && avail > 0) {
     const MotionBlock& b = queue_->peek(avail - 1);
     position_ = position_at(b, b.length);
-    shown_ = Shown{b.seq, b.segment, b.segment_first, b.segment_last, b.line, b.context, b.length};
+    shown_ = Shown{b.seq, b.segment, b.segment_first, b.segment_last, b.line, b.context, b.length,
+                   b.segment_offset};
   }
   out.position = position_;
   out.path_velocity = (s_f_ - s_prev) / config_.period_s;
@@ -425,6 +426,7 @@ void Interpolator::fill_output(TickOutput& out, double s_prev) noexcept {
   out.line = shown_.line;
   out.context = shown_.context;
   out.block_offset = shown_.offset;
+  out.segment_offset = shown_.segment_offset + shown_.offset;
   out.spindle_synced = sync_ == Sync::Locked;
   out.sync_lost = sync_lost_;
   out.tap_reverse = false;

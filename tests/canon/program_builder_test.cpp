@@ -113,7 +113,8 @@ TEST(ProgramBuilder, UnderG96TheSpindleSpeedIsASurfaceSpeedAboutTheSpindleAxis) 
   b.set_spindle_mode(0, 0);        // G97
   b.set_spindle_speed(0, 500);
   std::vector<Action> speeds;
-  for (const Action& a : b.program().actions()) {
+  for (std::size_t k = 0; k < b.program().action_count(); ++k) {
+    const Action& a = b.program().action(k);
     if (a.kind == ActionKind::SpindleSpeed) speeds.push_back(a);
   }
   ASSERT_EQ(speeds.size(), 5u);
@@ -169,13 +170,13 @@ TEST(ProgramBuilder, ActionsKeepTheirPlaceBetweenMoves) {
   b.dwell(0.5);
   b.straight_traverse(1, xyz(2, 0, 0));
   b.program_end();
-  const auto& acts = b.program().actions();
-  ASSERT_EQ(acts.size(), 4u);
-  EXPECT_EQ(acts[0].kind, ActionKind::SpindleSpeed);
-  EXPECT_EQ(acts[0].before_move, 0u);
-  EXPECT_EQ(acts[2].kind, ActionKind::Dwell);
-  EXPECT_EQ(acts[2].before_move, 1u);
-  EXPECT_EQ(acts[3].before_move, 2u);
+  const Program& p = b.program();
+  ASSERT_EQ(p.action_count(), 4u);
+  EXPECT_EQ(p.action(0).kind, ActionKind::SpindleSpeed);
+  EXPECT_EQ(p.action(0).before_move, 0u);
+  EXPECT_EQ(p.action(2).kind, ActionKind::Dwell);
+  EXPECT_EQ(p.action(2).before_move, 1u);
+  EXPECT_EQ(p.action(3).before_move, 2u);
 }
 
 TEST(ProgramBuilder, StoresOnlyTheConfiguredAxes) {

@@ -122,8 +122,7 @@ class ServoHarness {
  private:
   void pump() {
     if (!planner_) return;
-    const auto& actions = program_->actions();
-    while (next_action_ < actions.size()) {
+    while (next_action_ < program_->action_count()) {
       const auto a = machine_action(*program_, next_action_);
       if (a && !channels_->actions.try_push(*a)) break;
       ++next_action_;

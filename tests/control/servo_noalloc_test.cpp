@@ -73,24 +73,24 @@ TEST(ServoAllocations, NoneInsideTheTick) {
   Armed a(homing_mill({"interpreter.tool_table=\"" + tools + "\""}));
   a.ask(Request::simple(CommandKind::MachineOn));
   a.ask(Request::set_mode(Mode::Manual));
-  a.ask(Request::on_axis(CommandKind::Home, -1));
+  a.ask(Request::home());
   ASSERT_TRUE(a.idle());
   a.ask(Request::jog(Axis::X, -30));
   a.until([] { return false; }, 300);
-  a.ask(Request::on_axis(CommandKind::JogStop, -1));
+  a.ask(Request::jog_stop());
   ASSERT_TRUE(a.idle());
   a.ask(Request::set_mode(Mode::Mdi));
   a.ask(Request::mdi("G91 G1 Y2 F600"));
   ASSERT_TRUE(a.idle());
   a.ask(Request::set_mode(Mode::Auto));
-  a.ask(Request::flag_of(CommandKind::SetOptionalStop, true));
+  a.ask(Request::optional_stop(true));
   a.ask(Request::open(program));
   a.ask(Request::simple(CommandKind::CycleStart));
   int n = 0;
   ASSERT_TRUE(a.until(
       [&] {
         ++n;
-        if (n == 900) a.ask(Request::value_of(CommandKind::SetFeedOverride, 1.7));
+        if (n == 900) a.ask(Request::feed_override(1.7));
         if (n == 2000) a.ask(Request::simple(CommandKind::FeedHold));
         if (n == 2300) a.ask(Request::simple(CommandKind::Resume));
         if (a.state() == State::Stopped) a.ask(Request::simple(CommandKind::CycleStart));

@@ -319,11 +319,10 @@ const Row kRows[] = {
      Refusal::WrongMode, State::Idle},
     {"spindle_on_off", false, off, State::Off, cmd(CommandKind::SpindleOn, 1000, 0, -1, true),
      Refusal::MachineOff, State::Off},
-    {"coolant_manual", false, idle(Mode::Manual), State::Idle, cmd(CommandKind::Coolant, 0, 0, 0, true),
+    {"coolant_manual", false, idle(Mode::Manual), State::Idle, cmd(CommandKind::Coolant, 0, 0, -1, true),
      Refusal::None, State::Idle},
-    // the controller's own requests never reach the servo
-    {"open_program_is_not_for_the_servo", false, idle(Mode::Auto), State::Idle, cmd(CommandKind::OpenProgram),
-     Refusal::NotApplicable, State::Idle},
+    {"coolant_auto", false, idle(Mode::Auto), State::Idle, cmd(CommandKind::Coolant, 0, 0, -1, true),
+     Refusal::WrongMode, State::Idle},
 };
 
 void PrintTo(const Row& r, std::ostream* os) {

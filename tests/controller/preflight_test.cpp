@@ -158,7 +158,8 @@ TEST(ProgramTail, RestartsFromAPositionKeepingThePathSettings) {
   EXPECT_EQ(t->end(1), xyz(0, 10));
   EXPECT_DOUBLE_EQ(t->feed(0), 1200);
   bool path_mode = false, flood = false, message = false;
-  for (const canon::Action& a : t->actions()) {
+  for (std::size_t i = 0; i < t->action_count(); ++i) {
+    const canon::Action& a = t->action(i);
     path_mode = path_mode || a.kind == canon::ActionKind::MotionControl;
     flood = flood || a.kind == canon::ActionKind::FloodOn;
     if (a.kind == canon::ActionKind::Message) message = t->text(a.text) == "half way";
@@ -179,7 +180,7 @@ TEST(MachineActions, OnlyMarkerActionsBecomeRecords) {
   b.set_motion_output_bit(3);
   b.wait_for_input(2, false, 0, 0);
   const canon::Program p = b.take();
-  ASSERT_EQ(p.actions().size(), 5u);
+  ASSERT_EQ(p.action_count(), 5u);
   EXPECT_EQ(machine_action(p, 0)->code, ActionCode::SpindleSpeed);
   EXPECT_EQ(machine_action(p, 0)->value, 2500);
   EXPECT_EQ(machine_action(p, 1)->code, ActionCode::SpindleCw);

@@ -79,7 +79,7 @@ TEST(ManualScenario, JogThroughTheControllerAndStopAtTheLimit) {
   EXPECT_EQ(s.status().servo.commanded[Axis::Y], 12.0);
   s.must(Request::jog(Axis::Y, -40));
   s.ticks(100);
-  s.must(Request::on_axis(CommandKind::JogStop, index(Axis::Y)));
+  s.must(Request::jog_stop(Axis::Y));
   ASSERT_TRUE(s.idle(5000));
   EXPECT_LT(s.status().servo.commanded[Axis::Y], 12.0);
   s.must(Request::jog_by(Axis::Y, 100, 40));  // clamped at the limit
@@ -90,12 +90,8 @@ TEST(ManualScenario, JogThroughTheControllerAndStopAtTheLimit) {
 TEST(ManualScenario, ManualSpindleAndCoolant) {
   Scenario s(mill());
   s.on(Mode::Manual);
-  Request on = Request::value_of(CommandKind::SpindleOn, 1200);
-  on.flag = true;
-  s.must(on);
-  Request flood = Request::flag_of(CommandKind::Coolant, true);
-  flood.axis = 0;
-  s.must(flood);
+  s.must(Request::spindle_on(1200, true));
+  s.must(Request::coolant(Coolant::Flood, true));
   s.ticks(2000);
   EXPECT_NEAR(s.status().servo.spindle_rpm_actual, 1200, 30);
   EXPECT_TRUE(s.status().servo.flood);
@@ -115,8 +111,9 @@ TEST(ManualScenario, FaultsAreReportedInWordsNamingTheAxis) {
   EXPECT_EQ(st.servo.state, State::Faulted);
   EXPECT_NE(st.fault_text.find("Y drive"), std::string::npos) << st.fault_text;
   bool noted = false;
-  for (const Note& n : s.rig().controller().take_notes())
-    noted = noted || n.code == "control.fault.amplifier";
+  EventCursor events(s.rig().controller().events(), true);
+  for (const ControllerEvent& e : events.next())
+    noted = noted || (e.kind == ControllerEventKind::Note && e.code == "control.fault.amplifier");
   EXPECT_TRUE(noted);
   s.sim().set_amp_fault(1, false);
   s.ticks(2);

@@ -48,8 +48,7 @@ TEST(RunScenario, ProgramRunsToTheEndWithinTheLimits) {
   EXPECT_NEAR(st.servo.commanded[Axis::Z], 5.0, 1e-9);
   EXPECT_FALSE(st.servo.flood);
   EXPECT_EQ(st.servo.digital_out, 0u);
-  const auto program = s.rig().controller().open_program();
-  const RunReport r = s.report(*program);
+  const RunReport r = s.report();
   EXPECT_EQ(r.limit_violations, 0u);
   for (int i = 0; i < 3; ++i) {
     EXPECT_LE(r.axes[static_cast<std::size_t>(i)].max_velocity, 100 * (1 + 1e-6));
@@ -78,7 +77,7 @@ TEST(RunScenario, DefaultToleranceAppliesInInchProgramsToo) {
                   fmt::format("{} G90 G64\nG0 X0 Y0\nG1 X{} F200\nY{}\nX0\nY0\nM2\n", units, side, side));
     s.on(Mode::Auto);
     ASSERT_TRUE(s.run_file(p.path())) << s.message();
-    const RunReport r = s.report(*s.rig().controller().open_program());
+    const RunReport r = s.report();
     EXPECT_LE(r.max_command_contour_error_mm, 0.01 + 1e-6) << units;
     EXPECT_GT(r.max_command_contour_error_mm, 0.005) << units;  // the corners were blended
   }
@@ -91,7 +90,7 @@ TEST(RunScenario, ShippedMillBlendsWithoutABoundUnderG64WithoutP) {
   TempProgram p("sq.ngc", "G21 G90 G64\nG0 X0 Y0\nG1 X50 F6000\nY50\nX0\nY0\nM2\n");
   s.on(Mode::Auto);
   ASSERT_TRUE(s.run_file(p.path())) << s.message();
-  const RunReport r = s.report(*s.rig().controller().open_program());
+  const RunReport r = s.report();
   EXPECT_GT(r.max_command_contour_error_mm, 0.5);  // a blend of several mm at 100 mm/s
   EXPECT_EQ(r.limit_violations, 0u);
 }
@@ -144,7 +143,7 @@ TEST(RunScenario, FeedHoldInABlendThenResumeStaysOnThePath) {
   s.must(Request::simple(CommandKind::Resume));
   ASSERT_TRUE(s.idle(20000));
   EXPECT_NEAR(s.status().servo.commanded[Axis::Y], 100.0, 1e-9);
-  const RunReport r = s.report(*s.rig().controller().open_program());
+  const RunReport r = s.report();
   EXPECT_EQ(r.limit_violations, 0u);
   EXPECT_LE(r.max_command_contour_error_mm, 0.5 + 1e-6);
   for (std::size_t i = 1; i < s.samples().size(); ++i) {  // continuous: at most v·T per period
@@ -168,7 +167,7 @@ TEST(RunScenario, AbortIsAControlledStopOnThePath) {
   EXPECT_NEAR(at[Axis::Y], at[Axis::X] / 2, 1e-9);  // on the line
   EXPECT_FALSE(s.status().run_active);
   EXPECT_EQ(s.rig().channels().blocks.available(), 0u);
-  const RunReport r = s.report(*s.rig().controller().open_program());
+  const RunReport r = s.report();
   EXPECT_EQ(r.limit_violations, 0u);
   // Cycle start runs the program again, from where the machine stands.
   ASSERT_TRUE(s.start_and_finish());
@@ -224,33 +223,33 @@ TEST(RunScenario, FeedOverrideScalesTheFeedAndZeroHolds) {
   TempProgram p("slow.ngc", "G1 X20 F600\nM2\n");  // 10 mm/s: 2 s
   s.on(Mode::Auto);
   s.must(Request::open(p.path()));
-  s.must(Request::value_of(CommandKind::SetFeedOverride, 0.5));
+  s.must(Request::feed_override(0.5));
   ASSERT_TRUE(s.start_and_finish());
-  const RunReport half = s.report(*s.rig().controller().open_program());
+  const RunReport half = s.report();
   EXPECT_NEAR(half.motion_time_s, 4.0, 0.02);
   EXPECT_NEAR(half.axes[0].max_velocity, 5.0, 1e-6);
-  s.must(Request::value_of(CommandKind::SetFeedOverride, 2.0));
+  s.must(Request::feed_override(2.0));
   ASSERT_TRUE(s.run_file(p.path()));  // from X20 back... no: the same absolute end, so no motion
-  s.must(Request::value_of(CommandKind::SetFeedOverride, 0.0));
+  s.must(Request::feed_override(0.0));
   TempProgram back("back.ngc", "G1 X0 F600\nM2\n");
   s.must(Request::open(back.path()));
   s.must(Request::simple(CommandKind::CycleStart));
   s.ticks(500);
   EXPECT_EQ(s.status().servo.commanded[Axis::X], 20.0);  // 0 %: nothing moves
-  s.must(Request::value_of(CommandKind::SetFeedOverride, 2.0));
+  s.must(Request::feed_override(2.0));
   ASSERT_TRUE(s.idle(5000));
-  const RunReport twice = s.report(*s.rig().controller().open_program());
+  const RunReport twice = s.report();
   EXPECT_NEAR(twice.axes[0].max_velocity, 20.0, 1e-6);
-  EXPECT_EQ(s.ask(Request::value_of(CommandKind::SetFeedOverride, 2.5)).refusal, Refusal::BadValue);
+  EXPECT_EQ(s.ask(Request::feed_override(2.5)).refusal, Refusal::BadValue);
 }
 
 TEST(RunScenario, RapidOverrideScalesRapids) {
   Scenario s(mill());
   TempProgram p("rapid.ngc", "G0 X50\nM2\n");
   s.on(Mode::Auto);
-  s.must(Request::value_of(CommandKind::SetRapidOverride, 0.25));
+  s.must(Request::rapid_override(0.25));
   ASSERT_TRUE(s.run_file(p.path()));
-  const RunReport r = s.report(*s.rig().controller().open_program());
+  const RunReport r = s.report();
   EXPECT_NEAR(r.axes[0].max_velocity, 25.0, 1e-6);
 }
 
@@ -258,7 +257,7 @@ TEST(RunScenario, SingleBlockStopsAfterEveryMove) {
   Scenario s(mill());
   TempProgram p("three.ngc", "G61\nG1 X10 F3000\nY10\nX0\nM2\n");  // exact path: stops at the ends
   s.on(Mode::Auto);
-  s.must(Request::flag_of(CommandKind::SetSingleBlock, true));
+  s.must(Request::single_block(true));
   s.must(Request::open(p.path()));
   s.must(Request::simple(CommandKind::CycleStart));
   const Pose ends[] = {[] {
@@ -279,7 +278,7 @@ TEST(RunScenario, SingleBlockStopsAfterEveryMove) {
     EXPECT_NEAR(s.status().servo.commanded[Axis::Y], end[Axis::Y], 1e-9);
     s.must(Request::simple(CommandKind::CycleStart));
   }
-  s.must(Request::flag_of(CommandKind::SetSingleBlock, false));
+  s.must(Request::single_block(false));
   ASSERT_TRUE(s.idle(10000));
   EXPECT_NEAR(s.status().servo.commanded[Axis::X], 0.0, 1e-9);
 }
@@ -289,7 +288,7 @@ TEST(RunScenario, OptionalStopWaitsOnlyWhenTheSwitchIsOn) {
   for (const bool on : {false, true}) {
     Scenario s(mill());
     s.on(Mode::Auto);
-    s.must(Request::flag_of(CommandKind::SetOptionalStop, on));
+    s.must(Request::optional_stop(on));
     s.must(Request::open(p.path()));
     s.must(Request::simple(CommandKind::CycleStart));
     const bool stopped = s.until([&] { return s.status().servo.state == State::Stopped; }, 3000);
@@ -308,7 +307,7 @@ TEST(RunScenario, ProgramStopAndBlockDelete) {
   Scenario s(mill());
   TempProgram p("m0.ngc", "G1 X5 F3000\n/G1 Y5\nM0\nG1 X10\nM2\n");
   s.on(Mode::Auto);
-  s.must(Request::flag_of(CommandKind::SetBlockDelete, true));
+  s.must(Request::block_delete(true));
   s.must(Request::open(p.path()));
   s.must(Request::simple(CommandKind::CycleStart));
   ASSERT_TRUE(s.until([&] { return s.status().servo.state == State::Stopped; }, 5000));
@@ -360,7 +359,7 @@ TEST(RunScenario, ToolChangerHandshake) {
   TempProgram tools("tools.tbl", "T3 P3 Z0\nT7 P7 Z0\n");
   Scenario s(homing_mill({tool_table(tools)}));
   s.on(Mode::Manual);
-  s.must(Request::on_axis(CommandKind::Home, -1));
+  s.must(Request::home());
   ASSERT_TRUE(s.idle(120000));
   s.must(Request::set_mode(Mode::Auto));
   TempProgram p("tc.ngc", "T7\nG1 X280 F3000\nM6\nG1 X270\nM2\n");
@@ -377,7 +376,7 @@ TEST(RunScenario, AutoIsRefusedUntilHomedThenRuns) {
   s.must(Request::open(p.path()));
   EXPECT_EQ(s.ask(Request::simple(CommandKind::CycleStart)).refusal, Refusal::NotHomed);
   s.must(Request::set_mode(Mode::Manual));
-  s.must(Request::on_axis(CommandKind::Home, -1));
+  s.must(Request::home());
   ASSERT_TRUE(s.idle(120000));
   s.must(Request::set_mode(Mode::Auto));
   ASSERT_TRUE(s.start_and_finish());
@@ -391,7 +390,7 @@ TEST(RunScenario, AutoIsRefusedUntilHomedThenRuns) {
 TEST(RunScenario, ProbeTripStopsTheMoveAndTheProgramGoesOn) {
   Scenario s(homing_mill());
   s.on(Mode::Manual);
-  s.must(Request::on_axis(CommandKind::Home, -1));
+  s.must(Request::home());
   ASSERT_TRUE(s.idle(120000));
   s.must(Request::set_mode(Mode::Auto));
   canon::ProgramBuilder b(AxisMask::from_letters("XYZ"), s.status().servo.commanded);
@@ -422,7 +421,7 @@ TEST(RunScenario, VirtualTimeRunsAreBitForBitRepeatable) {
   for (int run = 0; run < 2; ++run) {
     Scenario s(mill());
     s.on(Mode::Auto);
-    s.must(Request::value_of(CommandKind::SetFeedOverride, 1.3));
+    s.must(Request::feed_override(1.3));
     ASSERT_TRUE(s.run_file(p.path()));
     if (run == 0) {
       first = s.samples();

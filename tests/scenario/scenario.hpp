@@ -44,14 +44,37 @@ class TempProgram {
   std::string path_;
 };
 
+/// Every servo period's sample, and the report of the program runs among them.
+class SampleKeeper final : public ControllerObserver {
+ public:
+  SampleKeeper(const plan::MachineLimits& limits, double period_s) : limits_(limits), period_s_(period_s) { forget(); }
+  void on_trace(const TraceSample& s, const TraceContext& c) override {
+    samples_.push_back(s);
+    if (s.activity == Activity::Program) recorder_->add(s, c);
+  }
+  void forget() {
+    samples_.clear();
+    recorder_ = std::make_unique<RunRecorder>(limits_, period_s_);
+  }
+  const std::vector<TraceSample>& samples() const { return samples_; }
+  RunReport report() const { return recorder_->report(); }
+
+ private:
+  plan::MachineLimits limits_;
+  double period_s_;
+  std::vector<TraceSample> samples_;
+  std::unique_ptr<RunRecorder> recorder_;
+};
+
 class Scenario {
  public:
-  explicit Scenario(const config::MachineProfile& profile) : profile_(profile) {
-    Diagnostics d;
-    auto source = GcodeProgramSource::create(profile, d);
-    EXPECT_TRUE(source != nullptr);
-    rig_ = std::make_unique<SimRig>(profile, source);
-    rig_->channels().trace_enabled = true;
+  explicit Scenario(const config::MachineProfile& profile) : Scenario(profile, make_source(profile)) {}
+  /// With a program source of the test's own (a tool table in memory, code modules).
+  Scenario(const config::MachineProfile& profile, std::shared_ptr<ProgramSource> source) : profile_(profile) {
+    rig_ = std::make_unique<SimRig>(profile, std::move(source));
+    keeper_ = std::make_shared<SampleKeeper>(machine_limits(profile), profile.servo_period_s);
+    rig_->controller().attach(keeper_, ObserverOptions{0, true});
+    rig_->step();  // the observer is attached from here on
   }
 
   Outcome ask(Request r) {
@@ -63,9 +86,9 @@ class Scenario {
   }
   /// Asserting form: the request must be accepted.
   void must(Request r) {
-    const CommandKind k = r.kind;
+    const std::string name = r.name();
     const Outcome o = ask(std::move(r));
-    ASSERT_TRUE(o.accepted) << to_string(k) << ": " << last_message_;
+    ASSERT_TRUE(o.accepted) << name << ": " << last_message_;
   }
   void on(Mode m) {
     must(Request::simple(CommandKind::MachineOn));
@@ -77,7 +100,6 @@ class Scenario {
   bool until(F done, std::uint64_t max_ticks) {
     for (std::uint64_t i = 0; i < max_ticks; ++i) {
       rig_->step();
-      drain();
       if (done()) return true;
     }
     return false;
@@ -92,7 +114,7 @@ class Scenario {
   }
   bool start_and_finish(std::uint64_t max_ticks = 200000) {
     const std::uint64_t finished = status().runs_finished;
-    samples_.clear();
+    keeper_->forget();
     must(Request::simple(CommandKind::CycleStart));
     return until([&] { return !status().run_active && status().runs_finished > finished; }, max_ticks);
   }
@@ -100,31 +122,27 @@ class Scenario {
     return until([&] { return status().servo.state == State::Idle && !status().run_active; }, max_ticks);
   }
 
-  /// The report of the samples recorded while a run was active (against `program`).
-  RunReport report(const canon::Program& program) const {
-    RunRecorder r(program, machine_limits(profile_), profile_.servo_period_s);
-    for (const TraceSample& s : samples_) {
-      if (s.activity == Activity::Program) r.add(s);
-    }
-    return r.report();
-  }
+  /// The report of the program runs since the last start_and_finish() or forget_samples().
+  RunReport report() const { return keeper_->report(); }
 
   ControllerStatus status() const { return rig_->status(); }
   SimRig& rig() { return *rig_; }
   machine::SimMachine& sim() { return rig_->machine(); }
-  const std::vector<TraceSample>& samples() const { return samples_; }
-  void forget_samples() { samples_.clear(); }
+  const std::vector<TraceSample>& samples() const { return keeper_->samples(); }
+  void forget_samples() { keeper_->forget(); }
   const std::string& message() const { return last_message_; }
 
  private:
-  void drain() {
-    TraceSample t;
-    while (rig_->channels().trace.try_pop(t)) samples_.push_back(t);
+  static std::shared_ptr<ProgramSource> make_source(const config::MachineProfile& profile) {
+    Diagnostics d;
+    auto source = GcodeProgramSource::create(profile, d);
+    EXPECT_TRUE(source != nullptr);
+    return source;
   }
 
   config::MachineProfile profile_;
   std::unique_ptr<SimRig> rig_;
-  std::vector<TraceSample> samples_;
+  std::shared_ptr<SampleKeeper> keeper_;
   std::string last_message_;
 };
 

@@ -32,6 +32,7 @@ struct Period {
 std::vector<Period> run_recording(Scenario& s, const std::string& path, bool& finished) {
   s.must(Request::open(path));
   const std::uint64_t before = s.status().runs_finished;
+  s.forget_samples();
   s.must(Request::simple(CommandKind::CycleStart));
   std::vector<Period> periods;
   finished = s.until(
@@ -105,8 +106,7 @@ TEST(SpindleScenario, RigidTapFollowsTheSpindleThroughItsReversalAndComesBackOut
   EXPECT_LE(worst_phase, 0.010);
   // Back on the start, then up: the program ended where it says.
   EXPECT_NEAR(t.back().z, 20.0, 1e-9);
-  const auto program = s.rig().controller().open_program();
-  const RunReport r = s.report(*program);
+  const RunReport r = s.report();
   EXPECT_EQ(r.limit_violations, 0u);
   EXPECT_LE(r.max_command_contour_error_mm, 1e-9);   // on the tap's line throughout
 }
@@ -174,8 +174,7 @@ TEST(SpindleScenario, ArcsOffTheirCircleRunAsSpiralsWithinTheLimits) {
                 "M2\n");
   s.on(Mode::Auto);
   ASSERT_TRUE(s.run_file(p.path())) << s.message();
-  const auto program = s.rig().controller().open_program();
-  const RunReport r = s.report(*program);
+  const RunReport r = s.report();
   EXPECT_EQ(r.limit_violations, 0u);
   EXPECT_LE(r.max_command_contour_error_mm, 0.01 * (1 + 1e-9));
   EXPECT_NEAR(s.status().servo.commanded[Axis::Y], -299.75, 1e-9);

@@ -54,6 +54,16 @@ class TraceChecker {
  public:
   TraceChecker(const canon::Program& program, const plan::MachineLimits& limits, double period_s,
                double relative_tolerance = 1e-6);
+  /// Without a program yet (set_program()): no contour error until there is one.
+  TraceChecker(const plan::MachineLimits& limits, double period_s, double relative_tolerance = 1e-6);
+
+  /// The program the next samples' segment ids refer to (a stream's window, a new leg of a run;
+  /// null: none). The moves within one of the samples' segments must still be held.
+  void set_program(const canon::Program* program) noexcept {
+    program_ = program;
+    nearest_ = 0;
+  }
+  const canon::Program* program() const noexcept { return program_; }
 
   /// Where the machine rests before the first sample (the origin unless said). Before add().
   void start_at(const Pose& position) { past_.fill(position); }

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <deque>
 #include <memory>
 #include <string>
 #include <vector>
@@ -108,6 +109,13 @@ struct Action {
 /// unit conversion and rotation applied. Built by canon::ProgramBuilder; read by the planner,
 /// the summary, the path index and the plotter. Non-real-time; not thread-safe while built,
 /// safe to share read-only afterwards.
+///
+/// A program may also be a window on a stream (the controller's execution of a file): moves
+/// and actions are appended while the front is read, and what every reader has passed is
+/// released (release_before). Indices never change; reading a released move or action is a
+/// bug. Release assumes the side tables are referenced in append order, as ProgramBuilder
+/// does (a move refers to the latest feed or a newer one, an action's text and pose are added
+/// just before it).
 class Program {
  public:
   explicit Program(AxisMask axes = kXyzabc);
@@ -132,9 +140,19 @@ class Program {
   const ArcGeometry& arc(SegmentId id) const noexcept { return arcs_[moves_[id].param]; }
   double feed(SegmentId id) const noexcept;
 
-  const std::vector<Action>& actions() const noexcept { return actions_; }
-  const std::string& text(std::uint32_t index) const { return texts_.at(index); }
-  const Pose& action_pose(std::uint32_t index) const { return action_poses_.at(index); }
+  /// Actions appended so far (the index of the next one).
+  std::size_t action_count() const noexcept { return actions_.size(); }
+  const Action& action(std::size_t index) const noexcept { return actions_[index]; }
+  const std::string& text(std::uint32_t index) const { return texts_.at(index - first_text_); }
+  const Pose& action_pose(std::uint32_t index) const { return action_poses_[index]; }
+
+  /// Streams: frees the moves before `move` and the actions before `action` (whole chunks of
+  /// them, with the arcs, feeds, texts and poses only they refer to). The first move kept
+  /// still has its predecessor's end (start_of) unless `move` is 0.
+  void release_before(std::size_t move, std::size_t action);
+  /// The first move (action) index still held (0 unless released).
+  std::size_t first_held_move() const noexcept { return moves_.first_held(); }
+  std::size_t first_held_action() const noexcept { return actions_.first_held(); }
 
   /// Segment ids and move indices. The interpreter numbers its motions (segment ids, what
   /// replay and breakpoints use); the program numbers its moves. They differ where one
@@ -163,7 +181,7 @@ class Program {
   Move& append(const Pose& end);
   std::uint32_t add_arc(const ArcGeometry& a);
   std::uint32_t add_feed(double value);
-  void add_action(const Action& a) { actions_.push_back(a); }
+  void add_action(const Action& a);
   std::uint32_t add_text(std::string s);
   std::uint32_t add_action_pose(const Pose& p);
   /// The segment id of the first move (default 0).
@@ -181,10 +199,22 @@ class Program {
   ChunkedVector<Move> moves_;
   ChunkedVector<double, 16> coords_;
   ChunkedVector<ArcGeometry, 12> arcs_;
-  std::vector<double> feeds_;
-  std::vector<Action> actions_;
-  std::vector<std::string> texts_;
-  std::vector<Pose> action_poses_;
+  ChunkedVector<double, 12> feeds_;
+  ChunkedVector<Action, 12> actions_;
+  std::deque<std::string> texts_;
+  std::uint32_t first_text_ = 0;  ///< index of texts_.front()
+  ChunkedVector<Pose, 10> action_poses_;
+  // The lowest side-table entries the first move (action) of each chunk and everything after
+  // it may refer to, noted when it was appended: the newest entry then (its own arc, feed,
+  // text or pose is added just before it). release_before frees below them.
+  struct MoveFloor {
+    std::size_t arc = 0, feed = 0;
+  };
+  struct ActionFloor {
+    std::size_t text = 0, pose = 0;
+  };
+  std::vector<MoveFloor> move_floors_;      ///< per chunk of moves_
+  std::vector<ActionFloor> action_floors_;  ///< per chunk of actions_
   std::shared_ptr<const SourceMap> sources_;
   // A segment split into several moves; `extra` counts the moves added by it and all splits
   // before it, so that later ids map by subtraction.

@@ -27,8 +27,16 @@ class ProgramBuilder final : public Sink {
   Program take() { return std::move(program_); }
   /// Current machine position (mm) after the last motion.
   const Pose& position() const noexcept { return position_; }
+  /// The block the last canonical calls came from.
+  const BlockOrigin& origin() const noexcept { return origin_; }
   /// Converts a canonical position to machine coordinates with the current offsets.
   Pose to_machine(const Pose& canonical) const noexcept;
+  /// Streams: a builder for what follows when the machine stopped elsewhere than this program's
+  /// last move ends (a probe tripped): a new program starting at `start` (machine coordinates)
+  /// with the same offsets, units and feed, the settings the planner reads as it goes (path
+  /// control, naive-CAM tolerance, feed override and hold switches, spindle sync) repeated as
+  /// its first actions, and the segment ids going on. This builder is left as it is.
+  std::unique_ptr<ProgramBuilder> continuation(const Pose& start) const;
 
   void begin_block(const BlockOrigin& origin) override { origin_ = origin; }
   void use_length_units(Units u) override;
@@ -100,7 +108,9 @@ class ProgramBuilder final : public Sink {
 
  private:
   Action make(ActionKind kind, int index = 0, int index2 = 0, double value = 0) const;
-  void simple(ActionKind kind, int index = 0, int index2 = 0) { program_.add_action(make(kind, index, index2)); }
+  void simple(ActionKind kind, int index = 0, int index2 = 0) { add(make(kind, index, index2)); }
+  /// Appends an action; remembers the last one of each planner setting (for continuation()).
+  void add(const Action& a);
   Pose offset_to_mm(const Pose& offset) const noexcept;
   void to_machine(const Pose& canonical, Pose& machine) const noexcept;
   void update_work_offset() noexcept;
@@ -111,6 +121,11 @@ class ProgramBuilder final : public Sink {
   std::uint8_t move_flags() const noexcept;
 
   Program program_;
+  /// The last action of each setting the planner reads as it goes: path control, naive-CAM
+  /// tolerance, feed override on/off, feed hold on/off, spindle sync on/off.
+  enum Setting { kPathControl, kNaiveCam, kFeedOverride, kFeedHold, kSpindleSync, kSettings };
+  Action settings_[kSettings] = {};
+  bool has_setting_[kSettings] = {};
   BlockOrigin origin_;
   Units units_ = Units::Mm;
   double unit_scale_[kAxisCount] = {};   ///< mm per program unit by axis (1 for rotary axes)

@@ -86,6 +86,10 @@ struct InterpreterOptions {
   AxisMap axis_map = identity_axis_map();    ///< program axis letter → machine axis
   std::vector<std::string> subroutine_path;  ///< folders searched for O-word subroutines
   std::string tool_table;                    ///< tool table file; empty = none
+  /// How far the interpreter reads ahead of the machine while a program runs, in moves and in
+  /// seconds of programmed motion (whichever comes first; never less than the planner needs).
+  int readahead_moves = 2000;
+  double readahead_s = 5.0;
 };
 
 struct PlannerOptions {

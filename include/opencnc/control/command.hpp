@@ -45,8 +45,12 @@ enum class Wait : std::uint8_t {
 /// Why the state is Stopped.
 enum class StopReason : std::uint8_t { None, ProgramStop, OptionalStop, SingleBlock };
 
+/// A coolant output (the Coolant command's `coolant`).
+enum class Coolant : std::uint8_t { Flood, Mist };
+
+/// What the servo tick executes. Requests that only the controller handles (opening programs,
+/// MDI lines, …) are the controller layer's (controller/request.hpp) and never reach the tick.
 enum class CommandKind : std::uint8_t {
-  // --- executed by the servo tick -----------------------------------------------------------
   EStop,               ///< stop everything now, drives off
   Reset,               ///< leave EStopped or Faulted (to Off) once the cause is gone
   MachineOn,           ///< Off → Idle: drives enabled, commanded position = actual
@@ -70,11 +74,7 @@ enum class CommandKind : std::uint8_t {
   ToolChanged,         ///< the operator has changed the tool by hand (manual M6)
   SpindleOn,           ///< manual: `value` rpm, `flag` true = clockwise
   SpindleOff,          ///< manual
-  Coolant,             ///< manual: `axis` 0 = flood, 1 = mist; `flag` on/off
-  // --- handled by the controller (non-real-time) and never sent to the servo ----------------
-  OpenProgram,     ///< a program file (or a canon::Program) for Auto mode
-  Mdi,             ///< one line of G-code in MDI mode
-  SetBlockDelete,  ///< `flag`: skip lines starting with '/' in programs loaded from now on
+  Coolant,             ///< manual: `coolant` on (`flag`) or off
 };
 
 /// Why a command was refused. Each has a stable code (refusal_code()).
@@ -130,6 +130,7 @@ struct Command {
   Mode mode = Mode::Manual;
   std::int8_t axis = -1;  ///< Axis index (X = 0 …), −1 = all / none
   bool flag = false;
+  Coolant coolant = Coolant::Flood;
   double value = 0;
   double value2 = 0;
   // StartRun: fences below which queued blocks and actions are stale, and the run's number.
@@ -198,6 +199,10 @@ enum class EventKind : std::uint8_t {
   Homed,         ///< `axis` is homed
   ProbeTripped,  ///< the probe tripped during run `run_id` (position in the status)
   InputRead,     ///< M66 of run `run_id` read `value` (−1: timed out)
+  /// Run `run_id` went on past a sync point: a Sync marker whose handshake is done, or a program
+  /// stop (M0, M1) — `action` (traj::kNoAction for the end of a probe move that did not trip),
+  /// `segment`; the controller's interpreter may read on from there.
+  SyncPassed,
 };
 
 struct ServoEvent {

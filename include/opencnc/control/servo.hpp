@@ -100,6 +100,7 @@ class Servo final : public Tickable {
   void run_program() noexcept;
   traj::TickInput program_inputs() noexcept;
   void apply_reports() noexcept;
+  void report_sync_points() noexcept;
   void apply_action(const MachineAction& a) noexcept;
   bool take_action(std::uint32_t action, MachineAction& out) noexcept;
   void run_sync() noexcept;
@@ -180,6 +181,9 @@ class Servo final : public Tickable {
   bool probe_tripped_ = false;
   std::uint64_t probe_seq_ = traj::kNoBlock;  ///< the probe move whose result probe_tripped_ is
   Pose probe_position_{};
+  std::uint32_t probe_edges_seen_ = 0;  ///< the machine's probe edge count at the last period
+  bool probe_edge_latched_ = false;     ///< the machine latched a probe edge in this period
+  Joints previous_feedback_{};          ///< feedback of the period before
   double input_value_ = 0;
 
   // Machine outputs the program and the operator set.

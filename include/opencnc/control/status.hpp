@@ -48,6 +48,8 @@ struct ServoStatus {
   bool run_active = false;
   traj::RunState motion = traj::RunState::Idle;  ///< the interpolator's state
   std::uint64_t segment = 0;                     ///< canon segment id at the commanded position
+  std::uint64_t segment_first = 0;  ///< the first move the block there stands for (blends, merges)
+  double segment_offset = 0;        ///< path length from the start of `segment` to the commanded position
   std::uint32_t line = 0;                        ///< its source line
   std::uint32_t context = 0;
   double path_velocity = 0;  ///< along the path, s-units/s

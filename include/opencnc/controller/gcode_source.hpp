@@ -1,46 +1,72 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// GcodeProgramSource — the ProgramSource of a real controller: gcode::Interpreter (scan mode)
-// into canon::ProgramBuilder, set up from the machine profile.
+// GcodeProgramSource — the ProgramSource of a real controller: gcode::Interpreter in scan mode for
+// the preflight, in execute mode (streaming, sync points) for runs, into canon::ProgramBuilder.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <string_view>
 
-#include "opencnc/canon/program_builder.hpp"
 #include "opencnc/config/machine_profile.hpp"
 #include "opencnc/controller/program_source.hpp"
 #include "opencnc/gcode/interpreter.hpp"
 #include "opencnc/gcode/options.hpp"
+#include "opencnc/tools/tool_table_service.hpp"
+
+namespace opencnc::gcode {
+struct Extensions;
+}
 
 namespace opencnc::control {
 
-/// Programs and MDI lines through the interpreter, with the profile's dialect, subroutine
-/// path, tool table and axes, in millimetres. While a program sets no G64 P the profile's
-/// planner.default_tolerance applies. Before a program, and before an MDI line when the machine
-/// has moved since the last one, the interpreter is told where the machine is (a G53 G0 to it,
-/// run without output), so that incremental moves and arcs start from there; in MDI an arc or
-/// canned-cycle motion mode is then cancelled (G80) rather than left for a line without G code.
-/// Non-real-time; one thread.
+/// How the G-code source is set up.
+struct GcodeSourceConfig {
+  /// The base: axes, axis map, subroutine path, units (mm), machine kind, the default dialect
+  /// (a program's own `(dialect: …)` comment wins over it).
+  gcode::Options options;
+  /// The code modules for a dialect; empty: gcode::standard_extensions. A feature that brings
+  /// G or M codes of its own (a coupling law, machining conditions) gives a function that adds
+  /// its modules to the standard ones.
+  std::function<std::shared_ptr<const gcode::Extensions>(gcode::Dialect)> extensions;
+  /// The machine's tool table (null: none): G43 and G41/G42 read it, G10 L1/L10/L11 write it
+  /// (while a program runs, not in its preflight). At sync points the interpreter takes the
+  /// operator's changes.
+  std::shared_ptr<tools::ToolTableService> tools;
+  /// Path tolerance (mm) while a program sets no G64 P (the profile's planner.default_tolerance).
+  double default_tolerance_mm = 0;
+};
+
+/// Programs and MDI lines through the interpreter, in millimetres. Before a program, and before
+/// an MDI line, the interpreter is placed where the machine is (Interpreter::set_machine_position),
+/// so incremental moves and arcs start from there. While a program sets no G64 P the default
+/// tolerance applies. Non-real-time; one thread (the controller's).
 class GcodeProgramSource final : public ProgramSource {
  public:
-  /// Reads the profile's tool table; its problems land in `diags` (errors: nullptr).
-  static std::shared_ptr<GcodeProgramSource> create(const config::MachineProfile& profile,
-                                                    Diagnostics& diags);
+  /// The profile's dialect, machine kind, axes and axis map, subroutine path, default tolerance,
+  /// and its tool table file as a tools::FileToolTable (G10 L1 writes it back); problems with it
+  /// land in `diags` (errors: nullptr).
+  static std::shared_ptr<GcodeProgramSource> create(const config::MachineProfile& profile, Diagnostics& diags);
+  explicit GcodeProgramSource(GcodeSourceConfig config);
+  ~GcodeProgramSource() override;
 
-  LoadedProgram load(const std::string& path, const Pose& start, const LoadOptions& options) override;
-  LoadedProgram mdi(std::string_view line, const Pose& start) override;
+  Preflight preflight(const std::string& path, const Pose& start, const LoadOptions& options,
+                      MoveCheck& check) override;
+  std::unique_ptr<ProgramStream> execute(const std::string& path, const Pose& start,
+                                         const LoadOptions& options) override;
+  std::unique_ptr<ProgramStream> mdi(std::string_view line, const Pose& start) override;
+  std::uint64_t version() const override { return config_.tools ? config_.tools->version() : 0; }
+
+  /// The tool table G-code reads and writes (null: none). Any thread.
+  const std::shared_ptr<tools::ToolTableService>& tools() const noexcept { return config_.tools; }
+  /// The interpreter options a file runs with: its dialect (its own comment, else the default)
+  /// and modules. Non-real-time.
+  gcode::Options options_for(const std::string& path, const LoadOptions& options) const;
 
  private:
-  GcodeProgramSource(gcode::Options options, double default_tolerance);
-  bool place(gcode::Interpreter& interp, const Pose& machine, Diagnostics& diags) const;
-  void replay_state(const gcode::InterpState& s, canon::ProgramBuilder& b) const;
-
-  gcode::Options options_;
-  double default_tolerance_;
+  GcodeSourceConfig config_;
   std::unique_ptr<gcode::Interpreter> mdi_;  ///< the MDI session: modal state lives on
-  Pose mdi_end_{};                           ///< where the last MDI line left the machine
-  bool mdi_placed_ = false;
+  std::uint64_t mdi_tools_version_ = 0;
 };
 
 }  // namespace opencnc::control

@@ -6,8 +6,10 @@
 
 #include "opencnc/canon/program.hpp"
 #include "opencnc/control/servo_config.hpp"
+#include "opencnc/controller/program_source.hpp"
 #include "opencnc/core/axes.hpp"
 #include "opencnc/core/diagnostic.hpp"
+#include "opencnc/plan/machine_limits.hpp"
 
 namespace opencnc::control {
 
@@ -29,5 +31,23 @@ double move_length(const canon::Program& program, canon::SegmentId id);
 /// axis that would cross a limit, with the move's file and line, and returns false if there was
 /// any. Non-real-time; O(moves).
 bool check_soft_limits(const canon::Program& program, const ServoConfig& config, Diagnostics& diags);
+
+/// What every move passes before it may run: the soft limits of the joints (as
+/// check_soft_limits) and the planner's own checks (plan::check_move). The preflight scan uses
+/// it on every move of a program, the controller again on every move of a running one (where
+/// a real probe result or input value may have changed it). Non-real-time; one thread.
+class MachineMoveCheck final : public MoveCheck {
+ public:
+  MachineMoveCheck(const ServoConfig& config, const plan::MachineLimits& limits) : config_(config), limits_(limits) {}
+  bool check(const canon::Program& program, canon::SegmentId move, Diagnostics& diags) override;
+  /// Soft-limit crossings after the first few are counted, not listed: adds one line for them
+  /// (call after the last check of a scan) and starts counting afresh.
+  void finish(Diagnostics& diags) override;
+
+ private:
+  ServoConfig config_;
+  plan::MachineLimits limits_;
+  int soft_limit_errors_ = 0;
+};
 
 }  // namespace opencnc::control

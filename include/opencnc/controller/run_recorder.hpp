@@ -13,6 +13,7 @@
 #include "opencnc/analysis/trace_checker.hpp"
 #include "opencnc/canon/program.hpp"
 #include "opencnc/control/status.hpp"
+#include "opencnc/controller/observer.hpp"
 #include "opencnc/plan/machine_limits.hpp"
 
 namespace opencnc::control {
@@ -31,16 +32,30 @@ struct RunReport {
   std::uint64_t samples = 0;
 };
 
-/// Accumulates the samples of one run. Non-real-time; the program must outlive the recorder.
-class RunRecorder {
+/// Accumulates the samples of program runs: attach it to a controller with trace on (it takes
+/// the Program activity's samples), or feed it samples with add(). Non-real-time.
+class RunRecorder final : public ControllerObserver {
  public:
+  RunRecorder(const plan::MachineLimits& limits, double period_s);
+  /// For samples of one whole program (its moves numbered as in `program`, which must outlive
+  /// the recorder).
   RunRecorder(const canon::Program& program, const plan::MachineLimits& limits, double period_s);
 
-  /// One period of the run (call for the run's samples only, in order).
+  /// One period of a run, with the program window its segment ids refer to (null: none; the
+  /// contour error is not measured then). In order.
+  void add(const TraceSample& s, const TraceContext& c);
+  /// One period of the run of the program given at construction.
   void add(const TraceSample& s);
   RunReport report() const;
 
+  void on_trace(const TraceSample& s, const TraceContext& c) override {
+    if (s.activity == Activity::Program) add(s, c);
+  }
+
  private:
+  void begin(const Pose& start);
+  const canon::Program* fixed_ = nullptr;
+  bool started_ = false;
   plan::MachineLimits limits_;
   double period_s_;
   analysis::TraceChecker commanded_;

@@ -13,6 +13,7 @@
 #include "opencnc/core/diagnostic.hpp"
 #include "opencnc/gcode/options.hpp"
 #include "opencnc/gcode/state.hpp"
+#include "opencnc/tools/tool_table.hpp"
 
 namespace opencnc::gcode {
 
@@ -27,7 +28,16 @@ enum class RunStatus : std::uint8_t {
 };
 
 /// What the machine reports at a sync point (Options::Mode::Execute).
-enum class SyncKind : std::uint8_t { None, Probe, Input, ToolChange };
+enum class SyncKind : std::uint8_t {
+  None,
+  Probe,        ///< G38.x: the trip position and whether it tripped (#5061-#5070)
+  Input,        ///< M66: the value read (#5399)
+  ToolChange,   ///< M6, M61: where the machine stands after the change
+  ProgramStop,  ///< M0, M1, M60: the operator continues (and may have changed offsets meanwhile)
+};
+
+/// "probe", "input", "tool change", "program stop" ("" for None). Any thread.
+const char* to_string(SyncKind k) noexcept;
 
 /// Values supplied with Interpreter::sync(). Positions in the program units and work
 /// coordinates the interpreter used for the move (as LinuxCNC's canon reports them).
@@ -42,6 +52,8 @@ struct SyncValues {
   /// Set by the interpreter in the request (G38.2, G38.4): a sync() without probe_tripped
   /// ends the run with `gcode.probe-no-contact` on the probe block. Ignored in sync() values.
   bool contact_required = false;
+  /// Set by the interpreter: G38.2/G38.3 seek contact, G38.4/G38.5 its loss.
+  bool seeks_contact = true;
 };
 
 /// One interpreter run. Non-real-time; one thread at a time (the planner's feeder thread).
@@ -68,15 +80,36 @@ class Interpreter {
   RunStatus run(canon::Sink& sink);
   /// Executes one block (streaming, bounded read-ahead). Interpreter thread; non-real-time.
   RunStatus step(canon::Sink& sink);
+  /// Executes at most `max_blocks` blocks (Ok: more follow), stopping at a sync point, the
+  /// end or an error: what a controller streaming the program calls. Interpreter thread.
+  RunStatus run(canon::Sink& sink, std::uint64_t max_blocks);
   /// Executes one line typed by the operator (no program needed; O-word calls read their
   /// subprogram from the search path). Interpreter thread; non-real-time.
   RunStatus execute_mdi(std::string_view line, canon::Sink& sink);
+  /// After a sync point inside a subprogram an MDI line called: runs the call on (Ok once the
+  /// line is done, NeedSync at the next sync point, Error). Interpreter thread.
+  RunStatus continue_mdi(canon::Sink& sink);
   /// What the pending sync point waits for (None when not waiting).
   SyncKind pending_sync() const noexcept;
+  /// The pending sync point's request: its kind and, for probes, whether contact is required
+  /// (the values are what a scan would assume). Interpreter thread.
+  const SyncValues& sync_request() const noexcept;
   /// Supplies machine feedback and releases the sync point. A G38.2/G38.4 result without
   /// contact ends the run (`gcode.probe-no-contact`; the next run() returns Error).
   /// Interpreter thread.
   void sync(const SyncValues& values);
+
+  /// Where the machine is (mm and degrees, by machine axis): the interpreter's position
+  /// becomes it, in program coordinates under the active offsets, as if it had moved there
+  /// without output (before a program or an MDI line, after a jog). Ignored while cutter
+  /// compensation is on. Interpreter thread.
+  void set_machine_position(const Pose& machine_mm);
+  /// A machine position (mm and degrees, by machine axis) in the program's units and active
+  /// work coordinates: what sync() takes. Interpreter thread.
+  Pose program_position(const Pose& machine_mm) const;
+  /// The machine's tool table changed (an operator's edit, a measurement): the interpreter's
+  /// copy becomes it, the tool in the spindle included. Interpreter thread.
+  void set_tool_table(const std::shared_ptr<const tools::ToolTable>& table);
 
   /// The exact state now (copy). Interpreter thread; non-real-time.
   InterpState state() const;

@@ -32,6 +32,12 @@ enum class MachineKind : std::uint8_t { Mill, Lathe };
 /// with #5070 = 0 and backs off towards the start, inputs read 0).
 enum class Mode : std::uint8_t { Scan, Execute };
 
+/// What a scan assumes the machine answers at sync points. Rs274 is what the stand-alone rs274
+/// assumes (above). Other gives other answers — a probe trips halfway with #5070 = 1, a digital
+/// input reads the opposite of #5399, an analog one #5399 + 1 — so that comparing two scans shows
+/// which moves rest on an assumed value (the controller's preflight does).
+enum class ScanAssumption : std::uint8_t { Rs274, Other };
+
 /// Runaway protection: exceeding any limit ends the run with a `gcode.limit-*` error that
 /// names the limit and the line. Zero means "use the default".
 struct Limits {
@@ -58,6 +64,7 @@ struct Options {
   Dialect dialect = Dialect::LinuxCnc;
   MachineKind machine = MachineKind::Mill;   ///< used by the Fanuc dialect
   Mode mode = Mode::Scan;
+  ScanAssumption scan_assumption = ScanAssumption::Rs274;
   /// Axes the machine has; an axis word outside the mask is an error (as in rs274, whose
   /// default is XYZABC).
   AxisMask axes = kXyzabc;

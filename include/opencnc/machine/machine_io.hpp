@@ -143,6 +143,12 @@ struct MachineInputs {
   PowerInputs power{};
   SpindleInputs spindle{};
   bool probe = false;  ///< probe input active (optional)
+  /// Optional: every joint's position where the probe input last changed state, captured at the
+  /// edge (encoder latches of Mesa cards, EtherCAT touch probe), and a count of the edges so
+  /// far. A backend without a latch leaves the count at 0; the servo then estimates the edge
+  /// from its own samples.
+  std::uint32_t probe_edges = 0;
+  std::array<double, kMaxJoints> probe_latch{};
   ProcessInputs process{};
   ToolChangerInputs tool{};
   std::uint64_t digital_in = 0;                     ///< bit i = generic digital input i (M66 P)

@@ -65,6 +65,8 @@ class SimMachine final : public MachineIO {
   std::array<SimJoint, kMaxJoints> joints_{};
   SimSpindle spindle_;
   SimSwitch probe_;
+  double probe_table_ = 0;  ///< the probe joint's table position at the last sample
+  std::array<double, kMaxJoints> previous_feedback_{};  ///< the encoders at the sample before
   SplitMix64 rng_;
   // The outputs latched by the last write() that the machine uses between writes.
   bool estop_release_ = false;

@@ -2,6 +2,7 @@
 // A switch of the simulated machine: a position window with hysteresis and seeded noise.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 
 #include "opencnc/machine/sim_config.hpp"
@@ -43,15 +44,21 @@ class SimSwitch {
     if (!window_.present) return false;
     const double jitter = noise_ > 0 ? noise_ * rng.symmetric() : 0.0;
     const double widen = active_ ? hysteresis_ : 0.0;
-    active_ = position >= window_.from - widen + jitter && position <= window_.to + widen + jitter;
+    const double from = window_.from - widen + jitter, to = window_.to + widen + jitter;
+    active_ = position >= from && position <= to;
+    // The switching point this evaluation used nearest to the position: where an edge happened.
+    edge_ = std::abs(position - from) <= std::abs(position - to) ? from : to;
     return active_;
   }
+  /// The switching point of the last update() nearest to its position (with its noise).
+  double edge() const noexcept { return edge_; }
 
  private:
   SwitchWindow window_{};
   double hysteresis_ = 0;
   double noise_ = 0;
   bool active_ = false;
+  double edge_ = 0;
 };
 
 }  // namespace opencnc::machine

@@ -15,6 +15,12 @@
 
 namespace opencnc::plan {
 
+/// Checks move `id` of `program` against the machine as start() checks every move: finite
+/// coordinates, configured axes, a positive feed, a valid arc, a supported kind. Errors go to
+/// `diags` with the move's file and line. Non-real-time.
+bool check_move(const canon::Program& program, canon::SegmentId id, const MachineLimits& limits,
+                Diagnostics& diags);
+
 /// Planner settings (the machine profile's [trajectory] part).
 struct PlannerConfig {
   double servo_period_s = 1e-3;        ///< must equal the interpolator's period
@@ -59,6 +65,26 @@ class Planner {
   /// Checks the whole program, then prepares to plan it. On any error nothing is planned,
   /// diagnostics() holds `file:line: message` entries and false is returned. Non-real-time.
   bool start(const canon::Program& program);
+
+  // --- streaming: the program grows while it is planned (the controller's execution) -------
+  /// Prepares to plan `program` as it grows. Nothing is read until stream_readable(); moves are
+  /// not checked here (check_move() them before they become readable). Non-real-time.
+  bool start_stream(const canon::Program& program);
+  /// Moves [0, moves) of the stream are checked and may be planned (with the actions before
+  /// and right after them). Non-real-time.
+  void stream_readable(std::size_t moves) noexcept;
+  /// What is readable ends at a sync point (the interpreter waits for the machine there): plan
+  /// it to a stop and publish all of it; reading goes on once it is published. Non-real-time.
+  void stream_flush() noexcept;
+  /// No more moves will come: the end of what is readable is the program's end. Non-real-time.
+  void stream_end() noexcept;
+  /// Streaming: every readable move has been read and the look-ahead could use more: the
+  /// moment to read further in the program. Non-real-time.
+  bool wants_input() const noexcept;
+  /// Streaming: the first move and action the planner may still read (the stream may free
+  /// what lies before them). Non-real-time.
+  std::size_t oldest_move_needed() const noexcept;
+  std::size_t oldest_action_needed() const noexcept;
 
   /// Plans ahead and pushes every block that is final into `queue`, as far as it has room.
   /// The queue's block numbering continues from its pushed() count. Non-real-time.

@@ -57,6 +57,9 @@ class ToolTable {
   void replace(std::size_t index, ToolEntry entry);
 
   const std::vector<ToolEntry>& entries() const noexcept { return entries_; }
+  /// The table as `.tbl` text that parse() reads back to an equal table (numbers in their
+  /// shortest exact form; zero offsets left out, as LinuxCNC writes them). Any thread.
+  std::string format() const;
   bool operator==(const ToolTable& other) const noexcept { return entries_ == other.entries_; }
 
  private:

@@ -74,6 +74,9 @@ struct TickOutput {
   std::uint32_t line = 0;     ///< its source line
   std::uint32_t context = 0;  ///< its SourceMap context
   double block_offset = 0;    ///< s within that block
+  /// Path length from the start of `segment` to the commanded position (the block's
+  /// segment_offset + block_offset): where inside its move the machine is.
+  double segment_offset = 0;
   int event_count = 0;
   std::array<TickEvent, kMaxTickEvents> events{};
   bool spindle_synced = false;  ///< following the spindle (G33) with a constant lag
@@ -190,6 +193,7 @@ class Interpolator {
     std::uint64_t seq = 0, segment = 0, segment_first = 0, segment_last = 0;
     std::uint32_t line = 0, context = 0;
     double offset = 0;
+    double segment_offset = 0;  ///< the block's own segment_offset
   } shown_;
 };
 

@@ -55,6 +55,8 @@ enum BlockFlag : std::uint8_t {
 
 /// Sentinel for "no block": links that point nowhere.
 inline constexpr std::uint64_t kNoBlock = ~std::uint64_t{0};
+/// Sentinel for a marker without a program action (a probe move's sync, an implied end).
+inline constexpr std::uint32_t kNoAction = ~std::uint32_t{0};
 
 /// One queue record. Plain data, no pointers, trivially copyable, the same size for every kind,
 /// so the queue can live in shared memory between the planning process and a HAL component.
@@ -77,7 +79,10 @@ struct MotionBlock {
   MarkerKind marker = MarkerKind::None;
   FeedClass feed_class = FeedClass::Feed;
   std::uint8_t flags = 0;
-  std::uint32_t action = 0;  ///< Marker: index into Program::actions()
+  std::uint32_t action = 0;  ///< Marker: index of a Program action, or kNoAction
+  /// Path length from the start of `segment` to this block's start (a blend or a split
+  /// trims it; for a G64 Q merge, along the merged line): where in its move the block begins.
+  double segment_offset = 0;
 
   // --- geometry ----------------------------------------------------------------------------
   double length = 0;             ///< s range [0, length]; 0 for markers

@@ -1,0 +1,83 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// How features plug into the controller: observers that receive its events, status and trace, and
+// features that also answer requests of their own (the journal writer, path retrace, the tool
+// guard, the HMI server). See docs/code-overview.md, "Where features plug in".
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include "opencnc/canon/program.hpp"
+#include "opencnc/config/machine_profile.hpp"
+#include "opencnc/control/status.hpp"
+#include "opencnc/controller/controller_status.hpp"
+#include "opencnc/controller/events.hpp"
+#include "opencnc/controller/request.hpp"
+
+namespace opencnc::control {
+
+/// The answer to a request.
+struct Outcome {
+  bool accepted = false;
+  Refusal refusal = Refusal::None;
+  std::string message;      ///< why it was refused, in words
+  Diagnostics diagnostics;  ///< program problems (open, MDI, cycle start)
+};
+
+/// What a trace sample refers to: the program window of the run it belongs to (its moves are
+/// held until every observer has seen the samples on them), and the job's move number of the
+/// window's first move. `program` is null for samples of a run no longer held.
+struct TraceContext {
+  const canon::Program* program = nullptr;
+  std::uint64_t first_move = 0;
+  JobKind job = JobKind::None;
+  std::uint32_t job_id = 0;
+};
+
+/// Receives what the controller does. Every call comes from the controller's thread, inside
+/// Controller::service(), in order: a slow observer slows the controller (never the servo);
+/// hand work to a thread of your own if it may block. Exceptions are caught: the observer is
+/// detached and a note says so.
+class ControllerObserver {
+ public:
+  virtual ~ControllerObserver() = default;
+  /// Every entry of the event log from the moment of attaching, in order.
+  virtual void on_event(const ControllerEvent& /*e*/) {}
+  /// The status, at the rate asked for (ObserverOptions::status_period_s).
+  virtual void on_status(const ControllerStatus& /*s*/) {}
+  /// Every servo period of a program run while tracing (ObserverOptions::trace).
+  virtual void on_trace(const TraceSample& /*s*/, const TraceContext& /*c*/) {}
+};
+
+struct ObserverOptions {
+  double status_period_s = 0;  ///< on_status every this much servo time (0: never)
+  bool trace = false;          ///< on_trace for every period of program runs
+};
+
+/// What a feature may do from the controller's thread while it handles a request or observes.
+class FeatureHost {
+ public:
+  virtual ~FeatureHost() = default;
+  /// Queues a request as a front end would (it is handled in this or the next service()).
+  virtual std::uint64_t submit(Request r) = 0;
+  /// The status as of the last service().
+  virtual const ControllerStatus& current_status() const = 0;
+  virtual const config::MachineProfile& profile() const = 0;
+  /// A note for the operator, in the event log.
+  virtual void note(Severity severity, std::string code, std::string text) = 0;
+};
+
+/// An observer that also answers requests::Feature requests addressed to its name().
+class Feature : public ControllerObserver {
+ public:
+  /// The name requests address ("retrace", "journal", …). Unique per controller.
+  virtual std::string_view name() const = 0;
+  /// Called once when added (Controller::add_feature), from the controller's thread.
+  virtual void attached(FeatureHost& /*host*/) {}
+  /// Handles one request addressed to this feature. Controller thread.
+  virtual Outcome handle(const requests::Feature& request, FeatureHost& host) = 0;
+};
+
+}  // namespace opencnc::control

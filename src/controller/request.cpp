@@ -1,0 +1,138 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Requests: their names, and the servo commands they stand for.
+#include "opencnc/controller/request.hpp"
+
+#include <type_traits>
+
+namespace opencnc::control {
+
+namespace {
+
+template <class... Fs>
+struct Overload : Fs... {
+  using Fs::operator()...;
+};
+template <class... Fs>
+Overload(Fs...) -> Overload<Fs...>;
+
+const char* override_name(OverrideKind k) {
+  switch (k) {
+    case OverrideKind::Feed:
+      return "feed-override";
+    case OverrideKind::Rapid:
+      return "rapid-override";
+    case OverrideKind::Spindle:
+      return "spindle-override";
+  }
+  return "override";
+}
+
+const char* switch_name(SwitchKind k) {
+  switch (k) {
+    case SwitchKind::SingleBlock:
+      return "single-block";
+    case SwitchKind::OptionalStop:
+      return "optional-stop";
+    case SwitchKind::BlockDelete:
+      return "block-delete";
+  }
+  return "switch";
+}
+
+Command command(CommandKind k) {
+  Command c;
+  c.kind = k;
+  return c;
+}
+
+std::int8_t axis_index(std::optional<Axis> a) {
+  return a ? static_cast<std::int8_t>(index(*a)) : std::int8_t{-1};
+}
+
+}  // namespace
+
+std::string Request::name() const {
+  return std::visit(Overload{
+                        [](const requests::Servo& r) -> std::string { return to_string(r.kind); },
+                        [](const requests::SetMode&) -> std::string { return "set-mode"; },
+                        [](const requests::Jog&) -> std::string { return "jog"; },
+                        [](const requests::JogBy&) -> std::string { return "jog-by"; },
+                        [](const requests::JogStop&) -> std::string { return "jog-stop"; },
+                        [](const requests::Home&) -> std::string { return "home"; },
+                        [](const requests::SetOverride& r) -> std::string { return override_name(r.which); },
+                        [](const requests::SetSwitch& r) -> std::string { return switch_name(r.which); },
+                        [](const requests::SpindleOn&) -> std::string { return "spindle-on"; },
+                        [](const requests::SetCoolant&) -> std::string { return "coolant"; },
+                        [](const requests::OpenFile&) -> std::string { return "open"; },
+                        [](const requests::OpenCanon&) -> std::string { return "open"; },
+                        [](const requests::Mdi&) -> std::string { return "mdi"; },
+                        [](const requests::RunAuxiliary&) -> std::string { return "run-auxiliary"; },
+                        [](const requests::Feature& r) -> std::string { return r.feature + "." + r.action; },
+                    },
+                    body);
+}
+
+std::optional<Command> to_command(const Request& r) {
+  return std::visit(
+      Overload{
+          [](const requests::Servo& s) -> std::optional<Command> { return command(s.kind); },
+          [](const requests::SetMode& s) -> std::optional<Command> {
+            Command c = command(CommandKind::SetMode);
+            c.mode = s.mode;
+            return c;
+          },
+          [](const requests::Jog& s) -> std::optional<Command> {
+            Command c = command(CommandKind::JogContinuous);
+            c.axis = axis_index(s.axis);
+            c.value = s.velocity;
+            return c;
+          },
+          [](const requests::JogBy& s) -> std::optional<Command> {
+            Command c = command(CommandKind::JogIncrement);
+            c.axis = axis_index(s.axis);
+            c.value = s.distance;
+            c.value2 = s.speed;
+            return c;
+          },
+          [](const requests::JogStop& s) -> std::optional<Command> {
+            Command c = command(CommandKind::JogStop);
+            c.axis = axis_index(s.axis);
+            return c;
+          },
+          [](const requests::Home& s) -> std::optional<Command> {
+            Command c = command(CommandKind::Home);
+            c.axis = axis_index(s.axis);
+            return c;
+          },
+          [](const requests::SetOverride& s) -> std::optional<Command> {
+            Command c = command(s.which == OverrideKind::Feed    ? CommandKind::SetFeedOverride
+                                : s.which == OverrideKind::Rapid ? CommandKind::SetRapidOverride
+                                                                 : CommandKind::SetSpindleOverride);
+            c.value = s.value;
+            return c;
+          },
+          [](const requests::SetSwitch& s) -> std::optional<Command> {
+            if (s.which == SwitchKind::BlockDelete) return std::nullopt;  // the controller's
+            Command c = command(s.which == SwitchKind::SingleBlock ? CommandKind::SetSingleBlock
+                                                                   : CommandKind::SetOptionalStop);
+            c.flag = s.on;
+            return c;
+          },
+          [](const requests::SpindleOn& s) -> std::optional<Command> {
+            Command c = command(CommandKind::SpindleOn);
+            c.value = s.rpm;
+            c.flag = s.clockwise;
+            return c;
+          },
+          [](const requests::SetCoolant& s) -> std::optional<Command> {
+            Command c = command(CommandKind::Coolant);
+            c.coolant = s.which;
+            c.flag = s.on;
+            return c;
+          },
+          [](const auto&) -> std::optional<Command> { return std::nullopt; },
+      },
+      r.body);
+}
+
+}  // namespace opencnc::control
