@@ -373,6 +373,7 @@ class Engine final : public ParamHost, public ExecContext {
   bool units_programmed_ = false;   ///< a G20/G21 was met (for the units warning)
   bool warned_units_ = false;
   bool warned_spindle_ = false;
+  bool warned_repeat_ = false;      ///< M99 ended the main program (the repeat warning)
   double user_to_program_factor_ = 1.0;
   std::uint32_t line_ = 0;          ///< line number of the block being executed
   std::uint32_t line_file_ = 0;     ///< its file

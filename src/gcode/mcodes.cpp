@@ -406,6 +406,12 @@ void Engine::convert_stop() {
             "M99 returns from a subprogram only at the start of its line: put the other words on a line of their "
             "own");
   if (opt_.main_m99 == MainM99::Repeat) return repeat_main();
+  // Read as rs274 reads it; a reader of the scan (a preflight, `opencnc check`) should know
+  // that the machine will not stop here.
+  if (!in_mdi_)
+    warn_once(warned_repeat_, ErrorCode::MainProgramRepeats,
+              "M99 in the main program: the scan ends here, but a run on the machine starts the program "
+              "again from its first line, endlessly, until the operator stops it");
   end_program(m);
 }
 

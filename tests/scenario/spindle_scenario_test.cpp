@@ -180,4 +180,34 @@ TEST(SpindleScenario, ArcsOffTheirCircleRunAsSpiralsWithinTheLimits) {
   EXPECT_NEAR(s.status().servo.commanded[Axis::Y], -299.75, 1e-9);
 }
 
+// M99 in the main program: LinuxCNC's task starts the program again from its first line with the
+// state as it is (the counter below goes on counting), until the operator stops the run.
+TEST(EndlessProgramScenario, M99InTheMainProgramRepeatsItUntilTheOperatorStops) {
+  Scenario s(mill());
+  TempProgram p("warmup.ngc",
+                "G21 G90 F6000\n"
+                "#<_pass> = [#<_pass> + 1]\n"
+                "G1 X[#<_pass> * 2] Y0\n"
+                "G1 Y10\n"
+                "G0 Y0\n"
+                "M99\n");
+  s.on(Mode::Auto);
+  const Outcome opened = s.ask(Request::open(p.path()));
+  ASSERT_TRUE(opened.accepted) << s.message();
+  // The preflight reads the program once, as rs274 does, and says that a run repeats it.
+  bool warned = false;
+  for (const auto& d : opened.diagnostics.items()) warned = warned || d.code == "gcode.main-program-repeats";
+  EXPECT_TRUE(warned) << s.message();
+  const std::uint64_t finished = s.status().runs_finished;
+  s.must(Request::simple(CommandKind::CycleStart));
+  // Ten passes: X steps 2 mm each time round.
+  ASSERT_TRUE(s.until([&] { return s.status().servo.commanded[Axis::X] >= 20.0 - 1e-9; }, 200000));
+  EXPECT_TRUE(s.status().run_active);
+  s.must(Request::simple(CommandKind::Abort));
+  ASSERT_TRUE(s.idle(20000));
+  EXPECT_FALSE(s.status().run_active);
+  EXPECT_EQ(s.status().runs_finished, finished);   // stopped, never finished
+  EXPECT_EQ(s.report().limit_violations, 0u);
+}
+
 }  // namespace opencnc::control::test

@@ -253,7 +253,8 @@ namespace opencnc::gcode {
   X(NoProgram, "gcode.no-program")                                           \
   /* warnings (the program runs; opencnc check and scan report them) */     \
   X(UnitsNotProgrammed, "gcode.units-not-programmed")                        \
-  X(FeedWithSpindleStopped, "gcode.feed-with-spindle-stopped")
+  X(FeedWithSpindleStopped, "gcode.feed-with-spindle-stopped")              \
+  X(MainProgramRepeats, "gcode.main-program-repeats")
 
 enum class ErrorCode : std::uint16_t {
 #define OPENCNC_GCODE_ENUM(e, id) e,
