@@ -175,7 +175,7 @@ TraceChecker::TraceChecker(const plan::MachineLimits& limits, double period_s, d
 double TraceChecker::box_distance(canon::SegmentId id, const Pose& p) const {
   const Pose a = program_->start_of(id), b = program_->end(id);
   double grow = 0;
-  if (program_->move(id).kind == canon::MoveKind::RigidTap) return 0;   // its line has no box
+  if (program_->move(id).kind == canon::MoveKind::RigidTap) return 0;  // its line has no box
   if (program_->move(id).kind == canon::MoveKind::Arc) {
     const canon::ArcGeometry& g = program_->arc(id);
     const int b0 =

@@ -63,7 +63,7 @@ void ProgramBuilder::set_g5x_offset(int index, const Pose& offset) {
   Action a = make(ActionKind::WorkOffset, index);
   a.pose = program_.add_action_pose(g5x_);
   add(a);
-  if (css_max_rpm_ > 0) add_spindle_speed(0);   // the spindle axis moved (LinuxCNC's canon)
+  if (css_max_rpm_ > 0) add_spindle_speed(0);  // the spindle axis moved (LinuxCNC's canon)
 }
 
 void ProgramBuilder::set_g92_offset(const Pose& offset) {
@@ -211,7 +211,7 @@ void ProgramBuilder::rigid_tap(SegmentId id, const Pose& end, double scale) {
   // next move starts where the tap started. Their feed is the way out's speed factor.
   const Pose start = position_;
   const std::uint32_t factor = program_.add_feed(scale);
-  last_feed_mm_ = -1;   // later moves refer to a feed added after this one (streams release in order)
+  last_feed_mm_ = -1;  // later moves refer to a feed added after this one (streams release in order)
   const std::size_t first = program_.size();
   to_machine(end, position_);
   append(MoveKind::RigidTap, id, factor);

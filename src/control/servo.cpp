@@ -305,8 +305,10 @@ void Servo::write_spindle(bool on) noexcept {
   machine::SpindleDirection dir = spindle_direction_;
   if (activity_ == Activity::Program && tick_out_.tap_reverse) {
     rpm *= tick_out_.tap_speed_scale;
-    if (dir == machine::SpindleDirection::Clockwise) dir = machine::SpindleDirection::Counterclockwise;
-    else if (dir == machine::SpindleDirection::Counterclockwise) dir = machine::SpindleDirection::Clockwise;
+    if (dir == machine::SpindleDirection::Clockwise)
+      dir = machine::SpindleDirection::Counterclockwise;
+    else if (dir == machine::SpindleDirection::Counterclockwise)
+      dir = machine::SpindleDirection::Clockwise;
   }
   if (config_.spindle_max_rpm > 0) rpm = std::min(rpm, config_.spindle_max_rpm);
   out_.spindle.speed_rpm = on ? rpm : 0.0;

@@ -221,7 +221,7 @@ Refusal Servo::manual_spindle_or_coolant(const Command& c) noexcept {
     case CommandKind::SpindleOn:
       if (!(c.value > 0 && c.value <= std::max(config_.spindle_max_rpm, 0.0))) return Refusal::BadValue;
       spindle_rpm_ = c.value;
-      css_max_rpm_ = 0;   // the operator's speed is in rpm
+      css_max_rpm_ = 0;  // the operator's speed is in rpm
       spindle_direction_ =
           c.flag ? machine::SpindleDirection::Clockwise : machine::SpindleDirection::Counterclockwise;
       spindle_changed_tick_ = tick_;

@@ -316,10 +316,12 @@ void Engine::check_word_rules(const Block& b) {
 void Engine::check_m98(const Block& b) {
   const int at = b.o_at;
   if (!b.has('p'))
-    fail_at(at, ErrorCode::FanucCallProgramMissing, "M98 needs a P word: the number of the subprogram (O number) to call");
+    fail_at(at, ErrorCode::FanucCallProgramMissing,
+            "M98 needs a P word: the number of the subprogram (O number) to call");
   const double p = b.get('p');
   if (std::fabs(p - std::floor(p + 0.5)) > 0.0001)
-    fail_at(b.word_position('p'), ErrorCode::NotAnInteger, "M98 P{}: a subprogram's number is a whole number", p);
+    fail_at(b.word_position('p'), ErrorCode::NotAnInteger, "M98 P{}: a subprogram's number is a whole number",
+            p);
   Block rest = b;
   rest.o_type = OWord::None;
   rest.words &= ~((1u << ('p' - 'a')) | (1u << ('l' - 'a')));
@@ -337,7 +339,8 @@ void Engine::check_m98(const Block& b) {
   if (rest.radius_flag || rest.theta_flag) take(rest.polar_position());
   if (first >= 0)
     fail_at(first, ErrorCode::OwordSyntax,
-            "a word other than P and L on an M98 line: the line only calls the subprogram, so put it on a line of "
+            "a word other than P and L on an M98 line: the line only calls the subprogram, so put it on a "
+            "line of "
             "its own");
 }
 

@@ -92,8 +92,10 @@ void Engine::control_flow() {
     case OWord::Program:
       if (fanuc()) return fanuc_program_line();
       return o_program();
-    case OWord::M98: return o_m98();
-    case OWord::M99: return o_m99();
+    case OWord::M98:
+      return o_m98();
+    case OWord::M99:
+      return o_m99();
     case OWord::Goto:
     case OWord::FanucWhile:
     case OWord::FanucEnd:
@@ -104,8 +106,10 @@ void Engine::control_flow() {
 }
 
 void Engine::mixed_styles(const char* what) const {
-  fail(ErrorCode::OwordMixedStyles, "{}: numbered subprograms (O{} ... M99, called by M98) and O-word ones "
-       "(o{} sub ... endsub, called by 'call') do not mix", what, block_.o_name, block_.o_name);
+  fail(ErrorCode::OwordMixedStyles,
+       "{}: numbered subprograms (O{} ... M99, called by M98) and O-word ones "
+       "(o{} sub ... endsub, called by 'call') do not mix",
+       what, block_.o_name, block_.o_name);
 }
 
 void Engine::o_sub() {
@@ -213,7 +217,8 @@ void Engine::enter_sub(CallFrame frame, std::string name, std::string_view conte
     c.seeking_sub = name;
     c.skip_start_line = line_;
   }
-  st_.frames.back().context = sources_->context(parent_context, call_site, st_.next.file, std::string(context_name));
+  st_.frames.back().context =
+      sources_->context(parent_context, call_site, st_.next.file, std::string(context_name));
 }
 
 // A bare O number. Where an M98 looked for it, the numbered subprogram starts here; in the
@@ -239,8 +244,9 @@ void Engine::o_program() {
 // its own line, which is read again.
 void Engine::o_m98() {
   if (!parser_.numbered_assignments.empty() || !parser_.named_assignments.empty())
-    fail_at(block_.o_at, ErrorCode::OwordSyntax,
-            "a parameter assignment on an M98 line: LinuxCNC would not make it, so put it on a line of its own");
+    fail_at(
+        block_.o_at, ErrorCode::OwordSyntax,
+        "a parameter assignment on an M98 line: LinuxCNC would not make it, so put it on a line of its own");
   const std::string name = std::to_string(round_to_int(block_.get('p')));
   block_.o_name = name;
   CallFrame& caller = st_.frames.back();
@@ -266,7 +272,8 @@ void Engine::o_m99() {
   ControlState& c = st_.control;
   const CallFrame& f = st_.frames.back();
   if (f.kind != CallKind::Numbered)
-    mixed_styles(fmt::format("M99 in o<{}> (called by 'call': it ends with endsub or return)", f.sub).c_str());
+    mixed_styles(
+        fmt::format("M99 in o<{}> (called by 'call': it ends with endsub or return)", f.sub).c_str());
   c.return_value = 0;
   c.value_returned = false;
   jump_to(f.return_to);

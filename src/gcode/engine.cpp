@@ -153,7 +153,7 @@ void Engine::start() {
     const std::uint64_t body = f.tell();
     if (!next_text()) empty("holds a '%' line and nothing else");
     st_.percent_delimited = true;
-    st_.next = {st_.next.file, body, 2};   // LinuxCNC counts the '%' line as line 1
+    st_.next = {st_.next.file, body, 2};  // LinuxCNC counts the '%' line as line 1
   } else {
     // Fanuc: "%O1000(NAME)" opens the tape and numbers the program on one line.
     st_.percent_delimited = fanuc() && first.front() == '%' && fanuc_program_number(first).has_value();
@@ -498,14 +498,16 @@ void Engine::sub_not_found() {
   const bool m98 = st_.frames.back().kind == CallKind::Numbered;
   std::string message;
   if (m98) {
-    message = own_file ? fmt::format("M98 P{}: no O{} line follows in this program, and no {}.ngc is on the "
-                                     "subroutine path (a numbered subprogram comes after its first call)",
-                                     name, name, name)
+    message = own_file ? fmt::format(
+                             "M98 P{}: no O{} line follows in this program, and no {}.ngc is on the "
+                             "subroutine path (a numbered subprogram comes after its first call)",
+                             name, name, name)
                        : fmt::format("M98 P{}: {} has no O{} line", name, searched, name);
   } else {
-    message = own_file ? fmt::format("o<{}> call: no 'o<{}> sub' follows in this file, and no {}.ngc is on the "
-                                     "subroutine path",
-                                     name, name, name)
+    message = own_file ? fmt::format(
+                             "o<{}> call: no 'o<{}> sub' follows in this file, and no {}.ngc is on the "
+                             "subroutine path",
+                             name, name, name)
                        : fmt::format("o<{}> call: {} does not define o<{}> (its sub line must name it)", name,
                                      searched, name);
   }

@@ -402,9 +402,10 @@ void Engine::convert_stop() {
   }
   // M99. In a subprogram it is its return, read as such when it starts the line.
   if (st_.frames.size() > 1)
-    fail_at(block_.m_position(kGroupStop), ErrorCode::OwordSyntax,
-            "M99 returns from a subprogram only at the start of its line: put the other words on a line of their "
-            "own");
+    fail_at(
+        block_.m_position(kGroupStop), ErrorCode::OwordSyntax,
+        "M99 returns from a subprogram only at the start of its line: put the other words on a line of their "
+        "own");
   if (opt_.main_m99 == MainM99::Repeat) return repeat_main();
   // Read as rs274 reads it; a reader of the scan (a preflight, `opencnc check`) should know
   // that the machine will not stop here.
@@ -425,13 +426,14 @@ void Engine::repeat_main() {
   out_.finish();
   ++c.main_repeats;
   if (opt_.mode == Mode::Scan) {
-    const std::uint64_t limit = opt_.limits.max_main_repeats == 0 ? Limits{}.max_main_repeats
-                                                                  : opt_.limits.max_main_repeats;
+    const std::uint64_t limit =
+        opt_.limits.max_main_repeats == 0 ? Limits{}.max_main_repeats : opt_.limits.max_main_repeats;
     if (c.main_repeats > limit)
-      fail_at(block_.m_position(kGroupStop), ErrorCode::LimitMainRepeats,
-              "M99 starts the main program again, endlessly: the scan stopped after {} repetitions (limit "
-              "max_main_repeats); a run repeats it until the operator stops it (or a /M30 with block delete off)",
-              limit);
+      fail_at(
+          block_.m_position(kGroupStop), ErrorCode::LimitMainRepeats,
+          "M99 starts the main program again, endlessly: the scan stopped after {} repetitions (limit "
+          "max_main_repeats); a run repeats it until the operator stops it (or a /M30 with block delete off)",
+          limit);
   } else {
     st_.blocks_executed = 0;
     st_.loop_iterations = 0;

@@ -116,9 +116,11 @@ RawLimits spiral_limits(const MotionBlock& b, double v_max, const LimitParams& p
     if (k + lam < 1e-15) continue;
     const AxisLimits& l = p.machine[i];
     cap = std::min(cap, l.max_velocity / (k * std::hypot(grow_max, rho) + lam));
-    if (k > 0) cap = std::min(cap, std::sqrt(p.normal_share * l.max_acceleration / (om * k * (grow_max + 2 * rho))));
+    if (k > 0)
+      cap = std::min(cap, std::sqrt(p.normal_share * l.max_acceleration / (om * k * (grow_max + 2 * rho))));
     if (k > 0 && limited_jerk(p, i)) {
-      cap = std::min(cap, std::cbrt(kJerkCapShare * (1 - p.step_share) * l.max_jerk / (om * om * k * (grow_max + 3 * rho))));
+      cap = std::min(cap, std::cbrt(kJerkCapShare * (1 - p.step_share) * l.max_jerk /
+                                    (om * om * k * (grow_max + 3 * rho))));
     }
   }
   double accel = kInf;

@@ -109,7 +109,8 @@ double spiral_length(double r0, double rho, double h, double sweep) noexcept {
   double sum = 0;
   for (int k = 0; k < pieces; ++k) {
     const double mid = (k + 0.5) * step, half = 0.5 * step;
-    for (int q = 0; q < 4; ++q) sum += kWeight[q] * (speed(mid - half * kNode[q]) + speed(mid + half * kNode[q]));
+    for (int q = 0; q < 4; ++q)
+      sum += kWeight[q] * (speed(mid - half * kNode[q]) + speed(mid + half * kNode[q]));
   }
   return std::fabs(0.5 * step * sum);
 }
@@ -232,7 +233,8 @@ double spiral_triple_length(const MotionBlock& b, int first) noexcept {
   double sum = 0;
   for (int k = 0; k < pieces; ++k) {
     const double mid = (k + 0.5) * step, half = 0.5 * step;
-    for (int q = 0; q < 4; ++q) sum += kWeight[q] * (speed(mid - half * kNode[q]) + speed(mid + half * kNode[q]));
+    for (int q = 0; q < 4; ++q)
+      sum += kWeight[q] * (speed(mid - half * kNode[q]) + speed(mid + half * kNode[q]));
   }
   return 0.5 * step * sum;
 }
@@ -416,7 +418,8 @@ double distance_to(const MotionBlock& b, const Pose& p) noexcept {
     if (sweep < 0) phi = -phi;
     if (phi < 0) phi += 2 * kPi;
     double best = std::min(norm(p - b.base), norm(p - end_point(b)));
-    for (double a = phi; a <= std::fabs(sweep); a += 2 * kPi) best = std::min(best, nearest_on(b, p, a / std::fabs(b.omega)));
+    for (double a = phi; a <= std::fabs(sweep); a += 2 * kPi)
+      best = std::min(best, nearest_on(b, p, a / std::fabs(b.omega)));
     return std::min({best, nearest_on(b, p, 0.0), nearest_on(b, p, b.length)});
   }
   // Bézier: sampled (only used for short blend curves).

@@ -106,9 +106,9 @@ bool check_move(const canon::Program& program, canon::SegmentId id, const Machin
     const bool out = (m.flags & canon::kTapReturn) != 0;
     bool paired;
     if (out) {
-      paired = id > 0 && (id - 1 < program.first_held_move() ||
-                          (program.move(id - 1).kind == MoveKind::RigidTap &&
-                           !(program.move(id - 1).flags & canon::kTapReturn)));
+      paired = id > 0 &&
+               (id - 1 < program.first_held_move() || (program.move(id - 1).kind == MoveKind::RigidTap &&
+                                                       !(program.move(id - 1).flags & canon::kTapReturn)));
     } else {
       paired = id + 1 < program.size() && program.move(id + 1).kind == MoveKind::RigidTap &&
                (program.move(id + 1).flags & canon::kTapReturn);
@@ -244,7 +244,7 @@ bool ProgramReader::make_element(canon::SegmentId id, Element& e) const {
   if (m.kind == MoveKind::RigidTap) {
     b.flags |= traj::kRigidTap;
     if (m.flags & canon::kTapReturn) b.flags |= traj::kTapReturn;
-    b.tap_scale = program_->feed(id);   // the way out's spindle speed factor (G33.1 I)
+    b.tap_scale = program_->feed(id);  // the way out's spindle speed factor (G33.1 I)
   }
   const double f = program_->feed(id);
   const double ratio = feed_length_ratio(start, end, b);

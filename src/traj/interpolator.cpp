@@ -202,7 +202,7 @@ void Interpolator::update_sync(const TickInput& in) noexcept {
   const std::size_t index = index_of(u_seq_);
   const bool in_sync_block = index < queue_->available() && queue_->peek(index).kind != BlockKind::Marker &&
                              queue_->peek(index).feed_class == FeedClass::SpindleSync &&
-                             (queue_->peek(index).flags & kRigidTap) == 0;   // the tap follows on its own
+                             (queue_->peek(index).flags & kRigidTap) == 0;  // the tap follows on its own
   if (!in_sync_block) {
     sync_ = Sync::Off;
   } else {
@@ -450,8 +450,8 @@ void Interpolator::tick(const TickInput& in, TickOutput& out) noexcept {
   sync_rev_s_ = in.spindle_rev_s;
   update_sync(in);
   double s_prev = s_f_;
-  const bool tapping = run_tap(in);   // a rigid tap moves on its own; the path waits
-  if (tapping && tap_ == Tap::Off) s_prev = s_f_;   // it ended: s moved past it, the tool did not
+  const bool tapping = run_tap(in);                // a rigid tap moves on its own; the path waits
+  if (tapping && tap_ == Tap::Off) s_prev = s_f_;  // it ended: s moved past it, the tool did not
   const double integral = tapping ? s_u_ * config_.period_s : advance_unfiltered(in);
   s_f_ = filter(integral);
   advance_filtered(out);

@@ -122,7 +122,7 @@ void Interpolator::follow_spindle(const TickInput& in, const MotionBlock& b) noe
 // rest exactly there.
 void Interpolator::place_tap(const MotionBlock& b) noexcept {
   const double tau = config_.period_s, A = b.accel;
-  const double dir = tap_depth_ > 0 ? -1.0 : 1.0;   // toward depth 0
+  const double dir = tap_depth_ > 0 ? -1.0 : 1.0;  // toward depth 0
   const double dist = std::fabs(tap_depth_), u = dir * tap_v_;
   const double v_end = stop_speed_limit(dist, u, A, tau);
   if (v_end < 0 || (dist < 1e-12 && std::fabs(u) <= A * tau)) {
@@ -156,7 +156,8 @@ void Interpolator::finish_tap() noexcept {
 void Interpolator::show_tap(TickOutput& out) noexcept {
   const MotionBlock& b = queue_->peek(index_of(u_seq_));
   for (int i = 0; i < kAxisCount; ++i) position_[i] = b.base[i] + tap_depth_ * b.lin[i];
-  shown_ = Shown{b.seq, b.segment, b.segment_first, b.segment_last, b.line, b.context, std::max(0.0, tap_depth_)};
+  shown_ =
+      Shown{b.seq, b.segment, b.segment_first, b.segment_last, b.line, b.context, std::max(0.0, tap_depth_)};
   out.position = position_;
   out.path_velocity = std::fabs(tap_v_);
   out.block_seq = shown_.seq;

@@ -79,10 +79,10 @@ TEST(ProgramBuilder, ARigidTapEndsWhereItStarted) {
   ASSERT_EQ(p.size(), 3u);
   EXPECT_EQ(p.move(1).kind, MoveKind::RigidTap);
   EXPECT_EQ(p.move(1).flags & kTapReturn, 0);
-  EXPECT_EQ(p.end(1)[Axis::Z], -10.0);   // the bottom of the tap
+  EXPECT_EQ(p.end(1)[Axis::Z], -10.0);  // the bottom of the tap
   EXPECT_EQ(p.move(2).kind, MoveKind::RigidTap);
   EXPECT_NE(p.move(2).flags & kTapReturn, 0);
-  EXPECT_EQ(p.end(2)[Axis::Z], 5.0);     // back at the start
+  EXPECT_EQ(p.end(2)[Axis::Z], 5.0);  // back at the start
   EXPECT_EQ(p.feed(1), 2.5);
   EXPECT_EQ(p.feed(2), 2.5);
   EXPECT_EQ(p.segment_of(2), 1u);
@@ -102,15 +102,15 @@ TEST(ProgramBuilder, UnderG96TheSpindleSpeedIsASurfaceSpeedAboutTheSpindleAxis) 
   Pose g5x{};
   g5x[Axis::X] = 12;
   b.set_g5x_offset(1, g5x);
-  b.set_spindle_speed(0, 800);     // G97: rpm
-  b.set_spindle_mode(0, 2000);     // G96 D2000
-  b.set_spindle_speed(0, 150);     // S150: m/min
+  b.set_spindle_speed(0, 800);  // G97: rpm
+  b.set_spindle_mode(0, 2000);  // G96 D2000
+  b.set_spindle_speed(0, 150);  // S150: m/min
   Pose g92{};
   g92[Axis::X] = 3;
-  b.set_g92_offset(g92);           // the spindle axis moves: the speed is given again
+  b.set_g92_offset(g92);  // the spindle axis moves: the speed is given again
   b.use_length_units(Units::Inch);
-  b.set_spindle_speed(0, 400);     // ft/min
-  b.set_spindle_mode(0, 0);        // G97
+  b.set_spindle_speed(0, 400);  // ft/min
+  b.set_spindle_mode(0, 0);     // G97
   b.set_spindle_speed(0, 500);
   std::vector<Action> speeds;
   for (std::size_t k = 0; k < b.program().action_count(); ++k) {
@@ -121,7 +121,7 @@ TEST(ProgramBuilder, UnderG96TheSpindleSpeedIsASurfaceSpeedAboutTheSpindleAxis) 
   EXPECT_EQ(speeds[0].index2, 0);
   EXPECT_EQ(speeds[0].value, 800);
   EXPECT_EQ(speeds[1].index2, 1);
-  EXPECT_EQ(speeds[1].value, 150000);   // mm/min
+  EXPECT_EQ(speeds[1].value, 150000);  // mm/min
   EXPECT_EQ(b.program().action_pose(speeds[1].pose)[Axis::X], 12);
   EXPECT_EQ(speeds[2].value, 150000);
   EXPECT_EQ(b.program().action_pose(speeds[2].pose)[Axis::X], 15);

@@ -504,7 +504,7 @@ TEST(CyclesProgram, TheBuilderSeesProbeTapAndSynchronisedMoves) {
   interp.open_text("p.ngc", "G21 F100 S300 M3\nG38.2 Z-5\nG33.1 Z-8 K1\nG33 Z-10 K1.5\nG1 X1\nM2\n");
   ASSERT_EQ(interp.run(builder), RunStatus::Finished);
   const canon::Program& p = builder.program();
-  ASSERT_EQ(p.size(), 5u);   // the tap is two moves: in, and back out
+  ASSERT_EQ(p.size(), 5u);  // the tap is two moves: in, and back out
   EXPECT_EQ(p.move(0).kind, canon::MoveKind::Probe);
   EXPECT_EQ(p.move(1).kind, canon::MoveKind::RigidTap);
   EXPECT_NE(p.move(1).flags & canon::kSpindleSynced, 0);

@@ -808,8 +808,8 @@ TEST(InterpreterErrors, AnEmptyProgramIsReportedOnItsFirstLine) {
 
 TEST(InterpreterOffsets, G28AndG30StoreAndReturnToMachinePositionsUnderARotatedSystem) {
   // G54 at X10 Y5 turned by 30 degrees: the machine origin is (-11.1603, 0.6699) in it.
-  const test::Result r = test::run(
-      "G21 G90\nG10 L2 P1 X10 Y5 R30\nG54\nG28.1\nG0 X20 Y10 Z5\nG28 X30 Y15\nG30.1\nM2\n");
+  const test::Result r =
+      test::run("G21 G90\nG10 L2 P1 X10 Y5 R30\nG54\nG28.1\nG0 X20 Y10 Z5\nG28 X30 Y15\nG30.1\nM2\n");
   ASSERT_EQ(r.status, RunStatus::Finished) << r.code();
   // #5161.. hold machine coordinates (inches for the stand-alone units), here the origin.
   EXPECT_NEAR(r.state.parameters[5161], 0.0, 1e-12);

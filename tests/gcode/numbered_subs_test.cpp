@@ -36,7 +36,7 @@ struct Outcome {
   RunStatus status = RunStatus::Ok;
   Moves sink;
   InterpState state;
-  Diagnostic error;   // the first error
+  Diagnostic error;  // the first error
 };
 
 Outcome run(const std::string& program, Options options = {}) {
@@ -82,36 +82,36 @@ class TempDir {
 // --- calls and returns -----------------------------------------------------------------------
 
 TEST(NumberedSubprograms, AnM98CallRunsTheOBodyThatFollowsAndM99ReturnsAfterTheCall) {
-  const Outcome r = run(
-      "G21 F100\n"      // 1
-      "G1 X1\n"         // 2
-      "M98 P100\n"      // 3
-      "G1 X3\n"         // 4
-      "M30\n"           // 5
-      "O100 (a sub)\n"  // 6
-      "G1 X2\n"         // 7
-      "M99\n");         // 8
+  const Outcome r =
+      run("G21 F100\n"      // 1
+          "G1 X1\n"         // 2
+          "M98 P100\n"      // 3
+          "G1 X3\n"         // 4
+          "M30\n"           // 5
+          "O100 (a sub)\n"  // 6
+          "G1 X2\n"         // 7
+          "M99\n");         // 8
   ASSERT_EQ(r.status, RunStatus::Finished) << r.error.message;
   EXPECT_EQ(feed_x(r), (std::vector<double>{1, 2, 3}));
   ASSERT_EQ(r.sink.moves.size(), 3u);
-  EXPECT_EQ(r.sink.moves[1].line, 7u);   // the body's own line
+  EXPECT_EQ(r.sink.moves[1].line, 7u);  // the body's own line
   EXPECT_EQ(r.state.frames.size(), 1u);
 }
 
 TEST(NumberedSubprograms, LRepeatsTheCallAndL0SkipsIt) {
   // #1..#30 are global for numbered subprograms: the body's count carries from call to call.
-  const Outcome r = run(
-      "G21 F100 G91\n"
-      "#1 = 0\n"
-      "M98 P7 L3\n"
-      "M98 P7 L0\n"
-      "M98 P7 L1\n"
-      "G90 G1 X[#1 * 100]\n"
-      "M30\n"
-      "O7\n"
-      "#1 = [#1 + 1]\n"
-      "G1 X1\n"
-      "M99\n");
+  const Outcome r =
+      run("G21 F100 G91\n"
+          "#1 = 0\n"
+          "M98 P7 L3\n"
+          "M98 P7 L0\n"
+          "M98 P7 L1\n"
+          "G90 G1 X[#1 * 100]\n"
+          "M30\n"
+          "O7\n"
+          "#1 = [#1 + 1]\n"
+          "G1 X1\n"
+          "M99\n");
   ASSERT_EQ(r.status, RunStatus::Finished) << r.error.message;
   EXPECT_EQ(feed_x(r), (std::vector<double>{1, 2, 3, 4, 400}));
   EXPECT_EQ(r.state.frames.size(), 1u);
@@ -119,9 +119,9 @@ TEST(NumberedSubprograms, LRepeatsTheCallAndL0SkipsIt) {
 }
 
 TEST(NumberedSubprograms, ParametersOneToThirtyAreSharedButNamedLocalsStayInTheirSub) {
-  const Outcome shared = run(
-      "G21 F100\n#5 = 2\nM98 P1\nG1 X#5 Y#<_g>\nM30\n"
-      "O1\n#5 = [#5 * 3]\n#<_g> = 4\nM99\n");
+  const Outcome shared =
+      run("G21 F100\n#5 = 2\nM98 P1\nG1 X#5 Y#<_g>\nM30\n"
+          "O1\n#5 = [#5 * 3]\n#<_g> = 4\nM99\n");
   ASSERT_EQ(shared.status, RunStatus::Finished) << shared.error.message;
   ASSERT_EQ(shared.sink.moves.size(), 1u);
   EXPECT_EQ(shared.sink.moves[0].end[Axis::X], 6);
@@ -133,20 +133,20 @@ TEST(NumberedSubprograms, ParametersOneToThirtyAreSharedButNamedLocalsStayInThei
 }
 
 TEST(NumberedSubprograms, NestedCallsAnExpressionPAndLeadingZerosNameTheSameProgram) {
-  const Outcome r = run(
-      "G21 F100\n"
-      "M98 P[50 * 2]\n"
-      "G1 X9\n"
-      "M30\n"
-      "O0100\n"
-      "G1 X1\n"
-      "M98 P200 L2\n"
-      "G1 X4\n"
-      "M99\n"
-      "O200\n"
-      "G91 G1 X1\n"
-      "G90\n"
-      "M99\n");
+  const Outcome r =
+      run("G21 F100\n"
+          "M98 P[50 * 2]\n"
+          "G1 X9\n"
+          "M30\n"
+          "O0100\n"
+          "G1 X1\n"
+          "M98 P200 L2\n"
+          "G1 X4\n"
+          "M99\n"
+          "O200\n"
+          "G91 G1 X1\n"
+          "G90\n"
+          "M99\n");
   ASSERT_EQ(r.status, RunStatus::Finished) << r.error.message;
   EXPECT_EQ(feed_x(r), (std::vector<double>{1, 2, 3, 4, 9}));
 }
@@ -191,11 +191,11 @@ TEST(NumberedSubprograms, TheCallLineHoldsPAndLOnly) {
       {"M98 L2", "fanuc.call-program-missing", 1},
       {"M98 P1.5", "gcode.not-an-integer", 5},
       {"M98 P1 L-1", "gcode.l-word-negative", 8},
-      {"M98 P1 Q3", "gcode.unused-word", 8},        // LinuxCNC's word rules first
-      {"M98 P1 F30", "gcode.oword-syntax", 8},       // what they let pass LinuxCNC ignores
+      {"M98 P1 Q3", "gcode.unused-word", 8},    // LinuxCNC's word rules first
+      {"M98 P1 F30", "gcode.oword-syntax", 8},  // what they let pass LinuxCNC ignores
       {"M98 P1 G1 X3", "gcode.oword-syntax", 8},
-      {"M98 P1 #3=7", "gcode.oword-syntax", 1},      // LinuxCNC would not assign it
-      {"G0 X1 M98 P1", "gcode.unknown-m-code", 7},   // M98 calls only at the start of a line
+      {"M98 P1 #3=7", "gcode.oword-syntax", 1},     // LinuxCNC would not assign it
+      {"G0 X1 M98 P1", "gcode.unknown-m-code", 7},  // M98 calls only at the start of a line
   };
   for (const Case& c : cases) {
     const Outcome r = run(std::string("G21 F100 G1\n") + c.line + "\nM30\nO1\nG1 X1\nM99\n");
@@ -227,9 +227,9 @@ TEST(NumberedSubprograms, TheTwoSubprogramStylesDoNotMix) {
     std::uint32_t line;
   };
   const Case cases[] = {
-      {"G21\no100 call\nM2\nO100\nM99\n", 4},                // a numbered body called with 'call'
-      {"G21\nM98 P100\nM2\no100 sub\no100 endsub\n", 4},     // an o-sub called with M98
-      {"G21\nM98 P100\nM2\nO100\no100 endsub\n", 5},         // a numbered body ended by endsub
+      {"G21\no100 call\nM2\nO100\nM99\n", 4},                   // a numbered body called with 'call'
+      {"G21\nM98 P100\nM2\no100 sub\no100 endsub\n", 4},        // an o-sub called with M98
+      {"G21\nM98 P100\nM2\nO100\no100 endsub\n", 5},            // a numbered body ended by endsub
       {"G21\no100 call\nM2\no100 sub\nM99\no100 endsub\n", 5},  // an o-sub ended by M99
   };
   for (const Case& c : cases) {
@@ -273,13 +273,14 @@ TEST(NumberedSubprograms, MainProgramM99RepeatsInExecuteModeUntilTheCallerStops)
   Interpreter interp(o);
   interp.open_text("warmup.ngc", "#<_n> = [#<_n> + 1]\nG21 F100 G91\nG1 X1\nM98 P5\nM99\nO5\nG1 Y1\nM99\n");
   Moves sink;
-  for (int i = 0; i < 100000 && sink.moves.size() < 2 * 5000; ++i) ASSERT_EQ(interp.step(sink), RunStatus::Ok) << i;
+  for (int i = 0; i < 100000 && sink.moves.size() < 2 * 5000; ++i)
+    ASSERT_EQ(interp.step(sink), RunStatus::Ok) << i;
   ASSERT_EQ(sink.moves.size(), 2u * 5000u);
   EXPECT_DOUBLE_EQ(sink.moves.back().end[Axis::X], 5000);
   EXPECT_DOUBLE_EQ(sink.moves.back().end[Axis::Y], 5000);
   EXPECT_EQ(interp.state().control.main_repeats, 4999u);
-  ASSERT_EQ(interp.state().frames.size(), 2u);   // in O5, its Y move just made
-  ASSERT_EQ(interp.step(sink), RunStatus::Ok);   // its M99
+  ASSERT_EQ(interp.state().frames.size(), 2u);  // in O5, its Y move just made
+  ASSERT_EQ(interp.step(sink), RunStatus::Ok);  // its M99
   EXPECT_EQ(interp.state().frames.size(), 1u);
 }
 
@@ -293,7 +294,7 @@ TEST(NumberedSubprograms, MainProgramM99RepeatInScanModeStopsWithAClearError) {
   EXPECT_EQ(r.error.line, 3u);
   EXPECT_EQ(r.error.col, 1u);
   EXPECT_NE(r.error.message.find("max_main_repeats"), std::string::npos) << r.error.message;
-  EXPECT_EQ(feed_x(r).size(), 5u);   // the first pass and four repetitions
+  EXPECT_EQ(feed_x(r).size(), 5u);  // the first pass and four repetitions
   // A /M30 ends the endless program once block delete is off (the operator's tidy stop).
   Options stop = o;
   stop.block_delete = false;

@@ -293,7 +293,7 @@ TEST(Planner, ARigidTapIsAPairOfSpindleSynchronisedBlocksEnteredAndLeftAtRest) {
   EXPECT_TRUE(out.flags & traj::kTapReturn);
   for (const MotionBlock* t : {&in, &out}) {
     EXPECT_EQ(t->feed_class, traj::FeedClass::SpindleSync);
-    EXPECT_DOUBLE_EQ(t->feed, 1.25);     // mm per revolution along the line
+    EXPECT_DOUBLE_EQ(t->feed, 1.25);  // mm per revolution along the line
     EXPECT_DOUBLE_EQ(t->tap_scale, 1.5);
     EXPECT_DOUBLE_EQ(t->length, 10.0);
     EXPECT_EQ(t->v_entry, 0.0);

@@ -111,10 +111,10 @@ TEST(Spiral, ClockwiseMultiTurnAndShrinkingSpiralsKeepTheirEnds) {
     canon::ArcGeometry arc;
   };
   const Case cases[] = {
-      {xyz(10, 0), xyz(-9.99, 0), xy_arc(0, 0, -1)},          // half turn clockwise, shrinking
-      {xyz(10, 0), xyz(0, -10.009, 3), xy_arc(0, 0, 3)},     // two extra turns, a helix
-      {xyz(0.05, 0), xyz(0, 0.07), xy_arc(0, 0, 1)},         // small radius, 40 % larger at the end
-      {xyz(3000, 0), xyz(-2997.5, 0), xy_arc(0, 0, 1)},      // large radius, 0.08 % smaller
+      {xyz(10, 0), xyz(-9.99, 0), xy_arc(0, 0, -1)},      // half turn clockwise, shrinking
+      {xyz(10, 0), xyz(0, -10.009, 3), xy_arc(0, 0, 3)},  // two extra turns, a helix
+      {xyz(0.05, 0), xyz(0, 0.07), xy_arc(0, 0, 1)},      // small radius, 40 % larger at the end
+      {xyz(3000, 0), xyz(-2997.5, 0), xy_arc(0, 0, 1)},   // large radius, 0.08 % smaller
   };
   for (const Case& c : cases) {
     MotionBlock b;
@@ -137,7 +137,7 @@ TEST(Spiral, ClockwiseMultiTurnAndShrinkingSpiralsKeepTheirEnds) {
     EXPECT_NEAR(plan::detail::distance_to(b, on), 0.0, 1e-9);
     if (b.lin[Axis::Z] == 0) {
       Pose out = on;
-      out[Axis::Z] += 0.5;   // off the plane: the nearest point is the one below
+      out[Axis::Z] += 0.5;  // off the plane: the nearest point is the one below
       EXPECT_NEAR(plan::detail::distance_to(b, out), 0.5, 1e-9);
     }
   }
@@ -174,9 +174,9 @@ TEST(Spiral, ArcsBeyondLinuxCncsToleranceAreStillRefused) {
 TEST(Spiral, ProgramsWithOffCircleArcsRunWithinTheLimitsOnTheSpiral) {
   const std::string program =
       "G0 X5 Y0\n"
-      "G3 X0 Y5.025 I-5 J0\n"            // 0.025 mm larger: within the absolute tolerance
-      "G3 X-5.0 Y0 Z-1 I0 J-5.025\n"     // back to 5.0 with a rise
-      "G2 X0 Y5 I5 J0 P2\n"              // a circle and a half, clockwise
+      "G3 X0 Y5.025 I-5 J0\n"         // 0.025 mm larger: within the absolute tolerance
+      "G3 X-5.0 Y0 Z-1 I0 J-5.025\n"  // back to 5.0 with a rise
+      "G2 X0 Y5 I5 J0 P2\n"           // a circle and a half, clockwise
       "G1 X0 Y300\n"
       "G2 X0 Y-299.75 I0 J-300 F3000\n"  // 0.25 mm smaller on a 300 mm radius (0.08 %)
       "M2\n";

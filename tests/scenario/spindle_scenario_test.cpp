@@ -20,10 +20,10 @@ constexpr double kTwoPi = 6.283185307179586;
 
 /// One servo period as the machine saw it.
 struct Period {
-  double z = 0, x = 0;        ///< commanded (machine) Z and X (the status: one period old)
-  double z_true = 0;          ///< the simulated Z table's true position
-  double revs = 0;            ///< the simulated spindle's true position (revolutions)
-  double rpm_cmd = 0;         ///< commanded spindle speed magnitude
+  double z = 0, x = 0;  ///< commanded (machine) Z and X (the status: one period old)
+  double z_true = 0;    ///< the simulated Z table's true position
+  double revs = 0;      ///< the simulated spindle's true position (revolutions)
+  double rpm_cmd = 0;   ///< commanded spindle speed magnitude
   machine::SpindleDirection dir = machine::SpindleDirection::Stopped;
   std::uint32_t line = 0;
 };
@@ -58,12 +58,12 @@ std::vector<Period> run_recording(Scenario& s, const std::string& path, bool& fi
 TEST(SpindleScenario, RigidTapFollowsTheSpindleThroughItsReversalAndComesBackOut) {
   Scenario s(mill());
   TempProgram p("tap.ngc",
-                "G21 G90\n"                  // 1
-                "S600 M3\n"                  // 2
-                "G0 X10 Y10 Z3\n"            // 3
-                "G33.1 Z-12 K1.25 I1.5\n"    // 4: M8 × 1.25, out at 900 rpm
-                "G0 Z20\n"                   // 5
-                "M5\n"                       // 6
+                "G21 G90\n"                // 1
+                "S600 M3\n"                // 2
+                "G0 X10 Y10 Z3\n"          // 3
+                "G33.1 Z-12 K1.25 I1.5\n"  // 4: M8 × 1.25, out at 900 rpm
+                "G0 Z20\n"                 // 5
+                "M5\n"                     // 6
                 "M2\n");
   s.on(Mode::Auto);
   bool finished = false;
@@ -99,8 +99,8 @@ TEST(SpindleScenario, RigidTapFollowsTheSpindleThroughItsReversalAndComesBackOut
   EXPECT_EQ(dirs[2], machine::SpindleDirection::Clockwise);
   EXPECT_DOUBLE_EQ(reversed_rpm, 900);
   EXPECT_LE(deepest, -12.0);
-  EXPECT_GE(deepest, -12.0 - 1.0);   // 600 rpm stopping at 4000 rpm/s: 0.75 rev = 0.94 mm
-  EXPECT_GT(highest_after, 3.0);     // out of the hole, past the start while the spindle turns back
+  EXPECT_GE(deepest, -12.0 - 1.0);  // 600 rpm stopping at 4000 rpm/s: 0.75 rev = 0.94 mm
+  EXPECT_GT(highest_after, 3.0);    // out of the hole, past the start while the spindle turns back
   // The true Z table against the spindle's true angle: one thread within 10 µm (measured 4.6 µm:
   // the drive's following error changes sign with the direction, the encoder reads 1/4096 rev).
   EXPECT_LE(worst_phase, 0.010);
@@ -108,20 +108,20 @@ TEST(SpindleScenario, RigidTapFollowsTheSpindleThroughItsReversalAndComesBackOut
   EXPECT_NEAR(t.back().z, 20.0, 1e-9);
   const RunReport r = s.report();
   EXPECT_EQ(r.limit_violations, 0u);
-  EXPECT_LE(r.max_command_contour_error_mm, 1e-9);   // on the tap's line throughout
+  EXPECT_LE(r.max_command_contour_error_mm, 1e-9);  // on the tap's line throughout
 }
 
 TEST(SpindleScenario, ConstantSurfaceSpeedDrivesTheSpindleFromXEveryPeriod) {
   Scenario s(mill());
   TempProgram p("css.ngc",
-                "G21 G90 G18\n"               // 1
-                "G10 L2 P1 X7\n"              // 2: the spindle axis at machine X 7
-                "G0 X60 Z0\n"                 // 3
-                "G96 D3000 S120 M3\n"         // 4: 120 m/min, at most 3000 rpm
-                "G1 X1 F600\n"                // 5: towards the axis
-                "G97 S900\n"                  // 6
-                "G1 X30\n"                    // 7
-                "M5\n"                        // 8
+                "G21 G90 G18\n"        // 1
+                "G10 L2 P1 X7\n"       // 2: the spindle axis at machine X 7
+                "G0 X60 Z0\n"          // 3
+                "G96 D3000 S120 M3\n"  // 4: 120 m/min, at most 3000 rpm
+                "G1 X1 F600\n"         // 5: towards the axis
+                "G97 S900\n"           // 6
+                "G1 X30\n"             // 7
+                "M5\n"                 // 8
                 "M2\n");
   s.on(Mode::Auto);
   bool finished = false;
@@ -142,7 +142,7 @@ TEST(SpindleScenario, ConstantSurfaceSpeedDrivesTheSpindleFromXEveryPeriod) {
     }
   }
   EXPECT_GT(css, 1000);
-  EXPECT_GT(clamped, 10);    // within 6.4 mm of the axis the D limit holds it
+  EXPECT_GT(clamped, 10);  // within 6.4 mm of the axis the D limit holds it
   EXPECT_GT(rpm_mode, 100);
   // The simulated spindle follows the command within its acceleration limit.
   EXPECT_GT(std::fabs(s.sim().spindle().speed_rps()), 0.0);
@@ -159,7 +159,7 @@ TEST(SpindleScenario, ConstantSurfaceSpeedWithoutDIsBoundByTheSpindlesMaximum) {
   for (const Period& q : t) {
     if (q.line == 4) highest = std::max(highest, q.rpm_cmd);
   }
-  EXPECT_DOUBLE_EQ(highest, 8000);   // configs/mill-3axis.toml: spindle.max_rpm
+  EXPECT_DOUBLE_EQ(highest, 8000);  // configs/mill-3axis.toml: spindle.max_rpm
 }
 
 TEST(SpindleScenario, ArcsOffTheirCircleRunAsSpiralsWithinTheLimits) {
@@ -206,7 +206,7 @@ TEST(EndlessProgramScenario, M99InTheMainProgramRepeatsItUntilTheOperatorStops) 
   s.must(Request::simple(CommandKind::Abort));
   ASSERT_TRUE(s.idle(20000));
   EXPECT_FALSE(s.status().run_active);
-  EXPECT_EQ(s.status().runs_finished, finished);   // stopped, never finished
+  EXPECT_EQ(s.status().runs_finished, finished);  // stopped, never finished
   EXPECT_EQ(s.report().limit_violations, 0u);
 }
 

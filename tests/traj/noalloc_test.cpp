@@ -90,7 +90,8 @@ TEST(InterpolatorAllocations, NoneInsideTickWhileRigidTapping) {
     g_armed = true;
     interp.tick(in, out);
     g_armed = false;
-    const double target = (out.tap_reverse ? -out.tap_speed_scale : 1.0) * 500.0 / 60.0, dv = 4000.0 / 60.0 * 1e-3;
+    const double target = (out.tap_reverse ? -out.tap_speed_scale : 1.0) * 500.0 / 60.0,
+                 dv = 4000.0 / 60.0 * 1e-3;
     const double v = std::fabs(target - rps) <= dv ? target : rps + std::copysign(dv, target - rps);
     revs += 0.5 * (rps + v) * 1e-3;
     rps = v;

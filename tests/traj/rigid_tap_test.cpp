@@ -18,7 +18,7 @@ using namespace opencnc::traj;
 
 namespace {
 
-constexpr double kPitch = 1.5;   // mm per revolution
+constexpr double kPitch = 1.5;  // mm per revolution
 constexpr double kStartZ = 2.0, kBottomZ = -10.0;
 
 Pose xyz(double x, double y, double z) {
@@ -78,7 +78,7 @@ TapRun run(const canon::Program& program, const plan::MachineLimits& limits, std
     in.spindle_revs = spindle.revs;
     in.spindle_rev_s = spindle.rps;
     in.abort = abort_at != 0 && n == abort_at;
-    in.feed_hold = n % 400 > 300;   // the tap does not stop for it (LinuxCNC)
+    in.feed_hold = n % 400 > 300;  // the tap does not stop for it (LinuxCNC)
     interp.tick(in, out);
     r.samples.push_back({out, spindle.revs, spindle.rps});
     spindle.step(out, 1e-3);
@@ -119,11 +119,11 @@ TEST(RigidTap, FollowsTheSpindleInReversesAtDepthComesOutAndEndsOnItsStart) {
     }
     if (reversed && !s.out.tap_reverse && !restored) {
       restored = true;
-      EXPECT_GE(z, kStartZ - 1e-9);   // the spindle turns back only once the tap is out
+      EXPECT_GE(z, kStartZ - 1e-9);  // the spindle turns back only once the tap is out
     }
   }
   ASSERT_TRUE(have_lag && reversed && restored);
-  EXPECT_LE(first_reverse_z, kBottomZ + 1e-9);          // reversal asked at the depth
+  EXPECT_LE(first_reverse_z, kBottomZ + 1e-9);           // reversal asked at the depth
   EXPECT_GT(first_reverse_z, kBottomZ - kPitch * 0.01);  // within one period's travel of it
   // The spindle's deceleration takes the tap past the depth and past its start (LinuxCNC too):
   // 500 rpm stopping at 4000 rpm/s turns 0.52 rev, 1000 rpm 2.08 rev.
@@ -159,7 +159,7 @@ TEST(RigidTap, AMovingAverageFilterLeavesTheTapAndThePathAroundItContinuous) {
     const Pose& b = r.samples[k].out.position;
     double step = 0;
     for (int i = 0; i < 3; ++i) step += (b[i] - a[i]) * (b[i] - a[i]);
-    EXPECT_LE(std::sqrt(step), 100 * 1e-3 * (1 + 1e-9)) << k;   // no jump
+    EXPECT_LE(std::sqrt(step), 100 * 1e-3 * (1 + 1e-9)) << k;  // no jump
   }
   EXPECT_NEAR(r.samples.back().out.position[Axis::Z], kStartZ, 1e-12);
 }
@@ -179,7 +179,7 @@ TEST(RigidTap, AnAbortDuringTheTapTakesItOutFirst) {
   ASSERT_EQ(r.end, RunState::Aborted);
   double z_min = 1e9;
   for (const Sample& s : r.samples) z_min = std::min(z_min, s.out.position[Axis::Z]);
-  EXPECT_GT(z_min, kBottomZ);                          // it never went to the depth
-  EXPECT_NEAR(r.samples.back().out.position[Axis::Z], kStartZ, 1e-12);   // out, on its start
-  EXPECT_DOUBLE_EQ(r.samples.back().out.position[Axis::X], 0.0);           // and no further
+  EXPECT_GT(z_min, kBottomZ);                                           // it never went to the depth
+  EXPECT_NEAR(r.samples.back().out.position[Axis::Z], kStartZ, 1e-12);  // out, on its start
+  EXPECT_DOUBLE_EQ(r.samples.back().out.position[Axis::X], 0.0);        // and no further
 }
