@@ -253,7 +253,11 @@ void Engine::o_m98() {
   CallFrame frame;
   frame.kind = CallKind::Numbered;
   frame.return_to = st_.next;
-  if (block_.has('l')) {
+  if (block_.has('l') && in_mdi_) {
+    // An MDI line is not read again: the body runs again from its M99 (L0: not at all).
+    if (round_to_int(block_.get('l')) == 0) return;
+    frame.m98_runs_left = round_to_int(block_.get('l')) - 1;
+  } else if (block_.has('l')) {
     if (caller.m98_left == -1) caller.m98_left = round_to_int(block_.get('l'));
     --caller.m98_left;
     if (caller.m98_left > 0) {
@@ -276,6 +280,14 @@ void Engine::o_m99() {
         fmt::format("M99 in o<{}> (called by 'call': it ends with endsub or return)", f.sub).c_str());
   c.return_value = 0;
   c.value_returned = false;
+  if (f.m98_runs_left > 0) {
+    if (const LabelInfo* body = find_label(f.sub); body != nullptr) {
+      --st_.frames.back().m98_runs_left;
+      count_loop();
+      jump_to(body->at);
+      return;
+    }
+  }
   jump_to(f.return_to);
   leave_frame();
 }

@@ -413,7 +413,7 @@ bool Engine::process_line() {
     case LineKind::Block: break;
   }
   if (block_.o_type != OWord::None) {
-    if (in_mdi_ && block_.o_type != OWord::Call && block_.o_type != OWord::MacroCall)
+    if (in_mdi_ && block_.o_type != OWord::Call && block_.o_type != OWord::MacroCall && block_.o_type != OWord::M98)
       fail(ErrorCode::OwordInMdi,
            "only 'call' O-words and subprogram calls can be used in MDI: control flow needs a program file");
     control_flow();

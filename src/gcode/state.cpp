@@ -170,6 +170,7 @@ std::uint64_t InterpState::digest() const noexcept {
     h.str(f.sub);
     h.u64(static_cast<std::uint64_t>(f.kind));
     h.i64(f.m98_left);
+    h.i64(f.m98_runs_left);
     for (double v : f.saved_args) h.f64(v);
     h.named(f.locals);
     h.pos(f.return_to);

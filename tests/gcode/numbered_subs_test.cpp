@@ -305,3 +305,18 @@ TEST(NumberedSubprograms, MainProgramM99RepeatInScanModeStopsWithAClearError) {
   skip.block_delete = true;
   EXPECT_EQ(run("G21 F100 G91\nG1 X1\n/M30\nM99\n", skip).error.code, "gcode.limit-main-repeats");
 }
+
+TEST(NumberedSubprograms, AnMdiLineCallsANumberedSubprogramFromTheSearchPath) {
+  TempDir dir;
+  dir.write("77.ngc", "(a numbered subprogram in a file of its own)\nO77\nG91 G1 X2\nG90\nM99\n");
+  Options o;
+  o.subroutine_path = {dir.str()};
+  Interpreter interp(o);
+  Moves sink;
+  ASSERT_EQ(interp.execute_mdi("G21 F100", sink), RunStatus::Ok);
+  ASSERT_EQ(interp.execute_mdi("M98 P77 L2", sink), RunStatus::Ok) << interp.diagnostics().items().back().format();
+  ASSERT_EQ(sink.moves.size(), 2u);
+  EXPECT_EQ(sink.moves[1].end[Axis::X], 4);
+  EXPECT_EQ(interp.state().frames.size(), 1u);
+  EXPECT_EQ(interp.execute_mdi("M98 P78", sink), RunStatus::Error);
+}

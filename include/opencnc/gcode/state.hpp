@@ -219,6 +219,8 @@ struct CallFrame {
   /// LinuxCNC M98 L run from this level: calls still to make (-1: none). The M98 line is
   /// read again for each, as LinuxCNC does.
   std::int64_t m98_left = -1;
+  /// M98 L from an MDI line, which cannot be read again: runs of this body still to come.
+  std::int64_t m98_runs_left = 0;
   FanucFrame fanuc;                                ///< Fanuc dialect only
   bool operator==(const CallFrame&) const = default;
 };
