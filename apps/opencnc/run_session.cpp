@@ -249,6 +249,27 @@ void follow(Driver& d, control::EventCursor& cursor, const SessionOptions& o, co
   }
 }
 
+/// What the preflight could only check with assumed answers (a probe's trip, an input's value).
+void note_assumptions(const control::PreflightSummary& s) {
+  if (s.assumed_moves == 0) return;
+  std::string lines;
+  for (const control::SourceLocation& l : s.assumed_lines) {
+    if (lines.size() > 200) {
+      lines += ", …";
+      break;
+    }
+    lines += (lines.empty() ? "" : ", ") + control::to_string(l);
+  }
+  const auto plural = [](std::uint64_t n, const char* one, const char* many) {
+    return fmt::format("{} {}", n, n == 1 ? one : many);
+  };
+  fmt::print(stderr,
+             "note: {} {} on what the machine answers while the program runs ({}); checked with assumed answers, "
+             "they are checked again with the real ones before they run: {}\n",
+             plural(s.assumed_moves, "move", "moves"), s.assumed_moves == 1 ? "rests" : "rest",
+             plural(s.sync_points, "sync point", "sync points"), lines);
+}
+
 }  // namespace
 
 SessionEnd run_session(const SessionOptions& o, const SessionHooks& hooks) {
@@ -292,6 +313,7 @@ SessionEnd run_session(const SessionOptions& o, const SessionHooks& hooks) {
     return end;
   }
   end.program = d.controller().open_program();
+  note_assumptions(end.program->preflight.summary);
   if (hooks.opened) {
     for (auto& [observer, options] : hooks.opened(end.profile, *end.program))
       d.controller().attach(observer, options);

@@ -152,12 +152,17 @@ void Interpolator::finish_tap() noexcept {
   tap_reverse_ = false;
 }
 
-// While the tap runs, the commanded position is the tap's, on its block's line.
+// While the tap runs, the commanded position is the tap's, on its block's line. The block shown
+// is the way in until the spindle has reversed, then the way out (its offset measured back up
+// from the bottom), each offset within its block.
 void Interpolator::show_tap(TickOutput& out) noexcept {
   const MotionBlock& b = queue_->peek(index_of(u_seq_));
   for (int i = 0; i < kAxisCount; ++i) position_[i] = b.base[i] + tap_depth_ * b.lin[i];
-  shown_ =
-      Shown{b.seq, b.segment, b.segment_first, b.segment_last, b.line, b.context, std::max(0.0, tap_depth_)};
+  const bool coming_out = tap_ == Tap::Out || tap_ == Tap::Restoring || tap_ == Tap::Placing;
+  const MotionBlock& shown = coming_out ? queue_->peek(index_of(u_seq_) + 1) : b;
+  const double offset = std::clamp(coming_out ? b.length - tap_depth_ : tap_depth_, 0.0, shown.length);
+  shown_ = Shown{shown.seq,  shown.segment, shown.segment_first, shown.segment_last,
+                 shown.line, shown.context, offset,              shown.segment_offset};
   out.position = position_;
   out.path_velocity = std::fabs(tap_v_);
   out.block_seq = shown_.seq;
@@ -167,6 +172,7 @@ void Interpolator::show_tap(TickOutput& out) noexcept {
   out.line = shown_.line;
   out.context = shown_.context;
   out.block_offset = shown_.offset;
+  out.segment_offset = shown_.segment_offset + shown_.offset;
   out.spindle_synced = tap_locked_;
   out.tap_reverse = tap_reverse_;
   out.tap_speed_scale = b.tap_scale;

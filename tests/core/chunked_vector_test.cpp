@@ -29,3 +29,19 @@ TEST(ChunkedVector, AppendsRunsAndSlotsAcrossChunks) {
   ASSERT_EQ(v.size(), 80u);
   for (std::size_t i = 0; i < v.size(); ++i) EXPECT_EQ(v[i], static_cast<int>(i));
 }
+
+TEST(ChunkedVector, ReleasesWholeChunksBeforeAnIndexAndKeepsIndices) {
+  opencnc::ChunkedVector<int, 3> v;  // 8 elements per chunk
+  for (int i = 0; i < 40; ++i) v.push_back(i);
+  EXPECT_EQ(v.capacity_bytes(), 5u * 8 * sizeof(int));
+  EXPECT_EQ(v.release_before(19), 16u);  // chunks 0 and 1 freed; 16..19 share a chunk with what stays
+  EXPECT_EQ(v.first_held(), 16u);
+  EXPECT_EQ(v.capacity_bytes(), 3u * 8 * sizeof(int));
+  EXPECT_EQ(v[16], 16);
+  EXPECT_EQ(v[39], 39);
+  EXPECT_EQ(v.size(), 40u);
+  EXPECT_EQ(v.release_before(100), 32u);  // never the chunk being filled
+  for (int i = 40; i < 48; ++i) v.push_back(i);  // the freed chunk is used again
+  EXPECT_EQ(v[47], 47);
+  EXPECT_EQ(v[33], 33);
+}

@@ -317,3 +317,123 @@ TEST(SyncScenario, StreamingMovesExactlyAsTheWholeProgram) {
 
 }  // namespace
 }  // namespace opencnc::control::test
+
+namespace opencnc::control::test {
+namespace {
+
+/// The most moves a run's program window held at once.
+class WindowWatch final : public ControllerObserver {
+ public:
+  void on_trace(const TraceSample&, const TraceContext& c) override {
+    if (c.program == nullptr) return;
+    most = std::max(most, c.program->size() - c.program->first_held_move());
+    moves = std::max<std::uint64_t>(moves, c.first_move + c.program->size());
+  }
+  std::size_t most = 0;
+  std::uint64_t moves = 0;
+};
+
+// A program far longer than the read-ahead runs in a window of the moves around the machine: what
+// the machine has passed is freed as it goes.
+TEST(StreamScenario, ALongProgramRunsInABoundedWindow) {
+  Scenario s(mill());
+  TempProgram p("long.ngc",
+                "G21 G90 G64 P0.01 F6000\n"
+                "#1 = 0\n"
+                "o1 while [#1 lt 120000]\n"
+                "  G1 X[#1 mod 2] Y[#1 * 0.001]\n"
+                "  #1 = [#1 + 1]\n"
+                "o1 endwhile\n"
+                "M2\n");
+  auto watch = std::make_shared<WindowWatch>();
+  s.rig().controller().attach(watch, ObserverOptions{0, true});
+  s.on(Mode::Auto);
+  ASSERT_TRUE(s.run_file(p.path(), 2'000'000)) << s.message();
+  EXPECT_EQ(watch->moves, 120000u) << watch->most;
+  EXPECT_GT(watch->most, 2000u);   // the read-ahead and the planner's window
+  EXPECT_LT(watch->most, 60000u);  // far from all of it: released chunk by chunk
+  const std::optional<OpenProgram> open = s.rig().controller().open_program();
+  EXPECT_EQ(open->preflight.summary.moves, 120000u);
+}
+
+}  // namespace
+}  // namespace opencnc::control::test
+
+namespace opencnc::control::test {
+namespace {
+
+// The program's own dialect comment wins over the profile's default, and an O-numbered Fanuc
+// program runs as `opencnc check --dialect fanuc` reads it (nothing is put in front of it).
+TEST(DialectScenario, RunReadsTheProgramInItsOwnDialect) {
+  const char* fanuc = "%\nO0001 (BRACKET)\nG21 G90 G54\nG0 X10. Y5.\nG1 X20. F600\nM30\n%\n";
+  {
+    Scenario s(mill({"interpreter.dialect=\"fanuc\""}));
+    TempProgram p("o0001.nc", fanuc);
+    s.on(Mode::Auto);
+    ASSERT_TRUE(s.run_file(p.path())) << s.message();
+    EXPECT_NEAR(s.status().servo.commanded[Axis::X], 20.0, 1e-9);
+  }
+  {
+    Scenario s(mill());  // LinuxCNC by default: the comment says Fanuc
+    TempProgram p("marked.nc", std::string("(dialect: fanuc)\n") + (fanuc + 2));
+    s.on(Mode::Auto);
+    ASSERT_TRUE(s.run_file(p.path())) << s.message();
+    EXPECT_NEAR(s.status().servo.commanded[Axis::Y], 5.0, 1e-9);
+  }
+}
+
+}  // namespace
+}  // namespace opencnc::control::test
+
+namespace opencnc::control::test {
+namespace {
+
+// Status says exactly where in the program the machine is: the move, the path length into it, the
+// line and the calls that led there (what a breakpoint journal records).
+TEST(StatusScenario, SaysTheMoveThePlaceInItAndTheCallStack) {
+  Scenario s(mill());
+  TempProgram p("calls.ngc",
+                "o<side> sub\n"
+                "  G1 X[#1] F600\n"
+                "o<side> endsub\n"
+                "G21 G90\n"
+                "G0 X0 Y0\n"
+                "o<side> call [40]\n"
+                "M2\n");
+  s.on(Mode::Auto);
+  s.must(Request::open(p.path()));
+  s.must(Request::simple(CommandKind::CycleStart));
+  ASSERT_TRUE(s.until([&] { return s.status().servo.commanded[Axis::X] > 10.0; }, 20000));
+  const ControllerStatus st = s.status();
+  EXPECT_EQ(st.job, JobKind::Program);
+  EXPECT_EQ(st.run_segment, 1u);  // the second move: the G0 was the first
+  EXPECT_NEAR(st.segment_offset, st.servo.commanded[Axis::X], 1e-9);  // the move starts at X0
+  EXPECT_EQ(st.location.line, 2u);
+  ASSERT_EQ(st.location.calls.size(), 1u);
+  EXPECT_NE(st.location.calls[0].find("calls.ngc:6"), std::string::npos) << st.location.calls[0];
+  EXPECT_NE(to_string(st.location).find("calls.ngc:2"), std::string::npos) << to_string(st.location);
+  ASSERT_TRUE(s.idle(20000));
+}
+
+}  // namespace
+}  // namespace opencnc::control::test
+
+namespace opencnc::control::test {
+namespace {
+
+// MDI lines meet the machine too: a probe typed by the operator sets #5063 for the next line.
+TEST(MdiSyncScenario, AProbeInMdiSetsItsParameters) {
+  Scenario s(mill());
+  s.on(Mode::Mdi);
+  s.must(Request::mdi("G21 G90 G0 X5 Y5 Z0"));
+  ASSERT_TRUE(s.idle(20000));
+  s.must(Request::mdi("G38.2 Z-100 F300"));
+  ASSERT_TRUE(s.idle(50000));
+  EXPECT_TRUE(s.status().servo.probe_tripped);
+  s.must(Request::mdi("G0 Z[#5063+5]"));
+  ASSERT_TRUE(s.idle(20000));
+  EXPECT_NEAR(s.status().servo.commanded[Axis::Z], -45.0, 0.001);
+}
+
+}  // namespace
+}  // namespace opencnc::control::test

@@ -129,6 +129,17 @@ TEST(RigidTap, FollowsTheSpindleInReversesAtDepthComesOutAndEndsOnItsStart) {
   // 500 rpm stopping at 4000 rpm/s turns 0.52 rev, 1000 rpm 2.08 rev.
   EXPECT_NEAR(kBottomZ - z_min, kPitch * (500.0 / 60) * (500.0 / 60) / (2 * 4000.0 / 60), 0.02);
   EXPECT_NEAR(z_max - kStartZ, kPitch * (1000.0 / 60) * (1000.0 / 60) / (2 * 4000.0 / 60), 0.05);
+  // Where in its move the machine is (for status and recovery) grows from 0 to the depth on
+  // the way in (move 1) and again on the way out (move 2), never backwards.
+  for (std::uint64_t move : {1u, 2u}) {
+    double last_offset = -1;
+    for (const Sample& s : r.samples) {
+      if (s.out.segment != move) continue;
+      EXPECT_GE(s.out.segment_offset, last_offset - 1e-12) << move;
+      last_offset = s.out.segment_offset;
+    }
+    EXPECT_NEAR(last_offset, kStartZ - kBottomZ, 1e-9) << move;
+  }
   // Then the tap goes back onto its start and the program goes on from there.
   bool at_start = false;
   for (const Sample& s : r.samples) {
