@@ -175,7 +175,7 @@ struct MachineAction {
   std::int32_t index = 0;
   std::int32_t index2 = 0;
   double value = 0;
-  double value2 = 0;
+  double value2 = 0;  ///< SurfaceSpeed: X of the spindle axis, machine coordinates (mm)
 };
 
 /// How a run ended.
