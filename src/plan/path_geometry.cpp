@@ -92,27 +92,35 @@ constexpr double kSpiralRelative = 0.001;
 /// Radii that differ by less than this (relative) are the same circle up to rounding.
 constexpr double kSameRadius = 1e-9;
 
-/// Length of a spiral block over θ ∈ [0, sweep]: |dp/dθ|² = r0²·((1 + ρθ)² + ρ²) + h² (h: the
-/// linear part per radian), by Gauss-Legendre quadrature over quarter turns (the integrand is
-/// the root of a quadratic in θ, smooth and positive).
-double spiral_length(double r0, double rho, double h, double sweep) noexcept {
+/// ∫ f over [0, span] by 8-point Gauss-Legendre on `pieces` equal parts (f smooth on each).
+template <typename F>
+double gauss_legendre(F f, double span, int pieces) {
   static constexpr double kNode[4] = {0.1834346424956498, 0.5255324099163290, 0.7966664774136267,
                                       0.9602898564975363};
   static constexpr double kWeight[4] = {0.3626837833783620, 0.3137066458778873, 0.2223810344533745,
                                         0.1012285362903763};
-  const int pieces = std::max(1, static_cast<int>(std::ceil(std::fabs(sweep) / (0.5 * kPi))));
-  const double step = sweep / pieces;
+  const double step = span / pieces, half = 0.5 * step;
+  double sum = 0;
+  for (int k = 0; k < pieces; ++k) {
+    const double mid = (k + 0.5) * step;
+    for (int q = 0; q < 4; ++q) sum += kWeight[q] * (f(mid - half * kNode[q]) + f(mid + half * kNode[q]));
+  }
+  return half * sum;
+}
+
+/// Quarter turns in a sweep (at least one): the pieces of a spiral's quadrature.
+int quarter_turns(double sweep) noexcept {
+  return std::max(1, static_cast<int>(std::ceil(std::fabs(sweep) / (0.5 * kPi))));
+}
+
+/// Length of a spiral block over θ ∈ [0, sweep]: |dp/dθ|² = r0²·((1 + ρθ)² + ρ²) + h² (h: the
+/// linear part per radian), the root of a quadratic in θ, smooth and positive.
+double spiral_length(double r0, double rho, double h, double sweep) noexcept {
   const auto speed = [&](double th) {
     const double a = 1.0 + rho * th;
     return std::sqrt(r0 * r0 * (a * a + rho * rho) + h * h);
   };
-  double sum = 0;
-  for (int k = 0; k < pieces; ++k) {
-    const double mid = (k + 0.5) * step, half = 0.5 * step;
-    for (int q = 0; q < 4; ++q)
-      sum += kWeight[q] * (speed(mid - half * kNode[q]) + speed(mid + half * kNode[q]));
-  }
-  return std::fabs(0.5 * step * sum);
+  return std::fabs(gauss_legendre(speed, sweep, quarter_turns(sweep)));
 }
 
 }  // namespace
@@ -216,27 +224,14 @@ bool make_spiral(const Pose& start, const Pose& end, const canon::ArcGeometry& a
 
 namespace {
 
-/// Length of a spiral block's path in the axis triple from `first` (Gauss-Legendre over quarter
-/// turns of the tangent restricted to the triple).
+/// Length of a spiral block's path in the axis triple from `first` (its tangent restricted to
+/// the triple, over the block's s).
 double spiral_triple_length(const MotionBlock& b, int first) noexcept {
-  static constexpr double kNode[4] = {0.1834346424956498, 0.5255324099163290, 0.7966664774136267,
-                                      0.9602898564975363};
-  static constexpr double kWeight[4] = {0.3626837833783620, 0.3137066458778873, 0.2223810344533745,
-                                        0.1012285362903763};
-  const double sweep = std::fabs(b.omega) * b.length;
-  const int pieces = std::max(1, static_cast<int>(std::ceil(sweep / (0.5 * kPi))));
-  const double step = b.length / pieces;
   const auto speed = [&](double s) {
     const Pose t = traj::tangent_at(b, s);
     return std::sqrt(t[first] * t[first] + t[first + 1] * t[first + 1] + t[first + 2] * t[first + 2]);
   };
-  double sum = 0;
-  for (int k = 0; k < pieces; ++k) {
-    const double mid = (k + 0.5) * step, half = 0.5 * step;
-    for (int q = 0; q < 4; ++q)
-      sum += kWeight[q] * (speed(mid - half * kNode[q]) + speed(mid + half * kNode[q]));
-  }
-  return 0.5 * step * sum;
+  return gauss_legendre(speed, b.length, quarter_turns(b.omega * b.length));
 }
 
 }  // namespace

@@ -5,9 +5,12 @@
 #include <algorithm>
 #include <cmath>
 
+#include "braking.hpp"
 #include "opencnc/traj/path_eval.hpp"
 
 namespace opencnc::traj {
+
+using detail::end_speed_limit;
 
 namespace {
 
@@ -18,17 +21,6 @@ constexpr int kMaxBoundaryScan = 256;
 
 bool is_stop_marker(const MotionBlock& b) noexcept {
   return b.kind == BlockKind::Marker && b.marker != MarkerKind::Report && b.marker != MarkerKind::None;
-}
-
-/// Largest speed at the end of a constant-acceleration piece of duration tau, starting at speed
-/// v, such that the braking curve is respected: v_end² + 2A·Δs ≤ K with Δs = (v + v_end)·tau/2,
-/// where K = v_q² + C(q) − C(s) for a limit v_q at q. Negative when no v_end ≥ 0 satisfies it
-/// (q is reached within the piece).
-double end_speed_limit(double K, double v, double A, double tau) noexcept {
-  const double at = A * tau;
-  const double disc = at * at + 4.0 * (K - at * v);
-  if (disc < 0) return -1.0;
-  return 0.5 * (std::sqrt(disc) - at);
 }
 
 /// ∫ s dt over a piece of duration t from (s0, v) with constant acceleration a.
@@ -416,9 +408,18 @@ void Interpolator::fill_output(TickOutput& out, double s_prev) noexcept {
     shown_ = Shown{b.seq, b.segment, b.segment_first, b.segment_last, b.line, b.context, b.length,
                    b.segment_offset};
   }
-  out.position = position_;
   out.path_velocity = (s_f_ - s_prev) / config_.period_s;
   out.state = state_;
+  write_shown(out);
+  out.spindle_synced = sync_ == Sync::Locked;
+  out.sync_lost = sync_lost_;
+  out.tap_reverse = false;
+  out.tap_speed_scale = 1;
+}
+
+// The commanded position and the block shown there.
+void Interpolator::write_shown(TickOutput& out) const noexcept {
+  out.position = position_;
   out.block_seq = shown_.seq;
   out.segment = shown_.segment;
   out.segment_first = shown_.segment_first;
@@ -427,10 +428,6 @@ void Interpolator::fill_output(TickOutput& out, double s_prev) noexcept {
   out.context = shown_.context;
   out.block_offset = shown_.offset;
   out.segment_offset = shown_.segment_offset + shown_.offset;
-  out.spindle_synced = sync_ == Sync::Locked;
-  out.sync_lost = sync_lost_;
-  out.tap_reverse = false;
-  out.tap_speed_scale = 1;
 }
 
 void Interpolator::tick(const TickInput& in, TickOutput& out) noexcept {

@@ -6,22 +6,10 @@
 #include <algorithm>
 #include <cmath>
 
+#include "braking.hpp"
 #include "opencnc/traj/interpolator.hpp"
 
 namespace opencnc::traj {
-
-namespace {
-
-/// Largest end speed of a constant-acceleration piece of length tau from speed v that can still
-/// stop within `dist` with deceleration A; negative when the stop point is reached within it.
-double stop_speed_limit(double dist, double v, double A, double tau) noexcept {
-  const double at = A * tau;
-  const double disc = at * at + 4.0 * (2.0 * A * dist - at * v);
-  if (disc < 0) return -1.0;
-  return 0.5 * (std::sqrt(disc) - at);
-}
-
-}  // namespace
 
 // The tap owns the period (the path generator waits at the start of the tap's blocks, which it
 // reaches at rest): true while it runs, including the period in which it ends.
@@ -124,7 +112,7 @@ void Interpolator::place_tap(const MotionBlock& b) noexcept {
   const double tau = config_.period_s, A = b.accel;
   const double dir = tap_depth_ > 0 ? -1.0 : 1.0;  // toward depth 0
   const double dist = std::fabs(tap_depth_), u = dir * tap_v_;
-  const double v_end = stop_speed_limit(dist, u, A, tau);
+  const double v_end = detail::end_speed_limit(2.0 * A * dist, u, A, tau);  // to rest at depth 0
   if (v_end < 0 || (dist < 1e-12 && std::fabs(u) <= A * tau)) {
     finish_tap();
     return;
@@ -163,16 +151,8 @@ void Interpolator::show_tap(TickOutput& out) noexcept {
   const double offset = std::clamp(coming_out ? b.length - tap_depth_ : tap_depth_, 0.0, shown.length);
   shown_ = Shown{shown.seq,  shown.segment, shown.segment_first, shown.segment_last,
                  shown.line, shown.context, offset,              shown.segment_offset};
-  out.position = position_;
+  write_shown(out);
   out.path_velocity = std::fabs(tap_v_);
-  out.block_seq = shown_.seq;
-  out.segment = shown_.segment;
-  out.segment_first = shown_.segment_first;
-  out.segment_last = shown_.segment_last;
-  out.line = shown_.line;
-  out.context = shown_.context;
-  out.block_offset = shown_.offset;
-  out.segment_offset = shown_.segment_offset + shown_.offset;
   out.spindle_synced = tap_locked_;
   out.tap_reverse = tap_reverse_;
   out.tap_speed_scale = b.tap_scale;

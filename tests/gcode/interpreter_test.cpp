@@ -19,6 +19,7 @@
 
 using namespace opencnc;
 using namespace opencnc::gcode;
+using test::TempDir;
 
 namespace {
 
@@ -74,21 +75,6 @@ std::string first_code(const Interpreter& interp) {
   const Diagnostic* d = first_error(interp);
   return d == nullptr ? std::string() : d->code;
 }
-
-// A scratch directory for subprogram files, removed at the end of the test.
-class TempDir {
- public:
-  TempDir() {
-    char name[] = "/tmp/opencnc_gcode_test_XXXXXX";
-    path_ = ::mkdtemp(name);
-  }
-  ~TempDir() { std::filesystem::remove_all(path_); }
-  void write(const std::string& file, const std::string& text) const { std::ofstream(path_ / file) << text; }
-  std::string str() const { return path_.string(); }
-
- private:
-  std::filesystem::path path_;
-};
 
 }  // namespace
 

@@ -12,6 +12,7 @@
 
 using namespace opencnc;
 using namespace opencnc::gcode;
+using test::TempDir;
 
 namespace {
 
@@ -62,20 +63,6 @@ std::vector<double> feed_x(const Outcome& o) {
   }
   return x;
 }
-
-class TempDir {
- public:
-  TempDir() {
-    char name[] = "/tmp/opencnc_numbered_subs_XXXXXX";
-    path_ = ::mkdtemp(name);
-  }
-  ~TempDir() { std::filesystem::remove_all(path_); }
-  void write(const std::string& file, const std::string& text) const { std::ofstream(path_ / file) << text; }
-  std::string str() const { return path_.string(); }
-
- private:
-  std::filesystem::path path_;
-};
 
 }  // namespace
 
@@ -314,7 +301,8 @@ TEST(NumberedSubprograms, AnMdiLineCallsANumberedSubprogramFromTheSearchPath) {
   Interpreter interp(o);
   Moves sink;
   ASSERT_EQ(interp.execute_mdi("G21 F100", sink), RunStatus::Ok);
-  ASSERT_EQ(interp.execute_mdi("M98 P77 L2", sink), RunStatus::Ok) << interp.diagnostics().items().back().format();
+  ASSERT_EQ(interp.execute_mdi("M98 P77 L2", sink), RunStatus::Ok)
+      << interp.diagnostics().items().back().format();
   ASSERT_EQ(sink.moves.size(), 2u);
   EXPECT_EQ(sink.moves[1].end[Axis::X], 4);
   EXPECT_EQ(interp.state().frames.size(), 1u);

@@ -127,6 +127,7 @@ class Interpolator {
   void release_marker() noexcept;
   void pop_and_rebase() noexcept;
   void fill_output(TickOutput& out, double s_prev) noexcept;
+  void write_shown(TickOutput& out) const noexcept;
   void update_sync(const TickInput& in) noexcept;
   double sync_acceleration(const MotionBlock& b, double tau) noexcept;
   // rigid_tap.cpp
