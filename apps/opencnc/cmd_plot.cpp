@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // `opencnc plot`: the toolpath (XY, XZ, YZ, isometric) and the velocity, acceleration and
-// following-error profiles of a run, as SVG — from a program (run in virtual time) or a trace CSV.
+// following-error profiles of a run, as SVG — from a program (run in virtual time) or a trace CSV;
+// a homing trace (`opencnc calibrate --trace`) shows each axis' homing phases and sensor level.
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 
@@ -14,6 +15,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "opencnc/control/homing.hpp"
 #include "opencnc/core/axes.hpp"
 #include "opencnc/viz/svg_chart.hpp"
 #include "run_session.hpp"
@@ -35,7 +37,19 @@ struct Sample {
   double path_velocity = 0;
   Pose cmd{};
   Pose ferr{};
+  Pose act{};
+  Pose level{};  ///< the home sensor's level
+  std::array<control::HomingPhase, kAxisCount> phase{};
 };
+
+/// The phase a trace names ("search", …); Idle for anything else.
+control::HomingPhase phase_named(const std::string& name) {
+  for (int p = 0; p <= static_cast<int>(control::HomingPhase::Failed); ++p) {
+    const auto phase = static_cast<control::HomingPhase>(p);
+    if (name == control::to_string(phase)) return phase;
+  }
+  return control::HomingPhase::Idle;
+}
 
 struct Trace {
   AxisMask axes;
@@ -56,9 +70,8 @@ bool read_trace(const std::string& path, Trace& trace, std::string& error) {
   std::vector<std::string> head;
   for (std::stringstream ss(line); std::getline(ss, line, ',');) head.push_back(line);
   int t_col = -1, rapid_col = -1, v_col = -1;
-  std::array<int, kAxisCount> cmd_col{}, ferr_col{};
-  cmd_col.fill(-1);
-  ferr_col.fill(-1);
+  std::array<int, kAxisCount> cmd_col{}, ferr_col{}, act_col{}, phase_col{}, level_col{};
+  for (auto* c : {&cmd_col, &ferr_col, &act_col, &phase_col, &level_col}) c->fill(-1);
   for (int c = 0; c < static_cast<int>(head.size()); ++c) {
     const std::string& h = head[static_cast<std::size_t>(c)];
     if (h == "time_s") t_col = c;
@@ -68,6 +81,9 @@ bool read_trace(const std::string& path, Trace& trace, std::string& error) {
       const std::string a(1, kAxisLetters[static_cast<std::size_t>(i)]);
       if (h == "cmd_" + a) cmd_col[static_cast<std::size_t>(i)] = c, trace.axes.set(static_cast<Axis>(i));
       if (h == "ferr_" + a) ferr_col[static_cast<std::size_t>(i)] = c;
+      if (h == "act_" + a) act_col[static_cast<std::size_t>(i)] = c;
+      if (h == "phase_" + a) phase_col[static_cast<std::size_t>(i)] = c;
+      if (h == "level_" + a) level_col[static_cast<std::size_t>(i)] = c;
     }
   }
   if (t_col < 0 || trace.axes.count() == 0) {
@@ -75,12 +91,16 @@ bool read_trace(const std::string& path, Trace& trace, std::string& error) {
     return false;
   }
   std::vector<double> v;
+  std::vector<std::string> words;
   std::size_t row = 1;
   while (std::getline(in, line)) {
     ++row;
     v.clear();
-    for (std::stringstream ss(line); std::getline(ss, line, ',');)
+    words.clear();
+    for (std::stringstream ss(line); std::getline(ss, line, ',');) {
       v.push_back(std::strtod(line.c_str(), nullptr));
+      words.push_back(line);
+    }
     if (v.size() != head.size()) {
       error = fmt::format("{}:{}: {} fields, the header has {}", path, row, v.size(), head.size());
       return false;
@@ -94,6 +114,10 @@ bool read_trace(const std::string& path, Trace& trace, std::string& error) {
         s.cmd[i] = v[static_cast<std::size_t>(cmd_col[static_cast<std::size_t>(i)])];
       if (ferr_col[static_cast<std::size_t>(i)] >= 0)
         s.ferr[i] = v[static_cast<std::size_t>(ferr_col[static_cast<std::size_t>(i)])];
+      const auto ui = static_cast<std::size_t>(i);
+      s.act[i] = act_col[ui] >= 0 ? v[static_cast<std::size_t>(act_col[ui])] : s.cmd[i];
+      if (level_col[ui] >= 0) s.level[i] = v[static_cast<std::size_t>(level_col[ui])];
+      if (phase_col[ui] >= 0) s.phase[ui] = phase_named(words[static_cast<std::size_t>(phase_col[ui])]);
     }
     trace.samples.push_back(s);
   }
@@ -242,7 +266,83 @@ viz::Panel following_errors(const Trace& tr) {
   return p;
 }
 
+// --- homing traces ----------------------------------------------------------------------------
+
+constexpr const char* kPhaseColors[] = {"#999999", "#8c564b", "#1f77b4", "#17becf", "#9467bd",
+                                        "#bcbd22", "#e8590c", "#2ca02c", "#d62728", "#e377c2",
+                                        "#7f7f7f", "#000000", "#ff0000"};
+
+bool homes(const Trace& tr, int a) {
+  for (const Sample& s : tr.samples) {
+    const control::HomingPhase p = s.phase[static_cast<std::size_t>(a)];
+    if (p != control::HomingPhase::Idle && p != control::HomingPhase::Done) return true;
+  }
+  return false;
+}
+
+/// The axis' position over time, one colour per homing phase.
+viz::Panel homing_phases(const Trace& tr, int a) {
+  viz::Panel p;
+  const char axis = kAxisLetters[static_cast<std::size_t>(a)];
+  p.title = fmt::format("homing {}: position by phase", axis);
+  p.x_label = "time (s)";
+  p.y_label = fmt::format("{} (mm)", axis);
+  std::array<bool, std::size(kPhaseColors)> labelled{};
+  for (std::size_t i = 0; i < tr.samples.size(); ++i) {
+    const auto phase = tr.samples[i].phase[static_cast<std::size_t>(a)];
+    if (p.series.empty() || phase != tr.samples[i - 1].phase[static_cast<std::size_t>(a)]) {
+      const auto k = std::min<std::size_t>(static_cast<std::size_t>(phase), std::size(kPhaseColors) - 1);
+      viz::Series s;
+      s.color = kPhaseColors[k];
+      if (!labelled[k]) s.label = control::to_string(phase);
+      labelled[k] = true;
+      if (i > 0) {
+        s.x.push_back(tr.samples[i - 1].t);
+        s.y.push_back(tr.samples[i - 1].act[a]);
+      }
+      p.series.push_back(std::move(s));
+    }
+    p.series.back().x.push_back(tr.samples[i].t);
+    p.series.back().y.push_back(tr.samples[i].act[a]);
+  }
+  return p;
+}
+
+/// The home sensor's level against the position while the edges are measured (the ramps whose
+/// threshold crossings homing interpolates).
+viz::Panel sensor_level(const Trace& tr, int a) {
+  viz::Panel p;
+  const char axis = kAxisLetters[static_cast<std::size_t>(a)];
+  p.title = fmt::format("homing {}: sensor level while returning and measuring", axis);
+  p.x_label = fmt::format("{} (mm, before the origin was set)", axis);
+  p.y_label = "level (0 … 1)";
+  viz::Series s;
+  s.label = "level";
+  s.color = kAxisColors[a];
+  for (const Sample& x : tr.samples) {
+    const auto phase = x.phase[static_cast<std::size_t>(a)];
+    if (phase != control::HomingPhase::Return && phase != control::HomingPhase::Measure) continue;
+    s.x.push_back(x.act[a]);
+    s.y.push_back(x.level[a]);
+  }
+  p.series.push_back(std::move(s));
+  return p;
+}
+
+bool draw_homing(const Trace& tr, const std::string& title, const std::string& out, std::string& error) {
+  viz::SvgChart chart(title, 2, 640, 430);
+  for (int a = 0; a < kAxisCount; ++a) {
+    if (!tr.axes.has(static_cast<Axis>(a)) || !homes(tr, a)) continue;
+    chart.add_panel(homing_phases(tr, a));
+    chart.add_panel(sensor_level(tr, a));
+  }
+  return chart.write(out, &error);
+}
+
 bool draw(const Trace& tr, const std::string& title, const std::string& out, std::string& error) {
+  for (int a = 0; a < kAxisCount; ++a) {
+    if (tr.axes.has(static_cast<Axis>(a)) && homes(tr, a)) return draw_homing(tr, title, out, error);
+  }
   viz::SvgChart chart(title, 2, 640, 430);
   const auto xy = [](int a, int b) { return [a, b](const Pose& q) { return std::pair{q[a], q[b]}; }; };
   chart.add_panel(toolpath(tr, "toolpath XY (top)", "X (mm)", "Y (mm)", xy(0, 1)));
@@ -265,8 +365,8 @@ class PlotRecorder final : public control::ControllerObserver {
   explicit PlotRecorder(Trace& tr) : tr_(tr) {}
   void on_trace(const control::TraceSample& s, const control::TraceContext&) override {
     if (s.activity != control::Activity::Program) return;
-    tr_.samples.push_back(Sample{static_cast<double>(s.tick) * tr_.period_s, s.rapid, s.path_velocity, s.commanded,
-                                 s.following_error});
+    tr_.samples.push_back(Sample{static_cast<double>(s.tick) * tr_.period_s, s.rapid, s.path_velocity,
+                                 s.commanded, s.following_error, s.actual, s.home_level, s.homing_phase});
   }
 
  private:

@@ -33,7 +33,8 @@ void print_summary(const config::MachineProfile& p) {
     const std::string limits =
         a.wrapped ? std::string("turns without end") : fmt::format("limits [{}, {}]", a.min_limit, a.max_limit);
     fmt::print("  {} joint {}: {} {}, v {} a {} j {}, {}, {} counts/unit\n", letter(a.axis), a.joint,
-               a.rotary ? "rotary" : "linear", a.drive == machine::JointDrive::Servo ? "servo" : "stepper",
+               a.rotary ? "rotary" : "linear",
+               a.drive == machine::JointDrive::Servo ? "servo" : (a.manual() ? "manual" : "stepper"),
                a.max_velocity, a.max_acceleration, a.max_jerk, limits, a.counts_per_unit);
   }
   if (p.spindle.present) fmt::print("  spindle: {}–{} rpm\n", p.spindle.min_rpm, p.spindle.max_rpm);

@@ -78,6 +78,10 @@ void print_report(const control::RunReport& r, const config::MachineProfile& pro
   fmt::print("axis  max velocity  max acceleration  max jerk\n");
   for (const config::AxisProfile& a : profile.axes) {
     const analysis::AxisStats& s = r.axes[static_cast<std::size_t>(index(a.axis))];
+    if (a.manual()) {
+      fmt::print("  {}   moved by hand\n", letter(a.axis));
+      continue;
+    }
     fmt::print("  {}   {:10.3f}    {:12.1f}    {:12.0f}\n", letter(a.axis), s.max_velocity,
                s.max_acceleration, s.max_jerk);
   }
@@ -133,7 +137,9 @@ int run(const RunOptions& o) {
   SessionHooks hooks;
   hooks.opened = [&](const config::MachineProfile& profile, const control::OpenProgram& program) {
     std::vector<std::pair<std::shared_ptr<control::ControllerObserver>, control::ObserverOptions>> out;
-    recorder = std::make_shared<control::RunRecorder>(control::machine_limits(profile), profile.servo_period_s);
+    const plan::MachineLimits axes = control::axis_limits(profile);  // the drives' commands: the axes' own
+    recorder = std::make_shared<control::RunRecorder>(control::machine_limits(profile),
+                                                      profile.servo_period_s, &axes);
     out.emplace_back(recorder, control::ObserverOptions{0, true});
     if (!o.trace.empty()) {
       csv.emplace(o.trace, profile.axis_mask(), profile.servo_period_s);

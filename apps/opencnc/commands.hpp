@@ -34,5 +34,6 @@ void add_profile_command(CLI::App& app, Registry& registry);
 void add_gcode_commands(CLI::App& app, Registry& registry);   ///< check, canon, scan
 void add_run_command(CLI::App& app, Registry& registry);
 void add_plot_command(CLI::App& app, Registry& registry);
+void add_calibrate_command(CLI::App& app, Registry& registry);
 
 }  // namespace opencnc::cli

@@ -18,6 +18,7 @@
 #include "opencnc/config/profile_loader.hpp"
 #include "opencnc/control/clock.hpp"
 #include "opencnc/control/servo.hpp"
+#include "opencnc/control/triple_buffer.hpp"
 #include "opencnc/controller/gcode_source.hpp"
 #include "opencnc/controller/servo_setup.hpp"
 #include "opencnc/controller/sim_rig.hpp"
@@ -47,6 +48,8 @@ class Driver {
   virtual control::Controller& controller() = 0;
   /// Whether time goes on by itself (a real-time servo) while the session waits for the operator.
   virtual bool ticks_by_itself() const = 0;
+  /// The simulated operator's hand moves hand-fed joint `joint` toward `target` at `speed`.
+  virtual void set_hand_target(int joint, double target, double speed) = 0;
 };
 
 class VirtualDriver final : public Driver {
@@ -56,16 +59,44 @@ class VirtualDriver final : public Driver {
   void advance() override { rig_.step(); }
   control::Controller& controller() override { return rig_.controller(); }
   bool ticks_by_itself() const override { return false; }
+  void set_hand_target(int joint, double target, double speed) override {
+    rig_.machine().set_hand_target(joint, target, speed);
+  }
 
  private:
   control::SimRig rig_;
+};
+
+/// The simulated machine behind a real-time servo: the servo thread alone touches it, so the
+/// hand's targets from the controller's thread are handed over (wait-free) and applied there.
+class HandedSimMachine final : public machine::MachineIO {
+ public:
+  struct HandTarget {
+    int joint = -1;
+    double target = 0, speed = 0;
+  };
+  explicit HandedSimMachine(const machine::SimMachineConfig& c) : sim_(c) {}
+  machine::MachineCapabilities capabilities() const noexcept override { return sim_.capabilities(); }
+  void read(machine::MachineInputs& in) noexcept override { sim_.read(in); }
+  void write(const machine::MachineOutputs& out) noexcept override {
+    if (hand_.update()) sim_.set_hand_target(hand_.front().joint, hand_.front().target, hand_.front().speed);
+    sim_.write(out);
+  }
+  /// Controller thread.
+  void set_hand_target(int joint, double target, double speed) noexcept {
+    hand_.write({joint, target, speed});
+  }
+
+ private:
+  machine::SimMachine sim_;
+  control::TripleBuffer<HandTarget> hand_;
 };
 
 class RealtimeDriver final : public Driver {
  public:
   RealtimeDriver(const config::MachineProfile& p, std::shared_ptr<control::ProgramSource> s)
       : channels_(std::make_unique<control::ServoChannels>()),
-        sim_(std::make_unique<machine::SimMachine>(config::sim_machine_config(p))),
+        sim_(std::make_unique<HandedSimMachine>(config::sim_machine_config(p))),
         servo_(std::make_unique<control::Servo>(control::servo_config(p), *channels_, *sim_)),
         controller_(std::make_unique<control::Controller>(p, *channels_, std::move(s))),
         period_(std::chrono::duration<double>(p.servo_period_s)),
@@ -82,10 +113,13 @@ class RealtimeDriver final : public Driver {
   }
   control::Controller& controller() override { return *controller_; }
   bool ticks_by_itself() const override { return true; }
+  void set_hand_target(int joint, double target, double speed) override {
+    sim_->set_hand_target(joint, target, speed);
+  }
 
  private:
   std::unique_ptr<control::ServoChannels> channels_;
-  std::unique_ptr<machine::SimMachine> sim_;
+  std::unique_ptr<HandedSimMachine> sim_;
   std::unique_ptr<control::Servo> servo_;
   std::unique_ptr<control::Controller> controller_;
   std::chrono::duration<double> period_;
@@ -187,7 +221,18 @@ void print_event(const ControllerEvent& e) {
   }
 }
 
-/// Follows the job started by cycle start until it ends, with the operator where it waits.
+/// The simulated machine's hand brings a hand-fed axis where the program waits for it (retracts
+/// quickly, feeds down at 2 mm/s): on the command line there is no hand wheel to turn.
+void bring_hand_axis(Driver& d, const control::ServoStatus& s) {
+  if (s.wait != control::Wait::HandAxis || s.hand_wait.axis < 0) return;
+  for (int j = 0; j < s.joint_count; ++j) {
+    if (d.controller().servo_config().joints[static_cast<std::size_t>(j)].axis == s.hand_wait.axis)
+      d.set_hand_target(j, s.hand_wait.target, s.hand_wait.retract ? 40.0 : 2.0);
+  }
+}
+
+/// Follows the job started by cycle start until it ends, with the operator where it waits (and
+/// the machine's hand at the hand-fed axes).
 void follow(Driver& d, control::EventCursor& cursor, const SessionOptions& o, const SessionHooks& hooks,
             SessionEnd& end) {
   const auto t0 = std::chrono::steady_clock::now();
@@ -206,6 +251,7 @@ void follow(Driver& d, control::EventCursor& cursor, const SessionOptions& o, co
     const control::ControllerStatus st = d.controller().status();
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (hooks.progress && (++n % 256 == 0)) hooks.progress(st, wall);
+    bring_hand_axis(d, st.servo);
     if (ended) {
       end.wall_s = wall;
       end.finished = ended->end == control::JobEnd::Finished;

@@ -48,7 +48,8 @@ struct SessionHooks {
 
 /// Runs `o.file` on the simulated machine of `o.machine`; prints problems and program messages
 /// to stderr. At program stops (M0, M1) and manual tool changes it asks the operator on the
-/// terminal (stdin: Enter continues, `a` aborts), or continues at once when `o.unattended`.
+/// terminal (stdin: Enter continues, `a` aborts), or continues at once when `o.unattended`. A
+/// hand-fed axis is brought where the program waits for it by the simulated machine's hand.
 SessionEnd run_session(const SessionOptions& o, const SessionHooks& hooks);
 
 }  // namespace opencnc::cli

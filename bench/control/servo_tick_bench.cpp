@@ -3,7 +3,9 @@
 // coupling, compensation, limits, outputs, status and trace), six axes, with percentiles.
 // Each iteration is one tick timed on its own; the controller's work between ticks is not timed.
 // Two machines: a loopback (feedback = command, nearly free: the servo alone) and the simulated
-// machine (the servo plus the machine's period).
+// machine (the servo plus the machine's period). And the drill retrofit (configs/drill-retrofit.toml):
+// two steppers through the pulse distributor with pitch and backlash compensation, six interlock
+// rules and a hand-fed axis, on a loopback, to show what those stages add.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -104,9 +106,29 @@ std::shared_ptr<canon::Program> six_axis_program() {
   return prog;
 }
 
+/// XY circles of 0.3–1 mm lines over the drill's table, reversing every quarter turn on one axis:
+/// the backlash is taken up again and again.
+std::shared_ptr<canon::Program> drill_program() {
+  canon::ProgramBuilder b(AxisMask::from_letters("XYZ"));
+  b.set_motion_control_mode(canon::MotionControl::Continuous, 0.01);
+  b.set_feed_rate(1500);
+  canon::SegmentId id = 0;
+  double th = 0;
+  for (int i = 0; i < 30000; ++i) {
+    th += (0.3 + 0.7 * ((i * 7919) % 97) / 97.0) / 40.0;
+    Pose p;
+    p[Axis::X] = 300 + 40 * std::cos(th);
+    p[Axis::Y] = 200 + 40 * std::sin(th);
+    b.straight_feed(id++, p);
+  }
+  b.program_end();
+  return std::make_shared<canon::Program>(b.take());
+}
+
 template <typename Machine>
-void servo_tick(benchmark::State& state, std::unique_ptr<Machine> machine) {
-  const config::ProfileLoad load = config::parse_profile(kSixAxes, "six-axis.toml");
+void servo_tick(benchmark::State& state, std::unique_ptr<Machine> machine,
+                const config::ProfileLoad& load = config::parse_profile(kSixAxes, "six-axis.toml"),
+                std::shared_ptr<canon::Program> program = six_axis_program()) {
   if (!load.ok()) {
     state.SkipWithError("profile");
     return;
@@ -125,8 +147,7 @@ void servo_tick(benchmark::State& state, std::unique_ptr<Machine> machine) {
     return o && o->accepted;
   };
   if (!submit(Request::simple(CommandKind::MachineOn)) || !submit(Request::set_mode(Mode::Auto)) ||
-      !submit(Request::open(six_axis_program(), "six-axis")) ||
-      !submit(Request::simple(CommandKind::CycleStart))) {
+      !submit(Request::open(program, "bench")) || !submit(Request::simple(CommandKind::CycleStart))) {
     state.SkipWithError("the program does not start");
     return;
   }
@@ -171,8 +192,19 @@ void BM_ServoTickSimMachine(benchmark::State& state) {
   servo_tick(state, std::make_unique<machine::SimMachine>(config::sim_machine_config(*load.profile)));
 }
 
+/// The drill on a loopback, homed where it stands (the tick of a run is what is timed, not the
+/// decel_midpoint homing before it).
+void BM_ServoTickDrillLoopback(benchmark::State& state) {
+  config::ProfileLoad load = config::load_profile(OPENCNC_SOURCE_DIR "/configs/drill-retrofit.toml");
+  if (load.ok()) {
+    for (config::AxisProfile& a : load.profile->axes) a.homing = config::HomingProfile{};
+  }
+  servo_tick(state, std::make_unique<LoopbackMachine>(3), load, drill_program());
+}
+
 }  // namespace
 
 BENCHMARK(BM_ServoTickLoopback)->UseManualTime()->Iterations(200000)->Unit(benchmark::kNanosecond);
 BENCHMARK(BM_ServoTickSimMachine)->UseManualTime()->Iterations(200000)->Unit(benchmark::kNanosecond);
+BENCHMARK(BM_ServoTickDrillLoopback)->UseManualTime()->Iterations(200000)->Unit(benchmark::kNanosecond);
 BENCHMARK_MAIN();

@@ -2,6 +2,9 @@
 // MachineProfile lookups and the simulated machine a profile describes.
 #include "opencnc/config/machine_profile.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 namespace opencnc::config {
 
 const AxisProfile* MachineProfile::find(Axis axis) const noexcept {
@@ -31,7 +34,12 @@ machine::SimMachineConfig sim_machine_config(const MachineProfile& profile) {
     j.counts_per_unit = a.counts_per_unit;
     j.model = a.sim;
     j.switches = a.switches;
+    j.stall_detector = a.stall_detector;
   }
+  for (std::size_t k = 0; k < profile.sim_input_switches.size() && k < c.input_switches.size(); ++k)
+    c.input_switches[k] = profile.sim_input_switches[k];
+  c.handwheel = profile.handwheel.present;
+  c.temperature_c = profile.sim_temperature_c;
   c.spindle = profile.spindle.present;
   c.spindle_config = profile.spindle.sim;
   c.power_monitor = profile.power.monitor;
@@ -47,6 +55,27 @@ machine::SimMachineConfig sim_machine_config(const MachineProfile& profile) {
   c.analog_inputs = profile.io.analog_inputs;
   c.analog_outputs = profile.io.analog_outputs;
   return c;
+}
+
+MotionReserve compensation_reserve(const AxisProfile& axis, double servo_period_s) {
+  const CompensationProfile& c = axis.compensation;
+  if (!c.present) return {};
+  double slope = 0, bend = 0;  // largest |dE/dx| and largest change of it at a point
+  for (const std::vector<double>* table : {&c.forward, &c.reverse}) {
+    double last = 0;
+    for (std::size_t i = 0; i + 1 < c.positions.size() && i + 1 < table->size(); ++i) {
+      const double k = ((*table)[i + 1] - (*table)[i]) / (c.positions[i + 1] - c.positions[i]);
+      slope = std::max(slope, std::abs(k));
+      bend = std::max(bend, std::abs(k - last));  // the first point bends from the flat end
+      last = k;
+    }
+    bend = std::max(bend, std::abs(last));  // and the last one into the flat end beyond
+  }
+  MotionReserve r;
+  r.velocity = c.takeup_velocity + slope * axis.max_velocity;
+  r.acceleration =
+      c.takeup_acceleration + slope * axis.max_acceleration + bend * axis.max_velocity / servo_period_s;
+  return r;
 }
 
 }  // namespace opencnc::config

@@ -40,12 +40,45 @@ machine::SimJointModel default_model(bool rotary) {
   return m;
 }
 
+/// decel_midpoint: the return velocity (Vm) runs against the search (Vc), in the working feed's
+/// direction, and the latch velocity (Vp) the same way; the overrun takes the axis past the dog.
+void read_midpoint_homing(Section& h, const AxisProfile& a, HomingProfile& hp) {
+  if (!h.has("return_velocity")) {
+    h.missing("return_velocity");
+  } else if (const auto v = h.number("return_velocity")) {
+    hp.return_velocity = *v;
+    if (*v == 0 || (hp.search_velocity != 0 && (*v > 0) == (hp.search_velocity > 0))) {
+      h.error("return_velocity",
+              fmt::format("{} ({}) must run against search_velocity ({}): back in the working direction",
+                          h.key_path("return_velocity"), show(*v), show(hp.search_velocity)),
+              "config.homing");
+    } else if (std::abs(*v) > a.max_velocity) {
+      h.error("return_velocity",
+              fmt::format("{} ({}) exceeds the axis' max_velocity ({})", h.key_path("return_velocity"),
+                          show(*v), show(a.max_velocity)),
+              "config.range");
+    }
+  }
+  if (hp.latch_velocity != 0 && hp.return_velocity != 0 &&
+      (hp.latch_velocity > 0) != (hp.return_velocity > 0)) {
+    h.error("latch_velocity",
+            fmt::format("{} ({}) must run the same way as return_velocity ({})", h.key_path("latch_velocity"),
+                        show(hp.latch_velocity), show(hp.return_velocity)),
+            "config.homing");
+  }
+  if (!h.has("overrun")) {
+    h.missing("overrun");
+  } else {
+    hp.overrun = h.number_or("overrun", 0, Bound::Positive);
+  }
+}
+
 void read_homing(Section& axis_section, AxisProfile& a) {
   const toml::table* t = axis_section.subtable("homing");
   if (t == nullptr) return;
   Section h(*t, axis_section.key_path("homing"),
             {"method", "position", "switch_position", "search_velocity", "latch_velocity", "final_velocity",
-             "sequence"},
+             "sequence", "return_velocity", "overrun", "return_after_program"},
             axis_section.reporter());
   HomingProfile& hp = a.homing;
   hp.method = h.choice<HomingMethod>("method",
@@ -53,12 +86,19 @@ void read_homing(Section& axis_section, AxisProfile& a) {
                                       {"switch", HomingMethod::Switch},
                                       {"switch_index", HomingMethod::SwitchIndex},
                                       {"index", HomingMethod::Index},
-                                      {"decel_home", HomingMethod::DecelHome}},
+                                      {"decel_home", HomingMethod::DecelHome},
+                                      {"decel_midpoint", HomingMethod::DecelMidpoint}},
                                      HomingMethod::Immediate);
   hp.position = h.number_or("position", 0);
   hp.sequence = static_cast<int>(h.integer("sequence", 0, 8).value_or(0));
+  hp.return_after_program = h.boolean_or("return_after_program", false);
+  if (hp.method != HomingMethod::DecelMidpoint) {
+    h.reject("return_velocity", "applies to decel_midpoint homing only");
+    h.reject("overrun", "applies to decel_midpoint homing only");
+  }
   if (hp.method == HomingMethod::Immediate) {
-    for (std::string_view k : {"switch_position", "search_velocity", "latch_velocity", "final_velocity"}) {
+    for (std::string_view k :
+         {"switch_position", "search_velocity", "latch_velocity", "final_velocity", "return_after_program"}) {
       h.reject(k, "does not apply to immediate homing");
     }
     return;
@@ -88,13 +128,47 @@ void read_homing(Section& axis_section, AxisProfile& a) {
   hp.search_velocity = searches ? velocity("search_velocity", true, true) : 0;
   hp.latch_velocity = velocity("latch_velocity", true, true);
   hp.final_velocity = velocity("final_velocity", false, false);
+  if (hp.method == HomingMethod::DecelMidpoint) read_midpoint_homing(h, a, hp);
+}
+
+/// `[axis.<letter>.switches.home_sensor]`: the home switch as an analog proximity sensor.
+void read_home_sensor(Section& switches, machine::SwitchLayout& s) {
+  const toml::table* t = switches.subtable("home_sensor");
+  if (t == nullptr) return;
+  Section p(*t, switches.key_path("home_sensor"), {"ramp", "threshold", "hysteresis", "noise", "drift_per_k"},
+            switches.reporter());
+  machine::ProximitySensor& ps = s.home_sensor;
+  ps.present = true;
+  ps.ramp = p.number_or("ramp", ps.ramp, Bound::Positive);
+  ps.threshold = p.number_or("threshold", ps.threshold, Bound::Positive);
+  ps.hysteresis = p.number_or("hysteresis", ps.hysteresis, Bound::NonNegative);
+  ps.noise = p.number_or("noise", ps.noise, Bound::NonNegative);
+  ps.drift_per_k = p.number_or("drift_per_k", ps.drift_per_k);
+  if (ps.threshold >= 1 || ps.hysteresis >= ps.threshold) {
+    p.error("threshold",
+            fmt::format("{}: threshold ({}) must be below 1 and above hysteresis ({})", p.path(),
+                        show(ps.threshold), show(ps.hysteresis)),
+            "config.range");
+  }
+  if (ps.noise > 0 && ps.noise >= ps.hysteresis / 2) {
+    p.warning("noise",
+              fmt::format("{}: noise ({}) of half the hysteresis ({}) or more makes the sensor chatter",
+                          p.path(), show(ps.noise), show(ps.hysteresis)),
+              "config.switch-chatter");
+  }
+  if (!s.home.present) {
+    p.error("ramp",
+            fmt::format("{} describes the home switch: {}.home is missing", p.path(), switches.path()),
+            "config.missing-key");
+  }
 }
 
 void read_switches(Section& axis_section, AxisProfile& a) {
   const toml::table* t = axis_section.subtable("switches");
   if (t == nullptr) return;
   Section w(*t, axis_section.key_path("switches"),
-            {"limit_min", "limit_max", "home", "decel", "hysteresis", "noise"}, axis_section.reporter());
+            {"limit_min", "limit_max", "home", "decel", "hysteresis", "noise", "home_sensor"},
+            axis_section.reporter());
   machine::SwitchLayout& s = a.switches;
   if (auto v = w.number("limit_min")) s.limit_neg = {true, -machine::kInf, *v};
   if (auto v = w.number("limit_max")) s.limit_pos = {true, *v, machine::kInf};
@@ -102,6 +176,7 @@ void read_switches(Section& axis_section, AxisProfile& a) {
   if (auto v = read_window(w, "decel")) s.decel = *v;
   s.hysteresis = w.number_or("hysteresis", s.hysteresis, Bound::NonNegative);
   s.noise = w.number_or("noise", s.noise, Bound::NonNegative);
+  read_home_sensor(w, s);
   if (s.limit_neg.present && s.limit_pos.present && s.limit_neg.to >= s.limit_pos.from) {
     w.error("limit_min",
             fmt::format("{}: limit_min ({}) must be less than limit_max ({})", w.path(), show(s.limit_neg.to),
@@ -241,6 +316,53 @@ void read_drive(Section& m, const AxisProfile& a, double substep_s, machine::Sim
   }
 }
 
+/// A stepper's mass and pull-out curve (optional: without `pullout_force_n` it is ideal). The
+/// servo-drive keys do not apply to it.
+void read_stepper_mechanics(Section& m, const AxisProfile& a, machine::SimJointModel& model) {
+  for (const auto& [name, value] : m.table()) {
+    const std::string_view k = name.str();
+    const bool stepper_key =
+        k == "backlash" || k == "pitch_error" || k == "start_position" || k == "mass_kg" ||
+        k == "coulomb_friction_n" || k == "static_friction_n" || k == "viscous_friction_n_per_mm_s" ||
+        k == "inertia_kg_m2" || k == "coulomb_friction_nm" || k == "static_friction_nm" ||
+        k == "viscous_friction_nm_per_deg_s" || k == "pullout_force_n" || k == "pullout_speed";
+    if (!stepper_key) m.reject(k, "applies to servo axes only (a stepper follows its steps)");
+  }
+  if (a.rotary) m.reject("pullout_force_n", "applies to linear axes (a rotary stepper is ideal for now)");
+  if (!m.has("pullout_force_n")) {
+    for (std::string_view k : {"mass_kg", "coulomb_friction_n", "static_friction_n",
+                               "viscous_friction_n_per_mm_s", "pullout_speed"})
+      m.reject(k, "needs pullout_force_n (without it the stepper is ideal)");
+    return;
+  }
+  model.pullout_effort = m.number_or("pullout_force_n", 0, Bound::Positive);
+  model.pullout_speed = m.number_or("pullout_speed", 0, Bound::NonNegative);
+  model.inertia = m.number_or("mass_kg", model.inertia, Bound::Positive);
+  model.coulomb_friction = m.number_or("coulomb_friction_n", model.coulomb_friction, Bound::NonNegative);
+  model.static_friction =
+      m.number("static_friction_n", Bound::NonNegative).value_or(1.25 * model.coulomb_friction);
+  model.viscous_friction =
+      m.number_or("viscous_friction_n_per_mm_s", model.viscous_friction, Bound::NonNegative);
+  if (model.static_friction < model.coulomb_friction) {
+    m.error("static_friction_n",
+            fmt::format("{} ({}) must be at least coulomb_friction_n ({})", m.key_path("static_friction_n"),
+                        show(model.static_friction), show(model.coulomb_friction)),
+            "config.range");
+  }
+  // At full speed the motor must still give the friction and the acceleration of the profile.
+  const double reach = model.pullout_speed > 0 ? 1 - a.max_velocity / model.pullout_speed : 1.0;
+  const double need = model.inertia * a.max_acceleration / 1000 + model.coulomb_friction +
+                      model.viscous_friction * a.max_velocity;
+  if (model.pullout_effort * reach < need) {
+    m.warning("pullout_force_n",
+              fmt::format("{}: at max_velocity ({}) the motor gives {:.0f} N, less than the {:.0f} N that "
+                          "max_acceleration ({}) and friction need: it will stall",
+                          m.path(), show(a.max_velocity), model.pullout_effort * std::max(0.0, reach), need,
+                          show(a.max_acceleration)),
+              "config.drive-too-weak");
+  }
+}
+
 void read_sim_model(Section& axis_section, AxisProfile& a, double substep_s) {
   a.sim = default_model(a.rotary);
   const toml::table* t = axis_section.subtable("sim");
@@ -268,10 +390,14 @@ void read_sim_model(Section& axis_section, AxisProfile& a, double substep_s) {
              "feedback",
              "index_spacing",
              "index_offset",
-             "start_position"},
+             "start_position",
+             "pullout_force_n",
+             "pullout_speed"},
             axis_section.reporter());
   machine::SimJointModel& model = a.sim;
   if (a.drive == JointDrive::Servo) {
+    m.reject("pullout_force_n", "applies to stepper axes only");
+    m.reject("pullout_speed", "applies to stepper axes only");
     read_mechanics(m, a, model);
     read_drive(m, a, substep_s, model);
     model.feedback = m.choice<machine::FeedbackSource>(
@@ -279,29 +405,37 @@ void read_sim_model(Section& axis_section, AxisProfile& a, double substep_s) {
         model.feedback);
     model.index_spacing = m.number_or("index_spacing", model.index_spacing, Bound::NonNegative);
     model.index_offset = m.number_or("index_offset", model.index_offset);
+  } else if (a.drive == JointDrive::Stepper) {
+    read_stepper_mechanics(m, a, model);
   } else {
     for (const auto& [name, value] : m.table()) {
-      const std::string_view k = name.str();
-      if (k != "backlash" && k != "pitch_error" && k != "start_position") {
-        m.reject(k, "applies to servo axes only (a stepper follows its steps)");
-      }
+      if (name.str() != "start_position")
+        m.reject(name.str(), "does not apply to a manual axis (a hand moves it)");
     }
   }
-  model.backlash = m.number_or("backlash", model.backlash, Bound::NonNegative);
   model.start_position = m.number_or("start_position", model.start_position);
+  if (a.drive == JointDrive::Manual) return;
+  model.backlash = m.number_or("backlash", model.backlash, Bound::NonNegative);
   read_pitch_table(m, model);
 }
 
 void read_drive_kind(Section& s, AxisProfile& a) {
-  a.drive = s.choice<JointDrive>("drive", {{"servo", JointDrive::Servo}, {"stepper", JointDrive::Stepper}},
-                                 JointDrive::Servo);
-  if (a.drive == JointDrive::Servo) {
+  a.drive = s.choice<JointDrive>(
+      "drive",
+      {{"servo", JointDrive::Servo}, {"stepper", JointDrive::Stepper}, {"manual", JointDrive::Manual}},
+      JointDrive::Servo);
+  if (a.drive != JointDrive::Stepper) {
+    // Servo: the encoder; manual: the scale the hand-fed axis is read with.
     a.counts_per_unit = s.number_or("encoder_counts_per_unit", a.counts_per_unit, Bound::Positive);
     s.reject("steps_per_unit", "applies to stepper axes only");
   } else {
     a.counts_per_unit = s.required_number("steps_per_unit", Bound::Positive);
     s.reject("encoder_counts_per_unit", "applies to servo axes only");
   }
+  a.stall_detector = s.boolean_or("stall_detector", false);
+  if (a.drive != JointDrive::Stepper) s.reject("stall_detector", "applies to stepper axes only");
+  a.hand_tolerance = s.number_or("hand_tolerance", a.hand_tolerance, Bound::Positive);
+  if (a.drive != JointDrive::Manual) s.reject("hand_tolerance", "applies to manual axes only");
 }
 
 void read_limits(Section& s, AxisProfile& a) {
@@ -324,16 +458,32 @@ void read_limits(Section& s, AxisProfile& a) {
 void check_homing(Section& s, const AxisProfile& a) {
   const HomingProfile& h = a.homing;
   const std::string method_key = "homing";
+  if (a.drive == JointDrive::Manual && h.method != HomingMethod::Immediate) {
+    s.error(method_key,
+            fmt::format("{}: a manual axis cannot make homing moves; it homes immediately (its position at "
+                        "power-up is homing.position)",
+                        s.path()),
+            "config.homing");
+    return;
+  }
+  const bool midpoint = h.method == HomingMethod::DecelMidpoint;
   const bool needs_home = h.method == HomingMethod::Switch || h.method == HomingMethod::SwitchIndex ||
-                          h.method == HomingMethod::DecelHome;
+                          h.method == HomingMethod::DecelHome || midpoint;
+  if (midpoint && a.switches.home.present && !a.switches.home_sensor.present) {
+    s.error(method_key,
+            fmt::format("{}: decel_midpoint homing interpolates the level of an analog proximity sensor "
+                        "({}.switches.home_sensor)",
+                        s.path(), s.path()),
+            "config.homing");
+  }
   if (needs_home && !a.switches.home.present) {
     s.error(method_key, fmt::format("{}: homing needs a home switch ({}.switches.home)", s.path(), s.path()),
             "config.homing");
   }
-  if (h.method == HomingMethod::DecelHome && !a.switches.decel.present) {
+  if ((h.method == HomingMethod::DecelHome || midpoint) && !a.switches.decel.present) {
     s.error(method_key,
-            fmt::format("{}: decel_home homing needs a deceleration switch ({}.switches.decel)", s.path(),
-                        s.path()),
+            fmt::format("{}: {} homing needs a deceleration switch ({}.switches.decel)", s.path(),
+                        midpoint ? "decel_midpoint" : "decel_home", s.path()),
             "config.homing");
   }
   const bool needs_index = h.method == HomingMethod::Index || h.method == HomingMethod::SwitchIndex;
@@ -368,11 +518,11 @@ void check_resolution(Section& s, const AxisProfile& a) {
 
 AxisProfile read_axis(const toml::table& table, const std::string& path, Axis axis, double substep_s,
                       Reporter& r) {
-  Section s(
-      table, path,
-      {"type", "drive", "max_velocity", "max_acceleration", "max_jerk", "min_limit", "max_limit", "wrapped",
-       "max_following_error", "encoder_counts_per_unit", "steps_per_unit", "homing", "switches", "sim"},
-      r);
+  Section s(table, path,
+            {"type", "drive", "max_velocity", "max_acceleration", "max_jerk", "min_limit", "max_limit",
+             "wrapped", "max_following_error", "encoder_counts_per_unit", "steps_per_unit", "homing",
+             "switches", "sim", "compensation", "stall_detector", "hand_tolerance"},
+            r);
   AxisProfile a;
   a.axis = axis;
   a.rotary = is_rotary(axis);
@@ -397,6 +547,8 @@ AxisProfile read_axis(const toml::table& table, const std::string& path, Axis ax
   read_switches(s, a);
   read_sim_model(s, a, substep_s);
   check_homing(s, a);
+  if (a.drive == JointDrive::Manual && a.max_jerk > 0)
+    s.reject("max_jerk", "does not apply to a manual axis");
   return a;
 }
 

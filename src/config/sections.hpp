@@ -25,6 +25,12 @@ void read_process(Section& top, MachineProfile& profile);
 void read_io(Section& top, MachineProfile& profile);
 void read_interpreter(Section& top, MachineProfile& profile, const std::filesystem::path& base_dir);
 void read_planner(Section& top, MachineProfile& profile);
+/// [axis.<letter>.compensation] of every axis read. Needs the axes; comp files are found from
+/// `base_dir`.
+void read_compensation(Section& top, MachineProfile& profile, const std::filesystem::path& base_dir);
+/// [interlocks] (named inputs and outputs, rules) and [handwheel]. Needs the axes and [io].
+void read_interlocks(Section& top, MachineProfile& profile);
+void read_handwheel(Section& top, MachineProfile& profile);
 
 /// `node` as an array of exactly two numbers (integers or floats, inf allowed), else nullopt.
 std::optional<std::pair<double, double>> number_pair(const toml::node& node);

@@ -38,6 +38,10 @@ const char* refusal_code(Refusal r) noexcept {
       return "control.soft-limit";
     case Refusal::StartMismatch:
       return "control.start-mismatch";
+    case Refusal::Interlock:
+      return "control.interlock";
+    case Refusal::HandAxis:
+      return "control.hand-axis";
   }
   return "control.unknown";
 }
@@ -58,6 +62,8 @@ const char* fault_code(FaultKind k) noexcept {
       return "control.fault.power-loss";
     case FaultKind::Homing:
       return "control.fault.homing";
+    case FaultKind::Stall:
+      return "control.fault.stall";
   }
   return "control.fault.unknown";
 }
@@ -142,6 +148,8 @@ const char* to_string(CommandKind k) noexcept {
       return "spindle-off";
     case CommandKind::Coolant:
       return "coolant";
+    case CommandKind::SetHandwheel:
+      return "handwheel";
   }
   return "?";
 }

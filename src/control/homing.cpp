@@ -2,6 +2,9 @@
 // JointHoming: one joint's homing phases, edge latching and the move to the home position.
 #include "opencnc/control/homing.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 namespace opencnc::control {
 
 namespace {
@@ -11,6 +14,61 @@ bool same_direction(double a, double b) noexcept {
 }
 
 }  // namespace
+
+const char* to_string(HomingPhase p) noexcept {
+  switch (p) {
+    case HomingPhase::Idle:
+      return "idle";
+    case HomingPhase::Clear:
+      return "clear";
+    case HomingPhase::Search:
+      return "search";
+    case HomingPhase::BackOff:
+      return "back-off";
+    case HomingPhase::Latch:
+      return "latch";
+    case HomingPhase::Index:
+      return "index";
+    case HomingPhase::Overrun:
+      return "overrun";
+    case HomingPhase::Return:
+      return "return";
+    case HomingPhase::Measure:
+      return "measure";
+    case HomingPhase::Center:
+      return "center";
+    case HomingPhase::Final:
+      return "final";
+    case HomingPhase::Done:
+      return "done";
+    case HomingPhase::Failed:
+      return "failed";
+  }
+  return "?";
+}
+
+void EdgeInterpolator::add(double position, double level) noexcept {
+  if (count_ > 0 && position == position_) {
+    sum_ += level;
+    ++count_;
+    return;
+  }
+  if (count_ > 0) {
+    previous_position_ = position_;
+    previous_level_ = sum_ / count_;
+    have_previous_ = true;
+  }
+  position_ = position;
+  sum_ = level;
+  count_ = 1;
+}
+
+double EdgeInterpolator::crossing(double level) const noexcept {
+  const double now = count_ > 0 ? sum_ / count_ : level;
+  if (!have_previous_ || now == previous_level_) return position_;
+  const double f = std::clamp((level - previous_level_) / (now - previous_level_), 0.0, 1.0);
+  return previous_position_ + f * (position_ - previous_position_);
+}
 
 void JointHoming::start(const HomeConfig& c, const HomingInputs& in) noexcept {
   stopping_ = false;
@@ -31,6 +89,11 @@ void JointHoming::start(const HomeConfig& c, const HomingInputs& in) noexcept {
     case HomeMethod::DecelHome:
       phase_ =
           in.home_switch ? HomingPhase::Clear : (in.decel_switch ? HomingPhase::Latch : HomingPhase::Search);
+      break;
+    case HomeMethod::DecelMidpoint:
+      phase_ = in.home_switch || in.decel_switch ? HomingPhase::Clear : HomingPhase::Search;
+      edge_.reset();
+      sensor_on_ = false;
       break;
   }
 }
@@ -73,10 +136,19 @@ void JointHoming::step(const HomeConfig& c, const HomingInputs& in, AxisMover& m
     if (!mover.settled()) return;
     stopping_ = false;
   }
+  if (c.method == HomeMethod::DecelMidpoint) {
+    step_midpoint(c, in, mover, offset);
+    return;
+  }
   const bool decel_home = c.method == HomeMethod::DecelHome;
   switch (phase_) {
     case HomingPhase::Idle:
     case HomingPhase::Done:
+    case HomingPhase::Failed:
+    case HomingPhase::Overrun:
+    case HomingPhase::Return:
+    case HomingPhase::Measure:
+    case HomingPhase::Center:
       break;
     case HomingPhase::Clear:
       mover.run_at(-c.search_velocity);
@@ -140,6 +212,74 @@ void JointHoming::step(const HomeConfig& c, const HomingInputs& in, AxisMover& m
     case HomingPhase::Final:
       mover.move_to(c.position - offset_, c.final_velocity);
       if (mover.settled()) phase_ = HomingPhase::Done;
+      break;
+  }
+}
+
+// The seed's precise origin. Past the dog and back in the working direction, the sensor is met
+// with the backlash taken up; its rising edge (the level crossing level_on) and its falling edge
+// (below level_off) are both interpolated between periods, and their middle is the origin: a
+// shift of the sensing distance (temperature) moves the two edges apart, not their middle.
+void JointHoming::step_midpoint(const HomeConfig& c, const HomingInputs& in, AxisMover& mover,
+                                double& offset) noexcept {
+  const double toward_dog = c.search_velocity > 0 ? 1.0 : -1.0;
+  switch (phase_) {
+    case HomingPhase::Clear:  // on the dog or the sensor already: off them, against the search
+      mover.run_at(-c.search_velocity);
+      if (!in.home_switch && !in.decel_switch) {
+        mover.stop();
+        stopping_ = true;
+        phase_ = HomingPhase::Search;
+      }
+      break;
+    case HomingPhase::Search:
+      mover.run_at(c.search_velocity);
+      if (in.decel_switch) {
+        dog_at_ = in.feedback;
+        mover.move_to(dog_at_ + toward_dog * c.overrun, std::abs(c.search_velocity));
+        phase_ = HomingPhase::Overrun;
+      }
+      break;
+    case HomingPhase::Overrun:
+      if (!mover.settled()) break;
+      edge_.reset();
+      sensor_on_ = in.home_level >= c.level_on;
+      if (sensor_on_ || !in.decel_switch) {  // the overrun did not take it past the sensor, or off the dog
+        phase_ = HomingPhase::Failed;
+        break;
+      }
+      mover.run_at(c.return_velocity);
+      phase_ = HomingPhase::Return;
+      break;
+    case HomingPhase::Return:
+    case HomingPhase::Measure:
+      edge_.add(in.feedback, in.home_level);
+      if (!in.decel_switch) {  // left the dog without both edges: the sensor is not on it
+        mover.stop();
+        phase_ = HomingPhase::Failed;
+      } else if (phase_ == HomingPhase::Return && in.home_level >= c.level_on) {
+        rising_ = edge_.crossing(c.level_on);
+        sensor_on_ = true;
+        mover.run_at(c.latch_velocity);
+        phase_ = HomingPhase::Measure;
+      } else if (phase_ == HomingPhase::Measure && in.home_level < c.level_off) {
+        falling_ = edge_.crossing(c.level_off);
+        sensor_on_ = false;
+        latch(c, 0.5 * (rising_ + falling_), offset);
+        mover.stop();
+        stopping_ = true;
+        phase_ = HomingPhase::Center;
+      }
+      break;
+    case HomingPhase::Center:  // back S/2: the middle of the on-zone
+      mover.move_to(latched_at_, std::abs(c.return_velocity));
+      if (mover.settled()) phase_ = HomingPhase::Final;
+      break;
+    case HomingPhase::Final:
+      mover.move_to(c.position - offset_, c.final_velocity);
+      if (mover.settled()) phase_ = HomingPhase::Done;
+      break;
+    default:
       break;
   }
 }

@@ -15,6 +15,8 @@ constexpr double kSoftLimitSlack = 1e-7;
 /// Commands taken per period; the rest wait for the next one.
 constexpr int kCommandsPerTick = 16;
 
+static_assert(motion::kMaxCompensatedJoints == machine::kMaxJoints);
+
 }  // namespace
 
 Servo::Servo(const ServoConfig& config, ServoChannels& channels, machine::MachineIO& machine) noexcept
@@ -24,6 +26,7 @@ Servo::Servo(const ServoConfig& config, ServoChannels& channels, machine::Machin
       caps_(machine.capabilities()),
       interp_(channels.blocks, config.interpolator, Pose{}) {
   config_.joint_count = std::clamp(std::min(config_.joint_count, caps_.joint_count), 0, machine::kMaxJoints);
+  comp_ = motion::Compensation(config_.compensation);
   stepper_slot_.fill(-1);
   for (int j = 0; j < config_.joint_count; ++j) {
     const JointConfig& jc = config_.joints[static_cast<std::size_t>(j)];
@@ -37,11 +40,12 @@ Servo::Servo(const ServoConfig& config, ServoChannels& channels, machine::Machin
 bool Servo::tick() noexcept {
   ++tick_;
   read_inputs();        // machine inputs (feedback, switches, power, spindle, I/O)
-  check_safety();       // e-stop, limit switches, amplifier faults, following error, power monitor
+  check_safety();       // e-stop, limit switches, amplifier faults, stalls, following error, power
+  apply_interlocks();   // the profile's interlock rules (the PLC): stops, holds, blocked starts
   handle_commands();    // operator and controller commands: the explicit state transitions
-  run_active_mode();    // homing / jog (movers) or MDI / auto (interpolator, machine handshakes)
+  run_active_mode();    // homing / jog / handwheel (movers) or MDI / auto (interpolator, handshakes)
   couple_axes();        // axes → joints (identity until coupling laws come)
-  compensate();         // pitch error and backlash (zero until compensation comes)
+  compensate();         // pitch error and backlash (motion::Compensation)
   check_soft_limits();  // every commanded joint within its soft limits
   write_outputs();      // position commands or step counts, enables, spindle, coolant, I/O
   publish();            // status snapshot, trace sample
@@ -57,7 +61,8 @@ void Servo::read_inputs() noexcept {
     const machine::JointInputs& ji = in_.joints[uj];
     previous_feedback_[uj] = feedback_[uj];
     feedback_[uj] = ji.position;
-    following_error_[uj] = reference_[uj] - feedback_[uj];
+    position_[uj] = ji.position - compensation_[uj];
+    following_error_[uj] = manual(j) ? 0.0 : reference_[uj] - feedback_[uj];
     const bool limit = ji.limit_neg || ji.limit_pos;
     limit_rising_[uj] = limit && !limit_active_[uj];
     limit_active_[uj] = limit;
@@ -80,7 +85,10 @@ void Servo::start_up() noexcept {
     }
     if (stepper_slot_[uj] >= 0)
       pulses_.set_position(stepper_slot_[uj], std::llround(feedback_[uj] * jc.counts_per_unit));
+    reference_[uj] = feedback_[uj];
+    following_error_[uj] = 0;
   }
+  handwheel_last_ = in_.handwheel_count;
   follow_feedback();
   reset_movers();
   state_ = published_state_ = in_.estop_ok ? State::Off : State::EStopped;
@@ -91,7 +99,7 @@ void Servo::start_up() noexcept {
 void Servo::follow_feedback() noexcept {
   for (int j = 0; j < config_.joint_count; ++j) {
     const auto uj = static_cast<std::size_t>(j);
-    commanded_[config_.joints[uj].axis] = feedback_[uj] + offset_[uj];
+    commanded_[config_.joints[uj].axis] = position_[uj] + offset_[uj];
   }
 }
 
@@ -112,7 +120,9 @@ void Servo::check_joint_faults() noexcept {
     const auto uj = static_cast<std::size_t>(j);
     const machine::JointInputs& ji = in_.joints[uj];
     const JointConfig& jc = config_.joints[uj];
-    const double actual = feedback_[uj] + offset_[uj];
+    const double actual = position_[uj] + offset_[uj];
+    if (manual(j)) continue;  // no drive: nothing to fault (a hand axis's switches are the operator's)
+    if (check_stall(j)) return;
     if (ji.amp_fault) {
       enter_fault({FaultKind::AmpFault, jc.axis, actual, 0, tick_});
     } else if (limit_rising_[uj]) {
@@ -122,6 +132,16 @@ void Servo::check_joint_faults() noexcept {
       enter_fault({FaultKind::FollowingError, jc.axis, following_error_[uj], jc.max_following_error, tick_});
     }
   }
+}
+
+// A stepper drive that reports a stall has lost steps: its position is no longer known.
+bool Servo::check_stall(int j) noexcept {
+  const auto uj = static_cast<std::size_t>(j);
+  if (!caps_.joints[uj].stall_detect || !in_.joints[uj].stall) return false;
+  const JointConfig& jc = config_.joints[uj];
+  enter_fault({FaultKind::Stall, jc.axis, position_[uj] + offset_[uj], 0, tick_});
+  homed_[uj] = jc.home.method == HomeMethod::Immediate;
+  return true;
 }
 
 // Mains lost or the UPS on battery: a controlled stop of whatever moves, then Faulted.
@@ -186,6 +206,8 @@ void Servo::run_active_mode() noexcept {
       if (!drives_enabled_) follow_feedback();
       break;
   }
+  run_handwheel();
+  follow_hand_axes();
   if (power_stop_ && activity_ == Activity::None && drives_enabled_) {
     enter_fault({FaultKind::PowerLoss, -1, in_.power.dc_link_v, 0, tick_});
   }
@@ -200,11 +222,14 @@ void Servo::couple_axes() noexcept {
   }
 }
 
+// The correction of each driven joint (pitch error from the origin once homed, backlash on
+// reversals, both taken up within the limits the planner left free); held while the drives are off
+// (the command then follows the feedback less the correction, so that machine-on moves nothing).
 void Servo::compensate() noexcept {
   for (int j = 0; j < config_.joint_count; ++j) {
     const auto uj = static_cast<std::size_t>(j);
-    const double step = joint_cmd_[uj] + compensation_[uj] - out_.joints[uj].position;
-    if (step != 0) direction_[uj] = step > 0 ? 1 : -1;
+    if (manual(j)) continue;
+    if (drives_enabled_) compensation_[uj] = comp_.update(j, joint_cmd_[uj], offset_[uj], homed_[uj]);
     joint_cmd_[uj] += compensation_[uj];
   }
 }
@@ -214,7 +239,7 @@ void Servo::check_soft_limits() noexcept {
   for (int j = 0; j < config_.joint_count; ++j) {
     const auto uj = static_cast<std::size_t>(j);
     const JointConfig& jc = config_.joints[uj];
-    if (!homed_[uj] || jc.wrapped || activity_ == Activity::Homing) continue;
+    if (!homed_[uj] || jc.wrapped || activity_ == Activity::Homing || manual(j)) continue;
     const double x = commanded_[jc.axis];
     const bool low = x<jc.min_limit - kSoftLimitSlack, high = x> jc.max_limit + kSoftLimitSlack;
     if (low || high) {
@@ -228,7 +253,14 @@ void Servo::check_soft_limits() noexcept {
 // --- outputs ---------------------------------------------------------------------------------
 
 void Servo::write_outputs() noexcept {
-  for (int j = 0; j < config_.joint_count; ++j) write_joint(j);
+  bool moved = false;
+  for (int j = 0; j < config_.joint_count; ++j) {
+    moved = moved ||
+            (!manual(j) && drives_enabled_ &&
+             joint_cmd_[static_cast<std::size_t>(j)] != out_.joints[static_cast<std::size_t>(j)].position);
+    write_joint(j);
+  }
+  moved_last_ = moved;
   if (stepper_count_ > 0) write_steppers();
   write_machine_outputs();
   machine_->write(out_);
@@ -237,6 +269,13 @@ void Servo::write_outputs() noexcept {
 void Servo::write_joint(int j) noexcept {
   const auto uj = static_cast<std::size_t>(j);
   machine::JointOutputs& o = out_.joints[uj];
+  if (manual(j)) {  // never commanded: the outputs only mirror the scale
+    joint_velocity_[uj] = velocity_ff_[uj] = 0;
+    reference_[uj] = o.position = feedback_[uj];
+    o.velocity_ff = 0;
+    o.enable = false;
+    return;
+  }
   const bool servo = config_.joints[uj].drive == machine::JointDrive::Servo;
   // Feed-forward from the last two commands: the drive extrapolates the reference with it over
   // the period (one period behind the true derivative, an error of a·T², 1 µm at 1000 mm/s²).
@@ -284,7 +323,7 @@ void Servo::write_machine_outputs() noexcept {
   out_.tool.prepare = on && preparing_;
   out_.tool.prepare_tool = preparing_ ? preparing_tool_ : out_.tool.prepare_tool;
   out_.tool.change = on && sync_step_ == SyncStep::ToolChanger;
-  out_.digital_out = digital_out_;
+  out_.digital_out = (digital_out_ & ~rule_outputs_mask_) | (rule_outputs_ & rule_outputs_mask_);
   out_.analog_out = analog_out_;
 }
 
@@ -311,8 +350,14 @@ void Servo::write_spindle(bool on) noexcept {
       dir = machine::SpindleDirection::Clockwise;
   }
   if (config_.spindle_max_rpm > 0) rpm = std::min(rpm, config_.spindle_max_rpm);
+  // A start waits while an interlock rule blocks it; a spindle that runs is not stopped by that.
+  if (!on || spindle_direction_ == machine::SpindleDirection::Stopped) {
+    spindle_running_ = false;
+  } else if (!spindle_running_ && spindle_may_start()) {
+    spindle_running_ = true;
+  }
   out_.spindle.speed_rpm = on ? rpm : 0.0;
-  out_.spindle.direction = on ? dir : machine::SpindleDirection::Stopped;
+  out_.spindle.direction = on && spindle_running_ ? dir : machine::SpindleDirection::Stopped;
   out_.spindle.orient = on && orient_;
   out_.spindle.orient_angle_deg = orient_angle_;
 }
@@ -349,7 +394,7 @@ void Servo::fill_status(ServoStatus& s) const noexcept {
     const machine::JointInputs& ji = in_.joints[uj];
     JointStatus& js = s.joints[uj];
     js.commanded = commanded_[config_.joints[uj].axis];
-    js.actual = feedback_[uj] + offset_[uj];
+    js.actual = position_[uj] + offset_[uj];
     js.following_error = following_error_[uj];
     js.velocity = joint_velocity_[uj];
     js.homed = homed_[uj];
@@ -385,7 +430,7 @@ void Servo::fill_status(ServoStatus& s) const noexcept {
   s.mist = out_.process.mist;
   s.tool = tool_;
   s.prepared_tool = prepared_tool_;
-  s.digital_out = digital_out_;
+  s.digital_out = out_.digital_out;  // what the machine is told (rules' outputs included)
   s.analog_out = analog_out_;
   s.mains_ok = in_.power.mains_ok;
   s.on_battery = in_.power.ups_on_battery;
@@ -400,6 +445,21 @@ void Servo::fill_status(ServoStatus& s) const noexcept {
   s.probe_tripped = probe_tripped_;
   s.probe_position = probe_position_;
   s.input_value = input_value_;
+  fill_drill_status(s);
+}
+
+void Servo::fill_drill_status(ServoStatus& s) const noexcept {
+  for (int j = 0; j < config_.joint_count; ++j) {
+    const auto uj = static_cast<std::size_t>(j);
+    s.homing[uj] = homing_status_[uj];
+    s.homing[uj].phase = homing_[uj].phase();
+    s.compensation[uj] = compensation_[uj];
+  }
+  s.hand_wait = hand_wait_;
+  s.interlock_rule = blocking_rule_;
+  s.interlocks_true = rules_true_;
+  s.handwheel_axis = handwheel_axis_;
+  s.handwheel_step = handwheel_step_;
 }
 
 void Servo::push_trace() noexcept {
@@ -421,8 +481,11 @@ void Servo::push_trace() noexcept {
   for (int j = 0; j < config_.joint_count; ++j) {
     const auto uj = static_cast<std::size_t>(j);
     const int axis = config_.joints[uj].axis;
-    t.actual[axis] = feedback_[uj] + offset_[uj];
+    t.actual[axis] = position_[uj] + offset_[uj];
     t.following_error[axis] = following_error_[uj];
+    t.output[axis] = manual(j) ? t.actual[axis] : joint_cmd_[uj] + offset_[uj];
+    t.homing_phase[static_cast<std::size_t>(axis)] = homing_[uj].phase();
+    t.home_level[axis] = in_.joints[uj].home_level;
   }
   if (!channels_->trace.try_push(t)) ++trace_dropped_;
 }

@@ -64,6 +64,8 @@ Refusal Servo::apply(const Command& c) noexcept {
     case CommandKind::SpindleOff:
     case CommandKind::Coolant:
       return manual_spindle_or_coolant(c);
+    case CommandKind::SetHandwheel:
+      return set_handwheel(c);
   }
   return Refusal::BadValue;
 }
@@ -84,6 +86,7 @@ Refusal Servo::need_on() const noexcept {
 Refusal Servo::reset() noexcept {
   if (state_ == State::EStopped) {
     if (!in_.estop_ok) return Refusal::EStopInput;
+    if (estop_rule_) return Refusal::Interlock;
     set_state(State::Off);
     return Refusal::None;
   }
@@ -128,6 +131,7 @@ Refusal Servo::start_run(const Command& c) noexcept {
   if (activity_ != Activity::None) return Refusal::Busy;
   if (config_.homing_required && !all_homed()) return Refusal::NotHomed;
   if (any_limit_switch()) return Refusal::LimitSwitch;
+  if (motion_blocked_) return Refusal::Interlock;
   // Blocks and actions below the fences belong to runs that have ended.
   channels_->blocks.pop(static_cast<std::size_t>(std::min<std::uint64_t>(
       c.first_block - std::min(c.first_block, channels_->blocks.popped()), channels_->blocks.available())));
@@ -136,7 +140,7 @@ Refusal Servo::start_run(const Command& c) noexcept {
     const traj::MotionBlock& first = channels_->blocks.peek(0);
     for (int j = 0; j < config_.joint_count; ++j) {
       const int axis = config_.joints[static_cast<std::size_t>(j)].axis;
-      if (std::fabs(first.base[axis] - commanded_[axis]) > 1e-6) return Refusal::StartMismatch;
+      if (!manual(j) && std::fabs(first.base[axis] - commanded_[axis]) > 1e-6) return Refusal::StartMismatch;
     }
   }
   interp_.restart(commanded_);
@@ -146,6 +150,9 @@ Refusal Servo::start_run(const Command& c) noexcept {
   run_mode_ = c.run_mode;
   hold_ = cycle_start_edge_ = abort_edge_ = sync_done_edge_ = aborting_ = false;
   sync_step_ = SyncStep::None;
+  sync_seq_ = traj::kNoBlock;
+  hand_wait_ = HandWait{};
+  hand_guard_ = false;
   activity_ = Activity::Program;
   set_state(State::Running);
   return Refusal::None;
@@ -155,6 +162,8 @@ Refusal Servo::cycle_start() noexcept {
   if (const Refusal r = need_on(); r != Refusal::None) return r;
   if (activity_ != Activity::Program || aborting_) return Refusal::NotApplicable;
   if (state_ != State::Held && state_ != State::Stopped) return Refusal::NotApplicable;
+  if (motion_blocked_) return Refusal::Interlock;
+  if (hand_guard_ && !hand_axis_there(true)) return Refusal::HandAxis;
   hold_ = false;
   cycle_start_edge_ = true;
   set_state(State::Running);
@@ -174,6 +183,8 @@ Refusal Servo::resume() noexcept {
   if (activity_ != Activity::Program || aborting_) return Refusal::NotApplicable;
   if (state_ == State::Stopped) return cycle_start();
   if (state_ != State::Held) return Refusal::NotApplicable;
+  if (motion_blocked_) return Refusal::Interlock;
+  if (hand_guard_ && !hand_axis_there(true)) return Refusal::HandAxis;
   hold_ = false;
   set_state(State::Running);
   return Refusal::None;
@@ -208,6 +219,27 @@ Refusal Servo::set_override(double& target, double value, double max) noexcept {
   return Refusal::None;
 }
 
+// The handwheel moves `axis` by `value` per count (one of the profile's steps, if it lists any);
+// axis −1 takes it off every axis.
+Refusal Servo::set_handwheel(const Command& c) noexcept {
+  if (!caps_.handwheel) return Refusal::NotApplicable;
+  if (c.axis < 0) {
+    handwheel_axis_ = -1;
+    return Refusal::None;
+  }
+  const int j = joint_of(c.axis);
+  if (j < 0) return Refusal::BadValue;
+  if (manual(j)) return Refusal::HandAxis;
+  bool listed = config_.handwheel_step_count == 0 && c.value > 0 && std::isfinite(c.value);
+  for (int k = 0; k < config_.handwheel_step_count; ++k)
+    listed = listed || c.value == config_.handwheel_steps[static_cast<std::size_t>(k)];
+  if (!listed) return Refusal::BadValue;
+  handwheel_axis_ = c.axis;
+  handwheel_step_ = c.value;
+  handwheel_last_ = in_.handwheel_count;  // counts turned before this do not move it
+  return Refusal::None;
+}
+
 Refusal Servo::tool_changed() noexcept {
   if (sync_step_ != SyncStep::ManualTool) return Refusal::NotApplicable;
   manual_tool_done_ = true;
@@ -220,6 +252,8 @@ Refusal Servo::manual_spindle_or_coolant(const Command& c) noexcept {
   switch (c.kind) {
     case CommandKind::SpindleOn:
       if (!(c.value > 0 && c.value <= std::max(config_.spindle_max_rpm, 0.0))) return Refusal::BadValue;
+      if (spindle_direction_ == machine::SpindleDirection::Stopped && !spindle_may_start())
+        return Refusal::Interlock;
       spindle_rpm_ = c.value;
       css_max_rpm_ = 0;  // the operator's speed is in rpm
       spindle_direction_ =
@@ -253,6 +287,8 @@ void Servo::halt(RunEnd why) noexcept {
   hold_ = cycle_start_edge_ = abort_edge_ = aborting_ = false;
   wait_ = Wait::None;
   stop_reason_ = StopReason::None;
+  hand_wait_ = HandWait{};
+  hand_guard_ = false;
   drives_enabled_ = false;
   // Steppers lose their place without drive power: they must home again.
   for (int j = 0; j < config_.joint_count; ++j) {

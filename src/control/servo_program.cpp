@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Servo, Auto and MDI runs: the interpolator's inputs and outputs, the machine side of the
-// program's markers (spindle, coolant, outputs, tool change, M66, M19), probing, run end.
+// program's markers (spindle, coolant, outputs, tool change, M66, M19, hand-axis waits), probing,
+// run end (and homing again after a part where the profile asks for it).
 #include <algorithm>
 #include <cmath>
 
@@ -29,10 +30,12 @@ const traj::MotionBlock* Servo::block(std::uint64_t seq) const noexcept {
 }
 
 // The drive's at-speed signal refers to the command it had when it sampled: only from the period
-// after a change on does it speak about the new one.
+// after a change on does it speak about the new one. A start an interlock holds back is not at
+// speed, whatever the drive says of the standing spindle it was told to keep still.
 bool Servo::spindle_at_speed() const noexcept {
   if (!caps_.spindle) return true;
   if (spindle_direction_ == machine::SpindleDirection::Stopped) return true;
+  if (!spindle_running_) return false;
   return in_.spindle.at_speed && tick_ > spindle_changed_tick_;
 }
 
@@ -89,11 +92,12 @@ void Servo::run_program() noexcept {
   interp_.tick(program_inputs(), tick_out_);
   for (int j = 0; j < config_.joint_count; ++j) {
     const int axis = config_.joints[static_cast<std::size_t>(j)].axis;
-    commanded_[axis] = tick_out_.position[axis];
+    if (!manual(j)) commanded_[axis] = tick_out_.position[axis];
   }
   apply_reports();
   report_sync_points();
   check_probe();
+  check_hand_guard();
   if (tick_out_.state == traj::RunState::WaitingSync) {
     run_sync();
   } else {
@@ -110,7 +114,11 @@ void Servo::map_program_state() noexcept {
       wait_ = Wait::Dwell;
       break;
     case traj::RunState::WaitingSpindle:
-      wait_ = Wait::Spindle;
+      // A start an interlock rule holds back is a wait of its own (status: interlock_rule).
+      wait_ =
+          spindle_direction_ != machine::SpindleDirection::Stopped && !spindle_running_ && spindle_blocked_
+              ? Wait::Interlock
+              : Wait::Spindle;
       break;
     case traj::RunState::Starved:
       wait_ = Wait::Starved;
@@ -249,6 +257,7 @@ void Servo::apply_action(const MachineAction& a) noexcept {
     case ActionCode::WaitInput:
     case ActionCode::SpindleOrient:
     case ActionCode::PalletShuttle:
+    case ActionCode::HandAxisWait:
     case ActionCode::Ignore:
       break;  // handshakes are Sync markers (run_sync); the rest needs nothing from the machine
   }
@@ -258,6 +267,8 @@ void Servo::apply_action(const MachineAction& a) noexcept {
 
 void Servo::run_sync() noexcept {
   if (sync_done_edge_) return;  // done; the interpolator sees it this tick
+  // Released last tick: the interpolator waits at the next marker, which shows from the next tick.
+  if (sync_step_ == SyncStep::None && tick_out_.block_seq == sync_seq_) return;
   if (sync_step_ == SyncStep::None) {
     begin_sync();
   } else if (step_sync()) {
@@ -270,6 +281,7 @@ void Servo::begin_sync() noexcept {
   // Reports passed in this very tick may still be queued behind a full event list: wait a tick.
   if (tick_out_.event_count == traj::kMaxTickEvents) return;
   const traj::MotionBlock* m = block(tick_out_.block_seq);
+  sync_seq_ = tick_out_.block_seq;
   MachineAction a;
   if (m == nullptr || !take_action(m->action, a)) {  // a probe move's end: nothing to do here
     wait_ = Wait::Probe;
@@ -298,6 +310,18 @@ void Servo::begin_sync() noexcept {
       wait_ = Wait::Orient;
       if (!caps_.spindle_orient) sync_done_edge_ = true;
       break;
+    case ActionCode::HandAxisWait: {
+      const int j = joint_of(a.index);
+      hand_wait_.axis = static_cast<std::int8_t>(a.index);
+      hand_wait_.target = a.value;
+      hand_wait_.retract = a.index2 > 0;
+      hand_wait_.tolerance = j >= 0 ? config_.joints[static_cast<std::size_t>(j)].hand_tolerance : 0.0;
+      hand_guard_ = false;
+      sync_step_ = j >= 0 ? SyncStep::HandAxis : SyncStep::None;
+      wait_ = Wait::HandAxis;
+      if (j < 0) sync_done_edge_ = true;
+      break;
+    }
     default:  // pallet shuttle and anything else without a handshake here
       sync_done_edge_ = true;
       break;
@@ -324,10 +348,43 @@ bool Servo::step_sync() noexcept {
       return step_wait_input();
     case SyncStep::Orient:
       return in_.spindle.orient_done;
+    case SyncStep::HandAxis:
+      if (!hand_axis_there(false)) return false;
+      hand_guard_ = true;  // from now on the run needs the axis to stay there
+      return true;
     case SyncStep::None:
       return true;
   }
   return true;
+}
+
+double Servo::hand_position(int axis) const noexcept {
+  const int j = joint_of(axis);
+  return j >= 0 ? position_[static_cast<std::size_t>(j)] + offset_[static_cast<std::size_t>(j)] : 0.0;
+}
+
+// The hand axis is where the wait asks (HandWait): a retract at or above target − tolerance; a
+// plunge reached at or below target + tolerance, and held within the tolerance of the target.
+bool Servo::hand_axis_there(bool holding) const noexcept {
+  const double x = hand_position(hand_wait_.axis);
+  const double lo = hand_wait_.target - hand_wait_.tolerance, hi = hand_wait_.target + hand_wait_.tolerance;
+  if (hand_wait_.retract) return x >= lo;
+  return x <= hi && (!holding || x >= lo);
+}
+
+// While the automatic axes move after a hand-axis wait, the hand axis must stay where that wait
+// put it (the drill must not come down while the table travels): if it leaves, feed hold; resume
+// and cycle start are refused until it is back.
+void Servo::check_hand_guard() noexcept {
+  if (!hand_guard_ || aborting_ || hold_ || tick_out_.path_velocity == 0 || hand_axis_there(true)) return;
+  hold_ = true;
+  set_state(State::Held);
+  ServoEvent e;
+  e.kind = EventKind::HandAxisMoved;
+  e.axis = hand_wait_.axis;
+  e.value = hand_position(hand_wait_.axis);
+  e.run_id = run_id_;
+  emit(e);
 }
 
 // M66: L0 reads at once; L1 waits for a rising edge, L2 a falling one, L3 a high level, L4 a low
@@ -421,9 +478,21 @@ void Servo::end_run(RunEnd why) noexcept {
   hold_ = aborting_ = cycle_start_edge_ = abort_edge_ = sync_done_edge_ = false;
   sync_step_ = SyncStep::None;
   wait_ = Wait::None;
+  hand_wait_ = HandWait{};
+  hand_guard_ = false;
   reset_movers();
   if (why == RunEnd::Finished || why == RunEnd::Aborted || why == RunEnd::ProbeTripped)
     set_state(State::Idle);
+  // Back to the origin after every part where the profile asks (the seed's way of keeping lost
+  // steps from adding up): the joints home again, and the status tells how far the origin moved.
+  if (why == RunEnd::Finished && run_mode_ == Mode::Auto) {
+    std::uint16_t again = 0;
+    for (int j = 0; j < config_.joint_count; ++j) {
+      if (config_.joints[static_cast<std::size_t>(j)].home.return_after_program && !manual(j))
+        again = static_cast<std::uint16_t>(again | (1u << j));
+    }
+    if (again != 0) start_homing(again);
+  }
 }
 
 }  // namespace opencnc::control

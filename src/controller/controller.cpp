@@ -55,6 +55,10 @@ std::string refusal_text(Refusal r) {
       return "the program would cross a soft limit";
     case Refusal::StartMismatch:
       return "the motion does not start where the machine is";
+    case Refusal::Interlock:
+      return "an interlock rule of the machine forbids it now";
+    case Refusal::HandAxis:
+      return "the axis is moved by hand (or is not where the program needs it)";
   }
   return "refused";
 }
@@ -277,6 +281,11 @@ void Controller::on_event(const ServoEvent& e) {
       if (job_) {
         if (const auto text = job_->message(e.run_id, e.action)) note(Severity::Note, "", *text);
       }
+      break;
+    case EventKind::Interlock:
+    case EventKind::HandAxisMoved:
+      note(Severity::Warning, e.kind == EventKind::Interlock ? "control.interlock" : "control.hand-axis",
+           interlock_text(e));
       break;
     default:
       break;
@@ -642,6 +651,19 @@ std::string Controller::wait_text() const {
         return fmt::format("the interpreter, at the {} of {}", to_string(published_.sync_wait),
                            to_string(published_.sync_location));
       return "the planner";
+    case Wait::HandAxis: {
+      const HandWait& h = s.hand_wait;
+      const char axis =
+          h.axis >= 0 && h.axis < kAxisCount ? kAxisLetters[static_cast<std::size_t>(h.axis)] : '?';
+      return fmt::format("the operator to bring the hand-fed {} {} {:.3f} mm", axis,
+                         h.retract ? "up to" : "down to", h.target);
+    }
+    case Wait::Interlock: {
+      const auto& texts = profile_.interlocks.rule_texts;
+      const auto rule = static_cast<std::size_t>(s.interlock_rule);
+      return fmt::format("the interlock \"{}\" to let the spindle start",
+                         s.interlock_rule >= 0 && rule < texts.size() ? texts[rule] : std::string("?"));
+    }
   }
   return {};
 }
@@ -704,6 +726,23 @@ void Controller::finish(std::uint64_t id, Refusal refusal, std::string message, 
   log(std::move(e));
 }
 
+std::string Controller::interlock_text(const ServoEvent& e) const {
+  if (e.kind == EventKind::HandAxisMoved) {
+    const char axis =
+        e.axis >= 0 && e.axis < kAxisCount ? kAxisLetters[static_cast<std::size_t>(e.axis)] : '?';
+    return fmt::format("{} left the position the program needs ({:.4f} mm) while the table moved: feed hold",
+                       axis, e.value);
+  }
+  const auto& texts = profile_.interlocks.rule_texts;
+  const std::string rule = e.action < texts.size() ? texts[e.action] : std::string("?");
+  const char* what = e.command == CommandKind::SpindleOff ? "stopped the spindle"
+                     : e.command == CommandKind::Coolant  ? "stopped the coolant"
+                     : e.command == CommandKind::FeedHold ? "held the motion"
+                     : e.command == CommandKind::JogStop  ? "stopped the jog"
+                                                          : "e-stopped the machine";
+  return fmt::format("interlock \"{}\" {}", rule, what);
+}
+
 std::string Controller::describe(const Fault& f) const {
   const char axis = f.axis >= 0 && f.axis < kAxisCount ? kAxisLetters[static_cast<std::size_t>(f.axis)] : '?';
   const JointConfig* jc = nullptr;
@@ -731,7 +770,13 @@ std::string Controller::describe(const Fault& f) const {
           "stopped on the path",
           f.value);
     case FaultKind::Homing:
-      return fmt::format("homing {} ran into a limit switch at {:.4f} {}", axis, f.value, unit);
+      return fmt::format(
+          "homing {} failed at {:.4f} {}: a limit switch, or the home sensor not on the "
+          "deceleration dog",
+          axis, f.value, unit);
+    case FaultKind::Stall:
+      return fmt::format("the {} stepper stalled at {:.4f} {}: steps were lost, home it again", axis, f.value,
+                         unit);
   }
   return "fault";
 }

@@ -97,8 +97,13 @@ void append(Diagnostics& to, const Diagnostics& from, std::size_t first = 0) {
 /// stream and a preflight scan share.
 class Pipeline {
  public:
-  Pipeline(gcode::Interpreter& interp, const Pose& start, double tolerance_mm, tools::ToolTableService* tools)
-      : interp_(&interp), tolerance_mm_(tolerance_mm), writer_(tools) {
+  Pipeline(gcode::Interpreter& interp, const Pose& start, double tolerance_mm, tools::ToolTableService* tools,
+           const HandAxes& hand)
+      : interp_(&interp),
+        tolerance_mm_(tolerance_mm),
+        writer_(tools),
+        hand_(hand),
+        hand_axes_any_(hand.any()) {
     auto b = std::make_unique<canon::ProgramBuilder>(interp.options().axes, start);
     b->program().set_sources(interp.sources());
     attach(std::move(b), interp.state().modal.units);
@@ -107,8 +112,10 @@ class Pipeline {
   canon::ProgramBuilder& builder() noexcept { return *builder_; }
   const canon::ProgramBuilder& builder() const noexcept { return *builder_; }
   const canon::Program& program() const noexcept { return builder_->program(); }
-  canon::Sink& sink() noexcept { return *outer_; }
+  canon::Sink& sink() noexcept { return hand_sink_ ? static_cast<canon::Sink&>(*with_hand_) : *outer_; }
   ToolTableWriter& writer() noexcept { return writer_; }
+  /// What the hand-axis pass refused (moves of hand-fed axes it cannot wait for).
+  const Diagnostics& hand_failures() const noexcept { return hand_.failures(); }
 
   /// A new leg at `start`: the builder's continuation; the old one is kept until the next leg
   /// (a run's last trace samples may still refer to its moves).
@@ -124,14 +131,24 @@ class Pipeline {
     tolerance_ = std::make_unique<DefaultTolerance>(*builder_, tolerance_mm_, units);
     inner_ = std::make_unique<canon::TeeSink>(*builder_, *tolerance_);
     outer_ = std::make_unique<canon::TeeSink>(*inner_, writer_);
+    // After the builder has appended a move, the hand-axis pass rewrites it (hand-fed axes only).
+    hand_.restart();
+    if (hand_axes_any_) {
+      hand_sink_ = std::make_unique<HandAxisSink>(hand_, builder_->program());
+      with_hand_ = std::make_unique<canon::TeeSink>(*outer_, *hand_sink_);
+    }
   }
 
   gcode::Interpreter* interp_;
   double tolerance_mm_;
   ToolTableWriter writer_;
+  HandAxisFilter hand_;
+  bool hand_axes_any_;
   std::unique_ptr<canon::ProgramBuilder> builder_, previous_;
   std::unique_ptr<DefaultTolerance> tolerance_;
   std::unique_ptr<canon::TeeSink> inner_, outer_;
+  std::unique_ptr<HandAxisSink> hand_sink_;
+  std::unique_ptr<canon::TeeSink> with_hand_;
 };
 
 /// Where the interpreter is placed for a program: the start-up calls, the profile's default
@@ -155,19 +172,22 @@ class GcodeStream final : public ProgramStream {
  public:
   /// A file: owns its interpreter.
   GcodeStream(const gcode::Options& o, const std::string& path, const Pose& start, double tolerance_mm,
-              std::shared_ptr<tools::ToolTableService> tools)
+              std::shared_ptr<tools::ToolTableService> tools, const HandAxes& hand)
       : owned_(std::make_unique<gcode::Interpreter>(o)),
         interp_(owned_.get()),
         tools_(std::move(tools)),
-        pipe_(*interp_, start, tolerance_mm, tools_.get()) {
+        pipe_(*interp_, start, tolerance_mm, tools_.get(), hand) {
     tools_version_ = tools_ ? tools_->version() : 0;
     if (!begin_program(*interp_, pipe_, path, start, tolerance_mm)) fail();
   }
   /// An MDI line on the session's interpreter (already placed and up to date).
   GcodeStream(gcode::Interpreter& session, std::string line, const Pose& start, double tolerance_mm,
-              std::shared_ptr<tools::ToolTableService> tools)
-      : interp_(&session), tools_(std::move(tools)), pipe_(session, start, tolerance_mm, tools_.get()),
-        mdi_line_(std::move(line)), mdi_(true) {
+              std::shared_ptr<tools::ToolTableService> tools, const HandAxes& hand)
+      : interp_(&session),
+        tools_(std::move(tools)),
+        pipe_(session, start, tolerance_mm, tools_.get(), hand),
+        mdi_line_(std::move(line)),
+        mdi_(true) {
     tools_version_ = tools_ ? tools_->version() : 0;
     first_diagnostic_ = interp_->diagnostics().items().size();
     replay_state();
@@ -235,8 +255,9 @@ class GcodeStream final : public ProgramStream {
   }
 
   void on_status(gcode::RunStatus s) {
-    if (!pipe_.writer().failures().items().empty()) {
+    if (!pipe_.writer().failures().items().empty() || !pipe_.hand_failures().items().empty()) {
       append(diags_, pipe_.writer().failures());
+      append(diags_, pipe_.hand_failures());
       state_ = StreamState::Error;
       return;
     }
@@ -313,8 +334,9 @@ class GcodeStream final : public ProgramStream {
 /// One scan of a file (gcode::Mode::Scan) into a window of moves.
 class Scan {
  public:
-  Scan(const gcode::Options& o, const std::string& path, const Pose& start, double tolerance_mm)
-      : interp_(o), pipe_(interp_, start, tolerance_mm, nullptr) {
+  Scan(const gcode::Options& o, const std::string& path, const Pose& start, double tolerance_mm,
+       const HandAxes& hand)
+      : interp_(o), pipe_(interp_, start, tolerance_mm, nullptr, hand) {
     ok_ = begin_program(interp_, pipe_, path, start, tolerance_mm);
     done_ = !ok_;
   }
@@ -330,6 +352,7 @@ class Scan {
   bool done() const noexcept { return done_; }
   bool ok() const noexcept { return ok_; }
   const Diagnostics& diagnostics() const noexcept { return interp_.diagnostics(); }
+  const Diagnostics& hand_failures() const noexcept { return pipe_.hand_failures(); }
   void release(std::size_t move, std::size_t action) { pipe_.builder().program().release_before(move, action); }
 
  private:
@@ -463,18 +486,18 @@ class PreflightRun {
 };
 
 /// One preflight pass; with `classify`, a second scan with other answers runs in step with it.
-Preflight preflight_pass(const gcode::Options& o, const std::string& path, const Pose& start, double tolerance_mm,
-                         MoveCheck& check, bool classify) {
+Preflight preflight_pass(const gcode::Options& o, const std::string& path, const Pose& start,
+                         double tolerance_mm, const HandAxes& hand, MoveCheck& check, bool classify) {
   Preflight out;
   gcode::Options main = o;
   main.mode = gcode::Mode::Scan;
   main.scan_assumption = gcode::ScanAssumption::Rs274;
-  Scan scan(main, path, start, tolerance_mm);
+  Scan scan(main, path, start, tolerance_mm, hand);
   std::unique_ptr<Scan> other;
   if (classify) {
     gcode::Options alt = main;
     alt.scan_assumption = gcode::ScanAssumption::Other;
-    other = std::make_unique<Scan>(alt, path, start, tolerance_mm);
+    other = std::make_unique<Scan>(alt, path, start, tolerance_mm, hand);
   }
   PreflightRun run(check, out);
   while (!scan.done() || run.checked() < scan.program().size()) {
@@ -487,6 +510,7 @@ Preflight preflight_pass(const gcode::Options& o, const std::string& path, const
     if (scan.done() && run.checked() >= scan.program().size()) break;
   }
   append(out.diagnostics, scan.diagnostics());
+  append(out.diagnostics, scan.hand_failures());
   if (!scan.ok() && !out.diagnostics.has_errors())
     out.diagnostics.error(path, 0, 0, "the program cannot be read", "control.program");
   check.finish(out.diagnostics);
@@ -516,6 +540,7 @@ std::shared_ptr<GcodeProgramSource> GcodeProgramSource::create(const config::Mac
     if (!c.tools) return nullptr;
   }
   c.default_tolerance_mm = profile.planner.default_tolerance;
+  c.hand = hand_axes(profile);
   return std::make_shared<GcodeProgramSource>(std::move(c));
 }
 
@@ -535,11 +560,11 @@ gcode::Options GcodeProgramSource::options_for(const std::string& path, const Lo
 Preflight GcodeProgramSource::preflight(const std::string& path, const Pose& start, const LoadOptions& options,
                                         MoveCheck& check) {
   const gcode::Options o = options_for(path, options);
-  Preflight first = preflight_pass(o, path, start, config_.default_tolerance_mm, check, false);
+  Preflight first = preflight_pass(o, path, start, config_.default_tolerance_mm, config_.hand, check, false);
   if (first.summary.sync_points == 0) return first;
   // Sync points: the checks of the moves after them rest on assumed answers. A second pass, beside
   // a scan with other answers, tells which moves those are.
-  Preflight second = preflight_pass(o, path, start, config_.default_tolerance_mm, check, true);
+  Preflight second = preflight_pass(o, path, start, config_.default_tolerance_mm, config_.hand, check, true);
   return second;
 }
 
@@ -550,7 +575,8 @@ std::unique_ptr<ProgramStream> GcodeProgramSource::execute(const std::string& pa
   // As LinuxCNC's task runs it, M99 in the main program starts it again until the operator
   // stops the run (the preflight scans it once, as rs274 reads it).
   o.main_m99 = gcode::MainM99::Repeat;
-  return std::make_unique<GcodeStream>(o, path, start, config_.default_tolerance_mm, config_.tools);
+  return std::make_unique<GcodeStream>(o, path, start, config_.default_tolerance_mm, config_.tools,
+                                       config_.hand);
 }
 
 std::unique_ptr<ProgramStream> GcodeProgramSource::mdi(std::string_view line, const Pose& start) {
@@ -567,8 +593,8 @@ std::unique_ptr<ProgramStream> GcodeProgramSource::mdi(std::string_view line, co
     mdi_tools_version_ = config_.tools->version();
   }
   mdi_->set_machine_position(start);
-  auto stream =
-      std::make_unique<GcodeStream>(*mdi_, std::string(line), start, config_.default_tolerance_mm, config_.tools);
+  auto stream = std::make_unique<GcodeStream>(*mdi_, std::string(line), start, config_.default_tolerance_mm,
+                                              config_.tools, config_.hand);
   return stream;
 }
 

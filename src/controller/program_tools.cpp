@@ -153,6 +153,9 @@ std::optional<MachineAction> machine_action(const canon::Program& program, std::
     case ActionKind::Message:
       m.code = ActionCode::Message;
       break;
+    case ActionKind::HandAxisWait:
+      m.code = ActionCode::HandAxisWait;
+      break;
     case ActionKind::ProbeOn:
     case ActionKind::ProbeOff:
       m.code = ActionCode::Ignore;

@@ -68,6 +68,7 @@ std::string Request::name() const {
                         [](const requests::Mdi&) -> std::string { return "mdi"; },
                         [](const requests::RunAuxiliary&) -> std::string { return "run-auxiliary"; },
                         [](const requests::Feature& r) -> std::string { return r.feature + "." + r.action; },
+                        [](const requests::SetHandwheel&) -> std::string { return "handwheel"; },
                     },
                     body);
 }
@@ -128,6 +129,12 @@ std::optional<Command> to_command(const Request& r) {
             Command c = command(CommandKind::Coolant);
             c.coolant = s.which;
             c.flag = s.on;
+            return c;
+          },
+          [](const requests::SetHandwheel& s) -> std::optional<Command> {
+            Command c = command(CommandKind::SetHandwheel);
+            c.axis = axis_index(s.axis);
+            c.value = s.step;
             return c;
           },
           [](const auto&) -> std::optional<Command> { return std::nullopt; },

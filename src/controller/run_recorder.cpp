@@ -2,6 +2,7 @@
 // Run reports from trace samples (two trace checkers: commanded and actual), and the trace CSV.
 #include "opencnc/controller/run_recorder.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -42,14 +43,21 @@ const char* motion_name(traj::RunState s) {
 
 }  // namespace
 
-RunRecorder::RunRecorder(const plan::MachineLimits& limits, double period_s)
-    : limits_(limits), period_s_(period_s), commanded_(limits, period_s), actual_(limits, period_s) {}
+RunRecorder::RunRecorder(const plan::MachineLimits& limits, double period_s,
+                         const plan::MachineLimits* output_limits)
+    : limits_(limits),
+      period_s_(period_s),
+      commanded_(limits, period_s),
+      actual_(limits, period_s),
+      output_(output_limits != nullptr ? *output_limits : limits, period_s) {}
 
-RunRecorder::RunRecorder(const canon::Program& program, const plan::MachineLimits& limits, double period_s)
-    : RunRecorder(limits, period_s) {
+RunRecorder::RunRecorder(const canon::Program& program, const plan::MachineLimits& limits, double period_s,
+                         const plan::MachineLimits* output_limits)
+    : RunRecorder(limits, period_s, output_limits) {
   fixed_ = &program;
   commanded_.set_program(&program);
   actual_.set_program(&program);
+  output_.set_program(&program);
   begin(program.start());
 }
 
@@ -58,22 +66,47 @@ void RunRecorder::begin(const Pose& start) {
   commanded_.start_at(start);
   actual_.start_at(start);
   last_ = start;
+  start_ = start;
   started_ = true;
+}
+
+// Axes nothing plans (hand-fed ones) move as the operator moves them: the path, its contour and
+// the limits are those of the planned axes, so the others are held where the run started.
+TraceSample RunRecorder::planned_axes(const TraceSample& in) const {
+  TraceSample s = in;
+  for (int i = 0; i < kAxisCount; ++i) {
+    if (limits_.axes.has(static_cast<Axis>(i))) continue;
+    s.commanded[i] = s.actual[i] = s.output[i] = start_[i];
+    s.following_error[i] = 0;
+  }
+  return s;
 }
 
 void RunRecorder::add(const TraceSample& s, const TraceContext& c) {
   if (c.program != commanded_.program()) {
     commanded_.set_program(c.program);
     actual_.set_program(c.program);
+    output_.set_program(c.program);
   }
   if (!started_) begin(c.program != nullptr ? c.program->start() : s.commanded);
   add(s);
 }
 
-void RunRecorder::add(const TraceSample& s) {
-  if (!started_) begin(s.commanded);
+void RunRecorder::add(const TraceSample& in) {
+  if (!started_) begin(in.commanded);
+  const TraceSample s = planned_axes(in);
+  // The compensation may still be taking something up when the run starts (the table switched
+  // on at homing a moment ago): the drives' commands are checked from the third period on, with
+  // the first two as their history.
+  if (r_.samples == 1) output_.start_moving(s.output, output_lead_);
+  if (r_.samples == 0) output_lead_ = s.output;
   commanded_.add(s.commanded, s.segment_first, s.segment_last);
   actual_.add(s.actual, s.segment_first, s.segment_last);
+  if (r_.samples >= 2) output_.add(s.output, s.segment_first, s.segment_last);
+  for (int i = 0; i < kAxisCount; ++i) {
+    if (limits_.axes.has(static_cast<Axis>(i)) && !is_rotary(static_cast<Axis>(i)))
+      r_.max_compensation_mm = std::max(r_.max_compensation_mm, std::fabs(s.output[i] - s.commanded[i]));
+  }
   for (int i = 0; i < kAxisCount; ++i) {
     if (!limits_.axes.has(static_cast<Axis>(i))) continue;
     const double e = std::fabs(s.following_error[i]);
@@ -100,7 +133,9 @@ RunReport RunRecorder::report() const {
   r.max_command_contour_error_mm = c.max_contour_error_mm;
   r.max_contour_error_mm = actual_.report().max_contour_error_mm;
   r.axes = c.axes;
-  r.limit_violations = c.limit_violations;
+  r.output_limit_violations = output_.report().limit_violations;
+  r.first_output_violation = output_.report().first_violation;
+  r.limit_violations = c.limit_violations + r.output_limit_violations;
   return r;
 }
 
@@ -111,7 +146,7 @@ TraceCsvWriter::TraceCsvWriter(const std::string& path, AxisMask axes, double pe
   for (int i = 0; i < kAxisCount; ++i) {
     if (!axes_.has(static_cast<Axis>(i))) continue;
     const char a = kAxisLetters[static_cast<std::size_t>(i)];
-    head += fmt::format(",cmd_{0},act_{0},ferr_{0}", a);
+    head += fmt::format(",cmd_{0},act_{0},ferr_{0},out_{0},phase_{0},level_{0}", a);
   }
   out_ << head << '\n';
 }
@@ -123,8 +158,9 @@ void TraceCsvWriter::add(const TraceSample& s) {
                  s.rapid ? 1 : 0, s.line, s.segment, s.path_velocity);
   for (int i = 0; i < kAxisCount; ++i) {
     if (!axes_.has(static_cast<Axis>(i))) continue;
-    fmt::format_to(std::back_inserter(row_), ",{:.6f},{:.6f},{:.6f}", s.commanded[i], s.actual[i],
-                   s.following_error[i]);
+    fmt::format_to(std::back_inserter(row_), ",{:.6f},{:.6f},{:.6f},{:.6f},{},{:.4f}", s.commanded[i],
+                   s.actual[i], s.following_error[i], s.output[i],
+                   to_string(s.homing_phase[static_cast<std::size_t>(i)]), s.home_level[i]);
   }
   row_ += '\n';
   out_ << row_;

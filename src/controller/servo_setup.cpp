@@ -20,19 +20,55 @@ HomeMethod home_method(config::HomingMethod m) {
       return HomeMethod::Index;
     case config::HomingMethod::DecelHome:
       return HomeMethod::DecelHome;
+    case config::HomingMethod::DecelMidpoint:
+      return HomeMethod::DecelMidpoint;
   }
   return HomeMethod::Immediate;
+}
+
+static_assert(config::kMaxCompensationPoints == motion::kMaxPitchPoints);
+
+/// The fixed-size compensation of one joint from its profile.
+motion::JointCompensation joint_compensation(const config::AxisProfile& a) {
+  motion::JointCompensation c;
+  const config::CompensationProfile& p = a.compensation;
+  if (!p.present) return c;
+  c.enabled = true;
+  c.backlash = p.backlash;
+  c.max_velocity = p.takeup_velocity;
+  c.max_acceleration = p.takeup_acceleration;
+  const std::size_t n = std::min<std::size_t>(p.positions.size(), motion::kMaxPitchPoints);
+  c.pitch.count = static_cast<int>(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    c.pitch.position[i] = p.positions[i];
+    c.pitch.forward[i] = p.forward[i];
+    c.pitch.reverse[i] = p.reverse[i];
+  }
+  return c;
+}
+
+plan::MachineLimits limits(const config::MachineProfile& profile, bool reserve) {
+  plan::MachineLimits m;
+  m.axes = AxisMask{};
+  for (const config::AxisProfile& a : profile.axes) {
+    if (a.manual()) continue;
+    m.axes.set(a.axis);
+    const config::MotionReserve r =
+        reserve ? config::compensation_reserve(a, profile.servo_period_s) : config::MotionReserve{};
+    m.axis[static_cast<std::size_t>(index(a.axis))] = {a.max_velocity - r.velocity,
+                                                       a.max_acceleration - r.acceleration, a.max_jerk};
+  }
+  return m;
 }
 
 }  // namespace
 
 plan::MachineLimits machine_limits(const config::MachineProfile& profile) {
-  plan::MachineLimits m;
-  m.axes = profile.axis_mask();
-  for (const config::AxisProfile& a : profile.axes) {
-    m.axis[static_cast<std::size_t>(index(a.axis))] = {a.max_velocity, a.max_acceleration, a.max_jerk};
-  }
-  return m;
+  return limits(profile, true);
+}
+
+plan::MachineLimits axis_limits(const config::MachineProfile& profile) {
+  return limits(profile, false);
 }
 
 plan::PlannerConfig planner_config(const config::MachineProfile& profile) {
@@ -49,26 +85,44 @@ ServoConfig servo_config(const config::MachineProfile& profile) {
   for (const config::AxisProfile& a : profile.axes) {
     if (a.joint < 0 || a.joint >= machine::kMaxJoints) continue;
     JointConfig& j = s.joints[static_cast<std::size_t>(a.joint)];
+    // Jogs and homing move within what the compensation leaves free, as programs do.
+    const config::MotionReserve r = config::compensation_reserve(a, profile.servo_period_s);
     j.axis = static_cast<std::int8_t>(index(a.axis));
     j.rotary = a.rotary;
     j.wrapped = a.wrapped;
     j.drive = a.drive;
     j.counts_per_unit = a.counts_per_unit;
-    j.max_velocity = a.max_velocity;
-    j.max_acceleration = a.max_acceleration;
+    j.max_velocity = a.max_velocity - r.velocity;
+    j.max_acceleration = a.max_acceleration - r.acceleration;
     j.max_jerk = a.max_jerk;
     j.min_limit = a.min_limit;
     j.max_limit = a.max_limit;
     j.max_following_error = a.max_following_error;
     const config::HomingProfile& h = a.homing;
-    j.home = {home_method(h.method),
-              h.position,
-              h.switch_position,
-              h.search_velocity,
-              h.latch_velocity,
-              h.final_velocity > 0 ? h.final_velocity : a.max_velocity,
-              h.sequence};
+    j.home.method = home_method(h.method);
+    j.home.position = h.position;
+    j.home.switch_position = h.switch_position;
+    j.home.search_velocity = h.search_velocity;
+    j.home.latch_velocity = h.latch_velocity;
+    j.home.final_velocity =
+        std::min(h.final_velocity > 0 ? h.final_velocity : a.max_velocity, j.max_velocity);
+    j.home.sequence = h.sequence;
+    j.home.return_velocity = h.return_velocity;
+    j.home.overrun = h.overrun;
+    j.home.level_on = a.switches.home_sensor.threshold;
+    j.home.level_off = a.switches.home_sensor.threshold - a.switches.home_sensor.hysteresis;
+    j.home.return_after_program = h.return_after_program;
+    j.hand_tolerance = a.hand_tolerance;
     if (j.home.method != HomeMethod::Immediate) s.homing_required = true;
+    s.compensation.joints[static_cast<std::size_t>(a.joint)] = joint_compensation(a);
+  }
+  s.compensation.period_s = profile.servo_period_s;
+  s.interlocks = profile.interlocks.rules;
+  if (profile.handwheel.present) {
+    s.handwheel_step_count =
+        static_cast<int>(std::min<std::size_t>(profile.handwheel.steps.size(), kMaxHandwheelSteps));
+    for (int k = 0; k < s.handwheel_step_count; ++k)
+      s.handwheel_steps[static_cast<std::size_t>(k)] = profile.handwheel.steps[static_cast<std::size_t>(k)];
   }
   s.interpolator = plan::Planner(machine_limits(profile), planner_config(profile)).interpolator_config();
   s.spindle_max_rpm = profile.spindle.present ? profile.spindle.max_rpm : 0.0;

@@ -77,9 +77,13 @@ SimJoint::SimJoint(const SimJointConfig& config, double servo_period_s, int subs
   if (config.drive == JointDrive::Stepper) {
     steps_emitted_ = std::llround(m.start_position * config.counts_per_unit);
     motor_ = static_cast<double>(steps_emitted_) / config.counts_per_unit;
+    stepper_dynamic_ = m.pullout_effort > 0;
   } else {
     motor_ = m.start_position;
   }
+  hand_target_ = motor_;
+  if (config.switches.home_sensor.present)
+    home_sensor_ = SimProximity(config.switches.home, config.switches.home_sensor);
   screw_ = motor_;
   steps_at_period_start_ = steps_emitted_;
   cmd_.position = motor_;
@@ -97,7 +101,14 @@ JointCapabilities SimJoint::capabilities() const noexcept {
   const bool servo = config_.drive == JointDrive::Servo;
   c.index = servo && config_.model.index_spacing > 0;
   c.effort = servo;
+  c.home_level = s.home.present && s.home_sensor.present;
+  c.stall_detect = config_.drive == JointDrive::Stepper && config_.stall_detector;
   return c;
+}
+
+void SimJoint::set_hand_target(double target, double speed) noexcept {
+  hand_target_ = target;
+  hand_speed_ = std::abs(speed);
 }
 
 double SimJoint::table_position() const noexcept {
@@ -107,6 +118,7 @@ double SimJoint::table_position() const noexcept {
 double SimJoint::feedback_raw() const noexcept {
   if (config_.drive == JointDrive::Stepper)
     return static_cast<double>(steps_emitted_) / config_.counts_per_unit;
+  if (config_.drive == JointDrive::Manual) return table_position();  // a scale on the quill
   return config_.model.feedback == FeedbackSource::Table ? table_position() : motor_;
 }
 
@@ -165,6 +177,11 @@ double SimJoint::energy_j() const noexcept {
 // the period, so the play operator can be applied once at the end), a joint that stands
 // without power and without a load that breaks it loose, and a linear drive.
 bool SimJoint::integrate_period() noexcept {
+  if (config_.drive == JointDrive::Manual) {
+    integrate_hand_period();
+    return true;
+  }
+  if (config_.drive == JointDrive::Stepper && stepper_dynamic_) return integrate_stepper_period();
   if (config_.drive == JointDrive::Stepper) {
     if (powered_) {
       steps_emitted_ = cmd_.step_position;
@@ -447,6 +464,83 @@ void SimJoint::take_up_backlash() noexcept {
   }
 }
 
+// A stepper with a pull-out curve, one period: the steps are emitted whatever the rotor does.
+// In step, the rotor follows them if the effort the period asks — mass × the change of step rate,
+// friction against the motion, minus the load (at rest: the load beyond static friction) — is
+// within the pull-out effort at that speed; otherwise it drops out of step. The step rate is
+// taken through a first-order lag of kRotorLag_s: the rotor's load angle absorbs the jitter of
+// whole steps from period to period (one step more or less is far inside the ±1 full step it may
+// lag), so only sustained accelerations count. Out of step (or without power) it coasts under
+// friction and load, and it locks on the nearest step again once the steps and the rotor are
+// both at rest; the steps emitted meanwhile are lost.
+bool SimJoint::integrate_stepper_period() noexcept {
+  constexpr double kRotorLag_s = 0.004;
+  const SimJointModel& m = config_.model;
+  const double spu = config_.counts_per_unit;
+  const double v_steps =
+      powered_ ? static_cast<double>(cmd_.step_position - steps_emitted_) / spu / period_s_ : 0.0;
+  if (powered_) steps_emitted_ = cmd_.step_position;
+  if (powered_ && !stalled_ && in_step_) {
+    const double smoothed =
+        step_velocity_ + (v_steps - step_velocity_) * period_s_ / (period_s_ + kRotorLag_s);
+    const double accel = (smoothed - step_velocity_) / period_s_;
+    const double need = v_steps != 0.0
+                            ? accel / accel_per_effort_ + std::copysign(m.coulomb_friction, v_steps) +
+                                  m.viscous_friction * v_steps - external_effort_
+                            : std::max(0.0, std::abs(external_effort_) - m.static_friction) +
+                                  std::abs(accel / accel_per_effort_);
+    const double reach = m.pullout_speed > 0 ? std::max(0.0, 1.0 - std::abs(v_steps) / m.pullout_speed) : 1.0;
+    step_velocity_ = smoothed;
+    if (std::abs(need) <= m.pullout_effort * reach) {
+      motor_ = static_cast<double>(steps_emitted_ - lost_steps_) / spu;
+      velocity_ = v_steps;
+      take_up_backlash();
+      return true;
+    }
+    stalled_ = true;  // out of step, with the speed the rotor had
+  }
+  in_step_ = false;
+  step_velocity_ = v_steps;
+  coast();
+  if (powered_ && v_steps == 0.0 && velocity_ == 0.0) {
+    const std::int64_t at = std::llround(motor_ * spu);
+    lost_steps_ = steps_emitted_ - at;
+    motor_ = static_cast<double>(at) / spu;
+    stalled_ = false;
+    in_step_ = true;
+    take_up_backlash();
+  }
+  return true;
+}
+
+/// A period of free motion (no drive effort) under friction and the load, sub-step by sub-step.
+void SimJoint::coast() noexcept {
+  for (int i = 0; i < substeps_; ++i) {
+    integrate_mechanics(0.0);
+    take_up_backlash();
+  }
+}
+
+// The operator's hand: toward the target at up to the hand speed, with a hand's acceleration,
+// braking so as to stop on the target (a quill against its depth stop).
+void SimJoint::integrate_hand_period() noexcept {
+  const double a_max = kHandAcceleration;
+  for (int i = 0; i < substeps_; ++i) {
+    const double d = hand_target_ - motor_;
+    if (d == 0.0 && velocity_ == 0.0) break;
+    const double want = std::copysign(std::min(hand_speed_, std::sqrt(2.0 * a_max * std::abs(d))), d);
+    velocity_ += std::clamp(want - velocity_, -a_max * h_, a_max * h_);
+    const double step = velocity_ * h_;
+    if ((d > 0 && step >= d) || (d < 0 && step <= d) || d == 0.0) {
+      motor_ = hand_target_;
+      velocity_ = 0;
+    } else {
+      motor_ += step;
+    }
+  }
+  screw_ = motor_;
+}
+
 // The step generator spreads this period's steps evenly; sub-step i has emitted the share
 // up to its end. An unpowered stepper emits nothing (and so loses its place).
 void SimJoint::stepper_substep(int i) noexcept {
@@ -458,7 +552,7 @@ void SimJoint::stepper_substep(int i) noexcept {
 }
 
 void SimJoint::end_period() noexcept {
-  if (config_.drive == JointDrive::Stepper) {
+  if (config_.drive == JointDrive::Stepper && !stepper_dynamic_) {
     velocity_ =
         static_cast<double>(steps_emitted_ - steps_at_period_start_) / config_.counts_per_unit / period_s_;
   }
@@ -480,18 +574,24 @@ void SimJoint::update_index(double before, double after) noexcept {
   index_position_ = quantise(offset + last_mark * spacing);
 }
 
-void SimJoint::sample(JointInputs& in, SplitMix64& rng) noexcept {
+void SimJoint::sample(JointInputs& in, SplitMix64& rng, double temperature_c) noexcept {
   const bool servo = config_.drive == JointDrive::Servo;
-  in.position = servo ? quantise(feedback_raw()) : feedback_raw();
+  in.position = config_.drive == JointDrive::Stepper ? feedback_raw() : quantise(feedback_raw());
   in.velocity = velocity_;
   in.effort = servo ? effort_ : 0.0;
   in.index_count = index_count_;
   in.index_position = index_position_;
   in.amp_fault = injected_fault_;
+  in.stall = config_.stall_detector && stalled_;
   const double x = table_position();
   in.limit_neg = limit_neg_.update(x, rng);
   in.limit_pos = limit_pos_.update(x, rng);
-  in.home = home_.update(x, rng);
+  if (home_sensor_.present()) {
+    in.home = home_sensor_.update(x, temperature_c, rng);
+    in.home_level = home_sensor_.level();
+  } else {
+    in.home = home_.update(x, rng);
+  }
   in.decel = decel_.update(x, rng);
 }
 

@@ -39,6 +39,11 @@ SimMachine::SimMachine(const SimMachineConfig& config) : config_(config), rng_(c
     probe_ = SimSwitch(config.probe.trip, config.probe.hysteresis, config.probe.noise);
     probe_table_ = joints_[static_cast<std::size_t>(config.probe.joint)].table_position();
   }
+  for (std::size_t k = 0; k < input_switches_.size(); ++k) {
+    const SimInputSwitch& in = config.input_switches[k];
+    if (in.channel >= 0 && in.joint >= 0) input_switches_[k] = SimSwitch(in.window, in.hysteresis, in.noise);
+  }
+  temperature_c_ = config.temperature_c;
   dc_link_v_ = config.power.dc_link_nominal_v;
   ups_periods_left_ =
       config.power.ups
@@ -68,7 +73,17 @@ MachineCapabilities SimMachine::capabilities() const noexcept {
   c.digital_outputs = config_.digital_outputs;
   c.analog_inputs = config_.analog_inputs;
   c.analog_outputs = config_.analog_outputs;
+  c.handwheel = config_.handwheel;
   return c;
+}
+
+void SimMachine::set_hand_target(int joint, double target, double speed) noexcept {
+  if (joint >= 0 && joint < config_.joint_count)
+    joints_[static_cast<std::size_t>(joint)].set_hand_target(target, speed);
+}
+
+void SimMachine::turn_handwheel(std::int32_t counts) noexcept {
+  if (config_.handwheel) handwheel_count_ += static_cast<std::uint32_t>(counts);
 }
 
 void SimMachine::read(MachineInputs& in) noexcept {
@@ -174,7 +189,7 @@ void SimMachine::sample() noexcept {
   for (int j = 0; j < config_.joint_count; ++j) {
     const auto uj = static_cast<std::size_t>(j);
     previous_feedback_[uj] = inputs_.joints[uj].position;
-    joints_[uj].sample(inputs_.joints[uj], rng_);
+    joints_[uj].sample(inputs_.joints[uj], rng_, temperature_c_);
     inputs_.joints[uj].amp_fault = inputs_.joints[uj].amp_fault || undervoltage_fault_[uj];
   }
   inputs_.power.mains_ok = mains_ok_;
@@ -201,7 +216,16 @@ void SimMachine::sample() noexcept {
   inputs_.process.gap_voltage_v = config_.process.generator && process_.generator_on ? gap_voltage_v_ : 0.0;
   inputs_.tool.prepared = prepare_periods_ >= prepare_needed_;
   inputs_.tool.changed = change_periods_ >= change_needed_;
-  inputs_.digital_in = digital_in_ & low_bits(config_.digital_inputs);
+  std::uint64_t switched = 0;  // inputs wired to switches on the machine
+  for (std::size_t k = 0; k < input_switches_.size(); ++k) {
+    const SimInputSwitch& w = config_.input_switches[k];
+    if (w.channel < 0 || w.joint < 0 || w.joint >= config_.joint_count || w.channel >= kDigitalChannels)
+      continue;
+    if (input_switches_[k].update(joints_[static_cast<std::size_t>(w.joint)].table_position(), rng_))
+      switched |= std::uint64_t{1} << w.channel;
+  }
+  inputs_.digital_in = (digital_in_ | switched) & low_bits(config_.digital_inputs);
+  inputs_.handwheel_count = static_cast<std::int32_t>(handwheel_count_);
   for (int k = 0; k < kAnalogChannels; ++k) {
     inputs_.analog_in[static_cast<std::size_t>(k)] =
         k < config_.analog_inputs ? analog_in_[static_cast<std::size_t>(k)] : 0.0;

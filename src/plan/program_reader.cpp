@@ -51,6 +51,7 @@ MarkerKind marker_for(ActionKind k) {
     case ActionKind::WaitInput:
     case ActionKind::PalletShuttle:
     case ActionKind::SpindleOrient:
+    case ActionKind::HandAxisWait:
       return MarkerKind::Sync;
     case ActionKind::SpindleSpeed:
     case ActionKind::SpindleCw:

@@ -130,5 +130,45 @@ TEST(ServoAllocations, NoneWhileRigidTappingOrUnderConstantSurfaceSpeed) {
   std::filesystem::remove_all(dir);
 }
 
+// The drill retrofit's tick: midpoint homing on the analog sensors, the compensation stage, the
+// interlock rules, the handwheel, hand-axis waits with a simulated operator, a stall and an e-stop.
+TEST(ServoAllocations, NoneInsideTheDrillsTick) {
+  g_allocations = 0;
+  Armed a(drill());
+  a.ask(Request::simple(CommandKind::MachineOn));
+  a.ask(Request::set_mode(Mode::Manual));
+  a.ask(Request::home());
+  ASSERT_TRUE(a.idle());
+  a.ask(Request::handwheel(Axis::X, 0.01));
+  a.rig().machine().turn_handwheel(40);
+  a.until([] { return false; }, 50);
+  ASSERT_TRUE(a.idle());
+  a.ask(Request::set_mode(Mode::Auto));
+  a.ask(Request::open(OPENCNC_SOURCE_DIR "/examples/drill-bearing-cap.ngc"));
+  a.ask(Request::simple(CommandKind::CycleStart));
+  int changing = 0;
+  ASSERT_TRUE(a.until(
+      [&] {
+        const ServoStatus v = a.rig().status().servo;
+        if (v.wait == Wait::HandAxis)
+          a.rig().machine().set_hand_target(2, v.hand_wait.target, v.hand_wait.retract ? 60.0 : 20.0);
+        if (v.wait == Wait::ManualToolChange && ++changing % 500 == 0)
+          a.rig().controller().submit(Request::simple(CommandKind::ToolChanged));
+        return a.state() == State::Idle && !a.rig().status().run_active && a.rig().status().servo.all_homed;
+      },
+      2'000'000));
+  EXPECT_EQ(a.rig().status().runs_finished, 1u);
+  a.ask(Request::set_mode(Mode::Manual));
+  a.ask(Request::jog(Axis::X, 30));
+  a.until([] { return false; }, 200);
+  a.rig().machine().set_external_effort(0, -3000);  // a stall the X drive detects
+  a.until([] { return false; }, 50);
+  EXPECT_EQ(a.state(), State::Faulted);
+  a.rig().machine().set_estop_pressed(true);
+  a.until([] { return false; }, 5);
+  EXPECT_EQ(a.state(), State::EStopped);
+  EXPECT_EQ(g_allocations.load(), 0);
+}
+
 }  // namespace
 }  // namespace opencnc::control::test

@@ -323,6 +323,11 @@ const Row kRows[] = {
      Refusal::None, State::Idle},
     {"coolant_auto", false, idle(Mode::Auto), State::Idle, cmd(CommandKind::Coolant, 0, 0, -1, true),
      Refusal::WrongMode, State::Idle},
+    // the handwheel is a setting, taken in every state where the machine has one (servo_drill_test)
+    {"handwheel_without_one", false, idle(Mode::Manual), State::Idle,
+     cmd(CommandKind::SetHandwheel, 0.01, 0, 0), Refusal::NotApplicable, State::Idle},
+    {"handwheel_without_one_estopped", false, estopped, State::EStopped,
+     cmd(CommandKind::SetHandwheel, 0.01, 0, 0), Refusal::NotApplicable, State::EStopped},
 };
 
 void PrintTo(const Row& r, std::ostream* os) {

@@ -24,6 +24,11 @@ inline config::MachineProfile mill(std::vector<std::string> sets = {}) {
   return loaded(config::load_profile(OPENCNC_SOURCE_DIR "/configs/mill-3axis.toml", sets));
 }
 
+/// configs/drill-retrofit.toml with `--set` overrides.
+inline config::MachineProfile drill(std::vector<std::string> sets = {}) {
+  return loaded(config::load_profile(OPENCNC_SOURCE_DIR "/configs/drill-retrofit.toml", sets));
+}
+
 /// Z homes first on a deceleration dog and a home switch; then X on a switch (latching the
 /// rising edge after backing off) and Y on a switch and the next index mark (latching away from
 /// the switch). Noisy switches with hysteresis, limit switches beyond the soft limits, a UPS,

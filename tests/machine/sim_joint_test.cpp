@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <utility>
+#include <vector>
 
 #include "opencnc/machine/sim_joint.hpp"
 
@@ -400,6 +402,168 @@ TEST(SimJoint, DisabledOrFaultedDriveProducesNoForce) {
   for (int k = 0; k < 100; ++k) rig.period(1.0, 0, false);
   EXPECT_EQ(rig.joint.motor_position(), 0.0);
   EXPECT_EQ(rig.in.effort, 0.0);
+}
+
+/// A stepper on a 5 mm screw, 200 full steps × 8 = 320 steps/mm, an 80 kg table with friction,
+/// and a motor that gives 800 N at standstill, falling to nothing at 150 mm/s.
+SimJointConfig dynamic_stepper() {
+  SimJointConfig c;
+  c.drive = JointDrive::Stepper;
+  c.counts_per_unit = 320;
+  c.model.inertia = 80;
+  c.model.coulomb_friction = 60;
+  c.model.static_friction = 75;
+  c.model.viscous_friction = 0.1;
+  c.model.pullout_effort = 800;
+  c.model.pullout_speed = 150;
+  c.stall_detector = true;
+  return c;
+}
+
+/// Step counts of a rest-to-rest trapezoid of `distance` mm at `v` and `a`.
+std::vector<std::int64_t> trapezoid_steps(double distance, double v, double a, double spu) {
+  std::vector<std::int64_t> out;
+  const double t_ramp = v / a, d_ramp = 0.5 * a * t_ramp * t_ramp;
+  const double t_total = 2 * t_ramp + (distance - 2 * d_ramp) / v;
+  for (double t = kPeriod; t < t_total + 0.05; t += kPeriod) {
+    double x;
+    if (t < t_ramp) {
+      x = 0.5 * a * t * t;
+    } else if (t < t_total - t_ramp) {
+      x = d_ramp + v * (t - t_ramp);
+    } else {
+      const double r = std::max(0.0, t_total - t);
+      x = distance - 0.5 * a * r * r;
+    }
+    out.push_back(std::llround(x * spu));
+  }
+  return out;
+}
+
+TEST(SimJoint, StepperWithinItsPullOutCurveMakesEveryStep) {
+  JointRig rig(dynamic_stepper());
+  // 500 mm/s² needs 40 N on the mass + 60 N friction; at 50 mm/s the motor still gives 533 N.
+  for (std::int64_t s : trapezoid_steps(100, 50, 500, 320)) rig.steps(s);
+  EXPECT_EQ(rig.in.position, 100.0);
+  EXPECT_EQ(rig.joint.motor_position(), 100.0);
+  EXPECT_EQ(rig.joint.lost_steps(), 0);
+  EXPECT_FALSE(rig.in.stall);
+}
+
+TEST(SimJoint, OverloadedStepperStallsAndLosesSteps) {
+  JointRig rig(dynamic_stepper());
+  // 10 000 mm/s² needs 800 N for the mass alone: it drops out of step on the first ramp.
+  bool stalled = false;
+  for (std::int64_t s : trapezoid_steps(100, 120, 10000, 320)) {
+    rig.steps(s);
+    stalled = stalled || rig.in.stall;
+  }
+  EXPECT_TRUE(stalled);
+  for (int k = 0; k < 500; ++k) rig.steps(32000);  // the command rests: the rotor locks again
+  EXPECT_FALSE(rig.in.stall);
+  EXPECT_EQ(rig.in.position, 100.0);  // the steps were emitted: open loop, the control believes it
+  EXPECT_LT(rig.joint.motor_position(), 50.0);
+  EXPECT_GT(rig.joint.lost_steps(), 50 * 320);
+  // Locked on a step: later steps are made again, from where it stands.
+  const double here = rig.joint.motor_position();
+  for (int k = 1; k <= 100; ++k) rig.steps(32000 + k);
+  EXPECT_DOUBLE_EQ(rig.joint.motor_position(), here + 100.0 / 320);
+}
+
+TEST(SimJoint, LoadBeyondThePullOutEffortStallsAStandingStepper) {
+  SimJointConfig c = dynamic_stepper();
+  c.stall_detector = false;  // no detector: the stall goes unseen
+  JointRig rig(c);
+  JointOutputs out;
+  out.enable = true;
+  rig.joint.begin_period(out, true, -2000);  // 2 kN pushing it back
+  rig.joint.end_period();
+  rig.joint.sample(rig.in, rig.rng);
+  EXPECT_TRUE(rig.joint.stalled());
+  EXPECT_FALSE(rig.in.stall);
+  EXPECT_LT(rig.joint.motor_position(), 0.0);
+}
+
+TEST(SimJoint, UnpoweredStepperCoastsToAStopOnFriction) {
+  JointRig rig(dynamic_stepper());
+  std::int64_t s = 0;
+  for (int k = 1; k <= 200; ++k) rig.steps(s = std::llround(0.5 * 500 * std::pow(k * kPeriod, 2) * 320));
+  ASSERT_FALSE(rig.joint.stalled());
+  const double v = rig.in.velocity;  // about 500 mm/s² · 0.2 s = 100 mm/s
+  EXPECT_NEAR(v, 100, 1);
+  const double at = rig.joint.motor_position();
+  for (int k = 0; k < 2000; ++k) rig.steps(s, false);
+  // Coulomb 60 N and viscous friction on 80 kg: at most v²/(2·60/80 m/s²) of coasting.
+  const double coast = rig.joint.motor_position() - at;
+  EXPECT_GT(coast, 0.0);
+  EXPECT_LE(coast, v * v / (2 * 60.0 / 80 * 1000) + v * kPeriod);
+  EXPECT_EQ(rig.joint.velocity(), 0.0);
+}
+
+TEST(SimJoint, ManualJointFollowsTheHandNotTheCommand) {
+  SimJointConfig c;
+  c.drive = JointDrive::Manual;
+  c.counts_per_unit = 1000;  // a 1 µm scale
+  JointRig rig(c);
+  EXPECT_EQ(rig.joint.capabilities().drive, JointDrive::Manual);
+  for (int k = 0; k < 100; ++k) rig.period(50.0);  // commands do nothing
+  EXPECT_EQ(rig.in.position, 0.0);
+  rig.joint.set_hand_target(-20.0, 10.0);
+  for (int k = 0; k < 1000; ++k) rig.period(50.0);
+  EXPECT_LT(rig.in.position, -9.0);  // 10 mm/s after a short run-up
+  EXPECT_GT(rig.in.position, -10.0);
+  for (int k = 0; k < 2000; ++k) rig.period(50.0);
+  EXPECT_EQ(rig.in.position, -20.0);
+  EXPECT_EQ(rig.joint.velocity(), 0.0);
+}
+
+TEST(SimJoint, AnalogHomeSensorGivesLevelAndComparator) {
+  SimJointConfig c = servo_config();
+  c.switches.home = {true, 10.0, 12.0};
+  c.switches.home_sensor = {true, 0.5, 0.5, 0.05, 0.0, 0.002};
+  c.model.start_position = 9.0;
+  JointRig rig(c);
+  EXPECT_TRUE(rig.joint.capabilities().home_level);
+  EXPECT_DOUBLE_EQ(rig.in.home_level, 0.0);  // 1 mm before the zone: 0.5 − 1/0.5, clamped
+  EXPECT_FALSE(rig.in.home);
+  const auto at = [&](double x) {
+    for (int k = 0; k < 300; ++k) rig.period(x);
+  };
+  at(9.9);
+  EXPECT_NEAR(rig.in.home_level, 0.3, 1e-3);
+  EXPECT_FALSE(rig.in.home);
+  at(10.001);
+  EXPECT_NEAR(rig.in.home_level, 0.502, 1e-3);
+  EXPECT_TRUE(rig.in.home);
+  at(9.99);  // inside the hysteresis band (off below level 0.45, at 9.975)
+  EXPECT_TRUE(rig.in.home);
+  at(9.97);
+  EXPECT_FALSE(rig.in.home);
+  at(11.0);
+  EXPECT_EQ(rig.in.home_level, 1.0);
+}
+
+TEST(SimProximity, TemperatureWidensTheZoneAboutItsMiddle) {
+  SimProximity p({true, 10.0, 12.0}, {true, 0.5, 0.5, 0.05, 0.0, 0.002});
+  SplitMix64 rng(1);
+  const auto edges = [&](double temperature) {
+    double rise = 0, fall = 0;
+    bool was = false;
+    for (int i = 0; i <= 40000; ++i) {
+      const double x = 9.0 + 4.0 * i / 40000;
+      const bool on = p.update(x, temperature, rng);
+      if (on && !was) rise = x;
+      if (!on && was) fall = x;
+      was = on;
+    }
+    return std::pair{rise, fall};
+  };
+  const auto [r20, f20] = edges(20);
+  const auto [r30, f30] = edges(30);
+  EXPECT_NEAR(r20, 10.0, 1e-4);
+  EXPECT_NEAR(r30, 10.0 - 0.02, 1e-4);  // 2 µm/K × 10 K earlier
+  EXPECT_NEAR(f30 - f20, 0.02, 1e-4);   // and the falling edge as much later
+  EXPECT_NEAR((r30 + f30) / 2, (r20 + f20) / 2, 1e-4);
 }
 
 }  // namespace

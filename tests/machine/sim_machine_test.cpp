@@ -70,6 +70,7 @@ class Fingerprint {
     for (const JointInputs& j : in.joints) {
       add(j.position), add(j.velocity), add(j.effort), add_bits(j.index_count), add(j.index_position);
       add(j.amp_fault), add(j.limit_neg), add(j.limit_pos), add(j.home), add(j.decel);
+      add(j.home_level), add(j.stall);
     }
     add(in.estop_ok), add(in.power.mains_ok), add(in.power.ups_on_battery), add(in.power.dc_link_v);
     add(in.spindle.position_rev), add(in.spindle.speed_rpm), add_bits(in.spindle.index_count);
@@ -78,6 +79,7 @@ class Fingerprint {
     add(in.probe), add(in.process.arc_ok), add(in.process.gap_voltage_v), add(in.tool.prepared),
         add(in.tool.changed);
     add_bits(in.digital_in);
+    add_bits(static_cast<std::uint32_t>(in.handwheel_count));
     for (double a : in.analog_in) add(a);
   }
   std::uint64_t value() const { return h_; }
@@ -367,6 +369,48 @@ TEST(SimMachine, CapabilitiesDescribeTheConfiguration) {
   EXPECT_TRUE(caps.probe);
   EXPECT_FALSE(caps.ups);
   EXPECT_EQ(caps.digital_inputs, 4);
+}
+
+TEST(SimMachine, SwitchesOnTheMachineDriveDigitalInputs) {
+  SimMachineConfig c = machine_config();
+  c.joints[2].drive = JointDrive::Manual;  // a hand-fed quill with a "tool up" switch at the top
+  c.input_switches[0] = {2, 2, {true, -1.0, kInf}, 0.01, 0.0};
+  SimMachine m(c);
+  MachineInputs in;
+  m.read(in);
+  EXPECT_EQ(in.digital_in, 0b100u);  // the quill starts at 0, up
+  m.set_hand_target(2, -30, 50);
+  MachineOutputs out = holding();
+  for (int k = 0; k < 1000; ++k) m.write(out);
+  m.read(in);
+  EXPECT_EQ(in.joints[2].position, -30.0);
+  EXPECT_EQ(in.digital_in, 0u);
+  m.set_digital_input(2, true);  // an injected value still reads
+  m.write(out);
+  m.read(in);
+  EXPECT_EQ(in.digital_in, 0b100u);
+}
+
+TEST(SimMachine, HandwheelCountsAndTemperature) {
+  SimMachineConfig c = machine_config();
+  c.handwheel = true;
+  c.temperature_c = 25;
+  SimMachine m(c);
+  EXPECT_TRUE(m.capabilities().handwheel);
+  EXPECT_EQ(m.temperature_c(), 25.0);
+  m.turn_handwheel(5);
+  m.turn_handwheel(-7);
+  MachineOutputs out = holding();
+  m.write(out);
+  MachineInputs in;
+  m.read(in);
+  EXPECT_EQ(in.handwheel_count, -2);
+  c.handwheel = false;
+  SimMachine none(c);
+  none.turn_handwheel(5);
+  none.write(out);
+  none.read(in);
+  EXPECT_EQ(in.handwheel_count, 0);
 }
 
 }  // namespace

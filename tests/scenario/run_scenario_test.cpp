@@ -355,6 +355,23 @@ TEST(RunScenario, WaitForInputReadsTheMachine) {
   EXPECT_EQ(s.status().servo.input_value, -1.0);  // the second wait timed out
 }
 
+// Two waits in a row, with no motion between them: each does its own waiting (the second was once
+// let through in the period after the first had ended).
+TEST(RunScenario, TwoSyncMarkersInARowEachWait) {
+  Scenario s(mill());
+  TempProgram p("m66x2.ngc", "M66 P1 L3 Q5\nM66 P2 L3 Q0.5\nG1 X6 F3000\nM2\n");
+  s.on(Mode::Auto);
+  s.must(Request::open(p.path()));
+  s.must(Request::simple(CommandKind::CycleStart));
+  ASSERT_TRUE(s.until([&] { return s.status().servo.wait == Wait::Input; }, 2000));
+  s.sim().set_digital_input(1, true);
+  const std::uint64_t t0 = s.rig().ticks();
+  ASSERT_TRUE(s.until([&] { return s.status().servo.commanded[Axis::X] > 0; }, 10000));
+  EXPECT_GE(s.rig().ticks() - t0, 500u);  // the second one waited its 0.5 s for input 2
+  ASSERT_TRUE(s.idle(10000));
+  EXPECT_EQ(s.status().servo.input_value, -1.0);
+}
+
 TEST(RunScenario, ToolChangerHandshake) {
   TempProgram tools("tools.tbl", "T3 P3 Z0\nT7 P7 Z0\n");
   Scenario s(homing_mill({tool_table(tools)}));

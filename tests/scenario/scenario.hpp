@@ -47,20 +47,24 @@ class TempProgram {
 /// Every servo period's sample, and the report of the program runs among them.
 class SampleKeeper final : public ControllerObserver {
  public:
-  SampleKeeper(const plan::MachineLimits& limits, double period_s) : limits_(limits), period_s_(period_s) { forget(); }
+  /// `output_limits`: what the drives' commands (with compensation) must stay within.
+  SampleKeeper(const plan::MachineLimits& limits, const plan::MachineLimits& output_limits, double period_s)
+      : limits_(limits), output_limits_(output_limits), period_s_(period_s) {
+    forget();
+  }
   void on_trace(const TraceSample& s, const TraceContext& c) override {
     samples_.push_back(s);
     if (s.activity == Activity::Program) recorder_->add(s, c);
   }
   void forget() {
     samples_.clear();
-    recorder_ = std::make_unique<RunRecorder>(limits_, period_s_);
+    recorder_ = std::make_unique<RunRecorder>(limits_, period_s_, &output_limits_);
   }
   const std::vector<TraceSample>& samples() const { return samples_; }
   RunReport report() const { return recorder_->report(); }
 
  private:
-  plan::MachineLimits limits_;
+  plan::MachineLimits limits_, output_limits_;
   double period_s_;
   std::vector<TraceSample> samples_;
   std::unique_ptr<RunRecorder> recorder_;
@@ -72,7 +76,8 @@ class Scenario {
   /// With a program source of the test's own (a tool table in memory, code modules).
   Scenario(const config::MachineProfile& profile, std::shared_ptr<ProgramSource> source) : profile_(profile) {
     rig_ = std::make_unique<SimRig>(profile, std::move(source));
-    keeper_ = std::make_shared<SampleKeeper>(machine_limits(profile), profile.servo_period_s);
+    keeper_ =
+        std::make_shared<SampleKeeper>(machine_limits(profile), axis_limits(profile), profile.servo_period_s);
     rig_->controller().attach(keeper_, ObserverOptions{0, true});
     rig_->step();  // the observer is attached from here on
   }

@@ -67,6 +67,12 @@ class TraceChecker {
 
   /// Where the machine rests before the first sample (the origin unless said). Before add().
   void start_at(const Pose& position) { past_.fill(position); }
+  /// The two samples before the first one, newest first, when the trajectory was already moving
+  /// (its acceleration before them taken as zero). Before add().
+  void start_moving(const Pose& newest, const Pose& previous) {
+    past_ = {newest, previous, previous};
+    for (int i = 0; i < kAxisCount; ++i) past_[2][i] = 2 * previous[i] - newest[i];
+  }
   /// One commanded sample; `first`..`last` are the segment ids of the block it lies on.
   void add(const Pose& position, canon::SegmentId first, canon::SegmentId last);
   /// The metrics so far.

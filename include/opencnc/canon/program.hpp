@@ -90,6 +90,10 @@ enum class ActionKind : std::uint8_t {
   Message,             ///< text
   Comment,             ///< text
   ProgramStop, OptionalStop, PalletShuttle, ProgramEnd,
+  /// Not from the interpreter: the controller's hand-axis pass (control::HandAxisFilter) puts
+  /// it where a move of a hand-fed axis was. index = axis, value = machine position, index2 = +1:
+  /// a retract (the move went in +), 0: a plunge.
+  HandAxisWait,
 };
 
 /// A non-motion action executed before move `before_move` (== move count: after the last).
@@ -179,6 +183,11 @@ class Program {
   /// Appends a move ending at `end` and returns it for the caller to fill in (every member):
   /// ProgramBuilder's way, which spares copying a Move it has just built.
   Move& append(const Pose& end);
+  /// Changes one coordinate of move `id`'s end (a pass over moves just appended, e.g. the
+  /// controller's hand-axis pass; `axis` must be in the mask).
+  void set_end_coord(SegmentId id, Axis axis, double value) noexcept {
+    coords_[static_cast<std::size_t>(id) * static_cast<std::size_t>(stride_) + axis_slots_[index(axis)]] = value;
+  }
   std::uint32_t add_arc(const ArcGeometry& a);
   std::uint32_t add_feed(double value);
   void add_action(const Action& a);

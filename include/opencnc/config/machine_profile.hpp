@@ -8,17 +8,20 @@
 
 #include "opencnc/core/axes.hpp"
 #include "opencnc/core/axis_map.hpp"
+#include "opencnc/machine/interlocks.hpp"
 #include "opencnc/machine/machine_io.hpp"
 #include "opencnc/machine/sim_config.hpp"
 
 namespace opencnc::config {
 
 enum class HomingMethod : std::uint8_t {
-  Immediate,    ///< no motion: the present position becomes `position`
-  Switch,       ///< search the home switch, back off, approach it slowly, latch its edge
-  SwitchIndex,  ///< as Switch, then latch the next encoder index mark
-  Index,        ///< latch the next encoder index mark (no switch)
-  DecelHome,    ///< fast to the deceleration dog, slow on it until the home (proximity) switch
+  Immediate,      ///< no motion: the present position becomes `position`
+  Switch,         ///< search the home switch, back off, approach it slowly, latch its edge
+  SwitchIndex,    ///< as Switch, then latch the next encoder index mark
+  Index,          ///< latch the next encoder index mark (no switch)
+  DecelHome,      ///< fast to the deceleration dog, slow on it until the home (proximity) switch
+  DecelMidpoint,  ///< past the dog, back in the working direction: the middle of the proximity
+                  ///< sensor's on-zone, both edges interpolated between periods
 };
 
 struct HomingProfile {
@@ -29,6 +32,26 @@ struct HomingProfile {
   double latch_velocity = 0;   ///< units/s; the sign is the direction of the latch move
   double final_velocity = 0;   ///< units/s for the move to `position` (0 = max_velocity)
   int sequence = 0;            ///< lower sequences home first; equal ones together
+  // decel_midpoint: search_velocity is Vc toward the dog, return_velocity Vm the other way (the
+  // working feed's direction), latch_velocity Vp the same way as Vm.
+  double return_velocity = 0;         ///< units/s, signed, opposite to search_velocity
+  double overrun = 0;                 ///< units travelled past the dog's edge before reversing
+  bool return_after_program = false;  ///< home again after every program that ends (M2/M30)
+};
+
+/// Most points of a pitch-error table (motion::kMaxPitchPoints, LinuxCNC's 256 too).
+inline constexpr int kMaxCompensationPoints = 256;
+
+/// Lead-screw and backlash compensation of one axis (`[axis.<letter>.compensation]`).
+/// Tables hold the measured error (actual − nominal, units) at machine positions.
+struct CompensationProfile {
+  bool present = false;
+  double backlash = 0;             ///< units
+  double takeup_velocity = 0;      ///< limit of the correction's own motion, units/s
+  double takeup_acceleration = 0;  ///< units/s²
+  std::vector<double> positions;   ///< increasing; empty = no pitch table
+  std::vector<double> forward;     ///< error moving in +
+  std::vector<double> reverse;     ///< error moving in − (== forward for one table)
 };
 
 /// One axis (= one joint: joints are numbered in axis order X Y Z A B C U V W).
@@ -48,6 +71,12 @@ struct AxisProfile {
   HomingProfile homing;
   machine::SwitchLayout switches;  ///< which switches exist, and where (the sim uses where)
   machine::SimJointModel sim;      ///< mechanics and drive of the simulated axis
+  bool stall_detector = false;     ///< stepper: the drive reports stalls (a fault)
+  /// Manual axis: how close to a programmed position the operator must bring it, units.
+  double hand_tolerance = 0.05;
+  CompensationProfile compensation;
+
+  bool manual() const noexcept { return drive == machine::JointDrive::Manual; }
 };
 
 struct SpindleProfile {
@@ -74,6 +103,25 @@ struct ProbeProfile {
 struct IoProfile {
   int digital_inputs = 4, digital_outputs = 4;
   int analog_inputs = 4, analog_outputs = 4;
+};
+
+/// A digital channel the interlock rules name.
+struct NamedSignal {
+  std::string name;
+  int channel = 0;
+};
+
+/// `[interlocks]`: named inputs and outputs and the compiled rules (docs/machine.md).
+struct InterlockProfile {
+  std::vector<NamedSignal> inputs, outputs;
+  std::vector<std::string> rule_texts;  ///< as written, for messages
+  machine::InterlockRules rules;
+};
+
+/// `[handwheel]`: a manual pulse generator for the driven axes.
+struct HandwheelProfile {
+  bool present = false;
+  std::vector<double> steps{0.001, 0.01, 0.1};  ///< units per count the operator may select
 };
 
 enum class Dialect : std::uint8_t { LinuxCnc, Fanuc };
@@ -110,6 +158,11 @@ struct MachineProfile {
   machine::SimToolChangerConfig tool_changer_sim;
   machine::SimProcessConfig process;  ///< torch / generator flags and their simulation
   IoProfile io;
+  InterlockProfile interlocks;
+  HandwheelProfile handwheel;
+  /// Digital inputs the simulated machine drives from switches (named inputs with a `sim`).
+  std::vector<machine::SimInputSwitch> sim_input_switches;
+  double sim_temperature_c = 20;  ///< machine temperature in the simulation
   InterpreterOptions interpreter;
   PlannerOptions planner;
   int sim_substeps = 10;  ///< integration sub-steps per servo period
@@ -124,5 +177,16 @@ struct MachineProfile {
 
 /// The simulated machine this profile describes. Non-real-time (copies pitch tables).
 machine::SimMachineConfig sim_machine_config(const MachineProfile& profile);
+
+/// How much of an axis' velocity and acceleration its compensation may use at most: the take-up
+/// limits plus what the pitch table adds when the axis moves at its limits (slope × velocity;
+/// slope × acceleration + the change of slope at a table point × velocity / servo period).
+/// Motion is planned within the axis' limits less this, so that the corrected command stays
+/// within the limits. Zero without compensation. Any thread.
+struct MotionReserve {
+  double velocity = 0;
+  double acceleration = 0;
+};
+MotionReserve compensation_reserve(const AxisProfile& axis, double servo_period_s);
 
 }  // namespace opencnc::config

@@ -35,6 +35,8 @@ class AxisMover {
   double tick() noexcept;
 
   double position() const noexcept { return out_; }  ///< commanded (filtered)
+  /// Where it is heading: the position goal, or (running at a speed) where the generator is now.
+  double goal() const noexcept { return goal_ == Goal::Position ? goal_position_ : raw_; }
   double velocity() const noexcept { return vel_; }  ///< of the unfiltered generator
   /// At rest, goal reached and the average settled: the commanded position no longer changes.
   bool settled() const noexcept { return vel_ == 0 && still_ >= filter_ticks_ && !pending(); }

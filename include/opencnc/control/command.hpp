@@ -40,6 +40,8 @@ enum class Wait : std::uint8_t {
   Orient,            ///< M19
   Probe,             ///< the end of a probe move
   Starved,           ///< the planner has not delivered the next blocks yet
+  HandAxis,          ///< the operator bringing a hand-fed axis to a position (status: hand_wait)
+  Interlock,         ///< an interlock rule holds back the next step (status: interlock_rule)
 };
 
 /// Why the state is Stopped.
@@ -75,6 +77,7 @@ enum class CommandKind : std::uint8_t {
   SpindleOn,           ///< manual: `value` rpm, `flag` true = clockwise
   SpindleOff,          ///< manual
   Coolant,             ///< manual: `coolant` on (`flag`) or off
+  SetHandwheel,        ///< `axis` the handwheel moves (−1 = none), `value` = units per count
 };
 
 /// Why a command was refused. Each has a stable code (refusal_code()).
@@ -95,6 +98,8 @@ enum class Refusal : std::uint8_t {
   ProgramError,   ///< control.program: the program or MDI line was rejected (see diagnostics)
   SoftLimit,      ///< control.soft-limit: the program would cross a soft limit (preflight)
   StartMismatch,  ///< control.start-mismatch: the queued motion does not start where the machine is
+  Interlock,      ///< control.interlock: an interlock rule of the profile forbids it now
+  HandAxis,       ///< control.hand-axis: the axis is moved by hand, or is not where the program needs it
 };
 
 /// Stable problem code of a refusal ("control.busy", ...). Any thread; real-time safe.
@@ -108,7 +113,8 @@ enum class FaultKind : std::uint8_t {
   FollowingError,  ///< `axis`, `value` = error, `limit` = the profile's maximum
   SoftLimit,       ///< `axis`, `value` = commanded position, `limit` = the soft limit (tick check)
   PowerLoss,       ///< mains lost or UPS on battery: `value` = DC link volts
-  Homing,          ///< `axis`: a homing move ran into a limit or found no switch
+  Homing,          ///< `axis`: a homing move ran into a limit or found no switch (`value` = where)
+  Stall,           ///< `axis`: the stepper drive detected a stall (steps were lost; home again)
 };
 
 /// Stable problem code of a fault ("control.fault.following-error", ...). Any thread.
@@ -161,9 +167,12 @@ enum class ActionCode : std::uint8_t {
   SpindleOrient,  ///< value = degrees
   PalletShuttle,
   Message,  ///< the controller shows the text (action index)
-  Ignore,   ///< nothing for the machine (probe on/off)
+  Ignore,        ///< nothing for the machine (probe on/off)
   SpindleMode,   ///< G96: value = highest rpm (D); 0 = G97, the speed is in rpm again
   SurfaceSpeed,  ///< G96 S: value = surface speed (mm/min), value2 = X of the spindle axis (mm)
+  /// Wait until the operator has brought hand axis `index` to `value`: index2 = +1 a retract (at
+  /// or above it), 0 a plunge (down to it); see HandWait in status.hpp.
+  HandAxisWait,
 };
 
 /// The machine side of marker `action` (Program::actions() index) of the current run. The
@@ -203,6 +212,8 @@ enum class EventKind : std::uint8_t {
   /// stop (M0, M1) — `action` (traj::kNoAction for the end of a probe move that did not trip),
   /// `segment`; the controller's interpreter may read on from there.
   SyncPassed,
+  Interlock,      ///< interlock rule `action` (its index) acted (`command`: what it did, see below)
+  HandAxisMoved,  ///< hand axis `axis` left the position the run needs while it moved: feed hold
 };
 
 struct ServoEvent {

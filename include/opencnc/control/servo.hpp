@@ -12,6 +12,7 @@
 #include "opencnc/control/homing.hpp"
 #include "opencnc/control/servo_config.hpp"
 #include "opencnc/machine/machine_io.hpp"
+#include "opencnc/motion/compensation.hpp"
 #include "opencnc/motion/pulse_distributor.hpp"
 #include "opencnc/traj/interpolator.hpp"
 
@@ -43,6 +44,7 @@ class Servo final : public Tickable {
   // --- stages of a period (servo.cpp) -------------------------------------------------------
   void read_inputs() noexcept;
   void check_safety() noexcept;
+  void apply_interlocks() noexcept;
   void handle_commands() noexcept;
   void run_active_mode() noexcept;
   void couple_axes() noexcept;
@@ -53,6 +55,7 @@ class Servo final : public Tickable {
 
   void start_up() noexcept;
   void check_joint_faults() noexcept;
+  bool check_stall(int j) noexcept;
   void check_power() noexcept;
   void follow_feedback() noexcept;
   void write_joint(int j) noexcept;
@@ -60,6 +63,7 @@ class Servo final : public Tickable {
   void write_machine_outputs() noexcept;
   void write_spindle(bool on) noexcept;
   void fill_status(ServoStatus& s) const noexcept;
+  void fill_drill_status(ServoStatus& s) const noexcept;
   void push_trace() noexcept;
 
   // --- transitions (servo_commands.cpp) -----------------------------------------------------
@@ -77,6 +81,7 @@ class Servo final : public Tickable {
   Refusal set_override(double& target, double value, double max) noexcept;
   Refusal manual_spindle_or_coolant(const Command& c) noexcept;
   Refusal tool_changed() noexcept;
+  Refusal set_handwheel(const Command& c) noexcept;
   void enter_estop() noexcept;
   void enter_fault(const Fault& f) noexcept;
   void halt(RunEnd why) noexcept;
@@ -95,6 +100,20 @@ class Servo final : public Tickable {
   bool toward_active_limit(int j, double direction) const noexcept;
   bool any_limit_switch() const noexcept;
   bool all_homed() const noexcept;
+  bool manual(int j) const noexcept {
+    return config_.joints[static_cast<std::size_t>(j)].drive == machine::JointDrive::Manual;
+  }
+  void run_handwheel() noexcept;
+  void follow_hand_axes() noexcept;
+  void start_homing(std::uint16_t joints) noexcept;
+  void finish_homing(int j) noexcept;
+
+  // --- interlocks (servo_interlocks.cpp) -----------------------------------------------------
+  bool signal(const machine::RuleToken& t) const noexcept;
+  bool holds(const machine::InterlockRule& r) const noexcept;
+  void act_on_rule(int index, const machine::InterlockRule& r, bool now, bool before) noexcept;
+  void emit_interlock(int index, CommandKind what) noexcept;
+  bool spindle_may_start() const noexcept;
 
   // --- Auto and MDI runs (servo_program.cpp) ------------------------------------------------
   void run_program() noexcept;
@@ -108,6 +127,9 @@ class Servo final : public Tickable {
   bool step_sync() noexcept;
   bool step_wait_input() noexcept;
   void check_probe() noexcept;
+  bool hand_axis_there(bool holding) const noexcept;
+  void check_hand_guard() noexcept;
+  double hand_position(int axis) const noexcept;
   void map_program_state() noexcept;
   void end_run(RunEnd why) noexcept;
   const traj::MotionBlock* block(std::uint64_t seq) const noexcept;
@@ -143,23 +165,30 @@ class Servo final : public Tickable {
   Joints reference_{};       ///< what the drive aims at by the end of the period (cmd + ff·T)
   Joints joint_velocity_{};  ///< commanded, joint units/s (last two commands)
   Joints velocity_ff_{};     ///< what servo drives get of it (steppers: none)
-  Joints feedback_{};        ///< joint coordinates
+  Joints feedback_{};        ///< joint coordinates (what the drive reports, compensation included)
+  Joints position_{};        ///< feedback less the compensation: joint coordinates as commanded
   Joints following_error_{};
   Joints offset_{};
   std::array<bool, machine::kMaxJoints> homed_{};
   std::array<bool, machine::kMaxJoints> limit_active_{};  ///< either limit switch active
   std::array<bool, machine::kMaxJoints> limit_rising_{};  ///< ... and not in the last period
   bool drives_enabled_ = false;
-  /// Compensation stage (pitch error, backlash): the correction each joint gets and its last
-  /// direction of motion, which backlash compensation will need. Zero for now.
-  Joints compensation_{};
-  std::array<std::int8_t, machine::kMaxJoints> direction_{};
+  /// Compensation stage (pitch error, backlash): the correction each joint gets.
+  motion::Compensation comp_;
+  Joints compensation_{};    ///< the correction in the last outputs (feedback reflects it)
+  bool moved_last_ = false;  ///< a driven joint's command changed in the last period
 
   // Manual mode.
   std::array<AxisMover, machine::kMaxJoints> movers_{};
   std::array<JointHoming, machine::kMaxJoints> homing_{};
   std::uint16_t homing_pending_ = 0;  ///< joints still to home, by bit
   std::uint16_t homing_active_ = 0;   ///< joints homing now
+  std::array<HomingStatus, machine::kMaxJoints> homing_status_{};
+  std::array<double, machine::kMaxJoints> offset_before_homing_{};
+  std::array<bool, machine::kMaxJoints> homed_once_{};
+  std::int8_t handwheel_axis_ = -1;
+  double handwheel_step_ = 0;
+  std::int32_t handwheel_last_ = 0;
 
   // Runs.
   traj::Interpolator interp_;
@@ -172,13 +201,18 @@ class Servo final : public Tickable {
   bool aborting_ = false;
   double feed_override_ = 1, rapid_override_ = 1, spindle_override_ = 1;
   bool single_block_ = false, optional_stop_ = false;
-  enum class SyncStep : std::uint8_t { None, ToolChanger, ManualTool, Input, Orient };
+  enum class SyncStep : std::uint8_t { None, ToolChanger, ManualTool, Input, Orient, HandAxis };
   SyncStep sync_step_ = SyncStep::None;
+  /// The Sync marker handled last: the tick after its release the commanded position may still
+  /// show it while the interpolator already waits at the next one.
+  std::uint64_t sync_seq_ = traj::kNoBlock;
   MachineAction sync_action_{};
   std::uint64_t sync_started_tick_ = 0;
   bool sync_input_before_ = false;
   bool manual_tool_done_ = false;
   bool probe_tripped_ = false;
+  HandWait hand_wait_{};  ///< the hand-axis wait in progress, then its guard while the run moves
+  bool hand_guard_ = false;
   std::uint64_t probe_seq_ = traj::kNoBlock;  ///< the probe move whose result probe_tripped_ is
   Pose probe_position_{};
   std::uint32_t probe_edges_seen_ = 0;  ///< the machine's probe edge count at the last period
@@ -197,10 +231,18 @@ class Servo final : public Tickable {
   bool orient_ = false;
   double orient_angle_ = 0;
   bool flood_ = false, mist_ = false;
+  bool spindle_running_ = false;  ///< the spindle output turns (an interlock may hold a start back)
   std::int32_t tool_ = 0, selected_tool_ = 0, prepared_tool_ = 0, preparing_tool_ = 0;
   bool preparing_ = false;
   std::uint64_t digital_out_ = 0;
   std::array<double, machine::kAnalogChannels> analog_out_{};
+
+  // Interlock rules: which conditions hold, and what they block now.
+  std::uint32_t rules_true_ = 0;
+  bool rules_started_ = false;
+  bool motion_blocked_ = false, spindle_blocked_ = false, estop_rule_ = false;
+  std::int8_t blocking_rule_ = -1;
+  std::uint64_t rule_outputs_mask_ = 0, rule_outputs_ = 0;
 
   // Stepper joints: one pulse distributor over all of them, slot per joint (−1 = servo).
   motion::PulseDistributor pulses_{motion::PulseMethod::Vector};

@@ -7,7 +7,9 @@
 #include <cstdint>
 #include <type_traits>
 
+#include "opencnc/machine/interlocks.hpp"
 #include "opencnc/machine/machine_io.hpp"
+#include "opencnc/motion/compensation.hpp"
 #include "opencnc/traj/interpolator.hpp"
 
 namespace opencnc::control {
@@ -19,6 +21,9 @@ enum class HomeMethod : std::uint8_t {
   SwitchIndex,  ///< as Switch, then latch the next encoder index mark
   Index,        ///< latch the next encoder index mark at latch velocity
   DecelHome,    ///< fast to the deceleration dog, then slowly to the home switch
+  /// Fast to the dog, a set distance past it, back in the working direction: the middle of the
+  /// proximity sensor's on-zone, both edges interpolated between periods (JointHoming).
+  DecelMidpoint,
 };
 
 struct HomeConfig {
@@ -29,6 +34,12 @@ struct HomeConfig {
   double latch_velocity = 0;   ///< units/s, signed: direction of the latch move
   double final_velocity = 0;   ///< units/s to `position` (> 0; servo_config() puts max_velocity for 0)
   int sequence = 0;            ///< lower sequences home first; equal ones together
+  // DecelMidpoint.
+  double return_velocity = 0;         ///< Vm, signed (the working feed's direction)
+  double overrun = 0;                 ///< units past the dog's edge before reversing
+  double level_on = 0.5;              ///< the sensor's level at which it switches on …
+  double level_off = 0.45;            ///< … and off (its comparator, from the profile)
+  bool return_after_program = false;  ///< home again when an Auto program ends (M2/M30)
 };
 
 /// One joint. The machine layer numbers joints in axis order, one joint per axis.
@@ -45,7 +56,11 @@ struct JointConfig {
   double max_limit = 0;
   double max_following_error = 1;  ///< units
   HomeConfig home;
+  double hand_tolerance = 0.05;  ///< manual joints: how close the operator must come, units
 };
+
+/// Most step sizes the handwheel offers.
+inline constexpr int kMaxHandwheelSteps = 8;
 
 /// The machine as the tick sees it.
 struct ServoConfig {
@@ -57,6 +72,13 @@ struct ServoConfig {
   double spindle_max_rpm = 0;
   /// Auto and MDI need every joint homed (true when some joint homes by a method that moves).
   bool homing_required = false;
+  /// Pitch-error and backlash compensation per joint (the compensation stage).
+  motion::CompensationConfig compensation;
+  /// The PLC's interlock rules (evaluated every period after safety).
+  machine::InterlockRules interlocks;
+  /// Units per count the operator may select for the handwheel (none: any positive step).
+  std::array<double, kMaxHandwheelSteps> handwheel_steps{};
+  int handwheel_step_count = 0;
 };
 
 static_assert(std::is_trivially_copyable_v<ServoConfig>);

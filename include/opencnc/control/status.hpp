@@ -8,11 +8,36 @@
 #include <type_traits>
 
 #include "opencnc/control/command.hpp"
+#include "opencnc/control/homing.hpp"
 #include "opencnc/core/axes.hpp"
 #include "opencnc/machine/machine_io.hpp"
 #include "opencnc/traj/interpolator.hpp"
 
 namespace opencnc::control {
+
+/// One joint's homing as the status shows it.
+struct HomingStatus {
+  HomingPhase phase = HomingPhase::Idle;
+  bool measured = false;   ///< DecelMidpoint: the edges below are from the last homing
+  double rising_edge = 0;  ///< interpolated edges, joint coordinates
+  double falling_edge = 0;
+  double width = 0;  ///< S = falling − rising
+  /// How far the positions before the last homing were off: where the controller believed the
+  /// axis was less where that homing found it (+ = believed further in +). Lost steps, or a
+  /// reference that drifted, show here; 0 after the first homing.
+  double origin_shift = 0;
+};
+
+/// A program waiting for a hand-fed axis (Wait::HandAxis), and then holding it there while the
+/// table moves. A retract (the program moved the axis in +) is reached and held at or above
+/// target − tolerance; a plunge is reached at or below target + tolerance and then held within
+/// the tolerance of the target.
+struct HandWait {
+  std::int8_t axis = -1;  ///< Axis index, −1 = none
+  double target = 0;      ///< machine position
+  bool retract = false;   ///< the move went in + (up, away from the work)
+  double tolerance = 0;
+};
 
 struct JointStatus {
   double commanded = 0;        ///< machine coordinates
@@ -66,7 +91,7 @@ struct ServoStatus {
   bool flood = false, mist = false;
   std::int32_t tool = 0;           ///< tool in the spindle
   std::int32_t prepared_tool = 0;  ///< tool brought to the change position
-  std::uint64_t digital_out = 0;
+  std::uint64_t digital_out = 0;   ///< as written to the machine (the interlock rules' outputs included)
   std::array<double, machine::kAnalogChannels> analog_out{};
   bool mains_ok = true, on_battery = false;
   double dc_link_v = 0;
@@ -80,6 +105,16 @@ struct ServoStatus {
   bool probe_tripped = false;  ///< during the last probe move
   Pose probe_position{};       ///< actual position when it tripped
   double input_value = 0;      ///< the last M66 result (−1: timed out)
+
+  // Homing, compensation, hand axes, interlocks, handwheel (the drill retrofit).
+  std::array<HomingStatus, machine::kMaxJoints> homing{};
+  std::array<double, machine::kMaxJoints> compensation{};  ///< correction each joint gets now, units
+  HandWait hand_wait{};                                    ///< what a Wait::HandAxis waits for
+  /// The first `block spindle` rule holding now (what a Wait::Interlock waits on), −1 = none.
+  std::int8_t interlock_rule = -1;
+  std::uint32_t interlocks_true = 0;  ///< bit per rule whose condition holds
+  std::int8_t handwheel_axis = -1;    ///< the axis the handwheel moves (−1 = none)
+  double handwheel_step = 0;          ///< units per count
 };
 
 /// One servo period, for traces and run reports (docs/controller.md, "Trace CSV").
@@ -96,6 +131,9 @@ struct TraceSample {
   Pose commanded{};        ///< machine coordinates, every axis
   Pose actual{};           ///< feedback in machine coordinates
   Pose following_error{};  ///< per axis
+  Pose output{};           ///< what the drives were told, machine coordinates (with compensation)
+  std::array<HomingPhase, kAxisCount> homing_phase{};  ///< per axis
+  Pose home_level{};                                   ///< the home proximity sensor's level, per axis
 };
 
 static_assert(std::is_trivially_copyable_v<ServoStatus>);

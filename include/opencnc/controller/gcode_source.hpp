@@ -9,6 +9,7 @@
 #include <string_view>
 
 #include "opencnc/config/machine_profile.hpp"
+#include "opencnc/controller/hand_axis.hpp"
 #include "opencnc/controller/program_source.hpp"
 #include "opencnc/gcode/interpreter.hpp"
 #include "opencnc/gcode/options.hpp"
@@ -35,12 +36,15 @@ struct GcodeSourceConfig {
   std::shared_ptr<tools::ToolTableService> tools;
   /// Path tolerance (mm) while a program sets no G64 P (the profile's planner.default_tolerance).
   double default_tolerance_mm = 0;
+  /// Hand-fed axes: their programmed moves become waits for the operator (hand_axis.hpp).
+  HandAxes hand;
 };
 
 /// Programs and MDI lines through the interpreter, in millimetres. Before a program, and before
 /// an MDI line, the interpreter is placed where the machine is (Interpreter::set_machine_position),
 /// so incremental moves and arcs start from there. While a program sets no G64 P the default
-/// tolerance applies. Non-real-time; one thread (the controller's).
+/// tolerance applies. On a machine with hand-fed axes the moves go through the hand-axis pass
+/// (hand_axis.hpp). Non-real-time; one thread (the controller's).
 class GcodeProgramSource final : public ProgramSource {
  public:
   /// The profile's dialect, machine kind, axes and axis map, subroutine path, default tolerance,

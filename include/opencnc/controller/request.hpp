@@ -73,6 +73,12 @@ struct SetCoolant {
   Coolant which = Coolant::Flood;
   bool on = false;
 };
+/// Puts the handwheel on an axis (none: off every axis) with a step (units per count, one of the
+/// profile's handwheel.steps).
+struct SetHandwheel {
+  std::optional<Axis> axis;
+  double step = 0;
+};
 /// Opens a G-code file as the main program (Auto mode): preflight, then it waits for cycle start.
 struct OpenFile {
   std::string path;
@@ -107,7 +113,7 @@ using RequestBody =
     std::variant<requests::Servo, requests::SetMode, requests::Jog, requests::JogBy, requests::JogStop,
                  requests::Home, requests::SetOverride, requests::SetSwitch, requests::SpindleOn,
                  requests::SetCoolant, requests::OpenFile, requests::OpenCanon, requests::Mdi,
-                 requests::RunAuxiliary, requests::Feature>;
+                 requests::RunAuxiliary, requests::Feature, requests::SetHandwheel>;
 
 /// A request with its typed body. Build one with the helpers.
 struct Request {
@@ -128,6 +134,7 @@ struct Request {
   static Request block_delete(bool on) { return {requests::SetSwitch{SwitchKind::BlockDelete, on}}; }
   static Request spindle_on(double rpm, bool clockwise) { return {requests::SpindleOn{rpm, clockwise}}; }
   static Request coolant(Coolant which, bool on) { return {requests::SetCoolant{which, on}}; }
+  static Request handwheel(std::optional<Axis> a, double step) { return {requests::SetHandwheel{a, step}}; }
   static Request open(std::string path) { return {requests::OpenFile{std::move(path)}}; }
   static Request open(std::shared_ptr<const canon::Program> p, std::string name) {
     return {requests::OpenCanon{std::move(p), std::move(name)}};

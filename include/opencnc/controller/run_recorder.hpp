@@ -28,7 +28,12 @@ struct RunReport {
   double max_contour_error_mm = 0;                     ///< actual (feedback) position to the programmed path
   double max_command_contour_error_mm = 0;             ///< commanded position to the programmed path
   std::array<analysis::AxisStats, kAxisCount> axes{};  ///< of the commanded trajectory
-  std::uint64_t limit_violations = 0;  ///< commanded samples × axes × derivatives above a limit
+  /// Samples × axes × derivatives above a limit: of the commanded trajectory against the planning
+  /// limits, and of the drives' commands (with compensation) against the axes' own limits.
+  std::uint64_t limit_violations = 0;
+  std::uint64_t output_limit_violations = 0;     ///< the drives' commands' share of them
+  analysis::Violation first_output_violation{};  ///< where to look when there are some
+  double max_compensation_mm = 0;                ///< largest |output − commanded| of a linear axis
   std::uint64_t samples = 0;
 };
 
@@ -36,10 +41,16 @@ struct RunReport {
 /// the Program activity's samples), or feed it samples with add(). Non-real-time.
 class RunRecorder final : public ControllerObserver {
  public:
-  RunRecorder(const plan::MachineLimits& limits, double period_s);
+  /// `limits`: what the commanded trajectory was planned within (control::machine_limits);
+  /// `output_limits`: what the drives' commands, with the compensation, must stay within
+  /// (control::axis_limits; by default `limits`). Axes outside `limits` (hand-fed ones) do not
+  /// count: they are taken to stay where the run started.
+  RunRecorder(const plan::MachineLimits& limits, double period_s,
+              const plan::MachineLimits* output_limits = nullptr);
   /// For samples of one whole program (its moves numbered as in `program`, which must outlive
   /// the recorder).
-  RunRecorder(const canon::Program& program, const plan::MachineLimits& limits, double period_s);
+  RunRecorder(const canon::Program& program, const plan::MachineLimits& limits, double period_s,
+              const plan::MachineLimits* output_limits = nullptr);
 
   /// One period of a run, with the program window its segment ids refer to (null: none; the
   /// contour error is not measured then). In order.
@@ -54,12 +65,16 @@ class RunRecorder final : public ControllerObserver {
 
  private:
   void begin(const Pose& start);
+  TraceSample planned_axes(const TraceSample& s) const;
   const canon::Program* fixed_ = nullptr;
   bool started_ = false;
   plan::MachineLimits limits_;
   double period_s_;
   analysis::TraceChecker commanded_;
   analysis::TraceChecker actual_;
+  analysis::TraceChecker output_;
+  Pose output_lead_{};  ///< the first sample's output, until the second starts the output check
+  Pose start_{};
   RunReport r_;
   Pose last_{};
   std::uint64_t first_move_ = 0, last_move_ = 0;

@@ -9,8 +9,14 @@
 
 namespace opencnc::control {
 
-/// Axis limits for the planner (velocity, acceleration, jerk of every axis). Non-real-time.
+/// Limits the planner plans with: of every driven axis, its velocity and acceleration less what
+/// its compensation may use (config::compensation_reserve), and its jerk. Manual (hand-fed) axes
+/// are not among them: nothing plans their motion. Non-real-time.
 plan::MachineLimits machine_limits(const config::MachineProfile& profile);
+
+/// The axes' own limits (the profile's, nothing reserved): what the drives' commands, with the
+/// compensation, must stay within. Driven axes only. Non-real-time.
+plan::MachineLimits axis_limits(const config::MachineProfile& profile);
 
 /// Planner settings: the profile's servo period and look-ahead. Non-real-time.
 plan::PlannerConfig planner_config(const config::MachineProfile& profile);

@@ -23,6 +23,7 @@ inline constexpr int kAnalogChannels = 16;
 enum class JointDrive : std::uint8_t {
   Servo,    ///< position (+ velocity feed-forward) command to a drive; encoder feedback
   Stepper,  ///< absolute step count to a step generator; feedback = steps emitted
+  Manual,   ///< moved by hand (a hand wheel): never commanded; feedback = its scale
 };
 
 enum class SpindleDirection : std::uint8_t { Stopped, Clockwise, Counterclockwise };
@@ -102,6 +103,11 @@ struct JointInputs {
   bool limit_pos = false;     ///< positive-end limit switch active (optional)
   bool home = false;          ///< home (proximity) switch active (optional)
   bool decel = false;         ///< deceleration dog switch active (optional)
+  /// Analog level of the home proximity sensor, 0 (nothing sensed) … 1 (fully covered), sampled
+  /// with `home`; homing interpolates its threshold crossings between periods. Optional
+  /// (capability `home_level`).
+  double home_level = 0;
+  bool stall = false;  ///< the stepper drive's stall detector reports lost steps (optional)
 };
 
 struct SpindleInputs {
@@ -153,6 +159,9 @@ struct MachineInputs {
   ToolChangerInputs tool{};
   std::uint64_t digital_in = 0;                     ///< bit i = generic digital input i (M66 P)
   std::array<double, kAnalogChannels> analog_in{};  ///< generic analog inputs (M66 E)
+  /// Manual pulse generator (handwheel): counts turned since start, + = clockwise; wraps.
+  /// Optional (capability `handwheel`).
+  std::int32_t handwheel_count = 0;
 };
 
 // ---------------------------------------------------------------------------------------
@@ -173,6 +182,8 @@ struct JointCapabilities {
   std::uint8_t switches = 0;  ///< SwitchBits present
   bool index = false;         ///< index_count/index_position are valid
   bool effort = false;        ///< effort is valid
+  bool home_level = false;    ///< home_level is valid (an analog home proximity sensor)
+  bool stall_detect = false;  ///< stall is valid (a stepper drive with a stall detector)
 };
 
 struct MachineCapabilities {
@@ -189,6 +200,7 @@ struct MachineCapabilities {
   bool generator = false;                       ///< generator_on / gap_voltage_v
   int digital_inputs = 0, digital_outputs = 0;  ///< generic channels 0 … n-1 exist
   int analog_inputs = 0, analog_outputs = 0;
+  bool handwheel = false;  ///< handwheel_count is valid
 };
 
 // Images must stay plain data: they will be copied into shared memory and HAL pins.

@@ -21,9 +21,32 @@ struct SwitchWindow {
   double to = kInf;
 };
 
+/// An inductive proximity sensor with an analog output (the home sensor of decel_midpoint
+/// homing). Its level is 0 far from the target and 1 over it, rising over `ramp` units at each end
+/// of the on-zone; the zone's window (SwitchWindow::from, to) is where the level crosses
+/// `threshold` at the reference temperature (20 °C). Each sample adds a fresh uniform value in
+/// ±`noise` (level units). The sensing distance grows with temperature, which widens the on-zone
+/// by `drift_per_k` units per kelvin above 20 °C at each end (narrows it below), so its middle
+/// stays put while each edge moves. The digital output is a comparator: on at `threshold`, off
+/// below `threshold − hysteresis`.
+struct ProximitySensor {
+  bool present = false;
+  double ramp = 0.5;         ///< units from level 0 to level 1 at each end
+  double threshold = 0.5;    ///< level at which the output switches on
+  double hysteresis = 0.05;  ///< the output switches off below threshold − hysteresis
+  double noise = 0.002;      ///< ± level units, uniform, per sample
+  double drift_per_k = 0;    ///< outward shift of each edge, units per kelvin above 20 °C
+};
+
+/// Temperature at which a proximity sensor's on-zone is exactly its window.
+inline constexpr double kReferenceTemperatureC = 20.0;
+
 /// The switches of one joint, at table positions (mm or degrees).
 struct SwitchLayout {
   SwitchWindow limit_neg, limit_pos, home, decel;
+  /// When present the home switch is this analog sensor over the `home` window (else an ideal
+  /// contact with the hysteresis and noise below).
+  ProximitySensor home_sensor;
   /// Differential travel: once active, a switch releases only this far outside its window.
   double hysteresis = 0.01;
   /// Each sample moves the switching points by a uniform random amount in ±noise (seeded).
@@ -67,6 +90,12 @@ struct SimJointModel {
   double index_spacing = 0;   ///< distance between encoder index marks, units (0 = no index)
   double index_offset = 0;    ///< position of one index mark, units
   double start_position = 0;  ///< motor (and table) position at power-up, units
+  // Steppers: with a pull-out effort the motor is a mass that must be dragged by the steps (mass
+  // `inertia`, the frictions above, injected loads); a period that asks more effort than the
+  // pull-out curve gives stalls it: the rotor drops out of step and coasts while steps go on being
+  // emitted (they are lost), and locks on a step again once command and rotor are at rest.
+  double pullout_effort = 0;  ///< N or N·m the motor gives at standstill; 0 = an ideal stepper
+  double pullout_speed = 0;   ///< units/s at which the pull-out effort has fallen to 0 (0 = flat)
 };
 
 struct SimJointConfig {
@@ -76,7 +105,21 @@ struct SimJointConfig {
   double counts_per_unit = 1000;
   SimJointModel model;
   SwitchLayout switches;
+  bool stall_detector = false;  ///< stepper: the drive reports a stall (JointInputs::stall)
 };
+
+/// A generic digital input driven by a switch on a joint's table position (e.g. "tool
+/// retracted" on a hand-fed quill). The input reads the injected value or the switch.
+struct SimInputSwitch {
+  int channel = -1;  ///< digital input channel; -1 = unused
+  int joint = -1;
+  SwitchWindow window;
+  double hysteresis = 0.01;
+  double noise = 0.001;
+};
+
+/// Most switch-driven digital inputs a simulated machine has.
+inline constexpr int kMaxSimInputSwitches = 8;
 
 struct SimSpindleConfig {
   double max_rpm = 0;                 ///< command is clamped to this
@@ -137,6 +180,9 @@ struct SimMachineConfig {
   SimProcessConfig process;
   int digital_inputs = 0, digital_outputs = 0;
   int analog_inputs = 0, analog_outputs = 0;
+  std::array<SimInputSwitch, kMaxSimInputSwitches> input_switches{};
+  bool handwheel = false;     ///< the machine has a manual pulse generator
+  double temperature_c = 20;  ///< machine temperature (proximity sensors drift with it)
 };
 
 }  // namespace opencnc::machine

@@ -85,11 +85,17 @@ class SimJoint {
   void substep(int i) noexcept;
   /// Finishes the period: index marks, velocity of a stepper.
   void end_period() noexcept;
-  /// Feedback, index and switches as the inputs of the next servo tick.
-  void sample(JointInputs& in, SplitMix64& rng) noexcept;
+  /// Feedback, index and switches as the inputs of the next servo tick; proximity sensors read
+  /// at `temperature_c`.
+  void sample(JointInputs& in, SplitMix64& rng, double temperature_c = kReferenceTemperatureC) noexcept;
 
   /// An injected drive fault: the drive drops its force and reports amp_fault.
   void set_fault(bool fault) noexcept { injected_fault_ = fault; }
+  /// A manual joint: the operator moves it toward `target` at up to `speed` (units/s), with the
+  /// acceleration of a hand (kHandAcceleration). Ignored by driven joints.
+  void set_hand_target(double target, double speed) noexcept;
+  /// Hand acceleration of a manual joint, units/s².
+  static constexpr double kHandAcceleration = 500;
 
   JointCapabilities capabilities() const noexcept;
 
@@ -101,6 +107,10 @@ class SimJoint {
   /// Mechanical energy the drive put into the axis during the last period, J (negative when
   /// braking). Feeds the DC link model.
   double energy_j() const noexcept;
+  /// Stepper: the rotor is out of step (stalled, or coasting without power).
+  bool stalled() const noexcept { return stalled_; }
+  /// Stepper: steps emitted that the rotor did not make (lost steps, + = the rotor is behind).
+  std::int64_t lost_steps() const noexcept { return lost_steps_; }
 
  private:
   double feedback_raw() const noexcept;
@@ -109,6 +119,9 @@ class SimJoint {
   double quantise_fast(double position) const noexcept;
   void servo_substep(double t_s) noexcept;
   void stepper_substep(int i) noexcept;
+  bool integrate_stepper_period() noexcept;
+  void coast() noexcept;
+  void integrate_hand_period() noexcept;
   void integrate_mechanics(double drive_effort) noexcept;
   void take_up_backlash() noexcept;
   void update_index(double before, double after) noexcept;
@@ -157,6 +170,15 @@ class SimJoint {
   SimPeriodMap::Row z_{};
   std::uint32_t index_count_ = 0;
   double index_position_ = 0;
+  // Stepper with a pull-out curve.
+  bool stepper_dynamic_ = false;  // the rotor is a mass that can stall
+  bool stalled_ = false;          // dropped out of step under power (what a stall detector sees)
+  bool in_step_ = true;           // the rotor follows the steps (false: it coasts)
+  std::int64_t lost_steps_ = 0;   // emitted − made
+  double step_velocity_ = 0;      // the step rate as the rotor feels it (lagged), units/s
+  // Manual joint: where the operator's hand is heading.
+  double hand_target_ = 0, hand_speed_ = 0;
+  SimProximity home_sensor_;
 };
 
 }  // namespace opencnc::machine

@@ -43,6 +43,12 @@ class SimMachine final : public MachineIO {
   void set_arc_available(bool available) noexcept { arc_available_ = available; }
   /// EDM gap voltage reported while the generator is on.
   void set_gap_voltage(double volts) noexcept { gap_voltage_v_ = volts; }
+  /// Machine temperature, °C (proximity sensors drift with it).
+  void set_temperature(double celsius) noexcept { temperature_c_ = celsius; }
+  /// The operator moves manual joint `joint` toward `target` at up to `speed` units/s.
+  void set_hand_target(int joint, double target, double speed) noexcept;
+  /// The operator turns the handwheel by `counts` (+ = clockwise); ignored without one.
+  void turn_handwheel(std::int32_t counts) noexcept;
 
   // --- ground truth ------------------------------------------------------------------
   std::uint64_t cycle() const noexcept { return inputs_.cycle; }
@@ -54,6 +60,7 @@ class SimMachine final : public MachineIO {
   double ups_remaining_s() const noexcept {
     return static_cast<double>(ups_periods_left_) * config_.servo_period_s;
   }
+  double temperature_c() const noexcept { return temperature_c_; }
 
  private:
   void advance(const MachineOutputs& out) noexcept;
@@ -65,6 +72,7 @@ class SimMachine final : public MachineIO {
   std::array<SimJoint, kMaxJoints> joints_{};
   SimSpindle spindle_;
   SimSwitch probe_;
+  std::array<SimSwitch, kMaxSimInputSwitches> input_switches_{};
   double probe_table_ = 0;  ///< the probe joint's table position at the last sample
   std::array<double, kMaxJoints> previous_feedback_{};  ///< the encoders at the sample before
   SplitMix64 rng_;
@@ -81,6 +89,8 @@ class SimMachine final : public MachineIO {
   std::array<double, kMaxJoints> external_effort_{};
   std::uint64_t digital_in_ = 0;
   std::array<double, kAnalogChannels> analog_in_{};
+  double temperature_c_ = kReferenceTemperatureC;
+  std::uint32_t handwheel_count_ = 0;  // wraps like a counter
   // Power supply: DC link, UPS, and the undervoltage fault each drive latches.
   double dc_link_v_ = 0;
   std::uint64_t ups_periods_left_ = 0;

@@ -2,6 +2,7 @@
 // A switch of the simulated machine: a position window with hysteresis and seeded noise.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 
@@ -59,6 +60,42 @@ class SimSwitch {
   double noise_ = 0;
   bool active_ = false;
   double edge_ = 0;
+};
+
+/// An analog proximity sensor over a window (ProximitySensor): its noisy level and the
+/// comparator that makes the digital output of it. Real-time safe.
+class SimProximity {
+ public:
+  constexpr SimProximity() noexcept = default;
+  constexpr SimProximity(const SwitchWindow& window, const ProximitySensor& sensor) noexcept
+      : window_(window), sensor_(sensor) {}
+
+  bool present() const noexcept { return window_.present; }
+  bool active() const noexcept { return active_; }
+  double level() const noexcept { return level_; }
+
+  /// The level without noise at `position` with the edges shifted outward by `shift` units.
+  double ideal_level(double position, double shift) const noexcept {
+    const double rise = (position - (window_.from - shift)) / sensor_.ramp;
+    const double fall = ((window_.to + shift) - position) / sensor_.ramp;
+    return std::clamp(sensor_.threshold + std::min(rise, fall), 0.0, 1.0);
+  }
+
+  /// Samples the sensor at `position` at `temperature_c`; draws one noise value when noise > 0.
+  bool update(double position, double temperature_c, SplitMix64& rng) noexcept {
+    if (!window_.present) return false;
+    const double shift = sensor_.drift_per_k * (temperature_c - kReferenceTemperatureC);
+    const double jitter = sensor_.noise > 0 ? sensor_.noise * rng.symmetric() : 0.0;
+    level_ = ideal_level(position, shift) + jitter;
+    active_ = level_ >= (active_ ? sensor_.threshold - sensor_.hysteresis : sensor_.threshold);
+    return active_;
+  }
+
+ private:
+  SwitchWindow window_{};
+  ProximitySensor sensor_{};
+  double level_ = 0;
+  bool active_ = false;
 };
 
 }  // namespace opencnc::machine

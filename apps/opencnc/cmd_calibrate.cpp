@@ -1,0 +1,308 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// `opencnc calibrate`: homing repeatability (midpoint against a single edge) and the positioning
+// test before and after compensation on the simulated machine; the measured table into the profile.
+#include <fmt/format.h>
+#include <sys/stat.h>
+#include <unistd.h>
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "commands.hpp"
+#include "opencnc/config/profile_loader.hpp"
+#include "opencnc/config/profile_writer.hpp"
+#include "opencnc/controller/calibration.hpp"
+#include "opencnc/controller/run_recorder.hpp"
+#include "opencnc/core/atomic_file.hpp"
+
+namespace opencnc::cli {
+
+namespace {
+
+struct CalibrateOptions {
+  std::string profile;
+  std::vector<std::string> sets;
+  int homing_runs = 0;
+  bool positioning = false;
+  bool write_table = false;
+  bool json = false;
+  std::string axes;
+  std::uint64_t seed = 1;
+  double temperature_swing_c = 10;
+  std::string trace;
+};
+
+std::string axis_key(Axis a) {
+  return std::string(1, letter(a));
+}
+
+double um(double mm) {
+  return std::round(mm * 1e4) / 10;  // µm to a tenth
+}
+
+/// The axes to position: the driven ones of the profile, or those `--axes` names.
+std::optional<AxisMask> positioning_axes(const config::MachineProfile& p, const std::string& letters) {
+  AxisMask m;
+  for (const config::AxisProfile& a : p.axes) {
+    if (a.manual()) continue;
+    if (letters.empty() || AxisMask::from_letters(letters).has(a.axis)) m.set(a.axis);
+  }
+  for (char c : letters) {
+    const AxisMask one = AxisMask::from_letters(std::string(1, c));
+    if (one.count() != 1 || (one.bits() & m.bits()) == 0) return std::nullopt;
+  }
+  return m;
+}
+
+/// A file we may write an output to: not the profile we read, not a folder or a device, not a
+/// read-only file.
+bool writable_output(const std::string& out, const std::string& input, std::string& why) {
+  std::error_code ec;
+  if (std::filesystem::equivalent(out, input, ec)) {
+    why = fmt::format("{} is the profile; it is not overwritten by a trace", out);
+    return false;
+  }
+  const auto st = std::filesystem::status(out, ec);
+  if (std::filesystem::exists(st) && !std::filesystem::is_regular_file(st)) {
+    why = fmt::format("{} is not a regular file", out);
+    return false;
+  }
+  if (std::filesystem::exists(st) && ::access(out.c_str(), W_OK) != 0) {
+    why = fmt::format("{} is read-only", out);
+    return false;
+  }
+  return true;
+}
+
+nlohmann::json figures(const control::AxisPositioning& a) {
+  return {{"accuracy_um", um(a.accuracy)},
+          {"repeatability_um", um(a.repeatability)},
+          {"reversal_um", um(a.reversal)}};
+}
+
+void print_homing(const control::HomingSpread& h) {
+  fmt::print("homing: {} runs from random start positions, {:.1f} to {:.1f} °C\n", h.runs,
+             h.temperature_min_c, h.temperature_max_c);
+  for (int i = 0; i < kAxisCount; ++i) {
+    if (!h.axes.has(static_cast<Axis>(i))) continue;
+    const auto ui = static_cast<std::size_t>(i);
+    fmt::print("  {}  midpoint spread {:7.2f} µm   single edge spread {:7.2f} µm\n",
+               letter(static_cast<Axis>(i)), 1000 * h.midpoint_spread[ui], 1000 * h.single_edge_spread[ui]);
+  }
+}
+
+void print_positioning(const control::Positioning& before, const control::Positioning& profile,
+                       const control::Positioning& after, const control::PositioningOptions& o) {
+  fmt::print("positioning (ISO 230-2 style): targets every {} mm, {} approaches from each direction\n",
+             o.interval, o.approaches);
+  for (int i = 0; i < kAxisCount; ++i) {
+    if (!before.axes.has(static_cast<Axis>(i))) continue;
+    const auto ui = static_cast<std::size_t>(i);
+    const auto line = [&](const char* what, const control::AxisPositioning& a) {
+      fmt::print("  {}  {:<7}  accuracy {:7.1f} µm   repeatability {:7.1f} µm   reversal {:7.1f} µm\n",
+                 what[0] == 'b' ? letter(static_cast<Axis>(i)) : ' ', what, um(a.accuracy),
+                 um(a.repeatability), um(a.reversal));
+    };
+    line("before", before.axis[ui]);
+    if (profile.axes.has(static_cast<Axis>(i))) line("profile", profile.axis[ui]);
+    line("after", after.axis[ui]);
+  }
+}
+
+/// Writes the measured tables into the profile file: never half-written (a temporary file renamed
+/// over it), never when the file is no longer `original` (the text the measured profile came
+/// from), and only a text that reads back as the same profile with those tables.
+bool write_tables(const CalibrateOptions& o, const std::string& original,
+                  const std::vector<std::pair<Axis, config::CompensationProfile>>& tables, std::string& why) {
+  std::string text = original;
+  for (const auto& [axis, table] : tables) {
+    std::optional<std::string> next = config::with_compensation(text, axis, table, why);
+    if (!next) return false;
+    text = std::move(*next);
+  }
+  const std::filesystem::path path = std::filesystem::canonical(o.profile);
+  const config::ProfileLoad check = config::parse_profile(text, path.string(), {}, path.parent_path());
+  if (!check.ok()) {
+    why = "the profile with the new tables does not load (nothing written)";
+    return false;
+  }
+  for (const auto& [axis, table] : tables) {
+    const config::CompensationProfile& got = check.profile->find(axis)->compensation;
+    bool same = got.positions.size() == table.positions.size();
+    for (std::size_t i = 0; same && i < table.positions.size(); ++i) {
+      same = std::abs(got.forward[i] - table.forward[i]) < 1e-6 &&
+             std::abs(got.reverse[i] - table.reverse[i]) < 1e-6 &&
+             std::abs(got.positions[i] - table.positions[i]) < 1e-6;
+    }
+    if (!same) {
+      why = fmt::format("the table of {} does not read back as measured (nothing written)", letter(axis));
+      return false;
+    }
+  }
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode) || ::access(path.c_str(), W_OK) != 0) {
+    why = fmt::format("{} is not a regular file we may write", path.string());
+    return false;
+  }
+  std::string now;
+  if (!read_file(path.string(), now, &why)) return false;
+  if (now != original) {
+    why = fmt::format("{} changed while the machine was measured (nothing written)", path.string());
+    return false;
+  }
+  if (!write_file_atomically(path.string(), text, &why)) return false;
+  ::chmod(path.c_str(), st.st_mode & 07777);  // keep its permissions
+  return true;
+}
+
+int calibrate(const CalibrateOptions& o) {
+  if (o.homing_runs <= 0 && !o.positioning) {
+    fmt::print(stderr, "error: nothing to do: give --homing-runs N and/or --positioning\n");
+    return kExitUsage;
+  }
+  if (o.write_table && (!o.positioning || !o.sets.empty())) {
+    fmt::print(stderr,
+               "error: --write-table needs --positioning, and writes only what the profile as written "
+               "measured (no --set)\n");
+    return kExitUsage;
+  }
+  // With --write-table the machine is measured from the text that will be edited, read once: if
+  // the file changes meanwhile, nothing is written.
+  std::string original;
+  if (o.write_table) {
+    std::string why;
+    if (!read_file(o.profile, original, &why)) {
+      fmt::print(stderr, "error: {}\n", why);
+      return kExitUsage;
+    }
+  }
+  const std::filesystem::path file(o.profile);
+  const config::ProfileLoad load = o.write_table
+                                       ? config::parse_profile(original, o.profile, {}, file.parent_path())
+                                       : config::load_profile(o.profile, o.sets);
+  for (const Diagnostic& d : load.diagnostics.items()) fmt::print(stderr, "{} [{}]\n", d.format(), d.code);
+  if (!load.ok()) {
+    const bool unreadable =
+        !load.diagnostics.items().empty() && load.diagnostics.items()[0].code == "config.file";
+    return unreadable ? kExitUsage : kExitProgram;
+  }
+  const config::MachineProfile& profile = *load.profile;
+  std::string why;
+  if (!o.trace.empty() && !writable_output(o.trace, o.profile, why)) {
+    fmt::print(stderr, "error: {}\n", why);
+    return kExitUsage;
+  }
+  const std::optional<AxisMask> axes = positioning_axes(profile, o.axes);
+  if (!axes) {
+    fmt::print(stderr, "error: --axes {}: not driven axes of the profile\n", o.axes);
+    return kExitUsage;
+  }
+  nlohmann::json out = nlohmann::json::object();
+  try {
+    if (o.homing_runs > 0) {
+      std::optional<control::TraceCsvWriter> csv;
+      if (!o.trace.empty()) csv.emplace(o.trace, profile.axis_mask(), profile.servo_period_s);
+      control::HomingSpreadOptions ho;
+      ho.runs = o.homing_runs;
+      ho.seed = o.seed;
+      ho.temperature_swing_c = o.temperature_swing_c;
+      if (csv) ho.trace = [&](const control::TraceSample& s) { csv->add(s); };
+      const control::HomingSpread h = control::homing_spread(profile, ho);
+      if (csv && !csv->close()) {
+        fmt::print(stderr, "error: cannot write the trace {}\n", o.trace);
+        return kExitUsage;
+      }
+      if (h.axes.count() == 0)
+        fmt::print(stderr, "warning: no axis homes by decel_midpoint: no homing figures\n");
+      if (!o.json) print_homing(h);
+      nlohmann::json& j = out["homing"] = nlohmann::json::object();
+      for (int i = 0; i < kAxisCount; ++i) {
+        if (!h.axes.has(static_cast<Axis>(i))) continue;
+        j[axis_key(static_cast<Axis>(i))] = {
+            {"midpoint_spread_um", um(h.midpoint_spread[static_cast<std::size_t>(i)])},
+            {"single_edge_spread_um", um(h.single_edge_spread[static_cast<std::size_t>(i)])}};
+      }
+    }
+    if (o.positioning) {
+      control::PositioningOptions po;
+      po.axes = *axes;
+      po.seed = o.seed;
+      const control::Positioning before =
+          control::measure_positioning(control::without_compensation(profile), po);
+      // With the profile's own tables too, where it has some: how good they are.
+      control::PositioningOptions with_own = po;
+      with_own.axes = AxisMask{};
+      for (const config::AxisProfile& a : profile.axes) {
+        if (po.axes.has(a.axis) && a.compensation.present) with_own.axes.set(a.axis);
+      }
+      const control::Positioning own = with_own.axes.count() > 0
+                                           ? control::measure_positioning(profile, with_own)
+                                           : control::Positioning{};
+      config::MachineProfile compensated = profile;
+      std::vector<std::pair<Axis, config::CompensationProfile>> tables;
+      for (config::AxisProfile& a : compensated.axes) {
+        if (!before.axes.has(a.axis)) continue;
+        a.compensation = control::compensation_from(before.axis[static_cast<std::size_t>(index(a.axis))], a);
+        tables.emplace_back(a.axis, a.compensation);
+      }
+      const control::Positioning after = control::measure_positioning(compensated, po);
+      if (!o.json) print_positioning(before, own, after, po);
+      nlohmann::json& j = out["positioning"] = nlohmann::json::object();
+      for (int i = 0; i < kAxisCount; ++i) {
+        if (!before.axes.has(static_cast<Axis>(i))) continue;
+        const auto ui = static_cast<std::size_t>(i);
+        nlohmann::json& a = j[axis_key(static_cast<Axis>(i))];
+        a = {{"before", figures(before.axis[ui])}, {"after", figures(after.axis[ui])}};
+        if (own.axes.has(static_cast<Axis>(i))) a["profile"] = figures(own.axis[ui]);
+      }
+      if (o.write_table) {
+        if (!write_tables(o, original, tables, why)) {
+          fmt::print(stderr, "error: --write-table: {}\n", why);
+          return kExitUsage;
+        }
+        if (!o.json) fmt::print("wrote the measured tables into {}\n", o.profile);
+      }
+    }
+  } catch (const std::runtime_error& e) {
+    fmt::print(stderr, "error: {}\n", e.what());
+    return kExitProgram;
+  }
+  if (o.json) fmt::print("{}\n", out.dump(2));
+  return kExitOk;
+}
+
+}  // namespace
+
+void add_calibrate_command(CLI::App& app, Registry& registry) {
+  auto opts = std::make_shared<CalibrateOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "calibrate",
+      "Measure the simulated machine: homing repeatability, positioning before and after compensation");
+  cmd->add_option("profile", opts->profile, "Machine profile, e.g. configs/drill-retrofit.toml")->required();
+  cmd->add_option("--set", opts->sets, "Override a profile key (repeatable; not with --write-table)")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  cmd->add_option("--homing-runs", opts->homing_runs,
+                  "Home N times from random start positions: spread of the midpoint against a single edge")
+      ->check(CLI::Range(1, 10000));
+  cmd->add_flag("--positioning", opts->positioning,
+                "Positioning test (ISO 230-2 style) before and after compensation with the measured table");
+  cmd->add_flag("--write-table", opts->write_table,
+                "Write the measured tables into the profile (atomically)");
+  cmd->add_option("--axes", opts->axes, "Axes to position, e.g. XY (default: every driven axis)");
+  cmd->add_flag("--json", opts->json, "Print the figures as JSON");
+  cmd->add_option("--seed", opts->seed, "Seed of the random start positions, temperatures and machine noise");
+  cmd->add_option("--temperature-swing", opts->temperature_swing_c,
+                  "Range of the homing runs' temperatures around the profile's, kelvin (default 10)")
+      ->check(CLI::Range(0.0, 100.0));
+  cmd->add_option("--trace", opts->trace, "Write the first homing run as a trace CSV (opencnc plot --trace)");
+  cmd->callback([opts, &registry] { registry.set_result(calibrate(*opts)); });
+}
+
+}  // namespace opencnc::cli
