@@ -22,9 +22,22 @@ test_packages=(
   linuxcnc-uspace             # rs274 (oracle) and /usr/share/linuxcnc/ncfiles
 )
 
-if [[ "${1:-}" == "--tests" ]]; then
-  packages+=("${test_packages[@]}")
-fi
+usage() {
+  cat <<'TXT'
+usage: scripts/setup.sh [--tests]
+  Installs the Debian 12 packages opencnc needs with apt-get (idempotent; sudo when not root).
+  --tests      also what the test suite needs (clang for fuzzing, LinuxCNC's rs274 and its samples)
+  -h, --help   this text
+TXT
+}
+while (($#)); do
+  case $1 in
+    --tests) packages+=("${test_packages[@]}") ;;
+    -h | --help) usage; exit 0 ;;
+    *) echo "setup.sh: unknown option '$1'" >&2; usage >&2; exit 2 ;;
+  esac
+  shift
+done
 
 missing=()
 for p in "${packages[@]}"; do

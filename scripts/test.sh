@@ -1,13 +1,33 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: GPL-3.0-or-later
 # Installs what the tests need, builds with warnings as errors, runs the whole suite, runs it again
-# under ASan+UBSan, then fuzzes the G-code front end. This is what CI runs (.ci/run).
-#   scripts/test.sh [--quick]   --quick: only the normal build and suite (no sanitizers, no fuzzing)
+# under ASan+UBSan, then the deterministic fuzz gate. This is what CI runs (.ci/run).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
+usage() {
+  cat <<'TXT'
+usage: scripts/test.sh [--quick]
+  Installs the test packages (scripts/setup.sh --tests), builds with warnings as errors and runs the
+  suite; then builds and runs it again under ASan + UBSan; then the fuzz gate (scripts/fuzz.sh --gate:
+  the committed corpus, the regression inputs and a fixed-seed run: the same commit always passes or
+  always fails). OPENCNC_JOBS sets the build's parallel jobs (default 2).
+  --quick      only the normal build and suite (no sanitizers, no fuzzing)
+  -h, --help   this text
+TXT
+}
+
+quick=0
+while (($#)); do
+  case $1 in
+    --quick) quick=1 ;;
+    -h | --help) usage; exit 0 ;;
+    *) echo "test.sh: unknown option '$1'" >&2; usage >&2; exit 2 ;;
+  esac
+  shift
+done
+
 jobs=${OPENCNC_JOBS:-2}
-fuzz_seconds=${OPENCNC_FUZZ_SECONDS:-60}
 
 scripts/setup.sh --tests
 
@@ -17,7 +37,7 @@ cmake --build --preset ci -j "$jobs"
 echo "== test suite"
 ctest --preset ci -j "$jobs"
 
-[[ "${1:-}" == "--quick" ]] && exit 0
+((quick)) && exit 0
 
 echo "== build with AddressSanitizer + UndefinedBehaviorSanitizer"
 cmake --preset asan >/dev/null
@@ -26,10 +46,10 @@ echo "== test suite under ASan + UBSan"
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
   ctest --preset asan -j "$jobs"
 
-if [[ -d fuzz ]] && compgen -G "fuzz/*/CMakeLists.txt" >/dev/null; then
-  echo "== fuzzing (${fuzz_seconds}s per target, ASan + UBSan)"
+if compgen -G "fuzz/*/CMakeLists.txt" >/dev/null; then
+  echo "== fuzz gate (the G-code libraries and the fuzz targets only; ASan + UBSan)"
   cmake --preset fuzz >/dev/null
   cmake --build --preset fuzz -j "$jobs"
-  scripts/fuzz.sh "$fuzz_seconds"
+  scripts/fuzz.sh --gate
 fi
 echo "== all tests passed"

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "cli_files.hpp"
 #include "commands.hpp"
 #include "opencnc/config/profile_loader.hpp"
 #include "opencnc/config/profile_writer.hpp"
@@ -62,24 +63,6 @@ std::optional<AxisMask> positioning_axes(const config::MachineProfile& p, const 
 
 /// A file we may write an output to: not the profile we read, not a folder or a device, not a
 /// read-only file.
-bool writable_output(const std::string& out, const std::string& input, std::string& why) {
-  std::error_code ec;
-  if (std::filesystem::equivalent(out, input, ec)) {
-    why = fmt::format("{} is the profile; it is not overwritten by a trace", out);
-    return false;
-  }
-  const auto st = std::filesystem::status(out, ec);
-  if (std::filesystem::exists(st) && !std::filesystem::is_regular_file(st)) {
-    why = fmt::format("{} is not a regular file", out);
-    return false;
-  }
-  if (std::filesystem::exists(st) && ::access(out.c_str(), W_OK) != 0) {
-    why = fmt::format("{} is read-only", out);
-    return false;
-  }
-  return true;
-}
-
 nlohmann::json figures(const control::AxisPositioning& a) {
   return {{"accuracy_um", um(a.accuracy)},
           {"repeatability_um", um(a.repeatability)},
@@ -193,10 +176,14 @@ int calibrate(const CalibrateOptions& o) {
     return unreadable ? kExitUsage : kExitProgram;
   }
   const config::MachineProfile& profile = *load.profile;
-  std::string why;
-  if (!o.trace.empty() && !writable_output(o.trace, o.profile, why)) {
-    fmt::print(stderr, "error: {}\n", why);
-    return kExitUsage;
+  // The trace is checked (and created) before anything runs: never over the profile or its tools.
+  std::unique_ptr<OutputFile> trace_file;
+  if (!o.trace.empty()) {
+    const NamedPath inputs[] = {{"the profile", o.profile}, {"the tool table", profile.interpreter.tool_table}};
+    const NamedPath outputs[] = {{"--trace", o.trace}};
+    auto files = open_outputs(inputs, outputs);
+    if (files.empty()) return kExitUsage;
+    trace_file = std::move(files[0]);
   }
   const std::optional<AxisMask> axes = positioning_axes(profile, o.axes);
   if (!axes) {
@@ -207,17 +194,14 @@ int calibrate(const CalibrateOptions& o) {
   try {
     if (o.homing_runs > 0) {
       std::optional<control::TraceCsvWriter> csv;
-      if (!o.trace.empty()) csv.emplace(o.trace, profile.axis_mask(), profile.servo_period_s);
+      if (trace_file) csv.emplace(*trace_file, profile.axis_mask(), profile.servo_period_s);
       control::HomingSpreadOptions ho;
       ho.runs = o.homing_runs;
       ho.seed = o.seed;
       ho.temperature_swing_c = o.temperature_swing_c;
       if (csv) ho.trace = [&](const control::TraceSample& s) { csv->add(s); };
       const control::HomingSpread h = control::homing_spread(profile, ho);
-      if (csv && !csv->close()) {
-        fmt::print(stderr, "error: cannot write the trace {}\n", o.trace);
-        return kExitUsage;
-      }
+      if (trace_file && !commit(*trace_file)) return kExitUsage;
       if (h.axes.count() == 0)
         fmt::print(stderr, "warning: no axis homes by decel_midpoint: no homing figures\n");
       if (!o.json) print_homing(h);
@@ -262,6 +246,7 @@ int calibrate(const CalibrateOptions& o) {
         if (own.axes.has(static_cast<Axis>(i))) a["profile"] = figures(own.axis[ui]);
       }
       if (o.write_table) {
+        std::string why;
         if (!write_tables(o, original, tables, why)) {
           fmt::print(stderr, "error: --write-table: {}\n", why);
           return kExitUsage;

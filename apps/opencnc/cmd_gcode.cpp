@@ -2,6 +2,7 @@
 // `opencnc check`, `opencnc canon` and `opencnc scan`: the G-code interpreter on files.
 #include <CLI/CLI.hpp>
 
+#include <cstdint>
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -9,12 +10,14 @@
 
 #include "commands.hpp"
 #include "gcode_summary.hpp"
+#include "numeric_options.hpp"
 #include "opencnc/canon/rs274_printer.hpp"
 #include "opencnc/core/axis_map.hpp"
 #include "opencnc/gcode/dialect.hpp"
 #include "opencnc/gcode/interpreter.hpp"
-#include "opencnc/gcode/standard_extensions.hpp"
 #include "opencnc/gcode/rs274_driver.hpp"
+#include "opencnc/gcode/standard_extensions.hpp"
+#include "progress.hpp"
 
 namespace opencnc::cli {
 
@@ -29,6 +32,8 @@ struct InterpArgs {
   std::string dialect;    ///< empty: the program's own marker, else LinuxCNC
   std::string machine;    ///< empty: guessed from a Fanuc program
   std::string axis_map;
+  bool progress = false;  ///< progress on stderr also when it is not a terminal
+  std::uint64_t max_blocks = gcode::Limits{}.max_blocks;
 };
 
 void add_interp_options(CLI::App* cmd, InterpArgs& a) {
@@ -45,6 +50,13 @@ void add_interp_options(CLI::App* cmd, InterpArgs& a) {
   cmd->add_option("--machine", a.machine, "mill or lathe, for Fanuc programs (default: guessed from the program's axis words)")
       ->check(CLI::IsMember({"mill", "lathe"}, CLI::ignore_case));
   cmd->add_option("--axis-map", a.axis_map, "axis exchange, program letter = machine axis (e.g. X=Y,Y=X)");
+  cmd->add_option("--max-blocks", a.max_blocks,
+                  "stop with gcode.limit-blocks after this many blocks (loop bodies count each time; default "
+                  "200000000)")
+      ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{1} << 62));
+  cmd->add_flag(
+      "--progress", a.progress,
+      "show progress on stderr also when it is not a terminal (on a terminal it shows after 0.5 s)");
 }
 
 // rs274's built-in tool table (used when it is given no -t): tools 1..3, lengths and
@@ -78,6 +90,7 @@ bool make_options(const InterpArgs& a, const std::string& file, gcode::Options& 
   }
   o.extensions = gcode::standard_extensions(o.dialect);
   o.block_delete = a.block_delete;
+  o.limits.max_blocks = a.max_blocks;
   o.subroutine_path = a.subroutine_path.empty() ? std::vector<std::string>{"."} : a.subroutine_path;
   if (!a.tool_table.empty()) {
     Diagnostics diags;
@@ -104,7 +117,9 @@ int run_canon(const std::string& file, const InterpArgs& args) {
     return kExitUsage;
   }
   canon::Rs274Printer printer(stdout, stdout);
-  const gcode::RunStatus status = gcode::run_like_rs274(interp, printer);
+  InterpreterProgress progress("canon " + file, args.progress);
+  const gcode::RunStatus status = gcode::run_like_rs274(
+      interp, printer, [&](gcode::Interpreter& i, canon::Sink& sink) { return progress.run(i, sink); });
   printer.flush();
   print_diagnostics(interp.diagnostics());
   return status == gcode::RunStatus::Error ? kExitProgram : kExitOk;
@@ -122,7 +137,7 @@ int run_check(const std::vector<std::string>& files, const InterpArgs& args) {
     if (!interp.open(file)) {
       unreadable = true;
     } else {
-      interp.run(quiet);
+      InterpreterProgress("check " + file, args.progress).run(interp, quiet);
     }
     for (const auto& d : interp.diagnostics().items()) std::printf("%s [%s]\n", d.format().c_str(), d.code.c_str());
     errors = errors || interp.diagnostics().has_errors();
@@ -137,8 +152,7 @@ void add_gcode_commands(CLI::App& app, Registry& registry) {
   static InterpArgs check_args, canon_args, scan_args;
   static std::vector<std::string> check_files;
   static std::string canon_file, scan_file;
-  static bool scan_json = false;
-  static double rapid_rate = 0;
+  static ScanOutput scan_out;
 
   CLI::App* check = app.add_subcommand("check", "Check G-code programs without moving anything");
   check->add_option("files", check_files, "programs to check")->required();
@@ -152,8 +166,10 @@ void add_gcode_commands(CLI::App& app, Registry& registry) {
 
   CLI::App* scan = app.add_subcommand("scan", "Summarise a program: moves, length, extents, time, tools, offsets");
   scan->add_option("file", scan_file, "program")->required();
-  scan->add_flag("--json", scan_json, "print the summary as JSON");
-  scan->add_option("--rapid-rate", rapid_rate, "rapid rate in mm/min for the time estimate (default: rapids not timed)");
+  scan->add_flag("--json", scan_out.json, "print the summary as JSON");
+  scan->add_option("--rapid-rate", scan_out.rapid_rate_mm_min,
+                   "rapid rate in mm/min for the time estimate (default: rapids not timed)")
+      ->check(finite_range(0.0, 1e9));
   add_interp_options(scan, scan_args);
   scan->callback([&registry] {
     gcode::Options options;
@@ -161,7 +177,8 @@ void add_gcode_commands(CLI::App& app, Registry& registry) {
       registry.set_result(kExitUsage);
       return;
     }
-    registry.set_result(run_scan(scan_file, options, scan_json, rapid_rate));
+    scan_out.progress = scan_args.progress;
+    registry.set_result(run_scan(scan_file, options, scan_out));
   });
 }
 

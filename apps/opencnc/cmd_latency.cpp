@@ -10,9 +10,10 @@
 
 #include <fmt/format.h>
 
+#include "cli_files.hpp"
 #include "commands.hpp"
+#include "numeric_options.hpp"
 #include "opencnc/control/clock.hpp"
-#include "opencnc/core/atomic_file.hpp"
 #include "opencnc/viz/svg_chart.hpp"
 
 namespace opencnc::cli {
@@ -60,17 +61,17 @@ void print_histogram(const control::LatencyHistogram& h) {
   }
 }
 
-bool write_csv(const std::string& path, const control::LatencyHistogram& h, std::string* err) {
+std::string histogram_csv(const control::LatencyHistogram& h) {
   std::string out = "bin_start_us,bin_end_us,count\n";
   const auto counts = h.counts();
   for (int i = 0; i <= control::LatencyHistogram::kBins; ++i) {
     out += i == control::LatencyHistogram::kBins ? fmt::format("{},inf,{}\n", i, counts[static_cast<std::size_t>(i)])
                                                  : fmt::format("{},{},{}\n", i, i + 1, counts[static_cast<std::size_t>(i)]);
   }
-  return write_file_atomically(path, out, err);
+  return out;
 }
 
-bool write_svg(const std::string& path, const control::RealtimeClock& clock, double period_us, std::string* err) {
+std::string histogram_svg(const control::RealtimeClock& clock, double period_us) {
   const auto& h = clock.latency();
   const auto counts = h.counts();
   viz::Panel p;
@@ -94,10 +95,14 @@ bool write_svg(const std::string& path, const control::RealtimeClock& clock, dou
   viz::SvgChart chart(fmt::format("opencnc latency — period {:.0f} us, {}", period_us,
                                   clock.realtime() ? "SCHED_FIFO" : "normal thread (not real-time)"));
   chart.add_panel(std::move(p));
-  return chart.write(path, err);
+  return chart.render();
 }
 
 int run_latency(const LatencyOptions& o) {
+  // Outputs are checked (and created) before the measurement, not after it.
+  const NamedPath outputs[] = {{"--csv", o.csv}, {"--svg", o.svg}};
+  const auto files = open_outputs({}, outputs);
+  if (files.empty()) return kExitUsage;
   control::RealtimeClock::Options co;
   co.period_ns = static_cast<std::int64_t>(o.period_us * 1000.0);
   co.priority = o.priority;
@@ -121,16 +126,10 @@ int run_latency(const LatencyOptions& o) {
              h.stddev_ns() / 1000.0, static_cast<double>(h.percentile_ns(0.99)) / 1000.0,
              static_cast<double>(h.percentile_ns(0.999)) / 1000.0, static_cast<double>(h.max_ns()) / 1000.0);
   print_histogram(h);
-  std::string err;
-  if (!o.csv.empty() && !write_csv(o.csv, h, &err)) {
-    fmt::print(stderr, "error: {}\n", err);
-    return kExitUsage;
-  }
-  if (!o.svg.empty() && !write_svg(o.svg, clock, o.period_us, &err)) {
-    fmt::print(stderr, "error: {}\n", err);
-    return kExitUsage;
-  }
-  return kExitOk;
+  int rc = kExitOk;
+  if (files[0] && !write_and_commit(*files[0], histogram_csv(h))) rc = kExitUsage;
+  if (files[1] && !write_and_commit(*files[1], histogram_svg(clock, o.period_us))) rc = kExitUsage;
+  return rc;
 }
 
 }  // namespace
@@ -138,10 +137,11 @@ int run_latency(const LatencyOptions& o) {
 void add_latency_command(CLI::App& app, Registry& registry) {
   auto opts = std::make_shared<LatencyOptions>();
   CLI::App* cmd = app.add_subcommand("latency", "Measure the wake-up jitter of the periodic servo thread");
-  cmd->add_option("--seconds", opts->seconds, "How long to measure")->check(CLI::Range(0.1, 86400.0));
-  cmd->add_option("--period-us", opts->period_us, "Thread period in microseconds")->check(CLI::Range(50.0, 100000.0));
+  cmd->add_option("--seconds", opts->seconds, "How long to measure")->check(finite_range(0.1, 86400.0));
+  cmd->add_option("--period-us", opts->period_us, "Thread period in microseconds")
+      ->check(finite_range(50.0, 100000.0));
   cmd->add_option("--priority", opts->priority, "SCHED_FIFO priority")->check(CLI::Range(1, 99));
-  cmd->add_option("--cpu", opts->cpu, "Pin the thread to this CPU");
+  cmd->add_option("--cpu", opts->cpu, "Pin the thread to this CPU")->check(CLI::Range(0, 1023));
   cmd->add_option("--csv", opts->csv, "Write the histogram as CSV");
   cmd->add_option("--svg", opts->svg, "Draw the histogram as SVG");
   cmd->callback([opts, &registry] { registry.set_result(run_latency(*opts)); });

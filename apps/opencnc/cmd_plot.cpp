@@ -7,13 +7,18 @@
 
 #include <algorithm>
 #include <array>
+#include <cerrno>
+#include <charconv>
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <memory>
-#include <sstream>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
+#include "cli_files.hpp"
 #include "commands.hpp"
 #include "opencnc/control/homing.hpp"
 #include "opencnc/core/axes.hpp"
@@ -59,66 +64,101 @@ struct Trace {
 
 // --- reading a trace CSV (the columns TraceCsvWriter writes) ---------------------------------
 
+/// Largest magnitude a trace value may have (mm, degrees, s, mm/s): beyond it a chart's scale
+/// overflows, and no machine travels a million kilometres.
+constexpr double kMaxTraceValue = 1e9;
+
+/// The columns a plot reads, by index in the header (-1: absent).
+struct TraceColumns {
+  int t = -1, rapid = -1, v = -1;
+  std::array<int, kAxisCount> cmd{}, ferr{}, act{}, phase{}, level{};
+};
+
+TraceColumns find_columns(const std::vector<std::string>& head, AxisMask& axes) {
+  TraceColumns c;
+  for (auto* col : {&c.cmd, &c.ferr, &c.act, &c.phase, &c.level}) col->fill(-1);
+  for (int k = 0; k < static_cast<int>(head.size()); ++k) {
+    const std::string& h = head[static_cast<std::size_t>(k)];
+    if (h == "time_s") c.t = k;
+    if (h == "rapid") c.rapid = k;
+    if (h == "path_velocity") c.v = k;
+    for (int i = 0; i < kAxisCount; ++i) {
+      const std::string a(1, kAxisLetters[static_cast<std::size_t>(i)]);
+      if (h == "cmd_" + a) c.cmd[static_cast<std::size_t>(i)] = k, axes.set(static_cast<Axis>(i));
+      if (h == "ferr_" + a) c.ferr[static_cast<std::size_t>(i)] = k;
+      if (h == "act_" + a) c.act[static_cast<std::size_t>(i)] = k;
+      if (h == "phase_" + a) c.phase[static_cast<std::size_t>(i)] = k;
+      if (h == "level_" + a) c.level[static_cast<std::size_t>(i)] = k;
+    }
+  }
+  return c;
+}
+
+std::vector<std::string_view> split_fields(std::string_view line) {
+  std::vector<std::string_view> out;
+  for (std::size_t start = 0;;) {
+    const std::size_t comma = line.find(',', start);
+    out.push_back(
+        line.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start));
+    if (comma == std::string_view::npos) return out;
+    start = comma + 1;
+  }
+}
+
+/// Field `k` of a row as a number a chart can take; `error` says file:row:col otherwise.
+bool number_field(const std::vector<std::string_view>& fields, std::string_view line, int k,
+                  const std::string& where, double& out, std::string& error) {
+  const std::string_view f = fields[static_cast<std::size_t>(k)];
+  const auto col = static_cast<std::size_t>(f.data() - line.data()) + 1;
+  const auto [end, ec] = std::from_chars(f.data(), f.data() + f.size(), out);
+  if (ec == std::errc() && end == f.data() + f.size() && std::isfinite(out) &&
+      std::fabs(out) <= kMaxTraceValue)
+    return true;
+  if (ec == std::errc::invalid_argument || end != f.data() + f.size())
+    error = fmt::format("{}:{}: '{}' is not a number", where, col, f);
+  else
+    error = fmt::format("{}:{}: {} is out of range (a plot takes finite values up to {:g} in magnitude)",
+                        where, col, f, kMaxTraceValue);
+  return false;
+}
+
 bool read_trace(const std::string& path, Trace& trace, std::string& error) {
   std::ifstream in(path);
   if (!in) {
-    error = "cannot read the trace " + path;
+    error = fmt::format("cannot read the trace {}: {}", path, std::strerror(errno));
     return false;
   }
   std::string line;
   std::getline(in, line);
   std::vector<std::string> head;
-  for (std::stringstream ss(line); std::getline(ss, line, ',');) head.push_back(line);
-  int t_col = -1, rapid_col = -1, v_col = -1;
-  std::array<int, kAxisCount> cmd_col{}, ferr_col{}, act_col{}, phase_col{}, level_col{};
-  for (auto* c : {&cmd_col, &ferr_col, &act_col, &phase_col, &level_col}) c->fill(-1);
-  for (int c = 0; c < static_cast<int>(head.size()); ++c) {
-    const std::string& h = head[static_cast<std::size_t>(c)];
-    if (h == "time_s") t_col = c;
-    if (h == "rapid") rapid_col = c;
-    if (h == "path_velocity") v_col = c;
-    for (int i = 0; i < kAxisCount; ++i) {
-      const std::string a(1, kAxisLetters[static_cast<std::size_t>(i)]);
-      if (h == "cmd_" + a) cmd_col[static_cast<std::size_t>(i)] = c, trace.axes.set(static_cast<Axis>(i));
-      if (h == "ferr_" + a) ferr_col[static_cast<std::size_t>(i)] = c;
-      if (h == "act_" + a) act_col[static_cast<std::size_t>(i)] = c;
-      if (h == "phase_" + a) phase_col[static_cast<std::size_t>(i)] = c;
-      if (h == "level_" + a) level_col[static_cast<std::size_t>(i)] = c;
-    }
-  }
-  if (t_col < 0 || trace.axes.count() == 0) {
+  for (const std::string_view h : split_fields(line)) head.emplace_back(h);
+  const TraceColumns c = find_columns(head, trace.axes);
+  if (c.t < 0 || trace.axes.count() == 0) {
     error = path + " is not an opencnc trace (no time_s or cmd_ columns)";
     return false;
   }
-  std::vector<double> v;
-  std::vector<std::string> words;
   std::size_t row = 1;
   while (std::getline(in, line)) {
     ++row;
-    v.clear();
-    words.clear();
-    for (std::stringstream ss(line); std::getline(ss, line, ',');) {
-      v.push_back(std::strtod(line.c_str(), nullptr));
-      words.push_back(line);
-    }
+    const std::vector<std::string_view> v = split_fields(line);
+    const std::string where = fmt::format("{}:{}", path, row);
     if (v.size() != head.size()) {
-      error = fmt::format("{}:{}: {} fields, the header has {}", path, row, v.size(), head.size());
+      error = fmt::format("{}: {} fields, the header has {}", where, v.size(), head.size());
       return false;
     }
     Sample s;
-    s.t = v[static_cast<std::size_t>(t_col)];
-    s.rapid = rapid_col >= 0 && v[static_cast<std::size_t>(rapid_col)] != 0;
-    s.path_velocity = v_col >= 0 ? v[static_cast<std::size_t>(v_col)] : 0;
-    for (int i = 0; i < kAxisCount; ++i) {
-      if (cmd_col[static_cast<std::size_t>(i)] >= 0)
-        s.cmd[i] = v[static_cast<std::size_t>(cmd_col[static_cast<std::size_t>(i)])];
-      if (ferr_col[static_cast<std::size_t>(i)] >= 0)
-        s.ferr[i] = v[static_cast<std::size_t>(ferr_col[static_cast<std::size_t>(i)])];
+    double rapid = 0;
+    auto field = [&](int k, double& out) { return k < 0 || number_field(v, line, k, where, out, error); };
+    bool ok = field(c.t, s.t) && field(c.rapid, rapid) && field(c.v, s.path_velocity);
+    for (int i = 0; ok && i < kAxisCount; ++i) {
       const auto ui = static_cast<std::size_t>(i);
-      s.act[i] = act_col[ui] >= 0 ? v[static_cast<std::size_t>(act_col[ui])] : s.cmd[i];
-      if (level_col[ui] >= 0) s.level[i] = v[static_cast<std::size_t>(level_col[ui])];
-      if (phase_col[ui] >= 0) s.phase[ui] = phase_named(words[static_cast<std::size_t>(phase_col[ui])]);
+      ok = field(c.cmd[ui], s.cmd[i]) && field(c.ferr[ui], s.ferr[i]) && field(c.level[ui], s.level[i]);
+      s.act[i] = s.cmd[i];
+      ok = ok && field(c.act[ui], s.act[i]);
+      if (c.phase[ui] >= 0) s.phase[ui] = phase_named(std::string(v[static_cast<std::size_t>(c.phase[ui])]));
     }
+    if (!ok) return false;
+    s.rapid = rapid != 0;
     trace.samples.push_back(s);
   }
   if (trace.samples.size() > 1) trace.period_s = trace.samples[1].t - trace.samples[0].t;
@@ -329,19 +369,21 @@ viz::Panel sensor_level(const Trace& tr, int a) {
   return p;
 }
 
-bool draw_homing(const Trace& tr, const std::string& title, const std::string& out, std::string& error) {
+/// A homing trace: per homing axis, its position by phase and the sensor's level.
+std::string draw_homing(const Trace& tr, const std::string& title) {
   viz::SvgChart chart(title, 2, 640, 430);
   for (int a = 0; a < kAxisCount; ++a) {
     if (!tr.axes.has(static_cast<Axis>(a)) || !homes(tr, a)) continue;
     chart.add_panel(homing_phases(tr, a));
     chart.add_panel(sensor_level(tr, a));
   }
-  return chart.write(out, &error);
+  return chart.render();
 }
 
-bool draw(const Trace& tr, const std::string& title, const std::string& out, std::string& error) {
+/// The whole page as an SVG document (a homing trace gets the homing charts).
+std::string draw(const Trace& tr, const std::string& title) {
   for (int a = 0; a < kAxisCount; ++a) {
-    if (tr.axes.has(static_cast<Axis>(a)) && homes(tr, a)) return draw_homing(tr, title, out, error);
+    if (tr.axes.has(static_cast<Axis>(a)) && homes(tr, a)) return draw_homing(tr, title);
   }
   viz::SvgChart chart(title, 2, 640, 430);
   const auto xy = [](int a, int b) { return [a, b](const Pose& q) { return std::pair{q[a], q[b]}; }; };
@@ -356,7 +398,21 @@ bool draw(const Trace& tr, const std::string& title, const std::string& out, std
   chart.add_panel(velocities(tr));
   chart.add_panel(accelerations(tr));
   chart.add_panel(following_errors(tr));
-  return chart.write(out, &error);
+  return chart.render();
+}
+
+/// A plot draws a trace or runs a program; given both it could only guess which was meant.
+bool check_sources(const PlotOptions& o) {
+  const bool program = !o.session.file.empty() || !o.session.machine.empty() || !o.session.sets.empty();
+  if (!o.trace.empty() && program) {
+    fmt::print(stderr, "error: plot draws a trace (--trace) or runs a program (with --machine), not both\n");
+    return false;
+  }
+  if (o.trace.empty() && (o.session.file.empty() || o.session.machine.empty())) {
+    fmt::print(stderr, "error: plot wants a program and --machine, or --trace\n");
+    return false;
+  }
+  return true;
 }
 
 /// The program run's samples, as the plot draws them.
@@ -374,19 +430,25 @@ class PlotRecorder final : public control::ControllerObserver {
 };
 
 int plot(const PlotOptions& o) {
+  if (!check_sources(o)) return kExitUsage;
+  const std::optional<config::MachineProfile> profile =
+      o.trace.empty() ? quiet_profile(o.session) : std::nullopt;
+  const std::vector<NamedPath> inputs = o.trace.empty()
+                                            ? session_inputs(o.session, profile ? &*profile : nullptr)
+                                            : std::vector<NamedPath>{{"the trace", o.trace}};
+  const NamedPath outputs[] = {{"-o", o.out}};
+  if (!check_inputs(inputs)) return kExitUsage;
+  const auto files = open_outputs(inputs, outputs);
+  if (files.empty()) return kExitUsage;
   Trace tr;
   std::string error, title;
   if (!o.trace.empty()) {
-    if (!read_trace(o.trace, tr, error)) {
+    if (!read_trace(o.trace, tr, error)) {  // (check_inputs said it can be read: its data is bad)
       fmt::print(stderr, "error: {}\n", error);
-      return kExitUsage;
+      return kExitProgram;
     }
     title = "opencnc trace " + o.trace;
   } else {
-    if (o.session.file.empty() || o.session.machine.empty()) {
-      fmt::print(stderr, "error: plot wants a program and --machine, or --trace\n");
-      return kExitUsage;
-    }
     SessionHooks hooks;
     hooks.opened = [&](const config::MachineProfile& p, const control::OpenProgram&) {
       tr.axes = p.axis_mask();
@@ -405,11 +467,7 @@ int plot(const PlotOptions& o) {
     fmt::print(stderr, "error: nothing to plot\n");
     return kExitProgram;
   }
-  if (!draw(tr, title, o.out, error)) {
-    fmt::print(stderr, "error: {}\n", error);
-    return kExitUsage;
-  }
-  return kExitOk;
+  return write_and_commit(*files[0], draw(tr, title)) ? kExitOk : kExitUsage;
 }
 
 }  // namespace

@@ -6,11 +6,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "cli_files.hpp"
 #include "commands.hpp"
 #include "opencnc/config/profile_loader.hpp"
 #include "opencnc/machine/sim_machine.hpp"
@@ -83,15 +83,13 @@ int run_move(const config::MachineProfile& p, const ProfileOptions& o) {
   const auto j = static_cast<std::size_t>(a->joint);
   const double start = in.joints[j].position, sign = distance < 0 ? -1 : 1;
   const Trapezoid move(distance, a->max_velocity, a->max_acceleration);
-  std::ofstream csv;
-  if (!o.csv.empty()) {
-    csv.open(o.csv);
-    if (!csv) {
-      fmt::print(stderr, "error: cannot write {}\n", o.csv);
-      return kExitUsage;
-    }
-    csv << "t_s,command,feedback,table,following_error,effort\n";
-  }
+  std::vector<NamedPath> inputs = {{"the profile", o.file}};
+  if (!p.interpreter.tool_table.empty()) inputs.push_back({"the tool table", p.interpreter.tool_table});
+  const NamedPath outputs[] = {{"--csv", o.csv}};
+  const auto files = open_outputs(inputs, outputs);
+  if (files.empty()) return kExitUsage;
+  OutputFile* const csv = files[0].get();
+  if (csv != nullptr) csv->write("t_s,command,feedback,table,following_error,effort\n");
   double worst = 0, worst_t = 0;
   const int periods = static_cast<int>(std::ceil((move.duration() + 0.2) / p.servo_period_s));
   for (int k = 0; k < periods; ++k) {
@@ -102,14 +100,15 @@ int run_move(const config::MachineProfile& p, const ProfileOptions& o) {
     m.read(in);
     const double error = out.joints[j].position - in.joints[j].position;
     if (std::abs(error) > worst) worst = std::abs(error), worst_t = t;
-    if (csv) {
-      csv << fmt::format("{:.4f},{:.6f},{:.6f},{:.6f},{:.6f},{:.3f}\n", t, out.joints[j].position,
-                         in.joints[j].position, m.joint(a->joint).table_position(), error,
-                         in.joints[j].effort);
+    if (csv != nullptr) {
+      csv->write(fmt::format("{:.4f},{:.6f},{:.6f},{:.6f},{:.6f},{:.3f}\n", t, out.joints[j].position,
+                             in.joints[j].position, m.joint(a->joint).table_position(), error,
+                             in.joints[j].effort));
     }
     m.write(out);
   }
   m.read(in);
+  if (csv != nullptr && !commit(*csv)) return kExitUsage;
   fmt::print("{} {:+} in {:.3f} s: max following error {:.4f} at t = {:.3f} s; final error {:.4f}\n",
              letter(a->axis), distance, move.duration(), worst, worst_t,
              out.joints[j].position - in.joints[j].position);
@@ -138,9 +137,11 @@ void add_profile_command(CLI::App& app, Registry& registry) {
   cmd->add_option("--set", opts->sets, "Override a key: --set axis.x.max_velocity=200 (repeatable)")
       ->expected(1)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
-  cmd->add_option("--move", opts->move, "Move one simulated axis from its start, e.g. --move x=100");
+  CLI::Option* move =
+      cmd->add_option("--move", opts->move, "Move one simulated axis from its start, e.g. --move x=100");
   cmd->add_option("--csv", opts->csv,
-                  "With --move: write t, command, feedback, table, error, effort per period");
+                  "With --move: write t, command, feedback, table, error, effort per period")
+      ->needs(move);
   cmd->callback([opts, &registry] { registry.set_result(run_profile(*opts)); });
 }
 

@@ -7,28 +7,63 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <fstream>
 #include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "cli_files.hpp"
 #include "commands.hpp"
+#include "gcode_summary.hpp"
+#include "numeric_options.hpp"
 #include "opencnc/controller/preflight.hpp"
 #include "opencnc/controller/run_recorder.hpp"
 #include "opencnc/controller/servo_setup.hpp"
-#include "opencnc/core/atomic_file.hpp"
 #include "run_session.hpp"
+#include "stop_signals.hpp"
 
 namespace opencnc::cli {
 
 namespace {
 
+/// Default of --max-time: a day of machining. Longer programs exist (moulds), and say so.
+constexpr double kDefaultMaxTimeS = 86400;
+
 struct RunOptions {
   SessionOptions session;
   std::string trace;
   std::string report;
+  double max_time_s = kDefaultMaxTimeS;  ///< 0: no limit
 };
+
+/// "3.2 h", "19.0 years": a duration a person reads at a glance.
+std::string human_duration(double s) {
+  if (s < 120) return fmt::format("{:.1f} s", s);
+  if (s < 7200) return fmt::format("{:.1f} min", s / 60);
+  if (s < 2 * 86400) return fmt::format("{:.1f} h", s / 3600);
+  if (s < 2 * 365.25 * 86400) return fmt::format("{:.1f} days", s / 86400);
+  return fmt::format("{:.3g} years", s / (365.25 * 86400));
+}
+
+/// Refuses (with the reason, and the slowest move) a program that needs more machining time than
+/// --max-time before it runs: F0.000001 would otherwise run for years. A program the scan cannot
+/// finish is left to the run, which reports its errors.
+bool within_max_time(const RunOptions& o, const config::MachineProfile& profile) {
+  if (o.max_time_s <= 0) return true;
+  const TimeEstimate e = estimate_machining_time(o.session.file, profile);
+  if (!e.complete || e.total_s() <= o.max_time_s) return true;
+  fmt::print(
+      stderr,
+      "error: {} needs at least {} of machining (feed {:.6g} s, rapid {:.6g} s, dwell {:.6g} s), more than "
+      "--max-time {:g} s ({}){}; raise --max-time (0: no limit) if that is meant\n",
+      o.session.file, human_duration(e.total_s()), e.feed_s, e.rapid_s, e.dwell_s, o.max_time_s,
+      human_duration(o.max_time_s),
+      e.slowest_move_at.empty() ? std::string()
+                                : fmt::format("; the slowest move, {}, takes {}", e.slowest_move_at,
+                                              human_duration(e.slowest_move_s)));
+  return false;
+}
+
 
 /// "[#########...........]  42.1 %  line 123  12.3 s  ~17.0 s left" on one terminal line: the
 /// path run so far against the preflight's length of the whole program.
@@ -100,6 +135,7 @@ nlohmann::json report_json(const control::RunReport& r, const RunOptions& o, con
   j["realtime"] = o.session.realtime;
   j["finished"] = end.finished;
   j["fault"] = end.fault.empty() ? nlohmann::json(nullptr) : nlohmann::json(end.fault);
+  j["stopped_by"] = end.stopped_by != 0 ? nlohmann::json(signal_name(end.stopped_by)) : nlohmann::json(nullptr);
   j["machining_time_s"] = r.machining_time_s;
   j["motion_time_s"] = r.motion_time_s;
   j["path_length_mm"] = r.path_length_mm;
@@ -124,25 +160,42 @@ nlohmann::json report_json(const control::RunReport& r, const RunOptions& o, con
   return j;
 }
 
+/// Commits the trace; a failure names the reason and how much of the trace is whole.
+bool commit_trace(OutputFile& trace) {
+  std::string error;
+  if (trace.commit(&error)) return true;
+  const std::uint64_t rows = trace.records() > 0 ? trace.records() - 1 : 0;
+  fmt::print(stderr, "error: {}; {}\n", error,
+             trace.records() > 0 ? fmt::format("the trace keeps its first {} whole rows", rows)
+                                 : std::string("the trace was not written"));
+  return false;
+}
+
 int run(const RunOptions& o) {
-  if (!o.trace.empty() && !std::ofstream(o.trace)) {  // before the run, not after it
-    fmt::print(stderr, "error: cannot write the trace {}\n", o.trace);
-    return kExitUsage;
-  }
+  // Every output is checked (and created) before anything runs.
+  const std::optional<config::MachineProfile> profile = quiet_profile(o.session);
+  const std::vector<NamedPath> inputs = session_inputs(o.session, profile ? &*profile : nullptr);
+  const NamedPath outputs[] = {{"--trace", o.trace}, {"--report", o.report}};
+  if (!check_inputs(inputs)) return kExitUsage;
+  if (profile && !within_max_time(o, *profile)) return kExitProgram;
+  const auto files = open_outputs(inputs, outputs);
+  if (files.empty()) return kExitUsage;
+  OutputFile* const trace_file = files[0].get();
+  OutputFile* const report_file = files[1].get();
   std::shared_ptr<control::RunRecorder> recorder;
   std::optional<control::TraceCsvWriter> csv;
   std::optional<ProgressBar> bar;
   const bool tty = ::isatty(STDOUT_FILENO) != 0;
   double run_start_s = -1;
   SessionHooks hooks;
-  hooks.opened = [&](const config::MachineProfile& profile, const control::OpenProgram& program) {
+  hooks.opened = [&](const config::MachineProfile& machine, const control::OpenProgram& program) {
     std::vector<std::pair<std::shared_ptr<control::ControllerObserver>, control::ObserverOptions>> out;
-    const plan::MachineLimits axes = control::axis_limits(profile);  // the drives' commands: the axes' own
-    recorder = std::make_shared<control::RunRecorder>(control::machine_limits(profile),
-                                                      profile.servo_period_s, &axes);
+    const plan::MachineLimits axes = control::axis_limits(machine);  // the drives' commands: the axes' own
+    recorder = std::make_shared<control::RunRecorder>(control::machine_limits(machine), machine.servo_period_s,
+                                                      &axes);
     out.emplace_back(recorder, control::ObserverOptions{0, true});
-    if (!o.trace.empty()) {
-      csv.emplace(o.trace, profile.axis_mask(), profile.servo_period_s);
+    if (trace_file != nullptr) {
+      csv.emplace(*trace_file, machine.axis_mask(), machine.servo_period_s);
       out.emplace_back(std::make_shared<TraceObserver>(*csv), control::ObserverOptions{0, true});
     }
     if (tty) bar.emplace(program.preflight.summary.path_length_mm);
@@ -152,23 +205,18 @@ int run(const RunOptions& o) {
     if (run_start_s < 0) run_start_s = st.servo.time_s;
     if (bar) bar->show(st, run_start_s, recorder->report().path_length_mm);
   };
-  const SessionEnd end = run_session(o.session, hooks);
+  const StopSignals signals;  // Ctrl-C: a controlled stop, and the report says so
+  SessionOptions session = o.session;
+  session.stop = &StopSignals::requested();
+  const SessionEnd end = run_session(session, hooks);
   if (bar) bar->finish();
-  if (!recorder) return end.exit_code;  // nothing ran
+  if (!recorder) return end.exit_code;  // nothing ran; the outputs are left as they were
   int rc = end.exit_code;
-  if (csv && !csv->close()) {
-    fmt::print(stderr, "error: cannot write the trace {}\n", o.trace);
-    rc = kExitUsage;
-  }
+  if (trace_file != nullptr && !commit_trace(*trace_file)) rc = kExitUsage;
   const control::RunReport r = recorder->report();
   print_report(r, end.profile, end);
-  if (!o.report.empty()) {
-    std::string err;
-    if (!write_file_atomically(o.report, report_json(r, o, end).dump(2) + "\n", &err)) {
-      fmt::print(stderr, "error: {}\n", err);
-      rc = kExitUsage;
-    }
-  }
+  if (report_file != nullptr && !write_and_commit(*report_file, report_json(r, o, end).dump(2) + "\n"))
+    rc = kExitUsage;
   return rc;
 }
 
@@ -191,6 +239,10 @@ void add_run_command(CLI::App& app, Registry& registry) {
                 "operator on the terminal");
   cmd->add_option("--trace", opts->trace, "Write one CSV row per servo period (docs/controller.md)");
   cmd->add_option("--report", opts->report, "Write the report as JSON");
+  cmd->add_option("--max-time", opts->max_time_s,
+                  "Refuse a program that needs more machining time than this, in seconds (default 86400, a day; "
+                  "0: no limit)")
+      ->check(finite_range(0, 1e12));
   cmd->callback([opts, &registry] { registry.set_result(run(*opts)); });
 }
 

@@ -12,7 +12,8 @@ namespace opencnc::cli {
 
 inline constexpr int kExitOk = 0;       ///< success
 inline constexpr int kExitProgram = 1;  ///< the program (G-code, machine) has an error
-inline constexpr int kExitUsage = 2;    ///< wrong command line, unreadable file
+inline constexpr int kExitUsage = 2;    ///< wrong command line, unreadable input, unwritable output
+inline constexpr int kExitFailure = 3;  ///< opencnc itself failed (out of memory, an internal error)
 
 /// Holds the exit code of the subcommand that ran.
 class Registry {

@@ -7,14 +7,19 @@
 #include <cstdio>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <set>
+
+#include <fmt/format.h>
 
 #include <nlohmann/json.hpp>
 
 #include "commands.hpp"
 #include "opencnc/canon/program_builder.hpp"
 #include "opencnc/canon/tee_sink.hpp"
+#include "opencnc/controller/gcode_source.hpp"
 #include "opencnc/gcode/interpreter.hpp"
+#include "progress.hpp"
 
 namespace opencnc::cli {
 
@@ -92,34 +97,59 @@ struct Totals {
   double feed_length = 0, rapid_length = 0;
   double feed_time_min = 0;
   bool untimed = false;   // per-revolution feeds: no time without a spindle model
+  double slowest_min = 0;  // the feed move that takes longest, and where it is
+  std::uint32_t slowest_file = 0, slowest_line = 0;
   Box box;
+  std::optional<Diagnostic> out_of_reach;  // the first move no machine could make
 };
 
+/// Farthest a move may end from the machine origin (mm): beyond it lengths and times stop
+/// meaning anything (10**300 overflows them to inf) and no machine travels that far.
+constexpr double kMaxReachMm = 1e9;
+
+bool within_reach(const double p[3]) {
+  return std::fabs(p[0]) <= kMaxReachMm && std::fabs(p[1]) <= kMaxReachMm && std::fabs(p[2]) <= kMaxReachMm;
+}
+
+/// Moves the builder keeps before the meter has it start over: the summary needs each move
+/// once, so a program of any length (a loop that never ends) scans in bounded memory.
+constexpr std::size_t kKeptMoves = std::size_t{1} << 16;
+
 // Counts, lengths, machine extents and feed time of a program's moves, taken as they are
-// appended (while they are still in the cache) instead of in a second pass over a program
-// of maybe a million moves. Moves are measured in order, one at a time.
+// appended (while they are still in the cache) instead of in a second pass. Moves are measured
+// in order, one at a time; every kKeptMoves the builder drops the moves measured.
 class MoveMeter {
  public:
-  explicit MoveMeter(const canon::Program& prog) : prog_(prog) {}
+  explicit MoveMeter(canon::ProgramBuilder& builder) : builder_(builder) {}
   /// Measures the moves appended since the last call.
   void catch_up() {
-    for (; next_ < prog_.size(); ++next_) measure(next_);
+    const canon::Program& prog = builder_.program();
+    for (; next_ < prog.size(); ++next_) measure(prog, next_);
+    if (next_ >= kKeptMoves) {
+      builder_.restart();
+      next_ = 0;
+    }
   }
   const Totals& totals() const { return t_; }
 
  private:
-  void measure(canon::SegmentId id) {
-    if (id == 0) {
-      const Pose& start = prog_.start();
+  void measure(const canon::Program& prog, canon::SegmentId id) {
+    if (id == 0) {  // (after a restart the start is where the last move measured ended)
+      const Pose& start = prog.start();
       for (int i = 0; i < 3; ++i) last_[i] = start[i];
       t_.box.add(last_[0], last_[1], last_[2]);
     }
     const double* s = last_;
-    const canon::Move& m = prog_.move(id);
-    const double e[3] = {prog_.end_coord(id, Axis::X), prog_.end_coord(id, Axis::Y), prog_.end_coord(id, Axis::Z)};
+    const canon::Move& m = prog.move(id);
+    const double e[3] = {prog.end_coord(id, Axis::X), prog.end_coord(id, Axis::Y),
+                         prog.end_coord(id, Axis::Z)};
+    if (!within_reach(e)) {
+      out_of_reach(prog, id, e);
+      return;
+    }
     double len;
     if (m.kind == canon::MoveKind::Arc) {
-      const canon::ArcGeometry& g = prog_.arc(id);
+      const canon::ArcGeometry& g = prog.arc(id);
       len = arc_extent(s, e, g.center, g.plane, g.turns, t_.box);
       ++t_.arcs;
     } else {
@@ -134,13 +164,38 @@ class MoveMeter {
     }
     ++t_.feeds;
     t_.feed_length += len;
-    const double f = prog_.feed(id);
-    if (m.flags & canon::kInverseTime) t_.feed_time_min += f > 0 ? 1.0 / f : 0;
+    const double f = prog.feed(id);
+    double minutes = 0;
+    if (m.flags & canon::kInverseTime)
+      minutes = f > 0 ? 1.0 / f : 0;
     else if (m.flags & canon::kPerRevolution) t_.untimed = true;
-    else if (f > 0) t_.feed_time_min += len / f;
+    else if (f > 0)
+      minutes = len / f;
+    t_.feed_time_min += minutes;
+    if (minutes > t_.slowest_min) {
+      t_.slowest_min = minutes;
+      t_.slowest_file = prog.file_of(id);
+      t_.slowest_line = m.line;
+    }
   }
 
-  const canon::Program& prog_;
+  // A move beyond any machine's reach is left out of the totals and reported (the first one).
+  void out_of_reach(const canon::Program& prog, canon::SegmentId id, const double e[3]) {
+    if (t_.out_of_reach) return;
+    const int axis = !(std::fabs(e[0]) <= kMaxReachMm) ? 0 : !(std::fabs(e[1]) <= kMaxReachMm) ? 1 : 2;
+    const std::uint32_t file = prog.file_of(id);
+    t_.out_of_reach =
+        Diagnostic{Severity::Error,
+                   file < prog.sources().file_count() ? prog.sources().file(file) : std::string(),
+                   prog.move(id).line,
+                   0,
+                   fmt::format("this move ends at {} {:g} mm, beyond any machine's reach (more than "
+                               "{:g} mm from the origin): lengths and times would mean nothing",
+                               kAxisLetters[static_cast<std::size_t>(axis)], e[axis], kMaxReachMm),
+                   "scan.out-of-reach"};
+  }
+
+  canon::ProgramBuilder& builder_;
   canon::SegmentId next_ = 0;
   double last_[3] = {0, 0, 0};   // X, Y, Z where the last move measured ended
   Totals t_;
@@ -161,7 +216,8 @@ class WorkWatcher final : public canon::Sink {
     c[a] = arc.first_center;
     c[b] = arc.second_center;
     c[n] = s[n];
-    arc_extent(s, e, c, arc.plane, arc.rotation, box_);
+    if (within_reach(s) && within_reach(e) && within_reach(c))
+      arc_extent(s, e, c, arc.plane, arc.rotation, box_);
     for (int i = 0; i < 3; ++i) pos_[i] = arc.end[i];
     meter_.catch_up();
   }
@@ -170,14 +226,17 @@ class WorkWatcher final : public canon::Sink {
   void select_tool(int tool) override { tools_selected.insert(tool); }
   void set_g5x_offset(int index, const Pose&) override { systems.insert(index); }
   void use_tool_length_offset(const Pose&) override { ++tool_offsets; }
+  void dwell(double seconds) override { dwell_s += seconds; }
 
   const Box& box() const { return box_; }
   std::set<int> tool_changes, tools_selected, systems;
   int tool_offsets = 0;
+  double dwell_s = 0;
 
  private:
   void move(const Pose& end) {
-    box_.add(end[0], end[1], end[2]);
+    // (a move beyond any machine's reach is reported by the meter, and would swamp the box)
+    if (within_reach(end.v.data())) box_.add(end[0], end[1], end[2]);
     for (int i = 0; i < 3; ++i) pos_[i] = end[i];
     meter_.catch_up();
   }
@@ -201,40 +260,74 @@ void print_box(const char* name, const Box& b) {
               b.lo[1] + 0.0, b.hi[1] + 0.0, b.lo[2] + 0.0, b.hi[2] + 0.0);
 }
 
+/// One scan of a program: the interpreter into the builder (which drops what the meter has
+/// measured) and the watcher, through a tee.
+class ProgramScan {
+ public:
+  explicit ProgramScan(const gcode::Options& options)
+      : interp_(options), builder_(options.axes), meter_(builder_), watch_(meter_), tee_(builder_, watch_) {}
+  /// False (with the diagnostic in the interpreter's) if the file cannot be opened.
+  bool open(const std::string& file) {
+    if (!interp_.open(file)) return false;
+    builder_.program().set_sources(interp_.sources());
+    return true;
+  }
+  gcode::RunStatus run(InterpreterProgress& progress) {
+    const gcode::RunStatus status = progress.run(interp_, tee_);
+    meter_.catch_up();  // moves of calls the watcher does not follow (probes, taps, splines)
+    return status;
+  }
+  const Totals& totals() const { return meter_.totals(); }
+  const WorkWatcher& watcher() const { return watch_; }
+  const gcode::Interpreter& interpreter() const { return interp_; }
+  /// "file:line" of a move.
+  std::string where(std::uint32_t file, std::uint32_t line) const {
+    const canon::SourceMap& sources = *interp_.sources();
+    return fmt::format("{}:{}", file < sources.file_count() ? sources.file(file) : std::string("?"), line);
+  }
+
+ private:
+  gcode::Interpreter interp_;
+  canon::ProgramBuilder builder_;
+  MoveMeter meter_;
+  WorkWatcher watch_;
+  canon::TeeSink tee_;  // the builder first: the watcher's meter reads its moves
+};
+
 }  // namespace
 
-int run_scan(const std::string& file, const gcode::Options& options, bool json, double rapid_rate_mm_min) {
-  gcode::Interpreter interp(options);
-  if (!interp.open(file)) {
-    for (const auto& d : interp.diagnostics().items()) std::fprintf(stderr, "%s [%s]\n", d.format().c_str(), d.code.c_str());
+int run_scan(const std::string& file, const gcode::Options& options, const ScanOutput& out) {
+  ProgramScan scan(options);
+  if (!scan.open(file)) {
+    for (const auto& d : scan.interpreter().diagnostics().items())
+      std::fprintf(stderr, "%s [%s]\n", d.format().c_str(), d.code.c_str());
     return kExitUsage;
   }
-  canon::ProgramBuilder builder(options.axes);
-  builder.program().set_sources(interp.sources());
-  const canon::Program& prog = builder.program();
-  MoveMeter meter(prog);
-  WorkWatcher watch(meter);
-  canon::TeeSink tee(builder, watch);   // the builder first: the watcher's meter reads its moves
-  const gcode::RunStatus status = interp.run(tee);
-  meter.catch_up();   // moves of calls the watcher does not follow (probes, taps, splines)
-  const Totals& t = meter.totals();
-  const gcode::InterpState st = interp.state();
+  InterpreterProgress progress("scan " + file, out.progress);
+  const gcode::RunStatus status = scan.run(progress);
+  const WorkWatcher& watch = scan.watcher();
+  const Totals& t = scan.totals();
+  const gcode::InterpState st = scan.interpreter().state();
+  const double rapid_rate_mm_min = out.rapid_rate_mm_min;
   const double rapid_min = rapid_rate_mm_min > 0 ? t.rapid_length / rapid_rate_mm_min : 0.0;
-  const auto& diags = interp.diagnostics();
-  if (json) {
+  Diagnostics diags = scan.interpreter().diagnostics();
+  if (t.out_of_reach) diags.add(*t.out_of_reach);
+  const bool ok = status != gcode::RunStatus::Error && !t.out_of_reach;
+  if (out.json) {
     nlohmann::json j;
     j["file"] = file;
-    j["ok"] = status != gcode::RunStatus::Error;
+    j["ok"] = ok;
     j["blocks"] = st.blocks_executed;
     j["segments"] = {{"feed", t.feeds}, {"rapid", t.rapids}, {"arcs", t.arcs}};
     j["length_mm"] = {{"feed", t.feed_length}, {"rapid", t.rapid_length}};
     j["bounding_box"] = {{"machine_mm", box_json(t.box)}, {"work", box_json(watch.box())}};
-    j["time_s"] = {{"feed", t.feed_time_min * 60.0}, {"rapid", rapid_rate_mm_min > 0 ? nlohmann::json(rapid_min * 60.0) : nullptr},
+    j["time_s"] = {{"feed", t.feed_time_min * 60.0},
+                   {"rapid", rapid_rate_mm_min > 0 ? nlohmann::json(rapid_min * 60.0) : nullptr},
+                   {"dwell", watch.dwell_s},
                    {"per_revolution_untimed", t.untimed}};
     j["tools"] = {{"selected", watch.tools_selected}, {"changed_index", watch.tool_changes}};
     j["coordinate_systems"] = watch.systems;
     j["tool_length_offsets"] = watch.tool_offsets;
-    j["program_memory_bytes"] = prog.memory_bytes();
     nlohmann::json d = nlohmann::json::array();
     for (const auto& x : diags.items()) d.push_back({{"text", x.format()}, {"code", x.code}});
     j["diagnostics"] = d;
@@ -249,6 +342,7 @@ int run_scan(const std::string& file, const gcode::Options& options, bool json, 
     std::printf("%-22s %.1f s at programmed feeds%s", "time", t.feed_time_min * 60.0,
                 t.untimed ? " (feed-per-revolution moves not timed)" : "");
     if (rapid_rate_mm_min > 0) std::printf(" + %.1f s rapid", rapid_min * 60.0);
+    if (watch.dwell_s > 0) std::printf(" + %.1f s dwell", watch.dwell_s);
     std::printf("\n");
     std::printf("%-22s", "tools selected");
     for (int x : watch.tools_selected) std::printf(" T%d", x);
@@ -260,7 +354,32 @@ int run_scan(const std::string& file, const gcode::Options& options, bool json, 
     std::printf("\n%-22s %d\n", "tool length offsets", watch.tool_offsets);
     for (const auto& x : diags.items()) std::printf("%s [%s]\n", x.format().c_str(), x.code.c_str());
   }
-  return status == gcode::RunStatus::Error ? kExitProgram : kExitOk;
+  return ok ? kExitOk : kExitProgram;
+}
+
+TimeEstimate estimate_machining_time(const std::string& file, const config::MachineProfile& profile) {
+  TimeEstimate e;
+  // The options the run's own source gives this file (dialect comment, modules, tool table).
+  Diagnostics diags;
+  const auto source = control::GcodeProgramSource::create(profile, diags);
+  if (!source) return e;
+  ProgramScan scan(source->options_for(file, {}));
+  if (!scan.open(file)) return e;
+  InterpreterProgress progress("checking the machining time of " + file, false);
+  e.complete = scan.run(progress) != gcode::RunStatus::Error && !scan.totals().out_of_reach;
+  double rapid_mm_s = 0;
+  for (const config::AxisProfile& a : profile.axes) {
+    if (a.axis == Axis::X || a.axis == Axis::Y || a.axis == Axis::Z)
+      rapid_mm_s += a.max_velocity * a.max_velocity;
+  }
+  rapid_mm_s = std::sqrt(rapid_mm_s);
+  const Totals& t = scan.totals();
+  e.feed_s = 60 * t.feed_time_min;
+  e.rapid_s = rapid_mm_s > 0 ? t.rapid_length / rapid_mm_s : 0;
+  e.dwell_s = scan.watcher().dwell_s;
+  e.slowest_move_s = 60 * t.slowest_min;
+  if (t.slowest_min > 0) e.slowest_move_at = scan.where(t.slowest_file, t.slowest_line);
+  return e;
 }
 
 }  // namespace opencnc::cli

@@ -22,6 +22,7 @@
 #include "opencnc/controller/gcode_source.hpp"
 #include "opencnc/controller/servo_setup.hpp"
 #include "opencnc/controller/sim_rig.hpp"
+#include "stop_signals.hpp"
 
 namespace opencnc::cli {
 
@@ -173,7 +174,7 @@ class OperatorInput {
       if (closed_) return std::nullopt;
       pollfd p{STDIN_FILENO, POLLIN, 0};
       const int n = ::poll(&p, 1, timeout_ms);
-      if (n < 0 && errno == EINTR) continue;
+      if (n < 0 && errno == EINTR) return std::nullopt;  // (a signal: the caller looks at its stop flag)
       if (n <= 0) return std::nullopt;
       char chunk[256];
       const ssize_t got = ::read(STDIN_FILENO, chunk, sizeof chunk);
@@ -231,10 +232,31 @@ void bring_hand_axis(Driver& d, const control::ServoStatus& s) {
   }
 }
 
+/// A stop asked through SessionOptions::stop (SIGINT, SIGTERM): feed hold on the path, then abort
+/// once the machine is at rest. Call every period; records the signal in `end`.
+class StopOnThePath {
+ public:
+  explicit StopOnThePath(const std::atomic<int>* flag) : flag_(flag) {}
+  bool requested() const noexcept { return flag_ != nullptr && flag_->load(std::memory_order_relaxed) != 0; }
+  void step(Driver& d, const control::ControllerStatus& st, SessionEnd& end) {
+    if (!requested() || aborted_) return;
+    end.stopped_by = flag_->load(std::memory_order_relaxed);
+    if (!held_) d.controller().submit(Request::simple(CommandKind::FeedHold));
+    else if (st.servo.path_velocity == 0) d.controller().submit(Request::simple(CommandKind::Abort));
+    aborted_ = held_ && st.servo.path_velocity == 0;
+    held_ = true;
+  }
+
+ private:
+  const std::atomic<int>* flag_;
+  bool held_ = false, aborted_ = false;
+};
+
 /// Follows the job started by cycle start until it ends, with the operator where it waits (and
 /// the machine's hand at the hand-fed axes).
 void follow(Driver& d, control::EventCursor& cursor, const SessionOptions& o, const SessionHooks& hooks,
             SessionEnd& end) {
+  StopOnThePath stop(o.stop);
   const auto t0 = std::chrono::steady_clock::now();
   OperatorInput input;
   std::uint32_t job = 0;
@@ -256,15 +278,20 @@ void follow(Driver& d, control::EventCursor& cursor, const SessionOptions& o, co
       end.wall_s = wall;
       end.finished = ended->end == control::JobEnd::Finished;
       if (!end.finished) {
-        end.fault = !st.fault_text.empty() ? st.fault_text
-                                           : fmt::format("the program ended: {}", control::to_string(ended->end));
+        // (a fault was printed as its note already)
+        if (!st.fault_text.empty()) end.fault = st.fault_text;
+        else if (end.stopped_by != 0)
+          end.fault = fmt::format("stopped by {} (feed hold on the path, then abort)", signal_name(end.stopped_by));
+        else end.fault = fmt::format("the program ended: {}", control::to_string(ended->end));
+        if (st.fault_text.empty()) fmt::print(stderr, "error: {}\n", end.fault);
         end.limit_touched = st.servo.fault.kind == control::FaultKind::SoftLimit ||
                             st.servo.fault.kind == control::FaultKind::LimitSwitch;
       }
       if (hooks.progress) hooks.progress(st, wall);
       return;
     }
-    const std::optional<OperatorWait> wait = operator_wait(st);
+    stop.step(d, st, end);
+    const std::optional<OperatorWait> wait = stop.requested() ? std::nullopt : operator_wait(st);
     if (!wait) {
       asked_tick = ~std::uint64_t{0};
       continue;
@@ -277,10 +304,11 @@ void follow(Driver& d, control::EventCursor& cursor, const SessionOptions& o, co
     }
     fmt::print(stderr, "\nwaiting for {}: press Enter to continue, or a and Enter to abort\n", wait->question);
     std::optional<std::string> answer;
-    while (!answer && !input.closed()) {
+    while (!answer && !input.closed() && !stop.requested()) {
       answer = input.line(d.ticks_by_itself() ? 10 : -1);
       if (!answer && d.ticks_by_itself()) d.advance();
     }
+    if (stop.requested()) continue;  // stopped at the question: the stop aborts it
     if (!answer) {
       fmt::print(stderr,
                  "error: the program waits for {} and no one can answer (stdin is closed): run it with "
@@ -367,8 +395,7 @@ SessionEnd run_session(const SessionOptions& o, const SessionHooks& hooks) {
   control::EventCursor cursor(d.controller().events());
   if (!must(d, Request::simple(CommandKind::CycleStart))) return end;
   follow(d, cursor, o, hooks, end);
-  if (!end.finished) fmt::print(stderr, "error: {}\n", end.fault);
-  end.exit_code = end.finished ? kExitOk : kExitProgram;
+  end.exit_code = end.finished ? kExitOk : end.stopped_by != 0 ? 128 + end.stopped_by : kExitProgram;
   return end;
 }
 

@@ -4,6 +4,7 @@
 // operator at the terminal where the program waits for one.
 #pragma once
 
+#include <atomic>
 #include <functional>
 #include <memory>
 #include <string>
@@ -22,6 +23,8 @@ struct SessionOptions {
   std::vector<std::string> sets;
   bool realtime = false;    ///< a real-time periodic thread instead of virtual time
   bool unattended = false;  ///< continue program stops and manual tool changes without asking
+  /// Polled during the run: a signal number there stops it on the path (feed hold, then abort).
+  const std::atomic<int>* stop = nullptr;
 };
 
 /// What a session ended with.
@@ -30,6 +33,7 @@ struct SessionEnd {
   bool finished = false;       ///< the program reached its end
   std::string fault;           ///< why it stopped early, in words ("" = it did not)
   bool limit_touched = false;  ///< a soft limit or a limit switch stopped it
+  int stopped_by = 0;          ///< the signal that stopped it (SessionOptions::stop), 0 if none
   double wall_s = 0;           ///< wall-clock time of the run
   config::MachineProfile profile;
   std::optional<control::OpenProgram> program;  ///< the program as opened (its preflight)

@@ -10,8 +10,17 @@ set -uo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 root=$here/../..
 opencnc=$root/build/opencnc
-if [[ ${1:-} == --opencnc ]]; then opencnc=$2; shift 2; fi
-filter=${1:-}
+usage() { echo "usage: $0 [--opencnc PATH] [PROGRAM-NAME-FILTER]"; }
+filter=
+while (($#)); do
+  case $1 in
+    --opencnc) opencnc=${2:?--opencnc wants a path}; shift ;;
+    -h | --help) usage; echo "  runs the accepted corpus programs through the controller (virtual time), one table row each"; exit 0 ;;
+    -*) echo "corpus_runs.sh: unknown option '$1'" >&2; usage >&2; exit 2 ;;
+    *) [[ -z $filter ]] || { usage >&2; exit 2; }; filter=$1 ;;
+  esac
+  shift
+done
 corpus=$root/../shared/gcode-corpus
 report=$(mktemp)
 trap 'rm -f "$report"' EXIT

@@ -18,7 +18,8 @@ lcnc=0
 while (($#)); do
   case $1 in
     --lcnc) lcnc=1 ;;
-    --opencnc) opencnc=$2; shift ;;
+    --opencnc) opencnc=${2:?--opencnc wants a path}; shift ;;
+    -h | --help) echo "usage: $0 [--lcnc] [--opencnc PATH]  (the reference programs of docs/performance.md)"; exit 0 ;;
     *) echo "usage: $0 [--lcnc] [--opencnc PATH]" >&2; exit 2 ;;
   esac
   shift

@@ -6,6 +6,13 @@
 # usage: bench/gcode/compare_rs274.sh [OPENCNC] [RUNS] [LINES]
 set -eu
 here=$(cd "$(dirname "$0")" && pwd)
+case ${1:-} in
+  -h | --help) echo "usage: $0 [OPENCNC] [RUNS] [LINES]  (opencnc canon/scan against rs274 -g, best of RUNS)"; exit 0 ;;
+  -*) echo "compare_rs274.sh: unknown option '$1'; usage: $0 [OPENCNC] [RUNS] [LINES]" >&2; exit 2 ;;
+esac
+for n in "${2:-5}" "${3:-1}"; do
+  case $n in '' | *[!0-9]*) echo "compare_rs274.sh: RUNS and LINES are whole numbers" >&2; exit 2 ;; esac
+done
 opencnc=${1:-$here/../../build/opencnc}
 runs=${2:-5}
 lines=${3:-1000000}

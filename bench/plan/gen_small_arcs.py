@@ -3,10 +3,19 @@
 # Writes N tangent arcs of radius R alternating G3/G2, each sweeping SWEEP degrees, at F3000 under
 # G64 P0.1: the small-arc case of docs/planner.md (same shape as analysis::small_arcs_program).
 # usage: gen_small_arcs.py N SWEEP_DEG OUT.ngc [R]
-import math, sys
+import argparse
+import math
 
-n, sweep_deg, out = int(sys.argv[1]), float(sys.argv[2]), sys.argv[3]
-r = float(sys.argv[4]) if len(sys.argv) > 4 else 0.3
+ap = argparse.ArgumentParser(description="Writes N tangent arcs of radius R alternating G3/G2, each sweeping "
+                             "SWEEP_DEG degrees, at F3000 under G64 P0.1.")
+ap.add_argument("n", type=int, help="number of arcs")
+ap.add_argument("sweep_deg", type=float, help="degrees each arc sweeps")
+ap.add_argument("out", help="the program to write")
+ap.add_argument("r", nargs="?", type=float, default=0.3, help="arc radius in mm (default 0.3)")
+args = ap.parse_args()
+if args.n < 1 or not (args.r > 0) or not math.isfinite(args.sweep_deg):
+    ap.error("N must be 1 or more, R positive and SWEEP_DEG finite")
+n, sweep_deg, out, r = args.n, args.sweep_deg, args.out, args.r
 sweep = math.radians(sweep_deg)
 lines = ["(%d alternating G3/G2 arcs, R%g, %g deg each, F3000, G64 P0.1)" % (n, r, sweep_deg),
          "G21 G17 G90 G94", "G64 P0.1", "G0 X0 Y0 Z0", "F3000"]

@@ -19,6 +19,14 @@ ProgramBuilder::ProgramBuilder(AxisMask axes, const Pose& start) : program_(axes
   use_length_units(units_);
 }
 
+void ProgramBuilder::restart() {
+  Program next(program_.axes());
+  next.set_start(position_);
+  next.set_sources(program_.sources_ptr());
+  program_ = std::move(next);
+  last_feed_mm_ = -1;  // the feed table starts empty again
+}
+
 void ProgramBuilder::use_length_units(Units u) {
   units_ = u;
   for (int i = 0; i < kAxisCount; ++i) unit_scale_[i] = is_linear(i) ? mm_per_unit(u) : 1.0;

@@ -72,6 +72,12 @@ std::optional<toml::table> parse_line(const std::string& text, std::uint32_t lin
   }
 }
 
+/// `inf`, `nan` (and signed ones) are TOML numbers a bare word must not turn into strings.
+bool looks_numeric(std::string_view v) {
+  while (!v.empty() && (v.back() == ' ' || v.back() == '\t')) v.remove_suffix(1);
+  return v == "inf" || v == "nan";
+}
+
 /// The override with its value as a TOML basic string ("fanuc" for a bare fanuc).
 std::string quoted(std::string_view key, std::string_view value) {
   std::string out(key);
@@ -106,8 +112,11 @@ bool apply_overrides(toml::table& root, std::span<const std::string> overrides, 
     // A bare word (fanuc, stepper, a path) is a string; what looks like TOML stays an error.
     const std::string_view value = std::string_view(text).substr(eq + 1);
     const auto start = value.find_first_not_of(" \t");
+    // A bare word is a string; what starts like a number or a TOML value (1e999, 2.5.1, [1, 2)
+    // stays the TOML error, which says what is wrong with it.
     const bool bare = start != std::string_view::npos &&
-                      std::string_view("[{\"'").find(value[start]) == std::string_view::npos;
+                      std::string_view("[{\"'+-.0123456789").find(value[start]) == std::string_view::npos &&
+                      !looks_numeric(value.substr(start));
     if (!doc && bare)
       doc = parse_line(quoted(std::string_view(text).substr(0, eq), value.substr(start)), line, nullptr);
     if (!doc) {

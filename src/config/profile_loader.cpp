@@ -4,11 +4,7 @@
 
 #include <fmt/format.h>
 
-#include <cerrno>
-#include <cstring>
-#include <fstream>
-#include <sstream>
-
+#include "opencnc/core/atomic_file.hpp"
 #include "overrides.hpp"
 #include "sections.hpp"
 
@@ -83,16 +79,13 @@ ProfileLoad parse_profile(std::string_view text, std::string_view source_name,
 }
 
 ProfileLoad load_profile(const std::filesystem::path& file, std::span<const std::string> overrides) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) {
+  std::string text, why;
+  if (!read_file(file.string(), text, &why)) {  // (a folder says so here, not as an empty profile)
     ProfileLoad out;
-    out.diagnostics.error(file.string(), 0, 0,
-                          fmt::format("cannot read the profile: {}", std::strerror(errno)), "config.file");
+    out.diagnostics.error(file.string(), 0, 0, "cannot read the profile: " + why, "config.file");
     return out;
   }
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parse_profile(text.str(), file.string(), overrides, file.parent_path());
+  return parse_profile(text, file.string(), overrides, file.parent_path());
 }
 
 }  // namespace opencnc::config

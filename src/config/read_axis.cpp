@@ -262,6 +262,18 @@ void read_mechanics(Section& m, const AxisProfile& a, machine::SimJointModel& mo
                   m.path(), reach, show(a.max_acceleration)),
               "config.drive-too-weak");
   }
+  // Top speed: where the peak effort only just overcomes the friction (viscous in the axis' units).
+  if (model.viscous_friction > 0) {
+    const double top = (model.peak_effort - model.coulomb_friction) / model.viscous_friction;
+    if (top < a.max_velocity) {
+      m.warning(
+          key(4),
+          fmt::format("{}: against its friction the drive can move the axis at {:.0f} at most, less than "
+                      "max_velocity ({})",
+                      m.path(), top, show(a.max_velocity)),
+          "config.drive-too-weak");
+    }
+  }
 }
 
 /// Drive loops, with the limits that keep the sampled cascade stable: the velocity loop
@@ -540,6 +552,7 @@ AxisProfile read_axis(const toml::table& table, const std::string& path, Axis ax
   a.max_acceleration = s.required_number("max_acceleration", Bound::Positive);
   a.max_jerk = s.number_or("max_jerk", 0, Bound::NonNegative);
   read_limits(s, a);
+  check_plausible(s, a);
   a.max_following_error = s.number_or("max_following_error", a.max_following_error, Bound::Positive);
   read_drive_kind(s, a);
   check_resolution(s, a);

@@ -32,6 +32,9 @@ void read_compensation(Section& top, MachineProfile& profile, const std::filesys
 void read_interlocks(Section& top, MachineProfile& profile);
 void read_handwheel(Section& top, MachineProfile& profile);
 
+/// Reports axis limits outside what any machine has (config.implausible), at the key.
+void check_plausible(Section& s, const AxisProfile& a);
+
 /// `node` as an array of exactly two numbers (integers or floats, inf allowed), else nullopt.
 std::optional<std::pair<double, double>> number_pair(const toml::node& node);
 /// `key` as a switch window [from, to] (±inf allowed, from ≤ to); nullopt if absent or bad.

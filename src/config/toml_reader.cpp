@@ -138,7 +138,11 @@ std::optional<std::int64_t> Section::integer(std::string_view key, std::int64_t 
   if (n == nullptr) return std::nullopt;
   const auto* i = n->as_integer();
   if (i == nullptr) {
-    error(key, fmt::format("{} must be a whole number, not {}", key_path(key), type_name(*n)), "config.type");
+    const auto* f = n->as_floating_point();
+    error(key,
+          f != nullptr ? fmt::format("{} must be a whole number (it is {})", key_path(key), show(f->get()))
+                       : fmt::format("{} must be a whole number, not {}", key_path(key), type_name(*n)),
+          "config.type");
     return std::nullopt;
   }
   if (i->get() < min || i->get() > max) {

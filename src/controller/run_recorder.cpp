@@ -139,19 +139,18 @@ RunReport RunRecorder::report() const {
   return r;
 }
 
-TraceCsvWriter::TraceCsvWriter(const std::string& path, AxisMask axes, double period_s)
-    : out_(path), axes_(axes), period_s_(period_s) {
-  if (!out_) return;
+TraceCsvWriter::TraceCsvWriter(OutputFile& out, AxisMask axes, double period_s)
+    : out_(out), axes_(axes), period_s_(period_s) {
   std::string head = "time_s,state,motion,rapid,line,segment,path_velocity";
   for (int i = 0; i < kAxisCount; ++i) {
     if (!axes_.has(static_cast<Axis>(i))) continue;
     const char a = kAxisLetters[static_cast<std::size_t>(i)];
     head += fmt::format(",cmd_{0},act_{0},ferr_{0},out_{0},phase_{0},level_{0}", a);
   }
-  out_ << head << '\n';
+  out_.write(head + '\n');
 }
 
-void TraceCsvWriter::add(const TraceSample& s) {
+bool TraceCsvWriter::add(const TraceSample& s) {
   row_.clear();
   fmt::format_to(std::back_inserter(row_), "{:.4f},{},{},{},{},{},{:.6g}",
                  static_cast<double>(s.tick) * period_s_, to_string(s.state), motion_name(s.motion),
@@ -163,14 +162,7 @@ void TraceCsvWriter::add(const TraceSample& s) {
                    to_string(s.homing_phase[static_cast<std::size_t>(i)]), s.home_level[i]);
   }
   row_ += '\n';
-  out_ << row_;
-}
-
-bool TraceCsvWriter::close() {
-  out_.flush();
-  const bool good = static_cast<bool>(out_);
-  out_.close();
-  return good && !out_.fail();
+  return out_.write(row_);
 }
 
 }  // namespace opencnc::control

@@ -75,17 +75,21 @@ bool write_file_atomically(const std::string& path, std::string_view content, st
 }
 
 bool read_file(const std::string& path, std::string& out, std::string* error) {
+  auto reason = [error](int err) {
+    if (error != nullptr) *error = std::strerror(err);
+    return false;
+  };
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) return fail(error, fmt::format("cannot open {}", path), errno);
+  if (fd < 0) return reason(errno);
   out.clear();
   char buf[1 << 16];
   for (;;) {
     const ssize_t n = ::read(fd, buf, sizeof buf);
     if (n < 0) {
       if (errno == EINTR) continue;
-      const int err = errno;
+      const int err = errno;  // EISDIR for a folder
       ::close(fd);
-      return fail(error, fmt::format("cannot read {}", path), err);
+      return reason(err);
     }
     if (n == 0) break;
     out.append(buf, static_cast<std::size_t>(n));

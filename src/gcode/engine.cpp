@@ -56,9 +56,11 @@ Engine::~Engine() = default;
 // --- program sources --------------------------------------------------------------------
 
 bool Engine::open_file(const std::string& path) {
-  auto file = SourceFile::open(path);
+  std::string why;
+  auto file = SourceFile::open(path, &why);
   if (!file) {
-    diags_.error(path, 0, 0, "cannot open the program file", std::string(error_id(ErrorCode::CannotOpenFile)));
+    diags_.error(path, 0, 0, "cannot open the program file: " + why,
+                 std::string(error_id(ErrorCode::CannotOpenFile)));
     failed_ = true;
     return false;
   }
@@ -87,8 +89,9 @@ SourceFile& Engine::source_at(std::uint32_t file) {
   auto& f = files_[file];
   if (!f) {
     // A file left earlier (a subprogram's caller): open it again.
-    f = SourceFile::open(sources_->file(file));
-    if (!f) fail(ErrorCode::CannotOpenFile, "cannot reopen {}", sources_->file(file));
+    std::string why;
+    f = SourceFile::open(sources_->file(file), &why);
+    if (!f) fail(ErrorCode::CannotOpenFile, "cannot reopen {}: {}", sources_->file(file), why);
     need_seek_ = true;
   }
   return *f;

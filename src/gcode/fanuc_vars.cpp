@@ -102,8 +102,17 @@ void Engine::fanuc_assignments() {
   for (const auto& [index, value] : parser_.numbered_assignments) {
     const FanucVariable kind = fanuc_variable_kind(index);
     const std::string text = block_.has_comment ? std::string(block_.comment) : std::string();
-    if (kind == FanucVariable::Alarm)
-      fail(ErrorCode::FanucAlarm, "alarm {}{}{} (#3000 = {})", 3000 + round_to_int(value), text.empty() ? "" : ": ", text, value);
+    if (kind == FanucVariable::Alarm) {
+      // Alarm numbers 3000..3999: #3000 = 0..999 (a value beyond names no alarm, and would
+      // overflow the sum).
+      const int n = round_to_int(value);
+      if (n < 0 || n > 999)
+        fail(ErrorCode::FanucAlarm,
+             "alarm: #3000 = {} is no alarm number (0 to 999, for alarms 3000 to 3999){}{}", value,
+             text.empty() ? "" : ": ", text);
+      fail(ErrorCode::FanucAlarm, "alarm {}{}{} (#3000 = {})", 3000 + n, text.empty() ? "" : ": ", text,
+           value);
+    }
     if (kind == FanucVariable::StopMessage) {
       out_.message(text.empty() ? fmt::format("#3006 = {}", value) : text);
       out_.program_stop();
@@ -114,7 +123,9 @@ void Engine::fanuc_assignments() {
   }
   for (int index : parser_.vacant_assignments) {
     st_.parameters[static_cast<std::size_t>(index)] = 0.0;
-    vacant.set(static_cast<std::size_t>(index));
+    // Only #0..#999 can be vacant (system variables such as #3006 cannot; the fuzzer found the
+    // bitset's out_of_range here).
+    if (index < kFanucVariableCount) vacant.set(static_cast<std::size_t>(index));
   }
   for (const auto& [name, value] : parser_.named_assignments) store_named(name, value);
 }

@@ -136,6 +136,8 @@ std::string sub_name(ExecContext& ctx, double q) {
 }
 
 // The G7x words, read before the profile lends the block to the profile's lines.
+constexpr int kMaxFinishingPasses = 10000;
+
 struct CycleWords {
   Block block;
   double d = 0, e = 0, i = 1, p = 1, r = 0.5, u = 0, w = 0;
@@ -213,6 +215,11 @@ void LatheCycle::run(ExecContext& ctx, const CycleWords& w, int code, const lath
       p.first_allowance = w.d;
       p.last_allowance = w.e;
       p.passes = w.p;
+      // LinuxCNC truncates P to an int; past the range that is undefined, and long before it
+      // a program error (each pass runs the whole profile).
+      if (!(w.p < kMaxFinishingPasses + 1.0))
+        ctx.error(ErrorCode::LimitRepeatCount,
+                  fmt::format("G70 P{}: more than {} finishing passes", w.p, kMaxFinishingPasses));
       lathe::finish(profile, p, moves);
       return;
     }

@@ -9,6 +9,8 @@
 #include <span>
 #include <utility>
 
+#include "numeric.hpp"
+
 namespace opencnc::gcode::lathe {
 
 namespace {
@@ -693,7 +695,7 @@ void finish(const Profile& profile, const FinishingParams& params, PathSink& out
   w.resolve_corners();
   w.require_monotonic();
   FramedSink framed(out, w.frame);
-  const int passes = static_cast<int>(params.passes);
+  const int passes = trunc_to_int(params.passes);  // (the G70 handler bounds it)
   for (int pass = passes; pass > 0; --pass) {
     const double distance =
         (pass - 1) * (params.first_allowance - params.last_allowance) / params.passes + params.last_allowance;

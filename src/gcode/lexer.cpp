@@ -14,16 +14,13 @@ bool is_c_space(char c) noexcept { return c == ' ' || c == '\t' || c == '\n' || 
 }  // namespace
 
 std::string_view trim_raw_line(std::string_view raw) noexcept {
-  if (const void* nul = std::memchr(raw.data(), '\0', raw.size())) {
-    raw = raw.substr(0, static_cast<std::size_t>(static_cast<const char*>(nul) - raw.data()));
-  }
   while (!raw.empty() && is_c_space(raw.back())) raw.remove_suffix(1);
   return raw;
 }
 
 namespace {
 // Normalisation of a byte outside comments: the byte it becomes and whether it is kept.
-// (', ';' and NUL stop the fast loop; NUL never reaches here, trim_raw_line cut it.)
+// ('(', ';' and NUL stop the fast loop.)
 struct CharMap {
   std::array<char, 256> to{};
   std::array<unsigned char, 256> keep{};
@@ -37,9 +34,18 @@ constexpr CharMap make_map() {
   }
   m.stop[static_cast<unsigned char>('(')] = 1;
   m.stop[static_cast<unsigned char>(';')] = 1;
+  m.stop[0] = 1;
   return m;
 }
 constexpr CharMap kMap = make_map();
+
+// LinuxCNC reads lines as C strings, so a NUL byte silently cuts the rest of the line off
+// (`G1 X1<NUL>Y2` moves X only). A NUL byte has no place in a program: the file is damaged or
+// not text. `index` is the byte's place in the normalised line.
+[[noreturn]] void nul_byte(std::size_t index) {
+  fail_at(static_cast<int>(index), ErrorCode::BadCharacter,
+          "a NUL byte (\\0) in the line: the file is damaged or not a text file");
+}
 }  // namespace
 
 std::size_t normalize_line(std::string_view raw, char* out, bool nested_comments) {
@@ -53,8 +59,11 @@ std::size_t normalize_line(std::string_view raw, char* out, bool nested_comments
       n += kMap.keep[u];
       continue;
     }
+    if (u == 0) nul_byte(n);
     if (u == ';') {
       // Everything after ';' is a comment and kept verbatim.
+      if (const void* nul = std::memchr(raw.data() + i, '\0', size - i))
+        nul_byte(n + static_cast<std::size_t>(static_cast<const char*>(nul) - (raw.data() + i)));
       std::memcpy(out + n, raw.data() + i, size - i);
       return n + (size - i);
     }
@@ -67,6 +76,7 @@ std::size_t normalize_line(std::string_view raw, char* out, bool nested_comments
         fail_at(open, ErrorCode::UnclosedComment,
                 "this '(' opens a comment that is not closed on its line: add ')'");
       const char d = raw[i];
+      if (d == '\0') nul_byte(n);
       if (d == '(') {
         if (!nested_comments)
           fail_at(static_cast<int>(n), ErrorCode::NestedComment, "'(' inside a comment: comments do not nest");

@@ -247,6 +247,13 @@ void Engine::check_feed(std::string_view what) const {
       if (st_.modal.spindle_speed == 0.0)
         fail_at(at, ErrorCode::SpindleSpeedZero,
                 "{} in feed per revolution (G95) with the spindle speed at 0: program an S word", what);
+      // rs274 only checks the speed; on the machine LinuxCNC's motion then waits for the
+      // revolutions for ever, without a word. A preflight must say so.
+      if (st_.modal.spindle == canon::SpindleDirection::Stopped)
+        fail_at(at, ErrorCode::SpindleStopped,
+                "{} in feed per revolution (G95) with the spindle stopped: start it with M3 or M4 first "
+                "(the move would wait for revolutions for ever)",
+                what);
       break;
     case canon::FeedMode::InverseTime:
       if (!block_.has('f'))

@@ -4,12 +4,12 @@
 
 namespace opencnc::gcode {
 
-RunStatus run_like_rs274(Interpreter& interp, canon::Rs274Printer& printer) {
+RunStatus run_like_rs274(Interpreter& interp, canon::Rs274Printer& printer, const RunFunction& run) {
   if (interp.start(printer) == RunStatus::Error) return RunStatus::Error;
   // The driver's resets belong to no block: no N label.
   printer.begin_block(canon::BlockOrigin{});
   printer.on_reset();
-  const RunStatus status = interp.run(printer);
+  const RunStatus status = run ? run(interp, printer) : interp.run(printer);
   printer.begin_block(canon::BlockOrigin{});
   printer.on_reset();
   printer.on_reset();

@@ -2,9 +2,11 @@
 // Windowed line reading with pread(); consumed pages of the page cache are released.
 #include "source_file.hpp"
 
+#include <cerrno>
 #include <cstring>
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 namespace opencnc::gcode {
@@ -14,9 +16,23 @@ constexpr std::size_t kWindow = 1 << 18;   // 256 KiB: far longer than any G-cod
 constexpr std::uint64_t kReleaseEvery = 16u << 20;
 }  // namespace
 
-std::unique_ptr<SourceFile> SourceFile::open(const std::string& path) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) return nullptr;
+std::unique_ptr<SourceFile> SourceFile::open(const std::string& path, std::string* why) {
+  // O_NONBLOCK: a FIFO must not hang the open until a writer comes (it is refused below).
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
+  if (fd < 0) {
+    if (why != nullptr) *why = std::strerror(errno);
+    return nullptr;
+  }
+  struct stat st {};
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    if (why != nullptr) {
+      *why = S_ISDIR(st.st_mode)
+                 ? "it is a folder, not a file"
+                 : "it is not a regular file (a program is read more than once: loops, subprograms)";
+    }
+    ::close(fd);
+    return nullptr;
+  }
   std::unique_ptr<SourceFile> f(new SourceFile);
   f->fd_ = fd;
   f->window_.resize(kWindow);
@@ -71,6 +87,7 @@ bool SourceFile::next(RawLine& line) {
       const auto len = static_cast<std::size_t>(static_cast<const char*>(nl) - start);
       line = {std::string_view(start, len), window_start_ + pos_, true};
       pos_ += len + 1;
+      skip_byte_order_mark(line);
       return true;
     }
     if (eof_ || (fd_ >= 0 && avail == window_.size())) {
@@ -78,10 +95,18 @@ bool SourceFile::next(RawLine& line) {
       // Last line without '\n', or a line longer than the window (returned cut).
       line = {std::string_view(start, avail), window_start_ + pos_, false};
       pos_ += avail;
+      skip_byte_order_mark(line);
       return true;
     }
     refill();
   }
+}
+
+// Editors on Windows may start a UTF-8 file with a byte-order mark; it is no part of the first
+// line (columns count from the character after it).
+void SourceFile::skip_byte_order_mark(RawLine& line) noexcept {
+  constexpr std::string_view kBom = "\xEF\xBB\xBF";
+  if (line.offset == 0 && line.text.starts_with(kBom)) line.text.remove_prefix(kBom.size());
 }
 
 void SourceFile::seek(std::uint64_t offset) {

@@ -22,8 +22,10 @@ struct RawLine {
 /// Sequential line reader over a file descriptor or an in-memory text. Not thread-safe.
 class SourceFile {
  public:
-  /// Opens `path`; returns nullptr if it cannot be read.
-  static std::unique_ptr<SourceFile> open(const std::string& path);
+  /// Opens `path`; returns nullptr if it cannot be read, with the reason in `*why` (if given):
+  /// `strerror`, or that it is a folder or not a regular file (a pipe or a device cannot be
+  /// read again from a remembered offset).
+  static std::unique_ptr<SourceFile> open(const std::string& path, std::string* why = nullptr);
   /// A program held in memory (MDI, tests).
   static std::unique_ptr<SourceFile> from_text(std::string text);
   ~SourceFile();
@@ -41,6 +43,7 @@ class SourceFile {
  private:
   SourceFile() = default;
   bool refill();
+  static void skip_byte_order_mark(RawLine& line) noexcept;
 
   int fd_ = -1;
   std::string text_;                 ///< in-memory program (fd_ < 0)

@@ -5,10 +5,10 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
-#include <fstream>
-#include <sstream>
 
 #include <fmt/format.h>
+
+#include "opencnc/core/atomic_file.hpp"
 
 namespace opencnc::tools {
 
@@ -156,14 +156,12 @@ ToolTable ToolTable::parse(std::string_view text, std::string_view file_name, Di
 }
 
 std::optional<ToolTable> ToolTable::load(const std::string& path, Diagnostics& diags) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    diags.error(path, 0, 0, "cannot open the tool table", "tools.cannot-open");
+  std::string text, why;
+  if (!read_file(path, text, &why)) {
+    diags.error(path, 0, 0, "cannot read the tool table: " + why, "tools.cannot-open");
     return std::nullopt;
   }
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return parse(ss.str(), path, diags);
+  return parse(text, path, diags);
 }
 
 std::string ToolTable::format() const {

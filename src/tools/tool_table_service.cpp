@@ -4,7 +4,7 @@
 
 #include <fmt/format.h>
 
-#include "opencnc/core/atomic_file.hpp"
+#include "opencnc/core/output_file.hpp"
 
 namespace opencnc::tools {
 
@@ -61,9 +61,12 @@ std::shared_ptr<FileToolTable> FileToolTable::open(const std::string& path, Diag
   return std::shared_ptr<FileToolTable>(new FileToolTable(path, std::move(*table)));
 }
 
+// The user's file, by OutputFile's rules: a symlink is followed, the permission bits stay, a
+// read-only table is refused, and a power cut leaves the old table or the new one.
 bool FileToolTable::store(const ToolTable& changed, Diagnostics& diags) {
   std::string error;
-  if (write_file_atomically(path_, changed.format(), &error)) return true;
+  const std::unique_ptr<OutputFile> out = OutputFile::open({"the tool table", path_}, &error);
+  if (out && out->write(changed.format()) && out->commit(&error)) return true;
   diags.error(path_, 0, 0, fmt::format("the tool table was not changed: {}", error), "tools.cannot-write");
   return false;
 }

@@ -9,8 +9,6 @@
 
 #include <fmt/format.h>
 
-#include "opencnc/core/atomic_file.hpp"
-
 namespace opencnc::viz {
 
 namespace {
@@ -230,10 +228,6 @@ std::string SvgChart::render() const {
   }
   out += "</svg>\n";
   return out;
-}
-
-bool SvgChart::write(const std::string& path, std::string* error) const {
-  return write_file_atomically(path, render(), error);
 }
 
 }  // namespace opencnc::viz

@@ -83,3 +83,92 @@ TEST(TraceChecker, ContourErrorIsTheDistanceToTheNearestProgrammedMove) {
   c.add(xy(10 + 9.99 * s, 10 - 9.99 * co), 1, 1);
   EXPECT_NEAR(c.report().max_contour_error_mm, 0.01, 1e-9);
 }
+
+namespace {
+
+// The issue's helix at a coarser pitch: from (10, 0, 0) about (5, 0), clockwise, `turns` turns
+// down to Z = -depth (pitch depth / turns).
+canon::Program helix(int turns, double depth) {
+  canon::ProgramBuilder b;
+  b.set_feed_rate(3000);
+  b.straight_traverse(0, xy(10, 0));
+  canon::ArcFeed a;
+  a.first_end = 10;
+  a.second_end = 0;
+  a.first_center = 5;
+  a.second_center = 0;
+  a.rotation = -turns;
+  a.axis_end = -depth;
+  a.end = xy(10, 0);
+  a.end[Axis::Z] = -depth;
+  b.arc_feed(1, a);
+  return b.take();
+}
+
+/// The helix at `turn` turns from its start (clockwise), radius 5 + `dr`, `dz` above it.
+Pose on_helix(double turn, int turns, double depth, double dr = 0, double dz = 0) {
+  const double angle = -2 * std::numbers::pi * turn;
+  Pose p = xy(5 + (5 + dr) * std::cos(angle), (5 + dr) * std::sin(angle));
+  p[Axis::Z] = -depth * turn / turns + dz;
+  return p;
+}
+
+/// Nearest distance by brute force: the helix sampled every degree over every turn, then a
+/// local refinement of the best sample (ternary search over ±1°).
+double brute_force(int turns, double depth, const Pose& p) {
+  auto dist = [&](double turn) {
+    const Pose h = on_helix(turn, turns, depth);
+    return std::sqrt(std::pow(h[0] - p[0], 2) + std::pow(h[1] - p[1], 2) + std::pow(h[2] - p[2], 2));
+  };
+  const int steps = 360 * turns;
+  int best = 0;
+  double best_d = dist(0);
+  for (int i = 1; i <= steps; ++i) {
+    const double d = dist(static_cast<double>(i) / 360);
+    if (d < best_d) best_d = d, best = i;
+  }
+  double lo = std::max(0.0, (best - 1) / 360.0), hi = std::min<double>(turns, (best + 1) / 360.0);
+  for (int it = 0; it < 200; ++it) {
+    const double m1 = lo + (hi - lo) / 3, m2 = hi - (hi - lo) / 3;
+    if (dist(m1) < dist(m2))
+      hi = m2;
+    else
+      lo = m1;
+  }
+  return std::min(best_d, dist(0.5 * (lo + hi)));
+}
+
+}  // namespace
+
+// Issue 7: the contour check walked every turn of a helix for every sample (G2 ... P1000 did not
+// finish). It now looks at the two turns next to the nearest one; the distances stay exact.
+TEST(TraceChecker, AThousandTurnHelixIsCheckedCorrectly) {
+  constexpr int kTurns = 1000;
+  constexpr double kDepth = 100;  // pitch 0.1 mm
+  const canon::Program p = helix(kTurns, kDepth);
+  const auto limits = plan::MachineLimits::uniform(AxisMask::from_letters("XYZ"), 100, 1000, 0);
+  analysis::TraceChecker c(p, limits, 1e-3);
+  // On the helix, at its ends and anywhere between: no error.
+  for (double turn : {0.0, 0.25, 1.0, 137.6, 500.5, 999.0, 999.75, 1000.0}) {
+    EXPECT_LT(c.distance_to_move(1, on_helix(turn, kTurns, kDepth)), 1e-9) << turn;
+  }
+  // Off it radially: the nearest point is at the same angle (a helix is symmetric about its normal
+  // line there), whichever turn.
+  for (double turn : {0.3, 1.5, 250.1, 777.7, 999.9}) {
+    EXPECT_NEAR(c.distance_to_move(1, on_helix(turn, kTurns, kDepth, 0.02)), 0.02, 1e-9) << turn;
+    EXPECT_NEAR(c.distance_to_move(1, on_helix(turn, kTurns, kDepth, -0.03)), 0.03, 1e-9) << turn;
+  }
+  // Between two turns, above the start and below the end: against a brute-force search.
+  for (const Pose& q : {on_helix(500.2, kTurns, kDepth, 0.01, 0.05), on_helix(0, kTurns, kDepth, 0, 3),
+                        on_helix(1000, kTurns, kDepth, 1, -2), xy(5, 0.5)}) {
+    EXPECT_NEAR(c.distance_to_move(1, q), brute_force(kTurns, kDepth, q), 1e-7)
+        << q[0] << " " << q[1] << " " << q[2];
+  }
+  // Through the report: samples along the whole helix, 0.01 mm off it at most.
+  for (int k = 0; k <= 5000; ++k) {
+    const double turn = kTurns * k / 5000.0;
+    c.add(on_helix(turn, kTurns, kDepth, 0.01 * std::sin(k)), 1, 1);
+  }
+  EXPECT_LE(c.report().max_contour_error_mm, 0.01 + 1e-9);
+  EXPECT_GT(c.report().max_contour_error_mm, 0.0099);
+}

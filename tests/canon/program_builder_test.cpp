@@ -193,3 +193,36 @@ TEST(ProgramBuilder, MillionMovesStayCompact) {
   // 16-byte move + 6 doubles per pose: well under the 100 MB budget of a million-line program.
   EXPECT_LT(b.program().memory_bytes(), 70u * 1024 * 1024);
 }
+
+// `opencnc scan` measures each move once and has the builder start over: the program built
+// after a restart is what an uninterrupted build would hold from there, minus the moves before.
+TEST(ProgramBuilder, RestartDropsTheMovesAndKeepsTheConversion) {
+  ProgramBuilder whole, restarted;
+  for (ProgramBuilder* b : {&whole, &restarted}) {
+    b->use_length_units(Units::Inch);
+    b->set_g5x_offset(1, xyz(1, 0, 0));
+    b->set_xy_rotation(90);
+    b->set_feed_rate(10);
+    b->straight_feed(0, xyz(1, 0, 0));
+    b->straight_traverse(1, xyz(2, 1, 0));
+  }
+  const auto sources = restarted.program().sources_ptr();
+  restarted.restart();
+  EXPECT_TRUE(restarted.program().empty());
+  EXPECT_EQ(restarted.program().sources_ptr(), sources);
+  EXPECT_EQ(restarted.program().start(), whole.position());
+  for (ProgramBuilder* b : {&whole, &restarted}) {
+    b->straight_feed(2, xyz(3, 1, 1));  // the same feed: its index must be valid in the new table
+    b->set_feed_rate(20);
+    b->straight_feed(3, xyz(0, 0, 0));
+  }
+  const Program& w = whole.program();
+  const Program& r = restarted.program();
+  ASSERT_EQ(r.size(), 2u);
+  for (std::size_t k = 0; k < 2; ++k) {
+    EXPECT_EQ(r.end(k), w.end(k + 2));
+    EXPECT_DOUBLE_EQ(r.feed(k), w.feed(k + 2));
+    EXPECT_EQ(r.segment_of(k), w.segment_of(k + 2));
+  }
+  EXPECT_EQ(r.start_of(0), w.start_of(2));
+}

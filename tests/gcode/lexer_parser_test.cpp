@@ -115,9 +115,21 @@ TEST(Lexer, RandomLinesNormaliseByTheRules) {
   }
 }
 
-TEST(Lexer, TrimsTheRawLineAsCStringReadingSeesIt) {
+TEST(Lexer, TrimsTheRawLine) {
   EXPECT_EQ(trim_raw_line("G1 X1  \r"), "G1 X1");
-  EXPECT_EQ(trim_raw_line(std::string_view("G1\0X2", 5)), "G1");
+  // A NUL byte is kept (LinuxCNC would cut the line there): normalize_line refuses it.
+  EXPECT_EQ(trim_raw_line(std::string_view("G1\0X2", 5)), std::string_view("G1\0X2", 5));
+}
+
+TEST(Lexer, RefusesANulByteAtItsPlace) {
+  const std::string_view raw("G1 X1\0Y2", 8);
+  try {
+    normalize(raw);
+    ADD_FAILURE() << "no error";
+  } catch (const GcodeError& e) {
+    EXPECT_EQ(e.code(), ErrorCode::BadCharacter);
+    EXPECT_EQ(raw_column(raw, e.position()), 6u);
+  }
 }
 
 TEST(Lexer, MapsNormalisedPositionsToRawColumns) {

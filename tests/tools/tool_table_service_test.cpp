@@ -109,3 +109,33 @@ TEST(FileToolTable, AFileWithErrorsOpensNothing) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(FileToolTable, WritesThroughASymlinkAndKeepsTheModeAndRefusesAReadOnlyTable) {
+  TempDir dir;
+  const auto real = dir.path() / "real.tbl";
+  const auto link = dir.path() / "tools.tbl";
+  std::ofstream(real) << "T1 P1 Z10\n";
+  std::filesystem::permissions(real, std::filesystem::perms::owner_read | std::filesystem::perms::owner_write |
+                                         std::filesystem::perms::group_read);
+  std::filesystem::create_symlink(real.filename(), link);
+  Diagnostics d;
+  auto tools = FileToolTable::open(link.string(), d);
+  ASSERT_TRUE(tools != nullptr);
+  ToolEntry e = tools->snapshot()->at_index(1);
+  e.offset[Axis::Z] = 11;
+  ASSERT_TRUE(tools->update(1, e, ChangeSource::Operator, d));
+  EXPECT_TRUE(std::filesystem::is_symlink(link));  // the link stays, its target changed
+  EXPECT_EQ(read(real), "T1 P1 Z11\n");
+  EXPECT_EQ(std::filesystem::status(real).permissions() & std::filesystem::perms::all,
+            std::filesystem::perms::owner_read | std::filesystem::perms::owner_write | std::filesystem::perms::group_read);
+  std::filesystem::permissions(real, std::filesystem::perms::owner_read);
+  e.offset[Axis::Z] = 12;
+  Diagnostics refused;
+  EXPECT_FALSE(tools->update(1, e, ChangeSource::Operator, refused));
+  EXPECT_EQ(tools->snapshot()->at_index(1).offset[Axis::Z], 11);
+  EXPECT_EQ(read(real), "T1 P1 Z11\n");
+}
+
+}  // namespace

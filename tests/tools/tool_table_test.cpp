@@ -56,6 +56,14 @@ TEST(ToolTable, MissingFileIsAnError) {
   EXPECT_FALSE(ToolTable::load("/nonexistent/tools.tbl", d).has_value());
   ASSERT_EQ(d.error_count(), 1u);
   EXPECT_EQ(d.items()[0].code, "tools.cannot-open");
+  EXPECT_EQ(d.items()[0].message, "cannot read the tool table: No such file or directory");
+}
+
+TEST(ToolTable, AFolderIsNotAnEmptyTable) {
+  Diagnostics d;
+  EXPECT_FALSE(ToolTable::load("/", d).has_value());
+  ASSERT_EQ(d.error_count(), 1u);
+  EXPECT_EQ(d.items()[0].message, "cannot read the tool table: Is a directory");
 }
 
 TEST(ToolTable, LookupAgreesWithLinearSearchOnRandomTables) {

@@ -5,7 +5,6 @@
 #include <cstdio>
 #include <string>
 
-#include "opencnc/core/atomic_file.hpp"
 #include "opencnc/viz/svg_chart.hpp"
 
 using namespace opencnc::viz;
@@ -45,17 +44,4 @@ TEST(SvgChart, RendersPanelsSeriesAndEscapesText) {
   std::size_t bars = 0;
   for (std::size_t pos = 0; (pos = svg.find("fill=\"#333\"", pos)) != std::string::npos; ++pos) ++bars;
   EXPECT_EQ(bars, 2u);
-}
-
-TEST(SvgChart, WritesFilesAtomically) {
-  SvgChart chart("t");
-  chart.add_panel(Panel{});
-  const std::string path = testing::TempDir() + "/chart.svg";
-  std::string err;
-  ASSERT_TRUE(chart.write(path, &err)) << err;
-  std::string back;
-  ASSERT_TRUE(opencnc::read_file(path, back, &err)) << err;
-  EXPECT_EQ(back, chart.render());
-  EXPECT_FALSE(chart.write("/nonexistent-folder/x.svg", &err));
-  EXPECT_NE(err.find("nonexistent-folder"), std::string::npos);
 }

@@ -25,6 +25,12 @@ class ProgramBuilder final : public Sink {
   /// The program built so far; take it when the run has ended.
   Program& program() noexcept { return program_; }
   Program take() { return std::move(program_); }
+  /// Drops the moves and actions built so far and goes on into an empty program that starts
+  /// where the machine is; the conversion state (units, offsets, rotation, plane, feed and
+  /// modes) and the source map are kept. For readers that take the moves as they come and need
+  /// not keep them (`opencnc scan`'s summary): memory stays bounded however long the program.
+  /// Non-real-time.
+  void restart();
   /// Current machine position (mm) after the last motion.
   const Pose& position() const noexcept { return position_; }
   /// The block the last canonical calls came from.

@@ -6,7 +6,6 @@
 
 #include <array>
 #include <cstdint>
-#include <fstream>
 #include <optional>
 #include <string>
 
@@ -14,6 +13,7 @@
 #include "opencnc/canon/program.hpp"
 #include "opencnc/control/status.hpp"
 #include "opencnc/controller/observer.hpp"
+#include "opencnc/core/output_file.hpp"
 #include "opencnc/plan/machine_limits.hpp"
 
 namespace opencnc::control {
@@ -81,19 +81,17 @@ class RunRecorder final : public ControllerObserver {
   bool moved_ = false;
 };
 
-/// Writes trace samples as CSV, one row per period (columns in docs/controller.md).
-/// Non-real-time.
+/// Writes trace samples as CSV, one row per period (columns in docs/controller.md), each row
+/// one whole record of `out` (core::OutputFile: a full disk leaves whole rows). Non-real-time.
 class TraceCsvWriter {
  public:
-  /// Opens `path` for the axes in `axes`; check ok().
-  TraceCsvWriter(const std::string& path, AxisMask axes, double period_s);
-  bool ok() const { return static_cast<bool>(out_); }
-  void add(const TraceSample& s);
-  /// Flushes and closes; false if anything failed.
-  bool close();
+  /// Writes the header for the axes in `axes`; `out` must outlive the writer.
+  TraceCsvWriter(OutputFile& out, AxisMask axes, double period_s);
+  /// One row; false once the output has failed (OutputFile::commit says why).
+  bool add(const TraceSample& s);
 
  private:
-  std::ofstream out_;
+  OutputFile& out_;
   AxisMask axes_;
   double period_s_;
   std::string row_;

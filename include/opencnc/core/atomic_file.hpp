@@ -13,7 +13,8 @@ namespace opencnc {
 /// old file is then untouched. Non-real-time (blocking I/O).
 bool write_file_atomically(const std::string& path, std::string_view content, std::string* error);
 
-/// Reads a whole file. Returns false and sets `*error` (if given) when it cannot be read.
+/// Reads a whole file (or what a pipe gives). Returns false and sets `*error` (if given) to the
+/// reason (`strerror`: "No such file or directory", "Is a directory"…) when it cannot be read.
 /// Non-real-time.
 bool read_file(const std::string& path, std::string& out, std::string* error);
 

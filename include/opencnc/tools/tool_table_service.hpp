@@ -58,8 +58,9 @@ class MemoryToolTable : public ToolTableService {
 };
 
 /// A LinuxCNC `.tbl` file: read when opened, and written back after every change before the
-/// change counts (temporary file, fdatasync, rename: a power cut leaves the old table or the new
-/// one, never a mix).
+/// change counts, by core::OutputFile's rules (temporary file, fdatasync, rename: a power cut leaves
+/// the old table or the new one; a symlink is written through, the permission bits stay, a
+/// read-only table refuses the change).
 class FileToolTable final : public MemoryToolTable {
  public:
   /// Reads `path`; null (and diagnostics) when it cannot be read or has errors.

@@ -30,9 +30,8 @@ class SvgChart {
  public:
   SvgChart(std::string title, int columns = 1, int panel_width_px = 560, int panel_height_px = 380);
   Panel& add_panel(Panel p);
+  /// The document; the command line writes it through core::OutputFile.
   std::string render() const;
-  /// Writes the SVG to `path` (temporary file, then rename). Returns false with `error` on failure.
-  bool write(const std::string& path, std::string* error) const;
 
  private:
   std::string title_;
