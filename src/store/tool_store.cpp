@@ -236,6 +236,7 @@ ToolSet ToolStore::read_live_locked() const {
 void ToolStore::refresh_locked() const {
   const std::int64_t v = db_->data_version();
   if (v == data_version_ && table_) return;
+  ++changes_;
   ToolSet fresh = read_live_locked();
   if (!table_ || fresh != live_) {
     live_ = std::move(fresh);
@@ -272,6 +273,7 @@ bool ToolStore::write_locked(const ToolSet& changed, std::string_view interface,
     table_ = std::make_shared<const tools::ToolTable>(tools::linuxcnc_table(live_));
     data_version_ = db_->data_version();
     ++version_;
+    ++changes_;
     return true;
   });
 }
@@ -345,6 +347,7 @@ std::optional<std::int64_t> ToolStore::backup(std::string_view interface, std::s
                  {{fmt::format("backup {}", id), "", fmt::format("{} edges", n)}});
     t.commit();
     data_version_ = db_->data_version();
+    ++changes_;
     return id;
   });
 }
@@ -413,6 +416,15 @@ std::shared_ptr<const tools::ToolTable> ToolStore::snapshot() const {
     // sees a half table. The next write reports the problem.
   }
   return table_;
+}
+
+std::uint64_t ToolStore::changes() const {
+  std::lock_guard lock(mutex_);
+  try {
+    refresh_locked();
+  } catch (const std::exception&) {
+  }
+  return changes_;
 }
 
 std::uint64_t ToolStore::version() const {

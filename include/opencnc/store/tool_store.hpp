@@ -74,6 +74,9 @@ class ToolStore final : public tools::ToolTableService {
   /// The newest `limit` audit entries (0: all), oldest first.
   std::vector<AuditEntry> audit(std::size_t limit = 0, std::string* error = nullptr);
 
+  /// Grows with every commit to the store by any connection (changes and backups): a cache
+  /// of a check compares it.
+  std::uint64_t changes() const;
   /// Where timestamps come from ("YYYY-MM-DDTHH:MM:SSZ"; default: the system clock in UTC).
   /// Tests fix it.
   void set_clock(std::function<std::string()> clock);
@@ -101,6 +104,7 @@ class ToolStore final : public tools::ToolTableService {
   mutable std::shared_ptr<const tools::ToolTable> table_;
   mutable std::int64_t data_version_ = -1;
   mutable std::uint64_t version_ = 0;
+  mutable std::uint64_t changes_ = 0;
 };
 
 /// The current UTC time as "YYYY-MM-DDTHH:MM:SSZ". Any thread.
