@@ -255,6 +255,33 @@ class StopOnThePath {
 
 /// Follows the job started by cycle start until it ends, with the operator where it waits (and
 /// the machine's hand at the hand-fed axes).
+/// The tool guard holds the program before a tool cuts (its note, with the differences, is
+/// printed): the operator at the terminal accepts the live values or restores the backup, and
+/// the program goes on; anything else, --unattended or no terminal aborts it (nothing is ever
+/// accepted without the operator). Returns false when the run was aborted.
+bool answer_tool_guard(Driver& d, const SessionOptions& o, OperatorInput& input) {
+  if (!o.unattended && !input.closed()) {
+    fmt::print(stderr,
+               "\nthe tool guard holds the program: type accept (the live values become the backup) or "
+               "restore (the backup's values become live) and Enter; anything else aborts\n");
+    std::optional<std::string> answer;
+    while (!answer && !input.closed()) {
+      answer = input.line(d.ticks_by_itself() ? 10 : -1);
+      if (!answer && d.ticks_by_itself()) d.advance();
+    }
+    if (answer && (*answer == "accept" || *answer == "restore")) {
+      if (must(d, Request::feature("tool-guard", *answer))) return true;
+    }
+  }
+  fmt::print(
+      stderr,
+      "error: the tool guard holds the program before the tool cuts; it is aborted: accept or restore "
+      "(`opencnc tools --db STORE accept|restore`, or at the terminal without --unattended), then run it "
+      "again\n");
+  d.controller().submit(Request::simple(CommandKind::Abort));
+  return false;
+}
+
 void follow(Driver& d, control::EventCursor& cursor, const SessionOptions& o, const SessionHooks& hooks,
             SessionEnd& end) {
   StopOnThePath stop(o.stop);
@@ -271,14 +298,8 @@ void follow(Driver& d, control::EventCursor& cursor, const SessionOptions& o, co
       print_event(e);
       if (e.kind == ControllerEventKind::JobStarted && job == 0 && e.job == control::JobKind::Program) job = e.job_id;
       if (e.kind == ControllerEventKind::JobEnded && e.job_id == job) ended = e;
-      if (e.kind == ControllerEventKind::Note && e.code == "tools.guard-hold" && !guard_abort) {
-        // No accept or restore at this terminal: the run ends before the tool cuts.
-        fmt::print(stderr,
-                   "error: the tool guard holds the program before the tool cuts; it is aborted: accept or "
-                   "restore with `opencnc tools --db STORE accept|restore`, then run it again\n");
-        d.controller().submit(Request::simple(CommandKind::Abort));
-        guard_abort = true;
-      }
+      if (e.kind == ControllerEventKind::Note && e.code == "tools.guard-hold" && !guard_abort)
+        guard_abort = !answer_tool_guard(d, o, input);
     }
     const control::ControllerStatus st = d.controller().status();
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -289,10 +310,13 @@ void follow(Driver& d, control::EventCursor& cursor, const SessionOptions& o, co
       end.finished = ended->end == control::JobEnd::Finished;
       if (!end.finished) {
         // (a fault was printed as its note already)
-        if (!st.fault_text.empty()) end.fault = st.fault_text;
+        if (!st.fault_text.empty())
+          end.fault = st.fault_text;
         else if (end.stopped_by != 0)
-          end.fault = fmt::format("stopped by {} (feed hold on the path, then abort)", signal_name(end.stopped_by));
-        else end.fault = fmt::format("the program ended: {}", control::to_string(ended->end));
+          end.fault =
+              fmt::format("stopped by {} (feed hold on the path, then abort)", signal_name(end.stopped_by));
+        else
+          end.fault = fmt::format("the program ended: {}", control::to_string(ended->end));
         if (st.fault_text.empty()) fmt::print(stderr, "error: {}\n", end.fault);
         end.limit_touched = st.servo.fault.kind == control::FaultKind::SoftLimit ||
                             st.servo.fault.kind == control::FaultKind::LimitSwitch;
@@ -312,7 +336,8 @@ void follow(Driver& d, control::EventCursor& cursor, const SessionOptions& o, co
       d.controller().submit(wait->go_on);
       continue;
     }
-    fmt::print(stderr, "\nwaiting for {}: press Enter to continue, or a and Enter to abort\n", wait->question);
+    fmt::print(stderr, "\nwaiting for {}: press Enter to continue, or a and Enter to abort\n",
+               wait->question);
     std::optional<std::string> answer;
     while (!answer && !input.closed() && !stop.requested()) {
       answer = input.line(d.ticks_by_itself() ? 10 : -1);
@@ -347,11 +372,12 @@ void note_assumptions(const control::PreflightSummary& s) {
   const auto plural = [](std::uint64_t n, const char* one, const char* many) {
     return fmt::format("{} {}", n, n == 1 ? one : many);
   };
-  fmt::print(stderr,
-             "note: {} {} on what the machine answers while the program runs ({}); checked with assumed answers, "
-             "they are checked again with the real ones before they run: {}\n",
-             plural(s.assumed_moves, "move", "moves"), s.assumed_moves == 1 ? "rests" : "rest",
-             plural(s.sync_points, "sync point", "sync points"), lines);
+  fmt::print(
+      stderr,
+      "note: {} {} on what the machine answers while the program runs ({}); checked with assumed answers, "
+      "they are checked again with the real ones before they run: {}\n",
+      plural(s.assumed_moves, "move", "moves"), s.assumed_moves == 1 ? "rests" : "rest",
+      plural(s.sync_points, "sync point", "sync points"), lines);
 }
 
 }  // namespace

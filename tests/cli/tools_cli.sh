@@ -58,4 +58,13 @@ expect 2 "tools.db is the tool store" $T export -o tools.db
 expect 0 "T3 D1 radius +4.25 -> 4.2" $T audit --last 3
 expect 2 "no parameter 'lenght1'" $T set T5 D1 lenght1=1
 expect 2 "-" $T frobnicate
+# Checked at the tool change only: the typo holds the run at T3's M6; the operator answers.
+printf 'G21 G90\nT1 M6\nG43 H1\nG0 X0 Y0 Z10\nT3 M6\nG43 H3\nG0 Z10\nG1 Z0 F3000\nM2\n' >tc.ngc
+runtc() { printf '%s\n' "$1" | $B run tc.ngc --machine "$SRC/configs/hmc-toolcheck.toml" \
+  --set "tool_guard.store=\"$dir/tools.db\"" --set 'tool_guard.check="tool-change"' \
+  --set tool_changer.sim.prepare_time_s=0.05 --set tool_changer.sim.change_time_s=0.1; }
+expect 0 "T3 set" $T set T3 D1 length1=105.25
+expect 1 "held before T3 cuts" runtc no
+expect 0 "backup 2 is the live tool table again" runtc restore
+expect 0 "matches backup 2" $T check
 echo "all tools cases passed"
