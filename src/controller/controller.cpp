@@ -312,6 +312,8 @@ void Controller::handle(std::uint64_t id, Request& r) {
           run_auxiliary(id, body);
         } else if constexpr (std::is_same_v<T, requests::Feature>) {
           feature(id, body);
+        } else if constexpr (std::is_same_v<T, requests::ResumeProgram>) {
+          resume_program(id, body);
         } else if constexpr (std::is_same_v<T, requests::SetSwitch>) {
           if (body.which == SwitchKind::BlockDelete) {
             block_delete_ = body.on;
@@ -486,6 +488,20 @@ void Controller::run_auxiliary(std::uint64_t id, const requests::RunAuxiliary& r
     return finish(id, program_refusal(pf.diagnostics), refusal_text(program_refusal(pf.diagnostics)), pf.diagnostics);
   start_job(id, JobKind::Auxiliary, name, Mode::Auto, source_->execute(r.path, servo().commanded, {block_delete_}),
             true);
+}
+
+void Controller::resume_program(std::uint64_t id, const requests::ResumeProgram& r) {
+  std::optional<OpenProgram> op = open_program();
+  if (!op) return finish(id, Refusal::NoProgram, refusal_text(Refusal::NoProgram));
+  if (op->path.empty()) return finish(id, Refusal::BadValue, "only a program file can be resumed at a segment");
+  if (!ready_for_job(id, Mode::Auto, "programs")) return;
+  std::unique_ptr<ProgramStream> stream =
+      source_->resume(op->path, r.program_start.value_or(open_at_), servo().commanded, r.segment, {block_delete_});
+  if (!stream) return finish(id, Refusal::BadValue, "this controller's program source cannot resume at a segment");
+  // The replay up to the segment, here and now: a program that cannot get there starts nothing.
+  while (stream->state() == StreamState::Reading && stream->program().empty()) stream->read(1);
+  // Every move is checked before it runs (the preflight's moves began elsewhere).
+  start_job(id, JobKind::Program, op->name, Mode::Auto, std::move(stream), false);
 }
 
 void Controller::feature(std::uint64_t id, const requests::Feature& r) {
