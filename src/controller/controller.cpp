@@ -581,6 +581,7 @@ void Controller::publish() {
   p.program_length_mm = open_ ? open_->preflight.summary.path_length_mm : 0;
   p.run_active = job_ != nullptr;
   const ServoStatus& s = servo();
+  p.servo = s;  // FeatureHost::current_status() is this, servo snapshot included
   if (job_) {
     const bool same_run = s.run_id == job_->run_id();
     p.job = job_->kind();

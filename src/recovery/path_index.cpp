@@ -302,6 +302,17 @@ Nearest PathIndex::nearest_linear(const Vec3& b, const QueryOptions& options) co
   return im.gather(hits, bound2);
 }
 
+std::optional<PathPoint> PathIndex::at_move(std::uint64_t move, double offset_mm) const {
+  const Impl& im = *impl_;
+  const auto it = std::partition_point(im.by_entry.begin(), im.by_entry.end(),
+                                       [&](std::uint32_t shape) { return im.shapes[shape].move < move; });
+  if (it == im.by_entry.end()) return std::nullopt;
+  const Shape& s = im.shapes[*it];
+  const double len = detail::length(s, im.arc_of(s));
+  const double t = s.move == move && len > 0 ? std::clamp(offset_mm / len, 0.0, 1.0) : 0.0;
+  return im.make_point(*it, t, 0.0);
+}
+
 PathPoint PathIndex::point_on(std::uint32_t entry, double param) const {
   return impl_->make_point(impl_->by_entry.at(entry), std::clamp(param, 0.0, 1.0), 0.0);
 }

@@ -7,6 +7,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "opencnc/canon/program.hpp"
@@ -71,6 +72,10 @@ class PathIndex {
   /// The point `distance_mm` further along the feed path from `from` (negative: back), stopping
   /// at the path's ends; a gap (a rapid between two feed moves) is jumped over. Any thread.
   PathPoint advance(const PathPoint& from, double distance_mm) const;
+  /// The point `offset_mm` along move `move` of the scan (a job's move number and the status'
+  /// segment_offset); on a move that is no feed move (a rapid), the start of the next feed move.
+  /// Nothing past the last feed move. Any thread after finish().
+  std::optional<PathPoint> at_move(std::uint64_t move, double offset_mm) const;
   /// The point at `param` of entry `entry`. Any thread.
   PathPoint point_on(std::uint32_t entry, double param) const;
 
