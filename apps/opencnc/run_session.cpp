@@ -207,7 +207,8 @@ struct OperatorWait {
 };
 
 std::optional<OperatorWait> operator_wait(const control::ControllerStatus& st) {
-  if (st.servo.state == State::Stopped) return OperatorWait{st.wait_text, Request::simple(CommandKind::CycleStart)};
+  if (st.servo.state == State::Stopped)
+    return OperatorWait{st.wait_text, Request::simple(CommandKind::CycleStart)};
   if (st.servo.wait == control::Wait::ManualToolChange)
     return OperatorWait{st.wait_text, Request::simple(CommandKind::ToolChanged)};
   return std::nullopt;
@@ -242,8 +243,10 @@ class StopOnThePath {
   void step(Driver& d, const control::ControllerStatus& st, SessionEnd& end) {
     if (!requested() || aborted_) return;
     end.stopped_by = flag_->load(std::memory_order_relaxed);
-    if (!held_) d.controller().submit(Request::simple(CommandKind::FeedHold));
-    else if (st.servo.path_velocity == 0) d.controller().submit(Request::simple(CommandKind::Abort));
+    if (!held_)
+      d.controller().submit(Request::simple(CommandKind::FeedHold));
+    else if (st.servo.path_velocity == 0)
+      d.controller().submit(Request::simple(CommandKind::Abort));
     aborted_ = held_ && st.servo.path_velocity == 0;
     held_ = true;
   }
@@ -296,7 +299,8 @@ void follow(Driver& d, control::EventCursor& cursor, const SessionOptions& o, co
     std::optional<ControllerEvent> ended;
     for (const ControllerEvent& e : cursor.next()) {
       print_event(e);
-      if (e.kind == ControllerEventKind::JobStarted && job == 0 && e.job == control::JobKind::Program) job = e.job_id;
+      if (e.kind == ControllerEventKind::JobStarted && job == 0 && e.job == control::JobKind::Program)
+        job = e.job_id;
       if (e.kind == ControllerEventKind::JobEnded && e.job_id == job) ended = e;
       if (e.kind == ControllerEventKind::Note && e.code == "tools.guard-hold" && !guard_abort)
         guard_abort = !answer_tool_guard(d, o, input);
@@ -305,6 +309,11 @@ void follow(Driver& d, control::EventCursor& cursor, const SessionOptions& o, co
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (hooks.progress && (++n % 256 == 0)) hooks.progress(st, wall);
     bring_hand_axis(d, st.servo);
+    if (hooks.tick) hooks.tick(d.controller(), st);
+    if (ended && hooks.goes_on && hooks.goes_on(*ended)) {
+      job = 0;  // the job that resumes the program is followed next
+      ended.reset();
+    }
     if (ended) {
       end.wall_s = wall;
       end.finished = ended->end == control::JobEnd::Finished;
@@ -420,6 +429,10 @@ SessionEnd run_session(const SessionOptions& o, const SessionHooks& hooks) {
   }
   Driver& d = *driver;
   if (setup->feature) d.controller().add_feature(setup->feature);
+  if (hooks.features) {
+    for (auto& f : hooks.features(end.profile))
+      d.controller().add_feature(std::move(f), control::ObserverOptions{end.profile.servo_period_s, false});
+  }
   const control::ServoConfig& sc = d.controller().servo_config();
   if (!must(d, Request::simple(CommandKind::MachineOn)) || !home_if_needed(d, sc) ||
       !must(d, Request::set_mode(control::Mode::Auto)) || !must(d, Request::open(o.file))) {

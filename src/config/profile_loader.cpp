@@ -48,8 +48,8 @@ MachineProfile read_profile(const toml::table& root, Reporter& r, const std::fil
   detail::read_power(top, p);
   detail::read_probe(top, p);
   detail::read_tool_changer(top, p);
-  detail::read_process(top, p);
   detail::read_io(top, p);
+  detail::read_process(top, p);  // [process.cutting] names [io] channels
   detail::read_interlocks(top, p);
   detail::read_handwheel(top, p);
   detail::read_interpreter(top, p, base_dir);

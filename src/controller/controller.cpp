@@ -314,6 +314,8 @@ void Controller::handle(std::uint64_t id, Request& r) {
           run_auxiliary(id, body);
         } else if constexpr (std::is_same_v<T, requests::Feature>) {
           feature(id, body);
+        } else if constexpr (std::is_same_v<T, requests::ResumeProgram>) {
+          resume_program(id, body);
         } else if constexpr (std::is_same_v<T, requests::SetSwitch>) {
           if (body.which == SwitchKind::BlockDelete) {
             block_delete_ = body.on;
@@ -534,6 +536,21 @@ bool Controller::features_allow_continue(const SyncCheck& sync) {
   return true;
 }
 
+void Controller::resume_program(std::uint64_t id, const requests::ResumeProgram& r) {
+  std::optional<OpenProgram> op = open_program();
+  if (!op) return finish(id, Refusal::NoProgram, refusal_text(Refusal::NoProgram));
+  if (op->path.empty()) return finish(id, Refusal::BadValue, "only a program file can be resumed at a segment");
+  if (!ready_for_job(id, Mode::Auto, "programs")) return;
+  if (!features_allow_start(id, {JobKind::Program, op->name})) return;
+  std::unique_ptr<ProgramStream> stream =
+      source_->resume(op->path, r.program_start.value_or(open_at_), servo().commanded, r.segment, {block_delete_});
+  if (!stream) return finish(id, Refusal::BadValue, "this controller's program source cannot resume at a segment");
+  // The replay up to the segment, here and now: a program that cannot get there starts nothing.
+  while (stream->state() == StreamState::Reading && stream->program().empty()) stream->read(1);
+  // Every move is checked before it runs (the preflight's moves began elsewhere).
+  start_job(id, JobKind::Program, op->name, Mode::Auto, std::move(stream), false);
+}
+
 void Controller::feature(std::uint64_t id, const requests::Feature& r) {
   const auto it = features_.find(r.feature);
   if (it == features_.end())
@@ -612,6 +629,7 @@ void Controller::publish() {
   p.program_length_mm = open_ ? open_->preflight.summary.path_length_mm : 0;
   p.run_active = job_ != nullptr;
   const ServoStatus& s = servo();
+  p.servo = s;  // FeatureHost::current_status() is this, servo snapshot included
   if (job_) {
     const bool same_run = s.run_id == job_->run_id();
     p.job = job_->kind();

@@ -99,6 +99,24 @@ struct ProbeProfile {
   double sim_noise = 0.0005;
 };
 
+/// `[process.cutting]`: how a flame or plasma torch is put out and lit again (the retrace
+/// feature's sequences, docs/retrace.md). Outputs are digital output channels (M64/M65 P);
+/// heights are machine Z, mm; times in seconds.
+struct CuttingProfile {
+  bool present = false;
+  int torch_output = -1;      ///< ignition and fuel gas (flame) or the arc (plasma)
+  int preheat_output = -1;    ///< preheat oxygen (flame), −1: none
+  int cut_output = -1;        ///< cutting oxygen (flame), −1: none
+  double ignite_s = 0;        ///< torch on → flame established
+  double preheat_s = 0;       ///< preheat at the pierce height before the cutting oxygen
+  double pierce_s = 0;        ///< cutting oxygen on, torch still at the pierce height
+  double safe_height_mm = 0;  ///< Z for moves to and from the path
+  bool has_safe_height = false;
+  double pierce_lift_mm = 0;  ///< pierce this much above the path's Z
+  double approach_mm_min = 0;  ///< speed of the move to the path (0: rapid)
+  double retrace_mm_min = 1000;  ///< speed of stepping along the path while paused
+};
+
 /// Generic I/O channel counts (M62–M68, M66). Channels 0 … n-1 exist.
 struct IoProfile {
   int digital_inputs = 4, digital_outputs = 4;
@@ -171,6 +189,7 @@ struct MachineProfile {
   int tool_changer_pockets = 0;
   machine::SimToolChangerConfig tool_changer_sim;
   machine::SimProcessConfig process;  ///< torch / generator flags and their simulation
+  CuttingProfile cutting;             ///< [process.cutting]: torch sequences for retrace
   IoProfile io;
   InterlockProfile interlocks;
   HandwheelProfile handwheel;

@@ -106,6 +106,7 @@ class Controller final : private FeatureHost {
   void mdi(std::uint64_t id, const std::string& line);
   void cycle_start(std::uint64_t id, const Request& r);
   void run_auxiliary(std::uint64_t id, const requests::RunAuxiliary& r);
+  void resume_program(std::uint64_t id, const requests::ResumeProgram& r);
   void feature(std::uint64_t id, const requests::Feature& r);
   bool features_allow_start(std::uint64_t id, const StartCheck& start);
   bool features_allow_continue(const SyncCheck& sync);

@@ -63,6 +63,8 @@ class GcodeProgramSource final : public ProgramSource {
                       MoveCheck& check) override;
   std::unique_ptr<ProgramStream> execute(const std::string& path, const Pose& start,
                                          const LoadOptions& options) override;
+  std::unique_ptr<ProgramStream> resume(const std::string& path, const Pose& program_start, const Pose& start,
+                                        canon::SegmentId segment, const LoadOptions& options) override;
   std::unique_ptr<ProgramStream> mdi(std::string_view line, const Pose& start) override;
   std::uint64_t version() const override { return config_.tools ? config_.tools->version() : 0; }
 
