@@ -156,8 +156,9 @@ void read_probe(Section& top, MachineProfile& profile) {
 void read_tool_changer(Section& top, MachineProfile& profile) {
   const toml::table* t = top.subtable("tool_changer");
   if (t == nullptr) return;
-  Section s(*t, "tool_changer", {"sim"}, top.reporter());
+  Section s(*t, "tool_changer", {"sim", "pockets"}, top.reporter());
   profile.tool_changer = true;
+  profile.tool_changer_pockets = static_cast<int>(s.integer("pockets", 1, 10000).value_or(0));
   profile.tool_changer_sim.present = true;
   const toml::table* st = s.subtable("sim");
   if (st == nullptr) return;

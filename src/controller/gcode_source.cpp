@@ -579,6 +579,12 @@ Preflight preflight_pass(const gcode::Options& o, const std::string& path, const
 
 std::shared_ptr<GcodeProgramSource> GcodeProgramSource::create(const config::MachineProfile& profile,
                                                                Diagnostics& diags) {
+  std::optional<GcodeSourceConfig> c = config_for(profile, diags);
+  return c ? std::make_shared<GcodeProgramSource>(std::move(*c)) : nullptr;
+}
+
+std::optional<GcodeSourceConfig> GcodeProgramSource::config_for(const config::MachineProfile& profile,
+                                                                Diagnostics& diags) {
   GcodeSourceConfig c;
   gcode::Options& o = c.options;
   o.dialect = profile.interpreter.dialect == config::Dialect::Fanuc ? gcode::Dialect::Fanuc
@@ -593,11 +599,11 @@ std::shared_ptr<GcodeProgramSource> GcodeProgramSource::create(const config::Mac
   o.optional_stop = true;  // M1 always reaches the servo, which decides with the live switch
   if (!profile.interpreter.tool_table.empty()) {
     c.tools = tools::FileToolTable::open(profile.interpreter.tool_table, diags);
-    if (!c.tools) return nullptr;
+    if (!c.tools) return std::nullopt;
   }
   c.default_tolerance_mm = profile.planner.default_tolerance;
   c.hand = hand_axes(profile);
-  return std::make_shared<GcodeProgramSource>(std::move(c));
+  return c;
 }
 
 GcodeProgramSource::GcodeProgramSource(GcodeSourceConfig config) : config_(std::move(config)) {}

@@ -158,6 +158,18 @@ struct InterpreterOptions {
   double readahead_s = 5.0;
 };
 
+/// `[tool_guard]`: the tool store and the check of its live table against the backup.
+struct ToolGuardProfile {
+  bool present = false;
+  std::string store;                 ///< the SQLite tool store (relative to the profile)
+  bool check_at_start = true;        ///< before every program start
+  bool check_at_tool_change = true;  ///< at every M6, for the tool put in the spindle
+  double geometry_tolerance_mm = 0.001;
+  double base_tolerance_mm = 0.001;
+  double wear_band_mm = 0.1;
+  int check_mcode = 160;  ///< M-code of the on-demand check from G-code (0: none)
+};
+
 struct PlannerOptions {
   int lookahead = 200;              ///< moves in the look-ahead window
   double default_tolerance = 0.01;  ///< mm: path tolerance while a program sets no G64 P
@@ -173,6 +185,8 @@ struct MachineProfile {
   PowerProfile power;
   ProbeProfile probe;
   bool tool_changer = false;
+  /// Pockets of the magazine (0: not said); the tool guard checks the tools' pockets against it.
+  int tool_changer_pockets = 0;
   machine::SimToolChangerConfig tool_changer_sim;
   machine::SimProcessConfig process;  ///< torch / generator flags and their simulation
   CuttingProfile cutting;             ///< [process.cutting]: torch sequences for retrace
@@ -183,6 +197,7 @@ struct MachineProfile {
   std::vector<machine::SimInputSwitch> sim_input_switches;
   double sim_temperature_c = 20;  ///< machine temperature in the simulation
   InterpreterOptions interpreter;
+  ToolGuardProfile tool_guard;
   PlannerOptions planner;
   int sim_substeps = 10;  ///< integration sub-steps per servo period
   bool sim_linear_periods = true;  ///< see machine::SimMachineConfig::linear_periods

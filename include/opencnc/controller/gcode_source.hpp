@@ -5,6 +5,7 @@
 
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -51,6 +52,10 @@ class GcodeProgramSource final : public ProgramSource {
   /// and its tool table file as a tools::FileToolTable (G10 L1 writes it back); problems with it
   /// land in `diags` (errors: nullptr).
   static std::shared_ptr<GcodeProgramSource> create(const config::MachineProfile& profile, Diagnostics& diags);
+  /// create()'s configuration, for a feature that changes a part of it (its own tool table or
+  /// code modules) before building the source; nothing (and diagnostics) on errors.
+  static std::optional<GcodeSourceConfig> config_for(const config::MachineProfile& profile,
+                                                     Diagnostics& diags);
   explicit GcodeProgramSource(GcodeSourceConfig config);
   ~GcodeProgramSource() override;
 
