@@ -50,6 +50,10 @@ Pose with_xyz(Pose p, double x, double y, double z) {
   return p;
 }
 
+/// The auxiliary moves go exactly along their lines (G61): a blended corner between the move
+/// over to C and the plunge to the pierce height would lower the torch while it still travels.
+void exact_path(canon::ProgramBuilder& b) { b.set_motion_control_mode(canon::MotionControl::ExactPath, 0); }
+
 /// Steps along the path at most this long: the chords of an arc stay within 0.03 mm of it for
 /// radii from 4 mm (sagitta l²/8r).
 constexpr double kStepChordMm = 1.0;
@@ -351,6 +355,7 @@ void RetraceFeature::run_auxiliary(const char* name, std::shared_ptr<const canon
 
 std::shared_ptr<const canon::Program> RetraceFeature::torch_off_program(const Pose& at) const {
   canon::ProgramBuilder b(host_->profile().axis_mask(), at);
+  exact_path(b);
   // Cutting oxygen first, then preheat, then the flame: the profile's order of putting it out.
   for (int output : {cutting_.cut_output, cutting_.preheat_output, cutting_.torch_output}) {
     if (output >= 0) b.clear_aux_output_bit(output);
@@ -363,6 +368,7 @@ std::shared_ptr<const canon::Program> RetraceFeature::torch_off_program(const Po
 std::shared_ptr<const canon::Program> RetraceFeature::approach_program(const Pose& from,
                                                                        const Vec3& c) const {
   canon::ProgramBuilder b(host_->profile().axis_mask(), from);
+  exact_path(b);
   canon::SegmentId id = 0;
   const double travel_z = cutting_.has_safe_height ? cutting_.safe_height_mm : std::max(from[2], c[2]);
   if (from[2] != travel_z) b.straight_traverse(id++, with_xyz(from, from[0], from[1], travel_z));
@@ -393,6 +399,7 @@ std::shared_ptr<const canon::Program> RetraceFeature::approach_program(const Pos
 std::shared_ptr<const canon::Program> RetraceFeature::step_program(const Pose& from, const PathPoint& along,
                                                                    double distance_mm) const {
   canon::ProgramBuilder b(host_->profile().axis_mask(), from);
+  exact_path(b);
   b.set_feed_rate(cutting_.retrace_mm_min);
   canon::SegmentId id = 0;
   // Onto the path where stepping goes on from, then along it in chords, at the torch's height.

@@ -76,6 +76,23 @@ TEST(MachineProfile, MillLoadsCleanly) {
 
 // The profile's machine moves X 100 mm with the profile's limits (trapezoid at 100 mm/s and
 // 1000 mm/s²) and keeps its following error far inside max_following_error.
+// The flame cutter of the retrace example: its torch sequence and heights (docs/retrace.md).
+TEST(MachineProfile, FlameCutterLoadsWithItsTorch) {
+  const ProfileLoad load = load_profile(OPENCNC_SOURCE_DIR "/configs/flame-cutter.toml");
+  ASSERT_TRUE(load.ok()) << all_messages(load.diagnostics);
+  EXPECT_TRUE(load.diagnostics.empty()) << all_messages(load.diagnostics);
+  const CuttingProfile& c = load.profile->cutting;
+  EXPECT_TRUE(c.present);
+  EXPECT_EQ(c.torch_output, 0);
+  EXPECT_EQ(c.preheat_output, 1);
+  EXPECT_EQ(c.cut_output, 2);
+  EXPECT_EQ(c.ignite_s + c.preheat_s + c.pierce_s, 6.5);
+  EXPECT_TRUE(c.has_safe_height);
+  EXPECT_EQ(c.safe_height_mm, 40.0);
+  EXPECT_EQ(c.pierce_lift_mm, 5.0);
+  EXPECT_FALSE(load_profile(kMill).profile->cutting.present);
+}
+
 TEST(MachineProfile, MillSimulationFollowsATrapezoid) {
   const ProfileLoad load = load_profile(kMill);
   ASSERT_TRUE(load.ok());
@@ -183,7 +200,13 @@ INSTANTIATE_TEST_SUITE_P(
                 {"config.range", "bad.toml", 8, 11}},
         BadCase{"FrictionOrder",
                 with("[axis.x.sim]\ncoulomb_friction_n = 50\nstatic_friction_n = 40\n"),
-                {"config.range", "bad.toml", 9, 21}}),
+                {"config.range", "bad.toml", 9, 21}},
+        BadCase{"TorchOnAnOutputTheMachineLacks",
+                with("[process.cutting]\ntorch_output = 7\n"),
+                {"config.range", "bad.toml", 8, 16}},
+        BadCase{"NegativePreheatTime",
+                with("[process.cutting]\ntorch_output = 0\npreheat_s = -1\n"),
+                {"config.range", "bad.toml", 9, 13}}),
     [](const auto& param_info) { return std::string(param_info.param.name); });
 
 TEST(MachineProfile, UnknownKeyMessageListsTheAllowedKeys) {
