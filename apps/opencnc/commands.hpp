@@ -36,5 +36,6 @@ void add_gcode_commands(CLI::App& app, Registry& registry);   ///< check, canon,
 void add_run_command(CLI::App& app, Registry& registry);
 void add_plot_command(CLI::App& app, Registry& registry);
 void add_calibrate_command(CLI::App& app, Registry& registry);
+void add_serve_command(CLI::App& app, Registry& registry);   ///< the HMI server
 
 }  // namespace opencnc::cli
