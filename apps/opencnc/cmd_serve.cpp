@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // `opencnc serve`: the simulated machine with its controller, and the operator's HMI in the
 // browser (docs/hmi.md, docs/api.md), until Ctrl-C.
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#include <CLI/CLI.hpp>
 
 #include <chrono>
 #include <cstdlib>
@@ -57,7 +57,8 @@ bool split_listen(const std::string& listen, std::string& address, std::uint16_t
   const std::size_t colon = listen.rfind(':');
   if (colon == std::string::npos || colon == 0) return false;
   address = listen.substr(0, colon);
-  if (address.size() > 2 && address.front() == '[' && address.back() == ']') address = address.substr(1, address.size() - 2);
+  if (address.size() > 2 && address.front() == '[' && address.back() == ']')
+    address = address.substr(1, address.size() - 2);
   try {
     std::size_t used = 0;
     const int p = std::stoi(listen.substr(colon + 1), &used);
@@ -79,8 +80,8 @@ bool open_program(control::Controller& c, const std::string& program) {
     }
     return control::Outcome{false, control::Refusal::Busy, "the controller does not answer", {}};
   };
-  for (auto r : {control::Request::simple(control::CommandKind::MachineOn), control::Request::set_mode(control::Mode::Auto),
-                 control::Request::open(program)}) {
+  for (auto r : {control::Request::simple(control::CommandKind::MachineOn),
+                 control::Request::set_mode(control::Mode::Auto), control::Request::open(program)}) {
     const std::string name = r.name();
     const control::Outcome o = ask(std::move(r));
     for (const Diagnostic& d : o.diagnostics.items()) fmt::print(stderr, "{}\n", d.format());
@@ -96,7 +97,8 @@ int serve(const ServeOptions& o) {
   std::string address;
   std::uint16_t port = 0;
   if (!split_listen(o.listen, address, port)) {
-    fmt::print(stderr, "error: --listen: expected ADDRESS:PORT (127.0.0.1:8080, [::1]:8080), not \"{}\"\n", o.listen);
+    fmt::print(stderr, "error: --listen: expected ADDRESS:PORT (127.0.0.1:8080, [::1]:8080), not \"{}\"\n",
+               o.listen);
     return kExitUsage;
   }
   const config::ProfileLoad load = config::load_profile(o.machine, o.sets);
@@ -140,9 +142,9 @@ int serve(const ServeOptions& o) {
   hmi::ServerConfig sc;
   sc.address = address;
   sc.port = port;
-  sc.programs_dir = !o.programs_dir.empty()  ? fs::path(o.programs_dir)
-                    : !o.program.empty()     ? fs::absolute(o.program).parent_path()
-                                             : fs::current_path();
+  sc.programs_dir = !o.programs_dir.empty() ? fs::path(o.programs_dir)
+                    : !o.program.empty()    ? fs::absolute(o.program).parent_path()
+                                            : fs::current_path();
   sc.static_dir = o.static_dir.empty() ? default_static_dir() : fs::path(o.static_dir);
   if (!fs::exists(sc.static_dir / "index.html", ec)) {
     fmt::print(stderr, "warning: no front end in {} (scripts/hmi.sh builds it): the API alone is served\n",
@@ -157,7 +159,8 @@ int serve(const ServeOptions& o) {
   }
   if (!o.program.empty() && !open_program(host.controller(), o.program)) return kExitProgram;
 
-  const std::string host_part = address.find(':') != std::string::npos ? fmt::format("[{}]", address) : address;
+  const std::string host_part =
+      address.find(':') != std::string::npos ? fmt::format("[{}]", address) : address;
   fmt::print("opencnc serve: {} on the simulated machine ({})\n", profile.name,
              o.speed == 0 ? "real time" : fmt::format("virtual time at {}x", o.speed));
   fmt::print("  open      http://{}:{}/#token={}\n", host_part, server.port(), tokens->operator_token());
@@ -184,24 +187,30 @@ int serve(const ServeOptions& o) {
 
 void add_serve_command(CLI::App& app, Registry& registry) {
   auto opts = std::make_shared<ServeOptions>();
-  CLI::App* cmd = app.add_subcommand("serve", "Run the simulated machine and serve the operator's HMI in the browser");
+  CLI::App* cmd =
+      app.add_subcommand("serve", "Run the simulated machine and serve the operator's HMI in the browser");
   cmd->add_option("--machine,-m", opts->machine, "Machine profile, e.g. configs/mill-3axis.toml")->required();
   cmd->add_option("--set", opts->sets, "Override a profile key (repeatable)")
       ->expected(1)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
-  cmd->add_option("--listen", opts->listen,
-                  "ADDRESS:PORT to listen on (default 127.0.0.1:8080; port 0: any free port; any other address "
-                  "than loopback needs a token for every call)");
+  cmd->add_option(
+      "--listen", opts->listen,
+      "ADDRESS:PORT to listen on (default 127.0.0.1:8080; port 0: any free port; any other address "
+      "than loopback needs a token for every call)");
   cmd->add_option("--program", opts->program, "A G-code program to open at start (Auto mode)");
-  cmd->add_option("--programs", opts->programs_dir,
-                  "The folder programs are opened from (default: the --program's folder, else the current one)");
-  cmd->add_option("--data", opts->data_dir,
-                  "Where the tokens and the history live (default $XDG_STATE_HOME/opencnc or ~/.local/state/opencnc)");
-  cmd->add_option("--static", opts->static_dir, "The built front end (default: web/dist beside the build folder)");
+  cmd->add_option(
+      "--programs", opts->programs_dir,
+      "The folder programs are opened from (default: the --program's folder, else the current one)");
+  cmd->add_option(
+      "--data", opts->data_dir,
+      "Where the tokens and the history live (default $XDG_STATE_HOME/opencnc or ~/.local/state/opencnc)");
+  cmd->add_option("--static", opts->static_dir,
+                  "The built front end (default: web/dist beside the build folder)");
   cmd->add_option("--speed", opts->speed,
                   "Virtual time at this many machine seconds per second instead of a real-time servo thread")
       ->check(finite_range(0.01, 1000));
-  cmd->add_option("--stream-hz", opts->stream_hz, "Status messages per second on the WebSocket stream (default 30)")
+  cmd->add_option("--stream-hz", opts->stream_hz,
+                  "Status messages per second on the WebSocket stream (default 30)")
       ->check(finite_range(1, 1000));
   cmd->callback([opts, &registry] { registry.set_result(serve(*opts)); });
 }

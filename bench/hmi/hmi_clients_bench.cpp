@@ -38,15 +38,17 @@ struct Client : std::enable_shared_from_this<Client> {
     auto& s = beast::get_lowest_layer(ws).socket();
     s.open(tcp::v4());
     if (receive_buffer > 0) s.set_option(net::socket_base::receive_buffer_size(receive_buffer));
-    beast::get_lowest_layer(ws).async_connect(
-        tcp::endpoint(net::ip::make_address("127.0.0.1"), port), [self = shared_from_this()](beast::error_code ec) {
-          if (ec) return;
-          self->ws.async_handshake("127.0.0.1", "/api/v1/stream?token=" + kToken,
-                                   [self](beast::error_code e) {
-                                     self->connected = !e;
-                                     if (!e && !self->stalled) self->read();
-                                   });
-        });
+    beast::get_lowest_layer(ws).async_connect(tcp::endpoint(net::ip::make_address("127.0.0.1"), port),
+                                              [self = shared_from_this()](beast::error_code ec) {
+                                                if (ec) return;
+                                                self->ws.async_handshake("127.0.0.1",
+                                                                         "/api/v1/stream?token=" + kToken,
+                                                                         [self](beast::error_code e) {
+                                                                           self->connected = !e;
+                                                                           if (!e && !self->stalled)
+                                                                             self->read();
+                                                                         });
+                                              });
   }
   void read() {
     ws.async_read(buffer, [self = shared_from_this()](beast::error_code ec, std::size_t n) {
@@ -70,12 +72,14 @@ struct Client : std::enable_shared_from_this<Client> {
 double cpu_s() {
   rusage u{};
   ::getrusage(RUSAGE_SELF, &u);
-  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + (u.ru_utime.tv_usec + u.ru_stime.tv_usec) * 1e-6;
+  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+         (u.ru_utime.tv_usec + u.ru_stime.tv_usec) * 1e-6;
 }
 
 int usage() {
-  std::fprintf(stderr,
-               "usage: hmi_clients_bench [--clients N (100)] [--stalled S (5)] [--seconds T (30)] [--hz R (30)]\n");
+  std::fprintf(
+      stderr,
+      "usage: hmi_clients_bench [--clients N (100)] [--stalled S (5)] [--seconds T (30)] [--hz R (30)]\n");
   return 2;
 }
 
@@ -88,11 +92,16 @@ int main(int argc, char** argv) {
     const std::string a = argv[i];
     if (a == "-h" || a == "--help") return usage(), 0;
     if (i + 1 >= argc) return usage();
-    if (a == "--clients") clients = std::atoi(argv[++i]);
-    else if (a == "--stalled") stalled = std::atoi(argv[++i]);
-    else if (a == "--seconds") seconds = std::atof(argv[++i]);
-    else if (a == "--hz") hz = std::atof(argv[++i]);
-    else return usage();
+    if (a == "--clients")
+      clients = std::atoi(argv[++i]);
+    else if (a == "--stalled")
+      stalled = std::atoi(argv[++i]);
+    else if (a == "--seconds")
+      seconds = std::atof(argv[++i]);
+    else if (a == "--hz")
+      hz = std::atof(argv[++i]);
+    else
+      return usage();
   }
   const auto load = config::load_profile(OPENCNC_SOURCE_DIR "/configs/mill-3axis.toml");
   if (!load.ok()) return 1;
@@ -112,7 +121,8 @@ int main(int argc, char** argv) {
   if (!server.start(&error)) return std::fprintf(stderr, "error: %s\n", error.c_str()), 1;
 
   control::Controller& c = host.controller();
-  for (auto r : {control::Request::simple(control::CommandKind::MachineOn), control::Request::set_mode(control::Mode::Auto),
+  for (auto r : {control::Request::simple(control::CommandKind::MachineOn),
+                 control::Request::set_mode(control::Mode::Auto),
                  control::Request::open(OPENCNC_SOURCE_DIR "/examples/bracket.ngc")}) {
     const auto id = c.submit(std::move(r));
     while (!c.outcome(id)) std::this_thread::sleep_for(std::chrono::milliseconds(1));
@@ -134,8 +144,10 @@ int main(int argc, char** argv) {
   const auto t0 = std::chrono::steady_clock::now();
   while (std::chrono::steady_clock::now() - t0 < std::chrono::duration<double>(seconds)) {
     const auto s = c.status();
-    if (s.servo.state == control::State::Idle && !s.run_active) c.submit(control::Request::simple(control::CommandKind::CycleStart));
-    if (s.servo.wait == control::Wait::ManualToolChange) c.submit(control::Request::simple(control::CommandKind::ToolChanged));
+    if (s.servo.state == control::State::Idle && !s.run_active)
+      c.submit(control::Request::simple(control::CommandKind::CycleStart));
+    if (s.servo.wait == control::Wait::ManualToolChange)
+      c.submit(control::Request::simple(control::CommandKind::ToolChanged));
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -163,13 +175,15 @@ int main(int argc, char** argv) {
     sum += cl.messages;
     bytes += cl.bytes;
   }
-  std::printf("servo: %llu periods in %.1f s, %llu overruns; wake-up latency p99 %.1f us, p99.9 %.1f us, max %.1f us "
-              "(SCHED_FIFO: %s)\n",
-              static_cast<unsigned long long>(ticks), wall, static_cast<unsigned long long>(overruns),
-              lat->percentile_ns(0.99) / 1e3, lat->percentile_ns(0.999) / 1e3, lat->max_ns() / 1e3,
-              warnings.empty() ? "yes" : "no");
-  std::printf("clients: %d of %d connected, messages per client %llu..%llu (mean %.1f/s), %.1f MB in all\n", connected,
-              clients, static_cast<unsigned long long>(clients ? min_msgs : 0), static_cast<unsigned long long>(max_msgs),
+  std::printf(
+      "servo: %llu periods in %.1f s, %llu overruns; wake-up latency p99 %.1f us, p99.9 %.1f us, max %.1f us "
+      "(SCHED_FIFO: %s)\n",
+      static_cast<unsigned long long>(ticks), wall, static_cast<unsigned long long>(overruns),
+      lat->percentile_ns(0.99) / 1e3, lat->percentile_ns(0.999) / 1e3, lat->max_ns() / 1e3,
+      warnings.empty() ? "yes" : "no");
+  std::printf("clients: %d of %d connected, messages per client %llu..%llu (mean %.1f/s), %.1f MB in all\n",
+              connected, clients, static_cast<unsigned long long>(clients ? min_msgs : 0),
+              static_cast<unsigned long long>(max_msgs),
               clients ? static_cast<double>(sum) / clients / wall : 0.0, static_cast<double>(bytes) / 1e6);
   std::printf("stalled clients: %d connected, %llu dropped by the server\n", stalled_closed,
               static_cast<unsigned long long>(stats.dropped));

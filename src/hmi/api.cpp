@@ -26,11 +26,16 @@ struct Bad {
 
 const std::map<std::string, CommandKind, std::less<>>& servo_kinds() {
   static const std::map<std::string, CommandKind, std::less<>> kinds{
-      {"estop", CommandKind::EStop},         {"reset", CommandKind::Reset},
-      {"machine-on", CommandKind::MachineOn}, {"machine-off", CommandKind::MachineOff},
-      {"cycle-start", CommandKind::CycleStart}, {"feed-hold", CommandKind::FeedHold},
-      {"resume", CommandKind::Resume},       {"abort", CommandKind::Abort},
-      {"tool-changed", CommandKind::ToolChanged}, {"spindle-off", CommandKind::SpindleOff},
+      {"estop", CommandKind::EStop},
+      {"reset", CommandKind::Reset},
+      {"machine-on", CommandKind::MachineOn},
+      {"machine-off", CommandKind::MachineOff},
+      {"cycle-start", CommandKind::CycleStart},
+      {"feed-hold", CommandKind::FeedHold},
+      {"resume", CommandKind::Resume},
+      {"abort", CommandKind::Abort},
+      {"tool-changed", CommandKind::ToolChanged},
+      {"spindle-off", CommandKind::SpindleOff},
   };
   return kinds;
 }
@@ -64,9 +69,11 @@ std::string text(const json& body, const char* name) {
 const config::AxisProfile& axis(const json& body, const config::MachineProfile& p) {
   const std::string a = text(body, "axis");
   const std::string_view letters = "XYZABCUVW";
-  const auto k = a.size() == 1 ? letters.find(static_cast<char>(std::toupper(static_cast<unsigned char>(a[0]))))
-                               : std::string_view::npos;
-  if (k == std::string_view::npos) throw Bad{400, fmt::format("\"axis\" must be one of X Y Z A B C U V W, not \"{}\"", a)};
+  const auto k = a.size() == 1
+                     ? letters.find(static_cast<char>(std::toupper(static_cast<unsigned char>(a[0]))))
+                     : std::string_view::npos;
+  if (k == std::string_view::npos)
+    throw Bad{400, fmt::format("\"axis\" must be one of X Y Z A B C U V W, not \"{}\"", a)};
   const config::AxisProfile* found = p.find(static_cast<Axis>(k));
   if (!found) throw Bad{422, fmt::format("this machine has no {} axis", letters[k])};
   return *found;
@@ -86,8 +93,9 @@ double axis_speed(const json& body, const char* name, const config::AxisProfile&
   const double v = number(body, name);
   const double m = a.max_velocity;
   if (signed_speed ? std::abs(v) > m || v == 0 : v <= 0 || v > m) {
-    throw Bad{422, fmt::format("\"{}\" must be {}within the axis' maximum of {} {}/s, not {}", name,
-                               signed_speed ? "nonzero and " : "above 0 and ", m, a.rotary ? "deg" : "mm", v)};
+    throw Bad{422,
+              fmt::format("\"{}\" must be {}within the axis' maximum of {} {}/s, not {}", name,
+                          signed_speed ? "nonzero and " : "above 0 and ", m, a.rotary ? "deg" : "mm", v)};
   }
   return v;
 }
@@ -107,7 +115,8 @@ Request switch_request(const json& body) {
   if (which == "single-block") return Request::single_block(on);
   if (which == "optional-stop") return Request::optional_stop(on);
   if (which == "block-delete") return Request::block_delete(on);
-  throw Bad{400, fmt::format("\"which\" must be single-block, optional-stop or block-delete, not \"{}\"", which)};
+  throw Bad{400,
+            fmt::format("\"which\" must be single-block, optional-stop or block-delete, not \"{}\"", which)};
 }
 
 Request mode_request(const json& body) {
@@ -157,7 +166,8 @@ Request handwheel_request(const json& body, const config::MachineProfile& p) {
 
 ToolChange tool_change(const json& body) {
   const double t = number(body, "tool");
-  if (t != std::floor(t) || t < 1 || t > 99999) throw Bad{422, "\"tool\" must be a tool number from 1 to 99999"};
+  if (t != std::floor(t) || t < 1 || t > 99999)
+    throw Bad{422, "\"tool\" must be a tool number from 1 to 99999"};
   ToolChange c;
   c.tool = static_cast<int>(t);
   if (body.contains("diameter")) c.diameter_mm = within(number(body, "diameter"), 0, 1000, "diameter");
@@ -198,7 +208,8 @@ Command parse(const json& body, const config::MachineProfile& p, const std::file
   if (kind == "coolant") {
     const std::string which = text(body, "which");
     if (which != "flood" && which != "mist") throw Bad{400, "\"which\" must be flood or mist"};
-    return Request::coolant(which == "flood" ? control::Coolant::Flood : control::Coolant::Mist, boolean(body, "on"));
+    return Request::coolant(which == "flood" ? control::Coolant::Flood : control::Coolant::Mist,
+                            boolean(body, "on"));
   }
   if (kind == "handwheel") return handwheel_request(body, p);
   if (kind == "open") return open_request(body, dir);
@@ -217,8 +228,9 @@ json axes_json(const Pose& p, int count, const config::MachineProfile& profile) 
 }
 
 const char* wait_name(control::Wait w) {
-  static constexpr const char* names[] = {"",      "dwell", "spindle", "tool-changer", "manual-tool-change", "input",
-                                          "orient", "probe", "starved", "hand-axis",   "interlock"};
+  static constexpr const char* names[] = {
+      "",       "dwell", "spindle", "tool-changer", "manual-tool-change", "input",
+      "orient", "probe", "starved", "hand-axis",    "interlock"};
   return names[static_cast<std::size_t>(w)];
 }
 
@@ -242,11 +254,14 @@ json location_json(const control::SourceLocation& l) {
 
 }  // namespace
 
-const char* to_string(Role r) noexcept { return r == Role::Admin ? "admin" : "operator"; }
+const char* to_string(Role r) noexcept {
+  return r == Role::Admin ? "admin" : "operator";
+}
 
 std::optional<Role> role_for(std::string_view kind) {
-  static const char* const operator_kinds[] = {"mode",   "jog",     "jog-by",    "jog-stop", "home", "override",
-                                               "switch", "spindle-on", "coolant", "handwheel", "open", "mdi"};
+  static const char* const operator_kinds[] = {"mode",    "jog",       "jog-by", "jog-stop",
+                                               "home",    "override",  "switch", "spindle-on",
+                                               "coolant", "handwheel", "open",   "mdi"};
   if (kind == "set-tool") return Role::Admin;
   if (servo_kinds().find(kind) != servo_kinds().end()) return Role::Operator;
   for (const char* k : operator_kinds) {
@@ -293,27 +308,40 @@ json status_json(const control::ControllerStatus& s, const config::MachineProfil
       {"spindle_override", v.spindle_override},
       {"single_block", v.single_block},
       {"optional_stop", v.optional_stop},
-      {"spindle", {{"rpm", v.spindle_rpm}, {"rpm_actual", v.spindle_rpm_actual}, {"at_speed", v.spindle_at_speed},
-                   {"direction", v.spindle_direction == machine::SpindleDirection::Stopped ? "stopped"
-                                 : v.spindle_direction == machine::SpindleDirection::Clockwise ? "cw"
-                                                                                             : "ccw"}}},
+      {"spindle",
+       {{"rpm", v.spindle_rpm},
+        {"rpm_actual", v.spindle_rpm_actual},
+        {"at_speed", v.spindle_at_speed},
+        {"direction", v.spindle_direction == machine::SpindleDirection::Stopped     ? "stopped"
+                      : v.spindle_direction == machine::SpindleDirection::Clockwise ? "cw"
+                                                                                    : "ccw"}}},
       {"flood", v.flood},
       {"mist", v.mist},
       {"tool", v.tool},
       {"prepared_tool", v.prepared_tool},
       {"fault", s.fault_text},
       {"program", {{"name", s.program_name}, {"moves", s.program_moves}, {"length_mm", s.program_length_mm}}},
-      {"job", {{"kind", control::to_string(s.job)}, {"id", s.job_id}, {"name", s.job_name}, {"active", s.run_active},
-               {"segment", s.run_segment}, {"progress", s.progress}, {"location", location_json(s.location)},
-               {"interpreter", location_json(s.interpreter)}}},
+      {"job",
+       {{"kind", control::to_string(s.job)},
+        {"id", s.job_id},
+        {"name", s.job_name},
+        {"active", s.run_active},
+        {"segment", s.run_segment},
+        {"progress", s.progress},
+        {"location", location_json(s.location)},
+        {"interpreter", location_json(s.interpreter)}}},
       {"sync_wait", control::to_string(s.sync_wait)},
       {"runs_finished", s.runs_finished},
   };
 }
 
 json event_json(const control::ControllerEvent& e) {
-  json j{{"seq", e.seq}, {"tick", e.tick}, {"kind", control::to_string(e.kind)}, {"severity", severity_name(e.severity)},
-         {"code", e.code}, {"text", e.text}};
+  json j{{"seq", e.seq},
+         {"tick", e.tick},
+         {"kind", control::to_string(e.kind)},
+         {"severity", severity_name(e.severity)},
+         {"code", e.code},
+         {"text", e.text}};
   switch (e.kind) {
     case control::ControllerEventKind::Answer:
       j["request"] = e.request_id;
@@ -353,9 +381,14 @@ json outcome_json(std::uint64_t id, const control::Outcome& o) {
 json machine_json(const config::MachineProfile& p) {
   json axes = json::array();
   for (const config::AxisProfile& a : p.axes) {
-    axes.push_back({{"axis", std::string(1, letter(a.axis))}, {"rotary", a.rotary}, {"manual", a.manual()},
-                    {"min_limit", a.min_limit}, {"max_limit", a.max_limit}, {"max_velocity", a.max_velocity},
-                    {"max_acceleration", a.max_acceleration}, {"homing", a.homing.method != config::HomingMethod::Immediate}});
+    axes.push_back({{"axis", std::string(1, letter(a.axis))},
+                    {"rotary", a.rotary},
+                    {"manual", a.manual()},
+                    {"min_limit", a.min_limit},
+                    {"max_limit", a.max_limit},
+                    {"max_velocity", a.max_velocity},
+                    {"max_acceleration", a.max_acceleration},
+                    {"homing", a.homing.method != config::HomingMethod::Immediate}});
   }
   return {{"name", p.name},
           {"description", p.description},

@@ -27,12 +27,16 @@ CREATE TABLE IF NOT EXISTS audit (
 /// A prepared statement that finalizes itself.
 class Statement {
  public:
-  Statement(sqlite3* db, const char* sql) { ok_ = sqlite3_prepare_v2(db, sql, -1, &s_, nullptr) == SQLITE_OK; }
+  Statement(sqlite3* db, const char* sql) {
+    ok_ = sqlite3_prepare_v2(db, sql, -1, &s_, nullptr) == SQLITE_OK;
+  }
   ~Statement() { sqlite3_finalize(s_); }
   Statement(const Statement&) = delete;
   Statement& operator=(const Statement&) = delete;
   bool ok() const { return ok_; }
-  void bind(int i, const std::string& v) { sqlite3_bind_text(s_, i, v.data(), static_cast<int>(v.size()), SQLITE_TRANSIENT); }
+  void bind(int i, const std::string& v) {
+    sqlite3_bind_text(s_, i, v.data(), static_cast<int>(v.size()), SQLITE_TRANSIENT);
+  }
   void bind(int i, std::int64_t v) { sqlite3_bind_int64(s_, i, v); }
   void bind(int i, double v) { sqlite3_bind_double(s_, i, v); }
   int step() { return sqlite3_step(s_); }
@@ -80,8 +84,8 @@ std::string utc_now() {
 
 std::unique_ptr<History> History::open(const std::filesystem::path& path, std::string* error) {
   sqlite3* db = nullptr;
-  if (sqlite3_open_v2(path.c_str(), &db, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_FULLMUTEX, nullptr) !=
-          SQLITE_OK ||
+  if (sqlite3_open_v2(path.c_str(), &db, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_FULLMUTEX,
+                      nullptr) != SQLITE_OK ||
       sqlite3_exec(db, kSchema, nullptr, nullptr, nullptr) != SQLITE_OK) {
     if (error) *error = fmt::format("{}: {}", path.string(), db ? sqlite3_errmsg(db) : "cannot open");
     sqlite3_close(db);
@@ -146,8 +150,10 @@ bool History::write(const std::variant<JobRecord, AuditRecord>& r) {
   std::lock_guard lock(db_mutex_);
   int rc = SQLITE_ERROR;
   if (const auto* j = std::get_if<JobRecord>(&r)) {
-    Statement s(db_, "INSERT INTO jobs (job_id, kind, program, started_utc, ended_utc, outcome, machining_s, end_line, alarms) "
-                     "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?)");
+    Statement s(db_,
+                "INSERT INTO jobs (job_id, kind, program, started_utc, ended_utc, outcome, machining_s, "
+                "end_line, alarms) "
+                "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?)");
     if (s.ok()) {
       s.bind(1, std::int64_t{j->job_id});
       s.bind(2, j->kind);
@@ -162,7 +168,9 @@ bool History::write(const std::variant<JobRecord, AuditRecord>& r) {
     }
   } else {
     const auto& a = std::get<AuditRecord>(r);
-    Statement s(db_, "INSERT INTO audit (time_utc, role, remote, action, body, status, result) VALUES (?, ?, ?, ?, ?, ?, ?)");
+    Statement s(db_,
+                "INSERT INTO audit (time_utc, role, remote, action, body, status, result) VALUES (?, ?, ?, "
+                "?, ?, ?, ?)");
     if (s.ok()) {
       s.bind(1, a.time_utc);
       s.bind(2, a.role);
@@ -182,38 +190,43 @@ bool History::write(const std::variant<JobRecord, AuditRecord>& r) {
 
 std::vector<JobRecord> History::jobs(int limit) const {
   std::lock_guard lock(db_mutex_);
-  Statement s(db_, "SELECT id, job_id, kind, program, started_utc, ended_utc, outcome, machining_s, end_line, alarms "
-                   "FROM jobs ORDER BY id DESC LIMIT ?");
+  Statement s(
+      db_,
+      "SELECT id, job_id, kind, program, started_utc, ended_utc, outcome, machining_s, end_line, alarms "
+      "FROM jobs ORDER BY id DESC LIMIT ?");
   std::vector<JobRecord> out;
   if (!s.ok()) return out;
   s.bind(1, std::int64_t{limit});
   while (s.step() == SQLITE_ROW) {
-    out.push_back({s.integer(0), static_cast<std::uint32_t>(s.integer(1)), s.text(2), s.text(3), s.text(4), s.text(5),
-                   s.text(6), s.real(7), static_cast<std::uint32_t>(s.integer(8)), split(s.text(9))});
+    out.push_back({s.integer(0), static_cast<std::uint32_t>(s.integer(1)), s.text(2), s.text(3), s.text(4),
+                   s.text(5), s.text(6), s.real(7), static_cast<std::uint32_t>(s.integer(8)),
+                   split(s.text(9))});
   }
   return out;
 }
 
 std::vector<AuditRecord> History::audit(int limit) const {
   std::lock_guard lock(db_mutex_);
-  Statement s(db_, "SELECT id, time_utc, role, remote, action, body, status, result FROM audit ORDER BY id DESC LIMIT ?");
+  Statement s(
+      db_,
+      "SELECT id, time_utc, role, remote, action, body, status, result FROM audit ORDER BY id DESC LIMIT ?");
   std::vector<AuditRecord> out;
   if (!s.ok()) return out;
   s.bind(1, std::int64_t{limit});
   while (s.step() == SQLITE_ROW) {
-    out.push_back({s.integer(0), s.text(1), s.text(2), s.text(3), s.text(4), s.text(5), static_cast<int>(s.integer(6)),
-                   s.text(7)});
+    out.push_back({s.integer(0), s.text(1), s.text(2), s.text(3), s.text(4), s.text(5),
+                   static_cast<int>(s.integer(6)), s.text(7)});
   }
   return out;
 }
 
 std::uint64_t History::failures() const {
-  std::lock_guard lock(const_cast<std::mutex&>(queue_mutex_));
+  std::lock_guard lock(queue_mutex_);
   return failures_;
 }
 
 std::string History::last_error() const {
-  std::lock_guard lock(const_cast<std::mutex&>(queue_mutex_));
+  std::lock_guard lock(queue_mutex_);
   return last_error_;
 }
 

@@ -11,8 +11,8 @@
 
 namespace opencnc::hmi {
 
-MachineHost::MachineHost(const config::MachineProfile& profile, std::shared_ptr<control::ProgramSource> source,
-                         HostOptions options)
+MachineHost::MachineHost(const config::MachineProfile& profile,
+                         std::shared_ptr<control::ProgramSource> source, HostOptions options)
     : options_(options), period_s_(profile.servo_period_s) {
   if (options_.realtime) {
     channels_ = std::make_unique<control::ServoChannels>();
@@ -26,7 +26,9 @@ MachineHost::MachineHost(const config::MachineProfile& profile, std::shared_ptr<
   }
 }
 
-MachineHost::~MachineHost() { stop(); }
+MachineHost::~MachineHost() {
+  stop();
+}
 
 bool MachineHost::start(std::vector<std::string>* warnings) {
   if (options_.realtime) {
@@ -46,13 +48,21 @@ void MachineHost::stop() {
   if (clock_) clock_->stop();
 }
 
-control::Controller& MachineHost::controller() noexcept { return rig_ ? rig_->controller() : *controller_; }
+control::Controller& MachineHost::controller() noexcept {
+  return rig_ ? rig_->controller() : *controller_;
+}
 
-std::uint64_t MachineHost::ticks() const noexcept { return clock_ ? clock_->ticks() : paced_ticks_.load(); }
+std::uint64_t MachineHost::ticks() const noexcept {
+  return clock_ ? clock_->ticks() : paced_ticks_.load();
+}
 
-std::uint64_t MachineHost::overruns() const noexcept { return clock_ ? clock_->overruns() : 0; }
+std::uint64_t MachineHost::overruns() const noexcept {
+  return clock_ ? clock_->overruns() : 0;
+}
 
-const control::LatencyHistogram* MachineHost::latency() const noexcept { return clock_ ? &clock_->latency() : nullptr; }
+const control::LatencyHistogram* MachineHost::latency() const noexcept {
+  return clock_ ? &clock_->latency() : nullptr;
+}
 
 // The controller's loop beside the real-time servo: one service() per servo period (it reads
 // whatever the servo produced meanwhile, so a late service costs nothing but latency).

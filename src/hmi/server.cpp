@@ -11,6 +11,7 @@
 #include <thread>
 #include <vector>
 
+#include <fmt/format.h>
 #include <boost/asio/dispatch.hpp>
 #include <boost/asio/post.hpp>
 #include <boost/asio/steady_timer.hpp>
@@ -19,7 +20,6 @@
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
 #include <boost/beast/websocket.hpp>
-#include <fmt/format.h>
 
 #include "opencnc/controller/gcode_source.hpp"
 #include "opencnc/hmi/api.hpp"
@@ -50,7 +50,9 @@ struct Target {
   std::map<std::string, std::string> query;
 };
 
-std::string_view sv(beast::string_view s) { return {s.data(), s.size()}; }
+std::string_view sv(beast::string_view s) {
+  return {s.data(), s.size()};
+}
 
 std::string url_decode(std::string_view s) {
   std::string out;
@@ -143,8 +145,17 @@ class WsSession;
 struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
   Impl(control::Controller& c, const config::MachineProfile& p, Tokens t, History* h,
        const control::GcodeProgramSource* s, ServerConfig cfg)
-      : controller(c), profile(p), tokens(std::move(t)), history(h), source(s), config(std::move(cfg)),
-        acceptor(net::make_strand(ioc)), stream_timer(ioc) {}
+      : controller(c),
+        profile(p),
+        tokens(std::move(t)),
+        history(h),
+        source(s),
+        config(std::move(cfg)),
+        ioc_owner(std::make_unique<net::io_context>()),
+        ioc(*ioc_owner) {
+    acceptor.emplace(net::make_strand(ioc));
+    stream_timer.emplace(ioc);
+  }
 
   control::Controller& controller;
   config::MachineProfile profile;
@@ -153,10 +164,14 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
   const control::GcodeProgramSource* source;
   ServerConfig config;
 
-  net::io_context ioc;
-  tcp::acceptor acceptor;
-  net::steady_timer stream_timer;
-  net::thread_pool workers{1};  ///< previews: the interpreter may take a while
+  /// Destroyed by Server::stop() after its threads ended: that destroys the handlers still
+  /// queued, and with them the sessions they hold (they hold this Impl too, so it cannot own it).
+  std::unique_ptr<net::io_context> ioc_owner;
+  net::io_context& ioc;
+  std::optional<tcp::acceptor> acceptor;              ///< reset before the io_context goes
+  std::optional<net::steady_timer> stream_timer;      ///< reset before the io_context goes
+  std::chrono::steady_clock::time_point next_tick{};  ///< of the stream (the io thread)
+  net::thread_pool workers{1};                        ///< previews: the interpreter may take a while
   std::vector<std::thread> threads;
   bool loopback = true;
   std::uint16_t port = 0;
@@ -202,7 +217,9 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     const auto ep = stream_.socket().remote_endpoint(ec);
     remote_ = ec ? "?" : fmt::format("{}:{}", ep.address().to_string(), ep.port());
   }
-  void run() { net::dispatch(stream_.get_executor(), [self = shared_from_this()] { self->read(); }); }
+  void run() {
+    net::dispatch(stream_.get_executor(), [self = shared_from_this()] { self->read(); });
+  }
   /// Sends `res`, then reads the next request (or closes). The session's executor.
   void send(HttpResponse res) {
     auto sp = std::make_shared<HttpResponse>(std::move(res));
@@ -223,9 +240,8 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     parser_.emplace();
     parser_->body_limit(kBodyLimit);
     stream_.expires_after(std::chrono::seconds(60));
-    http::async_read(stream_, buffer_, *parser_, [self = shared_from_this()](beast::error_code ec, std::size_t) {
-      self->on_read(ec);
-    });
+    http::async_read(stream_, buffer_, *parser_,
+                     [self = shared_from_this()](beast::error_code ec, std::size_t) { self->on_read(ec); });
   }
   void on_read(beast::error_code ec) {
     if (ec == http::error::body_limit) {
@@ -259,7 +275,8 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
 
   void run(HttpRequest req) {
     beast::error_code ec;
-    beast::get_lowest_layer(ws_).socket().set_option(net::socket_base::send_buffer_size(kSendBufferBytes), ec);
+    beast::get_lowest_layer(ws_).socket().set_option(net::socket_base::send_buffer_size(kSendBufferBytes),
+                                                     ec);
     ws_.set_option(websocket::stream_base::timeout::suggested(beast::role_type::server));
     ws_.async_accept(req, [self = shared_from_this()](beast::error_code e) {
       if (e) return;
@@ -303,15 +320,16 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
   void write() {
     writing_ = true;
     ws_.text(true);
-    ws_.async_write(net::buffer(*queue_.front()), [self = shared_from_this()](beast::error_code ec, std::size_t) {
-      self->writing_ = false;
-      if (ec) {
-        self->closed_ = true;
-        return;
-      }
-      if (!self->queue_.empty()) self->queue_.pop_front();
-      if (!self->queue_.empty() && !self->closed_) self->write();
-    });
+    ws_.async_write(net::buffer(*queue_.front()),
+                    [self = shared_from_this()](beast::error_code ec, std::size_t) {
+                      self->writing_ = false;
+                      if (ec) {
+                        self->closed_ = true;
+                        return;
+                      }
+                      if (!self->queue_.empty()) self->queue_.pop_front();
+                      if (!self->queue_.empty() && !self->closed_) self->write();
+                    });
   }
   /// Reads (and ignores) what the client sends, to see it close.
   void read() {
@@ -331,17 +349,19 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
   std::uint64_t reported_lost_ = 0;
   std::deque<std::shared_ptr<const std::string>> queue_;
   beast::flat_buffer in_;
-  bool writing_ = false, closed_ = false;
+  bool writing_ = false;
+  std::atomic<bool> closed_{false};  ///< read by the stream tick and stats() on other threads
 };
 
 // --- the server -----------------------------------------------------------------------------
 
 void Server::Impl::accept() {
-  acceptor.async_accept(net::make_strand(ioc), [self = shared_from_this()](beast::error_code ec, tcp::socket socket) {
-    if (self->stopping) return;
-    if (!ec) std::make_shared<HttpSession>(std::move(socket), self)->run();
-    self->accept();
-  });
+  acceptor->async_accept(net::make_strand(ioc),
+                         [self = shared_from_this()](beast::error_code ec, tcp::socket socket) {
+                           if (self->stopping) return;
+                           if (!ec) std::make_shared<HttpSession>(std::move(socket), self)->run();
+                           self->accept();
+                         });
 }
 
 // Every 1/stream_hz: the status once as JSON, handed to each client on its own executor.
@@ -359,9 +379,15 @@ void Server::Impl::stream_tick() {
       if (auto s = w.lock()) net::post(s->executor(), [s, status] { s->deliver(status); });
     }
   }
-  stream_timer.expires_after(std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-      std::chrono::duration<double>(1.0 / config.stream_hz)));
-  stream_timer.async_wait([self = shared_from_this()](beast::error_code ec) {
+  // A fixed schedule (not "a period after this one's work"), so the rate holds; a tick that
+  // came too late is not made up with a burst.
+  const auto period = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+      std::chrono::duration<double>(1.0 / config.stream_hz));
+  const auto now = std::chrono::steady_clock::now();
+  next_tick = next_tick.time_since_epoch().count() == 0 || next_tick + period < now ? now + period
+                                                                                    : next_tick + period;
+  stream_timer->expires_at(next_tick);
+  stream_timer->async_wait([self = shared_from_this()](beast::error_code ec) {
     if (!ec) self->stream_tick();
   });
 }
@@ -373,19 +399,21 @@ void Server::Impl::upgrade(tcp::socket socket, HttpRequest req, std::string remo
     const int status = t.path != "/api/v1/stream" ? 404 : 401;
     if (status == 401) audit(remote, role, req, 401, "no valid token");
     auto s = std::make_shared<HttpSession>(std::move(socket), shared_from_this());
-    HttpResponse res = error_response(req, status, status == 404 ? "no such stream" : "a valid token is needed");
+    HttpResponse res =
+        error_response(req, status, status == 404 ? "no such stream" : "a valid token is needed");
     res.keep_alive(false);
     return s->send(std::move(res));
   }
   std::make_shared<WsSession>(std::move(socket), shared_from_this())->run(std::move(req));
 }
 
-void Server::Impl::audit(const std::string& remote, std::optional<Role> role, const HttpRequest& req, int status,
-                         std::string result) {
+void Server::Impl::audit(const std::string& remote, std::optional<Role> role, const HttpRequest& req,
+                         int status, std::string result) {
   if (!history) return;
-  history->add(AuditRecord{0, utc_now(), role ? to_string(*role) : "", remote,
-                           fmt::format("{} {}", std::string(req.method_string()), parse_target(sv(req.target())).path),
-                           req.body(), status, std::move(result)});
+  history->add(
+      AuditRecord{0, utc_now(), role ? to_string(*role) : "", remote,
+                  fmt::format("{} {}", std::string(req.method_string()), parse_target(sv(req.target())).path),
+                  req.body(), status, std::move(result)});
 }
 
 void Server::Impl::handle(const std::shared_ptr<HttpSession>& s, HttpRequest req) {
@@ -397,7 +425,8 @@ void Server::Impl::handle(const std::shared_ptr<HttpSession>& s, HttpRequest req
     }
     return s->send(static_file(req, t));
   }
-  if (!t.path.starts_with("/api/v1/")) return s->send(error_response(req, 404, "this server speaks /api/v1/"));
+  if (!t.path.starts_with("/api/v1/"))
+    return s->send(error_response(req, 404, "this server speaks /api/v1/"));
   const std::optional<Role> role = tokens.role_of(token_of(req, t));
   const bool is_get = req.method() == http::verb::get;
   if (!role && !(is_get && t.path == "/api/v1/status" && loopback)) {
@@ -443,9 +472,16 @@ HttpResponse Server::Impl::get(const HttpRequest& req, const Target& t, Role rol
     if (!history) return json_response(req, 200, json::array());
     json list = json::array();
     for (const JobRecord& r : history->jobs(query_int(t, "limit", 50, 1, 1000))) {
-      list.push_back({{"id", r.id}, {"job_id", r.job_id}, {"kind", r.kind}, {"program", r.program},
-                      {"started", r.started_utc}, {"ended", r.ended_utc}, {"outcome", r.outcome},
-                      {"machining_s", r.machining_s}, {"end_line", r.end_line}, {"alarms", r.alarms}});
+      list.push_back({{"id", r.id},
+                      {"job_id", r.job_id},
+                      {"kind", r.kind},
+                      {"program", r.program},
+                      {"started", r.started_utc},
+                      {"ended", r.ended_utc},
+                      {"outcome", r.outcome},
+                      {"machining_s", r.machining_s},
+                      {"end_line", r.end_line},
+                      {"alarms", r.alarms}});
     }
     return json_response(req, 200, list);
   }
@@ -454,8 +490,14 @@ HttpResponse Server::Impl::get(const HttpRequest& req, const Target& t, Role rol
     json list = json::array();
     if (history) {
       for (const AuditRecord& r : history->audit(query_int(t, "limit", 100, 1, 1000))) {
-        list.push_back({{"id", r.id}, {"time", r.time_utc}, {"role", r.role}, {"remote", r.remote}, {"action", r.action},
-                        {"body", r.body}, {"status", r.status}, {"result", r.result}});
+        list.push_back({{"id", r.id},
+                        {"time", r.time_utc},
+                        {"role", r.role},
+                        {"remote", r.remote},
+                        {"action", r.action},
+                        {"body", r.body},
+                        {"status", r.status},
+                        {"result", r.result}});
       }
     }
     return json_response(req, 200, list);
@@ -463,13 +505,19 @@ HttpResponse Server::Impl::get(const HttpRequest& req, const Target& t, Role rol
   if (p == "/api/v1/server") {
     std::size_t clients = 0;
     {
-      std::lock_guard lock(const_cast<std::mutex&>(sessions_mutex));
+      std::lock_guard lock(sessions_mutex);
       clients = sessions.size();
     }
-    return json_response(req, 200, {{"address", config.address}, {"port", port}, {"loopback_only", loopback},
-                                    {"stream_hz", config.stream_hz}, {"clients", clients}, {"dropped", dropped.load()},
-                                    {"tokens", tokens.origin()}, {"role", to_string(role)},
-                                    {"programs", config.programs_dir.string()}});
+    return json_response(req, 200,
+                         {{"address", config.address},
+                          {"port", port},
+                          {"loopback_only", loopback},
+                          {"stream_hz", config.stream_hz},
+                          {"clients", clients},
+                          {"dropped", dropped.load()},
+                          {"tokens", tokens.origin()},
+                          {"role", to_string(role)},
+                          {"programs", config.programs_dir.string()}});
   }
   return error_response(req, 404, fmt::format("no such call: GET {}", p));
 }
@@ -482,9 +530,9 @@ void Server::Impl::command(const std::shared_ptr<HttpSession>& s, const HttpRequ
     audit(s->remote(), role, req, 400, "malformed JSON");
     return s->send(error_response(req, 400, fmt::format("the body is not JSON: {}", e.what())));
   }
-  const std::optional<Role> needed =
-      body.is_object() && body.contains("kind") && body["kind"].is_string() ? role_for(body["kind"].get<std::string>())
-                                                                           : std::nullopt;
+  const std::optional<Role> needed = body.is_object() && body.contains("kind") && body["kind"].is_string()
+                                         ? role_for(body["kind"].get<std::string>())
+                                         : std::nullopt;
   if (needed == Role::Admin && role != Role::Admin) {
     audit(s->remote(), role, req, 403, "needs the admin role");
     return s->send(error_response(req, 403, "this command needs the admin token"));
@@ -501,9 +549,9 @@ void Server::Impl::command(const std::shared_ptr<HttpSession>& s, const HttpRequ
     return s->send(std::move(res));
   }
   const std::uint64_t id = controller.submit(std::move(std::get<control::Request>(c)));
-  const auto deadline = std::chrono::steady_clock::now() +
-                        std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                            std::chrono::duration<double>(config.command_timeout_s));
+  const auto deadline =
+      std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                             std::chrono::duration<double>(config.command_timeout_s));
   wait_outcome(s, req, id, deadline);
 }
 
@@ -514,7 +562,8 @@ void Server::Impl::wait_outcome(const std::shared_ptr<HttpSession>& s, HttpReque
   const std::optional<Role> role = tokens.role_of(token_of(req, parse_target(sv(req.target()))));
   if (const auto o = controller.outcome(id)) {
     const int status = o->accepted ? 200 : 409;
-    audit(s->remote(), role, req, status, o->accepted ? "accepted" : fmt::format("{}: {}", control::refusal_code(o->refusal), o->message));
+    audit(s->remote(), role, req, status,
+          o->accepted ? "accepted" : fmt::format("{}: {}", control::refusal_code(o->refusal), o->message));
     return s->send(json_response(req, status, outcome_json(id, *o)));
   }
   if (std::chrono::steady_clock::now() >= deadline || stopping) {
@@ -522,9 +571,8 @@ void Server::Impl::wait_outcome(const std::shared_ptr<HttpSession>& s, HttpReque
     return s->send(json_response(req, 202, {{"id", id}, {"pending", true}}));
   }
   auto timer = std::make_shared<net::steady_timer>(s->executor(), std::chrono::milliseconds(2));
-  timer->async_wait([self = shared_from_this(), s, timer, req = std::move(req), id, deadline](beast::error_code) mutable {
-    self->wait_outcome(s, std::move(req), id, deadline);
-  });
+  timer->async_wait([self = shared_from_this(), s, timer, req = std::move(req), id, deadline](
+                        beast::error_code) mutable { self->wait_outcome(s, std::move(req), id, deadline); });
 }
 
 HttpResponse Server::Impl::tool_change(const HttpRequest& req, const ToolChange& c) {
@@ -543,13 +591,17 @@ HttpResponse Server::Impl::tool_change(const HttpRequest& req, const ToolChange&
     for (const Diagnostic& d : diags.items()) why += (why.empty() ? "" : "; ") + d.format();
     return error_response(req, 409, why.empty() ? "the tool table refused the change" : why);
   }
-  return json_response(req, 200, {{"accepted", true}, {"tool", c.tool}, {"diameter", e.diameter},
-                                  {"z_offset", e.offset[index(Axis::Z)]}});
+  return json_response(req, 200,
+                       {{"accepted", true},
+                        {"tool", c.tool},
+                        {"diameter", e.diameter},
+                        {"z_offset", e.offset[index(Axis::Z)]}});
 }
 
 std::string Server::Impl::relative_program(const std::string& path) const {
   std::error_code ec;
-  const auto rel = std::filesystem::relative(path, std::filesystem::weakly_canonical(config.programs_dir, ec), ec);
+  const auto rel =
+      std::filesystem::relative(path, std::filesystem::weakly_canonical(config.programs_dir, ec), ec);
   return ec || rel.empty() || rel.string().starts_with("..") ? std::filesystem::path(path).filename().string()
                                                              : rel.string();
 }
@@ -560,9 +612,15 @@ HttpResponse Server::Impl::program_info(const HttpRequest& req) {
   const control::PreflightSummary& s = open->preflight.summary;
   json warnings = json::array();
   for (const Diagnostic& d : open->preflight.diagnostics.items()) warnings.push_back(d.format());
-  return json_response(req, 200, {{"open", true}, {"name", open->name}, {"program", relative_program(open->path)},
-                                  {"moves", s.moves}, {"length_mm", s.path_length_mm}, {"warnings", warnings},
-                                  {"min", {s.min[0], s.min[1], s.min[2]}}, {"max", {s.max[0], s.max[1], s.max[2]}}});
+  return json_response(req, 200,
+                       {{"open", true},
+                        {"name", open->name},
+                        {"program", relative_program(open->path)},
+                        {"moves", s.moves},
+                        {"length_mm", s.path_length_mm},
+                        {"warnings", warnings},
+                        {"min", {s.min[0], s.min[1], s.min[2]}},
+                        {"max", {s.max[0], s.max[1], s.max[2]}}});
 }
 
 HttpResponse Server::Impl::program_text(const HttpRequest& req, const Target& t) {
@@ -583,10 +641,12 @@ HttpResponse Server::Impl::program_text(const HttpRequest& req, const Target& t)
 
 void Server::Impl::preview(const std::shared_ptr<HttpSession>& s, const HttpRequest& req) {
   const auto open = controller.open_program();
-  if (!open || open->path.empty() || !source) return s->send(error_response(req, 404, "no program file is open"));
+  if (!open || open->path.empty() || !source)
+    return s->send(error_response(req, 404, "no program file is open"));
   std::error_code ec;
-  const std::string key = fmt::format("{}|{}|{}", open->path, std::filesystem::file_size(open->path, ec),
-                                      std::filesystem::last_write_time(open->path, ec).time_since_epoch().count());
+  const std::string key =
+      fmt::format("{}|{}|{}", open->path, std::filesystem::file_size(open->path, ec),
+                  std::filesystem::last_write_time(open->path, ec).time_since_epoch().count());
   {
     std::lock_guard lock(preview_mutex);
     if (key == preview_key && preview_body) return s->send(respond(req, http::status::ok, *preview_body));
@@ -624,15 +684,19 @@ HttpResponse Server::Impl::tools_table(const HttpRequest& req) {
   json list = json::array();
   if (const auto service = source ? source->tools() : nullptr) {
     for (const tools::ToolEntry& e : service->snapshot()->entries()) {
-      list.push_back({{"tool", e.tool}, {"pocket", e.pocket}, {"diameter", e.diameter},
-                      {"z_offset", e.offset[index(Axis::Z)]}, {"comment", e.comment}});
+      list.push_back({{"tool", e.tool},
+                      {"pocket", e.pocket},
+                      {"diameter", e.diameter},
+                      {"z_offset", e.offset[index(Axis::Z)]},
+                      {"comment", e.comment}});
     }
   }
   return json_response(req, 200, list);
 }
 
 HttpResponse Server::Impl::static_file(const HttpRequest& req, const Target& t) {
-  if (config.static_dir.empty()) return error_response(req, 404, "no front end is served (build it: scripts/hmi.sh)");
+  if (config.static_dir.empty())
+    return error_response(req, 404, "no front end is served (build it: scripts/hmi.sh)");
   std::string rel = t.path == "/" ? "index.html" : t.path.substr(1);
   const std::filesystem::path p(rel);
   for (const auto& part : p) {
@@ -649,11 +713,14 @@ HttpResponse Server::Impl::static_file(const HttpRequest& req, const Target& t) 
 
 // --- public ---------------------------------------------------------------------------------
 
-Server::Server(control::Controller& controller, const config::MachineProfile& profile, Tokens tokens, History* history,
-               const control::GcodeProgramSource* source, ServerConfig config)
-    : impl_(std::make_shared<Impl>(controller, profile, std::move(tokens), history, source, std::move(config))) {}
+Server::Server(control::Controller& controller, const config::MachineProfile& profile, Tokens tokens,
+               History* history, const control::GcodeProgramSource* source, ServerConfig config)
+    : impl_(std::make_shared<Impl>(controller, profile, std::move(tokens), history, source,
+                                   std::move(config))) {}
 
-Server::~Server() { stop(); }
+Server::~Server() {
+  stop();
+}
 
 bool Server::start(std::string* error) {
   Impl& s = *impl_;
@@ -664,45 +731,52 @@ bool Server::start(std::string* error) {
     return false;
   }
   const tcp::endpoint ep{address, s.config.port};
-  s.acceptor.open(ep.protocol(), ec);
-  if (!ec) s.acceptor.set_option(net::socket_base::reuse_address(true), ec);
-  if (!ec) s.acceptor.bind(ep, ec);
-  if (!ec) s.acceptor.listen(net::socket_base::max_listen_connections, ec);
+  s.acceptor->open(ep.protocol(), ec);
+  if (!ec) s.acceptor->set_option(net::socket_base::reuse_address(true), ec);
+  if (!ec) s.acceptor->bind(ep, ec);
+  if (!ec) s.acceptor->listen(net::socket_base::max_listen_connections, ec);
   if (ec) {
-    if (error) *error = fmt::format("cannot listen on {}:{}: {}", s.config.address, s.config.port, ec.message());
+    if (error)
+      *error = fmt::format("cannot listen on {}:{}: {}", s.config.address, s.config.port, ec.message());
     return false;
   }
-  s.port = s.acceptor.local_endpoint().port();
+  s.port = s.acceptor->local_endpoint().port();
   s.loopback = address.is_loopback();
   s.accept();
   net::post(s.ioc, [self = impl_] { self->stream_tick(); });
-  for (int k = 0; k < std::max(1, s.config.io_threads); ++k) s.threads.emplace_back([self = impl_] { self->ioc.run(); });
+  for (int k = 0; k < std::max(1, s.config.io_threads); ++k)
+    s.threads.emplace_back([self = impl_] { self->ioc.run(); });
   return true;
 }
 
 void Server::stop() {
   Impl& s = *impl_;
-  if (s.stopping.exchange(true)) return;
-  net::post(s.ioc, [self = impl_] {
-    beast::error_code ec;
-    self->acceptor.close(ec);
-    self->stream_timer.cancel();
-    std::lock_guard lock(self->sessions_mutex);
-    for (const auto& w : self->sessions) {
-      if (auto ws = w.lock()) net::post(ws->executor(), [ws] { ws->close(); });
-    }
-  });
-  // Pending HTTP reads end with their timeout at the latest; stop() does not wait for them.
+  if (s.stopping.exchange(true) || !s.ioc_owner) return;
   s.ioc.stop();
   for (std::thread& t : s.threads) {
     if (t.joinable()) t.join();
   }
-  s.workers.join();
+  s.workers.join();  // a preview being made finishes; its answer is dropped below
+  // No thread runs the io_context now: close the I/O objects, then destroy the io_context,
+  // which destroys every handler still queued and the sessions only they kept alive.
+  beast::error_code ec;
+  s.acceptor->close(ec);
+  s.acceptor.reset();
+  s.stream_timer.reset();
+  {
+    std::lock_guard lock(s.sessions_mutex);
+    s.sessions.clear();
+  }
+  s.ioc_owner.reset();
 }
 
-std::uint16_t Server::port() const { return impl_->port; }
+std::uint16_t Server::port() const {
+  return impl_->port;
+}
 
-bool Server::loopback_only() const { return impl_->loopback; }
+bool Server::loopback_only() const {
+  return impl_->loopback;
+}
 
 ServerStats Server::stats() const {
   ServerStats st;

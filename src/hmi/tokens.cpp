@@ -51,7 +51,8 @@ bool write_private(const std::filesystem::path& path, const std::string& content
   if (fd >= 0) ::close(fd);
   if (ok) ok = ::rename(tmp.c_str(), path.c_str()) == 0;
   if (!ok) {
-    if (error) *error = fmt::format("cannot write {}: {}", path.string(), std::strerror(saved ? saved : errno));
+    if (error)
+      *error = fmt::format("cannot write {}: {}", path.string(), std::strerror(saved ? saved : errno));
     ::unlink(tmp.c_str());
     return false;
   }
@@ -70,7 +71,9 @@ std::optional<Tokens> read_tokens(const std::filesystem::path& path, std::string
     return std::nullopt;
   }
   if ((st.st_mode & 077) != 0) {
-    if (error) *error = fmt::format("{}: others may read it (mode {:o}); chmod 600 it", path.string(), st.st_mode & 0777);
+    if (error)
+      *error =
+          fmt::format("{}: others may read it (mode {:o}); chmod 600 it", path.string(), st.st_mode & 0777);
     return std::nullopt;
   }
   std::string text;
@@ -85,13 +88,18 @@ std::optional<Tokens> read_tokens(const std::filesystem::path& path, std::string
     std::string role, token, extra;
     words >> role >> token >> extra;
     if (!extra.empty() || token.size() < kMinLength || (role != "operator" && role != "admin")) {
-      if (error) *error = fmt::format("{}:{}:1: expected \"operator TOKEN\" or \"admin TOKEN\" (16 characters or more)", path.string(), n);
+      if (error)
+        *error =
+            fmt::format("{}:{}:1: expected \"operator TOKEN\" or \"admin TOKEN\" (16 characters or more)",
+                        path.string(), n);
       return std::nullopt;
     }
     (role == "admin" ? admin : op) = token;
   }
   if (op.empty() || admin.empty() || op == admin) {
-    if (error) *error = fmt::format("{}: needs an operator and an admin token, different from each other", path.string());
+    if (error)
+      *error =
+          fmt::format("{}: needs an operator and an admin token, different from each other", path.string());
     return std::nullopt;
   }
   Tokens t = Tokens::of(op, admin);
@@ -119,8 +127,12 @@ std::optional<Tokens> Tokens::load(const std::filesystem::path& path, std::strin
   const char* op = std::getenv("OPENCNC_OPERATOR_TOKEN");
   const char* admin = std::getenv("OPENCNC_ADMIN_TOKEN");
   if (op || admin) {
-    if (!op || !admin || std::strlen(op) < kMinLength || std::strlen(admin) < kMinLength || std::strcmp(op, admin) == 0) {
-      if (error) *error = "OPENCNC_OPERATOR_TOKEN and OPENCNC_ADMIN_TOKEN must both be set, differ, and have 16 characters or more";
+    if (!op || !admin || std::strlen(op) < kMinLength || std::strlen(admin) < kMinLength ||
+        std::strcmp(op, admin) == 0) {
+      if (error)
+        *error =
+            "OPENCNC_OPERATOR_TOKEN and OPENCNC_ADMIN_TOKEN must both be set, differ, and have 16 characters "
+            "or more";
       return std::nullopt;
     }
     Tokens t = of(op, admin);
@@ -132,7 +144,8 @@ std::optional<Tokens> Tokens::load(const std::filesystem::path& path, std::strin
     const auto o = random_token(error);
     const auto a = o ? random_token(error) : std::nullopt;
     if (!a) return std::nullopt;
-    const std::string text = fmt::format("# opencnc serve: HMI tokens (keep this file private)\noperator {}\nadmin {}\n", *o, *a);
+    const std::string text =
+        fmt::format("# opencnc serve: HMI tokens (keep this file private)\noperator {}\nadmin {}\n", *o, *a);
     if (!write_private(path, text, error)) return std::nullopt;
   }
   auto t = read_tokens(path, error);

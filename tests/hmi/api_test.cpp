@@ -31,7 +31,8 @@ class ApiParse : public ::testing::Test {
 TEST_F(ApiParse, EachKindBecomesItsRequest) {
   EXPECT_EQ(request({{"kind", "cycle-start"}}).name(), "cycle-start");
   EXPECT_EQ(request({{"kind", "tool-changed"}}).name(), "tool-changed");
-  const auto jog = std::get<control::requests::Jog>(request({{"kind", "jog"}, {"axis", "y"}, {"velocity", -20}}).body);
+  const auto jog =
+      std::get<control::requests::Jog>(request({{"kind", "jog"}, {"axis", "y"}, {"velocity", -20}}).body);
   EXPECT_EQ(jog.axis, Axis::Y);
   EXPECT_EQ(jog.velocity, -20);
   const auto by = std::get<control::requests::JogBy>(
@@ -43,8 +44,10 @@ TEST_F(ApiParse, EachKindBecomesItsRequest) {
   EXPECT_EQ(request({{"kind", "switch"}, {"which", "single-block"}, {"on", true}}).name(), "single-block");
   EXPECT_EQ(std::get<control::requests::SetMode>(request({{"kind", "mode"}, {"mode", "mdi"}}).body).mode,
             control::Mode::Mdi);
-  EXPECT_EQ(std::get<control::requests::Mdi>(request({{"kind", "mdi"}, {"line", "G0 X1"}}).body).line, "G0 X1");
-  const auto open = std::get<control::requests::OpenFile>(request({{"kind", "open"}, {"program", "bracket.ngc"}}).body);
+  EXPECT_EQ(std::get<control::requests::Mdi>(request({{"kind", "mdi"}, {"line", "G0 X1"}}).body).line,
+            "G0 X1");
+  const auto open =
+      std::get<control::requests::OpenFile>(request({{"kind", "open"}, {"program", "bracket.ngc"}}).body);
   EXPECT_TRUE(open.path.ends_with("examples/bracket.ngc"));
   EXPECT_EQ(request({{"kind", "coolant"}, {"which", "mist"}, {"on", true}}).name(), "coolant");
   EXPECT_EQ(request({{"kind", "spindle-on"}, {"rpm", 1000}}).name(), "spindle-on");
@@ -56,9 +59,11 @@ TEST_F(ApiParse, MalformedBodiesAre400WithTheReason) {
   EXPECT_EQ(error({{"nokind", "x"}}).message, "\"kind\" is missing");
   EXPECT_EQ(error({{"kind", "fly"}}).message, "unknown command kind \"fly\" (docs/api.md lists them)");
   EXPECT_EQ(error({{"kind", "jog"}, {"axis", "X"}}).message, "\"velocity\" is missing");
-  EXPECT_EQ(error({{"kind", "jog"}, {"axis", "X"}, {"velocity", "fast"}}).message, "\"velocity\" must be a number");
+  EXPECT_EQ(error({{"kind", "jog"}, {"axis", "X"}, {"velocity", "fast"}}).message,
+            "\"velocity\" must be a number");
   EXPECT_EQ(error({{"kind", "jog"}, {"axis", "Q"}, {"velocity", 1}}).status, 400);
-  EXPECT_EQ(error({{"kind", "switch"}, {"which", "single-block"}, {"on", 1}}).message, "\"on\" must be true or false");
+  EXPECT_EQ(error({{"kind", "switch"}, {"which", "single-block"}, {"on", 1}}).message,
+            "\"on\" must be true or false");
   EXPECT_EQ(error({{"kind", "mode"}, {"mode", "turbo"}}).status, 400);
   EXPECT_EQ(error({{"kind", "mdi"}, {"line", "G0 X1\nG0 X2"}}).message, "\"line\" must be one line");
 }
@@ -71,7 +76,8 @@ TEST_F(ApiParse, OutOfRangeIs422) {
   EXPECT_EQ(error({{"kind", "jog"}, {"axis", "A"}, {"velocity", 1}}).message, "this machine has no A axis");
   EXPECT_EQ(error({{"kind", "jog-by"}, {"axis", "X"}, {"distance", 1}, {"speed", -1}}).status, 422);
   EXPECT_EQ(error({{"kind", "spindle-on"}, {"rpm", 1e9}}).status, 422);
-  EXPECT_EQ(error({{"kind", "handwheel"}, {"axis", "X"}, {"step", 0.01}}).message, "this machine has no handwheel");
+  EXPECT_EQ(error({{"kind", "handwheel"}, {"axis", "X"}, {"step", 0.01}}).message,
+            "this machine has no handwheel");
   EXPECT_EQ(error({{"kind", "set-tool"}, {"tool", 1.5}, {"diameter", 6}}).status, 422);
   EXPECT_EQ(error({{"kind", "mdi"}, {"line", std::string(300, 'G')}}).status, 422);
 }
@@ -85,7 +91,8 @@ TEST_F(ApiParse, ProgramsStayInsideTheirFolder) {
 
 TEST(ApiRoles, AdminOnlyForToolDataOperatorForTheRest) {
   EXPECT_EQ(role_for("set-tool"), Role::Admin);
-  for (const char* k : {"cycle-start", "feed-hold", "jog", "home", "open", "mdi", "tool-changed", "override"}) {
+  for (const char* k :
+       {"cycle-start", "feed-hold", "jog", "home", "open", "mdi", "tool-changed", "override"}) {
     EXPECT_EQ(role_for(k), Role::Operator) << k;
   }
   EXPECT_FALSE(role_for("fly"));

@@ -25,8 +25,8 @@ struct Reply {
 };
 
 /// One request on a connection of its own.
-inline Reply call(std::uint16_t port, http::verb method, const std::string& target, const std::string& token = "",
-                  const std::string& body = "") {
+inline Reply call(std::uint16_t port, http::verb method, const std::string& target,
+                  const std::string& token = "", const std::string& body = "") {
   net::io_context ioc;
   beast::tcp_stream stream(ioc);
   stream.connect(tcp::endpoint(net::ip::make_address("127.0.0.1"), port));

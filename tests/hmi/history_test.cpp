@@ -10,7 +10,8 @@ namespace opencnc::hmi {
 namespace {
 
 std::filesystem::path fresh_db(const char* name) {
-  const auto d = std::filesystem::temp_directory_path() / (std::string("opencnc-history-") + name + "-" + std::to_string(::getpid()));
+  const auto d = std::filesystem::temp_directory_path() /
+                 (std::string("opencnc-history-") + name + "-" + std::to_string(::getpid()));
   std::filesystem::remove_all(d);
   std::filesystem::create_directories(d);
   return d / "history.sqlite";

@@ -28,8 +28,8 @@ const std::string kAdmin = "admin-token-for-tests-000000002";
 /// The simulated mill in virtual time at 200× the wall clock, its history and the server.
 struct Rig {
   explicit Rig(ServerConfig sc = {}, const std::string& address = "127.0.0.1") {
-    dir = std::filesystem::temp_directory_path() / ("opencnc-serve-" + std::to_string(::getpid()) + "-" +
-                                                     std::to_string(counter++));
+    dir = std::filesystem::temp_directory_path() /
+          ("opencnc-serve-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
     std::filesystem::remove_all(dir);
     std::filesystem::create_directories(dir);
     std::filesystem::copy_file(OPENCNC_SOURCE_DIR "/configs/mill-3axis.tbl", dir / "tools.tbl");
@@ -44,8 +44,8 @@ struct Rig {
     sc.address = address;
     sc.port = 0;
     sc.programs_dir = OPENCNC_SOURCE_DIR "/examples";
-    server = std::make_unique<Server>(host->controller(), profile, Tokens::of(kOperator, kAdmin), history.get(),
-                                      source.get(), sc);
+    server = std::make_unique<Server>(host->controller(), profile, Tokens::of(kOperator, kAdmin),
+                                      history.get(), source.get(), sc);
     EXPECT_TRUE(server->start(&error)) << error;
     port = server->port();
   }
@@ -103,10 +103,12 @@ TEST(Server, BadRequestsGetA4xxWithAMessageAndChangeNothing) {
   EXPECT_EQ(unknown.body["error"], "unknown command kind \"fly\" (docs/api.md lists them)");
   EXPECT_EQ(post(rig.port, R"({"kind":"override","which":"feed","value":7})", kOperator).status, 422);
   EXPECT_EQ(get(rig.port, "/api/v1/status").body["feed_override"], 1.0);
-  EXPECT_EQ(post(rig.port, R"({"kind":"open","program":"../configs/mill-3axis.toml"})", kOperator).status, 400);
+  EXPECT_EQ(post(rig.port, R"({"kind":"open","program":"../configs/mill-3axis.toml"})", kOperator).status,
+            400);
   EXPECT_EQ(get(rig.port, "/api/v1/nothing", kOperator).status, 404);
   EXPECT_EQ(call(rig.port, http::verb::get, "/api/v1/commands", kOperator).status, 405);
-  EXPECT_EQ(call(rig.port, http::verb::post, "/api/v1/commands", kOperator, std::string(2 << 20, ' ')).status, 413);
+  EXPECT_EQ(call(rig.port, http::verb::post, "/api/v1/commands", kOperator, std::string(2 << 20, ' ')).status,
+            413);
   // Refused by the controller: a jog while the machine is off.
   const Reply off = post(rig.port, R"({"kind":"jog","axis":"X","velocity":5})", kOperator);
   EXPECT_EQ(off.status, 409);
@@ -154,7 +156,8 @@ TEST(Server, TheStreamSendsStatusAtItsRateAndEachClientItsEvents) {
     for (int k = 0; k < 200 && !answered; ++k) {
       const json m = s->next();
       if (m["type"] != "events") continue;
-      for (const json& e : m["events"]) answered = answered || (e["kind"] == "answer" && e["accepted"] == true);
+      for (const json& e : m["events"])
+        answered = answered || (e["kind"] == "answer" && e["accepted"] == true);
     }
     EXPECT_TRUE(answered);
   }
@@ -176,7 +179,7 @@ TEST(Server, AClientThatStopsReadingIsDroppedWithoutSlowingTheOthers) {
   const double waited_s = std::chrono::duration<double>(Clock::now() - start).count();
   EXPECT_EQ(rig.server->stats().dropped, 1u);
   EXPECT_GT(received, static_cast<int>(waited_s * 200 * 0.5));  // the reader kept its rate meanwhile
-  EXPECT_TRUE(stalled.read_until_closed(100000));  // what was sent before, then the close
+  EXPECT_TRUE(stalled.read_until_closed(100000));               // what was sent before, then the close
   EXPECT_FALSE(reader.read_until_closed(20));
 }
 
@@ -223,7 +226,8 @@ TEST(Server, AJobRunsToItsEndWithHoldAndResumeAndLandsInTheHistory) {
   EXPECT_GT(history[0]["machining_s"].get<double>(), 10);
   const json events = get(rig.port, "/api/v1/events?after=0", t).body;
   bool ended = false;
-  for (const json& e : events["events"]) ended = ended || (e["kind"] == "job-ended" && e["end"] == "finished");
+  for (const json& e : events["events"])
+    ended = ended || (e["kind"] == "job-ended" && e["end"] == "finished");
   EXPECT_TRUE(ended);
 }
 

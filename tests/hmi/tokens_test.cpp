@@ -14,7 +14,8 @@ namespace opencnc::hmi {
 namespace {
 
 std::filesystem::path fresh_dir(const char* name) {
-  const auto d = std::filesystem::temp_directory_path() / (std::string("opencnc-tokens-") + name + "-" + std::to_string(::getpid()));
+  const auto d = std::filesystem::temp_directory_path() /
+                 (std::string("opencnc-tokens-") + name + "-" + std::to_string(::getpid()));
   std::filesystem::remove_all(d);
   std::filesystem::create_directories(d);
   return d;

@@ -47,7 +47,8 @@ std::optional<Role> role_for(std::string_view kind);
 /// Turns a command body (`{"kind": …, …}`) into a request: every field checked for type and
 /// range against the machine (axes configured, speeds within the axis' maximum, overrides in
 /// their ranges, programs inside `programs_dir`). Any thread.
-std::variant<Command, ApiError> parse_command(const nlohmann::json& body, const config::MachineProfile& profile,
+std::variant<Command, ApiError> parse_command(const nlohmann::json& body,
+                                              const config::MachineProfile& profile,
                                               const std::filesystem::path& programs_dir);
 
 /// The status as the API sends it (docs/api.md, "Status"). Any thread.

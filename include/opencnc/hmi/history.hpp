@@ -25,8 +25,8 @@ namespace opencnc::hmi {
 struct JobRecord {
   std::int64_t id = 0;  ///< row number (0 before it is stored)
   std::uint32_t job_id = 0;
-  std::string kind;     ///< "program", "auxiliary"
-  std::string program;  ///< its name
+  std::string kind;                    ///< "program", "auxiliary"
+  std::string program;                 ///< its name
   std::string started_utc, ended_utc;  ///< ISO 8601, seconds
   std::string outcome;                 ///< "finished", "aborted", "error", "fault"
   double machining_s = 0;              ///< machine time from start to end
@@ -75,7 +75,7 @@ class History {
 
   sqlite3* db_;
   mutable std::mutex db_mutex_;  ///< the connection
-  std::mutex queue_mutex_;
+  mutable std::mutex queue_mutex_;
   std::condition_variable queue_cv_, idle_cv_;
   std::deque<std::variant<JobRecord, AuditRecord>> queue_;
   bool stop_ = false, busy_ = false;

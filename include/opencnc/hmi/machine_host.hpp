@@ -37,7 +37,8 @@ struct HostOptions {
 /// from any (its API is thread-safe).
 class MachineHost {
  public:
-  MachineHost(const config::MachineProfile& profile, std::shared_ptr<control::ProgramSource> source, HostOptions options);
+  MachineHost(const config::MachineProfile& profile, std::shared_ptr<control::ProgramSource> source,
+              HostOptions options);
   ~MachineHost();
   MachineHost(const MachineHost&) = delete;
   MachineHost& operator=(const MachineHost&) = delete;

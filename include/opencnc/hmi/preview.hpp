@@ -16,7 +16,7 @@ namespace opencnc::hmi {
 /// machine position `start`, at most `max_moves` moves, into
 /// `{"polylines": [{"rapid": bool, "points": [x, y, z, …]}], "moves": n, "truncated": bool,
 ///   "diagnostics": [...]}`. Non-real-time; any thread but the controller's (it may take a while).
-nlohmann::json program_preview(const control::GcodeProgramSource& source, const std::string& path, const Pose& start,
-                               std::size_t max_moves = 200000);
+nlohmann::json program_preview(const control::GcodeProgramSource& source, const std::string& path,
+                               const Pose& start, std::size_t max_moves = 200000);
 
 }  // namespace opencnc::hmi

@@ -23,8 +23,8 @@ namespace opencnc::hmi {
 class History;
 
 struct ServerConfig {
-  std::string address = "127.0.0.1";  ///< where to listen (IPv4 or IPv6 literal)
-  std::uint16_t port = 8080;          ///< 0: any free port (port() tells which)
+  std::string address = "127.0.0.1";   ///< where to listen (IPv4 or IPv6 literal)
+  std::uint16_t port = 8080;           ///< 0: any free port (port() tells which)
   std::filesystem::path programs_dir;  ///< `open` names programs relative to this folder
   std::filesystem::path static_dir;    ///< the built front end ("" or missing: none served)
   double stream_hz = 30;               ///< status messages per second on the WebSocket stream
@@ -36,9 +36,9 @@ struct ServerConfig {
 
 /// Counters of the server. Any thread.
 struct ServerStats {
-  std::size_t clients = 0;             ///< WebSocket clients connected now
-  std::uint64_t dropped = 0;           ///< clients dropped because they stopped reading
-  std::uint64_t status_messages = 0;   ///< status messages queued to clients so far
+  std::size_t clients = 0;            ///< WebSocket clients connected now
+  std::uint64_t dropped = 0;          ///< clients dropped because they stopped reading
+  std::uint64_t status_messages = 0;  ///< status messages queued to clients so far
   std::uint64_t http_requests = 0;
 };
 
@@ -47,8 +47,8 @@ class Server {
  public:
   /// `controller`, `history` (may be null) and `source` (may be null: no preview, no tool data)
   /// must outlive the server.
-  Server(control::Controller& controller, const config::MachineProfile& profile, Tokens tokens, History* history,
-         const control::GcodeProgramSource* source, ServerConfig config);
+  Server(control::Controller& controller, const config::MachineProfile& profile, Tokens tokens,
+         History* history, const control::GcodeProgramSource* source, ServerConfig config);
   ~Server();
   Server(const Server&) = delete;
   Server& operator=(const Server&) = delete;
