@@ -172,7 +172,8 @@ async function start() {
       const c = cells[a.axis];
       c[0].textContent = coord(s.machine[a.axis]);
       c[1].textContent = coord(s.commanded[a.axis]);
-      c[2].textContent = (s.following_error[a.axis] ?? 0).toFixed(4);
+      const fe = s.following_error[a.axis] ?? 0;
+      c[2].textContent = (Math.abs(fe) < 0.00005 ? 0 : fe).toFixed(4);
       c[3].textContent = s.homed[a.axis] ? "●" : "○";
     }
     progName.textContent = s.program.name ? `${s.program.name.split("/").pop()} — ${s.program.moves} moves, ${s.program.length_mm.toFixed(1)} mm` : "no program open";

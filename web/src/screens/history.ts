@@ -23,7 +23,7 @@ async function load(ctx: Context) {
     ...jobs.map((j) =>
       el("tr", { class: j.outcome },
         el("td", {}, `${j.id}`), el("td", {}, j.program.split("/").pop() ?? j.program), el("td", {}, j.started),
-        el("td", {}, j.ended), el("td", {}, j.outcome), el("td", {}, j.machining_s.toFixed(1)), el("td", {}, `${j.end_line}`),
+        el("td", {}, j.ended), el("td", {}, j.outcome), el("td", {}, j.machining_s.toFixed(1)), el("td", {}, j.end_line ? `${j.end_line}` : "—"),
         el("td", {}, j.alarms.join("; "))),
     ),
   );
