@@ -112,12 +112,12 @@ int serve(const ServeOptions& o) {
 
   const fs::path data = o.data_dir.empty() ? default_data_dir() : fs::path(o.data_dir);
   std::error_code ec;
-  fs::create_directories(data, ec);
-  if (ec) {
-    fmt::print(stderr, "error: --data {}: {}\n", data.string(), ec.message());
+  const bool created = fs::create_directories(data, ec);
+  if (ec || !fs::is_directory(data, ec)) {
+    fmt::print(stderr, "error: --data {}: {}\n", data.string(), ec ? ec.message() : "not a folder");
     return kExitUsage;
   }
-  ::chmod(data.c_str(), 0700);
+  if (created) ::chmod(data.c_str(), 0700);  // a folder of ours; one given that exists keeps its mode
   std::string error;
   const auto tokens = hmi::Tokens::load(data / "tokens", &error);
   if (!tokens) {
