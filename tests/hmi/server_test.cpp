@@ -231,5 +231,24 @@ TEST(Server, AJobRunsToItsEndWithHoldAndResumeAndLandsInTheHistory) {
   EXPECT_TRUE(ended);
 }
 
+TEST(MachineHost, InRealTimeTheServoTicksByItselfAndTheControllerAnswers) {
+  const config::MachineProfile profile = control::test::mill();
+  MachineHost host(profile, nullptr, HostOptions{true, 1});
+  ASSERT_TRUE(host.start(nullptr));  // SCHED_FIFO or, with a warning, a normal thread
+  const std::uint64_t id = host.controller().submit(control::Request::simple(control::CommandKind::MachineOn));
+  const auto end = Clock::now() + std::chrono::seconds(10);
+  while (!host.controller().outcome(id) && Clock::now() < end) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  ASSERT_TRUE(host.controller().outcome(id));
+  EXPECT_TRUE(host.controller().outcome(id)->accepted);
+  const std::uint64_t ticks = host.ticks();
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  EXPECT_GT(host.ticks(), ticks);
+  ASSERT_NE(host.latency(), nullptr);
+  host.stop();
+  const std::uint64_t stopped = host.ticks();
+  std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  EXPECT_EQ(host.ticks(), stopped);
+}
+
 }  // namespace
 }  // namespace opencnc::hmi
