@@ -179,7 +179,7 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
 
   std::mutex sessions_mutex;
   std::vector<std::weak_ptr<WsSession>> sessions;
-  std::atomic<std::uint64_t> dropped{0}, status_messages{0}, http_requests{0};
+  std::atomic<std::uint64_t> dropped{0}, stream_ticks{0}, status_messages{0}, http_requests{0};
 
   std::mutex preview_mutex;
   std::string preview_key;
@@ -367,6 +367,7 @@ void Server::Impl::accept() {
 // Every 1/stream_hz: the status once as JSON, handed to each client on its own executor.
 void Server::Impl::stream_tick() {
   if (stopping) return;
+  ++stream_ticks;
   auto status = std::make_shared<const std::string>(
       json{{"type", "status"}, {"status", status_json(controller.status(), profile)}}.dump());
   {
@@ -787,6 +788,7 @@ ServerStats Server::stats() const {
     }
   }
   st.dropped = impl_->dropped;
+  st.stream_ticks = impl_->stream_ticks;
   st.status_messages = impl_->status_messages;
   st.http_requests = impl_->http_requests;
   return st;

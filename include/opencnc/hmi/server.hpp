@@ -38,6 +38,7 @@ struct ServerConfig {
 struct ServerStats {
   std::size_t clients = 0;            ///< WebSocket clients connected now
   std::uint64_t dropped = 0;          ///< clients dropped because they stopped reading
+  std::uint64_t stream_ticks = 0;     ///< status snapshots made for the stream so far
   std::uint64_t status_messages = 0;  ///< status messages queued to clients so far
   std::uint64_t http_requests = 0;
 };
