@@ -12,7 +12,8 @@ packages=(
   libcli11-dev          # command line parsing
   nlohmann-json3-dev    # JSON reports and API
   libtomlplusplus-dev   # machine profiles
-  libsqlite3-dev        # the tool store: tools, edges, backups and audit (store::Database)
+  libboost-dev          # Boost.Beast (header-only): the HMI server's HTTP and WebSocket
+  libsqlite3-dev        # the tool store (store::Database) and the HMI's machining history and audit trail
   python3               # helper scripts (program generators, golden regeneration)
 )
 test_packages=(
@@ -21,6 +22,7 @@ test_packages=(
   libbenchmark-dev            # benchmarks
   clang libclang-rt-14-dev    # libFuzzer + sanitizer runtime for the fuzz target
   linuxcnc-uspace             # rs274 (oracle) and /usr/share/linuxcnc/ncfiles
+  chromium                    # the HMI's end-to-end tests (headless, driven by playwright-core)
 )
 
 usage() {
@@ -39,6 +41,9 @@ while (($#)); do
   esac
   shift
 done
+
+# The front end is built with Node.js and npm (scripts/hmi.sh): Debian's, unless the machine has them.
+if ! command -v npm >/dev/null 2>&1; then packages+=(nodejs npm); fi
 
 missing=()
 for p in "${packages[@]}"; do

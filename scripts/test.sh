@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: GPL-3.0-or-later
-# Installs what the tests need, builds with warnings as errors, runs the whole suite, runs it again
-# under ASan+UBSan, then the deterministic fuzz gate. This is what CI runs (.ci/run).
+# Installs what the tests need, builds with warnings as errors, runs the whole suite and the HMI's
+# front-end and end-to-end tests, runs the suite again under ASan+UBSan, then the deterministic fuzz
+# gate. This is what CI runs (.ci/run).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -9,10 +10,11 @@ usage() {
   cat <<'TXT'
 usage: scripts/test.sh [--quick]
   Installs the test packages (scripts/setup.sh --tests), builds with warnings as errors and runs the
-  suite; then builds and runs it again under ASan + UBSan; then the fuzz gate (scripts/fuzz.sh --gate:
+  suite; the HMI's front end (scripts/hmi.sh: npm ci, build, vitest, the end-to-end test in headless
+  Chromium, screenshots in web/e2e/artifacts); then builds and runs the suite again under ASan + UBSan; then the fuzz gate (scripts/fuzz.sh --gate:
   the committed corpus, the regression inputs and a fixed-seed run: the same commit always passes or
   always fails). OPENCNC_JOBS sets the build's parallel jobs (default 2).
-  --quick      only the normal build and suite (no sanitizers, no fuzzing)
+  --quick      only the normal build, the suite and the HMI's tests (no sanitizers, no fuzzing)
   -h, --help   this text
 TXT
 }
@@ -36,6 +38,8 @@ cmake --preset ci >/dev/null
 cmake --build --preset ci -j "$jobs"
 echo "== test suite"
 ctest --preset ci -j "$jobs"
+echo "== HMI front end: build, unit tests, end to end in headless Chromium"
+scripts/hmi.sh --test --e2e
 
 ((quick)) && exit 0
 

@@ -38,5 +38,6 @@ void add_plot_command(CLI::App& app, Registry& registry);
 void add_calibrate_command(CLI::App& app, Registry& registry);
 void add_tools_command(CLI::App& app, Registry& registry);  ///< the tool store and its guard
 void add_nearest_command(CLI::App& app, Registry& registry);
+void add_serve_command(CLI::App& app, Registry& registry);   ///< the HMI server
 
 }  // namespace opencnc::cli

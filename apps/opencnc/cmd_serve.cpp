@@ -1,0 +1,218 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// `opencnc serve`: the simulated machine with its controller, and the operator's HMI in the
+// browser (docs/hmi.md, docs/api.md), until Ctrl-C.
+#include <fmt/format.h>
+#include <sys/stat.h>
+#include <unistd.h>
+#include <CLI/CLI.hpp>
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <thread>
+
+#include "commands.hpp"
+#include "numeric_options.hpp"
+#include "opencnc/config/profile_loader.hpp"
+#include "opencnc/controller/gcode_source.hpp"
+#include "opencnc/hmi/history.hpp"
+#include "opencnc/hmi/machine_host.hpp"
+#include "opencnc/hmi/server.hpp"
+#include "opencnc/hmi/tokens.hpp"
+#include "stop_signals.hpp"
+
+namespace opencnc::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct ServeOptions {
+  std::string machine;
+  std::vector<std::string> sets;
+  std::string listen = "127.0.0.1:8080";
+  std::string program;
+  std::string programs_dir;
+  std::string data_dir;
+  std::string static_dir;
+  double speed = 0;  ///< 0: real time on a periodic thread; else paced virtual time
+  double stream_hz = 30;
+};
+
+/// `$XDG_STATE_HOME/opencnc`, else `~/.local/state/opencnc`.
+fs::path default_data_dir() {
+  if (const char* x = std::getenv("XDG_STATE_HOME"); x && *x) return fs::path(x) / "opencnc";
+  const char* home = std::getenv("HOME");
+  return fs::path(home && *home ? home : ".") / ".local" / "state" / "opencnc";
+}
+
+/// The built front end beside the executable: <build>/../web/dist.
+fs::path default_static_dir() {
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  return ec ? fs::path{} : exe.parent_path().parent_path() / "web" / "dist";
+}
+
+bool split_listen(const std::string& listen, std::string& address, std::uint16_t& port) {
+  const std::size_t colon = listen.rfind(':');
+  if (colon == std::string::npos || colon == 0) return false;
+  address = listen.substr(0, colon);
+  if (address.size() > 2 && address.front() == '[' && address.back() == ']')
+    address = address.substr(1, address.size() - 2);
+  try {
+    std::size_t used = 0;
+    const int p = std::stoi(listen.substr(colon + 1), &used);
+    if (used != listen.size() - colon - 1 || p < 0 || p > 65535) return false;
+    port = static_cast<std::uint16_t>(p);
+  } catch (const std::exception&) {
+    return false;
+  }
+  return true;
+}
+
+/// Puts the machine in Auto and opens `program`, waiting for the answers.
+bool open_program(control::Controller& c, const std::string& program) {
+  auto ask = [&c](control::Request r) {
+    const std::uint64_t id = c.submit(std::move(r));
+    for (int k = 0; k < 30000; ++k) {
+      if (auto o = c.outcome(id)) return *o;
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    return control::Outcome{false, control::Refusal::Busy, "the controller does not answer", {}};
+  };
+  for (auto r : {control::Request::simple(control::CommandKind::MachineOn),
+                 control::Request::set_mode(control::Mode::Auto), control::Request::open(program)}) {
+    const std::string name = r.name();
+    const control::Outcome o = ask(std::move(r));
+    for (const Diagnostic& d : o.diagnostics.items()) fmt::print(stderr, "{}\n", d.format());
+    if (!o.accepted && name == "open") {
+      fmt::print(stderr, "error: {}: {}\n", program, o.message);
+      return false;
+    }
+  }
+  return true;
+}
+
+int serve(const ServeOptions& o) {
+  std::string address;
+  std::uint16_t port = 0;
+  if (!split_listen(o.listen, address, port)) {
+    fmt::print(stderr, "error: --listen: expected ADDRESS:PORT (127.0.0.1:8080, [::1]:8080), not \"{}\"\n",
+               o.listen);
+    return kExitUsage;
+  }
+  const config::ProfileLoad load = config::load_profile(o.machine, o.sets);
+  for (const Diagnostic& d : load.diagnostics.items()) fmt::print(stderr, "{}\n", d.format());
+  if (!load.ok()) return kExitProgram;
+  const config::MachineProfile& profile = *load.profile;
+  Diagnostics diags;
+  auto source = control::GcodeProgramSource::create(profile, diags);
+  for (const Diagnostic& d : diags.items()) fmt::print(stderr, "{}\n", d.format());
+  if (!source) return kExitProgram;
+
+  const fs::path data = o.data_dir.empty() ? default_data_dir() : fs::path(o.data_dir);
+  std::error_code ec;
+  const bool created = fs::create_directories(data, ec);
+  if (ec || !fs::is_directory(data, ec)) {
+    fmt::print(stderr, "error: --data {}: {}\n", data.string(), ec ? ec.message() : "not a folder");
+    return kExitUsage;
+  }
+  if (created) ::chmod(data.c_str(), 0700);  // a folder of ours; one given that exists keeps its mode
+  std::string error;
+  const auto tokens = hmi::Tokens::load(data / "tokens", &error);
+  if (!tokens) {
+    fmt::print(stderr, "error: tokens: {}\n", error);
+    return kExitUsage;
+  }
+  auto history = hmi::History::open(data / "history.sqlite", &error);
+  if (!history) {
+    fmt::print(stderr, "error: history: {}\n", error);
+    return kExitUsage;
+  }
+
+  hmi::MachineHost host(profile, source, {o.speed == 0, o.speed == 0 ? 1.0 : o.speed});
+  host.controller().attach(std::make_shared<hmi::HistoryRecorder>(*history, profile.servo_period_s));
+  std::vector<std::string> warnings;
+  if (!host.start(&warnings)) {
+    fmt::print(stderr, "error: the servo thread could not start\n");
+    return kExitFailure;
+  }
+  for (const std::string& w : warnings) fmt::print(stderr, "warning: {}\n", w);
+
+  hmi::ServerConfig sc;
+  sc.address = address;
+  sc.port = port;
+  sc.programs_dir = !o.programs_dir.empty() ? fs::path(o.programs_dir)
+                    : !o.program.empty()    ? fs::absolute(o.program).parent_path()
+                                            : fs::current_path();
+  sc.static_dir = o.static_dir.empty() ? default_static_dir() : fs::path(o.static_dir);
+  if (!fs::exists(sc.static_dir / "index.html", ec)) {
+    fmt::print(stderr, "warning: no front end in {} (scripts/hmi.sh builds it): the API alone is served\n",
+               sc.static_dir.string());
+    sc.static_dir.clear();
+  }
+  sc.stream_hz = o.stream_hz;
+  hmi::Server server(host.controller(), profile, *tokens, history.get(), source.get(), sc);
+  if (!server.start(&error)) {
+    fmt::print(stderr, "error: {}\n", error);
+    return kExitUsage;
+  }
+  if (!o.program.empty() && !open_program(host.controller(), o.program)) return kExitProgram;
+
+  const std::string host_part =
+      address.find(':') != std::string::npos ? fmt::format("[{}]", address) : address;
+  fmt::print("opencnc serve: {} on the simulated machine ({})\n", profile.name,
+             o.speed == 0 ? "real time" : fmt::format("virtual time at {}x", o.speed));
+  fmt::print("  open      http://{}:{}/#token={}\n", host_part, server.port(), tokens->operator_token());
+  fmt::print("  operator  {}\n  admin     in {}\n  history   {}\n  Ctrl-C stops.\n", tokens->operator_token(),
+             tokens->origin(), (data / "history.sqlite").string());
+  std::fflush(stdout);
+
+  const StopSignals signals;
+  while (StopSignals::requested().load() == 0) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  fmt::print("\nopencnc serve: {}: stopping (a run in progress is aborted on the path)\n",
+             signal_name(StopSignals::requested().load()));
+  server.stop();
+  host.controller().submit(control::Request::simple(control::CommandKind::FeedHold));
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  host.controller().submit(control::Request::simple(control::CommandKind::Abort));
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  host.stop();
+  history->flush();
+  if (host.overruns() > 0) fmt::print("servo overruns: {} of {} periods\n", host.overruns(), host.ticks());
+  return kExitOk;
+}
+
+}  // namespace
+
+void add_serve_command(CLI::App& app, Registry& registry) {
+  auto opts = std::make_shared<ServeOptions>();
+  CLI::App* cmd =
+      app.add_subcommand("serve", "Run the simulated machine and serve the operator's HMI in the browser");
+  cmd->add_option("--machine,-m", opts->machine, "Machine profile, e.g. configs/mill-3axis.toml")->required();
+  cmd->add_option("--set", opts->sets, "Override a profile key (repeatable)")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  cmd->add_option(
+      "--listen", opts->listen,
+      "ADDRESS:PORT to listen on (default 127.0.0.1:8080; port 0: any free port; any other address "
+      "than loopback needs a token for every call)");
+  cmd->add_option("--program", opts->program, "A G-code program to open at start (Auto mode)");
+  cmd->add_option(
+      "--programs", opts->programs_dir,
+      "The folder programs are opened from (default: the --program's folder, else the current one)");
+  cmd->add_option(
+      "--data", opts->data_dir,
+      "Where the tokens and the history live (default $XDG_STATE_HOME/opencnc or ~/.local/state/opencnc)");
+  cmd->add_option("--static", opts->static_dir,
+                  "The built front end (default: web/dist beside the build folder)");
+  cmd->add_option("--speed", opts->speed,
+                  "Virtual time at this many machine seconds per second instead of a real-time servo thread")
+      ->check(finite_range(0.01, 1000));
+  cmd->add_option("--stream-hz", opts->stream_hz,
+                  "Status messages per second on the WebSocket stream (default 30)")
+      ->check(finite_range(1, 1000));
+  cmd->callback([opts, &registry] { registry.set_result(serve(*opts)); });
+}
+
+}  // namespace opencnc::cli

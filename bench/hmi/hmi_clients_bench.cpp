@@ -1,0 +1,193 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// hmi_clients_bench: the simulated mill with a real-time servo thread runs the bracket program
+// over and over while N WebSocket clients read the status stream (and S more connect and never
+// read); prints the servo's overruns and wake-up latency, what the clients received, and who was
+// dropped. Run it with --clients 0 for the baseline of the same machine.
+#include <sys/resource.h>
+
+#include <boost/asio/connect.hpp>
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/beast/core.hpp>
+#include <boost/beast/websocket.hpp>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "opencnc/config/profile_loader.hpp"
+#include "opencnc/controller/gcode_source.hpp"
+#include "opencnc/hmi/machine_host.hpp"
+#include "opencnc/hmi/server.hpp"
+
+namespace {
+
+namespace beast = boost::beast;
+namespace websocket = beast::websocket;
+namespace net = boost::asio;
+using tcp = net::ip::tcp;
+using namespace opencnc;
+
+const std::string kToken = "bench-operator-token-0123456789";
+
+/// One client: connects, then reads every message (or, stalled, never reads one).
+struct Client : std::enable_shared_from_this<Client> {
+  Client(net::io_context& ioc, bool stalled) : ws(ioc), stalled(stalled) {}
+  void start(std::uint16_t port, int receive_buffer) {
+    auto& s = beast::get_lowest_layer(ws).socket();
+    s.open(tcp::v4());
+    if (receive_buffer > 0) s.set_option(net::socket_base::receive_buffer_size(receive_buffer));
+    beast::get_lowest_layer(ws).async_connect(tcp::endpoint(net::ip::make_address("127.0.0.1"), port),
+                                              [self = shared_from_this()](beast::error_code ec) {
+                                                if (ec) return;
+                                                self->ws.async_handshake("127.0.0.1",
+                                                                         "/api/v1/stream?token=" + kToken,
+                                                                         [self](beast::error_code e) {
+                                                                           self->connected = !e;
+                                                                           if (!e && !self->stalled)
+                                                                             self->read();
+                                                                         });
+                                              });
+  }
+  void read() {
+    ws.async_read(buffer, [self = shared_from_this()](beast::error_code ec, std::size_t n) {
+      if (ec) {
+        self->closed = true;
+        return;
+      }
+      ++self->messages;
+      self->bytes += n;
+      self->buffer.consume(self->buffer.size());
+      self->read();
+    });
+  }
+  websocket::stream<beast::tcp_stream> ws;
+  beast::flat_buffer buffer;
+  bool stalled;
+  bool connected = false, closed = false;
+  std::uint64_t messages = 0, bytes = 0;
+};
+
+double cpu_s() {
+  rusage u{};
+  ::getrusage(RUSAGE_SELF, &u);
+  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+         (u.ru_utime.tv_usec + u.ru_stime.tv_usec) * 1e-6;
+}
+
+int usage() {
+  std::fprintf(
+      stderr,
+      "usage: hmi_clients_bench [--clients N (100)] [--stalled S (5)] [--seconds T (30)] [--hz R (30)]\n");
+  return 2;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int clients = 100, stalled = 5;
+  double seconds = 30, hz = 30;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "-h" || a == "--help") return usage(), 0;
+    if (i + 1 >= argc) return usage();
+    if (a == "--clients")
+      clients = std::atoi(argv[++i]);
+    else if (a == "--stalled")
+      stalled = std::atoi(argv[++i]);
+    else if (a == "--seconds")
+      seconds = std::atof(argv[++i]);
+    else if (a == "--hz")
+      hz = std::atof(argv[++i]);
+    else
+      return usage();
+  }
+  const auto load = config::load_profile(OPENCNC_SOURCE_DIR "/configs/mill-3axis.toml");
+  if (!load.ok()) return 1;
+  Diagnostics d;
+  auto source = control::GcodeProgramSource::create(*load.profile, d);
+  hmi::MachineHost host(*load.profile, source, {true, 1});
+  std::vector<std::string> warnings;
+  host.start(&warnings);
+  for (const auto& w : warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+  hmi::ServerConfig sc;
+  sc.port = 0;
+  sc.stream_hz = hz;
+  sc.programs_dir = OPENCNC_SOURCE_DIR "/examples";
+  hmi::Server server(host.controller(), *load.profile, hmi::Tokens::of(kToken, kToken + "-admin"), nullptr,
+                     source.get(), sc);
+  std::string error;
+  if (!server.start(&error)) return std::fprintf(stderr, "error: %s\n", error.c_str()), 1;
+
+  control::Controller& c = host.controller();
+  for (auto r : {control::Request::simple(control::CommandKind::MachineOn),
+                 control::Request::set_mode(control::Mode::Auto),
+                 control::Request::open(OPENCNC_SOURCE_DIR "/examples/bracket.ngc")}) {
+    const auto id = c.submit(std::move(r));
+    while (!c.outcome(id)) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  net::io_context ioc;
+  std::vector<std::shared_ptr<Client>> all;
+  for (int k = 0; k < clients + stalled; ++k) {
+    all.push_back(std::make_shared<Client>(ioc, k >= clients));
+    all.back()->start(server.port(), k >= clients ? 4096 : 0);
+  }
+  std::thread io([&ioc] {
+    auto guard = net::make_work_guard(ioc);
+    ioc.run();
+  });
+
+  // The operator: starts the program, confirms tool changes, starts it again when it ends.
+  const std::uint64_t ticks0 = host.ticks(), overruns0 = host.overruns();
+  const double cpu0 = cpu_s();
+  const auto t0 = std::chrono::steady_clock::now();
+  while (std::chrono::steady_clock::now() - t0 < std::chrono::duration<double>(seconds)) {
+    const auto s = c.status();
+    if (s.servo.state == control::State::Idle && !s.run_active)
+      c.submit(control::Request::simple(control::CommandKind::CycleStart));
+    if (s.servo.wait == control::Wait::ManualToolChange)
+      c.submit(control::Request::simple(control::CommandKind::ToolChanged));
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double cpu = cpu_s() - cpu0;
+  const std::uint64_t ticks = host.ticks() - ticks0, overruns = host.overruns() - overruns0;
+  const auto stats = server.stats();
+  const auto* lat = host.latency();
+  const auto finished = c.status().runs_finished;
+  ioc.stop();
+  io.join();
+  server.stop();
+  host.stop();
+
+  std::uint64_t min_msgs = UINT64_MAX, max_msgs = 0, sum = 0, bytes = 0;
+  int connected = 0, stalled_closed = 0;
+  for (int k = 0; k < clients + stalled; ++k) {
+    const Client& cl = *all[static_cast<std::size_t>(k)];
+    if (k >= clients) {
+      stalled_closed += cl.connected ? 1 : 0;
+      continue;
+    }
+    connected += cl.connected ? 1 : 0;
+    min_msgs = std::min(min_msgs, cl.messages);
+    max_msgs = std::max(max_msgs, cl.messages);
+    sum += cl.messages;
+    bytes += cl.bytes;
+  }
+  std::printf(
+      "servo: %llu periods in %.1f s, %llu overruns; wake-up latency p99 %.1f us, p99.9 %.1f us, max %.1f us "
+      "(SCHED_FIFO: %s)\n",
+      static_cast<unsigned long long>(ticks), wall, static_cast<unsigned long long>(overruns),
+      lat->percentile_ns(0.99) / 1e3, lat->percentile_ns(0.999) / 1e3, lat->max_ns() / 1e3,
+      warnings.empty() ? "yes" : "no");
+  std::printf("clients: %d of %d connected, messages per client %llu..%llu (mean %.1f/s), %.1f MB in all\n",
+              connected, clients, static_cast<unsigned long long>(clients ? min_msgs : 0),
+              static_cast<unsigned long long>(max_msgs),
+              clients ? static_cast<double>(sum) / clients / wall : 0.0, static_cast<double>(bytes) / 1e6);
+  std::printf("stalled clients: %d connected, %llu dropped by the server\n", stalled_closed,
+              static_cast<unsigned long long>(stats.dropped));
+  std::printf("programs finished: %llu; process CPU %.2f s (%.0f %% of one core)\n",
+              static_cast<unsigned long long>(finished), cpu, 100 * cpu / wall);
+  return 0;
+}

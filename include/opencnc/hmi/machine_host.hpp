@@ -1,0 +1,79 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// MachineHost — the controller and the servo on the simulated machine, running by themselves for
+// a server: the servo on a real-time periodic thread with the controller's loop on another, or
+// virtual time paced against the wall clock (tests, demonstrations at a multiple of real time).
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "opencnc/config/machine_profile.hpp"
+#include "opencnc/control/clock.hpp"
+#include "opencnc/controller/controller.hpp"
+
+namespace opencnc::control {
+class SimRig;
+class Servo;
+}  // namespace opencnc::control
+
+namespace opencnc::machine {
+class SimMachine;
+}
+
+namespace opencnc::hmi {
+
+struct HostOptions {
+  /// The servo on a real-time periodic thread (SCHED_FIFO where permitted). Otherwise virtual
+  /// time on one thread, `speed` machine seconds per wall-clock second.
+  bool realtime = true;
+  double speed = 1;
+};
+
+/// Runs a machine until stopped. start()/stop() from one non-real-time thread; controller()
+/// from any (its API is thread-safe).
+class MachineHost {
+ public:
+  MachineHost(const config::MachineProfile& profile, std::shared_ptr<control::ProgramSource> source,
+              HostOptions options);
+  ~MachineHost();
+  MachineHost(const MachineHost&) = delete;
+  MachineHost& operator=(const MachineHost&) = delete;
+
+  /// Starts the threads; false when none could be started. Warnings (no SCHED_FIFO, …) in
+  /// `*warnings`.
+  bool start(std::vector<std::string>* warnings);
+  /// Stops and joins the threads. Idempotent.
+  void stop();
+
+  control::Controller& controller() noexcept;
+  /// Servo periods run so far; periods whose tick finished after the next deadline (real time
+  /// only); the servo thread's wake-up latency (real time only, else null). Any thread.
+  std::uint64_t ticks() const noexcept;
+  std::uint64_t overruns() const noexcept;
+  const control::LatencyHistogram* latency() const noexcept;
+
+ private:
+  void run_paced();
+  void run_controller();
+
+  HostOptions options_;
+  double period_s_;
+  // Real time: the pieces of a rig, with the servo on the clock's thread.
+  std::unique_ptr<control::ServoChannels> channels_;
+  std::unique_ptr<machine::SimMachine> sim_;
+  std::unique_ptr<control::Servo> servo_;
+  std::unique_ptr<control::Controller> controller_;
+  std::unique_ptr<control::RealtimeClock> clock_;
+  // Paced virtual time.
+  std::unique_ptr<control::SimRig> rig_;
+  std::atomic<std::uint64_t> paced_ticks_{0};
+
+  std::atomic<bool> stop_{false};
+  std::thread thread_;  ///< the controller's loop (real time) or the paced rig
+};
+
+}  // namespace opencnc::hmi

@@ -1,0 +1,95 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The simulated machine and the controller running on their own threads for the server.
+#include "opencnc/hmi/machine_host.hpp"
+
+#include <chrono>
+
+#include "opencnc/control/servo.hpp"
+#include "opencnc/controller/servo_setup.hpp"
+#include "opencnc/controller/sim_rig.hpp"
+#include "opencnc/machine/sim_machine.hpp"
+
+namespace opencnc::hmi {
+
+MachineHost::MachineHost(const config::MachineProfile& profile,
+                         std::shared_ptr<control::ProgramSource> source, HostOptions options)
+    : options_(options), period_s_(profile.servo_period_s) {
+  if (options_.realtime) {
+    channels_ = std::make_unique<control::ServoChannels>();
+    sim_ = std::make_unique<machine::SimMachine>(config::sim_machine_config(profile));
+    servo_ = std::make_unique<control::Servo>(control::servo_config(profile), *channels_, *sim_);
+    controller_ = std::make_unique<control::Controller>(profile, *channels_, std::move(source));
+    clock_ = std::make_unique<control::RealtimeClock>(
+        control::RealtimeClock::Options{static_cast<std::int64_t>(profile.servo_period_s * 1e9 + 0.5)});
+  } else {
+    rig_ = std::make_unique<control::SimRig>(profile, std::move(source));
+  }
+}
+
+MachineHost::~MachineHost() {
+  stop();
+}
+
+bool MachineHost::start(std::vector<std::string>* warnings) {
+  if (options_.realtime) {
+    const bool ok = clock_->start(*servo_);
+    if (warnings) warnings->insert(warnings->end(), clock_->warnings().begin(), clock_->warnings().end());
+    if (!ok) return false;
+    thread_ = std::thread([this] { run_controller(); });
+  } else {
+    thread_ = std::thread([this] { run_paced(); });
+  }
+  return true;
+}
+
+void MachineHost::stop() {
+  stop_ = true;
+  if (thread_.joinable()) thread_.join();
+  if (clock_) clock_->stop();
+}
+
+control::Controller& MachineHost::controller() noexcept {
+  return rig_ ? rig_->controller() : *controller_;
+}
+
+std::uint64_t MachineHost::ticks() const noexcept {
+  return clock_ ? clock_->ticks() : paced_ticks_.load();
+}
+
+std::uint64_t MachineHost::overruns() const noexcept {
+  return clock_ ? clock_->overruns() : 0;
+}
+
+const control::LatencyHistogram* MachineHost::latency() const noexcept {
+  return clock_ ? &clock_->latency() : nullptr;
+}
+
+// The controller's loop beside the real-time servo: one service() per servo period (it reads
+// whatever the servo produced meanwhile, so a late service costs nothing but latency).
+void MachineHost::run_controller() {
+  const auto period = std::chrono::duration<double>(period_s_);
+  auto next = std::chrono::steady_clock::now();
+  while (!stop_.load(std::memory_order_relaxed)) {
+    controller_->service();
+    next += std::chrono::duration_cast<std::chrono::steady_clock::duration>(period);
+    const auto now = std::chrono::steady_clock::now();
+    if (next < now) next = now;  // behind: do not try to catch up in a burst
+    std::this_thread::sleep_until(next);
+  }
+}
+
+// Virtual time paced to `speed` × the wall clock: the rig steps until it is where the wall clock
+// says, then sleeps a millisecond. Deterministic in its steps, not in when requests arrive.
+void MachineHost::run_paced() {
+  const auto start = std::chrono::steady_clock::now();
+  std::uint64_t done = 0;
+  while (!stop_.load(std::memory_order_relaxed)) {
+    const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const auto due = static_cast<std::uint64_t>(wall_s * options_.speed / period_s_);
+    for (int k = 0; done < due && k < 20000; ++k, ++done) rig_->step();
+    paced_ticks_.store(done, std::memory_order_relaxed);
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+}
+
+}  // namespace opencnc::hmi

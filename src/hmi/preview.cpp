@@ -1,0 +1,95 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The toolpath of a program as polylines for the HMI's 3D view.
+#include "opencnc/hmi/preview.hpp"
+
+#include <cmath>
+#include <numbers>
+
+#include "opencnc/canon/program_builder.hpp"
+#include "opencnc/gcode/interpreter.hpp"
+
+namespace opencnc::hmi {
+
+namespace {
+
+using nlohmann::json;
+
+constexpr double kChordDeg = 5;  ///< an arc is drawn with a chord every this many degrees
+
+/// Appends the points of arc `id` after its start (chords every kChordDeg, the helix linear).
+void arc_points(const canon::Program& p, canon::SegmentId id, std::vector<double>& out) {
+  const canon::ArcGeometry& g = p.arc(id);
+  const Pose s = p.start_of(id), e = p.end(id);
+  const double c[3] = {g.center[0], g.center[1], g.center[2]};
+  const double n[3] = {g.normal[0], g.normal[1], g.normal[2]};
+  const double r0[3] = {s[0] - c[0], s[1] - c[1], s[2] - c[2]};
+  const double along0 = r0[0] * n[0] + r0[1] * n[1] + r0[2] * n[2];
+  const double u[3] = {r0[0] - along0 * n[0], r0[1] - along0 * n[1], r0[2] - along0 * n[2]};
+  const double v[3] = {n[1] * u[2] - n[2] * u[1], n[2] * u[0] - n[0] * u[2], n[0] * u[1] - n[1] * u[0]};
+  const double re[3] = {e[0] - c[0], e[1] - c[1], e[2] - c[2]};
+  const double radius2 = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
+  const double along_e = re[0] * n[0] + re[1] * n[1] + re[2] * n[2];
+  double sweep = radius2 > 0 ? std::atan2((re[0] * v[0] + re[1] * v[1] + re[2] * v[2]) / radius2,
+                                          (re[0] * u[0] + re[1] * u[1] + re[2] * u[2]) / radius2)
+                             : 0.0;
+  if (sweep <= 1e-9) sweep += 2 * std::numbers::pi;
+  sweep += 2 * std::numbers::pi * (std::abs(g.turns) - 1);
+  const int steps = std::max(1, static_cast<int>(std::ceil(sweep * 180 / std::numbers::pi / kChordDeg)));
+  for (int k = 1; k < steps; ++k) {
+    const double t = static_cast<double>(k) / steps, a = sweep * t;
+    const double along = along0 + (along_e - along0) * t;
+    for (int i = 0; i < 3; ++i) out.push_back(c[i] + u[i] * std::cos(a) + v[i] * std::sin(a) + n[i] * along);
+  }
+  for (int i = 0; i < 3; ++i) out.push_back(e[i]);
+}
+
+}  // namespace
+
+json program_preview(const control::GcodeProgramSource& source, const std::string& path, const Pose& start,
+                     std::size_t max_moves) {
+  gcode::Options options = source.options_for(path, {});
+  options.mode = gcode::Mode::Scan;
+  gcode::Interpreter interp(options);
+  canon::ProgramBuilder builder(kXyzabc, start);
+  json diags = json::array();
+  bool truncated = false;
+  if (interp.open(path)) {
+    for (;;) {
+      const gcode::RunStatus rs = interp.run(builder, 1000);
+      if (rs != gcode::RunStatus::Ok) break;
+      if (builder.program().size() >= max_moves) {
+        truncated = true;
+        break;
+      }
+    }
+  }
+  for (const Diagnostic& d : interp.diagnostics().items()) diags.push_back(d.format());
+  const canon::Program& p = builder.program();
+  json lines = json::array();
+  std::vector<double> pts;
+  bool rapid = false;
+  auto flush = [&] {
+    if (pts.size() > 3) lines.push_back({{"rapid", rapid}, {"points", pts}});
+    pts.assign(pts.end() - 3, pts.end());
+  };
+  const Pose s = p.start();
+  pts = {s[0], s[1], s[2]};
+  for (canon::SegmentId id = 0; id < p.size(); ++id) {
+    const canon::Move& m = p.move(id);
+    const bool r = m.kind == canon::MoveKind::Traverse;
+    if (r != rapid) {
+      flush();
+      rapid = r;
+    }
+    if (m.kind == canon::MoveKind::Arc) {
+      arc_points(p, id, pts);
+    } else {
+      const Pose e = p.end(id);
+      pts.insert(pts.end(), {e[0], e[1], e[2]});
+    }
+  }
+  flush();
+  return {{"polylines", lines}, {"moves", p.size()}, {"truncated", truncated}, {"diagnostics", diags}};
+}
+
+}  // namespace opencnc::hmi

@@ -1,0 +1,797 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The HMI server on Boost.Beast: HTTP sessions (the JSON API, the front end's files) and
+// WebSocket sessions (status at a steady rate, each client's own cursor on the event log).
+#include "opencnc/hmi/server.hpp"
+
+#include <atomic>
+#include <chrono>
+#include <fstream>
+#include <mutex>
+#include <sstream>
+#include <thread>
+#include <vector>
+
+#include <fmt/format.h>
+#include <boost/asio/dispatch.hpp>
+#include <boost/asio/post.hpp>
+#include <boost/asio/steady_timer.hpp>
+#include <boost/asio/strand.hpp>
+#include <boost/asio/thread_pool.hpp>
+#include <boost/beast/core.hpp>
+#include <boost/beast/http.hpp>
+#include <boost/beast/websocket.hpp>
+
+#include "opencnc/controller/gcode_source.hpp"
+#include "opencnc/hmi/api.hpp"
+#include "opencnc/hmi/history.hpp"
+#include "opencnc/hmi/preview.hpp"
+#include "opencnc/tools/tool_table_service.hpp"
+
+namespace opencnc::hmi {
+
+namespace beast = boost::beast;
+namespace http = beast::http;
+namespace websocket = beast::websocket;
+namespace net = boost::asio;
+using tcp = net::ip::tcp;
+using nlohmann::json;
+using HttpRequest = http::request<http::string_body>;
+using HttpResponse = http::response<http::string_body>;
+
+namespace {
+
+constexpr std::size_t kBodyLimit = 1 << 20;
+constexpr std::size_t kEventsPerMessage = 256;
+constexpr int kSendBufferBytes = 64 * 1024;  ///< small, so a client that stops reading shows soon
+
+/// The path and the decoded query parameters of a request target.
+struct Target {
+  std::string path;
+  std::map<std::string, std::string> query;
+};
+
+std::string_view sv(beast::string_view s) {
+  return {s.data(), s.size()};
+}
+
+std::string url_decode(std::string_view s) {
+  std::string out;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (s[i] == '+') {
+      out += ' ';
+    } else if (s[i] == '%' && i + 2 < s.size() && std::isxdigit(static_cast<unsigned char>(s[i + 1])) &&
+               std::isxdigit(static_cast<unsigned char>(s[i + 2]))) {
+      out += static_cast<char>(std::stoi(std::string(s.substr(i + 1, 2)), nullptr, 16));
+      i += 2;
+    } else {
+      out += s[i];
+    }
+  }
+  return out;
+}
+
+Target parse_target(std::string_view t) {
+  Target r;
+  const std::size_t q = t.find('?');
+  r.path = url_decode(t.substr(0, q));
+  if (q == std::string_view::npos) return r;
+  std::string_view rest = t.substr(q + 1);
+  while (!rest.empty()) {
+    const std::size_t amp = rest.find('&');
+    const std::string_view kv = rest.substr(0, amp);
+    const std::size_t eq = kv.find('=');
+    r.query[url_decode(kv.substr(0, eq))] = eq == std::string_view::npos ? "" : url_decode(kv.substr(eq + 1));
+    rest = amp == std::string_view::npos ? std::string_view{} : rest.substr(amp + 1);
+  }
+  return r;
+}
+
+std::string token_of(const HttpRequest& req, const Target& t) {
+  const auto auth = req[http::field::authorization];
+  if (sv(auth).starts_with("Bearer ")) return std::string(sv(auth).substr(7));
+  const auto it = t.query.find("token");
+  return it == t.query.end() ? "" : it->second;
+}
+
+HttpResponse respond(const HttpRequest& req, http::status status, std::string body,
+                     std::string_view type = "application/json") {
+  HttpResponse res{status, req.version()};
+  res.set(http::field::server, "opencnc");
+  res.set(http::field::content_type, beast::string_view(type.data(), type.size()));
+  res.set(http::field::cache_control, "no-store");
+  res.keep_alive(req.keep_alive());
+  res.body() = std::move(body);
+  res.prepare_payload();
+  return res;
+}
+
+HttpResponse json_response(const HttpRequest& req, int status, const json& j) {
+  return respond(req, static_cast<http::status>(status), j.dump());
+}
+
+HttpResponse error_response(const HttpRequest& req, int status, std::string message) {
+  HttpResponse res = json_response(req, status, {{"error", std::move(message)}});
+  if (status == 401) res.set(http::field::www_authenticate, "Bearer");
+  return res;
+}
+
+std::string_view mime_type(const std::filesystem::path& p) {
+  const std::string e = p.extension().string();
+  if (e == ".html") return "text/html; charset=utf-8";
+  if (e == ".js") return "text/javascript";
+  if (e == ".css") return "text/css";
+  if (e == ".svg") return "image/svg+xml";
+  if (e == ".png") return "image/png";
+  if (e == ".json" || e == ".map") return "application/json";
+  if (e == ".ico") return "image/x-icon";
+  return "application/octet-stream";
+}
+
+int query_int(const Target& t, const char* name, int fallback, int lo, int hi) {
+  const auto it = t.query.find(name);
+  if (it == t.query.end()) return fallback;
+  try {
+    return std::clamp(std::stoi(it->second), lo, hi);
+  } catch (const std::exception&) {
+    return fallback;
+  }
+}
+
+}  // namespace
+
+class HttpSession;
+class WsSession;
+
+struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
+  Impl(control::Controller& c, const config::MachineProfile& p, Tokens t, History* h,
+       const control::GcodeProgramSource* s, ServerConfig cfg)
+      : controller(c),
+        profile(p),
+        tokens(std::move(t)),
+        history(h),
+        source(s),
+        config(std::move(cfg)),
+        ioc_owner(std::make_unique<net::io_context>()),
+        ioc(*ioc_owner) {
+    acceptor.emplace(net::make_strand(ioc));
+    stream_timer.emplace(ioc);
+  }
+
+  control::Controller& controller;
+  config::MachineProfile profile;
+  Tokens tokens;
+  History* history;
+  const control::GcodeProgramSource* source;
+  ServerConfig config;
+
+  /// Destroyed by Server::stop() after its threads ended: that destroys the handlers still
+  /// queued, and with them the sessions they hold (they hold this Impl too, so it cannot own it).
+  std::unique_ptr<net::io_context> ioc_owner;
+  net::io_context& ioc;
+  std::optional<tcp::acceptor> acceptor;              ///< reset before the io_context goes
+  std::optional<net::steady_timer> stream_timer;      ///< reset before the io_context goes
+  std::chrono::steady_clock::time_point next_tick{};  ///< of the stream (the io thread)
+  net::thread_pool workers{1};                        ///< previews: the interpreter may take a while
+  std::vector<std::thread> threads;
+  bool loopback = true;
+  std::uint16_t port = 0;
+  std::atomic<bool> stopping{false};
+
+  std::mutex sessions_mutex;
+  std::vector<std::weak_ptr<WsSession>> sessions;
+  std::atomic<std::uint64_t> dropped{0}, stream_ticks{0}, status_messages{0}, http_requests{0};
+
+  std::mutex preview_mutex;
+  std::string preview_key;
+  std::shared_ptr<const std::string> preview_body;
+
+  void accept();
+  void stream_tick();
+  void handle(const std::shared_ptr<HttpSession>& s, HttpRequest req);
+  void upgrade(tcp::socket socket, HttpRequest req, std::string remote);
+  void audit(const std::string& remote, std::optional<Role> role, const HttpRequest& req, int status,
+             std::string result);
+
+  // Routes (docs/api.md).
+  void command(const std::shared_ptr<HttpSession>& s, const HttpRequest& req, Role role);
+  void wait_outcome(const std::shared_ptr<HttpSession>& s, HttpRequest req, std::uint64_t id,
+                    std::chrono::steady_clock::time_point deadline);
+  HttpResponse tool_change(const HttpRequest& req, const ToolChange& c);
+  HttpResponse get(const HttpRequest& req, const Target& t, Role role);
+  HttpResponse program_info(const HttpRequest& req);
+  HttpResponse program_text(const HttpRequest& req, const Target& t);
+  void preview(const std::shared_ptr<HttpSession>& s, const HttpRequest& req);
+  HttpResponse programs(const HttpRequest& req);
+  HttpResponse tools_table(const HttpRequest& req);
+  HttpResponse static_file(const HttpRequest& req, const Target& t);
+  std::string relative_program(const std::string& path) const;
+};
+
+/// One HTTP connection: reads requests one after the other, answers each (some answers come
+/// later: a command waits for the controller's answer on a timer, never blocking the thread).
+class HttpSession : public std::enable_shared_from_this<HttpSession> {
+ public:
+  HttpSession(tcp::socket socket, std::shared_ptr<Server::Impl> server)
+      : stream_(std::move(socket)), server_(std::move(server)) {
+    beast::error_code ec;
+    const auto ep = stream_.socket().remote_endpoint(ec);
+    remote_ = ec ? "?" : fmt::format("{}:{}", ep.address().to_string(), ep.port());
+  }
+  void run() {
+    net::dispatch(stream_.get_executor(), [self = shared_from_this()] { self->read(); });
+  }
+  /// Sends `res`, then reads the next request (or closes). The session's executor.
+  void send(HttpResponse res) {
+    auto sp = std::make_shared<HttpResponse>(std::move(res));
+    http::async_write(stream_, *sp, [self = shared_from_this(), sp](beast::error_code ec, std::size_t) {
+      if (ec) return;
+      if (sp->need_eof()) {
+        self->stream_.socket().shutdown(tcp::socket::shutdown_send, ec);
+        return;
+      }
+      self->read();
+    });
+  }
+  net::any_io_executor executor() { return stream_.get_executor(); }
+  const std::string& remote() const { return remote_; }
+
+ private:
+  void read() {
+    parser_.emplace();
+    parser_->body_limit(kBodyLimit);
+    stream_.expires_after(std::chrono::seconds(60));
+    http::async_read(stream_, buffer_, *parser_,
+                     [self = shared_from_this()](beast::error_code ec, std::size_t) { self->on_read(ec); });
+  }
+  void on_read(beast::error_code ec) {
+    if (ec == http::error::body_limit) {
+      HttpRequest req;
+      req.version(11);
+      req.keep_alive(false);
+      return send(error_response(req, 413, "the body is larger than 1 MiB"));
+    }
+    if (ec) return;  // closed, timed out, or garbage: nothing to answer
+    stream_.expires_never();
+    HttpRequest req = parser_->release();
+    if (websocket::is_upgrade(req)) {
+      return server_->upgrade(stream_.release_socket(), std::move(req), remote_);
+    }
+    server_->handle(shared_from_this(), std::move(req));
+  }
+
+  beast::tcp_stream stream_;
+  beast::flat_buffer buffer_;
+  std::optional<http::request_parser<http::string_body>> parser_;
+  std::shared_ptr<Server::Impl> server_;
+  std::string remote_;
+};
+
+/// One WebSocket client of the stream: status at the server's rate and the event log from its
+/// own cursor. Messages wait in a queue of its own; a client that lets it fill is dropped.
+class WsSession : public std::enable_shared_from_this<WsSession> {
+ public:
+  WsSession(tcp::socket socket, std::shared_ptr<Server::Impl> server)
+      : ws_(std::move(socket)), server_(std::move(server)), cursor_(server_->controller.events()) {}
+
+  void run(HttpRequest req) {
+    beast::error_code ec;
+    beast::get_lowest_layer(ws_).socket().set_option(net::socket_base::send_buffer_size(kSendBufferBytes),
+                                                     ec);
+    ws_.set_option(websocket::stream_base::timeout::suggested(beast::role_type::server));
+    ws_.async_accept(req, [self = shared_from_this()](beast::error_code e) {
+      if (e) return;
+      {
+        std::lock_guard lock(self->server_->sessions_mutex);
+        self->server_->sessions.push_back(self);
+      }
+      self->read();
+    });
+  }
+  /// Queues the status (and this client's new events). The session's executor.
+  void deliver(const std::shared_ptr<const std::string>& status) {
+    if (closed_) return;
+    queue_.push_back(status);
+    ++server_->status_messages;
+    std::vector<control::ControllerEvent> events = cursor_.next(kEventsPerMessage);
+    if (!events.empty() || cursor_.lost() != reported_lost_) {
+      json list = json::array();
+      for (const auto& e : events) list.push_back(event_json(e));
+      reported_lost_ = cursor_.lost();
+      queue_.push_back(std::make_shared<const std::string>(
+          json{{"type", "events"}, {"events", list}, {"lost", cursor_.lost()}}.dump()));
+    }
+    if (queue_.size() > server_->config.max_queued) return drop();
+    if (!writing_) write();
+  }
+  void close() {
+    beast::error_code ec;
+    closed_ = true;
+    beast::get_lowest_layer(ws_).socket().close(ec);
+  }
+  bool closed() const { return closed_; }
+  net::any_io_executor executor() { return ws_.get_executor(); }
+
+ private:
+  void drop() {
+    ++server_->dropped;
+    queue_.clear();
+    close();
+  }
+  void write() {
+    writing_ = true;
+    ws_.text(true);
+    ws_.async_write(net::buffer(*queue_.front()),
+                    [self = shared_from_this()](beast::error_code ec, std::size_t) {
+                      self->writing_ = false;
+                      if (ec) {
+                        self->closed_ = true;
+                        return;
+                      }
+                      if (!self->queue_.empty()) self->queue_.pop_front();
+                      if (!self->queue_.empty() && !self->closed_) self->write();
+                    });
+  }
+  /// Reads (and ignores) what the client sends, to see it close.
+  void read() {
+    ws_.async_read(in_, [self = shared_from_this()](beast::error_code ec, std::size_t) {
+      if (ec) {
+        self->closed_ = true;
+        return;
+      }
+      self->in_.consume(self->in_.size());
+      self->read();
+    });
+  }
+
+  websocket::stream<beast::tcp_stream> ws_;
+  std::shared_ptr<Server::Impl> server_;
+  control::EventCursor cursor_;
+  std::uint64_t reported_lost_ = 0;
+  std::deque<std::shared_ptr<const std::string>> queue_;
+  beast::flat_buffer in_;
+  bool writing_ = false;
+  std::atomic<bool> closed_{false};  ///< read by the stream tick and stats() on other threads
+};
+
+// --- the server -----------------------------------------------------------------------------
+
+void Server::Impl::accept() {
+  acceptor->async_accept(net::make_strand(ioc),
+                         [self = shared_from_this()](beast::error_code ec, tcp::socket socket) {
+                           if (self->stopping) return;
+                           if (!ec) std::make_shared<HttpSession>(std::move(socket), self)->run();
+                           self->accept();
+                         });
+}
+
+// Every 1/stream_hz: the status once as JSON, handed to each client on its own executor.
+void Server::Impl::stream_tick() {
+  if (stopping) return;
+  ++stream_ticks;
+  auto status = std::make_shared<const std::string>(
+      json{{"type", "status"}, {"status", status_json(controller.status(), profile)}}.dump());
+  {
+    std::lock_guard lock(sessions_mutex);
+    std::erase_if(sessions, [](const std::weak_ptr<WsSession>& w) {
+      const auto s = w.lock();
+      return !s || s->closed();
+    });
+    for (const auto& w : sessions) {
+      if (auto s = w.lock()) net::post(s->executor(), [s, status] { s->deliver(status); });
+    }
+  }
+  // A fixed schedule (not "a period after this one's work"), so the rate holds; a tick that
+  // came too late is not made up with a burst.
+  const auto period = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+      std::chrono::duration<double>(1.0 / config.stream_hz));
+  const auto now = std::chrono::steady_clock::now();
+  next_tick = next_tick.time_since_epoch().count() == 0 || next_tick + period < now ? now + period
+                                                                                    : next_tick + period;
+  stream_timer->expires_at(next_tick);
+  stream_timer->async_wait([self = shared_from_this()](beast::error_code ec) {
+    if (!ec) self->stream_tick();
+  });
+}
+
+void Server::Impl::upgrade(tcp::socket socket, HttpRequest req, std::string remote) {
+  const Target t = parse_target(sv(req.target()));
+  const std::optional<Role> role = tokens.role_of(token_of(req, t));
+  if (t.path != "/api/v1/stream" || !role) {
+    const int status = t.path != "/api/v1/stream" ? 404 : 401;
+    if (status == 401) audit(remote, role, req, 401, "no valid token");
+    auto s = std::make_shared<HttpSession>(std::move(socket), shared_from_this());
+    HttpResponse res =
+        error_response(req, status, status == 404 ? "no such stream" : "a valid token is needed");
+    res.keep_alive(false);
+    return s->send(std::move(res));
+  }
+  std::make_shared<WsSession>(std::move(socket), shared_from_this())->run(std::move(req));
+}
+
+void Server::Impl::audit(const std::string& remote, std::optional<Role> role, const HttpRequest& req,
+                         int status, std::string result) {
+  if (!history) return;
+  history->add(
+      AuditRecord{0, utc_now(), role ? to_string(*role) : "", remote,
+                  fmt::format("{} {}", std::string(req.method_string()), parse_target(sv(req.target())).path),
+                  req.body(), status, std::move(result)});
+}
+
+void Server::Impl::handle(const std::shared_ptr<HttpSession>& s, HttpRequest req) {
+  ++http_requests;
+  const Target t = parse_target(sv(req.target()));
+  if (!t.path.starts_with("/api/")) {
+    if (req.method() != http::verb::get && req.method() != http::verb::head) {
+      return s->send(error_response(req, 405, "only GET here"));
+    }
+    return s->send(static_file(req, t));
+  }
+  if (!t.path.starts_with("/api/v1/"))
+    return s->send(error_response(req, 404, "this server speaks /api/v1/"));
+  const std::optional<Role> role = tokens.role_of(token_of(req, t));
+  const bool is_get = req.method() == http::verb::get;
+  if (!role && !(is_get && t.path == "/api/v1/status" && loopback)) {
+    if (!is_get) audit(s->remote(), role, req, 401, "no valid token");
+    return s->send(error_response(req, 401, "a valid token is needed (Authorization: Bearer TOKEN)"));
+  }
+  if (t.path == "/api/v1/commands") {
+    if (req.method() != http::verb::post) return s->send(error_response(req, 405, "commands are POSTed"));
+    return command(s, req, *role);
+  }
+  if (!is_get) return s->send(error_response(req, 405, "only GET here"));
+  if (t.path == "/api/v1/program/preview") return preview(s, req);
+  s->send(get(req, t, role.value_or(Role::Operator)));
+}
+
+HttpResponse Server::Impl::get(const HttpRequest& req, const Target& t, Role role) {
+  const std::string& p = t.path;
+  if (p == "/api/v1/status") return json_response(req, 200, status_json(controller.status(), profile));
+  if (p == "/api/v1/machine") return json_response(req, 200, machine_json(profile));
+  if (p == "/api/v1/program") return program_info(req);
+  if (p == "/api/v1/program/text") return program_text(req, t);
+  if (p == "/api/v1/programs") return programs(req);
+  if (p == "/api/v1/tools") return tools_table(req);
+  if (p == "/api/v1/events") {
+    const auto after = static_cast<std::uint64_t>(query_int(t, "after", 0, 0, INT32_MAX));
+    const auto max = static_cast<std::size_t>(query_int(t, "max", 1000, 1, 4096));
+    std::uint64_t lost = 0;
+    json list = json::array();
+    for (const auto& e : controller.events().read_after(after, max, &lost)) list.push_back(event_json(e));
+    return json_response(req, 200, {{"events", list}, {"lost", lost}, {"last", controller.events().last()}});
+  }
+  if (p.starts_with("/api/v1/commands/")) {
+    std::uint64_t id = 0;
+    try {
+      id = std::stoull(p.substr(17));
+    } catch (const std::exception&) {
+      return error_response(req, 400, "a command id is a number");
+    }
+    if (const auto o = controller.outcome(id)) return json_response(req, 200, outcome_json(id, *o));
+    return error_response(req, 404, fmt::format("no answer to command {} (yet)", id));
+  }
+  if (p == "/api/v1/history") {
+    if (!history) return json_response(req, 200, json::array());
+    json list = json::array();
+    for (const JobRecord& r : history->jobs(query_int(t, "limit", 50, 1, 1000))) {
+      list.push_back({{"id", r.id},
+                      {"job_id", r.job_id},
+                      {"kind", r.kind},
+                      {"program", r.program},
+                      {"started", r.started_utc},
+                      {"ended", r.ended_utc},
+                      {"outcome", r.outcome},
+                      {"machining_s", r.machining_s},
+                      {"end_line", r.end_line},
+                      {"alarms", r.alarms}});
+    }
+    return json_response(req, 200, list);
+  }
+  if (p == "/api/v1/audit") {
+    if (role != Role::Admin) return error_response(req, 403, "the audit trail is for the admin");
+    json list = json::array();
+    if (history) {
+      for (const AuditRecord& r : history->audit(query_int(t, "limit", 100, 1, 1000))) {
+        list.push_back({{"id", r.id},
+                        {"time", r.time_utc},
+                        {"role", r.role},
+                        {"remote", r.remote},
+                        {"action", r.action},
+                        {"body", r.body},
+                        {"status", r.status},
+                        {"result", r.result}});
+      }
+    }
+    return json_response(req, 200, list);
+  }
+  if (p == "/api/v1/server") {
+    std::size_t clients = 0;
+    {
+      std::lock_guard lock(sessions_mutex);
+      clients = sessions.size();
+    }
+    return json_response(req, 200,
+                         {{"address", config.address},
+                          {"port", port},
+                          {"loopback_only", loopback},
+                          {"stream_hz", config.stream_hz},
+                          {"clients", clients},
+                          {"dropped", dropped.load()},
+                          {"tokens", tokens.origin()},
+                          {"role", to_string(role)},
+                          {"programs", config.programs_dir.string()}});
+  }
+  return error_response(req, 404, fmt::format("no such call: GET {}", p));
+}
+
+void Server::Impl::command(const std::shared_ptr<HttpSession>& s, const HttpRequest& req, Role role) {
+  json body;
+  try {
+    body = json::parse(req.body());
+  } catch (const json::parse_error& e) {
+    audit(s->remote(), role, req, 400, "malformed JSON");
+    return s->send(error_response(req, 400, fmt::format("the body is not JSON: {}", e.what())));
+  }
+  const std::optional<Role> needed = body.is_object() && body.contains("kind") && body["kind"].is_string()
+                                         ? role_for(body["kind"].get<std::string>())
+                                         : std::nullopt;
+  if (needed == Role::Admin && role != Role::Admin) {
+    audit(s->remote(), role, req, 403, "needs the admin role");
+    return s->send(error_response(req, 403, "this command needs the admin token"));
+  }
+  auto parsed = parse_command(body, profile, config.programs_dir);
+  if (const auto* e = std::get_if<ApiError>(&parsed)) {
+    audit(s->remote(), role, req, e->status, e->message);
+    return s->send(error_response(req, e->status, e->message));
+  }
+  auto& c = std::get<Command>(parsed);
+  if (const auto* t = std::get_if<ToolChange>(&c)) {
+    HttpResponse res = tool_change(req, *t);
+    audit(s->remote(), role, req, static_cast<int>(res.result_int()), res.body());
+    return s->send(std::move(res));
+  }
+  const std::uint64_t id = controller.submit(std::move(std::get<control::Request>(c)));
+  const auto deadline =
+      std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                             std::chrono::duration<double>(config.command_timeout_s));
+  wait_outcome(s, req, id, deadline);
+}
+
+// Polls the controller for the answer every 2 ms on a timer of the session's executor: the
+// thread serves the other clients meanwhile.
+void Server::Impl::wait_outcome(const std::shared_ptr<HttpSession>& s, HttpRequest req, std::uint64_t id,
+                                std::chrono::steady_clock::time_point deadline) {
+  const std::optional<Role> role = tokens.role_of(token_of(req, parse_target(sv(req.target()))));
+  if (const auto o = controller.outcome(id)) {
+    const int status = o->accepted ? 200 : 409;
+    audit(s->remote(), role, req, status,
+          o->accepted ? "accepted" : fmt::format("{}: {}", control::refusal_code(o->refusal), o->message));
+    return s->send(json_response(req, status, outcome_json(id, *o)));
+  }
+  if (std::chrono::steady_clock::now() >= deadline || stopping) {
+    audit(s->remote(), role, req, 202, fmt::format("queued as {}, no answer yet", id));
+    return s->send(json_response(req, 202, {{"id", id}, {"pending", true}}));
+  }
+  auto timer = std::make_shared<net::steady_timer>(s->executor(), std::chrono::milliseconds(2));
+  timer->async_wait([self = shared_from_this(), s, timer, req = std::move(req), id, deadline](
+                        beast::error_code) mutable { self->wait_outcome(s, std::move(req), id, deadline); });
+}
+
+HttpResponse Server::Impl::tool_change(const HttpRequest& req, const ToolChange& c) {
+  const auto service = source ? source->tools() : nullptr;
+  if (!service) return error_response(req, 409, "this machine has no tool table");
+  const auto table = service->snapshot();
+  const auto slot = table->find(c.tool);
+  if (!slot) return error_response(req, 404, fmt::format("no tool T{} in the table", c.tool));
+  tools::ToolEntry e = table->at_index(*slot);
+  if (c.diameter_mm) e.diameter = *c.diameter_mm;
+  if (c.z_offset_mm) e.offset[index(Axis::Z)] = *c.z_offset_mm;
+  if (!c.comment.empty()) e.comment = c.comment;
+  Diagnostics diags;
+  if (!service->update(*slot, e, tools::ChangeSource::Operator, diags)) {
+    std::string why;
+    for (const Diagnostic& d : diags.items()) why += (why.empty() ? "" : "; ") + d.format();
+    return error_response(req, 409, why.empty() ? "the tool table refused the change" : why);
+  }
+  return json_response(req, 200,
+                       {{"accepted", true},
+                        {"tool", c.tool},
+                        {"diameter", e.diameter},
+                        {"z_offset", e.offset[index(Axis::Z)]}});
+}
+
+std::string Server::Impl::relative_program(const std::string& path) const {
+  std::error_code ec;
+  const auto rel =
+      std::filesystem::relative(path, std::filesystem::weakly_canonical(config.programs_dir, ec), ec);
+  return ec || rel.empty() || rel.string().starts_with("..") ? std::filesystem::path(path).filename().string()
+                                                             : rel.string();
+}
+
+HttpResponse Server::Impl::program_info(const HttpRequest& req) {
+  const auto open = controller.open_program();
+  if (!open) return json_response(req, 200, {{"open", false}});
+  const control::PreflightSummary& s = open->preflight.summary;
+  json warnings = json::array();
+  for (const Diagnostic& d : open->preflight.diagnostics.items()) warnings.push_back(d.format());
+  return json_response(req, 200,
+                       {{"open", true},
+                        {"name", open->name},
+                        {"program", relative_program(open->path)},
+                        {"moves", s.moves},
+                        {"length_mm", s.path_length_mm},
+                        {"warnings", warnings},
+                        {"min", {s.min[0], s.min[1], s.min[2]}},
+                        {"max", {s.max[0], s.max[1], s.max[2]}}});
+}
+
+HttpResponse Server::Impl::program_text(const HttpRequest& req, const Target& t) {
+  const auto open = controller.open_program();
+  if (!open || open->path.empty()) return error_response(req, 404, "no program file is open");
+  const int from = query_int(t, "from", 1, 1, INT32_MAX);
+  const int count = query_int(t, "count", 500, 1, 5000);
+  std::ifstream in(open->path);
+  if (!in) return error_response(req, 404, "the open program cannot be read");
+  json lines = json::array();
+  std::string line;
+  int n = 0;
+  while (std::getline(in, line) && n < from + count - 1) {
+    if (++n >= from) lines.push_back(line.size() > 400 ? line.substr(0, 400) : line);
+  }
+  return json_response(req, 200, {{"from", from}, {"lines", lines}});
+}
+
+void Server::Impl::preview(const std::shared_ptr<HttpSession>& s, const HttpRequest& req) {
+  const auto open = controller.open_program();
+  if (!open || open->path.empty() || !source)
+    return s->send(error_response(req, 404, "no program file is open"));
+  std::error_code ec;
+  const std::string key =
+      fmt::format("{}|{}|{}", open->path, std::filesystem::file_size(open->path, ec),
+                  std::filesystem::last_write_time(open->path, ec).time_since_epoch().count());
+  {
+    std::lock_guard lock(preview_mutex);
+    if (key == preview_key && preview_body) return s->send(respond(req, http::status::ok, *preview_body));
+  }
+  const Pose start = controller.status().servo.commanded;
+  net::post(workers, [self = shared_from_this(), s, req, key, path = open->path, start] {
+    auto body = std::make_shared<const std::string>(program_preview(*self->source, path, start).dump());
+    {
+      std::lock_guard lock(self->preview_mutex);
+      self->preview_key = key;
+      self->preview_body = body;
+    }
+    net::post(s->executor(), [s, req, body] { s->send(respond(req, http::status::ok, *body)); });
+  });
+}
+
+HttpResponse Server::Impl::programs(const HttpRequest& req) {
+  json list = json::array();
+  std::error_code ec;
+  std::vector<std::string> names;
+  for (const auto& e : std::filesystem::directory_iterator(config.programs_dir, ec)) {
+    const std::string ext = e.path().extension().string();
+    if (e.is_regular_file(ec) && (ext == ".ngc" || ext == ".nc" || ext == ".tap" || ext == ".gcode")) {
+      names.push_back(e.path().filename().string());
+    }
+  }
+  std::sort(names.begin(), names.end());
+  for (const std::string& n : names) {
+    list.push_back({{"name", n}, {"bytes", std::filesystem::file_size(config.programs_dir / n, ec)}});
+  }
+  return json_response(req, 200, list);
+}
+
+HttpResponse Server::Impl::tools_table(const HttpRequest& req) {
+  json list = json::array();
+  if (const auto service = source ? source->tools() : nullptr) {
+    for (const tools::ToolEntry& e : service->snapshot()->entries()) {
+      list.push_back({{"tool", e.tool},
+                      {"pocket", e.pocket},
+                      {"diameter", e.diameter},
+                      {"z_offset", e.offset[index(Axis::Z)]},
+                      {"comment", e.comment}});
+    }
+  }
+  return json_response(req, 200, list);
+}
+
+HttpResponse Server::Impl::static_file(const HttpRequest& req, const Target& t) {
+  if (config.static_dir.empty())
+    return error_response(req, 404, "no front end is served (build it: scripts/hmi.sh)");
+  std::string rel = t.path == "/" ? "index.html" : t.path.substr(1);
+  const std::filesystem::path p(rel);
+  for (const auto& part : p) {
+    if (part == ".." || part.string().starts_with(".")) return error_response(req, 404, "no such file");
+  }
+  std::ifstream in(config.static_dir / p, std::ios::binary);
+  if (!in) return error_response(req, 404, fmt::format("no such file: {}", t.path));
+  std::ostringstream body;
+  body << in.rdbuf();
+  HttpResponse res = respond(req, http::status::ok, body.str(), mime_type(p));
+  if (t.path.starts_with("/assets/")) res.set(http::field::cache_control, "max-age=31536000, immutable");
+  return res;
+}
+
+// --- public ---------------------------------------------------------------------------------
+
+Server::Server(control::Controller& controller, const config::MachineProfile& profile, Tokens tokens,
+               History* history, const control::GcodeProgramSource* source, ServerConfig config)
+    : impl_(std::make_shared<Impl>(controller, profile, std::move(tokens), history, source,
+                                   std::move(config))) {}
+
+Server::~Server() {
+  stop();
+}
+
+bool Server::start(std::string* error) {
+  Impl& s = *impl_;
+  beast::error_code ec;
+  const auto address = net::ip::make_address(s.config.address, ec);
+  if (ec) {
+    if (error) *error = fmt::format("--listen: \"{}\" is not an IP address", s.config.address);
+    return false;
+  }
+  const tcp::endpoint ep{address, s.config.port};
+  s.acceptor->open(ep.protocol(), ec);
+  if (!ec) s.acceptor->set_option(net::socket_base::reuse_address(true), ec);
+  if (!ec) s.acceptor->bind(ep, ec);
+  if (!ec) s.acceptor->listen(net::socket_base::max_listen_connections, ec);
+  if (ec) {
+    if (error)
+      *error = fmt::format("cannot listen on {}:{}: {}", s.config.address, s.config.port, ec.message());
+    return false;
+  }
+  s.port = s.acceptor->local_endpoint().port();
+  s.loopback = address.is_loopback();
+  s.accept();
+  net::post(s.ioc, [self = impl_] { self->stream_tick(); });
+  for (int k = 0; k < std::max(1, s.config.io_threads); ++k)
+    s.threads.emplace_back([self = impl_] { self->ioc.run(); });
+  return true;
+}
+
+void Server::stop() {
+  Impl& s = *impl_;
+  if (s.stopping.exchange(true) || !s.ioc_owner) return;
+  s.ioc.stop();
+  for (std::thread& t : s.threads) {
+    if (t.joinable()) t.join();
+  }
+  s.workers.join();  // a preview being made finishes; its answer is dropped below
+  // No thread runs the io_context now: close the I/O objects, then destroy the io_context,
+  // which destroys every handler still queued and the sessions only they kept alive.
+  beast::error_code ec;
+  s.acceptor->close(ec);
+  s.acceptor.reset();
+  s.stream_timer.reset();
+  {
+    std::lock_guard lock(s.sessions_mutex);
+    s.sessions.clear();
+  }
+  s.ioc_owner.reset();
+}
+
+std::uint16_t Server::port() const {
+  return impl_->port;
+}
+
+bool Server::loopback_only() const {
+  return impl_->loopback;
+}
+
+ServerStats Server::stats() const {
+  ServerStats st;
+  {
+    std::lock_guard lock(impl_->sessions_mutex);
+    for (const auto& w : impl_->sessions) {
+      if (const auto s = w.lock(); s && !s->closed()) ++st.clients;
+    }
+  }
+  st.dropped = impl_->dropped;
+  st.stream_ticks = impl_->stream_ticks;
+  st.status_messages = impl_->status_messages;
+  st.http_requests = impl_->http_requests;
+  return st;
+}
+
+}  // namespace opencnc::hmi

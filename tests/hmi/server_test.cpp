@@ -1,0 +1,259 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The HMI server on loopback with a real client: every call, the refusals (401, 403, 4xx with a
+// message, 409 from the controller) changing nothing, the stream's rate and events, a client
+// that stops reading dropped while another goes on, and a job run to its history entry.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <thread>
+
+#include "../control/test_profiles.hpp"
+#include "client.hpp"
+#include "opencnc/controller/gcode_source.hpp"
+#include "opencnc/hmi/history.hpp"
+#include "opencnc/hmi/machine_host.hpp"
+#include "opencnc/hmi/server.hpp"
+
+namespace opencnc::hmi {
+namespace {
+
+using namespace test;
+using nlohmann::json;
+using Clock = std::chrono::steady_clock;
+
+const std::string kOperator = "operator-token-for-tests-0001";
+const std::string kAdmin = "admin-token-for-tests-000000002";
+
+/// The simulated mill in virtual time at 200× the wall clock, its history and the server.
+struct Rig {
+  explicit Rig(ServerConfig sc = {}, const std::string& address = "127.0.0.1") {
+    dir = std::filesystem::temp_directory_path() /
+          ("opencnc-serve-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    std::filesystem::copy_file(OPENCNC_SOURCE_DIR "/configs/mill-3axis.tbl", dir / "tools.tbl");
+    profile = control::test::mill({"interpreter.tool_table=\"" + (dir / "tools.tbl").string() + "\""});
+    Diagnostics d;
+    source = control::GcodeProgramSource::create(profile, d);
+    std::string error;
+    history = History::open(dir / "history.sqlite", &error);
+    host = std::make_unique<MachineHost>(profile, source, HostOptions{false, 200});
+    host->controller().attach(std::make_shared<HistoryRecorder>(*history, profile.servo_period_s));
+    host->start(nullptr);
+    sc.address = address;
+    sc.port = 0;
+    sc.programs_dir = OPENCNC_SOURCE_DIR "/examples";
+    server = std::make_unique<Server>(host->controller(), profile, Tokens::of(kOperator, kAdmin),
+                                      history.get(), source.get(), sc);
+    EXPECT_TRUE(server->start(&error)) << error;
+    port = server->port();
+  }
+  ~Rig() {
+    server->stop();
+    host->stop();
+    std::filesystem::remove_all(dir);
+  }
+  /// Polls the status until `done` holds (at most `seconds` of wall time).
+  bool until(const std::function<bool(const json&)>& done, double seconds = 20) {
+    const auto end = Clock::now() + std::chrono::duration<double>(seconds);
+    while (Clock::now() < end) {
+      if (done(get(port, "/api/v1/status", kOperator).body)) return true;
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    return false;
+  }
+
+  static inline int counter = 0;
+  std::filesystem::path dir;
+  config::MachineProfile profile;
+  std::shared_ptr<control::GcodeProgramSource> source;
+  std::unique_ptr<History> history;
+  std::unique_ptr<MachineHost> host;
+  std::unique_ptr<Server> server;
+  std::uint16_t port = 0;
+};
+
+TEST(Server, StatusIsOpenOnLoopbackEverythingElseNeedsAToken) {
+  Rig rig;
+  const Reply s = get(rig.port, "/api/v1/status");
+  EXPECT_EQ(s.status, 200);
+  EXPECT_EQ(s.body["mode"], "manual");
+  EXPECT_EQ(get(rig.port, "/api/v1/machine").status, 401);
+  EXPECT_EQ(get(rig.port, "/api/v1/machine", "wrong-token-wrong-token").status, 401);
+  const Reply refused = post(rig.port, R"({"kind":"machine-on"})", "");
+  EXPECT_EQ(refused.status, 401);
+  EXPECT_EQ(refused.body["error"], "a valid token is needed (Authorization: Bearer TOKEN)");
+  EXPECT_EQ(get(rig.port, "/api/v1/status").body["state"], "off");  // nothing changed
+  EXPECT_EQ(get(rig.port, "/api/v1/machine", kOperator).body["axes"].size(), 3u);
+}
+
+TEST(Server, OnAnyOtherAddressTheStatusNeedsATokenToo) {
+  Rig rig({}, "0.0.0.0");
+  EXPECT_FALSE(rig.server->loopback_only());
+  EXPECT_EQ(get(rig.port, "/api/v1/status").status, 401);
+  EXPECT_EQ(get(rig.port, "/api/v1/status", kOperator).status, 200);
+}
+
+TEST(Server, BadRequestsGetA4xxWithAMessageAndChangeNothing) {
+  Rig rig;
+  EXPECT_EQ(post(rig.port, "{not json", kOperator).status, 400);
+  const Reply unknown = post(rig.port, R"({"kind":"fly"})", kOperator);
+  EXPECT_EQ(unknown.status, 400);
+  EXPECT_EQ(unknown.body["error"], "unknown command kind \"fly\" (docs/api.md lists them)");
+  EXPECT_EQ(post(rig.port, R"({"kind":"override","which":"feed","value":7})", kOperator).status, 422);
+  EXPECT_EQ(get(rig.port, "/api/v1/status").body["feed_override"], 1.0);
+  EXPECT_EQ(post(rig.port, R"({"kind":"open","program":"../configs/mill-3axis.toml"})", kOperator).status,
+            400);
+  EXPECT_EQ(get(rig.port, "/api/v1/nothing", kOperator).status, 404);
+  EXPECT_EQ(call(rig.port, http::verb::get, "/api/v1/commands", kOperator).status, 405);
+  EXPECT_EQ(call(rig.port, http::verb::post, "/api/v1/commands", kOperator, std::string(2 << 20, ' ')).status,
+            413);
+  // Refused by the controller: a jog while the machine is off.
+  const Reply off = post(rig.port, R"({"kind":"jog","axis":"X","velocity":5})", kOperator);
+  EXPECT_EQ(off.status, 409);
+  EXPECT_EQ(off.body["code"], "control.machine-off");
+  EXPECT_EQ(get(rig.port, "/api/v1/commands/" + off.body["id"].dump(), kOperator).body["accepted"], false);
+}
+
+TEST(Server, ToolDataIsTheAdminsAndEveryChangeIsAudited) {
+  Rig rig;
+  const std::string change = R"({"kind":"set-tool","tool":1,"diameter":6.02})";
+  EXPECT_EQ(post(rig.port, change, kOperator).status, 403);
+  EXPECT_EQ(get(rig.port, "/api/v1/tools", kOperator).body[0]["diameter"], 6.0);
+  const Reply ok = post(rig.port, change, kAdmin);
+  EXPECT_EQ(ok.status, 200) << ok.text;
+  EXPECT_EQ(get(rig.port, "/api/v1/tools", kOperator).body[0]["diameter"], 6.02);
+  EXPECT_EQ(post(rig.port, R"({"kind":"set-tool","tool":77,"diameter":1})", kAdmin).status, 404);
+  EXPECT_EQ(get(rig.port, "/api/v1/audit", kOperator).status, 403);
+  rig.history->flush();
+  const json audit = get(rig.port, "/api/v1/audit", kAdmin).body;
+  ASSERT_GE(audit.size(), 3u);
+  EXPECT_EQ(audit[1]["role"], "admin");
+  EXPECT_EQ(audit[1]["status"], 200);
+  EXPECT_EQ(audit[2]["role"], "operator");
+  EXPECT_EQ(audit[2]["status"], 403);
+  EXPECT_FALSE(audit[2]["time"].get<std::string>().empty());
+}
+
+TEST(Server, TheStreamSendsStatusAtItsRateAndEachClientItsEvents) {
+  ServerConfig sc;
+  sc.stream_hz = 30;
+  Rig rig(sc);
+  Stream a(rig.port, kOperator);
+  EXPECT_THROW(Stream(rig.port, "not-a-token-at-all-0000"), beast::system_error);
+  const auto start = Clock::now();
+  int status = 0;
+  while (Clock::now() - start < std::chrono::milliseconds(500)) {
+    if (a.next()["type"] == "status") ++status;
+  }
+  EXPECT_GE(status, 8);  // 15 at 30 Hz in 0.5 s; a loaded machine (or a sanitizer build) loses some
+  EXPECT_LE(status, 17);
+  Stream b(rig.port, kOperator);
+  EXPECT_EQ(post(rig.port, R"({"kind":"machine-on"})", kOperator).status, 200);
+  for (Stream* s : {&a, &b}) {  // both see the answer: their cursors are their own
+    bool answered = false;
+    for (int k = 0; k < 200 && !answered; ++k) {
+      const json m = s->next();
+      if (m["type"] != "events") continue;
+      for (const json& e : m["events"])
+        answered = answered || (e["kind"] == "answer" && e["accepted"] == true);
+    }
+    EXPECT_TRUE(answered);
+  }
+}
+
+TEST(Server, AClientThatStopsReadingIsDroppedWithoutSlowingTheOthers) {
+  ServerConfig sc;
+  sc.stream_hz = 200;
+  sc.max_queued = 8;
+  Rig rig(sc);
+  Stream stalled(rig.port, kOperator, 4096);  // connects, then never reads
+  Stream reader(rig.port, kOperator);
+  // The reader gets every status the stream makes while the stalled client fills its queue,
+  // whatever rate this machine (or a sanitizer build) reaches: nobody waits for the stalled one.
+  const std::uint64_t ticks0 = rig.server->stats().stream_ticks;
+  const auto start = Clock::now();
+  std::uint64_t statuses = 0;
+  while (rig.server->stats().dropped == 0 && Clock::now() - start < std::chrono::seconds(20)) {
+    if (reader.next()["type"] == "status") ++statuses;
+  }
+  const std::uint64_t made = rig.server->stats().stream_ticks - ticks0;
+  EXPECT_EQ(rig.server->stats().dropped, 1u);
+  EXPECT_GT(made, 8u);
+  EXPECT_GE(statuses + 10, made);                  // at most its own queue (8) and one tick behind
+  EXPECT_TRUE(stalled.read_until_closed(100000));  // what was sent before, then the close
+  EXPECT_FALSE(reader.read_until_closed(20));
+}
+
+TEST(Server, AJobRunsToItsEndWithHoldAndResumeAndLandsInTheHistory) {
+  Rig rig;
+  const std::string& t = kOperator;
+  EXPECT_EQ(post(rig.port, R"({"kind":"machine-on"})", t).status, 200);
+  EXPECT_EQ(post(rig.port, R"({"kind":"home"})", t).status, 200);
+  EXPECT_EQ(post(rig.port, R"({"kind":"mode","mode":"auto"})", t).status, 200);
+  const json programs = get(rig.port, "/api/v1/programs", t).body;
+  EXPECT_EQ(programs[0]["name"], "bracket.ngc");
+  const Reply open = post(rig.port, R"({"kind":"open","program":"bracket.ngc"})", t);
+  ASSERT_EQ(open.status, 200) << open.text;
+  const json info = get(rig.port, "/api/v1/program", t).body;
+  EXPECT_EQ(info["program"], "bracket.ngc");
+  EXPECT_GT(info["moves"].get<int>(), 100);
+  const json preview = get(rig.port, "/api/v1/program/preview", t).body;
+  EXPECT_GT(preview["polylines"].size(), 2u);
+  EXPECT_EQ(get(rig.port, "/api/v1/program/text?from=4&count=1", t).body["lines"][0],
+            "G21 G17 G40 G49 G80 G90 G94");
+  EXPECT_EQ(post(rig.port, R"({"kind":"cycle-start"})", t).status, 200);
+  ASSERT_TRUE(rig.until([](const json& s) { return s["wait"] == "manual-tool-change"; }));
+  EXPECT_EQ(post(rig.port, R"({"kind":"tool-changed"})", t).status, 200);
+  ASSERT_TRUE(rig.until([](const json& s) { return s["job"]["progress"].get<double>() > 0.2; }));
+  EXPECT_EQ(post(rig.port, R"({"kind":"feed-hold"})", t).status, 200);
+  ASSERT_TRUE(rig.until([](const json& s) { return s["state"] == "held" && s["path_velocity"] == 0.0; }));
+  const json held = get(rig.port, "/api/v1/status", t).body;
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  EXPECT_EQ(get(rig.port, "/api/v1/status", t).body["commanded"], held["commanded"]);  // it stands
+  EXPECT_EQ(post(rig.port, R"({"kind":"resume"})", t).status, 200);
+  ASSERT_TRUE(rig.until([&](const json& s) { return s["commanded"] != held["commanded"]; }));
+  // On to the end, the operator confirming the second tool (T2) when asked.
+  ASSERT_TRUE(rig.until(
+      [&](const json& s) {
+        if (s["wait"] == "manual-tool-change") post(rig.port, R"({"kind":"tool-changed"})", t);
+        return s["runs_finished"] == 1 && s["state"] == "idle";
+      },
+      60));
+  rig.history->flush();
+  const json history = get(rig.port, "/api/v1/history", t).body;
+  ASSERT_EQ(history.size(), 1u);
+  EXPECT_EQ(history[0]["outcome"], "finished");
+  EXPECT_TRUE(history[0]["program"].get<std::string>().ends_with("examples/bracket.ngc"));
+  EXPECT_GT(history[0]["machining_s"].get<double>(), 10);
+  const json events = get(rig.port, "/api/v1/events?after=0", t).body;
+  bool ended = false;
+  for (const json& e : events["events"])
+    ended = ended || (e["kind"] == "job-ended" && e["end"] == "finished");
+  EXPECT_TRUE(ended);
+}
+
+TEST(MachineHost, InRealTimeTheServoTicksByItselfAndTheControllerAnswers) {
+  const config::MachineProfile profile = control::test::mill();
+  MachineHost host(profile, nullptr, HostOptions{true, 1});
+  ASSERT_TRUE(host.start(nullptr));  // SCHED_FIFO or, with a warning, a normal thread
+  const std::uint64_t id =
+      host.controller().submit(control::Request::simple(control::CommandKind::MachineOn));
+  const auto end = Clock::now() + std::chrono::seconds(10);
+  while (!host.controller().outcome(id) && Clock::now() < end)
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  ASSERT_TRUE(host.controller().outcome(id));
+  EXPECT_TRUE(host.controller().outcome(id)->accepted);
+  const std::uint64_t ticks = host.ticks();
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  EXPECT_GT(host.ticks(), ticks);
+  ASSERT_NE(host.latency(), nullptr);
+  host.stop();
+  const std::uint64_t stopped = host.ticks();
+  std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  EXPECT_EQ(host.ticks(), stopped);
+}
+
+}  // namespace
+}  // namespace opencnc::hmi

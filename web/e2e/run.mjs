@@ -1,0 +1,140 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// End-to-end test of the HMI in headless Chromium (Debian's, driven by playwright-core): starts
+// `opencnc serve` on the simulated mill (virtual time at 30x), then with the mouse alone: machine
+// on, home, open the bracket program, run it, confirm the tool changes, hold and resume, see the
+// position change, run to the end, find the job in the history. Screenshots land in the
+// artefacts folder. Usage: node e2e/run.mjs [--opencnc PATH] [--out DIR]
+import { spawn } from "node:child_process";
+import { mkdtempSync, mkdirSync, rmSync } from "node:fs";
+import { tmpdir } from "node:os";
+import { dirname, join, resolve } from "node:path";
+import { fileURLToPath } from "node:url";
+import { chromium } from "playwright-core";
+
+const here = dirname(fileURLToPath(import.meta.url));
+const repo = resolve(here, "..", "..");
+const args = process.argv.slice(2);
+const opt = (name, fallback) => {
+  const i = args.indexOf(name);
+  return i >= 0 ? args[i + 1] : fallback;
+};
+if (args.includes("--help") || args.includes("-h")) {
+  console.log("usage: node e2e/run.mjs [--opencnc build/opencnc] [--out web/e2e/artifacts]");
+  process.exit(0);
+}
+for (let i = 0; i < args.length; i += 2) {
+  if (!["--opencnc", "--out"].includes(args[i])) {
+    console.error(`e2e: unknown option '${args[i]}'`);
+    process.exit(2);
+  }
+}
+const opencnc = resolve(opt("--opencnc", join(repo, "build", "opencnc")));
+const out = resolve(opt("--out", join(here, "artifacts")));
+mkdirSync(out, { recursive: true });
+const data = mkdtempSync(join(tmpdir(), "opencnc-e2e-"));
+
+const server = spawn(opencnc, ["serve", "--machine", join(repo, "configs/mill-3axis.toml"), "--listen", "127.0.0.1:0",
+  "--programs", join(repo, "examples"), "--data", data, "--static", join(repo, "web/dist"), "--speed", "30"], {
+  env: { ...process.env, OPENCNC_OPERATOR_TOKEN: "e2e-operator-token-0123456789", OPENCNC_ADMIN_TOKEN: "e2e-admin-token-0123456789" },
+  stdio: ["ignore", "pipe", "inherit"],
+});
+const url = await new Promise((ok, fail) => {
+  let text = "";
+  server.stdout.on("data", (d) => {
+    text += d;
+    const m = /open\s+(http:\S+)/.exec(text);
+    if (m) ok(m[1]);
+  });
+  server.on("exit", (code) => fail(new Error(`opencnc serve exited with ${code}`)));
+  setTimeout(() => fail(new Error("opencnc serve printed no URL in 20 s")), 20000);
+});
+
+const browser = await chromium.launch({
+  executablePath: "/usr/bin/chromium",
+  args: ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run", "--disable-background-networking",
+    "--disable-component-update", "--disable-sync", "--use-angle=swiftshader", "--enable-unsafe-swiftshader"],
+});
+let failed = false;
+const page = await browser.newPage({ viewport: { width: 1400, height: 900 } });
+page.on("pageerror", (e) => console.error(`page error: ${e.message}`));
+const step = (what) => console.log(`e2e: ${what}`);
+const shot = (name) => page.screenshot({ path: join(out, `${name}.png`) });
+const text = (id) => page.getByTestId(id).innerText();
+const waitFor = async (what, check, ms = 30000) => {
+  const end = Date.now() + ms;
+  while (Date.now() < end) {
+    if (await check()) return;
+    await page.waitForTimeout(50);
+  }
+  throw new Error(`timed out waiting for ${what}`);
+};
+// The dialog's button with this label, clicked when it is there.
+const answer = async (label) => {
+  const b = page.getByTestId("dialog").getByRole("button", { name: label });
+  if (await b.isVisible()) await b.click();
+};
+
+try {
+  await page.goto(url);
+  await waitFor("the status", async () => (await text("state")).length > 0);
+  step("machine on");
+  await page.click("#machine-on");
+  await waitFor("idle", async () => (await text("state")).startsWith("idle"));
+  step("home all");
+  await page.getByTestId("key-jog").click();
+  await page.getByTestId("home-all").click();
+  await waitFor("homed", async () => (await page.locator("table.dro td").allInnerTexts()).filter((t) => t === "●").length === 3);
+  await shot("01-homed");
+  step("open the bracket program");
+  await page.getByTestId("key-file").click();
+  await page.getByTestId("programs").selectOption("bracket.ngc");
+  await page.getByTestId("open").click();
+  await waitFor("the program", async () => (await page.locator(".progname").innerText()).startsWith("bracket.ngc"));
+  await page.waitForTimeout(500);  // the preview
+  await shot("02-opened");
+  const x0 = await text("pos-X");
+  step("cycle start");
+  await page.getByTestId("cycle-start").click();
+  await waitFor("the tool change dialog", async () => (await page.getByTestId("dialog").innerText()).includes("Tool change"));
+  await shot("03-tool-change");
+  await answer("Tool is in — continue");
+  await waitFor("motion", async () => (await text("pos-X")) !== x0);
+  step(`the position changed: X ${x0} -> ${await text("pos-X")}`);
+  await waitFor("a fifth of the program", async () => Number(await page.locator("progress").getAttribute("value")) > 0.2);
+  step("feed hold");
+  await page.getByTestId("feed-hold").click();
+  await waitFor("held", async () => (await text("state")).startsWith("held"));
+  await page.waitForTimeout(400);
+  const held = await text("pos-X");
+  await page.waitForTimeout(300);
+  if ((await text("pos-X")) !== held) throw new Error("the machine moved while held");
+  await shot("04-held");
+  step("resume");
+  await answer("Resume");
+  await waitFor("running again", async () => (await text("state")).startsWith("running"));
+  step("to the end (confirming the second tool)");
+  await waitFor("the end of the program", async () => {
+    await answer("Tool is in — continue");
+    return (await page.getByTestId("messages").innerText()).includes("finished");
+  }, 120000);
+  await shot("05-finished");
+  step("the history");
+  await page.getByTestId("key-history").click();
+  await waitFor("the history entry", async () => {
+    const rows = await page.getByTestId("history").innerText();
+    return rows.includes("bracket.ngc") && rows.includes("finished");
+  });
+  await shot("06-history");
+  step("passed");
+} catch (e) {
+  failed = true;
+  console.error(`e2e: FAILED: ${e.message}`);
+  await shot("failure").catch(() => {});
+} finally {
+  await browser.close();
+  server.kill("SIGINT");
+  await new Promise((ok) => server.on("exit", ok));
+  rmSync(data, { recursive: true, force: true });
+}
+console.log(`e2e: screenshots in ${out}`);
+process.exit(failed ? 1 : 0);

@@ -1,0 +1,91 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The shapes of the server's JSON (docs/api.md).
+
+export type Axes = Record<string, number>;
+
+export interface Location {
+  file: string;
+  line: number;
+  calls: string[];
+}
+
+export interface Status {
+  tick: number;
+  time_s: number;
+  state: string;
+  mode: string;
+  activity: string;
+  wait: string;
+  stop_reason: string;
+  wait_text: string;
+  machine: Axes;
+  commanded: Axes;
+  following_error: Axes;
+  homed: Record<string, boolean>;
+  all_homed: boolean;
+  path_velocity: number;
+  feed_override: number;
+  rapid_override: number;
+  spindle_override: number;
+  single_block: boolean;
+  optional_stop: boolean;
+  spindle: { rpm: number; rpm_actual: number; at_speed: boolean; direction: string };
+  flood: boolean;
+  mist: boolean;
+  tool: number;
+  prepared_tool: number;
+  fault: string;
+  program: { name: string; moves: number; length_mm: number };
+  job: {
+    kind: string;
+    id: number;
+    name: string;
+    active: boolean;
+    segment: number;
+    progress: number;
+    location: Location;
+    interpreter: Location;
+  };
+  sync_wait: string;
+  runs_finished: number;
+}
+
+export interface ControllerEvent {
+  seq: number;
+  tick: number;
+  kind: string;
+  severity: string;
+  code: string;
+  text: string;
+  accepted?: boolean;
+  end?: string;
+}
+
+export interface MachineAxis {
+  axis: string;
+  rotary: boolean;
+  manual: boolean;
+  min_limit: number;
+  max_limit: number;
+  max_velocity: number;
+  homing: boolean;
+}
+
+export interface Machine {
+  name: string;
+  description: string;
+  servo_period_s: number;
+  axes: MachineAxis[];
+  spindle_max_rpm: number;
+  tool_changer: boolean;
+  handwheel: number[] | null;
+}
+
+export interface Outcome {
+  id?: number;
+  accepted?: boolean;
+  code?: string;
+  message?: string;
+  error?: string;
+  diagnostics?: { severity: string; text: string; code: string }[];
+}

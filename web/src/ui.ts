@@ -1,0 +1,36 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Small DOM helpers and number formats shared by the screens.
+
+/** Creates an element with a class, text and children. */
+export function el<K extends keyof HTMLElementTagNameMap>(
+  tag: K,
+  attrs: Record<string, string> = {},
+  ...children: (Node | string)[]
+): HTMLElementTagNameMap[K] {
+  const e = document.createElement(tag);
+  for (const [k, v] of Object.entries(attrs)) {
+    if (k === "class") e.className = v;
+    else e.setAttribute(k, v);
+  }
+  for (const c of children) e.append(c);
+  return e;
+}
+
+/** A button that runs `action` on click (mouse alone is enough for every screen). */
+export function button(label: string, action: () => void, cls = ""): HTMLButtonElement {
+  const b = el("button", { class: cls, type: "button" }, label);
+  b.addEventListener("click", action);
+  return b;
+}
+
+/** A coordinate as a DRO shows it: sign, 3 decimals (mm). */
+export function coord(v: number | undefined): string {
+  if (v === undefined || !Number.isFinite(v)) return "—";
+  const r = Math.abs(v) < 0.0005 ? 0 : v;
+  return (r >= 0 ? "+" : "") + r.toFixed(3);
+}
+
+/** A percentage for overrides: 1.2 → "120 %". */
+export function percent(v: number): string {
+  return `${Math.round(v * 100)} %`;
+}
