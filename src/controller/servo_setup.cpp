@@ -3,6 +3,9 @@
 #include "opencnc/controller/servo_setup.hpp"
 
 #include <algorithm>
+#include <cstring>
+
+#include "opencnc/machine/sim_machine.hpp"
 
 namespace opencnc::control {
 
@@ -126,6 +129,18 @@ ServoConfig servo_config(const config::MachineProfile& profile) {
   }
   s.interpolator = plan::Planner(machine_limits(profile), planner_config(profile)).interpolator_config();
   s.spindle_max_rpm = profile.spindle.present ? profile.spindle.max_rpm : 0.0;
+  return s;
+}
+
+SharedSetup shared_setup(const config::MachineProfile& profile) {
+  SharedSetup s;
+  // Zeroed first, padding included: the tick compares set-ups byte for byte to keep its servo
+  // (and the joints' homed state) when a restarted controller hands over the same one.
+  std::memset(static_cast<void*>(&s), 0, sizeof s);
+  const ServoConfig servo = servo_config(profile);
+  std::memcpy(static_cast<void*>(&s.servo), &servo, sizeof servo);
+  const machine::MachineCapabilities caps = machine::SimMachine(config::sim_machine_config(profile)).capabilities();
+  std::memcpy(static_cast<void*>(&s.capabilities), &caps, sizeof caps);
   return s;
 }
 
