@@ -41,8 +41,8 @@ void SharedServoHost::take_setup() noexcept {
   SharedHeader& h = segment_->header;
   const std::uint64_t generation = h.setup_generation.load(std::memory_order_acquire);
   if (generation == h.setup_taken.load(std::memory_order_relaxed)) return;
-  if (servo_ != nullptr && guard_.drives_enabled()) return;
   const bool same = servo_ != nullptr && std::memcmp(&setup_, &segment_->setup, sizeof setup_) == 0;
+  if (!same && servo_ != nullptr && guard_.drives_enabled()) return;
   if (!same) {
     if (servo_ != nullptr) servo_->~Servo();
     std::memcpy(static_cast<void*>(&setup_), &segment_->setup, sizeof setup_);

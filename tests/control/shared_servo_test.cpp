@@ -119,6 +119,15 @@ TEST(SharedMemory, RefusesAForeignOrOtherBuildSegment) {
   EXPECT_NE(error.find("is not an opencnc segment"), std::string::npos) << error;
 }
 
+// A restarted controller hands over the same set-up byte for byte (padding included), so the tick
+// keeps its servo and the joints' homed state.
+TEST(SharedSetup, IsTheSameBytesForTheSameProfile) {
+  const SharedSetup a = shared_setup(mill()), b = shared_setup(mill());
+  const auto* pa = reinterpret_cast<const unsigned char*>(&a);
+  const auto* pb = reinterpret_cast<const unsigned char*>(&b);
+  for (std::size_t i = 0; i < sizeof a; ++i) ASSERT_EQ(pa[i], pb[i]) << "byte " << i;
+}
+
 TEST(SharedServoHost, SafeOutputsUntilASetupIsTaken) {
   const config::MachineProfile p = mill();
   std::string error;
