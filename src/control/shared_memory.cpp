@@ -46,20 +46,24 @@ std::string os_error(const std::string& what, const std::string& name) {
 std::uint64_t shared_layout_id() noexcept {
   std::uint64_t h = 0xcbf29ce484222325ULL;
   for (const std::uint64_t v :
-       {std::uint64_t{kSharedLayoutRevision}, std::uint64_t{sizeof(SharedSegment)}, std::uint64_t{alignof(SharedSegment)},
-        std::uint64_t{sizeof(SharedHeader)}, std::uint64_t{sizeof(SharedSetup)}, std::uint64_t{sizeof(ServoConfig)},
-        std::uint64_t{sizeof(ServoChannels)}, std::uint64_t{sizeof(Command)}, std::uint64_t{sizeof(ServoEvent)},
-        std::uint64_t{sizeof(ServoStatus)}, std::uint64_t{sizeof(TraceSample)}, std::uint64_t{sizeof(MachineAction)},
+       {std::uint64_t{kSharedLayoutRevision}, std::uint64_t{sizeof(SharedSegment)},
+        std::uint64_t{alignof(SharedSegment)}, std::uint64_t{sizeof(SharedHeader)},
+        std::uint64_t{sizeof(SharedSetup)}, std::uint64_t{sizeof(ServoConfig)},
+        std::uint64_t{sizeof(ServoChannels)}, std::uint64_t{sizeof(Command)},
+        std::uint64_t{sizeof(ServoEvent)}, std::uint64_t{sizeof(ServoStatus)},
+        std::uint64_t{sizeof(TraceSample)}, std::uint64_t{sizeof(MachineAction)},
         std::uint64_t{sizeof(traj::MotionBlock)}, std::uint64_t{sizeof(machine::MachineCapabilities)},
         std::uint64_t{offsetof(SharedSegment, setup)}, std::uint64_t{offsetof(SharedSegment, channels)}}) {
     h = mix(h, v);
   }
-  for (const char* p = OPENCNC_SHARED_HEADERS_HASH; *p != '\0'; ++p) h = mix(h, static_cast<unsigned char>(*p));
+  for (const char* p = OPENCNC_SHARED_HEADERS_HASH; *p != '\0'; ++p)
+    h = mix(h, static_cast<unsigned char>(*p));
   return h;
 }
 
 std::unique_ptr<SharedMemory> SharedMemory::create(const std::string& name, std::int64_t period_ns,
-                                                   std::uint32_t heartbeat_timeout_ticks, std::string& error) {
+                                                   std::uint32_t heartbeat_timeout_ticks,
+                                                   std::string& error) {
   if (!valid_name(name, error)) return nullptr;
   ::shm_unlink(name.c_str());  // a stale segment of a previous run (ENOENT otherwise)
   const int fd = ::shm_open(name.c_str(), O_RDWR | O_CREAT | O_EXCL, 0660);

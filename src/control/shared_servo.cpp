@@ -9,7 +9,8 @@ namespace opencnc::control {
 SharedServoHost::SharedServoHost(SharedSegment& segment, ConfigurableMachine& machine) noexcept
     : segment_(&segment),
       machine_(&machine),
-      watch_(segment.header.heartbeat, segment.header.heartbeat_timeout_ticks.load(std::memory_order_relaxed)),
+      watch_(segment.header.heartbeat,
+             segment.header.heartbeat_timeout_ticks.load(std::memory_order_relaxed)),
       guard_(machine, watch_) {}
 
 SharedServoHost::~SharedServoHost() {

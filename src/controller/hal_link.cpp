@@ -41,14 +41,17 @@ std::unique_ptr<HalLink> HalLink::attach(const std::string& name, const config::
   SharedSegment& s = memory->segment();
   SharedHeader& h = s.header;
   if (!wait_for([&] { return h.ticks.load() > 0 && h.period_ns > 0; }, wait)) {
-    error = fmt::format("the HAL component behind {} does not tick: add its function to a thread and start it "
-                        "(addf opencnc.update servo-thread; start)", name);
+    error = fmt::format(
+        "the HAL component behind {} does not tick: add its function to a thread and start it "
+        "(addf opencnc.update servo-thread; start)",
+        name);
     return nullptr;
   }
   const auto period_ns = static_cast<std::int64_t>(std::llround(profile.servo_period_s * 1e9));
   if (h.period_ns != period_ns) {
-    error = fmt::format("the HAL thread runs every {} ns, the profile's servo_period_s is {} ns: they must agree",
-                        h.period_ns, period_ns);
+    error =
+        fmt::format("the HAL thread runs every {} ns, the profile's servo_period_s is {} ns: they must agree",
+                    h.period_ns, period_ns);
     return nullptr;
   }
   if (other_controller(h)) {
@@ -58,13 +61,16 @@ std::unique_ptr<HalLink> HalLink::attach(const std::string& name, const config::
   std::unique_ptr<HalLink> link(new HalLink(std::move(memory)));
   h.controller_pid.store(static_cast<std::uint32_t>(::getpid()));
   // Beat well within the tick's timeout (5 beats per timeout, at most every 10 ms).
-  const auto timeout = std::chrono::nanoseconds(period_ns * std::max<std::uint32_t>(1, h.heartbeat_timeout_ticks.load()));
+  const auto timeout =
+      std::chrono::nanoseconds(period_ns * std::max<std::uint32_t>(1, h.heartbeat_timeout_ticks.load()));
   link->beat_every(std::min<std::chrono::nanoseconds>(timeout / 5, std::chrono::milliseconds(10)));
   drain_stale_output(s);
   const std::uint64_t generation = offer_setup(s, shared_setup(profile));
   if (!wait_for([&] { return setup_taken(s, generation); }, wait)) {
-    error = fmt::format("the tick behind {} does not take this profile's set-up while its drives are enabled "
-                        "(switch the machine off, or e-stop, first)", name);
+    error = fmt::format(
+        "the tick behind {} does not take this profile's set-up while its drives are enabled "
+        "(switch the machine off, or e-stop, first)",
+        name);
     return nullptr;
   }
   return link;

@@ -172,9 +172,10 @@ void update(void* arg, long period_ns) {
 }
 
 bool params_ok() {
-  if (joints < 1 || joints > opencnc::machine::kMaxJoints || din < 0 || din > opencnc::machine::kDigitalChannels ||
-      dout < 0 || dout > opencnc::machine::kDigitalChannels || ain < 0 || ain > opencnc::machine::kAnalogChannels ||
-      aout < 0 || aout > opencnc::machine::kAnalogChannels || heartbeat_ms < 1) {
+  if (joints < 1 || joints > opencnc::machine::kMaxJoints || din < 0 ||
+      din > opencnc::machine::kDigitalChannels || dout < 0 || dout > opencnc::machine::kDigitalChannels ||
+      ain < 0 || ain > opencnc::machine::kAnalogChannels || aout < 0 ||
+      aout > opencnc::machine::kAnalogChannels || heartbeat_ms < 1) {
     rtapi_print_msg(RTAPI_MSG_ERR,
                     "opencnc_rt: joints must be 1..9, din/dout 0..64, ain/aout 0..16, heartbeat_ms >= 1 "
                     "(got joints=%d din=%d dout=%d ain=%d aout=%d heartbeat_ms=%d)\n",

@@ -7,8 +7,8 @@
 
 #include <cmath>
 #include <functional>
-#include <optional>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "opencnc/control/shared_memory.hpp"
@@ -21,7 +21,9 @@
 namespace opencnc::control::test {
 namespace {
 
-std::string segment_name(const char* what) { return "/opencnc-test-" + std::to_string(::getpid()) + "-" + what; }
+std::string segment_name(const char* what) {
+  return "/opencnc-test-" + std::to_string(::getpid()) + "-" + what;
+}
 
 /// The simulated machine as a backend whose capabilities come with the set-up (the HAL pins' way).
 class SimBackend final : public ConfigurableMachine {

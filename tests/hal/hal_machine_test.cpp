@@ -13,7 +13,8 @@ struct FakePins {
   struct Joint {
     double pos_cmd = 0, vel_cmd = 0, pos_fb = 0;
     std::int32_t step_cmd = 0;
-    bool enable = false, amp_fault = false, home_sw = false, limit_min = false, limit_max = false, index = false;
+    bool enable = false, amp_fault = false, home_sw = false, limit_min = false, limit_max = false,
+         index = false;
   };
   std::array<Joint, 2> joints{};
   bool estop_in = true, estop_out = false, power_fail = false, probe = false, bits[16] = {};
@@ -26,8 +27,8 @@ struct FakePins {
     for (std::size_t j = 0; j < joints.size(); ++j) {
       Joint& s = joints[j];
       JointPins& p = pins.joints[j];
-      p = {&s.pos_cmd, &s.vel_cmd, &s.step_cmd, &s.pos_fb, &s.enable, &s.amp_fault, &s.home_sw,
-           &s.limit_min, &s.limit_max, &s.index};
+      p = {&s.pos_cmd,   &s.vel_cmd, &s.step_cmd,  &s.pos_fb,    &s.enable,
+           &s.amp_fault, &s.home_sw, &s.limit_min, &s.limit_max, &s.index};
     }
     pins.estop_in = &estop_in;
     pins.estop_out = &estop_out;
@@ -37,9 +38,19 @@ struct FakePins {
     pins.spindle_orient_angle = &floats[1];
     pins.spindle_speed_in = &floats[2];
     pins.spindle_revs = &floats[3];
-    Bit** bit_pins[] = {&pins.spindle_on, &pins.spindle_forward, &pins.spindle_reverse, &pins.spindle_orient,
-                        &pins.spindle_at_speed, &pins.spindle_orient_done, &pins.spindle_fault, &pins.flood,
-                        &pins.mist, &pins.tool_prepare, &pins.tool_change, &pins.tool_prepared, &pins.tool_changed};
+    Bit** bit_pins[] = {&pins.spindle_on,
+                        &pins.spindle_forward,
+                        &pins.spindle_reverse,
+                        &pins.spindle_orient,
+                        &pins.spindle_at_speed,
+                        &pins.spindle_orient_done,
+                        &pins.spindle_fault,
+                        &pins.flood,
+                        &pins.mist,
+                        &pins.tool_prepare,
+                        &pins.tool_change,
+                        &pins.tool_prepared,
+                        &pins.tool_changed};
     for (std::size_t i = 0; i < std::size(bit_pins); ++i) *bit_pins[i] = &bits[i];
     pins.tool_prepare_number = &s32[0];
     pins.handwheel_counts = &s32[1];

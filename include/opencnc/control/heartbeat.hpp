@@ -19,7 +19,9 @@ class HeartbeatWatch {
   HeartbeatWatch(const std::atomic<std::uint64_t>& beat, std::uint32_t timeout_ticks) noexcept
       : beat_(&beat), timeout_ticks_(timeout_ticks == 0 ? 1 : timeout_ticks) {}
   /// Sets the timeout (the thread's period may only be known at its first call). Servo thread.
-  void set_timeout(std::uint32_t timeout_ticks) noexcept { timeout_ticks_ = timeout_ticks == 0 ? 1 : timeout_ticks; }
+  void set_timeout(std::uint32_t timeout_ticks) noexcept {
+    timeout_ticks_ = timeout_ticks == 0 ? 1 : timeout_ticks;
+  }
   /// Once per period, before the machine's inputs are read. Returns alive(). Servo thread.
   bool update() noexcept;
   /// A heartbeat was seen within the last timeout_ticks periods. Servo thread.

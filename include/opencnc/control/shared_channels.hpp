@@ -61,7 +61,8 @@ struct SharedSegment {
 
 static_assert(std::is_standard_layout_v<SharedHeader>);
 static_assert(std::is_trivially_copyable_v<SharedSetup>);
-static_assert(std::atomic<std::uint64_t>::is_always_lock_free && std::atomic<std::uint32_t>::is_always_lock_free &&
-              std::atomic<bool>::is_always_lock_free, "atomics in shared memory must be address-free");
+static_assert(std::atomic<std::uint64_t>::is_always_lock_free &&
+                  std::atomic<std::uint32_t>::is_always_lock_free && std::atomic<bool>::is_always_lock_free,
+              "atomics in shared memory must be address-free");
 
 }  // namespace opencnc::control

@@ -21,39 +21,39 @@ using S32 = volatile std::int32_t;
 /// One joint's pins (names: opencnc.joint.N.<name>). Null pointers are not allowed: every pin
 /// exists; the profile says which ones are wired (the capabilities).
 struct JointPins {
-  Float* pos_cmd = nullptr;      ///< out: position command, joint units (servo and stepper joints)
-  Float* vel_cmd = nullptr;      ///< out: velocity feed-forward, units/s
-  S32* step_cmd = nullptr;       ///< out: stepper joints: absolute step count (low 32 bits)
-  Float* pos_fb = nullptr;       ///< in: feedback position, joint units
-  Bit* enable = nullptr;         ///< out: amplifier / step generator enable
-  Bit* amp_fault = nullptr;      ///< in: the drive reports a fault
-  Bit* home_sw = nullptr;        ///< in: home switch
-  Bit* limit_min = nullptr;      ///< in: negative-end limit switch
-  Bit* limit_max = nullptr;      ///< in: positive-end limit switch
-  Bit* index_enable = nullptr;   ///< io: armed by us, cleared by the encoder at the index mark
+  Float* pos_cmd = nullptr;     ///< out: position command, joint units (servo and stepper joints)
+  Float* vel_cmd = nullptr;     ///< out: velocity feed-forward, units/s
+  S32* step_cmd = nullptr;      ///< out: stepper joints: absolute step count (low 32 bits)
+  Float* pos_fb = nullptr;      ///< in: feedback position, joint units
+  Bit* enable = nullptr;        ///< out: amplifier / step generator enable
+  Bit* amp_fault = nullptr;     ///< in: the drive reports a fault
+  Bit* home_sw = nullptr;       ///< in: home switch
+  Bit* limit_min = nullptr;     ///< in: negative-end limit switch
+  Bit* limit_max = nullptr;     ///< in: positive-end limit switch
+  Bit* index_enable = nullptr;  ///< io: armed by us, cleared by the encoder at the index mark
 };
 
 /// The machine-wide pins (opencnc.<name>).
 struct MachinePins {
   std::array<JointPins, machine::kMaxJoints> joints{};
-  Bit* estop_in = nullptr;       ///< in: the external e-stop chain is closed (true = may run)
-  Bit* estop_out = nullptr;      ///< out: the controller's contact in the chain (true = release)
-  Bit* power_fail = nullptr;     ///< in: mains lost (true = lost)
-  Bit* probe_in = nullptr;       ///< in: probe contact
+  Bit* estop_in = nullptr;             ///< in: the external e-stop chain is closed (true = may run)
+  Bit* estop_out = nullptr;            ///< out: the controller's contact in the chain (true = release)
+  Bit* power_fail = nullptr;           ///< in: mains lost (true = lost)
+  Bit* probe_in = nullptr;             ///< in: probe contact
   Float* spindle_speed_out = nullptr;  ///< out: commanded rpm, signed (+ = clockwise)
-  Bit* spindle_on = nullptr, *spindle_forward = nullptr, *spindle_reverse = nullptr;  ///< out
-  Bit* spindle_orient = nullptr;       ///< out: M19 orient request
-  Float* spindle_orient_angle = nullptr;  ///< out: degrees
-  Float* spindle_speed_in = nullptr;   ///< in: measured rpm, signed
-  Float* spindle_revs = nullptr;       ///< in: spindle encoder position, revolutions
-  Bit* spindle_at_speed = nullptr;     ///< in
-  Bit* spindle_orient_done = nullptr;  ///< in
-  Bit* spindle_fault = nullptr;        ///< in
-  Bit* flood = nullptr, *mist = nullptr;  ///< out: coolant
-  S32* tool_prepare_number = nullptr;  ///< out
-  Bit* tool_prepare = nullptr, *tool_change = nullptr;      ///< out
-  Bit* tool_prepared = nullptr, *tool_changed = nullptr;    ///< in
-  S32* handwheel_counts = nullptr;     ///< in: MPG counts (encoder.counts)
+  Bit *spindle_on = nullptr, *spindle_forward = nullptr, *spindle_reverse = nullptr;  ///< out
+  Bit* spindle_orient = nullptr;                          ///< out: M19 orient request
+  Float* spindle_orient_angle = nullptr;                  ///< out: degrees
+  Float* spindle_speed_in = nullptr;                      ///< in: measured rpm, signed
+  Float* spindle_revs = nullptr;                          ///< in: spindle encoder position, revolutions
+  Bit* spindle_at_speed = nullptr;                        ///< in
+  Bit* spindle_orient_done = nullptr;                     ///< in
+  Bit* spindle_fault = nullptr;                           ///< in
+  Bit *flood = nullptr, *mist = nullptr;                  ///< out: coolant
+  S32* tool_prepare_number = nullptr;                     ///< out
+  Bit *tool_prepare = nullptr, *tool_change = nullptr;    ///< out
+  Bit *tool_prepared = nullptr, *tool_changed = nullptr;  ///< in
+  S32* handwheel_counts = nullptr;                        ///< in: MPG counts (encoder.counts)
   std::array<Bit*, machine::kDigitalChannels> digital_in{}, digital_out{};  ///< first din/dout exist
   std::array<Float*, machine::kAnalogChannels> analog_in{}, analog_out{};   ///< first ain/aout exist
   int digital_inputs = 0, digital_outputs = 0, analog_inputs = 0, analog_outputs = 0;
