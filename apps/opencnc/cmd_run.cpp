@@ -236,8 +236,8 @@ void add_run_command(CLI::App& app, Registry& registry) {
   cmd->add_flag("--realtime", opts->session.realtime,
                 "Tick in a real-time periodic thread instead of virtual time");
   CLI::Option* hal = cmd->add_flag("--hal", opts->session.hal,
-                                    "Drive the machine through LinuxCNC's HAL: the tick runs in the component "
-                                    "opencnc_rt.so, this process attaches to its shared memory (docs/hal.md)");
+                                   "Drive the machine through LinuxCNC's HAL: the tick runs in the component "
+                                   "opencnc_rt.so, this process attaches to its shared memory (docs/hal.md)");
   hal->excludes("--realtime");
   cmd->add_option("--hal-shm", opts->session.hal_shm,
                   "The component's shared memory (its shm= parameter), default /opencnc")

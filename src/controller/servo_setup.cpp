@@ -155,7 +155,8 @@ SharedSetup shared_setup(const config::MachineProfile& profile) {
       out.tokens[t].index = r.tokens[t].index;
     }
   }
-  const machine::MachineCapabilities caps = machine::SimMachine(config::sim_machine_config(profile)).capabilities();
+  const machine::MachineCapabilities caps =
+      machine::SimMachine(config::sim_machine_config(profile)).capabilities();
   std::memcpy(static_cast<void*>(&s.capabilities), &caps, sizeof caps);
   return s;
 }

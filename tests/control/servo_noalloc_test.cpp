@@ -20,8 +20,8 @@
 #include "opencnc/control/shared_servo.hpp"
 #include "opencnc/controller/gcode_source.hpp"
 #include "opencnc/controller/servo_setup.hpp"
-#include "opencnc/machine/sim_machine.hpp"
 #include "opencnc/controller/sim_rig.hpp"
+#include "opencnc/machine/sim_machine.hpp"
 #include "test_profiles.hpp"
 
 using opencnc::test::g_allocations;
