@@ -23,6 +23,7 @@
 #include "opencnc/controller/hal_link.hpp"
 #include "opencnc/controller/servo_setup.hpp"
 #include "opencnc/controller/sim_rig.hpp"
+#include "opencnc/toolguard/tool_guard.hpp"
 #include "stop_signals.hpp"
 
 namespace opencnc::cli {
@@ -231,7 +232,8 @@ struct OperatorWait {
 };
 
 std::optional<OperatorWait> operator_wait(const control::ControllerStatus& st) {
-  if (st.servo.state == State::Stopped) return OperatorWait{st.wait_text, Request::simple(CommandKind::CycleStart)};
+  if (st.servo.state == State::Stopped)
+    return OperatorWait{st.wait_text, Request::simple(CommandKind::CycleStart)};
   if (st.servo.wait == control::Wait::ManualToolChange)
     return OperatorWait{st.wait_text, Request::simple(CommandKind::ToolChanged)};
   return std::nullopt;
@@ -266,8 +268,10 @@ class StopOnThePath {
   void step(Driver& d, const control::ControllerStatus& st, SessionEnd& end) {
     if (!requested() || aborted_) return;
     end.stopped_by = flag_->load(std::memory_order_relaxed);
-    if (!held_) d.controller().submit(Request::simple(CommandKind::FeedHold));
-    else if (st.servo.path_velocity == 0) d.controller().submit(Request::simple(CommandKind::Abort));
+    if (!held_)
+      d.controller().submit(Request::simple(CommandKind::FeedHold));
+    else if (st.servo.path_velocity == 0)
+      d.controller().submit(Request::simple(CommandKind::Abort));
     aborted_ = held_ && st.servo.path_velocity == 0;
     held_ = true;
   }
@@ -287,27 +291,45 @@ void follow(Driver& d, control::EventCursor& cursor, const SessionOptions& o, co
   std::uint32_t job = 0;
   std::uint64_t asked_tick = ~std::uint64_t{0};  // the wait already answered (by its start tick)
   std::uint64_t n = 0;
+  bool guard_abort = false;
   for (;;) {
     d.advance();
     std::optional<ControllerEvent> ended;
     for (const ControllerEvent& e : cursor.next()) {
       print_event(e);
-      if (e.kind == ControllerEventKind::JobStarted && job == 0 && e.job == control::JobKind::Program) job = e.job_id;
+      if (e.kind == ControllerEventKind::JobStarted && job == 0 && e.job == control::JobKind::Program)
+        job = e.job_id;
       if (e.kind == ControllerEventKind::JobEnded && e.job_id == job) ended = e;
+      if (e.kind == ControllerEventKind::Note && e.code == "tools.guard-hold" && !guard_abort) {
+        // No accept or restore at this terminal: the run ends before the tool cuts.
+        fmt::print(stderr,
+                   "error: the tool guard holds the program before the tool cuts; it is aborted: accept or "
+                   "restore with `opencnc tools --db STORE accept|restore`, then run it again\n");
+        d.controller().submit(Request::simple(CommandKind::Abort));
+        guard_abort = true;
+      }
     }
     const control::ControllerStatus st = d.controller().status();
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (hooks.progress && (++n % 256 == 0)) hooks.progress(st, wall);
     bring_hand_axis(d, st.servo);
+    if (hooks.tick) hooks.tick(d.controller(), st);
+    if (ended && hooks.goes_on && hooks.goes_on(*ended)) {
+      job = 0;  // the job that resumes the program is followed next
+      ended.reset();
+    }
     if (ended) {
       end.wall_s = wall;
       end.finished = ended->end == control::JobEnd::Finished;
       if (!end.finished) {
         // (a fault was printed as its note already)
-        if (!st.fault_text.empty()) end.fault = st.fault_text;
+        if (!st.fault_text.empty())
+          end.fault = st.fault_text;
         else if (end.stopped_by != 0)
-          end.fault = fmt::format("stopped by {} (feed hold on the path, then abort)", signal_name(end.stopped_by));
-        else end.fault = fmt::format("the program ended: {}", control::to_string(ended->end));
+          end.fault =
+              fmt::format("stopped by {} (feed hold on the path, then abort)", signal_name(end.stopped_by));
+        else
+          end.fault = fmt::format("the program ended: {}", control::to_string(ended->end));
         if (st.fault_text.empty()) fmt::print(stderr, "error: {}\n", end.fault);
         end.limit_touched = st.servo.fault.kind == control::FaultKind::SoftLimit ||
                             st.servo.fault.kind == control::FaultKind::LimitSwitch;
@@ -327,7 +349,8 @@ void follow(Driver& d, control::EventCursor& cursor, const SessionOptions& o, co
       d.controller().submit(wait->go_on);
       continue;
     }
-    fmt::print(stderr, "\nwaiting for {}: press Enter to continue, or a and Enter to abort\n", wait->question);
+    fmt::print(stderr, "\nwaiting for {}: press Enter to continue, or a and Enter to abort\n",
+               wait->question);
     std::optional<std::string> answer;
     while (!answer && !input.closed() && !stop.requested()) {
       answer = input.line(d.ticks_by_itself() ? 10 : -1);
@@ -362,11 +385,12 @@ void note_assumptions(const control::PreflightSummary& s) {
   const auto plural = [](std::uint64_t n, const char* one, const char* many) {
     return fmt::format("{} {}", n, n == 1 ? one : many);
   };
-  fmt::print(stderr,
-             "note: {} {} on what the machine answers while the program runs ({}); checked with assumed answers, "
-             "they are checked again with the real ones before they run: {}\n",
-             plural(s.assumed_moves, "move", "moves"), s.assumed_moves == 1 ? "rests" : "rest",
-             plural(s.sync_points, "sync point", "sync points"), lines);
+  fmt::print(
+      stderr,
+      "note: {} {} on what the machine answers while the program runs ({}); checked with assumed answers, "
+      "they are checked again with the real ones before they run: {}\n",
+      plural(s.assumed_moves, "move", "moves"), s.assumed_moves == 1 ? "rests" : "rest",
+      plural(s.sync_points, "sync point", "sync points"), lines);
 }
 
 }  // namespace
@@ -390,9 +414,11 @@ SessionEnd run_session(const SessionOptions& o, const SessionHooks& hooks) {
     return end;
   }
   Diagnostics diags;
-  auto source = control::GcodeProgramSource::create(end.profile, diags);
+  // The profile's G-code source; with [tool_guard], the tool store and the guard's feature.
+  std::optional<toolguard::Setup> setup = toolguard::setup(end.profile, diags);
   print(diags);
-  if (!source) return end;
+  if (!setup) return end;
+  const std::shared_ptr<control::ProgramSource> source = setup->source;
 
   std::unique_ptr<Driver> driver;
   if (o.hal) {
@@ -418,6 +444,11 @@ SessionEnd run_session(const SessionOptions& o, const SessionHooks& hooks) {
     driver = std::make_unique<VirtualDriver>(end.profile, source);
   }
   Driver& d = *driver;
+  if (setup->feature) d.controller().add_feature(setup->feature);
+  if (hooks.features) {
+    for (auto& f : hooks.features(end.profile))
+      d.controller().add_feature(std::move(f), control::ObserverOptions{end.profile.servo_period_s, false});
+  }
   const control::ServoConfig& sc = d.controller().servo_config();
   // Through HAL the machine may already be on: a previous controller left it idle.
   const bool on = o.hal && d.controller().status().servo.state == State::Idle;
