@@ -241,7 +241,8 @@ nlohmann::json report_json(const control::RunReport& r, const RunOptions& o, con
   nlohmann::json j;
   j["program"] = o.session.file;
   j["machine"] = end.profile.name;
-  j["realtime"] = o.session.realtime;
+  j["realtime"] = o.session.realtime || o.session.hal;
+  j["hal"] = o.session.hal ? nlohmann::json(o.session.hal_shm) : nlohmann::json(nullptr);
   j["finished"] = end.finished;
   j["fault"] = end.fault.empty() ? nlohmann::json(nullptr) : nlohmann::json(end.fault);
   j["stopped_by"] =
@@ -368,6 +369,13 @@ void add_run_command(CLI::App& app, Registry& registry) {
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   cmd->add_flag("--realtime", opts->session.realtime,
                 "Tick in a real-time periodic thread instead of virtual time");
+  CLI::Option* hal = cmd->add_flag("--hal", opts->session.hal,
+                                   "Drive the machine through LinuxCNC's HAL: the tick runs in the component "
+                                   "opencnc_rt.so, this process attaches to its shared memory (docs/hal.md)");
+  hal->excludes("--realtime");
+  cmd->add_option("--hal-shm", opts->session.hal_shm,
+                  "The component's shared memory (its shm= parameter), default /opencnc")
+      ->needs(hal);
   cmd->add_flag("--unattended", opts->session.unattended,
                 "Go on by itself at program stops (M0, M1) and manual tool changes instead of asking the "
                 "operator on the terminal");

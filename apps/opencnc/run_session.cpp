@@ -20,6 +20,7 @@
 #include "opencnc/control/servo.hpp"
 #include "opencnc/control/triple_buffer.hpp"
 #include "opencnc/controller/gcode_source.hpp"
+#include "opencnc/controller/hal_link.hpp"
 #include "opencnc/controller/servo_setup.hpp"
 #include "opencnc/controller/sim_rig.hpp"
 #include "opencnc/toolguard/tool_guard.hpp"
@@ -126,6 +127,30 @@ class RealtimeDriver final : public Driver {
   std::unique_ptr<control::Controller> controller_;
   std::chrono::duration<double> period_;
   control::RealtimeClock clock_;
+};
+
+/// The tick runs in LinuxCNC's HAL (opencnc_rt.so); this process is the controller only, linked
+/// to it through shared memory (control::HalLink: set-up, heartbeat).
+class HalDriver final : public Driver {
+ public:
+  HalDriver(const config::MachineProfile& p, std::shared_ptr<control::ProgramSource> s,
+            std::unique_ptr<control::HalLink> link)
+      : link_(std::move(link)),
+        controller_(std::make_unique<control::Controller>(p, link_->channels(), std::move(s))),
+        period_(std::chrono::duration<double>(p.servo_period_s)) {}
+  ~HalDriver() override { controller_.reset(); }  // before the link: it unmaps the channels
+  void advance() override {
+    controller_->service();
+    std::this_thread::sleep_for(period_);
+  }
+  control::Controller& controller() override { return *controller_; }
+  bool ticks_by_itself() const override { return true; }
+  void set_hand_target(int, double, double) override {}  // a real hand moves a real axis
+
+ private:
+  std::unique_ptr<control::HalLink> link_;
+  std::unique_ptr<control::Controller> controller_;
+  std::chrono::duration<double> period_;
 };
 
 /// Submits `r` and advances until it is answered.
@@ -417,7 +442,19 @@ SessionEnd run_session(const SessionOptions& o, const SessionHooks& hooks) {
   const std::shared_ptr<control::ProgramSource> source = setup->source;
 
   std::unique_ptr<Driver> driver;
-  if (o.realtime) {
+  if (o.hal) {
+    std::string error;
+    auto link = control::HalLink::attach(o.hal_shm, end.profile, error);
+    if (!link) {
+      fmt::print(stderr, "error: --hal: {}\n", error);
+      end.exit_code = kExitUsage;
+      return end;
+    }
+    driver = std::make_unique<HalDriver>(end.profile, source, std::move(link));
+    // A previous controller's exit (its heartbeat stopped) left the tick faulted: clear it.
+    // (Refused when there is nothing to reset: that is fine.)
+    ask(*driver, Request::simple(CommandKind::Reset));
+  } else if (o.realtime) {
     auto rt = std::make_unique<RealtimeDriver>(end.profile, source);
     if (!rt->start()) {
       fmt::print(stderr, "error: cannot start the servo thread\n");
@@ -434,7 +471,9 @@ SessionEnd run_session(const SessionOptions& o, const SessionHooks& hooks) {
       d.controller().add_feature(std::move(f), control::ObserverOptions{end.profile.servo_period_s, false});
   }
   const control::ServoConfig& sc = d.controller().servo_config();
-  if (!must(d, Request::simple(CommandKind::MachineOn)) || !home_if_needed(d, sc) ||
+  // Through HAL the machine may already be on: a previous controller left it idle.
+  const bool on = o.hal && d.controller().status().servo.state == State::Idle;
+  if (!(on || must(d, Request::simple(CommandKind::MachineOn))) || !home_if_needed(d, sc) ||
       !must(d, Request::set_mode(control::Mode::Auto)) || !must(d, Request::open(o.file))) {
     return end;
   }

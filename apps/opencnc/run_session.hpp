@@ -22,6 +22,10 @@ struct SessionOptions {
   std::string machine;
   std::vector<std::string> sets;
   bool realtime = false;    ///< a real-time periodic thread instead of virtual time
+  /// The tick runs in LinuxCNC's HAL (opencnc_rt.so): attach to its shared memory `hal_shm`
+  /// instead of ticking here. docs/hal.md.
+  bool hal = false;
+  std::string hal_shm = "/opencnc";
   bool unattended = false;  ///< continue program stops and manual tool changes without asking
   /// Polled during the run: a signal number there stops it on the path (feed hold, then abort).
   const std::atomic<int>* stop = nullptr;

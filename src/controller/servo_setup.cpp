@@ -3,6 +3,9 @@
 #include "opencnc/controller/servo_setup.hpp"
 
 #include <algorithm>
+#include <cstring>
+
+#include "opencnc/machine/sim_machine.hpp"
 
 namespace opencnc::control {
 
@@ -79,7 +82,7 @@ plan::PlannerConfig planner_config(const config::MachineProfile& profile) {
 }
 
 ServoConfig servo_config(const config::MachineProfile& profile) {
-  ServoConfig s;
+  ServoConfig s{};  // value-initialised: padding zero too (shared_setup compares set-ups byte for byte)
   s.period_s = profile.servo_period_s;
   s.joint_count = static_cast<int>(std::min<std::size_t>(profile.axes.size(), machine::kMaxJoints));
   for (const config::AxisProfile& a : profile.axes) {
@@ -126,6 +129,35 @@ ServoConfig servo_config(const config::MachineProfile& profile) {
   }
   s.interpolator = plan::Planner(machine_limits(profile), planner_config(profile)).interpolator_config();
   s.spindle_max_rpm = profile.spindle.present ? profile.spindle.max_rpm : 0.0;
+  return s;
+}
+
+SharedSetup shared_setup(const config::MachineProfile& profile) {
+  SharedSetup s;
+  // Zeroed first, padding included: the tick compares set-ups byte for byte to keep its servo
+  // (and the joints' homed state) when a restarted controller hands over the same one.
+  std::memset(static_cast<void*>(&s), 0, sizeof s);
+  const ServoConfig servo = servo_config(profile);
+  std::memcpy(static_cast<void*>(&s.servo), &servo, sizeof servo);
+  // The rules' padding bytes hold whatever their copies left: rebuild them field by field on zeroed
+  // bytes, so that the same profile always gives the same bytes.
+  machine::InterlockRules& rules = s.servo.interlocks;
+  for (std::size_t i = 0; i < rules.rules.size(); ++i) {
+    const machine::InterlockRule r = servo.interlocks.rules[i];
+    machine::InterlockRule& out = rules.rules[i];
+    std::memset(static_cast<void*>(&out), 0, sizeof out);
+    if (static_cast<int>(i) >= rules.count) continue;
+    out.action = r.action;
+    out.token_count = r.token_count;
+    for (std::size_t t = 0; t < r.token_count && t < r.tokens.size(); ++t) {
+      out.tokens[t].op = r.tokens[t].op;
+      out.tokens[t].signal = r.tokens[t].signal;
+      out.tokens[t].index = r.tokens[t].index;
+    }
+  }
+  const machine::MachineCapabilities caps =
+      machine::SimMachine(config::sim_machine_config(profile)).capabilities();
+  std::memcpy(static_cast<void*>(&s.capabilities), &caps, sizeof caps);
   return s;
 }
 

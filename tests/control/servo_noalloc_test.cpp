@@ -11,10 +11,17 @@
 #include <fstream>
 #include <functional>
 #include <new>
+#include <string>
+
+#include <unistd.h>
 
 #include "../support/counting_new.hpp"
+#include "opencnc/control/shared_memory.hpp"
+#include "opencnc/control/shared_servo.hpp"
 #include "opencnc/controller/gcode_source.hpp"
+#include "opencnc/controller/servo_setup.hpp"
 #include "opencnc/controller/sim_rig.hpp"
+#include "opencnc/machine/sim_machine.hpp"
 #include "test_profiles.hpp"
 
 using opencnc::test::g_allocations;
@@ -167,6 +174,70 @@ TEST(ServoAllocations, NoneInsideTheDrillsTick) {
   a.rig().machine().set_estop_pressed(true);
   a.until([] { return false; }, 5);
   EXPECT_EQ(a.state(), State::EStopped);
+  EXPECT_EQ(g_allocations.load(), 0);
+}
+
+/// The simulated machine behind the shared-memory host, its capabilities handed over at run time.
+class SimBackend final : public ConfigurableMachine {
+ public:
+  explicit SimBackend(const config::MachineProfile& p) : sim_(config::sim_machine_config(p)) {}
+  machine::MachineCapabilities capabilities() const noexcept override { return caps_; }
+  void read(machine::MachineInputs& in) noexcept override { sim_.read(in); }
+  void write(const machine::MachineOutputs& out) noexcept override { sim_.write(out); }
+  void set_capabilities(const machine::MachineCapabilities& caps) noexcept override { caps_ = caps; }
+
+ private:
+  machine::SimMachine sim_;
+  machine::MachineCapabilities caps_{};
+};
+
+// The HAL component's tick: the host over shared memory, taking a set-up (the servo built in place),
+// a jog, the heartbeat stopping (the controlled stop and the fault), a second set-up taken.
+TEST(ServoAllocations, NoneInsideTheSharedMemoryHostsTick) {
+  const config::MachineProfile p = mill();
+  std::string error;
+  auto segment = SharedMemory::create("/opencnc-noalloc-" + std::to_string(::getpid()), 1'000'000, 20, error);
+  ASSERT_TRUE(segment) << error;
+  SharedSegment& s = segment->segment();
+  SimBackend backend(p);
+  SharedServoHost host(s, backend);
+  const SharedSetup setup = shared_setup(p);
+  Command c;
+  c.kind = CommandKind::MachineOn;
+  c.id = 1;
+  g_allocations = 0;
+  offer_setup(s, setup);
+  auto beat_and_tick = [&](int n) {
+    for (int i = 0; i < n; ++i) {
+      s.header.heartbeat.fetch_add(1);
+      g_armed = true;
+      host.tick();
+      g_armed = false;
+      ServoEvent e;
+      while (s.channels.events.try_pop(e)) {
+      }
+    }
+  };
+  beat_and_tick(5);
+  ASSERT_TRUE(host.running());
+  s.channels.commands.try_push(c);
+  c.kind = CommandKind::SetMode;
+  c.mode = Mode::Manual;
+  c.id = 2;
+  s.channels.commands.try_push(c);
+  c.kind = CommandKind::JogContinuous;
+  c.axis = 0;
+  c.value = 20;
+  c.id = 3;
+  s.channels.commands.try_push(c);
+  beat_and_tick(300);
+  g_armed = true;
+  for (int i = 0; i < 500; ++i) host.tick();  // the heartbeat stops
+  g_armed = false;
+  EXPECT_EQ(s.header.heartbeat_losses.load(), 1u);
+  offer_setup(s, shared_setup(mill({"servo_period_s=0.0005"})));
+  beat_and_tick(5);
+  EXPECT_EQ(s.header.setup_taken.load(), 2u);
   EXPECT_EQ(g_allocations.load(), 0);
 }
 

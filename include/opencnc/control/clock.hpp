@@ -8,16 +8,9 @@
 #include <string>
 #include <vector>
 
-namespace opencnc::control {
+#include "opencnc/control/tickable.hpp"
 
-/// Something advanced by one servo period per call. The control code does not know which clock
-/// drives it. `tick()` is called from the clock's thread only and must be real-time safe.
-class Tickable {
- public:
-  virtual ~Tickable() = default;
-  /// Advances by one period. Returns false to ask the clock to stop after this tick.
-  virtual bool tick() noexcept = 0;
-};
+namespace opencnc::control {
 
 /// Runs ticks back to back in virtual time: deterministic, as fast as the CPU allows.
 /// Any single thread; not real-time itself (it is the test and simulation driver).

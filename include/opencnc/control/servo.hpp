@@ -8,9 +8,9 @@
 
 #include "opencnc/control/axis_mover.hpp"
 #include "opencnc/control/channels.hpp"
-#include "opencnc/control/clock.hpp"
 #include "opencnc/control/homing.hpp"
 #include "opencnc/control/servo_config.hpp"
+#include "opencnc/control/tickable.hpp"
 #include "opencnc/machine/machine_io.hpp"
 #include "opencnc/motion/compensation.hpp"
 #include "opencnc/motion/pulse_distributor.hpp"

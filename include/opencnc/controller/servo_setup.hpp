@@ -4,6 +4,7 @@
 
 #include "opencnc/config/machine_profile.hpp"
 #include "opencnc/control/servo_config.hpp"
+#include "opencnc/control/shared_channels.hpp"
 #include "opencnc/plan/machine_limits.hpp"
 #include "opencnc/plan/planner.hpp"
 
@@ -24,5 +25,10 @@ plan::PlannerConfig planner_config(const config::MachineProfile& profile);
 /// The servo's view of the machine. The interpolator settings are those of a planner made with
 /// machine_limits() and planner_config(), so blocks and tick agree. Non-real-time.
 ServoConfig servo_config(const config::MachineProfile& profile);
+
+/// What a tick in another process (the HAL component) is handed: servo_config() and what the
+/// profile declares wired (the capabilities the simulated machine of the profile would have:
+/// joints and their drives, switches, index, spindle, probe, I/O counts). Non-real-time.
+SharedSetup shared_setup(const config::MachineProfile& profile);
 
 }  // namespace opencnc::control

@@ -1,0 +1,205 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The servo tick over POSIX shared memory, in one process: the segment created as the HAL component
+// creates it and attached a second time as the controller attaches it; the layout check, the
+// set-up hand-over, and the heartbeat (a silent controller stops the machine within its limits).
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "opencnc/control/shared_memory.hpp"
+#include "opencnc/control/shared_servo.hpp"
+#include "opencnc/controller/controller.hpp"
+#include "opencnc/controller/servo_setup.hpp"
+#include "opencnc/machine/sim_machine.hpp"
+#include "test_profiles.hpp"
+
+namespace opencnc::control::test {
+namespace {
+
+std::string segment_name(const char* what) {
+  return "/opencnc-test-" + std::to_string(::getpid()) + "-" + what;
+}
+
+/// The simulated machine as a backend whose capabilities come with the set-up (the HAL pins' way).
+class SimBackend final : public ConfigurableMachine {
+ public:
+  explicit SimBackend(const config::MachineProfile& p) : sim_(config::sim_machine_config(p)) {}
+  machine::MachineCapabilities capabilities() const noexcept override { return caps_; }
+  void read(machine::MachineInputs& in) noexcept override { sim_.read(in); }
+  void write(const machine::MachineOutputs& out) noexcept override {
+    last_ = out;
+    sim_.write(out);
+  }
+  void set_capabilities(const machine::MachineCapabilities& caps) noexcept override { caps_ = caps; }
+  const machine::MachineOutputs& last() const noexcept { return last_; }
+  machine::SimMachine& sim() noexcept { return sim_; }
+
+ private:
+  machine::SimMachine sim_;
+  machine::MachineCapabilities caps_{};
+  machine::MachineOutputs last_{};
+};
+
+/// Component side (segment creator, host, machine) and controller side (its own mapping, the
+/// controller, the heartbeat it beats while `beating`), stepped in one thread.
+class SharedRig {
+ public:
+  explicit SharedRig(const config::MachineProfile& p, const char* name, std::uint32_t timeout_ticks = 50)
+      : profile_(p), backend_(p) {
+    std::string error;
+    owner_ = SharedMemory::create(segment_name(name), 1'000'000, timeout_ticks, error);
+    EXPECT_TRUE(owner_) << error;
+    host_ = std::make_unique<SharedServoHost>(owner_->segment(), backend_);
+    attach();
+  }
+  /// A (new) controller process: maps the segment, drains what was left, hands its set-up over.
+  void attach() {
+    std::string error;
+    controller_.reset();
+    mapping_ = SharedMemory::attach(owner_->name(), error);
+    ASSERT_TRUE(mapping_) << error;
+    drain_stale_output(mapping_->segment());
+    controller_ = std::make_unique<Controller>(profile_, mapping_->segment().channels);
+    const std::uint64_t g = offer_setup(mapping_->segment(), shared_setup(profile_));
+    for (int i = 0; i < 10 && !setup_taken(mapping_->segment(), g); ++i) step();
+    ASSERT_TRUE(setup_taken(mapping_->segment(), g));
+  }
+  void step() {
+    if (controller_) controller_->service();
+    if (beating) mapping_->segment().header.heartbeat.fetch_add(1);
+    host_->tick();
+  }
+  bool until(const std::function<bool()>& done, int max) {
+    for (int i = 0; i < max; ++i) {
+      step();
+      if (done()) return true;
+    }
+    return false;
+  }
+  Outcome ask(Request r) {
+    const std::uint64_t id = controller_->submit(std::move(r));
+    std::optional<Outcome> o;
+    until([&] { return (o = controller_->outcome(id)).has_value(); }, 1000);
+    return o.value_or(Outcome{});
+  }
+  ServoStatus status() const { return controller_->status().servo; }
+
+  bool beating = true;
+  config::MachineProfile profile_;
+  SimBackend backend_;
+  std::unique_ptr<SharedMemory> owner_, mapping_;
+  std::unique_ptr<SharedServoHost> host_;
+  std::unique_ptr<Controller> controller_;
+};
+
+TEST(SharedMemory, RefusesAForeignOrOtherBuildSegment) {
+  std::string error;
+  EXPECT_FALSE(SharedMemory::attach(segment_name("absent"), error));
+  EXPECT_NE(error.find("is the HAL component opencnc_rt loaded"), std::string::npos) << error;
+  error.clear();
+  EXPECT_FALSE(SharedMemory::create("no-slash", 1'000'000, 10, error));
+  EXPECT_NE(error.find("must be one '/'"), std::string::npos) << error;
+
+  error.clear();
+  auto owner = SharedMemory::create(segment_name("layout"), 1'000'000, 10, error);
+  ASSERT_TRUE(owner) << error;
+  EXPECT_EQ(owner->segment().header.layout_id, shared_layout_id());
+  EXPECT_TRUE(SharedMemory::attach(owner->name(), error)) << error;
+
+  owner->segment().header.layout_id ^= 1;  // a tick of another build
+  EXPECT_FALSE(SharedMemory::attach(owner->name(), error));
+  EXPECT_NE(error.find("built from another opencnc"), std::string::npos) << error;
+  owner->segment().header.layout_id ^= 1;
+  owner->segment().header.magic = 0;  // not ours
+  error.clear();
+  EXPECT_FALSE(SharedMemory::attach(owner->name(), error));
+  EXPECT_NE(error.find("is not an opencnc segment"), std::string::npos) << error;
+}
+
+// A restarted controller hands over the same set-up byte for byte (padding included), so the tick
+// keeps its servo and the joints' homed state.
+TEST(SharedSetup, IsTheSameBytesForTheSameProfile) {
+  const SharedSetup a = shared_setup(mill()), b = shared_setup(mill());
+  const auto* pa = reinterpret_cast<const unsigned char*>(&a);
+  const auto* pb = reinterpret_cast<const unsigned char*>(&b);
+  for (std::size_t i = 0; i < sizeof a; ++i) ASSERT_EQ(pa[i], pb[i]) << "byte " << i;
+}
+
+TEST(SharedServoHost, SafeOutputsUntilASetupIsTaken) {
+  const config::MachineProfile p = mill();
+  std::string error;
+  auto owner = SharedMemory::create(segment_name("safe"), 1'000'000, 10, error);
+  ASSERT_TRUE(owner) << error;
+  SimBackend backend(p);
+  SharedServoHost host(owner->segment(), backend);
+  for (int i = 0; i < 5; ++i) host.tick();
+  EXPECT_FALSE(host.running());
+  EXPECT_FALSE(backend.last().estop_release);
+  for (const auto& j : backend.last().joints) EXPECT_FALSE(j.enable);
+  EXPECT_EQ(owner->segment().header.ticks.load(), 5u);
+  const std::uint64_t g = offer_setup(owner->segment(), shared_setup(p));
+  host.tick();
+  EXPECT_TRUE(setup_taken(owner->segment(), g));
+  EXPECT_TRUE(host.running());
+  EXPECT_GT(backend.capabilities().joint_count, 0);
+}
+
+TEST(SharedServoHost, AControllerOverSharedMemoryJogsTheMachine) {
+  SharedRig rig(mill(), "jog");
+  ASSERT_TRUE(rig.ask(Request::simple(CommandKind::MachineOn)).accepted);
+  ASSERT_TRUE(rig.ask(Request::set_mode(Mode::Manual)).accepted);
+  const double x0 = rig.status().commanded[0];
+  ASSERT_TRUE(rig.ask(Request::jog(Axis::X, 20)).accepted);
+  rig.until([] { return false; }, 500);
+  EXPECT_GT(rig.status().commanded[0], x0 + 5);
+  EXPECT_TRUE(rig.status().drives_enabled);
+  ASSERT_TRUE(rig.ask(Request::jog_stop()).accepted);
+  EXPECT_TRUE(rig.until([&] { return rig.status().state == State::Idle; }, 500));
+}
+
+// The controller process dies mid-jog: the tick sees no heartbeat for the timeout, brings the
+// joint to rest within its acceleration, faults (power loss path) and disables the drives; a new
+// controller attaches to the same tick (same set-up: the servo and its state stay) and resets.
+TEST(SharedServoHost, ASilentControllerStopsTheMachineAndANewOneTakesOver) {
+  SharedRig rig(mill(), "heartbeat", 50);
+  ASSERT_TRUE(rig.ask(Request::simple(CommandKind::MachineOn)).accepted);
+  ASSERT_TRUE(rig.ask(Request::set_mode(Mode::Manual)).accepted);
+  ASSERT_TRUE(rig.ask(Request::jog(Axis::X, 30)).accepted);
+  rig.until([] { return false; }, 400);
+  const Servo* servo_before = rig.host_->servo();
+  ASSERT_GT(rig.backend_.sim().joint(0).velocity(), 25.0);
+
+  rig.beating = false;
+  rig.controller_.reset();  // the process is gone: nothing services the channels any more
+  const double accel = rig.profile_.axes[0].max_acceleration;
+  double last = rig.backend_.sim().joint(0).motor_position();
+  int ticks = 0, stopped_at = -1;
+  for (; ticks < 2000; ++ticks) {
+    rig.host_->tick();
+    const double pos = rig.backend_.sim().joint(0).motor_position();
+    if (stopped_at < 0 && std::fabs(pos - last) < 1e-9 && ticks > 50) stopped_at = ticks;
+    last = pos;
+  }
+  EXPECT_EQ(rig.owner_->segment().header.heartbeat_losses.load(), 1u);
+  EXPECT_FALSE(rig.owner_->segment().header.controller_alive.load());
+  ASSERT_GE(stopped_at, 50) << "the joint did not come to rest";
+  // Within the timeout plus the time to stop at the joint's acceleration (and a margin of 20 %).
+  EXPECT_LE(stopped_at, 50 + static_cast<int>(1.2 * 1000 * 30 / accel) + 5);
+  for (const auto& j : rig.backend_.last().joints) EXPECT_FALSE(j.enable);
+
+  rig.beating = true;
+  rig.attach();
+  EXPECT_EQ(rig.host_->servo(), servo_before);  // same set-up: the servo (and its state) stayed
+  rig.until([&] { return rig.status().state == State::Faulted; }, 10);
+  EXPECT_EQ(rig.status().fault.kind, FaultKind::PowerLoss);
+  ASSERT_TRUE(rig.ask(Request::simple(CommandKind::Reset)).accepted);
+  EXPECT_TRUE(rig.ask(Request::simple(CommandKind::MachineOn)).accepted);
+}
+
+}  // namespace
+}  // namespace opencnc::control::test
