@@ -225,6 +225,37 @@ double CouplingLaw::max_slope(double a, double b) const noexcept {
   return best;
 }
 
+std::pair<double, double> CouplingLaw::slave_extent(double a, double b) const noexcept {
+  if (a > b) std::swap(a, b);
+  double lo = std::min(slave(a), slave(b)), hi = std::max(slave(a), slave(b));
+  if (kind_ != CouplingKind::Cam) return {lo, hi};  // the pitch laws are monotone
+  const auto& m = table_.master;
+  const auto& v = table_.value;
+  const auto take = [&](double x) {
+    if (!(x > a && x < b)) return;
+    const double s = slave(x);
+    lo = std::min(lo, s);
+    hi = std::max(hi, s);
+  };
+  for (int i = 0; i + 1 < table_.count; ++i) {
+    const double h = m[i + 1] - m[i];
+    const double qa = 6 * (v[i] - v[i + 1]) / h + 3 * derived_[i] + 3 * derived_[i + 1];
+    const double qb = -6 * (v[i] - v[i + 1]) / h - 4 * derived_[i] - 2 * derived_[i + 1];
+    const double qc = derived_[i];
+    double roots[2] = {-1, -1};
+    if (std::fabs(qa) < 1e-15) {
+      if (qb != 0) roots[0] = -qc / qb;
+    } else if (const double disc = qb * qb - 4 * qa * qc; disc >= 0) {
+      roots[0] = (-qb - std::sqrt(disc)) / (2 * qa);
+      roots[1] = (-qb + std::sqrt(disc)) / (2 * qa);
+    }
+    for (double u : roots) {
+      if (u > 0 && u < 1) take(m[i] + h * u);
+    }
+  }
+  return {lo, hi};
+}
+
 double CouplingLaw::max_curvature(double a, double b) const noexcept {
   if (a > b) std::swap(a, b);
   double best = std::max(std::fabs(curvature(a)), std::fabs(curvature(b)));

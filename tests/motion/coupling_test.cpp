@@ -115,5 +115,24 @@ TEST(CouplingLaw, ExtremesAreNeverBelowADenseSampling) {
   }
 }
 
+TEST(CouplingLaw, ExtentFindsACamsOvershootBetweenPoints) {
+  // Rises to 100 and back: the Hermite overshoots between the points; the extent finds it.
+  const CouplingLaw cam =
+      CouplingLaw::tabulated(CouplingKind::Cam, table({{0, 0}, {10, 100}, {20, 100}, {30, 0}}));
+  double lo = 0, hi = 0;
+  for (int i = 0; i <= 30000; ++i) {
+    const double s = cam.slave(i * 1e-3);
+    lo = std::min(lo, s);
+    hi = std::max(hi, s);
+  }
+  const auto [elo, ehi] = cam.slave_extent(0.0, 30.0);
+  EXPECT_NEAR(elo, lo, 1e-6);
+  EXPECT_NEAR(ehi, hi, 1e-6);
+  EXPECT_GT(ehi, 100.0);
+  const auto [plo, phi] = CouplingLaw::constant(5.0).slave_extent(10.0, -5.0);
+  EXPECT_DOUBLE_EQ(plo, -360.0);
+  EXPECT_DOUBLE_EQ(phi, 720.0);
+}
+
 }  // namespace
 }  // namespace opencnc::motion

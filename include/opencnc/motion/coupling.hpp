@@ -6,6 +6,7 @@
 #include <array>
 #include <cstdint>
 #include <type_traits>
+#include <utility>
 
 namespace opencnc::motion {
 
@@ -64,6 +65,9 @@ class CouplingLaw {
   /// slope, the vertex of its quadratic). Any thread; RT-safe.
   double max_slope(double a_mm, double b_mm) const noexcept;
   double max_curvature(double a_mm, double b_mm) const noexcept;
+  /// The smallest and largest slave offset for master offsets between `a_mm` and `b_mm` (either
+  /// order; exact: a cam's interior extremes are the roots of its slope). Any thread; RT-safe.
+  std::pair<double, double> slave_extent(double a_mm, double b_mm) const noexcept;
   /// Pitch at master offset `d_mm` for the pitch laws (mm per revolution; 0 for a cam). Any thread.
   double pitch_at(double d_mm) const noexcept;
 
