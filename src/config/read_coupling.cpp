@@ -75,13 +75,15 @@ void read_tables(Section& s, CouplingProfile& c) {
   if (n == nullptr) return;
   const toml::array* list = n->as_array();
   if (list == nullptr || !list->is_array_of_tables() || list->size() > kMaxTables) {
-    s.error("table", fmt::format("coupling.table must be an array of tables ([[coupling.table]]), at most {}",
-                                 kMaxTables),
-            "config.type");
+    s.error(
+        "table",
+        fmt::format("coupling.table must be an array of tables ([[coupling.table]]), at most {}", kMaxTables),
+        "config.type");
     return;
   }
   for (std::size_t i = 0; i < list->size(); ++i) {
-    Section t(*(*list)[i].as_table(), fmt::format("coupling.table[{}]", i + 1), {"kind", "points"}, s.reporter());
+    Section t(*(*list)[i].as_table(), fmt::format("coupling.table[{}]", i + 1), {"kind", "points"},
+              s.reporter());
     CouplingTableProfile table;
     table.kind = t.choice<CouplingTableProfile::Kind>(
         "kind", {{"pitch", CouplingTableProfile::Kind::Pitch}, {"cam", CouplingTableProfile::Kind::Cam}},
@@ -108,10 +110,13 @@ void read_coupling(Section& top, MachineProfile& profile) {
     const AxisProfile& m = *profile.find(*master);
     const AxisProfile& sl = *profile.find(*slave);
     if (*master == *slave) s.error("slave", "coupling.slave must not be the master axis", "config.range");
-    if (m.rotary) s.error("master", "coupling.master must be a linear axis (the law's offsets are mm)", "config.range");
-    if (!sl.rotary) s.error("slave", "coupling.slave must be a rotary axis (the law gives degrees)", "config.range");
+    if (m.rotary)
+      s.error("master", "coupling.master must be a linear axis (the law's offsets are mm)", "config.range");
+    if (!sl.rotary)
+      s.error("slave", "coupling.slave must be a rotary axis (the law gives degrees)", "config.range");
     if (m.manual() || sl.manual())
-      s.error(m.manual() ? "master" : "slave", "a coupled axis must be driven, not fed by hand", "config.range");
+      s.error(m.manual() ? "master" : "slave", "a coupled axis must be driven, not fed by hand",
+              "config.range");
   }
   c.from_actual = s.choice<bool>("source", {{"command", false}, {"actual", true}}, false);
   read_tables(s, c);

@@ -87,7 +87,8 @@ void CouplingPass::engage(const canon::Program& program, const canon::Action& a)
       break;
     default: {
       const int t = a.index2 - 1;
-      if (t < 0 || t >= motion::kMaxCouplingTables || axes_.config.table_kind[static_cast<std::size_t>(t)] != kind) {
+      if (t < 0 || t >= motion::kMaxCouplingTables ||
+          axes_.config.table_kind[static_cast<std::size_t>(t)] != kind) {
         fail(program, a.context, a.line,
              fmt::format("this machine has no {} table {} (its profile's [[coupling.table]] entries)",
                          kind == motion::CouplingKind::Cam ? "cam" : "pitch", a.index2));
@@ -119,10 +120,12 @@ void CouplingPass::process_move(canon::Program& program, canon::SegmentId id) {
                      letter(static_cast<Axis>(axes_.config.master_axis))));
     return;
   }
-  if (m.kind == canon::MoveKind::Probe || m.kind == canon::MoveKind::RigidTap || (m.flags & canon::kSpindleSynced)) {
+  if (m.kind == canon::MoveKind::Probe || m.kind == canon::MoveKind::RigidTap ||
+      (m.flags & canon::kSpindleSynced)) {
     fail(program, m.context, m.line,
-         fmt::format("a probe, rigid tap or spindle-synchronised move cannot run while {} is coupled (M175 first)",
-                     axis_letter));
+         fmt::format(
+             "a probe, rigid tap or spindle-synchronised move cannot run while {} is coupled (M175 first)",
+             axis_letter));
     return;
   }
   const int master = axes_.config.master_axis;
@@ -153,7 +156,8 @@ double CouplingPass::master_speed_bound(const canon::Program& program, canon::Se
 void CouplingPass::check_move(const canon::Program& program, canon::SegmentId id, double d0, double d1) {
   const canon::Move& m = program.move(id);
   const char s = letter(static_cast<Axis>(axes_.config.slave_axis));
-  if (law_.kind() == motion::CouplingKind::LinearPitch && (law_.pitch_at(d0) > 0) != (law_.pitch_at(d1) > 0)) {
+  if (law_.kind() == motion::CouplingKind::LinearPitch &&
+      (law_.pitch_at(d0) > 0) != (law_.pitch_at(d1) > 0)) {
     fail(program, m.context, m.line,
          fmt::format("the pitch of M172 reaches 0 on this move (at {:.3f} mm from where it was engaged)",
                      -law_.pitch_mm() / law_.pitch_rate()));
@@ -182,10 +186,11 @@ void CouplingPass::check_move(const canon::Program& program, canon::SegmentId id
   }
   const double curvature_accel = v * v * law_.max_curvature(d0, d1);
   if (curvature_accel > kCurvatureShare * axes_.slave_acceleration) {
-    fail(program, m.context, m.line,
-         fmt::format("the law's curvature alone would accelerate the coupled {} at {:.1f} deg/s² on this move "
-                     "(more than {:.0f} % of its {:.1f}): lower the feed",
-                     s, curvature_accel, kCurvatureShare * 100, axes_.slave_acceleration));
+    fail(
+        program, m.context, m.line,
+        fmt::format("the law's curvature alone would accelerate the coupled {} at {:.1f} deg/s² on this move "
+                    "(more than {:.0f} % of its {:.1f}): lower the feed",
+                    s, curvature_accel, kCurvatureShare * 100, axes_.slave_acceleration));
   }
 }
 

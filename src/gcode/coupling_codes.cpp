@@ -28,27 +28,30 @@ class CouplingCodes final : public CodeHandler {
   // The engine asks CodeHandler::check of G codes only; user M codes are checked as they execute.
   static std::optional<Rejection> problem(const Block& b, int code, const InterpState& state) {
     if (state.modal.cutter_comp != CutterComp::Off)
-      return Rejection{ErrorCode::CouplingCutterComp,
-                       fmt::format("M{} cannot change the axis coupling while cutter compensation is on: G40 first",
-                                   code)};
+      return Rejection{
+          ErrorCode::CouplingCutterComp,
+          fmt::format("M{} cannot change the axis coupling while cutter compensation is on: G40 first",
+                      code)};
     switch (code) {
       case kConstant:
       case kLinear:
         if (!b.has('p') || b.get('p') == 0 || !std::isfinite(b.get('p')))
-          return Rejection{ErrorCode::CouplingWord,
-                           fmt::format("M{} needs the pitch per revolution as P (not 0; negative: a left-hand helix)",
-                                       code)};
+          return Rejection{
+              ErrorCode::CouplingWord,
+              fmt::format("M{} needs the pitch per revolution as P (not 0; negative: a left-hand helix)",
+                          code)};
         if (code == kLinear && !b.has('q'))
-          return Rejection{ErrorCode::CouplingWord,
-                           "M172 needs Q, the change of pitch per unit of master travel (Q0: constant pitch)"};
+          return Rejection{
+              ErrorCode::CouplingWord,
+              "M172 needs Q, the change of pitch per unit of master travel (Q0: constant pitch)"};
         break;
       case kPitchTable:
       case kCam: {
         const double p = b.p_or(0);
         if (!b.has('p') || p != std::floor(p) || p < 1 || p > kMaxTables)
           return Rejection{ErrorCode::CouplingWord,
-                           fmt::format("M{} needs the number of a {} table of the machine as P, 1 to {}", code,
-                                       code == kCam ? "cam" : "pitch", kMaxTables)};
+                           fmt::format("M{} needs the number of a {} table of the machine as P, 1 to {}",
+                                       code, code == kCam ? "cam" : "pitch", kMaxTables)};
         break;
       }
       default:
@@ -86,7 +89,8 @@ class CouplingCodes final : public CodeHandler {
 
 void add_coupling_codes(Extensions& ext) {
   auto codes = std::make_shared<CouplingCodes>();
-  for (int code : {kConstant, kLinear, kPitchTable, kCam, kOff}) ext.m[static_cast<std::size_t>(code)] = codes;
+  for (int code : {kConstant, kLinear, kPitchTable, kCam, kOff})
+    ext.m[static_cast<std::size_t>(code)] = codes;
 }
 
 std::shared_ptr<const Extensions> coupling_extensions(Dialect dialect) {

@@ -77,7 +77,9 @@ class CouplingSink final : public canon::Sink {
   void arc_feed(canon::SegmentId, const canon::ArcFeed&) override { pass_.process(*program_); }
   void straight_probe(canon::SegmentId, const Pose&) override { pass_.process(*program_); }
   void rigid_tap(canon::SegmentId, const Pose&, double) override { pass_.process(*program_); }
-  void nurbs_feed(canon::SegmentId, int, std::span<const canon::NurbsPoint>) override { pass_.process(*program_); }
+  void nurbs_feed(canon::SegmentId, int, std::span<const canon::NurbsPoint>) override {
+    pass_.process(*program_);
+  }
 
  private:
   CouplingPass& pass_;
