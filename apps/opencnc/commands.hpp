@@ -36,5 +36,6 @@ void add_gcode_commands(CLI::App& app, Registry& registry);   ///< check, canon,
 void add_run_command(CLI::App& app, Registry& registry);
 void add_plot_command(CLI::App& app, Registry& registry);
 void add_calibrate_command(CLI::App& app, Registry& registry);
+void add_helix_command(CLI::App& app, Registry& registry);
 
 }  // namespace opencnc::cli

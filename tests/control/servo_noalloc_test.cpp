@@ -115,8 +115,9 @@ TEST(ServoAllocations, NoneInsideTheCoupledTick) {
   const auto dir = std::filesystem::temp_directory_path() / "opencnc-noalloc-coupled";
   std::filesystem::create_directories(dir);
   const std::string program = (dir / "broach.ngc").string();
-  std::ofstream(program) << "G21 G90 G0 X0 Z0 C0\nM171 P60\nG1 X0.1 F60\nG1 Z40 F6000\nM172 P600 Q-0.2\n"
-                            "G1 Z80\nM173 P1\nG1 Z120\nM174 P2\nG1 Z100\nG0 Z0\nM175\nM171 P60\nG1 Z200 F3000\nM2\n";
+  std::ofstream(program)
+      << "G21 G90 G0 X0 Z0 C0\nM171 P60\nG1 X0.1 F60\nG1 Z40 F6000\nM172 P600 Q-0.2\n"
+         "G1 Z80\nM173 P1\nG1 Z120\nM174 P2\nG1 Z100\nG0 Z0\nM175\nM171 P60\nG1 Z200 F3000\nM2\n";
   g_allocations = 0;
   Armed a(loaded(config::load_profile(OPENCNC_SOURCE_DIR "/configs/broach-zc.toml")));
   a.ask(Request::simple(CommandKind::MachineOn));

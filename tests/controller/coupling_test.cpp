@@ -177,5 +177,18 @@ TEST(Coupling, PreflightRefusesAtTheLine) {
       << messages(limited.opened);
 }
 
+TEST(Coupling, TheDemoJobsPassTheBroachsPreflight) {
+  for (const char* job : {"broach-constant.ngc", "broach-variable.ngc"}) {
+    Diagnostics d;
+    const config::MachineProfile p = broach();
+    SimRig rig(p, GcodeProgramSource::create(p, d));
+    rig.step();
+    ASSERT_TRUE(rig.request(Request::simple(CommandKind::MachineOn)).accepted);
+    ASSERT_TRUE(rig.request(Request::set_mode(Mode::Auto)).accepted);
+    const Outcome o = rig.request(Request::open(std::string(OPENCNC_SOURCE_DIR "/examples/") + job), 100000);
+    EXPECT_TRUE(o.accepted) << job << "\n" << messages(o);
+  }
+}
+
 }  // namespace
 }  // namespace opencnc::control::test
