@@ -66,7 +66,10 @@ double arc_extent(const double start[3], const double end[3], const double cente
                   Box& box) {
   int a, b, n;
   plane_axes(plane, a, b, n);
-  const double r = std::hypot(start[a] - center[a], start[b] - center[b]);
+  // An arc whose end is off its start circle runs as a spiral between the two radii: the
+  // larger one bounds its extremes.
+  const double r = std::max(std::hypot(start[a] - center[a], start[b] - center[b]),
+                            std::hypot(end[a] - center[a], end[b] - center[b]));
   const double a0 = std::atan2(start[b] - center[b], start[a] - center[a]);
   const double a1 = std::atan2(end[b] - center[b], end[a] - center[a]);
   const double sweep = swept(a0, a1, turns);

@@ -133,14 +133,27 @@ int main(int argc, char** argv) {
   int service_every = 1;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
+    if (a == "--help" || a == "-h") {
+      fmt::print(
+          "usage: controller_run [--profile FILE] [--set key=value]... [--no-report] [--service-every N] "
+          "[files...]\n  without files: the reference programs built from canonical calls\n");
+      return 0;
+    }
     if (a == "--profile" && i + 1 < argc) {
       profile_file = argv[++i];
     } else if (a == "--set" && i + 1 < argc) {
       sets.emplace_back(argv[++i]);
     } else if (a == "--service-every" && i + 1 < argc) {
       service_every = std::atoi(argv[++i]);
+      if (service_every < 1) {
+        fmt::print(stderr, "controller_run: --service-every takes a whole number of periods, 1 or more\n");
+        return 2;
+      }
     } else if (a == "--no-report") {
       report = false;
+    } else if (a.starts_with('-')) {
+      fmt::print(stderr, "controller_run: unknown option {} (see --help)\n", a);
+      return 2;
     } else {
       jobs.push_back({a.substr(a.find_last_of('/') + 1), nullptr, a});
     }

@@ -36,6 +36,9 @@ gcode::Options fuzz_options(std::uint8_t flags) {
   if (flags & 8) o.axes = AxisMask::from_letters("XYZUVW");
   if (flags & 16) std::swap(o.axis_map[0], o.axis_map[2]);
   o.quiet_until_segment = (flags & 32) ? 3 : 0;
+  // M99 in the main program repeats it only in scan mode here: in execute mode a repeating
+  // program runs until its caller stops it, which this harness does not.
+  if ((flags & 64) && o.mode == gcode::Mode::Scan) o.main_m99 = gcode::MainM99::Repeat;
   if (flags & 128) {
     o.dialect = gcode::Dialect::Fanuc;
     o.machine = (flags & 8) ? gcode::MachineKind::Lathe : gcode::MachineKind::Mill;
@@ -49,6 +52,7 @@ gcode::Options fuzz_options(std::uint8_t flags) {
   o.limits.max_repeat_count = 5000;
   o.limits.max_segments = 20000;
   o.limits.max_skipped_lines = 20000;
+  o.limits.max_main_repeats = 20;
   return o;
 }
 

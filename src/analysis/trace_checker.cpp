@@ -36,6 +36,22 @@ double segment_distance(const Pose& a, const Pose& b, const Pose& p) {
   return std::sqrt(s);
 }
 
+double line_distance(const Pose& a, const Pose& b, const Pose& p) {
+  double ab2 = 0, t = 0;
+  for (int i : kLinear) {
+    ab2 += (b[i] - a[i]) * (b[i] - a[i]);
+    t += (p[i] - a[i]) * (b[i] - a[i]);
+  }
+  if (!(ab2 > 0)) return linear_distance(a, p);
+  t /= ab2;
+  double s = 0;
+  for (int i : kLinear) {
+    const double q = a[i] + t * (b[i] - a[i]) - p[i];
+    s += q * q;
+  }
+  return std::sqrt(s);
+}
+
 /// Smallest f(a) for a within a quarter turn of a0 and inside [0, sweep] (golden section).
 template <typename F>
 double nearest_angle(F f, double a0, double sweep) {
@@ -193,13 +209,19 @@ TraceChecker::TraceChecker(const plan::MachineLimits& limits, double period_s, d
 double TraceChecker::box_distance(canon::SegmentId id, const Pose& p) const {
   const Pose a = program_->start_of(id), b = program_->end(id);
   double grow = 0;
+  if (program_->move(id).kind == canon::MoveKind::RigidTap) return 0;  // its line has no box
   if (program_->move(id).kind == canon::MoveKind::Arc) {
     const canon::ArcGeometry& g = program_->arc(id);
     const int b0 =
         (g.plane == canon::Plane::XY || g.plane == canon::Plane::YZ || g.plane == canon::Plane::XZ) ? 0 : 6;
-    double r2 = 0;
-    for (int k = 0; k < 3; ++k) r2 += (a[b0 + k] - g.center[k]) * (a[b0 + k] - g.center[k]);
-    grow = 2 * std::sqrt(r2);  // the whole circle fits in the end points' box grown by its diameter
+    double r2 = 0, e2 = 0;
+    for (int k = 0; k < 3; ++k) {
+      r2 += (a[b0 + k] - g.center[k]) * (a[b0 + k] - g.center[k]);
+      e2 += (b[b0 + k] - g.center[k]) * (b[b0 + k] - g.center[k]);
+    }
+    // The whole circle (or spiral, between its two radii) fits in the end points' box grown by
+    // its largest diameter.
+    grow = 2 * std::sqrt(std::max(r2, e2));
   }
   double s = 0;
   for (int i : kLinear) {
@@ -212,7 +234,11 @@ double TraceChecker::box_distance(canon::SegmentId id, const Pose& p) const {
 
 double TraceChecker::distance_to_move(canon::SegmentId id, const Pose& p) const {
   const Pose start = program_->start_of(id), end = program_->end(id);
-  if (program_->move(id).kind == canon::MoveKind::Arc) return arc_distance(program_->arc(id), start, end, p);
+  const canon::MoveKind kind = program_->move(id).kind;
+  if (kind == canon::MoveKind::Arc) return arc_distance(program_->arc(id), start, end, p);
+  // A rigid tap follows the spindle beyond the bottom and above its start while the spindle
+  // reverses (as in LinuxCNC): its contour error is the distance from its line.
+  if (kind == canon::MoveKind::RigidTap) return line_distance(start, end, p);
   return segment_distance(start, end, p);
 }
 

@@ -71,6 +71,7 @@ void ProgramBuilder::set_g5x_offset(int index, const Pose& offset) {
   Action a = make(ActionKind::WorkOffset, index);
   a.pose = program_.add_action_pose(g5x_);
   add(a);
+  if (css_max_rpm_ > 0) add_spindle_speed(0);  // the spindle axis moved (LinuxCNC's canon)
 }
 
 void ProgramBuilder::set_g92_offset(const Pose& offset) {
@@ -78,6 +79,7 @@ void ProgramBuilder::set_g92_offset(const Pose& offset) {
   Action a = make(ActionKind::G92Offset);
   a.pose = program_.add_action_pose(g92_);
   add(a);
+  if (css_max_rpm_ > 0) add_spindle_speed(0);
 }
 
 void ProgramBuilder::set_xy_rotation(double degrees) {
@@ -143,6 +145,8 @@ std::unique_ptr<ProgramBuilder> ProgramBuilder::continuation(const Pose& start) 
   next->feed_ = feed_;
   next->feed_mode_ = feed_mode_;
   next->synced_ = synced_;
+  next->css_max_rpm_ = css_max_rpm_;
+  next->spindle_speed_ = spindle_speed_;
   for (int k = 0; k < kSettings; ++k) {
     if (!has_setting_[k]) continue;
     Action a = settings_[k];
@@ -210,12 +214,18 @@ void ProgramBuilder::straight_probe(SegmentId id, const Pose& end) {
   append(MoveKind::Probe, id, current_feed_index());
 }
 
-void ProgramBuilder::rigid_tap(SegmentId id, const Pose& end, double /*scale*/) {
-  // The tap reverses at `end` and comes back: the machine ends where the tap started.
+void ProgramBuilder::rigid_tap(SegmentId id, const Pose& end, double scale) {
+  // The tap goes in to `end`, reverses and comes back: two moves of one segment, so that the
+  // next move starts where the tap started. Their feed is the way out's speed factor.
   const Pose start = position_;
+  const std::uint32_t factor = program_.add_feed(scale);
+  last_feed_mm_ = -1;  // later moves refer to a feed added after this one (streams release in order)
+  const std::size_t first = program_.size();
   to_machine(end, position_);
-  append(MoveKind::RigidTap, id, current_feed_index());
+  append(MoveKind::RigidTap, id, factor);
   position_ = start;
+  append(MoveKind::RigidTap, id, factor, kTapReturn);
+  program_.note_split(id, first, 2);
 }
 
 void ProgramBuilder::arc_feed(SegmentId id, const ArcFeed& arc) {
@@ -311,13 +321,31 @@ void ProgramBuilder::stop_speed_feed_synch() {
 }
 
 void ProgramBuilder::set_spindle_speed(int spindle, double rpm) {
-  add(make(ActionKind::SpindleSpeed, spindle, 0, rpm));
+  spindle_speed_ = rpm;
+  add_spindle_speed(spindle);
+}
+
+// Under G96 the S word is a surface speed (m/min, or ft/min in inch programs): the action holds
+// it in mm/min with the X of the spindle axis in machine coordinates, where program X = 0 lies
+// (G5x, G92 and tool offsets, as LinuxCNC's canon sends them; rotation left out, as there).
+void ProgramBuilder::add_spindle_speed(int spindle) {
+  if (css_max_rpm_ <= 0) {
+    add(make(ActionKind::SpindleSpeed, spindle, 0, spindle_speed_));
+    return;
+  }
+  const double per_min = units_ == Units::Inch ? 12.0 * 25.4 : 1000.0;
+  Action a = make(ActionKind::SpindleSpeed, spindle, 1, spindle_speed_ * per_min);
+  Pose axis{};
+  axis[0] = g5x_[0] + g92_[0] + tool_[0];
+  a.pose = program_.add_action_pose(axis);
+  add(a);
 }
 void ProgramBuilder::start_spindle_clockwise(int spindle) { simple(ActionKind::SpindleCw, spindle); }
 void ProgramBuilder::start_spindle_counterclockwise(int spindle) { simple(ActionKind::SpindleCcw, spindle); }
 void ProgramBuilder::stop_spindle_turning(int spindle) { simple(ActionKind::SpindleStop, spindle); }
 void ProgramBuilder::set_spindle_mode(int spindle, double css_max) {
-  add(make(ActionKind::SpindleMode, spindle, 0, css_max));
+  css_max_rpm_ = std::fabs(css_max);
+  add(make(ActionKind::SpindleMode, spindle, 0, css_max_rpm_));
 }
 void ProgramBuilder::orient_spindle(int spindle, double degrees, int direction) {
   add(make(ActionKind::SpindleOrient, spindle, direction, degrees));

@@ -304,18 +304,7 @@ void Servo::write_steppers() noexcept {
 void Servo::write_machine_outputs() noexcept {
   out_.estop_release = state_ != State::EStopped;
   const bool on = drives_enabled_;
-  double rpm = spindle_rpm_ * (spindle_override_enabled_ ? spindle_override_ : 1.0);
-  if (config_.spindle_max_rpm > 0) rpm = std::min(rpm, config_.spindle_max_rpm);
-  // A start waits while an interlock rule blocks it; a spindle that runs is not stopped by that.
-  if (!on || spindle_direction_ == machine::SpindleDirection::Stopped) {
-    spindle_running_ = false;
-  } else if (!spindle_running_ && spindle_may_start()) {
-    spindle_running_ = true;
-  }
-  out_.spindle.speed_rpm = on ? rpm : 0.0;
-  out_.spindle.direction = on && spindle_running_ ? spindle_direction_ : machine::SpindleDirection::Stopped;
-  out_.spindle.orient = on && orient_;
-  out_.spindle.orient_angle_deg = orient_angle_;
+  write_spindle(on);
   out_.process.flood = on && flood_;
   out_.process.mist = on && mist_;
   if (preparing_ && in_.tool.prepared) {
@@ -327,6 +316,41 @@ void Servo::write_machine_outputs() noexcept {
   out_.tool.change = on && sync_step_ == SyncStep::ToolChanger;
   out_.digital_out = (digital_out_ & ~rule_outputs_mask_) | (rule_outputs_ & rule_outputs_mask_);
   out_.analog_out = analog_out_;
+}
+
+// The spindle's command. Under G96 the speed follows the commanded X every period, as
+// LinuxCNC's motion does: rpm = v / (2π·|X − X_axis|) with v the surface speed (mm/min), the
+// override applied, then the G96 D limit, then the spindle's own maximum; on the axis itself the
+// D limit. A rigid tap (G33.1) turns it the other way from the bottom of the hole until the tap
+// is out, at its I factor times the speed.
+void Servo::write_spindle(bool on) noexcept {
+  const double ovr = spindle_override_enabled_ ? spindle_override_ : 1.0;
+  double rpm = spindle_rpm_ * ovr;
+  if (css_max_rpm_ > 0) {
+    constexpr double kTwoPi = 6.283185307179586;
+    const double radius = std::fabs(commanded_[Axis::X] - css_axis_x_);
+    rpm = radius > 0 ? css_surface_mm_min_ / (kTwoPi * radius) * ovr : css_max_rpm_;
+    rpm = std::min(rpm, css_max_rpm_);
+  }
+  machine::SpindleDirection dir = spindle_direction_;
+  if (activity_ == Activity::Program && tick_out_.tap_reverse) {
+    rpm *= tick_out_.tap_speed_scale;
+    if (dir == machine::SpindleDirection::Clockwise)
+      dir = machine::SpindleDirection::Counterclockwise;
+    else if (dir == machine::SpindleDirection::Counterclockwise)
+      dir = machine::SpindleDirection::Clockwise;
+  }
+  if (config_.spindle_max_rpm > 0) rpm = std::min(rpm, config_.spindle_max_rpm);
+  // A start waits while an interlock rule blocks it; a spindle that runs is not stopped by that.
+  if (!on || spindle_direction_ == machine::SpindleDirection::Stopped) {
+    spindle_running_ = false;
+  } else if (!spindle_running_ && spindle_may_start()) {
+    spindle_running_ = true;
+  }
+  out_.spindle.speed_rpm = on ? rpm : 0.0;
+  out_.spindle.direction = on && spindle_running_ ? dir : machine::SpindleDirection::Stopped;
+  out_.spindle.orient = on && orient_;
+  out_.spindle.orient_angle_deg = orient_angle_;
 }
 
 // --- status ----------------------------------------------------------------------------------

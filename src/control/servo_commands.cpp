@@ -255,6 +255,7 @@ Refusal Servo::manual_spindle_or_coolant(const Command& c) noexcept {
       if (spindle_direction_ == machine::SpindleDirection::Stopped && !spindle_may_start())
         return Refusal::Interlock;
       spindle_rpm_ = c.value;
+      css_max_rpm_ = 0;  // the operator's speed is in rpm
       spindle_direction_ =
           c.flag ? machine::SpindleDirection::Clockwise : machine::SpindleDirection::Counterclockwise;
       spindle_changed_tick_ = tick_;

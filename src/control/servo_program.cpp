@@ -50,7 +50,8 @@ bool Servo::spindle_change_pending() const noexcept {
   if (ring.available() == 0) return false;
   const MachineAction& next = ring.front();
   const bool spindle = next.code == ActionCode::SpindleCw || next.code == ActionCode::SpindleCcw ||
-                       next.code == ActionCode::SpindleSpeed || next.code == ActionCode::SpindleStop;
+                       next.code == ActionCode::SpindleSpeed || next.code == ActionCode::SpindleStop ||
+                       next.code == ActionCode::SpindleMode || next.code == ActionCode::SurfaceSpeed;
   if (!spindle) return false;
   const traj::BlockQueue& q = channels_->blocks;
   const std::uint64_t first = std::max(q.popped(), tick_out_.block_seq);
@@ -196,6 +197,15 @@ void Servo::apply_action(const MachineAction& a) noexcept {
   switch (a.code) {
     case ActionCode::SpindleSpeed:
       spindle_rpm_ = a.value;
+      spindle_changed_tick_ = tick_;
+      break;
+    case ActionCode::SpindleMode:
+      css_max_rpm_ = a.value;
+      spindle_changed_tick_ = tick_;
+      break;
+    case ActionCode::SurfaceSpeed:
+      css_surface_mm_min_ = a.value;
+      css_axis_x_ = a.value2;
       spindle_changed_tick_ = tick_;
       break;
     case ActionCode::SpindleCw:

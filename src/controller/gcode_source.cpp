@@ -597,6 +597,9 @@ std::unique_ptr<ProgramStream> GcodeProgramSource::execute(const std::string& pa
                                                            const LoadOptions& options) {
   gcode::Options o = options_for(path, options);
   o.mode = gcode::Mode::Execute;
+  // As LinuxCNC's task runs it, M99 in the main program starts it again until the operator
+  // stops the run (the preflight scans it once, as rs274 reads it).
+  o.main_m99 = gcode::MainM99::Repeat;
   return std::make_unique<GcodeStream>(o, path, start, config_.default_tolerance_mm, config_.tools,
                                        passes());
 }

@@ -88,6 +88,13 @@ std::optional<MachineAction> machine_action(const canon::Program& program, std::
   switch (a.kind) {
     case ActionKind::SpindleSpeed:
       m.code = ActionCode::SpindleSpeed;
+      if (a.index2 == 1) {  // G96: a surface speed about the spindle axis at this X
+        m.code = ActionCode::SurfaceSpeed;
+        m.value2 = program.action_pose(a.pose)[Axis::X];
+      }
+      break;
+    case ActionKind::SpindleMode:
+      m.code = ActionCode::SpindleMode;
       break;
     case ActionKind::SpindleCw:
       m.code = ActionCode::SpindleCw;
@@ -153,7 +160,6 @@ std::optional<MachineAction> machine_action(const canon::Program& program, std::
       m.code = ActionCode::AxisCoupling;
       m.value2 = program.action_pose(a.pose)[0];
       break;
-    case ActionKind::SpindleMode:
     case ActionKind::ProbeOn:
     case ActionKind::ProbeOff:
       m.code = ActionCode::Ignore;

@@ -132,6 +132,25 @@ void peck_hole(CycleMoves& m, const CycleBlock& cb, double a, double b) {
   m.traverse(a, b, cb.clear);
 }
 
+// The feed of a tap in and out, with the coordinates in the order LinuxCNC 2.9 gives them:
+// in G18 and G19 its G74/G84 hand (a, b, c) to the plane's mapping rotated by one place. In
+// G18 a hole at Z3 X1 tapped to Y-2 is fed to X-2 Y3 Z1, in G19 a hole at Y1 Z3 tapped to X-2
+// to X3 Y-2 Z1: sideways moves that rs274 prints and LinuxCNC's motion runs. opencnc follows
+// LinuxCNC here (issue 6); docs/cycles.md says so.
+void tap_feed(CycleMoves& m, const CycleBlock& cb, double a, double b, double c) {
+  switch (cb.ax.c) {
+    case 0:  // G19: drilling along X
+      m.feed(c, a, b);
+      return;
+    case 1:  // G18: drilling along Y
+      m.feed(b, c, a);
+      return;
+    default:
+      m.feed(a, b, c);
+      return;
+  }
+}
+
 // G84 (right hand) and G74 (left hand) floating-chuck tapping: feed in with the overrides off,
 // reverse the spindle, dwell, feed out, restore the spindle direction and the overrides.
 void tap_hole(CycleMoves& m, const CycleBlock& cb, const ModalState& modal, double a, double b) {
@@ -147,11 +166,11 @@ void tap_hole(CycleMoves& m, const CycleBlock& cb, const ModalState& modal, doub
   canon::Sink& out = m.out();
   out.disable_feed_override();
   out.disable_speed_override(0);
-  m.feed(a, b, cb.bottom);
+  tap_feed(m, cb, a, b, cb.bottom);
   out.stop_spindle_turning(0);
   start_spindle(out, right ? canon::SpindleDirection::Counterclockwise : canon::SpindleDirection::Clockwise);
   out.dwell(cb.dwell);
-  m.feed(a, b, cb.clear);
+  tap_feed(m, cb, a, b, cb.clear);
   out.stop_spindle_turning(0);
   start_spindle(out, cb.spindle);
   if (modal.feed_override) out.enable_feed_override();

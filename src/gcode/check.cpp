@@ -233,6 +233,7 @@ void Engine::check_other_codes() {
 }
 
 void Engine::check_word_rules(const Block& b) {
+  if (b.o_type == OWord::M98) return check_m98(b);
   const int motion = b.motion;
   const int m5 = b.m[kGroupIo], m6 = b.m[kGroupToolChange], m7 = b.m[kGroupSpindle], m9 = b.m[kGroupOverride];
   const int g0 = b.g[kGroupNonModal], g7 = b.g[kGroupCutterComp], g8 = b.g[kGroupToolLength];
@@ -305,6 +306,42 @@ void Engine::check_word_rules(const Block& b) {
               "G76 needs I, J and K words (thread offset, first cut depth, full thread depth): {}{}{}missing",
               b.has('i') ? "" : "I ", b.has('j') ? "" : "J ", b.has('k') ? "" : "K ");
   }
+}
+
+// An M98 line: P (the subprogram's number, whole) and L (calls, 0 or more: the parser refuses
+// a negative L) are its words.
+// LinuxCNC's word rules apply to the others; what they let through (axis words of a modal
+// motion, F, S, T, other codes), LinuxCNC reads and ignores: refused here, since a reader
+// would expect it to act.
+void Engine::check_m98(const Block& b) {
+  const int at = b.o_at;
+  if (!b.has('p'))
+    fail_at(at, ErrorCode::FanucCallProgramMissing,
+            "M98 needs a P word: the number of the subprogram (O number) to call");
+  const double p = b.get('p');
+  if (std::fabs(p - std::floor(p + 0.5)) > 0.0001)
+    fail_at(b.word_position('p'), ErrorCode::NotAnInteger, "M98 P{}: a subprogram's number is a whole number",
+            p);
+  Block rest = b;
+  rest.o_type = OWord::None;
+  rest.words &= ~((1u << ('p' - 'a')) | (1u << ('l' - 'a')));
+  check_word_rules(rest);
+  int first = -1;
+  const auto take = [&first](int position) {
+    if (position >= 0 && (first < 0 || position < first)) first = position;
+  };
+  for (int letter = 0; letter < 26; ++letter) {
+    if ((rest.words >> letter) & 1u) take(rest.word_position(static_cast<char>('a' + letter)));
+  }
+  for (int group = 0; group < kGGroupCount; ++group) take(rest.g_position(group));
+  for (int group = 0; group < kMGroupCount; ++group) take(rest.m_position(group));
+  if (rest.dollar_flag) take(rest.dollar_at);
+  if (rest.radius_flag || rest.theta_flag) take(rest.polar_position());
+  if (first >= 0)
+    fail_at(first, ErrorCode::OwordSyntax,
+            "a word other than P and L on an M98 line: the line only calls the subprogram, so put it on a "
+            "line of "
+            "its own");
 }
 
 // P: which codes use it, and the values arcs (turns) and M19 (direction) accept.

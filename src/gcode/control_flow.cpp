@@ -72,7 +72,7 @@ void Engine::control_flow() {
   const Block& b = block_;
   ControlState& c = st_.control;
   if (!c.skipping_to.empty() && c.skipping_to != b.o_name) return;
-  if (!c.seeking_sub.empty() && b.o_type != OWord::Sub) return;
+  if (!c.seeking_sub.empty() && b.o_type != OWord::Sub && b.o_type != OWord::Program) return;
   switch (b.o_type) {
     case OWord::Sub: return o_sub();
     case OWord::EndSub:
@@ -91,12 +91,11 @@ void Engine::control_flow() {
     case OWord::EndRepeat: return o_end_loop();
     case OWord::Program:
       if (fanuc()) return fanuc_program_line();
-      // A program number line: nothing to do in the main program; Fanuc subprograms are read
-      // by the Fanuc dialect.
-      if (st_.frames.size() > 1)
-        fail(ErrorCode::Unsupported,
-             "O{} program numbers inside a subprogram are Fanuc style: choose the Fanuc dialect", block_.o_name);
-      return;
+      return o_program();
+    case OWord::M98:
+      return o_m98();
+    case OWord::M99:
+      return o_m99();
     case OWord::Goto:
     case OWord::FanucWhile:
     case OWord::FanucEnd:
@@ -106,8 +105,17 @@ void Engine::control_flow() {
   }
 }
 
+void Engine::mixed_styles(const char* what) const {
+  fail(ErrorCode::OwordMixedStyles,
+       "{}: numbered subprograms (O{} ... M99, called by M98) and O-word ones "
+       "(o{} sub ... endsub, called by 'call') do not mix",
+       what, block_.o_name, block_.o_name);
+}
+
 void Engine::o_sub() {
   ControlState& c = st_.control;
+  if (st_.frames.back().kind == CallKind::Numbered)
+    mixed_styles(fmt::format("o{} sub reached by M98", block_.o_name).c_str());
   auto define = [&] {
     if (const LabelInfo* old = find_label(block_.o_name)) {
       if (old->at.line == line_ && old->at.file == line_file_)
@@ -139,6 +147,10 @@ void Engine::o_sub() {
 
 void Engine::o_return() {
   ControlState& c = st_.control;
+  if (st_.frames.back().kind == CallKind::Numbered)
+    mixed_styles(fmt::format("{} in a subprogram called by M98 (it returns with M99)",
+                             block_.o_type == OWord::EndSub ? "endsub" : "return")
+                     .c_str());
   c.return_value = block_.o_has_value ? block_.o_value : 0.0;
   c.value_returned = block_.o_has_value;
   if (st_.frames.size() == 1 && !c.defining_sub)
@@ -166,38 +178,118 @@ void Engine::leave_frame() {
 }
 
 void Engine::o_call() {
-  const std::uint32_t depth = static_cast<std::uint32_t>(st_.frames.size());
-  const std::uint32_t max_depth = opt_.limits.max_call_depth == 0 ? 10 : opt_.limits.max_call_depth;
-  if (depth >= max_depth)
-    fail(ErrorCode::LimitCallDepth, "{} call nests subprograms deeper than {} levels (limit max_call_depth)",
-         label_text(block_.o_name), max_depth - 1);
-  ControlState& c = st_.control;
-  c.skipping_to.clear();
   CallFrame frame;
-  frame.sub = block_.o_name;
+  frame.kind = CallKind::OWord;
   frame.return_to = st_.next;
   for (int i = 0; i < kSubArgumentCount; ++i) {
     frame.saved_args[static_cast<std::size_t>(i)] = st_.parameters[static_cast<std::size_t>(1 + i)];
+  }
+  enter_sub(std::move(frame), block_.o_name, fmt::format("o<{}>", block_.o_name));
+  // The arguments, once the call is sure to happen.
+  for (int i = 0; i < kSubArgumentCount; ++i) {
     st_.parameters[static_cast<std::size_t>(1 + i)] = i < block_.arg_count ? block_.args[static_cast<std::size_t>(i)] : 0.0;
   }
+}
+
+// Pushes the frame of a call to sub `name` (its kind and return position set) and goes to its
+// body: a sub met before, a file <name>.ngc on the search path, or later in this file.
+void Engine::enter_sub(CallFrame frame, std::string name, std::string_view context_name) {
+  const std::uint32_t depth = static_cast<std::uint32_t>(st_.frames.size());
+  const std::uint32_t max_depth = opt_.limits.max_call_depth == 0 ? 10 : opt_.limits.max_call_depth;
+  const bool m98 = frame.kind == CallKind::Numbered;
+  if (depth >= max_depth)
+    fail(ErrorCode::LimitCallDepth, "{} nests subprograms deeper than {} levels (limit max_call_depth)",
+         m98 ? fmt::format("M98 P{}", name) : fmt::format("{} call", label_text(name)), max_depth - 1);
+  ControlState& c = st_.control;
+  c.skipping_to.clear();
+  frame.sub = name;
   const std::uint32_t parent_context = st_.frames.back().context;
   const canon::SourceRef call_site{line_file_, line_, raw_column(raw_, block_.o_at)};
   st_.frames.push_back(std::move(frame));
-  // Find the body: a sub met before, a file <name>.ngc on the search path, or later in this file.
-  std::string name = block_.o_name;
   if (const std::size_t slash = name.rfind('/'); slash != std::string::npos) name = name.substr(slash + 1);
   if (const LabelInfo* l = find_label(name); l != nullptr && l->kind == LabelKind::Sub) {
     jump_to(l->at);
   } else {
     if (!open_sub_file(name) && in_mdi_)
-      fail(ErrorCode::OwordSubNotFound, "o<{}> is not defined, and no file {}.ngc is on the subroutine path",
-           name, name);
+      fail(ErrorCode::OwordSubNotFound, "{} is not defined, and no file {}.ngc is on the subroutine path",
+           m98 ? fmt::format("O{}", name) : fmt::format("o<{}>", name), name);
     c.skipping_to = name;
     c.seeking_sub = name;
     c.skip_start_line = line_;
   }
   st_.frames.back().context =
-      sources_->context(parent_context, call_site, st_.next.file, fmt::format("o<{}>", block_.o_name));
+      sources_->context(parent_context, call_site, st_.next.file, std::string(context_name));
+}
+
+// A bare O number. Where an M98 looked for it, the numbered subprogram starts here; in the
+// flow of the program (a main program's number, or the next subprogram after one without
+// M99) reading goes on into it, as LinuxCNC does. A sub called with 'call' cannot be one.
+void Engine::o_program() {
+  ControlState& c = st_.control;
+  if (st_.frames.back().kind == CallKind::OWord)
+    mixed_styles(fmt::format("O{} reached by 'o{} call' (a numbered subprogram is called with M98)",
+                             block_.o_name, block_.o_name)
+                     .c_str());
+  if (c.seeking_sub.empty()) return;
+  if (const LabelInfo* old = find_label(block_.o_name); old != nullptr)
+    fail(ErrorCode::OwordSubRedefined, "O{} is defined twice (first at {}:{}): renumber one of them",
+         block_.o_name, sources_->file(old->at.file), old->at.line);
+  save_label(LabelKind::Sub);
+  c.skipping_to.clear();
+  c.seeking_sub.clear();
+}
+
+// M98 P L: a call of the numbered subprogram O<P>, L times (none for L0). #1..#30 are not
+// saved: they are global for numbered subprograms. While repeats remain, the call returns to
+// its own line, which is read again.
+void Engine::o_m98() {
+  if (!parser_.numbered_assignments.empty() || !parser_.named_assignments.empty())
+    fail_at(
+        block_.o_at, ErrorCode::OwordSyntax,
+        "a parameter assignment on an M98 line: LinuxCNC would not make it, so put it on a line of its own");
+  const std::string name = std::to_string(round_to_int(block_.get('p')));
+  block_.o_name = name;
+  CallFrame& caller = st_.frames.back();
+  CallFrame frame;
+  frame.kind = CallKind::Numbered;
+  frame.return_to = st_.next;
+  if (block_.has('l') && in_mdi_) {
+    // An MDI line is not read again: the body runs again from its M99 (L0: not at all).
+    if (round_to_int(block_.get('l')) == 0) return;
+    frame.m98_runs_left = round_to_int(block_.get('l')) - 1;
+  } else if (block_.has('l')) {
+    if (caller.m98_left == -1) caller.m98_left = round_to_int(block_.get('l'));
+    --caller.m98_left;
+    if (caller.m98_left > 0) {
+      count_loop();
+      frame.return_to = {line_file_, line_offset_, line_};
+    } else {
+      caller.m98_left = -1;
+    }
+    if (round_to_int(block_.get('l')) == 0) return;
+  }
+  enter_sub(std::move(frame), name, fmt::format("O{}", name));
+}
+
+// M99 in a subprogram: back to the caller (to the M98 line itself while its L repeats remain).
+void Engine::o_m99() {
+  ControlState& c = st_.control;
+  const CallFrame& f = st_.frames.back();
+  if (f.kind != CallKind::Numbered)
+    mixed_styles(
+        fmt::format("M99 in o<{}> (called by 'call': it ends with endsub or return)", f.sub).c_str());
+  c.return_value = 0;
+  c.value_returned = false;
+  if (f.m98_runs_left > 0) {
+    if (const LabelInfo* body = find_label(f.sub); body != nullptr) {
+      --st_.frames.back().m98_runs_left;
+      count_loop();
+      jump_to(body->at);
+      return;
+    }
+  }
+  jump_to(f.return_to);
+  leave_frame();
 }
 
 bool Engine::open_sub_file(const std::string& name) {

@@ -131,29 +131,39 @@ void Engine::start() {
   line_file_ = st_.next.file;
   RawLine line;
   std::uint32_t n = 0;
-  for (;;) {
-    if (!f.next(line)) {
-      line_ = n;
-      fail(ErrorCode::ProgramEmpty, "the program file is empty{}", n == 0 ? "" : " (blank lines only)");
+  // The first line that is not blank, false at the end of the file.
+  const auto next_text = [&]() {
+    while (f.next(line)) {
+      ++n;
+      if (line.text.size() + (line.newline ? 1 : 0) > kMaxLineLength) {
+        line_ = n;
+        line_too_long();
+      }
+      if (!trim_raw_line(line.text).empty()) return true;
     }
-    ++n;
-    if (line.text.size() + (line.newline ? 1 : 0) > kMaxLineLength) {
-      line_ = n;
-      line_too_long();
-    }
-    if (!trim_raw_line(line.text).empty()) break;
-  }
+    return false;
+  };
+  // An empty program is reported on its first line, as every other error is placed.
+  const auto empty = [&](std::string_view what) {
+    line_ = 1;
+    raw_.clear();
+    fail(ErrorCode::ProgramEmpty, "the program file {}: there is nothing to run", what);
+  };
+  if (!next_text()) empty(n == 0 ? "is empty" : "holds blank lines only");
   std::string_view first = trim_raw_line(line.text);
   while (!first.empty() && (first.front() == ' ' || first.front() == '\t')) first.remove_prefix(1);
   if (first == "%") {
+    const std::uint64_t body = f.tell();
+    if (!next_text()) empty("holds a '%' line and nothing else");
     st_.percent_delimited = true;
-    st_.next = {st_.next.file, f.tell(), 2};   // LinuxCNC counts the '%' line as line 1
+    st_.next = {st_.next.file, body, 2};  // LinuxCNC counts the '%' line as line 1
   } else {
     // Fanuc: "%O1000(NAME)" opens the tape and numbers the program on one line.
     st_.percent_delimited = fanuc() && first.front() == '%' && fanuc_program_number(first).has_value();
     st_.next = {st_.next.file, 0, 1};
   }
   st_.frames.front().fanuc.body = st_.next;
+  st_.control.main_start = st_.next;
   need_seek_ = true;
 }
 
@@ -368,7 +378,11 @@ Engine::LineKind Engine::read_block() {
   norm_len_ = normalize_line(raw_, norm_.data(), fanuc());
   const std::string_view text(norm_.data(), norm_len_);
   if (text == "%" && fanuc() && !in_mdi_ && fanuc_percent_line()) return LineKind::Empty;
-  if (text == "%" && st_.percent_delimited && !in_mdi_) return LineKind::ProgramEnd;
+  if (text == "%" && st_.percent_delimited && !in_mdi_) {
+    // Nothing after the closing '%' belongs to the program, not even a subprogram (LinuxCNC).
+    if (!st_.control.seeking_sub.empty()) sub_not_found();
+    return LineKind::ProgramEnd;
+  }
   if (text.empty() || (text.front() == '/' && opt_.block_delete)) return LineKind::Empty;
   if (fanuc() && (text.front() == '$' || text.front() == '%')) check_foreign_syntax();
 
@@ -402,7 +416,7 @@ bool Engine::process_line() {
     case LineKind::Block: break;
   }
   if (block_.o_type != OWord::None) {
-    if (in_mdi_ && block_.o_type != OWord::Call && block_.o_type != OWord::MacroCall)
+    if (in_mdi_ && block_.o_type != OWord::Call && block_.o_type != OWord::MacroCall && block_.o_type != OWord::M98)
       fail(ErrorCode::OwordInMdi,
            "only 'call' O-words and subprogram calls can be used in MDI: control flow needs a program file");
     control_flow();
@@ -484,14 +498,23 @@ void Engine::sub_not_found() {
   const std::string searched = sources_->file(st_.next.file);
   const canon::SourceRef call = sources_->context_info(st_.frames.back().context).call_site;
   const bool own_file = call.file == st_.next.file;
-  throw GcodeError(
-      ErrorCode::OwordSubNotFound,
-      own_file ? fmt::format("o<{}> call: no 'o<{}> sub' follows in this file, and no {}.ngc is on the "
+  const bool m98 = st_.frames.back().kind == CallKind::Numbered;
+  std::string message;
+  if (m98) {
+    message = own_file ? fmt::format(
+                             "M98 P{}: no O{} line follows in this program, and no {}.ngc is on the "
+                             "subroutine path (a numbered subprogram comes after its first call)",
+                             name, name, name)
+                       : fmt::format("M98 P{}: {} has no O{} line", name, searched, name);
+  } else {
+    message = own_file ? fmt::format(
+                             "o<{}> call: no 'o<{}> sub' follows in this file, and no {}.ngc is on the "
                              "subroutine path",
                              name, name, name)
-               : fmt::format("o<{}> call: {} does not define o<{}> (its sub line must name it)", name,
-                             searched, name),
-      -1, Where{call.file, call.line, call.col});
+                       : fmt::format("o<{}> call: {} does not define o<{}> (its sub line must name it)", name,
+                                     searched, name);
+  }
+  throw GcodeError(ErrorCode::OwordSubNotFound, message, -1, Where{call.file, call.line, call.col});
 }
 
 // The file ended while passing over a block to its end label: the block was never closed.

@@ -175,6 +175,7 @@ class Engine final : public ParamHost, public ExecContext {
   void check_g10();
   void check_other_codes();
   void check_p_word();
+  void check_m98(const Block& b);
   void check_extension(int code, int position);   ///< `code` must have a handler
   /// The extension's handler of G code `code` (×10), nullptr if none (or code < 0).
   const CodeHandler* extension_handler(int code) const noexcept {
@@ -281,6 +282,12 @@ class Engine final : public ParamHost, public ExecContext {
   void o_endif();
   void o_break_continue(bool is_break);
   void o_end_loop();
+  void o_program();
+  void o_m98();
+  void o_m99();
+  void enter_sub(CallFrame frame, std::string name, std::string_view context_name);
+  [[noreturn]] void mixed_styles(const char* what) const;
+  void repeat_main();
   LabelInfo* find_label(const std::string& name);
   [[noreturn]] void unmatched(const char* keyword, const char* opener,
                               const char* other_opener = nullptr) const;
@@ -366,6 +373,7 @@ class Engine final : public ParamHost, public ExecContext {
   bool units_programmed_ = false;   ///< a G20/G21 was met (for the units warning)
   bool warned_units_ = false;
   bool warned_spindle_ = false;
+  bool warned_repeat_ = false;      ///< M99 ended the main program (the repeat warning)
   double user_to_program_factor_ = 1.0;
   std::uint32_t line_ = 0;          ///< line number of the block being executed
   std::uint32_t line_file_ = 0;     ///< its file

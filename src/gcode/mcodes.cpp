@@ -398,8 +398,48 @@ void Engine::convert_stop() {
       end_program(m);
       return;
     default:
-      fail(ErrorCode::Unsupported, "M99 (Fanuc-style program repeat) is not supported yet");
+      break;
   }
+  // M99. In a subprogram it is its return, read as such when it starts the line.
+  if (st_.frames.size() > 1)
+    fail_at(
+        block_.m_position(kGroupStop), ErrorCode::OwordSyntax,
+        "M99 returns from a subprogram only at the start of its line: put the other words on a line of their "
+        "own");
+  if (opt_.main_m99 == MainM99::Repeat) return repeat_main();
+  // Read as rs274 reads it; a reader of the scan (a preflight, `opencnc check`) should know
+  // that the machine will not stop here.
+  if (!in_mdi_)
+    warn_once(warned_repeat_, ErrorCode::MainProgramRepeats,
+              "M99 in the main program: the scan ends here, but a run on the machine starts the program "
+              "again from its first line, endlessly, until the operator stops it");
+  end_program(m);
+}
+
+// M99 in the main program with MainM99::Repeat: what LinuxCNC's task does, back to the first
+// line with every setting and parameter as it is (no program-end reset). A scan cannot run
+// an endless program to its end: it stops after max_main_repeats passes with an error that
+// says so. In execute mode each pass starts the block and loop counts afresh, so that the
+// limits still bound a runaway loop inside a pass.
+void Engine::repeat_main() {
+  ControlState& c = st_.control;
+  out_.finish();
+  ++c.main_repeats;
+  if (opt_.mode == Mode::Scan) {
+    const std::uint64_t limit =
+        opt_.limits.max_main_repeats == 0 ? Limits{}.max_main_repeats : opt_.limits.max_main_repeats;
+    if (c.main_repeats > limit)
+      fail_at(
+          block_.m_position(kGroupStop), ErrorCode::LimitMainRepeats,
+          "M99 starts the main program again, endlessly: the scan stopped after {} repetitions (limit "
+          "max_main_repeats); a run repeats it until the operator stops it (or a /M30 with block delete off)",
+          limit);
+  } else {
+    st_.blocks_executed = 0;
+    st_.loop_iterations = 0;
+    skipped_lines_ = 0;
+  }
+  jump_to(c.main_start);
 }
 
 void Engine::end_program(int code) {

@@ -409,7 +409,9 @@ void Engine::arc_center_ijk(int motion, double cur1, double cur2, double end1, d
             a, c1, b, c2);
   const double abs_err = std::fabs(r1 - r2);
   const double rel_err = abs_err / std::max(r1, r2);
-  if (abs_err > spiral_tol && rel_err > kSpiralRelativeTolerance)
+  // LinuxCNC: within the absolute tolerance, or within the relative one up to 100 times the
+  // absolute one (large radii); the planner runs the accepted difference as a spiral.
+  if (abs_err > 100.0 * spiral_tol || (abs_err > spiral_tol && rel_err > kSpiralRelativeTolerance))
     fail_at(at, ErrorCode::ArcEndOffCircle,
             "the arc's end ({}{:.4f}, {}{:.4f}) is not on its circle: around the centre ({}{:.4f}, {}{:.4f}) "
             "the start is "

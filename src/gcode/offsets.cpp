@@ -378,10 +378,15 @@ void Engine::save_home(int code) {
   if (st_.modal.cutter_comp != CutterComp::Off)
     fail_at(block_.g_position(kGroupNonModal), ErrorCode::CompReferencePoint,
             "{} cannot store a reference point while cutter compensation is on: G40 first", g_name(code));
+  // The machine position: X and Y leave the G92 frame through the XY rotation (LinuxCNC's
+  // convert_savehome), the inverse of machine_to_program().
   const PositionState& s = st_.position;
+  Pose p = s.current;
+  for (int i = 0; i < kAxisCount; ++i) p[i] += s.axis_offset[i];
+  rotate(p[0], p[1], s.rotation_xy_deg);
   const std::size_t base = code == 281 ? 5161 : 5181;
   for (int i = 0; i < kAxisCount; ++i) {
-    const double v = s.current[i] + s.tool_offset[i] + s.origin_offset[i] + s.axis_offset[i];
+    const double v = p[i] + s.tool_offset[i] + s.origin_offset[i];
     st_.parameters[base + static_cast<std::size_t>(i)] = linear(i) ? program_to_user(v) : v;
   }
 }

@@ -267,14 +267,8 @@ void Parser::parse(std::string_view text, const ParseEnv& env, Block& b) {
 
   if (fanuc) {
     if (read_fanuc_statement(c, b)) return;
-  } else if (c.at() == 'm' && env.skipping_to.empty() &&   // lines passed over are not read (LinuxCNC)
-             (starts_with(text, c.pos + 1, "98") || (starts_with(text, c.pos + 1, "99") && env.call_level > 0))) {
-    // M98 / M99 (Fanuc subprograms) start an O-word line in LinuxCNC.
-    Cursor probe{text, c.pos + 1, env};
-    const int m = integer_value(probe, "an M code");
-    if (m == 98 || (m == 99 && env.call_level > 0))
-      fail_at(static_cast<int>(c.pos), ErrorCode::Unsupported,
-              "M{} subprograms are Fanuc style: run the program with the Fanuc dialect", m);
+  } else if (read_numbered_statement(c, b)) {
+    return;
   }
 
   if (c.at() == 'o' || (fanuc && c.at() == ':')) {
@@ -300,6 +294,40 @@ void Parser::parse(std::string_view text, const ParseEnv& env, Block& b) {
   }
   if (!env.skipping_to.empty()) return;   // skipped lines are not evaluated
   while (c.pos < text.size()) read_item(c, b);
+}
+
+// LinuxCNC's numbered subprograms: a line that starts with M98 is a call, one that starts
+// with M99 inside a subprogram its return (M99 in the main program is an M code of the stop
+// group). Lines passed over are not read, as in LinuxCNC. The call's line is read as any
+// block (P, L and comments; the checks refuse the rest), the return's holds only comments.
+bool Parser::read_numbered_statement(Cursor& c, Block& b) {
+  if (c.at() != 'm' || !c.env.skipping_to.empty()) return false;
+  const bool ret = starts_with(c.text, c.pos + 1, "99") && c.env.call_level > 0;
+  if (!starts_with(c.text, c.pos + 1, "98") && !ret) return false;
+  Cursor probe{c.text, c.pos + 1, c.env};
+  const int m = integer_value(probe, "an M code");
+  if (m != 98 && !(m == 99 && ret)) return false;
+  b.o_at = position_byte(c.pos);
+  c.pos = probe.pos;
+  if (m == 98) {
+    b.o_type = OWord::M98;
+    while (c.pos < c.text.size()) read_item(c, b);
+    return true;
+  }
+  b.o_type = OWord::M99;
+  b.o_name.assign(c.env.call_sub);
+  while (c.pos < c.text.size()) {
+    if (c.at() == ';') break;
+    if (c.at() == '(') {
+      read_comment(c, b);
+      continue;
+    }
+    const char ch = c.at();
+    fail_at(static_cast<int>(c.pos), ErrorCode::OwordSyntax,
+            "'{}' after M99: a subprogram's M99 line holds only M99 and comments",
+            ch >= 'a' && ch <= 'z' ? static_cast<char>(ch - 'a' + 'A') : ch);
+  }
+  return true;
 }
 
 void Parser::read_line_number(Cursor& c, Block& b) {
@@ -957,6 +985,9 @@ double Parser::parameter(Cursor& c, bool exists_only) {
     double v = 0;
     const bool found = c.env.host->named_value(name, v);
     if (exists_only) return found ? 1.0 : 0.0;
+    // Lines of a subprogram definition are read, not run (an `o#<n> call` in the body names its
+    // sub by a value the call gives it): LinuxCNC does not require their names to be defined.
+    if (!found && c.env.defining_sub) return 0.0;
     if (!found) {
       // LinuxCNC reads HAL pins and INI entries through these names; this interpreter has neither.
       if (name.starts_with("_hal[") || name.starts_with("_ini["))

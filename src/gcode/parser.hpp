@@ -81,6 +81,7 @@ class Parser {
   [[noreturn, gnu::cold]] static void letter_without_word(const Cursor& c, char letter);
   static void misspelt_keyword(const Cursor& c, std::size_t keyword_at);
   void read_o_word(Cursor& c, Block& b);
+  bool read_numbered_statement(Cursor& c, Block& b);
   void read_word(Cursor& c, Block& b, char letter);
   [[gnu::cold]] static void repeated_word(const Block& b, char letter, int pos);
   double integer_word(Cursor& c, char letter, int pos);

@@ -168,6 +168,9 @@ std::uint64_t InterpState::digest() const noexcept {
   h.u64(frames.size());
   for (const CallFrame& f : frames) {
     h.str(f.sub);
+    h.u64(static_cast<std::uint64_t>(f.kind));
+    h.i64(f.m98_left);
+    h.i64(f.m98_runs_left);
     for (double v : f.saved_args) h.f64(v);
     h.named(f.locals);
     h.pos(f.return_to);
@@ -189,6 +192,8 @@ std::uint64_t InterpState::digest() const noexcept {
   h.str(control.defining_name);
   for (bool b : {control.executed_if, control.doing_break, control.doing_continue, control.value_returned}) h.flag(b);
   h.f64(control.return_value);
+  h.pos(control.main_start);
+  h.u64(control.main_repeats);
   h.f64(comp.start1);
   h.f64(comp.start2);
   h.flag(comp.start_valid);

@@ -65,18 +65,30 @@ double largest_within(F f, double budget, double a_hi) {
 // Circle or helix: g' = ω·(cos·w + sin·u) + λ, g'' = ω²·(cos·u − sin·w), g''' = −ω²·g'_circle.
 // Per axis, with k = |ω|·√(u² + w²): |g'| ≤ k + |λ|, the in-plane acceleration is at most
 // k·√(a² + v⁴ω²) and the in-plane jerk k·√((j + v³ω²)² + (3·v·a·ω)²).
-RawLimits arc_limits(const MotionBlock& b, double v_max, const LimitParams& p) {
-  const double om = std::fabs(b.omega);
+//
+// Spiral: with a = 1 + ρθ the circle's terms are a times the arc's, and the radius change adds
+//   g'  += ω·ρ·(sin·w − cos·u),   g'' += 2·ω²·ρ·(cos·w + sin·u),   g''' += 3·ω³·ρ·(cos·u − sin·w),
+// each at most k·|ρ| (times ω, ω²) per axis. So with A_max = max(1, 1 + ρθ_end):
+//   |ẍ| ≤ k·A_max·√(a² + v⁴ω²) + (λ + k|ρ|)·|a| + 2·k|ρ|·v²|ω|,
+//   |x⃛| ≤ k·A_max·√((j + v³ω²)² + (3vaω)²) + λ·j + k|ρ|·(j + 6·v·a·|ω| + 3·v³ω²),
+// the arc's bounds (ρ = 0) plus terms of the order of ρ (0.001 for the arcs LinuxCNC accepts
+// with large radii). With ρ = 0 (an arc block) every added term is exactly zero: arcs use this
+// too.
+RawLimits arc_or_spiral_limits(const MotionBlock& b, double v_max, const LimitParams& p) {
+  const double om = std::fabs(b.omega), rho = std::fabs(b.spiral);
+  const double grow_max = std::max(1.0, 1.0 + b.spiral * b.omega * b.length);
   double ks[kAxisCount];
   double cap = v_max;
   for (int i = 0; i < kAxisCount; ++i) {
     const double k = ks[i] = om * std::sqrt(b.u[i] * b.u[i] + b.w[i] * b.w[i]), lam = std::fabs(b.lin[i]);
     if (k + lam < 1e-15) continue;
     const AxisLimits& l = p.machine[i];
-    cap = std::min(cap, l.max_velocity / (k + lam));
-    if (k > 0) cap = std::min(cap, std::sqrt(p.normal_share * l.max_acceleration / (om * k)));
+    cap = std::min(cap, l.max_velocity / (k * std::hypot(grow_max, rho) + lam));
+    if (k > 0)
+      cap = std::min(cap, std::sqrt(p.normal_share * l.max_acceleration / (om * k * (grow_max + 2 * rho))));
     if (k > 0 && limited_jerk(p, i)) {
-      cap = std::min(cap, std::cbrt(kJerkCapShare * (1 - p.step_share) * l.max_jerk / (om * om * k)));
+      cap = std::min(cap, std::cbrt(kJerkCapShare * (1 - p.step_share) * l.max_jerk /
+                                    (om * om * k * (grow_max + 3 * rho))));
     }
   }
   double accel = kInf;
@@ -85,12 +97,14 @@ RawLimits arc_limits(const MotionBlock& b, double v_max, const LimitParams& p) {
     const double k = ks[i], lam = std::fabs(b.lin[i]);
     if (k + lam < 1e-15) continue;
     const AxisLimits& l = p.machine[i];
-    double a = arc_accel(k, lam, q, l.max_acceleration);
+    const double budget = l.max_acceleration - 2 * k * rho * q;
+    double a = budget > 0 ? arc_accel(k * grow_max, lam + k * rho, q, budget) : 0.0;
     if (limited_jerk(p, i)) {
       const double T = p.filter_s, v = cap;
       const auto jerk = [&](double acc) {
         const double j = 2 * acc / T;
-        return k * std::hypot(j + v * v * v * om * om, 3 * v * acc * om) + lam * j;
+        return k * grow_max * std::hypot(j + v * v * v * om * om, 3 * v * acc * om) + lam * j +
+               k * rho * (j + 6 * v * acc * om + 3 * v * v * v * om * om);
       };
       a = largest_within(jerk, (1 - p.step_share) * l.max_jerk, a);
     }
@@ -139,7 +153,8 @@ RawLimits block_limits(const MotionBlock& b, double v_commanded_max, const Limit
     case BlockKind::Line:
       return line_limits(b, v_commanded_max, p);
     case BlockKind::Arc:
-      return arc_limits(b, v_commanded_max, p);
+    case BlockKind::Spiral:
+      return arc_or_spiral_limits(b, v_commanded_max, p);
     case BlockKind::Bezier:
       return bezier_limits(b, v_commanded_max, p);
     case BlockKind::Marker:

@@ -126,7 +126,10 @@ void Lookahead::limit_range(double from, double to, double cap, double accel) {
     const double lo = std::max(from, s0), hi = std::min(to, s1);
     if (!(hi > lo)) continue;
     PlannedBlock& whole = window_[k];
-    if (!(cap < whole.cap * (1 - kSplitGain) || accel < whole.accel * (1 - kSplitGain))) {
+    // A rigid tap's blocks stay whole (the tap runs them as one motion): they take the lower
+    // limits throughout.
+    if (!(cap < whole.cap * (1 - kSplitGain) || accel < whole.accel * (1 - kSplitGain)) ||
+        (whole.b.flags & traj::kRigidTap)) {
       whole.cap = std::min(whole.cap, cap);  // too small a change to be worth a split
       whole.accel = std::min(whole.accel, accel);
       continue;

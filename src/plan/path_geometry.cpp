@@ -82,6 +82,49 @@ bool make_line(const Pose& a, const Pose& b, MotionBlock& out) noexcept {
   return true;
 }
 
+namespace {
+
+// LinuxCNC's tolerance on an arc's end radius (its interpreter's, for inch programs: the larger
+// of its two, so that nothing an interpreter accepted is refused here): within the absolute
+// tolerance, or within the relative one up to 100 times the absolute one.
+constexpr double kSpiralAbsMm = 2 * 0.001 * 1.41421356237309504880 * 25.4;
+constexpr double kSpiralRelative = 0.001;
+/// Radii that differ by less than this (relative) are the same circle up to rounding.
+constexpr double kSameRadius = 1e-9;
+
+/// ∫ f over [0, span] by 8-point Gauss-Legendre on `pieces` equal parts (f smooth on each).
+template <typename F>
+double gauss_legendre(F f, double span, int pieces) {
+  static constexpr double kNode[4] = {0.1834346424956498, 0.5255324099163290, 0.7966664774136267,
+                                      0.9602898564975363};
+  static constexpr double kWeight[4] = {0.3626837833783620, 0.3137066458778873, 0.2223810344533745,
+                                        0.1012285362903763};
+  const double step = span / pieces, half = 0.5 * step;
+  double sum = 0;
+  for (int k = 0; k < pieces; ++k) {
+    const double mid = (k + 0.5) * step;
+    for (int q = 0; q < 4; ++q) sum += kWeight[q] * (f(mid - half * kNode[q]) + f(mid + half * kNode[q]));
+  }
+  return half * sum;
+}
+
+/// Quarter turns in a sweep (at least one): the pieces of a spiral's quadrature.
+int quarter_turns(double sweep) noexcept {
+  return std::max(1, static_cast<int>(std::ceil(std::fabs(sweep) / (0.5 * kPi))));
+}
+
+/// Length of a spiral block over θ ∈ [0, sweep]: |dp/dθ|² = r0²·((1 + ρθ)² + ρ²) + h² (h: the
+/// linear part per radian), the root of a quadratic in θ, smooth and positive.
+double spiral_length(double r0, double rho, double h, double sweep) noexcept {
+  const auto speed = [&](double th) {
+    const double a = 1.0 + rho * th;
+    return std::sqrt(r0 * r0 * (a * a + rho * rho) + h * h);
+  };
+  return std::fabs(gauss_legendre(speed, sweep, quarter_turns(sweep)));
+}
+
+}  // namespace
+
 bool make_arc(const Pose& start, const Pose& end, const canon::ArcGeometry& arc, MotionBlock& out,
               std::string& error) {
   const int b0 = plane_base(arc.plane);
@@ -100,15 +143,18 @@ bool make_arc(const Pose& start, const Pose& end, const canon::ArcGeometry& arc,
   re = sub3(re, mul3(dot3(re, n), n));
   const double ex = dot3(re, e1), ey = dot3(re, e2);
   const double r_end = std::hypot(ex, ey);
-  if (std::fabs(r_end - r) > 0.01 + 1e-4 * r) {
+  const double off = std::fabs(r_end - r);
+  if (!(r_end >= 1e-9) || off > 100 * kSpiralAbsMm ||
+      (off > kSpiralAbsMm && off > kSpiralRelative * std::max(r, r_end))) {
     error = fmt::format(
         "the arc's end point is {:.4f} mm off its circle (radius {:.4f} mm at the start, "
-        "{:.4f} mm at the end)",
-        std::fabs(r_end - r), r, r_end);
+        "{:.4f} mm at the end), beyond LinuxCNC's tolerance",
+        off, r, r_end);
     return false;
   }
-  // Slightly different radii (rounded coordinates): move the centre onto the perpendicular
-  // bisector of the two end points, so that the circle passes through both.
+  if (off > kSameRadius * std::max(1.0, r)) return make_spiral(start, end, arc, r, r_end, out);
+  // Radii equal to rounding: move the centre onto the perpendicular bisector of the two end
+  // points, so that the circle passes through both to the last bit.
   double cx = 0, cy = 0;
   const double dx = ex - r, dy = ey, dd = dx * dx + dy * dy;
   if (dd > 1e-24) {
@@ -136,16 +182,69 @@ bool make_arc(const Pose& start, const Pose& end, const canon::ArcGeometry& arc,
   out.w = W;
   out.length = len;
   out.omega = sweep / len;
+  out.spiral = 0;
   out.lin = (1.0 / len) * rest;
   return true;
 }
+
+// An arc whose end lies off its start circle, as LinuxCNC's planner runs it: the radius goes
+// linearly with the angle from the start radius to the end radius about the programmed centre,
+// and the axial rise and the other axes linearly with it too. The path parameter s is the
+// spiral's length, θ = ω·s, so the speed along the curve follows the radius within their ratio.
+bool make_spiral(const Pose& start, const Pose& end, const canon::ArcGeometry& arc, double r0, double r1,
+                 MotionBlock& out) {
+  const int b0 = plane_base(arc.plane);
+  const Vec3 n{arc.normal[0], arc.normal[1], arc.normal[2]};
+  const Vec3 c{arc.center[0], arc.center[1], arc.center[2]};
+  Vec3 rs = sub3(take3(start, b0), c);
+  rs = sub3(rs, mul3(dot3(rs, n), n));
+  const Vec3 e1 = mul3(1.0 / r0, rs), e2 = cross3(n, e1);
+  Vec3 re = sub3(take3(end, b0), c);
+  re = sub3(re, mul3(dot3(re, n), n));
+  const double phi = std::atan2(dot3(re, e2), dot3(re, e1));
+  const double sweep = arc_sweep(phi, arc.turns == 0 ? 1 : arc.turns);
+  const double rho = (r1 - r0) / (r0 * sweep);
+  Pose U{}, W{};
+  put3(U, b0, mul3(-r0, e1));
+  put3(W, b0, mul3(r0, e2));
+  const double grow = rho * sweep, sn = std::sin(sweep), cs = std::cos(sweep);
+  const Pose turn = sn * W + (1.0 - cs) * U + grow * (sn * W - cs * U);
+  const Pose rest = end - start - turn;
+  const double len = spiral_length(r0, rho, norm(rest) / std::fabs(sweep), sweep);
+  out.kind = BlockKind::Spiral;
+  out.base = start;
+  out.u = U;
+  out.w = W;
+  out.length = len;
+  out.omega = sweep / len;
+  out.spiral = rho;
+  out.lin = (1.0 / len) * rest;
+  return true;
+}
+
+namespace {
+
+/// Length of a spiral block's path in the axis triple from `first` (its tangent restricted to
+/// the triple, over the block's s).
+double spiral_triple_length(const MotionBlock& b, int first) noexcept {
+  const auto speed = [&](double s) {
+    const Pose t = traj::tangent_at(b, s);
+    return std::sqrt(t[first] * t[first] + t[first + 1] * t[first + 1] + t[first + 2] * t[first + 2]);
+  };
+  return gauss_legendre(speed, b.length, quarter_turns(b.omega * b.length));
+}
+
+}  // namespace
 
 double feed_length_ratio(const Pose& start, const Pose& end, const MotionBlock& b) noexcept {
   const auto part = [](const Pose& v, int first) {
     return std::sqrt(v[first] * v[first] + v[first + 1] * v[first + 1] + v[first + 2] * v[first + 2]);
   };
   double feed_len = 0;
-  if (b.kind == BlockKind::Arc) {
+  if (b.kind == BlockKind::Spiral) {
+    const int first = (std::fabs(b.u[6]) + std::fabs(b.u[7]) + std::fabs(b.u[8]) > 0) ? 6 : 0;
+    feed_len = spiral_triple_length(b, first);
+  } else if (b.kind == BlockKind::Arc) {
     // The circle's plane holds XYZ or UVW; the helix length in that triple carries the feed.
     const int first = (std::fabs(b.u[6]) + std::fabs(b.u[7]) + std::fabs(b.u[8]) > 0) ? 6 : 0;
     const double circle = std::fabs(b.omega) * norm(b.u) * b.length;
@@ -191,11 +290,15 @@ void trim_start(MotionBlock& b, double d) noexcept {
     return;
   }
   const Pose p = traj::position_at(b, d);
-  if (b.kind == BlockKind::Arc) {
+  if (b.kind == BlockKind::Arc || b.kind == BlockKind::Spiral) {
+    // The frame turns with the start point; a spiral's radius there is (1 + ρθ) times the old
+    // one, and the rest of it grows by the same ρ per radian of the old radius.
     const double phi = b.omega * d, c = std::cos(phi), s = std::sin(phi);
-    const Pose u = c * b.u - s * b.w, w = s * b.u + c * b.w;
+    const double scale = b.kind == BlockKind::Spiral ? 1.0 + b.spiral * phi : 1.0;
+    const Pose u = scale * (c * b.u - s * b.w), w = scale * (s * b.u + c * b.w);
     b.u = u;
     b.w = w;
+    if (b.kind == BlockKind::Spiral) b.spiral /= scale;
   }
   b.base = p;
   b.length -= d;
@@ -299,6 +402,20 @@ double distance_to(const MotionBlock& b, const Pose& p) noexcept {
     }
     if (helix && best > 1e-9) best = std::min({best, nearest_on(b, p, 0.0), nearest_on(b, p, b.length)});
     return best;
+  }
+  if (b.kind == BlockKind::Spiral) {
+    // The angle of p about the centre gives a parameter near the nearest point on each turn;
+    // the search around it finds the point (the radius changes slowly with the angle).
+    const double r = norm(b.u);
+    const Pose q = p - (b.base + b.u);
+    double phi = std::atan2(dot(q, b.w) / r, -dot(q, b.u) / r);
+    const double sweep = b.omega * b.length;
+    if (sweep < 0) phi = -phi;
+    if (phi < 0) phi += 2 * kPi;
+    double best = std::min(norm(p - b.base), norm(p - end_point(b)));
+    for (double a = phi; a <= std::fabs(sweep); a += 2 * kPi)
+      best = std::min(best, nearest_on(b, p, a / std::fabs(b.omega)));
+    return std::min({best, nearest_on(b, p, 0.0), nearest_on(b, p, b.length)});
   }
   // Bézier: sampled (only used for short blend curves).
   double best = 1e300;

@@ -23,11 +23,15 @@ inline constexpr double kMinLength = 1e-9;
 /// Straight block from `a` to `b`; false when shorter than kMinLength.
 bool make_line(const Pose& a, const Pose& b, MotionBlock& out) noexcept;
 
-/// Arc or helix block from the program's arc geometry; the centre is moved onto the
-/// perpendicular bisector of the end points when the two radii differ slightly. On bad geometry
-/// returns false with a reason in `error`.
+/// Arc or helix block from the program's arc geometry. Where the end lies off the start circle
+/// within LinuxCNC's tolerance the block is a spiral (make_spiral); radii equal up to rounding
+/// keep a circle, its centre moved onto the perpendicular bisector of the end points. On bad
+/// geometry returns false with a reason in `error`.
 bool make_arc(const Pose& start, const Pose& end, const canon::ArcGeometry& arc, MotionBlock& out,
               std::string& error);
+/// Spiral block about the arc's centre from radius `r0` at `start` to `r1` at `end`.
+bool make_spiral(const Pose& start, const Pose& end, const canon::ArcGeometry& arc, double r0, double r1,
+                 MotionBlock& out);
 
 /// Length over which the feed rate applies (XYZ, else UVW, else ABC) divided by the block length.
 double feed_length_ratio(const Pose& start, const Pose& end, const MotionBlock& b) noexcept;

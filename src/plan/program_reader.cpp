@@ -104,8 +104,23 @@ bool check_move(const canon::Program& program, canon::SegmentId id, const Machin
     return false;
   }
   if (m.kind == MoveKind::RigidTap) {
-    fail("rigid tapping (G33.1) is not supported by the planner yet", "plan.unsupported-move");
-    return false;
+    // A tap is a pair, appended together: in to the bottom, then (kTapReturn) back out, both
+    // following the spindle. (A way out whose way in a stream has released was checked with it.)
+    const bool out = (m.flags & canon::kTapReturn) != 0;
+    bool paired;
+    if (out) {
+      paired = id > 0 &&
+               (id - 1 < program.first_held_move() || (program.move(id - 1).kind == MoveKind::RigidTap &&
+                                                       !(program.move(id - 1).flags & canon::kTapReturn)));
+    } else {
+      paired = id + 1 < program.size() && program.move(id + 1).kind == MoveKind::RigidTap &&
+               (program.move(id + 1).flags & canon::kTapReturn);
+    }
+    if (!paired || !(m.flags & canon::kSpindleSynced)) {
+      fail("a rigid tap needs its way out and spindle synchronisation (START_SPEED_FEED_SYNCH) around it",
+           "plan.unsupported-move");
+      return false;
+    }
   }
   for (int i = 0; i < kAxisCount; ++i) {
     if (end[i] != start[i] && !limits.axes.has(static_cast<Axis>(i))) {
@@ -229,6 +244,11 @@ bool ProgramReader::make_element(canon::SegmentId id, Element& e) const {
   b.context = m.context;
   b.flags = flags();
   if (m.kind == MoveKind::Probe) b.flags |= traj::kProbe;
+  if (m.kind == MoveKind::RigidTap) {
+    b.flags |= traj::kRigidTap;
+    if (m.flags & canon::kTapReturn) b.flags |= traj::kTapReturn;
+    b.tap_scale = program_->feed(id);  // the way out's spindle speed factor (G33.1 I)
+  }
   const double f = program_->feed(id);
   const double ratio = feed_length_ratio(start, end, b);
   if (m.kind == MoveKind::Traverse) {
@@ -266,7 +286,11 @@ void ProgramReader::chord_small_arc(const Pose& start, const Pose& end, double f
   if (norm(e.b.lin) > 1e-12) return;  // helix or other axes: not a flat arc
   const double sweep = std::fabs(e.b.omega) * e.b.length;
   if (sweep > 3.14159265358979323846) return;
-  const double sagitta = norm(e.b.u) * (1 - std::cos(0.5 * sweep));
+  // A spiral lies within its largest radius's sagitta of the chord between the points at that
+  // radius, and its ends are within the radius change of those points: the sum bounds it.
+  const double r0 = norm(e.b.u), r_end = r0 * (1 + e.b.spiral * e.b.omega * e.b.length);
+  const double r_max = std::max(r0, r_end);
+  const double sagitta = r_max * (1 - std::cos(0.5 * sweep)) + 2 * std::fabs(r_end - r0);
   if (sagitta > merge_budget()) return;
   MotionBlock line = e.b;
   if (!make_line(start, end, line)) return;

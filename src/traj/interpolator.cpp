@@ -5,9 +5,12 @@
 #include <algorithm>
 #include <cmath>
 
+#include "braking.hpp"
 #include "opencnc/traj/path_eval.hpp"
 
 namespace opencnc::traj {
+
+using detail::end_speed_limit;
 
 namespace {
 
@@ -18,17 +21,6 @@ constexpr int kMaxBoundaryScan = 256;
 
 bool is_stop_marker(const MotionBlock& b) noexcept {
   return b.kind == BlockKind::Marker && b.marker != MarkerKind::Report && b.marker != MarkerKind::None;
-}
-
-/// Largest speed at the end of a constant-acceleration piece of duration tau, starting at speed
-/// v, such that the braking curve is respected: v_end² + 2A·Δs ≤ K with Δs = (v + v_end)·tau/2,
-/// where K = v_q² + C(q) − C(s) for a limit v_q at q. Negative when no v_end ≥ 0 satisfies it
-/// (q is reached within the piece).
-double end_speed_limit(double K, double v, double A, double tau) noexcept {
-  const double at = A * tau;
-  const double disc = at * at + 4.0 * (K - at * v);
-  if (disc < 0) return -1.0;
-  return 0.5 * (std::sqrt(disc) - at);
 }
 
 /// ∫ s dt over a piece of duration t from (s0, v) with constant acceleration a.
@@ -63,6 +55,10 @@ void Interpolator::restart(const Pose& start) noexcept {
   sync_ = Sync::Off;
   sync_target_ = sync_lag_ = prev_revs_ = 0;
   sync_lost_ = false;
+  tap_ = Tap::Off;
+  tap_locked_ = tap_reverse_ = false;
+  tap_depth_ = tap_v_ = tap_lag_ = tap_rev0_ = tap_revs_ = 0;
+  tap_dir_ = 1;
 }
 
 double Interpolator::target_speed(const TickInput& in, const MotionBlock& b) const noexcept {
@@ -197,7 +193,8 @@ void Interpolator::update_sync(const TickInput& in) noexcept {
   const double turned = std::fabs(revs - prev_revs_);
   const std::size_t index = index_of(u_seq_);
   const bool in_sync_block = index < queue_->available() && queue_->peek(index).kind != BlockKind::Marker &&
-                             queue_->peek(index).feed_class == FeedClass::SpindleSync;
+                             queue_->peek(index).feed_class == FeedClass::SpindleSync &&
+                             (queue_->peek(index).flags & kRigidTap) == 0;  // the tap follows on its own
   if (!in_sync_block) {
     sync_ = Sync::Off;
   } else {
@@ -260,6 +257,10 @@ double Interpolator::advance_unfiltered(const TickInput& in) noexcept {
     // A corner passed at zero speed: the moving average must reach it before the motion goes on,
     // or the commanded path would round it off.
     if (b.v_entry == 0 && s_u_ == u_start_ && v_u_ == 0 && still_ticks_ < config_.filter_ticks) break;
+    if (b.flags & kRigidTap) {  // reached at rest; run_tap() moves the tap
+      v_u_ = 0;
+      break;
+    }
     if (b.feed_class == FeedClass::SpindleSync && (sync_ == Sync::Off || sync_ == Sync::WaitIndex)) break;
     step_piece(in, b, index, tau, integral);
   }
@@ -407,9 +408,18 @@ void Interpolator::fill_output(TickOutput& out, double s_prev) noexcept {
     shown_ = Shown{b.seq, b.segment, b.segment_first, b.segment_last, b.line, b.context, b.length,
                    b.segment_offset};
   }
-  out.position = position_;
   out.path_velocity = (s_f_ - s_prev) / config_.period_s;
   out.state = state_;
+  write_shown(out);
+  out.spindle_synced = sync_ == Sync::Locked;
+  out.sync_lost = sync_lost_;
+  out.tap_reverse = false;
+  out.tap_speed_scale = 1;
+}
+
+// The commanded position and the block shown there.
+void Interpolator::write_shown(TickOutput& out) const noexcept {
+  out.position = position_;
   out.block_seq = shown_.seq;
   out.segment = shown_.segment;
   out.segment_first = shown_.segment_first;
@@ -418,8 +428,6 @@ void Interpolator::fill_output(TickOutput& out, double s_prev) noexcept {
   out.context = shown_.context;
   out.block_offset = shown_.offset;
   out.segment_offset = shown_.segment_offset + shown_.offset;
-  out.spindle_synced = sync_ == Sync::Locked;
-  out.sync_lost = sync_lost_;
 }
 
 void Interpolator::tick(const TickInput& in, TickOutput& out) noexcept {
@@ -438,12 +446,14 @@ void Interpolator::tick(const TickInput& in, TickOutput& out) noexcept {
   if (ticks_ == 1) prev_revs_ = in.spindle_revs;
   sync_rev_s_ = in.spindle_rev_s;
   update_sync(in);
-  const double s_prev = s_f_;
-  const double integral = advance_unfiltered(in);
+  double s_prev = s_f_;
+  const bool tapping = run_tap(in);                // a rigid tap moves on its own; the path waits
+  if (tapping && tap_ == Tap::Off) s_prev = s_f_;  // it ended: s moved past it, the tool did not
+  const double integral = tapping ? s_u_ * config_.period_s : advance_unfiltered(in);
   s_f_ = filter(integral);
   advance_filtered(out);
 
-  const bool settled = v_u_ == 0 && still_ticks_ >= config_.filter_ticks;
+  const bool settled = tap_ == Tap::Off && v_u_ == 0 && still_ticks_ >= config_.filter_ticks;
   const std::size_t index = index_of(u_seq_);
   const bool moving = !settled;
   if (aborting_) {
@@ -465,6 +475,7 @@ void Interpolator::tick(const TickInput& in, TickOutput& out) noexcept {
     update_waiting(in);
   }
   fill_output(out, s_prev);
+  if (tap_ != Tap::Off) show_tap(out);
   pop_and_rebase();
 }
 

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
 
 #include "opencnc/canon/program_builder.hpp"
 
@@ -71,17 +72,62 @@ TEST(ProgramBuilder, ArcCentreLiesInThePlaneOfTheStartPoint) {
 TEST(ProgramBuilder, ARigidTapEndsWhereItStarted) {
   ProgramBuilder b;
   b.straight_traverse(0, xyz(1, 2, 5));
-  b.rigid_tap(1, xyz(1, 2, -10), 1.0);
-  ASSERT_EQ(b.program().size(), 2u);
-  EXPECT_EQ(b.program().move(1).kind, MoveKind::RigidTap);
-  EXPECT_EQ(b.program().end(1)[Axis::Z], -10.0);   // the bottom of the tap
+  b.rigid_tap(1, xyz(1, 2, -10), 2.5);
+  // Two moves of segment 1: in to the bottom, then back out to the start (kTapReturn), so that
+  // every later move starts where the tap started; their feed is the way out's speed factor I.
+  const Program& p = b.program();
+  ASSERT_EQ(p.size(), 3u);
+  EXPECT_EQ(p.move(1).kind, MoveKind::RigidTap);
+  EXPECT_EQ(p.move(1).flags & kTapReturn, 0);
+  EXPECT_EQ(p.end(1)[Axis::Z], -10.0);  // the bottom of the tap
+  EXPECT_EQ(p.move(2).kind, MoveKind::RigidTap);
+  EXPECT_NE(p.move(2).flags & kTapReturn, 0);
+  EXPECT_EQ(p.end(2)[Axis::Z], 5.0);  // back at the start
+  EXPECT_EQ(p.feed(1), 2.5);
+  EXPECT_EQ(p.feed(2), 2.5);
+  EXPECT_EQ(p.segment_of(2), 1u);
+  EXPECT_EQ(p.moves_of(1), 2u);
   EXPECT_EQ(b.position()[Axis::Z], 5.0);           // the machine is back at the start
   // A helix after the tap has its centre in the plane of the real start point.
   ArcFeed a;
   a.first_end = 3, a.second_end = 2, a.first_center = 2, a.second_center = 2, a.rotation = 1, a.axis_end = 4;
   a.end = xyz(3, 2, 4);
   b.arc_feed(2, a);
-  EXPECT_EQ(b.program().arc(2).center[2], 5.0);
+  EXPECT_EQ(p.arc(3).center[2], 5.0);
+  EXPECT_EQ(p.start_of(3)[Axis::Z], 5.0);
+}
+
+TEST(ProgramBuilder, UnderG96TheSpindleSpeedIsASurfaceSpeedAboutTheSpindleAxis) {
+  ProgramBuilder b;
+  Pose g5x{};
+  g5x[Axis::X] = 12;
+  b.set_g5x_offset(1, g5x);
+  b.set_spindle_speed(0, 800);  // G97: rpm
+  b.set_spindle_mode(0, 2000);  // G96 D2000
+  b.set_spindle_speed(0, 150);  // S150: m/min
+  Pose g92{};
+  g92[Axis::X] = 3;
+  b.set_g92_offset(g92);  // the spindle axis moves: the speed is given again
+  b.use_length_units(Units::Inch);
+  b.set_spindle_speed(0, 400);  // ft/min
+  b.set_spindle_mode(0, 0);     // G97
+  b.set_spindle_speed(0, 500);
+  std::vector<Action> speeds;
+  for (std::size_t k = 0; k < b.program().action_count(); ++k) {
+    const Action& a = b.program().action(k);
+    if (a.kind == ActionKind::SpindleSpeed) speeds.push_back(a);
+  }
+  ASSERT_EQ(speeds.size(), 5u);
+  EXPECT_EQ(speeds[0].index2, 0);
+  EXPECT_EQ(speeds[0].value, 800);
+  EXPECT_EQ(speeds[1].index2, 1);
+  EXPECT_EQ(speeds[1].value, 150000);  // mm/min
+  EXPECT_EQ(b.program().action_pose(speeds[1].pose)[Axis::X], 12);
+  EXPECT_EQ(speeds[2].value, 150000);
+  EXPECT_EQ(b.program().action_pose(speeds[2].pose)[Axis::X], 15);
+  EXPECT_DOUBLE_EQ(speeds[3].value, 400 * 304.8);
+  EXPECT_EQ(speeds[4].index2, 0);
+  EXPECT_EQ(speeds[4].value, 500);
 }
 
 TEST(ProgramBuilder, RotationTurnsTheNormalOfAnXzArc) {

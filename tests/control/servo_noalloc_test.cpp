@@ -109,6 +109,27 @@ TEST(ServoAllocations, NoneInsideTheTick) {
   std::filesystem::remove_all(dir);
 }
 
+TEST(ServoAllocations, NoneWhileRigidTappingOrUnderConstantSurfaceSpeed) {
+  // G96: the spindle's speed computed from X every period; G33.1: the tap following the spindle
+  // through its reversal (issue 6).
+  const auto dir = std::filesystem::temp_directory_path() / "opencnc-noalloc-spindle";
+  std::filesystem::create_directories(dir);
+  const std::string program = (dir / "spindle.ngc").string();
+  std::ofstream(program) << "G21 G90\nG0 X60 Y0 Z5\nG96 D3000 S150 M3\nG1 X2 F900\nG97 S600\n"
+                            "G0 X10 Y10 Z3\nG33.1 Z-8 K1.25 I1.5\nG0 Z20\nM5\nM2\n";
+  g_allocations = 0;
+  Armed a(mill());
+  a.ask(Request::simple(CommandKind::MachineOn));
+  a.ask(Request::set_mode(Mode::Auto));
+  a.ask(Request::open(program));
+  a.ask(Request::simple(CommandKind::CycleStart));
+  ASSERT_TRUE(a.until([&] { return a.state() == State::Idle && !a.rig().status().run_active; }, 200000));
+  EXPECT_EQ(a.rig().status().runs_finished, 1u);
+  EXPECT_NEAR(a.rig().status().servo.commanded[Axis::Z], 20.0, 1e-9);
+  EXPECT_EQ(g_allocations.load(), 0);
+  std::filesystem::remove_all(dir);
+}
+
 // The broach's tick: every coupling law engaged and released in a run, a feed hold while coupled,
 // and a power failure's stop with the coupling held.
 TEST(ServoAllocations, NoneInsideTheCoupledTick) {

@@ -199,14 +199,52 @@ TEST(CannedCycles, TappingReversesTheSpindleAndRestoresTheOverridesItFound) {
   // With the overrides off (M49) before the cycle, they stay off after it.
   const Outcome off = run("G21 F200 S300 M3 M49\nG0 Z10\nG84 X1 Y1 Z-5 R2 P0.5\nM2\n");
   EXPECT_EQ(sequence(off), "cvVtmttvVfowdfocmeEo");   // M2 turns them back on
-  // In G18 the tap feeds along Y, the drilling axis (rs274 2.9 permutes these coordinates).
+}
+
+// In G18 and G19 LinuxCNC 2.9 hands the tapping feeds' coordinates to its plane mapping
+// rotated by one place; rs274 prints them so and its motion runs them. opencnc gives the same
+// points (issue 6), while the rapids and the position after the block are the hole's.
+TEST(CannedCycles, TappingInG18AndG19FeedsToThePointsLinuxCncGives) {
+  const auto feeds = [](const Outcome& o) {
+    std::vector<Pose> f;
+    for (const Event& e : o.sink.moves()) {
+      if (e.kind == 'f') f.push_back(e.end);
+    }
+    return f;
+  };
+  // G18: hole at Z3 X1, bottom Y-2, R2 (LinuxCNC starts in G99: back to R).
   const Outcome xz = run("G21 F200 S300 M3\nG18 G0 X5 Y6 Z7\nG84 X1 Y-2 Z3 R2\nM2\n");
   ASSERT_EQ(xz.status, RunStatus::Finished) << xz.error;
-  for (const Event& e : xz.sink.moves()) {
-    if (e.kind != 'f') continue;
-    EXPECT_EQ(e.end[Axis::X], 1);
-    EXPECT_EQ(e.end[Axis::Z], 3);
-  }
+  const std::vector<Pose> f18 = feeds(xz);
+  ASSERT_EQ(f18.size(), 2u);
+  EXPECT_EQ(f18[0][Axis::X], -2);
+  EXPECT_EQ(f18[0][Axis::Y], 3);
+  EXPECT_EQ(f18[0][Axis::Z], 1);
+  EXPECT_EQ(f18[1][Axis::X], 2);
+  EXPECT_EQ(f18[1][Axis::Y], 3);
+  EXPECT_EQ(f18[1][Axis::Z], 1);
+  // G19 with G74: hole at Y1 Z3, bottom X-2, R2 (G99: back to R).
+  const Outcome yz = run("G21 F200 S300 M4\nG19 G0 X5 Y6 Z7\nG99 G74 Y1 Z3 X-2 R2\nM2\n");
+  ASSERT_EQ(yz.status, RunStatus::Finished) << yz.error;
+  const std::vector<Pose> f19 = feeds(yz);
+  ASSERT_EQ(f19.size(), 2u);
+  EXPECT_EQ(f19[0][Axis::X], 3);
+  EXPECT_EQ(f19[0][Axis::Y], -2);
+  EXPECT_EQ(f19[0][Axis::Z], 1);
+  EXPECT_EQ(f19[1][Axis::X], 3);
+  EXPECT_EQ(f19[1][Axis::Y], 2);
+  EXPECT_EQ(f19[1][Axis::Z], 1);
+  // The interpreter takes the tool to be over the hole at the retract height afterwards.
+  EXPECT_EQ(yz.state.position.current[Axis::X], 2);
+  EXPECT_EQ(yz.state.position.current[Axis::Y], 1);
+  EXPECT_EQ(yz.state.position.current[Axis::Z], 3);
+  // G17 is unchanged: along Z at the hole.
+  const Outcome xy = run("G21 F200 S300 M3\nG0 Z10\nG84 X1 Y2 Z-5 R2\nM2\n");
+  const std::vector<Pose> f17 = feeds(xy);
+  ASSERT_EQ(f17.size(), 2u);
+  EXPECT_EQ(f17[0][Axis::X], 1);
+  EXPECT_EQ(f17[0][Axis::Y], 2);
+  EXPECT_EQ(f17[0][Axis::Z], -5);
 }
 
 TEST(CannedCycles, RunInTheUvwPlanesOnMachinesWithThoseAxes) {
@@ -466,13 +504,15 @@ TEST(CyclesProgram, TheBuilderSeesProbeTapAndSynchronisedMoves) {
   interp.open_text("p.ngc", "G21 F100 S300 M3\nG38.2 Z-5\nG33.1 Z-8 K1\nG33 Z-10 K1.5\nG1 X1\nM2\n");
   ASSERT_EQ(interp.run(builder), RunStatus::Finished);
   const canon::Program& p = builder.program();
-  ASSERT_EQ(p.size(), 4u);
+  ASSERT_EQ(p.size(), 5u);  // the tap is two moves: in, and back out
   EXPECT_EQ(p.move(0).kind, canon::MoveKind::Probe);
   EXPECT_EQ(p.move(1).kind, canon::MoveKind::RigidTap);
   EXPECT_NE(p.move(1).flags & canon::kSpindleSynced, 0);
-  EXPECT_EQ(p.move(2).kind, canon::MoveKind::Feed);
-  EXPECT_NE(p.move(2).flags & canon::kSpindleSynced, 0);
-  EXPECT_EQ(p.move(3).flags & canon::kSpindleSynced, 0);
+  EXPECT_EQ(p.move(2).kind, canon::MoveKind::RigidTap);
+  EXPECT_NE(p.move(2).flags & canon::kTapReturn, 0);
+  EXPECT_EQ(p.move(3).kind, canon::MoveKind::Feed);
+  EXPECT_NE(p.move(3).flags & canon::kSpindleSynced, 0);
+  EXPECT_EQ(p.move(4).flags & canon::kSpindleSynced, 0);
 }
 
 }  // namespace

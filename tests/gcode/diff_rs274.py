@@ -105,7 +105,7 @@ def main():
             msg = msg[0] if msg else ""
             want = next((code for rx, code in errors if rx.fullmatch(msg)), "?")
             errs = "\n".join(ln for ln in err2.splitlines() if ": error: " in ln)
-            got = re.findall(r"\[(gcode\.[a-z0-9-]+|tools\.[a-z0-9-]+)\]", errs)
+            got = re.findall(r"\[([a-z]+\.[a-z0-9.-]+)\]", errs)
             got = got[0] if got else "-"
             problem = f"  rs274: {msg!r} -> {want}; opencnc: {got}"
             status = status and want == got

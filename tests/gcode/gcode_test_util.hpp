@@ -3,6 +3,9 @@
 #pragma once
 
 #include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -39,7 +42,7 @@ inline Result collect(Interpreter& interp, RunStatus status, const std::string& 
     if (nl == std::string::npos) nl = text.size();
     const std::string line = text.substr(pos, nl - pos);
     pos = nl + 1;
-    if (++line_no <= 5 || line.size() < 13) continue;   // start-up calls (units, offsets, ...)
+    if (++line_no <= 5 || line.size() < 13) continue;  // start-up calls (units, offsets, ...)
     r.labels.push_back(line.substr(6, 6));
     r.calls.push_back(line.substr(13));
   }
@@ -85,5 +88,23 @@ inline Result run(std::string_view program, Options options = {}) {
 inline std::vector<std::string> head(const Result& r, std::size_t n) {
   return {r.calls.begin(), r.calls.begin() + static_cast<std::ptrdiff_t>(std::min(n, r.calls.size()))};
 }
+
+/// A scratch directory for subprogram files under /tmp, removed with the object.
+class TempDir {
+ public:
+  TempDir() {
+    char name[] = "/tmp/opencnc_gcode_test_XXXXXX";
+    path_ = ::mkdtemp(name);
+  }
+  ~TempDir() { std::filesystem::remove_all(path_); }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  /// Writes `text` to `file` in the directory.
+  void write(const std::string& file, const std::string& text) const { std::ofstream(path_ / file) << text; }
+  std::string str() const { return path_.string(); }
+
+ private:
+  std::filesystem::path path_;
+};
 
 }  // namespace opencnc::gcode::test

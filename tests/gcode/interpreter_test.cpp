@@ -3,6 +3,7 @@
 // sync points, state values and digests, runaway limits, axis map and extension points.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -18,6 +19,7 @@
 
 using namespace opencnc;
 using namespace opencnc::gcode;
+using test::TempDir;
 
 namespace {
 
@@ -73,21 +75,6 @@ std::string first_code(const Interpreter& interp) {
   const Diagnostic* d = first_error(interp);
   return d == nullptr ? std::string() : d->code;
 }
-
-// A scratch directory for subprogram files, removed at the end of the test.
-class TempDir {
- public:
-  TempDir() {
-    char name[] = "/tmp/opencnc_gcode_test_XXXXXX";
-    path_ = ::mkdtemp(name);
-  }
-  ~TempDir() { std::filesystem::remove_all(path_); }
-  void write(const std::string& file, const std::string& text) const { std::ofstream(path_ / file) << text; }
-  std::string str() const { return path_.string(); }
-
- private:
-  std::filesystem::path path_;
-};
 
 }  // namespace
 
@@ -442,6 +429,12 @@ void expect_replay_matches(std::string_view program) {
 
 }  // namespace
 
+TEST(InterpreterReplay, NumberedSubprogramRepeatsReplayToTheSameState) {
+  // M98 L keeps its count in the caller's frame and reads its own line again: state like any other.
+  expect_replay_matches(
+      "G21 F100\n#1 = 0\nM98 P3 L4\nG1 X0\nM98 P3 L2\nM30\nO3\n#1 = [#1 + 1]\nG91 G1 X#1\nG90\nM99\n");
+}
+
 TEST(InterpreterReplay, StateAtSegmentKEqualsTheFullRunsState) {
   const char* program =
       "o<corner> sub\n"
@@ -594,11 +587,13 @@ TEST(InterpreterExtensions, UnsupportedFeaturesNameTheirCode) {
   }
 }
 
-TEST(InterpreterExtensions, FanucSubprogramsAreRefusedInTheLinuxCncDialect) {
+TEST(InterpreterExtensions, NumberedSubprogramsOfTheLinuxCncDialectNeedTheirBody) {
+  // M98 is LinuxCNC's own numbered subprogram call (numbered_subs_test.cpp); without an O1000
+  // after it the call has nothing to run.
   Interpreter interp;
   canon::Sink quiet;
   EXPECT_EQ(run_into(interp, quiet, "G21\nM98 P1000\nM30\n"), RunStatus::Error);
-  EXPECT_EQ(first_code(interp), "gcode.unsupported");
+  EXPECT_EQ(first_code(interp), "gcode.oword-sub-not-found");
 }
 
 namespace {
@@ -775,4 +770,56 @@ TEST(InterpreterScan, BuildsAMachineCoordinateProgram) {
   EXPECT_NEAR(prog.end(1)[Axis::X], 76.2, 1e-12);
   EXPECT_NEAR(prog.end(0)[Axis::Y], 25.4, 1e-12);
   EXPECT_EQ(prog.move(1).line, 4u);
+}
+
+// --- conformance gaps of issue 6 -----------------------------------------------------------------
+
+TEST(InterpreterErrors, AnEmptyProgramIsReportedOnItsFirstLine) {
+  // A 0-byte file, blank lines only, or an opening '%' with nothing after it: file:1:1 as for
+  // every other error (LinuxCNC: "File ended with no percent sign").
+  for (const char* text : {"", "\n\n  \n", "%\n", "  %\n\n\t\n"}) {
+    Interpreter interp;
+    canon::Sink quiet;
+    EXPECT_EQ(run_into(interp, quiet, text, "empty.ngc"), RunStatus::Error) << '"' << text << '"';
+    const Diagnostic* d = first_error(interp);
+    ASSERT_NE(d, nullptr);
+    EXPECT_EQ(d->code, "gcode.program-empty");
+    EXPECT_EQ(d->format().substr(0, 16), "empty.ngc:1:1: e") << d->format();
+  }
+  // Two '%' lines are a (empty) program, as rs274 reads them.
+  Interpreter interp;
+  canon::Sink quiet;
+  EXPECT_EQ(run_into(interp, quiet, "%\n%\n"), RunStatus::Finished);
+}
+
+TEST(InterpreterOffsets, G28AndG30StoreAndReturnToMachinePositionsUnderARotatedSystem) {
+  // G54 at X10 Y5 turned by 30 degrees: the machine origin is (-11.1603, 0.6699) in it.
+  const test::Result r =
+      test::run("G21 G90\nG10 L2 P1 X10 Y5 R30\nG54\nG28.1\nG0 X20 Y10 Z5\nG28 X30 Y15\nG30.1\nM2\n");
+  ASSERT_EQ(r.status, RunStatus::Finished) << r.code();
+  // #5161.. hold machine coordinates (inches for the stand-alone units), here the origin.
+  EXPECT_NEAR(r.state.parameters[5161], 0.0, 1e-12);
+  EXPECT_NEAR(r.state.parameters[5162], 0.0, 1e-12);
+  // The intermediate point is in the rotated system; the home comes back into it.
+  const auto at = [&](const std::string& call) {
+    return std::find(r.calls.begin(), r.calls.end(), call) != r.calls.end();
+  };
+  EXPECT_TRUE(at("STRAIGHT_TRAVERSE(30.0000, 15.0000, 5.0000, 0.0000, 0.0000, 0.0000)"));
+  EXPECT_TRUE(at("STRAIGHT_TRAVERSE(-11.1603, 0.6699, 5.0000, 0.0000, 0.0000, 0.0000)"));
+  // G30.1 at that point stores the machine origin again.
+  EXPECT_NEAR(r.state.parameters[5181], 0.0, 1e-9);
+  EXPECT_NEAR(r.state.parameters[5182], 0.0, 1e-9);
+}
+
+TEST(InterpreterParameters, ASubBodyMayNameItsCallsByLocalsItSetsLater) {
+  // While a definition is read (not run), a named parameter without a value reads as 0 for the
+  // O-word number of `o#<n> call`, as LinuxCNC allows; running the sub gives it its value.
+  const test::Result r = test::run(
+      "G21 F100\no1 sub\nG1 X1\no1 endsub\no<pick> sub\n#<n> = #1\no#<n> call\no<pick> endsub\n"
+      "o<pick> call [1]\nM2\n");
+  ASSERT_EQ(r.status, RunStatus::Finished) << r.code();
+  EXPECT_NE(r.text.find("STRAIGHT_FEED(1.0000, 0.0000"), std::string::npos);
+  // In the flow of the program (not a definition) the name must still have a value.
+  const test::Result undefined = test::run("G21 F100\no#<m> call\nM2\n");
+  EXPECT_EQ(undefined.code(), "gcode.named-parameter-undefined");
 }

@@ -274,3 +274,34 @@ TEST(Planner, ArcsAndHelicesEndExactlyWhereProgrammed) {
   EXPECT_NEAR(end[2], -4, 1e-9);
   EXPECT_LT(h.omega, 0);  // clockwise
 }
+
+TEST(Planner, ARigidTapIsAPairOfSpindleSynchronisedBlocksEnteredAndLeftAtRest) {
+  canon::ProgramBuilder b;
+  b.set_feed_rate(600);
+  b.straight_feed(0, xyz(0, 0, 2));
+  b.start_speed_feed_synch(0, 1.25, false);
+  b.rigid_tap(1, xyz(0, 0, -8), 1.5);
+  b.stop_speed_feed_synch();
+  b.straight_feed(2, xyz(4, 0, 2));
+  const auto blocks = path_blocks(plan_all(b.take()));
+  ASSERT_EQ(blocks.size(), 4u);
+  const MotionBlock& in = blocks[1];
+  const MotionBlock& out = blocks[2];
+  EXPECT_TRUE(in.flags & traj::kRigidTap);
+  EXPECT_FALSE(in.flags & traj::kTapReturn);
+  EXPECT_TRUE(out.flags & traj::kRigidTap);
+  EXPECT_TRUE(out.flags & traj::kTapReturn);
+  for (const MotionBlock* t : {&in, &out}) {
+    EXPECT_EQ(t->feed_class, traj::FeedClass::SpindleSync);
+    EXPECT_DOUBLE_EQ(t->feed, 1.25);  // mm per revolution along the line
+    EXPECT_DOUBLE_EQ(t->tap_scale, 1.5);
+    EXPECT_DOUBLE_EQ(t->length, 10.0);
+    EXPECT_EQ(t->v_entry, 0.0);
+    EXPECT_EQ(t->flags & traj::kFeedHoldAllowed, 0);
+  }
+  EXPECT_EQ(blocks[3].v_entry, 0.0);
+  // The way out ends where the tap started, where the next block begins.
+  const Pose back = traj::position_at(out, out.length);
+  EXPECT_NEAR(back[Axis::Z], 2.0, 1e-12);
+  EXPECT_EQ(blocks[3].base[Axis::Z], back[Axis::Z]);
+}

@@ -21,7 +21,8 @@ enum class MoveKind : std::uint8_t {
   Feed,       ///< G1 (and straight segments of cycles, cutter compensation, ...)
   Arc,        ///< G2/G3 arc or helix; details in Program::arc()
   Probe,      ///< G38.x straight probe
-  RigidTap,   ///< G33.1: feed to the end, reverse spindle, return
+  RigidTap,   ///< G33.1: two moves, in to the bottom and (kTapReturn) back out to the start;
+              ///< their Program::feed() is the way out's spindle speed factor (G33.1 I)
 };
 
 /// Bits of Move::flags.
@@ -30,6 +31,7 @@ enum MoveFlag : std::uint8_t {
   kPerRevolution = 1u << 1,    ///< feed is per spindle revolution (G95)
   kSpindleSynced = 1u << 2,    ///< position locked to the spindle (G33, G76, G33.1)
   kCurveChord = 1u << 3,       ///< a chord of a spline (NURBS_FEED) split by ProgramBuilder
+  kTapReturn = 1u << 4,        ///< RigidTap: the way out, from the bottom back to the start
 };
 
 /// One motion, 16 bytes. The end pose is stored separately (Program::end()); the start is
@@ -61,7 +63,8 @@ struct FeedValue {
 
 enum class ActionKind : std::uint8_t {
   Dwell,               ///< value = seconds
-  SpindleSpeed,        ///< index = spindle, value = rpm (or surface speed under CSS)
+  SpindleSpeed,        ///< index = spindle, value = rpm; under G96 (index2 = 1) the surface
+                       ///< speed in mm/min, its pose the X of the spindle axis (mm, machine)
   SpindleCw, SpindleCcw, SpindleStop,   ///< index = spindle
   SpindleMode,         ///< value = css max rpm, 0 = G97
   SpindleOrient,       ///< value = degrees, index2 = direction

@@ -124,6 +124,7 @@ class ProgramBuilder final : public Sink {
   /// Appends the move to position_ (the machine position it ends at, already set).
   void append(MoveKind kind, SegmentId id, std::uint32_t param, std::uint8_t extra_flags = 0);
   std::uint32_t current_feed_index();
+  void add_spindle_speed(int spindle);
   std::uint8_t move_flags() const noexcept;
 
   Program program_;
@@ -142,6 +143,8 @@ class ProgramBuilder final : public Sink {
   double feed_ = 0;
   FeedMode feed_mode_ = FeedMode::UnitsPerMinute;
   bool synced_ = false;
+  double css_max_rpm_ = 0;        ///< G96's limit (0: G97, rpm)
+  double spindle_speed_ = 0;      ///< the last S, as programmed
   double last_feed_mm_ = -1;
   std::uint32_t last_feed_index_ = 0;
   Pose position_{};

@@ -167,7 +167,9 @@ enum class ActionCode : std::uint8_t {
   SpindleOrient,  ///< value = degrees
   PalletShuttle,
   Message,  ///< the controller shows the text (action index)
-  Ignore,   ///< nothing for the machine (probe on/off, spindle mode)
+  Ignore,        ///< nothing for the machine (probe on/off)
+  SpindleMode,   ///< G96: value = highest rpm (D); 0 = G97, the speed is in rpm again
+  SurfaceSpeed,  ///< G96 S: value = surface speed (mm/min), value2 = X of the spindle axis (mm)
   /// Wait until the operator has brought hand axis `index` to `value`: index2 = +1 a retract (at
   /// or above it), 0 a plunge (down to it); see HandWait in status.hpp.
   HandAxisWait,
@@ -185,7 +187,7 @@ struct MachineAction {
   std::int32_t index = 0;
   std::int32_t index2 = 0;
   double value = 0;
-  double value2 = 0;
+  double value2 = 0;  ///< SurfaceSpeed: X of the spindle axis, machine coordinates (mm); AxisCoupling: pitch rate
 };
 
 /// How a run ended.

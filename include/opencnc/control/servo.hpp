@@ -61,6 +61,7 @@ class Servo final : public Tickable {
   void write_joint(int j) noexcept;
   void write_steppers() noexcept;
   void write_machine_outputs() noexcept;
+  void write_spindle(bool on) noexcept;
   void fill_status(ServoStatus& s) const noexcept;
   void fill_drill_status(ServoStatus& s) const noexcept;
   void push_trace() noexcept;
@@ -233,6 +234,9 @@ class Servo final : public Tickable {
   // Machine outputs the program and the operator set.
   double spindle_rpm_ = 0;
   machine::SpindleDirection spindle_direction_ = machine::SpindleDirection::Stopped;
+  /// G96 constant surface speed: the highest rpm (D, 0 = off), the surface speed (mm/min) and
+  /// the X (machine) of the spindle axis; the rpm follows X every period.
+  double css_max_rpm_ = 0, css_surface_mm_min_ = 0, css_axis_x_ = 0;
   std::uint64_t spindle_changed_tick_ = 0;  ///< period of the last change of speed or direction
   bool spindle_override_enabled_ = true;
   bool orient_ = false;

@@ -34,7 +34,9 @@ enum MGroup : int {
 enum class OWord : std::uint8_t {
   None, Sub, EndSub, Call, Do, While, If, ElseIf, Else, EndIf, Break, Continue, EndWhile,
   Return, Repeat, EndRepeat,
-  Program,     ///< a bare O number (Fanuc program number line)
+  Program,     ///< a bare O number: a program number line, or a numbered subprogram's start
+  M98,         ///< LinuxCNC dialect: `M98 P L` at the start of a line, a numbered subprogram call
+  M99,         ///< LinuxCNC dialect: `M99` at the start of a line in a subprogram, its return
   // Fanuc macro statements (docs/dialects.md):
   Goto,        ///< GOTO n, or IF [..] GOTO n whose condition holds (o_value = n)
   FanucWhile,  ///< WHILE [..] DO m, or DO m alone (o_value = condition, loop_id = m)

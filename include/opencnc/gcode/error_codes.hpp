@@ -213,6 +213,7 @@ namespace opencnc::gcode {
   X(OwordNotInSub, "gcode.oword-not-in-sub")                                 \
   X(OwordTooManyArgs, "gcode.oword-too-many-args")                           \
   X(OwordInMdi, "gcode.oword-in-mdi")                                        \
+  X(OwordMixedStyles, "gcode.oword-mixed-styles")                            \
   /* Fanuc dialect and coordinate transforms */                              \
   X(FanucGotoTargetMissing, "fanuc.goto-target-missing")                     \
   X(FanucEndWithoutDo, "fanuc.end-without-do")                               \
@@ -248,13 +249,15 @@ namespace opencnc::gcode {
   X(LimitRepeatCount, "gcode.limit-repeat-count")                            \
   X(LimitSegments, "gcode.limit-segments")                                   \
   X(LimitSkippedLines, "gcode.limit-skipped-lines")                          \
+  X(LimitMainRepeats, "gcode.limit-main-repeats")                            \
   /* another controller's syntax in this dialect */                          \
   X(DialectUnsupported, "dialect.unsupported")                               \
   /* interface use */                                                        \
   X(NoProgram, "gcode.no-program")                                           \
   /* warnings (the program runs; opencnc check and scan report them) */     \
   X(UnitsNotProgrammed, "gcode.units-not-programmed")                        \
-  X(FeedWithSpindleStopped, "gcode.feed-with-spindle-stopped")
+  X(FeedWithSpindleStopped, "gcode.feed-with-spindle-stopped")              \
+  X(MainProgramRepeats, "gcode.main-program-repeats")
 
 enum class ErrorCode : std::uint16_t {
 #define OPENCNC_GCODE_ENUM(e, id) e,

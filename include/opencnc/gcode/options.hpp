@@ -47,7 +47,17 @@ struct Limits {
   std::uint64_t max_repeat_count = 10'000'000;      ///< the count of one `repeat [n]`
   std::uint64_t max_segments = 500'000'000;         ///< motions emitted
   std::uint64_t max_skipped_lines = 200'000'000;    ///< lines read while seeking a label or a sub
+  /// Scan mode with MainM99::Repeat: times an endless program may start again before the scan
+  /// stops with gcode.limit-main-repeats (execute mode repeats until the caller stops).
+  std::uint64_t max_main_repeats = 100;
 };
+
+/// What M99 in the main program does (LinuxCNC dialect; the Fanuc dialect's M99 is its own).
+/// End: the program ends as with M2, what LinuxCNC's stand-alone `rs274` does. Repeat: reading
+/// starts again at the first line with the state as it is, what LinuxCNC's task does: an
+/// endless program (a warm-up cycle, a bar feeder), stopped by the operator or by a `/M30`.
+/// In execute mode every pass starts the block and loop counts of the limits afresh.
+enum class MainM99 : std::uint8_t { End, Repeat };
 
 /// Everything the interpreter is configured with. Plain data; copy freely.
 struct Options {
@@ -74,6 +84,7 @@ struct Options {
   Limits limits;
   bool block_delete = false;   ///< skip blocks starting with '/'
   bool optional_stop = true;   ///< M1 stops
+  MainM99 main_m99 = MainM99::End;
   /// Drop all canonical output until the motion with this segment id (replay to segment k);
   /// the interpreter state evolves exactly as in a full run. 0 = drop nothing.
   canon::SegmentId quiet_until_segment = 0;

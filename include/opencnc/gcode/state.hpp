@@ -202,14 +202,25 @@ struct FanucState {
   bool operator==(const FanucState&) const = default;
 };
 
+/// How a call level was entered: the main program, `o<name> call` (its sub ends with endsub
+/// or return) or LinuxCNC's numbered `M98 P` (its O-numbered sub ends with M99). LinuxCNC
+/// refuses to mix the two styles.
+enum class CallKind : std::uint8_t { Main, OWord, Numbered };
+
 /// One level of the subprogram call stack.
 struct CallFrame {
   std::string sub;                                 ///< name of the running subprogram
-  std::array<double, kSubArgumentCount> saved_args{};  ///< caller's #1..#30
+  CallKind kind = CallKind::Main;
+  std::array<double, kSubArgumentCount> saved_args{};  ///< caller's #1..#30 (not for M98: they are global)
   NamedParameters locals;
   SourcePosition return_to;                        ///< where the caller continues
   std::uint32_t context = 0;                       ///< SourceMap context of this level
   SavedContext saved;
+  /// LinuxCNC M98 L run from this level: calls still to make (-1: none). The M98 line is
+  /// read again for each, as LinuxCNC does.
+  std::int64_t m98_left = -1;
+  /// M98 L from an MDI line, which cannot be read again: runs of this body still to come.
+  std::int64_t m98_runs_left = 0;
   FanucFrame fanuc;                                ///< Fanuc dialect only
   bool operator==(const CallFrame&) const = default;
 };
@@ -237,6 +248,8 @@ struct ControlState {
   bool doing_continue = false;
   double return_value = 0;
   bool value_returned = false;
+  SourcePosition main_start;        ///< the main program's first line (M99 repeats from here)
+  std::uint64_t main_repeats = 0;   ///< times M99 sent the main program back to its start
   bool operator==(const ControlState&) const = default;
 };
 

@@ -81,6 +81,10 @@ struct TickOutput {
   std::array<TickEvent, kMaxTickEvents> events{};
   bool spindle_synced = false;  ///< following the spindle (G33) with a constant lag
   bool sync_lost = false;       ///< a limit forced the motion off the spindle during this run
+  /// Rigid tap (G33.1): the spindle must turn the other way, at `tap_speed_scale` times its speed
+  /// (from the bottom of the tap until it is back at its start). A level, for the spindle output.
+  bool tap_reverse = false;
+  double tap_speed_scale = 1;
 };
 
 /// Consumes motion blocks and computes the commanded position every servo period.
@@ -123,8 +127,16 @@ class Interpolator {
   void release_marker() noexcept;
   void pop_and_rebase() noexcept;
   void fill_output(TickOutput& out, double s_prev) noexcept;
+  void write_shown(TickOutput& out) const noexcept;
   void update_sync(const TickInput& in) noexcept;
   double sync_acceleration(const MotionBlock& b, double tau) noexcept;
+  // rigid_tap.cpp
+  bool run_tap(const TickInput& in) noexcept;
+  bool start_tap(const TickInput& in) noexcept;
+  void follow_spindle(const TickInput& in, const MotionBlock& b) noexcept;
+  void place_tap(const MotionBlock& b) noexcept;
+  void finish_tap() noexcept;
+  void show_tap(TickOutput& out) noexcept;
   std::size_t index_of(std::uint64_t seq) const noexcept {
     return static_cast<std::size_t>(seq - queue_->popped());
   }
@@ -163,6 +175,20 @@ class Interpolator {
   double prev_revs_ = 0;
   double sync_rev_s_ = 0;  ///< spindle speed of this tick
   bool sync_lost_ = false;
+
+  // Rigid tapping (G33.1): a generator of its own, signed along the tap's line, that follows the
+  // spindle in, through its reversal, out and through its restoring, then places the tap back
+  // on its start (LinuxCNC's TAPPING, REVERSING, RETRACTION, FINAL_REVERSAL, FINAL_PLACEMENT).
+  enum class Tap : std::uint8_t { Off, WaitIndex, In, Reversing, Out, Restoring, Placing };
+  Tap tap_ = Tap::Off;
+  bool tap_locked_ = false;   ///< following the spindle with a constant lag
+  bool tap_reverse_ = false;  ///< output: the spindle turns the other way
+  double tap_depth_ = 0;      ///< along the tap's line from its start (in = positive)
+  double tap_v_ = 0;          ///< d(tap_depth_)/dt
+  double tap_lag_ = 0;        ///< constant distance behind the spindle once locked
+  double tap_dir_ = 1;        ///< +1 when the spindle position rises as the tap goes in
+  double tap_rev0_ = 0;       ///< spindle position of the index the tap started at
+  double tap_revs_ = 0;       ///< spindle position of the previous tick
 
   struct Shown {  // the block at the commanded position, kept once it has been popped
     std::uint64_t seq = 0, segment = 0, segment_first = 0, segment_last = 0;

@@ -22,6 +22,15 @@ inline Pose position_at(const MotionBlock& b, double s) noexcept {
       for (int i = 0; i < kAxisCount; ++i) p[i] = b.base[i] + sn * b.w[i] + vers * b.u[i] + s * b.lin[i];
       break;
     }
+    case BlockKind::Spiral: {
+      // The arc's terms, plus the radius change along the radius vector sin θ·w − cos θ·u.
+      const double th = b.omega * s, sn = std::sin(th), cs = std::cos(th), h = std::sin(0.5 * th);
+      const double vers = 2.0 * h * h, grow = b.spiral * th;
+      for (int i = 0; i < kAxisCount; ++i) {
+        p[i] = b.base[i] + sn * b.w[i] + vers * b.u[i] + grow * (sn * b.w[i] - cs * b.u[i]) + s * b.lin[i];
+      }
+      break;
+    }
     case BlockKind::Bezier: {
       const double t = b.length > 0 ? s / b.length : 0.0, r = 1.0 - t;
       const double k0 = r * r * r, k1 = 3 * r * r * t, k2 = 3 * r * t * t, k3 = t * t * t;
@@ -35,7 +44,8 @@ inline Pose position_at(const MotionBlock& b, double s) noexcept {
   return p;
 }
 
-/// dp/ds of block `b` at s (unit length for lines and arcs). Any thread; real-time safe.
+/// dp/ds of block `b` at s (unit length for lines and arcs; for a spiral close to it, varying
+/// with the radius). Any thread; real-time safe.
 inline Pose tangent_at(const MotionBlock& b, double s) noexcept {
   Pose d;
   switch (b.kind) {
@@ -45,6 +55,14 @@ inline Pose tangent_at(const MotionBlock& b, double s) noexcept {
     case BlockKind::Arc: {
       const double c = std::cos(b.omega * s), sn = std::sin(b.omega * s);
       for (int i = 0; i < kAxisCount; ++i) d[i] = b.omega * (c * b.w[i] + sn * b.u[i]) + b.lin[i];
+      break;
+    }
+    case BlockKind::Spiral: {
+      // d/dθ: (1 + ρθ)·(cos θ·w + sin θ·u) + ρ·(sin θ·w − cos θ·u), times ω.
+      const double th = b.omega * s, c = std::cos(th), sn = std::sin(th), a = 1.0 + b.spiral * th;
+      for (int i = 0; i < kAxisCount; ++i) {
+        d[i] = b.omega * (a * (c * b.w[i] + sn * b.u[i]) + b.spiral * (sn * b.w[i] - c * b.u[i])) + b.lin[i];
+      }
       break;
     }
     case BlockKind::Bezier: {
@@ -71,6 +89,15 @@ inline Pose curvature_at(const MotionBlock& b, double s) noexcept {
     case BlockKind::Arc: {
       const double c = std::cos(b.omega * s), sn = std::sin(b.omega * s), w2 = b.omega * b.omega;
       for (int i = 0; i < kAxisCount; ++i) d[i] = w2 * (c * b.u[i] - sn * b.w[i]);
+      break;
+    }
+    case BlockKind::Spiral: {
+      // d²/dθ²: (1 + ρθ)·(cos θ·u − sin θ·w) + 2ρ·(cos θ·w + sin θ·u), times ω².
+      const double th = b.omega * s, c = std::cos(th), sn = std::sin(th), a = 1.0 + b.spiral * th;
+      const double w2 = b.omega * b.omega;
+      for (int i = 0; i < kAxisCount; ++i) {
+        d[i] = w2 * (a * (c * b.u[i] - sn * b.w[i]) + 2.0 * b.spiral * (c * b.w[i] + sn * b.u[i]));
+      }
       break;
     }
     case BlockKind::Bezier: {
