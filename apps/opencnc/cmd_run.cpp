@@ -6,7 +6,9 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <memory>
 #include <optional>
 #include <string>
@@ -16,6 +18,7 @@
 #include "commands.hpp"
 #include "gcode_summary.hpp"
 #include "numeric_options.hpp"
+#include "opencnc/controller/power_fail_recorder.hpp"
 #include "opencnc/controller/preflight.hpp"
 #include "opencnc/controller/run_recorder.hpp"
 #include "opencnc/controller/servo_setup.hpp"
@@ -34,7 +37,22 @@ struct RunOptions {
   std::string trace;
   std::string report;
   double max_time_s = kDefaultMaxTimeS;  ///< 0: no limit
+  std::string inject;                    ///< "mains-off@SECONDS"
 };
+
+/// "mains-off@12.5" → 12.5 (servo time of the run); nullopt with the reason printed.
+std::optional<double> mains_off_time(const std::string& inject) {
+  constexpr std::string_view kPrefix = "mains-off@";
+  char* end = nullptr;
+  const double s = inject.rfind(kPrefix, 0) == 0 ? std::strtod(inject.c_str() + kPrefix.size(), &end) : -1;
+  if (end == nullptr || *end != '\0' || !std::isfinite(s) || s < 0) {
+    fmt::print(stderr,
+               "error: --inject {}: expected mains-off@SECONDS (servo time from the run's start, >= 0)\n",
+               inject);
+    return std::nullopt;
+  }
+  return s;
+}
 
 /// "3.2 h", "19.0 years": a duration a person reads at a glance.
 std::string human_duration(double s) {
@@ -63,7 +81,6 @@ bool within_max_time(const RunOptions& o, const config::MachineProfile& profile)
                                               human_duration(e.slowest_move_s)));
   return false;
 }
-
 
 /// "[#########...........]  42.1 %  line 123  12.3 s  ~17.0 s left" on one terminal line: the
 /// path run so far against the preflight's length of the whole program.
@@ -128,14 +145,43 @@ void print_report(const control::RunReport& r, const config::MachineProfile& pro
   }
 }
 
-nlohmann::json report_json(const control::RunReport& r, const RunOptions& o, const SessionEnd& end) {
+nlohmann::json power_fail_json(const control::PowerFailReport& p) {
+  nlohmann::json j;
+  j["happened"] = p.happened;
+  j["coupled"] = p.coupled;
+  j["signal_s"] = p.signal_s;
+  j["stop_time_s"] = p.stop_time_s;
+  j["stop_distance_mm"] = p.stop_distance_mm;
+  j["coupled_error_um"] = p.coupled_error_um;
+  j["coupled_command_error_um"] = p.coupled_command_error_um;
+  j["independent_error_um"] = p.independent_error_um;
+  j["dc_link_min_v"] = p.happened ? nlohmann::json(p.dc_link_min_v) : nlohmann::json(nullptr);
+  return j;
+}
+
+void print_power_fail(const control::PowerFailReport& p) {
+  if (!p.happened) {
+    fmt::print("power fail          none (the run ended before the injected time)\n");
+    return;
+  }
+  fmt::print("power fail at       {:.3f} s: stopped in {:.3f} s over {:.3f} mm, DC link down to {:.0f} V\n",
+             p.signal_s, p.stop_time_s, p.stop_distance_mm, p.dc_link_min_v);
+  if (p.coupled)
+    fmt::print(
+        "helix error         {:.3f} um coupled ({:.6f} um commanded), {:.1f} um if each axis stopped alone\n",
+        p.coupled_error_um, p.coupled_command_error_um, p.independent_error_um);
+}
+
+nlohmann::json report_json(const control::RunReport& r, const RunOptions& o, const SessionEnd& end,
+                           const std::optional<control::PowerFailReport>& power_fail) {
   nlohmann::json j;
   j["program"] = o.session.file;
   j["machine"] = end.profile.name;
   j["realtime"] = o.session.realtime;
   j["finished"] = end.finished;
   j["fault"] = end.fault.empty() ? nlohmann::json(nullptr) : nlohmann::json(end.fault);
-  j["stopped_by"] = end.stopped_by != 0 ? nlohmann::json(signal_name(end.stopped_by)) : nlohmann::json(nullptr);
+  j["stopped_by"] =
+      end.stopped_by != 0 ? nlohmann::json(signal_name(end.stopped_by)) : nlohmann::json(nullptr);
   j["machining_time_s"] = r.machining_time_s;
   j["motion_time_s"] = r.motion_time_s;
   j["path_length_mm"] = r.path_length_mm;
@@ -157,6 +203,7 @@ nlohmann::json report_json(const control::RunReport& r, const RunOptions& o, con
   j["limit_touched"] = r.limit_violations > 0 || end.limit_touched;
   j["samples"] = r.samples;
   j["wall_time_s"] = end.wall_s;
+  if (power_fail) j["power_fail"] = power_fail_json(*power_fail);
   return j;
 }
 
@@ -183,6 +230,17 @@ int run(const RunOptions& o) {
   OutputFile* const trace_file = files[0].get();
   OutputFile* const report_file = files[1].get();
   std::shared_ptr<control::RunRecorder> recorder;
+  std::shared_ptr<control::PowerFailRecorder> power_recorder;
+  SessionOptions session = o.session;
+  if (!o.inject.empty()) {
+    const std::optional<double> at = mains_off_time(o.inject);
+    if (!at) return kExitUsage;
+    if (o.session.realtime) {
+      fmt::print(stderr, "error: --inject works in virtual time only (not with --realtime)\n");
+      return kExitUsage;
+    }
+    session.mains_off_s = *at;
+  }
   std::optional<control::TraceCsvWriter> csv;
   std::optional<ProgressBar> bar;
   const bool tty = ::isatty(STDOUT_FILENO) != 0;
@@ -191,9 +249,15 @@ int run(const RunOptions& o) {
   hooks.opened = [&](const config::MachineProfile& machine, const control::OpenProgram& program) {
     std::vector<std::pair<std::shared_ptr<control::ControllerObserver>, control::ObserverOptions>> out;
     const plan::MachineLimits axes = control::axis_limits(machine);  // the drives' commands: the axes' own
-    recorder = std::make_shared<control::RunRecorder>(control::machine_limits(machine), machine.servo_period_s,
-                                                      &axes);
+    recorder = std::make_shared<control::RunRecorder>(control::machine_limits(machine),
+                                                      machine.servo_period_s, &axes);
     out.emplace_back(recorder, control::ObserverOptions{0, true});
+    if (session.mains_off_s >= 0) {
+      power_recorder = std::make_shared<control::PowerFailRecorder>(
+          control::coupling_config(machine.coupling), control::machine_limits(machine),
+          machine.servo_period_s, machine.coupling.radius_mm);
+      out.emplace_back(power_recorder, control::ObserverOptions{machine.servo_period_s, true});
+    }
     if (trace_file != nullptr) {
       csv.emplace(*trace_file, machine.axis_mask(), machine.servo_period_s);
       out.emplace_back(std::make_shared<TraceObserver>(*csv), control::ObserverOptions{0, true});
@@ -206,7 +270,6 @@ int run(const RunOptions& o) {
     if (bar) bar->show(st, run_start_s, recorder->report().path_length_mm);
   };
   const StopSignals signals;  // Ctrl-C: a controlled stop, and the report says so
-  SessionOptions session = o.session;
   session.stop = &StopSignals::requested();
   const SessionEnd end = run_session(session, hooks);
   if (bar) bar->finish();
@@ -215,7 +278,13 @@ int run(const RunOptions& o) {
   if (trace_file != nullptr && !commit_trace(*trace_file)) rc = kExitUsage;
   const control::RunReport r = recorder->report();
   print_report(r, end.profile, end);
-  if (report_file != nullptr && !write_and_commit(*report_file, report_json(r, o, end).dump(2) + "\n"))
+  std::optional<control::PowerFailReport> power_fail;
+  if (power_recorder) {
+    power_fail = power_recorder->report();
+    print_power_fail(*power_fail);
+  }
+  if (report_file != nullptr &&
+      !write_and_commit(*report_file, report_json(r, o, end, power_fail).dump(2) + "\n"))
     rc = kExitUsage;
   return rc;
 }
@@ -239,9 +308,13 @@ void add_run_command(CLI::App& app, Registry& registry) {
                 "operator on the terminal");
   cmd->add_option("--trace", opts->trace, "Write one CSV row per servo period (docs/controller.md)");
   cmd->add_option("--report", opts->report, "Write the report as JSON");
-  cmd->add_option("--max-time", opts->max_time_s,
-                  "Refuse a program that needs more machining time than this, in seconds (default 86400, a day; "
-                  "0: no limit)")
+  cmd->add_option("--inject", opts->inject,
+                  "Fault injection in virtual time: mains-off@SECONDS (the mains fail then; the report gains "
+                  "power_fail)");
+  cmd->add_option(
+         "--max-time", opts->max_time_s,
+         "Refuse a program that needs more machining time than this, in seconds (default 86400, a day; "
+         "0: no limit)")
       ->check(finite_range(0, 1e12));
   cmd->callback([opts, &registry] { registry.set_result(run(*opts)); });
 }

@@ -51,6 +51,8 @@ class Driver {
   virtual bool ticks_by_itself() const = 0;
   /// The simulated operator's hand moves hand-fed joint `joint` toward `target` at `speed`.
   virtual void set_hand_target(int joint, double target, double speed) = 0;
+  /// The simulated mains fail (virtual time only: cmd_run refuses --inject with --realtime).
+  virtual void cut_mains() = 0;
 };
 
 class VirtualDriver final : public Driver {
@@ -63,6 +65,7 @@ class VirtualDriver final : public Driver {
   void set_hand_target(int joint, double target, double speed) override {
     rig_.machine().set_hand_target(joint, target, speed);
   }
+  void cut_mains() override { rig_.machine().set_mains_ok(false); }
 
  private:
   control::SimRig rig_;
@@ -117,6 +120,7 @@ class RealtimeDriver final : public Driver {
   void set_hand_target(int joint, double target, double speed) override {
     sim_->set_hand_target(joint, target, speed);
   }
+  void cut_mains() override {}  // the servo thread alone touches the machine; refused before
 
  private:
   std::unique_ptr<control::ServoChannels> channels_;
@@ -206,7 +210,8 @@ struct OperatorWait {
 };
 
 std::optional<OperatorWait> operator_wait(const control::ControllerStatus& st) {
-  if (st.servo.state == State::Stopped) return OperatorWait{st.wait_text, Request::simple(CommandKind::CycleStart)};
+  if (st.servo.state == State::Stopped)
+    return OperatorWait{st.wait_text, Request::simple(CommandKind::CycleStart)};
   if (st.servo.wait == control::Wait::ManualToolChange)
     return OperatorWait{st.wait_text, Request::simple(CommandKind::ToolChanged)};
   return std::nullopt;
@@ -241,8 +246,10 @@ class StopOnThePath {
   void step(Driver& d, const control::ControllerStatus& st, SessionEnd& end) {
     if (!requested() || aborted_) return;
     end.stopped_by = flag_->load(std::memory_order_relaxed);
-    if (!held_) d.controller().submit(Request::simple(CommandKind::FeedHold));
-    else if (st.servo.path_velocity == 0) d.controller().submit(Request::simple(CommandKind::Abort));
+    if (!held_)
+      d.controller().submit(Request::simple(CommandKind::FeedHold));
+    else if (st.servo.path_velocity == 0)
+      d.controller().submit(Request::simple(CommandKind::Abort));
     aborted_ = held_ && st.servo.path_velocity == 0;
     held_ = true;
   }
@@ -262,16 +269,22 @@ void follow(Driver& d, control::EventCursor& cursor, const SessionOptions& o, co
   std::uint32_t job = 0;
   std::uint64_t asked_tick = ~std::uint64_t{0};  // the wait already answered (by its start tick)
   std::uint64_t n = 0;
+  bool mains_cut = false;
   for (;;) {
     d.advance();
     std::optional<ControllerEvent> ended;
     for (const ControllerEvent& e : cursor.next()) {
       print_event(e);
-      if (e.kind == ControllerEventKind::JobStarted && job == 0 && e.job == control::JobKind::Program) job = e.job_id;
+      if (e.kind == ControllerEventKind::JobStarted && job == 0 && e.job == control::JobKind::Program)
+        job = e.job_id;
       if (e.kind == ControllerEventKind::JobEnded && e.job_id == job) ended = e;
     }
     const control::ControllerStatus st = d.controller().status();
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (o.mains_off_s >= 0 && !mains_cut && st.servo.time_s >= o.mains_off_s) {
+      d.cut_mains();  // the servo sees it at its next period
+      mains_cut = true;
+    }
     if (hooks.progress && (++n % 256 == 0)) hooks.progress(st, wall);
     bring_hand_axis(d, st.servo);
     if (ended) {
@@ -279,10 +292,13 @@ void follow(Driver& d, control::EventCursor& cursor, const SessionOptions& o, co
       end.finished = ended->end == control::JobEnd::Finished;
       if (!end.finished) {
         // (a fault was printed as its note already)
-        if (!st.fault_text.empty()) end.fault = st.fault_text;
+        if (!st.fault_text.empty())
+          end.fault = st.fault_text;
         else if (end.stopped_by != 0)
-          end.fault = fmt::format("stopped by {} (feed hold on the path, then abort)", signal_name(end.stopped_by));
-        else end.fault = fmt::format("the program ended: {}", control::to_string(ended->end));
+          end.fault =
+              fmt::format("stopped by {} (feed hold on the path, then abort)", signal_name(end.stopped_by));
+        else
+          end.fault = fmt::format("the program ended: {}", control::to_string(ended->end));
         if (st.fault_text.empty()) fmt::print(stderr, "error: {}\n", end.fault);
         end.limit_touched = st.servo.fault.kind == control::FaultKind::SoftLimit ||
                             st.servo.fault.kind == control::FaultKind::LimitSwitch;
@@ -302,7 +318,8 @@ void follow(Driver& d, control::EventCursor& cursor, const SessionOptions& o, co
       d.controller().submit(wait->go_on);
       continue;
     }
-    fmt::print(stderr, "\nwaiting for {}: press Enter to continue, or a and Enter to abort\n", wait->question);
+    fmt::print(stderr, "\nwaiting for {}: press Enter to continue, or a and Enter to abort\n",
+               wait->question);
     std::optional<std::string> answer;
     while (!answer && !input.closed() && !stop.requested()) {
       answer = input.line(d.ticks_by_itself() ? 10 : -1);
@@ -337,11 +354,12 @@ void note_assumptions(const control::PreflightSummary& s) {
   const auto plural = [](std::uint64_t n, const char* one, const char* many) {
     return fmt::format("{} {}", n, n == 1 ? one : many);
   };
-  fmt::print(stderr,
-             "note: {} {} on what the machine answers while the program runs ({}); checked with assumed answers, "
-             "they are checked again with the real ones before they run: {}\n",
-             plural(s.assumed_moves, "move", "moves"), s.assumed_moves == 1 ? "rests" : "rest",
-             plural(s.sync_points, "sync point", "sync points"), lines);
+  fmt::print(
+      stderr,
+      "note: {} {} on what the machine answers while the program runs ({}); checked with assumed answers, "
+      "they are checked again with the real ones before they run: {}\n",
+      plural(s.assumed_moves, "move", "moves"), s.assumed_moves == 1 ? "rests" : "rest",
+      plural(s.sync_points, "sync point", "sync points"), lines);
 }
 
 }  // namespace

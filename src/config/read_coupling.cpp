@@ -99,7 +99,7 @@ void read_tables(Section& s, CouplingProfile& c) {
 void read_coupling(Section& top, MachineProfile& profile) {
   const toml::table* t = top.subtable("coupling");
   if (t == nullptr) return;
-  Section s(*t, "coupling", {"master", "slave", "source", "table"}, top.reporter());
+  Section s(*t, "coupling", {"master", "slave", "source", "radius_mm", "table"}, top.reporter());
   CouplingProfile& c = profile.coupling;
   c.present = true;
   const auto master = read_axis_letter(s, "master", profile);
@@ -118,6 +118,7 @@ void read_coupling(Section& top, MachineProfile& profile) {
       s.error(m.manual() ? "master" : "slave", "a coupled axis must be driven, not fed by hand",
               "config.range");
   }
+  c.radius_mm = s.number_or("radius_mm", c.radius_mm, Bound::Positive);
   c.from_actual = s.choice<bool>("source", {{"command", false}, {"actual", true}}, false);
   read_tables(s, c);
 }

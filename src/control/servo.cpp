@@ -150,6 +150,7 @@ void Servo::check_power() noexcept {
   const bool lost = !in_.power.mains_ok || (caps_.ups && in_.power.ups_on_battery);
   if (!lost || power_stop_) return;
   power_stop_ = true;
+  stop_spindle_and_coolant();  // the process ends at once; the axes stop on the path (coupled)
   switch (activity_) {
     case Activity::Program:
       hold_ = false;
@@ -481,6 +482,7 @@ void Servo::push_trace() noexcept {
     t.home_level[axis] = in_.joints[uj].home_level;
   }
   t.coupled = law_.active();
+  t.power_stop = power_stop_;
   t.coupling_error_deg = coupling_error();
   if (!channels_->trace.try_push(t)) ++trace_dropped_;
 }

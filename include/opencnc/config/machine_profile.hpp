@@ -155,6 +155,7 @@ struct CouplingProfile {
   Axis master = Axis::Z;
   Axis slave = Axis::C;
   bool from_actual = false;  ///< the tick couples to the master's feedback instead of its command
+  double radius_mm = 50;     ///< where helix errors are measured (the bore's radius): reports only
   std::vector<CouplingTableProfile> tables;
 };
 

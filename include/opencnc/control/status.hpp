@@ -149,6 +149,7 @@ struct TraceSample {
   std::array<HomingPhase, kAxisCount> homing_phase{};  ///< per axis
   Pose home_level{};                                   ///< the home proximity sensor's level, per axis
   bool coupled = false;          ///< a coupling law held the slave in this period
+  bool power_stop = false;       ///< a power-fail stop is under way (from the period after the signal)
   double coupling_error_deg = 0;  ///< actual slave − law(actual master), degrees (0 uncoupled)
 };
 
