@@ -15,6 +15,7 @@
 #include "../control/test_profiles.hpp"
 #include "opencnc/controller/controller.hpp"
 #include "opencnc/controller/gcode_source.hpp"
+#include "opencnc/controller/power_fail_recorder.hpp"
 #include "opencnc/controller/servo_setup.hpp"
 #include "opencnc/controller/sim_rig.hpp"
 #include "opencnc/motion/coupling.hpp"
@@ -187,6 +188,41 @@ TEST(Coupling, TheDemoJobsPassTheBroachsPreflight) {
     ASSERT_TRUE(rig.request(Request::set_mode(Mode::Auto)).accepted);
     const Outcome o = rig.request(Request::open(std::string(OPENCNC_SOURCE_DIR "/examples/") + job), 100000);
     EXPECT_TRUE(o.accepted) << job << "\n" << messages(o);
+  }
+}
+
+// Fault injection: the mains fail at instants through the constant-pitch demo job (cutting,
+// lifting, returning at rapid). Within a period the spindle and the coolant are off; Z stops on the
+// path with C held to the law (≤ 1 µm of helix error at the bore, feedback included), where each
+// axis braking alone would tear the groove; then the machine faults with the drives off.
+TEST(Coupling, PowerFailStopsOnTheHelix) {
+  const config::MachineProfile p = broach();
+  for (const double cut_s : {1.7, 3.2, 5.05, 9.4}) {
+    Diagnostics d;
+    SimRig rig(p, GcodeProgramSource::create(p, d));
+    auto recorder = std::make_shared<PowerFailRecorder>(coupling_config(p.coupling), machine_limits(p),
+                                                        p.servo_period_s, p.coupling.radius_mm);
+    rig.controller().attach(recorder, ObserverOptions{p.servo_period_s, true});
+    rig.step();
+    ASSERT_TRUE(rig.request(Request::simple(CommandKind::MachineOn)).accepted);
+    ASSERT_TRUE(rig.request(Request::coolant(Coolant::Flood, true)).accepted);  // the process runs
+    ASSERT_TRUE(rig.request(Request::set_mode(Mode::Auto)).accepted);
+    ASSERT_TRUE(rig.request(Request::open(OPENCNC_SOURCE_DIR "/examples/broach-constant.ngc"), 100000).accepted);
+    ASSERT_TRUE(rig.request(Request::simple(CommandKind::CycleStart)).accepted);
+    ASSERT_TRUE(rig.run_until([&] { return rig.status().servo.time_s >= cut_s; }, 20000));
+    ASSERT_TRUE(rig.status().servo.flood);
+    rig.machine().set_mains_ok(false);
+    rig.run(2);  // the signal is read in the next period and acted on in it
+    EXPECT_FALSE(rig.status().servo.flood) << cut_s;
+    ASSERT_TRUE(rig.run_until([&] { return rig.status().servo.state == State::Faulted; }, 5000)) << cut_s;
+    EXPECT_EQ(rig.status().servo.fault.kind, FaultKind::PowerLoss);
+    EXPECT_FALSE(rig.status().servo.drives_enabled);
+    const PowerFailReport r = recorder->report();
+    ASSERT_TRUE(r.happened && r.coupled) << cut_s;
+    EXPECT_LE(r.coupled_error_um, 1.0) << cut_s;
+    EXPECT_LT(r.coupled_command_error_um, 1e-3) << cut_s;
+    EXPECT_GT(r.independent_error_um, 10 * std::max(r.coupled_error_um, 1.0)) << cut_s;
+    EXPECT_GT(r.stop_distance_mm, 0.0) << cut_s;
   }
 }
 
