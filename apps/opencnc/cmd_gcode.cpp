@@ -15,10 +15,10 @@
 #include "numeric_options.hpp"
 #include "opencnc/canon/rs274_printer.hpp"
 #include "opencnc/core/axis_map.hpp"
+#include "opencnc/gcode/coupling_codes.hpp"
 #include "opencnc/gcode/dialect.hpp"
 #include "opencnc/gcode/interpreter.hpp"
 #include "opencnc/gcode/rs274_driver.hpp"
-#include "opencnc/gcode/coupling_codes.hpp"
 #include "opencnc/gcode/standard_extensions.hpp"
 #include "progress.hpp"
 
@@ -53,9 +53,10 @@ void add_interp_options(CLI::App* cmd, InterpArgs& a) {
       ->check(CLI::IsMember({"linuxcnc", "fanuc"}, CLI::ignore_case));
   cmd->add_option("--machine", a.machine, "mill or lathe, for Fanuc programs (default: guessed from the program's axis words)")
       ->check(CLI::IsMember({"mill", "lathe"}, CLI::ignore_case));
-  cmd->add_option("--codes", a.codes,
-                  "code modules beyond the standard ones: coupling (M171-M175, the broaching codes of a machine "
-                  "with a [coupling] section)")
+  cmd->add_option(
+         "--codes", a.codes,
+         "code modules beyond the standard ones: coupling (M171-M175, the broaching codes of a machine "
+         "with a [coupling] section)")
       ->check(CLI::IsMember({"coupling"}));
   cmd->add_option("--axis-map", a.axis_map, "axis exchange, program letter = machine axis (e.g. X=Y,Y=X)");
   cmd->add_option("--max-blocks", a.max_blocks,

@@ -167,7 +167,8 @@ void Servo::apply_reports() noexcept {
   for (int e = 0; e < tick_out_.event_count; ++e) {
     const traj::TickEvent& ev = tick_out_.events[static_cast<std::size_t>(e)];
     const bool record_stop = ev.kind == traj::MarkerKind::Dwell && ring.available() > 0 &&
-                             ring.front().action == ev.action && ring.front().code == ActionCode::AxisCoupling;
+                             ring.front().action == ev.action &&
+                             ring.front().code == ActionCode::AxisCoupling;
     if (ev.kind != traj::MarkerKind::Report && !record_stop) continue;
     MachineAction a;
     if (take_action(ev.action, a)) apply_action(a);

@@ -121,7 +121,9 @@ class Pipeline {
   const Diagnostics& hand_failures() const noexcept { return hand_.failures(); }
   /// What the coupling pass refused (moves the law would drive past the slave's limits).
   const Diagnostics& coupling_failures() const noexcept { return coupling_.failures(); }
-  bool passes_failed() const noexcept { return !hand_.failures().items().empty() || !coupling_.failures().items().empty(); }
+  bool passes_failed() const noexcept {
+    return !hand_.failures().items().empty() || !coupling_.failures().items().empty();
+  }
 
   /// A new leg at `start`: the builder's continuation; the old one is kept until the next leg
   /// (a run's last trace samples may still refer to its moves).
@@ -600,8 +602,7 @@ std::unique_ptr<ProgramStream> GcodeProgramSource::execute(const std::string& pa
   // As LinuxCNC's task runs it, M99 in the main program starts it again until the operator
   // stops the run (the preflight scans it once, as rs274 reads it).
   o.main_m99 = gcode::MainM99::Repeat;
-  return std::make_unique<GcodeStream>(o, path, start, config_.default_tolerance_mm, config_.tools,
-                                       passes());
+  return std::make_unique<GcodeStream>(o, path, start, config_.default_tolerance_mm, config_.tools, passes());
 }
 
 std::unique_ptr<ProgramStream> GcodeProgramSource::mdi(std::string_view line, const Pose& start) {

@@ -140,7 +140,7 @@ motion::CouplingConfig coupling_config(const config::CouplingProfile& c) {
   for (std::size_t t = 0; t < n; ++t) {
     const config::CouplingTableProfile& tp = c.tables[t];
     out.table_kind[t] = tp.kind == config::CouplingTableProfile::Kind::Cam ? motion::CouplingKind::Cam
-                                                                            : motion::CouplingKind::PitchTable;
+                                                                           : motion::CouplingKind::PitchTable;
     motion::CouplingTable& table = out.tables[t];
     table.count = static_cast<int>(std::min<std::size_t>(tp.points.size(), motion::kMaxCouplingPoints));
     for (int k = 0; k < table.count; ++k) {

@@ -207,7 +207,8 @@ TEST(Coupling, PowerFailStopsOnTheHelix) {
     ASSERT_TRUE(rig.request(Request::simple(CommandKind::MachineOn)).accepted);
     ASSERT_TRUE(rig.request(Request::coolant(Coolant::Flood, true)).accepted);  // the process runs
     ASSERT_TRUE(rig.request(Request::set_mode(Mode::Auto)).accepted);
-    ASSERT_TRUE(rig.request(Request::open(OPENCNC_SOURCE_DIR "/examples/broach-constant.ngc"), 100000).accepted);
+    ASSERT_TRUE(
+        rig.request(Request::open(OPENCNC_SOURCE_DIR "/examples/broach-constant.ngc"), 100000).accepted);
     ASSERT_TRUE(rig.request(Request::simple(CommandKind::CycleStart)).accepted);
     ASSERT_TRUE(rig.run_until([&] { return rig.status().servo.time_s >= cut_s; }, 20000));
     ASSERT_TRUE(rig.status().servo.flood);
