@@ -213,8 +213,11 @@ TEST(Coupling, PowerFailStopsOnTheHelix) {
     ASSERT_TRUE(rig.run_until([&] { return rig.status().servo.time_s >= cut_s; }, 20000));
     ASSERT_TRUE(rig.status().servo.flood);
     rig.machine().set_mains_ok(false);
-    rig.run(2);  // the signal is read in the next period and acted on in it
-    EXPECT_FALSE(rig.status().servo.flood) << cut_s;
+    // The machine reports it after its next period, the servo acts in the period that reads it,
+    // and the controller's status shows that period at its next service.
+    rig.run(4);
+    EXPECT_TRUE(rig.status().servo.aborting) << cut_s;  // the stop is under way …
+    EXPECT_FALSE(rig.status().servo.flood) << cut_s;    // … with the process already off
     ASSERT_TRUE(rig.run_until([&] { return rig.status().servo.state == State::Faulted; }, 5000)) << cut_s;
     EXPECT_EQ(rig.status().servo.fault.kind, FaultKind::PowerLoss);
     EXPECT_FALSE(rig.status().servo.drives_enabled);
