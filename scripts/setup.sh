@@ -12,6 +12,7 @@ packages=(
   libcli11-dev          # command line parsing
   nlohmann-json3-dev    # JSON reports and API
   libtomlplusplus-dev   # machine profiles
+  libsqlite3-dev        # the tool store: tools, edges, backups and audit (store::Database)
   python3               # helper scripts (program generators, golden regeneration)
 )
 test_packages=(

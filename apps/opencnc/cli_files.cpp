@@ -26,6 +26,8 @@ std::vector<NamedPath> session_inputs(const SessionOptions& o, const config::Mac
   std::vector<NamedPath> in = {{"the program", o.file}, {"the profile", o.machine}};
   if (profile != nullptr && !profile->interpreter.tool_table.empty())
     in.push_back({"the tool table", profile->interpreter.tool_table});
+  if (profile != nullptr && profile->tool_guard.present)
+    in.push_back({"the tool store", profile->tool_guard.store});
   return in;
 }
 

@@ -36,6 +36,8 @@ void add_gcode_commands(CLI::App& app, Registry& registry);   ///< check, canon,
 void add_run_command(CLI::App& app, Registry& registry);
 void add_plot_command(CLI::App& app, Registry& registry);
 void add_calibrate_command(CLI::App& app, Registry& registry);
+void add_tools_command(CLI::App& app, Registry& registry);  ///< the tool store and its guard
+void add_nearest_command(CLI::App& app, Registry& registry);
 void add_helix_command(CLI::App& app, Registry& registry);
 
 }  // namespace opencnc::cli

@@ -22,6 +22,7 @@
 #include "opencnc/controller/gcode_source.hpp"
 #include "opencnc/controller/servo_setup.hpp"
 #include "opencnc/controller/sim_rig.hpp"
+#include "opencnc/toolguard/tool_guard.hpp"
 #include "stop_signals.hpp"
 
 namespace opencnc::cli {
@@ -270,6 +271,7 @@ void follow(Driver& d, control::EventCursor& cursor, const SessionOptions& o, co
   std::uint64_t asked_tick = ~std::uint64_t{0};  // the wait already answered (by its start tick)
   std::uint64_t n = 0;
   bool mains_cut = false;
+  bool guard_abort = false;
   for (;;) {
     d.advance();
     std::optional<ControllerEvent> ended;
@@ -278,6 +280,14 @@ void follow(Driver& d, control::EventCursor& cursor, const SessionOptions& o, co
       if (e.kind == ControllerEventKind::JobStarted && job == 0 && e.job == control::JobKind::Program)
         job = e.job_id;
       if (e.kind == ControllerEventKind::JobEnded && e.job_id == job) ended = e;
+      if (e.kind == ControllerEventKind::Note && e.code == "tools.guard-hold" && !guard_abort) {
+        // No accept or restore at this terminal: the run ends before the tool cuts.
+        fmt::print(stderr,
+                   "error: the tool guard holds the program before the tool cuts; it is aborted: accept or "
+                   "restore with `opencnc tools --db STORE accept|restore`, then run it again\n");
+        d.controller().submit(Request::simple(CommandKind::Abort));
+        guard_abort = true;
+      }
     }
     const control::ControllerStatus st = d.controller().status();
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -287,6 +297,11 @@ void follow(Driver& d, control::EventCursor& cursor, const SessionOptions& o, co
     }
     if (hooks.progress && (++n % 256 == 0)) hooks.progress(st, wall);
     bring_hand_axis(d, st.servo);
+    if (hooks.tick) hooks.tick(d.controller(), st);
+    if (ended && hooks.goes_on && hooks.goes_on(*ended)) {
+      job = 0;  // the job that resumes the program is followed next
+      ended.reset();
+    }
     if (ended) {
       end.wall_s = wall;
       end.finished = ended->end == control::JobEnd::Finished;
@@ -383,9 +398,11 @@ SessionEnd run_session(const SessionOptions& o, const SessionHooks& hooks) {
     return end;
   }
   Diagnostics diags;
-  auto source = control::GcodeProgramSource::create(end.profile, diags);
+  // The profile's G-code source; with [tool_guard], the tool store and the guard's feature.
+  std::optional<toolguard::Setup> setup = toolguard::setup(end.profile, diags);
   print(diags);
-  if (!source) return end;
+  if (!setup) return end;
+  const std::shared_ptr<control::ProgramSource> source = setup->source;
 
   std::unique_ptr<Driver> driver;
   if (o.realtime) {
@@ -399,6 +416,11 @@ SessionEnd run_session(const SessionOptions& o, const SessionHooks& hooks) {
     driver = std::make_unique<VirtualDriver>(end.profile, source);
   }
   Driver& d = *driver;
+  if (setup->feature) d.controller().add_feature(setup->feature);
+  if (hooks.features) {
+    for (auto& f : hooks.features(end.profile))
+      d.controller().add_feature(std::move(f), control::ObserverOptions{end.profile.servo_period_s, false});
+  }
   const control::ServoConfig& sc = d.controller().servo_config();
   if (!must(d, Request::simple(CommandKind::MachineOn)) || !home_if_needed(d, sc) ||
       !must(d, Request::set_mode(control::Mode::Auto)) || !must(d, Request::open(o.file))) {

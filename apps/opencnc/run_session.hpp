@@ -45,11 +45,19 @@ struct SessionEnd {
 struct SessionHooks {
   /// Called once the program is open and checked, before it starts: return the observers to
   /// attach (with their options) for the run.
-  std::function<std::vector<std::pair<std::shared_ptr<control::ControllerObserver>, control::ObserverOptions>>(
-      const config::MachineProfile&, const control::OpenProgram&)>
+  std::function<
+      std::vector<std::pair<std::shared_ptr<control::ControllerObserver>, control::ObserverOptions>>(
+          const config::MachineProfile&, const control::OpenProgram&)>
       opened;
   /// Now and then with the status (for progress).
   std::function<void(const control::ControllerStatus&, double elapsed_wall_s)> progress;
+  /// Features added to the controller before the program is opened (the retrace feature), each
+  /// following the status every servo period.
+  std::function<std::vector<std::shared_ptr<control::Feature>>(const config::MachineProfile&)> features;
+  /// Every period of the run, with the controller: a scripted operator (`run --retrace`).
+  std::function<void(control::Controller&, const control::ControllerStatus&)> tick;
+  /// When the program's job ends: true if the session goes on with the job that resumes it.
+  std::function<bool(const control::ControllerEvent&)> goes_on;
 };
 
 /// Runs `o.file` on the simulated machine of `o.machine`; prints problems and program messages

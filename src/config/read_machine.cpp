@@ -156,8 +156,9 @@ void read_probe(Section& top, MachineProfile& profile) {
 void read_tool_changer(Section& top, MachineProfile& profile) {
   const toml::table* t = top.subtable("tool_changer");
   if (t == nullptr) return;
-  Section s(*t, "tool_changer", {"sim"}, top.reporter());
+  Section s(*t, "tool_changer", {"sim", "pockets"}, top.reporter());
   profile.tool_changer = true;
+  profile.tool_changer_pockets = static_cast<int>(s.integer("pockets", 1, 10000).value_or(0));
   profile.tool_changer_sim.present = true;
   const toml::table* st = s.subtable("sim");
   if (st == nullptr) return;
@@ -167,13 +168,54 @@ void read_tool_changer(Section& top, MachineProfile& profile) {
   sim.change_time_s = m.number_or("change_time_s", sim.change_time_s, Bound::NonNegative);
 }
 
+namespace {
+
+/// [process.cutting]: the torch's outputs, times and heights (checked against [io] later: the
+/// output channels must exist).
+void read_cutting(Section& process, MachineProfile& profile) {
+  const toml::table* t = process.subtable("cutting");
+  if (t == nullptr) return;
+  Section s(*t, "process.cutting",
+            {"torch_output", "preheat_output", "cut_output", "ignite_s", "preheat_s", "pierce_s", "safe_height",
+             "pierce_lift", "approach_feed", "retrace_feed"},
+            process.reporter());
+  CuttingProfile& c = profile.cutting;
+  c.present = true;
+  const auto channel = [&](std::string_view key, int fallback) {
+    const auto v = s.integer(key, 0, machine::kDigitalChannels - 1);
+    if (v && *v >= profile.io.digital_outputs)
+      s.error(key,
+              fmt::format("{} is digital output {}, but the machine has {} (io.digital_outputs)", s.key_path(key), *v,
+                          profile.io.digital_outputs),
+              "config.range");
+    return static_cast<int>(v.value_or(fallback));
+  };
+  c.torch_output = channel("torch_output", -1);
+  if (c.torch_output < 0 && !s.has("torch_output")) s.missing("torch_output");
+  c.preheat_output = channel("preheat_output", -1);
+  c.cut_output = channel("cut_output", -1);
+  c.ignite_s = s.number_or("ignite_s", 0, Bound::NonNegative);
+  c.preheat_s = s.number_or("preheat_s", 0, Bound::NonNegative);
+  c.pierce_s = s.number_or("pierce_s", 0, Bound::NonNegative);
+  if (const auto h = s.number("safe_height")) {
+    c.safe_height_mm = *h;
+    c.has_safe_height = true;
+  }
+  c.pierce_lift_mm = s.number_or("pierce_lift", 0, Bound::NonNegative);
+  c.approach_mm_min = s.number_or("approach_feed", 0, Bound::NonNegative);
+  c.retrace_mm_min = s.number_or("retrace_feed", c.retrace_mm_min, Bound::Positive);
+}
+
+}  // namespace
+
 void read_process(Section& top, MachineProfile& profile) {
   const toml::table* t = top.subtable("process");
   if (t == nullptr) return;
-  Section s(*t, "process", {"torch", "generator", "sim"}, top.reporter());
+  Section s(*t, "process", {"torch", "generator", "sim", "cutting"}, top.reporter());
   machine::SimProcessConfig& p = profile.process;
   p.torch = s.boolean_or("torch", false);
   p.generator = s.boolean_or("generator", false);
+  read_cutting(s, profile);
   const toml::table* st = s.subtable("sim");
   if (st == nullptr) return;
   Section m(*st, "process.sim", {"arc_delay_s"}, top.reporter());

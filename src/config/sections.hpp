@@ -21,10 +21,13 @@ void read_power(Section& top, MachineProfile& profile);
 /// [probe]. Needs the axes.
 void read_probe(Section& top, MachineProfile& profile);
 void read_tool_changer(Section& top, MachineProfile& profile);
-void read_process(Section& top, MachineProfile& profile);
 void read_io(Section& top, MachineProfile& profile);
+/// [process] with [process.cutting]. Needs [io].
+void read_process(Section& top, MachineProfile& profile);
 void read_interpreter(Section& top, MachineProfile& profile, const std::filesystem::path& base_dir);
 void read_planner(Section& top, MachineProfile& profile);
+/// [tool_guard]. Needs [interpreter] (a tool store and a tool table file exclude each other).
+void read_tool_guard(Section& top, MachineProfile& profile, const std::filesystem::path& base_dir);
 /// [axis.<letter>.compensation] of every axis read. Needs the axes; comp files are found from
 /// `base_dir`.
 void read_compensation(Section& top, MachineProfile& profile, const std::filesystem::path& base_dir);

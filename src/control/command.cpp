@@ -42,6 +42,8 @@ const char* refusal_code(Refusal r) noexcept {
       return "control.interlock";
     case Refusal::HandAxis:
       return "control.hand-axis";
+    case Refusal::FeatureCheck:
+      return "control.feature-check";
   }
   return "control.unknown";
 }

@@ -59,6 +59,8 @@ std::string refusal_text(Refusal r) {
       return "an interlock rule of the machine forbids it now";
     case Refusal::HandAxis:
       return "the axis is moved by hand (or is not where the program needs it)";
+    case Refusal::FeatureCheck:
+      return "a check before the start failed";
   }
   return "refused";
 }
@@ -312,6 +314,8 @@ void Controller::handle(std::uint64_t id, Request& r) {
           run_auxiliary(id, body);
         } else if constexpr (std::is_same_v<T, requests::Feature>) {
           feature(id, body);
+        } else if constexpr (std::is_same_v<T, requests::ResumeProgram>) {
+          resume_program(id, body);
         } else if constexpr (std::is_same_v<T, requests::SetSwitch>) {
           if (body.which == SwitchKind::BlockDelete) {
             block_delete_ = body.on;
@@ -445,6 +449,7 @@ void Controller::cycle_start(std::uint64_t id, const Request& r) {
   std::optional<OpenProgram> op = open_program();
   if (!op) return finish(id, Refusal::NoProgram, refusal_text(Refusal::NoProgram));
   if (!ready_for_job(id, Mode::Auto, "programs")) return;
+  if (!features_allow_start(id, {JobKind::Program, op->name})) return;
   if (op->program) {
     const bool same_start = op->program->start() == servo().commanded;
     start_job(id, JobKind::Program, op->name, Mode::Auto, canon_stream(op->program, servo().commanded), same_start);
@@ -473,6 +478,7 @@ void Controller::cycle_start(std::uint64_t id, const Request& r) {
 void Controller::run_auxiliary(std::uint64_t id, const requests::RunAuxiliary& r) {
   if (!ready_for_job(id, Mode::Auto, "auxiliary programs")) return;
   const std::string name = r.name.empty() ? (r.path.empty() ? "auxiliary" : r.path) : r.name;
+  if (!features_allow_start(id, {JobKind::Auxiliary, name})) return;
   if (r.program) {
     Preflight pf = preflight_canon(*r.program);
     if (!pf.ok())
@@ -486,6 +492,63 @@ void Controller::run_auxiliary(std::uint64_t id, const requests::RunAuxiliary& r
     return finish(id, program_refusal(pf.diagnostics), refusal_text(program_refusal(pf.diagnostics)), pf.diagnostics);
   start_job(id, JobKind::Auxiliary, name, Mode::Auto, source_->execute(r.path, servo().commanded, {block_delete_}),
             true);
+}
+
+// Every feature's check before a start (Feature::allow_start); the first that says no refuses it.
+bool Controller::features_allow_start(std::uint64_t id, const StartCheck& start) {
+  for (auto& [name, f] : features_) {
+    std::string why;
+    bool ok = true;
+    try {
+      ok = f->allow_start(start, *this, &why);
+    } catch (const std::exception& ex) {
+      ok = false;
+      why = ex.what();
+    }
+    if (!ok) {
+      finish(id, Refusal::FeatureCheck,
+             fmt::format("{}: {}", name, why.empty() ? refusal_text(Refusal::FeatureCheck) : why));
+      return false;
+    }
+  }
+  return true;
+}
+
+// Whether every feature lets the job read on past a sync point (Feature::allow_continue).
+bool Controller::features_allow_continue(const SyncCheck& sync) {
+  for (auto& [name, f] : features_) {
+    bool ok = true;
+    try {
+      ok = f->allow_continue(sync, *this);
+    } catch (const std::exception& ex) {
+      // A feature that fails cannot vouch for what follows: hold, and say so once.
+      if (held_by_ != name)
+        note(Severity::Error, "control.feature",
+             fmt::format("{} failed at the {}: {}", name, to_string(sync.kind), ex.what()));
+      ok = false;
+    }
+    if (!ok) {
+      held_by_ = name;
+      return false;
+    }
+  }
+  held_by_.clear();
+  return true;
+}
+
+void Controller::resume_program(std::uint64_t id, const requests::ResumeProgram& r) {
+  std::optional<OpenProgram> op = open_program();
+  if (!op) return finish(id, Refusal::NoProgram, refusal_text(Refusal::NoProgram));
+  if (op->path.empty()) return finish(id, Refusal::BadValue, "only a program file can be resumed at a segment");
+  if (!ready_for_job(id, Mode::Auto, "programs")) return;
+  if (!features_allow_start(id, {JobKind::Program, op->name})) return;
+  std::unique_ptr<ProgramStream> stream =
+      source_->resume(op->path, r.program_start.value_or(open_at_), servo().commanded, r.segment, {block_delete_});
+  if (!stream) return finish(id, Refusal::BadValue, "this controller's program source cannot resume at a segment");
+  // The replay up to the segment, here and now: a program that cannot get there starts nothing.
+  while (stream->state() == StreamState::Reading && stream->program().empty()) stream->read(1);
+  // Every move is checked before it runs (the preflight's moves began elsewhere).
+  start_job(id, JobKind::Program, op->name, Mode::Auto, std::move(stream), false);
 }
 
 void Controller::feature(std::uint64_t id, const requests::Feature& r) {
@@ -521,6 +584,7 @@ void Controller::start_job(std::uint64_t id, JobKind kind, std::string name, Mod
   host.log = [this](ControllerEvent e) { log(std::move(e)); };
   host.send = [this](const Command& c) { return channels_->commands.try_push(c); };
   host.next_run_id = [this] { return ++run_counter_; };
+  host.may_continue = [this](const SyncCheck& c) { return features_allow_continue(c); };
   auto job = std::make_unique<detail::Job>(kind, ++job_counter_, name, mode, std::move(stream), std::move(host));
   Diagnostics d;
   if (!job->start(id, d)) {
@@ -565,6 +629,7 @@ void Controller::publish() {
   p.program_length_mm = open_ ? open_->preflight.summary.path_length_mm : 0;
   p.run_active = job_ != nullptr;
   const ServoStatus& s = servo();
+  p.servo = s;  // FeatureHost::current_status() is this, servo snapshot included
   if (job_) {
     const bool same_run = s.run_id == job_->run_id();
     p.job = job_->kind();
@@ -629,6 +694,9 @@ std::string Controller::wait_text() const {
     return fmt::format("the operator's cycle start ({} at {})", why, to_string(published_.location));
   }
   if (s.state == State::Held) return "the operator's resume (feed hold)";
+  if (job_->held_at_sync() && !held_by_.empty())
+    return fmt::format("the {} to let the program go on past the {} (see its note)", held_by_,
+                       to_string(job_->sync_wait()));
   switch (s.wait) {
     case Wait::None:
       return {};

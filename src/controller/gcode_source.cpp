@@ -15,6 +15,7 @@
 #include "opencnc/gcode/coupling_codes.hpp"
 #include "opencnc/gcode/dialect.hpp"
 #include "opencnc/gcode/standard_extensions.hpp"
+#include "replay_filter.hpp"
 
 namespace opencnc::control {
 
@@ -202,6 +203,21 @@ class GcodeStream final : public ProgramStream {
     tools_version_ = tools_ ? tools_->version() : 0;
     if (!begin_program(*interp_, pipe_, path, start, tolerance_mm)) fail();
   }
+  /// A file resumed at segment `first`: the interpreter runs it from the start, placed at
+  /// `program_start` (where the program first started), and everything before the segment is
+  /// replayed quietly (detail::ReplayFilter); the moves begin at `start` with the rest of it.
+  GcodeStream(const gcode::Options& o, const std::string& path, const Pose& program_start, const Pose& start,
+              canon::SegmentId first, double tolerance_mm, std::shared_ptr<tools::ToolTableService> tools,
+              const HandAxes& hand)
+      : owned_(std::make_unique<gcode::Interpreter>(o)),
+        interp_(owned_.get()),
+        tools_(std::move(tools)),
+        pipe_(*interp_, start, tolerance_mm, tools_.get(), hand) {
+    tools_version_ = tools_ ? tools_->version() : 0;
+    replay_ = std::make_unique<detail::ReplayFilter>(pipe_.sink(), first);
+    first_segment_ = first;
+    if (!begin_program(*interp_, pipe_, path, program_start, tolerance_mm)) fail();
+  }
   /// An MDI line on the session's interpreter (already placed and up to date).
   GcodeStream(gcode::Interpreter& session, std::string line, const Pose& start, double tolerance_mm,
               std::shared_ptr<tools::ToolTableService> tools, const MovePasses& passes)
@@ -227,7 +243,7 @@ class GcodeStream final : public ProgramStream {
     std::uint64_t blocks = 0;
     while (state_ == StreamState::Reading && program().size() < target && blocks < kReadBlockBudget) {
       blocks += kBlocksPerCall;
-      on_status(interp_->run(pipe_.sink(), kBlocksPerCall));
+      on_status(interp_->run(sink(), kBlocksPerCall));
     }
     return state_;
   }
@@ -288,6 +304,13 @@ class GcodeStream final : public ProgramStream {
       case gcode::RunStatus::Ok:
         return;
       case gcode::RunStatus::Finished:
+        if (replay_ && !replay_->live()) {
+          diags_.error("", 0, 0, fmt::format("cannot resume at segment {}: the program ends after {} segments",
+                                             first_segment_, interp_->segments()),
+                       "control.resume-past-end");
+          state_ = StreamState::Error;
+          return;
+        }
         state_ = StreamState::Finished;
         collect_diagnostics();
         return;
@@ -300,7 +323,38 @@ class GcodeStream final : public ProgramStream {
     }
   }
 
+  /// Where the interpreter writes: the pipeline, through the replay filter while resuming.
+  canon::Sink& sink() {
+    if (!replay_) return pipe_.sink();
+    replay_->set_next(pipe_.sink());
+    return *replay_;
+  }
+
+  /// A sync point before the segment a resumed program starts at: a stop or a tool change goes
+  /// on (the program went on from it when it ran); a probe result or an input value is not
+  /// known again, so the program cannot be resumed past it.
+  bool replay_sync() {
+    const gcode::SyncKind k = interp_->pending_sync();
+    if (k == gcode::SyncKind::Probe || k == gcode::SyncKind::Input) {
+      const SourceLocation where = location();
+      diags_.error(where.file, where.line, 0,
+                   fmt::format("cannot resume at segment {}: the program reads the machine's {} at {} before it, "
+                               "which a replay does not know",
+                               first_segment_, k == gcode::SyncKind::Probe ? "probe result" : "input",
+                               to_string(where)),
+                   "control.resume-past-sync");
+      state_ = StreamState::Error;
+      return true;
+    }
+    gcode::SyncValues v;
+    v.kind = k;
+    v.position = interp_->state().position.current;
+    interp_->sync(v);
+    return true;
+  }
+
   void enter_sync() {
+    if (replay_ && !replay_->live() && replay_sync()) return;
     state_ = StreamState::Sync;
     sync_.kind = from_gcode(interp_->pending_sync());
     sync_.where = location();
@@ -350,6 +404,8 @@ class GcodeStream final : public ProgramStream {
   std::size_t first_diagnostic_ = 0;
   std::string mdi_line_;
   bool mdi_ = false, mdi_started_ = false;
+  std::unique_ptr<detail::ReplayFilter> replay_;  ///< resuming: what comes before the first segment
+  canon::SegmentId first_segment_ = 0;
 };
 
 // --- the preflight scan --------------------------------------------------------------------------
@@ -548,6 +604,12 @@ Preflight preflight_pass(const gcode::Options& o, const std::string& path, const
 
 std::shared_ptr<GcodeProgramSource> GcodeProgramSource::create(const config::MachineProfile& profile,
                                                                Diagnostics& diags) {
+  std::optional<GcodeSourceConfig> c = config_for(profile, diags);
+  return c ? std::make_shared<GcodeProgramSource>(std::move(*c)) : nullptr;
+}
+
+std::optional<GcodeSourceConfig> GcodeProgramSource::config_for(const config::MachineProfile& profile,
+                                                                Diagnostics& diags) {
   GcodeSourceConfig c;
   gcode::Options& o = c.options;
   o.dialect = profile.interpreter.dialect == config::Dialect::Fanuc ? gcode::Dialect::Fanuc
@@ -562,13 +624,13 @@ std::shared_ptr<GcodeProgramSource> GcodeProgramSource::create(const config::Mac
   o.optional_stop = true;  // M1 always reaches the servo, which decides with the live switch
   if (!profile.interpreter.tool_table.empty()) {
     c.tools = tools::FileToolTable::open(profile.interpreter.tool_table, diags);
-    if (!c.tools) return nullptr;
+    if (!c.tools) return std::nullopt;
   }
   c.default_tolerance_mm = profile.planner.default_tolerance;
   c.hand = hand_axes(profile);
   c.coupling = coupled_axes(profile);
   if (c.coupling.any()) c.extensions = gcode::coupling_extensions;
-  return std::make_shared<GcodeProgramSource>(std::move(c));
+  return c;
 }
 
 GcodeProgramSource::GcodeProgramSource(GcodeSourceConfig config) : config_(std::move(config)) {}
@@ -603,6 +665,15 @@ std::unique_ptr<ProgramStream> GcodeProgramSource::execute(const std::string& pa
   // stops the run (the preflight scans it once, as rs274 reads it).
   o.main_m99 = gcode::MainM99::Repeat;
   return std::make_unique<GcodeStream>(o, path, start, config_.default_tolerance_mm, config_.tools, passes());
+}
+
+std::unique_ptr<ProgramStream> GcodeProgramSource::resume(const std::string& path, const Pose& program_start,
+                                                          const Pose& start, canon::SegmentId segment,
+                                                          const LoadOptions& options) {
+  gcode::Options o = options_for(path, options);
+  o.mode = gcode::Mode::Execute;
+  return std::make_unique<GcodeStream>(o, path, program_start, start, segment, config_.default_tolerance_mm,
+                                       config_.tools, config_.hand);
 }
 
 std::unique_ptr<ProgramStream> GcodeProgramSource::mdi(std::string_view line, const Pose& start) {

@@ -202,6 +202,9 @@ void Job::enter_sync() {
   }
   waiting_ = true;
   waiting_action_ = action;
+  waiting_tool_ = r.kind == SyncKind::ToolChange && action != traj::kNoAction
+                      ? stream_->program().action(action).index
+                      : 0;
   ControllerEvent e;
   e.kind = ControllerEventKind::SyncWait;
   e.job = kind_;
@@ -262,7 +265,8 @@ void Job::on_servo_event(const ServoEvent& e, const ServoStatus& s) {
       {
         SyncAnswer a = at_rest(stream_->sync_request().kind, s);
         a.input_value = input_value_;
-        answer(a);
+        held_ = a;
+        answer_when_allowed();
       }
       return;
     case EventKind::RunEnded:
@@ -315,8 +319,27 @@ void Job::on_servo_event(const ServoEvent& e, const ServoStatus& s) {
 
 // --- the periodic work -------------------------------------------------------------------------
 
+// The machine has passed the sync point; the interpreter reads on once every feature agrees
+// (Feature::allow_continue), else the job stands there and asks again next service().
+void Job::answer_when_allowed() {
+  if (!held_) return;
+  if (host_.may_continue) {
+    const SyncRequest& r = stream_->sync_request();
+    SyncCheck c;
+    c.job = kind_;
+    c.kind = r.kind;
+    c.where = r.where;
+    c.tool_index = waiting_tool_;
+    if (!host_.may_continue(c)) return;
+  }
+  const SyncAnswer a = *held_;
+  held_.reset();
+  answer(a);
+}
+
 void Job::service(const ServoStatus& s) {
   if (ended_) return;
+  answer_when_allowed();
   if (!failing_) read_ahead(s);
   push_actions();
   pump();

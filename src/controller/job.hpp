@@ -41,6 +41,9 @@ struct JobHost {
   std::function<bool(const Command&)> send;
   /// Servo run ids are the controller's to hand out.
   std::function<std::uint32_t()> next_run_id;
+  /// Whether the features let the interpreter read on past a sync point the machine has passed
+  /// (Feature::allow_continue); null: always.
+  std::function<bool(const SyncCheck&)> may_continue;
 };
 
 class Job {
@@ -59,6 +62,8 @@ class Job {
   void service(const ServoStatus& s);
 
   bool ended() const noexcept { return ended_; }
+  /// The machine has answered the sync point, but a feature holds the interpreter there.
+  bool held_at_sync() const noexcept { return held_.has_value(); }
   JobEnd end_reason() const noexcept { return end_; }
   /// The error that ended the job (JobEnd::Error), with file and line.
   const Diagnostics& errors() const noexcept { return errors_; }
@@ -104,6 +109,7 @@ class Job {
   void check_new_moves();
   void enter_sync();
   void answer(const SyncAnswer& a);
+  void answer_when_allowed();
   void push_actions();
   void pump();
   void release(const ServoStatus& s);
@@ -122,6 +128,8 @@ class Job {
   std::uint32_t previous_run_id_ = 0;  ///< the leg before (its samples may still come)
   bool waiting_ = false;               ///< the stream waits at a sync point for the servo
   std::uint32_t waiting_action_ = 0;   ///< the action of that sync point in the leg
+  int waiting_tool_ = 0;               ///< the tool of a tool-change sync point
+  std::optional<SyncAnswer> held_;     ///< the machine's answer, held while a feature says wait
   double input_value_ = 0;             ///< the last M66 result of the run
   bool failing_ = false;               ///< an error: stop at the end of the good moves, then abort
   bool prechecked_ = false;            ///< JobHost::prechecked, until the first sync point

@@ -69,6 +69,7 @@ std::string Request::name() const {
                         [](const requests::RunAuxiliary&) -> std::string { return "run-auxiliary"; },
                         [](const requests::Feature& r) -> std::string { return r.feature + "." + r.action; },
                         [](const requests::SetHandwheel&) -> std::string { return "handwheel"; },
+                        [](const requests::ResumeProgram&) -> std::string { return "resume-program"; },
                     },
                     body);
 }

@@ -89,6 +89,22 @@ void RunRecorder::add(const TraceSample& s, const TraceContext& c) {
     output_.set_program(c.program);
   }
   if (!started_) begin(c.program != nullptr ? c.program->start() : s.commanded);
+  // A later run (a program resumed elsewhere, a new leg) starts at rest where its program starts:
+  // the machine may have moved in between (jogs, auxiliary programs) without samples here, and
+  // that jump is no velocity of the run.
+  if (started_ && r_.samples > 0 && s.run_id != run_id_) {
+    // Its first period has moved already: before it, each signal stood that much back.
+    const Pose at = c.program != nullptr ? c.program->start() : s.commanded;
+    Pose actual_at = s.actual, output_at = s.output;
+    for (int i = 0; i < kAxisCount; ++i) {
+      actual_at[i] -= s.commanded[i] - at[i];
+      output_at[i] -= s.commanded[i] - at[i];
+    }
+    commanded_.start_at(at);
+    actual_.start_at(actual_at);
+    output_.start_at(output_at);
+  }
+  run_id_ = s.run_id;
   add(s);
 }
 

@@ -100,6 +100,24 @@ struct ProbeProfile {
   double sim_noise = 0.0005;
 };
 
+/// `[process.cutting]`: how a flame or plasma torch is put out and lit again (the retrace
+/// feature's sequences, docs/retrace.md). Outputs are digital output channels (M64/M65 P);
+/// heights are machine Z, mm; times in seconds.
+struct CuttingProfile {
+  bool present = false;
+  int torch_output = -1;      ///< ignition and fuel gas (flame) or the arc (plasma)
+  int preheat_output = -1;    ///< preheat oxygen (flame), −1: none
+  int cut_output = -1;        ///< cutting oxygen (flame), −1: none
+  double ignite_s = 0;        ///< torch on → flame established
+  double preheat_s = 0;       ///< preheat at the pierce height before the cutting oxygen
+  double pierce_s = 0;        ///< cutting oxygen on, torch still at the pierce height
+  double safe_height_mm = 0;  ///< Z for moves to and from the path
+  bool has_safe_height = false;
+  double pierce_lift_mm = 0;  ///< pierce this much above the path's Z
+  double approach_mm_min = 0;  ///< speed of the move to the path (0: rapid)
+  double retrace_mm_min = 1000;  ///< speed of stepping along the path while paused
+};
+
 /// Generic I/O channel counts (M62–M68, M66). Channels 0 … n-1 exist.
 struct IoProfile {
   int digital_inputs = 4, digital_outputs = 4;
@@ -159,6 +177,18 @@ struct CouplingProfile {
   std::vector<CouplingTableProfile> tables;
 };
 
+/// `[tool_guard]`: the tool store and the check of its live table against the backup.
+struct ToolGuardProfile {
+  bool present = false;
+  std::string store;                 ///< the SQLite tool store (relative to the profile)
+  bool check_at_start = true;        ///< before every program start
+  bool check_at_tool_change = true;  ///< at every M6, for the tool put in the spindle
+  double geometry_tolerance_mm = 0.001;
+  double base_tolerance_mm = 0.001;
+  double wear_band_mm = 0.1;
+  int check_mcode = 160;  ///< M-code of the on-demand check from G-code (0: none)
+};
+
 struct PlannerOptions {
   int lookahead = 200;              ///< moves in the look-ahead window
   double default_tolerance = 0.01;  ///< mm: path tolerance while a program sets no G64 P
@@ -174,8 +204,11 @@ struct MachineProfile {
   PowerProfile power;
   ProbeProfile probe;
   bool tool_changer = false;
+  /// Pockets of the magazine (0: not said); the tool guard checks the tools' pockets against it.
+  int tool_changer_pockets = 0;
   machine::SimToolChangerConfig tool_changer_sim;
   machine::SimProcessConfig process;  ///< torch / generator flags and their simulation
+  CuttingProfile cutting;             ///< [process.cutting]: torch sequences for retrace
   IoProfile io;
   InterlockProfile interlocks;
   HandwheelProfile handwheel;
@@ -184,6 +217,7 @@ struct MachineProfile {
   std::vector<machine::SimInputSwitch> sim_input_switches;
   double sim_temperature_c = 20;  ///< machine temperature in the simulation
   InterpreterOptions interpreter;
+  ToolGuardProfile tool_guard;
   PlannerOptions planner;
   int sim_substeps = 10;  ///< integration sub-steps per servo period
   bool sim_linear_periods = true;  ///< see machine::SimMachineConfig::linear_periods

@@ -100,6 +100,7 @@ enum class Refusal : std::uint8_t {
   StartMismatch,  ///< control.start-mismatch: the queued motion does not start where the machine is
   Interlock,      ///< control.interlock: an interlock rule of the profile forbids it now
   HandAxis,       ///< control.hand-axis: the axis is moved by hand, or is not where the program needs it
+  FeatureCheck,   ///< control.feature-check: a feature's check before the start failed (the message says why)
 };
 
 /// Stable problem code of a refusal ("control.busy", ...). Any thread; real-time safe.

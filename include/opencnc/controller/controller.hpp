@@ -106,7 +106,10 @@ class Controller final : private FeatureHost {
   void mdi(std::uint64_t id, const std::string& line);
   void cycle_start(std::uint64_t id, const Request& r);
   void run_auxiliary(std::uint64_t id, const requests::RunAuxiliary& r);
+  void resume_program(std::uint64_t id, const requests::ResumeProgram& r);
   void feature(std::uint64_t id, const requests::Feature& r);
+  bool features_allow_start(std::uint64_t id, const StartCheck& start);
+  bool features_allow_continue(const SyncCheck& sync);
   /// Refuses when a job cannot start now (mode `mode`, idle, homed, no job running).
   bool ready_for_job(std::uint64_t id, Mode mode, const char* what);
   Preflight preflight_file(const std::string& path);
@@ -155,6 +158,7 @@ class Controller final : private FeatureHost {
   const ServoStatus& servo() const noexcept { return channels_->status.front(); }
   std::vector<Attached> observers_;
   std::map<std::string, std::shared_ptr<Feature>, std::less<>> features_;
+  std::string held_by_;  ///< the feature that holds the job at a sync point ("" while none does)
   std::uint64_t described_fault_tick_ = ~std::uint64_t{0};
   Pose open_at_{};               ///< where the machine stood when the open program was checked
   bool open_block_delete_ = false;

@@ -5,6 +5,7 @@
 
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -61,6 +62,10 @@ class GcodeProgramSource final : public ProgramSource {
   /// and its tool table file as a tools::FileToolTable (G10 L1 writes it back); problems with it
   /// land in `diags` (errors: nullptr).
   static std::shared_ptr<GcodeProgramSource> create(const config::MachineProfile& profile, Diagnostics& diags);
+  /// create()'s configuration, for a feature that changes a part of it (its own tool table or
+  /// code modules) before building the source; nothing (and diagnostics) on errors.
+  static std::optional<GcodeSourceConfig> config_for(const config::MachineProfile& profile,
+                                                     Diagnostics& diags);
   explicit GcodeProgramSource(GcodeSourceConfig config);
   ~GcodeProgramSource() override;
 
@@ -68,6 +73,8 @@ class GcodeProgramSource final : public ProgramSource {
                       MoveCheck& check) override;
   std::unique_ptr<ProgramStream> execute(const std::string& path, const Pose& start,
                                          const LoadOptions& options) override;
+  std::unique_ptr<ProgramStream> resume(const std::string& path, const Pose& program_start, const Pose& start,
+                                        canon::SegmentId segment, const LoadOptions& options) override;
   std::unique_ptr<ProgramStream> mdi(std::string_view line, const Pose& start) override;
   std::uint64_t version() const override { return config_.tools ? config_.tools->version() : 0; }
 

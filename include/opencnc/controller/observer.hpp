@@ -69,9 +69,36 @@ class FeatureHost {
   virtual void note(Severity severity, std::string code, std::string text) = 0;
 };
 
+/// What is about to start: asked of every feature before a program or auxiliary program starts.
+struct StartCheck {
+  JobKind job = JobKind::Program;  ///< Program (cycle start in Auto) or Auxiliary
+  std::string name;                ///< the program's name or file
+};
+
+/// A sync point the machine has answered, before the interpreter reads on past it.
+struct SyncCheck {
+  JobKind job = JobKind::Program;
+  SyncKind kind = SyncKind::None;
+  SourceLocation where;  ///< the block that asked (M6 at part.ngc:12)
+  /// ToolChange: the tool-table index of the tool the program changed to (LinuxCNC's
+  /// CHANGE_TOOL index: entry k of the table the program runs with; 0: no tool).
+  int tool_index = 0;
+};
+
 /// An observer that also answers requests::Feature requests addressed to its name().
 class Feature : public ControllerObserver {
  public:
+  /// Before a program (cycle start in Auto, not a resume) or an auxiliary program starts:
+  /// false refuses the start (`control.feature-check`, `*why` the message, one line per
+  /// reason); nothing moves. Controller thread; called with the program preflighted.
+  virtual bool allow_start(const StartCheck& /*start*/, FeatureHost& /*host*/, std::string* /*why*/) {
+    return true;
+  }
+  /// At a sync point the machine has passed (a tool change, M0/M1, M66), before the interpreter
+  /// reads on: false holds the job there — the machine stands at the point, nothing after it is
+  /// interpreted or planned — and the feature is asked again every service() until it says
+  /// true (or the job is aborted). A feature that holds says why with a note. Controller thread.
+  virtual bool allow_continue(const SyncCheck& /*sync*/, FeatureHost& /*host*/) { return true; }
   /// The name requests address ("retrace", "journal", …). Unique per controller.
   virtual std::string_view name() const = 0;
   /// Called once when added (Controller::add_feature), from the controller's thread.

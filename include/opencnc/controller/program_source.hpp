@@ -141,6 +141,18 @@ class ProgramSource {
   /// state() == Error.
   virtual std::unique_ptr<ProgramStream> execute(const std::string& path, const Pose& start,
                                                  const LoadOptions& options) = 0;
+  /// Opens `path` for execution resumed at segment `segment` (the interpreter's segment id):
+  /// the program runs from its start, placed at `program_start` (where it started the first
+  /// time), quietly up to the segment — modal state, offsets, compensation, parameters and the
+  /// call stack as an uninterrupted run has them there; the spindle, coolant and outputs it had
+  /// set are repeated before the segment —, and its moves begin with the rest of the segment
+  /// from `start` (a point on it, machine coordinates). A probe or an input read before the
+  /// segment makes it an error (its answer is not known again). Null: this source cannot resume.
+  virtual std::unique_ptr<ProgramStream> resume(const std::string& /*path*/, const Pose& /*program_start*/,
+                                                const Pose& /*start*/, canon::SegmentId /*segment*/,
+                                                const LoadOptions& /*options*/) {
+    return nullptr;
+  }
   /// One MDI line from `start`, continuing the modal state the earlier lines left.
   virtual std::unique_ptr<ProgramStream> mdi(std::string_view line, const Pose& start) = 0;
   /// Changes whenever something a program reads besides its file changes (the tool table): a

@@ -99,6 +99,17 @@ struct RunAuxiliary {
   std::string path;
   std::shared_ptr<const canon::Program> program;
 };
+/// Runs the open program (a file; Auto mode, idle) from segment `segment` — the interpreter's
+/// segment id, as in status and the path index — with the machine where it stands, on that
+/// segment: the interpreter replays the program quietly up to it (ProgramSource::resume), so
+/// modal state, offsets, compensation and the call stack are exact, and the program goes on
+/// from there to its end. Power-fail resume and flame retrace use it.
+struct ResumeProgram {
+  canon::SegmentId segment = 0;
+  /// Where the program started the first time (G91 at its head starts from there); unset:
+  /// where the machine stood when the open program was last checked (opened or started).
+  std::optional<Pose> program_start;
+};
 /// A request for a feature plugged into the controller (Controller::add_feature): `feature` names
 /// it, `action` and `args` are the feature's own.
 struct Feature {
@@ -113,7 +124,7 @@ using RequestBody =
     std::variant<requests::Servo, requests::SetMode, requests::Jog, requests::JogBy, requests::JogStop,
                  requests::Home, requests::SetOverride, requests::SetSwitch, requests::SpindleOn,
                  requests::SetCoolant, requests::OpenFile, requests::OpenCanon, requests::Mdi,
-                 requests::RunAuxiliary, requests::Feature, requests::SetHandwheel>;
+                 requests::RunAuxiliary, requests::Feature, requests::SetHandwheel, requests::ResumeProgram>;
 
 /// A request with its typed body. Build one with the helpers.
 struct Request {
@@ -145,6 +156,9 @@ struct Request {
   }
   static Request run_auxiliary(std::string name, std::shared_ptr<const canon::Program> p) {
     return {requests::RunAuxiliary{std::move(name), {}, std::move(p)}};
+  }
+  static Request resume(canon::SegmentId segment, std::optional<Pose> program_start = {}) {
+    return {requests::ResumeProgram{segment, program_start}};
   }
   static Request feature(std::string feature, std::string action, std::any args = {}) {
     return {requests::Feature{std::move(feature), std::move(action), std::move(args)}};

@@ -68,6 +68,7 @@ class RunRecorder final : public ControllerObserver {
   TraceSample planned_axes(const TraceSample& s) const;
   const canon::Program* fixed_ = nullptr;
   bool started_ = false;
+  std::uint32_t run_id_ = 0;  ///< the servo run of the last sample (a new one starts at rest)
   plan::MachineLimits limits_;
   double period_s_;
   analysis::TraceChecker commanded_;

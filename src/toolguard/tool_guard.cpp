@@ -1,0 +1,178 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The tool guard's check, its Feature (refuse at start, hold at a tool change, accept, restore)
+// and the source and feature for a profile.
+#include "opencnc/toolguard/tool_guard.hpp"
+
+#include <fmt/format.h>
+
+#include "check_code.hpp"
+#include "opencnc/gcode/standard_extensions.hpp"
+#include "opencnc/tools/edge_mapping.hpp"
+
+namespace opencnc::toolguard {
+
+tools::CheckTolerances tolerances(const config::ToolGuardProfile& p) noexcept {
+  tools::CheckTolerances t;
+  t.geometry_mm = p.geometry_tolerance_mm;
+  t.base_mm = p.base_tolerance_mm;
+  t.wear_band_mm = p.wear_band_mm;
+  return t;
+}
+
+std::string CheckResult::report() const {
+  if (!error.empty()) return fmt::format("the tool store cannot be read: {}", error);
+  if (!backup)
+    return "the tool table has no backup to check against: take one once the offsets are known to be right "
+           "(opencnc tools --db STORE backup)";
+  if (differences.empty())
+    return fmt::format("the live tool table matches backup {} of {}", backup->id, backup->taken_utc);
+  std::string out =
+      fmt::format("the live tool table differs from backup {} of {} in {} {}:", backup->id, backup->taken_utc,
+                  differences.size(), differences.size() == 1 ? "place" : "places");
+  for (const tools::Difference& d : differences) out += "\n" + d.text();
+  return out;
+}
+
+CheckResult check(store::ToolStore& store, const tools::CheckTolerances& tolerances,
+                  std::optional<int> tool) {
+  CheckResult r;
+  r.backup = store.current_backup(&r.error);
+  if (!r.error.empty() || !r.backup) return r;
+  const std::optional<tools::ToolSet> backup = store.backup_set(r.backup->id, &r.error);
+  const std::optional<tools::ToolSet> live = store.live(&r.error);
+  if (!backup || !live) return r;
+  r.differences = tools::check(*backup, *live, tolerances, tool);
+  return r;
+}
+
+ToolGuard::ToolGuard(std::shared_ptr<store::ToolStore> store, const config::ToolGuardProfile& profile,
+                     int pockets)
+    : store_(std::move(store)), profile_(profile), tolerances_(tolerances(profile)), pockets_(pockets) {}
+
+namespace {
+
+// Tools whose pocket the magazine does not have: the changer would reach for nothing.
+std::string beyond_magazine(store::ToolStore& store, int pockets) {
+  std::string out;
+  if (pockets <= 0) return out;
+  const auto live = store.live();
+  if (!live) return out;
+  for (const tools::Tool& t : live->tools) {
+    if (t.pocket > pockets)
+      out += fmt::format("\nT{}: pocket {}, but the magazine has {}", t.tool, t.pocket, pockets);
+  }
+  return out;
+}
+
+}  // namespace
+
+bool ToolGuard::allow_start(const control::StartCheck& /*start*/, control::FeatureHost& /*host*/,
+                            std::string* why) {
+  held_ = false;
+  if (!profile_.check_at_start) return true;
+  const CheckResult r = check(*store_, tolerances_);
+  const std::string pockets = beyond_magazine(*store_, pockets_);
+  if (r.ok() && pockets.empty()) return true;
+  *why = r.ok() ? "tools are in pockets the magazine does not have:" + pockets : r.report() + pockets;
+  return false;
+}
+
+// At the tool change the check covers the edges of the tool going into the spindle: the
+// program stands there until they pass (the note is repeated only when the table changed).
+bool ToolGuard::allow_continue(const control::SyncCheck& sync, control::FeatureHost& host) {
+  if (!profile_.check_at_tool_change || sync.kind != control::SyncKind::ToolChange || sync.tool_index <= 0)
+    return true;
+  const std::uint64_t v = store_->changes();
+  if (held_ && v == held_version_) return false;
+  if (!held_) {
+    // The index is the entry of the table the program was reading (edges in T, D order).
+    const auto table = store_->snapshot();
+    const auto i = static_cast<std::size_t>(sync.tool_index);
+    const auto td = i <= table->size() ? tools::tool_and_edge(table->at_index(i).tool) : std::nullopt;
+    held_tool_ = td ? td->first : 0;
+  }
+  if (held_tool_ <= 0) return true;
+  const CheckResult r = check(*store_, tolerances_, held_tool_);
+  if (r.ok()) {
+    if (held_)
+      host.note(Severity::Note, "tools.guard-passed",
+                fmt::format("T{}: {}; the program goes on", held_tool_, r.report()));
+    held_ = false;
+    return true;
+  }
+  held_ = true;
+  held_version_ = v;
+  host.note(Severity::Error, "tools.guard-hold",
+            fmt::format("held before T{} cuts ({}): {}\naccept the live values or restore the backup "
+                        "(tool-guard accept|restore)",
+                        held_tool_, control::to_string(sync.where), r.report()));
+  return false;
+}
+
+control::Outcome ToolGuard::handle(const control::requests::Feature& request, control::FeatureHost& host) {
+  control::Outcome o;
+  std::string error;
+  if (request.action == "check") {
+    const CheckResult r = check(*store_, tolerances_);
+    o.accepted = r.ok();
+    o.refusal = r.ok() ? control::Refusal::None : control::Refusal::FeatureCheck;
+    o.message = r.report();
+    return o;
+  }
+  if (request.action == "accept") {
+    const auto id = store_->backup("controller", "accept", &error);
+    o.accepted = id.has_value();
+    o.message = id ? fmt::format("the live tool table is backup {} now", *id) : error;
+  } else if (request.action == "restore") {
+    std::optional<store::BackupInfo> b = store_->current_backup(&error);
+    std::int64_t id = b ? b->id : 0;
+    if (const auto* chosen = std::any_cast<std::int64_t>(&request.args)) id = *chosen;
+    o.accepted = id > 0 && store_->restore(id, "controller", &error);
+    o.message = o.accepted ? fmt::format("backup {} is the live tool table again", id)
+                           : (error.empty() ? std::string("there is no backup to restore") : error);
+  } else {
+    o.message = fmt::format("tool-guard knows check, accept and restore, not '{}'", request.action);
+    o.refusal = control::Refusal::BadValue;
+    return o;
+  }
+  if (!o.accepted) o.refusal = control::Refusal::BadValue;
+  host.note(o.accepted ? Severity::Note : Severity::Error, "tools.guard-" + request.action, o.message);
+  return o;
+}
+
+std::optional<Setup> setup(const config::MachineProfile& profile, Diagnostics& diags) {
+  std::optional<control::GcodeSourceConfig> c = control::GcodeProgramSource::config_for(profile, diags);
+  if (!c) return std::nullopt;
+  Setup s;
+  const config::ToolGuardProfile& g = profile.tool_guard;
+  if (g.present) {
+    std::string error;
+    s.store = store::ToolStore::open(g.store, &error, false);
+    if (!s.store) {
+      diags.error(
+          profile.source, 0, 0,
+          fmt::format("tool_guard.store: {} (create it with `opencnc tools --db {} import TABLE` and back it "
+                      "up with `opencnc tools --db {} backup`)",
+                      error, g.store, g.store),
+          "tools.store");
+      return std::nullopt;
+    }
+    c->tools = s.store;
+    if (g.check_mcode > 0) {
+      auto code = std::make_shared<CheckCode>(s.store, tolerances(g));
+      const auto m = static_cast<std::size_t>(g.check_mcode);
+      // On top of the modules the profile already brings (the coupling codes of a broach).
+      auto base = c->extensions;
+      c->extensions = [code, m, base](gcode::Dialect d) {
+        auto ext = std::make_shared<gcode::Extensions>(base ? *base(d) : *gcode::standard_extensions(d));
+        ext->m[m] = code;
+        return std::shared_ptr<const gcode::Extensions>(std::move(ext));
+      };
+    }
+    s.feature = std::make_shared<ToolGuard>(s.store, g, profile.tool_changer_pockets);
+  }
+  s.source = std::make_shared<control::GcodeProgramSource>(std::move(*c));
+  return s;
+}
+
+}  // namespace opencnc::toolguard
