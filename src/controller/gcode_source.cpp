@@ -208,11 +208,11 @@ class GcodeStream final : public ProgramStream {
   /// replayed quietly (detail::ReplayFilter); the moves begin at `start` with the rest of it.
   GcodeStream(const gcode::Options& o, const std::string& path, const Pose& program_start, const Pose& start,
               canon::SegmentId first, double tolerance_mm, std::shared_ptr<tools::ToolTableService> tools,
-              const HandAxes& hand)
+              const MovePasses& passes)
       : owned_(std::make_unique<gcode::Interpreter>(o)),
         interp_(owned_.get()),
         tools_(std::move(tools)),
-        pipe_(*interp_, start, tolerance_mm, tools_.get(), hand) {
+        pipe_(*interp_, start, tolerance_mm, tools_.get(), passes) {
     tools_version_ = tools_ ? tools_->version() : 0;
     replay_ = std::make_unique<detail::ReplayFilter>(pipe_.sink(), first);
     first_segment_ = first;
@@ -673,7 +673,7 @@ std::unique_ptr<ProgramStream> GcodeProgramSource::resume(const std::string& pat
   gcode::Options o = options_for(path, options);
   o.mode = gcode::Mode::Execute;
   return std::make_unique<GcodeStream>(o, path, program_start, start, segment, config_.default_tolerance_mm,
-                                       config_.tools, config_.hand);
+                                       config_.tools, passes());
 }
 
 std::unique_ptr<ProgramStream> GcodeProgramSource::mdi(std::string_view line, const Pose& start) {
