@@ -2,6 +2,8 @@
 // `opencnc check`, `opencnc canon` and `opencnc scan`: the G-code interpreter on files.
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
+
 #include <cstdint>
 #include <cstdio>
 #include <memory>
@@ -13,6 +15,7 @@
 #include "numeric_options.hpp"
 #include "opencnc/canon/rs274_printer.hpp"
 #include "opencnc/core/axis_map.hpp"
+#include "opencnc/gcode/coupling_codes.hpp"
 #include "opencnc/gcode/dialect.hpp"
 #include "opencnc/gcode/interpreter.hpp"
 #include "opencnc/gcode/rs274_driver.hpp"
@@ -34,6 +37,7 @@ struct InterpArgs {
   std::string axis_map;
   bool progress = false;  ///< progress on stderr also when it is not a terminal
   std::uint64_t max_blocks = gcode::Limits{}.max_blocks;
+  std::vector<std::string> codes;  ///< code modules beyond the standard ones ("coupling")
 };
 
 void add_interp_options(CLI::App* cmd, InterpArgs& a) {
@@ -49,6 +53,11 @@ void add_interp_options(CLI::App* cmd, InterpArgs& a) {
       ->check(CLI::IsMember({"linuxcnc", "fanuc"}, CLI::ignore_case));
   cmd->add_option("--machine", a.machine, "mill or lathe, for Fanuc programs (default: guessed from the program's axis words)")
       ->check(CLI::IsMember({"mill", "lathe"}, CLI::ignore_case));
+  cmd->add_option(
+         "--codes", a.codes,
+         "code modules beyond the standard ones: coupling (M171-M175, the broaching codes of a machine "
+         "with a [coupling] section)")
+      ->check(CLI::IsMember({"coupling"}));
   cmd->add_option("--axis-map", a.axis_map, "axis exchange, program letter = machine axis (e.g. X=Y,Y=X)");
   cmd->add_option("--max-blocks", a.max_blocks,
                   "stop with gcode.limit-blocks after this many blocks (loop bodies count each time; default "
@@ -88,7 +97,8 @@ bool make_options(const InterpArgs& a, const std::string& file, gcode::Options& 
     std::fprintf(stderr, "--axis-map: %s\n", problem.c_str());
     return false;
   }
-  o.extensions = gcode::standard_extensions(o.dialect);
+  const bool coupling = std::find(a.codes.begin(), a.codes.end(), "coupling") != a.codes.end();
+  o.extensions = coupling ? gcode::coupling_extensions(o.dialect) : gcode::standard_extensions(o.dialect);
   o.block_delete = a.block_delete;
   o.limits.max_blocks = a.max_blocks;
   o.subroutine_path = a.subroutine_path.empty() ? std::vector<std::string>{"."} : a.subroutine_path;

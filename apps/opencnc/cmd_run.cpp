@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <memory>
 #include <optional>
 #include <string>
@@ -18,6 +19,7 @@
 #include "gcode_summary.hpp"
 #include "numeric_options.hpp"
 #include "opencnc/controller/gcode_source.hpp"
+#include "opencnc/controller/power_fail_recorder.hpp"
 #include "opencnc/controller/preflight.hpp"
 #include "opencnc/controller/run_recorder.hpp"
 #include "opencnc/controller/servo_setup.hpp"
@@ -37,6 +39,7 @@ struct RunOptions {
   std::string trace;
   std::string report;
   double max_time_s = kDefaultMaxTimeS;  ///< 0: no limit
+  std::string inject;                    ///< "mains-off@SECONDS"
   std::vector<std::string> retraces;     ///< "AT_SECONDS:X,Y"
 };
 
@@ -126,6 +129,20 @@ class RetraceScript {
   double t0_ = -1;
   std::vector<double> times_;
 };
+
+/// "mains-off@12.5" → 12.5 (servo time of the run); nullopt with the reason printed.
+std::optional<double> mains_off_time(const std::string& inject) {
+  constexpr std::string_view kPrefix = "mains-off@";
+  char* end = nullptr;
+  const double s = inject.rfind(kPrefix, 0) == 0 ? std::strtod(inject.c_str() + kPrefix.size(), &end) : -1;
+  if (end == nullptr || *end != '\0' || !std::isfinite(s) || s < 0) {
+    fmt::print(stderr,
+               "error: --inject {}: expected mains-off@SECONDS (servo time from the run's start, >= 0)\n",
+               inject);
+    return std::nullopt;
+  }
+  return s;
+}
 
 /// "3.2 h", "19.0 years": a duration a person reads at a glance.
 std::string human_duration(double s) {
@@ -218,6 +235,33 @@ void print_report(const control::RunReport& r, const config::MachineProfile& pro
   }
 }
 
+nlohmann::json power_fail_json(const control::PowerFailReport& p) {
+  nlohmann::json j;
+  j["happened"] = p.happened;
+  j["coupled"] = p.coupled;
+  j["signal_s"] = p.signal_s;
+  j["stop_time_s"] = p.stop_time_s;
+  j["stop_distance_mm"] = p.stop_distance_mm;
+  j["coupled_error_um"] = p.coupled_error_um;
+  j["coupled_command_error_um"] = p.coupled_command_error_um;
+  j["independent_error_um"] = p.independent_error_um;
+  j["dc_link_min_v"] = p.happened ? nlohmann::json(p.dc_link_min_v) : nlohmann::json(nullptr);
+  return j;
+}
+
+void print_power_fail(const control::PowerFailReport& p) {
+  if (!p.happened) {
+    fmt::print("power fail          none (the run ended before the injected time)\n");
+    return;
+  }
+  fmt::print("power fail at       {:.3f} s: stopped in {:.3f} s over {:.3f} mm, DC link down to {:.0f} V\n",
+             p.signal_s, p.stop_time_s, p.stop_distance_mm, p.dc_link_min_v);
+  if (p.coupled)
+    fmt::print(
+        "helix error         {:.3f} um coupled ({:.6f} um commanded), {:.1f} um if each axis stopped alone\n",
+        p.coupled_error_um, p.coupled_command_error_um, p.independent_error_um);
+}
+
 nlohmann::json retraces_json(const std::vector<recovery::RetraceRecord>& records,
                              const std::vector<double>& times) {
   nlohmann::json list = nlohmann::json::array();
@@ -237,7 +281,8 @@ nlohmann::json retraces_json(const std::vector<recovery::RetraceRecord>& records
   return list;
 }
 
-nlohmann::json report_json(const control::RunReport& r, const RunOptions& o, const SessionEnd& end) {
+nlohmann::json report_json(const control::RunReport& r, const RunOptions& o, const SessionEnd& end,
+                           const std::optional<control::PowerFailReport>& power_fail) {
   nlohmann::json j;
   j["program"] = o.session.file;
   j["machine"] = end.profile.name;
@@ -268,6 +313,7 @@ nlohmann::json report_json(const control::RunReport& r, const RunOptions& o, con
   j["limit_touched"] = r.limit_violations > 0 || end.limit_touched;
   j["samples"] = r.samples;
   j["wall_time_s"] = end.wall_s;
+  if (power_fail) j["power_fail"] = power_fail_json(*power_fail);
   return j;
 }
 
@@ -294,6 +340,17 @@ int run(const RunOptions& o) {
   OutputFile* const trace_file = files[0].get();
   OutputFile* const report_file = files[1].get();
   std::shared_ptr<control::RunRecorder> recorder;
+  std::shared_ptr<control::PowerFailRecorder> power_recorder;
+  SessionOptions session = o.session;
+  if (!o.inject.empty()) {
+    const std::optional<double> at = mains_off_time(o.inject);
+    if (!at) return kExitUsage;
+    if (o.session.realtime) {
+      fmt::print(stderr, "error: --inject works in virtual time only (not with --realtime)\n");
+      return kExitUsage;
+    }
+    session.mains_off_s = *at;
+  }
   std::optional<control::TraceCsvWriter> csv;
   std::optional<ProgressBar> bar;
   const bool tty = ::isatty(STDOUT_FILENO) != 0;
@@ -305,6 +362,12 @@ int run(const RunOptions& o) {
     recorder = std::make_shared<control::RunRecorder>(control::machine_limits(machine),
                                                       machine.servo_period_s, &axes);
     out.emplace_back(recorder, control::ObserverOptions{0, true});
+    if (session.mains_off_s >= 0) {
+      power_recorder = std::make_shared<control::PowerFailRecorder>(
+          control::coupling_config(machine.coupling), control::machine_limits(machine),
+          machine.servo_period_s, machine.coupling.radius_mm);
+      out.emplace_back(power_recorder, control::ObserverOptions{machine.servo_period_s, true});
+    }
     if (trace_file != nullptr) {
       csv.emplace(*trace_file, machine.axis_mask(), machine.servo_period_s);
       out.emplace_back(std::make_shared<TraceObserver>(*csv), control::ObserverOptions{0, true});
@@ -333,7 +396,6 @@ int run(const RunOptions& o) {
     hooks.goes_on = [&](const control::ControllerEvent& e) { return script->goes_on(e); };
   }
   const StopSignals signals;  // Ctrl-C: a controlled stop, and the report says so
-  SessionOptions session = o.session;
   session.stop = &StopSignals::requested();
   const SessionEnd end = run_session(session, hooks);
   if (bar) bar->finish();
@@ -342,7 +404,12 @@ int run(const RunOptions& o) {
   if (trace_file != nullptr && !commit_trace(*trace_file)) rc = kExitUsage;
   const control::RunReport r = recorder->report();
   print_report(r, end.profile, end);
-  nlohmann::json j = report_json(r, o, end);
+  std::optional<control::PowerFailReport> power_fail;
+  if (power_recorder) {
+    power_fail = power_recorder->report();
+    print_power_fail(*power_fail);
+  }
+  nlohmann::json j = report_json(r, o, end, power_fail);
   if (feature) {
     const std::vector<recovery::RetraceRecord> records = feature->records();
     for (const recovery::RetraceRecord& x : records) {
@@ -381,6 +448,9 @@ void add_run_command(CLI::App& app, Registry& registry) {
                 "operator on the terminal");
   cmd->add_option("--trace", opts->trace, "Write one CSV row per servo period (docs/controller.md)");
   cmd->add_option("--report", opts->report, "Write the report as JSON");
+  cmd->add_option("--inject", opts->inject,
+                  "Fault injection in virtual time: mains-off@SECONDS (the mains fail then; the report gains "
+                  "power_fail)");
   cmd->add_option(
          "--max-time", opts->max_time_s,
          "Refuse a program that needs more machining time than this, in seconds (default 86400, a day; "

@@ -39,5 +39,6 @@ void add_calibrate_command(CLI::App& app, Registry& registry);
 void add_tools_command(CLI::App& app, Registry& registry);  ///< the tool store and its guard
 void add_nearest_command(CLI::App& app, Registry& registry);
 void add_serve_command(CLI::App& app, Registry& registry);   ///< the HMI server
+void add_helix_command(CLI::App& app, Registry& registry);
 
 }  // namespace opencnc::cli

@@ -53,6 +53,8 @@ class Driver {
   virtual bool ticks_by_itself() const = 0;
   /// The simulated operator's hand moves hand-fed joint `joint` toward `target` at `speed`.
   virtual void set_hand_target(int joint, double target, double speed) = 0;
+  /// The simulated mains fail (virtual time only: cmd_run refuses --inject with --realtime).
+  virtual void cut_mains() = 0;
 };
 
 class VirtualDriver final : public Driver {
@@ -65,6 +67,7 @@ class VirtualDriver final : public Driver {
   void set_hand_target(int joint, double target, double speed) override {
     rig_.machine().set_hand_target(joint, target, speed);
   }
+  void cut_mains() override { rig_.machine().set_mains_ok(false); }
 
  private:
   control::SimRig rig_;
@@ -119,6 +122,7 @@ class RealtimeDriver final : public Driver {
   void set_hand_target(int joint, double target, double speed) override {
     sim_->set_hand_target(joint, target, speed);
   }
+  void cut_mains() override {}  // the servo thread alone touches the machine; refused before
 
  private:
   std::unique_ptr<control::ServoChannels> channels_;
@@ -318,6 +322,7 @@ void follow(Driver& d, control::EventCursor& cursor, const SessionOptions& o, co
   std::uint32_t job = 0;
   std::uint64_t asked_tick = ~std::uint64_t{0};  // the wait already answered (by its start tick)
   std::uint64_t n = 0;
+  bool mains_cut = false;
   bool guard_abort = false;
   for (;;) {
     d.advance();
@@ -332,6 +337,10 @@ void follow(Driver& d, control::EventCursor& cursor, const SessionOptions& o, co
     }
     const control::ControllerStatus st = d.controller().status();
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (o.mains_off_s >= 0 && !mains_cut && st.servo.time_s >= o.mains_off_s) {
+      d.cut_mains();  // the servo sees it at its next period
+      mains_cut = true;
+    }
     if (hooks.progress && (++n % 256 == 0)) hooks.progress(st, wall);
     bring_hand_axis(d, st.servo);
     if (hooks.tick) hooks.tick(d.controller(), st);

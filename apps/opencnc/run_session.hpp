@@ -29,6 +29,8 @@ struct SessionOptions {
   bool unattended = false;  ///< continue program stops and manual tool changes without asking
   /// Polled during the run: a signal number there stops it on the path (feed hold, then abort).
   const std::atomic<int>* stop = nullptr;
+  /// Virtual time: the simulated mains fail at this servo time (s); negative: never.
+  double mains_off_s = -1;
 };
 
 /// What a session ended with.

@@ -358,6 +358,14 @@ void ProgramBuilder::change_tool_number(int tool) { simple(ActionKind::ChangeToo
 void ProgramBuilder::set_motion_output_value(int index, double value) {
   add(make(ActionKind::MotionOutputValue, index, 0, value));
 }
+// The pitch in mm; the rate (mm per mm) and the table number need no conversion.
+void ProgramBuilder::set_axis_coupling(const AxisCoupling& c) {
+  Action a = make(ActionKind::AxisCoupling, c.law, c.table, c.pitch * mm_per_unit(units_));
+  Pose rate{};
+  rate[0] = c.rate;
+  a.pose = program_.add_action_pose(rate);
+  add(a);
+}
 void ProgramBuilder::set_aux_output_value(int index, double value) {
   add(make(ActionKind::AuxOutputValue, index, 0, value));
 }

@@ -319,6 +319,21 @@ void Rs274Printer::set_motion_output_value(int index, double value) {
   end_line();
 }
 
+// Not a call of LinuxCNC's canon (it has no coupling): printed in its style, law, table, pitch, rate.
+void Rs274Printer::set_axis_coupling(const AxisCoupling& c) {
+  prefix();
+  buf_.append("SET_AXIS_COUPLING(");
+  integer(c.law);
+  buf_.push_back(',');
+  integer(c.table);
+  buf_.push_back(',');
+  num(c.pitch, 6);
+  buf_.push_back(',');
+  num(c.rate, 6);
+  buf_.push_back(')');
+  end_line();
+}
+
 void Rs274Printer::set_aux_output_value(int index, double value) {
   prefix();
   buf_.append("SET_AUX_OUTPUT_VALUE(");

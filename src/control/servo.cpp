@@ -44,7 +44,7 @@ bool Servo::tick() noexcept {
   apply_interlocks();   // the profile's interlock rules (the PLC): stops, holds, blocked starts
   handle_commands();    // operator and controller commands: the explicit state transitions
   run_active_mode();    // homing / jog / handwheel (movers) or MDI / auto (interpolator, handshakes)
-  couple_axes();        // axes → joints (identity until coupling laws come)
+  couple_axes();        // axes → joints, a coupled slave by its law (servo_coupling.cpp)
   compensate();         // pitch error and backlash (motion::Compensation)
   check_soft_limits();  // every commanded joint within its soft limits
   write_outputs();      // position commands or step counts, enables, spindle, coolant, I/O
@@ -150,6 +150,7 @@ void Servo::check_power() noexcept {
   const bool lost = !in_.power.mains_ok || (caps_.ups && in_.power.ups_on_battery);
   if (!lost || power_stop_) return;
   power_stop_ = true;
+  stop_spindle_and_coolant();  // the process ends at once; the axes stop on the path (coupled)
   switch (activity_) {
     case Activity::Program:
       hold_ = false;
@@ -210,15 +211,6 @@ void Servo::run_active_mode() noexcept {
   follow_hand_axes();
   if (power_stop_ && activity_ == Activity::None && drives_enabled_) {
     enter_fault({FaultKind::PowerLoss, -1, in_.power.dc_link_v, 0, tick_});
-  }
-}
-
-// --- axes to joints --------------------------------------------------------------------------
-
-void Servo::couple_axes() noexcept {
-  for (int j = 0; j < config_.joint_count; ++j) {
-    const auto uj = static_cast<std::size_t>(j);
-    joint_cmd_[uj] = commanded_[config_.joints[uj].axis] - offset_[uj];
   }
 }
 
@@ -459,6 +451,8 @@ void Servo::fill_drill_status(ServoStatus& s) const noexcept {
   s.interlock_rule = blocking_rule_;
   s.interlocks_true = rules_true_;
   s.handwheel_axis = handwheel_axis_;
+  s.coupling = coupling_;
+  s.coupling.error_deg = coupling_error();
   s.handwheel_step = handwheel_step_;
 }
 
@@ -487,6 +481,9 @@ void Servo::push_trace() noexcept {
     t.homing_phase[static_cast<std::size_t>(axis)] = homing_[uj].phase();
     t.home_level[axis] = in_.joints[uj].home_level;
   }
+  t.coupled = law_.active();
+  t.power_stop = power_stop_;
+  t.coupling_error_deg = coupling_error();
   if (!channels_->trace.try_push(t)) ++trace_dropped_;
 }
 

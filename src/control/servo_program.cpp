@@ -160,10 +160,16 @@ bool Servo::take_action(std::uint32_t action, MachineAction& out) noexcept {
   return true;
 }
 
+// Report markers, and the zero-time stops that carry a record (the coupling codes: a dwell
+// marker whose record is next in the ring; a G4 has none).
 void Servo::apply_reports() noexcept {
+  const auto& ring = channels_->actions;
   for (int e = 0; e < tick_out_.event_count; ++e) {
     const traj::TickEvent& ev = tick_out_.events[static_cast<std::size_t>(e)];
-    if (ev.kind != traj::MarkerKind::Report) continue;
+    const bool record_stop = ev.kind == traj::MarkerKind::Dwell && ring.available() > 0 &&
+                             ring.front().action == ev.action &&
+                             ring.front().code == ActionCode::AxisCoupling;
+    if (ev.kind != traj::MarkerKind::Report && !record_stop) continue;
     MachineAction a;
     if (take_action(ev.action, a)) apply_action(a);
   }
@@ -253,6 +259,9 @@ void Servo::apply_action(const MachineAction& a) noexcept {
       emit(e);
       break;
     }
+    case ActionCode::AxisCoupling:
+      engage_coupling(a);
+      break;
     case ActionCode::ChangeTool:
     case ActionCode::WaitInput:
     case ActionCode::SpindleOrient:
@@ -475,6 +484,7 @@ void Servo::end_run(RunEnd why) noexcept {
   e.segment = tick_out_.segment;
   emit(e);
   activity_ = Activity::None;
+  release_coupling();  // a program's coupling lasts as long as its run
   hold_ = aborting_ = cycle_start_edge_ = abort_edge_ = sync_done_edge_ = false;
   sync_step_ = SyncStep::None;
   wait_ = Wait::None;

@@ -12,6 +12,7 @@
 #include "opencnc/canon/program_builder.hpp"
 #include "opencnc/canon/tee_sink.hpp"
 #include "opencnc/controller/preflight.hpp"
+#include "opencnc/gcode/coupling_codes.hpp"
 #include "opencnc/gcode/dialect.hpp"
 #include "opencnc/gcode/standard_extensions.hpp"
 #include "replay_filter.hpp"
@@ -99,12 +100,14 @@ void append(Diagnostics& to, const Diagnostics& from, std::size_t first = 0) {
 class Pipeline {
  public:
   Pipeline(gcode::Interpreter& interp, const Pose& start, double tolerance_mm, tools::ToolTableService* tools,
-           const HandAxes& hand)
+           const MovePasses& passes)
       : interp_(&interp),
         tolerance_mm_(tolerance_mm),
         writer_(tools),
-        hand_(hand),
-        hand_axes_any_(hand.any()) {
+        hand_(passes.hand),
+        hand_axes_any_(passes.hand.any()),
+        coupling_(passes.coupling),
+        coupled_(passes.coupling.any()) {
     auto b = std::make_unique<canon::ProgramBuilder>(interp.options().axes, start);
     b->program().set_sources(interp.sources());
     attach(std::move(b), interp.state().modal.units);
@@ -113,10 +116,15 @@ class Pipeline {
   canon::ProgramBuilder& builder() noexcept { return *builder_; }
   const canon::ProgramBuilder& builder() const noexcept { return *builder_; }
   const canon::Program& program() const noexcept { return builder_->program(); }
-  canon::Sink& sink() noexcept { return hand_sink_ ? static_cast<canon::Sink&>(*with_hand_) : *outer_; }
+  canon::Sink& sink() noexcept { return *sink_; }
   ToolTableWriter& writer() noexcept { return writer_; }
   /// What the hand-axis pass refused (moves of hand-fed axes it cannot wait for).
   const Diagnostics& hand_failures() const noexcept { return hand_.failures(); }
+  /// What the coupling pass refused (moves the law would drive past the slave's limits).
+  const Diagnostics& coupling_failures() const noexcept { return coupling_.failures(); }
+  bool passes_failed() const noexcept {
+    return !hand_.failures().items().empty() || !coupling_.failures().items().empty();
+  }
 
   /// A new leg at `start`: the builder's continuation; the old one is kept until the next leg
   /// (a run's last trace samples may still refer to its moves).
@@ -134,9 +142,18 @@ class Pipeline {
     outer_ = std::make_unique<canon::TeeSink>(*inner_, writer_);
     // After the builder has appended a move, the hand-axis pass rewrites it (hand-fed axes only).
     hand_.restart();
+    sink_ = outer_.get();
     if (hand_axes_any_) {
       hand_sink_ = std::make_unique<HandAxisSink>(hand_, builder_->program());
-      with_hand_ = std::make_unique<canon::TeeSink>(*outer_, *hand_sink_);
+      with_hand_ = std::make_unique<canon::TeeSink>(*sink_, *hand_sink_);
+      sink_ = with_hand_.get();
+    }
+    // Then the coupling pass: the slave's coordinates by the law (coupling_pass.hpp).
+    coupling_.restart();
+    if (coupled_) {
+      coupling_sink_ = std::make_unique<CouplingSink>(coupling_, builder_->program());
+      with_coupling_ = std::make_unique<canon::TeeSink>(*sink_, *coupling_sink_);
+      sink_ = with_coupling_.get();
     }
   }
 
@@ -150,6 +167,11 @@ class Pipeline {
   std::unique_ptr<canon::TeeSink> inner_, outer_;
   std::unique_ptr<HandAxisSink> hand_sink_;
   std::unique_ptr<canon::TeeSink> with_hand_;
+  CouplingPass coupling_;
+  bool coupled_;
+  std::unique_ptr<CouplingSink> coupling_sink_;
+  std::unique_ptr<canon::TeeSink> with_coupling_;
+  canon::Sink* sink_ = nullptr;
 };
 
 /// Where the interpreter is placed for a program: the start-up calls, the profile's default
@@ -173,11 +195,11 @@ class GcodeStream final : public ProgramStream {
  public:
   /// A file: owns its interpreter.
   GcodeStream(const gcode::Options& o, const std::string& path, const Pose& start, double tolerance_mm,
-              std::shared_ptr<tools::ToolTableService> tools, const HandAxes& hand)
+              std::shared_ptr<tools::ToolTableService> tools, const MovePasses& passes)
       : owned_(std::make_unique<gcode::Interpreter>(o)),
         interp_(owned_.get()),
         tools_(std::move(tools)),
-        pipe_(*interp_, start, tolerance_mm, tools_.get(), hand) {
+        pipe_(*interp_, start, tolerance_mm, tools_.get(), passes) {
     tools_version_ = tools_ ? tools_->version() : 0;
     if (!begin_program(*interp_, pipe_, path, start, tolerance_mm)) fail();
   }
@@ -186,11 +208,11 @@ class GcodeStream final : public ProgramStream {
   /// replayed quietly (detail::ReplayFilter); the moves begin at `start` with the rest of it.
   GcodeStream(const gcode::Options& o, const std::string& path, const Pose& program_start, const Pose& start,
               canon::SegmentId first, double tolerance_mm, std::shared_ptr<tools::ToolTableService> tools,
-              const HandAxes& hand)
+              const MovePasses& passes)
       : owned_(std::make_unique<gcode::Interpreter>(o)),
         interp_(owned_.get()),
         tools_(std::move(tools)),
-        pipe_(*interp_, start, tolerance_mm, tools_.get(), hand) {
+        pipe_(*interp_, start, tolerance_mm, tools_.get(), passes) {
     tools_version_ = tools_ ? tools_->version() : 0;
     replay_ = std::make_unique<detail::ReplayFilter>(pipe_.sink(), first);
     first_segment_ = first;
@@ -198,10 +220,10 @@ class GcodeStream final : public ProgramStream {
   }
   /// An MDI line on the session's interpreter (already placed and up to date).
   GcodeStream(gcode::Interpreter& session, std::string line, const Pose& start, double tolerance_mm,
-              std::shared_ptr<tools::ToolTableService> tools, const HandAxes& hand)
+              std::shared_ptr<tools::ToolTableService> tools, const MovePasses& passes)
       : interp_(&session),
         tools_(std::move(tools)),
-        pipe_(session, start, tolerance_mm, tools_.get(), hand),
+        pipe_(session, start, tolerance_mm, tools_.get(), passes),
         mdi_line_(std::move(line)),
         mdi_(true) {
     tools_version_ = tools_ ? tools_->version() : 0;
@@ -271,9 +293,10 @@ class GcodeStream final : public ProgramStream {
   }
 
   void on_status(gcode::RunStatus s) {
-    if (!pipe_.writer().failures().items().empty() || !pipe_.hand_failures().items().empty()) {
+    if (!pipe_.writer().failures().items().empty() || pipe_.passes_failed()) {
       append(diags_, pipe_.writer().failures());
       append(diags_, pipe_.hand_failures());
+      append(diags_, pipe_.coupling_failures());
       state_ = StreamState::Error;
       return;
     }
@@ -391,8 +414,8 @@ class GcodeStream final : public ProgramStream {
 class Scan {
  public:
   Scan(const gcode::Options& o, const std::string& path, const Pose& start, double tolerance_mm,
-       const HandAxes& hand)
-      : interp_(o), pipe_(interp_, start, tolerance_mm, nullptr, hand) {
+       const MovePasses& passes)
+      : interp_(o), pipe_(interp_, start, tolerance_mm, nullptr, passes) {
     ok_ = begin_program(interp_, pipe_, path, start, tolerance_mm);
     done_ = !ok_;
   }
@@ -409,6 +432,7 @@ class Scan {
   bool ok() const noexcept { return ok_; }
   const Diagnostics& diagnostics() const noexcept { return interp_.diagnostics(); }
   const Diagnostics& hand_failures() const noexcept { return pipe_.hand_failures(); }
+  const Diagnostics& coupling_failures() const noexcept { return pipe_.coupling_failures(); }
   void release(std::size_t move, std::size_t action) { pipe_.builder().program().release_before(move, action); }
 
  private:
@@ -543,17 +567,17 @@ class PreflightRun {
 
 /// One preflight pass; with `classify`, a second scan with other answers runs in step with it.
 Preflight preflight_pass(const gcode::Options& o, const std::string& path, const Pose& start,
-                         double tolerance_mm, const HandAxes& hand, MoveCheck& check, bool classify) {
+                         double tolerance_mm, const MovePasses& passes, MoveCheck& check, bool classify) {
   Preflight out;
   gcode::Options main = o;
   main.mode = gcode::Mode::Scan;
   main.scan_assumption = gcode::ScanAssumption::Rs274;
-  Scan scan(main, path, start, tolerance_mm, hand);
+  Scan scan(main, path, start, tolerance_mm, passes);
   std::unique_ptr<Scan> other;
   if (classify) {
     gcode::Options alt = main;
     alt.scan_assumption = gcode::ScanAssumption::Other;
-    other = std::make_unique<Scan>(alt, path, start, tolerance_mm, hand);
+    other = std::make_unique<Scan>(alt, path, start, tolerance_mm, passes);
   }
   PreflightRun run(check, out);
   while (!scan.done() || run.checked() < scan.program().size()) {
@@ -567,6 +591,7 @@ Preflight preflight_pass(const gcode::Options& o, const std::string& path, const
   }
   append(out.diagnostics, scan.diagnostics());
   append(out.diagnostics, scan.hand_failures());
+  append(out.diagnostics, scan.coupling_failures());
   if (!scan.ok() && !out.diagnostics.has_errors())
     out.diagnostics.error(path, 0, 0, "the program cannot be read", "control.program");
   check.finish(out.diagnostics);
@@ -603,6 +628,8 @@ std::optional<GcodeSourceConfig> GcodeProgramSource::config_for(const config::Ma
   }
   c.default_tolerance_mm = profile.planner.default_tolerance;
   c.hand = hand_axes(profile);
+  c.coupling = coupled_axes(profile);
+  if (c.coupling.any()) c.extensions = gcode::coupling_extensions;
   return c;
 }
 
@@ -622,11 +649,11 @@ gcode::Options GcodeProgramSource::options_for(const std::string& path, const Lo
 Preflight GcodeProgramSource::preflight(const std::string& path, const Pose& start, const LoadOptions& options,
                                         MoveCheck& check) {
   const gcode::Options o = options_for(path, options);
-  Preflight first = preflight_pass(o, path, start, config_.default_tolerance_mm, config_.hand, check, false);
+  Preflight first = preflight_pass(o, path, start, config_.default_tolerance_mm, passes(), check, false);
   if (first.summary.sync_points == 0) return first;
   // Sync points: the checks of the moves after them rest on assumed answers. A second pass, beside
   // a scan with other answers, tells which moves those are.
-  Preflight second = preflight_pass(o, path, start, config_.default_tolerance_mm, config_.hand, check, true);
+  Preflight second = preflight_pass(o, path, start, config_.default_tolerance_mm, passes(), check, true);
   return second;
 }
 
@@ -637,8 +664,7 @@ std::unique_ptr<ProgramStream> GcodeProgramSource::execute(const std::string& pa
   // As LinuxCNC's task runs it, M99 in the main program starts it again until the operator
   // stops the run (the preflight scans it once, as rs274 reads it).
   o.main_m99 = gcode::MainM99::Repeat;
-  return std::make_unique<GcodeStream>(o, path, start, config_.default_tolerance_mm, config_.tools,
-                                       config_.hand);
+  return std::make_unique<GcodeStream>(o, path, start, config_.default_tolerance_mm, config_.tools, passes());
 }
 
 std::unique_ptr<ProgramStream> GcodeProgramSource::resume(const std::string& path, const Pose& program_start,
@@ -647,7 +673,7 @@ std::unique_ptr<ProgramStream> GcodeProgramSource::resume(const std::string& pat
   gcode::Options o = options_for(path, options);
   o.mode = gcode::Mode::Execute;
   return std::make_unique<GcodeStream>(o, path, program_start, start, segment, config_.default_tolerance_mm,
-                                       config_.tools, config_.hand);
+                                       config_.tools, passes());
 }
 
 std::unique_ptr<ProgramStream> GcodeProgramSource::mdi(std::string_view line, const Pose& start) {
@@ -665,7 +691,7 @@ std::unique_ptr<ProgramStream> GcodeProgramSource::mdi(std::string_view line, co
   }
   mdi_->set_machine_position(start);
   auto stream = std::make_unique<GcodeStream>(*mdi_, std::string(line), start, config_.default_tolerance_mm,
-                                              config_.tools, config_.hand);
+                                              config_.tools, passes());
   return stream;
 }
 

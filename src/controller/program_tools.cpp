@@ -156,6 +156,10 @@ std::optional<MachineAction> machine_action(const canon::Program& program, std::
     case ActionKind::HandAxisWait:
       m.code = ActionCode::HandAxisWait;
       break;
+    case ActionKind::AxisCoupling:
+      m.code = ActionCode::AxisCoupling;
+      m.value2 = program.action_pose(a.pose)[0];
+      break;
     case ActionKind::ProbeOn:
     case ActionKind::ProbeOff:
       m.code = ActionCode::Ignore;

@@ -129,6 +129,7 @@ ServoConfig servo_config(const config::MachineProfile& profile) {
   }
   s.interpolator = plan::Planner(machine_limits(profile), planner_config(profile)).interpolator_config();
   s.spindle_max_rpm = profile.spindle.present ? profile.spindle.max_rpm : 0.0;
+  s.coupling = coupling_config(profile.coupling);
   return s;
 }
 
@@ -159,6 +160,27 @@ SharedSetup shared_setup(const config::MachineProfile& profile) {
       machine::SimMachine(config::sim_machine_config(profile)).capabilities();
   std::memcpy(static_cast<void*>(&s.capabilities), &caps, sizeof caps);
   return s;
+}
+
+motion::CouplingConfig coupling_config(const config::CouplingProfile& c) {
+  motion::CouplingConfig out{};
+  out.enabled = c.present;
+  out.master_axis = static_cast<std::int8_t>(index(c.master));
+  out.slave_axis = static_cast<std::int8_t>(index(c.slave));
+  out.source = c.from_actual ? motion::CouplingSource::Actual : motion::CouplingSource::Command;
+  const std::size_t n = std::min<std::size_t>(c.tables.size(), motion::kMaxCouplingTables);
+  for (std::size_t t = 0; t < n; ++t) {
+    const config::CouplingTableProfile& tp = c.tables[t];
+    out.table_kind[t] = tp.kind == config::CouplingTableProfile::Kind::Cam ? motion::CouplingKind::Cam
+                                                                           : motion::CouplingKind::PitchTable;
+    motion::CouplingTable& table = out.tables[t];
+    table.count = static_cast<int>(std::min<std::size_t>(tp.points.size(), motion::kMaxCouplingPoints));
+    for (int k = 0; k < table.count; ++k) {
+      table.master[static_cast<std::size_t>(k)] = tp.points[static_cast<std::size_t>(k)].first;
+      table.value[static_cast<std::size_t>(k)] = tp.points[static_cast<std::size_t>(k)].second;
+    }
+  }
+  return out;
 }
 
 }  // namespace opencnc::control

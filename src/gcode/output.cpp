@@ -446,6 +446,9 @@ void Output::clear_aux_output_bit(int index) {
 void Output::set_motion_output_value(int index, double value) {
   if (auto* s = live()) s->set_motion_output_value(index, value);
 }
+void Output::set_axis_coupling(const canon::AxisCoupling& coupling) {
+  if (auto* s = live()) s->set_axis_coupling(coupling);
+}
 void Output::set_aux_output_value(int index, double value) {
   if (auto* s = live()) s->set_aux_output_value(index, value);
 }

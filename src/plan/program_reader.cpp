@@ -41,6 +41,8 @@ MarkerKind marker_for(ActionKind k) {
   switch (k) {
     case ActionKind::Dwell:
       return MarkerKind::Dwell;
+    case ActionKind::AxisCoupling:
+      return MarkerKind::Dwell;  // an exact stop of no time: the law engages where the path stands
     case ActionKind::ProgramStop:
       return MarkerKind::ProgramStop;
     case ActionKind::OptionalStop:
@@ -184,7 +186,7 @@ void ProgramReader::add_marker(std::size_t index, MarkerKind kind) {
   m.segment = m.segment_first = m.segment_last = a.before_move;
   m.line = a.line;
   m.context = a.context;
-  m.value = a.value;
+  m.value = a.kind == ActionKind::AxisCoupling ? 0.0 : a.value;  // its stop takes no time
   m.flags = flags();
   if (kind == MarkerKind::ProgramEnd) ended_ = true;
 }

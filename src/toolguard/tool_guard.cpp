@@ -161,8 +161,10 @@ std::optional<Setup> setup(const config::MachineProfile& profile, Diagnostics& d
     if (g.check_mcode > 0) {
       auto code = std::make_shared<CheckCode>(s.store, tolerances(g));
       const auto m = static_cast<std::size_t>(g.check_mcode);
-      c->extensions = [code, m](gcode::Dialect d) {
-        auto ext = std::make_shared<gcode::Extensions>(*gcode::standard_extensions(d));
+      // On top of the modules the profile already brings (the coupling codes of a broach).
+      auto base = c->extensions;
+      c->extensions = [code, m, base](gcode::Dialect d) {
+        auto ext = std::make_shared<gcode::Extensions>(base ? *base(d) : *gcode::standard_extensions(d));
         ext->m[m] = code;
         return std::shared_ptr<const gcode::Extensions>(std::move(ext));
       };

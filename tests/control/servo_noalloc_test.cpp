@@ -137,6 +137,38 @@ TEST(ServoAllocations, NoneWhileRigidTappingOrUnderConstantSurfaceSpeed) {
   std::filesystem::remove_all(dir);
 }
 
+// The broach's tick: every coupling law engaged and released in a run, a feed hold while coupled,
+// and a power failure's stop with the coupling held.
+TEST(ServoAllocations, NoneInsideTheCoupledTick) {
+  const auto dir = std::filesystem::temp_directory_path() / "opencnc-noalloc-coupled";
+  std::filesystem::create_directories(dir);
+  const std::string program = (dir / "broach.ngc").string();
+  std::ofstream(program)
+      << "G21 G90 G0 X0 Z0 C0\nM171 P60\nG1 X0.1 F60\nG1 Z40 F6000\nM172 P600 Q-0.2\n"
+         "G1 Z80\nM173 P1\nG1 Z120\nM174 P2\nG1 Z100\nG0 Z0\nM175\nM171 P60\nG1 Z200 F3000\nM2\n";
+  g_allocations = 0;
+  Armed a(loaded(config::load_profile(OPENCNC_SOURCE_DIR "/configs/broach-zc.toml")));
+  a.ask(Request::simple(CommandKind::MachineOn));
+  a.ask(Request::set_mode(Mode::Auto));
+  a.ask(Request::open(program));
+  a.ask(Request::simple(CommandKind::CycleStart));
+  int n = 0;
+  bool coupled_seen = false;
+  ASSERT_TRUE(a.until(
+      [&] {
+        ++n;
+        coupled_seen = coupled_seen || a.rig().status().servo.coupling.kind != motion::CouplingKind::Off;
+        if (n == 300) a.ask(Request::simple(CommandKind::FeedHold));
+        if (n == 600) a.ask(Request::simple(CommandKind::Resume));
+        if (a.rig().status().servo.commanded[Axis::Z] > 150) a.rig().machine().set_mains_ok(false);
+        return a.state() == State::Faulted;
+      },
+      200000));
+  EXPECT_TRUE(coupled_seen);
+  EXPECT_EQ(g_allocations.load(), 0);
+  std::filesystem::remove_all(dir);
+}
+
 // The drill retrofit's tick: midpoint homing on the analog sensors, the compensation stage, the
 // interlock rules, the handwheel, hand-axis waits with a simulated operator, a stall and an e-stop.
 TEST(ServoAllocations, NoneInsideTheDrillsTick) {

@@ -94,6 +94,9 @@ enum class ActionKind : std::uint8_t {
   /// it where a move of a hand-fed axis was. index = axis, value = machine position, index2 = +1:
   /// a retract (the move went in +), 0: a plunge.
   HandAxisWait,
+  /// The broaching codes' coupling (canon::AxisCoupling): index = law (0 off), index2 = table,
+  /// value = pitch (mm), action pose [0] = pitch rate. The motion stops exactly there.
+  AxisCoupling,
 };
 
 /// A non-motion action executed before move `before_move` (== move count: after the last).

@@ -100,6 +100,7 @@ class ProgramBuilder final : public Sink {
   void clear_aux_output_bit(int index) override { simple(ActionKind::AuxOutputBit, index, 0); }
   void set_motion_output_value(int index, double value) override;
   void set_aux_output_value(int index, double value) override;
+  void set_axis_coupling(const AxisCoupling& coupling) override;
   void wait_for_input(int index, bool digital, int mode, double timeout_s) override;
 
   void turn_probe_on() override { simple(ActionKind::ProbeOn); }

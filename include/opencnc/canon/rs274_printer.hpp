@@ -87,6 +87,7 @@ class Rs274Printer final : public Sink {
   void clear_aux_output_bit(int index) override { indexed("CLEAR_AUX_OUTPUT_BIT(", index); }
   void set_motion_output_value(int index, double value) override;
   void set_aux_output_value(int index, double value) override;
+  void set_axis_coupling(const AxisCoupling& coupling) override;
 
   void turn_probe_on() override { simple("TURN_PROBE_ON()"); }
   void turn_probe_off() override { simple("TURN_PROBE_OFF()"); }

@@ -96,6 +96,8 @@ class Sink {
   virtual void clear_aux_output_bit(int /*index*/) {}
   virtual void set_motion_output_value(int /*index*/, double /*value*/) {}
   virtual void set_aux_output_value(int /*index*/, double /*value*/) {}
+  /// Couples the machine's slave axis to its master by a law, or uncouples it (law 0).
+  virtual void set_axis_coupling(const AxisCoupling& /*coupling*/) {}
   /// M66: wait for input `index` (digital if `digital`), `mode` = L word, up to `timeout_s`.
   virtual void wait_for_input(int /*index*/, bool /*digital*/, int /*mode*/, double /*timeout_s*/) {}
 

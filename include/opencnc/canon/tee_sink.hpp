@@ -211,6 +211,10 @@ class TeeSink final : public Sink {
     a_.set_motion_output_value(index, value);
     b_.set_motion_output_value(index, value);
   }
+  void set_axis_coupling(const AxisCoupling& c) override {
+    a_.set_axis_coupling(c);
+    b_.set_axis_coupling(c);
+  }
   void set_aux_output_value(int index, double value) override {
     a_.set_aux_output_value(index, value);
     b_.set_aux_output_value(index, value);

@@ -56,6 +56,16 @@ struct ArcFeed {
   Pose end;
 };
 
+/// The machine's axis coupling switched on or off by a program (the broaching codes, see
+/// docs/broaching.md): which law, in program units. The machine's profile says which axes.
+struct AxisCoupling {
+  int law = 0;         ///< 0 off, 1 constant pitch, 2 linear pitch, 3 pitch table, 4 cam (motion::CouplingKind)
+  int table = 0;       ///< 1-based table number of the profile (laws 3 and 4)
+  double pitch = 0;    ///< pitch per revolution, program length units (laws 1 and 2; sign = hand)
+  double rate = 0;     ///< change of pitch per unit of master travel (law 2; dimensionless)
+  bool operator==(const AxisCoupling&) const = default;
+};
+
 /// A NURBS control point in the XY plane with its weight.
 struct NurbsPoint {
   double x = 0, y = 0, weight = 1;

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "opencnc/core/axes.hpp"
@@ -158,6 +159,24 @@ struct InterpreterOptions {
   double readahead_s = 5.0;
 };
 
+/// One `[[coupling.table]]`: points [master offset mm, value] — pitch (mm per revolution) for a
+/// pitch table, slave offset (degrees) for a cam. Numbered 1, 2, … in file order.
+struct CouplingTableProfile {
+  enum class Kind : std::uint8_t { Pitch, Cam };
+  Kind kind = Kind::Pitch;
+  std::vector<std::pair<double, double>> points;
+};
+
+/// `[coupling]`: the slave axis programs couple to a master (M171-M175, docs/broaching.md).
+struct CouplingProfile {
+  bool present = false;
+  Axis master = Axis::Z;
+  Axis slave = Axis::C;
+  bool from_actual = false;  ///< the tick couples to the master's feedback instead of its command
+  double radius_mm = 50;     ///< where helix errors are measured (the bore's radius): reports only
+  std::vector<CouplingTableProfile> tables;
+};
+
 /// `[tool_guard]`: the tool store and the check of its live table against the backup.
 struct ToolGuardProfile {
   bool present = false;
@@ -193,6 +212,7 @@ struct MachineProfile {
   IoProfile io;
   InterlockProfile interlocks;
   HandwheelProfile handwheel;
+  CouplingProfile coupling;
   /// Digital inputs the simulated machine drives from switches (named inputs with a `sim`).
   std::vector<machine::SimInputSwitch> sim_input_switches;
   double sim_temperature_c = 20;  ///< machine temperature in the simulation

@@ -174,6 +174,9 @@ enum class ActionCode : std::uint8_t {
   /// Wait until the operator has brought hand axis `index` to `value`: index2 = +1 a retract (at
   /// or above it), 0 a plunge (down to it); see HandWait in status.hpp.
   HandAxisWait,
+  /// Couple the profile's slave axis to its master (coupling stage): index = motion::CouplingKind
+  /// (0 = uncouple), index2 = table number (1-based), value = pitch (mm), value2 = pitch rate.
+  AxisCoupling,
 };
 
 /// The machine side of marker `action` (Program::actions() index) of the current run. The
@@ -185,7 +188,7 @@ struct MachineAction {
   std::int32_t index = 0;
   std::int32_t index2 = 0;
   double value = 0;
-  double value2 = 0;  ///< SurfaceSpeed: X of the spindle axis, machine coordinates (mm)
+  double value2 = 0;  ///< SurfaceSpeed: X of the spindle axis, machine coordinates (mm); AxisCoupling: pitch rate
 };
 
 /// How a run ended.

@@ -115,6 +115,12 @@ class Servo final : public Tickable {
   void emit_interlock(int index, CommandKind what) noexcept;
   bool spindle_may_start() const noexcept;
 
+  // --- axis coupling (servo_coupling.cpp) ----------------------------------------------------
+  void engage_coupling(const MachineAction& a) noexcept;
+  void release_coupling() noexcept;
+  double coupling_master() const noexcept;
+  double coupling_error() const noexcept;
+
   // --- Auto and MDI runs (servo_program.cpp) ------------------------------------------------
   void run_program() noexcept;
   traj::TickInput program_inputs() noexcept;
@@ -177,6 +183,11 @@ class Servo final : public Tickable {
   motion::Compensation comp_;
   Joints compensation_{};    ///< the correction in the last outputs (feedback reflects it)
   bool moved_last_ = false;  ///< a driven joint's command changed in the last period
+
+  // Axis coupling: the law a program engaged and where (CouplingStatus says the same).
+  motion::CouplingLaw law_{};
+  CouplingStatus coupling_{};
+  int master_joint_ = -1, slave_joint_ = -1;
 
   // Manual mode.
   std::array<AxisMover, machine::kMaxJoints> movers_{};

@@ -10,6 +10,7 @@
 #include "opencnc/machine/interlocks.hpp"
 #include "opencnc/machine/machine_io.hpp"
 #include "opencnc/motion/compensation.hpp"
+#include "opencnc/motion/coupling.hpp"
 #include "opencnc/traj/interpolator.hpp"
 
 namespace opencnc::control {
@@ -74,6 +75,8 @@ struct ServoConfig {
   bool homing_required = false;
   /// Pitch-error and backlash compensation per joint (the compensation stage).
   motion::CompensationConfig compensation;
+  /// The slave axis a program may couple to its master, and the profile's tables (coupling stage).
+  motion::CouplingConfig coupling;
   /// The PLC's interlock rules (evaluated every period after safety).
   machine::InterlockRules interlocks;
   /// Units per count the operator may select for the handwheel (none: any positive step).

@@ -11,6 +11,7 @@
 #include "opencnc/control/homing.hpp"
 #include "opencnc/core/axes.hpp"
 #include "opencnc/machine/machine_io.hpp"
+#include "opencnc/motion/coupling.hpp"
 #include "opencnc/traj/interpolator.hpp"
 
 namespace opencnc::control {
@@ -47,6 +48,18 @@ struct JointStatus {
   bool homed = false;
   bool homing = false;
   bool limit_neg = false, limit_pos = false, home_switch = false, amp_fault = false;
+};
+
+/// The coupling stage now: the law a program engaged (kind Off: none) and where it engaged.
+struct CouplingStatus {
+  motion::CouplingKind kind = motion::CouplingKind::Off;
+  std::int8_t master_axis = -1, slave_axis = -1;
+  std::int32_t table = 0;      ///< 1-based table number (pitch table, cam)
+  double pitch_mm = 0;         ///< constant pitch, or the pitch at engagement (linear law)
+  double pitch_rate = 0;       ///< linear law: mm of pitch per mm of master travel
+  double master_origin = 0;    ///< master's machine position at engagement
+  double slave_origin = 0;     ///< slave's machine position at engagement
+  double error_deg = 0;        ///< actual slave − law(actual master): the helix error now
 };
 
 struct ServoStatus {
@@ -115,6 +128,7 @@ struct ServoStatus {
   std::uint32_t interlocks_true = 0;  ///< bit per rule whose condition holds
   std::int8_t handwheel_axis = -1;    ///< the axis the handwheel moves (−1 = none)
   double handwheel_step = 0;          ///< units per count
+  CouplingStatus coupling{};          ///< the axis coupling (broaching)
 };
 
 /// One servo period, for traces and run reports (docs/controller.md, "Trace CSV").
@@ -134,6 +148,9 @@ struct TraceSample {
   Pose output{};           ///< what the drives were told, machine coordinates (with compensation)
   std::array<HomingPhase, kAxisCount> homing_phase{};  ///< per axis
   Pose home_level{};                                   ///< the home proximity sensor's level, per axis
+  bool coupled = false;          ///< a coupling law held the slave in this period
+  bool power_stop = false;       ///< a power-fail stop is under way (from the period after the signal)
+  double coupling_error_deg = 0;  ///< actual slave − law(actual master), degrees (0 uncoupled)
 };
 
 static_assert(std::is_trivially_copyable_v<ServoStatus>);

@@ -10,6 +10,7 @@
 #include <string_view>
 
 #include "opencnc/config/machine_profile.hpp"
+#include "opencnc/controller/coupling_pass.hpp"
 #include "opencnc/controller/hand_axis.hpp"
 #include "opencnc/controller/program_source.hpp"
 #include "opencnc/gcode/interpreter.hpp"
@@ -21,6 +22,12 @@ struct Extensions;
 }
 
 namespace opencnc::control {
+
+/// The passes a program's moves go through as the builder appends them.
+struct MovePasses {
+  HandAxes hand;         ///< hand-fed axes (hand_axis.hpp)
+  CoupledAxes coupling;  ///< the axis coupling (coupling_pass.hpp)
+};
 
 /// How the G-code source is set up.
 struct GcodeSourceConfig {
@@ -39,6 +46,9 @@ struct GcodeSourceConfig {
   double default_tolerance_mm = 0;
   /// Hand-fed axes: their programmed moves become waits for the operator (hand_axis.hpp).
   HandAxes hand;
+  /// The axis coupling of the broaching codes: while a law holds, the slave's coordinates come
+  /// from it and its limits are checked through it (coupling_pass.hpp).
+  CoupledAxes coupling;
 };
 
 /// Programs and MDI lines through the interpreter, in millimetres. Before a program, and before
@@ -75,6 +85,7 @@ class GcodeProgramSource final : public ProgramSource {
   gcode::Options options_for(const std::string& path, const LoadOptions& options) const;
 
  private:
+  MovePasses passes() const { return {config_.hand, config_.coupling}; }
   GcodeSourceConfig config_;
   std::unique_ptr<gcode::Interpreter> mdi_;  ///< the MDI session: modal state lives on
   std::uint64_t mdi_tools_version_ = 0;

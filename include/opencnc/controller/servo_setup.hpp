@@ -25,6 +25,9 @@ plan::PlannerConfig planner_config(const config::MachineProfile& profile);
 /// The servo's view of the machine. The interpolator settings are those of a planner made with
 /// machine_limits() and planner_config(), so blocks and tick agree. Non-real-time.
 ServoConfig servo_config(const config::MachineProfile& profile);
+/// The tick's fixed-size copy of the profile's [coupling] (tables numbered from 1 in programs).
+/// Non-real-time; any thread.
+motion::CouplingConfig coupling_config(const config::CouplingProfile& coupling);
 
 /// What a tick in another process (the HAL component) is handed: servo_config() and what the
 /// profile declares wired (the capabilities the simulated machine of the profile would have:

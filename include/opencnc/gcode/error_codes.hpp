@@ -240,6 +240,9 @@ namespace opencnc::gcode {
   X(FanucRotationPlaneChange, "fanuc.rotation-plane-change")            \
   X(FanucArcNonUniformScale, "fanuc.arc-nonuniform-scale")              \
   X(FanucTransformActive, "fanuc.transform-active")                     \
+  /* axis coupling (broaching codes M171-M175) */                       \
+  X(CouplingWord, "coupling.word")                                      \
+  X(CouplingCutterComp, "coupling.cutter-comp")                         \
   /* runaway protection */                                              \
   X(LimitCallDepth, "gcode.limit-call-depth")                           \
   X(LimitBlocks, "gcode.limit-blocks")                                  \

@@ -1,0 +1,90 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Servo, the coupling stage: axes → joints, the slave axis computed from its master by the law a
+// program engaged (broaching helices, cams), from the master's command or its feedback.
+#include <cmath>
+
+#include "opencnc/control/servo.hpp"
+
+namespace opencnc::control {
+
+// While a law is engaged the slave's command is the law's, whatever the interpolator said: the
+// program's own slave coordinates (the controller's coupling pass writes the law's value at every
+// move's end) agree with it at the ends of moves, so engaging and releasing moves nothing.
+void Servo::couple_axes() noexcept {
+  if (law_.active()) {
+    const double d = coupling_master() - coupling_.master_origin;
+    commanded_[coupling_.slave_axis] = coupling_.slave_origin + law_.slave(d);
+  }
+  for (int j = 0; j < config_.joint_count; ++j) {
+    const auto uj = static_cast<std::size_t>(j);
+    joint_cmd_[uj] = commanded_[config_.joints[uj].axis] - offset_[uj];
+  }
+}
+
+double Servo::coupling_master() const noexcept {
+  if (config_.coupling.source == motion::CouplingSource::Actual && master_joint_ >= 0) {
+    const auto mj = static_cast<std::size_t>(master_joint_);
+    return position_[mj] + offset_[mj];
+  }
+  return commanded_[coupling_.master_axis];
+}
+
+// The helix error: where the slave is against where the law puts it for where the master is.
+double Servo::coupling_error() const noexcept {
+  if (!law_.active() || master_joint_ < 0 || slave_joint_ < 0) return 0;
+  const auto mj = static_cast<std::size_t>(master_joint_), sj = static_cast<std::size_t>(slave_joint_);
+  const double master = position_[mj] + offset_[mj];
+  const double slave = position_[sj] + offset_[sj];
+  return slave - (coupling_.slave_origin + law_.slave(master - coupling_.master_origin));
+}
+
+// A program's coupling record (an exact stop of the path: the commanded position is the corner).
+// The origin is the master's commanded position there, so that the law meets the program's slave
+// coordinates; a record the machine cannot honour (no coupling configured, no such table)
+// releases the coupling — the preflight refuses such programs before they run.
+void Servo::engage_coupling(const MachineAction& a) noexcept {
+  const motion::CouplingConfig& cc = config_.coupling;
+  const auto kind = static_cast<motion::CouplingKind>(a.index);
+  master_joint_ = joint_of(cc.master_axis);
+  slave_joint_ = joint_of(cc.slave_axis);
+  if (!cc.enabled || kind == motion::CouplingKind::Off || master_joint_ < 0 || slave_joint_ < 0) {
+    release_coupling();
+    return;
+  }
+  switch (kind) {
+    case motion::CouplingKind::ConstantPitch:
+      law_ = motion::CouplingLaw::constant(a.value);
+      break;
+    case motion::CouplingKind::LinearPitch:
+      law_ = motion::CouplingLaw::linear(a.value, a.value2);
+      break;
+    case motion::CouplingKind::PitchTable:
+    case motion::CouplingKind::Cam: {
+      const int t = a.index2 - 1;
+      if (t < 0 || t >= motion::kMaxCouplingTables || cc.table_kind[static_cast<std::size_t>(t)] != kind) {
+        release_coupling();
+        return;
+      }
+      law_ = motion::CouplingLaw::tabulated(kind, cc.tables[static_cast<std::size_t>(t)]);
+      break;
+    }
+    default:
+      release_coupling();
+      return;
+  }
+  coupling_.kind = kind;
+  coupling_.master_axis = cc.master_axis;
+  coupling_.slave_axis = cc.slave_axis;
+  coupling_.table = a.index2;
+  coupling_.pitch_mm = a.value;
+  coupling_.pitch_rate = a.value2;
+  coupling_.master_origin = commanded_[cc.master_axis];
+  coupling_.slave_origin = commanded_[cc.slave_axis];
+}
+
+void Servo::release_coupling() noexcept {
+  law_ = motion::CouplingLaw{};
+  coupling_ = CouplingStatus{};
+}
+
+}  // namespace opencnc::control
