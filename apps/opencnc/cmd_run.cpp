@@ -345,8 +345,8 @@ int run(const RunOptions& o) {
   if (!o.inject.empty()) {
     const std::optional<double> at = mains_off_time(o.inject);
     if (!at) return kExitUsage;
-    if (o.session.realtime) {
-      fmt::print(stderr, "error: --inject works in virtual time only (not with --realtime)\n");
+    if (o.session.realtime || o.session.hal) {
+      fmt::print(stderr, "error: --inject works in virtual time only (not with --realtime or --hal)\n");
       return kExitUsage;
     }
     session.mains_off_s = *at;

@@ -53,7 +53,7 @@ class Driver {
   virtual bool ticks_by_itself() const = 0;
   /// The simulated operator's hand moves hand-fed joint `joint` toward `target` at `speed`.
   virtual void set_hand_target(int joint, double target, double speed) = 0;
-  /// The simulated mains fail (virtual time only: cmd_run refuses --inject with --realtime).
+  /// The simulated mains fail (virtual time only: cmd_run refuses --inject with --realtime or --hal).
   virtual void cut_mains() = 0;
 };
 
@@ -150,6 +150,7 @@ class HalDriver final : public Driver {
   control::Controller& controller() override { return *controller_; }
   bool ticks_by_itself() const override { return true; }
   void set_hand_target(int, double, double) override {}  // a real hand moves a real axis
+  void cut_mains() override {}  // real mains: nothing to simulate (cmd_run refuses --inject with --hal)
 
  private:
   std::unique_ptr<control::HalLink> link_;
