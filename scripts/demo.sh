@@ -1,28 +1,28 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: GPL-3.0-or-later
-# The main job: installs what is needed, builds, runs the bracket program on the simulated mill and
-# prints the report (or, with --hmi, serves the operator's HMI in the browser with it loaded).
+# The main job: installs what is needed, builds, and serves the operator's HMI on the simulated
+# mill with the bracket program loaded (or, with --batch, runs it and prints the report).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-hmi=0
+batch=0
 listen=127.0.0.1:8080
 while (($#)); do
   case $1 in
-    --hmi) hmi=1 ;;
-    --batch) hmi=0 ;;  # the default; kept for scripts that name it
+    --batch) batch=1 ;;
     --listen)
       [[ $# -ge 2 ]] || { echo "demo.sh: --listen needs ADDRESS:PORT" >&2; exit 2; }
       listen=$2
       shift ;;
     -h | --help)
       cat <<'TXT'
-usage: scripts/demo.sh [--hmi [--listen ADDRESS:PORT]]
-  Installs what is needed (scripts/setup.sh), builds the application and runs examples/bracket.ngc
-  on the simulated three-axis mill in virtual time: progress, then the run's report.
-  --hmi        instead, also install the front end's npm packages, build the front end and start
-               `opencnc serve` on the simulated mill with examples/bracket.ngc loaded: it prints
-               the URL (with the operator token) to open in a browser; Ctrl-C stops it
-  --listen     where the server listens with --hmi (default 127.0.0.1:8080)
+usage: scripts/demo.sh [--batch] [--listen ADDRESS:PORT]
+  Installs what is needed (scripts/setup.sh, the front end's npm packages), builds the application
+  and the front end, and starts `opencnc serve` on the simulated three-axis mill with
+  examples/bracket.ngc loaded: it prints the URL (with the operator token) to open in a browser;
+  Ctrl-C stops it.
+  --batch      instead, run examples/bracket.ngc on the simulated mill in virtual time and print
+               the run's report (no browser)
+  --listen     where the server listens (default 127.0.0.1:8080)
   -h, --help   this text
 TXT
       exit 0 ;;
@@ -34,7 +34,7 @@ scripts/setup.sh
 # The application only: the test and benchmark libraries are installed by `setup.sh --tests`.
 cmake --preset default -DOPENCNC_TESTS=OFF -DOPENCNC_BENCH=OFF >/dev/null
 cmake --build --preset default -j "${OPENCNC_JOBS:-2}" --target opencnc
-if ((!hmi)); then
+if ((batch)); then
   # A bracket (pocket, compensated profile, peck-drilled holes) on the simulated three-axis mill:
   # interpreted, checked against the soft limits, planned and run in virtual time; the report
   # follows (machining time, path length, following and contour error, axis maxima, violations).
