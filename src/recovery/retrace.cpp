@@ -32,6 +32,16 @@ Outcome refuse(std::string why) {
   return o;
 }
 
+// Start and step move the machine: only from a pause with the machine standing and no job.
+std::optional<Outcome> refuse_unless_paused_and_idle(RetracePhase phase, const control::ControllerStatus& s) {
+  if (phase != RetracePhase::Paused)
+    return refuse(fmt::format("retrace is {}, not paused", to_string(phase)));
+  if (s.servo.state != State::Idle || s.run_active)
+    return refuse(fmt::format("the machine is not idle ({}{})", control::to_string(s.servo.state),
+                              s.run_active ? ", a job runs" : ""));
+  return std::nullopt;
+}
+
 Outcome accept(std::string message = {}) {
   Outcome o;
   o.accepted = true;
@@ -174,12 +184,8 @@ Outcome RetraceFeature::pause(control::FeatureHost& host) {
 }
 
 Outcome RetraceFeature::start(const RetraceStart& args, control::FeatureHost& host) {
-  if (phase() != RetracePhase::Paused)
-    return refuse(fmt::format("retrace is {}, not paused", to_string(phase())));
+  if (std::optional<Outcome> no = refuse_unless_paused_and_idle(phase(), host.current_status())) return *no;
   const control::ControllerStatus& s = host.current_status();
-  if (s.servo.state != State::Idle || s.run_active)
-    return refuse(fmt::format("the machine is not idle ({}{})", control::to_string(s.servo.state),
-                              s.run_active ? ", a job runs" : ""));
   const PathIndex* ix = index();
   if (ix == nullptr) return refuse("no program is open");
   QueryOptions q;
@@ -216,12 +222,8 @@ Outcome RetraceFeature::start(const RetraceStart& args, control::FeatureHost& ho
 }
 
 Outcome RetraceFeature::step(const RetraceStep& args, control::FeatureHost& host) {
-  if (phase() != RetracePhase::Paused)
-    return refuse(fmt::format("retrace is {}, not paused", to_string(phase())));
+  if (std::optional<Outcome> no = refuse_unless_paused_and_idle(phase(), host.current_status())) return *no;
   const control::ControllerStatus& s = host.current_status();
-  if (s.servo.state != State::Idle || s.run_active)
-    return refuse(fmt::format("the machine is not idle ({}{})", control::to_string(s.servo.state),
-                              s.run_active ? ", a job runs" : ""));
   const PathIndex* ix = index();
   if (ix == nullptr || ix->size() == 0) return refuse("no program is open");
   if (!cursor_set_) {

@@ -407,32 +407,30 @@ std::vector<AuditEntry> ToolStore::audit(std::size_t limit, std::string* error) 
 
 // --- the interpreter's view ------------------------------------------------------------------
 
-std::shared_ptr<const tools::ToolTable> ToolStore::snapshot() const {
-  std::lock_guard lock(mutex_);
+void ToolStore::refresh_keeping_last_locked() const {
   try {
     refresh_locked();
   } catch (const std::exception&) {
     // A read that fails (the disk is gone) keeps the table last read: the interpreter never
     // sees a half table. The next write reports the problem.
   }
+}
+
+std::shared_ptr<const tools::ToolTable> ToolStore::snapshot() const {
+  std::lock_guard lock(mutex_);
+  refresh_keeping_last_locked();
   return table_;
 }
 
 std::uint64_t ToolStore::changes() const {
   std::lock_guard lock(mutex_);
-  try {
-    refresh_locked();
-  } catch (const std::exception&) {
-  }
+  refresh_keeping_last_locked();
   return changes_;
 }
 
 std::uint64_t ToolStore::version() const {
   std::lock_guard lock(mutex_);
-  try {
-    refresh_locked();
-  } catch (const std::exception&) {
-  }
+  refresh_keeping_last_locked();
   return version_;
 }
 

@@ -92,6 +92,7 @@ class ToolStore final : public tools::ToolTableService {
  private:
   ToolStore(std::unique_ptr<Database> db, std::string path);
   void refresh_locked() const;  // re-reads after another process's commit
+  void refresh_keeping_last_locked() const;  // the same; a failed read keeps the last table
   tools::ToolSet read_live_locked() const;
   bool write_locked(const tools::ToolSet& changed, std::string_view interface, std::string_view reason,
                     std::string* error);
