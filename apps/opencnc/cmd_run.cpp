@@ -39,7 +39,7 @@ struct RunOptions {
   std::string trace;
   std::string report;
   double max_time_s = kDefaultMaxTimeS;  ///< 0: no limit
-  std::string inject;                    ///< "mains-off@SECONDS"
+  std::vector<std::string> inject;       ///< "mains-off@SECONDS", "tool-dull@SECONDS=FACTOR"
   std::vector<std::string> retraces;     ///< "AT_SECONDS:X,Y"
 };
 
@@ -130,18 +130,38 @@ class RetraceScript {
   std::vector<double> times_;
 };
 
-/// "mains-off@12.5" → 12.5 (servo time of the run); nullopt with the reason printed.
-std::optional<double> mains_off_time(const std::string& inject) {
-  constexpr std::string_view kPrefix = "mains-off@";
-  char* end = nullptr;
-  const double s = inject.rfind(kPrefix, 0) == 0 ? std::strtod(inject.c_str() + kPrefix.size(), &end) : -1;
-  if (end == nullptr || *end != '\0' || !std::isfinite(s) || s < 0) {
-    fmt::print(stderr,
-               "error: --inject {}: expected mains-off@SECONDS (servo time from the run's start, >= 0)\n",
-               inject);
-    return std::nullopt;
+/// The faults --inject schedules, in servo time from the run's start.
+struct Injections {
+  double mains_off_s = -1;
+  double tool_dull_s = -1, tool_dull_factor = 1;
+};
+
+/// "mains-off@12.5" or "tool-dull@4=2.5" into `out`; false with the reason printed.
+bool parse_injection(const std::string& text, Injections& out) {
+  const auto number = [](const char* from, char stop, const char*& end) {
+    char* e = nullptr;
+    const double v = std::strtod(from, &e);
+    end = e;
+    return e != from && *e == stop && std::isfinite(v) ? v : -1.0;
+  };
+  const char* end = nullptr;
+  if (text.rfind("mains-off@", 0) == 0) {
+    out.mains_off_s = number(text.c_str() + 10, '\0', end);
+    if (out.mains_off_s >= 0) return true;
+  } else if (text.rfind("tool-dull@", 0) == 0) {
+    out.tool_dull_s = number(text.c_str() + 10, '=', end);
+    const double f = out.tool_dull_s >= 0 ? number(end + 1, '\0', end) : -1;
+    if (f > 0 && f <= 100) {
+      out.tool_dull_factor = f;
+      return true;
+    }
   }
-  return s;
+  fmt::print(
+      stderr,
+      "error: --inject {}: expected mains-off@SECONDS or tool-dull@SECONDS=FACTOR (servo time from the "
+      "run's start, >= 0; the cutter's force grows by FACTOR, 0 < FACTOR <= 100, 1 = sharp)\n",
+      text);
+  return false;
 }
 
 /// "3.2 h", "19.0 years": a duration a person reads at a glance.
@@ -343,13 +363,23 @@ int run(const RunOptions& o) {
   std::shared_ptr<control::PowerFailRecorder> power_recorder;
   SessionOptions session = o.session;
   if (!o.inject.empty()) {
-    const std::optional<double> at = mains_off_time(o.inject);
-    if (!at) return kExitUsage;
+    Injections at;
+    for (const std::string& text : o.inject) {
+      if (!parse_injection(text, at)) return kExitUsage;
+    }
     if (o.session.realtime || o.session.hal) {
       fmt::print(stderr, "error: --inject works in virtual time only (not with --realtime or --hal)\n");
       return kExitUsage;
     }
-    session.mains_off_s = *at;
+    if (at.tool_dull_s >= 0 && profile && !profile->broaching.sim.present) {
+      fmt::print(stderr,
+                 "error: --inject tool-dull needs a simulated broach ([process.broaching.sim] in {})\n",
+                 o.session.machine);
+      return kExitUsage;
+    }
+    session.mains_off_s = at.mains_off_s;
+    session.tool_dull_s = at.tool_dull_s;
+    session.tool_dull_factor = at.tool_dull_factor;
   }
   std::optional<control::TraceCsvWriter> csv;
   std::optional<ProgressBar> bar;
@@ -449,8 +479,11 @@ void add_run_command(CLI::App& app, Registry& registry) {
   cmd->add_option("--trace", opts->trace, "Write one CSV row per servo period (docs/controller.md)");
   cmd->add_option("--report", opts->report, "Write the report as JSON");
   cmd->add_option("--inject", opts->inject,
-                  "Fault injection in virtual time: mains-off@SECONDS (the mains fail then; the report gains "
-                  "power_fail)");
+                  "Fault injection in virtual time (repeatable): mains-off@SECONDS (the mains fail then; the "
+                  "report gains power_fail), tool-dull@SECONDS=FACTOR (the broach's cutter wears: its force "
+                  "grows by FACTOR, 1 = sharp)")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   cmd->add_option(
          "--max-time", opts->max_time_s,
          "Refuse a program that needs more machining time than this, in seconds (default 86400, a day; "
