@@ -23,6 +23,7 @@
 #include "opencnc/controller/preflight.hpp"
 #include "opencnc/controller/run_recorder.hpp"
 #include "opencnc/controller/servo_setup.hpp"
+#include "opencnc/process/process_log.hpp"
 #include "opencnc/recovery/retrace.hpp"
 #include "run_session.hpp"
 #include "stop_signals.hpp"
@@ -38,6 +39,7 @@ struct RunOptions {
   SessionOptions session;
   std::string trace;
   std::string report;
+  std::string process_log;  ///< FILE.csv or FILE.sqlite: the process data at the profile's rate
   double max_time_s = kDefaultMaxTimeS;  ///< 0: no limit
   std::vector<std::string> inject;       ///< "mains-off@SECONDS", "tool-dull@SECONDS=FACTOR"
   std::vector<std::string> retraces;     ///< "AT_SECONDS:X,Y"
@@ -352,13 +354,21 @@ int run(const RunOptions& o) {
   // Every output is checked (and created) before anything runs.
   const std::optional<config::MachineProfile> profile = quiet_profile(o.session);
   const std::vector<NamedPath> inputs = session_inputs(o.session, profile ? &*profile : nullptr);
-  const NamedPath outputs[] = {{"--trace", o.trace}, {"--report", o.report}};
+  const NamedPath outputs[] = {{"--trace", o.trace}, {"--report", o.report}, {"--process-log", o.process_log}};
   if (!check_inputs(inputs)) return kExitUsage;
+  const std::optional<process::LogFormat> log_format =
+      o.process_log.empty() ? std::nullopt : process::log_format(o.process_log);
+  if (!o.process_log.empty() && !log_format) {
+    fmt::print(stderr, "error: --process-log {}: the name must end in .csv, .sqlite, .sqlite3 or .db\n", o.process_log);
+    return kExitUsage;
+  }
   if (profile && !within_max_time(o, *profile)) return kExitProgram;
   const auto files = open_outputs(inputs, outputs);
   if (files.empty()) return kExitUsage;
   OutputFile* const trace_file = files[0].get();
   OutputFile* const report_file = files[1].get();
+  OutputFile* const log_file = files[2].get();
+  std::shared_ptr<process::ProcessLog> process_log;
   std::shared_ptr<control::RunRecorder> recorder;
   std::shared_ptr<control::PowerFailRecorder> power_recorder;
   SessionOptions session = o.session;
@@ -402,6 +412,13 @@ int run(const RunOptions& o) {
       csv.emplace(*trace_file, machine.axis_mask(), machine.servo_period_s);
       out.emplace_back(std::make_shared<TraceObserver>(*csv), control::ObserverOptions{0, true});
     }
+    if (log_file != nullptr) {
+      process::ProcessLogSetup setup{machine.axis_mask(), machine.broaching.present ? machine.broaching.log_rate_hz : 100.0,
+                                     machine.servo_period_s, machine.coupling.present ? machine.coupling.radius_mm : 0.0,
+                                     o.session.file, machine.name};
+      process_log = std::make_shared<process::ProcessLog>(setup, *log_format, *log_file);
+      out.emplace_back(process_log, control::ObserverOptions{0, true});
+    }
     if (tty) bar.emplace(program.preflight.summary.path_length_mm);
     return out;
   };
@@ -432,6 +449,13 @@ int run(const RunOptions& o) {
   if (!recorder) return end.exit_code;  // nothing ran; the outputs are left as they were
   int rc = end.exit_code;
   if (trace_file != nullptr && !commit_trace(*trace_file)) rc = kExitUsage;
+  if (process_log) {
+    std::string error;
+    if (!process_log->finish(&error) || !log_file->commit(&error)) {
+      fmt::print(stderr, "error: --process-log {}: {}\n", o.process_log, error);
+      rc = kExitUsage;
+    }
+  }
   const control::RunReport r = recorder->report();
   print_report(r, end.profile, end);
   std::optional<control::PowerFailReport> power_fail;
@@ -478,6 +502,9 @@ void add_run_command(CLI::App& app, Registry& registry) {
                 "operator on the terminal");
   cmd->add_option("--trace", opts->trace, "Write one CSV row per servo period (docs/controller.md)");
   cmd->add_option("--report", opts->report, "Write the report as JSON");
+  cmd->add_option("--process-log", opts->process_log,
+                  "Write the process data (load, positions, feed, helix error) at the profile's rate "
+                  "([process.broaching] log_rate_hz, else 100 Hz) to FILE.csv or FILE.sqlite (docs/broaching.md)");
   cmd->add_option("--inject", opts->inject,
                   "Fault injection in virtual time (repeatable): mains-off@SECONDS (the mains fail then; the "
                   "report gains power_fail), tool-dull@SECONDS=FACTOR (the broach's cutter wears: its force "
