@@ -16,8 +16,10 @@
 
 #include "cli_files.hpp"
 #include "commands.hpp"
+#include "edm_report.hpp"
 #include "gcode_summary.hpp"
 #include "numeric_options.hpp"
+#include "opencnc/controller/edm_recorder.hpp"
 #include "opencnc/controller/gcode_source.hpp"
 #include "opencnc/controller/power_fail_recorder.hpp"
 #include "opencnc/controller/preflight.hpp"
@@ -130,18 +132,21 @@ class RetraceScript {
   std::vector<double> times_;
 };
 
-/// "mains-off@12.5" → 12.5 (servo time of the run); nullopt with the reason printed.
-std::optional<double> mains_off_time(const std::string& inject) {
-  constexpr std::string_view kPrefix = "mains-off@";
-  char* end = nullptr;
-  const double s = inject.rfind(kPrefix, 0) == 0 ? std::strtod(inject.c_str() + kPrefix.size(), &end) : -1;
-  if (end == nullptr || *end != '\0' || !std::isfinite(s) || s < 0) {
-    fmt::print(stderr,
-               "error: --inject {}: expected mains-off@SECONDS (servo time from the run's start, >= 0)\n",
-               inject);
-    return std::nullopt;
+/// "mains-off@12.5" or "edm-short@3" → the kind and 12.5 (servo time of the run); nullopt with the
+/// reason printed.
+std::optional<std::pair<std::string, double>> injection(const std::string& inject) {
+  for (std::string_view prefix : {"mains-off@", "edm-short@"}) {
+    if (inject.rfind(prefix, 0) != 0) continue;
+    char* end = nullptr;
+    const double s = std::strtod(inject.c_str() + prefix.size(), &end);
+    if (end != nullptr && *end == '\0' && std::isfinite(s) && s >= 0)
+      return std::pair{std::string(prefix.substr(0, prefix.size() - 1)), s};
   }
-  return s;
+  fmt::print(stderr,
+             "error: --inject {}: expected mains-off@SECONDS or edm-short@SECONDS (servo time from the run's "
+             "start, >= 0)\n",
+             inject);
+  return std::nullopt;
 }
 
 /// "3.2 h", "19.0 years": a duration a person reads at a glance.
@@ -341,15 +346,16 @@ int run(const RunOptions& o) {
   OutputFile* const report_file = files[1].get();
   std::shared_ptr<control::RunRecorder> recorder;
   std::shared_ptr<control::PowerFailRecorder> power_recorder;
+  std::shared_ptr<control::EdmRecorder> edm_recorder;
   SessionOptions session = o.session;
   if (!o.inject.empty()) {
-    const std::optional<double> at = mains_off_time(o.inject);
+    const auto at = injection(o.inject);
     if (!at) return kExitUsage;
     if (o.session.realtime || o.session.hal) {
       fmt::print(stderr, "error: --inject works in virtual time only (not with --realtime or --hal)\n");
       return kExitUsage;
     }
-    session.mains_off_s = *at;
+    (at->first == "mains-off" ? session.mains_off_s : session.edm_short_s) = at->second;
   }
   std::optional<control::TraceCsvWriter> csv;
   std::optional<ProgressBar> bar;
@@ -362,6 +368,10 @@ int run(const RunOptions& o) {
     recorder = std::make_shared<control::RunRecorder>(control::machine_limits(machine),
                                                       machine.servo_period_s, &axes);
     out.emplace_back(recorder, control::ObserverOptions{0, true});
+    if (machine.edm.present) {
+      edm_recorder = std::make_shared<control::EdmRecorder>(machine.edm.config, machine.servo_period_s);
+      out.emplace_back(edm_recorder, control::ObserverOptions{0, true});
+    }
     if (session.mains_off_s >= 0) {
       power_recorder = std::make_shared<control::PowerFailRecorder>(
           control::coupling_config(machine.coupling), control::machine_limits(machine),
@@ -410,6 +420,11 @@ int run(const RunOptions& o) {
     print_power_fail(*power_fail);
   }
   nlohmann::json j = report_json(r, o, end, power_fail);
+  if (edm_recorder) {
+    const control::EdmReport e = edm_recorder->report();
+    print_edm(e);
+    j["edm"] = edm_json(e);
+  }
   if (feature) {
     const std::vector<recovery::RetraceRecord> records = feature->records();
     for (const recovery::RetraceRecord& x : records) {
@@ -450,7 +465,7 @@ void add_run_command(CLI::App& app, Registry& registry) {
   cmd->add_option("--report", opts->report, "Write the report as JSON");
   cmd->add_option("--inject", opts->inject,
                   "Fault injection in virtual time: mains-off@SECONDS (the mains fail then; the report gains "
-                  "power_fail)");
+                  "power_fail), edm-short@SECONDS (a short in the simulated EDM gap)");
   cmd->add_option(
          "--max-time", opts->max_time_s,
          "Refuse a program that needs more machining time than this, in seconds (default 86400, a day; "

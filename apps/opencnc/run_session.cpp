@@ -55,6 +55,8 @@ class Driver {
   virtual void set_hand_target(int joint, double target, double speed) = 0;
   /// The simulated mains fail (virtual time only: cmd_run refuses --inject with --realtime or --hal).
   virtual void cut_mains() = 0;
+  /// A short in the simulated EDM gap (virtual time only, as cut_mains).
+  virtual void inject_edm_short() {}
 };
 
 class VirtualDriver final : public Driver {
@@ -68,6 +70,7 @@ class VirtualDriver final : public Driver {
     rig_.machine().set_hand_target(joint, target, speed);
   }
   void cut_mains() override { rig_.machine().set_mains_ok(false); }
+  void inject_edm_short() override { rig_.machine().inject_edm_short(); }
 
  private:
   control::SimRig rig_;
@@ -323,7 +326,7 @@ void follow(Driver& d, control::EventCursor& cursor, const SessionOptions& o, co
   std::uint32_t job = 0;
   std::uint64_t asked_tick = ~std::uint64_t{0};  // the wait already answered (by its start tick)
   std::uint64_t n = 0;
-  bool mains_cut = false;
+  bool mains_cut = false, edm_shorted = false;
   bool guard_abort = false;
   for (;;) {
     d.advance();
@@ -341,6 +344,10 @@ void follow(Driver& d, control::EventCursor& cursor, const SessionOptions& o, co
     if (o.mains_off_s >= 0 && !mains_cut && st.servo.time_s >= o.mains_off_s) {
       d.cut_mains();  // the servo sees it at its next period
       mains_cut = true;
+    }
+    if (o.edm_short_s >= 0 && !edm_shorted && st.servo.time_s >= o.edm_short_s) {
+      d.inject_edm_short();
+      edm_shorted = true;
     }
     if (hooks.progress && (++n % 256 == 0)) hooks.progress(st, wall);
     bring_hand_axis(d, st.servo);

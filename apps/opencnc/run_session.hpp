@@ -31,6 +31,8 @@ struct SessionOptions {
   const std::atomic<int>* stop = nullptr;
   /// Virtual time: the simulated mains fail at this servo time (s); negative: never.
   double mains_off_s = -1;
+  /// Virtual time: a short in the simulated EDM gap at this servo time (s); negative: never.
+  double edm_short_s = -1;
 };
 
 /// What a session ended with.

@@ -50,6 +50,7 @@ machine::SimMachineConfig sim_machine_config(const MachineProfile& profile) {
   }
   c.tool_changer = profile.tool_changer_sim;
   c.process = profile.process;
+  c.edm = profile.edm.sim;
   c.digital_inputs = profile.io.digital_inputs;
   c.digital_outputs = profile.io.digital_outputs;
   c.analog_inputs = profile.io.analog_inputs;

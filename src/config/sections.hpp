@@ -36,6 +36,8 @@ void read_interlocks(Section& top, MachineProfile& profile);
 void read_handwheel(Section& top, MachineProfile& profile);
 /// [coupling] and its tables. Needs the axes.
 void read_coupling(Section& top, MachineProfile& profile);
+/// [edm], its conditions and [edm.sim]. Needs the axes and [process].
+void read_edm(Section& top, MachineProfile& profile);
 
 /// Reports axis limits outside what any machine has (config.implausible), at the key.
 void check_plausible(Section& s, const AxisProfile& a);

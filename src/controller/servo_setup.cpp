@@ -130,6 +130,7 @@ ServoConfig servo_config(const config::MachineProfile& profile) {
   s.interpolator = plan::Planner(machine_limits(profile), planner_config(profile)).interpolator_config();
   s.spindle_max_rpm = profile.spindle.present ? profile.spindle.max_rpm : 0.0;
   s.coupling = coupling_config(profile.coupling);
+  s.edm = profile.edm.config;
   return s;
 }
 

@@ -177,6 +177,14 @@ struct CouplingProfile {
   std::vector<CouplingTableProfile> tables;
 };
 
+/// `[edm]`: a sinker EDM's machining conditions and gap servo (the tick's copy, plain data) and
+/// its simulated spark gap `[edm.sim]` (docs/edm.md).
+struct EdmProfile {
+  bool present = false;
+  machine::EdmConfig config;
+  machine::SimEdmConfig sim;
+};
+
 /// `[tool_guard]`: the tool store and the check of its live table against the backup.
 struct ToolGuardProfile {
   bool present = false;
@@ -213,6 +221,7 @@ struct MachineProfile {
   InterlockProfile interlocks;
   HandwheelProfile handwheel;
   CouplingProfile coupling;
+  EdmProfile edm;
   /// Digital inputs the simulated machine drives from switches (named inputs with a `sim`).
   std::vector<machine::SimInputSwitch> sim_input_switches;
   double sim_temperature_c = 20;  ///< machine temperature in the simulation

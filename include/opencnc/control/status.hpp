@@ -8,6 +8,7 @@
 #include <type_traits>
 
 #include "opencnc/control/command.hpp"
+#include "opencnc/control/edm_status.hpp"
 #include "opencnc/control/homing.hpp"
 #include "opencnc/core/axes.hpp"
 #include "opencnc/machine/machine_io.hpp"
@@ -129,6 +130,7 @@ struct ServoStatus {
   std::int8_t handwheel_axis = -1;    ///< the axis the handwheel moves (−1 = none)
   double handwheel_step = 0;          ///< units per count
   CouplingStatus coupling{};          ///< the axis coupling (broaching)
+  EdmStatus edm{};                    ///< the EDM gap servo, jump and orbit
 };
 
 /// One servo period, for traces and run reports (docs/controller.md, "Trace CSV").
@@ -151,6 +153,7 @@ struct TraceSample {
   bool coupled = false;          ///< a coupling law held the slave in this period
   bool power_stop = false;       ///< a power-fail stop is under way (from the period after the signal)
   double coupling_error_deg = 0;  ///< actual slave − law(actual master), degrees (0 uncoupled)
+  EdmStatus edm{};                ///< the EDM gap servo (machines with [edm])
 };
 
 static_assert(std::is_trivially_copyable_v<ServoStatus>);

@@ -7,6 +7,7 @@
 #include <limits>
 #include <vector>
 
+#include "opencnc/machine/edm.hpp"
 #include "opencnc/machine/machine_io.hpp"
 
 namespace opencnc::machine {
@@ -178,6 +179,7 @@ struct SimMachineConfig {
   SimProbeConfig probe;
   SimToolChangerConfig tool_changer;
   SimProcessConfig process;
+  SimEdmConfig edm;  ///< the simulated spark gap (present: an EDM machine)
   int digital_inputs = 0, digital_outputs = 0;
   int analog_inputs = 0, analog_outputs = 0;
   std::array<SimInputSwitch, kMaxSimInputSwitches> input_switches{};
