@@ -56,7 +56,7 @@ void SimEdmProcess::step(double electrode, const double orientation[2], bool gen
   const bool clear = !generator_on && gap_mm_ > kClearGaps * std::max(breakdown, 0.01);
   const double tau = clear ? config_.jump_flush_time_s : config_.flush_time_s;
   debris_ -= debris_ * std::min(1.0, period_s_ / tau);
-  if (short_pending_) {
+  if (short_pending_ && generator_on) {  // a bridge forms where it sparks
     short_pending_ = false;
     short_ = true;
     bridge_until_mm_ = gap_mm_ + config_.short_bridge_mm;

@@ -28,8 +28,8 @@ class SimEdmProcess {
   /// What the sensor reports for the period just simulated.
   void sample(ProcessInputs& in) const noexcept;
 
-  /// Fault injection: a debris bridge shorts the gap from the next period until the electrode
-  /// has backed off `short_bridge_mm` further than the gap was.
+  /// Fault injection: a debris bridge shorts the gap from the next period the generator is on
+  /// until the electrode has backed off `short_bridge_mm` further than the gap was.
   void inject_short() noexcept { short_pending_ = true; }
 
   // Ground truth, for tests.
