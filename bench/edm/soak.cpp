@@ -196,7 +196,16 @@ int main(int argc, char** argv) {
       }
     }
     const ServoStatus s = rig.status().servo;
+    if (rig.status().runs_finished != r.channels + 1) {
+      std::fprintf(stderr, "soak: channel %llu ended without finishing (%s) at %.3f s\n",
+                   static_cast<unsigned long long>(r.channels + 1), rig.status().wait_text.c_str(), s.time_s);
+      return 1;
+    }
     ++r.channels;
+    if (std::getenv("SOAK_VERBOSE") != nullptr)
+      std::fprintf(stderr, "channel %llu ended at %.1f s, %u jumps, at X%.4f Z%.4f B%.3f, wait %s\n",
+                   static_cast<unsigned long long>(r.channels), s.time_s, s.edm.jumps, s.actual[Axis::X],
+                   s.actual[Axis::Z], s.actual[Axis::B], rig.status().wait_text.c_str());
     r.jumps = s.edm.jumps;
     for (Axis a : {Axis::X, Axis::Y, Axis::Z})
       r.drift_um = std::max(r.drift_um, 1000 * std::fabs(s.actual[a]));

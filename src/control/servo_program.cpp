@@ -74,7 +74,7 @@ void Servo::stop_spindle_and_coolant() noexcept {
 traj::TickInput Servo::program_inputs() noexcept {
   traj::TickInput in;
   in.feed_override = feed_override_ * gap_.feed_scale();  // the EDM gap servo's forward speed
-  in.rapid_override = rapid_override_;
+  in.rapid_override = gap_.head_waits() ? 0.0 : rapid_override_;  // a rapid waits for the electrode too
   in.feed_hold = hold_;
   in.cycle_start = take(cycle_start_edge_);
   released_ = in.cycle_start;

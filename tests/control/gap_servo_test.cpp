@@ -121,10 +121,12 @@ TEST(GapServo, HoldsAtTheReferenceAndBacksOffAlongThePathBelowIt) {
   EXPECT_NEAR(r.electrode[2], z + 0.2 * 0.3, 1e-4);
   EXPECT_NEAR(r.g.status().backlog_mm, r.electrode[2] - r.head[2], 1e-9);
   EXPECT_EQ(r.g.feed_scale(), 0.0);
+  EXPECT_TRUE(r.g.head_waits());  // rapids too: the interpolator goes on only with the electrode
   // The gap opens again: forward, up to the head first, then the head goes on.
   r.run(300, [](double, double) { return std::pair{90.0, GapState::Normal}; });
   EXPECT_NEAR(r.electrode[2], r.head[2], 1e-12);
   EXPECT_GT(r.g.feed_scale(), 0.0);
+  EXPECT_FALSE(r.g.head_waits());
 }
 
 TEST(GapServo, AShortBacksOffAtTheRetractLimitWithinTheAcceleration) {

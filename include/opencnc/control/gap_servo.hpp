@@ -74,6 +74,8 @@ class GapServo {
   /// The factor the interpolator's feed override is multiplied by (0 while the electrode is
   /// behind the head or the gap wants it back).
   double feed_scale() const noexcept { return feed_scale_; }
+  /// The electrode stands behind the head or is lifted: the interpolator waits, rapids included.
+  bool head_waits() const noexcept { return jump_ != Jump::Idle || s_ < memory_.head_s() - 1e-9; }
   /// The generator's pulses on, and its settings.
   bool generator_on() const noexcept { return status_.generator; }
   machine::GeneratorOutputs generator() const noexcept;
