@@ -16,8 +16,10 @@
 
 #include "cli_files.hpp"
 #include "commands.hpp"
+#include "edm_report.hpp"
 #include "gcode_summary.hpp"
 #include "numeric_options.hpp"
+#include "opencnc/controller/edm_recorder.hpp"
 #include "opencnc/controller/gcode_source.hpp"
 #include "opencnc/controller/power_fail_recorder.hpp"
 #include "opencnc/controller/preflight.hpp"
@@ -41,7 +43,7 @@ struct RunOptions {
   std::string report;
   std::string process_log;  ///< FILE.csv or FILE.sqlite: the process data at the profile's rate
   double max_time_s = kDefaultMaxTimeS;  ///< 0: no limit
-  std::vector<std::string> inject;       ///< "mains-off@SECONDS", "tool-dull@SECONDS=FACTOR"
+  std::vector<std::string> inject;       ///< "mains-off@SECONDS", "tool-dull@SECONDS=FACTOR", "edm-short@SECONDS"
   std::vector<std::string> retraces;     ///< "AT_SECONDS:X,Y"
 };
 
@@ -136,9 +138,10 @@ class RetraceScript {
 struct Injections {
   double mains_off_s = -1;
   double tool_dull_s = -1, tool_dull_factor = 1;
+  double edm_short_s = -1;
 };
 
-/// "mains-off@12.5" or "tool-dull@4=2.5" into `out`; false with the reason printed.
+/// "mains-off@12.5", "tool-dull@4=2.5" or "edm-short@3" into `out`; false with the reason printed.
 bool parse_injection(const std::string& text, Injections& out) {
   const auto number = [](const char* from, char stop, const char*& end) {
     char* e = nullptr;
@@ -150,6 +153,9 @@ bool parse_injection(const std::string& text, Injections& out) {
   if (text.rfind("mains-off@", 0) == 0) {
     out.mains_off_s = number(text.c_str() + 10, '\0', end);
     if (out.mains_off_s >= 0) return true;
+  } else if (text.rfind("edm-short@", 0) == 0) {
+    out.edm_short_s = number(text.c_str() + 10, '\0', end);
+    if (out.edm_short_s >= 0) return true;
   } else if (text.rfind("tool-dull@", 0) == 0) {
     out.tool_dull_s = number(text.c_str() + 10, '=', end);
     const double f = out.tool_dull_s >= 0 ? number(end + 1, '\0', end) : -1;
@@ -160,8 +166,8 @@ bool parse_injection(const std::string& text, Injections& out) {
   }
   fmt::print(
       stderr,
-      "error: --inject {}: expected mains-off@SECONDS or tool-dull@SECONDS=FACTOR (servo time from the "
-      "run's start, >= 0; the cutter's force grows by FACTOR, 0 < FACTOR <= 100, 1 = sharp)\n",
+      "error: --inject {}: expected mains-off@SECONDS, tool-dull@SECONDS=FACTOR or edm-short@SECONDS (servo "
+      "time from the run's start, >= 0; the cutter's force grows by FACTOR, 0 < FACTOR <= 100, 1 = sharp)\n",
       text);
   return false;
 }
@@ -371,6 +377,7 @@ int run(const RunOptions& o) {
   std::shared_ptr<process::ProcessLog> process_log;
   std::shared_ptr<control::RunRecorder> recorder;
   std::shared_ptr<control::PowerFailRecorder> power_recorder;
+  std::shared_ptr<control::EdmRecorder> edm_recorder;
   SessionOptions session = o.session;
   if (!o.inject.empty()) {
     Injections at;
@@ -390,6 +397,12 @@ int run(const RunOptions& o) {
     session.mains_off_s = at.mains_off_s;
     session.tool_dull_s = at.tool_dull_s;
     session.tool_dull_factor = at.tool_dull_factor;
+    if (at.edm_short_s >= 0 && profile && !profile->edm.sim.present) {
+      fmt::print(stderr, "error: --inject edm-short needs a simulated spark gap ([edm.sim] in {})\n",
+                 o.session.machine);
+      return kExitUsage;
+    }
+    session.edm_short_s = at.edm_short_s;
   }
   std::optional<control::TraceCsvWriter> csv;
   std::optional<ProgressBar> bar;
@@ -402,6 +415,10 @@ int run(const RunOptions& o) {
     recorder = std::make_shared<control::RunRecorder>(control::machine_limits(machine),
                                                       machine.servo_period_s, &axes);
     out.emplace_back(recorder, control::ObserverOptions{0, true});
+    if (machine.edm.present) {
+      edm_recorder = std::make_shared<control::EdmRecorder>(machine.edm.config, machine.servo_period_s);
+      out.emplace_back(edm_recorder, control::ObserverOptions{0, true});
+    }
     if (session.mains_off_s >= 0) {
       power_recorder = std::make_shared<control::PowerFailRecorder>(
           control::coupling_config(machine.coupling), control::machine_limits(machine),
@@ -464,6 +481,11 @@ int run(const RunOptions& o) {
     print_power_fail(*power_fail);
   }
   nlohmann::json j = report_json(r, o, end, power_fail);
+  if (edm_recorder) {
+    const control::EdmReport e = edm_recorder->report();
+    print_edm(e);
+    j["edm"] = edm_json(e);
+  }
   if (feature) {
     const std::vector<recovery::RetraceRecord> records = feature->records();
     for (const recovery::RetraceRecord& x : records) {
@@ -508,7 +530,7 @@ void add_run_command(CLI::App& app, Registry& registry) {
   cmd->add_option("--inject", opts->inject,
                   "Fault injection in virtual time (repeatable): mains-off@SECONDS (the mains fail then; the "
                   "report gains power_fail), tool-dull@SECONDS=FACTOR (the broach's cutter wears: its force "
-                  "grows by FACTOR, 1 = sharp)")
+                  "grows by FACTOR, 1 = sharp), edm-short@SECONDS (a short in the simulated EDM gap)")
       ->expected(1)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   cmd->add_option(

@@ -57,6 +57,8 @@ class Driver {
   virtual void cut_mains() = 0;
   /// The simulated broach's cutter wears to `factor` (virtual time only, as cut_mains).
   virtual void set_tool_dull(double factor) = 0;
+  /// A short in the simulated EDM gap (virtual time only, as cut_mains).
+  virtual void inject_edm_short() {}
 };
 
 class VirtualDriver final : public Driver {
@@ -71,6 +73,7 @@ class VirtualDriver final : public Driver {
   }
   void cut_mains() override { rig_.machine().set_mains_ok(false); }
   void set_tool_dull(double factor) override { rig_.machine().set_tool_dull(factor); }
+  void inject_edm_short() override { rig_.machine().inject_edm_short(); }
 
  private:
   control::SimRig rig_;
@@ -349,7 +352,7 @@ void follow(Driver& d, control::EventCursor& cursor, const SessionOptions& o, co
   std::uint32_t job = 0;
   std::uint64_t asked_tick = ~std::uint64_t{0};  // the wait already answered (by its start tick)
   std::uint64_t n = 0;
-  bool mains_cut = false, dulled = false;
+  bool mains_cut = false, dulled = false, edm_shorted = false;
   bool guard_abort = false, load_hold = false, load_abort = false;
   for (;;) {
     d.advance();
@@ -375,6 +378,10 @@ void follow(Driver& d, control::EventCursor& cursor, const SessionOptions& o, co
     if (o.tool_dull_s >= 0 && !dulled && st.servo.time_s >= o.tool_dull_s) {
       d.set_tool_dull(o.tool_dull_factor);
       dulled = true;
+    }
+    if (o.edm_short_s >= 0 && !edm_shorted && st.servo.time_s >= o.edm_short_s) {
+      d.inject_edm_short();
+      edm_shorted = true;
     }
     if (hooks.progress && (++n % 256 == 0)) hooks.progress(st, wall);
     bring_hand_axis(d, st.servo);

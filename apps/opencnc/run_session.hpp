@@ -34,6 +34,8 @@ struct SessionOptions {
   /// Virtual time: the broach's cutter wears to `tool_dull_factor` at this servo time (s); negative: never.
   double tool_dull_s = -1;
   double tool_dull_factor = 1;
+  /// Virtual time: a short in the simulated EDM gap at this servo time (s); negative: never.
+  double edm_short_s = -1;
 };
 
 /// What a session ended with.

@@ -366,6 +366,14 @@ void ProgramBuilder::set_axis_coupling(const AxisCoupling& c) {
   a.pose = program_.add_action_pose(rate);
   add(a);
 }
+// Passed as programmed: the module's words have their own units (a condition number, …).
+void ProgramBuilder::process_code(const ProcessCode& c) {
+  Action a = make(ActionKind::ProcessCode, c.code, 0, c.p);
+  Pose q{};
+  q[0] = c.q;
+  a.pose = program_.add_action_pose(q);
+  add(a);
+}
 void ProgramBuilder::set_aux_output_value(int index, double value) {
   add(make(ActionKind::AuxOutputValue, index, 0, value));
 }

@@ -334,6 +334,19 @@ void Rs274Printer::set_axis_coupling(const AxisCoupling& c) {
   end_line();
 }
 
+// Not a call of LinuxCNC's canon either: the code and its words, in its style.
+void Rs274Printer::process_code(const ProcessCode& c) {
+  prefix();
+  buf_.append("PROCESS_CODE(");
+  integer(c.code);
+  buf_.push_back(',');
+  num(c.p, 6);
+  buf_.push_back(',');
+  num(c.q, 6);
+  buf_.push_back(')');
+  end_line();
+}
+
 void Rs274Printer::set_aux_output_value(int index, double value) {
   prefix();
   buf_.append("SET_AUX_OUTPUT_VALUE(");

@@ -58,6 +58,7 @@ machine::SimMachineConfig sim_machine_config(const MachineProfile& profile) {
     c.broach.radial_joint = joint(profile.broaching.radial);
     c.broach.present = c.broach.stroke_joint >= 0 && c.broach.rotary_joint >= 0 && c.broach.radial_joint >= 0;
   }
+  c.edm = profile.edm.sim;
   c.digital_inputs = profile.io.digital_inputs;
   c.digital_outputs = profile.io.digital_outputs;
   c.analog_inputs = profile.io.analog_inputs;

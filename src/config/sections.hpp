@@ -38,6 +38,8 @@ void read_handwheel(Section& top, MachineProfile& profile);
 void read_coupling(Section& top, MachineProfile& profile);
 /// [process.broaching] and its sim, from read_process. Needs the axes, [io] and [coupling].
 void read_broaching(Section& process, MachineProfile& profile);
+/// [edm], its conditions and [edm.sim]. Needs the axes and [process].
+void read_edm(Section& top, MachineProfile& profile);
 
 /// Reports axis limits outside what any machine has (config.implausible), at the key.
 void check_plausible(Section& s, const AxisProfile& a);

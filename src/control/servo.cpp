@@ -27,6 +27,7 @@ Servo::Servo(const ServoConfig& config, ServoChannels& channels, machine::Machin
       interp_(channels.blocks, config.interpolator, Pose{}) {
   config_.joint_count = std::clamp(std::min(config_.joint_count, caps_.joint_count), 0, machine::kMaxJoints);
   comp_ = motion::Compensation(config_.compensation);
+  configure_gap_servo();
   stepper_slot_.fill(-1);
   for (int j = 0; j < config_.joint_count; ++j) {
     const JointConfig& jc = config_.joints[static_cast<std::size_t>(j)];
@@ -45,6 +46,7 @@ bool Servo::tick() noexcept {
   guard_load();         // the process load: feed hold, or stop and retract (servo_load_guard.cpp)
   handle_commands();    // operator and controller commands: the explicit state transitions
   run_active_mode();    // homing / jog / handwheel (movers) or MDI / auto (interpolator, handshakes)
+  run_gap_servo();      // EDM: along the path by the gap voltage, jump, orbit (servo_gap.cpp)
   couple_axes();        // axes → joints, a coupled slave by its law (servo_coupling.cpp)
   compensate();         // pitch error and backlash (motion::Compensation)
   check_soft_limits();  // every commanded joint within its soft limits
@@ -309,6 +311,8 @@ void Servo::write_machine_outputs() noexcept {
   write_spindle(on);
   out_.process.flood = on && flood_;
   out_.process.mist = on && mist_;
+  out_.process.generator_on = on && gap_.generator_on();
+  out_.process.generator = gap_.generator();
   if (preparing_ && in_.tool.prepared) {
     preparing_ = false;
     prepared_tool_ = preparing_tool_;
@@ -454,6 +458,7 @@ void Servo::fill_drill_status(ServoStatus& s) const noexcept {
   s.handwheel_axis = handwheel_axis_;
   s.coupling = coupling_;
   s.coupling.error_deg = coupling_error();
+  s.edm = gap_.status();
   s.handwheel_step = handwheel_step_;
   s.load_kn = load_kn_;
   s.load_action = load_action_;
@@ -488,6 +493,7 @@ void Servo::push_trace() noexcept {
   t.power_stop = power_stop_;
   t.coupling_error_deg = coupling_error();
   t.load_kn = load_kn_;
+  t.edm = gap_.status();
   if (!channels_->trace.try_push(t)) ++trace_dropped_;
 }
 

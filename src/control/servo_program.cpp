@@ -73,8 +73,8 @@ void Servo::stop_spindle_and_coolant() noexcept {
 
 traj::TickInput Servo::program_inputs() noexcept {
   traj::TickInput in;
-  in.feed_override = feed_override_;
-  in.rapid_override = rapid_override_;
+  in.feed_override = feed_override_ * gap_.feed_scale();  // the EDM gap servo's forward speed
+  in.rapid_override = gap_.head_waits() ? 0.0 : rapid_override_;  // a rapid waits for the electrode too
   in.feed_hold = hold_;
   in.cycle_start = take(cycle_start_edge_);
   released_ = in.cycle_start;
@@ -166,9 +166,9 @@ void Servo::apply_reports() noexcept {
   const auto& ring = channels_->actions;
   for (int e = 0; e < tick_out_.event_count; ++e) {
     const traj::TickEvent& ev = tick_out_.events[static_cast<std::size_t>(e)];
-    const bool record_stop = ev.kind == traj::MarkerKind::Dwell && ring.available() > 0 &&
-                             ring.front().action == ev.action &&
-                             ring.front().code == ActionCode::AxisCoupling;
+    const bool record_stop =
+        ev.kind == traj::MarkerKind::Dwell && ring.available() > 0 && ring.front().action == ev.action &&
+        (ring.front().code == ActionCode::AxisCoupling || ring.front().code == ActionCode::ProcessCode);
     if (ev.kind != traj::MarkerKind::Report && !record_stop) continue;
     MachineAction a;
     if (take_action(ev.action, a)) apply_action(a);
@@ -261,6 +261,9 @@ void Servo::apply_action(const MachineAction& a) noexcept {
     }
     case ActionCode::AxisCoupling:
       engage_coupling(a);
+      break;
+    case ActionCode::ProcessCode:
+      gap_.apply_code(a.index, a.value);  // the preflight refuses codes the machine lacks
       break;
     case ActionCode::ChangeTool:
     case ActionCode::WaitInput:
@@ -485,6 +488,7 @@ void Servo::end_run(RunEnd why) noexcept {
   emit(e);
   activity_ = Activity::None;
   release_coupling();  // a program's coupling lasts as long as its run
+  gap_.begin_run(commanded_);  // and so does its machining condition (the generator goes off)
   hold_ = aborting_ = cycle_start_edge_ = abort_edge_ = sync_done_edge_ = false;
   sync_step_ = SyncStep::None;
   wait_ = Wait::None;

@@ -14,6 +14,7 @@
 #include "opencnc/controller/preflight.hpp"
 #include "opencnc/gcode/coupling_codes.hpp"
 #include "opencnc/gcode/dialect.hpp"
+#include "opencnc/gcode/edm_codes.hpp"
 #include "opencnc/gcode/standard_extensions.hpp"
 #include "replay_filter.hpp"
 
@@ -598,6 +599,18 @@ Preflight preflight_pass(const gcode::Options& o, const std::string& path, const
   return out;
 }
 
+/// The machine's code modules with the EDM codes added, M180's P checked against its conditions.
+std::function<std::shared_ptr<const gcode::Extensions>(gcode::Dialect)> with_edm_codes(
+    const machine::EdmConfig& edm,
+    std::function<std::shared_ptr<const gcode::Extensions>(gcode::Dialect)> base) {
+  std::vector<int> numbers;
+  for (int i = 0; i < edm.condition_count; ++i)
+    numbers.push_back(edm.conditions[static_cast<std::size_t>(i)].number);
+  return [numbers, base](gcode::Dialect d) {
+    return gcode::edm_extensions(d, numbers, base ? base(d) : nullptr);
+  };
+}
+
 }  // namespace
 
 // --- the source ------------------------------------------------------------------------------
@@ -630,6 +643,7 @@ std::optional<GcodeSourceConfig> GcodeProgramSource::config_for(const config::Ma
   c.hand = hand_axes(profile);
   c.coupling = coupled_axes(profile);
   if (c.coupling.any()) c.extensions = gcode::coupling_extensions;
+  if (profile.edm.present) c.extensions = with_edm_codes(profile.edm.config, c.extensions);
   return c;
 }
 

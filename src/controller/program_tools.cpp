@@ -160,6 +160,10 @@ std::optional<MachineAction> machine_action(const canon::Program& program, std::
       m.code = ActionCode::AxisCoupling;
       m.value2 = program.action_pose(a.pose)[0];
       break;
+    case ActionKind::ProcessCode:
+      m.code = ActionCode::ProcessCode;
+      m.value2 = program.action_pose(a.pose)[0];
+      break;
     case ActionKind::ProbeOn:
     case ActionKind::ProbeOff:
       m.code = ActionCode::Ignore;

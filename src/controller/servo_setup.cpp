@@ -131,6 +131,7 @@ ServoConfig servo_config(const config::MachineProfile& profile) {
   s.spindle_max_rpm = profile.spindle.present ? profile.spindle.max_rpm : 0.0;
   s.coupling = coupling_config(profile.coupling);
   s.load_guard = load_guard_config(profile);
+  s.edm = profile.edm.config;
   return s;
 }
 

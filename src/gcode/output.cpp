@@ -449,6 +449,9 @@ void Output::set_motion_output_value(int index, double value) {
 void Output::set_axis_coupling(const canon::AxisCoupling& coupling) {
   if (auto* s = live()) s->set_axis_coupling(coupling);
 }
+void Output::process_code(const canon::ProcessCode& code) {
+  if (auto* s = live()) s->process_code(code);
+}
 void Output::set_aux_output_value(int index, double value) {
   if (auto* s = live()) s->set_aux_output_value(index, value);
 }

@@ -102,6 +102,7 @@ class Output final : public canon::Sink {
   void set_motion_output_value(int index, double value) override;
   void set_aux_output_value(int index, double value) override;
   void set_axis_coupling(const canon::AxisCoupling& coupling) override;
+  void process_code(const canon::ProcessCode& code) override;
   void wait_for_input(int index, bool digital, int mode, double timeout_s) override;
   void turn_probe_on() override;
   void turn_probe_off() override;

@@ -45,6 +45,7 @@ SimMachine::SimMachine(const SimMachineConfig& config) : config_(config), rng_(c
   }
   if (config.broach.present) broach_ = SimBroachLoad(config.broach, config.seed);
   temperature_c_ = config.temperature_c;
+  if (config.edm.present) edm_.configure(config.edm, config.servo_period_s);
   dc_link_v_ = config.power.dc_link_nominal_v;
   ups_periods_left_ =
       config.power.ups
@@ -151,6 +152,7 @@ void SimMachine::advance(const MachineOutputs& out) noexcept {
   update_power(out);
   update_auxiliaries();
   update_broach();
+  if (config_.edm.present) step_edm();
 }
 
 // The cutter's position from the joints' tables: where the chip is cut, not where the encoders say.
@@ -161,6 +163,21 @@ void SimMachine::update_broach() noexcept {
   broach_.update(stroke.table_position(), stroke.velocity(),
                  joints_[static_cast<std::size_t>(b.rotary_joint)].table_position(),
                  joints_[static_cast<std::size_t>(b.radial_joint)].table_position());
+}
+
+// The spark gap sees the electrode where the feed joint's table is, the work turned by the
+// orientation joints (B, C), and the generator's outputs of this period.
+void SimMachine::step_edm() noexcept {
+  const SimEdmConfig& e = config_.edm;
+  double orientation[2] = {0, 0};
+  for (int i = 0; i < 2; ++i) {
+    const int j = e.orientation_joints[i];
+    if (j >= 0 && j < config_.joint_count)
+      orientation[i] = joints_[static_cast<std::size_t>(j)].table_position();
+  }
+  const double electrode = joints_[static_cast<std::size_t>(e.joint)].table_position();
+  edm_.step(electrode, orientation, config_.process.generator && process_.generator_on, process_.generator,
+            rng_);
 }
 
 // Mains on: the rectifier holds the DC link at nominal. Mains off with a charged UPS: the
@@ -230,6 +247,7 @@ void SimMachine::sample() noexcept {
   }
   inputs_.process.arc_ok = arc_periods_ >= arc_needed_;
   inputs_.process.gap_voltage_v = config_.process.generator && process_.generator_on ? gap_voltage_v_ : 0.0;
+  if (config_.edm.present) edm_.sample(inputs_.process);
   inputs_.tool.prepared = prepare_periods_ >= prepare_needed_;
   inputs_.tool.changed = change_periods_ >= change_needed_;
   std::uint64_t switched = 0;  // inputs wired to switches on the machine

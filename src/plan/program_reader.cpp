@@ -42,6 +42,7 @@ MarkerKind marker_for(ActionKind k) {
     case ActionKind::Dwell:
       return MarkerKind::Dwell;
     case ActionKind::AxisCoupling:
+    case ActionKind::ProcessCode:
       return MarkerKind::Dwell;  // an exact stop of no time: the law engages where the path stands
     case ActionKind::ProgramStop:
       return MarkerKind::ProgramStop;
@@ -186,7 +187,8 @@ void ProgramReader::add_marker(std::size_t index, MarkerKind kind) {
   m.segment = m.segment_first = m.segment_last = a.before_move;
   m.line = a.line;
   m.context = a.context;
-  m.value = a.kind == ActionKind::AxisCoupling ? 0.0 : a.value;  // its stop takes no time
+  const bool record = a.kind == ActionKind::AxisCoupling || a.kind == ActionKind::ProcessCode;
+  m.value = record ? 0.0 : a.value;  // its stop takes no time
   m.flags = flags();
   if (kind == MarkerKind::ProgramEnd) ended_ = true;
 }

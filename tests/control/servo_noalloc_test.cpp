@@ -12,6 +12,7 @@
 #include <functional>
 #include <new>
 #include <string>
+#include <vector>
 
 #include <unistd.h>
 
@@ -195,6 +196,47 @@ TEST(ServoAllocations, NoneInsideTheLoadGuard) {
         return held && s.load_action == LoadAction::Lifted;
       },
       20000));
+  EXPECT_EQ(g_allocations.load(), 0);
+  std::filesystem::remove_all(dir);
+}
+
+// The sinker EDM's tick: the gap servo forward and back along the path (an injected short), jumps
+// along the tool axis and along the path, circle and square orbits growing, a feed hold, M181.
+TEST(ServoAllocations, NoneInsideTheEdmTick) {
+  const auto dir = std::filesystem::temp_directory_path() / "opencnc-noalloc-edm";
+  std::filesystem::create_directories(dir);
+  const std::string program = (dir / "edm.ngc").string();
+  std::ofstream(program) << "G21 G90\nT1 M6\nG0 B-30 X-0.8\nG0 Z-19.97\nM180 P1\nG1 Z-20.06 C0.1 F60\n"
+                            "M180 P2\nG1 Z-20.07 F30\nM180 P3\nG1 Z-20.075 F20\nM181\nG0 Z0 B0 X0\nM2\n";
+  g_allocations = 0;
+  const std::vector<std::string> sets = {"edm.sim.electrode_area_mm2=5"};
+  Armed a(loaded(config::load_profile(OPENCNC_SOURCE_DIR "/configs/edm-5axis.toml", sets)));
+  a.ask(Request::simple(CommandKind::MachineOn));
+  a.ask(Request::set_mode(Mode::Auto));
+  a.ask(Request::open(program));
+  a.ask(Request::simple(CommandKind::CycleStart));
+  int n = 0;
+  bool shorted = false, jumped = false, orbited = false, backed = false;
+  ASSERT_TRUE(a.until(
+      [&] {
+        const EdmStatus& e = a.rig().status().servo.edm;
+        jumped = jumped || e.jumping;
+        orbited = orbited || e.orbit_radius_mm > 0;
+        backed = backed || e.backlog_mm > 0.01;
+        if (!shorted && e.generator && e.gap_state == machine::GapState::Normal && ++n > 100) {
+          a.rig().machine().inject_edm_short();
+          shorted = true;
+        }
+        if (n == 400) a.ask(Request::simple(CommandKind::FeedHold));
+        if (n == 450) a.ask(Request::simple(CommandKind::Resume));
+        if (shorted) ++n;
+        return a.state() == State::Idle && !a.rig().status().run_active;
+      },
+      400000));
+  EXPECT_TRUE(shorted);
+  EXPECT_TRUE(jumped);
+  EXPECT_TRUE(orbited);
+  EXPECT_TRUE(backed);
   EXPECT_EQ(g_allocations.load(), 0);
   std::filesystem::remove_all(dir);
 }

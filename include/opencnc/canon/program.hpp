@@ -62,13 +62,17 @@ struct FeedValue {
 };
 
 enum class ActionKind : std::uint8_t {
-  Dwell,               ///< value = seconds
-  SpindleSpeed,        ///< index = spindle, value = rpm; under G96 (index2 = 1) the surface
-                       ///< speed in mm/min, its pose the X of the spindle axis (mm, machine)
-  SpindleCw, SpindleCcw, SpindleStop,   ///< index = spindle
-  SpindleMode,         ///< value = css max rpm, 0 = G97
-  SpindleOrient,       ///< value = degrees, index2 = direction
-  SelectTool, ChangeTool, ChangeToolNumber,  ///< index = tool
+  Dwell,         ///< value = seconds
+  SpindleSpeed,  ///< index = spindle, value = rpm; under G96 (index2 = 1) the surface
+                 ///< speed in mm/min, its pose the X of the spindle axis (mm, machine)
+  SpindleCw,
+  SpindleCcw,
+  SpindleStop,    ///< index = spindle
+  SpindleMode,    ///< value = css max rpm, 0 = G97
+  SpindleOrient,  ///< value = degrees, index2 = direction
+  SelectTool,
+  ChangeTool,
+  ChangeToolNumber,    ///< index = tool
   ToolLengthOffset,    ///< pose = offset (mm)
   WorkOffset,          ///< index = 1..9, pose = G5x offset (mm)
   G92Offset,           ///< pose = G92/G52 offset (mm)
@@ -77,19 +81,31 @@ enum class ActionKind : std::uint8_t {
   NaiveCamTolerance,   ///< value = mm
   SpeedFeedSyncStart,  ///< value = mm per revolution, index2 = velocity mode
   SpeedFeedSyncStop,
-  MistOn, MistOff, FloodOn, FloodOff,
-  FeedOverrideEnable, FeedOverrideDisable,
-  SpeedOverrideEnable, SpeedOverrideDisable,   ///< index = spindle
-  AdaptiveFeedEnable, AdaptiveFeedDisable,
-  FeedHoldEnable, FeedHoldDisable,
-  MotionOutputBit,     ///< index = output, index2 = 1 set / 0 clear (synchronised with motion)
-  AuxOutputBit,        ///< index = output, index2 = 1 set / 0 clear (immediate)
-  MotionOutputValue, AuxOutputValue,  ///< index = output, value
-  WaitInput,           ///< index = input, index2 = mode (L), value = timeout s; text = "digital"/"analog"
-  ProbeOn, ProbeOff,
-  Message,             ///< text
-  Comment,             ///< text
-  ProgramStop, OptionalStop, PalletShuttle, ProgramEnd,
+  MistOn,
+  MistOff,
+  FloodOn,
+  FloodOff,
+  FeedOverrideEnable,
+  FeedOverrideDisable,
+  SpeedOverrideEnable,
+  SpeedOverrideDisable,  ///< index = spindle
+  AdaptiveFeedEnable,
+  AdaptiveFeedDisable,
+  FeedHoldEnable,
+  FeedHoldDisable,
+  MotionOutputBit,  ///< index = output, index2 = 1 set / 0 clear (synchronised with motion)
+  AuxOutputBit,     ///< index = output, index2 = 1 set / 0 clear (immediate)
+  MotionOutputValue,
+  AuxOutputValue,  ///< index = output, value
+  WaitInput,       ///< index = input, index2 = mode (L), value = timeout s; text = "digital"/"analog"
+  ProbeOn,
+  ProbeOff,
+  Message,  ///< text
+  Comment,  ///< text
+  ProgramStop,
+  OptionalStop,
+  PalletShuttle,
+  ProgramEnd,
   /// Not from the interpreter: the controller's hand-axis pass (control::HandAxisFilter) puts
   /// it where a move of a hand-fed axis was. index = axis, value = machine position, index2 = +1:
   /// a retract (the move went in +), 0: a plunge.
@@ -97,6 +113,9 @@ enum class ActionKind : std::uint8_t {
   /// The broaching codes' coupling (canon::AxisCoupling): index = law (0 off), index2 = table,
   /// value = pitch (mm), action pose [0] = pitch rate. The motion stops exactly there.
   AxisCoupling,
+  /// A machine module's process code (canon::ProcessCode): index = code, value = P, action pose
+  /// [0] = Q. The motion stops exactly there.
+  ProcessCode,
 };
 
 /// A non-motion action executed before move `before_move` (== move count: after the last).

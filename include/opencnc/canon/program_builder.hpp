@@ -101,6 +101,7 @@ class ProgramBuilder final : public Sink {
   void set_motion_output_value(int index, double value) override;
   void set_aux_output_value(int index, double value) override;
   void set_axis_coupling(const AxisCoupling& coupling) override;
+  void process_code(const ProcessCode& code) override;
   void wait_for_input(int index, bool digital, int mode, double timeout_s) override;
 
   void turn_probe_on() override { simple(ActionKind::ProbeOn); }

@@ -88,6 +88,7 @@ class Rs274Printer final : public Sink {
   void set_motion_output_value(int index, double value) override;
   void set_aux_output_value(int index, double value) override;
   void set_axis_coupling(const AxisCoupling& coupling) override;
+  void process_code(const ProcessCode& code) override;
 
   void turn_probe_on() override { simple("TURN_PROBE_ON()"); }
   void turn_probe_off() override { simple("TURN_PROBE_OFF()"); }

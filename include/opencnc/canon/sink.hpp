@@ -98,6 +98,8 @@ class Sink {
   virtual void set_aux_output_value(int /*index*/, double /*value*/) {}
   /// Couples the machine's slave axis to its master by a law, or uncouples it (law 0).
   virtual void set_axis_coupling(const AxisCoupling& /*coupling*/) {}
+  /// A machine module's process code (EDM condition, generator off), passed to the machine.
+  virtual void process_code(const ProcessCode& /*code*/) {}
   /// M66: wait for input `index` (digital if `digital`), `mode` = L word, up to `timeout_s`.
   virtual void wait_for_input(int /*index*/, bool /*digital*/, int /*mode*/, double /*timeout_s*/) {}
 

@@ -215,6 +215,10 @@ class TeeSink final : public Sink {
     a_.set_axis_coupling(c);
     b_.set_axis_coupling(c);
   }
+  void process_code(const ProcessCode& c) override {
+    a_.process_code(c);
+    b_.process_code(c);
+  }
   void set_aux_output_value(int index, double value) override {
     a_.set_aux_output_value(index, value);
     b_.set_aux_output_value(index, value);

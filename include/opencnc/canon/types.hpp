@@ -66,6 +66,15 @@ struct AxisCoupling {
   bool operator==(const AxisCoupling&) const = default;
 };
 
+/// A machine module's own M code (a process code: EDM conditions, docs/edm.md) passed to the
+/// machine as it was programmed. The words are the module's business: passed unconverted.
+struct ProcessCode {
+  int code = 0;  ///< the M number (M100-M199)
+  double p = 0;  ///< P word (0 when absent)
+  double q = 0;  ///< Q word (0 when absent)
+  bool operator==(const ProcessCode&) const = default;
+};
+
 /// A NURBS control point in the XY plane with its weight.
 struct NurbsPoint {
   double x = 0, y = 0, weight = 1;

@@ -193,6 +193,14 @@ struct BroachingProfile {
   machine::SimBroachConfig sim;  ///< the load model (sim.present: [process.broaching.sim] exists)
 };
 
+/// `[edm]`: a sinker EDM's machining conditions and gap servo (the tick's copy, plain data) and
+/// its simulated spark gap `[edm.sim]` (docs/edm.md).
+struct EdmProfile {
+  bool present = false;
+  machine::EdmConfig config;
+  machine::SimEdmConfig sim;
+};
+
 /// `[tool_guard]`: the tool store and the check of its live table against the backup.
 struct ToolGuardProfile {
   bool present = false;
@@ -230,6 +238,7 @@ struct MachineProfile {
   HandwheelProfile handwheel;
   CouplingProfile coupling;
   BroachingProfile broaching;
+  EdmProfile edm;
   /// Digital inputs the simulated machine drives from switches (named inputs with a `sim`).
   std::vector<machine::SimInputSwitch> sim_input_switches;
   double sim_temperature_c = 20;  ///< machine temperature in the simulation

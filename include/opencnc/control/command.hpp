@@ -167,7 +167,7 @@ enum class ActionCode : std::uint8_t {
   WaitInput,      ///< index = channel, index2 = mode (L0–L4), value = timeout s, digital = flag
   SpindleOrient,  ///< value = degrees
   PalletShuttle,
-  Message,  ///< the controller shows the text (action index)
+  Message,       ///< the controller shows the text (action index)
   Ignore,        ///< nothing for the machine (probe on/off)
   SpindleMode,   ///< G96: value = highest rpm (D); 0 = G97, the speed is in rpm again
   SurfaceSpeed,  ///< G96 S: value = surface speed (mm/min), value2 = X of the spindle axis (mm)
@@ -177,6 +177,9 @@ enum class ActionCode : std::uint8_t {
   /// Couple the profile's slave axis to its master (coupling stage): index = motion::CouplingKind
   /// (0 = uncouple), index2 = table number (1-based), value = pitch (mm), value2 = pitch rate.
   AxisCoupling,
+  /// A machine module's process code (canon::ProcessCode): index = M number, value = P, value2 = Q
+  /// (the EDM codes M180/M181: servo_gap.cpp).
+  ProcessCode,
 };
 
 /// The machine side of marker `action` (Program::actions() index) of the current run. The

@@ -8,6 +8,7 @@
 
 #include "opencnc/control/axis_mover.hpp"
 #include "opencnc/control/channels.hpp"
+#include "opencnc/control/gap_servo.hpp"
 #include "opencnc/control/homing.hpp"
 #include "opencnc/control/servo_config.hpp"
 #include "opencnc/control/tickable.hpp"
@@ -127,6 +128,10 @@ class Servo final : public Tickable {
   double coupling_master() const noexcept;
   double coupling_error() const noexcept;
 
+  // --- EDM gap servo, jump and orbit (servo_gap.cpp) ------------------------------------------
+  void configure_gap_servo() noexcept;
+  void run_gap_servo() noexcept;
+
   // --- Auto and MDI runs (servo_program.cpp) ------------------------------------------------
   void run_program() noexcept;
   traj::TickInput program_inputs() noexcept;
@@ -202,6 +207,9 @@ class Servo final : public Tickable {
   LoadRetract load_retract_ = LoadRetract::None;
   LoadAction load_action_ = LoadAction::None;
   std::uint32_t load_run_id_ = 0;
+  // Sinker EDM: the gap servo stage and the block it last saw at the interpolator's head.
+  GapServo gap_;
+  std::uint64_t gap_block_ = traj::kNoBlock;
 
   // Manual mode.
   std::array<AxisMover, machine::kMaxJoints> movers_{};

@@ -8,6 +8,7 @@
 #include <type_traits>
 
 #include "opencnc/control/load_guard.hpp"
+#include "opencnc/machine/edm.hpp"
 #include "opencnc/machine/interlocks.hpp"
 #include "opencnc/machine/machine_io.hpp"
 #include "opencnc/motion/compensation.hpp"
@@ -80,6 +81,8 @@ struct ServoConfig {
   motion::CouplingConfig coupling;
   /// The process load's thresholds (the load guard stage, after the interlocks).
   LoadGuardConfig load_guard;
+  /// Sinker EDM: the machining conditions and the gap servo (the gap servo stage).
+  machine::EdmConfig edm;
   /// The PLC's interlock rules (evaluated every period after safety).
   machine::InterlockRules interlocks;
   /// Units per count the operator may select for the handwheel (none: any positive step).

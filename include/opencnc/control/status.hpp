@@ -8,6 +8,7 @@
 #include <type_traits>
 
 #include "opencnc/control/command.hpp"
+#include "opencnc/control/edm_status.hpp"
 #include "opencnc/control/homing.hpp"
 #include "opencnc/control/load_guard.hpp"
 #include "opencnc/core/axes.hpp"
@@ -133,6 +134,7 @@ struct ServoStatus {
   // The load guard (broaching): the process load and what the guard did last in this run.
   double load_kn = 0;  ///< the load input now (0 without a load guard)
   LoadAction load_action = LoadAction::None;
+  EdmStatus edm{};                    ///< the EDM gap servo, jump and orbit
 };
 
 /// One servo period, for traces and run reports (docs/controller.md, "Trace CSV").
@@ -156,6 +158,7 @@ struct TraceSample {
   bool power_stop = false;       ///< a power-fail stop is under way (from the period after the signal)
   double coupling_error_deg = 0;  ///< actual slave − law(actual master), degrees (0 uncoupled)
   double load_kn = 0;             ///< the process load input (load guard), kN
+  EdmStatus edm{};                ///< the EDM gap servo (machines with [edm])
 };
 
 static_assert(std::is_trivially_copyable_v<ServoStatus>);

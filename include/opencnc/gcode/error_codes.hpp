@@ -243,6 +243,8 @@ namespace opencnc::gcode {
   /* axis coupling (broaching codes M171-M175) */                       \
   X(CouplingWord, "coupling.word")                                      \
   X(CouplingCutterComp, "coupling.cutter-comp")                         \
+  /* sinker EDM (M180, M181) */                                         \
+  X(EdmCondition, "edm.condition")                                      \
   /* runaway protection */                                              \
   X(LimitCallDepth, "gcode.limit-call-depth")                           \
   X(LimitBlocks, "gcode.limit-blocks")                                  \

@@ -55,12 +55,22 @@ struct SpindleOutputs {
   double orient_angle_deg = 0;
 };
 
+/// EDM: the pulse generator's settings (the active machining condition, docs/edm.md).
+struct GeneratorOutputs {
+  double on_time_us = 0;      ///< pulse on-time
+  double off_time_us = 0;     ///< pause between pulses
+  double peak_current_a = 0;  ///< discharge current
+  double voltage_v = 0;       ///< open-circuit voltage
+  std::int8_t polarity = 1;   ///< +1: electrode positive
+};
+
 /// Process outputs: coolant, and the process-specific ones of the machine types we run.
 struct ProcessOutputs {
   bool flood = false;         ///< M8
   bool mist = false;          ///< M7
   bool torch_on = false;      ///< flame/plasma cutter: ignite and hold the torch
   bool generator_on = false;  ///< EDM: pulse generator on
+  GeneratorOutputs generator{};  ///< EDM: its settings while on
 };
 
 /// Tool changer handshake (both sides level-triggered: a request stays up until acknowledged
@@ -129,9 +139,18 @@ struct PowerInputs {
   double dc_link_v = 0;         ///< drives' DC bus voltage, V
 };
 
+/// EDM: what the generator's pulse discriminator saw in the last period.
+enum class GapState : std::uint8_t {
+  Open,    ///< no discharge: the gap is too wide (voltage at the open-circuit value)
+  Normal,  ///< discharges after an ignition delay
+  Arc,     ///< discharges without ignition delay at one spot (debris): damaging
+  Short,   ///< electrode and work touch (or debris bridges them): no voltage
+};
+
 struct ProcessInputs {
   bool arc_ok = false;       ///< torch arc/flame established (optional)
-  double gap_voltage_v = 0;  ///< EDM gap voltage, V (optional)
+  double gap_voltage_v = 0;  ///< EDM mean gap voltage over the period, V (optional: generator)
+  GapState gap_state = GapState::Open;  ///< EDM discharge state (optional: generator)
 };
 
 struct ToolChangerInputs {

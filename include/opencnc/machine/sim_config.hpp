@@ -7,6 +7,7 @@
 #include <limits>
 #include <vector>
 
+#include "opencnc/machine/edm.hpp"
 #include "opencnc/machine/machine_io.hpp"
 
 namespace opencnc::machine {
@@ -199,6 +200,7 @@ struct SimMachineConfig {
   SimToolChangerConfig tool_changer;
   SimProcessConfig process;
   SimBroachConfig broach;  ///< a broaching load cell and the bore it measures (present: false)
+  SimEdmConfig edm;  ///< the simulated spark gap (present: an EDM machine)
   int digital_inputs = 0, digital_outputs = 0;
   int analog_inputs = 0, analog_outputs = 0;
   std::array<SimInputSwitch, kMaxSimInputSwitches> input_switches{};

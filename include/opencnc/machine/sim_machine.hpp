@@ -8,6 +8,7 @@
 #include "opencnc/machine/machine_io.hpp"
 #include "opencnc/machine/sim_broach_load.hpp"
 #include "opencnc/machine/sim_config.hpp"
+#include "opencnc/machine/sim_edm_process.hpp"
 #include "opencnc/machine/sim_joint.hpp"
 #include "opencnc/machine/sim_spindle.hpp"
 #include "opencnc/machine/sim_switch.hpp"
@@ -42,8 +43,12 @@ class SimMachine final : public MachineIO {
   void set_analog_input(int channel, double value) noexcept;
   /// Whether the torch can light (false: gas out, no arc; arc_ok never comes).
   void set_arc_available(bool available) noexcept { arc_available_ = available; }
-  /// EDM gap voltage reported while the generator is on.
+  /// EDM gap voltage reported while the generator is on (a machine without a simulated gap).
   void set_gap_voltage(double volts) noexcept { gap_voltage_v_ = volts; }
+  /// EDM: a short (debris bridge) in the simulated gap until the electrode backs off from it.
+  void inject_edm_short() noexcept { edm_.inject_short(); }
+  /// EDM: a fresh workpiece (every front back at the surface), as when the next disc is clamped.
+  void new_edm_workpiece() noexcept { edm_.configure(config_.edm, config_.servo_period_s); }
   /// Machine temperature, °C (proximity sensors drift with it).
   void set_temperature(double celsius) noexcept { temperature_c_ = celsius; }
   /// The broach's cutter wears: its force grows by `factor` (1 = sharp); ignored without a broach.
@@ -58,6 +63,7 @@ class SimMachine final : public MachineIO {
   double time_s() const noexcept { return static_cast<double>(inputs_.cycle) * config_.servo_period_s; }
   const SimJoint& joint(int j) const noexcept { return joints_[static_cast<std::size_t>(j)]; }
   const SimSpindle& spindle() const noexcept { return spindle_; }
+  const SimEdmProcess& edm() const noexcept { return edm_; }
   /// True while the drives have power: e-stop chain closed, released, DC link above minimum.
   bool drives_powered() const noexcept;
   double ups_remaining_s() const noexcept {
@@ -72,11 +78,13 @@ class SimMachine final : public MachineIO {
   void update_power(const MachineOutputs& out) noexcept;
   void update_auxiliaries() noexcept;
   void update_broach() noexcept;
+  void step_edm() noexcept;
   void sample() noexcept;
 
   SimMachineConfig config_;
   std::array<SimJoint, kMaxJoints> joints_{};
   SimSpindle spindle_;
+  SimEdmProcess edm_;
   SimSwitch probe_;
   std::array<SimSwitch, kMaxSimInputSwitches> input_switches_{};
   double probe_table_ = 0;  ///< the probe joint's table position at the last sample

@@ -1,0 +1,31 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The `edm` part of `opencnc run`'s report.
+#include "edm_report.hpp"
+
+#include <fmt/format.h>
+
+namespace opencnc::cli {
+
+nlohmann::json edm_json(const control::EdmReport& e) {
+  nlohmann::json j;
+  j["gap_voltage_in_band_fraction"] = e.gap_voltage_in_band_fraction;
+  j["machining_s"] = e.machining_s;
+  j["shorts"] = e.shorts;
+  j["arcs"] = e.arcs;
+  j["arc_periods"] = e.arc_periods;
+  j["short_recovery_max_s"] = e.short_recovery_max_s;
+  j["depth_mm"] = e.depth_mm;
+  j["jumps"] = e.jumps;
+  return j;
+}
+
+void print_edm(const control::EdmReport& e) {
+  fmt::print(
+      "edm                 {:.1f} s machining, gap voltage in band {:.1f} %, {} jumps, deepest burn "
+      "{:.4f} mm\n",
+      e.machining_s, 100 * e.gap_voltage_in_band_fraction, e.jumps, e.depth_mm);
+  fmt::print("edm gap             {} shorts (longest {:.3f} s to a discharge again), {} arcs ({} periods)\n",
+             e.shorts, e.short_recovery_max_s, e.arcs, e.arc_periods);
+}
+
+}  // namespace opencnc::cli

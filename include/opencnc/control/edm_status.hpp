@@ -1,0 +1,32 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// EdmStatus — the EDM gap servo's state in the status snapshot and every trace sample (docs/edm.md).
+#pragma once
+
+#include <cstdint>
+#include <type_traits>
+
+#include "opencnc/machine/machine_io.hpp"
+
+namespace opencnc::control {
+
+/// The gap servo's state, for status and trace. Plain data.
+struct EdmStatus {
+  bool on = false;         ///< a condition is selected and the generator programmed on
+  bool generator = false;  ///< the generator's pulses are on now (off while lifted or held)
+  int condition = 0;       ///< the active condition's number (0: none)
+  machine::GapState gap_state = machine::GapState::Open;
+  double gap_voltage_v = 0;         ///< as measured this period
+  double filtered_voltage_v = 0;    ///< after the servo's low-pass filter
+  double path_speed_mm_s = 0;       ///< signed speed along the path (− = backing off)
+  double backlog_mm = 0;            ///< how far behind the interpolator's head the electrode stands
+  bool retract_limit = false;       ///< backing off reached the end of the path memory
+  bool jumping = false;             ///< a jump is lifting or returning
+  double jump_lift_mm = 0;          ///< how far the jump has lifted the electrode
+  std::uint32_t jumps = 0;          ///< jumps begun since the machine started
+  double orbit_radius_mm = 0;       ///< the orbit's radius now
+  double orbit_offset[2] = {0, 0};  ///< the orbit's offset in its plane
+};
+
+static_assert(std::is_trivially_copyable_v<EdmStatus>);
+
+}  // namespace opencnc::control

@@ -1,0 +1,48 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// EdmRecorder — an observer of the trace that measures a sinker EDM's run: the gap voltage's
+// share in band, shorts and their recovery, arcs, jumps, the depth burnt (docs/edm.md).
+#pragma once
+
+#include <cstdint>
+
+#include "opencnc/controller/observer.hpp"
+#include "opencnc/machine/edm.hpp"
+
+namespace opencnc::control {
+
+/// What `opencnc run --report` writes under `edm`.
+struct EdmReport {
+  /// Share of machining time (generator pulsing, from each burn's first discharge on) whose
+  /// measured gap voltage was within ±10 % of the active condition's servo reference.
+  double gap_voltage_in_band_fraction = 0;
+  double machining_s = 0;
+  std::uint64_t shorts = 0;         ///< times the gap went into a short
+  std::uint64_t arc_periods = 0;    ///< servo periods in which the gap arced
+  std::uint64_t arcs = 0;           ///< times the gap went into arcing (from another state)
+  double short_recovery_max_s = 0;  ///< longest short: from its first period to a discharge again
+  double depth_mm = 0;              ///< deepest burn: along the work's direction from its first discharge
+  std::uint64_t jumps = 0;
+};
+
+/// Controller thread (an observer with trace on).
+class EdmRecorder final : public ControllerObserver {
+ public:
+  EdmRecorder(const machine::EdmConfig& edm, double period_s);
+  void on_trace(const TraceSample& s, const TraceContext& c) override;
+  EdmReport report() const;
+
+ private:
+  machine::EdmConfig edm_;
+  double period_s_;
+  EdmReport r_;
+  std::uint64_t in_band_ = 0, machining_ = 0;
+  bool burning_ = false;  ///< a condition is on and the gap has sparked since it came on
+  double burn_start_ = 0;
+  machine::GapState last_ = machine::GapState::Open;
+  std::uint64_t short_since_ = 0;
+  bool shorted_ = false;
+  bool first_ = true;
+  std::uint32_t jumps_at_start_ = 0, jumps_now_ = 0;
+};
+
+}  // namespace opencnc::control

@@ -1,0 +1,106 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The sinker EDM's machining conditions (the generator's tables) and gap servo settings as
+// fixed-size plain data for the tick and the simulated machine (the profile's [edm], docs/edm.md).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <type_traits>
+
+namespace opencnc::machine {
+
+/// Most machining conditions a profile defines; a program selects one by its number 1 … 99.
+inline constexpr int kMaxEdmConditions = 32;
+/// The code that selects a condition and switches the generator on (`M180 P<n>`), and the code
+/// that switches it off (`M181`): LinuxCNC user M codes (M100–M199 take P and Q).
+inline constexpr int kEdmConditionCode = 180;
+inline constexpr int kEdmOffCode = 181;
+
+/// Points of the gap servo's path memory (control::PathMemory): with `path_spacing_mm` between
+/// them, how far back along the path the electrode can go.
+inline constexpr int kEdmPathPoints = 4096;
+
+/// The planar orbit superimposed on the path (around the tool axis).
+enum class OrbitKind : std::uint8_t {
+  None,
+  Circle,  ///< a circle of the radius
+  Square,  ///< a square of half-side the radius, edges parallel to the plane's axes
+  Star,    ///< eight rays from the centre to the radius and back (the vector orbit)
+};
+
+/// Where a jump lifts the electrode.
+enum class JumpMode : std::uint8_t {
+  Axis,  ///< along the tool axis, away from the work
+  Path,  ///< back along the path already machined
+};
+
+/// One machining condition: the generator's settings, the gap servo's, the jump's and the orbit's.
+struct EdmCondition {
+  int number = 0;  ///< 1 … 99; 0 = empty slot
+  // Generator.
+  double on_time_us = 0;      ///< pulse on-time
+  double off_time_us = 0;     ///< pause between pulses
+  double peak_current_a = 0;  ///< discharge current
+  double voltage_v = 0;       ///< open-circuit voltage
+  std::int8_t polarity = 1;   ///< +1: electrode positive, −1: negative
+  // Gap servo.
+  double servo_reference_v = 0;  ///< the mean gap voltage the servo holds
+  double gain_mm_s_per_v = 0;    ///< path speed per volt above (forward) or below (back) the reference
+  double max_forward_mm_s = 0;   ///< forward speed limit (an open gap feeds at this)
+  double max_retract_mm_s = 0;   ///< backward speed limit (a short backs off at this)
+  double filter_s = 0.005;       ///< time constant of the gap voltage's low-pass filter
+  // Jump (period 0: off).
+  double jump_height_mm = 0;   ///< H: how far the electrode lifts
+  double jump_period_s = 0;    ///< T_on: machining time between jumps
+  double jump_speed_mm_s = 0;  ///< speed of the lift and the return
+  JumpMode jump_mode = JumpMode::Axis;
+  // Orbit (kind None: off).
+  OrbitKind orbit = OrbitKind::None;
+  double orbit_radius_mm = 0;  ///< the final size
+  double orbit_step_mm = 0;    ///< the radius grows by this per turn (0: the whole radius at once)
+  double orbit_period_s = 0;   ///< one turn
+};
+
+/// The EDM machine as the tick sees it.
+struct EdmConfig {
+  bool enabled = false;
+  std::int8_t tool_axis = 2;           ///< axis index the electrode lies along (Z)
+  double lift_direction = 1;           ///< +1: away from the work is + along the tool axis
+  std::int8_t orbit_axes[2] = {0, 1};  ///< the orbit's plane (X, Y)
+  double path_spacing_mm = 0.002;      ///< spacing of the path memory's points (backing off)
+  std::array<EdmCondition, kMaxEdmConditions> conditions{};
+  int condition_count = 0;
+
+  /// The condition numbered `number`, or nullptr. Any thread; real-time safe.
+  const EdmCondition* find(int number) const noexcept {
+    for (int i = 0; i < condition_count; ++i)
+      if (conditions[static_cast<std::size_t>(i)].number == number)
+        return &conditions[static_cast<std::size_t>(i)];
+    return nullptr;
+  }
+};
+
+static_assert(std::is_trivially_copyable_v<EdmConfig>);
+
+/// The simulated EDM process (machine/sim_edm_process.hpp): a 1-D model along the tool axis.
+struct SimEdmConfig {
+  bool present = false;
+  std::int8_t joint = 2;               ///< the joint that feeds the electrode (the tool axis)
+  double work_direction = -1;          ///< the work lies this way from the electrode along the joint
+  double surface_mm = 0;               ///< the work's surface, joint coordinates (each orientation's start)
+  double electrode_area_mm2 = 20;      ///< frontal area: removed volume / area = depth
+  double removal_mm3_per_a_us = 5e-8;  ///< volume per discharge per (peak current × on-time)
+  double breakdown_um_per_v = 0.3;     ///< the widest gap that sparks, per volt of open voltage
+  double discharge_voltage_v = 25;     ///< the burning voltage of a discharge (and of an arc)
+  double debris_per_mm3 = 4;           ///< debris concentration added per mm³ removed (0 … 1 scale)
+  double flush_time_s = 1.5;           ///< the dielectric's own flushing: debris decays with it
+  double jump_flush_time_s = 0.02;     ///< … and with this while the electrode is lifted clear
+  double arc_threshold = 0.35;         ///< debris concentration above which discharges turn to arcs
+  double noise_v = 1.5;                ///< standard deviation of the measured mean gap voltage
+  double short_bridge_mm = 0.02;       ///< an injected short holds until the gap opened this much
+  /// Joints whose position tells the work's orientation (B, C: −1 = none): each orientation
+  /// (rounded to whole degrees) has its own surface, so two approaches burn two fronts.
+  std::int8_t orientation_joints[2] = {-1, -1};
+};
+
+}  // namespace opencnc::machine

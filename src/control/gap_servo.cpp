@@ -1,0 +1,358 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// GapServo: the path memory, the gap servo's law, the jump and the orbit (docs/edm.md).
+#include "opencnc/control/gap_servo.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace opencnc::control {
+
+namespace {
+
+constexpr double kTwoPi = 6.283185307179586;
+
+double distance(const Pose& a, const Pose& b) noexcept {
+  double d2 = 0;
+  for (std::size_t i = 0; i < a.v.size(); ++i) d2 += (a.v[i] - b.v[i]) * (a.v[i] - b.v[i]);
+  return std::sqrt(d2);
+}
+
+Pose lerp(const Pose& a, const Pose& b, double f) noexcept {
+  Pose p;
+  for (std::size_t i = 0; i < a.v.size(); ++i) p.v[i] = a.v[i] + f * (b.v[i] - a.v[i]);
+  return p;
+}
+
+double smoothstep(double f) noexcept {
+  return f * f * (3 - 2 * f);
+}
+
+}  // namespace
+
+// --- the path memory --------------------------------------------------------------------------
+
+void PathMemory::reset(const Pose& at) noexcept {
+  first_ = 0;
+  count_ = 1;
+  points_[0] = at;
+  s_[0] = 0;
+  head_ = at;
+  head_s_ = 0;
+}
+
+void PathMemory::advance(const Pose& head, double spacing, bool corner) noexcept {
+  if (count_ == 0) reset(head);
+  const std::size_t last = slot(count_ - 1);
+  const double d = distance(points_[last], head);
+  head_ = head;
+  head_s_ = s_[last] + d;
+  if (d <= 0 || (d < spacing && !corner)) return;
+  if (count_ == kPoints) {  // the oldest point goes: the memory is a ring
+    first_ = (first_ + 1) % kPoints;
+    --count_;
+  }
+  const std::size_t k = slot(count_);
+  points_[k] = head;
+  s_[k] = head_s_;
+  ++count_;
+}
+
+double PathMemory::tail_s() const noexcept {
+  return count_ > 0 ? s_[slot(0)] : 0.0;
+}
+
+// Between the last kept point and the live head the chord to the head; elsewhere the chord
+// between the two kept points around s (at most `spacing` apart or a block's own chord).
+Pose PathMemory::at(double s) const noexcept {
+  if (count_ == 0) return head_;
+  const std::size_t last = slot(count_ - 1);
+  if (s >= head_s_) return head_;
+  if (s >= s_[last]) {
+    const double len = head_s_ - s_[last];
+    return len > 0 ? lerp(points_[last], head_, (s - s_[last]) / len) : head_;
+  }
+  if (s <= s_[slot(0)]) return points_[slot(0)];
+  int lo = 0, hi = count_ - 1;  // s_[lo] ≤ s < s_[hi]
+  while (hi - lo > 1) {
+    const int mid = (lo + hi) / 2;
+    (s_[slot(mid)] <= s ? lo : hi) = mid;
+  }
+  const std::size_t a = slot(lo), b = slot(hi);
+  return lerp(points_[a], points_[b], (s - s_[a]) / (s_[b] - s_[a]));
+}
+
+// --- the orbit's shapes -----------------------------------------------------------------------
+
+// Each shape starts and ends a turn at the same point and has no step of velocity: the square's
+// edges and the star's rays are run with a smooth start and stop (the drives see no corner).
+void orbit_offset(OrbitKind kind, double phase, double r, double out[2]) noexcept {
+  phase -= std::floor(phase);
+  switch (kind) {
+    case OrbitKind::Circle:
+      out[0] = r * std::cos(kTwoPi * phase);
+      out[1] = r * std::sin(kTwoPi * phase);
+      return;
+    case OrbitKind::Square: {
+      static constexpr double kCorner[5][2] = {{1, 0}, {1, 1}, {-1, 1}, {-1, -1}, {1, -1}};
+      // Five legs: half an edge up to the first corner, three edges, then to the start (by length).
+      const double u = phase * 8;  // perimeter in units of r
+      const double ends[6] = {0, 1, 3, 5, 7, 8};
+      int k = 0;
+      while (k < 4 && u >= ends[k + 1]) ++k;
+      const double f = smoothstep((u - ends[k]) / (ends[k + 1] - ends[k]));
+      const double* a = kCorner[k];
+      const double* b = k == 4 ? kCorner[0] : kCorner[k + 1];
+      out[0] = r * (a[0] + f * (b[0] - a[0]));
+      out[1] = r * (a[1] + f * (b[1] - a[1]));
+      return;
+    }
+    case OrbitKind::Star: {
+      const double u = phase * 8;
+      const double k = std::floor(u), f = u - k;
+      const double rho = r * 0.5 * (1 - std::cos(kTwoPi * f));  // out and back, smooth at both ends
+      out[0] = rho * std::cos(k * kTwoPi / 8);
+      out[1] = rho * std::sin(k * kTwoPi / 8);
+      return;
+    }
+    case OrbitKind::None:
+      break;
+  }
+  out[0] = out[1] = 0;
+}
+
+// --- the stage ------------------------------------------------------------------------------
+
+void GapServo::configure(const EdmConfig& config, double period_s, double jump_accel_mm_s2) noexcept {
+  config_ = config;
+  period_s_ = period_s;
+  accel_ = jump_accel_mm_s2 > 0 ? jump_accel_mm_s2 : 1000;
+}
+
+void GapServo::begin_run(const Pose& at) noexcept {
+  memory_.reset(at);
+  s_ = v_ = 0;
+  feed_scale_ = 1;
+  status_.on = status_.generator = false;
+  status_.condition = 0;
+  cond_ = EdmCondition{};
+  jump_ = Jump::Idle;
+  lift_ = lift_v_ = 0;
+  machining_s_ = 0;
+  phase_ = radius_ = 0;
+  turns_ = 0;
+  orbit_[0] = orbit_[1] = 0;
+  shape_ = OrbitKind::None;
+}
+
+bool GapServo::apply_code(int code, double p) noexcept {
+  const EdmCondition* c =
+      code == machine::kEdmConditionCode ? config_.find(static_cast<int>(std::lround(p))) : nullptr;
+  if (c == nullptr) {
+    status_.on = false;
+    status_.condition = 0;
+    return code == machine::kEdmOffCode;
+  }
+  cond_ = *c;
+  status_.on = true;
+  status_.condition = c->number;
+  turns_ = 0;  // the orbit grows again, a step per turn, from where its radius stands
+  return true;
+}
+
+machine::GeneratorOutputs GapServo::generator() const noexcept {
+  machine::GeneratorOutputs g;
+  if (!status_.on) return g;
+  g.on_time_us = cond_.on_time_us;
+  g.off_time_us = cond_.off_time_us;
+  g.peak_current_a = cond_.peak_current_a;
+  g.voltage_v = cond_.voltage_v;
+  g.polarity = cond_.polarity;
+  return g;
+}
+
+// The period: the servo's speed moves the electrode on the memory (or lets the interpolator's
+// head go on), then the jump and the orbit add their offsets. Off (no condition, a rapid, a hold)
+// the generator is off, a jump under way comes back, the orbit shrinks to its centre and an
+// electrode left behind the head walks up to it before the interpolator goes on.
+Pose GapServo::step(const GapInputs& in) noexcept {
+  // An electrode at the head goes with it (the interpolator moved at the speed the servo asked).
+  const bool at_head = s_ >= memory_.head_s() - 1e-12;
+  memory_.advance(in.head, config_.path_spacing_mm, in.new_block);
+  if (at_head) s_ = memory_.head_s();
+  status_.gap_voltage_v = in.gap_voltage_v;
+  status_.gap_state = in.gap_state;
+  const bool machining = config_.enabled && status_.on && !in.rapid && !in.hold;
+  if (!machining) {
+    v_ = 0;
+    run_jump(false);
+    if (in.hold || jump_ != Jump::Idle) {
+      feed_scale_ = 0;
+    } else {
+      catch_up();
+    }
+    return_offsets();
+    status_.generator = false;
+  } else {
+    // A jump that is due waits until the servo has braked to rest (no step of velocity).
+    const bool due = jump_due();
+    if (jump_ == Jump::Idle) move_electrode(servo_speed(in, due), in);
+    run_jump(due && v_ == 0 && in.gap_state != machine::GapState::Short);
+    if (jump_ != Jump::Idle) feed_scale_ = 0;
+    run_orbit();
+    status_.generator = jump_ == Jump::Idle;
+    if (status_.generator) machining_s_ += period_s_;
+  }
+  Pose p = memory_.at(s_);
+  p[config_.tool_axis] += config_.lift_direction * lift_;
+  p[config_.orbit_axes[0]] += orbit_[0];
+  p[config_.orbit_axes[1]] += orbit_[1];
+  status_.path_speed_mm_s = v_;
+  status_.backlog_mm = memory_.head_s() - s_;
+  status_.retract_limit = s_ <= memory_.tail_s() && v_ <= 0 && status_.backlog_mm > 0;
+  status_.jumping = jump_ != Jump::Idle;
+  status_.jump_lift_mm = cond_.jump_mode == JumpMode::Axis || jump_ == Jump::Idle ? lift_ : jump_from_s_ - s_;
+  status_.orbit_radius_mm = radius_;
+  status_.orbit_offset[0] = orbit_[0];
+  status_.orbit_offset[1] = orbit_[1];
+  return p;
+}
+
+// Behind the head with nothing to machine: forward to it at the larger of the last condition's
+// forward limit and 1 mm/s while the interpolator waits; at the head it goes with it.
+void GapServo::catch_up() noexcept {
+  const double head = memory_.head_s();
+  if (s_ >= head - 1e-12) {
+    s_ = head;
+    feed_scale_ = 1;
+    catch_v_ = 0;
+    return;
+  }
+  feed_scale_ = 0;
+  s_ = approach(s_, head, catch_v_, std::max(cond_.max_forward_mm_s, 1.0), 0.5 * accel_, period_s_);
+}
+
+// The law: a short backs off at the retract limit at once; otherwise the filtered gap voltage's
+// excess over the reference times the gain (an open gap saturates forward, an arc's low voltage
+// backs off), limited in speed and in acceleration (the tool axis' limit).
+double GapServo::servo_speed(const GapInputs& in, bool brake) noexcept {
+  const double alpha = cond_.filter_s > 0 ? std::min(1.0, period_s_ / cond_.filter_s) : 1.0;
+  status_.filtered_voltage_v += alpha * (in.gap_voltage_v - status_.filtered_voltage_v);
+  double target = cond_.gain_mm_s_per_v * (status_.filtered_voltage_v - cond_.servo_reference_v);
+  if (in.gap_state == machine::GapState::Short) target = -cond_.max_retract_mm_s;
+  target = std::clamp(target, -cond_.max_retract_mm_s, cond_.max_forward_mm_s);
+  if (brake && in.gap_state != machine::GapState::Short) target = 0;
+  const double dv = accel_ * period_s_;
+  return std::clamp(target, v_ - dv, v_ + dv);
+}
+
+// Forward at the head: the interpolator runs at the servo's speed (its override scaled by the
+// block's feed), the electrode with it. Otherwise the interpolator waits and the electrode moves
+// on the memory, back down the path or forward to the head again.
+void GapServo::move_electrode(double v, const GapInputs& in) noexcept {
+  v_ = v;
+  const double head = memory_.head_s();
+  const bool at_head = s_ >= head - 1e-12;
+  if (at_head && v > 0) {
+    feed_scale_ = in.head_feed > 0 ? std::min(1.0, v / in.head_feed) : 1.0;  // a marker: pass it
+    s_ = head;
+    return;
+  }
+  feed_scale_ = 0;
+  s_ = std::clamp(s_ + v * period_s_, memory_.tail_s(), head);
+}
+
+// Every T_on of machining the electrode lifts by H at the jump speed and comes back (the
+// generator off meanwhile). Along the tool axis: an offset; along the path: the electrode walks
+// back on the memory and forward again to where it left it.
+bool GapServo::jump_due() const noexcept {
+  return jump_ == Jump::Idle && cond_.jump_period_s > 0 && cond_.jump_height_mm > 0 &&
+         cond_.jump_speed_mm_s > 0 && machining_s_ >= cond_.jump_period_s;
+}
+
+void GapServo::run_jump(bool may_start) noexcept {
+  const double h = cond_.jump_height_mm, vj = cond_.jump_speed_mm_s;
+  if (jump_ == Jump::Idle) {
+    if (!may_start) return;
+    jump_ = Jump::Up;
+    machining_s_ = 0;
+    ++status_.jumps;
+    jump_from_s_ = s_;
+    v_ = lift_v_ = 0;
+  }
+  const bool up = jump_ == Jump::Up;
+  if (cond_.jump_mode == JumpMode::Axis) {
+    lift_ = approach(lift_, up ? h : 0.0, lift_v_, vj, 0.5 * accel_, period_s_);
+    if (up && lift_ >= h) jump_ = Jump::Down;
+    if (!up && lift_ <= 0) jump_ = Jump::Idle;
+    return;
+  }
+  const double target = up ? std::max(memory_.tail_s(), jump_from_s_ - h) : jump_from_s_;
+  s_ = approach(s_, target, lift_v_, vj, 0.5 * accel_, period_s_);
+  if (s_ == target) {
+    jump_ = up ? Jump::Down : Jump::Idle;
+    lift_v_ = 0;
+  }
+}
+
+// A 1-D move toward `target`: speed up at a_max to v_max, brake so as to stop on it. The braking
+// speed is that of whole periods: slowing by a·T each period from n·a·T covers a·T²·n(n+1)/2, so
+// the move arrives at a·T. A move that turns (the jump's top) changes its step by up to 2·a·T²
+// there: the callers give half the axis' acceleration.
+double GapServo::approach(double x, double target, double& v, double v_max, double a_max,
+                          double dt) noexcept {
+  const double rest = std::fabs(target - x);
+  const double dir = target >= x ? 1.0 : -1.0;
+  const double at = a_max * dt;
+  const double brake = at * (std::sqrt(0.25 + 2 * rest / (at * dt)) - 0.5);
+  const double speed = std::min({std::fabs(v) + at, v_max, std::max(brake, at)});
+  if (speed * dt >= rest) {
+    v = 0;
+    return target;
+  }
+  v = dir * speed;
+  return x + v * dt;
+}
+
+// The orbit turns at its period while the condition machines (through jumps and shorts too:
+// stopping it would be a step of velocity); its radius grows by a step per turn toward the final
+// radius, at a step per quarter turn, so that the shape spirals out and never jumps.
+void GapServo::run_orbit() noexcept {
+  // Another shape (or none): the one drawn spirals in to the centre first, the new one grows from it.
+  if (shape_ != cond_.orbit || cond_.orbit_period_s <= 0) {
+    return_offsets();
+    if (radius_ == 0) shape_ = cond_.orbit_period_s > 0 ? cond_.orbit : OrbitKind::None;
+    if (shape_ == OrbitKind::None || radius_ > 0) return;
+  }
+  draw_period_s_ = cond_.orbit_period_s;
+  const double step = cond_.orbit_step_mm > 0 ? cond_.orbit_step_mm : cond_.orbit_radius_mm;
+  draw_rate_ = step / (0.25 * cond_.orbit_period_s);
+  turn();
+  const double goal = std::min(cond_.orbit_radius_mm, step * (turns_ + 1));
+  radius_ += std::clamp(goal - radius_, -draw_rate_ * period_s_, draw_rate_ * period_s_);
+  orbit_offset(shape_, phase_, radius_, orbit_);
+}
+
+void GapServo::turn() noexcept {
+  phase_ += period_s_ / draw_period_s_;
+  if (phase_ >= 1) {
+    phase_ -= 1;
+    ++turns_;
+  }
+}
+
+// The shape drawn spirals in: it keeps turning at its period while its radius shrinks at the rate
+// it grew (the generator off, another condition, none).
+void GapServo::return_offsets() noexcept {
+  if (shape_ == OrbitKind::None || radius_ <= 0) {
+    radius_ = orbit_[0] = orbit_[1] = phase_ = 0;
+    turns_ = 0;
+    shape_ = OrbitKind::None;
+    return;
+  }
+  turn();
+  radius_ = std::max(0.0, radius_ - draw_rate_ * period_s_);
+  orbit_offset(shape_, phase_, radius_, orbit_);
+  if (radius_ == 0) shape_ = OrbitKind::None;
+}
+
+}  // namespace opencnc::control

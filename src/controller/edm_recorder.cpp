@@ -1,0 +1,62 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// EdmRecorder: the EDM run's figures from the trace, period by period.
+#include "opencnc/controller/edm_recorder.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace opencnc::control {
+
+EdmRecorder::EdmRecorder(const machine::EdmConfig& edm, double period_s) : edm_(edm), period_s_(period_s) {}
+
+void EdmRecorder::on_trace(const TraceSample& s, const TraceContext& /*c*/) {
+  const EdmStatus& e = s.edm;
+  if (first_) {
+    jumps_at_start_ = e.jumps;
+    first_ = false;
+  }
+  jumps_now_ = e.jumps;
+  using machine::GapState;
+  const double tool = s.commanded[edm_.tool_axis] - edm_.lift_direction * (e.jumping ? e.jump_lift_mm : 0.0);
+  if (!e.on) {
+    burning_ = false;
+  } else if (!burning_ && e.generator && e.gap_state != GapState::Open) {
+    burning_ = true;
+    burn_start_ = tool;
+  }
+  if (burning_ && !e.jumping) r_.depth_mm = std::max(r_.depth_mm, (burn_start_ - tool) * edm_.lift_direction);
+  const bool pulsing = burning_ && e.generator;
+  if (pulsing) {
+    ++machining_;
+    const machine::EdmCondition* c = edm_.find(e.condition);
+    if (c != nullptr && std::fabs(e.gap_voltage_v - c->servo_reference_v) <= 0.1 * c->servo_reference_v)
+      ++in_band_;
+    if (e.gap_state == GapState::Arc) {
+      ++r_.arc_periods;
+      if (last_ != GapState::Arc) ++r_.arcs;
+    }
+    if (e.gap_state == GapState::Short && !shorted_) {
+      shorted_ = true;
+      short_since_ = s.tick;
+      ++r_.shorts;
+    }
+  }
+  // A short ends at the first discharge after it (normal or arc); lifted or off it is not over.
+  if (shorted_ && e.generator && (e.gap_state == GapState::Normal || e.gap_state == GapState::Arc)) {
+    shorted_ = false;
+    r_.short_recovery_max_s =
+        std::max(r_.short_recovery_max_s, static_cast<double>(s.tick - short_since_) * period_s_);
+  }
+  if (e.generator) last_ = e.gap_state;
+}
+
+EdmReport EdmRecorder::report() const {
+  EdmReport r = r_;
+  r.machining_s = static_cast<double>(machining_) * period_s_;
+  r.gap_voltage_in_band_fraction =
+      machining_ > 0 ? static_cast<double>(in_band_) / static_cast<double>(machining_) : 0.0;
+  r.jumps = jumps_now_ - jumps_at_start_;
+  return r;
+}
+
+}  // namespace opencnc::control

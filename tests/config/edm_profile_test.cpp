@@ -1,0 +1,131 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// [edm] in profiles: the shipped EDM loads with its conditions; bad conditions are named at
+// their file:line:col with a stable code.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "opencnc/config/profile_loader.hpp"
+
+namespace opencnc::config {
+namespace {
+
+const std::string kEdm = std::string(OPENCNC_SOURCE_DIR) + "/configs/edm-5axis.toml";
+
+std::string all_messages(const Diagnostics& d) {
+  std::string s;
+  for (const auto& i : d.items()) s += i.format() + "\n";
+  return s;
+}
+
+const Diagnostic* first_error(const ProfileLoad& load) {
+  for (const auto& d : load.diagnostics.items())
+    if (d.severity == Severity::Error) return &d;
+  return nullptr;
+}
+
+constexpr const char* kMachine = R"(name = "edm"
+[axis.x]
+max_velocity = 20
+max_acceleration = 500
+min_limit = -10
+max_limit = 10
+[axis.y]
+max_velocity = 20
+max_acceleration = 500
+min_limit = -10
+max_limit = 10
+[axis.z]
+max_velocity = 50
+max_acceleration = 2000
+min_limit = -50
+max_limit = 10
+[process]
+generator = true
+[edm]
+tool_axis = "Z"
+)";
+
+std::string condition(const std::string& extra) {
+  return "[[edm.condition]]\nnumber = 1\non_time_us = 100\noff_time_us = 50\npeak_current_a = 10\n"
+         "voltage_v = 100\nservo_reference_v = 45\ngain_mm_s_per_v = 0.02\nmax_forward_mm_s = 1\n"
+         "max_retract_mm_s = 3\n" +
+         extra;
+}
+
+TEST(EdmProfile, TheFiveAxisEdmLoadsWithItsConditions) {
+  const ProfileLoad load = load_profile(kEdm);
+  ASSERT_TRUE(load.ok()) << all_messages(load.diagnostics);
+  const MachineProfile& p = *load.profile;
+  ASSERT_TRUE(p.edm.present);
+  EXPECT_EQ(p.edm.config.condition_count, 4);
+  const machine::EdmCondition* c = p.edm.config.find(3);
+  ASSERT_NE(c, nullptr);
+  EXPECT_EQ(c->orbit, machine::OrbitKind::Square);
+  EXPECT_EQ(c->jump_mode, machine::JumpMode::Path);
+  EXPECT_EQ(c->orbit_radius_mm, 0.08);
+  EXPECT_EQ(p.edm.config.find(9)->jump_period_s, 0.0);
+  EXPECT_TRUE(p.edm.sim.present);
+  EXPECT_EQ(p.edm.sim.surface_mm, -20.0);
+  EXPECT_EQ(p.edm.sim.orientation_joints[0], 3);  // B
+  EXPECT_EQ(p.edm.sim.work_direction, -1.0);
+}
+
+/// The line (1-based) of the first line of `text` that starts with `start`, from line `from` on.
+std::uint32_t line_of(const std::string& text, const std::string& start, std::uint32_t from = 1) {
+  std::uint32_t line = 1;
+  for (std::size_t i = 0; i < text.size(); i = text.find('\n', i) + 1, ++line) {
+    if (line >= from && text.compare(i, start.size(), start) == 0) return line;
+    if (text.find('\n', i) == std::string::npos) break;
+  }
+  return 0;
+}
+
+struct Bad {
+  std::string text, key, message;
+  std::uint32_t after = 1;  // the key's line is the first at or after this one
+};
+
+TEST(EdmProfile, BadConditionsAreNamedWhereTheyAre) {
+  const std::string base = kMachine;
+  const std::uint32_t second = line_of(base + condition("") + condition(""), "[[edm.condition]]", 22);
+  const Bad cases[] = {
+      {base + condition("orbit = \"circle\"\norbit_radius_mm = 10\norbit_period_s = 0.1\n"), "orbit_period_s",
+       "above the orbit axes' max_velocity"},
+      {base + condition("jump_period_s = 0.2\njump_height_mm = 0.5\n"), "jump_period_s",
+       "jump_speed_mm_s > 0"},
+      {base + condition("") + condition(""), "number", "defined twice", second},
+      {base + "[[edm.condition]]\nnumber = 100\n", "number", "number"},
+      {base + condition("jump_mode = \"sideways\"\n"), "jump_mode", "must be one of axis, path"},
+  };
+  for (const Bad& b : cases) {
+    const ProfileLoad load = parse_profile(b.text, "edm.toml");
+    const Diagnostic* e = first_error(load);
+    ASSERT_NE(e, nullptr) << b.text;
+    EXPECT_EQ(e->file, "edm.toml");
+    EXPECT_EQ(e->code, "config.range") << all_messages(load.diagnostics);
+    EXPECT_NE(e->message.find(b.message), std::string::npos) << all_messages(load.diagnostics);
+    EXPECT_EQ(e->line, line_of(b.text, b.key, b.after)) << all_messages(load.diagnostics);
+    EXPECT_GT(e->col, 0u);
+  }
+}
+
+TEST(EdmProfile, TheReferenceMustBeBelowTheOpenVoltageAndTheGeneratorPresent) {
+  std::string text = kMachine;
+  text +=
+      "[[edm.condition]]\nnumber = 1\non_time_us = 100\noff_time_us = 50\npeak_current_a = 10\n"
+      "voltage_v = 40\nservo_reference_v = 45\ngain_mm_s_per_v = 0.02\nmax_forward_mm_s = 1\n"
+      "max_retract_mm_s = 3\n";
+  ProfileLoad load = parse_profile(text, "edm.toml");
+  ASSERT_NE(first_error(load), nullptr);
+  EXPECT_NE(first_error(load)->message.find("below voltage_v"), std::string::npos);
+  EXPECT_EQ(first_error(load)->line, line_of(text, "servo_reference_v"));
+  std::string no_generator = kMachine;
+  no_generator.replace(no_generator.find("generator = true"), 16, "generator = false");
+  load = parse_profile(no_generator + condition(""), "edm.toml");
+  ASSERT_NE(first_error(load), nullptr);
+  EXPECT_NE(first_error(load)->message.find("generator = true"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace opencnc::config

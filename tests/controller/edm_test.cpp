@@ -1,0 +1,220 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The sinker EDM through the whole controller on configs/edm-5axis.toml: the gap held in its
+// band while the depth grows, an injected short backed off and recovered within a bound, the
+// jump's timing and height, the orbit's radius and shape from the trace, arcing without the jump,
+// and the preflight refusing an unknown condition at its line.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "../control/test_profiles.hpp"
+#include "opencnc/controller/controller.hpp"
+#include "opencnc/controller/edm_recorder.hpp"
+#include "opencnc/controller/gcode_source.hpp"
+#include "opencnc/controller/sim_rig.hpp"
+
+namespace opencnc::control::test {
+namespace {
+
+/// The EDM with a smaller electrode (5 mm²: four times the depth per discharge) so that a burn of
+/// a few hundredths takes a second or two of virtual time.
+config::MachineProfile edm(std::vector<std::string> sets = {}) {
+  sets.insert(sets.begin(), "edm.sim.electrode_area_mm2=5");
+  return loaded(config::load_profile(OPENCNC_SOURCE_DIR "/configs/edm-5axis.toml", sets));
+}
+
+/// Every trace sample of the run.
+class Samples final : public ControllerObserver {
+ public:
+  void on_trace(const TraceSample& s, const TraceContext&) override { all.push_back(s); }
+  std::vector<TraceSample> all;
+};
+
+std::string write_program(const std::string& text) {
+  const auto dir =
+      std::filesystem::temp_directory_path() /
+      ("opencnc-edm-" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+  std::filesystem::create_directories(dir);
+  const std::string path = (dir / "p.ngc").string();
+  std::ofstream(path) << text;
+  return path;
+}
+
+struct EdmRun {
+  std::unique_ptr<SimRig> rig;
+  std::shared_ptr<EdmRecorder> recorder;
+  std::shared_ptr<Samples> samples;
+  Outcome opened;
+  bool finished = false;
+  EdmReport report;
+};
+
+/// Opens `text` and runs it to its end; `each` is called between periods (fault injection).
+EdmRun run(const std::string& text, const config::MachineProfile& profile = edm(),
+           const std::function<void(SimRig&)>& each = {}) {
+  EdmRun r;
+  Diagnostics d;
+  r.rig = std::make_unique<SimRig>(profile, GcodeProgramSource::create(profile, d));
+  r.recorder = std::make_shared<EdmRecorder>(profile.edm.config, profile.servo_period_s);
+  r.samples = std::make_shared<Samples>();
+  r.rig->controller().attach(r.recorder, ObserverOptions{0, true});
+  r.rig->controller().attach(r.samples, ObserverOptions{0, true});
+  r.rig->step();
+  EXPECT_TRUE(r.rig->request(Request::simple(CommandKind::MachineOn)).accepted);
+  EXPECT_TRUE(r.rig->request(Request::set_mode(Mode::Auto)).accepted);
+  r.opened = r.rig->request(Request::open(write_program(text)), 100000);
+  if (!r.opened.accepted) return r;
+  EXPECT_TRUE(r.rig->request(Request::simple(CommandKind::CycleStart)).accepted);
+  r.finished = r.rig->run_until(
+      [&] {
+        if (each) each(*r.rig);
+        return !r.rig->status().run_active && r.rig->status().servo.state == State::Idle;
+      },
+      60000);
+  r.report = r.recorder->report();
+  return r;
+}
+
+/// A burn of `depth` below the surface (Z −20) with condition `n`.
+std::string burn(int n, double depth, const std::string& feed = "F60") {
+  return "G21 G90\nG0 Z-19.97\nM180 P" + std::to_string(n) + "\nG1 Z" + std::to_string(-20 - depth) + " " +
+         feed + "\nM181\nG0 Z0\nM2\n";
+}
+
+TEST(Edm, TheGapIsHeldInBandWhileTheDepthGrows) {
+  const EdmRun r = run(burn(1, 0.03));
+  ASSERT_TRUE(r.opened.accepted) << r.opened.message;
+  ASSERT_TRUE(r.finished);
+  EXPECT_GT(r.report.machining_s, 0.5);
+  EXPECT_GT(r.report.gap_voltage_in_band_fraction, 0.8);
+  // From the first discharge (at Z −19.97: the open gap is 30 µm) to the program's end, Z −20.03.
+  EXPECT_NEAR(r.report.depth_mm, 0.06, 0.002);
+  EXPECT_EQ(r.report.shorts, 0u);
+  EXPECT_GT(r.report.jumps, 0u);
+  // The machine burnt what the program asked for: the front moved down, the electrode followed.
+  EXPECT_GT(r.rig->machine().edm().depth_mm(), 0.015);
+}
+
+TEST(Edm, AnInjectedShortIsBackedOffAlongThePathAndRecovered) {
+  bool injected = false;
+  double backlog_max = 0;
+  const EdmRun r = run(burn(1, 0.03), edm(), [&](SimRig& rig) {
+    const ServoStatus& s = rig.status().servo;
+    backlog_max = std::max(backlog_max, s.edm.backlog_mm);
+    if (!injected && s.time_s > 0.5 && s.edm.generator && s.edm.gap_state == machine::GapState::Normal) {
+      rig.machine().inject_edm_short();
+      injected = true;
+    }
+  });
+  ASSERT_TRUE(r.finished);
+  ASSERT_TRUE(injected);
+  EXPECT_GE(r.report.shorts, 1u);
+  // The 20 µm bridge breaks once the electrode has backed off that far: at 3 mm/s about 7 ms,
+  // with the acceleration and the filter well within 50 ms.
+  EXPECT_GT(r.report.short_recovery_max_s, 0.004);
+  EXPECT_LT(r.report.short_recovery_max_s, 0.05);
+  EXPECT_GT(backlog_max, 0.015);
+  EXPECT_GT(r.report.gap_voltage_in_band_fraction, 0.75);
+}
+
+TEST(Edm, JumpsLiftTheElectrodeEveryPeriodWithTheGeneratorOff) {
+  const EdmRun r = run(burn(1, 0.02));
+  ASSERT_TRUE(r.finished);
+  std::vector<double> starts;  // machining time at each jump's start
+  double machining = 0, lift_max = 0;
+  bool was = false;
+  for (const TraceSample& s : r.samples->all) {
+    if (s.edm.jumping) {
+      EXPECT_FALSE(s.edm.generator);
+      lift_max = std::max(lift_max, s.edm.jump_lift_mm);
+      if (!was) starts.push_back(machining);
+    }
+    if (s.edm.generator) machining += 0.001;
+    was = s.edm.jumping;
+  }
+  ASSERT_GE(starts.size(), 3u);
+  for (std::size_t i = 1; i < starts.size(); ++i) EXPECT_NEAR(starts[i] - starts[i - 1], 0.25, 0.0015);
+  EXPECT_NEAR(lift_max, 0.4, 1e-9);
+  EXPECT_EQ(r.report.jumps, starts.size());
+}
+
+/// The orbit's offsets from the trace: the commanded XY (the program stays at X0 Y0).
+struct OrbitSeen {
+  double r_max = 0, chebyshev_max = 0;
+  int at_full = 0, round = 0;
+};
+
+OrbitSeen orbit_of(const EdmRun& r, double radius) {
+  OrbitSeen o;
+  for (const TraceSample& s : r.samples->all) {
+    const double x = s.commanded[Axis::X], y = s.commanded[Axis::Y];
+    const double rr = std::hypot(x, y);
+    o.r_max = std::max(o.r_max, rr);
+    o.chebyshev_max = std::max({o.chebyshev_max, std::fabs(x), std::fabs(y)});
+    if (s.edm.orbit_radius_mm > radius - 1e-9) {
+      ++o.at_full;
+      o.round += std::fabs(rr - radius) < 1e-6;
+    }
+  }
+  return o;
+}
+
+TEST(Edm, ACircleOrbitGrowsInStepsToItsRadius) {
+  const EdmRun r = run(burn(2, 0.03, "F30"), edm({"edm.sim.electrode_area_mm2=20"}));
+  ASSERT_TRUE(r.finished);
+  const OrbitSeen o = orbit_of(r, 0.05);
+  EXPECT_NEAR(o.r_max, 0.05, 1e-9);
+  ASSERT_GT(o.at_full, 500);
+  EXPECT_EQ(o.round, o.at_full);  // a circle: every sample at the full radius is on it
+  // Grew a step per turn: a turn (1 s; the orbit turns through the jumps) after it began, one step.
+  double turning = 0;
+  for (const TraceSample& s : r.samples->all) {
+    if (s.edm.orbit_radius_mm > 0) turning += 0.001;
+    if (turning > 0.95 && turning < 0.97) {
+      EXPECT_NEAR(s.edm.orbit_radius_mm, 0.01, 1e-9);
+    }
+  }
+  // After M181 the orbit came back to the centre before the program ended.
+  EXPECT_EQ(r.samples->all.back().commanded[Axis::X], 0.0);
+}
+
+TEST(Edm, ASquareOrbitReachesItsCorners) {
+  const EdmRun r = run(burn(3, 0.025, "F20"));
+  ASSERT_TRUE(r.finished);
+  const OrbitSeen o = orbit_of(r, 0.08);
+  EXPECT_NEAR(o.chebyshev_max, 0.08, 1e-9);
+  EXPECT_NEAR(o.r_max, 0.08 * std::sqrt(2.0), 1e-9);  // the corners
+  ASSERT_GT(o.at_full, 200);
+  EXPECT_LT(o.round, o.at_full / 4);  // not a circle
+}
+
+TEST(Edm, WithoutTheJumpDebrisMakesTheGapArc) {
+  const EdmRun with = run(burn(1, 0.04));
+  const EdmRun without = run(burn(9, 0.04));
+  ASSERT_TRUE(with.finished);
+  ASSERT_TRUE(without.finished);
+  EXPECT_GT(without.report.arc_periods, 20 * std::max<std::uint64_t>(with.report.arc_periods, 1));
+  EXPECT_GT(without.report.arcs, 10u);
+  EXPECT_EQ(without.report.jumps, 0u);
+  EXPECT_GT(without.report.machining_s, with.report.machining_s);  // arcs remove little
+}
+
+TEST(Edm, ThePreflightRefusesAConditionTheMachineLacks) {
+  const EdmRun r = run("G21 G90\nG0 Z-19.97\nM180 P5\nG1 Z-20.01 F60\nM2\n");
+  ASSERT_FALSE(r.opened.accepted);
+  ASSERT_FALSE(r.opened.diagnostics.items().empty());
+  const Diagnostic& d = r.opened.diagnostics.items().front();
+  EXPECT_EQ(d.code, "edm.condition");
+  EXPECT_EQ(d.line, 3u);
+  EXPECT_NE(d.message.find("1, 2, 3, 9"), std::string::npos) << d.message;
+}
+
+}  // namespace
+}  // namespace opencnc::control::test
