@@ -13,6 +13,7 @@ packages=(
   nlohmann-json3-dev    # JSON reports and API
   libtomlplusplus-dev   # machine profiles
   libboost-dev          # Boost.Beast (header-only): the HMI server's HTTP and WebSocket
+  libeigen3-dev         # least squares of electrode setting's sphere fit (header-only)
   libsqlite3-dev        # the tool store (store::Database) and the HMI's machining history and audit trail
   python3               # helper scripts (program generators, golden regeneration)
 )

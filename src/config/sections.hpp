@@ -20,6 +20,8 @@ void read_spindle(Section& top, MachineProfile& profile);
 void read_power(Section& top, MachineProfile& profile);
 /// [probe]. Needs the axes.
 void read_probe(Section& top, MachineProfile& profile);
+/// [probe.reference_sphere] (read_probe calls it). Needs the axes.
+void read_reference_sphere(Section& probe, MachineProfile& profile);
 void read_tool_changer(Section& top, MachineProfile& profile);
 void read_io(Section& top, MachineProfile& profile);
 /// [process] with [process.cutting]. Needs [io].

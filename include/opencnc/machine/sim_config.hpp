@@ -141,12 +141,25 @@ struct SimPowerConfig {
   double ups_runtime_s = 300;  ///< battery time after mains loss
 };
 
-/// The probe: a switch on one joint's table position.
+/// A reference sphere the simulated probe input touches instead of a switch: the electrode (or
+/// stylus) in the spindle, whose tip is a ball of `SimSphereProbe::set_electrode`'s radius, closes
+/// the probe circuit when it meets the sphere (docs/electrode-setting.md). Table positions, mm.
+struct SimSphereTarget {
+  bool present = false;
+  std::array<int, 3> joints{-1, -1, -1};  ///< the joints of X, Y and Z
+  std::array<double, 3> centre{};
+  double radius = 0;
+  double hysteresis = 0.0005;  ///< once touching, the contact opens this far off the surface
+  double noise = 0.0002;       ///< ± mm, uniform, per sample
+};
+
+/// The probe: a switch on one joint's table position, or a reference sphere.
 struct SimProbeConfig {
-  int joint = -1;  ///< -1 = no probe
+  int joint = -1;  ///< -1 = no probe switch
   SwitchWindow trip;
   double hysteresis = 0.002;
   double noise = 0.0005;
+  SimSphereTarget sphere;  ///< present: the probe touches this sphere (`joint` is then −1)
 };
 
 struct SimToolChangerConfig {

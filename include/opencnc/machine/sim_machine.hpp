@@ -8,6 +8,7 @@
 #include "opencnc/machine/machine_io.hpp"
 #include "opencnc/machine/sim_config.hpp"
 #include "opencnc/machine/sim_joint.hpp"
+#include "opencnc/machine/sim_sphere_probe.hpp"
 #include "opencnc/machine/sim_spindle.hpp"
 #include "opencnc/machine/sim_switch.hpp"
 
@@ -47,6 +48,11 @@ class SimMachine final : public MachineIO {
   void set_temperature(double celsius) noexcept { temperature_c_ = celsius; }
   /// The operator moves manual joint `joint` toward `target` at up to `speed` units/s.
   void set_hand_target(int joint, double target, double speed) noexcept;
+  /// The electrode in the spindle of a machine whose probe touches a reference sphere: its true
+  /// offsets (as the tool table holds them, mm) and tip radius; ignored without a sphere.
+  void set_electrode(const std::array<double, 3>& offset, double tip_radius) noexcept {
+    sphere_.set_electrode(offset, tip_radius);
+  }
   /// The operator turns the handwheel by `counts` (+ = clockwise); ignored without one.
   void turn_handwheel(std::int32_t counts) noexcept;
 
@@ -55,6 +61,7 @@ class SimMachine final : public MachineIO {
   double time_s() const noexcept { return static_cast<double>(inputs_.cycle) * config_.servo_period_s; }
   const SimJoint& joint(int j) const noexcept { return joints_[static_cast<std::size_t>(j)]; }
   const SimSpindle& spindle() const noexcept { return spindle_; }
+  const SimSphereProbe& sphere_probe() const noexcept { return sphere_; }
   /// True while the drives have power: e-stop chain closed, released, DC link above minimum.
   bool drives_powered() const noexcept;
   double ups_remaining_s() const noexcept {
@@ -67,11 +74,14 @@ class SimMachine final : public MachineIO {
   void update_power(const MachineOutputs& out) noexcept;
   void update_auxiliaries() noexcept;
   void sample() noexcept;
+  void sample_probe() noexcept;
+  void sample_sphere_probe() noexcept;
 
   SimMachineConfig config_;
   std::array<SimJoint, kMaxJoints> joints_{};
   SimSpindle spindle_;
   SimSwitch probe_;
+  SimSphereProbe sphere_;
   std::array<SimSwitch, kMaxSimInputSwitches> input_switches_{};
   double probe_table_ = 0;  ///< the probe joint's table position at the last sample
   std::array<double, kMaxJoints> previous_feedback_{};  ///< the encoders at the sample before
