@@ -54,6 +54,30 @@ std::string around_name(int k, int n) {
   return fmt::format("{:g}°", 360.0 * k / n);
 }
 
+/// A touch that closed the contact closer than this to its start began in contact, mm.
+constexpr double kMinTravelMm = 0.001;
+/// … and one latched farther than this off the probe move's line closed it on the way there.
+constexpr double kMaxLateralMm = 0.002;
+
+/// Whether the contact closed during the probe move: the servo's latch of the edge lies on the
+/// move's line, past its start. A contact closed before (the electrode went down into the sphere,
+/// or met something on the way) latches where it closed, and the probe move trips at once.
+bool on_probe_path(const SphereTouch& t, const Point3& at) {
+  Point3 d{}, v{};
+  for (std::size_t i = 0; i < 3; ++i) {
+    d[i] = t.end[i] - t.start[i];
+    v[i] = at[i] - t.start[i];
+  }
+  const double length = std::hypot(d[0], d[1], d[2]);
+  const double along = (v[0] * d[0] + v[1] * d[1] + v[2] * d[2]) / length;
+  double lateral2 = 0;
+  for (std::size_t i = 0; i < 3; ++i) {
+    const double w = v[i] - along * d[i] / length;
+    lateral2 += w * w;
+  }
+  return along >= kMinTravelMm && std::sqrt(lateral2) <= kMaxLateralMm;
+}
+
 }  // namespace
 
 const char* to_string(ElectrodePhase p) noexcept {
@@ -382,7 +406,15 @@ void ElectrodeSetting::when_aux_ended(const ControllerEvent& e) {
             fmt::format("the touch from {} met nothing within {:g} mm past where the sphere should be: "
                         "no sphere, or the electrode is far off its offsets",
                         plan_[touch_].name, sphere_.clearance));
-      touched_.push_back(xyz(servo.probe_position));
+      const Point3 at = xyz(servo.probe_position);
+      const SphereTouch& t = plan_[touch_];
+      if (!on_probe_path(t, at))
+        return fail(
+            "electrode.contact-at-start",
+            fmt::format("the touch from {} was in contact where it began, {:g} mm off where the sphere "
+                        "should be: the electrode is far off its offsets, or something else touches",
+                        t.name, sphere_.clearance));
+      touched_.push_back(at);
       if (++touch_ < plan_.size()) return next_touch();
       return finish_measurement();
     }

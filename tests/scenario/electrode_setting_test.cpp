@@ -119,6 +119,16 @@ TEST(ElectrodeSetting, AMissingSphereIsRefusedAndNothingStored) {
   EXPECT_TRUE(noted);
 }
 
+TEST(ElectrodeSetting, AContactClosedBeforeTheTouchIsNotATouch) {
+  // 3 mm off in X: the electrode goes down into the sphere beside it and is in contact at the start.
+  Rig r(edm_profile());
+  r.scenario.sim().set_electrode({3, 0, 50}, 0);
+  const ElectrodeResult m = r.measure(1);
+  EXPECT_FALSE(m.ok);
+  EXPECT_EQ(m.code, "electrode.contact-at-start") << m.message;
+  EXPECT_EQ(r.table_offset(1), (Point3{0, 0, 50}));
+}
+
 TEST(ElectrodeSetting, ASphereFartherThanAllowedIsRefused) {
   Rig r(edm_profile({"probe.reference_sphere.max_deviation=0.5"}));
   r.scenario.sim().set_electrode({0.7, 0, 50}, 0);

@@ -45,7 +45,8 @@ std::shared_ptr<const canon::Program> touch_program(AxisMask axes, const Pose& f
 /// What a measurement found.
 struct ElectrodeResult {
   bool ok = false;
-  std::string code;     ///< "" when ok, else electrode.missing-touch, .fit, .far, .stopped, .table
+  /// "" when ok, else electrode.missing-touch, .contact-at-start, .fit, .far, .stopped, .refused, .table
+  std::string code;
   std::string message;  ///< in words, for the operator
   int tool = 0;
   double tip_radius = 0;
