@@ -153,6 +153,7 @@ int electrode_set(const ElectrodeOptions& o) {
     return kExitProgram;
   }
   if (!o.json) fmt::print("{}\n", asked.message);
+  const std::uint64_t started = rig.ticks();
   rig.run_until([&] { return feature->phase() == control::ElectrodePhase::Idle; }, kMaxTicks);
   const std::optional<control::ElectrodeResult> r = feature->last();
   if (!r) {
@@ -160,7 +161,8 @@ int electrode_set(const ElectrodeOptions& o) {
                static_cast<double>(kMaxTicks) * profile.servo_period_s);
     return kExitProgram;
   }
-  const nlohmann::json j = to_json(*r);
+  nlohmann::json j = to_json(*r);
+  j["machine_time_s"] = static_cast<double>(rig.ticks() - started) * profile.servo_period_s;
   if (o.json) fmt::print("{}\n", j.dump(2));
   if (!o.json) print_result(*r);
   if (!r->ok) fmt::print(stderr, "error: {} [{}]\n", r->message, r->code);
