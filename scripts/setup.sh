@@ -25,6 +25,7 @@ test_packages=(
   linuxcnc-uspace             # rs274 (oracle), /usr/share/linuxcnc/ncfiles; halrun for the HAL tests
   linuxcnc-uspace-dev         # hal.h, rtapi.h: the HAL component opencnc_rt.so (docs/hal.md)
   chromium                    # the HMI's end-to-end tests (headless, driven by playwright-core)
+  stress-ng                   # scripts/latency-under-load.sh: CPU, memory and I/O load from other processes
 )
 
 usage() {

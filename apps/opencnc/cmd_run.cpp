@@ -39,7 +39,7 @@ struct RunOptions {
   std::string trace;
   std::string report;
   double max_time_s = kDefaultMaxTimeS;  ///< 0: no limit
-  std::string inject;                    ///< "mains-off@SECONDS"
+  std::string inject;                    ///< "mains-off@SECONDS" or "analog:CH=VALUE@SECONDS[/RAMP_S]"
   std::vector<std::string> retraces;     ///< "AT_SECONDS:X,Y"
 };
 
@@ -129,6 +129,37 @@ class RetraceScript {
   double t0_ = -1;
   std::vector<double> times_;
 };
+
+/// "analog:1=45@3/2" → input 1 goes to 45 from servo time 3 s over 2 s; nullopt with the reason
+/// printed (a channel the profile does not have, numbers that are not finite or negative times).
+std::optional<SessionOptions::AnalogInjection> analog_injection(const std::string& inject,
+                                                                int analog_inputs) {
+  SessionOptions::AnalogInjection a;
+  const char* p = inject.c_str() + 7;  // after "analog:"
+  char* end = nullptr;
+  const long channel = std::strtol(p, &end, 10);
+  bool ok = end != p && *end == '=';
+  if (ok) a.value = std::strtod(p = end + 1, &end);
+  ok = ok && end != p && *end == '@' && std::isfinite(a.value);
+  if (ok) a.at_s = std::strtod(p = end + 1, &end);
+  ok = ok && end != p && std::isfinite(a.at_s) && a.at_s >= 0;
+  if (ok && *end == '/') {
+    a.ramp_s = std::strtod(p = end + 1, &end);
+    ok = end != p && std::isfinite(a.ramp_s) && a.ramp_s >= 0;
+  }
+  ok = ok && *end == '\0';
+  if (!ok) {
+    fmt::print(stderr, "error: --inject {}: expected analog:CHANNEL=VALUE@SECONDS[/RAMP_SECONDS]\n", inject);
+    return std::nullopt;
+  }
+  if (channel < 0 || channel >= analog_inputs) {
+    fmt::print(stderr, "error: --inject {}: the machine has no analog input {} ([io] analog_inputs = {})\n",
+               inject, channel, analog_inputs);
+    return std::nullopt;
+  }
+  a.channel = static_cast<int>(channel);
+  return a;
+}
 
 /// "mains-off@12.5" → 12.5 (servo time of the run); nullopt with the reason printed.
 std::optional<double> mains_off_time(const std::string& inject) {
@@ -343,13 +374,18 @@ int run(const RunOptions& o) {
   std::shared_ptr<control::PowerFailRecorder> power_recorder;
   SessionOptions session = o.session;
   if (!o.inject.empty()) {
-    const std::optional<double> at = mains_off_time(o.inject);
-    if (!at) return kExitUsage;
+    if (o.inject.rfind("analog:", 0) == 0) {
+      session.analog = analog_injection(o.inject, profile ? profile->io.analog_inputs : 0);
+      if (!session.analog) return kExitUsage;
+    } else {
+      const std::optional<double> at = mains_off_time(o.inject);
+      if (!at) return kExitUsage;
+      session.mains_off_s = *at;
+    }
     if (o.session.realtime || o.session.hal) {
       fmt::print(stderr, "error: --inject works in virtual time only (not with --realtime or --hal)\n");
       return kExitUsage;
     }
-    session.mains_off_s = *at;
   }
   std::optional<control::TraceCsvWriter> csv;
   std::optional<ProgressBar> bar;
@@ -448,9 +484,11 @@ void add_run_command(CLI::App& app, Registry& registry) {
                 "operator on the terminal");
   cmd->add_option("--trace", opts->trace, "Write one CSV row per servo period (docs/controller.md)");
   cmd->add_option("--report", opts->report, "Write the report as JSON");
-  cmd->add_option("--inject", opts->inject,
-                  "Fault injection in virtual time: mains-off@SECONDS (the mains fail then; the report gains "
-                  "power_fail)");
+  cmd->add_option(
+      "--inject", opts->inject,
+      "Fault injection in virtual time: mains-off@SECONDS (the mains fail then; the report gains "
+      "power_fail), or analog:CHANNEL=VALUE@SECONDS[/RAMP_SECONDS] (a process input goes to VALUE, "
+      "drifting over the ramp: the profile's alarms act on it)");
   cmd->add_option(
          "--max-time", opts->max_time_s,
          "Refuse a program that needs more machining time than this, in seconds (default 86400, a day; "

@@ -55,6 +55,8 @@ class Driver {
   virtual void set_hand_target(int joint, double target, double speed) = 0;
   /// The simulated mains fail (virtual time only: cmd_run refuses --inject with --realtime or --hal).
   virtual void cut_mains() = 0;
+  /// A simulated analog input goes to `value` over `ramp_s` (0: at once). Virtual time only.
+  virtual void drive_analog(int /*channel*/, double /*value*/, double /*ramp_s*/) {}
 };
 
 class VirtualDriver final : public Driver {
@@ -68,6 +70,14 @@ class VirtualDriver final : public Driver {
     rig_.machine().set_hand_target(joint, target, speed);
   }
   void cut_mains() override { rig_.machine().set_mains_ok(false); }
+  void drive_analog(int channel, double value, double ramp_s) override {
+    machine::SimMachine& m = rig_.machine();
+    if (ramp_s > 0) {
+      m.drift_analog_input(channel, value, (value - m.analog_input(channel)) / ramp_s);
+    } else {
+      m.set_analog_input(channel, value);
+    }
+  }
 
  private:
   control::SimRig rig_;
@@ -324,6 +334,8 @@ void follow(Driver& d, control::EventCursor& cursor, const SessionOptions& o, co
   std::uint64_t asked_tick = ~std::uint64_t{0};  // the wait already answered (by its start tick)
   std::uint64_t n = 0;
   bool mains_cut = false;
+  bool analog_driven = false;
+  bool alarm_abort = false;
   bool guard_abort = false;
   for (;;) {
     d.advance();
@@ -341,6 +353,21 @@ void follow(Driver& d, control::EventCursor& cursor, const SessionOptions& o, co
     if (o.mains_off_s >= 0 && !mains_cut && st.servo.time_s >= o.mains_off_s) {
       d.cut_mains();  // the servo sees it at its next period
       mains_cut = true;
+    }
+    if (o.analog && !analog_driven && st.servo.time_s >= o.analog->at_s) {
+      d.drive_analog(o.analog->channel, o.analog->value, o.analog->ramp_s);
+      analog_driven = true;
+    }
+    // A feed-hold alarm on an injected input that stays out of range: in virtual time nothing
+    // brings it back, so the run is aborted where it stands (its note says why).
+    if (o.analog && analog_driven && !alarm_abort && st.servo.state == State::Held &&
+        st.servo.alarms_active != 0 && st.servo.path_velocity == 0 &&
+        st.servo.time_s >= o.analog->at_s + o.analog->ramp_s && !stop.requested()) {
+      alarm_abort = true;
+      fmt::print(
+          stderr,
+          "error: a process alarm holds the program and the injected input stays out of range: abort\n");
+      d.controller().submit(Request::simple(CommandKind::Abort));
     }
     if (hooks.progress && (++n % 256 == 0)) hooks.progress(st, wall);
     bring_hand_axis(d, st.servo);

@@ -7,6 +7,7 @@
 #include <atomic>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -31,6 +32,13 @@ struct SessionOptions {
   const std::atomic<int>* stop = nullptr;
   /// Virtual time: the simulated mains fail at this servo time (s); negative: never.
   double mains_off_s = -1;
+  /// Virtual time: a simulated analog input driven to `value` from servo time `at_s`, over `ramp_s`
+  /// (0: at once) — a process input (dielectric level, a temperature) drifting out of range.
+  struct AnalogInjection {
+    int channel = 0;
+    double value = 0, at_s = 0, ramp_s = 0;
+  };
+  std::optional<AnalogInjection> analog;
 };
 
 /// What a session ended with.

@@ -68,6 +68,7 @@ machine::SimMachineConfig sim_machine_config(const MachineProfile& profile) {
   c.digital_outputs = profile.io.digital_outputs;
   c.analog_inputs = profile.io.analog_inputs;
   c.analog_outputs = profile.io.analog_outputs;
+  c.analog_in = profile.alarms.sim_values;
   return c;
 }
 

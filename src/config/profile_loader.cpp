@@ -37,7 +37,8 @@ void read_identity(Section& top, MachineProfile& p) {
 MachineProfile read_profile(const toml::table& root, Reporter& r, const std::filesystem::path& base_dir) {
   Section top(root, "",
               {"name", "description", "servo_period_s", "axis", "spindle", "power", "probe", "tool_changer",
-               "process", "io", "interpreter", "planner", "sim", "interlocks", "handwheel", "tool_guard", "coupling"},
+               "process", "io", "interpreter", "planner", "sim", "interlocks", "handwheel", "tool_guard",
+               "coupling", "alarms"},
               r);
   MachineProfile p;
   read_identity(top, p);
@@ -51,6 +52,7 @@ MachineProfile read_profile(const toml::table& root, Reporter& r, const std::fil
   detail::read_io(top, p);
   detail::read_process(top, p);  // [process.cutting] names [io] channels
   detail::read_interlocks(top, p);
+  detail::read_alarms(top, p);
   detail::read_handwheel(top, p);
   detail::read_coupling(top, p);
   detail::read_interpreter(top, p, base_dir);

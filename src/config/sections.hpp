@@ -36,6 +36,8 @@ void read_compensation(Section& top, MachineProfile& profile, const std::filesys
 /// [interlocks] (named inputs and outputs, rules) and [handwheel]. Needs the axes and [io].
 void read_interlocks(Section& top, MachineProfile& profile);
 void read_handwheel(Section& top, MachineProfile& profile);
+/// [alarms.<name>]: process-input alarms. Needs [io].
+void read_alarms(Section& top, MachineProfile& profile);
 /// [coupling] and its tables. Needs the axes.
 void read_coupling(Section& top, MachineProfile& profile);
 

@@ -42,6 +42,7 @@ bool Servo::tick() noexcept {
   read_inputs();        // machine inputs (feedback, switches, power, spindle, I/O)
   check_safety();       // e-stop, limit switches, amplifier faults, stalls, following error, power
   apply_interlocks();   // the profile's interlock rules (the PLC): stops, holds, blocked starts
+  check_process_alarms();  // analog process inputs out of range: message, feed hold, stop and fault
   handle_commands();    // operator and controller commands: the explicit state transitions
   run_active_mode();    // homing / jog / handwheel (movers) or MDI / auto (interpolator, handshakes)
   couple_axes();        // axes → joints, a coupled slave by its law (servo_coupling.cpp)
@@ -450,6 +451,7 @@ void Servo::fill_drill_status(ServoStatus& s) const noexcept {
   s.hand_wait = hand_wait_;
   s.interlock_rule = blocking_rule_;
   s.interlocks_true = rules_true_;
+  s.alarms_active = alarms_active_;
   s.handwheel_axis = handwheel_axis_;
   s.coupling = coupling_;
   s.coupling.error_deg = coupling_error();

@@ -121,6 +121,7 @@ ServoConfig servo_config(const config::MachineProfile& profile) {
   }
   s.compensation.period_s = profile.servo_period_s;
   s.interlocks = profile.interlocks.rules;
+  s.alarms = profile.alarms.alarms;
   if (profile.handwheel.present) {
     s.handwheel_step_count =
         static_cast<int>(std::min<std::size_t>(profile.handwheel.steps.size(), kMaxHandwheelSteps));

@@ -45,6 +45,7 @@ SimMachine::SimMachine(const SimMachineConfig& config) : config_(config), rng_(c
     if (in.channel >= 0 && in.joint >= 0) input_switches_[k] = SimSwitch(in.window, in.hysteresis, in.noise);
   }
   temperature_c_ = config.temperature_c;
+  analog_in_ = config.analog_in;
   dc_link_v_ = config.power.dc_link_nominal_v;
   ups_periods_left_ =
       config.power.ups
@@ -120,7 +121,15 @@ void SimMachine::set_digital_input(int channel, bool value) noexcept {
 }
 
 void SimMachine::set_analog_input(int channel, double value) noexcept {
-  if (channel >= 0 && channel < kAnalogChannels) analog_in_[static_cast<std::size_t>(channel)] = value;
+  if (channel < 0 || channel >= kAnalogChannels) return;
+  analog_in_[static_cast<std::size_t>(channel)] = value;
+  analog_rate_[static_cast<std::size_t>(channel)] = 0;
+}
+
+void SimMachine::drift_analog_input(int channel, double target, double units_per_s) noexcept {
+  if (channel < 0 || channel >= kAnalogChannels) return;
+  analog_target_[static_cast<std::size_t>(channel)] = target;
+  analog_rate_[static_cast<std::size_t>(channel)] = std::fabs(units_per_s);
 }
 
 void SimMachine::advance(const MachineOutputs& out) noexcept {
@@ -183,6 +192,12 @@ void SimMachine::update_auxiliaries() noexcept {
   prepare_periods_ = changer && tool_.prepare ? prepare_periods_ + 1 : 0;
   change_periods_ = changer && tool_.change ? change_periods_ + 1 : 0;
   arc_periods_ = config_.process.torch && process_.torch_on && arc_available_ ? arc_periods_ + 1 : 0;
+  for (std::size_t k = 0; k < analog_in_.size(); ++k) {
+    if (analog_rate_[k] == 0) continue;
+    const double step = analog_rate_[k] * config_.servo_period_s, gap = analog_target_[k] - analog_in_[k];
+    analog_in_[k] = std::fabs(gap) <= step ? analog_target_[k] : analog_in_[k] + std::copysign(step, gap);
+    if (analog_in_[k] == analog_target_[k]) analog_rate_[k] = 0;
+  }
 }
 
 void SimMachine::sample() noexcept {

@@ -12,6 +12,7 @@
 #include "opencnc/core/axis_map.hpp"
 #include "opencnc/machine/interlocks.hpp"
 #include "opencnc/machine/machine_io.hpp"
+#include "opencnc/machine/process_alarms.hpp"
 #include "opencnc/machine/sim_config.hpp"
 
 namespace opencnc::config {
@@ -157,6 +158,15 @@ struct InterlockProfile {
   machine::InterlockRules rules;
 };
 
+/// `[alarms.<name>]`: analog process inputs with bounds and a reaction (docs/machine.md).
+struct AlarmProfile {
+  std::vector<std::string> names;  ///< in profile order, for messages
+  std::vector<std::string> units;  ///< each alarm's unit as written ("" = none), for messages
+  /// The simulated input's value at power-up, per analog channel (`sim` of an alarm; else 0).
+  std::array<double, machine::kAnalogChannels> sim_values{};
+  machine::ProcessAlarms alarms;
+};
+
 /// `[handwheel]`: a manual pulse generator for the driven axes.
 struct HandwheelProfile {
   bool present = false;
@@ -231,6 +241,7 @@ struct MachineProfile {
   CuttingProfile cutting;             ///< [process.cutting]: torch sequences for retrace
   IoProfile io;
   InterlockProfile interlocks;
+  AlarmProfile alarms;
   HandwheelProfile handwheel;
   CouplingProfile coupling;
   /// Digital inputs the simulated machine drives from switches (named inputs with a `sim`).

@@ -193,6 +193,7 @@ struct SimMachineConfig {
   SimProcessConfig process;
   int digital_inputs = 0, digital_outputs = 0;
   int analog_inputs = 0, analog_outputs = 0;
+  std::array<double, kAnalogChannels> analog_in{};  ///< the analog inputs' values at power-up
   std::array<SimInputSwitch, kMaxSimInputSwitches> input_switches{};
   bool handwheel = false;     ///< the machine has a manual pulse generator
   double temperature_c = 20;  ///< machine temperature (proximity sensors drift with it)

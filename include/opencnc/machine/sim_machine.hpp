@@ -40,6 +40,12 @@ class SimMachine final : public MachineIO {
   void set_spindle_fault(bool fault) noexcept { spindle_.set_fault(fault); }
   void set_digital_input(int channel, bool value) noexcept;
   void set_analog_input(int channel, double value) noexcept;
+  /// Analog input `channel` drifts toward `target` at `units_per_s` (a level sinking, a
+  /// temperature rising); a set_analog_input() ends the drift.
+  void drift_analog_input(int channel, double target, double units_per_s) noexcept;
+  double analog_input(int channel) const noexcept {
+    return channel >= 0 && channel < kAnalogChannels ? analog_in_[static_cast<std::size_t>(channel)] : 0.0;
+  }
   /// Whether the torch can light (false: gas out, no arc; arc_ok never comes).
   void set_arc_available(bool available) noexcept { arc_available_ = available; }
   /// EDM gap voltage reported while the generator is on.
@@ -99,6 +105,7 @@ class SimMachine final : public MachineIO {
   std::array<double, kMaxJoints> external_effort_{};
   std::uint64_t digital_in_ = 0;
   std::array<double, kAnalogChannels> analog_in_{};
+  std::array<double, kAnalogChannels> analog_target_{}, analog_rate_{};  ///< drifts (rate 0: none)
   double temperature_c_ = kReferenceTemperatureC;
   std::uint32_t handwheel_count_ = 0;  // wraps like a counter
   // Power supply: DC link, UPS, and the undervoltage fault each drive latches.
