@@ -34,34 +34,34 @@ struct ElectrodeOptions {
 };
 
 /// Ten minutes of machine time: far more than the touches of any sphere take.
-constexpr std::uint64_t kMaxTicks = 600'000;
+constexpr std::uint64_t kElectrodeMaxTicks = 600'000;
 
-double um(double mm) {
+double electrode_um(double mm) {
   return std::round(mm * 1e4) / 10;  // µm to a tenth
 }
 
-nlohmann::json point(const control::Point3& p) {
+nlohmann::json json_point(const control::Point3& p) {
   return {p[0], p[1], p[2]};
 }
 
-nlohmann::json to_json(const control::ElectrodeResult& r) {
+nlohmann::json result_json(const control::ElectrodeResult& r) {
   nlohmann::json touches = nlohmann::json::array();
   for (std::size_t i = 0; i < r.touched.size(); ++i)
-    touches.push_back({{"from", i < r.names.size() ? r.names[i] : ""}, {"at", point(r.touched[i])}});
+    touches.push_back({{"from", i < r.names.size() ? r.names[i] : ""}, {"at", json_point(r.touched[i])}});
   nlohmann::json j = {{"ok", r.ok},     {"code", r.code},     {"message", r.message},
-                      {"tool", r.tool}, {"touches", touches}, {"previous", point(r.previous)}};
+                      {"tool", r.tool}, {"touches", touches}, {"previous", json_point(r.previous)}};
   if (r.touched.size() == r.names.size() && r.code != "electrode.missing-touch" &&
       r.code != "electrode.stopped") {
-    j["offset"] = point(r.offset);
+    j["offset"] = json_point(r.offset);
     j["length_mm"] = r.offset[2];
-    j["centre"] = point(r.centre);
-    j["rms_residual_um"] = um(r.rms_residual_mm);
-    j["max_residual_um"] = um(r.max_residual_mm);
+    j["centre"] = json_point(r.centre);
+    j["rms_residual_um"] = electrode_um(r.rms_residual_mm);
+    j["max_residual_um"] = electrode_um(r.max_residual_mm);
   }
   return j;
 }
 
-void print_result(const control::ElectrodeResult& r) {
+void print_electrode(const control::ElectrodeResult& r) {
   for (std::size_t i = 0; i < r.touched.size(); ++i)
     fmt::print("  touch {:<5} X{:.4f} Y{:.4f} Z{:.4f}\n", i < r.names.size() ? r.names[i] : "",
                r.touched[i][0], r.touched[i][1], r.touched[i][2]);
@@ -74,7 +74,7 @@ void print_result(const control::ElectrodeResult& r) {
 
 /// The profile's tool table: the file itself with --write (every change written back), else a
 /// copy in memory.
-std::shared_ptr<tools::ToolTableService> tool_table(const config::MachineProfile& p, bool write) {
+std::shared_ptr<tools::ToolTableService> electrode_tool_table(const config::MachineProfile& p, bool write) {
   Diagnostics d;
   std::shared_ptr<tools::ToolTableService> t;
   if (write) {
@@ -86,7 +86,7 @@ std::shared_ptr<tools::ToolTableService> tool_table(const config::MachineProfile
   return d.has_errors() ? nullptr : t;
 }
 
-bool ready(control::SimRig& rig) {
+bool machine_ready(control::SimRig& rig) {
   using control::CommandKind;
   using control::Request;
   const auto must = [&](Request r) {
@@ -99,7 +99,7 @@ bool ready(control::SimRig& rig) {
   if (!must(Request::set_mode(control::Mode::Manual)) || !must(Request::home())) return false;
   return rig.run_until(
       [&] { return rig.status().servo.all_homed && rig.status().servo.state == control::State::Idle; },
-      kMaxTicks);
+      kElectrodeMaxTicks);
 }
 
 int electrode_set(const ElectrodeOptions& o) {
@@ -127,7 +127,7 @@ int electrode_set(const ElectrodeOptions& o) {
     if (files.empty()) return kExitUsage;
     report = std::move(files[0]);
   }
-  const std::shared_ptr<tools::ToolTableService> table = tool_table(profile, o.write);
+  const std::shared_ptr<tools::ToolTableService> table = electrode_tool_table(profile, o.write);
   if (!table) return kExitUsage;
   const tools::ToolEntry* entry = table->snapshot()->tool(o.tool);
   if (entry == nullptr) {
@@ -145,7 +145,7 @@ int electrode_set(const ElectrodeOptions& o) {
   rig.machine().set_electrode(truth, entry->diameter / 2);
   auto feature = std::make_shared<control::ElectrodeSetting>(table, profile);
   rig.controller().add_feature(feature, control::ObserverOptions{profile.servo_period_s, true});
-  if (!ready(rig)) return kExitProgram;
+  if (!machine_ready(rig)) return kExitProgram;
   const control::Outcome asked =
       rig.request(control::Request::feature("electrode", "measure", control::ElectrodeMeasure{o.tool}));
   if (!asked.accepted) {
@@ -154,17 +154,17 @@ int electrode_set(const ElectrodeOptions& o) {
   }
   if (!o.json) fmt::print("{}\n", asked.message);
   const std::uint64_t started = rig.ticks();
-  rig.run_until([&] { return feature->phase() == control::ElectrodePhase::Idle; }, kMaxTicks);
+  rig.run_until([&] { return feature->phase() == control::ElectrodePhase::Idle; }, kElectrodeMaxTicks);
   const std::optional<control::ElectrodeResult> r = feature->last();
   if (!r) {
     fmt::print(stderr, "error: the measurement did not end in {} s of machine time\n",
-               static_cast<double>(kMaxTicks) * profile.servo_period_s);
+               static_cast<double>(kElectrodeMaxTicks) * profile.servo_period_s);
     return kExitProgram;
   }
-  nlohmann::json j = to_json(*r);
+  nlohmann::json j = result_json(*r);
   j["machine_time_s"] = static_cast<double>(rig.ticks() - started) * profile.servo_period_s;
   if (o.json) fmt::print("{}\n", j.dump(2));
-  if (!o.json) print_result(*r);
+  if (!o.json) print_electrode(*r);
   if (!r->ok) fmt::print(stderr, "error: {} [{}]\n", r->message, r->code);
   if (r->ok && o.write && !o.json) fmt::print("stored in {}\n", profile.interpreter.tool_table);
   if (report && !write_and_commit(*report, j.dump(2) + "\n")) return kExitUsage;
