@@ -13,6 +13,7 @@ packages=(
   nlohmann-json3-dev    # JSON reports and API
   libtomlplusplus-dev   # machine profiles
   libboost-dev          # Boost.Beast (header-only): the HMI server's HTTP and WebSocket
+  libeigen3-dev         # least squares of electrode setting's sphere fit (header-only)
   libsqlite3-dev        # the tool store (store::Database), the HMI's history and audit trail, the process-data log
   python3               # helper scripts (program generators, golden regeneration)
 )
@@ -24,6 +25,7 @@ test_packages=(
   linuxcnc-uspace             # rs274 (oracle), /usr/share/linuxcnc/ncfiles; halrun for the HAL tests
   linuxcnc-uspace-dev         # hal.h, rtapi.h: the HAL component opencnc_rt.so (docs/hal.md)
   chromium                    # the HMI's end-to-end tests (headless, driven by playwright-core)
+  stress-ng                   # scripts/latency-under-load.sh: CPU, memory and I/O load from other processes
 )
 
 usage() {

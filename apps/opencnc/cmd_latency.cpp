@@ -26,6 +26,7 @@ struct LatencyOptions {
   int priority = 80;
   int cpu = -1;
   std::string csv, svg;
+  bool json = false;
 };
 
 // The measured thread does nothing but wake up: what is measured is the platform's scheduling
@@ -52,8 +53,11 @@ void print_histogram(const control::LatencyHistogram& h) {
   const std::uint64_t peak = *std::max_element(std::begin(bucket), std::end(bucket));
   std::puts("  latency (us)      count  share");
   for (int b = first; b <= last; ++b) {
-    const double share = h.samples() == 0 ? 0 : static_cast<double>(bucket[b]) / static_cast<double>(h.samples());
-    const int bar = peak == 0 ? 0 : static_cast<int>(40.0 * static_cast<double>(bucket[b]) / static_cast<double>(peak) + 0.5);
+    const double share =
+        h.samples() == 0 ? 0 : static_cast<double>(bucket[b]) / static_cast<double>(h.samples());
+    const int bar =
+        peak == 0 ? 0
+                  : static_cast<int>(40.0 * static_cast<double>(bucket[b]) / static_cast<double>(peak) + 0.5);
     const std::string label = b + 1 < kBuckets ? fmt::format("{:4d} - {:<4d}", kEdges[b], kEdges[b + 1])
                                                : fmt::format(">= {:<8d}", kEdges[b]);
     fmt::print("  {} {:9d}  {:6.2f}%  {}\n", label, bucket[b], 100.0 * share,
@@ -65,8 +69,9 @@ std::string histogram_csv(const control::LatencyHistogram& h) {
   std::string out = "bin_start_us,bin_end_us,count\n";
   const auto counts = h.counts();
   for (int i = 0; i <= control::LatencyHistogram::kBins; ++i) {
-    out += i == control::LatencyHistogram::kBins ? fmt::format("{},inf,{}\n", i, counts[static_cast<std::size_t>(i)])
-                                                 : fmt::format("{},{},{}\n", i, i + 1, counts[static_cast<std::size_t>(i)]);
+    out += i == control::LatencyHistogram::kBins
+               ? fmt::format("{},inf,{}\n", i, counts[static_cast<std::size_t>(i)])
+               : fmt::format("{},{},{}\n", i, i + 1, counts[static_cast<std::size_t>(i)]);
   }
   return out;
 }
@@ -114,18 +119,34 @@ int run_latency(const LatencyOptions& o) {
     return kExitProgram;
   }
   for (const auto& w : clock.warnings()) fmt::print(stderr, "warning: {}\n", w);
-  fmt::print("measuring {:.0f} us periods for {:.1f} s ({})...\n", o.period_us, o.seconds,
-             clock.realtime() ? "SCHED_FIFO" : "normal thread");
+  if (!o.json)
+    fmt::print("measuring {:.0f} us periods for {:.1f} s ({})...\n", o.period_us, o.seconds,
+               clock.realtime() ? "SCHED_FIFO" : "normal thread");
   std::this_thread::sleep_for(std::chrono::duration<double>(o.seconds));
   clock.stop();
 
   const auto& h = clock.latency();
-  fmt::print("samples {}  overruns {}  min {:.1f} us  mean {:.1f} us  stddev {:.1f} us  p99 {:.0f} us  "
-             "p99.9 {:.0f} us  max {:.1f} us\n",
-             h.samples(), clock.overruns(), static_cast<double>(h.min_ns()) / 1000.0, h.mean_ns() / 1000.0,
-             h.stddev_ns() / 1000.0, static_cast<double>(h.percentile_ns(0.99)) / 1000.0,
-             static_cast<double>(h.percentile_ns(0.999)) / 1000.0, static_cast<double>(h.max_ns()) / 1000.0);
-  print_histogram(h);
+  if (o.json) {
+    // One object on one line: scripts (latency-under-load.sh) embed it as it is.
+    fmt::print(
+        "{{\"period_us\": {:.0f}, \"seconds\": {:.1f}, \"sched_fifo\": {}, \"samples\": {}, \"overruns\": "
+        "{}, "
+        "\"min_us\": {:.1f}, \"mean_us\": {:.1f}, \"stddev_us\": {:.1f}, \"p99_us\": {:.0f}, \"p999_us\": "
+        "{:.0f}, "
+        "\"max_us\": {:.1f}}}\n",
+        o.period_us, o.seconds, clock.realtime(), h.samples(), clock.overruns(),
+        static_cast<double>(h.min_ns()) / 1000.0, h.mean_ns() / 1000.0, h.stddev_ns() / 1000.0,
+        static_cast<double>(h.percentile_ns(0.99)) / 1000.0,
+        static_cast<double>(h.percentile_ns(0.999)) / 1000.0, static_cast<double>(h.max_ns()) / 1000.0);
+  } else {
+    fmt::print(
+        "samples {}  overruns {}  min {:.1f} us  mean {:.1f} us  stddev {:.1f} us  p99 {:.0f} us  "
+        "p99.9 {:.0f} us  max {:.1f} us\n",
+        h.samples(), clock.overruns(), static_cast<double>(h.min_ns()) / 1000.0, h.mean_ns() / 1000.0,
+        h.stddev_ns() / 1000.0, static_cast<double>(h.percentile_ns(0.99)) / 1000.0,
+        static_cast<double>(h.percentile_ns(0.999)) / 1000.0, static_cast<double>(h.max_ns()) / 1000.0);
+    print_histogram(h);
+  }
   int rc = kExitOk;
   if (files[0] && !write_and_commit(*files[0], histogram_csv(h))) rc = kExitUsage;
   if (files[1] && !write_and_commit(*files[1], histogram_svg(clock, o.period_us))) rc = kExitUsage;
@@ -144,6 +165,7 @@ void add_latency_command(CLI::App& app, Registry& registry) {
   cmd->add_option("--cpu", opts->cpu, "Pin the thread to this CPU")->check(CLI::Range(0, 1023));
   cmd->add_option("--csv", opts->csv, "Write the histogram as CSV");
   cmd->add_option("--svg", opts->svg, "Draw the histogram as SVG");
+  cmd->add_flag("--json", opts->json, "Print the figures as one JSON object (no histogram)");
   cmd->callback([opts, &registry] { registry.set_result(run_latency(*opts)); });
 }
 

@@ -43,7 +43,8 @@ struct RunOptions {
   std::string report;
   std::string process_log;  ///< FILE.csv or FILE.sqlite: the process data at the profile's rate
   double max_time_s = kDefaultMaxTimeS;  ///< 0: no limit
-  std::vector<std::string> inject;       ///< "mains-off@SECONDS", "tool-dull@SECONDS=FACTOR", "edm-short@SECONDS"
+  std::vector<std::string> inject;       ///< "mains-off@SECONDS", "tool-dull@SECONDS=FACTOR", "edm-short@SECONDS",
+                                         ///< "analog:CH=VALUE@SECONDS[/RAMP_S]"
   std::vector<std::string> retraces;     ///< "AT_SECONDS:X,Y"
 };
 
@@ -133,6 +134,37 @@ class RetraceScript {
   double t0_ = -1;
   std::vector<double> times_;
 };
+
+/// "analog:1=45@3/2" → input 1 goes to 45 from servo time 3 s over 2 s; nullopt with the reason
+/// printed (a channel the profile does not have, numbers that are not finite or negative times).
+std::optional<SessionOptions::AnalogInjection> analog_injection(const std::string& inject,
+                                                                int analog_inputs) {
+  SessionOptions::AnalogInjection a;
+  const char* p = inject.c_str() + 7;  // after "analog:"
+  char* end = nullptr;
+  const long channel = std::strtol(p, &end, 10);
+  bool ok = end != p && *end == '=';
+  if (ok) a.value = std::strtod(p = end + 1, &end);
+  ok = ok && end != p && *end == '@' && std::isfinite(a.value);
+  if (ok) a.at_s = std::strtod(p = end + 1, &end);
+  ok = ok && end != p && std::isfinite(a.at_s) && a.at_s >= 0;
+  if (ok && *end == '/') {
+    a.ramp_s = std::strtod(p = end + 1, &end);
+    ok = end != p && std::isfinite(a.ramp_s) && a.ramp_s >= 0;
+  }
+  ok = ok && *end == '\0';
+  if (!ok) {
+    fmt::print(stderr, "error: --inject {}: expected analog:CHANNEL=VALUE@SECONDS[/RAMP_SECONDS]\n", inject);
+    return std::nullopt;
+  }
+  if (channel < 0 || channel >= analog_inputs) {
+    fmt::print(stderr, "error: --inject {}: the machine has no analog input {} ([io] analog_inputs = {})\n",
+               inject, channel, analog_inputs);
+    return std::nullopt;
+  }
+  a.channel = static_cast<int>(channel);
+  return a;
+}
 
 /// The faults --inject schedules, in servo time from the run's start.
 struct Injections {
@@ -382,7 +414,16 @@ int run(const RunOptions& o) {
   if (!o.inject.empty()) {
     Injections at;
     for (const std::string& text : o.inject) {
-      if (!parse_injection(text, at)) return kExitUsage;
+      if (text.rfind("analog:", 0) == 0) {
+        if (session.analog) {
+          fmt::print(stderr, "error: --inject {}: one analog injection per run\n", text);
+          return kExitUsage;
+        }
+        session.analog = analog_injection(text, profile ? profile->io.analog_inputs : 0);
+        if (!session.analog) return kExitUsage;
+      } else if (!parse_injection(text, at)) {
+        return kExitUsage;
+      }
     }
     if (o.session.realtime || o.session.hal) {
       fmt::print(stderr, "error: --inject works in virtual time only (not with --realtime or --hal)\n");
@@ -530,7 +571,9 @@ void add_run_command(CLI::App& app, Registry& registry) {
   cmd->add_option("--inject", opts->inject,
                   "Fault injection in virtual time (repeatable): mains-off@SECONDS (the mains fail then; the "
                   "report gains power_fail), tool-dull@SECONDS=FACTOR (the broach's cutter wears: its force "
-                  "grows by FACTOR, 1 = sharp), edm-short@SECONDS (a short in the simulated EDM gap)")
+                  "grows by FACTOR, 1 = sharp), edm-short@SECONDS (a short in the simulated EDM gap), "
+                  "analog:CHANNEL=VALUE@SECONDS[/RAMP_SECONDS] (a process input goes to VALUE, drifting over the "
+                  "ramp: the profile's alarms act on it)")
       ->expected(1)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   cmd->add_option(

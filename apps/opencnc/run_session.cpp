@@ -59,6 +59,8 @@ class Driver {
   virtual void set_tool_dull(double factor) = 0;
   /// A short in the simulated EDM gap (virtual time only, as cut_mains).
   virtual void inject_edm_short() {}
+  /// A simulated analog input goes to `value` over `ramp_s` (0: at once). Virtual time only.
+  virtual void drive_analog(int /*channel*/, double /*value*/, double /*ramp_s*/) {}
 };
 
 class VirtualDriver final : public Driver {
@@ -74,6 +76,14 @@ class VirtualDriver final : public Driver {
   void cut_mains() override { rig_.machine().set_mains_ok(false); }
   void set_tool_dull(double factor) override { rig_.machine().set_tool_dull(factor); }
   void inject_edm_short() override { rig_.machine().inject_edm_short(); }
+  void drive_analog(int channel, double value, double ramp_s) override {
+    machine::SimMachine& m = rig_.machine();
+    if (ramp_s > 0) {
+      m.drift_analog_input(channel, value, (value - m.analog_input(channel)) / ramp_s);
+    } else {
+      m.set_analog_input(channel, value);
+    }
+  }
 
  private:
   control::SimRig rig_;
@@ -352,8 +362,8 @@ void follow(Driver& d, control::EventCursor& cursor, const SessionOptions& o, co
   std::uint32_t job = 0;
   std::uint64_t asked_tick = ~std::uint64_t{0};  // the wait already answered (by its start tick)
   std::uint64_t n = 0;
-  bool mains_cut = false, dulled = false, edm_shorted = false;
-  bool guard_abort = false, load_hold = false, load_abort = false;
+  bool mains_cut = false, dulled = false, edm_shorted = false, analog_driven = false;
+  bool guard_abort = false, load_hold = false, load_abort = false, alarm_abort = false;
   for (;;) {
     d.advance();
     std::optional<ControllerEvent> ended;
@@ -382,6 +392,21 @@ void follow(Driver& d, control::EventCursor& cursor, const SessionOptions& o, co
     if (o.edm_short_s >= 0 && !edm_shorted && st.servo.time_s >= o.edm_short_s) {
       d.inject_edm_short();
       edm_shorted = true;
+    }
+    if (o.analog && !analog_driven && st.servo.time_s >= o.analog->at_s) {
+      d.drive_analog(o.analog->channel, o.analog->value, o.analog->ramp_s);
+      analog_driven = true;
+    }
+    // A feed-hold alarm on an injected input that stays out of range: in virtual time nothing
+    // brings it back, so the run is aborted where it stands (its note says why).
+    if (o.analog && analog_driven && !alarm_abort && st.servo.state == State::Held &&
+        st.servo.alarms_active != 0 && st.servo.path_velocity == 0 &&
+        st.servo.time_s >= o.analog->at_s + o.analog->ramp_s && !stop.requested()) {
+      alarm_abort = true;
+      fmt::print(
+          stderr,
+          "error: a process alarm holds the program and the injected input stays out of range: abort\n");
+      d.controller().submit(Request::simple(CommandKind::Abort));
     }
     if (hooks.progress && (++n % 256 == 0)) hooks.progress(st, wall);
     bring_hand_axis(d, st.servo);

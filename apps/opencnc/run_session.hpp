@@ -7,6 +7,7 @@
 #include <atomic>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -36,6 +37,13 @@ struct SessionOptions {
   double tool_dull_factor = 1;
   /// Virtual time: a short in the simulated EDM gap at this servo time (s); negative: never.
   double edm_short_s = -1;
+  /// Virtual time: a simulated analog input driven to `value` from servo time `at_s`, over `ramp_s`
+  /// (0: at once) — a process input (dielectric level, a temperature) drifting out of range.
+  struct AnalogInjection {
+    int channel = 0;
+    double value = 0, at_s = 0, ramp_s = 0;
+  };
+  std::optional<AnalogInjection> analog;
 };
 
 /// What a session ended with.

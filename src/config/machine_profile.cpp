@@ -45,8 +45,22 @@ machine::SimMachineConfig sim_machine_config(const MachineProfile& profile) {
   c.power_monitor = profile.power.monitor;
   c.power = profile.power.sim;
   if (profile.probe.present && profile.probe.sim_joint >= 0) {
-    c.probe = {profile.probe.sim_joint, profile.probe.sim_trip, profile.probe.sim_hysteresis,
-               profile.probe.sim_noise};
+    c.probe.joint = profile.probe.sim_joint;
+    c.probe.trip = profile.probe.sim_trip;
+    c.probe.hysteresis = profile.probe.sim_hysteresis;
+    c.probe.noise = profile.probe.sim_noise;
+  }
+  const ReferenceSphereProfile& sphere = profile.probe.reference_sphere;
+  if (sphere.present && sphere.sim) {
+    machine::SimSphereTarget& t = c.probe.sphere;
+    t.present = true;
+    for (const AxisProfile& a : profile.axes) {
+      if (index(a.axis) < 3) t.joints[static_cast<std::size_t>(index(a.axis))] = a.joint;
+    }
+    t.centre = {sphere.position[0], sphere.position[1], sphere.position[2]};
+    t.radius = sphere.diameter / 2;
+    t.hysteresis = sphere.sim_hysteresis;
+    t.noise = sphere.sim_noise;
   }
   c.tool_changer = profile.tool_changer_sim;
   c.process = profile.process;
@@ -63,6 +77,7 @@ machine::SimMachineConfig sim_machine_config(const MachineProfile& profile) {
   c.digital_outputs = profile.io.digital_outputs;
   c.analog_inputs = profile.io.analog_inputs;
   c.analog_outputs = profile.io.analog_outputs;
+  c.analog_in = profile.alarms.sim_values;
   return c;
 }
 

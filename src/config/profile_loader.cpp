@@ -38,7 +38,7 @@ MachineProfile read_profile(const toml::table& root, Reporter& r, const std::fil
   Section top(root, "",
               {"name", "description", "servo_period_s", "axis", "spindle", "power", "probe", "tool_changer",
                "process", "io", "interpreter", "planner", "sim", "interlocks", "handwheel", "tool_guard",
-               "coupling", "edm"},
+               "coupling", "edm", "alarms"},
               r);
   MachineProfile p;
   read_identity(top, p);
@@ -51,6 +51,7 @@ MachineProfile read_profile(const toml::table& root, Reporter& r, const std::fil
   detail::read_tool_changer(top, p);
   detail::read_io(top, p);
   detail::read_interlocks(top, p);
+  detail::read_alarms(top, p);
   detail::read_handwheel(top, p);
   detail::read_coupling(top, p);
   detail::read_process(top,

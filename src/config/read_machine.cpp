@@ -126,11 +126,17 @@ void read_power(Section& top, MachineProfile& profile) {
 void read_probe(Section& top, MachineProfile& profile) {
   const toml::table* t = top.subtable("probe");
   if (t == nullptr) return;
-  Section s(*t, "probe", {"sim"}, top.reporter());
+  Section s(*t, "probe", {"sim", "reference_sphere"}, top.reporter());
   ProbeProfile& p = profile.probe;
   p.present = true;
+  read_reference_sphere(s, profile);
   const toml::table* st = s.subtable("sim");
   if (st == nullptr) return;
+  if (p.reference_sphere.sim)
+    s.error("sim",
+            "[probe.sim] and [probe.reference_sphere.sim] exclude each other: the simulated probe is one or "
+            "the other",
+            "config.range");
   Section m(*st, "probe.sim", {"axis", "trip", "hysteresis", "noise"}, top.reporter());
   if (const auto name = m.string("axis")) {
     const auto axis = axis_from_letter(*name);

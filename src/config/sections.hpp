@@ -20,6 +20,8 @@ void read_spindle(Section& top, MachineProfile& profile);
 void read_power(Section& top, MachineProfile& profile);
 /// [probe]. Needs the axes.
 void read_probe(Section& top, MachineProfile& profile);
+/// [probe.reference_sphere] (read_probe calls it). Needs the axes.
+void read_reference_sphere(Section& probe, MachineProfile& profile);
 void read_tool_changer(Section& top, MachineProfile& profile);
 void read_io(Section& top, MachineProfile& profile);
 /// [process] with [process.cutting] and [process.broaching]. Needs [io], the axes and [coupling].
@@ -34,6 +36,8 @@ void read_compensation(Section& top, MachineProfile& profile, const std::filesys
 /// [interlocks] (named inputs and outputs, rules) and [handwheel]. Needs the axes and [io].
 void read_interlocks(Section& top, MachineProfile& profile);
 void read_handwheel(Section& top, MachineProfile& profile);
+/// [alarms.<name>]: process-input alarms. Needs [io].
+void read_alarms(Section& top, MachineProfile& profile);
 /// [coupling] and its tables. Needs the axes.
 void read_coupling(Section& top, MachineProfile& profile);
 /// [process.broaching] and its sim, from read_process. Needs the axes, [io] and [coupling].

@@ -66,6 +66,8 @@ const char* fault_code(FaultKind k) noexcept {
       return "control.fault.homing";
     case FaultKind::Stall:
       return "control.fault.stall";
+    case FaultKind::ProcessAlarm:
+      return "control.fault.process-alarm";
   }
   return "control.fault.unknown";
 }

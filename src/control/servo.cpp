@@ -43,7 +43,8 @@ bool Servo::tick() noexcept {
   read_inputs();        // machine inputs (feedback, switches, power, spindle, I/O)
   check_safety();       // e-stop, limit switches, amplifier faults, stalls, following error, power
   apply_interlocks();   // the profile's interlock rules (the PLC): stops, holds, blocked starts
-  guard_load();         // the process load: feed hold, or stop and retract (servo_load_guard.cpp)
+  check_process_alarms();  // analog process inputs out of range: message, feed hold, stop and fault
+  guard_load();            // the process load: feed hold, or stop and retract (servo_load_guard.cpp)
   handle_commands();    // operator and controller commands: the explicit state transitions
   run_active_mode();    // homing / jog / handwheel (movers) or MDI / auto (interpolator, handshakes)
   run_gap_servo();      // EDM: along the path by the gap voltage, jump, orbit (servo_gap.cpp)
@@ -455,6 +456,7 @@ void Servo::fill_drill_status(ServoStatus& s) const noexcept {
   s.hand_wait = hand_wait_;
   s.interlock_rule = blocking_rule_;
   s.interlocks_true = rules_true_;
+  s.alarms_active = alarms_active_;
   s.handwheel_axis = handwheel_axis_;
   s.coupling = coupling_;
   s.coupling.error_deg = coupling_error();

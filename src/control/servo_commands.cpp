@@ -96,7 +96,9 @@ Refusal Servo::reset() noexcept {
       fault_.kind == FaultKind::AmpFault && j >= 0 && in_.joints[static_cast<std::size_t>(j)].amp_fault;
   const bool power = fault_.kind == FaultKind::PowerLoss && caps_.power_monitor &&
                      (!in_.power.mains_ok || (caps_.ups && in_.power.ups_on_battery));
-  if (amp || power) return Refusal::FaultPersists;
+  const bool alarm = fault_.kind == FaultKind::ProcessAlarm && fault_.axis >= 0 &&
+                     ((alarms_active_ >> fault_.axis) & 1u) != 0;
+  if (amp || power || alarm) return Refusal::FaultPersists;
   fault_ = Fault{};
   power_stop_ = false;
   set_state(State::Off);
@@ -131,7 +133,7 @@ Refusal Servo::start_run(const Command& c) noexcept {
   if (activity_ != Activity::None) return Refusal::Busy;
   if (config_.homing_required && !all_homed()) return Refusal::NotHomed;
   if (any_limit_switch()) return Refusal::LimitSwitch;
-  if (motion_blocked_) return Refusal::Interlock;
+  if (motion_blocked_ || alarm_blocks_motion_) return Refusal::Interlock;
   // Blocks and actions below the fences belong to runs that have ended.
   channels_->blocks.pop(static_cast<std::size_t>(std::min<std::uint64_t>(
       c.first_block - std::min(c.first_block, channels_->blocks.popped()), channels_->blocks.available())));
@@ -163,7 +165,7 @@ Refusal Servo::cycle_start() noexcept {
   if (const Refusal r = need_on(); r != Refusal::None) return r;
   if (activity_ != Activity::Program || aborting_) return Refusal::NotApplicable;
   if (state_ != State::Held && state_ != State::Stopped) return Refusal::NotApplicable;
-  if (motion_blocked_) return Refusal::Interlock;
+  if (motion_blocked_ || alarm_blocks_motion_) return Refusal::Interlock;
   if (hand_guard_ && !hand_axis_there(true)) return Refusal::HandAxis;
   hold_ = false;
   cycle_start_edge_ = true;
@@ -184,7 +186,7 @@ Refusal Servo::resume() noexcept {
   if (activity_ != Activity::Program || aborting_) return Refusal::NotApplicable;
   if (state_ == State::Stopped) return cycle_start();
   if (state_ != State::Held) return Refusal::NotApplicable;
-  if (motion_blocked_) return Refusal::Interlock;
+  if (motion_blocked_ || alarm_blocks_motion_) return Refusal::Interlock;
   if (hand_guard_ && !hand_axis_there(true)) return Refusal::HandAxis;
   hold_ = false;
   set_state(State::Running);

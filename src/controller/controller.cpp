@@ -9,6 +9,7 @@
 
 #include <fmt/format.h>
 
+#include "alarm_text.hpp"
 #include "job.hpp"
 #include "opencnc/controller/preflight.hpp"
 #include "opencnc/controller/servo_setup.hpp"
@@ -306,6 +307,12 @@ void Controller::on_event(const ServoEvent& e) {
       if (job_) {
         if (const auto text = job_->message(e.run_id, e.action)) note(Severity::Note, "", *text);
       }
+      break;
+    case EventKind::ProcessAlarm:
+    case EventKind::ProcessAlarmCleared:
+      note(e.kind == EventKind::ProcessAlarm ? Severity::Warning : Severity::Note, "control.process-alarm",
+           detail::alarm_text(profile_.alarms, e.action, e.value, e.axis == 0,
+                              e.kind == EventKind::ProcessAlarmCleared));
       break;
     case EventKind::Interlock:
     case EventKind::HandAxisMoved:
@@ -872,6 +879,9 @@ std::string Controller::describe(const Fault& f) const {
     case FaultKind::Stall:
       return fmt::format("the {} stepper stalled at {:.4f} {}: steps were lost, home it again", axis, f.value,
                          unit);
+    case FaultKind::ProcessAlarm:
+      return detail::alarm_text(profile_.alarms, static_cast<std::size_t>(f.axis), f.value, f.value < f.limit,
+                                false);
   }
   return "fault";
 }

@@ -121,6 +121,7 @@ ServoConfig servo_config(const config::MachineProfile& profile) {
   }
   s.compensation.period_s = profile.servo_period_s;
   s.interlocks = profile.interlocks.rules;
+  s.alarms = profile.alarms.alarms;
   if (profile.handwheel.present) {
     s.handwheel_step_count =
         static_cast<int>(std::min<std::size_t>(profile.handwheel.steps.size(), kMaxHandwheelSteps));
@@ -172,6 +173,21 @@ SharedSetup shared_setup(const config::MachineProfile& profile) {
       out.tokens[t].signal = r.tokens[t].signal;
       out.tokens[t].index = r.tokens[t].index;
     }
+  }
+  // The process alarms the same way (their structs have padding too).
+  machine::ProcessAlarms& alarms = s.servo.alarms;
+  std::memset(static_cast<void*>(&alarms), 0, sizeof alarms);
+  alarms.count = servo.alarms.count;
+  for (std::size_t i = 0; i < alarms.alarms.size() && static_cast<int>(i) < alarms.count; ++i) {
+    const machine::ProcessAlarm& a = servo.alarms.alarms[i];
+    machine::ProcessAlarm& out = alarms.alarms[i];
+    out.channel = a.channel;
+    out.has_low = a.has_low;
+    out.has_high = a.has_high;
+    out.low = a.low;
+    out.high = a.high;
+    out.hysteresis = a.hysteresis;
+    out.reaction = a.reaction;
   }
   const machine::MachineCapabilities caps =
       machine::SimMachine(config::sim_machine_config(profile)).capabilities();

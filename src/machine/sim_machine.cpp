@@ -39,6 +39,7 @@ SimMachine::SimMachine(const SimMachineConfig& config) : config_(config), rng_(c
     probe_ = SimSwitch(config.probe.trip, config.probe.hysteresis, config.probe.noise);
     probe_table_ = joints_[static_cast<std::size_t>(config.probe.joint)].table_position();
   }
+  if (config.probe.sphere.present) sphere_ = SimSphereProbe(config.probe.sphere);
   for (std::size_t k = 0; k < input_switches_.size(); ++k) {
     const SimInputSwitch& in = config.input_switches[k];
     if (in.channel >= 0 && in.joint >= 0) input_switches_[k] = SimSwitch(in.window, in.hysteresis, in.noise);
@@ -46,6 +47,7 @@ SimMachine::SimMachine(const SimMachineConfig& config) : config_(config), rng_(c
   if (config.broach.present) broach_ = SimBroachLoad(config.broach, config.seed);
   temperature_c_ = config.temperature_c;
   if (config.edm.present) edm_.configure(config.edm, config.servo_period_s);
+  analog_in_ = config.analog_in;
   dc_link_v_ = config.power.dc_link_nominal_v;
   ups_periods_left_ =
       config.power.ups
@@ -67,7 +69,7 @@ MachineCapabilities SimMachine::capabilities() const noexcept {
   c.spindle_orient = config_.spindle && config_.spindle_config.orient;
   c.power_monitor = config_.power_monitor;
   c.ups = config_.power_monitor && config_.power.ups;
-  c.probe = config_.probe.joint >= 0;
+  c.probe = config_.probe.joint >= 0 || config_.probe.sphere.present;
   c.tool_changer = config_.tool_changer.present;
   c.torch = config_.process.torch;
   c.generator = config_.process.generator;
@@ -121,7 +123,15 @@ void SimMachine::set_digital_input(int channel, bool value) noexcept {
 }
 
 void SimMachine::set_analog_input(int channel, double value) noexcept {
-  if (channel >= 0 && channel < kAnalogChannels) analog_in_[static_cast<std::size_t>(channel)] = value;
+  if (channel < 0 || channel >= kAnalogChannels) return;
+  analog_in_[static_cast<std::size_t>(channel)] = value;
+  analog_rate_[static_cast<std::size_t>(channel)] = 0;
+}
+
+void SimMachine::drift_analog_input(int channel, double target, double units_per_s) noexcept {
+  if (channel < 0 || channel >= kAnalogChannels) return;
+  analog_target_[static_cast<std::size_t>(channel)] = target;
+  analog_rate_[static_cast<std::size_t>(channel)] = std::fabs(units_per_s);
 }
 
 void SimMachine::advance(const MachineOutputs& out) noexcept {
@@ -215,6 +225,12 @@ void SimMachine::update_auxiliaries() noexcept {
   prepare_periods_ = changer && tool_.prepare ? prepare_periods_ + 1 : 0;
   change_periods_ = changer && tool_.change ? change_periods_ + 1 : 0;
   arc_periods_ = config_.process.torch && process_.torch_on && arc_available_ ? arc_periods_ + 1 : 0;
+  for (std::size_t k = 0; k < analog_in_.size(); ++k) {
+    if (analog_rate_[k] == 0) continue;
+    const double step = analog_rate_[k] * config_.servo_period_s, gap = analog_target_[k] - analog_in_[k];
+    analog_in_[k] = std::fabs(gap) <= step ? analog_target_[k] : analog_in_[k] + std::copysign(step, gap);
+    if (analog_in_[k] == analog_target_[k]) analog_rate_[k] = 0;
+  }
 }
 
 void SimMachine::sample() noexcept {
@@ -229,22 +245,8 @@ void SimMachine::sample() noexcept {
   inputs_.power.ups_on_battery = on_battery_;
   inputs_.power.dc_link_v = dc_link_v_;
   if (config_.spindle) spindle_.sample(inputs_.spindle);
-  if (config_.probe.joint >= 0) {
-    // The encoders are latched where the table crossed the switching point, as a probe latch
-    // input does in hardware: between the last two samples, in proportion.
-    const double before = probe_table_, now = joints_[static_cast<std::size_t>(config_.probe.joint)].table_position();
-    const bool was = inputs_.probe;
-    inputs_.probe = probe_.update(now, rng_);
-    if (inputs_.probe != was) {
-      const double f = now != before ? std::clamp((probe_.edge() - before) / (now - before), 0.0, 1.0) : 1.0;
-      for (int j = 0; j < config_.joint_count; ++j) {
-        const auto uj = static_cast<std::size_t>(j);
-        inputs_.probe_latch[uj] = previous_feedback_[uj] + f * (inputs_.joints[uj].position - previous_feedback_[uj]);
-      }
-      ++inputs_.probe_edges;
-    }
-    probe_table_ = now;
-  }
+  if (config_.probe.joint >= 0) sample_probe();
+  if (config_.probe.sphere.present) sample_sphere_probe();
   inputs_.process.arc_ok = arc_periods_ >= arc_needed_;
   inputs_.process.gap_voltage_v = config_.process.generator && process_.generator_on ? gap_voltage_v_ : 0.0;
   if (config_.edm.present) edm_.sample(inputs_.process);
@@ -266,6 +268,45 @@ void SimMachine::sample() noexcept {
   }
   if (config_.broach.present)
     inputs_.analog_in[static_cast<std::size_t>(config_.broach.load_input)] = broach_.load_kn();
+}
+
+void SimMachine::sample_probe() noexcept {
+  // The encoders are latched where the table crossed the switching point, as a probe latch
+  // input does in hardware: between the last two samples, in proportion.
+  const double before = probe_table_,
+               now = joints_[static_cast<std::size_t>(config_.probe.joint)].table_position();
+  const bool was = inputs_.probe;
+  inputs_.probe = probe_.update(now, rng_);
+  if (inputs_.probe != was) {
+    const double f = now != before ? std::clamp((probe_.edge() - before) / (now - before), 0.0, 1.0) : 1.0;
+    for (int j = 0; j < config_.joint_count; ++j) {
+      const auto uj = static_cast<std::size_t>(j);
+      inputs_.probe_latch[uj] =
+          previous_feedback_[uj] + f * (inputs_.joints[uj].position - previous_feedback_[uj]);
+    }
+    ++inputs_.probe_edges;
+  }
+  probe_table_ = now;
+}
+
+// The electrode against the reference sphere: the encoders latched where the contact changed,
+// in proportion between the last two samples (the gap changes smoothly over one period).
+void SimMachine::sample_sphere_probe() noexcept {
+  std::array<double, 3> p{};
+  for (std::size_t k = 0; k < 3; ++k) {
+    const int j = config_.probe.sphere.joints[k];
+    p[k] = j >= 0 ? joints_[static_cast<std::size_t>(j)].table_position() : 0.0;
+  }
+  const bool was = inputs_.probe;
+  inputs_.probe = sphere_.update(p, rng_);
+  if (inputs_.probe == was) return;
+  const double f = sphere_.edge_fraction();
+  for (int j = 0; j < config_.joint_count; ++j) {
+    const auto uj = static_cast<std::size_t>(j);
+    inputs_.probe_latch[uj] =
+        previous_feedback_[uj] + f * (inputs_.joints[uj].position - previous_feedback_[uj]);
+  }
+  ++inputs_.probe_edges;
 }
 
 }  // namespace opencnc::machine

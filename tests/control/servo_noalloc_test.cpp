@@ -17,6 +17,7 @@
 #include <unistd.h>
 
 #include "../support/counting_new.hpp"
+#include "opencnc/config/profile_loader.hpp"
 #include "opencnc/control/shared_memory.hpp"
 #include "opencnc/control/shared_servo.hpp"
 #include "opencnc/controller/gcode_source.hpp"
@@ -278,6 +279,37 @@ TEST(ServoAllocations, NoneInsideTheDrillsTick) {
   a.rig().machine().set_estop_pressed(true);
   a.until([] { return false; }, 5);
   EXPECT_EQ(a.state(), State::EStopped);
+  EXPECT_EQ(g_allocations.load(), 0);
+}
+
+TEST(ServoAllocations, NoneWithProcessAlarmsAndAReferenceSphere) {
+  const config::ProfileLoad load =
+      config::load_profile(OPENCNC_SOURCE_DIR "/tests/scenario/edm-setting.toml");
+  ASSERT_TRUE(load.ok());
+  g_allocations = 0;
+  Armed a(*load.profile);
+  a.ask(Request::simple(CommandKind::MachineOn));
+  a.ask(Request::set_mode(Mode::Mdi));
+  a.ask(Request::mdi("G0 X110 Y50 Z-150"));
+  ASSERT_TRUE(a.idle());
+  a.ask(Request::mdi("G38.2 X100 F600"));  // the simulated sphere's probe: contact at X105
+  ASSERT_TRUE(a.idle());
+  EXPECT_NEAR(a.rig().status().servo.probe_position[Axis::X], 105.0, 0.001);
+  a.ask(Request::mdi("G1 X0 F3000"));
+  a.until([] { return false; }, 200);
+  a.rig().machine().drift_analog_input(2, 80, 100);  // resistor box: a message
+  a.until([] { return false; }, 200);
+  a.rig().machine().set_analog_input(1, 45);  // dielectric temperature: feed hold
+  a.until([] { return false; }, 50);
+  EXPECT_EQ(a.state(), State::Held);
+  a.rig().machine().set_analog_input(1, 30);
+  a.until([] { return false; }, 5);
+  a.ask(Request::simple(CommandKind::CycleStart));
+  a.until([] { return false; }, 50);
+  a.rig().machine().drift_analog_input(0, 20, 100);  // dielectric level: stop and fault
+  a.until([] { return false; }, 1000);
+  EXPECT_EQ(a.state(), State::Faulted);
+  EXPECT_EQ(a.rig().status().servo.alarms_active, 0b101u);
   EXPECT_EQ(g_allocations.load(), 0);
 }
 

@@ -2,6 +2,7 @@
 // MachineProfile: the validated description of a machine, as plain structs (no TOML types).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <utility>
@@ -11,6 +12,7 @@
 #include "opencnc/core/axis_map.hpp"
 #include "opencnc/machine/interlocks.hpp"
 #include "opencnc/machine/machine_io.hpp"
+#include "opencnc/machine/process_alarms.hpp"
 #include "opencnc/machine/sim_config.hpp"
 
 namespace opencnc::config {
@@ -92,12 +94,31 @@ struct PowerProfile {
   machine::SimPowerConfig sim;  ///< ups, voltages, and the simulated supply
 };
 
+/// `[probe.reference_sphere]`: the sphere electrodes are set against (docs/electrode-setting.md).
+/// Machine coordinates, mm; feeds mm/min.
+struct ReferenceSphereProfile {
+  bool present = false;
+  std::array<double, 3> position{};  ///< the sphere's centre (with B at `b_deg` on a machine with B)
+  double diameter = 0;
+  double b_deg = 0;            ///< the B angle the routine turns to first (machines with B)
+  double clearance = 1;        ///< each touch starts this far off the surface and probes as far past it
+  double probe_feed = 30;      ///< the touches' feed
+  double safe_z = 0;           ///< machine Z of the controlled point for moves between touches
+  int touches_around = 4;      ///< touches around the equator (≥ 4), then one from above
+  double tolerance = 0.002;    ///< largest |residual| of the fit
+  double max_deviation = 1.0;  ///< largest change of the offsets from the table's (the sphere "too far")
+  bool sim = false;            ///< the simulated probe touches this sphere
+  double sim_hysteresis = 0.0005;
+  double sim_noise = 0.0002;
+};
+
 struct ProbeProfile {
   bool present = false;
   int sim_joint = -1;  ///< joint whose table position trips the simulated probe
   machine::SwitchWindow sim_trip;
   double sim_hysteresis = 0.002;
   double sim_noise = 0.0005;
+  ReferenceSphereProfile reference_sphere;
 };
 
 /// `[process.cutting]`: how a flame or plasma torch is put out and lit again (the retrace
@@ -135,6 +156,15 @@ struct InterlockProfile {
   std::vector<NamedSignal> inputs, outputs;
   std::vector<std::string> rule_texts;  ///< as written, for messages
   machine::InterlockRules rules;
+};
+
+/// `[alarms.<name>]`: analog process inputs with bounds and a reaction (docs/machine.md).
+struct AlarmProfile {
+  std::vector<std::string> names;  ///< in profile order, for messages
+  std::vector<std::string> units;  ///< each alarm's unit as written ("" = none), for messages
+  /// The simulated input's value at power-up, per analog channel (`sim` of an alarm; else 0).
+  std::array<double, machine::kAnalogChannels> sim_values{};
+  machine::ProcessAlarms alarms;
 };
 
 /// `[handwheel]`: a manual pulse generator for the driven axes.
@@ -235,6 +265,7 @@ struct MachineProfile {
   CuttingProfile cutting;             ///< [process.cutting]: torch sequences for retrace
   IoProfile io;
   InterlockProfile interlocks;
+  AlarmProfile alarms;
   HandwheelProfile handwheel;
   CouplingProfile coupling;
   BroachingProfile broaching;

@@ -116,6 +116,7 @@ enum class FaultKind : std::uint8_t {
   PowerLoss,       ///< mains lost or UPS on battery: `value` = DC link volts
   Homing,          ///< `axis`: a homing move ran into a limit or found no switch (`value` = where)
   Stall,           ///< `axis`: the stepper drive detected a stall (steps were lost; home again)
+  ProcessAlarm,    ///< a `stop` alarm: `axis` = the alarm's index, `value` = the input, `limit` = the bound
 };
 
 /// Stable problem code of a fault ("control.fault.following-error", ...). Any thread.
@@ -223,6 +224,11 @@ enum class EventKind : std::uint8_t {
   HandAxisMoved,  ///< hand axis `axis` left the position the run needs while it moved: feed hold
   /// The load guard acted (`action`: a control::LoadAction) at load `value` kN; run `run_id`.
   LoadGuard,
+  /// Process alarm `action` (its index) tripped: `value` = the input, `axis` 0 below its low
+  /// bound, 1 above its high one; the profile's reaction says what followed (a `stop` alarm's
+  /// Fault event comes next).
+  ProcessAlarm,
+  ProcessAlarmCleared,  ///< process alarm `action` is back in range (`value`)
 };
 
 struct ServoEvent {

@@ -47,6 +47,8 @@ class Servo final : public Tickable {
   void check_safety() noexcept;
   void apply_interlocks() noexcept;
   void guard_load() noexcept;
+  void check_process_alarms() noexcept;  // servo_alarms.cpp
+  void trip_process_alarm(int index, double value, bool low) noexcept;
   void handle_commands() noexcept;
   void run_active_mode() noexcept;
   void couple_axes() noexcept;
@@ -276,6 +278,10 @@ class Servo final : public Tickable {
   bool motion_blocked_ = false, spindle_blocked_ = false, estop_rule_ = false;
   std::int8_t blocking_rule_ = -1;
   std::uint64_t rule_outputs_mask_ = 0, rule_outputs_ = 0;
+
+  // Process alarms: a bit per alarm out of range; a feed-hold alarm out of range blocks starts.
+  std::uint16_t alarms_active_ = 0;
+  bool alarm_blocks_motion_ = false;
 
   // Stepper joints: one pulse distributor over all of them, slot per joint (−1 = servo).
   motion::PulseDistributor pulses_{motion::PulseMethod::Vector};

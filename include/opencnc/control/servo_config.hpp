@@ -11,6 +11,7 @@
 #include "opencnc/machine/edm.hpp"
 #include "opencnc/machine/interlocks.hpp"
 #include "opencnc/machine/machine_io.hpp"
+#include "opencnc/machine/process_alarms.hpp"
 #include "opencnc/motion/compensation.hpp"
 #include "opencnc/motion/coupling.hpp"
 #include "opencnc/traj/interpolator.hpp"
@@ -85,6 +86,8 @@ struct ServoConfig {
   machine::EdmConfig edm;
   /// The PLC's interlock rules (evaluated every period after safety).
   machine::InterlockRules interlocks;
+  /// The process-input alarms (analog inputs out of range: message, feed hold, or stop and fault).
+  machine::ProcessAlarms alarms;
   /// Units per count the operator may select for the handwheel (none: any positive step).
   std::array<double, kMaxHandwheelSteps> handwheel_steps{};
   int handwheel_step_count = 0;

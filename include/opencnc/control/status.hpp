@@ -128,6 +128,7 @@ struct ServoStatus {
   /// The first `block spindle` rule holding now (what a Wait::Interlock waits on), −1 = none.
   std::int8_t interlock_rule = -1;
   std::uint32_t interlocks_true = 0;  ///< bit per rule whose condition holds
+  std::uint16_t alarms_active = 0;    ///< bit per process alarm whose input is out of range
   std::int8_t handwheel_axis = -1;    ///< the axis the handwheel moves (−1 = none)
   double handwheel_step = 0;          ///< units per count
   CouplingStatus coupling{};          ///< the axis coupling (broaching)

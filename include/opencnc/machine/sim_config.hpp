@@ -142,12 +142,25 @@ struct SimPowerConfig {
   double ups_runtime_s = 300;  ///< battery time after mains loss
 };
 
-/// The probe: a switch on one joint's table position.
+/// A reference sphere the simulated probe input touches instead of a switch: the electrode (or
+/// stylus) in the spindle, whose tip is a ball of `SimSphereProbe::set_electrode`'s radius, closes
+/// the probe circuit when it meets the sphere (docs/electrode-setting.md). Table positions, mm.
+struct SimSphereTarget {
+  bool present = false;
+  std::array<int, 3> joints{-1, -1, -1};  ///< the joints of X, Y and Z
+  std::array<double, 3> centre{};
+  double radius = 0;
+  double hysteresis = 0.0005;  ///< once touching, the contact opens this far off the surface
+  double noise = 0.0002;       ///< ± mm, uniform, per sample
+};
+
+/// The probe: a switch on one joint's table position, or a reference sphere.
 struct SimProbeConfig {
-  int joint = -1;  ///< -1 = no probe
+  int joint = -1;  ///< -1 = no probe switch
   SwitchWindow trip;
   double hysteresis = 0.002;
   double noise = 0.0005;
+  SimSphereTarget sphere;  ///< present: the probe touches this sphere (`joint` is then −1)
 };
 
 struct SimToolChangerConfig {
@@ -203,6 +216,7 @@ struct SimMachineConfig {
   SimEdmConfig edm;  ///< the simulated spark gap (present: an EDM machine)
   int digital_inputs = 0, digital_outputs = 0;
   int analog_inputs = 0, analog_outputs = 0;
+  std::array<double, kAnalogChannels> analog_in{};  ///< the analog inputs' values at power-up
   std::array<SimInputSwitch, kMaxSimInputSwitches> input_switches{};
   bool handwheel = false;     ///< the machine has a manual pulse generator
   double temperature_c = 20;  ///< machine temperature (proximity sensors drift with it)

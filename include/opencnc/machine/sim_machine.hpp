@@ -10,6 +10,7 @@
 #include "opencnc/machine/sim_config.hpp"
 #include "opencnc/machine/sim_edm_process.hpp"
 #include "opencnc/machine/sim_joint.hpp"
+#include "opencnc/machine/sim_sphere_probe.hpp"
 #include "opencnc/machine/sim_spindle.hpp"
 #include "opencnc/machine/sim_switch.hpp"
 
@@ -41,6 +42,12 @@ class SimMachine final : public MachineIO {
   void set_spindle_fault(bool fault) noexcept { spindle_.set_fault(fault); }
   void set_digital_input(int channel, bool value) noexcept;
   void set_analog_input(int channel, double value) noexcept;
+  /// Analog input `channel` drifts toward `target` at `units_per_s` (a level sinking, a
+  /// temperature rising); a set_analog_input() ends the drift.
+  void drift_analog_input(int channel, double target, double units_per_s) noexcept;
+  double analog_input(int channel) const noexcept {
+    return channel >= 0 && channel < kAnalogChannels ? analog_in_[static_cast<std::size_t>(channel)] : 0.0;
+  }
   /// Whether the torch can light (false: gas out, no arc; arc_ok never comes).
   void set_arc_available(bool available) noexcept { arc_available_ = available; }
   /// EDM gap voltage reported while the generator is on (a machine without a simulated gap).
@@ -55,6 +62,11 @@ class SimMachine final : public MachineIO {
   void set_tool_dull(double factor) noexcept { broach_.set_dull_factor(factor); }
   /// The operator moves manual joint `joint` toward `target` at up to `speed` units/s.
   void set_hand_target(int joint, double target, double speed) noexcept;
+  /// The electrode in the spindle of a machine whose probe touches a reference sphere: its true
+  /// offsets (as the tool table holds them, mm) and tip radius; ignored without a sphere.
+  void set_electrode(const std::array<double, 3>& offset, double tip_radius) noexcept {
+    sphere_.set_electrode(offset, tip_radius);
+  }
   /// The operator turns the handwheel by `counts` (+ = clockwise); ignored without one.
   void turn_handwheel(std::int32_t counts) noexcept;
 
@@ -64,6 +76,7 @@ class SimMachine final : public MachineIO {
   const SimJoint& joint(int j) const noexcept { return joints_[static_cast<std::size_t>(j)]; }
   const SimSpindle& spindle() const noexcept { return spindle_; }
   const SimEdmProcess& edm() const noexcept { return edm_; }
+  const SimSphereProbe& sphere_probe() const noexcept { return sphere_; }
   /// True while the drives have power: e-stop chain closed, released, DC link above minimum.
   bool drives_powered() const noexcept;
   double ups_remaining_s() const noexcept {
@@ -80,12 +93,15 @@ class SimMachine final : public MachineIO {
   void update_broach() noexcept;
   void step_edm() noexcept;
   void sample() noexcept;
+  void sample_probe() noexcept;
+  void sample_sphere_probe() noexcept;
 
   SimMachineConfig config_;
   std::array<SimJoint, kMaxJoints> joints_{};
   SimSpindle spindle_;
   SimEdmProcess edm_;
   SimSwitch probe_;
+  SimSphereProbe sphere_;
   std::array<SimSwitch, kMaxSimInputSwitches> input_switches_{};
   double probe_table_ = 0;  ///< the probe joint's table position at the last sample
   std::array<double, kMaxJoints> previous_feedback_{};  ///< the encoders at the sample before
@@ -104,6 +120,7 @@ class SimMachine final : public MachineIO {
   std::array<double, kMaxJoints> external_effort_{};
   std::uint64_t digital_in_ = 0;
   std::array<double, kAnalogChannels> analog_in_{};
+  std::array<double, kAnalogChannels> analog_target_{}, analog_rate_{};  ///< drifts (rate 0: none)
   double temperature_c_ = kReferenceTemperatureC;
   std::uint32_t handwheel_count_ = 0;  // wraps like a counter
   // Power supply: DC link, UPS, and the undervoltage fault each drive latches.

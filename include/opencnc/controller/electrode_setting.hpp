@@ -1,0 +1,147 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Electrode setting against a reference sphere (sinker EDM): touches from around and above as
+// auxiliary programs of probe moves, the sphere's centre fitted, the electrode's offsets into the
+// tool table, and the stopped job resumed with the new electrode (docs/electrode-setting.md).
+#pragma once
+
+#include <array>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "opencnc/controller/observer.hpp"
+#include "opencnc/tools/tool_table_service.hpp"
+
+namespace opencnc::control {
+
+using Point3 = std::array<double, 3>;
+
+/// One touch of the sphere: the controlled point's machine position where it starts and where
+/// its probe move ends if it touches nothing (each `clearance` off the surface, outside and
+/// inside), and the direction from the sphere's centre toward the start.
+struct SphereTouch {
+  std::string name;  ///< "+X", "top", "45°" …
+  Point3 start{}, end{}, direction{};
+};
+
+/// The touches for an electrode with tool-table offsets `offset` (X, Y, Z: G43's, the tip's
+/// lowest point at controlled point − offset) and a ball tip of `tip_radius` (half the table's
+/// diameter; 0: a point): `touches_around` at the height of the sphere's centre, evenly from +X
+/// counter-clockwise, then one from above along the tool axis. Any thread.
+std::vector<SphereTouch> plan_touches(const config::ReferenceSphereProfile& sphere, const Point3& offset,
+                                      double tip_radius);
+
+/// The auxiliary program of one touch, from `from`: up to the safe height (or over at the height
+/// it is at, if higher) and straight down to the start, the probe move (G38.2's: it stops at the contact),
+/// back to the start and up. With `turn_b` it first turns B to the sphere's angle at the safe height.
+/// Non-real-time.
+std::shared_ptr<const canon::Program> touch_program(AxisMask axes, const Pose& from, const SphereTouch& touch,
+                                                    const config::ReferenceSphereProfile& sphere,
+                                                    bool turn_b);
+
+/// What a measurement found.
+struct ElectrodeResult {
+  bool ok = false;
+  /// "" when ok, else electrode.missing-touch, .contact-at-start, .fit, .far, .stopped, .refused, .table
+  std::string code;
+  std::string message;  ///< in words, for the operator
+  int tool = 0;
+  double tip_radius = 0;
+  std::vector<std::string> names;  ///< of the touches made, in order
+  std::vector<Point3> touched;     ///< the controlled point where each touch closed the contact
+  Point3 centre{};                 ///< fitted: the controlled point that puts the tip's ball on the centre
+  Point3 previous{};               ///< the tool table's X, Y, Z offsets before
+  Point3 offset{};                 ///< … and as measured (Z is the electrode's length)
+  double rms_residual_mm = 0, max_residual_mm = 0;
+};
+
+/// From the touch points: the fit of the points lifted by the tip radius (radius: the sphere's plus
+/// the tip's; its centre is then the sphere's plus the offsets), the offsets, and
+/// the checks: a residual above the tolerance (`electrode.fit`), offsets farther than
+/// `max_deviation` from the table's (`electrode.far`: the sphere is not where the profile says,
+/// or the wrong electrode). Any thread.
+ElectrodeResult evaluate_touches(const config::ReferenceSphereProfile& sphere, int tool,
+                                 const Point3& previous, double tip_radius,
+                                 std::span<const std::string> names, std::span<const Point3> touched);
+
+/// `requests::Feature{"electrode", "measure", ElectrodeMeasure{tool}}`.
+struct ElectrodeMeasure {
+  int tool = 0;
+};
+
+/// Where the main program stopped (aborted or faulted) before its end: what `resume` needs.
+struct ProgramStop {
+  canon::SegmentId segment = 0;  ///< the interpreter's segment id at the commanded position
+  Pose position{};               ///< the commanded position, machine coordinates
+};
+
+enum class ElectrodePhase : std::uint8_t { Idle, Measuring, Approaching, Resuming };
+const char* to_string(ElectrodePhase p) noexcept;
+
+/// The feature "electrode". Actions: `measure` (args ElectrodeMeasure): the machine idle and
+/// homed, no job running, the tool in the table — the touches run one auxiliary program each
+/// (Auto mode), then the offsets are checked and written to the tool table (ChangeSource::Operator,
+/// G10 L1's fields X Y Z) and a note `electrode.set` (or the error's code) says what was found;
+/// `resume`: after a measurement, the main program that stopped before its end goes on — an
+/// approach to where it stopped, moved by the change of the measured tool's offsets (up to the
+/// safe height, over, down), then requests::ResumeProgram at its segment. Attach it with
+/// `trace = true` (it follows the main program's segment) and a status period. Controller thread;
+/// last() and stop() from any thread.
+class ElectrodeSetting final : public Feature {
+ public:
+  ElectrodeSetting(std::shared_ptr<tools::ToolTableService> tools, const config::MachineProfile& profile);
+
+  std::string_view name() const override { return "electrode"; }
+  void attached(FeatureHost& host) override { host_ = &host; }
+  Outcome handle(const requests::Feature& request, FeatureHost& host) override;
+  void on_event(const ControllerEvent& e) override;
+  void on_status(const ControllerStatus& s) override;
+  void on_trace(const TraceSample& s, const TraceContext& c) override;
+
+  ElectrodePhase phase() const;
+  std::optional<ElectrodeResult> last() const;
+  std::optional<ProgramStop> stop() const;
+
+ private:
+  Outcome measure(const ElectrodeMeasure& args, FeatureHost& host);
+  Outcome resume(FeatureHost& host);
+  void when_aux_ended(const ControllerEvent& e);
+  void next_touch();
+  void finish_measurement();
+  void fail(std::string code, std::string message);
+  void set_phase(ElectrodePhase p);
+
+  std::shared_ptr<tools::ToolTableService> tools_;
+  config::ReferenceSphereProfile sphere_;
+  AxisMask axes_;
+  FeatureHost* host_ = nullptr;
+
+  // The measurement under way.
+  int tool_ = 0;
+  std::size_t tool_index_ = 0;
+  tools::ToolEntry entry_;
+  std::vector<SphereTouch> plan_;
+  std::vector<Point3> touched_;
+  std::size_t touch_ = 0;
+  std::shared_ptr<const canon::Program> next_aux_;
+  std::string next_aux_name_;
+  std::uint64_t pending_ = 0;  ///< the request whose refusal ends what runs
+
+  // The main program: its segment at the commanded position while it runs, where it stopped.
+  canon::SegmentId running_segment_ = 0;
+  Pose running_position_{};
+  bool running_seen_ = false;
+  /// The measured tool's offsets when the program stopped (the first measurement since the stop
+  /// knows them): the approach moves the stop point by what changed since.
+  std::optional<Point3> stop_offset_;
+
+  mutable std::mutex mutex_;  ///< guards what the accessors read
+  ElectrodePhase phase_ = ElectrodePhase::Idle;
+  std::optional<ElectrodeResult> last_;
+  std::optional<ProgramStop> stop_;
+};
+
+}  // namespace opencnc::control

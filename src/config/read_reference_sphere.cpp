@@ -1,0 +1,85 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Reading [probe.reference_sphere]: the sphere electrodes are set against, and its simulation.
+#include <fmt/format.h>
+
+#include <cmath>
+
+#include "sections.hpp"
+
+namespace opencnc::config::detail {
+
+namespace {
+
+/// `key` as [x, y, z] (three finite numbers); reports and returns false otherwise.
+bool read_point(Section& s, std::string_view key, std::array<double, 3>& out) {
+  const toml::node* n = s.find(key);
+  if (n == nullptr) {
+    s.missing(key);
+    return false;
+  }
+  const toml::array* a = n->as_array();
+  bool ok = a != nullptr && a->size() == 3;
+  for (std::size_t i = 0; ok && i < 3; ++i) {
+    const std::optional<double> v = (*a)[i].value<double>();
+    ok = v.has_value() && std::isfinite(*v);
+    if (ok) out[i] = *v;
+  }
+  if (!ok)
+    s.error(key, fmt::format("{} must be [x, y, z]: three finite numbers, mm", s.key_path(key)),
+            "config.type");
+  return ok;
+}
+
+void read_sim(Section& s, ReferenceSphereProfile& r) {
+  const toml::table* st = s.subtable("sim");
+  if (st == nullptr) return;
+  Section m(*st, s.path() + ".sim", {"hysteresis", "noise"}, s.reporter());
+  r.sim = true;
+  r.sim_hysteresis = m.number_or("hysteresis", r.sim_hysteresis, Bound::NonNegative);
+  r.sim_noise = m.number_or("noise", r.sim_noise, Bound::NonNegative);
+}
+
+}  // namespace
+
+void read_reference_sphere(Section& probe, MachineProfile& profile) {
+  const toml::table* t = probe.subtable("reference_sphere");
+  if (t == nullptr) return;
+  Section s(*t, "probe.reference_sphere",
+            {"position", "diameter", "b", "clearance", "probe_feed", "safe_z", "touches_around", "tolerance",
+             "max_deviation", "sim"},
+            probe.reporter());
+  ReferenceSphereProfile& r = profile.probe.reference_sphere;
+  r.present = true;
+  read_point(s, "position", r.position);
+  r.diameter = s.required_number("diameter", Bound::Positive);
+  r.clearance = s.number_or("clearance", r.clearance, Bound::Positive);
+  r.probe_feed = s.number_or("probe_feed", r.probe_feed, Bound::Positive);
+  r.safe_z = s.required_number("safe_z");
+  if (const auto n = s.integer("touches_around", 4, 64)) r.touches_around = static_cast<int>(*n);
+  r.tolerance = s.number_or("tolerance", r.tolerance, Bound::Positive);
+  r.max_deviation = s.number_or("max_deviation", r.max_deviation, Bound::Positive);
+  if (s.has("b")) {
+    r.b_deg = s.number_or("b", 0);
+    if (profile.find(Axis::B) == nullptr) s.reject("b", "the profile has no B axis");
+  }
+  for (const Axis a : {Axis::X, Axis::Y, Axis::Z}) {
+    const AxisProfile* ap = profile.find(a);
+    if (ap == nullptr || ap->manual()) {
+      s.error("position",
+              fmt::format("probe.reference_sphere needs driven X, Y and Z axes ({} is {})", letter(a),
+                          ap == nullptr ? "missing" : "hand-fed"),
+              "config.range");
+      return;
+    }
+  }
+  if (r.diameter > 0 && r.safe_z < r.position[2] + r.diameter / 2 + r.clearance) {
+    s.error(
+        "safe_z",
+        fmt::format("probe.reference_sphere.safe_z ({}) is below the sphere's top plus the clearance ({})",
+                    show(r.safe_z), show(r.position[2] + r.diameter / 2 + r.clearance)),
+        "config.range");
+  }
+  read_sim(s, r);
+}
+
+}  // namespace opencnc::config::detail

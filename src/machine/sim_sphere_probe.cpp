@@ -1,0 +1,35 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The simulated electrode against a reference sphere: the gap between two balls, and where
+// between two samples the contact changed.
+#include "opencnc/machine/sim_sphere_probe.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace opencnc::machine {
+
+double SimSphereProbe::gap(const std::array<double, 3>& p) const noexcept {
+  const double dx = p[0] - offset_[0] - target_.centre[0];
+  const double dy = p[1] - offset_[1] - target_.centre[1];
+  const double dz = p[2] - offset_[2] + tip_radius_ - target_.centre[2];
+  return std::sqrt(dx * dx + dy * dy + dz * dz) - target_.radius - tip_radius_;
+}
+
+bool SimSphereProbe::update(const std::array<double, 3>& p, SplitMix64& rng) noexcept {
+  if (!target_.present) return false;
+  const double g = gap(p);
+  const double jitter = target_.noise > 0 ? target_.noise * rng.symmetric() : 0.0;
+  const double threshold = jitter + (active_ ? target_.hysteresis : 0.0);
+  const bool now = g <= threshold;
+  if (now != active_) {
+    // The gap changes smoothly between two samples: the edge is where it crossed the threshold.
+    const double before = sampled_ ? last_gap_ : g;
+    edge_fraction_ = before != g ? std::clamp((before - threshold) / (before - g), 0.0, 1.0) : 1.0;
+  }
+  active_ = now;
+  sampled_ = true;
+  last_gap_ = g;
+  return active_;
+}
+
+}  // namespace opencnc::machine

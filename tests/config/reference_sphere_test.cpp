@@ -1,0 +1,99 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// [probe.reference_sphere]: read into the profile and its simulated machine, and bad values
+// rejected at file:line:col.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "opencnc/config/profile_loader.hpp"
+
+namespace opencnc::config {
+namespace {
+
+/// X Y Z and [probe] (lines 1–17); tests append from line 18.
+const std::string kBase = R"(name = "t"
+[axis.x]
+max_velocity = 50
+max_acceleration = 300
+min_limit = -300
+max_limit = 300
+[axis.y]
+max_velocity = 50
+max_acceleration = 300
+min_limit = -300
+max_limit = 300
+[axis.z]
+max_velocity = 50
+max_acceleration = 300
+min_limit = -300
+max_limit = 100
+[probe]
+)";
+
+const std::string kSphere = R"([probe.reference_sphere]
+position = [100.0, 50.0, -150.0]
+diameter = 10.0
+safe_z = -60.0
+)";
+
+std::string first_error(const ProfileLoad& load) {
+  for (const auto& d : load.diagnostics.items()) {
+    if (d.severity == Severity::Error) return d.format() + " [" + d.code + "]";
+  }
+  return "";
+}
+
+TEST(ReferenceSphere, IsReadWithItsDefaultsAndMadeTheSimulatedProbe) {
+  const ProfileLoad load =
+      parse_profile(kBase + kSphere + "[probe.reference_sphere.sim]\nnoise = 0.0001\n", "p.toml");
+  ASSERT_TRUE(load.ok()) << first_error(load);
+  const ReferenceSphereProfile& s = load.profile->probe.reference_sphere;
+  EXPECT_TRUE(s.present);
+  EXPECT_EQ(s.position, (std::array<double, 3>{100, 50, -150}));
+  EXPECT_EQ(s.touches_around, 4);
+  EXPECT_EQ(s.clearance, 1.0);
+  const machine::SimMachineConfig c = sim_machine_config(*load.profile);
+  EXPECT_TRUE(c.probe.sphere.present);
+  EXPECT_EQ(c.probe.joint, -1);
+  EXPECT_EQ(c.probe.sphere.radius, 5.0);
+  EXPECT_EQ(c.probe.sphere.noise, 0.0001);
+  EXPECT_EQ(c.probe.sphere.joints, (std::array<int, 3>{0, 1, 2}));
+}
+
+struct Bad {
+  const char* name;
+  std::string extra;
+  std::string error;  ///< the start of the first error
+};
+
+class BadReferenceSphere : public ::testing::TestWithParam<Bad> {};
+
+TEST_P(BadReferenceSphere, IsRejectedAtItsPlace) {
+  const ProfileLoad load = parse_profile(kBase + GetParam().extra, "p.toml");
+  EXPECT_FALSE(load.ok());
+  EXPECT_EQ(first_error(load).rfind(GetParam().error, 0), 0u) << first_error(load);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Cases, BadReferenceSphere,
+    ::testing::Values(
+        Bad{"PositionNotThreeNumbers",
+            "[probe.reference_sphere]\nposition = [1.0, 2.0]\ndiameter = 10\nsafe_z = 0\n",
+            "p.toml:19:12: error: probe.reference_sphere.position must be [x, y, z]"},
+        Bad{"NoDiameter", "[probe.reference_sphere]\nposition = [0, 0, 0]\nsafe_z = 50\n",
+            "p.toml:18:1: error:"},
+        Bad{"NegativeDiameter",
+            "[probe.reference_sphere]\nposition = [0, 0, 0]\ndiameter = -3\nsafe_z = 50\n",
+            "p.toml:20:12: error:"},
+        Bad{"SafeZBelowTheTop",
+            "[probe.reference_sphere]\nposition = [0, 0, 0]\ndiameter = 10\nsafe_z = 5.5\n",
+            "p.toml:21:10: error: probe.reference_sphere.safe_z (5.5) is below the sphere's top"},
+        Bad{"TooFewTouches", kSphere + "touches_around = 3\n", "p.toml:22:18: error:"},
+        Bad{"BWithoutAxisB", kSphere + "b = 30\n", "p.toml:22:5: error:"},
+        Bad{"BothSimulations",
+            kSphere + "[probe.reference_sphere.sim]\n[probe.sim]\naxis = \"z\"\ntrip = [-inf, 0]\n",
+            "p.toml:23:1: error: [probe.sim] and [probe.reference_sphere.sim] exclude each other"}),
+    [](const auto& p) { return std::string(p.param.name); });
+
+}  // namespace
+}  // namespace opencnc::config

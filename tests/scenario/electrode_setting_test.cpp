@@ -1,0 +1,229 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Electrode setting through the whole controller on a simulated machine whose probe input is an
+// electrode touching a reference sphere: the offsets measured to the micrometre and stored in the
+// tool table; a missing sphere, a sphere elsewhere and touches off a sphere refused with nothing
+// stored; a worn electrode replaced in the middle of a job, which then goes on where it stopped.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "opencnc/config/profile_loader.hpp"
+#include "opencnc/controller/electrode_setting.hpp"
+#include "scenario.hpp"
+
+namespace opencnc::control::test {
+namespace {
+
+config::MachineProfile edm_profile(const std::vector<std::string>& sets = {}) {
+  const config::ProfileLoad load =
+      config::load_profile(OPENCNC_SOURCE_DIR "/tests/scenario/edm-setting.toml", sets);
+  for (const Diagnostic& d : load.diagnostics.items()) ADD_FAILURE() << d.format();
+  EXPECT_TRUE(load.profile.has_value());
+  return *load.profile;
+}
+
+/// Tool 1: a 50 mm electrode with a point tip; tool 2: 40 mm with a 3 mm ball (diameter 6).
+std::shared_ptr<tools::MemoryToolTable> electrode_table() {
+  tools::ToolTable t;
+  tools::ToolEntry e1;
+  e1.tool = 1;
+  e1.pocket = 1;
+  e1.offset[2] = 50;
+  t.add(e1);
+  tools::ToolEntry e2;
+  e2.tool = 2;
+  e2.pocket = 2;
+  e2.offset[2] = 40;
+  e2.diameter = 6;
+  t.add(e2);
+  return std::make_shared<tools::MemoryToolTable>(std::move(t));
+}
+
+/// The whole controller with the electrode feature, on `sim` (the simulated machine's profile)
+/// while the feature and the program source use `profile`.
+struct Rig {
+  explicit Rig(const config::MachineProfile& profile, const config::MachineProfile& sim)
+      : tools(electrode_table()), scenario(sim, source(profile, tools)) {
+    feature = std::make_shared<ElectrodeSetting>(tools, profile);
+    EXPECT_TRUE(
+        scenario.rig().controller().add_feature(feature, ObserverOptions{profile.servo_period_s, true}));
+    scenario.must(Request::simple(CommandKind::MachineOn));
+  }
+  explicit Rig(const config::MachineProfile& profile) : Rig(profile, profile) {}
+
+  static std::shared_ptr<ProgramSource> source(const config::MachineProfile& p,
+                                               std::shared_ptr<tools::MemoryToolTable> t) {
+    Diagnostics d;
+    std::optional<GcodeSourceConfig> c = GcodeProgramSource::config_for(p, d);
+    EXPECT_TRUE(c.has_value());
+    c->tools = std::move(t);
+    return std::make_shared<GcodeProgramSource>(std::move(*c));
+  }
+  /// Measures `tool`; the result once the feature is idle again.
+  ElectrodeResult measure(int tool) {
+    scenario.must(Request::feature("electrode", "measure", ElectrodeMeasure{tool}));
+    EXPECT_TRUE(scenario.until([&] { return feature->phase() == ElectrodePhase::Idle; }, 60000));
+    EXPECT_TRUE(feature->last().has_value());
+    return feature->last().value_or(ElectrodeResult{});
+  }
+  Point3 table_offset(int tool) const {
+    const tools::ToolEntry* e = tools->snapshot()->tool(tool);
+    return {e->offset[0], e->offset[1], e->offset[2]};
+  }
+
+  std::shared_ptr<tools::MemoryToolTable> tools;
+  Scenario scenario;
+  std::shared_ptr<ElectrodeSetting> feature;
+};
+
+TEST(ElectrodeSetting, MeasuresAnOffsetElectrodeWithinAMicrometreAndStoresIt) {
+  Rig r(edm_profile());
+  const Point3 truth{0.2, -0.1, 50.5};  // tool 1 is off its table entry by (0.2, −0.1, 0.5)
+  r.scenario.sim().set_electrode(truth, 0);
+  const ElectrodeResult m = r.measure(1);
+  ASSERT_TRUE(m.ok) << m.message;
+  ASSERT_EQ(m.touched.size(), 5u) << "four around and one from above";
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_NEAR(m.offset[i], truth[i], 0.001) << "axis " << i;
+    EXPECT_EQ(r.table_offset(1)[i], m.offset[i]) << "stored in the tool table";
+  }
+  EXPECT_LT(m.max_residual_mm, 0.001);
+  EXPECT_EQ(r.scenario.status().servo.commanded[Axis::Z], -60.0) << "left at the safe height";
+}
+
+TEST(ElectrodeSetting, ABallTippedElectrodeIsMeasuredToItsLowestPoint) {
+  Rig r(edm_profile({"probe.reference_sphere.touches_around=6"}));
+  const Point3 truth{-0.3, 0.15, 39.8};
+  r.scenario.sim().set_electrode(truth, 3.0);
+  const ElectrodeResult m = r.measure(2);
+  ASSERT_TRUE(m.ok) << m.message;
+  ASSERT_EQ(m.touched.size(), 7u);
+  EXPECT_EQ(m.names[1], "60°");
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_NEAR(m.offset[i], truth[i], 0.001) << "axis " << i;
+}
+
+TEST(ElectrodeSetting, AMissingSphereIsRefusedAndNothingStored) {
+  // The simulated sphere is 30 mm from where the profile says: the first touch meets nothing.
+  Rig r(edm_profile(), edm_profile({"probe.reference_sphere.position=[130.0, 50.0, -150.0]"}));
+  r.scenario.sim().set_electrode({0, 0, 50}, 0);
+  EventCursor log(r.scenario.rig().controller().events());
+  const ElectrodeResult m = r.measure(1);
+  EXPECT_FALSE(m.ok);
+  EXPECT_EQ(m.code, "electrode.missing-touch");
+  EXPECT_NE(m.message.find("touch from +X met nothing"), std::string::npos) << m.message;
+  EXPECT_EQ(r.table_offset(1), (Point3{0, 0, 50}));
+  bool noted = false;
+  for (const ControllerEvent& e : log.next(1 << 16))
+    noted |= e.kind == ControllerEventKind::Note && e.code == "electrode.missing-touch";
+  EXPECT_TRUE(noted);
+}
+
+TEST(ElectrodeSetting, AContactClosedBeforeTheTouchIsNotATouch) {
+  // 3 mm off in X: the electrode goes down into the sphere beside it and is in contact at the start.
+  Rig r(edm_profile());
+  r.scenario.sim().set_electrode({3, 0, 50}, 0);
+  const ElectrodeResult m = r.measure(1);
+  EXPECT_FALSE(m.ok);
+  EXPECT_EQ(m.code, "electrode.contact-at-start") << m.message;
+  EXPECT_EQ(r.table_offset(1), (Point3{0, 0, 50}));
+}
+
+TEST(ElectrodeSetting, ASphereFartherThanAllowedIsRefused) {
+  Rig r(edm_profile({"probe.reference_sphere.max_deviation=0.5"}));
+  r.scenario.sim().set_electrode({0.7, 0, 50}, 0);
+  const ElectrodeResult m = r.measure(1);
+  EXPECT_FALSE(m.ok);
+  EXPECT_EQ(m.code, "electrode.far") << m.message;
+  EXPECT_NEAR(m.offset[0], 0.7, 0.001) << "what was found is reported";
+  EXPECT_EQ(r.table_offset(1), (Point3{0, 0, 50}));
+}
+
+TEST(ElectrodeSetting, TouchesOffTheSphereExceedTheTolerance) {
+  // A sphere 0.04 mm larger than the profile's (dirt, the wrong sphere): no centre fits.
+  Rig r(edm_profile(), edm_profile({"probe.reference_sphere.diameter=10.04"}));
+  r.scenario.sim().set_electrode({0, 0, 50}, 0);
+  const ElectrodeResult m = r.measure(1);
+  EXPECT_FALSE(m.ok);
+  EXPECT_EQ(m.code, "electrode.fit") << m.message;
+  EXPECT_GT(m.max_residual_mm, 0.002);
+  EXPECT_EQ(r.table_offset(1), (Point3{0, 0, 50}));
+}
+
+TEST(ElectrodeSetting, RefusesWhatItCannotMeasure) {
+  Rig r(edm_profile());
+  EXPECT_FALSE(r.scenario.ask(Request::feature("electrode", "measure", ElectrodeMeasure{9})).accepted);
+  EXPECT_NE(r.scenario.message().find("tool 9 is not in the tool table"), std::string::npos);
+  EXPECT_FALSE(r.scenario.ask(Request::feature("electrode", "resume")).accepted);
+  EXPECT_FALSE(r.scenario.ask(Request::feature("electrode", "measure")).accepted);
+  Rig low(edm_profile({"probe.reference_sphere.safe_z=-100"}));
+  EXPECT_FALSE(low.scenario.ask(Request::feature("electrode", "measure", ElectrodeMeasure{1})).accepted);
+  EXPECT_NE(low.scenario.message().find("safe_z"), std::string::npos) << low.scenario.message();
+}
+
+constexpr const char* kJob =
+    "G21 G90 G17 G40\n"
+    "G43 H1\n"
+    "G0 X0 Y0 Z10\n"
+    "G1 Z-20 F600\n"
+    "G1 X40\n"  // the electrode wears out half way along here
+    "G1 Y40\n"
+    "G0 Z10\n"
+    "M2\n";
+
+TEST(ElectrodeSetting, AWornElectrodeIsReplacedMidJobAndTheJobGoesOnWhereItStopped) {
+  Rig r(edm_profile());
+  r.scenario.sim().set_electrode({0, 0, 50}, 0);
+  TempProgram p("job.ngc", kJob);
+  r.scenario.must(Request::set_mode(Mode::Auto));
+  r.scenario.must(Request::open(p.path()));
+  r.scenario.must(Request::simple(CommandKind::CycleStart));
+  ASSERT_TRUE(r.scenario.until([&] { return r.scenario.status().servo.commanded[Axis::X] > 20; }, 20000));
+  r.scenario.must(Request::simple(CommandKind::FeedHold));
+  ASSERT_TRUE(r.scenario.until(
+      [&] {
+        return r.scenario.status().servo.state == State::Held && r.scenario.status().servo.path_velocity == 0;
+      },
+      5000));
+  r.scenario.must(Request::simple(CommandKind::Abort));
+  ASSERT_TRUE(r.scenario.idle());
+  const std::optional<ProgramStop> stop = r.feature->stop();
+  ASSERT_TRUE(stop.has_value());
+  EXPECT_GT(stop->position[0], 20);
+  EXPECT_EQ(stop->position[2], 30.0) << "on the G1 X40 at Z-20 + 50";
+
+  // The new electrode is 0.2, −0.1 and 0.5 mm off the worn one's offsets.
+  const Point3 truth{0.2, -0.1, 50.5};
+  r.scenario.sim().set_electrode(truth, 0);
+  const ElectrodeResult m = r.measure(1);
+  ASSERT_TRUE(m.ok) << m.message;
+  EventCursor log(r.scenario.rig().controller().events());
+  r.scenario.must(Request::feature("electrode", "resume"));
+  const std::uint64_t finished = r.scenario.status().runs_finished;
+  ASSERT_TRUE(r.scenario.until(
+      [&] { return r.feature->phase() == ElectrodePhase::Idle && r.scenario.status().run_active; }, 60000));
+  // Where the resumed program started: the stop point moved by the measured change.
+  const Pose at = r.scenario.status().servo.commanded;
+  for (int i = 0; i < 3; ++i)
+    EXPECT_NEAR(at[i], stop->position[i] + m.offset[static_cast<std::size_t>(i)] - (i == 2 ? 50.0 : 0.0),
+                1e-6);
+  ASSERT_TRUE(r.scenario.until(
+      [&] { return !r.scenario.status().run_active && r.scenario.status().runs_finished > finished; },
+      60000));
+  int ended = 0;
+  for (const ControllerEvent& e : log.next(1 << 16)) {
+    if (e.kind != ControllerEventKind::JobEnded || e.job != JobKind::Program) continue;
+    EXPECT_EQ(e.end, JobEnd::Finished);
+    ++ended;
+  }
+  EXPECT_EQ(ended, 1);
+  // The rest of the job ran with the new offsets: it ends at X40 Y40 Z10 of the program.
+  const Pose end = r.scenario.status().servo.commanded;
+  EXPECT_NEAR(end[0], 40 + m.offset[0], 1e-9);
+  EXPECT_NEAR(end[1], 40 + m.offset[1], 1e-9);
+  EXPECT_NEAR(end[2], 10 + m.offset[2], 1e-9);
+  EXPECT_FALSE(r.feature->stop().has_value()) << "the job reached its end";
+}
+
+}  // namespace
+}  // namespace opencnc::control::test
