@@ -117,14 +117,14 @@ TEST(BreakpointRecord, TornOrCorruptSlotLeavesTheLastGoodRecord) {
       ASSERT_TRUE(j->write(encode(sample(2)), &error));  // slot b, the newest
     }
     const auto slot_b = dir / "slot-b.jrn";
-    const std::uintmax_t b_size = std::filesystem::file_size(slot_b);
+    const std::uintmax_t middle = encode(sample(2)).size() / 2;  // inside the record
     if (torn) {
-      std::filesystem::resize_file(slot_b, b_size / 2);
+      std::filesystem::resize_file(slot_b, middle);
     } else {
       std::fstream f(slot_b, std::ios::in | std::ios::out | std::ios::binary);
-      f.seekp(static_cast<std::streamoff>(b_size / 2));
+      f.seekp(static_cast<std::streamoff>(middle));
       const char c = static_cast<char>(f.peek() ^ 0x5a);
-      f.seekp(static_cast<std::streamoff>(b_size / 2));
+      f.seekp(static_cast<std::streamoff>(middle));
       f.put(c);
     }
     auto j = Journal::open(dir.string(), &error);
