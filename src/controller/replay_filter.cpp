@@ -4,9 +4,13 @@
 
 namespace opencnc::control::detail {
 
-bool ReplayFilter::motion(canon::SegmentId id) {
+bool ReplayFilter::motion(canon::SegmentId id, const Pose* end, bool end_unknown) {
   if (live_) return true;
-  if (id < first_) return false;
+  if (id < first_) {
+    if (end != nullptr) at_ = *end;
+    at_known_ = end != nullptr || (at_known_ && !end_unknown);
+    return false;
+  }
   live_ = true;
   // The machine as the program had left it before segment k: spindles, coolant, outputs. Each
   // is repeated once, in this order, before the first move.
@@ -27,6 +31,14 @@ bool ReplayFilter::motion(canon::SegmentId id) {
   }
   for (const auto& [index, v] : analog_) next_->set_aux_output_value(index, v);
   return true;
+}
+
+void ReplayFilter::set_axis_coupling(const canon::AxisCoupling& c) {
+  if (live_ || c.law == 0 || !at_known_) return next_->set_axis_coupling(c);
+  canon::AxisCoupling with_origin = c;
+  with_origin.has_origin = true;
+  with_origin.origin = at_;
+  next_->set_axis_coupling(with_origin);
 }
 
 void ReplayFilter::set_spindle_speed(int spindle, double rpm) {

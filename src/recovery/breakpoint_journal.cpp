@@ -80,10 +80,15 @@ BreakpointJournal::~BreakpointJournal() {
 }
 
 void BreakpointJournal::on_event(const control::ControllerEvent& e) {
+  recovery_event(e);
   if (e.kind != ControllerEventKind::ProgramOpened || host_ == nullptr) return;
-  // Resume replays from where the program was placed when it was opened (the controller's rule).
+  // Resume replays from where the program was placed when it was opened (the controller's rule);
+  // a program resumed after a power failure keeps its first start.
   path_ = e.text;
-  program_start_ = host_->current_status().servo.commanded;
+  program_start_ = phase_ == RecoveryPhase::Opening || phase_ == RecoveryPhase::RunningIn ||
+                           phase_ == RecoveryPhase::Resuming
+                       ? recovering_.program_start
+                       : host_->current_status().servo.commanded;
   options_.reset();
   if (source_) options_ = source_->options_for(path_, {});
   stopping_ = completed_ = false;
@@ -280,16 +285,61 @@ void BreakpointJournal::write_one(Work& w) {
   }
 }
 
-control::Outcome BreakpointJournal::handle(const control::requests::Feature& request, control::FeatureHost&) {
+control::Outcome BreakpointJournal::handle(const control::requests::Feature& request,
+                                           control::FeatureHost& host) {
   control::Outcome o;
+  const std::optional<BreakpointRecord> r = last_written();
   if (request.action == "show") {
-    const std::optional<BreakpointRecord> r = last_written();
     o.accepted = true;
     o.message = r ? describe(*r) : "the journal holds no record";
     return o;
   }
+  const bool choice =
+      request.action == "resume" || request.action == "retract" || request.action == "discard";
+  if (choice) {
+    if (!r || !r->valid) {
+      o.refusal = control::Refusal::NotApplicable;
+      o.message = "the journal holds no valid breakpoint";
+      return o;
+    }
+    if (phase_ == RecoveryPhase::Opening || phase_ == RecoveryPhase::RunningIn ||
+        phase_ == RecoveryPhase::Resuming || phase_ == RecoveryPhase::Retracting) {
+      o.refusal = control::Refusal::Busy;
+      o.message = "a recovery choice is under way";
+      return o;
+    }
+  }
+  try {
+    if (request.action == "resume") {
+      const auto* a = std::any_cast<ResumeArgs>(&request.args);
+      if (r->stage != BreakpointStage::AtRest) {
+        o.refusal = control::Refusal::NotApplicable;
+        o.message =
+            "the record was not completed at rest (the power went before the axes stopped): retract or "
+            "discard";
+        return o;
+      }
+      return start_resume(*r, a != nullptr ? *a : ResumeArgs{}, host);
+    }
+    if (request.action == "retract") {
+      const auto* a = std::any_cast<RetractArgs>(&request.args);
+      if (a == nullptr) throw std::bad_any_cast();
+      return start_retract(*r, *a, host);
+    }
+  } catch (const std::bad_any_cast&) {
+    o.refusal = control::Refusal::BadValue;
+    o.message = "retract needs RetractArgs";
+    return o;
+  }
+  if (request.action == "discard") {
+    recovering_ = *r;
+    finish_recovery(true, {});
+    o.accepted = true;
+    o.message = "breakpoint discarded";
+    return o;
+  }
   o.refusal = control::Refusal::BadValue;
-  o.message = fmt::format("the journal has no action '{}' (show)", request.action);
+  o.message = fmt::format("the journal has no action '{}' (show, resume, retract, discard)", request.action);
   return o;
 }
 

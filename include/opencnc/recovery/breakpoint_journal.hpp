@@ -25,6 +25,30 @@ class GcodeProgramSource;
 
 namespace opencnc::recovery {
 
+/// `Request::feature("journal", "resume", ResumeArgs{…})`: how far the axes may be from where the
+/// record says they rest.
+struct ResumeArgs {
+  double tolerance_mm = 0.01;   ///< linear axes
+  double tolerance_deg = 0.01;  ///< rotary axes
+  /// Run-in: the master backs off this far along the interrupted move (the slave on the law)
+  /// before the program cuts on, so the drives have settled at the cutting speed by the time the
+  /// tool reaches the breakpoint (they lag differently while they break away from rest). 0: none;
+  /// never more than the move's part already cut.
+  double run_in_mm = 2.0;
+  double run_in_speed_mm_min = 600;  ///< of the master, backing off
+};
+
+/// `Request::feature("journal", "retract", RetractArgs{…})`: along the master (Z) by `distance_mm`,
+/// the slave (C) held on the law; onward in the interrupted move's direction, or back.
+struct RetractArgs {
+  double distance_mm = 0;
+  bool onward = false;
+  double speed_mm_min = 100;  ///< of the master
+};
+
+/// Where a recovery choice is.
+enum class RecoveryPhase : std::uint8_t { None, Opening, RunningIn, Resuming, Retracting, Done, Failed };
+
 /// The breakpoint journal's writer, a Feature named "journal". Add it with
 /// `Controller::add_feature(f, {servo period, true})`: it follows the status and the trace every
 /// period. At the first period of a power-fail stop during a program it builds the record from
@@ -32,7 +56,9 @@ namespace opencnc::recovery {
 /// the program had them) and hands it to its writer thread, which makes it durable; once the
 /// machine has come to rest (the power-loss fault) the record is completed with where it rests
 /// and written again, then once more with the modal digest (a replay on the writer thread).
-/// Requests: `Request::feature("journal", "show")` says what the journal holds.
+/// Requests: `Request::feature("journal", "show")` says what the journal holds; after the power
+/// returns, with a valid record, "resume" (ResumeArgs), "retract" (RetractArgs) and "discard" —
+/// each clears the valid flag once it has completed (docs/broaching.md, "Recovery").
 class BreakpointJournal final : public control::Feature {
  public:
   /// Opens the journal in `dir` (created if missing); `source` gives the interpreter options of
@@ -61,6 +87,9 @@ class BreakpointJournal final : public control::Feature {
   std::vector<double> latencies_ms() const;
   /// The last write's error ("" = none). Any thread.
   std::string last_error() const;
+  /// Where the last recovery choice is, and why it failed. Controller thread.
+  RecoveryPhase phase() const noexcept { return phase_; }
+  const std::string& recovery_error() const noexcept { return recovery_error_; }
 
  private:
   using Clock = std::chrono::steady_clock;
@@ -78,6 +107,18 @@ class BreakpointJournal final : public control::Feature {
   void write_one(Work& w);
   void begin_record(const control::TraceSample& s, const control::TraceContext& c);
   void complete_record();
+  // Recovery (breakpoint_recovery.cpp).
+  control::Outcome start_resume(const BreakpointRecord& r, const ResumeArgs& args,
+                                control::FeatureHost& host);
+  control::Outcome start_retract(const BreakpointRecord& r, const RetractArgs& args,
+                                 control::FeatureHost& host);
+  std::shared_ptr<const canon::Program> along_helix(const BreakpointRecord& r, double distance_mm,
+                                                    bool onward, double speed_mm_min,
+                                                    control::FeatureHost& host, std::string* why) const;
+  void recovery_event(const control::ControllerEvent& e);
+  void run_in();
+  void finish_recovery(bool ok, std::string why);
+  void clear_valid();
   double period_s() const { return host_ != nullptr ? host_->profile().servo_period_s : 0.0; }
 
   std::unique_ptr<Journal> journal_;
@@ -94,6 +135,12 @@ class BreakpointJournal final : public control::Feature {
   double move_length_mm_ = 0;  ///< of the interrupted move
   bool stopping_ = false, completed_ = false;
   BreakpointRecord record_;
+  // The recovery under way: its phase, the request it waits for, the record it acts on.
+  RecoveryPhase phase_ = RecoveryPhase::None;
+  std::uint64_t pending_ = 0;
+  BreakpointRecord recovering_;
+  ResumeArgs resume_args_;
+  std::string recovery_error_;
 
   // Shared with the writer thread.
   mutable std::mutex mutex_;
