@@ -40,5 +40,6 @@ void add_tools_command(CLI::App& app, Registry& registry);  ///< the tool store 
 void add_nearest_command(CLI::App& app, Registry& registry);
 void add_serve_command(CLI::App& app, Registry& registry);   ///< the HMI server
 void add_helix_command(CLI::App& app, Registry& registry);
+void add_recover_command(CLI::App& app, Registry& registry);  ///< power-fail recovery
 
 }  // namespace opencnc::cli
