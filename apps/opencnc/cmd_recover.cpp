@@ -182,11 +182,13 @@ int recover(const RecoverOptions& o) {
     done = journal->phase() == recovery::RecoveryPhase::Done;
   }
   journal->flush();
-  const std::string why = !answer.accepted ? answer.message : journal->recovery_error();
+  std::string why = !answer.accepted ? answer.message : journal->recovery_error();
+  if (!rig.status().fault_text.empty()) why += " (" + rig.status().fault_text + ")";
   const auto after = journal->last_written();
   fmt::print("{}  {}\n", o.choice, done ? "completed" : "refused or failed: " + why);
   if (r->coupling.kind != 0)
-    fmt::print("helix error         {:.3f} um (feedback, while the breakpoint's law held)\n", trace->helix_error_um());
+    fmt::print("helix error         {:.3f} um (feedback, while the breakpoint's law held)\n",
+               trace->helix_error_um());
   fmt::print("breakpoint valid    {}\n", after && after->valid ? "yes" : "no (cleared)");
   int rc = done ? kExitOk : kExitProgram;
   if (files[0] && !commit(*files[0])) rc = kExitUsage;
