@@ -67,8 +67,9 @@ struct Rig {
 
 /// Largest distance on the bore (µm) of the resumed groove from the reference's, segment by
 /// segment (C interpolated at the same Z), from the breakpoint on along the cutting direction.
+/// `skip_mm`: leave out the first millimetres of every segment (where both runs break away from rest).
 double deviation_um(const Grooves& resumed, const Grooves& ref, const recovery::BreakpointRecord& r,
-                    double radius_mm) {
+                    double radius_mm, double skip_mm = 0) {
   double worst = 0;
   for (const auto& [segment, rows] : resumed.by_segment) {
     auto it = ref.by_segment.find(segment);
@@ -76,8 +77,10 @@ double deviation_um(const Grooves& resumed, const Grooves& ref, const recovery::
     std::vector<std::pair<double, double>> line = it->second;
     std::sort(line.begin(), line.end());
     const double dir = r.move_end[Axis::Z] >= r.move_start[Axis::Z] ? 1.0 : -1.0;
+    const double first_z = it->second.front().first;  // where the reference began the segment
     for (const auto& [z, c] : rows) {
       if (segment == r.segment && (z - r.actual[Axis::Z]) * dir < 0) continue;  // the run-in
+      if (std::fabs(z - first_z) < skip_mm) continue;
       auto hi = std::lower_bound(line.begin(), line.end(), std::pair{z, -1e300});
       if (hi == line.begin() || hi == line.end()) continue;
       const auto lo = hi - 1;
@@ -134,7 +137,7 @@ int main(int argc, char** argv) {
 
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> at(0.5, length_s - 0.5);
-  double coupled_max = 0, independent_max = 0, resume_max = 0;
+  double coupled_max = 0, independent_max = 0, resume_max = 0, moving_max = 0;
   std::vector<double> latencies;
   int resumed = 0, failed = 0;
   for (int k = 0; k < cuts; ++k) {
@@ -182,6 +185,8 @@ int main(int argc, char** argv) {
         ++resumed;
         dev = deviation_um(*after.grooves, *ref.grooves, r, after.profile.coupling.radius_mm);
         resume_max = std::max(resume_max, dev);
+        moving_max = std::max(
+            moving_max, deviation_um(*after.grooves, *ref.grooves, r, after.profile.coupling.radius_mm, 1.0));
       } else {
         ++failed;
         fmt::print(stderr, "cut {} at {:.3f} s: resume failed: {}{}\n", k, cut_s, o.message,
@@ -205,15 +210,16 @@ int main(int argc, char** argv) {
   if (json) {
     fmt::print(
         "{{\"cuts\": {}, \"resumed\": {}, \"resume_failed\": {}, \"coupled_error_um_max\": {:.6f}, "
-        "\"independent_error_um_max\": {:.6f}, \"resume_deviation_um_max\": {:.6f}, \"record_p99_ms\": "
-        "{:.6f}, "
-        "\"record_max_ms\": {:.6f}, \"program_s\": {:.3f}}}\n",
-        cuts, resumed, failed, coupled_max, independent_max, resume_max, p99, pmax, length_s);
+        "\"independent_error_um_max\": {:.6f}, \"resume_deviation_um_max\": {:.6f}, "
+        "\"resume_deviation_um_max_past_1mm\": {:.6f}, \"record_p99_ms\": {:.6f}, \"record_max_ms\": {:.6f}, "
+        "\"program_s\": {:.3f}}}\n",
+        cuts, resumed, failed, coupled_max, independent_max, resume_max, moving_max, p99, pmax, length_s);
   } else {
     fmt::print(
-        "coupled {:.3f} um max, independent {:.1f} um max, resumed groove {:.3f} um max ({} of {} resumed), "
-        "record p99 {:.3f} ms (max {:.3f})\n",
-        coupled_max, independent_max, resume_max, resumed, cuts, p99, pmax);
+        "coupled {:.3f} um max, independent {:.1f} um max, resumed groove {:.3f} um max ({:.3f} past the "
+        "first mm "
+        "of each move; {} of {} resumed), record p99 {:.3f} ms (max {:.3f})\n",
+        coupled_max, independent_max, resume_max, moving_max, resumed, cuts, p99, pmax);
   }
   return failed == 0 ? 0 : 1;
 }

@@ -12,6 +12,7 @@ bool ReplayFilter::motion(canon::SegmentId id, const Pose* end, bool end_unknown
     return false;
   }
   live_ = true;
+  if (coupling_.law != 0) next_->set_axis_coupling(coupling_);
   // The machine as the program had left it before segment k: spindles, coolant, outputs. Each
   // is repeated once, in this order, before the first move.
   for (const auto& [index, s] : spindles_) {
@@ -33,12 +34,13 @@ bool ReplayFilter::motion(canon::SegmentId id, const Pose* end, bool end_unknown
   return true;
 }
 
+// Only the coupling that holds at segment k matters: every code before it replaces the one before
+// (M175 releases it); it is passed on at k with the origin it had.
 void ReplayFilter::set_axis_coupling(const canon::AxisCoupling& c) {
-  if (live_ || c.law == 0 || !at_known_) return next_->set_axis_coupling(c);
-  canon::AxisCoupling with_origin = c;
-  with_origin.has_origin = true;
-  with_origin.origin = at_;
-  next_->set_axis_coupling(with_origin);
+  if (live_) return next_->set_axis_coupling(c);
+  coupling_ = c;
+  coupling_.has_origin = at_known_;
+  coupling_.origin = at_;
 }
 
 void ReplayFilter::set_spindle_speed(int spindle, double rpm) {

@@ -50,9 +50,9 @@ class ReplayFilter final : public canon::Sink {
   void nurbs_feed(canon::SegmentId id, int order, std::span<const canon::NurbsPoint> points) override {
     if (motion(id, nullptr, true)) next_->nurbs_feed(id, order, points);
   }
-  /// A coupling code before segment k passes in its place with the origin it had there (where
-  /// the path stood: the end of the motion before it), so the resumed run's law is the original
-  /// one, not one engaged where the machine stands now.
+  /// The coupling codes before segment k: the one that holds at k passes just before it with the
+  /// origin it had (where the path stood: the end of the motion before it), so the resumed run's
+  /// law is the original one, not one engaged where the machine stands now.
   void set_axis_coupling(const canon::AxisCoupling& c) override;
   void dwell(double s) override {
     if (live_) next_->dwell(s);
@@ -183,6 +183,7 @@ class ReplayFilter final : public canon::Sink {
   /// last motion (not after a NURBS, whose end the filter does not compute, nor before the first).
   Pose at_{};
   bool at_known_ = false;
+  canon::AxisCoupling coupling_{};  ///< the coupling code that holds (law 0: none)
   // What the replayed part left on (−1: never set, so left as the machine has it).
   struct Spindle {
     double speed = 0;
