@@ -173,6 +173,24 @@ TEST(PowerFailRecovery, ResumedGrooveMatchesTheUninterruptedRun) {
   EXPECT_FALSE(cleared->valid);  // cleared once the resumed program finished
 }
 
+// In the second groove (its law engaged at C 180°, after the first groove's M171 … M175): only the
+// law that holds at the segment re-engages, with its origin, and the job finishes.
+TEST(PowerFailRecovery, ResumesInTheSecondGroove) {
+  const auto dir = fresh_dir("journal");
+  BreakpointRecord r;
+  {
+    Machine cut(dir);
+    r = cut.cut_mains(kProgram, 62.05);
+    ASSERT_EQ(r.coupling.slave_origin, 180.0);
+  }
+  Machine after(dir, power_up_at(r));
+  const control::Outcome o = after.choose("resume");
+  ASSERT_TRUE(o.accepted) << o.message;
+  EXPECT_EQ(after.journal->phase(), RecoveryPhase::Done) << after.journal->recovery_error();
+  EXPECT_EQ(after.rig->status().servo.fault.kind, control::FaultKind::None);
+  EXPECT_FALSE(after.journal->last_written()->valid);
+}
+
 TEST(PowerFailRecovery, RetractKeepsTheHelix) {
   const auto dir = fresh_dir("journal");
   BreakpointRecord r;
