@@ -27,6 +27,7 @@
 #include "opencnc/controller/servo_setup.hpp"
 #include "opencnc/process/process_log.hpp"
 #include "opencnc/recovery/retrace.hpp"
+#include "run_journal.hpp"
 #include "run_session.hpp"
 #include "stop_signals.hpp"
 
@@ -46,6 +47,7 @@ struct RunOptions {
   std::vector<std::string> inject;       ///< "mains-off@SECONDS", "tool-dull@SECONDS=FACTOR", "edm-short@SECONDS",
                                          ///< "analog:CH=VALUE@SECONDS[/RAMP_S]"
   std::vector<std::string> retraces;     ///< "AT_SECONDS:X,Y"
+  std::string journal;                   ///< the breakpoint journal's folder ("" = none)
 };
 
 /// One scripted retrace: at `at_s` seconds into the run, pause, jog to (x, y), start.
@@ -489,14 +491,26 @@ int run(const RunOptions& o) {
   for (const std::string& text : o.retraces) steps.push_back(*parse_retrace(text));  // checked by the option
   std::shared_ptr<recovery::RetraceFeature> feature;
   std::optional<RetraceScript> script;
-  if (!steps.empty()) {
+  // --journal: the breakpoint journal's writer (docs/broaching.md), opened before anything runs.
+  std::shared_ptr<recovery::BreakpointJournal> journal;
+  if (!o.journal.empty()) {
+    if (!profile || !(journal = open_run_journal(o.journal, *profile))) return kExitUsage;
+    hooks.features_trace = true;
+  }
+  if (!steps.empty() || journal) {
     hooks.features = [&](const config::MachineProfile& machine) {
+      std::vector<std::shared_ptr<control::Feature>> out;
+      if (journal) out.push_back(journal);
+      if (steps.empty()) return out;
       Diagnostics d;
       feature = std::make_shared<recovery::RetraceFeature>(control::GcodeProgramSource::create(machine, d),
                                                            machine);
       script.emplace(steps, feature);
-      return std::vector<std::shared_ptr<control::Feature>>{feature};
+      out.push_back(feature);
+      return out;
     };
+  }
+  if (!steps.empty()) {
     hooks.tick = [&](control::Controller& c, const control::ControllerStatus& st) { script->tick(c, st); };
     hooks.goes_on = [&](const control::ControllerEvent& e) { return script->goes_on(e); };
   }
@@ -535,6 +549,7 @@ int run(const RunOptions& o) {
     }
     j["retraces"] = retraces_json(records, script->times());
   }
+  if (journal) j["journal"] = finish_run_journal(*journal);
   if (report_file != nullptr && !write_and_commit(*report_file, j.dump(2) + "\n")) rc = kExitUsage;
   return rc;
 }
@@ -576,6 +591,9 @@ void add_run_command(CLI::App& app, Registry& registry) {
                   "ramp: the profile's alarms act on it)")
       ->expected(1)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  cmd->add_option("--journal", opts->journal,
+                  "Write the breakpoint journal in this folder when the mains fail (two checksummed slots; "
+                  "`opencnc recover` reads it; the report gains `journal`)");
   cmd->add_option(
          "--max-time", opts->max_time_s,
          "Refuse a program that needs more machining time than this, in seconds (default 86400, a day; "

@@ -544,7 +544,8 @@ SessionEnd run_session(const SessionOptions& o, const SessionHooks& hooks) {
   if (setup->feature) d.controller().add_feature(setup->feature);
   if (hooks.features) {
     for (auto& f : hooks.features(end.profile))
-      d.controller().add_feature(std::move(f), control::ObserverOptions{end.profile.servo_period_s, false});
+      d.controller().add_feature(std::move(f),
+                                 control::ObserverOptions{end.profile.servo_period_s, hooks.features_trace});
   }
   const control::ServoConfig& sc = d.controller().servo_config();
   // Through HAL the machine may already be on: a previous controller left it idle.

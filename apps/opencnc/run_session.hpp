@@ -71,6 +71,8 @@ struct SessionHooks {
   /// Features added to the controller before the program is opened (the retrace feature), each
   /// following the status every servo period.
   std::function<std::vector<std::shared_ptr<control::Feature>>(const config::MachineProfile&)> features;
+  /// The features follow the trace too (the breakpoint journal reads the interrupted move from it).
+  bool features_trace = false;
   /// Every period of the run, with the controller: a scripted operator (`run --retrace`).
   std::function<void(control::Controller&, const control::ControllerStatus&)> tick;
   /// When the program's job ends: true if the session goes on with the job that resumes it.

@@ -364,6 +364,7 @@ void ProgramBuilder::set_axis_coupling(const AxisCoupling& c) {
   Pose rate{};
   rate[0] = c.rate;
   a.pose = program_.add_action_pose(rate);
+  if (c.has_origin) a.origin = 1 + program_.add_action_pose(to_machine(c.origin));
   add(a);
 }
 // Passed as programmed: the module's words have their own units (a condition number, …).

@@ -78,8 +78,8 @@ void Servo::engage_coupling(const MachineAction& a) noexcept {
   coupling_.table = a.index2;
   coupling_.pitch_mm = a.value;
   coupling_.pitch_rate = a.value2;
-  coupling_.master_origin = commanded_[cc.master_axis];
-  coupling_.slave_origin = commanded_[cc.slave_axis];
+  coupling_.master_origin = a.has_origin ? a.master_origin : commanded_[cc.master_axis];
+  coupling_.slave_origin = a.has_origin ? a.slave_origin : commanded_[cc.slave_axis];
 }
 
 void Servo::release_coupling() noexcept {

@@ -98,8 +98,12 @@ void CouplingPass::engage(const canon::Program& program, const canon::Action& a)
       law_ = motion::CouplingLaw::tabulated(kind, axes_.config.tables[static_cast<std::size_t>(t)]);
     }
   }
-  master_origin_ = at[axes_.config.master_axis];
-  slave_origin_ = at[slave];
+  // A resumed program's law engages with the origin its code had; the slave coordinate the
+  // program asked for last is the one it had there (it cannot ask for another while coupled).
+  const Pose& origin = a.origin != 0 ? program.action_pose(a.origin - 1) : at;
+  if (a.origin != 0) programmed_slave_ = origin[slave];
+  master_origin_ = origin[axes_.config.master_axis];
+  slave_origin_ = origin[slave];
 }
 
 void CouplingPass::process_move(canon::Program& program, canon::SegmentId id) {

@@ -357,7 +357,8 @@ void Job::service(const ServoStatus& s) {
 void Job::push_actions() {
   const canon::Program& p = stream_->program();
   while (leg_.next_action < p.action_count() && p.action(leg_.next_action).before_move <= leg_.checked) {
-    const auto a = machine_action(p, leg_.next_action);
+    const auto a =
+        machine_action(p, leg_.next_action, host_.servo != nullptr ? &host_.servo->coupling : nullptr);
     if (a && !host_.channels->actions.try_push(*a)) break;
     ++leg_.next_action;
   }

@@ -2,6 +2,8 @@
 // Program tails (restart from a position) and canon actions → machine actions.
 #include "opencnc/controller/program_tools.hpp"
 
+#include "opencnc/motion/coupling.hpp"
+
 #include <unordered_map>
 
 namespace opencnc::control {
@@ -39,7 +41,8 @@ canon::Action copy_action(const canon::Program& from, canon::Program& to, canon:
   }
   const bool has_pose = a.kind == ActionKind::ToolLengthOffset || a.kind == ActionKind::WorkOffset ||
                         a.kind == ActionKind::G92Offset;
-  if (has_pose) a.pose = to.add_action_pose(from.action_pose(a.pose));
+  if (has_pose || a.kind == ActionKind::AxisCoupling) a.pose = to.add_action_pose(from.action_pose(a.pose));
+  if (a.origin != 0) a.origin = 1 + to.add_action_pose(from.action_pose(a.origin - 1));
   return a;
 }
 
@@ -78,7 +81,8 @@ std::shared_ptr<canon::Program> program_tail(const canon::Program& program, cano
   return out;
 }
 
-std::optional<MachineAction> machine_action(const canon::Program& program, std::uint32_t index) {
+std::optional<MachineAction> machine_action(const canon::Program& program, std::uint32_t index,
+                                            const motion::CouplingConfig* coupling) {
   const canon::Action& a = program.action(index);
   MachineAction m;
   m.action = index;
@@ -159,6 +163,12 @@ std::optional<MachineAction> machine_action(const canon::Program& program, std::
     case ActionKind::AxisCoupling:
       m.code = ActionCode::AxisCoupling;
       m.value2 = program.action_pose(a.pose)[0];
+      if (a.origin != 0 && coupling != nullptr && coupling->master_axis >= 0 && coupling->slave_axis >= 0) {
+        const Pose& origin = program.action_pose(a.origin - 1);
+        m.has_origin = true;
+        m.master_origin = origin[coupling->master_axis];
+        m.slave_origin = origin[coupling->slave_axis];
+      }
       break;
     case ActionKind::ProcessCode:
       m.code = ActionCode::ProcessCode;

@@ -4,10 +4,15 @@
 
 namespace opencnc::control::detail {
 
-bool ReplayFilter::motion(canon::SegmentId id) {
+bool ReplayFilter::motion(canon::SegmentId id, const Pose* end, bool end_unknown) {
   if (live_) return true;
-  if (id < first_) return false;
+  if (id < first_) {
+    if (end != nullptr) at_ = *end;
+    at_known_ = end != nullptr || (at_known_ && !end_unknown);
+    return false;
+  }
   live_ = true;
+  if (coupling_.law != 0) next_->set_axis_coupling(coupling_);
   // The machine as the program had left it before segment k: spindles, coolant, outputs. Each
   // is repeated once, in this order, before the first move.
   for (const auto& [index, s] : spindles_) {
@@ -27,6 +32,15 @@ bool ReplayFilter::motion(canon::SegmentId id) {
   }
   for (const auto& [index, v] : analog_) next_->set_aux_output_value(index, v);
   return true;
+}
+
+// Only the coupling that holds at segment k matters: every code before it replaces the one before
+// (M175 releases it); it is passed on at k with the origin it had.
+void ReplayFilter::set_axis_coupling(const canon::AxisCoupling& c) {
+  if (live_) return next_->set_axis_coupling(c);
+  coupling_ = c;
+  coupling_.has_origin = at_known_;
+  coupling_.origin = at_;
 }
 
 void ReplayFilter::set_spindle_speed(int spindle, double rpm) {

@@ -32,23 +32,28 @@ class ReplayFilter final : public canon::Sink {
   void set_feed_reference(canon::FeedReference r) override { next_->set_feed_reference(r); }
 
   void straight_traverse(canon::SegmentId id, const Pose& end) override {
-    if (motion(id)) next_->straight_traverse(id, end);
+    if (motion(id, &end)) next_->straight_traverse(id, end);
   }
   void straight_feed(canon::SegmentId id, const Pose& end) override {
-    if (motion(id)) next_->straight_feed(id, end);
+    if (motion(id, &end)) next_->straight_feed(id, end);
   }
   void arc_feed(canon::SegmentId id, const canon::ArcFeed& arc) override {
-    if (motion(id)) next_->arc_feed(id, arc);
+    if (motion(id, &arc.end)) next_->arc_feed(id, arc);
   }
   void straight_probe(canon::SegmentId id, const Pose& end) override {
-    if (motion(id)) next_->straight_probe(id, end);
+    if (motion(id, &end)) next_->straight_probe(id, end);
   }
   void rigid_tap(canon::SegmentId id, const Pose& end, double scale) override {
-    if (motion(id)) next_->rigid_tap(id, end, scale);
+    // The tap returns to where it started: the path stands at its start again.
+    if (motion(id, nullptr)) next_->rigid_tap(id, end, scale);
   }
   void nurbs_feed(canon::SegmentId id, int order, std::span<const canon::NurbsPoint> points) override {
-    if (motion(id)) next_->nurbs_feed(id, order, points);
+    if (motion(id, nullptr, true)) next_->nurbs_feed(id, order, points);
   }
+  /// The coupling codes before segment k: the one that holds at k passes just before it with the
+  /// origin it had (where the path stood: the end of the motion before it), so the resumed run's
+  /// law is the original one, not one engaged where the machine stands now.
+  void set_axis_coupling(const canon::AxisCoupling& c) override;
   void dwell(double s) override {
     if (live_) next_->dwell(s);
   }
@@ -167,13 +172,18 @@ class ReplayFilter final : public canon::Sink {
 
  private:
   /// Whether a motion passes; the first that does restores the machine's state first.
-  bool motion(canon::SegmentId id);
+  bool motion(canon::SegmentId id, const Pose* end, bool end_unknown = false);
   void coolant(int& state, bool on, void (canon::Sink::*call)());
   void output(int index, int value, bool motion);
 
   canon::Sink* next_;
   canon::SegmentId first_;
   bool live_ = false;
+  /// Where the path stands in the replayed part (program coordinates), if known: the end of the
+  /// last motion (not after a NURBS, whose end the filter does not compute, nor before the first).
+  Pose at_{};
+  bool at_known_ = false;
+  canon::AxisCoupling coupling_{};  ///< the coupling code that holds (law 0: none)
   // What the replayed part left on (−1: never set, so left as the machine has it).
   struct Spindle {
     double speed = 0;

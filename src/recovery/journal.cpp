@@ -20,6 +20,8 @@ constexpr std::array<char, 8> kMagic = {'O', 'C', 'N', 'C', 'J', 'R', 'N', 'L'};
 constexpr std::uint32_t kVersion = 1;
 /// magic, version (u32), payload length (u32), sequence (u64); then payload, then CRC-32 (u32).
 constexpr std::size_t kHeader = 8 + 4 + 4 + 8;
+/// Size a slot file is given when opened (a breakpoint record is about 600 bytes).
+constexpr off_t kPresize = 4096;
 
 std::array<std::uint32_t, 256> make_crc_table() {
   std::array<std::uint32_t, 256> t{};
@@ -51,6 +53,16 @@ bool sync_folder(const std::string& dir, std::string* error) {
   return true;
 }
 
+// A slot file is made kPresize bytes long (zeros: no record) once, when opened shorter: a record
+// that fits then never changes the file's size, so its fdatasync flushes the data blocks only and
+// not the inode (about half the latency of the first write into a fresh file on ext4).
+bool presize(int fd) {
+  struct stat st {};
+  if (::fstat(fd, &st) != 0) return false;
+  if (st.st_size >= kPresize) return true;
+  return ::ftruncate(fd, kPresize) == 0 && ::fsync(fd) == 0;
+}
+
 }  // namespace
 
 std::uint32_t crc32(std::span<const std::byte> bytes, std::uint32_t crc) noexcept {
@@ -72,8 +84,9 @@ std::unique_ptr<Journal> Journal::open(const std::string& dir, std::string* erro
   for (int s = 0; s < 2; ++s) {
     const std::string path = (std::filesystem::path(dir) / names[s]).string();
     fds[s] = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-    if (fds[s] < 0) {
-      if (error) *error = reason("cannot open", path);
+    if (fds[s] < 0 || !presize(fds[s])) {
+      if (error) *error = reason(fds[s] < 0 ? "cannot open" : "cannot size", path);
+      if (fds[s] >= 0) ::close(fds[s]);
       if (s == 1) ::close(fds[0]);
       return nullptr;
     }

@@ -111,7 +111,8 @@ enum class ActionKind : std::uint8_t {
   /// a retract (the move went in +), 0: a plunge.
   HandAxisWait,
   /// The broaching codes' coupling (canon::AxisCoupling): index = law (0 off), index2 = table,
-  /// value = pitch (mm), action pose [0] = pitch rate. The motion stops exactly there.
+  /// value = pitch (mm), action pose [0] = pitch rate, `origin` = 1 + the action pose of the
+  /// law's origin in machine coordinates (0: where the path stands). The motion stops exactly there.
   AxisCoupling,
   /// A machine module's process code (canon::ProcessCode): index = code, value = P, action pose
   /// [0] = Q. The motion stops exactly there.
@@ -129,6 +130,7 @@ struct Action {
   double value = 0;
   std::uint32_t text = 0;   ///< index into texts (Message/Comment)
   std::uint32_t pose = 0;   ///< index into poses of actions (offsets)
+  std::uint32_t origin = 0;  ///< AxisCoupling: 1 + index into poses of the law's origin (0: none)
 };
 
 /// The expanded program. Positions in machine coordinates (mm, degrees) with every offset,

@@ -63,6 +63,11 @@ struct AxisCoupling {
   int table = 0;       ///< 1-based table number of the profile (laws 3 and 4)
   double pitch = 0;    ///< pitch per revolution, program length units (laws 1 and 2; sign = hand)
   double rate = 0;     ///< change of pitch per unit of master travel (law 2; dimensionless)
+  /// Where the law engaged, in program coordinates, when it is not where the path stands now: a
+  /// program resumed at a later segment re-engages the law of a code its replay passed with the
+  /// origin the code had (the replay filter sets it). False: where the path stands.
+  bool has_origin = false;
+  Pose origin{};
   bool operator==(const AxisCoupling&) const = default;
 };
 

@@ -193,6 +193,10 @@ struct MachineAction {
   std::int32_t index2 = 0;
   double value = 0;
   double value2 = 0;  ///< SurfaceSpeed: X of the spindle axis, machine coordinates (mm); AxisCoupling: pitch rate
+  /// AxisCoupling: the law's origin (master, slave; machine coordinates) when it is not where the
+  /// path stands (a resumed program re-engaging the law of a code before its segment).
+  bool has_origin = false;
+  double master_origin = 0, slave_origin = 0;
 };
 
 /// How a run ended.

@@ -9,6 +9,10 @@
 #include "opencnc/canon/program.hpp"
 #include "opencnc/control/command.hpp"
 
+namespace opencnc::motion {
+struct CouplingConfig;
+}
+
 namespace opencnc::control {
 
 /// A copy of `program` from move `from` on, whose first move starts at `start`. Its moves are
@@ -20,7 +24,9 @@ std::shared_ptr<canon::Program> program_tail(const canon::Program& program, cano
                                              const Pose& start);
 
 /// The machine side of action `index` of `program` when the planner turns it into a marker the
-/// servo must act on (a Report or Sync marker), else nothing. Non-real-time.
-std::optional<MachineAction> machine_action(const canon::Program& program, std::uint32_t index);
+/// servo must act on (a Report or Sync marker), else nothing. `coupling` (the servo's) names the
+/// master and slave whose origin a coupling action carries. Non-real-time.
+std::optional<MachineAction> machine_action(const canon::Program& program, std::uint32_t index,
+                                            const motion::CouplingConfig* coupling = nullptr);
 
 }  // namespace opencnc::control

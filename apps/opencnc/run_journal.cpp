@@ -1,0 +1,49 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// `opencnc run --journal DIR`: opening the journal feature and reporting what it wrote.
+#include "run_journal.hpp"
+
+#include <fmt/format.h>
+
+#include "opencnc/controller/gcode_source.hpp"
+
+namespace opencnc::cli {
+
+std::shared_ptr<recovery::BreakpointJournal> open_run_journal(const std::string& dir,
+                                                              const config::MachineProfile& profile) {
+  Diagnostics d;
+  std::shared_ptr<control::GcodeProgramSource> source = control::GcodeProgramSource::create(profile, d);
+  std::string error;
+  auto journal = recovery::BreakpointJournal::open(dir, source, &error);
+  if (!journal) fmt::print(stderr, "error: --journal {}: {}\n", dir, error);
+  return journal;
+}
+
+nlohmann::json finish_run_journal(recovery::BreakpointJournal& journal) {
+  journal.flush();
+  nlohmann::json j;
+  const std::optional<recovery::BreakpointRecord> r = journal.last_written();
+  const std::vector<double> latencies = journal.latencies_ms();
+  const std::string error = journal.last_error();
+  j["written"] = r.has_value() && !latencies.empty();
+  j["error"] = error.empty() ? nlohmann::json(nullptr) : nlohmann::json(error);
+  if (!error.empty()) fmt::print(stderr, "error: journal: {}\n", error);
+  if (!r || latencies.empty()) {
+    fmt::print("journal             no breakpoint written (no power failure during the program)\n");
+    return j;
+  }
+  j["valid"] = r->valid;
+  j["stage"] = to_string(r->stage);
+  j["segment"] = r->segment;
+  j["file"] = r->source_file;
+  j["line"] = r->line;
+  j["segment_offset_mm"] = r->segment_offset_mm;
+  j["move_remaining_mm"] = r->move_remaining_mm;
+  j["program_hash"] = fmt::format("{:016x}", r->program_hash);
+  j["modal_digest"] = fmt::format("{:016x}", r->modal_digest);
+  j["record_latency_ms"] = latencies.front();
+  fmt::print("journal             {}\n", describe(*r));
+  fmt::print("journal latency     {:.3f} ms from the signal to the durable record\n", latencies.front());
+  return j;
+}
+
+}  // namespace opencnc::cli
