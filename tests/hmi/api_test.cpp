@@ -110,6 +110,16 @@ TEST(ApiJson, StatusCarriesWhatTheScreensShow) {
   EXPECT_EQ(j["wait_text"], "the operator's resume (feed hold)");
   EXPECT_TRUE(j["following_error"].contains("Z"));
   EXPECT_FALSE(j["machine"].contains("A"));
+  // Work coordinates: the feedback position less the offsets; distance to go as the status has it.
+  s.offsets.system = 3;
+  s.offsets.g5x[0] = 2.5;
+  s.offsets.g92[0] = 1;
+  s.distance_to_go[0] = -4;
+  const json w = status_json(s, p);
+  EXPECT_EQ(w["offsets"]["system"], "G56");
+  EXPECT_EQ(w["work"]["X"], 9.0);
+  EXPECT_EQ(w["distance_to_go"]["X"], -4.0);
+  EXPECT_EQ(w["offsets"]["g92"]["X"], 1.0);
   const json m = machine_json(p);
   EXPECT_EQ(m["axes"].size(), 3u);
   EXPECT_EQ(m["axes"][0]["axis"], "X");

@@ -233,6 +233,34 @@ TEST(Server, AJobRunsToItsEndWithHoldAndResumeAndLandsInTheHistory) {
   EXPECT_TRUE(ended);
 }
 
+TEST(Server, TheStatusShowsWorkCoordinatesWithAG55OffsetAndAG92Shift) {
+  Rig rig;
+  const std::string& t = kOperator;
+  EXPECT_EQ(post(rig.port, R"({"kind":"machine-on"})", t).status, 200);
+  EXPECT_EQ(post(rig.port, R"({"kind":"mode","mode":"mdi"})", t).status, 200);
+  const auto mdi = [&](const std::string& line) {
+    ASSERT_EQ(post(rig.port, json{{"kind", "mdi"}, {"line", line}}.dump(), t).status, 200) << line;
+    ASSERT_TRUE(rig.until([](const json& s) { return s["state"] == "idle" && !s["job"]["active"].get<bool>(); }));
+  };
+  mdi("G21 G90 G10 L2 P2 X10 Y20 Z-5");
+  mdi("G55 G0 X1 Y2 Z0");
+  mdi("G52 X1");  // a local shift (the G92 offset) of exactly 1
+  const json s = get(rig.port, "/api/v1/status").body;  // tokenless on loopback
+  EXPECT_EQ(s["offsets"]["system"], "G55");
+  EXPECT_EQ(s["offsets"]["g5x"]["X"], 10.0);
+  EXPECT_EQ(s["offsets"]["g5x"]["Y"], 20.0);
+  EXPECT_EQ(s["offsets"]["g5x"]["Z"], -5.0);
+  EXPECT_EQ(s["offsets"]["g92"]["X"], 1.0);
+  EXPECT_NEAR(s["commanded"]["X"].get<double>(), 11.0, 1e-9);
+  EXPECT_EQ(s["distance_to_go"]["X"], 0.0);
+  // work = machine − offsets, from the feedback position
+  const double machine_x = s["machine"]["X"].get<double>(), machine_y = s["machine"]["Y"].get<double>();
+  EXPECT_EQ(s["work"]["X"].get<double>(), machine_x - 10.0 - 1.0);
+  EXPECT_EQ(s["work"]["Y"].get<double>(), machine_y - 20.0);
+  EXPECT_NEAR(s["work"]["X"].get<double>(), 0.0, 1e-3);  // X1 in G55 before the shift
+  EXPECT_NEAR(s["work"]["Y"].get<double>(), 2.0, 1e-3);
+}
+
 TEST(MachineHost, InRealTimeTheServoTicksByItselfAndTheControllerAnswers) {
   const config::MachineProfile profile = control::test::mill();
   MachineHost host(profile, nullptr, HostOptions{true, 1});

@@ -13,7 +13,7 @@ import "./screens/history";
 import "./screens/params";
 import "./screens/network";
 import type { ControllerEvent, Machine, Status } from "./types";
-import { button, coord, el, percent } from "./ui";
+import { button, coord, el, offsetsText, percent } from "./ui";
 import { View3d, type Preview } from "./view3d";
 
 function token(): string {
@@ -81,13 +81,16 @@ async function start() {
   const dro = el("tbody");
   const cells: Record<string, HTMLElement[]> = {};
   for (const a of machine.axes) {
-    const c = [el("td", { class: "pos" }), el("td", {}), el("td", {}), el("td", {})];
-    c[0].dataset.testid = `pos-${a.axis}`;
+    const c = [el("td", { class: "pos" }), el("td", {}), el("td", {}), el("td", {}), el("td", {})];
+    c[0].dataset.testid = `work-${a.axis}`;
+    c[1].dataset.testid = `pos-${a.axis}`;
+    c[2].dataset.testid = `togo-${a.axis}`;
     cells[a.axis] = c;
     dro.append(el("tr", {}, el("th", {}, a.axis), ...c));
   }
+  const workHead = el("th", {}, "work");
   const droTable = el("table", { class: "dro" },
-    el("thead", {}, el("tr", {}, ...["", "machine", "commanded", "following error", "homed"].map((h) => el("th", {}, h)))), dro);
+    el("thead", {}, el("tr", {}, el("th", {}), workHead, ...["machine", "to go", "following error", "homed"].map((h) => el("th", {}, h)))), dro);
 
   // The program with its current line.
   const progName = el("div", { class: "progname" });
@@ -170,12 +173,15 @@ async function start() {
     mode.textContent = s.mode.toUpperCase();
     for (const a of machine.axes) {
       const c = cells[a.axis];
-      c[0].textContent = coord(s.machine[a.axis]);
-      c[1].textContent = coord(s.commanded[a.axis]);
+      c[0].textContent = coord(s.work[a.axis]);
+      c[1].textContent = coord(s.machine[a.axis]);
+      c[2].textContent = coord(s.distance_to_go[a.axis]);
       const fe = s.following_error[a.axis] ?? 0;
-      c[2].textContent = (Math.abs(fe) < 0.00005 ? 0 : fe).toFixed(4);
-      c[3].textContent = s.homed[a.axis] ? "●" : "○";
+      c[3].textContent = (Math.abs(fe) < 0.00005 ? 0 : fe).toFixed(4);
+      c[4].textContent = s.homed[a.axis] ? "●" : "○";
     }
+    workHead.textContent = `work ${s.offsets.system}`;
+    workHead.title = offsetsText(s.offsets, machine.axes.map((a) => a.axis));
     progName.textContent = s.program.name ? `${s.program.name.split("/").pop()} — ${s.program.moves} moves, ${s.program.length_mm.toFixed(1)} mm` : "no program open";
     progress.value = s.job.progress;
     if (s.program.name !== listingOf) {
