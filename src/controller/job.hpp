@@ -11,6 +11,7 @@
 #include <optional>
 #include <string>
 
+#include "offset_track.hpp"
 #include "opencnc/control/channels.hpp"
 #include "opencnc/control/servo_config.hpp"
 #include "opencnc/controller/controller_status.hpp"
@@ -18,7 +19,6 @@
 #include "opencnc/controller/observer.hpp"
 #include "opencnc/controller/program_source.hpp"
 #include "opencnc/plan/planner.hpp"
-#include "offset_track.hpp"
 
 namespace opencnc::control::detail {
 
@@ -90,7 +90,9 @@ class Job {
   void set_initial_offsets(const WorkOffsets& o) { offsets_ = OffsetTrack(o); }
   /// The offsets of the servo's move `segment` of the current run (segments asked for must
   /// not go backward), and after everything read so far.
-  const WorkOffsets& offsets_at(std::uint64_t segment) { return offsets_.at(static_cast<std::size_t>(segment)); }
+  const WorkOffsets& offsets_at(std::uint64_t segment) {
+    return offsets_.at(static_cast<std::size_t>(segment));
+  }
   const WorkOffsets& latest_offsets() const noexcept { return offsets_.latest(); }
   /// The end of the servo's move `segment` of the current run, if the window still holds it.
   std::optional<Pose> move_end(std::uint64_t segment) const;

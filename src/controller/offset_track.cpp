@@ -26,8 +26,10 @@ void OffsetTrack::scan(const canon::Program& p) {
         continue;
     }
     // Several changes before the same move are one change.
-    if (!changes_.empty() && changes_.back().first == a.before_move) changes_.back().second = latest_;
-    else changes_.emplace_back(a.before_move, latest_);
+    if (!changes_.empty() && changes_.back().first == a.before_move)
+      changes_.back().second = latest_;
+    else
+      changes_.emplace_back(a.before_move, latest_);
   }
 }
 

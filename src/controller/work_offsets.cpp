@@ -8,7 +8,8 @@
 namespace opencnc::control {
 
 const char* work_system_name(std::uint8_t system) noexcept {
-  static constexpr const char* kNames[] = {"G54", "G55", "G56", "G57", "G58", "G59", "G59.1", "G59.2", "G59.3"};
+  static constexpr const char* kNames[] = {"G54", "G55",   "G56",   "G57",  "G58",
+                                           "G59", "G59.1", "G59.2", "G59.3"};
   return system >= 1 && system <= 9 ? kNames[system - 1] : "";
 }
 

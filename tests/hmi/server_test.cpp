@@ -240,11 +240,12 @@ TEST(Server, TheStatusShowsWorkCoordinatesWithAG55OffsetAndAG92Shift) {
   EXPECT_EQ(post(rig.port, R"({"kind":"mode","mode":"mdi"})", t).status, 200);
   const auto mdi = [&](const std::string& line) {
     ASSERT_EQ(post(rig.port, json{{"kind", "mdi"}, {"line", line}}.dump(), t).status, 200) << line;
-    ASSERT_TRUE(rig.until([](const json& s) { return s["state"] == "idle" && !s["job"]["active"].get<bool>(); }));
+    ASSERT_TRUE(
+        rig.until([](const json& s) { return s["state"] == "idle" && !s["job"]["active"].get<bool>(); }));
   };
   mdi("G21 G90 G10 L2 P2 X10 Y20 Z-5");
   mdi("G55 G0 X1 Y2 Z0");
-  mdi("G52 X1");  // a local shift (the G92 offset) of exactly 1
+  mdi("G52 X1");                                        // a local shift (the G92 offset) of exactly 1
   const json s = get(rig.port, "/api/v1/status").body;  // tokenless on loopback
   EXPECT_EQ(s["offsets"]["system"], "G55");
   EXPECT_EQ(s["offsets"]["g5x"]["X"], 10.0);

@@ -23,7 +23,7 @@ bool until_past(Scenario& s, std::uint32_t line, double x) {
 
 TEST(WorkOffsetsScenario, AG55OffsetAndAG92ShiftShowUpExactly) {
   TempProgram p("offsets.ngc",
-                "G21 G90 F600\n"          // 1
+                "G21 G90 F600\n"           // 1
                 "G10 L2 P2 X10 Y20 Z-5\n"  // 2
                 "G55\n"                    // 3
                 "G0 X0 Y0 Z0\n"            // 4

@@ -36,10 +36,10 @@ const char* to_string(JobEnd e) noexcept;
 /// The offsets the interpreter applies to a move (mm, or degrees on a rotary axis; machine axes):
 /// machine = rotate_xy(work + g92) + g5x + tool, the program builder's transform.
 struct WorkOffsets {
-  std::uint8_t system = 1;  ///< 1 … 9: G54, G55, … G59, G59.1, G59.2, G59.3
-  Pose g5x{};               ///< the active coordinate system's origin
-  Pose g92{};               ///< G92 / G52 shift
-  Pose tool{};              ///< tool length offset (G43)
+  std::uint8_t system = 1;     ///< 1 … 9: G54, G55, … G59, G59.1, G59.2, G59.3
+  Pose g5x{};                  ///< the active coordinate system's origin
+  Pose g92{};                  ///< G92 / G52 shift
+  Pose tool{};                 ///< tool length offset (G43)
   double xy_rotation_deg = 0;  ///< the coordinate system's XY rotation (G10 L2 R)
 };
 
