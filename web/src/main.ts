@@ -13,7 +13,7 @@ import "./screens/history";
 import "./screens/params";
 import "./screens/network";
 import type { ControllerEvent, Machine, Status } from "./types";
-import {button, coord, el, offsetsText, percent} from './ui';
+import { button, coord, el, offsetsText, percent } from "./ui";
 import { View3d, type Preview } from "./view3d";
 
 function token(): string {
@@ -81,20 +81,16 @@ async function start() {
   const dro = el("tbody");
   const cells: Record<string, HTMLElement[]> = {};
   for (const a of machine.axes) {
-    const c = [el('td', {class: 'pos'}), el('td', {}), el('td', {}), el('td', {}), el('td', {})];
+    const c = [el("td", { class: "pos" }), el("td", {}), el("td", {}), el("td", {}), el("td", {})];
     c[0].dataset.testid = `work-${a.axis}`;
     c[1].dataset.testid = `pos-${a.axis}`;
     c[2].dataset.testid = `togo-${a.axis}`;
     cells[a.axis] = c;
     dro.append(el("tr", {}, el("th", {}, a.axis), ...c));
   }
-  const workHead = el('th', {}, 'work');
-  const droTable =
-      el('table', {class: 'dro'},
-         el('thead', {},
-            el('tr', {}, el('th', {}), workHead,
-               ...['machine', 'to go', 'following error', 'homed'].map((h) => el('th', {}, h)))),
-         dro);
+  const workHead = el("th", {}, "work");
+  const droTable = el("table", { class: "dro" },
+    el("thead", {}, el("tr", {}, el("th", {}), workHead, ...["machine", "to go", "following error", "homed"].map((h) => el("th", {}, h)))), dro);
 
   // The program with its current line.
   const progName = el("div", { class: "progname" });
@@ -182,7 +178,7 @@ async function start() {
       c[2].textContent = coord(s.distance_to_go[a.axis]);
       const fe = s.following_error[a.axis] ?? 0;
       c[3].textContent = (Math.abs(fe) < 0.00005 ? 0 : fe).toFixed(4);
-      c[4].textContent = s.homed[a.axis] ? '●' : '○';
+      c[4].textContent = s.homed[a.axis] ? "●" : "○";
     }
     workHead.textContent = `work ${s.offsets.system}`;
     workHead.title = offsetsText(s.offsets, machine.axes.map((a) => a.axis));

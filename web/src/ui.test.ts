@@ -1,10 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The formats of the DRO and the overrides, and which dialog a status asks for.
-import {describe, expect, it} from 'vitest';
-
-import {dialogFor} from './dialogs/waits';
-import {coord, offsetsText, percent} from './ui';
-
+import { describe, expect, it } from "vitest";
+import { coord, offsetsText, percent } from "./ui";
+import { dialogFor } from "./dialogs/waits";
 import type { Status } from "./types";
 
 describe("formats", () => {
@@ -14,16 +12,10 @@ describe("formats", () => {
     expect(coord(-3)).toBe("-3.000");
     expect(coord(undefined)).toBe("—");
   });
-  it('says which offsets hold, only the axes that have one', () => {
-    const o = {
-      system: 'G55',
-      g5x: {X: 10, Y: 20, Z: 0},
-      g92: {X: 1, Y: 0, Z: 0},
-      tool: {X: 0, Y: 0, Z: 0},
-      xy_rotation_deg: 0
-    };
-    expect(offsetsText(o, ['X', 'Y', 'Z'])).toBe('G55 X+10.000 Y+20.000 · G92 X+1.000');
-    expect(offsetsText({...o, g5x: {}, g92: {}}, ['X'])).toBe('G55');
+  it("says which offsets hold, only the axes that have one", () => {
+    const o = { system: "G55", g5x: { X: 10, Y: 20, Z: 0 }, g92: { X: 1, Y: 0, Z: 0 }, tool: { X: 0, Y: 0, Z: 0 }, xy_rotation_deg: 0 };
+    expect(offsetsText(o, ["X", "Y", "Z"])).toBe("G55 X+10.000 Y+20.000 · G92 X+1.000");
+    expect(offsetsText({ ...o, g5x: {}, g92: {} }, ["X"])).toBe("G55");
   });
   it("shows overrides in per cent", () => {
     expect(percent(1.2)).toBe("120 %");

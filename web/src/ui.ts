@@ -37,17 +37,14 @@ export function percent(v: number): string {
 
 /** The offsets of a status in words, for the DRO's work column: "G55 X+10.000 Y+20.000 · G92 X+1.000". */
 export function offsetsText(
-    o: {
-      system: string; g5x: Record<string, number>; g92: Record<string, number>; tool: Record<string, number>;
-      xy_rotation_deg: number
-    },
-    axes: string[],
-    ): string {
+  o: { system: string; g5x: Record<string, number>; g92: Record<string, number>; tool: Record<string, number>; xy_rotation_deg: number },
+  axes: string[],
+): string {
   const part = (name: string, p: Record<string, number>) => {
     const set = axes.filter((a) => (p[a] ?? 0) !== 0).map((a) => `${a}${coord(p[a])}`);
-    return set.length ? `${name} ${set.join(' ')}` : '';
+    return set.length ? `${name} ${set.join(" ")}` : "";
   };
-  const parts = [part(o.system, o.g5x) || o.system, part('G92', o.g92), part('tool', o.tool)];
+  const parts = [part(o.system, o.g5x) || o.system, part("G92", o.g92), part("tool", o.tool)];
   if (o.xy_rotation_deg !== 0) parts.push(`R${o.xy_rotation_deg}°`);
-  return parts.filter((p) => p).join(' · ');
+  return parts.filter((p) => p).join(" · ");
 }
