@@ -586,8 +586,9 @@ void Controller::start_job(std::uint64_t id, JobKind kind, std::string name, Mod
   host.next_run_id = [this] { return ++run_counter_; };
   host.may_continue = [this](const SyncCheck& c) { return features_allow_continue(c); };
   auto job = std::make_unique<detail::Job>(kind, ++job_counter_, name, mode, std::move(stream), std::move(host));
-  // A program's interpreter sets its offsets as it starts; the MDI session's keeps its own.
-  if (kind == JobKind::Mdi) job->set_initial_offsets(mdi_offsets_);
+  // A program's interpreter sets its offsets as it starts; the MDI session's keeps its own; a
+  // canonical program (an approach move) has none: the ones shown stay.
+  job->set_initial_offsets(kind == JobKind::Mdi ? mdi_offsets_ : published_.offsets);
   Diagnostics d;
   if (!job->start(id, d)) {
     const Refusal why = program_refusal(d);
