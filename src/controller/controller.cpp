@@ -675,6 +675,7 @@ void Controller::publish() {
     described_fault_tick_ = s.fault.tick;
   }
   p.runs_finished = runs_finished_;
+  p.block_delete = block_delete_;
 }
 
 // The offsets of the move at the commanded position, and what is left of that move.

@@ -117,7 +117,7 @@ Outcome RunFromLineFeature::handle(const requests::Feature& request, FeatureHost
   }
   std::string why;
   std::optional<LineStart> at =
-      find_line_start(*source_, s.program_name, program_start_, args->line, {}, &why);
+      find_line_start(*source_, s.program_name, program_start_, args->line, {s.block_delete}, &why);
   if (!at) {
     o.message = why;
     return o;

@@ -11,6 +11,7 @@
 #include "../control/test_profiles.hpp"
 #include "client.hpp"
 #include "opencnc/controller/gcode_source.hpp"
+#include "opencnc/controller/run_from_line.hpp"
 #include "opencnc/hmi/history.hpp"
 #include "opencnc/hmi/machine_host.hpp"
 #include "opencnc/hmi/server.hpp"
@@ -40,6 +41,8 @@ struct Rig {
     history = History::open(dir / "history.sqlite", &error);
     host = std::make_unique<MachineHost>(profile, source, HostOptions{false, 200});
     host->controller().attach(std::make_shared<HistoryRecorder>(*history, profile.servo_period_s));
+    host->controller().add_feature(
+        std::make_shared<control::RunFromLineFeature>(control::GcodeProgramSource::create(profile, d)));
     host->start(nullptr);
     sc.address = address;
     sc.port = 0;
@@ -260,6 +263,33 @@ TEST(Server, TheStatusShowsWorkCoordinatesWithAG55OffsetAndAG92Shift) {
   EXPECT_EQ(s["work"]["Y"].get<double>(), machine_y - 20.0);
   EXPECT_NEAR(s["work"]["X"].get<double>(), 0.0, 1e-3);  // X1 in G55 before the shift
   EXPECT_NEAR(s["work"]["Y"].get<double>(), 2.0, 1e-3);
+}
+
+TEST(Server, RunFromLineStartsTheProgramAtTheLineAfterTheApproach) {
+  Rig rig;
+  const std::string& t = kOperator;
+  EXPECT_EQ(post(rig.port, R"({"kind":"machine-on"})", t).status, 200);
+  EXPECT_EQ(post(rig.port, R"({"kind":"home"})", t).status, 200);
+  EXPECT_EQ(post(rig.port, R"({"kind":"mode","mode":"auto"})", t).status, 200);
+  ASSERT_EQ(post(rig.port, R"({"kind":"open","program":"bracket.ngc"})", t).status, 200);
+  EXPECT_EQ(post(rig.port, R"({"kind":"run-from-line","line":0})", t).status, 422);
+  EXPECT_EQ(post(rig.port, R"({"kind":"run-from-line"})", t).status, 400);
+  const Reply none = post(rig.port, R"({"kind":"run-from-line","line":12})", t);  // an assignment
+  EXPECT_EQ(none.status, 409);
+  EXPECT_NE(none.text.find("line 12 makes no move"), std::string::npos) << none.text;
+  // The drilling after the second tool change: the approach, then the program from line 66.
+  const Reply from = post(rig.port, R"({"kind":"run-from-line","line":66})", t);
+  ASSERT_EQ(from.status, 200) << from.text;
+  EXPECT_NE(from.text.find("bracket.ngc:66"), std::string::npos) << from.text;
+  std::uint32_t first_line = 0;
+  ASSERT_TRUE(rig.until(
+      [&](const json& s) {
+        if (first_line == 0 && s["job"]["kind"] == "program" && s["job"]["location"]["line"].get<int>() > 0)
+          first_line = s["job"]["location"]["line"].get<std::uint32_t>();
+        return s["runs_finished"].get<int>() >= 1 && s["job"]["kind"] == "" && s["state"] == "idle";
+      },
+      60));
+  EXPECT_GE(first_line, 66u);
 }
 
 TEST(MachineHost, InRealTimeTheServoTicksByItselfAndTheControllerAnswers) {

@@ -100,7 +100,11 @@ async function start() {
   const loadListing = async () => {
     try {
       const t = await api.get<{ from: number; lines: string[] }>("program/text?from=1&count=5000");
-      listing.replaceChildren(...t.lines.map((l) => el("li", {}, l || " ")));
+      listing.replaceChildren(...t.lines.map((l, i) => {
+        const li = el("li", {}, l || " ");
+        li.addEventListener("click", () => document.dispatchEvent(new CustomEvent("line-chosen", { detail: t.from + i })));
+        return li;
+      }));
     } catch {
       listing.replaceChildren();
     }

@@ -86,6 +86,7 @@ struct ControllerStatus {
   /// What the job waits for, in words ("" = nothing): "the operator (M0 at part.ngc:12)".
   std::string wait_text;
 
+  bool block_delete = false;  ///< the block-delete switch ('/' lines skipped by the programs started now)
   std::string fault_text;           ///< servo.fault in words ("" = none)
   std::uint64_t runs_finished = 0;  ///< jobs that reached their program end
 };
