@@ -15,6 +15,7 @@
 #include "opencnc/hmi/history.hpp"
 #include "opencnc/hmi/machine_host.hpp"
 #include "opencnc/hmi/server.hpp"
+#include "opencnc/hmi/stream_tickets.hpp"
 
 namespace opencnc::hmi {
 namespace {
@@ -138,6 +139,41 @@ TEST(Server, ToolDataIsTheAdminsAndEveryChangeIsAudited) {
   EXPECT_FALSE(audit[2]["time"].get<std::string>().empty());
 }
 
+TEST(Server, TheStreamOpensWithASingleUseTicketAndNeverATokenInTheUrl) {
+  Rig rig;
+  const Reply issued = call(rig.port, http::verb::post, "/api/v1/stream-ticket", kOperator, "");
+  ASSERT_EQ(issued.status, 200) << issued.text;
+  const std::string ticket = issued.body["ticket"];
+  EXPECT_EQ(ticket.size(), 48u);
+  EXPECT_EQ(issued.body["expires_in_s"], 30);
+  EXPECT_EQ(call(rig.port, http::verb::post, "/api/v1/stream-ticket", "", "").status, 401);
+  EXPECT_EQ(get(rig.port, "/api/v1/stream-ticket", kOperator).status, 405);
+  {
+    Stream s(rig.port, "", 0, "?ticket=" + ticket);
+    EXPECT_EQ(s.next()["type"], "status");
+  }
+  // Used up; a token in the query opens nothing (nor does it pass for any other call).
+  EXPECT_THROW(Stream(rig.port, "", 0, "?ticket=" + ticket), beast::system_error);
+  EXPECT_THROW(Stream(rig.port, "", 0, "?token=" + kOperator), beast::system_error);
+  EXPECT_EQ(get(rig.port, "/api/v1/programs?token=" + kOperator).status, 401);
+}
+
+TEST(StreamTickets, LastTheirLifetimeAndOpenOnce) {
+  StreamTickets t;
+  const auto now = StreamTickets::Clock::now();
+  std::string error;
+  const auto a = t.issue(Role::Admin, now, &error), b = t.issue(Role::Operator, now, &error);
+  ASSERT_TRUE(a && b) << error;
+  EXPECT_NE(*a, *b);
+  EXPECT_EQ(t.redeem(*a, now + std::chrono::seconds(29)), Role::Admin);
+  EXPECT_FALSE(t.redeem(*a, now + std::chrono::seconds(29)));  // once
+  EXPECT_FALSE(t.redeem(*b, now + StreamTickets::kLifetime));  // expired
+  EXPECT_FALSE(t.redeem("", now));
+  EXPECT_EQ(t.outstanding(), 0u);
+  for (std::size_t k = 0; k < StreamTickets::kMaxOutstanding + 5; ++k) ASSERT_TRUE(t.issue(Role::Operator, now, &error));
+  EXPECT_EQ(t.outstanding(), StreamTickets::kMaxOutstanding);
+}
+
 TEST(Server, TheStreamSendsStatusAtItsRateAndEachClientItsEvents) {
   ServerConfig sc;
   sc.stream_hz = 30;
@@ -205,6 +241,11 @@ TEST(Server, AJobRunsToItsEndWithHoldAndResumeAndLandsInTheHistory) {
   EXPECT_GT(preview["polylines"].size(), 2u);
   EXPECT_EQ(get(rig.port, "/api/v1/program/text?from=4&count=1", t).body["lines"][0],
             "G21 G17 G40 G49 G80 G90 G94");
+  EXPECT_TRUE(get(rig.port, "/api/v1/program/text?from=4&count=1", t).body["more"]);  // a window: more after it
+  const json tail = get(rig.port, "/api/v1/program/text?from=70&count=5000", t).body;
+  EXPECT_FALSE(tail["more"]);
+  EXPECT_EQ(tail["from"], 70);
+  EXPECT_EQ(tail["lines"][0], "G80");
   EXPECT_EQ(post(rig.port, R"({"kind":"cycle-start"})", t).status, 200);
   ASSERT_TRUE(rig.until([](const json& s) { return s["wait"] == "manual-tool-change"; }));
   EXPECT_EQ(post(rig.port, R"({"kind":"tool-changed"})", t).status, 200);

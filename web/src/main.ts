@@ -13,7 +13,7 @@ import "./screens/history";
 import "./screens/params";
 import "./screens/network";
 import type { ControllerEvent, Machine, Status } from "./types";
-import { button, coord, el, offsetsText, percent } from "./ui";
+import { button, coord, el, offsetsText, outsideWindow, percent, windowStart } from "./ui";
 import { View3d, type Preview } from "./view3d";
 
 function token(): string {
@@ -97,9 +97,19 @@ async function start() {
   const progress = el("progress", { max: "1", value: "0" });
   const listing = el("ol", { class: "listing" });
   let listingOf = "";
-  const loadListing = async () => {
+  // A window of the program around the current line (a program may have millions of lines).
+  const kWindow = 2000;
+  let windowFrom = 1, windowLines = 0, windowMore = false, windowWanted = 0;
+  const loadListing = async (around = 1) => {
+    const from = windowStart(around, kWindow);
+    windowWanted = from;
     try {
-      const t = await api.get<{ from: number; lines: string[] }>("program/text?from=1&count=5000");
+      const t = await api.get<{ from: number; lines: string[]; more: boolean }>(`program/text?from=${from}&count=${kWindow}`);
+      if (windowWanted !== from) return;  // a newer window was asked for meanwhile
+      windowFrom = t.from;
+      windowLines = t.lines.length;
+      windowMore = t.more;
+      listing.start = t.from;
       listing.replaceChildren(...t.lines.map((l, i) => {
         const li = el("li", {}, l || " ");
         li.addEventListener("click", () => document.dispatchEvent(new CustomEvent("line-chosen", { detail: t.from + i })));
@@ -107,6 +117,8 @@ async function start() {
       }));
     } catch {
       listing.replaceChildren();
+      windowFrom = from;
+      windowLines = 0;
     }
   };
 
@@ -194,9 +206,10 @@ async function start() {
       void loadPreview();
     }
     const line = s.job.active ? s.job.location.line : 0;
+    if (outsideWindow(line, windowFrom, windowLines, windowMore) && windowWanted === windowFrom) void loadListing(line);
     listing.querySelectorAll("li.current").forEach((li) => li.classList.remove("current"));
-    if (line > 0 && listing.children[line - 1]) {
-      const li = listing.children[line - 1] as HTMLElement;
+    if (line > 0 && listing.children[line - windowFrom]) {
+      const li = listing.children[line - windowFrom] as HTMLElement;
       li.classList.add("current");
       li.scrollIntoView({ block: "nearest" });
     }

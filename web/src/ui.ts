@@ -48,3 +48,14 @@ export function offsetsText(
   if (o.xy_rotation_deg !== 0) parts.push(`R${o.xy_rotation_deg}°`);
   return parts.filter((p) => p).join(" · ");
 }
+
+/** The first line of a listing window of `size` lines for `line`: a quarter of it before. */
+export function windowStart(line: number, size: number): number {
+  return Math.max(1, line - Math.floor(size / 4));
+}
+
+/** Whether `line` (0: none) lies outside the window [from, from + count) of a file that has more
+ * lines after it when `more`, so that another window must be loaded. */
+export function outsideWindow(line: number, from: number, count: number, more: boolean): boolean {
+  return line > 0 && (line < from || (line >= from + count && more));
+}
