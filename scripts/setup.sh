@@ -13,7 +13,7 @@ packages=(
   nlohmann-json3-dev    # JSON reports and API
   libtomlplusplus-dev   # machine profiles
   libboost-dev          # Boost.Beast (header-only): the HMI server's HTTP and WebSocket
-  libsqlite3-dev        # the tool store (store::Database) and the HMI's machining history and audit trail
+  libsqlite3-dev        # the tool store (store::Database), the HMI's history and audit trail, the process-data log
   python3               # helper scripts (program generators, golden regeneration)
 )
 test_packages=(

@@ -23,6 +23,7 @@
 #include "opencnc/controller/preflight.hpp"
 #include "opencnc/controller/run_recorder.hpp"
 #include "opencnc/controller/servo_setup.hpp"
+#include "opencnc/process/process_log.hpp"
 #include "opencnc/recovery/retrace.hpp"
 #include "run_session.hpp"
 #include "stop_signals.hpp"
@@ -38,8 +39,9 @@ struct RunOptions {
   SessionOptions session;
   std::string trace;
   std::string report;
+  std::string process_log;  ///< FILE.csv or FILE.sqlite: the process data at the profile's rate
   double max_time_s = kDefaultMaxTimeS;  ///< 0: no limit
-  std::string inject;                    ///< "mains-off@SECONDS"
+  std::vector<std::string> inject;       ///< "mains-off@SECONDS", "tool-dull@SECONDS=FACTOR"
   std::vector<std::string> retraces;     ///< "AT_SECONDS:X,Y"
 };
 
@@ -130,18 +132,38 @@ class RetraceScript {
   std::vector<double> times_;
 };
 
-/// "mains-off@12.5" → 12.5 (servo time of the run); nullopt with the reason printed.
-std::optional<double> mains_off_time(const std::string& inject) {
-  constexpr std::string_view kPrefix = "mains-off@";
-  char* end = nullptr;
-  const double s = inject.rfind(kPrefix, 0) == 0 ? std::strtod(inject.c_str() + kPrefix.size(), &end) : -1;
-  if (end == nullptr || *end != '\0' || !std::isfinite(s) || s < 0) {
-    fmt::print(stderr,
-               "error: --inject {}: expected mains-off@SECONDS (servo time from the run's start, >= 0)\n",
-               inject);
-    return std::nullopt;
+/// The faults --inject schedules, in servo time from the run's start.
+struct Injections {
+  double mains_off_s = -1;
+  double tool_dull_s = -1, tool_dull_factor = 1;
+};
+
+/// "mains-off@12.5" or "tool-dull@4=2.5" into `out`; false with the reason printed.
+bool parse_injection(const std::string& text, Injections& out) {
+  const auto number = [](const char* from, char stop, const char*& end) {
+    char* e = nullptr;
+    const double v = std::strtod(from, &e);
+    end = e;
+    return e != from && *e == stop && std::isfinite(v) ? v : -1.0;
+  };
+  const char* end = nullptr;
+  if (text.rfind("mains-off@", 0) == 0) {
+    out.mains_off_s = number(text.c_str() + 10, '\0', end);
+    if (out.mains_off_s >= 0) return true;
+  } else if (text.rfind("tool-dull@", 0) == 0) {
+    out.tool_dull_s = number(text.c_str() + 10, '=', end);
+    const double f = out.tool_dull_s >= 0 ? number(end + 1, '\0', end) : -1;
+    if (f > 0 && f <= 100) {
+      out.tool_dull_factor = f;
+      return true;
+    }
   }
-  return s;
+  fmt::print(
+      stderr,
+      "error: --inject {}: expected mains-off@SECONDS or tool-dull@SECONDS=FACTOR (servo time from the "
+      "run's start, >= 0; the cutter's force grows by FACTOR, 0 < FACTOR <= 100, 1 = sharp)\n",
+      text);
+  return false;
 }
 
 /// "3.2 h", "19.0 years": a duration a person reads at a glance.
@@ -332,24 +354,42 @@ int run(const RunOptions& o) {
   // Every output is checked (and created) before anything runs.
   const std::optional<config::MachineProfile> profile = quiet_profile(o.session);
   const std::vector<NamedPath> inputs = session_inputs(o.session, profile ? &*profile : nullptr);
-  const NamedPath outputs[] = {{"--trace", o.trace}, {"--report", o.report}};
+  const NamedPath outputs[] = {{"--trace", o.trace}, {"--report", o.report}, {"--process-log", o.process_log}};
   if (!check_inputs(inputs)) return kExitUsage;
+  const std::optional<process::LogFormat> log_format =
+      o.process_log.empty() ? std::nullopt : process::log_format(o.process_log);
+  if (!o.process_log.empty() && !log_format) {
+    fmt::print(stderr, "error: --process-log {}: the name must end in .csv, .sqlite, .sqlite3 or .db\n", o.process_log);
+    return kExitUsage;
+  }
   if (profile && !within_max_time(o, *profile)) return kExitProgram;
   const auto files = open_outputs(inputs, outputs);
   if (files.empty()) return kExitUsage;
   OutputFile* const trace_file = files[0].get();
   OutputFile* const report_file = files[1].get();
+  OutputFile* const log_file = files[2].get();
+  std::shared_ptr<process::ProcessLog> process_log;
   std::shared_ptr<control::RunRecorder> recorder;
   std::shared_ptr<control::PowerFailRecorder> power_recorder;
   SessionOptions session = o.session;
   if (!o.inject.empty()) {
-    const std::optional<double> at = mains_off_time(o.inject);
-    if (!at) return kExitUsage;
+    Injections at;
+    for (const std::string& text : o.inject) {
+      if (!parse_injection(text, at)) return kExitUsage;
+    }
     if (o.session.realtime || o.session.hal) {
       fmt::print(stderr, "error: --inject works in virtual time only (not with --realtime or --hal)\n");
       return kExitUsage;
     }
-    session.mains_off_s = *at;
+    if (at.tool_dull_s >= 0 && profile && !profile->broaching.sim.present) {
+      fmt::print(stderr,
+                 "error: --inject tool-dull needs a simulated broach ([process.broaching.sim] in {})\n",
+                 o.session.machine);
+      return kExitUsage;
+    }
+    session.mains_off_s = at.mains_off_s;
+    session.tool_dull_s = at.tool_dull_s;
+    session.tool_dull_factor = at.tool_dull_factor;
   }
   std::optional<control::TraceCsvWriter> csv;
   std::optional<ProgressBar> bar;
@@ -371,6 +411,13 @@ int run(const RunOptions& o) {
     if (trace_file != nullptr) {
       csv.emplace(*trace_file, machine.axis_mask(), machine.servo_period_s);
       out.emplace_back(std::make_shared<TraceObserver>(*csv), control::ObserverOptions{0, true});
+    }
+    if (log_file != nullptr) {
+      process::ProcessLogSetup setup{machine.axis_mask(), machine.broaching.present ? machine.broaching.log_rate_hz : 100.0,
+                                     machine.servo_period_s, machine.coupling.present ? machine.coupling.radius_mm : 0.0,
+                                     o.session.file, machine.name};
+      process_log = std::make_shared<process::ProcessLog>(setup, *log_format, *log_file);
+      out.emplace_back(process_log, control::ObserverOptions{0, true});
     }
     if (tty) bar.emplace(program.preflight.summary.path_length_mm);
     return out;
@@ -402,6 +449,13 @@ int run(const RunOptions& o) {
   if (!recorder) return end.exit_code;  // nothing ran; the outputs are left as they were
   int rc = end.exit_code;
   if (trace_file != nullptr && !commit_trace(*trace_file)) rc = kExitUsage;
+  if (process_log) {
+    std::string error;
+    if (!process_log->finish(&error) || !log_file->commit(&error)) {
+      fmt::print(stderr, "error: --process-log {}: {}\n", o.process_log, error);
+      rc = kExitUsage;
+    }
+  }
   const control::RunReport r = recorder->report();
   print_report(r, end.profile, end);
   std::optional<control::PowerFailReport> power_fail;
@@ -448,9 +502,15 @@ void add_run_command(CLI::App& app, Registry& registry) {
                 "operator on the terminal");
   cmd->add_option("--trace", opts->trace, "Write one CSV row per servo period (docs/controller.md)");
   cmd->add_option("--report", opts->report, "Write the report as JSON");
+  cmd->add_option("--process-log", opts->process_log,
+                  "Write the process data (load, positions, feed, helix error) at the profile's rate "
+                  "([process.broaching] log_rate_hz, else 100 Hz) to FILE.csv or FILE.sqlite (docs/broaching.md)");
   cmd->add_option("--inject", opts->inject,
-                  "Fault injection in virtual time: mains-off@SECONDS (the mains fail then; the report gains "
-                  "power_fail)");
+                  "Fault injection in virtual time (repeatable): mains-off@SECONDS (the mains fail then; the "
+                  "report gains power_fail), tool-dull@SECONDS=FACTOR (the broach's cutter wears: its force "
+                  "grows by FACTOR, 1 = sharp)")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   cmd->add_option(
          "--max-time", opts->max_time_s,
          "Refuse a program that needs more machining time than this, in seconds (default 86400, a day; "

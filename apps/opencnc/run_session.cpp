@@ -55,6 +55,8 @@ class Driver {
   virtual void set_hand_target(int joint, double target, double speed) = 0;
   /// The simulated mains fail (virtual time only: cmd_run refuses --inject with --realtime or --hal).
   virtual void cut_mains() = 0;
+  /// The simulated broach's cutter wears to `factor` (virtual time only, as cut_mains).
+  virtual void set_tool_dull(double factor) = 0;
 };
 
 class VirtualDriver final : public Driver {
@@ -68,6 +70,7 @@ class VirtualDriver final : public Driver {
     rig_.machine().set_hand_target(joint, target, speed);
   }
   void cut_mains() override { rig_.machine().set_mains_ok(false); }
+  void set_tool_dull(double factor) override { rig_.machine().set_tool_dull(factor); }
 
  private:
   control::SimRig rig_;
@@ -123,6 +126,7 @@ class RealtimeDriver final : public Driver {
     sim_->set_hand_target(joint, target, speed);
   }
   void cut_mains() override {}  // the servo thread alone touches the machine; refused before
+  void set_tool_dull(double) override {}
 
  private:
   std::unique_ptr<control::ServoChannels> channels_;
@@ -151,6 +155,7 @@ class HalDriver final : public Driver {
   bool ticks_by_itself() const override { return true; }
   void set_hand_target(int, double, double) override {}  // a real hand moves a real axis
   void cut_mains() override {}  // real mains: nothing to simulate (cmd_run refuses --inject with --hal)
+  void set_tool_dull(double) override {}
 
  private:
   std::unique_ptr<control::HalLink> link_;
@@ -315,6 +320,27 @@ bool answer_tool_guard(Driver& d, const SessionOptions& o, OperatorInput& input)
   return false;
 }
 
+/// The load guard held the feed (its note says at what load): the operator at the terminal resumes
+/// (the cutter checked) or aborts; --unattended or no terminal aborts, since nothing would resume.
+/// Returns false when the run was aborted.
+bool answer_load_hold(Driver& d, const SessionOptions& o, OperatorInput& input) {
+  if (!o.unattended && !input.closed()) {
+    fmt::print(stderr,
+               "\nthe load guard holds the feed: type resume and Enter to cut on; anything else aborts\n");
+    std::optional<std::string> answer;
+    while (!answer && !input.closed()) {
+      answer = input.line(d.ticks_by_itself() ? 10 : -1);
+      if (!answer && d.ticks_by_itself()) d.advance();
+    }
+    if (answer && *answer == "resume" && must(d, Request::simple(CommandKind::Resume))) return true;
+  }
+  fmt::print(
+      stderr,
+      "error: the load guard held the feed (the cutter's load passed its hold level); the run is aborted\n");
+  d.controller().submit(Request::simple(CommandKind::Abort));
+  return false;
+}
+
 void follow(Driver& d, control::EventCursor& cursor, const SessionOptions& o, const SessionHooks& hooks,
             SessionEnd& end) {
   StopOnThePath stop(o.stop);
@@ -323,8 +349,8 @@ void follow(Driver& d, control::EventCursor& cursor, const SessionOptions& o, co
   std::uint32_t job = 0;
   std::uint64_t asked_tick = ~std::uint64_t{0};  // the wait already answered (by its start tick)
   std::uint64_t n = 0;
-  bool mains_cut = false;
-  bool guard_abort = false;
+  bool mains_cut = false, dulled = false;
+  bool guard_abort = false, load_hold = false, load_abort = false;
   for (;;) {
     d.advance();
     std::optional<ControllerEvent> ended;
@@ -335,12 +361,20 @@ void follow(Driver& d, control::EventCursor& cursor, const SessionOptions& o, co
       if (e.kind == ControllerEventKind::JobEnded && e.job_id == job) ended = e;
       if (e.kind == ControllerEventKind::Note && e.code == "tools.guard-hold" && !guard_abort)
         guard_abort = !answer_tool_guard(d, o, input);
+      if (e.kind == ControllerEventKind::Servo && e.servo.kind == control::EventKind::LoadGuard)
+        load_hold = e.servo.action == static_cast<std::uint32_t>(control::LoadAction::Hold);
+      if (e.kind == ControllerEventKind::Note && e.code == "control.load" && load_hold && !load_abort)
+        load_abort = !answer_load_hold(d, o, input);  // after its note is printed
     }
     const control::ControllerStatus st = d.controller().status();
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (o.mains_off_s >= 0 && !mains_cut && st.servo.time_s >= o.mains_off_s) {
       d.cut_mains();  // the servo sees it at its next period
       mains_cut = true;
+    }
+    if (o.tool_dull_s >= 0 && !dulled && st.servo.time_s >= o.tool_dull_s) {
+      d.set_tool_dull(o.tool_dull_factor);
+      dulled = true;
     }
     if (hooks.progress && (++n % 256 == 0)) hooks.progress(st, wall);
     bring_hand_axis(d, st.servo);

@@ -31,6 +31,9 @@ struct SessionOptions {
   const std::atomic<int>* stop = nullptr;
   /// Virtual time: the simulated mains fail at this servo time (s); negative: never.
   double mains_off_s = -1;
+  /// Virtual time: the broach's cutter wears to `tool_dull_factor` at this servo time (s); negative: never.
+  double tool_dull_s = -1;
+  double tool_dull_factor = 1;
 };
 
 /// What a session ended with.

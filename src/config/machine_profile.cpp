@@ -50,6 +50,14 @@ machine::SimMachineConfig sim_machine_config(const MachineProfile& profile) {
   }
   c.tool_changer = profile.tool_changer_sim;
   c.process = profile.process;
+  if (profile.broaching.sim.present) {  // the bore on the coupling's axes (the reader checked them)
+    c.broach = profile.broaching.sim;
+    const auto joint = [&](Axis a) { return profile.find(a) != nullptr ? profile.find(a)->joint : -1; };
+    c.broach.stroke_joint = joint(profile.coupling.master);
+    c.broach.rotary_joint = joint(profile.coupling.slave);
+    c.broach.radial_joint = joint(profile.broaching.radial);
+    c.broach.present = c.broach.stroke_joint >= 0 && c.broach.rotary_joint >= 0 && c.broach.radial_joint >= 0;
+  }
   c.digital_inputs = profile.io.digital_inputs;
   c.digital_outputs = profile.io.digital_outputs;
   c.analog_inputs = profile.io.analog_inputs;

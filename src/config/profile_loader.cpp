@@ -49,10 +49,11 @@ MachineProfile read_profile(const toml::table& root, Reporter& r, const std::fil
   detail::read_probe(top, p);
   detail::read_tool_changer(top, p);
   detail::read_io(top, p);
-  detail::read_process(top, p);  // [process.cutting] names [io] channels
   detail::read_interlocks(top, p);
   detail::read_handwheel(top, p);
   detail::read_coupling(top, p);
+  detail::read_process(top,
+                       p);  // [process.cutting] names [io] channels, [process.broaching] the coupling's axes
   detail::read_interpreter(top, p, base_dir);
   detail::read_planner(top, p);
   detail::read_tool_guard(top, p, base_dir);

@@ -211,11 +211,12 @@ void read_cutting(Section& process, MachineProfile& profile) {
 void read_process(Section& top, MachineProfile& profile) {
   const toml::table* t = top.subtable("process");
   if (t == nullptr) return;
-  Section s(*t, "process", {"torch", "generator", "sim", "cutting"}, top.reporter());
+  Section s(*t, "process", {"torch", "generator", "sim", "cutting", "broaching"}, top.reporter());
   machine::SimProcessConfig& p = profile.process;
   p.torch = s.boolean_or("torch", false);
   p.generator = s.boolean_or("generator", false);
   read_cutting(s, profile);
+  read_broaching(s, profile);
   const toml::table* st = s.subtable("sim");
   if (st == nullptr) return;
   Section m(*st, "process.sim", {"arc_delay_s"}, top.reporter());

@@ -22,7 +22,7 @@ void read_power(Section& top, MachineProfile& profile);
 void read_probe(Section& top, MachineProfile& profile);
 void read_tool_changer(Section& top, MachineProfile& profile);
 void read_io(Section& top, MachineProfile& profile);
-/// [process] with [process.cutting]. Needs [io].
+/// [process] with [process.cutting] and [process.broaching]. Needs [io], the axes and [coupling].
 void read_process(Section& top, MachineProfile& profile);
 void read_interpreter(Section& top, MachineProfile& profile, const std::filesystem::path& base_dir);
 void read_planner(Section& top, MachineProfile& profile);
@@ -36,6 +36,8 @@ void read_interlocks(Section& top, MachineProfile& profile);
 void read_handwheel(Section& top, MachineProfile& profile);
 /// [coupling] and its tables. Needs the axes.
 void read_coupling(Section& top, MachineProfile& profile);
+/// [process.broaching] and its sim, from read_process. Needs the axes, [io] and [coupling].
+void read_broaching(Section& process, MachineProfile& profile);
 
 /// Reports axis limits outside what any machine has (config.implausible), at the key.
 void check_plausible(Section& s, const AxisProfile& a);

@@ -42,6 +42,7 @@ bool Servo::tick() noexcept {
   read_inputs();        // machine inputs (feedback, switches, power, spindle, I/O)
   check_safety();       // e-stop, limit switches, amplifier faults, stalls, following error, power
   apply_interlocks();   // the profile's interlock rules (the PLC): stops, holds, blocked starts
+  guard_load();         // the process load: feed hold, or stop and retract (servo_load_guard.cpp)
   handle_commands();    // operator and controller commands: the explicit state transitions
   run_active_mode();    // homing / jog / handwheel (movers) or MDI / auto (interpolator, handshakes)
   couple_axes();        // axes → joints, a coupled slave by its law (servo_coupling.cpp)
@@ -454,6 +455,8 @@ void Servo::fill_drill_status(ServoStatus& s) const noexcept {
   s.coupling = coupling_;
   s.coupling.error_deg = coupling_error();
   s.handwheel_step = handwheel_step_;
+  s.load_kn = load_kn_;
+  s.load_action = load_action_;
 }
 
 void Servo::push_trace() noexcept {
@@ -484,6 +487,7 @@ void Servo::push_trace() noexcept {
   t.coupled = law_.active();
   t.power_stop = power_stop_;
   t.coupling_error_deg = coupling_error();
+  t.load_kn = load_kn_;
   if (!channels_->trace.try_push(t)) ++trace_dropped_;
 }
 

@@ -21,6 +21,29 @@ constexpr std::size_t kKeptOutcomes = 4096;
 /// Status details that cost strings (where the interpreter is) refresh at most this often.
 constexpr double kLocationRefreshS = 0.01;
 
+/// The load guard's message: what the load was, the level it passed, what the tick did.
+std::string load_guard_text(const ServoEvent& e, const config::BroachingProfile& b) {
+  const char axis = e.axis >= 0 && e.axis < kAxisCount ? kAxisLetters[static_cast<std::size_t>(e.axis)] : '?';
+  switch (static_cast<LoadAction>(e.action)) {
+    case LoadAction::Hold:
+      return fmt::format(
+          "broaching load {:.2f} kN above the hold level {:g} kN: feed hold (the coupling holds; "
+          "check the cutter, then resume)",
+          e.value, b.hold_kn);
+    case LoadAction::Retract:
+      return fmt::format(
+          "broaching load {:.2f} kN above the retract level {:g} kN: the run stops on the helix "
+          "and {} lifts the cutter by {:g} mm",
+          e.value, b.retract_kn, axis, b.retract_lift);
+    case LoadAction::Lifted:
+      return fmt::format("the cutter is lifted ({} by {:g} mm); the run was stopped by an overload", axis,
+                         b.retract_lift);
+    case LoadAction::None:
+      break;
+  }
+  return "load guard";
+}
+
 std::string refusal_text(Refusal r) {
   switch (r) {
     case Refusal::None:
@@ -288,6 +311,9 @@ void Controller::on_event(const ServoEvent& e) {
     case EventKind::HandAxisMoved:
       note(Severity::Warning, e.kind == EventKind::Interlock ? "control.interlock" : "control.hand-axis",
            interlock_text(e));
+      break;
+    case EventKind::LoadGuard:
+      note(Severity::Warning, "control.load", interlock_text(e));
       break;
     default:
       break;
@@ -821,6 +847,7 @@ void Controller::finish(std::uint64_t id, Refusal refusal, std::string message, 
 }
 
 std::string Controller::interlock_text(const ServoEvent& e) const {
+  if (e.kind == EventKind::LoadGuard) return load_guard_text(e, profile_.broaching);
   if (e.kind == EventKind::HandAxisMoved) {
     const char axis =
         e.axis >= 0 && e.axis < kAxisCount ? kAxisLetters[static_cast<std::size_t>(e.axis)] : '?';

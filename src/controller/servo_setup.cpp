@@ -130,7 +130,23 @@ ServoConfig servo_config(const config::MachineProfile& profile) {
   s.interpolator = plan::Planner(machine_limits(profile), planner_config(profile)).interpolator_config();
   s.spindle_max_rpm = profile.spindle.present ? profile.spindle.max_rpm : 0.0;
   s.coupling = coupling_config(profile.coupling);
+  s.load_guard = load_guard_config(profile);
   return s;
+}
+
+LoadGuardConfig load_guard_config(const config::MachineProfile& profile) {
+  const config::BroachingProfile& b = profile.broaching;
+  LoadGuardConfig g{};
+  if (!b.present) return g;
+  g.enabled = true;
+  g.input = b.load_input;
+  g.hold_kn = b.hold_kn;
+  g.retract_kn = b.retract_kn;
+  g.confirm_periods = std::max(1, static_cast<int>(std::ceil(b.confirm_s / profile.servo_period_s - 1e-9)));
+  g.radial_axis = static_cast<std::int8_t>(index(b.radial));
+  g.retract_lift = b.retract_lift;
+  g.retract_speed = b.retract_speed;
+  return g;
 }
 
 SharedSetup shared_setup(const config::MachineProfile& profile) {

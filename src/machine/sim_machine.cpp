@@ -43,6 +43,7 @@ SimMachine::SimMachine(const SimMachineConfig& config) : config_(config), rng_(c
     const SimInputSwitch& in = config.input_switches[k];
     if (in.channel >= 0 && in.joint >= 0) input_switches_[k] = SimSwitch(in.window, in.hysteresis, in.noise);
   }
+  if (config.broach.present) broach_ = SimBroachLoad(config.broach, config.seed);
   temperature_c_ = config.temperature_c;
   dc_link_v_ = config.power.dc_link_nominal_v;
   ups_periods_left_ =
@@ -128,7 +129,11 @@ void SimMachine::advance(const MachineOutputs& out) noexcept {
   bool substeps = false;  // begin_period() integrates what it can at once
   for (int j = 0; j < n; ++j) {
     const auto uj = static_cast<std::size_t>(j);
-    joints_[uj].begin_period(out.joints[uj], powered && !undervoltage_fault_[uj], external_effort_[uj]);
+    const double cutting = config_.broach.load_on_stroke && j == config_.broach.stroke_joint
+                               ? broach_.stroke_force_n()
+                               : 0.0;  // the chip resists the stroke (last period's)
+    joints_[uj].begin_period(out.joints[uj], powered && !undervoltage_fault_[uj],
+                             external_effort_[uj] + cutting);
     substeps = substeps || joints_[uj].needs_substeps();
   }
   if (config_.spindle) {
@@ -145,6 +150,17 @@ void SimMachine::advance(const MachineOutputs& out) noexcept {
   if (config_.spindle) spindle_.end_period();
   update_power(out);
   update_auxiliaries();
+  update_broach();
+}
+
+// The cutter's position from the joints' tables: where the chip is cut, not where the encoders say.
+void SimMachine::update_broach() noexcept {
+  const SimBroachConfig& b = config_.broach;
+  if (!b.present) return;
+  const SimJoint& stroke = joints_[static_cast<std::size_t>(b.stroke_joint)];
+  broach_.update(stroke.table_position(), stroke.velocity(),
+                 joints_[static_cast<std::size_t>(b.rotary_joint)].table_position(),
+                 joints_[static_cast<std::size_t>(b.radial_joint)].table_position());
 }
 
 // Mains on: the rectifier holds the DC link at nominal. Mains off with a charged UPS: the
@@ -230,6 +246,8 @@ void SimMachine::sample() noexcept {
     inputs_.analog_in[static_cast<std::size_t>(k)] =
         k < config_.analog_inputs ? analog_in_[static_cast<std::size_t>(k)] : 0.0;
   }
+  if (config_.broach.present)
+    inputs_.analog_in[static_cast<std::size_t>(config_.broach.load_input)] = broach_.load_kn();
 }
 
 }  // namespace opencnc::machine

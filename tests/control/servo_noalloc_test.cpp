@@ -169,6 +169,36 @@ TEST(ServoAllocations, NoneInsideTheCoupledTick) {
   std::filesystem::remove_all(dir);
 }
 
+// The broach's load guard in the tick: a worn cutter's hold, a resume, an overload's stop on the
+// helix and the radial lift (and the simulated load model under it).
+TEST(ServoAllocations, NoneInsideTheLoadGuard) {
+  const auto dir = std::filesystem::temp_directory_path() / "opencnc-noalloc-load";
+  std::filesystem::create_directories(dir);
+  const std::string program = (dir / "broach.ngc").string();
+  std::ofstream(program) << "G21 G90 G0 X-0.5 Z-10 C0\nM171 P600\nG1 X0.1 F60\nG1 Z200 F3000\nM175\nM2\n";
+  g_allocations = 0;
+  Armed a(loaded(config::load_profile(OPENCNC_SOURCE_DIR "/configs/broach-zc.toml")));
+  a.rig().machine().set_tool_dull(1.8);
+  a.ask(Request::simple(CommandKind::MachineOn));
+  a.ask(Request::set_mode(Mode::Auto));
+  a.ask(Request::open(program));
+  a.ask(Request::simple(CommandKind::CycleStart));
+  bool held = false;
+  ASSERT_TRUE(a.until(
+      [&] {
+        const ServoStatus s = a.rig().status().servo;
+        if (!held && s.state == State::Held && s.path_velocity == 0) {
+          held = true;
+          a.rig().machine().set_tool_dull(3.0);  // worse: the resumed cut overloads
+          a.ask(Request::simple(CommandKind::Resume));
+        }
+        return held && s.load_action == LoadAction::Lifted;
+      },
+      20000));
+  EXPECT_EQ(g_allocations.load(), 0);
+  std::filesystem::remove_all(dir);
+}
+
 // The drill retrofit's tick: midpoint homing on the analog sensors, the compensation stage, the
 // interlock rules, the handwheel, hand-axis waits with a simulated operator, a stall and an e-stop.
 TEST(ServoAllocations, NoneInsideTheDrillsTick) {

@@ -177,6 +177,22 @@ struct CouplingProfile {
   std::vector<CouplingTableProfile> tables;
 };
 
+/// `[process.broaching]`: the broach's load cell, the levels at which the tick holds the feed or
+/// retracts the cutter, the process-data log's rate, and (`[process.broaching.sim]`) the bore and
+/// the cutter the simulated machine derives the load from (docs/broaching.md).
+struct BroachingProfile {
+  bool present = false;
+  int load_input = 0;            ///< analog input channel of the load, kN
+  double hold_kn = 0;            ///< feed hold above this (0: none)
+  double retract_kn = 0;         ///< stop and retract above this (0: none)
+  double confirm_s = 0.003;      ///< how long a level must be passed before it acts
+  Axis radial = Axis::X;         ///< the axis that feeds the cutter out and lifts it
+  double retract_lift = -0.5;    ///< signed lift along the radial axis, mm
+  double retract_speed = 0;      ///< mm/s (0: the axis' maximum)
+  double log_rate_hz = 100;      ///< rows per second of the process-data log
+  machine::SimBroachConfig sim;  ///< the load model (sim.present: [process.broaching.sim] exists)
+};
+
 /// `[tool_guard]`: the tool store and the check of its live table against the backup.
 struct ToolGuardProfile {
   bool present = false;
@@ -213,6 +229,7 @@ struct MachineProfile {
   InterlockProfile interlocks;
   HandwheelProfile handwheel;
   CouplingProfile coupling;
+  BroachingProfile broaching;
   /// Digital inputs the simulated machine drives from switches (named inputs with a `sim`).
   std::vector<machine::SimInputSwitch> sim_input_switches;
   double sim_temperature_c = 20;  ///< machine temperature in the simulation

@@ -218,6 +218,8 @@ enum class EventKind : std::uint8_t {
   SyncPassed,
   Interlock,      ///< interlock rule `action` (its index) acted (`command`: what it did, see below)
   HandAxisMoved,  ///< hand axis `axis` left the position the run needs while it moved: feed hold
+  /// The load guard acted (`action`: a control::LoadAction) at load `value` kN; run `run_id`.
+  LoadGuard,
 };
 
 struct ServoEvent {

@@ -45,6 +45,7 @@ class Servo final : public Tickable {
   void read_inputs() noexcept;
   void check_safety() noexcept;
   void apply_interlocks() noexcept;
+  void guard_load() noexcept;
   void handle_commands() noexcept;
   void run_active_mode() noexcept;
   void couple_axes() noexcept;
@@ -114,6 +115,11 @@ class Servo final : public Tickable {
   void act_on_rule(int index, const machine::InterlockRule& r, bool now, bool before) noexcept;
   void emit_interlock(int index, CommandKind what) noexcept;
   bool spindle_may_start() const noexcept;
+
+  // --- the load guard (servo_load_guard.cpp) ------------------------------------------------
+  void step_load_retract() noexcept;
+  void start_load_lift() noexcept;
+  void emit_load(LoadAction a) noexcept;
 
   // --- axis coupling (servo_coupling.cpp) ----------------------------------------------------
   void engage_coupling(const MachineAction& a) noexcept;
@@ -188,6 +194,14 @@ class Servo final : public Tickable {
   motion::CouplingLaw law_{};
   CouplingStatus coupling_{};
   int master_joint_ = -1, slave_joint_ = -1;
+
+  // The load guard: the load now, periods above each level, the retract under way.
+  enum class LoadRetract : std::uint8_t { None, Stopping, Lifting };
+  double load_kn_ = 0;
+  int hold_periods_ = 0, retract_periods_ = 0;
+  LoadRetract load_retract_ = LoadRetract::None;
+  LoadAction load_action_ = LoadAction::None;
+  std::uint32_t load_run_id_ = 0;
 
   // Manual mode.
   std::array<AxisMover, machine::kMaxJoints> movers_{};

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <type_traits>
 
+#include "opencnc/control/load_guard.hpp"
 #include "opencnc/machine/interlocks.hpp"
 #include "opencnc/machine/machine_io.hpp"
 #include "opencnc/motion/compensation.hpp"
@@ -77,6 +78,8 @@ struct ServoConfig {
   motion::CompensationConfig compensation;
   /// The slave axis a program may couple to its master, and the profile's tables (coupling stage).
   motion::CouplingConfig coupling;
+  /// The process load's thresholds (the load guard stage, after the interlocks).
+  LoadGuardConfig load_guard;
   /// The PLC's interlock rules (evaluated every period after safety).
   machine::InterlockRules interlocks;
   /// Units per count the operator may select for the handwheel (none: any positive step).

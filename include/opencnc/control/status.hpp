@@ -9,6 +9,7 @@
 
 #include "opencnc/control/command.hpp"
 #include "opencnc/control/homing.hpp"
+#include "opencnc/control/load_guard.hpp"
 #include "opencnc/core/axes.hpp"
 #include "opencnc/machine/machine_io.hpp"
 #include "opencnc/motion/coupling.hpp"
@@ -129,6 +130,9 @@ struct ServoStatus {
   std::int8_t handwheel_axis = -1;    ///< the axis the handwheel moves (−1 = none)
   double handwheel_step = 0;          ///< units per count
   CouplingStatus coupling{};          ///< the axis coupling (broaching)
+  // The load guard (broaching): the process load and what the guard did last in this run.
+  double load_kn = 0;  ///< the load input now (0 without a load guard)
+  LoadAction load_action = LoadAction::None;
 };
 
 /// One servo period, for traces and run reports (docs/controller.md, "Trace CSV").
@@ -151,6 +155,7 @@ struct TraceSample {
   bool coupled = false;          ///< a coupling law held the slave in this period
   bool power_stop = false;       ///< a power-fail stop is under way (from the period after the signal)
   double coupling_error_deg = 0;  ///< actual slave − law(actual master), degrees (0 uncoupled)
+  double load_kn = 0;             ///< the process load input (load guard), kN
 };
 
 static_assert(std::is_trivially_copyable_v<ServoStatus>);

@@ -28,6 +28,8 @@ ServoConfig servo_config(const config::MachineProfile& profile);
 /// The tick's fixed-size copy of the profile's [coupling] (tables numbered from 1 in programs).
 /// Non-real-time; any thread.
 motion::CouplingConfig coupling_config(const config::CouplingProfile& coupling);
+/// The load guard's levels from `[process.broaching]` (disabled without it). Any thread.
+LoadGuardConfig load_guard_config(const config::MachineProfile& profile);
 
 /// What a tick in another process (the HAL component) is handed: servo_config() and what the
 /// profile declares wired (the capabilities the simulated machine of the profile would have:

@@ -161,6 +161,26 @@ struct SimProcessConfig {
   bool generator = false;
 };
 
+/// The bore of a helical broach and its cutter (docs/broaching.md, "The broaching load"). The
+/// stroke joint pulls the cutter through the bore between `bore_start` and `bore_end`; the rotary
+/// joint turns the workpiece; the radial joint feeds the cutter out, the bore wall being at
+/// `surface`. Positions are the joints' own (mm, degrees).
+struct SimBroachConfig {
+  bool present = false;
+  int load_input = 0;  ///< the analog input the load cell is wired to (kN)
+  int stroke_joint = -1, rotary_joint = -1, radial_joint = -1;
+  double bore_start = 0, bore_end = 0;  ///< stroke positions where there is material
+  double surface = 0;                   ///< radial position at which the cutter touches the wall
+  double radius_mm = 40;                ///< the bore's radius (the cutter's width in degrees)
+  double specific_force_n_mm2 = 2500;   ///< k_c: force per mm² of chip section
+  double width_mm = 10;                 ///< the cutting edge's width (the groove's)
+  double speed_gain_per_m_min = 0.05;   ///< the force grows by this fraction per m/min of cutting speed
+  double min_speed_mm_s = 0.5;          ///< below this the edge rubs but cuts no chip
+  double dull_factor = 1;               ///< a sharp cutter 1; a worn one more
+  double noise_kn = 0.02;               ///< ± uniform noise of the load cell, kN
+  bool load_on_stroke = false;          ///< the force also acts on the stroke joint against its motion
+};
+
 struct SimMachineConfig {
   double servo_period_s = 0.001;
   int substeps = 10;  ///< integration sub-steps per servo period
@@ -178,6 +198,7 @@ struct SimMachineConfig {
   SimProbeConfig probe;
   SimToolChangerConfig tool_changer;
   SimProcessConfig process;
+  SimBroachConfig broach;  ///< a broaching load cell and the bore it measures (present: false)
   int digital_inputs = 0, digital_outputs = 0;
   int analog_inputs = 0, analog_outputs = 0;
   std::array<SimInputSwitch, kMaxSimInputSwitches> input_switches{};

@@ -6,6 +6,7 @@
 #include <cstdint>
 
 #include "opencnc/machine/machine_io.hpp"
+#include "opencnc/machine/sim_broach_load.hpp"
 #include "opencnc/machine/sim_config.hpp"
 #include "opencnc/machine/sim_joint.hpp"
 #include "opencnc/machine/sim_spindle.hpp"
@@ -45,6 +46,8 @@ class SimMachine final : public MachineIO {
   void set_gap_voltage(double volts) noexcept { gap_voltage_v_ = volts; }
   /// Machine temperature, °C (proximity sensors drift with it).
   void set_temperature(double celsius) noexcept { temperature_c_ = celsius; }
+  /// The broach's cutter wears: its force grows by `factor` (1 = sharp); ignored without a broach.
+  void set_tool_dull(double factor) noexcept { broach_.set_dull_factor(factor); }
   /// The operator moves manual joint `joint` toward `target` at up to `speed` units/s.
   void set_hand_target(int joint, double target, double speed) noexcept;
   /// The operator turns the handwheel by `counts` (+ = clockwise); ignored without one.
@@ -61,11 +64,14 @@ class SimMachine final : public MachineIO {
     return static_cast<double>(ups_periods_left_) * config_.servo_period_s;
   }
   double temperature_c() const noexcept { return temperature_c_; }
+  /// The broaching load model (material cut so far, the chip, the force).
+  const SimBroachLoad& broach() const noexcept { return broach_; }
 
  private:
   void advance(const MachineOutputs& out) noexcept;
   void update_power(const MachineOutputs& out) noexcept;
   void update_auxiliaries() noexcept;
+  void update_broach() noexcept;
   void sample() noexcept;
 
   SimMachineConfig config_;
@@ -76,6 +82,7 @@ class SimMachine final : public MachineIO {
   double probe_table_ = 0;  ///< the probe joint's table position at the last sample
   std::array<double, kMaxJoints> previous_feedback_{};  ///< the encoders at the sample before
   SplitMix64 rng_;
+  SimBroachLoad broach_;  ///< the broaching load (config_.broach.present)
   // The outputs latched by the last write() that the machine uses between writes.
   bool estop_release_ = false;
   ProcessOutputs process_{};
