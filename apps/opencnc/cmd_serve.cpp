@@ -15,6 +15,7 @@
 #include "numeric_options.hpp"
 #include "opencnc/config/profile_loader.hpp"
 #include "opencnc/controller/gcode_source.hpp"
+#include "opencnc/controller/run_from_line.hpp"
 #include "opencnc/hmi/history.hpp"
 #include "opencnc/hmi/machine_host.hpp"
 #include "opencnc/hmi/server.hpp"
@@ -132,6 +133,9 @@ int serve(const ServeOptions& o) {
 
   hmi::MachineHost host(profile, source, {o.speed == 0, o.speed == 0 ? 1.0 : o.speed});
   host.controller().attach(std::make_shared<hmi::HistoryRecorder>(*history, profile.servo_period_s));
+  // Run from line scans with a program source of its own (the controller's is the controller's).
+  host.controller().add_feature(
+      std::make_shared<control::RunFromLineFeature>(control::GcodeProgramSource::create(profile, diags)));
   std::vector<std::string> warnings;
   if (!host.start(&warnings)) {
     fmt::print(stderr, "error: the servo thread could not start\n");

@@ -25,6 +25,7 @@ namespace {
 
 namespace beast = boost::beast;
 namespace websocket = beast::websocket;
+namespace http = beast::http;
 namespace net = boost::asio;
 using tcp = net::ip::tcp;
 using namespace opencnc;
@@ -41,8 +42,11 @@ struct Client : std::enable_shared_from_this<Client> {
     beast::get_lowest_layer(ws).async_connect(tcp::endpoint(net::ip::make_address("127.0.0.1"), port),
                                               [self = shared_from_this()](beast::error_code ec) {
                                                 if (ec) return;
-                                                self->ws.async_handshake("127.0.0.1",
-                                                                         "/api/v1/stream?token=" + kToken,
+                                                self->ws.set_option(websocket::stream_base::decorator(
+                                                    [](websocket::request_type& req) {
+                                                      req.set(http::field::authorization, "Bearer " + kToken);
+                                                    }));
+                                                self->ws.async_handshake("127.0.0.1", "/api/v1/stream",
                                                                          [self](beast::error_code e) {
                                                                            self->connected = !e;
                                                                            if (!e && !self->stalled)

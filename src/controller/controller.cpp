@@ -619,6 +619,9 @@ void Controller::start_job(std::uint64_t id, JobKind kind, std::string name, Mod
   host.next_run_id = [this] { return ++run_counter_; };
   host.may_continue = [this](const SyncCheck& c) { return features_allow_continue(c); };
   auto job = std::make_unique<detail::Job>(kind, ++job_counter_, name, mode, std::move(stream), std::move(host));
+  // A program's interpreter sets its offsets as it starts; the MDI session's keeps its own; a
+  // canonical program (an approach move) has none: the ones shown stay.
+  job->set_initial_offsets(kind == JobKind::Mdi ? mdi_offsets_ : published_.offsets);
   Diagnostics d;
   if (!job->start(id, d)) {
     const Refusal why = program_refusal(d);
@@ -640,6 +643,13 @@ void Controller::end_job() {
     note(d.severity, d.code, d.format());
   }
   if (j.end_reason() == JobEnd::Finished) ++runs_finished_;
+  {
+    // The interpreter's offsets stay in effect after the job: the status keeps showing them.
+    std::lock_guard lock(out_mutex_);
+    published_.offsets = j.latest_offsets();
+    published_.distance_to_go = Pose{};
+  }
+  if (j.kind() == JobKind::Mdi) mdi_offsets_ = j.latest_offsets();
   ControllerEvent e;
   e.kind = ControllerEventKind::JobEnded;
   e.job = j.kind();
@@ -676,12 +686,14 @@ void Controller::publish() {
     p.interpreter_moves = job_->moves_read();
     p.sync_wait = job_->sync_wait();
     update_locations();
+    update_offsets(same_run);
   } else {
     p.job = JobKind::None;
     p.run_segment = 0;
     p.segment_offset = 0;
     p.progress = 0;
     p.sync_wait = SyncKind::None;
+    p.distance_to_go = Pose{};
   }
   // What the run waits for, in words: only when one of the things it is made of changed.
   const WaitKey key{s.state, s.wait, s.stop_reason, p.sync_wait, s.line, s.context, job_ != nullptr};
@@ -696,6 +708,20 @@ void Controller::publish() {
     described_fault_tick_ = s.fault.tick;
   }
   p.runs_finished = runs_finished_;
+  p.block_delete = block_delete_;
+}
+
+// The offsets of the move at the commanded position, and what is left of that move.
+void Controller::update_offsets(bool same_run) {
+  ControllerStatus& p = published_;
+  const ServoStatus& s = servo();
+  p.distance_to_go = Pose{};
+  if (!same_run) return;
+  p.offsets = job_->offsets_at(s.segment);
+  if (!s.run_active) return;
+  if (const std::optional<Pose> end = job_->move_end(s.segment)) {
+    for (int i = 0; i < kAxisCount; ++i) p.distance_to_go[i] = (*end)[i] - s.commanded[i];
+  }
 }
 
 // Strings, so only when they change: the source at the commanded position, and (at most every

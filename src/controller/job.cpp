@@ -293,6 +293,8 @@ void Job::on_servo_event(const ServoEvent& e, const ServoStatus& s) {
             return;
           }
           const std::uint64_t next_first = leg_.first_move + from;
+          offsets_.scan(stream_->program());
+          offsets_.restart(from);
           stream_->restart_at(s.commanded, from);
           leg_.first_move = next_first;
           Diagnostics d;
@@ -356,6 +358,7 @@ void Job::service(const ServoStatus& s) {
 
 void Job::push_actions() {
   const canon::Program& p = stream_->program();
+  offsets_.scan(p);  // every action read, before release() may free it
   while (leg_.next_action < p.action_count() && p.action(leg_.next_action).before_move <= leg_.checked) {
     const auto a =
         machine_action(p, leg_.next_action, host_.servo != nullptr ? &host_.servo->coupling : nullptr);
@@ -427,6 +430,12 @@ std::optional<std::string> Job::message(std::uint32_t run_id, std::uint32_t acti
   const canon::Program& p = stream_->program();
   if (run_id != leg_.run_id || action < p.first_held_action() || action >= p.action_count()) return std::nullopt;
   return p.text(p.action(action).text);
+}
+
+std::optional<Pose> Job::move_end(std::uint64_t segment) const {
+  const canon::Program& p = stream_->program();
+  if (segment < p.first_held_move() || segment >= p.size()) return std::nullopt;
+  return p.end(static_cast<canon::SegmentId>(segment));
 }
 
 TraceContext Job::trace_context(std::uint32_t run_id) const {

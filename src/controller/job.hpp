@@ -11,6 +11,7 @@
 #include <optional>
 #include <string>
 
+#include "offset_track.hpp"
 #include "opencnc/control/channels.hpp"
 #include "opencnc/control/servo_config.hpp"
 #include "opencnc/controller/controller_status.hpp"
@@ -85,6 +86,16 @@ class Job {
   std::optional<std::string> message(std::uint32_t run_id, std::uint32_t action) const;
   /// The program window and first job move of a servo run (null if it is no longer held).
   TraceContext trace_context(std::uint32_t run_id) const;
+  /// The offsets in effect before the job's stream sets any (the MDI session's, carried over).
+  void set_initial_offsets(const WorkOffsets& o) { offsets_ = OffsetTrack(o); }
+  /// The offsets of the servo's move `segment` of the current run (segments asked for must
+  /// not go backward), and after everything read so far.
+  const WorkOffsets& offsets_at(std::uint64_t segment) {
+    return offsets_.at(static_cast<std::size_t>(segment));
+  }
+  const WorkOffsets& latest_offsets() const noexcept { return offsets_.latest(); }
+  /// The end of the servo's move `segment` of the current run, if the window still holds it.
+  std::optional<Pose> move_end(std::uint64_t segment) const;
 
  private:
   struct Leg {
@@ -125,6 +136,7 @@ class Job {
   std::unique_ptr<ProgramStream> stream_;
   JobHost host_;
   Leg leg_;
+  OffsetTrack offsets_;
   std::uint32_t previous_run_id_ = 0;  ///< the leg before (its samples may still come)
   bool waiting_ = false;               ///< the stream waits at a sync point for the servo
   std::uint32_t waiting_action_ = 0;   ///< the action of that sync point in the leg

@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "opencnc/control/command.hpp"
+#include "opencnc/controller/run_from_line.hpp"
 
 namespace opencnc::hmi {
 
@@ -215,6 +216,11 @@ Command parse(const json& body, const config::MachineProfile& p, const std::file
   if (kind == "open") return open_request(body, dir);
   if (kind == "mdi") return mdi_request(body);
   if (kind == "set-tool") return tool_change(body);
+  if (kind == "run-from-line") {
+    const double line = number(body, "line");
+    if (line != std::floor(line) || line < 1 || line > 1e9) throw Bad{422, "\"line\" must be a line number from 1"};
+    return Request::feature("run-from-line", "start", control::RunFromLineArgs{static_cast<std::uint32_t>(line)});
+  }
   throw Bad{400, fmt::format("unknown command kind \"{}\" (docs/api.md lists them)", kind)};
 }
 
@@ -261,7 +267,8 @@ const char* to_string(Role r) noexcept {
 std::optional<Role> role_for(std::string_view kind) {
   static const char* const operator_kinds[] = {"mode",    "jog",       "jog-by", "jog-stop",
                                                "home",    "override",  "switch", "spindle-on",
-                                               "coolant", "handwheel", "open",   "mdi"};
+                                               "coolant", "handwheel", "open",   "mdi",
+                                               "run-from-line"};
   if (kind == "set-tool") return Role::Admin;
   if (servo_kinds().find(kind) != servo_kinds().end()) return Role::Operator;
   for (const char* k : operator_kinds) {
@@ -299,6 +306,14 @@ json status_json(const control::ControllerStatus& s, const config::MachineProfil
       {"wait_text", s.wait_text},
       {"machine", axes_json(v.actual, n, profile)},
       {"commanded", axes_json(v.commanded, n, profile)},
+      {"work", axes_json(control::work_position(v.actual, s.offsets), n, profile)},
+      {"distance_to_go", axes_json(s.distance_to_go, n, profile)},
+      {"offsets",
+       {{"system", control::work_system_name(s.offsets.system)},
+        {"g5x", axes_json(s.offsets.g5x, n, profile)},
+        {"g92", axes_json(s.offsets.g92, n, profile)},
+        {"tool", axes_json(s.offsets.tool, n, profile)},
+        {"xy_rotation_deg", s.offsets.xy_rotation_deg}}},
       {"following_error", fe},
       {"homed", homed},
       {"all_homed", v.all_homed},

@@ -25,6 +25,7 @@
 #include "opencnc/hmi/api.hpp"
 #include "opencnc/hmi/history.hpp"
 #include "opencnc/hmi/preview.hpp"
+#include "opencnc/hmi/stream_tickets.hpp"
 #include "opencnc/tools/tool_table_service.hpp"
 
 namespace opencnc::hmi {
@@ -86,11 +87,12 @@ Target parse_target(std::string_view t) {
   return r;
 }
 
-std::string token_of(const HttpRequest& req, const Target& t) {
+// Tokens travel in the Authorization header only: a URL ends up in logs and browser history
+// (the stream takes a ticket instead, StreamTickets).
+std::string token_of(const HttpRequest& req) {
   const auto auth = req[http::field::authorization];
   if (sv(auth).starts_with("Bearer ")) return std::string(sv(auth).substr(7));
-  const auto it = t.query.find("token");
-  return it == t.query.end() ? "" : it->second;
+  return "";
 }
 
 HttpResponse respond(const HttpRequest& req, http::status status, std::string body,
@@ -160,6 +162,7 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
   control::Controller& controller;
   config::MachineProfile profile;
   Tokens tokens;
+  StreamTickets tickets;
   History* history;
   const control::GcodeProgramSource* source;
   ServerConfig config;
@@ -395,13 +398,16 @@ void Server::Impl::stream_tick() {
 
 void Server::Impl::upgrade(tcp::socket socket, HttpRequest req, std::string remote) {
   const Target t = parse_target(sv(req.target()));
-  const std::optional<Role> role = tokens.role_of(token_of(req, t));
+  std::optional<Role> role = tokens.role_of(token_of(req));
+  if (const auto it = t.query.find("ticket"); !role && it != t.query.end()) {
+    role = tickets.redeem(it->second, StreamTickets::Clock::now());
+  }
   if (t.path != "/api/v1/stream" || !role) {
     const int status = t.path != "/api/v1/stream" ? 404 : 401;
     if (status == 401) audit(remote, role, req, 401, "no valid token");
     auto s = std::make_shared<HttpSession>(std::move(socket), shared_from_this());
     HttpResponse res =
-        error_response(req, status, status == 404 ? "no such stream" : "a valid token is needed");
+        error_response(req, status, status == 404 ? "no such stream" : "a valid token or stream ticket is needed");
     res.keep_alive(false);
     return s->send(std::move(res));
   }
@@ -428,7 +434,7 @@ void Server::Impl::handle(const std::shared_ptr<HttpSession>& s, HttpRequest req
   }
   if (!t.path.starts_with("/api/v1/"))
     return s->send(error_response(req, 404, "this server speaks /api/v1/"));
-  const std::optional<Role> role = tokens.role_of(token_of(req, t));
+  const std::optional<Role> role = tokens.role_of(token_of(req));
   const bool is_get = req.method() == http::verb::get;
   if (!role && !(is_get && t.path == "/api/v1/status" && loopback)) {
     if (!is_get) audit(s->remote(), role, req, 401, "no valid token");
@@ -437,6 +443,14 @@ void Server::Impl::handle(const std::shared_ptr<HttpSession>& s, HttpRequest req
   if (t.path == "/api/v1/commands") {
     if (req.method() != http::verb::post) return s->send(error_response(req, 405, "commands are POSTed"));
     return command(s, req, *role);
+  }
+  if (t.path == "/api/v1/stream-ticket") {
+    if (req.method() != http::verb::post) return s->send(error_response(req, 405, "stream tickets are POSTed"));
+    std::string error;
+    const auto ticket = tickets.issue(*role, StreamTickets::Clock::now(), &error);
+    if (!ticket) return s->send(error_response(req, 503, error));
+    return s->send(
+        json_response(req, 200, {{"ticket", *ticket}, {"expires_in_s", StreamTickets::kLifetime.count()}}));
   }
   if (!is_get) return s->send(error_response(req, 405, "only GET here"));
   if (t.path == "/api/v1/program/preview") return preview(s, req);
@@ -560,7 +574,7 @@ void Server::Impl::command(const std::shared_ptr<HttpSession>& s, const HttpRequ
 // thread serves the other clients meanwhile.
 void Server::Impl::wait_outcome(const std::shared_ptr<HttpSession>& s, HttpRequest req, std::uint64_t id,
                                 std::chrono::steady_clock::time_point deadline) {
-  const std::optional<Role> role = tokens.role_of(token_of(req, parse_target(sv(req.target()))));
+  const std::optional<Role> role = tokens.role_of(token_of(req));
   if (const auto o = controller.outcome(id)) {
     const int status = o->accepted ? 200 : 409;
     audit(s->remote(), role, req, status,
@@ -637,7 +651,9 @@ HttpResponse Server::Impl::program_text(const HttpRequest& req, const Target& t)
   while (std::getline(in, line) && n < from + count - 1) {
     if (++n >= from) lines.push_back(line.size() > 400 ? line.substr(0, 400) : line);
   }
-  return json_response(req, 200, {{"from", from}, {"lines", lines}});
+  // Whether the file goes on after the window (the listing pages on when the run gets there).
+  const bool more = n == from + count - 1 && static_cast<bool>(std::getline(in, line));
+  return json_response(req, 200, {{"from", from}, {"lines", lines}, {"more", more}});
 }
 
 void Server::Impl::preview(const std::shared_ptr<HttpSession>& s, const HttpRequest& req) {

@@ -162,4 +162,8 @@ std::optional<Role> Tokens::role_of(std::string_view token) const noexcept {
   return std::nullopt;
 }
 
+std::optional<std::string> random_secret(std::string* error) {
+  return random_token(error);
+}
+
 }  // namespace opencnc::hmi

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "../control/test_profiles.hpp"
+#include "opencnc/controller/run_from_line.hpp"
 #include "opencnc/hmi/api.hpp"
 
 namespace opencnc::hmi {
@@ -51,6 +52,11 @@ TEST_F(ApiParse, EachKindBecomesItsRequest) {
   EXPECT_TRUE(open.path.ends_with("examples/bracket.ngc"));
   EXPECT_EQ(request({{"kind", "coolant"}, {"which", "mist"}, {"on", true}}).name(), "coolant");
   EXPECT_EQ(request({{"kind", "spindle-on"}, {"rpm", 1000}}).name(), "spindle-on");
+  const auto from = std::get<control::requests::Feature>(request({{"kind", "run-from-line"}, {"line", 66}}).body);
+  EXPECT_EQ(from.feature, "run-from-line");
+  EXPECT_EQ(std::any_cast<control::RunFromLineArgs>(from.args).line, 66u);
+  EXPECT_EQ(error({{"kind", "run-from-line"}, {"line", 2.5}}).status, 422);
+  EXPECT_EQ(error({{"kind", "run-from-line"}, {"line", "x"}}).status, 400);
 }
 
 TEST_F(ApiParse, MalformedBodiesAre400WithTheReason) {
@@ -92,7 +98,7 @@ TEST_F(ApiParse, ProgramsStayInsideTheirFolder) {
 TEST(ApiRoles, AdminOnlyForToolDataOperatorForTheRest) {
   EXPECT_EQ(role_for("set-tool"), Role::Admin);
   for (const char* k :
-       {"cycle-start", "feed-hold", "jog", "home", "open", "mdi", "tool-changed", "override"}) {
+       {"cycle-start", "feed-hold", "jog", "home", "open", "mdi", "tool-changed", "override", "run-from-line"}) {
     EXPECT_EQ(role_for(k), Role::Operator) << k;
   }
   EXPECT_FALSE(role_for("fly"));
@@ -110,6 +116,16 @@ TEST(ApiJson, StatusCarriesWhatTheScreensShow) {
   EXPECT_EQ(j["wait_text"], "the operator's resume (feed hold)");
   EXPECT_TRUE(j["following_error"].contains("Z"));
   EXPECT_FALSE(j["machine"].contains("A"));
+  // Work coordinates: the feedback position less the offsets; distance to go as the status has it.
+  s.offsets.system = 3;
+  s.offsets.g5x[0] = 2.5;
+  s.offsets.g92[0] = 1;
+  s.distance_to_go[0] = -4;
+  const json w = status_json(s, p);
+  EXPECT_EQ(w["offsets"]["system"], "G56");
+  EXPECT_EQ(w["work"]["X"], 9.0);
+  EXPECT_EQ(w["distance_to_go"]["X"], -4.0);
+  EXPECT_EQ(w["offsets"]["g92"]["X"], 1.0);
   const json m = machine_json(p);
   EXPECT_EQ(m["axes"].size(), 3u);
   EXPECT_EQ(m["axes"][0]["axis"], "X");

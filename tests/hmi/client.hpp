@@ -89,12 +89,18 @@ inline Reply post(std::uint16_t port, const std::string& body, const std::string
 class Stream {
  public:
   /// `receive_buffer`: the socket's receive buffer (small: a client that stops reading shows soon).
-  Stream(std::uint16_t port, const std::string& token, int receive_buffer = 0) : ws_(ioc_) {
+  Stream(std::uint16_t port, const std::string& token, int receive_buffer = 0, const std::string& query = "")
+      : ws_(ioc_) {
     auto& socket = beast::get_lowest_layer(ws_).socket();
     socket.open(tcp::v4());
     if (receive_buffer > 0) socket.set_option(net::socket_base::receive_buffer_size(receive_buffer));
     beast::get_lowest_layer(ws_).connect(tcp::endpoint(net::ip::make_address("127.0.0.1"), port));
-    ws_.handshake("127.0.0.1", "/api/v1/stream?token=" + token);
+    // A token in the header (what a program can send); a browser sends a ticket (`ticket=` in the
+    // target: Stream(port, "", 0, "?ticket=…")).
+    ws_.set_option(websocket::stream_base::decorator([token](websocket::request_type& req) {
+      if (!token.empty()) req.set(http::field::authorization, "Bearer " + token);
+    }));
+    ws_.handshake("127.0.0.1", "/api/v1/stream" + query);
   }
   /// The next message, parsed; throws when the server closed the stream.
   nlohmann::json next() {

@@ -11,9 +11,11 @@
 #include "../control/test_profiles.hpp"
 #include "client.hpp"
 #include "opencnc/controller/gcode_source.hpp"
+#include "opencnc/controller/run_from_line.hpp"
 #include "opencnc/hmi/history.hpp"
 #include "opencnc/hmi/machine_host.hpp"
 #include "opencnc/hmi/server.hpp"
+#include "opencnc/hmi/stream_tickets.hpp"
 
 namespace opencnc::hmi {
 namespace {
@@ -40,6 +42,8 @@ struct Rig {
     history = History::open(dir / "history.sqlite", &error);
     host = std::make_unique<MachineHost>(profile, source, HostOptions{false, 200});
     host->controller().attach(std::make_shared<HistoryRecorder>(*history, profile.servo_period_s));
+    host->controller().add_feature(
+        std::make_shared<control::RunFromLineFeature>(control::GcodeProgramSource::create(profile, d)));
     host->start(nullptr);
     sc.address = address;
     sc.port = 0;
@@ -135,6 +139,41 @@ TEST(Server, ToolDataIsTheAdminsAndEveryChangeIsAudited) {
   EXPECT_FALSE(audit[2]["time"].get<std::string>().empty());
 }
 
+TEST(Server, TheStreamOpensWithASingleUseTicketAndNeverATokenInTheUrl) {
+  Rig rig;
+  const Reply issued = call(rig.port, http::verb::post, "/api/v1/stream-ticket", kOperator, "");
+  ASSERT_EQ(issued.status, 200) << issued.text;
+  const std::string ticket = issued.body["ticket"];
+  EXPECT_EQ(ticket.size(), 48u);
+  EXPECT_EQ(issued.body["expires_in_s"], 30);
+  EXPECT_EQ(call(rig.port, http::verb::post, "/api/v1/stream-ticket", "", "").status, 401);
+  EXPECT_EQ(get(rig.port, "/api/v1/stream-ticket", kOperator).status, 405);
+  {
+    Stream s(rig.port, "", 0, "?ticket=" + ticket);
+    EXPECT_EQ(s.next()["type"], "status");
+  }
+  // Used up; a token in the query opens nothing (nor does it pass for any other call).
+  EXPECT_THROW(Stream(rig.port, "", 0, "?ticket=" + ticket), beast::system_error);
+  EXPECT_THROW(Stream(rig.port, "", 0, "?token=" + kOperator), beast::system_error);
+  EXPECT_EQ(get(rig.port, "/api/v1/programs?token=" + kOperator).status, 401);
+}
+
+TEST(StreamTickets, LastTheirLifetimeAndOpenOnce) {
+  StreamTickets t;
+  const auto now = StreamTickets::Clock::now();
+  std::string error;
+  const auto a = t.issue(Role::Admin, now, &error), b = t.issue(Role::Operator, now, &error);
+  ASSERT_TRUE(a && b) << error;
+  EXPECT_NE(*a, *b);
+  EXPECT_EQ(t.redeem(*a, now + std::chrono::seconds(29)), Role::Admin);
+  EXPECT_FALSE(t.redeem(*a, now + std::chrono::seconds(29)));  // once
+  EXPECT_FALSE(t.redeem(*b, now + StreamTickets::kLifetime));  // expired
+  EXPECT_FALSE(t.redeem("", now));
+  EXPECT_EQ(t.outstanding(), 0u);
+  for (std::size_t k = 0; k < StreamTickets::kMaxOutstanding + 5; ++k) ASSERT_TRUE(t.issue(Role::Operator, now, &error));
+  EXPECT_EQ(t.outstanding(), StreamTickets::kMaxOutstanding);
+}
+
 TEST(Server, TheStreamSendsStatusAtItsRateAndEachClientItsEvents) {
   ServerConfig sc;
   sc.stream_hz = 30;
@@ -202,6 +241,11 @@ TEST(Server, AJobRunsToItsEndWithHoldAndResumeAndLandsInTheHistory) {
   EXPECT_GT(preview["polylines"].size(), 2u);
   EXPECT_EQ(get(rig.port, "/api/v1/program/text?from=4&count=1", t).body["lines"][0],
             "G21 G17 G40 G49 G80 G90 G94");
+  EXPECT_TRUE(get(rig.port, "/api/v1/program/text?from=4&count=1", t).body["more"]);  // a window: more after it
+  const json tail = get(rig.port, "/api/v1/program/text?from=70&count=5000", t).body;
+  EXPECT_FALSE(tail["more"]);
+  EXPECT_EQ(tail["from"], 70);
+  EXPECT_EQ(tail["lines"][0], "G80");
   EXPECT_EQ(post(rig.port, R"({"kind":"cycle-start"})", t).status, 200);
   ASSERT_TRUE(rig.until([](const json& s) { return s["wait"] == "manual-tool-change"; }));
   EXPECT_EQ(post(rig.port, R"({"kind":"tool-changed"})", t).status, 200);
@@ -231,6 +275,73 @@ TEST(Server, AJobRunsToItsEndWithHoldAndResumeAndLandsInTheHistory) {
   for (const json& e : events["events"])
     ended = ended || (e["kind"] == "job-ended" && e["end"] == "finished");
   EXPECT_TRUE(ended);
+}
+
+TEST(Server, TheStatusShowsWorkCoordinatesWithAG55OffsetAndAG92Shift) {
+  Rig rig;
+  const std::string& t = kOperator;
+  EXPECT_EQ(post(rig.port, R"({"kind":"machine-on"})", t).status, 200);
+  EXPECT_EQ(post(rig.port, R"({"kind":"mode","mode":"mdi"})", t).status, 200);
+  const auto mdi = [&](const std::string& line) {
+    ASSERT_EQ(post(rig.port, json{{"kind", "mdi"}, {"line", line}}.dump(), t).status, 200) << line;
+    ASSERT_TRUE(
+        rig.until([](const json& s) { return s["state"] == "idle" && !s["job"]["active"].get<bool>(); }));
+  };
+  mdi("G21 G90 G10 L2 P2 X10 Y20 Z-5");
+  mdi("G55 G0 X1 Y2 Z0");
+  mdi("G52 X1");                                        // a local shift (the G92 offset) of exactly 1
+  const json s = get(rig.port, "/api/v1/status").body;  // tokenless on loopback
+  EXPECT_EQ(s["offsets"]["system"], "G55");
+  EXPECT_EQ(s["offsets"]["g5x"]["X"], 10.0);
+  EXPECT_EQ(s["offsets"]["g5x"]["Y"], 20.0);
+  EXPECT_EQ(s["offsets"]["g5x"]["Z"], -5.0);
+  EXPECT_EQ(s["offsets"]["g92"]["X"], 1.0);
+  EXPECT_NEAR(s["commanded"]["X"].get<double>(), 11.0, 1e-9);
+  EXPECT_EQ(s["distance_to_go"]["X"], 0.0);
+  // work = machine − offsets, from the feedback position
+  const double machine_x = s["machine"]["X"].get<double>(), machine_y = s["machine"]["Y"].get<double>();
+  EXPECT_EQ(s["work"]["X"].get<double>(), machine_x - 10.0 - 1.0);
+  EXPECT_EQ(s["work"]["Y"].get<double>(), machine_y - 20.0);
+  EXPECT_NEAR(s["work"]["X"].get<double>(), 0.0, 1e-3);  // X1 in G55 before the shift
+  EXPECT_NEAR(s["work"]["Y"].get<double>(), 2.0, 1e-3);
+}
+
+TEST(Server, RunFromLineStartsTheProgramAtTheLineAfterTheApproach) {
+  Rig rig;
+  const std::string& t = kOperator;
+  EXPECT_EQ(post(rig.port, R"({"kind":"machine-on"})", t).status, 200);
+  EXPECT_EQ(post(rig.port, R"({"kind":"home"})", t).status, 200);
+  EXPECT_EQ(post(rig.port, R"({"kind":"mode","mode":"auto"})", t).status, 200);
+  ASSERT_EQ(post(rig.port, R"({"kind":"open","program":"bracket.ngc"})", t).status, 200);
+  EXPECT_EQ(post(rig.port, R"({"kind":"run-from-line","line":0})", t).status, 422);
+  EXPECT_EQ(post(rig.port, R"({"kind":"run-from-line"})", t).status, 400);
+  const Reply none = post(rig.port, R"({"kind":"run-from-line","line":12})", t);  // an assignment
+  EXPECT_EQ(none.status, 409);
+  EXPECT_NE(none.text.find("line 12 makes no move"), std::string::npos) << none.text;
+  // The drilling after the second tool change: the approach, then the program from line 66.
+  const Reply from = post(rig.port, R"({"kind":"run-from-line","line":66})", t);
+  ASSERT_EQ(from.status, 200) << from.text;
+  EXPECT_NE(from.text.find("bracket.ngc:66"), std::string::npos) << from.text;
+  std::uint32_t first_line = 0;
+  ASSERT_TRUE(rig.until(
+      [&](const json& s) {
+        if (first_line == 0 && s["job"]["kind"] == "program" && s["job"]["location"]["line"].get<int>() > 0)
+          first_line = s["job"]["location"]["line"].get<std::uint32_t>();
+        return s["runs_finished"].get<int>() >= 2 && s["job"]["kind"] == "" && s["state"] == "idle";  // approach, program
+      },
+      60));
+  // Seen while polling when the run is slow enough (a sanitizer build may run past it between polls).
+  if (first_line != 0) {
+    EXPECT_GE(first_line, 66u);
+  }
+  // In the history: the approach, then the program from there to its end.
+  rig.history->flush();
+  const json history = get(rig.port, "/api/v1/history", t).body;
+  ASSERT_EQ(history.size(), 2u);
+  EXPECT_EQ(history[1]["program"], "approach to line 66");
+  EXPECT_EQ(history[1]["outcome"], "finished");
+  EXPECT_EQ(history[0]["outcome"], "finished");
+  EXPECT_TRUE(history[0]["program"].get<std::string>().ends_with("examples/bracket.ngc"));
 }
 
 TEST(MachineHost, InRealTimeTheServoTicksByItselfAndTheControllerAnswers) {

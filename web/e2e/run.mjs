@@ -2,7 +2,8 @@
 // End-to-end test of the HMI in headless Chromium (Debian's, driven by playwright-core): starts
 // `opencnc serve` on the simulated mill (virtual time at 30x), then with the mouse alone: machine
 // on, home, open the bracket program, run it, confirm the tool changes, hold and resume, see the
-// position change, run to the end, find the job in the history. Screenshots land in the
+// position change, run to the end, find the job in the history; then run it again from line 66
+// chosen in the listing. Screenshots land in the
 // artefacts folder. Usage: node e2e/run.mjs [--opencnc PATH] [--out DIR]
 import { spawn } from "node:child_process";
 import { mkdtempSync, mkdirSync, rmSync } from "node:fs";
@@ -125,6 +126,19 @@ try {
     return rows.includes("bracket.ngc") && rows.includes("finished");
   });
   await shot("06-history");
+  step("run from line 66 (the drilling), chosen in the listing");
+  if (!(await page.locator("table.dro thead").innerText()).includes("work G54")) throw new Error("the DRO names no G54");
+  await page.getByTestId("key-file").click();
+  await page.locator("ol.listing li").nth(65).click();
+  if ((await page.getByTestId("from-line").inputValue()) !== "66") throw new Error("the listing did not choose line 66");
+  const finished = async () => ((await page.getByTestId("messages").innerText()).match(/finished/g) ?? []).length;
+  const before = await finished();
+  await page.getByTestId("run-from-line").click();
+  await waitFor("the approach and the drilling", async () => {
+    await answer("Tool is in — continue");
+    return (await finished()) >= before + 2;  // the approach, then the program
+  }, 60000);
+  await shot("07-run-from-line");
   step("passed");
 } catch (e) {
   failed = true;

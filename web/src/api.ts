@@ -31,9 +31,23 @@ export class Api {
 
   /** Follows /api/v1/stream: status at the server's rate, events as they come. */
   stream(onStatus: (s: Status) => void, onEvents: (e: ControllerEvent[]) => void, onLink: (up: boolean) => void) {
-    const open = () => {
+    // A browser cannot give a WebSocket headers: a single-use ticket, asked for with the token in
+    // the header, opens the stream, so the token never travels in a URL.
+    const open = async () => {
+      let ticket = "";
+      try {
+        const res = await fetch("/api/v1/stream-ticket", { method: "POST", headers: this.headers() });
+        if (res.ok) ticket = ((await res.json()) as { ticket: string }).ticket;
+      } catch {
+        /* the server is away: try again below */
+      }
+      if (!ticket) {
+        onLink(false);
+        setTimeout(() => void open(), 1000);
+        return;
+      }
       const proto = location.protocol === "https:" ? "wss" : "ws";
-      const ws = new WebSocket(`${proto}://${location.host}/api/v1/stream?token=${encodeURIComponent(this.token)}`);
+      const ws = new WebSocket(`${proto}://${location.host}/api/v1/stream?ticket=${encodeURIComponent(ticket)}`);
       ws.onopen = () => onLink(true);
       ws.onmessage = (m) => {
         const msg = JSON.parse(m.data as string);
@@ -42,9 +56,9 @@ export class Api {
       };
       ws.onclose = () => {
         onLink(false);
-        setTimeout(open, 1000);
+        setTimeout(() => void open(), 1000);
       };
     };
-    open();
+    void open();
   }
 }

@@ -13,7 +13,7 @@ import "./screens/history";
 import "./screens/params";
 import "./screens/network";
 import type { ControllerEvent, Machine, Status } from "./types";
-import { button, coord, el, percent } from "./ui";
+import { button, coord, el, offsetsText, outsideWindow, percent, windowStart } from "./ui";
 import { View3d, type Preview } from "./view3d";
 
 function token(): string {
@@ -81,25 +81,44 @@ async function start() {
   const dro = el("tbody");
   const cells: Record<string, HTMLElement[]> = {};
   for (const a of machine.axes) {
-    const c = [el("td", { class: "pos" }), el("td", {}), el("td", {}), el("td", {})];
-    c[0].dataset.testid = `pos-${a.axis}`;
+    const c = [el("td", { class: "pos" }), el("td", {}), el("td", {}), el("td", {}), el("td", {})];
+    c[0].dataset.testid = `work-${a.axis}`;
+    c[1].dataset.testid = `pos-${a.axis}`;
+    c[2].dataset.testid = `togo-${a.axis}`;
     cells[a.axis] = c;
     dro.append(el("tr", {}, el("th", {}, a.axis), ...c));
   }
+  const workHead = el("th", {}, "work");
   const droTable = el("table", { class: "dro" },
-    el("thead", {}, el("tr", {}, ...["", "machine", "commanded", "following error", "homed"].map((h) => el("th", {}, h)))), dro);
+    el("thead", {}, el("tr", {}, el("th", {}), workHead, ...["machine", "to go", "following error", "homed"].map((h) => el("th", {}, h)))), dro);
 
   // The program with its current line.
   const progName = el("div", { class: "progname" });
   const progress = el("progress", { max: "1", value: "0" });
   const listing = el("ol", { class: "listing" });
   let listingOf = "";
-  const loadListing = async () => {
+  // A window of the program around the current line (a program may have millions of lines).
+  const kWindow = 2000;
+  let windowFrom = 1, windowLines = 0, windowMore = false, windowWanted = 0;
+  const loadListing = async (around = 1) => {
+    const from = windowStart(around, kWindow);
+    windowWanted = from;
     try {
-      const t = await api.get<{ from: number; lines: string[] }>("program/text?from=1&count=5000");
-      listing.replaceChildren(...t.lines.map((l) => el("li", {}, l || " ")));
+      const t = await api.get<{ from: number; lines: string[]; more: boolean }>(`program/text?from=${from}&count=${kWindow}`);
+      if (windowWanted !== from) return;  // a newer window was asked for meanwhile
+      windowFrom = t.from;
+      windowLines = t.lines.length;
+      windowMore = t.more;
+      listing.start = t.from;
+      listing.replaceChildren(...t.lines.map((l, i) => {
+        const li = el("li", {}, l || " ");
+        li.addEventListener("click", () => document.dispatchEvent(new CustomEvent("line-chosen", { detail: t.from + i })));
+        return li;
+      }));
     } catch {
       listing.replaceChildren();
+      windowFrom = from;
+      windowLines = 0;
     }
   };
 
@@ -170,12 +189,15 @@ async function start() {
     mode.textContent = s.mode.toUpperCase();
     for (const a of machine.axes) {
       const c = cells[a.axis];
-      c[0].textContent = coord(s.machine[a.axis]);
-      c[1].textContent = coord(s.commanded[a.axis]);
+      c[0].textContent = coord(s.work[a.axis]);
+      c[1].textContent = coord(s.machine[a.axis]);
+      c[2].textContent = coord(s.distance_to_go[a.axis]);
       const fe = s.following_error[a.axis] ?? 0;
-      c[2].textContent = (Math.abs(fe) < 0.00005 ? 0 : fe).toFixed(4);
-      c[3].textContent = s.homed[a.axis] ? "●" : "○";
+      c[3].textContent = (Math.abs(fe) < 0.00005 ? 0 : fe).toFixed(4);
+      c[4].textContent = s.homed[a.axis] ? "●" : "○";
     }
+    workHead.textContent = `work ${s.offsets.system}`;
+    workHead.title = offsetsText(s.offsets, machine.axes.map((a) => a.axis));
     progName.textContent = s.program.name ? `${s.program.name.split("/").pop()} — ${s.program.moves} moves, ${s.program.length_mm.toFixed(1)} mm` : "no program open";
     progress.value = s.job.progress;
     if (s.program.name !== listingOf) {
@@ -184,9 +206,10 @@ async function start() {
       void loadPreview();
     }
     const line = s.job.active ? s.job.location.line : 0;
+    if (outsideWindow(line, windowFrom, windowLines, windowMore) && windowWanted === windowFrom) void loadListing(line);
     listing.querySelectorAll("li.current").forEach((li) => li.classList.remove("current"));
-    if (line > 0 && listing.children[line - 1]) {
-      const li = listing.children[line - 1] as HTMLElement;
+    if (line > 0 && listing.children[line - windowFrom]) {
+      const li = listing.children[line - windowFrom] as HTMLElement;
       li.classList.add("current");
       li.scrollIntoView({ block: "nearest" });
     }

@@ -9,6 +9,15 @@ export interface Location {
   calls: string[];
 }
 
+/** The offsets of the move at the commanded position. */
+export interface Offsets {
+  system: string;
+  g5x: Axes;
+  g92: Axes;
+  tool: Axes;
+  xy_rotation_deg: number;
+}
+
 export interface Status {
   tick: number;
   time_s: number;
@@ -20,6 +29,10 @@ export interface Status {
   wait_text: string;
   machine: Axes;
   commanded: Axes;
+  /** machine − offsets (docs/api.md) */
+  work: Axes;
+  distance_to_go: Axes;
+  offsets: Offsets;
   following_error: Axes;
   homed: Record<string, boolean>;
   all_homed: boolean;

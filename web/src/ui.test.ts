@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The formats of the DRO and the overrides, and which dialog a status asks for.
 import { describe, expect, it } from "vitest";
-import { coord, percent } from "./ui";
+import { coord, offsetsText, outsideWindow, percent, windowStart } from "./ui";
 import { dialogFor } from "./dialogs/waits";
 import type { Status } from "./types";
 
@@ -11,6 +11,20 @@ describe("formats", () => {
     expect(coord(-0.0001)).toBe("+0.000");
     expect(coord(-3)).toBe("-3.000");
     expect(coord(undefined)).toBe("—");
+  });
+  it("says which offsets hold, only the axes that have one", () => {
+    const o = { system: "G55", g5x: { X: 10, Y: 20, Z: 0 }, g92: { X: 1, Y: 0, Z: 0 }, tool: { X: 0, Y: 0, Z: 0 }, xy_rotation_deg: 0 };
+    expect(offsetsText(o, ["X", "Y", "Z"])).toBe("G55 X+10.000 Y+20.000 · G92 X+1.000");
+    expect(offsetsText({ ...o, g5x: {}, g92: {} }, ["X"])).toBe("G55");
+  });
+  it("pages the listing around the current line", () => {
+    expect(windowStart(1, 2000)).toBe(1);
+    expect(windowStart(10000, 2000)).toBe(9500);
+    expect(outsideWindow(0, 1, 2000, true)).toBe(false);
+    expect(outsideWindow(1999, 1, 2000, true)).toBe(false);
+    expect(outsideWindow(2001, 1, 2000, true)).toBe(true);
+    expect(outsideWindow(2001, 1, 2000, false)).toBe(false);  // past the file's end: nothing to load
+    expect(outsideWindow(10, 9500, 2000, true)).toBe(true);
   });
   it("shows overrides in per cent", () => {
     expect(percent(1.2)).toBe("120 %");

@@ -34,3 +34,28 @@ export function coord(v: number | undefined): string {
 export function percent(v: number): string {
   return `${Math.round(v * 100)} %`;
 }
+
+/** The offsets of a status in words, for the DRO's work column: "G55 X+10.000 Y+20.000 · G92 X+1.000". */
+export function offsetsText(
+  o: { system: string; g5x: Record<string, number>; g92: Record<string, number>; tool: Record<string, number>; xy_rotation_deg: number },
+  axes: string[],
+): string {
+  const part = (name: string, p: Record<string, number>) => {
+    const set = axes.filter((a) => (p[a] ?? 0) !== 0).map((a) => `${a}${coord(p[a])}`);
+    return set.length ? `${name} ${set.join(" ")}` : "";
+  };
+  const parts = [part(o.system, o.g5x) || o.system, part("G92", o.g92), part("tool", o.tool)];
+  if (o.xy_rotation_deg !== 0) parts.push(`R${o.xy_rotation_deg}°`);
+  return parts.filter((p) => p).join(" · ");
+}
+
+/** The first line of a listing window of `size` lines for `line`: a quarter of it before. */
+export function windowStart(line: number, size: number): number {
+  return Math.max(1, line - Math.floor(size / 4));
+}
+
+/** Whether `line` (0: none) lies outside the window [from, from + count) of a file that has more
+ * lines after it when `more`, so that another window must be loaded. */
+export function outsideWindow(line: number, from: number, count: number, more: boolean): boolean {
+  return line > 0 && (line < from || (line >= from + count && more));
+}

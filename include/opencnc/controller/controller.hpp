@@ -122,6 +122,7 @@ class Controller final : private FeatureHost {
   void log(ControllerEvent e);
   void publish();
   void update_locations();
+  void update_offsets(bool same_run);
   std::string wait_text() const;
   void tell_observers();
   void take_attachments();
@@ -170,6 +171,7 @@ class Controller final : private FeatureHost {
   std::uint32_t job_counter_ = 0;
   std::uint32_t run_counter_ = 0;
   std::uint64_t runs_finished_ = 0;
+  WorkOffsets mdi_offsets_;  ///< the MDI session's interpreter's, after its last line
   // Status details that cost strings, refreshed when they change.
   std::uint32_t located_context_ = ~0u, located_line_ = ~0u, located_run_ = ~0u;
   std::uint64_t interpreter_seen_ = ~std::uint64_t{0};

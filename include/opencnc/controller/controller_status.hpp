@@ -33,6 +33,22 @@ enum class JobEnd : std::uint8_t {
 /// "finished", "aborted", "error", "fault". Any thread.
 const char* to_string(JobEnd e) noexcept;
 
+/// The offsets the interpreter applies to a move (mm, or degrees on a rotary axis; machine axes):
+/// machine = rotate_xy(work + g92) + g5x + tool, the program builder's transform.
+struct WorkOffsets {
+  std::uint8_t system = 1;     ///< 1 … 9: G54, G55, … G59, G59.1, G59.2, G59.3
+  Pose g5x{};                  ///< the active coordinate system's origin
+  Pose g92{};                  ///< G92 / G52 shift
+  Pose tool{};                 ///< tool length offset (G43)
+  double xy_rotation_deg = 0;  ///< the coordinate system's XY rotation (G10 L2 R)
+};
+
+/// "G54" … "G59.3" for WorkOffsets::system (1 … 9). Any thread.
+const char* work_system_name(std::uint8_t system) noexcept;
+/// The work coordinates of machine position `machine` under `o` (the builder's transform
+/// inverted). Any thread; does not allocate.
+Pose work_position(const Pose& machine, const WorkOffsets& o) noexcept;
+
 /// The status a front end shows (Controller::status()).
 struct ControllerStatus {
   ServoStatus servo;
@@ -53,6 +69,12 @@ struct ControllerStatus {
   std::uint64_t run_segment = 0;
   double segment_offset = 0;
   double progress = 0;  ///< 0 … 1 of the main program's path length
+  /// The offsets of the move at the commanded position (after a job: the last job's, as they
+  /// stay in the interpreter's state); work position = work_position(servo.actual, offsets).
+  WorkOffsets offsets;
+  /// The current move's end minus the commanded position, per axis (machine coordinates; 0
+  /// without a run moving).
+  Pose distance_to_go{};
   /// The source at the commanded position: file, line and the calls that led there.
   SourceLocation location;
   /// Where the interpreter reads (ahead of the machine), and the moves it has made so far.
@@ -64,6 +86,7 @@ struct ControllerStatus {
   /// What the job waits for, in words ("" = nothing): "the operator (M0 at part.ngc:12)".
   std::string wait_text;
 
+  bool block_delete = false;  ///< the block-delete switch ('/' lines skipped by the programs started now)
   std::string fault_text;           ///< servo.fault in words ("" = none)
   std::uint64_t runs_finished = 0;  ///< jobs that reached their program end
 };

@@ -35,4 +35,8 @@ class Tokens {
   std::string operator_, admin_, origin_;
 };
 
+/// 24 random bytes from the kernel as 48 hex digits (nothing, and `*error`, when none come).
+/// Any thread.
+std::optional<std::string> random_secret(std::string* error);
+
 }  // namespace opencnc::hmi

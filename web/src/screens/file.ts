@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // File machining: the programs folder, open (the preflight checks the program: its warnings and
-// errors show here), run, hold, resume, abort, single block, optional stop, block delete.
+// errors show here), run, hold, resume, abort, single block, optional stop, block delete, and run
+// from a line (typed, or clicked in the listing).
 import { registerScreen, type Context } from "../registry";
 import { button, el } from "../ui";
 
@@ -36,6 +37,20 @@ registerScreen({
       x.dataset.testid = id;
       return x;
     };
+    const lineInput = el("input", { type: "number", min: "1", step: "1", class: "line" });
+    lineInput.dataset.testid = "from-line";
+    document.addEventListener("line-chosen", (e) => {
+      lineInput.value = String((e as CustomEvent<number>).detail);
+    });
+    const runFromLine = async () => {
+      const line = Number(lineInput.value);
+      if (!Number.isInteger(line) || line < 1) return ctx.message("give the line to start at (1 or more)", "warning");
+      const o = await ctx.api.command("run-from-line", { line });
+      report.replaceChildren(el("p", { class: o.accepted ? "note" : "error" }, `run from line ${line}: ${o.message ?? o.error ?? ""}`));
+      if (!o.accepted) ctx.message(`run from line ${line}: ${o.message ?? o.error}`, "warning");
+    };
+    const fromButton = button("Run from line", () => void runFromLine(), "go");
+    fromButton.dataset.testid = "run-from-line";
     const openButton = button("Open and check", () => void open(), "go");
     openButton.dataset.testid = "open";
     root.append(
@@ -46,7 +61,8 @@ registerScreen({
         b("Resume", "resume", "resume"), b("Abort", "abort", "abort", "danger")),
       el("div", { class: "row" }, sw("single-block", "single block"), sw("optional-stop", "optional stop (M1)"),
         sw("block-delete", "block delete (/)")),
-      el("p", { class: "hint" }, "Run from a line: not yet (the controller cannot start a program in its middle)."),
+      el("div", { class: "row" }, el("span", { class: "label" }, "Line"), lineInput, fromButton,
+        el("span", { class: "hint" }, "click a line of the listing to choose it; the machine goes there (up, across, down), then runs on")),
     );
     void refresh().catch((e) => ctx.message(String(e), "error"));
   },
