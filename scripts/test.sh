@@ -10,7 +10,8 @@ usage() {
   cat <<'TXT'
 usage: scripts/test.sh [--quick]
   Installs the test packages (scripts/setup.sh --tests); builds the application, the HAL component
-  and the benchmarks optimised with warnings as errors and runs the HAL tests in halrun; the HMI's
+  and the benchmarks optimised with warnings as errors and runs the HAL tests in halrun and the
+  breakpoint journal's torture (100 kills); the HMI's
   front end (scripts/hmi.sh: npm ci, build, vitest, the end-to-end test in headless Chromium,
   screenshots in web/e2e/artifacts); then builds the whole suite under ASan + UBSan and runs it
   (every tenth conformance program); then the fuzz gate (scripts/fuzz.sh --gate: the committed
@@ -50,10 +51,11 @@ fi
 # builds (`--quick` runs it here), and building the tests twice does not fit CI's 15 minutes. This
 # build makes everything else with the optimiser and warnings as errors: the application, the HAL
 # component and the benchmarks; then the tests that need this build: the HAL component in halrun
-# (a sanitised module cannot load into rtapi_app) and the real-time core's symbol check.
+# (a sanitised module cannot load into rtapi_app), the real-time core's symbol check, and the
+# breakpoint journal's torture (100 kills of the writing process; its benchmark, optimised).
 cmake --build --preset ci -j "$jobs" --target src/all apps/opencnc/all bench/all
-echo "== the HAL component in halrun and the real-time core's symbols (optimised build)"
-ctest --preset ci -j "$jobs" -R '^(hal|repo)[.]'
+echo "== the HAL component in halrun, the real-time core's symbols, the journal's torture (optimised build)"
+ctest --preset ci -j "$jobs" -R '^(hal|repo|bench)[.]'
 echo "== HMI front end: build, unit tests, end to end in headless Chromium"
 scripts/hmi.sh --test --e2e
 

@@ -104,7 +104,25 @@ int main(int argc, char** argv) {
       return usage(2);
     }
   }
-  std::filesystem::remove_all(dir);
+  // The folder is the torture's own: a fresh one, or one holding nothing but an earlier run's two
+  // slots. Anything else in it is somebody's, and stays.
+  std::error_code ec;
+  if (std::filesystem::exists(dir, ec)) {
+    if (!std::filesystem::is_directory(dir, ec)) {
+      fmt::print(stderr, "journal_torture: --dir {} is not a folder\n", dir.string());
+      return 2;
+    }
+    for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
+      const std::string name = entry.path().filename().string();
+      if (name != "slot-a.jrn" && name != "slot-b.jrn") {
+        fmt::print(stderr, "journal_torture: --dir {} holds {}, not only a journal's slots: choose another folder\n",
+                   dir.string(), name);
+        return 2;
+      }
+    }
+    std::filesystem::remove(dir / "slot-a.jrn", ec);
+    std::filesystem::remove(dir / "slot-b.jrn", ec);
+  }
   std::mt19937 rng(seed);
   std::uniform_int_distribution<int> delay_us(0, 60000);
   int runs = 0, lost = 0, corrupt = 0, damaged = 0, double_faults = 0;

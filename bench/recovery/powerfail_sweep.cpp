@@ -126,6 +126,23 @@ int main(int argc, char** argv) {
     }
   }
   const std::string profile_path = OPENCNC_SOURCE_DIR "/configs/broach-zc.toml";
+  // The root is the sweep's own: a fresh folder, or an earlier sweep's (only "reference" and
+  // "cut-N" in it). Anything else is somebody's, and stays.
+  std::error_code ec;
+  if (std::filesystem::exists(root, ec)) {
+    for (const auto& entry : std::filesystem::directory_iterator(root, ec)) {
+      const std::string name = entry.path().filename().string();
+      if (name != "reference" && name.rfind("cut-", 0) != 0) {
+        fmt::print(stderr, "powerfail_sweep: --journal-root {} holds {}, not an earlier sweep's journals\n",
+                   root.string(), name);
+        return 2;
+      }
+    }
+    if (ec || !std::filesystem::is_directory(root, ec)) {
+      fmt::print(stderr, "powerfail_sweep: --journal-root {} is not a folder the sweep can use\n", root.string());
+      return 2;
+    }
+  }
   // The uninterrupted run, once.
   std::filesystem::remove_all(root);
   Rig ref(profile_path, root / "reference");
