@@ -8,6 +8,7 @@
 //
 //   soak [--hours H] [--json] [--profile FILE]
 #include <fmt/format.h>
+#include <malloc.h>
 
 #include <algorithm>
 #include <array>
@@ -95,6 +96,13 @@ std::pair<double, double> rss_mb() {
   return {rss, hwm};
 }
 
+/// Bytes the allocator has handed out and not had back (MiB): unlike the resident set, it does not
+/// count pages the allocator keeps after a free, so it tells a leak from fragmentation.
+double heap_in_use_mb() {
+  const struct mallinfo2 m = mallinfo2();
+  return static_cast<double>(m.uordblks + m.hblkhd) / (1024.0 * 1024.0);
+}
+
 [[noreturn]] void usage(int code) {
   std::fputs(
       "usage: soak [--hours H] [--json] [--profile FILE]\n"
@@ -133,6 +141,7 @@ Options parse(int argc, char** argv) {
 
 struct Result {
   double wall_s = 0, rss_first = 0, rss_last = 0, hwm_first = 0, hwm_last = 0;
+  double heap_first = 0, heap_last = 0;
   double p99_first = 0, p99_last = 0, drift_um = 0, drift_mdeg = 0;
   std::uint64_t channels = 0, ticks = 0, jumps = 0;
 };
@@ -183,6 +192,7 @@ int main(int argc, char** argv) {
       if (++tick == hour_end) {
         if (hour_end == hour_ticks) {
           std::tie(r.rss_first, r.hwm_first) = rss_mb();
+          r.heap_first = heap_in_use_mb();
           std::swap(first, now);
         }
         if (tick < end_tick) now = std::make_unique<Histogram>();  // the last hour's own
@@ -203,9 +213,9 @@ int main(int argc, char** argv) {
     }
     ++r.channels;
     if (std::getenv("SOAK_VERBOSE") != nullptr)
-      std::fprintf(stderr, "channel %llu ended at %.1f s, %u jumps, at X%.4f Z%.4f B%.3f, wait %s\n",
+      std::fprintf(stderr, "channel %llu ended at %.1f s, %u jumps, at X%.4f Z%.4f B%.3f, heap %.3f MiB, wait %s\n",
                    static_cast<unsigned long long>(r.channels), s.time_s, s.edm.jumps, s.actual[Axis::X],
-                   s.actual[Axis::Z], s.actual[Axis::B], rig.status().wait_text.c_str());
+                   s.actual[Axis::Z], s.actual[Axis::B], heap_in_use_mb(), rig.status().wait_text.c_str());
     r.jumps = s.edm.jumps;
     for (Axis a : {Axis::X, Axis::Y, Axis::Z})
       r.drift_um = std::max(r.drift_um, 1000 * std::fabs(s.actual[a]));
@@ -213,7 +223,11 @@ int main(int argc, char** argv) {
   }
   r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::tie(r.rss_last, r.hwm_last) = rss_mb();
-  if (r.hwm_first == 0) std::tie(r.rss_first, r.hwm_first) = std::pair{r.rss_last, r.hwm_last};
+  r.heap_last = heap_in_use_mb();
+  if (r.hwm_first == 0) {
+    std::tie(r.rss_first, r.hwm_first) = std::pair{r.rss_last, r.hwm_last};
+    r.heap_first = r.heap_last;
+  }
   if (first->count == 0) std::swap(first, now);  // under an hour: one window
   r.p99_first = first->p99();
   r.p99_last = now->count > 0 ? now->p99() : r.p99_first;
@@ -226,15 +240,17 @@ int main(int argc, char** argv) {
         "\"peak_rss_mb_first_hour\": {:.1f}, \"peak_rss_mb_last_hour\": {:.1f}, \"tick_ns_p99_first_hour\": "
         "{:.0f}, "
         "\"tick_ns_p99_last_hour\": {:.0f}, \"position_drift_um\": {:.3f}, \"position_drift_mdeg\": {:.3f}, "
-        "\"channels\": {}, \"jumps\": {}}}\n",
+        "\"heap_mb_first_hour\": {:.3f}, \"heap_mb_last_hour\": {:.3f}, \"channels\": {}, \"jumps\": {}}}\n",
         hours, r.wall_s, r.rss_first, r.rss_last, r.hwm_first, r.hwm_last, r.p99_first, r.p99_last,
-        r.drift_um, r.drift_mdeg, r.channels, r.jumps);
+        r.drift_um, r.drift_mdeg, r.heap_first, r.heap_last, r.channels, r.jumps);
   } else {
     fmt::print("soak: {:.3f} h of machining ({} channels, {} jumps) in {:.1f} s\n", hours, r.channels,
                r.jumps, r.wall_s);
     fmt::print(
         "  resident memory  {:.1f} MiB after the first hour, {:.1f} MiB at the end (peak {:.1f} → {:.1f})\n",
         r.rss_first, r.rss_last, r.hwm_first, r.hwm_last);
+    fmt::print("  heap in use      {:.3f} MiB after the first hour, {:.3f} MiB at the end\n", r.heap_first,
+               r.heap_last);
     fmt::print("  servo tick p99   {:.0f} ns in the first hour, {:.0f} ns in the last\n", r.p99_first,
                r.p99_last);
     fmt::print("  rest position    {:.3f} µm, {:.3f} millidegrees from the program at most\n", r.drift_um,

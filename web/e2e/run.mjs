@@ -105,9 +105,17 @@ try {
   step("feed hold");
   await page.getByTestId("feed-hold").click();
   await waitFor("held", async () => (await text("state")).startsWith("held"));
-  await page.waitForTimeout(400);
+  // "held" shows at once while the axes still decelerate along the path (longer on a busy
+  // machine): wait until the position has rested for half a second, then it must stay there.
+  let last = await text("pos-X");
+  let since = Date.now();
+  await waitFor("the axes at rest", async () => {
+    const now = await text("pos-X");
+    if (now !== last) [last, since] = [now, Date.now()];
+    return Date.now() - since >= 500;
+  });
   const held = await text("pos-X");
-  await page.waitForTimeout(300);
+  await page.waitForTimeout(500);
   if ((await text("pos-X")) !== held) throw new Error("the machine moved while held");
   await shot("04-held");
   step("resume");
