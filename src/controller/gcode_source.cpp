@@ -635,6 +635,7 @@ std::optional<GcodeSourceConfig> GcodeProgramSource::config_for(const config::Ma
   o.user_units = canon::Units::Mm;
   o.initial_units = canon::Units::Mm;
   o.optional_stop = true;  // M1 always reaches the servo, which decides with the live switch
+  o.spindle = profile.spindle.present;
   if (!profile.interpreter.tool_table.empty()) {
     c.tools = tools::FileToolTable::open(profile.interpreter.tool_table, diags);
     if (!c.tools) return std::nullopt;

@@ -576,7 +576,7 @@ void Engine::check_motion_habits(bool feed) {
   if (!units_programmed_ && !warned_units_)
     warn_once(warned_units_, ErrorCode::UnitsNotProgrammed,
               "motion before any G20/G21: the program relies on the machine's default units");
-  if (feed && !warned_spindle_ && st_.modal.spindle == canon::SpindleDirection::Stopped)
+  if (feed && opt_.spindle && !warned_spindle_ && st_.modal.spindle == canon::SpindleDirection::Stopped)
     warn_once(warned_spindle_, ErrorCode::FeedWithSpindleStopped, "feed move while the spindle is stopped");
 }
 

@@ -243,6 +243,12 @@ TEST(Interpreter, WarnsOnceAboutHabitsLinuxCncAccepts) {
   Interpreter careful;
   ASSERT_EQ(run_into(careful, quiet, "G21 F100 M3 S1000\nG1 X1\nG2 X2 I0.5\nM2\n"), RunStatus::Finished);
   EXPECT_TRUE(careful.diagnostics().empty());
+  // A machine without a spindle (an EDM, a flame cutter) feeds with none turning as a rule.
+  Options spindleless;
+  spindleless.spindle = false;
+  Interpreter cutter(spindleless);
+  ASSERT_EQ(run_into(cutter, quiet, "G21 F100\nG1 X1\nM2\n"), RunStatus::Finished);
+  EXPECT_TRUE(cutter.diagnostics().empty());
 }
 
 // --- stepping, MDI and sync points ---------------------------------------------------------

@@ -82,6 +82,9 @@ struct Options {
   /// Length units at program start (before any G20/G21).
   canon::Units initial_units = canon::Units::Mm;
   Limits limits;
+  /// The machine has a spindle. Without one (an EDM, a flame cutter) a feed move with the
+  /// spindle stopped is the normal case, not a habit to point out.
+  bool spindle = true;
   bool block_delete = false;   ///< skip blocks starting with '/'
   bool optional_stop = true;   ///< M1 stops
   MainM99 main_m99 = MainM99::End;
