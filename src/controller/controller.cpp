@@ -799,7 +799,7 @@ std::string Controller::wait_text() const {
 
 void Controller::log(ControllerEvent e) {
   e.tick = servo().tick;
-  log_.append(std::move(e));
+  log_.append(e);
 }
 
 void Controller::tell_observers() {
