@@ -135,7 +135,9 @@ Controller::Controller(const config::MachineProfile& profile, ServoChannels& cha
       channels_(&channels),
       source_(std::move(source)),
       check_(std::make_unique<MachineMoveCheck>(servo_config_, limits_)),
-      location_every_(static_cast<std::uint64_t>(kLocationRefreshS / servo_config_.period_s) + 1) {}
+      location_every_(static_cast<std::uint64_t>(kLocationRefreshS / servo_config_.period_s) + 1) {
+  outcomes_.resize(kKeptOutcomes);
+}
 
 Controller::~Controller() = default;
 
@@ -154,9 +156,9 @@ std::uint64_t Controller::new_id() {
 
 std::optional<Outcome> Controller::outcome(std::uint64_t id) const {
   std::lock_guard lock(out_mutex_);
-  auto it = outcomes_.find(id);
-  if (it == outcomes_.end()) return std::nullopt;
-  return it->second;
+  const KeptOutcome& k = outcomes_[id % outcomes_.size()];
+  if (k.id != id || id == 0) return std::nullopt;
+  return k.outcome;
 }
 
 ControllerStatus Controller::status() const {
@@ -842,13 +844,15 @@ void Controller::finish(std::uint64_t id, Refusal refusal, std::string message, 
   e.severity = e.accepted ? Severity::Note : Severity::Error;
   {
     std::lock_guard lock(out_mutex_);
-    Outcome& o = outcomes_[id];
-    o.accepted = refusal == Refusal::None;
-    o.refusal = refusal;
-    o.message = message.empty() ? refusal_text(refusal) : std::move(message);
-    o.diagnostics = std::move(diags);
-    e.text = o.message;
-    while (outcomes_.size() > kKeptOutcomes) outcomes_.erase(outcomes_.begin());
+    KeptOutcome& k = outcomes_[id % outcomes_.size()];
+    e.text = message.empty() ? refusal_text(refusal) : std::move(message);
+    if (k.id <= id) {  // a later request's answer already there: this one is older than any kept
+      k.id = id;
+      k.outcome.accepted = refusal == Refusal::None;
+      k.outcome.refusal = refusal;
+      k.outcome.message = e.text;
+      k.outcome.diagnostics = std::move(diags);
+    }
   }
   log(std::move(e));
 }
