@@ -324,6 +324,12 @@ void Controller::on_event(const ServoEvent& e) {
     case EventKind::LoadGuard:
       note(Severity::Warning, "control.load", interlock_text(e));
       break;
+    case EventKind::EdmRetractLimit:
+      note(Severity::Warning, "control.edm.retract-limit",
+           fmt::format("EDM condition {}: backing off reached the end of the path memory {:.3f} mm behind "
+                       "the program; the electrode holds there and can go back no further",
+                       e.action, e.value));
+      break;
     default:
       break;
   }
@@ -909,6 +915,12 @@ std::string Controller::describe(const Fault& f) const {
     case FaultKind::Stall:
       return fmt::format("the {} stepper stalled at {:.4f} {}: steps were lost, home it again", axis, f.value,
                          unit);
+    case FaultKind::EdmShort:
+      return fmt::format(
+          "the EDM gap stayed shorted for {:.2f} s, longer than condition {}'s short_timeout_s ({} s): "
+          "the program was stopped with the generator off; clear the gap (debris, a bridge, the electrode "
+          "on the work) before going on",
+          f.value, static_cast<int>(f.axis), f.limit);
     case FaultKind::ProcessAlarm:
       return detail::alarm_text(profile_.alarms, static_cast<std::size_t>(f.axis), f.value, f.value < f.limit,
                                 false);

@@ -2,7 +2,8 @@
 // The sinker EDM through the whole controller on configs/edm-5axis.toml: the gap held in its
 // band while the depth grows, an injected short backed off and recovered within a bound, the
 // jump's timing and height, the orbit's radius and shape from the trace, arcing without the jump,
-// and the preflight refusing an unknown condition at its line.
+// a short that never clears stopped by its time, and the preflight refusing an unknown condition
+// at its line.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -122,6 +123,78 @@ TEST(Edm, AnInjectedShortIsBackedOffAlongThePathAndRecovered) {
   EXPECT_LT(r.report.short_recovery_max_s, 0.05);
   EXPECT_GT(backlog_max, 0.015);
   EXPECT_GT(r.report.gap_voltage_in_band_fraction, 0.75);
+}
+
+// A bridge that no backing off breaks (100 mm): the electrode backs off at 3 mm/s to the end of the
+// path memory (which starts with the run: the approach from Z0, 20 mm up the path), is told to
+// hold there, and once the short has lasted short_timeout_s the machine stops with a fault that
+// says so.
+TEST(Edm, AShortThatNeverClearsStopsTheMachineWithAFault) {
+  const config::MachineProfile p = edm({"edm.sim.short_bridge_mm=100", "edm.short_timeout_s=8"});
+  ASSERT_EQ(p.edm.config.find(1)->short_timeout_s, 8.0);
+  Diagnostics d;
+  SimRig rig(p, GcodeProgramSource::create(p, d));
+  EventCursor events(rig.controller().events());
+  rig.step();
+  ASSERT_TRUE(rig.request(Request::simple(CommandKind::MachineOn)).accepted);
+  ASSERT_TRUE(rig.request(Request::set_mode(Mode::Auto)).accepted);
+  ASSERT_TRUE(rig.request(Request::open(write_program(burn(1, 0.03))), 100000).accepted);
+  ASSERT_TRUE(rig.request(Request::simple(CommandKind::CycleStart)).accepted);
+  double shorted_at = -1, limit_at = -1;
+  ASSERT_TRUE(rig.run_until(
+      [&] {
+        const ServoStatus& s = rig.status().servo;
+        if (shorted_at < 0 && s.edm.generator && s.edm.gap_state == machine::GapState::Normal) {
+          rig.machine().inject_edm_short();
+          shorted_at = s.time_s;
+        }
+        if (limit_at < 0 && s.edm.retract_limit) limit_at = s.time_s;
+        return s.state == State::Faulted || (!rig.status().run_active && s.state == State::Idle);
+      },
+      40000));
+  const ServoStatus s = rig.status().servo;
+  ASSERT_EQ(s.state, State::Faulted);
+  EXPECT_EQ(s.fault.kind, FaultKind::EdmShort);
+  ASSERT_GE(shorted_at, 0);
+  ASSERT_GE(limit_at, shorted_at);
+  // The short is timed from its first period: the fault comes 8 s later, to a period or two.
+  EXPECT_NEAR(s.time_s - shorted_at, 8, 0.003);
+  EXPECT_LT(limit_at - shorted_at, 8);
+  EXPECT_NEAR(s.edm.backlog_mm, 20.0, 0.05);
+  EXPECT_FALSE(s.edm.generator);
+  bool told_limit = false, told_fault = false;
+  for (const ControllerEvent& e : events.next()) {
+    if (e.kind != ControllerEventKind::Note) continue;
+    if (e.code == "control.edm.retract-limit") {
+      told_limit = true;
+      EXPECT_NE(e.text.find("end of the path memory"), std::string::npos) << e.text;
+    }
+    if (e.code == "control.fault.edm-short") {
+      told_fault = true;
+      EXPECT_NE(e.text.find("shorted for 8.00 s, longer than condition 1's short_timeout_s (8 s)"),
+                std::string::npos)
+          << e.text;
+    }
+  }
+  EXPECT_TRUE(told_limit);
+  EXPECT_TRUE(told_fault);
+}
+
+// A short that clears within its time is no fault, however long the program runs on.
+TEST(Edm, TheShortTimeCountsOnlyAnUnbrokenShort) {
+  int shorts = 0;
+  const EdmRun r = run(burn(1, 0.03), edm({"edm.short_timeout_s=0.05"}), [&](SimRig& rig) {
+    const ServoStatus& s = rig.status().servo;
+    if (shorts < 3 && s.time_s > 0.3 * (shorts + 1) && s.edm.generator &&
+        s.edm.gap_state == machine::GapState::Normal) {
+      rig.machine().inject_edm_short();  // the 20 µm bridge breaks in about 7 ms each time
+      ++shorts;
+    }
+  });
+  ASSERT_TRUE(r.finished);
+  EXPECT_EQ(shorts, 3);
+  EXPECT_EQ(r.rig->status().servo.state, State::Idle);
+  EXPECT_GE(r.report.shorts, 3u);
 }
 
 TEST(Edm, JumpsLiftTheElectrodeEveryPeriodWithTheGeneratorOff) {
