@@ -197,6 +197,49 @@ TEST(Edm, TheShortTimeCountsOnlyAnUnbrokenShort) {
   EXPECT_GE(r.report.shorts, 3u);
 }
 
+// Resumed at the second feed of condition 2 (ResumeProgram, as run from line and electrode setting
+// use it): the condition in force there is selected again and the generator comes on before the
+// electrode cuts on: condition 2, not condition 1 nor none.
+TEST(Edm, AResumedProgramSelectsTheConditionInForceAgain) {
+  const config::MachineProfile p = edm();
+  const std::string text =
+      "G21 G90\nG0 Z-19.97\nM180 P1\nG1 Z-19.99 F60\nM180 P2\nG1 Z-20.0 F30\nG1 Z-20.02\nM181\n"
+      "G0 Z0\nM2\n";
+  const std::string path = write_program(text);
+  Diagnostics d;
+  auto source = GcodeProgramSource::create(p, d);
+  canon::SegmentId k = 0;  // the segment of line 7 (G1 Z-20.02)
+  {
+    auto whole = source->execute(path, Pose{}, {});
+    for (int i = 0; i < 1000 && whole->state() == StreamState::Reading; ++i) whole->read(100);
+    for (std::size_t m = 0; m < whole->program().size(); ++m)
+      if (whole->program().move(m).line == 7) k = whole->program().segment_of(m);
+  }
+  ASSERT_NE(k, 0u);
+  SimRig rig(p, GcodeProgramSource::create(p, d));
+  rig.step();
+  ASSERT_TRUE(rig.request(Request::simple(CommandKind::MachineOn)).accepted);
+  ASSERT_TRUE(rig.request(Request::set_mode(Mode::Mdi)).accepted);
+  ASSERT_TRUE(rig.request(Request::mdi("G0 Z-19.995"), 100000).accepted);  // on segment k's line
+  ASSERT_TRUE(rig.run_until(
+      [&] { return rig.status().servo.state == State::Idle && !rig.status().run_active; }, 20000));
+  ASSERT_TRUE(rig.request(Request::set_mode(Mode::Auto)).accepted);
+  ASSERT_TRUE(rig.request(Request::open(path), 100000).accepted);
+  const Outcome resumed = rig.request(Request::resume(k), 100000);
+  ASSERT_TRUE(resumed.accepted) << resumed.message;
+  int condition_when_burning = -1;
+  ASSERT_TRUE(rig.run_until(
+      [&] {
+        const EdmStatus& e = rig.status().servo.edm;
+        if (e.generator && condition_when_burning < 0) condition_when_burning = e.condition;
+        return !rig.status().run_active && rig.status().servo.state == State::Idle;
+      },
+      60000));
+  EXPECT_EQ(condition_when_burning, 2);
+  EXPECT_LT(rig.machine().edm().depth_mm(), 0.05);  // it burnt from Z -19.995 to -20.02, no more
+  EXPECT_GT(rig.machine().edm().depth_mm(), 0.0);
+}
+
 TEST(Edm, JumpsLiftTheElectrodeEveryPeriodWithTheGeneratorOff) {
   const EdmRun r = run(burn(1, 0.02));
   ASSERT_TRUE(r.finished);
