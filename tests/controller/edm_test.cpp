@@ -322,6 +322,44 @@ TEST(Edm, WithoutTheJumpDebrisMakesTheGapArc) {
   EXPECT_GT(without.report.machining_s, with.report.machining_s);  // arcs remove little
 }
 
+// The preflight sees what the gap servo adds to the path: condition 3's square orbit (0.08 mm)
+// around a burn 0.05 mm inside X's limit of 150 mm, condition 1's axis jump (0.4 mm up Z) on a
+// burn 0.2 mm below Z's limit of 50 mm; both refused at the burn's line, the same burns without
+// the orbit or the jump are not.
+TEST(Edm, ThePreflightSeesTheOrbitAndTheJump) {
+  struct Case {
+    std::string program, message;  // message "": accepted
+  };
+  const Case cases[] = {
+      {"G21 G90\nG0 X149.95 Z-19.97\nM180 P3\nG1 Z-20.01 F60\nM181\nG0 Z0\nM2\n",
+       "with EDM condition 3's orbit (0.08 mm) this move takes X to 150.0300 mm, beyond its maximum soft "
+       "limit of 150 mm"},
+      {"G21 G90\nG0 Z49.8\nM180 P1\nG1 Z49.7 F60\nM181\nG0 Z0\nM2\n",
+       "with EDM condition 1's jump (0.4 mm) this move takes Z to 50.2000 mm, beyond its maximum soft limit"},
+      {"G21 G90\nG0 X149.95 Z-19.97\nM180 P1\nG1 Z-20.01 F60\nM181\nG0 Z0\nM2\n", ""},
+  };
+  for (const Case& c : cases) {
+    const config::MachineProfile p = edm();
+    Diagnostics d;
+    SimRig rig(p, GcodeProgramSource::create(p, d));
+    rig.step();
+    ASSERT_TRUE(rig.request(Request::simple(CommandKind::MachineOn)).accepted);
+    ASSERT_TRUE(rig.request(Request::set_mode(Mode::Auto)).accepted);
+    const Outcome o = rig.request(Request::open(write_program(c.program)), 100000);
+    if (c.message.empty()) {
+      EXPECT_TRUE(o.accepted) << o.message
+                              << (o.diagnostics.items().empty() ? "" : o.diagnostics.items()[0].format());
+      continue;
+    }
+    ASSERT_FALSE(o.accepted) << c.program;
+    ASSERT_FALSE(o.diagnostics.items().empty());
+    const Diagnostic& first = o.diagnostics.items().front();
+    EXPECT_EQ(first.code, "control.soft-limit");
+    EXPECT_EQ(first.line, 4u);
+    EXPECT_NE(first.message.find(c.message), std::string::npos) << first.message;
+  }
+}
+
 TEST(Edm, ThePreflightRefusesAConditionTheMachineLacks) {
   const EdmRun r = run("G21 G90\nG0 Z-19.97\nM180 P5\nG1 Z-20.01 F60\nM2\n");
   ASSERT_FALSE(r.opened.accepted);
