@@ -14,6 +14,7 @@
 #include <map>
 #include <numbers>
 #include <random>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -24,6 +25,7 @@
 #include "opencnc/controller/servo_setup.hpp"
 #include "opencnc/controller/sim_rig.hpp"
 #include "opencnc/recovery/breakpoint_journal.hpp"
+#include "opencnc/recovery/recovery_wait.hpp"
 
 namespace {
 
@@ -162,6 +164,7 @@ int main(int argc, char** argv) {
     const auto dir = root / fmt::format("cut-{}", k);
     recovery::BreakpointRecord r;
     control::PowerFailReport pf;
+    std::vector<float> bore;  // the workpiece as the cut left it
     {
       Rig cut(profile_path, dir);
       auto recorder = std::make_shared<control::PowerFailRecorder>(
@@ -178,6 +181,8 @@ int main(int argc, char** argv) {
       pf = recorder->report();
       for (double l : cut.journal->latencies_ms()) latencies.push_back(l);
       r = cut.journal->last_written().value_or(recovery::BreakpointRecord{});
+      const std::span<const float> b = cut.rig->machine().broach_bore();
+      bore.assign(b.begin(), b.end());
     }
     if (pf.coupled) {
       coupled_max = std::max(coupled_max, pf.coupled_error_um);
@@ -191,14 +196,12 @@ int main(int argc, char** argv) {
         sets.push_back(fmt::format("axis.{}.homing.position={:.17g}", name, r.actual[axis]));
       }
       Rig after(profile_path, dir, sets);
+      after.rig->machine().restore_broach_bore(bore);  // the groove cut before the power failed
       const control::Outcome o = after.rig->request(Request::feature("journal", "resume"), 1000000);
-      after.rig->run_until(
-          [&] {
-            const auto p = after.journal->phase();
-            return !o.accepted || p == recovery::RecoveryPhase::Done || p == recovery::RecoveryPhase::Failed;
-          },
-          100'000'000);
-      if (after.journal->phase() == recovery::RecoveryPhase::Done) {
+      // Bounded: the rest of the job cannot take longer than the whole of it.
+      const std::string why =
+          o.accepted ? recovery::run_recovery(*after.rig, *after.journal, {length_s + 10, 2.0}) : o.message;
+      if (why.empty()) {
         ++resumed;
         dev = deviation_um(*after.grooves, *ref.grooves, r, after.profile.coupling.radius_mm);
         resume_max = std::max(resume_max, dev);
@@ -206,8 +209,7 @@ int main(int argc, char** argv) {
             moving_max, deviation_um(*after.grooves, *ref.grooves, r, after.profile.coupling.radius_mm, 1.0));
       } else {
         ++failed;
-        fmt::print(stderr, "cut {} at {:.3f} s: resume failed: {}{}\n", k, cut_s, o.message,
-                   after.journal->recovery_error());
+        fmt::print(stderr, "cut {} at {:.3f} s: resume failed: {}: {}\n", k, cut_s, o.message, why);
       }
     }
     if (!json) {
