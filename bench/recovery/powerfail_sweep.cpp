@@ -294,11 +294,11 @@ int main(int argc, char** argv) {
     }
   }
   std::sort(latencies.begin(), latencies.end());
+  // Nearest rank: the ⌈0.99·n⌉-th smallest (with fewer than 100 records, the largest).
   const double p99 =
       latencies.empty()
           ? 0
-          : latencies[std::min(latencies.size() - 1,
-                               static_cast<std::size_t>(0.99 * static_cast<double>(latencies.size())))];
+          : latencies[static_cast<std::size_t>(std::ceil(0.99 * static_cast<double>(latencies.size()))) - 1];
   const double pmax = latencies.empty() ? 0 : latencies.back();
   std::filesystem::remove_all(root);
   if (json) {
