@@ -260,9 +260,12 @@ void BreakpointJournal::writer_loop() {
     std::optional<Clock::time_point> signal;
     std::optional<Work> last;
     for (Work& w : batch) {
-      if (w.hash_only) {
+      if (w.hash_only) {  // a program just opened: no emergency, and a huge file takes a while
+        const bool fifo = this_thread_is_fifo();
+        if (fifo) schedule_this_thread(0);
         hashed_path_ = w.record.program_path;
         hash_ = hash_file(hashed_path_).value_or(FileHash{});
+        if (fifo) schedule_this_thread(kWriterPriority);
         continue;
       }
       if (w.signal && !signal) signal = w.signal;
