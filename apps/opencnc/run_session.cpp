@@ -61,12 +61,14 @@ class Driver {
   virtual void inject_edm_short() {}
   /// A simulated analog input goes to `value` over `ramp_s` (0: at once). Virtual time only.
   virtual void drive_analog(int /*channel*/, double /*value*/, double /*ramp_s*/) {}
+  /// The simulated spark gap's figures (virtual time only; nothing elsewhere).
+  virtual std::optional<SimEdmFigures> sim_edm() { return std::nullopt; }
 };
 
 class VirtualDriver final : public Driver {
  public:
   VirtualDriver(const config::MachineProfile& p, std::shared_ptr<control::ProgramSource> s)
-      : rig_(p, std::move(s)) {}
+      : rig_(p, std::move(s)), edm_sim_(p.edm.sim.present) {}
   void advance() override { rig_.step(); }
   control::Controller& controller() override { return rig_.controller(); }
   bool ticks_by_itself() const override { return false; }
@@ -84,9 +86,15 @@ class VirtualDriver final : public Driver {
       m.set_analog_input(channel, value);
     }
   }
+  std::optional<SimEdmFigures> sim_edm() override {
+    if (!edm_sim_) return std::nullopt;
+    const machine::SimEdmProcess& e = rig_.machine().edm();
+    return SimEdmFigures{e.cavity_oversize_max_mm(), e.electrode_wear_max_mm(), e.depth_max_mm()};
+  }
 
  private:
   control::SimRig rig_;
+  bool edm_sim_ = false;
 };
 
 /// The simulated machine behind a real-time servo: the servo thread alone touches it, so the
@@ -563,6 +571,7 @@ SessionEnd run_session(const SessionOptions& o, const SessionHooks& hooks) {
   control::EventCursor cursor(d.controller().events());
   if (!must(d, Request::simple(CommandKind::CycleStart))) return end;
   follow(d, cursor, o, hooks, end);
+  end.sim_edm = d.sim_edm();
   end.exit_code = end.finished ? kExitOk : end.stopped_by != 0 ? 128 + end.stopped_by : kExitProgram;
   return end;
 }

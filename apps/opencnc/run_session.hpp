@@ -46,6 +46,14 @@ struct SessionOptions {
   std::optional<AnalogInjection> analog;
 };
 
+/// The simulated spark gap's ground truth at the end of a run in virtual time (docs/edm.md):
+/// what a real machine shows only when the work is measured.
+struct SimEdmFigures {
+  double cavity_oversize_mm = 0;  ///< the widest cavity's oversize per side beyond the electrode
+  double electrode_wear_mm = 0;   ///< the most length an electrode lost
+  double cavity_depth_mm = 0;     ///< the deepest front below the work's surface
+};
+
 /// What a session ended with.
 struct SessionEnd {
   int exit_code = 0;           ///< kExitOk, kExitProgram or kExitUsage
@@ -56,6 +64,7 @@ struct SessionEnd {
   double wall_s = 0;           ///< wall-clock time of the run
   config::MachineProfile profile;
   std::optional<control::OpenProgram> program;  ///< the program as opened (its preflight)
+  std::optional<SimEdmFigures> sim_edm;         ///< in virtual time on a machine with [edm.sim]
 };
 
 /// Observers attached before the program starts (a run recorder, a trace writer), and progress.
