@@ -302,6 +302,8 @@ void SimMachine::sample_sphere_probe() noexcept {
     const int j = config_.probe.sphere.joints[k];
     p[k] = j >= 0 ? joints_[static_cast<std::size_t>(j)].table_position() : 0.0;
   }
+  const int b = config_.probe.sphere.b_joint;
+  if (b >= 0 && b < config_.joint_count) sphere_.turn(joints_[static_cast<std::size_t>(b)].table_position());
   const bool was = inputs_.probe;
   inputs_.probe = sphere_.update(p, rng_);
   if (inputs_.probe == was) return;
