@@ -538,8 +538,8 @@ int run(const RunOptions& o) {
   nlohmann::json j = report_json(r, o, end, power_fail);
   if (edm_recorder) {
     const control::EdmReport e = edm_recorder->report();
-    print_edm(e);
-    j["edm"] = edm_json(e);
+    print_edm(e, end.sim_edm);
+    j["edm"] = edm_json(e, end.sim_edm);
   }
   if (feature) {
     const std::vector<recovery::RetraceRecord> records = feature->records();

@@ -2,13 +2,17 @@
 // The `edm` part of `opencnc run`'s report: printed and as JSON (docs/edm.md).
 #pragma once
 
+#include <optional>
+
 #include <nlohmann/json.hpp>
 
 #include "opencnc/controller/edm_recorder.hpp"
+#include "run_session.hpp"
 
 namespace opencnc::cli {
 
-nlohmann::json edm_json(const control::EdmReport& e);
-void print_edm(const control::EdmReport& e);
+/// The recorder's figures, and the simulated gap's (`sim`) where the run had one.
+nlohmann::json edm_json(const control::EdmReport& e, const std::optional<SimEdmFigures>& sim);
+void print_edm(const control::EdmReport& e, const std::optional<SimEdmFigures>& sim);
 
 }  // namespace opencnc::cli

@@ -63,12 +63,14 @@ class Driver {
   virtual void drive_analog(int /*channel*/, double /*value*/, double /*ramp_s*/) {}
   /// The simulated broach's workpiece (virtual time only: empty otherwise).
   virtual std::vector<float> sim_bore() { return {}; }
+  /// The simulated spark gap's figures (virtual time only; nothing elsewhere).
+  virtual std::optional<SimEdmFigures> sim_edm() { return std::nullopt; }
 };
 
 class VirtualDriver final : public Driver {
  public:
   VirtualDriver(const config::MachineProfile& p, std::shared_ptr<control::ProgramSource> s)
-      : rig_(p, std::move(s)) {}
+      : rig_(p, std::move(s)), edm_sim_(p.edm.sim.present) {}
   void advance() override { rig_.step(); }
   control::Controller& controller() override { return rig_.controller(); }
   bool ticks_by_itself() const override { return false; }
@@ -90,9 +92,15 @@ class VirtualDriver final : public Driver {
     const std::span<const float> b = rig_.machine().broach_bore();
     return {b.begin(), b.end()};
   }
+  std::optional<SimEdmFigures> sim_edm() override {
+    if (!edm_sim_) return std::nullopt;
+    const machine::SimEdmProcess& e = rig_.machine().edm();
+    return SimEdmFigures{e.cavity_oversize_max_mm(), e.electrode_wear_max_mm(), e.depth_max_mm()};
+  }
 
  private:
   control::SimRig rig_;
+  bool edm_sim_ = false;
 };
 
 /// The simulated machine behind a real-time servo: the servo thread alone touches it, so the
@@ -570,6 +578,7 @@ SessionEnd run_session(const SessionOptions& o, const SessionHooks& hooks) {
   if (!must(d, Request::simple(CommandKind::CycleStart))) return end;
   follow(d, cursor, o, hooks, end);
   end.sim_bore = d.sim_bore();
+  end.sim_edm = d.sim_edm();
   end.exit_code = end.finished ? kExitOk : end.stopped_by != 0 ? 128 + end.stopped_by : kExitProgram;
   return end;
 }

@@ -46,6 +46,14 @@ struct SessionOptions {
   std::optional<AnalogInjection> analog;
 };
 
+/// The simulated spark gap's ground truth at the end of a run in virtual time (docs/edm.md):
+/// what a real machine shows only when the work is measured.
+struct SimEdmFigures {
+  double cavity_oversize_mm = 0;  ///< the widest cavity's oversize per side beyond the electrode
+  double electrode_wear_mm = 0;   ///< the most length an electrode lost
+  double cavity_depth_mm = 0;     ///< the deepest front below the work's surface
+};
+
 /// What a session ended with.
 struct SessionEnd {
   int exit_code = 0;           ///< kExitOk, kExitProgram or kExitUsage
@@ -59,6 +67,7 @@ struct SessionEnd {
   /// The simulated broach's workpiece as the run left it (virtual time on a machine with a
   /// simulated broach; empty otherwise): `--journal` keeps it beside the breakpoint.
   std::vector<float> sim_bore;
+  std::optional<SimEdmFigures> sim_edm;         ///< in virtual time on a machine with [edm.sim]
 };
 
 /// Observers attached before the program starts (a run recorder, a trace writer), and progress.

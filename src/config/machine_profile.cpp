@@ -60,6 +60,11 @@ machine::SimMachineConfig sim_machine_config(const MachineProfile& profile) {
     t.centre = {sphere.position[0], sphere.position[1], sphere.position[2]};
     t.radius = sphere.diameter / 2;
     t.hysteresis = sphere.sim_hysteresis;
+    if (sphere.sim_turns_with_b && profile.find(Axis::B) != nullptr) {
+      t.b_joint = profile.find(Axis::B)->joint;
+      t.b_axis = sphere.sim_b_axis;
+      t.b_at_centre_deg = sphere.b_deg;
+    }
     t.noise = sphere.sim_noise;
   }
   c.tool_changer = profile.tool_changer_sim;

@@ -163,10 +163,28 @@ void read_conditions(Section& s, MachineProfile& p) {
   machine::EdmConfig& e = p.edm.config;
   for (std::size_t i = 0; i < list->size(); ++i) {
     Section t(*(*list)[i].as_table(), fmt::format("edm.condition[{}]", i + 1),
-              {"number",   "on_time_us",        "off_time_us",     "peak_current_a",   "voltage_v",
-               "polarity", "servo_reference_v", "gain_mm_s_per_v", "max_forward_mm_s", "max_retract_mm_s",
-               "filter_s", "jump_height_mm",    "jump_period_s",   "jump_speed_mm_s",  "jump_mode",
-               "orbit",    "orbit_radius_mm",   "orbit_step_mm",   "orbit_period_s",   "short_timeout_s"},
+              {"number",
+               "on_time_us",
+               "off_time_us",
+               "peak_current_a",
+               "voltage_v",
+               "polarity",
+               "servo_reference_v",
+               "gain_mm_s_per_v",
+               "max_forward_mm_s",
+               "max_retract_mm_s",
+               "filter_s",
+               "jump_height_mm",
+               "jump_period_s",
+               "jump_speed_mm_s",
+               "jump_mode",
+               "orbit",
+               "orbit_radius_mm",
+               "orbit_step_mm",
+               "orbit_period_s",
+               "short_timeout_s",
+               "side_gap_mm",
+               "electrode_wear_ratio"},
               s.reporter());
     EdmCondition c;
     const auto number = t.integer("number", 1, 99);
@@ -179,6 +197,13 @@ void read_conditions(Section& s, MachineProfile& p) {
     read_servo(t, c, p);
     read_jump(t, c, p);
     read_orbit(t, c, p);
+    c.side_gap_mm = t.number_or("side_gap_mm", 0, Bound::NonNegative);
+    c.electrode_wear_ratio = t.number_or("electrode_wear_ratio", 0, Bound::NonNegative);
+    if (c.electrode_wear_ratio >= 1)
+      t.error("electrode_wear_ratio",
+              fmt::format("{} must be below 1 (the electrode would wear faster than the work)",
+                          t.key_path("electrode_wear_ratio")),
+              "config.range");
     e.conditions[static_cast<std::size_t>(e.condition_count++)] = c;
   }
 }
@@ -208,6 +233,16 @@ void read_edm_sim(Section& s, MachineProfile& p) {
   if (c.arc_threshold >= 1) m.error("arc_threshold", "edm.sim.arc_threshold must be below 1", "config.range");
   c.noise_v = m.number_or("noise_v", c.noise_v, Bound::NonNegative);
   c.short_bridge_mm = m.number_or("short_bridge_mm", c.short_bridge_mm, Bound::Positive);
+  const machine::EdmConfig& e = p.edm.config;
+  for (int i = 0; i < 2; ++i) {  // the orbit's plane: the electrode's lateral position
+    const AxisProfile* a = p.find(static_cast<Axis>(e.orbit_axes[i]));
+    c.lateral_joints[i] = static_cast<std::int8_t>(a != nullptr ? a->joint : -1);
+  }
+  for (int i = 0; i < e.condition_count; ++i) {
+    const EdmCondition& k = e.conditions[static_cast<std::size_t>(i)];
+    c.conditions[static_cast<std::size_t>(i)] = {k.number, k.side_gap_mm, k.electrode_wear_ratio};
+  }
+  c.condition_count = e.condition_count;
   const toml::node* o = m.find("orientation");
   if (o == nullptr) return;
   const toml::array* list = o->as_array();

@@ -33,10 +33,25 @@ bool read_point(Section& s, std::string_view key, std::array<double, 3>& out) {
 void read_sim(Section& s, ReferenceSphereProfile& r) {
   const toml::table* st = s.subtable("sim");
   if (st == nullptr) return;
-  Section m(*st, s.path() + ".sim", {"hysteresis", "noise"}, s.reporter());
+  Section m(*st, s.path() + ".sim", {"hysteresis", "noise", "b_axis"}, s.reporter());
   r.sim = true;
   r.sim_hysteresis = m.number_or("hysteresis", r.sim_hysteresis, Bound::NonNegative);
   r.sim_noise = m.number_or("noise", r.sim_noise, Bound::NonNegative);
+  if (const toml::node* n = m.find("b_axis")) {
+    const toml::array* a = n->as_array();
+    bool ok = a != nullptr && a->size() == 2;
+    for (std::size_t i = 0; ok && i < 2; ++i) {
+      const std::optional<double> v = (*a)[i].value<double>();
+      ok = v.has_value() && std::isfinite(*v);
+      if (ok) r.sim_b_axis[i] = *v;
+    }
+    if (!ok)
+      m.error(
+          "b_axis",
+          fmt::format("{} must be [x, z]: where B's axis crosses machine X and Z, mm", m.key_path("b_axis")),
+          "config.type");
+    r.sim_turns_with_b = ok;
+  }
 }
 
 }  // namespace
@@ -46,7 +61,7 @@ void read_reference_sphere(Section& probe, MachineProfile& profile) {
   if (t == nullptr) return;
   Section s(*t, "probe.reference_sphere",
             {"position", "diameter", "b", "clearance", "probe_feed", "safe_z", "touches_around", "tolerance",
-             "max_deviation", "sim"},
+             "max_deviation", "fast_feed", "back_off", "sim"},
             probe.reporter());
   ReferenceSphereProfile& r = profile.probe.reference_sphere;
   r.present = true;
@@ -58,6 +73,13 @@ void read_reference_sphere(Section& probe, MachineProfile& profile) {
   if (const auto n = s.integer("touches_around", 4, 64)) r.touches_around = static_cast<int>(*n);
   r.tolerance = s.number_or("tolerance", r.tolerance, Bound::Positive);
   r.max_deviation = s.number_or("max_deviation", r.max_deviation, Bound::Positive);
+  r.fast_feed = s.number_or("fast_feed", 0, Bound::NonNegative);
+  r.back_off = s.number_or("back_off", r.back_off, Bound::Positive);
+  if (r.fast_feed > 0 && r.back_off >= r.clearance)
+    s.error("back_off",
+            fmt::format("{} ({}) must be below the clearance ({}): the slow touch starts off the surface",
+                        s.key_path("back_off"), show(r.back_off), show(r.clearance)),
+            "config.range");
   if (s.has("b")) {
     r.b_deg = s.number_or("b", 0);
     if (profile.find(Axis::B) == nullptr) s.reject("b", "the profile has no B axis");
@@ -80,6 +102,8 @@ void read_reference_sphere(Section& probe, MachineProfile& profile) {
         "config.range");
   }
   read_sim(s, r);
+  if (r.sim_turns_with_b && profile.find(Axis::B) == nullptr)
+    s.error("sim", "probe.reference_sphere.sim.b_axis: the profile has no B axis", "config.range");
 }
 
 }  // namespace opencnc::config::detail

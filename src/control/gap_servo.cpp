@@ -169,6 +169,7 @@ machine::GeneratorOutputs GapServo::generator() const noexcept {
   g.peak_current_a = cond_.peak_current_a;
   g.voltage_v = cond_.voltage_v;
   g.polarity = cond_.polarity;
+  g.condition = cond_.number;
   return g;
 }
 

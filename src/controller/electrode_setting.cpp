@@ -148,11 +148,38 @@ std::shared_ptr<const canon::Program> touch_program(AxisMask axes, const Pose& f
   }
   traverse(with_xyz(at, {touch.start[0], touch.start[1], travel_z}));
   traverse(with_xyz(at, touch.start));
-  b.set_feed_rate(sphere.probe_feed);
+  const bool fast = sphere.fast_feed > 0;
+  b.set_feed_rate(fast ? sphere.fast_feed : sphere.probe_feed);
   b.straight_probe(id++, with_xyz(at, touch.end));
-  // After the contact the rest runs from where the machine stopped: back out, then up.
-  b.straight_traverse(id++, with_xyz(at, touch.start));
-  b.straight_traverse(id++, with_xyz(at, {touch.start[0], touch.start[1], sphere.safe_z}));
+  if (!fast) {
+    // After the contact the rest runs from where the machine stopped: back out, then up.
+    b.straight_traverse(id++, with_xyz(at, touch.start));
+    b.straight_traverse(id++, with_xyz(at, {touch.start[0], touch.start[1], sphere.safe_z}));
+  }
+  return std::make_shared<canon::Program>(b.take());
+}
+
+std::shared_ptr<const canon::Program> slow_touch_program(AxisMask axes, const Pose& from,
+                                                         const SphereTouch& touch, const Point3& contact,
+                                                         const config::ReferenceSphereProfile& sphere,
+                                                         SphereTouch& slow) {
+  Point3 u{};  // along the probe move
+  const double length =
+      std::hypot(touch.end[0] - touch.start[0], touch.end[1] - touch.start[1], touch.end[2] - touch.start[2]);
+  for (std::size_t i = 0; i < 3; ++i) u[i] = (touch.end[i] - touch.start[i]) / length;
+  slow = touch;
+  for (std::size_t i = 0; i < 3; ++i) {
+    slow.start[i] = contact[i] - sphere.back_off * u[i];
+    slow.end[i] = contact[i] + sphere.back_off * u[i];
+  }
+  canon::ProgramBuilder b(axes, from);
+  b.set_motion_control_mode(canon::MotionControl::ExactPath, 0);
+  canon::SegmentId id = 0;
+  b.straight_traverse(id++, with_xyz(from, slow.start));
+  b.set_feed_rate(sphere.probe_feed);
+  b.straight_probe(id++, with_xyz(from, slow.end));
+  b.straight_traverse(id++, with_xyz(from, touch.start));
+  b.straight_traverse(id++, with_xyz(from, {touch.start[0], touch.start[1], sphere.safe_z}));
   return std::make_shared<canon::Program>(b.take());
 }
 
@@ -275,7 +302,9 @@ Outcome ElectrodeSetting::measure(const ElectrodeMeasure& args, FeatureHost& hos
         "raise safe_z or check the tool's Z offset",
         tool_, top_start, sphere_.safe_z));
   touched_.clear();
+  fast_touched_.clear();
   touch_ = 0;
+  slow_ = false;
   set_phase(ElectrodePhase::Measuring);
   next_touch();
   return accept(
@@ -284,6 +313,7 @@ Outcome ElectrodeSetting::measure(const ElectrodeMeasure& args, FeatureHost& hos
 
 void ElectrodeSetting::next_touch() {
   const SphereTouch& t = plan_[touch_];
+  slow_ = false;
   next_aux_ = touch_program(axes_, host_->current_status().servo.commanded, t, sphere_,
                             touch_ == 0 && axes_.has(Axis::B));
   next_aux_name_ = fmt::format("electrode touch {}", t.name);
@@ -400,23 +430,22 @@ void ElectrodeSetting::when_aux_ended(const ControllerEvent& e) {
         return fail("electrode.stopped", fmt::format("the touch from {} did not finish ({})",
                                                      plan_[touch_].name, to_string(e.end)));
       const ServoStatus& servo = host_->current_status().servo;
+      const SphereTouch& t = slow_ ? slow_line_ : plan_[touch_];
+      const char* const stage = slow_ ? "slow touch" : "touch";
+      const double within = slow_ ? sphere_.back_off : sphere_.clearance;
+      const char* const where = slow_ ? "fast touch closed" : "sphere should be";
       if (!servo.probe_tripped)
-        return fail(
-            "electrode.missing-touch",
-            fmt::format("the touch from {} met nothing within {:g} mm past where the sphere should be: "
-                        "no sphere, or the electrode is far off its offsets",
-                        plan_[touch_].name, sphere_.clearance));
+        return fail("electrode.missing-touch",
+                    fmt::format("the {} from {} met nothing within {:g} mm past where the {}: no sphere, or "
+                                "the electrode is far off its offsets",
+                                stage, t.name, within, where));
       const Point3 at = xyz(servo.probe_position);
-      const SphereTouch& t = plan_[touch_];
       if (!on_probe_path(t, at))
-        return fail(
-            "electrode.contact-at-start",
-            fmt::format("the touch from {} was in contact where it began, {:g} mm off where the sphere "
-                        "should be: the electrode is far off its offsets, or something else touches",
-                        t.name, sphere_.clearance));
-      touched_.push_back(at);
-      if (++touch_ < plan_.size()) return next_touch();
-      return finish_measurement();
+        return fail("electrode.contact-at-start",
+                    fmt::format("the {} from {} was in contact where it began, {:g} mm off where the {}: the "
+                                "electrode is far off its offsets, or something else touches",
+                                stage, t.name, within, where));
+      return touched(at);
     }
     case ElectrodePhase::Approaching:
       if (e.end != JobEnd::Finished) {
@@ -432,11 +461,30 @@ void ElectrodeSetting::when_aux_ended(const ControllerEvent& e) {
   }
 }
 
+// A touch closed at `at`: after a fast one, the slow one from just before it; after a slow (or
+// the only) one, the point is kept and the next direction follows.
+void ElectrodeSetting::touched(const Point3& at) {
+  if (sphere_.fast_feed > 0 && !slow_) {
+    fast_touched_.push_back(at);
+    next_aux_ = slow_touch_program(axes_, host_->current_status().servo.commanded, plan_[touch_], at, sphere_,
+                                   slow_line_);
+    next_aux_name_ = fmt::format("electrode slow touch {}", plan_[touch_].name);
+    slow_ = true;
+    if (host_->current_status().servo.mode != Mode::Auto)
+      pending_ = host_->submit(Request::set_mode(Mode::Auto));
+    return;
+  }
+  touched_.push_back(at);
+  if (++touch_ < plan_.size()) return next_touch();
+  finish_measurement();
+}
+
 void ElectrodeSetting::finish_measurement() {
   std::vector<std::string> names;
   for (const SphereTouch& t : plan_) names.push_back(t.name);
   ElectrodeResult r =
       evaluate_touches(sphere_, tool_, offsets_of(entry_), entry_.diameter / 2, names, touched_);
+  r.fast_touched = fast_touched_;
   if (r.ok) {
     tools::ToolEntry changed = entry_;
     for (int i = 0; i < 3; ++i) changed.offset[i] = r.offset[static_cast<std::size_t>(i)];
@@ -466,6 +514,7 @@ void ElectrodeSetting::fail(std::string code, std::string message) {
   r.previous = offsets_of(entry_);
   for (std::size_t i = 0; i < touched_.size(); ++i) r.names.push_back(plan_[i].name);
   r.touched = touched_;
+  r.fast_touched = fast_touched_;
   {
     std::lock_guard lock(mutex_);
     last_ = r;

@@ -25,32 +25,132 @@ void SimEdmProcess::configure(const SimEdmConfig& config, double period_s) noexc
   config_ = config;
   period_s_ = period_s;
   fronts_ = 0;
+  front_index_ = -1;
+  condition_ = -1;
+  electrodes_ = 1;
+  electrode_ = 0;
+  tool_.fill(0);
+  wear_.fill(0);
+  constexpr double kPi = 3.14159265358979323846;
+  for (int k = 0; k < kSides; ++k) {
+    const double a = 2 * kPi * k / kSides;
+    direction_[static_cast<std::size_t>(2 * k)] = std::cos(a);
+    direction_[static_cast<std::size_t>(2 * k + 1)] = std::sin(a);
+  }
 }
 
-int SimEdmProcess::front_for(const double orientation[2]) noexcept {
+void SimEdmProcess::mount(std::int32_t tool) noexcept {
+  for (int e = 0; e < electrodes_; ++e)
+    if (tool_[static_cast<std::size_t>(e)] == tool) {
+      electrode_ = e;
+      return;
+    }
+  electrode_ = electrodes_ < kMaxElectrodes ? electrodes_++ : kMaxElectrodes - 1;
+  tool_[static_cast<std::size_t>(electrode_)] = tool;
+  wear_[static_cast<std::size_t>(electrode_)] = 0;  // a new electrode (or one too many: the last slot anew)
+}
+
+double SimEdmProcess::electrode_wear_max_mm() const noexcept {
+  double w = 0;
+  for (int e = 0; e < electrodes_; ++e) w = std::max(w, wear_[static_cast<std::size_t>(e)]);
+  return w;
+}
+
+// The condition's side gap and wear ratio, looked up when the generator's condition changes: the
+// table's side gap, or the clean breakdown gap at its open voltage where the table gives none.
+void SimEdmProcess::select(const GeneratorOutputs& gen) noexcept {
+  if (gen.condition == condition_) return;
+  condition_ = gen.condition;
+  side_gap_mm_ = config_.breakdown_um_per_v * 1e-3 * gen.voltage_v;
+  wear_ratio_ = 0;
+  for (int i = 0; i < config_.condition_count; ++i) {
+    const SimEdmConditionEffect& c = config_.conditions[static_cast<std::size_t>(i)];
+    if (c.number != gen.condition) continue;
+    if (c.side_gap_mm > 0) side_gap_mm_ = c.side_gap_mm;
+    wear_ratio_ = c.electrode_wear_ratio;
+  }
+}
+
+// The front of this orientation; a new one only where the generator sparks (create): B turning
+// through 30° under G0 would otherwise take a front for every whole degree it passes and, beyond
+// kMaxFronts, wipe the one burnt before. −1: none yet.
+int SimEdmProcess::front_for(const double orientation[2], bool create) noexcept {
   std::int32_t k[2];
   for (int i = 0; i < 2; ++i) k[i] = static_cast<std::int32_t>(std::lround(orientation[i]));
   for (int f = 0; f < fronts_; ++f)
     if (key_[static_cast<std::size_t>(2 * f)] == k[0] && key_[static_cast<std::size_t>(2 * f + 1)] == k[1])
       return f;
+  if (!create) return -1;
   const int f = fronts_ < kMaxFronts ? fronts_++ : kMaxFronts - 1;  // beyond eight: the last one again
   key_[static_cast<std::size_t>(2 * f)] = k[0];
   key_[static_cast<std::size_t>(2 * f + 1)] = k[1];
   front_[static_cast<std::size_t>(f)] = config_.surface_mm;
+  burning_[static_cast<std::size_t>(f)] = false;
+  for (int s = 0; s < kSides; ++s) wall_[static_cast<std::size_t>(f * kSides + s)] = 0;
   return f;
 }
 
 double SimEdmProcess::depth_mm() const noexcept {
-  if (fronts_ == 0) return 0;
+  if (front_index_ < 0) return 0;
   return (front_[static_cast<std::size_t>(front_index_)] - config_.surface_mm) * config_.work_direction;
 }
 
-void SimEdmProcess::step(double electrode, const double orientation[2], bool generator_on,
-                         const GeneratorOutputs& gen, SplitMix64& rng) noexcept {
-  front_index_ = front_for(orientation);
-  const double front = front_[static_cast<std::size_t>(front_index_)];
-  gap_mm_ = (electrode - front) * -config_.work_direction;
+double SimEdmProcess::depth_max_mm() const noexcept {
+  double d = 0;
+  for (int f = 0; f < fronts_; ++f)
+    d = std::max(d, (front_[static_cast<std::size_t>(f)] - config_.surface_mm) * config_.work_direction);
+  return d;
+}
+
+double SimEdmProcess::side_wall_mm(int k) const noexcept {
+  if (front_index_ < 0 || k < 0 || k >= kSides) return 0;
+  return wall_[static_cast<std::size_t>(front_index_ * kSides + k)];
+}
+
+double SimEdmProcess::oversize_of(int front) const noexcept {
+  double sum = 0;
+  for (int k = 0; k < kSides; ++k) sum += wall_[static_cast<std::size_t>(front * kSides + k)];
+  return sum / kSides;
+}
+
+double SimEdmProcess::cavity_oversize_mm() const noexcept {
+  return front_index_ < 0 ? 0 : oversize_of(front_index_);
+}
+
+double SimEdmProcess::cavity_oversize_max_mm() const noexcept {
+  double o = 0;
+  for (int f = 0; f < fronts_; ++f) o = std::max(o, oversize_of(f));
+  return o;
+}
+
+// The envelope of the side discharges: inside the cavity (the tip past the work's surface) and
+// sparking, the electrode's sides burn the wall in each direction out to the side gap beyond
+// where the electrode's outline stands (its lateral offset from the burn's centre along that
+// direction). The side gap, not a removal rate, sets the size: an orbit's turn takes seconds, a
+// side wall within the gap burns in milliseconds.
+void SimEdmProcess::burn_sides(const SimEdmPose& pose, double tip) noexcept {
+  const auto f = static_cast<std::size_t>(front_index_);
+  if ((tip - config_.surface_mm) * config_.work_direction <= 0) return;  // not yet in the work
+  const double d[2] = {config_.lateral_joints[0] >= 0 ? pose.lateral[0] - centre_[2 * f] : 0.0,
+                       config_.lateral_joints[1] >= 0 ? pose.lateral[1] - centre_[2 * f + 1] : 0.0};
+  for (int k = 0; k < kSides; ++k) {
+    const auto uk = static_cast<std::size_t>(k);
+    const double reach = d[0] * direction_[2 * uk] + d[1] * direction_[2 * uk + 1] + side_gap_mm_;
+    double& wall = wall_[f * kSides + uk];
+    wall = std::max(wall, reach);
+  }
+}
+
+void SimEdmProcess::step(const SimEdmPose& pose, bool generator_on, const GeneratorOutputs& gen,
+                         SplitMix64& rng) noexcept {
   const double u0 = gen.voltage_v;
+  front_index_ = front_for(pose.orientation, generator_on && u0 > 0);
+  // The worn electrode's tip stands its lost length back from where the feed joint puts it.
+  const double tip = pose.feed - config_.work_direction * electrode_wear_mm();
+  constexpr double kNoWork = 1e9;  // no front at this orientation yet: nothing near the electrode
+  gap_mm_ = front_index_ < 0
+                ? kNoWork
+                : (tip - front_[static_cast<std::size_t>(front_index_)]) * -config_.work_direction;
   const double breakdown = config_.breakdown_um_per_v * 1e-3 * u0 * (1 + debris_);
   // The dielectric flushes the debris slowly; fast once a jump has lifted the electrode clear.
   const bool clear = !generator_on && gap_mm_ > kClearGaps * std::max(breakdown, 0.01);
@@ -67,6 +167,7 @@ void SimEdmProcess::step(double electrode, const double orientation[2], bool gen
     voltage_v_ = 0;
     return;
   }
+  select(gen);
   if (short_ || gap_mm_ <= 0) {
     state_ = GapState::Short;
     voltage_v_ = 0.5 + 0.2 * std::fabs(gauss(rng));
@@ -76,6 +177,13 @@ void SimEdmProcess::step(double electrode, const double orientation[2], bool gen
   } else {
     discharge(gen, gap_mm_ / breakdown, rng);
   }
+  const auto f = static_cast<std::size_t>(front_index_);
+  if (!burning_[f] && (state_ == GapState::Normal || state_ == GapState::Arc)) {  // the burn's centre
+    burning_[f] = true;
+    centre_[2 * f] = pose.lateral[0];
+    centre_[2 * f + 1] = pose.lateral[1];
+  }
+  if (burning_[f] && state_ != GapState::Short) burn_sides(pose, tip);
 }
 
 // The discharges of one period: each waits an ignition delay that grows without bound as the gap
@@ -97,7 +205,10 @@ void SimEdmProcess::discharge(const GeneratorOutputs& gen, double x, SplitMix64&
       n * config_.removal_mm3_per_a_us * gen.peak_current_a * ton * (arc ? kArcRemoval : 1.0);
   const double dz = std::min(volume / config_.electrode_area_mm2, gap_mm_);
   front_[static_cast<std::size_t>(front_index_)] += config_.work_direction * dz;
-  gap_mm_ -= dz;
+  // The electrode's face wears by the ratio of the volume (the same area): the gap closes less.
+  const double worn = wear_ratio_ * dz;
+  wear_[static_cast<std::size_t>(electrode_)] += worn;
+  gap_mm_ -= dz - worn;
   debris_ = std::min(2.0, debris_ + volume * config_.debris_per_mm3);
   discharges_ += static_cast<std::uint64_t>(n);
 }

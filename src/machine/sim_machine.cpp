@@ -175,19 +175,24 @@ void SimMachine::update_broach() noexcept {
                  joints_[static_cast<std::size_t>(b.radial_joint)].table_position());
 }
 
-// The spark gap sees the electrode where the feed joint's table is, the work turned by the
-// orientation joints (B, C), and the generator's outputs of this period.
+// The spark gap sees the electrode where the feed joint's table is (and across the tool axis
+// where the lateral joints' are), the work turned by the orientation joints (B, C), and the
+// generator's outputs of this period. A tool change puts another electrode in.
 void SimMachine::step_edm() noexcept {
   const SimEdmConfig& e = config_.edm;
-  double orientation[2] = {0, 0};
+  const auto table = [&](int j) {
+    return j >= 0 && j < config_.joint_count ? joints_[static_cast<std::size_t>(j)].table_position() : 0.0;
+  };
+  SimEdmPose pose;
+  pose.feed = table(e.joint);
   for (int i = 0; i < 2; ++i) {
-    const int j = e.orientation_joints[i];
-    if (j >= 0 && j < config_.joint_count)
-      orientation[i] = joints_[static_cast<std::size_t>(j)].table_position();
+    pose.orientation[i] = table(e.orientation_joints[i]);
+    pose.lateral[i] = table(e.lateral_joints[i]);
   }
-  const double electrode = joints_[static_cast<std::size_t>(e.joint)].table_position();
-  edm_.step(electrode, orientation, config_.process.generator && process_.generator_on, process_.generator,
-            rng_);
+  const bool changed = config_.tool_changer.present && tool_.change && change_periods_ >= change_needed_;
+  if (changed && !edm_tool_changed_) edm_.mount(tool_.prepare_tool);
+  edm_tool_changed_ = changed;
+  edm_.step(pose, config_.process.generator && process_.generator_on, process_.generator, rng_);
 }
 
 // Mains on: the rectifier holds the DC link at nominal. Mains off with a charged UPS: the
@@ -297,6 +302,8 @@ void SimMachine::sample_sphere_probe() noexcept {
     const int j = config_.probe.sphere.joints[k];
     p[k] = j >= 0 ? joints_[static_cast<std::size_t>(j)].table_position() : 0.0;
   }
+  const int b = config_.probe.sphere.b_joint;
+  if (b >= 0 && b < config_.joint_count) sphere_.turn(joints_[static_cast<std::size_t>(b)].table_position());
   const bool was = inputs_.probe;
   inputs_.probe = sphere_.update(p, rng_);
   if (inputs_.probe == was) return;

@@ -8,10 +8,20 @@
 
 namespace opencnc::machine {
 
+void SimSphereProbe::turn(double b_deg) noexcept {
+  if (target_.b_joint < 0) return;
+  constexpr double kRad = 3.14159265358979323846 / 180;
+  const double a = (b_deg - target_.b_at_centre_deg) * kRad, c = std::cos(a), s = std::sin(a);
+  const double x = target_.centre[0] - target_.b_axis[0], z = target_.centre[2] - target_.b_axis[1];
+  centre_[0] = target_.b_axis[0] + c * x + s * z;
+  centre_[1] = target_.centre[1];
+  centre_[2] = target_.b_axis[1] - s * x + c * z;
+}
+
 double SimSphereProbe::gap(const std::array<double, 3>& p) const noexcept {
-  const double dx = p[0] - offset_[0] - target_.centre[0];
-  const double dy = p[1] - offset_[1] - target_.centre[1];
-  const double dz = p[2] - offset_[2] + tip_radius_ - target_.centre[2];
+  const double dx = p[0] - offset_[0] - centre_[0];
+  const double dy = p[1] - offset_[1] - centre_[1];
+  const double dz = p[2] - offset_[2] + tip_radius_ - centre_[2];
   return std::sqrt(dx * dx + dy * dy + dz * dz) - target_.radius - tip_radius_;
 }
 

@@ -69,6 +69,15 @@ TEST(EdmProfile, TheFiveAxisEdmLoadsWithItsConditions) {
   EXPECT_EQ(p.edm.sim.surface_mm, -20.0);
   EXPECT_EQ(p.edm.sim.orientation_joints[0], 3);  // B
   EXPECT_EQ(p.edm.sim.work_direction, -1.0);
+  // The table's side gap and wear reach the simulated gap, and X, Y are its lateral joints.
+  EXPECT_EQ(c->side_gap_mm, 0.012);
+  EXPECT_EQ(c->electrode_wear_ratio, 0.08);
+  ASSERT_EQ(p.edm.sim.condition_count, 4);
+  EXPECT_EQ(p.edm.sim.conditions[2].number, 3);
+  EXPECT_EQ(p.edm.sim.conditions[2].side_gap_mm, 0.012);
+  EXPECT_EQ(p.edm.sim.conditions[2].electrode_wear_ratio, 0.08);
+  EXPECT_EQ(p.edm.sim.lateral_joints[0], 0);
+  EXPECT_EQ(p.edm.sim.lateral_joints[1], 1);
 }
 
 /// The line (1-based) of the first line of `text` that starts with `start`, from line `from` on.
@@ -100,6 +109,8 @@ TEST(EdmProfile, BadConditionsAreNamedWhereTheyAre) {
       {base + condition("short_timeout_s = 0\n"), "short_timeout_s", "must be greater than 0"},
       {std::string(kMachine).replace(base.find("tool_axis"), 0, "short_timeout_s = -1\n") + condition(""),
        "short_timeout_s", "edm.short_timeout_s must be greater than 0"},
+      {base + condition("electrode_wear_ratio = 1.5\n"), "electrode_wear_ratio", "must be below 1"},
+      {base + condition("side_gap_mm = -0.01\n"), "side_gap_mm", "side_gap_mm"},
   };
   for (const Bad& b : cases) {
     const ProfileLoad load = parse_profile(b.text, "edm.toml");

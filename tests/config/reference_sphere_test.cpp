@@ -58,6 +58,8 @@ TEST(ReferenceSphere, IsReadWithItsDefaultsAndMadeTheSimulatedProbe) {
   EXPECT_EQ(c.probe.sphere.radius, 5.0);
   EXPECT_EQ(c.probe.sphere.noise, 0.0001);
   EXPECT_EQ(c.probe.sphere.joints, (std::array<int, 3>{0, 1, 2}));
+  EXPECT_EQ(s.fast_feed, 0.0) << "one touch a direction unless fast_feed is given";
+  EXPECT_EQ(c.probe.sphere.b_joint, -1) << "no B: the sphere does not turn";
 }
 
 struct Bad {
@@ -90,6 +92,12 @@ INSTANTIATE_TEST_SUITE_P(
             "p.toml:21:10: error: probe.reference_sphere.safe_z (5.5) is below the sphere's top"},
         Bad{"TooFewTouches", kSphere + "touches_around = 3\n", "p.toml:22:18: error:"},
         Bad{"BWithoutAxisB", kSphere + "b = 30\n", "p.toml:22:5: error:"},
+        Bad{"BackOffNotBelowTheClearance", kSphere + "fast_feed = 600\nback_off = 1.5\n",
+            "p.toml:23:12: error: probe.reference_sphere.back_off (1.5) must be below the clearance"},
+        Bad{"SimBAxisNotTwoNumbers", kSphere + "[probe.reference_sphere.sim]\nb_axis = [1, 2, 3]\n",
+            "p.toml:23:10: error: probe.reference_sphere.sim.b_axis must be [x, z]"},
+        Bad{"SimBAxisWithoutAxisB", kSphere + "[probe.reference_sphere.sim]\nb_axis = [1, 2]\n",
+            "p.toml:22:1: error: probe.reference_sphere.sim.b_axis: the profile has no B axis"},
         Bad{"BothSimulations",
             kSphere + "[probe.reference_sphere.sim]\n[probe.sim]\naxis = \"z\"\ntrip = [-inf, 0]\n",
             "p.toml:23:1: error: [probe.sim] and [probe.reference_sphere.sim] exclude each other"}),

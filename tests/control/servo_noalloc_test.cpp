@@ -255,6 +255,10 @@ TEST(ServoAllocations, NoneInsideTheEdmTick) {
   EXPECT_TRUE(jumped);
   EXPECT_TRUE(orbited);
   EXPECT_TRUE(backed);
+  // The simulated gap's side walls, the electrode change and its wear ran in the counted ticks.
+  const machine::SimEdmProcess& sim = a.rig().machine().edm();
+  EXPECT_GT(sim.cavity_oversize_max_mm(), 0.04);  // orbits beyond the roughing's side gap
+  EXPECT_GT(sim.electrode_wear_mm(), 0.0);
   EXPECT_EQ(g_allocations.load(), 0);
   std::filesystem::remove_all(dir);
 }

@@ -1,8 +1,11 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The simulated spark gap: open / normal / short by the gap's width, the mean voltage rising with
 // the gap, removal that deepens the front, debris that turns discharges into arcs unless a lift
-// flushes it, an injected short that holds until the electrode backs off, a front per orientation.
+// flushes it, an injected short that holds until the electrode backs off, a front per orientation,
+// side walls burnt out to the orbit plus the side gap, the electrode's wear by the condition's ratio.
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 #include "opencnc/machine/sim_edm_process.hpp"
 
@@ -30,7 +33,11 @@ struct Gap {
     p.configure(c, 0.001);
   }
   ProcessInputs at(double z, bool on = true) {
-    p.step(z, orientation, on, roughing(), rng);
+    SimEdmPose pose;
+    pose.feed = z;
+    pose.orientation[0] = orientation[0];
+    pose.orientation[1] = orientation[1];
+    p.step(pose, on, roughing(), rng);
     ProcessInputs in;
     p.sample(in);
     return in;
@@ -98,6 +105,122 @@ TEST(SimEdmProcess, EachOrientationHasItsOwnFront) {
   g.orientation[0] = 0;
   g.at(0.05);
   EXPECT_NEAR(g.p.depth_mm(), left, 1e-12);
+}
+
+TEST(SimEdmProcess, TurningTheWorkWithTheGeneratorOffKeepsItsFronts) {
+  Gap g;
+  for (int i = 0; i < 200; ++i) g.at(0.010);
+  const double first = g.p.depth_mm();
+  for (int b = 0; b >= -30; --b) {  // B through thirty whole degrees under G0: no front for each
+    g.orientation[0] = b;
+    g.at(1.0, false);
+    if (b < 0) {
+      EXPECT_EQ(g.p.depth_mm(), 0.0);
+    }
+  }
+  for (int i = 0; i < 200; ++i) g.at(0.010);  // the second flank
+  for (int b = -30; b <= 0; ++b) {
+    g.orientation[0] = b;
+    g.at(1.0, false);
+  }
+  EXPECT_NEAR(g.p.depth_mm(), first, 1e-12);  // the first flank's front is still there
+  EXPECT_GE(g.p.depth_max_mm(), first);
+}
+
+/// A gap with side walls in X/Y and two conditions: 2 (side gap 20 µm, 10 % wear) and 3 (none given).
+struct Cavity {
+  SimEdmProcess p;
+  SplitMix64 rng{11};
+  SimEdmPose pose;
+  GeneratorOutputs gen = roughing();
+  Cavity() {
+    SimEdmConfig c;
+    c.present = true;
+    c.surface_mm = 0;
+    c.noise_v = 0;
+    c.removal_mm3_per_a_us = 5e-7;  // ten times the default: the test burns in tenths of a second
+    c.debris_per_mm3 = 0;           // no arcs: the walls and the wear alone
+    c.lateral_joints[0] = 0;
+    c.lateral_joints[1] = 1;
+    c.conditions[0] = {2, 0.020, 0.1};
+    c.conditions[1] = {3, 0.0, 0.0};
+    c.condition_count = 2;
+    p.configure(c, 0.001);
+    gen.condition = 2;
+    pose.lateral[0] = 5;  // the burn's centre: X 5, Y −3
+    pose.lateral[1] = -3;
+  }
+  /// One period with the electrode's tip held `gap_mm` off the front, as the gap servo would.
+  void hold(double gap_mm) {
+    pose.feed = -p.depth_mm() + gap_mm - p.electrode_wear_mm();
+    p.step(pose, true, gen, rng);
+  }
+};
+
+TEST(SimEdmProcess, TheSideWallsStandTheSideGapBeyondTheElectrode) {
+  Cavity c;
+  for (int i = 0; i < 400; ++i) c.hold(0.010);
+  ASSERT_GT(c.p.depth_mm(), 0.05);  // the tip well inside the work
+  for (int k = 0; k < SimEdmProcess::kSides; ++k) EXPECT_DOUBLE_EQ(c.p.side_wall_mm(k), 0.020);
+  EXPECT_DOUBLE_EQ(c.p.cavity_oversize_mm(), 0.020);
+  c.gen.condition = 3;  // no side gap in the table: the clean breakdown gap, 0.3 µm/V × 100 V
+  c.hold(0.010);
+  EXPECT_NEAR(c.p.side_gap_mm(), 0.030, 1e-12);
+  EXPECT_NEAR(c.p.cavity_oversize_mm(), 0.030, 1e-12);
+}
+
+TEST(SimEdmProcess, AnOrbitWidensTheCavityByItsRadiusPlusTheSideGap) {
+  Cavity c;
+  for (int i = 0; i < 400; ++i) c.hold(0.010);
+  const double r = 0.05;
+  for (int i = 0; i <= 1000; ++i) {  // one turn of a 50 µm circle around the centre
+    const double a = 2 * 3.14159265358979323846 * i / 1000;
+    c.pose.lateral[0] = 5 + r * std::cos(a);
+    c.pose.lateral[1] = -3 + r * std::sin(a);
+    c.hold(0.010);
+  }
+  // Within the sampling of the turn (0.36° a period: r·(1 − cos 0.18°) = 0.25 nm).
+  for (int k = 0; k < SimEdmProcess::kSides; ++k) EXPECT_NEAR(c.p.side_wall_mm(k), r + 0.020, 1e-6) << k;
+  EXPECT_NEAR(c.p.cavity_oversize_mm(), r + 0.020, 1e-6);
+  // A move 0.1 mm along +X only widens the walls that face +X.
+  c.pose.lateral[0] = 5.1;
+  c.pose.lateral[1] = -3;
+  c.hold(0.010);
+  EXPECT_NEAR(c.p.side_wall_mm(0), 0.120, 1e-12);
+  EXPECT_NEAR(c.p.side_wall_mm(SimEdmProcess::kSides / 2), r + 0.020, 1e-6);
+  EXPECT_NEAR(c.p.cavity_oversize_max_mm(), c.p.cavity_oversize_mm(), 1e-15);
+}
+
+TEST(SimEdmProcess, NoSideWallAboveTheSurfaceOrWithoutABurn) {
+  Cavity c;
+  c.pose.lateral[0] = 5.5;
+  c.pose.feed = 1.0;  // open gap, far above
+  c.p.step(c.pose, true, c.gen, c.rng);
+  EXPECT_EQ(c.p.cavity_oversize_mm(), 0.0);
+  c.hold(0.010);  // the first discharge sets the centre; the tip is still above the surface
+  EXPECT_EQ(c.p.cavity_oversize_mm(), 0.0);
+}
+
+TEST(SimEdmProcess, TheElectrodeWearsByTheConditionsRatio) {
+  Cavity c;
+  for (int i = 0; i < 400; ++i) c.hold(0.010);
+  const double depth = c.p.depth_mm();
+  ASSERT_GT(depth, 0.05);
+  EXPECT_NEAR(c.p.electrode_wear_mm(), 0.1 * depth, 1e-12);
+  // To keep the gap, the feed joint went the wear further than the front (within the last
+  // period's removal, 0.17 µm).
+  EXPECT_NEAR(c.pose.feed, -depth + 0.010 - 0.1 * depth, 5e-4);
+  EXPECT_LT(c.pose.feed, -depth + 0.010 - 0.09 * depth);
+  c.gen.condition = 3;  // no wear given: none
+  const double worn = c.p.electrode_wear_mm();
+  for (int i = 0; i < 100; ++i) c.hold(0.010);
+  EXPECT_EQ(c.p.electrode_wear_mm(), worn);
+  // A new electrode starts unworn; the first one keeps its wear when it comes back.
+  c.p.mount(7);
+  EXPECT_EQ(c.p.electrode_wear_mm(), 0.0);
+  c.p.mount(0);
+  EXPECT_EQ(c.p.electrode_wear_mm(), worn);
+  EXPECT_EQ(c.p.electrode_wear_max_mm(), worn);
 }
 
 }  // namespace

@@ -6,7 +6,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 #include <string>
+
+#include <fmt/format.h>
 
 #include "opencnc/config/profile_loader.hpp"
 #include "opencnc/controller/electrode_setting.hpp"
@@ -101,6 +104,62 @@ TEST(ElectrodeSetting, ABallTippedElectrodeIsMeasuredToItsLowestPoint) {
   ASSERT_EQ(m.touched.size(), 7u);
   EXPECT_EQ(m.names[1], "60°");
   for (std::size_t i = 0; i < 3; ++i) EXPECT_NEAR(m.offset[i], truth[i], 0.001) << "axis " << i;
+}
+
+/// Fast-then-slow touches (10 mm/s, back 50 µm, then 0.5 µm a period) on a sphere without noise.
+std::vector<std::string> fast_then_slow(std::vector<std::string> more = {}) {
+  more.insert(more.begin(), {"probe.reference_sphere.fast_feed=600", "probe.reference_sphere.back_off=0.05",
+                             "probe.reference_sphere.probe_feed=30", "probe.reference_sphere.sim.noise=0"});
+  return more;
+}
+
+TEST(ElectrodeSetting, FastThenSlowTouchesMeasureToATenthOfAMicrometre) {
+  Rig r(edm_profile(fast_then_slow()));
+  const Point3 truth{0.2, -0.1, 50.5};
+  r.scenario.sim().set_electrode(truth, 0);
+  const ElectrodeResult m = r.measure(1);
+  ASSERT_TRUE(m.ok) << m.message;
+  ASSERT_EQ(m.touched.size(), 5u);
+  ASSERT_EQ(m.fast_touched.size(), 5u) << "each direction touched fast first";
+  for (std::size_t k = 0; k < 5; ++k) {
+    // The slow touch closed near the fast one, on the same line, and is the one fitted.
+    const double apart =
+        std::hypot(m.touched[k][0] - m.fast_touched[k][0], m.touched[k][1] - m.fast_touched[k][1],
+                   m.touched[k][2] - m.fast_touched[k][2]);
+    EXPECT_LT(apart, 0.005) << m.names[k];
+  }
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_NEAR(m.offset[i], truth[i], 1e-4) << "axis " << i;
+    EXPECT_EQ(r.table_offset(1)[i], m.offset[i]);
+  }
+  const ElectrodeResult refit =
+      evaluate_touches(r.feature->profile_sphere(), 1, m.previous, 0, m.names, m.touched);
+  for (std::size_t i = 0; i < 3; ++i)
+    EXPECT_EQ(refit.offset[i], m.offset[i]) << "the slow touches are fitted";
+  EXPECT_EQ(r.scenario.status().servo.commanded[Axis::Z], -60.0) << "left at the safe height";
+}
+
+TEST(ElectrodeSetting, TheSphereTurnsWithBAndIsMeasuredAtItsAngle) {
+  // B's axis crosses X 100, Z −170, 20 mm below the sphere's centre at B 0 (X 100, Z −150). The
+  // routine measures at B 30, where the sphere's centre is at X 100 + 20·sin 30° = 110,
+  // Z −170 + 20·cos 30°.
+  const double z30 = -170 + 20 * std::cos(std::numbers::pi / 6);
+  const std::string position =
+      "probe.reference_sphere.position=[110.0, 50.0, " + fmt::format("{:.12f}", z30) + "]";
+  Rig r(edm_profile(fast_then_slow(
+      {"probe.reference_sphere.b=30", position, "probe.reference_sphere.sim.b_axis=[100.0, -170.0]"})));
+  const machine::SimSphereProbe& sphere = r.scenario.sim().sphere_probe();
+  EXPECT_NEAR(sphere.centre()[0], 100.0, 1e-9) << "at B 0 the sphere is where it was mounted";
+  EXPECT_NEAR(sphere.centre()[2], -150.0, 1e-9);
+  const Point3 truth{-0.15, 0.25, 49.7};
+  r.scenario.sim().set_electrode(truth, 0);
+  const ElectrodeResult m = r.measure(1);
+  ASSERT_TRUE(m.ok) << m.message;
+  EXPECT_EQ(r.scenario.status().servo.commanded[Axis::B], 30.0);
+  // Turned with the B table (where its steps put it: within 0.1 µm at 20 mm from the axis).
+  EXPECT_NEAR(sphere.centre()[0], 110.0, 1e-4);
+  EXPECT_NEAR(sphere.centre()[2], z30, 1e-4);
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_NEAR(m.offset[i], truth[i], 1e-4) << "axis " << i;
 }
 
 TEST(ElectrodeSetting, AMissingSphereIsRefusedAndNothingStored) {

@@ -102,7 +102,11 @@ struct ReferenceSphereProfile {
   double diameter = 0;
   double b_deg = 0;            ///< the B angle the routine turns to first (machines with B)
   double clearance = 1;        ///< each touch starts this far off the surface and probes as far past it
-  double probe_feed = 30;      ///< the touches' feed
+  double probe_feed = 30;      ///< the touches' feed (the slow touch's, with fast_feed)
+  /// Each direction approaches at this feed, backs off `back_off` from the contact and touches
+  /// again at probe_feed (the slow touch's latch is used); 0: one touch at probe_feed.
+  double fast_feed = 0;
+  double back_off = 0.1;       ///< mm, the slow touch starts this far back from the fast one's contact
   double safe_z = 0;           ///< machine Z of the controlled point for moves between touches
   int touches_around = 4;      ///< touches around the equator (≥ 4), then one from above
   double tolerance = 0.002;    ///< largest |residual| of the fit
@@ -110,6 +114,10 @@ struct ReferenceSphereProfile {
   bool sim = false;            ///< the simulated probe touches this sphere
   double sim_hysteresis = 0.0005;
   double sim_noise = 0.0002;
+  /// The simulated sphere turns with B (a machine with B): about the line parallel to Y through
+  /// machine X, Z `sim_b_axis` (the true axis; `position` is its centre with B at `b_deg`).
+  bool sim_turns_with_b = false;
+  std::array<double, 2> sim_b_axis{};
 };
 
 struct ProbeProfile {

@@ -37,10 +37,20 @@ std::vector<SphereTouch> plan_touches(const config::ReferenceSphereProfile& sphe
 /// The auxiliary program of one touch, from `from`: up to the safe height (or over at the height
 /// it is at, if higher) and straight down to the start, the probe move (G38.2's: it stops at the contact),
 /// back to the start and up. With `turn_b` it first turns B to the sphere's angle at the safe height.
-/// Non-real-time.
+/// With the sphere's `fast_feed` the probe move is the fast one and the program ends at the contact
+/// (slow_touch_program goes on from there). Non-real-time.
 std::shared_ptr<const canon::Program> touch_program(AxisMask axes, const Pose& from, const SphereTouch& touch,
                                                     const config::ReferenceSphereProfile& sphere,
                                                     bool turn_b);
+
+/// The slow touch after a fast one that closed at `contact` (`from`: where the machine stopped):
+/// back along the touch's line to `back_off` before the contact, the probe move at probe_feed to
+/// `back_off` past it, then back to the touch's start and up. `slow` gets that probe move's line
+/// (its start and end) to check the latch against. Non-real-time.
+std::shared_ptr<const canon::Program> slow_touch_program(AxisMask axes, const Pose& from,
+                                                         const SphereTouch& touch, const Point3& contact,
+                                                         const config::ReferenceSphereProfile& sphere,
+                                                         SphereTouch& slow);
 
 /// What a measurement found.
 struct ElectrodeResult {
@@ -52,6 +62,7 @@ struct ElectrodeResult {
   double tip_radius = 0;
   std::vector<std::string> names;  ///< of the touches made, in order
   std::vector<Point3> touched;     ///< the controlled point where each touch closed the contact
+  std::vector<Point3> fast_touched;  ///< with fast_feed: where each fast touch closed it (not fitted)
   Point3 centre{};                 ///< fitted: the controlled point that puts the tip's ball on the centre
   Point3 previous{};               ///< the tool table's X, Y, Z offsets before
   Point3 offset{};                 ///< … and as measured (Z is the electrode's length)
@@ -103,6 +114,8 @@ class ElectrodeSetting final : public Feature {
 
   ElectrodePhase phase() const;
   std::optional<ElectrodeResult> last() const;
+  /// The sphere as the profile gives it. Any thread.
+  const config::ReferenceSphereProfile& profile_sphere() const noexcept { return sphere_; }
   std::optional<ProgramStop> stop() const;
 
  private:
@@ -110,6 +123,7 @@ class ElectrodeSetting final : public Feature {
   Outcome resume(FeatureHost& host);
   void when_aux_ended(const ControllerEvent& e);
   void next_touch();
+  void touched(const Point3& at);
   void finish_measurement();
   void fail(std::string code, std::string message);
   void set_phase(ElectrodePhase p);
@@ -124,8 +138,10 @@ class ElectrodeSetting final : public Feature {
   std::size_t tool_index_ = 0;
   tools::ToolEntry entry_;
   std::vector<SphereTouch> plan_;
-  std::vector<Point3> touched_;
+  std::vector<Point3> touched_, fast_touched_;
   std::size_t touch_ = 0;
+  bool slow_ = false;      ///< the current touch's slow stage runs (after its fast one)
+  SphereTouch slow_line_;  ///< the slow stage's probe move
   std::shared_ptr<const canon::Program> next_aux_;
   std::string next_aux_name_;
   std::uint64_t pending_ = 0;  ///< the request whose refusal ends what runs

@@ -60,6 +60,9 @@ struct EdmCondition {
   double orbit_radius_mm = 0;  ///< the final size
   double orbit_step_mm = 0;    ///< the radius grows by this per turn (0: the whole radius at once)
   double orbit_period_s = 0;   ///< one turn
+  // What the generator's table says the condition does (the simulated gap burns by them).
+  double side_gap_mm = 0;           ///< spark gap at the electrode's sides, per side (0: not given)
+  double electrode_wear_ratio = 0;  ///< electrode volume worn per volume of work removed
 };
 
 /// The EDM machine as the tick sees it.
@@ -84,7 +87,15 @@ struct EdmConfig {
 
 static_assert(std::is_trivially_copyable_v<EdmConfig>);
 
-/// The simulated EDM process (machine/sim_edm_process.hpp): a 1-D model along the tool axis.
+/// What the simulated gap takes from a machining condition (selected by its number).
+struct SimEdmConditionEffect {
+  int number = 0;                   ///< the condition's number; 0 = empty slot
+  double side_gap_mm = 0;           ///< the side spark gap (0: the clean breakdown gap at its voltage)
+  double electrode_wear_ratio = 0;  ///< electrode volume worn per volume of work removed
+};
+
+/// The simulated EDM process (machine/sim_edm_process.hpp): the front along the tool axis, the
+/// cavity's side walls across it, the electrode's wear.
 struct SimEdmConfig {
   bool present = false;
   std::int8_t joint = 2;               ///< the joint that feeds the electrode (the tool axis)
@@ -103,6 +114,11 @@ struct SimEdmConfig {
   /// Joints whose position tells the work's orientation (B, C: −1 = none): each orientation
   /// (rounded to whole degrees) has its own surface, so two approaches burn two fronts.
   std::int8_t orientation_joints[2] = {-1, -1};
+  /// The joints across the tool axis (the orbit's plane: X, Y; −1 = none): the electrode's
+  /// lateral position, which burns the cavity's side walls out to the side gap.
+  std::int8_t lateral_joints[2] = {-1, -1};
+  std::array<SimEdmConditionEffect, kMaxEdmConditions> conditions{};  ///< from the profile's conditions
+  int condition_count = 0;
 };
 
 }  // namespace opencnc::machine

@@ -62,6 +62,7 @@ struct GeneratorOutputs {
   double peak_current_a = 0;  ///< discharge current
   double voltage_v = 0;       ///< open-circuit voltage
   std::int8_t polarity = 1;   ///< +1: electrode positive
+  std::int32_t condition = 0;  ///< the condition's number (a generator with its own tables selects by it)
 };
 
 /// Process outputs: coolant, and the process-specific ones of the machine types we run.

@@ -152,6 +152,11 @@ struct SimSphereTarget {
   double radius = 0;
   double hysteresis = 0.0005;  ///< once touching, the contact opens this far off the surface
   double noise = 0.0002;       ///< ± mm, uniform, per sample
+  /// The sphere turns with B (joint `b_joint`, −1: it does not) about the line parallel to Y
+  /// through X, Z `b_axis`; `centre` is where it is with B at `b_at_centre_deg`.
+  int b_joint = -1;
+  std::array<double, 2> b_axis{};
+  double b_at_centre_deg = 0;
 };
 
 /// The probe: a switch on one joint's table position, or a reference sphere.

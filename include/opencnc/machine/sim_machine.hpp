@@ -110,6 +110,7 @@ class SimMachine final : public MachineIO {
   std::array<SimJoint, kMaxJoints> joints_{};
   SimSpindle spindle_;
   SimEdmProcess edm_;
+  bool edm_tool_changed_ = false;  ///< the tool changer acknowledged a change last period
   SimSwitch probe_;
   SimSphereProbe sphere_;
   std::array<SimSwitch, kMaxSimInputSwitches> input_switches_{};

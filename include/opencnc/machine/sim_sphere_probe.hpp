@@ -18,7 +18,7 @@ namespace opencnc::machine {
 class SimSphereProbe {
  public:
   constexpr SimSphereProbe() noexcept = default;
-  explicit SimSphereProbe(const SimSphereTarget& target) noexcept : target_(target) {}
+  explicit SimSphereProbe(const SimSphereTarget& target) noexcept : target_(target), centre_(target.centre) {}
 
   bool present() const noexcept { return target_.present; }
   /// The electrode in the spindle: its offsets (X, Y, Z) and tip radius, mm.
@@ -28,6 +28,11 @@ class SimSphereProbe {
   }
   const std::array<double, 3>& offset() const noexcept { return offset_; }
   double tip_radius() const noexcept { return tip_radius_; }
+  /// B stands at `b_deg`: a sphere that turns with B has its centre turned about B's axis by
+  /// b_deg − b_at_centre_deg (right-handed about +Y: +B turns Z toward X).
+  void turn(double b_deg) noexcept;
+  /// The sphere's centre now, machine coordinates.
+  const std::array<double, 3>& centre() const noexcept { return centre_; }
   /// The distance between the tip's surface and the sphere's at table positions `p` (X, Y, Z):
   /// negative when they overlap.
   double gap(const std::array<double, 3>& p) const noexcept;
@@ -38,6 +43,7 @@ class SimSphereProbe {
 
  private:
   SimSphereTarget target_{};
+  std::array<double, 3> centre_{};
   std::array<double, 3> offset_{};
   double tip_radius_ = 0;
   bool active_ = false;
