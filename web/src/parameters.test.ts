@@ -26,11 +26,14 @@ describe("machine parameters", () => {
   it("shows the refusal with the profile's file:line:col messages", () => {
     const lines = outcomeLines({
       message: "the profile refuses the change: m.toml:24:20: error: max_velocity must be > 0",
-      diagnostics: [{ severity: "error", text: "m.toml:24:20: error: max_velocity must be > 0", code: "config.range" }],
+      diagnostics: [
+        { severity: "error", text: "m.toml:24:20: error: max_velocity must be > 0", code: "config.range" },
+        { severity: "warning", text: "m.toml:30:1: warning: the drive cannot reach it", code: "config.plausible" },
+      ],
     });
     expect(lines).toEqual([
       "the profile refuses the change: m.toml:24:20: error: max_velocity must be > 0",
-      "m.toml:24:20: error: max_velocity must be > 0",
+      "m.toml:30:1: warning: the drive cannot reach it",
     ]);
     expect(outcomeLines({ error: "this command needs the admin token" })).toEqual(["this command needs the admin token"]);
   });

@@ -41,10 +41,10 @@ export async function adminCommand(ctx: Context, body: Record<string, unknown>):
   return { ...((await res.json()) as Outcome), status: res.status };
 }
 
-/** The answer in words: the message, then each diagnostic (`file:line:col: error: …`). */
+/** The answer in words: the message, then each diagnostic (`file:line:col: error: …`) it does not quote. */
 export function outcomeLines(o: Outcome): string[] {
   const lines = [o.message ?? o.error ?? ""];
-  for (const d of o.diagnostics ?? []) lines.push(d.text);
+  for (const d of o.diagnostics ?? []) if (!lines[0].includes(d.text)) lines.push(d.text);
   return lines.filter((l) => l !== "");
 }
 
