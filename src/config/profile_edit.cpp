@@ -62,6 +62,14 @@ std::vector<EditableParameter> editable_parameters(const MachineProfile& profile
     }
     out.push_back({axis_key(a, "max_following_error"), a.max_following_error, unit,
                    "largest following error before a fault"});
+    if (a.compensation.present) {
+      out.push_back({axis_key(a, "compensation.backlash"), a.compensation.backlash, unit,
+                     "backlash: lost motion on a reversal"});
+      out.push_back({axis_key(a, "compensation.takeup_velocity"), a.compensation.takeup_velocity, unit + "/s",
+                     "fastest motion of the compensation's own correction"});
+      out.push_back({axis_key(a, "compensation.takeup_acceleration"), a.compensation.takeup_acceleration,
+                     unit + "/s²", "largest acceleration of the compensation's own correction"});
+    }
   }
   return out;
 }

@@ -12,9 +12,12 @@ namespace {
 bool valid(const JointLimits& l, bool wrapped) noexcept {
   const bool finite = std::isfinite(l.max_velocity) && std::isfinite(l.max_acceleration) &&
                       std::isfinite(l.min_limit) && std::isfinite(l.max_limit) &&
-                      std::isfinite(l.max_following_error) && std::isfinite(l.home_final_velocity);
+                      std::isfinite(l.max_following_error) && std::isfinite(l.home_final_velocity) &&
+                      std::isfinite(l.backlash) && std::isfinite(l.takeup_velocity) &&
+                      std::isfinite(l.takeup_acceleration);
   return finite && l.max_velocity > 0 && l.max_acceleration > 0 && l.max_following_error > 0 &&
-         l.home_final_velocity > 0 && (wrapped || l.min_limit < l.max_limit);
+         l.home_final_velocity > 0 && (wrapped || l.min_limit < l.max_limit) && l.backlash >= 0 &&
+         l.takeup_velocity >= 0 && l.takeup_acceleration >= 0;
 }
 
 }  // namespace
@@ -63,6 +66,13 @@ Refusal Servo::apply_joint_limits() noexcept {
     jc.max_following_error = l.max_following_error;
     jc.home.final_velocity = l.home_final_velocity;
     movers_[uj].configure(config_.period_s, jc.max_acceleration, jc.max_jerk, movers_[uj].position());
+    if (uj < config_.compensation.joints.size() && config_.compensation.joints[uj].enabled) {
+      motion::JointCompensation& c = config_.compensation.joints[uj];
+      c.backlash = l.backlash;
+      c.max_velocity = l.takeup_velocity;
+      c.max_acceleration = l.takeup_acceleration;
+      comp_.set_backlash(j, l.backlash, l.takeup_velocity, l.takeup_acceleration);
+    }
   }
   configure_gap_servo();  // the jump accelerates within the tool axis' limit
   return Refusal::None;

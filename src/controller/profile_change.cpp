@@ -20,9 +20,17 @@ std::string change_text(const std::vector<config::ProfileChange>& changes) {
   return s;
 }
 
-JointLimits joint_limits(const JointConfig& j) {
-  return {j.max_velocity, j.max_acceleration,    j.min_limit,
-          j.max_limit,    j.max_following_error, j.home.final_velocity};
+JointLimits joint_limits(const ServoConfig& s, int joint) {
+  const JointConfig& j = s.joints[static_cast<std::size_t>(joint)];
+  JointLimits l{j.max_velocity, j.max_acceleration,    j.min_limit,
+                j.max_limit,    j.max_following_error, j.home.final_velocity};
+  if (static_cast<std::size_t>(joint) < s.compensation.joints.size()) {
+    const motion::JointCompensation& c = s.compensation.joints[static_cast<std::size_t>(joint)];
+    l.backlash = c.backlash;
+    l.takeup_velocity = c.max_velocity;
+    l.takeup_acceleration = c.max_acceleration;
+  }
+  return l;
 }
 
 /// The homed joint of `next` whose axis stands outside its new soft limits, as a message; "".
@@ -94,7 +102,7 @@ void Controller::edit_profile(std::uint64_t id, const requests::EditProfile& r) 
     c.id = pending.stage_id;
     c.kind = CommandKind::StageJointLimits;
     c.axis = static_cast<std::int8_t>(j);
-    c.limits = joint_limits(next.joints[static_cast<std::size_t>(j)]);
+    c.limits = joint_limits(next, j);
     queued = channels_->commands.try_push(c);
   }
   Command apply;

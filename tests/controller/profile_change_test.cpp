@@ -17,6 +17,7 @@
 #include "../control/test_profiles.hpp"
 #include "opencnc/canon/program_builder.hpp"
 #include "opencnc/config/profile_loader.hpp"
+#include "opencnc/controller/servo_setup.hpp"
 #include "opencnc/controller/sim_rig.hpp"
 #include "opencnc/core/atomic_file.hpp"
 
@@ -210,6 +211,53 @@ TEST(ServoLimits, AStagedSetAppliesWhileIdleAndABadStageRefusesTheApply) {
   const std::uint64_t none = send(CommandKind::ApplyJointLimits, -1, {});
   rig.run(3);
   EXPECT_EQ(rig.controller().outcome(none)->refusal, Refusal::NotApplicable);
+}
+
+}  // namespace
+}  // namespace opencnc::control::test
+
+namespace opencnc::control::test {
+namespace {
+
+// The drill's X has a pitch table with backlash: its backlash and take-up limits are editable, the
+// tick's compensation takes the new ones, the planner's reserve follows the new take-up limits.
+TEST(ProfileChangeCompensation, BacklashAndTakeUpLimitsReachTheTickAndTheReserve) {
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("opencnc-comp-change-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  for (const char* f : {"drill-retrofit.toml", "drill-retrofit.tbl"})
+    std::filesystem::copy_file(std::filesystem::path(OPENCNC_SOURCE_DIR "/configs") / f, dir / f,
+                               std::filesystem::copy_options::overwrite_existing);
+  const std::string path = (dir / "drill-retrofit.toml").string();
+  std::string original;
+  ASSERT_TRUE(read_file(path, original, nullptr));
+  {
+    SimRig rig(loaded(config::load_profile(path)));
+    const Outcome o = rig.request(Request::edit_profile(
+        {{"axis.x.compensation.backlash", "0.05"}, {"axis.x.compensation.takeup_velocity", "4.0"}}));
+    ASSERT_TRUE(o.accepted) << o.message;
+    EXPECT_EQ(o.message,
+              "axis.x.compensation.backlash 0.02 → 0.05; axis.x.compensation.takeup_velocity 2.0 → 4.0");
+    const motion::JointCompensation& c = rig.servo().config().compensation.joints[0];
+    EXPECT_EQ(c.backlash, 0.05);
+    EXPECT_EQ(c.max_velocity, 4.0);
+    const ServoConfig expected = control::servo_config(rig.controller().profile());
+    EXPECT_EQ(rig.servo().config().joints[0].max_velocity, expected.joints[0].max_velocity);
+    EXPECT_LT(rig.servo().config().joints[0].max_velocity,
+              rig.controller().profile().axes[0].max_velocity - 4.0);
+    std::string text;
+    ASSERT_TRUE(read_file(path, text, nullptr));
+    std::string want = original;
+    const std::size_t table = want.find("[axis.x.compensation]");
+    want.replace(want.find("backlash = 0.02", table), 15, "backlash = 0.05");
+    const std::size_t v = want.find("takeup_velocity = 2.0", table);
+    want.replace(v, 21, "takeup_velocity = 4.0");
+    EXPECT_EQ(text, want);
+    const Outcome bad = rig.request(Request::edit_profile({{"axis.x.compensation.backlash", "-0.01"}}));
+    EXPECT_FALSE(bad.accepted);
+    EXPECT_EQ(rig.servo().config().compensation.joints[0].backlash, 0.05);
+  }
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

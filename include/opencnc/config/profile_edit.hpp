@@ -30,7 +30,8 @@ struct EditableParameter {
 };
 
 /// The editable parameters of `profile`, axis by axis (per axis: max_velocity, max_acceleration,
-/// min_limit and max_limit unless wrapped, max_following_error). Any thread.
+/// min_limit and max_limit unless wrapped, max_following_error; with a compensation table its
+/// backlash and take-up limits). Any thread.
 std::vector<EditableParameter> editable_parameters(const MachineProfile& profile);
 
 /// One key's change, as text for the audit and the answer ("100.0" → "80.0").

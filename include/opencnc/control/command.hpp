@@ -134,7 +134,7 @@ struct Fault {
 };
 
 /// A joint's limits as an admin changes them (the profile's editable keys, less the compensation's
-/// reserve as servo_config() computes them). Plain data.
+/// reserve as servo_config() computes them), with its backlash and take-up limits. Plain data.
 struct JointLimits {
   double max_velocity = 0;      ///< units/s
   double max_acceleration = 0;  ///< units/s²
@@ -142,6 +142,10 @@ struct JointLimits {
   double max_limit = 0;
   double max_following_error = 1;  ///< units
   double home_final_velocity = 0;  ///< units/s (bounded by max_velocity)
+  // The compensation's scalars (motion::JointCompensation; joints without compensation: 0).
+  double backlash = 0;             ///< units
+  double takeup_velocity = 0;      ///< units/s
+  double takeup_acceleration = 0;  ///< units/s²
 };
 
 /// One operator (or controller) command. Plain data; which fields apply depends on `kind`.
