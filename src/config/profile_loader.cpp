@@ -65,6 +65,12 @@ MachineProfile read_profile(const toml::table& root, Reporter& r, const std::fil
 
 }  // namespace
 
+std::uint64_t text_digest(std::string_view text) noexcept {
+  std::uint64_t h = 14695981039346656037ull;  // FNV-1a, 64 bits
+  for (const char c : text) h = (h ^ static_cast<unsigned char>(c)) * 1099511628211ull;
+  return h;
+}
+
 ProfileLoad parse_profile(std::string_view text, std::string_view source_name,
                           std::span<const std::string> overrides, const std::filesystem::path& base_dir) {
   ProfileLoad out;
@@ -80,6 +86,8 @@ ProfileLoad parse_profile(std::string_view text, std::string_view source_name,
   MachineProfile p = read_profile(root, r, base_dir);
   if (r.has_errors()) return out;
   p.source = std::string(source_name);
+  p.overrides.assign(overrides.begin(), overrides.end());
+  p.source_digest = text_digest(text);
   out.profile = std::move(p);
   return out;
 }

@@ -10,68 +10,16 @@
 #include <cmath>
 #include <vector>
 
+#include "toml_lines.hpp"
+
 namespace opencnc::config {
 
 namespace {
 
-struct Line {
-  std::string_view text;           ///< without its line ending
-  std::size_t begin = 0, end = 0;  ///< byte range in the whole text, line ending included
-};
-
-std::vector<Line> split_lines(std::string_view text) {
-  std::vector<Line> out;
-  std::size_t at = 0;
-  while (at < text.size()) {
-    const std::size_t nl = text.find('\n', at);
-    const std::size_t end = nl == std::string_view::npos ? text.size() : nl + 1;
-    std::string_view t = text.substr(at, (nl == std::string_view::npos ? text.size() : nl) - at);
-    if (!t.empty() && t.back() == '\r') t.remove_suffix(1);
-    out.push_back({t, at, end});
-    at = end;
-  }
-  return out;
-}
-
-std::string_view trim(std::string_view s) {
-  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
-  while (!s.empty() && (s.back() == ' ' || s.back() == '\t')) s.remove_suffix(1);
-  return s;
-}
-
-/// The key of a table header line (`[axis.X.compensation]  # …` → "axis.x.compensation", lower
-/// case, blanks and quotes dropped), or "" for any other line. Array-of-tables headers and array
-/// values (`[1.0, 2.0]`) are not table headers.
-std::string header_key(std::string_view line) {
-  std::string_view t = trim(line);
-  if (t.size() < 3 || t[0] != '[' || t[1] == '[') return "";
-  const std::size_t close = t.find(']');
-  if (close == std::string_view::npos) return "";
-  const std::string_view rest = trim(t.substr(close + 1));
-  if (!rest.empty() && rest[0] != '#') return "";
-  std::string key;
-  for (char c : t.substr(1, close - 1)) {
-    if (c == ' ' || c == '\t' || c == '"' || c == '\'') continue;
-    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.')) return "";
-    key += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  }
-  return key.empty() || !std::isalpha(static_cast<unsigned char>(key[0])) ? "" : key;
-}
-
-bool is_blank_or_comment(std::string_view line) {
-  const std::string_view t = trim(line);
-  return t.empty() || t[0] == '#';
-}
-
-/// End (exclusive line index) of the table that starts at line `header`: the next header, less
-/// the comments and blank lines that lead into it.
-std::size_t table_end(const std::vector<Line>& lines, std::size_t header) {
-  std::size_t next = header + 1;
-  while (next < lines.size() && header_key(lines[next].text).empty()) ++next;
-  std::size_t end = next;
-  while (end > header + 1 && is_blank_or_comment(lines[end - 1].text)) --end;
-  return end;
-}
+using detail::header_key;
+using detail::split_lines;
+using detail::table_end;
+using Line = detail::TomlLine;
 
 std::string number(double v) {
   // Micrometres to a tenth (what a laser measures), without a trailing "-0.0".

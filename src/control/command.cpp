@@ -156,6 +156,10 @@ const char* to_string(CommandKind k) noexcept {
       return "coolant";
     case CommandKind::SetHandwheel:
       return "handwheel";
+    case CommandKind::StageJointLimits:
+      return "stage-joint-limits";
+    case CommandKind::ApplyJointLimits:
+      return "apply-joint-limits";
   }
   return "?";
 }

@@ -66,6 +66,10 @@ Refusal Servo::apply(const Command& c) noexcept {
       return manual_spindle_or_coolant(c);
     case CommandKind::SetHandwheel:
       return set_handwheel(c);
+    case CommandKind::StageJointLimits:
+      return stage_joint_limits(c);
+    case CommandKind::ApplyJointLimits:
+      return apply_joint_limits();
   }
   return Refusal::BadValue;
 }

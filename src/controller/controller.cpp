@@ -135,6 +135,7 @@ Controller::Controller(const config::MachineProfile& profile, ServoChannels& cha
       channels_(&channels),
       source_(std::move(source)),
       check_(std::make_unique<MachineMoveCheck>(servo_config_, limits_)),
+      shown_profile_(profile),
       location_every_(static_cast<std::uint64_t>(kLocationRefreshS / servo_config_.period_s) + 1) {
   outcomes_.resize(kKeptOutcomes);
 }
@@ -300,7 +301,7 @@ void Controller::on_event(const ServoEvent& e) {
   switch (e.kind) {
     case EventKind::Accepted:
     case EventKind::Refused:
-      finish(e.command_id, e.refusal);
+      if (!settle_profile_change(e)) finish(e.command_id, e.refusal);
       break;
     case EventKind::Fault:
       note(Severity::Error, fault_code(e.fault.kind), describe(e.fault));
@@ -357,6 +358,8 @@ void Controller::handle(std::uint64_t id, Request& r) {
           feature(id, body);
         } else if constexpr (std::is_same_v<T, requests::ResumeProgram>) {
           resume_program(id, body);
+        } else if constexpr (std::is_same_v<T, requests::EditProfile>) {
+          edit_profile(id, body);
         } else if constexpr (std::is_same_v<T, requests::SetSwitch>) {
           if (body.which == SwitchKind::BlockDelete) {
             block_delete_ = body.on;
@@ -446,6 +449,7 @@ void Controller::open_file(std::uint64_t id, const std::string& path) {
   open_block_delete_ = block_delete_;
   open_stamp_ = file_stamp(path);
   open_version_ = source_->version();
+  open_limits_version_ = limits_version_;
   ControllerEvent e;
   e.kind = ControllerEventKind::ProgramOpened;
   e.text = path;
@@ -469,6 +473,7 @@ void Controller::open_canon(std::uint64_t id, std::shared_ptr<const canon::Progr
     open_ = std::move(op);
   }
   open_at_ = servo().commanded;
+  open_limits_version_ = limits_version_;
   ControllerEvent e;
   e.kind = ControllerEventKind::ProgramOpened;
   e.text = name;
@@ -492,14 +497,17 @@ void Controller::cycle_start(std::uint64_t id, const Request& r) {
   if (!ready_for_job(id, Mode::Auto, "programs")) return;
   if (!features_allow_start(id, {JobKind::Program, op->name})) return;
   if (op->program) {
-    const bool same_start = op->program->start() == servo().commanded;
+    // Checked when opened, unless the machine stands elsewhere or its limits changed since.
+    const bool same_start =
+        op->program->start() == servo().commanded && open_limits_version_ == limits_version_;
     start_job(id, JobKind::Program, op->name, Mode::Auto, canon_stream(op->program, servo().commanded), same_start);
     return;
   }
   // The preflight holds for the position, the switches and the file it was made with: anything
   // else, and the program is checked again before it may start.
-  if (servo().commanded != open_at_ || block_delete_ != open_block_delete_ || file_stamp(op->path) != open_stamp_ ||
-      source_->version() != open_version_) {
+  if (servo().commanded != open_at_ || block_delete_ != open_block_delete_ ||
+      file_stamp(op->path) != open_stamp_ || source_->version() != open_version_ ||
+      open_limits_version_ != limits_version_) {
     Preflight pf = preflight_file(op->path);
     if (!pf.ok())
       return finish(id, program_refusal(pf.diagnostics), refusal_text(program_refusal(pf.diagnostics)),
@@ -508,6 +516,7 @@ void Controller::cycle_start(std::uint64_t id, const Request& r) {
     open_block_delete_ = block_delete_;
     open_stamp_ = file_stamp(op->path);
     open_version_ = source_->version();
+    open_limits_version_ = limits_version_;
     std::lock_guard lock(out_mutex_);
     if (open_) open_->preflight = std::move(pf);
   }

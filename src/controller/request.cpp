@@ -70,6 +70,7 @@ std::string Request::name() const {
                         [](const requests::Feature& r) -> std::string { return r.feature + "." + r.action; },
                         [](const requests::SetHandwheel&) -> std::string { return "handwheel"; },
                         [](const requests::ResumeProgram&) -> std::string { return "resume-program"; },
+                        [](const requests::EditProfile&) -> std::string { return "edit-profile"; },
                     },
                     body);
 }

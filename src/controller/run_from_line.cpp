@@ -16,12 +16,29 @@ namespace {
 
 constexpr std::size_t kScanBatch = 4096;
 
-LineStart line_start(const canon::Program& p, std::size_t move, const ProgramStream& s) {
+/// The spindle speed (rpm) the program has set before move `limit`, reading its actions from
+/// `*next` on (0: none, or a surface speed under G96, whose rpm depends on X).
+void follow_spindle(const canon::Program& p, std::size_t limit, std::size_t* next, double* rpm) {
+  for (; *next < p.action_count() && p.action(*next).before_move <= limit; ++*next) {
+    const canon::Action& a = p.action(*next);
+    if (a.kind == canon::ActionKind::SpindleSpeed) *rpm = a.index2 == 0 ? a.value : 0;
+  }
+}
+
+/// The move's feed in mm/min for the approach's last leg: as the program has it (G94, and G93,
+/// whose inverse time the interpreter has already turned into the move's feed per minute); under
+/// G95 (F per revolution) × the spindle speed set before it (0 when unknown).
+double feed_per_minute(const canon::Program& p, std::size_t move, double rpm) {
+  const double f = p.feed(static_cast<canon::SegmentId>(move));
+  return (p.move(move).flags & canon::kPerRevolution) ? f * rpm : f;
+}
+
+LineStart line_start(const canon::Program& p, std::size_t move, const ProgramStream& s, double rpm) {
   LineStart l;
   l.segment = p.segment_of(move);
   l.start = p.start_of(static_cast<canon::SegmentId>(move));
   l.rapid = p.move(move).kind == canon::MoveKind::Traverse;
-  l.feed_mm_per_min = l.rapid ? 0 : p.feed(static_cast<canon::SegmentId>(move));
+  l.feed_mm_per_min = l.rapid ? 0 : feed_per_minute(p, move, rpm);
   l.where = s.location_of(move);
   return l;
 }
@@ -33,15 +50,28 @@ std::optional<LineStart> find_line_start(ProgramSource& source, const std::strin
                                          const LoadOptions& options, std::string* why) {
   std::unique_ptr<ProgramStream> s = source.execute(path, program_start, options);
   std::uint32_t last_line = 0;  // the main file's line of the last move seen
-  std::size_t scanned = 0;
+  std::size_t scanned = 0, next_action = 0;
+  double rpm = 0;  // the spindle speed set before the move scanned
   for (;;) {
     const canon::Program& p = s->program();
     for (; scanned < p.size(); ++scanned) {
       if (p.file_of(static_cast<canon::SegmentId>(scanned)) != 0) continue;
       const std::uint32_t at = p.move(scanned).line;
-      if (at == line) return line_start(p, scanned, *s);
+      if (at == line) {
+        follow_spindle(p, scanned, &next_action, &rpm);
+        const LineStart l = line_start(p, scanned, *s, rpm);
+        if (!l.rapid && l.feed_mm_per_min <= 0) {
+          *why = fmt::format(
+              "line {} feeds per revolution (G95) and no spindle speed in rpm is set before it (none, or "
+              "G96's surface speed): the approach's feed is not known; run from an earlier line",
+              line);
+          return std::nullopt;
+        }
+        return l;
+      }
       last_line = std::max(last_line, at);
     }
+    follow_spindle(p, scanned, &next_action, &rpm);
     // What is passed is freed (the last move stays: the next one starts at its end).
     if (scanned > 1) s->release(scanned - 1, p.action_count());
     switch (s->state()) {

@@ -10,6 +10,7 @@
 
 #include "opencnc/control/command.hpp"
 #include "opencnc/controller/run_from_line.hpp"
+#include "opencnc/hmi/api_admin.hpp"
 
 namespace opencnc::hmi {
 
@@ -216,6 +217,11 @@ Command parse(const json& body, const config::MachineProfile& p, const std::file
   if (kind == "open") return open_request(body, dir);
   if (kind == "mdi") return mdi_request(body);
   if (kind == "set-tool") return tool_change(body);
+  if (kind == "set-parameters") {
+    ParametersRequest r = parameters_request(body, p);
+    if (!r.request) throw Bad{r.status, r.message};
+    return std::move(*r.request);
+  }
   if (kind == "run-from-line") {
     const double line = number(body, "line");
     if (line != std::floor(line) || line < 1 || line > 1e9) throw Bad{422, "\"line\" must be a line number from 1"};
@@ -269,7 +275,7 @@ std::optional<Role> role_for(std::string_view kind) {
                                                "home",    "override",  "switch", "spindle-on",
                                                "coolant", "handwheel", "open",   "mdi",
                                                "run-from-line"};
-  if (kind == "set-tool") return Role::Admin;
+  if (kind == "set-tool" || kind == "set-parameters") return Role::Admin;
   if (servo_kinds().find(kind) != servo_kinds().end()) return Role::Operator;
   for (const char* k : operator_kinds) {
     if (kind == k) return Role::Operator;

@@ -23,6 +23,7 @@
 
 #include "opencnc/controller/gcode_source.hpp"
 #include "opencnc/hmi/api.hpp"
+#include "opencnc/hmi/api_admin.hpp"
 #include "opencnc/hmi/history.hpp"
 #include "opencnc/hmi/preview.hpp"
 #include "opencnc/hmi/stream_tickets.hpp"
@@ -148,7 +149,7 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
   Impl(control::Controller& c, const config::MachineProfile& p, Tokens t, History* h,
        const control::GcodeProgramSource* s, ServerConfig cfg)
       : controller(c),
-        profile(p),
+        profile(std::make_shared<const config::MachineProfile>(p)),
         tokens(std::move(t)),
         history(h),
         source(s),
@@ -160,7 +161,13 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
   }
 
   control::Controller& controller;
-  config::MachineProfile profile;
+  /// The profile in force (replaced after an accepted set-parameters): any io thread.
+  std::shared_ptr<const config::MachineProfile> machine() const {
+    std::lock_guard lock(profile_mutex);
+    return profile;
+  }
+  mutable std::mutex profile_mutex;
+  std::shared_ptr<const config::MachineProfile> profile;
   Tokens tokens;
   StreamTickets tickets;
   History* history;
@@ -198,7 +205,7 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
   // Routes (docs/api.md).
   void command(const std::shared_ptr<HttpSession>& s, const HttpRequest& req, Role role);
   void wait_outcome(const std::shared_ptr<HttpSession>& s, HttpRequest req, std::uint64_t id,
-                    std::chrono::steady_clock::time_point deadline);
+                    std::chrono::steady_clock::time_point deadline, bool profile_edit = false);
   HttpResponse tool_change(const HttpRequest& req, const ToolChange& c);
   HttpResponse get(const HttpRequest& req, const Target& t, Role role);
   HttpResponse program_info(const HttpRequest& req);
@@ -372,7 +379,7 @@ void Server::Impl::stream_tick() {
   if (stopping) return;
   ++stream_ticks;
   auto status = std::make_shared<const std::string>(
-      json{{"type", "status"}, {"status", status_json(controller.status(), profile)}}.dump());
+      json{{"type", "status"}, {"status", status_json(controller.status(), *machine())}}.dump());
   {
     std::lock_guard lock(sessions_mutex);
     std::erase_if(sessions, [](const std::weak_ptr<WsSession>& w) {
@@ -459,8 +466,9 @@ void Server::Impl::handle(const std::shared_ptr<HttpSession>& s, HttpRequest req
 
 HttpResponse Server::Impl::get(const HttpRequest& req, const Target& t, Role role) {
   const std::string& p = t.path;
-  if (p == "/api/v1/status") return json_response(req, 200, status_json(controller.status(), profile));
-  if (p == "/api/v1/machine") return json_response(req, 200, machine_json(profile));
+  if (p == "/api/v1/status") return json_response(req, 200, status_json(controller.status(), *machine()));
+  if (p == "/api/v1/machine") return json_response(req, 200, machine_json(*machine()));
+  if (p == "/api/v1/parameters") return json_response(req, 200, parameters_json(*machine()));
   if (p == "/api/v1/program") return program_info(req);
   if (p == "/api/v1/program/text") return program_text(req, t);
   if (p == "/api/v1/programs") return programs(req);
@@ -552,7 +560,7 @@ void Server::Impl::command(const std::shared_ptr<HttpSession>& s, const HttpRequ
     audit(s->remote(), role, req, 403, "needs the admin role");
     return s->send(error_response(req, 403, "this command needs the admin token"));
   }
-  auto parsed = parse_command(body, profile, config.programs_dir);
+  auto parsed = parse_command(body, *machine(), config.programs_dir);
   if (const auto* e = std::get_if<ApiError>(&parsed)) {
     audit(s->remote(), role, req, e->status, e->message);
     return s->send(error_response(req, e->status, e->message));
@@ -563,22 +571,31 @@ void Server::Impl::command(const std::shared_ptr<HttpSession>& s, const HttpRequ
     audit(s->remote(), role, req, static_cast<int>(res.result_int()), res.body());
     return s->send(std::move(res));
   }
-  const std::uint64_t id = controller.submit(std::move(std::get<control::Request>(c)));
+  auto& request = std::get<control::Request>(c);
+  auto* edit = std::get_if<control::requests::EditProfile>(&request.body);
+  if (edit) edit->who = fmt::format("{}@{}", to_string(role), s->remote());
+  const std::uint64_t id = controller.submit(std::move(request));
   const auto deadline =
       std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                                              std::chrono::duration<double>(config.command_timeout_s));
-  wait_outcome(s, req, id, deadline);
+  wait_outcome(s, req, id, deadline, edit != nullptr);
 }
 
 // Polls the controller for the answer every 2 ms on a timer of the session's executor: the
 // thread serves the other clients meanwhile.
 void Server::Impl::wait_outcome(const std::shared_ptr<HttpSession>& s, HttpRequest req, std::uint64_t id,
-                                std::chrono::steady_clock::time_point deadline) {
+                                std::chrono::steady_clock::time_point deadline, bool profile_edit) {
   const std::optional<Role> role = tokens.role_of(token_of(req));
   if (const auto o = controller.outcome(id)) {
     const int status = o->accepted ? 200 : 409;
+    if (profile_edit && o->accepted) {  // the new limits for the checks of later commands
+      auto next = std::make_shared<const config::MachineProfile>(controller.current_profile());
+      std::lock_guard lock(profile_mutex);
+      profile = std::move(next);
+    }
     audit(s->remote(), role, req, status,
-          o->accepted ? "accepted" : fmt::format("{}: {}", control::refusal_code(o->refusal), o->message));
+          o->accepted ? (profile_edit ? "accepted: " + o->message : "accepted")
+                      : fmt::format("{}: {}", control::refusal_code(o->refusal), o->message));
     return s->send(json_response(req, status, outcome_json(id, *o)));
   }
   if (std::chrono::steady_clock::now() >= deadline || stopping) {
@@ -586,8 +603,10 @@ void Server::Impl::wait_outcome(const std::shared_ptr<HttpSession>& s, HttpReque
     return s->send(json_response(req, 202, {{"id", id}, {"pending", true}}));
   }
   auto timer = std::make_shared<net::steady_timer>(s->executor(), std::chrono::milliseconds(2));
-  timer->async_wait([self = shared_from_this(), s, timer, req = std::move(req), id, deadline](
-                        beast::error_code) mutable { self->wait_outcome(s, std::move(req), id, deadline); });
+  timer->async_wait([self = shared_from_this(), s, timer, req = std::move(req), id, deadline,
+                     profile_edit](beast::error_code) mutable {
+    self->wait_outcome(s, std::move(req), id, deadline, profile_edit);
+  });
 }
 
 HttpResponse Server::Impl::tool_change(const HttpRequest& req, const ToolChange& c) {

@@ -59,6 +59,21 @@ double Compensation::update(int j, double joint_position, double offset, bool ho
   return s.correction;
 }
 
+// The target's backlash term is direction · B/2: a new B moves the target by direction · ΔB/2,
+// which u takes up from where c stands (c = target + u stays continuous).
+void Compensation::set_backlash(int j, double backlash, double max_velocity,
+                                double max_acceleration) noexcept {
+  if (j < 0 || j >= kMaxCompensatedJoints) return;
+  JointCompensation& c = config_.joints[index(j)];
+  JointState& s = state_[index(j)];
+  const double shift = s.direction * (backlash - c.backlash) / 2;
+  c.backlash = backlash;
+  c.max_velocity = max_velocity;
+  c.max_acceleration = max_acceleration;
+  s.target += shift;
+  s.take_up -= shift;
+}
+
 // u toward 0, time-optimal under |u̇| ≤ V and |ü| ≤ A with the position updated by the new
 // velocity (u += v·T). From speed v, braking by A·T every period covers T·(v + (v − AT) + …),
 // which stays within the distance D left iff v ≤ (√((AT)² + 8AD) − AT)/2: that speed toward 0,

@@ -109,6 +109,19 @@ TEST(ServoAllocations, NoneInsideTheTick) {
   EXPECT_EQ(a.rig().status().runs_finished, 2u);  // the MDI line and the program
   EXPECT_NEAR(a.rig().status().servo.commanded[Axis::X], 250.0, 1e-9);
   EXPECT_EQ(a.rig().status().servo.tool, 2);
+  // An admin's change of the limits while idle: staged joint by joint, applied by one command.
+  const JointConfig& x = a.rig().servo().config().joints[0];
+  Command stage;
+  stage.kind = CommandKind::StageJointLimits;
+  stage.axis = 0;
+  stage.limits = {x.max_velocity / 2, x.max_acceleration,    x.min_limit,
+                  x.max_limit,        x.max_following_error, x.home.final_velocity / 2};
+  Command apply;
+  apply.kind = CommandKind::ApplyJointLimits;
+  ASSERT_TRUE(a.rig().channels().commands.try_push(stage) && a.rig().channels().commands.try_push(apply));
+  const double halved = stage.limits.max_velocity;
+  a.until([] { return false; }, 5);
+  EXPECT_EQ(a.rig().servo().config().joints[0].max_velocity, halved);
   a.rig().machine().set_amp_fault(0, true);
   a.until([] { return false; }, 5);
   a.rig().machine().set_estop_pressed(true);

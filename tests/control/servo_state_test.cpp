@@ -328,6 +328,13 @@ const Row kRows[] = {
      cmd(CommandKind::SetHandwheel, 0.01, 0, 0), Refusal::NotApplicable, State::Idle},
     {"handwheel_without_one_estopped", false, estopped, State::EStopped,
      cmd(CommandKind::SetHandwheel, 0.01, 0, 0), Refusal::NotApplicable, State::EStopped},
+    // joint limits (an admin's profile edit): staged joint by joint, applied together while idle
+    {"apply_limits_nothing_staged", false, idle(Mode::Manual), State::Idle,
+     cmd(CommandKind::ApplyJointLimits), Refusal::NotApplicable, State::Idle},
+    {"stage_limits_zero_velocity", false, running_program, State::Running,
+     cmd(CommandKind::StageJointLimits, 0, 0, 0), Refusal::BadValue, State::Running},
+    {"stage_limits_no_such_joint", false, off, State::Off, cmd(CommandKind::StageJointLimits, 0, 0, 7),
+     Refusal::BadValue, State::Off},
 };
 
 void PrintTo(const Row& r, std::ostream* os) {

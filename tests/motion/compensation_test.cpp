@@ -4,6 +4,7 @@
 // them.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -141,6 +142,26 @@ TEST(Compensation, DirectionComesFromTheJointNotTheOffset) {
   // Homing changes the offset by −30 while the joint keeps moving up: no reversal.
   comp.update(0, 10.0, -30.0, true);
   EXPECT_EQ(comp.direction(0), 1);
+}
+
+// An admin's new backlash while the joint stands: no step in the correction, the difference taken
+// up within the new limits, the new half-backlash in the end.
+TEST(Compensation, ANewBacklashAtRestIsTakenUpWithoutAStep) {
+  Compensation comp(one_joint(PitchTable{}, 0.02, 5, 200));
+  for (int k = 0; k < 100; ++k) comp.update(0, 0.1 * k, 0.0, false);
+  for (int k = 0; k < 200; ++k) comp.update(0, 9.9, 0.0, false);
+  ASSERT_EQ(comp.correction(0), 0.01);
+  comp.set_backlash(0, 0.06, 2, 100);
+  double last = comp.correction(0), fastest = 0;
+  EXPECT_EQ(last, 0.01);
+  for (int k = 0; k < 2000; ++k) {
+    const double c = comp.update(0, 9.9, 0.0, false);
+    fastest = std::max(fastest, std::abs(c - last) / 1e-3);
+    last = c;
+  }
+  EXPECT_NEAR(last, 0.03, 1e-15);
+  EXPECT_LE(fastest, 2 * (1 + 1e-9));
+  EXPECT_EQ(comp.config().joints[0].backlash, 0.06);
 }
 
 TEST(Compensation, DisabledJointsGetNothing) {

@@ -111,3 +111,41 @@ TEST(RunFromLineScenario, LinesWithoutAMovePastTheEndOrAfterAnInputAreRefused) {
 
 }  // namespace
 }  // namespace opencnc::control::test
+
+namespace opencnc::control::test {
+namespace {
+
+// The approach's last leg runs at the line's move's feed per minute: under G93 the move's own
+// (length × F), under G95 F × the spindle speed set before it; a G95 line under G96 (no rpm known)
+// is refused.
+TEST(RunFromLineScenario, TheApproachFeedIsPerMinuteUnderInverseTimeAndPerRevolution) {
+  TempProgram p("feeds.ngc",
+                "G21 G90 G94 F600\n"  // 1
+                "S1000 M3\n"          // 2
+                "G0 X0 Y0 Z5\n"       // 3
+                "G1 Z0\n"             // 4
+                "G93 G1 X30 F2\n"     // 5: 30 mm in 1/2 min: 60 mm/min
+                "G95 G1 X40 F0.1\n"   // 6: 0.1 mm/rev at 1000 rpm: 100 mm/min
+                "S2500\n"             // 7
+                "G1 Y10\n"            // 8: 250 mm/min
+                "G94 G1 X0 F300\n"    // 9
+                "M2\n");              // 10
+  Diagnostics d;
+  const auto source = GcodeProgramSource::create(mill(), d);
+  const double expected[][2] = {{4, 600}, {5, 60}, {6, 100}, {8, 250}, {9, 300}};
+  for (const auto& [line, feed] : expected) {
+    std::string why;
+    const auto at = find_line_start(*source, p.path(), Pose{}, static_cast<std::uint32_t>(line), {}, &why);
+    ASSERT_TRUE(at.has_value()) << why;
+    EXPECT_NEAR(at->feed_mm_per_min, feed, 1e-9) << "line " << line;
+  }
+  TempProgram q("no-speed.ngc", "G21 G90 G96 S100 D3000 M3\nG95 G1 X5 F0.1\nM2\n");
+  std::string why;
+  EXPECT_FALSE(find_line_start(*source, q.path(), Pose{}, 2, {}, &why).has_value());
+  EXPECT_NE(why.find("line 2 feeds per revolution (G95) and no spindle speed in rpm is set before it"),
+            std::string::npos)
+      << why;
+}
+
+}  // namespace
+}  // namespace opencnc::control::test

@@ -3,10 +3,11 @@
 // `opencnc serve` on the simulated mill (virtual time at 30x), then with the mouse alone: machine
 // on, home, open the bracket program, run it, confirm the tool changes, hold and resume, see the
 // position change, run to the end, find the job in the history; then run it again from line 66
-// chosen in the listing. Screenshots land in the
+// chosen in the listing; as the admin, lower X's maximum velocity and see a bad value refused with
+// the profile's message (the profile is a copy in the test's folder). Screenshots land in the
 // artefacts folder. Usage: node e2e/run.mjs [--opencnc PATH] [--out DIR]
 import { spawn } from "node:child_process";
-import { mkdtempSync, mkdirSync, rmSync } from "node:fs";
+import { copyFileSync, mkdtempSync, mkdirSync, readFileSync, rmSync } from "node:fs";
 import { tmpdir } from "node:os";
 import { dirname, join, resolve } from "node:path";
 import { fileURLToPath } from "node:url";
@@ -33,8 +34,10 @@ const opencnc = resolve(opt("--opencnc", join(repo, "build", "opencnc")));
 const out = resolve(opt("--out", join(here, "artifacts")));
 mkdirSync(out, { recursive: true });
 const data = mkdtempSync(join(tmpdir(), "opencnc-e2e-"));
+// The profile is a copy: the admin's step changes a machine parameter, which writes the file.
+for (const f of ["mill-3axis.toml", "mill-3axis.tbl"]) copyFileSync(join(repo, "configs", f), join(data, f));
 
-const server = spawn(opencnc, ["serve", "--machine", join(repo, "configs/mill-3axis.toml"), "--listen", "127.0.0.1:0",
+const server = spawn(opencnc, ["serve", "--machine", join(data, "mill-3axis.toml"), "--listen", "127.0.0.1:0",
   "--programs", join(repo, "examples"), "--data", data, "--static", join(repo, "web/dist"), "--speed", "30"], {
   env: { ...process.env, OPENCNC_OPERATOR_TOKEN: "e2e-operator-token-0123456789", OPENCNC_ADMIN_TOKEN: "e2e-admin-token-0123456789" },
   stdio: ["ignore", "pipe", "inherit"],
@@ -150,6 +153,19 @@ try {
     return (await finished()) >= before + 2;  // the approach, then the program
   }, 60000);
   await shot("07-run-from-line");
+  step("machine parameters: the admin lowers X's maximum velocity, then a bad value is refused");
+  await page.getByTestId("key-params").click();
+  await page.fill("#admin-token", "e2e-admin-token-0123456789");
+  const vx = page.locator('input[data-key="axis.x.max_velocity"]');
+  await waitFor("the parameters", async () => (await vx.count()) === 1);
+  await vx.fill("90");
+  await page.getByRole("button", { name: "Apply changes (admin)" }).click();
+  await waitFor("the change", async () => (await page.locator("#parameters-result").innerText()).includes("axis.x.max_velocity 100.0 → 90.0"));
+  if (!readFileSync(join(data, "mill-3axis.toml"), "utf8").includes("max_velocity = 90.0")) throw new Error("the profile file was not changed");
+  await vx.fill("-5");
+  await page.getByRole("button", { name: "Apply changes (admin)" }).click();
+  await waitFor("the profile's message", async () => (await page.locator("#parameters-result").innerText()).includes("the profile refuses the change: "));
+  await shot("08-parameters");
   step("passed");
 } catch (e) {
   failed = true;

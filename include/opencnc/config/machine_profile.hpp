@@ -260,6 +260,8 @@ struct MachineProfile {
   std::string name;
   std::string description;
   std::string source;  ///< file the profile was read from
+  std::vector<std::string> overrides;  ///< the `--set key=value` overrides it was read with
+  std::uint64_t source_digest = 0;     ///< FNV-1a of the text it was read from (edits check it)
   double servo_period_s = 0.001;
   std::vector<AxisProfile> axes;  ///< in joint order
   SpindleProfile spindle;

@@ -2,6 +2,7 @@
 // Loading a machine profile from TOML, with `--set key=value` overrides and validation.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <span>
@@ -33,5 +34,9 @@ ProfileLoad load_profile(const std::filesystem::path& file, std::span<const std:
 ProfileLoad parse_profile(std::string_view text, std::string_view source_name,
                           std::span<const std::string> overrides = {},
                           const std::filesystem::path& base_dir = {});
+
+/// The digest of a profile's text that MachineProfile::source_digest holds (FNV-1a, 64 bits).
+/// Any thread.
+std::uint64_t text_digest(std::string_view text) noexcept;
 
 }  // namespace opencnc::config

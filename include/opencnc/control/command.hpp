@@ -78,6 +78,8 @@ enum class CommandKind : std::uint8_t {
   SpindleOff,          ///< manual
   Coolant,             ///< manual: `coolant` on (`flag`) or off
   SetHandwheel,        ///< `axis` the handwheel moves (−1 = none), `value` = units per count
+  StageJointLimits,    ///< `axis` = joint: `limits` wait for ApplyJointLimits (no effect yet)
+  ApplyJointLimits,    ///< the staged joints' limits take effect at once, only while nothing moves
 };
 
 /// Why a command was refused. Each has a stable code (refusal_code()).
@@ -132,6 +134,21 @@ struct Fault {
   std::uint64_t tick = 0;
 };
 
+/// A joint's limits as an admin changes them (the profile's editable keys, less the compensation's
+/// reserve as servo_config() computes them), with its backlash and take-up limits. Plain data.
+struct JointLimits {
+  double max_velocity = 0;      ///< units/s
+  double max_acceleration = 0;  ///< units/s²
+  double min_limit = 0;         ///< soft limits, machine coordinates
+  double max_limit = 0;
+  double max_following_error = 1;  ///< units
+  double home_final_velocity = 0;  ///< units/s (bounded by max_velocity)
+  // The compensation's scalars (motion::JointCompensation; joints without compensation: 0).
+  double backlash = 0;             ///< units
+  double takeup_velocity = 0;      ///< units/s
+  double takeup_acceleration = 0;  ///< units/s²
+};
+
 /// One operator (or controller) command. Plain data; which fields apply depends on `kind`.
 struct Command {
   std::uint64_t id = 0;  ///< chosen by the sender; echoed in the ServoEvent that answers it
@@ -147,6 +164,7 @@ struct Command {
   std::uint64_t first_action = 0;
   std::uint32_t run_id = 0;
   Mode run_mode = Mode::Auto;  ///< StartRun: Auto program or MDI line
+  JointLimits limits{};        ///< StageJointLimits
 };
 
 /// What a program's marker asks the machine to do (canon actions, in a form the tick can apply).
@@ -255,6 +273,7 @@ struct ServoEvent {
   double value = 0;
 };
 
+static_assert(std::is_trivially_copyable_v<JointLimits>);
 static_assert(std::is_trivially_copyable_v<Command>);
 static_assert(std::is_trivially_copyable_v<MachineAction>);
 static_assert(std::is_trivially_copyable_v<ServoEvent>);

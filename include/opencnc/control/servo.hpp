@@ -86,6 +86,10 @@ class Servo final : public Tickable {
   Refusal manual_spindle_or_coolant(const Command& c) noexcept;
   Refusal tool_changed() noexcept;
   Refusal set_handwheel(const Command& c) noexcept;
+
+  // --- limits changed while idle (servo_limits.cpp) -----------------------------------------
+  Refusal stage_joint_limits(const Command& c) noexcept;
+  Refusal apply_joint_limits() noexcept;
   void enter_estop() noexcept;
   void enter_fault(const Fault& f) noexcept;
   void halt(RunEnd why) noexcept;
@@ -158,6 +162,9 @@ class Servo final : public Tickable {
   void stop_spindle_and_coolant() noexcept;
 
   ServoConfig config_;
+  std::array<JointLimits, machine::kMaxJoints> staged_limits_{};  ///< StageJointLimits, not applied yet
+  std::uint16_t staged_joints_ = 0;                               ///< bit j: joint j is staged
+  bool staged_invalid_ = false;  ///< a stage was refused: the next apply refuses too (all or nothing)
   ServoChannels* channels_;
   machine::MachineIO* machine_;
   machine::MachineCapabilities caps_{};

@@ -80,8 +80,12 @@ class Controller final : private FeatureHost {
   /// thread. Deterministic for the same inputs.
   void service();
 
+  /// The servo configuration and the profile in force. Controller thread (they change with an
+  /// EditProfile request).
   const ServoConfig& servo_config() const noexcept { return servo_config_; }
   const config::MachineProfile& profile() const noexcept override { return profile_; }
+  /// A copy of the profile in force (after the last EditProfile). Any thread.
+  config::MachineProfile current_profile() const;
 
  private:
   struct Attached {
@@ -108,6 +112,10 @@ class Controller final : private FeatureHost {
   void run_auxiliary(std::uint64_t id, const requests::RunAuxiliary& r);
   void resume_program(std::uint64_t id, const requests::ResumeProgram& r);
   void feature(std::uint64_t id, const requests::Feature& r);
+  // Profile edits (profile_change.cpp).
+  void edit_profile(std::uint64_t id, const requests::EditProfile& r);
+  bool settle_profile_change(const ServoEvent& e);
+  void swap_profile(config::MachineProfile profile);
   bool features_allow_start(std::uint64_t id, const StartCheck& start);
   bool features_allow_continue(const SyncCheck& sync);
   /// Refuses when a job cannot start now (mode `mode`, idle, homed, no job running).
@@ -159,6 +167,7 @@ class Controller final : private FeatureHost {
   std::vector<KeptOutcome> outcomes_;
   ControllerStatus published_;
   std::optional<OpenProgram> open_;
+  config::MachineProfile shown_profile_;  ///< profile_ for other threads (current_profile())
 
   // Controller thread only.
   /// The servo's status as last read (the triple buffer's reader slot).
@@ -178,6 +187,15 @@ class Controller final : private FeatureHost {
   std::uint32_t run_counter_ = 0;
   std::uint64_t runs_finished_ = 0;
   WorkOffsets mdi_offsets_;  ///< the MDI session's interpreter's, after its last line
+  /// A profile edit the tick has not answered yet: what to restore if it refuses.
+  struct ProfileChange {
+    std::uint64_t id = 0, stage_id = 0;
+    config::MachineProfile old_profile;
+    std::string old_text, message, who;
+  };
+  std::optional<ProfileChange> profile_change_;
+  std::uint32_t limits_version_ = 0;       ///< counts applied profile edits
+  std::uint32_t open_limits_version_ = 0;  ///< limits_version_ when the open program was checked
   // Status details that cost strings, refreshed when they change.
   std::uint32_t located_context_ = ~0u, located_line_ = ~0u, located_run_ = ~0u;
   std::uint64_t interpreter_seen_ = ~std::uint64_t{0};

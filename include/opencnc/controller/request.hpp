@@ -9,8 +9,10 @@
 #include <string>
 #include <string_view>
 #include <variant>
+#include <vector>
 
 #include "opencnc/canon/program.hpp"
+#include "opencnc/config/profile_edit.hpp"
 #include "opencnc/control/command.hpp"
 #include "opencnc/core/axes.hpp"
 
@@ -118,13 +120,23 @@ struct Feature {
   std::any args;
 };
 
+/// Changes editable keys of the machine profile (config::editable_parameters: axis limits) while
+/// nothing moves: the file's text edited key by key and loaded again by the profile loader, then
+/// written back (atomically), the planner's limits and the move checks swapped, and the joints'
+/// limits applied by the tick together. `who` names the one asking (for the event log).
+struct EditProfile {
+  std::vector<config::ProfileKeyEdit> edits;
+  std::string who;
+};
+
 }  // namespace requests
 
 using RequestBody =
     std::variant<requests::Servo, requests::SetMode, requests::Jog, requests::JogBy, requests::JogStop,
                  requests::Home, requests::SetOverride, requests::SetSwitch, requests::SpindleOn,
                  requests::SetCoolant, requests::OpenFile, requests::OpenCanon, requests::Mdi,
-                 requests::RunAuxiliary, requests::Feature, requests::SetHandwheel, requests::ResumeProgram>;
+                 requests::RunAuxiliary, requests::Feature, requests::SetHandwheel, requests::ResumeProgram,
+                 requests::EditProfile>;
 
 /// A request with its typed body. Build one with the helpers.
 struct Request {
@@ -159,6 +171,9 @@ struct Request {
   }
   static Request resume(canon::SegmentId segment, std::optional<Pose> program_start = {}) {
     return {requests::ResumeProgram{segment, program_start}};
+  }
+  static Request edit_profile(std::vector<config::ProfileKeyEdit> edits, std::string who = {}) {
+    return {requests::EditProfile{std::move(edits), std::move(who)}};
   }
   static Request feature(std::string feature, std::string action, std::any args = {}) {
     return {requests::Feature{std::move(feature), std::move(action), std::move(args)}};

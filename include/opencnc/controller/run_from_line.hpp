@@ -26,7 +26,9 @@ struct LineStart {
   canon::SegmentId segment = 0;  ///< the interpreter's segment id (what ResumeProgram takes)
   Pose start{};                  ///< where the move starts (machine coordinates)
   bool rapid = false;            ///< the move is a G0
-  double feed_mm_per_min = 0;    ///< its feed (a feed move in units per minute; else 0)
+  /// Its feed in mm/min (0 for a G0): under G93 the move's own (the interpreter's length × F),
+  /// under G95 F × the spindle speed set before it.
+  double feed_mm_per_min = 0;
   SourceLocation where;          ///< its block, with the calls that led there
 };
 

@@ -72,6 +72,10 @@ class Compensation {
   /// to add to the joint command. Servo thread.
   double update(int j, double joint_position, double offset, bool homed) noexcept;
 
+  /// Joint `j`'s backlash and take-up limits changed (an admin's edit while it stands): the
+  /// correction stays where it is and the change of its target is taken up within the new
+  /// limits, as a reversal's is. Servo thread; real-time safe.
+  void set_backlash(int j, double backlash, double max_velocity, double max_acceleration) noexcept;
   /// The correction of the last update(). Servo thread.
   double correction(int j) const noexcept { return state_[index(j)].correction; }
   /// Direction of the last motion: +1, −1, 0 before the first. Servo thread.

@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Machine parameters (the profile's axes and limits, read-only here) and the tool data, which
-// the admin may change (the server checks the range; the table file is written back).
+// The Parameters screen: the machine parameters (parameters.ts: the admin changes them) and the
+// tool data, which the admin may change (the server checks the range; the table file is written back).
 import { registerScreen, type Context } from "../registry";
 import { button, el } from "../ui";
+import { ParametersPanel } from "./parameters";
 
 interface Tool {
   tool: number;
@@ -13,6 +14,7 @@ interface Tool {
 }
 
 let tools: HTMLElement | undefined;
+let parameters: ParametersPanel | undefined;
 
 async function loadTools(ctx: Context) {
   if (!tools) return;
@@ -41,20 +43,22 @@ registerScreen({
   title: "Parameters",
   mount(root, ctx) {
     const m = ctx.machine;
-    const axes = el("tbody");
-    for (const a of m.axes) {
-      axes.append(el("tr", {}, el("td", {}, a.axis), el("td", {}, `${a.min_limit}`), el("td", {}, `${a.max_limit}`), el("td", {}, `${a.max_velocity}`), el("td", {}, a.homing ? "moves" : "immediate")));
-    }
     tools = el("tbody");
+    parameters = new ParametersPanel(ctx);
     root.append(
       el("h2", {}, `Machine: ${m.name}`),
       el("p", {}, m.description),
-      el("table", { class: "grid" }, el("thead", {}, el("tr", {}, ...["axis", "min", "max", "max velocity", "homing"].map((h) => el("th", {}, h)))), axes),
-      el("p", { class: "hint" }, `Servo period ${m.servo_period_s * 1000} ms; spindle up to ${m.spindle_max_rpm} rpm. The profile is edited in its file (opencnc profile checks it).`),
-      el("h2", {}, "Tool data"),
+      el("p", { class: "hint" }, `Servo period ${m.servo_period_s * 1000} ms; spindle up to ${m.spindle_max_rpm} rpm.`),
       el("div", { class: "row" }, "Admin token: ", el("input", { id: "admin-token", type: "password", class: "token" })),
+    );
+    parameters.mount(root);
+    root.append(
+      el("h2", {}, "Tool data"),
       el("table", { class: "grid" }, el("thead", {}, el("tr", {}, ...["tool", "pocket", "diameter", "Z offset", "comment", ""].map((h) => el("th", {}, h)))), tools),
     );
   },
-  shown: (ctx) => void loadTools(ctx),
+  shown: (ctx) => {
+    void parameters?.load();
+    void loadTools(ctx);
+  },
 });

@@ -1,0 +1,61 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Changing a loaded profile's editable keys: which keys, the edit of the file's text (one key at a
+// time, comments kept), and the new profile validated by the profile's own loader.
+#pragma once
+
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "opencnc/config/machine_profile.hpp"
+#include "opencnc/core/diagnostic.hpp"
+
+namespace opencnc::config {
+
+/// One key set to a new value: `key` dotted as the file has it ("axis.x.max_velocity"), `value`
+/// as TOML text ("80.0").
+struct ProfileKeyEdit {
+  std::string key;
+  std::string value;
+};
+
+/// A parameter the admin may change while the machine is idle, with its present value.
+struct EditableParameter {
+  std::string key;   ///< "axis.x.max_velocity"
+  double value = 0;  ///< in the profile's units
+  std::string unit;  ///< "mm/s", "mm/s²", "mm", "deg/s" …
+  std::string what;  ///< one line for the screen
+};
+
+/// The editable parameters of `profile`, axis by axis (per axis: max_velocity, max_acceleration,
+/// min_limit and max_limit unless wrapped, max_following_error; with a compensation table its
+/// backlash and take-up limits). Any thread.
+std::vector<EditableParameter> editable_parameters(const MachineProfile& profile);
+
+/// One key's change, as text for the audit and the answer ("100.0" → "80.0").
+struct ProfileChange {
+  std::string key;
+  std::string old_value, new_value;
+};
+
+/// What edit_profile() made: the new profile and its file's text, or why not.
+struct ProfileEditResult {
+  std::optional<MachineProfile> profile;
+  std::string text;                    ///< the profile file's new text
+  std::vector<ProfileChange> changes;  ///< in the order asked
+  std::string error;                   ///< a refusal of the request itself (a key not editable …)
+  Diagnostics diagnostics;             ///< the loader's on the new text (`file:line:col: message`)
+  bool ok() const noexcept { return profile.has_value(); }
+};
+
+/// The profile `live` (loaded from `live.source` with `live.overrides`) with `edits` applied: the
+/// file is read again and must still be the text `live` was loaded from (its digest); each key
+/// must be one of editable_parameters(live) and not set by an override; its line is edited with
+/// with_toml_value(); the new text is loaded by parse_profile() with the same overrides, so its
+/// errors are the loader's own, at the edited line. Nothing is written. Non-real-time (reads the
+/// file).
+ProfileEditResult edit_profile(const MachineProfile& live, std::span<const ProfileKeyEdit> edits);
+
+}  // namespace opencnc::config

@@ -1,0 +1,27 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Setting one key of a TOML text to a new value, line by line: comments, blank lines, the order of
+// keys and every other value stay as the user wrote them.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <string_view>
+
+namespace opencnc::config {
+
+/// `text` with the key `dotted_key` ("axis.x.max_velocity": the table `[axis.x]`, whose header
+/// is compared in lower case, and the key `max_velocity` in it) set to `value_toml` (a TOML value
+/// on one line: a number, a boolean, a string, an array). The key's line keeps its indentation
+/// and trailing comment; a key the table lacks is added after the table's last key. Refused
+/// (nullopt, `error` says why) when the table has no header line of its own (dotted or inline
+/// tables), the key is written twice or its value spans lines (multi-line strings or arrays),
+/// the value is not TOML, or the result does not read back as `text` with only that value
+/// changed. Non-real-time; any thread.
+std::optional<std::string> with_toml_value(std::string_view text, std::string_view dotted_key,
+                                           std::string_view value_toml, std::string& error);
+
+/// A number as TOML text that reads back as the same double (always a float: "80.0", "1e-05").
+/// Any thread.
+std::string toml_number(double v);
+
+}  // namespace opencnc::config

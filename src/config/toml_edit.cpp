@@ -1,0 +1,220 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// One key of a TOML text set to a new value in place; the result is checked against the parsed
+// original with only that value changed, so nothing else can have moved.
+#include "opencnc/config/toml_edit.hpp"
+
+#include <fmt/format.h>
+#include <toml++/toml.h>
+
+#include <algorithm>
+#include <cctype>
+#include <vector>
+
+#include "toml_lines.hpp"
+
+namespace opencnc::config {
+
+namespace {
+
+using detail::TomlLine;
+
+bool bare_key_char(char c) {
+  return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-';
+}
+
+std::string lower(std::string_view s) {
+  std::string out(s);
+  for (char& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return out;
+}
+
+/// Where a `key = value` line's value starts and ends (bytes in the line), or nullopt when the
+/// line does not assign `key`. `multi_line` is set when the value goes on past this line.
+struct ValueSpan {
+  std::size_t begin = 0, end = 0;
+  bool multi_line = false;
+};
+
+std::optional<ValueSpan> value_span(std::string_view line, std::string_view key) {
+  std::size_t at = 0;
+  while (at < line.size() && (line[at] == ' ' || line[at] == '\t')) ++at;
+  if (line.substr(at, key.size()) != key) return std::nullopt;
+  at += key.size();
+  if (at < line.size() && (bare_key_char(line[at]) || line[at] == '.')) return std::nullopt;
+  while (at < line.size() && (line[at] == ' ' || line[at] == '\t')) ++at;
+  if (at >= line.size() || line[at] != '=') return std::nullopt;
+  ++at;
+  while (at < line.size() && (line[at] == ' ' || line[at] == '\t')) ++at;
+  ValueSpan v{at, at, false};
+  if (line.substr(at, 3) == "\"\"\"" || line.substr(at, 3) == "'''") {
+    v.multi_line = true;
+    return v;
+  }
+  // Scan to a comment outside strings, counting brackets: an array open at the line's end goes on.
+  int depth = 0;
+  char quote = 0;
+  std::size_t i = at;
+  for (; i < line.size(); ++i) {
+    const char c = line[i];
+    if (quote) {
+      if (c == '\\' && quote == '"')
+        ++i;
+      else if (c == quote)
+        quote = 0;
+    } else if (c == '"' || c == '\'') {
+      quote = c;
+    } else if (c == '[' || c == '{') {
+      ++depth;
+    } else if (c == ']' || c == '}') {
+      --depth;
+    } else if (c == '#') {
+      break;
+    }
+  }
+  v.multi_line = depth > 0 || quote != 0;
+  v.end = i;
+  while (v.end > v.begin && (line[v.end - 1] == ' ' || line[v.end - 1] == '\t')) --v.end;
+  return v;
+}
+
+/// The table at `path` (components compared in lower case), or nullptr.
+toml::table* find_table(toml::table& root, const std::vector<std::string>& path) {
+  toml::table* t = &root;
+  for (const std::string& part : path) {
+    toml::table* next = nullptr;
+    for (auto&& [k, v] : *t) {
+      if (lower(k.str()) == part && v.is_table()) next = v.as_table();
+    }
+    if (!next) return nullptr;
+    t = next;
+  }
+  return t;
+}
+
+std::vector<std::string> split_key(std::string_view dotted) {
+  std::vector<std::string> parts;
+  std::size_t at = 0;
+  while (true) {
+    const std::size_t dot = dotted.find('.', at);
+    parts.emplace_back(dotted.substr(at, dot == std::string_view::npos ? std::string_view::npos : dot - at));
+    if (dot == std::string_view::npos) break;
+    at = dot + 1;
+  }
+  return parts;
+}
+
+/// The text with the value replaced or the key added; "" in `error` when done.
+std::string edit_lines(std::string_view text, const std::string& table, std::string_view key,
+                       std::string_view value, std::string& error) {
+  const std::vector<TomlLine> lines = detail::split_lines(text);
+  std::size_t header = lines.size(), found = lines.size(), hits = 0;
+  ValueSpan span;
+  bool inside = false;
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    if (detail::is_array_header(lines[i].text)) {
+      inside = false;
+      continue;
+    }
+    if (const std::string h = detail::header_key(lines[i].text); !h.empty()) {
+      inside = h == table;
+      if (inside) header = i;
+      continue;
+    }
+    if (!inside) continue;
+    if (const auto s = value_span(lines[i].text, key)) {
+      found = i;
+      span = *s;
+      ++hits;
+    }
+  }
+  if (header == lines.size()) {
+    error = fmt::format("the profile has no [{}] table of its own to edit {} in", table, key);
+    return {};
+  }
+  if (hits > 1) {
+    error = fmt::format("{} is written more than once in [{}]", key, table);
+    return {};
+  }
+  std::string out;
+  if (found < lines.size()) {
+    if (span.multi_line) {
+      error = fmt::format("{}.{} spans more than one line in the profile: edit it by hand", table, key);
+      return {};
+    }
+    out.append(text.substr(0, lines[found].begin + span.begin));
+    out.append(value);
+    out.append(text.substr(lines[found].begin + span.end));
+    return out;
+  }
+  const std::size_t end = detail::table_end(lines, header);
+  const std::size_t at = end < lines.size() ? lines[end].begin : text.size();
+  out.append(text.substr(0, at));
+  if (!out.empty() && out.back() != '\n') out += '\n';
+  out += fmt::format("{} = {}\n", key, value);
+  out.append(text.substr(at));
+  return out;
+}
+
+}  // namespace
+
+std::string toml_number(double v) {
+  std::string s = fmt::format("{}", v == 0 ? 0.0 : v);
+  if (s.find_first_of(".eEn") == std::string::npos) s += ".0";  // "n": inf, nan
+  return s;
+}
+
+std::optional<std::string> with_toml_value(std::string_view text, std::string_view dotted_key,
+                                           std::string_view value_toml, std::string& error) {
+  std::vector<std::string> path = split_key(lower(dotted_key));
+  for (const std::string& part : path) {
+    if (part.empty() || !std::all_of(part.begin(), part.end(), bare_key_char)) {
+      error = fmt::format("\"{}\" is not a dotted key of bare words", dotted_key);
+      return std::nullopt;
+    }
+  }
+  if (path.size() < 2) {
+    error = fmt::format("\"{}\" is not a key inside a table", dotted_key);
+    return std::nullopt;
+  }
+  const std::string key = path.back();
+  path.pop_back();
+  std::string table = path.front();
+  for (std::size_t i = 1; i < path.size(); ++i) table += "." + path[i];
+  toml::table value_doc;
+  try {
+    value_doc = toml::parse(fmt::format("v = {}", value_toml));
+  } catch (const toml::parse_error& e) {
+    error = fmt::format("\"{}\" is not a TOML value: {}", value_toml, e.description());
+    return std::nullopt;
+  }
+  if (value_doc.size() != 1 || value_toml.find('\n') != std::string_view::npos) {
+    error = fmt::format("\"{}\" is not one TOML value on one line", value_toml);
+    return std::nullopt;
+  }
+  std::string out = edit_lines(text, table, key, value_toml, error);
+  if (!error.empty()) return std::nullopt;
+  // The edit must read back as the original with this one value set, and nothing else changed.
+  try {
+    toml::table expected = toml::parse(text);
+    const toml::table after = toml::parse(out);
+    toml::table* t = find_table(expected, path);
+    if (!t) {
+      error = fmt::format("[{}] is not a table in the profile", table);
+      return std::nullopt;
+    }
+    value_doc.get("v")->visit([&](auto& node) { t->insert_or_assign(key, node); });
+    if (!(expected == after)) {
+      error = fmt::format(
+          "{}.{} is also set elsewhere in the profile (a dotted key or an inline table): edit it by hand",
+          table, key);
+      return std::nullopt;
+    }
+  } catch (const toml::parse_error& e) {
+    error =
+        fmt::format("the profile would not read back after setting {}.{}: {}", table, key, e.description());
+    return std::nullopt;
+  }
+  return out;
+}
+
+}  // namespace opencnc::config

@@ -1,0 +1,81 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Servo: joint limits changed by an admin while nothing moves — staged joint by joint, applied
+// together by one command, so that the tick takes all of them or none.
+#include <cmath>
+
+#include "opencnc/control/servo.hpp"
+
+namespace opencnc::control {
+
+namespace {
+
+bool valid(const JointLimits& l, bool wrapped) noexcept {
+  const bool finite = std::isfinite(l.max_velocity) && std::isfinite(l.max_acceleration) &&
+                      std::isfinite(l.min_limit) && std::isfinite(l.max_limit) &&
+                      std::isfinite(l.max_following_error) && std::isfinite(l.home_final_velocity) &&
+                      std::isfinite(l.backlash) && std::isfinite(l.takeup_velocity) &&
+                      std::isfinite(l.takeup_acceleration);
+  return finite && l.max_velocity > 0 && l.max_acceleration > 0 && l.max_following_error > 0 &&
+         l.home_final_velocity > 0 && (wrapped || l.min_limit < l.max_limit) && l.backlash >= 0 &&
+         l.takeup_velocity >= 0 && l.takeup_acceleration >= 0;
+}
+
+}  // namespace
+
+Refusal Servo::stage_joint_limits(const Command& c) noexcept {
+  const int j = c.axis;
+  if (j < 0 || j >= config_.joint_count ||
+      !valid(c.limits, config_.joints[static_cast<std::size_t>(j)].wrapped)) {
+    staged_invalid_ = true;
+    return Refusal::BadValue;
+  }
+  staged_limits_[static_cast<std::size_t>(j)] = c.limits;
+  staged_joints_ = static_cast<std::uint16_t>(staged_joints_ | (1u << j));
+  return Refusal::None;
+}
+
+// Nothing may move: a jog, homing or a program (running, held or stopped) planned with the old
+// limits would finish under the new ones. A homed joint must stand within its new soft limits,
+// or the soft-limit check would fault it at once.
+Refusal Servo::apply_joint_limits() noexcept {
+  const std::uint16_t staged = staged_joints_;
+  const bool invalid = staged_invalid_;
+  staged_joints_ = 0;
+  staged_invalid_ = false;
+  if (invalid) return Refusal::BadValue;
+  if (staged == 0) return Refusal::NotApplicable;
+  if (activity_ != Activity::None || state_ == State::Running || state_ == State::Held ||
+      state_ == State::Stopped)
+    return Refusal::Busy;
+  for (int j = 0; j < config_.joint_count; ++j) {
+    const auto uj = static_cast<std::size_t>(j);
+    const JointConfig& jc = config_.joints[uj];
+    if (!(staged & (1u << j)) || !homed_[uj] || jc.wrapped || manual(j)) continue;
+    const double x = commanded_[jc.axis];
+    if (x < staged_limits_[uj].min_limit || x > staged_limits_[uj].max_limit) return Refusal::SoftLimit;
+  }
+  for (int j = 0; j < config_.joint_count; ++j) {
+    if (!(staged & (1u << j))) continue;
+    const auto uj = static_cast<std::size_t>(j);
+    JointConfig& jc = config_.joints[uj];
+    const JointLimits& l = staged_limits_[uj];
+    jc.max_velocity = l.max_velocity;
+    jc.max_acceleration = l.max_acceleration;
+    jc.min_limit = l.min_limit;
+    jc.max_limit = l.max_limit;
+    jc.max_following_error = l.max_following_error;
+    jc.home.final_velocity = l.home_final_velocity;
+    movers_[uj].configure(config_.period_s, jc.max_acceleration, jc.max_jerk, movers_[uj].position());
+    if (uj < config_.compensation.joints.size() && config_.compensation.joints[uj].enabled) {
+      motion::JointCompensation& c = config_.compensation.joints[uj];
+      c.backlash = l.backlash;
+      c.max_velocity = l.takeup_velocity;
+      c.max_acceleration = l.takeup_acceleration;
+      comp_.set_backlash(j, l.backlash, l.takeup_velocity, l.takeup_acceleration);
+    }
+  }
+  configure_gap_servo();  // the jump accelerates within the tool axis' limit
+  return Refusal::None;
+}
+
+}  // namespace opencnc::control

@@ -1,0 +1,146 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Controller: the machine profile's editable keys changed while nothing moves — the file edited
+// and loaded again, written back, the planner's limits and move checks swapped, the joints'
+// limits staged in the tick and applied by one command (all of them or none).
+#include <fmt/format.h>
+
+#include "opencnc/controller/controller.hpp"
+#include "opencnc/controller/preflight.hpp"
+#include "opencnc/controller/servo_setup.hpp"
+#include "opencnc/core/atomic_file.hpp"
+
+namespace opencnc::control {
+
+namespace {
+
+std::string change_text(const std::vector<config::ProfileChange>& changes) {
+  std::string s;
+  for (const config::ProfileChange& c : changes)
+    s += fmt::format("{}{} {} → {}", s.empty() ? "" : "; ", c.key, c.old_value, c.new_value);
+  return s;
+}
+
+JointLimits joint_limits(const ServoConfig& s, int joint) {
+  const JointConfig& j = s.joints[static_cast<std::size_t>(joint)];
+  JointLimits l{j.max_velocity, j.max_acceleration,    j.min_limit,
+                j.max_limit,    j.max_following_error, j.home.final_velocity};
+  if (static_cast<std::size_t>(joint) < s.compensation.joints.size()) {
+    const motion::JointCompensation& c = s.compensation.joints[static_cast<std::size_t>(joint)];
+    l.backlash = c.backlash;
+    l.takeup_velocity = c.max_velocity;
+    l.takeup_acceleration = c.max_acceleration;
+  }
+  return l;
+}
+
+/// The homed joint of `next` whose axis stands outside its new soft limits, as a message; "".
+std::string outside_new_limits(const ServoConfig& next, const ServoStatus& s) {
+  for (int j = 0; j < next.joint_count; ++j) {
+    const JointConfig& jc = next.joints[static_cast<std::size_t>(j)];
+    if (!s.joints[static_cast<std::size_t>(j)].homed || jc.wrapped || jc.drive == machine::JointDrive::Manual)
+      continue;
+    const double x = s.commanded[jc.axis];
+    if (x < jc.min_limit || x > jc.max_limit)
+      return fmt::format(
+          "{} stands at {:.4f}, outside the new soft limits {:.4f} … {:.4f}: move it inside first",
+          kAxisLetters[static_cast<std::size_t>(jc.axis)], x, jc.min_limit, jc.max_limit);
+  }
+  return {};
+}
+
+}  // namespace
+
+config::MachineProfile Controller::current_profile() const {
+  std::lock_guard lock(out_mutex_);
+  return shown_profile_;
+}
+
+void Controller::swap_profile(config::MachineProfile profile) {
+  profile_ = std::move(profile);
+  servo_config_ = control::servo_config(profile_);
+  limits_ = machine_limits(profile_);
+  check_ = std::make_unique<MachineMoveCheck>(servo_config_, limits_);
+  ++limits_version_;  // the open program is checked again before it starts
+  std::lock_guard lock(out_mutex_);
+  shown_profile_ = profile_;
+}
+
+// The request's checks, then the file (written first: if that fails nothing has changed), then
+// the controller's side at once (so a request after this one plans with the new limits), then
+// the tick's side; settle_profile_change() keeps it or puts everything back.
+void Controller::edit_profile(std::uint64_t id, const requests::EditProfile& r) {
+  const ServoStatus& s = servo();
+  if (profile_change_) return finish(id, Refusal::Busy, "another change of the profile is being applied");
+  if (job_ || s.activity != Activity::None || s.state == State::Running || s.state == State::Held ||
+      s.state == State::Stopped)
+    return finish(id, Refusal::Busy,
+                  "machine parameters change only while nothing runs (no program, MDI line, jog or homing)");
+  config::ProfileEditResult edit = config::edit_profile(profile_, r.edits);
+  if (!edit.error.empty()) return finish(id, Refusal::BadValue, edit.error);
+  if (!edit.ok()) {
+    const Diagnostic* first = nullptr;
+    for (const Diagnostic& d : edit.diagnostics.items())
+      if (d.severity == Severity::Error && !first) first = &d;
+    return finish(
+        id, Refusal::BadValue,
+        first ? "the profile refuses the change: " + first->format() : "the profile refuses the change",
+        std::move(edit.diagnostics));
+  }
+  const ServoConfig next = control::servo_config(*edit.profile);
+  if (const std::string why = outside_new_limits(next, s); !why.empty())
+    return finish(id, Refusal::SoftLimit, why);
+  std::string old_text, error;
+  if (!read_file(profile_.source, old_text, &error) ||
+      !write_file_atomically(profile_.source, edit.text, &error))
+    return finish(id, Refusal::BadValue,
+                  fmt::format("{}: cannot write the profile: {}", profile_.source, error));
+  ProfileChange pending{id, new_id(), profile_, std::move(old_text), change_text(edit.changes), r.who};
+  swap_profile(std::move(*edit.profile));
+  bool queued = true;
+  for (int j = 0; j < next.joint_count && queued; ++j) {
+    Command c;
+    c.id = pending.stage_id;
+    c.kind = CommandKind::StageJointLimits;
+    c.axis = static_cast<std::int8_t>(j);
+    c.limits = joint_limits(next, j);
+    queued = channels_->commands.try_push(c);
+  }
+  Command apply;
+  apply.id = id;
+  apply.kind = CommandKind::ApplyJointLimits;
+  profile_change_ = std::move(pending);
+  if (!queued || !channels_->commands.try_push(apply)) {
+    ServoEvent refused;
+    refused.kind = EventKind::Refused;
+    refused.command_id = id;
+    refused.refusal = Refusal::Busy;
+    settle_profile_change(refused);  // the stages already queued are dropped by the next apply
+  }
+}
+
+bool Controller::settle_profile_change(const ServoEvent& e) {
+  if (!profile_change_) return false;
+  if (e.command_id == profile_change_->stage_id) return true;  // the apply answers for all
+  if (e.command_id != profile_change_->id) return false;
+  ProfileChange change = std::move(*profile_change_);
+  profile_change_.reset();
+  if (e.kind == EventKind::Accepted) {
+    note(Severity::Note, "control.profile",
+         fmt::format("{}machine parameters changed: {} ({})", change.who.empty() ? "" : change.who + ": ",
+                     change.message, profile_.source));
+    finish(change.id, Refusal::None, change.message);
+    return true;
+  }
+  // The tick said no (something started moving meanwhile): the file and the limits as they were.
+  std::string error;
+  const bool restored = write_file_atomically(profile_.source, change.old_text, &error);
+  swap_profile(std::move(change.old_profile));
+  finish(change.id, e.refusal == Refusal::None ? Refusal::Busy : e.refusal,
+         restored
+             ? fmt::format("the machine would not take the new limits now: nothing changed")
+             : fmt::format("the machine would not take the new limits now, and {} could not be restored: {}",
+                           profile_.source, error));
+  return true;
+}
+
+}  // namespace opencnc::control

@@ -1,0 +1,170 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Editing one key of a profile's text (comments, layout and other values kept; what cannot be
+// edited safely refused) and a whole profile edit validated by the profile's own loader.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "opencnc/config/profile_edit.hpp"
+#include "opencnc/config/profile_loader.hpp"
+#include "opencnc/config/toml_edit.hpp"
+
+namespace opencnc::config {
+namespace {
+
+const char* kText =
+    "# a machine\n"
+    "name = \"m\"\n"
+    "\n"
+    "[axis.X]   # the table\n"
+    "  max_velocity = 100.0   # mm/s, the drive's limit\n"
+    "max_acceleration=1000.0\n"
+    "tags = [1, 2]  # an array\n"
+    "\n"
+    "# Y follows\n"
+    "[axis.y]\n"
+    "max_velocity = 50.0\n";
+
+std::string set(std::string_view text, std::string_view key, std::string_view value,
+                std::string* why = nullptr) {
+  std::string error;
+  const auto out = with_toml_value(text, key, value, error);
+  if (why) *why = error;
+  return out ? *out : "";
+}
+
+TEST(TomlEdit, OneValueChangesAndEveryCommentAndBlankStays) {
+  std::string expected = kText;
+  expected.replace(expected.find("100.0"), 5, "80.5");
+  EXPECT_EQ(set(kText, "axis.x.max_velocity", "80.5"), expected);
+  expected = kText;
+  expected.replace(expected.find("=1000.0") + 1, 6, "250.0");
+  EXPECT_EQ(set(kText, "axis.X.max_acceleration", "250.0"), expected);
+  expected = kText;
+  expected.replace(expected.find("[1, 2]"), 6, "[3]");
+  EXPECT_EQ(set(kText, "axis.x.tags", "[3]"), expected);
+}
+
+TEST(TomlEdit, AKeyTheTableLacksIsAddedAfterItsLastKey) {
+  const std::string out = set(kText, "axis.x.max_jerk", "5000.0");
+  EXPECT_NE(out.find("tags = [1, 2]  # an array\nmax_jerk = 5000.0\n\n# Y follows\n"), std::string::npos)
+      << out;
+  EXPECT_NE(set(kText, "axis.y.min_limit", "-1.0").find("max_velocity = 50.0\nmin_limit = -1.0\n"),
+            std::string::npos);
+}
+
+TEST(TomlEdit, RefusesWhatItCannotEditSafely) {
+  std::string why;
+  EXPECT_EQ(set(kText, "axis.z.max_velocity", "1.0", &why), "");
+  EXPECT_NE(why.find("no [axis.z] table of its own"), std::string::npos) << why;
+  EXPECT_EQ(set("[a]\nv = [1,\n 2]\n", "a.v", "[3]", &why), "");
+  EXPECT_NE(why.find("spans more than one line"), std::string::npos) << why;
+  EXPECT_EQ(set("[a]\ns = \"\"\"x\ny\"\"\"\n", "a.s", "\"z\"", &why), "");
+  EXPECT_NE(why.find("spans more than one line"), std::string::npos) << why;
+  EXPECT_EQ(set("[a]\nb.c = 1\n[a.b]\n", "a.b.c", "2", &why), "");  // a dotted key elsewhere
+  EXPECT_FALSE(why.empty());
+  EXPECT_EQ(set("[a]\nb = { c = 1 }\n", "a.b.c", "2", &why), "");  // an inline table
+  EXPECT_NE(why.find("no [a.b] table"), std::string::npos) << why;
+  EXPECT_EQ(set(kText, "axis.x.max_velocity", "fast", &why), "");
+  EXPECT_NE(why.find("not a TOML value"), std::string::npos) << why;
+  EXPECT_EQ(set(kText, "axis.x.max_velocity", "1.0 # x\nname = 2", &why), "");
+  EXPECT_EQ(set(kText, "max_velocity", "1.0", &why), "");
+  EXPECT_NE(why.find("not a key inside a table"), std::string::npos) << why;
+  EXPECT_EQ(set(kText, "axis.x.\"v\"", "1.0", &why), "");
+  EXPECT_EQ(set("[a]\nv = 1\n[b]\n[a.c]\n", "a.v", "2"), "[a]\nv = 2\n[b]\n[a.c]\n");
+}
+
+TEST(TomlEdit, NumbersReadBackAsTheSameDouble) {
+  EXPECT_EQ(toml_number(80), "80.0");
+  EXPECT_EQ(toml_number(-0.0), "0.0");
+  EXPECT_EQ(toml_number(1e-5), "1e-05");
+  EXPECT_EQ(toml_number(0.1), "0.1");
+}
+
+class ProfileEditFile : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() / ("opencnc-profile-edit-" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir_);
+    path_ = (dir_ / "mill.toml").string();
+    std::ifstream in(OPENCNC_SOURCE_DIR "/configs/mill-3axis.toml");
+    std::stringstream s;
+    s << in.rdbuf();
+    original_ = s.str();
+    std::ofstream(path_) << original_;
+    ProfileLoad load = load_profile(path_);
+    ASSERT_TRUE(load.ok());
+    live_ = *load.profile;
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+  std::filesystem::path dir_;
+  std::string path_, original_;
+  MachineProfile live_;
+};
+
+TEST_F(ProfileEditFile, AGoodValueGivesTheNewProfileAndTextWithOnlyThatLineChanged) {
+  const ProfileKeyEdit edits[] = {{"axis.x.max_velocity", "80.0"}, {"axis.y.max_limit", "500.0"}};
+  const ProfileEditResult r = edit_profile(live_, edits);
+  ASSERT_TRUE(r.ok()) << r.error;
+  EXPECT_EQ(r.profile->axes[0].max_velocity, 80.0);
+  EXPECT_EQ(r.profile->axes[1].max_limit, 500.0);
+  EXPECT_EQ(r.profile->source, path_);
+  ASSERT_EQ(r.changes.size(), 2u);
+  EXPECT_EQ(r.changes[0].key, "axis.x.max_velocity");
+  EXPECT_EQ(r.changes[0].old_value, "100.0");
+  EXPECT_EQ(r.changes[0].new_value, "80.0");
+  std::string expected = original_;
+  expected.replace(expected.find("max_velocity = 100.0"), 20, "max_velocity = 80.0");
+  const std::size_t y = expected.find("[axis.y]");
+  expected.replace(expected.find("max_limit = 2000.0", y), 18, "max_limit = 500.0");
+  EXPECT_EQ(r.text, expected);
+  EXPECT_EQ(r.profile->source_digest, text_digest(expected));
+}
+
+TEST_F(ProfileEditFile, ABadValueGetsTheLoadersMessageAtTheEditedLine) {
+  const ProfileKeyEdit edits[] = {{"axis.x.max_velocity", "-5.0"}};
+  const ProfileEditResult r = edit_profile(live_, edits);
+  ASSERT_FALSE(r.ok());
+  EXPECT_TRUE(r.error.empty());
+  ASSERT_FALSE(r.diagnostics.items().empty());
+  const Diagnostic& d = r.diagnostics.items().front();
+  EXPECT_EQ(d.file, path_);
+  const std::size_t at = original_.find("max_velocity = 100.0");
+  EXPECT_EQ(d.line, 1 + std::count(original_.begin(), original_.begin() + static_cast<long>(at), '\n'));
+  EXPECT_NE(d.format().find(path_ + ":" + std::to_string(d.line) + ":"), std::string::npos) << d.format();
+  const ProfileKeyEdit inverted[] = {{"axis.z.min_limit", "3000.0"}};
+  EXPECT_FALSE(edit_profile(live_, inverted).ok());
+}
+
+TEST_F(ProfileEditFile, KeysThatAreNotEditableOrOverriddenAndAChangedFileAreRefused) {
+  const ProfileKeyEdit homing[] = {{"axis.x.homing.position", "1.0"}};
+  EXPECT_NE(edit_profile(live_, homing).error.find("not a parameter that can be changed here"),
+            std::string::npos);
+  const ProfileKeyEdit period[] = {{"servo_period_s", "0.002"}};
+  EXPECT_FALSE(edit_profile(live_, period).error.empty());
+  ProfileLoad over = load_profile(path_, std::vector<std::string>{"axis.X.max_velocity=50"});
+  ASSERT_TRUE(over.ok());
+  const ProfileKeyEdit v[] = {{"axis.x.max_velocity", "80.0"}};
+  EXPECT_NE(edit_profile(*over.profile, v).error.find("override"), std::string::npos);
+  std::ofstream(path_, std::ios::app) << "# touched\n";
+  EXPECT_NE(edit_profile(live_, v).error.find("changed on disk"), std::string::npos);
+}
+
+TEST(ProfileEdit, TheEditableParametersAreEachAxisLimits) {
+  ProfileLoad load = load_profile(OPENCNC_SOURCE_DIR "/configs/mill-3axis.toml");
+  ASSERT_TRUE(load.ok());
+  const auto params = editable_parameters(*load.profile);
+  ASSERT_EQ(params.size(), 15u);
+  EXPECT_EQ(params[0].key, "axis.x.max_velocity");
+  EXPECT_EQ(params[0].value, 100.0);
+  EXPECT_EQ(params[0].unit, "mm/s");
+  EXPECT_EQ(params[14].key, "axis.z.max_following_error");
+}
+
+}  // namespace
+}  // namespace opencnc::config

@@ -1,0 +1,154 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The admin's machine parameters through the HMI server on loopback: read by anyone with a
+// token, changed by the admin only (403 for the operator), a bad value answered with the profile's
+// own message and nothing changed, a good one in the file and the live limits, audited.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+
+#include "../control/test_profiles.hpp"
+#include "client.hpp"
+#include "opencnc/controller/gcode_source.hpp"
+#include "opencnc/core/atomic_file.hpp"
+#include "opencnc/hmi/api.hpp"
+#include "opencnc/hmi/history.hpp"
+#include "opencnc/hmi/machine_host.hpp"
+#include "opencnc/hmi/server.hpp"
+
+namespace opencnc::hmi {
+namespace {
+
+using namespace test;
+using nlohmann::json;
+
+const std::string kOperator = "operator-token-for-tests-0001";
+const std::string kAdmin = "admin-token-for-tests-000000002";
+
+/// The simulated mill (its profile a copy in a folder of its own) at 200× in virtual time.
+struct AdminRig {
+  AdminRig() {
+    dir = std::filesystem::temp_directory_path() / ("opencnc-admin-" + std::to_string(::getpid()));
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    path = (dir / "mill.toml").string();
+    EXPECT_TRUE(read_file(OPENCNC_SOURCE_DIR "/configs/mill-3axis.toml", original, nullptr));
+    EXPECT_TRUE(write_file_atomically(path, original, nullptr));
+    profile = control::test::loaded(config::load_profile(path));
+    Diagnostics d;
+    source = control::GcodeProgramSource::create(profile, d);
+    std::string error;
+    history = History::open(dir / "history.sqlite", &error);
+    host = std::make_unique<MachineHost>(profile, source, HostOptions{false, 200});
+    host->start(nullptr);
+    ServerConfig sc;
+    sc.port = 0;
+    sc.programs_dir = OPENCNC_SOURCE_DIR "/examples";
+    server = std::make_unique<Server>(host->controller(), profile, Tokens::of(kOperator, kAdmin),
+                                      history.get(), source.get(), sc);
+    EXPECT_TRUE(server->start(&error)) << error;
+    port = server->port();
+  }
+  ~AdminRig() {
+    server->stop();
+    host->stop();
+    std::filesystem::remove_all(dir);
+  }
+  std::string file() const {
+    std::string s;
+    read_file(path, s, nullptr);
+    return s;
+  }
+  double parameter(const std::string& key) {
+    const Reply r = get(port, "/api/v1/parameters", kOperator);
+    for (const json& p : r.body["parameters"])
+      if (p["key"] == key) return p["value"].get<double>();
+    return -1;
+  }
+
+  std::filesystem::path dir;
+  std::string path, original;
+  config::MachineProfile profile;
+  std::shared_ptr<control::GcodeProgramSource> source;
+  std::unique_ptr<History> history;
+  std::unique_ptr<MachineHost> host;
+  std::unique_ptr<Server> server;
+  std::uint16_t port = 0;
+};
+
+TEST(AdminParameters, TheOperatorReadsThemOnlyTheAdminChangesThem) {
+  AdminRig rig;
+  const Reply list = get(rig.port, "/api/v1/parameters", kOperator);
+  ASSERT_EQ(list.status, 200);
+  EXPECT_EQ(list.body["profile"], rig.path);
+  EXPECT_EQ(list.body["parameters"].size(), 15u);
+  EXPECT_EQ(list.body["parameters"][0], (json{{"key", "axis.x.max_velocity"},
+                                              {"value", 100.0},
+                                              {"unit", "mm/s"},
+                                              {"what", "fastest speed of the axis"}}));
+  const std::string change = R"({"kind":"set-parameters","values":{"axis.x.max_velocity":40}})";
+  EXPECT_EQ(post(rig.port, change, kOperator).status, 403);
+  EXPECT_EQ(rig.file(), rig.original);
+  const Reply ok = post(rig.port, change, kAdmin);
+  ASSERT_EQ(ok.status, 200) << ok.text;
+  EXPECT_EQ(ok.body["message"], "axis.x.max_velocity 100.0 → 40.0");
+  std::string expected = rig.original;
+  expected.replace(expected.find("max_velocity = 100.0"), 20, "max_velocity = 40.0");
+  EXPECT_EQ(rig.file(), expected);
+  EXPECT_EQ(rig.parameter("axis.x.max_velocity"), 40.0);
+  EXPECT_EQ(get(rig.port, "/api/v1/machine", kOperator).body["axes"][0]["max_velocity"], 40.0);
+  // The API's own checks use the new limit at once: a jog above it is a 422.
+  EXPECT_EQ(post(rig.port, R"({"kind":"jog","axis":"X","velocity":50})", kOperator).status, 422);
+  rig.history->flush();
+  const json audit = get(rig.port, "/api/v1/audit", kAdmin).body;
+  ASSERT_GE(audit.size(), 2u);
+  const json& done = audit[audit.size() - 2];  // newest first: the jog, the change, the refusal
+  EXPECT_EQ(done["role"], "admin");
+  EXPECT_EQ(done["status"], 200);
+  EXPECT_EQ(done["result"], "accepted: axis.x.max_velocity 100.0 → 40.0");
+  EXPECT_EQ(audit.back()["status"], 403);
+}
+
+TEST(AdminParameters, ABadValueGetsTheProfilesMessageAndNothingChanges) {
+  AdminRig rig;
+  const Reply bad =
+      post(rig.port, R"({"kind":"set-parameters","values":{"axis.z.max_acceleration":-3}})", kAdmin);
+  ASSERT_EQ(bad.status, 409) << bad.text;
+  EXPECT_EQ(bad.body["code"], "control.bad-value");
+  ASSERT_FALSE(bad.body["diagnostics"].empty());
+  const std::string text = bad.body["diagnostics"][0]["text"];
+  EXPECT_EQ(text.rfind(rig.path + ":", 0), 0u) << text;  // file:line:col: error: message
+  EXPECT_NE(text.find("max_acceleration"), std::string::npos) << text;
+  EXPECT_EQ(
+      bad.body["message"].get<std::string>().rfind("the profile refuses the change: " + rig.path + ":", 0),
+      0u);
+  EXPECT_EQ(
+      post(rig.port, R"({"kind":"set-parameters","values":{"axis.x.homing.position":1}})", kAdmin).status,
+      422);
+  EXPECT_EQ(
+      post(rig.port, R"({"kind":"set-parameters","values":{"axis.x.max_velocity":"fast"}})", kAdmin).status,
+      400);
+  EXPECT_EQ(post(rig.port, R"({"kind":"set-parameters","values":{}})", kAdmin).status, 400);
+  EXPECT_EQ(post(rig.port, R"({"kind":"set-parameters"})", kAdmin).status, 400);
+  EXPECT_EQ(rig.file(), rig.original);
+  EXPECT_EQ(rig.parameter("axis.z.max_acceleration"), 1000.0);
+}
+
+TEST(ApiAdmin, SetParametersIsTheAdminsAndBecomesAnEditProfileRequest) {
+  EXPECT_EQ(role_for("set-parameters"), Role::Admin);
+  const config::MachineProfile p = control::test::mill();
+  const auto parsed =
+      parse_command(json::parse(R"({"kind":"set-parameters","values":{"axis.y.max_limit":500.5}})"), p,
+                    OPENCNC_SOURCE_DIR "/examples");
+  const auto* c = std::get_if<Command>(&parsed);
+  ASSERT_NE(c, nullptr);
+  const auto& r = std::get<control::Request>(*c);
+  const auto& e = std::get<control::requests::EditProfile>(r.body);
+  ASSERT_EQ(e.edits.size(), 1u);
+  EXPECT_EQ(e.edits[0].key, "axis.y.max_limit");
+  EXPECT_EQ(e.edits[0].value, "500.5");
+  EXPECT_EQ(r.name(), "edit-profile");
+}
+
+}  // namespace
+}  // namespace opencnc::hmi
