@@ -221,6 +221,17 @@ Command parse(const json& body, const config::MachineProfile& p, const std::file
     if (line != std::floor(line) || line < 1 || line > 1e9) throw Bad{422, "\"line\" must be a line number from 1"};
     return Request::feature("run-from-line", "start", control::RunFromLineArgs{static_cast<std::uint32_t>(line)});
   }
+  if (kind == "simulate") {
+    std::string event = text(body, "event");
+    if (event != "mains-off" && event != "mains-on")
+      throw Bad{400, fmt::format("\"event\" must be mains-off or mains-on, not \"{}\"", event)};
+    return SimulationEvent{std::move(event)};
+  }
+  if (kind == "feature") {
+    auto r = parse_feature_command(body, p);
+    if (auto* e = std::get_if<ApiError>(&r)) throw Bad{e->status, e->message};
+    return std::get<Request>(std::move(r));
+  }
   throw Bad{400, fmt::format("unknown command kind \"{}\" (docs/api.md lists them)", kind)};
 }
 
@@ -268,8 +279,8 @@ std::optional<Role> role_for(std::string_view kind) {
   static const char* const operator_kinds[] = {"mode",    "jog",       "jog-by", "jog-stop",
                                                "home",    "override",  "switch", "spindle-on",
                                                "coolant", "handwheel", "open",   "mdi",
-                                               "run-from-line"};
-  if (kind == "set-tool") return Role::Admin;
+                                               "run-from-line", "feature"};
+  if (kind == "set-tool" || kind == "simulate") return Role::Admin;
   if (servo_kinds().find(kind) != servo_kinds().end()) return Role::Operator;
   for (const char* k : operator_kinds) {
     if (kind == k) return Role::Operator;
@@ -295,7 +306,7 @@ json status_json(const control::ControllerStatus& s, const config::MachineProfil
     homed[std::string(1, letter(a.axis))] = j.homed;
   }
   const int n = static_cast<int>(profile.axes.size());
-  return {
+  json j = {
       {"tick", v.tick},
       {"time_s", v.time_s},
       {"state", control::to_string(v.state)},
@@ -348,6 +359,8 @@ json status_json(const control::ControllerStatus& s, const config::MachineProfil
       {"sync_wait", control::to_string(s.sync_wait)},
       {"runs_finished", s.runs_finished},
   };
+  j.update(process_json(v, profile));
+  return j;
 }
 
 json event_json(const control::ControllerEvent& e) {

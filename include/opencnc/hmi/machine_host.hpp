@@ -7,7 +7,9 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <string>
+#include <string_view>
 #include <thread>
 #include <vector>
 
@@ -55,6 +57,10 @@ class MachineHost {
   std::uint64_t ticks() const noexcept;
   std::uint64_t overruns() const noexcept;
   const control::LatencyHistogram* latency() const noexcept;
+  /// A control of the simulated machine: "mains-off" (the mains fail: the power-fail stop) or
+  /// "mains-on". Applied by the thread that steps the machine before its next period; "" or why
+  /// not (in real time the servo thread alone touches the machine: virtual time only). Any thread.
+  std::string simulate(std::string_view event);
 
  private:
   void run_paced();
@@ -71,6 +77,8 @@ class MachineHost {
   // Paced virtual time.
   std::unique_ptr<control::SimRig> rig_;
   std::atomic<std::uint64_t> paced_ticks_{0};
+  std::mutex simulate_mutex_;
+  std::vector<std::string> simulate_;  ///< events for the paced thread to apply
 
   std::atomic<bool> stop_{false};
   std::thread thread_;  ///< the controller's loop (real time) or the paced rig

@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -21,6 +22,7 @@ class GcodeProgramSource;
 namespace opencnc::hmi {
 
 class History;
+class MachineFeatures;
 
 struct ServerConfig {
   std::string address = "127.0.0.1";   ///< where to listen (IPv4 or IPv6 literal)
@@ -32,6 +34,11 @@ struct ServerConfig {
   std::size_t max_queued = 64;
   double command_timeout_s = 10;  ///< how long POST /commands waits for the answer (then 202)
   int io_threads = 1;
+  /// The machine's features: their state goes into the status as `features` (null: none).
+  const MachineFeatures* features = nullptr;
+  /// The simulated machine's controls (`{"kind": "simulate", …}`, admin): applies `event`
+  /// ("mains-off", "mains-on") and returns "" or why it cannot. Empty: none (a 409).
+  std::function<std::string(std::string_view event)> simulate;
 };
 
 /// Counters of the server. Any thread.
