@@ -46,12 +46,33 @@ class MachineFeatures::Board final : public control::ControllerObserver {
   explicit Board(MachineFeatures& owner) : owner_(owner) {}
   void on_status(const control::ControllerStatus& s) override {
     json j = owner_.snapshot(s);
+    if (owner_.profile_.edm.present) j["edm"] = edm_depth(s.servo);
     std::lock_guard lock(owner_.mutex_);
     owner_.state_ = std::move(j);
   }
 
  private:
+  /// The depth burnt as the EDM report counts it (docs/edm.md, `depth_mm`): the electrode's
+  /// travel into the work along the tool axis from the burn's first discharge; a burn runs from
+  /// a condition's selection to M181. At the status rate, so a depth the electrode held between
+  /// two samples only is missed (the report's, from every period, is exact).
+  json edm_depth(const control::ServoStatus& v) {
+    const machine::EdmConfig& c = owner_.profile_.edm.config;
+    const double along = v.actual[static_cast<std::size_t>(c.tool_axis)];
+    if (!v.edm.on) {
+      burning_ = false;
+    } else if (!burning_ && v.edm.gap_state != machine::GapState::Open) {
+      burning_ = true;
+      start_ = along;
+      depth_mm_ = 0;
+    }
+    if (burning_) depth_mm_ = std::max(depth_mm_, (start_ - along) * c.lift_direction);
+    return {{"depth_mm", depth_mm_}, {"burning", burning_}};
+  }
+
   MachineFeatures& owner_;
+  bool burning_ = false;
+  double start_ = 0, depth_mm_ = 0;
 };
 
 std::unique_ptr<MachineFeatures> MachineFeatures::create(const config::MachineProfile& profile,

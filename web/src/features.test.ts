@@ -1,0 +1,107 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The feature dialogs and panels: the power-fail recovery dialog through the power's return (what
+// it offers in each state, each choice confirmed, the retract's inputs sent), the load hold, and
+// the process panels' lines.
+import { describe, expect, it } from "vitest";
+import { actionFields } from "./dialog_view";
+import { recoveryPending } from "./dialogs/recovery";
+import { dialogFor } from "./dialogs/waits";
+import { alarmLines, edmRows, loadBanner, loadText } from "./panels/process";
+import type { Status } from "./types";
+import type { JournalState } from "./types_features";
+
+const record = {
+  valid: true, stage: "at-rest", program: "/x/broach-constant.ngc", file: "broach-constant.ngc", line: 11, segment: 3,
+  segment_offset_mm: 543.2, move_remaining_mm: 179.8, actual: { X: 0.1, Z: 455.8, C: 279.5 }, tool: 0, spindle_rpm: 0,
+  coupled: true, signal_time_s: 46.1, summary: "valid breakpoint",
+};
+const journal: JournalState = { record, phase: "none", recovery_error: "", write_error: "", can_resume: true, can_retract: true, mains_ok: true };
+const base = {
+  state: "idle", mode: "auto", wait: "", stop_reason: "", fault: "", job: { active: false },
+  power: { monitor: true, mains_ok: true, on_battery: false, dc_link_v: 560 },
+  features: { installed: ["journal"], journal },
+} as unknown as Status;
+const withJournal = (j: Partial<JournalState>, s: Partial<Status> = {}) =>
+  ({ ...base, ...s, features: { installed: ["journal"], journal: { ...journal, ...j } } }) as Status;
+
+describe("power-fail recovery dialog", () => {
+  it("opens while a valid record waits and no choice acts on it", () => {
+    expect(dialogFor(base)?.id).toBe("power-fail");
+    expect(recoveryPending(withJournal({ phase: "resuming" }))).toBe(false);
+    expect(dialogFor(withJournal({ record: { ...record, valid: false } }))).toBeUndefined();
+    expect(dialogFor(withJournal({ record: null }))).toBeUndefined();
+  });
+  it("offers nothing while the mains are off, then reset and machine on", () => {
+    const off = withJournal({}, { state: "faulted", power: { monitor: true, mains_ok: false, on_battery: false, dc_link_v: 0 } });
+    const d = dialogFor(off)!;
+    expect(d.id).toBe("power-fail");  // before the fault dialog
+    expect(d.title(off)).toBe("Power failure");
+    expect(d.text(off)).toContain("The mains are off");
+    expect(d.actions(off)).toEqual([]);
+    const back = withJournal({}, { state: "faulted" });
+    expect(d.actions(back).map((a) => a.kind)).toEqual(["reset"]);
+    expect(d.actions(withJournal({}, { state: "off" })).map((a) => a.kind)).toEqual(["machine-on"]);
+  });
+  it("shows what the record says and offers resume, retract and discard, each confirmed", () => {
+    const d = dialogFor(base)!;
+    expect(d.text(base)).toContain("broach-constant.ngc line 11 (segment 3)");
+    expect(d.text(base)).toContain("Z 455.800");
+    const actions = d.actions(base);
+    expect(actions.map((a) => a.fields?.action)).toEqual(["resume", "retract", "discard"]);
+    for (const a of actions) expect(a.confirm).toBeTruthy();
+    expect(d.fields!(base).map((f) => f.name)).toEqual(["distance_mm", "direction", "speed_mm_min"]);
+    const retract = actions[1];
+    expect(actionFields(retract, { distance_mm: 2, direction: "onward", speed_mm_min: 50 }, true)).toEqual({
+      feature: "journal", action: "retract", distance_mm: 2, direction: "onward", speed_mm_min: 50, confirmed: true,
+    });
+    // Unconfirmed, a choice carries no confirmation (the server refuses it).
+    expect(actionFields(actions[2], {}, false)).toEqual({ feature: "journal", action: "discard" });
+  });
+  it("offers only what the record allows, AUTO first when needed, and says why a choice failed", () => {
+    const d = dialogFor(base)!;
+    const stopping = withJournal({ can_resume: false, can_retract: false, phase: "failed", recovery_error: "Z is 0.5 mm from where it came to rest" },
+      { mode: "manual" });
+    expect(d.actions(stopping).map((a) => a.label)).toEqual(["AUTO mode", "Discard"]);
+    expect(d.text(stopping)).toContain("The last choice failed: Z is 0.5 mm");
+    expect(d.fields!(stopping)).toEqual([]);
+  });
+});
+
+describe("load guard", () => {
+  const load = { kn: 4.31, action: "hold", hold_kn: 4, retract_kn: 6 };
+  it("shows a hold dialog with the load and the level, resume or abort", () => {
+    const s = { ...base, features: undefined, state: "held", load } as unknown as Status;
+    const d = dialogFor(s)!;
+    expect(d.id).toBe("load-hold");
+    expect(d.text(s)).toContain("hold level of 4 kN (now 4.31 kN)");
+    expect(d.actions(s).map((a) => a.kind)).toEqual(["resume", "abort"]);
+    expect(loadBanner(s)).toBe("Feed held: the load passed 4 kN. Check the cutter, then resume or abort.");
+  });
+  it("puts the load against its levels and says what a retract did", () => {
+    const s = { ...base, load: { ...load, action: "lifted" } } as unknown as Status;
+    expect(loadText(s)).toBe("Load 4.31 kN · hold 4 kN · retract 6 kN");
+    expect(loadBanner(s)).toContain("the cutter lifted off the wall");
+    expect(loadBanner({ ...s, load: { ...load, action: "none" } } as Status)).toBe("");
+  });
+});
+
+describe("process panels", () => {
+  it("lists the alarms with their state", () => {
+    const s = { ...base, alarms: [{ name: "dielectric_level", active: true, reaction: "stop", low: 40, high: null, unit: "mm" }] } as unknown as Status;
+    expect(alarmLines(s)).toEqual([{ text: "dielectric_level: ALARM (≥ 40 mm; stop)", active: true }]);
+  });
+  it("shows the EDM's gap against the reference, the discharge, jumps and depth", () => {
+    const s = {
+      ...base,
+      edm: { on: true, generator: true, condition: 12, reference_v: 45, gap_state: "normal", gap_voltage_v: 44, filtered_voltage_v: 45.23,
+        path_speed_mm_s: 0.012, backlog_mm: 0, retract_limit: false, jumping: false, jump_lift_mm: 0, jumps: 88, orbit_radius_mm: 0 },
+      features: { installed: [], edm: { depth_mm: 0.109, burning: true } },
+    } as unknown as Status;
+    const rows = Object.fromEntries(edmRows(s));
+    expect(rows.Condition).toBe("E12");
+    expect(rows.Gap).toBe("45.2 V (ref 45 V)");
+    expect(rows.Discharge).toBe("normal");
+    expect(rows.Jumps).toBe("88");
+    expect(rows.Depth).toBe("0.109 mm");
+  });
+});
