@@ -3,7 +3,7 @@
 // `opencnc serve` on the simulated mill (virtual time at 30x), then with the mouse alone: machine
 // on, home, open the bracket program, run it, confirm the tool changes, hold and resume, see the
 // position change, run to the end, find the job in the history; then run it again from line 66
-// chosen in the listing. Screenshots land in the
+// chosen in the listing; then the power-fail recovery on the broach (recovery.mjs). Screenshots land in the
 // artefacts folder. Usage: node e2e/run.mjs [--opencnc PATH] [--out DIR]
 import { spawn } from "node:child_process";
 import { mkdtempSync, mkdirSync, rmSync } from "node:fs";
@@ -11,6 +11,7 @@ import { tmpdir } from "node:os";
 import { dirname, join, resolve } from "node:path";
 import { fileURLToPath } from "node:url";
 import { chromium } from "playwright-core";
+import { recoveryStep } from "./recovery.mjs";
 
 const here = dirname(fileURLToPath(import.meta.url));
 const repo = resolve(here, "..", "..");
@@ -150,6 +151,7 @@ try {
     return (await finished()) >= before + 2;  // the approach, then the program
   }, 60000);
   await shot("07-run-from-line");
+  await recoveryStep({ opencnc, repo, out, browser, step });
   step("passed");
 } catch (e) {
   failed = true;

@@ -232,7 +232,8 @@ async function start() {
     panels.forEach((p, i) => (panelRoots[i].hidden = !p.update(s, panelRoots[i], ctx)));
     v3.setTool(s.machine.X ?? 0, s.machine.Y ?? 0, s.machine.Z ?? 0, s.job.active && s.job.kind === "program");
     const d = dialogFor(s);
-    const key = d ? `${d.id}|${d.text(s)}` : "";
+    // Drawn again when what it says or offers changes (not at every status: its inputs keep their values).
+    const key = d ? `${d.id}|${d.text(s)}|${d.actions(s).map((a) => a.label).join(",")}` : "";
     if (key !== dialogKey) {
       dialogKey = key;
       if (!d) {

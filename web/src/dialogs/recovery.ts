@@ -43,7 +43,7 @@ registerDialog({
     return `${recordText(s)} You may ${offer}.${auto}${failed}`;
   },
   fields: (s) => (journal(s)?.can_retract && s.state === "idle"
-    ? [{ name: "distance_mm", label: "Retract", value: 5, unit: "mm" },
+    ? [{ name: "distance_mm", label: "Distance", value: 5, unit: "mm" },
       { name: "direction", label: "direction", value: "back", options: ["back", "onward"] },
       { name: "speed_mm_min", label: "at", value: 100, unit: "mm/min" }]
     : []),
