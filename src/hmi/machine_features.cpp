@@ -135,7 +135,7 @@ json MachineFeatures::status() const {
   return state_;
 }
 
-json MachineFeatures::snapshot(const control::ControllerStatus& s) const {
+json MachineFeatures::snapshot(const control::ControllerStatus& s) {
   json j{{"installed", names_}};
   if (journal_) {
     json r = nullptr;
@@ -198,11 +198,32 @@ json MachineFeatures::snapshot(const control::ControllerStatus& s) const {
                       {"last", last},
                       {"stopped_program", electrode_->stop().has_value()}};
   }
-  if (guard_) {
-    j["tool_guard"] = {{"store", profile_.tool_guard.store},
-                       {"holding", s.wait_text.find("the tool-guard ") != std::string::npos}};
-  }
+  if (guard_) j["tool_guard"] = tool_guard_state(s);
   return j;
+}
+
+// While the guard holds the program at a tool change (the controller's wait text names the
+// feature that holds), the differences of the whole live table from the backup, for the dialog.
+// The check reads the store (SQLite): it runs once when the hold begins and again only when the
+// store has changed, not at every status.
+json MachineFeatures::tool_guard_state(const control::ControllerStatus& s) {
+  const bool holding = s.wait_text.find("the tool-guard ") != std::string::npos;
+  if (!holding) {
+    guard_holding_ = false;
+    guard_report_ = nullptr;
+  } else if (!guard_holding_ || store_->changes() != guard_checked_) {
+    guard_holding_ = true;
+    guard_checked_ = store_->changes();
+    const toolguard::CheckResult r = toolguard::check(*store_, toolguard::tolerances(profile_.tool_guard));
+    json lines = json::array();
+    for (const tools::Difference& d : r.differences) lines.push_back(d.text());
+    guard_report_ = {{"ok", r.ok()},
+                     {"error", r.error},
+                     {"backup", r.backup ? json{{"id", r.backup->id}, {"taken", r.backup->taken_utc}} : json(nullptr)},
+                     {"differences", lines},
+                     {"report", r.report()}};
+  }
+  return {{"store", profile_.tool_guard.store}, {"holding", holding}, {"check", guard_report_}};
 }
 
 }  // namespace opencnc::hmi

@@ -7,12 +7,14 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <fstream>
 #include <thread>
 
 #include "../control/test_profiles.hpp"
 #include "client.hpp"
 #include "opencnc/config/profile_loader.hpp"
 #include "opencnc/controller/electrode_setting.hpp"
+#include "opencnc/core/atomic_file.hpp"
 #include "opencnc/controller/gcode_source.hpp"
 #include "opencnc/hmi/api.hpp"
 #include "opencnc/hmi/machine_features.hpp"
@@ -20,6 +22,8 @@
 #include "opencnc/hmi/server.hpp"
 #include "opencnc/recovery/breakpoint_journal.hpp"
 #include "opencnc/recovery/retrace.hpp"
+#include "opencnc/store/tool_store.hpp"
+#include "opencnc/tools/tool_text.hpp"
 
 namespace opencnc::hmi {
 namespace {
@@ -173,21 +177,24 @@ TEST(MachineFeatures, EachProfileGetsTheFeaturesItCallsFor) {
   std::filesystem::remove_all(dir);
 }
 
-/// The broach served on loopback in virtual time at 100× with its features and the simulation
-/// controls, the constant-pitch job open.
-struct BroachRig {
-  BroachRig() {
-    dir = std::filesystem::temp_directory_path() / ("opencnc-serve-broach-" + std::to_string(::getpid()));
+/// A machine served on loopback in virtual time at 200× with its features and the simulation
+/// controls; programs from `programs` (default the examples).
+struct FeatureRig {
+  explicit FeatureRig(const char* machine, std::vector<std::string> sets = {},
+                      std::filesystem::path programs = OPENCNC_SOURCE_DIR "/examples") {
+    dir = std::filesystem::temp_directory_path() / ("opencnc-serve-features-" + std::to_string(::getpid()));
     std::filesystem::remove_all(dir);
-    profile = load("broach-zc.toml");
+    std::filesystem::create_directories(dir);
+    profile = load(machine, sets);
     Diagnostics d;
     features = MachineFeatures::create(profile, {(dir / "journal").string()}, d);
-    host = std::make_unique<MachineHost>(profile, features->source(), HostOptions{false, 100});
+    EXPECT_TRUE(features) << (d.items().empty() ? "" : d.items()[0].format());
+    host = std::make_unique<MachineHost>(profile, features->source(), HostOptions{false, 200});
     features->install(host->controller());
     host->start(nullptr);
     ServerConfig sc;
     sc.port = 0;
-    sc.programs_dir = OPENCNC_SOURCE_DIR "/examples";
+    sc.programs_dir = programs;
     sc.features = features.get();
     sc.simulate = [this](std::string_view e) { return host->simulate(e); };
     server = std::make_unique<Server>(host->controller(), profile, Tokens::of(kOperator, kAdmin), nullptr,
@@ -196,7 +203,7 @@ struct BroachRig {
     EXPECT_TRUE(server->start(&error)) << error;
     port = server->port();
   }
-  ~BroachRig() {
+  ~FeatureRig() {
     server->stop();
     host->stop();
     std::filesystem::remove_all(dir);
@@ -221,7 +228,7 @@ struct BroachRig {
 };
 
 TEST(ServerFeatures, PowerFailRecordInTheStatusThenARetractConfirmedByTheOperator) {
-  BroachRig rig;
+  FeatureRig rig("broach-zc.toml");
   for (const char* k : {"machine-on"}) ASSERT_EQ(rig.command({{"kind", k}}).status, 200);
   ASSERT_EQ(rig.command({{"kind", "mode"}, {"mode", "auto"}}).status, 200);
   ASSERT_EQ(rig.command({{"kind", "open"}, {"program", "broach-constant.ngc"}}).status, 200);
@@ -275,6 +282,92 @@ TEST(ServerFeatures, PowerFailRecordInTheStatusThenARetractConfirmedByTheOperato
       rig.command({{"kind", "feature"}, {"feature", "journal"}, {"action", "discard"}, {"confirmed", true}});
   EXPECT_EQ(again.status, 409);
   EXPECT_EQ(again.body["message"], "the journal holds no valid breakpoint");
+}
+
+TEST(ServerFeatures, RetracePausesStepsBackAndCutsOnFromTheNearestPoint) {
+  FeatureRig rig("flame-cutter.toml");
+  EXPECT_EQ(rig.status()["features"]["installed"], json({"retrace", "run-from-line"}));
+  ASSERT_EQ(rig.command({{"kind", "machine-on"}}).status, 200);
+  ASSERT_EQ(rig.command({{"kind", "home"}}).status, 200);
+  ASSERT_TRUE(rig.until([](const json& s) { return s["all_homed"] == true; }));
+  ASSERT_EQ(rig.command({{"kind", "mode"}, {"mode", "auto"}}).status, 200);
+  ASSERT_EQ(rig.command({{"kind", "open"}, {"program", "nesting.ngc"}}).status, 200);
+  ASSERT_EQ(rig.command({{"kind", "cycle-start"}}).status, 200);
+  ASSERT_TRUE(rig.until([](const json& s) { return s["job"]["progress"].get<double>() > 0.05; }));
+  const json retrace = {{"kind", "feature"}, {"feature", "retrace"}};
+  auto with = [&retrace](json extra) {
+    extra.update(retrace);
+    return extra;
+  };
+  ASSERT_EQ(rig.command(with({{"action", "pause"}})).status, 200);
+  ASSERT_TRUE(rig.until([](const json& s) { return s["features"]["retrace"]["phase"] == "paused"; }));
+  EXPECT_EQ(rig.status()["mode"], "manual");  // the operator may jog the torch off the path
+  ASSERT_EQ(rig.command(with({{"action", "step"}, {"distance_mm", -5}})).status, 200);
+  ASSERT_TRUE(rig.until([](const json& s) { return s["features"]["retrace"]["phase"] == "paused"; }));
+  EXPECT_EQ(rig.command(with({{"action", "start"}})).status, 400);  // not confirmed
+  const Reply start = rig.command(with({{"action", "start"}, {"confirmed", true}}));
+  ASSERT_EQ(start.status, 200) << start.body.dump();
+  ASSERT_TRUE(rig.until([](const json& s) { return s["features"]["retrace"]["phase"] == "cutting"; }));
+  const json last = rig.status()["features"]["retrace"]["last"];
+  EXPECT_EQ(rig.status()["features"]["retrace"]["retraces"], 1);
+  EXPECT_TRUE(last["line"].get<std::string>().find("nesting.ngc:") != std::string::npos) << last.dump();
+  EXPECT_LT(last["distance_mm"].get<double>(), 0.01);  // the torch stood on the path: C is where it stood
+}
+
+/// A tool store made from hmc-toolcheck's table and backed up, and a three-tool program, in a
+/// folder of their own.
+struct GuardedStore {
+  GuardedStore() {
+    dir = std::filesystem::temp_directory_path() / ("opencnc-guard-" + std::to_string(::getpid()));
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    std::string error, text;
+    store = store::ToolStore::open((dir / "tools.db").string(), &error);
+    EXPECT_NE(store, nullptr) << error;
+    EXPECT_TRUE(read_file(OPENCNC_SOURCE_DIR "/configs/hmc-toolcheck.tbl", text, &error)) << error;
+    Diagnostics d;
+    const auto set = tools::from_linuxcnc(tools::ToolTable::parse(text, "hmc-toolcheck.tbl", d), "hmc", d);
+    EXPECT_TRUE(set && store->write(*set, "test", "import", &error)) << error;
+    EXPECT_TRUE(store->backup("test", "backup", &error)) << error;
+    std::ofstream(dir / "three-tools.ngc") << "G21 G90\nT1 M6\nG43 H1\nG0 X0 Y0 Z10\nT3 M6\nG43 H3\nG0 Z20\n"
+                                              "T5 M6\nG43 H5\nG0 Z30\nM2\n";
+  }
+  ~GuardedStore() { std::filesystem::remove_all(dir); }
+  std::vector<std::string> sets() const {
+    return {"tool_guard.store=\"" + (dir / "tools.db").string() + "\"", "tool_guard.check=\"tool-change\"",
+            "tool_changer.sim.prepare_time_s=0.05", "tool_changer.sim.change_time_s=0.1"};
+  }
+  std::filesystem::path dir;
+  std::shared_ptr<store::ToolStore> store;
+};
+
+TEST(ServerFeatures, TheToolGuardsHoldShowsTheDifferencesAndARestoreLetsTheProgramGoOn) {
+  GuardedStore tools;
+  std::string error;
+  ASSERT_TRUE(tools.store->set(5, 1, tools::Param::Length1, 139.225, "test", &error)) << error;  // a typo
+  FeatureRig rig("hmc-toolcheck.toml", tools.sets(), tools.dir);
+  EXPECT_EQ(rig.status()["features"]["installed"], json({"tool-guard", "run-from-line"}));
+  ASSERT_EQ(rig.command({{"kind", "machine-on"}}).status, 200);
+  ASSERT_EQ(rig.command({{"kind", "mode"}, {"mode", "auto"}}).status, 200);
+  ASSERT_EQ(rig.command({{"kind", "open"}, {"program", "three-tools.ngc"}}).status, 200);
+  ASSERT_EQ(rig.command({{"kind", "cycle-start"}}).status, 200);
+  ASSERT_TRUE(rig.until([](const json& s) { return s["features"]["tool_guard"]["holding"] == true; }));
+  const json held = rig.status()["features"]["tool_guard"];
+  EXPECT_EQ(held["check"]["ok"], false);
+  EXPECT_EQ(held["check"]["backup"]["id"], 1);
+  ASSERT_EQ(held["check"]["differences"].size(), 1u);
+  EXPECT_EQ(held["check"]["differences"][0],
+            "T5 D1 length1: backup 193.225, live 139.225 (-54 mm; geometry tolerance 0.001 mm)");
+  // No silent overwrite: a restore without the operator's confirmation changes nothing.
+  EXPECT_EQ(rig.command({{"kind", "feature"}, {"feature", "tool-guard"}, {"action", "restore"}}).status, 400);
+  EXPECT_EQ(rig.status()["features"]["tool_guard"]["holding"], true);
+  const Reply restored =
+      rig.command({{"kind", "feature"}, {"feature", "tool-guard"}, {"action", "restore"}, {"confirmed", true}});
+  ASSERT_EQ(restored.status, 200) << restored.body.dump();
+  EXPECT_EQ(restored.body["message"], "backup 1 is the live tool table again");
+  ASSERT_TRUE(rig.until([](const json& s) { return s["runs_finished"].get<int>() >= 1 && s["state"] == "idle"; }));
+  EXPECT_EQ(rig.status()["features"]["tool_guard"]["holding"], false);
+  EXPECT_TRUE(rig.status()["features"]["tool_guard"]["check"].is_null());
 }
 
 }  // namespace

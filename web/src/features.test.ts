@@ -1,12 +1,14 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The feature dialogs and panels: the power-fail recovery dialog through the power's return (what
-// it offers in each state, each choice confirmed, the retract's inputs sent), the load hold, and
-// the process panels' lines.
+// it offers in each state, each choice confirmed, the retract's inputs sent), the load hold, the
+// process panels' lines, the tool check dialog and the retrace panel.
 import { describe, expect, it } from "vitest";
-import { actionFields } from "./dialog_view";
+import { actionFields, question } from "./dialog_view";
 import { recoveryPending } from "./dialogs/recovery";
+import "./dialogs/toolcheck";
 import { dialogFor } from "./dialogs/waits";
 import { alarmLines, edmRows, loadBanner, loadText } from "./panels/process";
+import { retraceControls, retraceText } from "./panels/retrace";
 import type { Status } from "./types";
 import type { JournalState } from "./types_features";
 
@@ -103,5 +105,47 @@ describe("process panels", () => {
     expect(rows.Discharge).toBe("normal");
     expect(rows.Jumps).toBe("88");
     expect(rows.Depth).toBe("0.109 mm");
+  });
+});
+
+describe("tool check dialog", () => {
+  const check = { ok: false, error: "", backup: { id: 1, taken: "2026-11-26T09:56:24Z" },
+    differences: ["T5 D1 length1: backup 193.225, live 139.225 (-54 mm; geometry tolerance 0.001 mm)"], report: "" };
+  const held = { ...base, state: "running", job: { active: true, kind: "program" },
+    features: { installed: ["tool-guard"], tool_guard: { store: "x.db", holding: true, check } } } as unknown as Status;
+  it("lists the differences while the guard holds and asks before accept or restore", () => {
+    const d = dialogFor(held)!;
+    expect(d.id).toBe("tool-check");
+    expect(d.text(held)).toContain("differ from backup 1 of 2026-11-26T09:56:24Z:\nT5 D1 length1: backup 193.225, live 139.225");
+    const actions = d.actions(held);
+    expect(actions.map((a) => a.fields?.action ?? a.kind)).toEqual(["check", "accept", "restore", "abort"]);
+    expect(actions[1].confirm).toContain("new backup");
+    expect(actions[2].confirm).toContain("Overwrite the live values with backup 1's");
+    expect(actions[0].confirm).toBeUndefined();
+  });
+  it("is not shown when the guard does not hold", () => {
+    expect(dialogFor({ ...held, features: { installed: ["tool-guard"], tool_guard: { store: "x.db", holding: false, check: null } } } as Status))
+      .toBeUndefined();
+  });
+});
+
+describe("retrace panel", () => {
+  const at = (phase: string, active = true) => ({ ...base, job: { active, kind: "program" },
+    features: { installed: ["retrace"], retrace: { phase, retraces: 0, last: null } } }) as unknown as Status;
+  it("offers the pause while the program cuts, nothing while it stops", () => {
+    expect(retraceControls(at("idle")).actions.map((a) => a.fields?.action)).toEqual(["pause"]);
+    expect(retraceControls(at("idle", false)).actions).toEqual([]);
+    expect(retraceControls(at("torch-off")).actions).toEqual([]);
+    expect(retraceText(at("torch-off"))).toContain("the torch goes out");
+  });
+  it("steps back and on by the distance and cuts on from the nearest point, confirmed", () => {
+    const { fields, actions } = retraceControls(at("paused"));
+    expect(fields.map((f) => f.name)).toEqual(["distance_mm", "metric"]);
+    const values = { distance_mm: 3, metric: "xyz" };
+    expect(actionFields(actions[0], values, false)).toEqual({ feature: "retrace", action: "step", distance_mm: -3 });
+    expect(actionFields(actions[1], values, false)).toEqual({ feature: "retrace", action: "step", distance_mm: 3 });
+    expect(actions[2].confirm).toBeTruthy();
+    expect(actionFields(actions[2], values, true)).toEqual({ feature: "retrace", action: "start", metric: "xyz", confirmed: true });
+    expect(question(actions[2], fields, values)).toBe("Light the torch and cut on from the nearest point of the path? (metric xyz)");
   });
 });

@@ -7,8 +7,10 @@ import { Api } from "./api";
 import { renderDialog } from "./dialog_view";
 // The feature dialogs first: the first registered dialog a status wants is shown.
 import "./dialogs/recovery";
+import "./dialogs/toolcheck";
 import { dialogFor } from "./dialogs/waits";
 import "./panels/process";
+import "./panels/retrace";
 import { panels, screens, type Context } from "./registry";
 import "./screens/jog";
 import "./screens/mdi";

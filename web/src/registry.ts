@@ -38,8 +38,9 @@ export interface DialogAction {
   cls?: string;
   /** Asked in the dialog before it is sent ("Retract Z by 2 mm?"); sent with `confirmed: true`. */
   confirm?: string;
-  /** The dialog's inputs' values go with the fields. */
+  /** The dialog's inputs' values go with the fields (through `transform` when given). */
   form?: boolean;
+  transform?: (values: Record<string, number | string>) => Record<string, unknown>;
 }
 
 /** An input of a dialog (a number, or one of a few choices). */

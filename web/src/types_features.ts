@@ -97,6 +97,8 @@ export interface ElectrodeState {
 export interface ToolGuardState {
   store: string;
   holding: boolean;
+  /** While holding: the check of the live table against the backup. */
+  check: { ok: boolean; error: string; backup: { id: number; taken: string } | null; differences: string[]; report: string } | null;
 }
 
 export interface Features {

@@ -70,7 +70,8 @@ class MachineFeatures {
  private:
   class Board;
   MachineFeatures() = default;
-  nlohmann::json snapshot(const control::ControllerStatus& s) const;  // controller thread
+  nlohmann::json snapshot(const control::ControllerStatus& s);  // controller thread
+  nlohmann::json tool_guard_state(const control::ControllerStatus& s);  // controller thread
 
   config::MachineProfile profile_;
   std::shared_ptr<control::GcodeProgramSource> source_;
@@ -81,6 +82,11 @@ class MachineFeatures {
   std::shared_ptr<control::ElectrodeSetting> electrode_;
   std::vector<std::shared_ptr<control::Feature>> features_;
   std::vector<std::string> names_;
+
+  // The tool guard's check while it holds, run again only when the store changed.
+  bool guard_holding_ = false;
+  std::uint64_t guard_checked_ = ~std::uint64_t{0};
+  nlohmann::json guard_report_;
 
   mutable std::mutex mutex_;
   nlohmann::json state_;  ///< the board's last snapshot
