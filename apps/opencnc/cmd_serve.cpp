@@ -161,7 +161,7 @@ int serve(const ServeOptions& o) {
   }
   sc.stream_hz = o.stream_hz;
   sc.features = features.get();
-  sc.simulate = [&host](std::string_view event) { return host.simulate(event); };
+  sc.simulate = [&host](const hmi::SimulationEvent& e) { return host.simulate(e); };
   hmi::Server server(host.controller(), profile, *tokens, history.get(), source.get(), sc);
   if (!server.start(&error)) {
     fmt::print(stderr, "error: {}\n", error);

@@ -180,6 +180,21 @@ ToolChange tool_change(const json& body) {
   return c;
 }
 
+/// A control of the simulated machine: the mains, or an electrode (offsets and tip radius, mm).
+SimulationEvent simulation_event(const json& body) {
+  SimulationEvent e{text(body, "event")};
+  if (e.event == "electrode") {
+    const json& o = field(body, "offset");
+    if (!o.is_array() || o.size() != 3 || !o[0].is_number() || !o[1].is_number() || !o[2].is_number())
+      throw Bad{400, "\"offset\" must be [X, Y, Z] in mm"};
+    for (std::size_t i = 0; i < 3; ++i) e.offset_mm[i] = within(o[i].get<double>(), -1000, 1000, "offset");
+    e.tip_radius_mm = within(number(body, "tip_radius"), 0, 100, "tip_radius");
+  } else if (e.event != "mains-off" && e.event != "mains-on") {
+    throw Bad{400, fmt::format("\"event\" must be mains-off, mains-on or electrode, not \"{}\"", e.event)};
+  }
+  return e;
+}
+
 Command parse(const json& body, const config::MachineProfile& p, const std::filesystem::path& dir) {
   if (!body.is_object()) throw Bad{400, "the body must be a JSON object"};
   const std::string kind = text(body, "kind");
@@ -221,12 +236,7 @@ Command parse(const json& body, const config::MachineProfile& p, const std::file
     if (line != std::floor(line) || line < 1 || line > 1e9) throw Bad{422, "\"line\" must be a line number from 1"};
     return Request::feature("run-from-line", "start", control::RunFromLineArgs{static_cast<std::uint32_t>(line)});
   }
-  if (kind == "simulate") {
-    std::string event = text(body, "event");
-    if (event != "mains-off" && event != "mains-on")
-      throw Bad{400, fmt::format("\"event\" must be mains-off or mains-on, not \"{}\"", event)};
-    return SimulationEvent{std::move(event)};
-  }
+  if (kind == "simulate") return simulation_event(body);
   if (kind == "feature") {
     auto r = parse_feature_command(body, p);
     if (auto* e = std::get_if<ApiError>(&r)) throw Bad{e->status, e->message};

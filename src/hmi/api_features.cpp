@@ -123,13 +123,24 @@ Request electrode(const std::string& action, const json& body) {
   if (action == "measure") {
     const double t = required(body, "tool", 1, 99999);
     if (t != std::floor(t)) throw Refused{422, "\"tool\" must be a tool number from 1 to 99999"};
-    return Request::feature("electrode", "measure", control::ElectrodeMeasure{static_cast<int>(t)});
+    // By default the offsets are shown first and stored by a confirmed "write".
+    bool write = false;
+    if (body.contains("write")) {
+      if (!body["write"].is_boolean()) throw Refused{400, "\"write\" must be true or false"};
+      write = body["write"].get<bool>();
+    }
+    if (write) confirmed(body, "storing the measured offsets");
+    return Request::feature("electrode", "measure", control::ElectrodeMeasure{static_cast<int>(t), write});
+  }
+  if (action == "write") {
+    confirmed(body, "storing the measured offsets");
+    return Request::feature("electrode", "write");
   }
   if (action == "resume") {
     confirmed(body, "resuming the program");
     return Request::feature("electrode", "resume");
   }
-  throw Refused{400, fmt::format("electrode has no action \"{}\" (measure, resume)", action)};
+  throw Refused{400, fmt::format("electrode has no action \"{}\" (measure, write, resume)", action)};
 }
 
 Request tool_guard(const std::string& action, const json& body) {

@@ -192,7 +192,8 @@ json MachineFeatures::snapshot(const control::ControllerStatus& s) {
               {"previous", point3_json(r->previous)},
               {"offset", point3_json(r->offset)},
               {"rms_residual_mm", r->rms_residual_mm},
-              {"max_residual_mm", r->max_residual_mm}};
+              {"max_residual_mm", r->max_residual_mm},
+              {"written", r->written}};
     }
     j["electrode"] = {{"phase", control::to_string(electrode_->phase())},
                       {"last", last},

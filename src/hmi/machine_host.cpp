@@ -66,11 +66,12 @@ const control::LatencyHistogram* MachineHost::latency() const noexcept {
   return clock_ ? &clock_->latency() : nullptr;
 }
 
-std::string MachineHost::simulate(std::string_view event) {
-  if (event != "mains-off" && event != "mains-on") return fmt::format("no simulation event \"{}\"", event);
+std::string MachineHost::simulate(const SimulationEvent& event) {
+  if (event.event != "mains-off" && event.event != "mains-on" && event.event != "electrode")
+    return fmt::format("no simulation event \"{}\"", event.event);
   if (!rig_) return "the simulation controls need virtual time (opencnc serve --speed X)";
   std::lock_guard lock(simulate_mutex_);
-  simulate_.emplace_back(event);
+  simulate_.push_back(event);
   return {};
 }
 
@@ -98,7 +99,10 @@ void MachineHost::run_paced() {
     const auto due = static_cast<std::uint64_t>(wall_s * options_.speed / period_s_);
     {
       std::lock_guard lock(simulate_mutex_);
-      for (const std::string& e : simulate_) rig_->machine().set_mains_ok(e == "mains-on");
+      for (const SimulationEvent& e : simulate_) {
+        if (e.event == "electrode") rig_->machine().set_electrode(e.offset_mm, e.tip_radius_mm);
+        else rig_->machine().set_mains_ok(e.event == "mains-on");
+      }
       simulate_.clear();
     }
     for (int k = 0; done < due && k < 20000; ++k, ++done) rig_->step();

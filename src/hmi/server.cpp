@@ -566,7 +566,7 @@ void Server::Impl::command(const std::shared_ptr<HttpSession>& s, const HttpRequ
   }
   auto& c = std::get<Command>(parsed);
   if (const auto* e = std::get_if<SimulationEvent>(&c)) {
-    const std::string why = config.simulate ? config.simulate(e->event) : "this server has no simulation controls";
+    const std::string why = config.simulate ? config.simulate(*e) : "this server has no simulation controls";
     HttpResponse res = why.empty() ? json_response(req, 200, {{"accepted", true}, {"event", e->event}})
                                    : error_response(req, 409, why);
     audit(s->remote(), role, req, static_cast<int>(res.result_int()), why.empty() ? "accepted" : why);

@@ -107,6 +107,13 @@ TEST_F(FeatureParse, RetraceElectrodeAndToolGuardActions) {
   EXPECT_EQ(request({{"kind", "feature"}, {"feature", "retrace"}, {"action", "pause"}}).action, "pause");
   const auto measure = request({{"kind", "feature"}, {"feature", "electrode"}, {"action", "measure"}, {"tool", 3}});
   EXPECT_EQ(std::any_cast<control::ElectrodeMeasure>(measure.args).tool, 3);
+  EXPECT_FALSE(std::any_cast<control::ElectrodeMeasure>(measure.args).write);  // shown first, stored on confirmation
+  EXPECT_EQ(error({{"kind", "feature"}, {"feature", "electrode"}, {"action", "measure"}, {"tool", 3}, {"write", true}})
+                .status,
+            400);
+  EXPECT_EQ(error({{"kind", "feature"}, {"feature", "electrode"}, {"action", "write"}}).status, 400);
+  EXPECT_EQ(request({{"kind", "feature"}, {"feature", "electrode"}, {"action", "write"}, {"confirmed", true}}).action,
+            "write");
   EXPECT_EQ(error({{"kind", "feature"}, {"feature", "electrode"}, {"action", "measure"}, {"tool", 0}}).status, 422);
   EXPECT_EQ(request({{"kind", "feature"}, {"feature", "tool-guard"}, {"action", "check"}}).feature, "tool-guard");
   EXPECT_EQ(error({{"kind", "feature"}, {"feature", "tool-guard"}, {"action", "accept"}}).status, 400);
@@ -196,7 +203,7 @@ struct FeatureRig {
     sc.port = 0;
     sc.programs_dir = programs;
     sc.features = features.get();
-    sc.simulate = [this](std::string_view e) { return host->simulate(e); };
+    sc.simulate = [this](const SimulationEvent& e) { return host->simulate(e); };
     server = std::make_unique<Server>(host->controller(), profile, Tokens::of(kOperator, kAdmin), nullptr,
                                       features->source().get(), sc);
     std::string error;
@@ -312,6 +319,48 @@ TEST(ServerFeatures, RetracePausesStepsBackAndCutsOnFromTheNearestPoint) {
   EXPECT_EQ(rig.status()["features"]["retrace"]["retraces"], 1);
   EXPECT_TRUE(last["line"].get<std::string>().find("nesting.ngc:") != std::string::npos) << last.dump();
   EXPECT_LT(last["distance_mm"].get<double>(), 0.01);  // the torch stood on the path: C is where it stood
+}
+
+TEST(ServerFeatures, ElectrodeMeasuredOnTheSphereIsShownThenStoredOnConfirmation) {
+  // A copy of the tool table: the write goes into it, not into the repository's file.
+  const auto tables = std::filesystem::temp_directory_path() / ("opencnc-electrode-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(tables);
+  std::filesystem::copy_file(OPENCNC_SOURCE_DIR "/configs/edm-5axis.tbl", tables / "edm-5axis.tbl",
+                             std::filesystem::copy_options::overwrite_existing);
+  FeatureRig rig("edm-5axis.toml", {"interpreter.tool_table=\"" + (tables / "edm-5axis.tbl").string() + "\""});
+  EXPECT_EQ(rig.status()["features"]["installed"], json({"electrode", "run-from-line"}));
+  ASSERT_EQ(rig.command({{"kind", "machine-on"}}).status, 200);
+  ASSERT_EQ(rig.command({{"kind", "home"}}).status, 200);
+  ASSERT_TRUE(rig.until([](const json& s) { return s["all_homed"] == true; }));
+  // The electrode in the spindle sits 0.05, -0.03 and 0.2 mm off tool 1's table offsets (0, 0, 0).
+  ASSERT_EQ(rig.command({{"kind", "simulate"}, {"event", "electrode"}, {"offset", {0.05, -0.03, 0.2}}, {"tip_radius", 0.8}},
+                        kAdmin)
+                .status,
+            200);
+  const Reply measure = rig.command({{"kind", "feature"}, {"feature", "electrode"}, {"action", "measure"}, {"tool", 1}});
+  ASSERT_EQ(measure.status, 200) << measure.body.dump();
+  ASSERT_TRUE(rig.until([](const json& s) {
+    const json& e = s["features"]["electrode"];
+    return e["phase"] == "idle" && !e["last"].is_null();
+  }));
+  const json last = rig.status()["features"]["electrode"]["last"];
+  ASSERT_EQ(last["ok"], true) << last.dump();
+  EXPECT_EQ(last["written"], false);
+  EXPECT_NEAR(last["offset"][0].get<double>(), 0.05, 0.002);
+  EXPECT_NEAR(last["offset"][1].get<double>(), -0.03, 0.002);
+  EXPECT_NEAR(last["offset"][2].get<double>(), 0.2, 0.002);
+  auto z_of_tool_1 = [&rig] { return get(rig.port, "/api/v1/tools", kOperator).body[0]["z_offset"].get<double>(); };
+  EXPECT_EQ(z_of_tool_1(), 0.0);  // shown, not stored
+  EXPECT_EQ(rig.command({{"kind", "feature"}, {"feature", "electrode"}, {"action", "write"}}).status, 400);
+  const Reply write =
+      rig.command({{"kind", "feature"}, {"feature", "electrode"}, {"action", "write"}, {"confirmed", true}});
+  ASSERT_EQ(write.status, 200) << write.body.dump();
+  EXPECT_NEAR(z_of_tool_1(), 0.2, 0.002);
+  ASSERT_TRUE(rig.until([](const json& s) { return s["features"]["electrode"]["last"]["written"] == true; }));
+  // Stored once: a second write is the feature's refusal.
+  EXPECT_EQ(rig.command({{"kind", "feature"}, {"feature", "electrode"}, {"action", "write"}, {"confirmed", true}}).status,
+            409);
+  std::filesystem::remove_all(tables);
 }
 
 /// A tool store made from hmc-toolcheck's table and backed up, and a three-tool program, in a

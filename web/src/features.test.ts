@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The feature dialogs and panels: the power-fail recovery dialog through the power's return (what
 // it offers in each state, each choice confirmed, the retract's inputs sent), the load hold, the
-// process panels' lines, the tool check dialog and the retrace panel.
+// process panels' lines, the tool check dialog, the retrace panel and the electrode setting screen.
 import { describe, expect, it } from "vitest";
 import { actionFields, question } from "./dialog_view";
 import { recoveryPending } from "./dialogs/recovery";
@@ -9,6 +9,7 @@ import "./dialogs/toolcheck";
 import { dialogFor } from "./dialogs/waits";
 import { alarmLines, edmRows, loadBanner, loadText } from "./panels/process";
 import { retraceControls, retraceText } from "./panels/retrace";
+import { electrodeActions, resultLines } from "./screens/electrode";
 import type { Status } from "./types";
 import type { JournalState } from "./types_features";
 
@@ -147,5 +148,30 @@ describe("retrace panel", () => {
     expect(actions[2].confirm).toBeTruthy();
     expect(actionFields(actions[2], values, true)).toEqual({ feature: "retrace", action: "start", metric: "xyz", confirmed: true });
     expect(question(actions[2], fields, values)).toBe("Light the torch and cut on from the nearest point of the path? (metric xyz)");
+  });
+});
+
+describe("electrode setting screen", () => {
+  const result = { ok: true, code: "", message: "", tool: 1, touches: 5, previous: [0, 0, 0], offset: [0.05, -0.03, 0.2],
+    rms_residual_mm: 0.0001, max_residual_mm: 0.0002, written: false };
+  const at = (last: unknown, stopped = false) =>
+    ({ ...base, features: { installed: ["electrode"], electrode: { phase: "idle", last, stopped_program: stopped } } }) as unknown as Status;
+  it("shows the measured offsets against the table's and stores them only when confirmed", () => {
+    expect(resultLines(result as never)).toEqual([
+      "T1: 5 touches, fit residual 0.1 µm rms, 0.2 µm max",
+      "measured  X 0.0500  Y -0.0300  Z 0.2000",
+      "table     X 0.0000  Y 0.0000  Z 0.0000",
+      "change    X 0.0500  Y -0.0300  Z 0.2000",
+      "not stored yet: store the offsets to use them",
+    ]);
+    const [store] = electrodeActions(at(result));
+    expect(store.fields).toEqual({ feature: "electrode", action: "write" });
+    expect(store.confirm).toContain("Store T1's offsets X 0.0500  Y -0.0300  Z 0.2000 in the tool table");
+  });
+  it("offers the resume once stored, nothing after a failed measurement", () => {
+    expect(electrodeActions(at({ ...result, written: true }, true)).map((a) => a.fields?.action)).toEqual(["resume"]);
+    const failed = { ...result, ok: false, code: "electrode.far", message: "offsets 2 mm from the table's" };
+    expect(electrodeActions(at(failed, true))).toEqual([]);
+    expect(resultLines(failed as never)).toEqual(["T1: offsets 2 mm from the table's (electrode.far; nothing stored)"]);
   });
 });

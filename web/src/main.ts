@@ -18,6 +18,7 @@ import "./screens/file";
 import "./screens/history";
 import "./screens/params";
 import "./screens/network";
+import "./screens/electrode";
 import type { ControllerEvent, Machine, Status } from "./types";
 import { button, coord, el, offsetsText, outsideWindow, percent, windowStart } from "./ui";
 import { View3d, type Preview } from "./view3d";
@@ -163,6 +164,7 @@ async function start() {
   };
   screens.forEach((s, i) => {
     const root = el("div", {});
+    root.dataset.screenRoot = s.id;
     root.hidden = true;
     s.mount(root, ctx);
     roots.set(s.id, root);
@@ -244,6 +246,10 @@ async function start() {
         renderDialog(dialog, d, s, (kind, fields) => ctx.send(kind, fields));
         if (!dialog.open) dialog.showModal();
       }
+    }
+    // A screen whose feature the machine lacks has no key.
+    for (const sc of screens) {
+      if (sc.requires) (keys.querySelector(`[data-screen="${sc.id}"]`) as HTMLElement).hidden = !s.features?.installed.includes(sc.requires);
     }
     screens.find((x) => x.id === shownId)?.update?.(s, ctx);
   };

@@ -28,6 +28,8 @@ export interface Screen {
   update?(s: Status, ctx: Context): void;
   /** Called when the screen is shown. */
   shown?(ctx: Context): void;
+  /** A controller feature the screen needs: its key is hidden on a machine without it. */
+  requires?: string;
 }
 
 /** A button of a dialog: a label and the command it sends. */

@@ -86,6 +86,7 @@ export interface ElectrodeResult {
   offset: number[];
   rms_residual_mm: number;
   max_residual_mm: number;
+  written: boolean;
 }
 
 export interface ElectrodeState {

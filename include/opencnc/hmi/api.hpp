@@ -15,6 +15,7 @@
 #include "opencnc/controller/events.hpp"
 #include "opencnc/controller/observer.hpp"
 #include "opencnc/controller/request.hpp"
+#include "opencnc/hmi/simulation.hpp"
 
 namespace opencnc::hmi {
 
@@ -38,10 +39,6 @@ struct ToolChange {
   int tool = 0;
   std::optional<double> diameter_mm, z_offset_mm;
   std::string comment;
-};
-/// A control of the simulated machine (admin; docs/api.md, "Simulation"): "mains-off", "mains-on".
-struct SimulationEvent {
-  std::string event;
 };
 using Command = std::variant<control::Request, ToolChange, SimulationEvent>;
 

@@ -16,6 +16,7 @@
 #include "opencnc/config/machine_profile.hpp"
 #include "opencnc/control/clock.hpp"
 #include "opencnc/controller/controller.hpp"
+#include "opencnc/hmi/simulation.hpp"
 
 namespace opencnc::control {
 class SimRig;
@@ -57,10 +58,11 @@ class MachineHost {
   std::uint64_t ticks() const noexcept;
   std::uint64_t overruns() const noexcept;
   const control::LatencyHistogram* latency() const noexcept;
-  /// A control of the simulated machine: "mains-off" (the mains fail: the power-fail stop) or
-  /// "mains-on". Applied by the thread that steps the machine before its next period; "" or why
-  /// not (in real time the servo thread alone touches the machine: virtual time only). Any thread.
-  std::string simulate(std::string_view event);
+  /// A control of the simulated machine: "mains-off" (the mains fail: the power-fail stop),
+  /// "mains-on", "electrode" (the electrode in the spindle, for the reference sphere). Applied by
+  /// the thread that steps the machine before its next period; "" or why not (in real time the
+  /// servo thread alone touches the machine: virtual time only). Any thread.
+  std::string simulate(const SimulationEvent& event);
 
  private:
   void run_paced();
@@ -78,7 +80,7 @@ class MachineHost {
   std::unique_ptr<control::SimRig> rig_;
   std::atomic<std::uint64_t> paced_ticks_{0};
   std::mutex simulate_mutex_;
-  std::vector<std::string> simulate_;  ///< events for the paced thread to apply
+  std::vector<SimulationEvent> simulate_;  ///< events for the paced thread to apply
 
   std::atomic<bool> stop_{false};
   std::thread thread_;  ///< the controller's loop (real time) or the paced rig

@@ -13,6 +13,7 @@
 
 #include "opencnc/config/machine_profile.hpp"
 #include "opencnc/controller/controller.hpp"
+#include "opencnc/hmi/simulation.hpp"
 #include "opencnc/hmi/tokens.hpp"
 
 namespace opencnc::control {
@@ -36,9 +37,9 @@ struct ServerConfig {
   int io_threads = 1;
   /// The machine's features: their state goes into the status as `features` (null: none).
   const MachineFeatures* features = nullptr;
-  /// The simulated machine's controls (`{"kind": "simulate", …}`, admin): applies `event`
-  /// ("mains-off", "mains-on") and returns "" or why it cannot. Empty: none (a 409).
-  std::function<std::string(std::string_view event)> simulate;
+  /// The simulated machine's controls (`{"kind": "simulate", …}`, admin): applies the event and
+  /// returns "" or why it cannot. Empty: none (a 409).
+  std::function<std::string(const SimulationEvent&)> simulate;
 };
 
 /// Counters of the server. Any thread.
