@@ -174,8 +174,8 @@ int serve(const ServeOptions& o) {
   fmt::print("opencnc serve: {} on the simulated machine ({})\n", profile.name,
              o.speed == 0 ? "real time" : fmt::format("virtual time at {}x", o.speed));
   fmt::print("  open      http://{}:{}/#token={}\n", host_part, server.port(), tokens->operator_token());
-  fmt::print("  operator  {}\n  admin     in {}\n  history   {}\n", tokens->operator_token(), tokens->origin(),
-             (data / "history.sqlite").string());
+  fmt::print("  operator  {}\n  admin     in {}\n  history   {}\n", tokens->operator_token(),
+             tokens->origin(), (data / "history.sqlite").string());
   if (features->journal()) fmt::print("  journal   {}\n", fo.journal_dir);
   fmt::print("  features  {}\n  Ctrl-C stops.\n", fmt::join(features->names(), ", "));
   std::fflush(stdout);
@@ -216,8 +216,9 @@ void add_serve_command(CLI::App& app, Registry& registry) {
   cmd->add_option(
       "--data", opts->data_dir,
       "Where the tokens and the history live (default $XDG_STATE_HOME/opencnc or ~/.local/state/opencnc)");
-  cmd->add_option("--journal", opts->journal_dir,
-                  "The breakpoint journal's folder on a machine with a power monitor (default: journal in --data)");
+  cmd->add_option(
+      "--journal", opts->journal_dir,
+      "The breakpoint journal's folder on a machine with a power monitor (default: journal in --data)");
   cmd->add_option("--static", opts->static_dir,
                   "The built front end (default: web/dist beside the build folder)");
   cmd->add_option("--speed", opts->speed,

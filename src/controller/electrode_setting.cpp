@@ -447,8 +447,9 @@ void ElectrodeSetting::finish_measurement() {
     phase_ = ElectrodePhase::Idle;
   }
   const char* const code = !r.ok ? r.code.c_str() : r.written ? "electrode.set" : "electrode.measured";
-  host_->note(r.ok ? Severity::Note : Severity::Error, code,
-              fmt::format("electrode setting: {}{}", r.message, r.ok && !r.written ? " (not stored yet)" : ""));
+  host_->note(
+      r.ok ? Severity::Note : Severity::Error, code,
+      fmt::format("electrode setting: {}{}", r.message, r.ok && !r.written ? " (not stored yet)" : ""));
 }
 
 // The measured offsets into the tool table (the tool's entry as it was measured against, with
@@ -471,15 +472,16 @@ bool ElectrodeSetting::store(ElectrodeResult& r) {
 // After a measurement kept for the operator's look: stored only if the table still holds the
 // offsets it was measured against (nobody changed the tool meanwhile).
 Outcome ElectrodeSetting::write() {
-  if (phase() != ElectrodePhase::Idle) return refuse(fmt::format("electrode setting is {}", to_string(phase())));
+  if (phase() != ElectrodePhase::Idle)
+    return refuse(fmt::format("electrode setting is {}", to_string(phase())));
   std::optional<ElectrodeResult> r = last();
   if (!r || !r->ok) return refuse("no passed measurement to store (electrode measure)");
   if (r->written) return refuse(fmt::format("tool {}'s measured offsets are stored already", r->tool));
   const auto table = tools_->snapshot();
   const std::optional<std::size_t> index = table->find(r->tool);
   if (!index || *index != tool_index_ || offsets_of(table->at_index(*index)) != r->previous)
-    return refuse(fmt::format("tool {}'s offsets changed in the table since the measurement: measure again",
-                              r->tool));
+    return refuse(
+        fmt::format("tool {}'s offsets changed in the table since the measurement: measure again", r->tool));
   entry_ = table->at_index(*index);
   const bool ok = store(*r);
   {
@@ -488,9 +490,10 @@ Outcome ElectrodeSetting::write() {
     last_ = r;
   }
   host_->note(ok ? Severity::Note : Severity::Error, ok ? "electrode.set" : r->code,
-              fmt::format("electrode setting: {}", ok ? fmt::format("tool {} stored ({})", r->tool, show(r->offset))
-                                                     : r->message));
-  return ok ? accept(fmt::format("tool {}'s offsets stored: {}", r->tool, show(r->offset))) : refuse(r->message);
+              fmt::format("electrode setting: {}",
+                          ok ? fmt::format("tool {} stored ({})", r->tool, show(r->offset)) : r->message));
+  return ok ? accept(fmt::format("tool {}'s offsets stored: {}", r->tool, show(r->offset)))
+            : refuse(r->message);
 }
 
 void ElectrodeSetting::fail(std::string code, std::string message) {

@@ -289,8 +289,9 @@ std::optional<Role> role_for(std::string_view kind) {
   static const char* const operator_kinds[] = {"mode",    "jog",       "jog-by", "jog-stop",
                                                "home",    "override",  "switch", "spindle-on",
                                                "coolant", "handwheel", "open",   "mdi",
-                                               "run-from-line", "feature"};
+                                               "run-from-line"};
   if (kind == "set-tool" || kind == "simulate") return Role::Admin;
+  if (kind == "feature") return Role::Operator;  // the confirmation is in the body (api_features.cpp)
   if (servo_kinds().find(kind) != servo_kinds().end()) return Role::Operator;
   for (const char* k : operator_kinds) {
     if (kind == k) return Role::Operator;

@@ -72,7 +72,8 @@ Request journal(const std::string& action, const json& body, const config::Machi
     a.tolerance_mm = number_or(body, "tolerance_mm", a.tolerance_mm, 0, 1);
     a.tolerance_deg = number_or(body, "tolerance_deg", a.tolerance_deg, 0, 1);
     a.run_in_mm = number_or(body, "run_in_mm", a.run_in_mm, 0, 50);
-    a.run_in_speed_mm_min = number_or(body, "run_in_speed_mm_min", a.run_in_speed_mm_min, 1, fastest_mm_min(p));
+    a.run_in_speed_mm_min =
+        number_or(body, "run_in_speed_mm_min", a.run_in_speed_mm_min, 1, fastest_mm_min(p));
     return Request::feature("journal", "resume", a);
   }
   if (action == "retract") {
@@ -90,7 +91,8 @@ Request journal(const std::string& action, const json& body, const config::Machi
     confirmed(body, "discard");
     return Request::feature("journal", "discard");
   }
-  throw Refused{400, fmt::format("the journal has no action \"{}\" (show, resume, retract, discard)", action)};
+  throw Refused{400,
+                fmt::format("the journal has no action \"{}\" (show, resume, retract, discard)", action)};
 }
 
 Request retrace(const std::string& action, const json& body) {
@@ -172,7 +174,8 @@ std::variant<control::Request, ApiError> parse_feature_command(const json& body,
     if (feature == "retrace") return retrace(action, body);
     if (feature == "electrode") return electrode(action, body);
     if (feature == "tool-guard") return tool_guard(action, body);
-    throw Refused{400, fmt::format("unknown feature \"{}\" (journal, retrace, electrode, tool-guard)", feature)};
+    throw Refused{400,
+                  fmt::format("unknown feature \"{}\" (journal, retrace, electrode, tool-guard)", feature)};
   } catch (const Refused& r) {
     return ApiError{r.status, r.message};
   }

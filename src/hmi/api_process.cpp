@@ -13,7 +13,9 @@ namespace {
 using nlohmann::json;
 
 const char* reaction_name(machine::AlarmReaction r) {
-  return r == machine::AlarmReaction::Stop ? "stop" : r == machine::AlarmReaction::FeedHold ? "feed-hold" : "message";
+  return r == machine::AlarmReaction::Stop       ? "stop"
+         : r == machine::AlarmReaction::FeedHold ? "feed-hold"
+                                                 : "message";
 }
 
 const char* gap_name(machine::GapState g) {

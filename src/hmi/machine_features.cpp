@@ -19,8 +19,8 @@ using nlohmann::json;
 namespace {
 
 const char* phase_name(recovery::RecoveryPhase p) {
-  static constexpr const char* names[] = {"none",     "opening", "running-in", "resuming",
-                                          "retracting", "done",  "failed"};
+  static constexpr const char* names[] = {"none",       "opening", "running-in", "resuming",
+                                          "retracting", "done",    "failed"};
   return names[static_cast<std::size_t>(p)];
 }
 
@@ -105,8 +105,8 @@ std::unique_ptr<MachineFeatures> MachineFeatures::create(const config::MachinePr
     add(f->electrode_);
   }
   if (profile.cutting.present) {
-    f->retrace_ =
-        std::make_shared<recovery::RetraceFeature>(control::GcodeProgramSource::create(profile, diags), profile);
+    f->retrace_ = std::make_shared<recovery::RetraceFeature>(
+        control::GcodeProgramSource::create(profile, diags), profile);
     add(f->retrace_);
   }
   // Run from line scans with a program source of its own (the controller's is the controller's).
@@ -179,7 +179,8 @@ json MachineFeatures::snapshot(const control::ControllerStatus& s) {
               {"distance_mm", r.distance_mm},
               {"candidates", r.candidates}};
     }
-    j["retrace"] = {{"phase", recovery::to_string(retrace_->phase())}, {"retraces", records.size()}, {"last", last}};
+    j["retrace"] = {
+        {"phase", recovery::to_string(retrace_->phase())}, {"retraces", records.size()}, {"last", last}};
   }
   if (electrode_) {
     json last = nullptr;
@@ -218,11 +219,12 @@ json MachineFeatures::tool_guard_state(const control::ControllerStatus& s) {
     const toolguard::CheckResult r = toolguard::check(*store_, toolguard::tolerances(profile_.tool_guard));
     json lines = json::array();
     for (const tools::Difference& d : r.differences) lines.push_back(d.text());
-    guard_report_ = {{"ok", r.ok()},
-                     {"error", r.error},
-                     {"backup", r.backup ? json{{"id", r.backup->id}, {"taken", r.backup->taken_utc}} : json(nullptr)},
-                     {"differences", lines},
-                     {"report", r.report()}};
+    guard_report_ = {
+        {"ok", r.ok()},
+        {"error", r.error},
+        {"backup", r.backup ? json{{"id", r.backup->id}, {"taken", r.backup->taken_utc}} : json(nullptr)},
+        {"differences", lines},
+        {"report", r.report()}};
   }
   return {{"store", profile_.tool_guard.store}, {"holding", holding}, {"check", guard_report_}};
 }

@@ -100,8 +100,10 @@ void MachineHost::run_paced() {
     {
       std::lock_guard lock(simulate_mutex_);
       for (const SimulationEvent& e : simulate_) {
-        if (e.event == "electrode") rig_->machine().set_electrode(e.offset_mm, e.tip_radius_mm);
-        else rig_->machine().set_mains_ok(e.event == "mains-on");
+        if (e.event == "electrode")
+          rig_->machine().set_electrode(e.offset_mm, e.tip_radius_mm);
+        else
+          rig_->machine().set_mains_ok(e.event == "mains-on");
       }
       simulate_.clear();
     }

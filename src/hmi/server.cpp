@@ -23,8 +23,8 @@
 
 #include "opencnc/controller/gcode_source.hpp"
 #include "opencnc/hmi/api.hpp"
-#include "opencnc/hmi/machine_features.hpp"
 #include "opencnc/hmi/history.hpp"
+#include "opencnc/hmi/machine_features.hpp"
 #include "opencnc/hmi/preview.hpp"
 #include "opencnc/hmi/stream_tickets.hpp"
 #include "opencnc/tools/tool_table_service.hpp"
@@ -378,8 +378,8 @@ void Server::Impl::accept() {
 void Server::Impl::stream_tick() {
   if (stopping) return;
   ++stream_ticks;
-  auto status = std::make_shared<const std::string>(
-      json{{"type", "status"}, {"status", status_object()}}.dump());
+  auto status =
+      std::make_shared<const std::string>(json{{"type", "status"}, {"status", status_object()}}.dump());
   {
     std::lock_guard lock(sessions_mutex);
     std::erase_if(sessions, [](const std::weak_ptr<WsSession>& w) {

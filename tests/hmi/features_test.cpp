@@ -14,8 +14,8 @@
 #include "client.hpp"
 #include "opencnc/config/profile_loader.hpp"
 #include "opencnc/controller/electrode_setting.hpp"
-#include "opencnc/core/atomic_file.hpp"
 #include "opencnc/controller/gcode_source.hpp"
+#include "opencnc/core/atomic_file.hpp"
 #include "opencnc/hmi/api.hpp"
 #include "opencnc/hmi/machine_features.hpp"
 #include "opencnc/hmi/machine_host.hpp"
@@ -36,7 +36,8 @@ const std::string kOperator = "operator-token-for-tests-0001";
 const std::string kAdmin = "admin-token-for-tests-000000002";
 
 config::MachineProfile load(const char* name, std::vector<std::string> sets = {}) {
-  const config::ProfileLoad l = config::load_profile(std::string(OPENCNC_SOURCE_DIR "/configs/") + name, sets);
+  const config::ProfileLoad l =
+      config::load_profile(std::string(OPENCNC_SOURCE_DIR "/configs/") + name, sets);
   EXPECT_TRUE(l.ok()) << name;
   return *l.profile;
 }
@@ -62,10 +63,14 @@ TEST_F(FeatureParse, JournalChoicesCarryTheirArgumentsAndNeedTheOperatorsConfirm
   const ApiError unconfirmed = error({{"kind", "feature"}, {"feature", "journal"}, {"action", "discard"}});
   EXPECT_EQ(unconfirmed.status, 400);
   EXPECT_EQ(unconfirmed.message, "discard must be confirmed by the operator: add \"confirmed\": true");
-  EXPECT_EQ(error({{"kind", "feature"}, {"feature", "journal"}, {"action", "discard"}, {"confirmed", false}}).status,
+  EXPECT_EQ(error({{"kind", "feature"}, {"feature", "journal"}, {"action", "discard"}, {"confirmed", false}})
+                .status,
             400);
-  const auto resume = request(
-      {{"kind", "feature"}, {"feature", "journal"}, {"action", "resume"}, {"confirmed", true}, {"run_in_mm", 1.5}});
+  const auto resume = request({{"kind", "feature"},
+                               {"feature", "journal"},
+                               {"action", "resume"},
+                               {"confirmed", true},
+                               {"run_in_mm", 1.5}});
   const auto r = std::any_cast<recovery::ResumeArgs>(resume.args);
   EXPECT_EQ(r.run_in_mm, 1.5);
   EXPECT_EQ(r.tolerance_mm, 0.01);  // the default where the body says nothing
@@ -80,7 +85,8 @@ TEST_F(FeatureParse, JournalChoicesCarryTheirArgumentsAndNeedTheOperatorsConfirm
   EXPECT_EQ(a.distance_mm, 5);
   EXPECT_TRUE(a.onward);
   EXPECT_EQ(a.speed_mm_min, 200);
-  const json no_distance = {{"kind", "feature"}, {"feature", "journal"}, {"action", "retract"}, {"confirmed", true}};
+  const json no_distance = {
+      {"kind", "feature"}, {"feature", "journal"}, {"action", "retract"}, {"confirmed", true}};
   EXPECT_EQ(error(no_distance).message, "\"distance_mm\" is missing");
   json sideways = no_distance;
   sideways["distance_mm"] = 1;
@@ -102,23 +108,36 @@ TEST_F(FeatureParse, RetraceElectrodeAndToolGuardActions) {
                               {"candidate", 1}});
   EXPECT_EQ(std::any_cast<recovery::RetraceStart>(start.args).metric, recovery::Metric::Xyz);
   EXPECT_EQ(std::any_cast<recovery::RetraceStart>(start.args).candidate, 1u);
-  const auto step = request({{"kind", "feature"}, {"feature", "retrace"}, {"action", "step"}, {"distance_mm", -2}});
+  const auto step =
+      request({{"kind", "feature"}, {"feature", "retrace"}, {"action", "step"}, {"distance_mm", -2}});
   EXPECT_EQ(std::any_cast<recovery::RetraceStep>(step.args).distance_mm, -2);
   EXPECT_EQ(request({{"kind", "feature"}, {"feature", "retrace"}, {"action", "pause"}}).action, "pause");
-  const auto measure = request({{"kind", "feature"}, {"feature", "electrode"}, {"action", "measure"}, {"tool", 3}});
+  const auto measure =
+      request({{"kind", "feature"}, {"feature", "electrode"}, {"action", "measure"}, {"tool", 3}});
   EXPECT_EQ(std::any_cast<control::ElectrodeMeasure>(measure.args).tool, 3);
-  EXPECT_FALSE(std::any_cast<control::ElectrodeMeasure>(measure.args).write);  // shown first, stored on confirmation
-  EXPECT_EQ(error({{"kind", "feature"}, {"feature", "electrode"}, {"action", "measure"}, {"tool", 3}, {"write", true}})
+  EXPECT_FALSE(
+      std::any_cast<control::ElectrodeMeasure>(measure.args).write);  // shown first, stored on confirmation
+  EXPECT_EQ(error({{"kind", "feature"},
+                   {"feature", "electrode"},
+                   {"action", "measure"},
+                   {"tool", 3},
+                   {"write", true}})
                 .status,
             400);
   EXPECT_EQ(error({{"kind", "feature"}, {"feature", "electrode"}, {"action", "write"}}).status, 400);
-  EXPECT_EQ(request({{"kind", "feature"}, {"feature", "electrode"}, {"action", "write"}, {"confirmed", true}}).action,
+  EXPECT_EQ(request({{"kind", "feature"}, {"feature", "electrode"}, {"action", "write"}, {"confirmed", true}})
+                .action,
             "write");
-  EXPECT_EQ(error({{"kind", "feature"}, {"feature", "electrode"}, {"action", "measure"}, {"tool", 0}}).status, 422);
-  EXPECT_EQ(request({{"kind", "feature"}, {"feature", "tool-guard"}, {"action", "check"}}).feature, "tool-guard");
+  EXPECT_EQ(error({{"kind", "feature"}, {"feature", "electrode"}, {"action", "measure"}, {"tool", 0}}).status,
+            422);
+  EXPECT_EQ(request({{"kind", "feature"}, {"feature", "tool-guard"}, {"action", "check"}}).feature,
+            "tool-guard");
   EXPECT_EQ(error({{"kind", "feature"}, {"feature", "tool-guard"}, {"action", "accept"}}).status, 400);
-  const auto restore = request(
-      {{"kind", "feature"}, {"feature", "tool-guard"}, {"action", "restore"}, {"confirmed", true}, {"backup", 4}});
+  const auto restore = request({{"kind", "feature"},
+                                {"feature", "tool-guard"},
+                                {"action", "restore"},
+                                {"confirmed", true},
+                                {"backup", 4}});
   EXPECT_EQ(std::any_cast<std::int64_t>(restore.args), 4);
   EXPECT_EQ(error({{"kind", "feature"}, {"feature", "warp"}, {"action", "x"}}).message,
             "unknown feature \"warp\" (journal, retrace, electrode, tool-guard)");
@@ -163,7 +182,8 @@ TEST(ProcessJson, LoadAlarmsAndEdmAsTheProfileHasThem) {
 }
 
 TEST(MachineFeatures, EachProfileGetsTheFeaturesItCallsFor) {
-  const auto dir = std::filesystem::temp_directory_path() / ("opencnc-features-" + std::to_string(::getpid()));
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("opencnc-features-" + std::to_string(::getpid()));
   Diagnostics d;
   auto broach = MachineFeatures::create(load("broach-zc.toml"), {(dir / "journal").string()}, d);
   ASSERT_TRUE(broach) << (d.items().empty() ? "" : d.items()[0].format());
@@ -224,7 +244,9 @@ struct FeatureRig {
     }
     return false;
   }
-  Reply command(const json& body, const std::string& token = kOperator) { return post(port, body.dump(), token); }
+  Reply command(const json& body, const std::string& token = kOperator) {
+    return post(port, body.dump(), token);
+  }
 
   std::filesystem::path dir;
   config::MachineProfile profile;
@@ -279,7 +301,8 @@ TEST(ServerFeatures, PowerFailRecordInTheStatusThenARetractConfirmedByTheOperato
   ASSERT_EQ(retract.status, 200) << retract.body.dump();
   // Done, then the record written again without its valid flag (the writer's thread makes it durable).
   ASSERT_TRUE(rig.until([](const json& st) {
-    return st["features"]["journal"]["phase"] == "done" && st["features"]["journal"]["record"]["valid"] == false;
+    return st["features"]["journal"]["phase"] == "done" &&
+           st["features"]["journal"]["record"]["valid"] == false;
   }));
   s = rig.status();
   EXPECT_EQ(s["features"]["journal"]["record"]["valid"], false);
@@ -323,21 +346,27 @@ TEST(ServerFeatures, RetracePausesStepsBackAndCutsOnFromTheNearestPoint) {
 
 TEST(ServerFeatures, ElectrodeMeasuredOnTheSphereIsShownThenStoredOnConfirmation) {
   // A copy of the tool table: the write goes into it, not into the repository's file.
-  const auto tables = std::filesystem::temp_directory_path() / ("opencnc-electrode-" + std::to_string(::getpid()));
+  const auto tables =
+      std::filesystem::temp_directory_path() / ("opencnc-electrode-" + std::to_string(::getpid()));
   std::filesystem::create_directories(tables);
   std::filesystem::copy_file(OPENCNC_SOURCE_DIR "/configs/edm-5axis.tbl", tables / "edm-5axis.tbl",
                              std::filesystem::copy_options::overwrite_existing);
-  FeatureRig rig("edm-5axis.toml", {"interpreter.tool_table=\"" + (tables / "edm-5axis.tbl").string() + "\""});
+  FeatureRig rig("edm-5axis.toml",
+                 {"interpreter.tool_table=\"" + (tables / "edm-5axis.tbl").string() + "\""});
   EXPECT_EQ(rig.status()["features"]["installed"], json({"electrode", "run-from-line"}));
   ASSERT_EQ(rig.command({{"kind", "machine-on"}}).status, 200);
   ASSERT_EQ(rig.command({{"kind", "home"}}).status, 200);
   ASSERT_TRUE(rig.until([](const json& s) { return s["all_homed"] == true; }));
   // The electrode in the spindle sits 0.05, -0.03 and 0.2 mm off tool 1's table offsets (0, 0, 0).
-  ASSERT_EQ(rig.command({{"kind", "simulate"}, {"event", "electrode"}, {"offset", {0.05, -0.03, 0.2}}, {"tip_radius", 0.8}},
+  ASSERT_EQ(rig.command({{"kind", "simulate"},
+                         {"event", "electrode"},
+                         {"offset", {0.05, -0.03, 0.2}},
+                         {"tip_radius", 0.8}},
                         kAdmin)
                 .status,
             200);
-  const Reply measure = rig.command({{"kind", "feature"}, {"feature", "electrode"}, {"action", "measure"}, {"tool", 1}});
+  const Reply measure =
+      rig.command({{"kind", "feature"}, {"feature", "electrode"}, {"action", "measure"}, {"tool", 1}});
   ASSERT_EQ(measure.status, 200) << measure.body.dump();
   ASSERT_TRUE(rig.until([](const json& s) {
     const json& e = s["features"]["electrode"];
@@ -349,7 +378,9 @@ TEST(ServerFeatures, ElectrodeMeasuredOnTheSphereIsShownThenStoredOnConfirmation
   EXPECT_NEAR(last["offset"][0].get<double>(), 0.05, 0.002);
   EXPECT_NEAR(last["offset"][1].get<double>(), -0.03, 0.002);
   EXPECT_NEAR(last["offset"][2].get<double>(), 0.2, 0.002);
-  auto z_of_tool_1 = [&rig] { return get(rig.port, "/api/v1/tools", kOperator).body[0]["z_offset"].get<double>(); };
+  auto z_of_tool_1 = [&rig] {
+    return get(rig.port, "/api/v1/tools", kOperator).body[0]["z_offset"].get<double>();
+  };
   EXPECT_EQ(z_of_tool_1(), 0.0);  // shown, not stored
   EXPECT_EQ(rig.command({{"kind", "feature"}, {"feature", "electrode"}, {"action", "write"}}).status, 400);
   const Reply write =
@@ -358,8 +389,10 @@ TEST(ServerFeatures, ElectrodeMeasuredOnTheSphereIsShownThenStoredOnConfirmation
   EXPECT_NEAR(z_of_tool_1(), 0.2, 0.002);
   ASSERT_TRUE(rig.until([](const json& s) { return s["features"]["electrode"]["last"]["written"] == true; }));
   // Stored once: a second write is the feature's refusal.
-  EXPECT_EQ(rig.command({{"kind", "feature"}, {"feature", "electrode"}, {"action", "write"}, {"confirmed", true}}).status,
-            409);
+  EXPECT_EQ(
+      rig.command({{"kind", "feature"}, {"feature", "electrode"}, {"action", "write"}, {"confirmed", true}})
+          .status,
+      409);
   std::filesystem::remove_all(tables);
 }
 
@@ -410,11 +443,12 @@ TEST(ServerFeatures, TheToolGuardsHoldShowsTheDifferencesAndARestoreLetsTheProgr
   // No silent overwrite: a restore without the operator's confirmation changes nothing.
   EXPECT_EQ(rig.command({{"kind", "feature"}, {"feature", "tool-guard"}, {"action", "restore"}}).status, 400);
   EXPECT_EQ(rig.status()["features"]["tool_guard"]["holding"], true);
-  const Reply restored =
-      rig.command({{"kind", "feature"}, {"feature", "tool-guard"}, {"action", "restore"}, {"confirmed", true}});
+  const Reply restored = rig.command(
+      {{"kind", "feature"}, {"feature", "tool-guard"}, {"action", "restore"}, {"confirmed", true}});
   ASSERT_EQ(restored.status, 200) << restored.body.dump();
   EXPECT_EQ(restored.body["message"], "backup 1 is the live tool table again");
-  ASSERT_TRUE(rig.until([](const json& s) { return s["runs_finished"].get<int>() >= 1 && s["state"] == "idle"; }));
+  ASSERT_TRUE(
+      rig.until([](const json& s) { return s["runs_finished"].get<int>() >= 1 && s["state"] == "idle"; }));
   EXPECT_EQ(rig.status()["features"]["tool_guard"]["holding"], false);
   EXPECT_TRUE(rig.status()["features"]["tool_guard"]["check"].is_null());
 }

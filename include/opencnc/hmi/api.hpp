@@ -42,7 +42,8 @@ struct ToolChange {
 };
 using Command = std::variant<control::Request, ToolChange, SimulationEvent>;
 
-/// The role a command kind needs (admin for tool data and the simulation, else operator); nothing for an unknown kind.
+/// The role a command kind needs (admin for tool data and the simulation, else operator); nothing for an
+/// unknown kind.
 std::optional<Role> role_for(std::string_view kind);
 
 /// Turns a command body (`{"kind": …, …}`) into a request: every field checked for type and

@@ -70,7 +70,7 @@ class MachineFeatures {
  private:
   class Board;
   MachineFeatures() = default;
-  nlohmann::json snapshot(const control::ControllerStatus& s);  // controller thread
+  nlohmann::json snapshot(const control::ControllerStatus& s);          // controller thread
   nlohmann::json tool_guard_state(const control::ControllerStatus& s);  // controller thread
 
   config::MachineProfile profile_;
