@@ -17,6 +17,7 @@
 #include "opencnc/core/axis_map.hpp"
 #include "opencnc/gcode/coupling_codes.hpp"
 #include "opencnc/gcode/dialect.hpp"
+#include "opencnc/gcode/edm_codes.hpp"
 #include "opencnc/gcode/interpreter.hpp"
 #include "opencnc/gcode/rs274_driver.hpp"
 #include "opencnc/gcode/standard_extensions.hpp"
@@ -37,7 +38,7 @@ struct InterpArgs {
   std::string axis_map;
   bool progress = false;  ///< progress on stderr also when it is not a terminal
   std::uint64_t max_blocks = gcode::Limits{}.max_blocks;
-  std::vector<std::string> codes;  ///< code modules beyond the standard ones ("coupling")
+  std::vector<std::string> codes;  ///< code modules beyond the standard ones ("coupling", "edm")
 };
 
 void add_interp_options(CLI::App* cmd, InterpArgs& a) {
@@ -56,8 +57,9 @@ void add_interp_options(CLI::App* cmd, InterpArgs& a) {
   cmd->add_option(
          "--codes", a.codes,
          "code modules beyond the standard ones: coupling (M171-M175, the broaching codes of a machine "
-         "with a [coupling] section)")
-      ->check(CLI::IsMember({"coupling"}));
+         "with a [coupling] section), edm (M180 P<n> selects machining condition n, 1-99, and switches "
+         "the generator on, M181 switches it off: the codes of a machine with an [edm] section)")
+      ->check(CLI::IsMember({"coupling", "edm"}));
   cmd->add_option("--axis-map", a.axis_map, "axis exchange, program letter = machine axis (e.g. X=Y,Y=X)");
   cmd->add_option("--max-blocks", a.max_blocks,
                   "stop with gcode.limit-blocks after this many blocks (loop bodies count each time; default "
@@ -97,8 +99,13 @@ bool make_options(const InterpArgs& a, const std::string& file, gcode::Options& 
     std::fprintf(stderr, "--axis-map: %s\n", problem.c_str());
     return false;
   }
-  const bool coupling = std::find(a.codes.begin(), a.codes.end(), "coupling") != a.codes.end();
-  o.extensions = coupling ? gcode::coupling_extensions(o.dialect) : gcode::standard_extensions(o.dialect);
+  const auto wanted = [&](const char* module) {
+    return std::find(a.codes.begin(), a.codes.end(), module) != a.codes.end();
+  };
+  o.extensions =
+      wanted("coupling") ? gcode::coupling_extensions(o.dialect) : gcode::standard_extensions(o.dialect);
+  // Without a profile any condition number 1-99 is one: the machine's are checked when it opens.
+  if (wanted("edm")) o.extensions = gcode::edm_extensions(o.dialect, {}, o.extensions);
   o.block_delete = a.block_delete;
   o.limits.max_blocks = a.max_blocks;
   o.subroutine_path = a.subroutine_path.empty() ? std::vector<std::string>{"."} : a.subroutine_path;

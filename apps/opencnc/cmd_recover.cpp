@@ -20,6 +20,8 @@
 #include "opencnc/controller/sim_rig.hpp"
 #include "opencnc/motion/coupling.hpp"
 #include "opencnc/recovery/breakpoint_journal.hpp"
+#include "opencnc/recovery/recovery_wait.hpp"
+#include "opencnc/recovery/sim_bore.hpp"
 
 namespace opencnc::cli {
 
@@ -93,6 +95,25 @@ std::optional<recovery::BreakpointRecord> read_record(const std::string& dir) {
   return r && r->valid ? r : std::nullopt;
 }
 
+/// The simulated workpiece as the run that wrote the record left it (`opencnc run --journal` keeps
+/// it beside the journal): the machine powers up with the groove already cut. Without it (or one of
+/// another breakpoint) the simulated bore is uncut, and the load guard meets the groove as a chip.
+void restore_bore(control::SimRig& rig, const std::string& dir, const recovery::BreakpointRecord& r) {
+  if (rig.machine().broach_bore().empty()) return;  // no simulated broach
+  std::string error;
+  const std::optional<recovery::SimBore> b = recovery::load_sim_bore(dir, &error);
+  if (b && b->program_hash == r.program_hash && b->signal_time_s == r.signal_time_s &&
+      rig.machine().restore_broach_bore(b->cells)) {
+    fmt::print("simulated bore      as the power failure left it ({})\n", recovery::kSimBoreFile);
+    return;
+  }
+  const std::string why = !error.empty() ? error
+                          : b            ? "it belongs to another breakpoint"
+                                         : std::string("none beside the journal");
+  fmt::print(stderr, "warning: simulated bore: {}: the workpiece powers up uncut (the load guard may hold)\n",
+             why);
+}
+
 /// The operator's yes on the terminal (anything else, or no input, is no).
 bool confirmed(const std::string& question) {
   fmt::print("{} [y/N] ", question);
@@ -159,6 +180,7 @@ int recover(const RecoverOptions& o) {
       std::make_shared<RecoverTrace>(csv ? &*csv : nullptr, r->coupling,
                                      control::coupling_config(profile.coupling), profile.coupling.radius_mm);
   rig.controller().attach(trace, control::ObserverOptions{profile.servo_period_s, true});
+  restore_bore(rig, o.journal, *r);
   rig.step();
   if (!rig.request(control::Request::simple(control::CommandKind::MachineOn)).accepted ||
       !rig.request(control::Request::set_mode(control::Mode::Auto)).accepted) {
@@ -172,18 +194,12 @@ int recover(const RecoverOptions& o) {
     args = recovery::RetractArgs{o.distance_mm, o.direction == "onward", o.speed_mm_min};
   const control::Outcome answer = rig.request(control::Request::feature("journal", o.choice, args), 100000);
   bool done = false;
+  std::string why = answer.message;
   if (answer.accepted) {
-    rig.run_until(
-        [&] {
-          const auto p = journal->phase();
-          return p == recovery::RecoveryPhase::Done || p == recovery::RecoveryPhase::Failed;
-        },
-        100'000'000);
-    done = journal->phase() == recovery::RecoveryPhase::Done;
+    why = recovery::run_recovery(rig, *journal);
+    done = why.empty();
   }
   journal->flush();
-  std::string why = !answer.accepted ? answer.message : journal->recovery_error();
-  if (!rig.status().fault_text.empty()) why += " (" + rig.status().fault_text + ")";
   const auto after = journal->last_written();
   fmt::print("{}  {}\n", o.choice, done ? "completed" : "refused or failed: " + why);
   if (r->coupling.kind != 0)

@@ -549,7 +549,7 @@ int run(const RunOptions& o) {
     }
     j["retraces"] = retraces_json(records, script->times());
   }
-  if (journal) j["journal"] = finish_run_journal(*journal);
+  if (journal) j["journal"] = finish_run_journal(*journal, o.journal, end.sim_bore);
   if (report_file != nullptr && !write_and_commit(*report_file, j.dump(2) + "\n")) rc = kExitUsage;
   return rc;
 }

@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "opencnc/controller/gcode_source.hpp"
+#include "opencnc/recovery/sim_bore.hpp"
 
 namespace opencnc::cli {
 
@@ -18,7 +19,8 @@ std::shared_ptr<recovery::BreakpointJournal> open_run_journal(const std::string&
   return journal;
 }
 
-nlohmann::json finish_run_journal(recovery::BreakpointJournal& journal) {
+nlohmann::json finish_run_journal(recovery::BreakpointJournal& journal, const std::string& dir,
+                                  const std::vector<float>& sim_bore) {
   journal.flush();
   nlohmann::json j;
   const std::optional<recovery::BreakpointRecord> r = journal.last_written();
@@ -43,6 +45,16 @@ nlohmann::json finish_run_journal(recovery::BreakpointJournal& journal) {
   j["record_latency_ms"] = latencies.front();
   fmt::print("journal             {}\n", describe(*r));
   fmt::print("journal latency     {:.3f} ms from the signal to the durable record\n", latencies.front());
+  j["sim_bore"] = false;
+  if (!sim_bore.empty()) {
+    // The simulated workpiece keeps its groove across the restart, as a real one does.
+    std::string bore_error;
+    if (recovery::save_sim_bore(dir, {r->program_hash, r->signal_time_s, sim_bore}, &bore_error)) {
+      j["sim_bore"] = true;
+    } else {
+      fmt::print(stderr, "warning: journal: the simulated bore was not kept: {}\n", bore_error);
+    }
+  }
   return j;
 }
 

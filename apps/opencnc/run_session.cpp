@@ -61,6 +61,8 @@ class Driver {
   virtual void inject_edm_short() {}
   /// A simulated analog input goes to `value` over `ramp_s` (0: at once). Virtual time only.
   virtual void drive_analog(int /*channel*/, double /*value*/, double /*ramp_s*/) {}
+  /// The simulated broach's workpiece (virtual time only: empty otherwise).
+  virtual std::vector<float> sim_bore() { return {}; }
 };
 
 class VirtualDriver final : public Driver {
@@ -83,6 +85,10 @@ class VirtualDriver final : public Driver {
     } else {
       m.set_analog_input(channel, value);
     }
+  }
+  std::vector<float> sim_bore() override {
+    const std::span<const float> b = rig_.machine().broach_bore();
+    return {b.begin(), b.end()};
   }
 
  private:
@@ -563,6 +569,7 @@ SessionEnd run_session(const SessionOptions& o, const SessionHooks& hooks) {
   control::EventCursor cursor(d.controller().events());
   if (!must(d, Request::simple(CommandKind::CycleStart))) return end;
   follow(d, cursor, o, hooks, end);
+  end.sim_bore = d.sim_bore();
   end.exit_code = end.finished ? kExitOk : end.stopped_by != 0 ? 128 + end.stopped_by : kExitProgram;
   return end;
 }

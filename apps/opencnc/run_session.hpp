@@ -56,6 +56,9 @@ struct SessionEnd {
   double wall_s = 0;           ///< wall-clock time of the run
   config::MachineProfile profile;
   std::optional<control::OpenProgram> program;  ///< the program as opened (its preflight)
+  /// The simulated broach's workpiece as the run left it (virtual time on a machine with a
+  /// simulated broach; empty otherwise): `--journal` keeps it beside the breakpoint.
+  std::vector<float> sim_bore;
 };
 
 /// Observers attached before the program starts (a run recorder, a trace writer), and progress.

@@ -2,12 +2,14 @@
 // soak — the five-axis sinker EDM machining for hours in virtual time: one channel after another
 // (roughing with jumps, semi-finishing with a circle orbit, finishing with a square orbit and jumps
 // along the path, four electrode changes per channel, B tilted both ways), a fresh workpiece per
-// channel. Measures what a days-long job needs: resident memory flat after the first hour, the
+// channel. Measures what a days-long job needs: resident memory flat after the first hour (and
+// the resident set and the heap in use at the end of every hour), the
 // servo tick's cost (p99) unchanged from the first hour to the last, and no drift of the rest
 // position against the program.
 //
 //   soak [--hours H] [--json] [--profile FILE]
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <malloc.h>
 
 #include <algorithm>
@@ -23,6 +25,7 @@
 #include <string>
 #include <string_view>
 #include <tuple>
+#include <vector>
 
 #include "opencnc/config/profile_loader.hpp"
 #include "opencnc/controller/gcode_source.hpp"
@@ -144,6 +147,7 @@ struct Result {
   double heap_first = 0, heap_last = 0;
   double p99_first = 0, p99_last = 0, drift_um = 0, drift_mdeg = 0;
   std::uint64_t channels = 0, ticks = 0, jumps = 0;
+  std::vector<double> rss_hourly, heap_hourly;  // at the end of every hour of machining
 };
 
 bool accepted(SimRig& rig, Request r) {
@@ -190,6 +194,8 @@ int main(int argc, char** argv) {
       clock_gettime(CLOCK_MONOTONIC, &b);
       now->add((b.tv_sec - a.tv_sec) * 1'000'000'000LL + (b.tv_nsec - a.tv_nsec));
       if (++tick == hour_end) {
+        r.rss_hourly.push_back(rss_mb().first);
+        r.heap_hourly.push_back(heap_in_use_mb());
         if (hour_end == hour_ticks) {
           std::tie(r.rss_first, r.hwm_first) = rss_mb();
           r.heap_first = heap_in_use_mb();
@@ -240,9 +246,11 @@ int main(int argc, char** argv) {
         "\"peak_rss_mb_first_hour\": {:.1f}, \"peak_rss_mb_last_hour\": {:.1f}, \"tick_ns_p99_first_hour\": "
         "{:.0f}, "
         "\"tick_ns_p99_last_hour\": {:.0f}, \"position_drift_um\": {:.3f}, \"position_drift_mdeg\": {:.3f}, "
-        "\"heap_mb_first_hour\": {:.3f}, \"heap_mb_last_hour\": {:.3f}, \"channels\": {}, \"jumps\": {}}}\n",
+        "\"heap_mb_first_hour\": {:.3f}, \"heap_mb_last_hour\": {:.3f}, \"channels\": {}, \"jumps\": {}, "
+        "\"rss_mb_hourly\": [{:.2f}], \"heap_mb_hourly\": [{:.3f}]}}\n",
         hours, r.wall_s, r.rss_first, r.rss_last, r.hwm_first, r.hwm_last, r.p99_first, r.p99_last,
-        r.drift_um, r.drift_mdeg, r.heap_first, r.heap_last, r.channels, r.jumps);
+        r.drift_um, r.drift_mdeg, r.heap_first, r.heap_last, r.channels, r.jumps,
+        fmt::join(r.rss_hourly, ", "), fmt::join(r.heap_hourly, ", "));
   } else {
     fmt::print("soak: {:.3f} h of machining ({} channels, {} jumps) in {:.1f} s\n", hours, r.channels,
                r.jumps, r.wall_s);

@@ -52,6 +52,7 @@ void read_axes_of(Section& s, MachineProfile& p) {
     }
   }
   c.path_spacing_mm = s.number_or("path_spacing_mm", c.path_spacing_mm, Bound::Positive);
+  c.short_timeout_s = s.number_or("short_timeout_s", c.short_timeout_s, Bound::Positive);
 }
 
 double speed_limit(const MachineProfile& p, int axis) {
@@ -78,6 +79,7 @@ void read_servo(Section& t, EdmCondition& c, const MachineProfile& p) {
   c.max_forward_mm_s = t.required_number("max_forward_mm_s", Bound::Positive);
   c.max_retract_mm_s = t.required_number("max_retract_mm_s", Bound::Positive);
   c.filter_s = t.number_or("filter_s", c.filter_s, Bound::NonNegative);
+  c.short_timeout_s = t.number_or("short_timeout_s", p.edm.config.short_timeout_s, Bound::Positive);
   const double v_max = speed_limit(p, p.edm.config.tool_axis);
   for (const char* key : {"max_forward_mm_s", "max_retract_mm_s"}) {
     const double v = std::string_view(key) == "max_forward_mm_s" ? c.max_forward_mm_s : c.max_retract_mm_s;
@@ -161,10 +163,10 @@ void read_conditions(Section& s, MachineProfile& p) {
   machine::EdmConfig& e = p.edm.config;
   for (std::size_t i = 0; i < list->size(); ++i) {
     Section t(*(*list)[i].as_table(), fmt::format("edm.condition[{}]", i + 1),
-              {"number", "on_time_us", "off_time_us", "peak_current_a", "voltage_v", "polarity",
-               "servo_reference_v", "gain_mm_s_per_v", "max_forward_mm_s", "max_retract_mm_s", "filter_s",
-               "jump_height_mm", "jump_period_s", "jump_speed_mm_s", "jump_mode", "orbit", "orbit_radius_mm",
-               "orbit_step_mm", "orbit_period_s"},
+              {"number",   "on_time_us",        "off_time_us",     "peak_current_a",   "voltage_v",
+               "polarity", "servo_reference_v", "gain_mm_s_per_v", "max_forward_mm_s", "max_retract_mm_s",
+               "filter_s", "jump_height_mm",    "jump_period_s",   "jump_speed_mm_s",  "jump_mode",
+               "orbit",    "orbit_radius_mm",   "orbit_step_mm",   "orbit_period_s",   "short_timeout_s"},
               s.reporter());
     EdmCondition c;
     const auto number = t.integer("number", 1, 99);
@@ -232,7 +234,8 @@ void read_edm_sim(Section& s, MachineProfile& p) {
 void read_edm(Section& top, MachineProfile& profile) {
   const toml::table* t = top.subtable("edm");
   if (t == nullptr) return;
-  Section s(*t, "edm", {"tool_axis", "lift", "orbit_plane", "path_spacing_mm", "condition", "sim"},
+  Section s(*t, "edm",
+            {"tool_axis", "lift", "orbit_plane", "path_spacing_mm", "short_timeout_s", "condition", "sim"},
             top.reporter());
   profile.edm.present = true;
   profile.edm.config.enabled = true;

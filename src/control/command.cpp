@@ -68,6 +68,8 @@ const char* fault_code(FaultKind k) noexcept {
       return "control.fault.stall";
     case FaultKind::ProcessAlarm:
       return "control.fault.process-alarm";
+    case FaultKind::EdmShort:
+      return "control.fault.edm-short";
   }
   return "control.fault.unknown";
 }

@@ -138,6 +138,8 @@ void GapServo::begin_run(const Pose& at) noexcept {
   jump_ = Jump::Idle;
   lift_ = lift_v_ = 0;
   machining_s_ = 0;
+  status_.short_s = 0;
+  status_.retract_limit = reached_retract_limit_ = pressing_limit_ = false;
   phase_ = radius_ = 0;
   turns_ = 0;
   orbit_[0] = orbit_[1] = 0;
@@ -182,6 +184,12 @@ Pose GapServo::step(const GapInputs& in) noexcept {
   status_.gap_voltage_v = in.gap_voltage_v;
   status_.gap_state = in.gap_state;
   const bool machining = config_.enabled && status_.on && !in.rapid && !in.hold;
+  // A short is timed while machining; a hold leaves the count where it stands (the gap is still
+  // shorted when the program goes on), anything else (a rapid, M181) ends it.
+  if (machining && in.gap_state == machine::GapState::Short)
+    status_.short_s += period_s_;
+  else if (!in.hold)
+    status_.short_s = 0;
   if (!machining) {
     v_ = 0;
     run_jump(false);
@@ -209,6 +217,11 @@ Pose GapServo::step(const GapInputs& in) noexcept {
   status_.path_speed_mm_s = v_;
   status_.backlog_mm = memory_.head_s() - s_;
   status_.retract_limit = s_ <= memory_.tail_s() && v_ <= 0 && status_.backlog_mm > 0;
+  // Reached: the servo still drives back (a short, an arc) and the memory has no more path. Told
+  // once until the electrode has moved off the end again.
+  reached_retract_limit_ = machining && status_.retract_limit && v_ < 0 && !pressing_limit_;
+  if (reached_retract_limit_) pressing_limit_ = true;
+  if (!status_.retract_limit) pressing_limit_ = false;
   status_.jumping = jump_ != Jump::Idle;
   status_.jump_lift_mm = cond_.jump_mode == JumpMode::Axis || jump_ == Jump::Idle ? lift_ : jump_from_s_ - s_;
   status_.orbit_radius_mm = radius_;

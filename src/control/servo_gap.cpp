@@ -35,6 +35,25 @@ void Servo::run_gap_servo() noexcept {
     const int axis = config_.joints[static_cast<std::size_t>(j)].axis;
     if (!manual(j)) commanded_[axis] = p[axis];
   }
+  watch_gap();
+}
+
+// What the gap servo cannot mend itself: backing off has run out of path (told, the servo holds
+// there), and a short that outlasts the condition's short_timeout_s (a fault: the generator and
+// the drives off, the run ended).
+void Servo::watch_gap() noexcept {
+  const EdmStatus& s = gap_.status();
+  if (gap_.reached_retract_limit()) {
+    ServoEvent e;
+    e.kind = EventKind::EdmRetractLimit;
+    e.run_id = run_id_;
+    e.action = static_cast<std::uint32_t>(s.condition);
+    e.value = s.backlog_mm;
+    emit(e);
+  }
+  if (gap_.short_timed_out())
+    enter_fault({FaultKind::EdmShort, static_cast<std::int8_t>(s.condition), s.short_s,
+                 gap_.condition().short_timeout_s, tick_});
 }
 
 }  // namespace opencnc::control

@@ -135,7 +135,9 @@ Controller::Controller(const config::MachineProfile& profile, ServoChannels& cha
       channels_(&channels),
       source_(std::move(source)),
       check_(std::make_unique<MachineMoveCheck>(servo_config_, limits_)),
-      location_every_(static_cast<std::uint64_t>(kLocationRefreshS / servo_config_.period_s) + 1) {}
+      location_every_(static_cast<std::uint64_t>(kLocationRefreshS / servo_config_.period_s) + 1) {
+  outcomes_.resize(kKeptOutcomes);
+}
 
 Controller::~Controller() = default;
 
@@ -154,9 +156,9 @@ std::uint64_t Controller::new_id() {
 
 std::optional<Outcome> Controller::outcome(std::uint64_t id) const {
   std::lock_guard lock(out_mutex_);
-  auto it = outcomes_.find(id);
-  if (it == outcomes_.end()) return std::nullopt;
-  return it->second;
+  const KeptOutcome& k = outcomes_[id % outcomes_.size()];
+  if (k.id != id || id == 0) return std::nullopt;
+  return k.outcome;
 }
 
 ControllerStatus Controller::status() const {
@@ -321,6 +323,12 @@ void Controller::on_event(const ServoEvent& e) {
       break;
     case EventKind::LoadGuard:
       note(Severity::Warning, "control.load", interlock_text(e));
+      break;
+    case EventKind::EdmRetractLimit:
+      note(Severity::Warning, "control.edm.retract-limit",
+           fmt::format("EDM condition {}: backing off reached the end of the path memory {:.3f} mm behind "
+                       "the program; the electrode holds there and can go back no further",
+                       e.action, e.value));
       break;
     default:
       break;
@@ -799,7 +807,7 @@ std::string Controller::wait_text() const {
 
 void Controller::log(ControllerEvent e) {
   e.tick = servo().tick;
-  log_.append(std::move(e));
+  log_.append(e);
 }
 
 void Controller::tell_observers() {
@@ -842,13 +850,15 @@ void Controller::finish(std::uint64_t id, Refusal refusal, std::string message, 
   e.severity = e.accepted ? Severity::Note : Severity::Error;
   {
     std::lock_guard lock(out_mutex_);
-    Outcome& o = outcomes_[id];
-    o.accepted = refusal == Refusal::None;
-    o.refusal = refusal;
-    o.message = message.empty() ? refusal_text(refusal) : std::move(message);
-    o.diagnostics = std::move(diags);
-    e.text = o.message;
-    while (outcomes_.size() > kKeptOutcomes) outcomes_.erase(outcomes_.begin());
+    KeptOutcome& k = outcomes_[id % outcomes_.size()];
+    e.text = message.empty() ? refusal_text(refusal) : std::move(message);
+    if (k.id <= id) {  // a later request's answer already there: this one is older than any kept
+      k.id = id;
+      k.outcome.accepted = refusal == Refusal::None;
+      k.outcome.refusal = refusal;
+      k.outcome.message = e.text;
+      k.outcome.diagnostics = std::move(diags);
+    }
   }
   log(std::move(e));
 }
@@ -905,6 +915,12 @@ std::string Controller::describe(const Fault& f) const {
     case FaultKind::Stall:
       return fmt::format("the {} stepper stalled at {:.4f} {}: steps were lost, home it again", axis, f.value,
                          unit);
+    case FaultKind::EdmShort:
+      return fmt::format(
+          "the EDM gap stayed shorted for {:.2f} s, longer than condition {}'s short_timeout_s ({} s): "
+          "the program was stopped with the generator off; clear the gap (debris, a bridge, the electrode "
+          "on the work) before going on",
+          f.value, static_cast<int>(f.axis), f.limit);
     case FaultKind::ProcessAlarm:
       return detail::alarm_text(profile_.alarms, static_cast<std::size_t>(f.axis), f.value, f.value < f.limit,
                                 false);

@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <string>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -135,11 +137,40 @@ double move_length(const canon::Program& program, canon::SegmentId id) {
 
 namespace {
 
+/// The move's extent widened by an EDM condition's orbit (both orbit axes) and axis jump (the tool
+/// axis, away from the work); a jump along the path stays on the path.
+void widen_by_edm(const machine::EdmConfig& edm, const machine::EdmCondition& c, Extent& e) {
+  if (c.orbit != machine::OrbitKind::None) {
+    for (const std::int8_t a : edm.orbit_axes) {
+      e.min[a] -= c.orbit_radius_mm;
+      e.max[a] += c.orbit_radius_mm;
+    }
+  }
+  if (c.jump_period_s > 0 && c.jump_mode == machine::JumpMode::Axis) {
+    (edm.lift_direction > 0 ? e.max : e.min)[edm.tool_axis] += edm.lift_direction * c.jump_height_mm;
+  }
+}
+
+/// "with condition 2's orbit (0.08 mm) and jump (0.4 mm) ": what widened the move, for the message.
+std::string edm_reason(const machine::EdmCondition* c) {
+  if (c == nullptr) return "";
+  const bool orbit = c->orbit != machine::OrbitKind::None;
+  const bool jump = c->jump_period_s > 0 && c->jump_mode == machine::JumpMode::Axis;
+  if (!orbit && !jump) return "";
+  std::string s = fmt::format("with EDM condition {}'s ", c->number);
+  if (orbit) s += fmt::format("orbit ({} mm)", c->orbit_radius_mm);
+  if (orbit && jump) s += " and ";
+  if (jump) s += fmt::format("jump ({} mm)", c->jump_height_mm);
+  return s + " ";
+}
+
 /// One move against the soft limits; `errors` counts every crossing, the first kMaxReported are
-/// listed. Returns whether the move stays inside.
+/// listed. Returns whether the move stays inside. `edm`: the EDM condition whose offsets add to
+/// the move (null: none).
 bool check_move_limits(const canon::Program& program, canon::SegmentId id, const ServoConfig& config,
-                       Diagnostics& diags, int& errors) {
-  const Extent e = move_extent(program, id);
+                       Diagnostics& diags, int& errors, const machine::EdmCondition* edm = nullptr) {
+  Extent e = move_extent(program, id);
+  if (edm != nullptr) widen_by_edm(config.edm, *edm, e);
   bool inside = true;
   for (int j = 0; j < config.joint_count; ++j) {
     const JointConfig& jc = config.joints[static_cast<std::size_t>(j)];
@@ -150,11 +181,12 @@ bool check_move_limits(const canon::Program& program, canon::SegmentId id, const
     if (++errors > kMaxReported) continue;
     const canon::Move& m = program.move(id);
     const char* unit = jc.rotary ? "deg" : "mm";
-    diags.error(file_of(program, id), m.line, 0,
-                fmt::format("this move takes {} to {:.4f} {}, beyond its {} soft limit of {} {}",
-                            kAxisLetters[static_cast<std::size_t>(jc.axis)], high ? e.max[jc.axis] : e.min[jc.axis],
-                            unit, high ? "maximum" : "minimum", high ? jc.max_limit : jc.min_limit, unit),
-                "control.soft-limit");
+    diags.error(
+        file_of(program, id), m.line, 0,
+        fmt::format("{}this move takes {} to {:.4f} {}, beyond its {} soft limit of {} {}", edm_reason(edm),
+                    kAxisLetters[static_cast<std::size_t>(jc.axis)], high ? e.max[jc.axis] : e.min[jc.axis],
+                    unit, high ? "maximum" : "minimum", high ? jc.max_limit : jc.min_limit, unit),
+        "control.soft-limit");
   }
   return inside;
 }
@@ -177,13 +209,45 @@ bool check_soft_limits(const canon::Program& program, const ServoConfig& config,
 
 bool MachineMoveCheck::check(const canon::Program& program, canon::SegmentId move, Diagnostics& diags) {
   const bool planner_ok = plan::check_move(program, move, limits_, diags);
+  const machine::EdmCondition* edm = edm_condition_at(program, move);
   // A move the planner cannot make (not finite, a bad arc) has no extent worth checking.
-  return planner_ok && check_move_limits(program, move, config_, diags, soft_limit_errors_);
+  return planner_ok && check_move_limits(program, move, config_, diags, soft_limit_errors_, edm);
 }
 
 void MachineMoveCheck::finish(Diagnostics& diags) {
   report_unlisted(soft_limit_errors_, diags);
   soft_limit_errors_ = 0;
+  edm_program_ = nullptr;  // the next scan starts from its program's start
+}
+
+// The moves are checked in order; the codes before each are read once (a new program, or a move
+// before the last one, starts afresh). Actions already released were seen before (the scan
+// releases only what it has checked).
+const machine::EdmCondition* MachineMoveCheck::edm_condition_at(const canon::Program& program,
+                                                                std::size_t move) {
+  if (!config_.edm.enabled) return nullptr;
+  if (&program != edm_program_ || move < edm_last_move_) {
+    edm_program_ = &program;
+    edm_next_action_ = 0;
+    edm_on_ = edm_tail_ = 0;
+  }
+  edm_last_move_ = move;
+  edm_next_action_ = std::max(edm_next_action_, program.first_held_action());
+  for (; edm_next_action_ < program.action_count(); ++edm_next_action_) {
+    const canon::Action& a = program.action(edm_next_action_);
+    if (a.before_move > move) break;
+    if (a.kind != canon::ActionKind::ProcessCode) continue;
+    if (a.index == machine::kEdmConditionCode) {
+      edm_on_ = static_cast<int>(std::lround(a.value));
+      edm_tail_ = 0;
+    } else if (a.index == machine::kEdmOffCode) {
+      edm_tail_ = edm_on_ != 0 ? edm_on_ : edm_tail_;
+      edm_on_ = 0;
+    }
+  }
+  if (edm_on_ != 0) return config_.edm.find(edm_on_);
+  const int tail = std::exchange(edm_tail_, 0);  // the one move after M181
+  return tail != 0 ? config_.edm.find(tail) : nullptr;
 }
 
 }  // namespace opencnc::control

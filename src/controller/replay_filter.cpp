@@ -31,7 +31,15 @@ bool ReplayFilter::motion(canon::SegmentId id, const Pose* end, bool end_unknown
     }
   }
   for (const auto& [index, v] : analog_) next_->set_aux_output_value(index, v);
+  for (const canon::ProcessCode& c : process_) next_->process_code(c);  // last: the process on
   return true;
+}
+
+void ReplayFilter::process_code(const canon::ProcessCode& c) {
+  if (live_) return next_->process_code(c);
+  if (c.group == 0) return;
+  std::erase_if(process_, [&](const canon::ProcessCode& held) { return held.group == c.group; });
+  process_.push_back(c);
 }
 
 // Only the coupling that holds at segment k matters: every code before it replaces the one before

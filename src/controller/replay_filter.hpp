@@ -1,13 +1,15 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // ReplayFilter — the canonical calls of a program resumed at segment k: before it, only what
 // sets the builder's state (units, offsets, rotation, plane, feed, path control, override
-// switches) passes; motions and the machine's actions are held back, the last spindle, coolant
-// and output states noted and restored just before segment k runs. Controller thread.
+// switches) passes; motions and the machine's actions are held back, the last spindle, coolant,
+// output states and modal process codes noted and restored just before segment k runs.
+// Controller thread.
 #pragma once
 
 #include <array>
 #include <cstdint>
 #include <map>
+#include <vector>
 
 #include "opencnc/canon/sink.hpp"
 
@@ -54,6 +56,9 @@ class ReplayFilter final : public canon::Sink {
   /// origin it had (where the path stood: the end of the motion before it), so the resumed run's
   /// law is the original one, not one engaged where the machine stands now.
   void set_axis_coupling(const canon::AxisCoupling& c) override;
+  /// A modal process code (group ≠ 0) before segment k is held, the last of each group passed
+  /// just before k (an EDM condition and the generator on, or off); one-shot codes are dropped.
+  void process_code(const canon::ProcessCode& c) override;
   void dwell(double s) override {
     if (live_) next_->dwell(s);
   }
@@ -184,6 +189,7 @@ class ReplayFilter final : public canon::Sink {
   Pose at_{};
   bool at_known_ = false;
   canon::AxisCoupling coupling_{};  ///< the coupling code that holds (law 0: none)
+  std::vector<canon::ProcessCode> process_;  ///< the last code of each modal group, in program order
   // What the replayed part left on (−1: never set, so left as the machine has it).
   struct Spindle {
     double speed = 0;

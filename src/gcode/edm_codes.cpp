@@ -29,6 +29,7 @@ class EdmCodes final : public CodeHandler {
   void execute(ExecContext& ctx, const Block& b, int code) override {
     canon::ProcessCode c;
     c.code = code;
+    c.group = kCondition;  // M180 and M181 replace each other: the generator's condition or off
     if (code == kCondition) {
       const double p = b.p_or(0);
       const bool whole = b.has('p') && std::isfinite(p) && p == std::floor(p) && p >= 1 && p <= 99;

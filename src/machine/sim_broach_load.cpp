@@ -38,6 +38,15 @@ double SimBroachLoad::cut_depth(double stroke, double angle_deg) const noexcept 
   return cut_[static_cast<std::size_t>(cell * kAngleCells + angle_cell(angle_deg))];
 }
 
+bool SimBroachLoad::restore_bore(std::span<const float> bore) noexcept {
+  if (bore.size() != cut_.size()) return false;
+  std::copy(bore.begin(), bore.end(), cut_.begin());
+  cell_ = -1;
+  direction_ = 0;
+  chip_mm_ = 0;
+  return true;
+}
+
 // Entering a cell the cutter meets what the strokes before left there (read at the cutter's
 // middle) and cuts the wall down to its own depth across its width. Marking the whole width, not
 // only the middle, keeps a later stroke along the same helix from finding fresh material in the

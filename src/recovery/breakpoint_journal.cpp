@@ -3,6 +3,9 @@
 // at rest, made durable on the writer thread (hash of the program, journal write, modal digest).
 #include "opencnc/recovery/breakpoint_journal.hpp"
 
+#include <pthread.h>
+#include <sched.h>
+
 #include <cmath>
 #include <numbers>
 
@@ -51,6 +54,25 @@ double arc_length(const canon::Program& p, canon::SegmentId id) {
   const double turns = std::fabs(sweep) + 2 * std::numbers::pi * (std::abs(g.turns) - 1);
   const double rise = wn - un;
   return std::hypot(r * turns, rise);
+}
+
+/// The writer's SCHED_FIFO priority where the process may have one: below the servo thread's (80,
+/// control::RealtimeClock), above everything that is not real-time. Under load the time from the
+/// signal to the durable record was the writer waiting for a core, not the disk (docs/broaching.md).
+constexpr int kWriterPriority = 70;
+
+/// The calling thread to SCHED_FIFO at `priority`, or back to SCHED_OTHER (0); false where not
+/// permitted (no CAP_SYS_NICE, no RLIMIT_RTPRIO): the thread then stays as it was.
+bool schedule_this_thread(int priority) {
+  sched_param param{};
+  param.sched_priority = priority;
+  return pthread_setschedparam(pthread_self(), priority > 0 ? SCHED_FIFO : SCHED_OTHER, &param) == 0;
+}
+
+bool this_thread_is_fifo() {
+  int policy = SCHED_OTHER;
+  sched_param param{};
+  return pthread_getschedparam(pthread_self(), &policy, &param) == 0 && policy == SCHED_FIFO;
 }
 
 }  // namespace
@@ -226,6 +248,7 @@ std::string BreakpointJournal::last_error() const {
 // Takes the queue in one piece: a newer record makes an older one not yet written moot (but the
 // older one's signal time still counts for the latency of the first durable record).
 void BreakpointJournal::writer_loop() {
+  schedule_this_thread(kWriterPriority);  // where permitted; a normal thread otherwise
   std::unique_lock lock(mutex_);
   for (;;) {
     wake_.wait(lock, [this] { return stop_ || !queue_.empty(); });
@@ -237,9 +260,12 @@ void BreakpointJournal::writer_loop() {
     std::optional<Clock::time_point> signal;
     std::optional<Work> last;
     for (Work& w : batch) {
-      if (w.hash_only) {
+      if (w.hash_only) {  // a program just opened: no emergency, and a huge file takes a while
+        const bool fifo = this_thread_is_fifo();
+        if (fifo) schedule_this_thread(0);
         hashed_path_ = w.record.program_path;
         hash_ = hash_file(hashed_path_).value_or(FileHash{});
+        if (fifo) schedule_this_thread(kWriterPriority);
         continue;
       }
       if (w.signal && !signal) signal = w.signal;
@@ -269,8 +295,13 @@ void BreakpointJournal::write_one(Work& w) {
   bool ok = journal_->write(encode(r), &error);
   const Clock::time_point durable = Clock::now();
   if (ok && w.digest) {
+    // The replay is no emergency (the record is durable) and may be long: not at real-time priority.
+    const bool fifo = this_thread_is_fifo();
+    if (fifo) schedule_this_thread(0);
     std::string why;
-    if (auto d = modal_digest_at(w.options, r.program_path, r.program_start, r.segment, &why)) {
+    const auto d = modal_digest_at(w.options, r.program_path, r.program_start, r.segment, &why);
+    if (fifo) schedule_this_thread(kWriterPriority);
+    if (d) {
       r.modal_digest = *d;
       ok = journal_->write(encode(r), &error);
     } else {

@@ -97,6 +97,9 @@ TEST(EdmProfile, BadConditionsAreNamedWhereTheyAre) {
       {base + condition("") + condition(""), "number", "defined twice", second},
       {base + "[[edm.condition]]\nnumber = 100\n", "number", "number"},
       {base + condition("jump_mode = \"sideways\"\n"), "jump_mode", "must be one of axis, path"},
+      {base + condition("short_timeout_s = 0\n"), "short_timeout_s", "must be greater than 0"},
+      {std::string(kMachine).replace(base.find("tool_axis"), 0, "short_timeout_s = -1\n") + condition(""),
+       "short_timeout_s", "edm.short_timeout_s must be greater than 0"},
   };
   for (const Bad& b : cases) {
     const ProfileLoad load = parse_profile(b.text, "edm.toml");
@@ -108,6 +111,21 @@ TEST(EdmProfile, BadConditionsAreNamedWhereTheyAre) {
     EXPECT_EQ(e->line, line_of(b.text, b.key, b.after)) << all_messages(load.diagnostics);
     EXPECT_GT(e->col, 0u);
   }
+}
+
+// A short's time limit: 5 s unless [edm] says otherwise, and a condition may have its own.
+TEST(EdmProfile, TheShortTimeoutComesFromTheConditionOrEdm) {
+  ProfileLoad load = parse_profile(std::string(kMachine) + condition(""), "edm.toml");
+  ASSERT_TRUE(load.ok()) << all_messages(load.diagnostics);
+  EXPECT_EQ(load.profile->edm.config.find(1)->short_timeout_s, 5.0);
+  std::string text = kMachine;
+  text.replace(text.find("tool_axis"), 0, "short_timeout_s = 2.5\n");
+  std::string second = condition("short_timeout_s = 0.8\n");
+  second.replace(second.find("number = 1"), 10, "number = 2");
+  load = parse_profile(text + condition("") + second, "edm.toml");
+  ASSERT_TRUE(load.ok()) << all_messages(load.diagnostics);
+  EXPECT_EQ(load.profile->edm.config.find(1)->short_timeout_s, 2.5);
+  EXPECT_EQ(load.profile->edm.config.find(2)->short_timeout_s, 0.8);
 }
 
 TEST(EdmProfile, TheReferenceMustBeBelowTheOpenVoltageAndTheGeneratorPresent) {

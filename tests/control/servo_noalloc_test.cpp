@@ -201,6 +201,23 @@ TEST(ServoAllocations, NoneInsideTheLoadGuard) {
   std::filesystem::remove_all(dir);
 }
 
+// The event log keeps its entries in a ring built once: a job that runs for days appends events
+// without the log's memory growing (the strings are copied into fixed fields).
+TEST(ServoAllocations, NoneWhenTheEventLogAppends) {
+  EventLog log(8);
+  ControllerEvent e;
+  e.text = std::string(400, 'x');  // longer than its field: cut, not stored on the heap
+  e.code = "control.fault.stall";
+  e.location.file = "part.ngc";
+  e.location.calls = {"o<a> called at part.ngc:1", "o<b> called at a.ngc:2"};
+  g_allocations = 0;
+  g_armed = true;
+  for (int i = 0; i < 100; ++i) log.append(e);
+  g_armed = false;
+  EXPECT_EQ(g_allocations.load(), 0);
+  EXPECT_EQ(log.last(), 100u);
+}
+
 // The sinker EDM's tick: the gap servo forward and back along the path (an injected short), jumps
 // along the tool axis and along the path, circle and square orbits growing, a feed hold, M181.
 TEST(ServoAllocations, NoneInsideTheEdmTick) {

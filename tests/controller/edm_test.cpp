@@ -2,7 +2,8 @@
 // The sinker EDM through the whole controller on configs/edm-5axis.toml: the gap held in its
 // band while the depth grows, an injected short backed off and recovered within a bound, the
 // jump's timing and height, the orbit's radius and shape from the trace, arcing without the jump,
-// and the preflight refusing an unknown condition at its line.
+// a short that never clears stopped by its time, and the preflight refusing an unknown condition
+// at its line.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -124,6 +125,121 @@ TEST(Edm, AnInjectedShortIsBackedOffAlongThePathAndRecovered) {
   EXPECT_GT(r.report.gap_voltage_in_band_fraction, 0.75);
 }
 
+// A bridge that no backing off breaks (100 mm): the electrode backs off at 3 mm/s to the end of the
+// path memory (which starts with the run: the approach from Z0, 20 mm up the path), is told to
+// hold there, and once the short has lasted short_timeout_s the machine stops with a fault that
+// says so.
+TEST(Edm, AShortThatNeverClearsStopsTheMachineWithAFault) {
+  const config::MachineProfile p = edm({"edm.sim.short_bridge_mm=100", "edm.short_timeout_s=8"});
+  ASSERT_EQ(p.edm.config.find(1)->short_timeout_s, 8.0);
+  Diagnostics d;
+  SimRig rig(p, GcodeProgramSource::create(p, d));
+  EventCursor events(rig.controller().events());
+  rig.step();
+  ASSERT_TRUE(rig.request(Request::simple(CommandKind::MachineOn)).accepted);
+  ASSERT_TRUE(rig.request(Request::set_mode(Mode::Auto)).accepted);
+  ASSERT_TRUE(rig.request(Request::open(write_program(burn(1, 0.03))), 100000).accepted);
+  ASSERT_TRUE(rig.request(Request::simple(CommandKind::CycleStart)).accepted);
+  double shorted_at = -1, limit_at = -1;
+  ASSERT_TRUE(rig.run_until(
+      [&] {
+        const ServoStatus& s = rig.status().servo;
+        if (shorted_at < 0 && s.edm.generator && s.edm.gap_state == machine::GapState::Normal) {
+          rig.machine().inject_edm_short();
+          shorted_at = s.time_s;
+        }
+        if (limit_at < 0 && s.edm.retract_limit) limit_at = s.time_s;
+        return s.state == State::Faulted || (!rig.status().run_active && s.state == State::Idle);
+      },
+      40000));
+  const ServoStatus s = rig.status().servo;
+  ASSERT_EQ(s.state, State::Faulted);
+  EXPECT_EQ(s.fault.kind, FaultKind::EdmShort);
+  ASSERT_GE(shorted_at, 0);
+  ASSERT_GE(limit_at, shorted_at);
+  // The short is timed from its first period: the fault comes 8 s later, to a period or two.
+  EXPECT_NEAR(s.time_s - shorted_at, 8, 0.003);
+  EXPECT_LT(limit_at - shorted_at, 8);
+  EXPECT_NEAR(s.edm.backlog_mm, 20.0, 0.05);
+  EXPECT_FALSE(s.edm.generator);
+  bool told_limit = false, told_fault = false;
+  for (const ControllerEvent& e : events.next()) {
+    if (e.kind != ControllerEventKind::Note) continue;
+    if (e.code == "control.edm.retract-limit") {
+      told_limit = true;
+      EXPECT_NE(e.text.find("end of the path memory"), std::string::npos) << e.text;
+    }
+    if (e.code == "control.fault.edm-short") {
+      told_fault = true;
+      EXPECT_NE(e.text.find("shorted for 8.00 s, longer than condition 1's short_timeout_s (8 s)"),
+                std::string::npos)
+          << e.text;
+    }
+  }
+  EXPECT_TRUE(told_limit);
+  EXPECT_TRUE(told_fault);
+}
+
+// A short that clears within its time is no fault, however long the program runs on.
+TEST(Edm, TheShortTimeCountsOnlyAnUnbrokenShort) {
+  int shorts = 0;
+  const EdmRun r = run(burn(1, 0.03), edm({"edm.short_timeout_s=0.05"}), [&](SimRig& rig) {
+    const ServoStatus& s = rig.status().servo;
+    if (shorts < 3 && s.time_s > 0.3 * (shorts + 1) && s.edm.generator &&
+        s.edm.gap_state == machine::GapState::Normal) {
+      rig.machine().inject_edm_short();  // the 20 µm bridge breaks in about 7 ms each time
+      ++shorts;
+    }
+  });
+  ASSERT_TRUE(r.finished);
+  EXPECT_EQ(shorts, 3);
+  EXPECT_EQ(r.rig->status().servo.state, State::Idle);
+  EXPECT_GE(r.report.shorts, 3u);
+}
+
+// Resumed at the second feed of condition 2 (ResumeProgram, as run from line and electrode setting
+// use it): the condition in force there is selected again and the generator comes on before the
+// electrode cuts on: condition 2, not condition 1 nor none.
+TEST(Edm, AResumedProgramSelectsTheConditionInForceAgain) {
+  const config::MachineProfile p = edm();
+  const std::string text =
+      "G21 G90\nG0 Z-19.97\nM180 P1\nG1 Z-19.99 F60\nM180 P2\nG1 Z-20.0 F30\nG1 Z-20.02\nM181\n"
+      "G0 Z0\nM2\n";
+  const std::string path = write_program(text);
+  Diagnostics d;
+  auto source = GcodeProgramSource::create(p, d);
+  canon::SegmentId k = 0;  // the segment of line 7 (G1 Z-20.02)
+  {
+    auto whole = source->execute(path, Pose{}, {});
+    for (int i = 0; i < 1000 && whole->state() == StreamState::Reading; ++i) whole->read(100);
+    for (std::size_t m = 0; m < whole->program().size(); ++m)
+      if (whole->program().move(m).line == 7) k = whole->program().segment_of(m);
+  }
+  ASSERT_NE(k, 0u);
+  SimRig rig(p, GcodeProgramSource::create(p, d));
+  rig.step();
+  ASSERT_TRUE(rig.request(Request::simple(CommandKind::MachineOn)).accepted);
+  ASSERT_TRUE(rig.request(Request::set_mode(Mode::Mdi)).accepted);
+  ASSERT_TRUE(rig.request(Request::mdi("G0 Z-19.995"), 100000).accepted);  // on segment k's line
+  ASSERT_TRUE(rig.run_until(
+      [&] { return rig.status().servo.state == State::Idle && !rig.status().run_active; }, 20000));
+  ASSERT_TRUE(rig.request(Request::set_mode(Mode::Auto)).accepted);
+  ASSERT_TRUE(rig.request(Request::open(path), 100000).accepted);
+  const Outcome resumed = rig.request(Request::resume(k), 100000);
+  ASSERT_TRUE(resumed.accepted) << resumed.message;
+  int condition_when_burning = -1;
+  ASSERT_TRUE(rig.run_until(
+      [&] {
+        const EdmStatus& e = rig.status().servo.edm;
+        if (e.generator && condition_when_burning < 0) condition_when_burning = e.condition;
+        return !rig.status().run_active && rig.status().servo.state == State::Idle;
+      },
+      60000));
+  EXPECT_EQ(condition_when_burning, 2);
+  EXPECT_LT(rig.machine().edm().depth_mm(), 0.05);  // it burnt from Z -19.995 to -20.02, no more
+  EXPECT_GT(rig.machine().edm().depth_mm(), 0.0);
+}
+
 TEST(Edm, JumpsLiftTheElectrodeEveryPeriodWithTheGeneratorOff) {
   const EdmRun r = run(burn(1, 0.02));
   ASSERT_TRUE(r.finished);
@@ -204,6 +320,44 @@ TEST(Edm, WithoutTheJumpDebrisMakesTheGapArc) {
   EXPECT_GT(without.report.arcs, 10u);
   EXPECT_EQ(without.report.jumps, 0u);
   EXPECT_GT(without.report.machining_s, with.report.machining_s);  // arcs remove little
+}
+
+// The preflight sees what the gap servo adds to the path: condition 3's square orbit (0.08 mm)
+// around a burn 0.05 mm inside X's limit of 150 mm, condition 1's axis jump (0.4 mm up Z) on a
+// burn 0.2 mm below Z's limit of 50 mm; both refused at the burn's line, the same burns without
+// the orbit or the jump are not.
+TEST(Edm, ThePreflightSeesTheOrbitAndTheJump) {
+  struct Case {
+    std::string program, message;  // message "": accepted
+  };
+  const Case cases[] = {
+      {"G21 G90\nG0 X149.95 Z-19.97\nM180 P3\nG1 Z-20.01 F60\nM181\nG0 Z0\nM2\n",
+       "with EDM condition 3's orbit (0.08 mm) this move takes X to 150.0300 mm, beyond its maximum soft "
+       "limit of 150 mm"},
+      {"G21 G90\nG0 Z49.8\nM180 P1\nG1 Z49.7 F60\nM181\nG0 Z0\nM2\n",
+       "with EDM condition 1's jump (0.4 mm) this move takes Z to 50.2000 mm, beyond its maximum soft limit"},
+      {"G21 G90\nG0 X149.95 Z-19.97\nM180 P1\nG1 Z-20.01 F60\nM181\nG0 Z0\nM2\n", ""},
+  };
+  for (const Case& c : cases) {
+    const config::MachineProfile p = edm();
+    Diagnostics d;
+    SimRig rig(p, GcodeProgramSource::create(p, d));
+    rig.step();
+    ASSERT_TRUE(rig.request(Request::simple(CommandKind::MachineOn)).accepted);
+    ASSERT_TRUE(rig.request(Request::set_mode(Mode::Auto)).accepted);
+    const Outcome o = rig.request(Request::open(write_program(c.program)), 100000);
+    if (c.message.empty()) {
+      EXPECT_TRUE(o.accepted) << o.message
+                              << (o.diagnostics.items().empty() ? "" : o.diagnostics.items()[0].format());
+      continue;
+    }
+    ASSERT_FALSE(o.accepted) << c.program;
+    ASSERT_FALSE(o.diagnostics.items().empty());
+    const Diagnostic& first = o.diagnostics.items().front();
+    EXPECT_EQ(first.code, "control.soft-limit");
+    EXPECT_EQ(first.line, 4u);
+    EXPECT_NE(first.message.find(c.message), std::string::npos) << first.message;
+  }
 }
 
 TEST(Edm, ThePreflightRefusesAConditionTheMachineLacks) {

@@ -78,6 +78,23 @@ TEST(EventLog, NumbersEntriesAndCursorsCountWhatTheyMissed) {
   EXPECT_EQ(all.next().size(), 2u);
 }
 
+// The answers are kept in slots built with the controller: the last 4096 requests' answers can be
+// read, older ones are gone, and answering more never grows the controller.
+TEST(Hub, KeepsTheAnswersOfTheLatestRequestsInFixedSlots) {
+  SimRig rig(mill());
+  Controller& c = rig.controller();
+  const std::uint64_t first = c.submit(Request::set_mode(Mode::Auto));
+  std::uint64_t last = first;
+  for (int i = 0; i < 4200; ++i) last = c.submit(Request::set_mode(Mode::Manual));
+  ASSERT_TRUE(rig.run_until([&] { return c.outcome(last).has_value() && c.outcome(last - 4095).has_value(); },
+                            20000));
+  EXPECT_FALSE(c.outcome(first).has_value());  // 4200 later answers took its place
+  const std::optional<Outcome> o = c.outcome(last);
+  ASSERT_TRUE(o.has_value());
+  EXPECT_EQ(o->accepted, o->refusal == Refusal::None);
+  EXPECT_FALSE(c.outcome(last + 1).has_value());  // not asked yet
+}
+
 TEST(Hub, ObserversEachSeeEveryEventFromWhenTheyAttached) {
   SimRig rig(mill());
   auto first = std::make_shared<Recorder>();

@@ -8,8 +8,11 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "../control/test_profiles.hpp"
+#include "opencnc/config/profile_loader.hpp"
 #include "opencnc/controller/gcode_source.hpp"
 
 namespace opencnc::control {
@@ -132,6 +135,55 @@ TEST_F(ResumeTest, APastProbeOrInputOrTheEndCannotBeReplayed) {
   read_all(*past_end);
   ASSERT_EQ(past_end->state(), StreamState::Error);
   EXPECT_EQ(past_end->diagnostics().items()[0].code, "control.resume-past-end");
+}
+
+// A machine module's modal codes (the EDM's M180 P<n> / M181, one group): the last of the group
+// before segment k is passed again before k's move, earlier ones not; codes after k pass live.
+TEST_F(ResumeTest, TheProcessCodeInForceAtSegmentKIsSelectedAgain) {
+  const config::MachineProfile edm =
+      test::loaded(config::load_profile(OPENCNC_SOURCE_DIR "/configs/edm-5axis.toml"));
+  Diagnostics d;
+  auto source = GcodeProgramSource::create(edm, d);
+  const std::string path = write(
+      "G21 G90\nG0 Z-19.97\nM180 P1\nG1 Z-20.0 F60\nM180 P2\nG1 Z-20.01 F30\nG1 Z-20.02\nM181\nG0 Z0\n"
+      "G0 Z-19.98\nM180 P3\nG1 Z-20.03 F20\nM2\n");
+  auto whole = source->execute(path, Pose{}, {});
+  read_all(*whole);
+  ASSERT_EQ(whole->state(), StreamState::Finished);
+  const canon::Program& w = whole->program();
+  const auto segment_at_line = [&](std::uint32_t line) {
+    for (std::size_t m = 0; m < w.size(); ++m)
+      if (w.move(m).line == line) return w.segment_of(m);
+    ADD_FAILURE() << "no move at line " << line;
+    return canon::SegmentId{0};
+  };
+  struct Case {
+    std::uint32_t line;
+    std::vector<std::pair<int, double>> before;  // the codes before the first move (code, P)
+  };
+  const Case cases[] = {
+      {7, {{180, 2}}},  // the second feed of condition 2: P2 again, not P1
+      {9, {{181, 0}}},  // after M181: the generator stays off
+      {4, {{180, 1}}},  // the first feed
+      {2, {}},          // the approach: nothing in force yet
+  };
+  for (const Case& c : cases) {
+    const canon::SegmentId k = segment_at_line(c.line);
+    auto rest = source->resume(path, Pose{}, Pose{0, 0, -19.97, 0, 0}, k, {});
+    ASSERT_TRUE(rest != nullptr);
+    read_all(*rest);
+    ASSERT_EQ(rest->state(), StreamState::Finished);
+    const canon::Program& r = rest->program();
+    std::vector<std::pair<int, double>> before, all;
+    for (std::size_t i = 0; i < r.action_count(); ++i) {
+      if (r.action(i).kind != canon::ActionKind::ProcessCode) continue;
+      all.emplace_back(r.action(i).index, r.action(i).value);
+      if (r.action(i).before_move == 0) before.emplace_back(r.action(i).index, r.action(i).value);
+    }
+    EXPECT_EQ(before, c.before) << "from line " << c.line;
+    ASSERT_FALSE(all.empty() && c.line != 9 && c.line != 2) << "from line " << c.line;
+    EXPECT_EQ(all.back(), (std::pair<int, double>{180, 3})) << "from line " << c.line;  // live after k
+  }
 }
 
 }  // namespace

@@ -60,6 +60,28 @@ TEST(SimBroachLoad, AStrokeMeetsTheChipOfItsInfeed) {
   EXPECT_NEAR(m.cut_depth(100, 60), 0.2, 1e-6);
 }
 
+// A simulation powered up again takes over the workpiece: a stroke that carries on from rest where
+// the first stopped (z 140, inside the cell [138.28, 140.63)) meets nothing before the next cell
+// and the infeed's chip from there on.
+TEST(SimBroachLoad, ARestoredBoreKeepsItsGroove) {
+  SimBroachLoad first(bore(), 1);
+  stroke(first, 0.1, 0, -10, 140);
+  SimBroachLoad again(bore(), 2);
+  EXPECT_FALSE(again.restore_bore(first.bore().first(10)));  // another geometry: nothing changed
+  EXPECT_EQ(again.cut_depth(100, 60), 0.0);
+  ASSERT_TRUE(again.restore_bore(first.bore()));
+  EXPECT_NEAR(again.cut_depth(100, 60), 0.1, 1e-6);
+  const double next_cell = 600.0 / SimBroachLoad::kStrokeCells * 60;
+  double before = 0, beyond = 0;
+  for (double z = 140; z <= 300; z += 0.05) {
+    again.update(z, z == 140 ? 0 : 50, 360 * z / 600, 0.1);
+    double& worst = z < next_cell ? before : beyond;
+    worst = std::max(worst, again.chip_mm());
+  }
+  EXPECT_EQ(before, 0.0);          // the groove cut before the stop
+  EXPECT_NEAR(beyond, 0.1, 1e-6);  // fresh material past it
+}
+
 TEST(SimBroachLoad, TheSecondGrooveIsFreshMaterialAndTheReturnCutsNothing) {
   SimBroachLoad m(bore(), 1);
   stroke(m, 0.1);

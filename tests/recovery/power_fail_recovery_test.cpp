@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <numbers>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -21,6 +22,7 @@
 #include "opencnc/controller/sim_rig.hpp"
 
 #include "opencnc/recovery/breakpoint_journal.hpp"
+#include "opencnc/recovery/recovery_wait.hpp"
 
 namespace opencnc::recovery {
 namespace {
@@ -38,12 +40,18 @@ const char* const kJob =
     "G1 Z310 F3000\nG1 X-0.4 F60\nG0 Z-10\nM175\nG0 C180\nM171 P600\nG1 X0.1 F60\nG1 Z110 F3000\n"
     "G1 X-0.4 F60\nG0 Z-10\nM175\nM2\n";
 
+/// Two strokes of 0.1 mm each in one groove (the second to X 0.2): a resume in the second meets
+/// 0.2 mm of chip on an uncut bore (5.75 kN, above the hold level), 0.1 mm on the real one.
+const char* const kTwoStrokes =
+    "G21 G90 G94 G17 G40 G49\nG64 P0.005\nG0 X-0.5\nG0 Z-10 C0\nM171 P600\nG1 X0.1 F60\n"
+    "G1 Z110 F3000\nG1 X-0.4 F60\nG0 Z-10\nG1 X0.2 F60\nG1 Z110 F3000\nG1 X-0.3 F60\nG0 Z-10\nM175\nM2\n";
+
 std::filesystem::path fresh_dir(const std::string& what);
 
-/// The short job as a file of its own.
-std::string job_file() {
+/// A short job as a file of its own.
+std::string job_file(const char* text = kJob) {
   const auto path = fresh_dir("job") / "job.ngc";
-  std::ofstream(path) << kJob;
+  std::ofstream(path) << text;
   return path.string();
 }
 
@@ -169,19 +177,18 @@ TEST(PowerFailRecovery, ResumedGrooveMatchesTheUninterruptedRun) {
 
   const auto dir = fresh_dir("journal");
   BreakpointRecord r;
+  std::vector<float> bore;
   {
     Machine cut(dir);
     r = cut.cut_mains(kProgram, kCutS);
     ASSERT_TRUE(r.valid && r.stage == BreakpointStage::AtRest);
+    const std::span<const float> b = cut.rig->machine().broach_bore();
+    bore.assign(b.begin(), b.end());
   }
-  // A new simulated machine starts with an uncut bore (the workpiece's cut does not survive the
-  // simulation's restart, as it would on a real machine): its load guard would take the groove's
-  // whole depth for a fresh chip and hold the feed. This test is about the groove's geometry:
-  // the guard's levels are put out of reach.
-  std::vector<std::string> sets = power_up_at(r);
-  sets.push_back("process.broaching.hold_kn=9000");
-  sets.push_back("process.broaching.retract_kn=10000");
-  Machine after(dir, sets);
+  // The machine powers up with the groove cut so far (the workpiece keeps it) and the load
+  // guard's own levels: the run-in and the rest of the groove meet no chip they have cut already.
+  Machine after(dir, power_up_at(r));
+  ASSERT_TRUE(after.rig->machine().restore_broach_bore(bore));
   const control::Outcome o = after.choose("resume");
   ASSERT_TRUE(o.accepted) << o.message;
   EXPECT_EQ(after.journal->phase(), RecoveryPhase::Done) << after.journal->recovery_error();
@@ -194,6 +201,43 @@ TEST(PowerFailRecovery, ResumedGrooveMatchesTheUninterruptedRun) {
   const auto cleared = after.journal->last_written();
   ASSERT_TRUE(cleared.has_value());
   EXPECT_FALSE(cleared->valid);  // cleared once the resumed program finished
+  EXPECT_LT(after.rig->status().servo.load_kn, 4.0);
+}
+
+// Without the groove cut before (a fresh workpiece where the record says it was cut), the
+// resumed stroke meets the groove's whole depth as a chip: the load guard holds the feed, and the
+// wait for the choice ends with the reason instead of waiting for a resume nobody gives.
+TEST(PowerFailRecovery, ResumesIntoTheGrooveCutBeforeWithTheLoadGuardsLevels) {
+  const std::string kProgram = job_file(kTwoStrokes);
+  const auto dir = fresh_dir("journal");
+  BreakpointRecord r;
+  std::vector<float> bore;
+  {
+    Machine cut(dir);
+    r = cut.cut_mains(kProgram, 6.0);  // in the second stroke
+    ASSERT_NEAR(r.actual[Axis::X], 0.2, 1e-3);
+    const std::span<const float> b = cut.rig->machine().broach_bore();
+    bore.assign(b.begin(), b.end());
+  }
+  {
+    Machine uncut(dir, power_up_at(r));  // the bore not restored
+    const control::Outcome o = uncut.rig->request(Request::feature("journal", "resume"), 100000);
+    ASSERT_TRUE(o.accepted) << o.message;
+    const std::string why = run_recovery(*uncut.rig, *uncut.journal, {60.0, 2.0});
+    EXPECT_NE(why.find("the feed was held (load 5."), std::string::npos) << why;
+    EXPECT_EQ(uncut.journal->phase(), RecoveryPhase::Failed);
+    EXPECT_LT(uncut.rig->status().servo.time_s, 10.0);  // ended at the hold, far from the bound
+    uncut.journal->flush();
+    EXPECT_TRUE(uncut.journal->last_written()->valid);  // the choice is still the operator's
+  }
+  Machine after(dir, power_up_at(r));
+  ASSERT_TRUE(after.rig->machine().restore_broach_bore(bore));
+  const control::Outcome o = after.rig->request(Request::feature("journal", "resume"), 100000);
+  ASSERT_TRUE(o.accepted) << o.message;
+  EXPECT_EQ(run_recovery(*after.rig, *after.journal, {60.0, 2.0}), "");
+  EXPECT_EQ(after.rig->status().servo.load_action, control::LoadAction::None);
+  after.journal->flush();
+  EXPECT_FALSE(after.journal->last_written()->valid);
 }
 
 // In the second groove (its law engaged at C 180°, after the first groove's M171 … M175): only the

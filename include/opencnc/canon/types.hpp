@@ -77,6 +77,9 @@ struct ProcessCode {
   int code = 0;  ///< the M number (M100-M199)
   double p = 0;  ///< P word (0 when absent)
   double q = 0;  ///< Q word (0 when absent)
+  /// Its modal group, chosen by the module (0: a one-shot code). A code stays in force until the
+  /// next of its group: a program resumed past it gets the last of each group again (ReplayFilter).
+  int group = 0;
   bool operator==(const ProcessCode&) const = default;
 };
 

@@ -117,6 +117,7 @@ enum class FaultKind : std::uint8_t {
   Homing,          ///< `axis`: a homing move ran into a limit or found no switch (`value` = where)
   Stall,           ///< `axis`: the stepper drive detected a stall (steps were lost; home again)
   ProcessAlarm,    ///< a `stop` alarm: `axis` = the alarm's index, `value` = the input, `limit` = the bound
+  EdmShort,  ///< the EDM gap stayed shorted: `axis` = the condition, `value` = seconds, `limit` = its limit
 };
 
 /// Stable problem code of a fault ("control.fault.following-error", ...). Any thread.
@@ -233,6 +234,9 @@ enum class EventKind : std::uint8_t {
   /// Fault event comes next).
   ProcessAlarm,
   ProcessAlarmCleared,  ///< process alarm `action` is back in range (`value`)
+  /// EDM: backing off reached the end of the path memory while the gap servo still drove back;
+  /// the electrode holds there (`action` = the condition, `value` = how far behind the head, mm).
+  EdmRetractLimit,
 };
 
 struct ServoEvent {

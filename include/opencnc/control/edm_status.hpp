@@ -20,6 +20,7 @@ struct EdmStatus {
   double path_speed_mm_s = 0;       ///< signed speed along the path (− = backing off)
   double backlog_mm = 0;            ///< how far behind the interpolator's head the electrode stands
   bool retract_limit = false;       ///< backing off reached the end of the path memory
+  double short_s = 0;               ///< how long the gap has been shorted while machining
   bool jumping = false;             ///< a jump is lifting or returning
   double jump_lift_mm = 0;          ///< how far the jump has lifted the electrode
   std::uint32_t jumps = 0;          ///< jumps begun since the machine started

@@ -80,6 +80,15 @@ class GapServo {
   bool generator_on() const noexcept { return status_.generator; }
   machine::GeneratorOutputs generator() const noexcept;
   const EdmStatus& status() const noexcept { return status_; }
+  /// The active condition (number 0: none).
+  const EdmCondition& condition() const noexcept { return cond_; }
+  /// The gap has been shorted for longer than the condition's short_timeout_s: the machine must
+  /// stop (the tick faults).
+  bool short_timed_out() const noexcept {
+    return status_.on && cond_.short_timeout_s > 0 && status_.short_s >= cond_.short_timeout_s;
+  }
+  /// This period backing off reached the end of the path memory while the servo wanted to go on.
+  bool reached_retract_limit() const noexcept { return reached_retract_limit_; }
 
  private:
   double servo_speed(const GapInputs& in, bool brake) noexcept;
@@ -101,6 +110,8 @@ class GapServo {
   double v_ = 0;        ///< its signed speed along the path
   double catch_v_ = 0;  ///< its speed walking up to the head with nothing to machine
   double feed_scale_ = 1;
+  bool reached_retract_limit_ = false;
+  bool pressing_limit_ = false;  ///< backing off against the end of the memory (until it lets go)
   EdmStatus status_{};
   // Jump: axis lift or path backlog, its phase and the machining time since the last one.
   enum class Jump : std::uint8_t { Idle, Up, Down };

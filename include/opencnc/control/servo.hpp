@@ -133,6 +133,7 @@ class Servo final : public Tickable {
   // --- EDM gap servo, jump and orbit (servo_gap.cpp) ------------------------------------------
   void configure_gap_servo() noexcept;
   void run_gap_servo() noexcept;
+  void watch_gap() noexcept;
 
   // --- Auto and MDI runs (servo_program.cpp) ------------------------------------------------
   void run_program() noexcept;

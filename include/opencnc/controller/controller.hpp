@@ -150,7 +150,13 @@ class Controller final : private FeatureHost {
   std::vector<std::shared_ptr<Feature>> features_to_add_;
 
   mutable std::mutex out_mutex_;  ///< outcomes, the published status, the open program
-  std::map<std::uint64_t, Outcome> outcomes_;
+  /// The answer to request `id` at `id % size()`, kept until a later id takes its place: slots built
+  /// once, so answering requests for days does not grow the controller.
+  struct KeptOutcome {
+    std::uint64_t id = 0;
+    Outcome outcome;
+  };
+  std::vector<KeptOutcome> outcomes_;
   ControllerStatus published_;
   std::optional<OpenProgram> open_;
 

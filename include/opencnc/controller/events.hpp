@@ -1,10 +1,12 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The controller's event log: every servo event, note, answer, job start and end and sync point,
-// numbered, kept in a bounded ring that any number of readers follow with cursors of their own.
+// numbered, kept in a ring of fixed-size entries allocated once, which any number of readers follow
+// with cursors of their own.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
-#include <deque>
+#include <memory>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -48,12 +50,27 @@ struct ControllerEvent {
   SourceLocation location;
 };
 
-/// The numbered, bounded log. append() from the controller thread; reads from any thread.
+/// What one entry of the log keeps of the strings of a ControllerEvent, in bytes (with the
+/// terminating zero). A longer string is cut at a UTF-8 character boundary and ends in "…".
+inline constexpr std::size_t kEventCodeBytes = 48;
+inline constexpr std::size_t kEventTextBytes = 240;
+inline constexpr std::size_t kEventFileBytes = 96;
+/// The call chain (SourceLocation::calls), all calls together.
+inline constexpr std::size_t kEventCallsBytes = 112;
+
+struct StoredEvent;  // one fixed-size entry of the ring (events.cpp)
+
+/// The numbered, bounded log. Its memory is allocated and touched once, at construction: a long
+/// job's events never grow it. append() from the controller thread; reads from any thread.
 class EventLog {
  public:
   explicit EventLog(std::size_t capacity = 16384);
-  /// Numbers `e` and appends it, dropping the oldest entry when full; returns its number.
-  std::uint64_t append(ControllerEvent e);
+  ~EventLog();
+  EventLog(const EventLog&) = delete;
+  EventLog& operator=(const EventLog&) = delete;
+  /// Numbers `e` and copies it into the ring (strings cut to the capacities above), overwriting
+  /// the oldest entry when full; returns its number. Allocates nothing.
+  std::uint64_t append(const ControllerEvent& e);
   /// The number of the newest entry (0 while empty).
   std::uint64_t last() const;
   /// Up to `max` entries numbered after `after`, oldest first. `*lost` (if given) is set to how
@@ -62,8 +79,8 @@ class EventLog {
 
  private:
   mutable std::mutex mutex_;
-  std::deque<ControllerEvent> ring_;
   std::size_t capacity_;
+  std::unique_ptr<StoredEvent[]> ring_;  // entry n lives at (n - 1) % capacity_
   std::uint64_t next_ = 1;
 };
 

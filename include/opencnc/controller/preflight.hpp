@@ -36,6 +36,11 @@ bool check_soft_limits(const canon::Program& program, const ServoConfig& config,
 /// check_soft_limits) and the planner's own checks (plan::check_move). The preflight scan uses
 /// it on every move of a program, the controller again on every move of a running one (where
 /// a real probe result or input value may have changed it). Non-real-time; one thread.
+///
+/// On an EDM (`config.edm`) it follows the program's M180 P<n> / M181: while a condition is in
+/// force (and for the one move after M181, while the orbit spirals back and a jump comes down)
+/// a move's extent is widened by what the gap servo adds to the path: the condition's orbit
+/// radius on both orbit axes and an axis jump's height on the tool axis, away from the work.
 class MachineMoveCheck final : public MoveCheck {
  public:
   MachineMoveCheck(const ServoConfig& config, const plan::MachineLimits& limits) : config_(config), limits_(limits) {}
@@ -45,9 +50,18 @@ class MachineMoveCheck final : public MoveCheck {
   void finish(Diagnostics& diags) override;
 
  private:
+  /// Follows the EDM codes up to move `move` and returns the condition whose offsets may add to it
+  /// (null: none).
+  const machine::EdmCondition* edm_condition_at(const canon::Program& program, std::size_t move);
+
   ServoConfig config_;
   plan::MachineLimits limits_;
   int soft_limit_errors_ = 0;
+  // The EDM codes seen so far in the program being checked.
+  const canon::Program* edm_program_ = nullptr;
+  std::size_t edm_next_action_ = 0, edm_last_move_ = 0;
+  int edm_on_ = 0;    ///< the condition in force (0: none)
+  int edm_tail_ = 0;  ///< the condition just switched off: its offsets may still be out
 };
 
 }  // namespace opencnc::control

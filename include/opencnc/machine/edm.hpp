@@ -49,6 +49,7 @@ struct EdmCondition {
   double max_forward_mm_s = 0;   ///< forward speed limit (an open gap feeds at this)
   double max_retract_mm_s = 0;   ///< backward speed limit (a short backs off at this)
   double filter_s = 0.005;       ///< time constant of the gap voltage's low-pass filter
+  double short_timeout_s = 5;    ///< a short that lasts longer stops the machine with a fault
   // Jump (period 0: off).
   double jump_height_mm = 0;   ///< H: how far the electrode lifts
   double jump_period_s = 0;    ///< T_on: machining time between jumps
@@ -68,6 +69,7 @@ struct EdmConfig {
   double lift_direction = 1;           ///< +1: away from the work is + along the tool axis
   std::int8_t orbit_axes[2] = {0, 1};  ///< the orbit's plane (X, Y)
   double path_spacing_mm = 0.002;      ///< spacing of the path memory's points (backing off)
+  double short_timeout_s = 5;          ///< [edm] short_timeout_s: the conditions' default
   std::array<EdmCondition, kMaxEdmConditions> conditions{};
   int condition_count = 0;
 

@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cstdint>
+#include <span>
 
 #include "opencnc/machine/sim_config.hpp"
 #include "opencnc/machine/sim_switch.hpp"
@@ -35,6 +36,13 @@ class SimBroachLoad {
   double dull_factor() const noexcept { return dull_; }
   /// The depth cut so far at a point of the bore, mm beyond the surface.
   double cut_depth(double stroke, double angle_deg) const noexcept;
+  /// The workpiece's bore: the depth cut so far in every cell (stroke-major, kStrokeCells ×
+  /// kAngleCells), so that a simulation restarted after a power failure can carry it over as a
+  /// real workpiece keeps its cut. Any thread that owns the model (between periods).
+  std::span<const float> bore() const noexcept { return cut_; }
+  /// Takes over a bore (`bore()` of the same geometry); false and nothing changed if its size is
+  /// not kStrokeCells × kAngleCells. The cutter is then taken as entering its cell afresh.
+  bool restore_bore(std::span<const float> bore) noexcept;
 
  private:
   int stroke_cell(double stroke) const noexcept;

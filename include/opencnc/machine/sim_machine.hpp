@@ -60,6 +60,12 @@ class SimMachine final : public MachineIO {
   void set_temperature(double celsius) noexcept { temperature_c_ = celsius; }
   /// The broach's cutter wears: its force grows by `factor` (1 = sharp); ignored without a broach.
   void set_tool_dull(double factor) noexcept { broach_.set_dull_factor(factor); }
+  /// The broach's workpiece as another simulation left it (SimBroachLoad::bore()): the machine
+  /// powered up again after a power failure finds its groove already cut. False (nothing
+  /// changed) without a broach or for a bore of another size.
+  bool restore_broach_bore(std::span<const float> bore) noexcept {
+    return config_.broach.present && broach_.restore_bore(bore);
+  }
   /// The operator moves manual joint `joint` toward `target` at up to `speed` units/s.
   void set_hand_target(int joint, double target, double speed) noexcept;
   /// The electrode in the spindle of a machine whose probe touches a reference sphere: its true
@@ -85,6 +91,10 @@ class SimMachine final : public MachineIO {
   double temperature_c() const noexcept { return temperature_c_; }
   /// The broaching load model (material cut so far, the chip, the force).
   const SimBroachLoad& broach() const noexcept { return broach_; }
+  /// The broach's workpiece (SimBroachLoad::bore()); empty on a machine without a broach.
+  std::span<const float> broach_bore() const noexcept {
+    return config_.broach.present ? broach_.bore() : std::span<const float>{};
+  }
 
  private:
   void advance(const MachineOutputs& out) noexcept;
