@@ -2,6 +2,7 @@
 // `opencnc serve`: the simulated machine with its controller, and the operator's HMI in the
 // browser (docs/hmi.md, docs/api.md), until Ctrl-C.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <sys/stat.h>
 #include <unistd.h>
 #include <CLI/CLI.hpp>
@@ -15,8 +16,8 @@
 #include "numeric_options.hpp"
 #include "opencnc/config/profile_loader.hpp"
 #include "opencnc/controller/gcode_source.hpp"
-#include "opencnc/controller/run_from_line.hpp"
 #include "opencnc/hmi/history.hpp"
+#include "opencnc/hmi/machine_features.hpp"
 #include "opencnc/hmi/machine_host.hpp"
 #include "opencnc/hmi/server.hpp"
 #include "opencnc/hmi/tokens.hpp"
@@ -36,6 +37,7 @@ struct ServeOptions {
   std::string programs_dir;
   std::string data_dir;
   std::string static_dir;
+  std::string journal_dir;  ///< "" = <data>/journal (machines with a power monitor)
   double speed = 0;  ///< 0: real time on a periodic thread; else paced virtual time
   double stream_hz = 30;
 };
@@ -106,10 +108,6 @@ int serve(const ServeOptions& o) {
   for (const Diagnostic& d : load.diagnostics.items()) fmt::print(stderr, "{}\n", d.format());
   if (!load.ok()) return kExitProgram;
   const config::MachineProfile& profile = *load.profile;
-  Diagnostics diags;
-  auto source = control::GcodeProgramSource::create(profile, diags);
-  for (const Diagnostic& d : diags.items()) fmt::print(stderr, "{}\n", d.format());
-  if (!source) return kExitProgram;
 
   const fs::path data = o.data_dir.empty() ? default_data_dir() : fs::path(o.data_dir);
   std::error_code ec;
@@ -119,6 +117,14 @@ int serve(const ServeOptions& o) {
     return kExitUsage;
   }
   if (created) ::chmod(data.c_str(), 0700);  // a folder of ours; one given that exists keeps its mode
+  // The features the profile calls for (docs/hmi.md, "Features"), with the program source.
+  Diagnostics diags;
+  hmi::FeatureOptions fo;
+  fo.journal_dir = o.journal_dir.empty() ? (data / "journal").string() : o.journal_dir;
+  const std::unique_ptr<hmi::MachineFeatures> features = hmi::MachineFeatures::create(profile, fo, diags);
+  for (const Diagnostic& d : diags.items()) fmt::print(stderr, "{}\n", d.format());
+  if (!features) return kExitUsage;
+  const std::shared_ptr<control::GcodeProgramSource> source = features->source();
   std::string error;
   const auto tokens = hmi::Tokens::load(data / "tokens", &error);
   if (!tokens) {
@@ -133,9 +139,7 @@ int serve(const ServeOptions& o) {
 
   hmi::MachineHost host(profile, source, {o.speed == 0, o.speed == 0 ? 1.0 : o.speed});
   host.controller().attach(std::make_shared<hmi::HistoryRecorder>(*history, profile.servo_period_s));
-  // Run from line scans with a program source of its own (the controller's is the controller's).
-  host.controller().add_feature(
-      std::make_shared<control::RunFromLineFeature>(control::GcodeProgramSource::create(profile, diags)));
+  features->install(host.controller());
   std::vector<std::string> warnings;
   if (!host.start(&warnings)) {
     fmt::print(stderr, "error: the servo thread could not start\n");
@@ -156,6 +160,8 @@ int serve(const ServeOptions& o) {
     sc.static_dir.clear();
   }
   sc.stream_hz = o.stream_hz;
+  sc.features = features.get();
+  sc.simulate = [&host](const hmi::SimulationEvent& e) { return host.simulate(e); };
   hmi::Server server(host.controller(), profile, *tokens, history.get(), source.get(), sc);
   if (!server.start(&error)) {
     fmt::print(stderr, "error: {}\n", error);
@@ -168,8 +174,10 @@ int serve(const ServeOptions& o) {
   fmt::print("opencnc serve: {} on the simulated machine ({})\n", profile.name,
              o.speed == 0 ? "real time" : fmt::format("virtual time at {}x", o.speed));
   fmt::print("  open      http://{}:{}/#token={}\n", host_part, server.port(), tokens->operator_token());
-  fmt::print("  operator  {}\n  admin     in {}\n  history   {}\n  Ctrl-C stops.\n", tokens->operator_token(),
+  fmt::print("  operator  {}\n  admin     in {}\n  history   {}\n", tokens->operator_token(),
              tokens->origin(), (data / "history.sqlite").string());
+  if (features->journal()) fmt::print("  journal   {}\n", fo.journal_dir);
+  fmt::print("  features  {}\n  Ctrl-C stops.\n", fmt::join(features->names(), ", "));
   std::fflush(stdout);
 
   const StopSignals signals;
@@ -208,6 +216,9 @@ void add_serve_command(CLI::App& app, Registry& registry) {
   cmd->add_option(
       "--data", opts->data_dir,
       "Where the tokens and the history live (default $XDG_STATE_HOME/opencnc or ~/.local/state/opencnc)");
+  cmd->add_option(
+      "--journal", opts->journal_dir,
+      "The breakpoint journal's folder on a machine with a power monitor (default: journal in --data)");
   cmd->add_option("--static", opts->static_dir,
                   "The built front end (default: web/dist beside the build folder)");
   cmd->add_option("--speed", opts->speed,

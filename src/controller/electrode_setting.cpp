@@ -275,7 +275,8 @@ Outcome ElectrodeSetting::handle(const requests::Feature& request, FeatureHost& 
     return measure(*args, host);
   }
   if (request.action == "resume") return resume(host);
-  return refuse(fmt::format("electrode: unknown action \"{}\" (measure, resume)", request.action));
+  if (request.action == "write") return write();
+  return refuse(fmt::format("electrode: unknown action \"{}\" (measure, write, resume)", request.action));
 }
 
 Outcome ElectrodeSetting::measure(const ElectrodeMeasure& args, FeatureHost& host) {
@@ -292,6 +293,7 @@ Outcome ElectrodeSetting::measure(const ElectrodeMeasure& args, FeatureHost& hos
   const std::optional<std::size_t> index = table->find(args.tool);
   if (args.tool <= 0 || !index) return refuse(fmt::format("tool {} is not in the tool table", args.tool));
   tool_ = args.tool;
+  write_ = args.write;
   tool_index_ = *index;
   entry_ = table->at_index(*index);
   plan_ = plan_touches(sphere_, offsets_of(entry_), entry_.diameter / 2);
@@ -485,25 +487,61 @@ void ElectrodeSetting::finish_measurement() {
   ElectrodeResult r =
       evaluate_touches(sphere_, tool_, offsets_of(entry_), entry_.diameter / 2, names, touched_);
   r.fast_touched = fast_touched_;
-  if (r.ok) {
-    tools::ToolEntry changed = entry_;
-    for (int i = 0; i < 3; ++i) changed.offset[i] = r.offset[static_cast<std::size_t>(i)];
-    Diagnostics d;
-    if (!tools_->update(tool_index_, changed, tools::ChangeSource::Operator, d)) {
-      r.ok = false;
-      r.code = "electrode.table";
-      r.message = fmt::format("tool {} measured ({}) but the tool table refused it: {}", tool_,
-                              show(r.offset), d.items().empty() ? std::string("?") : d.items()[0].format());
-    }
-  }
+  if (r.ok && write_) store(r);
   {
     std::lock_guard lock(mutex_);
-    if (r.ok && stop_ && !stop_offset_) stop_offset_ = r.previous;
+    if (r.ok && r.written && stop_ && !stop_offset_) stop_offset_ = r.previous;
     last_ = r;
     phase_ = ElectrodePhase::Idle;
   }
-  host_->note(r.ok ? Severity::Note : Severity::Error, r.ok ? "electrode.set" : r.code,
-              fmt::format("electrode setting: {}", r.message));
+  const char* const code = !r.ok ? r.code.c_str() : r.written ? "electrode.set" : "electrode.measured";
+  host_->note(
+      r.ok ? Severity::Note : Severity::Error, code,
+      fmt::format("electrode setting: {}{}", r.message, r.ok && !r.written ? " (not stored yet)" : ""));
+}
+
+// The measured offsets into the tool table (the tool's entry as it was measured against, with
+// X, Y, Z replaced); a refusal makes the result failed with the table's reason.
+bool ElectrodeSetting::store(ElectrodeResult& r) {
+  tools::ToolEntry changed = entry_;
+  for (int i = 0; i < 3; ++i) changed.offset[i] = r.offset[static_cast<std::size_t>(i)];
+  Diagnostics d;
+  if (!tools_->update(tool_index_, changed, tools::ChangeSource::Operator, d)) {
+    r.ok = false;
+    r.code = "electrode.table";
+    r.message = fmt::format("tool {} measured ({}) but the tool table refused it: {}", r.tool, show(r.offset),
+                            d.items().empty() ? std::string("?") : d.items()[0].format());
+    return false;
+  }
+  r.written = true;
+  return true;
+}
+
+// After a measurement kept for the operator's look: stored only if the table still holds the
+// offsets it was measured against (nobody changed the tool meanwhile).
+Outcome ElectrodeSetting::write() {
+  if (phase() != ElectrodePhase::Idle)
+    return refuse(fmt::format("electrode setting is {}", to_string(phase())));
+  std::optional<ElectrodeResult> r = last();
+  if (!r || !r->ok) return refuse("no passed measurement to store (electrode measure)");
+  if (r->written) return refuse(fmt::format("tool {}'s measured offsets are stored already", r->tool));
+  const auto table = tools_->snapshot();
+  const std::optional<std::size_t> index = table->find(r->tool);
+  if (!index || *index != tool_index_ || offsets_of(table->at_index(*index)) != r->previous)
+    return refuse(
+        fmt::format("tool {}'s offsets changed in the table since the measurement: measure again", r->tool));
+  entry_ = table->at_index(*index);
+  const bool ok = store(*r);
+  {
+    std::lock_guard lock(mutex_);
+    if (ok && stop_ && !stop_offset_) stop_offset_ = r->previous;
+    last_ = r;
+  }
+  host_->note(ok ? Severity::Note : Severity::Error, ok ? "electrode.set" : r->code,
+              fmt::format("electrode setting: {}",
+                          ok ? fmt::format("tool {} stored ({})", r->tool, show(r->offset)) : r->message));
+  return ok ? accept(fmt::format("tool {}'s offsets stored: {}", r->tool, show(r->offset)))
+            : refuse(r->message);
 }
 
 void ElectrodeSetting::fail(std::string code, std::string message) {

@@ -181,6 +181,21 @@ ToolChange tool_change(const json& body) {
   return c;
 }
 
+/// A control of the simulated machine: the mains, or an electrode (offsets and tip radius, mm).
+SimulationEvent simulation_event(const json& body) {
+  SimulationEvent e{text(body, "event")};
+  if (e.event == "electrode") {
+    const json& o = field(body, "offset");
+    if (!o.is_array() || o.size() != 3 || !o[0].is_number() || !o[1].is_number() || !o[2].is_number())
+      throw Bad{400, "\"offset\" must be [X, Y, Z] in mm"};
+    for (std::size_t i = 0; i < 3; ++i) e.offset_mm[i] = within(o[i].get<double>(), -1000, 1000, "offset");
+    e.tip_radius_mm = within(number(body, "tip_radius"), 0, 100, "tip_radius");
+  } else if (e.event != "mains-off" && e.event != "mains-on") {
+    throw Bad{400, fmt::format("\"event\" must be mains-off, mains-on or electrode, not \"{}\"", e.event)};
+  }
+  return e;
+}
+
 Command parse(const json& body, const config::MachineProfile& p, const std::filesystem::path& dir) {
   if (!body.is_object()) throw Bad{400, "the body must be a JSON object"};
   const std::string kind = text(body, "kind");
@@ -226,6 +241,12 @@ Command parse(const json& body, const config::MachineProfile& p, const std::file
     const double line = number(body, "line");
     if (line != std::floor(line) || line < 1 || line > 1e9) throw Bad{422, "\"line\" must be a line number from 1"};
     return Request::feature("run-from-line", "start", control::RunFromLineArgs{static_cast<std::uint32_t>(line)});
+  }
+  if (kind == "simulate") return simulation_event(body);
+  if (kind == "feature") {
+    auto r = parse_feature_command(body, p);
+    if (auto* e = std::get_if<ApiError>(&r)) throw Bad{e->status, e->message};
+    return std::get<Request>(std::move(r));
   }
   throw Bad{400, fmt::format("unknown command kind \"{}\" (docs/api.md lists them)", kind)};
 }
@@ -275,7 +296,8 @@ std::optional<Role> role_for(std::string_view kind) {
                                                "home",    "override",  "switch", "spindle-on",
                                                "coolant", "handwheel", "open",   "mdi",
                                                "run-from-line"};
-  if (kind == "set-tool" || kind == "set-parameters") return Role::Admin;
+  if (kind == "set-tool" || kind == "set-parameters" || kind == "simulate") return Role::Admin;
+  if (kind == "feature") return Role::Operator;  // the confirmation is in the body (api_features.cpp)
   if (servo_kinds().find(kind) != servo_kinds().end()) return Role::Operator;
   for (const char* k : operator_kinds) {
     if (kind == k) return Role::Operator;
@@ -301,7 +323,7 @@ json status_json(const control::ControllerStatus& s, const config::MachineProfil
     homed[std::string(1, letter(a.axis))] = j.homed;
   }
   const int n = static_cast<int>(profile.axes.size());
-  return {
+  json j = {
       {"tick", v.tick},
       {"time_s", v.time_s},
       {"state", control::to_string(v.state)},
@@ -354,6 +376,8 @@ json status_json(const control::ControllerStatus& s, const config::MachineProfil
       {"sync_wait", control::to_string(s.sync_wait)},
       {"runs_finished", s.runs_finished},
   };
+  j.update(process_json(v, profile));
+  return j;
 }
 
 json event_json(const control::ControllerEvent& e) {

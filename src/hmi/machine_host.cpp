@@ -4,6 +4,8 @@
 
 #include <chrono>
 
+#include <fmt/format.h>
+
 #include "opencnc/control/servo.hpp"
 #include "opencnc/controller/servo_setup.hpp"
 #include "opencnc/controller/sim_rig.hpp"
@@ -64,6 +66,15 @@ const control::LatencyHistogram* MachineHost::latency() const noexcept {
   return clock_ ? &clock_->latency() : nullptr;
 }
 
+std::string MachineHost::simulate(const SimulationEvent& event) {
+  if (event.event != "mains-off" && event.event != "mains-on" && event.event != "electrode")
+    return fmt::format("no simulation event \"{}\"", event.event);
+  if (!rig_) return "the simulation controls need virtual time (opencnc serve --speed X)";
+  std::lock_guard lock(simulate_mutex_);
+  simulate_.push_back(event);
+  return {};
+}
+
 // The controller's loop beside the real-time servo: one service() per servo period (it reads
 // whatever the servo produced meanwhile, so a late service costs nothing but latency).
 void MachineHost::run_controller() {
@@ -86,6 +97,16 @@ void MachineHost::run_paced() {
   while (!stop_.load(std::memory_order_relaxed)) {
     const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     const auto due = static_cast<std::uint64_t>(wall_s * options_.speed / period_s_);
+    {
+      std::lock_guard lock(simulate_mutex_);
+      for (const SimulationEvent& e : simulate_) {
+        if (e.event == "electrode")
+          rig_->machine().set_electrode(e.offset_mm, e.tip_radius_mm);
+        else
+          rig_->machine().set_mains_ok(e.event == "mains-on");
+      }
+      simulate_.clear();
+    }
     for (int k = 0; done < due && k < 20000; ++k, ++done) rig_->step();
     paced_ticks_.store(done, std::memory_order_relaxed);
     std::this_thread::sleep_for(std::chrono::milliseconds(1));

@@ -25,6 +25,7 @@
 #include "opencnc/hmi/api.hpp"
 #include "opencnc/hmi/api_admin.hpp"
 #include "opencnc/hmi/history.hpp"
+#include "opencnc/hmi/machine_features.hpp"
 #include "opencnc/hmi/preview.hpp"
 #include "opencnc/hmi/stream_tickets.hpp"
 #include "opencnc/tools/tool_table_service.hpp"
@@ -197,6 +198,12 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
 
   void accept();
   void stream_tick();
+  /// The status with the features' state (`features`), as GET /status and the stream send it.
+  json status_object() const {
+    json j = status_json(controller.status(), *machine());
+    if (config.features != nullptr) j["features"] = config.features->status();
+    return j;
+  }
   void handle(const std::shared_ptr<HttpSession>& s, HttpRequest req);
   void upgrade(tcp::socket socket, HttpRequest req, std::string remote);
   void audit(const std::string& remote, std::optional<Role> role, const HttpRequest& req, int status,
@@ -378,8 +385,8 @@ void Server::Impl::accept() {
 void Server::Impl::stream_tick() {
   if (stopping) return;
   ++stream_ticks;
-  auto status = std::make_shared<const std::string>(
-      json{{"type", "status"}, {"status", status_json(controller.status(), *machine())}}.dump());
+  auto status =
+      std::make_shared<const std::string>(json{{"type", "status"}, {"status", status_object()}}.dump());
   {
     std::lock_guard lock(sessions_mutex);
     std::erase_if(sessions, [](const std::weak_ptr<WsSession>& w) {
@@ -466,7 +473,7 @@ void Server::Impl::handle(const std::shared_ptr<HttpSession>& s, HttpRequest req
 
 HttpResponse Server::Impl::get(const HttpRequest& req, const Target& t, Role role) {
   const std::string& p = t.path;
-  if (p == "/api/v1/status") return json_response(req, 200, status_json(controller.status(), *machine()));
+  if (p == "/api/v1/status") return json_response(req, 200, status_object());
   if (p == "/api/v1/machine") return json_response(req, 200, machine_json(*machine()));
   if (p == "/api/v1/parameters") return json_response(req, 200, parameters_json(*machine()));
   if (p == "/api/v1/program") return program_info(req);
@@ -566,6 +573,13 @@ void Server::Impl::command(const std::shared_ptr<HttpSession>& s, const HttpRequ
     return s->send(error_response(req, e->status, e->message));
   }
   auto& c = std::get<Command>(parsed);
+  if (const auto* e = std::get_if<SimulationEvent>(&c)) {
+    const std::string why = config.simulate ? config.simulate(*e) : "this server has no simulation controls";
+    HttpResponse res = why.empty() ? json_response(req, 200, {{"accepted", true}, {"event", e->event}})
+                                   : error_response(req, 409, why);
+    audit(s->remote(), role, req, static_cast<int>(res.result_int()), why.empty() ? "accepted" : why);
+    return s->send(std::move(res));
+  }
   if (const auto* t = std::get_if<ToolChange>(&c)) {
     HttpResponse res = tool_change(req, *t);
     audit(s->remote(), role, req, static_cast<int>(res.result_int()), res.body());

@@ -4,7 +4,8 @@
 // on, home, open the bracket program, run it, confirm the tool changes, hold and resume, see the
 // position change, run to the end, find the job in the history; then run it again from line 66
 // chosen in the listing; as the admin, lower X's maximum velocity and see a bad value refused with
-// the profile's message (the profile is a copy in the test's folder). Screenshots land in the
+// the profile's message (the profile is a copy in the test's folder); then the power-fail
+// recovery on the broach (recovery.mjs). Screenshots land in the
 // artefacts folder. Usage: node e2e/run.mjs [--opencnc PATH] [--out DIR]
 import { spawn } from "node:child_process";
 import { copyFileSync, mkdtempSync, mkdirSync, readFileSync, rmSync } from "node:fs";
@@ -12,6 +13,7 @@ import { tmpdir } from "node:os";
 import { dirname, join, resolve } from "node:path";
 import { fileURLToPath } from "node:url";
 import { chromium } from "playwright-core";
+import { recoveryStep } from "./recovery.mjs";
 
 const here = dirname(fileURLToPath(import.meta.url));
 const repo = resolve(here, "..", "..");
@@ -166,6 +168,7 @@ try {
   await page.getByRole("button", { name: "Apply changes (admin)" }).click();
   await waitFor("the profile's message", async () => (await page.locator("#parameters-result").innerText()).includes("the profile refuses the change: "));
   await shot("08-parameters");
+  await recoveryStep({ opencnc, repo, out, browser, step });
   step("passed");
 } catch (e) {
   failed = true;

@@ -4,14 +4,21 @@
 // the 3D view, and the function keys to the sub-screens; the dialogs over it.
 import "./style.css";
 import { Api } from "./api";
+import { renderDialog } from "./dialog_view";
+// The feature dialogs first: the first registered dialog a status wants is shown.
+import "./dialogs/recovery";
+import "./dialogs/toolcheck";
 import { dialogFor } from "./dialogs/waits";
-import { screens, type Context } from "./registry";
+import "./panels/process";
+import "./panels/retrace";
+import { panels, screens, type Context } from "./registry";
 import "./screens/jog";
 import "./screens/mdi";
 import "./screens/file";
 import "./screens/history";
 import "./screens/params";
 import "./screens/network";
+import "./screens/electrode";
 import type { ControllerEvent, Machine, Status } from "./types";
 import { button, coord, el, offsetsText, outsideWindow, percent, windowStart } from "./ui";
 import { View3d, type Preview } from "./view3d";
@@ -135,6 +142,13 @@ async function start() {
   };
   const feed = override("feed", "Feed", 2), spindle = override("spindle", "Spindle", 2), rapid = override("rapid", "Rapid", 1);
   const process = el("div", { class: "process" });
+  const panelRoots = panels.map((p) => {
+    const root = el("div", { class: `panel ${p.id}` });
+    root.dataset.testid = `panel-${p.id}`;
+    root.hidden = true;
+    p.mount(root, ctx);
+    return root;
+  });
 
   // The 3D view and the sub-screens behind the function keys.
   const view = el("div", { class: "view3d" });
@@ -150,6 +164,7 @@ async function start() {
   };
   screens.forEach((s, i) => {
     const root = el("div", {});
+    root.dataset.screenRoot = s.id;
     root.hidden = true;
     s.mount(root, ctx);
     roots.set(s.id, root);
@@ -168,7 +183,7 @@ async function start() {
     el("main", {},
       el("div", { class: "info" }, droTable, progName, progress, listing),
       el("div", { class: "center" }, view),
-      el("div", { class: "params" }, el("h3", {}, "Process"), feed.row, spindle.row, rapid.row, process, el("h3", {}, "Alarms and messages"), messages)),
+      el("div", { class: "params" }, el("h3", {}, "Process"), feed.row, spindle.row, rapid.row, process, ...panelRoots, el("h3", {}, "Alarms and messages"), messages)),
     keys, sub, dialog);
   const v3 = new View3d(view);
   v3.setMachine(machine);
@@ -218,18 +233,23 @@ async function start() {
     rapid.value.textContent = percent(s.rapid_override);
     process.textContent = `Spindle ${s.spindle.direction} ${Math.round(s.spindle.rpm_actual)} rpm · tool T${s.tool} · ` +
       `${s.flood ? "flood " : ""}${s.mist ? "mist" : ""} · feed ${(s.path_velocity * 60).toFixed(0)} mm/min`;
+    panels.forEach((p, i) => (panelRoots[i].hidden = !p.update(s, panelRoots[i], ctx)));
     v3.setTool(s.machine.X ?? 0, s.machine.Y ?? 0, s.machine.Z ?? 0, s.job.active && s.job.kind === "program");
     const d = dialogFor(s);
-    const key = d ? `${d.id}|${d.text(s)}` : "";
+    // Drawn again when what it says or offers changes (not at every status: its inputs keep their values).
+    const key = d ? `${d.id}|${d.text(s)}|${d.actions(s).map((a) => a.label).join(",")}` : "";
     if (key !== dialogKey) {
       dialogKey = key;
       if (!d) {
         dialog.close();
       } else {
-        dialog.replaceChildren(el("h2", {}, d.title(s)), el("p", {}, d.text(s)),
-          el("div", { class: "row" }, ...d.actions(s).map((a) => button(a.label, () => void ctx.send(a.kind, a.fields), a.cls ?? ""))));
+        renderDialog(dialog, d, s, (kind, fields) => ctx.send(kind, fields));
         if (!dialog.open) dialog.showModal();
       }
+    }
+    // A screen whose feature the machine lacks has no key.
+    for (const sc of screens) {
+      if (sc.requires) (keys.querySelector(`[data-screen="${sc.id}"]`) as HTMLElement).hidden = !s.features?.installed.includes(sc.requires);
     }
     screens.find((x) => x.id === shownId)?.update?.(s, ctx);
   };

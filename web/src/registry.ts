@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Screens and dialogs plug in here: a new feature (power-fail recovery, retrace, tool check, EDM
-// conditions) adds a file that calls registerScreen or registerDialog, and one import in main.ts.
+// Screens, dialogs and panels plug in here: a new feature (power-fail recovery, retrace, tool
+// check, EDM conditions) adds a file that calls registerScreen, registerDialog or registerPanel,
+// and one import in main.ts.
 import type { Api } from "./api";
 import type { Machine, Status } from "./types";
 
@@ -27,6 +28,31 @@ export interface Screen {
   update?(s: Status, ctx: Context): void;
   /** Called when the screen is shown. */
   shown?(ctx: Context): void;
+  /** A controller feature the screen needs: its key is hidden on a machine without it. */
+  requires?: string;
+}
+
+/** A button of a dialog: a label and the command it sends. */
+export interface DialogAction {
+  label: string;
+  kind: string;
+  fields?: Record<string, unknown>;
+  cls?: string;
+  /** Asked in the dialog before it is sent ("Retract Z by 2 mm?"); sent with `confirmed: true`. */
+  confirm?: string;
+  /** The dialog's inputs' values go with the fields (through `transform` when given). */
+  form?: boolean;
+  transform?: (values: Record<string, number | string>) => Record<string, unknown>;
+}
+
+/** An input of a dialog (a number, or one of a few choices). */
+export interface DialogField {
+  name: string;
+  label: string;
+  value: number | string;
+  /** Choices: a select; otherwise a number input. */
+  options?: string[];
+  unit?: string;
 }
 
 /** A modal dialog shown while the status asks for it (what the controller waits on). */
@@ -37,11 +63,23 @@ export interface Dialog {
   title(s: Status): string;
   text(s: Status): string;
   /** The buttons: a label and what it sends. */
-  actions(s: Status): { label: string; kind: string; fields?: Record<string, unknown>; cls?: string }[];
+  actions(s: Status): DialogAction[];
+  /** Inputs shown above the buttons (kept while the dialog stays open). */
+  fields?(s: Status): DialogField[];
+}
+
+/** A panel of the main screen's process column (the load, the alarms, the EDM's live values). */
+export interface Panel {
+  id: string;
+  /** Builds the panel into `root` once. */
+  mount(root: HTMLElement, ctx: Context): void;
+  /** Every status: fills `root`; the panel is hidden while this returns false. */
+  update(s: Status, root: HTMLElement, ctx: Context): boolean;
 }
 
 export const screens: Screen[] = [];
 export const dialogs: Dialog[] = [];
+export const panels: Panel[] = [];
 
 export function registerScreen(s: Screen) {
   screens.push(s);
@@ -49,4 +87,8 @@ export function registerScreen(s: Screen) {
 
 export function registerDialog(d: Dialog) {
   dialogs.push(d);
+}
+
+export function registerPanel(p: Panel) {
+  panels.push(p);
 }

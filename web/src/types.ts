@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The shapes of the server's JSON (docs/api.md).
+import type { Alarm, Edm, Features, Load, Power } from "./types_features";
 
 export type Axes = Record<string, number>;
 
@@ -61,6 +62,12 @@ export interface Status {
   };
   sync_wait: string;
   runs_finished: number;
+  /** The process side and the features (types_features.ts); each present when the machine has it. */
+  power?: Power;
+  load?: Load;
+  alarms?: Alarm[];
+  edm?: Edm;
+  features?: Features;
 }
 
 export interface ControllerEvent {

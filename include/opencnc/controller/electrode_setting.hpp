@@ -67,6 +67,7 @@ struct ElectrodeResult {
   Point3 previous{};               ///< the tool table's X, Y, Z offsets before
   Point3 offset{};                 ///< … and as measured (Z is the electrode's length)
   double rms_residual_mm = 0, max_residual_mm = 0;
+  bool written = false;  ///< the offsets are in the tool table (at once, or by "write" after a look)
 };
 
 /// From the touch points: the fit of the points lifted by the tip radius (radius: the sphere's plus
@@ -81,6 +82,9 @@ ElectrodeResult evaluate_touches(const config::ReferenceSphereProfile& sphere, i
 /// `requests::Feature{"electrode", "measure", ElectrodeMeasure{tool}}`.
 struct ElectrodeMeasure {
   int tool = 0;
+  /// Store the offsets when the measurement passes its checks; false: keep them in last() until
+  /// the operator has seen them and sends "write" (an HMI's confirmation).
+  bool write = true;
 };
 
 /// Where the main program stopped (aborted or faulted) before its end: what `resume` needs.
@@ -96,6 +100,8 @@ const char* to_string(ElectrodePhase p) noexcept;
 /// homed, no job running, the tool in the table — the touches run one auxiliary program each
 /// (Auto mode), then the offsets are checked and written to the tool table (ChangeSource::Operator,
 /// G10 L1's fields X Y Z) and a note `electrode.set` (or the error's code) says what was found;
+/// `write`: stores the last measurement's offsets when it passed, was not stored yet, and the
+/// tool's offsets in the table are still those it was measured against;
 /// `resume`: after a measurement, the main program that stopped before its end goes on — an
 /// approach to where it stopped, moved by the change of the measured tool's offsets (up to the
 /// safe height, over, down), then requests::ResumeProgram at its segment. Attach it with
@@ -121,6 +127,8 @@ class ElectrodeSetting final : public Feature {
  private:
   Outcome measure(const ElectrodeMeasure& args, FeatureHost& host);
   Outcome resume(FeatureHost& host);
+  Outcome write();
+  bool store(ElectrodeResult& r);
   void when_aux_ended(const ControllerEvent& e);
   void next_touch();
   void touched(const Point3& at);
@@ -135,6 +143,7 @@ class ElectrodeSetting final : public Feature {
 
   // The measurement under way.
   int tool_ = 0;
+  bool write_ = true;  ///< store the offsets when the measurement ends
   std::size_t tool_index_ = 0;
   tools::ToolEntry entry_;
   std::vector<SphereTouch> plan_;

@@ -15,6 +15,7 @@
 #include "opencnc/controller/events.hpp"
 #include "opencnc/controller/observer.hpp"
 #include "opencnc/controller/request.hpp"
+#include "opencnc/hmi/simulation.hpp"
 
 namespace opencnc::hmi {
 
@@ -39,9 +40,10 @@ struct ToolChange {
   std::optional<double> diameter_mm, z_offset_mm;
   std::string comment;
 };
-using Command = std::variant<control::Request, ToolChange>;
+using Command = std::variant<control::Request, ToolChange, SimulationEvent>;
 
-/// The role a command kind needs (admin for tool data, else operator); nothing for an unknown kind.
+/// The role a command kind needs (admin for tool data and the simulation, else operator); nothing for an
+/// unknown kind.
 std::optional<Role> role_for(std::string_view kind);
 
 /// Turns a command body (`{"kind": …, …}`) into a request: every field checked for type and
@@ -50,6 +52,17 @@ std::optional<Role> role_for(std::string_view kind);
 std::variant<Command, ApiError> parse_command(const nlohmann::json& body,
                                               const config::MachineProfile& profile,
                                               const std::filesystem::path& programs_dir);
+
+/// A `{"kind": "feature", "feature": F, "action": A, …}` body to Request::feature(F, A, args):
+/// the journal, retrace, electrode and tool-guard actions with their fields checked, the ones
+/// that move the machine or change kept data only with `"confirmed": true` (docs/api.md,
+/// "Features"). Any thread.
+std::variant<control::Request, ApiError> parse_feature_command(const nlohmann::json& body,
+                                                               const config::MachineProfile& profile);
+
+/// The process side of the status: `power`, `load` (a load guard), `alarms` (the profile's
+/// process alarms with their state), `edm` (a machine with [edm]). Any thread.
+nlohmann::json process_json(const control::ServoStatus& s, const config::MachineProfile& profile);
 
 /// The status as the API sends it (docs/api.md, "Status"). Any thread.
 nlohmann::json status_json(const control::ControllerStatus& s, const config::MachineProfile& profile);

@@ -7,13 +7,16 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <string>
+#include <string_view>
 #include <thread>
 #include <vector>
 
 #include "opencnc/config/machine_profile.hpp"
 #include "opencnc/control/clock.hpp"
 #include "opencnc/controller/controller.hpp"
+#include "opencnc/hmi/simulation.hpp"
 
 namespace opencnc::control {
 class SimRig;
@@ -55,6 +58,11 @@ class MachineHost {
   std::uint64_t ticks() const noexcept;
   std::uint64_t overruns() const noexcept;
   const control::LatencyHistogram* latency() const noexcept;
+  /// A control of the simulated machine: "mains-off" (the mains fail: the power-fail stop),
+  /// "mains-on", "electrode" (the electrode in the spindle, for the reference sphere). Applied by
+  /// the thread that steps the machine before its next period; "" or why not (in real time the
+  /// servo thread alone touches the machine: virtual time only). Any thread.
+  std::string simulate(const SimulationEvent& event);
 
  private:
   void run_paced();
@@ -71,6 +79,8 @@ class MachineHost {
   // Paced virtual time.
   std::unique_ptr<control::SimRig> rig_;
   std::atomic<std::uint64_t> paced_ticks_{0};
+  std::mutex simulate_mutex_;
+  std::vector<SimulationEvent> simulate_;  ///< events for the paced thread to apply
 
   std::atomic<bool> stop_{false};
   std::thread thread_;  ///< the controller's loop (real time) or the paced rig

@@ -7,11 +7,13 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <string>
 
 #include "opencnc/config/machine_profile.hpp"
 #include "opencnc/controller/controller.hpp"
+#include "opencnc/hmi/simulation.hpp"
 #include "opencnc/hmi/tokens.hpp"
 
 namespace opencnc::control {
@@ -21,6 +23,7 @@ class GcodeProgramSource;
 namespace opencnc::hmi {
 
 class History;
+class MachineFeatures;
 
 struct ServerConfig {
   std::string address = "127.0.0.1";   ///< where to listen (IPv4 or IPv6 literal)
@@ -32,6 +35,11 @@ struct ServerConfig {
   std::size_t max_queued = 64;
   double command_timeout_s = 10;  ///< how long POST /commands waits for the answer (then 202)
   int io_threads = 1;
+  /// The machine's features: their state goes into the status as `features` (null: none).
+  const MachineFeatures* features = nullptr;
+  /// The simulated machine's controls (`{"kind": "simulate", …}`, admin): applies the event and
+  /// returns "" or why it cannot. Empty: none (a 409).
+  std::function<std::string(const SimulationEvent&)> simulate;
 };
 
 /// Counters of the server. Any thread.

@@ -1,0 +1,95 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// MachineFeatures — the controller features a profile calls for, as `opencnc serve` installs them
+// (power-fail journal, electrode setting, retrace, tool guard, run from line), and a board that
+// snapshots their state on the controller's thread for the HMI's status (docs/hmi.md, "Features").
+#pragma once
+
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "opencnc/config/machine_profile.hpp"
+#include "opencnc/controller/controller.hpp"
+#include "opencnc/core/diagnostic.hpp"
+
+namespace opencnc::control {
+class GcodeProgramSource;
+class ElectrodeSetting;
+}  // namespace opencnc::control
+namespace opencnc::recovery {
+class BreakpointJournal;
+class RetraceFeature;
+}  // namespace opencnc::recovery
+namespace opencnc::store {
+class ToolStore;
+}
+namespace opencnc::toolguard {
+class ToolGuard;
+}
+
+namespace opencnc::hmi {
+
+struct FeatureOptions {
+  /// The breakpoint journal's folder (created if missing). Used when the profile has a power
+  /// monitor (`[power] monitor`); "" then means no journal.
+  std::string journal_dir;
+};
+
+/// The features of one machine. create() on the thread that sets the server up; install() once,
+/// before the controller runs; status() from any thread.
+class MachineFeatures {
+ public:
+  /// The profile's program source (with `[tool_guard]`, the tool store as its table) and the
+  /// features it calls for: "journal" with a power monitor and a journal folder, "electrode"
+  /// with `[probe.reference_sphere]` and a tool table, "retrace" with `[process.cutting]`,
+  /// "tool-guard" with `[tool_guard]`, "run-from-line" always. Nullptr with the reasons in `diags`
+  /// (a journal folder or tool store that cannot be opened).
+  static std::unique_ptr<MachineFeatures> create(const config::MachineProfile& profile,
+                                                 const FeatureOptions& options, Diagnostics& diags);
+  ~MachineFeatures();
+  MachineFeatures(const MachineFeatures&) = delete;
+  MachineFeatures& operator=(const MachineFeatures&) = delete;
+
+  /// The program source the controller and the server use. Any thread.
+  const std::shared_ptr<control::GcodeProgramSource>& source() const noexcept { return source_; }
+  /// Adds the features and the board that follows them to `controller` (before it runs).
+  void install(control::Controller& controller);
+  /// The names of the installed features, in installation order. Any thread.
+  const std::vector<std::string>& names() const noexcept { return names_; }
+  /// The features' state as of the controller's last status period (docs/api.md, "features"):
+  /// `{"installed": […], "journal": {…}, "retrace": {…}, "electrode": {…}, "tool_guard": {…}}`,
+  /// each present when its feature is. Any thread.
+  nlohmann::json status() const;
+
+  /// The journal feature (null without it). Any thread (its accessors say which).
+  const std::shared_ptr<recovery::BreakpointJournal>& journal() const noexcept { return journal_; }
+
+ private:
+  class Board;
+  MachineFeatures() = default;
+  nlohmann::json snapshot(const control::ControllerStatus& s);          // controller thread
+  nlohmann::json tool_guard_state(const control::ControllerStatus& s);  // controller thread
+
+  config::MachineProfile profile_;
+  std::shared_ptr<control::GcodeProgramSource> source_;
+  std::shared_ptr<store::ToolStore> store_;
+  std::shared_ptr<toolguard::ToolGuard> guard_;
+  std::shared_ptr<recovery::BreakpointJournal> journal_;
+  std::shared_ptr<recovery::RetraceFeature> retrace_;
+  std::shared_ptr<control::ElectrodeSetting> electrode_;
+  std::vector<std::shared_ptr<control::Feature>> features_;
+  std::vector<std::string> names_;
+
+  // The tool guard's check while it holds, run again only when the store changed.
+  bool guard_holding_ = false;
+  std::uint64_t guard_checked_ = ~std::uint64_t{0};
+  nlohmann::json guard_report_;
+
+  mutable std::mutex mutex_;
+  nlohmann::json state_;  ///< the board's last snapshot
+};
+
+}  // namespace opencnc::hmi

@@ -1,0 +1,18 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// SimulationEvent — a control of the simulated machine the HMI's admin may use (docs/api.md,
+// "Simulation"): the mains cut and restored, an electrode put in the spindle.
+#pragma once
+
+#include <array>
+#include <string>
+
+namespace opencnc::hmi {
+
+struct SimulationEvent {
+  /// "mains-off", "mains-on", "electrode" (the simulated electrode's true offsets and tip).
+  std::string event;
+  std::array<double, 3> offset_mm{};  ///< electrode: X, Y, Z as a tool table holds them
+  double tip_radius_mm = 0;           ///< electrode: its tip's ball
+};
+
+}  // namespace opencnc::hmi
