@@ -34,13 +34,16 @@ while (($#)); do
 done
 
 jobs=${OPENCNC_JOBS:-2}
+# Builds run one job more than the cores: a link (single-threaded, long for the sanitized test
+# binaries) then leaves no core idle. Tests stay at one per core: some of them time real threads.
+build_jobs=$((jobs + 1))
 
 scripts/setup.sh --tests
 
 echo "== build (warnings are errors)"
 cmake --preset ci >/dev/null
 if ((quick)); then
-  cmake --build --preset ci -j "$jobs"
+  cmake --build --preset ci -j "$build_jobs"
   echo "== test suite"
   ctest --preset ci -j "$jobs"
   echo "== HMI front end: build, unit tests, end to end in headless Chromium"
@@ -53,7 +56,7 @@ fi
 # component and the benchmarks; then the tests that need this build: the HAL component in halrun
 # (a sanitised module cannot load into rtapi_app), the real-time core's symbol check, and the
 # breakpoint journal's torture (100 kills of the writing process; its benchmark, optimised).
-cmake --build --preset ci -j "$jobs" --target src/all apps/opencnc/all bench/all
+cmake --build --preset ci -j "$build_jobs" --target src/all apps/opencnc/all bench/all
 echo "== the HAL component in halrun, the real-time core's symbols, the journal's torture (optimised build)"
 ctest --preset ci -j "$jobs" -R '^(hal|repo|bench)[.]'
 echo "== HMI front end: build, unit tests, end to end in headless Chromium"
@@ -61,7 +64,7 @@ scripts/hmi.sh --test --e2e
 
 echo "== build with AddressSanitizer + UndefinedBehaviorSanitizer"
 cmake --preset asan >/dev/null
-cmake --build --preset asan -j "$jobs"
+cmake --build --preset asan -j "$build_jobs"
 echo "== test suite under ASan + UBSan"
 # Each conformance program forks an instrumented opencnc and rs274 (five minutes for all 615 under
 # ASan): every tenth of them runs here and all of them in `--quick`; the interpreter itself runs
@@ -73,7 +76,7 @@ ctest --preset asan -j "$jobs" -R 'Conformance[.]Program/' -I ,,10
 if compgen -G "fuzz/*/CMakeLists.txt" >/dev/null; then
   echo "== fuzz gate (the G-code libraries and the fuzz targets only; ASan + UBSan)"
   cmake --preset fuzz >/dev/null
-  cmake --build --preset fuzz -j "$jobs"
+  cmake --build --preset fuzz -j "$build_jobs"
   scripts/fuzz.sh --gate
 fi
 echo "== all tests passed"
