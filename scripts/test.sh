@@ -16,7 +16,8 @@ usage: scripts/test.sh [--quick]
   screenshots in web/e2e/artifacts); then builds the whole suite under ASan + UBSan and runs it
   (every tenth conformance program); then the fuzz gate (scripts/fuzz.sh --gate: the committed
   corpus, the regression inputs and a fixed-seed run: the same commit always passes or always
-  fails). OPENCNC_JOBS sets the build's parallel jobs (default 2).
+  fails). OPENCNC_JOBS sets the cores to use (default 2): the tests run that many at once, the
+  builds one more.
   --quick      the optimised build of everything and the whole suite there (all conformance
                programs), and the HMI's tests; no sanitizers, no fuzzing
   -h, --help   this text
