@@ -8,13 +8,10 @@
 #include <filesystem>
 
 #include "../control/test_profiles.hpp"
-#include "client.hpp"
-#include "opencnc/controller/gcode_source.hpp"
 #include "opencnc/core/atomic_file.hpp"
 #include "opencnc/hmi/api.hpp"
 #include "opencnc/hmi/history.hpp"
-#include "opencnc/hmi/machine_host.hpp"
-#include "opencnc/hmi/server.hpp"
+#include "server_rig.hpp"
 
 namespace opencnc::hmi {
 namespace {
@@ -22,42 +19,13 @@ namespace {
 using namespace test;
 using nlohmann::json;
 
-const std::string kOperator = "operator-token-for-tests-0001";
-const std::string kAdmin = "admin-token-for-tests-000000002";
-
-/// The simulated mill (its profile a copy in a folder of its own) at 200× in virtual time.
-struct AdminRig {
-  AdminRig() {
-    dir = std::filesystem::temp_directory_path() / ("opencnc-admin-" + std::to_string(::getpid()));
-    std::filesystem::remove_all(dir);
-    std::filesystem::create_directories(dir);
-    path = (dir / "mill.toml").string();
-    EXPECT_TRUE(read_file(OPENCNC_SOURCE_DIR "/configs/mill-3axis.toml", original, nullptr));
-    EXPECT_TRUE(write_file_atomically(path, original, nullptr));
-    profile = control::test::loaded(config::load_profile(path));
-    Diagnostics d;
-    source = control::GcodeProgramSource::create(profile, d);
-    std::string error;
-    history = History::open(dir / "history.sqlite", &error);
-    host = std::make_unique<MachineHost>(profile, source, HostOptions{false, 200});
-    host->start(nullptr);
-    ServerConfig sc;
-    sc.port = 0;
-    sc.programs_dir = OPENCNC_SOURCE_DIR "/examples";
-    server = std::make_unique<Server>(host->controller(), profile, Tokens::of(kOperator, kAdmin),
-                                      history.get(), source.get(), sc);
-    EXPECT_TRUE(server->start(&error)) << error;
-    port = server->port();
-  }
-  ~AdminRig() {
-    server->stop();
-    host->stop();
-    std::filesystem::remove_all(dir);
-  }
-  std::string file() const {
-    std::string s;
-    read_file(path, s, nullptr);
-    return s;
+/// The simulated mill, its profile a copy in the rig's folder that the admin may edit.
+struct AdminRig : ServerRig {
+  AdminRig() : ServerRig(options()) {}
+  static RigOptions options() {
+    RigOptions o;
+    o.profile_copy = true;
+    return o;
   }
   double parameter(const std::string& key) {
     const Reply r = get(port, "/api/v1/parameters", kOperator);
@@ -65,22 +33,13 @@ struct AdminRig {
       if (p["key"] == key) return p["value"].get<double>();
     return -1;
   }
-
-  std::filesystem::path dir;
-  std::string path, original;
-  config::MachineProfile profile;
-  std::shared_ptr<control::GcodeProgramSource> source;
-  std::unique_ptr<History> history;
-  std::unique_ptr<MachineHost> host;
-  std::unique_ptr<Server> server;
-  std::uint16_t port = 0;
 };
 
 TEST(AdminParameters, TheOperatorReadsThemOnlyTheAdminChangesThem) {
   AdminRig rig;
   const Reply list = get(rig.port, "/api/v1/parameters", kOperator);
   ASSERT_EQ(list.status, 200);
-  EXPECT_EQ(list.body["profile"], rig.path);
+  EXPECT_EQ(list.body["profile"], rig.profile_path);
   EXPECT_EQ(list.body["parameters"].size(), 15u);
   EXPECT_EQ(list.body["parameters"][0], (json{{"key", "axis.x.max_velocity"},
                                               {"value", 100.0},
@@ -88,13 +47,13 @@ TEST(AdminParameters, TheOperatorReadsThemOnlyTheAdminChangesThem) {
                                               {"what", "fastest speed of the axis"}}));
   const std::string change = R"({"kind":"set-parameters","values":{"axis.x.max_velocity":40}})";
   EXPECT_EQ(post(rig.port, change, kOperator).status, 403);
-  EXPECT_EQ(rig.file(), rig.original);
+  EXPECT_EQ(rig.profile_text(), rig.profile_original);
   const Reply ok = post(rig.port, change, kAdmin);
   ASSERT_EQ(ok.status, 200) << ok.text;
   EXPECT_EQ(ok.body["message"], "axis.x.max_velocity 100.0 → 40.0");
-  std::string expected = rig.original;
+  std::string expected = rig.profile_original;
   expected.replace(expected.find("max_velocity = 100.0"), 20, "max_velocity = 40.0");
-  EXPECT_EQ(rig.file(), expected);
+  EXPECT_EQ(rig.profile_text(), expected);
   EXPECT_EQ(rig.parameter("axis.x.max_velocity"), 40.0);
   EXPECT_EQ(get(rig.port, "/api/v1/machine", kOperator).body["axes"][0]["max_velocity"], 40.0);
   // The API's own checks use the new limit at once: a jog above it is a 422.
@@ -117,11 +76,11 @@ TEST(AdminParameters, ABadValueGetsTheProfilesMessageAndNothingChanges) {
   EXPECT_EQ(bad.body["code"], "control.bad-value");
   ASSERT_FALSE(bad.body["diagnostics"].empty());
   const std::string text = bad.body["diagnostics"][0]["text"];
-  EXPECT_EQ(text.rfind(rig.path + ":", 0), 0u) << text;  // file:line:col: error: message
+  EXPECT_EQ(text.rfind(rig.profile_path + ":", 0), 0u) << text;  // file:line:col: error: message
   EXPECT_NE(text.find("max_acceleration"), std::string::npos) << text;
-  EXPECT_EQ(
-      bad.body["message"].get<std::string>().rfind("the profile refuses the change: " + rig.path + ":", 0),
-      0u);
+  EXPECT_EQ(bad.body["message"].get<std::string>().rfind(
+                "the profile refuses the change: " + rig.profile_path + ":", 0),
+            0u);
   EXPECT_EQ(
       post(rig.port, R"({"kind":"set-parameters","values":{"axis.x.homing.position":1}})", kAdmin).status,
       422);
@@ -130,7 +89,7 @@ TEST(AdminParameters, ABadValueGetsTheProfilesMessageAndNothingChanges) {
       400);
   EXPECT_EQ(post(rig.port, R"({"kind":"set-parameters","values":{}})", kAdmin).status, 400);
   EXPECT_EQ(post(rig.port, R"({"kind":"set-parameters"})", kAdmin).status, 400);
-  EXPECT_EQ(rig.file(), rig.original);
+  EXPECT_EQ(rig.profile_text(), rig.profile_original);
   EXPECT_EQ(rig.parameter("axis.z.max_acceleration"), 1000.0);
 }
 

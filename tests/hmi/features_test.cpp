@@ -11,7 +11,6 @@
 #include <thread>
 
 #include "../control/test_profiles.hpp"
-#include "client.hpp"
 #include "opencnc/config/profile_loader.hpp"
 #include "opencnc/controller/electrode_setting.hpp"
 #include "opencnc/controller/gcode_source.hpp"
@@ -24,6 +23,7 @@
 #include "opencnc/recovery/retrace.hpp"
 #include "opencnc/store/tool_store.hpp"
 #include "opencnc/tools/tool_text.hpp"
+#include "server_rig.hpp"
 
 namespace opencnc::hmi {
 namespace {
@@ -31,9 +31,6 @@ namespace {
 using namespace test;
 using nlohmann::json;
 using Clock = std::chrono::steady_clock;
-
-const std::string kOperator = "operator-token-for-tests-0001";
-const std::string kAdmin = "admin-token-for-tests-000000002";
 
 config::MachineProfile load(const char* name, std::vector<std::string> sets = {}) {
   const config::ProfileLoad l =
@@ -204,60 +201,21 @@ TEST(MachineFeatures, EachProfileGetsTheFeaturesItCallsFor) {
   std::filesystem::remove_all(dir);
 }
 
-/// A machine served on loopback in virtual time at 200× with its features and the simulation
-/// controls; programs from `programs` (default the examples).
-struct FeatureRig {
-  explicit FeatureRig(const char* machine, std::vector<std::string> sets = {},
-                      std::filesystem::path programs = OPENCNC_SOURCE_DIR "/examples") {
-    dir = std::filesystem::temp_directory_path() / ("opencnc-serve-features-" + std::to_string(::getpid()));
-    std::filesystem::remove_all(dir);
-    std::filesystem::create_directories(dir);
-    profile = load(machine, sets);
-    Diagnostics d;
-    features = MachineFeatures::create(profile, {(dir / "journal").string()}, d);
-    EXPECT_TRUE(features) << (d.items().empty() ? "" : d.items()[0].format());
-    host = std::make_unique<MachineHost>(profile, features->source(), HostOptions{false, 200});
-    features->install(host->controller());
-    host->start(nullptr);
-    ServerConfig sc;
-    sc.port = 0;
-    sc.programs_dir = programs;
-    sc.features = features.get();
-    sc.simulate = [this](const SimulationEvent& e) { return host->simulate(e); };
-    server = std::make_unique<Server>(host->controller(), profile, Tokens::of(kOperator, kAdmin), nullptr,
-                                      features->source().get(), sc);
-    std::string error;
-    EXPECT_TRUE(server->start(&error)) << error;
-    port = server->port();
-  }
-  ~FeatureRig() {
-    server->stop();
-    host->stop();
-    std::filesystem::remove_all(dir);
-  }
-  json status() { return get(port, "/api/v1/status", kOperator).body; }
-  bool until(const std::function<bool(const json&)>& done, double seconds = 20) {
-    const auto end = Clock::now() + std::chrono::duration<double>(seconds);
-    while (Clock::now() < end) {
-      if (done(status())) return true;
-      std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    }
-    return false;
-  }
-  Reply command(const json& body, const std::string& token = kOperator) {
-    return post(port, body.dump(), token);
-  }
-
-  std::filesystem::path dir;
-  config::MachineProfile profile;
-  std::unique_ptr<MachineFeatures> features;
-  std::unique_ptr<MachineHost> host;
-  std::unique_ptr<Server> server;
-  std::uint16_t port = 0;
-};
+/// A machine served on loopback with its features and the simulation controls; programs from
+/// `programs` (default the examples).
+RigOptions featured(const char* machine, std::vector<std::string> sets = {},
+                    std::filesystem::path programs = OPENCNC_SOURCE_DIR "/examples") {
+  RigOptions o;
+  o.machine = machine;
+  o.sets = std::move(sets);
+  o.features = true;
+  o.history = false;
+  o.programs = std::move(programs);
+  return o;
+}
 
 TEST(ServerFeatures, PowerFailRecordInTheStatusThenARetractConfirmedByTheOperator) {
-  FeatureRig rig("broach-zc.toml");
+  ServerRig rig(featured("broach-zc.toml"));
   for (const char* k : {"machine-on"}) ASSERT_EQ(rig.command({{"kind", k}}).status, 200);
   ASSERT_EQ(rig.command({{"kind", "mode"}, {"mode", "auto"}}).status, 200);
   ASSERT_EQ(rig.command({{"kind", "open"}, {"program", "broach-constant.ngc"}}).status, 200);
@@ -315,7 +273,7 @@ TEST(ServerFeatures, PowerFailRecordInTheStatusThenARetractConfirmedByTheOperato
 }
 
 TEST(ServerFeatures, RetracePausesStepsBackAndCutsOnFromTheNearestPoint) {
-  FeatureRig rig("flame-cutter.toml");
+  ServerRig rig(featured("flame-cutter.toml"));
   EXPECT_EQ(rig.status()["features"]["installed"], json({"retrace", "run-from-line"}));
   ASSERT_EQ(rig.command({{"kind", "machine-on"}}).status, 200);
   ASSERT_EQ(rig.command({{"kind", "home"}}).status, 200);
@@ -351,8 +309,8 @@ TEST(ServerFeatures, ElectrodeMeasuredOnTheSphereIsShownThenStoredOnConfirmation
   std::filesystem::create_directories(tables);
   std::filesystem::copy_file(OPENCNC_SOURCE_DIR "/configs/edm-5axis.tbl", tables / "edm-5axis.tbl",
                              std::filesystem::copy_options::overwrite_existing);
-  FeatureRig rig("edm-5axis.toml",
-                 {"interpreter.tool_table=\"" + (tables / "edm-5axis.tbl").string() + "\""});
+  ServerRig rig(
+      featured("edm-5axis.toml", {"interpreter.tool_table=\"" + (tables / "edm-5axis.tbl").string() + "\""}));
   EXPECT_EQ(rig.status()["features"]["installed"], json({"electrode", "run-from-line"}));
   ASSERT_EQ(rig.command({{"kind", "machine-on"}}).status, 200);
   ASSERT_EQ(rig.command({{"kind", "home"}}).status, 200);
@@ -427,7 +385,7 @@ TEST(ServerFeatures, TheToolGuardsHoldShowsTheDifferencesAndARestoreLetsTheProgr
   GuardedStore tools;
   std::string error;
   ASSERT_TRUE(tools.store->set(5, 1, tools::Param::Length1, 139.225, "test", &error)) << error;  // a typo
-  FeatureRig rig("hmc-toolcheck.toml", tools.sets(), tools.dir);
+  ServerRig rig(featured("hmc-toolcheck.toml", tools.sets(), tools.dir));
   EXPECT_EQ(rig.status()["features"]["installed"], json({"tool-guard", "run-from-line"}));
   ASSERT_EQ(rig.command({{"kind", "machine-on"}}).status, 200);
   ASSERT_EQ(rig.command({{"kind", "mode"}, {"mode", "auto"}}).status, 200);

@@ -8,14 +8,11 @@
 #include <chrono>
 #include <thread>
 
-#include "../control/test_profiles.hpp"
-#include "client.hpp"
-#include "opencnc/controller/gcode_source.hpp"
-#include "opencnc/controller/run_from_line.hpp"
 #include "opencnc/hmi/history.hpp"
 #include "opencnc/hmi/machine_host.hpp"
 #include "opencnc/hmi/server.hpp"
 #include "opencnc/hmi/stream_tickets.hpp"
+#include "server_rig.hpp"
 
 namespace opencnc::hmi {
 namespace {
@@ -24,62 +21,18 @@ using namespace test;
 using nlohmann::json;
 using Clock = std::chrono::steady_clock;
 
-const std::string kOperator = "operator-token-for-tests-0001";
-const std::string kAdmin = "admin-token-for-tests-000000002";
-
-/// The simulated mill in virtual time at 200× the wall clock, its history and the server.
-struct Rig {
-  explicit Rig(ServerConfig sc = {}, const std::string& address = "127.0.0.1") {
-    dir = std::filesystem::temp_directory_path() /
-          ("opencnc-serve-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
-    std::filesystem::remove_all(dir);
-    std::filesystem::create_directories(dir);
-    std::filesystem::copy_file(OPENCNC_SOURCE_DIR "/configs/mill-3axis.tbl", dir / "tools.tbl");
-    profile = control::test::mill({"interpreter.tool_table=\"" + (dir / "tools.tbl").string() + "\""});
-    Diagnostics d;
-    source = control::GcodeProgramSource::create(profile, d);
-    std::string error;
-    history = History::open(dir / "history.sqlite", &error);
-    host = std::make_unique<MachineHost>(profile, source, HostOptions{false, 200});
-    host->controller().attach(std::make_shared<HistoryRecorder>(*history, profile.servo_period_s));
-    host->controller().add_feature(
-        std::make_shared<control::RunFromLineFeature>(control::GcodeProgramSource::create(profile, d)));
-    host->start(nullptr);
-    sc.address = address;
-    sc.port = 0;
-    sc.programs_dir = OPENCNC_SOURCE_DIR "/examples";
-    server = std::make_unique<Server>(host->controller(), profile, Tokens::of(kOperator, kAdmin),
-                                      history.get(), source.get(), sc);
-    EXPECT_TRUE(server->start(&error)) << error;
-    port = server->port();
-  }
-  ~Rig() {
-    server->stop();
-    host->stop();
-    std::filesystem::remove_all(dir);
-  }
-  /// Polls the status until `done` holds (at most `seconds` of wall time).
-  bool until(const std::function<bool(const json&)>& done, double seconds = 20) {
-    const auto end = Clock::now() + std::chrono::duration<double>(seconds);
-    while (Clock::now() < end) {
-      if (done(get(port, "/api/v1/status", kOperator).body)) return true;
-      std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    }
-    return false;
-  }
-
-  static inline int counter = 0;
-  std::filesystem::path dir;
-  config::MachineProfile profile;
-  std::shared_ptr<control::GcodeProgramSource> source;
-  std::unique_ptr<History> history;
-  std::unique_ptr<MachineHost> host;
-  std::unique_ptr<Server> server;
-  std::uint16_t port = 0;
-};
+/// The simulated mill with its history, its tool table a copy, and run from line.
+RigOptions mill(ServerConfig sc = {}, std::string address = "127.0.0.1") {
+  RigOptions o;
+  o.tool_table_copy = true;
+  o.run_from_line = true;
+  o.server = sc;
+  o.address = std::move(address);
+  return o;
+}
 
 TEST(Server, StatusIsOpenOnLoopbackEverythingElseNeedsAToken) {
-  Rig rig;
+  ServerRig rig(mill());
   const Reply s = get(rig.port, "/api/v1/status");
   EXPECT_EQ(s.status, 200);
   EXPECT_EQ(s.body["mode"], "manual");
@@ -93,14 +46,14 @@ TEST(Server, StatusIsOpenOnLoopbackEverythingElseNeedsAToken) {
 }
 
 TEST(Server, OnAnyOtherAddressTheStatusNeedsATokenToo) {
-  Rig rig({}, "0.0.0.0");
+  ServerRig rig(mill({}, "0.0.0.0"));
   EXPECT_FALSE(rig.server->loopback_only());
   EXPECT_EQ(get(rig.port, "/api/v1/status").status, 401);
   EXPECT_EQ(get(rig.port, "/api/v1/status", kOperator).status, 200);
 }
 
 TEST(Server, BadRequestsGetA4xxWithAMessageAndChangeNothing) {
-  Rig rig;
+  ServerRig rig(mill());
   EXPECT_EQ(post(rig.port, "{not json", kOperator).status, 400);
   const Reply unknown = post(rig.port, R"({"kind":"fly"})", kOperator);
   EXPECT_EQ(unknown.status, 400);
@@ -120,7 +73,7 @@ TEST(Server, BadRequestsGetA4xxWithAMessageAndChangeNothing) {
 }
 
 TEST(Server, ToolDataIsTheAdminsAndEveryChangeIsAudited) {
-  Rig rig;
+  ServerRig rig(mill());
   const std::string change = R"({"kind":"set-tool","tool":1,"diameter":6.02})";
   EXPECT_EQ(post(rig.port, change, kOperator).status, 403);
   EXPECT_EQ(get(rig.port, "/api/v1/tools", kOperator).body[0]["diameter"], 6.0);
@@ -140,7 +93,7 @@ TEST(Server, ToolDataIsTheAdminsAndEveryChangeIsAudited) {
 }
 
 TEST(Server, TheStreamOpensWithASingleUseTicketAndNeverATokenInTheUrl) {
-  Rig rig;
+  ServerRig rig(mill());
   const Reply issued = call(rig.port, http::verb::post, "/api/v1/stream-ticket", kOperator, "");
   ASSERT_EQ(issued.status, 200) << issued.text;
   const std::string ticket = issued.body["ticket"];
@@ -170,14 +123,15 @@ TEST(StreamTickets, LastTheirLifetimeAndOpenOnce) {
   EXPECT_FALSE(t.redeem(*b, now + StreamTickets::kLifetime));  // expired
   EXPECT_FALSE(t.redeem("", now));
   EXPECT_EQ(t.outstanding(), 0u);
-  for (std::size_t k = 0; k < StreamTickets::kMaxOutstanding + 5; ++k) ASSERT_TRUE(t.issue(Role::Operator, now, &error));
+  for (std::size_t k = 0; k < StreamTickets::kMaxOutstanding + 5; ++k)
+    ASSERT_TRUE(t.issue(Role::Operator, now, &error));
   EXPECT_EQ(t.outstanding(), StreamTickets::kMaxOutstanding);
 }
 
 TEST(Server, TheStreamSendsStatusAtItsRateAndEachClientItsEvents) {
   ServerConfig sc;
   sc.stream_hz = 30;
-  Rig rig(sc);
+  ServerRig rig(mill(sc));
   Stream a(rig.port, kOperator);
   EXPECT_THROW(Stream(rig.port, "not-a-token-at-all-0000"), beast::system_error);
   const auto start = Clock::now();
@@ -205,7 +159,7 @@ TEST(Server, AClientThatStopsReadingIsDroppedWithoutSlowingTheOthers) {
   ServerConfig sc;
   sc.stream_hz = 200;
   sc.max_queued = 8;
-  Rig rig(sc);
+  ServerRig rig(mill(sc));
   Stream stalled(rig.port, kOperator, 4096);  // connects, then never reads
   Stream reader(rig.port, kOperator);
   // The reader gets every status the stream makes while the stalled client fills its queue,
@@ -225,7 +179,7 @@ TEST(Server, AClientThatStopsReadingIsDroppedWithoutSlowingTheOthers) {
 }
 
 TEST(Server, AJobRunsToItsEndWithHoldAndResumeAndLandsInTheHistory) {
-  Rig rig;
+  ServerRig rig(mill());
   const std::string& t = kOperator;
   EXPECT_EQ(post(rig.port, R"({"kind":"machine-on"})", t).status, 200);
   EXPECT_EQ(post(rig.port, R"({"kind":"home"})", t).status, 200);
@@ -241,7 +195,8 @@ TEST(Server, AJobRunsToItsEndWithHoldAndResumeAndLandsInTheHistory) {
   EXPECT_GT(preview["polylines"].size(), 2u);
   EXPECT_EQ(get(rig.port, "/api/v1/program/text?from=4&count=1", t).body["lines"][0],
             "G21 G17 G40 G49 G80 G90 G94");
-  EXPECT_TRUE(get(rig.port, "/api/v1/program/text?from=4&count=1", t).body["more"]);  // a window: more after it
+  EXPECT_TRUE(
+      get(rig.port, "/api/v1/program/text?from=4&count=1", t).body["more"]);  // a window: more after it
   const json tail = get(rig.port, "/api/v1/program/text?from=70&count=5000", t).body;
   EXPECT_FALSE(tail["more"]);
   EXPECT_EQ(tail["from"], 70);
@@ -278,7 +233,7 @@ TEST(Server, AJobRunsToItsEndWithHoldAndResumeAndLandsInTheHistory) {
 }
 
 TEST(Server, TheStatusShowsWorkCoordinatesWithAG55OffsetAndAG92Shift) {
-  Rig rig;
+  ServerRig rig(mill());
   const std::string& t = kOperator;
   EXPECT_EQ(post(rig.port, R"({"kind":"machine-on"})", t).status, 200);
   EXPECT_EQ(post(rig.port, R"({"kind":"mode","mode":"mdi"})", t).status, 200);
@@ -307,7 +262,7 @@ TEST(Server, TheStatusShowsWorkCoordinatesWithAG55OffsetAndAG92Shift) {
 }
 
 TEST(Server, RunFromLineStartsTheProgramAtTheLineAfterTheApproach) {
-  Rig rig;
+  ServerRig rig(mill());
   const std::string& t = kOperator;
   EXPECT_EQ(post(rig.port, R"({"kind":"machine-on"})", t).status, 200);
   EXPECT_EQ(post(rig.port, R"({"kind":"home"})", t).status, 200);
@@ -327,7 +282,8 @@ TEST(Server, RunFromLineStartsTheProgramAtTheLineAfterTheApproach) {
       [&](const json& s) {
         if (first_line == 0 && s["job"]["kind"] == "program" && s["job"]["location"]["line"].get<int>() > 0)
           first_line = s["job"]["location"]["line"].get<std::uint32_t>();
-        return s["runs_finished"].get<int>() >= 2 && s["job"]["kind"] == "" && s["state"] == "idle";  // approach, program
+        return s["runs_finished"].get<int>() >= 2 && s["job"]["kind"] == "" &&
+               s["state"] == "idle";  // approach, program
       },
       60));
   // Seen while polling when the run is slow enough (a sanitizer build may run past it between polls).

@@ -7,6 +7,7 @@ import { spawn } from "node:child_process";
 import { mkdtempSync, rmSync } from "node:fs";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
+import { waitFor as waitForOn } from "./wait.mjs";
 
 const operator = "e2e-operator-token-0123456789", admin = "e2e-admin-token-0123456789";
 
@@ -41,14 +42,7 @@ export async function recoveryStep({ opencnc, repo, out, browser, step }) {
       if (r.status !== 200) throw new Error(`simulate ${event}: ${r.status} ${await r.text()}`);
     };
     const dialog = page.getByTestId("dialog");
-    const waitFor = async (what, check, ms = 30000) => {
-      const end = Date.now() + ms;
-      while (Date.now() < end) {
-        if (await check()) return;
-        await page.waitForTimeout(50);
-      }
-      throw new Error(`timed out waiting for ${what}`);
-    };
+    const waitFor = (what, check, ms) => waitForOn(page, what, check, ms);
     const dialogSays = async (t) => (await dialog.isVisible()) && (await dialog.innerText()).includes(t);
     await page.goto(url);
     await waitFor("the broach's load panel", async () => (await page.getByTestId("panel-load").innerText()).includes("hold 4 kN"));

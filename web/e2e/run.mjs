@@ -14,6 +14,7 @@ import { dirname, join, resolve } from "node:path";
 import { fileURLToPath } from "node:url";
 import { chromium } from "playwright-core";
 import { recoveryStep } from "./recovery.mjs";
+import { waitFor as waitForOn } from "./wait.mjs";
 
 const here = dirname(fileURLToPath(import.meta.url));
 const repo = resolve(here, "..", "..");
@@ -66,14 +67,7 @@ page.on("pageerror", (e) => console.error(`page error: ${e.message}`));
 const step = (what) => console.log(`e2e: ${what}`);
 const shot = (name) => page.screenshot({ path: join(out, `${name}.png`) });
 const text = (id) => page.getByTestId(id).innerText();
-const waitFor = async (what, check, ms = 30000) => {
-  const end = Date.now() + ms;
-  while (Date.now() < end) {
-    if (await check()) return;
-    await page.waitForTimeout(50);
-  }
-  throw new Error(`timed out waiting for ${what}`);
-};
+const waitFor = (what, check, ms) => waitForOn(page, what, check, ms);
 // The dialog's button with this label, clicked when it is there.
 const answer = async (label) => {
   const b = page.getByTestId("dialog").getByRole("button", { name: label });
