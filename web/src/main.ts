@@ -17,6 +17,7 @@ import "./screens/mdi";
 import "./screens/file";
 import "./screens/history";
 import "./screens/params";
+import "./screens/compensation";
 import "./screens/network";
 import "./screens/electrode";
 import type { ControllerEvent, Machine, Status } from "./types";
