@@ -191,5 +191,31 @@ TEST(AdminCompensation, ABadTableGetsTheProfilesMessageAndNothingChanges) {
   EXPECT_EQ(get(rig.port, "/api/v1/compensation", kOperator).body["axes"][1]["table"]["forward"][8], -0.012);
 }
 
+TEST(AdminConditions, AnEdmsConditionsAreListedInTheProfilesOrder) {
+  RigOptions o;
+  o.machine = "edm-5axis.toml";
+  o.history = false;
+  ServerRig rig(o);
+  const Reply r = get(rig.port, "/api/v1/conditions", kOperator);
+  ASSERT_EQ(r.status, 200) << r.text;
+  const json& list = r.body["conditions"];
+  ASSERT_EQ(list.size(), 4u);
+  EXPECT_EQ(list[0]["number"], 1);
+  EXPECT_EQ(list[0]["peak_current_a"], 12.0);
+  EXPECT_EQ(list[0]["on_time_us"], 100.0);
+  EXPECT_EQ(list[0]["polarity"], "+");
+  EXPECT_EQ(list[0]["jump_height_mm"], 0.4);
+  EXPECT_EQ(list[1]["orbit"], "circle");
+  EXPECT_EQ(list[2]["orbit"], "square");
+  EXPECT_EQ(list[2]["jump_mode"], "path");
+  EXPECT_EQ(list[3]["number"], 9);
+  EXPECT_EQ(get(rig.port, "/api/v1/conditions", "").status, 401);
+}
+
+TEST(AdminConditions, AMachineWithoutEdmHasNone) {
+  AdminRig rig;
+  EXPECT_EQ(get(rig.port, "/api/v1/conditions", kOperator).body["conditions"], json::array());
+}
+
 }  // namespace
 }  // namespace opencnc::hmi

@@ -40,4 +40,9 @@ ParametersRequest compensation_request(const nlohmann::json& body, const config:
 /// the comp file it came from and whether it can be changed here). Any thread.
 nlohmann::json compensation_json(const config::MachineProfile& profile);
 
+/// `GET /api/v1/conditions`: an EDM's machining conditions (`[[edm.condition]]`) in the order of
+/// the profile, each with its generator, gap-servo, jump and orbit settings; an empty list on a
+/// machine without `[edm]`. Any thread.
+nlohmann::json conditions_json(const config::MachineProfile& profile);
+
 }  // namespace opencnc::hmi
