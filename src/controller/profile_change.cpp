@@ -33,25 +33,14 @@ JointLimits joint_limits(const ServoConfig& s, int joint) {
   return l;
 }
 
-bool same_table(const motion::PitchTable& a, const motion::PitchTable& b) {
-  if (a.count != b.count) return false;
-  for (int i = 0; i < a.count; ++i) {
-    const auto k = static_cast<std::size_t>(i);
-    if (a.position[k] != b.position[k] || a.forward[k] != b.forward[k] || a.reverse[k] != b.reverse[k])
-      return false;
-  }
-  return true;
-}
-
-/// Bit j: joint j is compensated in `next` with a pitch table other than in `now`.
-std::uint16_t changed_tables(const ServoConfig& now, const ServoConfig& next) {
+/// Bit j: joint j is compensated in `next` (its table is staged at every change, changed or not:
+/// a stage left in the tick by a change whose commands did not all fit in the ring is then
+/// always overwritten before the next apply; an unchanged table switches without any take-up).
+std::uint16_t compensated_joints(const ServoConfig& next) {
   std::uint16_t mask = 0;
-  for (int j = 0; j < next.joint_count && j < motion::kMaxCompensatedJoints; ++j) {
-    const auto uj = static_cast<std::size_t>(j);
-    const motion::JointCompensation& c = next.compensation.joints[uj];
-    if (c.enabled && !same_table(now.compensation.joints[uj].pitch, c.pitch))
+  for (int j = 0; j < next.joint_count && j < motion::kMaxCompensatedJoints; ++j)
+    if (next.compensation.joints[static_cast<std::size_t>(j)].enabled)
       mask = static_cast<std::uint16_t>(mask | (1u << j));
-  }
   return mask;
 }
 
@@ -117,7 +106,7 @@ void Controller::edit_profile(std::uint64_t id, const requests::EditProfile& r) 
     return finish(id, Refusal::BadValue,
                   fmt::format("{}: cannot write the profile: {}", profile_.source, error));
   ProfileChange pending{id, new_id(), profile_, std::move(old_text), change_text(edit.changes), r.who};
-  const std::uint16_t tables = changed_tables(servo_config_, next);
+  const std::uint16_t tables = compensated_joints(next);
   swap_profile(std::move(*edit.profile));
   bool queued = true;
   for (int j = 0; j < next.joint_count && queued; ++j) {
