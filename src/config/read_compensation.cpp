@@ -128,6 +128,7 @@ void read_table(Section& s, CompensationProfile& c) {
   if (one) {
     if (!read_numbers(s, "errors", c.forward)) return;
     c.reverse = c.forward;
+    c.one_table = true;
   } else {
     if (!s.has("forward") || !s.has("reverse")) {
       s.missing(s.has("forward") ? "reverse" : "forward");
@@ -183,6 +184,7 @@ void read_axis_compensation(Section& s, AxisProfile& a, double period_s,
     const auto type = s.integer("comp_file_type", 0, 1);
     if (!type && !s.has("comp_file_type")) s.missing("comp_file_type");
     if (const auto file = s.string("comp_file"); file && type) {
+      c.comp_file = *file;
       const std::filesystem::path p(*file);
       read_comp_file(s, p.is_absolute() || base_dir.empty() ? p : base_dir / p, static_cast<int>(*type), c);
     }

@@ -103,9 +103,10 @@ std::vector<std::string> split_key(std::string_view dotted) {
   return parts;
 }
 
-/// The text with the value replaced or the key added; "" in `error` when done.
+/// The text with the value replaced or the key added (`remove`: its line dropped); "" in `error`
+/// when done.
 std::string edit_lines(std::string_view text, const std::string& table, std::string_view key,
-                       std::string_view value, std::string& error) {
+                       std::string_view value, std::string& error, bool remove = false) {
   const std::vector<TomlLine> lines = detail::split_lines(text);
   std::size_t header = lines.size(), found = lines.size(), hits = 0;
   ValueSpan span;
@@ -141,10 +142,19 @@ std::string edit_lines(std::string_view text, const std::string& table, std::str
       error = fmt::format("{}.{} spans more than one line in the profile: edit it by hand", table, key);
       return {};
     }
+    if (remove) {
+      out.append(text.substr(0, lines[found].begin));
+      out.append(text.substr(lines[found].end));
+      return out;
+    }
     out.append(text.substr(0, lines[found].begin + span.begin));
     out.append(value);
     out.append(text.substr(lines[found].begin + span.end));
     return out;
+  }
+  if (remove) {
+    error = fmt::format("[{}] has no {} to remove", table, key);
+    return {};
   }
   const std::size_t end = detail::table_end(lines, header);
   const std::size_t at = end < lines.size() ? lines[end].begin : text.size();
@@ -155,6 +165,28 @@ std::string edit_lines(std::string_view text, const std::string& table, std::str
   return out;
 }
 
+/// `dotted_key` as the path of its table, the table's dotted name and the key; false (with `error`)
+/// when it is not bare words inside a table.
+bool parse_key(std::string_view dotted_key, std::vector<std::string>& path, std::string& table,
+               std::string& key, std::string& error) {
+  path = split_key(lower(dotted_key));
+  for (const std::string& part : path) {
+    if (part.empty() || !std::all_of(part.begin(), part.end(), bare_key_char)) {
+      error = fmt::format("\"{}\" is not a dotted key of bare words", dotted_key);
+      return false;
+    }
+  }
+  if (path.size() < 2) {
+    error = fmt::format("\"{}\" is not a key inside a table", dotted_key);
+    return false;
+  }
+  key = path.back();
+  path.pop_back();
+  table = path.front();
+  for (std::size_t i = 1; i < path.size(); ++i) table += "." + path[i];
+  return true;
+}
+
 }  // namespace
 
 std::string toml_number(double v) {
@@ -163,23 +195,35 @@ std::string toml_number(double v) {
   return s;
 }
 
-std::optional<std::string> with_toml_value(std::string_view text, std::string_view dotted_key,
-                                           std::string_view value_toml, std::string& error) {
-  std::vector<std::string> path = split_key(lower(dotted_key));
-  for (const std::string& part : path) {
-    if (part.empty() || !std::all_of(part.begin(), part.end(), bare_key_char)) {
-      error = fmt::format("\"{}\" is not a dotted key of bare words", dotted_key);
+std::optional<std::string> without_toml_key(std::string_view text, std::string_view dotted_key,
+                                            std::string& error) {
+  std::vector<std::string> path;
+  std::string table, key;
+  if (!parse_key(dotted_key, path, table, key, error)) return std::nullopt;
+  std::string out = edit_lines(text, table, key, {}, error, true);
+  if (!error.empty()) return std::nullopt;
+  try {  // the original less this one key, nothing else
+    toml::table expected = toml::parse(text);
+    const toml::table after = toml::parse(out);
+    toml::table* t = find_table(expected, path);
+    if (!t || !t->erase(key) || !(expected == after)) {
+      error = fmt::format(
+          "{}.{} is also set elsewhere in the profile (a dotted key or an inline table): edit it by hand",
+          table, key);
       return std::nullopt;
     }
-  }
-  if (path.size() < 2) {
-    error = fmt::format("\"{}\" is not a key inside a table", dotted_key);
+  } catch (const toml::parse_error& e) {
+    error = fmt::format("the profile would not read back without {}.{}: {}", table, key, e.description());
     return std::nullopt;
   }
-  const std::string key = path.back();
-  path.pop_back();
-  std::string table = path.front();
-  for (std::size_t i = 1; i < path.size(); ++i) table += "." + path[i];
+  return out;
+}
+
+std::optional<std::string> with_toml_value(std::string_view text, std::string_view dotted_key,
+                                           std::string_view value_toml, std::string& error) {
+  std::vector<std::string> path;
+  std::string table, key;
+  if (!parse_key(dotted_key, path, table, key, error)) return std::nullopt;
   toml::table value_doc;
   try {
     value_doc = toml::parse(fmt::format("v = {}", value_toml));

@@ -160,6 +160,8 @@ const char* to_string(CommandKind k) noexcept {
       return "stage-joint-limits";
     case CommandKind::ApplyJointLimits:
       return "apply-joint-limits";
+    case CommandKind::StagePitchTable:
+      return "stage-pitch-table";
   }
   return "?";
 }

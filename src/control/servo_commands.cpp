@@ -70,6 +70,8 @@ Refusal Servo::apply(const Command& c) noexcept {
       return stage_joint_limits(c);
     case CommandKind::ApplyJointLimits:
       return apply_joint_limits();
+    case CommandKind::StagePitchTable:
+      return stage_pitch_table(c);
   }
   return Refusal::BadValue;
 }

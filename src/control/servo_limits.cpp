@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Servo: joint limits changed by an admin while nothing moves — staged joint by joint, applied
-// together by one command, so that the tick takes all of them or none.
+// Servo: joint limits and pitch-error tables changed by an admin while nothing moves — staged joint
+// by joint, applied together by one command, so that the tick takes all of them or none.
 #include <cmath>
 
 #include "opencnc/control/servo.hpp"
@@ -20,7 +20,35 @@ bool valid(const JointLimits& l, bool wrapped) noexcept {
          l.takeup_velocity >= 0 && l.takeup_acceleration >= 0;
 }
 
+/// A table the lookup can use: at most kMaxPitchPoints, finite, positions strictly increasing.
+bool valid(const motion::PitchTable& t) noexcept {
+  if (t.count < 0 || t.count > motion::kMaxPitchPoints) return false;
+  for (int i = 0; i < t.count; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    if (!std::isfinite(t.position[k]) || !std::isfinite(t.forward[k]) || !std::isfinite(t.reverse[k]))
+      return false;
+    if (i > 0 && !(t.position[k] > t.position[k - 1])) return false;
+  }
+  return true;
+}
+
 }  // namespace
+
+// The table is checked here, once, so that the lookup in every period can trust it (a bounded
+// loop over at most 256 points; the controller does not write this buffer until the apply).
+Refusal Servo::stage_pitch_table(const Command& c) noexcept {
+  const int j = c.axis;
+  const auto uj = static_cast<std::size_t>(j);
+  if (j < 0 || j >= config_.joint_count || j >= motion::kMaxCompensatedJoints || c.table_buffer > 1 ||
+      !config_.compensation.joints[uj].enabled ||
+      !valid(channels_->pitch_tables.joints[uj][c.table_buffer])) {
+    staged_invalid_ = true;
+    return Refusal::BadValue;
+  }
+  staged_buffer_[uj] = c.table_buffer;
+  staged_tables_ = static_cast<std::uint16_t>(staged_tables_ | (1u << j));
+  return Refusal::None;
+}
 
 Refusal Servo::stage_joint_limits(const Command& c) noexcept {
   const int j = c.axis;
@@ -38,12 +66,12 @@ Refusal Servo::stage_joint_limits(const Command& c) noexcept {
 // limits would finish under the new ones. A homed joint must stand within its new soft limits,
 // or the soft-limit check would fault it at once.
 Refusal Servo::apply_joint_limits() noexcept {
-  const std::uint16_t staged = staged_joints_;
+  const std::uint16_t staged = staged_joints_, tables = staged_tables_;
   const bool invalid = staged_invalid_;
-  staged_joints_ = 0;
+  staged_joints_ = staged_tables_ = 0;
   staged_invalid_ = false;
   if (invalid) return Refusal::BadValue;
-  if (staged == 0) return Refusal::NotApplicable;
+  if (staged == 0 && tables == 0) return Refusal::NotApplicable;
   if (activity_ != Activity::None || state_ == State::Running || state_ == State::Held ||
       state_ == State::Stopped)
     return Refusal::Busy;
@@ -73,6 +101,10 @@ Refusal Servo::apply_joint_limits() noexcept {
       c.max_acceleration = l.takeup_acceleration;
       comp_.set_backlash(j, l.backlash, l.takeup_velocity, l.takeup_acceleration);
     }
+  }
+  for (int j = 0; j < config_.joint_count; ++j) {
+    const auto uj = static_cast<std::size_t>(j);
+    if (tables & (1u << j)) comp_.set_pitch_table(j, &channels_->pitch_tables.joints[uj][staged_buffer_[uj]]);
   }
   configure_gap_servo();  // the jump accelerates within the tool axis' limit
   return Refusal::None;

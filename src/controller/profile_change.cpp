@@ -33,6 +33,17 @@ JointLimits joint_limits(const ServoConfig& s, int joint) {
   return l;
 }
 
+/// Bit j: joint j is compensated in `next` (its table is staged at every change, changed or not:
+/// a stage left in the tick by a change whose commands did not all fit in the ring is then
+/// always overwritten before the next apply; an unchanged table switches without any take-up).
+std::uint16_t compensated_joints(const ServoConfig& next) {
+  std::uint16_t mask = 0;
+  for (int j = 0; j < next.joint_count && j < motion::kMaxCompensatedJoints; ++j)
+    if (next.compensation.joints[static_cast<std::size_t>(j)].enabled)
+      mask = static_cast<std::uint16_t>(mask | (1u << j));
+  return mask;
+}
+
 /// The homed joint of `next` whose axis stands outside its new soft limits, as a message; "".
 std::string outside_new_limits(const ServoConfig& next, const ServoStatus& s) {
   for (int j = 0; j < next.joint_count; ++j) {
@@ -95,6 +106,7 @@ void Controller::edit_profile(std::uint64_t id, const requests::EditProfile& r) 
     return finish(id, Refusal::BadValue,
                   fmt::format("{}: cannot write the profile: {}", profile_.source, error));
   ProfileChange pending{id, new_id(), profile_, std::move(old_text), change_text(edit.changes), r.who};
+  const std::uint16_t tables = compensated_joints(next);
   swap_profile(std::move(*edit.profile));
   bool queued = true;
   for (int j = 0; j < next.joint_count && queued; ++j) {
@@ -105,6 +117,8 @@ void Controller::edit_profile(std::uint64_t id, const requests::EditProfile& r) 
     c.limits = joint_limits(next, j);
     queued = channels_->commands.try_push(c);
   }
+  for (int j = 0; j < motion::kMaxCompensatedJoints && queued; ++j)
+    if (tables & (1u << j)) queued = stage_pitch_table(j, next, pending);
   Command apply;
   apply.id = id;
   apply.kind = CommandKind::ApplyJointLimits;
@@ -118,6 +132,22 @@ void Controller::edit_profile(std::uint64_t id, const requests::EditProfile& r) 
   }
 }
 
+// The joint's new table into the buffer its tick does not read (nothing else is in flight: one
+// change at a time), named by a StagePitchTable. Returns false when the ring is full.
+bool Controller::stage_pitch_table(int joint, const ServoConfig& next, ProfileChange& pending) {
+  const auto j = static_cast<std::size_t>(joint);
+  const motion::JointCompensation& c = next.compensation.joints[j];
+  const auto buffer = static_cast<std::uint8_t>(pitch_buffer_[j] == 0 ? 1 : 0);
+  channels_->pitch_tables.joints[j][buffer] = c.pitch;
+  Command stage;
+  stage.id = pending.stage_id;
+  stage.kind = CommandKind::StagePitchTable;
+  stage.axis = static_cast<std::int8_t>(joint);
+  stage.table_buffer = buffer;
+  pending.tables = static_cast<std::uint16_t>(pending.tables | (1u << joint));
+  return channels_->commands.try_push(stage);
+}
+
 bool Controller::settle_profile_change(const ServoEvent& e) {
   if (!profile_change_) return false;
   if (e.command_id == profile_change_->stage_id) return true;  // the apply answers for all
@@ -125,6 +155,8 @@ bool Controller::settle_profile_change(const ServoEvent& e) {
   ProfileChange change = std::move(*profile_change_);
   profile_change_.reset();
   if (e.kind == EventKind::Accepted) {
+    for (std::size_t j = 0; j < pitch_buffer_.size(); ++j)
+      if (change.tables & (1u << j)) pitch_buffer_[j] = pitch_buffer_[j] == 0 ? 1 : 0;
     note(Severity::Note, "control.profile",
          fmt::format("{}machine parameters changed: {} ({})", change.who.empty() ? "" : change.who + ": ",
                      change.message, profile_.source));

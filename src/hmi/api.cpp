@@ -237,6 +237,11 @@ Command parse(const json& body, const config::MachineProfile& p, const std::file
     if (!r.request) throw Bad{r.status, r.message};
     return std::move(*r.request);
   }
+  if (kind == "set-compensation") {
+    ParametersRequest r = compensation_request(body, p);
+    if (!r.request) throw Bad{r.status, r.message};
+    return std::move(*r.request);
+  }
   if (kind == "run-from-line") {
     const double line = number(body, "line");
     if (line != std::floor(line) || line < 1 || line > 1e9) throw Bad{422, "\"line\" must be a line number from 1"};
@@ -296,7 +301,8 @@ std::optional<Role> role_for(std::string_view kind) {
                                                "home",    "override",  "switch", "spindle-on",
                                                "coolant", "handwheel", "open",   "mdi",
                                                "run-from-line"};
-  if (kind == "set-tool" || kind == "set-parameters" || kind == "simulate") return Role::Admin;
+  if (kind == "set-tool" || kind == "set-parameters" || kind == "set-compensation" || kind == "simulate")
+    return Role::Admin;
   if (kind == "feature") return Role::Operator;  // the confirmation is in the body (api_features.cpp)
   if (servo_kinds().find(kind) != servo_kinds().end()) return Role::Operator;
   for (const char* k : operator_kinds) {

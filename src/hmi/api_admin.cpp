@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include <cctype>
 #include <cmath>
 
 #include "opencnc/config/profile_edit.hpp"
@@ -59,6 +60,135 @@ json parameters_json(const config::MachineProfile& profile) {
   return {{"profile", profile.source},
           {"when", "while nothing runs (no program, MDI line, jog or homing)"},
           {"parameters", list}};
+}
+
+namespace {
+
+/// `body[key]` as a TOML array of 1 … 256 finite numbers; "" with `r` filled when it is not.
+std::string table_toml(const json& body, const char* key, ParametersRequest& r) {
+  const auto v = body.find(key);
+  if (v == body.end() || !v->is_array()) {
+    r.message = fmt::format("\"{}\" must be an array of numbers (the errors at the table's points)", key);
+    return {};
+  }
+  if (v->empty() || v->size() > static_cast<std::size_t>(config::kMaxCompensationPoints)) {
+    r.status = 422;
+    r.message = fmt::format("\"{}\" has {} points: a table has 1 to {}", key, v->size(),
+                            config::kMaxCompensationPoints);
+    return {};
+  }
+  std::string out = "[";
+  for (const json& e : *v) {
+    if (!e.is_number() || !std::isfinite(e.get<double>())) {
+      r.status = e.is_number() ? 422 : 400;
+      r.message = fmt::format("\"{}\" must hold finite numbers only", key);
+      return {};
+    }
+    out += (out.size() > 1 ? ", " : "") + config::toml_number(e.get<double>());
+  }
+  return out + "]";
+}
+
+}  // namespace
+
+ParametersRequest compensation_request(const json& body, const config::MachineProfile& profile) {
+  ParametersRequest r;
+  const auto axis = body.find("axis");
+  if (axis == body.end() || !axis->is_string() || axis->get<std::string>().size() != 1) {
+    r.message = "\"axis\" must be an axis letter";
+    return r;
+  }
+  const char name = static_cast<char>(std::toupper(static_cast<unsigned char>(axis->get<std::string>()[0])));
+  const config::AxisProfile* a = nullptr;
+  for (const config::AxisProfile& p : profile.axes)
+    if (letter(p.axis) == name) a = &p;
+  if (!a || !a->compensation.present) {
+    r.status = 422;
+    r.message =
+        fmt::format("axis {} has no compensation (GET /api/v1/compensation lists the axes that have)", name);
+    return r;
+  }
+  if (!a->compensation.comp_file.empty()) {
+    r.status = 422;
+    r.message = fmt::format("axis {}'s table comes from the comp file {}: edit that file, then restart", name,
+                            a->compensation.comp_file);
+    return r;
+  }
+  const std::string base = fmt::format("axis.{}.compensation.", static_cast<char>(std::tolower(name)));
+  std::vector<config::ProfileKeyEdit> edits;
+  const std::string forward = table_toml(body, "forward", r);
+  if (forward.empty()) return r;
+  const std::string reverse = table_toml(body, "reverse", r);
+  if (reverse.empty()) return r;
+  for (const char* key : {"start", "interval", "backlash"}) {
+    const auto v = body.find(key);
+    if (v == body.end()) continue;
+    if (!v->is_number() || !std::isfinite(v->get<double>())) {
+      r.status = v->is_number() ? 422 : 400;
+      r.message = fmt::format("\"{}\" must be a finite number", key);
+      return r;
+    }
+    edits.push_back({base + key, config::toml_number(v->get<double>())});
+  }
+  edits.push_back({base + "forward", forward});
+  edits.push_back({base + "reverse", reverse});
+  r.request = control::Request::edit_profile(std::move(edits));
+  return r;
+}
+
+json compensation_json(const config::MachineProfile& profile) {
+  json axes = json::array();
+  for (const config::AxisProfile& a : profile.axes) {
+    const config::CompensationProfile& c = a.compensation;
+    if (!c.present) continue;
+    json table = nullptr;
+    if (!c.positions.empty())
+      table = {{"positions", c.positions},
+               {"forward", c.forward},
+               {"reverse", c.reverse},
+               {"one_table", c.one_table}};
+    axes.push_back({{"axis", std::string(1, letter(a.axis))},
+                    {"unit", a.rotary ? "deg" : "mm"},
+                    {"backlash", c.backlash},
+                    {"takeup_velocity", c.takeup_velocity},
+                    {"takeup_acceleration", c.takeup_acceleration},
+                    {"table", table},
+                    {"comp_file", c.comp_file.empty() ? json(nullptr) : json(c.comp_file)},
+                    {"editable", c.comp_file.empty()},
+                    {"max_points", config::kMaxCompensationPoints}});
+  }
+  return {{"profile", profile.source},
+          {"when", "while nothing runs (no program, MDI line, jog or homing)"},
+          {"axes", axes}};
+}
+
+json conditions_json(const config::MachineProfile& profile) {
+  static constexpr const char* orbits[] = {"none", "circle", "square", "star"};
+  json list = json::array();
+  const machine::EdmConfig& edm = profile.edm.config;
+  for (int k = 0; profile.edm.present && k < edm.condition_count; ++k) {
+    const machine::EdmCondition& c = edm.conditions[static_cast<std::size_t>(k)];
+    list.push_back({{"number", c.number},
+                    {"on_time_us", c.on_time_us},
+                    {"off_time_us", c.off_time_us},
+                    {"peak_current_a", c.peak_current_a},
+                    {"voltage_v", c.voltage_v},
+                    {"polarity", c.polarity > 0 ? "+" : "-"},
+                    {"servo_reference_v", c.servo_reference_v},
+                    {"gain_mm_s_per_v", c.gain_mm_s_per_v},
+                    {"max_forward_mm_s", c.max_forward_mm_s},
+                    {"max_retract_mm_s", c.max_retract_mm_s},
+                    {"short_timeout_s", c.short_timeout_s},
+                    {"jump_height_mm", c.jump_height_mm},
+                    {"jump_period_s", c.jump_period_s},
+                    {"jump_speed_mm_s", c.jump_speed_mm_s},
+                    {"jump_mode", c.jump_mode == machine::JumpMode::Path ? "path" : "axis"},
+                    {"orbit", orbits[static_cast<std::size_t>(c.orbit)]},
+                    {"orbit_radius_mm", c.orbit_radius_mm},
+                    {"orbit_step_mm", c.orbit_step_mm},
+                    {"orbit_period_s", c.orbit_period_s}});
+  }
+  return {{"profile", profile.source}, {"conditions", list}};
 }
 
 }  // namespace opencnc::hmi

@@ -476,6 +476,8 @@ HttpResponse Server::Impl::get(const HttpRequest& req, const Target& t, Role rol
   if (p == "/api/v1/status") return json_response(req, 200, status_object());
   if (p == "/api/v1/machine") return json_response(req, 200, machine_json(*machine()));
   if (p == "/api/v1/parameters") return json_response(req, 200, parameters_json(*machine()));
+  if (p == "/api/v1/compensation") return json_response(req, 200, compensation_json(*machine()));
+  if (p == "/api/v1/conditions") return json_response(req, 200, conditions_json(*machine()));
   if (p == "/api/v1/program") return program_info(req);
   if (p == "/api/v1/program/text") return program_text(req, t);
   if (p == "/api/v1/programs") return programs(req);

@@ -31,7 +31,7 @@ double pitch_error(const PitchTable& t, double x, int direction, int& segment) n
 double Compensation::target(int j, double x) noexcept {
   JointState& s = state_[index(j)];
   const JointCompensation& c = config_.joints[index(j)];
-  const double pitch = s.homed ? pitch_error(c.pitch, x, s.direction, s.segment) : 0.0;
+  const double pitch = s.homed ? pitch_error(pitch_table(j), x, s.direction, s.segment) : 0.0;
   return -pitch + 0.5 * c.backlash * s.direction;
 }
 
@@ -48,6 +48,7 @@ double Compensation::update(int j, double joint_position, double offset, bool ho
   const double p = joint_position, x = joint_position + offset;
   const int direction = p > s.last_position ? 1 : (p < s.last_position ? -1 : s.direction);
   s.last_position = p;
+  s.last_x = x;
   const bool jumped = direction != s.direction || homed != s.homed;
   const double before = s.target;
   s.direction = direction;
@@ -72,6 +73,19 @@ void Compensation::set_backlash(int j, double backlash, double max_velocity,
   c.max_acceleration = max_acceleration;
   s.target += shift;
   s.take_up -= shift;
+}
+
+// As set_backlash: the target at the joint's last position moves to the new table's value, and u
+// takes the difference up from where c stands. Before the first update there is nothing to take up.
+void Compensation::set_pitch_table(int j, const PitchTable* table) noexcept {
+  if (j < 0 || j >= kMaxCompensatedJoints) return;
+  tables_[index(j)] = table;
+  JointState& s = state_[index(j)];
+  s.segment = 0;
+  if (!s.started) return;
+  const double before = s.target;
+  s.target = target(j, s.last_x);
+  s.take_up -= s.target - before;
 }
 
 // u toward 0, time-optimal under |u̇| ≤ V and |ü| ≤ A with the position updated by the new

@@ -155,6 +155,91 @@ TEST_F(ProfileEditFile, KeysThatAreNotEditableOrOverriddenAndAChangedFileAreRefu
   EXPECT_NE(edit_profile(live_, v).error.find("changed on disk"), std::string::npos);
 }
 
+TEST(TomlEdit, AKeyIsRemovedWithItsLineOnly) {
+  std::string why;
+  const auto out = without_toml_key(kText, "axis.x.tags", why);
+  ASSERT_TRUE(out) << why;
+  std::string expected = kText;
+  expected.erase(expected.find("tags = [1, 2]  # an array\n"), 26);
+  EXPECT_EQ(*out, expected);
+  EXPECT_FALSE(without_toml_key(kText, "axis.x.none", why));
+  EXPECT_NE(why.find("no none"), std::string::npos) << why;
+}
+
+/// The drill's profile: X's pitch table written as `errors` (both directions), Y's per direction.
+class ProfileEditTable : public ProfileEditFile {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() / ("opencnc-table-edit-" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir_);
+    for (const char* f : {"drill-retrofit.toml", "drill-retrofit.tbl"})
+      std::filesystem::copy_file(std::string(OPENCNC_SOURCE_DIR "/configs/") + f, dir_ / f);
+    path_ = (dir_ / "drill-retrofit.toml").string();
+    std::ifstream in(path_);
+    std::stringstream s;
+    s << in.rdbuf();
+    original_ = s.str();
+    ProfileLoad load = load_profile(path_);
+    ASSERT_TRUE(load.ok());
+    live_ = *load.profile;
+  }
+};
+
+TEST_F(ProfileEditTable, EqualDirectionsKeepTheOneTableAndItsComments) {
+  const std::string errors =
+      "[0.0, 0.003, 0.006, 0.012, 0.015, 0.018, 0.022, 0.027, 0.028, 0.030, 0.033, 0.037, 0.040]";
+  const ProfileKeyEdit edits[] = {{"axis.x.compensation.forward", errors},
+                                  {"axis.x.compensation.reverse", errors}};
+  const ProfileEditResult r = edit_profile(live_, edits);
+  ASSERT_TRUE(r.ok()) << r.error;
+  EXPECT_EQ(r.profile->axes[0].compensation.forward[3], 0.012);
+  EXPECT_TRUE(r.profile->axes[0].compensation.one_table);
+  std::string expected = original_;
+  const std::size_t at = expected.find("errors = [");
+  expected.replace(at, expected.find('\n', at) - at, "errors = " + errors);
+  EXPECT_EQ(r.text, expected);
+  ASSERT_EQ(r.changes.size(), 2u);
+  EXPECT_EQ(r.changes[0].old_value, "13 points");
+  EXPECT_EQ(r.changes[0].new_value, "13 points, 1 changed (largest 0.01 → 0.012 at 150.0)");
+}
+
+TEST_F(ProfileEditTable, DifferentDirectionsReplaceErrorsAndAnotherLengthMovesThePoints) {
+  const ProfileKeyEdit edits[] = {{"axis.x.compensation.forward", "[0.0, 0.01, 0.02]"},
+                                  {"axis.x.compensation.reverse", "[0.005, 0.015, 0.025]"},
+                                  {"axis.x.compensation.interval", "100.0"}};
+  const ProfileEditResult r = edit_profile(live_, edits);
+  ASSERT_TRUE(r.ok()) << r.error;
+  const CompensationProfile& c = r.profile->axes[0].compensation;
+  EXPECT_FALSE(c.one_table);
+  EXPECT_EQ(c.positions, (std::vector<double>{0, 100, 200}));
+  EXPECT_EQ(c.reverse[2], 0.025);
+  EXPECT_EQ(r.text.find("errors = ["), std::string::npos);
+  EXPECT_NE(r.text.find("forward = [0.0, 0.01, 0.02]\n"), std::string::npos);
+  EXPECT_NE(r.text.find("# The seed's table as it entered it"), std::string::npos);  // comments stay
+  EXPECT_EQ(r.changes[2].new_value, "100.0");
+  EXPECT_EQ(r.changes[0].new_value, "3 points");
+}
+
+TEST_F(ProfileEditTable, ABadTableGetsTheLoadersMessageAndOneDirectionOfOneTableIsRefused) {
+  const ProfileKeyEdit steep[] = {
+      {"axis.y.compensation.forward", "[0, -0.002, -0.004, -0.0045, -0.005, -0.007, -0.009, -0.0105, 0.9]"}};
+  const ProfileEditResult r = edit_profile(live_, steep);
+  ASSERT_FALSE(r.ok());
+  ASSERT_FALSE(r.diagnostics.items().empty());
+  const Diagnostic& d = r.diagnostics.items().front();
+  EXPECT_EQ(d.file, path_);
+  const std::size_t at = original_.find("forward = [0, -0.002");
+  EXPECT_EQ(d.line, 1 + std::count(original_.begin(), original_.begin() + static_cast<long>(at), '\n'));
+  const ProfileKeyEdit unequal[] = {{"axis.y.compensation.reverse", "[0.015, 0.013]"}};
+  EXPECT_FALSE(edit_profile(live_, unequal).ok());
+  const ProfileKeyEdit one[] = {{"axis.x.compensation.forward", "[0.0, 0.01]"}};
+  EXPECT_NE(edit_profile(live_, one).error.find("give forward and reverse together"), std::string::npos);
+  const ProfileKeyEdit none[] = {{"axis.z.compensation.forward", "[0.0]"}};
+  EXPECT_NE(edit_profile(live_, none).error.find("no [axis.z.compensation]"), std::string::npos);
+  EXPECT_TRUE(is_pitch_table_key("axis.x.compensation.interval"));
+  EXPECT_FALSE(is_pitch_table_key("axis.x.compensation.errors"));
+}
+
 TEST(ProfileEdit, TheEditableParametersAreEachAxisLimits) {
   ProfileLoad load = load_profile(OPENCNC_SOURCE_DIR "/configs/mill-3axis.toml");
   ASSERT_TRUE(load.ok());

@@ -304,6 +304,20 @@ TEST(ServoAllocations, NoneInsideTheDrillsTick) {
       },
       2'000'000));
   EXPECT_EQ(a.rig().status().runs_finished, 1u);
+  // An admin's new pitch table for X: the controller's buffer, staged and switched to at rest,
+  // then taken up (the lookup reads the channels' buffer from here on).
+  motion::PitchTable& next = a.rig().channels().pitch_tables.joints[0][0];
+  next = a.rig().servo().compensation().pitch_table(0);
+  for (int i = 0; i < next.count; ++i) next.forward[static_cast<std::size_t>(i)] += 0.005;
+  Command stage;
+  stage.kind = CommandKind::StagePitchTable;
+  stage.axis = 0;
+  stage.table_buffer = 0;
+  Command apply;
+  apply.kind = CommandKind::ApplyJointLimits;
+  ASSERT_TRUE(a.rig().channels().commands.try_push(stage) && a.rig().channels().commands.try_push(apply));
+  a.until([] { return false; }, 100);
+  EXPECT_EQ(&a.rig().servo().compensation().pitch_table(0), &next);
   a.ask(Request::set_mode(Mode::Manual));
   a.ask(Request::jog(Axis::X, 30));
   a.until([] { return false; }, 200);

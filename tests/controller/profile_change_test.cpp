@@ -260,5 +260,60 @@ TEST(ProfileChangeCompensation, BacklashAndTakeUpLimitsReachTheTickAndTheReserve
   std::filesystem::remove_all(dir);
 }
 
+// X's pitch table through the controller: the message says what changed, the tick reads the new
+// table from the channels' buffer; a table the loader refuses changes nothing; a table the tick
+// cannot use (positions not increasing) makes the apply refuse.
+TEST(ProfileChangeCompensation, APitchTableReachesTheTickAndABadOneChangesNothing) {
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("opencnc-pitch-change-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  for (const char* f : {"drill-retrofit.toml", "drill-retrofit.tbl"})
+    std::filesystem::copy_file(std::filesystem::path(OPENCNC_SOURCE_DIR "/configs") / f, dir / f,
+                               std::filesystem::copy_options::overwrite_existing);
+  const std::string path = (dir / "drill-retrofit.toml").string();
+  {
+    SimRig rig(loaded(config::load_profile(path)));
+    const std::string y = "[0, -0.002, -0.004, -0.0045, -0.006, -0.007, -0.009, -0.0105, -0.012]";
+    const Outcome o = rig.request(Request::edit_profile({{"axis.y.compensation.forward", y}}, "admin"));
+    ASSERT_TRUE(o.accepted) << o.message;
+    EXPECT_EQ(
+        o.message,
+        "axis.y.compensation.forward 9 points → 9 points, 1 changed (largest -0.005 → -0.006 at 200.0)");
+    const motion::PitchTable& t = rig.servo().compensation().pitch_table(1);
+    EXPECT_EQ(&t, &rig.channels().pitch_tables.joints[1][0]);
+    EXPECT_EQ(t.forward[4], -0.006);
+    EXPECT_EQ(rig.controller().profile().axes[1].compensation.forward[4], -0.006);
+    std::string text;
+    ASSERT_TRUE(read_file(path, text, nullptr));
+    const Outcome steep =
+        rig.request(Request::edit_profile({{"axis.y.compensation.forward", "[0, 0, 0, 0, 0, 0, 0, 0, 2]"}}));
+    EXPECT_FALSE(steep.accepted);
+    EXPECT_EQ(steep.refusal, Refusal::BadValue);
+    EXPECT_NE(steep.message.find(path + ":"), std::string::npos) << steep.message;
+    std::string after;
+    ASSERT_TRUE(read_file(path, after, nullptr));
+    EXPECT_EQ(after, text);
+    EXPECT_EQ(&rig.servo().compensation().pitch_table(1), &t);
+    // The tick checks what it is handed: positions not increasing.
+    motion::PitchTable& bad = rig.channels().pitch_tables.joints[1][1];
+    bad = t;
+    bad.position[3] = bad.position[2];
+    Command stage;
+    stage.id = 77001;
+    stage.kind = CommandKind::StagePitchTable;
+    stage.axis = 1;
+    stage.table_buffer = 1;
+    Command apply;
+    apply.id = 77002;
+    apply.kind = CommandKind::ApplyJointLimits;
+    ASSERT_TRUE(rig.channels().commands.try_push(stage) && rig.channels().commands.try_push(apply));
+    rig.run(3);
+    ASSERT_TRUE(rig.controller().outcome(77002).has_value());
+    EXPECT_EQ(rig.controller().outcome(77002)->refusal, Refusal::BadValue);
+    EXPECT_EQ(&rig.servo().compensation().pitch_table(1), &t);
+  }
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace opencnc::control::test

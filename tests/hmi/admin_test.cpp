@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The admin's machine parameters through the HMI server on loopback: read by anyone with a
-// token, changed by the admin only (403 for the operator), a bad value answered with the profile's
-// own message and nothing changed, a good one in the file and the live limits, audited.
+// The admin's machine parameters and pitch-error tables through the HMI server on loopback: read
+// by anyone with a token, changed by the admin only (403 for the operator), a bad value answered
+// with the profile's own message and nothing changed, a good one in the file and the live limits,
+// audited.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -95,6 +96,7 @@ TEST(AdminParameters, ABadValueGetsTheProfilesMessageAndNothingChanges) {
 
 TEST(ApiAdmin, SetParametersIsTheAdminsAndBecomesAnEditProfileRequest) {
   EXPECT_EQ(role_for("set-parameters"), Role::Admin);
+  EXPECT_EQ(role_for("set-compensation"), Role::Admin);
   const config::MachineProfile p = control::test::mill();
   const auto parsed =
       parse_command(json::parse(R"({"kind":"set-parameters","values":{"axis.y.max_limit":500.5}})"), p,
@@ -107,6 +109,112 @@ TEST(ApiAdmin, SetParametersIsTheAdminsAndBecomesAnEditProfileRequest) {
   EXPECT_EQ(e.edits[0].key, "axis.y.max_limit");
   EXPECT_EQ(e.edits[0].value, "500.5");
   EXPECT_EQ(r.name(), "edit-profile");
+}
+
+/// The drill, its profile (X's table one for both ways, Y's per direction) a copy the admin may edit.
+struct DrillRig : ServerRig {
+  DrillRig() : ServerRig(options()) {}
+  static RigOptions options() {
+    RigOptions o;
+    o.machine = "drill-retrofit.toml";
+    o.profile_copy = true;
+    o.history = true;
+    return o;
+  }
+};
+
+TEST(AdminCompensation, TheOperatorReadsTheTablesOnlyTheAdminChangesThem) {
+  DrillRig rig;
+  const Reply list = get(rig.port, "/api/v1/compensation", kOperator);
+  ASSERT_EQ(list.status, 200) << list.text;
+  ASSERT_EQ(list.body["axes"].size(), 2u);
+  const json& x = list.body["axes"][0];
+  EXPECT_EQ(x["axis"], "X");
+  EXPECT_EQ(x["backlash"], 0.02);
+  EXPECT_EQ(x["table"]["one_table"], true);
+  EXPECT_EQ(x["table"]["positions"].size(), 13u);
+  EXPECT_EQ(x["table"]["forward"][3], 0.010);
+  EXPECT_EQ(x["editable"], true);
+  const std::string change =
+      R"({"kind":"set-compensation","axis":"X","interval":100,"forward":[0,0.006,0.015,0.022,0.028,0.033,0.04],)"
+      R"("reverse":[0.002,0.008,0.017,0.024,0.030,0.035,0.042]})";
+  EXPECT_EQ(post(rig.port, change, kOperator).status, 403);
+  EXPECT_EQ(rig.profile_text(), rig.profile_original);
+  const Reply ok = post(rig.port, change, kAdmin);
+  ASSERT_EQ(ok.status, 200) << ok.text;
+  EXPECT_EQ(ok.body["message"],
+            "axis.x.compensation.interval 50.0 → 100.0; axis.x.compensation.forward 13 points → 7 points; "
+            "axis.x.compensation.reverse 13 points → 7 points");
+  const std::string text = rig.profile_text();
+  EXPECT_NE(text.find("forward = [0.0, 0.006, 0.015, 0.022, 0.028, 0.033, 0.04]\n"), std::string::npos);
+  EXPECT_EQ(text.find("errors = ["), std::string::npos);
+  EXPECT_NE(text.find("# The seed's table as it entered it"), std::string::npos);
+  const json now = get(rig.port, "/api/v1/compensation", kOperator).body["axes"][0]["table"];
+  EXPECT_EQ(now["positions"][6], 600.0);
+  EXPECT_EQ(now["reverse"][0], 0.002);
+  EXPECT_EQ(now["one_table"], false);
+  rig.history->flush();
+  const json audit = get(rig.port, "/api/v1/audit", kAdmin).body;
+  ASSERT_GE(audit.size(), 2u);
+  EXPECT_EQ(audit[0]["result"], "accepted: " + ok.body["message"].get<std::string>());
+  EXPECT_EQ(audit[0]["role"], "admin");
+}
+
+TEST(AdminCompensation, ABadTableGetsTheProfilesMessageAndNothingChanges) {
+  DrillRig rig;
+  const Reply steep = post(
+      rig.port,
+      R"({"kind":"set-compensation","axis":"y","forward":[0,0,0,0,0,0,0,0,2],"reverse":[0,0,0,0,0,0,0,0,0]})",
+      kAdmin);
+  ASSERT_EQ(steep.status, 409) << steep.text;
+  EXPECT_EQ(steep.body["code"], "control.bad-value");
+  ASSERT_FALSE(steep.body["diagnostics"].empty());
+  const std::string text = steep.body["diagnostics"][0]["text"];
+  EXPECT_EQ(text.rfind(rig.profile_path + ":", 0), 0u) << text;
+  const std::string unequal = R"({"kind":"set-compensation","axis":"Y","forward":[0,0.001],"reverse":[0]})";
+  EXPECT_EQ(post(rig.port, unequal, kAdmin).status, 409);
+  EXPECT_EQ(
+      post(rig.port, R"({"kind":"set-compensation","axis":"Z","forward":[0],"reverse":[0]})", kAdmin).status,
+      422);
+  json big = {
+      {"kind", "set-compensation"}, {"axis", "X"}, {"forward", json::array()}, {"reverse", json::array()}};
+  for (int i = 0; i < 257; ++i) {
+    big["forward"].push_back(0.0);
+    big["reverse"].push_back(0.0);
+  }
+  EXPECT_EQ(post(rig.port, big.dump(), kAdmin).status, 422);
+  EXPECT_EQ(post(rig.port, R"({"kind":"set-compensation","axis":"X","forward":[0]})", kAdmin).status, 400);
+  EXPECT_EQ(post(rig.port, R"({"kind":"set-compensation","axis":"X","forward":["a"],"reverse":[0]})", kAdmin)
+                .status,
+            400);
+  EXPECT_EQ(rig.profile_text(), rig.profile_original);
+  EXPECT_EQ(get(rig.port, "/api/v1/compensation", kOperator).body["axes"][1]["table"]["forward"][8], -0.012);
+}
+
+TEST(AdminConditions, AnEdmsConditionsAreListedInTheProfilesOrder) {
+  RigOptions o;
+  o.machine = "edm-5axis.toml";
+  o.history = false;
+  ServerRig rig(o);
+  const Reply r = get(rig.port, "/api/v1/conditions", kOperator);
+  ASSERT_EQ(r.status, 200) << r.text;
+  const json& list = r.body["conditions"];
+  ASSERT_EQ(list.size(), 4u);
+  EXPECT_EQ(list[0]["number"], 1);
+  EXPECT_EQ(list[0]["peak_current_a"], 12.0);
+  EXPECT_EQ(list[0]["on_time_us"], 100.0);
+  EXPECT_EQ(list[0]["polarity"], "+");
+  EXPECT_EQ(list[0]["jump_height_mm"], 0.4);
+  EXPECT_EQ(list[1]["orbit"], "circle");
+  EXPECT_EQ(list[2]["orbit"], "square");
+  EXPECT_EQ(list[2]["jump_mode"], "path");
+  EXPECT_EQ(list[3]["number"], 9);
+  EXPECT_EQ(get(rig.port, "/api/v1/conditions", "").status, 401);
+}
+
+TEST(AdminConditions, AMachineWithoutEdmHasNone) {
+  AdminRig rig;
+  EXPECT_EQ(get(rig.port, "/api/v1/conditions", kOperator).body["conditions"], json::array());
 }
 
 }  // namespace

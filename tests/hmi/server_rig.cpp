@@ -54,6 +54,11 @@ ServerRig::ServerRig(RigOptions o) : dir(fresh_folder()) {
     profile_path = (dir / o.machine).string();
     EXPECT_TRUE(read_file(path, profile_original, &error)) << error;
     EXPECT_TRUE(write_file_atomically(profile_path, profile_original, &error)) << error;
+    // The tool table a profile names beside it (the drill's), copied along.
+    const std::filesystem::path tbl = std::filesystem::path(path).replace_extension(".tbl");
+    if (std::filesystem::exists(tbl))
+      std::filesystem::copy_file(tbl, dir / tbl.filename(),
+                                 std::filesystem::copy_options::overwrite_existing);
     path = profile_path;
   }
   profile = load(path, sets);

@@ -164,6 +164,36 @@ TEST(Compensation, ANewBacklashAtRestIsTakenUpWithoutAStep) {
   EXPECT_EQ(comp.config().joints[0].backlash, 0.06);
 }
 
+// An admin's new pitch table while the joint stands homed at 175 mm: the correction does not step,
+// moves to the new table's value within the take-up velocity, and the next motion reads the new
+// table. The old table may change (the buffer is reused) only after the switch.
+TEST(Compensation, ANewPitchTableAtRestIsTakenUpWithoutAStep) {
+  Compensation comp(one_joint(seed_table(), 0, 2, 100));
+  for (int k = 0; k <= 1750; ++k) comp.update(0, 0.1 * k, 0.0, true);
+  for (int k = 0; k < 500; ++k) comp.update(0, 175, 0.0, true);
+  ASSERT_NEAR(comp.correction(0), -0.0125, 1e-12);
+  PitchTable doubled = seed_table();
+  for (int i = 0; i < doubled.count; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    doubled.forward[k] *= 2;
+    doubled.reverse[k] *= 2;
+  }
+  comp.set_pitch_table(0, &doubled);
+  EXPECT_EQ(&comp.pitch_table(0), &doubled);
+  double last = comp.correction(0), fastest = 0;
+  EXPECT_NEAR(last, -0.0125, 1e-12);
+  for (int k = 0; k < 2000; ++k) {
+    const double c = comp.update(0, 175, 0.0, true);
+    fastest = std::max(fastest, std::abs(c - last) / 1e-3);
+    last = c;
+  }
+  EXPECT_NEAR(last, -0.025, 1e-12);
+  EXPECT_GT(fastest, 0.0);
+  EXPECT_LE(fastest, 2 * (1 + 1e-9));
+  comp.update(0, 175.1, 0.0, true);  // moving on: the new table, 0.020 at 150 mm and 0.030 at 200
+  EXPECT_NEAR(comp.correction(0), -0.025 - 0.1 * (0.030 - 0.020) / 50, 1e-12);
+}
+
 TEST(Compensation, DisabledJointsGetNothing) {
   CompensationConfig c = one_joint(seed_table(), 0.02, 5, 200);
   c.joints[0].enabled = false;

@@ -3,9 +3,12 @@
 // holes drilled, enlarged and reamed with a simulated operator (hand feed of the quill, manual
 // tool changes), their positions against the program; e-stop and every hard limit during motion;
 // a lost step found when the machine homes again after the part.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -341,6 +344,73 @@ TEST(DrillScenario, HardLimitDuringAProgram) {
   EXPECT_GE(past, 0.0);
   EXPECT_LE(past, coast_bound(profile, Axis::X, 50.0) + 0.05);
   EXPECT_FALSE(s.status().servo.joints[kX].homed);  // steppers without power lose their place
+}
+
+/// The drill's profile and tool table copied into a folder of the test's own (an admin's change
+/// writes the file); removed with the object.
+class DrillCopy {
+ public:
+  DrillCopy() {
+    dir_ = std::filesystem::temp_directory_path() /
+           ("opencnc-drill-copy-" + std::to_string(::getpid()) + "-" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    std::filesystem::create_directories(dir_);
+    for (const char* f : {"drill-retrofit.toml", "drill-retrofit.tbl"})
+      std::filesystem::copy_file(std::filesystem::path(OPENCNC_SOURCE_DIR "/configs") / f, dir_ / f,
+                                 std::filesystem::copy_options::overwrite_existing);
+  }
+  ~DrillCopy() {
+    std::error_code ec;
+    std::filesystem::remove_all(dir_, ec);
+  }
+  std::string profile() const { return (dir_ / "drill-retrofit.toml").string(); }
+
+ private:
+  std::filesystem::path dir_;
+};
+
+/// X's pitch errors (the seed's table) with `shift` added: one TOML array for both directions.
+std::string seed_errors_plus(double shift) {
+  const double errors[] = {0,     0.003, 0.006, 0.010, 0.015, 0.018, 0.022,
+                           0.027, 0.028, 0.030, 0.033, 0.037, 0.040};
+  std::string s = "[";
+  for (double e : errors) s += (s.size() > 1 ? ", " : "") + fmt::format("{}", e + shift);
+  return s + "]";
+}
+
+// An admin's new pitch table while X stands homed at 175 mm (its last motion +): the table (the
+// simulated machine's ground truth) moves by the tables' difference, the drive's command never
+// faster than the take-up velocity (2 mm/s); a second change (the other buffer) moves it on.
+// Both changes lower the error, so the drive moves on in + and the nut stays engaged (a change
+// the other way is lost in the screw's backlash until the axis reverses: docs/compensation.md).
+TEST(DrillScenario, APitchTableChangeMovesTheTableByItsDifferenceWithoutAStep) {
+  DrillCopy copy;
+  Scenario s(loaded(config::load_profile(copy.profile())));
+  home(s);
+  s.must(Request::jog_by(Axis::X, 175.0 - s.status().servo.commanded[Axis::X], 40));
+  ASSERT_TRUE(s.idle());
+  s.ticks(500);
+  const double before = table_x(s);
+  EXPECT_NEAR(before, 175.0, 0.002);
+  for (const double shift : {-0.010, -0.020}) {
+    s.forget_samples();
+    const double start = table_x(s);
+    const std::string errors = seed_errors_plus(shift);
+    s.must(Request::edit_profile(
+        {{"axis.x.compensation.forward", errors}, {"axis.x.compensation.reverse", errors}}, "admin"));
+    s.ticks(300);
+    double fastest = 0;
+    const std::vector<TraceSample>& t = s.samples();
+    for (std::size_t i = 1; i < t.size(); ++i)
+      fastest = std::max(fastest, std::abs(t[i].output[Axis::X] - t[i - 1].output[Axis::X]) / 1e-3);
+    EXPECT_GT(fastest, 0.5);  // it moved, at up to the take-up velocity
+    EXPECT_LE(fastest, 2.0 * (1 + 1e-9));
+    EXPECT_NEAR(table_x(s) - start, 0.010, 0.0015);  // to the stepper's step (1 µm) at each end
+    // −E(175) + backlash/2 (X's last motion was +).
+    EXPECT_NEAR(s.rig().servo().compensation().correction(kX), -(0.0125 + shift) + 0.01, 1e-12);
+  }
+  EXPECT_NEAR(table_x(s), before + 0.020, 0.0015);
+  EXPECT_EQ(s.status().servo.commanded[Axis::X], 175.0);
 }
 
 }  // namespace

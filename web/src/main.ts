@@ -19,6 +19,8 @@ import "./screens/history";
 import "./screens/params";
 import "./screens/network";
 import "./screens/electrode";
+import "./screens/compensation";
+import "./screens/conditions";
 import type { ControllerEvent, Machine, Status } from "./types";
 import { button, coord, el, offsetsText, outsideWindow, percent, windowStart } from "./ui";
 import { View3d, type Preview } from "./view3d";

@@ -55,6 +55,8 @@ struct CompensationProfile {
   std::vector<double> positions;   ///< increasing; empty = no pitch table
   std::vector<double> forward;     ///< error moving in +
   std::vector<double> reverse;     ///< error moving in − (== forward for one table)
+  bool one_table = false;          ///< written as `errors` (both directions), not forward/reverse
+  std::string comp_file;           ///< the LinuxCNC comp file the table came from, as written; "" none
 };
 
 /// One axis (= one joint: joints are numbered in axis order X Y Z A B C U V W).

@@ -34,6 +34,11 @@ struct EditableParameter {
 /// backlash and take-up limits). Any thread.
 std::vector<EditableParameter> editable_parameters(const MachineProfile& profile);
 
+/// True for a key of an axis' pitch-error table the admin may change through edit_profile():
+/// `axis.<a>.compensation.forward`, `.reverse` (one-line TOML arrays: the errors moving in + and
+/// in −, one per point), `.start`, `.interval` (the points' positions). Any thread.
+bool is_pitch_table_key(std::string_view key);
+
 /// One key's change, as text for the audit and the answer ("100.0" → "80.0").
 struct ProfileChange {
   std::string key;
@@ -52,10 +57,13 @@ struct ProfileEditResult {
 
 /// The profile `live` (loaded from `live.source` with `live.overrides`) with `edits` applied: the
 /// file is read again and must still be the text `live` was loaded from (its digest); each key
-/// must be one of editable_parameters(live) and not set by an override; its line is edited with
-/// with_toml_value(); the new text is loaded by parse_profile() with the same overrides, so its
-/// errors are the loader's own, at the edited line. Nothing is written. Non-real-time (reads the
-/// file).
+/// must be one of editable_parameters(live), or a pitch-table key (is_pitch_table_key) of an axis
+/// with `[axis.<a>.compensation]` whose table is not a comp file, and not set by an override; its
+/// line is edited with with_toml_value(). A table written as `errors` stays so while forward and
+/// reverse are equal; when they differ, `errors` gives way to `forward` and `reverse` (the
+/// section's comments stay). The new text is loaded by parse_profile() with the same overrides,
+/// so its errors are the loader's own, at the edited line. Nothing is written. Non-real-time
+/// (reads the file).
 ProfileEditResult edit_profile(const MachineProfile& live, std::span<const ProfileKeyEdit> edits);
 
 }  // namespace opencnc::config

@@ -20,6 +20,12 @@ namespace opencnc::config {
 std::optional<std::string> with_toml_value(std::string_view text, std::string_view dotted_key,
                                            std::string_view value_toml, std::string& error);
 
+/// `text` without the key `dotted_key`'s line (as with_toml_value() finds it; the lines around it
+/// stay). Refused (nullopt, `error` says why) as with_toml_value() refuses, and when the table has
+/// no such key. Non-real-time; any thread.
+std::optional<std::string> without_toml_key(std::string_view text, std::string_view dotted_key,
+                                            std::string& error);
+
 /// A number as TOML text that reads back as the same double (always a float: "80.0", "1e-05").
 /// Any thread.
 std::string toml_number(double v);

@@ -3,6 +3,7 @@
 // fixed-size lock-free queues and the status buffer, without pointers (shared-memory ready).
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <type_traits>
 
@@ -10,9 +11,20 @@
 #include "opencnc/control/spsc_ring.hpp"
 #include "opencnc/control/status.hpp"
 #include "opencnc/control/triple_buffer.hpp"
+#include "opencnc/motion/compensation.hpp"
 #include "opencnc/traj/block_queue.hpp"
 
 namespace opencnc::control {
+
+/// Pitch-error tables handed to the tick (an admin's edit): two buffers per joint, allocated once
+/// with the channels. The tick reads the buffer it switched to last (none at start: it uses its
+/// configuration's table); the controller writes only the other one, and only while no change is
+/// in flight, then names it in a StagePitchTable command: the command ring's release/acquire
+/// publishes the table with it. Once the tick has applied it (ApplyJointLimits accepted), the
+/// buffer it used before is the controller's to write. Plain data.
+struct PitchTableArea {
+  std::array<std::array<motion::PitchTable, 2>, motion::kMaxCompensatedJoints> joints{};
+};
 
 /// Every queue has exactly one producer and one consumer:
 ///
@@ -25,6 +37,7 @@ namespace opencnc::control {
 /// | status     | servo tick                | controller |
 /// | trace      | servo tick (when enabled) | recorder   |
 ///
+/// and `pitch_tables` is written by the controller, read by the servo tick (PitchTableArea).
 /// About 4 MB; construct it on the heap or in shared memory (standard layout, lock-free atomics).
 struct ServoChannels {
   SpscRing<Command, 256> commands;
@@ -36,6 +49,7 @@ struct ServoChannels {
   TripleBuffer<ServoStatus> status;
   SpscRing<TraceSample, 8192> trace;
   std::atomic<bool> trace_enabled{false};
+  PitchTableArea pitch_tables;
 };
 
 static_assert(std::is_standard_layout_v<ServoChannels>);

@@ -79,7 +79,10 @@ enum class CommandKind : std::uint8_t {
   Coolant,             ///< manual: `coolant` on (`flag`) or off
   SetHandwheel,        ///< `axis` the handwheel moves (−1 = none), `value` = units per count
   StageJointLimits,    ///< `axis` = joint: `limits` wait for ApplyJointLimits (no effect yet)
-  ApplyJointLimits,    ///< the staged joints' limits take effect at once, only while nothing moves
+  ApplyJointLimits,  ///< the staged joints' limits (and tables) take effect at once, only while nothing moves
+  /// `axis` = joint, `table_buffer` = 0/1: that joint's buffer of ServoChannels::pitch_tables is
+  /// its new pitch-error table from the next ApplyJointLimits on (no effect yet)
+  StagePitchTable,
 };
 
 /// Why a command was refused. Each has a stable code (refusal_code()).
@@ -165,6 +168,7 @@ struct Command {
   std::uint32_t run_id = 0;
   Mode run_mode = Mode::Auto;  ///< StartRun: Auto program or MDI line
   JointLimits limits{};        ///< StageJointLimits
+  std::uint8_t table_buffer = 0;  ///< StagePitchTable: which of the joint's two buffers
 };
 
 /// What a program's marker asks the machine to do (canon actions, in a form the tick can apply).

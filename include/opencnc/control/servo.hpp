@@ -38,6 +38,9 @@ class Servo final : public Tickable {
   /// Periods run. Servo thread (or any thread once the servo has stopped).
   std::uint64_t ticks() const noexcept { return tick_; }
   const ServoConfig& config() const noexcept { return config_; }
+  /// The compensation stage (its tables and corrections now). Servo thread, or any thread once
+  /// the servo has stopped (tests in virtual time).
+  const motion::Compensation& compensation() const noexcept { return comp_; }
 
  private:
   using Joints = std::array<double, machine::kMaxJoints>;
@@ -90,6 +93,7 @@ class Servo final : public Tickable {
   // --- limits changed while idle (servo_limits.cpp) -----------------------------------------
   Refusal stage_joint_limits(const Command& c) noexcept;
   Refusal apply_joint_limits() noexcept;
+  Refusal stage_pitch_table(const Command& c) noexcept;
   void enter_estop() noexcept;
   void enter_fault(const Fault& f) noexcept;
   void halt(RunEnd why) noexcept;
@@ -164,6 +168,8 @@ class Servo final : public Tickable {
   ServoConfig config_;
   std::array<JointLimits, machine::kMaxJoints> staged_limits_{};  ///< StageJointLimits, not applied yet
   std::uint16_t staged_joints_ = 0;                               ///< bit j: joint j is staged
+  std::uint16_t staged_tables_ = 0;  ///< bit j: joint j has a pitch table staged (StagePitchTable)
+  std::array<std::uint8_t, machine::kMaxJoints> staged_buffer_{};  ///< which buffer is staged
   bool staged_invalid_ = false;  ///< a stage was refused: the next apply refuses too (all or nothing)
   ServoChannels* channels_;
   machine::MachineIO* machine_;

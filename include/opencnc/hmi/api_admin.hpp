@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The admin's part of the JSON API: machine parameters (the profile's editable keys) read and
-// changed through the controller's EditProfile request.
+// The admin's part of the JSON API: machine parameters (the profile's editable keys) and the
+// pitch-error compensation tables read and changed through the controller's EditProfile request.
 #pragma once
 
 #include <nlohmann/json.hpp>
@@ -26,5 +26,23 @@ ParametersRequest parameters_request(const nlohmann::json& body, const config::M
 /// `GET /api/v1/parameters`: the profile's file and its editable parameters with their values,
 /// units and a line each. Any thread.
 nlohmann::json parameters_json(const config::MachineProfile& profile);
+
+/// A `set-compensation` body (`{"axis": "X", "forward": [...], "reverse": [...]}`, optionally
+/// `start`, `interval`, `backlash`) as the controller's EditProfile request of that axis' keys
+/// `axis.<a>.compensation.*`, or the HTTP status and message of why not (400 malformed, 422 an
+/// axis without compensation, a table from a comp file, a table of 0 or more than 256 points,
+/// a value that is not a finite number). The loader's own checks (slopes, forward and reverse
+/// of one length) come from the controller. Any thread.
+ParametersRequest compensation_request(const nlohmann::json& body, const config::MachineProfile& profile);
+
+/// `GET /api/v1/compensation`: per axis with `[axis.<a>.compensation]`, its backlash, take-up
+/// limits and pitch-error table (positions, forward, reverse, whether one table for both ways,
+/// the comp file it came from and whether it can be changed here). Any thread.
+nlohmann::json compensation_json(const config::MachineProfile& profile);
+
+/// `GET /api/v1/conditions`: an EDM's machining conditions (`[[edm.condition]]`) in the order of
+/// the profile, each with its generator, gap-servo, jump and orbit settings; an empty list on a
+/// machine without `[edm]`. Any thread.
+nlohmann::json conditions_json(const config::MachineProfile& profile);
 
 }  // namespace opencnc::hmi

@@ -76,6 +76,17 @@ class Compensation {
   /// correction stays where it is and the change of its target is taken up within the new
   /// limits, as a reversal's is. Servo thread; real-time safe.
   void set_backlash(int j, double backlash, double max_velocity, double max_acceleration) noexcept;
+  /// Joint `j`'s pitch-error table is now `*table` (an admin's edit while it stands; the table is
+  /// the caller's and must stay unchanged while in use: the channels' double-buffered area). The
+  /// correction stays where it is and the change of its target at the joint's position is taken
+  /// up within the take-up limits, as a reversal's is. Servo thread; real-time safe.
+  void set_pitch_table(int j, const PitchTable* table) noexcept;
+  /// The pitch-error table joint `j` uses now (the configuration's, or the last set_pitch_table()).
+  /// Servo thread.
+  const PitchTable& pitch_table(int j) const noexcept {
+    const PitchTable* t = tables_[index(j)];
+    return t ? *t : config_.joints[index(j)].pitch;
+  }
   /// The correction of the last update(). Servo thread.
   double correction(int j) const noexcept { return state_[index(j)].correction; }
   /// Direction of the last motion: +1, −1, 0 before the first. Servo thread.
@@ -89,6 +100,7 @@ class Compensation {
   struct JointState {
     bool started = false;
     double last_position = 0;  // joint coordinates
+    double last_x = 0;         // machine coordinates (the table's)
     int direction = 0;
     bool homed = false;
     double target = 0;
@@ -103,6 +115,8 @@ class Compensation {
 
   CompensationConfig config_{};
   std::array<JointState, kMaxCompensatedJoints> state_{};
+  /// Tables set by set_pitch_table() (nullptr: the configuration's own). Not owned.
+  std::array<const PitchTable*, kMaxCompensatedJoints> tables_{};
 };
 
 }  // namespace opencnc::motion

@@ -1,0 +1,38 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The machining-conditions screen's logic: each condition's cells, and which one is in force.
+import { describe, expect, it } from "vitest";
+import { activeCondition, conditionCells, conditionHeader, type Condition } from "./screens/conditions";
+import type { Status } from "./types";
+
+const roughing: Condition = {
+  number: 1,
+  on_time_us: 100,
+  off_time_us: 50,
+  peak_current_a: 12,
+  voltage_v: 100,
+  polarity: "+",
+  servo_reference_v: 45,
+  jump_height_mm: 0.4,
+  jump_period_s: 0.25,
+  jump_mode: "axis",
+  orbit: "none",
+  orbit_radius_mm: 0,
+  orbit_step_mm: 0,
+};
+
+describe("machining conditions", () => {
+  it("shows a condition's settings in the header's order", () => {
+    expect(conditionCells(roughing)).toEqual(["E1", "100", "50", "12", "100", "+", "45", "0.4 / 0.25", "off"]);
+    expect(conditionCells(roughing).length).toBe(conditionHeader.length);
+  });
+  it("names a jump back along the path, an orbit with its steps, and a jump that is off", () => {
+    const finishing = { ...roughing, number: 3, jump_mode: "path", orbit: "square", orbit_radius_mm: 0.08, orbit_step_mm: 0.02 };
+    expect(conditionCells(finishing).slice(7)).toEqual(["0.4 / 0.25 (path)", "square 0.08 mm by 0.02"]);
+    expect(conditionCells({ ...roughing, jump_period_s: 0 })[7]).toBe("off");
+  });
+  it("takes the condition in force from the status' EDM values (0 without)", () => {
+    expect(activeCondition({ edm: { condition: 2 } } as unknown as Status)).toBe(2);
+    expect(activeCondition({} as Status)).toBe(0);
+    expect(activeCondition(undefined)).toBe(0);
+  });
+});
