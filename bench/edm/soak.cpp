@@ -154,6 +154,16 @@ bool accepted(SimRig& rig, Request r) {
   return rig.request(std::move(r), 200000).accepted;
 }
 
+/// Every axis homed on its switches (the profile's methods; at once where it homes immediately).
+bool home_all(SimRig& rig) {
+  if (!accepted(rig, Request::set_mode(Mode::Manual)) || !accepted(rig, Request::home())) return false;
+  if (rig.run_until([&] { return rig.status().servo.state == State::Idle && rig.status().servo.all_homed; },
+                    600000))
+    return true;
+  std::fprintf(stderr, "soak: homing did not finish\n");
+  return false;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -171,7 +181,7 @@ int main(int argc, char** argv) {
   Diagnostics d;
   SimRig rig(profile, GcodeProgramSource::create(profile, d));
   rig.step();
-  if (!accepted(rig, Request::simple(CommandKind::MachineOn)) ||
+  if (!accepted(rig, Request::simple(CommandKind::MachineOn)) || !home_all(rig) ||
       !accepted(rig, Request::set_mode(Mode::Auto)))
     return 1;
   const auto hour_ticks = static_cast<std::uint64_t>(std::llround(3600.0 / profile.servo_period_s));

@@ -44,6 +44,8 @@ const char* refusal_code(Refusal r) noexcept {
       return "control.hand-axis";
     case Refusal::FeatureCheck:
       return "control.feature-check";
+    case Refusal::NoLimitSwitch:
+      return "control.no-limit-switch";
   }
   return "control.unknown";
 }
@@ -70,6 +72,8 @@ const char* fault_code(FaultKind k) noexcept {
       return "control.fault.process-alarm";
     case FaultKind::EdmShort:
       return "control.fault.edm-short";
+    case FaultKind::SeekNoSwitch:
+      return "control.fault.seek-limit";
   }
   return "control.fault.unknown";
 }
@@ -160,6 +164,8 @@ const char* to_string(CommandKind k) noexcept {
       return "stage-joint-limits";
     case CommandKind::ApplyJointLimits:
       return "apply-joint-limits";
+    case CommandKind::SeekLimit:
+      return "seek-limit";
   }
   return "?";
 }

@@ -80,6 +80,9 @@ enum class CommandKind : std::uint8_t {
   SetHandwheel,        ///< `axis` the handwheel moves (−1 = none), `value` = units per count
   StageJointLimits,    ///< `axis` = joint: `limits` wait for ApplyJointLimits (no effect yet)
   ApplyJointLimits,    ///< the staged joints' limits take effect at once, only while nothing moves
+  /// `axis`, `value` = +1 / −1: jog to that limit switch, latch it slowly, back off onto its free
+  /// side (LimitSeek); Manual mode, idle, the axis with that switch and seek keys
+  SeekLimit,
 };
 
 /// Why a command was refused. Each has a stable code (refusal_code()).
@@ -103,6 +106,8 @@ enum class Refusal : std::uint8_t {
   Interlock,      ///< control.interlock: an interlock rule of the profile forbids it now
   HandAxis,       ///< control.hand-axis: the axis is moved by hand, or is not where the program needs it
   FeatureCheck,   ///< control.feature-check: a feature's check before the start failed (the message says why)
+  NoLimitSwitch,  ///< control.no-limit-switch: the axis has no limit switch that way to seek (or no seek
+                  ///< keys)
 };
 
 /// Stable problem code of a refusal ("control.busy", ...). Any thread; real-time safe.
@@ -120,6 +125,9 @@ enum class FaultKind : std::uint8_t {
   Stall,           ///< `axis`: the stepper drive detected a stall (steps were lost; home again)
   ProcessAlarm,    ///< a `stop` alarm: `axis` = the alarm's index, `value` = the input, `limit` = the bound
   EdmShort,  ///< the EDM gap stayed shorted: `axis` = the condition, `value` = seconds, `limit` = its limit
+  /// A seek of a homed axis went its soft limit + overtravel without the limit switch tripping:
+  /// `axis`, `value` = where it stopped, `limit` = the soft limit (the axis must home again)
+  SeekNoSwitch,
 };
 
 /// Stable problem code of a fault ("control.fault.following-error", ...). Any thread.
@@ -255,6 +263,9 @@ enum class EventKind : std::uint8_t {
   /// EDM: backing off reached the end of the path memory while the gap servo still drove back;
   /// the electrode holds there (`action` = the condition, `value` = how far behind the head, mm).
   EdmRetractLimit,
+  /// A seek of a limit switch ended: `axis`, `action` 1 = found (`value` = where the switch
+  /// tripped, machine position; the rest position is in the status), 0 = stopped before it.
+  LimitSeek,
 };
 
 struct ServoEvent {
