@@ -11,6 +11,7 @@ nlohmann::json edm_json(const control::EdmReport& e, const std::optional<SimEdmF
   j["gap_voltage_in_band_fraction"] = e.gap_voltage_in_band_fraction;
   j["machining_s"] = e.machining_s;
   j["shorts"] = e.shorts;
+  j["shorts_uncleared"] = e.shorts_uncleared;
   j["arcs"] = e.arcs;
   j["arc_periods"] = e.arc_periods;
   j["short_recovery_max_s"] = e.short_recovery_max_s;
@@ -29,8 +30,8 @@ void print_edm(const control::EdmReport& e, const std::optional<SimEdmFigures>& 
       "edm                 {:.1f} s machining, gap voltage in band {:.1f} %, {} jumps, deepest burn "
       "{:.4f} mm\n",
       e.machining_s, 100 * e.gap_voltage_in_band_fraction, e.jumps, e.depth_mm);
-  fmt::print("edm gap             {} shorts (longest {:.3f} s to a discharge again), {} arcs ({} periods)\n",
-             e.shorts, e.short_recovery_max_s, e.arcs, e.arc_periods);
+  fmt::print("edm gap             {} shorts ({} never cleared; longest {:.3f} s), {} arcs ({} periods)\n",
+             e.shorts, e.shorts_uncleared, e.short_recovery_max_s, e.arcs, e.arc_periods);
   if (sim) {
     fmt::print(
         "edm simulated work  cavity {:.4f} mm over the electrode a side, {:.4f} mm deep; "

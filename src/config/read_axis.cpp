@@ -163,17 +163,71 @@ void read_home_sensor(Section& switches, machine::SwitchLayout& s) {
   }
 }
 
-void read_switches(Section& axis_section, AxisProfile& a) {
+/// The seek-limit move's keys: they need a limit switch, an overtravel the seek stops within
+/// (braking from seek_velocity after the period that sees the switch, and the jerk filter's delay).
+void read_seek(Section& w, AxisProfile& a, double period_s) {
+  LimitSeekProfile& k = a.seek;
+  k.overtravel = w.number_or("overtravel", 0, Bound::Positive);
+  if (!w.has("seek_velocity")) {
+    for (std::string_view key : {"seek_latch_velocity", "seek_back_off"})
+      w.reject(key, "needs seek_velocity (the axis seeks its limit switches at that speed)");
+    return;
+  }
+  k.velocity = w.number_or("seek_velocity", 0, Bound::Positive);
+  k.latch_velocity = w.number_or("seek_latch_velocity", k.velocity / 10, Bound::Positive);
+  k.back_off = w.number_or("seek_back_off", 0.5, Bound::Positive);
+  if (!a.switches.limit_neg.present && !a.switches.limit_pos.present) {
+    w.error("seek_velocity",
+            fmt::format("{}: seeking a limit needs a limit switch (limit_min or limit_max)", w.path()),
+            "config.missing-key");
+  }
+  for (std::string_view key : {"seek_velocity", "seek_latch_velocity"}) {
+    const double v = key == "seek_velocity" ? k.velocity : k.latch_velocity;
+    if (v > a.max_velocity)
+      w.error(key,
+              fmt::format("{} ({}) exceeds the axis' max_velocity ({})", w.key_path(key), show(v),
+                          show(a.max_velocity)),
+              "config.range");
+  }
+  if (k.latch_velocity > k.velocity)
+    w.error("seek_latch_velocity",
+            fmt::format("{} ({}) must not exceed seek_velocity ({})", w.key_path("seek_latch_velocity"),
+                        show(k.latch_velocity), show(k.velocity)),
+            "config.range");
+  if (!w.has("overtravel")) {
+    w.missing("overtravel");
+    return;
+  }
+  const double a_max = a.max_acceleration;
+  const double filter_periods = a.max_jerk > 0 ? std::ceil(2 * a_max / (a.max_jerk * period_s)) : 0;
+  const double stop =
+      k.velocity * k.velocity / (2 * a_max) + k.velocity * period_s * (2 + filter_periods / 2);
+  if (stop > k.overtravel) {
+    w.error("seek_velocity",
+            fmt::format("{}: from seek_velocity ({}) the axis needs {} to stop once the switch trips, more "
+                        "than the overtravel ({})",
+                        w.path(), show(k.velocity), show(stop), show(k.overtravel)),
+            "config.range");
+  }
+}
+
+void read_switches(Section& axis_section, AxisProfile& a, double period_s) {
   const toml::table* t = axis_section.subtable("switches");
   if (t == nullptr) return;
   Section w(*t, axis_section.key_path("switches"),
-            {"limit_min", "limit_max", "home", "decel", "hysteresis", "noise", "home_sensor"},
+            {"limit_min", "limit_max", "home", "decel", "hysteresis", "noise", "home_sensor", "overtravel",
+             "seek_velocity", "seek_latch_velocity", "seek_back_off"},
             axis_section.reporter());
   machine::SwitchLayout& s = a.switches;
   if (auto v = w.number("limit_min")) s.limit_neg = {true, -machine::kInf, *v};
   if (auto v = w.number("limit_max")) s.limit_pos = {true, *v, machine::kInf};
   if (auto v = read_window(w, "home")) s.home = *v;
   if (auto v = read_window(w, "decel")) s.decel = *v;
+  if (a.wrapped) {  // the cams on a table that turns without end come round every turn
+    if (std::isfinite(s.home.from) && std::isfinite(s.home.to)) s.home.period = 360;
+    if (std::isfinite(s.decel.from) && std::isfinite(s.decel.to)) s.decel.period = 360;
+  }
+  read_seek(w, a, period_s);
   s.hysteresis = w.number_or("hysteresis", s.hysteresis, Bound::NonNegative);
   s.noise = w.number_or("noise", s.noise, Bound::NonNegative);
   read_home_sensor(w, s);
@@ -528,8 +582,8 @@ void check_resolution(Section& s, const AxisProfile& a) {
   }
 }
 
-AxisProfile read_axis(const toml::table& table, const std::string& path, Axis axis, double substep_s,
-                      Reporter& r) {
+AxisProfile read_axis(const toml::table& table, const std::string& path, Axis axis, double period_s,
+                      double substep_s, Reporter& r) {
   Section s(table, path,
             {"type", "drive", "max_velocity", "max_acceleration", "max_jerk", "min_limit", "max_limit",
              "wrapped", "max_following_error", "encoder_counts_per_unit", "steps_per_unit", "homing",
@@ -557,7 +611,7 @@ AxisProfile read_axis(const toml::table& table, const std::string& path, Axis ax
   read_drive_kind(s, a);
   check_resolution(s, a);
   read_homing(s, a);
-  read_switches(s, a);
+  read_switches(s, a, period_s);
   read_sim_model(s, a, substep_s);
   check_homing(s, a);
   if (a.drive == JointDrive::Manual && a.max_jerk > 0)
@@ -615,7 +669,8 @@ void read_axes(Section& top, MachineProfile& profile) {
     const toml::key* key = seen[static_cast<std::size_t>(i)];
     const toml::table* t = key != nullptr ? axes->get(key->str())->as_table() : nullptr;
     if (t == nullptr) continue;
-    AxisProfile a = read_axis(*t, "axis." + std::string(key->str()), static_cast<Axis>(i), substep_s, r);
+    AxisProfile a = read_axis(*t, "axis." + std::string(key->str()), static_cast<Axis>(i),
+                              profile.servo_period_s, substep_s, r);
     a.joint = static_cast<int>(profile.axes.size());
     profile.axes.push_back(std::move(a));
   }

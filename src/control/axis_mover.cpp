@@ -58,7 +58,12 @@ void AxisMover::step_velocity() noexcept {
 // in one period at less than A, and the generator lands on the goal at rest.
 void AxisMover::step_position() noexcept {
   const double d = goal_position_ - raw_;
-  if (d == 0 && vel_ == 0) return;
+  // On the goal with a speed a period's braking takes away (the rounding of the last steps can
+  // leave one of a few 1e-10 whose sign the frame below flips every period): at rest.
+  if (d == 0 && std::fabs(vel_) <= accel_ * period_) {
+    vel_ = 0;
+    return;
+  }
   const double dir = d > 0 ? 1.0 : (d < 0 ? -1.0 : (vel_ > 0 ? -1.0 : 1.0));
   const double D = std::fabs(d), u = dir * vel_, at = accel_ * period_;
   if (u >= 0 && u <= at && D <= 0.5 * u * period_ + 1e-12) {

@@ -44,6 +44,8 @@ const char* refusal_code(Refusal r) noexcept {
       return "control.hand-axis";
     case Refusal::FeatureCheck:
       return "control.feature-check";
+    case Refusal::NoLimitSwitch:
+      return "control.no-limit-switch";
   }
   return "control.unknown";
 }
@@ -70,6 +72,8 @@ const char* fault_code(FaultKind k) noexcept {
       return "control.fault.process-alarm";
     case FaultKind::EdmShort:
       return "control.fault.edm-short";
+    case FaultKind::SeekNoSwitch:
+      return "control.fault.seek-limit";
   }
   return "control.fault.unknown";
 }
@@ -162,6 +166,8 @@ const char* to_string(CommandKind k) noexcept {
       return "apply-joint-limits";
     case CommandKind::StagePitchTable:
       return "stage-pitch-table";
+    case CommandKind::SeekLimit:
+      return "seek-limit";
   }
   return "?";
 }

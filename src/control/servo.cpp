@@ -129,7 +129,7 @@ void Servo::check_joint_faults() noexcept {
     if (check_stall(j)) return;
     if (ji.amp_fault) {
       enter_fault({FaultKind::AmpFault, jc.axis, actual, 0, tick_});
-    } else if (limit_rising_[uj]) {
+    } else if (limit_rising_[uj] && !(seeking(j) && sought_switch_only(j))) {
       enter_fault({activity_ == Activity::Homing ? FaultKind::Homing : FaultKind::LimitSwitch, jc.axis,
                    actual, 0, tick_});
     } else if (std::fabs(following_error_[uj]) > jc.max_following_error) {
@@ -162,6 +162,7 @@ void Servo::check_power() noexcept {
       break;
     case Activity::Homing:
     case Activity::Jog:
+      cancel_seeks();
       for (int j = 0; j < config_.joint_count; ++j) {
         homing_[static_cast<std::size_t>(j)].cancel(movers_[static_cast<std::size_t>(j)]);
         movers_[static_cast<std::size_t>(j)].stop();
@@ -235,7 +236,7 @@ void Servo::check_soft_limits() noexcept {
   for (int j = 0; j < config_.joint_count; ++j) {
     const auto uj = static_cast<std::size_t>(j);
     const JointConfig& jc = config_.joints[uj];
-    if (!homed_[uj] || jc.wrapped || activity_ == Activity::Homing || manual(j)) continue;
+    if (!homed_[uj] || jc.wrapped || activity_ == Activity::Homing || manual(j) || seeking(j)) continue;
     const double x = commanded_[jc.axis];
     const bool low = x<jc.min_limit - kSoftLimitSlack, high = x> jc.max_limit + kSoftLimitSlack;
     if (low || high) {
@@ -449,6 +450,8 @@ void Servo::fill_status(ServoStatus& s) const noexcept {
 void Servo::fill_drill_status(ServoStatus& s) const noexcept {
   for (int j = 0; j < config_.joint_count; ++j) {
     const auto uj = static_cast<std::size_t>(j);
+    s.seek[uj] = seek_status_[uj];
+    s.seek[uj].phase = seeks_[uj].phase();
     s.homing[uj] = homing_status_[uj];
     s.homing[uj].phase = homing_[uj].phase();
     s.compensation[uj] = compensation_[uj];

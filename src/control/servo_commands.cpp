@@ -72,6 +72,8 @@ Refusal Servo::apply(const Command& c) noexcept {
       return apply_joint_limits();
     case CommandKind::StagePitchTable:
       return stage_pitch_table(c);
+    case CommandKind::SeekLimit:
+      return seek_limit(c);
   }
   return Refusal::BadValue;
 }
@@ -214,6 +216,7 @@ Refusal Servo::abort() noexcept {
       activity_ = Activity::Jog;  // the movers bring the joints to rest, then Idle
       break;
     case Activity::Jog:
+      cancel_seeks();
       for (int j = 0; j < config_.joint_count; ++j) movers_[static_cast<std::size_t>(j)].stop();
       break;
     case Activity::None:
@@ -291,6 +294,7 @@ void Servo::halt(RunEnd why) noexcept {
     const auto uj = static_cast<std::size_t>(j);
     if (homing_[uj].active()) homing_[uj].cancel(movers_[uj]);
   }
+  cancel_seeks();
   homing_pending_ = homing_active_ = 0;
   activity_ = Activity::None;
   hold_ = cycle_start_edge_ = abort_edge_ = aborting_ = false;

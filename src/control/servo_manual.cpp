@@ -47,7 +47,7 @@ void Servo::reset_movers() noexcept {
 Refusal Servo::jog(const Command& c) noexcept {
   if (const Refusal r = need_on(); r != Refusal::None) return r;
   if (mode_ != Mode::Manual) return Refusal::WrongMode;
-  if (activity_ != Activity::None && activity_ != Activity::Jog) return Refusal::Busy;
+  if ((activity_ != Activity::None && activity_ != Activity::Jog) || seeking_ != 0) return Refusal::Busy;
   const int j = joint_of(c.axis);
   if (j < 0) return Refusal::BadValue;
   if (manual(j)) return Refusal::HandAxis;
@@ -82,7 +82,13 @@ Refusal Servo::jog_stop(int axis) noexcept {
   const int j = joint_of(axis);
   if (axis >= 0 && j < 0) return Refusal::BadValue;
   for (int k = 0; k < config_.joint_count; ++k) {
-    if (axis < 0 || k == j) movers_[static_cast<std::size_t>(k)].stop();
+    if (axis >= 0 && k != j) continue;
+    const auto uk = static_cast<std::size_t>(k);
+    if (seeking(k)) {
+      seeks_[uk].cancel(movers_[uk]);
+      seeking_ = static_cast<std::uint16_t>(seeking_ & ~(1u << k));
+    }
+    movers_[uk].stop();
   }
   return Refusal::None;
 }
@@ -90,7 +96,9 @@ Refusal Servo::jog_stop(int axis) noexcept {
 // Every joint's commanded position comes from its mover (the joints not jogging rest where
 // they are); once all have settled the jog is over.
 void Servo::run_movers() noexcept {
-  bool settled = true;
+  run_seeks();
+  if (activity_ != Activity::Jog) return;  // a seek that found no switch faulted the machine
+  bool settled = seeking_ == 0;
   for (int j = 0; j < config_.joint_count; ++j) {
     const auto uj = static_cast<std::size_t>(j);
     if (manual(j)) continue;
@@ -111,7 +119,7 @@ void Servo::run_handwheel() noexcept {
   handwheel_last_ = in_.handwheel_count;
   if (counts == 0 || handwheel_axis_ < 0 || !drives_enabled_ || mode_ != Mode::Manual || motion_blocked_)
     return;
-  if (activity_ != Activity::None && activity_ != Activity::Jog) return;
+  if ((activity_ != Activity::None && activity_ != Activity::Jog) || seeking_ != 0) return;
   const int j = joint_of(handwheel_axis_);
   if (j < 0) return;
   const auto uj = static_cast<std::size_t>(j);

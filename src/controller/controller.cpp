@@ -85,6 +85,9 @@ std::string refusal_text(Refusal r) {
       return "the axis is moved by hand (or is not where the program needs it)";
     case Refusal::FeatureCheck:
       return "a check before the start failed";
+    case Refusal::NoLimitSwitch:
+      return "the axis has no limit switch on that side to seek (the profile's limit_min/limit_max and "
+             "seek_velocity)";
   }
   return "refused";
 }
@@ -324,6 +327,9 @@ void Controller::on_event(const ServoEvent& e) {
       break;
     case EventKind::LoadGuard:
       note(Severity::Warning, "control.load", interlock_text(e));
+      break;
+    case EventKind::LimitSeek:
+      note(e.action == 1 ? Severity::Note : Severity::Error, "control.seek-limit", seek_text(e));
       break;
     case EventKind::EdmRetractLimit:
       note(Severity::Warning, "control.edm.retract-limit",
@@ -890,6 +896,23 @@ std::string Controller::interlock_text(const ServoEvent& e) const {
   return fmt::format("interlock \"{}\" {}", rule, what);
 }
 
+// What a seek found, in the units of the axis; the rest position is in the status.
+std::string Controller::seek_text(const ServoEvent& e) const {
+  const char axis = e.axis >= 0 && e.axis < kAxisCount ? kAxisLetters[static_cast<std::size_t>(e.axis)] : '?';
+  const control::ServoStatus& s = servo();
+  for (int j = 0; j < servo_config_.joint_count; ++j) {
+    const JointConfig& jc = servo_config_.joints[static_cast<std::size_t>(j)];
+    if (jc.axis != e.axis) continue;
+    const char* unit = jc.rotary ? "deg" : "mm";
+    const control::LimitSeekStatus& st = s.seek[static_cast<std::size_t>(j)];
+    if (e.action != 1)
+      return fmt::format("{}: the seek of its limit switch stopped at {:.4f} {}", axis, e.value, unit);
+    return fmt::format("{}'s {} limit switch trips at {:.4f} {}; the axis backed off to {:.4f} {}", axis,
+                       st.direction > 0 ? "+" : "−", e.value, unit, st.rest_at, unit);
+  }
+  return fmt::format("{}: limit seek at {:.4f}", axis, e.value);
+}
+
 std::string Controller::describe(const Fault& f) const {
   const char axis = f.axis >= 0 && f.axis < kAxisCount ? kAxisLetters[static_cast<std::size_t>(f.axis)] : '?';
   const JointConfig* jc = nullptr;
@@ -930,6 +953,11 @@ std::string Controller::describe(const Fault& f) const {
           "the program was stopped with the generator off; clear the gap (debris, a bridge, the electrode "
           "on the work) before going on",
           f.value, static_cast<int>(f.axis), f.limit);
+    case FaultKind::SeekNoSwitch:
+      return fmt::format(
+          "seeking its limit, {} went {:.4f} {} (its soft limit {} {} and the overtravel) without the limit "
+          "switch tripping: check the switch and its wiring, then home {} again",
+          axis, f.value, unit, f.limit, unit, axis);
     case FaultKind::ProcessAlarm:
       return detail::alarm_text(profile_.alarms, static_cast<std::size_t>(f.axis), f.value, f.value < f.limit,
                                 false);

@@ -16,7 +16,9 @@ void EdmRecorder::on_trace(const TraceSample& s, const TraceContext& /*c*/) {
     first_ = false;
   }
   jumps_now_ = e.jumps;
+  last_tick_ = s.tick;
   using machine::GapState;
+  if (shorted_ && !e.on) end_short(s.tick, false);  // the burn ended shorted (M181, the run's end, a fault)
   const double tool = s.commanded[edm_.tool_axis] - edm_.lift_direction * (e.jumping ? e.jump_lift_mm : 0.0);
   if (!e.on) {
     burning_ = false;
@@ -42,16 +44,25 @@ void EdmRecorder::on_trace(const TraceSample& s, const TraceContext& /*c*/) {
     }
   }
   // A short ends at the first discharge after it (normal or arc); lifted or off it is not over.
-  if (shorted_ && e.generator && (e.gap_state == GapState::Normal || e.gap_state == GapState::Arc)) {
-    shorted_ = false;
-    r_.short_recovery_max_s =
-        std::max(r_.short_recovery_max_s, static_cast<double>(s.tick - short_since_) * period_s_);
-  }
+  if (shorted_ && e.generator && (e.gap_state == GapState::Normal || e.gap_state == GapState::Arc))
+    end_short(s.tick, true);
   if (e.generator) last_ = e.gap_state;
+}
+
+void EdmRecorder::end_short(std::uint64_t tick, bool cleared) {
+  shorted_ = false;
+  r_.short_recovery_max_s =
+      std::max(r_.short_recovery_max_s, static_cast<double>(tick - short_since_) * period_s_);
+  if (!cleared) ++r_.shorts_uncleared;
 }
 
 EdmReport EdmRecorder::report() const {
   EdmReport r = r_;
+  if (shorted_) {  // still shorted at the last sample: it counts with its time so far
+    r.short_recovery_max_s =
+        std::max(r.short_recovery_max_s, static_cast<double>(last_tick_ - short_since_) * period_s_);
+    ++r.shorts_uncleared;
+  }
   r.machining_s = static_cast<double>(machining_) * period_s_;
   r.gap_voltage_in_band_fraction =
       machining_ > 0 ? static_cast<double>(in_band_) / static_cast<double>(machining_) : 0.0;

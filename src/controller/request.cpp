@@ -71,6 +71,7 @@ std::string Request::name() const {
                         [](const requests::SetHandwheel&) -> std::string { return "handwheel"; },
                         [](const requests::ResumeProgram&) -> std::string { return "resume-program"; },
                         [](const requests::EditProfile&) -> std::string { return "edit-profile"; },
+                        [](const requests::SeekLimit&) -> std::string { return "seek-limit"; },
                     },
                     body);
 }
@@ -105,6 +106,12 @@ std::optional<Command> to_command(const Request& r) {
           [](const requests::Home& s) -> std::optional<Command> {
             Command c = command(CommandKind::Home);
             c.axis = axis_index(s.axis);
+            return c;
+          },
+          [](const requests::SeekLimit& s) -> std::optional<Command> {
+            Command c = command(CommandKind::SeekLimit);
+            c.axis = axis_index(s.axis);
+            c.value = s.direction;
             return c;
           },
           [](const requests::SetOverride& s) -> std::optional<Command> {

@@ -115,6 +115,7 @@ ServoConfig servo_config(const config::MachineProfile& profile) {
     j.home.level_on = a.switches.home_sensor.threshold;
     j.home.level_off = a.switches.home_sensor.threshold - a.switches.home_sensor.hysteresis;
     j.home.return_after_program = h.return_after_program;
+    j.seek = {a.seek.velocity, a.seek.latch_velocity, a.seek.back_off, a.seek.overtravel};
     j.hand_tolerance = a.hand_tolerance;
     if (j.home.method != HomeMethod::Immediate) s.homing_required = true;
     s.compensation.joints[static_cast<std::size_t>(a.joint)] = joint_compensation(a);

@@ -216,6 +216,13 @@ Command parse(const json& body, const config::MachineProfile& p, const std::file
   }
   if (kind == "jog-stop") return Request::jog_stop(optional_axis(body, p));
   if (kind == "home") return Request::home(optional_axis(body, p));
+  if (kind == "seek-limit") {
+    const config::AxisProfile& a = axis(body, p);
+    const std::string d = text(body, "direction");
+    if (d != "+" && d != "-")
+      throw Bad{400, "\"direction\" must be \"+\" or \"-\" (the limit switch sought)"};
+    return Request::seek_limit(a.axis, d == "+" ? 1 : -1);
+  }
   if (kind == "override") return override_request(body);
   if (kind == "switch") return switch_request(body);
   if (kind == "spindle-on") {
@@ -244,8 +251,10 @@ Command parse(const json& body, const config::MachineProfile& p, const std::file
   }
   if (kind == "run-from-line") {
     const double line = number(body, "line");
-    if (line != std::floor(line) || line < 1 || line > 1e9) throw Bad{422, "\"line\" must be a line number from 1"};
-    return Request::feature("run-from-line", "start", control::RunFromLineArgs{static_cast<std::uint32_t>(line)});
+    if (line != std::floor(line) || line < 1 || line > 1e9)
+      throw Bad{422, "\"line\" must be a line number from 1"};
+    return Request::feature("run-from-line", "start",
+                            control::RunFromLineArgs{static_cast<std::uint32_t>(line)});
   }
   if (kind == "simulate") return simulation_event(body);
   if (kind == "feature") {
@@ -297,10 +306,9 @@ const char* to_string(Role r) noexcept {
 }
 
 std::optional<Role> role_for(std::string_view kind) {
-  static const char* const operator_kinds[] = {"mode",    "jog",       "jog-by", "jog-stop",
-                                               "home",    "override",  "switch", "spindle-on",
-                                               "coolant", "handwheel", "open",   "mdi",
-                                               "run-from-line"};
+  static const char* const operator_kinds[] = {
+      "mode",       "jog",     "jog-by",    "jog-stop", "home", "override",      "switch",
+      "spindle-on", "coolant", "handwheel", "open",     "mdi",  "run-from-line", "seek-limit"};
   if (kind == "set-tool" || kind == "set-parameters" || kind == "set-compensation" || kind == "simulate")
     return Role::Admin;
   if (kind == "feature") return Role::Operator;  // the confirmation is in the body (api_features.cpp)
@@ -322,11 +330,18 @@ std::variant<Command, ApiError> parse_command(const json& body, const config::Ma
 
 json status_json(const control::ControllerStatus& s, const config::MachineProfile& profile) {
   const control::ServoStatus& v = s.servo;
-  json fe = json::object(), homed = json::object();
+  json fe = json::object(), homed = json::object(), seek = json::object();
   for (const config::AxisProfile& a : profile.axes) {
     const auto& j = v.joints[static_cast<std::size_t>(a.joint)];
     fe[std::string(1, letter(a.axis))] = j.following_error;
     homed[std::string(1, letter(a.axis))] = j.homed;
+    const control::LimitSeekStatus& k = v.seek[static_cast<std::size_t>(a.joint)];
+    if (k.direction == 0) continue;  // never sought
+    seek[std::string(1, letter(a.axis))] = {{"phase", control::to_string(k.phase)},
+                                            {"direction", k.direction > 0 ? "+" : "-"},
+                                            {"found", k.found},
+                                            {"tripped_at", k.tripped_at},
+                                            {"rest_at", k.rest_at}};
   }
   const int n = static_cast<int>(profile.axes.size());
   json j = {
@@ -351,6 +366,7 @@ json status_json(const control::ControllerStatus& s, const config::MachineProfil
       {"following_error", fe},
       {"homed", homed},
       {"all_homed", v.all_homed},
+      {"seek", seek},
       {"path_velocity", v.path_velocity},
       {"feed_override", v.feed_override},
       {"rapid_override", v.rapid_override},
@@ -429,6 +445,15 @@ json outcome_json(std::uint64_t id, const control::Outcome& o) {
           {"diagnostics", diags}};
 }
 
+/// The limit switches the axis can seek ("-", "+").
+static json seek_sides(const config::AxisProfile& a) {
+  json sides = json::array();
+  if (a.seek.velocity <= 0) return sides;
+  if (a.switches.limit_neg.present) sides.push_back("-");
+  if (a.switches.limit_pos.present) sides.push_back("+");
+  return sides;
+}
+
 json machine_json(const config::MachineProfile& p) {
   json axes = json::array();
   for (const config::AxisProfile& a : p.axes) {
@@ -439,7 +464,8 @@ json machine_json(const config::MachineProfile& p) {
                     {"max_limit", a.max_limit},
                     {"max_velocity", a.max_velocity},
                     {"max_acceleration", a.max_acceleration},
-                    {"homing", a.homing.method != config::HomingMethod::Immediate}});
+                    {"homing", a.homing.method != config::HomingMethod::Immediate},
+                    {"seek", seek_sides(a)}});
   }
   return {{"name", p.name},
           {"description", p.description},

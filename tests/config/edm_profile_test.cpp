@@ -139,6 +139,43 @@ TEST(EdmProfile, TheShortTimeoutComesFromTheConditionOrEdm) {
   EXPECT_EQ(load.profile->edm.config.find(2)->short_timeout_s, 0.8);
 }
 
+// The EDM's switches: every axis homes on one, X Y Z and B can seek their limit switches; C's
+// home mark comes round every turn. A seek that cannot stop within the overtravel, or that has
+// no limit switch, or seek keys without seek_velocity, is refused at its key.
+TEST(EdmProfile, TheSeekOfALimitStopsWithinItsOvertravel) {
+  ProfileLoad load = load_profile(kEdm);
+  ASSERT_TRUE(load.ok()) << all_messages(load.diagnostics);
+  for (const AxisProfile& a : load.profile->axes) {
+    EXPECT_NE(a.homing.method, HomingMethod::Immediate) << letter(a.axis);
+    EXPECT_EQ(a.seek.velocity > 0, a.axis != Axis::C) << letter(a.axis);
+  }
+  const AxisProfile& x = load.profile->axes[0];
+  EXPECT_EQ(x.seek.overtravel, 4.0);
+  EXPECT_EQ(x.seek.latch_velocity, 0.5);
+  EXPECT_EQ(x.switches.limit_pos.from, 151.0);
+  EXPECT_EQ(load.profile->axes[4].switches.home.period, 360.0);
+  EXPECT_EQ(x.switches.home.period, 0.0);
+
+  std::string text = std::string(kMachine) + condition("");
+  text.replace(text.find("[axis.y]"), 0,
+               "[axis.x.switches]\nlimit_max = 11\novertravel = 0.3\nseek_velocity = 20\n");
+  load = parse_profile(text, "edm.toml");
+  ASSERT_NE(first_error(load), nullptr);
+  EXPECT_NE(first_error(load)->message.find(
+                "needs 0.44 to stop once the switch trips, more than the overtravel (0.3)"),
+            std::string::npos)
+      << first_error(load)->message;
+  EXPECT_EQ(first_error(load)->line, line_of(text, "seek_velocity"));
+
+  load = load_profile(kEdm, std::vector<std::string>{"axis.c.switches.seek_velocity=10"});
+  ASSERT_NE(first_error(load), nullptr);
+  EXPECT_NE(first_error(load)->message.find("needs a limit switch"), std::string::npos);
+  load = load_profile(kEdm, std::vector<std::string>{"axis.x.switches.seek_latch_velocity=30"});
+  ASSERT_NE(first_error(load), nullptr);
+  EXPECT_NE(first_error(load)->message.find("exceeds the axis' max_velocity"), std::string::npos)
+      << first_error(load)->message;
+}
+
 TEST(EdmProfile, TheReferenceMustBeBelowTheOpenVoltageAndTheGeneratorPresent) {
   std::string text = kMachine;
   text +=

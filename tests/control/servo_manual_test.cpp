@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Manual mode on the simulated machine: homing in sequences on noisy switches (repeatable to the
-// micrometre), jogs that stop exactly at the soft limits, jogging off a limit switch.
+// micrometre), jogs that stop exactly at the soft limits, jogging off a limit switch; the EDM's
+// homing on its reference cams and seeks of its limit switches.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -151,6 +152,179 @@ TEST(Jog, UnhomedJogIntoALimitSwitchFaultsAndCanJogOffAfterReset) {
   ASSERT_EQ(h.jog(Axis::X, -10), Refusal::None);
   ASSERT_TRUE(h.until([&] { return !h.status().joints[kX].limit_pos; }, 5000));
   EXPECT_EQ(h.state(), State::Running);
+}
+
+// --- the five-axis EDM: homing on its cams, seeking its limit switches ------------------------
+
+constexpr int kC = 4;
+
+config::MachineProfile edm(std::vector<std::string> sets = {}) {
+  return loaded(config::load_profile(OPENCNC_SOURCE_DIR "/configs/edm-5axis.toml", sets));
+}
+
+Refusal seek(ServoHarness& h, Axis a, int direction) {
+  Command c;
+  c.kind = CommandKind::SeekLimit;
+  c.axis = static_cast<std::int8_t>(index(a));
+  c.value = direction;
+  return h.send(c);
+}
+
+std::vector<ServoEvent> seek_events(ServoHarness& h) {
+  std::vector<ServoEvent> v;
+  for (const ServoEvent& e : h.events()) {
+    if (e.kind == EventKind::LimitSeek) v.push_back(e);
+  }
+  return v;
+}
+
+// Steppers know nothing at power-up: every axis searches its cam's edge (from on the cam it moves
+// off first), backs off and latches it at 0.2 mm/s. Other switch noise and power-up positions on
+// either side of the edges give the same home reference to within a step (0.625 µm) and the
+// switch's noise; C finds its mark, which comes round every turn.
+TEST(EdmHoming, LandsOnTheCamsWithinTheLatchsRepeatability) {
+  std::array<std::vector<double>, 5> refs;
+  const char* starts[] = {"-2.5", "1.5", "-0.7", "3.2"};
+  for (int run = 0; run < 4; ++run) {
+    const std::string p = starts[run];
+    std::vector<std::string> sets = {"sim.seed=" + std::to_string(run + 3)};
+    for (const char* a : {"x", "y", "z", "b"})
+      sets.push_back(std::string("axis.") + a + ".sim.start_position=" + p);
+    sets.push_back("axis.c.sim.start_position=" + std::string(run % 2 ? "358.5" : "1.0"));
+    ServoHarness h(edm(sets));
+    EXPECT_FALSE(h.status().all_homed);
+    home_all(h);
+    h.tick(50);
+    for (int j = 0; j < 5; ++j) {
+      const double ref =
+          h.status().joints[static_cast<std::size_t>(j)].actual - h.sim().joint(j).table_position();
+      refs[static_cast<std::size_t>(j)].push_back(j == kC ? std::remainder(ref, 360.0) : ref);
+      EXPECT_NEAR(h.status().commanded[static_cast<Axis>(j)], 0.0, 1e-9);
+    }
+  }
+  for (int j = 0; j < 5; ++j) {
+    const auto& v = refs[static_cast<std::size_t>(j)];
+    const auto [lo, hi] = std::minmax_element(v.begin(), v.end());
+    std::printf("EDM home reference of joint %d: %.3g spread\n", j, *hi - *lo);
+    EXPECT_LE(*hi - *lo, 0.001) << "joint " << j;         // a step (0.625 µm) and the noise
+    EXPECT_NEAR(v.front(), 0.0, 0.003) << "joint " << j;  // the cams' edges are at table 0
+  }
+}
+
+// Not homed: the seek runs at 20 mm/s until X's + switch (table 151) trips, stops within the 4 mm
+// overtravel, comes off it and onto it again at 0.5 mm/s, and rests 0.5 mm on the free side of
+// where it released. No fault: that trip is what it sought.
+TEST(LimitSeek, StopsAtTheSwitchAndBacksOffOntoItsFreeSide) {
+  ServoHarness h(edm({"axis.x.sim.start_position=147.0"}));
+  on_in_manual(h);
+  ASSERT_EQ(seek(h, Axis::X, +1), Refusal::None);
+  EXPECT_EQ(h.state(), State::Running);
+  double furthest = 0;
+  bool shown = false;
+  ASSERT_TRUE(h.until(
+      [&] {
+        furthest = std::max(furthest, h.sim().joint(kX).table_position());
+        shown = shown || h.status().seek[kX].phase == SeekPhase::Latch;
+        return h.state() != State::Running;
+      },
+      20000));
+  EXPECT_EQ(h.state(), State::Idle);
+  EXPECT_TRUE(shown);
+  EXPECT_GT(furthest, 151.0);
+  EXPECT_LT(furthest, 151.0 + 4.0);
+  const std::vector<ServoEvent> found = seek_events(h);
+  ASSERT_EQ(found.size(), 1u);
+  EXPECT_EQ(found[0].action, 1u);
+  EXPECT_NEAR(found[0].value, 151.0, 0.002);  // machine = table before homing
+  const LimitSeekStatus& st = h.status().seek[kX];
+  EXPECT_EQ(st.phase, SeekPhase::Done);
+  EXPECT_TRUE(st.found);
+  EXPECT_NEAR(st.tripped_at, 151.0, 0.002);
+  EXPECT_NEAR(st.rest_at, st.released_at - 0.5, 1e-9);
+  EXPECT_NEAR(st.released_at, 151.0 - 0.01, 0.003);  // the switch's differential travel
+  h.tick(100);
+  EXPECT_FALSE(h.status().joints[kX].limit_pos);
+  EXPECT_NEAR(h.sim().joint(kX).table_position(), st.rest_at, 0.001);
+}
+
+// Homed, the seek goes past the soft limit (no fault) to the switch and comes to rest back on the
+// soft limit, so that the axis can jog and run programs at once.
+TEST(LimitSeek, AHomedAxisComesBackWithinItsSoftLimits) {
+  ServoHarness h(edm());
+  home_all(h);
+  ASSERT_EQ(seek(h, Axis::Z, -1), Refusal::None);
+  ASSERT_TRUE(h.until([&] { return h.state() != State::Running; }, 20000));
+  ASSERT_EQ(h.state(), State::Idle) << fault_code(h.status().fault.kind);
+  const LimitSeekStatus& st = h.status().seek[kZ];
+  EXPECT_TRUE(st.found);
+  EXPECT_NEAR(st.tripped_at, -81.0, 0.003);
+  EXPECT_DOUBLE_EQ(st.rest_at, -80.0);
+  EXPECT_DOUBLE_EQ(h.status().commanded[Axis::Z], -80.0);
+  EXPECT_TRUE(h.status().all_homed);
+}
+
+// A switch that does not trip: the homed search ends at the soft limit + overtravel, faults, and
+// the axis must home again.
+TEST(LimitSeek, ASwitchThatNeverTripsIsAFault) {
+  ServoHarness h(edm({"axis.y.switches.limit_max=130.0"}));  // the switch moved beyond the stops
+  home_all(h);
+  ASSERT_EQ(seek(h, Axis::Y, +1), Refusal::None);
+  ASSERT_TRUE(h.until([&] { return h.state() != State::Running; }, 20000))
+      << to_string(h.status().seek[kY].phase) << " " << h.status().commanded[Axis::Y];
+  EXPECT_EQ(h.state(), State::Faulted);
+  EXPECT_EQ(h.status().fault.kind, FaultKind::SeekNoSwitch);
+  EXPECT_NEAR(h.status().fault.value, 104.0, 1e-6);
+  EXPECT_FALSE(h.status().joints[kY].homed);
+  const std::vector<ServoEvent> ev = seek_events(h);
+  ASSERT_EQ(ev.size(), 1u);
+  EXPECT_EQ(ev[0].action, 0u);
+}
+
+TEST(LimitSeek, IsRefusedWithoutASwitchOutsideManualOrWhileSomethingMoves) {
+  ServoHarness h(edm({"axis.x.sim.start_position=140.0"}));
+  EXPECT_EQ(seek(h, Axis::X, +1), Refusal::MachineOff);
+  on_in_manual(h);
+  EXPECT_EQ(seek(h, Axis::C, +1), Refusal::NoLimitSwitch);  // C turns without end: no limit switch
+  EXPECT_EQ(seek(h, Axis::X, 0), Refusal::BadValue);
+  ASSERT_EQ(h.send_mode(Mode::Mdi), Refusal::None);
+  EXPECT_EQ(seek(h, Axis::X, +1), Refusal::WrongMode);
+  ASSERT_EQ(h.send_mode(Mode::Manual), Refusal::None);
+  ASSERT_EQ(h.jog(Axis::Y, 5), Refusal::None);
+  EXPECT_EQ(seek(h, Axis::X, +1), Refusal::Busy);
+  ASSERT_EQ(h.send(Command{0, CommandKind::JogStop}), Refusal::None);
+  ASSERT_TRUE(h.until([&] { return h.state() == State::Idle; }, 2000));
+  ASSERT_EQ(seek(h, Axis::X, +1), Refusal::None);
+  EXPECT_EQ(h.jog(Axis::Y, 5), Refusal::Busy);  // nothing else moves beside a seek
+  EXPECT_TRUE(seek_events(h).empty());
+}
+
+// E-stop during the search: the seek ends where it is, the axis never reaches the switch, and
+// nothing is reported as found. A jog stop ends a seek too.
+TEST(LimitSeek, EStopOrJogStopDuringASeekStopsIt) {
+  ServoHarness h(edm({"axis.x.sim.start_position=140.0"}));
+  on_in_manual(h);
+  ASSERT_EQ(seek(h, Axis::X, +1), Refusal::None);
+  h.tick(200);
+  ASSERT_EQ(h.status().seek[kX].phase, SeekPhase::Search);
+  ASSERT_EQ(h.send(CommandKind::EStop), Refusal::None);
+  EXPECT_EQ(h.state(), State::EStopped);
+  EXPECT_EQ(h.status().seek[kX].phase, SeekPhase::Idle);
+  h.tick(2000);  // the drives are off: the table coasts to rest on its friction
+  const double stopped = h.sim().joint(kX).table_position();
+  EXPECT_LT(stopped, 145.0);  // 4 mm after the seek began, 6 mm short of the switch
+  h.tick(1000);
+  EXPECT_EQ(h.sim().joint(kX).table_position(), stopped);
+  EXPECT_TRUE(seek_events(h).empty());
+
+  ASSERT_EQ(h.send(CommandKind::Reset), Refusal::None);
+  on_in_manual(h);
+  ASSERT_EQ(seek(h, Axis::X, +1), Refusal::None);
+  h.tick(100);
+  ASSERT_EQ(h.send(Command{0, CommandKind::JogStop}), Refusal::None);
+  ASSERT_TRUE(h.until([&] { return h.state() == State::Idle; }, 2000));
+  EXPECT_EQ(h.status().seek[kX].phase, SeekPhase::Idle);
+  EXPECT_FALSE(h.status().joints[kX].limit_pos);
+  EXPECT_TRUE(seek_events(h).empty());
 }
 
 }  // namespace

@@ -232,7 +232,8 @@ TEST(ServoAllocations, NoneWhenTheEventLogAppends) {
 }
 
 // The sinker EDM's tick: the gap servo forward and back along the path (an injected short), jumps
-// along the tool axis and along the path, circle and square orbits growing, a feed hold, M181.
+// along the tool axis and along the path, circle and square orbits growing, a feed hold, M181;
+// before it, homing on the cams and the seek of a limit switch.
 TEST(ServoAllocations, NoneInsideTheEdmTick) {
   const auto dir = std::filesystem::temp_directory_path() / "opencnc-noalloc-edm";
   std::filesystem::create_directories(dir);
@@ -243,6 +244,12 @@ TEST(ServoAllocations, NoneInsideTheEdmTick) {
   const std::vector<std::string> sets = {"edm.sim.electrode_area_mm2=5"};
   Armed a(loaded(config::load_profile(OPENCNC_SOURCE_DIR "/configs/edm-5axis.toml", sets)));
   a.ask(Request::simple(CommandKind::MachineOn));
+  a.ask(Request::set_mode(Mode::Manual));
+  a.ask(Request::home());  // on the reference cams
+  ASSERT_TRUE(a.idle());
+  a.ask(Request::seek_limit(Axis::Z, +1));  // to Z's + limit switch, latched, backed off
+  ASSERT_TRUE(a.idle());
+  ASSERT_TRUE(a.rig().status().servo.seek[2].found);
   a.ask(Request::set_mode(Mode::Auto));
   a.ask(Request::open(program));
   a.ask(Request::simple(CommandKind::CycleStart));

@@ -240,6 +240,18 @@ const Row kRows[] = {
     {"home_jogging", false, jogging, State::Running, cmd(CommandKind::Home), Refusal::Busy, State::Running},
     {"home_homing", true, homing, State::Running, cmd(CommandKind::Home), Refusal::Busy, State::Running},
     {"home_off", true, off, State::Off, cmd(CommandKind::Home), Refusal::MachineOff, State::Off},
+    // seek a limit switch (the homing mill's X has one on its + side, but no seek keys; the
+    // seeks that run are servo_manual_test's LimitSeek.*)
+    {"seek_no_seek_keys", true, idle(Mode::Manual), State::Idle, cmd(CommandKind::SeekLimit, 1, 0, 0),
+     Refusal::NoLimitSwitch, State::Idle},
+    {"seek_bad_direction", true, idle(Mode::Manual), State::Idle, cmd(CommandKind::SeekLimit, 0.5, 0, 0),
+     Refusal::BadValue, State::Idle},
+    {"seek_idle_auto", true, idle(Mode::Auto), State::Idle, cmd(CommandKind::SeekLimit, 1, 0, 0),
+     Refusal::WrongMode, State::Idle},
+    {"seek_jogging", false, jogging, State::Running, cmd(CommandKind::SeekLimit, 1, 0, 0), Refusal::Busy,
+     State::Running},
+    {"seek_off", true, off, State::Off, cmd(CommandKind::SeekLimit, 1, 0, 0), Refusal::MachineOff,
+     State::Off},
     // runs (the controller's StartRun)
     {"run_idle_auto", false, idle(Mode::Auto), State::Idle, start_run(Mode::Auto), Refusal::None,
      State::Running},

@@ -27,6 +27,15 @@ config::MachineProfile edm_machine() {
   return loaded(config::load_profile(OPENCNC_SOURCE_DIR "/configs/edm-5axis.toml", sets));
 }
 
+/// Machine on and every axis homed on its switches (the EDM's steppers know nothing at power-up).
+bool on_and_homed(SimRig& rig) {
+  if (!rig.request(Request::simple(CommandKind::MachineOn)).accepted) return false;
+  if (!rig.request(Request::set_mode(Mode::Manual)).accepted || !rig.request(Request::home()).accepted)
+    return false;
+  return rig.run_until(
+      [&] { return rig.status().servo.state == State::Idle && rig.status().servo.all_homed; }, 60000);
+}
+
 /// Every trace sample of the run.
 class Samples final : public ControllerObserver {
  public:
@@ -55,7 +64,7 @@ Burnt run(const std::string& text, const config::MachineProfile& profile) {
   r.samples = std::make_shared<Samples>();
   r.rig->controller().attach(r.samples, ObserverOptions{0, true});
   r.rig->step();
-  EXPECT_TRUE(r.rig->request(Request::simple(CommandKind::MachineOn)).accepted);
+  EXPECT_TRUE(on_and_homed(*r.rig));
   EXPECT_TRUE(r.rig->request(Request::set_mode(Mode::Auto)).accepted);
   const Outcome opened = r.rig->request(Request::open(path), 100000);
   EXPECT_TRUE(opened.accepted) << opened.message;

@@ -4,6 +4,7 @@
 // jump's timing and height, the orbit's radius and shape from the trace, arcing without the jump,
 // a short that never clears stopped by its time, and the preflight refusing an unknown condition
 // at its line.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -29,6 +30,15 @@ namespace {
 config::MachineProfile edm(std::vector<std::string> sets = {}) {
   sets.insert(sets.begin(), "edm.sim.electrode_area_mm2=5");
   return loaded(config::load_profile(OPENCNC_SOURCE_DIR "/configs/edm-5axis.toml", sets));
+}
+
+/// Machine on and every axis homed on its switches (the EDM's steppers know nothing at power-up).
+bool on_and_homed(SimRig& rig) {
+  if (!rig.request(Request::simple(CommandKind::MachineOn)).accepted) return false;
+  if (!rig.request(Request::set_mode(Mode::Manual)).accepted || !rig.request(Request::home()).accepted)
+    return false;
+  return rig.run_until(
+      [&] { return rig.status().servo.state == State::Idle && rig.status().servo.all_homed; }, 60000);
 }
 
 /// Every trace sample of the run.
@@ -68,7 +78,7 @@ EdmRun run(const std::string& text, const config::MachineProfile& profile = edm(
   r.rig->controller().attach(r.recorder, ObserverOptions{0, true});
   r.rig->controller().attach(r.samples, ObserverOptions{0, true});
   r.rig->step();
-  EXPECT_TRUE(r.rig->request(Request::simple(CommandKind::MachineOn)).accepted);
+  EXPECT_TRUE(on_and_homed(*r.rig));
   EXPECT_TRUE(r.rig->request(Request::set_mode(Mode::Auto)).accepted);
   r.opened = r.rig->request(Request::open(write_program(text)), 100000);
   if (!r.opened.accepted) return r;
@@ -135,8 +145,10 @@ TEST(Edm, AShortThatNeverClearsStopsTheMachineWithAFault) {
   Diagnostics d;
   SimRig rig(p, GcodeProgramSource::create(p, d));
   EventCursor events(rig.controller().events());
+  auto recorder = std::make_shared<EdmRecorder>(p.edm.config, p.servo_period_s);
+  rig.controller().attach(recorder, ObserverOptions{0, true});
   rig.step();
-  ASSERT_TRUE(rig.request(Request::simple(CommandKind::MachineOn)).accepted);
+  ASSERT_TRUE(on_and_homed(rig));
   ASSERT_TRUE(rig.request(Request::set_mode(Mode::Auto)).accepted);
   ASSERT_TRUE(rig.request(Request::open(write_program(burn(1, 0.03))), 100000).accepted);
   ASSERT_TRUE(rig.request(Request::simple(CommandKind::CycleStart)).accepted);
@@ -178,14 +190,22 @@ TEST(Edm, AShortThatNeverClearsStopsTheMachineWithAFault) {
   }
   EXPECT_TRUE(told_limit);
   EXPECT_TRUE(told_fault);
+  // The report counts the short that never cleared, with its 8 s until the fault.
+  rig.run_until([] { return false; }, 5);
+  const EdmReport report = recorder->report();
+  EXPECT_EQ(report.shorts, 1u);
+  EXPECT_EQ(report.shorts_uncleared, 1u);
+  EXPECT_NEAR(report.short_recovery_max_s, 8.0, 0.003);
 }
 
 // A short that clears within its time is no fault, however long the program runs on.
 TEST(Edm, TheShortTimeCountsOnlyAnUnbrokenShort) {
   int shorts = 0;
+  double start = -1;  // the run's (after homing)
   const EdmRun r = run(burn(1, 0.03), edm({"edm.short_timeout_s=0.05"}), [&](SimRig& rig) {
     const ServoStatus& s = rig.status().servo;
-    if (shorts < 3 && s.time_s > 0.3 * (shorts + 1) && s.edm.generator &&
+    if (start < 0) start = s.time_s;
+    if (shorts < 3 && s.time_s - start > 0.3 * (shorts + 1) && s.edm.generator &&
         s.edm.gap_state == machine::GapState::Normal) {
       rig.machine().inject_edm_short();  // the 20 µm bridge breaks in about 7 ms each time
       ++shorts;
@@ -195,6 +215,7 @@ TEST(Edm, TheShortTimeCountsOnlyAnUnbrokenShort) {
   EXPECT_EQ(shorts, 3);
   EXPECT_EQ(r.rig->status().servo.state, State::Idle);
   EXPECT_GE(r.report.shorts, 3u);
+  EXPECT_EQ(r.report.shorts_uncleared, 0u);  // each cleared before the burn ended
 }
 
 // Resumed at the second feed of condition 2 (ResumeProgram, as run from line and electrode setting
@@ -218,7 +239,7 @@ TEST(Edm, AResumedProgramSelectsTheConditionInForceAgain) {
   ASSERT_NE(k, 0u);
   SimRig rig(p, GcodeProgramSource::create(p, d));
   rig.step();
-  ASSERT_TRUE(rig.request(Request::simple(CommandKind::MachineOn)).accepted);
+  ASSERT_TRUE(on_and_homed(rig));
   ASSERT_TRUE(rig.request(Request::set_mode(Mode::Mdi)).accepted);
   ASSERT_TRUE(rig.request(Request::mdi("G0 Z-19.995"), 100000).accepted);  // on segment k's line
   ASSERT_TRUE(rig.run_until(
@@ -329,6 +350,7 @@ TEST(Edm, WithoutTheJumpDebrisMakesTheGapArc) {
 TEST(Edm, ThePreflightSeesTheOrbitAndTheJump) {
   struct Case {
     std::string program, message;  // message "": accepted
+    unsigned line = 4;
   };
   const Case cases[] = {
       {"G21 G90\nG0 X149.95 Z-19.97\nM180 P3\nG1 Z-20.01 F60\nM181\nG0 Z0\nM2\n",
@@ -337,13 +359,25 @@ TEST(Edm, ThePreflightSeesTheOrbitAndTheJump) {
       {"G21 G90\nG0 Z49.8\nM180 P1\nG1 Z49.7 F60\nM181\nG0 Z0\nM2\n",
        "with EDM condition 1's jump (0.4 mm) this move takes Z to 50.2000 mm, beyond its maximum soft limit"},
       {"G21 G90\nG0 X149.95 Z-19.97\nM180 P1\nG1 Z-20.01 F60\nM181\nG0 Z0\nM2\n", ""},
+      // Condition 2's orbit (0.05 mm, 0.01 mm a turn of 1 s) takes 1.25 s to spiral back after
+      // M181: the second short move after it is still widened ...
+      {"G21 G90\nG0 X149.9 Z-19.97\nM180 P2\nG1 Z-20.01 F60\nM181\nG0 Z-19.9\nG0 X149.97\nG0 Z0\nM2\n",
+       "with EDM condition 2's orbit (0.05 mm) and jump (0.3 mm) this move takes X to 150.0200 mm", 7},
+      // ... but not once a move that takes at least 2 s (49.9 mm at X's 25 mm/s) has passed.
+      {"G21 G90\nG0 X149.9 Z-19.97\nM180 P2\nG1 Z-20.01 F60\nM181\nG0 X100\nG0 X149.97\nG0 Z0\nM2\n", ""},
+      // Condition 3's square spirals in while condition 2's circle grows: the larger one counts.
+      {"G21 G90\nG0 X149.9 Z-19.97\nM180 P3\nG1 Z-20.01 F60\nM180 P2\nG1 X149.94 Z-20.02 F30\nM181\nG0 "
+       "Z0\nM2\n",
+       "with EDM condition 3's orbit (0.08 mm) and condition 2's jump (0.3 mm) this move takes X to 150.0200 "
+       "mm",
+       6},
   };
   for (const Case& c : cases) {
     const config::MachineProfile p = edm();
     Diagnostics d;
     SimRig rig(p, GcodeProgramSource::create(p, d));
     rig.step();
-    ASSERT_TRUE(rig.request(Request::simple(CommandKind::MachineOn)).accepted);
+    ASSERT_TRUE(on_and_homed(rig));
     ASSERT_TRUE(rig.request(Request::set_mode(Mode::Auto)).accepted);
     const Outcome o = rig.request(Request::open(write_program(c.program)), 100000);
     if (c.message.empty()) {
@@ -355,7 +389,7 @@ TEST(Edm, ThePreflightSeesTheOrbitAndTheJump) {
     ASSERT_FALSE(o.diagnostics.items().empty());
     const Diagnostic& first = o.diagnostics.items().front();
     EXPECT_EQ(first.code, "control.soft-limit");
-    EXPECT_EQ(first.line, 4u);
+    EXPECT_EQ(first.line, c.line) << c.program;
     EXPECT_NE(first.message.find(c.message), std::string::npos) << first.message;
   }
 }
@@ -368,6 +402,42 @@ TEST(Edm, ThePreflightRefusesAConditionTheMachineLacks) {
   EXPECT_EQ(d.code, "edm.condition");
   EXPECT_EQ(d.line, 3u);
   EXPECT_NE(d.message.find("1, 2, 3, 9"), std::string::npos) << d.message;
+}
+
+// The setter's seek of the end of the travel through the controller: the request, the note that
+// says where the switch tripped and where the axis rests, the status; C (no limit switch) refused
+// with the reason.
+TEST(EdmSeek, TheControllerSaysWhereTheLimitSwitchTripped) {
+  const config::MachineProfile p = edm({"axis.y.sim.start_position=95.0"});
+  Diagnostics d;
+  SimRig rig(p, GcodeProgramSource::create(p, d));
+  EventCursor events(rig.controller().events());
+  rig.step();
+  ASSERT_TRUE(rig.request(Request::simple(CommandKind::MachineOn)).accepted);
+  ASSERT_TRUE(rig.request(Request::set_mode(Mode::Manual)).accepted);
+  const Outcome refused = rig.request(Request::seek_limit(Axis::C, -1));
+  EXPECT_FALSE(refused.accepted);
+  EXPECT_EQ(refused.refusal, Refusal::NoLimitSwitch);
+  EXPECT_NE(refused.message.find("no limit switch on that side"), std::string::npos) << refused.message;
+  ASSERT_TRUE(rig.request(Request::seek_limit(Axis::Y, +1)).accepted);
+  bool running_shown = false;
+  ASSERT_TRUE(rig.run_until(
+      [&] {
+        running_shown = running_shown || rig.status().servo.seek[1].phase == SeekPhase::Search;
+        return rig.status().servo.state == State::Idle;
+      },
+      20000));
+  EXPECT_TRUE(running_shown);
+  std::string note;
+  for (const ControllerEvent& e : events.next()) {
+    if (e.code == "control.seek-limit") note = e.text;
+  }
+  const LimitSeekStatus st = rig.status().servo.seek[1];
+  EXPECT_TRUE(st.found);
+  EXPECT_NEAR(st.tripped_at, 101.0, 0.002);  // the switch's noise: 1 µm
+  EXPECT_NEAR(st.rest_at, 100.49, 0.002);    // not homed: 0.5 mm off where it released
+  EXPECT_EQ(note, fmt::format("Y's + limit switch trips at {:.4f} mm; the axis backed off to {:.4f} mm",
+                              st.tripped_at, st.rest_at));
 }
 
 }  // namespace

@@ -41,6 +41,11 @@ TEST_F(ApiParse, EachKindBecomesItsRequest) {
   EXPECT_EQ(by.distance, 0.1);
   EXPECT_FALSE(std::get<control::requests::Home>(request({{"kind", "home"}}).body).axis);
   EXPECT_EQ(std::get<control::requests::Home>(request({{"kind", "home"}, {"axis", "X"}}).body).axis, Axis::X);
+  const auto seek = std::get<control::requests::SeekLimit>(
+      request({{"kind", "seek-limit"}, {"axis", "Z"}, {"direction", "-"}}).body);
+  EXPECT_EQ(seek.axis, Axis::Z);
+  EXPECT_EQ(seek.direction, -1);
+  EXPECT_EQ(error({{"kind", "seek-limit"}, {"axis", "Z"}, {"direction", "up"}}).status, 400);
   EXPECT_EQ(request({{"kind", "override"}, {"which", "feed"}, {"value", 1.5}}).name(), "feed-override");
   EXPECT_EQ(request({{"kind", "switch"}, {"which", "single-block"}, {"on", true}}).name(), "single-block");
   EXPECT_EQ(std::get<control::requests::SetMode>(request({{"kind", "mode"}, {"mode", "mdi"}}).body).mode,
@@ -97,8 +102,8 @@ TEST_F(ApiParse, ProgramsStayInsideTheirFolder) {
 
 TEST(ApiRoles, AdminOnlyForToolDataOperatorForTheRest) {
   EXPECT_EQ(role_for("set-tool"), Role::Admin);
-  for (const char* k :
-       {"cycle-start", "feed-hold", "jog", "home", "open", "mdi", "tool-changed", "override", "run-from-line"}) {
+  for (const char* k : {"cycle-start", "feed-hold", "jog", "home", "open", "mdi", "tool-changed", "override",
+                        "run-from-line", "seek-limit"}) {
     EXPECT_EQ(role_for(k), Role::Operator) << k;
   }
   EXPECT_FALSE(role_for("fly"));
@@ -129,6 +134,16 @@ TEST(ApiJson, StatusCarriesWhatTheScreensShow) {
   const json m = machine_json(p);
   EXPECT_EQ(m["axes"].size(), 3u);
   EXPECT_EQ(m["axes"][0]["axis"], "X");
+  EXPECT_EQ(m["axes"][0]["seek"], json::array());  // the mill has no limit switches to seek
+  // A seek: only the axes that have been sought, with the phase and what it found.
+  EXPECT_EQ(w["seek"], json::object());
+  s.servo.seek[2] = {control::SeekPhase::Done, -1, true, -81.0004, -80.99, -80.0};
+  const json k = status_json(s, p)["seek"];
+  EXPECT_EQ(k.size(), 1u);
+  EXPECT_EQ(k["Z"]["phase"], "done");
+  EXPECT_EQ(k["Z"]["direction"], "-");
+  EXPECT_EQ(k["Z"]["tripped_at"], -81.0004);
+  EXPECT_EQ(k["Z"]["rest_at"], -80.0);
 }
 
 }  // namespace

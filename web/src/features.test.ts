@@ -10,6 +10,7 @@ import { dialogFor } from "./dialogs/waits";
 import { alarmLines, edmRows, loadBanner, loadText } from "./panels/process";
 import { retraceControls, retraceText } from "./panels/retrace";
 import { electrodeActions, resultLines } from "./screens/electrode";
+import { seekText } from "./screens/jog";
 import type { Status } from "./types";
 import type { JournalState } from "./types_features";
 
@@ -173,5 +174,19 @@ describe("electrode setting screen", () => {
     const failed = { ...result, ok: false, code: "electrode.far", message: "offsets 2 mm from the table's" };
     expect(electrodeActions(at(failed, true))).toEqual([]);
     expect(resultLines(failed as never)).toEqual(["T1: offsets 2 mm from the table's (electrode.far; nothing stored)"]);
+  });
+});
+
+describe("seek of a limit switch on the jog screen", () => {
+  it("shows the phase while a seek runs and what each found after", () => {
+    const seek = (k: object) => ({ ...base, seek: k }) as unknown as Status;
+    expect(seekText(seek({}))).toBe("");
+    expect(seekText(seek({ X: { phase: "latch", direction: "+", found: false, tripped_at: 0, rest_at: 0 } }))).toBe(
+      "X seeking its + limit: latch",
+    );
+    expect(
+      seekText(seek({ X: { phase: "done", direction: "+", found: true, tripped_at: 151.0003, rest_at: 150 },
+        Z: { phase: "failed", direction: "-", found: false, tripped_at: 0, rest_at: 0 } })),
+    ).toBe("X + limit at 151.0003, backed off to 150.0000 · Z: the − limit switch was not found");
   });
 });

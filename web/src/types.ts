@@ -37,6 +37,8 @@ export interface Status {
   following_error: Axes;
   homed: Record<string, boolean>;
   all_homed: boolean;
+  /** The seeks of limit switches: the phase while one runs, and what the last one found. */
+  seek: Record<string, LimitSeek>;
   path_velocity: number;
   feed_override: number;
   rapid_override: number;
@@ -81,6 +83,14 @@ export interface ControllerEvent {
   end?: string;
 }
 
+export interface LimitSeek {
+  phase: string;
+  direction: "+" | "-";
+  found: boolean;
+  tripped_at: number;
+  rest_at: number;
+}
+
 export interface MachineAxis {
   axis: string;
   rotary: boolean;
@@ -89,6 +99,8 @@ export interface MachineAxis {
   max_limit: number;
   max_velocity: number;
   homing: boolean;
+  /** The limit switches the axis can seek ("-", "+"). */
+  seek: string[];
 }
 
 export interface Machine {

@@ -42,6 +42,16 @@ struct HomingProfile {
   bool return_after_program = false;  ///< home again after every program that ends (M2/M30)
 };
 
+/// The seek-limit move of an axis (keys of `[axis.<letter>.switches]`): at `velocity` to a limit
+/// switch, off it and onto it again at `latch_velocity` (that trip is the one reported), then
+/// `back_off` past where it released (docs/machine.md, "Seeking a limit switch").
+struct LimitSeekProfile {
+  double overtravel = 0;      ///< units past a limit switch's trip point before the hard stop
+  double velocity = 0;        ///< seek_velocity, units/s; 0 = the axis has no seek
+  double latch_velocity = 0;  ///< seek_latch_velocity, units/s
+  double back_off = 0;        ///< seek_back_off, units beyond where the switch released
+};
+
 /// Most points of a pitch-error table (motion::kMaxPitchPoints, LinuxCNC's 256 too).
 inline constexpr int kMaxCompensationPoints = 256;
 
@@ -75,6 +85,7 @@ struct AxisProfile {
   double counts_per_unit = 1000;  ///< encoder counts (servo) or steps (stepper) per unit
   HomingProfile homing;
   machine::SwitchLayout switches;  ///< which switches exist, and where (the sim uses where)
+  LimitSeekProfile seek;           ///< the move that seeks the limit switches
   machine::SimJointModel sim;      ///< mechanics and drive of the simulated axis
   bool stall_detector = false;     ///< stepper: the drive reports stalls (a fault)
   /// Manual axis: how close to a programmed position the operator must bring it, units.

@@ -83,6 +83,9 @@ enum class CommandKind : std::uint8_t {
   /// `axis` = joint, `table_buffer` = 0/1: that joint's buffer of ServoChannels::pitch_tables is
   /// its new pitch-error table from the next ApplyJointLimits on (no effect yet)
   StagePitchTable,
+  /// `axis`, `value` = +1 / −1: jog to that limit switch, latch it slowly, back off onto its free
+  /// side (LimitSeek); Manual mode, idle, the axis with that switch and seek keys
+  SeekLimit,
 };
 
 /// Why a command was refused. Each has a stable code (refusal_code()).
@@ -106,6 +109,8 @@ enum class Refusal : std::uint8_t {
   Interlock,      ///< control.interlock: an interlock rule of the profile forbids it now
   HandAxis,       ///< control.hand-axis: the axis is moved by hand, or is not where the program needs it
   FeatureCheck,   ///< control.feature-check: a feature's check before the start failed (the message says why)
+  NoLimitSwitch,  ///< control.no-limit-switch: the axis has no limit switch that way to seek (or no seek
+                  ///< keys)
 };
 
 /// Stable problem code of a refusal ("control.busy", ...). Any thread; real-time safe.
@@ -123,6 +128,9 @@ enum class FaultKind : std::uint8_t {
   Stall,           ///< `axis`: the stepper drive detected a stall (steps were lost; home again)
   ProcessAlarm,    ///< a `stop` alarm: `axis` = the alarm's index, `value` = the input, `limit` = the bound
   EdmShort,  ///< the EDM gap stayed shorted: `axis` = the condition, `value` = seconds, `limit` = its limit
+  /// A seek of a homed axis went its soft limit + overtravel without the limit switch tripping:
+  /// `axis`, `value` = where it stopped, `limit` = the soft limit (the axis must home again)
+  SeekNoSwitch,
 };
 
 /// Stable problem code of a fault ("control.fault.following-error", ...). Any thread.
@@ -259,6 +267,9 @@ enum class EventKind : std::uint8_t {
   /// EDM: backing off reached the end of the path memory while the gap servo still drove back;
   /// the electrode holds there (`action` = the condition, `value` = how far behind the head, mm).
   EdmRetractLimit,
+  /// A seek of a limit switch ended: `axis`, `action` 1 = found (`value` = where the switch
+  /// tripped, machine position; the rest position is in the status), 0 = stopped before it.
+  LimitSeek,
 };
 
 struct ServoEvent {

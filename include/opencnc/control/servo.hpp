@@ -10,6 +10,7 @@
 #include "opencnc/control/channels.hpp"
 #include "opencnc/control/gap_servo.hpp"
 #include "opencnc/control/homing.hpp"
+#include "opencnc/control/limit_seek.hpp"
 #include "opencnc/control/servo_config.hpp"
 #include "opencnc/control/tickable.hpp"
 #include "opencnc/machine/machine_io.hpp"
@@ -119,6 +120,15 @@ class Servo final : public Tickable {
   void follow_hand_axes() noexcept;
   void start_homing(std::uint16_t joints) noexcept;
   void finish_homing(int j) noexcept;
+
+  // --- seeking a limit switch (servo_seek.cpp) -----------------------------------------------
+  Refusal seek_limit(const Command& c) noexcept;
+  void run_seeks() noexcept;
+  void cancel_seeks() noexcept;
+  void end_seek(int j) noexcept;
+  bool seeking(int j) const noexcept { return seeks_[static_cast<std::size_t>(j)].active(); }
+  /// The seek's own switch is on and the other limit switch is not (that one would be a fault).
+  bool sought_switch_only(int j) const noexcept;
 
   // --- interlocks (servo_interlocks.cpp) -----------------------------------------------------
   bool signal(const machine::RuleToken& t) const noexcept;
@@ -233,6 +243,9 @@ class Servo final : public Tickable {
   std::uint16_t homing_pending_ = 0;  ///< joints still to home, by bit
   std::uint16_t homing_active_ = 0;   ///< joints homing now
   std::array<HomingStatus, machine::kMaxJoints> homing_status_{};
+  std::array<LimitSeek, machine::kMaxJoints> seeks_{};
+  std::array<LimitSeekStatus, machine::kMaxJoints> seek_status_{};
+  std::uint16_t seeking_ = 0;  ///< a bit per joint whose seek runs
   std::array<double, machine::kMaxJoints> offset_before_homing_{};
   std::array<bool, machine::kMaxJoints> homed_once_{};
   std::int8_t handwheel_axis_ = -1;

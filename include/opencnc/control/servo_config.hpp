@@ -46,6 +46,14 @@ struct HomeConfig {
   bool return_after_program = false;  ///< home again when an Auto program ends (M2/M30)
 };
 
+/// The seek-limit move of a joint (LimitSeek; the profile's seek keys). velocity 0: no seek.
+struct LimitSeekConfig {
+  double velocity = 0;        ///< units/s, toward the switch
+  double latch_velocity = 0;  ///< units/s: off the switch and onto it again, the trip reported
+  double back_off = 0;        ///< units beyond where the switch released
+  double overtravel = 0;      ///< units past the trip point before the hard stop
+};
+
 /// One joint. The machine layer numbers joints in axis order, one joint per axis.
 struct JointConfig {
   std::int8_t axis = 0;  ///< Axis index (X = 0 … W = 8) this joint moves
@@ -60,6 +68,7 @@ struct JointConfig {
   double max_limit = 0;
   double max_following_error = 1;  ///< units
   HomeConfig home;
+  LimitSeekConfig seek;
   double hand_tolerance = 0.05;  ///< manual joints: how close the operator must come, units
 };
 

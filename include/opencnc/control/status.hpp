@@ -10,6 +10,7 @@
 #include "opencnc/control/command.hpp"
 #include "opencnc/control/edm_status.hpp"
 #include "opencnc/control/homing.hpp"
+#include "opencnc/control/limit_seek.hpp"
 #include "opencnc/control/load_guard.hpp"
 #include "opencnc/core/axes.hpp"
 #include "opencnc/machine/machine_io.hpp"
@@ -29,6 +30,17 @@ struct HomingStatus {
   /// axis was less where that homing found it (+ = believed further in +). Lost steps, or a
   /// reference that drifted, show here; 0 after the first homing.
   double origin_shift = 0;
+};
+
+/// One joint's seek of a limit switch as the status shows it (machine coordinates): the phase
+/// while it runs, and what the last one found.
+struct LimitSeekStatus {
+  SeekPhase phase = SeekPhase::Idle;
+  std::int8_t direction = 0;  ///< +1 / −1: the switch sought; 0 = no seek yet
+  bool found = false;         ///< the last seek latched its switch
+  double tripped_at = 0;      ///< where the switch tripped at latch velocity
+  double released_at = 0;     ///< where it released on the way off
+  double rest_at = 0;         ///< where the seek left the axis
 };
 
 /// A program waiting for a hand-fed axis (Wait::HandAxis), and then holding it there while the
@@ -123,6 +135,7 @@ struct ServoStatus {
 
   // Homing, compensation, hand axes, interlocks, handwheel (the drill retrofit).
   std::array<HomingStatus, machine::kMaxJoints> homing{};
+  std::array<LimitSeekStatus, machine::kMaxJoints> seek{};  ///< the seeks of the limit switches
   std::array<double, machine::kMaxJoints> compensation{};  ///< correction each joint gets now, units
   HandWait hand_wait{};                                    ///< what a Wait::HandAxis waits for
   /// The first `block spindle` rule holding now (what a Wait::Interlock waits on), −1 = none.

@@ -138,6 +138,7 @@ class Controller final : private FeatureHost {
   void take_attachments();
   std::string describe(const Fault& f) const;
   std::string interlock_text(const ServoEvent& e) const;
+  std::string seek_text(const ServoEvent& e) const;
   std::uint64_t new_id();
 
   config::MachineProfile profile_;

@@ -16,10 +16,13 @@ struct EdmReport {
   /// measured gap voltage was within ±10 % of the active condition's servo reference.
   double gap_voltage_in_band_fraction = 0;
   double machining_s = 0;
-  std::uint64_t shorts = 0;         ///< times the gap went into a short
-  std::uint64_t arc_periods = 0;    ///< servo periods in which the gap arced
-  std::uint64_t arcs = 0;           ///< times the gap went into arcing (from another state)
-  double short_recovery_max_s = 0;  ///< longest short: from its first period to a discharge again
+  std::uint64_t shorts = 0;            ///< times the gap went into a short
+  std::uint64_t shorts_uncleared = 0;  ///< of them, still shorted when their burn or the run ended
+  std::uint64_t arc_periods = 0;       ///< servo periods in which the gap arced
+  std::uint64_t arcs = 0;              ///< times the gap went into arcing (from another state)
+  /// Longest short: from its first period to a discharge again, or, for one that never cleared,
+  /// to the end of its burn (M181, the run's end, the fault that stopped it) or of the trace.
+  double short_recovery_max_s = 0;
   double depth_mm = 0;              ///< deepest burn: along the work's direction from its first discharge
   std::uint64_t jumps = 0;
 };
@@ -32,6 +35,8 @@ class EdmRecorder final : public ControllerObserver {
   EdmReport report() const;
 
  private:
+  void end_short(std::uint64_t tick, bool cleared);
+
   machine::EdmConfig edm_;
   double period_s_;
   EdmReport r_;
@@ -41,6 +46,7 @@ class EdmRecorder final : public ControllerObserver {
   machine::GapState last_ = machine::GapState::Open;
   std::uint64_t short_since_ = 0;
   bool shorted_ = false;
+  std::uint64_t last_tick_ = 0;  ///< the newest sample's
   bool first_ = true;
   std::uint32_t jumps_at_start_ = 0, jumps_now_ = 0;
 };

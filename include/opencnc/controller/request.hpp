@@ -57,6 +57,13 @@ struct JogStop {
 struct Home {
   std::optional<Axis> axis;
 };
+/// Seeks the axis' limit switch on the side of `direction` (+1 / −1): jogs to it, latches it
+/// slowly and backs off onto its free side; where it tripped comes as a note and in the status
+/// (ServoStatus::seek). Manual mode, idle.
+struct SeekLimit {
+  Axis axis = Axis::X;
+  int direction = 1;
+};
 struct SetOverride {
   OverrideKind which = OverrideKind::Feed;
   double value = 1;
@@ -136,7 +143,7 @@ using RequestBody =
                  requests::Home, requests::SetOverride, requests::SetSwitch, requests::SpindleOn,
                  requests::SetCoolant, requests::OpenFile, requests::OpenCanon, requests::Mdi,
                  requests::RunAuxiliary, requests::Feature, requests::SetHandwheel, requests::ResumeProgram,
-                 requests::EditProfile>;
+                 requests::EditProfile, requests::SeekLimit>;
 
 /// A request with its typed body. Build one with the helpers.
 struct Request {
@@ -149,6 +156,7 @@ struct Request {
   static Request jog_by(Axis a, double distance, double speed) { return {requests::JogBy{a, distance, speed}}; }
   static Request jog_stop(std::optional<Axis> a = {}) { return {requests::JogStop{a}}; }
   static Request home(std::optional<Axis> a = {}) { return {requests::Home{a}}; }
+  static Request seek_limit(Axis a, int direction) { return {requests::SeekLimit{a, direction}}; }
   static Request feed_override(double v) { return {requests::SetOverride{OverrideKind::Feed, v}}; }
   static Request rapid_override(double v) { return {requests::SetOverride{OverrideKind::Rapid, v}}; }
   static Request spindle_override(double v) { return {requests::SetOverride{OverrideKind::Spindle, v}}; }

@@ -20,6 +20,9 @@ struct SwitchWindow {
   bool present = false;
   double from = -kInf;
   double to = kInf;
+  /// A wrapped rotary axis' cam comes round every turn: the window repeats every `period` units
+  /// (360 degrees; 0 = once).
+  double period = 0;
 };
 
 /// An inductive proximity sensor with an analog output (the home sensor of decel_midpoint

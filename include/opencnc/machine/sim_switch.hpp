@@ -45,7 +45,12 @@ class SimSwitch {
     if (!window_.present) return false;
     const double jitter = noise_ > 0 ? noise_ * rng.symmetric() : 0.0;
     const double widen = active_ ? hysteresis_ : 0.0;
-    const double from = window_.from - widen + jitter, to = window_.to + widen + jitter;
+    // A window that repeats: the turn whose copy of the window is nearest to the position.
+    const double turn =
+        window_.period > 0
+            ? window_.period * std::round((position - 0.5 * (window_.from + window_.to)) / window_.period)
+            : 0.0;
+    const double from = window_.from + turn - widen + jitter, to = window_.to + turn + widen + jitter;
     active_ = position >= from && position <= to;
     // The switching point this evaluation used nearest to the position: where an edge happened.
     edge_ = std::abs(position - from) <= std::abs(position - to) ? from : to;
