@@ -17,9 +17,11 @@
 #include "cli_files.hpp"
 #include "commands.hpp"
 #include "edm_report.hpp"
+#include "electrode_change.hpp"
 #include "gcode_summary.hpp"
 #include "numeric_options.hpp"
 #include "opencnc/controller/edm_recorder.hpp"
+#include "opencnc/controller/electrode_setting.hpp"
 #include "opencnc/controller/gcode_source.hpp"
 #include "opencnc/controller/power_fail_recorder.hpp"
 #include "opencnc/controller/preflight.hpp"
@@ -48,6 +50,7 @@ struct RunOptions {
                                          ///< "analog:CH=VALUE@SECONDS[/RAMP_S]"
   std::vector<std::string> retraces;     ///< "AT_SECONDS:X,Y"
   std::string journal;                   ///< the breakpoint journal's folder ("" = none)
+  std::vector<std::string> electrode_changes;  ///< "AT_SECONDS:X,Y,Z"
 };
 
 /// One scripted retrace: at `at_s` seconds into the run, pause, jog to (x, y), start.
@@ -447,6 +450,22 @@ int run(const RunOptions& o) {
     }
     session.edm_short_s = at.edm_short_s;
   }
+  if (!o.electrode_changes.empty()) {
+    if (o.session.realtime || o.session.hal) {
+      fmt::print(stderr,
+                 "error: --electrode-change works in virtual time only (not with --realtime or --hal)\n");
+      return kExitUsage;
+    }
+    if (profile && !(profile->probe.reference_sphere.present && profile->probe.reference_sphere.sim)) {
+      fmt::print(
+          stderr,
+          "error: --electrode-change needs a simulated reference sphere ([probe.reference_sphere.sim] in "
+          "{})\n",
+          o.session.machine);
+      return kExitUsage;
+    }
+    session.tool_table_in_memory = true;  // the simulated electrodes' offsets stay out of the table file
+  }
   std::optional<control::TraceCsvWriter> csv;
   std::optional<ProgressBar> bar;
   const bool tty = ::isatty(STDOUT_FILENO) != 0;
@@ -497,10 +516,24 @@ int run(const RunOptions& o) {
     if (!profile || !(journal = open_run_journal(o.journal, *profile))) return kExitUsage;
     hooks.features_trace = true;
   }
-  if (!steps.empty() || journal) {
-    hooks.features = [&](const config::MachineProfile& machine) {
+  // --electrode-change: the electrode feature on the program's tool table and the scripted operator.
+  std::vector<ElectrodeChangeAt> changes;
+  for (const std::string& text : o.electrode_changes) changes.push_back(*parse_electrode_change(text));
+  std::optional<ElectrodeChangeScript> changer;
+  if (!steps.empty() || journal || !changes.empty()) {
+    hooks.features = [&](const config::MachineProfile& machine,
+                         const std::shared_ptr<tools::ToolTableService>& tools) {
       std::vector<std::shared_ptr<control::Feature>> out;
       if (journal) out.push_back(journal);
+      if (!changes.empty()) {
+        auto electrode = std::make_shared<control::ElectrodeSetting>(tools, machine);
+        const Axis axis = machine.edm.present ? static_cast<Axis>(machine.edm.config.tool_axis) : Axis::Z;
+        const config::AxisProfile* a = machine.find(axis);
+        const double lift = machine.edm.present ? 10.0 * machine.edm.config.lift_direction : 10.0;
+        changer.emplace(changes, electrode, axis, lift, a != nullptr ? a->min_limit : -1e9,
+                        a != nullptr ? a->max_limit : 1e9);
+        out.push_back(electrode);
+      }
       if (steps.empty()) return out;
       Diagnostics d;
       feature = std::make_shared<recovery::RetraceFeature>(control::GcodeProgramSource::create(machine, d),
@@ -510,9 +543,15 @@ int run(const RunOptions& o) {
       return out;
     };
   }
-  if (!steps.empty()) {
-    hooks.tick = [&](control::Controller& c, const control::ControllerStatus& st) { script->tick(c, st); };
-    hooks.goes_on = [&](const control::ControllerEvent& e) { return script->goes_on(e); };
+  if (!steps.empty() || !changes.empty()) {
+    if (!changes.empty()) hooks.features_trace = true;  // the electrode feature follows the program's segment
+    hooks.tick = [&](control::Controller& c, const control::ControllerStatus& st, machine::SimMachine* sim) {
+      if (script) script->tick(c, st);
+      if (changer) changer->tick(c, st, sim);
+    };
+    hooks.goes_on = [&](const control::ControllerEvent& e) {
+      return (script && script->goes_on(e)) || (changer && changer->goes_on(e));
+    };
   }
   const StopSignals signals;  // Ctrl-C: a controlled stop, and the report says so
   session.stop = &StopSignals::requested();
@@ -548,6 +587,17 @@ int run(const RunOptions& o) {
                  x.b[0], x.b[1], x.c[0], x.c[1], x.distance_mm, x.segment, x.line);
     }
     j["retraces"] = retraces_json(records, script->times());
+  }
+  if (changer) {
+    for (const ElectrodeChangeRecord& x : changer->records()) {
+      const control::ElectrodeResult& m = x.measured;
+      fmt::print(
+          "electrode change    at {:.3f} s, tool {}, segment {}: measured X{:.4f} Y{:.4f} Z{:.4f} (was "
+          "X{:.4f} Y{:.4f} Z{:.4f}), {}\n",
+          x.at_s, x.tool, x.segment, m.offset[0], m.offset[1], m.offset[2], m.previous[0], m.previous[1],
+          m.previous[2], x.resumed ? "resumed" : "not resumed");
+    }
+    j["electrode_changes"] = changer->json();
   }
   if (journal) j["journal"] = finish_run_journal(*journal, o.journal, end.sim_bore);
   if (report_file != nullptr && !write_and_commit(*report_file, j.dump(2) + "\n")) rc = kExitUsage;
@@ -612,6 +662,23 @@ void add_run_command(CLI::App& app, Registry& registry) {
                                     : "expected AT_SECONDS:X,Y (seconds into the run, mm), e.g. 12.5:100,40";
           },
           "AT_SECONDS:X,Y"));
+  cmd->add_option(
+         "--electrode-change", opts->electrode_changes,
+         "Script the EDM operator who replaces a worn electrode (virtual time, a simulated reference "
+         "sphere): at AT_SECONDS into the run feed hold and abort, lift the electrode 10 mm along the "
+         "tool axis, put in a new one whose true offsets are X,Y,Z (mm), measure it on the sphere, store "
+         "it (in a copy of the tool table) and resume where the job stopped (repeatable; the report "
+         "lists them as `electrode_changes`; docs/edm.md)")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
+      ->excludes("--retrace")
+      ->check(CLI::Validator(
+          [](const std::string& s) {
+            return parse_electrode_change(s) ? std::string()
+                                             : "expected AT_SECONDS:X,Y,Z (seconds into the run, mm), e.g. "
+                                               "20:0.02,-0.01,0.05";
+          },
+          "AT_SECONDS:X,Y,Z"));
   cmd->callback([opts, &registry] { registry.set_result(run(*opts)); });
 }
 

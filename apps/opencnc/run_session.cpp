@@ -63,6 +63,8 @@ class Driver {
   virtual void drive_analog(int /*channel*/, double /*value*/, double /*ramp_s*/) {}
   /// The simulated broach's workpiece (virtual time only: empty otherwise).
   virtual std::vector<float> sim_bore() { return {}; }
+  /// The simulated machine (virtual time only; null elsewhere).
+  virtual machine::SimMachine* sim_machine() { return nullptr; }
   /// The simulated spark gap's figures (virtual time only; nothing elsewhere).
   virtual std::optional<SimEdmFigures> sim_edm() { return std::nullopt; }
 };
@@ -80,6 +82,7 @@ class VirtualDriver final : public Driver {
   void cut_mains() override { rig_.machine().set_mains_ok(false); }
   void set_tool_dull(double factor) override { rig_.machine().set_tool_dull(factor); }
   void inject_edm_short() override { rig_.machine().inject_edm_short(); }
+  machine::SimMachine* sim_machine() override { return &rig_.machine(); }
   void drive_analog(int channel, double value, double ramp_s) override {
     machine::SimMachine& m = rig_.machine();
     if (ramp_s > 0) {
@@ -424,7 +427,7 @@ void follow(Driver& d, control::EventCursor& cursor, const SessionOptions& o, co
     }
     if (hooks.progress && (++n % 256 == 0)) hooks.progress(st, wall);
     bring_hand_axis(d, st.servo);
-    if (hooks.tick) hooks.tick(d.controller(), st);
+    if (hooks.tick) hooks.tick(d.controller(), st, d.sim_machine());
     if (ended && hooks.goes_on && hooks.goes_on(*ended)) {
       job = 0;  // the job that resumes the program is followed next
       ended.reset();
@@ -526,7 +529,7 @@ SessionEnd run_session(const SessionOptions& o, const SessionHooks& hooks) {
   }
   Diagnostics diags;
   // The profile's G-code source; with [tool_guard], the tool store and the guard's feature.
-  std::optional<toolguard::Setup> setup = toolguard::setup(end.profile, diags);
+  std::optional<toolguard::Setup> setup = toolguard::setup(end.profile, diags, o.tool_table_in_memory);
   print(diags);
   if (!setup) return end;
   const std::shared_ptr<control::ProgramSource> source = setup->source;
@@ -557,7 +560,7 @@ SessionEnd run_session(const SessionOptions& o, const SessionHooks& hooks) {
   Driver& d = *driver;
   if (setup->feature) d.controller().add_feature(setup->feature);
   if (hooks.features) {
-    for (auto& f : hooks.features(end.profile))
+    for (auto& f : hooks.features(end.profile, setup->source->tools()))
       d.controller().add_feature(std::move(f),
                                  control::ObserverOptions{end.profile.servo_period_s, hooks.features_trace});
   }

@@ -15,6 +15,11 @@
 #include "opencnc/config/machine_profile.hpp"
 #include "opencnc/control/status.hpp"
 #include "opencnc/controller/controller.hpp"
+#include "opencnc/tools/tool_table_service.hpp"
+
+namespace opencnc::machine {
+class SimMachine;
+}
 
 namespace opencnc::cli {
 
@@ -44,6 +49,9 @@ struct SessionOptions {
     double value = 0, at_s = 0, ramp_s = 0;
   };
   std::optional<AnalogInjection> analog;
+  /// The program's tool table is a copy in memory: what the run changes in it (a simulated
+  /// electrode's measurement, `run --electrode-change`) does not reach the profile's file.
+  bool tool_table_in_memory = false;
 };
 
 /// The simulated spark gap's ground truth at the end of a run in virtual time (docs/edm.md):
@@ -82,11 +90,15 @@ struct SessionHooks {
   std::function<void(const control::ControllerStatus&, double elapsed_wall_s)> progress;
   /// Features added to the controller before the program is opened (the retrace feature), each
   /// following the status every servo period.
-  std::function<std::vector<std::shared_ptr<control::Feature>>(const config::MachineProfile&)> features;
+  /// They get the program source's tool table (G43 reads it, electrode setting writes it).
+  std::function<std::vector<std::shared_ptr<control::Feature>>(
+      const config::MachineProfile&, const std::shared_ptr<tools::ToolTableService>&)>
+      features;
   /// The features follow the trace too (the breakpoint journal reads the interrupted move from it).
   bool features_trace = false;
-  /// Every period of the run, with the controller: a scripted operator (`run --retrace`).
-  std::function<void(control::Controller&, const control::ControllerStatus&)> tick;
+  /// Every period of the run, with the controller and (in virtual time, else null) the simulated
+  /// machine: a scripted operator (`run --retrace`, `run --electrode-change`).
+  std::function<void(control::Controller&, const control::ControllerStatus&, machine::SimMachine*)> tick;
   /// When the program's job ends: true if the session goes on with the job that resumes it.
   std::function<bool(const control::ControllerEvent&)> goes_on;
 };

@@ -78,6 +78,9 @@ machine::SimMachineConfig sim_machine_config(const MachineProfile& profile) {
     c.broach.present = c.broach.stroke_joint >= 0 && c.broach.rotary_joint >= 0 && c.broach.radial_joint >= 0;
   }
   c.edm = profile.edm.sim;
+  for (const machine::SimElectrode& e : profile.sim_electrodes)  // the reader kept them within the array
+    if (c.electrode_count < machine::kMaxSimElectrodes)
+      c.electrodes[static_cast<std::size_t>(c.electrode_count++)] = e;
   c.digital_inputs = profile.io.digital_inputs;
   c.digital_outputs = profile.io.digital_outputs;
   c.analog_inputs = profile.io.analog_inputs;

@@ -220,6 +220,10 @@ void read_edm_sim(Section& s, MachineProfile& p) {
   c.present = true;
   const AxisProfile* tool = p.find(static_cast<Axis>(p.edm.config.tool_axis));
   c.joint = static_cast<std::int8_t>(tool != nullptr ? tool->joint : 0);
+  const auto offset_axis = [](const AxisProfile* a) {  // X, Y, Z carry the tool table's offsets
+    return static_cast<std::int8_t>(a != nullptr && index(a->axis) < 3 ? index(a->axis) : -1);
+  };
+  c.offset_axis = offset_axis(tool);
   c.surface_mm = m.number_or("surface_mm", c.surface_mm);
   c.work_direction = m.choice<double>("work", {{"-", -1.0}, {"+", 1.0}}, -p.edm.config.lift_direction);
   c.electrode_area_mm2 = m.number_or("electrode_area_mm2", c.electrode_area_mm2, Bound::Positive);
@@ -237,6 +241,7 @@ void read_edm_sim(Section& s, MachineProfile& p) {
   for (int i = 0; i < 2; ++i) {  // the orbit's plane: the electrode's lateral position
     const AxisProfile* a = p.find(static_cast<Axis>(e.orbit_axes[i]));
     c.lateral_joints[i] = static_cast<std::int8_t>(a != nullptr ? a->joint : -1);
+    c.lateral_offset_axes[i] = offset_axis(a);
   }
   for (int i = 0; i < e.condition_count; ++i) {
     const EdmCondition& k = e.conditions[static_cast<std::size_t>(i)];

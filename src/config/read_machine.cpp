@@ -48,7 +48,8 @@ void read_sim(Section& top, MachineProfile& profile) {
   profile.sim_substeps = std::max(1, static_cast<int>(std::lround(period / kDefaultSubstep)));
   const toml::table* t = top.subtable("sim");
   if (t == nullptr) return;
-  Section s(*t, "sim", {"substep_s", "seed", "linear_periods", "temperature_c"}, top.reporter());
+  Section s(*t, "sim", {"substep_s", "seed", "linear_periods", "temperature_c", "electrode"}, top.reporter());
+  read_sim_electrodes(s, profile);
   profile.sim_temperature_c = s.number_or("temperature_c", profile.sim_temperature_c);
   if (const auto h = s.number("substep_s", Bound::Positive)) {
     const double n = period / *h;

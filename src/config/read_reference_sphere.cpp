@@ -1,8 +1,10 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Reading [probe.reference_sphere]: the sphere electrodes are set against, and its simulation.
+// Reading [probe.reference_sphere]: the sphere electrodes are set against, and its simulation;
+// [[sim.electrode]]: the simulated electrodes it measures.
 #include <fmt/format.h>
 
 #include <cmath>
+#include <limits>
 
 #include "sections.hpp"
 
@@ -104,6 +106,37 @@ void read_reference_sphere(Section& probe, MachineProfile& profile) {
   read_sim(s, r);
   if (r.sim_turns_with_b && profile.find(Axis::B) == nullptr)
     s.error("sim", "probe.reference_sphere.sim.b_axis: the profile has no B axis", "config.range");
+}
+
+// Each [[sim.electrode]]: a tool number (once), its true offsets and its tip's radius.
+void read_sim_electrodes(Section& sim, MachineProfile& profile) {
+  const toml::node* n = sim.find("electrode");
+  if (n == nullptr) return;
+  const toml::array* list = n->as_array();
+  if (list == nullptr || !list->is_array_of_tables() ||
+      list->size() > static_cast<std::size_t>(machine::kMaxSimElectrodes)) {
+    sim.error("electrode",
+              fmt::format("sim.electrode must be an array of tables ([[sim.electrode]]), at most {}",
+                          machine::kMaxSimElectrodes),
+              "config.type");
+    return;
+  }
+  for (std::size_t i = 0; i < list->size(); ++i) {
+    Section t(*(*list)[i].as_table(), fmt::format("sim.electrode[{}]", i + 1),
+              {"tool", "offset", "tip_radius"}, sim.reporter());
+    machine::SimElectrode e;
+    const auto tool = t.integer("tool", 1, std::numeric_limits<std::int32_t>::max());
+    if (!tool && !t.has("tool")) t.missing("tool");
+    e.tool = static_cast<std::int32_t>(tool.value_or(0));
+    for (const machine::SimElectrode& other : profile.sim_electrodes)
+      if (e.tool != 0 && other.tool == e.tool)
+        t.error("tool",
+                fmt::format("{}: tool {} has a simulated electrode already", t.key_path("tool"), e.tool),
+                "config.range");
+    read_point(t, "offset", e.offset);
+    e.tip_radius = t.number_or("tip_radius", 0, Bound::NonNegative);
+    profile.sim_electrodes.push_back(e);
+  }
 }
 
 }  // namespace opencnc::config::detail

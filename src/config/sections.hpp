@@ -22,6 +22,8 @@ void read_power(Section& top, MachineProfile& profile);
 void read_probe(Section& top, MachineProfile& profile);
 /// [probe.reference_sphere] (read_probe calls it). Needs the axes.
 void read_reference_sphere(Section& probe, MachineProfile& profile);
+/// [[sim.electrode]]: the tools' true electrodes in the simulation (read_sim calls it).
+void read_sim_electrodes(Section& sim, MachineProfile& profile);
 void read_tool_changer(Section& top, MachineProfile& profile);
 void read_io(Section& top, MachineProfile& profile);
 /// [process] with [process.cutting] and [process.broaching]. Needs [io], the axes and [coupling].

@@ -459,6 +459,7 @@ void Servo::check_probe() noexcept {
   }
   if (!in_.probe || probe_tripped_) return;
   probe_tripped_ = true;
+  probe_run_ = run_id_;
   // Where the probe tripped: the machine's latch of the edge when it has one, else the middle of
   // the last two samples (the edge lies between them: half the error of either).
   const bool latched = probe_edge_latched_;
@@ -479,7 +480,9 @@ void Servo::end_run(RunEnd why) noexcept {
   traj::BlockQueue& q = channels_->blocks;
   q.pop(q.available());
   channels_->actions.drop_until(~std::uint64_t{0});
-  if (why == RunEnd::Aborted && probe_tripped_) why = RunEnd::ProbeTripped;
+  // Only this run's probe move stops it as a probe's stop: the latch of an earlier run's (the
+  // electrode setting's touches) stays for the status, and an abort now is an abort.
+  if (why == RunEnd::Aborted && probe_tripped_ && probe_run_ == run_id_) why = RunEnd::ProbeTripped;
   ServoEvent e;
   e.kind = EventKind::RunEnded;
   e.run_id = run_id_;

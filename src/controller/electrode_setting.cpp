@@ -339,7 +339,9 @@ Outcome ElectrodeSetting::resume(FeatureHost& host) {
   b.set_motion_control_mode(canon::MotionControl::ExactPath, 0);
   Pose p = s.servo.commanded;
   canon::SegmentId id = 0;
-  const double travel_z = std::max({p[2], sphere_.safe_z, target[2]});
+  // Over at a height from which the last `clearance` down is at the probe feed: a stop point above
+  // safe_z (a sinker's work above the sphere) is not come at sideways.
+  const double travel_z = std::max({p[2], sphere_.safe_z, target[2] + sphere_.clearance});
   const auto traverse = [&](const Pose& to) {
     if (to == p) return;
     b.straight_traverse(id++, to);

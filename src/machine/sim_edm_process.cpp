@@ -50,6 +50,11 @@ void SimEdmProcess::mount(std::int32_t tool) noexcept {
   wear_[static_cast<std::size_t>(electrode_)] = 0;  // a new electrode (or one too many: the last slot anew)
 }
 
+void SimEdmProcess::replace(std::int32_t tool) noexcept {
+  for (int e = 0; e < electrodes_; ++e)
+    if (tool_[static_cast<std::size_t>(e)] == tool) wear_[static_cast<std::size_t>(e)] = 0;
+}
+
 double SimEdmProcess::electrode_wear_max_mm() const noexcept {
   double w = 0;
   for (int e = 0; e < electrodes_; ++e) w = std::max(w, wear_[static_cast<std::size_t>(e)]);

@@ -47,6 +47,7 @@ SimMachine::SimMachine(const SimMachineConfig& config) : config_(config), rng_(c
   if (config.broach.present) broach_ = SimBroachLoad(config.broach, config.seed);
   temperature_c_ = config.temperature_c;
   if (config.edm.present) edm_.configure(config.edm, config.servo_period_s);
+  mount(0);  // the spindle holds tool 0 (or its simulated electrode) until a change
   analog_in_ = config.analog_in;
   dc_link_v_ = config.power.dc_link_nominal_v;
   ups_periods_left_ =
@@ -175,24 +176,55 @@ void SimMachine::update_broach() noexcept {
                  joints_[static_cast<std::size_t>(b.radial_joint)].table_position());
 }
 
-// The spark gap sees the electrode where the feed joint's table is (and across the tool axis
-// where the lateral joints' are), the work turned by the orientation joints (B, C), and the
-// generator's outputs of this period. A tool change puts another electrode in.
+// The spark gap sees the true electrode's tip: the feed joint's table less the electrode's offset
+// along it (and across the tool axis the lateral joints' less theirs), the work turned by the
+// orientation joints (B, C), and the generator's outputs of this period.
 void SimMachine::step_edm() noexcept {
   const SimEdmConfig& e = config_.edm;
   const auto table = [&](int j) {
     return j >= 0 && j < config_.joint_count ? joints_[static_cast<std::size_t>(j)].table_position() : 0.0;
   };
+  const auto offset = [&](int axis) {
+    return axis >= 0 ? electrode_.offset[static_cast<std::size_t>(axis)] : 0.0;
+  };
   SimEdmPose pose;
-  pose.feed = table(e.joint);
+  pose.feed = table(e.joint) - offset(e.offset_axis);
   for (int i = 0; i < 2; ++i) {
     pose.orientation[i] = table(e.orientation_joints[i]);
-    pose.lateral[i] = table(e.lateral_joints[i]);
+    pose.lateral[i] = table(e.lateral_joints[i]) - offset(e.lateral_offset_axes[i]);
   }
-  const bool changed = config_.tool_changer.present && tool_.change && change_periods_ >= change_needed_;
-  if (changed && !edm_tool_changed_) edm_.mount(tool_.prepare_tool);
-  edm_tool_changed_ = changed;
   edm_.step(pose, config_.process.generator && process_.generator_on, process_.generator, rng_);
+}
+
+// A tool change puts `tool`'s true electrode in: the spark gap burns with it (and its own wear),
+// the reference sphere is touched with it.
+void SimMachine::mount(std::int32_t tool) noexcept {
+  mounted_tool_ = tool;
+  electrode_ = SimElectrode{tool, {}, 0};
+  for (int k = 0; k < config_.electrode_count; ++k)
+    if (config_.electrodes[static_cast<std::size_t>(k)].tool == tool)
+      electrode_ = config_.electrodes[static_cast<std::size_t>(k)];
+  if (config_.edm.present) edm_.mount(tool);
+}
+
+void SimMachine::replace_electrode(std::int32_t tool, const std::array<double, 3>& offset,
+                                   double tip_radius) noexcept {
+  int k = 0;
+  while (k < config_.electrode_count && config_.electrodes[static_cast<std::size_t>(k)].tool != tool) ++k;
+  if (k == kMaxSimElectrodes) return;
+  if (k == config_.electrode_count) ++config_.electrode_count;
+  config_.electrodes[static_cast<std::size_t>(k)] = SimElectrode{tool, offset, tip_radius};
+  if (config_.edm.present) edm_.replace(tool);
+  if (tool == mounted_tool_) electrode_ = config_.electrodes[static_cast<std::size_t>(k)];
+}
+
+// The mounted electrode's offsets as the sphere sees them: shorter along the tool axis by its wear.
+std::array<double, 3> SimMachine::worn_offset() const noexcept {
+  std::array<double, 3> o = electrode_.offset;
+  const SimEdmConfig& e = config_.edm;
+  if (e.present && e.offset_axis >= 0)
+    o[static_cast<std::size_t>(e.offset_axis)] += e.work_direction * edm_.electrode_wear_mm();
+  return o;
 }
 
 // Mains on: the rectifier holds the DC link at nominal. Mains off with a charged UPS: the
@@ -230,6 +262,9 @@ void SimMachine::update_auxiliaries() noexcept {
   prepare_periods_ = changer && tool_.prepare ? prepare_periods_ + 1 : 0;
   change_periods_ = changer && tool_.change ? change_periods_ + 1 : 0;
   arc_periods_ = config_.process.torch && process_.torch_on && arc_available_ ? arc_periods_ + 1 : 0;
+  const bool changed = changer && tool_.change && change_periods_ >= change_needed_;
+  if (changed && !tool_changed_) mount(tool_.prepare_tool);
+  tool_changed_ = changed;
   for (std::size_t k = 0; k < analog_in_.size(); ++k) {
     if (analog_rate_[k] == 0) continue;
     const double step = analog_rate_[k] * config_.servo_period_s, gap = analog_target_[k] - analog_in_[k];
@@ -304,6 +339,7 @@ void SimMachine::sample_sphere_probe() noexcept {
   }
   const int b = config_.probe.sphere.b_joint;
   if (b >= 0 && b < config_.joint_count) sphere_.turn(joints_[static_cast<std::size_t>(b)].table_position());
+  sphere_.set_electrode(worn_offset(), electrode_.tip_radius);
   const bool was = inputs_.probe;
   inputs_.probe = sphere_.update(p, rng_);
   if (inputs_.probe == was) return;

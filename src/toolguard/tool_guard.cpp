@@ -8,6 +8,7 @@
 #include "check_code.hpp"
 #include "opencnc/gcode/standard_extensions.hpp"
 #include "opencnc/tools/edge_mapping.hpp"
+#include "opencnc/tools/tool_table_service.hpp"
 
 namespace opencnc::toolguard {
 
@@ -140,9 +141,12 @@ control::Outcome ToolGuard::handle(const control::requests::Feature& request, co
   return o;
 }
 
-std::optional<Setup> setup(const config::MachineProfile& profile, Diagnostics& diags) {
+std::optional<Setup> setup(const config::MachineProfile& profile, Diagnostics& diags,
+                           bool tool_table_in_memory) {
   std::optional<control::GcodeSourceConfig> c = control::GcodeProgramSource::config_for(profile, diags);
   if (!c) return std::nullopt;
+  if (tool_table_in_memory && c->tools && !profile.tool_guard.present)
+    c->tools = std::make_shared<tools::MemoryToolTable>(*c->tools->snapshot());
   Setup s;
   const config::ToolGuardProfile& g = profile.tool_guard;
   if (g.present) {

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// [probe.reference_sphere]: read into the profile and its simulated machine, and bad values
-// rejected at file:line:col.
+// [probe.reference_sphere] and [[sim.electrode]]: read into the profile and its simulated
+// machine, and bad values rejected at file:line:col.
 #include <gtest/gtest.h>
 
 #include <string>
@@ -62,6 +62,22 @@ TEST(ReferenceSphere, IsReadWithItsDefaultsAndMadeTheSimulatedProbe) {
   EXPECT_EQ(c.probe.sphere.b_joint, -1) << "no B: the sphere does not turn";
 }
 
+TEST(SimElectrodes, AreReadIntoTheSimulatedMachine) {
+  const ProfileLoad load =
+      parse_profile(kBase + kSphere +
+                        "[sim]\n[[sim.electrode]]\ntool = 3\noffset = [0.1, -0.2, 50.5]\n"
+                        "tip_radius = 0.8\n[[sim.electrode]]\ntool = 4\noffset = [0, 0, 40]\n",
+                    "p.toml");
+  ASSERT_TRUE(load.ok()) << first_error(load);
+  const machine::SimMachineConfig c = sim_machine_config(*load.profile);
+  ASSERT_EQ(c.electrode_count, 2);
+  EXPECT_EQ(c.electrodes[0].tool, 3);
+  EXPECT_EQ(c.electrodes[0].offset, (std::array<double, 3>{0.1, -0.2, 50.5}));
+  EXPECT_EQ(c.electrodes[0].tip_radius, 0.8);
+  EXPECT_EQ(c.electrodes[1].tool, 4);
+  EXPECT_EQ(c.electrodes[1].tip_radius, 0.0) << "a point tip unless said";
+}
+
 struct Bad {
   const char* name;
   std::string extra;
@@ -98,6 +114,20 @@ INSTANTIATE_TEST_SUITE_P(
             "p.toml:23:10: error: probe.reference_sphere.sim.b_axis must be [x, z]"},
         Bad{"SimBAxisWithoutAxisB", kSphere + "[probe.reference_sphere.sim]\nb_axis = [1, 2]\n",
             "p.toml:22:1: error: probe.reference_sphere.sim.b_axis: the profile has no B axis"},
+        Bad{"SimElectrodeNotATable", "[sim]\nelectrode = 3\n",
+            "p.toml:19:13: error: sim.electrode must be an array of tables"},
+        Bad{"SimElectrodeWithoutTool", "[sim]\n[[sim.electrode]]\noffset = [0, 0, 1]\n",
+            "p.toml:19:1: error:"},
+        Bad{"SimElectrodeTwice",
+            "[sim]\n[[sim.electrode]]\ntool = 2\noffset = [0, 0, 1]\n[[sim.electrode]]\ntool = 2\noffset = "
+            "[0, 0, "
+            "2]\n",
+            "p.toml:23:8: error: sim.electrode[2].tool: tool 2 has a simulated electrode already"},
+        Bad{"SimElectrodeOffsetNotThreeNumbers", "[sim]\n[[sim.electrode]]\ntool = 2\noffset = [0, 1]\n",
+            "p.toml:21:10: error: sim.electrode[1].offset must be [x, y, z]"},
+        Bad{"SimElectrodeNegativeTip",
+            "[sim]\n[[sim.electrode]]\ntool = 2\noffset = [0, 0, 1]\ntip_radius = -1\n",
+            "p.toml:22:14: error:"},
         Bad{"BothSimulations",
             kSphere + "[probe.reference_sphere.sim]\n[probe.sim]\naxis = \"z\"\ntrip = [-inf, 0]\n",
             "p.toml:23:1: error: [probe.sim] and [probe.reference_sphere.sim] exclude each other"}),

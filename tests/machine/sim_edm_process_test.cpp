@@ -221,6 +221,8 @@ TEST(SimEdmProcess, TheElectrodeWearsByTheConditionsRatio) {
   c.p.mount(0);
   EXPECT_EQ(c.p.electrode_wear_mm(), worn);
   EXPECT_EQ(c.p.electrode_wear_max_mm(), worn);
+  c.p.replace(0);  // a new electrode for tool 0: its wear starts again
+  EXPECT_EQ(c.p.electrode_wear_mm(), 0.0);
 }
 
 }  // namespace

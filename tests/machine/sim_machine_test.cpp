@@ -315,6 +315,43 @@ TEST(SimMachine, ToolChangerAcknowledgesAfterItsTimes) {
   EXPECT_TRUE(in.tool.changed);
 }
 
+TEST(SimMachine, AToolChangeMountsTheToolsTrueElectrodeInTheGapAndAtTheSphere) {
+  SimMachineConfig c = machine_config();
+  c.probe.joint = -1;
+  c.probe.sphere.present = true;  // far away: only the electrode it sees matters here
+  c.probe.sphere.joints = {0, 1, 2};
+  c.probe.sphere.centre = {500, 0, 0};
+  c.probe.sphere.radius = 5;
+  c.edm.present = true;
+  c.edm.joint = 2;
+  c.edm.offset_axis = 2;
+  c.edm.surface_mm = -0.5;  // the work 0.5 mm below the holder at Z 0
+  c.edm.noise_v = 0;
+  c.electrodes[0] = SimElectrode{5, {0.1, 0.2, 0.3}, 0.8};
+  c.electrode_count = 1;
+  SimMachine m(c);
+  MachineOutputs out = holding();
+  out.process.generator_on = true;
+  out.process.generator.voltage_v = 100;
+  m.write(out);
+  EXPECT_EQ(m.mounted_tool(), 0);
+  EXPECT_NEAR(m.edm().gap_mm(), 0.5, 1e-9) << "no electrode known: its tip is at the holder";
+  out.tool.prepare_tool = 5;
+  out.tool.change = true;
+  for (int k = 0; k < 2000; ++k) m.write(out);
+  EXPECT_EQ(m.mounted_tool(), 5);
+  m.write(out);
+  EXPECT_NEAR(m.edm().gap_mm(), 0.2, 1e-9) << "tool 5's electrode is 0.3 mm long";
+  EXPECT_EQ(m.sphere_probe().offset(), (std::array<double, 3>{0.1, 0.2, 0.3}));
+  EXPECT_EQ(m.sphere_probe().tip_radius(), 0.8);
+  // The operator replaces it with a shorter one: the gap and the sphere see it at once.
+  m.replace_electrode(5, {0, 0, 0.1}, 0);
+  m.write(out);
+  EXPECT_NEAR(m.edm().gap_mm(), 0.4, 1e-9);
+  EXPECT_EQ(m.sphere_probe().offset(), (std::array<double, 3>{0, 0, 0.1}));
+  EXPECT_EQ(m.electrode().tool, 5);
+}
+
 TEST(SimMachine, TorchArcNeedsItsDelayAndGas) {
   SimMachine m(machine_config());
   MachineOutputs out = holding();

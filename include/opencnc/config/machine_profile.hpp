@@ -302,6 +302,9 @@ struct MachineProfile {
   int sim_substeps = 10;  ///< integration sub-steps per servo period
   bool sim_linear_periods = true;  ///< see machine::SimMachineConfig::linear_periods
   std::uint64_t sim_seed = 1;
+  /// [[sim.electrode]]: what the tools really are in the simulation (the controller's tool
+  /// table may differ until electrode setting measures them).
+  std::vector<machine::SimElectrode> sim_electrodes;
 
   /// The axis with this letter, or nullptr. Any thread.
   const AxisProfile* find(Axis axis) const noexcept;

@@ -276,6 +276,7 @@ class Servo final : public Tickable {
   HandWait hand_wait_{};  ///< the hand-axis wait in progress, then its guard while the run moves
   bool hand_guard_ = false;
   std::uint64_t probe_seq_ = traj::kNoBlock;  ///< the probe move whose result probe_tripped_ is
+  std::uint32_t probe_run_ = 0;               ///< the run in which probe_tripped_ was set
   Pose probe_position_{};
   std::uint32_t probe_edges_seen_ = 0;  ///< the machine's probe edge count at the last period
   bool probe_edge_latched_ = false;     ///< the machine latched a probe edge in this period

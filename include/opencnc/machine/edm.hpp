@@ -99,6 +99,10 @@ struct SimEdmConditionEffect {
 struct SimEdmConfig {
   bool present = false;
   std::int8_t joint = 2;               ///< the joint that feeds the electrode (the tool axis)
+  /// Which of the electrode's offsets (0 X, 1 Y, 2 Z; −1 none) lies along the feed joint and along
+  /// each lateral joint: the true electrode's tip stands that far from the joints' positions.
+  std::int8_t offset_axis = 2;
+  std::int8_t lateral_offset_axes[2] = {-1, -1};
   double work_direction = -1;          ///< the work lies this way from the electrode along the joint
   double surface_mm = 0;               ///< the work's surface, joint coordinates (each orientation's start)
   double electrode_area_mm2 = 20;      ///< frontal area: removed volume / area = depth

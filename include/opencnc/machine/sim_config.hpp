@@ -203,6 +203,19 @@ struct SimBroachConfig {
   bool load_on_stroke = false;          ///< the force also acts on the stroke joint against its motion
 };
 
+/// Tools whose true electrode the simulation knows (more are a configuration error).
+inline constexpr int kMaxSimElectrodes = 32;
+
+/// What a tool really is in the simulated machine (`[[sim.electrode]]`), unknown to the
+/// controller: the offsets the tool table would hold if it were exact (X, Y, Z: its lowest point
+/// at the controlled point − offset, Z its length) and its tip's radius. A tool change mounts it;
+/// the spark gap burns and the reference sphere is touched where it really is.
+struct SimElectrode {
+  std::int32_t tool = 0;
+  std::array<double, 3> offset{};
+  double tip_radius = 0;
+};
+
 struct SimMachineConfig {
   double servo_period_s = 0.001;
   int substeps = 10;  ///< integration sub-steps per servo period
@@ -228,6 +241,9 @@ struct SimMachineConfig {
   std::array<SimInputSwitch, kMaxSimInputSwitches> input_switches{};
   bool handwheel = false;     ///< the machine has a manual pulse generator
   double temperature_c = 20;  ///< machine temperature (proximity sensors drift with it)
+  /// The tools' true electrodes; a tool not listed is exactly at the controlled point (offsets 0).
+  std::array<SimElectrode, kMaxSimElectrodes> electrodes{};
+  int electrode_count = 0;
 };
 
 }  // namespace opencnc::machine

@@ -40,6 +40,8 @@ class SimEdmProcess {
   void step(const SimEdmPose& pose, bool generator_on, const GeneratorOutputs& gen, SplitMix64& rng) noexcept;
   /// Electrode `tool` is put in (a tool change): its wear is its own, kept from earlier use.
   void mount(std::int32_t tool) noexcept;
+  /// A new electrode for `tool` (the worn one replaced): its wear starts again from nothing.
+  void replace(std::int32_t tool) noexcept;
   /// What the sensor reports for the period just simulated.
   void sample(ProcessInputs& in) const noexcept;
 
@@ -65,6 +67,11 @@ class SimEdmProcess {
   /// orientation, and the largest of any orientation's; 0 before a burn.
   double cavity_oversize_mm() const noexcept;
   double cavity_oversize_max_mm() const noexcept;
+  /// Where the cavity at the current orientation was begun across the tool axis: the true
+  /// electrode tip's lateral joint `i` (0, 1) at its first discharge, mm (0 before a burn).
+  double cavity_centre_mm(int i) const noexcept {
+    return front_index_ < 0 || i < 0 || i > 1 ? 0.0 : centre_[static_cast<std::size_t>(2 * front_index_ + i)];
+  }
   /// The side gap of the condition burning now (or last), mm.
   double side_gap_mm() const noexcept { return side_gap_mm_; }
 

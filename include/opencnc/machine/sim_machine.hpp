@@ -55,7 +55,10 @@ class SimMachine final : public MachineIO {
   /// EDM: a short (debris bridge) in the simulated gap until the electrode backs off from it.
   void inject_edm_short() noexcept { edm_.inject_short(); }
   /// EDM: a fresh workpiece (every front back at the surface), as when the next disc is clamped.
-  void new_edm_workpiece() noexcept { edm_.configure(config_.edm, config_.servo_period_s); }
+  void new_edm_workpiece() noexcept {
+    edm_.configure(config_.edm, config_.servo_period_s);
+    edm_.mount(mounted_tool_);
+  }
   /// Machine temperature, °C (proximity sensors drift with it).
   void set_temperature(double celsius) noexcept { temperature_c_ = celsius; }
   /// The broach's cutter wears: its force grows by `factor` (1 = sharp); ignored without a broach.
@@ -68,11 +71,16 @@ class SimMachine final : public MachineIO {
   }
   /// The operator moves manual joint `joint` toward `target` at up to `speed` units/s.
   void set_hand_target(int joint, double target, double speed) noexcept;
-  /// The electrode in the spindle of a machine whose probe touches a reference sphere: its true
-  /// offsets (as the tool table holds them, mm) and tip radius; ignored without a sphere.
+  /// The electrode in the spindle is replaced by another one (the same tool number): its true
+  /// offsets (as an exact tool table would hold them, mm) and tip radius. The reference sphere
+  /// is touched and the spark gap burns where it really is; it is new (no wear).
   void set_electrode(const std::array<double, 3>& offset, double tip_radius) noexcept {
-    sphere_.set_electrode(offset, tip_radius);
+    replace_electrode(mounted_tool_, offset, tip_radius);
   }
+  /// The operator puts a new electrode in for `tool` (in the spindle now or in its pocket): its
+  /// true offsets and tip radius, no wear; a tool change mounts it. Ignored beyond
+  /// kMaxSimElectrodes tools.
+  void replace_electrode(std::int32_t tool, const std::array<double, 3>& offset, double tip_radius) noexcept;
   /// The operator turns the handwheel by `counts` (+ = clockwise); ignored without one.
   void turn_handwheel(std::int32_t counts) noexcept;
 
@@ -83,6 +91,11 @@ class SimMachine final : public MachineIO {
   const SimSpindle& spindle() const noexcept { return spindle_; }
   const SimEdmProcess& edm() const noexcept { return edm_; }
   const SimSphereProbe& sphere_probe() const noexcept { return sphere_; }
+  /// The tool the last tool change mounted (0 before any).
+  std::int32_t mounted_tool() const noexcept { return mounted_tool_; }
+  /// The mounted electrode's true offsets and tip radius (zero for a tool the simulation does
+  /// not know), without its wear.
+  const SimElectrode& electrode() const noexcept { return electrode_; }
   /// True while the drives have power: e-stop chain closed, released, DC link above minimum.
   bool drives_powered() const noexcept;
   double ups_remaining_s() const noexcept {
@@ -102,6 +115,8 @@ class SimMachine final : public MachineIO {
   void update_auxiliaries() noexcept;
   void update_broach() noexcept;
   void step_edm() noexcept;
+  void mount(std::int32_t tool) noexcept;
+  std::array<double, 3> worn_offset() const noexcept;
   void sample() noexcept;
   void sample_probe() noexcept;
   void sample_sphere_probe() noexcept;
@@ -110,7 +125,9 @@ class SimMachine final : public MachineIO {
   std::array<SimJoint, kMaxJoints> joints_{};
   SimSpindle spindle_;
   SimEdmProcess edm_;
-  bool edm_tool_changed_ = false;  ///< the tool changer acknowledged a change last period
+  bool tool_changed_ = false;  ///< the tool changer acknowledged a change last period
+  std::int32_t mounted_tool_ = 0;
+  SimElectrode electrode_{};  ///< the mounted tool's true electrode
   SimSwitch probe_;
   SimSphereProbe sphere_;
   std::array<SimSwitch, kMaxSimInputSwitches> input_switches_{};

@@ -78,7 +78,10 @@ struct Setup {
 };
 
 /// Builds the Setup; problems (a store that cannot be opened) land in `diags` and give nothing.
-/// Non-real-time; one thread.
-std::optional<Setup> setup(const config::MachineProfile& profile, Diagnostics& diags);
+/// `tool_table_in_memory`: without a tool store, the profile's tool table file is read into a
+/// table in memory that G10 L1 and electrode setting change instead of the file (a simulation's
+/// own measurements). Non-real-time; one thread.
+std::optional<Setup> setup(const config::MachineProfile& profile, Diagnostics& diags,
+                           bool tool_table_in_memory = false);
 
 }  // namespace opencnc::toolguard
