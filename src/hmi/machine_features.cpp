@@ -109,8 +109,12 @@ std::unique_ptr<MachineFeatures> MachineFeatures::create(const config::MachinePr
         control::GcodeProgramSource::create(profile, diags), profile);
     add(f->retrace_);
   }
-  // Run from line scans with a program source of its own (the controller's is the controller's).
-  add(std::make_shared<control::RunFromLineFeature>(control::GcodeProgramSource::create(profile, diags)));
+  // Run from line scans with a program source of its own (the controller's is the controller's),
+  // reading the controller's tool table (a scan's G10 L1 writes only a copy of its own).
+  std::shared_ptr<control::RunFromLineFeature> from_line =
+      control::RunFromLineFeature::create(profile, f->source_->tools(), diags);
+  if (!from_line) return nullptr;
+  add(from_line);
   f->state_ = {{"installed", f->names_}};
   return f;
 }
