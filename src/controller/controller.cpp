@@ -752,6 +752,7 @@ void Controller::publish() {
     described_fault_tick_ = s.fault.tick;
   }
   p.runs_finished = runs_finished_;
+  p.limits_version = limits_version_;
   p.block_delete = block_delete_;
 }
 

@@ -194,6 +194,7 @@ TEST(Server, AJobRunsToItsEndWithHoldAndResumeAndLandsInTheHistory) {
   EXPECT_GT(info["moves"].get<int>(), 100);
   const json preview = get(rig.port, "/api/v1/program/preview", t).body;
   EXPECT_GT(preview["polylines"].size(), 2u);
+  EXPECT_EQ(preview["tools"], json::array({1, 2}));  // T1 M6, T2 M6
   EXPECT_EQ(get(rig.port, "/api/v1/program/text?from=4&count=1", t).body["lines"][0],
             "G21 G17 G40 G49 G80 G90 G94");
   EXPECT_TRUE(

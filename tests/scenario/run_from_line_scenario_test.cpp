@@ -286,6 +286,10 @@ TEST(RunFromLineScenario, TheControllerAnswersWhileTheScanRunsAndNothingStarts) 
   Scenario s(mill());
   auto gate = std::make_shared<GatedSource>(mill_source());
   ASSERT_TRUE(s.rig().controller().add_feature(std::make_shared<RunFromLineFeature>(gate)));
+  struct Open {  // a failed assertion still lets the scan's thread end before the rig goes
+    std::shared_ptr<GatedSource> gate;
+    ~Open() { gate->release(); }
+  } open{gate};
   s.on(Mode::Auto);
   s.must(Request::open(p.path()));
   Controller& c = s.rig().controller();
