@@ -63,7 +63,7 @@ registerDialog({
         { name: "run_in_mm", label: "run-in", value: d.run_in_mm, unit: "mm" },
         { name: "run_in_speed_mm_min", label: "at", value: d.run_in_speed_mm_min, unit: "mm/min" }] : []),
       ...(j.can_retract ? [
-        { name: "distance_mm", label: "Retract", value: 5, unit: "mm" },
+        { name: "distance_mm", label: "Distance", value: 5, unit: "mm" },
         { name: "direction", label: "direction", value: "back", options: ["back", "onward"] },
         { name: "speed_mm_min", label: "at", value: 100, unit: "mm/min" }] : []),
     ];
