@@ -7,7 +7,7 @@ cd "$(dirname "$0")/.."
 
 usage() {
   cat <<'TXT'
-usage: scripts/hmi.sh [--test] [--e2e]
+usage: scripts/hmi.sh [--test] [--e2e [--opencnc PATH]]
   Installs the front end's packages (npm ci, from web/package-lock.json) and builds it into
   web/dist (type check, then Vite).
   --test       also its unit tests (vitest)
@@ -15,21 +15,30 @@ usage: scripts/hmi.sh [--test] [--e2e]
                Debian's headless Chromium (/usr/bin/chromium) by playwright-core: home, open the
                bracket program, run it with hold and resume, find it in the history; screenshots
                in web/e2e/artifacts (build build/opencnc first)
+  --opencnc PATH  the opencnc the end-to-end test serves with (default build/opencnc; CI uses the
+               sanitized build-asan/opencnc)
   -h, --help   this text
 TXT
 }
 unit=0
 e2e=0
+opencnc=build/opencnc
 while (($#)); do
   case $1 in
     --test) unit=1 ;;
     --e2e) e2e=1 ;;
+    --opencnc)
+      [[ $# -ge 2 ]] || { echo "hmi.sh: --opencnc needs a path" >&2; exit 2; }
+      opencnc=$2
+      shift
+      ;;
     -h | --help) usage; exit 0 ;;
     *) echo "hmi.sh: unknown option '$1'" >&2; usage >&2; exit 2 ;;
   esac
   shift
 done
 
+opencnc=$(realpath -m "$opencnc")
 cd web
 # The installed tree is reused while the lockfile is unchanged (npm ci starts from scratch).
 stamp=node_modules/.opencnc-lock
@@ -44,5 +53,5 @@ if ((e2e)); then
     echo "hmi.sh: the end-to-end test needs Debian's chromium (scripts/setup.sh --tests)" >&2
     exit 2
   fi
-  node e2e/run.mjs --opencnc ../build/opencnc
+  node e2e/run.mjs --opencnc "$opencnc"
 fi

@@ -22,6 +22,7 @@ test_packages=(
   liblzma-dev xz-utils        # compressed golden files of the conformance suite
   libbenchmark-dev            # benchmarks
   clang libclang-rt-14-dev    # libFuzzer + sanitizer runtime for the fuzz target
+  lld                         # LLVM's linker: the sanitized test binaries link in a third of the time
   linuxcnc-uspace             # rs274 (oracle), /usr/share/linuxcnc/ncfiles; halrun for the HAL tests
   linuxcnc-uspace-dev         # hal.h, rtapi.h: the HAL component opencnc_rt.so (docs/hal.md)
   chromium                    # the HMI's end-to-end tests (headless, driven by playwright-core)

@@ -1,20 +1,21 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: GPL-3.0-or-later
-# Installs what the tests need, builds with warnings as errors, runs the HAL tests and the HMI's
-# front-end and end-to-end tests, the whole suite under ASan+UBSan, then the deterministic fuzz
-# gate. This is what CI runs (.ci/run); --quick is the whole suite without sanitizers.
+# Installs what the tests need, builds everything under ASan+UBSan with warnings as errors, runs
+# the whole suite there (the HAL component in halrun too), the HMI's front-end and end-to-end
+# tests, then the deterministic fuzz gate. This is what CI runs (.ci/run); --quick is the whole
+# suite optimised, without sanitizers.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 usage() {
   cat <<'TXT'
 usage: scripts/test.sh [--quick]
-  Installs the test packages (scripts/setup.sh --tests); builds the application, the HAL component
-  and the benchmarks optimised with warnings as errors and runs the HAL tests in halrun and the
-  breakpoint journal's torture (100 kills); the HMI's
-  front end (scripts/hmi.sh: npm ci, build, vitest, the end-to-end test in headless Chromium,
-  screenshots in web/e2e/artifacts); then builds the whole suite under ASan + UBSan and runs it
-  (every tenth conformance program); then the fuzz gate (scripts/fuzz.sh --gate: the committed
+  Installs the test packages (scripts/setup.sh --tests); builds everything (application, tests,
+  benchmarks, the HAL component) under ASan + UBSan with warnings as errors and runs the whole
+  suite there (every tenth conformance program; the HAL component in halrun; the breakpoint
+  journal's torture, 100 kills); the HMI's front end (scripts/hmi.sh: npm ci, build, vitest, the
+  end-to-end test in headless Chromium with the sanitized opencnc, screenshots in
+  web/e2e/artifacts); then the fuzz gate (scripts/fuzz.sh --gate: the committed
   corpus, the regression inputs and a fixed-seed run: the same commit always passes or always
   fails). OPENCNC_JOBS sets the cores to use (default 2): the tests run that many at once, the
   builds one more.
@@ -41,9 +42,9 @@ build_jobs=$((jobs + 1))
 
 scripts/setup.sh --tests
 
-echo "== build (warnings are errors)"
-cmake --preset ci >/dev/null
 if ((quick)); then
+  echo "== build (warnings are errors)"
+  cmake --preset ci >/dev/null
   cmake --build --preset ci -j "$build_jobs"
   echo "== test suite"
   ctest --preset ci -j "$jobs"
@@ -51,28 +52,24 @@ if ((quick)); then
   scripts/hmi.sh --test --e2e
   exit 0
 fi
-# The whole suite is built and run once, under the sanitizers, below: the suite's tests pass in both
-# builds (`--quick` runs it here), and building the tests twice does not fit CI's 15 minutes. This
-# build makes everything else with the optimiser and warnings as errors: the application, the HAL
-# component and the benchmarks; then the tests that need this build: the HAL component in halrun
-# (a sanitised module cannot load into rtapi_app), the real-time core's symbol check, and the
-# breakpoint journal's torture (100 kills of the writing process; its benchmark, optimised).
-cmake --build --preset ci -j "$build_jobs" --target src/all apps/opencnc/all bench/all
-echo "== the HAL component in halrun, the real-time core's symbols, the journal's torture (optimised build)"
-ctest --preset ci -j "$jobs" -R '^(hal|repo|bench)[.]'
-echo "== HMI front end: build, unit tests, end to end in headless Chromium"
-scripts/hmi.sh --test --e2e
-
-echo "== build with AddressSanitizer + UndefinedBehaviorSanitizer"
+# CI builds everything once, under the sanitizers, with warnings as errors: the application, the
+# tests, the benchmarks, and the HAL component (rtapi_app cannot load an instrumented module: it
+# links the real-time core's plain twins, cmake/Sanitizers.cmake). Building the optimised tree as
+# well does not fit CI's 15 minutes; `--quick` builds and runs it whole.
+echo "== build with AddressSanitizer + UndefinedBehaviorSanitizer (warnings are errors)"
 cmake --preset asan >/dev/null
 cmake --build --preset asan -j "$build_jobs"
 echo "== test suite under ASan + UBSan"
 # Each conformance program forks an instrumented opencnc and rs274 (five minutes for all 615 under
 # ASan): every tenth of them runs here and all of them in `--quick`; the interpreter itself runs
-# under the sanitizers in its own tests and in the fuzz gate below. Everything else runs whole.
+# under the sanitizers in its own tests and in the fuzz gate below. Everything else runs whole:
+# the HAL component in halrun beside the sanitized controller, the real-time core's symbols, the
+# breakpoint journal's torture (100 kills of the writing process).
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 ctest --preset asan -j "$jobs" -E 'Conformance[.]Program/'
 ctest --preset asan -j "$jobs" -R 'Conformance[.]Program/' -I ,,10
+echo "== HMI front end: build, unit tests, end to end in headless Chromium (the sanitized opencnc)"
+scripts/hmi.sh --test --e2e --opencnc build-asan/opencnc
 
 if compgen -G "fuzz/*/CMakeLists.txt" >/dev/null; then
   echo "== fuzz gate (the G-code libraries and the fuzz targets only; ASan + UBSan)"

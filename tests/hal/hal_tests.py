@@ -97,6 +97,18 @@ def moving(rows):
     return next(i for i, r in enumerate(rows) if any(v != 0.0 for v in r[:3]))
 
 
+def wait_for_motion(hal, before, seconds=30.0):
+    """Waits until X moves in the samples after `before` (a controller under the sanitizers, on a
+    busy machine, takes seconds to start), so that what follows happens mid-motion."""
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        xs = [r[0] for r in hal.samples()[before:]]
+        if any(b != a for a, b in zip(xs, xs[1:])):
+            return True
+        time.sleep(0.05)
+    return False
+
+
 def same_as_virtual(opencnc, source_dir, hal, work):
     trace = work / "virtual.csv"
     subprocess.run([str(opencnc), "run", str(source_dir / "tests/hal/move.ngc"), "--machine",
@@ -126,7 +138,9 @@ def same_as_virtual(opencnc, source_dir, hal, work):
 def reaction(hal, signal_name, value, column, opencnc, source_dir, work):
     before = len(hal.samples())
     run = controller(opencnc, source_dir, "long_move.ngc", work)
-    time.sleep(1.0)
+    if not wait_for_motion(hal, before):
+        return fail(f"{signal_name}: the program never moved X")
+    time.sleep(0.5)
     hal.sets(signal_name, value)
     run.wait(timeout=30)
     time.sleep(0.2)
@@ -151,8 +165,11 @@ def safety_pins(opencnc, source_dir, hal, work):
 
 
 def kill_controller(opencnc, source_dir, hal, work):
+    before = len(hal.samples())
     run = controller(opencnc, source_dir, "long_move.ngc", work)
-    time.sleep(1.5)
+    if not wait_for_motion(hal, before):
+        return fail("the program never moved X")
+    time.sleep(1.0)
     run.send_signal(signal.SIGKILL)
     run.wait()
     time.sleep(1.0)

@@ -7,7 +7,7 @@ import { spawn } from "node:child_process";
 import { mkdtempSync, rmSync } from "node:fs";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
-import { waitFor as waitForOn } from "./wait.mjs";
+import { stopServer, waitFor as waitForOn } from "./wait.mjs";
 
 const operator = "e2e-operator-token-0123456789", admin = "e2e-admin-token-0123456789";
 
@@ -24,6 +24,7 @@ export async function recoveryStep({ opencnc, repo, out, browser, step }) {
   const data = mkdtempSync(join(tmpdir(), "opencnc-e2e-broach-"));
   const server = serve(opencnc, repo, data);
   const page = await browser.newPage({ viewport: { width: 1400, height: 900 } });
+  let stop = null;
   try {
     const url = await new Promise((ok, fail) => {
       let text = "";
@@ -91,8 +92,8 @@ export async function recoveryStep({ opencnc, repo, out, browser, step }) {
     throw e;
   } finally {
     await page.close();
-    server.kill("SIGINT");
-    await new Promise((ok) => (server.exitCode !== null ? ok() : server.on("exit", ok)));
+    stop = await stopServer(server);
     rmSync(data, { recursive: true, force: true });
   }
+  if (stop) throw new Error(`broach: ${stop}`);
 }

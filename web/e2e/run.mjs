@@ -14,7 +14,7 @@ import { dirname, join, resolve } from "node:path";
 import { fileURLToPath } from "node:url";
 import { chromium } from "playwright-core";
 import { recoveryStep } from "./recovery.mjs";
-import { waitFor as waitForOn } from "./wait.mjs";
+import { stopServer, waitFor as waitForOn } from "./wait.mjs";
 
 const here = dirname(fileURLToPath(import.meta.url));
 const repo = resolve(here, "..", "..");
@@ -68,10 +68,12 @@ const step = (what) => console.log(`e2e: ${what}`);
 const shot = (name) => page.screenshot({ path: join(out, `${name}.png`) });
 const text = (id) => page.getByTestId(id).innerText();
 const waitFor = (what, check, ms) => waitForOn(page, what, check, ms);
-// The dialog's button with this label, clicked when it is there.
+// The dialog's button with this label, clicked when it is there. The dialog may close between the
+// look and the click (the stream redraws it): a click that finds no button is let go, and the
+// caller's wait for what the answer does tells whether it took.
 const answer = async (label) => {
   const b = page.getByTestId("dialog").getByRole("button", { name: label });
-  if (await b.isVisible()) await b.click();
+  if (await b.isVisible()) await b.click({ timeout: 2000 }).catch(() => {});
 };
 
 try {
@@ -170,8 +172,11 @@ try {
   await shot("failure").catch(() => {});
 } finally {
   await browser.close();
-  server.kill("SIGINT");
-  await new Promise((ok) => server.on("exit", ok));
+  const stop = await stopServer(server);
+  if (stop) {
+    failed = true;
+    console.error(`e2e: FAILED: ${stop}`);
+  }
   rmSync(data, { recursive: true, force: true });
 }
 console.log(`e2e: screenshots in ${out}`);

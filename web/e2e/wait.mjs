@@ -10,3 +10,17 @@ export async function waitFor(page, what, check, ms = 30000) {
   }
   throw new Error(`timed out waiting for ${what}`);
 }
+
+/**
+ * Stops `opencnc serve` with SIGINT, as Ctrl-C would, and resolves to what went wrong, if anything:
+ * a controlled stop exits 0 (under the sanitizers a leak or undefined behaviour at exit does not).
+ */
+export async function stopServer(server) {
+  if (server.exitCode === null && server.signalCode === null) {
+    const exited = new Promise((ok) => server.on("exit", ok));
+    server.kill("SIGINT");
+    await exited;
+  }
+  if (server.exitCode === 0) return null;
+  return `opencnc serve ended with ${server.exitCode ?? server.signalCode}, not 0, after SIGINT`;
+}
