@@ -102,9 +102,17 @@ void read_spindle(Section& top, MachineProfile& profile) {
 void read_power(Section& top, MachineProfile& profile) {
   const toml::table* t = top.subtable("power");
   if (t == nullptr) return;
-  Section s(*t, "power", {"monitor", "ups", "dc_link_nominal_v", "dc_link_min_v", "sim"}, top.reporter());
+  Section s(*t, "power",
+            {"monitor", "ups", "dc_link_nominal_v", "dc_link_min_v", "sim", "resume_tolerance_mm",
+             "resume_tolerance_deg", "resume_run_in_mm", "resume_run_in_speed_mm_min"},
+            top.reporter());
   PowerProfile& p = profile.power;
   p.monitor = s.boolean_or("monitor", true);
+  p.resume_tolerance_mm = s.number_or("resume_tolerance_mm", p.resume_tolerance_mm, Bound::Positive);
+  p.resume_tolerance_deg = s.number_or("resume_tolerance_deg", p.resume_tolerance_deg, Bound::Positive);
+  p.resume_run_in_mm = s.number_or("resume_run_in_mm", p.resume_run_in_mm, Bound::NonNegative);
+  p.resume_run_in_speed_mm_min =
+      s.number_or("resume_run_in_speed_mm_min", p.resume_run_in_speed_mm_min, Bound::Positive);
   p.sim.ups = s.boolean_or("ups", false);
   p.sim.dc_link_nominal_v = s.number_or("dc_link_nominal_v", p.sim.dc_link_nominal_v, Bound::Positive);
   p.sim.dc_link_min_v = s.number_or("dc_link_min_v", p.sim.dc_link_min_v, Bound::Positive);

@@ -460,6 +460,11 @@ void Servo::fill_drill_status(ServoStatus& s) const noexcept {
   s.interlock_rule = blocking_rule_;
   s.interlocks_true = rules_true_;
   s.alarms_active = alarms_active_;
+  for (int i = 0; i < config_.alarms.count && i < machine::kMaxProcessAlarms; ++i) {
+    const int ch = config_.alarms.alarms[static_cast<std::size_t>(i)].channel;
+    s.alarm_values[static_cast<std::size_t>(i)] =
+        ch >= 0 && ch < machine::kAnalogChannels ? in_.analog_in[static_cast<std::size_t>(ch)] : 0.0;
+  }
   s.handwheel_axis = handwheel_axis_;
   s.coupling = coupling_;
   s.coupling.error_deg = coupling_error();

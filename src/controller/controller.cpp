@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <stdexcept>
 #include <variant>
 
 #include <fmt/format.h>
@@ -222,6 +223,7 @@ void Controller::service() {
     for (auto& [id, r] : requests_) handle(id, r);
     requests_.clear();
   }
+  poll_features();
   if (job_) {
     job_->service(servo());
     if (job_->ended()) end_job();
@@ -612,15 +614,40 @@ void Controller::feature(std::uint64_t id, const requests::Feature& r) {
   if (it == features_.end())
     return finish(id, Refusal::BadValue, fmt::format("there is no feature named '{}'", r.feature));
   Outcome o;
+  handling_ = id;
+  deferred_ = false;
   try {
     o = it->second->handle(r, *this);
   } catch (const std::exception& ex) {
+    deferred_ = false;  // a feature that fails answers now, deferred or not
     o.accepted = false;
     o.refusal = Refusal::BadValue;
     o.message = fmt::format("{}: {}", r.feature, ex.what());
   }
+  handling_ = 0;
+  if (!deferred_) answer(id, std::move(o));
+}
+
+std::uint64_t Controller::defer() {
+  if (handling_ == 0) throw std::logic_error("FeatureHost::defer() outside Feature::handle");
+  deferred_ = true;
+  return handling_;
+}
+
+void Controller::answer(std::uint64_t id, Outcome o) {
   finish(id, o.accepted ? Refusal::None : (o.refusal == Refusal::None ? Refusal::BadValue : o.refusal), o.message,
          std::move(o.diagnostics));
+}
+
+// Features whose work runs on threads of their own look whether it is done.
+void Controller::poll_features() {
+  for (auto& [name, f] : features_) {
+    try {
+      f->poll(*this);
+    } catch (const std::exception& ex) {
+      note(Severity::Error, "control.feature", fmt::format("{}: {}", name, ex.what()));
+    }
+  }
 }
 
 // --- jobs ------------------------------------------------------------------------------------
@@ -731,6 +758,7 @@ void Controller::publish() {
     described_fault_tick_ = s.fault.tick;
   }
   p.runs_finished = runs_finished_;
+  p.limits_version = limits_version_;
   p.block_delete = block_delete_;
 }
 

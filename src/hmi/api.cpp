@@ -397,6 +397,7 @@ json status_json(const control::ControllerStatus& s, const config::MachineProfil
         {"interpreter", location_json(s.interpreter)}}},
       {"sync_wait", control::to_string(s.sync_wait)},
       {"runs_finished", s.runs_finished},
+      {"limits_version", s.limits_version},
   };
   j.update(process_json(v, profile));
   return j;

@@ -68,12 +68,12 @@ Request journal(const std::string& action, const json& body, const config::Machi
   if (action == "show") return Request::feature("journal", "show");
   if (action == "resume") {
     confirmed(body, "resume");
-    recovery::ResumeArgs a;
-    a.tolerance_mm = number_or(body, "tolerance_mm", a.tolerance_mm, 0, 1);
-    a.tolerance_deg = number_or(body, "tolerance_deg", a.tolerance_deg, 0, 1);
-    a.run_in_mm = number_or(body, "run_in_mm", a.run_in_mm, 0, 50);
+    recovery::ResumeArgs a;  // the profile's values unless the operator changed them
+    a.tolerance_mm = number_or(body, "tolerance_mm", p.power.resume_tolerance_mm, 0, 1);
+    a.tolerance_deg = number_or(body, "tolerance_deg", p.power.resume_tolerance_deg, 0, 1);
+    a.run_in_mm = number_or(body, "run_in_mm", p.power.resume_run_in_mm, 0, 50);
     a.run_in_speed_mm_min =
-        number_or(body, "run_in_speed_mm_min", a.run_in_speed_mm_min, 1, fastest_mm_min(p));
+        number_or(body, "run_in_speed_mm_min", p.power.resume_run_in_speed_mm_min, 1, fastest_mm_min(p));
     return Request::feature("journal", "resume", a);
   }
   if (action == "retract") {

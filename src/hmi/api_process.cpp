@@ -30,6 +30,7 @@ json alarms_json(const control::ServoStatus& s, const config::AlarmProfile& p) {
     const auto i = static_cast<std::size_t>(k);
     list.push_back({{"name", i < p.names.size() ? p.names[i] : std::string("alarm ") + std::to_string(k + 1)},
                     {"active", (s.alarms_active >> k & 1U) != 0},
+                    {"value", s.alarm_values[i]},
                     {"reaction", reaction_name(a.reaction)},
                     {"low", a.has_low ? json(a.low) : json(nullptr)},
                     {"high", a.has_high ? json(a.high) : json(nullptr)},

@@ -109,8 +109,12 @@ std::unique_ptr<MachineFeatures> MachineFeatures::create(const config::MachinePr
         control::GcodeProgramSource::create(profile, diags), profile);
     add(f->retrace_);
   }
-  // Run from line scans with a program source of its own (the controller's is the controller's).
-  add(std::make_shared<control::RunFromLineFeature>(control::GcodeProgramSource::create(profile, diags)));
+  // Run from line scans with a program source of its own (the controller's is the controller's),
+  // reading the controller's tool table (a scan's G10 L1 writes only a copy of its own).
+  std::shared_ptr<control::RunFromLineFeature> from_line =
+      control::RunFromLineFeature::create(profile, f->source_->tools(), diags);
+  if (!from_line) return nullptr;
+  add(from_line);
   f->state_ = {{"installed", f->names_}};
   return f;
 }
@@ -164,6 +168,12 @@ json MachineFeatures::snapshot(const control::ControllerStatus& s) {
                     // a law that held; the machine must be on and idle for either to start.
                     {"can_resume", valid && r["stage"] == "at-rest"},
                     {"can_retract", valid && r["coupled"].get<bool>()},
+                    // The resume's values the dialog offers (the operator may change them).
+                    {"resume_defaults",
+                     {{"tolerance_mm", profile_.power.resume_tolerance_mm},
+                      {"tolerance_deg", profile_.power.resume_tolerance_deg},
+                      {"run_in_mm", profile_.power.resume_run_in_mm},
+                      {"run_in_speed_mm_min", profile_.power.resume_run_in_speed_mm_min}}},
                     {"mains_ok", s.servo.mains_ok && !s.servo.on_battery}};
   }
   if (retrace_) {
@@ -217,13 +227,17 @@ json MachineFeatures::tool_guard_state(const control::ControllerStatus& s) {
     guard_holding_ = true;
     guard_checked_ = store_->changes();
     const toolguard::CheckResult r = toolguard::check(*store_, toolguard::tolerances(profile_.tool_guard));
-    json lines = json::array();
-    for (const tools::Difference& d : r.differences) lines.push_back(d.text());
+    json lines = json::array(), tools = json::array();
+    for (const tools::Difference& d : r.differences) {
+      lines.push_back(d.text());
+      tools.push_back(d.tool);  // the dialog lists the program's tools first
+    }
     guard_report_ = {
         {"ok", r.ok()},
         {"error", r.error},
         {"backup", r.backup ? json{{"id", r.backup->id}, {"taken", r.backup->taken_utc}} : json(nullptr)},
         {"differences", lines},
+        {"difference_tools", tools},
         {"report", r.report()}};
   }
   return {{"store", profile_.tool_guard.store}, {"holding", holding}, {"check", guard_report_}};

@@ -4,6 +4,8 @@
 
 #include <cmath>
 #include <numbers>
+#include <set>
+#include <vector>
 
 #include "opencnc/canon/program_builder.hpp"
 #include "opencnc/gcode/interpreter.hpp"
@@ -41,6 +43,19 @@ void arc_points(const canon::Program& p, canon::SegmentId id, std::vector<double
     for (int i = 0; i < 3; ++i) out.push_back(c[i] + u[i] * std::cos(a) + v[i] * std::sin(a) + n[i] * along);
   }
   for (int i = 0; i < 3; ++i) out.push_back(e[i]);
+}
+
+/// The tools the program puts in the spindle (M6 after a T, M61 Q), each once, in number order.
+std::vector<int> program_tools(const canon::Program& p) {
+  std::set<int> tools;
+  int selected = 0;
+  for (std::size_t a = 0; a < p.action_count(); ++a) {
+    const canon::Action& x = p.action(a);
+    if (x.kind == canon::ActionKind::SelectTool) selected = x.index;
+    if (x.kind == canon::ActionKind::ChangeTool && selected > 0) tools.insert(selected);
+    if (x.kind == canon::ActionKind::ChangeToolNumber && x.index > 0) tools.insert(x.index);
+  }
+  return {tools.begin(), tools.end()};
 }
 
 }  // namespace
@@ -89,7 +104,11 @@ json program_preview(const control::GcodeProgramSource& source, const std::strin
     }
   }
   flush();
-  return {{"polylines", lines}, {"moves", p.size()}, {"truncated", truncated}, {"diagnostics", diags}};
+  return {{"polylines", lines},
+          {"moves", p.size()},
+          {"truncated", truncated},
+          {"diagnostics", diags},
+          {"tools", program_tools(p)}};
 }
 
 }  // namespace opencnc::hmi

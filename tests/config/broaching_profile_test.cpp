@@ -80,6 +80,17 @@ struct BadCase {
 
 class BadBroachingProfile : public ::testing::TestWithParam<BadCase> {};
 
+// The resume after a power failure as the HMI's recovery dialog offers it: the profile's values.
+TEST(BroachingProfile, TheResumesTolerancesAndRunInComeFromPower) {
+  const ProfileLoad load =
+      parse_profile(kBase + "[power]\nresume_tolerance_mm = 0.02\nresume_run_in_mm = 0\n", "p.toml");
+  ASSERT_TRUE(load.ok()) << all_messages(load.diagnostics);
+  EXPECT_EQ(load.profile->power.resume_tolerance_mm, 0.02);
+  EXPECT_EQ(load.profile->power.resume_tolerance_deg, 0.01);
+  EXPECT_EQ(load.profile->power.resume_run_in_mm, 0.0);
+  EXPECT_EQ(load.profile->power.resume_run_in_speed_mm_min, 600.0);
+}
+
 TEST_P(BadBroachingProfile, IsRejectedAtThePlaceOfTheProblem) {
   const ProfileLoad load = parse_profile(kBase + GetParam().extra, "p.toml");
   EXPECT_FALSE(load.ok());
@@ -108,6 +119,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"LogFasterThanTheServo",
                 "[process.broaching]\nload_input = 0\nhold_kn = 4\nlog_rate_hz = 5000\n",
                 {"config.range", 22, 15}},
+        BadCase{"ResumeToleranceZero", "[power]\nresume_tolerance_mm = 0\n", {"config.range", 20, 23}},
         BadCase{"UnknownKey",
                 "[process.broaching]\nload_input = 0\nhold_kn = 4\nhold = 5\n",
                 {"config.unknown-key", 22, 1}},

@@ -366,6 +366,10 @@ TEST(ServoAllocations, NoneWithProcessAlarmsAndAReferenceSphere) {
   EXPECT_EQ(a.state(), State::Faulted);
   EXPECT_EQ(a.rig().status().servo.alarms_active, 0b101u);
   EXPECT_EQ(g_allocations.load(), 0);
+  // The status carries each alarm's input (what the HMI's alarm lines show beside the bounds):
+  // the dielectric temperature (input 1) set back to 30 °C, the level drifted down to 20 mm.
+  EXPECT_EQ(a.rig().status().servo.alarm_values[1], 30.0);
+  EXPECT_LT(a.rig().status().servo.alarm_values[0], 40.0);
 }
 
 /// The simulated machine behind the shared-memory host, its capabilities handed over at run time.

@@ -49,9 +49,12 @@ TEST(AdminParameters, TheOperatorReadsThemOnlyTheAdminChangesThem) {
   const std::string change = R"({"kind":"set-parameters","values":{"axis.x.max_velocity":40}})";
   EXPECT_EQ(post(rig.port, change, kOperator).status, 403);
   EXPECT_EQ(rig.profile_text(), rig.profile_original);
+  EXPECT_EQ(get(rig.port, "/api/v1/status").body["limits_version"], 0);
   const Reply ok = post(rig.port, change, kAdmin);
   ASSERT_EQ(ok.status, 200) << ok.text;
   EXPECT_EQ(ok.body["message"], "axis.x.max_velocity 100.0 → 40.0");
+  // The status tells the pages the limits changed (the 3D view reads the soft-limit box again).
+  EXPECT_TRUE(rig.until([](const json& s) { return s["limits_version"] == 1; }, 5));
   std::string expected = rig.profile_original;
   expected.replace(expected.find("max_velocity = 100.0"), 20, "max_velocity = 40.0");
   EXPECT_EQ(rig.profile_text(), expected);

@@ -162,6 +162,7 @@ TEST(ProcessJson, LoadAlarmsAndEdmAsTheProfileHasThem) {
   ASSERT_GE(edm.alarms.alarms.count, 2);
   s = {};
   s.alarms_active = 0b10;
+  s.alarm_values[1] = 47.5;
   s.edm.on = true;
   s.edm.condition = edm.edm.config.conditions[0].number;
   s.edm.gap_state = machine::GapState::Short;
@@ -172,6 +173,8 @@ TEST(ProcessJson, LoadAlarmsAndEdmAsTheProfileHasThem) {
   EXPECT_EQ(e["alarms"][0]["name"], edm.alarms.names[0]);
   EXPECT_EQ(e["alarms"][0]["active"], false);
   EXPECT_EQ(e["alarms"][1]["active"], true);
+  EXPECT_EQ(e["alarms"][1]["value"], 47.5);
+  EXPECT_EQ(e["alarms"][1]["unit"], edm.alarms.units[1]);
   EXPECT_EQ(e["edm"]["gap_state"], "short");
   EXPECT_EQ(e["edm"]["gap_voltage_v"], 3.5);
   EXPECT_EQ(e["edm"]["jumps"], 12);
@@ -241,6 +244,8 @@ TEST(ServerFeatures, PowerFailRecordInTheStatusThenARetractConfirmedByTheOperato
   EXPECT_TRUE(j["record"]["program"].get<std::string>().ends_with("broach-constant.ngc"));
   EXPECT_TRUE(j["can_resume"].get<bool>());
   EXPECT_TRUE(j["can_retract"].get<bool>());
+  EXPECT_EQ(j["resume_defaults"]["tolerance_mm"], rig.profile.power.resume_tolerance_mm);  // the dialog's
+  EXPECT_EQ(j["resume_defaults"]["run_in_mm"], rig.profile.power.resume_run_in_mm);
   // Unconfirmed: 400 and nothing happens.
   EXPECT_EQ(rig.command({{"kind", "feature"}, {"feature", "journal"}, {"action", "discard"}}).status, 400);
   // The power returns; reset, machine on; the retract, confirmed, completes and clears the record.
@@ -396,6 +401,7 @@ TEST(ServerFeatures, TheToolGuardsHoldShowsTheDifferencesAndARestoreLetsTheProgr
   EXPECT_EQ(held["check"]["ok"], false);
   EXPECT_EQ(held["check"]["backup"]["id"], 1);
   ASSERT_EQ(held["check"]["differences"].size(), 1u);
+  EXPECT_EQ(held["check"]["difference_tools"], json::array({5}));
   EXPECT_EQ(held["check"]["differences"][0],
             "T5 D1 length1: backup 193.225, live 139.225 (-54 mm; geometry tolerance 0.001 mm)");
   // No silent overwrite: a restore without the operator's confirmation changes nothing.

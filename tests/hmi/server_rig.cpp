@@ -75,8 +75,7 @@ ServerRig::ServerRig(RigOptions o) : dir(fresh_folder()) {
   if (history) host->controller().attach(std::make_shared<HistoryRecorder>(*history, profile.servo_period_s));
   if (features) features->install(host->controller());
   if (o.run_from_line)
-    host->controller().add_feature(
-        std::make_shared<control::RunFromLineFeature>(control::GcodeProgramSource::create(profile, d)));
+    host->controller().add_feature(control::RunFromLineFeature::create(profile, source->tools(), d));
   host->start(nullptr);
   ServerConfig sc = o.server;
   sc.address = o.address;

@@ -194,6 +194,7 @@ TEST(Server, AJobRunsToItsEndWithHoldAndResumeAndLandsInTheHistory) {
   EXPECT_GT(info["moves"].get<int>(), 100);
   const json preview = get(rig.port, "/api/v1/program/preview", t).body;
   EXPECT_GT(preview["polylines"].size(), 2u);
+  EXPECT_EQ(preview["tools"], json::array({1, 2}));  // T1 M6, T2 M6
   EXPECT_EQ(get(rig.port, "/api/v1/program/text?from=4&count=1", t).body["lines"][0],
             "G21 G17 G40 G49 G80 G90 G94");
   EXPECT_TRUE(
@@ -274,17 +275,29 @@ TEST(Server, RunFromLineStartsTheProgramAtTheLineAfterTheApproach) {
   const Reply none = post(rig.port, R"({"kind":"run-from-line","line":12})", t);  // an assignment
   EXPECT_EQ(none.status, 409);
   EXPECT_NE(none.text.find("line 12 makes no move"), std::string::npos) << none.text;
-  // The drilling after the second tool change: the approach, then the program from line 66.
+  // The drilling after the second tool change: the approach (T2 changed in by hand first, the
+  // spindle on), then the program from line 66.
   const Reply from = post(rig.port, R"({"kind":"run-from-line","line":66})", t);
   ASSERT_EQ(from.status, 200) << from.text;
   EXPECT_NE(from.text.find("bracket.ngc:66"), std::string::npos) << from.text;
+  EXPECT_NE(from.text.find("with tool 2 changed in"), std::string::npos) << from.text;
+  ASSERT_TRUE(rig.until([&](const json& s) { return s["wait"] == "manual-tool-change"; }, 20));
+  json s = get(rig.port, "/api/v1/status").body;
+  EXPECT_EQ(s["job"]["kind"], "auxiliary");
+  EXPECT_EQ(s["prepared_tool"], 2);
+  EXPECT_EQ(post(rig.port, R"({"kind":"tool-changed"})", t).status, 200);
+  ASSERT_TRUE(rig.until([&](const json& st) { return st["job"]["kind"] == "program"; }, 20));
+  s = get(rig.port, "/api/v1/status").body;
+  EXPECT_EQ(s["tool"], 2);
+  EXPECT_EQ(s["spindle"]["direction"], "cw");
+  EXPECT_EQ(s["offsets"]["tool"]["Z"], 62.5);  // configs/mill-3axis.tbl
   std::uint32_t first_line = 0;
   ASSERT_TRUE(rig.until(
-      [&](const json& s) {
-        if (first_line == 0 && s["job"]["kind"] == "program" && s["job"]["location"]["line"].get<int>() > 0)
-          first_line = s["job"]["location"]["line"].get<std::uint32_t>();
-        return s["runs_finished"].get<int>() >= 2 && s["job"]["kind"] == "" &&
-               s["state"] == "idle";  // approach, program
+      [&](const json& st) {
+        if (first_line == 0 && st["job"]["kind"] == "program" && st["job"]["location"]["line"].get<int>() > 0)
+          first_line = st["job"]["location"]["line"].get<std::uint32_t>();
+        return st["runs_finished"].get<int>() >= 2 && st["job"]["kind"] == "" &&
+               st["state"] == "idle";  // approach, program
       },
       60));
   // Seen while polling when the run is slow enough (a sanitizer build may run past it between polls).

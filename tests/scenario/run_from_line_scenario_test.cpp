@@ -1,13 +1,18 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Run from line: the line resolved to its first move, the approach there, the program resumed
-// with the state it has at that line (a G55 offset set before it); lines that make no move, lie
-// past the end or after an input are refused with words and move nothing.
+// Run from line: the line resolved to its first move, the approach there (the line's tool changed
+// in, its spindle and coolant), the program resumed with the state it has at that line (a G55
+// offset set before it); lines that make no move, lie past the end or after an input are refused
+// with words and move nothing; the scan runs beside the controller, which keeps answering.
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
+#include <condition_variable>
+#include <mutex>
 #include <string>
 
 #include "../control/test_profiles.hpp"
+#include "opencnc/controller/gcode_source.hpp"
 #include "opencnc/controller/run_from_line.hpp"
 #include "scenario.hpp"
 
@@ -28,15 +33,26 @@ constexpr const char* kProgram =
     "o<unused> endsub\n"  // 11
     "M2\n";               // 12
 
+std::shared_ptr<GcodeProgramSource> mill_source() {
+  Diagnostics d;
+  return GcodeProgramSource::create(mill(), d);
+}
+
 struct Rig {
-  Rig() : s(mill()) {
+  explicit Rig(std::shared_ptr<GcodeProgramSource> source = mill_source()) : s(mill(), source) {
     Diagnostics d;
-    feature = std::make_shared<RunFromLineFeature>(GcodeProgramSource::create(mill(), d));
+    feature = RunFromLineFeature::create(mill(), source->tools(), d);
+    EXPECT_TRUE(feature);
     EXPECT_TRUE(s.rig().controller().add_feature(feature));
     s.ticks(1);
   }
+  /// The answer comes once the scan on the feature's thread has ended: the machine ticks meanwhile.
   Outcome run_from(std::uint32_t line) {
-    return s.ask(Request::feature("run-from-line", "start", RunFromLineArgs{line}));
+    Controller& c = s.rig().controller();
+    const std::uint64_t id = c.submit(Request::feature("run-from-line", "start", RunFromLineArgs{line}));
+    std::optional<Outcome> o;
+    EXPECT_TRUE(s.until([&] { return (o = c.outcome(id)).has_value(); }, 1000000));
+    return o.value_or(Outcome{});
   }
   Scenario s;
   std::shared_ptr<RunFromLineFeature> feature;
@@ -145,6 +161,197 @@ TEST(RunFromLineScenario, TheApproachFeedIsPerMinuteUnderInverseTimeAndPerRevolu
   EXPECT_NE(why.find("line 2 feeds per revolution (G95) and no spindle speed in rpm is set before it"),
             std::string::npos)
       << why;
+}
+
+}  // namespace
+}  // namespace opencnc::control::test
+
+namespace opencnc::control::test {
+namespace {
+
+constexpr const char* kTwoTools =
+    "G21 G90 G94 F600\n"  // 1
+    "T1 M6 G43\n"         // 2: configs/mill-3axis.tbl: T1 Z45
+    "S1000 M3\n"          // 3
+    "G0 X0 Y0 Z5\n"       // 4
+    "G1 Z0\n"             // 5
+    "G1 X20\n"            // 6
+    "G0 Z5\n"             // 7
+    "T2 M6 G43\n"         // 8: T2 Z62.5
+    "S2000 M4 M8\n"       // 9
+    "G0 X10 Y10 Z5\n"     // 10
+    "G1 Z-2 F300\n"       // 11
+    "G1 X30\n"            // 12
+    "G0 Z5\n"             // 13
+    "M2\n";               // 14
+
+// Started on a line after the second T M6 with no tool in the spindle: the approach changes T2
+// in (the manual change the operator confirms), starts the spindle counterclockwise at 2000 rpm
+// and the flood, then moves to the line's start with T2's length offset; the program runs on from
+// there. A second start from the line, T2 now in the spindle, changes nothing.
+TEST(RunFromLineScenario, TheApproachChangesToTheLinesToolThenStartsTheSpindleAndCoolant) {
+  TempProgram p("tools.ngc", kTwoTools);
+  Rig r;
+  r.s.on(Mode::Auto);
+  r.s.must(Request::open(p.path()));
+  ASSERT_EQ(r.s.status().servo.tool, 0);
+  const Outcome o = r.run_from(12);
+  ASSERT_TRUE(o.accepted) << o.message;
+  EXPECT_NE(o.message.find("with tool 2 changed in"), std::string::npos) << o.message;
+  ASSERT_TRUE(r.s.until([&] { return r.s.status().servo.wait == Wait::ManualToolChange; }, 5000));
+  EXPECT_EQ(r.s.status().job, JobKind::Auxiliary);
+  EXPECT_EQ(r.s.status().servo.prepared_tool, 2);
+  EXPECT_FALSE(r.s.status().servo.flood);  // nothing after the change has run
+  const Pose at_change = r.s.status().servo.commanded;
+  r.s.must(Request::simple(CommandKind::ToolChanged));
+  ASSERT_TRUE(r.s.until([&] { return r.s.status().job == JobKind::Program; }, 100000));
+  ControllerStatus st = r.s.status();
+  EXPECT_EQ(st.servo.tool, 2);
+  EXPECT_TRUE(st.servo.flood);
+  EXPECT_EQ(st.servo.spindle_direction, machine::SpindleDirection::Counterclockwise);
+  EXPECT_NEAR(st.servo.spindle_rpm, 2000.0, 1e-9);
+  // Line 12's move starts at X10 Y10 Z−2 with T2's 62.5 mm: machine Z 60.5.
+  EXPECT_NEAR(st.servo.commanded[Axis::X], 10.0, 1e-9);
+  EXPECT_NEAR(st.servo.commanded[Axis::Y], 10.0, 1e-9);
+  EXPECT_NEAR(st.servo.commanded[Axis::Z], 60.5, 1e-9);
+  EXPECT_NE(at_change, st.servo.commanded);
+  ASSERT_TRUE(r.s.until(
+      [&] {
+        const ControllerStatus now = r.s.status();
+        EXPECT_NE(now.servo.wait, Wait::ManualToolChange);  // no change after line 12
+        return !now.run_active && now.servo.state == State::Idle;
+      },
+      200000));
+  st = r.s.status();
+  EXPECT_NEAR(st.servo.commanded[Axis::X], 30.0, 1e-9);
+  EXPECT_NEAR(st.servo.commanded[Axis::Z], 67.5, 1e-9);  // G0 Z5 with T2
+  EXPECT_NEAR(st.offsets.tool[Axis::Z], 62.5, 1e-9);
+
+  // Again from line 12: T2 is in the spindle, so the approach goes straight there.
+  const Outcome again = r.run_from(12);
+  ASSERT_TRUE(again.accepted) << again.message;
+  EXPECT_EQ(again.message.find("changed in"), std::string::npos) << again.message;
+  ASSERT_TRUE(r.s.until(
+      [&] {
+        EXPECT_NE(r.s.status().servo.wait, Wait::ManualToolChange);
+        return r.s.status().job == JobKind::Program;
+      },
+      100000));
+  EXPECT_NEAR(r.s.status().servo.commanded[Axis::Z], 60.5, 1e-9);
+  ASSERT_TRUE(r.s.idle(200000));
+}
+
+/// The mill's program source, whose execute() (the run-from-line scan) waits until released:
+/// a scan that lasts as long as the test wants.
+class GatedSource final : public ProgramSource {
+ public:
+  explicit GatedSource(std::shared_ptr<GcodeProgramSource> inner) : inner_(std::move(inner)) {}
+  Preflight preflight(const std::string& path, const Pose& start, const LoadOptions& options,
+                      MoveCheck& check) override {
+    return inner_->preflight(path, start, options, check);
+  }
+  std::unique_ptr<ProgramStream> execute(const std::string& path, const Pose& start,
+                                         const LoadOptions& options) override {
+    std::unique_lock lock(mutex_);
+    entered_ = true;
+    changed_.notify_all();
+    changed_.wait(lock, [&] { return open_; });
+    return inner_->execute(path, start, options);
+  }
+  std::unique_ptr<ProgramStream> mdi(std::string_view line, const Pose& start) override {
+    return inner_->mdi(line, start);
+  }
+  bool wait_entered() {
+    std::unique_lock lock(mutex_);
+    return changed_.wait_for(lock, std::chrono::seconds(10), [&] { return entered_; });
+  }
+  void release() {
+    std::lock_guard lock(mutex_);
+    open_ = true;
+    changed_.notify_all();
+  }
+
+ private:
+  std::shared_ptr<GcodeProgramSource> inner_;
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  bool entered_ = false, open_ = false;
+};
+
+// While the scan runs on its thread the controller answers: the status goes on, a feed override
+// is accepted, a cycle start and a second run from line are refused with the reason, the machine
+// stays idle; once the scan ends the request gets its answer and the program runs from the line.
+TEST(RunFromLineScenario, TheControllerAnswersWhileTheScanRunsAndNothingStarts) {
+  TempProgram p("part.ngc", kProgram);
+  Scenario s(mill());
+  auto gate = std::make_shared<GatedSource>(mill_source());
+  ASSERT_TRUE(s.rig().controller().add_feature(std::make_shared<RunFromLineFeature>(gate)));
+  struct Open {  // a failed assertion still lets the scan's thread end before the rig goes
+    std::shared_ptr<GatedSource> gate;
+    ~Open() { gate->release(); }
+  } open{gate};
+  s.on(Mode::Auto);
+  s.must(Request::open(p.path()));
+  Controller& c = s.rig().controller();
+  const std::uint64_t id = c.submit(Request::feature("run-from-line", "start", RunFromLineArgs{6}));
+  s.ticks(2);
+  ASSERT_TRUE(gate->wait_entered());
+  const std::uint64_t tick = s.status().servo.tick;
+  s.ticks(100);
+  EXPECT_GE(s.status().servo.tick, tick + 100);  // the status goes on
+  EXPECT_FALSE(c.outcome(id).has_value());
+  EXPECT_TRUE(s.ask(Request::feed_override(0.5)).accepted);
+  const Outcome start = s.ask(Request::simple(CommandKind::CycleStart));
+  EXPECT_EQ(start.refusal, Refusal::FeatureCheck);
+  EXPECT_NE(start.message.find("run from line 6: the scan of the program is under way"), std::string::npos)
+      << start.message;
+  EXPECT_EQ(s.ask(Request::feature("run-from-line", "start", RunFromLineArgs{7})).refusal, Refusal::Busy);
+  EXPECT_FALSE(s.status().run_active);
+  EXPECT_EQ(s.status().servo.state, State::Idle);
+  gate->release();
+  std::optional<Outcome> o;
+  ASSERT_TRUE(s.until([&] { return (o = c.outcome(id)).has_value(); }, 1000000));
+  ASSERT_TRUE(o->accepted) << o->message;
+  EXPECT_NE(o->message.find("part.ngc:6"), std::string::npos) << o->message;
+  ASSERT_TRUE(s.until([&] { return s.status().job == JobKind::Program; }, 100000));
+  ASSERT_TRUE(s.idle(200000));
+  EXPECT_NEAR(s.status().servo.commanded[Axis::X], 10.0, 1e-9);
+}
+
+}  // namespace
+}  // namespace opencnc::control::test
+
+namespace opencnc::control::test {
+namespace {
+
+// A G10 L1 before the line is written to the table when the program runs, not when it is
+// scanned: the scan reads the live table and writes a copy of its own, dropped before the next.
+TEST(RunFromLineScenario, TheScanReadsTheLiveToolTableAndWritesOnlyItsOwnCopy) {
+  tools::ToolTable table;
+  tools::ToolEntry t1;
+  t1.tool = 1;
+  t1.pocket = 1;
+  t1.offset[Axis::Z] = 45;
+  ASSERT_TRUE(table.add(t1));
+  auto live = std::make_shared<tools::MemoryToolTable>(table);
+  auto scan = std::make_shared<ScanToolTable>(live);
+  Diagnostics d;
+  std::optional<GcodeSourceConfig> config = GcodeProgramSource::config_for(mill(), d);
+  ASSERT_TRUE(config);
+  config->tools = scan;
+  GcodeProgramSource source(std::move(*config));
+  TempProgram p("g10.ngc", "G21 G90\nT1 M6\nG10 L1 P1 Z99\nG43\nG0 X1 Z5\nM2\n");
+  std::string why;
+  const auto at = find_line_start(source, p.path(), Pose{}, 5, {}, &why);
+  ASSERT_TRUE(at.has_value()) << why;
+  EXPECT_NEAR(at->tool_offset[Axis::Z], 99.0, 1e-9);  // the program's own G10 holds at the line
+  EXPECT_EQ(at->tool, 1);
+  EXPECT_NEAR(live->snapshot()->tool(1)->offset[Axis::Z], 45.0, 1e-9);
+  EXPECT_NEAR(scan->snapshot()->tool(1)->offset[Axis::Z], 99.0, 1e-9);
+  const std::uint64_t version = scan->version();
+  scan->reset();
+  EXPECT_GT(scan->version(), version);
+  EXPECT_NEAR(scan->snapshot()->tool(1)->offset[Axis::Z], 45.0, 1e-9);
 }
 
 }  // namespace

@@ -20,9 +20,13 @@ export function actionFields(a: DialogAction, values: Values, confirmed: boolean
 
 /** The question a confirmed button asks, with the inputs' values it sends. */
 export function question(a: DialogAction, fields: DialogField[], values: Values): string {
+  const shown = (k: string, v: unknown) => {
+    const f = fields.find((x) => x.name === k);  // an input's own label and unit where it has one
+    return f ? `${f.label.toLowerCase()} ${v}${f.unit ? ` ${f.unit}` : ""}` : `${k.replace(/_/g, " ")} ${v}`;
+  };
   const detail = !a.form ? ""
-    : a.transform ? Object.entries(a.transform(values)).map(([k, v]) => `${k.replace(/_/g, " ")} ${v}`).join(", ")
-      : fields.map((f) => `${f.label.toLowerCase()} ${values[f.name]}${f.unit ? ` ${f.unit}` : ""}`).join(", ");
+    : a.transform ? Object.entries(a.transform(values)).map(([k, v]) => shown(k, v)).join(", ")
+      : fields.map((f) => shown(f.name, values[f.name])).join(", ");
   return detail ? `${a.confirm} (${detail})` : (a.confirm ?? "");
 }
 
@@ -69,5 +73,7 @@ export function renderDialog(dialog: HTMLDialogElement, d: Dialog, s: Status, se
   const row = el("div", { class: "row" });
   const inputs = fields.length ? [renderFields(fields, values)] : [];
   renderActions(row, d.actions(s), fields, values, send);
-  dialog.replaceChildren(el("h2", {}, d.title(s)), el("p", { class: "dialog-text" }, d.text(s)), ...inputs, row);
+  const more = d.more?.(s);
+  const folded = more ? [el("details", { class: "dialog-more" }, el("summary", {}, more.summary), el("pre", {}, more.text))] : [];
+  dialog.replaceChildren(el("h2", {}, d.title(s)), el("p", { class: "dialog-text" }, d.text(s)), ...folded, ...inputs, row);
 }

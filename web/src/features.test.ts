@@ -5,7 +5,7 @@
 import { describe, expect, it } from "vitest";
 import { actionFields, question } from "./dialog_view";
 import { recoveryPending } from "./dialogs/recovery";
-import "./dialogs/toolcheck";
+import { splitDifferences, toolCheckMore, toolCheckText } from "./dialogs/toolcheck";
 import { dialogFor } from "./dialogs/waits";
 import { alarmLines, edmRows, loadBanner, loadText } from "./panels/process";
 import { retraceControls, retraceText } from "./panels/retrace";
@@ -53,13 +53,31 @@ describe("power-fail recovery dialog", () => {
     const actions = d.actions(base);
     expect(actions.map((a) => a.fields?.action)).toEqual(["resume", "retract", "discard"]);
     for (const a of actions) expect(a.confirm).toBeTruthy();
-    expect(d.fields!(base).map((f) => f.name)).toEqual(["distance_mm", "direction", "speed_mm_min"]);
+    expect(d.fields!(base).map((f) => f.name)).toEqual(
+      ["tolerance_mm", "tolerance_deg", "run_in_mm", "run_in_speed_mm_min", "distance_mm", "direction", "speed_mm_min"]);
+    const values = { tolerance_mm: 0.01, tolerance_deg: 0.01, run_in_mm: 2, run_in_speed_mm_min: 600, distance_mm: 2, direction: "onward", speed_mm_min: 50 };
     const retract = actions[1];
-    expect(actionFields(retract, { distance_mm: 2, direction: "onward", speed_mm_min: 50 }, true)).toEqual({
+    expect(actionFields(retract, values, true)).toEqual({
       feature: "journal", action: "retract", distance_mm: 2, direction: "onward", speed_mm_min: 50, confirmed: true,
     });
     // Unconfirmed, a choice carries no confirmation (the server refuses it).
     expect(actionFields(actions[2], {}, false)).toEqual({ feature: "journal", action: "discard" });
+  });
+  it("shows the resume's tolerances and run-in from the profile, sends the operator's values and names them in the question", () => {
+    const d = dialogFor(base)!;
+    const s = withJournal({ can_retract: false, resume_defaults: { tolerance_mm: 0.02, tolerance_deg: 0.05, run_in_mm: 3, run_in_speed_mm_min: 400 } });
+    expect(d.fields!(s).map((f) => [f.name, f.value])).toEqual(
+      [["tolerance_mm", 0.02], ["tolerance_deg", 0.05], ["run_in_mm", 3], ["run_in_speed_mm_min", 400]]);
+    const resume = d.actions(s)[0];
+    expect(resume.fields?.action).toBe("resume");
+    const values = { tolerance_mm: 0.05, tolerance_deg: 0.05, run_in_mm: 1.5, run_in_speed_mm_min: 400 };
+    expect(actionFields(resume, values, true)).toEqual({
+      feature: "journal", action: "resume", tolerance_mm: 0.05, tolerance_deg: 0.05, run_in_mm: 1.5, run_in_speed_mm_min: 400, confirmed: true,
+    });
+    expect(question(resume, d.fields!(s), values)).toBe(
+      "Resume the program from the breakpoint, then on to its end (resume within 0.05 mm, and 0.05 °, run-in 1.5 mm, at 400 mm/min)");
+    // Without the server's values: recovery::ResumeArgs' defaults.
+    expect(d.fields!(withJournal({ can_retract: false })).map((f) => f.value)).toEqual([0.01, 0.01, 2, 600]);
   });
   it("offers only what the record allows, AUTO first when needed, and says why a choice failed", () => {
     const d = dialogFor(base)!;
@@ -91,8 +109,8 @@ describe("load guard", () => {
 
 describe("process panels", () => {
   it("lists the alarms with their state", () => {
-    const s = { ...base, alarms: [{ name: "dielectric_level", active: true, reaction: "stop", low: 40, high: null, unit: "mm" }] } as unknown as Status;
-    expect(alarmLines(s)).toEqual([{ text: "dielectric_level: ALARM (≥ 40 mm; stop)", active: true }]);
+    const s = { ...base, alarms: [{ name: "dielectric_level", active: true, reaction: "stop", low: 40, high: null, unit: "mm", value: 38.25 }] } as unknown as Status;
+    expect(alarmLines(s)).toEqual([{ text: "dielectric_level: ALARM 38.25 mm (≥ 40 mm; stop)", active: true }]);
   });
   it("shows the EDM's gap against the reference, the discharge, jumps and depth", () => {
     const s = {
@@ -125,6 +143,26 @@ describe("tool check dialog", () => {
     expect(actions[2].confirm).toContain("Overwrite the live values with backup 1's");
     expect(actions[0].confirm).toBeUndefined();
   });
+  it("lists the program's tools' differences first and folds the others", () => {
+    const many = {
+      ...check,
+      differences: ["T1 D1 length1: backup 45, live 46 (…)", "T5 D1 length1: backup 193.225, live 139.225 (…)", "T9 D1 radius: backup 3, live 3.5 (…)"],
+      difference_tools: [1, 5, 9],
+    };
+    const s = { ...held, features: { installed: ["tool-guard"], tool_guard: { store: "x.db", holding: true, check: many } } } as unknown as Status;
+    expect(splitDifferences(s, [2, 5])).toEqual({ used: [many.differences[1]], rest: [many.differences[0], many.differences[2]] });
+    const text = toolCheckText(s, [2, 5]);
+    expect(text).toContain("differ from backup 1 of 2026-11-26T09:56:24Z in the program's tools (T2 T5):\nT5 D1 length1");
+    expect(text).not.toContain("T9");
+    expect(toolCheckMore(s, [2, 5])).toEqual({
+      summary: "2 more differences in tools the program does not use", text: `${many.differences[0]}\n${many.differences[2]}`,
+    });
+    // The program's tools not known (no preview yet): every difference, nothing folded.
+    expect(splitDifferences(s, []).rest).toEqual([]);
+    expect(toolCheckMore(s, [])).toBeUndefined();
+    // None of the program's tools differ: said so, the others below.
+    expect(toolCheckText(s, [2])).toContain("(none of the program's tools; the others differ, below)");
+  });
   it("is not shown when the guard does not hold", () => {
     expect(dialogFor({ ...held, features: { installed: ["tool-guard"], tool_guard: { store: "x.db", holding: false, check: null } } } as Status))
       .toBeUndefined();
@@ -148,7 +186,7 @@ describe("retrace panel", () => {
     expect(actionFields(actions[1], values, false)).toEqual({ feature: "retrace", action: "step", distance_mm: 3 });
     expect(actions[2].confirm).toBeTruthy();
     expect(actionFields(actions[2], values, true)).toEqual({ feature: "retrace", action: "start", metric: "xyz", confirmed: true });
-    expect(question(actions[2], fields, values)).toBe("Light the torch and cut on from the nearest point of the path? (metric xyz)");
+    expect(question(actions[2], fields, values)).toBe("Light the torch and cut on from the nearest point of the path? (nearest in xyz)");
   });
 });
 

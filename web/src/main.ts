@@ -11,6 +11,7 @@ import "./dialogs/toolcheck";
 import { dialogFor } from "./dialogs/waits";
 import "./panels/process";
 import "./panels/retrace";
+import { programInfo } from "./program_info";
 import { panels, screens, type Context } from "./registry";
 import "./screens/jog";
 import "./screens/mdi";
@@ -191,12 +192,23 @@ async function start() {
   v3.setMachine(machine);
   const loadPreview = async () => {
     try {
-      v3.setPreview(await api.get<Preview>("program/preview"));
+      const p = await api.get<Preview>("program/preview");
+      programInfo.tools = p.tools ?? [];
+      v3.setPreview(p);
     } catch {
       /* no program open */
     }
   };
   document.addEventListener("program-opened", () => void loadPreview());
+  // The soft limits changed (an admin's parameter change, from any page): the box follows.
+  let limitsSeen = -1;
+  const followLimits = async (version: number) => {
+    const first = limitsSeen < 0;
+    limitsSeen = version;
+    if (first) return;
+    Object.assign(machine, await api.get<Machine>("machine"));
+    v3.setMachine(machine);
+  };
   show(screens[0].id);
 
   const render = (s: Status) => {
@@ -217,8 +229,10 @@ async function start() {
     workHead.title = offsetsText(s.offsets, machine.axes.map((a) => a.axis));
     progName.textContent = s.program.name ? `${s.program.name.split("/").pop()} — ${s.program.moves} moves, ${s.program.length_mm.toFixed(1)} mm` : "no program open";
     progress.value = s.job.progress;
+    if (typeof s.limits_version === "number" && s.limits_version !== limitsSeen) void followLimits(s.limits_version);
     if (s.program.name !== listingOf) {
       listingOf = s.program.name;
+      programInfo.tools = [];
       void loadListing();
       void loadPreview();
     }
@@ -239,7 +253,7 @@ async function start() {
     v3.setTool(s.machine.X ?? 0, s.machine.Y ?? 0, s.machine.Z ?? 0, s.job.active && s.job.kind === "program");
     const d = dialogFor(s);
     // Drawn again when what it says or offers changes (not at every status: its inputs keep their values).
-    const key = d ? `${d.id}|${d.text(s)}|${d.actions(s).map((a) => a.label).join(",")}` : "";
+    const key = d ? `${d.id}|${d.text(s)}|${d.more?.(s)?.text ?? ""}|${d.actions(s).map((a) => a.label).join(",")}` : "";
     if (key !== dialogKey) {
       dialogKey = key;
       if (!d) {

@@ -66,6 +66,8 @@ export interface Dialog {
   actions(s: Status): DialogAction[];
   /** Inputs shown above the buttons (kept while the dialog stays open). */
   fields?(s: Status): DialogField[];
+  /** A part of the text folded under a summary line (opened with a click), if any. */
+  more?(s: Status): { summary: string; text: string } | undefined;
 }
 
 /** A panel of the main screen's process column (the load, the alarms, the EDM's live values). */

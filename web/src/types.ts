@@ -64,6 +64,8 @@ export interface Status {
   };
   sync_wait: string;
   runs_finished: number;
+  /** Counts the machine parameters' changes: the soft-limit box is read again when it changes. */
+  limits_version: number;
   /** The process side and the features (types_features.ts); each present when the machine has it. */
   power?: Power;
   load?: Load;

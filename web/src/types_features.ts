@@ -23,6 +23,8 @@ export interface Alarm {
   low: number | null;
   high: number | null;
   unit: string;
+  /** The input as read now, in `unit`. */
+  value: number;
 }
 
 /** The EDM gap servo's live values. */
@@ -68,6 +70,8 @@ export interface JournalState {
   can_resume: boolean;
   can_retract: boolean;
   mains_ok: boolean;
+  /** The resume's values from the profile, offered in the dialog (the operator may change them). */
+  resume_defaults?: { tolerance_mm: number; tolerance_deg: number; run_in_mm: number; run_in_speed_mm_min: number };
 }
 
 export interface RetraceState {
@@ -99,7 +103,9 @@ export interface ToolGuardState {
   store: string;
   holding: boolean;
   /** While holding: the check of the live table against the backup. */
-  check: { ok: boolean; error: string; backup: { id: number; taken: string } | null; differences: string[]; report: string } | null;
+  check: { ok: boolean; error: string; backup: { id: number; taken: string } | null; differences: string[];
+    /** The tool of each difference (the dialog lists the program's tools first). */
+    difference_tools?: number[]; report: string } | null;
 }
 
 export interface Features {

@@ -9,6 +9,8 @@ export interface Preview {
   polylines: { rapid: boolean; points: number[] }[];
   moves: number;
   truncated: boolean;
+  /** The tools the program puts in the spindle. */
+  tools?: number[];
 }
 
 const kTrail = 20000;  // points of the path cut kept

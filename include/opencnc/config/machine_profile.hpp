@@ -105,6 +105,10 @@ struct SpindleProfile {
 struct PowerProfile {
   bool monitor = false;         ///< the machine reports mains, UPS and DC link
   machine::SimPowerConfig sim;  ///< ups, voltages, and the simulated supply
+  /// A resume after a power failure, as offered to the operator (who may change them): how far
+  /// the axes may stand from the breakpoint (mm, degrees), the run-in and its speed.
+  double resume_tolerance_mm = 0.01, resume_tolerance_deg = 0.01;
+  double resume_run_in_mm = 2.0, resume_run_in_speed_mm_min = 600;
 };
 
 /// `[probe.reference_sphere]`: the sphere electrodes are set against (docs/electrode-setting.md).

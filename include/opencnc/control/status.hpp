@@ -14,6 +14,7 @@
 #include "opencnc/control/load_guard.hpp"
 #include "opencnc/core/axes.hpp"
 #include "opencnc/machine/machine_io.hpp"
+#include "opencnc/machine/process_alarms.hpp"
 #include "opencnc/motion/coupling.hpp"
 #include "opencnc/traj/interpolator.hpp"
 
@@ -142,6 +143,8 @@ struct ServoStatus {
   std::int8_t interlock_rule = -1;
   std::uint32_t interlocks_true = 0;  ///< bit per rule whose condition holds
   std::uint16_t alarms_active = 0;    ///< bit per process alarm whose input is out of range
+  /// Each process alarm's input as read this period (in its profile unit; 0 past the count).
+  std::array<double, machine::kMaxProcessAlarms> alarm_values{};
   std::int8_t handwheel_axis = -1;    ///< the axis the handwheel moves (−1 = none)
   double handwheel_step = 0;          ///< units per count
   CouplingStatus coupling{};          ///< the axis coupling (broaching)

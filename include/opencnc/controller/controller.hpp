@@ -99,6 +99,9 @@ class Controller final : private FeatureHost {
   // FeatureHost
   const ControllerStatus& current_status() const override { return published_; }
   void note(Severity s, std::string code, std::string text) override;
+  std::uint64_t defer() override;
+  void answer(std::uint64_t id, Outcome outcome) override;
+  void poll_features();
 
   void read_servo();
   void deliver_trace();
@@ -178,6 +181,8 @@ class Controller final : private FeatureHost {
   std::vector<Attached> observers_;
   std::map<std::string, std::shared_ptr<Feature>, std::less<>> features_;
   std::string held_by_;  ///< the feature that holds the job at a sync point ("" while none does)
+  std::uint64_t handling_ = 0;  ///< the feature request being handled (0: none)
+  bool deferred_ = false;       ///< its feature answers it later (FeatureHost::defer)
   std::uint64_t described_fault_tick_ = ~std::uint64_t{0};
   Pose open_at_{};               ///< where the machine stood when the open program was checked
   bool open_block_delete_ = false;

@@ -89,6 +89,9 @@ struct ControllerStatus {
   bool block_delete = false;  ///< the block-delete switch ('/' lines skipped by the programs started now)
   std::string fault_text;           ///< servo.fault in words ("" = none)
   std::uint64_t runs_finished = 0;  ///< jobs that reached their program end
+  /// Counts the machine parameters' changes applied (EditProfile): a front end that shows the
+  /// soft limits reads them again when it changes.
+  std::uint32_t limits_version = 0;
 };
 
 }  // namespace opencnc::control

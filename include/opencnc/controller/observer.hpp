@@ -67,6 +67,12 @@ class FeatureHost {
   virtual const config::MachineProfile& profile() const = 0;
   /// A note for the operator, in the event log.
   virtual void note(Severity severity, std::string code, std::string text) = 0;
+  /// Inside Feature::handle only: the request being handled is answered later, by answer()
+  /// (work on a thread of the feature's own: a scan of a long program); handle's Outcome is then
+  /// not used. Returns the request's id. Controller thread.
+  virtual std::uint64_t defer() = 0;
+  /// The answer to a request deferred with defer() (once). Controller thread.
+  virtual void answer(std::uint64_t id, Outcome outcome) = 0;
 };
 
 /// What is about to start: asked of every feature before a program or auxiliary program starts.
@@ -105,6 +111,10 @@ class Feature : public ControllerObserver {
   virtual void attached(FeatureHost& /*host*/) {}
   /// Handles one request addressed to this feature. Controller thread.
   virtual Outcome handle(const requests::Feature& request, FeatureHost& host) = 0;
+  /// Every service(), before the job is served: a feature whose work runs on a thread of its
+  /// own looks here whether it is done (and answers a deferred request). Controller thread; keep
+  /// it cheap (an atomic load).
+  virtual void poll(FeatureHost& /*host*/) {}
 };
 
 }  // namespace opencnc::control

@@ -15,7 +15,8 @@ namespace opencnc::hmi {
 /// Scans `path` (the interpreter in scan mode, the options the source gives the file) from the
 /// machine position `start`, at most `max_moves` moves, into
 /// `{"polylines": [{"rapid": bool, "points": [x, y, z, …]}], "moves": n, "truncated": bool,
-///   "diagnostics": [...]}`. Non-real-time; any thread but the controller's (it may take a while).
+///   "diagnostics": [...], "tools": [the tools its M6/M61 put in the spindle]}`. Non-real-time;
+/// any thread but the controller's (it may take a while).
 nlohmann::json program_preview(const control::GcodeProgramSource& source, const std::string& path,
                                const Pose& start, std::size_t max_moves = 200000);
 

@@ -5,6 +5,16 @@ import { registerDialog, type DialogAction } from "../registry";
 import type { Status } from "../types";
 import type { JournalState } from "../types_features";
 
+/** The resume's values when the server sends none (recovery::ResumeArgs' defaults). */
+const kResumeDefaults = { tolerance_mm: 0.01, tolerance_deg: 0.01, run_in_mm: 2, run_in_speed_mm_min: 600 };
+const kResumeFields = ["tolerance_mm", "tolerance_deg", "run_in_mm", "run_in_speed_mm_min"];
+const kRetractFields = ["distance_mm", "direction", "speed_mm_min"];
+
+/** A choice's own inputs out of the dialog's (resume and retract share the form). */
+function pick(names: string[]) {
+  return (values: Record<string, number | string>) => Object.fromEntries(names.filter((n) => n in values).map((n) => [n, values[n]]));
+}
+
 /** The phases in which a recovery choice is under way (the dialog steps aside meanwhile). */
 const busy = ["opening", "running-in", "resuming", "retracting"];
 
@@ -42,11 +52,22 @@ registerDialog({
     const auto = s.mode !== "auto" ? " Resume needs AUTO mode." : "";
     return `${recordText(s)} You may ${offer}.${auto}${failed}`;
   },
-  fields: (s) => (journal(s)?.can_retract && s.state === "idle"
-    ? [{ name: "distance_mm", label: "Distance", value: 5, unit: "mm" },
-      { name: "direction", label: "direction", value: "back", options: ["back", "onward"] },
-      { name: "speed_mm_min", label: "at", value: 100, unit: "mm/min" }]
-    : []),
+  fields: (s) => {
+    const j = journal(s);
+    if (!j || s.state !== "idle") return [];
+    const d = j.resume_defaults ?? kResumeDefaults;
+    return [
+      ...(j.can_resume ? [
+        { name: "tolerance_mm", label: "Resume within", value: d.tolerance_mm, unit: "mm" },
+        { name: "tolerance_deg", label: "and", value: d.tolerance_deg, unit: "°" },
+        { name: "run_in_mm", label: "run-in", value: d.run_in_mm, unit: "mm" },
+        { name: "run_in_speed_mm_min", label: "at", value: d.run_in_speed_mm_min, unit: "mm/min" }] : []),
+      ...(j.can_retract ? [
+        { name: "distance_mm", label: "Distance", value: 5, unit: "mm" },
+        { name: "direction", label: "direction", value: "back", options: ["back", "onward"] },
+        { name: "speed_mm_min", label: "at", value: 100, unit: "mm/min" }] : []),
+    ];
+  },
   actions: (s) => {
     const j = journal(s)!;
     if (s.power && (!s.power.mains_ok || s.power.on_battery)) return [];
@@ -57,8 +78,8 @@ registerDialog({
     const out: DialogAction[] = [];
     if (s.mode !== "auto") out.push({ label: "AUTO mode", kind: "mode", fields: { mode: "auto" } });
     if (j.can_resume)
-      out.push(feature("resume", "Resume", "Resume the program from the breakpoint (a 2 mm run-in, then on to its end)?", { cls: "go" }));
-    if (j.can_retract) out.push(feature("retract", "Retract", "Retract the cutter", { form: true }));
+      out.push(feature("resume", "Resume", "Resume the program from the breakpoint, then on to its end", { cls: "go", form: true, transform: pick(kResumeFields) }));
+    if (j.can_retract) out.push(feature("retract", "Retract", "Retract the cutter", { form: true, transform: pick(kRetractFields) }));
     out.push(feature("discard", "Discard", "Discard the breakpoint? The program cannot be resumed from it afterwards.", { cls: "danger" }));
     return out;
   },

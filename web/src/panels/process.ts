@@ -24,11 +24,12 @@ export function loadBanner(s: Status): string {
   return "";
 }
 
-/** One line per process alarm: name, state, bounds and what it does. */
+/** One line per process alarm: name, state, the input now, bounds and what it does. */
 export function alarmLines(s: Status): { text: string; active: boolean }[] {
   return (s.alarms ?? []).map((a) => {
     const range = [a.low !== null ? `≥ ${a.low}` : "", a.high !== null ? `≤ ${a.high}` : ""].filter((x) => x).join(" and ");
-    return { text: `${a.name}: ${a.active ? "ALARM" : "ok"} (${range} ${a.unit}; ${a.reaction})`.replace(" ;", ";"), active: a.active };
+    const value = typeof a.value === "number" ? ` ${a.value.toFixed(2)}${a.unit ? ` ${a.unit}` : ""}` : "";
+    return { text: `${a.name}: ${a.active ? "ALARM" : "ok"}${value} (${range} ${a.unit}; ${a.reaction})`.replace(" ;", ";"), active: a.active };
   });
 }
 
