@@ -8,6 +8,7 @@
 #include <chrono>
 #include <thread>
 
+#include "../control/test_profiles.hpp"
 #include "opencnc/hmi/history.hpp"
 #include "opencnc/hmi/machine_host.hpp"
 #include "opencnc/hmi/server.hpp"
