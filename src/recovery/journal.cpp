@@ -53,14 +53,28 @@ bool sync_folder(const std::string& dir, std::string* error) {
   return true;
 }
 
-// A slot file is made kPresize bytes long (zeros: no record) once, when opened shorter: a record
-// that fits then never changes the file's size, so its fdatasync flushes the data blocks only and
-// not the inode (about half the latency of the first write into a fresh file on ext4).
+// A slot file is made kPresize bytes long and its blocks allocated and written, once, when opened
+// shorter or sparse: a record that fits then changes neither the file's size nor its block map, so
+// the fdatasync of a record has no metadata to commit, only the data block to write (ftruncate
+// alone leaves a hole, whose first write allocates a block: an extent change for the file
+// system's journal inside the signal's fdatasync). The bytes there are written back as they
+// read (a hole reads as zeros: no record), so a slot that holds a record keeps it even if this
+// write is torn.
 bool presize(int fd) {
   struct stat st {};
   if (::fstat(fd, &st) != 0) return false;
-  if (st.st_size >= kPresize) return true;
-  return ::ftruncate(fd, kPresize) == 0 && ::fsync(fd) == 0;
+  if (st.st_size >= kPresize && st.st_blocks * 512 >= kPresize) return true;
+  std::array<std::byte, kPresize> bytes{};
+  const ssize_t got = ::pread(fd, bytes.data(), bytes.size(), 0);
+  if (got < 0) return false;
+  std::size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t n = ::pwrite(fd, bytes.data() + done, bytes.size() - done, static_cast<off_t>(done));
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return false;
+    done += static_cast<std::size_t>(n);
+  }
+  return ::fsync(fd) == 0;
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <signal.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -65,6 +66,40 @@ TEST(Journal, RecordsSurviveReopening) {
   EXPECT_TRUE(matches(*r));
   ASSERT_TRUE(j->write(payload(6), &error));  // numbering goes on
   EXPECT_EQ(j->read()->sequence, 6u);
+  std::filesystem::remove_all(dir);
+}
+
+/// Bytes the file system has allocated to `path` (a hole has none).
+std::uintmax_t allocated_bytes(const std::filesystem::path& path) {
+  struct stat st {};
+  return ::stat(path.c_str(), &st) == 0 ? static_cast<std::uintmax_t>(st.st_blocks) * 512 : 0;
+}
+
+// The slots are written out when opened, so a record's fdatasync has no block to allocate; a
+// short slot holding a record (an older journal's) keeps the record while it is filled out.
+TEST(Journal, SlotsAreAllocatedWhenOpenedAndKeepTheirRecord) {
+  const auto dir = fresh_dir();
+  std::string error;
+  {
+    auto j = Journal::open(dir.string(), &error);
+    ASSERT_TRUE(j) << error;
+    for (const char* slot : {"slot-a.jrn", "slot-b.jrn"}) {
+      EXPECT_EQ(std::filesystem::file_size(dir / slot), 4096u) << slot;
+      EXPECT_GE(allocated_bytes(dir / slot), 4096u) << slot;
+    }
+    ASSERT_TRUE(j->write(payload(1), &error)) << error;
+  }
+  // slot-a cut down to the record alone, as a journal that did not fill its slots left it.
+  const std::size_t record_bytes = 24 + payload(1).size() + 4;
+  std::filesystem::resize_file(dir / "slot-a.jrn", record_bytes);
+  auto j = Journal::open(dir.string(), &error);
+  ASSERT_TRUE(j) << error;
+  EXPECT_EQ(std::filesystem::file_size(dir / "slot-a.jrn"), 4096u);
+  EXPECT_GE(allocated_bytes(dir / "slot-a.jrn"), 4096u);
+  const auto r = j->read();
+  ASSERT_TRUE(r.has_value());
+  EXPECT_EQ(r->sequence, 1u);
+  EXPECT_TRUE(matches(*r));
   std::filesystem::remove_all(dir);
 }
 
