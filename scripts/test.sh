@@ -68,13 +68,29 @@ echo "== test suite under ASan + UBSan"
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 ctest --preset asan -j "$jobs" -E 'Conformance[.]Program/'
 ctest --preset asan -j "$jobs" -R 'Conformance[.]Program/' -I ,,10
+fuzz=0
+compgen -G "fuzz/*/CMakeLists.txt" >/dev/null && fuzz=1
+if ((fuzz)); then
+  # The fuzz targets (the G-code libraries again, with clang) build at low priority beside the
+  # end-to-end test, which mostly waits on the browser and the machine; their log follows it.
+  fuzz_log=$(mktemp)
+  (cmake --preset fuzz >/dev/null && nice -n 15 cmake --build --preset fuzz -j "$jobs") >"$fuzz_log" 2>&1 &
+  fuzz_build=$!
+  trap 'kill "$fuzz_build" 2>/dev/null || true; rm -f "$fuzz_log"' EXIT
+fi
 echo "== HMI front end: build, unit tests, end to end in headless Chromium (the sanitized opencnc)"
 scripts/hmi.sh --test --e2e --opencnc build-asan/opencnc
 
-if compgen -G "fuzz/*/CMakeLists.txt" >/dev/null; then
+if ((fuzz)); then
   echo "== fuzz gate (the G-code libraries and the fuzz targets only; ASan + UBSan)"
-  cmake --preset fuzz >/dev/null
-  cmake --build --preset fuzz -j "$build_jobs"
+  built=0
+  wait "$fuzz_build" && built=1
+  tail -n 3 "$fuzz_log"
+  if ((!built)); then
+    cat "$fuzz_log"
+    echo "test.sh: the fuzz targets did not build" >&2
+    exit 1
+  fi
   scripts/fuzz.sh --gate
 fi
 echo "== all tests passed"

@@ -31,6 +31,11 @@ config::MachineProfile edm_machine() {
   return loaded(config::load_profile(OPENCNC_SOURCE_DIR "/configs/edm-5axis.toml", sets));
 }
 
+/// Positions from the simulated steppers are whole steps (0.625 µm) and the machine's zero, homed
+/// on its switches, lies within a step of the switch: two steps is as close as a centre or an
+/// offset measured on the machine can be asked to come.
+constexpr double kTwoSteps = 2 * 0.000625 + 1e-9;
+
 /// Machine on and every axis homed on its switches (the EDM's steppers know nothing at power-up).
 bool on_and_homed(SimRig& rig) {
   if (!rig.request(Request::simple(CommandKind::MachineOn)).accepted) return false;
@@ -153,7 +158,7 @@ struct ElectrodeRig {
     feature = std::make_shared<ElectrodeSetting>(tools, profile);
     EXPECT_TRUE(rig->controller().add_feature(feature, ObserverOptions{profile.servo_period_s, true}));
     rig->step();
-    EXPECT_TRUE(rig->request(Request::simple(CommandKind::MachineOn)).accepted);
+    EXPECT_TRUE(on_and_homed(*rig));
   }
   bool idle() {
     return rig->run_until(
@@ -218,7 +223,7 @@ TEST(EdmElectrode, AnUnmeasuredElectrodeBurnsOffByItsErrorAMeasuredOneWhereProgr
   measured.mdi("T1 M6");
   const ElectrodeResult m = measured.measure(1);
   ASSERT_TRUE(m.ok) << m.message;
-  for (std::size_t i = 0; i < 3; ++i) EXPECT_NEAR(m.offset[i], truth[i], 0.001) << "axis " << i;
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_NEAR(m.offset[i], truth[i], kTwoSteps) << "axis " << i;
   ASSERT_TRUE(measured.run(kBurnWithG43, "measured"));
 
   const double depth = exact.sim().depth_mm();
@@ -226,13 +231,13 @@ TEST(EdmElectrode, AnUnmeasuredElectrodeBurnsOffByItsErrorAMeasuredOneWhereProgr
   // Unmeasured: the longer electrode burns 50 µm deeper (within the gap's spread at the end of the
   // servo's two runs), the cavity 30 µm toward −X and 20 µm toward +Y of where the program put it.
   EXPECT_NEAR(unmeasured.sim().depth_mm() - depth, truth[2], 0.002);
-  EXPECT_NEAR(unmeasured.sim().cavity_centre_mm(0), -truth[0], 0.001);
-  EXPECT_NEAR(unmeasured.sim().cavity_centre_mm(1), -truth[1], 0.001);
+  EXPECT_NEAR(unmeasured.sim().cavity_centre_mm(0), -truth[0], kTwoSteps);
+  EXPECT_NEAR(unmeasured.sim().cavity_centre_mm(1), -truth[1], kTwoSteps);
   // Measured and stored: G43 moves the holder by the measured offsets, the cavity is the program's.
   EXPECT_NEAR(measured.sim().depth_mm(), depth, 0.002);
-  EXPECT_NEAR(measured.sim().cavity_centre_mm(0), 0, 0.001);
-  EXPECT_NEAR(measured.sim().cavity_centre_mm(1), 0, 0.001);
-  EXPECT_NEAR(exact.sim().cavity_centre_mm(0), 0, 0.001);
+  EXPECT_NEAR(measured.sim().cavity_centre_mm(0), 0, kTwoSteps);
+  EXPECT_NEAR(measured.sim().cavity_centre_mm(1), 0, kTwoSteps);
+  EXPECT_NEAR(exact.sim().cavity_centre_mm(0), 0, kTwoSteps);
 }
 
 TEST(EdmElectrode, AWornElectrodeReplacedMidJobFinishesTheCavityAsAnUninterruptedJob) {
@@ -269,7 +274,7 @@ TEST(EdmElectrode, AWornElectrodeReplacedMidJobFinishesTheCavityAsAnUninterrupte
   changed.rig->machine().replace_electrode(1, fresh, 0.8);
   const ElectrodeResult m = changed.measure(1);
   ASSERT_TRUE(m.ok) << m.message;
-  for (std::size_t i = 0; i < 3; ++i) EXPECT_NEAR(m.offset[i], fresh[i], 0.001) << "axis " << i;
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_NEAR(m.offset[i], fresh[i], kTwoSteps) << "axis " << i;
   const std::uint64_t finished = changed.rig->status().runs_finished;
   const Outcome resumed = changed.rig->request(Request::feature("electrode", "resume"));
   ASSERT_TRUE(resumed.accepted) << resumed.message;
@@ -283,8 +288,8 @@ TEST(EdmElectrode, AWornElectrodeReplacedMidJobFinishesTheCavityAsAnUninterrupte
   const double depth = whole.sim().depth_max_mm();
   EXPECT_GT(depth, 0.07);
   EXPECT_NEAR(changed.sim().depth_max_mm(), depth, 0.002);
-  EXPECT_NEAR(changed.sim().cavity_centre_mm(0), whole.sim().cavity_centre_mm(0), 0.001);
-  EXPECT_NEAR(changed.sim().cavity_centre_mm(1), whole.sim().cavity_centre_mm(1), 0.001);
+  EXPECT_NEAR(changed.sim().cavity_centre_mm(0), whole.sim().cavity_centre_mm(0), kTwoSteps);
+  EXPECT_NEAR(changed.sim().cavity_centre_mm(1), whole.sim().cavity_centre_mm(1), kTwoSteps);
   for (int k = 0; k < machine::SimEdmProcess::kSides; ++k)
     EXPECT_NEAR(changed.sim().side_wall_mm(k), whole.sim().side_wall_mm(k), 0.002) << "direction " << k;
   // A fresh electrode burnt the rest: it lost less than the uninterrupted job's one electrode.

@@ -64,7 +64,7 @@ TEST(Server, BadRequestsGetA4xxWithAMessageAndChangeNothing) {
   EXPECT_EQ(post(rig.port, R"({"kind":"open","program":"../configs/mill-3axis.toml"})", kOperator).status,
             400);
   EXPECT_EQ(get(rig.port, "/api/v1/nothing", kOperator).status, 404);
-  EXPECT_EQ(call(rig.port, http::verb::get, "/api/v1/commands", kOperator).status, 405);
+  EXPECT_EQ(call(rig.port, Method::Get, "/api/v1/commands", kOperator).status, 405);
   EXPECT_EQ(call_declaring(rig.port, "/api/v1/commands", kOperator, 2 << 20).status, 413);
   // Refused by the controller: a jog while the machine is off.
   const Reply off = post(rig.port, R"({"kind":"jog","axis":"X","velocity":5})", kOperator);
@@ -95,20 +95,20 @@ TEST(Server, ToolDataIsTheAdminsAndEveryChangeIsAudited) {
 
 TEST(Server, TheStreamOpensWithASingleUseTicketAndNeverATokenInTheUrl) {
   ServerRig rig(mill());
-  const Reply issued = call(rig.port, http::verb::post, "/api/v1/stream-ticket", kOperator, "");
+  const Reply issued = call(rig.port, Method::Post, "/api/v1/stream-ticket", kOperator, "");
   ASSERT_EQ(issued.status, 200) << issued.text;
   const std::string ticket = issued.body["ticket"];
   EXPECT_EQ(ticket.size(), 48u);
   EXPECT_EQ(issued.body["expires_in_s"], 30);
-  EXPECT_EQ(call(rig.port, http::verb::post, "/api/v1/stream-ticket", "", "").status, 401);
+  EXPECT_EQ(call(rig.port, Method::Post, "/api/v1/stream-ticket", "", "").status, 401);
   EXPECT_EQ(get(rig.port, "/api/v1/stream-ticket", kOperator).status, 405);
   {
     Stream s(rig.port, "", 0, "?ticket=" + ticket);
     EXPECT_EQ(s.next()["type"], "status");
   }
   // Used up; a token in the query opens nothing (nor does it pass for any other call).
-  EXPECT_THROW(Stream(rig.port, "", 0, "?ticket=" + ticket), beast::system_error);
-  EXPECT_THROW(Stream(rig.port, "", 0, "?token=" + kOperator), beast::system_error);
+  EXPECT_THROW(Stream(rig.port, "", 0, "?ticket=" + ticket), std::runtime_error);
+  EXPECT_THROW(Stream(rig.port, "", 0, "?token=" + kOperator), std::runtime_error);
   EXPECT_EQ(get(rig.port, "/api/v1/programs?token=" + kOperator).status, 401);
 }
 
@@ -134,7 +134,7 @@ TEST(Server, TheStreamSendsStatusAtItsRateAndEachClientItsEvents) {
   sc.stream_hz = 30;
   ServerRig rig(mill(sc));
   Stream a(rig.port, kOperator);
-  EXPECT_THROW(Stream(rig.port, "not-a-token-at-all-0000"), beast::system_error);
+  EXPECT_THROW(Stream(rig.port, "not-a-token-at-all-0000"), std::runtime_error);
   const auto start = Clock::now();
   int status = 0;
   while (Clock::now() - start < std::chrono::milliseconds(500)) {
