@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "../control/test_profiles.hpp"
+#include "edm_rig.hpp"
 #include "opencnc/controller/controller.hpp"
 #include "opencnc/controller/electrode_setting.hpp"
 #include "opencnc/controller/gcode_source.hpp"
@@ -24,33 +24,14 @@
 namespace opencnc::control::test {
 namespace {
 
-/// The EDM with a smaller electrode (5 mm²: four times the depth per discharge) so that a burn of
-/// a few hundredths takes seconds of virtual time.
 config::MachineProfile edm_machine() {
-  const std::vector<std::string> sets = {"edm.sim.electrode_area_mm2=5"};
-  return loaded(config::load_profile(OPENCNC_SOURCE_DIR "/configs/edm-5axis.toml", sets));
+  return edm_profile();
 }
 
 /// Positions from the simulated steppers are whole steps (0.625 µm) and the machine's zero, homed
 /// on its switches, lies within a step of the switch: two steps is as close as a centre or an
 /// offset measured on the machine can be asked to come.
 constexpr double kTwoSteps = 2 * 0.000625 + 1e-9;
-
-/// Machine on and every axis homed on its switches (the EDM's steppers know nothing at power-up).
-bool on_and_homed(SimRig& rig) {
-  if (!rig.request(Request::simple(CommandKind::MachineOn)).accepted) return false;
-  if (!rig.request(Request::set_mode(Mode::Manual)).accepted || !rig.request(Request::home()).accepted)
-    return false;
-  return rig.run_until(
-      [&] { return rig.status().servo.state == State::Idle && rig.status().servo.all_homed; }, 60000);
-}
-
-/// Every trace sample of the run.
-class Samples final : public ControllerObserver {
- public:
-  void on_trace(const TraceSample& s, const TraceContext&) override { all.push_back(s); }
-  std::vector<TraceSample> all;
-};
 
 struct Burnt {
   std::unique_ptr<SimRig> rig;
@@ -62,12 +43,7 @@ struct Burnt {
 /// Runs `text` to its end on `profile`.
 Burnt run(const std::string& text, const config::MachineProfile& profile) {
   Burnt r;
-  const auto dir =
-      std::filesystem::temp_directory_path() /
-      ("opencnc-edm-cavity-" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-  std::filesystem::create_directories(dir);
-  const std::string path = (dir / "p.ngc").string();
-  std::ofstream(path) << text;
+  const std::string path = write_program(text, "opencnc-edm-cavity");
   Diagnostics d;
   r.rig = std::make_unique<SimRig>(profile, GcodeProgramSource::create(profile, d));
   r.samples = std::make_shared<Samples>();

@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "../control/test_profiles.hpp"
+#include "edm_rig.hpp"
 #include "opencnc/controller/controller.hpp"
 #include "opencnc/controller/edm_recorder.hpp"
 #include "opencnc/controller/gcode_source.hpp"
@@ -25,37 +25,12 @@
 namespace opencnc::control::test {
 namespace {
 
-/// The EDM with a smaller electrode (5 mm²: four times the depth per discharge) so that a burn of
-/// a few hundredths takes a second or two of virtual time.
 config::MachineProfile edm(std::vector<std::string> sets = {}) {
-  sets.insert(sets.begin(), "edm.sim.electrode_area_mm2=5");
-  return loaded(config::load_profile(OPENCNC_SOURCE_DIR "/configs/edm-5axis.toml", sets));
+  return edm_profile(std::move(sets));
 }
-
-/// Machine on and every axis homed on its switches (the EDM's steppers know nothing at power-up).
-bool on_and_homed(SimRig& rig) {
-  if (!rig.request(Request::simple(CommandKind::MachineOn)).accepted) return false;
-  if (!rig.request(Request::set_mode(Mode::Manual)).accepted || !rig.request(Request::home()).accepted)
-    return false;
-  return rig.run_until(
-      [&] { return rig.status().servo.state == State::Idle && rig.status().servo.all_homed; }, 60000);
-}
-
-/// Every trace sample of the run.
-class Samples final : public ControllerObserver {
- public:
-  void on_trace(const TraceSample& s, const TraceContext&) override { all.push_back(s); }
-  std::vector<TraceSample> all;
-};
 
 std::string write_program(const std::string& text) {
-  const auto dir =
-      std::filesystem::temp_directory_path() /
-      ("opencnc-edm-" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-  std::filesystem::create_directories(dir);
-  const std::string path = (dir / "p.ngc").string();
-  std::ofstream(path) << text;
-  return path;
+  return test::write_program(text, "opencnc-edm");
 }
 
 struct EdmRun {
