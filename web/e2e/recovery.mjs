@@ -7,7 +7,7 @@ import { spawn } from "node:child_process";
 import { mkdtempSync, rmSync } from "node:fs";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
-import { stopServer, waitFor as waitForOn } from "./wait.mjs";
+import { serverUrl, stopServer, waitFor as waitForOn } from "./wait.mjs";
 
 const operator = "e2e-operator-token-0123456789", admin = "e2e-admin-token-0123456789";
 
@@ -26,16 +26,7 @@ export async function recoveryStep({ opencnc, repo, out, browser, step }) {
   const page = await browser.newPage({ viewport: { width: 1400, height: 900 } });
   let stop = null;
   try {
-    const url = await new Promise((ok, fail) => {
-      let text = "";
-      server.stdout.on("data", (d) => {
-        text += d;
-        const m = /open\s+(http:\S+)/.exec(text);
-        if (m) ok(m[1]);
-      });
-      server.on("exit", (code) => fail(new Error(`opencnc serve (broach) exited with ${code}`)));
-      setTimeout(() => fail(new Error("opencnc serve (broach) printed no URL in 20 s")), 20000);
-    });
+    const url = await serverUrl(server, "opencnc serve (broach)");
     const base = new URL(url).origin;
     const simulate = async (event) => {
       const r = await fetch(`${base}/api/v1/commands`, { method: "POST", headers: { Authorization: `Bearer ${admin}` },

@@ -14,7 +14,7 @@ import { dirname, join, resolve } from "node:path";
 import { fileURLToPath } from "node:url";
 import { chromium } from "playwright-core";
 import { recoveryStep } from "./recovery.mjs";
-import { stopServer, waitFor as waitForOn } from "./wait.mjs";
+import { serverUrl, stopServer, waitFor as waitForOn } from "./wait.mjs";
 
 const here = dirname(fileURLToPath(import.meta.url));
 const repo = resolve(here, "..", "..");
@@ -45,16 +45,7 @@ const server = spawn(opencnc, ["serve", "--machine", join(data, "mill-3axis.toml
   env: { ...process.env, OPENCNC_OPERATOR_TOKEN: "e2e-operator-token-0123456789", OPENCNC_ADMIN_TOKEN: "e2e-admin-token-0123456789" },
   stdio: ["ignore", "pipe", "inherit"],
 });
-const url = await new Promise((ok, fail) => {
-  let text = "";
-  server.stdout.on("data", (d) => {
-    text += d;
-    const m = /open\s+(http:\S+)/.exec(text);
-    if (m) ok(m[1]);
-  });
-  server.on("exit", (code) => fail(new Error(`opencnc serve exited with ${code}`)));
-  setTimeout(() => fail(new Error("opencnc serve printed no URL in 20 s")), 20000);
-});
+const url = await serverUrl(server);
 
 const browser = await chromium.launch({
   executablePath: "/usr/bin/chromium",

@@ -24,3 +24,17 @@ export async function stopServer(server) {
   if (server.exitCode === 0) return null;
   return `opencnc serve ended with ${server.exitCode ?? server.signalCode}, not 0, after SIGINT`;
 }
+
+/** Resolves to the URL `opencnc serve` prints; rejects if it exits first or prints none in 20 s. */
+export function serverUrl(server, name = "opencnc serve") {
+  return new Promise((ok, fail) => {
+    let text = "";
+    server.stdout.on("data", (d) => {
+      text += d;
+      const m = /open\s+(http:\S+)/.exec(text);
+      if (m) ok(m[1]);
+    });
+    server.on("exit", (code) => fail(new Error(`${name} exited with ${code}`)));
+    setTimeout(() => fail(new Error(`${name} printed no URL in 20 s`)), 20000);
+  });
+}
