@@ -132,19 +132,21 @@ void Controller::edit_profile(std::uint64_t id, const requests::EditProfile& r) 
   }
 }
 
-// The joint's new table into the buffer its tick does not read (nothing else is in flight: one
-// change at a time), named by a StagePitchTable. Returns false when the ring is full.
-bool Controller::stage_pitch_table(int joint, const ServoConfig& next, ProfileChange& pending) {
+// The joint's new table into the buffer its tick does not read, as the tick publishes it (not as
+// this controller remembers it: the tick may have outlived the controller that switched it).
+// Nothing else is in flight: one change at a time. Named by a StagePitchTable. Returns false when
+// the ring is full.
+bool Controller::stage_pitch_table(int joint, const ServoConfig& next, const ProfileChange& pending) {
   const auto j = static_cast<std::size_t>(joint);
   const motion::JointCompensation& c = next.compensation.joints[j];
-  const auto buffer = static_cast<std::uint8_t>(pitch_buffer_[j] == 0 ? 1 : 0);
+  const std::int8_t reading = channels_->pitch_tables.reading[j].index.load(std::memory_order_acquire);
+  const auto buffer = static_cast<std::uint8_t>(reading == 0 ? 1 : 0);
   channels_->pitch_tables.joints[j][buffer] = c.pitch;
   Command stage;
   stage.id = pending.stage_id;
   stage.kind = CommandKind::StagePitchTable;
   stage.axis = static_cast<std::int8_t>(joint);
   stage.table_buffer = buffer;
-  pending.tables = static_cast<std::uint16_t>(pending.tables | (1u << joint));
   return channels_->commands.try_push(stage);
 }
 
@@ -155,8 +157,6 @@ bool Controller::settle_profile_change(const ServoEvent& e) {
   ProfileChange change = std::move(*profile_change_);
   profile_change_.reset();
   if (e.kind == EventKind::Accepted) {
-    for (std::size_t j = 0; j < pitch_buffer_.size(); ++j)
-      if (change.tables & (1u << j)) pitch_buffer_[j] = pitch_buffer_[j] == 0 ? 1 : 0;
     note(Severity::Note, "control.profile",
          fmt::format("{}machine parameters changed: {} ({})", change.who.empty() ? "" : change.who + ": ",
                      change.message, profile_.source));
