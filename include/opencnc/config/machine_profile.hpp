@@ -67,6 +67,9 @@ struct CompensationProfile {
   std::vector<double> reverse;     ///< error moving in − (== forward for one table)
   bool one_table = false;          ///< written as `errors` (both directions), not forward/reverse
   std::string comp_file;           ///< the LinuxCNC comp file the table came from, as written; "" none
+  int comp_file_type = 0;          ///< comp_file_type: 0 positions reached, 1 trims (−error)
+  std::string comp_path;           ///< comp_file resolved against the profile's folder
+  std::uint64_t comp_digest = 0;   ///< text_digest() of the comp file's text as loaded
 };
 
 /// One axis (= one joint: joints are numbered in axis order X Y Z A B C U V W).

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "opencnc/config/machine_profile.hpp"
+#include "opencnc/config/profile_loader.hpp"
 #include "opencnc/control/channels.hpp"
 #include "opencnc/control/command.hpp"
 #include "opencnc/control/servo_config.hpp"
@@ -200,6 +201,7 @@ class Controller final : private FeatureHost {
     std::uint64_t id = 0, stage_id = 0;
     config::MachineProfile old_profile;
     std::string old_text, message, who;
+    std::vector<config::FileText> old_files;  ///< other files the change wrote (a comp file), as they were
   };
   std::optional<ProfileChange> profile_change_;
   std::uint32_t limits_version_ = 0;       ///< counts applied profile edits
