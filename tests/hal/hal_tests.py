@@ -193,12 +193,12 @@ def kill_controller(opencnc, source_dir, hal, work):
     if enabled_at_end:
         return fail("the drive is still enabled with no controller")
     # The tick kept its servo (the same set-up) and drops what the dead controller staged.
-    again = controller(opencnc, source_dir, "move.ngc", work)
+    again = controller(opencnc, source_dir, "short_move.ngc", work)
     code = again.wait(timeout=60)
     if code != 0:
         print((work / "run.out").read_text())
         return fail(f"a new controller attached after the kill exited {code}")
-    print("a new controller attached to the same tick and ran move.ngc to the end")
+    print("a new controller attached to the same tick and ran short_move.ngc to the end")
     return 0
 
 
