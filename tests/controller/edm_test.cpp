@@ -418,7 +418,9 @@ TEST(EdmSeek, TheControllerSaysWhereTheLimitSwitchTripped) {
 /// Runs until the machine is idle again with nothing moving; false if that takes `ticks`.
 bool comes_to_rest(SimRig& rig, std::uint64_t ticks) {
   return rig.run_until(
-      [&] { return rig.status().servo.state == State::Idle && rig.status().servo.activity == Activity::None; },
+      [&] {
+        return rig.status().servo.state == State::Idle && rig.status().servo.activity == Activity::None;
+      },
       ticks);
 }
 

@@ -236,6 +236,27 @@ TEST(ElectrodeSetting, WithBTurnedTheElectrodeIsRightOnlyAboutTheMeasuredAxis) {
   }
 }
 
+TEST(ElectrodeSetting, CalibrateBWithTheSphereNotWhereTheDrawingsAxisTurnsItChangesNothing) {
+  // The drawing's axis 5 mm off the true one: at 40° the sphere is 3.4 mm from where it is looked
+  // for, and that angle's touch fails; the calibration ends with its reason and the angle.
+  Rig r(edm_profile(fast_then_slow({"probe.reference_sphere.b_axis=[100.0, -165.0]",
+                                    "probe.reference_sphere.sim.b_axis=[100.0, -170.0]"})));
+  r.scenario.sim().set_electrode({0, 0, 50}, 0);
+  EventCursor log(r.scenario.rig().controller().events());
+  const BAxisResult c = calibrate_b(r, {0, 40, -40});
+  EXPECT_FALSE(c.ok);
+  EXPECT_EQ(c.centres.size(), 1u) << "B at 0 is where the profile's position holds";
+  EXPECT_EQ(c.code.rfind("electrode.", 0), 0u) << c.code;
+  EXPECT_EQ(c.message.rfind("with B at 40°: ", 0), 0u) << c.message;
+  EXPECT_EQ(r.feature->sphere().b_axis, (std::array<double, 2>{100.0, -165.0})) << "the axis unchanged";
+  EXPECT_EQ(r.feature->phase(), ElectrodePhase::Idle);
+  bool noted = false;
+  for (const ControllerEvent& e : log.next(1 << 16))
+    noted |= e.kind == ControllerEventKind::Note && e.code == c.code &&
+             e.text.find("calibrate-b") != std::string::npos;
+  EXPECT_TRUE(noted);
+}
+
 TEST(ElectrodeSetting, CalibrateBRefusesWhatItCannotMeasure) {
   Rig r(edm_profile(b_axis_off_nominal()));
   const auto refused = [&](std::vector<double> angles) {
