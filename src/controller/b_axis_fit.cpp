@@ -89,13 +89,18 @@ std::optional<BAxisFit> fit_b_axis(std::span<const double> angles_deg, std::span
   const std::optional<Eigen::Vector3d> circle = fit_circle(flat);
   if (!circle || !((*circle)(2) > 0)) return std::nullopt;
   Eigen::Vector3d centre = mean + (*circle)(0) * u + (*circle)(1) * v;
-  // B turns right-handed about the direction: the way the centres go round as B grows.
-  const auto first =
-      std::min_element(angles_deg.begin(), angles_deg.begin() + static_cast<std::ptrdiff_t>(n));
-  const auto last = std::max_element(angles_deg.begin(), angles_deg.begin() + static_cast<std::ptrdiff_t>(n));
-  const Eigen::Vector3d from = vec(centres[static_cast<std::size_t>(first - angles_deg.begin())]) - centre;
-  const Eigen::Vector3d to = vec(centres[static_cast<std::size_t>(last - angles_deg.begin())]) - centre;
-  if (from.cross(to).dot(normal) * std::sin((*last - *first) * kRad) < 0) normal = -normal;
+  // B turns right-handed about the direction: the way the centres go round as B grows, seen
+  // from the two angles whose turn between them is farthest from 0° and 180° (its sense is surest).
+  std::size_t from = 0, to = 1;
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t k = i + 1; k < n; ++k)
+      if (std::fabs(std::sin((angles_deg[k] - angles_deg[i]) * kRad)) >
+          std::fabs(std::sin((angles_deg[to] - angles_deg[from]) * kRad))) {
+        from = i;
+        to = k;
+      }
+  const Eigen::Vector3d a = vec(centres[from]) - centre, b = vec(centres[to]) - centre;
+  if (a.cross(b).dot(normal) * std::sin((angles_deg[to] - angles_deg[from]) * kRad) < 0) normal = -normal;
   if (std::fabs(normal.y()) < 1e-6) return std::nullopt;  // the axis does not cross the sphere's plane
   // Each centre turned back to b: their mean is the sphere plus the electrode's offsets there.
   Eigen::Vector3d at_b = Eigen::Vector3d::Zero();

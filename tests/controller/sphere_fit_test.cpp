@@ -94,6 +94,19 @@ TEST(BAxisFit, ExactCentresGiveTheAxisWhateverTheElectrodesOffsets) {
   }
 }
 
+TEST(BAxisFit, TheDirectionTurnsWithBWhateverTheAnglesOrder) {
+  // −90°, 0°, 90°: the first and last are half a turn apart, which says nothing of the sense.
+  const config::ReferenceSphereProfile truth = sphere_on_b(0);
+  for (const std::vector<double>& angles :
+       {std::vector<double>{-90, 0, 90}, std::vector<double>{90, -90, 0}}) {
+    const auto fit = fit_b_axis(angles, turned_centres(truth, {0, 0, 0}, angles), truth);
+    ASSERT_TRUE(fit.has_value());
+    EXPECT_GT(fit->axis.direction[1], 0.99);
+    EXPECT_NEAR(fit->axis.crossing[0], 120.012, 1e-9);
+    EXPECT_LT(fit->max_residual_mm, 1e-9);
+  }
+}
+
 TEST(BAxisFit, ResidualsSayHowFarACentreIsFromTheTurnedSphere) {
   const config::ReferenceSphereProfile truth = sphere_on_b(0);
   const std::vector<double> angles{-40, -20, 0, 20, 40};

@@ -374,23 +374,9 @@ TEST(ServerFeatures, ElectrodeMeasuredOnTheSphereIsShownThenStoredOnConfirmation
       rig.command({{"kind", "feature"}, {"feature", "electrode"}, {"action", "write"}, {"confirmed", true}})
           .status,
       409);
-  // B's axis calibrated through the API: the simulated table's true axis (X 120.012, Z -90.015).
-  EXPECT_TRUE(rig.status()["features"]["electrode"]["b_axis"].is_null()) << "none before";
-  const Reply calibrate = rig.command({{"kind", "feature"},
-                                       {"feature", "electrode"},
-                                       {"action", "calibrate-b"},
-                                       {"tool", 1},
-                                       {"angles_deg", {-45, 0, 45}},
-                                       {"confirmed", true}});
-  ASSERT_EQ(calibrate.status, 200) << calibrate.body.dump();
-  ASSERT_TRUE(rig.until([](const json& s) {
-    const json& e = s["features"]["electrode"];
-    return e["phase"] == "idle" && !e["b_axis"].is_null();
-  }));
-  const json b = rig.status()["features"]["electrode"]["b_axis"];
-  ASSERT_EQ(b["ok"], true) << b.dump();
-  EXPECT_NEAR(b["b_axis"][0].get<double>(), 120.012, 0.001);
-  EXPECT_NEAR(b["b_axis"][1].get<double>(), -90.015, 0.001);
+  // No calibration of B's axis yet (calibrate-b's request is FeatureParse's; through the server
+  // it would be three more measurements in a test that is already the slowest under ASan).
+  EXPECT_TRUE(rig.status()["features"]["electrode"]["b_axis"].is_null());
   std::filesystem::remove_all(tables);
 }
 
