@@ -11,6 +11,7 @@
 #include "opencnc/control/spsc_ring.hpp"
 #include "opencnc/control/status.hpp"
 #include "opencnc/control/triple_buffer.hpp"
+#include "opencnc/machine/edm.hpp"
 #include "opencnc/motion/compensation.hpp"
 #include "opencnc/traj/block_queue.hpp"
 
@@ -26,6 +27,15 @@ struct PitchTableArea {
   std::array<std::array<motion::PitchTable, 2>, motion::kMaxCompensatedJoints> joints{};
 };
 
+/// The machining conditions handed to the tick (an admin's edit): the controller writes them only
+/// while no change of the profile is in flight, then sends StageEdmConditions and
+/// ApplyJointLimits; the tick reads them only in that apply (checks them, then copies them into
+/// its configuration), so one buffer is enough. Plain data.
+struct EdmConditionTable {
+  std::array<machine::EdmCondition, machine::kMaxEdmConditions> conditions{};
+  int count = 0;
+};
+
 /// Every queue has exactly one producer and one consumer:
 ///
 /// | member     | producer                  | consumer   |
@@ -37,7 +47,8 @@ struct PitchTableArea {
 /// | status     | servo tick                | controller |
 /// | trace      | servo tick (when enabled) | recorder   |
 ///
-/// and `pitch_tables` is written by the controller, read by the servo tick (PitchTableArea).
+/// and `pitch_tables` and `edm_conditions` are written by the controller, read by the servo tick
+/// (PitchTableArea, EdmConditionTable).
 /// About 4 MB; construct it on the heap or in shared memory (standard layout, lock-free atomics).
 struct ServoChannels {
   SpscRing<Command, 256> commands;
@@ -50,6 +61,7 @@ struct ServoChannels {
   SpscRing<TraceSample, 8192> trace;
   std::atomic<bool> trace_enabled{false};
   PitchTableArea pitch_tables;
+  EdmConditionTable edm_conditions;
 };
 
 static_assert(std::is_standard_layout_v<ServoChannels>);
