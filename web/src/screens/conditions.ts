@@ -91,6 +91,7 @@ let note: HTMLElement | undefined;
 let editor: HTMLElement | undefined;
 let result: HTMLElement | undefined;
 let token: HTMLInputElement | undefined;
+let unlockRow: HTMLElement | undefined;
 let shown = -1;
 /** The admin's token once checked (the page's own when it is an admin's); "" while read-only. */
 let adminToken = "";
@@ -163,6 +164,7 @@ async function load(ctx: Context, selected = 0) {
   if (!body || !note || !editor) return;
   answer = r;
   const empty = r.conditions.length === 0;
+  if (unlockRow) unlockRow.style.display = empty || adminToken !== "" ? "none" : ""; // .row is a flex box: not `hidden`
   note.textContent = empty
     ? "This machine has no machining conditions (an EDM's [[edm.condition]] in its profile)."
     : `From ${r.profile}; M180 P<n> selects one in a program, M181 switches the generator off. The one in force is highlighted.` +
@@ -202,11 +204,12 @@ registerScreen({
     editor = el("div", { id: "condition-editor" });
     result = el("pre", { class: "diagnostics", id: "conditions-result" });
     token = el("input", { id: "cond-admin-token", type: "password", class: "token" });
+    unlockRow = el("div", { class: "row" }, "Admin token: ", token, button("Edit (admin)", () => void unlock(ctx)));
     const head = el("tr", {}, ...conditionHeader.map((h) => el("th", {}, h)), el("th", {}, ""));
     root.append(
       el("h2", {}, "Machining conditions"),
       note,
-      el("div", { class: "row" }, "Admin token: ", token, button("Edit (admin)", () => void unlock(ctx))),
+      unlockRow,
       el("table", { class: "grid", id: "conditions" }, el("thead", {}, head), body),
       editor,
       result,
