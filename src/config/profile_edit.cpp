@@ -11,6 +11,7 @@
 #include <filesystem>
 
 #include "opencnc/config/comp_file_edit.hpp"
+#include "condition_edit.hpp"
 #include "opencnc/config/profile_loader.hpp"
 #include "opencnc/config/toml_edit.hpp"
 #include "opencnc/core/atomic_file.hpp"
@@ -119,6 +120,20 @@ bool edit_directions(std::string& text, const AxisProfile& a, const std::string&
   return true;
 }
 
+/// `text` with `key` set to `value` (with_toml_value()); false with the refusal in `r.error`,
+/// prefixed by the profile's file.
+bool set_key(std::string& text, const std::string& key, const std::string& value, const std::string& source,
+             ProfileEditResult& r) {
+  std::string error;
+  std::optional<std::string> next = with_toml_value(text, key, value, error);
+  if (!next) {
+    r.error = fmt::format("{}: {}", source, error);
+    return false;
+  }
+  text = std::move(*next);
+  return true;
+}
+
 }  // namespace
 
 bool is_pitch_table_key(std::string_view key) {
@@ -214,13 +229,11 @@ ProfileEditResult edit_profile(const MachineProfile& live, std::span<const Profi
         (parts->second == "forward" ? d->forward : d->reverse) = e.value;
         continue;
       }
-      std::string error;
-      std::optional<std::string> next = with_toml_value(text, key, e.value, error);
-      if (!next) {
-        r.error = fmt::format("{}: {}", live.source, error);
-        return r;
-      }
-      text = std::move(*next);
+      if (!set_key(text, key, e.value, live.source, r)) return r;
+      continue;
+    }
+    if (key.rfind("edm.condition.", 0) == 0) {
+      if (!detail::edit_condition(text, live, key, e.value, r.changes.emplace_back(), r.error)) return r;
       continue;
     }
     const std::optional<double> old = value_of(params, key);
@@ -233,13 +246,7 @@ ProfileEditResult edit_profile(const MachineProfile& live, std::span<const Profi
           "{} is set by an override (--set) at start: the file's value would not take effect", key);
       return r;
     }
-    std::string error;
-    std::optional<std::string> next = with_toml_value(text, key, e.value, error);
-    if (!next) {
-      r.error = fmt::format("{}: {}", live.source, error);
-      return r;
-    }
-    text = std::move(*next);
+    if (!set_key(text, key, e.value, live.source, r)) return r;
     r.changes.push_back({key, toml_number(*old), e.value});
   }
   for (const Directions& d : directions) {
@@ -258,6 +265,10 @@ ProfileEditResult edit_profile(const MachineProfile& live, std::span<const Profi
   if (!load.profile) return r;
   const std::vector<EditableParameter> now = editable_parameters(*load.profile);
   for (ProfileChange& c : r.changes) {
+    if (is_condition_key(c.key)) {
+      c.new_value = detail::condition_value(*load.profile, c.key);
+      continue;
+    }
     const auto parts = pitch_key_parts(c.key);
     if (!parts) {
       c.new_value = toml_number(value_of(now, c.key).value_or(0));

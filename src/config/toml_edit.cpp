@@ -103,21 +103,34 @@ std::vector<std::string> split_key(std::string_view dotted) {
   return parts;
 }
 
+/// Which table an edit is in: `[table]`, or with `element` ≥ 0 that element (0 first) of the
+/// array of tables `[[table]]`.
+struct Target {
+  std::string table;
+  int element = -1;
+  std::string name() const {
+    return element < 0 ? fmt::format("[{}]", table) : fmt::format("[[{}]] #{}", table, element + 1);
+  }
+};
+
 /// The text with the value replaced or the key added (`remove`: its line dropped); "" in `error`
 /// when done.
-std::string edit_lines(std::string_view text, const std::string& table, std::string_view key,
+std::string edit_lines(std::string_view text, const Target& target, std::string_view key,
                        std::string_view value, std::string& error, bool remove = false) {
   const std::vector<TomlLine> lines = detail::split_lines(text);
   std::size_t header = lines.size(), found = lines.size(), hits = 0;
   ValueSpan span;
   bool inside = false;
+  int elements = 0;  // the [[table]] headers seen so far
   for (std::size_t i = 0; i < lines.size(); ++i) {
     if (detail::is_array_header(lines[i].text)) {
-      inside = false;
+      inside = target.element >= 0 && detail::array_header_key(lines[i].text) == target.table &&
+               elements++ == target.element;
+      if (inside) header = i;
       continue;
     }
     if (const std::string h = detail::header_key(lines[i].text); !h.empty()) {
-      inside = h == table;
+      inside = target.element < 0 && h == target.table;
       if (inside) header = i;
       continue;
     }
@@ -129,17 +142,18 @@ std::string edit_lines(std::string_view text, const std::string& table, std::str
     }
   }
   if (header == lines.size()) {
-    error = fmt::format("the profile has no [{}] table of its own to edit {} in", table, key);
+    error = fmt::format("the profile has no {} table of its own to edit {} in", target.name(), key);
     return {};
   }
   if (hits > 1) {
-    error = fmt::format("{} is written more than once in [{}]", key, table);
+    error = fmt::format("{} is written more than once in {}", key, target.name());
     return {};
   }
   std::string out;
   if (found < lines.size()) {
     if (span.multi_line) {
-      error = fmt::format("{}.{} spans more than one line in the profile: edit it by hand", table, key);
+      error = fmt::format("{} in {} spans more than one line in the profile: edit it by hand", key,
+                          target.name());
       return {};
     }
     if (remove) {
@@ -153,7 +167,7 @@ std::string edit_lines(std::string_view text, const std::string& table, std::str
     return out;
   }
   if (remove) {
-    error = fmt::format("[{}] has no {} to remove", table, key);
+    error = fmt::format("{} has no {} to remove", target.name(), key);
     return {};
   }
   const std::size_t end = detail::table_end(lines, header);
@@ -163,6 +177,21 @@ std::string edit_lines(std::string_view text, const std::string& table, std::str
   out += fmt::format("{} = {}\n", key, value);
   out.append(text.substr(at));
   return out;
+}
+
+/// The table an edit of `target` changes in the parsed document `root` (`path`: the target's
+/// table as components), or nullptr.
+toml::table* target_table(toml::table& root, const std::vector<std::string>& path, const Target& target) {
+  if (target.element < 0) return find_table(root, path);
+  std::vector<std::string> parent(path.begin(), path.end() - 1);
+  toml::table* t = find_table(root, parent);
+  if (!t) return nullptr;
+  for (auto&& [k, v] : *t) {
+    toml::array* a = lower(k.str()) == path.back() ? v.as_array() : nullptr;
+    if (a && static_cast<std::size_t>(target.element) < a->size())
+      return (*a)[static_cast<std::size_t>(target.element)].as_table();
+  }
+  return nullptr;
 }
 
 /// `dotted_key` as the path of its table, the table's dotted name and the key; false (with `error`)
@@ -195,35 +224,33 @@ std::string toml_number(double v) {
   return s;
 }
 
-std::optional<std::string> without_toml_key(std::string_view text, std::string_view dotted_key,
-                                            std::string& error) {
-  std::vector<std::string> path;
-  std::string table, key;
-  if (!parse_key(dotted_key, path, table, key, error)) return std::nullopt;
-  std::string out = edit_lines(text, table, key, {}, error, true);
+namespace {
+
+std::optional<std::string> remove_key(std::string_view text, const std::vector<std::string>& path,
+                                      const Target& target, const std::string& key, std::string& error) {
+  std::string out = edit_lines(text, target, key, {}, error, true);
   if (!error.empty()) return std::nullopt;
   try {  // the original less this one key, nothing else
     toml::table expected = toml::parse(text);
     const toml::table after = toml::parse(out);
-    toml::table* t = find_table(expected, path);
+    toml::table* t = target_table(expected, path, target);
     if (!t || !t->erase(key) || !(expected == after)) {
       error = fmt::format(
-          "{}.{} is also set elsewhere in the profile (a dotted key or an inline table): edit it by hand",
-          table, key);
+          "{} in {} is also set elsewhere in the profile (a dotted key or an inline table): edit it by hand",
+          key, target.name());
       return std::nullopt;
     }
   } catch (const toml::parse_error& e) {
-    error = fmt::format("the profile would not read back without {}.{}: {}", table, key, e.description());
+    error = fmt::format("the profile would not read back without {} in {}: {}", key, target.name(),
+                        e.description());
     return std::nullopt;
   }
   return out;
 }
 
-std::optional<std::string> with_toml_value(std::string_view text, std::string_view dotted_key,
-                                           std::string_view value_toml, std::string& error) {
-  std::vector<std::string> path;
-  std::string table, key;
-  if (!parse_key(dotted_key, path, table, key, error)) return std::nullopt;
+std::optional<std::string> set_value(std::string_view text, const std::vector<std::string>& path,
+                                     const Target& target, const std::string& key,
+                                     std::string_view value_toml, std::string& error) {
   toml::table value_doc;
   try {
     value_doc = toml::parse(fmt::format("v = {}", value_toml));
@@ -235,30 +262,87 @@ std::optional<std::string> with_toml_value(std::string_view text, std::string_vi
     error = fmt::format("\"{}\" is not one TOML value on one line", value_toml);
     return std::nullopt;
   }
-  std::string out = edit_lines(text, table, key, value_toml, error);
+  std::string out = edit_lines(text, target, key, value_toml, error);
   if (!error.empty()) return std::nullopt;
   // The edit must read back as the original with this one value set, and nothing else changed.
   try {
     toml::table expected = toml::parse(text);
     const toml::table after = toml::parse(out);
-    toml::table* t = find_table(expected, path);
+    toml::table* t = target_table(expected, path, target);
     if (!t) {
-      error = fmt::format("[{}] is not a table in the profile", table);
+      error = fmt::format("{} is not a table in the profile", target.name());
       return std::nullopt;
     }
     value_doc.get("v")->visit([&](auto& node) { t->insert_or_assign(key, node); });
     if (!(expected == after)) {
       error = fmt::format(
-          "{}.{} is also set elsewhere in the profile (a dotted key or an inline table): edit it by hand",
-          table, key);
+          "{} in {} is also set elsewhere in the profile (a dotted key or an inline table): edit it by hand",
+          key, target.name());
       return std::nullopt;
     }
   } catch (const toml::parse_error& e) {
-    error =
-        fmt::format("the profile would not read back after setting {}.{}: {}", table, key, e.description());
+    error = fmt::format("the profile would not read back after setting {} in {}: {}", key, target.name(),
+                        e.description());
     return std::nullopt;
   }
   return out;
+}
+
+/// `dotted_key` of a plain table as its path, target and key; false with `error`.
+bool plain_target(std::string_view dotted_key, std::vector<std::string>& path, Target& target,
+                  std::string& key, std::string& error) {
+  return parse_key(dotted_key, path, target.table, key, error);
+}
+
+/// `array_key` ("edm.condition") and `key` as the path, target and key of element `element`.
+bool element_target(std::string_view array_key, int element, std::string_view key,
+                    std::vector<std::string>& path, Target& target, std::string& name, std::string& error) {
+  if (element < 0) {
+    error = fmt::format("element {} of [[{}]] does not exist", element + 1, array_key);
+    return false;
+  }
+  if (!parse_key(fmt::format("{}.{}", array_key, key), path, target.table, name, error)) return false;
+  target.element = element;
+  return true;
+}
+
+}  // namespace
+
+std::optional<std::string> without_toml_key(std::string_view text, std::string_view dotted_key,
+                                            std::string& error) {
+  std::vector<std::string> path;
+  Target target;
+  std::string key;
+  if (!plain_target(dotted_key, path, target, key, error)) return std::nullopt;
+  return remove_key(text, path, target, key, error);
+}
+
+std::optional<std::string> with_toml_value(std::string_view text, std::string_view dotted_key,
+                                           std::string_view value_toml, std::string& error) {
+  std::vector<std::string> path;
+  Target target;
+  std::string key;
+  if (!plain_target(dotted_key, path, target, key, error)) return std::nullopt;
+  return set_value(text, path, target, key, value_toml, error);
+}
+
+std::optional<std::string> with_toml_element_value(std::string_view text, std::string_view array_key,
+                                                   int element, std::string_view key,
+                                                   std::string_view value_toml, std::string& error) {
+  std::vector<std::string> path;
+  Target target;
+  std::string name;
+  if (!element_target(array_key, element, key, path, target, name, error)) return std::nullopt;
+  return set_value(text, path, target, name, value_toml, error);
+}
+
+std::optional<std::string> without_toml_element_key(std::string_view text, std::string_view array_key,
+                                                    int element, std::string_view key, std::string& error) {
+  std::vector<std::string> path;
+  Target target;
+  std::string name;
+  if (!element_target(array_key, element, key, path, target, name, error)) return std::nullopt;
+  return remove_key(text, path, target, name, error);
 }
 
 }  // namespace opencnc::config

@@ -47,6 +47,15 @@ bool is_array_header(std::string_view line) {
   return t.size() > 4 && t.substr(0, 2) == "[[";
 }
 
+std::string array_header_key(std::string_view line) {
+  const std::string_view t = trim(line);
+  if (!is_array_header(t)) return "";
+  const std::size_t close = t.find("]]");
+  if (close == std::string_view::npos) return "";
+  // "[[a.b]] # …" read as the table header "[a.b] # …" without the outer brackets.
+  return header_key(std::string(t.substr(1, close)) + std::string(t.substr(close + 2)));
+}
+
 bool is_blank_or_comment(std::string_view line) {
   const std::string_view t = trim(line);
   return t.empty() || t[0] == '#';

@@ -28,6 +28,10 @@ std::string header_key(std::string_view line);
 /// True for a line that starts an array of tables (`[[edm.condition]]`). Any thread.
 bool is_array_header(std::string_view line);
 
+/// The key of an array-of-tables header line (`[[edm.condition]]  # …` → "edm.condition", as
+/// header_key() writes it), or "" for any other line. Any thread.
+std::string array_header_key(std::string_view line);
+
 /// True for a blank line or a comment. Any thread.
 bool is_blank_or_comment(std::string_view line);
 

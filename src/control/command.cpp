@@ -166,6 +166,8 @@ const char* to_string(CommandKind k) noexcept {
       return "apply-joint-limits";
     case CommandKind::StagePitchTable:
       return "stage-pitch-table";
+    case CommandKind::StageEdmConditions:
+      return "stage-edm-conditions";
     case CommandKind::SeekLimit:
       return "seek-limit";
   }

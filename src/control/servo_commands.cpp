@@ -72,6 +72,8 @@ Refusal Servo::apply(const Command& c) noexcept {
       return apply_joint_limits();
     case CommandKind::StagePitchTable:
       return stage_pitch_table(c);
+    case CommandKind::StageEdmConditions:
+      return stage_edm_conditions();
     case CommandKind::SeekLimit:
       return seek_limit(c);
   }

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Servo: joint limits and pitch-error tables changed by an admin while nothing moves — staged joint
-// by joint, applied together by one command, so that the tick takes all of them or none.
+// Servo: joint limits, pitch-error tables and EDM machining conditions changed by an admin while
+// nothing moves — staged, applied together by one command, so that the tick takes all or none.
 #include <cmath>
 
 #include "opencnc/control/servo.hpp"
@@ -32,7 +32,48 @@ bool valid(const motion::PitchTable& t) noexcept {
   return true;
 }
 
+/// A condition the gap servo can run: a number, finite values in the ranges the profile's loader
+/// allows (the loader checks the rest, against the axes' limits).
+bool valid(const machine::EdmCondition& c) noexcept {
+  const double values[] = {c.on_time_us,        c.off_time_us,     c.peak_current_a,   c.voltage_v,
+                           c.servo_reference_v, c.gain_mm_s_per_v, c.max_forward_mm_s, c.max_retract_mm_s,
+                           c.filter_s,          c.short_timeout_s, c.jump_height_mm,   c.jump_period_s,
+                           c.jump_speed_mm_s,   c.orbit_radius_mm, c.orbit_step_mm,    c.orbit_period_s};
+  for (const double v : values)
+    if (!std::isfinite(v) || v < 0) return false;
+  return c.number >= 1 && c.number <= 99 && c.on_time_us > 0 && c.peak_current_a > 0 && c.voltage_v > 0 &&
+         c.servo_reference_v > 0 && c.servo_reference_v < c.voltage_v && c.gain_mm_s_per_v > 0 &&
+         c.max_forward_mm_s > 0 && c.max_retract_mm_s > 0 && c.short_timeout_s > 0 &&
+         (c.polarity == 1 || c.polarity == -1) && c.jump_mode <= machine::JumpMode::Path &&
+         c.orbit <= machine::OrbitKind::Star &&
+         (c.jump_period_s == 0 || (c.jump_height_mm > 0 && c.jump_speed_mm_s > 0)) &&
+         (c.orbit == machine::OrbitKind::None || (c.orbit_radius_mm > 0 && c.orbit_period_s > 0));
+}
+
+/// A table the gap servo can select from: each condition valid and numbered once.
+bool valid(const EdmConditionTable& t) noexcept {
+  if (t.count < 0 || t.count > machine::kMaxEdmConditions) return false;
+  for (int i = 0; i < t.count; ++i) {
+    const machine::EdmCondition& c = t.conditions[static_cast<std::size_t>(i)];
+    if (!valid(c)) return false;
+    for (int k = 0; k < i; ++k)
+      if (t.conditions[static_cast<std::size_t>(k)].number == c.number) return false;
+  }
+  return true;
+}
+
 }  // namespace
+
+// Only marked here: the conditions are read, checked and copied in the apply, after which the
+// controller may write the buffer again (one buffer, no reader between the two).
+Refusal Servo::stage_edm_conditions() noexcept {
+  if (!config_.edm.enabled) {
+    staged_invalid_ = true;
+    return Refusal::NotApplicable;
+  }
+  staged_conditions_ = true;
+  return Refusal::None;
+}
 
 // The table is checked here, once, so that the lookup in every period can trust it (a bounded
 // loop over at most 256 points; the controller does not write this buffer until the apply). A
@@ -69,11 +110,11 @@ Refusal Servo::stage_joint_limits(const Command& c) noexcept {
 // or the soft-limit check would fault it at once.
 Refusal Servo::apply_joint_limits() noexcept {
   const std::uint16_t staged = staged_joints_, tables = staged_tables_;
-  const bool invalid = staged_invalid_;
+  const bool invalid = staged_invalid_, conditions = staged_conditions_;
   staged_joints_ = staged_tables_ = 0;
-  staged_invalid_ = false;
-  if (invalid) return Refusal::BadValue;
-  if (staged == 0 && tables == 0) return Refusal::NotApplicable;
+  staged_invalid_ = staged_conditions_ = false;
+  if (invalid || (conditions && !valid(channels_->edm_conditions))) return Refusal::BadValue;
+  if (staged == 0 && tables == 0 && !conditions) return Refusal::NotApplicable;
   if (activity_ != Activity::None || state_ == State::Running || state_ == State::Held ||
       state_ == State::Stopped)
     return Refusal::Busy;
@@ -112,7 +153,11 @@ Refusal Servo::apply_joint_limits() noexcept {
     channels_->pitch_tables.reading[uj].index.store(static_cast<std::int8_t>(staged_buffer_[uj]),
                                                     std::memory_order_release);
   }
-  configure_gap_servo();  // the jump accelerates within the tool axis' limit
+  if (conditions) {  // a program selects from them from its next M180 on (nothing runs now)
+    config_.edm.conditions = channels_->edm_conditions.conditions;
+    config_.edm.condition_count = channels_->edm_conditions.count;
+  }
+  configure_gap_servo();  // the jump accelerates within the tool axis' limit, from the new conditions
   return Refusal::None;
 }
 

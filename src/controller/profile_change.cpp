@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Controller: the machine profile's editable keys changed while nothing moves — the file edited
 // and loaded again, written back, the planner's limits and move checks swapped, the joints'
-// limits staged in the tick and applied by one command (all of them or none).
+// limits, pitch tables and EDM conditions staged in the tick and applied by one command (all of
+// them or none).
 #include <fmt/format.h>
 
 #include "opencnc/controller/controller.hpp"
@@ -142,6 +143,7 @@ void Controller::edit_profile(std::uint64_t id, const requests::EditProfile& r) 
   }
   for (int j = 0; j < motion::kMaxCompensatedJoints && queued; ++j)
     if (tables & (1u << j)) queued = stage_pitch_table(j, next, pending);
+  if (next.edm.enabled && queued) queued = stage_edm_conditions(next, pending);
   Command apply;
   apply.id = id;
   apply.kind = CommandKind::ApplyJointLimits;
@@ -170,6 +172,18 @@ bool Controller::stage_pitch_table(int joint, const ServoConfig& next, const Pro
   stage.kind = CommandKind::StagePitchTable;
   stage.axis = static_cast<std::int8_t>(joint);
   stage.table_buffer = buffer;
+  return channels_->commands.try_push(stage);
+}
+
+// The machining conditions into the channels' table (the tick reads it only in the apply, and no
+// other change is in flight), named by a StageEdmConditions: staged at every change of an EDM's
+// profile, changed or not, as the pitch tables are. Returns false when the ring is full.
+bool Controller::stage_edm_conditions(const ServoConfig& next, const ProfileChange& pending) {
+  channels_->edm_conditions.conditions = next.edm.conditions;
+  channels_->edm_conditions.count = next.edm.condition_count;
+  Command stage;
+  stage.id = pending.stage_id;
+  stage.kind = CommandKind::StageEdmConditions;
   return channels_->commands.try_push(stage);
 }
 

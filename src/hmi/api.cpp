@@ -249,6 +249,11 @@ Command parse(const json& body, const config::MachineProfile& p, const std::file
     if (!r.request) throw Bad{r.status, r.message};
     return std::move(*r.request);
   }
+  if (kind == "set-conditions") {
+    ParametersRequest r = conditions_request(body, p);
+    if (!r.request) throw Bad{r.status, r.message};
+    return std::move(*r.request);
+  }
   if (kind == "run-from-line") {
     const double line = number(body, "line");
     if (line != std::floor(line) || line < 1 || line > 1e9)
@@ -309,7 +314,8 @@ std::optional<Role> role_for(std::string_view kind) {
   static const char* const operator_kinds[] = {
       "mode",       "jog",     "jog-by",    "jog-stop", "home", "override",      "switch",
       "spindle-on", "coolant", "handwheel", "open",     "mdi",  "run-from-line", "seek-limit"};
-  if (kind == "set-tool" || kind == "set-parameters" || kind == "set-compensation" || kind == "simulate")
+  if (kind == "set-tool" || kind == "set-parameters" || kind == "set-compensation" ||
+      kind == "set-conditions" || kind == "simulate")
     return Role::Admin;
   if (kind == "feature") return Role::Operator;  // the confirmation is in the body (api_features.cpp)
   if (servo_kinds().find(kind) != servo_kinds().end()) return Role::Operator;

@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 
@@ -178,6 +179,57 @@ json compensation_json(const config::MachineProfile& profile) {
           {"axes", axes}};
 }
 
+namespace {
+
+/// "+|-" → ["+", "-"].
+json words(std::string_view choices) {
+  json out = json::array();
+  while (!choices.empty()) {
+    const std::size_t bar = choices.find('|');
+    out.push_back(std::string(choices.substr(0, bar)));
+    choices.remove_prefix(bar == std::string_view::npos ? choices.size() : bar + 1);
+  }
+  return out;
+}
+
+/// A condition field's value from the request as TOML text ("60.0", "\"-\""); "" with `r` filled
+/// when the field cannot be changed or the value does not fit it.
+std::string condition_value_toml(const std::string& key, const json& value, ParametersRequest& r) {
+  const auto fields = config::condition_fields();
+  const auto f = std::find_if(fields.begin(), fields.end(),
+                              [&](const config::ConditionField& c) { return key == c.key; });
+  if (f == fields.end()) {
+    r.status = 422;
+    r.message = fmt::format("\"{}\" is not a field of a condition that can be changed here", key);
+    return {};
+  }
+  if (f->choices == nullptr) {
+    if (!value.is_number()) {
+      r.message = fmt::format("\"{}\" must be a number", key);
+      return {};
+    }
+    if (!std::isfinite(value.get<double>())) {
+      r.status = 422;
+      r.message = fmt::format("\"{}\" must be finite", key);
+      return {};
+    }
+    return config::toml_number(value.get<double>());
+  }
+  const json choices = words(f->choices);
+  if (!value.is_string()) {
+    r.message = fmt::format("\"{}\" must be one of {}", key, choices.dump());
+    return {};
+  }
+  if (std::find(choices.begin(), choices.end(), value) == choices.end()) {
+    r.status = 422;
+    r.message = fmt::format("\"{}\" must be one of {}", key, choices.dump());
+    return {};
+  }
+  return json(value).dump();  // a TOML basic string is a JSON string of these words
+}
+
+}  // namespace
+
 json conditions_json(const config::MachineProfile& profile) {
   static constexpr const char* orbits[] = {"none", "circle", "square", "star"};
   json list = json::array();
@@ -194,6 +246,7 @@ json conditions_json(const config::MachineProfile& profile) {
                     {"gain_mm_s_per_v", c.gain_mm_s_per_v},
                     {"max_forward_mm_s", c.max_forward_mm_s},
                     {"max_retract_mm_s", c.max_retract_mm_s},
+                    {"filter_s", c.filter_s},
                     {"short_timeout_s", c.short_timeout_s},
                     {"jump_height_mm", c.jump_height_mm},
                     {"jump_period_s", c.jump_period_s},
@@ -204,7 +257,45 @@ json conditions_json(const config::MachineProfile& profile) {
                     {"orbit_step_mm", c.orbit_step_mm},
                     {"orbit_period_s", c.orbit_period_s}});
   }
-  return {{"profile", profile.source}, {"conditions", list}};
+  json fields = json::array();
+  for (const config::ConditionField& f : config::condition_fields()) {
+    json field = {{"key", f.key}, {"unit", f.unit}, {"what", f.what}};
+    if (f.choices != nullptr) field["choices"] = words(f.choices);
+    fields.push_back(std::move(field));
+  }
+  return {{"profile", profile.source},
+          {"when", "while nothing runs (no program, MDI line, jog or homing)"},
+          {"fields", fields},
+          {"conditions", list}};
+}
+
+ParametersRequest conditions_request(const json& body, const config::MachineProfile& profile) {
+  ParametersRequest r;
+  const auto number = body.find("condition");
+  if (number == body.end() || !number->is_number_integer()) {
+    r.message = "\"condition\" must be a condition's number";
+    return r;
+  }
+  const int n = number->get<int>();
+  if (!profile.edm.present || profile.edm.config.find(n) == nullptr) {
+    r.status = 422;
+    r.message =
+        fmt::format("the machine has no machining condition {} (GET /api/v1/conditions lists them)", n);
+    return r;
+  }
+  const auto values = body.find("values");
+  if (values == body.end() || !values->is_object() || values->empty()) {
+    r.message = "\"values\" must be an object of a condition's fields and their values, with at least one";
+    return r;
+  }
+  std::vector<config::ProfileKeyEdit> edits;
+  for (const auto& [key, value] : values->items()) {
+    const std::string toml = condition_value_toml(key, value, r);
+    if (toml.empty()) return r;
+    edits.push_back({fmt::format("edm.condition.{}.{}", n, key), toml});
+  }
+  r.request = control::Request::edit_profile(std::move(edits));
+  return r;
 }
 
 }  // namespace opencnc::hmi

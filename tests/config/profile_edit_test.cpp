@@ -354,6 +354,129 @@ TEST_F(ProfileEditCompFile, ABadTableGetsTheLoadersMessageAtTheCompFilesLine) {
   EXPECT_NE(edit_profile(live_, steep).error.find("changed on disk"), std::string::npos);
 }
 
+const char* kConditions =
+    "[edm]\n"
+    "tool_axis = \"Z\"\n"
+    "\n"
+    "# roughing\n"
+    "[[edm.condition]]\n"
+    "number = 1\n"
+    "on_time_us = 100.0   # long pulses\n"
+    "\n"
+    "[[ edm.condition ]]  # finishing\n"
+    "number = 3\n"
+    "on_time_us = 15.0\n"
+    "\n"
+    "# the sim\n"
+    "[edm.sim]\n"
+    "surface_mm = -20.0\n";
+
+std::string set_element(std::string_view text, int element, std::string_view key, std::string_view value,
+                        std::string* why = nullptr) {
+  std::string error;
+  const auto out = with_toml_element_value(text, "edm.condition", element, key, value, error);
+  if (why) *why = error;
+  return out ? *out : "";
+}
+
+TEST(TomlEdit, AnElementOfAnArrayOfTablesIsEditedInItsOwnLinesOnly) {
+  std::string expected = kConditions;
+  expected.replace(expected.find("15.0"), 4, "20.0");
+  EXPECT_EQ(set_element(kConditions, 1, "on_time_us", "20.0"), expected);
+  expected = kConditions;
+  expected.replace(expected.find("100.0"), 5, "60.0");  // the comment stays
+  EXPECT_EQ(set_element(kConditions, 0, "ON_TIME_US", "60.0"), expected);
+  expected = kConditions;  // a key the element lacks: after its last key, before the blank line
+  expected.insert(expected.find("on_time_us = 15.0\n") + 18, "polarity = \"-\"\n");
+  EXPECT_EQ(set_element(kConditions, 1, "polarity", "\"-\""), expected);
+  std::string why;
+  const auto out = without_toml_element_key(kConditions, "edm.condition", 0, "on_time_us", why);
+  ASSERT_TRUE(out) << why;
+  expected = kConditions;
+  expected.erase(expected.find("on_time_us = 100.0"), 35);
+  EXPECT_EQ(*out, expected);
+}
+
+TEST(TomlEdit, AnElementThatIsNotWrittenUnderAHeaderOfItsOwnIsRefused) {
+  std::string why;
+  EXPECT_EQ(set_element(kConditions, 2, "on_time_us", "1.0", &why), "");
+  EXPECT_NE(why.find("no [[edm.condition]] #3 table"), std::string::npos) << why;
+  EXPECT_EQ(set_element(kConditions, -1, "on_time_us", "1.0", &why), "");
+  EXPECT_FALSE(why.empty());
+  // Two elements of an inline array then one under a header: the header is element 3, not 1.
+  const char* mixed = "[edm]\ncondition = [{number = 1}, {number = 2}]\n";
+  EXPECT_EQ(set_element(mixed, 0, "number", "5", &why), "");
+  EXPECT_FALSE(why.empty());
+  EXPECT_EQ(set_element(kConditions, 0, "on_time_us", "[1,\n2]", &why), "");
+  EXPECT_NE(why.find("not one TOML value on one line"), std::string::npos) << why;
+}
+
+/// The EDM's profile (four conditions) and its tool table in a directory of their own.
+class ProfileEditConditions : public ProfileEditFile {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() / ("opencnc-condition-edit-" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir_);
+    for (const char* f : {"edm-5axis.toml", "edm-5axis.tbl"})
+      std::filesystem::copy_file(std::string(OPENCNC_SOURCE_DIR "/configs/") + f, dir_ / f);
+    path_ = (dir_ / "edm-5axis.toml").string();
+    std::ifstream in(path_);
+    std::stringstream s;
+    s << in.rdbuf();
+    original_ = s.str();
+    ProfileLoad load = load_profile(path_);
+    ASSERT_TRUE(load.ok());
+    live_ = *load.profile;
+  }
+};
+
+TEST_F(ProfileEditConditions, AConditionsFieldsChangeInItsElementAndTheAuditSaysWhichAndHow) {
+  const ProfileKeyEdit edits[] = {{"edm.condition.3.on_time_us", "20.0"},
+                                  {"edm.condition.9.polarity", "\"-\""},
+                                  {"edm.condition.2.orbit", "\"star\""}};
+  const ProfileEditResult r = edit_profile(live_, edits);
+  ASSERT_TRUE(r.ok()) << r.error;
+  EXPECT_EQ(r.profile->edm.config.find(3)->on_time_us, 20.0);
+  EXPECT_EQ(r.profile->edm.config.find(1)->on_time_us, 100.0);  // the other conditions' stay
+  EXPECT_EQ(r.profile->edm.config.find(9)->polarity, -1);
+  EXPECT_EQ(r.profile->edm.config.find(2)->orbit, machine::OrbitKind::Star);
+  ASSERT_EQ(r.changes.size(), 3u);
+  EXPECT_EQ(r.changes[0].key, "edm.condition.3.on_time_us");
+  EXPECT_EQ(r.changes[0].old_value, "15.0");
+  EXPECT_EQ(r.changes[0].new_value, "20.0");
+  EXPECT_EQ(r.changes[1].old_value, "+");
+  EXPECT_EQ(r.changes[1].new_value, "-");
+  EXPECT_EQ(r.changes[2].new_value, "star");
+  std::string expected = original_;
+  expected.replace(expected.find("on_time_us = 15.0"), 17, "on_time_us = 20.0");
+  expected.replace(expected.find("orbit = \"circle\""), 16, "orbit = \"star\"");
+  const std::size_t nine = expected.find("number = 9");
+  const std::size_t after = expected.find("max_retract_mm_s = 3.0\n", nine) + 23;
+  expected.insert(after, "polarity = \"-\"\n");
+  EXPECT_EQ(r.text, expected);
+}
+
+TEST_F(ProfileEditConditions, ABadValueGetsTheLoadersMessageAndUnknownConditionsOrFieldsAreRefused) {
+  const ProfileKeyEdit high[] = {{"edm.condition.1.servo_reference_v", "120.0"}};  // above voltage_v
+  const ProfileEditResult r = edit_profile(live_, high);
+  ASSERT_FALSE(r.ok());
+  ASSERT_FALSE(r.diagnostics.items().empty());
+  const Diagnostic& d = r.diagnostics.items().front();
+  EXPECT_EQ(d.file, path_);
+  const std::size_t at = original_.find("servo_reference_v = 45.0");
+  EXPECT_EQ(d.line, 1 + std::count(original_.begin(), original_.begin() + static_cast<long>(at), '\n'));
+  EXPECT_NE(d.message.find("must be below voltage_v"), std::string::npos) << d.message;
+  const ProfileKeyEdit word[] = {{"edm.condition.1.polarity", "\"x\""}};
+  EXPECT_FALSE(edit_profile(live_, word).ok());
+  const ProfileKeyEdit missing[] = {{"edm.condition.4.on_time_us", "1.0"}};
+  EXPECT_NE(edit_profile(live_, missing).error.find("no machining condition 4"), std::string::npos);
+  const ProfileKeyEdit field[] = {{"edm.condition.1.side_gap_mm", "0.1"}};
+  EXPECT_NE(edit_profile(live_, field).error.find("not a field of a machining condition"), std::string::npos);
+  EXPECT_TRUE(is_condition_key("edm.condition.12.jump_mode"));
+  EXPECT_FALSE(is_condition_key("edm.condition.0.jump_mode"));
+  EXPECT_FALSE(is_condition_key("edm.condition.x.on_time_us"));
+}
+
 TEST(ProfileEdit, TheEditableParametersAreEachAxisLimits) {
   ProfileLoad load = load_profile(OPENCNC_SOURCE_DIR "/configs/mill-3axis.toml");
   ASSERT_TRUE(load.ok());

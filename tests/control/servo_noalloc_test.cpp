@@ -279,6 +279,18 @@ TEST(ServoAllocations, NoneInsideTheEdmTick) {
   const machine::SimEdmProcess& sim = a.rig().machine().edm();
   EXPECT_GT(sim.cavity_oversize_max_mm(), 0.04);  // orbits beyond the roughing's side gap
   EXPECT_GT(sim.electrode_wear_mm(), 0.0);
+  // An admin's edit of the conditions: staged and taken at rest, in the counted ticks.
+  EdmConditionTable& next = a.rig().channels().edm_conditions;
+  next.conditions = a.rig().servo().config().edm.conditions;
+  next.count = a.rig().servo().config().edm.condition_count;
+  next.conditions[0].on_time_us = 60;
+  Command stage;
+  stage.kind = CommandKind::StageEdmConditions;
+  Command apply;
+  apply.kind = CommandKind::ApplyJointLimits;
+  ASSERT_TRUE(a.rig().channels().commands.try_push(stage) && a.rig().channels().commands.try_push(apply));
+  a.until([] { return false; }, 20);
+  EXPECT_EQ(a.rig().servo().config().edm.find(1)->on_time_us, 60.0);
   EXPECT_EQ(g_allocations.load(), 0);
   std::filesystem::remove_all(dir);
 }

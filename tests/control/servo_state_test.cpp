@@ -347,6 +347,9 @@ const Row kRows[] = {
      cmd(CommandKind::StageJointLimits, 0, 0, 0), Refusal::BadValue, State::Running},
     {"stage_limits_no_such_joint", false, off, State::Off, cmd(CommandKind::StageJointLimits, 0, 0, 7),
      Refusal::BadValue, State::Off},
+    // machining conditions on a machine without an EDM (the mill): nothing to stage them into
+    {"stage_conditions_without_edm", false, idle(Mode::Manual), State::Idle,
+     cmd(CommandKind::StageEdmConditions), Refusal::NotApplicable, State::Idle},
 };
 
 void PrintTo(const Row& r, std::ostream* os) {

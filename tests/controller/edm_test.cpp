@@ -16,11 +16,14 @@
 #include <string>
 #include <vector>
 
+#include <unistd.h>
+
 #include "edm_rig.hpp"
 #include "opencnc/controller/controller.hpp"
 #include "opencnc/controller/edm_recorder.hpp"
 #include "opencnc/controller/gcode_source.hpp"
 #include "opencnc/controller/sim_rig.hpp"
+#include "opencnc/core/atomic_file.hpp"
 
 namespace opencnc::control::test {
 namespace {
@@ -377,6 +380,65 @@ TEST(Edm, ThePreflightRefusesAConditionTheMachineLacks) {
   EXPECT_EQ(d.code, "edm.condition");
   EXPECT_EQ(d.line, 3u);
   EXPECT_NE(d.message.find("1, 2, 3, 9"), std::string::npos) << d.message;
+}
+
+// An admin's edit of a machining condition while the machine is idle: the file changes in its
+// [[edm.condition]] element, the audit says what changed, and a program that selects the
+// condition afterwards jumps by the new height; a condition the tick cannot run (handed to it
+// directly) makes the apply refuse and leaves the conditions as they were.
+TEST(Edm, AnEditedConditionIsTheOneAProgramSelectsAfterwards) {
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("opencnc-edm-edit-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  for (const char* f : {"edm-5axis.toml", "edm-5axis.tbl"})
+    std::filesystem::copy_file(std::filesystem::path(OPENCNC_SOURCE_DIR "/configs") / f, dir / f,
+                               std::filesystem::copy_options::overwrite_existing);
+  const std::string path = (dir / "edm-5axis.toml").string();
+  {
+    const config::MachineProfile p =
+        loaded(config::load_profile(path, std::vector<std::string>{"edm.sim.electrode_area_mm2=5"}));
+    Diagnostics d;
+    SimRig rig(p, GcodeProgramSource::create(p, d));
+    auto samples = std::make_shared<Samples>();
+    rig.controller().attach(samples, ObserverOptions{0, true});
+    rig.step();
+    ASSERT_TRUE(on_and_homed(rig));
+    const Outcome o =
+        rig.request(Request::edit_profile({{"edm.condition.1.jump_height_mm", "0.25"}}, "admin"));
+    ASSERT_TRUE(o.accepted) << o.message;
+    EXPECT_EQ(o.message, "edm.condition.1.jump_height_mm 0.4 → 0.25");
+    EXPECT_EQ(rig.servo().config().edm.find(1)->jump_height_mm, 0.25);
+    std::string text;
+    ASSERT_TRUE(read_file(path, text, nullptr));
+    EXPECT_NE(text.find("number = 1\non_time_us = 100.0"), std::string::npos);
+    EXPECT_NE(text.find("jump_height_mm = 0.25\njump_period_s = 0.25      # T_on"), std::string::npos);
+
+    ASSERT_TRUE(rig.request(Request::set_mode(Mode::Auto)).accepted);
+    ASSERT_TRUE(rig.request(Request::open(write_program(burn(1, 0.01))), 100000).accepted);
+    ASSERT_TRUE(rig.request(Request::simple(CommandKind::CycleStart)).accepted);
+    ASSERT_TRUE(rig.run_until(
+        [&] { return !rig.status().run_active && rig.status().servo.state == State::Idle; }, 60000));
+    double lift_max = 0;
+    for (const TraceSample& s : samples->all) lift_max = std::max(lift_max, s.edm.jump_lift_mm);
+    EXPECT_NEAR(lift_max, 0.25, 1e-9);
+
+    EdmConditionTable& bad = rig.channels().edm_conditions;
+    bad.conditions = rig.servo().config().edm.conditions;
+    bad.count = rig.servo().config().edm.condition_count;
+    bad.conditions[0].servo_reference_v = bad.conditions[0].voltage_v;  // the gap would never burn
+    Command stage;
+    stage.id = 78001;
+    stage.kind = CommandKind::StageEdmConditions;
+    Command apply;
+    apply.id = 78002;
+    apply.kind = CommandKind::ApplyJointLimits;
+    ASSERT_TRUE(rig.channels().commands.try_push(stage) && rig.channels().commands.try_push(apply));
+    rig.run(3);
+    ASSERT_TRUE(rig.controller().outcome(78002).has_value());
+    EXPECT_EQ(rig.controller().outcome(78002)->refusal, Refusal::BadValue);
+    EXPECT_EQ(rig.servo().config().edm.find(1)->servo_reference_v, 45.0);
+  }
+  std::filesystem::remove_all(dir);
 }
 
 // The setter's seek of the end of the travel through the controller: the request, the note that

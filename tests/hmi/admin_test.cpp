@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The admin's machine parameters and pitch-error tables through the HMI server on loopback: read
-// by anyone with a token, changed by the admin only (403 for the operator), a bad value answered
-// with the profile's own message and nothing changed, a good one in the file and the live limits,
-// audited.
+// The admin's machine parameters, pitch-error tables and EDM machining conditions through the HMI
+// server on loopback: read by anyone with a token, changed by the admin only (403 for the
+// operator), a bad value answered with the profile's own message and nothing changed, a busy
+// machine refused, a good one in the file and the live limits, audited.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -274,6 +274,77 @@ TEST(AdminConditions, AnEdmsConditionsAreListedInTheProfilesOrder) {
   EXPECT_EQ(list[2]["jump_mode"], "path");
   EXPECT_EQ(list[3]["number"], 9);
   EXPECT_EQ(get(rig.port, "/api/v1/conditions", "").status, 401);
+}
+
+/// The EDM, its profile a copy (with its tool table) the admin may edit.
+struct EdmRig : ServerRig {
+  EdmRig() : ServerRig(options()) {}
+  static RigOptions options() {
+    RigOptions o;
+    o.machine = "edm-5axis.toml";
+    o.profile_copy = true;
+    o.history = true;
+    return o;
+  }
+};
+
+TEST(AdminConditions, TheOperatorReadsThemOnlyTheAdminChangesThemAndTheChangeIsAudited) {
+  EdmRig rig;
+  const json fields = get(rig.port, "/api/v1/conditions", kOperator).body["fields"];
+  ASSERT_EQ(fields.size(), 19u);
+  EXPECT_EQ(fields[0], (json{{"key", "on_time_us"}, {"unit", "µs"}, {"what", "pulse on-time"}}));
+  EXPECT_EQ(fields[4]["choices"], json::array({"+", "-"}));
+  const std::string change =
+      R"({"kind":"set-conditions","condition":3,"values":{"on_time_us":20,"orbit":"circle"}})";
+  EXPECT_EQ(post(rig.port, change, kOperator).status, 403);
+  EXPECT_EQ(rig.profile_text(), rig.profile_original);
+  const Reply ok = post(rig.port, change, kAdmin);
+  ASSERT_EQ(ok.status, 200) << ok.text;
+  EXPECT_EQ(ok.body["message"],
+            "edm.condition.3.on_time_us 15.0 → 20.0; edm.condition.3.orbit square → circle");
+  std::string expected = rig.profile_original;
+  expected.replace(expected.find("on_time_us = 15.0"), 17, "on_time_us = 20.0");
+  expected.replace(expected.find("orbit = \"square\""), 16, "orbit = \"circle\"");
+  EXPECT_EQ(rig.profile_text(), expected);
+  const json now = get(rig.port, "/api/v1/conditions", kOperator).body["conditions"][2];
+  EXPECT_EQ(now["on_time_us"], 20.0);
+  EXPECT_EQ(now["orbit"], "circle");
+  rig.history->flush();
+  const json audit = get(rig.port, "/api/v1/audit", kAdmin).body;
+  ASSERT_GE(audit.size(), 2u);
+  EXPECT_EQ(audit[0]["result"], "accepted: " + ok.body["message"].get<std::string>());
+  EXPECT_EQ(audit[0]["role"], "admin");
+  EXPECT_EQ(audit[1]["status"], 403);
+}
+
+TEST(AdminConditions, ABadValueGetsTheProfilesMessageAndABusyMachineIsRefusedAndNothingChanges) {
+  EdmRig rig;
+  const Reply bad =
+      post(rig.port, R"({"kind":"set-conditions","condition":1,"values":{"servo_reference_v":150}})", kAdmin);
+  ASSERT_EQ(bad.status, 409) << bad.text;
+  EXPECT_EQ(bad.body["code"], "control.bad-value");
+  ASSERT_FALSE(bad.body["diagnostics"].empty());
+  const std::string text = bad.body["diagnostics"][0]["text"];
+  EXPECT_EQ(text.rfind(rig.profile_path + ":", 0), 0u) << text;  // file:line:col: error: message
+  EXPECT_NE(text.find("must be below voltage_v"), std::string::npos) << text;
+  const auto status = [&](const char* body) { return post(rig.port, body, kAdmin).status; };
+  EXPECT_EQ(status(R"({"kind":"set-conditions","condition":4,"values":{"on_time_us":1}})"), 422);
+  EXPECT_EQ(status(R"({"kind":"set-conditions","condition":1,"values":{"side_gap_mm":0.1}})"), 422);
+  EXPECT_EQ(status(R"({"kind":"set-conditions","condition":1,"values":{"polarity":"x"}})"), 422);
+  EXPECT_EQ(status(R"({"kind":"set-conditions","condition":1,"values":{"polarity":1}})"), 400);
+  EXPECT_EQ(status(R"({"kind":"set-conditions","condition":1,"values":{"on_time_us":"long"}})"), 400);
+  EXPECT_EQ(status(R"({"kind":"set-conditions","condition":"1","values":{"on_time_us":1}})"), 400);
+  EXPECT_EQ(status(R"({"kind":"set-conditions","condition":1,"values":{}})"), 400);
+  // A jog runs: the change waits for the machine to stand still.
+  EXPECT_EQ(post(rig.port, R"({"kind":"machine-on"})", kOperator).status, 200);
+  EXPECT_EQ(post(rig.port, R"({"kind":"jog","axis":"Z","velocity":1})", kOperator).status, 200);
+  const Reply busy =
+      post(rig.port, R"({"kind":"set-conditions","condition":1,"values":{"on_time_us":90}})", kAdmin);
+  EXPECT_EQ(busy.status, 409) << busy.text;
+  EXPECT_EQ(busy.body["code"], "control.busy");
+  EXPECT_EQ(post(rig.port, R"({"kind":"jog-stop","axis":"Z"})", kOperator).status, 200);
+  EXPECT_EQ(rig.profile_text(), rig.profile_original);
+  EXPECT_EQ(get(rig.port, "/api/v1/conditions", kOperator).body["conditions"][0]["on_time_us"], 100.0);
 }
 
 TEST(AdminConditions, AMachineWithoutEdmHasNone) {

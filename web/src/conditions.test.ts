@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The machining-conditions screen's logic: each condition's cells, and which one is in force.
+// The machining-conditions screen's logic: each condition's cells, which one is in force, who may
+// edit them, and the admin's edit as a set-conditions command.
 import { describe, expect, it } from "vitest";
-import { activeCondition, conditionCells, conditionHeader, type Condition } from "./screens/conditions";
+import { activeCondition, conditionCells, conditionCommand, conditionHeader, mayEdit, type Condition, type ConditionField } from "./screens/conditions";
 import type { Status } from "./types";
 
 const roughing: Condition = {
@@ -34,5 +35,34 @@ describe("machining conditions", () => {
     expect(activeCondition({ edm: { condition: 2 } } as unknown as Status)).toBe(2);
     expect(activeCondition({} as Status)).toBe(0);
     expect(activeCondition(undefined)).toBe(0);
+  });
+});
+
+const fields: ConditionField[] = [
+  { key: "on_time_us", unit: "µs", what: "pulse on-time" },
+  { key: "peak_current_a", unit: "A", what: "discharge current" },
+  { key: "polarity", unit: "", what: "electrode + or −", choices: ["+", "-"] },
+  { key: "orbit", unit: "", what: "the orbit's shape", choices: ["none", "circle", "square", "star"] },
+];
+
+describe("editing a machining condition", () => {
+  it("is the admin's only: an operator's token sees the conditions read-only", () => {
+    expect(mayEdit("admin")).toBe(true);
+    expect(mayEdit("operator")).toBe(false);
+    expect(mayEdit(undefined)).toBe(false);
+  });
+  it("sends only the fields that changed, numbers as numbers and choices as their words", () => {
+    expect(conditionCommand(roughing, fields, { on_time_us: " 60 ", peak_current_a: "12", polarity: "-", orbit: "none" })).toEqual({
+      kind: "set-conditions",
+      condition: 1,
+      values: { on_time_us: 60, polarity: "-" },
+    });
+    expect(conditionCommand(roughing, fields, { orbit: "circle" })).toEqual({ kind: "set-conditions", condition: 1, values: { orbit: "circle" } });
+  });
+  it("says in words what it will not send", () => {
+    expect(conditionCommand(roughing, fields, { on_time_us: "long" })).toBe('E1 on_time_us: "long" is not a number');
+    expect(conditionCommand(roughing, fields, { peak_current_a: " " })).toBe("E1 peak_current_a: a value is needed");
+    expect(conditionCommand(roughing, fields, { polarity: "x" })).toBe("E1 polarity: one of + -");
+    expect(conditionCommand(roughing, fields, {})).toBe("E1: nothing changed");
   });
 });

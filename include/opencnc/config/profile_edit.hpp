@@ -41,6 +41,27 @@ std::vector<EditableParameter> editable_parameters(const MachineProfile& profile
 /// file `.positions` (one-line TOML array: each point's position). Any thread.
 bool is_pitch_table_key(std::string_view key);
 
+/// A field of a machining condition (`[[edm.condition]]`) the admin may change: the key in the
+/// file, its unit, one line for the screen, and for a choice its words ("+|-").
+struct ConditionField {
+  const char* key;      ///< "on_time_us"
+  const char* unit;     ///< "µs", "A", "V", "mm/s" … ("" for a choice)
+  const char* what;     ///< one line for the screen
+  const char* choices;  ///< "+|-", "axis|path", "none|circle|square|star"; nullptr for a number
+};
+
+/// The editable fields of every machining condition, in the Conditions screen's order (the
+/// generator's, the gap servo's, the jump's, the orbit's). Any thread.
+std::span<const ConditionField> condition_fields();
+
+/// The field `field` of `c` as TOML-free text for the audit and the screen ("100.0", "+",
+/// "circle"); "" for a field that is not editable. Any thread.
+std::string condition_field_text(const machine::EdmCondition& c, std::string_view field);
+
+/// True for a key of a machining condition the admin may change through edit_profile():
+/// `edm.condition.<number>.<field>`, a field of condition_fields(). Any thread.
+bool is_condition_key(std::string_view key);
+
 /// One key's change, as text for the audit and the answer ("100.0" → "80.0").
 struct ProfileChange {
   std::string key;
@@ -63,14 +84,15 @@ struct ProfileEditResult {
 /// The profile `live` (loaded from `live.source` with `live.overrides`) with `edits` applied: the
 /// file is read again and must still be the text `live` was loaded from (its digest); each key
 /// must be one of editable_parameters(live), or a pitch-table key (is_pitch_table_key) of an axis
-/// with `[axis.<a>.compensation]`, and not set by an override; its line is edited with
-/// with_toml_value(). A table written as `errors` stays so while forward and reverse are equal;
-/// when they differ, `errors` gives way to `forward` and `reverse` (the section's comments stay).
-/// A table in a LinuxCNC comp file is written into that file instead (CompFileEdits: forward,
-/// reverse and positions; its comment lines stay), returned in `files`. The new text is loaded by
-/// parse_profile() with the same overrides and those files' new texts, so its errors are the
-/// loader's own, at the edited line (of the profile or of the comp file). Nothing is written.
-/// Non-real-time (reads the files).
+/// with `[axis.<a>.compensation]`, or a condition key (is_condition_key) of a condition the
+/// profile defines, and not set by an override; its line is edited with with_toml_value() (a
+/// condition's in its `[[edm.condition]]` element). A table written as `errors` stays so while
+/// forward and reverse are equal; when they differ, `errors` gives way to `forward` and `reverse`
+/// (the section's comments stay). A table in a LinuxCNC comp file is written into that file
+/// instead (CompFileEdits: forward, reverse and positions; its comment lines stay), returned in
+/// `files`. The new text is loaded by parse_profile() with the same overrides and those files' new
+/// texts, so its errors are the loader's own, at the edited line (of the profile or of the comp
+/// file). Nothing is written. Non-real-time (reads the files).
 ProfileEditResult edit_profile(const MachineProfile& live, std::span<const ProfileKeyEdit> edits);
 
 }  // namespace opencnc::config

@@ -26,6 +26,21 @@ std::optional<std::string> with_toml_value(std::string_view text, std::string_vi
 std::optional<std::string> without_toml_key(std::string_view text, std::string_view dotted_key,
                                             std::string& error);
 
+/// `text` with the key `key` of element `element` (0 first) of the array of tables `array_key`
+/// (`[[edm.condition]]`: "edm.condition", compared in lower case) set to `value_toml`, as
+/// with_toml_value() sets a key of a table: the line keeps its indentation and comment, a key the
+/// element lacks is added after its last key. Refused (nullopt, `error` says why) as
+/// with_toml_value() refuses, and when the elements are not each written under a `[[…]]` header
+/// of their own (an inline array of tables). Non-real-time; any thread.
+std::optional<std::string> with_toml_element_value(std::string_view text, std::string_view array_key,
+                                                   int element, std::string_view key,
+                                                   std::string_view value_toml, std::string& error);
+
+/// `text` without the key `key` of element `element` of the array of tables `array_key` (as
+/// with_toml_element_value() finds it). Non-real-time; any thread.
+std::optional<std::string> without_toml_element_key(std::string_view text, std::string_view array_key,
+                                                    int element, std::string_view key, std::string& error);
+
 /// A number as TOML text that reads back as the same double (always a float: "80.0", "1e-05").
 /// Any thread.
 std::string toml_number(double v);

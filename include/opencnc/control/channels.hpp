@@ -12,6 +12,7 @@
 #include "opencnc/control/spsc_ring.hpp"
 #include "opencnc/control/status.hpp"
 #include "opencnc/control/triple_buffer.hpp"
+#include "opencnc/machine/edm.hpp"
 #include "opencnc/motion/compensation.hpp"
 #include "opencnc/traj/block_queue.hpp"
 
@@ -39,6 +40,14 @@ struct PitchTableArea {
 };
 
 static_assert(std::atomic<std::int8_t>::is_always_lock_free);
+/// The machining conditions handed to the tick (an admin's edit): the controller writes them only
+/// while no change of the profile is in flight, then sends StageEdmConditions and
+/// ApplyJointLimits; the tick reads them only in that apply (checks them, then copies them into
+/// its configuration), so one buffer is enough. Plain data.
+struct EdmConditionTable {
+  std::array<machine::EdmCondition, machine::kMaxEdmConditions> conditions{};
+  int count = 0;
+};
 
 /// Every queue has exactly one producer and one consumer:
 ///
@@ -51,8 +60,9 @@ static_assert(std::atomic<std::int8_t>::is_always_lock_free);
 /// | status     | servo tick                | controller |
 /// | trace      | servo tick (when enabled) | recorder   |
 ///
-/// and `pitch_tables`' buffers are written by the controller and read by the servo tick, which
-/// publishes in `pitch_tables.reading` the buffer it reads (PitchTableArea).
+/// and `pitch_tables`' buffers and `edm_conditions` are written by the controller and read by the
+/// servo tick, which publishes in `pitch_tables.reading` the buffer it reads (PitchTableArea,
+/// EdmConditionTable).
 /// About 4 MB; construct it on the heap or in shared memory (standard layout, lock-free atomics).
 struct ServoChannels {
   SpscRing<Command, 256> commands;
@@ -65,6 +75,7 @@ struct ServoChannels {
   SpscRing<TraceSample, 8192> trace;
   std::atomic<bool> trace_enabled{false};
   PitchTableArea pitch_tables;
+  EdmConditionTable edm_conditions;
 };
 
 static_assert(std::is_standard_layout_v<ServoChannels>);

@@ -83,6 +83,9 @@ enum class CommandKind : std::uint8_t {
   /// `axis` = joint, `table_buffer` = 0/1: that joint's buffer of ServoChannels::pitch_tables is
   /// its new pitch-error table from the next ApplyJointLimits on (no effect yet)
   StagePitchTable,
+  /// ServoChannels::edm_conditions are the EDM's machining conditions from the next
+  /// ApplyJointLimits on (checked there; no effect yet)
+  StageEdmConditions,
   /// `axis`, `value` = +1 / −1: jog to that limit switch, latch it slowly, back off onto its free
   /// side (LimitSeek); Manual mode, idle, the axis with that switch and seek keys
   SeekLimit,

@@ -102,6 +102,7 @@ class Servo final : public Tickable {
   Refusal stage_joint_limits(const Command& c) noexcept;
   Refusal apply_joint_limits() noexcept;
   Refusal stage_pitch_table(const Command& c) noexcept;
+  Refusal stage_edm_conditions() noexcept;
   void enter_estop() noexcept;
   void enter_fault(const Fault& f) noexcept;
   void halt(RunEnd why) noexcept;
@@ -187,6 +188,7 @@ class Servo final : public Tickable {
   std::uint16_t staged_joints_ = 0;                               ///< bit j: joint j is staged
   std::uint16_t staged_tables_ = 0;  ///< bit j: joint j has a pitch table staged (StagePitchTable)
   std::array<std::uint8_t, machine::kMaxJoints> staged_buffer_{};  ///< which buffer is staged
+  bool staged_conditions_ = false;  ///< StageEdmConditions: the channels' conditions wait for the apply
   bool staged_invalid_ = false;  ///< a stage was refused: the next apply refuses too (all or nothing)
   ServoChannels* channels_;
   machine::MachineIO* machine_;

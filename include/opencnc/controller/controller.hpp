@@ -121,6 +121,7 @@ class Controller final : private FeatureHost {
   bool settle_profile_change(const ServoEvent& e);
   struct ProfileChange;
   bool stage_pitch_table(int joint, const ServoConfig& next, const ProfileChange& pending);
+  bool stage_edm_conditions(const ServoConfig& next, const ProfileChange& pending);
   void swap_profile(config::MachineProfile profile);
   bool features_allow_start(std::uint64_t id, const StartCheck& start);
   bool features_allow_continue(const SyncCheck& sync);

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The admin's part of the JSON API: machine parameters (the profile's editable keys) and the
-// pitch-error compensation tables read and changed through the controller's EditProfile request.
+// The admin's part of the JSON API: machine parameters (the profile's editable keys), the
+// pitch-error compensation tables and an EDM's machining conditions, read and changed through the
+// controller's EditProfile request.
 #pragma once
 
 #include <nlohmann/json.hpp>
@@ -41,8 +42,16 @@ ParametersRequest compensation_request(const nlohmann::json& body, const config:
 nlohmann::json compensation_json(const config::MachineProfile& profile);
 
 /// `GET /api/v1/conditions`: an EDM's machining conditions (`[[edm.condition]]`) in the order of
-/// the profile, each with its generator, gap-servo, jump and orbit settings; an empty list on a
-/// machine without `[edm]`. Any thread.
+/// the profile, each with its generator, gap-servo, jump and orbit settings, and the fields the
+/// admin may change (key, unit, a line, the words of a choice); an empty list on a machine
+/// without `[edm]`. Any thread.
 nlohmann::json conditions_json(const config::MachineProfile& profile);
+
+/// A `set-conditions` body (`{"condition": 3, "values": {"on_time_us": 60, "polarity": "-"}}`) as
+/// the controller's EditProfile request of the keys `edm.condition.<n>.<field>`, or the HTTP
+/// status and message of why not (400 malformed or a value of the wrong type, 422 a condition the
+/// profile lacks, a field that cannot be changed, a number that is not finite or a word that is
+/// not one of the choice's). The loader's own checks come from the controller. Any thread.
+ParametersRequest conditions_request(const nlohmann::json& body, const config::MachineProfile& profile);
 
 }  // namespace opencnc::hmi

@@ -1,10 +1,13 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The Machining conditions screen: an EDM's conditions ([[edm.condition]] of its profile) as a
 // table — number, on/off time, peak current, voltage, polarity, servo reference, jump and orbit —
-// with the one the generator runs now (the status' edm.condition) highlighted live.
-import { registerScreen } from "../registry";
-import type { Status } from "../types";
-import { el } from "../ui";
+// with the one the generator runs now (the status' edm.condition) highlighted live. An admin
+// edits a condition's fields while nothing runs (set-conditions: the profile's own checks, the
+// tick takes the new values at rest); an operator sees them read-only.
+import { registerScreen, type Context } from "../registry";
+import type { Outcome, Status } from "../types";
+import { button, el } from "../ui";
+import { outcomeLines } from "./parameters";
 
 /** One condition as GET /api/v1/conditions gives it. */
 export interface Condition {
@@ -21,6 +24,16 @@ export interface Condition {
   orbit: string;
   orbit_radius_mm: number;
   orbit_step_mm: number;
+  [field: string]: number | string;
+}
+
+/** A field the admin may change, as GET /api/v1/conditions lists them. */
+export interface ConditionField {
+  key: string;
+  unit: string;
+  what: string;
+  /** The words of a choice ("+", "-"); absent for a number. */
+  choices?: string[];
 }
 
 /** The table's header: what each column of conditionCells() shows, with its unit. */
@@ -38,9 +51,51 @@ export function activeCondition(s: Status | undefined): number {
   return s?.edm?.condition ?? 0;
 }
 
+/** Whether a token of `role` (GET /api/v1/server's) may change the conditions. */
+export function mayEdit(role: string | undefined): boolean {
+  return role === "admin";
+}
+
+/**
+ * The set-conditions command for what the admin typed into condition `c`'s fields, with only the
+ * fields that changed; or why not in words (checked before anything is sent; the profile's own
+ * checks follow on the controller).
+ */
+export function conditionCommand(c: Condition, fields: ConditionField[], inputs: Record<string, string>): Record<string, unknown> | string {
+  const values: Record<string, number | string> = {};
+  for (const f of fields) {
+    const typed = (inputs[f.key] ?? `${c[f.key]}`).trim();
+    if (f.choices) {
+      if (!f.choices.includes(typed)) return `E${c.number} ${f.key}: one of ${f.choices.join(" ")}`;
+      if (typed !== c[f.key]) values[f.key] = typed;
+      continue;
+    }
+    if (typed === "") return `E${c.number} ${f.key}: a value is needed`;
+    const v = Number(typed);
+    if (!Number.isFinite(v)) return `E${c.number} ${f.key}: "${typed}" is not a number`;
+    if (v !== c[f.key]) values[f.key] = v;
+  }
+  if (Object.keys(values).length === 0) return `E${c.number}: nothing changed`;
+  return { kind: "set-conditions", condition: c.number, values };
+}
+
+interface ConditionsAnswer {
+  profile: string;
+  when: string;
+  fields: ConditionField[];
+  conditions: Condition[];
+}
+
 let body: HTMLElement | undefined;
 let note: HTMLElement | undefined;
+let editor: HTMLElement | undefined;
+let result: HTMLElement | undefined;
+let token: HTMLInputElement | undefined;
+let unlockRow: HTMLElement | undefined;
 let shown = -1;
+/** The admin's token once checked (the page's own when it is an admin's); "" while read-only. */
+let adminToken = "";
+let answer: ConditionsAnswer | undefined;
 
 function highlight(active: number) {
   if (!body || active === shown) return;
@@ -48,31 +103,121 @@ function highlight(active: number) {
   body.querySelectorAll("tr").forEach((tr) => tr.classList.toggle("active", Number(tr.dataset.condition) === active));
 }
 
+function show(ctx: Context, lines: string[], severity: "note" | "error") {
+  if (!result) return;
+  result.textContent = lines.join("\n");
+  result.className = `diagnostics ${severity}`;
+  ctx.message(lines[0] ?? "", severity);
+}
+
+/** The role of `t` (GET /api/v1/server answers with the token's role), undefined when refused. */
+async function roleOf(t: string): Promise<string | undefined> {
+  const res = await fetch("/api/v1/server", { headers: { Authorization: `Bearer ${t}` } });
+  return res.ok ? ((await res.json()) as { role?: string }).role : undefined;
+}
+
+async function apply(ctx: Context, body: Record<string, unknown>) {
+  const res = await fetch("/api/v1/commands", {
+    method: "POST",
+    headers: { Authorization: `Bearer ${adminToken}`, "Content-Type": "application/json" },
+    body: JSON.stringify(body),
+  });
+  const o = { ...((await res.json()) as Outcome), status: res.status };
+  show(ctx, outcomeLines(o), o.status === 200 ? "note" : "error");
+  if (o.status === 200) await load(ctx, Number(body.condition));
+}
+
+/** The admin's form for condition `c`: a line per field (a number or the choice's words). */
+function edit(ctx: Context, c: Condition) {
+  if (!editor || !answer) return;
+  const inputs: Record<string, string> = {};
+  const rows = answer.fields.map((f) => {
+    inputs[f.key] = `${c[f.key]}`;
+    let input: HTMLInputElement | HTMLSelectElement;
+    if (f.choices) {
+      input = el("select", { "data-field": f.key }, ...f.choices.map((w) => el("option", { value: w }, w)));
+    } else {
+      input = el("input", { type: "number", step: "any", class: "num", "data-field": f.key });
+    }
+    input.value = inputs[f.key];
+    input.addEventListener("input", () => (inputs[f.key] = input.value));
+    input.addEventListener("change", () => (inputs[f.key] = input.value));
+    return el("tr", {}, el("th", {}, f.key), el("td", {}, input), el("td", {}, f.unit), el("td", { class: "hint" }, f.what));
+  });
+  editor.replaceChildren(
+    el("h3", {}, `Condition E${c.number}`),
+    el("table", { class: "grid", id: "condition-form" }, el("tbody", {}, ...rows)),
+    el(
+      "div",
+      { class: "row" },
+      button(`Apply E${c.number} (admin)`, () => {
+        const command = conditionCommand(c, answer?.fields ?? [], inputs);
+        if (typeof command === "string") return show(ctx, [command], "error");
+        void apply(ctx, command);
+      }, "primary"),
+    ),
+  );
+}
+
+async function load(ctx: Context, selected = 0) {
+  const r = await ctx.api.get<ConditionsAnswer>("conditions");
+  if (!body || !note || !editor) return;
+  answer = r;
+  const empty = r.conditions.length === 0;
+  if (unlockRow) unlockRow.style.display = empty || adminToken !== "" ? "none" : ""; // .row is a flex box: not `hidden`
+  note.textContent = empty
+    ? "This machine has no machining conditions (an EDM's [[edm.condition]] in its profile)."
+    : `From ${r.profile}; M180 P<n> selects one in a program, M181 switches the generator off. The one in force is highlighted.` +
+      (adminToken ? ` Choose a condition to change it (written to the profile, comments kept, ${r.when}).` : "");
+  body.replaceChildren(
+    ...r.conditions.map((c) => {
+      const cells = conditionCells(c).map((t) => el("td", {}, t));
+      const tr = el("tr", {}, ...cells);
+      if (adminToken) tr.append(el("td", {}, button("Edit", () => edit(ctx, c))));
+      tr.dataset.condition = `${c.number}`;
+      return tr;
+    }),
+  );
+  editor.replaceChildren();
+  const again = r.conditions.find((c) => c.number === selected);
+  if (adminToken && again) edit(ctx, again);
+  shown = -1;
+  highlight(activeCondition(ctx.status()));
+}
+
+/** Edit mode when the typed token (or the page's) is an admin's. */
+async function unlock(ctx: Context) {
+  const t = token?.value || ctx.api.token;
+  if (mayEdit(await roleOf(t))) {
+    adminToken = t;
+    return load(ctx);
+  }
+  show(ctx, ["Only an admin's token may change the conditions: they stay read-only."], "error");
+}
+
 registerScreen({
   id: "conditions",
   title: "Conditions",
-  mount(root) {
+  mount(root, ctx) {
     body = el("tbody");
     note = el("p", { class: "hint" });
-    const head = el("tr", {}, ...conditionHeader.map((h) => el("th", {}, h)));
-    root.append(el("h2", {}, "Machining conditions"), note, el("table", { class: "grid", id: "conditions" }, el("thead", {}, head), body));
+    editor = el("div", { id: "condition-editor" });
+    result = el("pre", { class: "diagnostics", id: "conditions-result" });
+    token = el("input", { id: "cond-admin-token", type: "password", class: "token" });
+    unlockRow = el("div", { class: "row" }, "Admin token: ", token, button("Edit (admin)", () => void unlock(ctx)));
+    const head = el("tr", {}, ...conditionHeader.map((h) => el("th", {}, h)), el("th", {}, ""));
+    root.append(
+      el("h2", {}, "Machining conditions"),
+      note,
+      unlockRow,
+      el("table", { class: "grid", id: "conditions" }, el("thead", {}, head), body),
+      editor,
+      result,
+    );
   },
   async shown(ctx) {
-    const r = await ctx.api.get<{ profile: string; conditions: Condition[] }>("conditions");
-    if (!body || !note) return;
-    note.textContent =
-      r.conditions.length === 0
-        ? "This machine has no machining conditions (an EDM's [[edm.condition]] in its profile)."
-        : `From ${r.profile}; M180 P<n> selects one in a program, M181 switches the generator off. The one in force is highlighted.`;
-    body.replaceChildren(
-      ...r.conditions.map((c) => {
-        const tr = el("tr", {}, ...conditionCells(c).map((t) => el("td", {}, t)));
-        tr.dataset.condition = `${c.number}`;
-        return tr;
-      }),
-    );
-    shown = -1;
-    highlight(activeCondition(ctx.status()));
+    if (!adminToken && mayEdit(await roleOf(ctx.api.token))) adminToken = ctx.api.token;
+    await load(ctx);
   },
   update(s) {
     highlight(activeCondition(s));
