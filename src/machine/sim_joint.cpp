@@ -171,23 +171,33 @@ void SimJoint::begin_period(const JointOutputs& cmd, bool powered, double extern
 // A drive's friction compensation. Starting from rest, the velocity loop's integrator has to
 // build up the Coulomb friction from what it holds (nothing after a power-up) before the axis
 // follows, and axes whose friction is larger against their inertia lag longer: coupled axes
-// drift apart. So when the commanded velocity starts from rest or reverses, the integrator is
+// drift apart. So when the drive starts to move from rest or reverses, the integrator is
 // *set* to hold at least the friction in the new direction. Setting rather than adding makes
 // it bumpless: a standing torque the loop holds that way already (left from a deceleration) is
 // kept, never doubled, and nothing is added while the command keeps its direction. The
 // compensation stays below static friction, so by itself it does not move the axis.
 void SimJoint::compensate_friction() noexcept {
-  const int direction = (cmd_.velocity_ff > 0) - (cmd_.velocity_ff < 0);
+  // The direction the drive wants to move: that of its velocity reference at the period's start
+  // (the command's velocity and the position loop's correction), once it is beyond what a few
+  // counts of following error ask for. An axis that overshot its end point and stuck starts
+  // back before the command rests, and the loop's dithering at standstill starts nothing.
+  constexpr double kDeadBandCounts = 4;
+  const SimJointModel& m = config_.model;
+  const double per_integral = velocity_gain_ * velocity_integral_;  // force per unit of the integral
+  if (m.friction_compensation <= 0 || per_integral <= 0) return;
+  const double error = cmd_.position - quantise_fast(feedback_raw());
+  const double reference = m.feed_forward * cmd_.velocity_ff + m.position_gain * error;
+  const double dead_band = m.position_gain * kDeadBandCounts * unit_per_count_;
+  const int direction = std::abs(reference) <= dead_band ? 0 : reference > 0 ? 1 : -1;
   const bool start = direction != 0 && direction != command_direction_;
   command_direction_ = direction;
-  const double per_integral = velocity_gain_ * velocity_integral_;  // force per unit of the integral
-  if (!start || config_.model.friction_compensation <= 0 || per_integral <= 0) return;
-  const double comp = config_.model.friction_compensation;
+  if (!start) return;
+  const double comp = m.friction_compensation;
   const double held = direction * velocity_error_integral_ * per_integral;  // in the new direction
   // Standing within static friction the loop may hold friction only: the integrator is set to
   // the compensation. Beyond it the loop holds a load (a weight) as well, which must stay: then
   // it is moved by the compensation at most.
-  const bool friction_only = std::abs(held) <= config_.model.static_friction;
+  const bool friction_only = std::abs(held) <= m.static_friction;
   const double change = friction_only ? comp - held : std::min(comp, comp - held);
   if (change > 0) velocity_error_integral_ += direction * change / per_integral;
 }

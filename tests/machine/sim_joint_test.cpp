@@ -222,8 +222,8 @@ TEST(SimJoint, FrictionCompensationKeepsWhatTheLoopHolds) {
     ASSERT_EQ(up_plain->in.position, up_comp->in.position) << "period " << k;
   }
   auto down_plain = loaded(0), down_comp = loaded(40);
-  down_plain->period(-1e-6, -1e-3, true, -200);
-  down_comp->period(-1e-6, -1e-3, true, -200);
+  down_plain->period(-1e-4, -0.1, true, -200);  // 0.1 mm/s: beyond the drive's dead band
+  down_comp->period(-1e-4, -0.1, true, -200);
   EXPECT_NEAR(down_comp->in.effort - down_plain->in.effort, -40, 1);  // not set to −40 N: +160 N
 }
 
