@@ -40,6 +40,7 @@ struct ServeOptions {
   std::string journal_dir;  ///< "" = <data>/journal (machines with a power monitor)
   double speed = 0;  ///< 0: real time on a periodic thread; else paced virtual time
   double stream_hz = 30;
+  int servo_cpu = -1;  ///< real time: the servo thread's own CPU; the server keeps off it
 };
 
 /// `$XDG_STATE_HOME/opencnc`, else `~/.local/state/opencnc`.
@@ -137,7 +138,11 @@ int serve(const ServeOptions& o) {
     return kExitUsage;
   }
 
-  hmi::MachineHost host(profile, source, {o.speed == 0, o.speed == 0 ? 1.0 : o.speed});
+  hmi::HostOptions ho;
+  ho.realtime = o.speed == 0;
+  ho.speed = o.speed == 0 ? 1.0 : o.speed;
+  ho.servo_cpu = o.servo_cpu;
+  hmi::MachineHost host(profile, source, ho);
   host.controller().attach(std::make_shared<hmi::HistoryRecorder>(*history, profile.servo_period_s));
   features->install(host.controller());
   std::vector<std::string> warnings;
@@ -224,6 +229,10 @@ void add_serve_command(CLI::App& app, Registry& registry) {
   cmd->add_option("--speed", opts->speed,
                   "Virtual time at this many machine seconds per second instead of a real-time servo thread")
       ->check(finite_range(0.01, 1000));
+  cmd->add_option("--servo-cpu", opts->servo_cpu,
+                  "Real time: run the servo thread on this CPU and keep the server's threads off it "
+                  "(best with that CPU isolated: isolcpus=N)")
+      ->check(CLI::Range(0, 1023));
   cmd->add_option("--stream-hz", opts->stream_hz,
                   "Status messages per second on the WebSocket stream (default 30)")
       ->check(finite_range(1, 1000));

@@ -83,7 +83,7 @@ double cpu_s() {
 int usage() {
   std::fprintf(
       stderr,
-      "usage: hmi_clients_bench [--clients N (100)] [--stalled S (5)] [--seconds T (30)] [--hz R (30)]\n");
+      "usage: hmi_clients_bench [--clients N (100)] [--stalled S (5)] [--seconds T (30)] [--hz R (30)] [--servo-cpu N]\n");
   return 2;
 }
 
@@ -92,6 +92,7 @@ int usage() {
 int main(int argc, char** argv) {
   int clients = 100, stalled = 5;
   double seconds = 30, hz = 30;
+  int servo_cpu = -1;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "-h" || a == "--help") return usage(), 0;
@@ -104,6 +105,8 @@ int main(int argc, char** argv) {
       seconds = std::atof(argv[++i]);
     else if (a == "--hz")
       hz = std::atof(argv[++i]);
+    else if (a == "--servo-cpu")
+      servo_cpu = std::atoi(argv[++i]);
     else
       return usage();
   }
@@ -111,7 +114,9 @@ int main(int argc, char** argv) {
   if (!load.ok()) return 1;
   Diagnostics d;
   auto source = control::GcodeProgramSource::create(*load.profile, d);
-  hmi::MachineHost host(*load.profile, source, {true, 1});
+  hmi::HostOptions ho;
+  ho.servo_cpu = servo_cpu;  // the clients' threads start after host.start(): they keep off it too
+  hmi::MachineHost host(*load.profile, source, ho);
   std::vector<std::string> warnings;
   host.start(&warnings);
   for (const auto& w : warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());

@@ -2,7 +2,11 @@
 // The simulated machine and the controller running on their own threads for the server.
 #include "opencnc/hmi/machine_host.hpp"
 
+#include <pthread.h>
+#include <sched.h>
+
 #include <chrono>
+#include <string>
 
 #include <fmt/format.h>
 
@@ -21,12 +25,34 @@ MachineHost::MachineHost(const config::MachineProfile& profile,
     sim_ = std::make_unique<machine::SimMachine>(config::sim_machine_config(profile));
     servo_ = std::make_unique<control::Servo>(control::servo_config(profile), *channels_, *sim_);
     controller_ = std::make_unique<control::Controller>(profile, *channels_, std::move(source));
-    clock_ = std::make_unique<control::RealtimeClock>(
-        control::RealtimeClock::Options{static_cast<std::int64_t>(profile.servo_period_s * 1e9 + 0.5)});
+    control::RealtimeClock::Options clock;
+    clock.period_ns = static_cast<std::int64_t>(profile.servo_period_s * 1e9 + 0.5);
+    clock.cpu = options_.servo_cpu;
+    clock_ = std::make_unique<control::RealtimeClock>(clock);
   } else {
     rig_ = std::make_unique<control::SimRig>(profile, std::move(source));
   }
 }
+
+namespace {
+
+// The calling thread leaves `cpu` to the servo; threads it starts afterwards inherit the mask.
+// Returns a warning, or "" when done.
+std::string keep_off_cpu(int cpu) {
+  if (cpu >= CPU_SETSIZE) return fmt::format("no CPU {} to keep the server's threads off", cpu);
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  if (pthread_getaffinity_np(pthread_self(), sizeof set, &set) != 0)
+    return "cannot read this thread's CPU affinity: the server shares the servo's CPU";
+  CPU_CLR(static_cast<unsigned>(cpu), &set);
+  if (CPU_COUNT(&set) == 0)
+    return fmt::format("CPU {} is the only one allowed: the server shares it with the servo", cpu);
+  if (pthread_setaffinity_np(pthread_self(), sizeof set, &set) != 0)
+    return fmt::format("cannot keep the server's threads off CPU {}", cpu);
+  return {};
+}
+
+}  // namespace
 
 MachineHost::~MachineHost() {
   stop();
@@ -37,6 +63,10 @@ bool MachineHost::start(std::vector<std::string>* warnings) {
     const bool ok = clock_->start(*servo_);
     if (warnings) warnings->insert(warnings->end(), clock_->warnings().begin(), clock_->warnings().end());
     if (!ok) return false;
+    if (options_.servo_cpu >= 0) {
+      const std::string w = keep_off_cpu(options_.servo_cpu);
+      if (!w.empty() && warnings) warnings->push_back(w);
+    }
     thread_ = std::thread([this] { run_controller(); });
   } else {
     thread_ = std::thread([this] { run_paced(); });

@@ -3,6 +3,8 @@
 // message, 409 from the controller) changing nothing, the stream's rate and events, a client
 // that stops reading dropped while another goes on, and a job run to its history entry.
 #include <gtest/gtest.h>
+#include <pthread.h>
+#include <sched.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -333,6 +335,37 @@ TEST(MachineHost, InRealTimeTheServoTicksByItselfAndTheControllerAnswers) {
   const std::uint64_t stopped = host.ticks();
   std::this_thread::sleep_for(std::chrono::milliseconds(5));
   EXPECT_EQ(host.ticks(), stopped);
+}
+
+// On a machine with a CPU set aside for the servo, the server's threads must not wake on it: they
+// would delay the servo's wake-up. Runs on a thread of its own, whose affinity the host changes.
+TEST(MachineHost, AServoCpuKeepsTheHostsOtherThreadsOffIt) {
+  cpu_set_t allowed;
+  CPU_ZERO(&allowed);
+  ASSERT_EQ(pthread_getaffinity_np(pthread_self(), sizeof allowed, &allowed), 0);
+  if (CPU_COUNT(&allowed) < 2) GTEST_SKIP() << "one CPU allowed: nothing to keep the server off";
+  int servo_cpu = -1;
+  for (int cpu = 0; cpu < CPU_SETSIZE; ++cpu)
+    if (CPU_ISSET(cpu, &allowed)) servo_cpu = cpu;
+  std::thread caller([&] {
+    const config::MachineProfile profile = control::test::mill();
+    HostOptions options;
+    options.servo_cpu = servo_cpu;
+    MachineHost host(profile, nullptr, options);
+    std::vector<std::string> warnings;
+    ASSERT_TRUE(host.start(&warnings));
+    for (const std::string& w : warnings) EXPECT_EQ(w.find("CPU"), std::string::npos) << w;
+    cpu_set_t later;
+    std::thread started_after([&] { pthread_getaffinity_np(pthread_self(), sizeof later, &later); });
+    started_after.join();
+    EXPECT_FALSE(CPU_ISSET(servo_cpu, &later));
+    EXPECT_EQ(CPU_COUNT(&later), CPU_COUNT(&allowed) - 1);
+    const std::uint64_t ticks = host.ticks();
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    EXPECT_GT(host.ticks(), ticks);
+    host.stop();
+  });
+  caller.join();
 }
 
 }  // namespace

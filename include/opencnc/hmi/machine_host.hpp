@@ -34,6 +34,9 @@ struct HostOptions {
   /// time on one thread, `speed` machine seconds per wall-clock second.
   bool realtime = true;
   double speed = 1;
+  /// Real time only: pin the servo thread to this CPU (-1: no pinning) and keep the host's other
+  /// threads off it, as on a machine with a CPU set aside for the servo (isolcpus).
+  int servo_cpu = -1;
 };
 
 /// Runs a machine until stopped. start()/stop() from one non-real-time thread; controller()
@@ -47,7 +50,8 @@ class MachineHost {
   MachineHost& operator=(const MachineHost&) = delete;
 
   /// Starts the threads; false when none could be started. Warnings (no SCHED_FIFO, …) in
-  /// `*warnings`.
+  /// `*warnings`. With `servo_cpu` set, the calling thread (and so every thread it starts later,
+  /// such as the server's) is moved off the servo's CPU.
   bool start(std::vector<std::string>* warnings);
   /// Stops and joins the threads. Idempotent.
   void stop();
