@@ -13,6 +13,7 @@
 #include <cstring>
 
 #include "opencnc/config/profile_loader.hpp"
+#include "opencnc/core/atomic_file.hpp"
 #include "run_session.hpp"
 
 namespace opencnc::cli {
@@ -84,6 +85,24 @@ bool commit(OutputFile& out) {
   if (out.commit(&error)) return true;
   fmt::print(stderr, "error: {}\n", error);
   return false;
+}
+
+bool replace_profile_text(const std::string& path, const std::string& original, const std::string& text,
+                          std::string& why) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode) || ::access(path.c_str(), W_OK) != 0) {
+    why = fmt::format("{} is not a regular file we may write", path);
+    return false;
+  }
+  std::string now;
+  if (!read_file(path, now, &why)) return false;
+  if (now != original) {
+    why = fmt::format("{} changed while the machine was measured (nothing written)", path);
+    return false;
+  }
+  if (!write_file_atomically(path, text, &why)) return false;
+  ::chmod(path.c_str(), st.st_mode & 07777);  // keep its permissions
+  return true;
 }
 
 }  // namespace opencnc::cli

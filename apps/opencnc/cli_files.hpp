@@ -39,4 +39,11 @@ bool commit(OutputFile& out);
 /// CLI thread.
 bool write_and_commit(OutputFile& out, std::string_view content);
 
+/// Replaces the profile file `path` by `text` (a measurement written into it): never
+/// half-written (a temporary file renamed over it, its permissions kept), and not when the file
+/// is not a regular one we may write or no longer holds `original` (the text measured from).
+/// False with `why` otherwise. CLI thread.
+bool replace_profile_text(const std::string& path, const std::string& original, const std::string& text,
+                          std::string& why);
+
 }  // namespace opencnc::cli

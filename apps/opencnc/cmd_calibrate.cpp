@@ -128,20 +128,7 @@ bool write_tables(const CalibrateOptions& o, const std::string& original,
       return false;
     }
   }
-  struct stat st {};
-  if (::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode) || ::access(path.c_str(), W_OK) != 0) {
-    why = fmt::format("{} is not a regular file we may write", path.string());
-    return false;
-  }
-  std::string now;
-  if (!read_file(path.string(), now, &why)) return false;
-  if (now != original) {
-    why = fmt::format("{} changed while the machine was measured (nothing written)", path.string());
-    return false;
-  }
-  if (!write_file_atomically(path.string(), text, &why)) return false;
-  ::chmod(path.c_str(), st.st_mode & 07777);  // keep its permissions
-  return true;
+  return replace_profile_text(path.string(), original, text, why);
 }
 
 int calibrate(const CalibrateOptions& o) {

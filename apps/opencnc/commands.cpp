@@ -14,6 +14,7 @@ void register_all(CLI::App& app, Registry& registry) {
   add_plot_command(app, registry);
   add_calibrate_command(app, registry);
   add_electrode_command(app, registry);
+  add_calibrate_b_command(app, registry);
   add_tools_command(app, registry);
   add_nearest_command(app, registry);
   add_serve_command(app, registry);

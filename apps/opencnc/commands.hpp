@@ -41,6 +41,7 @@ void add_nearest_command(CLI::App& app, Registry& registry);
 void add_serve_command(CLI::App& app, Registry& registry);   ///< the HMI server
 void add_helix_command(CLI::App& app, Registry& registry);
 void add_electrode_command(CLI::App& app, Registry& registry);  ///< electrode-set
+void add_calibrate_b_command(CLI::App& app, Registry& registry);  ///< calibrate-b
 void add_recover_command(CLI::App& app, Registry& registry);  ///< power-fail recovery
 
 }  // namespace opencnc::cli

@@ -63,6 +63,7 @@ machine::SimMachineConfig sim_machine_config(const MachineProfile& profile) {
     if (sphere.sim_turns_with_b && profile.find(Axis::B) != nullptr) {
       t.b_joint = profile.find(Axis::B)->joint;
       t.b_axis = sphere.sim_b_axis;
+      t.b_direction = sphere.sim_b_direction;
       t.b_at_centre_deg = sphere.b_deg;
     }
     t.noise = sphere.sim_noise;

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include "opencnc/config/comp_file_edit.hpp"
 #include "opencnc/config/profile_loader.hpp"
 #include "opencnc/config/toml_edit.hpp"
 #include "opencnc/core/atomic_file.hpp"
@@ -60,7 +61,8 @@ std::optional<std::pair<std::string, std::string>> pitch_key_parts(std::string_v
   const std::string axis = k.substr(head.size(), 1);
   if (k.compare(head.size() + 1, mid.size(), mid) != 0) return std::nullopt;
   std::string name = k.substr(head.size() + 1 + mid.size());
-  if (name != "forward" && name != "reverse" && name != "start" && name != "interval") return std::nullopt;
+  if (name != "forward" && name != "reverse" && name != "start" && name != "interval" && name != "positions")
+    return std::nullopt;
   return std::pair{axis, name};
 }
 
@@ -178,6 +180,7 @@ ProfileEditResult edit_profile(const MachineProfile& live, std::span<const Profi
     std::optional<std::string> forward, reverse;
   };
   std::vector<Directions> directions;
+  CompFileEdits comp_files;
   for (const ProfileKeyEdit& e : edits) {
     const std::string key = lower(e.key);
     if (const auto parts = pitch_key_parts(key)) {
@@ -188,9 +191,14 @@ ProfileEditResult edit_profile(const MachineProfile& live, std::span<const Profi
                               e.key, base);
         return r;
       }
-      if (!a->compensation.comp_file.empty()) {
-        r.error = fmt::format("{}: the table comes from the comp file {}: edit that file, then restart",
-                              e.key, a->compensation.comp_file);
+      if (!a->compensation.comp_file.empty()) {  // written into that file (comp_file_edit.cpp)
+        if (!comp_files.add(*a, parts->second, e.value, r.error)) return r;
+        r.changes.push_back({key, table_text(a->compensation, parts->second), e.value});
+        continue;
+      }
+      if (parts->second == "positions") {
+        r.error = fmt::format(
+            "{}: the profile's table has its points at start + k·interval: give start and interval", e.key);
         return r;
       }
       if (overridden(live, key)) {
@@ -243,8 +251,9 @@ ProfileEditResult edit_profile(const MachineProfile& live, std::span<const Profi
       return r;
     }
   }
-  ProfileLoad load =
-      parse_profile(text, live.source, live.overrides, std::filesystem::path(live.source).parent_path());
+  if (!comp_files.texts(r.files, r.error)) return r;
+  ProfileLoad load = parse_profile(text, live.source, live.overrides,
+                                   std::filesystem::path(live.source).parent_path(), r.files);
   r.diagnostics = std::move(load.diagnostics);
   if (!load.profile) return r;
   const std::vector<EditableParameter> now = editable_parameters(*load.profile);

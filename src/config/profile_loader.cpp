@@ -34,7 +34,8 @@ void read_identity(Section& top, MachineProfile& p) {
   }
 }
 
-MachineProfile read_profile(const toml::table& root, Reporter& r, const std::filesystem::path& base_dir) {
+MachineProfile read_profile(const toml::table& root, Reporter& r, const std::filesystem::path& base_dir,
+                            std::span<const FileText> files) {
   Section top(root, "",
               {"name", "description", "servo_period_s", "axis", "spindle", "power", "probe", "tool_changer",
                "process", "io", "interpreter", "planner", "sim", "interlocks", "handwheel", "tool_guard",
@@ -44,7 +45,7 @@ MachineProfile read_profile(const toml::table& root, Reporter& r, const std::fil
   read_identity(top, p);
   detail::read_sim(top, p);
   detail::read_axes(top, p);
-  detail::read_compensation(top, p, base_dir);
+  detail::read_compensation(top, p, base_dir, files);
   detail::read_spindle(top, p);
   detail::read_power(top, p);
   detail::read_probe(top, p);
@@ -72,7 +73,8 @@ std::uint64_t text_digest(std::string_view text) noexcept {
 }
 
 ProfileLoad parse_profile(std::string_view text, std::string_view source_name,
-                          std::span<const std::string> overrides, const std::filesystem::path& base_dir) {
+                          std::span<const std::string> overrides, const std::filesystem::path& base_dir,
+                          std::span<const FileText> files) {
   ProfileLoad out;
   Reporter r(out.diagnostics, std::string(source_name));
   toml::table root;
@@ -83,7 +85,7 @@ ProfileLoad parse_profile(std::string_view text, std::string_view source_name,
     return out;
   }
   if (!detail::apply_overrides(root, overrides, r)) return out;
-  MachineProfile p = read_profile(root, r, base_dir);
+  MachineProfile p = read_profile(root, r, base_dir, files);
   if (r.has_errors()) return out;
   p.source = std::string(source_name);
   p.overrides.assign(overrides.begin(), overrides.end());

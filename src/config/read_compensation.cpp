@@ -3,12 +3,12 @@
 // given at equal intervals (one table or one per direction) or imported from a LinuxCNC comp file.
 #include <fmt/format.h>
 
-#include <cerrno>
+#include <algorithm>
 #include <cmath>
-#include <cstring>
-#include <fstream>
 #include <memory>
 #include <sstream>
+
+#include "opencnc/core/atomic_file.hpp"
 
 #include "sections.hpp"
 
@@ -61,19 +61,33 @@ toml::source_region at_line(const std::shared_ptr<const std::string>& file, std:
   return r;
 }
 
+/// The error of a type 0 line (actual − nominal), rounded to 1e-9 units: the difference of two
+/// positions carries their rounding (99.996 − 100 is −0.00400000000000489 in binary), which would
+/// make a table written back and read again differ from the one written.
+double reached_error(double reached, double nominal) {
+  return std::round((reached - nominal) * 1e9) / 1e9;
+}
+
 /// A LinuxCNC comp file: "nominal forward reverse" per line, nominals increasing. Type 0 gives
 /// where the axis actually is moving up and moving down; type 1 the trims LinuxCNC adds to the
 /// command (the negative of the error). Blank lines and lines starting with '#' are skipped;
 /// anything else that is not three numbers is an error at its line.
-void read_comp_file(Section& s, const std::filesystem::path& path, int type, CompensationProfile& c) {
-  std::ifstream in(path);
-  if (!in) {
+void read_comp_file(Section& s, const std::filesystem::path& path, int type, CompensationProfile& c,
+                    std::span<const FileText> files) {
+  std::string all;
+  const auto given = std::find_if(files.begin(), files.end(), [&](const FileText& f) {
+    return std::filesystem::path(f.path).lexically_normal() == path.lexically_normal();
+  });
+  if (given != files.end()) {
+    all = given->text;
+  } else if (std::string why; !read_file(path.string(), all, &why)) {
     s.error("comp_file",
-            fmt::format("{}: cannot read the comp file {}: {}", s.key_path("comp_file"), path.string(),
-                        std::strerror(errno)),
+            fmt::format("{}: cannot read the comp file {}: {}", s.key_path("comp_file"), path.string(), why),
             "config.file");
     return;
   }
+  c.comp_digest = text_digest(all);
+  std::istringstream in(all);
   const auto file = std::make_shared<const std::string>(path.string());
   Reporter& r = s.reporter();
   std::string text;
@@ -107,8 +121,8 @@ void read_comp_file(Section& s, const std::filesystem::path& path, int type, Com
       return;
     }
     c.positions.push_back(nominal);
-    c.forward.push_back(type == 0 ? up - nominal : -up);
-    c.reverse.push_back(type == 0 ? down - nominal : -down);
+    c.forward.push_back(type == 0 ? reached_error(up, nominal) : -up);
+    c.reverse.push_back(type == 0 ? reached_error(down, nominal) : -down);
   }
   if (c.positions.empty()) {
     s.error("comp_file", fmt::format("{}: {} holds no points", s.key_path("comp_file"), path.string()),
@@ -172,7 +186,7 @@ void check_slopes(Section& s, std::string_view key, const CompensationProfile& c
 }
 
 void read_axis_compensation(Section& s, AxisProfile& a, double period_s,
-                            const std::filesystem::path& base_dir) {
+                            const std::filesystem::path& base_dir, std::span<const FileText> files) {
   CompensationProfile& c = a.compensation;
   c.present = true;
   c.backlash = s.number_or("backlash", 0, Bound::NonNegative);
@@ -185,8 +199,11 @@ void read_axis_compensation(Section& s, AxisProfile& a, double period_s,
     if (!type && !s.has("comp_file_type")) s.missing("comp_file_type");
     if (const auto file = s.string("comp_file"); file && type) {
       c.comp_file = *file;
+      c.comp_file_type = static_cast<int>(*type);
       const std::filesystem::path p(*file);
-      read_comp_file(s, p.is_absolute() || base_dir.empty() ? p : base_dir / p, static_cast<int>(*type), c);
+      const std::filesystem::path resolved = p.is_absolute() || base_dir.empty() ? p : base_dir / p;
+      c.comp_path = resolved.string();
+      read_comp_file(s, resolved, c.comp_file_type, c, files);
     }
   } else {
     s.reject("comp_file_type", "needs comp_file");
@@ -219,7 +236,8 @@ void read_axis_compensation(Section& s, AxisProfile& a, double period_s,
 
 }  // namespace
 
-void read_compensation(Section& top, MachineProfile& profile, const std::filesystem::path& base_dir) {
+void read_compensation(Section& top, MachineProfile& profile, const std::filesystem::path& base_dir,
+                       std::span<const FileText> files) {
   const toml::node* axes_node = top.find("axis");
   const toml::table* axes = axes_node != nullptr ? axes_node->as_table() : nullptr;
   if (axes == nullptr) return;
@@ -248,7 +266,7 @@ void read_compensation(Section& top, MachineProfile& profile, const std::filesys
                            "config.not-applicable");
       continue;
     }
-    read_axis_compensation(s, *a, profile.servo_period_s, base_dir);
+    read_axis_compensation(s, *a, profile.servo_period_s, base_dir, files);
   }
 }
 

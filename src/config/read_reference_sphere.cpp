@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <limits>
+#include <numbers>
 
 #include "sections.hpp"
 
@@ -32,28 +33,51 @@ bool read_point(Section& s, std::string_view key, std::array<double, 3>& out) {
   return ok;
 }
 
+/// `key` as [x, z]: where B's axis crosses machine X and Z; reports and returns false otherwise.
+bool read_b_axis(Section& s, std::string_view key, std::array<double, 2>& out) {
+  const toml::array* a = s.find(key)->as_array();
+  bool ok = a != nullptr && a->size() == 2;
+  for (std::size_t i = 0; ok && i < 2; ++i) {
+    const std::optional<double> v = (*a)[i].value<double>();
+    ok = v.has_value() && std::isfinite(*v);
+    if (ok) out[i] = *v;
+  }
+  if (!ok)
+    s.error(key,
+            fmt::format("{} must be [x, z]: where B's axis crosses machine X and Z, mm", s.key_path(key)),
+            "config.type");
+  return ok;
+}
+
+/// B's axis turns about Y on this kind of machine: a direction more than this far from Y is a
+/// mistake (and would not cross the sphere's plane near the sphere).
+constexpr double kMaxTiltFromYDeg = 10.0;
+
+/// `key` (when present) as a direction [x, y, z] within kMaxTiltFromYDeg of Y, made a unit vector.
+void read_b_direction(Section& s, std::string_view key, std::array<double, 3>& out) {
+  if (!s.has(key)) return;
+  std::array<double, 3> d{};
+  if (!read_point(s, key, d)) return;
+  const double length = std::hypot(d[0], d[1], d[2]);
+  if (!(length > 0) || d[1] < length * std::cos(kMaxTiltFromYDeg * std::numbers::pi / 180)) {
+    s.error(key,
+            fmt::format("{} must point along +Y within {:g}° (B turns about Y): {}", s.key_path(key),
+                        kMaxTiltFromYDeg, length > 0 ? "it does not" : "it has no length"),
+            "config.range");
+    return;
+  }
+  for (std::size_t i = 0; i < 3; ++i) out[i] = d[i] / length;
+}
+
 void read_sim(Section& s, ReferenceSphereProfile& r) {
   const toml::table* st = s.subtable("sim");
   if (st == nullptr) return;
-  Section m(*st, s.path() + ".sim", {"hysteresis", "noise", "b_axis"}, s.reporter());
+  Section m(*st, s.path() + ".sim", {"hysteresis", "noise", "b_axis", "b_axis_direction"}, s.reporter());
   r.sim = true;
   r.sim_hysteresis = m.number_or("hysteresis", r.sim_hysteresis, Bound::NonNegative);
   r.sim_noise = m.number_or("noise", r.sim_noise, Bound::NonNegative);
-  if (const toml::node* n = m.find("b_axis")) {
-    const toml::array* a = n->as_array();
-    bool ok = a != nullptr && a->size() == 2;
-    for (std::size_t i = 0; ok && i < 2; ++i) {
-      const std::optional<double> v = (*a)[i].value<double>();
-      ok = v.has_value() && std::isfinite(*v);
-      if (ok) r.sim_b_axis[i] = *v;
-    }
-    if (!ok)
-      m.error(
-          "b_axis",
-          fmt::format("{} must be [x, z]: where B's axis crosses machine X and Z, mm", m.key_path("b_axis")),
-          "config.type");
-    r.sim_turns_with_b = ok;
-  }
+  if (m.has("b_axis")) r.sim_turns_with_b = read_b_axis(m, "b_axis", r.sim_b_axis);
+  read_b_direction(m, "b_axis_direction", r.sim_b_direction);
 }
 
 }  // namespace
@@ -63,7 +87,7 @@ void read_reference_sphere(Section& probe, MachineProfile& profile) {
   if (t == nullptr) return;
   Section s(*t, "probe.reference_sphere",
             {"position", "diameter", "b", "clearance", "probe_feed", "safe_z", "touches_around", "tolerance",
-             "max_deviation", "fast_feed", "back_off", "sim"},
+             "max_deviation", "fast_feed", "back_off", "b_axis", "b_axis_direction", "sim"},
             probe.reporter());
   ReferenceSphereProfile& r = profile.probe.reference_sphere;
   r.present = true;
@@ -103,6 +127,11 @@ void read_reference_sphere(Section& probe, MachineProfile& profile) {
                     show(r.safe_z), show(r.position[2] + r.diameter / 2 + r.clearance)),
         "config.range");
   }
+  if (s.has("b_axis")) {
+    r.has_b_axis = read_b_axis(s, "b_axis", r.b_axis);
+    if (profile.find(Axis::B) == nullptr) s.reject("b_axis", "the profile has no B axis");
+  }
+  read_b_direction(s, "b_axis_direction", r.b_axis_direction);
   read_sim(s, r);
   if (r.sim_turns_with_b && profile.find(Axis::B) == nullptr)
     s.error("sim", "probe.reference_sphere.sim.b_axis: the profile has no B axis", "config.range");

@@ -4,10 +4,12 @@
 
 #include <filesystem>
 #include <optional>
+#include <span>
 #include <string_view>
 #include <utility>
 
 #include "opencnc/config/machine_profile.hpp"
+#include "opencnc/config/profile_loader.hpp"
 #include "toml_reader.hpp"
 
 namespace opencnc::config::detail {
@@ -33,8 +35,9 @@ void read_planner(Section& top, MachineProfile& profile);
 /// [tool_guard]. Needs [interpreter] (a tool store and a tool table file exclude each other).
 void read_tool_guard(Section& top, MachineProfile& profile, const std::filesystem::path& base_dir);
 /// [axis.<letter>.compensation] of every axis read. Needs the axes; comp files are found from
-/// `base_dir`.
-void read_compensation(Section& top, MachineProfile& profile, const std::filesystem::path& base_dir);
+/// `base_dir`, or taken from `files` when their path is there.
+void read_compensation(Section& top, MachineProfile& profile, const std::filesystem::path& base_dir,
+                       std::span<const FileText> files);
 /// [interlocks] (named inputs and outputs, rules) and [handwheel]. Needs the axes and [io].
 void read_interlocks(Section& top, MachineProfile& profile);
 void read_handwheel(Section& top, MachineProfile& profile);

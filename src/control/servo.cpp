@@ -27,6 +27,7 @@ Servo::Servo(const ServoConfig& config, ServoChannels& channels, machine::Machin
       interp_(channels.blocks, config.interpolator, Pose{}) {
   config_.joint_count = std::clamp(std::min(config_.joint_count, caps_.joint_count), 0, machine::kMaxJoints);
   comp_ = motion::Compensation(config_.compensation);
+  for (PitchBufferInUse& b : channels.pitch_tables.reading) b.index.store(-1, std::memory_order_release);
   configure_gap_servo();
   stepper_slot_.fill(-1);
   for (int j = 0; j < config_.joint_count; ++j) {

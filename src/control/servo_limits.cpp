@@ -35,12 +35,14 @@ bool valid(const motion::PitchTable& t) noexcept {
 }  // namespace
 
 // The table is checked here, once, so that the lookup in every period can trust it (a bounded
-// loop over at most 256 points; the controller does not write this buffer until the apply).
+// loop over at most 256 points; the controller does not write this buffer until the apply). A
+// stage naming the buffer the tick reads is refused: the controller broke the hand-over.
 Refusal Servo::stage_pitch_table(const Command& c) noexcept {
   const int j = c.axis;
   const auto uj = static_cast<std::size_t>(j);
   if (j < 0 || j >= config_.joint_count || j >= motion::kMaxCompensatedJoints || c.table_buffer > 1 ||
       !config_.compensation.joints[uj].enabled ||
+      channels_->pitch_tables.reading[uj].index.load(std::memory_order_relaxed) == c.table_buffer ||
       !valid(channels_->pitch_tables.joints[uj][c.table_buffer])) {
     staged_invalid_ = true;
     return Refusal::BadValue;
@@ -104,7 +106,11 @@ Refusal Servo::apply_joint_limits() noexcept {
   }
   for (int j = 0; j < config_.joint_count; ++j) {
     const auto uj = static_cast<std::size_t>(j);
-    if (tables & (1u << j)) comp_.set_pitch_table(j, &channels_->pitch_tables.joints[uj][staged_buffer_[uj]]);
+    if (!(tables & (1u << j))) continue;
+    comp_.set_pitch_table(j, &channels_->pitch_tables.joints[uj][staged_buffer_[uj]]);
+    // Published after the switch: the buffer read until now is the controller's from here on.
+    channels_->pitch_tables.reading[uj].index.store(static_cast<std::int8_t>(staged_buffer_[uj]),
+                                                    std::memory_order_release);
   }
   configure_gap_servo();  // the jump accelerates within the tool axis' limit
   return Refusal::None;

@@ -37,7 +37,8 @@ bool SharedServoHost::tick() noexcept {
 
 // A new set-up replaces the servo only while no drive is enabled (a moving machine keeps the servo
 // that moves it; the controller sees the set-up pending). An identical set-up keeps the servo and
-// its state (homed joints survive a restart of the controller).
+// its state (homed joints survive a restart of the controller), but not what the previous
+// controller staged and did not apply: the new one fills the pitch buffers the tick does not read.
 void SharedServoHost::take_setup() noexcept {
   SharedHeader& h = segment_->header;
   const std::uint64_t generation = h.setup_generation.load(std::memory_order_acquire);
@@ -50,6 +51,8 @@ void SharedServoHost::take_setup() noexcept {
     machine_->set_capabilities(setup_.capabilities);
     guard_.refresh_capabilities();
     servo_ = new (storage_) Servo(setup_.servo, segment_->channels, guard_);
+  } else {
+    servo_->drop_staged();
   }
   h.setup_taken.store(generation, std::memory_order_release);
 }

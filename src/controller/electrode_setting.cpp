@@ -90,6 +90,8 @@ const char* to_string(ElectrodePhase p) noexcept {
       return "approaching";
     case ElectrodePhase::Resuming:
       return "resuming";
+    case ElectrodePhase::Calibrating:
+      return "calibrating";
   }
   return "";
 }
@@ -245,7 +247,21 @@ ElectrodeResult evaluate_touches(const config::ReferenceSphereProfile& sphere, i
 
 ElectrodeSetting::ElectrodeSetting(std::shared_ptr<tools::ToolTableService> tools,
                                    const config::MachineProfile& profile)
-    : tools_(std::move(tools)), sphere_(profile.probe.reference_sphere), axes_(profile.axis_mask()) {}
+    : tools_(std::move(tools)),
+      profile_sphere_(profile.probe.reference_sphere),
+      sphere_(profile_sphere_),
+      at_(profile_sphere_),
+      axes_(profile.axis_mask()) {}
+
+config::ReferenceSphereProfile ElectrodeSetting::sphere() const {
+  std::lock_guard lock(mutex_);
+  return sphere_;
+}
+
+std::optional<BAxisResult> ElectrodeSetting::last_b_axis() const {
+  std::lock_guard lock(mutex_);
+  return last_b_;
+}
 
 ElectrodePhase ElectrodeSetting::phase() const {
   std::lock_guard lock(mutex_);
@@ -276,10 +292,29 @@ Outcome ElectrodeSetting::handle(const requests::Feature& request, FeatureHost& 
   }
   if (request.action == "resume") return resume(host);
   if (request.action == "write") return write();
-  return refuse(fmt::format("electrode: unknown action \"{}\" (measure, write, resume)", request.action));
+  if (request.action == "calibrate-b") {
+    const auto* args = std::any_cast<BAxisCalibrate>(&request.args);
+    if (args == nullptr)
+      return refuse("electrode calibrate-b needs the tool and the angles (BAxisCalibrate)");
+    return calibrate_b(*args, host);
+  }
+  return refuse(
+      fmt::format("electrode: unknown action \"{}\" (measure, write, resume, calibrate-b)", request.action));
 }
 
 Outcome ElectrodeSetting::measure(const ElectrodeMeasure& args, FeatureHost& host) {
+  if (std::optional<Outcome> refused = start_measurement(args.tool, args.b_deg, host)) return *refused;
+  write_ = args.write;
+  set_phase(ElectrodePhase::Measuring);
+  next_touch();
+  return accept(fmt::format("measuring tool {} against the reference sphere{}: {} touches", tool_,
+                            args.b_deg ? fmt::format(" with B at {:g}°", *args.b_deg) : "", plan_.size()));
+}
+
+// The checks and the plan of one measurement with B at `b_deg` (the profile's b if absent): a
+// refusal, or nothing when the touches are planned.
+std::optional<Outcome> ElectrodeSetting::start_measurement(int tool, std::optional<double> b_deg,
+                                                           FeatureHost& host) {
   if (!sphere_.present) return refuse("the profile has no [probe.reference_sphere]");
   if (phase() != ElectrodePhase::Idle)
     return refuse(fmt::format("electrode setting is {}", to_string(phase())));
@@ -289,34 +324,132 @@ Outcome ElectrodeSetting::measure(const ElectrodeMeasure& args, FeatureHost& hos
                               s.run_active ? ", a job runs" : ""));
   if (!s.servo.all_homed) return refuse("the machine is not homed");
   if (tools_ == nullptr) return refuse("the machine has no tool table");
+  const double b = b_deg.value_or(sphere_.b_deg);
+  if (b_deg && !axes_.has(Axis::B)) return refuse("the machine has no B axis to measure at an angle of");
+  if (b_deg && !std::isfinite(*b_deg)) return refuse("the B angle must be a finite number");
+  if (b != sphere_.b_deg && !sphere_.has_b_axis)
+    return refuse(
+        fmt::format("B's axis is not known (probe.reference_sphere.b_axis): the sphere can be measured only "
+                    "with B at {:g}° "
+                    "until calibrate-b has measured it",
+                    sphere_.b_deg));
   const auto table = tools_->snapshot();
-  const std::optional<std::size_t> index = table->find(args.tool);
-  if (args.tool <= 0 || !index) return refuse(fmt::format("tool {} is not in the tool table", args.tool));
-  tool_ = args.tool;
-  write_ = args.write;
+  const std::optional<std::size_t> index = table->find(tool);
+  if (tool <= 0 || !index) return refuse(fmt::format("tool {} is not in the tool table", tool));
+  tool_ = tool;
   tool_index_ = *index;
   entry_ = table->at_index(*index);
-  plan_ = plan_touches(sphere_, offsets_of(entry_), entry_.diameter / 2);
+  // The sphere as B turns it: its centre there, and B turned there by the first touch.
+  at_ = sphere_;
+  at_.position = sphere_centre_at(sphere_, b);
+  at_.b_deg = b;
+  plan_ = plan_touches(at_, offsets_of(entry_), entry_.diameter / 2);
   const double top_start = plan_.back().start[2];
-  if (top_start > sphere_.safe_z)
+  if (top_start > at_.safe_z)
     return refuse(fmt::format(
         "tool {}'s touch from above starts at machine Z{:.3f}, above probe.reference_sphere.safe_z ({:g}): "
         "raise safe_z or check the tool's Z offset",
-        tool_, top_start, sphere_.safe_z));
+        tool_, top_start, at_.safe_z));
   touched_.clear();
   fast_touched_.clear();
   touch_ = 0;
   slow_ = false;
-  set_phase(ElectrodePhase::Measuring);
+  return std::nullopt;
+}
+
+Outcome ElectrodeSetting::calibrate_b(const BAxisCalibrate& args, FeatureHost& host) {
+  if (!axes_.has(Axis::B)) return refuse("the machine has no B axis");
+  std::vector<double> distinct = args.angles_deg;
+  std::sort(distinct.begin(), distinct.end());
+  if (std::unique(distinct.begin(), distinct.end()) - distinct.begin() < 3 ||
+      !std::all_of(distinct.begin(), distinct.end(), [](double a) { return std::isfinite(a); }))
+    return refuse("calibrate-b needs at least three different B angles, spread over B's travel");
+  // Each angle's sphere is looked for where the axis known so far turns it (the drawing's, or the
+  // last calibration's): it must be found within the clearance.
+  if (!sphere_.has_b_axis)
+    return refuse(
+        "calibrate-b looks for the sphere where B's nominal axis turns it: give "
+        "probe.reference_sphere.b_axis "
+        "from the machine's drawing (within the touches' clearance)");
+  if (std::optional<Outcome> refused = start_measurement(args.tool, args.angles_deg[0], host))
+    return *refused;
+  calibration_ = BAxisResult{};
+  calibration_.tool = args.tool;
+  calibration_.angles_deg = args.angles_deg;
+  calibration_.previous = BAxisLine{sphere_.b_axis, sphere_.b_axis_direction};
+  write_ = false;
+  set_phase(ElectrodePhase::Calibrating);
   next_touch();
-  return accept(
-      fmt::format("measuring tool {} against the reference sphere: {} touches", tool_, plan_.size()));
+  return accept(fmt::format("calibrating B's axis with tool {}: the sphere at {} B angles", args.tool,
+                            args.angles_deg.size()));
+}
+
+// One angle measured: its centre kept, then the next angle, or the fit once all are.
+void ElectrodeSetting::next_calibration_angle(const ElectrodeResult& r) {
+  BAxisResult& c = calibration_;
+  const std::size_t done = c.centres.size();
+  if (!r.ok) {
+    c.code = r.code;
+    c.message = fmt::format("with B at {:g}°: {}", c.angles_deg[done], r.message);
+    return finish_calibration();
+  }
+  c.centres.push_back(r.centre);
+  if (c.centres.size() < c.angles_deg.size()) {
+    set_phase(ElectrodePhase::Idle);
+    if (std::optional<Outcome> refused = start_measurement(c.tool, c.angles_deg[c.centres.size()], *host_)) {
+      c.code = "electrode.refused";
+      c.message = fmt::format("with B at {:g}°: {}", c.angles_deg[c.centres.size()], refused->message);
+      return finish_calibration();
+    }
+    set_phase(ElectrodePhase::Calibrating);
+    return next_touch();
+  }
+  const std::optional<BAxisFit> fit = fit_b_axis(c.angles_deg, c.centres, sphere_);
+  if (!fit) {
+    c.code = "electrode.b-axis-fit";
+    c.message = "the sphere's centres fix no axis (the same point at every angle, or on a line)";
+  } else {
+    c.fit = *fit;
+    if (fit->max_residual_mm > sphere_.tolerance) {
+      c.code = "electrode.b-axis-fit";
+      c.message = fmt::format(
+          "the sphere's centres are not on one circle about an axis: {:.4f} mm off it (tolerance {:g} mm); "
+          "a loose sphere or table, or B's position is not what its encoder says",
+          fit->max_residual_mm, sphere_.tolerance);
+    } else {
+      c.ok = true;
+      c.message = fmt::format(
+          "B's axis crosses X{:.4f} Z{:.4f} (at Y{:.4f}) along [{:.6f}, {:.6f}, {:.6f}]; the sphere {:.4f} "
+          "mm "
+          "from it; residual {:.4f} mm rms",
+          fit->axis.crossing[0], fit->axis.crossing[1], sphere_.position[1], fit->axis.direction[0],
+          fit->axis.direction[1], fit->axis.direction[2], fit->radius_mm, fit->rms_residual_mm);
+    }
+  }
+  finish_calibration();
+}
+
+void ElectrodeSetting::finish_calibration() {
+  BAxisResult& c = calibration_;
+  {
+    std::lock_guard lock(mutex_);
+    if (c.ok) {
+      sphere_.has_b_axis = true;
+      sphere_.b_axis = c.fit.axis.crossing;
+      sphere_.b_axis_direction = c.fit.axis.direction;
+    }
+    last_b_ = c;
+    phase_ = ElectrodePhase::Idle;
+  }
+  next_aux_.reset();
+  host_->note(c.ok ? Severity::Note : Severity::Error, c.ok ? "electrode.b-axis" : c.code,
+              fmt::format("calibrate-b: {}{}", c.message, c.ok ? "" : " (the axis is unchanged)"));
 }
 
 void ElectrodeSetting::next_touch() {
   const SphereTouch& t = plan_[touch_];
   slow_ = false;
-  next_aux_ = touch_program(axes_, host_->current_status().servo.commanded, t, sphere_,
+  next_aux_ = touch_program(axes_, host_->current_status().servo.commanded, t, at_,
                             touch_ == 0 && axes_.has(Axis::B));
   next_aux_name_ = fmt::format("electrode touch {}", t.name);
   if (host_->current_status().servo.mode != Mode::Auto)
@@ -408,7 +541,8 @@ void ElectrodeSetting::on_event(const ControllerEvent& e) {
       if (e.request_id == pending_ && !e.accepted && phase() != ElectrodePhase::Idle) {
         next_aux_.reset();
         const ElectrodePhase was = phase();
-        if (was == ElectrodePhase::Measuring) return fail("electrode.refused", e.text);
+        if (was == ElectrodePhase::Measuring || was == ElectrodePhase::Calibrating)
+          return fail("electrode.refused", e.text);
         host_->note(Severity::Error, "electrode.refused", fmt::format("electrode resume: {}", e.text));
         set_phase(ElectrodePhase::Idle);
       }
@@ -429,14 +563,15 @@ void ElectrodeSetting::on_status(const ControllerStatus& s) {
 void ElectrodeSetting::when_aux_ended(const ControllerEvent& e) {
   if (host_ == nullptr) return;
   switch (phase()) {
-    case ElectrodePhase::Measuring: {
+    case ElectrodePhase::Measuring:
+    case ElectrodePhase::Calibrating: {
       if (e.end != JobEnd::Finished)
         return fail("electrode.stopped", fmt::format("the touch from {} did not finish ({})",
                                                      plan_[touch_].name, to_string(e.end)));
       const ServoStatus& servo = host_->current_status().servo;
       const SphereTouch& t = slow_ ? slow_line_ : plan_[touch_];
       const char* const stage = slow_ ? "slow touch" : "touch";
-      const double within = slow_ ? sphere_.back_off : sphere_.clearance;
+      const double within = slow_ ? at_.back_off : at_.clearance;
       const char* const where = slow_ ? "fast touch closed" : "sphere should be";
       if (!servo.probe_tripped)
         return fail("electrode.missing-touch",
@@ -468,9 +603,9 @@ void ElectrodeSetting::when_aux_ended(const ControllerEvent& e) {
 // A touch closed at `at`: after a fast one, the slow one from just before it; after a slow (or
 // the only) one, the point is kept and the next direction follows.
 void ElectrodeSetting::touched(const Point3& at) {
-  if (sphere_.fast_feed > 0 && !slow_) {
+  if (at_.fast_feed > 0 && !slow_) {
     fast_touched_.push_back(at);
-    next_aux_ = slow_touch_program(axes_, host_->current_status().servo.commanded, plan_[touch_], at, sphere_,
+    next_aux_ = slow_touch_program(axes_, host_->current_status().servo.commanded, plan_[touch_], at, at_,
                                    slow_line_);
     next_aux_name_ = fmt::format("electrode slow touch {}", plan_[touch_].name);
     slow_ = true;
@@ -486,9 +621,9 @@ void ElectrodeSetting::touched(const Point3& at) {
 void ElectrodeSetting::finish_measurement() {
   std::vector<std::string> names;
   for (const SphereTouch& t : plan_) names.push_back(t.name);
-  ElectrodeResult r =
-      evaluate_touches(sphere_, tool_, offsets_of(entry_), entry_.diameter / 2, names, touched_);
+  ElectrodeResult r = evaluate_touches(at_, tool_, offsets_of(entry_), entry_.diameter / 2, names, touched_);
   r.fast_touched = fast_touched_;
+  if (phase() == ElectrodePhase::Calibrating) return next_calibration_angle(r);
   if (r.ok && write_) store(r);
   {
     std::lock_guard lock(mutex_);
@@ -547,6 +682,12 @@ Outcome ElectrodeSetting::write() {
 }
 
 void ElectrodeSetting::fail(std::string code, std::string message) {
+  if (phase() == ElectrodePhase::Calibrating) {
+    calibration_.code = std::move(code);
+    calibration_.message =
+        fmt::format("with B at {:g}°: {}", calibration_.angles_deg[calibration_.centres.size()], message);
+    return finish_calibration();
+  }
   ElectrodeResult r;
   r.tool = tool_;
   r.code = std::move(code);

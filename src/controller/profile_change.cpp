@@ -13,6 +13,24 @@ namespace opencnc::control {
 
 namespace {
 
+/// Writes each of `files` atomically, keeping what each held in `old` (for a later put back);
+/// on a failure puts back those written and returns false with `error`.
+bool write_files(const std::vector<config::FileText>& files, std::vector<config::FileText>& old,
+                 std::string& error) {
+  for (const config::FileText& f : files) {
+    config::FileText was{f.path, {}};
+    std::string why;
+    if (!read_file(f.path, was.text, &why) || !write_file_atomically(f.path, f.text, &why)) {
+      error = fmt::format("{}: cannot write: {}", f.path, why);
+      for (const config::FileText& back : old) write_file_atomically(back.path, back.text, nullptr);
+      old.clear();
+      return false;
+    }
+    old.push_back(std::move(was));
+  }
+  return true;
+}
+
 std::string change_text(const std::vector<config::ProfileChange>& changes) {
   std::string s;
   for (const config::ProfileChange& c : changes)
@@ -101,11 +119,16 @@ void Controller::edit_profile(std::uint64_t id, const requests::EditProfile& r) 
   if (const std::string why = outside_new_limits(next, s); !why.empty())
     return finish(id, Refusal::SoftLimit, why);
   std::string old_text, error;
+  std::vector<config::FileText> old_files;  // a comp file the table is written into
+  if (!write_files(edit.files, old_files, error)) return finish(id, Refusal::BadValue, error);
   if (!read_file(profile_.source, old_text, &error) ||
-      !write_file_atomically(profile_.source, edit.text, &error))
+      !write_file_atomically(profile_.source, edit.text, &error)) {
+    for (const config::FileText& back : old_files) write_file_atomically(back.path, back.text, nullptr);
     return finish(id, Refusal::BadValue,
                   fmt::format("{}: cannot write the profile: {}", profile_.source, error));
-  ProfileChange pending{id, new_id(), profile_, std::move(old_text), change_text(edit.changes), r.who};
+  }
+  ProfileChange pending{
+      id, new_id(), profile_, std::move(old_text), change_text(edit.changes), r.who, std::move(old_files)};
   const std::uint16_t tables = compensated_joints(next);
   swap_profile(std::move(*edit.profile));
   bool queued = true;
@@ -132,19 +155,21 @@ void Controller::edit_profile(std::uint64_t id, const requests::EditProfile& r) 
   }
 }
 
-// The joint's new table into the buffer its tick does not read (nothing else is in flight: one
-// change at a time), named by a StagePitchTable. Returns false when the ring is full.
-bool Controller::stage_pitch_table(int joint, const ServoConfig& next, ProfileChange& pending) {
+// The joint's new table into the buffer its tick does not read, as the tick publishes it (not as
+// this controller remembers it: the tick may have outlived the controller that switched it).
+// Nothing else is in flight: one change at a time. Named by a StagePitchTable. Returns false when
+// the ring is full.
+bool Controller::stage_pitch_table(int joint, const ServoConfig& next, const ProfileChange& pending) {
   const auto j = static_cast<std::size_t>(joint);
   const motion::JointCompensation& c = next.compensation.joints[j];
-  const auto buffer = static_cast<std::uint8_t>(pitch_buffer_[j] == 0 ? 1 : 0);
+  const std::int8_t reading = channels_->pitch_tables.reading[j].index.load(std::memory_order_acquire);
+  const auto buffer = static_cast<std::uint8_t>(reading == 0 ? 1 : 0);
   channels_->pitch_tables.joints[j][buffer] = c.pitch;
   Command stage;
   stage.id = pending.stage_id;
   stage.kind = CommandKind::StagePitchTable;
   stage.axis = static_cast<std::int8_t>(joint);
   stage.table_buffer = buffer;
-  pending.tables = static_cast<std::uint16_t>(pending.tables | (1u << joint));
   return channels_->commands.try_push(stage);
 }
 
@@ -155,23 +180,25 @@ bool Controller::settle_profile_change(const ServoEvent& e) {
   ProfileChange change = std::move(*profile_change_);
   profile_change_.reset();
   if (e.kind == EventKind::Accepted) {
-    for (std::size_t j = 0; j < pitch_buffer_.size(); ++j)
-      if (change.tables & (1u << j)) pitch_buffer_[j] = pitch_buffer_[j] == 0 ? 1 : 0;
     note(Severity::Note, "control.profile",
          fmt::format("{}machine parameters changed: {} ({})", change.who.empty() ? "" : change.who + ": ",
                      change.message, profile_.source));
     finish(change.id, Refusal::None, change.message);
     return true;
   }
-  // The tick said no (something started moving meanwhile): the file and the limits as they were.
+  // The tick said no (something started moving meanwhile): the files and the limits as they were.
   std::string error;
-  const bool restored = write_file_atomically(profile_.source, change.old_text, &error);
+  std::vector<config::FileText> files = std::move(change.old_files);
+  files.push_back({profile_.source, std::move(change.old_text)});
+  for (const config::FileText& back : files)
+    if (std::string why; !write_file_atomically(back.path, back.text, &why))
+      error += fmt::format("{}{}: {}", error.empty() ? "" : "; ", back.path, why);
   swap_profile(std::move(change.old_profile));
   finish(change.id, e.refusal == Refusal::None ? Refusal::Busy : e.refusal,
-         restored
-             ? fmt::format("the machine would not take the new limits now: nothing changed")
-             : fmt::format("the machine would not take the new limits now, and {} could not be restored: {}",
-                           profile_.source, error));
+         error.empty() ? fmt::format("the machine would not take the new limits now: nothing changed")
+                       : fmt::format("the machine would not take the new limits now, and a file could not be "
+                                     "restored: {}",
+                                     error));
   return true;
 }
 

@@ -190,6 +190,21 @@ SharedSetup shared_setup(const config::MachineProfile& profile) {
     out.hysteresis = a.hysteresis;
     out.reaction = a.reaction;
   }
+  // The compensated joints the same way (a flag and a point count before doubles): a re-attaching
+  // controller with the same pitch tables hands over the same bytes.
+  for (std::size_t j = 0; j < s.servo.compensation.joints.size(); ++j) {
+    const motion::JointCompensation& c = servo.compensation.joints[j];
+    motion::JointCompensation& out = s.servo.compensation.joints[j];
+    std::memset(static_cast<void*>(&out), 0, sizeof out);
+    out.enabled = c.enabled;
+    out.pitch.count = c.pitch.count;
+    out.pitch.position = c.pitch.position;
+    out.pitch.forward = c.pitch.forward;
+    out.pitch.reverse = c.pitch.reverse;
+    out.backlash = c.backlash;
+    out.max_velocity = c.max_velocity;
+    out.max_acceleration = c.max_acceleration;
+  }
   const machine::MachineCapabilities caps =
       machine::SimMachine(config::sim_machine_config(profile)).capabilities();
   std::memcpy(static_cast<void*>(&s.capabilities), &caps, sizeof caps);

@@ -108,12 +108,7 @@ ParametersRequest compensation_request(const json& body, const config::MachinePr
         fmt::format("axis {} has no compensation (GET /api/v1/compensation lists the axes that have)", name);
     return r;
   }
-  if (!a->compensation.comp_file.empty()) {
-    r.status = 422;
-    r.message = fmt::format("axis {}'s table comes from the comp file {}: edit that file, then restart", name,
-                            a->compensation.comp_file);
-    return r;
-  }
+  const bool comp_file = !a->compensation.comp_file.empty();
   const std::string base = fmt::format("axis.{}.compensation.", static_cast<char>(std::tolower(name)));
   std::vector<config::ProfileKeyEdit> edits;
   const std::string forward = table_toml(body, "forward", r);
@@ -123,12 +118,32 @@ ParametersRequest compensation_request(const json& body, const config::MachinePr
   for (const char* key : {"start", "interval", "backlash"}) {
     const auto v = body.find(key);
     if (v == body.end()) continue;
+    if (comp_file && key[0] != 'b') {
+      r.status = 422;
+      r.message = fmt::format(
+          "axis {}'s table is in the comp file {}, which lists each point's position: send \"positions\", "
+          "not "
+          "\"{}\"",
+          name, a->compensation.comp_file, key);
+      return r;
+    }
     if (!v->is_number() || !std::isfinite(v->get<double>())) {
       r.status = v->is_number() ? 422 : 400;
       r.message = fmt::format("\"{}\" must be a finite number", key);
       return r;
     }
     edits.push_back({base + key, config::toml_number(v->get<double>())});
+  }
+  if (body.contains("positions")) {
+    if (!comp_file) {
+      r.status = 422;
+      r.message = fmt::format(
+          "axis {}'s table has its points at start + k·interval: send \"start\" and \"interval\"", name);
+      return r;
+    }
+    const std::string positions = table_toml(body, "positions", r);
+    if (positions.empty()) return r;
+    edits.push_back({base + "positions", positions});
   }
   edits.push_back({base + "forward", forward});
   edits.push_back({base + "reverse", reverse});
@@ -154,7 +169,8 @@ json compensation_json(const config::MachineProfile& profile) {
                     {"takeup_acceleration", c.takeup_acceleration},
                     {"table", table},
                     {"comp_file", c.comp_file.empty() ? json(nullptr) : json(c.comp_file)},
-                    {"editable", c.comp_file.empty()},
+                    {"comp_file_type", c.comp_file_type},
+                    {"editable", true},
                     {"max_points", config::kMaxCompensationPoints}});
   }
   return {{"profile", profile.source},

@@ -132,7 +132,24 @@ Request electrode(const std::string& action, const json& body) {
       write = body["write"].get<bool>();
     }
     if (write) confirmed(body, "storing the measured offsets");
-    return Request::feature("electrode", "measure", control::ElectrodeMeasure{static_cast<int>(t), write});
+    control::ElectrodeMeasure m{static_cast<int>(t), write, std::nullopt};
+    if (body.contains("b_deg")) m.b_deg = required(body, "b_deg", -100000, 100000);
+    return Request::feature("electrode", "measure", m);
+  }
+  if (action == "calibrate-b") {
+    const double t = required(body, "tool", 1, 99999);
+    if (t != std::floor(t)) throw Refused{422, "\"tool\" must be a tool number from 1 to 99999"};
+    const auto angles = body.find("angles_deg");
+    if (angles == body.end() || !angles->is_array() || angles->size() < 3 || angles->size() > 64)
+      throw Refused{400, "\"angles_deg\" must be a list of 3 to 64 B angles, degrees"};
+    control::BAxisCalibrate c{static_cast<int>(t), {}};
+    for (const json& a : *angles) {
+      if (!a.is_number() || !std::isfinite(a.get<double>()))
+        throw Refused{400, "\"angles_deg\" must be a list of 3 to 64 B angles, degrees"};
+      c.angles_deg.push_back(a.get<double>());
+    }
+    confirmed(body, "calibrating B's axis");  // B turns, and the axis found replaces the one in use
+    return Request::feature("electrode", "calibrate-b", c);
   }
   if (action == "write") {
     confirmed(body, "storing the measured offsets");
@@ -142,7 +159,8 @@ Request electrode(const std::string& action, const json& body) {
     confirmed(body, "resuming the program");
     return Request::feature("electrode", "resume");
   }
-  throw Refused{400, fmt::format("electrode has no action \"{}\" (measure, write, resume)", action)};
+  throw Refused{400,
+                fmt::format("electrode has no action \"{}\" (measure, write, resume, calibrate-b)", action)};
 }
 
 Request tool_guard(const std::string& action, const json& body) {

@@ -206,8 +206,19 @@ json MachineFeatures::snapshot(const control::ControllerStatus& s) {
               {"max_residual_mm", r->max_residual_mm},
               {"written", r->written}};
     }
+    json b_axis = nullptr;
+    if (const std::optional<control::BAxisResult> c = electrode_->last_b_axis()) {
+      b_axis = {{"ok", c->ok},
+                {"code", c->code},
+                {"message", c->message},
+                {"angles_deg", c->angles_deg},
+                {"b_axis", c->fit.axis.crossing},
+                {"b_axis_direction", c->fit.axis.direction},
+                {"max_residual_mm", c->fit.max_residual_mm}};
+    }
     j["electrode"] = {{"phase", control::to_string(electrode_->phase())},
                       {"last", last},
+                      {"b_axis", b_axis},
                       {"stopped_program", electrode_->stop().has_value()}};
   }
   if (guard_) j["tool_guard"] = tool_guard_state(s);

@@ -75,7 +75,11 @@ bool MachineHost::start(std::vector<std::string>* warnings) {
 }
 
 void MachineHost::stop() {
-  stop_ = true;
+  {
+    std::lock_guard lock(simulate_mutex_);  // a simulate() waiting sees stop_ and returns
+    stop_ = true;
+  }
+  simulate_applied_cv_.notify_all();
   if (thread_.joinable()) thread_.join();
   if (clock_) clock_->stop();
 }
@@ -100,9 +104,33 @@ std::string MachineHost::simulate(const SimulationEvent& event) {
   if (event.event != "mains-off" && event.event != "mains-on" && event.event != "electrode")
     return fmt::format("no simulation event \"{}\"", event.event);
   if (!rig_) return "the simulation controls need virtual time (opencnc serve --speed X)";
-  std::lock_guard lock(simulate_mutex_);
+  std::unique_lock lock(simulate_mutex_);
   simulate_.push_back(event);
+  const std::uint64_t mine = ++simulate_queued_;
+  simulate_pending_.store(true, std::memory_order_release);
+  // Waiting makes the event happen before whatever the caller asks next (a measurement on the
+  // sphere must not see the electrode change half-way through its touches).
+  if (!simulate_applied_cv_.wait_for(lock, std::chrono::seconds(5),
+                                     [&] { return simulate_applied_ >= mine || stop_.load(); }))
+    return "the simulated machine did not take the event within 5 s";
+  if (simulate_applied_ < mine) return "the simulated machine stopped before it took the event";
   return {};
+}
+
+void MachineHost::apply_simulation_events() {
+  {
+    std::lock_guard lock(simulate_mutex_);
+    for (const SimulationEvent& e : simulate_) {
+      if (e.event == "electrode")
+        rig_->machine().set_electrode(e.offset_mm, e.tip_radius_mm);
+      else
+        rig_->machine().set_mains_ok(e.event == "mains-on");
+    }
+    simulate_.clear();
+    simulate_applied_ = simulate_queued_;
+    simulate_pending_.store(false, std::memory_order_relaxed);
+  }
+  simulate_applied_cv_.notify_all();
 }
 
 // The controller's loop beside the real-time servo: one service() per servo period (it reads
@@ -127,17 +155,11 @@ void MachineHost::run_paced() {
   while (!stop_.load(std::memory_order_relaxed)) {
     const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     const auto due = static_cast<std::uint64_t>(wall_s * options_.speed / period_s_);
-    {
-      std::lock_guard lock(simulate_mutex_);
-      for (const SimulationEvent& e : simulate_) {
-        if (e.event == "electrode")
-          rig_->machine().set_electrode(e.offset_mm, e.tip_radius_mm);
-        else
-          rig_->machine().set_mains_ok(e.event == "mains-on");
-      }
-      simulate_.clear();
+    for (int k = 0; done < due && k < 20000; ++k, ++done) {
+      if (simulate_pending_.load(std::memory_order_acquire)) apply_simulation_events();
+      rig_->step();
     }
-    for (int k = 0; done < due && k < 20000; ++k, ++done) rig_->step();
+    if (simulate_pending_.load(std::memory_order_acquire)) apply_simulation_events();
     paced_ticks_.store(done, std::memory_order_relaxed);
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }

@@ -6,16 +6,16 @@
 #include <algorithm>
 #include <cmath>
 
+#include "opencnc/machine/rotary_axis.hpp"
+
 namespace opencnc::machine {
 
 void SimSphereProbe::turn(double b_deg) noexcept {
   if (target_.b_joint < 0) return;
   constexpr double kRad = 3.14159265358979323846 / 180;
-  const double a = (b_deg - target_.b_at_centre_deg) * kRad, c = std::cos(a), s = std::sin(a);
-  const double x = target_.centre[0] - target_.b_axis[0], z = target_.centre[2] - target_.b_axis[1];
-  centre_[0] = target_.b_axis[0] + c * x + s * z;
-  centre_[1] = target_.centre[1];
-  centre_[2] = target_.b_axis[1] - s * x + c * z;
+  const std::array<double, 3> on_axis{target_.b_axis[0], target_.centre[1], target_.b_axis[1]};
+  centre_ =
+      rotate_about(target_.centre, on_axis, target_.b_direction, (b_deg - target_.b_at_centre_deg) * kRad);
 }
 
 double SimSphereProbe::gap(const std::array<double, 3>& p) const noexcept {

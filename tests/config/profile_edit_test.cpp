@@ -10,9 +10,12 @@
 #include <sstream>
 #include <string>
 
+#include "../support/drill_comp_file.hpp"
+#include "opencnc/config/comp_file_edit.hpp"
 #include "opencnc/config/profile_edit.hpp"
 #include "opencnc/config/profile_loader.hpp"
 #include "opencnc/config/toml_edit.hpp"
+#include "opencnc/core/atomic_file.hpp"
 
 namespace opencnc::config {
 namespace {
@@ -238,6 +241,117 @@ TEST_F(ProfileEditTable, ABadTableGetsTheLoadersMessageAndOneDirectionOfOneTable
   EXPECT_NE(edit_profile(live_, none).error.find("no [axis.z.compensation]"), std::string::npos);
   EXPECT_TRUE(is_pitch_table_key("axis.x.compensation.interval"));
   EXPECT_FALSE(is_pitch_table_key("axis.x.compensation.errors"));
+}
+
+/// The drill's profile with Y's table in a LinuxCNC comp file (type 0) beside it.
+class ProfileEditCompFile : public ProfileEditFile {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() / ("opencnc-comp-edit-" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir_);
+    std::string text;
+    ASSERT_TRUE(read_file(OPENCNC_SOURCE_DIR "/configs/drill-retrofit.toml", text, nullptr));
+    original_ = opencnc::test::drill_with_y_comp_file(text);
+    ASSERT_FALSE(original_.empty());
+    path_ = (dir_ / "drill-retrofit.toml").string();
+    comp_ = (dir_ / opencnc::test::kDrillYCompName).string();
+    ASSERT_TRUE(write_file_atomically(path_, original_, nullptr));
+    ASSERT_TRUE(write_file_atomically(comp_, opencnc::test::kDrillYComp, nullptr));
+    std::filesystem::copy_file(OPENCNC_SOURCE_DIR "/configs/drill-retrofit.tbl", dir_ / "drill-retrofit.tbl");
+    ProfileLoad load = load_profile(path_);
+    ASSERT_TRUE(load.ok()) << (load.diagnostics.items().empty() ? "" : load.diagnostics.items()[0].format());
+    live_ = *load.profile;
+  }
+  std::string comp_;
+};
+
+// The table written into the comp file (the profile's text unchanged, the comment lines where
+// they were, a point added after the last); the file as written loads to the same table.
+TEST_F(ProfileEditCompFile, TheTableIsWrittenIntoTheCompFileAndLoadsBackTheSame) {
+  const CompensationProfile& was = live_.axes[1].compensation;
+  ASSERT_EQ(was.comp_file, opencnc::test::kDrillYCompName);
+  EXPECT_EQ(was.comp_path, comp_);
+  EXPECT_NEAR(was.forward[4], -0.005, 1e-12);
+  const ProfileKeyEdit edits[] = {
+      {"axis.y.compensation.forward",
+       "[0, -0.002, -0.004, -0.0045, -0.006, -0.007, -0.009, -0.0105, -0.012, -0.013]"},
+      {"axis.y.compensation.reverse",
+       "[0.015, 0.013, 0.011, 0.0105, 0.01, 0.008, 0.006, 0.0045, 0.003, 0.002]"},
+      {"axis.y.compensation.positions", "[0, 50, 100, 150, 200, 250, 300, 350, 400, 440]"}};
+  const ProfileEditResult r = edit_profile(live_, edits);
+  ASSERT_TRUE(r.ok()) << r.error << (r.diagnostics.items().empty() ? "" : r.diagnostics.items()[0].format());
+  EXPECT_EQ(r.text, original_);
+  ASSERT_EQ(r.files.size(), 1u);
+  EXPECT_EQ(r.files[0].path, comp_);
+  const std::string expected =
+      "# Y's lead screw by laser: nominal, reached moving up, reached moving down (mm)\n"
+      "0 0 0.015\n50 49.998 50.013\n100 99.996 100.011\n150 149.9955 150.0105\n"
+      "# the middle of the screw\n"
+      "200 199.994 200.01\n250 249.993 250.008\n300 299.991 300.006\n350 349.9895 350.0045\n"
+      "400 399.988 400.003\n440 439.987 440.002\n";
+  EXPECT_EQ(r.files[0].text, expected);
+  ASSERT_EQ(r.changes.size(), 3u);
+  EXPECT_EQ(r.changes[0].old_value, "9 points");
+  EXPECT_EQ(r.changes[0].new_value, "10 points");
+  ASSERT_TRUE(write_file_atomically(comp_, r.files[0].text, nullptr));
+  const ProfileLoad again = load_profile(path_);
+  ASSERT_TRUE(again.ok());
+  const CompensationProfile& now = again.profile->axes[1].compensation;
+  const CompensationProfile& edited = r.profile->axes[1].compensation;
+  EXPECT_EQ(now.positions, edited.positions);
+  EXPECT_EQ(now.forward, edited.forward);
+  EXPECT_EQ(now.reverse, edited.reverse);
+  EXPECT_NEAR(now.forward[4], -0.006, 1e-12);  // type 0 holds positions: the error is x' − x
+  EXPECT_NEAR(now.reverse[9], 0.002, 1e-12);
+  EXPECT_EQ(now.positions.back(), 440.0);
+  // The same table again: each point unchanged.
+  const ProfileKeyEdit same[] = {
+      {"axis.y.compensation.forward",
+       "[0, -0.002, -0.004, -0.0045, -0.006, -0.007, -0.009, -0.0105, -0.012, -0.013]"}};
+  const ProfileEditResult r2 = edit_profile(*again.profile, same);
+  ASSERT_TRUE(r2.ok()) << r2.error;
+  EXPECT_EQ(r2.files[0].text, expected);
+  EXPECT_EQ(r2.changes[0].new_value, "10 points, unchanged");
+}
+
+// Type 1 holds the trims (−error), written back exactly; fewer points drop the number lines past
+// them and keep every comment line.
+TEST(CompFileText, TrimsAreTheNegativeErrorAndCommentsStay) {
+  const double x[] = {-10, 0}, f[] = {0.005, -0.002}, r[] = {-0.005, 0.003};
+  EXPECT_EQ(comp_file_with_table("# head\n-10 1 1\n\n# mid\n0 1 1\n10 1 1\n# tail", 1, x, f, r),
+            "# head\n-10 -0.005 0.005\n\n# mid\n0 0.002 -0.003\n# tail\n");
+}
+
+// A table the loader refuses gets its message at the comp file's line; refusals of the request
+// itself; nothing is written by edit_profile.
+TEST_F(ProfileEditCompFile, ABadTableGetsTheLoadersMessageAtTheCompFilesLine) {
+  const ProfileKeyEdit back[] = {
+      {"axis.y.compensation.positions", "[0, 50, 100, 150, 150, 250, 300, 350, 400]"}};
+  const ProfileEditResult r = edit_profile(live_, back);
+  ASSERT_FALSE(r.ok());
+  ASSERT_FALSE(r.diagnostics.items().empty());
+  const Diagnostic& d = r.diagnostics.items().front();
+  EXPECT_EQ(d.file, comp_);
+  EXPECT_EQ(d.line, 7u);  // the fifth point, after the head comment and the middle one
+  EXPECT_EQ(d.col, 1u);
+  EXPECT_NE(d.message.find("nominal positions must increase"), std::string::npos) << d.message;
+  const ProfileKeyEdit steep[] = {{"axis.y.compensation.forward", "[0, 0, 0, 0, 0, 0, 0, 0, 2]"}};
+  const ProfileEditResult s = edit_profile(live_, steep);
+  ASSERT_FALSE(s.ok());
+  EXPECT_EQ(s.diagnostics.items().front().file, path_);  // the slope: at the profile's comp_file
+  const ProfileKeyEdit interval[] = {{"axis.y.compensation.interval", "100"}};
+  EXPECT_NE(edit_profile(live_, interval).error.find("give positions"), std::string::npos);
+  const ProfileKeyEdit longer[] = {{"axis.y.compensation.forward", "[0, 0]"}};
+  EXPECT_NE(edit_profile(live_, longer).error.find("2 forward"), std::string::npos);
+  const ProfileKeyEdit text[] = {{"axis.y.compensation.reverse", "[0, \"a\"]"}};
+  EXPECT_NE(edit_profile(live_, text).error.find("finite numbers"), std::string::npos);
+  const ProfileKeyEdit x_positions[] = {{"axis.x.compensation.positions", "[0, 1]"}};
+  EXPECT_NE(edit_profile(live_, x_positions).error.find("give start and interval"), std::string::npos);
+  std::string now;
+  ASSERT_TRUE(read_file(comp_, now, nullptr));
+  EXPECT_EQ(now, opencnc::test::kDrillYComp);
+  ASSERT_TRUE(write_file_atomically(comp_, now + "# touched\n", nullptr));
+  EXPECT_NE(edit_profile(live_, steep).error.find("changed on disk"), std::string::npos);
 }
 
 TEST(ProfileEdit, TheEditableParametersAreEachAxisLimits) {

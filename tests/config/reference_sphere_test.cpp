@@ -3,6 +3,7 @@
 // machine, and bad values rejected at file:line:col.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <string>
 
 #include "opencnc/config/profile_loader.hpp"
@@ -62,6 +63,31 @@ TEST(ReferenceSphere, IsReadWithItsDefaultsAndMadeTheSimulatedProbe) {
   EXPECT_EQ(c.probe.sphere.b_joint, -1) << "no B: the sphere does not turn";
 }
 
+TEST(ReferenceSphere, BsAxisIsReadAndItsDirectionMadeAUnitVector) {
+  const std::string b =
+      "[axis.b]\ntype = \"rotary\"\nmax_velocity = 30\nmax_acceleration = 300\n"
+      "min_limit = -95\nmax_limit = 95\n";
+  const ProfileLoad load =
+      parse_profile(kBase + b + kSphere +
+                        "b_axis = [100.0, -170.0]\nb_axis_direction = [0.0, 2.0, 0.002]\n"
+                        "[probe.reference_sphere.sim]\nb_axis = [100.01, -170.02]\n"
+                        "b_axis_direction = [0.001, 1.0, 0.0]\n",
+                    "p.toml");
+  ASSERT_TRUE(load.ok()) << first_error(load);
+  const ReferenceSphereProfile& s = load.profile->probe.reference_sphere;
+  EXPECT_TRUE(s.has_b_axis);
+  EXPECT_EQ(s.b_axis, (std::array<double, 2>{100.0, -170.0}));
+  EXPECT_NEAR(s.b_axis_direction[1], 1 / std::hypot(1.0, 0.001), 1e-15);
+  EXPECT_NEAR(s.b_axis_direction[2], 0.001 / std::hypot(1.0, 0.001), 1e-15);
+  const machine::SimMachineConfig c = sim_machine_config(*load.profile);
+  EXPECT_EQ(c.probe.sphere.b_axis, (std::array<double, 2>{100.01, -170.02}));
+  EXPECT_NEAR(c.probe.sphere.b_direction[0], 0.001 / std::hypot(1.0, 0.001), 1e-15) << "the true axis";
+  const ProfileLoad plain = parse_profile(kBase + b + kSphere, "p.toml");
+  ASSERT_TRUE(plain.ok()) << first_error(plain);
+  EXPECT_FALSE(plain.profile->probe.reference_sphere.has_b_axis);
+  EXPECT_EQ(plain.profile->probe.reference_sphere.b_axis_direction, (std::array<double, 3>{0, 1, 0}));
+}
+
 TEST(SimElectrodes, AreReadIntoTheSimulatedMachine) {
   const ProfileLoad load =
       parse_profile(kBase + kSphere +
@@ -114,6 +140,17 @@ INSTANTIATE_TEST_SUITE_P(
             "p.toml:23:10: error: probe.reference_sphere.sim.b_axis must be [x, z]"},
         Bad{"SimBAxisWithoutAxisB", kSphere + "[probe.reference_sphere.sim]\nb_axis = [1, 2]\n",
             "p.toml:22:1: error: probe.reference_sphere.sim.b_axis: the profile has no B axis"},
+        Bad{"BAxisWithoutAxisB", kSphere + "b_axis = [1.0, 2.0]\n",
+            "p.toml:22:10: error: probe.reference_sphere.b_axis the profile has no B axis"},
+        Bad{"BAxisNotTwoNumbers", kSphere + "b_axis = [1.0]\n",
+            "p.toml:22:10: error: probe.reference_sphere.b_axis must be [x, z]"},
+        Bad{"BAxisDirectionFarFromY", kSphere + "b_axis_direction = [1.0, 1.0, 0.0]\n",
+            "p.toml:22:20: error: probe.reference_sphere.b_axis_direction must point along +Y within 10°"},
+        Bad{"SimBAxisDirectionWithoutLength",
+            kSphere + "[probe.reference_sphere.sim]\nb_axis_direction = [0.0, 0.0, 0.0]\n",
+            "p.toml:23:20: error: probe.reference_sphere.sim.b_axis_direction must point along +Y within 10° "
+            "(B turns "
+            "about Y): it has no length"},
         Bad{"SimElectrodeNotATable", "[sim]\nelectrode = 3\n",
             "p.toml:19:13: error: sim.electrode must be an array of tables"},
         Bad{"SimElectrodeWithoutTool", "[sim]\n[[sim.electrode]]\noffset = [0, 0, 1]\n",

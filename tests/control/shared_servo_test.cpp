@@ -6,6 +6,8 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstring>
+#include <filesystem>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -13,6 +15,7 @@
 
 #include "opencnc/control/shared_memory.hpp"
 #include "opencnc/control/shared_servo.hpp"
+#include "opencnc/config/profile_loader.hpp"
 #include "opencnc/controller/controller.hpp"
 #include "opencnc/controller/servo_setup.hpp"
 #include "opencnc/machine/sim_machine.hpp"
@@ -57,15 +60,17 @@ class SharedRig {
     host_ = std::make_unique<SharedServoHost>(owner_->segment(), backend_);
     attach();
   }
-  /// A (new) controller process: maps the segment, drains what was left, hands its set-up over.
-  void attach() {
+  /// A (new) controller process: maps the segment, drains what was left, hands its set-up over
+  /// (`setup`, else the profile's).
+  void attach(const SharedSetup* setup = nullptr) {
     std::string error;
     controller_.reset();
     mapping_ = SharedMemory::attach(owner_->name(), error);
     ASSERT_TRUE(mapping_) << error;
     drain_stale_output(mapping_->segment());
     controller_ = std::make_unique<Controller>(profile_, mapping_->segment().channels);
-    const std::uint64_t g = offer_setup(mapping_->segment(), shared_setup(profile_));
+    const std::uint64_t g = setup ? offer_setup(mapping_->segment(), *setup)  // its bytes, padding too
+                                  : offer_setup(mapping_->segment(), shared_setup(profile_));
     for (int i = 0; i < 10 && !setup_taken(mapping_->segment(), g); ++i) step();
     ASSERT_TRUE(setup_taken(mapping_->segment(), g));
   }
@@ -124,10 +129,12 @@ TEST(SharedMemory, RefusesAForeignOrOtherBuildSegment) {
 // A restarted controller hands over the same set-up byte for byte (padding included), so the tick
 // keeps its servo and the joints' homed state.
 TEST(SharedSetup, IsTheSameBytesForTheSameProfile) {
-  const SharedSetup a = shared_setup(mill()), b = shared_setup(mill());
-  const auto* pa = reinterpret_cast<const unsigned char*>(&a);
-  const auto* pb = reinterpret_cast<const unsigned char*>(&b);
-  for (std::size_t i = 0; i < sizeof a; ++i) ASSERT_EQ(pa[i], pb[i]) << "byte " << i;
+  for (const config::MachineProfile& p : {mill(), drill()}) {  // the drill: pitch tables, backlash
+    const SharedSetup a = shared_setup(p), b = shared_setup(p);
+    const auto* pa = reinterpret_cast<const unsigned char*>(&a);
+    const auto* pb = reinterpret_cast<const unsigned char*>(&b);
+    for (std::size_t i = 0; i < sizeof a; ++i) ASSERT_EQ(pa[i], pb[i]) << p.name << " byte " << i;
+  }
 }
 
 TEST(SharedServoHost, SafeOutputsUntilASetupIsTaken) {
@@ -199,6 +206,89 @@ TEST(SharedServoHost, ASilentControllerStopsTheMachineAndANewOneTakesOver) {
   EXPECT_EQ(rig.status().fault.kind, FaultKind::PowerLoss);
   ASSERT_TRUE(rig.ask(Request::simple(CommandKind::Reset)).accepted);
   EXPECT_TRUE(rig.ask(Request::simple(CommandKind::MachineOn)).accepted);
+}
+
+/// The drill's profile and tool table copied to a directory of this test's own (profile edits
+/// write the file); removed with the object.
+struct DrillCopy {
+  explicit DrillCopy(const char* what)
+      : dir(std::filesystem::temp_directory_path() /
+            ("opencnc-" + std::string(what) + "-" + std::to_string(::getpid()))) {
+    std::filesystem::create_directories(dir);
+    for (const char* f : {"drill-retrofit.toml", "drill-retrofit.tbl"})
+      std::filesystem::copy_file(std::filesystem::path(OPENCNC_SOURCE_DIR "/configs") / f, dir / f,
+                                 std::filesystem::copy_options::overwrite_existing);
+  }
+  ~DrillCopy() { std::filesystem::remove_all(dir); }
+  config::MachineProfile profile() const {
+    return loaded(config::load_profile((dir / "drill-retrofit.toml").string()));
+  }
+  std::filesystem::path dir;
+};
+
+// The tick outlives a controller that left Y on pitch buffer 0 with the profile's own table (three
+// edits: buffers 0, 1, 0, the last back to the file's first values) and whose last act was a stage
+// the tick refused. A new controller loads that file: the same set-up, so the servo and its table
+// stay. Its edit goes into buffer 1, never into the buffer the lookup reads, and is not refused for
+// what the dead one staged.
+TEST(SharedServoHost, ANewControllerNeverWritesThePitchBufferTheTickReads) {
+  const DrillCopy copy("pitch-reattach");
+  SharedRig rig(copy.profile(), "pitch-reattach");
+  PitchTableArea& area = rig.owner_->segment().channels.pitch_tables;
+  EXPECT_EQ(area.reading[1].index.load(), -1);  // a servo just built reads its configuration's table
+  const auto forward = [](const char* fifth) {
+    return std::string("[0, -0.002, -0.004, -0.0045, ") + fifth + ", -0.007, -0.009, -0.0105, -0.012]";
+  };
+  for (const char* fifth : {"-0.006", "-0.007", "-0.005"}) {
+    const Outcome o = rig.ask(Request::edit_profile({{"axis.y.compensation.forward", forward(fifth)}}, "admin"));
+    ASSERT_TRUE(o.accepted) << o.message;
+  }
+  ASSERT_EQ(area.reading[1].index.load(), 0);
+  const motion::PitchTable in_use = area.joints[1][0];
+  EXPECT_EQ(in_use.forward[4], -0.005);
+  const std::uint64_t taken = rig.owner_->segment().header.setup_taken.load();
+
+  // The dead controller's last act: a table the tick refuses (positions not increasing) staged in
+  // buffer 1, no apply.
+  area.joints[1][1] = in_use;
+  area.joints[1][1].position[3] = area.joints[1][1].position[2];
+  Command stale;
+  stale.id = 99001;
+  stale.kind = CommandKind::StagePitchTable;
+  stale.axis = 1;
+  stale.table_buffer = 1;
+  ASSERT_TRUE(rig.owner_->segment().channels.commands.try_push(stale));
+  rig.step();
+  rig.controller_.reset();
+  // The same set-up, byte for byte as the tick took it (shared_setup() leaves EdmConfig's padding
+  // as the copies made it, so two calls may differ there under the sanitizers).
+  const auto same = std::make_unique<SharedSetup>();
+  std::memcpy(static_cast<void*>(same.get()), &rig.owner_->segment().setup, sizeof(SharedSetup));
+  rig.profile_ = copy.profile();
+  rig.attach(same.get());
+  ASSERT_GT(rig.owner_->segment().header.setup_taken.load(), taken);
+  ASSERT_EQ(area.reading[1].index.load(), 0) << "the set-up differs: the servo was rebuilt";
+
+  const Outcome o = rig.ask(Request::edit_profile({{"axis.y.compensation.forward", forward("-0.008")}}, "admin"));
+  ASSERT_TRUE(o.accepted) << o.message;
+  EXPECT_EQ(area.reading[1].index.load(), 1);
+  const Servo* servo = rig.host_->servo();
+  EXPECT_EQ(&servo->compensation().pitch_table(1), &area.joints[1][1]);
+  EXPECT_EQ(area.joints[1][1].forward[4], -0.008);
+  EXPECT_EQ(std::memcmp(&area.joints[1][0], &in_use, sizeof in_use), 0) << "the table in use was written";
+
+  // A stage naming the buffer the tick reads is refused, and the apply with it.
+  Command own = stale;
+  own.id = 99002;
+  Command apply;
+  apply.id = 99003;
+  apply.kind = CommandKind::ApplyJointLimits;
+  ASSERT_TRUE(rig.mapping_->segment().channels.commands.try_push(own) &&
+              rig.mapping_->segment().channels.commands.try_push(apply));
+  rig.until([&] { return rig.controller_->outcome(99003).has_value(); }, 10);
+  ASSERT_TRUE(rig.controller_->outcome(99003).has_value());
+  EXPECT_EQ(rig.controller_->outcome(99003)->refusal, Refusal::BadValue);
+  EXPECT_EQ(area.reading[1].index.load(), 1);
 }
 
 }  // namespace

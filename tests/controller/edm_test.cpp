@@ -415,5 +415,43 @@ TEST(EdmSeek, TheControllerSaysWhereTheLimitSwitchTripped) {
                               st.tripped_at, st.rest_at));
 }
 
+/// Runs until the machine is idle again with nothing moving; false if that takes `ticks`.
+bool comes_to_rest(SimRig& rig, std::uint64_t ticks) {
+  return rig.run_until(
+      [&] {
+        return rig.status().servo.state == State::Idle && rig.status().servo.activity == Activity::None;
+      },
+      ticks);
+}
+
+TEST(EdmJog, ZJogsOnTheHomedMachineEnd) {
+  // Reported last stop: a Z jog on the homed EDM that never finished (the mover creeping about its
+  // goal at 1e-10 mm/s, fixed with homing on switches). Incremental, continuous with a stop, and
+  // continuous to the soft limit: each ends, where it should, within a stepper step.
+  const config::MachineProfile p = edm();
+  Diagnostics d;
+  SimRig rig(p, GcodeProgramSource::create(p, d));
+  ASSERT_TRUE(on_and_homed(rig));
+  const double step = 1 / 1600.0;
+  const auto z = [&] { return rig.status().servo.commanded[Axis::Z]; };
+  ASSERT_TRUE(rig.request(Request::jog_by(Axis::Z, -5.0, 10.0)).accepted);
+  ASSERT_TRUE(comes_to_rest(rig, 2000)) << "5 mm at 10 mm/s: 0.5 s and its ramps";
+  EXPECT_NEAR(z(), -5.0, 1e-9);
+  EXPECT_NEAR(rig.status().servo.actual[Axis::Z], -5.0, step);
+  ASSERT_TRUE(rig.request(Request::jog_by(Axis::Z, 0.001, 0.2)).accepted);  // one handwheel count
+  ASSERT_TRUE(comes_to_rest(rig, 1000));
+  EXPECT_NEAR(z(), -4.999, 1e-9);
+  ASSERT_TRUE(rig.request(Request::jog(Axis::Z, 20.0)).accepted);
+  rig.run(200);
+  EXPECT_EQ(rig.status().servo.state, State::Running);
+  ASSERT_TRUE(rig.request(Request::jog_stop(Axis::Z)).accepted);
+  ASSERT_TRUE(comes_to_rest(rig, 500)) << "stopped from 20 mm/s at 2 m/s²: 10 ms";
+  EXPECT_GT(z(), -1.0);
+  ASSERT_TRUE(rig.request(Request::jog(Axis::Z, 60.0)).accepted);
+  ASSERT_TRUE(comes_to_rest(rig, 3000)) << "to the + soft limit, 51 mm at 60 mm/s";
+  EXPECT_NEAR(z(), 50.0, 1e-9);
+  EXPECT_NEAR(rig.status().servo.actual[Axis::Z], 50.0, step);
+}
+
 }  // namespace
 }  // namespace opencnc::control::test

@@ -15,6 +15,7 @@
 #include <string>
 
 #include "../control/test_profiles.hpp"
+#include "../support/drill_comp_file.hpp"
 #include "opencnc/canon/program_builder.hpp"
 #include "opencnc/config/profile_loader.hpp"
 #include "opencnc/controller/servo_setup.hpp"
@@ -311,6 +312,45 @@ TEST(ProfileChangeCompensation, APitchTableReachesTheTickAndABadOneChangesNothin
     ASSERT_TRUE(rig.controller().outcome(77002).has_value());
     EXPECT_EQ(rig.controller().outcome(77002)->refusal, Refusal::BadValue);
     EXPECT_EQ(&rig.servo().compensation().pitch_table(1), &t);
+  }
+  std::filesystem::remove_all(dir);
+}
+
+// Y's table in a comp file: a jog queued in the same period makes the tick refuse, and the comp
+// file is put back with the profile; at rest the change is written into the comp file and the
+// tick reads the new table.
+TEST(ProfileChangeCompensation, ACompFilesTableIsPutBackWhenTheTickRefusesAndWrittenWhenItTakesIt) {
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("opencnc-comp-change-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  std::string text;
+  ASSERT_TRUE(read_file(OPENCNC_SOURCE_DIR "/configs/drill-retrofit.toml", text, nullptr));
+  const std::string path = (dir / "drill-retrofit.toml").string(),
+                    comp = (dir / opencnc::test::kDrillYCompName).string();
+  ASSERT_TRUE(write_file_atomically(path, opencnc::test::drill_with_y_comp_file(text), nullptr));
+  ASSERT_TRUE(write_file_atomically(comp, opencnc::test::kDrillYComp, nullptr));
+  std::filesystem::copy_file(OPENCNC_SOURCE_DIR "/configs/drill-retrofit.tbl", dir / "drill-retrofit.tbl",
+                             std::filesystem::copy_options::overwrite_existing);
+  {
+    SimRig rig(loaded(config::load_profile(path)));
+    ASSERT_TRUE(rig.request(Request::simple(CommandKind::MachineOn)).accepted);
+    const std::string forward = "[0, -0.002, -0.004, -0.0045, -0.006, -0.007, -0.009, -0.0105, -0.012]";
+    rig.controller().submit(Request::jog(Axis::X, 5));
+    const Outcome refused =
+        rig.request(Request::edit_profile({{"axis.y.compensation.forward", forward}}, "admin"));
+    ASSERT_FALSE(refused.accepted);
+    EXPECT_EQ(refused.message, "the machine would not take the new limits now: nothing changed");
+    std::string now;
+    ASSERT_TRUE(read_file(comp, now, nullptr));
+    EXPECT_EQ(now, opencnc::test::kDrillYComp);
+    EXPECT_EQ(rig.controller().profile().axes[1].compensation.forward[4], -0.005);
+    ASSERT_TRUE(rig.request(Request::jog_stop()).accepted);
+    ASSERT_TRUE(rig.run_until([&] { return rig.status().servo.state == State::Idle; }, 10000));
+    const Outcome o = rig.request(Request::edit_profile({{"axis.y.compensation.forward", forward}}, "admin"));
+    ASSERT_TRUE(o.accepted) << o.message;
+    ASSERT_TRUE(read_file(comp, now, nullptr));
+    EXPECT_NE(now.find("200 199.994 200.01\n"), std::string::npos) << now;
+    EXPECT_EQ(rig.servo().compensation().pitch_table(1).forward[4], -0.006);
   }
   std::filesystem::remove_all(dir);
 }

@@ -11,7 +11,9 @@ TEST is one of:
   safety-pins      e-stop, amplifier fault and limit switch set from halcmd mid-motion: the drive
                    enable falls within one servo period
   kill-controller  the controller killed (SIGKILL) mid-motion: the axis stops within its limits
-                   (heartbeat timeout, then the abort deceleration) and the drives are disabled"""
+                   (heartbeat timeout, then the abort deceleration) and the drives are disabled;
+                   then a new controller attaches to the tick that outlived it (same set-up),
+                   resets the fault and runs a program to the end"""
 import csv
 import os
 import shutil
@@ -190,6 +192,13 @@ def kill_controller(opencnc, source_dir, hal, work):
         return fail("the stop exceeded the axis's acceleration (1000 mm/s^2)")
     if enabled_at_end:
         return fail("the drive is still enabled with no controller")
+    # The tick kept its servo (the same set-up) and drops what the dead controller staged.
+    again = controller(opencnc, source_dir, "short_move.ngc", work)
+    code = again.wait(timeout=60)
+    if code != 0:
+        print((work / "run.out").read_text())
+        return fail(f"a new controller attached after the kill exited {code}")
+    print("a new controller attached to the same tick and ran short_move.ngc to the end")
     return 0
 
 

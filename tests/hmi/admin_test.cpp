@@ -9,6 +9,7 @@
 #include <filesystem>
 
 #include "../control/test_profiles.hpp"
+#include "../support/drill_comp_file.hpp"
 #include "opencnc/core/atomic_file.hpp"
 #include "opencnc/hmi/api.hpp"
 #include "opencnc/hmi/history.hpp"
@@ -192,6 +193,66 @@ TEST(AdminCompensation, ABadTableGetsTheProfilesMessageAndNothingChanges) {
             400);
   EXPECT_EQ(rig.profile_text(), rig.profile_original);
   EXPECT_EQ(get(rig.port, "/api/v1/compensation", kOperator).body["axes"][1]["table"]["forward"][8], -0.012);
+}
+
+// The drill with Y's table in a LinuxCNC comp file: listed as editable with its file and type;
+// the admin's table goes into that file (comment lines kept, the profile untouched), into the
+// live table and the audit; positions that do not increase get the loader's message at the comp
+// file's line; start and interval are refused; nothing changed.
+TEST(AdminCompensation, ATableInACompFileIsWrittenThere) {
+  RigOptions o = DrillRig::options();
+  o.edit_copy = [](const std::string& text, const std::filesystem::path& dir) {
+    EXPECT_TRUE(write_file_atomically((dir / opencnc::test::kDrillYCompName).string(),
+                                      opencnc::test::kDrillYComp, nullptr));
+    return opencnc::test::drill_with_y_comp_file(text);
+  };
+  ServerRig rig(o);
+  const std::string comp = (rig.dir / opencnc::test::kDrillYCompName).string();
+  const json y = get(rig.port, "/api/v1/compensation", kOperator).body["axes"][1];
+  EXPECT_EQ(y["comp_file"], opencnc::test::kDrillYCompName);
+  EXPECT_EQ(y["comp_file_type"], 0);
+  EXPECT_EQ(y["editable"], true);
+  ASSERT_EQ(y["table"]["positions"].size(), 9u);
+  const std::string bad =
+      R"({"kind":"set-compensation","axis":"Y","positions":[0,50,100,150,150,250,300,350,400],)"
+      R"("forward":[0,0,0,0,0,0,0,0,0],"reverse":[0,0,0,0,0,0,0,0,0]})";
+  const Reply refused = post(rig.port, bad, kAdmin);
+  ASSERT_EQ(refused.status, 409) << refused.text;
+  const std::string where = refused.body["diagnostics"][0]["text"];
+  EXPECT_EQ(where.rfind(comp + ":7:1:", 0), 0u) << where;
+  EXPECT_EQ(
+      post(rig.port, R"({"kind":"set-compensation","axis":"Y","interval":10,"forward":[0],"reverse":[0]})",
+           kAdmin)
+          .status,
+      422);
+  EXPECT_EQ(
+      post(rig.port, R"({"kind":"set-compensation","axis":"X","positions":[0],"forward":[0],"reverse":[0]})",
+           kAdmin)
+          .status,
+      422);
+  std::string text;
+  ASSERT_TRUE(read_file(comp, text, nullptr));
+  EXPECT_EQ(text, opencnc::test::kDrillYComp);
+  const std::string change =
+      R"({"kind":"set-compensation","axis":"Y","forward":[0,-0.002,-0.004,-0.0045,-0.006,-0.007,-0.009,-0.0105,-0.012],)"
+      R"("reverse":[0.015,0.013,0.011,0.0105,0.01,0.008,0.006,0.0045,0.003]})";
+  EXPECT_EQ(post(rig.port, change, kOperator).status, 403);
+  const Reply ok = post(rig.port, change, kAdmin);
+  ASSERT_EQ(ok.status, 200) << ok.text;
+  EXPECT_EQ(ok.body["message"],
+            "axis.y.compensation.forward 9 points → 9 points, 1 changed (largest -0.005 → -0.006 at 200.0); "
+            "axis.y.compensation.reverse 9 points → 9 points, unchanged");
+  ASSERT_TRUE(read_file(comp, text, nullptr));
+  std::string expected = opencnc::test::kDrillYComp;
+  expected.replace(expected.find("199.995"), 7, "199.994");
+  EXPECT_EQ(text, expected);
+  EXPECT_EQ(rig.profile_text(), rig.profile_original);
+  const json now = get(rig.port, "/api/v1/compensation", kOperator).body["axes"][1]["table"];
+  EXPECT_NEAR(now["forward"][4].get<double>(), -0.006, 1e-12);
+  rig.history->flush();
+  const json audit = get(rig.port, "/api/v1/audit", kAdmin).body;
+  ASSERT_GE(audit.size(), 1u);
+  EXPECT_EQ(audit[0]["result"], "accepted: " + ok.body["message"].get<std::string>());
 }
 
 TEST(AdminConditions, AnEdmsConditionsAreListedInTheProfilesOrder) {

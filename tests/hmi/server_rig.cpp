@@ -53,6 +53,7 @@ ServerRig::ServerRig(RigOptions o) : dir(fresh_folder()) {
   if (o.profile_copy) {
     profile_path = (dir / o.machine).string();
     EXPECT_TRUE(read_file(path, profile_original, &error)) << error;
+    if (o.edit_copy) profile_original = o.edit_copy(profile_original, dir);
     EXPECT_TRUE(write_file_atomically(profile_path, profile_original, &error)) << error;
     // The tool table a profile names beside it (the drill's), copied along.
     const std::filesystem::path tbl = std::filesystem::path(path).replace_extension(".tbl");

@@ -34,6 +34,9 @@ struct RigOptions {
   std::string machine = "mill-3axis.toml";  ///< a profile under configs/
   std::vector<std::string> sets;            ///< `--set` overrides
   bool profile_copy = false;     ///< read the profile from a copy in the rig's folder (admin edits)
+  /// With `profile_copy`: the copy's text from the original's (it may write files beside it in
+  /// the rig's folder, the second argument).
+  std::function<std::string(const std::string&, const std::filesystem::path&)> edit_copy;
   bool tool_table_copy = false;  ///< a copy of configs/mill-3axis.tbl as the interpreter's tool table
   bool history = true;           ///< a machining history in the rig's folder
   bool run_from_line = false;    ///< the run-from-line feature alone

@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 
 #include "opencnc/config/profile_loader.hpp"
+#include "opencnc/controller/b_axis_fit.hpp"
 #include "opencnc/controller/electrode_setting.hpp"
 #include "scenario.hpp"
 
@@ -160,6 +161,119 @@ TEST(ElectrodeSetting, TheSphereTurnsWithBAndIsMeasuredAtItsAngle) {
   EXPECT_NEAR(sphere.centre()[0], 110.0, 1e-4);
   EXPECT_NEAR(sphere.centre()[2], z30, 1e-4);
   for (std::size_t i = 0; i < 3; ++i) EXPECT_NEAR(m.offset[i], truth[i], 1e-4) << "axis " << i;
+}
+
+/// B's axis as the drawing gives it (X 100, Z −170 at Y 50, along Y) and as the simulated table
+/// really turns: 12 µm and −15 µm off at the sphere, tilted by 0.2 and −0.1 mrad.
+std::vector<std::string> b_axis_off_nominal() {
+  return fast_then_slow({"probe.reference_sphere.b_axis=[100.0, -170.0]",
+                         "probe.reference_sphere.sim.b_axis=[100.012, -170.015]",
+                         "probe.reference_sphere.sim.b_axis_direction=[0.0002, 1.0, -0.0001]"});
+}
+
+BAxisResult calibrate_b(Rig& r, std::vector<double> angles) {
+  r.scenario.must(Request::feature("electrode", "calibrate-b", BAxisCalibrate{1, std::move(angles)}));
+  EXPECT_TRUE(r.scenario.until([&] { return r.feature->phase() == ElectrodePhase::Idle; }, 200000));
+  EXPECT_TRUE(r.feature->last_b_axis().has_value());
+  return r.feature->last_b_axis().value_or(BAxisResult{});
+}
+
+TEST(ElectrodeSetting, CalibrateBFindsTheTrueAxisWithinAMicrometre) {
+  Rig r(edm_profile(b_axis_off_nominal()));
+  // An electrode 0.2, −0.1, 0.5 mm off its table entry: it moves every centre alike, not the axis.
+  r.scenario.sim().set_electrode({0.2, -0.1, 50.5}, 0);
+  const BAxisResult c = calibrate_b(r, {-40, 0, 40});
+  ASSERT_TRUE(c.ok) << c.message;
+  ASSERT_EQ(c.centres.size(), 3u);
+  EXPECT_NEAR(c.fit.axis.crossing[0], 100.012, 0.001);
+  EXPECT_NEAR(c.fit.axis.crossing[1], -170.015, 0.001);
+  const double n = std::hypot(0.0002, 1.0, 0.0001);
+  EXPECT_NEAR(c.fit.axis.direction[0], 0.0002 / n, 2e-5) << "the tilt, over a 26 mm chord";
+  EXPECT_NEAR(c.fit.axis.direction[2], -0.0001 / n, 2e-5);
+  EXPECT_NEAR(c.fit.radius_mm, std::hypot(0.012, 20.015), 0.001);
+  EXPECT_LT(c.fit.max_residual_mm, 0.001);
+  EXPECT_EQ(r.table_offset(1), (Point3{0, 0, 50})) << "the tool table is not touched";
+  const config::ReferenceSphereProfile now = r.feature->sphere();
+  EXPECT_TRUE(now.has_b_axis);
+  EXPECT_EQ(now.b_axis, c.fit.axis.crossing) << "kept for the measurements that follow";
+  EXPECT_EQ(r.feature->profile_sphere().b_axis, (std::array<double, 2>{100.0, -170.0}));
+}
+
+TEST(ElectrodeSetting, WithBTurnedTheElectrodeIsRightOnlyAboutTheMeasuredAxis) {
+  Rig r(edm_profile(b_axis_off_nominal()));
+  const Point3 truth{0.2, -0.1, 50.5};
+  r.scenario.sim().set_electrode(truth, 0);
+  const machine::SimSphereProbe& sphere = r.scenario.sim().sphere_probe();
+  // About the drawing's axis, with B at 40°: the sphere is not where the touches are aimed, and
+  // the offsets come out wrong by as much (the sphere's true centre less the expected one).
+  const auto measure_at_40 = [&] {
+    r.scenario.must(Request::feature("electrode", "measure", ElectrodeMeasure{1, true, 40.0}));
+    EXPECT_TRUE(r.scenario.until([&] { return r.feature->phase() == ElectrodePhase::Idle; }, 60000));
+    return r.feature->last().value_or(ElectrodeResult{});
+  };
+  const ElectrodeResult nominal = measure_at_40();
+  ASSERT_TRUE(nominal.ok) << nominal.message;
+  EXPECT_EQ(r.scenario.status().servo.commanded[Axis::B], 40.0);
+  const Point3 expected = sphere_centre_at(r.feature->sphere(), 40);
+  double off = 0;
+  for (std::size_t i = 0; i < 3; ++i) {
+    const double error = sphere.centre()[i] - expected[i];
+    EXPECT_NEAR(nominal.offset[i] - truth[i], error, 0.001) << "axis " << i;
+    off = std::hypot(off, error);
+  }
+  // 2·sin 20° of the 19 µm between the axes, and the tilt: 13.5 µm.
+  EXPECT_GT(off, 0.010) << "the drawing's axis puts the turned sphere this far off";
+  // B's axis measured: the same measurement at 40° lands on the sphere where it really is.
+  r.scenario.sim().set_electrode(truth, 0);
+  ASSERT_TRUE(calibrate_b(r, {-40, 0, 40}).ok);
+  const ElectrodeResult measured = measure_at_40();
+  ASSERT_TRUE(measured.ok) << measured.message;
+  const Point3 now = sphere_centre_at(r.feature->sphere(), 40);
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_NEAR(now[i], sphere.centre()[i], 0.001)
+        << "the sphere where the measured axis turns it, axis " << i;
+    EXPECT_NEAR(measured.offset[i], truth[i], 0.001) << "axis " << i;
+  }
+}
+
+TEST(ElectrodeSetting, CalibrateBWithTheSphereNotWhereTheDrawingsAxisTurnsItChangesNothing) {
+  // The drawing's axis 5 mm off the true one: at 40° the sphere is 3.4 mm from where it is looked
+  // for, and that angle's touch fails; the calibration ends with its reason and the angle.
+  Rig r(edm_profile(fast_then_slow({"probe.reference_sphere.b_axis=[100.0, -165.0]",
+                                    "probe.reference_sphere.sim.b_axis=[100.0, -170.0]"})));
+  r.scenario.sim().set_electrode({0, 0, 50}, 0);
+  EventCursor log(r.scenario.rig().controller().events());
+  const BAxisResult c = calibrate_b(r, {0, 40, -40});
+  EXPECT_FALSE(c.ok);
+  EXPECT_EQ(c.centres.size(), 1u) << "B at 0 is where the profile's position holds";
+  EXPECT_EQ(c.code.rfind("electrode.", 0), 0u) << c.code;
+  EXPECT_EQ(c.message.rfind("with B at 40°: ", 0), 0u) << c.message;
+  EXPECT_EQ(r.feature->sphere().b_axis, (std::array<double, 2>{100.0, -165.0})) << "the axis unchanged";
+  EXPECT_EQ(r.feature->phase(), ElectrodePhase::Idle);
+  bool noted = false;
+  for (const ControllerEvent& e : log.next(1 << 16))
+    noted |= e.kind == ControllerEventKind::Note && e.code == c.code &&
+             e.text.find("calibrate-b") != std::string::npos;
+  EXPECT_TRUE(noted);
+}
+
+TEST(ElectrodeSetting, CalibrateBRefusesWhatItCannotMeasure) {
+  Rig r(edm_profile(b_axis_off_nominal()));
+  const auto refused = [&](std::vector<double> angles) {
+    return !r.scenario.ask(Request::feature("electrode", "calibrate-b", BAxisCalibrate{1, std::move(angles)}))
+                .accepted;
+  };
+  EXPECT_TRUE(refused({0, 40})) << "two angles fix no circle";
+  EXPECT_TRUE(refused({0, 40, 40})) << "nor three with two alike";
+  Rig without(edm_profile(fast_then_slow()));  // no nominal axis to look for the sphere about
+  const Outcome o =
+      without.scenario.ask(Request::feature("electrode", "calibrate-b", BAxisCalibrate{1, {-40, 0, 40}}));
+  EXPECT_FALSE(o.accepted);
+  EXPECT_NE(o.message.find("b_axis"), std::string::npos) << o.message;
+  const Outcome at =
+      without.scenario.ask(Request::feature("electrode", "measure", ElectrodeMeasure{1, true, 30.0}));
+  EXPECT_FALSE(at.accepted) << "B's axis unknown: only at b";
+  EXPECT_EQ(r.feature->phase(), ElectrodePhase::Idle);
 }
 
 TEST(ElectrodeSetting, AMissingSphereIsRefusedAndNothingStored) {

@@ -2,7 +2,7 @@
 // The compensation screen's logic: the set-compensation command from the admin's inputs (checked
 // before anything is sent), the points' positions, and the plot.
 import { describe, expect, it } from "vitest";
-import { compensationCommand, plotSvg, positionsOf, spacing, type CompensationAxis } from "./screens/compensation";
+import { compensationCommand, nextRow, plotSvg, positionsOf, spacing, type CompensationAxis } from "./screens/compensation";
 
 const x: CompensationAxis = {
   axis: "X",
@@ -16,6 +16,14 @@ const x: CompensationAxis = {
   max_points: 256,
 };
 const rows = (f: string[], r: string[]) => f.map((v, i) => ({ forward: v, reverse: r[i] }));
+const y: CompensationAxis = {
+  ...x,
+  axis: "Y",
+  table: { positions: [0, 40, 100], forward: [0, -0.002, -0.005], reverse: [0.01, 0.008, 0.005], one_table: false },
+  comp_file: "y.comp",
+  comp_file_type: 0,
+};
+const points = (p: string[]) => p.map((position) => ({ forward: "0", reverse: "0", position }));
 
 describe("compensation", () => {
   it("sends both directions as numbers, and start and interval only when they changed", () => {
@@ -57,5 +65,30 @@ describe("compensation", () => {
     expect(svg).toContain('points="48.0,76.0 ');
     expect(svg).toMatch(/190\.0,\d+\.\d"\/>/);
     expect(plotSvg([], [], [], "mm")).not.toContain("polyline");
+  });
+  it("a comp file's points: their own positions, sent only when they changed, and increasing", () => {
+    expect(compensationCommand(y, { start: "", interval: "", rows: points(["0", "40", "100"]) })).toEqual({
+      kind: "set-compensation",
+      axis: "Y",
+      forward: [0, 0, 0],
+      reverse: [0, 0, 0],
+    });
+    expect(compensationCommand(y, { start: "", interval: "", rows: points(["0", "50", "100", "130"]) })).toEqual({
+      kind: "set-compensation",
+      axis: "Y",
+      forward: [0, 0, 0, 0],
+      reverse: [0, 0, 0, 0],
+      positions: [0, 50, 100, 130],
+    });
+    expect(compensationCommand(y, { start: "", interval: "", rows: points(["0", "100", "100"]) })).toBe(
+      "Y point 3, position: must be greater than point 2's (100)",
+    );
+    expect(compensationCommand(y, { start: "", interval: "", rows: points(["0", ""]) })).toBe("Y point 2, position: a value is needed");
+    expect(positionsOf({ start: "", interval: "", rows: points(["0", "40", "100"]) })).toEqual([0, 40, 100]);
+  });
+  it("adds a comp file's point one interval beyond the last", () => {
+    expect(nextRow(points(["0", "40", "100"]), true)).toEqual({ forward: "0", reverse: "0", position: "160" });
+    expect(nextRow(points(["5"]), true).position).toBe("6");
+    expect(nextRow(rows(["0.1"], ["0.2"]), false)).toEqual({ forward: "0.1", reverse: "0.2" });
   });
 });

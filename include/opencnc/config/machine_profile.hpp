@@ -67,6 +67,9 @@ struct CompensationProfile {
   std::vector<double> reverse;     ///< error moving in − (== forward for one table)
   bool one_table = false;          ///< written as `errors` (both directions), not forward/reverse
   std::string comp_file;           ///< the LinuxCNC comp file the table came from, as written; "" none
+  int comp_file_type = 0;          ///< comp_file_type: 0 positions reached, 1 trims (−error)
+  std::string comp_path;           ///< comp_file resolved against the profile's folder
+  std::uint64_t comp_digest = 0;   ///< text_digest() of the comp file's text as loaded
 };
 
 /// One axis (= one joint: joints are numbered in axis order X Y Z A B C U V W).
@@ -128,13 +131,22 @@ struct ReferenceSphereProfile {
   int touches_around = 4;      ///< touches around the equator (≥ 4), then one from above
   double tolerance = 0.002;    ///< largest |residual| of the fit
   double max_deviation = 1.0;  ///< largest change of the offsets from the table's (the sphere "too far")
+  /// B's axis of rotation as the machine's drawing gives it, or as `opencnc calibrate-b` measured
+  /// it: the line along the unit vector `b_axis_direction` (about Y) that crosses the plane of
+  /// the sphere's centre (Y = position's) at X, Z `b_axis`. +B turns right-handed about it. The
+  /// electrode setting reads it to find the sphere at any B (absent: only at `b_deg`).
+  bool has_b_axis = false;
+  std::array<double, 2> b_axis{};
+  std::array<double, 3> b_axis_direction{0, 1, 0};
   bool sim = false;            ///< the simulated probe touches this sphere
   double sim_hysteresis = 0.0005;
   double sim_noise = 0.0002;
-  /// The simulated sphere turns with B (a machine with B): about the line parallel to Y through
-  /// machine X, Z `sim_b_axis` (the true axis; `position` is its centre with B at `b_deg`).
+  /// The simulated sphere turns with B (a machine with B): about the line along
+  /// `sim_b_direction` through machine X, Z `sim_b_axis` at the sphere's Y (the true axis, which
+  /// the controller does not know; `position` is its centre with B at `b_deg`).
   bool sim_turns_with_b = false;
   std::array<double, 2> sim_b_axis{};
+  std::array<double, 3> sim_b_direction{0, 1, 0};
 };
 
 struct ProbeProfile {

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "opencnc/config/machine_profile.hpp"
+#include "opencnc/config/profile_loader.hpp"
 #include "opencnc/core/diagnostic.hpp"
 
 namespace opencnc::config {
@@ -36,7 +37,8 @@ std::vector<EditableParameter> editable_parameters(const MachineProfile& profile
 
 /// True for a key of an axis' pitch-error table the admin may change through edit_profile():
 /// `axis.<a>.compensation.forward`, `.reverse` (one-line TOML arrays: the errors moving in + and
-/// in −, one per point), `.start`, `.interval` (the points' positions). Any thread.
+/// in −, one per point), `.start`, `.interval` (the points' positions), or for a table in a comp
+/// file `.positions` (one-line TOML array: each point's position). Any thread.
 bool is_pitch_table_key(std::string_view key);
 
 /// One key's change, as text for the audit and the answer ("100.0" → "80.0").
@@ -49,6 +51,9 @@ struct ProfileChange {
 struct ProfileEditResult {
   std::optional<MachineProfile> profile;
   std::string text;                    ///< the profile file's new text
+  /// Other files the change writes, with their new text (an axis' comp file); the loader checked
+  /// the profile with these texts in place of the files.
+  std::vector<FileText> files;
   std::vector<ProfileChange> changes;  ///< in the order asked
   std::string error;                   ///< a refusal of the request itself (a key not editable …)
   Diagnostics diagnostics;             ///< the loader's on the new text (`file:line:col: message`)
@@ -58,12 +63,14 @@ struct ProfileEditResult {
 /// The profile `live` (loaded from `live.source` with `live.overrides`) with `edits` applied: the
 /// file is read again and must still be the text `live` was loaded from (its digest); each key
 /// must be one of editable_parameters(live), or a pitch-table key (is_pitch_table_key) of an axis
-/// with `[axis.<a>.compensation]` whose table is not a comp file, and not set by an override; its
-/// line is edited with with_toml_value(). A table written as `errors` stays so while forward and
-/// reverse are equal; when they differ, `errors` gives way to `forward` and `reverse` (the
-/// section's comments stay). The new text is loaded by parse_profile() with the same overrides,
-/// so its errors are the loader's own, at the edited line. Nothing is written. Non-real-time
-/// (reads the file).
+/// with `[axis.<a>.compensation]`, and not set by an override; its line is edited with
+/// with_toml_value(). A table written as `errors` stays so while forward and reverse are equal;
+/// when they differ, `errors` gives way to `forward` and `reverse` (the section's comments stay).
+/// A table in a LinuxCNC comp file is written into that file instead (CompFileEdits: forward,
+/// reverse and positions; its comment lines stay), returned in `files`. The new text is loaded by
+/// parse_profile() with the same overrides and those files' new texts, so its errors are the
+/// loader's own, at the edited line (of the profile or of the comp file). Nothing is written.
+/// Non-real-time (reads the files).
 ProfileEditResult edit_profile(const MachineProfile& live, std::span<const ProfileKeyEdit> edits);
 
 }  // namespace opencnc::config

@@ -22,6 +22,14 @@ struct ProfileLoad {
   bool ok() const noexcept { return profile.has_value(); }
 };
 
+/// A file's text that stands in for the file on disk while a profile is parsed (an edit checked
+/// by the loader before it is written). `path` as the loader resolves it (the profile's folder
+/// joined with the name the profile gives).
+struct FileText {
+  std::string path;
+  std::string text;
+};
+
 /// Reads, overrides and validates the profile in `file`. Each override is `dotted.key=value`
 /// with a TOML value (a bare word is taken as a string), applied before validation and
 /// validated the same way; its diagnostics name the file `--set` and the line is the
@@ -30,10 +38,11 @@ struct ProfileLoad {
 ProfileLoad load_profile(const std::filesystem::path& file, std::span<const std::string> overrides = {});
 
 /// The same for profile text already in memory; `source_name` names it in diagnostics and
-/// relative paths are resolved against `base_dir`. Non-real-time; does not throw.
+/// relative paths are resolved against `base_dir`. A file the profile names (a comp file) whose
+/// path is among `files` is read from there, not from the disk. Non-real-time; does not throw.
 ProfileLoad parse_profile(std::string_view text, std::string_view source_name,
                           std::span<const std::string> overrides = {},
-                          const std::filesystem::path& base_dir = {});
+                          const std::filesystem::path& base_dir = {}, std::span<const FileText> files = {});
 
 /// The digest of a profile's text that MachineProfile::source_digest holds (FNV-1a, 64 bits).
 /// Any thread.

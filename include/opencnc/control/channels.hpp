@@ -5,6 +5,7 @@
 
 #include <array>
 #include <atomic>
+#include <cstdint>
 #include <type_traits>
 
 #include "opencnc/control/command.hpp"
@@ -16,15 +17,28 @@
 
 namespace opencnc::control {
 
+/// Which of a joint's two pitch buffers its tick reads: 0 or 1, or −1 for its configuration's own
+/// table (a servo just built). Written by the tick only (release), read by the controller (acquire).
+struct PitchBufferInUse {
+  std::atomic<std::int8_t> index{-1};
+};
+
 /// Pitch-error tables handed to the tick (an admin's edit): two buffers per joint, allocated once
-/// with the channels. The tick reads the buffer it switched to last (none at start: it uses its
-/// configuration's table); the controller writes only the other one, and only while no change is
-/// in flight, then names it in a StagePitchTable command: the command ring's release/acquire
-/// publishes the table with it. Once the tick has applied it (ApplyJointLimits accepted), the
-/// buffer it used before is the controller's to write. Plain data.
+/// with the channels. Ownership is published, not remembered: `reading[j]` names the buffer joint
+/// j's tick reads, and the controller writes only the other one, after reading `reading[j]` (so a
+/// controller that attaches to a tick that outlived the previous one never writes the table in
+/// use), and only while no change is in flight. It then names the buffer in a StagePitchTable
+/// command (the command ring's release/acquire publishes the table with it); the tick refuses a
+/// stage that names the buffer it reads. When the tick switches (ApplyJointLimits accepted) it
+/// publishes the new index; the buffer it read before is the controller's from then on. A new
+/// controller's set-up drops whatever a dead one staged and did not apply. Plain data and
+/// lock-free atomics.
 struct PitchTableArea {
   std::array<std::array<motion::PitchTable, 2>, motion::kMaxCompensatedJoints> joints{};
+  std::array<PitchBufferInUse, motion::kMaxCompensatedJoints> reading{};
 };
+
+static_assert(std::atomic<std::int8_t>::is_always_lock_free);
 
 /// Every queue has exactly one producer and one consumer:
 ///
@@ -37,7 +51,8 @@ struct PitchTableArea {
 /// | status     | servo tick                | controller |
 /// | trace      | servo tick (when enabled) | recorder   |
 ///
-/// and `pitch_tables` is written by the controller, read by the servo tick (PitchTableArea).
+/// and `pitch_tables`' buffers are written by the controller and read by the servo tick, which
+/// publishes in `pitch_tables.reading` the buffer it reads (PitchTableArea).
 /// About 4 MB; construct it on the heap or in shared memory (standard layout, lock-free atomics).
 struct ServoChannels {
   SpscRing<Command, 256> commands;

@@ -42,6 +42,13 @@ class Servo final : public Tickable {
   /// The compensation stage (its tables and corrections now). Servo thread, or any thread once
   /// the servo has stopped (tests in virtual time).
   const motion::Compensation& compensation() const noexcept { return comp_; }
+  /// Forgets joint limits and pitch tables staged and not applied (a controller that staged them
+  /// died before its ApplyJointLimits): the next apply takes only what is staged after this.
+  /// Servo thread (SharedServoHost, when a new controller's set-up arrives); real-time safe.
+  void drop_staged() noexcept {
+    staged_joints_ = staged_tables_ = 0;
+    staged_invalid_ = false;
+  }
 
  private:
   using Joints = std::array<double, machine::kMaxJoints>;

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "opencnc/config/machine_profile.hpp"
+#include "opencnc/config/profile_loader.hpp"
 #include "opencnc/control/channels.hpp"
 #include "opencnc/control/command.hpp"
 #include "opencnc/control/servo_config.hpp"
@@ -119,7 +120,7 @@ class Controller final : private FeatureHost {
   void edit_profile(std::uint64_t id, const requests::EditProfile& r);
   bool settle_profile_change(const ServoEvent& e);
   struct ProfileChange;
-  bool stage_pitch_table(int joint, const ServoConfig& next, ProfileChange& pending);
+  bool stage_pitch_table(int joint, const ServoConfig& next, const ProfileChange& pending);
   void swap_profile(config::MachineProfile profile);
   bool features_allow_start(std::uint64_t id, const StartCheck& start);
   bool features_allow_continue(const SyncCheck& sync);
@@ -200,17 +201,9 @@ class Controller final : private FeatureHost {
     std::uint64_t id = 0, stage_id = 0;
     config::MachineProfile old_profile;
     std::string old_text, message, who;
-    std::uint16_t tables = 0;  ///< bit j: joint j's new pitch table staged in its idle buffer
+    std::vector<config::FileText> old_files;  ///< other files the change wrote (a comp file), as they were
   };
   std::optional<ProfileChange> profile_change_;
-  /// The buffer of ServoChannels::pitch_tables each joint's tick reads (−1: its configuration's
-  /// table, as at start); the other one is the controller's to fill.
-  std::array<std::int8_t, motion::kMaxCompensatedJoints> pitch_buffer_ = filled_pitch_buffers();
-  static constexpr std::array<std::int8_t, motion::kMaxCompensatedJoints> filled_pitch_buffers() {
-    std::array<std::int8_t, motion::kMaxCompensatedJoints> a{};
-    for (std::int8_t& b : a) b = -1;
-    return a;
-  }
   std::uint32_t limits_version_ = 0;       ///< counts applied profile edits
   std::uint32_t open_limits_version_ = 0;  ///< limits_version_ when the open program was checked
   // Status details that cost strings, refreshed when they change.

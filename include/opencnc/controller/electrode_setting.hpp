@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "opencnc/controller/b_axis_fit.hpp"
 #include "opencnc/controller/observer.hpp"
 #include "opencnc/tools/tool_table_service.hpp"
 
@@ -85,6 +86,28 @@ struct ElectrodeMeasure {
   /// Store the offsets when the measurement passes its checks; false: keep them in last() until
   /// the operator has seen them and sends "write" (an HMI's confirmation).
   bool write = true;
+  /// Measure with B at this angle, where the profile's (or the last calibrate-b's) B axis turns
+  /// the sphere to; absent: at the profile's `b`.
+  std::optional<double> b_deg{};
+};
+
+/// `requests::Feature{"electrode", "calibrate-b", BAxisCalibrate{tool, angles}}`: B's axis of
+/// rotation from the sphere measured with `tool` at each angle (at least three distinct ones).
+struct BAxisCalibrate {
+  int tool = 0;
+  std::vector<double> angles_deg{};
+};
+
+/// What calibrate-b found.
+struct BAxisResult {
+  bool ok = false;
+  std::string code;  ///< "" when ok, else electrode.b-axis-fit or a measurement's code
+  std::string message;
+  int tool = 0;
+  std::vector<double> angles_deg;           ///< measured so far, in order
+  std::vector<Point3> centres;              ///< the fitted centre (sphere + electrode) at each
+  BAxisLine previous;                       ///< the axis the spheres were looked for about
+  BAxisFit fit;                             ///< when ok (and when the residual failed, what it was)
 };
 
 /// Where the main program stopped (aborted or faulted) before its end: what `resume` needs.
@@ -93,7 +116,7 @@ struct ProgramStop {
   Pose position{};               ///< the commanded position, machine coordinates
 };
 
-enum class ElectrodePhase : std::uint8_t { Idle, Measuring, Approaching, Resuming };
+enum class ElectrodePhase : std::uint8_t { Idle, Measuring, Approaching, Resuming, Calibrating };
 const char* to_string(ElectrodePhase p) noexcept;
 
 /// The feature "electrode". Actions: `measure` (args ElectrodeMeasure): the machine idle and
@@ -102,6 +125,10 @@ const char* to_string(ElectrodePhase p) noexcept;
 /// G10 L1's fields X Y Z) and a note `electrode.set` (or the error's code) says what was found;
 /// `write`: stores the last measurement's offsets when it passed, was not stored yet, and the
 /// tool's offsets in the table are still those it was measured against;
+/// `calibrate-b` (args BAxisCalibrate): the sphere measured at each B angle as `measure` does
+/// (nothing stored in the tool table), B's axis fitted (`fit_b_axis`), checked against the
+/// sphere's `tolerance` and kept for the measurements that follow (`sphere()`); a note
+/// `electrode.b-axis` says what was found (the caller writes it into the profile);
 /// `resume`: after a measurement, the main program that stopped before its end goes on — an
 /// approach to where it stopped, moved by the change of the measured tool's offsets (up to the
 /// safe height, over, down), then requests::ResumeProgram at its segment. Attach it with
@@ -121,11 +148,19 @@ class ElectrodeSetting final : public Feature {
   ElectrodePhase phase() const;
   std::optional<ElectrodeResult> last() const;
   /// The sphere as the profile gives it. Any thread.
-  const config::ReferenceSphereProfile& profile_sphere() const noexcept { return sphere_; }
+  const config::ReferenceSphereProfile& profile_sphere() const noexcept { return profile_sphere_; }
+  /// The sphere as measurements use it: the profile's, with B's axis from the last calibrate-b
+  /// that passed. Any thread.
+  config::ReferenceSphereProfile sphere() const;
+  std::optional<BAxisResult> last_b_axis() const;
   std::optional<ProgramStop> stop() const;
 
  private:
   Outcome measure(const ElectrodeMeasure& args, FeatureHost& host);
+  Outcome calibrate_b(const BAxisCalibrate& args, FeatureHost& host);
+  std::optional<Outcome> start_measurement(int tool, std::optional<double> b_deg, FeatureHost& host);
+  void next_calibration_angle(const ElectrodeResult& r);
+  void finish_calibration();
   Outcome resume(FeatureHost& host);
   Outcome write();
   bool store(ElectrodeResult& r);
@@ -137,7 +172,9 @@ class ElectrodeSetting final : public Feature {
   void set_phase(ElectrodePhase p);
 
   std::shared_ptr<tools::ToolTableService> tools_;
-  config::ReferenceSphereProfile sphere_;
+  config::ReferenceSphereProfile profile_sphere_;
+  config::ReferenceSphereProfile sphere_;  ///< with the calibrated B axis (guarded by mutex_)
+  config::ReferenceSphereProfile at_;      ///< the sphere where the measurement under way finds it
   AxisMask axes_;
   FeatureHost* host_ = nullptr;
 
@@ -154,6 +191,7 @@ class ElectrodeSetting final : public Feature {
   std::shared_ptr<const canon::Program> next_aux_;
   std::string next_aux_name_;
   std::uint64_t pending_ = 0;  ///< the request whose refusal ends what runs
+  BAxisResult calibration_;    ///< calibrate-b under way (phase Calibrating)
 
   // The main program: its segment at the commanded position while it runs, where it stopped.
   canon::SegmentId running_segment_ = 0;
@@ -166,6 +204,7 @@ class ElectrodeSetting final : public Feature {
   mutable std::mutex mutex_;  ///< guards what the accessors read
   ElectrodePhase phase_ = ElectrodePhase::Idle;
   std::optional<ElectrodeResult> last_;
+  std::optional<BAxisResult> last_b_;
   std::optional<ProgramStop> stop_;
 };
 

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <atomic>
+#include <condition_variable>
 #include <cstdint>
 #include <memory>
 #include <mutex>
@@ -64,12 +65,14 @@ class MachineHost {
   const control::LatencyHistogram* latency() const noexcept;
   /// A control of the simulated machine: "mains-off" (the mains fail: the power-fail stop),
   /// "mains-on", "electrode" (the electrode in the spindle, for the reference sphere). Applied by
-  /// the thread that steps the machine before its next period; "" or why not (in real time the
-  /// servo thread alone touches the machine: virtual time only). Any thread.
+  /// the thread that steps the machine before its next period, and returns once it is: a request
+  /// submitted afterwards meets the changed machine. "" or why not (in real time the servo thread
+  /// alone touches the machine: virtual time only). Any thread but the stepping one.
   std::string simulate(const SimulationEvent& event);
 
  private:
   void run_paced();
+  void apply_simulation_events();
   void run_controller();
 
   HostOptions options_;
@@ -84,7 +87,10 @@ class MachineHost {
   std::unique_ptr<control::SimRig> rig_;
   std::atomic<std::uint64_t> paced_ticks_{0};
   std::mutex simulate_mutex_;
+  std::condition_variable simulate_applied_cv_;
   std::vector<SimulationEvent> simulate_;  ///< events for the paced thread to apply
+  std::uint64_t simulate_queued_ = 0, simulate_applied_ = 0;  ///< counts, under simulate_mutex_
+  std::atomic<bool> simulate_pending_{false};                 ///< a cheap look before every period
 
   std::atomic<bool> stop_{false};
   std::thread thread_;  ///< the controller's loop (real time) or the paced rig

@@ -162,10 +162,12 @@ struct SimSphereTarget {
   double radius = 0;
   double hysteresis = 0.0005;  ///< once touching, the contact opens this far off the surface
   double noise = 0.0002;       ///< ± mm, uniform, per sample
-  /// The sphere turns with B (joint `b_joint`, −1: it does not) about the line parallel to Y
-  /// through X, Z `b_axis`; `centre` is where it is with B at `b_at_centre_deg`.
+  /// The sphere turns with B (joint `b_joint`, −1: it does not) about the line along the unit
+  /// vector `b_direction` (Y on a perfect machine) through X, Z `b_axis` at the centre's Y;
+  /// `centre` is where it is with B at `b_at_centre_deg`.
   int b_joint = -1;
   std::array<double, 2> b_axis{};
+  std::array<double, 3> b_direction{0, 1, 0};
   double b_at_centre_deg = 0;
 };
 

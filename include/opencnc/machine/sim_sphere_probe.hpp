@@ -28,8 +28,8 @@ class SimSphereProbe {
   }
   const std::array<double, 3>& offset() const noexcept { return offset_; }
   double tip_radius() const noexcept { return tip_radius_; }
-  /// B stands at `b_deg`: a sphere that turns with B has its centre turned about B's axis by
-  /// b_deg − b_at_centre_deg (right-handed about +Y: +B turns Z toward X).
+  /// B stands at `b_deg`: a sphere that turns with B has its centre turned about B's true axis
+  /// by b_deg − b_at_centre_deg (right-handed about its direction; about +Y, +B turns Z toward X).
   void turn(double b_deg) noexcept;
   /// The sphere's centre now, machine coordinates.
   const std::array<double, 3>& centre() const noexcept { return centre_; }

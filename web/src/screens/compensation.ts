@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The Compensation screen: each compensated axis' lead-screw (pitch-error) table as a table and a
-// plot, its backlash beside it; the admin changes points, directions, start and interval while
-// nothing runs (set-compensation: the profile's own checks, the tick takes the new table at rest).
+// plot, its backlash beside it; the admin changes points, directions, start and interval (or, for
+// a table in a LinuxCNC comp file, each point's position) while nothing runs (set-compensation:
+// the profile's own checks, the tick takes the new table at rest).
 import { registerScreen, type Context } from "../registry";
 import { button, el } from "../ui";
 import type { Outcome } from "../types";
@@ -16,15 +17,20 @@ export interface CompensationAxis {
   takeup_acceleration: number;
   table: { positions: number[]; forward: number[]; reverse: number[]; one_table: boolean } | null;
   comp_file: string | null;
+  comp_file_type?: number;
   editable: boolean;
   max_points: number;
 }
 
-/** What the admin typed: start, interval, and per point the errors moving in + and in −. */
+/**
+ * What the admin typed: start, interval, and per point the errors moving in + and in −; for a
+ * table in a comp file (points at any positions) each point's position instead of start and
+ * interval.
+ */
 export interface TableInputs {
   start: string;
   interval: string;
-  rows: { forward: string; reverse: string }[];
+  rows: { forward: string; reverse: string; position?: string }[];
 }
 
 function number(text: string, what: string): number | string {
@@ -59,6 +65,7 @@ export function compensationCommand(a: CompensationAxis, inputs: TableInputs): R
     reverse.push(b);
   }
   const body: Record<string, unknown> = { kind: "set-compensation", axis: a.axis, forward, reverse };
+  if (a.comp_file) return withPositions(a, inputs, body);
   const was = spacing(a);
   const start = number(inputs.start, `${a.axis} start`);
   if (typeof start === "string") return start;
@@ -70,8 +77,29 @@ export function compensationCommand(a: CompensationAxis, inputs: TableInputs): R
   return body;
 }
 
-/** The points of a table as they would be with `inputs`' start and interval (NaN where not a number). */
+/**
+ * A comp file's points: each row's position, increasing; sent only when they changed (the
+ * controller keeps the file's positions otherwise).
+ */
+function withPositions(a: CompensationAxis, inputs: TableInputs, body: Record<string, unknown>): Record<string, unknown> | string {
+  const positions: number[] = [];
+  for (const [i, r] of inputs.rows.entries()) {
+    const x = number(r.position ?? "", `${a.axis} point ${i + 1}, position`);
+    if (typeof x === "string") return x;
+    if (i > 0 && !(x > positions[i - 1])) return `${a.axis} point ${i + 1}, position: must be greater than point ${i}'s (${positions[i - 1]})`;
+    positions.push(x);
+  }
+  const was = a.table?.positions ?? [];
+  if (positions.length !== was.length || positions.some((x, i) => x !== was[i])) body.positions = positions;
+  return body;
+}
+
+/**
+ * The points of a table as they would be with `inputs`: each row's position for a comp file,
+ * else start + k·interval (NaN where not a number).
+ */
 export function positionsOf(inputs: TableInputs): number[] {
+  if (inputs.rows.some((r) => r.position !== undefined)) return inputs.rows.map((r) => Number(r.position));
   const s = Number(inputs.start);
   const d = Number(inputs.interval);
   return inputs.rows.map((_, k) => s + k * d);
@@ -114,6 +142,18 @@ export function plotSvg(positions: number[], forward: number[], reverse: number[
   ].join("");
 }
 
+/**
+ * The row "Add a point" appends: the last row's errors, and for a comp file a position one
+ * interval (the last two points' distance, else 1) beyond the last.
+ */
+export function nextRow(rows: TableInputs["rows"], compFile: boolean): TableInputs["rows"][number] {
+  const last = rows[rows.length - 1] ?? { forward: "0", reverse: "0", ...(compFile ? { position: "0" } : {}) };
+  if (!compFile) return { forward: last.forward, reverse: last.reverse };
+  const x = Number(last.position);
+  const step = rows.length > 1 ? x - Number(rows[rows.length - 2].position) : 1;
+  return { forward: last.forward, reverse: last.reverse, position: `${+(x + (step > 0 ? step : 1)).toFixed(6)}` };
+}
+
 /** One axis' section: backlash, the table of inputs, the plot, add/remove a point, apply. */
 class AxisTable {
   private inputs: TableInputs;
@@ -133,14 +173,18 @@ class AxisTable {
     this.inputs = {
       start: `${s.start}`,
       interval: `${s.interval || 50}`,
-      rows: (t?.forward ?? []).map((f, i) => ({ forward: `${f}`, reverse: `${t?.reverse[i] ?? f}` })),
+      rows: (t?.forward ?? []).map((f, i) => ({
+        forward: `${f}`,
+        reverse: `${t?.reverse[i] ?? f}`,
+        ...(a.comp_file ? { position: `${t?.positions[i] ?? 0}` } : {}),
+      })),
     };
   }
 
   mount(root: HTMLElement) {
     const a = this.a;
     const source = a.comp_file
-      ? `from the comp file ${a.comp_file} (edit that file, then restart)`
+      ? `in the LinuxCNC comp file ${a.comp_file} (type ${a.comp_file_type ?? 0}: written back there, comment lines kept)`
       : a.table?.one_table
         ? "one table for both directions"
         : a.table
@@ -160,7 +204,7 @@ class AxisTable {
       el("h3", {}, `Axis ${a.axis}`),
       el("p", { class: "hint" }, `Backlash ${a.backlash} ${a.unit} (Parameters screen), take-up ${a.takeup_velocity} ${a.unit}/s and ${a.takeup_acceleration} ${a.unit}/s²; ${source}.`),
       this.plot,
-      el("div", { class: "row" }, "start ", this.start, ` ${a.unit}, interval `, this.interval, ` ${a.unit}`),
+      a.comp_file ? "" : el("div", { class: "row" }, "start ", this.start, ` ${a.unit}, interval `, this.interval, ` ${a.unit}`),
       el("table", { class: "grid comp-table" }, el("thead", {}, head), this.body),
     );
     if (a.editable)
@@ -180,7 +224,7 @@ class AxisTable {
 
   private resize(by: number) {
     const rows = this.inputs.rows;
-    if (by > 0 && rows.length < this.a.max_points) rows.push({ ...(rows[rows.length - 1] ?? { forward: "0", reverse: "0" }) });
+    if (by > 0 && rows.length < this.a.max_points) rows.push(nextRow(rows, this.a.comp_file !== null));
     if (by < 0 && rows.length > 1) rows.pop();
     this.fill();
   }
@@ -199,7 +243,15 @@ class AxisTable {
           });
           return el("td", {}, input);
         };
-        return el("tr", {}, el("td", {}, `${i + 1}`), el("td", { class: "pos" }, ""), cell("forward"), cell("reverse"));
+        if (r.position === undefined)
+          return el("tr", {}, el("td", {}, `${i + 1}`), el("td", { class: "pos" }, ""), cell("forward"), cell("reverse"));
+        const at = el("input", { type: "number", step: "any", value: r.position, class: "num", "data-point": `${i}`, "data-dir": "position" });
+        at.disabled = !editable;
+        at.addEventListener("input", () => {
+          r.position = at.value;
+          this.draw();
+        });
+        return el("tr", {}, el("td", {}, `${i + 1}`), el("td", {}, at), cell("forward"), cell("reverse"));
       }),
     );
     this.draw();
