@@ -18,12 +18,13 @@ using machine::JointDrive;
 struct KindKeys {
   std::string_view linear, rotary;
 };
-constexpr std::array<KindKeys, 5> kKindKeys{{
+constexpr std::array<KindKeys, 6> kKindKeys{{
     {"mass_kg", "inertia_kg_m2"},
     {"peak_force_n", "peak_torque_nm"},
     {"coulomb_friction_n", "coulomb_friction_nm"},
     {"static_friction_n", "static_friction_nm"},
     {"viscous_friction_n_per_mm_s", "viscous_friction_nm_per_deg_s"},
+    {"friction_compensation_n", "friction_compensation_nm"},
 }};
 
 /// Defaults of a simulated axis: a 100 kg table on a ball screw, or a rotary table whose
@@ -307,6 +308,15 @@ void read_mechanics(Section& m, const AxisProfile& a, machine::SimJointModel& mo
                         key(2), show(model.coulomb_friction)),
             "config.range");
   }
+  // Above static friction the compensation alone would move the axis at a start.
+  model.friction_compensation = m.number_or(key(5), model.friction_compensation, Bound::NonNegative);
+  if (model.friction_compensation > model.static_friction) {
+    m.error(
+        key(5),
+        fmt::format("{} ({}) must not exceed {} ({}): it alone would break the axis away", m.key_path(key(5)),
+                    show(model.friction_compensation), key(3), show(model.static_friction)),
+        "config.range");
+  }
   const double units_per_si = a.rotary ? 180 / std::numbers::pi : 1000;
   const double reach = (model.peak_effort - model.coulomb_friction) / model.inertia * units_per_si;
   if (reach < a.max_acceleration) {
@@ -345,6 +355,14 @@ void read_drive(Section& m, const AxisProfile& a, double substep_s, machine::Sim
   model.current_bandwidth_hz =
       m.number_or("current_bandwidth_hz", model.current_bandwidth_hz, Bound::NonNegative);
   model.velocity_limit = m.number_or("velocity_limit", model.velocity_limit, Bound::NonNegative);
+  model.acceleration_feed_forward =
+      m.number_or("acceleration_feed_forward", model.acceleration_feed_forward, Bound::NonNegative);
+  if (model.acceleration_feed_forward > 1.5) {
+    m.error("acceleration_feed_forward",
+            fmt::format("{} must be between 0 and 1.5 (it is {})", m.key_path("acceleration_feed_forward"),
+                        show(model.acceleration_feed_forward)),
+            "config.range");
+  }
   if (model.feed_forward > 1.5) {
     m.error("feed_forward",
             fmt::format("{} must be between 0 and 1.5 (it is {})", m.key_path("feed_forward"),
@@ -373,6 +391,15 @@ void read_drive(Section& m, const AxisProfile& a, double substep_s, machine::Sim
         fmt::format("{} ({}) is too high for a {} Hz velocity loop (at most {})", m.key_path("position_gain"),
                     show(model.position_gain), show(model.velocity_bandwidth_hz), show(std::floor(max_kp))),
         "config.range");
+  }
+  // Both act through the velocity loop's integrator (sim_joint.cpp).
+  if ((model.friction_compensation > 0 || model.acceleration_feed_forward > 0) &&
+      model.velocity_integral_hz == 0) {
+    m.error("velocity_integral_hz",
+            fmt::format("{} is 0, but the friction compensation and the acceleration feed-forward act "
+                        "through the velocity loop's integrator",
+                        m.key_path("velocity_integral_hz")),
+            "config.range");
   }
   if (model.velocity_limit > 0 && model.velocity_limit < a.max_velocity) {
     m.warning("velocity_limit",
@@ -444,6 +471,8 @@ void read_sim_model(Section& axis_section, AxisProfile& a, double substep_s) {
              "coulomb_friction_nm",
              "static_friction_nm",
              "viscous_friction_nm_per_deg_s",
+             "friction_compensation_n",
+             "friction_compensation_nm",
              "position_gain",
              "position_integral",
              "feed_forward",
@@ -451,6 +480,7 @@ void read_sim_model(Section& axis_section, AxisProfile& a, double substep_s) {
              "velocity_integral_hz",
              "current_bandwidth_hz",
              "velocity_limit",
+             "acceleration_feed_forward",
              "backlash",
              "pitch_error",
              "feedback",

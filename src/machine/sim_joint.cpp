@@ -157,9 +157,65 @@ void SimJoint::begin_period(const JointOutputs& cmd, bool powered, double extern
     effort_ = 0;
     position_integral_ = 0;
     velocity_error_integral_ = 0;
+    command_direction_ = 0;
+    accel_ff_shift_ = 0;
+  } else if (config_.drive == JointDrive::Servo) {
+    compensate_friction();
+    feed_forward_acceleration();
   }
+  last_velocity_ff_ = cmd.velocity_ff;
   period_moving_ = false;
   period_done_ = integrate_period();
+}
+
+// A drive's friction compensation. Starting from rest, the velocity loop's integrator has to
+// build up the Coulomb friction from what it holds (nothing after a power-up) before the axis
+// follows, and axes whose friction is larger against their inertia lag longer: coupled axes
+// drift apart. So when the drive starts to move from rest or reverses, the integrator is
+// *set* to hold at least the friction in the new direction. Setting rather than adding makes
+// it bumpless: a standing torque the loop holds that way already (left from a deceleration) is
+// kept, never doubled, and nothing is added while the command keeps its direction. The
+// compensation stays below static friction, so by itself it does not move the axis.
+void SimJoint::compensate_friction() noexcept {
+  // The direction the drive wants to move: that of its velocity reference at the period's start
+  // (the command's velocity and the position loop's correction), once it is beyond what a few
+  // counts of following error ask for. An axis that overshot its end point and stuck starts
+  // back before the command rests, and the loop's dithering at standstill starts nothing.
+  constexpr double kDeadBandCounts = 4;
+  const SimJointModel& m = config_.model;
+  const double per_integral = velocity_gain_ * velocity_integral_;  // force per unit of the integral
+  if (m.friction_compensation <= 0 || per_integral <= 0) return;
+  const double error = cmd_.position - quantise_fast(feedback_raw());
+  const double reference = m.feed_forward * cmd_.velocity_ff + m.position_gain * error;
+  const double dead_band = m.position_gain * kDeadBandCounts * unit_per_count_;
+  const int direction = std::abs(reference) <= dead_band ? 0 : reference > 0 ? 1 : -1;
+  const bool start = direction != 0 && direction != command_direction_;
+  command_direction_ = direction;
+  if (!start) return;
+  const double comp = m.friction_compensation;
+  const double held = direction * velocity_error_integral_ * per_integral;  // in the new direction
+  // Standing within static friction the loop may hold friction only: the integrator is set to
+  // the compensation. Beyond it the loop holds a load (a weight) as well, which must stay: then
+  // it is moved by the compensation at most.
+  const bool friction_only = std::abs(held) <= m.static_friction;
+  const double change = friction_only ? comp - held : std::min(comp, comp - held);
+  if (change > 0) velocity_error_integral_ += direction * change / per_integral;
+}
+
+// Acceleration feed-forward: the drive derives the commanded acceleration from the change of
+// the velocity feed-forward over the period and adds inertia × acceleration to its force
+// command, so that the loops need no following error to accelerate or brake the axis (without
+// it the axis lags while accelerating and leads while braking, then overshoots its end point
+// and settles back against static friction: differently on each axis). Added to the force
+// command for one period, it is the same as a shift of the velocity integrator by
+// F / (Kv·ωi) that end_period() takes back — which keeps the period maps as they are.
+void SimJoint::feed_forward_acceleration() noexcept {
+  accel_ff_shift_ = 0;
+  const double per_integral = velocity_gain_ * velocity_integral_;
+  if (config_.model.acceleration_feed_forward <= 0 || per_integral <= 0) return;
+  const double accel = (cmd_.velocity_ff - last_velocity_ff_) / period_s_;
+  accel_ff_shift_ = config_.model.acceleration_feed_forward * accel / accel_per_effort_ / per_integral;
+  velocity_error_integral_ += accel_ff_shift_;
 }
 
 double SimJoint::energy_j() const noexcept {
@@ -552,6 +608,8 @@ void SimJoint::stepper_substep(int i) noexcept {
 }
 
 void SimJoint::end_period() noexcept {
+  velocity_error_integral_ -= accel_ff_shift_;
+  accel_ff_shift_ = 0;
   if (config_.drive == JointDrive::Stepper && !stepper_dynamic_) {
     velocity_ =
         static_cast<double>(steps_emitted_ - steps_at_period_start_) / config_.counts_per_unit / period_s_;

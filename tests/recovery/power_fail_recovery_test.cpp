@@ -272,10 +272,10 @@ TEST(PowerFailRecovery, RetractKeepsTheHelix) {
   ASSERT_TRUE(o.accepted) << o.message;
   EXPECT_EQ(after.journal->phase(), RecoveryPhase::Done) << after.journal->recovery_error();
   EXPECT_NEAR(after.rig->status().servo.commanded[Axis::Z], r.actual[Axis::Z] - 40.0, 1e-9);
-  // The drives break away from rest differently (static friction: C starts a few periods after
-  // Z): the helix error of the first 50 ms is that transient, measured apart.
-  constexpr int kBreakaway = 50;  // periods: 3.3 µm at the 11th, below 1 µm from the 34th
-  double worst_um = 0, breakaway_um = 0;
+  // The breakaway included: the drives' friction compensation puts the Coulomb friction into both
+  // velocity integrators at the start (empty after the power-up), so C does not lag Z while they
+  // build it (3.27 µm before; 0.14 µm measured, in the second period).
+  double worst_um = 0;
   int n = 0;
   for (const auto& row : after.samples->rows) {
     if (row.job != control::JobKind::Auxiliary) continue;
@@ -283,12 +283,11 @@ TEST(PowerFailRecovery, RetractKeepsTheHelix) {
         r.coupling.slave_origin + 360.0 * (row.z - r.coupling.master_origin) / r.coupling.pitch_mm;
     const double e = std::fabs(std::remainder(row.c - law, 360.0)) * std::numbers::pi / 180 *
                      after.profile.coupling.radius_mm * 1000;
-    (n < kBreakaway ? breakaway_um : worst_um) = std::max(n < kBreakaway ? breakaway_um : worst_um, e);
+    worst_um = std::max(worst_um, e);
     ++n;
   }
   EXPECT_GT(n, 3000);  // 40 mm at 10 mm/s
   EXPECT_LE(worst_um, 1.0);
-  EXPECT_LE(breakaway_um, 3.5);  // 3.27 µm measured: docs/broaching.md, "Known gaps"
   EXPECT_FALSE(after.journal->last_written()->valid);
 }
 

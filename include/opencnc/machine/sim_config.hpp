@@ -87,6 +87,13 @@ struct SimJointModel {
   double velocity_integral_hz = 30;    ///< velocity loop PI corner (0 = P velocity loop)
   double current_bandwidth_hz = 1000;  ///< current (force) loop first-order lag
   double velocity_limit = 0;           ///< drive velocity clamp, units/s (0 = none)
+  /// Friction compensation, N or N·m (0 = none): when the drive's velocity reference starts from
+  /// rest or reverses (beyond 4 counts' worth) the drive sets its velocity integrator to hold this
+  /// much in the new direction (set, not added: a standing torque it holds that way is kept).
+  double friction_compensation = 0;
+  /// Acceleration (torque) feed-forward, the fraction of inertia × the commanded velocity's change
+  /// per period the drive adds to its force command (0 = none, 1 = the whole inertia).
+  double acceleration_feed_forward = 0;
   // Transmission and feedback.
   double backlash = 0;                  ///< lost motion between motor and table, units
   std::vector<PitchPoint> pitch_error;  ///< sorted by position; empty = perfect screw

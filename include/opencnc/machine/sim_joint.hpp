@@ -122,6 +122,8 @@ class SimJoint {
   bool integrate_stepper_period() noexcept;
   void coast() noexcept;
   void integrate_hand_period() noexcept;
+  void compensate_friction() noexcept;
+  void feed_forward_acceleration() noexcept;
   void integrate_mechanics(double drive_effort) noexcept;
   void take_up_backlash() noexcept;
   void update_index(double before, double after) noexcept;
@@ -162,6 +164,9 @@ class SimJoint {
   // State.
   double motor_ = 0, velocity_ = 0, effort_ = 0, screw_ = 0;
   double position_integral_ = 0, velocity_error_integral_ = 0;
+  int command_direction_ = 0;    // sign of the last period's commanded velocity (friction compensation)
+  double last_velocity_ff_ = 0;  // the last period's commanded velocity (acceleration feed-forward)
+  double accel_ff_shift_ = 0;    // this period's feed-forward, as a shift of the velocity integrator
   std::int64_t steps_emitted_ = 0, steps_at_period_start_ = 0;
   double feedback_at_period_start_ = 0;
   double energy_j_ = 0;
