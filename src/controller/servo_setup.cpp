@@ -152,6 +152,53 @@ LoadGuardConfig load_guard_config(const config::MachineProfile& profile) {
   return g;
 }
 
+namespace {
+
+// The EDM's configuration field by field on zeroed bytes (a flag and small integers before
+// doubles leave padding that copies carry along), for shared_setup's byte-for-byte comparison.
+// A new field changes these sizes: copy it below too.
+static_assert(sizeof(machine::EdmCondition) == 168 && sizeof(machine::EdmConfig) == 40 + 32 * 168 + 8,
+              "a field was added to the EDM's configuration: copy it in plain_edm_config");
+void plain_edm_config(const machine::EdmConfig& e, machine::EdmConfig& out) {
+  std::memset(static_cast<void*>(&out), 0, sizeof out);
+  out.enabled = e.enabled;
+  out.tool_axis = e.tool_axis;
+  out.lift_direction = e.lift_direction;
+  out.orbit_axes[0] = e.orbit_axes[0];
+  out.orbit_axes[1] = e.orbit_axes[1];
+  out.path_spacing_mm = e.path_spacing_mm;
+  out.short_timeout_s = e.short_timeout_s;
+  out.condition_count = e.condition_count;
+  for (std::size_t i = 0; i < e.conditions.size() && static_cast<int>(i) < e.condition_count; ++i) {
+    const machine::EdmCondition& c = e.conditions[i];
+    machine::EdmCondition& o = out.conditions[i];
+    o.number = c.number;
+    o.on_time_us = c.on_time_us;
+    o.off_time_us = c.off_time_us;
+    o.peak_current_a = c.peak_current_a;
+    o.voltage_v = c.voltage_v;
+    o.polarity = c.polarity;
+    o.servo_reference_v = c.servo_reference_v;
+    o.gain_mm_s_per_v = c.gain_mm_s_per_v;
+    o.max_forward_mm_s = c.max_forward_mm_s;
+    o.max_retract_mm_s = c.max_retract_mm_s;
+    o.filter_s = c.filter_s;
+    o.short_timeout_s = c.short_timeout_s;
+    o.jump_height_mm = c.jump_height_mm;
+    o.jump_period_s = c.jump_period_s;
+    o.jump_speed_mm_s = c.jump_speed_mm_s;
+    o.jump_mode = c.jump_mode;
+    o.orbit = c.orbit;
+    o.orbit_radius_mm = c.orbit_radius_mm;
+    o.orbit_step_mm = c.orbit_step_mm;
+    o.orbit_period_s = c.orbit_period_s;
+    o.side_gap_mm = c.side_gap_mm;
+    o.electrode_wear_ratio = c.electrode_wear_ratio;
+  }
+}
+
+}  // namespace
+
 SharedSetup shared_setup(const config::MachineProfile& profile) {
   SharedSetup s;
   // Zeroed first, padding included: the tick compares set-ups byte for byte to keep its servo
@@ -205,6 +252,7 @@ SharedSetup shared_setup(const config::MachineProfile& profile) {
     out.max_velocity = c.max_velocity;
     out.max_acceleration = c.max_acceleration;
   }
+  plain_edm_config(servo.edm, s.servo.edm);
   const machine::MachineCapabilities caps =
       machine::SimMachine(config::sim_machine_config(profile)).capabilities();
   std::memcpy(static_cast<void*>(&s.capabilities), &caps, sizeof caps);

@@ -129,7 +129,10 @@ TEST(SharedMemory, RefusesAForeignOrOtherBuildSegment) {
 // A restarted controller hands over the same set-up byte for byte (padding included), so the tick
 // keeps its servo and the joints' homed state.
 TEST(SharedSetup, IsTheSameBytesForTheSameProfile) {
-  for (const config::MachineProfile& p : {mill(), drill()}) {  // the drill: pitch tables, backlash
+  // The drill: pitch tables, backlash; the EDM: its conditions (padding after flags and small
+  // integers, which ASan's filled allocations show).
+  const config::MachineProfile edm = loaded(config::load_profile(OPENCNC_SOURCE_DIR "/configs/edm-5axis.toml"));
+  for (const config::MachineProfile& p : {mill(), drill(), edm}) {
     const SharedSetup a = shared_setup(p), b = shared_setup(p);
     const auto* pa = reinterpret_cast<const unsigned char*>(&a);
     const auto* pb = reinterpret_cast<const unsigned char*>(&b);
