@@ -105,6 +105,21 @@ class ProfileEditFile : public ::testing::Test {
     live_ = *load.profile;
   }
   void TearDown() override { std::filesystem::remove_all(dir_); }
+  /// A copy of configs/<name>.toml and its tool table in a folder of its own (`tag`), loaded.
+  void copy_profile(const std::string& tag, const std::string& name) {
+    dir_ = std::filesystem::temp_directory_path() / (tag + "-" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir_);
+    for (const std::string& f : {name + ".toml", name + ".tbl"})
+      std::filesystem::copy_file(std::string(OPENCNC_SOURCE_DIR "/configs/") + f, dir_ / f);
+    path_ = (dir_ / (name + ".toml")).string();
+    std::ifstream in(path_);
+    std::stringstream s;
+    s << in.rdbuf();
+    original_ = s.str();
+    ProfileLoad load = load_profile(path_);
+    ASSERT_TRUE(load.ok());
+    live_ = *load.profile;
+  }
   std::filesystem::path dir_;
   std::string path_, original_;
   MachineProfile live_;
@@ -172,20 +187,7 @@ TEST(TomlEdit, AKeyIsRemovedWithItsLineOnly) {
 /// The drill's profile: X's pitch table written as `errors` (both directions), Y's per direction.
 class ProfileEditTable : public ProfileEditFile {
  protected:
-  void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() / ("opencnc-table-edit-" + std::to_string(::getpid()));
-    std::filesystem::create_directories(dir_);
-    for (const char* f : {"drill-retrofit.toml", "drill-retrofit.tbl"})
-      std::filesystem::copy_file(std::string(OPENCNC_SOURCE_DIR "/configs/") + f, dir_ / f);
-    path_ = (dir_ / "drill-retrofit.toml").string();
-    std::ifstream in(path_);
-    std::stringstream s;
-    s << in.rdbuf();
-    original_ = s.str();
-    ProfileLoad load = load_profile(path_);
-    ASSERT_TRUE(load.ok());
-    live_ = *load.profile;
-  }
+  void SetUp() override { copy_profile("opencnc-table-edit", "drill-retrofit"); }
 };
 
 TEST_F(ProfileEditTable, EqualDirectionsKeepTheOneTableAndItsComments) {
@@ -414,20 +416,7 @@ TEST(TomlEdit, AnElementThatIsNotWrittenUnderAHeaderOfItsOwnIsRefused) {
 /// The EDM's profile (four conditions) and its tool table in a directory of their own.
 class ProfileEditConditions : public ProfileEditFile {
  protected:
-  void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() / ("opencnc-condition-edit-" + std::to_string(::getpid()));
-    std::filesystem::create_directories(dir_);
-    for (const char* f : {"edm-5axis.toml", "edm-5axis.tbl"})
-      std::filesystem::copy_file(std::string(OPENCNC_SOURCE_DIR "/configs/") + f, dir_ / f);
-    path_ = (dir_ / "edm-5axis.toml").string();
-    std::ifstream in(path_);
-    std::stringstream s;
-    s << in.rdbuf();
-    original_ = s.str();
-    ProfileLoad load = load_profile(path_);
-    ASSERT_TRUE(load.ok());
-    live_ = *load.profile;
-  }
+  void SetUp() override { copy_profile("opencnc-condition-edit", "edm-5axis"); }
 };
 
 TEST_F(ProfileEditConditions, AConditionsFieldsChangeInItsElementAndTheAuditSaysWhichAndHow) {
