@@ -51,6 +51,7 @@ void SharedServoHost::take_setup() noexcept {
     machine_->set_capabilities(setup_.capabilities);
     guard_.refresh_capabilities();
     servo_ = new (storage_) Servo(setup_.servo, segment_->channels, guard_);
+    ++servos_built_;
   } else {
     servo_->drop_staged();
   }

@@ -181,7 +181,8 @@ TEST(SharedServoHost, ASilentControllerStopsTheMachineAndANewOneTakesOver) {
   ASSERT_TRUE(rig.ask(Request::set_mode(Mode::Manual)).accepted);
   ASSERT_TRUE(rig.ask(Request::jog(Axis::X, 30)).accepted);
   rig.until([] { return false; }, 400);
-  const Servo* servo_before = rig.host_->servo();
+  const std::uint64_t built_before = rig.host_->servos_built();
+  ASSERT_EQ(built_before, 1u);
   ASSERT_GT(rig.backend_.sim().joint(0).velocity(), 25.0);
 
   rig.beating = false;
@@ -204,7 +205,7 @@ TEST(SharedServoHost, ASilentControllerStopsTheMachineAndANewOneTakesOver) {
 
   rig.beating = true;
   rig.attach();
-  EXPECT_EQ(rig.host_->servo(), servo_before);  // same set-up: the servo (and its state) stayed
+  EXPECT_EQ(rig.host_->servos_built(), built_before);  // same set-up: the servo (and its state) stayed
   rig.until([&] { return rig.status().state == State::Faulted; }, 10);
   EXPECT_EQ(rig.status().fault.kind, FaultKind::PowerLoss);
   ASSERT_TRUE(rig.ask(Request::simple(CommandKind::Reset)).accepted);

@@ -30,6 +30,9 @@ class SharedServoHost final : public Tickable {
   bool running() const noexcept { return servo_ != nullptr; }
   /// The servo (running() only). Servo thread.
   const Servo* servo() const noexcept { return servo_; }
+  /// How many servos were built from set-ups so far (an identical set-up keeps the servo: the
+  /// count stays). Servo thread.
+  std::uint64_t servos_built() const noexcept { return servos_built_; }
   /// Periods without a heartbeat before the machine stops. Servo thread.
   void set_heartbeat_timeout(std::uint32_t ticks) noexcept { watch_.set_timeout(ticks); }
   /// Servo thread.
@@ -44,6 +47,7 @@ class SharedServoHost final : public Tickable {
   HeartbeatGuard guard_;
   SharedSetup setup_{};  ///< the set-up the servo was built from
   Servo* servo_ = nullptr;
+  std::uint64_t servos_built_ = 0;
   alignas(Servo) unsigned char storage_[sizeof(Servo)];
 };
 
