@@ -59,6 +59,17 @@ fi
 echo "== build with AddressSanitizer + UndefinedBehaviorSanitizer (warnings are errors)"
 cmake --preset asan >/dev/null
 cmake --build --preset asan -j "$build_jobs"
+fuzz=0
+compgen -G "fuzz/*/CMakeLists.txt" >/dev/null && fuzz=1
+if ((fuzz)); then
+  # The fuzz targets (the G-code libraries again, with clang) build at the lowest priority but one
+  # beside the suite and the end-to-end test, which leave a core idle much of the time (tests that
+  # wait on timers, the browser, halrun); their log follows the end-to-end test.
+  fuzz_log=$(mktemp)
+  (cmake --preset fuzz >/dev/null && nice -n 18 cmake --build --preset fuzz -j "$jobs") >"$fuzz_log" 2>&1 &
+  fuzz_build=$!
+  trap 'kill "$fuzz_build" 2>/dev/null || true; rm -f "$fuzz_log"' EXIT
+fi
 echo "== test suite under ASan + UBSan"
 # Each conformance program forks an instrumented opencnc and rs274 (five minutes for all 615 under
 # ASan): every tenth of them runs here and all of them in `--quick`; the interpreter itself runs
@@ -68,16 +79,6 @@ echo "== test suite under ASan + UBSan"
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 ctest --preset asan -j "$jobs" -E 'Conformance[.]Program/'
 ctest --preset asan -j "$jobs" -R 'Conformance[.]Program/' -I ,,10
-fuzz=0
-compgen -G "fuzz/*/CMakeLists.txt" >/dev/null && fuzz=1
-if ((fuzz)); then
-  # The fuzz targets (the G-code libraries again, with clang) build at low priority beside the
-  # end-to-end test, which mostly waits on the browser and the machine; their log follows it.
-  fuzz_log=$(mktemp)
-  (cmake --preset fuzz >/dev/null && nice -n 15 cmake --build --preset fuzz -j "$jobs") >"$fuzz_log" 2>&1 &
-  fuzz_build=$!
-  trap 'kill "$fuzz_build" 2>/dev/null || true; rm -f "$fuzz_log"' EXIT
-fi
 echo "== HMI front end: build, unit tests, end to end in headless Chromium (the sanitized opencnc)"
 scripts/hmi.sh --test --e2e --opencnc build-asan/opencnc
 
