@@ -191,6 +191,28 @@ TEST(Coupling, TheDemoJobsPassTheBroachsPreflight) {
   }
 }
 
+/// The broach on the simulated machine with a power-fail recorder attached, `program` started
+/// in Auto (with flood coolant on: a process running), ready for the mains to fail.
+struct PowerFailRun {
+  PowerFailRun(const config::MachineProfile& p, const std::string& program, bool flood)
+      : rig(p, GcodeProgramSource::create(p, diags)),
+        recorder(std::make_shared<PowerFailRecorder>(coupling_config(p.coupling), machine_limits(p),
+                                                     p.servo_period_s, p.coupling.radius_mm)) {
+    rig.controller().attach(recorder, ObserverOptions{p.servo_period_s, true});
+    rig.step();
+    EXPECT_TRUE(rig.request(Request::simple(CommandKind::MachineOn)).accepted);
+    if (flood) {
+      EXPECT_TRUE(rig.request(Request::coolant(Coolant::Flood, true)).accepted);
+    }
+    EXPECT_TRUE(rig.request(Request::set_mode(Mode::Auto)).accepted);
+    EXPECT_TRUE(rig.request(Request::open(program), 100000).accepted);
+    EXPECT_TRUE(rig.request(Request::simple(CommandKind::CycleStart)).accepted);
+  }
+  Diagnostics diags;
+  SimRig rig;
+  std::shared_ptr<PowerFailRecorder> recorder;
+};
+
 // Fault injection: the mains fail at instants through the constant-pitch demo job (cutting,
 // lifting, returning at rapid). Within a period the spindle and the coolant are off; Z stops on the
 // path with C held to the law (≤ 1 µm of helix error at the bore, feedback included), where each
@@ -198,18 +220,9 @@ TEST(Coupling, TheDemoJobsPassTheBroachsPreflight) {
 TEST(Coupling, PowerFailStopsOnTheHelix) {
   const config::MachineProfile p = broach();
   for (const double cut_s : {1.7, 3.2, 5.05, 9.4}) {
-    Diagnostics d;
-    SimRig rig(p, GcodeProgramSource::create(p, d));
-    auto recorder = std::make_shared<PowerFailRecorder>(coupling_config(p.coupling), machine_limits(p),
-                                                        p.servo_period_s, p.coupling.radius_mm);
-    rig.controller().attach(recorder, ObserverOptions{p.servo_period_s, true});
-    rig.step();
-    ASSERT_TRUE(rig.request(Request::simple(CommandKind::MachineOn)).accepted);
-    ASSERT_TRUE(rig.request(Request::coolant(Coolant::Flood, true)).accepted);  // the process runs
-    ASSERT_TRUE(rig.request(Request::set_mode(Mode::Auto)).accepted);
-    ASSERT_TRUE(
-        rig.request(Request::open(OPENCNC_SOURCE_DIR "/examples/broach-constant.ngc"), 100000).accepted);
-    ASSERT_TRUE(rig.request(Request::simple(CommandKind::CycleStart)).accepted);
+    PowerFailRun run(p, OPENCNC_SOURCE_DIR "/examples/broach-constant.ngc", true);  // the process runs
+    ASSERT_FALSE(HasFailure()) << cut_s;
+    SimRig& rig = run.rig;
     ASSERT_TRUE(rig.run_until([&] { return rig.status().servo.time_s >= cut_s; }, 20000));
     ASSERT_TRUE(rig.status().servo.flood);
     rig.machine().set_mains_ok(false);
@@ -221,7 +234,7 @@ TEST(Coupling, PowerFailStopsOnTheHelix) {
     ASSERT_TRUE(rig.run_until([&] { return rig.status().servo.state == State::Faulted; }, 5000)) << cut_s;
     EXPECT_EQ(rig.status().servo.fault.kind, FaultKind::PowerLoss);
     EXPECT_FALSE(rig.status().servo.drives_enabled);
-    const PowerFailReport r = recorder->report();
+    const PowerFailReport r = run.recorder->report();
     ASSERT_TRUE(r.happened && r.coupled) << cut_s;
     EXPECT_LE(r.coupled_error_um, 1.0) << cut_s;
     EXPECT_LT(r.coupled_command_error_um, 1e-3) << cut_s;
@@ -240,23 +253,15 @@ TEST(Coupling, APowerFailWhileTheAxesSettleAfterAReturnStaysOnTheHelix) {
   const std::string program = write_program(
       "G21 G90 G94 G64 P0.005\nG0 X-0.5\nG0 Z100 C0\nG4 P0.3\nM171 P600\nG0 Z-10\nG1 X0.1 F60\nM175\nM2\n");
   auto stop_error_um = [&](const config::MachineProfile& p) {
-    Diagnostics d;
-    SimRig rig(p, GcodeProgramSource::create(p, d));
-    auto recorder = std::make_shared<PowerFailRecorder>(coupling_config(p.coupling), machine_limits(p),
-                                                        p.servo_period_s, p.coupling.radius_mm);
-    rig.controller().attach(recorder, ObserverOptions{p.servo_period_s, true});
-    rig.step();
-    EXPECT_TRUE(rig.request(Request::simple(CommandKind::MachineOn)).accepted);
-    EXPECT_TRUE(rig.request(Request::set_mode(Mode::Auto)).accepted);
-    EXPECT_TRUE(rig.request(Request::open(program), 100000).accepted);
-    EXPECT_TRUE(rig.request(Request::simple(CommandKind::CycleStart)).accepted);
+    PowerFailRun run(p, program, false);
+    SimRig& rig = run.rig;
     EXPECT_TRUE(rig.run_until([&] { return rig.status().servo.commanded[Axis::Z] < 0; }, 20000));
     // The command ends its return; 10 ms later the axes creep back from their overshoot.
     EXPECT_TRUE(rig.run_until([&] { return rig.status().servo.commanded[Axis::Z] <= -10 + 1e-9; }, 2000));
     rig.run(10);
     rig.machine().set_mains_ok(false);
     EXPECT_TRUE(rig.run_until([&] { return rig.status().servo.state == State::Faulted; }, 5000));
-    const PowerFailReport r = recorder->report();
+    const PowerFailReport r = run.recorder->report();
     EXPECT_TRUE(r.happened && r.coupled);
     return r.coupled_error_um;
   };

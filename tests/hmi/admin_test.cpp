@@ -115,12 +115,12 @@ TEST(ApiAdmin, SetParametersIsTheAdminsAndBecomesAnEditProfileRequest) {
   EXPECT_EQ(r.name(), "edit-profile");
 }
 
-/// The drill, its profile (X's table one for both ways, Y's per direction) a copy the admin may edit.
-struct DrillRig : ServerRig {
-  DrillRig() : ServerRig(options()) {}
-  static RigOptions options() {
+/// A machine whose profile is a copy (with its tool table) the admin may edit, with a history.
+struct EditableRig : ServerRig {
+  explicit EditableRig(const char* machine) : ServerRig(options(machine)) {}
+  static RigOptions options(const char* machine) {
     RigOptions o;
-    o.machine = "drill-retrofit.toml";
+    o.machine = machine;
     o.profile_copy = true;
     o.history = true;
     return o;
@@ -128,7 +128,7 @@ struct DrillRig : ServerRig {
 };
 
 TEST(AdminCompensation, TheOperatorReadsTheTablesOnlyTheAdminChangesThem) {
-  DrillRig rig;
+  EditableRig rig("drill-retrofit.toml");  // X's table one for both ways, Y's per direction
   const Reply list = get(rig.port, "/api/v1/compensation", kOperator);
   ASSERT_EQ(list.status, 200) << list.text;
   ASSERT_EQ(list.body["axes"].size(), 2u);
@@ -165,7 +165,7 @@ TEST(AdminCompensation, TheOperatorReadsTheTablesOnlyTheAdminChangesThem) {
 }
 
 TEST(AdminCompensation, ABadTableGetsTheProfilesMessageAndNothingChanges) {
-  DrillRig rig;
+  EditableRig rig("drill-retrofit.toml");  // X's table one for both ways, Y's per direction
   const Reply steep = post(
       rig.port,
       R"({"kind":"set-compensation","axis":"y","forward":[0,0,0,0,0,0,0,0,2],"reverse":[0,0,0,0,0,0,0,0,0]})",
@@ -200,7 +200,7 @@ TEST(AdminCompensation, ABadTableGetsTheProfilesMessageAndNothingChanges) {
 // live table and the audit; positions that do not increase get the loader's message at the comp
 // file's line; start and interval are refused; nothing changed.
 TEST(AdminCompensation, ATableInACompFileIsWrittenThere) {
-  RigOptions o = DrillRig::options();
+  RigOptions o = EditableRig::options("drill-retrofit.toml");
   o.edit_copy = [](const std::string& text, const std::filesystem::path& dir) {
     EXPECT_TRUE(write_file_atomically((dir / opencnc::test::kDrillYCompName).string(),
                                       opencnc::test::kDrillYComp, nullptr));
@@ -276,20 +276,8 @@ TEST(AdminConditions, AnEdmsConditionsAreListedInTheProfilesOrder) {
   EXPECT_EQ(get(rig.port, "/api/v1/conditions", "").status, 401);
 }
 
-/// The EDM, its profile a copy (with its tool table) the admin may edit.
-struct EdmRig : ServerRig {
-  EdmRig() : ServerRig(options()) {}
-  static RigOptions options() {
-    RigOptions o;
-    o.machine = "edm-5axis.toml";
-    o.profile_copy = true;
-    o.history = true;
-    return o;
-  }
-};
-
 TEST(AdminConditions, TheOperatorReadsThemOnlyTheAdminChangesThemAndTheChangeIsAudited) {
-  EdmRig rig;
+  EditableRig rig("edm-5axis.toml");
   const json fields = get(rig.port, "/api/v1/conditions", kOperator).body["fields"];
   ASSERT_EQ(fields.size(), 19u);
   EXPECT_EQ(fields[0], (json{{"key", "on_time_us"}, {"unit", "µs"}, {"what", "pulse on-time"}}));
@@ -318,7 +306,7 @@ TEST(AdminConditions, TheOperatorReadsThemOnlyTheAdminChangesThemAndTheChangeIsA
 }
 
 TEST(AdminConditions, ABadValueGetsTheProfilesMessageAndABusyMachineIsRefusedAndNothingChanges) {
-  EdmRig rig;
+  EditableRig rig("edm-5axis.toml");
   const Reply bad =
       post(rig.port, R"({"kind":"set-conditions","condition":1,"values":{"servo_reference_v":150}})", kAdmin);
   ASSERT_EQ(bad.status, 409) << bad.text;

@@ -126,6 +126,18 @@ TEST(SimJoint, FeedForwardRemovesSteadyFollowingError) {
   EXPECT_LT(max_late, 2e-4);  // vs v/Kp = 1.7 mm without feed-forward
 }
 
+/// A ramp from rest at `accel` (mm/s²) over `periods`: the largest following error, each
+/// period's position against where the ramp stands at the period's end.
+double ramp_error(JointRig& rig, double accel, int periods) {
+  double worst = 0;
+  for (int k = 0; k < periods; ++k) {
+    const double t = k * kPeriod;
+    rig.period(0.5 * accel * t * t, accel * t);
+    worst = std::max(worst, std::abs(0.5 * accel * (t + kPeriod) * (t + kPeriod) - rig.in.position));
+  }
+  return worst;
+}
+
 // Following error while accelerating emerges from the loops: the feed-forward velocity is
 // held over the period while the needed velocity ramps on, and the velocity loop must build
 // the force m·a through its error. It is proportional to the acceleration (a linear system),
@@ -136,13 +148,7 @@ TEST(SimJoint, FollowingErrorDuringAccelerationFollowsGains) {
     c.model.position_gain = kp;
     c.model.feed_forward = ff;
     JointRig rig(c);
-    double worst = 0;
-    for (int k = 0; k < 300; ++k) {
-      const double t = k * kPeriod;
-      rig.period(0.5 * accel * t * t, accel * t);
-      worst = std::max(worst, std::abs(0.5 * accel * (t + kPeriod) * (t + kPeriod) - rig.in.position));
-    }
-    return worst;
+    return ramp_error(rig, accel, 300);
   };
   const double base = max_error(1000, 60, 1);
   EXPECT_GT(base, 1e-3);  // microns, not a constant zero
@@ -160,13 +166,7 @@ TEST(SimJoint, AccelerationFeedForwardGivesTheForceAtTheStartOfAnAcceleration) {
     SimJointConfig c = servo_config();
     c.model.acceleration_feed_forward = ka;
     JointRig rig(c, linear_periods);
-    double worst = 0;
-    for (int k = 0; k < 5; ++k) {
-      const double t = k * kPeriod;
-      rig.period(0.5 * 1000 * t * t, 1000 * t);
-      worst = std::max(worst, std::abs(0.5 * 1000 * (t + kPeriod) * (t + kPeriod) - rig.in.position));
-    }
-    return worst;
+    return ramp_error(rig, 1000, 5);
   };
   const double without = max_error(0, true);
   const double with = max_error(1, true);
@@ -179,13 +179,7 @@ TEST(SimJoint, AccelerationFeedForwardGivesTheForceAtTheStartOfAnAcceleration) {
 double breakaway_error(SimJointConfig c, double friction_compensation) {
   c.model.friction_compensation = friction_compensation;
   JointRig rig(c);
-  double worst = 0;
-  for (int k = 0; k < 50; ++k) {
-    const double t = k * kPeriod;
-    rig.period(0.5 * 200 * t * t, 200 * t);
-    worst = std::max(worst, std::abs(0.5 * 200 * (t + kPeriod) * (t + kPeriod) - rig.in.position));
-  }
-  return worst;
+  return ramp_error(rig, 200, 50);
 }
 
 // After a power-up the velocity integrator holds nothing and must build the Coulomb friction out
