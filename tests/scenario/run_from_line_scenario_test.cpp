@@ -125,11 +125,6 @@ TEST(RunFromLineScenario, LinesWithoutAMovePastTheEndOrAfterAnInputAreRefused) {
   EXPECT_EQ(r.run_from(2).refusal, Refusal::WrongMode);
 }
 
-}  // namespace
-}  // namespace opencnc::control::test
-
-namespace opencnc::control::test {
-namespace {
 
 // The approach's last leg runs at the line's move's feed per minute: under G93 the move's own
 // (length × F), under G95 F × the spindle speed set before it; a G95 line under G96 (no rpm known)
@@ -163,11 +158,6 @@ TEST(RunFromLineScenario, TheApproachFeedIsPerMinuteUnderInverseTimeAndPerRevolu
       << why;
 }
 
-}  // namespace
-}  // namespace opencnc::control::test
-
-namespace opencnc::control::test {
-namespace {
 
 constexpr const char* kTwoTools =
     "G21 G90 G94 F600\n"  // 1
@@ -318,11 +308,6 @@ TEST(RunFromLineScenario, TheControllerAnswersWhileTheScanRunsAndNothingStarts) 
   EXPECT_NEAR(s.status().servo.commanded[Axis::X], 10.0, 1e-9);
 }
 
-}  // namespace
-}  // namespace opencnc::control::test
-
-namespace opencnc::control::test {
-namespace {
 
 // A G10 L1 before the line is written to the table when the program runs, not when it is
 // scanned: the scan reads the live table and writes a copy of its own, dropped before the next.
