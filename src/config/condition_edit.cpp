@@ -61,11 +61,7 @@ std::span<const ConditionField> condition_fields() {
   return kFields;
 }
 
-std::string condition_field_text(const machine::EdmCondition& c, std::string_view field) {
-  static constexpr const char* orbits[] = {"none", "circle", "square", "star"};
-  if (field == "polarity") return c.polarity > 0 ? "+" : "-";
-  if (field == "jump_mode") return c.jump_mode == machine::JumpMode::Path ? "path" : "axis";
-  if (field == "orbit") return orbits[static_cast<std::size_t>(c.orbit)];
+std::optional<double> condition_field_number(const machine::EdmCondition& c, std::string_view field) {
   const std::pair<std::string_view, double> numbers[] = {
       {"on_time_us", c.on_time_us},
       {"off_time_us", c.off_time_us},
@@ -85,8 +81,17 @@ std::string condition_field_text(const machine::EdmCondition& c, std::string_vie
       {"orbit_period_s", c.orbit_period_s},
   };
   for (const auto& [name, v] : numbers)
-    if (name == field) return toml_number(v);
-  return "";
+    if (name == field) return v;
+  return std::nullopt;
+}
+
+std::string condition_field_text(const machine::EdmCondition& c, std::string_view field) {
+  static constexpr const char* orbits[] = {"none", "circle", "square", "star"};
+  if (field == "polarity") return c.polarity > 0 ? "+" : "-";
+  if (field == "jump_mode") return c.jump_mode == machine::JumpMode::Path ? "path" : "axis";
+  if (field == "orbit") return orbits[static_cast<std::size_t>(c.orbit)];
+  const std::optional<double> v = condition_field_number(c, field);
+  return v ? toml_number(*v) : "";
 }
 
 bool is_condition_key(std::string_view key) {

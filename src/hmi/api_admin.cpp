@@ -231,31 +231,18 @@ std::string condition_value_toml(const std::string& key, const json& value, Para
 }  // namespace
 
 json conditions_json(const config::MachineProfile& profile) {
-  static constexpr const char* orbits[] = {"none", "circle", "square", "star"};
   json list = json::array();
   const machine::EdmConfig& edm = profile.edm.config;
   for (int k = 0; profile.edm.present && k < edm.condition_count; ++k) {
     const machine::EdmCondition& c = edm.conditions[static_cast<std::size_t>(k)];
-    list.push_back({{"number", c.number},
-                    {"on_time_us", c.on_time_us},
-                    {"off_time_us", c.off_time_us},
-                    {"peak_current_a", c.peak_current_a},
-                    {"voltage_v", c.voltage_v},
-                    {"polarity", c.polarity > 0 ? "+" : "-"},
-                    {"servo_reference_v", c.servo_reference_v},
-                    {"gain_mm_s_per_v", c.gain_mm_s_per_v},
-                    {"max_forward_mm_s", c.max_forward_mm_s},
-                    {"max_retract_mm_s", c.max_retract_mm_s},
-                    {"filter_s", c.filter_s},
-                    {"short_timeout_s", c.short_timeout_s},
-                    {"jump_height_mm", c.jump_height_mm},
-                    {"jump_period_s", c.jump_period_s},
-                    {"jump_speed_mm_s", c.jump_speed_mm_s},
-                    {"jump_mode", c.jump_mode == machine::JumpMode::Path ? "path" : "axis"},
-                    {"orbit", orbits[static_cast<std::size_t>(c.orbit)]},
-                    {"orbit_radius_mm", c.orbit_radius_mm},
-                    {"orbit_step_mm", c.orbit_step_mm},
-                    {"orbit_period_s", c.orbit_period_s}});
+    json condition = {{"number", c.number}};
+    for (const config::ConditionField& f : config::condition_fields()) {
+      if (f.choices != nullptr)
+        condition[f.key] = config::condition_field_text(c, f.key);
+      else
+        condition[f.key] = *config::condition_field_number(c, f.key);
+    }
+    list.push_back(std::move(condition));
   }
   json fields = json::array();
   for (const config::ConditionField& f : config::condition_fields()) {

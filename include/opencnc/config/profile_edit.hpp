@@ -58,6 +58,10 @@ std::span<const ConditionField> condition_fields();
 /// "circle"); "" for a field that is not editable. Any thread.
 std::string condition_field_text(const machine::EdmCondition& c, std::string_view field);
 
+/// The numeric field `field` of `c`; nullopt for a choice (condition_field_text gives its word)
+/// or a field that is not editable. Any thread.
+std::optional<double> condition_field_number(const machine::EdmCondition& c, std::string_view field);
+
 /// True for a key of a machining condition the admin may change through edit_profile():
 /// `edm.condition.<number>.<field>`, a field of condition_fields(). Any thread.
 bool is_condition_key(std::string_view key);
