@@ -85,6 +85,10 @@ traj::TickInput Servo::program_inputs() noexcept {
   in.spindle_at_speed = spindle_at_speed() && !spindle_change_pending();
   in.spindle_revs = in_.spindle.position_rev;
   in.spindle_rev_s = in_.spindle.speed_rpm / 60.0;
+  if (power_stop_) {
+    choose_stop_scale();
+    in.abort_decel_scale = stop_scale_;
+  }
   return in;
 }
 

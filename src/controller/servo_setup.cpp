@@ -98,6 +98,8 @@ ServoConfig servo_config(const config::MachineProfile& profile) {
     j.max_velocity = a.max_velocity - r.velocity;
     j.max_acceleration = a.max_acceleration - r.acceleration;
     j.max_jerk = a.max_jerk;
+    // The compensation may still take its reserve while the path brakes at its peak.
+    j.peak_deceleration = std::max(j.max_acceleration, a.peak_deceleration - r.acceleration);
     j.min_limit = a.min_limit;
     j.max_limit = a.max_limit;
     j.max_following_error = a.max_following_error;
@@ -133,6 +135,11 @@ ServoConfig servo_config(const config::MachineProfile& profile) {
   s.spindle_max_rpm = profile.spindle.present ? profile.spindle.max_rpm : 0.0;
   s.coupling = coupling_config(profile.coupling);
   s.load_guard = load_guard_config(profile);
+  if (profile.power.monitor && profile.power.dc_link_capacitance_f > 0) {
+    s.power_stop.dc_link_capacitance_f = profile.power.dc_link_capacitance_f;
+    s.power_stop.dc_link_min_v = profile.power.sim.dc_link_min_v;
+    s.power_stop.dc_link_idle_power_w = profile.power.dc_link_idle_power_w;
+  }
   s.edm = profile.edm.config;
   return s;
 }

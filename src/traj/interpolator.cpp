@@ -102,7 +102,10 @@ void Interpolator::step_piece(const TickInput& in, const MotionBlock& b, std::si
 
   double v_tgt = target_speed(in, b);
   if (aborting_ || (hold_ && (b.flags & kFeedHoldAllowed) != 0)) v_tgt = 0;
-  double a = std::clamp((v_tgt - v) / tau, -A, A);
+  // An abort may brake harder than the block's budget (a power-fail stop short of energy); the
+  // junction limits below keep the budget, so they never ask for more than the plan did.
+  const double a_min = aborting_ ? -A * std::max(1.0, in.abort_decel_scale) : -A;
+  double a = std::clamp((v_tgt - v) / tau, a_min, A);
   const bool follow = b.feed_class == FeedClass::SpindleSync && !aborting_;
   if (follow) a = sync_acceleration(b, tau);
   const double a_follow = a;
@@ -149,7 +152,7 @@ void Interpolator::step_piece(const TickInput& in, const MotionBlock& b, std::si
     const std::size_t si = index_of(stop_seq_);
     if (si < avail) limit(queue_->peek(si).brake_prefix - c_s, si == index + 1, 0.0);
   }
-  a = std::clamp(a, -A, A);
+  a = std::clamp(a, a_min, A);
   // Braking for a limit ahead (the end of the thread): the motion leaves the spindle.
   if (follow && sync_ == Sync::Locked && a < a_follow - 1e-9 * A) sync_ = Sync::CatchUp;
 
@@ -409,6 +412,9 @@ void Interpolator::fill_output(TickOutput& out, double s_prev) noexcept {
                    b.segment_offset};
   }
   out.path_velocity = (s_f_ - s_prev) / config_.period_s;
+  const std::size_t u_index = index_of(u_seq_);
+  out.path_acceleration =
+      u_index < avail && queue_->peek(u_index).kind != BlockKind::Marker ? queue_->peek(u_index).accel : 0.0;
   out.state = state_;
   write_shown(out);
   out.spindle_synced = sync_ == Sync::Locked;

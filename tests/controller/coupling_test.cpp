@@ -243,6 +243,50 @@ TEST(Coupling, PowerFailStopsOnTheHelix) {
   }
 }
 
+// The stop shortened by the DC link's energy. The mains cut while a stroke cuts (3.2 s, Z at
+// 3 m/min) and during a rapid return (14.2 s, 9 m/min), the UPS's battery empty so that the link
+// alone feeds the drives. With broach-zc's 4.7 mF (361 J above 400 V) the stop is as planned;
+// with 40 µF (2.9 J) the planned stop would drain the link before rest (the drives trip on
+// undervoltage: an amplifier fault, the axes coasting), so the tick brakes harder — 1.87 times
+// the planned deceleration on the stroke, the peak decelerations' bound of 4 on the return — and
+// the axes rest on the helix with energy left.
+TEST(Coupling, APowerFailOnANearlyEmptyDcLinkBrakesHarderAndStaysOnTheHelix) {
+  const std::vector<std::string> empty_ups = {"power.sim.ups_runtime_s=0"};
+  auto cut = [&](std::vector<std::string> sets, double cut_s) {
+    PowerFailRun run(broach(sets), OPENCNC_SOURCE_DIR "/examples/broach-constant.ngc", false);
+    SimRig& rig = run.rig;
+    EXPECT_TRUE(rig.run_until([&] { return rig.status().servo.time_s >= cut_s; }, 20000));
+    rig.machine().set_mains_ok(false);
+    EXPECT_TRUE(rig.run_until([&] { return rig.status().servo.state == State::Faulted; }, 5000));
+    return std::pair{run.recorder->report(), rig.status().servo.fault.kind};
+  };
+  std::vector<std::string> small = empty_ups;
+  small.push_back("power.dc_link_capacitance_f=0.00004");
+  std::vector<std::string> no_margin = small;
+  no_margin.insert(no_margin.end(), {"axis.z.peak_deceleration=1500", "axis.c.peak_deceleration=3600"});
+  for (const double cut_s : {3.2, 14.2}) {
+    const auto [normal, normal_fault] = cut(empty_ups, cut_s);
+    const auto [with_ups, ups_fault] = cut({}, cut_s);
+    EXPECT_EQ(normal.decel_scale, 1.0) << cut_s;  // enough energy: the stop as planned, bit for bit
+    EXPECT_EQ(normal.stop_distance_mm, with_ups.stop_distance_mm) << cut_s;
+    EXPECT_EQ(normal.coupled_error_um, with_ups.coupled_error_um) << cut_s;
+    EXPECT_GT(normal.energy_at_signal_j, 350.0) << cut_s;
+    const auto [short_stop, short_fault] = cut(small, cut_s);
+    EXPECT_EQ(short_fault, FaultKind::PowerLoss) << cut_s;  // at rest, the drives still powered
+    EXPECT_GT(short_stop.decel_scale, 1.5) << cut_s;
+    EXPECT_LE(short_stop.decel_scale, 4.0) << cut_s;  // Z 6000 / 1500, C 14400 / 3600
+    EXPECT_LT(short_stop.stop_distance_mm, 0.6 * normal.stop_distance_mm) << cut_s;
+    EXPECT_LT(short_stop.stop_time_s, normal.stop_time_s) << cut_s;
+    EXPECT_GT(short_stop.energy_at_rest_j, 0.0) << cut_s;
+    EXPECT_GE(short_stop.dc_link_min_v, 400.0) << cut_s;
+    EXPECT_LE(short_stop.coupled_error_um, 1.0) << cut_s;
+    EXPECT_LT(short_stop.coupled_command_error_um, 1e-3) << cut_s;
+    const auto [planned, planned_fault] = cut(no_margin, cut_s);  // no peak above the plan
+    EXPECT_EQ(planned.decel_scale, 1.0) << cut_s;
+    EXPECT_EQ(planned_fault, FaultKind::AmpFault) << cut_s;  // undervoltage before rest
+  }
+}
+
 // The 100-cut sweep's outlier (3.18 µm, the mains cut 10–40 ms after a rapid return arrived,
 // while X fed in): the stop had nothing to stop; the drives had overshot the return's end point
 // by a few µm and stuck, and crept back — Z first, C 40 ms later, its friction being larger

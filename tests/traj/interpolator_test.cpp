@@ -229,6 +229,31 @@ TEST(Interpolator, AbortStopsUnderControlAndDropsTheQueue) {
   EXPECT_EQ(rig.step().state, RunState::Aborted);
 }
 
+// A power-fail stop short of energy: the abort brakes at the scale times the block's budget, so
+// it rests in 1/scale of the time and distance; the scale is ignored while not aborting, and the
+// path's budget is reported for the servo's estimate.
+TEST(Interpolator, AnAbortBrakesAtItsDecelerationScale) {
+  auto stop = [](double scale) {
+    Rig rig;
+    rig.publish(plan({line(at(0), at(100), 100, 1000, 0), marker(MarkerKind::ProgramEnd)}));
+    rig.in.abort_decel_scale = scale;  // not aborting yet: no effect on the acceleration
+    for (int i = 0; i < 300; ++i) rig.step();
+    EXPECT_EQ(rig.trace.back().path_acceleration, 1000.0);
+    EXPECT_LE(rig.max_accel_x(), 1000.0 * (1 + 1e-6));
+    const double x0 = rig.trace.back().position[0];
+    rig.in.abort = true;
+    const int ticks = rig.run_until(RunState::Aborted);
+    EXPECT_LE(rig.max_accel_x(), 1000.0 * std::max(1.0, scale) * (1 + 1e-6));
+    return std::pair{ticks, rig.trace.back().position[0] - x0};
+  };
+  const auto [t1, d1] = stop(1.0);
+  const auto [t3, d3] = stop(3.0);
+  EXPECT_NEAR(d1, 100.0 * 100.0 / (2 * 1000.0), 0.1);  // v²/2a from 100 mm/s
+  EXPECT_NEAR(d3, d1 / 3, 0.1);
+  EXPECT_LT(t3, t1 / 2);
+  EXPECT_EQ(stop(0.5), stop(1.0));  // never softer than planned
+}
+
 TEST(Interpolator, StopsAtTheEndOfTheQueuedDataAndGoesOnWhenMoreArrives) {
   Rig rig;
   std::vector<MotionBlock> blocks =

@@ -37,6 +37,9 @@ struct TickInput {
   bool spindle_at_speed = true;  ///< spindle at its commanded speed (for SpindleWait markers)
   double spindle_revs = 0;       ///< spindle encoder position, revolutions (G33)
   double spindle_rev_s = 0;      ///< spindle speed, revolutions per second (G95, G33)
+  /// While aborting, the path brakes at up to this many times each block's acceleration budget
+  /// (≥ 1; the servo raises it when the drives' DC link would not last the normal stop). Level.
+  double abort_decel_scale = 1.0;
 };
 
 /// What the interpolator is doing.
@@ -66,6 +69,9 @@ struct TickEvent {
 struct TickOutput {
   Pose position{};           ///< commanded position of every axis (mm, degrees)
   double path_velocity = 0;  ///< ds/dt of the commanded position (s-units/s)
+  /// The acceleration budget of the block the generator is in (s-units/s², 0 when none): the
+  /// normal deceleration a stop on the path brakes at (the servo's power-fail stop estimates by it).
+  double path_acceleration = 0;
   RunState state = RunState::Idle;
   std::uint64_t block_seq = 0;      ///< block at the commanded position
   std::uint64_t segment = 0;        ///< canon segment id of the move being executed
