@@ -222,7 +222,8 @@ int main(int argc, char** argv) {
   const std::uint64_t ticks = host.ticks() - ticks0, overruns = host.overruns() - overruns0;
   const auto stats = server.stats();
   const auto* lat = host.latency();
-  const auto finished = c.status().runs_finished;
+  const auto last = c.status();
+  const auto finished = last.runs_finished;
   accounting.stop();
   std::vector<control::OverrunRecord> log = clock ? clock->overrun_log() : std::vector<control::OverrunRecord>{};
   log.erase(log.begin(), log.begin() + static_cast<std::ptrdiff_t>(std::min<std::uint64_t>(logged0, log.size())));
@@ -257,8 +258,9 @@ int main(int argc, char** argv) {
               clients ? static_cast<double>(sum) / clients / wall : 0.0, static_cast<double>(bytes) / 1e6);
   std::printf("stalled clients: %d connected, %llu dropped by the server\n", stalled_closed,
               static_cast<unsigned long long>(stats.dropped));
-  std::printf("programs finished: %llu; process CPU %.2f s (%.0f %% of one core)\n",
-              static_cast<unsigned long long>(finished), cpu, 100 * cpu / wall);
+  std::printf("programs finished: %llu, the last at %.0f %% (line %u)%s%s; process CPU %.2f s (%.0f %% of one core)\n",
+              static_cast<unsigned long long>(finished), 100 * last.progress, last.location.line,
+              last.fault_text.empty() ? "" : ", fault: ", last.fault_text.c_str(), cpu, 100 * cpu / wall);
   print_accounting(accounting, log, ticks, list_overruns);
   return 0;
 }
