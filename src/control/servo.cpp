@@ -437,6 +437,7 @@ void Servo::fill_status(ServoStatus& s) const noexcept {
   s.mains_ok = in_.power.mains_ok;
   s.on_battery = in_.power.ups_on_battery;
   s.dc_link_v = in_.power.dc_link_v;
+  s.coupling_wait = activity_ == Activity::Program && tick_out_.waiting_in_position;
   s.dc_link_energy_j = dc_link_energy_j();
   s.stop_decel_scale = stop_scale_;
   s.fault = fault_;

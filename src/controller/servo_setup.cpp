@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <numbers>
 
 #include "opencnc/machine/sim_machine.hpp"
 
@@ -272,6 +273,9 @@ motion::CouplingConfig coupling_config(const config::CouplingProfile& c) {
   out.master_axis = static_cast<std::int8_t>(index(c.master));
   out.slave_axis = static_cast<std::int8_t>(index(c.slave));
   out.source = c.from_actual ? motion::CouplingSource::Actual : motion::CouplingSource::Command;
+  out.engage_tolerance_master = c.engage_tolerance_um / 1000;                                        // mm
+  out.engage_tolerance_slave = c.engage_tolerance_um / 1000 / c.radius_mm * 180 / std::numbers::pi;  // deg
+  out.engage_timeout_s = c.engage_timeout_s;
   const std::size_t n = std::min<std::size_t>(c.tables.size(), motion::kMaxCouplingTables);
   for (std::size_t t = 0; t < n; ++t) {
     const config::CouplingTableProfile& tp = c.tables[t];

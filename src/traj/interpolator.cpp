@@ -334,6 +334,10 @@ void Interpolator::update_waiting(const TickInput& in) noexcept {
   switch (m.marker) {
     case MarkerKind::Dwell:
       state_ = RunState::Dwelling;
+      if ((m.flags & kWaitInPosition) != 0 && !in.in_position) {
+        waiting_in_position_ = true;  // the drives still settle: the marker's action must wait
+        break;
+      }
       if (dwell_ticks_left_ == 0 || --dwell_ticks_left_ == 0) release_marker();
       break;
     case MarkerKind::ProgramStop:
@@ -421,6 +425,7 @@ void Interpolator::fill_output(TickOutput& out, double s_prev) noexcept {
   out.sync_lost = sync_lost_;
   out.tap_reverse = false;
   out.tap_speed_scale = 1;
+  out.waiting_in_position = waiting_in_position_;
 }
 
 // The commanded position and the block shown there.
@@ -439,6 +444,7 @@ void Interpolator::write_shown(TickOutput& out) const noexcept {
 void Interpolator::tick(const TickInput& in, TickOutput& out) noexcept {
   ++ticks_;
   out.event_count = 0;
+  waiting_in_position_ = false;
   if (state_ == RunState::Aborted || state_ == RunState::Finished) {
     const double s_now = s_f_;
     fill_output(out, s_now);

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -33,6 +34,7 @@ class HelixWatch final : public ControllerObserver {
  public:
   explicit HelixWatch(motion::CouplingConfig c) : config_(c) {}
   void on_status(const ControllerStatus& s) override {
+    waited_in_position = waited_in_position || s.servo.coupling_wait;
     const CouplingStatus& c = s.servo.coupling;
     if (c.kind == motion::CouplingKind::Off) return;
     ++coupled;
@@ -59,6 +61,7 @@ class HelixWatch final : public ControllerObserver {
   std::vector<motion::CouplingKind> kinds;
   double command_error_deg = 0, actual_error_deg = 0;
   bool backwards = false;
+  bool waited_in_position = false;  ///< a coupling code waited for the drives (status coupling_wait)
 
  private:
   motion::CouplingConfig config_;
@@ -241,6 +244,51 @@ TEST(Coupling, PowerFailStopsOnTheHelix) {
     EXPECT_GT(r.independent_error_um, 10 * std::max(r.coupled_error_um, 1.0)) << cut_s;
     EXPECT_GT(r.stop_distance_mm, 0.0) << cut_s;
   }
+}
+
+// The law engages on settled drives. Indexing C by 180° uncoupled (as between the demo jobs'
+// grooves) leaves C overshooting by 0.05° when its command rests; a law that took C then would
+// hold it to that command while the drive still settles: 35 µm of helix error at the bore during
+// the X infeed after M171. The code waits until Z and C stand within [coupling]
+// engage_tolerance_um (0.25 µm) of their commands: the error after it stays within 1 µm.
+TEST(Coupling, TheLawEngagesOnSettledDrives) {
+  const std::string program =
+      "G21 G90 G94 G64 P0.005\nG0 X-0.5\nG0 Z-10 C180\nM171 P600\nG1 X0.1 F60\nM175\nM2\n";
+  auto helix_um = [](const CoupledRun& r) {
+    return r.watch->actual_error_deg * std::numbers::pi / 180 * 40e3;
+  };
+  const CoupledRun settled = run(program);
+  ASSERT_TRUE(settled.opened.accepted) << messages(settled.opened);
+  EXPECT_TRUE(settled.watch->waited_in_position);
+  EXPECT_GT(settled.watch->coupled, 500u);
+  EXPECT_LE(helix_um(settled), 1.0);
+  const CoupledRun at_once = run(program, broach({"coupling.engage_tolerance_um=0"}));  // no wait
+  EXPECT_FALSE(at_once.watch->waited_in_position);
+  EXPECT_GT(helix_um(at_once), 10.0);
+}
+
+// The wait is bounded: a drive that does not settle within engage_timeout_s (here 10 ms, C needs
+// about 80) stops the run with a fault that names it.
+TEST(Coupling, ADriveThatDoesNotSettleStopsTheRunWithAFault) {
+  const config::MachineProfile p = broach({"coupling.engage_timeout_s=0.01"});
+  Diagnostics d;
+  SimRig rig(p, GcodeProgramSource::create(p, d));
+  rig.step();
+  ASSERT_TRUE(rig.request(Request::simple(CommandKind::MachineOn)).accepted);
+  ASSERT_TRUE(rig.request(Request::set_mode(Mode::Auto)).accepted);
+  ASSERT_TRUE(
+      rig.request(Request::open(write_program("G21 G90\nG0 Z-10 C180\nM171 P600\nG1 Z50 F3000\nM2\n")),
+                  100000)
+          .accepted);
+  ASSERT_TRUE(rig.request(Request::simple(CommandKind::CycleStart)).accepted);
+  ASSERT_TRUE(rig.run_until([&] { return rig.status().servo.state == State::Faulted; }, 20000));
+  const ControllerStatus s = rig.status();
+  EXPECT_EQ(s.servo.fault.kind, FaultKind::CouplingPosition);
+  EXPECT_EQ(s.servo.fault.axis, index(Axis::C));
+  EXPECT_GT(s.servo.fault.value, s.servo.fault.limit);
+  EXPECT_NE(s.fault_text.find("engage_tolerance_um"), std::string::npos) << s.fault_text;
+  EXPECT_EQ(s.servo.coupling.kind, motion::CouplingKind::Off);  // the law never took the axes
+  EXPECT_NEAR(s.servo.actual[Axis::Z], -10.0, 0.01);            // the stroke never started
 }
 
 // The stop shortened by the DC link's energy. The mains cut while a stroke cuts (3.2 s, Z at

@@ -254,6 +254,38 @@ TEST(Interpolator, AnAbortBrakesAtItsDecelerationScale) {
   EXPECT_EQ(stop(0.5), stop(1.0));  // never softer than planned
 }
 
+// A coupling code's marker (kWaitInPosition) waits at rest for the servo's in-position, then
+// releases and reports; a G4 of no time does not wait for it.
+TEST(Interpolator, AWaitInPositionMarkerHoldsUntilTheDrivesStandInPosition) {
+  for (const bool flagged : {true, false}) {
+    Rig rig;
+    std::vector<MotionBlock> blocks = {line(at(0), at(10), 100, 1000, 0), marker(MarkerKind::Dwell, 0, 7),
+                                       line(at(10), at(20), 100, 1000, 1), marker(MarkerKind::ProgramEnd)};
+    if (flagged) blocks[1].flags |= kWaitInPosition;
+    rig.publish(plan(blocks));
+    rig.in.in_position = false;
+    const int at_marker = rig.run_until(RunState::Dwelling, 2000);
+    ASSERT_GT(at_marker, 0);
+    for (int i = 0; i < 50; ++i) rig.step();
+    const TickOutput& waiting = rig.trace.back();
+    EXPECT_EQ(waiting.waiting_in_position, flagged);
+    if (flagged) {
+      EXPECT_EQ(waiting.position[0], 10.0);  // at rest on the marker
+    } else {
+      EXPECT_GT(waiting.position[0], 10.0);  // gone on
+    }
+    bool reported = false;
+    for (const TickOutput& o : rig.trace)
+      for (int e = 0; e < o.event_count; ++e)
+        reported = reported || o.events[static_cast<std::size_t>(e)].action == 7;
+    EXPECT_EQ(reported, !flagged);  // the marker's action follows its release
+    rig.in.in_position = true;
+    EXPECT_GT(rig.run_until(RunState::Finished), 0);
+    EXPECT_FALSE(rig.trace.back().waiting_in_position);
+    EXPECT_EQ(rig.trace.back().position[0], 20.0);
+  }
+}
+
 TEST(Interpolator, StopsAtTheEndOfTheQueuedDataAndGoesOnWhenMoreArrives) {
   Rig rig;
   std::vector<MotionBlock> blocks =

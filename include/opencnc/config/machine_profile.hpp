@@ -248,7 +248,12 @@ struct CouplingProfile {
   Axis master = Axis::Z;
   Axis slave = Axis::C;
   bool from_actual = false;  ///< the tick couples to the master's feedback instead of its command
-  double radius_mm = 50;     ///< where helix errors are measured (the bore's radius): reports only
+  double radius_mm = 50;     ///< where helix errors are measured (the bore's radius)
+  /// A coupling code waits until master and slave stand within this of their commands (µm: of the
+  /// master's travel and of the slave's arc at radius_mm; 0: no wait) before the law takes them,
+  /// at most engage_timeout_s (then the run stops with a fault).
+  double engage_tolerance_um = 0.25;
+  double engage_timeout_s = 2;
   std::vector<CouplingTableProfile> tables;
 };
 

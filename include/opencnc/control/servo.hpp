@@ -159,6 +159,8 @@ class Servo final : public Tickable {
   void release_coupling() noexcept;
   double coupling_master() const noexcept;
   double coupling_error() const noexcept;
+  bool coupling_in_position() noexcept;
+  void check_engage_wait() noexcept;
 
   // --- EDM gap servo, jump and orbit (servo_gap.cpp) ------------------------------------------
   void configure_gap_servo() noexcept;
@@ -214,6 +216,10 @@ class Servo final : public Tickable {
   /// The power-fail stop's deceleration: times the path's budget (1 = as planned), and the most
   /// the moving axes' peak decelerations allow (chosen at the signal).
   double stop_scale_ = 1, stop_scale_max_ = 1;
+  /// A coupling code's wait for master and slave in position: periods they have stood within the
+  /// tolerance, periods waited so far.
+  int in_position_periods_ = 0;
+  std::uint64_t engage_wait_periods_ = 0;
   std::uint64_t last_command_id_ = 0;
   Refusal last_refusal_ = Refusal::None;
   std::uint64_t accepted_ = 0, refused_ = 0, events_dropped_ = 0, trace_dropped_ = 0;

@@ -123,6 +123,9 @@ struct ServoStatus {
   std::array<double, machine::kAnalogChannels> analog_out{};
   bool mains_ok = true, on_battery = false;
   double dc_link_v = 0;
+  /// Wait::Dwell at a coupling code (M171–M174): master and slave coming to stand on their
+  /// commands before the law takes them ([coupling] engage_tolerance_um).
+  bool coupling_wait = false;
   /// ½·C·(V² − V_min²) of the link the profile's [power] states, J (0: not stated).
   double dc_link_energy_j = 0;
   /// The last power-fail stop's deceleration, times the path's budget (1: as planned), until reset.

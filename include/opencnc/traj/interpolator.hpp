@@ -40,6 +40,8 @@ struct TickInput {
   /// While aborting, the path brakes at up to this many times each block's acceleration budget
   /// (≥ 1; the servo raises it when the drives' DC link would not last the normal stop). Level.
   double abort_decel_scale = 1.0;
+  /// The drives a kWaitInPosition marker waits for stand in position (the servo decides). Level.
+  bool in_position = true;
 };
 
 /// What the interpolator is doing.
@@ -91,6 +93,8 @@ struct TickOutput {
   /// (from the bottom of the tap until it is back at its start). A level, for the spindle output.
   bool tap_reverse = false;
   double tap_speed_scale = 1;
+  /// At a kWaitInPosition marker, waiting for TickInput::in_position (state Dwelling).
+  bool waiting_in_position = false;
 };
 
 /// Consumes motion blocks and computes the commanded position every servo period.
@@ -172,6 +176,7 @@ class Interpolator {
   std::uint64_t step_from_seq_ = 0;        ///< single-block stops only after this block
   std::uint64_t dwell_ticks_left_ = 0;
   bool waiting_ = false;  ///< at a stop marker, action not finished
+  bool waiting_in_position_ = false;  ///< this tick, at a kWaitInPosition marker not yet in position
 
   // Spindle-synchronised motion (G33): wait for the index, catch up, then follow the encoder.
   enum class Sync : std::uint8_t { Off, WaitIndex, CatchUp, Locked };
