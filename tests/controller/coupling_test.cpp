@@ -329,10 +329,10 @@ TEST(Coupling, APowerFailOnANearlyEmptyDcLinkBrakesHarderAndStaysOnTheHelix) {
     EXPECT_GE(short_stop.dc_link_min_v, 400.0) << cut_s;
     EXPECT_LE(short_stop.coupled_error_um, 1.0) << cut_s;
     EXPECT_LT(short_stop.coupled_command_error_um, 1e-3) << cut_s;
-    const auto [planned, planned_fault] = cut(no_margin, cut_s);  // no peak above the plan
-    EXPECT_EQ(planned.decel_scale, 1.0) << cut_s;
-    EXPECT_EQ(planned_fault, FaultKind::AmpFault) << cut_s;  // undervoltage before rest
   }
+  const auto [planned, planned_fault] = cut(no_margin, 3.2);  // no peak above the plan
+  EXPECT_EQ(planned.decel_scale, 1.0);
+  EXPECT_EQ(planned_fault, FaultKind::AmpFault);  // the drives' undervoltage, before rest
 }
 
 // The 100-cut sweep's outlier (3.18 µm, the mains cut 10–40 ms after a rapid return arrived,
