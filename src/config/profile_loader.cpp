@@ -38,6 +38,7 @@ MachineProfile read_profile(const toml::table& root, Reporter& r, const std::fil
                             std::span<const FileText> files) {
   Section top(root, "",
               {"name", "description", "servo_period_s", "axis", "spindle", "power", "probe", "tool_changer",
+               "tool_change",
                "process", "io", "interpreter", "planner", "sim", "interlocks", "handwheel", "tool_guard",
                "coupling", "edm", "alarms"},
               r);
@@ -50,6 +51,7 @@ MachineProfile read_profile(const toml::table& root, Reporter& r, const std::fil
   detail::read_power(top, p);
   detail::read_probe(top, p);
   detail::read_tool_changer(top, p);
+  detail::read_tool_change(top, p);
   detail::read_io(top, p);
   detail::read_interlocks(top, p);
   detail::read_alarms(top, p);
