@@ -171,12 +171,16 @@ void Engine::move_to_tool_change(int at) {
     st_.position.current = p;
   };
   if (to == from) return;
+  // Each move ends where it is programmed (Z up before anything goes across), then the program's
+  // own path control again.
+  out_.set_motion_control_mode(canon::MotionControl::ExactStop, 0);
   if (tc.z_first && z_letter >= 0 && to[z_letter] != from[z_letter]) {
     Pose up = from;
     up[z_letter] = to[z_letter];
     if (!(up == to)) go(up);
   }
   go(to);
+  out_.set_motion_control_mode(st_.modal.control, st_.modal.path_tolerance);
 }
 
 void Engine::set_tool_number(int tool) {

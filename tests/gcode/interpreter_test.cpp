@@ -392,6 +392,16 @@ TEST(ToolChangePosition, WithoutOneM6ChangesWhereTheToolStands) {
 TEST(ToolChangePosition, M6RetractsZFirstThenGoesAcrossInMachineCoordinates) {
   const test::Result r = test::run(kTwoChanges, tool_change_options(AxisMask::from_letters("XZ")));
   ASSERT_EQ(r.status, RunStatus::Finished) << r.code();
+  // Each change's moves stop where they end (Z up before anything goes across), then the
+  // program's own path control is back.
+  std::vector<std::string> modes;
+  for (const auto& c : r.calls) {
+    if (c.starts_with("SET_MOTION_CONTROL_MODE")) modes.push_back(c);
+  }
+  EXPECT_EQ(modes, (std::vector<std::string>{"SET_MOTION_CONTROL_MODE(CANON_EXACT_STOP)",
+                                             "SET_MOTION_CONTROL_MODE(CANON_CONTINUOUS, 0.000000)",
+                                             "SET_MOTION_CONTROL_MODE(CANON_EXACT_STOP)",
+                                             "SET_MOTION_CONTROL_MODE(CANON_CONTINUOUS, 0.000000)"}));
   // Machine = program + G54 (X10 Z5) + tool length (Z50 after the G43): Z 200 is program Z 195
   // with no tool offset, 145 with tool 1's; X 100 is program X 90; Y stays. The machine stands
   // at its origin at first: program X -10 once G54 is set.

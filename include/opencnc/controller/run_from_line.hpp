@@ -124,7 +124,7 @@ class RunFromLineFeature final : public Feature {
     std::atomic<bool> done{false}, cancel{false};
     std::thread thread;
   };
-  std::shared_ptr<const canon::Program> approach(const Pose& from, int spindle_tool,
+  std::shared_ptr<const canon::Program> approach(const Pose& machine, int spindle_tool,
                                                  const LineStart& to) const;
   void start_approach(Scan& scan, FeatureHost& host);
 
