@@ -386,6 +386,27 @@ TEST(RunScenario, M6GoesToTheToolChangePositionAndTheOperatorChangesThere) {
   EXPECT_NEAR(at[Axis::X], -49.0, 1e-9);  // G91 X1 from the tool-change position
 }
 
+// The preflight checks M6's moves like the program's own. A profile file cannot hold a
+// tool-change position outside the soft limits (the loader refuses it at its key); one built past
+// the loader shows the check: the program is refused at the M6's line and nothing moves.
+TEST(RunScenario, ThePreflightChecksTheToolChangeMoves) {
+  TempProgram tools("tools.tbl", "T3 P3 Z0\n");
+  config::MachineProfile profile = mill({tool_table(tools)});
+  profile.tool_change.axes = AxisMask::from_letters("Z");
+  profile.tool_change.position[Axis::Z] = 2500;  // beyond Z's 2000
+  Scenario s(profile);
+  TempProgram p("tool.ngc", "G0 X5\nT3 M6\nG0 X6\nM2\n");
+  s.on(Mode::Auto);
+  const Outcome o = s.ask(Request::open(p.path()));
+  EXPECT_FALSE(o.accepted);
+  ASSERT_FALSE(o.diagnostics.items().empty());
+  const Diagnostic& d = o.diagnostics.items().front();
+  EXPECT_EQ(d.code, "control.soft-limit");
+  EXPECT_EQ(d.line, 2u);
+  EXPECT_NE(d.message.find("takes Z to 2500"), std::string::npos) << d.message;
+  EXPECT_EQ(s.status().servo.commanded, Pose{});
+}
+
 TEST(RunScenario, WaitForInputReadsTheMachine) {
   Scenario s(mill());
   // M66 P1 L3 Q5: wait up to 5 s for input 1 high; then M66 P2 L1 Q0.1 times out.
