@@ -36,11 +36,10 @@ void read_identity(Section& top, MachineProfile& p) {
 
 MachineProfile read_profile(const toml::table& root, Reporter& r, const std::filesystem::path& base_dir,
                             std::span<const FileText> files) {
-  Section top(root, "",
-              {"name", "description", "servo_period_s", "axis", "spindle", "power", "probe", "tool_changer",
-               "tool_change",
-               "process", "io", "interpreter", "planner", "sim", "interlocks", "handwheel", "tool_guard",
-               "coupling", "edm", "alarms"},
+  Section top(root, "", {"name",   "description",  "servo_period_s", "axis",       "spindle",     "power",
+                         "probe",  "tool_changer", "process",        "io",         "interpreter", "planner",
+                         "sim",    "interlocks",   "handwheel",      "tool_guard", "coupling",    "edm",
+                         "alarms", "tool_change"},
               r);
   MachineProfile p;
   read_identity(top, p);

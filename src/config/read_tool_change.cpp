@@ -30,7 +30,8 @@ void read_position_axis(Section& s, std::string_view key, MachineProfile& profil
     return;
   }
   if (profile.tool_change.axes.has(*axis)) {
-    s.error(key, fmt::format("{}: axis {} is named twice", s.key_path(key), letter(*axis)), "config.duplicate-axis");
+    s.error(key, fmt::format("{}: axis {} is named twice", s.key_path(key), letter(*axis)),
+            "config.duplicate-axis");
     return;
   }
   const std::optional<double> v = s.number(key);
@@ -43,8 +44,8 @@ void read_position_axis(Section& s, std::string_view key, MachineProfile& profil
   if (!a->wrapped && (*v < a->min_limit || *v > a->max_limit)) {
     s.error(key,
             fmt::format("{} = {} {} is outside {}'s soft limits [{}, {}] {}: M6 would move there",
-                        s.key_path(key), show(*v), unit, letter(*axis), show(a->min_limit), show(a->max_limit),
-                        unit),
+                        s.key_path(key), show(*v), unit, letter(*axis), show(a->min_limit),
+                        show(a->max_limit), unit),
             "config.range");
     return;
   }

@@ -359,7 +359,8 @@ TEST(MachineProfile, ToolChangePositionIsReadWithItsPlace) {
   const ProfileLoad none = parse_profile(kBase, "p.toml");
   ASSERT_TRUE(none.ok()) << all_messages(none.diagnostics);
   EXPECT_EQ(none.profile->tool_change.axes.count(), 0);  // no key: M6 does not move
-  const ProfileLoad load = parse_profile(with("[tool_change]\nposition = { x = -10 }\nz_first = false\n"), "p.toml");
+  const ProfileLoad load =
+      parse_profile(with("[tool_change]\nposition = { x = -10 }\nz_first = false\n"), "p.toml");
   ASSERT_TRUE(load.ok()) << all_messages(load.diagnostics);
   const ToolChangeProfile& tc = load.profile->tool_change;
   EXPECT_EQ(tc.axes, AxisMask::from_letters("X"));

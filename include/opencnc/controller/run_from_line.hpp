@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // RunFromLine — start the open program at a chosen line: the line resolved to the first move that
 // starts at it (a scan on a thread of the feature's own), an approach there (an auxiliary program:
-// the line's tool changed in at the tool-change position, its spindle and coolant, the moves), then the program resumed at
-// that move's segment (requests::ResumeProgram: the interpreter replays quietly up to it).
+// the line's tool changed in at the tool-change position, its spindle and coolant, the moves),
+// then the program resumed at that move's segment (requests::ResumeProgram: the interpreter
+// replays quietly up to it).
 // Requests: requests::Feature{"run-from-line", "start", RunFromLineArgs}. See docs/hmi.md.
 #pragma once
 
