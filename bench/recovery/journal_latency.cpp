@@ -2,10 +2,10 @@
 // journal_latency: signal to durable breakpoint record for each way of writing a journal slot
 // (O_DIRECT|O_DSYNC, fdatasync, RWF_DSYNC; sync_file_range as a not-durable reference), with and
 // without the writer's real-time I/O priority, on a quiet disk or while a load thread streams
-// buffered writes of new files to the same file system; the disk's own counters for each.
+// buffered writes of new files to the same file system in bursts; the disk's own counters over the run.
 //
-//   journal_latency --dir DIR [--records N] [--interval-ms M] [--sync WAY|all] [--ioprio rt|none|both]
-//                   [--load-mb MB] [--load-period-s P] [--seed S] [--json]
+//   journal_latency --dir DIR [--records N] [--interval-ms M] [--sync WAY[,WAY]|all]
+//                   [--ioprio rt|none|both] [--load-mb MB] [--load-period-s P] [--seed S] [--json]
 #include <fcntl.h>
 #include <pthread.h>
 #include <sched.h>
@@ -353,13 +353,13 @@ std::vector<Result> measure(const Options& o, std::optional<DiskStats>& disk, do
 
 int usage(int rc) {
   fmt::print(rc == 0 ? stdout : stderr,
-             "usage: journal_latency --dir DIR [--records N] [--interval-ms M] [--sync WAY|all]\n"
+             "usage: journal_latency --dir DIR [--records N] [--interval-ms M] [--sync WAY[,WAY]|all]\n"
              "                       [--ioprio rt|none|both] [--load-mb MB] [--load-period-s P] [--seed S] "
              "[--json]\n"
              "  signal to durable breakpoint record (p50/p99/max) for each way of writing a slot, in DIR\n"
              "  (the file system under test; created; only this program's jl-* folders may be in it)\n"
              "  WAY: direct (O_DIRECT|O_DSYNC), fdatasync, dsync (RWF_DSYNC), sync-file-range (not\n"
-             "  durable: no cache flush; a reference); all: each (default)\n"
+             "  durable: no cache flush; a reference); a comma-separated list; all: each (default)\n"
              "  --ioprio: the writer's I/O priority real-time class, the default, or each (default both)\n"
              "  --load-mb: MB of new files written to DIR's file system, their writeback started at once,\n"
              "  every --load-period-s seconds (default 5) while the records are written (default 0: none)\n"
@@ -410,13 +410,19 @@ std::optional<Options> parse(int argc, char** argv, int& rc) {
     fmt::print(stderr, "journal_latency: --dir is required (a folder on the file system to measure)\n");
     return std::nullopt;
   }
-  for (std::string_view name : {"direct", "fdatasync", "dsync", "sync-file-range"}) {
-    if (sync == "all" || sync == name) o.ways.push_back(*way_named(name));
-  }
-  if (o.ways.empty()) {
-    fmt::print(stderr, "journal_latency: --sync {}: direct, fdatasync, dsync, sync-file-range or all\n",
-               sync);
-    return std::nullopt;
+  if (sync == "all") sync = "dsync,fdatasync,direct,sync-file-range";
+  for (std::size_t at = 0; at <= sync.size();) {  // a comma-separated list
+    const std::size_t end = std::min(sync.find(',', at), sync.size());
+    const std::optional<Way> way = way_named(std::string_view(sync).substr(at, end - at));
+    if (!way) {
+      fmt::print(stderr,
+                 "journal_latency: --sync {}: dsync, fdatasync, direct, sync-file-range, a list of them, or "
+                 "all\n",
+                 sync);
+      return std::nullopt;
+    }
+    o.ways.push_back(*way);
+    at = end + 1;
   }
   if (ioprio != "rt" && ioprio != "none" && ioprio != "both") {
     fmt::print(stderr, "journal_latency: --ioprio {}: rt, none or both\n", ioprio);
