@@ -99,9 +99,9 @@ std::unique_ptr<Journal> Journal::open(const std::string& dir, std::string* erro
   }
   JournalSync sync = options.sync;
   std::string how = describe(sync);
-  if (sync == JournalSync::Direct) {
-    for (Slot& slot : slots) slot.direct_fd = detail::open_direct(paths[&slot - slots]);
-    if (slots[0].direct_fd < 0 || slots[1].direct_fd < 0) {
+  for (int s = 0; s < 2 && sync == JournalSync::Direct; ++s) {
+    slots[s].direct_fd = detail::open_direct(paths[s]);
+    if (slots[s].direct_fd < 0) {
       how = describe(JournalSync::Fdatasync) +
             " (O_DIRECT refused by the file system: " + std::strerror(errno) + ")";
       sync = JournalSync::Fdatasync;
@@ -159,8 +159,8 @@ bool Journal::write(std::span<const std::byte> payload, std::string* error) {
   if (!payload.empty()) std::memcpy(b + kHeader, payload.data(), payload.size());
   const std::uint32_t crc = crc32(std::span<const std::byte>(b, kHeader + payload.size()));
   std::memcpy(b + kHeader + payload.size(), &crc, 4);
-  std::memset(b + record, 0,
-              bytes - record);  // the rest of the last block: zeros, not an older record's tail
+  // The rest of the last block: zeros, not an older record's tail.
+  std::memset(b + record, 0, bytes - record);
   // Never the slot of the last good record as it is on the disk now (a slot corrupted since the
   // last write is the one to overwrite, whatever this object remembers).
   const auto a = read_slot(slots_[0].fd), other = read_slot(slots_[1].fd);

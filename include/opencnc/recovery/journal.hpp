@@ -102,7 +102,7 @@ class Journal {
   Slot slots_[2];
   JournalSync sync_ = JournalSync::Dsync;
   std::string how_;
-  std::uint64_t sequence_ = 0;  ///< of the newest record written or found
+  std::uint64_t sequence_ = 0;   ///< of the newest record written or found
   std::byte* buffer_ = nullptr;  ///< kBlockBytes-aligned, buffer_bytes_ long (O_DIRECT needs it)
   std::size_t buffer_bytes_ = 0;
 };
