@@ -28,6 +28,7 @@ nlohmann::json finish_run_journal(recovery::BreakpointJournal& journal, const st
   const std::string error = journal.last_error();
   j["written"] = r.has_value() && !latencies.empty();
   j["error"] = error.empty() ? nlohmann::json(nullptr) : nlohmann::json(error);
+  j["storage"] = journal.writer_status();
   if (!error.empty()) fmt::print(stderr, "error: journal: {}\n", error);
   if (!r || latencies.empty()) {
     fmt::print("journal             no breakpoint written (no power failure during the program)\n");
@@ -45,6 +46,7 @@ nlohmann::json finish_run_journal(recovery::BreakpointJournal& journal, const st
   j["record_latency_ms"] = latencies.front();
   fmt::print("journal             {}\n", describe(*r));
   fmt::print("journal latency     {:.3f} ms from the signal to the durable record\n", latencies.front());
+  fmt::print("journal storage     {}\n", journal.writer_status());
   j["sim_bore"] = false;
   if (!sim_bore.empty()) {
     // The simulated workpiece keeps its groove across the restart, as a real one does.

@@ -69,10 +69,15 @@ bool schedule_this_thread(int priority) {
   return pthread_setschedparam(pthread_self(), priority > 0 ? SCHED_FIFO : SCHED_OTHER, &param) == 0;
 }
 
-bool this_thread_is_fifo() {
-  int policy = SCHED_OTHER;
-  sched_param param{};
-  return pthread_getschedparam(pthread_self(), &policy, &param) == 0 && policy == SCHED_FIFO;
+/// Runs `f` at normal CPU and I/O priority when the writer holds raised ones (hashing a program,
+/// replaying it for the digest: no emergency, and long for a large file), then raises them again.
+template <typename F>
+void at_normal_priority(bool fifo, bool rt_io, F&& f) {
+  if (fifo) schedule_this_thread(0);
+  if (rt_io) reset_io_priority();
+  f();
+  if (rt_io) raise_io_priority();
+  if (fifo) schedule_this_thread(kWriterPriority);
 }
 
 }  // namespace
@@ -89,6 +94,7 @@ BreakpointJournal::BreakpointJournal(std::unique_ptr<Journal> journal,
     : journal_(std::move(journal)), source_(std::move(source)) {
   // A record left by an earlier run (the power came back): what recovery offers.
   if (const std::optional<JournalRecord> raw = journal_->read()) written_ = decode(raw->payload, &error_);
+  writer_status_ = journal_->how() + "; writer thread starting";
   writer_ = std::thread([this] { writer_loop(); });
 }
 
@@ -245,10 +251,28 @@ std::string BreakpointJournal::last_error() const {
   return error_;
 }
 
+std::string BreakpointJournal::writer_status() const {
+  std::lock_guard lock(mutex_);
+  return writer_status_;
+}
+
+void BreakpointJournal::set_writer_status(bool fifo, bool rt_io) {
+  std::string status =
+      fmt::format("{}; writer thread {}; I/O priority {}", journal_->how(),
+                  fifo ? fmt::format("SCHED_FIFO {}", kWriterPriority) : "normal (SCHED_FIFO not permitted)",
+                  rt_io ? "real-time class" : "normal (the real-time class not permitted)");
+  std::lock_guard lock(mutex_);
+  writer_status_ = std::move(status);
+}
+
 // Takes the queue in one piece: a newer record makes an older one not yet written moot (but the
 // older one's signal time still counts for the latency of the first durable record).
 void BreakpointJournal::writer_loop() {
-  schedule_this_thread(kWriterPriority);  // where permitted; a normal thread otherwise
+  // Where permitted (else a normal thread, and the status says so): the CPU when the signal comes,
+  // and the I/O scheduler's first place for the record's write (docs/broaching.md).
+  fifo_ = schedule_this_thread(kWriterPriority);
+  rt_io_ = raise_io_priority();
+  set_writer_status(fifo_, rt_io_);
   std::unique_lock lock(mutex_);
   for (;;) {
     wake_.wait(lock, [this] { return stop_ || !queue_.empty(); });
@@ -261,11 +285,8 @@ void BreakpointJournal::writer_loop() {
     std::optional<Work> last;
     for (Work& w : batch) {
       if (w.hash_only) {  // a program just opened: no emergency, and a huge file takes a while
-        const bool fifo = this_thread_is_fifo();
-        if (fifo) schedule_this_thread(0);
         hashed_path_ = w.record.program_path;
-        hash_ = hash_file(hashed_path_).value_or(FileHash{});
-        if (fifo) schedule_this_thread(kWriterPriority);
+        at_normal_priority(fifo_, rt_io_, [&] { hash_ = hash_file(hashed_path_).value_or(FileHash{}); });
         continue;
       }
       if (w.signal && !signal) signal = w.signal;
@@ -292,15 +313,17 @@ void BreakpointJournal::write_one(Work& w) {
   r.program_hash = hash_.hash;
   r.program_size = hash_.size;
   std::string error;
+  const JournalSync before = journal_->sync();
   bool ok = journal_->write(encode(r), &error);
   const Clock::time_point durable = Clock::now();
+  if (journal_->sync() != before) set_writer_status(fifo_, rt_io_);  // the file system refused a way
   if (ok && w.digest) {
     // The replay is no emergency (the record is durable) and may be long: not at real-time priority.
-    const bool fifo = this_thread_is_fifo();
-    if (fifo) schedule_this_thread(0);
     std::string why;
-    const auto d = modal_digest_at(w.options, r.program_path, r.program_start, r.segment, &why);
-    if (fifo) schedule_this_thread(kWriterPriority);
+    std::optional<std::uint64_t> d;
+    at_normal_priority(fifo_, rt_io_, [&] {
+      d = modal_digest_at(w.options, r.program_path, r.program_start, r.segment, &why);
+    });
     if (d) {
       r.modal_digest = *d;
       ok = journal_->write(encode(r), &error);
@@ -322,7 +345,7 @@ control::Outcome BreakpointJournal::handle(const control::requests::Feature& req
   const std::optional<BreakpointRecord> r = last_written();
   if (request.action == "show") {
     o.accepted = true;
-    o.message = r ? describe(*r) : "the journal holds no record";
+    o.message = (r ? describe(*r) : "the journal holds no record") + "\nwritten " + writer_status();
     return o;
   }
   const bool choice =

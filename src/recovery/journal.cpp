@@ -1,16 +1,19 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The breakpoint journal's two slots: layout, CRC-32, write in turn with fdatasync, read the newest
-// good one.
+// The breakpoint journal's two slots: layout, CRC-32, written in turn and made durable (direct,
+// fdatasync or RWF_DSYNC), the newest good one read.
 #include "opencnc/recovery/journal.hpp"
 
-#include <fcntl.h>
-#include <sys/stat.h>
+#include <sys/uio.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
+
+#include "journal_slot.hpp"
 
 namespace opencnc::recovery {
 
@@ -20,8 +23,6 @@ constexpr std::array<char, 8> kMagic = {'O', 'C', 'N', 'C', 'J', 'R', 'N', 'L'};
 constexpr std::uint32_t kVersion = 1;
 /// magic, version (u32), payload length (u32), sequence (u64); then payload, then CRC-32 (u32).
 constexpr std::size_t kHeader = 8 + 4 + 4 + 8;
-/// Size a slot file is given when opened (a breakpoint record is about 600 bytes).
-constexpr off_t kPresize = 4096;
 
 std::array<std::uint32_t, 256> make_crc_table() {
   std::array<std::uint32_t, 256> t{};
@@ -33,50 +34,6 @@ std::array<std::uint32_t, 256> make_crc_table() {
   return t;
 }
 
-void put(std::vector<std::byte>& out, const void* p, std::size_t n) {
-  const auto* b = static_cast<const std::byte*>(p);
-  out.insert(out.end(), b, b + n);
-}
-
-std::string reason(const char* what, const std::string& path) {
-  return std::string(what) + " " + path + ": " + std::strerror(errno);
-}
-
-bool sync_folder(const std::string& dir, std::string* error) {
-  const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (fd < 0 || ::fsync(fd) != 0) {
-    if (error) *error = reason("cannot sync the folder", dir);
-    if (fd >= 0) ::close(fd);
-    return false;
-  }
-  ::close(fd);
-  return true;
-}
-
-// A slot file is made kPresize bytes long and its blocks allocated and written, once, when opened
-// shorter or sparse: a record that fits then changes neither the file's size nor its block map, so
-// the fdatasync of a record has no metadata to commit, only the data block to write (ftruncate
-// alone leaves a hole, whose first write allocates a block: an extent change for the file
-// system's journal inside the signal's fdatasync). The bytes there are written back as they
-// read (a hole reads as zeros: no record), so a slot that holds a record keeps it even if this
-// write is torn.
-bool presize(int fd) {
-  struct stat st {};
-  if (::fstat(fd, &st) != 0) return false;
-  if (st.st_size >= kPresize && st.st_blocks * 512 >= kPresize) return true;
-  std::array<std::byte, kPresize> bytes{};
-  const ssize_t got = ::pread(fd, bytes.data(), bytes.size(), 0);
-  if (got < 0) return false;
-  std::size_t done = 0;
-  while (done < bytes.size()) {
-    const ssize_t n = ::pwrite(fd, bytes.data() + done, bytes.size() - done, static_cast<off_t>(done));
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) return false;
-    done += static_cast<std::size_t>(n);
-  }
-  return ::fsync(fd) == 0;
-}
-
 }  // namespace
 
 std::uint32_t crc32(std::span<const std::byte> bytes, std::uint32_t crc) noexcept {
@@ -86,44 +43,94 @@ std::uint32_t crc32(std::span<const std::byte> bytes, std::uint32_t crc) noexcep
   return ~crc;
 }
 
-std::unique_ptr<Journal> Journal::open(const std::string& dir, std::string* error) {
+namespace {
+
+std::string describe(JournalSync sync) {
+  switch (sync) {
+    case JournalSync::Direct:
+      return "direct (O_DIRECT|O_DSYNC, whole 4 KiB blocks)";
+    case JournalSync::Fdatasync:
+      return "fdatasync";
+    case JournalSync::Dsync:
+      return "dsync (pwritev2 with RWF_DSYNC)";
+  }
+  return "?";
+}
+
+/// pwritev2's answers where the kernel or the file system does not know RWF_DSYNC.
+bool refused(int error) {
+  return error == EOPNOTSUPP || error == ENOSYS || error == EINVAL;
+}
+
+void close_slot(int& fd) {
+  if (fd >= 0) ::close(fd);
+  fd = -1;
+}
+
+}  // namespace
+
+std::unique_ptr<Journal> Journal::open(const std::string& dir, std::string* error, JournalOptions options) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec) {
     if (error) *error = "cannot create the journal folder " + dir + ": " + ec.message();
     return nullptr;
   }
-  int fds[2] = {-1, -1};
-  const char* names[2] = {"slot-a.jrn", "slot-b.jrn"};
-  for (int s = 0; s < 2; ++s) {
-    const std::string path = (std::filesystem::path(dir) / names[s]).string();
-    fds[s] = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-    if (fds[s] < 0 || !presize(fds[s])) {
-      if (error) *error = reason(fds[s] < 0 ? "cannot open" : "cannot size", path);
-      if (fds[s] >= 0) ::close(fds[s]);
-      if (s == 1) ::close(fds[0]);
+  const std::string paths[2] = {(std::filesystem::path(dir) / "slot-a.jrn").string(),
+                                (std::filesystem::path(dir) / "slot-b.jrn").string()};
+  for (const std::string& path : paths) {  // both checked before either is touched
+    if (std::string why = detail::refuse_slot_file(path); !why.empty()) {
+      if (error) *error = std::move(why);
       return nullptr;
     }
   }
-  if (!sync_folder(dir, error)) {  // the slot files themselves survive a power cut
-    ::close(fds[0]);
-    ::close(fds[1]);
+  Slot slots[2];
+  for (int s = 0; s < 2; ++s) {
+    slots[s].fd = detail::open_slot(paths[s], error);
+    if (slots[s].fd < 0) {
+      if (s == 1) close_slot(slots[0].fd);
+      return nullptr;
+    }
+  }
+  if (!detail::sync_folder(dir, error)) {  // the slot files themselves survive a power cut
+    close_slot(slots[0].fd);
+    close_slot(slots[1].fd);
     return nullptr;
   }
-  std::unique_ptr<Journal> j(new Journal(fds[0], fds[1]));
-  for (int s = 0; s < 2; ++s) {
-    const auto r = j->read_slot(j->fds_[s]);
+  JournalSync sync = options.sync;
+  std::string how = describe(sync);
+  for (int s = 0; s < 2 && sync == JournalSync::Direct; ++s) {
+    slots[s].direct_fd = detail::open_direct(paths[s]);
+    if (slots[s].direct_fd < 0) {
+      how = describe(JournalSync::Fdatasync) +
+            " (O_DIRECT refused by the file system: " + std::strerror(errno) + ")";
+      sync = JournalSync::Fdatasync;
+      for (Slot& slot : slots) close_slot(slot.direct_fd);
+    }
+  }
+  std::unique_ptr<Journal> j(new Journal(slots[0], slots[1], sync, std::move(how)));
+  for (const Slot& slot : j->slots_) {
+    const auto r = j->read_slot(slot.fd);
     if (r && r->sequence > j->sequence_) j->sequence_ = r->sequence;
   }
   return j;
 }
 
-Journal::Journal(int fd_a, int fd_b) : fds_{fd_a, fd_b} {}
+Journal::Journal(Slot a, Slot b, JournalSync sync, std::string how)
+    : slots_{a, b}, sync_(sync), how_(std::move(how)) {}
 
 Journal::~Journal() {
-  for (int fd : fds_) {
-    if (fd >= 0) ::close(fd);
+  for (Slot& slot : slots_) {
+    close_slot(slot.fd);
+    close_slot(slot.direct_fd);
   }
+  std::free(buffer_);
+}
+
+void Journal::fall_back(const std::string& why) {
+  sync_ = JournalSync::Fdatasync;
+  how_ = describe(sync_) + " (" + why + ")";
+  for (Slot& slot : slots_) close_slot(slot.direct_fd);
 }
 
 bool Journal::write(std::span<const std::byte> payload, std::string* error) {
@@ -133,35 +140,67 @@ bool Journal::write(std::span<const std::byte> payload, std::string* error) {
   }
   const std::uint64_t seq = sequence_ + 1;
   const auto size = static_cast<std::uint32_t>(payload.size());
-  std::vector<std::byte> buf;
-  buf.reserve(kHeader + payload.size() + 4);
-  put(buf, kMagic.data(), kMagic.size());
-  put(buf, &kVersion, 4);
-  put(buf, &size, 4);
-  put(buf, &seq, 8);
-  buf.insert(buf.end(), payload.begin(), payload.end());
-  const std::uint32_t crc = crc32(buf);
-  put(buf, &crc, 4);
+  const std::size_t record = kHeader + payload.size() + 4;
+  const std::size_t bytes = (record + kBlockBytes - 1) / kBlockBytes * kBlockBytes;
+  if (buffer_bytes_ < bytes) {  // aligned for O_DIRECT; grows only for a larger record
+    std::free(buffer_);
+    buffer_ = static_cast<std::byte*>(std::aligned_alloc(kBlockBytes, bytes));
+    buffer_bytes_ = buffer_ != nullptr ? bytes : 0;
+    if (buffer_ == nullptr) {
+      if (error) *error = "cannot write the journal: out of memory";
+      return false;
+    }
+  }
+  std::byte* b = buffer_;
+  std::memcpy(b, kMagic.data(), kMagic.size());
+  std::memcpy(b + 8, &kVersion, 4);
+  std::memcpy(b + 12, &size, 4);
+  std::memcpy(b + 16, &seq, 8);
+  if (!payload.empty()) std::memcpy(b + kHeader, payload.data(), payload.size());
+  const std::uint32_t crc = crc32(std::span<const std::byte>(b, kHeader + payload.size()));
+  std::memcpy(b + kHeader + payload.size(), &crc, 4);
+  // The rest of the last block: zeros, not an older record's tail.
+  std::memset(b + record, 0, bytes - record);
   // Never the slot of the last good record as it is on the disk now (a slot corrupted since the
   // last write is the one to overwrite, whatever this object remembers).
-  const auto a = read_slot(fds_[0]), b = read_slot(fds_[1]);
-  const int slot = !a ? 0 : !b ? 1 : (a->sequence < b->sequence ? 0 : 1);
-  const int fd = fds_[slot];
+  const auto a = read_slot(slots_[0].fd), other = read_slot(slots_[1].fd);
+  const int slot = !a ? 0 : !other ? 1 : (a->sequence < other->sequence ? 0 : 1);
+  if (!write_blocks(slots_[slot], std::span<const std::byte>(b, bytes), error)) return false;
+  sequence_ = seq;
+  return true;
+}
+
+// One write of whole blocks at offset 0, durable when it returns: one pwritev2 with RWF_DSYNC, a
+// buffered write then fdatasync, or with O_DIRECT|O_DSYNC the write itself. A way the kernel or the
+// file system refuses at the first write falls back to fdatasync for good.
+bool Journal::write_blocks(const Slot& slot, std::span<const std::byte> blocks, std::string* error) {
+  const bool direct = sync_ == JournalSync::Direct;
+  const int fd = direct ? slot.direct_fd : slot.fd;
   std::size_t done = 0;
-  while (done < buf.size()) {
-    const ssize_t n = ::pwrite(fd, buf.data() + done, buf.size() - done, static_cast<off_t>(done));
+  while (done < blocks.size()) {
+    ssize_t n = 0;
+    if (sync_ == JournalSync::Dsync) {
+      iovec iov{const_cast<std::byte*>(blocks.data() + done), blocks.size() - done};
+      n = ::pwritev2(fd, &iov, 1, static_cast<off_t>(done), RWF_DSYNC);
+    } else {
+      n = ::pwrite(fd, blocks.data() + done, blocks.size() - done, static_cast<off_t>(done));
+    }
     if (n < 0 && errno == EINTR) continue;
+    if (n < 0 && done == 0 &&
+        ((direct && errno == EINVAL) || (sync_ == JournalSync::Dsync && refused(errno)))) {
+      fall_back(std::string(direct ? "O_DIRECT" : "RWF_DSYNC") + " refused: " + std::strerror(errno));
+      return write_blocks(slot, blocks, error);
+    }
     if (n <= 0) {
       if (error) *error = std::string("cannot write the journal: ") + std::strerror(errno);
       return false;
     }
     done += static_cast<std::size_t>(n);
   }
-  if (::fdatasync(fd) != 0) {
+  if (sync_ == JournalSync::Fdatasync && ::fdatasync(fd) != 0) {
     if (error) *error = std::string("cannot sync the journal: ") + std::strerror(errno);
     return false;
   }
-  sequence_ = seq;
   return true;
 }
 
@@ -188,8 +227,8 @@ std::optional<JournalRecord> Journal::read_slot(int fd) const {
 
 std::optional<JournalRecord> Journal::read() const {
   std::optional<JournalRecord> best;
-  for (int fd : fds_) {
-    auto r = read_slot(fd);
+  for (const Slot& slot : slots_) {
+    auto r = read_slot(slot.fd);
     if (r && (!best || r->sequence > best->sequence)) best = std::move(r);
   }
   return best;

@@ -209,6 +209,11 @@ TEST(BreakpointJournal, WritesTheRecordWhenTheMainsFail) {
   rig.run(3);
   journal->flush();
   EXPECT_EQ(journal->last_error(), "");
+  // The writer says how it writes and what priority it got (or that it was not permitted).
+  const std::string status = journal->writer_status();
+  EXPECT_NE(status.find("; writer thread "), std::string::npos) << status;
+  EXPECT_NE(status.find("; I/O priority "), std::string::npos) << status;
+  EXPECT_EQ(status.find("starting"), std::string::npos) << status;
   const auto r = journal->last_written();
   ASSERT_TRUE(r.has_value());
   EXPECT_TRUE(r->valid);

@@ -1,18 +1,23 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The breakpoint journal's storage: records read back after reopening, a torn or corrupt newest
-// slot falls back to the last good record, both slots bad read as none, and a writer process
-// SIGKILLed at random moments never loses a record it had reported durable.
+// The breakpoint journal's storage: records read back after reopening (each way of writing), slots
+// of whole blocks allocated when opened, a file that is not a slot refused untouched, a torn or
+// corrupt newest slot falls back to the last good record, both slots bad read as none, and a writer
+// process SIGKILLed at random moments never loses a record it had reported durable.
 #include <gtest/gtest.h>
 
+#include <linux/ioprio.h>
 #include <signal.h>
 #include <sys/stat.h>
+#include <sys/syscall.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <random>
 #include <string>
 #include <thread>
@@ -69,6 +74,110 @@ TEST(Journal, RecordsSurviveReopening) {
   std::filesystem::remove_all(dir);
 }
 
+// Each way of writing keeps the same slots: what one wrote, a journal opened another way reads.
+TEST(Journal, EveryWayOfWritingReadsBackAcrossReopening) {
+  const auto dir = fresh_dir();
+  std::string error;
+  std::uint64_t seq = 0;
+  for (JournalSync sync : {JournalSync::Direct, JournalSync::Fdatasync, JournalSync::Dsync}) {
+    auto j = Journal::open(dir.string(), &error, {sync});
+    ASSERT_TRUE(j) << error;
+    EXPECT_EQ(j->sequence(), seq) << to_string(sync);
+    for (int k = 0; k < 3; ++k)
+      ASSERT_TRUE(j->write(payload(++seq), &error)) << to_string(sync) << ": " << error;
+    // Where the file system refuses a way the journal says it fell back to fdatasync.
+    EXPECT_TRUE(j->sync() == sync ||
+                (j->sync() == JournalSync::Fdatasync && j->how().find("refused") != std::string::npos))
+        << to_string(sync) << ": " << j->how();
+    const auto r = j->read();  // through the page cache, after O_DIRECT writes too
+    ASSERT_TRUE(r.has_value());
+    EXPECT_EQ(r->sequence, seq);
+    EXPECT_TRUE(matches(*r));
+  }
+  const auto r = Journal::open(dir.string(), &error)->read();
+  ASSERT_TRUE(r.has_value());
+  EXPECT_EQ(r->sequence, 9u);
+  EXPECT_TRUE(matches(*r));
+  std::filesystem::remove_all(dir);
+}
+
+std::vector<char> bytes_of(const std::filesystem::path& path) {
+  std::ifstream f(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
+}
+
+// A record longer than a block grows its slot by whole blocks; a shorter one after it is written as
+// its own block, zeros past its checksum (the longer one's second block stays, never read).
+TEST(Journal, ARecordIsWrittenAsWholeBlocks) {
+  const auto dir = fresh_dir();
+  std::string error;
+  auto j = Journal::open(dir.string(), &error);
+  ASSERT_TRUE(j) << error;
+  std::vector<std::byte> big(5000, std::byte{0x5A});
+  ASSERT_TRUE(j->write(big, &error)) << error;         // slot a
+  ASSERT_TRUE(j->write(payload(2), &error)) << error;  // slot b
+  ASSERT_TRUE(j->write(payload(3), &error)) << error;  // slot a again, over the big one
+  EXPECT_EQ(std::filesystem::file_size(dir / "slot-a.jrn"), 8192u);
+  EXPECT_EQ(std::filesystem::file_size(dir / "slot-b.jrn"), 4096u);
+  const std::vector<char> a = bytes_of(dir / "slot-a.jrn");
+  const std::size_t record = 24 + payload(3).size() + 4;
+  ASSERT_EQ(a.size(), 8192u);
+  EXPECT_TRUE(std::all_of(a.begin() + static_cast<std::ptrdiff_t>(record), a.begin() + 4096,
+                          [](char c) { return c == 0; }));
+  EXPECT_EQ(a[4096], 0x5A);
+  EXPECT_EQ(j->read()->sequence, 3u);
+  EXPECT_TRUE(matches(*j->read()));
+  std::filesystem::remove_all(dir);
+}
+
+// A file in a slot's place that no journal writes (too large, or not a regular file) is refused
+// with its name, before either slot is created or written.
+TEST(Journal, AFileThatIsNotASlotIsRefusedAndLeftAsItIs) {
+  const auto dir = fresh_dir();
+  std::filesystem::create_directories(dir);
+  {
+    std::ofstream f(dir / "slot-a.jrn", std::ios::binary);
+    std::string text(Journal::kMaxSlotBytes + 1, 'x');
+    f << text;
+  }
+  const std::vector<char> before = bytes_of(dir / "slot-a.jrn");
+  std::string error;
+  EXPECT_FALSE(Journal::open(dir.string(), &error));
+  EXPECT_NE(error.find("slot-a.jrn"), std::string::npos) << error;
+  EXPECT_NE(error.find("not a journal slot"), std::string::npos) << error;
+  EXPECT_TRUE(bytes_of(dir / "slot-a.jrn") == before);
+  EXPECT_FALSE(std::filesystem::exists(dir / "slot-b.jrn"));
+  // A folder where slot b belongs: refused too, slot a (a good one now) untouched.
+  std::filesystem::remove(dir / "slot-a.jrn");
+  {
+    auto j = Journal::open(dir.string(), &error);
+    ASSERT_TRUE(j) << error;
+    ASSERT_TRUE(j->write(payload(1), &error));
+  }
+  std::filesystem::remove(dir / "slot-b.jrn");
+  std::filesystem::create_directory(dir / "slot-b.jrn");
+  const std::vector<char> good = bytes_of(dir / "slot-a.jrn");
+  error.clear();
+  EXPECT_FALSE(Journal::open(dir.string(), &error));
+  EXPECT_NE(error.find("slot-b.jrn is not a regular file"), std::string::npos) << error;
+  EXPECT_TRUE(bytes_of(dir / "slot-a.jrn") == good);
+  std::filesystem::remove_all(dir);
+}
+
+// The writer's I/O priority: raised to the real-time class where permitted (it is, or the call
+// says it is not), and put back.
+TEST(Journal, TheWritersIoPriorityIsRaisedWherePermitted) {
+  const auto priority = [] { return ::syscall(SYS_ioprio_get, IOPRIO_WHO_PROCESS, 0); };
+  std::thread([&] {
+    if (raise_io_priority())
+      EXPECT_EQ(IOPRIO_PRIO_CLASS(priority()), IOPRIO_CLASS_RT);
+    else
+      EXPECT_NE(IOPRIO_PRIO_CLASS(priority()), IOPRIO_CLASS_RT);
+    reset_io_priority();
+    EXPECT_NE(IOPRIO_PRIO_CLASS(priority()), IOPRIO_CLASS_RT);
+  }).join();
+}
+
 /// Bytes the file system has allocated to `path` (a hole has none).
 std::uintmax_t allocated_bytes(const std::filesystem::path& path) {
   struct stat st {};
@@ -100,6 +209,16 @@ TEST(Journal, SlotsAreAllocatedWhenOpenedAndKeepTheirRecord) {
   ASSERT_TRUE(r.has_value());
   EXPECT_EQ(r->sequence, 1u);
   EXPECT_TRUE(matches(*r));
+  // An older journal's slot that a long record left at 5000 bytes: rounded up to two blocks, kept.
+  std::vector<std::byte> big(4900, std::byte{0x33});
+  ASSERT_TRUE(j->write(big, &error)) << error;  // slot b
+  j.reset();
+  std::filesystem::resize_file(dir / "slot-b.jrn", 24 + big.size() + 4);
+  j = Journal::open(dir.string(), &error);
+  ASSERT_TRUE(j) << error;
+  EXPECT_EQ(std::filesystem::file_size(dir / "slot-b.jrn"), 8192u);
+  EXPECT_EQ(j->read()->sequence, 2u);
+  EXPECT_TRUE(j->read()->payload == big);
   std::filesystem::remove_all(dir);
 }
 

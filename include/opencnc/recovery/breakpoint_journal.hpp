@@ -87,6 +87,10 @@ class BreakpointJournal final : public control::Feature {
   std::vector<double> latencies_ms() const;
   /// The last write's error ("" = none). Any thread.
   std::string last_error() const;
+  /// How the writer makes a record durable and at what priority, in words: the journal's way
+  /// (Journal::how), the thread's scheduling (SCHED_FIFO 70, or why not) and its I/O priority
+  /// (real-time class, or why not); the way alone until the writer thread has started. Any thread.
+  std::string writer_status() const;
   /// Where the last recovery choice is, and why it failed. Controller thread.
   RecoveryPhase phase() const noexcept { return phase_; }
   const std::string& recovery_error() const noexcept { return recovery_error_; }
@@ -105,6 +109,7 @@ class BreakpointJournal final : public control::Feature {
   void post(Work w);
   void writer_loop();
   void write_one(Work& w);
+  void set_writer_status(bool fifo, bool rt_io);
   void begin_record(const control::TraceSample& s, const control::TraceContext& c);
   void complete_record();
   // Recovery (breakpoint_recovery.cpp).
@@ -150,9 +155,11 @@ class BreakpointJournal final : public control::Feature {
   std::optional<BreakpointRecord> written_;
   std::vector<double> latencies_ms_;
   std::string error_;
+  std::string writer_status_;
   // Writer thread only: the content hash of the program opened last.
   std::string hashed_path_;
   FileHash hash_;
+  bool fifo_ = false, rt_io_ = false;  ///< what the writer thread was granted
   std::thread writer_;
 };
 
