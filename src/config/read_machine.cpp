@@ -132,12 +132,15 @@ void read_power(Section& top, MachineProfile& profile) {
     s.reject("dc_link_idle_power_w", "needs power.dc_link_capacitance_f");
   const toml::table* st = s.subtable("sim");
   if (st == nullptr) return;
-  Section m(*st, "power.sim", {"dc_link_capacitance_f", "idle_power_w", "ups_runtime_s"}, top.reporter());
+  Section m(*st, "power.sim", {"dc_link_capacitance_f", "idle_power_w", "ups_runtime_s", "ups_holds_dc_link"},
+            top.reporter());
   p.sim.dc_link_capacitance_f =
       m.number_or("dc_link_capacitance_f", p.sim.dc_link_capacitance_f, Bound::Positive);
   p.sim.idle_power_w = m.number_or("idle_power_w", p.sim.idle_power_w, Bound::NonNegative);
   p.sim.ups_runtime_s = m.number_or("ups_runtime_s", p.sim.ups_runtime_s, Bound::NonNegative);
   if (!p.sim.ups) m.reject("ups_runtime_s", "needs power.ups = true");
+  p.sim.ups_holds_dc_link = m.boolean_or("ups_holds_dc_link", false);
+  if (!p.sim.ups) m.reject("ups_holds_dc_link", "needs power.ups = true");
 }
 
 void read_probe(Section& top, MachineProfile& profile) {

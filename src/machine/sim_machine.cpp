@@ -227,19 +227,21 @@ std::array<double, 3> SimMachine::worn_offset() const noexcept {
   return o;
 }
 
-// Mains on: the rectifier holds the DC link at nominal. Mains off with a charged UPS: the
-// UPS does. Otherwise the link capacitor alone feeds the idle load and the axes:
-// ½·C·V² loses idle_power·T + E_axes per period (braking axes give energy back).
+// Mains on: the rectifier holds the DC link at nominal. Mains off: a charged UPS keeps the
+// control going (and holds the link too only if it is built to); otherwise the link capacitor
+// alone feeds the idle load and the axes: ½·C·V² loses idle_power·T + E_axes per period
+// (braking axes give energy back).
 void SimMachine::update_power(const MachineOutputs& out) noexcept {
   const SimPowerConfig& p = config_.power;
   const double period = config_.servo_period_s;
   on_battery_ = !mains_ok_ && ups_periods_left_ > 0;
   if (mains_ok_) {
     dc_link_v_ = p.dc_link_nominal_v;
-  } else if (on_battery_) {
+  } else if (on_battery_ && p.ups_holds_dc_link) {
     --ups_periods_left_;
     dc_link_v_ = p.dc_link_nominal_v;
   } else {
+    if (on_battery_) --ups_periods_left_;
     double energy_j = 0;  // what the axes took from the link in this period
     for (int j = 0; j < config_.joint_count; ++j) energy_j += joints_[static_cast<std::size_t>(j)].energy_j();
     const double c = p.dc_link_capacitance_f;

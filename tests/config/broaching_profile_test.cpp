@@ -76,6 +76,8 @@ TEST(BroachingProfile, TheBroachLoadsItsLevelsAndBore) {
   EXPECT_EQ(load.profile->power.dc_link_idle_power_w, 150.0);
   EXPECT_EQ(sim.power.dc_link_capacitance_f, 0.0047);
   EXPECT_EQ(sim.power.idle_power_w, 150.0);
+  EXPECT_TRUE(sim.power.ups);
+  EXPECT_FALSE(sim.power.ups_holds_dc_link);  // the UPS feeds the control; the link drains
   EXPECT_EQ(load.profile->find(Axis::Z)->peak_deceleration, 6000.0);
   EXPECT_EQ(load.profile->find(Axis::C)->peak_deceleration, 14400.0);
 }

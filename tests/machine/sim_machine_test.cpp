@@ -207,10 +207,34 @@ TEST(SimMachine, DcLinkRunsDownAfterMainsLoss) {
   EXPECT_TRUE(in.joints[1].amp_fault);
 }
 
-TEST(SimMachine, UpsHoldsTheLinkForItsRuntime) {
+// The usual UPS feeds the control only: it reports its battery while the drives' link drains as
+// without it.
+TEST(SimMachine, UpsFeedsTheControlWhileTheLinkDrains) {
   SimMachineConfig c = machine_config();
   c.power.ups = true;
   c.power.ups_runtime_s = 0.5;
+  SimMachineConfig no_ups = machine_config();
+  SimMachine m(c), bare(no_ups);
+  m.set_mains_ok(false);
+  bare.set_mains_ok(false);
+  MachineInputs in, bare_in;
+  for (int k = 0; k < 200; ++k) {
+    m.write(holding());
+    bare.write(holding());
+  }
+  m.read(in);
+  bare.read(bare_in);
+  EXPECT_TRUE(in.power.ups_on_battery);
+  EXPECT_NEAR(m.ups_remaining_s(), 0.3, 1e-12);
+  EXPECT_LT(in.power.dc_link_v, 560.0);
+  EXPECT_EQ(in.power.dc_link_v, bare_in.power.dc_link_v);
+}
+
+TEST(SimMachine, AUpsBuiltToHoldTheLinkHoldsItForItsRuntime) {
+  SimMachineConfig c = machine_config();
+  c.power.ups = true;
+  c.power.ups_runtime_s = 0.5;
+  c.power.ups_holds_dc_link = true;
   SimMachine m(c);
   m.set_mains_ok(false);
   MachineInputs in;

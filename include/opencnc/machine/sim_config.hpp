@@ -150,6 +150,9 @@ struct SimPowerConfig {
   double idle_power_w = 150;  ///< load on the DC link when no axis moves
   bool ups = false;
   double ups_runtime_s = 300;  ///< battery time after mains loss
+  /// The UPS feeds the control only (the usual set-up: the drives' link drains from the signal
+  /// on); true models a UPS large enough to hold the drives' link too, for its runtime.
+  bool ups_holds_dc_link = false;
 };
 
 /// A reference sphere the simulated probe input touches instead of a switch: the electrode (or
