@@ -599,16 +599,13 @@ Preflight preflight_pass(const gcode::Options& o, const std::string& path, const
   return out;
 }
 
-/// The machine's code modules with the EDM codes added, M180's P checked against its conditions.
-std::function<std::shared_ptr<const gcode::Extensions>(gcode::Dialect)> with_edm_codes(
-    const machine::EdmConfig& edm,
-    std::function<std::shared_ptr<const gcode::Extensions>(gcode::Dialect)> base) {
-  std::vector<int> numbers;
-  for (int i = 0; i < edm.condition_count; ++i)
-    numbers.push_back(edm.conditions[static_cast<std::size_t>(i)].number);
-  return [numbers, base](gcode::Dialect d) {
-    return gcode::edm_extensions(d, numbers, base ? base(d) : nullptr);
-  };
+/// The numbers of the machine's machining conditions, for M180's P; null without [edm].
+std::shared_ptr<const std::vector<int>> edm_condition_numbers(const config::MachineProfile& profile) {
+  if (!profile.edm.present) return nullptr;
+  const machine::EdmConfig& edm = profile.edm.config;
+  auto numbers = std::make_shared<std::vector<int>>();
+  for (int i = 0; i < edm.condition_count; ++i) numbers->push_back(edm.conditions[static_cast<std::size_t>(i)].number);
+  return numbers;
 }
 
 }  // namespace
@@ -644,7 +641,7 @@ std::optional<GcodeSourceConfig> GcodeProgramSource::config_for(const config::Ma
   c.hand = hand_axes(profile);
   c.coupling = coupled_axes(profile);
   if (c.coupling.any()) c.extensions = gcode::coupling_extensions;
-  if (profile.edm.present) c.extensions = with_edm_codes(profile.edm.config, c.extensions);
+  c.edm_conditions = edm_condition_numbers(profile);
   return c;
 }
 
@@ -652,10 +649,23 @@ GcodeProgramSource::GcodeProgramSource(GcodeSourceConfig config) : config_(std::
 
 GcodeProgramSource::~GcodeProgramSource() = default;
 
+// A program opened after this reads M180 against the new numbers; the MDI session starts afresh
+// (its interpreter holds the modules it was made with).
+void GcodeProgramSource::profile_changed(const config::MachineProfile& profile) {
+  std::shared_ptr<const std::vector<int>> numbers = edm_condition_numbers(profile);
+  const bool same = numbers && config_.edm_conditions ? *numbers == *config_.edm_conditions
+                                                      : numbers == config_.edm_conditions;
+  if (same) return;
+  config_.edm_conditions = std::move(numbers);
+  ++conditions_changed_;
+  mdi_.reset();
+}
+
 gcode::Options GcodeProgramSource::options_for(const std::string& path, const LoadOptions& options) const {
   gcode::Options o = config_.options;
   if (!path.empty()) o.dialect = gcode::dialect_marker(path).value_or(o.dialect);
   o.extensions = config_.extensions ? config_.extensions(o.dialect) : gcode::standard_extensions(o.dialect);
+  if (config_.edm_conditions) o.extensions = gcode::edm_extensions(o.dialect, *config_.edm_conditions, o.extensions);
   o.block_delete = options.block_delete;
   if (config_.tools) o.tool_table = config_.tools->snapshot();
   return o;

@@ -285,4 +285,47 @@ ParametersRequest conditions_request(const json& body, const config::MachineProf
   return r;
 }
 
+ParametersRequest condition_change_request(const json& body, const config::MachineProfile& profile, bool remove) {
+  ParametersRequest r;
+  const auto number = body.find("condition");
+  if (number == body.end() || !number->is_number_integer()) {
+    r.message = "\"condition\" must be a condition's number";
+    return r;
+  }
+  const auto from = body.find("from");
+  if (!remove && from != body.end() && !from->is_number_integer()) {
+    r.message = "\"from\" must be the number of the condition to copy";
+    return r;
+  }
+  r.status = 422;
+  const machine::EdmConfig& edm = profile.edm.config;
+  if (!profile.edm.present) {
+    r.message = "this machine has no machining conditions (no [edm] section)";
+    return r;
+  }
+  const int n = number->get<int>();
+  config::ConditionChange change{n, remove, 0};
+  if (remove && edm.find(n) == nullptr) {
+    r.message = fmt::format("the machine has no machining condition {} (GET /api/v1/conditions lists them)", n);
+    return r;
+  }
+  if (!remove) {
+    if (n < 1 || n > 99) {
+      r.message = fmt::format("a machining condition's number is 1 to 99, not {}", n);
+      return r;
+    }
+    if (edm.find(n) != nullptr) {
+      r.message = fmt::format("condition {} exists already: change its values with set-conditions", n);
+      return r;
+    }
+    change.from = from != body.end() ? from->get<int>() : config::condition_to_copy(edm, n);
+    if (edm.find(change.from) == nullptr) {
+      r.message = fmt::format("the machine has no machining condition {} to copy", change.from);
+      return r;
+    }
+  }
+  r.request = control::Request::change_conditions({change});
+  return r;
+}
+
 }  // namespace opencnc::hmi
