@@ -2,8 +2,10 @@
 // hmi_clients_bench: the simulated mill with a real-time servo thread runs the bracket program
 // over and over while N WebSocket clients read the status stream (and S more connect and never
 // read); prints the servo's overruns and wake-up latency, what the clients received, and who was
-// dropped. Run it with --clients 0 for the baseline of the same machine.
+// dropped; and where the servo's lost periods went (stolen by the hypervisor, waiting for its CPU,
+// preempted). Run it with --clients 0 for the baseline of the same machine.
 #include <sys/resource.h>
+#include <unistd.h>
 
 #include <boost/asio/connect.hpp>
 #include <boost/asio/ip/tcp.hpp>
@@ -20,6 +22,7 @@
 #include "opencnc/controller/gcode_source.hpp"
 #include "opencnc/hmi/machine_host.hpp"
 #include "opencnc/hmi/server.hpp"
+#include "servo_accounting.hpp"
 
 namespace {
 
@@ -80,10 +83,55 @@ double cpu_s() {
          (u.ru_utime.tv_usec + u.ru_stime.tv_usec) * 1e-6;
 }
 
+// Where the lost periods went: the servo thread's own accounting over the run, then each overrun
+// with the stolen time and run-queue wait in the 20 ms before its deadline and after its end.
+void print_accounting(const bench::ServoAccounting& a, const std::vector<control::OverrunRecord>& log,
+                      std::uint64_t ticks, bool list) {
+  if (!a.error().empty() || a.samples().size() < 2) {
+    std::printf("servo accounting: %s\n", a.error().empty() ? "too few samples" : a.error().c_str());
+    return;
+  }
+  const auto& first = a.samples().front();
+  const auto& last = a.samples().back();
+  std::printf(
+      "servo thread: waited %.3f ms for its CPU, preempted %llu times, slept %llu times in %llu periods; "
+      "%.0f ms stolen from its CPU by the hypervisor\n",
+      static_cast<double>(last.run_delay_ns - first.run_delay_ns) / 1e6,
+      static_cast<unsigned long long>(last.involuntary - first.involuntary),
+      static_cast<unsigned long long>(last.voluntary - first.voluntary), static_cast<unsigned long long>(ticks),
+      static_cast<double>(last.steal_ticks - first.steal_ticks) * 1000.0 / static_cast<double>(sysconf(_SC_CLK_TCK)));
+  constexpr std::int64_t kAround = 20'000'000;
+  int late = 0, long_tick = 0, stolen = 0, waited = 0, neither = 0;
+  double worst_ms = 0;
+  for (const auto& c : a.attribute(log, kAround, kAround)) {
+    const double woke_ms = static_cast<double>(c.record.woke_ns - c.record.deadline_ns) / 1e6;
+    const double tick_ms = static_cast<double>(c.record.done_ns - c.record.woke_ns) / 1e6;
+    (woke_ms >= tick_ms ? late : long_tick) += 1;
+    worst_ms = std::max(worst_ms, woke_ms + tick_ms);
+    if (c.steal_ticks > 0)
+      ++stolen;
+    else if (c.run_delay_ns > 100'000 || c.involuntary > 0)
+      ++waited;
+    else
+      ++neither;
+    if (list)
+      std::printf("  overrun at %.3f s: woke %.3f ms late, tick %.3f ms; around it: %llu stolen ticks, "
+                  "%.3f ms run-queue wait, %llu preemptions\n",
+                  static_cast<double>(c.record.deadline_ns - a.samples().front().t_ns) / 1e9, woke_ms, tick_ms,
+                  static_cast<unsigned long long>(c.steal_ticks), static_cast<double>(c.run_delay_ns) / 1e6,
+                  static_cast<unsigned long long>(c.involuntary));
+  }
+  std::printf(
+      "overruns logged: %zu (woke late %d, tick ran long %d; worst %.3f ms); within 20 ms of stolen time %d, "
+      "of the thread waiting for its CPU %d, of neither %d\n",
+      log.size(), late, long_tick, worst_ms, stolen, waited, neither);
+}
+
 int usage() {
   std::fprintf(
       stderr,
-      "usage: hmi_clients_bench [--clients N (100)] [--stalled S (5)] [--seconds T (30)] [--hz R (30)] [--servo-cpu N]\n");
+      "usage: hmi_clients_bench [--clients N (100)] [--stalled S (5)] [--seconds T (30)] [--hz R (30)] [--servo-cpu N]\n"
+      "                         [--overruns] (list each overrun with what was seen around it)\n");
   return 2;
 }
 
@@ -93,9 +141,14 @@ int main(int argc, char** argv) {
   int clients = 100, stalled = 5;
   double seconds = 30, hz = 30;
   int servo_cpu = -1;
+  bool list_overruns = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "-h" || a == "--help") return usage(), 0;
+    if (a == "--overruns") {
+      list_overruns = true;
+      continue;
+    }
     if (i + 1 >= argc) return usage();
     if (a == "--clients")
       clients = std::atoi(argv[++i]);
@@ -147,6 +200,11 @@ int main(int argc, char** argv) {
     ioc.run();
   });
 
+  // Sampled every 2 ms from a thread that, started after the servo's, keeps off the servo's CPU.
+  const control::RealtimeClock* clock = host.realtime_clock();
+  bench::ServoAccounting accounting(clock ? clock->thread_id() : 0, servo_cpu, 2'000'000);
+  const std::uint64_t logged0 = clock ? clock->overrun_log().size() : 0;
+
   // The operator: starts the program, confirms tool changes, starts it again when it ends.
   const std::uint64_t ticks0 = host.ticks(), overruns0 = host.overruns();
   const double cpu0 = cpu_s();
@@ -164,7 +222,11 @@ int main(int argc, char** argv) {
   const std::uint64_t ticks = host.ticks() - ticks0, overruns = host.overruns() - overruns0;
   const auto stats = server.stats();
   const auto* lat = host.latency();
-  const auto finished = c.status().runs_finished;
+  const auto last = c.status();
+  const auto finished = last.runs_finished;
+  accounting.stop();
+  std::vector<control::OverrunRecord> log = clock ? clock->overrun_log() : std::vector<control::OverrunRecord>{};
+  log.erase(log.begin(), log.begin() + static_cast<std::ptrdiff_t>(std::min<std::uint64_t>(logged0, log.size())));
   ioc.stop();
   io.join();
   server.stop();
@@ -196,7 +258,9 @@ int main(int argc, char** argv) {
               clients ? static_cast<double>(sum) / clients / wall : 0.0, static_cast<double>(bytes) / 1e6);
   std::printf("stalled clients: %d connected, %llu dropped by the server\n", stalled_closed,
               static_cast<unsigned long long>(stats.dropped));
-  std::printf("programs finished: %llu; process CPU %.2f s (%.0f %% of one core)\n",
-              static_cast<unsigned long long>(finished), cpu, 100 * cpu / wall);
+  std::printf("programs finished: %llu, the last at %.0f %% (line %u)%s%s; process CPU %.2f s (%.0f %% of one core)\n",
+              static_cast<unsigned long long>(finished), 100 * last.progress, last.location.line,
+              last.fault_text.empty() ? "" : ", fault: ", last.fault_text.c_str(), cpu, 100 * cpu / wall);
+  print_accounting(accounting, log, ticks, list_overruns);
   return 0;
 }

@@ -5,7 +5,9 @@
 #include <pthread.h>
 #include <sched.h>
 #include <sys/mman.h>
+#include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -161,6 +163,7 @@ bool RealtimeClock::start(Tickable& t) {
 
 void RealtimeClock::loop(Tickable& t) noexcept {
   prefault_stack();
+  thread_id_.store(static_cast<int>(gettid()), std::memory_order_release);
   const std::int64_t period = options_.period_ns;
   std::int64_t deadline = monotonic_ns();
   while (!stop_requested_.load(std::memory_order_acquire)) {
@@ -177,12 +180,19 @@ void RealtimeClock::loop(Tickable& t) noexcept {
     // the schedule stays on the absolute grid instead of bursting to catch up.
     if (done > deadline + period) {
       const std::int64_t missed = (done - deadline) / period;
-      overruns_.fetch_add(1, std::memory_order_relaxed);
+      const std::uint64_t n = overruns_.load(std::memory_order_relaxed);
+      if (n < kOverrunLog) overrun_log_[n] = OverrunRecord{deadline, woke, done};
+      overruns_.store(n + 1, std::memory_order_release);
       deadline += (missed - 1) * period;
     }
     if (!go_on) break;
   }
   running_.store(false, std::memory_order_release);
+}
+
+std::vector<OverrunRecord> RealtimeClock::overrun_log() const {
+  const std::uint64_t n = overruns_.load(std::memory_order_acquire);
+  return {overrun_log_.begin(), overrun_log_.begin() + static_cast<std::ptrdiff_t>(std::min<std::uint64_t>(n, kOverrunLog))};
 }
 
 void RealtimeClock::stop() {

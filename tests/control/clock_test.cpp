@@ -2,6 +2,7 @@
 // Clocks: the virtual clock is exact; the periodic thread ticks, stops, and records its latency.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <thread>
@@ -84,4 +85,37 @@ TEST(RealtimeClock, StopEndsARunningThread) {
   const auto after = c.n.load();
   std::this_thread::sleep_for(std::chrono::milliseconds(5));
   EXPECT_EQ(c.n.load(), after);
+}
+
+namespace {
+// Ticks until `stop_after`; the tick numbered `slow` takes `slow_ns` of wall time.
+struct SlowTick final : Tickable {
+  std::uint64_t n = 0, stop_after = 10, slow = 3;
+  std::int64_t slow_ns = 3'000'000;
+  bool tick() noexcept override {
+    if (++n == slow) std::this_thread::sleep_for(std::chrono::nanoseconds(slow_ns));
+    return n < stop_after;
+  }
+};
+}  // namespace
+
+// A tick that outlasts two periods is an overrun whatever the machine; the log says the time went
+// into the tick, not into a late wake-up, and names the periodic thread so benches can read its
+// scheduler accounting.
+TEST(RealtimeClock, LogsEachOverrunWithWhereItsTimeWent) {
+  RealtimeClock::Options o;
+  o.period_ns = 1'000'000;
+  o.lock_memory = false;
+  RealtimeClock clock(o);
+  SlowTick t;
+  ASSERT_TRUE(clock.start(t));
+  clock.wait();
+  ASSERT_GE(clock.overruns(), 1u);
+  const auto log = clock.overrun_log();
+  ASSERT_EQ(log.size(), clock.overruns());
+  const bool found = std::any_of(log.begin(), log.end(), [](const OverrunRecord& r) {
+    return r.done_ns - r.woke_ns >= 3'000'000 && r.woke_ns >= r.deadline_ns;
+  });
+  EXPECT_TRUE(found);
+  EXPECT_GT(clock.thread_id(), 0);
 }

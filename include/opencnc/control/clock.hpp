@@ -2,6 +2,7 @@
 // Clocks that drive the servo tick: virtual time (tests, simulation) and a real-time periodic thread.
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <memory>
@@ -56,6 +57,14 @@ class LatencyHistogram {
   std::atomic<double> sum_sq_ns2_{0};
 };
 
+/// One overrun as the periodic thread saw it, in CLOCK_MONOTONIC ns: whether the thread woke late
+/// (`woke_ns - deadline_ns`) or its tick ran long (`done_ns - woke_ns`) tells where the time went.
+struct OverrunRecord {
+  std::int64_t deadline_ns = 0;
+  std::int64_t woke_ns = 0;
+  std::int64_t done_ns = 0;
+};
+
 /// A periodic thread with absolute-time sleeps (clock_nanosleep on CLOCK_MONOTONIC), SCHED_FIFO and
 /// mlockall where permitted (a clear warning and a normal thread where not), overrun counting and a
 /// wake-up latency histogram. Start/stop from a non-real-time thread.
@@ -91,6 +100,12 @@ class RealtimeClock {
   std::uint64_t overruns() const noexcept { return overruns_.load(std::memory_order_relaxed); }
   std::uint64_t ticks() const noexcept { return ticks_.load(std::memory_order_relaxed); }
   const LatencyHistogram& latency() const noexcept { return latency_; }
+  /// The first kOverrunLog overruns, oldest first (fewer if fewer happened). Any thread.
+  static constexpr std::size_t kOverrunLog = 512;
+  std::vector<OverrunRecord> overrun_log() const;
+  /// The periodic thread's kernel thread id (0 before it runs), so that a benchmark can read its
+  /// scheduler accounting (/proc/self/task/<tid>/schedstat). Any thread.
+  int thread_id() const noexcept { return thread_id_.load(std::memory_order_acquire); }
 
  private:
   struct Thread;
@@ -102,7 +117,10 @@ class RealtimeClock {
   std::atomic<bool> running_{false};
   std::atomic<std::uint64_t> overruns_{0};
   std::atomic<std::uint64_t> ticks_{0};
+  std::atomic<int> thread_id_{0};
   LatencyHistogram latency_;
+  // Written by the periodic thread only, each slot before overruns_ is released past it.
+  std::array<OverrunRecord, kOverrunLog> overrun_log_{};
   bool realtime_ = false;
   bool memory_locked_ = false;
   std::vector<std::string> warnings_;

@@ -63,6 +63,8 @@ class MachineHost {
   std::uint64_t ticks() const noexcept;
   std::uint64_t overruns() const noexcept;
   const control::LatencyHistogram* latency() const noexcept;
+  /// The real-time clock (its overrun log and thread id, for benchmarks); null in virtual time.
+  const control::RealtimeClock* realtime_clock() const noexcept { return clock_.get(); }
   /// A control of the simulated machine: "mains-off" (the mains fail: the power-fail stop),
   /// "mains-on", "electrode" (the electrode in the spindle, for the reference sphere). Applied by
   /// the thread that steps the machine before its next period, and returns once it is: a request
