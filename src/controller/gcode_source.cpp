@@ -599,6 +599,11 @@ Preflight preflight_pass(const gcode::Options& o, const std::string& path, const
   return out;
 }
 
+/// True when `a` and `b` are both null or hold the same numbers.
+bool same_numbers(const std::shared_ptr<const std::vector<int>>& a, const std::shared_ptr<const std::vector<int>>& b) {
+  return a && b ? *a == *b : a == b;
+}
+
 /// The numbers of the machine's machining conditions, for M180's P; null without [edm].
 std::shared_ptr<const std::vector<int>> edm_condition_numbers(const config::MachineProfile& profile) {
   if (!profile.edm.present) return nullptr;
@@ -649,16 +654,13 @@ GcodeProgramSource::GcodeProgramSource(GcodeSourceConfig config) : config_(std::
 
 GcodeProgramSource::~GcodeProgramSource() = default;
 
-// A program opened after this reads M180 against the new numbers; the MDI session starts afresh
-// (its interpreter holds the modules it was made with).
+// A program opened after this reads M180 against the new numbers; the MDI session starts afresh at
+// its next line if they differ from its own (its interpreter holds the modules it was made with).
 void GcodeProgramSource::profile_changed(const config::MachineProfile& profile) {
   std::shared_ptr<const std::vector<int>> numbers = edm_condition_numbers(profile);
-  const bool same = numbers && config_.edm_conditions ? *numbers == *config_.edm_conditions
-                                                      : numbers == config_.edm_conditions;
-  if (same) return;
+  if (same_numbers(numbers, config_.edm_conditions)) return;
   config_.edm_conditions = std::move(numbers);
   ++conditions_changed_;
-  mdi_.reset();
 }
 
 gcode::Options GcodeProgramSource::options_for(const std::string& path, const LoadOptions& options) const {
@@ -702,7 +704,9 @@ std::unique_ptr<ProgramStream> GcodeProgramSource::resume(const std::string& pat
 }
 
 std::unique_ptr<ProgramStream> GcodeProgramSource::mdi(std::string_view line, const Pose& start) {
+  if (mdi_ && !same_numbers(mdi_conditions_, config_.edm_conditions)) mdi_.reset();
   if (!mdi_) {
+    mdi_conditions_ = config_.edm_conditions;
     gcode::Options o = options_for("", {});
     o.mode = gcode::Mode::Execute;
     mdi_ = std::make_unique<gcode::Interpreter>(o);

@@ -443,8 +443,9 @@ TEST(Edm, AnEditedConditionIsTheOneAProgramSelectsAfterwards) {
 
 // Conditions added and deleted by the admin while idle: a program opened after the add selects
 // the new condition and burns with its values (a copy of 1, its jump lowered); deleting the
-// condition the open program selects is refused at the program's line; a program opened after a
-// delete gets the interpreter's error for an unknown condition. The event log says "machining
+// condition the open program selects is refused at the program's line; an MDI line (its session
+// older than the change) and a program opened after a delete get the interpreter's error for an
+// unknown condition. The event log says "machining
 // conditions changed".
 TEST(Edm, AnAddedConditionIsSelectableAndADeletedOneIsNot) {
   const auto dir = std::filesystem::temp_directory_path() / ("opencnc-edm-add-" + std::to_string(::getpid()));
@@ -489,10 +490,23 @@ TEST(Edm, AnAddedConditionIsSelectableAndADeletedOneIsNot) {
     double lift_max = 0;
     for (const TraceSample& s : samples->all) lift_max = std::max(lift_max, s.edm.jump_lift_mm);
     EXPECT_NEAR(lift_max, 0.15, 1e-9);
-    // 9 deleted: a program opened afterwards that selects it gets the interpreter's message.
+    // 9 deleted: an MDI line (its session made before) and a program opened afterwards that
+    // select it get the interpreter's message.
+    ASSERT_TRUE(rig.request(Request::set_mode(Mode::Mdi)).accepted);
+    const auto mdi = [&](const char* line) {
+      const Outcome m = rig.request(Request::mdi(line), 100000);
+      rig.run_until([&] { return !rig.status().run_active && rig.status().servo.state == State::Idle; }, 20000);
+      return m;
+    };
+    ASSERT_TRUE(mdi("G0 Z0").accepted);
     o = rig.request(Request::change_conditions({{9, true, 0}}, "admin"));
     ASSERT_TRUE(o.accepted) << o.message;
     EXPECT_EQ(rig.servo().config().edm.find(9), nullptr);
+    const Outcome m9 = mdi("M180 P9");
+    EXPECT_FALSE(m9.accepted);
+    ASSERT_FALSE(m9.diagnostics.items().empty());
+    EXPECT_NE(m9.diagnostics.items().front().message.find("(1, 2, 3, 5)"), std::string::npos);
+    ASSERT_TRUE(rig.request(Request::set_mode(Mode::Auto)).accepted);
     const std::string nine = write_program(burn(9, 0.01));
     o = rig.request(Request::open(nine), 100000);
     ASSERT_FALSE(o.accepted);

@@ -99,6 +99,7 @@ class GcodeProgramSource final : public ProgramSource {
   std::unique_ptr<gcode::Interpreter> mdi_;  ///< the MDI session: modal state lives on
   std::uint64_t mdi_tools_version_ = 0;
   std::uint64_t conditions_changed_ = 0;  ///< counts changes of config_.edm_conditions
+  std::shared_ptr<const std::vector<int>> mdi_conditions_;  ///< the numbers mdi_ was made with
 };
 
 }  // namespace opencnc::control
