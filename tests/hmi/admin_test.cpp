@@ -380,6 +380,9 @@ TEST(AdminConditions, AddsAndDeletesThatCannotBeAreRefusedAndChangeNothing) {
   const auto status = [&](const char* body) { return post(rig.port, body, kAdmin).status; };
   EXPECT_EQ(status(R"({"kind":"add-condition","condition":3})"), 422);               // exists
   EXPECT_EQ(status(R"({"kind":"add-condition","condition":0})"), 422);               // 1 to 99
+  EXPECT_EQ(status(R"({"kind":"add-condition","condition":4294967300})"), 422);      // not 4
+  EXPECT_EQ(status(R"({"kind":"delete-condition","condition":4294967305})"), 422);   // not 9
+  EXPECT_EQ(status(R"({"kind":"set-conditions","condition":4294967297,"values":{"on_time_us":1}})"), 422);
   EXPECT_EQ(status(R"({"kind":"add-condition","condition":5,"from":6})"), 422);      // no 6 to copy
   EXPECT_EQ(status(R"({"kind":"add-condition","condition":5,"from":"3"})"), 400);
   EXPECT_EQ(status(R"({"kind":"add-condition"})"), 400);
