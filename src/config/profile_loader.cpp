@@ -36,10 +36,10 @@ void read_identity(Section& top, MachineProfile& p) {
 
 MachineProfile read_profile(const toml::table& root, Reporter& r, const std::filesystem::path& base_dir,
                             std::span<const FileText> files) {
-  Section top(root, "",
-              {"name", "description", "servo_period_s", "axis", "spindle", "power", "probe", "tool_changer",
-               "process", "io", "interpreter", "planner", "sim", "interlocks", "handwheel", "tool_guard",
-               "coupling", "edm", "alarms"},
+  Section top(root, "", {"name",   "description",  "servo_period_s", "axis",       "spindle",     "power",
+                         "probe",  "tool_changer", "process",        "io",         "interpreter", "planner",
+                         "sim",    "interlocks",   "handwheel",      "tool_guard", "coupling",    "edm",
+                         "alarms", "tool_change"},
               r);
   MachineProfile p;
   read_identity(top, p);
@@ -50,6 +50,7 @@ MachineProfile read_profile(const toml::table& root, Reporter& r, const std::fil
   detail::read_power(top, p);
   detail::read_probe(top, p);
   detail::read_tool_changer(top, p);
+  detail::read_tool_change(top, p);
   detail::read_io(top, p);
   detail::read_interlocks(top, p);
   detail::read_alarms(top, p);

@@ -27,6 +27,8 @@ void read_reference_sphere(Section& probe, MachineProfile& profile);
 /// [[sim.electrode]]: the tools' true electrodes in the simulation (read_sim calls it).
 void read_sim_electrodes(Section& sim, MachineProfile& profile);
 void read_tool_changer(Section& top, MachineProfile& profile);
+/// [tool_change]: the tool-change position. Needs the axes (their letters and soft limits).
+void read_tool_change(Section& top, MachineProfile& profile);
 void read_io(Section& top, MachineProfile& profile);
 /// [process] with [process.cutting] and [process.broaching]. Needs [io], the axes and [coupling].
 void read_process(Section& top, MachineProfile& profile);

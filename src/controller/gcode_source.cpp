@@ -638,6 +638,9 @@ std::optional<GcodeSourceConfig> GcodeProgramSource::config_for(const config::Ma
   o.initial_units = canon::Units::Mm;
   o.optional_stop = true;  // M1 always reaches the servo, which decides with the live switch
   o.spindle = profile.spindle.present;
+  o.tool_change.axes = profile.tool_change.axes;
+  o.tool_change.machine = profile.tool_change.position;
+  o.tool_change.z_first = profile.tool_change.z_first;
   if (!profile.interpreter.tool_table.empty()) {
     c.tools = tools::FileToolTable::open(profile.interpreter.tool_table, diags);
     if (!c.tools) return std::nullopt;

@@ -345,17 +345,48 @@ void RunFromLineFeature::start_approach(Scan& scan, FeatureHost& host) {
       fmt::format("approach to line {}", scan.line), approach(s.servo.commanded, s.servo.tool, *scan.at)));
 }
 
-// The line's tool changed in first (M6 through the machine's own path: the changer or the
-// operator's dialog), then the spindle and the coolant as the program has them at the line, then
-// up to the higher of the two Z, across, and down onto the move's start: at the move's own feed
-// when it is a feed move (the tool may be near the work there), else at rapid. The points carry
-// the line's tool-length offset, so the status shows the work position the program will have.
-std::shared_ptr<const canon::Program> RunFromLineFeature::approach(const Pose& from, int spindle_tool,
+namespace {
+
+/// Rapids to the profile's tool-change position as the interpreter's M6 does (Z alone first when
+/// asked); returns where the machine then stands. The builder has no offsets yet: its points are
+/// machine coordinates.
+Pose to_tool_change(canon::ProgramBuilder& b, canon::SegmentId& id, const Pose& from,
+                    const config::ToolChangeProfile& tc) {
+  Pose there = from;
+  for (int i = 0; i < kAxisCount; ++i) {
+    if (tc.axes.has(static_cast<Axis>(i))) there[i] = tc.position[i];
+  }
+  if (there == from) return from;
+  if (tc.z_first && there[Axis::Z] != from[Axis::Z]) {
+    Pose up = from;
+    up[Axis::Z] = there[Axis::Z];
+    if (!(up == there)) b.straight_traverse(id++, up);
+  }
+  b.straight_traverse(id++, there);
+  return there;
+}
+
+}  // namespace
+
+// The line's tool changed in first (M6 through the machine's own path: the spindle stopped, the
+// profile's tool-change position, the changer or the operator's dialog), then the spindle and the
+// coolant as the program has them at the line, then up to the higher of the two Z, across, and
+// down onto the move's start: at the move's own feed when it is a feed move (the tool may be near
+// the work there), else at rapid. The points carry the line's tool-length offset, so the status
+// shows the work position the program will have.
+std::shared_ptr<const canon::Program> RunFromLineFeature::approach(const Pose& machine, int spindle_tool,
                                                                    const LineStart& to) const {
-  canon::ProgramBuilder b(host_->profile().axis_mask(), from);
+  canon::ProgramBuilder b(host_->profile().axis_mask(), machine);
   b.set_motion_control_mode(canon::MotionControl::ExactPath, 0);  // each leg ends where it is programmed
+  Pose from = machine;
+  canon::SegmentId id = 0;
   if (to.tool >= 0 && to.tool != spindle_tool) {
     b.select_tool(to.tool);
+    const config::InterpreterOptions& i = host_->profile().interpreter;
+    // As the interpreter's M6: a Fanuc lathe's turret indexes with the spindle turning.
+    if (!(i.dialect == config::Dialect::Fanuc && i.machine == config::MachineKind::Lathe))
+      b.stop_spindle_turning(0);
+    from = to_tool_change(b, id, from, host_->profile().tool_change);
     b.change_tool(to.tool_index);
   }
   b.use_tool_length_offset(to.tool_offset);
@@ -375,7 +406,6 @@ std::shared_ptr<const canon::Program> RunFromLineFeature::approach(const Pose& f
   };
   Pose up = from;
   up[Axis::Z] = std::max(from[Axis::Z], to.start[Axis::Z]);
-  canon::SegmentId id = 0;
   if (up[Axis::Z] != from[Axis::Z]) b.straight_traverse(id++, program_point(up));
   Pose across = to.start;
   across[Axis::Z] = up[Axis::Z];

@@ -239,6 +239,7 @@ class Engine final : public ParamHost, public ExecContext {
   void tool_length_offset(int code);
   Pose current_in_system(int system, bool without_tlo) const;
   Pose machine_to_program(const Pose& machine_user) const;
+  Pose program_to_machine(const Pose& program) const;  ///< machine_to_program's inverse
   void rotate(double& x, double& y, double degrees) const noexcept;
   double user_to_program(double v) const noexcept { return v * user_to_program_factor_; }
   double program_to_user(double v) const noexcept { return v / user_to_program_factor_; }
@@ -252,6 +253,7 @@ class Engine final : public ParamHost, public ExecContext {
   void convert_overrides();
   void select_tool(int tool);
   void change_tool();
+  void move_to_tool_change(int at);  ///< `at`: where the M6 starts (its errors point there)
   void set_tool_number(int tool);
   void load_spindle(int index);
   void set_tool_parameters();

@@ -123,12 +123,64 @@ void Engine::change_tool() {
     out_.stop_spindle_turning(0);
     st_.modal.spindle = canon::SpindleDirection::Stopped;
   }
+  move_to_tool_change(at);
   out_.change_tool(st_.tool.selected_index);
   load_spindle(st_.tool.selected_index);
   SyncValues assumed;
   assumed.kind = SyncKind::ToolChange;
   assumed.position = st_.position.canon_position;
   request_sync(assumed);
+}
+
+// The profile's tool-change position: rapid there before the change, in machine coordinates as
+// G53 takes them (the work, G92 and tool-length offsets taken off, so the spindle ends at the
+// position whatever the tool), Z alone first when asked. The moves are the program's own: the
+// preview, the preflight's limits check and a replay see them, and the next move starts there.
+void Engine::move_to_tool_change(int at) {
+  const ToolChangePosition& tc = opt_.tool_change;
+  if (tc.axes.count() == 0) return;
+  if (st_.fanuc.transform.active()) {
+    const TransformState& t = st_.fanuc.transform;
+    fail_at(at, ErrorCode::FanucTransformActive,
+            "M6 moves to the tool-change position in machine coordinates: it cannot while {} is on (cancel "
+            "it first)",
+            t.rotating  ? "G68 rotation"
+            : t.scaling ? "G51 scaling"
+                        : "G51.1 mirroring");
+  }
+  const double per_mm = 1.0 / canon::mm_per_unit(st_.modal.units);
+  const Pose from = program_to_machine(st_.position.current);
+  Pose to = from;
+  int z_letter = -1;  // the program letter the axis map sends to the machine's Z
+  for (int i = 0; i < kAxisCount; ++i) {
+    const Axis axis = opt_.axis_map[static_cast<std::size_t>(i)];
+    if (!tc.axes.has(axis)) continue;
+    to[i] = tc.machine[axis] * (is_rotary(axis) ? 1.0 : per_mm);
+    if (axis == Axis::Z) z_letter = i;
+  }
+  // An axis that stays keeps its program coordinate exactly (no rounding through the offsets),
+  // X and Y both unless the XY rotation turns a move of one into both.
+  const auto go = [&](const Pose& machine) {
+    const Pose& now = st_.position.current;
+    const bool turned = st_.position.rotation_xy_deg != 0 && (machine[0] != from[0] || machine[1] != from[1]);
+    Pose p = machine_to_program(machine);
+    for (int i = 0; i < kAxisCount; ++i) {
+      if (machine[i] == from[i] && !(i < 2 && turned)) p[i] = now[i];
+    }
+    out_.straight_traverse(0, p);
+    st_.position.current = p;
+  };
+  if (to == from) return;
+  // Each move ends where it is programmed (Z up before anything goes across), then the program's
+  // own path control again.
+  out_.set_motion_control_mode(canon::MotionControl::ExactStop, 0);
+  if (tc.z_first && z_letter >= 0 && to[z_letter] != from[z_letter]) {
+    Pose up = from;
+    up[z_letter] = to[z_letter];
+    if (!(up == to)) go(up);
+  }
+  go(to);
+  out_.set_motion_control_mode(st_.modal.control, st_.modal.path_tolerance);
 }
 
 void Engine::set_tool_number(int tool) {

@@ -81,6 +81,20 @@ Pose Engine::machine_to_program(const Pose& m) const {
   return r;
 }
 
+Pose Engine::program_to_machine(const Pose& p) const {
+  const PositionState& s = st_.position;
+  Pose m;
+  double x = p[0] + s.axis_offset[0];
+  double y = p[1] + s.axis_offset[1];
+  rotate(x, y, s.rotation_xy_deg);
+  m[0] = x + s.origin_offset[0] + s.tool_offset[0];
+  m[1] = y + s.origin_offset[1] + s.tool_offset[1];
+  m[2] = p[2] + s.origin_offset[2] + s.axis_offset[2] + s.tool_offset[2];
+  for (int i = 3; i < 6; ++i) m[i] = p[i] + s.origin_offset[i] + s.axis_offset[i];
+  for (int i = 6; i < 9; ++i) m[i] = p[i] + s.origin_offset[i] + s.axis_offset[i] + s.tool_offset[i];
+  return m;
+}
+
 void Engine::set_coordinate_system(int code) {
   if (st_.modal.cutter_comp != CutterComp::Off)
     fail_at(block_.g_position(kGroupCoordSystem), ErrorCode::CompCoordinateSystem,

@@ -159,6 +159,27 @@ TEST_F(ProfileEditFile, ABadValueGetsTheLoadersMessageAtTheEditedLine) {
   EXPECT_FALSE(edit_profile(live_, inverted).ok());
 }
 
+// Soft limits narrowed past the tool-change position would let M6 move outside them: the edit
+// is refused with the loader's message at the position's axis.
+TEST_F(ProfileEditFile, LimitsThatLeaveTheToolChangePositionOutsideAreRefusedAtThePosition) {
+  std::ofstream(path_) << original_ << "\n[tool_change]\nposition = { X = 0.0, Z = 150.0 }\n";
+  const ProfileLoad load = load_profile(path_);
+  ASSERT_TRUE(load.ok());
+  const ProfileKeyEdit edits[] = {{"axis.z.max_limit", "100.0"}};
+  const ProfileEditResult r = edit_profile(*load.profile, edits);
+  ASSERT_FALSE(r.ok());
+  ASSERT_FALSE(r.diagnostics.items().empty());
+  const Diagnostic& d = r.diagnostics.items().front();
+  EXPECT_EQ(d.code, "config.range");
+  EXPECT_EQ(d.file, path_);
+  EXPECT_EQ(d.line, 3 + std::count(original_.begin(), original_.end(), '\n'));
+  EXPECT_EQ(d.col, 27u);
+  EXPECT_NE(d.message.find("tool_change.position.Z = 150 mm is outside Z's soft limits"), std::string::npos)
+      << d.message;
+  const ProfileKeyEdit wider[] = {{"axis.z.max_limit", "150.0"}};  // on the limit is inside
+  EXPECT_TRUE(edit_profile(*load.profile, wider).ok());
+}
+
 TEST_F(ProfileEditFile, KeysThatAreNotEditableOrOverriddenAndAChangedFileAreRefused) {
   const ProfileKeyEdit homing[] = {{"axis.x.homing.position", "1.0"}};
   EXPECT_NE(edit_profile(live_, homing).error.find("not a parameter that can be changed here"),

@@ -195,6 +195,21 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"AxisMapNotAnExchange",
                 with("[interpreter]\naxis_map = \"X=Z,Y=Z\"\n"),
                 {"config.range", "bad.toml", 8, 12}},
+        BadCase{"ToolChangeOutsideTheSoftLimits",
+                with("[tool_change]\nposition = { X = 500.0 }\n"),
+                {"config.range", "bad.toml", 8, 18}},
+        BadCase{"ToolChangeOnAnAxisTheMachineLacks",
+                with("[tool_change]\nposition = { X = 0.0, Z = 0.0 }\n"),
+                {"config.axis-letter", "bad.toml", 8, 27}},
+        BadCase{"ToolChangeNotAnAxisLetter",
+                with("[tool_change]\nposition = { Q = 0.0 }\n"),
+                {"config.unknown-key", "bad.toml", 8, 14}},
+        BadCase{"ToolChangeWithoutAPosition",
+                with("[tool_change]\nz_first = false\n"),
+                {"config.missing-key", "bad.toml", 7, 1}},
+        BadCase{"ToolChangeOrderNotABoolean",
+                with("[tool_change]\nposition = { X = 0.0 }\nz_first = \"yes\"\n"),
+                {"config.type", "bad.toml", 9, 11}},
         BadCase{"UnknownMachineKind",
                 with("[interpreter]\nmachine = \"router\"\n"),
                 {"config.range", "bad.toml", 8, 11}},
@@ -338,6 +353,23 @@ start_position = 280
 
 ProfileLoad with_overrides(std::vector<std::string> sets) {
   return load_profile(kMill, sets);
+}
+
+TEST(MachineProfile, ToolChangePositionIsReadWithItsPlace) {
+  const ProfileLoad none = parse_profile(kBase, "p.toml");
+  ASSERT_TRUE(none.ok()) << all_messages(none.diagnostics);
+  EXPECT_EQ(none.profile->tool_change.axes.count(), 0);  // no key: M6 does not move
+  const ProfileLoad load =
+      parse_profile(with("[tool_change]\nposition = { x = -10 }\nz_first = false\n"), "p.toml");
+  ASSERT_TRUE(load.ok()) << all_messages(load.diagnostics);
+  const ToolChangeProfile& tc = load.profile->tool_change;
+  EXPECT_EQ(tc.axes, AxisMask::from_letters("X"));
+  EXPECT_EQ(tc.position[Axis::X], -10.0);  // on the soft limit is inside
+  EXPECT_FALSE(tc.z_first);
+  EXPECT_EQ(tc.where, "p.toml:8:12");
+  // From an override too, where it is checked like the file.
+  const ProfileLoad set = with_overrides({"tool_change.position.Z=2001"});
+  EXPECT_EQ(first_error(set), (Where{"config.range", "--set", 1, 24})) << all_messages(set.diagnostics);
 }
 
 TEST(ProfileOverride, ReplacesValues) {

@@ -16,6 +16,7 @@
 #include "opencnc/canon/program_builder.hpp"
 #include "opencnc/canon/tee_sink.hpp"
 #include "opencnc/gcode/extension.hpp"
+#include "opencnc/gcode/standard_extensions.hpp"
 
 using namespace opencnc;
 using namespace opencnc::gcode;
@@ -335,6 +336,132 @@ TEST(Interpreter, ExecuteModeTakesThePositionAfterAToolChange) {
   ASSERT_EQ(rec.motions.size(), 2u);
   EXPECT_EQ(rec.motions[1].end[Axis::X], 11.0);
   EXPECT_EQ(rec.motions[1].end[Axis::Y], 20.0);
+}
+
+// --- the tool-change position ([tool_change] of the profile) --------------------------------
+
+namespace {
+
+/// Millimetre options with tools 1 (Z offset 50) and 2, and a tool-change position at machine
+/// X 100, Z 200 when `axes` names any.
+Options tool_change_options(AxisMask axes, bool z_first = true) {
+  Options o;
+  o.user_units = canon::Units::Mm;
+  auto table = std::make_shared<tools::ToolTable>();
+  for (int t = 1; t <= 2; ++t) {
+    tools::ToolEntry e;
+    e.tool = t;
+    e.pocket = t;
+    e.offset[Axis::Z] = t == 1 ? 50.0 : 0.0;
+    table->add(e);
+  }
+  o.tool_table = table;
+  o.tool_change.axes = axes;
+  o.tool_change.machine[Axis::X] = 100;
+  o.tool_change.machine[Axis::Z] = 200;
+  o.tool_change.z_first = z_first;
+  return o;
+}
+
+/// The traverses and tool changes of a run, in order.
+std::vector<std::string> moves_and_changes(const test::Result& r) {
+  std::vector<std::string> out;
+  for (const auto& c : r.calls) {
+    if (c.starts_with("STRAIGHT_TRAVERSE") || c.starts_with("CHANGE_TOOL(")) out.push_back(c);
+  }
+  return out;
+}
+
+// G54 at X10 Z5; tool 1 (Z offset 50) under G43 when tool 2 is changed in.
+constexpr const char* kTwoChanges =
+    "G21 G10 L2 P1 X10 Z5\nG54 T1 M6 G43\nG0 X1 Y2 Z3\nT2 M6\nG91 G0 X1\nM2\n";
+
+}  // namespace
+
+TEST(ToolChangePosition, WithoutOneM6ChangesWhereTheToolStands) {
+  const test::Result r = test::run(kTwoChanges, tool_change_options(AxisMask{}));
+  ASSERT_EQ(r.status, RunStatus::Finished) << r.code();
+  EXPECT_EQ(moves_and_changes(r), (std::vector<std::string>{
+                                      "CHANGE_TOOL(1)",
+                                      "STRAIGHT_TRAVERSE(1.0000, 2.0000, 3.0000, 0.0000, 0.0000, 0.0000)",
+                                      "CHANGE_TOOL(2)",
+                                      "STRAIGHT_TRAVERSE(2.0000, 2.0000, 3.0000, 0.0000, 0.0000, 0.0000)",
+                                  }));
+}
+
+TEST(ToolChangePosition, M6RetractsZFirstThenGoesAcrossInMachineCoordinates) {
+  const test::Result r = test::run(kTwoChanges, tool_change_options(AxisMask::from_letters("XZ")));
+  ASSERT_EQ(r.status, RunStatus::Finished) << r.code();
+  // Each change's moves stop where they end (Z up before anything goes across), then the
+  // program's own path control is back.
+  std::vector<std::string> modes;
+  for (const auto& c : r.calls) {
+    if (c.starts_with("SET_MOTION_CONTROL_MODE")) modes.push_back(c);
+  }
+  EXPECT_EQ(modes, (std::vector<std::string>{"SET_MOTION_CONTROL_MODE(CANON_EXACT_STOP)",
+                                             "SET_MOTION_CONTROL_MODE(CANON_CONTINUOUS, 0.000000)",
+                                             "SET_MOTION_CONTROL_MODE(CANON_EXACT_STOP)",
+                                             "SET_MOTION_CONTROL_MODE(CANON_CONTINUOUS, 0.000000)"}));
+  // Machine = program + G54 (X10 Z5) + tool length (Z50 after the G43): Z 200 is program Z 195
+  // with no tool offset, 145 with tool 1's; X 100 is program X 90; Y stays. The machine stands
+  // at its origin at first: program X -10 once G54 is set.
+  EXPECT_EQ(moves_and_changes(r), (std::vector<std::string>{
+                                      "STRAIGHT_TRAVERSE(-10.0000, 0.0000, 195.0000, 0.0000, 0.0000, 0.0000)",
+                                      "STRAIGHT_TRAVERSE(90.0000, 0.0000, 195.0000, 0.0000, 0.0000, 0.0000)",
+                                      "CHANGE_TOOL(1)",
+                                      "STRAIGHT_TRAVERSE(1.0000, 2.0000, 3.0000, 0.0000, 0.0000, 0.0000)",
+                                      "STRAIGHT_TRAVERSE(1.0000, 2.0000, 145.0000, 0.0000, 0.0000, 0.0000)",
+                                      "STRAIGHT_TRAVERSE(90.0000, 2.0000, 145.0000, 0.0000, 0.0000, 0.0000)",
+                                      "CHANGE_TOOL(2)",
+                                      // the next move starts at the tool-change position
+                                      "STRAIGHT_TRAVERSE(91.0000, 2.0000, 145.0000, 0.0000, 0.0000, 0.0000)",
+                                  }));
+  EXPECT_EQ(r.state.position.current[Axis::X], 91.0);
+  EXPECT_EQ(r.state.position.current[Axis::Z], 145.0);
+}
+
+TEST(ToolChangePosition, WithoutZFirstAllAxesGoTogetherAndInchProgramsGetInches) {
+  const test::Result r =
+      test::run("G20 G0 X1 Y2 Z3\nT2 M6\nM2\n", tool_change_options(AxisMask::from_letters("XZ"), false));
+  ASSERT_EQ(r.status, RunStatus::Finished) << r.code();
+  // 100 mm and 200 mm in the program's inches, in one move.
+  EXPECT_EQ(moves_and_changes(r), (std::vector<std::string>{
+                                      "STRAIGHT_TRAVERSE(1.0000, 2.0000, 3.0000, 0.0000, 0.0000, 0.0000)",
+                                      "STRAIGHT_TRAVERSE(3.9370, 2.0000, 7.8740, 0.0000, 0.0000, 0.0000)",
+                                      "CHANGE_TOOL(2)",
+                                  }));
+  // Only Z named: one move, whether Z goes first or not; already there: no move.
+  const test::Result z =
+      test::run("G21 G0 X1 Z3\nT2 M6\nT1 M6\nM2\n", tool_change_options(AxisMask::from_letters("Z")));
+  EXPECT_EQ(moves_and_changes(z), (std::vector<std::string>{
+                                      "STRAIGHT_TRAVERSE(1.0000, 0.0000, 3.0000, 0.0000, 0.0000, 0.0000)",
+                                      "STRAIGHT_TRAVERSE(1.0000, 0.0000, 200.0000, 0.0000, 0.0000, 0.0000)",
+                                      "CHANGE_TOOL(2)",
+                                      "CHANGE_TOOL(1)",
+                                  }));
+}
+
+TEST(ToolChangePosition, AnXyRotationTurnsTheAcrossMoveButNotTheMachinePoint) {
+  // G54 at X10 turned by 90 degrees: machine X 100, Y 0 is program X 0, Y -90.
+  Options o = tool_change_options(AxisMask::from_letters("XYZ"));
+  const test::Result r = test::run("G21 G10 L2 P1 X10 R90\nG54 G0 X1 Y1 Z0\nT2 M6\nM2\n", o);
+  ASSERT_EQ(r.status, RunStatus::Finished) << r.code();
+  const auto m = moves_and_changes(r);
+  ASSERT_EQ(m.size(), 4u);
+  EXPECT_EQ(m[1], "STRAIGHT_TRAVERSE(1.0000, 1.0000, 200.0000, 0.0000, 0.0000, 0.0000)");
+  EXPECT_EQ(m[2], "STRAIGHT_TRAVERSE(0.0000, -90.0000, 200.0000, 0.0000, 0.0000, 0.0000)");
+}
+
+TEST(ToolChangePosition, UnderAFanucRotationM6IsRefusedAtTheM6) {
+  Options o = tool_change_options(AxisMask::from_letters("Z"));
+  o.dialect = Dialect::Fanuc;
+  o.extensions = standard_extensions(Dialect::Fanuc);
+  const test::Result r = test::run("O1\nG21 G68 X0 Y0 R30\nT2 M6\nM30\n", o);
+  EXPECT_EQ(r.status, RunStatus::Error);
+  EXPECT_EQ(r.code(), "fanuc.transform-active");
+  ASSERT_FALSE(r.diagnostics.items().empty());
+  EXPECT_EQ(r.diagnostics.items().front().line, 3u);
+  EXPECT_NE(r.diagnostics.items().front().message.find("tool-change position"), std::string::npos);
 }
 
 // --- state, digest and replay ------------------------------------------------------------

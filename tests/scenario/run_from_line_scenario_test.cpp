@@ -33,15 +33,17 @@ constexpr const char* kProgram =
     "o<unused> endsub\n"  // 11
     "M2\n";               // 12
 
-std::shared_ptr<GcodeProgramSource> mill_source() {
+std::shared_ptr<GcodeProgramSource> mill_source(const config::MachineProfile& profile = mill()) {
   Diagnostics d;
-  return GcodeProgramSource::create(mill(), d);
+  return GcodeProgramSource::create(profile, d);
 }
 
 struct Rig {
-  explicit Rig(std::shared_ptr<GcodeProgramSource> source = mill_source()) : s(mill(), source) {
+  explicit Rig(std::shared_ptr<GcodeProgramSource> source = mill_source(),
+               const config::MachineProfile& profile = mill())
+      : s(profile, source) {
     Diagnostics d;
-    feature = RunFromLineFeature::create(mill(), source->tools(), d);
+    feature = RunFromLineFeature::create(profile, source->tools(), d);
     EXPECT_TRUE(feature);
     EXPECT_TRUE(s.rig().controller().add_feature(feature));
     s.ticks(1);
@@ -229,6 +231,42 @@ TEST(RunFromLineScenario, TheApproachChangesToTheLinesToolThenStartsTheSpindleAn
       100000));
   EXPECT_NEAR(r.s.status().servo.commanded[Axis::Z], 60.5, 1e-9);
   ASSERT_TRUE(r.s.idle(200000));
+}
+
+// With a tool-change position the approach changes the tool there, as the program's M6 does: Z
+// up alone first, then across; the operator's dialog comes there, and the approach goes on from
+// there to the line, whose segment is found with the M6 moves counted as the program counts them.
+TEST(RunFromLineScenario, TheApproachChangesTheToolAtTheToolChangePosition) {
+  TempProgram p("tools.ngc", kTwoTools);
+  const config::MachineProfile profile = mill({"tool_change.position={X=-50,Y=40,Z=150}"});
+  Rig r(mill_source(profile), profile);
+  r.s.on(Mode::Auto);
+  r.s.must(Request::open(p.path()));
+  const Outcome o = r.run_from(12);
+  ASSERT_TRUE(o.accepted) << o.message;
+  double xy_while_z_rose = 0;  // the machine starts at its origin
+  ASSERT_TRUE(r.s.until(
+      [&] {
+        const Pose c = r.s.status().servo.commanded;
+        if (c[Axis::Z] < 150.0 - 1e-9)
+          xy_while_z_rose = std::max({xy_while_z_rose, std::abs(c[Axis::X]), std::abs(c[Axis::Y])});
+        return r.s.status().servo.wait == Wait::ManualToolChange;
+      },
+      10000));
+  EXPECT_EQ(xy_while_z_rose, 0.0);
+  const Pose at_change = r.s.status().servo.commanded;
+  EXPECT_NEAR(at_change[Axis::X], -50.0, 1e-9);
+  EXPECT_NEAR(at_change[Axis::Y], 40.0, 1e-9);
+  EXPECT_NEAR(at_change[Axis::Z], 150.0, 1e-9);
+  r.s.must(Request::simple(CommandKind::ToolChanged));
+  ASSERT_TRUE(r.s.until([&] { return r.s.status().job == JobKind::Program; }, 100000));
+  // Line 12's move starts at X10 Y10 Z−2 with T2's 62.5 mm, reached from the tool-change position.
+  EXPECT_NEAR(r.s.status().servo.commanded[Axis::X], 10.0, 1e-9);
+  EXPECT_NEAR(r.s.status().servo.commanded[Axis::Z], 60.5, 1e-9);
+  ASSERT_TRUE(r.s.idle(200000));
+  EXPECT_NEAR(r.s.status().servo.commanded[Axis::X], 30.0, 1e-9);  // line 12, then G0 Z5
+  EXPECT_NEAR(r.s.status().servo.commanded[Axis::Z], 67.5, 1e-9);
+  EXPECT_EQ(r.s.status().servo.tool, 2);
 }
 
 /// The mill's program source, whose execute() (the run-from-line scan) waits until released:

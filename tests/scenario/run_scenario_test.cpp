@@ -5,6 +5,7 @@
 // bit-for-bit repeatable runs.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
@@ -337,6 +338,73 @@ TEST(RunScenario, ManualToolChangeWaitsForTheOperator) {
   ASSERT_TRUE(s.idle(5000));
   EXPECT_EQ(s.status().servo.tool, 3);
   EXPECT_NEAR(s.status().servo.commanded[Axis::X], 5.0, 1e-9);
+}
+
+// With [tool_change] position the M6 retracts Z first, then goes across, in machine coordinates
+// (G54 and the tool length do not shift it); the operator changes the tool there, and the
+// program's next move starts from there.
+TEST(RunScenario, M6GoesToTheToolChangePositionAndTheOperatorChangesThere) {
+  TempProgram tools("tools.tbl", "T3 P3 Z20\nT7 P7 Z0\n");
+  Scenario s(mill({tool_table(tools), "tool_change.position={X=-50,Z=100}"}));
+  TempProgram p("tool.ngc",
+                "G64 P0.01\nG10 L2 P1 X10 Z-5\nG54 G0 Z2\nG0 Y10\nG0 X20\nT3 M6 G43\nG0 Z5\nG91 G0 X1\nM2\n");
+  s.on(Mode::Auto);
+  s.must(Request::open(p.path()));
+  s.must(Request::simple(CommandKind::CycleStart));
+  // The program goes to machine X30 Y10 Z-3 (its last move across at Z-3); then Z rises to 100
+  // and only then does X go back to -50: X does not fall while Z is under 100, and the path
+  // keeps to the corner into the rise (blended within the program's G64 P0.01, as any G0 of its
+  // own there would be).
+  double corner_mm = 0, x_max = 0, x_fell_mm = 0;
+  bool down = false;  // Z has come down to -3
+  ASSERT_TRUE(s.until(
+      [&] {
+        const Pose c = s.status().servo.commanded;
+        down = down || std::abs(c[Axis::Z] + 3.0) < 1e-9;
+        if (down && c[Axis::Z] < 100.0 - 1e-9) {
+          x_max = std::max(x_max, c[Axis::X]);
+          x_fell_mm = std::max(x_fell_mm, x_max - c[Axis::X]);
+          if (c[Axis::X] <= 30.0)
+            corner_mm = std::max(corner_mm, std::min(30.0 - c[Axis::X], c[Axis::Z] + 3.0));
+        }
+        return s.status().servo.wait == Wait::ManualToolChange;
+      },
+      10000));
+  EXPECT_LE(corner_mm, 0.01 + 1e-9);
+  EXPECT_EQ(x_fell_mm, 0.0);
+  EXPECT_NEAR(x_max, 30.0, 1e-9);
+  s.ticks(200);
+  Pose at = s.status().servo.commanded;
+  EXPECT_NEAR(at[Axis::X], -50.0, 1e-9);
+  EXPECT_NEAR(at[Axis::Y], 10.0, 1e-9);  // not named: it stays
+  EXPECT_NEAR(at[Axis::Z], 100.0, 1e-9);
+  s.must(Request::simple(CommandKind::ToolChanged));
+  ASSERT_TRUE(s.idle(10000));
+  at = s.status().servo.commanded;
+  EXPECT_EQ(s.status().servo.tool, 3);
+  EXPECT_NEAR(at[Axis::Z], 20.0, 1e-9);   // G0 Z5 under G54 Z-5 and T3's 20 mm
+  EXPECT_NEAR(at[Axis::X], -49.0, 1e-9);  // G91 X1 from the tool-change position
+}
+
+// The preflight checks M6's moves like the program's own. A profile file cannot hold a
+// tool-change position outside the soft limits (the loader refuses it at its key); one built past
+// the loader shows the check: the program is refused at the M6's line and nothing moves.
+TEST(RunScenario, ThePreflightChecksTheToolChangeMoves) {
+  TempProgram tools("tools.tbl", "T3 P3 Z0\n");
+  config::MachineProfile profile = mill({tool_table(tools)});
+  profile.tool_change.axes = AxisMask::from_letters("Z");
+  profile.tool_change.position[Axis::Z] = 2500;  // beyond Z's 2000
+  Scenario s(profile);
+  TempProgram p("tool.ngc", "G0 X5\nT3 M6\nG0 X6\nM2\n");
+  s.on(Mode::Auto);
+  const Outcome o = s.ask(Request::open(p.path()));
+  EXPECT_FALSE(o.accepted);
+  ASSERT_FALSE(o.diagnostics.items().empty());
+  const Diagnostic& d = o.diagnostics.items().front();
+  EXPECT_EQ(d.code, "control.soft-limit");
+  EXPECT_EQ(d.line, 2u);
+  EXPECT_NE(d.message.find("takes Z to 2500"), std::string::npos) << d.message;
+  EXPECT_EQ(s.status().servo.commanded, Pose{});
 }
 
 TEST(RunScenario, WaitForInputReadsTheMachine) {

@@ -280,6 +280,15 @@ struct ToolGuardProfile {
   int check_mcode = 160;  ///< M-code of the on-demand check from G-code (0: none)
 };
 
+/// `[tool_change]`: where M6 takes the machine before the change, in machine coordinates
+/// (docs/tool-change.md); given to the interpreter as gcode::Options::tool_change.
+struct ToolChangeProfile {
+  AxisMask axes;        ///< the axes `position` names (none: M6 does not move)
+  Pose position{};      ///< mm, degrees for rotary axes
+  bool z_first = true;  ///< Z alone first, then the others together
+  std::string where;    ///< "file:line:col" of `position` (for messages)
+};
+
 struct PlannerOptions {
   int lookahead = 200;              ///< moves in the look-ahead window
   double default_tolerance = 0.01;  ///< mm: path tolerance while a program sets no G64 P
@@ -300,6 +309,7 @@ struct MachineProfile {
   /// Pockets of the magazine (0: not said); the tool guard checks the tools' pockets against it.
   int tool_changer_pockets = 0;
   machine::SimToolChangerConfig tool_changer_sim;
+  ToolChangeProfile tool_change;
   machine::SimProcessConfig process;  ///< torch / generator flags and their simulation
   CuttingProfile cutting;             ///< [process.cutting]: torch sequences for retrace
   IoProfile io;

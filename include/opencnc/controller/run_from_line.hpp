@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // RunFromLine — start the open program at a chosen line: the line resolved to the first move that
 // starts at it (a scan on a thread of the feature's own), an approach there (an auxiliary program:
-// the line's tool changed in, its spindle and coolant, the moves), then the program resumed at
-// that move's segment (requests::ResumeProgram: the interpreter replays quietly up to it).
+// the line's tool changed in at the tool-change position, its spindle and coolant, the moves),
+// then the program resumed at that move's segment (requests::ResumeProgram: the interpreter
+// replays quietly up to it).
 // Requests: requests::Feature{"run-from-line", "start", RunFromLineArgs}. See docs/hmi.md.
 #pragma once
 
@@ -84,7 +85,8 @@ std::optional<LineStart> find_line_start(ProgramSource& source, const std::strin
 /// scans the program on a thread of its own (the controller answers meanwhile; every start is
 /// refused until the scan ends, so the machine stays idle) and answers the request once the scan
 /// has found where the program will start (or why not); then it runs the approach (the line's
-/// tool changed in if the spindle has another, the spindle and coolant as the program has them
+/// tool changed in if the spindle has another, at the profile's tool-change position when it has
+/// one, docs/tool-change.md; the spindle and coolant as the program has them
 /// there, rapid up to the higher of the two Z, across, down at the move's own feed) and, once that
 /// has finished, resumes the program there. Controller thread.
 class RunFromLineFeature final : public Feature {
@@ -124,7 +126,7 @@ class RunFromLineFeature final : public Feature {
     std::atomic<bool> done{false}, cancel{false};
     std::thread thread;
   };
-  std::shared_ptr<const canon::Program> approach(const Pose& from, int spindle_tool,
+  std::shared_ptr<const canon::Program> approach(const Pose& machine, int spindle_tool,
                                                  const LineStart& to) const;
   void start_approach(Scan& scan, FeatureHost& host);
 

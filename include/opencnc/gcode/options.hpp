@@ -59,6 +59,17 @@ struct Limits {
 /// In execute mode every pass starts the block and loop counts of the limits afresh.
 enum class MainM99 : std::uint8_t { End, Repeat };
 
+/// Where M6 takes the machine before the change (the profile's [tool_change], docs/tool-change.md):
+/// the axes in `axes` go at rapid to `machine` (machine coordinates in mm, degrees for rotary
+/// axes, as G53 takes them: the spindle ends there whatever the offsets and the tool), the others
+/// stay. With `z_first` Z goes there alone first, then the others together. No axes: M6 does not
+/// move (LinuxCNC's rs274 without TOOL_CHANGE_POSITION).
+struct ToolChangePosition {
+  AxisMask axes;
+  Pose machine{};
+  bool z_first = true;
+};
+
 /// Everything the interpreter is configured with. Plain data; copy freely.
 struct Options {
   Dialect dialect = Dialect::LinuxCnc;
@@ -86,6 +97,7 @@ struct Options {
   /// spindle stopped is the normal case, not a habit to point out.
   bool spindle = true;
   bool block_delete = false;   ///< skip blocks starting with '/'
+  ToolChangePosition tool_change;  ///< where M6 moves first (none by default)
   bool optional_stop = true;   ///< M1 stops
   MainM99 main_m99 = MainM99::End;
   /// Drop all canonical output until the motion with this segment id (replay to segment k);
