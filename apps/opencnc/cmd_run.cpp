@@ -311,6 +311,9 @@ nlohmann::json power_fail_json(const control::PowerFailReport& p) {
   j["coupled_command_error_um"] = p.coupled_command_error_um;
   j["independent_error_um"] = p.independent_error_um;
   j["dc_link_min_v"] = p.happened ? nlohmann::json(p.dc_link_min_v) : nlohmann::json(nullptr);
+  j["energy_at_signal_j"] = p.energy_at_signal_j;
+  j["energy_at_rest_j"] = p.energy_at_rest_j;
+  j["decel_scale"] = p.decel_scale;
   return j;
 }
 
@@ -321,6 +324,11 @@ void print_power_fail(const control::PowerFailReport& p) {
   }
   fmt::print("power fail at       {:.3f} s: stopped in {:.3f} s over {:.3f} mm, DC link down to {:.0f} V\n",
              p.signal_s, p.stop_time_s, p.stop_distance_mm, p.dc_link_min_v);
+  if (p.energy_at_signal_j > 0 || p.decel_scale > 1)
+    fmt::print(
+        "DC link energy      {:.2f} J at the signal, {:.2f} J at rest; braked at {:.3f}x the planned "
+        "deceleration\n",
+        p.energy_at_signal_j, p.energy_at_rest_j, p.decel_scale);
   if (p.coupled)
     fmt::print(
         "helix error         {:.3f} um coupled ({:.6f} um commanded), {:.1f} um if each axis stopped alone\n",

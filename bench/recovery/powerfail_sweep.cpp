@@ -6,7 +6,8 @@
 // --json the output lists every cut too (its instant and errors), so that an outlier can be found
 // and replayed; --stop-only skips the resumes (the stops alone, about ten times faster).
 //
-//   powerfail_sweep [--cuts N] [--seed S] [--program FILE] [--journal-root DIR] [--stop-only] [--json]
+//   powerfail_sweep [--cuts N] [--seed S] [--program FILE] [--journal-root DIR] [--set KEY=VALUE]...
+//                   [--stop-only] [--json]
 #include <fmt/format.h>
 #include <unistd.h>
 
@@ -165,14 +166,16 @@ double same_z_deviation_um(const Grooves& resumed, const Grooves& ref, const rec
 }
 
 int usage(int rc) {
-  fmt::print(
-      rc == 0 ? stdout : stderr,
-      "usage: powerfail_sweep [--cuts N] [--seed S] [--program FILE] [--journal-root DIR] [--stop-only]\n"
-      "                       [--json]\n"
-      "  the mains cut at N random instants of the broach's demo job: coupled and independent stop\n"
-      "  errors, record latency, and the resumed groove against the uninterrupted run's\n"
-      "  --stop-only  measure the stops, do not resume\n"
-      "  --json       one JSON object: the maxima, and \"per_cut\": each cut's instant and errors\n");
+  fmt::print(rc == 0 ? stdout : stderr,
+             "usage: powerfail_sweep [--cuts N] [--seed S] [--program FILE] [--journal-root DIR]\n"
+             "                       [--set KEY=VALUE]... [--stop-only] [--json]\n"
+             "  the mains cut at N random instants of the broach's demo job: coupled and independent stop\n"
+             "  errors, record latency, and the resumed groove against the uninterrupted run's\n"
+             "  --set        override a key of configs/broach-zc.toml in every run (as opencnc run --set):\n"
+             "               e.g. power.sim.ups_runtime_s=0 power.dc_link_capacitance_f=0.00004 (a nearly\n"
+             "               empty DC link: the stops shortened by its energy)\n"
+             "  --stop-only  measure the stops, do not resume\n"
+             "  --json       one JSON object: the maxima, and \"per_cut\": each cut's instant and errors\n");
   return rc;
 }
 
@@ -184,6 +187,7 @@ int main(int argc, char** argv) {
   bool json = false, stop_only = false;
   std::string program = OPENCNC_SOURCE_DIR "/examples/broach-constant.ngc";
   std::filesystem::path root = std::filesystem::current_path() / "powerfail-sweep";
+  std::vector<std::string> profile_sets;  // --set, for every run
   for (int i = 1; i < argc; ++i) {
     const std::string_view a = argv[i];
     const auto value = [&]() -> const char* { return i + 1 < argc ? argv[++i] : nullptr; };
@@ -192,9 +196,10 @@ int main(int argc, char** argv) {
       json = true;
     } else if (a == "--stop-only") {
       stop_only = true;
-    } else if (a == "--cuts" || a == "--seed" || a == "--program" || a == "--journal-root") {
+    } else if (a == "--cuts" || a == "--seed" || a == "--program" || a == "--journal-root" || a == "--set") {
       const char* v = value();
       if (v == nullptr) return usage(2);
+      if (a == "--set") profile_sets.emplace_back(v);
       if (a == "--cuts") cuts = std::max(1, std::atoi(v));
       if (a == "--seed") seed = static_cast<unsigned>(std::strtoul(v, nullptr, 10));
       if (a == "--program") program = v;
@@ -205,6 +210,13 @@ int main(int argc, char** argv) {
     }
   }
   const std::string profile_path = OPENCNC_SOURCE_DIR "/configs/broach-zc.toml";
+  {
+    const config::ProfileLoad load = config::load_profile(profile_path, profile_sets);
+    if (!load.ok()) {
+      for (const auto& d : load.diagnostics.items()) fmt::print(stderr, "{}\n", d.format());
+      return 2;
+    }
+  }
   // The root is the sweep's own: a fresh folder, or an earlier sweep's (only "reference" and
   // "cut-N" in it). Anything else is somebody's, and stays.
   std::error_code ec;
@@ -225,7 +237,7 @@ int main(int argc, char** argv) {
   }
   // The uninterrupted run, once.
   std::filesystem::remove_all(root);
-  Rig ref(profile_path, root / "reference");
+  Rig ref(profile_path, root / "reference", profile_sets);
   ref.rig->request(Request::open(program), 1000000);
   ref.rig->request(Request::simple(control::CommandKind::CycleStart));
   ref.rig->run_until([&] { return !ref.rig->status().run_active && ref.rig->status().servo.time_s > 1; },
@@ -235,6 +247,7 @@ int main(int argc, char** argv) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> at(0.5, length_s - 0.5);
   double coupled_max = 0, independent_max = 0, resume_max = 0, moving_max = 0, same_z_max = 0, track_max = 0;
+  double scale_max = 1, energy_at_rest_min = 1e300;  // the stops shortened by the DC link's energy
   std::vector<double> latencies;
   int resumed = 0, failed = 0;
   std::string per_cut;  // JSON objects, one per cut
@@ -245,7 +258,7 @@ int main(int argc, char** argv) {
     control::PowerFailReport pf;
     std::vector<float> bore;  // the workpiece as the cut left it
     {
-      Rig cut(profile_path, dir);
+      Rig cut(profile_path, dir, profile_sets);
       auto recorder = std::make_shared<control::PowerFailRecorder>(
           control::coupling_config(cut.profile.coupling), control::machine_limits(cut.profile),
           cut.profile.servo_period_s, cut.profile.coupling.radius_mm);
@@ -267,9 +280,13 @@ int main(int argc, char** argv) {
       coupled_max = std::max(coupled_max, pf.coupled_error_um);
       independent_max = std::max(independent_max, pf.independent_error_um);
     }
+    if (pf.happened) {
+      scale_max = std::max(scale_max, pf.decel_scale);
+      energy_at_rest_min = std::min(energy_at_rest_min, pf.energy_at_rest_j);
+    }
     double dev = 0;
     if (r.valid && !stop_only) {
-      std::vector<std::string> sets;
+      std::vector<std::string> sets = profile_sets;
       for (const auto& [name, axis] : {std::pair{"x", Axis::X}, {"z", Axis::Z}, {"c", Axis::C}}) {
         sets.push_back(fmt::format("axis.{}.sim.start_position={:.17g}", name, r.actual[axis]));
         sets.push_back(fmt::format("axis.{}.homing.position={:.17g}", name, r.actual[axis]));
@@ -298,9 +315,10 @@ int main(int argc, char** argv) {
     }
     per_cut += fmt::format(
         "{}{{\"cut\": {}, \"at_s\": {:.6f}, \"coupled\": {}, \"coupled_error_um\": {:.6f}, "
-        "\"independent_error_um\": {:.6f}, \"resume_deviation_um\": {:.6f}}}",
+        "\"independent_error_um\": {:.6f}, \"resume_deviation_um\": {:.6f}, \"decel_scale\": {:.6f}, "
+        "\"energy_at_rest_j\": {:.6f}}}",
         k == 0 ? "" : ", ", k, cut_s, pf.coupled, pf.coupled ? pf.coupled_error_um : 0.0,
-        pf.coupled ? pf.independent_error_um : 0.0, dev);
+        pf.coupled ? pf.independent_error_um : 0.0, dev, pf.decel_scale, pf.energy_at_rest_j);
     if (!json) {
       fmt::print(
           "cut {:3} at {:8.3f} s  coupled {:.3f} um  independent {:9.1f} um  resumed groove {:.3f} um\n", k,
@@ -321,9 +339,10 @@ int main(int argc, char** argv) {
         "\"independent_error_um_max\": {:.6f}, \"resume_deviation_um_max\": {:.6f}, "
         "\"resume_deviation_um_max_past_1mm\": {:.6f}, \"resume_deviation_whole_track_um_max\": {:.6f}, "
         "\"resume_deviation_same_z_um_max\": {:.6f}, "
+        "\"decel_scale_max\": {:.6f}, \"energy_at_rest_j_min\": {:.6f}, "
         "\"record_p99_ms\": {:.6f}, \"record_max_ms\": {:.6f}, \"program_s\": {:.3f}, \"per_cut\": [{}]}}\n",
         cuts, resumed, failed, coupled_max, independent_max, resume_max, moving_max, track_max, same_z_max,
-        p99, pmax, length_s, per_cut);
+        scale_max, energy_at_rest_min < 1e300 ? energy_at_rest_min : 0.0, p99, pmax, length_s, per_cut);
   } else {
     fmt::print(
         "coupled {:.3f} um max, independent {:.1f} um max, resumed groove {:.3f} um max ({:.3f} past the "

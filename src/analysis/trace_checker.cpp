@@ -255,7 +255,8 @@ void TraceChecker::check_limits(const Pose& x) {
     st.max_acceleration = std::max(st.max_acceleration, a);
     st.max_jerk = std::max(st.max_jerk, j);
     const plan::AxisLimits& l = limits_[i];
-    const double values[3] = {v, a, j}, caps[3] = {l.max_velocity, l.max_acceleration, l.max_jerk};
+    const double values[3] = {v, a, j};
+    const double caps[3] = {l.max_velocity, l.max_acceleration * accel_scale_, l.max_jerk * accel_scale_};
     for (int d = 0; d < 3; ++d) {
       if (caps[d] <= 0 || values[d] <= caps[d] * (1 + tolerance_)) continue;
       if (report_.limit_violations++ == 0) {

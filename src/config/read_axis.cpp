@@ -612,12 +612,24 @@ void check_resolution(Section& s, const AxisProfile& a) {
   }
 }
 
+// The drive's emergency braking: at least the planned acceleration (a stop never brakes softer).
+void read_peak_deceleration(Section& s, AxisProfile& a) {
+  if (!s.has("peak_deceleration")) return;
+  a.peak_deceleration = s.number_or("peak_deceleration", 0, Bound::Positive);
+  if (a.peak_deceleration > 0 && a.peak_deceleration < a.max_acceleration) {
+    s.error("peak_deceleration",
+            fmt::format("{}: peak_deceleration ({}) must be at least max_acceleration ({})", s.path(),
+                        show(a.peak_deceleration), show(a.max_acceleration)),
+            "config.limits");
+  }
+}
+
 AxisProfile read_axis(const toml::table& table, const std::string& path, Axis axis, double period_s,
                       double substep_s, Reporter& r) {
   Section s(table, path,
             {"type", "drive", "max_velocity", "max_acceleration", "max_jerk", "min_limit", "max_limit",
              "wrapped", "max_following_error", "encoder_counts_per_unit", "steps_per_unit", "homing",
-             "switches", "sim", "compensation", "stall_detector", "hand_tolerance"},
+             "switches", "sim", "compensation", "stall_detector", "hand_tolerance", "peak_deceleration"},
             r);
   AxisProfile a;
   a.axis = axis;
@@ -635,6 +647,7 @@ AxisProfile read_axis(const toml::table& table, const std::string& path, Axis ax
   a.max_velocity = s.required_number("max_velocity", Bound::Positive);
   a.max_acceleration = s.required_number("max_acceleration", Bound::Positive);
   a.max_jerk = s.number_or("max_jerk", 0, Bound::NonNegative);
+  read_peak_deceleration(s, a);
   read_limits(s, a);
   check_plausible(s, a);
   a.max_following_error = s.number_or("max_following_error", a.max_following_error, Bound::Positive);
@@ -646,6 +659,8 @@ AxisProfile read_axis(const toml::table& table, const std::string& path, Axis ax
   check_homing(s, a);
   if (a.drive == JointDrive::Manual && a.max_jerk > 0)
     s.reject("max_jerk", "does not apply to a manual axis");
+  if (a.drive == JointDrive::Manual && a.peak_deceleration > 0)
+    s.reject("peak_deceleration", "does not apply to a manual axis");
   return a;
 }
 

@@ -99,7 +99,9 @@ void read_tables(Section& s, CouplingProfile& c) {
 void read_coupling(Section& top, MachineProfile& profile) {
   const toml::table* t = top.subtable("coupling");
   if (t == nullptr) return;
-  Section s(*t, "coupling", {"master", "slave", "source", "radius_mm", "table"}, top.reporter());
+  Section s(*t, "coupling",
+            {"master", "slave", "source", "radius_mm", "engage_tolerance_um", "engage_timeout_s", "table"},
+            top.reporter());
   CouplingProfile& c = profile.coupling;
   c.present = true;
   const auto master = read_axis_letter(s, "master", profile);
@@ -119,6 +121,8 @@ void read_coupling(Section& top, MachineProfile& profile) {
               "config.range");
   }
   c.radius_mm = s.number_or("radius_mm", c.radius_mm, Bound::Positive);
+  c.engage_tolerance_um = s.number_or("engage_tolerance_um", c.engage_tolerance_um, Bound::NonNegative);
+  c.engage_timeout_s = s.number_or("engage_timeout_s", c.engage_timeout_s, Bound::Positive);
   c.from_actual = s.choice<bool>("source", {{"command", false}, {"actual", true}}, false);
   read_tables(s, c);
 }

@@ -103,8 +103,9 @@ void read_power(Section& top, MachineProfile& profile) {
   const toml::table* t = top.subtable("power");
   if (t == nullptr) return;
   Section s(*t, "power",
-            {"monitor", "ups", "dc_link_nominal_v", "dc_link_min_v", "sim", "resume_tolerance_mm",
-             "resume_tolerance_deg", "resume_run_in_mm", "resume_run_in_speed_mm_min"},
+            {"monitor", "ups", "dc_link_nominal_v", "dc_link_min_v", "dc_link_capacitance_f",
+             "dc_link_idle_power_w", "sim", "resume_tolerance_mm", "resume_tolerance_deg", "resume_run_in_mm",
+             "resume_run_in_speed_mm_min"},
             top.reporter());
   PowerProfile& p = profile.power;
   p.monitor = s.boolean_or("monitor", true);
@@ -122,6 +123,13 @@ void read_power(Section& top, MachineProfile& profile) {
                         show(p.sim.dc_link_min_v), show(p.sim.dc_link_nominal_v)),
             "config.limits");
   }
+  // The link as the machine states it; the simulated link is the same unless [power.sim] says.
+  p.dc_link_capacitance_f = s.number_or("dc_link_capacitance_f", 0, Bound::Positive);
+  p.dc_link_idle_power_w = s.number_or("dc_link_idle_power_w", 0, Bound::NonNegative);
+  if (p.dc_link_capacitance_f > 0) p.sim.dc_link_capacitance_f = p.dc_link_capacitance_f;
+  if (s.has("dc_link_idle_power_w")) p.sim.idle_power_w = p.dc_link_idle_power_w;
+  if (s.has("dc_link_idle_power_w") && p.dc_link_capacitance_f == 0)
+    s.reject("dc_link_idle_power_w", "needs power.dc_link_capacitance_f");
   const toml::table* st = s.subtable("sim");
   if (st == nullptr) return;
   Section m(*st, "power.sim", {"dc_link_capacitance_f", "idle_power_w", "ups_runtime_s"}, top.reporter());

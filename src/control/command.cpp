@@ -74,6 +74,8 @@ const char* fault_code(FaultKind k) noexcept {
       return "control.fault.edm-short";
     case FaultKind::SeekNoSwitch:
       return "control.fault.seek-limit";
+    case FaultKind::CouplingPosition:
+      return "control.fault.coupling-position";
   }
   return "control.fault.unknown";
 }

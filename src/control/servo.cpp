@@ -160,6 +160,8 @@ void Servo::check_power() noexcept {
     case Activity::Program:
       hold_ = false;
       abort_edge_ = aborting_ = true;
+      stop_scale_ = 1;
+      stop_scale_max_ = stop_scale_bound();
       break;
     case Activity::Homing:
     case Activity::Jog:
@@ -435,6 +437,9 @@ void Servo::fill_status(ServoStatus& s) const noexcept {
   s.mains_ok = in_.power.mains_ok;
   s.on_battery = in_.power.ups_on_battery;
   s.dc_link_v = in_.power.dc_link_v;
+  s.coupling_wait = activity_ == Activity::Program && tick_out_.waiting_in_position;
+  s.dc_link_energy_j = dc_link_energy_j();
+  s.stop_decel_scale = stop_scale_;
   s.fault = fault_;
   s.last_command_id = last_command_id_;
   s.last_refusal = last_refusal_;
@@ -504,6 +509,8 @@ void Servo::push_trace() noexcept {
   t.power_stop = power_stop_;
   t.coupling_error_deg = coupling_error();
   t.load_kn = load_kn_;
+  t.dc_link_energy_j = dc_link_energy_j();
+  t.stop_decel_scale = power_stop_ ? stop_scale_ : 1.0;
   t.edm = gap_.status();
   if (!channels_->trace.try_push(t)) ++trace_dropped_;
 }

@@ -111,6 +111,7 @@ Refusal Servo::reset() noexcept {
   if (amp || power || alarm) return Refusal::FaultPersists;
   fault_ = Fault{};
   power_stop_ = false;
+  stop_scale_ = stop_scale_max_ = 1;
   set_state(State::Off);
   return Refusal::None;
 }
@@ -322,7 +323,7 @@ void Servo::enter_estop() noexcept {
 
 void Servo::enter_fault(const Fault& f) noexcept {
   halt(RunEnd::Faulted);
-  power_stop_ = false;
+  power_stop_ = false;  // the stop's scale stays in status until reset
   fault_ = f;
   set_state(State::Faulted);
   ServoEvent e;

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Servo, the coupling stage: axes → joints, the slave axis computed from its master by the law a
 // program engaged (broaching helices, cams), from the master's command or its feedback.
+#include <algorithm>
 #include <cmath>
 
 #include "opencnc/control/servo.hpp"
@@ -80,6 +81,40 @@ void Servo::engage_coupling(const MachineAction& a) noexcept {
   coupling_.pitch_rate = a.value2;
   coupling_.master_origin = a.has_origin ? a.master_origin : commanded_[cc.master_axis];
   coupling_.slave_origin = a.has_origin ? a.slave_origin : commanded_[cc.slave_axis];
+}
+
+// A coupling code's marker waits here until master and slave stand within the tolerance of
+// their commands for kInPositionPeriods in a row (a drive swinging through its target is not in
+// position). Every period, so that the count is current when the marker is reached.
+bool Servo::coupling_in_position() noexcept {
+  constexpr int kInPositionPeriods = 5;
+  const motion::CouplingConfig& cc = config_.coupling;
+  const int m = joint_of(cc.master_axis), s = joint_of(cc.slave_axis);
+  if (m < 0 || s < 0 || (cc.engage_tolerance_master <= 0 && cc.engage_tolerance_slave <= 0)) return true;
+  const bool in = std::fabs(following_error_[static_cast<std::size_t>(m)]) <= cc.engage_tolerance_master &&
+                  std::fabs(following_error_[static_cast<std::size_t>(s)]) <= cc.engage_tolerance_slave;
+  in_position_periods_ = in ? std::min(in_position_periods_ + 1, kInPositionPeriods) : 0;
+  return in_position_periods_ >= kInPositionPeriods;
+}
+
+// Bounded: a drive that does not settle in engage_timeout_s stops the run with a fault naming
+// the axis furthest out (relative to its tolerance) and its error.
+void Servo::check_engage_wait() noexcept {
+  if (!tick_out_.waiting_in_position) {
+    engage_wait_periods_ = 0;
+    return;
+  }
+  const motion::CouplingConfig& cc = config_.coupling;
+  if (static_cast<double>(++engage_wait_periods_) * config_.period_s <= cc.engage_timeout_s) return;
+  const int m = joint_of(cc.master_axis), s = joint_of(cc.slave_axis);
+  const double em = following_error_[static_cast<std::size_t>(m)];
+  const double es = following_error_[static_cast<std::size_t>(s)];
+  const bool master_worse =
+      std::fabs(em) * cc.engage_tolerance_slave > std::fabs(es) * cc.engage_tolerance_master;
+  engage_wait_periods_ = 0;
+  enter_fault({FaultKind::CouplingPosition, master_worse ? cc.master_axis : cc.slave_axis,
+               std::fabs(master_worse ? em : es),
+               master_worse ? cc.engage_tolerance_master : cc.engage_tolerance_slave, tick_});
 }
 
 void Servo::release_coupling() noexcept {

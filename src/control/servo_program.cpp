@@ -85,11 +85,18 @@ traj::TickInput Servo::program_inputs() noexcept {
   in.spindle_at_speed = spindle_at_speed() && !spindle_change_pending();
   in.spindle_revs = in_.spindle.position_rev;
   in.spindle_rev_s = in_.spindle.speed_rpm / 60.0;
+  in.in_position = coupling_in_position();
+  if (power_stop_) {
+    choose_stop_scale();
+    in.abort_decel_scale = stop_scale_;
+  }
   return in;
 }
 
 void Servo::run_program() noexcept {
   interp_.tick(program_inputs(), tick_out_);
+  check_engage_wait();
+  if (activity_ != Activity::Program) return;  // it faulted: the run has ended
   for (int j = 0; j < config_.joint_count; ++j) {
     const int axis = config_.joints[static_cast<std::size_t>(j)].axis;
     if (!manual(j)) commanded_[axis] = tick_out_.position[axis];
@@ -111,7 +118,7 @@ void Servo::run_program() noexcept {
 void Servo::map_program_state() noexcept {
   switch (tick_out_.state) {
     case traj::RunState::Dwelling:
-      wait_ = Wait::Dwell;
+      wait_ = Wait::Dwell;  // status coupling_wait tells a coupling code's wait from a G4
       break;
     case traj::RunState::WaitingSpindle:
       // A start an interlock rule holds back is a wait of its own (status: interlock_rule).

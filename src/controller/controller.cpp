@@ -811,7 +811,9 @@ std::string Controller::wait_text() const {
     case Wait::None:
       return {};
     case Wait::Dwell:
-      return "a dwell";
+      return s.coupling_wait
+                 ? "the coupled axes to stand on their commands before the law takes them (M171-M174)"
+                 : "a dwell";
     case Wait::Spindle:
       return "the spindle to reach its speed";
     case Wait::ToolChanger:
@@ -986,6 +988,12 @@ std::string Controller::describe(const Fault& f) const {
           "seeking its limit, {} went {:.4f} {} (its soft limit {} {} and the overtravel) without the limit "
           "switch tripping: check the switch and its wiring, then home {} again",
           axis, f.value, unit, f.limit, unit, axis);
+    case FaultKind::CouplingPosition:
+      return fmt::format(
+          "the coupling code waited for {} to stand on its command, but it stayed {:.6f} {} off "
+          "(within {:.6f} {} needed, [coupling] engage_tolerance_um, for engage_timeout_s): the drive "
+          "does not settle; check its tuning, or allow more",
+          axis, f.value, unit, f.limit, unit);
     case FaultKind::ProcessAlarm:
       return detail::alarm_text(profile_.alarms, static_cast<std::size_t>(f.axis), f.value, f.value < f.limit,
                                 false);

@@ -3,6 +3,7 @@
 // from the state at the signal.
 #include "opencnc/controller/power_fail_recorder.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -68,6 +69,7 @@ void PowerFailRecorder::on_trace(const TraceSample& s, const TraceContext&) {
     report_.dc_link_min_v = 1e300;
     stopping_ = true;
     master_at_signal_ = s.commanded[m];
+    report_.energy_at_signal_j = report_.energy_at_rest_j = s.dc_link_energy_j;
     if (report_.coupled && previous_) simulate_independent_stop(*previous_, s);
   }
   if (stopping_) {
@@ -81,7 +83,9 @@ void PowerFailRecorder::on_trace(const TraceSample& s, const TraceContext&) {
     if (moving) {
       report_.stop_time_s = static_cast<double>(s.tick) * period_s_ - report_.signal_s;
       report_.stop_distance_mm = std::fabs(s.commanded[m] - master_at_signal_);
+      report_.energy_at_rest_j = s.dc_link_energy_j;
     }
+    report_.decel_scale = std::max(report_.decel_scale, s.stop_decel_scale);
   }
   previous_ = s;
 }

@@ -116,6 +116,8 @@ void RunRecorder::add(const TraceSample& in) {
   // the first two as their history.
   if (r_.samples == 1) output_.start_moving(s.output, output_lead_);
   if (r_.samples == 0) output_lead_ = s.output;
+  for (analysis::TraceChecker* c : {&commanded_, &actual_, &output_})
+    c->set_acceleration_scale(s.stop_decel_scale);
   commanded_.add(s.commanded, s.segment_first, s.segment_last);
   actual_.add(s.actual, s.segment_first, s.segment_last);
   if (r_.samples >= 2) output_.add(s.output, s.segment_first, s.segment_last);

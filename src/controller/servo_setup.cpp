@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <numbers>
 
 #include "opencnc/machine/sim_machine.hpp"
 
@@ -98,6 +99,8 @@ ServoConfig servo_config(const config::MachineProfile& profile) {
     j.max_velocity = a.max_velocity - r.velocity;
     j.max_acceleration = a.max_acceleration - r.acceleration;
     j.max_jerk = a.max_jerk;
+    // The compensation may still take its reserve while the path brakes at its peak.
+    j.peak_deceleration = std::max(j.max_acceleration, a.peak_deceleration - r.acceleration);
     j.min_limit = a.min_limit;
     j.max_limit = a.max_limit;
     j.max_following_error = a.max_following_error;
@@ -133,6 +136,11 @@ ServoConfig servo_config(const config::MachineProfile& profile) {
   s.spindle_max_rpm = profile.spindle.present ? profile.spindle.max_rpm : 0.0;
   s.coupling = coupling_config(profile.coupling);
   s.load_guard = load_guard_config(profile);
+  if (profile.power.monitor && profile.power.dc_link_capacitance_f > 0) {
+    s.power_stop.dc_link_capacitance_f = profile.power.dc_link_capacitance_f;
+    s.power_stop.dc_link_min_v = profile.power.sim.dc_link_min_v;
+    s.power_stop.dc_link_idle_power_w = profile.power.dc_link_idle_power_w;
+  }
   s.edm = profile.edm.config;
   return s;
 }
@@ -265,6 +273,9 @@ motion::CouplingConfig coupling_config(const config::CouplingProfile& c) {
   out.master_axis = static_cast<std::int8_t>(index(c.master));
   out.slave_axis = static_cast<std::int8_t>(index(c.slave));
   out.source = c.from_actual ? motion::CouplingSource::Actual : motion::CouplingSource::Command;
+  out.engage_tolerance_master = c.engage_tolerance_um / 1000;                                        // mm
+  out.engage_tolerance_slave = c.engage_tolerance_um / 1000 / c.radius_mm * 180 / std::numbers::pi;  // deg
+  out.engage_timeout_s = c.engage_timeout_s;
   const std::size_t n = std::min<std::size_t>(c.tables.size(), motion::kMaxCouplingTables);
   for (std::size_t t = 0; t < n; ++t) {
     const config::CouplingTableProfile& tp = c.tables[t];

@@ -190,6 +190,9 @@ void ProgramReader::add_marker(std::size_t index, MarkerKind kind) {
   const bool record = a.kind == ActionKind::AxisCoupling || a.kind == ActionKind::ProcessCode;
   m.value = record ? 0.0 : a.value;  // its stop takes no time
   m.flags = flags();
+  // A law engages where master and slave are commanded: it waits for the drives to stand there
+  // (the servo's in-position check), or it would take them while they still settle.
+  if (a.kind == ActionKind::AxisCoupling && a.index != 0) m.flags |= traj::kWaitInPosition;
   if (kind == MarkerKind::ProgramEnd) ended_ = true;
 }
 

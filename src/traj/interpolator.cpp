@@ -102,7 +102,10 @@ void Interpolator::step_piece(const TickInput& in, const MotionBlock& b, std::si
 
   double v_tgt = target_speed(in, b);
   if (aborting_ || (hold_ && (b.flags & kFeedHoldAllowed) != 0)) v_tgt = 0;
-  double a = std::clamp((v_tgt - v) / tau, -A, A);
+  // An abort may brake harder than the block's budget (a power-fail stop short of energy); the
+  // junction limits below keep the budget, so they never ask for more than the plan did.
+  const double a_min = aborting_ ? -A * std::max(1.0, in.abort_decel_scale) : -A;
+  double a = std::clamp((v_tgt - v) / tau, a_min, A);
   const bool follow = b.feed_class == FeedClass::SpindleSync && !aborting_;
   if (follow) a = sync_acceleration(b, tau);
   const double a_follow = a;
@@ -149,7 +152,7 @@ void Interpolator::step_piece(const TickInput& in, const MotionBlock& b, std::si
     const std::size_t si = index_of(stop_seq_);
     if (si < avail) limit(queue_->peek(si).brake_prefix - c_s, si == index + 1, 0.0);
   }
-  a = std::clamp(a, -A, A);
+  a = std::clamp(a, a_min, A);
   // Braking for a limit ahead (the end of the thread): the motion leaves the spindle.
   if (follow && sync_ == Sync::Locked && a < a_follow - 1e-9 * A) sync_ = Sync::CatchUp;
 
@@ -331,6 +334,10 @@ void Interpolator::update_waiting(const TickInput& in) noexcept {
   switch (m.marker) {
     case MarkerKind::Dwell:
       state_ = RunState::Dwelling;
+      if ((m.flags & kWaitInPosition) != 0 && !in.in_position) {
+        waiting_in_position_ = true;  // the drives still settle: the marker's action must wait
+        break;
+      }
       if (dwell_ticks_left_ == 0 || --dwell_ticks_left_ == 0) release_marker();
       break;
     case MarkerKind::ProgramStop:
@@ -409,12 +416,16 @@ void Interpolator::fill_output(TickOutput& out, double s_prev) noexcept {
                    b.segment_offset};
   }
   out.path_velocity = (s_f_ - s_prev) / config_.period_s;
+  const std::size_t u_index = index_of(u_seq_);
+  out.path_acceleration =
+      u_index < avail && queue_->peek(u_index).kind != BlockKind::Marker ? queue_->peek(u_index).accel : 0.0;
   out.state = state_;
   write_shown(out);
   out.spindle_synced = sync_ == Sync::Locked;
   out.sync_lost = sync_lost_;
   out.tap_reverse = false;
   out.tap_speed_scale = 1;
+  out.waiting_in_position = waiting_in_position_;
 }
 
 // The commanded position and the block shown there.
@@ -433,6 +444,7 @@ void Interpolator::write_shown(TickOutput& out) const noexcept {
 void Interpolator::tick(const TickInput& in, TickOutput& out) noexcept {
   ++ticks_;
   out.event_count = 0;
+  waiting_in_position_ = false;
   if (state_ == RunState::Aborted || state_ == RunState::Finished) {
     const double s_now = s_f_;
     fill_output(out, s_now);

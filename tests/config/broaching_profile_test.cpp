@@ -70,6 +70,14 @@ TEST(BroachingProfile, TheBroachLoadsItsLevelsAndBore) {
   EXPECT_EQ(sim.broach.stroke_joint, 1);
   EXPECT_EQ(sim.broach.rotary_joint, 2);
   EXPECT_EQ(sim.broach.radial_joint, 0);
+  // The link the power-fail stop counts on, stated in [power] (the simulated link is the same),
+  // and how hard the drives may brake the axes when it would not last.
+  EXPECT_EQ(load.profile->power.dc_link_capacitance_f, 0.0047);
+  EXPECT_EQ(load.profile->power.dc_link_idle_power_w, 150.0);
+  EXPECT_EQ(sim.power.dc_link_capacitance_f, 0.0047);
+  EXPECT_EQ(sim.power.idle_power_w, 150.0);
+  EXPECT_EQ(load.profile->find(Axis::Z)->peak_deceleration, 6000.0);
+  EXPECT_EQ(load.profile->find(Axis::C)->peak_deceleration, 14400.0);
 }
 
 struct BadCase {

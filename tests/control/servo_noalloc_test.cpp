@@ -153,7 +153,7 @@ TEST(ServoAllocations, NoneWhileRigidTappingOrUnderConstantSurfaceSpeed) {
 }
 
 // The broach's tick: every coupling law engaged and released in a run, a feed hold while coupled,
-// and a power failure's stop with the coupling held.
+// and a power failure's stop with the coupling held, braking harder on a nearly empty DC link.
 TEST(ServoAllocations, NoneInsideTheCoupledTick) {
   const auto dir = std::filesystem::temp_directory_path() / "opencnc-noalloc-coupled";
   std::filesystem::create_directories(dir);
@@ -162,7 +162,10 @@ TEST(ServoAllocations, NoneInsideTheCoupledTick) {
       << "G21 G90 G0 X0 Z0 C0\nM171 P60\nG1 X0.1 F60\nG1 Z40 F6000\nM172 P600 Q-0.2\n"
          "G1 Z80\nM173 P1\nG1 Z120\nM174 P2\nG1 Z100\nG0 Z0\nM175\nM171 P60\nG1 Z200 F3000\nM2\n";
   g_allocations = 0;
-  Armed a(loaded(config::load_profile(OPENCNC_SOURCE_DIR "/configs/broach-zc.toml")));
+  // A nearly empty DC link (no UPS runtime, 40 µF): the power-fail stop brakes harder.
+  const std::vector<std::string> empty_link = {"power.sim.ups_runtime_s=0",
+                                               "power.dc_link_capacitance_f=0.00004"};
+  Armed a(loaded(config::load_profile(OPENCNC_SOURCE_DIR "/configs/broach-zc.toml", empty_link)));
   a.ask(Request::simple(CommandKind::MachineOn));
   a.ask(Request::set_mode(Mode::Auto));
   a.ask(Request::open(program));
@@ -180,6 +183,7 @@ TEST(ServoAllocations, NoneInsideTheCoupledTick) {
       },
       200000));
   EXPECT_TRUE(coupled_seen);
+  EXPECT_GT(a.rig().status().servo.stop_decel_scale, 1.0);  // the energy's stop ran in the tick
   EXPECT_EQ(g_allocations.load(), 0);
   std::filesystem::remove_all(dir);
 }

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -33,6 +34,7 @@ class HelixWatch final : public ControllerObserver {
  public:
   explicit HelixWatch(motion::CouplingConfig c) : config_(c) {}
   void on_status(const ControllerStatus& s) override {
+    waited_in_position = waited_in_position || s.servo.coupling_wait;
     const CouplingStatus& c = s.servo.coupling;
     if (c.kind == motion::CouplingKind::Off) return;
     ++coupled;
@@ -59,6 +61,7 @@ class HelixWatch final : public ControllerObserver {
   std::vector<motion::CouplingKind> kinds;
   double command_error_deg = 0, actual_error_deg = 0;
   bool backwards = false;
+  bool waited_in_position = false;  ///< a coupling code waited for the drives (status coupling_wait)
 
  private:
   motion::CouplingConfig config_;
@@ -241,6 +244,95 @@ TEST(Coupling, PowerFailStopsOnTheHelix) {
     EXPECT_GT(r.independent_error_um, 10 * std::max(r.coupled_error_um, 1.0)) << cut_s;
     EXPECT_GT(r.stop_distance_mm, 0.0) << cut_s;
   }
+}
+
+// The law engages on settled drives. Indexing C by 180° uncoupled (as between the demo jobs'
+// grooves) leaves C overshooting by 0.05° when its command rests; a law that took C then would
+// hold it to that command while the drive still settles: 35 µm of helix error at the bore during
+// the X infeed after M171. The code waits until Z and C stand within [coupling]
+// engage_tolerance_um (0.25 µm) of their commands: the error after it stays within 1 µm.
+TEST(Coupling, TheLawEngagesOnSettledDrives) {
+  const std::string program =
+      "G21 G90 G94 G64 P0.005\nG0 X-0.5\nG0 Z-10 C180\nM171 P600\nG1 X0.1 F60\nM175\nM2\n";
+  auto helix_um = [](const CoupledRun& r) {
+    return r.watch->actual_error_deg * std::numbers::pi / 180 * 40e3;
+  };
+  const CoupledRun settled = run(program);
+  ASSERT_TRUE(settled.opened.accepted) << messages(settled.opened);
+  EXPECT_TRUE(settled.watch->waited_in_position);
+  EXPECT_GT(settled.watch->coupled, 500u);
+  EXPECT_LE(helix_um(settled), 1.0);
+  const CoupledRun at_once = run(program, broach({"coupling.engage_tolerance_um=0"}));  // no wait
+  EXPECT_FALSE(at_once.watch->waited_in_position);
+  EXPECT_GT(helix_um(at_once), 10.0);
+}
+
+// The wait is bounded: a drive that does not settle within engage_timeout_s (here 10 ms, C needs
+// about 80) stops the run with a fault that names it.
+TEST(Coupling, ADriveThatDoesNotSettleStopsTheRunWithAFault) {
+  const config::MachineProfile p = broach({"coupling.engage_timeout_s=0.01"});
+  Diagnostics d;
+  SimRig rig(p, GcodeProgramSource::create(p, d));
+  rig.step();
+  ASSERT_TRUE(rig.request(Request::simple(CommandKind::MachineOn)).accepted);
+  ASSERT_TRUE(rig.request(Request::set_mode(Mode::Auto)).accepted);
+  ASSERT_TRUE(
+      rig.request(Request::open(write_program("G21 G90\nG0 Z-10 C180\nM171 P600\nG1 Z50 F3000\nM2\n")),
+                  100000)
+          .accepted);
+  ASSERT_TRUE(rig.request(Request::simple(CommandKind::CycleStart)).accepted);
+  ASSERT_TRUE(rig.run_until([&] { return rig.status().servo.state == State::Faulted; }, 20000));
+  const ControllerStatus s = rig.status();
+  EXPECT_EQ(s.servo.fault.kind, FaultKind::CouplingPosition);
+  EXPECT_EQ(s.servo.fault.axis, index(Axis::C));
+  EXPECT_GT(s.servo.fault.value, s.servo.fault.limit);
+  EXPECT_NE(s.fault_text.find("engage_tolerance_um"), std::string::npos) << s.fault_text;
+  EXPECT_EQ(s.servo.coupling.kind, motion::CouplingKind::Off);  // the law never took the axes
+  EXPECT_NEAR(s.servo.actual[Axis::Z], -10.0, 0.01);            // the stroke never started
+}
+
+// The stop shortened by the DC link's energy. The mains cut while a stroke cuts (3.2 s, Z at
+// 3 m/min) and during a rapid return (14.2 s, 9 m/min), the UPS's battery empty so that the link
+// alone feeds the drives. With broach-zc's 4.7 mF (361 J above 400 V) the stop is as planned;
+// with 40 µF (2.9 J) the planned stop would drain the link before rest (the drives trip on
+// undervoltage: an amplifier fault, the axes coasting), so the tick brakes harder — 1.87 times
+// the planned deceleration on the stroke, the peak decelerations' bound of 4 on the return — and
+// the axes rest on the helix with energy left.
+TEST(Coupling, APowerFailOnANearlyEmptyDcLinkBrakesHarderAndStaysOnTheHelix) {
+  const std::vector<std::string> empty_ups = {"power.sim.ups_runtime_s=0"};
+  auto cut = [&](std::vector<std::string> sets, double cut_s) {
+    PowerFailRun run(broach(sets), OPENCNC_SOURCE_DIR "/examples/broach-constant.ngc", false);
+    SimRig& rig = run.rig;
+    EXPECT_TRUE(rig.run_until([&] { return rig.status().servo.time_s >= cut_s; }, 20000));
+    rig.machine().set_mains_ok(false);
+    EXPECT_TRUE(rig.run_until([&] { return rig.status().servo.state == State::Faulted; }, 5000));
+    return std::pair{run.recorder->report(), rig.status().servo.fault.kind};
+  };
+  std::vector<std::string> small = empty_ups;
+  small.push_back("power.dc_link_capacitance_f=0.00004");
+  std::vector<std::string> no_margin = small;
+  no_margin.insert(no_margin.end(), {"axis.z.peak_deceleration=1500", "axis.c.peak_deceleration=3600"});
+  for (const double cut_s : {3.2, 14.2}) {
+    const auto [normal, normal_fault] = cut(empty_ups, cut_s);
+    const auto [with_ups, ups_fault] = cut({}, cut_s);
+    EXPECT_EQ(normal.decel_scale, 1.0) << cut_s;  // enough energy: the stop as planned, bit for bit
+    EXPECT_EQ(normal.stop_distance_mm, with_ups.stop_distance_mm) << cut_s;
+    EXPECT_EQ(normal.coupled_error_um, with_ups.coupled_error_um) << cut_s;
+    EXPECT_GT(normal.energy_at_signal_j, 350.0) << cut_s;
+    const auto [short_stop, short_fault] = cut(small, cut_s);
+    EXPECT_EQ(short_fault, FaultKind::PowerLoss) << cut_s;  // at rest, the drives still powered
+    EXPECT_GT(short_stop.decel_scale, 1.5) << cut_s;
+    EXPECT_LE(short_stop.decel_scale, 4.0) << cut_s;  // Z 6000 / 1500, C 14400 / 3600
+    EXPECT_LT(short_stop.stop_distance_mm, 0.6 * normal.stop_distance_mm) << cut_s;
+    EXPECT_LT(short_stop.stop_time_s, normal.stop_time_s) << cut_s;
+    EXPECT_GT(short_stop.energy_at_rest_j, 0.0) << cut_s;
+    EXPECT_GE(short_stop.dc_link_min_v, 400.0) << cut_s;
+    EXPECT_LE(short_stop.coupled_error_um, 1.0) << cut_s;
+    EXPECT_LT(short_stop.coupled_command_error_um, 1e-3) << cut_s;
+  }
+  const auto [planned, planned_fault] = cut(no_margin, 3.2);  // no peak above the plan
+  EXPECT_EQ(planned.decel_scale, 1.0);
+  EXPECT_EQ(planned_fault, FaultKind::AmpFault);  // the drives' undervoltage, before rest
 }
 
 // The 100-cut sweep's outlier (3.18 µm, the mains cut 10–40 ms after a rapid return arrived,

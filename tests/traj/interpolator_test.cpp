@@ -229,6 +229,63 @@ TEST(Interpolator, AbortStopsUnderControlAndDropsTheQueue) {
   EXPECT_EQ(rig.step().state, RunState::Aborted);
 }
 
+// A power-fail stop short of energy: the abort brakes at the scale times the block's budget, so
+// it rests in 1/scale of the time and distance; the scale is ignored while not aborting, and the
+// path's budget is reported for the servo's estimate.
+TEST(Interpolator, AnAbortBrakesAtItsDecelerationScale) {
+  auto stop = [](double scale) {
+    Rig rig;
+    rig.publish(plan({line(at(0), at(100), 100, 1000, 0), marker(MarkerKind::ProgramEnd)}));
+    rig.in.abort_decel_scale = scale;  // not aborting yet: no effect on the acceleration
+    for (int i = 0; i < 300; ++i) rig.step();
+    EXPECT_EQ(rig.trace.back().path_acceleration, 1000.0);
+    EXPECT_LE(rig.max_accel_x(), 1000.0 * (1 + 1e-6));
+    const double x0 = rig.trace.back().position[0];
+    rig.in.abort = true;
+    const int ticks = rig.run_until(RunState::Aborted);
+    EXPECT_LE(rig.max_accel_x(), 1000.0 * std::max(1.0, scale) * (1 + 1e-6));
+    return std::pair{ticks, rig.trace.back().position[0] - x0};
+  };
+  const auto [t1, d1] = stop(1.0);
+  const auto [t3, d3] = stop(3.0);
+  EXPECT_NEAR(d1, 100.0 * 100.0 / (2 * 1000.0), 0.1);  // v²/2a from 100 mm/s
+  EXPECT_NEAR(d3, d1 / 3, 0.1);
+  EXPECT_LT(t3, t1 / 2);
+  EXPECT_EQ(stop(0.5), stop(1.0));  // never softer than planned
+}
+
+// A coupling code's marker (kWaitInPosition) waits at rest for the servo's in-position, then
+// releases and reports; a G4 of no time does not wait for it.
+TEST(Interpolator, AWaitInPositionMarkerHoldsUntilTheDrivesStandInPosition) {
+  for (const bool flagged : {true, false}) {
+    Rig rig;
+    std::vector<MotionBlock> blocks = {line(at(0), at(10), 100, 1000, 0), marker(MarkerKind::Dwell, 0, 7),
+                                       line(at(10), at(20), 100, 1000, 1), marker(MarkerKind::ProgramEnd)};
+    if (flagged) blocks[1].flags |= kWaitInPosition;
+    rig.publish(plan(blocks));
+    rig.in.in_position = false;
+    const int at_marker = rig.run_until(RunState::Dwelling, 2000);
+    ASSERT_GT(at_marker, 0);
+    for (int i = 0; i < 50; ++i) rig.step();
+    const TickOutput& waiting = rig.trace.back();
+    EXPECT_EQ(waiting.waiting_in_position, flagged);
+    if (flagged) {
+      EXPECT_EQ(waiting.position[0], 10.0);  // at rest on the marker
+    } else {
+      EXPECT_GT(waiting.position[0], 10.0);  // gone on
+    }
+    bool reported = false;
+    for (const TickOutput& o : rig.trace)
+      for (int e = 0; e < o.event_count; ++e)
+        reported = reported || o.events[static_cast<std::size_t>(e)].action == 7;
+    EXPECT_EQ(reported, !flagged);  // the marker's action follows its release
+    rig.in.in_position = true;
+    EXPECT_GT(rig.run_until(RunState::Finished), 0);
+    EXPECT_FALSE(rig.trace.back().waiting_in_position);
+    EXPECT_EQ(rig.trace.back().position[0], 20.0);
+  }
+}
+
 TEST(Interpolator, StopsAtTheEndOfTheQueuedDataAndGoesOnWhenMoreArrives) {
   Rig rig;
   std::vector<MotionBlock> blocks =

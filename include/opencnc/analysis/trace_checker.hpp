@@ -73,6 +73,9 @@ class TraceChecker {
     past_ = {newest, previous, previous};
     for (int i = 0; i < kAxisCount; ++i) past_[2][i] = 2 * previous[i] - newest[i];
   }
+  /// The acceleration and jerk limits of the next samples, times `scale` (≥ 1: a power-fail stop
+  /// short of energy brakes harder than planned, up to the axes' peak deceleration).
+  void set_acceleration_scale(double scale) noexcept { accel_scale_ = scale < 1 ? 1.0 : scale; }
   /// One commanded sample; `first`..`last` are the segment ids of the block it lies on.
   void add(const Pose& position, canon::SegmentId first, canon::SegmentId last);
   /// The metrics so far.
@@ -89,6 +92,7 @@ class TraceChecker {
   plan::MachineLimits limits_;
   double period_s_;
   double tolerance_;
+  double accel_scale_ = 1;        ///< set_acceleration_scale
   std::array<Pose, 3> past_{};    ///< the three previous samples, newest first
   canon::SegmentId nearest_ = 0;  ///< the move nearest to the last sample
   TraceReport report_;

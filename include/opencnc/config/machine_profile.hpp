@@ -81,6 +81,9 @@ struct AxisProfile {
   double max_velocity = 0;      ///< units/s
   double max_acceleration = 0;  ///< units/s²
   double max_jerk = 0;          ///< units/s³; 0 = no jerk limit
+  /// Units/s² the drive can brake the axis at in an emergency stop (≥ max_acceleration; 0 =
+  /// not stated: no harder than max_acceleration). A power-fail stop short of energy uses it.
+  double peak_deceleration = 0;
   double min_limit = 0;         ///< soft limits, machine coordinates
   double max_limit = 0;
   double max_following_error = 1;  ///< units; more is a fault
@@ -108,6 +111,11 @@ struct SpindleProfile {
 struct PowerProfile {
   bool monitor = false;         ///< the machine reports mains, UPS and DC link
   machine::SimPowerConfig sim;  ///< ups, voltages, and the simulated supply
+  /// The drives' common DC link as the machine states it (`[power]`; 0 = not stated: a power-fail
+  /// stop is never shortened): its capacitance, F, and the power its standing load draws, W
+  /// (the drives' electronics and whatever else hangs on it). The simulation's link defaults to it.
+  double dc_link_capacitance_f = 0;
+  double dc_link_idle_power_w = 0;
   /// A resume after a power failure, as offered to the operator (who may change them): how far
   /// the axes may stand from the breakpoint (mm, degrees), the run-in and its speed.
   double resume_tolerance_mm = 0.01, resume_tolerance_deg = 0.01;
@@ -240,7 +248,12 @@ struct CouplingProfile {
   Axis master = Axis::Z;
   Axis slave = Axis::C;
   bool from_actual = false;  ///< the tick couples to the master's feedback instead of its command
-  double radius_mm = 50;     ///< where helix errors are measured (the bore's radius): reports only
+  double radius_mm = 50;     ///< where helix errors are measured (the bore's radius)
+  /// A coupling code waits until master and slave stand within this of their commands (µm: of the
+  /// master's travel and of the slave's arc at radius_mm; 0: no wait) before the law takes them,
+  /// at most engage_timeout_s (then the run stops with a fault).
+  double engage_tolerance_um = 0.25;
+  double engage_timeout_s = 2;
   std::vector<CouplingTableProfile> tables;
 };
 

@@ -134,6 +134,9 @@ enum class FaultKind : std::uint8_t {
   /// A seek of a homed axis went its soft limit + overtravel without the limit switch tripping:
   /// `axis`, `value` = where it stopped, `limit` = the soft limit (the axis must home again)
   SeekNoSwitch,
+  /// A coupling code's master or slave (`axis`) did not stand within `limit` of its command in
+  /// the profile's engage_timeout_s: `value` = its following error then (the run stopped)
+  CouplingPosition,
 };
 
 /// Stable problem code of a fault ("control.fault.following-error", ...). Any thread.

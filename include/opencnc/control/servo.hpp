@@ -72,6 +72,10 @@ class Servo final : public Tickable {
   void check_joint_faults() noexcept;
   bool check_stall(int j) noexcept;
   void check_power() noexcept;
+  // --- the power-fail stop's deceleration (servo_power_stop.cpp) -----------------------------
+  double dc_link_energy_j() const noexcept;
+  double stop_scale_bound() const noexcept;
+  void choose_stop_scale() noexcept;
   void follow_feedback() noexcept;
   void write_joint(int j) noexcept;
   void write_steppers() noexcept;
@@ -155,6 +159,8 @@ class Servo final : public Tickable {
   void release_coupling() noexcept;
   double coupling_master() const noexcept;
   double coupling_error() const noexcept;
+  bool coupling_in_position() noexcept;
+  void check_engage_wait() noexcept;
 
   // --- EDM gap servo, jump and orbit (servo_gap.cpp) ------------------------------------------
   void configure_gap_servo() noexcept;
@@ -207,6 +213,13 @@ class Servo final : public Tickable {
   StopReason stop_reason_ = StopReason::None;
   Fault fault_{};
   bool power_stop_ = false;  ///< a controlled stop for a power failure is under way
+  /// The power-fail stop's deceleration: times the path's budget (1 = as planned), and the most
+  /// the moving axes' peak decelerations allow (chosen at the signal).
+  double stop_scale_ = 1, stop_scale_max_ = 1;
+  /// A coupling code's wait for master and slave in position: periods they have stood within the
+  /// tolerance, periods waited so far.
+  int in_position_periods_ = 0;
+  std::uint64_t engage_wait_periods_ = 0;
   std::uint64_t last_command_id_ = 0;
   Refusal last_refusal_ = Refusal::None;
   std::uint64_t accepted_ = 0, refused_ = 0, events_dropped_ = 0, trace_dropped_ = 0;

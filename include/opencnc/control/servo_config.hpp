@@ -64,12 +64,23 @@ struct JointConfig {
   double max_velocity = 0;        ///< units/s
   double max_acceleration = 0;    ///< units/s²
   double max_jerk = 0;            ///< units/s³, 0 = none
+  /// Units/s² the path may brake the joint at in a power-fail stop short of energy (the profile's
+  /// peak_deceleration less the compensation's reserve; ≤ max_acceleration: no harder than planned).
+  double peak_deceleration = 0;
   double min_limit = 0;           ///< soft limits, machine coordinates
   double max_limit = 0;
   double max_following_error = 1;  ///< units
   HomeConfig home;
   LimitSeekConfig seek;
   double hand_tolerance = 0.05;  ///< manual joints: how close the operator must come, units
+};
+
+/// The drives' DC link as the profile's `[power]` states it: the power-fail stop computes the
+/// energy left in it from the voltage the drives report (capacitance 0: not stated, never shortened).
+struct PowerStopConfig {
+  double dc_link_capacitance_f = 0;
+  double dc_link_min_v = 0;         ///< the drives trip on undervoltage below this
+  double dc_link_idle_power_w = 0;  ///< the link's standing load while the axes stop
 };
 
 /// Most step sizes the handwheel offers.
@@ -89,6 +100,8 @@ struct ServoConfig {
   motion::CompensationConfig compensation;
   /// The slave axis a program may couple to its master, and the profile's tables (coupling stage).
   motion::CouplingConfig coupling;
+  /// The DC link a power-fail stop must finish on (the stop's deceleration scale).
+  PowerStopConfig power_stop;
   /// The process load's thresholds (the load guard stage, after the interlocks).
   LoadGuardConfig load_guard;
   /// Sinker EDM: the machining conditions and the gap servo (the gap servo stage).

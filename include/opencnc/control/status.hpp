@@ -123,6 +123,13 @@ struct ServoStatus {
   std::array<double, machine::kAnalogChannels> analog_out{};
   bool mains_ok = true, on_battery = false;
   double dc_link_v = 0;
+  /// Wait::Dwell at a coupling code (M171–M174): master and slave coming to stand on their
+  /// commands before the law takes them ([coupling] engage_tolerance_um).
+  bool coupling_wait = false;
+  /// ½·C·(V² − V_min²) of the link the profile's [power] states, J (0: not stated).
+  double dc_link_energy_j = 0;
+  /// The last power-fail stop's deceleration, times the path's budget (1: as planned), until reset.
+  double stop_decel_scale = 1;
 
   // Answers.
   Fault fault{};  ///< the fault that made the state Faulted (kind None otherwise)
@@ -175,6 +182,8 @@ struct TraceSample {
   bool power_stop = false;       ///< a power-fail stop is under way (from the period after the signal)
   double coupling_error_deg = 0;  ///< actual slave − law(actual master), degrees (0 uncoupled)
   double load_kn = 0;             ///< the process load input (load guard), kN
+  double dc_link_energy_j = 0;    ///< the link's usable energy (ServoStatus::dc_link_energy_j), J
+  double stop_decel_scale = 1;    ///< the power-fail stop's deceleration scale (1: not in one)
   EdmStatus edm{};                ///< the EDM gap servo (machines with [edm])
 };
 

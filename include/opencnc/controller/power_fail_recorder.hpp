@@ -28,6 +28,11 @@ struct PowerFailReport {
   /// commanded state at the signal (no coupling): the largest helix error, µm.
   double independent_error_um = 0;
   double dc_link_min_v = 0;  ///< lowest DC link voltage seen from the signal on
+  /// The link's usable energy above its minimum voltage (profile's [power]; 0 when not stated), J:
+  /// in the period of the signal and in the last period the master moved.
+  double energy_at_signal_j = 0;
+  double energy_at_rest_j = 0;
+  double decel_scale = 1;  ///< the stop's deceleration, times the path's budget (1: as planned)
 };
 
 /// An observer (trace and status every period) of a run that may meet a power failure.

@@ -99,6 +99,11 @@ struct CouplingConfig {
   std::int8_t master_axis = 2;  ///< Axis index (Z)
   std::int8_t slave_axis = 5;   ///< Axis index (C)
   CouplingSource source = CouplingSource::Command;
+  /// A coupling code's law takes master and slave once both stand within these of their commands
+  /// (master units, slave degrees; 0: at once), waiting at most `engage_timeout_s`.
+  double engage_tolerance_master = 0;
+  double engage_tolerance_slave = 0;
+  double engage_timeout_s = 2;
   /// Tables by number (1-based in programs: P1 is tables[0]); kind Off = no table there.
   std::array<CouplingKind, kMaxCouplingTables> table_kind{};
   std::array<CouplingTable, kMaxCouplingTables> tables{};

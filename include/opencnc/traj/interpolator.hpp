@@ -37,6 +37,11 @@ struct TickInput {
   bool spindle_at_speed = true;  ///< spindle at its commanded speed (for SpindleWait markers)
   double spindle_revs = 0;       ///< spindle encoder position, revolutions (G33)
   double spindle_rev_s = 0;      ///< spindle speed, revolutions per second (G95, G33)
+  /// While aborting, the path brakes at up to this many times each block's acceleration budget
+  /// (≥ 1; the servo raises it when the drives' DC link would not last the normal stop). Level.
+  double abort_decel_scale = 1.0;
+  /// The drives a kWaitInPosition marker waits for stand in position (the servo decides). Level.
+  bool in_position = true;
 };
 
 /// What the interpolator is doing.
@@ -66,6 +71,9 @@ struct TickEvent {
 struct TickOutput {
   Pose position{};           ///< commanded position of every axis (mm, degrees)
   double path_velocity = 0;  ///< ds/dt of the commanded position (s-units/s)
+  /// The acceleration budget of the block the generator is in (s-units/s², 0 when none): the
+  /// normal deceleration a stop on the path brakes at (the servo's power-fail stop estimates by it).
+  double path_acceleration = 0;
   RunState state = RunState::Idle;
   std::uint64_t block_seq = 0;      ///< block at the commanded position
   std::uint64_t segment = 0;        ///< canon segment id of the move being executed
@@ -85,6 +93,8 @@ struct TickOutput {
   /// (from the bottom of the tap until it is back at its start). A level, for the spindle output.
   bool tap_reverse = false;
   double tap_speed_scale = 1;
+  /// At a kWaitInPosition marker, waiting for TickInput::in_position (state Dwelling).
+  bool waiting_in_position = false;
 };
 
 /// Consumes motion blocks and computes the commanded position every servo period.
@@ -166,6 +176,7 @@ class Interpolator {
   std::uint64_t step_from_seq_ = 0;        ///< single-block stops only after this block
   std::uint64_t dwell_ticks_left_ = 0;
   bool waiting_ = false;  ///< at a stop marker, action not finished
+  bool waiting_in_position_ = false;  ///< this tick, at a kWaitInPosition marker not yet in position
 
   // Spindle-synchronised motion (G33): wait for the index, catch up, then follow the encoder.
   enum class Sync : std::uint8_t { Off, WaitIndex, CatchUp, Locked };

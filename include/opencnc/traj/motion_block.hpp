@@ -51,6 +51,9 @@ enum BlockFlag : std::uint8_t {
   kProbe = 1u << 3,                ///< straight probe move (G38.x)
   kRigidTap = 1u << 4,             ///< rigid tap (G33.1): a line in, with its way out next
   kTapReturn = 1u << 5,            ///< rigid tap: the way out, back to the tap's start
+  /// A stop marker that releases only once the drives stand in position (TickInput::in_position):
+  /// a coupling code, whose law must take master and slave where they are commanded.
+  kWaitInPosition = 1u << 6,
 };
 
 /// Sentinel for "no block": links that point nowhere.
