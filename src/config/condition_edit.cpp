@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <charconv>
+#include <functional>
 #include <optional>
 
 #include "opencnc/config/toml_edit.hpp"
@@ -56,6 +57,16 @@ std::optional<std::pair<int, std::string>> condition_key_parts(std::string_view 
 }
 
 }  // namespace
+
+int condition_to_copy(const machine::EdmConfig& edm, int number) {
+  int below = 0, lowest = 0;
+  for (int i = 0; i < edm.condition_count; ++i) {
+    const int n = edm.conditions[static_cast<std::size_t>(i)].number;
+    if (n < number && n > below) below = n;
+    if (lowest == 0 || n < lowest) lowest = n;
+  }
+  return below != 0 ? below : lowest;
+}
 
 std::span<const ConditionField> condition_fields() {
   return kFields;
@@ -121,6 +132,106 @@ bool edit_condition(std::string& text, const MachineProfile& live, const std::st
   text = std::move(*next);
   change = {key, condition_field_text(*c, parts->second), ""};
   return true;
+}
+
+namespace {
+
+/// The element of condition `c` in the file: the loader keeps the conditions in the file's order.
+int element_of(const machine::EdmConfig& edm, const machine::EdmCondition* c) {
+  return static_cast<int>(c - edm.conditions.data());
+}
+
+/// Adds the conditions of `changes` to `text` (a copy of each one's source after the last
+/// element); `count` goes up by each. False with `error`.
+bool add_conditions(std::string& text, const machine::EdmConfig& edm,
+                    std::span<const ConditionChange> changes, int& count, std::vector<ProfileChange>& out,
+                    std::string& error) {
+  std::vector<int> added;
+  for (const ConditionChange& c : changes) {
+    if (c.remove) continue;
+    if (c.number < 1 || c.number > 99) {
+      error = fmt::format("a machining condition's number is 1 to 99, not {}", c.number);
+      return false;
+    }
+    if (edm.find(c.number) != nullptr || std::find(added.begin(), added.end(), c.number) != added.end()) {
+      error = fmt::format("condition {} exists already: change its values instead", c.number);
+      return false;
+    }
+    const machine::EdmCondition* from = edm.find(c.from);
+    if (from == nullptr) {
+      error = fmt::format("there is no condition {} to copy the new condition {} from", c.from, c.number);
+      return false;
+    }
+    if (++count > machine::kMaxEdmConditions) {
+      error = fmt::format(
+          "the machine holds at most {} machining conditions: delete one before adding condition {}",
+          machine::kMaxEdmConditions, c.number);
+      return false;
+    }
+    std::optional<std::string> next = with_toml_element_copy(
+        text, "edm.condition", element_of(edm, from), "number", std::to_string(c.number),
+        fmt::format("Condition {}: a copy of condition {}.", c.number, c.from), error);
+    if (!next) return false;
+    text = std::move(*next);
+    added.push_back(c.number);
+    out.push_back(
+        {fmt::format("edm.condition.{}", c.number), "none", fmt::format("a copy of condition {}", c.from)});
+  }
+  return true;
+}
+
+/// Deletes the conditions of `changes` from `text` (the last element first, so that the others'
+/// places stand); `count` goes down by each. False with `error`.
+bool delete_conditions(std::string& text, const machine::EdmConfig& edm,
+                       std::span<const ConditionChange> changes, std::span<const ProfileKeyEdit> edits,
+                       int& count, std::vector<ProfileChange>& out, std::string& error) {
+  std::vector<int> elements;
+  for (const ConditionChange& c : changes) {
+    if (!c.remove) continue;
+    const machine::EdmCondition* d = edm.find(c.number);
+    if (d == nullptr) {
+      error = fmt::format("the profile has no machining condition {} to delete", c.number);
+      return false;
+    }
+    const std::string key = fmt::format("edm.condition.{}", c.number);
+    const bool edited = std::any_of(edits.begin(), edits.end(), [&](const ProfileKeyEdit& e) {
+      return e.key.size() > key.size() && e.key.compare(0, key.size() + 1, key + ".") == 0;
+    });
+    if (edited || std::find(elements.begin(), elements.end(), element_of(edm, d)) != elements.end()) {
+      error = fmt::format("condition {} is deleted and changed (or deleted twice) in one request", c.number);
+      return false;
+    }
+    if (--count < 1) {
+      error =
+          fmt::format("condition {} is the machine's last machining condition: an EDM needs one", c.number);
+      return false;
+    }
+    elements.push_back(element_of(edm, d));
+    out.push_back({key, "defined", "deleted"});
+  }
+  std::sort(elements.begin(), elements.end(), std::greater<>());
+  for (const int element : elements) {
+    std::optional<std::string> next = without_toml_element(text, "edm.condition", element, error);
+    if (!next) return false;
+    text = std::move(*next);
+  }
+  return true;
+}
+
+}  // namespace
+
+bool change_conditions(std::string& text, const MachineProfile& live,
+                       std::span<const ConditionChange> changes, std::span<const ProfileKeyEdit> edits,
+                       std::vector<ProfileChange>& changes_out, std::string& error) {
+  const machine::EdmConfig& edm = live.edm.config;
+  int count = edm.condition_count;
+  if (!live.edm.present)
+    error = "the machine has no [edm] section: it has no machining conditions to add or delete";
+  else if (add_conditions(text, edm, changes, count, changes_out, error) &&
+           delete_conditions(text, edm, changes, edits, count, changes_out, error))
+    return true;
+  error = fmt::format("{}: {}", live.source, error);
+  return false;
 }
 
 std::string condition_value(const MachineProfile& profile, const std::string& key) {

@@ -167,9 +167,10 @@ std::vector<EditableParameter> editable_parameters(const MachineProfile& profile
   return out;
 }
 
-ProfileEditResult edit_profile(const MachineProfile& live, std::span<const ProfileKeyEdit> edits) {
+ProfileEditResult edit_profile(const MachineProfile& live, std::span<const ProfileKeyEdit> edits,
+                               std::span<const ConditionChange> conditions) {
   ProfileEditResult r;
-  if (edits.empty()) {
+  if (edits.empty() && conditions.empty()) {
     r.error = "no parameter to change";
     return r;
   }
@@ -258,6 +259,8 @@ ProfileEditResult edit_profile(const MachineProfile& live, std::span<const Profi
       return r;
     }
   }
+  if (!conditions.empty() && !detail::change_conditions(text, live, conditions, edits, r.changes, r.error))
+    return r;
   if (!comp_files.texts(r.files, r.error)) return r;
   ProfileLoad load = parse_profile(text, live.source, live.overrides,
                                    std::filesystem::path(live.source).parent_path(), r.files);
@@ -265,6 +268,7 @@ ProfileEditResult edit_profile(const MachineProfile& live, std::span<const Profi
   if (!load.profile) return r;
   const std::vector<EditableParameter> now = editable_parameters(*load.profile);
   for (ProfileChange& c : r.changes) {
+    if (c.key.rfind("edm.condition.", 0) == 0 && !is_condition_key(c.key)) continue;  // added, deleted
     if (is_condition_key(c.key)) {
       c.new_value = detail::condition_value(*load.profile, c.key);
       continue;

@@ -599,16 +599,18 @@ Preflight preflight_pass(const gcode::Options& o, const std::string& path, const
   return out;
 }
 
-/// The machine's code modules with the EDM codes added, M180's P checked against its conditions.
-std::function<std::shared_ptr<const gcode::Extensions>(gcode::Dialect)> with_edm_codes(
-    const machine::EdmConfig& edm,
-    std::function<std::shared_ptr<const gcode::Extensions>(gcode::Dialect)> base) {
-  std::vector<int> numbers;
-  for (int i = 0; i < edm.condition_count; ++i)
-    numbers.push_back(edm.conditions[static_cast<std::size_t>(i)].number);
-  return [numbers, base](gcode::Dialect d) {
-    return gcode::edm_extensions(d, numbers, base ? base(d) : nullptr);
-  };
+/// True when `a` and `b` are both null or hold the same numbers.
+bool same_numbers(const std::shared_ptr<const std::vector<int>>& a, const std::shared_ptr<const std::vector<int>>& b) {
+  return a && b ? *a == *b : a == b;
+}
+
+/// The numbers of the machine's machining conditions, for M180's P; null without [edm].
+std::shared_ptr<const std::vector<int>> edm_condition_numbers(const config::MachineProfile& profile) {
+  if (!profile.edm.present) return nullptr;
+  const machine::EdmConfig& edm = profile.edm.config;
+  auto numbers = std::make_shared<std::vector<int>>();
+  for (int i = 0; i < edm.condition_count; ++i) numbers->push_back(edm.conditions[static_cast<std::size_t>(i)].number);
+  return numbers;
 }
 
 }  // namespace
@@ -647,7 +649,7 @@ std::optional<GcodeSourceConfig> GcodeProgramSource::config_for(const config::Ma
   c.hand = hand_axes(profile);
   c.coupling = coupled_axes(profile);
   if (c.coupling.any()) c.extensions = gcode::coupling_extensions;
-  if (profile.edm.present) c.extensions = with_edm_codes(profile.edm.config, c.extensions);
+  c.edm_conditions = edm_condition_numbers(profile);
   return c;
 }
 
@@ -655,10 +657,20 @@ GcodeProgramSource::GcodeProgramSource(GcodeSourceConfig config) : config_(std::
 
 GcodeProgramSource::~GcodeProgramSource() = default;
 
+// A program opened after this reads M180 against the new numbers; the MDI session starts afresh at
+// its next line if they differ from its own (its interpreter holds the modules it was made with).
+void GcodeProgramSource::profile_changed(const config::MachineProfile& profile) {
+  std::shared_ptr<const std::vector<int>> numbers = edm_condition_numbers(profile);
+  if (same_numbers(numbers, config_.edm_conditions)) return;
+  config_.edm_conditions = std::move(numbers);
+  ++conditions_changed_;
+}
+
 gcode::Options GcodeProgramSource::options_for(const std::string& path, const LoadOptions& options) const {
   gcode::Options o = config_.options;
   if (!path.empty()) o.dialect = gcode::dialect_marker(path).value_or(o.dialect);
   o.extensions = config_.extensions ? config_.extensions(o.dialect) : gcode::standard_extensions(o.dialect);
+  if (config_.edm_conditions) o.extensions = gcode::edm_extensions(o.dialect, *config_.edm_conditions, o.extensions);
   o.block_delete = options.block_delete;
   if (config_.tools) o.tool_table = config_.tools->snapshot();
   return o;
@@ -695,7 +707,9 @@ std::unique_ptr<ProgramStream> GcodeProgramSource::resume(const std::string& pat
 }
 
 std::unique_ptr<ProgramStream> GcodeProgramSource::mdi(std::string_view line, const Pose& start) {
+  if (mdi_ && !same_numbers(mdi_conditions_, config_.edm_conditions)) mdi_.reset();
   if (!mdi_) {
+    mdi_conditions_ = config_.edm_conditions;
     gcode::Options o = options_for("", {});
     o.mode = gcode::Mode::Execute;
     mdi_ = std::make_unique<gcode::Interpreter>(o);

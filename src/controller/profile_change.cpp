@@ -5,6 +5,8 @@
 // them or none).
 #include <fmt/format.h>
 
+#include <algorithm>
+
 #include "opencnc/controller/controller.hpp"
 #include "opencnc/controller/preflight.hpp"
 #include "opencnc/controller/servo_setup.hpp"
@@ -37,6 +39,12 @@ std::string change_text(const std::vector<config::ProfileChange>& changes) {
   for (const config::ProfileChange& c : changes)
     s += fmt::format("{}{} {} → {}", s.empty() ? "" : "; ", c.key, c.old_value, c.new_value);
   return s;
+}
+
+/// True when every change is of a machining condition (`edm.condition.…`): the audit says so.
+bool only_conditions(const std::vector<config::ProfileChange>& changes) {
+  return std::all_of(changes.begin(), changes.end(),
+                     [](const config::ProfileChange& c) { return c.key.rfind("edm.condition.", 0) == 0; });
 }
 
 JointLimits joint_limits(const ServoConfig& s, int joint) {
@@ -91,6 +99,7 @@ void Controller::swap_profile(config::MachineProfile profile) {
   limits_ = machine_limits(profile_);
   check_ = std::make_unique<MachineMoveCheck>(servo_config_, limits_);
   ++limits_version_;  // the open program is checked again before it starts
+  if (source_) source_->profile_changed(profile_);  // M180 selects from the conditions now defined
   std::lock_guard lock(out_mutex_);
   shown_profile_ = profile_;
 }
@@ -105,7 +114,7 @@ void Controller::edit_profile(std::uint64_t id, const requests::EditProfile& r) 
       s.state == State::Stopped)
     return finish(id, Refusal::Busy,
                   "machine parameters change only while nothing runs (no program, MDI line, jog or homing)");
-  config::ProfileEditResult edit = config::edit_profile(profile_, r.edits);
+  config::ProfileEditResult edit = config::edit_profile(profile_, r.edits, r.conditions);
   if (!edit.error.empty()) return finish(id, Refusal::BadValue, edit.error);
   if (!edit.ok()) {
     const Diagnostic* first = nullptr;
@@ -119,6 +128,12 @@ void Controller::edit_profile(std::uint64_t id, const requests::EditProfile& r) 
   const ServoConfig next = control::servo_config(*edit.profile);
   if (const std::string why = outside_new_limits(next, s); !why.empty())
     return finish(id, Refusal::SoftLimit, why);
+  if (Diagnostics selects; !open_program_keeps_its_conditions(r, *edit.profile, selects)) {
+    std::string why = selects.items().front().format();
+    return finish(id, Refusal::ProgramError,
+                  fmt::format("the open program selects a condition this would delete: {}", why),
+                  std::move(selects));
+  }
   std::string old_text, error;
   std::vector<config::FileText> old_files;  // a comp file the table is written into
   if (!write_files(edit.files, old_files, error)) return finish(id, Refusal::BadValue, error);
@@ -129,7 +144,8 @@ void Controller::edit_profile(std::uint64_t id, const requests::EditProfile& r) 
                   fmt::format("{}: cannot write the profile: {}", profile_.source, error));
   }
   ProfileChange pending{
-      id, new_id(), profile_, std::move(old_text), change_text(edit.changes), r.who, std::move(old_files)};
+      id, new_id(), profile_, std::move(old_text), change_text(edit.changes), r.who, std::move(old_files),
+      only_conditions(edit.changes) ? "machining conditions" : "machine parameters"};
   const std::uint16_t tables = compensated_joints(next);
   swap_profile(std::move(*edit.profile));
   bool queued = true;
@@ -155,6 +171,26 @@ void Controller::edit_profile(std::uint64_t id, const requests::EditProfile& r) 
     refused.refusal = Refusal::Busy;
     settle_profile_change(refused);  // the stages already queued are dropped by the next apply
   }
+}
+
+// A condition deleted that the open program selects: its preflight with the edited profile's
+// conditions fails at the line of its M180 (`edm.condition`), and those errors go to `selects`.
+// The source is put back to the present profile either way (swap_profile() moves it on).
+bool Controller::open_program_keeps_its_conditions(const requests::EditProfile& r,
+                                                   const config::MachineProfile& next, Diagnostics& selects) {
+  const bool deletes = std::any_of(r.conditions.begin(), r.conditions.end(),
+                                   [](const config::ConditionChange& c) { return c.remove; });
+  const std::optional<OpenProgram> op = deletes && source_ ? open_program() : std::nullopt;
+  if (!op || op->path.empty()) return true;
+  source_->profile_changed(next);
+  const Preflight pf = preflight_file(op->path);
+  source_->profile_changed(profile_);
+  constexpr std::string_view code = "edm.condition";
+  for (const Diagnostic& d : pf.diagnostics.items())
+    if (d.severity == Severity::Error && d.code.size() >= code.size() &&
+        d.code.compare(d.code.size() - code.size(), code.size(), code) == 0)
+      selects.add(d);
+  return selects.items().empty();
 }
 
 // The joint's new table into the buffer its tick does not read, as the tick publishes it (not as
@@ -195,7 +231,7 @@ bool Controller::settle_profile_change(const ServoEvent& e) {
   profile_change_.reset();
   if (e.kind == EventKind::Accepted) {
     note(Severity::Note, "control.profile",
-         fmt::format("{}machine parameters changed: {} ({})", change.who.empty() ? "" : change.who + ": ",
+         fmt::format("{}{} changed: {} ({})", change.who.empty() ? "" : change.who + ": ", change.what,
                      change.message, profile_.source));
     finish(change.id, Refusal::None, change.message);
     return true;

@@ -254,6 +254,11 @@ Command parse(const json& body, const config::MachineProfile& p, const std::file
     if (!r.request) throw Bad{r.status, r.message};
     return std::move(*r.request);
   }
+  if (kind == "add-condition" || kind == "delete-condition") {
+    ParametersRequest r = condition_change_request(body, p, kind == "delete-condition");
+    if (!r.request) throw Bad{r.status, r.message};
+    return std::move(*r.request);
+  }
   if (kind == "run-from-line") {
     const double line = number(body, "line");
     if (line != std::floor(line) || line < 1 || line > 1e9)
@@ -315,7 +320,7 @@ std::optional<Role> role_for(std::string_view kind) {
       "mode",       "jog",     "jog-by",    "jog-stop", "home", "override",      "switch",
       "spindle-on", "coolant", "handwheel", "open",     "mdi",  "run-from-line", "seek-limit"};
   if (kind == "set-tool" || kind == "set-parameters" || kind == "set-compensation" ||
-      kind == "set-conditions" || kind == "simulate")
+      kind == "set-conditions" || kind == "add-condition" || kind == "delete-condition" || kind == "simulate")
     return Role::Admin;
   if (kind == "feature") return Role::Operator;  // the confirmation is in the body (api_features.cpp)
   if (servo_kinds().find(kind) != servo_kinds().end()) return Role::Operator;

@@ -192,6 +192,13 @@ json words(std::string_view choices) {
   return out;
 }
 
+/// A request's integer as a condition's number (1–99); 0 for any other (not narrowed: 2^32 + 4 is
+/// not condition 4).
+int condition_number(const json& v) {
+  const std::int64_t n = v.is_number_integer() ? v.get<std::int64_t>() : 0;
+  return n >= 1 && n <= 99 ? static_cast<int>(n) : 0;
+}
+
 /// A condition field's value from the request as TOML text ("60.0", "\"-\""); "" with `r` filled
 /// when the field cannot be changed or the value does not fit it.
 std::string condition_value_toml(const std::string& key, const json& value, ParametersRequest& r) {
@@ -263,7 +270,7 @@ ParametersRequest conditions_request(const json& body, const config::MachineProf
     r.message = "\"condition\" must be a condition's number";
     return r;
   }
-  const int n = number->get<int>();
+  const int n = condition_number(*number);
   if (!profile.edm.present || profile.edm.config.find(n) == nullptr) {
     r.status = 422;
     r.message =
@@ -282,6 +289,50 @@ ParametersRequest conditions_request(const json& body, const config::MachineProf
     edits.push_back({fmt::format("edm.condition.{}.{}", n, key), toml});
   }
   r.request = control::Request::edit_profile(std::move(edits));
+  return r;
+}
+
+ParametersRequest condition_change_request(const json& body, const config::MachineProfile& profile, bool remove) {
+  ParametersRequest r;
+  const auto number = body.find("condition");
+  if (number == body.end() || !number->is_number_integer()) {
+    r.message = "\"condition\" must be a condition's number";
+    return r;
+  }
+  const auto from = body.find("from");
+  if (!remove && from != body.end() && !from->is_number_integer()) {
+    r.message = "\"from\" must be the number of the condition to copy";
+    return r;
+  }
+  r.status = 422;
+  const machine::EdmConfig& edm = profile.edm.config;
+  if (!profile.edm.present) {
+    r.message = "this machine has no machining conditions (no [edm] section)";
+    return r;
+  }
+  const int n = condition_number(*number);
+  config::ConditionChange change{n, remove, 0};
+  if (n == 0) {
+    r.message = fmt::format("a machining condition's number is 1 to 99, not {}", number->dump());
+    return r;
+  }
+  if (remove && edm.find(n) == nullptr) {
+    r.message = fmt::format("the machine has no machining condition {} (GET /api/v1/conditions lists them)", n);
+    return r;
+  }
+  if (!remove) {
+    if (edm.find(n) != nullptr) {
+      r.message = fmt::format("condition {} exists already: change its values with set-conditions", n);
+      return r;
+    }
+    change.from = from != body.end() ? condition_number(*from) : config::condition_to_copy(edm, n);
+    if (edm.find(change.from) == nullptr) {
+      r.message = fmt::format("the machine has no machining condition {} to copy",
+                              from != body.end() ? from->dump() : std::to_string(change.from));
+      return r;
+    }
+  }
+  r.request = control::Request::change_conditions({change});
   return r;
 }
 

@@ -434,6 +434,50 @@ TEST(TomlEdit, AnElementThatIsNotWrittenUnderAHeaderOfItsOwnIsRefused) {
   EXPECT_NE(why.find("not one TOML value on one line"), std::string::npos) << why;
 }
 
+TEST(TomlEdit, AnElementIsCopiedAfterTheLastOneWithItsKeysAndNoComments) {
+  std::string why;
+  const auto out = with_toml_element_copy(kConditions, "edm.condition", 0, "number", "7", "a copy", why);
+  ASSERT_TRUE(out) << why;
+  std::string expected = kConditions;  // after condition 3, before the comment that leads into the sim
+  expected.insert(expected.find("\n# the sim"),
+                  "\n# a copy\n[[edm.condition]]\nnumber = 7\non_time_us = 100.0\n");
+  EXPECT_EQ(*out, expected);
+  const auto last = with_toml_element_copy(kConditions, "edm.condition", 1, "jump", "true", "", why);
+  ASSERT_TRUE(last) << why;  // a key the source lacks comes after its own; no comment line
+  expected = kConditions;
+  expected.insert(expected.find("\n# the sim"),
+                  "\n[[ edm.condition ]]\nnumber = 3\non_time_us = 15.0\njump = true\n");
+  EXPECT_EQ(*last, expected);
+  EXPECT_FALSE(with_toml_element_copy(kConditions, "edm.condition", 2, "number", "7", "", why));
+  EXPECT_NE(why.find("not written under a [[edm.condition]] header"), std::string::npos) << why;
+  EXPECT_FALSE(with_toml_element_copy("[edm]\ncondition = [{number = 1}]\n", "edm.condition", 0, "number", "7",
+                                      "", why));
+  EXPECT_FALSE(with_toml_element_copy("[[edm.condition]]\nnumber = 1\nlist = [1, 2]\n", "edm.condition", 0,
+                                      "number", "7", "", why));
+  EXPECT_NE(why.find("list is not a number"), std::string::npos) << why;
+}
+
+TEST(TomlEdit, AnElementIsRemovedWithTheCommentAboveItAndEveryOtherLineStays) {
+  std::string why;
+  const auto first = without_toml_element(kConditions, "edm.condition", 0, why);
+  ASSERT_TRUE(first) << why;
+  std::string expected = kConditions;
+  expected.erase(expected.find("\n# roughing"), std::string_view("\n# roughing\n[[edm.condition]]\nnumber = 1\n"
+                                                                  "on_time_us = 100.0   # long pulses\n")
+                                                     .size());
+  EXPECT_EQ(*first, expected);
+  const auto second = without_toml_element(kConditions, "edm.condition", 1, why);
+  ASSERT_TRUE(second) << why;
+  expected = kConditions;  // its header's own comment goes with it; the sim's comment stays
+  expected.erase(expected.find("\n[[ edm.condition ]]"),
+                 std::string_view("\n[[ edm.condition ]]  # finishing\nnumber = 3\non_time_us = 15.0\n").size());
+  EXPECT_EQ(*second, expected);
+  EXPECT_FALSE(without_toml_element(kConditions, "edm.condition", 2, why));
+  // A sub-table of the element would be left to the one before: refused.
+  EXPECT_FALSE(without_toml_element("[[a.b]]\nx = 1\n[[a.b]]\nx = 2\n[a.b.c]\ny = 1\n", "a.b", 1, why));
+  EXPECT_NE(why.find("remove it by hand"), std::string::npos) << why;
+}
+
 /// The EDM's profile (four conditions) and its tool table in a directory of their own.
 class ProfileEditConditions : public ProfileEditFile {
  protected:
@@ -485,6 +529,57 @@ TEST_F(ProfileEditConditions, ABadValueGetsTheLoadersMessageAndUnknownConditions
   EXPECT_TRUE(is_condition_key("edm.condition.12.jump_mode"));
   EXPECT_FALSE(is_condition_key("edm.condition.0.jump_mode"));
   EXPECT_FALSE(is_condition_key("edm.condition.x.on_time_us"));
+}
+
+TEST_F(ProfileEditConditions, AConditionIsAddedAsACopyAndAnotherDeletedWithTheAuditOfEach) {
+  const ConditionChange changes[] = {{4, false, 3}, {9, true, 0}};
+  const ProfileEditResult r = edit_profile(live_, {}, changes);
+  ASSERT_TRUE(r.ok()) << r.error;
+  const machine::EdmConfig& edm = r.profile->edm.config;
+  ASSERT_EQ(edm.condition_count, 4);
+  EXPECT_EQ(edm.find(9), nullptr);
+  ASSERT_NE(edm.find(4), nullptr);
+  const machine::EdmCondition& copy = *edm.find(4);
+  const machine::EdmCondition& three = *live_.edm.config.find(3);
+  for (const ConditionField& f : condition_fields())
+    EXPECT_EQ(condition_field_text(copy, f.key), condition_field_text(three, f.key)) << f.key;
+  EXPECT_EQ(copy.side_gap_mm, three.side_gap_mm);
+  EXPECT_EQ(copy.electrode_wear_ratio, three.electrode_wear_ratio);
+  ASSERT_EQ(r.changes.size(), 2u);
+  EXPECT_EQ(r.changes[0].key, "edm.condition.4");
+  EXPECT_EQ(r.changes[0].new_value, "a copy of condition 3");
+  EXPECT_EQ(r.changes[1].key, "edm.condition.9");
+  EXPECT_EQ(r.changes[1].new_value, "deleted");
+  // Condition 9 and its comment are gone, 4 stands where 9 stood; the others' comments stay.
+  EXPECT_EQ(r.text.find("a test's condition"), std::string::npos);
+  EXPECT_NE(r.text.find("# Finishing: 2 A"), std::string::npos);
+  EXPECT_NE(r.text.find("# Condition 4: a copy of condition 3.\n[[edm.condition]]\nnumber = 4\n"), std::string::npos);
+  EXPECT_LT(r.text.find("number = 4"), r.text.find("[edm.sim]"));
+}
+
+TEST_F(ProfileEditConditions, AddsAndDeletesThatCannotBeAreRefusedWithWhy) {
+  const auto refusal = [&](std::vector<ConditionChange> c, std::vector<ProfileKeyEdit> e = {}) {
+    const ProfileEditResult r = edit_profile(live_, e, c);
+    EXPECT_FALSE(r.ok());
+    return r.error;
+  };
+  EXPECT_NE(refusal({{3, false, 1}}).find("condition 3 exists already"), std::string::npos);
+  EXPECT_NE(refusal({{100, false, 1}}).find("1 to 99, not 100"), std::string::npos);
+  EXPECT_NE(refusal({{5, false, 6}}).find("no condition 6 to copy"), std::string::npos);
+  EXPECT_NE(refusal({{5, false, 1}, {5, false, 2}}).find("condition 5 exists already"), std::string::npos);
+  EXPECT_NE(refusal({{6, true}}).find("no machining condition 6 to delete"), std::string::npos);
+  EXPECT_NE(refusal({{3, true}}, {{"edm.condition.3.on_time_us", "20.0"}}).find("deleted and changed"),
+            std::string::npos);
+  EXPECT_NE(refusal({{1, true}, {2, true}, {3, true}, {9, true}}).find("last machining condition"),
+            std::string::npos);
+  std::vector<ConditionChange> many;  // 4 + 28 fill the table; one more does not fit
+  for (int n = 10; n < 10 + machine::kMaxEdmConditions - 3; ++n) many.push_back({n, false, 1});
+  EXPECT_NE(refusal(many).find("at most 32 machining conditions"), std::string::npos);
+  many.pop_back();
+  EXPECT_TRUE(edit_profile(live_, {}, many).ok());
+  EXPECT_EQ(condition_to_copy(live_.edm.config, 5), 3);
+  EXPECT_EQ(condition_to_copy(live_.edm.config, 1), 1);
+  EXPECT_EQ(condition_to_copy(live_.edm.config, 99), 9);
 }
 
 TEST(ProfileEdit, TheEditableParametersAreEachAxisLimits) {

@@ -283,7 +283,7 @@ TEST(ServoAllocations, NoneInsideTheEdmTick) {
   const machine::SimEdmProcess& sim = a.rig().machine().edm();
   EXPECT_GT(sim.cavity_oversize_max_mm(), 0.04);  // orbits beyond the roughing's side gap
   EXPECT_GT(sim.electrode_wear_mm(), 0.0);
-  // An admin's edit of the conditions: staged and taken at rest, in the counted ticks.
+  // An admin's edit of the conditions, an add and a delete: staged and taken at rest, in the counted ticks.
   EdmConditionTable& next = a.rig().channels().edm_conditions;
   next.conditions = a.rig().servo().config().edm.conditions;
   next.count = a.rig().servo().config().edm.condition_count;
@@ -295,6 +295,18 @@ TEST(ServoAllocations, NoneInsideTheEdmTick) {
   ASSERT_TRUE(a.rig().channels().commands.try_push(stage) && a.rig().channels().commands.try_push(apply));
   a.until([] { return false; }, 20);
   EXPECT_EQ(a.rig().servo().config().edm.find(1)->on_time_us, 60.0);
+  // A condition added (a copy of 1 as 7) and then one deleted (the last): the table's count changes.
+  const int count = next.count;
+  next.conditions[static_cast<std::size_t>(count)] = next.conditions[0];
+  next.conditions[static_cast<std::size_t>(count)].number = 7;
+  next.count = count + 1;
+  ASSERT_TRUE(a.rig().channels().commands.try_push(stage) && a.rig().channels().commands.try_push(apply));
+  a.until([] { return false; }, 20);
+  EXPECT_EQ(a.rig().servo().config().edm.condition_count, count + 1);
+  next.count = count - 1;
+  ASSERT_TRUE(a.rig().channels().commands.try_push(stage) && a.rig().channels().commands.try_push(apply));
+  a.until([] { return false; }, 20);
+  EXPECT_EQ(a.rig().servo().config().edm.condition_count, count - 1);
   EXPECT_EQ(g_allocations.load(), 0);
   std::filesystem::remove_all(dir);
 }

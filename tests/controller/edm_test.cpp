@@ -441,6 +441,89 @@ TEST(Edm, AnEditedConditionIsTheOneAProgramSelectsAfterwards) {
   std::filesystem::remove_all(dir);
 }
 
+// Conditions added and deleted by the admin while idle: a program opened after the add selects
+// the new condition and burns with its values (a copy of 1, its jump lowered); deleting the
+// condition the open program selects is refused at the program's line; an MDI line (its session
+// older than the change) and a program opened after a delete get the interpreter's error for an
+// unknown condition. The event log says "machining
+// conditions changed".
+TEST(Edm, AnAddedConditionIsSelectableAndADeletedOneIsNot) {
+  const auto dir = std::filesystem::temp_directory_path() / ("opencnc-edm-add-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  for (const char* f : {"edm-5axis.toml", "edm-5axis.tbl"})
+    std::filesystem::copy_file(std::filesystem::path(OPENCNC_SOURCE_DIR "/configs") / f, dir / f,
+                               std::filesystem::copy_options::overwrite_existing);
+  const std::string path = (dir / "edm-5axis.toml").string();
+  {
+    const config::MachineProfile p =
+        loaded(config::load_profile(path, std::vector<std::string>{"edm.sim.electrode_area_mm2=5"}));
+    Diagnostics d;
+    SimRig rig(p, GcodeProgramSource::create(p, d));
+    auto samples = std::make_shared<Samples>();
+    rig.controller().attach(samples, ObserverOptions{0, true});
+    rig.step();
+    ASSERT_TRUE(on_and_homed(rig));
+    ASSERT_TRUE(rig.request(Request::set_mode(Mode::Auto)).accepted);
+    const std::string five = write_program(burn(5, 0.01));
+    const Outcome unknown = rig.request(Request::open(five), 100000);
+    ASSERT_FALSE(unknown.accepted);  // no condition 5 yet
+    Outcome o = rig.request(Request::change_conditions({{5, false, 1}}, "admin"));
+    ASSERT_TRUE(o.accepted) << o.message;
+    o = rig.request(Request::edit_profile({{"edm.condition.5.jump_height_mm", "0.15"}}, "admin"));
+    ASSERT_TRUE(o.accepted) << o.message;
+    EXPECT_EQ(rig.servo().config().edm.condition_count, 5);
+    ASSERT_TRUE(rig.request(Request::open(five), 100000).accepted);
+    // The open program selects 5 at its line 3: it stays.
+    o = rig.request(Request::change_conditions({{5, true, 0}}, "admin"));
+    ASSERT_FALSE(o.accepted);
+    EXPECT_EQ(o.refusal, Refusal::ProgramError);
+    EXPECT_NE(o.message.find(five + ":3:"), std::string::npos) << o.message;
+    ASSERT_TRUE(rig.request(Request::simple(CommandKind::CycleStart)).accepted);
+    int condition = 0;
+    ASSERT_TRUE(rig.run_until(
+        [&] {
+          condition = std::max(condition, rig.status().servo.edm.condition);
+          return !rig.status().run_active && rig.status().servo.state == State::Idle;
+        },
+        60000));
+    EXPECT_EQ(condition, 5);
+    double lift_max = 0;
+    for (const TraceSample& s : samples->all) lift_max = std::max(lift_max, s.edm.jump_lift_mm);
+    EXPECT_NEAR(lift_max, 0.15, 1e-9);
+    // 9 deleted: an MDI line (its session made before) and a program opened afterwards that
+    // select it get the interpreter's message.
+    ASSERT_TRUE(rig.request(Request::set_mode(Mode::Mdi)).accepted);
+    const auto mdi = [&](const char* line) {
+      const Outcome m = rig.request(Request::mdi(line), 100000);
+      rig.run_until([&] { return !rig.status().run_active && rig.status().servo.state == State::Idle; }, 20000);
+      return m;
+    };
+    ASSERT_TRUE(mdi("G0 Z0").accepted);
+    o = rig.request(Request::change_conditions({{9, true, 0}}, "admin"));
+    ASSERT_TRUE(o.accepted) << o.message;
+    EXPECT_EQ(rig.servo().config().edm.find(9), nullptr);
+    const Outcome m9 = mdi("M180 P9");
+    EXPECT_FALSE(m9.accepted);
+    ASSERT_FALSE(m9.diagnostics.items().empty());
+    EXPECT_NE(m9.diagnostics.items().front().message.find("(1, 2, 3, 5)"), std::string::npos);
+    ASSERT_TRUE(rig.request(Request::set_mode(Mode::Auto)).accepted);
+    const std::string nine = write_program(burn(9, 0.01));
+    o = rig.request(Request::open(nine), 100000);
+    ASSERT_FALSE(o.accepted);
+    ASSERT_FALSE(o.diagnostics.items().empty());
+    const Diagnostic& e = o.diagnostics.items().front();
+    EXPECT_EQ(e.line, 3u);
+    EXPECT_NE(e.message.find("machining conditions as P (1, 2, 3, 5)"), std::string::npos) << e.message;
+    bool noted = false;
+    EventCursor cursor(rig.controller().events(), true);
+    for (const ControllerEvent& ev : cursor.next())
+      noted |= ev.code == "control.profile" &&
+               ev.text.rfind("admin: machining conditions changed: edm.condition.9 defined → deleted", 0) == 0;
+    EXPECT_TRUE(noted);
+  }
+  std::filesystem::remove_all(dir);
+}
+
 // The setter's seek of the end of the travel through the controller: the request, the note that
 // says where the switch tripped and where the axis rests, the status; C (no limit switch) refused
 // with the reason.

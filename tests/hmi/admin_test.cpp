@@ -335,6 +335,64 @@ TEST(AdminConditions, ABadValueGetsTheProfilesMessageAndABusyMachineIsRefusedAnd
   EXPECT_EQ(get(rig.port, "/api/v1/conditions", kOperator).body["conditions"][0]["on_time_us"], 100.0);
 }
 
+TEST(AdminConditions, TheAdminAddsACopyAndDeletesOneTheOpenProgramDoesNotSelect) {
+  EditableRig rig("edm-5axis.toml");
+  ASSERT_EQ(rig.command({{"kind", "machine-on"}}).status, 200);
+  ASSERT_EQ(rig.command({{"kind", "mode"}, {"mode", "auto"}}).status, 200);
+  const Reply open = rig.command({{"kind", "open"}, {"program", "edm-turbine-channel.ngc"}});
+  ASSERT_EQ(open.status, 200) << open.text;
+  const std::string add = R"({"kind":"add-condition","condition":4})";  // a copy of 3, the one below
+  EXPECT_EQ(post(rig.port, add, kOperator).status, 403);
+  const Reply added = post(rig.port, add, kAdmin);
+  ASSERT_EQ(added.status, 200) << added.text;
+  EXPECT_EQ(added.body["message"], "edm.condition.4 none → a copy of condition 3");
+  // The open program selects 3 (line 29): deleting it is refused with that line, nothing changes.
+  const std::string after_add = rig.profile_text();
+  const Reply selected = post(rig.port, R"({"kind":"delete-condition","condition":3})", kAdmin);
+  ASSERT_EQ(selected.status, 409) << selected.text;
+  EXPECT_EQ(selected.body["code"], "control.program");
+  const std::string why = selected.body["message"];
+  EXPECT_NE(why.find("the open program selects a condition this would delete"), std::string::npos) << why;
+  EXPECT_NE(why.find("edm-turbine-channel.ngc:29:"), std::string::npos) << why;
+  EXPECT_EQ(rig.profile_text(), after_add);
+  const Reply deleted = post(rig.port, R"({"kind":"delete-condition","condition":9})", kAdmin);
+  ASSERT_EQ(deleted.status, 200) << deleted.text;
+  EXPECT_EQ(deleted.body["message"], "edm.condition.9 defined → deleted");
+  const json list = get(rig.port, "/api/v1/conditions", kOperator).body["conditions"];
+  ASSERT_EQ(list.size(), 4u);
+  EXPECT_EQ(list[3]["number"], 4);
+  EXPECT_EQ(list[3]["on_time_us"], 15.0);  // condition 3's
+  EXPECT_EQ(list[3]["orbit"], "square");
+  const std::string text = rig.profile_text();
+  EXPECT_NE(text.find("# Condition 4: a copy of condition 3.\n[[edm.condition]]\nnumber = 4\n"), std::string::npos);
+  EXPECT_EQ(text.find("number = 9"), std::string::npos);
+  EXPECT_NE(text.find("# Finishing: 2 A"), std::string::npos);  // the others' comments stay
+  rig.history->flush();
+  const json audit = get(rig.port, "/api/v1/audit", kAdmin).body;
+  ASSERT_GE(audit.size(), 4u);
+  EXPECT_EQ(audit[0]["result"], "accepted: edm.condition.9 defined → deleted");
+  EXPECT_EQ(audit[1]["status"], 409);
+  EXPECT_EQ(audit[2]["result"], "accepted: edm.condition.4 none → a copy of condition 3");
+}
+
+TEST(AdminConditions, AddsAndDeletesThatCannotBeAreRefusedAndChangeNothing) {
+  EditableRig rig("edm-5axis.toml");
+  const auto status = [&](const char* body) { return post(rig.port, body, kAdmin).status; };
+  EXPECT_EQ(status(R"({"kind":"add-condition","condition":3})"), 422);               // exists
+  EXPECT_EQ(status(R"({"kind":"add-condition","condition":0})"), 422);               // 1 to 99
+  EXPECT_EQ(status(R"({"kind":"add-condition","condition":4294967300})"), 422);      // not 4
+  EXPECT_EQ(status(R"({"kind":"delete-condition","condition":4294967305})"), 422);   // not 9
+  EXPECT_EQ(status(R"({"kind":"set-conditions","condition":4294967297,"values":{"on_time_us":1}})"), 422);
+  EXPECT_EQ(status(R"({"kind":"add-condition","condition":5,"from":6})"), 422);      // no 6 to copy
+  EXPECT_EQ(status(R"({"kind":"add-condition","condition":5,"from":"3"})"), 400);
+  EXPECT_EQ(status(R"({"kind":"add-condition"})"), 400);
+  EXPECT_EQ(status(R"({"kind":"delete-condition","condition":6})"), 422);            // no 6
+  EXPECT_EQ(status(R"({"kind":"delete-condition","condition":"9"})"), 400);
+  EXPECT_EQ(rig.profile_text(), rig.profile_original);
+  AdminRig mill;
+  EXPECT_EQ(post(mill.port, R"({"kind":"add-condition","condition":1})", kAdmin).status, 422);
+}
+
 TEST(AdminConditions, AMachineWithoutEdmHasNone) {
   AdminRig rig;
   EXPECT_EQ(get(rig.port, "/api/v1/conditions", kOperator).body["conditions"], json::array());

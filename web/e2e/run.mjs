@@ -5,8 +5,8 @@
 // position change, run to the end, find the job in the history; then run it again from line 66
 // chosen in the listing; as the admin, lower X's maximum velocity and see a bad value refused with
 // the profile's message (the profile is a copy in the test's folder); the Conditions screen
-// saying the mill has none, and one pitch point changed on the drill's Compensation screen
-// (data.mjs); then the power-fail recovery on the broach (recovery.mjs). Screenshots land in the
+// saying the mill has none, one pitch point changed on the drill's Compensation screen, and on the
+// EDM a condition's value changed, a condition added and one deleted (data.mjs); then the power-fail recovery on the broach (recovery.mjs). Screenshots land in the
 // artefacts folder. Usage: node e2e/run.mjs [--opencnc PATH] [--out DIR]
 import { spawn } from "node:child_process";
 import { copyFileSync, mkdtempSync, mkdirSync, readFileSync, rmSync } from "node:fs";
@@ -14,7 +14,7 @@ import { tmpdir } from "node:os";
 import { dirname, join, resolve } from "node:path";
 import { fileURLToPath } from "node:url";
 import { chromium } from "playwright-core";
-import { compensationStep, noConditionsStep } from "./data.mjs";
+import { compensationStep, conditionsStep, noConditionsStep } from "./data.mjs";
 import { recoveryStep } from "./recovery.mjs";
 import { serverUrl, stopServer, waitFor as waitForOn } from "./wait.mjs";
 
@@ -159,6 +159,7 @@ try {
   await shot("08-parameters");
   await noConditionsStep({ page, out, step });
   await compensationStep({ opencnc, repo, out, browser, step });
+  await conditionsStep({ opencnc, repo, out, browser, step });
   await recoveryStep({ opencnc, repo, out, browser, step });
   step("passed");
 } catch (e) {

@@ -1,8 +1,18 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The machining-conditions screen's logic: each condition's cells, which one is in force, who may
-// edit them, and the admin's edit as a set-conditions command.
+// edit them, the admin's edit as a set-conditions command, an add and a delete.
 import { describe, expect, it } from "vitest";
-import { activeCondition, conditionCells, conditionCommand, conditionHeader, mayEdit, type Condition, type ConditionField } from "./screens/conditions";
+import {
+  activeCondition,
+  addConditionCommand,
+  conditionCells,
+  conditionCommand,
+  conditionHeader,
+  deleteQuestion,
+  mayEdit,
+  type Condition,
+  type ConditionField,
+} from "./screens/conditions";
 import type { Status } from "./types";
 
 const roughing: Condition = {
@@ -64,5 +74,23 @@ describe("editing a machining condition", () => {
     expect(conditionCommand(roughing, fields, { peak_current_a: " " })).toBe("E1 peak_current_a: a value is needed");
     expect(conditionCommand(roughing, fields, { polarity: "x" })).toBe("E1 polarity: one of + -");
     expect(conditionCommand(roughing, fields, {})).toBe("E1: nothing changed");
+  });
+});
+
+describe("adding and deleting a machining condition", () => {
+  const numbers = [1, 2, 3, 9];
+  it("adds a new number as a copy of the chosen condition, or of the one below when none is chosen", () => {
+    expect(addConditionCommand(numbers, " 4 ", 3)).toEqual({ kind: "add-condition", condition: 4, from: 3 });
+    expect(addConditionCommand(numbers, "12", undefined)).toEqual({ kind: "add-condition", condition: 12 });
+  });
+  it("says in words what it will not send", () => {
+    expect(addConditionCommand(numbers, "3", 1)).toBe("E3 exists already: edit it instead");
+    expect(addConditionCommand(numbers, "0", 1)).toBe('A condition\'s number is a whole number from 1 to 99, not "0"');
+    expect(addConditionCommand(numbers, "4.5", 1)).toBe('A condition\'s number is a whole number from 1 to 99, not "4.5"');
+    expect(addConditionCommand(numbers, "", 1)).toBe('A condition\'s number is a whole number from 1 to 99, not ""');
+    expect(addConditionCommand(numbers, "5", 7)).toBe("There is no E7 to copy");
+  });
+  it("asks before a delete and says what it costs", () => {
+    expect(deleteQuestion(9)).toBe("Delete E9 from the profile? Programs that select it (M180 P9) will no longer open.");
   });
 });

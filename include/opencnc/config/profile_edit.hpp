@@ -66,6 +66,19 @@ std::optional<double> condition_field_number(const machine::EdmCondition& c, std
 /// `edm.condition.<number>.<field>`, a field of condition_fields(). Any thread.
 bool is_condition_key(std::string_view key);
 
+/// A machining condition added or deleted through edit_profile(): `number` added as a copy of
+/// condition `from` (every key its `[[edm.condition]]` element sets: the generator, gap servo,
+/// jump, orbit, side gap and wear ratio), or deleted (`remove`).
+struct ConditionChange {
+  int number = 0;
+  bool remove = false;
+  int from = 0;  ///< an add's source: a condition of the profile
+};
+
+/// The condition a new condition `number` is copied from when the admin names none: the one with
+/// the highest number below it, else the lowest; 0 when `edm` has none. Any thread.
+int condition_to_copy(const machine::EdmConfig& edm, int number);
+
 /// One key's change, as text for the audit and the answer ("100.0" → "80.0").
 struct ProfileChange {
   std::string key;
@@ -96,7 +109,13 @@ struct ProfileEditResult {
 /// instead (CompFileEdits: forward, reverse and positions; its comment lines stay), returned in
 /// `files`. The new text is loaded by parse_profile() with the same overrides and those files' new
 /// texts, so its errors are the loader's own, at the edited line (of the profile or of the comp
-/// file). Nothing is written. Non-real-time (reads the files).
-ProfileEditResult edit_profile(const MachineProfile& live, std::span<const ProfileKeyEdit> edits);
+/// file). With `conditions`, machining conditions are added after the keys are set (each a new
+/// `[[edm.condition]]` element after the last one, with_toml_element_copy()), then deleted (the
+/// element and the comment above it, without_toml_element()); refused when a number to add exists
+/// or is not 1–99, a copy's source or a condition to delete does not exist (or is deleted and
+/// changed at once), the table would hold more than machine::kMaxEdmConditions or none. Nothing
+/// is written. Non-real-time (reads the files).
+ProfileEditResult edit_profile(const MachineProfile& live, std::span<const ProfileKeyEdit> edits,
+                               std::span<const ConditionChange> conditions = {});
 
 }  // namespace opencnc::config

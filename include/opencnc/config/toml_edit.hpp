@@ -41,6 +41,27 @@ std::optional<std::string> with_toml_element_value(std::string_view text, std::s
 std::optional<std::string> without_toml_element_key(std::string_view text, std::string_view array_key,
                                                     int element, std::string_view key, std::string& error);
 
+/// `text` with a copy of element `element` (0 first) of the array of tables `array_key`
+/// ("edm.condition", lower case) appended after the array's last element: a blank line, the
+/// comment line `comment` ("" for none), the element's header, and its keys in the order its lines
+/// give them, each written afresh from its value (the source's comments are not copied), with
+/// `key` set to `value_toml` (added when the element lacks it). The comments and lines that lead
+/// into the next table stay after the copy. Refused (nullopt, `error` says why) when the elements
+/// are not each written under a `[[…]]` header of their own, a copied value is an array, a table
+/// or a date, `value_toml` is not one TOML value, or the result does not read back as `text` with
+/// exactly that element appended. Non-real-time; any thread.
+std::optional<std::string> with_toml_element_copy(std::string_view text, std::string_view array_key,
+                                                  int element, std::string_view key, std::string_view value_toml,
+                                                  std::string_view comment, std::string& error);
+
+/// `text` without element `element` of the array of tables `array_key`: its header, its lines,
+/// the comment lines right above its header (what it is) and the blank line before them; every
+/// other line stays. Refused (nullopt, `error` says why) as with_toml_element_copy() refuses, and
+/// when the result does not read back as `text` without exactly that element. Non-real-time; any
+/// thread.
+std::optional<std::string> without_toml_element(std::string_view text, std::string_view array_key, int element,
+                                                std::string& error);
+
 /// A number as TOML text that reads back as the same double (always a float: "80.0", "1e-05").
 /// Any thread.
 std::string toml_number(double v);

@@ -122,6 +122,8 @@ class Controller final : private FeatureHost {
   struct ProfileChange;
   bool stage_pitch_table(int joint, const ServoConfig& next, const ProfileChange& pending);
   bool stage_edm_conditions(const ServoConfig& next, const ProfileChange& pending);
+  bool open_program_keeps_its_conditions(const requests::EditProfile& r, const config::MachineProfile& next,
+                                         Diagnostics& selects);
   void swap_profile(config::MachineProfile profile);
   bool features_allow_start(std::uint64_t id, const StartCheck& start);
   bool features_allow_continue(const SyncCheck& sync);
@@ -203,6 +205,7 @@ class Controller final : private FeatureHost {
     config::MachineProfile old_profile;
     std::string old_text, message, who;
     std::vector<config::FileText> old_files;  ///< other files the change wrote (a comp file), as they were
+    const char* what = "machine parameters";  ///< for the audit: "machining conditions" when only those
   };
   std::optional<ProfileChange> profile_change_;
   std::uint32_t limits_version_ = 0;       ///< counts applied profile edits

@@ -8,6 +8,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "opencnc/config/machine_profile.hpp"
 #include "opencnc/controller/coupling_pass.hpp"
@@ -38,6 +39,10 @@ struct GcodeSourceConfig {
   /// G or M codes of its own (a coupling law, machining conditions) gives a function that adds
   /// its modules to the standard ones.
   std::function<std::shared_ptr<const gcode::Extensions>(gcode::Dialect)> extensions;
+  /// On an EDM (a profile with [edm]): the numbers of its machining conditions. M180 and M181
+  /// are added to the modules above, and M180's P must be one of these (profile_changed() takes
+  /// them again from an edited profile). Null on any other machine.
+  std::shared_ptr<const std::vector<int>> edm_conditions;
   /// The machine's tool table (null: none): G43 and G41/G42 read it, G10 L1/L10/L11 write it
   /// (while a program runs, not in its preflight). At sync points the interpreter takes the
   /// operator's changes.
@@ -76,7 +81,11 @@ class GcodeProgramSource final : public ProgramSource {
   std::unique_ptr<ProgramStream> resume(const std::string& path, const Pose& program_start, const Pose& start,
                                         canon::SegmentId segment, const LoadOptions& options) override;
   std::unique_ptr<ProgramStream> mdi(std::string_view line, const Pose& start) override;
-  std::uint64_t version() const override { return config_.tools ? config_.tools->version() : 0; }
+  std::uint64_t version() const override {
+    return (config_.tools ? config_.tools->version() : 0) + conditions_changed_;
+  }
+  /// An EDM's condition numbers taken again from `profile` (a condition added or deleted).
+  void profile_changed(const config::MachineProfile& profile) override;
 
   /// The tool table G-code reads and writes (null: none). Any thread.
   const std::shared_ptr<tools::ToolTableService>& tools() const noexcept { return config_.tools; }
@@ -89,6 +98,8 @@ class GcodeProgramSource final : public ProgramSource {
   GcodeSourceConfig config_;
   std::unique_ptr<gcode::Interpreter> mdi_;  ///< the MDI session: modal state lives on
   std::uint64_t mdi_tools_version_ = 0;
+  std::uint64_t conditions_changed_ = 0;  ///< counts changes of config_.edm_conditions
+  std::shared_ptr<const std::vector<int>> mdi_conditions_;  ///< the numbers mdi_ was made with
 };
 
 }  // namespace opencnc::control

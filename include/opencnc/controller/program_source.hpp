@@ -14,6 +14,10 @@
 #include "opencnc/core/axes.hpp"
 #include "opencnc/core/diagnostic.hpp"
 
+namespace opencnc::config {
+struct MachineProfile;
+}
+
 namespace opencnc::control {
 
 /// Switches that change how a program is read.
@@ -158,6 +162,10 @@ class ProgramSource {
   /// Changes whenever something a program reads besides its file changes (the tool table): a
   /// preflight holds for the version it was made with.
   virtual std::uint64_t version() const { return 0; }
+  /// The machine's profile changed (an admin's edit while nothing runs): a source that took
+  /// something from it (an EDM's condition numbers, which M180 P must name) takes it again, and
+  /// its version() changes when a program may read differently. Controller thread.
+  virtual void profile_changed(const config::MachineProfile& /*profile*/) {}
 };
 
 /// The location of a block: `line` in the body file of `context` (the main file for context 0),

@@ -131,9 +131,13 @@ struct Feature {
 /// nothing moves: the file's text edited key by key and loaded again by the profile loader, then
 /// written back (atomically), the planner's limits and the move checks swapped, and the joints'
 /// limits applied by the tick together. `who` names the one asking (for the event log).
+/// With `conditions`, machining conditions are added (copies) or deleted as well; a delete is
+/// refused while the open program selects that condition (its preflight with the new conditions,
+/// whose message names the program's line).
 struct EditProfile {
   std::vector<config::ProfileKeyEdit> edits;
   std::string who;
+  std::vector<config::ConditionChange> conditions;
 };
 
 }  // namespace requests
@@ -181,7 +185,10 @@ struct Request {
     return {requests::ResumeProgram{segment, program_start}};
   }
   static Request edit_profile(std::vector<config::ProfileKeyEdit> edits, std::string who = {}) {
-    return {requests::EditProfile{std::move(edits), std::move(who)}};
+    return {requests::EditProfile{std::move(edits), std::move(who), {}}};
+  }
+  static Request change_conditions(std::vector<config::ConditionChange> changes, std::string who = {}) {
+    return {requests::EditProfile{{}, std::move(who), std::move(changes)}};
   }
   static Request feature(std::string feature, std::string action, std::any args = {}) {
     return {requests::Feature{std::move(feature), std::move(action), std::move(args)}};

@@ -54,4 +54,14 @@ nlohmann::json conditions_json(const config::MachineProfile& profile);
 /// not one of the choice's). The loader's own checks come from the controller. Any thread.
 ParametersRequest conditions_request(const nlohmann::json& body, const config::MachineProfile& profile);
 
+/// An `add-condition` body (`{"condition": 4, "from": 3}`: condition 4 added as a copy of 3;
+/// without `from` a copy of the condition with the highest number below it, else of the lowest)
+/// or, with `remove`, a `delete-condition` body (`{"condition": 9}`) as the controller's
+/// EditProfile request of that change, or the HTTP status and message of why not (400 malformed,
+/// 422 a machine without conditions, a number outside 1–99, a condition to add that exists, one
+/// to copy or delete that does not). The table's size, the last condition and the open program
+/// are the controller's checks. Any thread.
+ParametersRequest condition_change_request(const nlohmann::json& body, const config::MachineProfile& profile,
+                                           bool remove);
+
 }  // namespace opencnc::hmi

@@ -3,7 +3,8 @@
 // table — number, on/off time, peak current, voltage, polarity, servo reference, jump and orbit —
 // with the one the generator runs now (the status' edm.condition) highlighted live. An admin
 // edits a condition's fields while nothing runs (set-conditions: the profile's own checks, the
-// tick takes the new values at rest); an operator sees them read-only.
+// tick takes the new values at rest), adds a condition as a copy of another (add-condition) and
+// deletes one after a confirmation (delete-condition); an operator sees them read-only.
 import { registerScreen, type Context } from "../registry";
 import type { Outcome, Status } from "../types";
 import { button, el } from "../ui";
@@ -79,6 +80,24 @@ export function conditionCommand(c: Condition, fields: ConditionField[], inputs:
   return { kind: "set-conditions", condition: c.number, values };
 }
 
+/**
+ * The add-condition command for a new condition numbered `typed`, a copy of condition `from` (the
+ * admin's choice; the server copies the one below when it is absent); or why not in words.
+ */
+export function addConditionCommand(numbers: number[], typed: string, from: number | undefined): Record<string, unknown> | string {
+  const t = typed.trim();
+  const n = Number(t);
+  if (t === "" || !Number.isInteger(n) || n < 1 || n > 99) return `A condition's number is a whole number from 1 to 99, not "${t}"`;
+  if (numbers.includes(n)) return `E${n} exists already: edit it instead`;
+  if (from !== undefined && !numbers.includes(from)) return `There is no E${from} to copy`;
+  return from === undefined ? { kind: "add-condition", condition: n } : { kind: "add-condition", condition: n, from };
+}
+
+/** The question asked before condition `n` is deleted (the delete is sent on the second click). */
+export function deleteQuestion(n: number): string {
+  return `Delete E${n} from the profile? Programs that select it (M180 P${n}) will no longer open.`;
+}
+
 interface ConditionsAnswer {
   profile: string;
   when: string;
@@ -92,6 +111,7 @@ let editor: HTMLElement | undefined;
 let result: HTMLElement | undefined;
 let token: HTMLInputElement | undefined;
 let unlockRow: HTMLElement | undefined;
+let adderRow: HTMLElement | undefined;
 let shown = -1;
 /** The admin's token once checked (the page's own when it is an admin's); "" while read-only. */
 let adminToken = "";
@@ -159,6 +179,41 @@ function edit(ctx: Context, c: Condition) {
   );
 }
 
+/** The question before condition `c` is deleted, in the editor: "Yes, delete" sends it, "Back" does not. */
+function confirmDelete(ctx: Context, c: Condition) {
+  if (!editor) return;
+  editor.replaceChildren(
+    el("p", { id: "delete-question" }, deleteQuestion(c.number)),
+    el(
+      "div",
+      { class: "row" },
+      button(`Yes, delete E${c.number}`, () => void apply(ctx, { kind: "delete-condition", condition: c.number }), "primary"),
+      button("Back", () => editor?.replaceChildren()),
+    ),
+  );
+}
+
+/** The admin's row to add a condition: its number and the condition it copies. */
+function adder(ctx: Context, conditions: Condition[]): HTMLElement {
+  const numbers = conditions.map((c) => c.number);
+  const number = el("input", { id: "new-condition", type: "number", step: "1", min: "1", max: "99", class: "num" });
+  const from = el("select", { id: "new-condition-from" }, ...conditions.map((c) => el("option", { value: `${c.number}` }, `E${c.number}`)));
+  from.value = `${numbers[numbers.length - 1] ?? ""}`;
+  return el(
+    "div",
+    { class: "row", id: "condition-adder" },
+    "New condition E",
+    number,
+    " a copy of ",
+    from,
+    button("Add (admin)", () => {
+      const command = addConditionCommand(numbers, number.value, Number(from.value));
+      if (typeof command === "string") return show(ctx, [command], "error");
+      void apply(ctx, command);
+    }),
+  );
+}
+
 async function load(ctx: Context, selected = 0) {
   const r = await ctx.api.get<ConditionsAnswer>("conditions");
   if (!body || !note || !editor) return;
@@ -173,12 +228,13 @@ async function load(ctx: Context, selected = 0) {
     ...r.conditions.map((c) => {
       const cells = conditionCells(c).map((t) => el("td", {}, t));
       const tr = el("tr", {}, ...cells);
-      if (adminToken) tr.append(el("td", {}, button("Edit", () => edit(ctx, c))));
+      if (adminToken) tr.append(el("td", {}, button("Edit", () => edit(ctx, c)), button("Delete", () => confirmDelete(ctx, c))));
       tr.dataset.condition = `${c.number}`;
       return tr;
     }),
   );
   editor.replaceChildren();
+  adderRow?.replaceChildren(...(adminToken && !empty ? [adder(ctx, r.conditions)] : []));
   const again = r.conditions.find((c) => c.number === selected);
   if (adminToken && again) edit(ctx, again);
   shown = -1;
@@ -202,6 +258,7 @@ registerScreen({
     body = el("tbody");
     note = el("p", { class: "hint" });
     editor = el("div", { id: "condition-editor" });
+    adderRow = el("div");
     result = el("pre", { class: "diagnostics", id: "conditions-result" });
     token = el("input", { id: "cond-admin-token", type: "password", class: "token" });
     unlockRow = el("div", { class: "row" }, "Admin token: ", token, button("Edit (admin)", () => void unlock(ctx)));
@@ -211,6 +268,7 @@ registerScreen({
       note,
       unlockRow,
       el("table", { class: "grid", id: "conditions" }, el("thead", {}, head), body),
+      adderRow,
       editor,
       result,
     );
