@@ -121,30 +121,63 @@ std::optional<toml::table> parsed(std::string_view text, std::string_view what, 
   }
 }
 
+// The profile's lines, its [[array]] headers and its tables as parsed. The edits below change
+// the tables as they mean to change the text, and the text must then read back as them.
+struct ElementText {
+  std::vector<TomlLine> lines;
+  std::vector<std::size_t> headers;
+  toml::table expected;
+  toml::array* array = nullptr;  // in `expected`
+};
+
+/// Reads `text` into `e`, checking that element `element` of [[array_key]] is a table written under
+/// a header of its own; false with `error` if not.
+bool open_element(std::string_view text, std::string_view array_key, int element, ElementText& e,
+                  std::string& error) {
+  e.lines = detail::split_lines(text);
+  e.headers = element_headers(e.lines, array_key);
+  std::optional<toml::table> tables = parsed(text, "the profile does not read", error);
+  if (!tables) return false;
+  e.expected = std::move(*tables);
+  e.array = find_array(e.expected, array_key);
+  if (e.array == nullptr || element < 0 || static_cast<std::size_t>(element) >= e.headers.size() ||
+      e.headers.size() != e.array->size() || !(*e.array)[static_cast<std::size_t>(element)].is_table()) {
+    error = fmt::format("element {} of [[{}]] is not written under a [[{}]] header of its own", element + 1,
+                        array_key, array_key);
+    return false;
+  }
+  return true;
+}
+
+/// True if `out` reads back as `e.expected`; else false with `error` (`mismatch` if it reads).
+bool reads_back(const std::string& out, const ElementText& e, std::string_view what, std::string mismatch,
+                std::string& error) {
+  const std::optional<toml::table> after = parsed(out, what, error);
+  if (!after) return false;
+  if (!(e.expected == *after)) {
+    error = std::move(mismatch);
+    return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 std::optional<std::string> with_toml_element_copy(std::string_view text, std::string_view array_key,
                                                   int element, std::string_view key,
                                                   std::string_view value_toml, std::string_view comment,
                                                   std::string& error) {
-  const std::vector<TomlLine> lines = detail::split_lines(text);
-  const std::vector<std::size_t> headers = element_headers(lines, array_key);
-  std::optional<toml::table> expected = parsed(text, "the profile does not read", error);
-  if (!expected) return std::nullopt;
-  toml::array* array = find_array(*expected, array_key);
-  if (array == nullptr || element < 0 || static_cast<std::size_t>(element) >= headers.size() ||
-      headers.size() != array->size() || !(*array)[static_cast<std::size_t>(element)].is_table()) {
-    error = fmt::format("element {} of [[{}]] is not written under a [[{}]] header of its own", element + 1,
-                        array_key, array_key);
-    return std::nullopt;
-  }
+  ElementText e;
+  if (!open_element(text, array_key, element, e, error)) return std::nullopt;
+  const std::vector<TomlLine>& lines = e.lines;
+  toml::array* array = e.array;
   const std::optional<toml::table> value_doc =
       parsed(fmt::format("v = {}", value_toml), "not a TOML value", error);
   if (!value_doc || value_toml.find('\n') != std::string_view::npos) {
     error = fmt::format("\"{}\" is not one TOML value on one line", value_toml);
     return std::nullopt;
   }
-  const std::size_t from = headers[static_cast<std::size_t>(element)];
+  const std::size_t from = e.headers[static_cast<std::size_t>(element)];
   const std::size_t from_end = detail::table_end(lines, from);
   std::string_view header = lines[from].text.substr(0, lines[from].text.find('#'));
   const std::vector<TomlLine> body(lines.begin() + static_cast<std::ptrdiff_t>(from + 1),
@@ -155,7 +188,7 @@ std::optional<std::string> with_toml_element_copy(std::string_view text, std::st
   if (!copy_lines(detail::trim(header), body, element_copy, key, value_toml, copy, error))
     return std::nullopt;
   // After the array's last element, before whatever comments lead into the next table.
-  const std::size_t end = detail::table_end(lines, headers.back());
+  const std::size_t end = detail::table_end(lines, e.headers.back());
   const std::size_t at = end < lines.size() ? lines[end].begin : text.size();
   std::string out(text.substr(0, at));
   if (!out.empty() && out.back() != '\n') out += '\n';
@@ -164,31 +197,21 @@ std::optional<std::string> with_toml_element_copy(std::string_view text, std::st
   // The original with this one element appended, and nothing else changed.
   value_doc->get("v")->visit([&](auto& node) { element_copy.insert_or_assign(key, node); });
   array->push_back(std::move(element_copy));
-  const std::optional<toml::table> after = parsed(out, "the copy would not read back", error);
-  if (!after) return std::nullopt;
-  if (!(*expected == *after)) {
-    error = fmt::format("a copy of element {} of [[{}]] would not read back as written: copy it by hand",
-                        element + 1, array_key);
+  if (!reads_back(out, e, "the copy would not read back",
+                  fmt::format("a copy of element {} of [[{}]] would not read back as written: copy it by hand",
+                              element + 1, array_key),
+                  error))
     return std::nullopt;
-  }
   return out;
 }
 
 std::optional<std::string> without_toml_element(std::string_view text, std::string_view array_key,
                                                 int element, std::string& error) {
-  const std::vector<TomlLine> lines = detail::split_lines(text);
-  const std::vector<std::size_t> headers = element_headers(lines, array_key);
-  std::optional<toml::table> expected = parsed(text, "the profile does not read", error);
-  if (!expected) return std::nullopt;
-  toml::array* array = find_array(*expected, array_key);
-  if (array == nullptr || element < 0 || static_cast<std::size_t>(element) >= headers.size() ||
-      headers.size() != array->size()) {
-    error = fmt::format("element {} of [[{}]] is not written under a [[{}]] header of its own", element + 1,
-                        array_key, array_key);
-    return std::nullopt;
-  }
+  ElementText e;
+  if (!open_element(text, array_key, element, e, error)) return std::nullopt;
+  const std::vector<TomlLine>& lines = e.lines;
   // The element's lines, the comment right above its header (what it is) and the blank line before.
-  const std::size_t header = headers[static_cast<std::size_t>(element)];
+  const std::size_t header = e.headers[static_cast<std::size_t>(element)];
   const std::size_t end = detail::table_end(lines, header);
   std::size_t begin = header;
   while (begin > 0 && !detail::trim(lines[begin - 1].text).empty() &&
@@ -199,14 +222,12 @@ std::optional<std::string> without_toml_element(std::string_view text, std::stri
   const std::size_t to = end < lines.size() ? lines[end].begin : text.size();
   std::string out(text.substr(0, from));
   out.append(text.substr(to));
-  array->erase(array->begin() + element);
-  const std::optional<toml::table> after = parsed(out, "the profile would not read back", error);
-  if (!after) return std::nullopt;
-  if (!(*expected == *after)) {
-    error = fmt::format("element {} of [[{}]] is also written elsewhere in the profile: remove it by hand",
-                        element + 1, array_key);
+  e.array->erase(e.array->begin() + element);
+  if (!reads_back(out, e, "the profile would not read back",
+                  fmt::format("element {} of [[{}]] is also written elsewhere in the profile: remove it by hand",
+                              element + 1, array_key),
+                  error))
     return std::nullopt;
-  }
   return out;
 }
 

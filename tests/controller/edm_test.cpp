@@ -386,17 +386,31 @@ TEST(Edm, ThePreflightRefusesAConditionTheMachineLacks) {
 // [[edm.condition]] element, the audit says what changed, and a program that selects the
 // condition afterwards jumps by the new height; a condition the tick cannot run (handed to it
 // directly) makes the apply refuse and leaves the conditions as they were.
+// A copy of edm-5axis (and its tool table) in a folder of its own, for the tests that edit the
+// profile's conditions; the folder goes with the object.
+struct EditableEdm {
+  explicit EditableEdm(const std::string& tag)
+      : dir(std::filesystem::temp_directory_path() / ("opencnc-edm-" + tag + "-" + std::to_string(::getpid()))),
+        path((dir / "edm-5axis.toml").string()) {
+    std::filesystem::create_directories(dir);
+    for (const char* f : {"edm-5axis.toml", "edm-5axis.tbl"})
+      std::filesystem::copy_file(std::filesystem::path(OPENCNC_SOURCE_DIR "/configs") / f, dir / f,
+                                 std::filesystem::copy_options::overwrite_existing);
+  }
+  ~EditableEdm() { std::filesystem::remove_all(dir); }
+  const std::filesystem::path dir;
+  const std::string path;
+  /// The profile as edited so far, with the small electrode the burns use.
+  config::MachineProfile profile() const {
+    return loaded(config::load_profile(path, std::vector<std::string>{"edm.sim.electrode_area_mm2=5"}));
+  }
+};
+
 TEST(Edm, AnEditedConditionIsTheOneAProgramSelectsAfterwards) {
-  const auto dir =
-      std::filesystem::temp_directory_path() / ("opencnc-edm-edit-" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  for (const char* f : {"edm-5axis.toml", "edm-5axis.tbl"})
-    std::filesystem::copy_file(std::filesystem::path(OPENCNC_SOURCE_DIR "/configs") / f, dir / f,
-                               std::filesystem::copy_options::overwrite_existing);
-  const std::string path = (dir / "edm-5axis.toml").string();
+  EditableEdm edm("edit");
+  const std::string& path = edm.path;
   {
-    const config::MachineProfile p =
-        loaded(config::load_profile(path, std::vector<std::string>{"edm.sim.electrode_area_mm2=5"}));
+    const config::MachineProfile p = edm.profile();
     Diagnostics d;
     SimRig rig(p, GcodeProgramSource::create(p, d));
     auto samples = std::make_shared<Samples>();
@@ -438,25 +452,17 @@ TEST(Edm, AnEditedConditionIsTheOneAProgramSelectsAfterwards) {
     EXPECT_EQ(rig.controller().outcome(78002)->refusal, Refusal::BadValue);
     EXPECT_EQ(rig.servo().config().edm.find(1)->servo_reference_v, 45.0);
   }
-  std::filesystem::remove_all(dir);
 }
 
 // Conditions added and deleted by the admin while idle: a program opened after the add selects
 // the new condition and burns with its values (a copy of 1, its jump lowered); deleting the
 // condition the open program selects is refused at the program's line; an MDI line (its session
 // older than the change) and a program opened after a delete get the interpreter's error for an
-// unknown condition. The event log says "machining
-// conditions changed".
+// unknown condition. The event log says "machining conditions changed".
 TEST(Edm, AnAddedConditionIsSelectableAndADeletedOneIsNot) {
-  const auto dir = std::filesystem::temp_directory_path() / ("opencnc-edm-add-" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  for (const char* f : {"edm-5axis.toml", "edm-5axis.tbl"})
-    std::filesystem::copy_file(std::filesystem::path(OPENCNC_SOURCE_DIR "/configs") / f, dir / f,
-                               std::filesystem::copy_options::overwrite_existing);
-  const std::string path = (dir / "edm-5axis.toml").string();
+  EditableEdm edm("add");
   {
-    const config::MachineProfile p =
-        loaded(config::load_profile(path, std::vector<std::string>{"edm.sim.electrode_area_mm2=5"}));
+    const config::MachineProfile p = edm.profile();
     Diagnostics d;
     SimRig rig(p, GcodeProgramSource::create(p, d));
     auto samples = std::make_shared<Samples>();
@@ -521,7 +527,6 @@ TEST(Edm, AnAddedConditionIsSelectableAndADeletedOneIsNot) {
                ev.text.rfind("admin: machining conditions changed: edm.condition.9 defined → deleted", 0) == 0;
     EXPECT_TRUE(noted);
   }
-  std::filesystem::remove_all(dir);
 }
 
 // The setter's seek of the end of the travel through the controller: the request, the note that
