@@ -282,6 +282,8 @@ Outcome RunFromLineFeature::handle(const requests::Feature& request, FeatureHost
   }
   // The scan replays the interpreter over the file up to the line: a long program must not
   // hold the controller, so it runs on a thread of its own and the answer waits for it.
+  // The scan's interpreter selects from the conditions an admin may have added or deleted since.
+  source_->profile_changed(host.profile());
   scan_ = std::make_unique<Scan>();
   Scan& scan = *scan_;
   scan.request = host.defer();

@@ -118,7 +118,10 @@ void BreakpointJournal::on_event(const control::ControllerEvent& e) {
                        ? recovering_.program_start
                        : host_->current_status().servo.commanded;
   options_.reset();
-  if (source_) options_ = source_->options_for(path_, {});
+  if (source_) {
+    source_->profile_changed(host_->profile());  // the conditions an admin changed since
+    options_ = source_->options_for(path_, {});
+  }
   stopping_ = completed_ = false;
   Work w;
   w.record.program_path = path_;

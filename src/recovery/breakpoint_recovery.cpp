@@ -84,6 +84,7 @@ Outcome BreakpointJournal::start_resume(const BreakpointRecord& r, const ResumeA
   if (const std::string moved = moved_axis(host.profile(), st.servo.actual, r.actual, args); !moved.empty())
     return refuse(Refusal::StartMismatch, moved);
   if (r.modal_digest != 0 && source_) {
+    source_->profile_changed(host.profile());  // the conditions an admin changed since
     std::string why;
     const auto d = modal_digest_at(source_->options_for(r.program_path, {}), r.program_path, r.program_start,
                                    r.segment, &why);

@@ -22,6 +22,7 @@
 #include "opencnc/controller/controller.hpp"
 #include "opencnc/controller/edm_recorder.hpp"
 #include "opencnc/controller/gcode_source.hpp"
+#include "opencnc/controller/run_from_line.hpp"
 #include "opencnc/controller/sim_rig.hpp"
 #include "opencnc/core/atomic_file.hpp"
 
@@ -464,7 +465,10 @@ TEST(Edm, AnAddedConditionIsSelectableAndADeletedOneIsNot) {
   {
     const config::MachineProfile p = edm.profile();
     Diagnostics d;
-    SimRig rig(p, GcodeProgramSource::create(p, d));
+    const auto source = GcodeProgramSource::create(p, d);
+    SimRig rig(p, source);
+    // Run from line reads the program with a source of its own, made before the add.
+    ASSERT_TRUE(rig.controller().add_feature(RunFromLineFeature::create(p, source->tools(), d)));
     auto samples = std::make_shared<Samples>();
     rig.controller().attach(samples, ObserverOptions{0, true});
     rig.step();
@@ -496,9 +500,21 @@ TEST(Edm, AnAddedConditionIsSelectableAndADeletedOneIsNot) {
     double lift_max = 0;
     for (const TraceSample& s : samples->all) lift_max = std::max(lift_max, s.edm.jump_lift_mm);
     EXPECT_NEAR(lift_max, 0.15, 1e-9);
+    // Run from line 4 scans past the M180 P5 at line 3: its source knows the added condition too.
+    const Outcome from = rig.request(Request::feature("run-from-line", "start", RunFromLineArgs{4}), 100000);
+    EXPECT_TRUE(from.accepted) << from.message;
+    // The approach (an auxiliary job), then the program from line 4 to its end.
+    ASSERT_TRUE(rig.run_until([&] { return rig.status().run_active && rig.status().job == JobKind::Program; },
+                              60000))
+        << rig.status().fault_text;
+    ASSERT_TRUE(rig.run_until(
+        [&] { return !rig.status().run_active && rig.status().servo.state == State::Idle; }, 60000))
+        << rig.status().fault_text;
+    EXPECT_TRUE(rig.status().fault_text.empty()) << rig.status().fault_text;
     // 9 deleted: an MDI line (its session made before) and a program opened afterwards that
     // select it get the interpreter's message.
-    ASSERT_TRUE(rig.request(Request::set_mode(Mode::Mdi)).accepted);
+    const Outcome to_mdi = rig.request(Request::set_mode(Mode::Mdi));
+    ASSERT_TRUE(to_mdi.accepted) << to_mdi.message;
     const auto mdi = [&](const char* line) {
       const Outcome m = rig.request(Request::mdi(line), 100000);
       rig.run_until([&] { return !rig.status().run_active && rig.status().servo.state == State::Idle; }, 20000);
