@@ -131,13 +131,17 @@ class HandedSimMachine final : public machine::MachineIO {
   control::TripleBuffer<HandTarget> hand_;
 };
 
+/// A tick that runs by itself (a real-time thread, HAL) is never kept waiting by the controller:
+/// its long work (preflights) runs on a thread of its own.
+constexpr control::ControllerOptions kTickByItself{.long_work_on_thread = true};
+
 class RealtimeDriver final : public Driver {
  public:
   RealtimeDriver(const config::MachineProfile& p, std::shared_ptr<control::ProgramSource> s)
       : channels_(std::make_unique<control::ServoChannels>()),
         sim_(std::make_unique<HandedSimMachine>(config::sim_machine_config(p))),
         servo_(std::make_unique<control::Servo>(control::servo_config(p), *channels_, *sim_)),
-        controller_(std::make_unique<control::Controller>(p, *channels_, std::move(s))),
+        controller_(std::make_unique<control::Controller>(p, *channels_, std::move(s), kTickByItself)),
         period_(std::chrono::duration<double>(p.servo_period_s)),
         clock_(control::RealtimeClock::Options{static_cast<std::int64_t>(p.servo_period_s * 1e9 + 0.5)}) {}
   ~RealtimeDriver() override { clock_.stop(); }
@@ -174,7 +178,7 @@ class HalDriver final : public Driver {
   HalDriver(const config::MachineProfile& p, std::shared_ptr<control::ProgramSource> s,
             std::unique_ptr<control::HalLink> link)
       : link_(std::move(link)),
-        controller_(std::make_unique<control::Controller>(p, link_->channels(), std::move(s))),
+        controller_(std::make_unique<control::Controller>(p, link_->channels(), std::move(s), kTickByItself)),
         period_(std::chrono::duration<double>(p.servo_period_s)) {}
   ~HalDriver() override { controller_.reset(); }  // before the link: it unmaps the channels
   void advance() override {

@@ -46,6 +46,8 @@ const char* refusal_code(Refusal r) noexcept {
       return "control.feature-check";
     case Refusal::NoLimitSwitch:
       return "control.no-limit-switch";
+    case Refusal::Superseded:
+      return "control.superseded";
   }
   return "control.unknown";
 }

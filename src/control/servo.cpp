@@ -180,9 +180,21 @@ void Servo::check_power() noexcept {
 
 // --- commands --------------------------------------------------------------------------------
 
+// Both queues in the order the controller sent their commands; past kCommandsPerTick the rest of
+// the controller's queue waits, but the urgent one is always taken whole: a stop never waits a period.
+bool Servo::next_command(Command& c, bool urgent_only) noexcept {
+  auto& urgent = channels_->urgent;
+  auto& queued = channels_->commands;
+  const bool u = urgent.available() > 0;
+  const bool q = !urgent_only && queued.available() > 0;
+  if (u && (!q || urgent.front().seq < queued.front().seq)) return urgent.try_pop(c);
+  return q && queued.try_pop(c);
+}
+
 void Servo::handle_commands() noexcept {
   Command c;
-  for (int n = 0; n < kCommandsPerTick && channels_->commands.try_pop(c); ++n) {
+  constexpr int kMost = kCommandsPerTick + static_cast<int>(decltype(channels_->urgent)::kCapacity);
+  for (int n = 0; n < kMost && next_command(c, n >= kCommandsPerTick); ++n) {
     const Refusal r = apply(c);
     last_command_id_ = c.id;
     last_refusal_ = r;

@@ -14,9 +14,46 @@ bool on_state(State s) noexcept {
   return s == State::Idle || s == State::Running || s == State::Held || s == State::Stopped;
 }
 
+/// A stop: what was sent before it and would start something is dropped once it has acted.
+bool is_stop(CommandKind k) noexcept {
+  return k == CommandKind::EStop || k == CommandKind::MachineOff || k == CommandKind::Abort ||
+         k == CommandKind::FeedHold;
+}
+
+/// Commands that start motion, power or the process (or undo a stop): never applied after a stop
+/// that was sent later than they were.
+bool starts_something(const Command& c) noexcept {
+  switch (c.kind) {
+    case CommandKind::Reset:
+    case CommandKind::MachineOn:
+    case CommandKind::JogContinuous:
+    case CommandKind::JogIncrement:
+    case CommandKind::Home:
+    case CommandKind::StartRun:
+    case CommandKind::CycleStart:
+    case CommandKind::Resume:
+    case CommandKind::ToolChanged:
+    case CommandKind::SpindleOn:
+    case CommandKind::SeekLimit:
+      return true;
+    case CommandKind::Coolant:
+      return c.flag;
+    case CommandKind::SetHandwheel:
+      return c.axis >= 0;
+    default:
+      return false;
+  }
+}
+
 }  // namespace
 
+// The order of sending decides, not the order of arrival: a stop that overtook older commands on
+// the urgent lane (ServoChannels::urgent) drops those that would start something.
 Refusal Servo::apply(const Command& c) noexcept {
+  if (c.seq != 0) {
+    if (starts_something(c) && c.seq < stop_seq_) return Refusal::Superseded;
+    if (is_stop(c.kind) && c.seq > stop_seq_) stop_seq_ = c.seq;
+  }
   switch (c.kind) {
     case CommandKind::EStop:
       if (state_ != State::EStopped) enter_estop();

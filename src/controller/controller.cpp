@@ -12,6 +12,7 @@
 
 #include "alarm_text.hpp"
 #include "job.hpp"
+#include "task_runner.hpp"
 #include "opencnc/controller/preflight.hpp"
 #include "opencnc/controller/servo_setup.hpp"
 
@@ -89,6 +90,9 @@ std::string refusal_text(Refusal r) {
     case Refusal::NoLimitSwitch:
       return "the axis has no limit switch on that side to seek (the profile's limit_min/limit_max and "
              "seek_velocity)";
+    case Refusal::Superseded:
+      return "a stop (e-stop, machine off, abort or feed hold) sent after it acted first: it was dropped; "
+             "send it again if it is still meant";
   }
   return "refused";
 }
@@ -131,7 +135,7 @@ std::string file_stamp(const std::string& path) {
 }  // namespace
 
 Controller::Controller(const config::MachineProfile& profile, ServoChannels& channels,
-                       std::shared_ptr<ProgramSource> source)
+                       std::shared_ptr<ProgramSource> source, ControllerOptions options)
     : profile_(profile),
       servo_config_(control::servo_config(profile)),
       limits_(machine_limits(profile)),
@@ -140,18 +144,46 @@ Controller::Controller(const config::MachineProfile& profile, ServoChannels& cha
       source_(std::move(source)),
       check_(std::make_unique<MachineMoveCheck>(servo_config_, limits_)),
       shown_profile_(profile),
-      location_every_(static_cast<std::uint64_t>(kLocationRefreshS / servo_config_.period_s) + 1) {
+      location_every_(static_cast<std::uint64_t>(kLocationRefreshS / servo_config_.period_s) + 1),
+      tasks_(std::make_unique<detail::TaskRunner>(options.long_work_on_thread)) {
   outcomes_.resize(kKeptOutcomes);
 }
 
-Controller::~Controller() = default;
+Controller::~Controller() {
+  halt_seq_.store(~std::uint64_t{0});  // a task under way stops at its next batch, then its thread is joined
+}
 
+// The urgent lane: a stop is in the tick's queue before this returns, from whichever thread sends
+// it, numbered in the order of sending with every other request (docs/controller.md, "Stops never
+// wait"). The lock is the inbox's, never held by the controller for long; the tick takes none.
 std::uint64_t Controller::submit(Request r) {
   std::lock_guard lock(inbox_mutex_);
   const std::uint64_t id = next_id_++;
-  inbox_.emplace_back(id, std::move(r));
+  const std::uint64_t seq = ++next_seq_;
+  if (is_stop(r)) stop_seq_.store(seq, std::memory_order_relaxed);
+  if (is_halt(r)) halt_seq_.store(seq, std::memory_order_relaxed);
+  if (takes_urgent_lane(r)) {
+    std::optional<Command> c = to_command(r);
+    if (c) {
+      c->id = id;
+      c->seq = seq;
+      // Full (32 urgent commands within one period): they act first; this one follows in order.
+      if (channels_->urgent.try_push(*c)) return id;
+    }
+  }
+  inbox_.push_back(Submitted{id, seq, std::move(r)});
   inbox_filled_.store(true, std::memory_order_release);
   return id;
+}
+
+std::uint64_t Controller::next_seq() {
+  std::lock_guard lock(inbox_mutex_);
+  return ++next_seq_;
+}
+
+bool Controller::send(Command c) {
+  if (c.seq == 0) c.seq = next_seq();
+  return channels_->commands.try_push(c);
 }
 
 std::uint64_t Controller::new_id() {
@@ -215,13 +247,20 @@ void Controller::service() {
   read_servo();
   if (inbox_filled_.load(std::memory_order_acquire)) {
     take_attachments();
-    {
-      std::lock_guard lock(inbox_mutex_);
-      requests_.swap(inbox_);
-      inbox_filled_.store(false, std::memory_order_relaxed);
-    }
-    for (auto& [id, r] : requests_) handle(id, r);
-    requests_.clear();
+    std::lock_guard lock(inbox_mutex_);
+    for (Submitted& s : inbox_) backlog_.push_back(std::move(s));
+    inbox_.clear();
+    inbox_filled_.store(false, std::memory_order_relaxed);
+  }
+  finish_long_work();
+  // In the order of sending; a long request's work (on the task thread) holds back the rest.
+  while (!long_ && !backlog_.empty()) {
+    Submitted s = std::move(backlog_.front());
+    backlog_.pop_front();
+    handling_seq_ = s.seq;
+    handle(s.id, s.request);
+    handling_seq_ = 0;
+    finish_long_work();  // done at once when long work runs on this thread
   }
   poll_features();
   if (job_) {
@@ -395,7 +434,49 @@ void Controller::handle_servo(std::uint64_t id, const Request& r) {
 void Controller::forward(std::uint64_t id, const Command& command) {
   Command c = command;
   c.id = id;
-  if (!channels_->commands.try_push(c)) finish(id, Refusal::Busy, "the servo's command queue is full");
+  c.seq = handling_seq_;
+  if (!send(c)) finish(id, Refusal::Busy, "the servo's command queue is full");
+}
+
+// --- long work -------------------------------------------------------------------------------
+
+bool Controller::busy_with_long_work() const noexcept {
+  return long_.has_value();
+}
+
+void Controller::run_long(std::uint64_t id, std::function<void()> work, std::function<void()> then) {
+  auto failure = std::make_shared<std::string>();
+  long_ = LongRequest{id, handling_seq_, std::move(then), failure};
+  tasks_->start([work = std::move(work), failure] {
+    try {
+      work();
+    } catch (const std::exception& ex) {
+      *failure = ex.what();
+    } catch (...) {
+      *failure = "an unknown error";
+    }
+  });
+}
+
+void Controller::finish_long_work() {
+  if (!long_ || !tasks_->finished()) return;
+  tasks_->collect();
+  LongRequest l = std::move(*long_);
+  long_.reset();
+  handling_seq_ = l.seq;
+  if (!l.failure->empty()) {
+    finish(l.id, Refusal::ProgramError, fmt::format("the program could not be checked: {}", *l.failure));
+  } else {
+    l.then();
+  }
+  handling_seq_ = 0;
+}
+
+bool Controller::superseded(std::uint64_t id, bool halts_only) {
+  const std::uint64_t after = (halts_only ? halt_seq_ : stop_seq_).load(std::memory_order_relaxed);
+  if (handling_seq_ == 0 || after <= handling_seq_) return false;
+  finish(id, Refusal::Superseded, refusal_text(Refusal::Superseded));
+  return true;
 }
 
 bool Controller::ready_for_job(std::uint64_t id, Mode mode, const char* what) {
@@ -419,13 +500,13 @@ bool Controller::ready_for_job(std::uint64_t id, Mode mode, const char* what) {
   return true;
 }
 
-Preflight Controller::preflight_file(const std::string& path) {
+Preflight Controller::preflight_file(const std::string& path, const Pose& at, bool block_delete, ScanCancel cancel) {
   if (!source_) {
     Preflight p;
     p.diagnostics.error(path, 0, 0, "this controller has no G-code interpreter", "control.program");
     return p;
   }
-  return source_->preflight(path, servo().commanded, {block_delete_}, *check_);
+  return source_->preflight(path, at, {block_delete, cancel}, *check_);
 }
 
 Preflight Controller::preflight_canon(const canon::Program& program) {
@@ -439,10 +520,28 @@ Preflight Controller::preflight_canon(const canon::Program& program) {
   return p;
 }
 
+// The preflight is long work: the controller goes on serving the servo while it runs. The file's
+// stamp and the source's version are taken before it reads, so that a change made while it reads
+// is a change after the check.
 void Controller::open_file(std::uint64_t id, const std::string& path) {
   if (job_) return finish(id, Refusal::Busy, "a program is running");
   if (servo().mode != Mode::Auto) return finish(id, Refusal::WrongMode, "programs are opened in Auto mode");
-  Preflight pf = preflight_file(path);
+  if (superseded(id, true)) return;
+  const Pose at = servo().commanded;
+  const bool block_delete = block_delete_;
+  std::string stamp = file_stamp(path);
+  const std::uint64_t version = source_ ? source_->version() : 0;
+  auto pf = std::make_shared<Preflight>();
+  run_long(
+      id, [this, pf, path, at, block_delete, cancel = cancel_token()] { *pf = preflight_file(path, at, block_delete, cancel); },
+      [this, id, pf, path, at, block_delete, stamp = std::move(stamp), version]() mutable {
+        finish_open(id, path, std::move(*pf), at, block_delete, std::move(stamp), version);
+      });
+}
+
+void Controller::finish_open(std::uint64_t id, const std::string& path, Preflight pf, const Pose& at,
+                             bool block_delete, std::string stamp, std::uint64_t version) {
+  if (superseded(id, true)) return;
   if (!pf.ok()) return finish(id, program_refusal(pf.diagnostics), refusal_text(program_refusal(pf.diagnostics)),
                               pf.diagnostics);
   OpenProgram op;
@@ -453,10 +552,10 @@ void Controller::open_file(std::uint64_t id, const std::string& path) {
     std::lock_guard lock(out_mutex_);
     open_ = std::move(op);
   }
-  open_at_ = servo().commanded;
-  open_block_delete_ = block_delete_;
-  open_stamp_ = file_stamp(path);
-  open_version_ = source_->version();
+  open_at_ = at;
+  open_block_delete_ = block_delete;
+  open_stamp_ = std::move(stamp);
+  open_version_ = version;
   open_limits_version_ = limits_version_;
   ControllerEvent e;
   e.kind = ControllerEventKind::ProgramOpened;
@@ -469,24 +568,31 @@ void Controller::open_canon(std::uint64_t id, std::shared_ptr<const canon::Progr
   if (job_) return finish(id, Refusal::Busy, "a program is running");
   if (servo().mode != Mode::Auto) return finish(id, Refusal::WrongMode, "programs are opened in Auto mode");
   if (!program) return finish(id, Refusal::BadValue, "no program given");
-  Preflight pf = preflight_canon(*program);
-  if (!pf.ok()) return finish(id, program_refusal(pf.diagnostics), refusal_text(program_refusal(pf.diagnostics)),
-                              pf.diagnostics);
-  OpenProgram op;
-  op.name = name;
-  op.program = std::move(program);
-  op.preflight = pf;
-  {
-    std::lock_guard lock(out_mutex_);
-    open_ = std::move(op);
-  }
-  open_at_ = servo().commanded;
-  open_limits_version_ = limits_version_;
-  ControllerEvent e;
-  e.kind = ControllerEventKind::ProgramOpened;
-  e.text = name;
-  log(std::move(e));
-  finish(id, Refusal::None, {}, std::move(pf.diagnostics));
+  if (superseded(id, true)) return;
+  auto pf = std::make_shared<Preflight>();
+  run_long(
+      id, [this, pf, program] { *pf = preflight_canon(*program); },
+      [this, id, pf, program, name = std::move(name)]() mutable {
+        if (superseded(id, true)) return;
+        if (!pf->ok())
+          return finish(id, program_refusal(pf->diagnostics), refusal_text(program_refusal(pf->diagnostics)),
+                        pf->diagnostics);
+        OpenProgram op;
+        op.name = name;
+        op.program = std::move(program);
+        op.preflight = *pf;
+        {
+          std::lock_guard lock(out_mutex_);
+          open_ = std::move(op);
+        }
+        open_at_ = servo().commanded;
+        open_limits_version_ = limits_version_;
+        ControllerEvent e;
+        e.kind = ControllerEventKind::ProgramOpened;
+        e.text = name;
+        log(std::move(e));
+        finish(id, Refusal::None, {}, std::move(pf->diagnostics));
+      });
 }
 
 void Controller::mdi(std::uint64_t id, const std::string& line) {
@@ -512,44 +618,77 @@ void Controller::cycle_start(std::uint64_t id, const Request& r) {
     return;
   }
   // The preflight holds for the position, the switches and the file it was made with: anything
-  // else, and the program is checked again before it may start.
-  if (servo().commanded != open_at_ || block_delete_ != open_block_delete_ ||
-      file_stamp(op->path) != open_stamp_ || source_->version() != open_version_ ||
-      open_limits_version_ != limits_version_) {
-    Preflight pf = preflight_file(op->path);
-    if (!pf.ok())
-      return finish(id, program_refusal(pf.diagnostics), refusal_text(program_refusal(pf.diagnostics)),
-                    pf.diagnostics);
-    open_at_ = servo().commanded;
-    open_block_delete_ = block_delete_;
-    open_stamp_ = file_stamp(op->path);
-    open_version_ = source_->version();
-    open_limits_version_ = limits_version_;
-    std::lock_guard lock(out_mutex_);
-    if (open_) open_->preflight = std::move(pf);
+  // else, and the program is checked again (long work) before it may start.
+  const Pose at = servo().commanded;
+  const bool block_delete = block_delete_;
+  if (at != open_at_ || block_delete != open_block_delete_ || file_stamp(op->path) != open_stamp_ ||
+      source_->version() != open_version_ || open_limits_version_ != limits_version_) {
+    std::string stamp = file_stamp(op->path);
+    const std::uint64_t version = source_->version();
+    auto pf = std::make_shared<Preflight>();
+    run_long(
+        id, [this, pf, path = op->path, at, block_delete, cancel = cancel_token()] {
+          *pf = preflight_file(path, at, block_delete, cancel);
+        },
+        [this, id, pf, path = op->path, at, block_delete, stamp = std::move(stamp), version]() mutable {
+          start_checked(id, path, std::move(*pf), at, block_delete, std::move(stamp), version);
+        });
+    return;
   }
   // Up to its first sync point the program is the one the preflight checked.
-  start_job(id, JobKind::Program, op->name, Mode::Auto, source_->execute(op->path, servo().commanded, {block_delete_}),
-            true);
+  start_job(id, JobKind::Program, op->name, Mode::Auto, source_->execute(op->path, at, {block_delete}), true);
+}
+
+// The open program checked again for a cycle start: it starts if nothing changed meanwhile (only
+// the urgent lane's stops can act while it is checked, and a stop sent after the start drops it).
+void Controller::start_checked(std::uint64_t id, const std::string& path, Preflight pf, const Pose& at,
+                               bool block_delete, std::string stamp, std::uint64_t version) {
+  if (superseded(id, false)) return;
+  if (!pf.ok())
+    return finish(id, program_refusal(pf.diagnostics), refusal_text(program_refusal(pf.diagnostics)), pf.diagnostics);
+  open_at_ = at;
+  open_block_delete_ = block_delete;
+  open_stamp_ = std::move(stamp);
+  open_version_ = version;
+  open_limits_version_ = limits_version_;
+  std::string name;
+  {
+    std::lock_guard lock(out_mutex_);
+    if (!open_ || open_->path != path) return finish(id, Refusal::NoProgram, refusal_text(Refusal::NoProgram));
+    open_->preflight = std::move(pf);
+    name = open_->name;
+  }
+  if (!ready_for_job(id, Mode::Auto, "programs")) return;
+  if (servo().commanded != at)
+    return finish(id, Refusal::StartMismatch, "the machine moved while the program was checked: start it again");
+  start_job(id, JobKind::Program, name, Mode::Auto, source_->execute(path, at, {block_delete}), true);
 }
 
 void Controller::run_auxiliary(std::uint64_t id, const requests::RunAuxiliary& r) {
   if (!ready_for_job(id, Mode::Auto, "auxiliary programs")) return;
   const std::string name = r.name.empty() ? (r.path.empty() ? "auxiliary" : r.path) : r.name;
   if (!features_allow_start(id, {JobKind::Auxiliary, name})) return;
-  if (r.program) {
-    Preflight pf = preflight_canon(*r.program);
-    if (!pf.ok())
-      return finish(id, program_refusal(pf.diagnostics), refusal_text(program_refusal(pf.diagnostics)),
-                    pf.diagnostics);
-    const bool same_start = r.program->start() == servo().commanded;
-    return start_job(id, JobKind::Auxiliary, name, Mode::Auto, canon_stream(r.program, servo().commanded), same_start);
-  }
-  Preflight pf = preflight_file(r.path);
-  if (!pf.ok())
-    return finish(id, program_refusal(pf.diagnostics), refusal_text(program_refusal(pf.diagnostics)), pf.diagnostics);
-  start_job(id, JobKind::Auxiliary, name, Mode::Auto, source_->execute(r.path, servo().commanded, {block_delete_}),
-            true);
+  if (superseded(id, false)) return;
+  const Pose at = servo().commanded;
+  const bool block_delete = block_delete_;
+  auto pf = std::make_shared<Preflight>();
+  run_long(
+      id,
+      [this, pf, program = r.program, path = r.path, at, block_delete, cancel = cancel_token()] {
+        *pf = program ? preflight_canon(*program) : preflight_file(path, at, block_delete, cancel);
+      },
+      [this, id, pf, program = r.program, path = r.path, name, at, block_delete] {
+        if (superseded(id, false)) return;
+        if (!pf->ok())
+          return finish(id, program_refusal(pf->diagnostics), refusal_text(program_refusal(pf->diagnostics)),
+                        pf->diagnostics);
+        if (!ready_for_job(id, Mode::Auto, "auxiliary programs")) return;
+        if (servo().commanded != at)
+          return finish(id, Refusal::StartMismatch, "the machine moved while the program was checked: start it again");
+        if (program)
+          return start_job(id, JobKind::Auxiliary, name, Mode::Auto, canon_stream(program, at), program->start() == at);
+        start_job(id, JobKind::Auxiliary, name, Mode::Auto, source_->execute(path, at, {block_delete}), true);
+      });
 }
 
 // Every feature's check before a start (Feature::allow_start); the first that says no refuses it.
@@ -600,13 +739,28 @@ void Controller::resume_program(std::uint64_t id, const requests::ResumeProgram&
   if (op->path.empty()) return finish(id, Refusal::BadValue, "only a program file can be resumed at a segment");
   if (!ready_for_job(id, Mode::Auto, "programs")) return;
   if (!features_allow_start(id, {JobKind::Program, op->name})) return;
-  std::unique_ptr<ProgramStream> stream =
-      source_->resume(op->path, r.program_start.value_or(open_at_), servo().commanded, r.segment, {block_delete_});
-  if (!stream) return finish(id, Refusal::BadValue, "this controller's program source cannot resume at a segment");
-  // The replay up to the segment, here and now: a program that cannot get there starts nothing.
-  while (stream->state() == StreamState::Reading && stream->program().empty()) stream->read(1);
-  // Every move is checked before it runs (the preflight's moves began elsewhere).
-  start_job(id, JobKind::Program, op->name, Mode::Auto, std::move(stream), false);
+  if (superseded(id, false)) return;
+  const Pose at = servo().commanded;
+  const ScanCancel cancel = cancel_token();
+  // Held in a shared slot: the task reads it, then the job takes it.
+  auto stream = std::make_shared<std::unique_ptr<ProgramStream>>(
+      source_->resume(op->path, r.program_start.value_or(open_at_), at, r.segment, {block_delete_, cancel}));
+  if (!*stream) return finish(id, Refusal::BadValue, "this controller's program source cannot resume at a segment");
+  // The replay up to the segment (long work): a program that cannot get there starts nothing.
+  run_long(
+      id,
+      [stream, cancel] {
+        ProgramStream& s = **stream;
+        while (s.state() == StreamState::Reading && s.program().empty() && !cancel.requested()) s.read(1);
+      },
+      [this, id, stream, at, name = op->name] {
+        if (superseded(id, false)) return;
+        if (!ready_for_job(id, Mode::Auto, "programs")) return;
+        if (servo().commanded != at)
+          return finish(id, Refusal::StartMismatch, "the machine moved while the program was replayed: start it again");
+        // Every move is checked before it runs (the preflight's moves began elsewhere).
+        start_job(id, JobKind::Program, name, Mode::Auto, std::move(*stream), false);
+      });
 }
 
 void Controller::feature(std::uint64_t id, const requests::Feature& r) {
@@ -665,7 +819,8 @@ void Controller::start_job(std::uint64_t id, JobKind kind, std::string name, Mod
   host.prechecked = prechecked;
   host.next_command_id = [this] { return new_id(); };
   host.log = [this](ControllerEvent e) { log(std::move(e)); };
-  host.send = [this](const Command& c) { return channels_->commands.try_push(c); };
+  host.send = [this](const Command& c) { return send(c); };
+  host.request_seq = handling_seq_;
   host.next_run_id = [this] { return ++run_counter_; };
   host.may_continue = [this](const SyncCheck& c) { return features_allow_continue(c); };
   auto job = std::make_unique<detail::Job>(kind, ++job_counter_, name, mode, std::move(stream), std::move(host));

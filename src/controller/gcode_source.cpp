@@ -415,14 +415,20 @@ class GcodeStream final : public ProgramStream {
 class Scan {
  public:
   Scan(const gcode::Options& o, const std::string& path, const Pose& start, double tolerance_mm,
-       const MovePasses& passes)
-      : interp_(o), pipe_(interp_, start, tolerance_mm, nullptr, passes) {
+       const MovePasses& passes, ScanCancel cancel = {})
+      : interp_(o), pipe_(interp_, start, tolerance_mm, nullptr, passes), cancel_(cancel) {
     ok_ = begin_program(interp_, pipe_, path, start, tolerance_mm);
     done_ = !ok_;
   }
-  /// Reads until `moves` moves exist or the scan ends.
+  /// Reads until `moves` moves exist or the scan ends (or is cancelled).
   void read_to(std::size_t moves) {
     while (!done_ && program().size() < moves) {
+      if (cancel_.requested()) {
+        cancelled_ = true;
+        done_ = true;
+        ok_ = false;
+        return;
+      }
       const gcode::RunStatus s = interp_.run(pipe_.sink(), kBlocksPerCall);
       if (s == gcode::RunStatus::Error) ok_ = false;
       if (s == gcode::RunStatus::Error || s == gcode::RunStatus::Finished) done_ = true;
@@ -431,6 +437,7 @@ class Scan {
   const canon::Program& program() const noexcept { return pipe_.program(); }
   bool done() const noexcept { return done_; }
   bool ok() const noexcept { return ok_; }
+  bool cancelled() const noexcept { return cancelled_; }
   const Diagnostics& diagnostics() const noexcept { return interp_.diagnostics(); }
   const Diagnostics& hand_failures() const noexcept { return pipe_.hand_failures(); }
   const Diagnostics& coupling_failures() const noexcept { return pipe_.coupling_failures(); }
@@ -439,7 +446,8 @@ class Scan {
  private:
   gcode::Interpreter interp_;
   Pipeline pipe_;
-  bool ok_ = true, done_ = false;
+  ScanCancel cancel_;
+  bool ok_ = true, done_ = false, cancelled_ = false;
 };
 
 /// Whether move k is the same in two scans: kind, line, end points, feed and (arcs) geometry.
@@ -568,12 +576,13 @@ class PreflightRun {
 
 /// One preflight pass; with `classify`, a second scan with other answers runs in step with it.
 Preflight preflight_pass(const gcode::Options& o, const std::string& path, const Pose& start,
-                         double tolerance_mm, const MovePasses& passes, MoveCheck& check, bool classify) {
+                         double tolerance_mm, const MovePasses& passes, MoveCheck& check, bool classify,
+                         ScanCancel cancel) {
   Preflight out;
   gcode::Options main = o;
   main.mode = gcode::Mode::Scan;
   main.scan_assumption = gcode::ScanAssumption::Rs274;
-  Scan scan(main, path, start, tolerance_mm, passes);
+  Scan scan(main, path, start, tolerance_mm, passes, cancel);
   std::unique_ptr<Scan> other;
   if (classify) {
     gcode::Options alt = main;
@@ -593,6 +602,9 @@ Preflight preflight_pass(const gcode::Options& o, const std::string& path, const
   append(out.diagnostics, scan.diagnostics());
   append(out.diagnostics, scan.hand_failures());
   append(out.diagnostics, scan.coupling_failures());
+  if (scan.cancelled())
+    out.diagnostics.error(path, 0, 0, "the check was cancelled: an e-stop, machine off or abort was sent",
+                          "control.cancelled");
   if (!scan.ok() && !out.diagnostics.has_errors())
     out.diagnostics.error(path, 0, 0, "the program cannot be read", "control.program");
   check.finish(out.diagnostics);
@@ -679,11 +691,13 @@ gcode::Options GcodeProgramSource::options_for(const std::string& path, const Lo
 Preflight GcodeProgramSource::preflight(const std::string& path, const Pose& start, const LoadOptions& options,
                                         MoveCheck& check) {
   const gcode::Options o = options_for(path, options);
-  Preflight first = preflight_pass(o, path, start, config_.default_tolerance_mm, passes(), check, false);
-  if (first.summary.sync_points == 0) return first;
+  Preflight first =
+      preflight_pass(o, path, start, config_.default_tolerance_mm, passes(), check, false, options.cancel);
+  if (first.summary.sync_points == 0 || options.cancel.requested()) return first;
   // Sync points: the checks of the moves after them rest on assumed answers. A second pass, beside
   // a scan with other answers, tells which moves those are.
-  Preflight second = preflight_pass(o, path, start, config_.default_tolerance_mm, passes(), check, true);
+  Preflight second =
+      preflight_pass(o, path, start, config_.default_tolerance_mm, passes(), check, true, options.cancel);
   return second;
 }
 

@@ -53,6 +53,7 @@ bool Job::start(std::uint64_t command_id, Diagnostics& diags) {
 // A servo run over the stream's current window. The first moves are read and checked before the
 // run starts: a program (an MDI line) whose first moves fail starts nothing.
 bool Job::begin_leg(std::uint64_t command_id, Diagnostics& diags) {
+  const bool first_leg = leg_.run_id == 0;
   const std::uint64_t first_move = leg_.first_move;
   previous_run_id_ = leg_.run_id;
   leg_ = Leg{};
@@ -77,6 +78,7 @@ bool Job::begin_leg(std::uint64_t command_id, Diagnostics& diags) {
   Command c;
   c.kind = CommandKind::StartRun;
   c.id = command_id;
+  c.seq = first_leg ? host_.request_seq : 0;
   c.run_id = leg_.run_id;
   c.run_mode = mode_;
   c.first_block = host_.channels->blocks.pushed();
@@ -249,7 +251,8 @@ void Job::on_servo_event(const ServoEvent& e, const ServoStatus& s) {
   if (ended_) return;
   switch (e.kind) {
     case EventKind::Refused:
-      if (e.command == CommandKind::StartRun && e.command_id == leg_.command_id) finish(JobEnd::Fault);
+      if (e.command == CommandKind::StartRun && e.command_id == leg_.command_id)
+        finish(e.refusal == Refusal::Superseded ? JobEnd::Aborted : JobEnd::Fault);
       return;
     case EventKind::InputRead:
       if (e.run_id == leg_.run_id) input_value_ = e.value;

@@ -40,6 +40,9 @@ struct JobHost {
   std::function<void(ControllerEvent)> log;
   /// Sends a servo command; false when the queue is full.
   std::function<bool(const Command&)> send;
+  /// The send order of the request that started the job: its first StartRun carries it, so that a
+  /// stop sent after the request drops the start (Command::seq); later legs take a new number.
+  std::uint64_t request_seq = 0;
   /// Servo run ids are the controller's to hand out.
   std::function<std::uint32_t()> next_run_id;
   /// Whether the features let the interpreter read on past a sync point the machine has passed

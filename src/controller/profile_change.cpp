@@ -155,7 +155,7 @@ void Controller::edit_profile(std::uint64_t id, const requests::EditProfile& r) 
     c.kind = CommandKind::StageJointLimits;
     c.axis = static_cast<std::int8_t>(j);
     c.limits = joint_limits(next, j);
-    queued = channels_->commands.try_push(c);
+    queued = send(c);
   }
   for (int j = 0; j < motion::kMaxCompensatedJoints && queued; ++j)
     if (tables & (1u << j)) queued = stage_pitch_table(j, next, pending);
@@ -164,7 +164,7 @@ void Controller::edit_profile(std::uint64_t id, const requests::EditProfile& r) 
   apply.id = id;
   apply.kind = CommandKind::ApplyJointLimits;
   profile_change_ = std::move(pending);
-  if (!queued || !channels_->commands.try_push(apply)) {
+  if (!queued || !send(apply)) {
     ServoEvent refused;
     refused.kind = EventKind::Refused;
     refused.command_id = id;
@@ -183,7 +183,7 @@ bool Controller::open_program_keeps_its_conditions(const requests::EditProfile& 
   const std::optional<OpenProgram> op = deletes && source_ ? open_program() : std::nullopt;
   if (!op || op->path.empty()) return true;
   source_->profile_changed(next);
-  const Preflight pf = preflight_file(op->path);
+  const Preflight pf = preflight_file(op->path, servo().commanded, block_delete_, {});
   source_->profile_changed(profile_);
   constexpr std::string_view code = "edm.condition";
   for (const Diagnostic& d : pf.diagnostics.items())
@@ -208,7 +208,7 @@ bool Controller::stage_pitch_table(int joint, const ServoConfig& next, const Pro
   stage.kind = CommandKind::StagePitchTable;
   stage.axis = static_cast<std::int8_t>(joint);
   stage.table_buffer = buffer;
-  return channels_->commands.try_push(stage);
+  return send(stage);
 }
 
 // The machining conditions into the channels' table (the tick reads it only in the apply, and no
@@ -220,7 +220,7 @@ bool Controller::stage_edm_conditions(const ServoConfig& next, const ProfileChan
   Command stage;
   stage.id = pending.stage_id;
   stage.kind = CommandKind::StageEdmConditions;
-  return channels_->commands.try_push(stage);
+  return send(stage);
 }
 
 bool Controller::settle_profile_change(const ServoEvent& e) {

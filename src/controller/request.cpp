@@ -151,4 +151,32 @@ std::optional<Command> to_command(const Request& r) {
       r.body);
 }
 
+bool takes_urgent_lane(const Request& r) {
+  if (const auto* s = std::get_if<requests::Servo>(&r.body)) {
+    switch (s->kind) {
+      case CommandKind::EStop:
+      case CommandKind::MachineOff:
+      case CommandKind::Abort:
+      case CommandKind::FeedHold:
+      case CommandKind::SpindleOff:
+        return true;
+      default:
+        return false;
+    }
+  }
+  if (const auto* c = std::get_if<requests::SetCoolant>(&r.body)) return !c->on;
+  return std::holds_alternative<requests::JogStop>(r.body) || std::holds_alternative<requests::SetOverride>(r.body);
+}
+
+bool is_halt(const Request& r) {
+  const auto* s = std::get_if<requests::Servo>(&r.body);
+  return s != nullptr &&
+         (s->kind == CommandKind::EStop || s->kind == CommandKind::MachineOff || s->kind == CommandKind::Abort);
+}
+
+bool is_stop(const Request& r) {
+  const auto* s = std::get_if<requests::Servo>(&r.body);
+  return is_halt(r) || (s != nullptr && s->kind == CommandKind::FeedHold);
+}
+
 }  // namespace opencnc::control

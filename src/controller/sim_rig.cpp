@@ -7,11 +7,11 @@
 namespace opencnc::control {
 
 SimRig::SimRig(const config::MachineProfile& profile, std::shared_ptr<ProgramSource> source,
-               int service_every)
+               int service_every, ControllerOptions options)
     : channels_(std::make_unique<ServoChannels>()),
       machine_(std::make_unique<machine::SimMachine>(config::sim_machine_config(profile))),
       servo_(std::make_unique<Servo>(servo_config(profile), *channels_, *machine_)),
-      controller_(std::make_unique<Controller>(profile, *channels_, std::move(source))),
+      controller_(std::make_unique<Controller>(profile, *channels_, std::move(source), options)),
       service_every_(service_every < 1 ? 1 : service_every) {}
 
 SimRig::~SimRig() = default;

@@ -54,6 +54,7 @@ struct EdmConditionTable {
 /// | member     | producer                  | consumer   |
 /// |------------|---------------------------|------------|
 /// | commands   | controller                | servo tick |
+/// | urgent     | controller's submit() (any thread, one at a time) | servo tick |
 /// | blocks     | planner (controller)      | servo tick |
 /// | actions    | controller                | servo tick |
 /// | events     | servo tick                | controller |
@@ -66,6 +67,11 @@ struct EdmConditionTable {
 /// About 4 MB; construct it on the heap or in shared memory (standard layout, lock-free atomics).
 struct ServoChannels {
   SpscRing<Command, 256> commands;
+  /// The stops and overrides an operator sends (e-stop, machine off, abort, feed hold, jog stop,
+  /// spindle off, the overrides), pushed by the thread that submits them the moment it does: they
+  /// never wait behind the controller's other work. The tick takes both queues in `seq` order and
+  /// this one whole every period.
+  SpscRing<Command, 32> urgent;
   traj::BlockQueue blocks;
   /// The machine side of the markers of the current run, in action order; as many as blocks
   /// can be queued, so the record of every queued marker is always there.

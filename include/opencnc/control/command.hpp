@@ -114,6 +114,9 @@ enum class Refusal : std::uint8_t {
   FeatureCheck,   ///< control.feature-check: a feature's check before the start failed (the message says why)
   NoLimitSwitch,  ///< control.no-limit-switch: the axis has no limit switch that way to seek (or no seek
                   ///< keys)
+  /// control.superseded: an e-stop, machine off, abort or feed hold was sent after this request and
+  /// acted first; what this one would have started is dropped (send it again to mean it)
+  Superseded,
 };
 
 /// Stable problem code of a refusal ("control.busy", ...). Any thread; real-time safe.
@@ -183,6 +186,9 @@ struct Command {
   Mode run_mode = Mode::Auto;  ///< StartRun: Auto program or MDI line
   JointLimits limits{};        ///< StageJointLimits
   std::uint8_t table_buffer = 0;  ///< StagePitchTable: which of the joint's two buffers
+  /// The order in which the controller sent it, over both of its lanes (ServoChannels::commands
+  /// and ::urgent): the tick applies what it finds in both in this order. 0: unordered (a test).
+  std::uint64_t seq = 0;
 };
 
 /// What a program's marker asks the machine to do (canon actions, in a form the tick can apply).

@@ -61,6 +61,7 @@ class Servo final : public Tickable {
   void check_process_alarms() noexcept;  // servo_alarms.cpp
   void trip_process_alarm(int index, double value, bool low) noexcept;
   void handle_commands() noexcept;
+  bool next_command(Command& c, bool urgent_only) noexcept;
   void run_active_mode() noexcept;
   void couple_axes() noexcept;
   void compensate() noexcept;
@@ -221,6 +222,7 @@ class Servo final : public Tickable {
   int in_position_periods_ = 0;
   std::uint64_t engage_wait_periods_ = 0;
   std::uint64_t last_command_id_ = 0;
+  std::uint64_t stop_seq_ = 0;  ///< the send order (Command::seq) of the latest stop applied
   Refusal last_refusal_ = Refusal::None;
   std::uint64_t accepted_ = 0, refused_ = 0, events_dropped_ = 0, trace_dropped_ = 0;
 

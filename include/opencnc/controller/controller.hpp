@@ -8,6 +8,8 @@
 
 #include <atomic>
 #include <cstdint>
+#include <deque>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -32,8 +34,18 @@ namespace opencnc::control {
 
 namespace detail {
 class Job;
-}
+class TaskRunner;
+}  // namespace detail
 class MachineMoveCheck;
+
+/// How a controller runs.
+struct ControllerOptions {
+  /// Long work (a preflight, the replay before a resume) on a thread of its own while service()
+  /// goes on reading the servo and publishing the status; later requests (but the urgent lane's)
+  /// wait their turn behind it. Off (virtual time): it runs inside service(), so a run repeats bit
+  /// for bit; the tick then waits for it as well.
+  bool long_work_on_thread = false;
+};
 
 /// The open (main) program: what the preflight found, and what it was checked for.
 struct OpenProgram {
@@ -52,12 +64,14 @@ class Controller final : private FeatureHost {
   /// `channels` must outlive the controller; `source` turns G-code into programs (may be null:
   /// then only programs given as canon::Program can run).
   Controller(const config::MachineProfile& profile, ServoChannels& channels,
-             std::shared_ptr<ProgramSource> source = nullptr);
+             std::shared_ptr<ProgramSource> source = nullptr, ControllerOptions options = {});
   ~Controller() override;
   Controller(const Controller&) = delete;
   Controller& operator=(const Controller&) = delete;
 
-  /// Queues a request; returns its id (the answer comes as its Outcome). Any thread.
+  /// Queues a request; returns its id (the answer comes as its Outcome). A request of the urgent
+  /// lane (takes_urgent_lane) is in the servo's queue when this returns: the next tick acts on it,
+  /// whatever service() is doing. Any thread.
   std::uint64_t submit(Request r) override;
   /// The answer to request `id`, once known. Any thread.
   std::optional<Outcome> outcome(std::uint64_t id) const;
@@ -75,6 +89,8 @@ class Controller final : private FeatureHost {
   bool add_feature(std::shared_ptr<Feature> feature, ObserverOptions options = {});
   /// The open program (its preflight summary and warnings), if any. Any thread.
   std::optional<OpenProgram> open_program() const;
+  /// A long request's work is under way (long_work_on_thread): later requests wait. Controller thread.
+  bool busy_with_long_work() const noexcept;
 
   /// The periodic work: reads the servo's events, status and trace, handles queued requests,
   /// keeps the interpreter and the planner ahead of the servo, tells the observers. Controller
@@ -129,12 +145,28 @@ class Controller final : private FeatureHost {
   bool features_allow_continue(const SyncCheck& sync);
   /// Refuses when a job cannot start now (mode `mode`, idle, homed, no job running).
   bool ready_for_job(std::uint64_t id, Mode mode, const char* what);
-  Preflight preflight_file(const std::string& path);
+  Preflight preflight_file(const std::string& path, const Pose& at, bool block_delete, ScanCancel cancel);
   Preflight preflight_canon(const canon::Program& program);
+  /// `work` as the long task of request `id` (on the task thread, or at once), then `then` on the
+  /// controller's thread; a task that throws is answered with its message.
+  void run_long(std::uint64_t id, std::function<void()> work, std::function<void()> then);
+  void finish_long_work();
+  /// Whether the request being handled was sent before a halt (`halts_only`) or any stop that has
+  /// been sent since: it is then answered control.superseded and true is returned.
+  bool superseded(std::uint64_t id, bool halts_only);
+  ScanCancel cancel_token() const noexcept { return {&halt_seq_, handling_seq_}; }
+  void finish_open(std::uint64_t id, const std::string& path, Preflight pf, const Pose& at, bool block_delete,
+                   std::string stamp, std::uint64_t version);
+  void start_checked(std::uint64_t id, const std::string& path, Preflight pf, const Pose& at, bool block_delete,
+                     std::string stamp, std::uint64_t version);
+  /// Sends a command to the tick in the order of sending: `c.seq` as set (a request's own), or
+  /// the next number. False when the queue is full. Controller thread.
+  bool send(Command c);
   void start_job(std::uint64_t id, JobKind kind, std::string name, Mode mode, std::unique_ptr<ProgramStream> stream,
                  bool prechecked = false);
   void end_job();
   void forward(std::uint64_t id, const Command& c);
+  std::uint64_t next_seq();
   void finish(std::uint64_t id, Refusal refusal, std::string message = {}, Diagnostics diags = {});
   void log(ControllerEvent e);
   void publish();
@@ -157,12 +189,22 @@ class Controller final : private FeatureHost {
   std::unique_ptr<MachineMoveCheck> check_;
   EventLog log_;
 
-  mutable std::mutex inbox_mutex_;  ///< the inbox, the id counter, attachments waiting
-  std::vector<std::pair<std::uint64_t, Request>> inbox_;
+  /// A request as submitted, with its place in the order of sending (Command::seq).
+  struct Submitted {
+    std::uint64_t id = 0;
+    std::uint64_t seq = 0;
+    Request request;
+  };
+  mutable std::mutex inbox_mutex_;  ///< the inbox, the id and send counters, the urgent lane, attachments waiting
+  std::vector<Submitted> inbox_;
   /// Set with every submit(): service() takes the lock only when there is something to take.
   std::atomic<bool> inbox_filled_{false};
-  std::vector<std::pair<std::uint64_t, Request>> requests_;  ///< controller thread: being handled
+  std::deque<Submitted> backlog_;  ///< controller thread: waiting their turn (behind a long task)
   std::uint64_t next_id_ = 1;
+  std::uint64_t next_seq_ = 0;  ///< under inbox_mutex_: the send order of requests and commands
+  /// The send order of the latest stop / halt submitted (written under inbox_mutex_).
+  std::atomic<std::uint64_t> stop_seq_{0}, halt_seq_{0};
+  std::uint64_t handling_seq_ = 0;  ///< controller thread: the send order of the request being handled
   std::vector<Attached> to_attach_;
   std::vector<std::uint64_t> to_detach_;
   std::vector<std::shared_ptr<Feature>> features_to_add_;
@@ -193,6 +235,13 @@ class Controller final : private FeatureHost {
   std::string open_stamp_;       ///< the open file's size and change time when it was checked
   std::uint64_t open_version_ = 0;  ///< the source's version when it was checked
   bool block_delete_ = false;
+  /// The long request under way (its task on tasks_), and what to do on this thread when it is done.
+  struct LongRequest {
+    std::uint64_t id = 0, seq = 0;
+    std::function<void()> then;
+    std::shared_ptr<std::string> failure;  ///< what the task threw
+  };
+  std::optional<LongRequest> long_;
   std::unique_ptr<detail::Job> job_;
   std::unique_ptr<detail::Job> retired_;  ///< the job that ended last (its last samples may come)
   std::uint32_t job_counter_ = 0;
@@ -224,6 +273,8 @@ class Controller final : private FeatureHost {
     bool operator==(const WaitKey&) const = default;
   };
   WaitKey wait_key_{State::Off, Wait::None, StopReason::None, SyncKind::None, ~0u, ~0u, false};
+  /// Last: destroyed (its thread joined) before everything its task may use.
+  std::unique_ptr<detail::TaskRunner> tasks_;
 };
 
 }  // namespace opencnc::control

@@ -4,6 +4,7 @@
 // machine has answered (a probe's trip, an input's value, a tool change, the operator's go-on).
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -20,9 +21,20 @@ struct MachineProfile;
 
 namespace opencnc::control {
 
+/// Ends a long scan early: a halt (e-stop, machine off, abort) was sent after the request that
+/// started it. Plain data; reads one atomic.
+struct ScanCancel {
+  const std::atomic<std::uint64_t>* halt_seq = nullptr;  ///< the send order of the latest halt
+  std::uint64_t request_seq = 0;                         ///< the send order of the request scanning
+  bool requested() const noexcept {
+    return halt_seq != nullptr && halt_seq->load(std::memory_order_relaxed) > request_seq;
+  }
+};
+
 /// Switches that change how a program is read.
 struct LoadOptions {
   bool block_delete = false;  ///< skip lines that start with '/'
+  ScanCancel cancel = {};     ///< preflight and resume's replay: stop when it is requested
 };
 
 /// What a program waits for at a sync point.

@@ -201,4 +201,15 @@ struct Request {
 /// The servo command a request stands for (nothing for the controller's own requests). Any thread.
 std::optional<Command> to_command(const Request& r);
 
+/// The urgent lane (docs/controller.md, "Stops never wait"): an e-stop, machine off, abort, feed
+/// hold, jog stop, spindle off, coolant off or an override goes from the thread that submits it
+/// straight to the tick (ServoChannels::urgent), whatever the controller is busy with. Any thread.
+bool takes_urgent_lane(const Request& r);
+/// A stop (e-stop, machine off, abort, feed hold): requests sent before it that would start
+/// something are dropped once it has acted (control.superseded). Any thread.
+bool is_stop(const Request& r);
+/// A halt (e-stop, machine off, abort): it also cancels the controller's long work (a preflight,
+/// a replay) for requests sent before it. Any thread.
+bool is_halt(const Request& r);
+
 }  // namespace opencnc::control

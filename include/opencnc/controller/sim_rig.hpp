@@ -20,8 +20,10 @@ namespace opencnc::control {
 class SimRig {
  public:
   /// `service_every`: the controller's work runs before every n-th tick (1 = every tick).
+  /// `options`: the controller's; with long work on a thread, virtual time goes on while a program
+  /// is checked (paced virtual time for a server), and runs no longer repeat bit for bit.
   explicit SimRig(const config::MachineProfile& profile, std::shared_ptr<ProgramSource> source = nullptr,
-                  int service_every = 1);
+                  int service_every = 1, ControllerOptions options = {});
   ~SimRig();
 
   /// One servo period (with the controller's work first when it is due).
