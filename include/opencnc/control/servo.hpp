@@ -38,6 +38,10 @@ class Servo final : public Tickable {
 
   /// Periods run. Servo thread (or any thread once the servo has stopped).
   std::uint64_t ticks() const noexcept { return tick_; }
+  /// The state, and the id of the command applied last (accepted or not). Servo thread (tests that
+  /// tick by hand measure with them how soon a command acts).
+  State state() const noexcept { return state_; }
+  std::uint64_t last_command_id() const noexcept { return last_command_id_; }
   const ServoConfig& config() const noexcept { return config_; }
   /// The compensation stage (its tables and corrections now). Servo thread, or any thread once
   /// the servo has stopped (tests in virtual time).
