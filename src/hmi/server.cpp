@@ -183,6 +183,18 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
   std::optional<net::steady_timer> stream_timer;      ///< reset before the io_context goes
   std::chrono::steady_clock::time_point next_tick{};  ///< of the stream (the io thread)
   net::thread_pool workers{1};                        ///< previews: the interpreter may take a while
+  /// Work that may wait for a disk, the database or the simulated machine (files, the history, a
+  /// tool-table write, a simulation event): never on an io thread, which stays free for the stops
+  /// (docs/controller.md, "Stops never wait").
+  net::thread_pool blocking{2};
+  /// `make_response()` on the blocking pool, its answer sent on the session's executor.
+  template <class Session, class F>
+  void off_io(const std::shared_ptr<Session>& s, F make_response) {
+    net::post(blocking, [s, make_response = std::move(make_response)]() mutable {
+      auto res = std::make_shared<HttpResponse>(make_response());
+      net::post(s->executor(), [s, res] { s->send(std::move(*res)); });
+    });
+  }
   std::vector<std::thread> threads;
   bool loopback = true;
   std::uint16_t port = 0;
@@ -444,7 +456,7 @@ void Server::Impl::handle(const std::shared_ptr<HttpSession>& s, HttpRequest req
     if (req.method() != http::verb::get && req.method() != http::verb::head) {
       return s->send(error_response(req, 405, "only GET here"));
     }
-    return s->send(static_file(req, t));
+    return off_io(s, [self = shared_from_this(), req, t] { return self->static_file(req, t); });
   }
   if (!t.path.starts_with("/api/v1/"))
     return s->send(error_response(req, 404, "this server speaks /api/v1/"));
@@ -468,6 +480,11 @@ void Server::Impl::handle(const std::shared_ptr<HttpSession>& s, HttpRequest req
   }
   if (!is_get) return s->send(error_response(req, 405, "only GET here"));
   if (t.path == "/api/v1/program/preview") return preview(s, req);
+  // What reads a file or the database goes off the io thread; the rest is in memory.
+  const bool reads_disk = t.path == "/api/v1/program/text" || t.path == "/api/v1/programs" ||
+                          t.path == "/api/v1/history" || t.path == "/api/v1/audit";
+  if (reads_disk)
+    return off_io(s, [self = shared_from_this(), req, t, role] { return self->get(req, t, role.value_or(Role::Operator)); });
   s->send(get(req, t, role.value_or(Role::Operator)));
 }
 
@@ -575,17 +592,22 @@ void Server::Impl::command(const std::shared_ptr<HttpSession>& s, const HttpRequ
     return s->send(error_response(req, e->status, e->message));
   }
   auto& c = std::get<Command>(parsed);
-  if (const auto* e = std::get_if<SimulationEvent>(&c)) {
-    const std::string why = config.simulate ? config.simulate(*e) : "this server has no simulation controls";
-    HttpResponse res = why.empty() ? json_response(req, 200, {{"accepted", true}, {"event", e->event}})
-                                   : error_response(req, 409, why);
-    audit(s->remote(), role, req, static_cast<int>(res.result_int()), why.empty() ? "accepted" : why);
-    return s->send(std::move(res));
+  if (const auto* e = std::get_if<SimulationEvent>(&c)) {  // waits for the machine to take it
+    return off_io(s, [self = shared_from_this(), s, req, role, e = *e] {
+      const std::string why =
+          self->config.simulate ? self->config.simulate(e) : "this server has no simulation controls";
+      HttpResponse res = why.empty() ? json_response(req, 200, {{"accepted", true}, {"event", e.event}})
+                                     : error_response(req, 409, why);
+      self->audit(s->remote(), role, req, static_cast<int>(res.result_int()), why.empty() ? "accepted" : why);
+      return res;
+    });
   }
-  if (const auto* t = std::get_if<ToolChange>(&c)) {
-    HttpResponse res = tool_change(req, *t);
-    audit(s->remote(), role, req, static_cast<int>(res.result_int()), res.body());
-    return s->send(std::move(res));
+  if (const auto* t = std::get_if<ToolChange>(&c)) {  // writes the tool table (a file, the database)
+    return off_io(s, [self = shared_from_this(), s, req, role, t = *t] {
+      HttpResponse res = self->tool_change(req, t);
+      self->audit(s->remote(), role, req, static_cast<int>(res.result_int()), res.body());
+      return res;
+    });
   }
   auto& request = std::get<control::Request>(c);
   auto* edit = std::get_if<control::requests::EditProfile>(&request.body);
@@ -809,6 +831,7 @@ void Server::stop() {
     if (t.joinable()) t.join();
   }
   s.workers.join();  // a preview being made finishes; its answer is dropped below
+  s.blocking.join();
   // No thread runs the io_context now: close the I/O objects, then destroy the io_context,
   // which destroys every handler still queued and the sessions only they kept alive.
   beast::error_code ec;

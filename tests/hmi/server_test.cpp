@@ -8,6 +8,8 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <filesystem>
+#include <fstream>
 #include <thread>
 
 #include "../control/test_profiles.hpp"
@@ -234,6 +236,37 @@ TEST(Server, AJobRunsToItsEndWithHoldAndResumeAndLandsInTheHistory) {
   for (const json& e : events["events"])
     ended = ended || (e["kind"] == "job-ended" && e["end"] == "finished");
   EXPECT_TRUE(ended);
+}
+
+// The issue's reproduction: the spindle at 3000 rpm, an endless moving loop opened, then the
+// e-stop. The e-stop is answered (200, not 202 pending) while the open's check runs, the machine
+// stands e-stopped with the spindle stopped, and the e-stop cancelled the check.
+TEST(Server, AnEStopIsAnsweredAndActsWhileAnEndlessProgramIsChecked) {
+  const auto dir = std::filesystem::temp_directory_path() / ("opencnc-hmi-estop-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "endless.ngc") << "G21 G90 F1000\no1 while [1]\nG1 X1\nG1 X0\no1 endwhile\nM2\n";
+  RigOptions o = mill();
+  o.programs = dir;
+  o.server.command_timeout_s = 30;  // a 202 would mean the e-stop waited behind the open
+  ServerRig rig(o);
+  const std::string& t = kOperator;
+  ASSERT_EQ(post(rig.port, R"({"kind":"machine-on"})", t).status, 200);
+  ASSERT_EQ(post(rig.port, R"({"kind":"mode","mode":"manual"})", t).status, 200);
+  ASSERT_EQ(post(rig.port, R"({"kind":"spindle-on","rpm":3000})", t).status, 200);
+  ASSERT_TRUE(rig.until([](const json& s) { return s["spindle"]["rpm"] == 3000.0; }));
+  ASSERT_EQ(post(rig.port, R"({"kind":"mode","mode":"auto"})", t).status, 200);
+  Reply open;
+  std::thread opener([&] { open = post(rig.port, R"({"kind":"open","program":"endless.ngc"})", t); });
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));  // the check is under way
+  const Reply estop = post(rig.port, R"({"kind":"estop"})", t);
+  EXPECT_EQ(estop.status, 200) << estop.text;
+  EXPECT_TRUE(estop.body.value("accepted", false)) << estop.text;
+  EXPECT_TRUE(rig.until([](const json& s) { return s["state"] == "e-stopped"; }, 5));
+  EXPECT_EQ(rig.status()["spindle"]["direction"], "stopped");
+  opener.join();
+  EXPECT_EQ(open.status, 409) << open.text;
+  EXPECT_NE(open.text.find("control.superseded"), std::string::npos) << open.text;
+  std::filesystem::remove_all(dir);
 }
 
 TEST(Server, TheStatusShowsWorkCoordinatesWithAG55OffsetAndAG92Shift) {
