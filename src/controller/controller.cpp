@@ -788,6 +788,11 @@ std::uint64_t Controller::defer() {
   return handling_;
 }
 
+void Controller::answer_after(std::function<void()> work, std::function<Outcome()> then) {
+  const std::uint64_t id = defer();
+  run_long(id, std::move(work), [this, id, then = std::move(then)] { answer(id, then()); });
+}
+
 void Controller::answer(std::uint64_t id, Outcome o) {
   finish(id, o.accepted ? Refusal::None : (o.refusal == Refusal::None ? Refusal::BadValue : o.refusal), o.message,
          std::move(o.diagnostics));

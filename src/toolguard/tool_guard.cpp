@@ -112,7 +112,6 @@ bool ToolGuard::allow_continue(const control::SyncCheck& sync, control::FeatureH
 
 control::Outcome ToolGuard::handle(const control::requests::Feature& request, control::FeatureHost& host) {
   control::Outcome o;
-  std::string error;
   if (request.action == "check") {
     const CheckResult r = check(*store_, tolerances_);
     o.accepted = r.ok();
@@ -120,24 +119,34 @@ control::Outcome ToolGuard::handle(const control::requests::Feature& request, co
     o.message = r.report();
     return o;
   }
-  if (request.action == "accept") {
-    const auto id = store_->backup("controller", "accept", &error);
-    o.accepted = id.has_value();
-    o.message = id ? fmt::format("the live tool table is backup {} now", *id) : error;
-  } else if (request.action == "restore") {
-    std::optional<store::BackupInfo> b = store_->current_backup(&error);
-    std::int64_t id = b ? b->id : 0;
-    if (const auto* chosen = std::any_cast<std::int64_t>(&request.args)) id = *chosen;
-    o.accepted = id > 0 && store_->restore(id, "controller", &error);
-    o.message = o.accepted ? fmt::format("backup {} is the live tool table again", id)
-                           : (error.empty() ? std::string("there is no backup to restore") : error);
-  } else {
+  if (request.action != "accept" && request.action != "restore") {
     o.message = fmt::format("tool-guard knows check, accept and restore, not '{}'", request.action);
     o.refusal = control::Refusal::BadValue;
     return o;
   }
-  if (!o.accepted) o.refusal = control::Refusal::BadValue;
-  host.note(o.accepted ? Severity::Note : Severity::Error, "tools.guard-" + request.action, o.message);
+  std::optional<std::int64_t> chosen;
+  if (const auto* id = std::any_cast<std::int64_t>(&request.args)) chosen = *id;
+  auto out = std::make_shared<control::Outcome>();
+  host.answer_after(
+      [out, store = store_, action = request.action, chosen] {
+        std::string error;
+        if (action == "accept") {
+          const auto id = store->backup("controller", "accept", &error);
+          out->accepted = id.has_value();
+          out->message = id ? fmt::format("the live tool table is backup {} now", *id) : error;
+        } else {
+          std::optional<store::BackupInfo> b = store->current_backup(&error);
+          const std::int64_t id = chosen.value_or(b ? b->id : 0);
+          out->accepted = id > 0 && store->restore(id, "controller", &error);
+          out->message = out->accepted ? fmt::format("backup {} is the live tool table again", id)
+                                       : (error.empty() ? std::string("there is no backup to restore") : error);
+        }
+        if (!out->accepted) out->refusal = control::Refusal::BadValue;
+      },
+      [out, &host, action = request.action] {
+        host.note(out->accepted ? Severity::Note : Severity::Error, "tools.guard-" + action, out->message);
+        return *out;
+      });
   return o;
 }
 

@@ -118,6 +118,7 @@ class Controller final : private FeatureHost {
   void note(Severity s, std::string code, std::string text) override;
   std::uint64_t defer() override;
   void answer(std::uint64_t id, Outcome outcome) override;
+  void answer_after(std::function<void()> work, std::function<Outcome()> then) override;
   void poll_features();
 
   void read_servo();

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -73,6 +74,12 @@ class FeatureHost {
   virtual std::uint64_t defer() = 0;
   /// The answer to a request deferred with defer() (once). Controller thread.
   virtual void answer(std::uint64_t id, Outcome outcome) = 0;
+  /// Inside Feature::handle only: the request being handled is the controller's long work (it may
+  /// wait for a disk or a database): `work` runs on the controller's task thread where the tick
+  /// runs by itself, at once in virtual time (so runs repeat bit for bit); then `then`, on the
+  /// controller's thread, gives the answer. handle's Outcome is then not used. Requests sent after
+  /// it wait their turn; the stops do not (docs/controller.md, "Stops never wait").
+  virtual void answer_after(std::function<void()> work, std::function<Outcome()> then) = 0;
 };
 
 /// What is about to start: asked of every feature before a program or auxiliary program starts.

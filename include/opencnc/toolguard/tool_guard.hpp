@@ -43,7 +43,9 @@ CheckResult check(store::ToolStore& store, const tools::CheckTolerances& toleran
 /// tool change) until the live table passes: the operator accepts (the live values become a new
 /// backup) or restores (the backup's values become live) with requests::Feature{"tool-guard",
 /// "accept"|"restore"|"check"} (restore's args: a backup id as std::int64_t, else the
-/// current one). Every result is a note with the difference lines. Controller thread.
+/// current one). Every result is a note with the difference lines. Accept and restore write the
+/// store, which may wait for another writer's lock: they are the controller's long work
+/// (FeatureHost::answer_after), so its loop never waits for the database. Controller thread.
 class ToolGuard final : public control::Feature {
  public:
   /// `pockets`: the magazine's pockets (0: not checked); a tool in a pocket beyond it refuses
