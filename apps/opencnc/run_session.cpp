@@ -7,6 +7,7 @@
 
 #include <cerrno>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <optional>
@@ -15,6 +16,7 @@
 #include <fmt/format.h>
 
 #include "commands.hpp"
+#include "opencnc/core/atomic_file.hpp"
 #include "opencnc/config/profile_loader.hpp"
 #include "opencnc/control/clock.hpp"
 #include "opencnc/control/servo.hpp"
@@ -525,9 +527,8 @@ SessionEnd run_session(const SessionOptions& o, const SessionHooks& hooks) {
     return end;
   }
   end.profile = *load.profile;
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(o.file, ec)) {
-    fmt::print(stderr, "error: cannot read the program {}\n", o.file);
+  if (const std::string why = unreadable_input(o.file, SIZE_MAX); !why.empty()) {
+    fmt::print(stderr, "error: cannot read the program {}: {}\n", o.file, why);
     end.exit_code = kExitUsage;
     return end;
   }
