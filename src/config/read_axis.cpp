@@ -604,9 +604,9 @@ void check_homing(Section& s, const AxisProfile& a) {
 void check_resolution(Section& s, const AxisProfile& a) {
   const std::string_view resolution_key =
       a.drive == JointDrive::Servo ? "encoder_counts_per_unit" : "steps_per_unit";
-  if (s.has(resolution_key) && a.counts_per_unit > 0 && 1 / a.counts_per_unit > a.max_following_error / 4) {
+  if (s.has(resolution_key) && a.counts_per_unit > 0 && 1 / a.counts_per_unit > a.max_following_error) {
     s.error(resolution_key,
-            fmt::format("{} = {} is no plausible value: one count ({} {}) must be finer than a quarter of "
+            fmt::format("{} = {} is no plausible value: one count ({} {}) must be finer than "
                         "max_following_error ({} {})",
                         s.key_path(resolution_key), show(a.counts_per_unit), show(1 / a.counts_per_unit),
                         a.rotary ? "deg" : "mm", show(a.max_following_error), a.rotary ? "deg" : "mm"),

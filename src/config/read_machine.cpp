@@ -290,7 +290,8 @@ void read_interpreter(Section& top, MachineProfile& profile, const std::filesyst
   const toml::table* t = top.subtable("interpreter");
   if (t == nullptr) return;
   Section s(*t, "interpreter",
-            {"dialect", "machine", "axis_map", "subroutine_path", "tool_table", "readahead_moves", "readahead_s"},
+            {"dialect", "machine", "axis_map", "subroutine_path", "tool_table", "readahead_moves", "readahead_s",
+             "max_scan_s"},
             top.reporter());
   InterpreterOptions& o = profile.interpreter;
   o.dialect =
@@ -327,6 +328,7 @@ void read_interpreter(Section& top, MachineProfile& profile, const std::filesyst
   }
   o.readahead_moves = static_cast<int>(s.integer("readahead_moves", 1, 10'000'000).value_or(o.readahead_moves));
   o.readahead_s = s.number_or("readahead_s", o.readahead_s, Bound::Positive);
+  o.max_scan_s = s.number_or("max_scan_s", o.max_scan_s, Bound::Positive);
 }
 
 void read_planner(Section& top, MachineProfile& profile) {

@@ -134,6 +134,14 @@ bool make_arc(const Pose& start, const Pose& end, const canon::ArcGeometry& arc,
   Vec3 rs = sub3(s3, c);
   rs = sub3(rs, mul3(dot3(rs, n), n));
   const double r = std::sqrt(dot3(rs, rs));
+  {
+    // An arc whose circle is smaller than a nanometre at both ends (which the interpreter, as
+    // LinuxCNC's, accepts) is its chord to within that nanometre: run it as a line rather than
+    // refuse at run time what the check passed.
+    Vec3 re = sub3(e3, c);
+    re = sub3(re, mul3(dot3(re, n), n));
+    if (r < kPointArcMm && std::sqrt(dot3(re, re)) < kPointArcMm) return make_line(start, end, out);
+  }
   if (!(r >= 1e-9)) {
     error = "the arc's start point lies on its centre (radius zero)";
     return false;
