@@ -385,6 +385,11 @@ int run(const std::string& action, ToolsOptions o) {
     return fail("name the tool store: --db FILE (or --machine PROFILE with a [tool_guard])", kExitUsage);
   const bool writes = action == "set" || action == "import" || action == "backup" || action == "accept" ||
                       action == "restore";
+  // An import whose source cannot be read creates no store.
+  if (action == "import" && o.words.size() == 1) {
+    if (const std::string why = unreadable_input(o.words[0]); !why.empty())
+      return fail(fmt::format("cannot read {}: {}", o.words[0], why), kExitUsage);
+  }
   const auto s = open_store(o, writes);
   if (!s) return kExitUsage;
   if (action == "list") return list(*s, o);
