@@ -107,6 +107,22 @@ TEST(Server, EveryRefusedTokenIsAuditedOnGetCallsToo) {
   EXPECT_EQ(refused, 3) << audit.dump(1);
 }
 
+// The second hostile probe (issue 29): a comment with a newline wrote a line the interpreter read
+// as a tool; 100 KB comments and control characters were written verbatim.
+TEST(Server, AToolCommentIsOneBoundedLine) {
+  ServerRig rig(mill());
+  const json before = get(rig.port, "/api/v1/tools", kOperator).body;
+  for (const std::string comment : {std::string("x\nT99 P99 Z-1000 D1"), std::string("a\r\u0000b"),
+                                    std::string(100000, 'x')}) {
+    const json body = {{"kind", "set-tool"}, {"tool", 1}, {"comment", comment}};
+    const Reply r = post(rig.port, body.dump(), kAdmin);
+    EXPECT_EQ(r.status, 422) << r.text;
+  }
+  EXPECT_EQ(get(rig.port, "/api/v1/tools", kOperator).body, before);
+  const Reply ok = post(rig.port, R"({"kind":"set-tool","tool":1,"comment":"end mill 6 mm, new"})", kAdmin);
+  EXPECT_EQ(ok.status, 200) << ok.text;
+}
+
 TEST(Server, ToolDataIsTheAdminsAndEveryChangeIsAudited) {
   ServerRig rig(mill());
   const std::string change = R"({"kind":"set-tool","tool":1,"diameter":6.02})";
