@@ -112,7 +112,7 @@ TEST(Server, EveryRefusedTokenIsAuditedOnGetCallsToo) {
 TEST(Server, AToolCommentIsOneBoundedLine) {
   ServerRig rig(mill());
   const json before = get(rig.port, "/api/v1/tools", kOperator).body;
-  for (const std::string comment : {std::string("x\nT99 P99 Z-1000 D1"), std::string("a\r\u0000b"),
+  for (const std::string& comment : {std::string("x\nT99 P99 Z-1000 D1"), std::string("a\r\0b", 4),
                                     std::string(100000, 'x')}) {
     const json body = {{"kind", "set-tool"}, {"tool", 1}, {"comment", comment}};
     const Reply r = post(rig.port, body.dump(), kAdmin);
