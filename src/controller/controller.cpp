@@ -486,10 +486,6 @@ void Controller::forward(std::uint64_t id, const Command& command) {
 
 // --- long work -------------------------------------------------------------------------------
 
-bool Controller::busy_with_long_work() const noexcept {
-  return long_.has_value();
-}
-
 void Controller::run_long(std::uint64_t id, std::function<void()> work, std::function<void()> then) {
   auto failure = std::make_shared<std::string>();
   long_ = LongRequest{id, handling_seq_, std::move(then), failure};
