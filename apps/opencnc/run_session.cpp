@@ -16,7 +16,6 @@
 #include <fmt/format.h>
 
 #include "commands.hpp"
-#include "opencnc/core/atomic_file.hpp"
 #include "opencnc/config/profile_loader.hpp"
 #include "opencnc/control/clock.hpp"
 #include "opencnc/control/servo.hpp"
@@ -25,6 +24,7 @@
 #include "opencnc/controller/hal_link.hpp"
 #include "opencnc/controller/servo_setup.hpp"
 #include "opencnc/controller/sim_rig.hpp"
+#include "opencnc/core/atomic_file.hpp"
 #include "opencnc/toolguard/tool_guard.hpp"
 #include "stop_signals.hpp"
 
@@ -466,7 +466,8 @@ void follow(Driver& d, control::EventCursor& cursor, const SessionOptions& o, co
           end.fault =
               fmt::format("stopped by {} (feed hold on the path, then abort)", signal_name(end.stopped_by));
         else if (end.over_max_time)
-          end.fault = fmt::format("stopped by --max-time {:g} s (feed hold on the path, then abort)", o.max_time_s);
+          end.fault =
+              fmt::format("stopped by --max-time {:g} s (feed hold on the path, then abort)", o.max_time_s);
         else
           end.fault = fmt::format("the program ended: {}", control::to_string(ended->end));
         if (st.fault_text.empty()) fmt::print(stderr, "error: {}\n", end.fault);

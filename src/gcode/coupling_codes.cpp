@@ -39,8 +39,9 @@ class CouplingCodes final : public CodeHandler {
         if (!b.has('p') || std::fabs(b.get('p')) < 1e-4 || !std::isfinite(b.get('p')))
           return Rejection{
               ErrorCode::CouplingWord,
-              fmt::format("M{} needs the pitch per revolution as P, at least 0.0001 mm (negative: a left-hand helix)",
-                          code)};
+              fmt::format(
+                  "M{} needs the pitch per revolution as P, at least 0.0001 mm (negative: a left-hand helix)",
+                  code)};
         if (code == kLinear && !b.has('q'))
           return Rejection{
               ErrorCode::CouplingWord,
