@@ -34,12 +34,13 @@ bool bad(double v) {
   return !std::isfinite(v);
 }
 
-/// Moving-average length in servo periods: long enough that 2·A/T ≤ (1 − η)·J on every axis.
+/// Moving-average length in servo periods: T ≥ A/J on every axis, so that an acceleration ramp of
+/// the average from 0 to A takes its jerk to J at most (the time-optimal ramp when T = A/J).
 int filter_ticks(const MachineLimits& m, const PlannerConfig& c) {
   double t = 0;
   for (int i = 0; i < kAxisCount; ++i) {
     if (!m.axes.has(static_cast<Axis>(i)) || m[i].max_jerk <= 0) continue;
-    t = std::max(t, 2.0 * m[i].max_acceleration / ((1.0 - c.jerk_step_share) * m[i].max_jerk));
+    t = std::max(t, m[i].max_acceleration / m[i].max_jerk);
   }
   if (t <= 0) return 1;
   return std::max(2, static_cast<int>(std::ceil(t / c.servo_period_s - 1e-9)));
@@ -174,10 +175,9 @@ void Planner::Impl::emit_path(const MotionBlock& block, double junction) {
   b = block;
   detail::rebase(b, last_end);
   if (b.length < detail::kMinLength) return;
-  const detail::RawLimits r = detail::block_limits(b, commanded_max(b), params);
-  if (b.feed_class == FeedClass::Rapid) b.feed = r.cap;
-  pb.cap_raw = r.cap;
-  pb.accel_raw = r.accel;
+  pb.v_max = commanded_max(b);
+  pb.raw = detail::block_limits(b, pb.v_max, params);
+  if (b.feed_class == FeedClass::Rapid) b.feed = pb.raw.cap;
   pb.junction = junction;
   if (params.filter_s > 0) {  // the curvature steps matter with jerk limits only
     if (continues && junction > 0) pb.step = detail::curvature_step(prev, b);
@@ -340,6 +340,12 @@ traj::InterpolatorConfig Planner::interpolator_config() const noexcept {
   c.period_s = impl_->config.servo_period_s;
   c.filter_ticks = impl_->ticks;
   c.max_feed_override = impl_->config.max_feed_override;
+  // No block's budget exceeds a line's in the best direction: √(Σ A_i²).
+  for (int i = 0; i < kAxisCount; ++i) {
+    if (impl_->limits.axes.has(static_cast<Axis>(i)))
+      c.max_path_accel += impl_->limits[i].max_acceleration * impl_->limits[i].max_acceleration;
+  }
+  c.max_path_accel = std::sqrt(c.max_path_accel);
   return c;
 }
 
@@ -394,9 +400,13 @@ bool Planner::Impl::begin(const canon::Program& program, bool stream) {
   m.reader.emplace(program, stream);
   detail::WindowParams wp;
   wp.filter_s = m.params.filter_s;
+  wp.period_s = m.config.servo_period_s;
+  wp.limits = &m.params;
+  double a_min = kInf;
   for (int i = 0; i < kAxisCount; ++i) {
     if (!m.limits.axes.has(static_cast<Axis>(i))) continue;
     const AxisLimits& l = m.limits[i];
+    a_min = std::min(a_min, l.max_acceleration);
     wp.v_bound += l.max_velocity * l.max_velocity;
     if (wp.filter_s > 0 && l.max_jerk > 0) {
       wp.step_budget[static_cast<std::size_t>(i)] =
@@ -405,6 +415,10 @@ bool Planner::Impl::begin(const canon::Program& program, bool stream) {
   }
   wp.v_bound = std::sqrt(wp.v_bound);
   wp.step_window_s = 3.0 * wp.v_bound * m.config.servo_period_s;
+  // The look-ahead never limits the speed: the window may hold the braking distance from the
+  // highest speed at the lowest acceleration, beyond the blocks still settling.
+  wp.soft_blocks = 2 * m.config.lookahead_moves + 16;
+  wp.soft_length = wp.v_bound * wp.v_bound / (2 * a_min) + wp.v_bound * (0.5 * wp.filter_s + 4 * wp.period_s);
   m.window.emplace(wp);
   m.reading_done = false;
   m.pending.reset();
@@ -441,7 +455,6 @@ PlanStatus Planner::pump(traj::BlockQueue& queue) {
   Impl& m = *impl_;
   if (m.failed || m.program == nullptr) return PlanStatus::Failed;
   detail::Lookahead& w = *m.window;
-  const std::size_t max_window = 2 * m.config.lookahead_moves + 16;
   for (;;) {
     while (queue.free_slots() > 0 && w.publishable() > 0 && w.front_link_decided()) m.publish_front(queue);
     if (queue.free_slots() == 0) return PlanStatus::Working;
@@ -458,7 +471,7 @@ PlanStatus Planner::pump(traj::BlockQueue& queue) {
       if (!m.flush_asked) return PlanStatus::Working;
       m.input_waiting = false;
     }
-    if (w.size() >= max_window) {
+    if (!w.wants_more()) {
       // The window is full and nothing is final: publish the front with the entry speed it
       // has (a stop at the window's end is assumed, so it is on the safe side).
       if (w.settled() == 0) return PlanStatus::Working;
@@ -467,7 +480,7 @@ PlanStatus Planner::pump(traj::BlockQueue& queue) {
     }
     // Read a batch before looking for final blocks again: the backward pass then runs once
     // per batch instead of once per block.
-    for (int i = 0; i < 64 && w.size() < max_window; ++i) {
+    for (int i = 0; i < 64 && w.wants_more(); ++i) {
       if (!m.read_one()) {
         m.out_of_input();
         break;

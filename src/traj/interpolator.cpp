@@ -47,6 +47,9 @@ void Interpolator::restart(const Pose& start) noexcept {
   still_ticks_ = config_.filter_ticks;
   history_.fill(0.0);
   history_pos_ = 0;
+  acc_lo_.fill(0.0);
+  acc_hi_.fill(0.0);
+  period_lo_ = period_hi_ = 0;
   hold_ = aborting_ = waiting_ = false;
   released_seq_ = stop_seq_ = kNoBlock;
   step_from_seq_ = 0;
@@ -59,6 +62,15 @@ void Interpolator::restart(const Pose& start) noexcept {
   tap_locked_ = tap_reverse_ = false;
   tap_depth_ = tap_v_ = tap_lag_ = tap_rev0_ = tap_revs_ = 0;
   tap_dir_ = 1;
+}
+
+// The largest budget a coast toward a limit at the start of block `q_index` may cross.
+double Interpolator::coast_budget(std::size_t q_index) const noexcept {
+  const std::size_t u = index_of(u_seq_);
+  const std::size_t k = q_index > u ? q_index - u : 0;  // blocks u … q_index − 1
+  if (k == 0) return 0;
+  const double a = k <= static_cast<std::size_t>(coast_count_) ? coast_max_[k - 1] : coast_beyond_;
+  return a * coast_scale_;
 }
 
 double Interpolator::target_speed(const TickInput& in, const MotionBlock& b) const noexcept {
@@ -88,11 +100,62 @@ void Interpolator::handle_commands(const TickInput& in) noexcept {
   if (!in.single_block) stop_seq_ = kNoBlock;
 }
 
+// With jerk limits the commanded position is the average of the generator's over the last T, so
+// its jerk is (a(t) − a(t − T))/T: each acceleration of this period stays within Δ = J·T of those
+// of the period a window earlier (J the jerk budget where the commanded position is). After
+// accelerating, the generator therefore may not brake fully until that period has left the window
+// (at worst it coasts): the braking limits allow for that coast (docs/planner.md, "Jerk").
+Interpolator::Turn Interpolator::turn_bounds(const TickInput& in) noexcept {
+  Turn t;
+  const int m = config_.filter_ticks;
+  if (m <= 1) return t;
+  const std::size_t avail = queue_->available();
+  double jerk = 0;
+  for (std::size_t i = index_of(f_seq_), n = 0; i < avail && n < 8; ++i, ++n) {
+    const MotionBlock& b = queue_->peek(i);
+    if (b.kind == BlockKind::Marker) continue;
+    jerk = b.jerk;
+    break;
+  }
+  if (jerk <= 0) return t;
+  t.active = true;
+  const double T = m * config_.period_s;
+  t.delta = jerk * T * (aborting_ ? std::max(1.0, in.abort_decel_scale) : 1.0);
+  const auto slot = [&](int k) { return static_cast<std::size_t>((history_pos_ + k) % m); };
+  t.lo_old = acc_hi_[slot(0)];
+  t.hi_old = acc_lo_[slot(0)];
+  int last = 0;
+  for (int k = 1; k < m; ++k) {
+    if (acc_hi_[slot(k)] > 0) last = k;
+  }
+  t.coast_hist = last * config_.period_s;
+  t.coast_full = m * config_.period_s;
+  // The largest budget over the path a coast may cover before each block (the braking toward a
+  // limit at block k coasts over blocks before k only): prefix maxima from the generator's block,
+  // as far as a coast can reach; beyond a scan cut short, the planner's bound.
+  const std::size_t u = index_of(u_seq_);
+  const double a_cur = u < avail ? queue_->peek(u).accel : 0.0;
+  const double reach = 2.0 * (v_u_ + a_cur * config_.period_s) * (config_.period_s + t.coast_full) + kSnap;
+  double covered = -(s_u_ - u_start_), running = 0;
+  std::size_t i = u;
+  int n = 0;
+  for (; i < avail && n < kCoastScan && covered < reach; ++i, ++n) {
+    const MotionBlock& b = queue_->peek(i);
+    running = std::max(running, b.accel);
+    coast_max_[static_cast<std::size_t>(n)] = running;
+    covered += b.length;
+  }
+  coast_count_ = n;
+  coast_beyond_ = i < avail && covered < reach ? config_.max_path_accel : running;
+  coast_scale_ = aborting_ ? std::max(1.0, in.abort_decel_scale) : 1.0;
+  return t;
+}
+
 // One piece of constant acceleration inside block `b` (at queue index `index`): chooses the
 // acceleration from the target speed and every braking limit, then moves until the block end or
 // the end of the period.
-void Interpolator::step_piece(const TickInput& in, const MotionBlock& b, std::size_t index, double& tau,
-                              double& integral) noexcept {
+void Interpolator::step_piece(const TickInput& in, const MotionBlock& b, std::size_t index, const Turn& turn,
+                              double& tau, double& integral) noexcept {
   const std::size_t avail = queue_->available();
   const double x = s_u_ - u_start_;
   const double rem = b.length - x;
@@ -109,28 +172,36 @@ void Interpolator::step_piece(const TickInput& in, const MotionBlock& b, std::si
   const bool follow = b.feed_class == FeedClass::SpindleSync && !aborting_;
   if (follow) a = sync_acceleration(b, tau);
   const double a_follow = a;
-  const auto limit = [&](double K, bool at_block_end, double vq) {
-    const double ve = end_speed_limit(K, v, A, tau);
-    double aq;
-    if (ve >= 0) {
-      aq = (ve - v) / tau;
-    } else if (at_block_end && rem > 0) {
-      aq = (vq * vq - v * v) / (2.0 * rem);  // reach vq exactly at the block end
-    } else {
-      aq = -A;
+  // Braking limits: the largest acceleration with which each stays reachable, if this period
+  // accelerates (the full coast after it) and if it does not (the coast the history asks for).
+  double a_full = A, a_hist = A;
+  const auto limit = [&](double K, std::size_t q_index, double vq) {
+    const bool at_block_end = q_index == index + 1;
+    const auto bound = [&](double coast) {
+      const double ve = end_speed_limit(K, v, A, tau, coast, coast_budget(q_index));
+      if (ve >= 0) return (ve - v) / tau;
+      if (at_block_end && rem > 0)
+        return (vq * vq - v * v) / (2.0 * rem);  // reach vq exactly at the block end
+      return -A;
+    };
+    if (!turn.active) {
+      a_full = std::min(a_full, bound(0));
+      return;
     }
-    a = std::min(a, aq);
+    a_full = std::min(a_full, bound(turn.coast_full));
+    // A piece earlier in this period that accelerated has committed it already.
+    a_hist = std::min(a_hist, bound(period_hi_ > 0 ? turn.coast_full : turn.coast_hist));
   };
 
   // The next junction: the planner's backward pass holds every later hard limit in v_entry.
   if (index + 1 < avail) {
     const double e = queue_->peek(index + 1).v_entry;
-    limit(e * e + 2.0 * A * rem, true, e);
+    limit(e * e + 2.0 * A * rem, index + 1, e);
   }
   // The end of the queued data: stopping there must stay possible.
   {
     const MotionBlock& last = queue_->peek(avail - 1);
-    limit(last.brake_prefix + 2.0 * last.accel * last.length - c_s, index + 1 == avail, 0.0);
+    limit(last.brake_prefix + 2.0 * last.accel * last.length - c_s, avail, 0.0);
   }
   // Lower nominal speeds further on (override-dependent, so checked here rather than planned).
   const double reach_bound = (v + A * tau) * (v + A * tau);
@@ -143,19 +214,31 @@ void Interpolator::step_piece(const TickInput& in, const MotionBlock& b, std::si
     if (reach >= reach_bound) break;  // later points have a larger reach still
     if (q.kind != BlockKind::Marker) {
       const double vq = target_speed(in, q);
-      limit(vq * vq + reach, ci == index + 1, vq);
+      limit(vq * vq + reach, ci, vq);
     }
     c = q.next_soft;
   }
   // A committed single-block stop.
   if (stop_seq_ != kNoBlock && stop_seq_ > b.seq) {
     const std::size_t si = index_of(stop_seq_);
-    if (si < avail) limit(queue_->peek(si).brake_prefix - c_s, si == index + 1, 0.0);
+    if (si < avail) limit(queue_->peek(si).brake_prefix - c_s, si, 0.0);
+  }
+  if (turn.active) {
+    // Within Δ of the acceleration a window earlier (0 is always allowed: the planner keeps
+    // every budget within Δ), and no positive acceleration unless braking stays possible
+    // after the full coast it commits to.
+    const double lo = std::min(0.0, turn.lo_old - turn.delta), hi = std::max(0.0, turn.hi_old + turn.delta);
+    a = std::clamp(a, std::max(a_min, lo), std::min(A, hi));
+    a = std::min(a, a_full > 0 ? a_full : std::min(a_hist, 0.0));
+  } else {
+    a = std::min(a, a_full);
   }
   a = std::clamp(a, a_min, A);
   // Braking for a limit ahead (the end of the thread): the motion leaves the spindle.
   if (follow && sync_ == Sync::Locked && a < a_follow - 1e-9 * A) sync_ = Sync::CatchUp;
 
+  period_lo_ = std::min(period_lo_, a);
+  period_hi_ = std::max(period_hi_, a);
   double t = tau;
   bool stops = false;
   if (a < 0 && v + a * tau <= 0) {
@@ -236,6 +319,8 @@ double Interpolator::advance_unfiltered(const TickInput& in) noexcept {
   double tau = config_.period_s, integral = 0;
   const double s_before = s_u_;
   const std::size_t avail = queue_->available();
+  const Turn turn = turn_bounds(in);
+  period_lo_ = period_hi_ = 0;
   for (int i = 0; i < kMaxPieces && tau > 0; ++i) {
     const std::size_t index = index_of(u_seq_);
     if (index >= avail || u_seq_ == stop_seq_) {
@@ -265,7 +350,7 @@ double Interpolator::advance_unfiltered(const TickInput& in) noexcept {
       break;
     }
     if (b.feed_class == FeedClass::SpindleSync && (sync_ == Sync::Off || sync_ == Sync::WaitIndex)) break;
-    step_piece(in, b, index, tau, integral);
+    step_piece(in, b, index, turn, tau, integral);
   }
   if (tau > 0) integral += s_u_ * tau;
   still_ticks_ = (s_u_ == s_before && v_u_ == 0) ? still_ticks_ + 1 : 0;
@@ -276,6 +361,8 @@ double Interpolator::filter(double integral) noexcept {
   const int m = config_.filter_ticks;
   if (m <= 1) return s_u_;
   history_[static_cast<std::size_t>(history_pos_)] = integral;
+  acc_lo_[static_cast<std::size_t>(history_pos_)] = period_lo_;
+  acc_hi_[static_cast<std::size_t>(history_pos_)] = period_hi_;
   history_pos_ = history_pos_ + 1 == m ? 0 : history_pos_ + 1;
   if (still_ticks_ >= m) return s_u_;  // the window holds only the resting position
   double sum = 0;
