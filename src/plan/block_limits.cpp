@@ -118,26 +118,6 @@ RawLimits arc_or_spiral_limits(const MotionBlock& b, double v_max, const LimitPa
   return r;
 }
 
-/// Per-axis bounds of |g'|, |g''|, |g'''| of a Bézier block from its control polygon (the
-/// derivative of a Bézier is the Bézier of the differences, inside their convex hull).
-void polygon_bounds(const MotionBlock& b, double d1[kAxisCount], double d2[kAxisCount],
-                    double d3[kAxisCount]) {
-  const double L = b.length;
-  const int n = b.kind == BlockKind::Quintic ? 5 : 3;
-  for (int i = 0; i < kAxisCount; ++i) {
-    double c[6];
-    for (int k = 0; k <= n; ++k) c[k] = traj::detail::quintic_point(b, k)[i];  // base, u, w, lin(, p4, p5)
-    double m1 = 0, m2 = 0, m3 = 0;
-    for (int k = 0; k + 1 <= n; ++k) m1 = std::max(m1, std::fabs(c[k + 1] - c[k]));
-    for (int k = 0; k + 2 <= n; ++k) m2 = std::max(m2, std::fabs(c[k + 2] - 2 * c[k + 1] + c[k]));
-    for (int k = 0; k + 3 <= n; ++k)
-      m3 = std::max(m3, std::fabs(c[k + 3] - 3 * c[k + 2] + 3 * c[k + 1] - c[k]));
-    d1[i] = n * m1 / L;
-    d2[i] = n * (n - 1) * m2 / (L * L);
-    d3[i] = n * (n - 1) * (n - 2) * m3 / (L * L * L);
-  }
-}
-
 // Cubic or quintic Bézier at t = s/L, with the polygon bounds D1, D2, D3 per axis:
 //   |ẋ| ≤ D1·v,  |ẍ| ≤ D1·|a| + D2·v²,  |x⃛| ≤ D1·|j| + 3·D2·v·|a| + D3·v³.
 RawLimits bezier_limits(const MotionBlock& b, double v_max, const LimitParams& p, double jerk_scale) {
@@ -174,6 +154,25 @@ RawLimits bezier_limits(const MotionBlock& b, double v_max, const LimitParams& p
 }
 
 }  // namespace
+
+// The derivative of a Bézier is the Bézier of the differences, inside their convex hull.
+void polygon_bounds(const MotionBlock& b, double d1[kAxisCount], double d2[kAxisCount],
+                    double d3[kAxisCount]) noexcept {
+  const double L = b.length;
+  const int n = b.kind == BlockKind::Quintic ? 5 : 3;
+  for (int i = 0; i < kAxisCount; ++i) {
+    double c[6];
+    for (int k = 0; k <= n; ++k) c[k] = traj::detail::quintic_point(b, k)[i];  // base, u, w, lin(, p4, p5)
+    double m1 = 0, m2 = 0, m3 = 0;
+    for (int k = 0; k + 1 <= n; ++k) m1 = std::max(m1, std::fabs(c[k + 1] - c[k]));
+    for (int k = 0; k + 2 <= n; ++k) m2 = std::max(m2, std::fabs(c[k + 2] - 2 * c[k + 1] + c[k]));
+    for (int k = 0; k + 3 <= n; ++k)
+      m3 = std::max(m3, std::fabs(c[k + 3] - 3 * c[k + 2] + 3 * c[k + 1] - c[k]));
+    d1[i] = n * m1 / L;
+    d2[i] = n * (n - 1) * m2 / (L * L);
+    d3[i] = n * (n - 1) * (n - 2) * m3 / (L * L * L);
+  }
+}
 
 RawLimits block_limits(const MotionBlock& b, double v_commanded_max, const LimitParams& p,
                        double jerk_scale) noexcept {

@@ -280,6 +280,27 @@ void split_bezier(const MotionBlock& b, double t, MotionBlock* head, MotionBlock
   }
 }
 
+// The same for a quintic (de Casteljau on six points).
+void split_quintic(const MotionBlock& b, double t, MotionBlock* head, MotionBlock* tail) {
+  Pose q[6] = {b.base, b.u, b.w, b.lin, b.p4, b.p5};
+  Pose left[6], right[6];
+  for (int level = 0; level < 6; ++level) {
+    left[level] = q[0];
+    right[5 - level] = q[5 - level];
+    for (int k = 0; k + level < 5; ++k) q[k] = q[k] + t * (q[k + 1] - q[k]);
+  }
+  if (head != nullptr) {
+    head->base = left[0], head->u = left[1], head->w = left[2], head->lin = left[3], head->p4 = left[4];
+    head->p5 = left[5];
+    head->length = b.length * t;
+  }
+  if (tail != nullptr) {
+    tail->base = right[0], tail->u = right[1], tail->w = right[2], tail->lin = right[3], tail->p4 = right[4];
+    tail->p5 = right[5];
+    tail->length = b.length * (1 - t);
+  }
+}
+
 }  // namespace
 
 void trim_start(MotionBlock& b, double d) noexcept {
@@ -287,6 +308,10 @@ void trim_start(MotionBlock& b, double d) noexcept {
   b.segment_offset += d;
   if (b.kind == BlockKind::Bezier) {
     split_bezier(b, d / b.length, nullptr, &b);
+    return;
+  }
+  if (b.kind == BlockKind::Quintic) {
+    split_quintic(b, d / b.length, nullptr, &b);
     return;
   }
   const Pose p = traj::position_at(b, d);
@@ -308,6 +333,10 @@ void trim_end(MotionBlock& b, double d) noexcept {
   if (d <= 0) return;
   if (b.kind == BlockKind::Bezier) {
     split_bezier(b, (b.length - d) / b.length, &b, nullptr);
+    return;
+  }
+  if (b.kind == BlockKind::Quintic) {
+    split_quintic(b, (b.length - d) / b.length, &b, nullptr);
     return;
   }
   b.length -= d;
@@ -536,6 +565,113 @@ bool bezier_blend(const MotionBlock& in, double avail_in, const MotionBlock& out
 }
 
 }  // namespace
+
+JoinPoint join_at(const MotionBlock& b, double s) noexcept {
+  return {traj::position_at(b, s), traj::tangent_at(b, s), traj::curvature_at(b, s)};
+}
+
+namespace {
+
+/// Control points of the G2 quintic for parameter length L.
+void g2_points(const JoinPoint& a, const JoinPoint& b, double L, MotionBlock& c) {
+  const double h = L / 5, k = L * L / 20;
+  c.base = a.p;
+  c.u = a.p + h * a.d1;
+  c.w = 2.0 * c.u - a.p + k * a.d2;
+  c.p5 = b.p;
+  c.p4 = b.p - h * b.d1;
+  c.lin = 2.0 * c.p4 - b.p + k * b.d2;
+  c.length = L;
+}
+
+/// Arc length of a quintic block (8-point Gauss-Legendre on two halves) and its smallest speed
+/// |dB/dt| among the nodes relative to L (a cusp makes it vanish).
+double quintic_arc_length(const MotionBlock& c, double& slowest) {
+  static constexpr double kNode[4] = {0.1834346424956498, 0.5255324099163290, 0.7966664774136267,
+                                      0.9602898564975363};
+  static constexpr double kWeight[4] = {0.3626837833783620, 0.3137066458778873, 0.2223810344533745,
+                                        0.1012285362903763};
+  double sum = 0;
+  slowest = 1e300;
+  for (int half = 0; half < 2; ++half) {
+    const double mid = 0.25 + 0.5 * half;
+    for (int q = 0; q < 4; ++q) {
+      for (int side = -1; side <= 1; side += 2) {
+        const double t = mid + side * 0.25 * kNode[q];
+        const double speed = norm(traj::tangent_at(c, t * c.length));  // |dB/dt| / L
+        slowest = std::min(slowest, speed);
+        sum += kWeight[q] * speed;
+      }
+    }
+  }
+  return 0.25 * sum * c.length;
+}
+
+}  // namespace
+
+bool make_g2_curve(const JoinPoint& a, const JoinPoint& b, MotionBlock& out) noexcept {
+  const double chord = norm(b.p - a.p);
+  if (!(chord >= kMinLength)) return false;
+  out.kind = BlockKind::Quintic;
+  out.omega = 0;
+  out.spiral = 0;
+  double L = chord;
+  for (int it = 0; it < 12; ++it) {
+    g2_points(a, b, L, out);
+    double slowest = 0;
+    const double next = quintic_arc_length(out, slowest);
+    if (!(slowest > 0.05) || !(next > 0)) return false;  // (nearly) a cusp: no useful curve
+    if (std::fabs(next - L) <= 1e-9 * L) {
+      L = next;
+      break;
+    }
+    L = next;
+  }
+  g2_points(a, b, L, out);
+  return std::isfinite(L) && L >= kMinLength;
+}
+
+bool blend_within(const MotionBlock& c, const MotionBlock& in, const MotionBlock& out,
+                  double tolerance) noexcept {
+  // The distance to any set is 1-Lipschitz, and the curve moves at most Lip·Δt in Δt, Lip the
+  // bound of |dB/dt| from the control polygon (5·max|ΔP|). Between parameters a and b the
+  // distance is at most min(d_a + Lip·(t − a), d_b + Lip·(b − t)) ≤ (d_a + d_b + Lip·(b − a))/2.
+  // Intervals whose bound exceeds the tolerance are halved until it holds, or a sample exceeds it
+  // (branch and bound: the work follows how close the curve comes to the tolerance).
+  const Pose q[6] = {c.base, c.u, c.w, c.lin, c.p4, c.p5};
+  double lip = 0;
+  for (int k = 0; k + 1 < 6; ++k) lip = std::max(lip, norm(q[k + 1] - q[k]));
+  lip *= 5;
+  const auto dist = [&](double t) {
+    const Pose p = traj::position_at(c, c.length * t);
+    return std::min(distance_to(in, p), distance_to(out, p));
+  };
+  constexpr int kStart = 16, kMaxSamples = 4096;
+  struct Span {
+    double a, b, da, db;
+  };
+  Span stack[64];
+  int top = 0, samples = kStart + 1;
+  const double prev = dist(0.0);
+  double da = prev;
+  for (int k = 1; k <= kStart; ++k) {
+    const double t0 = static_cast<double>(k - 1) / kStart, t1 = static_cast<double>(k) / kStart;
+    const double db = dist(t1);
+    if (db > tolerance) return false;
+    stack[top++] = {t0, t1, da, db};
+    while (top > 0) {
+      const Span s = stack[--top];
+      if (0.5 * (s.da + s.db + lip * (s.b - s.a)) <= tolerance) continue;
+      if (top + 2 > 64 || ++samples > kMaxSamples) return false;  // too close to call: not within
+      const double m = 0.5 * (s.a + s.b), dm = dist(m);
+      if (dm > tolerance) return false;
+      stack[top++] = {m, s.b, dm, s.db};
+      stack[top++] = {s.a, m, s.da, dm};
+    }
+    da = db;
+  }
+  return true;
+}
 
 CornerTurn corner_turn(const MotionBlock& in, const MotionBlock& out) noexcept {
   CornerTurn t;

@@ -80,4 +80,24 @@ bool blend_corner(const MotionBlock& in, double avail_in, const MotionBlock& out
 /// Distance from `p` to the block's curve (lines and arcs exact; others by sampling).
 double distance_to(const MotionBlock& b, const Pose& p) noexcept;
 
+/// A point of a path block with the first and second derivative there (dp/ds, d²p/ds²): what a
+/// curvature-continuous (G2) blend must match to keep every axis's acceleration continuous.
+struct JoinPoint {
+  Pose p{}, d1{}, d2{};
+};
+JoinPoint join_at(const MotionBlock& b, double s) noexcept;
+
+/// The quintic Bézier from `a` to `b` whose position, dp/ds and d²p/ds² at both ends are those of
+/// the join points, parameterised by its own length (so that |dp/ds| is about 1 all along):
+/// control points P0 = a.p, P1 = P0 + L/5·a.d1, P2 = 2P1 − P0 + L²/20·a.d2 and the mirror
+/// image at the end, L the fixed point of L = arc length(L). False when it has no such length or
+/// stops (a cusp). The caller sets identity, class and feed.
+bool make_g2_curve(const JoinPoint& a, const JoinPoint& b, MotionBlock& out) noexcept;
+
+/// Whether every point of the quintic `c` lies within `tolerance` of the nearer of `in` and
+/// `out` (proved by a Lipschitz bound between samples; "no" when too close to decide).
+/// Non-real-time.
+bool blend_within(const MotionBlock& c, const MotionBlock& in, const MotionBlock& out,
+                  double tolerance) noexcept;
+
 }  // namespace opencnc::plan::detail

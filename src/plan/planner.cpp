@@ -11,10 +11,7 @@
 
 #include <fmt/format.h>
 
-#include "block_limits.hpp"
-#include "lookahead.hpp"
-#include "path_geometry.hpp"
-#include "program_reader.hpp"
+#include "planner_impl.hpp"
 #include "vec.hpp"
 
 namespace opencnc::plan {
@@ -27,8 +24,6 @@ using traj::MarkerKind;
 using traj::MotionBlock;
 
 namespace {
-
-constexpr double kInf = std::numeric_limits<double>::infinity();
 
 bool bad(double v) {
   return !std::isfinite(v);
@@ -67,50 +62,6 @@ bool validate(const MachineLimits& limits, Diagnostics& diags) {
   }
   return ok;
 }
-
-struct Planner::Impl {
-  MachineLimits limits;
-  PlannerConfig config;
-  detail::LimitParams params;
-  int ticks = 1;
-  Diagnostics diags;
-  PlanStats stats;
-  bool config_ok = true;
-  bool failed = false;
-
-  const canon::Program* program = nullptr;
-  std::optional<detail::ProgramReader> reader;
-  std::optional<detail::Lookahead> window;
-  bool reading_done = false;
-  // Streams (start_stream): the program grows while it is planned.
-  bool streaming = false;
-  bool flush_asked = false;   ///< stream_flush(): plan what is readable to a stop
-  bool flushing = false;      ///< a flush is being published; reading waits until it is
-  bool input_waiting = false; ///< everything readable has been read
-  std::optional<Element> pending;          ///< last element; its end is decided by the next one
-  std::vector<MotionBlock> reports;        ///< Report markers waiting after `pending`
-  Pose last_end{};                         ///< exact end of the last emitted path block
-  bool continues = false;                  ///< `prev` runs on into the next path block (no stop)
-  MotionBlock prev;                        ///< the last emitted path block (with jerk limits)
-
-  Impl(const MachineLimits& l, const PlannerConfig& c);
-  void check_config();
-  void emit_path(const MotionBlock& b, double junction);
-  void emit_marker(const MotionBlock& m);
-  void emit_reports();
-  void publish_front(traj::BlockQueue& queue);
-  void on_element(Element& e);
-  void on_marker(const MotionBlock& m);
-  void flush_pending();
-  bool corner(Element& a, Element& e);
-  double commanded_max(const MotionBlock& b) const;
-  detail::BlendNeed blend_need(const MotionBlock& a, const MotionBlock& e) const;
-  bool blend_pays(const Element& a, const Element& e, const detail::Blend& blend) const;
-  bool read_one();
-  bool begin(const canon::Program& program, bool stream);
-  /// The reader has nothing for now: ends the program, a flush, or waits for input.
-  void out_of_input();
-};
 
 Planner::Impl::Impl(const MachineLimits& l, const PlannerConfig& c) : limits(l), config(c) {
   check_config();
@@ -175,12 +126,18 @@ void Planner::Impl::emit_path(const MotionBlock& block, double junction) {
   b = block;
   detail::rebase(b, last_end);
   if (b.length < detail::kMinLength) return;
-  pb.v_max = commanded_max(b);
+  pb.v_max = std::min(commanded_max(b), speed_bound());
   pb.raw = detail::block_limits(b, pb.v_max, params);
   if (b.feed_class == FeedClass::Rapid) b.feed = pb.raw.cap;
   pb.junction = junction;
   if (params.filter_s > 0) {  // the curvature steps matter with jerk limits only
     if (continues && junction > 0) pb.step = detail::curvature_step(prev, b);
+    // A step whose largest sampled jerk, (3/4)·v²·|Δg''|/T_servo, is far below the axis's limit
+    // is rounding (the joins of the curvature-continuous blends): none.
+    for (int i = 0; i < kAxisCount; ++i) {
+      const double j = limits[i].max_jerk;
+      if (j > 0 && 0.75 * v_bound * v_bound * pb.step[i] / config.servo_period_s <= 1e-7 * j) pb.step[i] = 0;
+    }
     prev = b;
   }
   continues = true;
@@ -212,7 +169,7 @@ void Planner::Impl::emit_reports() {
 
 /// The curve between two elements: returns true when it blended (or the corner is tangent), false
 /// when the motion has to stop at the corner. Emits `a` (trimmed) and the blend.
-bool Planner::Impl::corner(Element& a, Element& e) {
+bool Planner::Impl::corner_g1(Element& a, Element& e) {
   if (a.stop_after || a.mode == canon::MotionControl::ExactStop) return false;
   if ((a.b.feed_class == FeedClass::SpindleSync) != (e.b.feed_class == FeedClass::SpindleSync)) return false;
   const detail::CornerTurn turn = detail::corner_turn(a.b, e.b);
@@ -295,6 +252,7 @@ void Planner::Impl::on_element(Element& e) {
   if (pending) {
     e.junction = corner(*pending, e) ? kInf : 0.0;
     if (e.junction == 0) {  // no blend: `pending` ends with a stop at the corner
+      release_held();
       emit_path(pending->b, pending->junction);
       emit_reports();
     }
@@ -303,6 +261,7 @@ void Planner::Impl::on_element(Element& e) {
 }
 
 void Planner::Impl::flush_pending() {
+  release_held();
   if (pending) emit_path(pending->b, pending->junction);
   pending.reset();
   emit_reports();
@@ -346,6 +305,7 @@ traj::InterpolatorConfig Planner::interpolator_config() const noexcept {
       c.max_path_accel += impl_->limits[i].max_acceleration * impl_->limits[i].max_acceleration;
   }
   c.max_path_accel = std::sqrt(c.max_path_accel);
+  c.max_path_speed = impl_->speed_bound();
   return c;
 }
 
@@ -414,6 +374,7 @@ bool Planner::Impl::begin(const canon::Program& program, bool stream) {
     }
   }
   wp.v_bound = std::sqrt(wp.v_bound);
+  m.v_bound = wp.v_bound;
   wp.step_window_s = 3.0 * wp.v_bound * m.config.servo_period_s;
   // The look-ahead never limits the speed: the window may hold the braking distance from the
   // highest speed at the lowest acceleration, beyond the blocks still settling.
@@ -421,6 +382,8 @@ bool Planner::Impl::begin(const canon::Program& program, bool stream) {
   wp.soft_length = wp.v_bound * wp.v_bound / (2 * a_min) + wp.v_bound * (0.5 * wp.filter_s + 4 * wp.period_s);
   m.window.emplace(wp);
   m.reading_done = false;
+  m.g2 = m.params.filter_s > 0;
+  m.held.reset();
   m.pending.reset();
   m.reports.clear();
   m.last_end = program.start();

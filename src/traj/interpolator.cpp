@@ -50,6 +50,7 @@ void Interpolator::restart(const Pose& start) noexcept {
   acc_lo_.fill(0.0);
   acc_hi_.fill(0.0);
   period_lo_ = period_hi_ = 0;
+  commit_end_ = full_end_ = -1e300;
   hold_ = aborting_ = waiting_ = false;
   released_seq_ = stop_seq_ = kNoBlock;
   step_from_seq_ = 0;
@@ -62,15 +63,6 @@ void Interpolator::restart(const Pose& start) noexcept {
   tap_locked_ = tap_reverse_ = false;
   tap_depth_ = tap_v_ = tap_lag_ = tap_rev0_ = tap_revs_ = 0;
   tap_dir_ = 1;
-}
-
-// The largest budget a coast toward a limit at the start of block `q_index` may cross.
-double Interpolator::coast_budget(std::size_t q_index) const noexcept {
-  const std::size_t u = index_of(u_seq_);
-  const std::size_t k = q_index > u ? q_index - u : 0;  // blocks u … q_index − 1
-  if (k == 0) return 0;
-  const double a = k <= static_cast<std::size_t>(coast_count_) ? coast_max_[k - 1] : coast_beyond_;
-  return a * coast_scale_;
 }
 
 double Interpolator::target_speed(const TickInput& in, const MotionBlock& b) const noexcept {
@@ -130,24 +122,36 @@ Interpolator::Turn Interpolator::turn_bounds(const TickInput& in) noexcept {
   }
   t.coast_hist = last * config_.period_s;
   t.coast_full = m * config_.period_s;
-  // The largest budget over the path a coast may cover before each block (the braking toward a
-  // limit at block k coasts over blocks before k only): prefix maxima from the generator's block,
-  // as far as a coast can reach; beyond a scan cut short, the planner's bound.
+  // The budgets a coast may cross. If this period accelerates, the coast after it stays within
+  // (v + M·T_servo)·(T_servo + T) of the generator (M the planner's bound of every budget, the
+  // most v can gain in the period); the coasts the history asks for stay within the regions the
+  // accelerating periods committed to (commit_end_), which only shrink as the generator moves
+  // on. Over the region the largest budget, and M beyond the queued data or the scan (blocks
+  // that arrive later never raise it): a plan found feasible stays so.
   const std::size_t u = index_of(u_seq_);
-  const double a_cur = u < avail ? queue_->peek(u).accel : 0.0;
-  const double reach = 2.0 * (v_u_ + a_cur * config_.period_s) * (config_.period_s + t.coast_full) + kSnap;
-  double covered = -(s_u_ - u_start_), running = 0;
+  const double big =
+      config_.max_path_accel > 0 ? config_.max_path_accel : (u < avail ? queue_->peek(u).accel : 0.0);
+  full_end_ = s_u_ + (v_u_ + big * config_.period_s) * (config_.period_s + t.coast_full);
+  if (t.coast_hist <= 0) commit_end_ = -1e300;
+  const double hist_end = commit_end_;
+  double start = u_start_;
+  t.coast_accel_full = t.coast_accel_hist = 0;
   std::size_t i = u;
   int n = 0;
-  for (; i < avail && n < kCoastScan && covered < reach; ++i, ++n) {
-    const MotionBlock& b = queue_->peek(i);
-    running = std::max(running, b.accel);
-    coast_max_[static_cast<std::size_t>(n)] = running;
-    covered += b.length;
+  const double scan_end = std::max(full_end_, hist_end);  // the junctions within either are limits too
+  for (; i < avail && n < kCoastScan && start < scan_end; ++i, ++n) {
+    const double a = queue_->peek(i).accel;
+    if (start < full_end_) t.coast_accel_full = std::max(t.coast_accel_full, a);
+    if (start < hist_end) t.coast_accel_hist = std::max(t.coast_accel_hist, a);
+    start += queue_->peek(i).length;
   }
+  if (start < full_end_) t.coast_accel_full = std::max(t.coast_accel_full, big);
+  if (start < hist_end) t.coast_accel_hist = std::max(t.coast_accel_hist, big);
+  const double scale = aborting_ ? std::max(1.0, in.abort_decel_scale) : 1.0;
+  t.coast_accel_full *= scale;
+  t.coast_accel_hist *= scale;
   coast_count_ = n;
-  coast_beyond_ = i < avail && covered < reach ? config_.max_path_accel : running;
-  coast_scale_ = aborting_ ? std::max(1.0, in.abort_decel_scale) : 1.0;
+  coast_from_ = u_seq_;
   return t;
 }
 
@@ -172,25 +176,26 @@ void Interpolator::step_piece(const TickInput& in, const MotionBlock& b, std::si
   const bool follow = b.feed_class == FeedClass::SpindleSync && !aborting_;
   if (follow) a = sync_acceleration(b, tau);
   const double a_follow = a;
-  // Braking limits: the largest acceleration with which each stays reachable, if this period
-  // accelerates (the full coast after it) and if it does not (the coast the history asks for).
-  double a_full = A, a_hist = A;
+  // Braking limits: the largest acceleration with which each stays reachable. With jerk limits
+  // the generator may have to coast before it brakes; every limit then holds the same coast, so
+  // they are gathered as the lowest K, for a coast after this period if it accelerates (the full
+  // window) and if it does not (what the history asks for).
+  double a_full = A, k_min = 1e300;
   const auto limit = [&](double K, std::size_t q_index, double vq) {
-    const bool at_block_end = q_index == index + 1;
-    const auto bound = [&](double coast) {
-      const double ve = end_speed_limit(K, v, A, tau, coast, coast_budget(q_index));
-      if (ve >= 0) return (ve - v) / tau;
-      if (at_block_end && rem > 0)
-        return (vq * vq - v * v) / (2.0 * rem);  // reach vq exactly at the block end
-      return -A;
-    };
-    if (!turn.active) {
-      a_full = std::min(a_full, bound(0));
+    if (turn.active) {
+      k_min = std::min(k_min, K);
       return;
     }
-    a_full = std::min(a_full, bound(turn.coast_full));
-    // A piece earlier in this period that accelerated has committed it already.
-    a_hist = std::min(a_hist, bound(period_hi_ > 0 ? turn.coast_full : turn.coast_hist));
+    const double ve = end_speed_limit(K, v, A, tau);
+    double aq;
+    if (ve >= 0) {
+      aq = (ve - v) / tau;
+    } else if (q_index == index + 1 && rem > 0) {
+      aq = (vq * vq - v * v) / (2.0 * rem);  // reach vq exactly at the block end
+    } else {
+      aq = -A;
+    }
+    a_full = std::min(a_full, aq);
   };
 
   // The next junction: the planner's backward pass holds every later hard limit in v_entry.
@@ -198,13 +203,26 @@ void Interpolator::step_piece(const TickInput& in, const MotionBlock& b, std::si
     const double e = queue_->peek(index + 1).v_entry;
     limit(e * e + 2.0 * A * rem, index + 1, e);
   }
+  // Entry speeds assume braking can begin at once; a coast may carry the motion past the next
+  // junction, so every junction the coast can reach is a limit of its own (the first one beyond
+  // its reach holds every later one: its braking curve lies below theirs).
+  if (turn.active) {
+    const std::size_t last =
+        std::min(avail, index_of(coast_from_) + static_cast<std::size_t>(coast_count_) + 1);
+    for (std::size_t k = index + 2; k < last; ++k) {
+      const MotionBlock& q = queue_->peek(k);
+      limit(q.v_entry * q.v_entry + q.brake_prefix - c_s, k, q.v_entry);
+    }
+  }
   // The end of the queued data: stopping there must stay possible.
   {
     const MotionBlock& last = queue_->peek(avail - 1);
     limit(last.brake_prefix + 2.0 * last.accel * last.length - c_s, avail, 0.0);
   }
   // Lower nominal speeds further on (override-dependent, so checked here rather than planned).
-  const double reach_bound = (v + A * tau) * (v + A * tau);
+  // Points farther than any coast and braking from here can reach cannot bind.
+  double reach_bound = (v + A * tau) * (v + A * tau);
+  if (turn.active) reach_bound += 2.0 * turn.coast_accel_full * (v + A * tau) * (tau + turn.coast_full);
   std::uint64_t c = b.next_soft;
   for (int hop = 0; hop < kMaxSoftHops && c != kNoBlock && c > b.seq; ++hop) {
     const std::size_t ci = index_of(c);
@@ -224,6 +242,15 @@ void Interpolator::step_piece(const TickInput& in, const MotionBlock& b, std::si
     if (si < avail) limit(queue_->peek(si).brake_prefix - c_s, si, 0.0);
   }
   if (turn.active) {
+    // Braking: if this period accelerates it commits the full window; a piece earlier in this
+    // period that accelerated has committed it already.
+    const auto bound = [&](double coast, double a_coast) {
+      if (k_min >= 1e300) return A;
+      const double ve = end_speed_limit(k_min, v, A, tau, coast, a_coast);
+      return ve >= 0 ? (ve - v) / tau : -A;
+    };
+    a_full = bound(turn.coast_full, turn.coast_accel_full);
+    const double a_hist = period_hi_ > 0 ? a_full : bound(turn.coast_hist, turn.coast_accel_hist);
     // Within Δ of the acceleration a window earlier (0 is always allowed: the planner keeps
     // every budget within Δ), and no positive acceleration unless braking stays possible
     // after the full coast it commits to.
@@ -353,6 +380,8 @@ double Interpolator::advance_unfiltered(const TickInput& in) noexcept {
     step_piece(in, b, index, turn, tau, integral);
   }
   if (tau > 0) integral += s_u_ * tau;
+  if (turn.active && period_hi_ > 0)
+    commit_end_ = std::max(commit_end_, full_end_);  // the coast it commits to
   still_ticks_ = (s_u_ == s_before && v_u_ == 0) ? still_ticks_ + 1 : 0;
   return integral;
 }
@@ -376,7 +405,8 @@ void Interpolator::advance_filtered(TickOutput& out) noexcept {
     const std::size_t index = index_of(f_seq_);
     if (index >= avail || f_seq_ >= u_seq_) break;  // never ahead of the generator's block
     const MotionBlock& b = queue_->peek(index);
-    if (s_f_ < f_start_ + b.length - (b.kind == BlockKind::Marker ? 0.0 : kSnap)) break;
+    // Exactly: a commanded position put on the next block early would jump by the difference.
+    if (s_f_ < f_start_ + b.length) break;
     f_start_ += b.length;
     ++f_seq_;
   }
@@ -483,6 +513,7 @@ void Interpolator::pop_and_rebase() noexcept {
   u_start_ -= shift;
   s_f_ -= shift;
   f_start_ -= shift;
+  commit_end_ -= shift;
   sync_target_ -= shift;
   const double shift_dt = shift * config_.period_s;
   for (int i = 0; i < config_.filter_ticks; ++i) history_[static_cast<std::size_t>(i)] -= shift_dt;

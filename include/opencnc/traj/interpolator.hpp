@@ -24,6 +24,8 @@ struct InterpolatorConfig {
   /// The largest acceleration budget any block may have (s-units/s²): bounds the braking a
   /// jerk-limited generator loses while it may not yet turn its acceleration round.
   double max_path_accel = 0;
+  /// The largest speed along s any block may have (s-units/s): how far such a coast may reach.
+  double max_path_speed = 0;
 };
 
 /// Inputs sampled once per tick. Levels stay as long as the condition holds; `cycle_start`,
@@ -136,11 +138,12 @@ class Interpolator {
     double hi_old = 0;
     double coast_hist = 0;  ///< time after this period before full braking is allowed (history)
     double coast_full = 0;  ///< the same if this period accelerates
+    double coast_accel_hist = 0;  ///< the largest budget either coast may cross
+    double coast_accel_full = 0;
   };
   void handle_commands(const TickInput& in) noexcept;
   double advance_unfiltered(const TickInput& in) noexcept;
   Turn turn_bounds(const TickInput& in) noexcept;
-  double coast_budget(std::size_t q_index) const noexcept;
   void step_piece(const TickInput& in, const MotionBlock& b, std::size_t index, const Turn& turn, double& tau,
                   double& integral) noexcept;
   void commit_single_block_stop(std::size_t available) noexcept;
@@ -187,12 +190,14 @@ class Interpolator {
   // jerk budget × T of the one a window earlier keeps the commanded jerk within it.
   std::array<double, kMaxFilterTicks> acc_lo_{}, acc_hi_{};
   double period_lo_ = 0, period_hi_ = 0;  ///< this period's
-  // This tick: the largest budget over the blocks from the generator's to each of the next ones,
-  // as far as a coast before braking can reach (turn_bounds), and beyond them.
+  // This tick: the blocks from the generator's as far as a coast before braking can reach
+  // (turn_bounds): how many, from which.
   static constexpr int kCoastScan = 256;
-  std::array<double, kCoastScan> coast_max_{};
   int coast_count_ = 0;
-  double coast_beyond_ = 0, coast_scale_ = 1;
+  std::uint64_t coast_from_ = 0;
+  double full_end_ = -1e300;  ///< this tick: where a coast after accelerating may reach (global s)
+  double commit_end_ =
+      -1e300;  ///< where the coasts the accelerating periods in the window committed to may reach
 
   // Operator state.
   bool hold_ = false, aborting_ = false;
