@@ -74,6 +74,7 @@ struct Args {
   std::size_t lookahead = 200;
   std::string tool_table;
   bool check = true;
+  double normal_share = 0;  ///< 0: the planner's default
   std::vector<std::string> files;
 };
 
@@ -94,6 +95,8 @@ bool parse(int argc, char** argv, Args& a) {
       a.lookahead = static_cast<std::size_t>(std::strtoul(value().c_str(), nullptr, 10));
     } else if (s == "--tool-table") {
       a.tool_table = value();
+    } else if (s == "--normal-share") {
+      a.normal_share = std::strtod(value().c_str(), nullptr);
     } else if (s == "--no-check") {
       a.check = false;
     } else if (s == "-h" || s == "--help") {
@@ -155,6 +158,7 @@ Run run(const canon::Program& program, double jerk, const Args& args) {
       plan::MachineLimits::uniform(AxisMask::from_letters("XYZ"), 100, 1000, jerk);
   analysis::SimulationOptions opt;
   opt.planner.lookahead_moves = args.lookahead;
+  if (args.normal_share > 0) opt.planner.normal_accel_share = args.normal_share;
   opt.max_time_s = 48 * 3600;
   Run r;
   for (int pass = 0; pass < (args.check ? 2 : 1); ++pass) {

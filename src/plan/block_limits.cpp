@@ -118,11 +118,11 @@ RawLimits arc_or_spiral_limits(const MotionBlock& b, double v_max, const LimitPa
   return r;
 }
 
-// Cubic or quintic Bézier at t = s/L, with the polygon bounds D1, D2, D3 per axis:
+// Cubic or quintic Bézier at t = s/L, with the bounds D1, D2, D3 of |g'|, |g''|, |g'''| per axis:
 //   |ẋ| ≤ D1·v,  |ẍ| ≤ D1·|a| + D2·v²,  |x⃛| ≤ D1·|j| + 3·D2·v·|a| + D3·v³.
 RawLimits bezier_limits(const MotionBlock& b, double v_max, const LimitParams& p, double jerk_scale) {
   double d1[kAxisCount], d2[kAxisCount], d3[kAxisCount];
-  polygon_bounds(b, d1, d2, d3);
+  derivative_bounds(b, d1, d2, d3);
   double cap = v_max;
   for (int i = 0; i < kAxisCount; ++i) {
     if (d1[i] + d2[i] < 1e-15) continue;
@@ -155,22 +155,74 @@ RawLimits bezier_limits(const MotionBlock& b, double v_max, const LimitParams& p
 
 }  // namespace
 
-// The derivative of a Bézier is the Bézier of the differences, inside their convex hull.
-void polygon_bounds(const MotionBlock& b, double d1[kAxisCount], double d2[kAxisCount],
-                    double d3[kAxisCount]) noexcept {
+namespace {
+
+/// A Bernstein polynomial of degree n (coefficients c[0..n]) at t (de Casteljau).
+double bernstein(const double* c, int n, double t) {
+  double q[6];
+  for (int k = 0; k <= n; ++k) q[k] = c[k];
+  for (int level = n; level > 0; --level) {
+    for (int k = 0; k < level; ++k) q[k] += t * (q[k + 1] - q[k]);
+  }
+  return q[0];
+}
+
+/// Largest |p| on [0, 1] of a Bernstein polynomial of degree n ≤ 5: at the ends, on a grid, and
+/// where p' changes sign between grid points (bisection): its extrema.
+double max_abs_bernstein(const double* c, int n) {
+  double best = std::max(std::fabs(c[0]), std::fabs(c[n]));
+  if (n <= 1) return best;
+  double d[5];
+  for (int k = 0; k < n; ++k) d[k] = n * (c[k + 1] - c[k]);
+  constexpr int kGrid = 12;  // p' has at most 4 roots; two closer than 1/12 leave p nearly flat between
+  double t0 = 0, s0 = bernstein(d, n - 1, 0.0);
+  for (int g = 1; g <= kGrid; ++g) {
+    const double t1 = static_cast<double>(g) / kGrid, s1 = bernstein(d, n - 1, t1);
+    best = std::max(best, std::fabs(bernstein(c, n, t1)));
+    if ((s0 < 0) != (s1 < 0)) {
+      double lo = t0, hi = t1, slo = s0;
+      for (int it = 0; it < 30; ++it) {
+        const double mid = 0.5 * (lo + hi), sm = bernstein(d, n - 1, mid);
+        if ((sm < 0) == (slo < 0)) {
+          lo = mid;
+          slo = sm;
+        } else {
+          hi = mid;
+        }
+      }
+      best = std::max(best, std::fabs(bernstein(c, n, 0.5 * (lo + hi))));
+    }
+    t0 = t1;
+    s0 = s1;
+  }
+  return best;
+}
+
+}  // namespace
+
+// Per axis the derivatives of the Bézier in t are Béziers of the differences of the control
+// points; their largest magnitudes on [0, 1], divided by L, L², L³, are those along s.
+void derivative_bounds(const MotionBlock& b, double d1[kAxisCount], double d2[kAxisCount],
+                       double d3[kAxisCount]) noexcept {
   const double L = b.length;
   const int n = b.kind == BlockKind::Quintic ? 5 : 3;
   for (int i = 0; i < kAxisCount; ++i) {
-    double c[6];
-    for (int k = 0; k <= n; ++k) c[k] = traj::detail::quintic_point(b, k)[i];  // base, u, w, lin(, p4, p5)
-    double m1 = 0, m2 = 0, m3 = 0;
-    for (int k = 0; k + 1 <= n; ++k) m1 = std::max(m1, std::fabs(c[k + 1] - c[k]));
-    for (int k = 0; k + 2 <= n; ++k) m2 = std::max(m2, std::fabs(c[k + 2] - 2 * c[k + 1] + c[k]));
-    for (int k = 0; k + 3 <= n; ++k)
-      m3 = std::max(m3, std::fabs(c[k + 3] - 3 * c[k + 2] + 3 * c[k + 1] - c[k]));
-    d1[i] = n * m1 / L;
-    d2[i] = n * (n - 1) * m2 / (L * L);
-    d3[i] = n * (n - 1) * (n - 2) * m3 / (L * L * L);
+    double c[6], e1[5], e2[4], e3[3];
+    bool moves = false;
+    for (int k = 0; k <= n; ++k) {
+      c[k] = traj::detail::quintic_point(b, k)[i];  // base, u, w, lin(, p4, p5)
+      moves = moves || c[k] != c[0];
+    }
+    if (!moves) {  // an axis the block does not move
+      d1[i] = d2[i] = d3[i] = 0;
+      continue;
+    }
+    for (int k = 0; k < n; ++k) e1[k] = n * (c[k + 1] - c[k]);
+    for (int k = 0; k < n - 1; ++k) e2[k] = (n - 1) * (e1[k + 1] - e1[k]);
+    for (int k = 0; k < n - 2; ++k) e3[k] = (n - 2) * (e2[k + 1] - e2[k]);
+    d1[i] = max_abs_bernstein(e1, n - 1) / L;
+    d2[i] = max_abs_bernstein(e2, n - 2) / (L * L);
+    d3[i] = max_abs_bernstein(e3, n - 3) / (L * L * L);
   }
 }
 

@@ -33,10 +33,10 @@ struct RawLimits {
 RawLimits block_limits(const traj::MotionBlock& b, double v_commanded_max, const LimitParams& p,
                        double jerk_scale = 1.0) noexcept;
 
-/// Per-axis bounds of |g'|, |g''|, |g'''| of a cubic or quintic Bézier block from its control
-/// polygon. Non-real-time.
-void polygon_bounds(const traj::MotionBlock& b, double d1[kAxisCount], double d2[kAxisCount],
-                    double d3[kAxisCount]) noexcept;
+/// Per-axis largest |g'|, |g''|, |g'''| along a cubic or quintic Bézier block (its derivatives'
+/// extrema). Non-real-time.
+void derivative_bounds(const traj::MotionBlock& b, double d1[kAxisCount], double d2[kAxisCount],
+                       double d3[kAxisCount]) noexcept;
 
 /// Per-axis |Δg''| where `prev` ends and `next` starts: the step of curvature that makes the
 /// acceleration jump by v²·|Δg''| there.

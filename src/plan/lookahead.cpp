@@ -20,6 +20,9 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr std::size_t kSoftScan = 64;
 constexpr double kMinPiece = 1e-4;   ///< blocks are not split into pieces shorter than this
 constexpr double kSplitGain = 1e-3;  ///< nor for a limit less than this much (relative) lower
+/// Short blocks are split only where a limit falls below this share of their own: lesser ones
+/// cost little over the block's length, and every cut costs the settling a pass over the ranges.
+constexpr double kShortSplitShare = 0.5;
 
 bool is_stop(const traj::MotionBlock& b) {
   return b.kind == BlockKind::Marker && b.marker != traj::MarkerKind::Report;
@@ -30,8 +33,8 @@ bool has_step(const Pose& s) {
   }
   return false;
 }
-bool lower(double limit, double own) {
-  return limit < own * (1 - kSplitGain);
+bool lower(double limit, double own, double share) {
+  return limit < own * share;
 }
 
 }  // namespace
@@ -206,9 +209,8 @@ void Lookahead::settle_front() {
   const Range own = ranges_[ranges_.size() - pending_.size()];
   if (pb.b.kind == BlockKind::Marker || !widening()) {
     append_settled(pb.b, own.start, Widened{own.cap, own.accel, own.jerk}, own.junction);
-  } else if (pb.b.length <= 0.5 * reach_) {
-    append_settled(pb.b, own.start, widened_over(own.start, own.end, own.epoch, own), own.junction);
   } else {
+    const double share = pb.b.length <= 0.5 * reach_ ? kShortSplitShare : 1 - kSplitGain;
     // Where a lower range begins or ends inside the block.
     cuts_.clear();
     const auto cut_at = [&](double x) {
@@ -218,15 +220,15 @@ void Lookahead::settle_front() {
       const Range& r = ranges_[j];
       if (r.start - reach_ >= own.end) break;
       if (r.marker || r.epoch != own.epoch) continue;
-      if (lower(r.cap, own.cap) || lower(r.accel, own.accel)) {
+      if (lower(r.cap, own.cap, share) || lower(r.accel, own.accel, share)) {
         cut_at(r.start - r.cap * half_window_);
         cut_at(r.end + r.cap * half_window_);
       }
-      if (lower(r.jerk, own.jerk)) {
+      if (lower(r.jerk, own.jerk, share)) {
         cut_at(r.start - r.cap * jerk_window_);
         cut_at(r.end + r.cap * jerk_window_);
       }
-      if (r.junction > 0 && r.junction < kInf && lower(r.junction, own.cap)) {
+      if (r.junction > 0 && r.junction < kInf && lower(r.junction, own.cap, share)) {
         cut_at(r.start - r.junction * half_window_);
         cut_at(r.start + r.junction * half_window_);
       }

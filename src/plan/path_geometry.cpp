@@ -584,8 +584,8 @@ void g2_points(const JoinPoint& a, const JoinPoint& b, double L, MotionBlock& c)
   c.length = L;
 }
 
-/// Arc length of a quintic block (8-point Gauss-Legendre on two halves) and its smallest speed
-/// |dB/dt| among the nodes relative to L (a cusp makes it vanish).
+/// Arc length of a quintic block (8-point Gauss-Legendre: the speed of a blend is smooth) and
+/// its smallest speed |dB/dt| among the nodes relative to L (a cusp makes it vanish).
 double quintic_arc_length(const MotionBlock& c, double& slowest) {
   static constexpr double kNode[4] = {0.1834346424956498, 0.5255324099163290, 0.7966664774136267,
                                       0.9602898564975363};
@@ -593,18 +593,15 @@ double quintic_arc_length(const MotionBlock& c, double& slowest) {
                                         0.1012285362903763};
   double sum = 0;
   slowest = 1e300;
-  for (int half = 0; half < 2; ++half) {
-    const double mid = 0.25 + 0.5 * half;
-    for (int q = 0; q < 4; ++q) {
-      for (int side = -1; side <= 1; side += 2) {
-        const double t = mid + side * 0.25 * kNode[q];
-        const double speed = norm(traj::tangent_at(c, t * c.length));  // |dB/dt| / L
-        slowest = std::min(slowest, speed);
-        sum += kWeight[q] * speed;
-      }
+  for (int q = 0; q < 4; ++q) {
+    for (int side = -1; side <= 1; side += 2) {
+      const double t = 0.5 + side * 0.5 * kNode[q];
+      const double speed = norm(traj::tangent_at(c, t * c.length));  // |dB/dt| / L
+      slowest = std::min(slowest, speed);
+      sum += kWeight[q] * speed;
     }
   }
-  return 0.25 * sum * c.length;
+  return 0.5 * sum * c.length;
 }
 
 }  // namespace
@@ -621,7 +618,8 @@ bool make_g2_curve(const JoinPoint& a, const JoinPoint& b, MotionBlock& out) noe
     double slowest = 0;
     const double next = quintic_arc_length(out, slowest);
     if (!(slowest > 0.05) || !(next > 0)) return false;  // (nearly) a cusp: no useful curve
-    if (std::fabs(next - L) <= 1e-9 * L) {
+    // Any L keeps the curve G2; its own length only makes |dp/ds| about 1 (the feed).
+    if (std::fabs(next - L) <= 1e-6 * L) {
       L = next;
       break;
     }

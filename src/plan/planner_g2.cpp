@@ -94,7 +94,7 @@ bool Planner::Impl::g2_blend(const Element& a, const Element& e, const detail::C
                                 detail::distance_to(unit_line(v, v + 2.0 * turn.out), mid));
     if (tol > 0 && dev > 0) d_max = std::min(d_max, tol / dev);
     double d1[kAxisCount], d2[kAxisCount], d3[kAxisCount];
-    detail::polygon_bounds(out.curve, d1, d2, d3);
+    detail::derivative_bounds(out.curve, d1, d2, d3);
     double d_need = 0;
     const double v_top = need.speed;
     for (int i = 0; i < kAxisCount; ++i) {
