@@ -118,9 +118,17 @@ RawLimits arc_or_spiral_limits(const MotionBlock& b, double v_max, const LimitPa
   return r;
 }
 
-// Cubic or quintic Bézier at t = s/L, with the bounds D1, D2, D3 of |g'|, |g''|, |g'''| per axis:
-//   |ẋ| ≤ D1·v,  |ẍ| ≤ D1·|a| + D2·v²,  |x⃛| ≤ D1·|j| + 3·D2·v·|a| + D3·v³.
+// Cubic or quintic Bézier at t = s/L. Per axis the caps use the largest |g'|, |g''|, |g'''| on the
+// block (D1, D2, D3): v·D1 ≤ V, v²·D2 ≤ α·A, v³·D3 ≤ J/2. The budget uses them where they occur
+// together: on each of kIntervals pieces of t, bounds G1, G2, G3 from the values at its ends and
+// the next derivative's bound (a function whose slope is at most M stays within
+// (f_a + f_b + M·Δs)/2 between a and b), and |ẍ| ≤ G1·|a| + G2·v², |x⃛| ≤ G1·|j| + 3·G2·v·|a| + G3·v³
+// there. Along a curve the axis that carries the curvature is rarely the one that carries the
+// tangent, so the budget at the cap is far above (A − v²·D2)/D1.
+double bernstein(const double* c, int n, double t);
+
 RawLimits bezier_limits(const MotionBlock& b, double v_max, const LimitParams& p, double jerk_scale) {
+  constexpr int kIntervals = 24;
   double d1[kAxisCount], d2[kAxisCount], d3[kAxisCount];
   derivative_bounds(b, d1, d2, d3);
   double cap = v_max;
@@ -133,22 +141,51 @@ RawLimits bezier_limits(const MotionBlock& b, double v_max, const LimitParams& p
       cap = std::min(cap, std::cbrt(kJerkCapShare * jerk_scale * l.max_jerk / d3[i]));
   }
   RawLimits r{cap, kInf, kInf};
-  const double T = p.filter_s;
+  const double T = p.filter_s, L = b.length, ds = L / kIntervals;
+  const int n = b.kind == BlockKind::Quintic ? 5 : 3;
+  // Per axis the values of |g'|, |g''|, |g'''| at the ends of the pieces.
+  double g1[kAxisCount][kIntervals + 1], g2[kAxisCount][kIntervals + 1];
+  for (int i = 0; i < kAxisCount; ++i) {
+    if (d1[i] <= 0) continue;
+    double c[6], e1[5], e2[4];
+    for (int k = 0; k <= n; ++k) c[k] = traj::detail::quintic_point(b, k)[i];
+    for (int k = 0; k < n; ++k) e1[k] = n * (c[k + 1] - c[k]);
+    for (int k = 0; k < n - 1; ++k) e2[k] = (n - 1) * (e1[k + 1] - e1[k]);
+    for (int q = 0; q <= kIntervals; ++q) {
+      const double t = static_cast<double>(q) / kIntervals;
+      g1[i][q] = std::fabs(bernstein(e1, n - 1, t)) / L;
+      g2[i][q] = std::fabs(bernstein(e2, n - 2, t)) / (L * L);
+    }
+  }
+  const auto piece = [&](int i, int q, double& G1, double& G2) {
+    G1 = std::min(d1[i], 0.5 * (g1[i][q] + g1[i][q + 1] + d2[i] * ds));
+    G2 = std::min(d2[i], 0.5 * (g2[i][q] + g2[i][q + 1] + d3[i] * ds));
+  };
   for (int i = 0; i < kAxisCount; ++i) {
     if (d1[i] <= 0) continue;
     const AxisLimits& l = p.machine[i];
-    r.accel = std::min(r.accel, (l.max_acceleration - cap * cap * d2[i]) / d1[i]);
-    if (limited_jerk(p, i)) {
-      const double left = jerk_scale * l.max_jerk - cap * cap * cap * d3[i];
-      r.accel = std::min(r.accel, left / (d1[i] / T + 3 * cap * d2[i]));
+    for (int q = 0; q < kIntervals; ++q) {
+      double G1, G2;
+      piece(i, q, G1, G2);
+      if (G1 <= 0) continue;
+      r.accel = std::min(r.accel, (l.max_acceleration - cap * cap * G2) / G1);
+      if (limited_jerk(p, i)) {
+        const double left = jerk_scale * l.max_jerk - cap * cap * cap * d3[i];
+        r.accel = std::min(r.accel, left / (G1 / T + 3 * cap * G2));
+      }
     }
   }
   r.accel = std::max(r.accel, 0.0);
   for (int i = 0; i < kAxisCount; ++i) {
     if (d1[i] <= 0 || !limited_jerk(p, i)) continue;
-    const double left =
-        jerk_scale * p.machine[i].max_jerk - cap * cap * cap * d3[i] - 3 * cap * d2[i] * r.accel;
-    r.jerk = std::min(r.jerk, std::max(left, 0.0) / d1[i]);
+    for (int q = 0; q < kIntervals; ++q) {
+      double G1, G2;
+      piece(i, q, G1, G2);
+      if (G1 <= 0) continue;
+      const double left =
+          jerk_scale * p.machine[i].max_jerk - cap * cap * cap * d3[i] - 3 * cap * G2 * r.accel;
+      r.jerk = std::min(r.jerk, std::max(left, 0.0) / G1);
+    }
   }
   return r;
 }

@@ -503,18 +503,18 @@ bool line_line_blend(const MotionBlock& in, double avail_in, const MotionBlock& 
 void bezier_at(const MotionBlock& in, const MotionBlock& out, double d, MotionBlock& c) {
   const Pose p0 = traj::position_at(in, in.length - d);
   const Pose p3 = traj::position_at(out, d);
-  Pose ta = traj::tangent_at(in, in.length - d), tb = traj::tangent_at(out, d);
-  ta = (1.0 / norm(ta)) * ta;
-  tb = (1.0 / norm(tb)) * tb;
-  const double theta = angle_between(ta, tb);
+  // The arms along dp/ds of the pieces (not only its direction): the velocity stays continuous
+  // where |dp/ds| is not exactly 1 (a spiral, a fitted run of short moves).
+  const Pose da = traj::tangent_at(in, in.length - d), db = traj::tangent_at(out, d);
+  const double theta = angle_between((1.0 / norm(da)) * da, (1.0 / norm(db)) * db);
   const double cq = std::cos(0.25 * theta);
   const double h = norm(p3 - p0) / (3.0 * cq * cq);
   c.line = in.line;  // the caller sets identity, class and feed
   c.context = in.context;
   c.kind = BlockKind::Bezier;
   c.base = p0;
-  c.u = p0 + h * ta;
-  c.w = p3 - h * tb;
+  c.u = p0 + h * da;
+  c.w = p3 - h * db;
   c.lin = p3;
   c.length = 3.0 * h;
   c.omega = 0;
@@ -541,7 +541,8 @@ bool bezier_blend(const MotionBlock& in, double avail_in, const MotionBlock& out
   Pose n = tb - ta;
   n = n - dot(n, ta) * ta;
   n = (1.0 / norm(n)) * n;
-  const double d_need = 2.0 * needed_radius(ta, n, need) * std::tan(0.5 * theta);
+  const double d_need =
+      theta > kTangentAngle ? 2.0 * needed_radius(ta, n, need) * std::tan(0.5 * theta) : avail_in;
   const double d_max = std::min({avail_in, avail_out, d_need});
   if (!(d_max >= kMinLength)) return false;
   const auto ok = [&](double d) {
@@ -631,44 +632,16 @@ bool make_g2_curve(const JoinPoint& a, const JoinPoint& b, MotionBlock& out) noe
 
 bool blend_within(const MotionBlock& c, const MotionBlock& in, const MotionBlock& out,
                   double tolerance) noexcept {
-  // The distance to any set is 1-Lipschitz, and the curve moves at most Lip·Δt in Δt, Lip the
-  // bound of |dB/dt| from the control polygon (5·max|ΔP|). Between parameters a and b the
-  // distance is at most min(d_a + Lip·(t − a), d_b + Lip·(b − t)) ≤ (d_a + d_b + Lip·(b − a))/2.
-  // Intervals whose bound exceeds the tolerance are halved until it holds, or a sample exceeds it
-  // (branch and bound: the work follows how close the curve comes to the tolerance).
-  const Pose q[6] = {c.base, c.u, c.w, c.lin, c.p4, c.p5};
-  double lip = 0;
-  for (int k = 0; k + 1 < 6; ++k) lip = std::max(lip, norm(q[k + 1] - q[k]));
-  lip *= 5;
-  const auto dist = [&](double t) {
-    const Pose p = traj::position_at(c, c.length * t);
-    return std::min(distance_to(in, p), distance_to(out, p));
-  };
-  constexpr int kStart = 16, kMaxSamples = 4096;
-  struct Span {
-    double a, b, da, db;
-  };
-  Span stack[64];
-  int top = 0, samples = kStart + 1;
-  const double prev = dist(0.0);
-  double da = prev;
-  for (int k = 1; k <= kStart; ++k) {
-    const double t0 = static_cast<double>(k - 1) / kStart, t1 = static_cast<double>(k) / kStart;
-    const double db = dist(t1);
-    if (db > tolerance) return false;
-    stack[top++] = {t0, t1, da, db};
-    while (top > 0) {
-      const Span s = stack[--top];
-      if (0.5 * (s.da + s.db + lip * (s.b - s.a)) <= tolerance) continue;
-      if (top + 2 > 64 || ++samples > kMaxSamples) return false;  // too close to call: not within
-      const double m = 0.5 * (s.a + s.b), dm = dist(m);
-      if (dm > tolerance) return false;
-      stack[top++] = {m, s.b, dm, s.db};
-      stack[top++] = {s.a, m, s.da, dm};
-    }
-    da = db;
-  }
-  return true;
+  return curve_within(
+      c, [&](const Pose& p) { return std::min(distance_to(in, p), distance_to(out, p)); }, tolerance);
+}
+
+double speed_scale_step(const MotionBlock& in, const MotionBlock& out) noexcept {
+  return std::fabs(norm(traj::tangent_at(in, in.length)) - norm(traj::tangent_at(out, 0.0)));
+}
+
+bool same_speed_scale(const MotionBlock& in, const MotionBlock& out) noexcept {
+  return speed_scale_step(in, out) <= 1e-9;
 }
 
 CornerTurn corner_turn(const MotionBlock& in, const MotionBlock& out) noexcept {
@@ -685,7 +658,11 @@ bool blend_corner(const MotionBlock& in, double avail_in, const MotionBlock& out
   const Pose& ta = turn.in;
   const Pose& tb = turn.out;
   const double theta = turn.angle;
-  if (theta <= kTangentAngle || theta >= kReversalAngle) return false;
+  if (theta >= kReversalAngle) return false;
+  if (theta <= kTangentAngle) {  // tangent, but |dp/ds| differs: a transition between the two
+    if (same_speed_scale(in, out)) return false;
+    return bezier_blend(in, avail_in, out, avail_out, tolerance, need, theta, ta, tb, result);
+  }
   if (in.kind == BlockKind::Line && out.kind == BlockKind::Line) {
     return line_line_blend(in, avail_in, out, avail_out, tolerance, need, turn, result);
   }

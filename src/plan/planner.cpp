@@ -173,7 +173,10 @@ bool Planner::Impl::corner_g1(Element& a, Element& e) {
   if (a.stop_after || a.mode == canon::MotionControl::ExactStop) return false;
   if ((a.b.feed_class == FeedClass::SpindleSync) != (e.b.feed_class == FeedClass::SpindleSync)) return false;
   const detail::CornerTurn turn = detail::corner_turn(a.b, e.b);
-  if (turn.angle <= detail::kTangentAngle) {
+  const bool tangent = turn.angle <= detail::kTangentAngle;
+  if (tangent && (detail::same_speed_scale(a.b, e.b) ||
+                  (a.mode != canon::MotionControl::Continuous &&
+                   detail::speed_scale_step(a.b, e.b) <= detail::kSpeedScaleSlack))) {
     emit_path(a.b, a.junction);
     emit_reports();
     return true;
@@ -284,6 +287,7 @@ bool Planner::Impl::read_one() {
   } else {
     on_element(it->element);
   }
+  stats.smoothed_runs = reader->smoothed_runs();
   stats.moves = reader->moves_read();
   stats.merged_moves = reader->merged();
   return true;
@@ -358,6 +362,7 @@ bool Planner::Impl::begin(const canon::Program& program, bool stream) {
   m.flush_asked = m.flushing = m.input_waiting = false;
   m.program = &program;
   m.reader.emplace(program, stream);
+  m.reader->set_smoothing(m.config.smooth_short_moves && m.params.filter_s > 0);
   detail::WindowParams wp;
   wp.filter_s = m.params.filter_s;
   wp.period_s = m.config.servo_period_s;

@@ -119,7 +119,9 @@ bool Planner::Impl::g2_blend(const Element& a, const Element& e, const detail::C
       if (limits.axes.has(static_cast<Axis>(i)) && limits[i].max_jerk > 0)
         j_min = std::min(j_min, limits[i].max_jerk);
     }
-    if (j_min < kInf) d_max = std::min(d_max, need.speed * need.speed * need.speed * jump / j_min);
+    // (a step of |dp/ds| alone, with no curvature jump, takes what the tolerance allows)
+    if (j_min < kInf && jump > 0)
+      d_max = std::min(d_max, need.speed * need.speed * need.speed * jump / j_min);
   }
   if (!(d_max >= detail::kMinLength)) return false;
   const auto ok = [&](double d) {
@@ -169,7 +171,8 @@ bool Planner::Impl::corner_g2(Element& a, Element& e) {
   if ((a.b.feed_class == FeedClass::SpindleSync) != (e.b.feed_class == FeedClass::SpindleSync)) return false;
   const detail::CornerTurn turn = detail::corner_turn(a.b, e.b);
   const bool kink = turn.angle > detail::kTangentAngle;
-  if (!kink && !curvature_jumps(a.b, e.b)) {
+  const bool scale_step = !kink && !detail::same_speed_scale(a.b, e.b);  // |dp/ds| would step
+  if (!kink && !scale_step && !curvature_jumps(a.b, e.b)) {
     pass_through(a);
     return true;
   }
@@ -181,9 +184,13 @@ bool Planner::Impl::corner_g2(Element& a, Element& e) {
   const bool smooth = a.mode == canon::MotionControl::Continuous && (a.tolerance <= 0 || tol > 0) &&
                       g2_blend(a, e, turn, tol, blend);
   if (!smooth) {
-    if (!kink) {  // a curvature step stays: the window's step limit takes it
-      pass_through(a);
+    if (!kink && (!scale_step || detail::speed_scale_step(a.b, e.b) <= detail::kSpeedScaleSlack)) {
+      pass_through(a);  // a curvature step stays: the window's step limit takes it
       return true;
+    }
+    if (!kink) {
+      release_held();
+      return false;  // |dp/ds| would step and nothing may smooth it: stop there
     }
     release_held();
     return corner_g1(a, e);  // a G1 blend (steps included) or a stop

@@ -29,9 +29,13 @@ struct PlannerConfig {
   /// Largest share of an axis's acceleration that the centripetal part may take on arcs and
   /// blends; the rest stays available along the path. In (0, 1).
   double normal_accel_share = 0.95;
-  /// With jerk limits: share of each axis's jerk reserved for the curvature steps where a line
-  /// meets an arc (sampled at the servo period). In (0, 1).
+  /// With jerk limits: share of each axis's jerk reserved where a curvature step is left (a
+  /// line meeting an arc tangentially under G61, sampled at the servo period). In (0, 1).
   double jerk_step_share = 0.5;
+  /// With jerk limits, runs of short feed lines are replaced by one curvature-continuous curve
+  /// within the G64 P tolerance before G64 Q may merge what is left (docs/planner.md, "Runs of
+  /// short moves"). Without jerk limits the moves keep their circular blends.
+  bool smooth_short_moves = true;
 };
 
 enum class PlanStatus : std::uint8_t {
@@ -45,6 +49,7 @@ struct PlanStats {
   std::uint64_t moves = 0;         ///< programmed moves read
   std::uint64_t merged_moves = 0;  ///< moves folded into a previous line by G64 Q
   std::uint64_t blends = 0;        ///< corners replaced by a blend curve
+  std::uint64_t smoothed_runs = 0;  ///< runs of short moves replaced by one fitted curve
   std::uint64_t blocks = 0;        ///< blocks published (path blocks and markers)
 };
 
