@@ -5,11 +5,13 @@
 // planner and the tick ran (docs/performance.md, "Jerk-limited motion").
 //
 //   jerk_table [--lcnc TIMES.tsv] [--jerks 0,1e5,2e4] [--cpu-limit S] [--lookahead N]
-//              [--tool-table FILE] [--no-check] FILES...
+//              [--tol P] [--tool-table FILE] [--no-check] FILES...
 //
-// The machine is configs/mill-3axis.toml's: X Y Z at 100 mm/s and 1000 mm/s², 1 ms, G64 without
-// P unbounded, 200 moves of look-ahead; the jerk J on all three axes. Each program is interpreted
-// once by opencnc's interpreter into a canon::Program, then planned and run in virtual time
+// The machine is configs/mill-3axis.toml's: X Y Z at 100 mm/s and 1000 mm/s², 1 ms, 200 moves of
+// look-ahead; the jerk J on all three axes. Before each program the interpreter runs the MDI line
+// `G64 P<tol>` (default 0.01), as the LinuxCNC harness does with its --tol: a program that sets no
+// path mode of its own runs under that tolerance in both (G64 without P stays unbounded). Each program is
+// interpreted once by opencnc's interpreter into a canon::Program, then planned and run in virtual time
 // (analysis::simulate) twice per J: without the trace checker for the CPU time (planner + tick,
 // one thread), then with it for the metrics. A run whose CPU time passes --cpu-limit (default 120 s)
 // is aborted and reported as not finished, with the motion time it reached.
@@ -72,6 +74,7 @@ struct Args {
   std::vector<double> jerks{0, 1e5, 2e4};
   double cpu_limit_s = 120;
   std::size_t lookahead = 200;
+  double tolerance = 0.01;
   std::string tool_table;
   bool check = true;
   double normal_share = 0;  ///< 0: the planner's default
@@ -93,6 +96,8 @@ bool parse(int argc, char** argv, Args& a) {
       a.cpu_limit_s = std::strtod(value().c_str(), nullptr);
     } else if (s == "--lookahead") {
       a.lookahead = static_cast<std::size_t>(std::strtoul(value().c_str(), nullptr, 10));
+    } else if (s == "--tol") {
+      a.tolerance = std::strtod(value().c_str(), nullptr);
     } else if (s == "--tool-table") {
       a.tool_table = value();
     } else if (s == "--normal-share") {
@@ -120,9 +125,9 @@ std::optional<canon::Program> interpret(const std::string& path, const Args& arg
   }
   gcode::Interpreter interp(o);
   canon::ProgramBuilder builder(kXyzabc);
-  if (!interp.open(path)) return std::nullopt;
-  // G64 without P: no bound, as configs/mill-3axis.toml (planner.default_tolerance = 0).
-  builder.set_motion_control_mode(canon::MotionControl::Continuous, 0);
+  // The harness's `--tol`: an MDI G64 P before the program (LinuxCNC's G64 P also sets Q = P).
+  const std::string mdi = args.tolerance > 0 ? fmt::format("G64 P{:g}", args.tolerance) : std::string("G64");
+  if (interp.execute_mdi(mdi, builder) == gcode::RunStatus::Error || !interp.open(path)) return std::nullopt;
   if (interp.run(builder) == gcode::RunStatus::Error) {
     for (const auto& d : interp.diagnostics().items()) {
       if (d.severity == Severity::Error) fmt::print(stderr, "{}\n", d.format());
@@ -195,7 +200,7 @@ int main(int argc, char** argv) {
   if (!parse(argc, argv, args)) {
     std::fprintf(stderr,
                  "usage: jerk_table [--lcnc TIMES.tsv] [--jerks 0,1e5,2e4] [--cpu-limit S] [--lookahead N] "
-                 "[--tool-table FILE] [--no-check] FILES...\n");
+                 "[--tol P] [--tool-table FILE] [--no-check] FILES...\n");
     return 2;
   }
   const std::map<std::string, double> lcnc =

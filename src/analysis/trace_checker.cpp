@@ -249,7 +249,7 @@ void TraceChecker::check_limits(const Pose& x) {
     const double x1 = past_[0][i], x2 = past_[1][i], x3 = past_[2][i];
     const double v = std::fabs(x[i] - x1) / t;
     const double a = std::fabs(x[i] - 2 * x1 + x2) / t2;
-    const double j = std::fabs(x[i] - 3 * x1 + 3 * x2 - x3) / t3;
+    const double j = jerk_unknown_ ? 0.0 : std::fabs(x[i] - 3 * x1 + 3 * x2 - x3) / t3;
     AxisStats& st = report_.axes[k];
     st.max_velocity = std::max(st.max_velocity, v);
     st.max_acceleration = std::max(st.max_acceleration, a);
@@ -264,6 +264,7 @@ void TraceChecker::check_limits(const Pose& x) {
       }
     }
   }
+  jerk_unknown_ = false;
 }
 
 void TraceChecker::add(const Pose& position, canon::SegmentId first, canon::SegmentId last) {

@@ -31,17 +31,23 @@ bool bad(double v) {
 
 /// Moving-average length in servo periods: T ≥ A/J on every axis, so that an acceleration ramp of
 /// the average from 0 to A takes its jerk to J at most (the time-optimal ramp when T = A/J).
-int filter_ticks(const MachineLimits& m, const PlannerConfig& c) {
+int filter_ticks(const MachineLimits& m, double servo_period_s) {
   double t = 0;
   for (int i = 0; i < kAxisCount; ++i) {
     if (!m.axes.has(static_cast<Axis>(i)) || m[i].max_jerk <= 0) continue;
     t = std::max(t, m[i].max_acceleration / m[i].max_jerk);
   }
   if (t <= 0) return 1;
-  return std::max(2, static_cast<int>(std::ceil(t / c.servo_period_s - 1e-9)));
+  return std::max(2, static_cast<int>(std::ceil(t / servo_period_s - 1e-9)));
 }
 
 }  // namespace
+
+double jerk_filter_s(const MachineLimits& limits, double servo_period_s) noexcept {
+  if (!(servo_period_s > 0)) return 0;
+  const int ticks = filter_ticks(limits, servo_period_s);
+  return ticks > 1 ? ticks * servo_period_s : 0.0;
+}
 
 bool validate(const MachineLimits& limits, Diagnostics& diags) {
   bool ok = true;
@@ -66,7 +72,7 @@ bool validate(const MachineLimits& limits, Diagnostics& diags) {
 Planner::Impl::Impl(const MachineLimits& l, const PlannerConfig& c) : limits(l), config(c) {
   check_config();
   if (!config_ok) return;
-  ticks = filter_ticks(limits, config);
+  ticks = filter_ticks(limits, config.servo_period_s);
   params.machine = limits;
   params.normal_share = config.normal_accel_share;
   params.step_share = config.jerk_step_share;

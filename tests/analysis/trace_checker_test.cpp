@@ -70,6 +70,28 @@ TEST(TraceChecker, CountsEverySampleAndAxisAboveALimit) {
   EXPECT_NE(r.summary().find("2 limit violations"), std::string::npos);
 }
 
+// A trace that was already moving: its first two samples are the history, the one before them is
+// unknown, so the first checked sample has no jerk; from the next one on the jerk is measured.
+TEST(TraceChecker, AlreadyMovingTheFirstSampleHasNoJerkTheNextOnesHave) {
+  const canon::Program p = line_and_arc();
+  const auto limits = plan::MachineLimits::uniform(AxisMask::from_letters("XYZ"), 100, 1000, 1e5);
+  analysis::TraceChecker c(p, limits, 1e-3);
+  // x = J t³/6 with J = 9e4 from t = 0 (samples at 1 ms): a jerk-limited start.
+  const auto x = [](int n) { return 9e4 * std::pow(n * 1e-3, 3) / 6; };
+  c.start_moving(xy(x(1), 0), xy(x(0), 0));
+  c.add(xy(x(2), 0), 0, 0);
+  EXPECT_EQ(c.report().axes[0].max_jerk, 0.0);
+  for (int n = 3; n <= 10; ++n) c.add(xy(x(n), 0), 0, 0);
+  EXPECT_NEAR(c.report().axes[0].max_jerk, 9e4, 1e-3);
+  EXPECT_NEAR(c.report().axes[0].max_acceleration, 9e4 * 9e-3, 1e-6);  // second difference at sample 10
+  EXPECT_EQ(c.report().limit_violations, 0u);
+  // A jerk above the limit after the first sample is counted: 50 nm more adds 5e4 mm/s³ (and
+  // 50 mm/s², still within the acceleration limit).
+  c.add(xy(x(11) + 5e-5, 0), 0, 0);
+  EXPECT_EQ(c.report().limit_violations, 1u);
+  EXPECT_EQ(c.report().first_violation.derivative, 3);
+}
+
 TEST(TraceChecker, ContourErrorIsTheDistanceToTheNearestProgrammedMove) {
   const canon::Program p = line_and_arc();
   const auto limits = plan::MachineLimits::uniform(AxisMask::from_letters("XYZ"), 1e9, 1e12);

@@ -66,12 +66,16 @@ class TraceChecker {
   const canon::Program* program() const noexcept { return program_; }
 
   /// Where the machine rests before the first sample (the origin unless said). Before add().
-  void start_at(const Pose& position) { past_.fill(position); }
-  /// The two samples before the first one, newest first, when the trajectory was already moving
-  /// (its acceleration before them taken as zero). Before add().
+  void start_at(const Pose& position) {
+    past_.fill(position);
+    jerk_unknown_ = false;
+  }
+  /// The two samples before the first one, newest first, when the trajectory was already moving.
+  /// The sample before them is unknown, so the first sample's jerk (a third difference) is not
+  /// measured; its velocity and acceleration are. Before add().
   void start_moving(const Pose& newest, const Pose& previous) {
     past_ = {newest, previous, previous};
-    for (int i = 0; i < kAxisCount; ++i) past_[2][i] = 2 * previous[i] - newest[i];
+    jerk_unknown_ = true;
   }
   /// The acceleration and jerk limits of the next samples, times `scale` (≥ 1: a power-fail stop
   /// short of energy brakes harder than planned, up to the axes' peak deceleration).
@@ -94,6 +98,7 @@ class TraceChecker {
   double tolerance_;
   double accel_scale_ = 1;        ///< set_acceleration_scale
   std::array<Pose, 3> past_{};    ///< the three previous samples, newest first
+  bool jerk_unknown_ = false;     ///< the oldest of them is not known (start_moving)
   canon::SegmentId nearest_ = 0;  ///< the move nearest to the last sample
   TraceReport report_;
 };

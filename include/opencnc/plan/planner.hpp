@@ -21,6 +21,12 @@ namespace opencnc::plan {
 bool check_move(const canon::Program& program, canon::SegmentId id, const MachineLimits& limits,
                 Diagnostics& diags);
 
+/// Length in seconds of the moving average on s that meets the jerk limits (docs/planner.md,
+/// "Jerk"): the largest A/J of the axes with a jerk limit, in whole servo periods; 0 without jerk
+/// limits. The commanded position trails the path generator by up to half of it, so a feed hold
+/// taken at speed v travels v·T/2 beyond the generator's braking distance. Any thread.
+double jerk_filter_s(const MachineLimits& limits, double servo_period_s) noexcept;
+
 /// Planner settings (the machine profile's [trajectory] part).
 struct PlannerConfig {
   double servo_period_s = 1e-3;        ///< must equal the interpolator's period
