@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // jerk_table — per G-code program: LinuxCNC 2.9's motion time (from a file the harness wrote),
 // opencnc's without a jerk limit, with J = 1e5 and J = 2e4 mm/s³ (or --jerks), the peak jerk the
-// trace used, its contour error, its limit violations and how much faster than real time the
+// trace used, its contour error (both ways: the path from the programmed moves and the moves' end
+// points from the path), its limit violations and how much faster than real time the
 // planner and the tick ran (docs/performance.md, "Jerk-limited motion").
 //
 //   jerk_table [--lcnc TIMES.tsv] [--jerks 0,1e5,2e4] [--cpu-limit S] [--lookahead N]
@@ -153,6 +154,7 @@ struct Run {
   double cpu_s = 0;
   double peak_jerk_share = 0;  ///< largest axis jerk / its limit (0 without a limit)
   double contour_mm = 0;
+  double corner_mm = 0;  ///< largest distance from a programmed end point to the path
   std::uint64_t violations = 0;
   std::uint64_t ticks = 0;  ///< virtual time simulated, in servo periods
   int state = 0;            ///< traj::RunState at the end
@@ -184,6 +186,7 @@ Run run(const canon::Program& program, double jerk, const Args& args) {
       continue;
     }
     r.contour_mm = s.report.max_contour_error_mm;
+    r.corner_mm = s.report.max_corner_miss_mm;
     r.violations = s.report.limit_violations;
     if (jerk > 0) {
       for (const analysis::AxisStats& a : s.report.axes)
@@ -216,8 +219,8 @@ int main(int argc, char** argv) {
       rule += "---:|";
     }
   }
-  head += " contour [mm] | violations | × real time (slowest) |";
-  rule += "---:|---:|---:|";
+  head += " contour [mm] | corner miss [mm] | violations | × real time (slowest) |";
+  rule += "---:|---:|---:|---:|";
   fmt::print("{}\n{}\n", head, rule);
   std::fflush(stdout);
   for (const std::string& file : args.files) {
@@ -232,7 +235,7 @@ int main(int argc, char** argv) {
         fmt::format("| {} | {} | {} | {} |", name, program->size(),
                     largest_tolerance(*program) > 0 ? fmt::format("{:g}", largest_tolerance(*program)) : "—",
                     l != lcnc.end() ? fmt::format("{:.3f}", l->second) : "—");
-    double base = 0, contour = 0, slowest = 1e300;
+    double base = 0, contour = 0, corner = 0, slowest = 1e300;
     std::uint64_t violations = 0;
     for (double j : args.jerks) {
       const Run r = run(*program, j, args);
@@ -249,11 +252,12 @@ int main(int argc, char** argv) {
       row += fmt::format(" {:.3f} | {} |", r.motion_s, ratio > 0 ? fmt::format("{:.3f}", ratio) : "—");
       if (j > 0) row += fmt::format(" {:.0f} % |", 100 * r.peak_jerk_share);
       contour = std::max(contour, r.contour_mm);
+      corner = std::max(corner, r.corner_mm);
       violations += r.violations;
       slowest = std::min(slowest, r.motion_s / r.cpu_s);
     }
-    row += fmt::format(" {:.4f} | {} | {:.0f} |", contour, args.check ? fmt::format("{}", violations) : "—",
-                       slowest);
+    row += fmt::format(" {:.4f} | {:.4f} | {} | {:.0f} |", contour, corner,
+                       args.check ? fmt::format("{}", violations) : "—", slowest);
     fmt::print("{}\n", row);
     std::fflush(stdout);
   }

@@ -468,10 +468,12 @@ double needed_radius(const Pose& t, const Pose& n, const BlendNeed& need) {
 
 bool line_line_blend(const MotionBlock& in, double avail_in, const MotionBlock& out, double avail_out,
                      double tolerance, const BlendNeed& need, const CornerTurn& turn, Blend& result) {
-  // Circular fillet tangent to both lines: tangent length d, radius R = d / tan(θ/2), largest
-  // distance from the lines R·(1 − cos(θ/2)) ≤ tolerance, and no larger than the speed needs.
-  // From s = sin(θ/2) and c = cos(θ/2): tan(θ/2) = s/c and 1 − c = s²/(1 + c), without
-  // cancellation at small angles, so d ≤ tolerance·(1 + c)/(s·c).
+  // Circular fillet tangent to both lines: tangent length d, radius R = d / tan(θ/2). Its middle
+  // is nearest to the corner, R·(1/cos(θ/2) − 1) from it (and R·(1 − cos(θ/2)) from the lines):
+  // that distance ≤ tolerance, as LinuxCNC sizes its blend arcs, so that the path passes within
+  // the tolerance of the corner too (a hairpin is not cut off at its moves' middles). And no
+  // larger than the speed needs. From s = sin(θ/2) and c = cos(θ/2): tan(θ/2) = s/c and
+  // 1 − c = s²/(1 + c), without cancellation at small angles, so d ≤ tolerance·(1 + c)/s.
   const double theta = turn.angle, s = turn.half_sine, c2 = std::sqrt(1.0 - s * s);
   const double t2 = s / c2;
   const Pose& ta = turn.in;
@@ -479,7 +481,7 @@ bool line_line_blend(const MotionBlock& in, double avail_in, const MotionBlock& 
   n = n - dot(n, ta) * ta;
   n = (1.0 / norm(n)) * n;
   double d = std::min({avail_in, avail_out, needed_radius(ta, n, need) * t2});
-  if (tolerance > 0) d = std::min(d, tolerance * (1.0 + c2) / (s * c2));
+  if (tolerance > 0) d = std::min(d, tolerance * (1.0 + c2) / s);
   if (!(d >= kMinLength)) return false;
   const double radius = d / t2;
   MotionBlock& c = result.curve;  // the caller sets identity, class and feed
@@ -548,7 +550,8 @@ bool bezier_blend(const MotionBlock& in, double avail_in, const MotionBlock& out
   const auto ok = [&](double d) {
     bezier_at(in, out, d, result.curve);
     if (result.curve.length < kMinLength) return false;
-    return tolerance <= 0 || bezier_deviation(result.curve, in, out) <= tolerance;
+    return tolerance <= 0 || (bezier_deviation(result.curve, in, out) <= tolerance &&
+                              point_to_curve(result.curve, end_point(in)) <= tolerance);
   };
   double d = d_max;
   if (!ok(d)) {
@@ -630,10 +633,47 @@ bool make_g2_curve(const JoinPoint& a, const JoinPoint& b, MotionBlock& out) noe
   return std::isfinite(L) && L >= kMinLength;
 }
 
+double point_to_curve(const MotionBlock& c, const Pose& v) noexcept {
+  // The nearest of 16 samples, then a golden-section search between its neighbours: the distance
+  // to a point of the curve, so never below the true distance.
+  constexpr int kSamples = 16;
+  const auto dist = [&](double t) { return norm(traj::position_at(c, c.length * t) - v); };
+  int best_k = 0;
+  double best = dist(0.0);
+  for (int k = 1; k <= kSamples; ++k) {
+    const double d = dist(static_cast<double>(k) / kSamples);
+    if (d < best) {
+      best = d;
+      best_k = k;
+    }
+  }
+  constexpr double kGolden = 0.6180339887498949;
+  double a = std::max(0, best_k - 1) / static_cast<double>(kSamples);
+  double b = std::min(kSamples, best_k + 1) / static_cast<double>(kSamples);
+  double x1 = b - kGolden * (b - a), x2 = a + kGolden * (b - a), f1 = dist(x1), f2 = dist(x2);
+  for (int it = 0; it < 24; ++it) {
+    if (f1 < f2) {
+      b = x2;
+      x2 = x1;
+      f2 = f1;
+      x1 = b - kGolden * (b - a);
+      f1 = dist(x1);
+    } else {
+      a = x1;
+      x1 = x2;
+      f1 = f2;
+      x2 = a + kGolden * (b - a);
+      f2 = dist(x2);
+    }
+  }
+  return std::min({best, f1, f2});
+}
+
 bool blend_within(const MotionBlock& c, const MotionBlock& in, const MotionBlock& out,
                   double tolerance) noexcept {
-  return curve_within(
-      c, [&](const Pose& p) { return std::min(distance_to(in, p), distance_to(out, p)); }, tolerance);
+  return point_to_curve(c, end_point(in)) <= tolerance &&
+         curve_within(
+             c, [&](const Pose& p) { return std::min(distance_to(in, p), distance_to(out, p)); }, tolerance);
 }
 
 double speed_scale_step(const MotionBlock& in, const MotionBlock& out) noexcept {

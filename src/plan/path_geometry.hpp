@@ -145,8 +145,15 @@ bool curve_within(const MotionBlock& c, Distance&& distance, double tolerance) n
   return true;
 }
 
+/// Distance from `v` to a point of the Bézier `c` near the nearest one (sampled, then refined): at
+/// least the distance from `v` to the curve, and equal to it up to the search's resolution.
+/// Non-real-time.
+double point_to_curve(const MotionBlock& c, const Pose& v) noexcept;
+
 /// Whether every point of the quintic `c` lies within `tolerance` of the nearer of `in` and
-/// `out` (curve_within). Non-real-time.
+/// `out` (curve_within), and the corner where they meet (the end of `in`) within `tolerance` of
+/// the curve (point_to_curve): the blend neither strays from the moves nor cuts the corner off.
+/// Non-real-time.
 bool blend_within(const MotionBlock& c, const MotionBlock& in, const MotionBlock& out,
                   double tolerance) noexcept;
 

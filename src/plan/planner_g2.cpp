@@ -89,9 +89,11 @@ bool Planner::Impl::g2_blend(const Element& a, const Element& e, const detail::C
     }
     // The symmetric blend is farthest from both lines at its middle (checked numerically for
     // turns of 1° to 179°): its deviation grows as d from there.
+    // Its middle is also where it passes the corner, |mid − v| from it (a point of the curve:
+    // the corner is at most that far from it).
     const Pose mid = traj::position_at(out.curve, 0.5 * out.curve.length);
-    const double dev = std::min(detail::distance_to(unit_line(v - 2.0 * turn.in, v), mid),
-                                detail::distance_to(unit_line(v, v + 2.0 * turn.out), mid));
+    const double dev = std::max({detail::distance_to(unit_line(v - 2.0 * turn.in, v), mid),
+                                 detail::distance_to(unit_line(v, v + 2.0 * turn.out), mid), norm(mid - v)});
     if (tol > 0 && dev > 0) d_max = std::min(d_max, tol / dev);
     double d1[kAxisCount], d2[kAxisCount], d3[kAxisCount];
     detail::derivative_bounds(out.curve, d1, d2, d3);

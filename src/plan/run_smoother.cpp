@@ -11,7 +11,7 @@
 // Σ_k |C(u_k) − Q_k|² + λ·Σ_i |Δ²P_i|² (λ small: it only fixes control points of spans without a
 // vertex); the normal equations are banded (half-width 3) and positive definite, solved by
 // Cholesky. With few spans the fit averages the vertices' rounding and CAM noise away; the number
-// of spans doubles until every span stays within the tolerance of the moves (curve_within).
+// of spans doubles until every span stays within the tolerance of the moves (span_within).
 #include "run_smoother.hpp"
 
 #include <algorithm>
@@ -37,6 +37,86 @@ void basis(double t, double w[4]) {
   w[1] = (3 * t3 - 6 * t2 + 4) / 6;
   w[2] = (-3 * t3 + 3 * t2 + 3 * t + 1) / 6;
   w[3] = t3 / 6;
+}
+
+/// The point of the line moves [lo, hi] nearest to `x`: its move and distance.
+struct Nearest {
+  double d = 1e300;
+  std::size_t k = 0;
+  Pose p{};
+};
+
+Nearest nearest_line(const std::vector<Element>& moves, std::size_t lo, std::size_t hi, const Pose& x) {
+  Nearest n;
+  for (std::size_t k = lo; k <= hi; ++k) {
+    const traj::MotionBlock& b = moves[k].b;  // a line: unit direction `lin`
+    const Pose q = b.base + std::clamp(dot(x - b.base, b.lin), 0.0, b.length) * b.lin;
+    const double d = norm(x - q);
+    if (d < n.d) n = {d, k, q};
+  }
+  return n;
+}
+
+/// Whether every point of the cubic Bézier span `c` lies within `tol` of the line moves
+/// [lo, hi] (consecutive, each starting where the one before ends). Branch and bound on
+/// intervals [a, b] of its parameter with two bounds on the distance between samples:
+/// - first order: the distance is 1-Lipschitz and the curve moves at most Lip·(b − a), so it
+///   stays within (d_a + d_b + Lip·(b − a))/2 (as curve_within);
+/// - second order: the curve stays within (b − a)²/8 · max|C''| of the chord from C(a) to C(b)
+///   (linear interpolation error); a chord point (1 − λ)C(a) + λC(b) is within (1 − λ)d_a + λd_b
+///   of (1 − λ)n_a + λn_b, n_a and n_b the nearest points of the moves; when both lie on one move
+///   that point is on it, when on two neighbours it is within H of them (H the height of their
+///   common vertex above the line n_a n_b: the base of the triangle n_a, vertex, n_b is within
+///   its height of the other two sides). So the distance is at most max(d_a, d_b) + H + (b − a)²/8 ·
+///   max|C''|, which for a smooth fit holds on intervals as long as a move rather than the
+///   thousandth of a span the first order needs near the tolerance.
+bool span_within(const traj::MotionBlock& c, const std::vector<Element>& moves, std::size_t lo,
+                 std::size_t hi, double tol) {
+  const Pose q[4] = {c.base, c.u, c.w, c.lin};
+  const double lip = 3 * std::max({norm(q[1] - q[0]), norm(q[2] - q[1]), norm(q[3] - q[2])});
+  const double m2 = 6 * std::max(norm(q[2] - 2.0 * q[1] + q[0]), norm(q[3] - 2.0 * q[2] + q[1]));
+  const auto at = [&](double t) { return nearest_line(moves, lo, hi, traj::position_at(c, c.length * t)); };
+  const auto second_order = [&](const Nearest& na, const Nearest& nb, double dt) {
+    double height = 0;
+    if (na.k != nb.k) {
+      if (na.k + 1 != nb.k && nb.k + 1 != na.k) return 1e300;  // farther apart: not this bound
+      const Pose v = end_point(moves[std::min(na.k, nb.k)].b);
+      const Pose base = nb.p - na.p;
+      const double len2 = dot(base, base);
+      const Pose w = v - na.p;
+      height = len2 > 0 ? norm(w - (dot(w, base) / len2) * base) : norm(w);
+    }
+    return std::max(na.d, nb.d) + height + 0.125 * dt * dt * m2;
+  };
+  constexpr int kStart = 4, kMaxSamples = 4096, kDepth = 64;
+  struct Span {
+    double a, b;
+    Nearest na, nb;
+  };
+  Span stack[kDepth];
+  int samples = kStart + 1;
+  Nearest na = at(0.0);
+  if (na.d > tol) return false;
+  for (int i = 1; i <= kStart; ++i) {
+    const double t1 = static_cast<double>(i) / kStart;
+    const Nearest nb = at(t1);
+    if (nb.d > tol) return false;
+    int top = 0;
+    stack[top++] = {static_cast<double>(i - 1) / kStart, t1, na, nb};
+    while (top > 0) {
+      const Span sp = stack[--top];
+      const double dt = sp.b - sp.a;
+      if (0.5 * (sp.na.d + sp.nb.d + lip * dt) <= tol || second_order(sp.na, sp.nb, dt) <= tol) continue;
+      if (top + 2 > kDepth || ++samples > kMaxSamples) return false;  // too close to call: not within
+      const double m = 0.5 * (sp.a + sp.b);
+      const Nearest nm = at(m);
+      if (nm.d > tol) return false;
+      stack[top++] = {m, sp.b, nm, sp.nb};
+      stack[top++] = {sp.a, m, sp.na, nm};
+    }
+    na = nb;
+  }
+  return true;
 }
 
 bool only_xyz(const traj::MotionBlock& b) {
@@ -241,7 +321,7 @@ bool RunSmoother::fit(std::size_t m, double tolerance, bool partial, std::vector
   }
   // Each span as a cubic Bézier, checked against the moves within a span of its range.
   const std::size_t first_out = out.size();
-  std::size_t k_lo = 0;
+  std::size_t k_lo = 0, near_a = 0, near_b = 0;
   for (long j = 0; j < last_span; ++j) {
     const double u0 = static_cast<double>(j) * h, u1 = u0 + h;
     const Pose a = at(j - 1), b = at(j), c = at(j + 1), d = at(j + 2);
@@ -263,16 +343,14 @@ bool RunSmoother::fit(std::size_t m, double tolerance, bool partial, std::vector
     s.segment_first = run_[k_lo].b.segment_first;
     s.segment_last = run_[k_hi].b.segment_last;
     s.segment_offset = 0;
+    // Checked against the moves within a span's length of it, [near_a, near_b] (u_ grows with k,
+    // and so do the spans, so both ends only move forward): a subset of the path, so the
+    // distance to it bounds the distance to the path from above.
     const double near_lo = u0 - h, near_hi = u1 + h;
-    const auto distance = [&](const Pose& p) {
-      double best = 1e300;
-      for (std::size_t k = 0; k < n; ++k) {
-        if (u_[k + 1] < near_lo || u_[k] > near_hi) continue;
-        best = std::min(best, distance_to(run_[k].b, p));
-      }
-      return best;
-    };
-    if (!curve_within(s, distance, tolerance)) {
+    while (near_a + 1 < n && u_[near_a + 1] < near_lo) ++near_a;
+    near_b = std::max(near_b, near_a);
+    while (near_b + 1 < n && u_[near_b + 1] <= near_hi) ++near_b;
+    if (!span_within(s, run_, near_a, near_b, tolerance)) {
       out.resize(first_out);
       return false;
     }
@@ -281,7 +359,7 @@ bool RunSmoother::fit(std::size_t m, double tolerance, bool partial, std::vector
     double deviation = tolerance;
     if (j == 0 || j + 1 == M) {
       for (double share = 0.125; share < 1; share *= 2) {
-        if (curve_within(s, distance, share * tolerance)) {
+        if (span_within(s, run_, near_a, near_b, share * tolerance)) {
           deviation = share * tolerance;
           break;
         }
@@ -290,6 +368,21 @@ bool RunSmoother::fit(std::size_t m, double tolerance, bool partial, std::vector
     e.orig_length = h;
     e.merge_deviation = deviation;  // the run's own merges added below
     out.push_back(e);
+  }
+  // The other way round: every vertex the spans pass stays within the tolerance of the curve
+  // (the fit must not cut a corner of the moves off, whatever its distance to them).
+  const double covered = static_cast<double>(last_span) * h;
+  for (std::size_t k = 1; k < n && u_[k] < covered; ++k) {
+    const long j = std::min(last_span - 1, static_cast<long>(std::floor(u_[k] / h)));
+    const traj::MotionBlock& span = out[first_out + static_cast<std::size_t>(j)].b;
+    if (norm(traj::position_at(span, u_[k] - static_cast<double>(j) * h) - points_[k]) <= tolerance) continue;
+    double best = 1e300;
+    for (long q = std::max(0L, j - 1); q <= std::min(last_span - 1, j + 1); ++q)
+      best = std::min(best, point_to_curve(out[first_out + static_cast<std::size_t>(q)].b, points_[k]));
+    if (best > tolerance) {
+      out.resize(first_out);
+      return false;
+    }
   }
   double merged = 0;
   for (const Element& e : run_) merged = std::max(merged, e.merge_deviation);

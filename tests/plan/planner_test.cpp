@@ -144,9 +144,10 @@ TEST(Planner, ContinuousCornersGetArcsWithinTheTolerance) {
     const MotionBlock& arc = blocks[i];
     ASSERT_EQ(arc.kind, BlockKind::Arc);
     EXPECT_TRUE(arc.flags & traj::kBlend);
-    // A 90° fillet: radius r with r·(1 − cos 45°) = P, so the middle of the arc is P from both lines.
+    // A 90° fillet: radius r with r·(1/cos 45° − 1) = P, so the middle of the arc is P from the
+    // corner (as LinuxCNC sizes its blend arcs) and closer to both lines.
     const double r = 1.0 / std::fabs(arc.omega);
-    EXPECT_NEAR(r * (1 - std::cos(std::numbers::pi / 4)), P, 1e-12);
+    EXPECT_NEAR(r * (1 / std::cos(std::numbers::pi / 4) - 1), P, 1e-12);
     // Centripetal acceleration at the cap within 95 % of the axis limit.
     EXPECT_NEAR(arc.v_cap * arc.v_cap / r, 0.95 * 1000, 1e-6);
     const Pose end = traj::position_at(arc, arc.length);
