@@ -126,6 +126,7 @@ std::optional<canon::Program> interpret(const std::string& path, const Args& arg
   }
   gcode::Interpreter interp(o);
   canon::ProgramBuilder builder(kXyzabc);
+  builder.program().set_sources(interp.sources());  // diagnostics name the file and line
   // The harness's `--tol`: an MDI G64 P before the program (LinuxCNC's G64 P also sets Q = P).
   const std::string mdi = args.tolerance > 0 ? fmt::format("G64 P{:g}", args.tolerance) : std::string("G64");
   if (interp.execute_mdi(mdi, builder) == gcode::RunStatus::Error || !interp.open(path)) return std::nullopt;

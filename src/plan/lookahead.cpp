@@ -73,16 +73,18 @@ void Lookahead::push_next() {
   r.junction = pb.junction;
   r.epoch = epoch_;
   r.marker = marker;
+  r.scaled = false;
   if (marker && is_stop(pb.b)) ++epoch_;  // a stop: the generator waits there for the average
   total_s_ = r.end;
   pending_.commit_spare();
   if (widening() && !marker) {
     if (has_step(pb.step)) scale_near_step(pending_.size() - 1);
-    if (r.start < scaled_until_) {
+    if (r.start < scaled_until_ && !r.scaled) {
       const RawLimits s = block_limits(pb.b, pb.v_max, *p_.limits, 1 - p_.limits->step_share);
       r.cap = std::min(r.cap, s.cap);
       r.accel = std::min(r.accel, s.accel);
       r.jerk = std::min(r.jerk, s.jerk);
+      r.scaled = true;
     }
     add_steps(pending_.size() - 1);
   }
@@ -105,11 +107,12 @@ void Lookahead::scale_near_step(std::size_t m) {
   for (std::size_t j = m; j-- > 0;) {
     Range& r = range_of(j);
     if (r.end < at - reach) break;
-    if (r.marker) continue;
+    if (r.marker || r.scaled) continue;  // (the scaled limits do not depend on which step asks)
     const RawLimits s = block_limits(pending_[j].b, pending_[j].v_max, *p_.limits, 1 - p_.limits->step_share);
     r.cap = std::min(r.cap, s.cap);
     r.accel = std::min(r.accel, s.accel);
     r.jerk = std::min(r.jerk, s.jerk);
+    r.scaled = true;
   }
 }
 

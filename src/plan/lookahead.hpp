@@ -117,6 +117,7 @@ class Lookahead {
     double junction = 0;      ///< speed limit at its start
     std::uint64_t epoch = 0;  ///< stops before it: ranges reach only blocks of the same epoch
     bool marker = false;
+    bool scaled = false;  ///< its limits already hold with the jerk share left by curvature steps
   };
   struct Widened {
     double cap, accel, jerk;
