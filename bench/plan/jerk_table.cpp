@@ -54,7 +54,7 @@ std::string dir_name(const std::string& path) {
   return slash == std::string::npos ? std::string(".") : path.substr(0, slash);
 }
 
-/// LinuxCNC's times by file name: lines "PATH<TAB>SECONDS" (FAIL or empty: not measured).
+/// LinuxCNC's times by path: lines "PATH<TAB>SECONDS" (FAIL or empty: not measured).
 std::map<std::string, double> read_lcnc_times(const std::string& file) {
   std::map<std::string, double> times;
   std::ifstream in(file);
@@ -65,7 +65,7 @@ std::map<std::string, double> read_lcnc_times(const std::string& file) {
     char* end = nullptr;
     const std::string value = line.substr(tab + 1);
     const double t = std::strtod(value.c_str(), &end);
-    if (end != value.c_str() && t > 0) times[base_name(line.substr(0, tab))] = t;
+    if (end != value.c_str() && t > 0) times[line.substr(0, tab)] = t;
   }
   return times;
 }
@@ -186,6 +186,7 @@ Run run(const canon::Program& program, double jerk, const Args& args) {
       if (!s.finished) return r;
       continue;
     }
+    if (s.report.limit_violations > 0) fmt::print(stderr, "J {:g}: {}\n", jerk, s.report.summary());
     r.contour_mm = s.report.max_contour_error_mm;
     r.corner_mm = s.report.max_corner_miss_mm;
     r.violations = s.report.limit_violations;
@@ -231,7 +232,7 @@ int main(int argc, char** argv) {
       fmt::print("| {} | interpreter error |\n", name);
       continue;
     }
-    const auto l = lcnc.find(name);
+    const auto l = lcnc.find(file);  // by path: programs of the same name may differ
     std::string row =
         fmt::format("| {} | {} | {} | {} |", name, program->size(),
                     largest_tolerance(*program) > 0 ? fmt::format("{:g}", largest_tolerance(*program)) : "—",

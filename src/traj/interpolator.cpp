@@ -102,12 +102,20 @@ Interpolator::Turn Interpolator::turn_bounds(const TickInput& in) noexcept {
   const int m = config_.filter_ticks;
   if (m <= 1) return t;
   const std::size_t avail = queue_->available();
+  // The budget where the commanded position is; resting at the end of its block (a corner taken
+  // at rest, where the window's ranges stop), the motion leaves along the next block: its budget
+  // too.
   double jerk = 0;
-  for (std::size_t i = index_of(f_seq_), n = 0; i < avail && n < 8; ++i, ++n) {
+  const std::size_t f_index = index_of(f_seq_);
+  for (std::size_t i = f_index, n = 0; i < avail && n < 8; ++i, ++n) {
     const MotionBlock& b = queue_->peek(i);
     if (b.kind == BlockKind::Marker) continue;
+    if (jerk > 0) {
+      jerk = std::min(jerk, b.jerk);
+      break;
+    }
     jerk = b.jerk;
-    break;
+    if (i != f_index || s_f_ - f_start_ < b.length) break;
   }
   if (jerk <= 0) return t;
   t.active = true;
@@ -370,8 +378,11 @@ double Interpolator::advance_unfiltered(const TickInput& in) noexcept {
       continue;
     }
     // A corner passed at zero speed: the moving average must reach it before the motion goes on,
-    // or the commanded path would round it off.
-    if (b.v_entry == 0 && s_u_ == u_start_ && v_u_ == 0 && still_ticks_ < config_.filter_ticks) break;
+    // or the commanded path would round it off. With jerk limits it also rests there for the three
+    // periods the trace's third difference spans: a difference across the corner would add the
+    // kink of the axes' directions (Δg' times the motion within a period) to their jerk.
+    const int rest = config_.filter_ticks > 1 ? config_.filter_ticks + 3 : config_.filter_ticks;
+    if (b.v_entry == 0 && s_u_ == u_start_ && v_u_ == 0 && still_ticks_ < rest) break;
     if (b.flags & kRigidTap) {  // reached at rest; run_tap() moves the tap
       v_u_ = 0;
       break;
