@@ -204,34 +204,50 @@ double bernstein(const double* c, int n, double t) {
   return q[0];
 }
 
-/// Largest |p| on [0, 1] of a Bernstein polynomial of degree n ≤ 5: at the ends, on a grid, and
-/// where p' changes sign between grid points (bisection): its extrema.
+/// The roots in (0, 1) of a Bernstein polynomial of degree n ≤ 5, in order (at most n). Between
+/// two consecutive roots of its derivative (found the same way) it is monotone, so each such piece
+/// holds at most one root, found by bisection where the sign changes: no root is missed, however
+/// close two of them lie.
+int bernstein_roots(const double* c, int n, double* roots) {
+  if (n <= 0) return 0;
+  double d[5];
+  for (int k = 0; k < n; ++k) d[k] = n * (c[k + 1] - c[k]);
+  double cuts[7];
+  int nc = 0;
+  cuts[nc++] = 0.0;
+  double inner[5];
+  const int ni = bernstein_roots(d, n - 1, inner);
+  for (int k = 0; k < ni; ++k) cuts[nc++] = inner[k];
+  cuts[nc++] = 1.0;
+  int found = 0;
+  for (int k = 0; k + 1 < nc; ++k) {
+    double lo = cuts[k], hi = cuts[k + 1];
+    double flo = bernstein(c, n, lo);
+    const double fhi = bernstein(c, n, hi);
+    if (flo == 0 || (flo < 0) == (fhi < 0)) continue;
+    for (int it = 0; it < 45 && hi - lo > 1e-12; ++it) {
+      const double mid = 0.5 * (lo + hi), fm = bernstein(c, n, mid);
+      if ((fm < 0) == (flo < 0)) {
+        lo = mid;
+        flo = fm;
+      } else {
+        hi = mid;
+      }
+    }
+    roots[found++] = 0.5 * (lo + hi);
+  }
+  return found;
+}
+
+/// Largest |p| on [0, 1] of a Bernstein polynomial of degree n ≤ 5: at the ends and at the roots
+/// of p' (bernstein_roots), its extrema.
 double max_abs_bernstein(const double* c, int n) {
   double best = std::max(std::fabs(c[0]), std::fabs(c[n]));
   if (n <= 1) return best;
-  double d[5];
+  double d[5], roots[5];
   for (int k = 0; k < n; ++k) d[k] = n * (c[k + 1] - c[k]);
-  constexpr int kGrid = 12;  // p' has at most 4 roots; two closer than 1/12 leave p nearly flat between
-  double t0 = 0, s0 = bernstein(d, n - 1, 0.0);
-  for (int g = 1; g <= kGrid; ++g) {
-    const double t1 = static_cast<double>(g) / kGrid, s1 = bernstein(d, n - 1, t1);
-    best = std::max(best, std::fabs(bernstein(c, n, t1)));
-    if ((s0 < 0) != (s1 < 0)) {
-      double lo = t0, hi = t1, slo = s0;
-      for (int it = 0; it < 30; ++it) {
-        const double mid = 0.5 * (lo + hi), sm = bernstein(d, n - 1, mid);
-        if ((sm < 0) == (slo < 0)) {
-          lo = mid;
-          slo = sm;
-        } else {
-          hi = mid;
-        }
-      }
-      best = std::max(best, std::fabs(bernstein(c, n, 0.5 * (lo + hi))));
-    }
-    t0 = t1;
-    s0 = s1;
-  }
+  const int nr = bernstein_roots(d, n - 1, roots);
+  for (int k = 0; k < nr; ++k) best = std::max(best, std::fabs(bernstein(c, n, roots[k])));
   return best;
 }
 
