@@ -14,6 +14,7 @@ packages=(
   libtomlplusplus-dev   # machine profiles
   libboost-dev          # Boost.Beast (header-only): the HMI server's HTTP and WebSocket
   libeigen3-dev         # least squares of electrode setting's sphere fit (header-only)
+  libxml2-dev           # MTConnect: its documents written, `path=` XPaths evaluated (src/connect)
   libsqlite3-dev        # the tool store (store::Database), the HMI's history and audit trail, the process-data log
   python3               # helper scripts (program generators, golden regeneration)
 )
