@@ -7,9 +7,9 @@
 
 #include <algorithm>
 #include <charconv>
-#include <ctime>
 
 #include "opencnc/config/machine_profile.hpp"
+#include "opencnc/connect/json_messages.hpp"
 #include "path_filter.hpp"
 #include "xml_writer.hpp"
 
@@ -23,16 +23,6 @@ constexpr const char* kDevicesNs = "urn:mtconnect.org:MTConnectDevices:2.7";
 constexpr const char* kAssetsNs = "urn:mtconnect.org:MTConnectAssets:2.7";
 constexpr const char* kErrorNs = "urn:mtconnect.org:MTConnectError:2.7";
 constexpr std::size_t kAssetBufferSize = 1024;
-
-/// ISO 8601 UTC with microseconds, as MTConnect's timestamps are written.
-std::string iso_time(std::int64_t us) {
-  const std::time_t seconds = static_cast<std::time_t>(us >= 0 ? us / 1000000 : (us - 999999) / 1000000);
-  const auto micro = static_cast<int>(us - static_cast<std::int64_t>(seconds) * 1000000);
-  std::tm tm{};
-  gmtime_r(&seconds, &tm);
-  return fmt::format("{:04}-{:02}-{:02}T{:02}:{:02}:{:02}.{:06}Z", tm.tm_year + 1900, tm.tm_mon + 1, tm.tm_mday,
-                     tm.tm_hour, tm.tm_min, tm.tm_sec, micro);
-}
 
 int hex(char c) {
   if (c >= '0' && c <= '9') return c - '0';
@@ -113,7 +103,8 @@ Agent::Agent(DeviceModel model, std::vector<std::unique_ptr<Contribution>> contr
 }
 
 std::unique_ptr<Agent> Agent::for_profile(const config::MachineProfile& profile, AgentOptions options) {
-  const std::string name = profile.name.empty() ? std::string("opencnc") : profile.name;
+  const std::string name =
+      !options.device_name.empty() ? options.device_name : profile.name.empty() ? std::string("opencnc") : profile.name;
   DeviceModel model(name, "opencnc-" + xml_id(name),
                     profile.description.empty() ? std::string("opencnc machine") : profile.description);
   return std::make_unique<Agent>(std::move(model), contributions_for(profile), std::move(options));
@@ -201,6 +192,27 @@ void Agent::set_tools(std::vector<ToolAsset> tools, std::int64_t time_us) {
 std::uint64_t Agent::next_sequence() const {
   std::lock_guard lock(mutex_);
   return buffer_.next_sequence();
+}
+
+std::vector<Observation> Agent::observations(std::uint64_t from, std::size_t max, std::uint64_t* first) const {
+  std::lock_guard lock(mutex_);
+  const std::uint64_t start = std::max(from, buffer_.first_sequence());
+  if (first != nullptr) *first = start;
+  std::vector<Observation> out;
+  for (std::uint64_t s = start; s < buffer_.next_sequence() && out.size() < max; ++s) out.push_back(buffer_.at(s));
+  return out;
+}
+
+std::vector<Observation> Agent::snapshot() const {
+  std::lock_guard lock(mutex_);
+  std::vector<Observation> out;
+  for (const auto& s : buffer_.current()) {
+    if (!s.active.empty())
+      out.insert(out.end(), s.active.begin(), s.active.end());
+    else
+      out.push_back(s.last);
+  }
+  return out;
 }
 
 // --- Requests ----------------------------------------------------------------------------------

@@ -124,7 +124,7 @@ class EveryProfile : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(EveryProfile, EveryDocumentIsValidMTConnect27) {
   const auto p = profile(GetParam());
-  auto agent = Agent::for_profile(p, AgentOptions{"test-host", 7, 4096, 1000});
+  auto agent = Agent::for_profile(p, AgentOptions{"test-host", "", 7, 4096, 1000});
   Scenario s(p);
   observe(*agent, s, 50);
   s.on(control::Mode::Mdi);
@@ -215,7 +215,7 @@ TEST(Agent, AMachineThatRunsShowsItsPositionsStateAndProgramValues) {
 
 TEST(Agent, SampleWalksEverySequenceOnceInOrderAndRefusesWhatTheBufferForgot) {
   const auto p = profile("mill-3axis");
-  auto agent = Agent::for_profile(p, AgentOptions{"h", 1, 64, 1000});
+  auto agent = Agent::for_profile(p, AgentOptions{"h", "", 1, 64, 1000});
   Scenario s(p);
   s.on(control::Mode::Mdi);
   s.must(control::Request::mdi("G1 X20 F600"));

@@ -26,6 +26,9 @@ namespace opencnc::connect {
 
 struct AgentOptions {
   std::string sender = "opencnc";  ///< the documents' Header sender (the host's name)
+  /// The device's name ("" = the profile's): machines of one profile in one shop need their own.
+  /// Its uuid is "opencnc-<name>".
+  std::string device_name;
   /// Tells clients the agent restarted (sequence numbers began again): the start time, say.
   std::uint64_t instance_id = 1;
   std::size_t buffer_size = 131072;  ///< observations kept (MTConnect's bufferSize)
@@ -89,6 +92,13 @@ class Agent {
   SampleAnswer sample(const AgentRequest& request, std::int64_t now_us) const;
   /// The next sequence number (observations are < it). Any thread.
   std::uint64_t next_sequence() const;
+  /// Observations from `from` on (the oldest retained when `from` is older: `*first` says where the
+  /// answer begins), at most `max`. Any thread.
+  std::vector<Observation> observations(std::uint64_t from, std::size_t max, std::uint64_t* first = nullptr) const;
+  /// Every item's current observation (each active condition of a condition item, else its last),
+  /// in model order: what a new SHDR client or a retained MQTT message starts from. Any thread.
+  std::vector<Observation> snapshot() const;
+  const AgentOptions& options() const noexcept { return options_; }
 
   const DeviceModel& model() const noexcept { return model_; }
 
