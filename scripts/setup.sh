@@ -15,6 +15,7 @@ packages=(
   libboost-dev          # Boost.Beast (header-only): the HMI server's HTTP and WebSocket
   libeigen3-dev         # least squares of electrode setting's sphere fit (header-only)
   libxml2-dev           # MTConnect: its documents written, `path=` XPaths evaluated (src/connect)
+  libmosquitto-dev      # MQTT: the machine's observations published to the shop's broker (src/connect)
   libsqlite3-dev        # the tool store (store::Database), the HMI's history and audit trail, the process-data log
   python3               # helper scripts (program generators, golden regeneration)
 )
@@ -27,6 +28,7 @@ test_packages=(
   linuxcnc-uspace             # rs274 (oracle), /usr/share/linuxcnc/ncfiles; halrun for the HAL tests
   linuxcnc-uspace-dev         # hal.h, rtapi.h: the HAL component opencnc_rt.so (docs/hal.md)
   chromium                    # the HMI's end-to-end tests (headless, driven by playwright-core)
+  mosquitto                   # a real MQTT broker the connectivity tests start on loopback
   stress-ng                   # scripts/latency-under-load.sh: CPU, memory and I/O load from other processes
 )
 
