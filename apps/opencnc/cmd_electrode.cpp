@@ -45,7 +45,7 @@ double electrode_um(double mm) {
   return std::round(mm * 1e4) / 10;  // µm to a tenth
 }
 
-nlohmann::json json_point(const control::Point3& p) {
+nlohmann::json json_point(const Vec3& p) {
   return {p[0], p[1], p[2]};
 }
 
@@ -151,7 +151,7 @@ std::optional<int> open_session(const config::MachineProfile& profile, const std
   s.rig = std::make_unique<control::SimRig>(
       profile, std::make_shared<control::GcodeProgramSource>(std::move(*config)));
   // The simulated electrode: where the table says, unless --sim-electrode puts it elsewhere.
-  control::Point3 truth{entry->offset[0], entry->offset[1], entry->offset[2]};
+  Vec3 truth{entry->offset[0], entry->offset[1], entry->offset[2]};
   if (sim_electrode.size() == 3) truth = {sim_electrode[0], sim_electrode[1], sim_electrode[2]};
   s.rig->machine().set_electrode(truth, entry->diameter / 2);
   s.feature = std::make_shared<control::ElectrodeSetting>(table, profile);

@@ -83,7 +83,7 @@ int run_nearest(const NearestOptions& o) {
   recovery::QueryOptions q;
   q.metric = o.three_d ? recovery::Metric::Xyz : recovery::Metric::Xy;
   q.margin_mm = o.margin_mm;
-  const recovery::Vec3 b{o.point[0], o.point[1], o.point.size() > 2 ? o.point[2] : 0.0};
+  const Vec3 b{o.point[0], o.point[1], o.point.size() > 2 ? o.point[2] : 0.0};
   const recovery::Nearest n = ix.nearest(b, q);
   if (!n.found) {
     fmt::print(stderr, "error: {} has no feed moves\n", o.file);

@@ -2,6 +2,7 @@
 // B's axis of rotation fitted to the sphere's centres at several B angles: the plane's normal,
 // the circle's centre, the electrode's offsets taken out.
 #include "opencnc/controller/b_axis_fit.hpp"
+#include "opencnc/core/vec3.hpp"
 
 #include <Eigen/Dense>
 
@@ -15,14 +16,13 @@ namespace opencnc::control {
 
 namespace {
 
-using Point3 = std::array<double, 3>;
 constexpr double kRad = std::numbers::pi / 180;
 
-Eigen::Vector3d vec(const Point3& p) {
+Eigen::Vector3d vec(const Vec3& p) {
   return {p[0], p[1], p[2]};
 }
 
-Point3 point(const Eigen::Vector3d& v) {
+Vec3 point(const Eigen::Vector3d& v) {
   return {v.x(), v.y(), v.z()};
 }
 
@@ -60,14 +60,14 @@ std::optional<Eigen::Vector3d> fit_circle(const std::vector<Eigen::Vector2d>& p)
 
 }  // namespace
 
-Point3 sphere_centre_at(const config::ReferenceSphereProfile& sphere, double b_deg) {
+Vec3 sphere_centre_at(const config::ReferenceSphereProfile& sphere, double b_deg) {
   if (!sphere.has_b_axis || b_deg == sphere.b_deg) return sphere.position;
-  const Point3 on_axis{sphere.b_axis[0], sphere.position[1], sphere.b_axis[1]};
+  const Vec3 on_axis{sphere.b_axis[0], sphere.position[1], sphere.b_axis[1]};
   return machine::rotate_about(sphere.position, on_axis, sphere.b_axis_direction,
                                (b_deg - sphere.b_deg) * kRad);
 }
 
-std::optional<BAxisFit> fit_b_axis(std::span<const double> angles_deg, std::span<const Point3> centres,
+std::optional<BAxisFit> fit_b_axis(std::span<const double> angles_deg, std::span<const Vec3> centres,
                                    const config::ReferenceSphereProfile& sphere) {
   const std::size_t n = std::min(angles_deg.size(), centres.size());
   std::vector<double> distinct(angles_deg.begin(), angles_deg.begin() + static_cast<std::ptrdiff_t>(n));
@@ -112,8 +112,8 @@ std::optional<BAxisFit> fit_b_axis(std::span<const double> angles_deg, std::span
   BAxisFit fit;
   fit.radius_mm = (*circle)(2);
   for (std::size_t k = 0; k < n; ++k) {
-    const Point3 predicted = machine::rotate_about(point(at_b), point(centre), point(normal),
-                                                   (angles_deg[k] - sphere.b_deg) * kRad);
+    const Vec3 predicted = machine::rotate_about(point(at_b), point(centre), point(normal),
+                                                 (angles_deg[k] - sphere.b_deg) * kRad);
     const double r = (vec(predicted) - vec(centres[k])).norm();
     fit.residuals_mm.push_back(r);
     fit.rms_residual_mm += r * r;

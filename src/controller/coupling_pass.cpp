@@ -78,25 +78,12 @@ void CouplingPass::engage(const canon::Program& program, const canon::Action& a)
     law_ = motion::CouplingLaw{};
     return;
   }
-  switch (kind) {
-    case motion::CouplingKind::ConstantPitch:
-      law_ = motion::CouplingLaw::constant(a.value);
-      break;
-    case motion::CouplingKind::LinearPitch:
-      law_ = motion::CouplingLaw::linear(a.value, program.action_pose(a.pose)[0]);
-      break;
-    default: {
-      const int t = a.index2 - 1;
-      if (t < 0 || t >= motion::kMaxCouplingTables ||
-          axes_.config.table_kind[static_cast<std::size_t>(t)] != kind) {
-        fail(program, a.context, a.line,
-             fmt::format("this machine has no {} table {} (its profile's [[coupling.table]] entries)",
-                         kind == motion::CouplingKind::Cam ? "cam" : "pitch", a.index2));
-        law_ = motion::CouplingLaw{};
-        return;
-      }
-      law_ = motion::CouplingLaw::tabulated(kind, axes_.config.tables[static_cast<std::size_t>(t)]);
-    }
+  law_ = motion::law_for(axes_.config, kind, a.value, program.action_pose(a.pose)[0], a.index2);
+  if (!law_.active()) {  // only a table can be missing: the codes give the pitch laws their pitch
+    fail(program, a.context, a.line,
+         fmt::format("this machine has no {} table {} (its profile's [[coupling.table]] entries)",
+                     kind == motion::CouplingKind::Cam ? "cam" : "pitch", a.index2));
+    return;
   }
   // A resumed program's law engages with the origin its code had; the slave coordinate the
   // program asked for last is the one it had there (it cannot ask for another while coupled).

@@ -30,20 +30,20 @@ Outcome accept(std::string message) {
   return o;
 }
 
-Pose with_xyz(Pose p, const Point3& xyz) {
+Pose with_xyz(Pose p, const Vec3& xyz) {
   for (int i = 0; i < 3; ++i) p[i] = xyz[static_cast<std::size_t>(i)];
   return p;
 }
 
-Point3 xyz(const Pose& p) {
+Vec3 xyz(const Pose& p) {
   return {p[0], p[1], p[2]};
 }
 
-Point3 offsets_of(const tools::ToolEntry& e) {
+Vec3 offsets_of(const tools::ToolEntry& e) {
   return {e.offset[0], e.offset[1], e.offset[2]};
 }
 
-std::string show(const Point3& p) {
+std::string show(const Vec3& p) {
   return fmt::format("X{:.4f} Y{:.4f} Z{:.4f}", p[0], p[1], p[2]);
 }
 
@@ -62,8 +62,8 @@ constexpr double kMaxLateralMm = 0.002;
 /// Whether the contact closed during the probe move: the servo's latch of the edge lies on the
 /// move's line, past its start. A contact closed before (the electrode went down into the sphere,
 /// or met something on the way) latches where it closed, and the probe move trips at once.
-bool on_probe_path(const SphereTouch& t, const Point3& at) {
-  Point3 d{}, v{};
+bool on_probe_path(const SphereTouch& t, const Vec3& at) {
+  Vec3 d{}, v{};
   for (std::size_t i = 0; i < 3; ++i) {
     d[i] = t.end[i] - t.start[i];
     v[i] = at[i] - t.start[i];
@@ -98,18 +98,18 @@ const char* to_string(ElectrodePhase p) noexcept {
 
 // --- planning and evaluation -------------------------------------------------------------------
 
-std::vector<SphereTouch> plan_touches(const config::ReferenceSphereProfile& sphere, const Point3& offset,
+std::vector<SphereTouch> plan_touches(const config::ReferenceSphereProfile& sphere, const Vec3& offset,
                                       double tip_radius) {
   const double reach = sphere.diameter / 2 + tip_radius;  // tip ball's centre to the sphere's centre
   // The controlled point that puts the tip ball's centre at q.
-  const auto controlled = [&](const Point3& q) {
-    return Point3{q[0] + offset[0], q[1] + offset[1], q[2] + offset[2] - tip_radius};
+  const auto controlled = [&](const Vec3& q) {
+    return Vec3{q[0] + offset[0], q[1] + offset[1], q[2] + offset[2] - tip_radius};
   };
-  const auto touch = [&](std::string name, const Point3& u) {
+  const auto touch = [&](std::string name, const Vec3& u) {
     SphereTouch t;
     t.name = std::move(name);
     t.direction = u;
-    Point3 out{}, in{};
+    Vec3 out{}, in{};
     for (std::size_t i = 0; i < 3; ++i) {
       out[i] = sphere.position[i] + (reach + sphere.clearance) * u[i];
       in[i] = sphere.position[i] + (reach - sphere.clearance) * u[i];
@@ -162,10 +162,10 @@ std::shared_ptr<const canon::Program> touch_program(AxisMask axes, const Pose& f
 }
 
 std::shared_ptr<const canon::Program> slow_touch_program(AxisMask axes, const Pose& from,
-                                                         const SphereTouch& touch, const Point3& contact,
+                                                         const SphereTouch& touch, const Vec3& contact,
                                                          const config::ReferenceSphereProfile& sphere,
                                                          SphereTouch& slow) {
-  Point3 u{};  // along the probe move
+  Vec3 u{};  // along the probe move
   const double length =
       std::hypot(touch.end[0] - touch.start[0], touch.end[1] - touch.start[1], touch.end[2] - touch.start[2]);
   for (std::size_t i = 0; i < 3; ++i) u[i] = (touch.end[i] - touch.start[i]) / length;
@@ -185,9 +185,9 @@ std::shared_ptr<const canon::Program> slow_touch_program(AxisMask axes, const Po
   return std::make_shared<canon::Program>(b.take());
 }
 
-ElectrodeResult evaluate_touches(const config::ReferenceSphereProfile& sphere, int tool,
-                                 const Point3& previous, double tip_radius,
-                                 std::span<const std::string> names, std::span<const Point3> touched) {
+ElectrodeResult evaluate_touches(const config::ReferenceSphereProfile& sphere, int tool, const Vec3& previous,
+                                 double tip_radius, std::span<const std::string> names,
+                                 std::span<const Vec3> touched) {
   ElectrodeResult r;
   r.tool = tool;
   r.tip_radius = tip_radius;
@@ -196,9 +196,9 @@ ElectrodeResult evaluate_touches(const config::ReferenceSphereProfile& sphere, i
   r.touched.assign(touched.begin(), touched.end());
   // The tip ball's centre is the controlled point less the offsets plus the tip radius up: fit
   // the controlled points lifted by the tip radius, and the centre found is sphere + offsets.
-  std::vector<Point3> lifted(touched.begin(), touched.end());
-  for (Point3& p : lifted) p[2] += tip_radius;
-  Point3 guess{};
+  std::vector<Vec3> lifted(touched.begin(), touched.end());
+  for (Vec3& p : lifted) p[2] += tip_radius;
+  Vec3 guess{};
   for (std::size_t i = 0; i < 3; ++i) guess[i] = sphere.position[i] + previous[i];
   guess[2] -= tip_radius;
   const std::optional<SphereFit> fit = fit_sphere(lifted, sphere.diameter / 2 + tip_radius, guess);
@@ -578,7 +578,7 @@ void ElectrodeSetting::when_aux_ended(const ControllerEvent& e) {
                     fmt::format("the {} from {} met nothing within {:g} mm past where the {}: no sphere, or "
                                 "the electrode is far off its offsets",
                                 stage, t.name, within, where));
-      const Point3 at = xyz(servo.probe_position);
+      const Vec3 at = xyz(servo.probe_position);
       if (!on_probe_path(t, at))
         return fail("electrode.contact-at-start",
                     fmt::format("the {} from {} was in contact where it began, {:g} mm off where the {}: the "
@@ -602,7 +602,7 @@ void ElectrodeSetting::when_aux_ended(const ControllerEvent& e) {
 
 // A touch closed at `at`: after a fast one, the slow one from just before it; after a slow (or
 // the only) one, the point is kept and the next direction follows.
-void ElectrodeSetting::touched(const Point3& at) {
+void ElectrodeSetting::touched(const Vec3& at) {
   if (at_.fast_feed > 0 && !slow_) {
     fast_touched_.push_back(at);
     next_aux_ = slow_touch_program(axes_, host_->current_status().servo.commanded, plan_[touch_], at, at_,

@@ -460,9 +460,7 @@ bool same_move(const canon::Program& a, const canon::Program& b, canon::SegmentI
   if (ma.kind != canon::MoveKind::Arc) return true;
   const canon::ArcGeometry& ga = a.arc(k);
   const canon::ArcGeometry& gb = b.arc(k);
-  return ga.turns == gb.turns && ga.plane == gb.plane &&
-         std::equal(std::begin(ga.center), std::end(ga.center), std::begin(gb.center)) &&
-         std::equal(std::begin(ga.normal), std::end(ga.normal), std::begin(gb.normal));
+  return ga.turns == gb.turns && ga.plane == gb.plane && ga.center == gb.center && ga.normal == gb.normal;
 }
 
 /// The sync point an action or a move stands for (None if it is none).

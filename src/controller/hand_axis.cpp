@@ -5,6 +5,8 @@
 
 #include <fmt/format.h>
 
+#include "opencnc/canon/arc_geometry.hpp"
+
 namespace opencnc::control {
 
 namespace {
@@ -44,22 +46,8 @@ void HandAxisFilter::process(canon::Program& program) {
 
 // Whether an arc in `plane` moves a hand axis along its circle.
 bool HandAxisFilter::in_plane(canon::Plane plane) const noexcept {
-  const auto has = [&](Axis a) { return hand_.axes.has(a); };
-  switch (plane) {
-    case canon::Plane::XY:
-      return has(Axis::X) || has(Axis::Y);
-    case canon::Plane::YZ:
-      return has(Axis::Y) || has(Axis::Z);
-    case canon::Plane::XZ:
-      return has(Axis::X) || has(Axis::Z);
-    case canon::Plane::UV:
-      return has(Axis::U) || has(Axis::V);
-    case canon::Plane::VW:
-      return has(Axis::V) || has(Axis::W);
-    case canon::Plane::UW:
-      return has(Axis::U) || has(Axis::W);
-  }
-  return false;
+  const canon::PlaneAxes a = canon::plane_axes(plane);
+  return hand_.axes.has(static_cast<Axis>(a.first)) || hand_.axes.has(static_cast<Axis>(a.second));
 }
 
 void HandAxisFilter::fail(const canon::Program& program, canon::SegmentId id, std::string message) {

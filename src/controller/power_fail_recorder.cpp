@@ -23,21 +23,7 @@ PowerFailRecorder::PowerFailRecorder(const motion::CouplingConfig& coupling,
     : coupling_(coupling), limits_(limits), period_s_(period_s), radius_mm_(radius_mm) {}
 
 motion::CouplingLaw PowerFailRecorder::law_of(const CouplingStatus& c) const {
-  switch (c.kind) {
-    case motion::CouplingKind::ConstantPitch:
-      return motion::CouplingLaw::constant(c.pitch_mm);
-    case motion::CouplingKind::LinearPitch:
-      return motion::CouplingLaw::linear(c.pitch_mm, c.pitch_rate);
-    case motion::CouplingKind::PitchTable:
-    case motion::CouplingKind::Cam:
-      if (c.table >= 1 && c.table <= motion::kMaxCouplingTables)
-        return motion::CouplingLaw::tabulated(c.kind,
-                                              coupling_.tables[static_cast<std::size_t>(c.table - 1)]);
-      break;
-    case motion::CouplingKind::Off:
-      break;
-  }
-  return {};
+  return motion::law_for(coupling_, c.kind, c.pitch_mm, c.pitch_rate, c.table);
 }
 
 void PowerFailRecorder::on_status(const ControllerStatus& s) {

@@ -10,6 +10,8 @@
 
 #include <fmt/format.h>
 
+#include "opencnc/canon/arc_geometry.hpp"
+#include "opencnc/core/vec3.hpp"
 #include "opencnc/plan/planner.hpp"
 
 namespace opencnc::control {
@@ -20,36 +22,10 @@ constexpr double kTwoPi = 2 * std::numbers::pi;
 constexpr double kSlack = 1e-7;   ///< as the tick's check
 constexpr int kMaxReported = 20;  ///< errors listed before the rest are summed up
 
-struct V3 {
-  double v[3] = {0, 0, 0};
-};
-
-double dot(const V3& a, const V3& b) {
-  return a.v[0] * b.v[0] + a.v[1] * b.v[1] + a.v[2] * b.v[2];
-}
-
-V3 cross(const V3& a, const V3& b) {
-  return {{a.v[1] * b.v[2] - a.v[2] * b.v[1], a.v[2] * b.v[0] - a.v[0] * b.v[2],
-           a.v[0] * b.v[1] - a.v[1] * b.v[0]}};
-}
-
 /// The part of `q − c` in the plane with unit normal n.
-V3 in_plane(const Pose& q, int base, const V3& c, const V3& n) {
-  V3 d;
-  for (int k = 0; k < 3; ++k) d.v[k] = q[base + k] - c.v[k];
-  const double h = dot(d, n);
-  for (int k = 0; k < 3; ++k) d.v[k] -= h * n.v[k];
-  return d;
-}
-
-/// The sweep of an arc the way the planner runs it: counterclockwise about the normal for
-/// turns > 0, end on start = a full circle, |turns| − 1 extra circles.
-double sweep_of(double phi, int turns) {
-  const bool ccw = turns >= 0;
-  const bool full = std::fabs(phi) < 1e-9;
-  double s = ccw ? (full ? kTwoPi : (phi > 0 ? phi : phi + kTwoPi))
-                 : (full ? -kTwoPi : (phi < 0 ? phi : phi - kTwoPi));
-  return s + (ccw ? 1.0 : -1.0) * kTwoPi * std::max(0, std::abs(turns) - 1);
+Vec3 in_plane(const Pose& q, int base, const Vec3& c, const Vec3& n) {
+  const Vec3 d = take3(q, base) - c;
+  return d - dot(d, n) * n;
 }
 
 /// Whether some angle α + 2πm lies in [lo, hi].
@@ -61,21 +37,20 @@ bool passes(double alpha, double lo, double hi) {
 /// An arc in its plane: centre, start direction e1, e2 = n × e1, radius, signed sweep.
 struct ArcFrame {
   int base = 0;
-  V3 c, e1, e2;
+  Vec3 c, e1, e2;
   double radius = 0, sweep = 0;
 };
 
 bool arc_frame(const canon::ArcGeometry& g, const Pose& start, const Pose& end, ArcFrame& f) {
-  f.base =
-      (g.plane == canon::Plane::XY || g.plane == canon::Plane::YZ || g.plane == canon::Plane::XZ) ? 0 : 6;
-  f.c = V3{{g.center[0], g.center[1], g.center[2]}};
-  const V3 n{{g.normal[0], g.normal[1], g.normal[2]}};
-  const V3 rs = in_plane(start, f.base, f.c, n), re = in_plane(end, f.base, f.c, n);
+  f.base = canon::plane_base(g.plane);
+  f.c = g.center;
+  const Vec3& n = g.normal;
+  const Vec3 rs = in_plane(start, f.base, f.c, n), re = in_plane(end, f.base, f.c, n);
   const double r = std::sqrt(dot(rs, rs));
   if (!(r > 0)) return false;
-  for (int k = 0; k < 3; ++k) f.e1.v[k] = rs.v[k] / r;
+  for (int k = 0; k < 3; ++k) f.e1[k] = rs[k] / r;
   f.e2 = cross(n, f.e1);
-  f.sweep = sweep_of(std::atan2(dot(re, f.e2), dot(re, f.e1)), g.turns == 0 ? 1 : g.turns);
+  f.sweep = canon::arc_sweep(std::atan2(dot(re, f.e2), dot(re, f.e1)), g.turns == 0 ? 1 : g.turns);
   f.radius = std::max(r, std::sqrt(dot(re, re)));
   return true;
 }
@@ -87,13 +62,13 @@ void widen_by_arc(const canon::ArcGeometry& g, const Pose& start, const Pose& en
   // Along axis k the circle is c_k + r·A·cos(θ − α), A = |(e1_k, e2_k)|, α = atan2(e2_k, e1_k):
   // its largest value at θ = α, its smallest at θ = α + π, where the sweep passes them.
   for (int k = 0; k < 3; ++k) {
-    const double amp = std::hypot(f.e1.v[k], f.e2.v[k]);
+    const double amp = std::hypot(f.e1[k], f.e2[k]);
     if (amp < 1e-12) continue;
-    const double alpha = std::atan2(f.e2.v[k], f.e1.v[k]);
+    const double alpha = std::atan2(f.e2[k], f.e1[k]);
     const int axis = f.base + k;
-    if (passes(alpha, lo, hi)) e.max[axis] = std::max(e.max[axis], f.c.v[k] + f.radius * amp);
+    if (passes(alpha, lo, hi)) e.max[axis] = std::max(e.max[axis], f.c[k] + f.radius * amp);
     if (passes(alpha + std::numbers::pi, lo, hi))
-      e.min[axis] = std::min(e.min[axis], f.c.v[k] - f.radius * amp);
+      e.min[axis] = std::min(e.min[axis], f.c[k] - f.radius * amp);
   }
 }
 

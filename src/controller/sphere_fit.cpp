@@ -18,8 +18,7 @@ constexpr int kMaxIterations = 50;
 
 }  // namespace
 
-std::optional<SphereFit> fit_sphere(std::span<const std::array<double, 3>> points, double radius,
-                                    const std::array<double, 3>& guess) {
+std::optional<SphereFit> fit_sphere(std::span<const Vec3> points, double radius, const Vec3& guess) {
   const auto n = static_cast<Eigen::Index>(points.size());
   if (n < 3) return std::nullopt;
   Eigen::Vector3d c(guess[0], guess[1], guess[2]);

@@ -7,6 +7,7 @@
 #include "arc_math.hpp"
 #include "engine.hpp"
 #include "numeric.hpp"
+#include "opencnc/canon/arc_geometry.hpp"
 
 namespace opencnc::gcode {
 
@@ -36,31 +37,10 @@ int first_offset_position(const Block& b) noexcept {
   return first;
 }
 
-const char* plane_name(canon::Plane p) noexcept {
-  switch (p) {
-    case canon::Plane::XY:
-      return "XY";
-    case canon::Plane::YZ:
-      return "YZ";
-    case canon::Plane::XZ:
-      return "XZ";
-    case canon::Plane::UV:
-      return "UV";
-    case canon::Plane::VW:
-      return "VW";
-    case canon::Plane::UW:
-      return "UW";
-  }
-  return "?";
-}
-
 char plane_letter(canon::Plane p, int which) {
-  switch (p) {
-    case canon::Plane::XY: return which == 0 ? 'X' : 'Y';
-    case canon::Plane::XZ: return which == 0 ? 'Z' : 'X';
-    case canon::Plane::YZ: return which == 0 ? 'Y' : 'Z';
-    default: return '?';
-  }
+  if (canon::plane_base(p) != 0) return '?';
+  const canon::PlaneAxes axes = canon::plane_axes(p);
+  return kAxisLetters[static_cast<std::size_t>(which == 0 ? axes.first : axes.second)];
 }
 
 }  // namespace
@@ -306,7 +286,7 @@ void Engine::convert_arc(int motion) {
   if (m.plane == canon::Plane::UV || m.plane == canon::Plane::VW || m.plane == canon::Plane::UW)
     fail_at(at, ErrorCode::ArcUvwPlane,
             "{} in the {} plane: arcs are possible only in the XY, XZ and YZ planes (G17, G18, G19)", name,
-            plane_name(m.plane));
+            canon::plane_name(m.plane));
   if (!b.has('r') && !ijk)
     fail_at(at, ErrorCode::ArcCentreMissing, "{} needs either R (the radius) or I/J/K (the centre offsets)",
             name);
@@ -323,7 +303,7 @@ void Engine::convert_arc(int motion) {
     if (b.has(bad))
       fail_at(b.word_position(bad), ErrorCode::ArcOffsetWrongPlane,
               "{} word in an arc of the {} plane: its centre offsets are {} and {}",
-              static_cast<char>(bad - 32), plane_name(m.plane), static_cast<char>(l1 - 32),
+              static_cast<char>(bad - 32), canon::plane_name(m.plane), static_cast<char>(l1 - 32),
               static_cast<char>(l2 - 32));
     for (char need : {l1, l2}) {
       if (b.has(need)) continue;
@@ -341,7 +321,7 @@ void Engine::convert_arc(int motion) {
     if (missing)
       fail_at(at, ErrorCode::ArcEndpointMissing,
               "{} with R but no end point in the {} plane: give the end point (a full circle needs I/J/K)",
-              name, plane_name(m.plane));
+              name, canon::plane_name(m.plane));
   }
   const Pose end = find_ends(b);
   check_motion_habits(true);

@@ -30,11 +30,7 @@ json pose_json(const Pose& p, const config::MachineProfile& profile) {
   return j;
 }
 
-json vec3_json(const recovery::Vec3& v) {
-  return json::array({v[0], v[1], v[2]});
-}
-
-json point3_json(const control::Point3& v) {
+json vec3_json(const Vec3& v) {
   return json::array({v[0], v[1], v[2]});
 }
 
@@ -200,8 +196,8 @@ json MachineFeatures::snapshot(const control::ControllerStatus& s) {
               {"message", r->message},
               {"tool", r->tool},
               {"touches", r->names.size()},
-              {"previous", point3_json(r->previous)},
-              {"offset", point3_json(r->offset)},
+              {"previous", vec3_json(r->previous)},
+              {"offset", vec3_json(r->offset)},
               {"rms_residual_mm", r->rms_residual_mm},
               {"max_residual_mm", r->max_residual_mm},
               {"written", r->written}};
@@ -213,7 +209,7 @@ json MachineFeatures::snapshot(const control::ControllerStatus& s) {
                 {"message", c->message},
                 {"angles_deg", c->angles_deg},
                 {"b_axis", c->fit.axis.crossing},
-                {"b_axis_direction", c->fit.axis.direction},
+                {"b_axis_direction", vec3_json(c->fit.axis.direction)},
                 {"max_residual_mm", c->fit.max_residual_mm}};
     }
     j["electrode"] = {{"phase", control::to_string(electrode_->phase())},

@@ -7,7 +7,9 @@
 #include <set>
 #include <vector>
 
+#include "opencnc/canon/arc_geometry.hpp"
 #include "opencnc/canon/program_builder.hpp"
+#include "opencnc/core/vec3.hpp"
 #include "opencnc/gcode/interpreter.hpp"
 
 namespace opencnc::hmi {
@@ -18,25 +20,21 @@ using nlohmann::json;
 
 constexpr double kChordDeg = 5;  ///< an arc is drawn with a chord every this many degrees
 
-/// Appends the points of arc `id` after its start (chords every kChordDeg, the helix linear).
+/// Appends the points of arc `id` after its start (chords every kChordDeg, the helix linear). An
+/// arc of the U V W planes moves X Y Z along a line: its end point only.
 void arc_points(const canon::Program& p, canon::SegmentId id, std::vector<double>& out) {
   const canon::ArcGeometry& g = p.arc(id);
   const Pose s = p.start_of(id), e = p.end(id);
-  const double c[3] = {g.center[0], g.center[1], g.center[2]};
-  const double n[3] = {g.normal[0], g.normal[1], g.normal[2]};
-  const double r0[3] = {s[0] - c[0], s[1] - c[1], s[2] - c[2]};
-  const double along0 = r0[0] * n[0] + r0[1] * n[1] + r0[2] * n[2];
-  const double u[3] = {r0[0] - along0 * n[0], r0[1] - along0 * n[1], r0[2] - along0 * n[2]};
-  const double v[3] = {n[1] * u[2] - n[2] * u[1], n[2] * u[0] - n[0] * u[2], n[0] * u[1] - n[1] * u[0]};
-  const double re[3] = {e[0] - c[0], e[1] - c[1], e[2] - c[2]};
-  const double radius2 = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
-  const double along_e = re[0] * n[0] + re[1] * n[1] + re[2] * n[2];
-  double sweep = radius2 > 0 ? std::atan2((re[0] * v[0] + re[1] * v[1] + re[2] * v[2]) / radius2,
-                                          (re[0] * u[0] + re[1] * u[1] + re[2] * u[2]) / radius2)
-                             : 0.0;
-  if (sweep <= 1e-9) sweep += 2 * std::numbers::pi;
-  sweep += 2 * std::numbers::pi * (std::abs(g.turns) - 1);
-  const int steps = std::max(1, static_cast<int>(std::ceil(sweep * 180 / std::numbers::pi / kChordDeg)));
+  const Vec3 &c = g.center, &n = g.normal;
+  const Vec3 r0 = take3(s) - c, re = take3(e) - c;
+  const double along0 = dot(r0, n), along_e = dot(re, n);
+  const Vec3 u = r0 - along0 * n, v = cross(n, u);
+  const double radius2 = dot(u, u);
+  const double sweep = canon::plane_base(g.plane) == 0 && radius2 > 0
+                           ? canon::arc_sweep(std::atan2(dot(re, v) / radius2, dot(re, u) / radius2), g.turns)
+                           : 0.0;
+  const int steps =
+      std::max(1, static_cast<int>(std::ceil(std::fabs(sweep) * 180 / std::numbers::pi / kChordDeg)));
   for (int k = 1; k < steps; ++k) {
     const double t = static_cast<double>(k) / steps, a = sweep * t;
     const double along = along0 + (along_e - along0) * t;

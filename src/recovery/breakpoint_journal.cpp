@@ -11,6 +11,7 @@
 
 #include <fmt/format.h>
 
+#include "opencnc/canon/arc_geometry.hpp"
 #include "opencnc/controller/gcode_source.hpp"
 #include "opencnc/recovery/modal_digest.hpp"
 
@@ -31,29 +32,14 @@ double line_length(const Pose& a, const Pose& b) {
 /// Length of an arc or helix move: the sweep about its centre times the radius, with the rise.
 double arc_length(const canon::Program& p, canon::SegmentId id) {
   const canon::ArcGeometry& g = p.arc(id);
-  const Pose a = p.start_of(id), b = p.end(id);
-  const int base =
-      g.plane == canon::Plane::UV || g.plane == canon::Plane::VW || g.plane == canon::Plane::UW ? 6 : 0;
-  double u[3], w[3], n[3] = {g.normal[0], g.normal[1], g.normal[2]};
-  for (int k = 0; k < 3; ++k) {
-    u[k] = a.v[static_cast<std::size_t>(base + k)] - g.center[k];
-    w[k] = b.v[static_cast<std::size_t>(base + k)] - g.center[k];
-  }
-  const double un = u[0] * n[0] + u[1] * n[1] + u[2] * n[2];
-  const double wn = w[0] * n[0] + w[1] * n[1] + w[2] * n[2];
-  for (int k = 0; k < 3; ++k) {
-    u[k] -= un * n[k];
-    w[k] -= wn * n[k];
-  }
-  const double r = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
-  const double cx = u[1] * w[2] - u[2] * w[1], cy = u[2] * w[0] - u[0] * w[2], cz = u[0] * w[1] - u[1] * w[0];
-  double sweep = std::atan2(cx * n[0] + cy * n[1] + cz * n[2], u[0] * w[0] + u[1] * w[1] + u[2] * w[2]);
-  const bool ccw = g.turns > 0;
-  if (ccw && sweep <= 0) sweep += 2 * std::numbers::pi;
-  if (!ccw && sweep >= 0) sweep -= 2 * std::numbers::pi;
-  const double turns = std::fabs(sweep) + 2 * std::numbers::pi * (std::abs(g.turns) - 1);
-  const double rise = wn - un;
-  return std::hypot(r * turns, rise);
+  const int base = canon::plane_base(g.plane);
+  const Vec3& n = g.normal;
+  Vec3 u = take3(p.start_of(id), base) - g.center, w = take3(p.end(id), base) - g.center;
+  const double un = dot(u, n), wn = dot(w, n);
+  u = u - un * n;
+  w = w - wn * n;
+  const double sweep = canon::arc_sweep(std::atan2(dot(cross(u, w), n), dot(u, w)), g.turns);
+  return std::hypot(norm(u) * std::fabs(sweep), wn - un);
 }
 
 /// The writer's SCHED_FIFO priority where the process may have one: below the servo thread's (80,

@@ -30,21 +30,8 @@ Outcome refuse(Refusal r, std::string why) {
 
 /// The law of the record, in the slave's units per the master's (the profile's tables).
 motion::CouplingLaw law_of(const BreakpointCoupling& c, const motion::CouplingConfig& config) {
-  const auto kind = static_cast<motion::CouplingKind>(c.kind);
-  switch (kind) {
-    case motion::CouplingKind::ConstantPitch:
-      return motion::CouplingLaw::constant(c.pitch_mm);
-    case motion::CouplingKind::LinearPitch:
-      return motion::CouplingLaw::linear(c.pitch_mm, c.pitch_rate);
-    case motion::CouplingKind::PitchTable:
-    case motion::CouplingKind::Cam:
-      if (c.table >= 1 && c.table <= motion::kMaxCouplingTables)
-        return motion::CouplingLaw::tabulated(kind, config.tables[static_cast<std::size_t>(c.table - 1)]);
-      break;
-    case motion::CouplingKind::Off:
-      break;
-  }
-  return {};
+  return motion::law_for(config, static_cast<motion::CouplingKind>(c.kind), c.pitch_mm, c.pitch_rate,
+                         c.table);
 }
 
 /// The first axis of the profile farther from the record's rest than the tolerance, in words.

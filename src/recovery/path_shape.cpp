@@ -5,47 +5,20 @@
 #include <algorithm>
 #include <cmath>
 
+#include "opencnc/canon/arc_geometry.hpp"
+#include "opencnc/core/minimise.hpp"
+
 namespace opencnc::recovery::detail {
 
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-Vec3 sub(const Vec3& a, const Vec3& b) noexcept {
-  return {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
-}
-Vec3 add(const Vec3& a, const Vec3& b) noexcept {
-  return {a[0] + b[0], a[1] + b[1], a[2] + b[2]};
-}
-Vec3 mul(double k, const Vec3& a) noexcept {
-  return {k * a[0], k * a[1], k * a[2]};
-}
-double dot(const Vec3& a, const Vec3& b) noexcept {
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-Vec3 cross(const Vec3& a, const Vec3& b) noexcept {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-Vec3 xyz(const Pose& p) noexcept {
-  return {p[0], p[1], p[2]};
-}
-
 /// Squared distance in the metric: XY ignores Z.
 double dist2(const Vec3& a, const Vec3& b, Metric m) noexcept {
   const double dx = a[0] - b[0], dy = a[1] - b[1];
   const double dz = m == Metric::Xyz ? a[2] - b[2] : 0.0;
   return dx * dx + dy * dy + dz * dz;
-}
-
-/// Signed sweep from the end's angle `phi` ∈ (−π, π] and LinuxCNC's turn count: the end on
-/// the start is a whole circle; |turns| − 1 extra full circles.
-double sweep_of(double phi, int turns) noexcept {
-  const bool ccw = turns >= 0;
-  const bool full = std::fabs(phi) < 1e-9;
-  double s = ccw ? (full ? 2 * kPi : (phi > 0 ? phi : phi + 2 * kPi))
-                 : (full ? -2 * kPi : (phi < 0 ? phi : phi - 2 * kPi));
-  const int extra = std::max(0, std::abs(turns) - 1);
-  return s + (ccw ? 1.0 : -1.0) * 2 * kPi * extra;
 }
 
 /// The first θ of the sweep (from 0 toward `sweep`) at the angle `phi`, or −1 if it lies outside.
@@ -72,46 +45,27 @@ Closest numeric(const Shape& s, const ArcShape& arc, const Vec3& q, Metric m) no
       best = i;
     }
   }
-  double lo = static_cast<double>(std::max(0, best - 1)) / n;
-  double hi = static_cast<double>(std::min(n, best + 1)) / n;
-  constexpr double kG = 0.6180339887498949;
-  double x1 = hi - kG * (hi - lo), x2 = lo + kG * (hi - lo);
-  double f1 = dist2(point_at(s, &arc, x1), q, m), f2 = dist2(point_at(s, &arc, x2), q, m);
-  for (int i = 0; i < 80 && hi - lo > 1e-15; ++i) {
-    if (f1 < f2) {
-      hi = x2;
-      x2 = x1;
-      f2 = f1;
-      x1 = hi - kG * (hi - lo);
-      f1 = dist2(point_at(s, &arc, x1), q, m);
-    } else {
-      lo = x1;
-      x1 = x2;
-      f1 = f2;
-      x2 = lo + kG * (hi - lo);
-      f2 = dist2(point_at(s, &arc, x2), q, m);
-    }
-  }
-  Closest c{best_d2 <= std::min(f1, f2) ? static_cast<double>(best) / n : (f1 < f2 ? x1 : x2),
-            std::min(best_d2, std::min(f1, f2))};
-  return c;
+  const auto f = [&](double t) { return dist2(point_at(s, &arc, t), q, m); };
+  const Minimum g = golden_section(f, static_cast<double>(std::max(0, best - 1)) / n,
+                                   static_cast<double>(std::min(n, best + 1)) / n, 80, 1e-15);
+  return best_d2 <= g.f ? Closest{static_cast<double>(best) / n, best_d2} : Closest{g.x, g.f};
 }
 
 }  // namespace
 
 bool make_arc_shape(const canon::Program& p, std::size_t move, ArcShape& out) {
   const canon::ArcGeometry& g = p.arc(move);
-  if (g.plane != canon::Plane::XY && g.plane != canon::Plane::YZ && g.plane != canon::Plane::XZ) return false;
-  const Vec3 s = xyz(p.start_of(move)), e = xyz(p.end(move));
-  const Vec3 n{g.normal[0], g.normal[1], g.normal[2]};
-  const Vec3 c0{g.center[0], g.center[1], g.center[2]};
-  Vec3 rs = sub(s, c0);
-  rs = sub(rs, mul(dot(rs, n), n));
+  if (canon::plane_base(g.plane) != 0) return false;
+  const Vec3 s = take3(p.start_of(move)), e = take3(p.end(move));
+  const Vec3& n = g.normal;
+  const Vec3& c0 = g.center;
+  Vec3 rs = s - c0;
+  rs = rs - dot(rs, n) * n;
   const double r0 = std::sqrt(dot(rs, rs));
   if (!(r0 >= 1e-9)) return false;
-  const Vec3 u1 = mul(1.0 / r0, rs), u2 = cross(n, u1);
-  Vec3 re = sub(e, c0);
-  re = sub(re, mul(dot(re, n), n));
+  const Vec3 u1 = (1.0 / r0) * rs, u2 = cross(n, u1);
+  Vec3 re = e - c0;
+  re = re - dot(re, n) * n;
   const double ex = dot(re, u1), ey = dot(re, u2), r_end = std::hypot(ex, ey);
   // Rounded coordinates give slightly different radii at the two ends: the centre goes onto the
   // bisector of the end points so that the circle passes through both (as the planner runs it).
@@ -122,17 +76,17 @@ bool make_arc_shape(const canon::Program& p, std::size_t move, ArcShape& out) {
     cx = k * dx;
     cy = k * dy;
   }
-  out.c = add(c0, add(mul(cx, u1), mul(cy, u2)));
-  const Vec3 rs2 = sub(rs, add(mul(cx, u1), mul(cy, u2)));
+  out.c = c0 + (cx * u1 + cy * u2);
+  const Vec3 rs2 = rs - (cx * u1 + cy * u2);
   out.r = std::sqrt(dot(rs2, rs2));
-  out.c = add(out.c, mul(dot(sub(s, c0), n), n));  // the centre in the start's plane
-  out.e1 = mul(1.0 / out.r, rs2);
+  out.c = out.c + dot(s - c0, n) * n;  // the centre in the start's plane
+  out.e1 = (1.0 / out.r) * rs2;
   out.e2 = cross(n, out.e1);
-  const Vec3 re2 = sub(re, add(mul(cx, u1), mul(cy, u2)));
-  out.sweep = sweep_of(std::atan2(dot(re2, out.e2), dot(re2, out.e1)), g.turns == 0 ? 1 : g.turns);
+  const Vec3 re2 = re - (cx * u1 + cy * u2);
+  out.sweep = canon::arc_sweep(std::atan2(dot(re2, out.e2), dot(re2, out.e1)), g.turns == 0 ? 1 : g.turns);
   const Vec3 circle_end =
-      add(out.c, add(mul(out.r * std::cos(out.sweep), out.e1), mul(out.r * std::sin(out.sweep), out.e2)));
-  out.rest = sub(e, circle_end);
+      out.c + ((out.r * std::cos(out.sweep)) * out.e1 + (out.r * std::sin(out.sweep)) * out.e2);
+  out.rest = e - circle_end;
   constexpr double kFlat = 1e-12;
   out.circle_xyz =
       std::fabs(out.rest[0]) < kFlat && std::fabs(out.rest[1]) < kFlat && std::fabs(out.rest[2]) < kFlat;
@@ -142,12 +96,11 @@ bool make_arc_shape(const canon::Program& p, std::size_t move, ArcShape& out) {
 }
 
 Vec3 point_at(const Shape& s, const ArcShape* arc, double t) noexcept {
-  if (arc == nullptr) return add(s.a, mul(t, sub(s.b, s.a)));
+  if (arc == nullptr) return s.a + t * (s.b - s.a);
   if (t >= 1) return s.b;
   if (t <= 0) return s.a;
   const double th = t * arc->sweep;
-  return add(add(arc->c, add(mul(arc->r * std::cos(th), arc->e1), mul(arc->r * std::sin(th), arc->e2))),
-             mul(t, arc->rest));
+  return (arc->c + ((arc->r * std::cos(th)) * arc->e1 + (arc->r * std::sin(th)) * arc->e2)) + t * arc->rest;
 }
 
 Box bounds(const Shape& s, const ArcShape* arc) noexcept {
@@ -159,7 +112,7 @@ Box bounds(const Shape& s, const ArcShape* arc) noexcept {
   // where the sweep passes them (θ = atan2(e2ᵢ, e1ᵢ) and that + π); the rise t·rest then
   // widens the box by its range.
   const auto circle = [&](double th) {
-    return add(arc->c, add(mul(arc->r * std::cos(th), arc->e1), mul(arc->r * std::sin(th), arc->e2)));
+    return arc->c + ((arc->r * std::cos(th)) * arc->e1 + (arc->r * std::sin(th)) * arc->e2);
   };
   Box c;
   c.add(circle(0));
@@ -180,17 +133,17 @@ Box bounds(const Shape& s, const ArcShape* arc) noexcept {
 }
 
 double length(const Shape& s, const ArcShape* arc) noexcept {
-  if (arc == nullptr) return std::sqrt(dot(sub(s.b, s.a), sub(s.b, s.a)));
+  if (arc == nullptr) return norm(s.b - s.a);
   return std::hypot(arc->r * arc->sweep, std::sqrt(dot(arc->rest, arc->rest)));
 }
 
 Closest closest(const Shape& s, const ArcShape* arc, const Vec3& q, Metric m) noexcept {
   if (arc == nullptr) {
-    const Vec3 d = sub(s.b, s.a);
+    const Vec3 d = s.b - s.a;
     const double l2 = d[0] * d[0] + d[1] * d[1] + (m == Metric::Xyz ? d[2] * d[2] : 0.0);
     double t = 0;
     if (l2 > 0) {
-      const Vec3 w = sub(q, s.a);
+      const Vec3 w = q - s.a;
       t = (w[0] * d[0] + w[1] * d[1] + (m == Metric::Xyz ? w[2] * d[2] : 0.0)) / l2;
       t = std::clamp(t, 0.0, 1.0);
     }
@@ -199,7 +152,7 @@ Closest closest(const Shape& s, const ArcShape* arc, const Vec3& q, Metric m) no
   if (!(m == Metric::Xy ? arc->circle_xy : arc->circle_xyz)) return numeric(s, *arc, q, m);
   // A circular arc in the metric's view: the nearest point of the circle lies at the query's
   // angle about the centre; if the sweep does not reach it, the nearer end is the nearest.
-  Vec3 w = sub(q, arc->c);
+  Vec3 w = q - arc->c;
   if (m == Metric::Xy) w[2] = 0;
   Closest best{0, dist2(s.a, q, m)};
   const double d_end = dist2(s.b, q, m);

@@ -117,7 +117,7 @@ TEST(EdmCavity, TheElectrodesWearLeavesTheCavityShallowerThanTheProgram) {
 /// table, offsets `table`), the program source reading it: the operator's way, an electrode
 /// mounted by MDI, measured on the reference sphere, then the burn.
 struct ElectrodeRig {
-  ElectrodeRig(const config::MachineProfile& profile, const Point3& table) {
+  ElectrodeRig(const config::MachineProfile& profile, const Vec3& table) {
     tools::ToolTable t;
     tools::ToolEntry e;
     e.tool = 1;
@@ -189,7 +189,7 @@ TEST(EdmElectrode, AnUnmeasuredElectrodeBurnsOffByItsErrorAMeasuredOneWhereProgr
   ASSERT_TRUE(exact.run(kBurnWithG43, "exact"));
   // The electrode in pocket 1 is really 30 µm off in X, −20 µm in Y and 50 µm longer (a 0.8 mm
   // ball tip, as the table's D1.6 says): unknown to the controller until measured.
-  const Point3 truth{0.03, -0.02, 0.05};
+  const Vec3 truth{0.03, -0.02, 0.05};
   p.sim_electrodes = {machine::SimElectrode{1, truth, 0.8}};
   ElectrodeRig unmeasured(p, {0, 0, 0});
   unmeasured.mdi("T1 M6");
@@ -246,7 +246,7 @@ TEST(EdmElectrode, AWornElectrodeReplacedMidJobFinishesTheCavityAsAnUninterrupte
   const double worn_mm = changed.sim().electrode_wear_mm();
   EXPECT_GT(worn_mm, 0.0);
   changed.mdi("G53 G0 Z-10");  // out of the cavity
-  const Point3 fresh{0.07, -0.01, 0.09};
+  const Vec3 fresh{0.07, -0.01, 0.09};
   changed.rig->machine().replace_electrode(1, fresh, 0.8);
   const ElectrodeResult m = changed.measure(1);
   ASSERT_TRUE(m.ok) << m.message;

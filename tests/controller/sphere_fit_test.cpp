@@ -13,7 +13,7 @@
 namespace opencnc::control {
 namespace {
 
-using P = std::array<double, 3>;
+using P = Vec3;
 
 std::vector<P> touches(const P& c, double r) {  // four around the equator and the top
   return {{c[0] + r, c[1], c[2]},

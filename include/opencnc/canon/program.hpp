@@ -13,6 +13,7 @@
 #include "opencnc/canon/types.hpp"
 #include "opencnc/core/axes.hpp"
 #include "opencnc/core/chunked_vector.hpp"
+#include "opencnc/core/vec3.hpp"
 
 namespace opencnc::canon {
 
@@ -49,8 +50,8 @@ static_assert(sizeof(Move) == 16);
 /// Geometry of an arc or helix in machine coordinates (mm), in the plane's axis triple
 /// (X,Y,Z for XY/YZ/XZ; U,V,W for UV/VW/UW).
 struct ArcGeometry {
-  double center[3] = {0, 0, 0};  ///< on the plane through the start point
-  double normal[3] = {0, 0, 1};  ///< unit normal; rotation is counterclockwise about it
+  Vec3 center{0, 0, 0};          ///< on the plane through the start point
+  Vec3 normal{0, 0, 1};          ///< unit normal; rotation is counterclockwise about it
   std::int32_t turns = 1;        ///< LinuxCNC's rotation: |turns|-1 extra full circles; sign = direction
   Plane plane = Plane::XY;
   std::uint32_t feed = 0;        ///< index into feeds

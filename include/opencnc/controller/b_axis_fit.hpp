@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "opencnc/config/machine_profile.hpp"
+#include "opencnc/core/vec3.hpp"
 
 namespace opencnc::control {
 
@@ -17,7 +18,7 @@ namespace opencnc::control {
 /// unit direction (+B right-handed about it).
 struct BAxisLine {
   std::array<double, 2> crossing{};  ///< X, Z, mm
-  std::array<double, 3> direction{0, 1, 0};
+  Vec3 direction{0, 1, 0};
 };
 
 /// What the fit found.
@@ -38,12 +39,11 @@ struct BAxisFit {
 /// is off its table entry does not move the axis). Nothing when fewer than three distinct angles
 /// are given, the centres are (nearly) one point or on a line, or the axis lies along the plane.
 /// Any thread; not real-time.
-std::optional<BAxisFit> fit_b_axis(std::span<const double> angles_deg,
-                                   std::span<const std::array<double, 3>> centres,
+std::optional<BAxisFit> fit_b_axis(std::span<const double> angles_deg, std::span<const Vec3> centres,
                                    const config::ReferenceSphereProfile& sphere);
 
 /// The sphere's centre with B at `b_deg`: `position` turned about the profile's `b_axis` by
 /// b_deg − b. Without a b_axis, `position` (only right at b). Any thread.
-std::array<double, 3> sphere_centre_at(const config::ReferenceSphereProfile& sphere, double b_deg);
+Vec3 sphere_centre_at(const config::ReferenceSphereProfile& sphere, double b_deg);
 
 }  // namespace opencnc::control

@@ -14,25 +14,24 @@
 
 #include "opencnc/controller/b_axis_fit.hpp"
 #include "opencnc/controller/observer.hpp"
+#include "opencnc/core/vec3.hpp"
 #include "opencnc/tools/tool_table_service.hpp"
 
 namespace opencnc::control {
-
-using Point3 = std::array<double, 3>;
 
 /// One touch of the sphere: the controlled point's machine position where it starts and where
 /// its probe move ends if it touches nothing (each `clearance` off the surface, outside and
 /// inside), and the direction from the sphere's centre toward the start.
 struct SphereTouch {
   std::string name;  ///< "+X", "top", "45°" …
-  Point3 start{}, end{}, direction{};
+  Vec3 start{}, end{}, direction{};
 };
 
 /// The touches for an electrode with tool-table offsets `offset` (X, Y, Z: G43's, the tip's
 /// lowest point at controlled point − offset) and a ball tip of `tip_radius` (half the table's
 /// diameter; 0: a point): `touches_around` at the height of the sphere's centre, evenly from +X
 /// counter-clockwise, then one from above along the tool axis. Any thread.
-std::vector<SphereTouch> plan_touches(const config::ReferenceSphereProfile& sphere, const Point3& offset,
+std::vector<SphereTouch> plan_touches(const config::ReferenceSphereProfile& sphere, const Vec3& offset,
                                       double tip_radius);
 
 /// The auxiliary program of one touch, from `from`: up to the safe height (or over at the height
@@ -49,7 +48,7 @@ std::shared_ptr<const canon::Program> touch_program(AxisMask axes, const Pose& f
 /// `back_off` past it, then back to the touch's start and up. `slow` gets that probe move's line
 /// (its start and end) to check the latch against. Non-real-time.
 std::shared_ptr<const canon::Program> slow_touch_program(AxisMask axes, const Pose& from,
-                                                         const SphereTouch& touch, const Point3& contact,
+                                                         const SphereTouch& touch, const Vec3& contact,
                                                          const config::ReferenceSphereProfile& sphere,
                                                          SphereTouch& slow);
 
@@ -62,11 +61,11 @@ struct ElectrodeResult {
   int tool = 0;
   double tip_radius = 0;
   std::vector<std::string> names;  ///< of the touches made, in order
-  std::vector<Point3> touched;     ///< the controlled point where each touch closed the contact
-  std::vector<Point3> fast_touched;  ///< with fast_feed: where each fast touch closed it (not fitted)
-  Point3 centre{};                 ///< fitted: the controlled point that puts the tip's ball on the centre
-  Point3 previous{};               ///< the tool table's X, Y, Z offsets before
-  Point3 offset{};                 ///< … and as measured (Z is the electrode's length)
+  std::vector<Vec3> touched;       ///< the controlled point where each touch closed the contact
+  std::vector<Vec3> fast_touched;  ///< with fast_feed: where each fast touch closed it (not fitted)
+  Vec3 centre{};                   ///< fitted: the controlled point that puts the tip's ball on the centre
+  Vec3 previous{};                 ///< the tool table's X, Y, Z offsets before
+  Vec3 offset{};                   ///< … and as measured (Z is the electrode's length)
   double rms_residual_mm = 0, max_residual_mm = 0;
   bool written = false;  ///< the offsets are in the tool table (at once, or by "write" after a look)
 };
@@ -76,9 +75,9 @@ struct ElectrodeResult {
 /// the checks: a residual above the tolerance (`electrode.fit`), offsets farther than
 /// `max_deviation` from the table's (`electrode.far`: the sphere is not where the profile says,
 /// or the wrong electrode). Any thread.
-ElectrodeResult evaluate_touches(const config::ReferenceSphereProfile& sphere, int tool,
-                                 const Point3& previous, double tip_radius,
-                                 std::span<const std::string> names, std::span<const Point3> touched);
+ElectrodeResult evaluate_touches(const config::ReferenceSphereProfile& sphere, int tool, const Vec3& previous,
+                                 double tip_radius, std::span<const std::string> names,
+                                 std::span<const Vec3> touched);
 
 /// `requests::Feature{"electrode", "measure", ElectrodeMeasure{tool}}`.
 struct ElectrodeMeasure {
@@ -105,7 +104,7 @@ struct BAxisResult {
   std::string message;
   int tool = 0;
   std::vector<double> angles_deg;           ///< measured so far, in order
-  std::vector<Point3> centres;              ///< the fitted centre (sphere + electrode) at each
+  std::vector<Vec3> centres;                ///< the fitted centre (sphere + electrode) at each
   BAxisLine previous;                       ///< the axis the spheres were looked for about
   BAxisFit fit;                             ///< when ok (and when the residual failed, what it was)
 };
@@ -166,7 +165,7 @@ class ElectrodeSetting final : public Feature {
   bool store(ElectrodeResult& r);
   void when_aux_ended(const ControllerEvent& e);
   void next_touch();
-  void touched(const Point3& at);
+  void touched(const Vec3& at);
   void finish_measurement();
   void fail(std::string code, std::string message);
   void set_phase(ElectrodePhase p);
@@ -184,7 +183,7 @@ class ElectrodeSetting final : public Feature {
   std::size_t tool_index_ = 0;
   tools::ToolEntry entry_;
   std::vector<SphereTouch> plan_;
-  std::vector<Point3> touched_, fast_touched_;
+  std::vector<Vec3> touched_, fast_touched_;
   std::size_t touch_ = 0;
   bool slow_ = false;      ///< the current touch's slow stage runs (after its fast one)
   SphereTouch slow_line_;  ///< the slow stage's probe move
@@ -199,7 +198,7 @@ class ElectrodeSetting final : public Feature {
   bool running_seen_ = false;
   /// The measured tool's offsets when the program stopped (the first measurement since the stop
   /// knows them): the approach moves the stop point by what changed since.
-  std::optional<Point3> stop_offset_;
+  std::optional<Vec3> stop_offset_;
 
   mutable std::mutex mutex_;  ///< guards what the accessors read
   ElectrodePhase phase_ = ElectrodePhase::Idle;

@@ -7,11 +7,13 @@
 #include <span>
 #include <vector>
 
+#include "opencnc/core/vec3.hpp"
+
 namespace opencnc::control {
 
 /// The centre that best fits the points, with the residuals |p − centre| − radius, mm.
 struct SphereFit {
-  std::array<double, 3> centre{};
+  Vec3 centre{};
   std::vector<double> residuals;  ///< per point, in the order given
   double rms_residual = 0;
   double max_residual = 0;  ///< largest |residual|
@@ -23,7 +25,6 @@ struct SphereFit {
 /// Nothing when there are fewer than three points, when a point sits on the centre, when the
 /// points do not fix the centre (all on one line through it, say) or when it does not converge in
 /// 50 steps. Any thread; not real-time.
-std::optional<SphereFit> fit_sphere(std::span<const std::array<double, 3>> points, double radius,
-                                    const std::array<double, 3>& guess);
+std::optional<SphereFit> fit_sphere(std::span<const Vec3> points, double radius, const Vec3& guess);
 
 }  // namespace opencnc::control

@@ -11,10 +11,9 @@
 #include <vector>
 
 #include "opencnc/canon/program.hpp"
+#include "opencnc/core/vec3.hpp"
 
 namespace opencnc::recovery {
-
-using Vec3 = std::array<double, 3>;
 
 /// How distance is measured: in the XY plane (torch height ignored, the default) or in space.
 enum class Metric : std::uint8_t { Xy, Xyz };
