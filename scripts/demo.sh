@@ -31,9 +31,10 @@ TXT
   shift
 done
 scripts/setup.sh
-# The application only: the test and benchmark libraries are installed by `setup.sh --tests`.
-cmake --preset default -DOPENCNC_TESTS=OFF -DOPENCNC_BENCH=OFF >/dev/null
-cmake --build --preset default -j "${OPENCNC_JOBS:-2}" --target opencnc
+# The application only (the test and benchmark libraries are installed by `setup.sh --tests`),
+# optimised without debug information: the first build on two cores is what a newcomer waits for.
+cmake --preset demo >/dev/null
+cmake --build --preset demo -j "${OPENCNC_JOBS:-2}" --target opencnc
 if ((batch)); then
   # A bracket (pocket, compensated profile, peck-drilled holes) on the simulated three-axis mill:
   # interpreted, checked against the soft limits, planned and run in virtual time; the report

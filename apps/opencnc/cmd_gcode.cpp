@@ -27,6 +27,10 @@ namespace opencnc::cli {
 
 namespace {
 
+/// `check` and `scan` refuse a program still running after this much checking (an endless loop);
+/// `canon` prints as rs274 does, without a bound on time.
+constexpr double kDefaultCheckSeconds = 5;
+
 struct InterpArgs {
   std::string tool_table;
   std::vector<std::string> subroutine_path;
@@ -38,6 +42,8 @@ struct InterpArgs {
   std::string axis_map;
   bool progress = false;  ///< progress on stderr also when it is not a terminal
   std::uint64_t max_blocks = gcode::Limits{}.max_blocks;
+  /// CPU seconds a check may take (0: no bound): an endless loop is refused in seconds.
+  double max_seconds = kDefaultCheckSeconds;
   std::vector<std::string> codes;  ///< code modules beyond the standard ones ("coupling", "edm")
 };
 
@@ -65,6 +71,10 @@ void add_interp_options(CLI::App* cmd, InterpArgs& a) {
                   "stop with gcode.limit-blocks after this many blocks (loop bodies count each time; default "
                   "200000000)")
       ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{1} << 62));
+  if (a.max_seconds > 0)
+    cmd->add_option("--max-seconds", a.max_seconds,
+                    "stop with gcode.limit-time after this many seconds of checking (an endless loop?; default 5)")
+        ->check(finite_range(0.1, 1e6));
   cmd->add_flag(
       "--progress", a.progress,
       "show progress on stderr also when it is not a terminal (on a terminal it shows after 0.5 s)");
@@ -108,6 +118,7 @@ bool make_options(const InterpArgs& a, const std::string& file, gcode::Options& 
   if (wanted("edm")) o.extensions = gcode::edm_extensions(o.dialect, {}, o.extensions);
   o.block_delete = a.block_delete;
   o.limits.max_blocks = a.max_blocks;
+  o.limits.max_seconds = a.max_seconds;
   o.subroutine_path = a.subroutine_path.empty() ? std::vector<std::string>{"."} : a.subroutine_path;
   if (!a.tool_table.empty()) {
     Diagnostics diags;
@@ -167,6 +178,7 @@ int run_check(const std::vector<std::string>& files, const InterpArgs& args) {
 
 void add_gcode_commands(CLI::App& app, Registry& registry) {
   static InterpArgs check_args, canon_args, scan_args;
+  canon_args.max_seconds = 0;  // rs274's output, however long the program
   static std::vector<std::string> check_files;
   static std::string canon_file, scan_file;
   static ScanOutput scan_out;

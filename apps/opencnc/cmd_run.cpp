@@ -413,7 +413,6 @@ int run(const RunOptions& o) {
     fmt::print(stderr, "error: --process-log {}: the name must end in .csv, .sqlite, .sqlite3 or .db\n", o.process_log);
     return kExitUsage;
   }
-  if (profile && !within_max_time(o, *profile)) return kExitProgram;
   const auto files = open_outputs(inputs, outputs);
   if (files.empty()) return kExitUsage;
   OutputFile* const trace_file = files[0].get();
@@ -479,6 +478,11 @@ int run(const RunOptions& o) {
   const bool tty = ::isatty(STDOUT_FILENO) != 0;
   double run_start_s = -1;
   SessionHooks hooks;
+  // The machining time against --max-time: once the preflight has passed (an endless program is
+  // refused there, in seconds, not estimated first).
+  hooks.may_start = [&](const config::MachineProfile& machine, const control::OpenProgram&) {
+    return within_max_time(o, machine);
+  };
   hooks.opened = [&](const config::MachineProfile& machine, const control::OpenProgram& program) {
     std::vector<std::pair<std::shared_ptr<control::ControllerObserver>, control::ObserverOptions>> out;
     const plan::MachineLimits axes = control::axis_limits(machine);  // the drives' commands: the axes' own
@@ -563,6 +567,8 @@ int run(const RunOptions& o) {
   }
   const StopSignals signals;  // Ctrl-C: a controlled stop, and the report says so
   session.stop = &StopSignals::requested();
+  session.stops = &StopSignals::count();
+  session.max_time_s = o.max_time_s;
   const SessionEnd end = run_session(session, hooks);
   if (bar) bar->finish();
   if (!recorder) return end.exit_code;  // nothing ran; the outputs are left as they were

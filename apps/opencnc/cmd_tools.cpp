@@ -5,7 +5,14 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include <unistd.h>
+
+#include <cerrno>
 #include <charconv>
+#include <cstring>
+#include <filesystem>
+#include <cmath>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -31,6 +38,7 @@ struct ToolsOptions {
   std::vector<std::string> words;  // the action's arguments
   std::string file, output, format = "text";
   std::int64_t backup = 0;  // 0: the current one
+  bool allow_empty = false;  // import: a table without tools may replace the live one
   std::size_t last = 20;
   tools::CheckTolerances tolerances;
 };
@@ -85,15 +93,38 @@ std::optional<int> numbered(std::string_view word, char letter) {
   return n;
 }
 
-std::shared_ptr<store::ToolStore> open_store(const ToolsOptions& o, bool create) {
+// Actions that only look open the store read-only: a store the user may read but not write
+// (another user's, read-only media) is listed and checked all the same.
+std::shared_ptr<store::ToolStore> open_store(const ToolsOptions& o, bool writes) {
   std::string error;
-  auto s = store::ToolStore::open(o.db, &error, create);
-  if (!s)
-    fail(create ? error
-                : fmt::format("{} (`opencnc tools --db {} import TABLE` creates a store)", error, o.db),
+  std::error_code ec;
+  const bool exists = std::filesystem::exists(o.db, ec);
+  if (writes && exists && ::access(o.db.c_str(), W_OK) != 0) {
+    fail(fmt::format("{}: {} (the store is read-only for this user: list, show, check, diff, export and audit "
+                     "read it; changes need write access)",
+                     o.db, std::strerror(errno)),
          kExitUsage);
-  return s;
+    return nullptr;
+  }
+  auto s = store::ToolStore::open(o.db, &error, writes, !writes);
+  if (s) return s;
+  if (!exists)
+    fail(fmt::format("{} (`opencnc tools --db {} import TABLE` creates a store)", error, o.db), kExitUsage);
+  else
+    fail(error, kExitUsage);
+  return nullptr;
 }
+
+/// Backups are numbered from 1: 0 or a negative number names none (it is not "the current one").
+const CLI::Validator kBackupNumber(
+    [](std::string& value) -> std::string {
+      std::int64_t n = 0;
+      const auto [p, ec] = std::from_chars(value.data(), value.data() + value.size(), n);
+      if (ec != std::errc() || p != value.data() + value.size() || n < 1)
+        return fmt::format("backups are numbered from 1, not '{}' (without --backup: the current one)", value);
+      return {};
+    },
+    "BACKUP");
 
 void print(const ToolsOptions& o, const nlohmann::json& j, const std::string& text) {
   if (o.json)
@@ -129,7 +160,8 @@ int show(store::ToolStore& s, const ToolsOptions& o) {
   return kExitOk;
 }
 
-// set T3 D1 length1=139.225 wear_length1=-0.02 | set T3 pocket=4 comment="…": one transaction.
+// set T3 D1 length1=139.225 wear_length1=-0.02 | set T3 pocket=4 comment="…": one transaction,
+// applied to the table as committed when it is written (a concurrent writer's values stay).
 int set(store::ToolStore& s, const ToolsOptions& o) {
   const std::optional<int> t = o.words.empty() ? std::nullopt : numbered(o.words[0], 'T');
   if (!t) return fail("set wants a tool, an edge and values: set T3 D1 length1=139.225", kExitUsage);
@@ -138,10 +170,9 @@ int set(store::ToolStore& s, const ToolsOptions& o) {
   if (o.words.size() > 1) {
     if (const auto e = numbered(o.words[1], 'D')) d = *e, next = 2;
   }
-  std::string error;
-  std::optional<tools::ToolSet> changed = s.live(&error);
-  if (!changed) return fail(error);
   if (next >= o.words.size()) return fail("set names no value: e.g. length1=139.225", kExitUsage);
+  // Every word checked before anything is written.
+  std::vector<std::function<void(tools::ToolSet&)>> changes;
   for (std::size_t i = next; i < o.words.size(); ++i) {
     const std::string& w = o.words[i];
     const auto eq = w.find('=');
@@ -149,17 +180,18 @@ int set(store::ToolStore& s, const ToolsOptions& o) {
     if (eq == std::string::npos)
       return fail(fmt::format("'{}': a value is written name=value", w), kExitUsage);
     if (name == "comment") {
-      changed->tool_or_add(*t).comment = value;
+      if (const auto why = tools::invalid_comment(value)) return fail(fmt::format("'{}': {}", w, *why), kExitUsage);
+      changes.push_back([t = *t, value](tools::ToolSet& set) { set.tool_or_add(t).comment = value; });
       continue;
     }
     double v = 0;
     const auto [p, ec] = std::from_chars(value.data(), value.data() + value.size(), v);
-    if (ec != std::errc() || p != value.data() + value.size() || value.empty())
+    if (ec != std::errc() || p != value.data() + value.size() || value.empty() || !std::isfinite(v))
       return fail(fmt::format("'{}': {} is not a number", w, value), kExitUsage);
     if (name == "pocket") {
       if (v != static_cast<int>(v))
         return fail(fmt::format("'{}': a pocket is a whole number", w), kExitUsage);
-      changed->tool_or_add(*t).pocket = static_cast<int>(v);
+      changes.push_back([t = *t, v](tools::ToolSet& set) { set.tool_or_add(t).pocket = static_cast<int>(v); });
       continue;
     }
     const auto param = tools::param_named(name);
@@ -173,10 +205,19 @@ int set(store::ToolStore& s, const ToolsOptions& o) {
       return fail(fmt::format("T{} D{}: tools go from T1 to T{}, edges from D1 to D{}", *t, d,
                               tools::kMaxToolNumber, tools::kMaxEdge),
                   kExitUsage);
-    changed->edge_or_add(*t, d).set(*param, v);
+    changes.push_back([t = *t, d, param = *param, v](tools::ToolSet& set) { set.edge_or_add(t, d).set(param, v); });
   }
-  if (!s.write(*changed, kInterface, "set", &error)) return fail(error);
-  print(o, tool_json(*changed->tool(*t)), fmt::format("T{} set", *t));
+  std::string error;
+  std::optional<tools::Tool> written;
+  const bool ok = s.modify(
+      [&](tools::ToolSet& live) -> std::optional<std::string> {
+        for (const auto& change : changes) change(live);
+        written = *live.tool(*t);
+        return std::nullopt;
+      },
+      kInterface, "set", &error);
+  if (!ok) return fail(error);
+  print(o, tool_json(*written), fmt::format("T{} set", *t));
   return kExitOk;
 }
 
@@ -264,6 +305,10 @@ int import(store::ToolStore& s, const ToolsOptions& o) {
   }
   for (const Diagnostic& x : d.items()) fmt::print(stderr, "{}\n", x.format());
   if (!set || d.error_count() > 0) return fail(fmt::format("{} was not imported: nothing changed", path));
+  if (set->tools.empty() && !o.allow_empty)
+    return fail(fmt::format("{} holds no tools: importing it would empty the live table (nothing changed; "
+                            "--allow-empty if that is meant)",
+                            path));
   if (!s.write(*set, kInterface, fmt::format("import {}", path), &error)) return fail(error);
   print(o, {{"imported", path}, {"tools", set->tools.size()}, {"edges", set->edge_count()}},
         fmt::format("{}: {} tools, {} edges are the live table now (check against the backup, then accept)",
@@ -338,7 +383,13 @@ int run(const std::string& action, ToolsOptions o) {
   }
   if (o.db.empty())
     return fail("name the tool store: --db FILE (or --machine PROFILE with a [tool_guard])", kExitUsage);
-  const bool writes = action == "set" || action == "import" || action == "backup" || action == "accept";
+  const bool writes = action == "set" || action == "import" || action == "backup" || action == "accept" ||
+                      action == "restore";
+  // An import whose source cannot be read creates no store.
+  if (action == "import" && o.words.size() == 1) {
+    if (const std::string why = unreadable_input(o.words[0]); !why.empty())
+      return fail(fmt::format("cannot read {}: {}", o.words[0], why), kExitUsage);
+  }
   const auto s = open_store(o, writes);
   if (!s) return kExitUsage;
   if (action == "list") return list(*s, o);
@@ -384,17 +435,20 @@ void add_tools_command(CLI::App& app, Registry& registry) {
   add("check", "Compare the live table with the current backup; exit 1 and one line per difference",
       "[T<n>]");
   add("diff", "Every difference with a backup, tolerated ones marked", nullptr)
-      ->add_option("--backup", o->backup, "The backup (default: the current one)");
+      ->add_option("--backup", o->backup, "The backup (default: the current one)")
+      ->check(kBackupNumber);
   add("accept", "The live values become the new backup", nullptr);
   add("restore", "The backup's values become live", nullptr)
-      ->add_option("--backup", o->backup, "The backup (default: the current one)");
-  add("import", "Replace the live table by a LinuxCNC .tbl or an 840D export", "FILE");
+      ->add_option("--backup", o->backup, "The backup (default: the current one)")
+      ->check(kBackupNumber);
+  add("import", "Replace the live table by a LinuxCNC .tbl or an 840D export", "FILE")
+      ->add_flag("--allow-empty", o->allow_empty, "Let a table without tools empty the live one");
   CLI::App* ex =
       add("export", "Write the live table (or a backup) as text, 840D subprogram, .tbl or JSON", nullptr);
   ex->add_option("--format", o->format, "text, 840d, tbl or json")
       ->check(CLI::IsMember({"text", "840d", "tbl", "json"}));
   ex->add_option("-o,--output", o->output, "The file (default: standard output)");
-  ex->add_option("--backup", o->backup, "A backup instead of the live table");
+  ex->add_option("--backup", o->backup, "A backup instead of the live table")->check(kBackupNumber);
   add("audit", "The last changes: when, through which interface, what, old and new value", nullptr)
       ->add_option("--last", o->last, "How many (0: all; default 20)");
 }

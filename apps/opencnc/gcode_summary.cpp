@@ -76,7 +76,7 @@ struct Totals {
   std::size_t feeds = 0, rapids = 0, arcs = 0;
   double feed_length = 0, rapid_length = 0;
   double feed_time_min = 0;
-  bool untimed = false;   // per-revolution feeds: no time without a spindle model
+  bool untimed = false;   // per-revolution moves without a spindle speed (or under G96): not timed
   double slowest_min = 0;  // the feed move that takes longest, and where it is
   std::uint32_t slowest_file = 0, slowest_line = 0;
   Box box;
@@ -104,15 +104,38 @@ class MoveMeter {
   /// Measures the moves appended since the last call.
   void catch_up() {
     const canon::Program& prog = builder_.program();
-    for (; next_ < prog.size(); ++next_) measure(prog, next_);
+    for (; next_ < prog.size(); ++next_) {
+      spindle_before(prog, next_);
+      measure(prog, next_);
+    }
     if (next_ >= kKeptMoves) {
+      spindle_before(prog, next_);
       builder_.restart();
       next_ = 0;
+      next_action_ = 0;
     }
   }
   const Totals& totals() const { return t_; }
 
  private:
+  // The spindle's speed and a synchronised run's pitch as they stand before move `id`: a move per
+  // revolution (G95, G33, G76, G33.1) takes its length over (distance per turn × turns per minute).
+  void spindle_before(const canon::Program& prog, canon::SegmentId id) {
+    for (; next_action_ < prog.action_count() && prog.action(next_action_).before_move <= id; ++next_action_) {
+      const canon::Action& a = prog.action(next_action_);
+      if (a.kind == canon::ActionKind::SpindleSpeed) rpm_ = a.index2 == 0 ? a.value : 0;  // G96: varies
+      if (a.kind == canon::ActionKind::SpeedFeedSyncStart) per_turn_mm_ = a.value;
+      if (a.kind == canon::ActionKind::SpeedFeedSyncStop) per_turn_mm_ = 0;
+    }
+  }
+  /// Minutes of a move of `len` mm at `per_turn` mm per spindle turn; 0 (and untimed) when the
+  /// speed is not known.
+  double per_turn_minutes(double len, double per_turn) {
+    if (rpm_ > 0 && per_turn > 0) return len / (per_turn * rpm_);
+    t_.untimed = true;
+    return 0;
+  }
+
   void measure(const canon::Program& prog, canon::SegmentId id) {
     if (id == 0) {  // (after a restart the start is where the last move measured ended)
       const Pose& start = prog.start();
@@ -148,7 +171,10 @@ class MoveMeter {
     double minutes = 0;
     if (m.flags & canon::kInverseTime)
       minutes = f > 0 ? 1.0 / f : 0;
-    else if (m.flags & canon::kPerRevolution) t_.untimed = true;
+    else if (m.flags & canon::kSpindleSynced)
+      minutes = per_turn_minutes(len, per_turn_mm_);
+    else if (m.flags & canon::kPerRevolution)
+      minutes = per_turn_minutes(len, f);
     else if (f > 0)
       minutes = len / f;
     t_.feed_time_min += minutes;
@@ -177,6 +203,9 @@ class MoveMeter {
 
   canon::ProgramBuilder& builder_;
   canon::SegmentId next_ = 0;
+  std::size_t next_action_ = 0;  // the first action not yet seen
+  double rpm_ = 0;               // the spindle speed in force (0: none, or G96)
+  double per_turn_mm_ = 0;       // the pitch of the synchronised run in force (0: none)
   double last_[3] = {0, 0, 0};   // X, Y, Z where the last move measured ended
   Totals t_;
 };
@@ -321,7 +350,7 @@ int run_scan(const std::string& file, const gcode::Options& options, const ScanO
     print_box("extent (machine, mm)", t.box);
     print_box("extent (work)", watch.box());
     std::printf("%-22s %.1f s at programmed feeds%s", "time", t.feed_time_min * 60.0,
-                t.untimed ? " (feed-per-revolution moves not timed)" : "");
+                t.untimed ? " (some moves per spindle turn without a known speed not timed)" : "");
     if (rapid_rate_mm_min > 0) std::printf(" + %.1f s rapid", rapid_min * 60.0);
     if (watch.dwell_s > 0) std::printf(" + %.1f s dwell", watch.dwell_s);
     std::printf("\n");

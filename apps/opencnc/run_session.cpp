@@ -7,6 +7,7 @@
 
 #include <cerrno>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <optional>
@@ -15,6 +16,7 @@
 #include <fmt/format.h>
 
 #include "commands.hpp"
+#include "opencnc/core/atomic_file.hpp"
 #include "opencnc/config/profile_loader.hpp"
 #include "opencnc/control/clock.hpp"
 #include "opencnc/control/servo.hpp"
@@ -303,26 +305,43 @@ void bring_hand_axis(Driver& d, const control::ServoStatus& s) {
   }
 }
 
-/// A stop asked through SessionOptions::stop (SIGINT, SIGTERM): feed hold on the path, then abort
-/// once the machine is at rest. Call every period; records the signal in `end`.
+/// A stop asked through SessionOptions::stop (SIGINT, SIGTERM) or by SessionOptions::max_time_s:
+/// feed hold on the path, then abort once the machine is at rest. Where a hold does not act (a
+/// thread or tap follows the spindle: G33, G76, G33.1) the abort comes at once, as it does at a
+/// second signal: it brakes on the path too, the run ends and the report is written. Call every
+/// period; records why in `end`.
 class StopOnThePath {
  public:
-  explicit StopOnThePath(const std::atomic<int>* flag) : flag_(flag) {}
-  bool requested() const noexcept { return flag_ != nullptr && flag_->load(std::memory_order_relaxed) != 0; }
+  StopOnThePath(const SessionOptions& o) : flag_(o.stop), count_(o.stops), max_time_s_(o.max_time_s) {}
+  bool requested() const noexcept { return signal() != 0 || over_time_; }
   void step(Driver& d, const control::ControllerStatus& st, SessionEnd& end) {
+    if (run_start_s_ < 0) run_start_s_ = st.servo.time_s;
+    if (max_time_s_ > 0 && !over_time_ && signal() == 0 && st.servo.time_s - run_start_s_ > max_time_s_) {
+      over_time_ = end.over_max_time = true;
+      fmt::print(stderr, "error: the run passed --max-time {:g} s: stopping on the path\n", max_time_s_);
+    }
     if (!requested() || aborted_) return;
-    end.stopped_by = flag_->load(std::memory_order_relaxed);
-    if (!held_)
+    if (signal() != 0) end.stopped_by = signal();
+    const bool again = count_ != nullptr && count_->load(std::memory_order_relaxed) >= 2;
+    const bool hold_does_not_act = held_ && st.servo.spindle_synced;
+    if (!held_ && !again) {
       d.controller().submit(Request::simple(CommandKind::FeedHold));
-    else if (st.servo.path_velocity == 0)
+      held_ = true;
+      return;
+    }
+    if (again || hold_does_not_act || st.servo.path_velocity == 0) {
       d.controller().submit(Request::simple(CommandKind::Abort));
-    aborted_ = held_ && st.servo.path_velocity == 0;
-    held_ = true;
+      aborted_ = true;
+    }
   }
 
  private:
+  int signal() const noexcept { return flag_ != nullptr ? flag_->load(std::memory_order_relaxed) : 0; }
   const std::atomic<int>* flag_;
-  bool held_ = false, aborted_ = false;
+  const std::atomic<int>* count_;
+  double max_time_s_ = 0;
+  double run_start_s_ = -1;
+  bool held_ = false, aborted_ = false, over_time_ = false;
 };
 
 /// Follows the job started by cycle start until it ends, with the operator where it waits (and
@@ -377,7 +396,7 @@ bool answer_load_hold(Driver& d, const SessionOptions& o, OperatorInput& input) 
 
 void follow(Driver& d, control::EventCursor& cursor, const SessionOptions& o, const SessionHooks& hooks,
             SessionEnd& end) {
-  StopOnThePath stop(o.stop);
+  StopOnThePath stop(o);
   const auto t0 = std::chrono::steady_clock::now();
   OperatorInput input;
   std::uint32_t job = 0;
@@ -446,6 +465,8 @@ void follow(Driver& d, control::EventCursor& cursor, const SessionOptions& o, co
         else if (end.stopped_by != 0)
           end.fault =
               fmt::format("stopped by {} (feed hold on the path, then abort)", signal_name(end.stopped_by));
+        else if (end.over_max_time)
+          end.fault = fmt::format("stopped by --max-time {:g} s (feed hold on the path, then abort)", o.max_time_s);
         else
           end.fault = fmt::format("the program ended: {}", control::to_string(ended->end));
         if (st.fault_text.empty()) fmt::print(stderr, "error: {}\n", end.fault);
@@ -525,9 +546,8 @@ SessionEnd run_session(const SessionOptions& o, const SessionHooks& hooks) {
     return end;
   }
   end.profile = *load.profile;
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(o.file, ec)) {
-    fmt::print(stderr, "error: cannot read the program {}\n", o.file);
+  if (const std::string why = unreadable_input(o.file, SIZE_MAX); !why.empty()) {
+    fmt::print(stderr, "error: cannot read the program {}: {}\n", o.file, why);
     end.exit_code = kExitUsage;
     return end;
   }
@@ -577,6 +597,7 @@ SessionEnd run_session(const SessionOptions& o, const SessionHooks& hooks) {
   }
   end.program = d.controller().open_program();
   note_assumptions(end.program->preflight.summary);
+  if (hooks.may_start && !hooks.may_start(end.profile, *end.program)) return end;
   if (hooks.opened) {
     for (auto& [observer, options] : hooks.opened(end.profile, *end.program))
       d.controller().attach(observer, options);

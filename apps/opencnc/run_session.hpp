@@ -35,6 +35,12 @@ struct SessionOptions {
   bool unattended = false;  ///< continue program stops and manual tool changes without asking
   /// Polled during the run: a signal number there stops it on the path (feed hold, then abort).
   const std::atomic<int>* stop = nullptr;
+  /// Polled with `stop`: how many signals came; from the second on the run is aborted at once
+  /// (the report is still written).
+  const std::atomic<int>* stops = nullptr;
+  /// Machine time (s) after which the run is stopped on the path as by a signal (0: none):
+  /// `run --max-time` holds while the program runs, not only in its estimate.
+  double max_time_s = 0;
   /// Virtual time: the simulated mains fail at this servo time (s); negative: never.
   double mains_off_s = -1;
   /// Virtual time: the broach's cutter wears to `tool_dull_factor` at this servo time (s); negative: never.
@@ -69,6 +75,7 @@ struct SessionEnd {
   std::string fault;           ///< why it stopped early, in words ("" = it did not)
   bool limit_touched = false;  ///< a soft limit or a limit switch stopped it
   int stopped_by = 0;          ///< the signal that stopped it (SessionOptions::stop), 0 if none
+  bool over_max_time = false;  ///< SessionOptions::max_time_s stopped it
   double wall_s = 0;           ///< wall-clock time of the run
   config::MachineProfile profile;
   std::optional<control::OpenProgram> program;  ///< the program as opened (its preflight)
@@ -86,6 +93,10 @@ struct SessionHooks {
       std::vector<std::pair<std::shared_ptr<control::ControllerObserver>, control::ObserverOptions>>(
           const config::MachineProfile&, const control::OpenProgram&)>
       opened;
+  /// Called once the program is open and checked, before `opened`: false ends the session there
+  /// (nothing has moved; it has said why). A program the preflight refused never gets here, so a
+  /// second look at it (the machining time against --max-time) is made only of a finite program.
+  std::function<bool(const config::MachineProfile&, const control::OpenProgram&)> may_start;
   /// Now and then with the status (for progress).
   std::function<void(const control::ControllerStatus&, double elapsed_wall_s)> progress;
   /// Features added to the controller before the program is opened (the retrace feature), each

@@ -59,12 +59,16 @@ std::optional<std::string> validate(const HelixJob& j) {
   const auto finite = [](double v) { return std::isfinite(v); };
   if (!finite(j.z_start) || !finite(j.z_end) || j.z_start == j.z_end)
     return "--z-start and --z-end must be different finite positions";
+  // The job writes pitches with 4 decimals (M171 P, as the interpreter reads them): a smaller one
+  // would be written as 0, which the interpreter refuses.
+  constexpr double kLeastPitchMm = 1e-4;
   if ((j.type == HelixType::Constant || j.type == HelixType::Variable) &&
-      (!finite(j.pitch_mm) || j.pitch_mm == 0))
-    return "--pitch must be a pitch per revolution other than 0 (negative: a left-hand helix)";
+      (!finite(j.pitch_mm) || std::fabs(j.pitch_mm) < kLeastPitchMm))
+    return "--pitch must be a pitch per revolution of at least 0.0001 mm (negative: a left-hand helix)";
   if (j.type == HelixType::Variable) {
-    if (!finite(j.pitch_end_mm) || j.pitch_end_mm == 0 || (j.pitch_end_mm > 0) != (j.pitch_mm > 0))
-      return "--pitch-end must be a pitch of the same sign as --pitch";
+    if (!finite(j.pitch_end_mm) || std::fabs(j.pitch_end_mm) < kLeastPitchMm ||
+        (j.pitch_end_mm > 0) != (j.pitch_mm > 0))
+      return "--pitch-end must be a pitch of at least 0.0001 mm, of the same sign as --pitch";
   }
   if ((j.type == HelixType::Table || j.type == HelixType::Cam) && (j.table < 1 || j.table > 8))
     return "--table must be the number of one of the machine's coupling tables, 1 to 8";

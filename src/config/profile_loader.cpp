@@ -4,6 +4,11 @@
 
 #include <fmt/format.h>
 
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <utility>
+
 #include "opencnc/core/atomic_file.hpp"
 #include "overrides.hpp"
 #include "sections.hpp"
@@ -65,6 +70,52 @@ MachineProfile read_profile(const toml::table& root, Reporter& r, const std::fil
   return p;
 }
 
+/// The most parts a dotted key may have ("axis.x.homing" has 3): the TOML parser builds a table per
+/// part recursively, and 50,000 of them overflow the stack before any error could be given.
+constexpr int kMaxKeyParts = 64;
+/// A profile is a few kilobytes; a compensation table with thousands of points a few hundred.
+constexpr std::size_t kMaxProfileBytes = 4u << 20;
+
+/// Where a dotted key of more than kMaxKeyParts parts is (line, column: 1-based), if any. Counts
+/// the dots of each line outside strings and comments, but those between two digits (1.5).
+std::optional<std::pair<std::uint32_t, std::uint32_t>> too_many_key_parts(std::string_view text) {
+  std::uint32_t line = 1, col = 0;
+  int dots = 0;
+  char quote = 0;  // inside "…" or '…' (triple quotes open and close the same way)
+  bool comment = false, escaped = false;
+  char before = '\n';
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    ++col;
+    if (c == '\n') {
+      ++line, col = 0, dots = 0, comment = false;  // a string stays open: triple quotes span lines
+      before = c;
+      continue;
+    }
+    if (comment) continue;
+    if (quote != 0) {
+      if (quote == '"' && c == '\\' && !escaped) {
+        escaped = true;
+        continue;
+      }
+      if (c == quote && !escaped) quote = 0;
+      escaped = false;
+      continue;
+    }
+    if (c == '#') {
+      comment = true;
+    } else if (c == '"' || c == '\'') {
+      quote = c;
+    } else if (c == '.') {
+      const char after = i + 1 < text.size() ? text[i + 1] : ' ';
+      const bool decimal = before >= '0' && before <= '9' && after >= '0' && after <= '9';
+      if (!decimal && ++dots >= kMaxKeyParts) return std::pair{line, col};
+    }
+    if (c != ' ' && c != '\t') before = c;
+  }
+  return std::nullopt;
+}
+
 }  // namespace
 
 std::uint64_t text_digest(std::string_view text) noexcept {
@@ -78,6 +129,20 @@ ProfileLoad parse_profile(std::string_view text, std::string_view source_name,
                           std::span<const FileText> files) {
   ProfileLoad out;
   Reporter r(out.diagnostics, std::string(source_name));
+  if (text.size() > kMaxProfileBytes) {
+    out.diagnostics.error(std::string(source_name), 0, 0,
+                          fmt::format("a profile is at most {} MiB (this text has {} bytes)", kMaxProfileBytes >> 20,
+                                      text.size()),
+                          "config.syntax");
+    return out;
+  }
+  if (const auto at = too_many_key_parts(text)) {
+    out.diagnostics.error(std::string(source_name), at->first, at->second,
+                          fmt::format("a dotted key of more than {} parts (no machine profile nests that deep)",
+                                      kMaxKeyParts),
+                          "config.syntax");
+    return out;
+  }
   toml::table root;
   try {
     root = toml::parse(text, source_name);

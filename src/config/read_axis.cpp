@@ -599,7 +599,20 @@ void check_homing(Section& s, const AxisProfile& a) {
 }
 
 /// A double holds integers exactly up to 2^53; keep the counter well inside that over the travel.
+/// And a count must be finer than the following error allowed: with counts of a millimetre, the
+/// drive's position could never be told within a 0.5 mm limit (the first move would fault).
 void check_resolution(Section& s, const AxisProfile& a) {
+  const std::string_view resolution_key =
+      a.drive == JointDrive::Servo ? "encoder_counts_per_unit" : "steps_per_unit";
+  if (s.has(resolution_key) && a.counts_per_unit > 0 && 1 / a.counts_per_unit > a.max_following_error) {
+    s.error(resolution_key,
+            fmt::format("{} = {} is no plausible value: one count ({} {}) must be finer than "
+                        "max_following_error ({} {})",
+                        s.key_path(resolution_key), show(a.counts_per_unit), show(1 / a.counts_per_unit),
+                        a.rotary ? "deg" : "mm", show(a.max_following_error), a.rotary ? "deg" : "mm"),
+            "config.implausible");
+    return;
+  }
   constexpr double kMaxCounts = 0x1.0p50;
   const double travel = a.wrapped ? 360.0 * 1e6 : std::max(std::abs(a.min_limit), std::abs(a.max_limit));
   if (travel * a.counts_per_unit > kMaxCounts) {

@@ -7,6 +7,7 @@
 #include <limits>
 #include <system_error>
 
+#include "opencnc/core/atomic_file.hpp"
 #include "sections.hpp"
 
 namespace opencnc::config::detail {
@@ -75,6 +76,17 @@ void read_spindle(Section& top, MachineProfile& profile) {
   SpindleProfile& sp = profile.spindle;
   sp.present = true;
   sp.max_rpm = s.required_number("max_rpm", Bound::Positive);
+  // The fastest spindles (dental, PCB drills) turn at a few 100,000 rpm: beyond 1e6 is a typo,
+  // and a run would wait for ever for the spindle to reach it.
+  constexpr double kMaxPlausibleRpm = 1e6;
+  if (sp.max_rpm > kMaxPlausibleRpm) {
+    s.error("max_rpm",
+            fmt::format("spindle.max_rpm = {} is no plausible value: spindles turn at most {:g} rpm (a typo, or "
+                        "another unit?)",
+                        show(sp.max_rpm), kMaxPlausibleRpm),
+            "config.implausible");
+    sp.max_rpm = kMaxPlausibleRpm;
+  }
   sp.min_rpm = s.number_or("min_rpm", 0, Bound::NonNegative);
   if (sp.min_rpm > sp.max_rpm) {
     s.error(
@@ -278,7 +290,8 @@ void read_interpreter(Section& top, MachineProfile& profile, const std::filesyst
   const toml::table* t = top.subtable("interpreter");
   if (t == nullptr) return;
   Section s(*t, "interpreter",
-            {"dialect", "machine", "axis_map", "subroutine_path", "tool_table", "readahead_moves", "readahead_s"},
+            {"dialect", "machine", "axis_map", "subroutine_path", "tool_table", "readahead_moves", "readahead_s",
+             "max_scan_s"},
             top.reporter());
   InterpreterOptions& o = profile.interpreter;
   o.dialect =
@@ -307,9 +320,15 @@ void read_interpreter(Section& top, MachineProfile& profile, const std::filesyst
       }
     }
   }
-  if (const auto table = s.string("tool_table")) o.tool_table = resolve(base_dir, *table);
+  if (const auto table = s.string("tool_table")) {
+    o.tool_table = resolve(base_dir, *table);
+    // Checked now, not when the first program runs: a missing table, a folder or a device.
+    if (const std::string why = unreadable_input(o.tool_table); !why.empty())
+      s.error("tool_table", fmt::format("interpreter.tool_table: {}: {}", o.tool_table, why), "config.path");
+  }
   o.readahead_moves = static_cast<int>(s.integer("readahead_moves", 1, 10'000'000).value_or(o.readahead_moves));
   o.readahead_s = s.number_or("readahead_s", o.readahead_s, Bound::Positive);
+  o.max_scan_s = s.number_or("max_scan_s", o.max_scan_s, Bound::Positive);
 }
 
 void read_planner(Section& top, MachineProfile& profile) {

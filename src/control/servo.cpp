@@ -431,6 +431,7 @@ void Servo::fill_status(ServoStatus& s) const noexcept {
   s.line = tick_out_.line;
   s.context = tick_out_.context;
   s.path_velocity = activity_ == Activity::Program ? tick_out_.path_velocity : 0.0;
+  s.spindle_synced = activity_ == Activity::Program && tick_out_.spindle_synced;
   s.feed_override = feed_override_;
   s.rapid_override = rapid_override_;
   s.spindle_override = spindle_override_;

@@ -97,6 +97,52 @@ std::string refusal_text(Refusal r) {
   return "refused";
 }
 
+/// What the operator can do about a refusal of `command`, where the generic text would leave them
+/// guessing ("nothing to do in this state"); "" when the generic text says it.
+std::string what_next(CommandKind command, Refusal r) {
+  switch (r) {
+    case Refusal::NotApplicable:
+      switch (command) {
+        case CommandKind::MachineOn:
+          return "the machine is already on";
+        case CommandKind::MachineOff:
+          return "the machine is already off";
+        case CommandKind::FeedHold:
+          return "nothing is running to hold";
+        case CommandKind::Resume:
+          return "nothing is held: resume continues after a feed hold";
+        case CommandKind::CycleStart:
+          return "nothing is held or stopped to continue, and no program is open to start: open one (Auto), "
+                 "then cycle start";
+        case CommandKind::Reset:
+          return "nothing to reset: the machine is neither e-stopped nor faulted";
+        case CommandKind::Abort:
+          return "nothing is running to abort";
+        case CommandKind::ToolChanged:
+          return "no manual tool change is waiting";
+        default:
+          return "";
+      }
+    case Refusal::WrongMode:
+      switch (command) {
+        case CommandKind::JogContinuous:
+        case CommandKind::JogIncrement:
+        case CommandKind::Home:
+        case CommandKind::SeekLimit:
+        case CommandKind::SpindleOn:
+        case CommandKind::Coolant:
+          return "that is done in Manual mode: switch to MANUAL first";
+        default:
+          return "";
+      }
+    case Refusal::Busy:
+      return command == CommandKind::SetMode ? "the mode changes while nothing runs: wait for the end, or abort"
+                                             : "";
+    default:
+      return "";
+  }
+}
+
 /// The refusal the servo would give for a run in `state`.
 Refusal not_idle(State s) {
   switch (s) {
@@ -345,7 +391,7 @@ void Controller::on_event(const ServoEvent& e) {
   switch (e.kind) {
     case EventKind::Accepted:
     case EventKind::Refused:
-      if (!settle_profile_change(e)) finish(e.command_id, e.refusal);
+      if (!settle_profile_change(e)) finish(e.command_id, e.refusal, what_next(e.command, e.refusal));
       break;
     case EventKind::Fault:
       note(Severity::Error, fault_code(e.fault.kind), describe(e.fault));
@@ -439,10 +485,6 @@ void Controller::forward(std::uint64_t id, const Command& command) {
 }
 
 // --- long work -------------------------------------------------------------------------------
-
-bool Controller::busy_with_long_work() const noexcept {
-  return long_.has_value();
-}
 
 void Controller::run_long(std::uint64_t id, std::function<void()> work, std::function<void()> then) {
   auto failure = std::make_shared<std::string>();
@@ -602,13 +644,17 @@ void Controller::mdi(std::uint64_t id, const std::string& line) {
 }
 
 void Controller::cycle_start(std::uint64_t id, const Request& r) {
-  if (job_ || servo().mode != Mode::Auto) {  // the servo continues (M0, hold) or says no
+  std::optional<OpenProgram> op = open_program();
+  // A program open and the machine idle in Manual or MDI (after homing, a jog, an MDI line): the
+  // mode follows, as the operator means to run it (docs/controller.md, "Cycle start").
+  const bool mode_follows = !job_ && op && servo().mode != Mode::Auto && servo().state == State::Idle;
+  if (job_ || (servo().mode != Mode::Auto && !mode_follows)) {  // the servo continues (M0, hold) or says no
     const std::optional<Command> c = to_command(r);
     return forward(id, *c);
   }
-  std::optional<OpenProgram> op = open_program();
-  if (!op) return finish(id, Refusal::NoProgram, refusal_text(Refusal::NoProgram));
-  if (!ready_for_job(id, Mode::Auto, "programs")) return;
+  if (!op)
+    return finish(id, Refusal::NoProgram, "no program is open: open one (the Program screen, or open FILE), then cycle start");
+  if (!ready_for_job(id, mode_follows ? servo().mode : Mode::Auto, "programs")) return;
   if (!features_allow_start(id, {JobKind::Program, op->name})) return;
   if (op->program) {
     // Checked when opened, unless the machine stands elsewhere or its limits changed since.
@@ -658,7 +704,8 @@ void Controller::start_checked(std::uint64_t id, const std::string& path, Prefli
     open_->preflight = std::move(pf);
     name = open_->name;
   }
-  if (!ready_for_job(id, Mode::Auto, "programs")) return;
+  // (The cycle start it answers may have been pressed in Manual or MDI: the mode follows.)
+  if (!ready_for_job(id, servo().mode, "programs")) return;
   if (servo().commanded != at)
     return finish(id, Refusal::StartMismatch, "the machine moved while the program was checked: start it again");
   start_job(id, JobKind::Program, name, Mode::Auto, source_->execute(path, at, {block_delete}), true);
@@ -813,6 +860,15 @@ void Controller::poll_features() {
 
 void Controller::start_job(std::uint64_t id, JobKind kind, std::string name, Mode mode,
                            std::unique_ptr<ProgramStream> stream, bool prechecked) {
+  if (servo().mode != mode) {
+    // A program started from Manual or MDI: the mode follows, ahead of the StartRun in the queue.
+    Command m;
+    m.kind = CommandKind::SetMode;
+    m.mode = mode;
+    m.id = new_id();
+    m.seq = handling_seq_;
+    if (!send(m)) return finish(id, Refusal::Busy, "the servo's command queue is full");
+  }
   detail::JobHost host;
   host.channels = channels_;
   host.servo = &servo_config_;

@@ -651,6 +651,7 @@ std::optional<GcodeSourceConfig> GcodeProgramSource::config_for(const config::Ma
   o.tool_change.axes = profile.tool_change.axes;
   o.tool_change.machine = profile.tool_change.position;
   o.tool_change.z_first = profile.tool_change.z_first;
+  o.limits.max_seconds = profile.interpreter.max_scan_s;  // scans only: a run goes on for hours
   if (!profile.interpreter.tool_table.empty()) {
     c.tools = tools::FileToolTable::open(profile.interpreter.tool_table, diags);
     if (!c.tools) return std::nullopt;

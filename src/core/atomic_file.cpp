@@ -3,9 +3,11 @@
 #include "opencnc/core/atomic_file.hpp"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdint>
 #include <cstring>
 
 #include <fmt/format.h>
@@ -74,24 +76,77 @@ bool write_file_atomically(const std::string& path, std::string_view content, st
   return true;
 }
 
-bool read_file(const std::string& path, std::string& out, std::string* error) {
-  auto reason = [error](int err) {
-    if (error != nullptr) *error = std::strerror(err);
+namespace {
+
+/// What kind of file `mode` is, for a refusal.
+const char* file_kind(mode_t mode) {
+  if (S_ISDIR(mode)) return "it is a folder, not a file";
+  if (S_ISFIFO(mode)) return "it is a FIFO, not a file";
+  if (S_ISCHR(mode) || S_ISBLK(mode)) return "it is a device, not a file";
+  if (S_ISSOCK(mode)) return "it is a socket, not a file";
+  return "it is not a regular file";
+}
+
+std::string too_large(std::size_t max_bytes) {
+  return max_bytes % (1u << 20) == 0 ? fmt::format("it is larger than {} MiB", max_bytes >> 20)
+                                     : fmt::format("it is larger than {} bytes", max_bytes);
+}
+
+/// Opens `path` for reading without blocking on a FIFO, and checks it is a regular file of at most
+/// `max_bytes`: the descriptor, or −1 with the reason in `why`.
+int open_input(const std::string& path, std::size_t max_bytes, std::string& why) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK | O_NOCTTY);
+  if (fd < 0) {
+    why = std::strerror(errno);
+    return -1;
+  }
+  struct stat st {};
+  if (::fstat(fd, &st) != 0) {
+    why = std::strerror(errno);
+  } else if (!S_ISREG(st.st_mode)) {
+    why = file_kind(st.st_mode);
+  } else if (static_cast<std::uint64_t>(st.st_size) > max_bytes) {
+    why = too_large(max_bytes);
+  } else {
+    return fd;
+  }
+  ::close(fd);
+  return -1;
+}
+
+}  // namespace
+
+std::string unreadable_input(const std::string& path, std::size_t max_bytes) {
+  std::string why;
+  const int fd = open_input(path, max_bytes, why);
+  if (fd >= 0) ::close(fd);
+  return why;
+}
+
+bool read_file(const std::string& path, std::string& out, std::string* error, std::size_t max_bytes) {
+  std::string why;
+  const int fd = open_input(path, max_bytes, why);
+  if (fd < 0) {
+    if (error != nullptr) *error = why;
     return false;
-  };
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) return reason(errno);
+  }
   out.clear();
   char buf[1 << 16];
   for (;;) {
     const ssize_t n = ::read(fd, buf, sizeof buf);
     if (n < 0) {
       if (errno == EINTR) continue;
-      const int err = errno;  // EISDIR for a folder
+      const int err = errno;
       ::close(fd);
-      return reason(err);
+      if (error != nullptr) *error = std::strerror(err);
+      return false;
     }
     if (n == 0) break;
+    if (out.size() + static_cast<std::size_t>(n) > max_bytes) {  // it grew while we read
+      ::close(fd);
+      if (error != nullptr) *error = too_large(max_bytes);
+      return false;
+    }
     out.append(buf, static_cast<std::size_t>(n));
   }
   ::close(fd);

@@ -247,6 +247,7 @@ void Engine::check_word_rules(const Block& b) {
             "$ word (spindle number) used by no code on this line: $ belongs with S, M3, M4, M5, M19, M51, "
             "G33, G33.1 or G76");
   // Most blocks carry axis words and F/S only: none of the rules below can apply.
+  if (b.has('f') || b.has('k') || b.has('p')) check_per_turn(b);
   constexpr auto bit = [](char c) { return 1u << (c - 'a'); };
   constexpr std::uint32_t kRuledWords = bit('d') | bit('e') | bit('h') | bit('i') | bit('j') | bit('k') | bit('l') |
                                         bit('p') | bit('q') | bit('r');
@@ -306,6 +307,33 @@ void Engine::check_word_rules(const Block& b) {
               "G76 needs I, J and K words (thread offset, first cut depth, full thread depth): {}{}{}missing",
               b.has('i') ? "" : "I ", b.has('j') ? "" : "J ", b.has('k') ? "" : "K ");
   }
+}
+
+// A distance per spindle turn (a thread's pitch, G95's feed) below the least increment a program
+// states (0.0001 mm, 0.00001 in) is a move that never ends: K0 would stand still at the spindle's
+// full speed for ever. LinuxCNC's rs274 passes them; opencnc refuses them where they are written
+// (docs/conformance.md, "Stricter than LinuxCNC").
+void Engine::check_per_turn(const Block& b) {
+  const int units = b.g[kGroupUnits];
+  const bool inch = units == 200 || (units == -1 && st_.modal.units == canon::Units::Inch);
+  const double least = inch ? 1e-5 : 1e-4;
+  const char* unit = inch ? "in" : "mm";
+  const int motion = b.motion;
+  const auto small = [least](double v) { return std::fabs(v) < least; };
+  if ((motion == 330 || motion == 331) && b.has('k') && small(b.get('k')))
+    fail_at(b.word_position('k'), ErrorCode::PerTurnTooSmall,
+            "{} K{}: a pitch below {} {} per turn never ends (the least increment a program states)",
+            g_name(motion), b.get('k'), least, unit);
+  if (motion == 760 && b.has('p') && small(b.get('p')))
+    fail_at(b.word_position('p'), ErrorCode::PerTurnTooSmall,
+            "G76 P{}: a pitch below {} {} per turn never ends (the least increment a program states)", b.get('p'),
+            least, unit);
+  const int feed_mode = b.g[kGroupFeedMode];
+  const bool per_turn = feed_mode == 950 || (feed_mode == -1 && st_.modal.feed_mode == canon::FeedMode::UnitsPerRevolution);
+  if (per_turn && b.has('f') && b.get('f') != 0 && small(b.get('f')))
+    fail_at(b.word_position('f'), ErrorCode::PerTurnTooSmall,
+            "G95 F{}: a feed below {} {} per turn never ends (the least increment a program states)", b.get('f'),
+            least, unit);
 }
 
 // An M98 line: P (the subprogram's number, whole) and L (calls, 0 or more: the parser refuses

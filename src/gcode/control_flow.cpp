@@ -249,6 +249,10 @@ void Engine::o_m98() {
         "a parameter assignment on an M98 line: LinuxCNC would not make it, so put it on a line of its own");
   const std::string name = std::to_string(round_to_int(block_.get('p')));
   block_.o_name = name;
+  if (block_.has('l') && opt_.limits.max_repeat_count != 0 &&
+      block_.get('l') > static_cast<double>(opt_.limits.max_repeat_count))
+    fail_at(block_.word_position('l'), ErrorCode::LimitRepeatCount, "M98 L{} is more than {} (limit max_repeat_count)",
+            block_.get('l'), opt_.limits.max_repeat_count);
   CallFrame& caller = st_.frames.back();
   CallFrame frame;
   frame.kind = CallKind::Numbered;

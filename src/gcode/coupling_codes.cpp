@@ -35,10 +35,11 @@ class CouplingCodes final : public CodeHandler {
     switch (code) {
       case kConstant:
       case kLinear:
-        if (!b.has('p') || b.get('p') == 0 || !std::isfinite(b.get('p')))
+        // A pitch below the least increment (0.0001 mm) would turn the slave without end.
+        if (!b.has('p') || std::fabs(b.get('p')) < 1e-4 || !std::isfinite(b.get('p')))
           return Rejection{
               ErrorCode::CouplingWord,
-              fmt::format("M{} needs the pitch per revolution as P (not 0; negative: a left-hand helix)",
+              fmt::format("M{} needs the pitch per revolution as P, at least 0.0001 mm (negative: a left-hand helix)",
                           code)};
         if (code == kLinear && !b.has('q'))
           return Rejection{

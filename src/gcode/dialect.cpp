@@ -2,11 +2,29 @@
 // Dialect names, dialect markers in programs, and the lathe-or-mill guess for Fanuc programs.
 #include "opencnc/gcode/dialect.hpp"
 
+#include <cstdint>
 #include <fstream>
+#include <sstream>
+
+#include "opencnc/core/atomic_file.hpp"
 
 namespace opencnc::gcode {
 
 namespace {
+
+/// The first `bytes` of a program file, read only from a regular file (a FIFO would block, a
+/// device such as /dev/zero never end): these guesses look at the head of a program; the
+/// program itself is read by SourceFile, which says what is wrong with the file.
+std::istringstream program_head(const std::string& path, std::size_t bytes) {
+  std::string head;
+  if (unreadable_input(path, SIZE_MAX).empty()) {
+    std::ifstream in(path, std::ios::binary);
+    head.resize(bytes);
+    in.read(head.data(), static_cast<std::streamsize>(bytes));
+    head.resize(static_cast<std::size_t>(in.gcount()));
+  }
+  return std::istringstream(head);
+}
 
 std::string lower(std::string_view s) {
   std::string out(s);
@@ -35,7 +53,7 @@ std::optional<MachineKind> machine_kind_from_name(std::string_view name) noexcep
 }
 
 std::optional<Dialect> dialect_marker(const std::string& path) {
-  std::ifstream in(path);
+  std::istringstream in = program_head(path, 64 << 10);
   std::string line;
   for (int n = 0; n < 20 && std::getline(in, line); ++n) {
     const std::string text = lower(line);
@@ -53,7 +71,7 @@ std::optional<Dialect> dialect_marker(const std::string& path) {
 }
 
 MachineKind guess_machine_kind(const std::string& path) {
-  std::ifstream in(path);
+  std::istringstream in = program_head(path, 4 << 20);
   std::string line;
   bool x = false, z = false;
   while (std::getline(in, line)) {

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <ctime>
 #include <utility>
 
 #include "lexer.hpp"
@@ -191,6 +192,30 @@ void Engine::require_program() {
     diags_.error("", 0, 0, "no program is open", std::string(error_id(ErrorCode::NoProgram)));
     failed_ = true;
   }
+}
+
+namespace {
+
+// The thread's CPU time, not the wall clock: a loaded machine does not make a program fail its check.
+double thread_cpu_s() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+}  // namespace
+
+void Engine::check_time() {
+  const double now = thread_cpu_s();
+  if (lines_read_ == 1) {
+    cpu_at_start_s_ = now;
+    return;
+  }
+  if (now - cpu_at_start_s_ > opt_.limits.max_seconds)
+    fail(ErrorCode::LimitTime,
+         "the program was still running here after {:g} s of checking ({} blocks; limit max_seconds): an endless "
+         "loop?",
+         opt_.limits.max_seconds, st_.blocks_executed);
 }
 
 RunStatus Engine::step(canon::Sink& sink) {
@@ -387,6 +412,7 @@ Engine::LineKind Engine::read_block() {
   if (fanuc() && (text.front() == '$' || text.front() == '%')) check_foreign_syntax();
 
   const bool skipping = !st_.control.skipping_to.empty();
+  if (opt_.limits.max_seconds > 0 && opt_.mode == Mode::Scan && (lines_read_++ & 4095) == 0) check_time();
   if (skipping) {
     if (opt_.limits.max_skipped_lines != 0 && ++skipped_lines_ > opt_.limits.max_skipped_lines)
       fail(ErrorCode::LimitSkippedLines, "more than {} lines passed over while looking for a label (limit max_skipped_lines)",

@@ -11,6 +11,7 @@
 #include "opencnc/control/command.hpp"
 #include "opencnc/controller/run_from_line.hpp"
 #include "opencnc/hmi/api_admin.hpp"
+#include "opencnc/tools/tool_data.hpp"
 
 namespace opencnc::hmi {
 
@@ -174,7 +175,10 @@ ToolChange tool_change(const json& body) {
   c.tool = static_cast<int>(t);
   if (body.contains("diameter")) c.diameter_mm = within(number(body, "diameter"), 0, 1000, "diameter");
   if (body.contains("z_offset")) c.z_offset_mm = within(number(body, "z_offset"), -1000, 1000, "z_offset");
-  if (body.contains("comment")) c.comment = text(body, "comment");
+  if (body.contains("comment")) {
+    c.comment = text(body, "comment");
+    if (const auto why = tools::invalid_comment(c.comment)) throw Bad{422, *why};
+  }
   if (!c.diameter_mm && !c.z_offset_mm && !body.contains("comment")) {
     throw Bad{400, "nothing to change: give \"diameter\", \"z_offset\" or \"comment\""};
   }

@@ -463,7 +463,7 @@ void Server::Impl::handle(const std::shared_ptr<HttpSession>& s, HttpRequest req
   const std::optional<Role> role = tokens.role_of(token_of(req));
   const bool is_get = req.method() == http::verb::get;
   if (!role && !(is_get && t.path == "/api/v1/status" && loopback)) {
-    if (!is_get) audit(s->remote(), role, req, 401, "no valid token");
+    audit(s->remote(), role, req, 401, token_of(req).empty() ? "no token" : "no valid token");
     return s->send(error_response(req, 401, "a valid token is needed (Authorization: Bearer TOKEN)"));
   }
   if (t.path == "/api/v1/commands") {
@@ -483,9 +483,13 @@ void Server::Impl::handle(const std::shared_ptr<HttpSession>& s, HttpRequest req
   // What reads a file or the database goes off the io thread; the rest is in memory.
   const bool reads_disk = t.path == "/api/v1/program/text" || t.path == "/api/v1/programs" ||
                           t.path == "/api/v1/history" || t.path == "/api/v1/audit";
-  if (reads_disk)
-    return off_io(s, [self = shared_from_this(), req, t, role] { return self->get(req, t, role.value_or(Role::Operator)); });
-  s->send(get(req, t, role.value_or(Role::Operator)));
+  auto answer = [self = shared_from_this(), s, req, t, role] {
+    HttpResponse res = self->get(req, t, role.value_or(Role::Operator));
+    if (res.result_int() == 403) self->audit(s->remote(), role, req, 403, "needs the admin role");
+    return res;
+  };
+  if (reads_disk) return off_io(s, std::move(answer));
+  s->send(answer());
 }
 
 HttpResponse Server::Impl::get(const HttpRequest& req, const Target& t, Role role) {
@@ -575,9 +579,9 @@ void Server::Impl::command(const std::shared_ptr<HttpSession>& s, const HttpRequ
   json body;
   try {
     body = json::parse(req.body());
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {  // malformed, or a number no double holds (1e400)
     audit(s->remote(), role, req, 400, "malformed JSON");
-    return s->send(error_response(req, 400, fmt::format("the body is not JSON: {}", e.what())));
+    return s->send(error_response(req, 400, fmt::format("the body is not JSON opencnc can read: {}", e.what())));
   }
   const std::optional<Role> needed = body.is_object() && body.contains("kind") && body["kind"].is_string()
                                          ? role_for(body["kind"].get<std::string>())

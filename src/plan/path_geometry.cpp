@@ -90,6 +90,14 @@ bool make_arc(const Pose& start, const Pose& end, const canon::ArcGeometry& arc,
   Vec3 rs = s3 - c;
   rs = rs - dot(rs, n) * n;
   const double r = std::sqrt(dot(rs, rs));
+  {
+    // An arc whose circle is smaller than a nanometre at both ends (which the interpreter, as
+    // LinuxCNC's, accepts) is its chord to within that nanometre: run it as a line rather than
+    // refuse at run time what the check passed.
+    Vec3 re = e3 - c;
+    re = re - dot(re, n) * n;
+    if (r < kPointArcMm && std::sqrt(dot(re, re)) < kPointArcMm) return make_line(start, end, out);
+  }
   if (!(r >= 1e-9)) {
     error = "the arc's start point lies on its centre (radius zero)";
     return false;

@@ -23,10 +23,14 @@ inline constexpr double kMinLength = 1e-9;
 /// Straight block from `a` to `b`; false when shorter than kMinLength.
 bool make_line(const Pose& a, const Pose& b, MotionBlock& out) noexcept;
 
+/// Arcs smaller than this radius at both ends (mm) are their chords (a line block, or nothing).
+inline constexpr double kPointArcMm = 1e-6;
+
 /// Arc or helix block from the program's arc geometry. Where the end lies off the start circle
 /// within LinuxCNC's tolerance the block is a spiral (make_spiral); radii equal up to rounding
 /// keep a circle, its centre moved onto the perpendicular bisector of the end points. On bad
-/// geometry returns false with a reason in `error`.
+/// geometry returns false with a reason in `error`; false with no reason: a point-sized arc with
+/// no length, nothing to move.
 bool make_arc(const Pose& start, const Pose& end, const canon::ArcGeometry& arc, MotionBlock& out,
               std::string& error);
 /// Spiral block about the arc's centre from radius `r0` at `start` to `r1` at `end`.

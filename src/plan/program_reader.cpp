@@ -96,7 +96,8 @@ bool check_move(const canon::Program& program, canon::SegmentId id, const Machin
   using canon::MoveKind;
   const std::size_t before = diags.error_count();
   const auto fail = [&](std::string msg, const char* code) {
-    diags.error(file_name(program, id), program.move(id).line, 0, std::move(msg), code);
+    // Column 1: the block that made the move (the planner knows lines, not words).
+    diags.error(file_name(program, id), program.move(id).line, 1, std::move(msg), code);
   };
   const canon::Move& m = program.move(id);
   const Pose start = program.start_of(id), end = program.end(id);
@@ -133,7 +134,7 @@ bool check_move(const canon::Program& program, canon::SegmentId id, const Machin
   if (m.kind == MoveKind::Arc) {
     traj::MotionBlock b;
     std::string why;
-    if (!make_arc(start, end, program.arc(id), b, why)) fail(why, "plan.bad-arc");
+    if (!make_arc(start, end, program.arc(id), b, why) && !why.empty()) fail(why, "plan.bad-arc");
   }
   if (m.kind != MoveKind::Traverse && !(m.flags & canon::kSpindleSynced) && !(program.feed(id) > 0)) {
     fail("feed move with a zero feed rate", "plan.feed-zero");

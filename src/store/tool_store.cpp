@@ -55,11 +55,12 @@ CREATE TABLE IF NOT EXISTS audit(id INTEGER PRIMARY KEY, at_utc TEXT NOT NULL, i
                       cols));
 }
 
-void open_schema(Database& db) {
+void open_schema(Database& db, bool read_only) {
   const std::int64_t v = db.query_integer("PRAGMA user_version");
   if (v > kSchemaVersion)
     throw Error(fmt::format("the tool store has schema {}, newer than this opencnc's {}", v, kSchemaVersion));
   if (v == kSchemaVersion) return;
+  if (read_only) throw Error("this database is not an opencnc tool store (or one that must be opened writable to be set up)");
   const bool empty = db.query_integer("SELECT count(*) FROM sqlite_schema") == 0;
   if (!empty) throw Error("this database is not an opencnc tool store");
   Database::Transaction t(db);
@@ -205,13 +206,15 @@ ToolStore::ToolStore(std::unique_ptr<Database> db, std::string path)
 
 ToolStore::~ToolStore() = default;
 
-std::shared_ptr<ToolStore> ToolStore::open(const std::string& path, std::string* error, bool create) {
+std::shared_ptr<ToolStore> ToolStore::open(const std::string& path, std::string* error, bool create,
+                                           bool read_only) {
   return guarded(error, [&]() -> std::shared_ptr<ToolStore> {
     OpenOptions o;
-    o.create = create;
+    o.create = create && !read_only;
+    o.read_only = read_only;
     auto db = std::make_unique<Database>(path, o);
     try {
-      open_schema(*db);
+      open_schema(*db, read_only);
     } catch (const Error& e) {
       throw Error(fmt::format("{}: {}", path, e.what()));
     }
@@ -256,26 +259,39 @@ std::optional<ToolSet> ToolStore::live(std::string* error) {
 
 bool ToolStore::write_locked(const ToolSet& changed, std::string_view interface, std::string_view reason,
                              std::string* error) {
-  if (const auto why = tools::invalid(changed)) {
-    if (error != nullptr) *error = *why;
-    return false;
-  }
-  return guarded(error, [&]() -> bool {
+  return modify_locked([&changed](ToolSet& live) -> std::optional<std::string> {
+    live = changed;
+    return std::nullopt;
+  }, interface, reason, error);
+}
+
+// The read, the change and the write in one BEGIN IMMEDIATE transaction: two writers each change
+// what the other committed, never a copy read before it (the audit names only what this one changed).
+bool ToolStore::modify_locked(const Edit& change, std::string_view interface, std::string_view reason,
+                              std::string* error) {
+  std::optional<std::string> refused;
+  const bool ok = guarded(error, [&]() -> bool {
     Database::Transaction t(*db_);
-    // Compared with what is committed now (another process may have written since our read).
     const ToolSet before = read_live_locked();
+    ToolSet changed = before;
+    refused = change(changed);
+    if (!refused) refused = tools::invalid(changed);
+    if (refused) return false;
     const std::vector<Change> changes = diff(before, changed);
-    if (changes.empty()) return true;
-    replace_live(*db_, changed);
-    insert_audit(*db_, clock_(), interface, reason, changes);
-    t.commit();
-    live_ = changed;
+    if (!changes.empty()) {
+      replace_live(*db_, changed);
+      insert_audit(*db_, clock_(), interface, reason, changes);
+      t.commit();
+    }
+    live_ = std::move(changed);
     table_ = std::make_shared<const tools::ToolTable>(tools::linuxcnc_table(live_));
     data_version_ = db_->data_version();
     ++version_;
     ++changes_;
     return true;
   });
+  if (refused && error != nullptr) *error = *refused;
+  return ok;
 }
 
 bool ToolStore::write(const ToolSet& changed, std::string_view interface, std::string_view reason,
@@ -284,41 +300,37 @@ bool ToolStore::write(const ToolSet& changed, std::string_view interface, std::s
   return write_locked(changed, interface, reason, error);
 }
 
-bool ToolStore::set(int t, int d, Param p, double value, std::string_view interface, std::string* error) {
+bool ToolStore::modify(const Edit& change, std::string_view interface, std::string_view reason,
+                       std::string* error) {
   std::lock_guard lock(mutex_);
-  const bool ok = guarded(error, [&] {
-    refresh_locked();
-    return true;
-  });
-  if (!ok) return false;
-  ToolSet changed = live_;
+  return modify_locked(change, interface, reason, error);
+}
+
+bool ToolStore::set(int t, int d, Param p, double value, std::string_view interface, std::string* error) {
   if (t < 1 || t > tools::kMaxToolNumber || d < 1 || d > tools::kMaxEdge) {
     if (error != nullptr)
       *error = fmt::format("T{} D{}: tools go from T1 to T{}, edges from D1 to D{}", t, d,
                            tools::kMaxToolNumber, tools::kMaxEdge);
     return false;
   }
-  changed.edge_or_add(t, d).set(p, value);
-  return write_locked(changed, interface, "set", error);
+  return modify([&](ToolSet& live) -> std::optional<std::string> {
+    live.edge_or_add(t, d).set(p, value);
+    return std::nullopt;
+  }, interface, "set", error);
 }
 
 bool ToolStore::set_tool(int t, int pocket, std::string_view comment, std::string_view interface,
                          std::string* error) {
-  std::lock_guard lock(mutex_);
-  const bool ok = guarded(error, [&] {
-    refresh_locked();
-    return true;
-  });
-  if (!ok) return false;
-  ToolSet changed = live_;
   if (t < 1 || t > tools::kMaxToolNumber) {
     if (error != nullptr) *error = fmt::format("T{}: tools go from T1 to T{}", t, tools::kMaxToolNumber);
     return false;
   }
-  Tool& tool = changed.tool_or_add(t);
-  tool.pocket = pocket;
-  tool.comment = std::string(comment);
-  return write_locked(changed, interface, "set", error);
+  return modify([&](ToolSet& live) -> std::optional<std::string> {
+    Tool& tool = live.tool_or_add(t);
+    tool.pocket = pocket;
+    tool.comment = std::string(comment);
+    return std::nullopt;
+  }, interface, "set", error);
 }
 
 std::optional<std::int64_t> ToolStore::backup(std::string_view interface, std::string_view reason,
@@ -459,13 +471,19 @@ bool ToolStore::update(std::size_t index, const tools::ToolEntry& entry, tools::
         fmt::format("tool {} cannot be renumbered to {} (T/D numbers are fixed)", old.tool, entry.tool));
   const auto td = tools::tool_and_edge(entry.tool);
   if (!td) return refuse(fmt::format("tool {} names no edge", entry.tool));
-  ToolSet changed = live_;
-  Edge* e = changed.tool(td->first)->edge(td->second);
-  if (const auto why = tools::apply_entry(entry, *e))
-    return refuse(fmt::format("T{} D{}: {}", td->first, td->second, *why));
-  if (td->second == 1) changed.tool(td->first)->pocket = entry.pocket;
-  if (!write_locked(changed, tools::to_string(source), "G10", &error)) return refuse(error);
-  return true;
+  // The entry applied to the table as committed when it is written (the rest of it as another
+  // writer may have left it).
+  const bool written = modify_locked(
+      [&](ToolSet& live) -> std::optional<std::string> {
+        Tool* tool = live.tool(td->first);
+        Edge* e = tool != nullptr ? tool->edge(td->second) : nullptr;
+        if (e == nullptr) return fmt::format("T{} D{} was removed meanwhile", td->first, td->second);
+        if (const auto why = tools::apply_entry(entry, *e)) return fmt::format("T{} D{}: {}", td->first, td->second, *why);
+        if (td->second == 1) tool->pocket = entry.pocket;
+        return std::nullopt;
+      },
+      tools::to_string(source), "G10", &error);
+  return written || refuse(error);
 }
 
 }  // namespace opencnc::store

@@ -132,6 +132,17 @@ std::size_t ToolSet::edge_count() const noexcept {
   return n;
 }
 
+std::optional<std::string> invalid_comment(std::string_view comment) {
+  if (comment.size() > kMaxCommentBytes)
+    return fmt::format("a comment is at most {} bytes (this one has {})", kMaxCommentBytes, comment.size());
+  for (const char ch : comment) {
+    const auto c = static_cast<unsigned char>(ch);
+    if (c < 0x20 || c == 0x7f)
+      return fmt::format("a comment is one line of text without control characters (it holds byte 0x{:02x})", c);
+  }
+  return std::nullopt;
+}
+
 std::optional<std::string> invalid(const ToolSet& set) {
   int last = 0;
   for (const Tool& t : set.tools) {
@@ -140,8 +151,7 @@ std::optional<std::string> invalid(const ToolSet& set) {
     if (t.tool <= last) return fmt::format("T{} is listed twice or out of order", t.tool);
     last = t.tool;
     if (t.pocket < 0) return fmt::format("T{}: pocket {} is negative", t.tool, t.pocket);
-    if (t.comment.find_first_of("\r\n") != std::string::npos)
-      return fmt::format("T{}: a comment is one line of text", t.tool);
+    if (const auto why = invalid_comment(t.comment)) return fmt::format("T{}: {}", t.tool, *why);
     int last_edge = 0;
     for (const Edge& e : t.edges) {
       if (e.edge < 1 || e.edge > kMaxEdge)

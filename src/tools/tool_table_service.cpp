@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "opencnc/core/output_file.hpp"
+#include "opencnc/tools/tool_data.hpp"
 
 namespace opencnc::tools {
 
@@ -38,6 +39,10 @@ bool MemoryToolTable::update(std::size_t index, const ToolEntry& entry, ChangeSo
   if (index < 1 || index > table_->size()) {
     diags.error("", 0, 0, fmt::format("there is no tool table entry {} (the table has {})", index, table_->size()),
                 "tools.no-entry");
+    return false;
+  }
+  if (const auto why = invalid_comment(entry.comment)) {
+    diags.error("", 0, 0, fmt::format("T{}: {}", entry.tool, *why), "tools.bad-comment");
     return false;
   }
   if (const auto other = table_->find(entry.tool); other && *other != index) {

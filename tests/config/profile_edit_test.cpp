@@ -100,6 +100,8 @@ class ProfileEditFile : public ::testing::Test {
     s << in.rdbuf();
     original_ = s.str();
     std::ofstream(path_) << original_;
+    std::filesystem::copy_file(OPENCNC_SOURCE_DIR "/configs/mill-3axis.tbl", dir_ / "mill-3axis.tbl",
+                               std::filesystem::copy_options::overwrite_existing);
     ProfileLoad load = load_profile(path_);
     ASSERT_TRUE(load.ok());
     live_ = *load.profile;

@@ -455,6 +455,7 @@ TEST(ProfileFile, RelativePathsAreResolvedAgainstTheProfileFolder) {
     std::ofstream f(dir / "m.toml");
     f << kBase << "[interpreter]\nsubroutine_path = [\"subs\", \"missing\"]\ntool_table = \"tools.tbl\"\n";
   }
+  std::ofstream(dir / "tools.tbl") << "T1 P1 Z10 D6\n";  // the table must be there to be named
   const ProfileLoad load = load_profile(dir / "m.toml");
   ASSERT_TRUE(load.ok()) << all_messages(load.diagnostics);
   const InterpreterOptions& o = load.profile->interpreter;

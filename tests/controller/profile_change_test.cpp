@@ -43,6 +43,8 @@ class ProfileChange : public ::testing::Test {
     path_ = (dir_ / "mill.toml").string();
     ASSERT_TRUE(read_file(OPENCNC_SOURCE_DIR "/configs/mill-3axis.toml", original_, nullptr));
     ASSERT_TRUE(write_file_atomically(path_, original_, nullptr));
+    std::filesystem::copy_file(OPENCNC_SOURCE_DIR "/configs/mill-3axis.tbl", dir_ / "mill-3axis.tbl",
+                               std::filesystem::copy_options::overwrite_existing);
     rig_ = std::make_unique<SimRig>(loaded(config::load_profile(path_)));
     ASSERT_TRUE(rig_->request(Request::simple(CommandKind::MachineOn)).accepted);
   }

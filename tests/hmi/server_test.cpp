@@ -77,6 +77,52 @@ TEST(Server, BadRequestsGetA4xxWithAMessageAndChangeNothing) {
   EXPECT_EQ(get(rig.port, "/api/v1/commands/" + off.body["id"].dump(), kOperator).body["accepted"], false);
 }
 
+// The second hostile probe (issue 29): a number no double holds aborted the server; refused tokens
+// on GET calls left no audit row.
+TEST(Server, ANumberTooLargeForADoubleIsA400AndTheServerGoesOn) {
+  ServerRig rig(mill());
+  for (const char* body : {R"({"kind":"jog","axis":"X","velocity":1e400})", R"({"kind":"override","which":"feed","value":-1e999})",
+                           R"([1e400])"}) {
+    const Reply r = post(rig.port, body, kOperator);
+    EXPECT_EQ(r.status, 400) << body << ": " << r.text;
+  }
+  EXPECT_EQ(get(rig.port, "/api/v1/status").status, 200);
+  EXPECT_EQ(post(rig.port, R"({"kind":"machine-on"})", kOperator).status, 200);
+}
+
+TEST(Server, EveryRefusedTokenIsAuditedOnGetCallsToo) {
+  ServerRig rig(mill());
+  EXPECT_EQ(get(rig.port, "/api/v1/tools", "not-a-token").status, 401);
+  EXPECT_EQ(get(rig.port, "/api/v1/history").status, 401);
+  EXPECT_EQ(get(rig.port, "/api/v1/audit", kOperator).status, 403);
+  rig.history->flush();
+  const json audit = get(rig.port, "/api/v1/audit", kAdmin).body;
+  int refused = 0;
+  for (const json& a : audit) {
+    const std::string action = a["action"];
+    if ((a["status"] == 401 && (action == "GET /api/v1/tools" || action == "GET /api/v1/history")) ||
+        (a["status"] == 403 && action == "GET /api/v1/audit"))
+      ++refused;
+  }
+  EXPECT_EQ(refused, 3) << audit.dump(1);
+}
+
+// The second hostile probe (issue 29): a comment with a newline wrote a line the interpreter read
+// as a tool; 100 KB comments and control characters were written verbatim.
+TEST(Server, AToolCommentIsOneBoundedLine) {
+  ServerRig rig(mill());
+  const json before = get(rig.port, "/api/v1/tools", kOperator).body;
+  for (const std::string& comment : {std::string("x\nT99 P99 Z-1000 D1"), std::string("a\r\0b", 4),
+                                    std::string(100000, 'x')}) {
+    const json body = {{"kind", "set-tool"}, {"tool", 1}, {"comment", comment}};
+    const Reply r = post(rig.port, body.dump(), kAdmin);
+    EXPECT_EQ(r.status, 422) << r.text;
+  }
+  EXPECT_EQ(get(rig.port, "/api/v1/tools", kOperator).body, before);
+  const Reply ok = post(rig.port, R"({"kind":"set-tool","tool":1,"comment":"end mill 6 mm, new"})", kAdmin);
+  EXPECT_EQ(ok.status, 200) << ok.text;
+}
+
 TEST(Server, ToolDataIsTheAdminsAndEveryChangeIsAudited) {
   ServerRig rig(mill());
   const std::string change = R"({"kind":"set-tool","tool":1,"diameter":6.02})";
@@ -89,12 +135,14 @@ TEST(Server, ToolDataIsTheAdminsAndEveryChangeIsAudited) {
   EXPECT_EQ(get(rig.port, "/api/v1/audit", kOperator).status, 403);
   rig.history->flush();
   const json audit = get(rig.port, "/api/v1/audit", kAdmin).body;
-  ASSERT_GE(audit.size(), 3u);
-  EXPECT_EQ(audit[1]["role"], "admin");
-  EXPECT_EQ(audit[1]["status"], 200);
-  EXPECT_EQ(audit[2]["role"], "operator");
-  EXPECT_EQ(audit[2]["status"], 403);
-  EXPECT_FALSE(audit[2]["time"].get<std::string>().empty());
+  ASSERT_GE(audit.size(), 4u);  // newest first: the operator's look at the audit, T77, the change, the refusal
+  EXPECT_EQ(audit[0]["action"], "GET /api/v1/audit");
+  EXPECT_EQ(audit[0]["status"], 403);
+  EXPECT_EQ(audit[2]["role"], "admin");
+  EXPECT_EQ(audit[2]["status"], 200);
+  EXPECT_EQ(audit[3]["role"], "operator");
+  EXPECT_EQ(audit[3]["status"], 403);
+  EXPECT_FALSE(audit[3]["time"].get<std::string>().empty());
 }
 
 TEST(Server, TheStreamOpensWithASingleUseTicketAndNeverATokenInTheUrl) {

@@ -2,6 +2,7 @@
 // The simulated broach's workpiece beside the journal: round trip, and a torn or corrupt file refused.
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -50,6 +51,24 @@ TEST(SimBore, ATornOrCorruptFileIsRefused) {
   EXPECT_FALSE(decode_sim_bore(std::string_view(bytes).substr(0, bytes.size() - 100), &error).has_value());
   EXPECT_NE(error.find("checksum"), std::string::npos) << error;
   EXPECT_FALSE(decode_sim_bore("", &error).has_value());
+}
+
+// The second hostile probe (issue 29): a symlink to /dev/zero in the journal's folder was read until
+// memory ran out; a FIFO would block. Refused before a byte is read.
+TEST(SimBore, ADeviceOrAFifoInItsPlaceIsRefusedAtOnce) {
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("opencnc-sim-bore-dev-" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  std::filesystem::create_symlink("/dev/zero", dir / "sim-bore.bin");
+  std::string error;
+  EXPECT_FALSE(load_sim_bore(dir.string(), &error).has_value());
+  EXPECT_EQ(error, "it is a device, not a file");
+  std::filesystem::remove(dir / "sim-bore.bin");
+  ASSERT_EQ(::mkfifo((dir / "sim-bore.bin").c_str(), 0600), 0);
+  EXPECT_FALSE(load_sim_bore(dir.string(), &error).has_value());
+  EXPECT_EQ(error, "it is a FIFO, not a file");
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

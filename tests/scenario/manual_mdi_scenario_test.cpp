@@ -71,6 +71,42 @@ TEST(MdiScenario, BadLinesAndWrongModesAreRefused) {
   EXPECT_EQ(s.ask(Request::jog(Axis::X, 10)).refusal, Refusal::WrongMode);
 }
 
+// A newcomer's first minutes (issue 29): after homing or a jog the machine is in Manual; cycle
+// start runs the open program (the mode follows, as LinuxCNC's AXIS does), and the refusals that
+// used to say "nothing to do in this state" say what the matter is.
+TEST(ManualScenario, CycleStartInManualRunsTheOpenProgramAndRefusalsSayWhy) {
+  TempProgram p("part.ngc", "G21 G90\nG1 X10 F600\nM2\n");
+  Scenario s(mill());
+  s.on(Mode::Auto);
+  s.must(Request::open(p.path()));
+  s.must(Request::set_mode(Mode::Manual));
+  s.must(Request::jog_by(Axis::Y, 2, 20));
+  ASSERT_TRUE(s.until([&] { return s.idle(); }, 5000));
+  s.must(Request::simple(CommandKind::CycleStart));
+  EXPECT_EQ(s.status().servo.mode, Mode::Auto);
+  ASSERT_TRUE(s.until([&] { return !s.status().run_active && s.status().runs_finished == 1; }, 20000));
+  EXPECT_NEAR(s.status().servo.commanded[Axis::X], 10.0, 1e-9);
+  EXPECT_NEAR(s.status().servo.commanded[Axis::Y], 2.0, 1e-9);  // from where the jog left it
+  Outcome o = s.ask(Request::simple(CommandKind::MachineOn));
+  EXPECT_EQ(o.refusal, Refusal::NotApplicable);
+  EXPECT_EQ(o.message, "the machine is already on");
+  o = s.ask(Request::simple(CommandKind::FeedHold));
+  EXPECT_EQ(o.message, "nothing is running to hold");
+  s.must(Request::set_mode(Mode::Mdi));
+  o = s.ask(Request::jog(Axis::X, 10));
+  EXPECT_EQ(o.refusal, Refusal::WrongMode);
+  EXPECT_EQ(o.message, "that is done in Manual mode: switch to MANUAL first");
+}
+
+TEST(ManualScenario, CycleStartWithoutAProgramSaysToOpenOne) {
+  Scenario s(mill());
+  s.on(Mode::Manual);
+  const Outcome o = s.ask(Request::simple(CommandKind::CycleStart));
+  EXPECT_FALSE(o.accepted);
+  EXPECT_NE(o.message.find("open one"), std::string::npos) << o.message;
+  EXPECT_EQ(s.status().servo.mode, Mode::Manual);
+}
+
 TEST(ManualScenario, JogThroughTheControllerAndStopAtTheLimit) {
   Scenario s(mill({"axis.y.max_limit=12.0"}));
   s.on(Mode::Manual);

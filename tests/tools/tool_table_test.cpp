@@ -63,7 +63,7 @@ TEST(ToolTable, AFolderIsNotAnEmptyTable) {
   Diagnostics d;
   EXPECT_FALSE(ToolTable::load("/", d).has_value());
   ASSERT_EQ(d.error_count(), 1u);
-  EXPECT_EQ(d.items()[0].message, "cannot read the tool table: Is a directory");
+  EXPECT_EQ(d.items()[0].message, "cannot read the tool table: it is a folder, not a file");
 }
 
 TEST(ToolTable, LookupAgreesWithLinearSearchOnRandomTables) {

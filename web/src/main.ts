@@ -23,7 +23,7 @@ import "./screens/electrode";
 import "./screens/compensation";
 import "./screens/conditions";
 import type { ControllerEvent, Machine, Status } from "./types";
-import { button, coord, el, offsetsText, outsideWindow, percent, windowStart } from "./ui";
+import { button, coord, el, offsetsText, outsideWindow, percent, topBarLooks, windowStart } from "./ui";
 import { View3d, type Preview } from "./view3d";
 
 function token(): string {
@@ -78,14 +78,17 @@ async function start() {
   state.dataset.testid = "state";
   const mode = el("span", { class: "mode" });
   const link = el("span", { class: "link" }, "…");
+  // The power and mode buttons show the state they are in (topBarLooks).
+  const topButtons: Record<string, HTMLButtonElement> = {
+    estop: button("E-STOP", () => void ctx.send("estop"), "estop"),
+    reset: button("Reset", () => void ctx.send("reset")),
+    "machine-on": Object.assign(button("Machine on", () => void ctx.send("machine-on"), "go"), { id: "machine-on" }),
+    "machine-off": button("Machine off", () => void ctx.send("machine-off")),
+  };
+  for (const m of ["manual", "mdi", "auto"]) topButtons[m] = button(m.toUpperCase(), () => void ctx.send("mode", { mode: m }));
+  for (const [k, b] of Object.entries(topButtons)) b.dataset.testid = `top-${k}`;
   const top = el("header", {},
-    el("strong", {}, `opencnc · ${machine.name}`), state, mode, link,
-    button("E-STOP", () => void ctx.send("estop"), "estop"),
-    button("Reset", () => void ctx.send("reset")),
-    Object.assign(button("Machine on", () => void ctx.send("machine-on"), "go"), { id: "machine-on" }),
-    button("Machine off", () => void ctx.send("machine-off")),
-    ...["manual", "mdi", "auto"].map((m) => button(m.toUpperCase(), () => void ctx.send("mode", { mode: m }))),
-  );
+    el("strong", {}, `opencnc · ${machine.name}`), state, mode, link, ...Object.values(topButtons));
 
   // Information display: the DRO.
   const dro = el("tbody");
@@ -216,6 +219,13 @@ async function start() {
     state.textContent = s.state + (s.wait_text ? ` — waiting for ${s.wait_text}` : "");
     state.className = `state ${s.state}`;
     mode.textContent = s.mode.toUpperCase();
+    for (const [k, look] of Object.entries(topBarLooks(s.state, s.mode))) {
+      const b = topButtons[k];
+      if (k !== "estop") b.disabled = look.disabled;  // the e-stop is never disabled
+      b.classList.toggle("on", look.on);
+      b.setAttribute("aria-pressed", String(look.on));
+      b.title = look.title;
+    }
     for (const a of machine.axes) {
       const c = cells[a.axis];
       c[0].textContent = coord(s.work[a.axis]);

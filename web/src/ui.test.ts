@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The formats of the DRO and the overrides, and which dialog a status asks for.
 import { describe, expect, it } from "vitest";
-import { coord, offsetsText, outsideWindow, percent, windowStart } from "./ui";
+import { coord, offsetsText, outsideWindow, percent, topBarLooks, windowStart } from "./ui";
 import { dialogFor } from "./dialogs/waits";
 import type { Status } from "./types";
 
@@ -28,6 +28,27 @@ describe("formats", () => {
   });
   it("shows overrides in per cent", () => {
     expect(percent(1.2)).toBe("120 %");
+  });
+});
+
+describe("the top bar's buttons", () => {
+  it("show the machine on as pressed and have nothing to do there", () => {
+    const on = topBarLooks("idle", "manual");
+    expect(on["machine-on"]).toEqual({ on: true, disabled: true, title: "the machine is on" });
+    expect(on["machine-off"].disabled).toBe(false);
+    expect(on.manual).toEqual({ on: true, disabled: true, title: "in MANUAL mode" });
+    expect(on.auto).toEqual({ on: false, disabled: false, title: "" });
+    expect(on.reset.disabled).toBe(true);
+  });
+  it("say what comes first when the machine cannot be turned on", () => {
+    expect(topBarLooks("e-stopped", "manual")["machine-on"]).toEqual({ on: false, disabled: true, title: "reset the e-stop first" });
+    expect(topBarLooks("e-stopped", "manual").reset.disabled).toBe(false);
+    expect(topBarLooks("e-stopped", "manual").estop.on).toBe(true);
+    expect(topBarLooks("off", "manual")["machine-on"].disabled).toBe(false);
+    expect(topBarLooks("off", "manual")["machine-off"]).toEqual({ on: true, disabled: true, title: "the machine is off" });
+  });
+  it("keep the mode while a program runs", () => {
+    expect(topBarLooks("running", "auto").manual).toEqual({ on: false, disabled: true, title: "the mode changes while nothing runs" });
   });
 });
 

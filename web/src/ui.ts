@@ -59,3 +59,29 @@ export function windowStart(line: number, size: number): number {
 export function outsideWindow(line: number, from: number, count: number, more: boolean): boolean {
   return line > 0 && (line < from || (line >= from + count && more));
 }
+
+/** How one of the top bar's buttons shows itself: pressed when what it sets is in force, disabled
+ * when it has nothing to do (the title says why, so a click never answers "nothing to do"). */
+export interface ButtonLook {
+  on: boolean;
+  disabled: boolean;
+  title: string;
+}
+
+/** The top bar's power and mode buttons for a machine state ("e-stopped", "off", "idle",
+ * "running", "held", "stopped", "faulted") and mode ("manual", "mdi", "auto"). */
+export function topBarLooks(state: string, mode: string): Record<string, ButtonLook> {
+  const on = state === "idle" || state === "running" || state === "held" || state === "stopped";
+  const busy = state === "running" || state === "held" || state === "stopped";
+  const look = (pressed: boolean, why: string): ButtonLook => ({ on: pressed, disabled: why !== "", title: why });
+  const looks: Record<string, ButtonLook> = {
+    estop: look(state === "e-stopped", ""),
+    reset: look(false, state === "e-stopped" || state === "faulted" ? "" : "nothing to reset: the machine is neither e-stopped nor faulted"),
+    "machine-on": look(on, on ? "the machine is on" : state === "e-stopped" ? "reset the e-stop first"
+      : state === "faulted" ? "reset the fault first" : ""),
+    "machine-off": look(state === "off", on ? "" : "the machine is off"),
+  };
+  for (const m of ["manual", "mdi", "auto"])
+    looks[m] = look(mode === m, mode === m ? `in ${m.toUpperCase()} mode` : busy ? "the mode changes while nothing runs" : "");
+  return looks;
+}

@@ -233,6 +233,9 @@ struct InterpreterOptions {
   /// seconds of programmed motion (whichever comes first; never less than the planner needs).
   int readahead_moves = 2000;
   double readahead_s = 5.0;
+  /// CPU seconds a program's check (the preflight, run from line's scan) may take before it is
+  /// refused as an endless loop (gcode.limit-time); raise it for a program that long.
+  double max_scan_s = 5.0;
 };
 
 /// One `[[coupling.table]]`: points [master offset mm, value] — pitch (mm per revolution) for a

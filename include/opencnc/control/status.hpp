@@ -106,6 +106,9 @@ struct ServoStatus {
   std::uint32_t line = 0;                        ///< its source line
   std::uint32_t context = 0;
   double path_velocity = 0;  ///< along the path, s-units/s
+  /// The motion follows the spindle (G33, G76, G33.1): feed hold and the feed override do not act
+  /// on it (an abort does).
+  bool spindle_synced = false;
 
   // Operator switches.
   double feed_override = 1, rapid_override = 1, spindle_override = 1;

@@ -89,8 +89,6 @@ class Controller final : private FeatureHost {
   bool add_feature(std::shared_ptr<Feature> feature, ObserverOptions options = {});
   /// The open program (its preflight summary and warnings), if any. Any thread.
   std::optional<OpenProgram> open_program() const;
-  /// A long request's work is under way (long_work_on_thread): later requests wait. Controller thread.
-  bool busy_with_long_work() const noexcept;
 
   /// The periodic work: reads the servo's events, status and trace, handles queued requests,
   /// keeps the interpreter and the planner ahead of the servo, tells the observers. Controller

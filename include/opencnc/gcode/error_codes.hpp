@@ -170,6 +170,7 @@ namespace opencnc::gcode {
   /* codes of feature modules whose read-time rules the core checks */  \
   X(CycleRotaryAxis, "gcode.cycle-rotary-axis")                         \
   X(ThreadPitchMissing, "gcode.thread-pitch-missing")                   \
+  X(PerTurnTooSmall, "gcode.per-turn-too-small")                        \
   X(ThreadFeedWord, "gcode.thread-feed-word")                           \
   X(ThreadG76WordMissing, "gcode.thread-g76-word-missing")              \
   /* canned cycles, threading and probing */                            \
@@ -248,6 +249,7 @@ namespace opencnc::gcode {
   /* runaway protection */                                              \
   X(LimitCallDepth, "gcode.limit-call-depth")                           \
   X(LimitBlocks, "gcode.limit-blocks")                                  \
+  X(LimitTime, "gcode.limit-time")                                      \
   X(LimitLoopIterations, "gcode.limit-loop-iterations")                 \
   X(LimitRepeatCount, "gcode.limit-repeat-count")                       \
   X(LimitSegments, "gcode.limit-segments")                              \

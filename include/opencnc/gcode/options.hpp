@@ -50,6 +50,10 @@ struct Limits {
   /// Scan mode with MainM99::Repeat: times an endless program may start again before the scan
   /// stops with gcode.limit-main-repeats (execute mode repeats until the caller stops).
   std::uint64_t max_main_repeats = 100;
+  /// Scan mode: CPU seconds of the interpreter's thread after which the scan stops with
+  /// gcode.limit-time (an endless loop refused in seconds, not after the block limits' minutes).
+  /// 0: no bound (the default: `check`, `scan` and the controller's preflight set one).
+  double max_seconds = 0;
 };
 
 /// What M99 in the main program does (LinuxCNC dialect; the Fanuc dialect's M99 is its own).

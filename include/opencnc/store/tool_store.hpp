@@ -46,7 +46,10 @@ struct AuditEntry {
 class ToolStore final : public tools::ToolTableService {
  public:
   /// Opens (creates, when allowed) the store at `path`; null with `*error` when it cannot.
-  static std::shared_ptr<ToolStore> open(const std::string& path, std::string* error, bool create = true);
+  /// `read_only`: for looking only (a store the user may not write, a backup on read-only media):
+  /// nothing is created or upgraded, and every change is refused.
+  static std::shared_ptr<ToolStore> open(const std::string& path, std::string* error, bool create = true,
+                                         bool read_only = false);
   ~ToolStore() override;
 
   /// The live table as now committed.
@@ -55,6 +58,11 @@ class ToolStore final : public tools::ToolTableService {
   /// changed (`interface` and `reason` on each). Invalid sets (tools::invalid) are refused.
   bool write(const tools::ToolSet& changed, std::string_view interface, std::string_view reason,
              std::string* error);
+  /// A change of the live table as it is committed when the change is made: `change` edits the
+  /// table read inside the write transaction (another writer's commit is never overwritten with
+  /// a stale copy) and returns why it cannot, or nothing. Audited as write() is.
+  using Edit = std::function<std::optional<std::string>(tools::ToolSet&)>;
+  bool modify(const Edit& change, std::string_view interface, std::string_view reason, std::string* error);
   /// One parameter of edge D`d` of tool T`t` (the edge and tool are added when new).
   bool set(int t, int d, tools::Param p, double value, std::string_view interface, std::string* error);
   /// Pocket and comment of tool T`t` (added when new).
@@ -96,6 +104,7 @@ class ToolStore final : public tools::ToolTableService {
   tools::ToolSet read_live_locked() const;
   bool write_locked(const tools::ToolSet& changed, std::string_view interface, std::string_view reason,
                     std::string* error);
+  bool modify_locked(const Edit& change, std::string_view interface, std::string_view reason, std::string* error);
 
   mutable std::mutex mutex_;
   std::unique_ptr<Database> db_;

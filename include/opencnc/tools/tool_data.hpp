@@ -104,4 +104,11 @@ struct ToolSet {
 /// numbers, edges, finite values, comments without line breaks. Any thread.
 std::optional<std::string> invalid(const ToolSet& set);
 
+/// The longest comment a tool may carry (bytes).
+inline constexpr std::size_t kMaxCommentBytes = 200;
+/// Why `comment` cannot be a tool's comment, or nothing: it is one line of at most
+/// kMaxCommentBytes, without control characters (a newline would start a new line of the .tbl
+/// file, which the interpreter then reads as a tool). Any thread.
+std::optional<std::string> invalid_comment(std::string_view comment);
+
 }  // namespace opencnc::tools
