@@ -20,15 +20,15 @@
 #include "electrode_change.hpp"
 #include "gcode_summary.hpp"
 #include "numeric_options.hpp"
-#include "opencnc/controller/edm_recorder.hpp"
-#include "opencnc/controller/electrode_setting.hpp"
+#include "opencnc/broaching/power_fail_recorder.hpp"
 #include "opencnc/controller/gcode_source.hpp"
-#include "opencnc/controller/power_fail_recorder.hpp"
 #include "opencnc/controller/preflight.hpp"
 #include "opencnc/controller/run_recorder.hpp"
 #include "opencnc/controller/servo_setup.hpp"
+#include "opencnc/edm/edm_recorder.hpp"
+#include "opencnc/edm/electrode_setting.hpp"
 #include "opencnc/process/process_log.hpp"
-#include "opencnc/recovery/retrace.hpp"
+#include "opencnc/retrace/retrace.hpp"
 #include "run_journal.hpp"
 #include "run_session.hpp"
 #include "stop_signals.hpp"
@@ -423,6 +423,7 @@ int run(const RunOptions& o) {
   std::shared_ptr<control::PowerFailRecorder> power_recorder;
   std::shared_ptr<control::EdmRecorder> edm_recorder;
   SessionOptions session = o.session;
+  session.reports = true;
   if (!o.inject.empty()) {
     Injections at;
     for (const std::string& text : o.inject) {
@@ -489,10 +490,6 @@ int run(const RunOptions& o) {
     recorder = std::make_shared<control::RunRecorder>(control::machine_limits(machine),
                                                       machine.servo_period_s, &axes);
     out.emplace_back(recorder, control::ObserverOptions{0, true});
-    if (machine.edm.present) {
-      edm_recorder = std::make_shared<control::EdmRecorder>(machine.edm.config, machine.servo_period_s);
-      out.emplace_back(edm_recorder, control::ObserverOptions{0, true});
-    }
     if (session.mains_off_s >= 0) {
       power_recorder = std::make_shared<control::PowerFailRecorder>(
           control::coupling_config(machine.coupling), control::machine_limits(machine),
@@ -517,46 +514,56 @@ int run(const RunOptions& o) {
     if (run_start_s < 0) run_start_s = st.servo.time_s;
     if (bar) bar->show(st, run_start_s, recorder->report().path_length_mm);
   };
-  // --retrace: the retrace feature on the controller and the scripted operator.
+  // --retrace: the scripted operator of the retrace feature (flame/plasma machines).
   std::vector<RetraceAt> steps;
   for (const std::string& text : o.retraces) steps.push_back(*parse_retrace(text));  // checked by the option
   std::shared_ptr<recovery::RetraceFeature> feature;
   std::optional<RetraceScript> script;
-  // --journal: the breakpoint journal's writer (docs/broaching.md), opened before anything runs.
+  // --journal: the breakpoint journal's writer (docs/broaching.md), set up with the features.
   std::shared_ptr<recovery::BreakpointJournal> journal;
-  if (!o.journal.empty()) {
-    if (!profile || !(journal = open_run_journal(o.journal, *profile))) return kExitUsage;
-    hooks.features_trace = true;
-  }
-  // --electrode-change: the electrode feature on the program's tool table and the scripted operator.
+  if (!o.journal.empty()) session.settings["journal"] = o.journal;
+  // --electrode-change: the scripted operator of the electrode feature on the program's tool table.
   std::vector<ElectrodeChangeAt> changes;
   for (const std::string& text : o.electrode_changes) changes.push_back(*parse_electrode_change(text));
   std::optional<ElectrodeChangeScript> changer;
-  if (!steps.empty() || journal || !changes.empty()) {
-    hooks.features = [&](const config::MachineProfile& machine,
-                         const std::shared_ptr<tools::ToolTableService>& tools) {
-      std::vector<std::shared_ptr<control::Feature>> out;
-      if (journal) out.push_back(journal);
-      if (!changes.empty()) {
-        auto electrode = std::make_shared<control::ElectrodeSetting>(tools, machine);
-        const Axis axis = machine.edm.present ? static_cast<Axis>(machine.edm.config.tool_axis) : Axis::Z;
-        const config::AxisProfile* a = machine.find(axis);
-        const double lift = machine.edm.present ? 10.0 * machine.edm.config.lift_direction : 10.0;
-        changer.emplace(changes, electrode, axis, lift, a != nullptr ? a->min_limit : -1e9,
-                        a != nullptr ? a->max_limit : 1e9);
-        out.push_back(electrode);
+  hooks.set_up = [&](control::MachineSetup& machine) {
+    const config::MachineProfile& p = machine.profile();
+    for (const auto& [observer, options] : machine.observers())  // the EDM's report section
+      if (auto e = std::dynamic_pointer_cast<control::EdmRecorder>(observer)) edm_recorder = e;
+    if (!o.journal.empty()) {
+      journal = std::dynamic_pointer_cast<recovery::BreakpointJournal>(machine.feature("journal"));
+      if (!journal) {
+        fmt::print(stderr,
+                   "error: --journal {}: {} has no power monitor ([power] monitor) to write a journal for\n",
+                   o.journal, o.session.machine);
+        return false;
       }
-      if (steps.empty()) return out;
-      Diagnostics d;
-      feature = std::make_shared<recovery::RetraceFeature>(control::GcodeProgramSource::create(machine, d),
-                                                           machine);
+    }
+    if (!changes.empty()) {
+      auto electrode = std::dynamic_pointer_cast<control::ElectrodeSetting>(machine.feature("electrode"));
+      if (!electrode) {
+        fmt::print(stderr, "error: --electrode-change: {} has no tool table for the electrodes\n",
+                   o.session.machine);
+        return false;
+      }
+      const Axis axis = p.edm.present ? static_cast<Axis>(p.edm.config.tool_axis) : Axis::Z;
+      const config::AxisProfile* a = p.find(axis);
+      const double lift = p.edm.present ? 10.0 * p.edm.config.lift_direction : 10.0;
+      changer.emplace(changes, electrode, axis, lift, a != nullptr ? a->min_limit : -1e9,
+                      a != nullptr ? a->max_limit : 1e9);
+    }
+    if (!steps.empty()) {
+      feature = std::dynamic_pointer_cast<recovery::RetraceFeature>(machine.feature("retrace"));
+      if (!feature) {
+        fmt::print(stderr, "error: --retrace: {} has no torch to retrace with ([process.cutting])\n",
+                   o.session.machine);
+        return false;
+      }
       script.emplace(steps, feature);
-      out.push_back(feature);
-      return out;
-    };
-  }
+    }
+    return true;
+  };
   if (!steps.empty() || !changes.empty()) {
-    if (!changes.empty()) hooks.features_trace = true;  // the electrode feature follows the program's segment
     hooks.tick = [&](control::Controller& c, const control::ControllerStatus& st, machine::SimMachine* sim) {
       if (script) script->tick(c, st);
       if (changer) changer->tick(c, st, sim);

@@ -6,7 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "opencnc/controller/edm_recorder.hpp"
+#include "opencnc/edm/edm_recorder.hpp"
 #include "run_session.hpp"
 
 namespace opencnc::cli {

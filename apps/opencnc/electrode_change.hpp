@@ -12,7 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "opencnc/controller/controller.hpp"
-#include "opencnc/controller/electrode_setting.hpp"
+#include "opencnc/edm/electrode_setting.hpp"
 
 namespace opencnc::machine {
 class SimMachine;

@@ -19,6 +19,7 @@
 #include "opencnc/canon/program_builder.hpp"
 #include "opencnc/canon/tee_sink.hpp"
 #include "opencnc/controller/gcode_source.hpp"
+#include "opencnc/features/features.hpp"
 #include "opencnc/gcode/interpreter.hpp"
 #include "progress.hpp"
 
@@ -371,8 +372,9 @@ TimeEstimate estimate_machining_time(const std::string& file, const config::Mach
   TimeEstimate e;
   // The options the run's own source gives this file (dialect comment, modules, tool table).
   Diagnostics diags;
-  const auto source = control::GcodeProgramSource::create(profile, diags);
-  if (!source) return e;
+  const std::unique_ptr<control::MachineSetup> machine = features::machine_setup(profile, diags);
+  if (!machine) return e;
+  const auto& source = machine->source();
   ProgramScan scan(source->options_for(file, {}));
   if (!scan.open(file)) return e;
   InterpreterProgress progress("checking the machining time of " + file, false);

@@ -5,6 +5,7 @@
 #include <poll.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cstdint>
@@ -16,16 +17,17 @@
 #include <fmt/format.h>
 
 #include "commands.hpp"
-#include "opencnc/core/atomic_file.hpp"
 #include "opencnc/config/profile_loader.hpp"
 #include "opencnc/control/clock.hpp"
 #include "opencnc/control/servo.hpp"
 #include "opencnc/control/triple_buffer.hpp"
 #include "opencnc/controller/gcode_source.hpp"
 #include "opencnc/controller/hal_link.hpp"
+#include "opencnc/controller/machine_setup.hpp"
 #include "opencnc/controller/servo_setup.hpp"
 #include "opencnc/controller/sim_rig.hpp"
-#include "opencnc/toolguard/tool_guard.hpp"
+#include "opencnc/core/atomic_file.hpp"
+#include "opencnc/features/features.hpp"
 #include "stop_signals.hpp"
 
 namespace opencnc::cli {
@@ -38,9 +40,22 @@ using control::ControllerEventKind;
 using control::Request;
 using control::State;
 
+void print_one(const Diagnostic& d) {
+  fmt::print(stderr, "{}{}\n", d.format(), d.code.empty() ? "" : fmt::format(" [{}]", d.code));
+}
+
 void print(const Diagnostics& diags) {
+  for (const Diagnostic& d : diags.items()) print_one(d);
+}
+
+/// The features' set-up problems: one with a setting the command line gave (`setting.NAME`) names
+/// its option (`--NAME FILE: why`), as the option's own checks do.
+void print_setup(const Diagnostics& diags) {
   for (const Diagnostic& d : diags.items()) {
-    fmt::print(stderr, "{}{}\n", d.format(), d.code.empty() ? "" : fmt::format(" [{}]", d.code));
+    if (d.code.rfind("setting.", 0) == 0)
+      fmt::print(stderr, "error: --{} {}: {}\n", d.code.substr(8), d.file, d.message);
+    else
+      print_one(d);
   }
 }
 
@@ -551,12 +566,29 @@ SessionEnd run_session(const SessionOptions& o, const SessionHooks& hooks) {
     end.exit_code = kExitUsage;
     return end;
   }
+  // The machine as its features set it up (features::set_up), as every front end does.
   Diagnostics diags;
-  // The profile's G-code source; with [tool_guard], the tool store and the guard's feature.
-  std::optional<toolguard::Setup> setup = toolguard::setup(end.profile, diags, o.tool_table_in_memory);
+  control::MachineSetup::Options asked;
+  asked.reports = o.reports;
+  asked.settings = o.settings;
+  if (o.tool_table_in_memory) asked.settings["tool-table"] = "memory";
+  std::unique_ptr<control::MachineSetup> setup = control::MachineSetup::create(end.profile, asked, diags);
   print(diags);
   if (!setup) return end;
-  const std::shared_ptr<control::ProgramSource> source = setup->source;
+  const bool set_up = features::set_up(*setup);
+  print_setup(setup->diagnostics());
+  if (!set_up) {  // a setting the command line gave is a usage error; the profile's, the program's
+    const auto& items = setup->diagnostics().items();
+    if (std::any_of(items.begin(), items.end(),
+                    [](const Diagnostic& d) { return d.code.rfind("setting.", 0) == 0; }))
+      end.exit_code = kExitUsage;
+    return end;
+  }
+  if (hooks.set_up && !hooks.set_up(*setup)) {
+    end.exit_code = kExitUsage;
+    return end;
+  }
+  const std::shared_ptr<control::ProgramSource> source = setup->source();
 
   std::unique_ptr<Driver> driver;
   if (o.hal) {
@@ -582,12 +614,7 @@ SessionEnd run_session(const SessionOptions& o, const SessionHooks& hooks) {
     driver = std::make_unique<VirtualDriver>(end.profile, source);
   }
   Driver& d = *driver;
-  if (setup->feature) d.controller().add_feature(setup->feature);
-  if (hooks.features) {
-    for (auto& f : hooks.features(end.profile, setup->source->tools()))
-      d.controller().add_feature(std::move(f),
-                                 control::ObserverOptions{end.profile.servo_period_s, hooks.features_trace});
-  }
+  setup->install(d.controller());
   const control::ServoConfig& sc = d.controller().servo_config();
   // Through HAL the machine may already be on: a previous controller left it idle.
   const bool on = o.hal && d.controller().status().servo.state == State::Idle;

@@ -6,6 +6,7 @@
 
 #include <atomic>
 #include <functional>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -15,6 +16,7 @@
 #include "opencnc/config/machine_profile.hpp"
 #include "opencnc/control/status.hpp"
 #include "opencnc/controller/controller.hpp"
+#include "opencnc/controller/machine_setup.hpp"
 #include "opencnc/tools/tool_table_service.hpp"
 
 namespace opencnc::machine {
@@ -58,6 +60,10 @@ struct SessionOptions {
   /// The program's tool table is a copy in memory: what the run changes in it (a simulated
   /// electrode's measurement, `run --electrode-change`) does not reach the profile's file.
   bool tool_table_in_memory = false;
+  /// The run writes a report: the features add the observers of its sections.
+  bool reports = false;
+  /// Settings for the features' setup by name (control::MachineSetup::Options): "journal".
+  std::map<std::string, std::string, std::less<>> settings;
 };
 
 /// The simulated spark gap's ground truth at the end of a run in virtual time (docs/edm.md):
@@ -99,14 +105,9 @@ struct SessionHooks {
   std::function<bool(const config::MachineProfile&, const control::OpenProgram&)> may_start;
   /// Now and then with the status (for progress).
   std::function<void(const control::ControllerStatus&, double elapsed_wall_s)> progress;
-  /// Features added to the controller before the program is opened (the retrace feature), each
-  /// following the status every servo period.
-  /// They get the program source's tool table (G43 reads it, electrode setting writes it).
-  std::function<std::vector<std::shared_ptr<control::Feature>>(
-      const config::MachineProfile&, const std::shared_ptr<tools::ToolTableService>&)>
-      features;
-  /// The features follow the trace too (the breakpoint journal reads the interrupted move from it).
-  bool features_trace = false;
+  /// Once the machine's features are set up (features::set_up), before the controller is built:
+  /// the command line takes the features it drives. False stops the session (after printing why).
+  std::function<bool(control::MachineSetup&)> set_up;
   /// Every period of the run, with the controller and (in virtual time, else null) the simulated
   /// machine: a scripted operator (`run --retrace`, `run --electrode-change`).
   std::function<void(control::Controller&, const control::ControllerStatus&, machine::SimMachine*)> tick;

@@ -22,7 +22,7 @@
 #include <fmt/format.h>
 
 #include "opencnc/canon/program_builder.hpp"
-#include "opencnc/recovery/path_index.hpp"
+#include "opencnc/retrace/path_index.hpp"
 
 using namespace opencnc;
 using Clock = std::chrono::steady_clock;

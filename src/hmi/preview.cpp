@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The toolpath of a program as polylines for the HMI's 3D view.
+// The toolpath of a program as polylines for the HMI's 3D view, as the program source makes it.
 #include "opencnc/hmi/preview.hpp"
 
 #include <cmath>
@@ -8,9 +8,7 @@
 #include <vector>
 
 #include "opencnc/canon/arc_geometry.hpp"
-#include "opencnc/canon/program_builder.hpp"
 #include "opencnc/core/vec3.hpp"
-#include "opencnc/gcode/interpreter.hpp"
 
 namespace opencnc::hmi {
 
@@ -43,70 +41,73 @@ void arc_points(const canon::Program& p, canon::SegmentId id, std::vector<double
   for (int i = 0; i < 3; ++i) out.push_back(e[i]);
 }
 
-/// The tools the program puts in the spindle (M6 after a T, M61 Q), each once, in number order.
-std::vector<int> program_tools(const canon::Program& p) {
-  std::set<int> tools;
-  int selected = 0;
-  for (std::size_t a = 0; a < p.action_count(); ++a) {
-    const canon::Action& x = p.action(a);
-    if (x.kind == canon::ActionKind::SelectTool) selected = x.index;
-    if (x.kind == canon::ActionKind::ChangeTool && selected > 0) tools.insert(selected);
-    if (x.kind == canon::ActionKind::ChangeToolNumber && x.index > 0) tools.insert(x.index);
+/// Builds the polylines (rapids and feeds apart) and notes the tools the program puts in the
+/// spindle (M6 after a T, M61 Q), as the scan shows them; stops after `max_moves` moves.
+class PreviewReader final : public control::ScanReader {
+ public:
+  PreviewReader(const Pose& start, std::size_t max_moves) : max_moves_(max_moves) {
+    pts_ = {start[0], start[1], start[2]};
   }
-  return {tools.begin(), tools.end()};
-}
+  bool action(const canon::Program& p, std::size_t index) override {
+    const canon::Action& x = p.action(index);
+    if (x.kind == canon::ActionKind::SelectTool) selected_ = x.index;
+    if (x.kind == canon::ActionKind::ChangeTool && selected_ > 0) tools_.insert(selected_);
+    if (x.kind == canon::ActionKind::ChangeToolNumber && x.index > 0) tools_.insert(x.index);
+    return true;
+  }
+  bool move(const canon::Program& p, canon::SegmentId id) override {
+    if (moves_ >= max_moves_) {
+      truncated_ = true;
+      return false;
+    }
+    ++moves_;
+    const canon::Move& m = p.move(id);
+    const bool r = m.kind == canon::MoveKind::Traverse;
+    if (r != rapid_) {
+      flush();
+      rapid_ = r;
+    }
+    if (m.kind == canon::MoveKind::Arc) {
+      arc_points(p, id, pts_);
+    } else {
+      const Pose e = p.end(id);
+      pts_.insert(pts_.end(), {e[0], e[1], e[2]});
+    }
+    return true;
+  }
+  json result(json diagnostics) {
+    flush();
+    return {{"polylines", lines_},
+            {"moves", moves_},
+            {"truncated", truncated_},
+            {"diagnostics", std::move(diagnostics)},
+            {"tools", std::vector<int>(tools_.begin(), tools_.end())}};
+  }
+
+ private:
+  void flush() {
+    if (pts_.size() > 3) lines_.push_back({{"rapid", rapid_}, {"points", pts_}});
+    pts_.assign(pts_.end() - 3, pts_.end());
+  }
+
+  std::size_t max_moves_;
+  std::size_t moves_ = 0;
+  bool truncated_ = false, rapid_ = false;
+  std::vector<double> pts_;
+  json lines_ = json::array();
+  int selected_ = 0;
+  std::set<int> tools_;
+};
 
 }  // namespace
 
 json program_preview(const control::GcodeProgramSource& source, const std::string& path, const Pose& start,
                      std::size_t max_moves) {
-  gcode::Options options = source.options_for(path, {});
-  options.mode = gcode::Mode::Scan;
-  gcode::Interpreter interp(options);
-  canon::ProgramBuilder builder(kXyzabc, start);
+  PreviewReader reader(start, max_moves);
+  const Diagnostics d = source.scan(path, start, {}, reader);
   json diags = json::array();
-  bool truncated = false;
-  if (interp.open(path)) {
-    for (;;) {
-      const gcode::RunStatus rs = interp.run(builder, 1000);
-      if (rs != gcode::RunStatus::Ok) break;
-      if (builder.program().size() >= max_moves) {
-        truncated = true;
-        break;
-      }
-    }
-  }
-  for (const Diagnostic& d : interp.diagnostics().items()) diags.push_back(d.format());
-  const canon::Program& p = builder.program();
-  json lines = json::array();
-  std::vector<double> pts;
-  bool rapid = false;
-  auto flush = [&] {
-    if (pts.size() > 3) lines.push_back({{"rapid", rapid}, {"points", pts}});
-    pts.assign(pts.end() - 3, pts.end());
-  };
-  const Pose s = p.start();
-  pts = {s[0], s[1], s[2]};
-  for (canon::SegmentId id = 0; id < p.size(); ++id) {
-    const canon::Move& m = p.move(id);
-    const bool r = m.kind == canon::MoveKind::Traverse;
-    if (r != rapid) {
-      flush();
-      rapid = r;
-    }
-    if (m.kind == canon::MoveKind::Arc) {
-      arc_points(p, id, pts);
-    } else {
-      const Pose e = p.end(id);
-      pts.insert(pts.end(), {e[0], e[1], e[2]});
-    }
-  }
-  flush();
-  return {{"polylines", lines},
-          {"moves", p.size()},
-          {"truncated", truncated},
-          {"diagnostics", diags},
-          {"tools", program_tools(p)}};
+  for (const Diagnostic& x : d.items()) diags.push_back(x.format());
+  return reader.result(std::move(diags));
 }
 
 }  // namespace opencnc::hmi

@@ -23,6 +23,7 @@
 #include "opencnc/controller/gcode_source.hpp"
 #include "opencnc/controller/servo_setup.hpp"
 #include "opencnc/controller/sim_rig.hpp"
+#include "opencnc/features/features.hpp"
 #include "opencnc/machine/sim_machine.hpp"
 #include "test_profiles.hpp"
 
@@ -37,7 +38,7 @@ class Armed {
  public:
   explicit Armed(const config::MachineProfile& p) {
     Diagnostics d;
-    rig_ = std::make_unique<SimRig>(p, GcodeProgramSource::create(p, d));
+    rig_ = std::make_unique<SimRig>(p, *features::machine_setup(p, d));
     rig_->channels().trace_enabled = true;
   }
   void tick() {

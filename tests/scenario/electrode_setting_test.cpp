@@ -12,8 +12,8 @@
 #include <fmt/format.h>
 
 #include "opencnc/config/profile_loader.hpp"
-#include "opencnc/controller/b_axis_fit.hpp"
-#include "opencnc/controller/electrode_setting.hpp"
+#include "opencnc/edm/b_axis_fit.hpp"
+#include "opencnc/edm/electrode_setting.hpp"
 #include "scenario.hpp"
 
 namespace opencnc::control::test {
@@ -47,22 +47,23 @@ std::shared_ptr<tools::MemoryToolTable> electrode_table() {
 /// The whole controller with the electrode feature, on `sim` (the simulated machine's profile)
 /// while the feature and the program source use `profile`.
 struct Rig {
+  /// The features `profile` calls for (as every front end sets them up) on the test's tool table,
+  /// on the simulated machine of `sim` (the truth the profile may not know).
   explicit Rig(const config::MachineProfile& profile, const config::MachineProfile& sim)
-      : tools(electrode_table()), scenario(sim, source(profile, tools)) {
-    feature = std::make_shared<ElectrodeSetting>(tools, profile);
-    EXPECT_TRUE(
-        scenario.rig().controller().add_feature(feature, ObserverOptions{profile.servo_period_s, true}));
+      : tools(electrode_table()), machine(set_up(profile, tools)), scenario(sim, machine->source()) {
+    feature = std::dynamic_pointer_cast<ElectrodeSetting>(machine->feature("electrode"));
+    EXPECT_TRUE(feature);
+    machine->install(scenario.rig().controller());
     scenario.must(Request::simple(CommandKind::MachineOn));
   }
   explicit Rig(const config::MachineProfile& profile) : Rig(profile, profile) {}
 
-  static std::shared_ptr<ProgramSource> source(const config::MachineProfile& p,
-                                               std::shared_ptr<tools::MemoryToolTable> t) {
+  static std::unique_ptr<MachineSetup> set_up(const config::MachineProfile& p,
+                                              std::shared_ptr<tools::MemoryToolTable> t) {
     Diagnostics d;
-    std::optional<GcodeSourceConfig> c = GcodeProgramSource::config_for(p, d);
-    EXPECT_TRUE(c.has_value());
-    c->tools = std::move(t);
-    return std::make_shared<GcodeProgramSource>(std::move(*c));
+    auto m = features::machine_setup(p, d, control::MachineSetup::Options::with_tools(std::move(t)));
+    EXPECT_TRUE(m) << (d.items().empty() ? "" : d.items()[0].format());
+    return m;
   }
   /// Measures `tool`; the result once the feature is idle again.
   ElectrodeResult measure(int tool) {
@@ -77,6 +78,7 @@ struct Rig {
   }
 
   std::shared_ptr<tools::MemoryToolTable> tools;
+  std::unique_ptr<MachineSetup> machine;
   Scenario scenario;
   std::shared_ptr<ElectrodeSetting> feature;
 };

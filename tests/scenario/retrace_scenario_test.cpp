@@ -12,7 +12,8 @@
 #include <vector>
 
 #include "opencnc/config/profile_loader.hpp"
-#include "opencnc/recovery/retrace.hpp"
+#include "opencnc/features/features.hpp"
+#include "opencnc/retrace/retrace.hpp"
 #include "scenario.hpp"
 
 namespace opencnc::control::test {
@@ -94,7 +95,7 @@ config::MachineProfile flame_cutter() {
 /// The whole program as the controller's G-code source runs it, every move kept.
 canon::Program whole_program(const config::MachineProfile& profile, const std::string& path) {
   Diagnostics d;
-  auto source = GcodeProgramSource::create(profile, d);
+  auto source = features::machine_setup(profile, d)->source();
   auto stream = source->execute(path, Pose{}, {});
   while (stream->state() == StreamState::Reading) stream->read(100000);
   EXPECT_EQ(stream->state(), StreamState::Finished);
@@ -112,9 +113,8 @@ canon::Program whole_program(const config::MachineProfile& profile, const std::s
 TEST(RetraceScenario, PauseJogBackStartStopAgainAtAStepBackAndCutToTheEnd) {
   const config::MachineProfile profile = flame_cutter();
   Scenario s(profile);
-  Diagnostics d;
-  auto feature = std::make_shared<recovery::RetraceFeature>(GcodeProgramSource::create(profile, d), profile);
-  ASSERT_TRUE(s.rig().controller().add_feature(feature, ObserverOptions{profile.servo_period_s, false}));
+  auto feature = std::dynamic_pointer_cast<recovery::RetraceFeature>(s.machine().feature("retrace"));
+  ASSERT_TRUE(feature);
   auto cuts = std::make_shared<CutMoves>();
   s.rig().controller().attach(cuts, ObserverOptions{0, true});
   TempProgram p("nest.ngc", kNest);

@@ -134,6 +134,23 @@ struct Action {
   std::uint32_t origin = 0;  ///< AxisCoupling: 1 + index into poses of the law's origin (0: none)
 };
 
+/// Whether `a` refers to a pose of its program's action poses (`pose`): the offsets, a surface
+/// speed's spindle axis (index2 = 1), a coupling's rate, a process code's Q.
+constexpr bool has_pose(const Action& a) noexcept {
+  switch (a.kind) {
+    case ActionKind::ToolLengthOffset:
+    case ActionKind::WorkOffset:
+    case ActionKind::G92Offset:
+    case ActionKind::AxisCoupling:
+    case ActionKind::ProcessCode:
+      return true;
+    case ActionKind::SpindleSpeed:
+      return a.index2 == 1;
+    default:
+      return false;
+  }
+}
+
 /// The expanded program. Positions in machine coordinates (mm, degrees) with every offset,
 /// unit conversion and rotation applied. Built by canon::ProgramBuilder; read by the planner,
 /// the summary, the path index and the plotter. Non-real-time; not thread-safe while built,
