@@ -420,7 +420,8 @@ class SimBackend final : public ConfigurableMachine {
 TEST(ServoAllocations, NoneInsideTheSharedMemoryHostsTick) {
   const config::MachineProfile p = mill();
   std::string error;
-  auto segment = SharedMemory::create("/opencnc-noalloc-" + std::to_string(::getpid()), 1'000'000, 20, error);
+  auto segment =
+      SegmentMapping::create("/opencnc-noalloc-" + std::to_string(::getpid()), 1'000'000, 20, error);
   ASSERT_TRUE(segment) << error;
   SharedSegment& s = segment->segment();
   SimBackend backend(p);
