@@ -45,11 +45,6 @@ struct SessionOptions {
   double max_time_s = 0;
   /// Virtual time: the simulated mains fail at this servo time (s); negative: never.
   double mains_off_s = -1;
-  /// Virtual time: the broach's cutter wears to `tool_dull_factor` at this servo time (s); negative: never.
-  double tool_dull_s = -1;
-  double tool_dull_factor = 1;
-  /// Virtual time: a short in the simulated EDM gap at this servo time (s); negative: never.
-  double edm_short_s = -1;
   /// Virtual time: a simulated analog input driven to `value` from servo time `at_s`, over `ramp_s`
   /// (0: at once) — a process input (dielectric level, a temperature) drifting out of range.
   struct AnalogInjection {
@@ -66,14 +61,6 @@ struct SessionOptions {
   std::map<std::string, std::string, std::less<>> settings;
 };
 
-/// The simulated spark gap's ground truth at the end of a run in virtual time (docs/edm.md):
-/// what a real machine shows only when the work is measured.
-struct SimEdmFigures {
-  double cavity_oversize_mm = 0;  ///< the widest cavity's oversize per side beyond the electrode
-  double electrode_wear_mm = 0;   ///< the most length an electrode lost
-  double cavity_depth_mm = 0;     ///< the deepest front below the work's surface
-};
-
 /// What a session ended with.
 struct SessionEnd {
   int exit_code = 0;           ///< kExitOk, kExitProgram or kExitUsage
@@ -85,20 +72,31 @@ struct SessionEnd {
   double wall_s = 0;           ///< wall-clock time of the run
   config::MachineProfile profile;
   std::optional<control::OpenProgram> program;  ///< the program as opened (its preflight)
-  /// The simulated broach's workpiece as the run left it (virtual time on a machine with a
-  /// simulated broach; empty otherwise): `--journal` keeps it beside the breakpoint.
-  std::vector<float> sim_bore;
-  std::optional<SimEdmFigures> sim_edm;         ///< in virtual time on a machine with [edm.sim]
+};
+
+/// Observers to attach for a run, with their options.
+using SessionObservers =
+    std::vector<std::pair<std::shared_ptr<control::ControllerObserver>, control::ObserverOptions>>;
+
+/// The operator at the terminal, for a feature that holds the program and asks (the tool guard's
+/// accept or restore, the load guard's resume). Controller thread (the session's loop).
+class SessionOperator {
+ public:
+  virtual ~SessionOperator() = default;
+  /// Prints `question` and waits for a line, the machine going on meanwhile; nothing when no one
+  /// can answer (--unattended, stdin closed).
+  virtual std::optional<std::string> ask(const std::string& question) = 0;
+  /// Sends a request and waits for its answer (printing a refusal); whether it was accepted.
+  virtual bool must(control::Request r) = 0;
+  /// Sends a request.
+  virtual void submit(control::Request r) = 0;
 };
 
 /// Observers attached before the program starts (a run recorder, a trace writer), and progress.
 struct SessionHooks {
   /// Called once the program is open and checked, before it starts: return the observers to
   /// attach (with their options) for the run.
-  std::function<
-      std::vector<std::pair<std::shared_ptr<control::ControllerObserver>, control::ObserverOptions>>(
-          const config::MachineProfile&, const control::OpenProgram&)>
-      opened;
+  std::function<SessionObservers(const config::MachineProfile&, const control::OpenProgram&)> opened;
   /// Called once the program is open and checked, before `opened`: false ends the session there
   /// (nothing has moved; it has said why). A program the preflight refused never gets here, so a
   /// second look at it (the machining time against --max-time) is made only of a finite program.
@@ -113,6 +111,12 @@ struct SessionHooks {
   std::function<void(control::Controller&, const control::ControllerStatus&, machine::SimMachine*)> tick;
   /// When the program's job ends: true if the session goes on with the job that resumes it.
   std::function<bool(const control::ControllerEvent&)> goes_on;
+  /// Every event of the run, after it is printed: a feature that holds the program asks the
+  /// operator (and aborts when no one answers).
+  std::function<void(const control::ControllerEvent&, SessionOperator&)> on_event;
+  /// The session ends, with the simulated machine (virtual time; else null): what the features
+  /// keep of it (the simulated bore, the spark gap's figures).
+  std::function<void(machine::SimMachine*)> finished;
 };
 
 /// Runs `o.file` on the simulated machine of `o.machine`; prints problems and program messages

@@ -3,6 +3,9 @@
 // from the state at the signal.
 #include "opencnc/broaching/power_fail_recorder.hpp"
 
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -98,6 +101,42 @@ void PowerFailRecorder::simulate_independent_stop(const TraceSample& before, con
     worst = std::max(worst, helix_error_um(x[0], x[1]));
   }
   report_.independent_error_um = worst;
+}
+
+std::string PowerFailRecorder::report_text() const {
+  const PowerFailReport& p = report_;
+  if (!p.happened) return "power fail          none (the run ended before the injected time)\n";
+  std::string out = fmt::format(
+      "power fail at       {:.3f} s: stopped in {:.3f} s over {:.3f} mm, DC link down to {:.0f} V\n",
+      p.signal_s, p.stop_time_s, p.stop_distance_mm, p.dc_link_min_v);
+  if (p.energy_at_signal_j > 0 || p.decel_scale > 1)
+    out += fmt::format(
+        "DC link energy      {:.2f} J at the signal, {:.2f} J at rest; braked at {:.3f}x the planned "
+        "deceleration\n",
+        p.energy_at_signal_j, p.energy_at_rest_j, p.decel_scale);
+  if (p.coupled)
+    out += fmt::format(
+        "helix error         {:.3f} um coupled ({:.6f} um commanded), {:.1f} um if each axis stopped alone\n",
+        p.coupled_error_um, p.coupled_command_error_um, p.independent_error_um);
+  return out;
+}
+
+std::string PowerFailRecorder::report_json() const {
+  const PowerFailReport& p = report_;
+  nlohmann::json j;
+  j["happened"] = p.happened;
+  j["coupled"] = p.coupled;
+  j["signal_s"] = p.signal_s;
+  j["stop_time_s"] = p.stop_time_s;
+  j["stop_distance_mm"] = p.stop_distance_mm;
+  j["coupled_error_um"] = p.coupled_error_um;
+  j["coupled_command_error_um"] = p.coupled_command_error_um;
+  j["independent_error_um"] = p.independent_error_um;
+  j["dc_link_min_v"] = p.happened ? nlohmann::json(p.dc_link_min_v) : nlohmann::json(nullptr);
+  j["energy_at_signal_j"] = p.energy_at_signal_j;
+  j["energy_at_rest_j"] = p.energy_at_rest_j;
+  j["decel_scale"] = p.decel_scale;
+  return j.dump();
 }
 
 }  // namespace opencnc::control

@@ -30,8 +30,12 @@ std::unique_ptr<control::MachineSetup> machine_setup(const config::MachineProfil
   return ok ? std::move(m) : nullptr;
 }
 
-std::vector<std::string_view> code_module_names() {
-  return {"coupling", "edm"};
+std::vector<CodeModules> code_modules() {
+  return {
+      {"coupling", "M171-M175, the broaching codes of a machine with a [coupling] section"},
+      {"edm",
+       "M180 P<n> selects machining condition n, 1-99, and switches the generator on, M181 switches it off: "
+       "the codes of a machine with an [edm] section"}};
 }
 
 std::shared_ptr<const gcode::Extensions> with_code_modules(std::string_view name, gcode::Dialect dialect,

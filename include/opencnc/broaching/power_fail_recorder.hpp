@@ -7,6 +7,7 @@
 #include <optional>
 #include <vector>
 
+#include "opencnc/controller/extensions.hpp"
 #include "opencnc/controller/observer.hpp"
 #include "opencnc/motion/coupling.hpp"
 #include "opencnc/plan/machine_limits.hpp"
@@ -37,7 +38,7 @@ struct PowerFailReport {
 
 /// An observer (trace and status every period) of a run that may meet a power failure.
 /// Controller thread; non-real-time.
-class PowerFailRecorder final : public ControllerObserver {
+class PowerFailRecorder final : public ControllerObserver, public ReportSection {
  public:
   /// `coupling`: the machine's (its tables); `limits`: the planner's (the independent stop brakes
   /// at them); `radius_mm`: where the helix error is measured (the bore's radius).
@@ -47,6 +48,13 @@ class PowerFailRecorder final : public ControllerObserver {
   void on_status(const ControllerStatus& s) override;
   void on_trace(const TraceSample& s, const TraceContext& c) override;
   PowerFailReport report() const { return report_; }
+
+  std::string report_key() const override { return "power_fail"; }
+  /// "power fail at … s: stopped in … s over … mm, DC link down to … V" (or "none"), the DC link's
+  /// energy and, coupled, the helix error.
+  std::string report_text() const override;
+  /// The report's values by their names (`happened`, `coupled`, `signal_s`, …).
+  std::string report_json() const override;
 
  private:
   motion::CouplingLaw law_of(const CouplingStatus& c) const;

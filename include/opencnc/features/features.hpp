@@ -26,9 +26,14 @@ std::unique_ptr<control::MachineSetup> machine_setup(const config::MachineProfil
                                                      Diagnostics& diags,
                                                      control::MachineSetup::Options options = {});
 
-/// The names of the features' code modules a program may be checked with without a machine
-/// (`opencnc check --codes`): "coupling", "edm".
-std::vector<std::string_view> code_module_names();
+/// A feature's code modules a program may be checked with without a machine (`opencnc check
+/// --codes NAME`).
+struct CodeModules {
+  std::string_view name;  ///< "coupling", "edm"
+  std::string_view help;  ///< what they are, for the option's help
+};
+/// The features' code modules, in the order they are added: coupling, edm.
+std::vector<CodeModules> code_modules();
 
 /// `base` with the code modules named `name` added (any condition number for the EDM's: a
 /// machine's are checked when it opens the program); null for a name no feature has. Any thread.
