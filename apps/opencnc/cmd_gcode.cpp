@@ -73,8 +73,9 @@ void add_interp_options(CLI::App* cmd, InterpArgs& a) {
                   "200000000)")
       ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{1} << 62));
   if (a.max_seconds > 0)
-    cmd->add_option("--max-seconds", a.max_seconds,
-                    "stop with gcode.limit-time after this many seconds of checking (an endless loop?; default 5)")
+    cmd->add_option(
+           "--max-seconds", a.max_seconds,
+           "stop with gcode.limit-time after this many seconds of checking (an endless loop?; default 5)")
         ->check(finite_range(0.1, 1e6));
   cmd->add_flag(
       "--progress", a.progress,

@@ -9,9 +9,9 @@
 
 #include <cerrno>
 #include <charconv>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
-#include <cmath>
 #include <functional>
 #include <optional>
 #include <string>
@@ -100,10 +100,11 @@ std::shared_ptr<store::ToolStore> open_store(const ToolsOptions& o, bool writes)
   std::error_code ec;
   const bool exists = std::filesystem::exists(o.db, ec);
   if (writes && exists && ::access(o.db.c_str(), W_OK) != 0) {
-    fail(fmt::format("{}: {} (the store is read-only for this user: list, show, check, diff, export and audit "
-                     "read it; changes need write access)",
-                     o.db, std::strerror(errno)),
-         kExitUsage);
+    fail(
+        fmt::format("{}: {} (the store is read-only for this user: list, show, check, diff, export and audit "
+                    "read it; changes need write access)",
+                    o.db, std::strerror(errno)),
+        kExitUsage);
     return nullptr;
   }
   auto s = store::ToolStore::open(o.db, &error, writes, !writes);
@@ -121,7 +122,8 @@ const CLI::Validator kBackupNumber(
       std::int64_t n = 0;
       const auto [p, ec] = std::from_chars(value.data(), value.data() + value.size(), n);
       if (ec != std::errc() || p != value.data() + value.size() || n < 1)
-        return fmt::format("backups are numbered from 1, not '{}' (without --backup: the current one)", value);
+        return fmt::format("backups are numbered from 1, not '{}' (without --backup: the current one)",
+                           value);
       return {};
     },
     "BACKUP");
@@ -180,7 +182,8 @@ int set(store::ToolStore& s, const ToolsOptions& o) {
     if (eq == std::string::npos)
       return fail(fmt::format("'{}': a value is written name=value", w), kExitUsage);
     if (name == "comment") {
-      if (const auto why = tools::invalid_comment(value)) return fail(fmt::format("'{}': {}", w, *why), kExitUsage);
+      if (const auto why = tools::invalid_comment(value))
+        return fail(fmt::format("'{}': {}", w, *why), kExitUsage);
       changes.push_back([t = *t, value](tools::ToolSet& set) { set.tool_or_add(t).comment = value; });
       continue;
     }
@@ -191,7 +194,8 @@ int set(store::ToolStore& s, const ToolsOptions& o) {
     if (name == "pocket") {
       if (v != static_cast<int>(v))
         return fail(fmt::format("'{}': a pocket is a whole number", w), kExitUsage);
-      changes.push_back([t = *t, v](tools::ToolSet& set) { set.tool_or_add(t).pocket = static_cast<int>(v); });
+      changes.push_back(
+          [t = *t, v](tools::ToolSet& set) { set.tool_or_add(t).pocket = static_cast<int>(v); });
       continue;
     }
     const auto param = tools::param_named(name);
@@ -205,7 +209,8 @@ int set(store::ToolStore& s, const ToolsOptions& o) {
       return fail(fmt::format("T{} D{}: tools go from T1 to T{}, edges from D1 to D{}", *t, d,
                               tools::kMaxToolNumber, tools::kMaxEdge),
                   kExitUsage);
-    changes.push_back([t = *t, d, param = *param, v](tools::ToolSet& set) { set.edge_or_add(t, d).set(param, v); });
+    changes.push_back(
+        [t = *t, d, param = *param, v](tools::ToolSet& set) { set.edge_or_add(t, d).set(param, v); });
   }
   std::string error;
   std::optional<tools::Tool> written;
@@ -306,9 +311,10 @@ int import(store::ToolStore& s, const ToolsOptions& o) {
   for (const Diagnostic& x : d.items()) fmt::print(stderr, "{}\n", x.format());
   if (!set || d.error_count() > 0) return fail(fmt::format("{} was not imported: nothing changed", path));
   if (set->tools.empty() && !o.allow_empty)
-    return fail(fmt::format("{} holds no tools: importing it would empty the live table (nothing changed; "
-                            "--allow-empty if that is meant)",
-                            path));
+    return fail(
+        fmt::format("{} holds no tools: importing it would empty the live table (nothing changed; "
+                    "--allow-empty if that is meant)",
+                    path));
   if (!s.write(*set, kInterface, fmt::format("import {}", path), &error)) return fail(error);
   print(o, {{"imported", path}, {"tools", set->tools.size()}, {"edges", set->edge_count()}},
         fmt::format("{}: {} tools, {} edges are the live table now (check against the backup, then accept)",

@@ -77,7 +77,7 @@ struct Totals {
   std::size_t feeds = 0, rapids = 0, arcs = 0;
   double feed_length = 0, rapid_length = 0;
   double feed_time_min = 0;
-  bool untimed = false;   // per-revolution moves without a spindle speed (or under G96): not timed
+  bool untimed = false;    // per-revolution moves without a spindle speed (or under G96): not timed
   double slowest_min = 0;  // the feed move that takes longest, and where it is
   std::uint32_t slowest_file = 0, slowest_line = 0;
   Box box;
@@ -122,7 +122,8 @@ class MoveMeter {
   // The spindle's speed and a synchronised run's pitch as they stand before move `id`: a move per
   // revolution (G95, G33, G76, G33.1) takes its length over (distance per turn × turns per minute).
   void spindle_before(const canon::Program& prog, canon::SegmentId id) {
-    for (; next_action_ < prog.action_count() && prog.action(next_action_).before_move <= id; ++next_action_) {
+    for (; next_action_ < prog.action_count() && prog.action(next_action_).before_move <= id;
+         ++next_action_) {
       const canon::Action& a = prog.action(next_action_);
       if (a.kind == canon::ActionKind::SpindleSpeed) rpm_ = a.index2 == 0 ? a.value : 0;  // G96: varies
       if (a.kind == canon::ActionKind::SpeedFeedSyncStart) per_turn_mm_ = a.value;

@@ -422,7 +422,8 @@ void follow(Driver& d, control::EventCursor& cursor, const SessionOptions& o, co
           end.fault =
               fmt::format("stopped by {} (feed hold on the path, then abort)", signal_name(end.stopped_by));
         else if (end.over_max_time)
-          end.fault = fmt::format("stopped by --max-time {:g} s (feed hold on the path, then abort)", o.max_time_s);
+          end.fault =
+              fmt::format("stopped by --max-time {:g} s (feed hold on the path, then abort)", o.max_time_s);
         else
           end.fault = fmt::format("the program ended: {}", control::to_string(ended->end));
         if (st.fault_text.empty()) fmt::print(stderr, "error: {}\n", end.fault);

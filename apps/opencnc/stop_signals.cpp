@@ -32,7 +32,8 @@ extern "C" void on_stop_signal(int signal) {
     return;
   }
   if (n == 2) {
-    static constexpr char kAborting[] = "\nopencnc: aborting at once; the report follows (again: quit without it)\n";
+    static constexpr char kAborting[] =
+        "\nopencnc: aborting at once; the report follows (again: quit without it)\n";
     say(kAborting, sizeof kAborting - 1);
     return;
   }

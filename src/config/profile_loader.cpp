@@ -131,16 +131,16 @@ ProfileLoad parse_profile(std::string_view text, std::string_view source_name,
   Reporter r(out.diagnostics, std::string(source_name));
   if (text.size() > kMaxProfileBytes) {
     out.diagnostics.error(std::string(source_name), 0, 0,
-                          fmt::format("a profile is at most {} MiB (this text has {} bytes)", kMaxProfileBytes >> 20,
-                                      text.size()),
+                          fmt::format("a profile is at most {} MiB (this text has {} bytes)",
+                                      kMaxProfileBytes >> 20, text.size()),
                           "config.syntax");
     return out;
   }
   if (const auto at = too_many_key_parts(text)) {
-    out.diagnostics.error(std::string(source_name), at->first, at->second,
-                          fmt::format("a dotted key of more than {} parts (no machine profile nests that deep)",
-                                      kMaxKeyParts),
-                          "config.syntax");
+    out.diagnostics.error(
+        std::string(source_name), at->first, at->second,
+        fmt::format("a dotted key of more than {} parts (no machine profile nests that deep)", kMaxKeyParts),
+        "config.syntax");
     return out;
   }
   toml::table root;

@@ -80,11 +80,12 @@ void read_spindle(Section& top, MachineProfile& profile) {
   // and a run would wait for ever for the spindle to reach it.
   constexpr double kMaxPlausibleRpm = 1e6;
   if (sp.max_rpm > kMaxPlausibleRpm) {
-    s.error("max_rpm",
-            fmt::format("spindle.max_rpm = {} is no plausible value: spindles turn at most {:g} rpm (a typo, or "
-                        "another unit?)",
-                        show(sp.max_rpm), kMaxPlausibleRpm),
-            "config.implausible");
+    s.error(
+        "max_rpm",
+        fmt::format("spindle.max_rpm = {} is no plausible value: spindles turn at most {:g} rpm (a typo, or "
+                    "another unit?)",
+                    show(sp.max_rpm), kMaxPlausibleRpm),
+        "config.implausible");
     sp.max_rpm = kMaxPlausibleRpm;
   }
   sp.min_rpm = s.number_or("min_rpm", 0, Bound::NonNegative);
@@ -290,8 +291,8 @@ void read_interpreter(Section& top, MachineProfile& profile, const std::filesyst
   const toml::table* t = top.subtable("interpreter");
   if (t == nullptr) return;
   Section s(*t, "interpreter",
-            {"dialect", "machine", "axis_map", "subroutine_path", "tool_table", "readahead_moves", "readahead_s",
-             "max_scan_s"},
+            {"dialect", "machine", "axis_map", "subroutine_path", "tool_table", "readahead_moves",
+             "readahead_s", "max_scan_s"},
             top.reporter());
   InterpreterOptions& o = profile.interpreter;
   o.dialect =

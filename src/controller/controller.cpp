@@ -12,9 +12,9 @@
 
 #include "alarm_text.hpp"
 #include "job.hpp"
-#include "task_runner.hpp"
 #include "opencnc/controller/preflight.hpp"
 #include "opencnc/controller/servo_setup.hpp"
+#include "task_runner.hpp"
 
 namespace opencnc::control {
 
@@ -113,8 +113,9 @@ std::string what_next(CommandKind command, Refusal r) {
           return "";
       }
     case Refusal::Busy:
-      return command == CommandKind::SetMode ? "the mode changes while nothing runs: wait for the end, or abort"
-                                             : "";
+      return command == CommandKind::SetMode
+                 ? "the mode changes while nothing runs: wait for the end, or abort"
+                 : "";
     default:
       return "";
   }
@@ -542,7 +543,8 @@ bool Controller::ready_for_job(std::uint64_t id, Mode mode, const char* what) {
   return true;
 }
 
-Preflight Controller::preflight_file(const std::string& path, const Pose& at, bool block_delete, ScanCancel cancel) {
+Preflight Controller::preflight_file(const std::string& path, const Pose& at, bool block_delete,
+                                     ScanCancel cancel) {
   if (!source_) {
     Preflight p;
     p.diagnostics.error(path, 0, 0, "this controller has no G-code interpreter", "control.program");
@@ -575,7 +577,10 @@ void Controller::open_file(std::uint64_t id, const std::string& path) {
   const std::uint64_t version = source_ ? source_->version() : 0;
   auto pf = std::make_shared<Preflight>();
   run_long(
-      id, [this, pf, path, at, block_delete, cancel = cancel_token()] { *pf = preflight_file(path, at, block_delete, cancel); },
+      id,
+      [this, pf, path, at, block_delete, cancel = cancel_token()] {
+        *pf = preflight_file(path, at, block_delete, cancel);
+      },
       [this, id, pf, path, at, block_delete, stamp = std::move(stamp), version]() mutable {
         finish_open(id, path, std::move(*pf), at, block_delete, std::move(stamp), version);
       });
@@ -653,7 +658,8 @@ void Controller::cycle_start(std::uint64_t id, const Request& r) {
     return forward(id, *c);
   }
   if (!op)
-    return finish(id, Refusal::NoProgram, "no program is open: open one (the Program screen, or open FILE), then cycle start");
+    return finish(id, Refusal::NoProgram,
+                  "no program is open: open one (the Program screen, or open FILE), then cycle start");
   if (!ready_for_job(id, mode_follows ? servo().mode : Mode::Auto, "programs")) return;
   if (!features_allow_start(id, {JobKind::Program, op->name})) return;
   if (op->program) {
@@ -673,7 +679,8 @@ void Controller::cycle_start(std::uint64_t id, const Request& r) {
     const std::uint64_t version = source_->version();
     auto pf = std::make_shared<Preflight>();
     run_long(
-        id, [this, pf, path = op->path, at, block_delete, cancel = cancel_token()] {
+        id,
+        [this, pf, path = op->path, at, block_delete, cancel = cancel_token()] {
           *pf = preflight_file(path, at, block_delete, cancel);
         },
         [this, id, pf, path = op->path, at, block_delete, stamp = std::move(stamp), version]() mutable {
@@ -691,7 +698,8 @@ void Controller::start_checked(std::uint64_t id, const std::string& path, Prefli
                                bool block_delete, std::string stamp, std::uint64_t version) {
   if (superseded(id, false)) return;
   if (!pf.ok())
-    return finish(id, program_refusal(pf.diagnostics), refusal_text(program_refusal(pf.diagnostics)), pf.diagnostics);
+    return finish(id, program_refusal(pf.diagnostics), refusal_text(program_refusal(pf.diagnostics)),
+                  pf.diagnostics);
   open_at_ = at;
   open_block_delete_ = block_delete;
   open_stamp_ = std::move(stamp);
@@ -700,14 +708,16 @@ void Controller::start_checked(std::uint64_t id, const std::string& path, Prefli
   std::string name;
   {
     std::lock_guard lock(out_mutex_);
-    if (!open_ || open_->path != path) return finish(id, Refusal::NoProgram, refusal_text(Refusal::NoProgram));
+    if (!open_ || open_->path != path)
+      return finish(id, Refusal::NoProgram, refusal_text(Refusal::NoProgram));
     open_->preflight = std::move(pf);
     name = open_->name;
   }
   // (The cycle start it answers may have been pressed in Manual or MDI: the mode follows.)
   if (!ready_for_job(id, servo().mode, "programs")) return;
   if (servo().commanded != at)
-    return finish(id, Refusal::StartMismatch, "the machine moved while the program was checked: start it again");
+    return finish(id, Refusal::StartMismatch,
+                  "the machine moved while the program was checked: start it again");
   start_job(id, JobKind::Program, name, Mode::Auto, source_->execute(path, at, {block_delete}), true);
 }
 
@@ -731,9 +741,11 @@ void Controller::run_auxiliary(std::uint64_t id, const requests::RunAuxiliary& r
                         pf->diagnostics);
         if (!ready_for_job(id, Mode::Auto, "auxiliary programs")) return;
         if (servo().commanded != at)
-          return finish(id, Refusal::StartMismatch, "the machine moved while the program was checked: start it again");
+          return finish(id, Refusal::StartMismatch,
+                        "the machine moved while the program was checked: start it again");
         if (program)
-          return start_job(id, JobKind::Auxiliary, name, Mode::Auto, canon_stream(program, at), program->start() == at);
+          return start_job(id, JobKind::Auxiliary, name, Mode::Auto, canon_stream(program, at),
+                           program->start() == at);
         start_job(id, JobKind::Auxiliary, name, Mode::Auto, source_->execute(path, at, {block_delete}), true);
       });
 }
@@ -792,7 +804,8 @@ void Controller::resume_program(std::uint64_t id, const requests::ResumeProgram&
   // Held in a shared slot: the task reads it, then the job takes it.
   auto stream = std::make_shared<std::unique_ptr<ProgramStream>>(
       source_->resume(op->path, r.program_start.value_or(open_at_), at, r.segment, {block_delete_, cancel}));
-  if (!*stream) return finish(id, Refusal::BadValue, "this controller's program source cannot resume at a segment");
+  if (!*stream)
+    return finish(id, Refusal::BadValue, "this controller's program source cannot resume at a segment");
   // The replay up to the segment (long work): a program that cannot get there starts nothing.
   run_long(
       id,
@@ -804,7 +817,8 @@ void Controller::resume_program(std::uint64_t id, const requests::ResumeProgram&
         if (superseded(id, false)) return;
         if (!ready_for_job(id, Mode::Auto, "programs")) return;
         if (servo().commanded != at)
-          return finish(id, Refusal::StartMismatch, "the machine moved while the program was replayed: start it again");
+          return finish(id, Refusal::StartMismatch,
+                        "the machine moved while the program was replayed: start it again");
         // Every move is checked before it runs (the preflight's moves began elsewhere).
         start_job(id, JobKind::Program, name, Mode::Auto, std::move(*stream), false);
       });

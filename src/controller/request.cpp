@@ -165,13 +165,14 @@ bool takes_urgent_lane(const Request& r) {
     }
   }
   if (const auto* c = std::get_if<requests::SetCoolant>(&r.body)) return !c->on;
-  return std::holds_alternative<requests::JogStop>(r.body) || std::holds_alternative<requests::SetOverride>(r.body);
+  return std::holds_alternative<requests::JogStop>(r.body) ||
+         std::holds_alternative<requests::SetOverride>(r.body);
 }
 
 bool is_halt(const Request& r) {
   const auto* s = std::get_if<requests::Servo>(&r.body);
-  return s != nullptr &&
-         (s->kind == CommandKind::EStop || s->kind == CommandKind::MachineOff || s->kind == CommandKind::Abort);
+  return s != nullptr && (s->kind == CommandKind::EStop || s->kind == CommandKind::MachineOff ||
+                          s->kind == CommandKind::Abort);
 }
 
 bool is_stop(const Request& r) {

@@ -326,14 +326,15 @@ void Engine::check_per_turn(const Block& b) {
             g_name(motion), b.get('k'), least, unit);
   if (motion == 760 && b.has('p') && small(b.get('p')))
     fail_at(b.word_position('p'), ErrorCode::PerTurnTooSmall,
-            "G76 P{}: a pitch below {} {} per turn never ends (the least increment a program states)", b.get('p'),
-            least, unit);
+            "G76 P{}: a pitch below {} {} per turn never ends (the least increment a program states)",
+            b.get('p'), least, unit);
   const int feed_mode = b.g[kGroupFeedMode];
-  const bool per_turn = feed_mode == 950 || (feed_mode == -1 && st_.modal.feed_mode == canon::FeedMode::UnitsPerRevolution);
+  const bool per_turn =
+      feed_mode == 950 || (feed_mode == -1 && st_.modal.feed_mode == canon::FeedMode::UnitsPerRevolution);
   if (per_turn && b.has('f') && b.get('f') != 0 && small(b.get('f')))
     fail_at(b.word_position('f'), ErrorCode::PerTurnTooSmall,
-            "G95 F{}: a feed below {} {} per turn never ends (the least increment a program states)", b.get('f'),
-            least, unit);
+            "G95 F{}: a feed below {} {} per turn never ends (the least increment a program states)",
+            b.get('f'), least, unit);
 }
 
 // An M98 line: P (the subprogram's number, whole) and L (calls, 0 or more: the parser refuses

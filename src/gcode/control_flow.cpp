@@ -251,8 +251,9 @@ void Engine::o_m98() {
   block_.o_name = name;
   if (block_.has('l') && opt_.limits.max_repeat_count != 0 &&
       block_.get('l') > static_cast<double>(opt_.limits.max_repeat_count))
-    fail_at(block_.word_position('l'), ErrorCode::LimitRepeatCount, "M98 L{} is more than {} (limit max_repeat_count)",
-            block_.get('l'), opt_.limits.max_repeat_count);
+    fail_at(block_.word_position('l'), ErrorCode::LimitRepeatCount,
+            "M98 L{} is more than {} (limit max_repeat_count)", block_.get('l'),
+            opt_.limits.max_repeat_count);
   CallFrame& caller = st_.frames.back();
   CallFrame frame;
   frame.kind = CallKind::Numbered;

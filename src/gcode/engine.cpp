@@ -213,7 +213,8 @@ void Engine::check_time() {
   }
   if (now - cpu_at_start_s_ > opt_.limits.max_seconds)
     fail(ErrorCode::LimitTime,
-         "the program was still running here after {:g} s of checking ({} blocks; limit max_seconds): an endless "
+         "the program was still running here after {:g} s of checking ({} blocks; limit max_seconds): an "
+         "endless "
          "loop?",
          opt_.limits.max_seconds, st_.blocks_executed);
 }

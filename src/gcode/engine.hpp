@@ -373,8 +373,8 @@ class Engine final : public ParamHost, public ExecContext {
   std::uint32_t mdi_file_ = 0;
   bool in_mdi_file_ = false;        ///< "<mdi>" is registered in the source map
   std::uint64_t skipped_lines_ = 0; ///< lines passed over while seeking a label
-  std::uint64_t lines_read_ = 0;     ///< every line, for the time bound (Limits::max_seconds)
-  double cpu_at_start_s_ = 0;        ///< the thread's CPU time at the first line
+  std::uint64_t lines_read_ = 0;    ///< every line, for the time bound (Limits::max_seconds)
+  double cpu_at_start_s_ = 0;       ///< the thread's CPU time at the first line
   void check_time();
   bool units_programmed_ = false;   ///< a G20/G21 was met (for the units warning)
   bool warned_units_ = false;

@@ -25,8 +25,8 @@ MachineHost::MachineHost(const config::MachineProfile& profile,
     sim_ = std::make_unique<machine::SimMachine>(config::sim_machine_config(profile));
     servo_ = std::make_unique<control::Servo>(control::servo_config(profile), *channels_, *sim_);
     // The servo ticks by itself: the controller's long work never holds back its loop.
-    controller_ = std::make_unique<control::Controller>(profile, *channels_, std::move(source),
-                                                        control::ControllerOptions{.long_work_on_thread = true});
+    controller_ = std::make_unique<control::Controller>(
+        profile, *channels_, std::move(source), control::ControllerOptions{.long_work_on_thread = true});
     control::RealtimeClock::Options clock;
     clock.period_ns = static_cast<std::int64_t>(profile.servo_period_s * 1e9 + 0.5);
     clock.cpu = options_.servo_cpu;

@@ -581,7 +581,8 @@ void Server::Impl::command(const std::shared_ptr<HttpSession>& s, const HttpRequ
     body = json::parse(req.body());
   } catch (const json::exception& e) {  // malformed, or a number no double holds (1e400)
     audit(s->remote(), role, req, 400, "malformed JSON");
-    return s->send(error_response(req, 400, fmt::format("the body is not JSON opencnc can read: {}", e.what())));
+    return s->send(
+        error_response(req, 400, fmt::format("the body is not JSON opencnc can read: {}", e.what())));
   }
   const std::optional<Role> needed = body.is_object() && body.contains("kind") && body["kind"].is_string()
                                          ? role_for(body["kind"].get<std::string>())

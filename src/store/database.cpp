@@ -98,14 +98,15 @@ Database::Database(const std::string& path, OpenOptions options) : path_(path) {
     throw Error(fmt::format("cannot open {}: {}", path, why));
   }
   sqlite3_busy_timeout(db_, 5000);
-  if (options.read_only && sqlite3_exec(db_, "SELECT count(*) FROM sqlite_schema", nullptr, nullptr, nullptr) != SQLITE_OK) {
+  if (options.read_only &&
+      sqlite3_exec(db_, "SELECT count(*) FROM sqlite_schema", nullptr, nullptr, nullptr) != SQLITE_OK) {
     // A WAL database in a folder this user may not write (read-only media, another user's store):
     // its shared-memory index cannot be made there. Read it as an unchanging file instead; a
     // writer elsewhere at the same time is the one case this cannot see.
     sqlite3_close(db_);
     db_ = nullptr;
-    if (sqlite3_open_v2(uri(path, "immutable=1").c_str(), &db_, SQLITE_OPEN_READONLY | SQLITE_OPEN_URI | SQLITE_OPEN_NOMUTEX,
-                        nullptr) != SQLITE_OK) {
+    if (sqlite3_open_v2(uri(path, "immutable=1").c_str(), &db_,
+                        SQLITE_OPEN_READONLY | SQLITE_OPEN_URI | SQLITE_OPEN_NOMUTEX, nullptr) != SQLITE_OK) {
       const std::string why = db_ != nullptr ? sqlite3_errmsg(db_) : "out of memory";
       sqlite3_close(db_);
       throw Error(fmt::format("cannot open {}: {}", path, why));

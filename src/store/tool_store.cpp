@@ -60,7 +60,9 @@ void open_schema(Database& db, bool read_only) {
   if (v > kSchemaVersion)
     throw Error(fmt::format("the tool store has schema {}, newer than this opencnc's {}", v, kSchemaVersion));
   if (v == kSchemaVersion) return;
-  if (read_only) throw Error("this database is not an opencnc tool store (or one that must be opened writable to be set up)");
+  if (read_only)
+    throw Error(
+        "this database is not an opencnc tool store (or one that must be opened writable to be set up)");
   const bool empty = db.query_integer("SELECT count(*) FROM sqlite_schema") == 0;
   if (!empty) throw Error("this database is not an opencnc tool store");
   Database::Transaction t(db);
@@ -259,10 +261,12 @@ std::optional<ToolSet> ToolStore::live(std::string* error) {
 
 bool ToolStore::write_locked(const ToolSet& changed, std::string_view interface, std::string_view reason,
                              std::string* error) {
-  return modify_locked([&changed](ToolSet& live) -> std::optional<std::string> {
-    live = changed;
-    return std::nullopt;
-  }, interface, reason, error);
+  return modify_locked(
+      [&changed](ToolSet& live) -> std::optional<std::string> {
+        live = changed;
+        return std::nullopt;
+      },
+      interface, reason, error);
 }
 
 // The read, the change and the write in one BEGIN IMMEDIATE transaction: two writers each change
@@ -313,10 +317,12 @@ bool ToolStore::set(int t, int d, Param p, double value, std::string_view interf
                            tools::kMaxToolNumber, tools::kMaxEdge);
     return false;
   }
-  return modify([&](ToolSet& live) -> std::optional<std::string> {
-    live.edge_or_add(t, d).set(p, value);
-    return std::nullopt;
-  }, interface, "set", error);
+  return modify(
+      [&](ToolSet& live) -> std::optional<std::string> {
+        live.edge_or_add(t, d).set(p, value);
+        return std::nullopt;
+      },
+      interface, "set", error);
 }
 
 bool ToolStore::set_tool(int t, int pocket, std::string_view comment, std::string_view interface,
@@ -325,12 +331,14 @@ bool ToolStore::set_tool(int t, int pocket, std::string_view comment, std::strin
     if (error != nullptr) *error = fmt::format("T{}: tools go from T1 to T{}", t, tools::kMaxToolNumber);
     return false;
   }
-  return modify([&](ToolSet& live) -> std::optional<std::string> {
-    Tool& tool = live.tool_or_add(t);
-    tool.pocket = pocket;
-    tool.comment = std::string(comment);
-    return std::nullopt;
-  }, interface, "set", error);
+  return modify(
+      [&](ToolSet& live) -> std::optional<std::string> {
+        Tool& tool = live.tool_or_add(t);
+        tool.pocket = pocket;
+        tool.comment = std::string(comment);
+        return std::nullopt;
+      },
+      interface, "set", error);
 }
 
 std::optional<std::int64_t> ToolStore::backup(std::string_view interface, std::string_view reason,
@@ -478,7 +486,8 @@ bool ToolStore::update(std::size_t index, const tools::ToolEntry& entry, tools::
         Tool* tool = live.tool(td->first);
         Edge* e = tool != nullptr ? tool->edge(td->second) : nullptr;
         if (e == nullptr) return fmt::format("T{} D{} was removed meanwhile", td->first, td->second);
-        if (const auto why = tools::apply_entry(entry, *e)) return fmt::format("T{} D{}: {}", td->first, td->second, *why);
+        if (const auto why = tools::apply_entry(entry, *e))
+          return fmt::format("T{} D{}: {}", td->first, td->second, *why);
         if (td->second == 1) tool->pocket = entry.pocket;
         return std::nullopt;
       },

@@ -139,8 +139,9 @@ control::Outcome ToolGuard::handle(const control::requests::Feature& request, co
           std::optional<store::BackupInfo> b = store->current_backup(&error);
           const std::int64_t id = chosen.value_or(b ? b->id : 0);
           out->accepted = id > 0 && store->restore(id, "controller", &error);
-          out->message = out->accepted ? fmt::format("backup {} is the live tool table again", id)
-                                       : (error.empty() ? std::string("there is no backup to restore") : error);
+          out->message = out->accepted
+                             ? fmt::format("backup {} is the live tool table again", id)
+                             : (error.empty() ? std::string("there is no backup to restore") : error);
         }
         if (!out->accepted) out->refusal = control::Refusal::BadValue;
       },

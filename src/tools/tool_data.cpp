@@ -138,7 +138,8 @@ std::optional<std::string> invalid_comment(std::string_view comment) {
   for (const char ch : comment) {
     const auto c = static_cast<unsigned char>(ch);
     if (c < 0x20 || c == 0x7f)
-      return fmt::format("a comment is one line of text without control characters (it holds byte 0x{:02x})", c);
+      return fmt::format("a comment is one line of text without control characters (it holds byte 0x{:02x})",
+                         c);
   }
   return std::nullopt;
 }

@@ -96,7 +96,8 @@ TEST(HostileProfile, AFolderIsNotAProfileWithoutAName) {
   const ProfileLoad load = load_profile(dir);
   ASSERT_NE(first_error(load), nullptr);
   EXPECT_EQ(first_error(load)->code, "config.file");
-  EXPECT_EQ(first_error(load)->format(), dir + ": error: cannot read the profile: it is a folder, not a file");
+  EXPECT_EQ(first_error(load)->format(),
+            dir + ": error: cannot read the profile: it is a folder, not a file");
 }
 
 TEST(HostileProfile, AnUnreadableProfileSaysWhy) {

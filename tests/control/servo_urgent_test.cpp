@@ -22,7 +22,8 @@ Command command(CommandKind k, std::uint64_t id, std::uint64_t seq) {
 /// The servo's answer to command `id` among the events so far (None = accepted).
 std::optional<Refusal> answer(const ServoHarness& h, std::uint64_t id) {
   for (const ServoEvent& e : h.events()) {
-    if ((e.kind == EventKind::Accepted || e.kind == EventKind::Refused) && e.command_id == id) return e.refusal;
+    if ((e.kind == EventKind::Accepted || e.kind == EventKind::Refused) && e.command_id == id)
+      return e.refusal;
   }
   return std::nullopt;
 }
@@ -31,7 +32,8 @@ std::optional<Refusal> answer(const ServoHarness& h, std::uint64_t id) {
 std::vector<std::uint64_t> answer_order(const ServoHarness& h) {
   std::vector<std::uint64_t> ids;
   for (const ServoEvent& e : h.events()) {
-    if ((e.kind == EventKind::Accepted || e.kind == EventKind::Refused) && e.command_id >= 100) ids.push_back(e.command_id);
+    if ((e.kind == EventKind::Accepted || e.kind == EventKind::Refused) && e.command_id >= 100)
+      ids.push_back(e.command_id);
   }
   return ids;
 }

@@ -81,8 +81,8 @@ TEST(Server, BadRequestsGetA4xxWithAMessageAndChangeNothing) {
 // on GET calls left no audit row.
 TEST(Server, ANumberTooLargeForADoubleIsA400AndTheServerGoesOn) {
   ServerRig rig(mill());
-  for (const char* body : {R"({"kind":"jog","axis":"X","velocity":1e400})", R"({"kind":"override","which":"feed","value":-1e999})",
-                           R"([1e400])"}) {
+  for (const char* body : {R"({"kind":"jog","axis":"X","velocity":1e400})",
+                           R"({"kind":"override","which":"feed","value":-1e999})", R"([1e400])"}) {
     const Reply r = post(rig.port, body, kOperator);
     EXPECT_EQ(r.status, 400) << body << ": " << r.text;
   }
@@ -112,8 +112,8 @@ TEST(Server, EveryRefusedTokenIsAuditedOnGetCallsToo) {
 TEST(Server, AToolCommentIsOneBoundedLine) {
   ServerRig rig(mill());
   const json before = get(rig.port, "/api/v1/tools", kOperator).body;
-  for (const std::string& comment : {std::string("x\nT99 P99 Z-1000 D1"), std::string("a\r\0b", 4),
-                                    std::string(100000, 'x')}) {
+  for (const std::string& comment :
+       {std::string("x\nT99 P99 Z-1000 D1"), std::string("a\r\0b", 4), std::string(100000, 'x')}) {
     const json body = {{"kind", "set-tool"}, {"tool", 1}, {"comment", comment}};
     const Reply r = post(rig.port, body.dump(), kAdmin);
     EXPECT_EQ(r.status, 422) << r.text;
@@ -135,7 +135,8 @@ TEST(Server, ToolDataIsTheAdminsAndEveryChangeIsAudited) {
   EXPECT_EQ(get(rig.port, "/api/v1/audit", kOperator).status, 403);
   rig.history->flush();
   const json audit = get(rig.port, "/api/v1/audit", kAdmin).body;
-  ASSERT_GE(audit.size(), 4u);  // newest first: the operator's look at the audit, T77, the change, the refusal
+  ASSERT_GE(audit.size(),
+            4u);  // newest first: the operator's look at the audit, T77, the change, the refusal
   EXPECT_EQ(audit[0]["action"], "GET /api/v1/audit");
   EXPECT_EQ(audit[0]["status"], 403);
   EXPECT_EQ(audit[2]["role"], "admin");
@@ -290,7 +291,8 @@ TEST(Server, AJobRunsToItsEndWithHoldAndResumeAndLandsInTheHistory) {
 // e-stop. The e-stop is answered (200, not 202 pending) while the open's check runs, the machine
 // stands e-stopped with the spindle stopped, and the e-stop cancelled the check.
 TEST(Server, AnEStopIsAnsweredAndActsWhileAnEndlessProgramIsChecked) {
-  const auto dir = std::filesystem::temp_directory_path() / ("opencnc-hmi-estop-" + std::to_string(::getpid()));
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("opencnc-hmi-estop-" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   std::ofstream(dir / "endless.ngc") << "G21 G90 F1000\no1 while [1]\nG1 X1\nG1 X0\no1 endwhile\nM2\n";
   RigOptions o = mill();

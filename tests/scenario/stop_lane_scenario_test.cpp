@@ -201,7 +201,8 @@ TEST(StopLane, AnEStopActsInTheNextPeriodWhileRunFromLineScans) {
   machine->install(r.controller());
   spindle_running(r);
   r.must(Request::open(p.path()));
-  const std::uint64_t scan = r.controller().submit(Request::feature("run-from-line", "start", RunFromLineArgs{8}));
+  const std::uint64_t scan =
+      r.controller().submit(Request::feature("run-from-line", "start", RunFromLineArgs{8}));
   r.ticks(5);
   EXPECT_EQ(r.periods_to_apply(Request::simple(CommandKind::EStop)), 1u);
   EXPECT_TRUE(r.everything_off());
@@ -252,7 +253,8 @@ TEST(StopLane, AnEStopActsInTheNextPeriodWhileTheJournalWritesTheBreakpoint) {
   TempProgram p("job.ngc",
                 "G21 G90 G94 G17 G40 G49\nG64 P0.005\nG0 X-0.5\nG0 Z-10 C0\nM171 P600\nG1 X0.1 F60\n"
                 "G1 Z310 F3000\nG1 X-0.4 F60\nG0 Z-10\nM175\nM2\n");
-  const config::MachineProfile profile = loaded(config::load_profile(OPENCNC_SOURCE_DIR "/configs/broach-zc.toml"));
+  const config::MachineProfile profile =
+      loaded(config::load_profile(OPENCNC_SOURCE_DIR "/configs/broach-zc.toml"));
   auto source = source_for(profile);
   SplitRig r(profile, source);
   const auto dir = std::filesystem::path(p.path()).parent_path() / "journal";
@@ -270,7 +272,8 @@ TEST(StopLane, AnEStopActsInTheNextPeriodWhileTheJournalWritesTheBreakpoint) {
   r.ticks(2);
   // The clock is the test's: the axes stand still in time while the journal catches up.
   const auto give_up = std::chrono::steady_clock::now() + 60s;
-  while (!journal->last_written() && std::chrono::steady_clock::now() < give_up) std::this_thread::sleep_for(1ms);
+  while (!journal->last_written() && std::chrono::steady_clock::now() < give_up)
+    std::this_thread::sleep_for(1ms);
   ASSERT_TRUE(journal->last_written()) << "the journal wrote no record";
   ASSERT_NE(r.servo().state(), State::Faulted) << "the axes came to rest before the e-stop could be sent";
   // The axes still stopping on the helix, the journal's writer about to write the at-rest record.
@@ -322,7 +325,8 @@ TEST_P(StopsWhileStuck, TheStopActsInTheNextPeriod) {
   r.must(Request::set_mode(Mode::Auto));
   r.must(Request::open(p.path()));
   r.must(Request::simple(CommandKind::CycleStart));
-  ASSERT_TRUE(r.until([&] { return r.servo().state() == State::Running && r.outputs().spindle.speed_rpm == 3000; }));
+  ASSERT_TRUE(
+      r.until([&] { return r.servo().state() == State::Running && r.outputs().spindle.speed_rpm == 3000; }));
   r.ticks(300);
   const std::uint64_t id = r.controller().submit(Request::feature("stuck", "wait"));
   stuck->wait_inside();  // the controller's thread is held from here on

@@ -163,8 +163,8 @@ class Controller final : private FeatureHost {
   ScanCancel cancel_token() const noexcept { return {&halt_seq_, handling_seq_}; }
   void finish_open(std::uint64_t id, const std::string& path, Preflight pf, const Pose& at, bool block_delete,
                    std::string stamp, std::uint64_t version);
-  void start_checked(std::uint64_t id, const std::string& path, Preflight pf, const Pose& at, bool block_delete,
-                     std::string stamp, std::uint64_t version);
+  void start_checked(std::uint64_t id, const std::string& path, Preflight pf, const Pose& at,
+                     bool block_delete, std::string stamp, std::uint64_t version);
   /// Sends a command to the tick in the order of sending: `c.seq` as set (a request's own), or
   /// the next number. False when the queue is full. Controller thread.
   bool send(Command c);
@@ -203,7 +203,8 @@ class Controller final : private FeatureHost {
     std::uint64_t seq = 0;
     Request request;
   };
-  mutable std::mutex inbox_mutex_;  ///< the inbox, the id and send counters, the urgent lane, attachments waiting
+  mutable std::mutex
+      inbox_mutex_;  ///< the inbox, the id and send counters, the urgent lane, attachments waiting
   std::vector<Submitted> inbox_;
   /// Set with every submit(): service() takes the lock only when there is something to take.
   std::atomic<bool> inbox_filled_{false};

@@ -104,7 +104,8 @@ class ToolStore final : public tools::ToolTableService {
   tools::ToolSet read_live_locked() const;
   bool write_locked(const tools::ToolSet& changed, std::string_view interface, std::string_view reason,
                     std::string* error);
-  bool modify_locked(const Edit& change, std::string_view interface, std::string_view reason, std::string* error);
+  bool modify_locked(const Edit& change, std::string_view interface, std::string_view reason,
+                     std::string* error);
 
   mutable std::mutex mutex_;
   std::unique_ptr<Database> db_;
