@@ -11,7 +11,10 @@
 
 namespace opencnc::gcode {
 
-Engine::Engine(Options options) : opt_(std::move(options)), sources_(std::make_shared<canon::SourceMap>()) {
+Engine::Engine(Options options)
+    : opt_(std::move(options)),
+      sources_(std::make_shared<canon::SourceMap>()),
+      dialect_(&dialect_hooks(opt_.dialect)) {
   ext_ = opt_.extensions.get();
   // The G groups where a code with an extension handler can stand (its core group, else the
   // one its traits name): check_block looks for handlers in these only.
@@ -44,12 +47,7 @@ Engine::Engine(Options options) : opt_(std::move(options)), sources_(std::make_s
     if (opt_.axes.has(opt_.axis_map[static_cast<std::size_t>(i)])) letters_ |= bit;
     else if (opt_.axes.has(static_cast<Axis>(i))) mapped_away_ |= bit;
   }
-  if (fanuc()) {
-    // #0, the locals and the commons start vacant; on a lathe U and W are incremental X and Z.
-    st_.fanuc.vacant.set();
-    for (int i = 34; i < 100; ++i) st_.fanuc.vacant.reset(static_cast<std::size_t>(i));
-    if (opt_.machine == MachineKind::Lathe) letters_ |= (1u << ('u' - 'a')) | (1u << ('w' - 'a'));
-  }
+  if (dialect_->make_state) dialect_state_ = dialect_->make_state(*this);
 }
 
 Engine::~Engine() = default;
@@ -124,7 +122,7 @@ void Engine::start() {
   out_.set_g92_offset(st_.position.axis_offset);
   out_.set_xy_rotation(st_.position.rotation_xy_deg);
   out_.set_feed_reference(canon::FeedReference::Xyz);
-  if (fanuc()) fanuc_start();
+  if (dialect_->start) dialect_->start(*this);
   if (!has_program_) return;
   // A program whose first non-blank line is a lone '%' must end with another '%'.
   SourceFile& f = current_file();
@@ -159,8 +157,8 @@ void Engine::start() {
     st_.percent_delimited = true;
     st_.next = {st_.next.file, body, 2};  // LinuxCNC counts the '%' line as line 1
   } else {
-    // Fanuc: "%O1000(NAME)" opens the tape and numbers the program on one line.
-    st_.percent_delimited = fanuc() && first.front() == '%' && fanuc_program_number(first).has_value();
+    // A dialect's header: "%O1000(NAME)" opens the tape and numbers the program on one line.
+    st_.percent_delimited = dialect_->program_header != nullptr && dialect_->program_header(first);
     st_.next = {st_.next.file, 0, 1};
   }
   st_.frames.front().fanuc.body = st_.next;
@@ -297,12 +295,7 @@ RunStatus Engine::mdi(std::string_view line, canon::Sink& sink) {
 void Engine::abandon_calls() {
   while (st_.frames.size() > 1) {
     const CallFrame& f = st_.frames.back();
-    if (f.fanuc.macro) {
-      for (std::size_t i = 1; i <= kFanucLocalCount; ++i) {
-        st_.parameters[i] = f.fanuc.saved_locals[i - 1];
-        st_.fanuc.vacant[i] = f.fanuc.saved_vacant[i];
-      }
-    } else if (!fanuc()) {
+    if (!(dialect_->leave_call && dialect_->leave_call(*this, f))) {
       for (int i = 0; i < kSubArgumentCount; ++i)
         st_.parameters[static_cast<std::size_t>(1 + i)] = f.saved_args[static_cast<std::size_t>(i)];
     }
@@ -325,7 +318,7 @@ ParseEnv Engine::parse_env() const noexcept {
   env.defining_sub = st_.control.defining_sub;
   env.defining_name = st_.control.defining_name;
   env.skipping_to = st_.control.skipping_to;
-  env.dialect = opt_.dialect;
+  env.syntax = &dialect_->syntax;
   env.ext = ext_;
   env.vacant = &st_.fanuc.vacant;
   return env;
@@ -390,7 +383,7 @@ Engine::LineKind Engine::read_block() {
     line_file_ = st_.next.file;
     line_ = st_.next.line;
     raw_.clear();
-    if (fanuc()) fanuc_end_of_file();
+    if (dialect_->end_of_file) dialect_->end_of_file(*this);
     if (!st_.control.seeking_sub.empty()) sub_not_found();
     if (!st_.control.skipping_to.empty()) unclosed_block();
     if (st_.percent_delimited)
@@ -401,16 +394,18 @@ Engine::LineKind Engine::read_block() {
   }
   if (norm_.size() < raw_.size() + 1) norm_.resize(raw_.size() + 1);
   set_origin_from_line();
-  norm_len_ = normalize_line(raw_, norm_.data(), fanuc());
+  norm_len_ = normalize_line(raw_, norm_.data(), dialect_->syntax.nested_comments);
   const std::string_view text(norm_.data(), norm_len_);
-  if (text == "%" && fanuc() && !in_mdi_ && fanuc_percent_line()) return LineKind::Empty;
+  if (text == "%" && dialect_->percent_line && !in_mdi_ && dialect_->percent_line(*this))
+    return LineKind::Empty;
   if (text == "%" && st_.percent_delimited && !in_mdi_) {
     // Nothing after the closing '%' belongs to the program, not even a subprogram (LinuxCNC).
     if (!st_.control.seeking_sub.empty()) sub_not_found();
     return LineKind::ProgramEnd;
   }
   if (text.empty() || (text.front() == '/' && opt_.block_delete)) return LineKind::Empty;
-  if (fanuc() && (text.front() == '$' || text.front() == '%')) check_foreign_syntax();
+  if (dialect_->foreign_syntax && (text.front() == '$' || text.front() == '%'))
+    dialect_->foreign_syntax(*this);
 
   const bool skipping = !st_.control.skipping_to.empty();
   if (opt_.limits.max_seconds > 0 && opt_.mode == Mode::Scan && (lines_read_++ & 4095) == 0) check_time();
@@ -421,15 +416,19 @@ Engine::LineKind Engine::read_block() {
   } else if (opt_.limits.max_blocks != 0 && ++st_.blocks_executed > opt_.limits.max_blocks) {
     fail(ErrorCode::LimitBlocks, "more than {} blocks executed (limit max_blocks)", opt_.limits.max_blocks);
   }
-  if (!skipping && (text.front() == '%' || text.front() == '$') && opt_.dialect == Dialect::LinuxCnc)
+  if (!skipping && (text.front() == '%' || text.front() == '$') && !dialect_->foreign_syntax)
     reject_foreign_syntax(text);
   parser_.parse(text, parse_env(), block_);
-  if (fanuc()) fanuc_translate();
+  if (dialect_->translate) dialect_->translate(*this);
   if (!skipping) {
     enhance_block();
     check_block();
   }
   return LineKind::Block;
+}
+
+Engine::LineKind Engine::next_block() {
+  return read_block();
 }
 
 // Reads and executes one line. Returns when the line is done (or the program ended).
@@ -447,17 +446,17 @@ bool Engine::process_line() {
       fail(ErrorCode::OwordInMdi,
            "only 'call' O-words and subprogram calls can be used in MDI: control flow needs a program file");
     control_flow();
-    if (fanuc() && block_.o_type != OWord::BlockRange) fanuc_block_done();
+    if (dialect_->block_done && block_.o_type != OWord::BlockRange) dialect_->block_done(*this, true);
     if (in_mdi_) finish_mdi_call();
     return true;
   }
   if (!st_.control.skipping_to.empty()) return true;
-  if (fanuc()) fanuc_assignments();
+  if (dialect_->assignments)
+    dialect_->assignments(*this);
   else apply_assignments();
   execute_block();
-  if (fanuc()) {
-    fanuc_after_block();
-    fanuc_block_done();
+  if (dialect_->block_done) {
+    dialect_->block_done(*this, false);
     if (in_mdi_) finish_mdi_call();
   }
   if (block_sync_pending_) {
@@ -475,24 +474,6 @@ void Engine::finish_mdi_call() {
     process_line();
     in_mdi_ = true;
   }
-}
-
-// Lines that start like another controller's program header or command ("%PM",
-// "%_N_PART_MPF", "$H", "$BR0137.MIN%") are named as such instead of failing on a character.
-void Engine::check_foreign_syntax() {
-  const std::size_t first = raw_.find_first_not_of(" \t");
-  if (first == std::string::npos) return;
-  const char c = raw_[first];
-  const char next = first + 1 < raw_.size() ? raw_[first + 1] : '\0';
-  const bool dollar = c == '$' && ((next >= 'A' && next <= 'Z') || (next >= 'a' && next <= 'z'));
-  const bool percent = c == '%' && next != '\0' && next != ' ' && next != '\t' &&
-                       !(fanuc() && fanuc_program_number(raw_).has_value());
-  if (!dollar && !percent) return;
-  const std::size_t end = raw_.find_first_of(" \t(", first);
-  const std::string construct = raw_.substr(first, end == std::string::npos ? std::string::npos : end - first);
-  fail(ErrorCode::DialectUnsupported, "'{}' is another controller's syntax ({}), not {} G-code", construct,
-       dollar ? "a command or program header starting with '$'" : "a program header starting with '%'",
-       fanuc() ? "Fanuc" : "LinuxCNC");
 }
 
 // --- errors -------------------------------------------------------------------------------
@@ -578,7 +559,7 @@ void Engine::report(const GcodeError& e) {
     line = w->line;
     col = w->col;
   } else if (e.position() >= 0) {
-    col = raw_column(raw_, e.position(), fanuc());
+    col = raw_column(raw_, e.position(), dialect_->syntax.nested_comments);
   } else {
     const std::size_t first = raw_.find_first_not_of(" \t");
     col = first == std::string::npos ? 1 : static_cast<std::uint32_t>(first + 1);
@@ -789,43 +770,18 @@ void Engine::read_subprogram(const std::string& name, std::uint32_t extra_letter
   restore_line(saved, last);
 }
 
-// Fanuc G71/G72 P Q: the shape's blocks read, not run (ExecContext::read_block_range).
+// A dialect's block ranges (G71/G72 P Q): the program's own blocks read, not run.
 void Engine::read_block_range(std::int64_t first, std::int64_t last, std::string_view what,
                               const std::function<void(const Block&)>& visit) {
-  if (in_mdi_)
-    fail(ErrorCode::OwordInMdi, "{} P Q reads the program's own blocks: it cannot run from MDI (as G70 P Q cannot)", what);
-  const SourcePosition body = st_.frames.back().fanuc.body;
-  const SourcePosition from = fanuc_sequence(body, first, fmt::format("{} P", what));
-  const SourcePosition to = fanuc_sequence(body, last, fmt::format("{} Q", what));
-  if (to.file != from.file || to.offset < from.offset)
-    fail(ErrorCode::FanucGotoTargetMissing, "{} P{} Q{}: block N{} comes before N{}", what, first, last, last, first);
-  // Errors of the shape's blocks point at them, not at the cycle's code.
-  struct Site {
-    int& slot;
-    int saved;
-    ~Site() { slot = saved; }
-  } site{extension_at_, std::exchange(extension_at_, -1)};
-  const SourcePosition resume = st_.next;
-  SavedLine saved = save_line();
-  const double p = fanuc_p_, l = fanuc_l_, clamp = fanuc_clamp_;   // the block's own, reset per line read
-  jump_to(from);
-  for (;;) {
-    const LineKind kind = read_block();
-    if (kind == LineKind::ProgramEnd)
-      fail(ErrorCode::MissingProgramEnd, "the program ends inside the shape of {} P{} Q{}", what, first, last);
-    if (kind == LineKind::Block) {
-      if (block_.o_type != OWord::None || !parser_.numbered_assignments.empty() || !parser_.named_assignments.empty())
-        fail(ErrorCode::FanucProfileBlock,
-             "the shape of {} P{} Q{} cannot hold macro statements, assignments, calls or G70 (only its moves are read)",
-             what, first, last);
-      visit(block_);
-    }
-    if (line_file_ == to.file && line_offset_ == to.offset) break;
-  }
-  const SourcePosition after = st_.next;
-  restore_line(saved, saved.origin);
-  fanuc_p_ = p, fanuc_l_ = l, fanuc_clamp_ = clamp;
-  jump_to(only_comments_between(resume, from) ? after : resume);
+  if (!dialect_->read_block_range)
+    fail(ErrorCode::DialectUnsupported, "{} P Q reads numbered blocks, which this dialect does not have",
+         what);
+  dialect_->read_block_range(*this, first, last, what, visit);
+}
+
+// The dialect's system variables (ParamHost).
+bool Engine::computed_variable(int index, double& value) {
+  return dialect_->computed_variable != nullptr && dialect_->computed_variable(*this, index, value);
 }
 
 InterpState Engine::snapshot() const {

@@ -12,6 +12,8 @@
 #include <string_view>
 #include <vector>
 
+#include "dialect_hooks.hpp"
+#include "gcode_error.hpp"
 #include "opencnc/canon/source_map.hpp"
 #include "opencnc/core/diagnostic.hpp"
 #include "opencnc/gcode/block.hpp"
@@ -19,8 +21,6 @@
 #include "opencnc/gcode/interpreter.hpp"
 #include "opencnc/gcode/options.hpp"
 #include "opencnc/gcode/state.hpp"
-#include "fanuc_index.hpp"
-#include "gcode_error.hpp"
 #include "output.hpp"
 #include "parser.hpp"
 #include "source_file.hpp"
@@ -45,6 +45,8 @@ const char* label_end_keyword(LabelKind k) noexcept;
 std::string label_text(std::string_view key);
 
 class Engine final : public ParamHost, public ExecContext {
+  friend class FanucDialect;  // the Fanuc dialect's hooks run the engine's lines and calls
+
  public:
   explicit Engine(Options options);
   ~Engine() override;
@@ -72,11 +74,13 @@ class Engine final : public ParamHost, public ExecContext {
   const Diagnostics& diagnostics() const noexcept { return diags_; }
   std::shared_ptr<canon::SourceMap> sources() const noexcept { return sources_; }
   const Options& options() const override { return opt_; }
+  /// The dialect's own state (DialectHooks::make_state), for its hooks.
+  DialectState* dialect_state() noexcept { return dialect_state_.get(); }
 
   // --- ParamHost (params.cpp) ------------------------------------------------------------
   bool named_value(std::string_view name, double& value) override;
   void declare_named(std::string_view name) override;
-  bool fanuc_variable(int index, double& value) override;   // fanuc_vars.cpp
+  bool computed_variable(int index, double& value) override;  // the dialect's (DialectHooks)
 
   // --- ExecContext (extension facade, engine.cpp) ----------------------------------------
   InterpState& state() override { return st_; }
@@ -149,6 +153,7 @@ class Engine final : public ParamHost, public ExecContext {
   // Inlined into its two callers in engine.cpp: as a call it cost 2-3 % of gcode_bench's
   // lines/s on the per-line path.
   [[gnu::always_inline]] inline LineKind read_block();
+  LineKind next_block();  ///< read_block() out of line, for a dialect reading a block range
   bool process_line();
   void report(const GcodeError& e);
   [[noreturn]] void sub_not_found();
@@ -158,7 +163,6 @@ class Engine final : public ParamHost, public ExecContext {
   void warn_once(bool& done, ErrorCode code, std::string_view message);
   void check_motion_habits(bool feed);
   void set_origin_from_line();
-  void check_foreign_syntax();
   SourceFile& current_file() {
     const std::uint32_t file = st_.next.file;
     return file < files_.size() && files_[file] ? *files_[file] : source_at(file);
@@ -301,43 +305,9 @@ class Engine final : public ParamHost, public ExecContext {
   void count_loop();
   void leave_frame();
 
-  // fanuc_flow.cpp: the Fanuc dialect's programs, calls and loops
-  bool fanuc() const noexcept { return opt_.dialect == Dialect::Fanuc; }
-  void fanuc_start();
-  bool fanuc_percent_line();
-  void fanuc_end_of_file();
-  void fanuc_control_flow();
-  void fanuc_program_line();
-  void fanuc_goto(std::int64_t n);
-  void fanuc_while();
-  void fanuc_end();
-  void fanuc_call(std::uint32_t program, int count, bool macro);
-  void fanuc_range();
-  void fanuc_block_done();
-  void fanuc_return();
-  SourcePosition fanuc_find_program(std::uint32_t program);
-  bool fanuc_program_file(std::uint32_t program, SourcePosition& at);
-  const FanucIndex::Region& fanuc_region(const SourcePosition& start);
-  SourcePosition fanuc_sequence(const SourcePosition& program_start, std::int64_t n, std::string_view what);
-  std::string fanuc_program_name(const FanucFrame& f) const;
-  bool only_comments_between(const SourcePosition& from, const SourcePosition& to);
+  // The dialect's side (DialectHooks: fanuc/ for the Fanuc dialect).
   void finish_mdi_call();
   void abandon_calls();
-
-  // fanuc_translate.cpp: Fanuc words and codes rewritten into the core's before the checks
-  void fanuc_translate();
-  void fanuc_lathe_words();
-  void fanuc_lathe_tool();
-  void fanuc_lathe_codes();
-  void fanuc_dwell();
-  void fanuc_transform_conflicts();
-  void fanuc_after_block();
-  bool block_has_content() const noexcept;
-
-  // fanuc_vars.cpp: system variables, vacancy, #3000 alarms and #3006 stops
-  double fanuc_computed(int index) const;
-  double fanuc_modal(int group) const;
-  void fanuc_assignments();
 
   // params.cpp
   bool predefined_value(std::string_view name, double& value) const;
@@ -385,12 +355,8 @@ class Engine final : public ParamHost, public ExecContext {
   std::uint32_t line_file_ = 0;     ///< its file
   std::uint64_t line_offset_ = 0;   ///< its byte offset
   std::string raw_;                 ///< the raw line (for messages and N labels)
-  // Fanuc dialect
-  FanucIndex fanuc_index_;          ///< program lines, sequence numbers, loops of the files read
-  std::map<std::uint32_t, SourcePosition> fanuc_programs_;   ///< O number → program line found
-  double fanuc_p_ = -1;             ///< M98/M99 P of the block (taken out before the checks)
-  double fanuc_l_ = -1;             ///< M98 L of the block
-  double fanuc_clamp_ = -1;         ///< G50 S / G92 S of the block
+  const DialectHooks* dialect_;     ///< chosen when the program opens (Options::dialect)
+  std::unique_ptr<DialectState> dialect_state_;  ///< the dialect's own (null: none)
   std::vector<char> norm_;          ///< normalised text of the line
   std::size_t norm_len_ = 0;
 };

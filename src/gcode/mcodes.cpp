@@ -119,7 +119,7 @@ void Engine::change_tool() {
             "M6 cannot change tools while cutter compensation is on: G40 first");
   out_.start_change();
   // A lathe turret indexes with the spindle turning (the Fanuc dialect's T0101).
-  if (!(fanuc() && opt_.machine == MachineKind::Lathe)) {
+  if (!(dialect_->turret_keeps_spindle && opt_.machine == MachineKind::Lathe)) {
     out_.stop_spindle_turning(0);
     st_.modal.spindle = canon::SpindleDirection::Stopped;
   }
@@ -414,19 +414,7 @@ void Engine::convert_overrides() {
 void Engine::convert_stop() {
   const int m = block_.m[kGroupStop];
   if (run_extension_m(m)) return;
-  if (fanuc() && m == 98) {   // after the block's motion, as Fanuc calls
-    const int p = round_to_int(fanuc_p_);
-    if (p < 1) fail(ErrorCode::FanucCallProgramMissing, "M98 needs P (the program number)");
-    // More than four digits: the Fanuc 0 form P<count><program>, e.g. P0031002.
-    if (p > 9999 && fanuc_l_ >= 0) fail(ErrorCode::FanucCallCountConflict, "M98 P{} already holds a repeat count: no L with it", p);
-    const int count = p > 9999 ? p / 10000 : (fanuc_l_ >= 0 ? round_to_int(fanuc_l_) : 1);
-    fanuc_call(static_cast<std::uint32_t>(p > 9999 ? p % 10000 : p), count, false);
-    return;
-  }
-  if (fanuc() && m == 99) {
-    fanuc_return();
-    return;
-  }
+  if (dialect_->stop_code && dialect_->stop_code(*this, m)) return;  // its calls and returns (M98, M99)
   if (st_.modal.cutter_comp != CutterComp::Off && ext_ != nullptr && ext_->compensator) {
     const ExtensionSite site(*this, block_.m_position(kGroupStop));
     ext_->compensator->finish(*this);

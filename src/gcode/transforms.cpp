@@ -6,7 +6,7 @@
 #include <cmath>
 #include <memory>
 
-#include "fanuc_codes.hpp"
+#include "fanuc/codes.hpp"
 #include "gcode_error.hpp"
 #include "opencnc/canon/arc_geometry.hpp"
 #include "opencnc/gcode/extension.hpp"

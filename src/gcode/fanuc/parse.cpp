@@ -3,22 +3,26 @@
 // DO m, END m and G65 macro calls, read into Block::o_type like LinuxCNC's O-words.
 #include <string_view>
 
-#include "fanuc_variables.hpp"
 #include "gcode_error.hpp"
 #include "parser.hpp"
+#include "variables.hpp"
 
 namespace opencnc::gcode {
 
 namespace {
 
-bool is_digit(char c) noexcept { return c >= '0' && c <= '9'; }
-bool starts_value(char c) noexcept { return is_digit(c) || c == '#' || c == '['; }
+bool is_digit(char c) noexcept {
+  return c >= '0' && c <= '9';
+}
+bool starts_value(char c) noexcept {
+  return is_digit(c) || c == '#' || c == '[';
+}
 
 // The local variable (1-based) a G65 argument letter sets (Fanuc's argument specification I);
 // 0 for letters that are not arguments (G, L, N, O, P).
 int argument_variable(char letter) noexcept {
-  static constexpr int kVariable[26] = {1,  2,  3,  7,  8,  9,  0,  11, 4,  5,  6,  0,  13,
-                                        0,  0,  0,  17, 18, 19, 20, 21, 22, 23, 24, 25, 26};
+  static constexpr int kVariable[26] = {1, 2, 3, 7,  8,  9,  0,  11, 4,  5,  6,  0,  13,
+                                        0, 0, 0, 17, 18, 19, 20, 21, 22, 23, 24, 25, 26};
   return kVariable[letter - 'a'];
 }
 
@@ -58,7 +62,8 @@ void Parser::read_statement_tail(Cursor& c, Block& b) {
   while (c.pos < c.text.size()) {
     if (c.at() == ';') return;
     if (c.at() != '(')
-      fail_at(static_cast<int>(c.pos), ErrorCode::FanucStatementSyntax, "unexpected '{}' after the statement", c.at());
+      fail_at(static_cast<int>(c.pos), ErrorCode::FanucStatementSyntax, "unexpected '{}' after the statement",
+              c.at());
     read_comment(c, b);
   }
 }
@@ -97,7 +102,8 @@ void Parser::read_if(Cursor& c, Block& b) {
     } else if (ch == '#') {
       read_assignment(c);
     } else {
-      fail_at(static_cast<int>(c.pos), ErrorCode::FanucIfSyntax, "only macro assignments (#i = ..) may follow THEN");
+      fail_at(static_cast<int>(c.pos), ErrorCode::FanucIfSyntax,
+              "only macro assignments (#i = ..) may follow THEN");
     }
   }
   if (numbered_assignments.empty() && named_assignments.empty())
@@ -105,7 +111,7 @@ void Parser::read_if(Cursor& c, Block& b) {
 }
 
 void Parser::read_while(Cursor& c, Block& b, bool with_condition) {
-  double condition = 1.0;   // DO m alone loops until a GOTO leaves it
+  double condition = 1.0;  // DO m alone loops until a GOTO leaves it
   if (with_condition) {
     condition = expression(c);
     if (!c.text.substr(c.pos).starts_with("do"))
@@ -122,7 +128,8 @@ void Parser::read_while(Cursor& c, Block& b, bool with_condition) {
 int Parser::loop_number(Cursor& c) {
   const int pos = static_cast<int>(c.pos);
   const int id = integer_value(c, "a loop number");
-  if (id < 1 || id > 3) fail_at(pos, ErrorCode::FanucLoopStructure, "DO and END numbers are 1, 2 or 3 (not {})", id);
+  if (id < 1 || id > 3)
+    fail_at(pos, ErrorCode::FanucLoopStructure, "DO and END numbers are 1, 2 or 3 (not {})", id);
   return id;
 }
 
@@ -141,15 +148,16 @@ void Parser::read_macro_call(Cursor& c, Block& b) {
       read_comment(c, b);
       continue;
     }
-    if (ch < 'a' || ch > 'z')
-      fail_at(pos, ErrorCode::BadCharacter, "unexpected '{}' in a G65 call", ch);
+    if (ch < 'a' || ch > 'z') fail_at(pos, ErrorCode::BadCharacter, "unexpected '{}' in a G65 call", ch);
     const std::uint32_t bit = 1u << (ch - 'a');
-    if ((seen & bit) != 0) fail_at(pos, ErrorCode::RepeatedWord, "more than one {} word on the line", static_cast<char>(ch - 32));
+    if ((seen & bit) != 0)
+      fail_at(pos, ErrorCode::RepeatedWord, "more than one {} word on the line", static_cast<char>(ch - 32));
     seen |= bit;
     ++c.pos;
     if (ch == 'p') {
       const int program = integer_value(c, "P");
-      if (program < 1) fail_at(pos, ErrorCode::FanucCallProgramMissing, "G65 P{}: program numbers start at 1", program);
+      if (program < 1)
+        fail_at(pos, ErrorCode::FanucCallProgramMissing, "G65 P{}: program numbers start at 1", program);
       b.o_value = program;
       has_p = true;
     } else if (ch == 'l') {
@@ -175,7 +183,8 @@ void Parser::check_fanuc_assignment(int index, int pos) const {
     fail_at(pos, ErrorCode::ParameterOutOfRange, "variable #{} does not exist", index);
   switch (fanuc_variable_kind(index)) {
     case FanucVariable::Null:
-      fail_at(pos, ErrorCode::FanucReadOnlyVariable, "#0 is the null variable: it is always vacant and cannot be set");
+      fail_at(pos, ErrorCode::FanucReadOnlyVariable,
+              "#0 is the null variable: it is always vacant and cannot be set");
     case FanucVariable::Missing:
       fail_at(pos, ErrorCode::ParameterOutOfRange,
               "variable #{} does not exist (locals are #1-#33, common variables #100-#999)", index);

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Reading Fanuc program files for their program lines, sequence numbers and loop statements.
-#include "fanuc_index.hpp"
+#include "index.hpp"
 
 #include "lexer.hpp"
 
@@ -8,8 +8,12 @@ namespace opencnc::gcode {
 
 namespace {
 
-bool is_digit(char c) noexcept { return c >= '0' && c <= '9'; }
-bool is_blank(char c) noexcept { return c == ' ' || c == '\t' || c == '\r'; }
+bool is_digit(char c) noexcept {
+  return c >= '0' && c <= '9';
+}
+bool is_blank(char c) noexcept {
+  return c == ' ' || c == '\t' || c == '\r';
+}
 
 std::string_view skip_blanks(std::string_view s) noexcept {
   while (!s.empty() && is_blank(s.front())) s.remove_prefix(1);
@@ -19,7 +23,7 @@ std::string_view skip_blanks(std::string_view s) noexcept {
 // The line without blanks, lower case, comments dropped (enough to recognise statements).
 void squeeze(std::string_view raw, std::string& out) {
   out.clear();
-  int comment = 0;   // nesting depth
+  int comment = 0;  // nesting depth
   for (char c : raw) {
     if (comment > 0) {
       comment += c == '(' ? 1 : c == ')' ? -1 : 0;
@@ -96,7 +100,8 @@ const std::vector<FanucIndex::Program>& FanucIndex::programs(std::uint32_t file,
   std::uint32_t number = 0;
   while (source.next(line)) {
     ++number;
-    if (const auto n = fanuc_program_number(line.text)) it->second.push_back({*n, {file, line.offset, number}});
+    if (const auto n = fanuc_program_number(line.text))
+      it->second.push_back({*n, {file, line.offset, number}});
   }
   return it->second;
 }
@@ -108,14 +113,14 @@ const FanucIndex::Region& FanucIndex::region(const SourcePosition& start, Source
   source.seek(start.offset);
   RawLine line;
   std::uint32_t number = start.line;
-  bool code = false;   // a line other than comments and the program's own number was met
+  bool code = false;  // a line other than comments and the program's own number was met
   for (; source.next(line); ++number) {
     const std::string_view text = trim_raw_line(line.text);
     const std::string_view lead = skip_blanks(text);
     if (lead.empty()) continue;
     if (fanuc_program_number(lead)) {
-      if (code) break;   // the next program
-      code = true;       // its own number
+      if (code) break;  // the next program
+      code = true;      // its own number
       continue;
     }
     if (lead == "%") {

@@ -6,7 +6,7 @@
 #include <memory>
 #include <vector>
 
-#include "fanuc_codes.hpp"
+#include "codes.hpp"
 #include "gcode_error.hpp"
 #include "numeric.hpp"
 
@@ -15,9 +15,11 @@ namespace opencnc::gcode {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-constexpr int kMaxPasses = 10000;   // a thread or groove needing more is a programming error
+constexpr int kMaxPasses = 10000;  // a thread or groove needing more is a programming error
 
-double sign(double v) noexcept { return v < 0.0 ? -1.0 : 1.0; }
+double sign(double v) noexcept {
+  return v < 0.0 ? -1.0 : 1.0;
+}
 
 Pose xz(const Pose& base, double x, double z) {
   Pose p = base;
@@ -28,15 +30,15 @@ Pose xz(const Pose& base, double x, double z) {
 
 // Plain data of one threading job, in radius coordinates.
 struct Thread {
-  double x0, z0;         // start point (where every pass starts and ends)
-  double x_end, z_end;   // thread end at the root
-  double taper;          // radius at the start minus radius at the end (R / I)
-  double height;         // thread height (radius)
-  double first_depth;    // depth of the first cut
-  double min_depth;      // smallest depth increment
-  double allowance;      // finishing allowance
+  double x0, z0;        // start point (where every pass starts and ends)
+  double x_end, z_end;  // thread end at the root
+  double taper;         // radius at the start minus radius at the end (R / I)
+  double height;        // thread height (radius)
+  double first_depth;   // depth of the first cut
+  double min_depth;     // smallest depth increment
+  double allowance;     // finishing allowance
   int finish_passes;
-  double chamfer;        // pull-out length along Z
+  double chamfer;  // pull-out length along Z
   double half_angle_deg;
   double lead;
 };
@@ -70,14 +72,15 @@ void synchronised(ExecContext& ctx, const Pose& from, const Pose& to, double lea
 
 void cut_thread(ExecContext& ctx, const Thread& t) {
   const std::vector<double> depths = thread_depths(t);
-  if (depths.empty()) ctx.error(ErrorCode::LimitRepeatCount, fmt::format("G76 would need more than {} passes", kMaxPasses));
-  const double side = sign(t.x0 - t.x_end);   // +1: outside (external thread)
+  if (depths.empty())
+    ctx.error(ErrorCode::LimitRepeatCount, fmt::format("G76 would need more than {} passes", kMaxPasses));
+  const double side = sign(t.x0 - t.x_end);  // +1: outside (external thread)
   const double dir = sign(t.z_end - t.z0);
   const double flank = std::tan(t.half_angle_deg * kPi / 180.0);
   Pose at = ctx.state().position.current;
   for (const double depth : depths) {
     const double x_end = t.x_end + side * (t.height - depth);
-    const double z_start = t.z0 + dir * depth * flank;   // infeed along the flank
+    const double z_start = t.z0 + dir * depth * flank;  // infeed along the flank
     ctx.straight(true, xz(at, t.x0, z_start));
     const Pose start = xz(at, x_end + t.taper, z_start);
     ctx.straight(true, start);
@@ -147,12 +150,19 @@ class FanucThreading final : public CodeHandler {
     const char* h = haas ? "K" : "P";
     const char* q = haas ? "D" : "Q";
     if (t.lead <= 0) ctx.error(ErrorCode::FanucCycleWordMissing, "G76 needs F (the lead)");
-    if (t.height <= 0) ctx.error(ErrorCode::FanucCycleWordMissing, fmt::format("G76 needs {} (the thread height)", h));
-    if (t.first_depth <= 0) ctx.error(ErrorCode::FanucCycleWordMissing, fmt::format("G76 needs {} (the depth of the first cut)", q));
+    if (t.height <= 0)
+      ctx.error(ErrorCode::FanucCycleWordMissing, fmt::format("G76 needs {} (the thread height)", h));
+    if (t.first_depth <= 0)
+      ctx.error(ErrorCode::FanucCycleWordMissing,
+                fmt::format("G76 needs {} (the depth of the first cut)", q));
     if (t.allowance >= t.height && t.allowance > 0)
-      ctx.error(ErrorCode::FanucCycleWordValue, "G76 R (finishing allowance) must be less than the thread height");
-    if (t.z_end == t.z0) ctx.error(ErrorCode::FanucCycleWordMissing, "G76 needs a Z (or W) end different from the start");
-    if (t.x_end == t.x0) ctx.error(ErrorCode::FanucCycleWordValue, "G76 must start outside (or inside) the thread's root diameter");
+      ctx.error(ErrorCode::FanucCycleWordValue,
+                "G76 R (finishing allowance) must be less than the thread height");
+    if (t.z_end == t.z0)
+      ctx.error(ErrorCode::FanucCycleWordMissing, "G76 needs a Z (or W) end different from the start");
+    if (t.x_end == t.x0)
+      ctx.error(ErrorCode::FanucCycleWordValue,
+                "G76 must start outside (or inside) the thread's root diameter");
     if (ctx.state().modal.spindle == canon::SpindleDirection::Stopped)
       ctx.error(ErrorCode::SpindleStopped, "G76 needs the spindle turning (M3 or M4)");
     cut_thread(ctx, t);
@@ -162,20 +172,22 @@ class FanucThreading final : public CodeHandler {
 // Plain data of one grooving job, in radius coordinates.
 struct Groove {
   double x0, z0, x_end, z_end;
-  double peck;      // X depth per peck (0: one plunge)
-  double step;      // Z distance between plunges
-  double retract;   // rapid back after each peck
+  double peck;     // X depth per peck (0: one plunge)
+  double step;     // Z distance between plunges
+  double retract;  // rapid back after each peck
 };
 
 void cut_grooves(ExecContext& ctx, const Groove& g) {
   const double xdir = sign(g.x_end - g.x0), zdir = sign(g.z_end - g.z0);
   const double width = std::fabs(g.z_end - g.z0);
-  if (width > 0 && g.step <= 0) ctx.error(ErrorCode::FanucCycleWordMissing, "G75 with a Z end needs the step between plunges (Q or K)");
+  if (width > 0 && g.step <= 0)
+    ctx.error(ErrorCode::FanucCycleWordMissing, "G75 with a Z end needs the step between plunges (Q or K)");
   const double plunges = width > 0 ? std::ceil(width / g.step - 1e-9) : 0;
   const double depth = std::fabs(g.x_end - g.x0);
   const double pecks = g.peck > 0 ? std::ceil(depth / g.peck - 1e-9) : 1;
   if (plunges > kMaxPasses || pecks > kMaxPasses)
-    ctx.error(ErrorCode::LimitRepeatCount, fmt::format("G75 would need more than {} plunges or pecks", kMaxPasses));
+    ctx.error(ErrorCode::LimitRepeatCount,
+              fmt::format("G75 would need more than {} plunges or pecks", kMaxPasses));
   Pose at = ctx.state().position.current;
   for (int j = 0; j <= static_cast<int>(plunges); ++j) {
     const double z = j == static_cast<int>(plunges) ? g.z_end : g.z0 + zdir * g.step * j;
@@ -183,7 +195,8 @@ void cut_grooves(ExecContext& ctx, const Groove& g) {
     for (int k = 1; k <= static_cast<int>(pecks); ++k) {
       const double x = k == static_cast<int>(pecks) ? g.x_end : g.x0 + xdir * g.peck * k;
       ctx.straight(false, xz(at, x, z));
-      if (k < static_cast<int>(pecks) && g.retract > 0) ctx.straight(true, xz(at, x - xdir * std::min(g.retract, g.peck), z));
+      if (k < static_cast<int>(pecks) && g.retract > 0)
+        ctx.straight(true, xz(at, x - xdir * std::min(g.retract, g.peck), z));
     }
     ctx.straight(true, xz(at, g.x0, z));
   }
@@ -203,7 +216,8 @@ class FanucGrooving final : public CodeHandler {
       if (b.has('r')) set.groove_retract = b.get('r');
       return;
     }
-    if (ctx.state().modal.feed_rate <= 0) ctx.error(ErrorCode::FeedZero, "G75 with zero feed rate (program an F word)");
+    if (ctx.state().modal.feed_rate <= 0)
+      ctx.error(ErrorCode::FeedZero, "G75 with zero feed rate (program an F word)");
     const Pose& cur = ctx.state().position.current;
     const Pose end = ctx.end_point(b);
     Groove g{};
@@ -229,8 +243,11 @@ double length_word(ExecContext& ctx, const Block& b, char letter) {
 
 void require_lathe(ExecContext& ctx, int code) {
   if (ctx.options().machine != MachineKind::Lathe)
-    ctx.error(ErrorCode::Unsupported,
-              fmt::format("G{} is a Fanuc lathe cycle (on a Fanuc mill it is a canned cycle this controller does not have)", code / 10));
+    ctx.error(
+        ErrorCode::Unsupported,
+        fmt::format(
+            "G{} is a Fanuc lathe cycle (on a Fanuc mill it is a canned cycle this controller does not have)",
+            code / 10));
 }
 
 void add_fanuc_lathe_cycles(Extensions& ext) {

@@ -27,19 +27,19 @@ class FanucIndex {
  public:
   struct Program {
     std::uint32_t number = 0;
-    SourcePosition at;   ///< its program line
+    SourcePosition at;  ///< its program line
   };
   /// A WHILE..DO m or DO m line (end = false) or an END m line.
   struct LoopMark {
-    SourcePosition at;      ///< the line
-    SourcePosition after;   ///< the line after it
+    SourcePosition at;     ///< the line
+    SourcePosition after;  ///< the line after it
     int id = 0;
     bool end = false;
   };
   /// One program: from its start to the next program line (or a '%' line, or the end).
   struct Region {
-    std::unordered_map<std::int64_t, SourcePosition> first_n;   ///< first line with each N number
-    std::vector<LoopMark> loops;                                 ///< in file order
+    std::unordered_map<std::int64_t, SourcePosition> first_n;  ///< first line with each N number
+    std::vector<LoopMark> loops;                               ///< in file order
   };
 
   /// The program lines of `file` in file order (read once).

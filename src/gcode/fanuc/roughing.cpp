@@ -11,7 +11,7 @@
 #include <memory>
 #include <string>
 
-#include "fanuc_codes.hpp"
+#include "codes.hpp"
 #include "lathe_errors.hpp"
 #include "numeric.hpp"
 #include "opencnc/gcode/lathe_roughing.hpp"
@@ -28,7 +28,9 @@ using lathe::Point;
 constexpr double kDefaultRetractMm = 0.5;
 constexpr double kDefaultRetractInch = 0.02;
 
-Point zx(const Pose& p) { return {p[Axis::Z], p[Axis::X]}; }
+Point zx(const Pose& p) {
+  return {p[Axis::Z], p[Axis::X]};
+}
 
 // Reads the shape's blocks into a profile, element 0 running from the cycle's start point:
 // G0/G1 give lines, G2/G3 arcs, with the core's end points (X a diameter on a diameter lathe,
@@ -36,7 +38,8 @@ Point zx(const Pose& p) { return {p[Axis::Z], p[Axis::X]}; }
 // to the finishing pass (G70 runs the blocks): the roughing passes do not use them.
 class ShapeReader {
  public:
-  ShapeReader(ExecContext& ctx, const char* cycle, const Pose& start) : ctx_(ctx), cycle_(cycle), at_(start) {}
+  ShapeReader(ExecContext& ctx, const char* cycle, const Pose& start)
+      : ctx_(ctx), cycle_(cycle), at_(start) {}
 
   void add(const Block& b) {
     check_codes(b);
@@ -47,17 +50,20 @@ class ShapeReader {
     if (b.motion == -1) return;
     const Pose end = ctx_.end_point(b);
     for (int axis = 0; axis < kAxisCount; ++axis) {
-      if (axis != 0 && axis != 2 && end[axis] != at_[axis])   // X and Z
+      if (axis != 0 && axis != 2 && end[axis] != at_[axis])  // X and Z
         ctx_.error(ErrorCode::FanucProfileBlock,
                    fmt::format("the shape of {} moves only X and Z: this block moves another axis", cycle_));
     }
     if (b.motion == 0 || b.motion == 10) {
-      if (zx(end) != zx(at_)) profile.push_back({lathe::ProfileElement::Kind::Line, zx(at_), zx(end), {}, false, 0});
+      if (zx(end) != zx(at_))
+        profile.push_back({lathe::ProfileElement::Kind::Line, zx(at_), zx(end), {}, false, 0});
     } else {
       const ArcCentre c = ctx_.arc_centre(b, b.motion, at_, end);
       if (std::abs(c.turn) != 1)
-        ctx_.error(ErrorCode::FanucProfileBlock, fmt::format("an arc of the shape of {} cannot turn more than once", cycle_));
-      profile.push_back({lathe::ProfileElement::Kind::Arc, zx(at_), zx(end), Point(c.first, c.second), b.motion == 30, 0});
+        ctx_.error(ErrorCode::FanucProfileBlock,
+                   fmt::format("an arc of the shape of {} cannot turn more than once", cycle_));
+      profile.push_back(
+          {lathe::ProfileElement::Kind::Arc, zx(at_), zx(end), Point(c.first, c.second), b.motion == 30, 0});
     }
     at_ = end;
     st.position.current = end;
@@ -76,12 +82,16 @@ class ShapeReader {
                            group == kGroupSpindleMode || group == kGroupToolLength ||
                            (group == kGroupMotion && (code == 0 || code == 10 || code == 20 || code == 30));
       if (!allowed)
-        ctx_.error(ErrorCode::FanucProfileBlock,
-                   fmt::format("{} in the shape of {}: the shape's blocks may hold G0-G3, G40-G42, G96/G97 and G98/G99 only",
-                               g_name(code), cycle_));
+        ctx_.error(
+            ErrorCode::FanucProfileBlock,
+            fmt::format(
+                "{} in the shape of {}: the shape's blocks may hold G0-G3, G40-G42, G96/G97 and G98/G99 only",
+                g_name(code), cycle_));
     }
     if (const int stop = b.m[kGroupStop]; stop != -1)
-      ctx_.error(ErrorCode::FanucProfileBlock, fmt::format("M{} in the shape of {}: the cycle reads its blocks, it does not run them", stop, cycle_));
+      ctx_.error(ErrorCode::FanucProfileBlock,
+                 fmt::format("M{} in the shape of {}: the cycle reads its blocks, it does not run them", stop,
+                             cycle_));
   }
 
   ExecContext& ctx_;
@@ -89,7 +99,9 @@ class ShapeReader {
   Pose at_;
 };
 
-constexpr std::uint32_t bit(char letter) noexcept { return 1u << (letter - 'a'); }
+constexpr std::uint32_t bit(char letter) noexcept {
+  return 1u << (letter - 'a');
+}
 
 // The passes as the core's G0/G1/G2/G3 with absolute X (radius) and Z words, under the
 // program's transforms and checks. Moves that would not move are left out (the engine's first
@@ -149,9 +161,9 @@ class FanucRoughing final : public CodeHandler {
 
  private:
   struct Cut {
-    std::int64_t first = 0, last = 0;   // N P, N Q
+    std::int64_t first = 0, last = 0;  // N P, N Q
     double depth = 0, retract = 0;
-    Point allowance;                    // W, U as a radius
+    Point allowance;  // W, U as a radius
   };
   static void settings(ExecContext& ctx, const Block& b, const char* name, bool facing);
   static Cut cut_of(ExecContext& ctx, const Block& b, const char* name, bool facing);
@@ -163,8 +175,10 @@ void FanucRoughing::execute(ExecContext& ctx, const Block& b, int code) {
   const bool facing = code == 720;
   const char* name = facing ? "G72" : "G71";
   if (b.has('x') || b.has('z'))
-    ctx.error(ErrorCode::FanucCycleWordValue,
-              fmt::format("{} starts where the tool is: move to the start point first (X and Z are not its words)", name));
+    ctx.error(
+        ErrorCode::FanucCycleWordValue,
+        fmt::format("{} starts where the tool is: move to the start point first (X and Z are not its words)",
+                    name));
   if (!b.has('p') && !b.has('q')) return settings(ctx, b, name, facing);
   rough(ctx, cut_of(ctx, b, name, facing), name, facing);
 }
@@ -175,10 +189,13 @@ void FanucRoughing::settings(ExecContext& ctx, const Block& b, const char* name,
   const char depth = facing ? 'w' : 'u';
   if (!b.has(depth) && !b.has('r'))
     ctx.error(ErrorCode::FanucCycleWordMissing,
-              fmt::format("{} needs {} (depth of cut) and R (retract), or P and Q (the finishing shape)", name, facing ? 'W' : 'U'));
+              fmt::format("{} needs {} (depth of cut) and R (retract), or P and Q (the finishing shape)",
+                          name, facing ? 'W' : 'U'));
   if (b.has(depth) && b.get(depth) <= 0)
-    ctx.error(ErrorCode::FanucCycleWordValue, fmt::format("{} {}: the depth of cut must be greater than zero", name, facing ? 'W' : 'U'));
-  if (b.has('r') && b.get('r') < 0) ctx.error(ErrorCode::FanucCycleWordValue, fmt::format("{} R: the retract cannot be negative", name));
+    ctx.error(ErrorCode::FanucCycleWordValue,
+              fmt::format("{} {}: the depth of cut must be greater than zero", name, facing ? 'W' : 'U'));
+  if (b.has('r') && b.get('r') < 0)
+    ctx.error(ErrorCode::FanucCycleWordValue, fmt::format("{} R: the retract cannot be negative", name));
   if (b.has(depth)) set.rough_depth = b.get(depth);
   if (b.has('r')) set.rough_retract = b.get('r');
 }
@@ -189,33 +206,44 @@ FanucRoughing::Cut FanucRoughing::cut_of(ExecContext& ctx, const Block& b, const
   const InterpState& st = ctx.state();
   const FanucCycleSettings& set = st.fanuc.cycles;
   if (!b.has('p') || !b.has('q'))
-    ctx.error(ErrorCode::FanucCycleWordMissing, fmt::format("{} needs P and Q (the first and last block numbers of the finishing shape)", name));
+    ctx.error(
+        ErrorCode::FanucCycleWordMissing,
+        fmt::format("{} needs P and Q (the first and last block numbers of the finishing shape)", name));
   if (b.has('i') || b.has('k'))
-    ctx.error(ErrorCode::Unsupported, fmt::format("{} I/K (Haas's allowances of the last roughing pass) are not supported", name));
+    ctx.error(ErrorCode::Unsupported,
+              fmt::format("{} I/K (Haas's allowances of the last roughing pass) are not supported", name));
   Cut cut;
-  cut.first = trunc_to_int(b.get('p'));   // saturated: too large a number names no block
+  cut.first = trunc_to_int(b.get('p'));  // saturated: too large a number names no block
   cut.last = trunc_to_int(b.get('q'));
   cut.depth = b.has('d') ? length_word(ctx, b, 'd') : set.rough_depth;
   if (b.has('d') && cut.depth <= 0)
-    ctx.error(ErrorCode::FanucCycleWordValue, fmt::format("{} D: the depth of cut must be greater than zero", name));
+    ctx.error(ErrorCode::FanucCycleWordValue,
+              fmt::format("{} D: the depth of cut must be greater than zero", name));
   if (cut.depth <= 0)
-    ctx.error(ErrorCode::FanucCycleWordMissing,
-              fmt::format("{} needs a depth of cut: D in this block, or a {} {}(depth) R(retract) block before it", name, name,
-                          facing ? 'W' : 'U'));
+    ctx.error(
+        ErrorCode::FanucCycleWordMissing,
+        fmt::format("{} needs a depth of cut: D in this block, or a {} {}(depth) R(retract) block before it",
+                    name, name, facing ? 'W' : 'U'));
   const bool inch = st.modal.units == canon::Units::Inch;
-  cut.retract = set.rough_retract >= 0 ? set.rough_retract : std::min(cut.depth, inch ? kDefaultRetractInch : kDefaultRetractMm);
+  cut.retract = set.rough_retract >= 0 ? set.rough_retract
+                                       : std::min(cut.depth, inch ? kDefaultRetractInch : kDefaultRetractMm);
   const double u = b.has('u') ? b.get('u') : 0.0;
   cut.allowance = Point(b.has('w') ? b.get('w') : 0.0, st.modal.lathe_diameter ? u / 2 : u);
-  if (st.modal.feed_rate <= 0) ctx.error(ErrorCode::FeedZero, fmt::format("{} with zero feed rate (program an F word)", name));
+  if (st.modal.feed_rate <= 0)
+    ctx.error(ErrorCode::FeedZero, fmt::format("{} with zero feed rate (program an F word)", name));
   return cut;
 }
 
 void FanucRoughing::rough(ExecContext& ctx, const Cut& cut, const char* name, bool facing) {
   InterpState& st = ctx.state();
   if (st.modal.cutter_comp != CutterComp::Off)
-    ctx.error(ErrorCode::LatheCompensation,
-              fmt::format("{} cannot run while cutter compensation is on (G40 first; G41/G42 in the shape apply to G70)", name));
-  if (st.modal.plane != canon::Plane::XZ) ctx.error(ErrorCode::LathePlane, fmt::format("{} works only in the XZ plane (G18)", name));
+    ctx.error(
+        ErrorCode::LatheCompensation,
+        fmt::format(
+            "{} cannot run while cutter compensation is on (G40 first; G41/G42 in the shape apply to G70)",
+            name));
+  if (st.modal.plane != canon::Plane::XZ)
+    ctx.error(ErrorCode::LathePlane, fmt::format("{} works only in the XZ plane (G18)", name));
   const Pose start = st.position.current;
   const int motion = st.modal.motion;
   ShapeReader reader(ctx, name, start);
@@ -224,8 +252,9 @@ void FanucRoughing::rough(ExecContext& ctx, const Cut& cut, const char* name, bo
   st.modal.motion = motion;
   if (reader.profile.size() < 2)
     ctx.error(ErrorCode::FanucProfileBlock,
-              fmt::format("{} P{} Q{}: the shape does not move beyond its first point, so there is nothing to rough", name,
-                          cut.first, cut.last));
+              fmt::format(
+                  "{} P{} Q{}: the shape does not move beyond its first point, so there is nothing to rough",
+                  name, cut.first, cut.last));
   lathe::RoughingParams p;
   p.direction = facing ? lathe::Direction::Facing : lathe::Direction::Turning;
   p.pockets = lathe::Pockets::All;
@@ -239,9 +268,10 @@ void FanucRoughing::rough(ExecContext& ctx, const Cut& cut, const char* name, bo
   try {
     lathe::rough(reader.profile, p, moves);
   } catch (const lathe::RoughingError& e) {
-    ctx.error(roughing_error_code(e.kind()), fmt::format("{} P{} Q{}: {}", name, cut.first, cut.last, e.what()));
+    ctx.error(roughing_error_code(e.kind()),
+              fmt::format("{} P{} Q{}: {}", name, cut.first, cut.last, e.what()));
   }
-  moves.rapid(p.start);   // Fanuc ends the cycle at its start point
+  moves.rapid(p.start);  // Fanuc ends the cycle at its start point
   st.modal.motion = motion;
 }
 

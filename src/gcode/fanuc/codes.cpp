@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The Fanuc dialect's M codes: M31 counts parts; M codes a machine builder defines (gear
 // ranges, chip conveyors, through-spindle coolant, ...) pass as comments.
-#include "fanuc_codes.hpp"
+#include "codes.hpp"
 
 #include <fmt/format.h>
 
@@ -13,7 +13,7 @@ namespace opencnc::gcode {
 
 namespace {
 
-constexpr int kPartsCount = 3901;   // Fanuc's parts-count variable
+constexpr int kPartsCount = 3901;  // Fanuc's parts-count variable
 
 // M31: one more part counted (#3901), and a comment saying so; no motion, no I/O.
 class PartsCounter final : public CodeHandler {
@@ -42,7 +42,8 @@ void add_fanuc_codes(Extensions& ext) {
   add_fanuc_roughing_cycles(ext);
   auto machine = std::make_shared<MachineFunction>();
   for (int code = 0; code < 100; ++code) {
-    if (m_group(code) < 0 && code != 98 && !ext.m[static_cast<std::size_t>(code)]) ext.m[static_cast<std::size_t>(code)] = machine;
+    if (m_group(code) < 0 && code != 98 && !ext.m[static_cast<std::size_t>(code)])
+      ext.m[static_cast<std::size_t>(code)] = machine;
   }
   ext.m[31] = std::make_shared<PartsCounter>();
 }
