@@ -90,7 +90,7 @@ void Engine::control_flow() {
     case OWord::EndWhile:
     case OWord::EndRepeat: return o_end_loop();
     case OWord::Program:
-      if (dialect_->control_flow) return dialect_->control_flow(*this);  // its numbered programs
+      if (dialect_.control_flow) return dialect_.control_flow(*this);  // its numbered programs
       return o_program();
     case OWord::M98:
       return o_m98();
@@ -101,7 +101,7 @@ void Engine::control_flow() {
     case OWord::FanucEnd:
     case OWord::MacroCall:
     case OWord::BlockRange:  // the dialect's own statements (only its parser makes them)
-      if (dialect_->control_flow) dialect_->control_flow(*this);
+      if (dialect_.control_flow) dialect_.control_flow(*this);
       return;
     case OWord::None: return;
   }

@@ -14,7 +14,7 @@ namespace opencnc::gcode {
 Engine::Engine(Options options)
     : opt_(std::move(options)),
       sources_(std::make_shared<canon::SourceMap>()),
-      dialect_(&dialect_hooks(opt_.dialect)) {
+      dialect_(dialect_hooks(opt_.dialect)) {
   ext_ = opt_.extensions.get();
   // The G groups where a code with an extension handler can stand (its core group, else the
   // one its traits name): check_block looks for handlers in these only.
@@ -47,7 +47,7 @@ Engine::Engine(Options options)
     if (opt_.axes.has(opt_.axis_map[static_cast<std::size_t>(i)])) letters_ |= bit;
     else if (opt_.axes.has(static_cast<Axis>(i))) mapped_away_ |= bit;
   }
-  if (dialect_->make_state) dialect_state_ = dialect_->make_state(*this);
+  if (dialect_.make_state) dialect_state_ = dialect_.make_state(*this);
 }
 
 Engine::~Engine() = default;
@@ -122,7 +122,7 @@ void Engine::start() {
   out_.set_g92_offset(st_.position.axis_offset);
   out_.set_xy_rotation(st_.position.rotation_xy_deg);
   out_.set_feed_reference(canon::FeedReference::Xyz);
-  if (dialect_->start) dialect_->start(*this);
+  if (dialect_.start) dialect_.start(*this);
   if (!has_program_) return;
   // A program whose first non-blank line is a lone '%' must end with another '%'.
   SourceFile& f = current_file();
@@ -158,7 +158,7 @@ void Engine::start() {
     st_.next = {st_.next.file, body, 2};  // LinuxCNC counts the '%' line as line 1
   } else {
     // A dialect's header: "%O1000(NAME)" opens the tape and numbers the program on one line.
-    st_.percent_delimited = dialect_->program_header != nullptr && dialect_->program_header(first);
+    st_.percent_delimited = dialect_.program_header != nullptr && dialect_.program_header(first);
     st_.next = {st_.next.file, 0, 1};
   }
   st_.frames.front().fanuc.body = st_.next;
@@ -295,7 +295,7 @@ RunStatus Engine::mdi(std::string_view line, canon::Sink& sink) {
 void Engine::abandon_calls() {
   while (st_.frames.size() > 1) {
     const CallFrame& f = st_.frames.back();
-    if (!(dialect_->leave_call && dialect_->leave_call(*this, f))) {
+    if (!(dialect_.leave_call && dialect_.leave_call(*this, f))) {
       for (int i = 0; i < kSubArgumentCount; ++i)
         st_.parameters[static_cast<std::size_t>(1 + i)] = f.saved_args[static_cast<std::size_t>(i)];
     }
@@ -318,7 +318,7 @@ ParseEnv Engine::parse_env() const noexcept {
   env.defining_sub = st_.control.defining_sub;
   env.defining_name = st_.control.defining_name;
   env.skipping_to = st_.control.skipping_to;
-  env.syntax = &dialect_->syntax;
+  env.syntax = dialect_.syntax;
   env.ext = ext_;
   env.vacant = &st_.fanuc.vacant;
   return env;
@@ -383,7 +383,7 @@ Engine::LineKind Engine::read_block() {
     line_file_ = st_.next.file;
     line_ = st_.next.line;
     raw_.clear();
-    if (dialect_->end_of_file) dialect_->end_of_file(*this);
+    if (dialect_.end_of_file) dialect_.end_of_file(*this);
     if (!st_.control.seeking_sub.empty()) sub_not_found();
     if (!st_.control.skipping_to.empty()) unclosed_block();
     if (st_.percent_delimited)
@@ -394,9 +394,9 @@ Engine::LineKind Engine::read_block() {
   }
   if (norm_.size() < raw_.size() + 1) norm_.resize(raw_.size() + 1);
   set_origin_from_line();
-  norm_len_ = normalize_line(raw_, norm_.data(), dialect_->syntax.nested_comments);
+  norm_len_ = normalize_line(raw_, norm_.data(), dialect_.syntax.nested_comments);
   const std::string_view text(norm_.data(), norm_len_);
-  if (text == "%" && dialect_->percent_line && !in_mdi_ && dialect_->percent_line(*this))
+  if (text == "%" && dialect_.percent_line && !in_mdi_ && dialect_.percent_line(*this))
     return LineKind::Empty;
   if (text == "%" && st_.percent_delimited && !in_mdi_) {
     // Nothing after the closing '%' belongs to the program, not even a subprogram (LinuxCNC).
@@ -404,8 +404,8 @@ Engine::LineKind Engine::read_block() {
     return LineKind::ProgramEnd;
   }
   if (text.empty() || (text.front() == '/' && opt_.block_delete)) return LineKind::Empty;
-  if (dialect_->foreign_syntax && (text.front() == '$' || text.front() == '%'))
-    dialect_->foreign_syntax(*this);
+  const bool foreign_start = text.front() == '$' || text.front() == '%';  // tested first: most lines are not
+  if (foreign_start && dialect_.foreign_syntax != nullptr) dialect_.foreign_syntax(*this);
 
   const bool skipping = !st_.control.skipping_to.empty();
   if (opt_.limits.max_seconds > 0 && opt_.mode == Mode::Scan && (lines_read_++ & 4095) == 0) check_time();
@@ -416,10 +416,10 @@ Engine::LineKind Engine::read_block() {
   } else if (opt_.limits.max_blocks != 0 && ++st_.blocks_executed > opt_.limits.max_blocks) {
     fail(ErrorCode::LimitBlocks, "more than {} blocks executed (limit max_blocks)", opt_.limits.max_blocks);
   }
-  if (!skipping && (text.front() == '%' || text.front() == '$') && !dialect_->foreign_syntax)
+  if (!skipping && foreign_start && dialect_.foreign_syntax == nullptr)
     reject_foreign_syntax(text);
   parser_.parse(text, parse_env(), block_);
-  if (dialect_->translate) dialect_->translate(*this);
+  if (dialect_.translate) dialect_.translate(*this);
   if (!skipping) {
     enhance_block();
     check_block();
@@ -446,17 +446,20 @@ bool Engine::process_line() {
       fail(ErrorCode::OwordInMdi,
            "only 'call' O-words and subprogram calls can be used in MDI: control flow needs a program file");
     control_flow();
-    if (dialect_->block_done && block_.o_type != OWord::BlockRange) dialect_->block_done(*this, true);
+    if (dialect_.block_done && block_.o_type != OWord::BlockRange) dialect_.block_done(*this, true);
     if (in_mdi_) finish_mdi_call();
     return true;
   }
   if (!st_.control.skipping_to.empty()) return true;
-  if (dialect_->assignments)
-    dialect_->assignments(*this);
-  else apply_assignments();
+  const DialectHooks& dialect = dialect_;
+  if (dialect.assignments != nullptr) {
+    dialect.assignments(*this);
+  } else {
+    apply_assignments();
+  }
   execute_block();
-  if (dialect_->block_done) {
-    dialect_->block_done(*this, false);
+  if (dialect.block_done != nullptr) {
+    dialect.block_done(*this, false);
     if (in_mdi_) finish_mdi_call();
   }
   if (block_sync_pending_) {
@@ -559,7 +562,7 @@ void Engine::report(const GcodeError& e) {
     line = w->line;
     col = w->col;
   } else if (e.position() >= 0) {
-    col = raw_column(raw_, e.position(), dialect_->syntax.nested_comments);
+    col = raw_column(raw_, e.position(), dialect_.syntax.nested_comments);
   } else {
     const std::size_t first = raw_.find_first_not_of(" \t");
     col = first == std::string::npos ? 1 : static_cast<std::uint32_t>(first + 1);
@@ -773,15 +776,15 @@ void Engine::read_subprogram(const std::string& name, std::uint32_t extra_letter
 // A dialect's block ranges (G71/G72 P Q): the program's own blocks read, not run.
 void Engine::read_block_range(std::int64_t first, std::int64_t last, std::string_view what,
                               const std::function<void(const Block&)>& visit) {
-  if (!dialect_->read_block_range)
+  if (!dialect_.read_block_range)
     fail(ErrorCode::DialectUnsupported, "{} P Q reads numbered blocks, which this dialect does not have",
          what);
-  dialect_->read_block_range(*this, first, last, what, visit);
+  dialect_.read_block_range(*this, first, last, what, visit);
 }
 
 // The dialect's system variables (ParamHost).
 bool Engine::computed_variable(int index, double& value) {
-  return dialect_->computed_variable != nullptr && dialect_->computed_variable(*this, index, value);
+  return dialect_.computed_variable != nullptr && dialect_.computed_variable(*this, index, value);
 }
 
 InterpState Engine::snapshot() const {

@@ -355,7 +355,7 @@ class Engine final : public ParamHost, public ExecContext {
   std::uint32_t line_file_ = 0;     ///< its file
   std::uint64_t line_offset_ = 0;   ///< its byte offset
   std::string raw_;                 ///< the raw line (for messages and N labels)
-  const DialectHooks* dialect_;     ///< chosen when the program opens (Options::dialect)
+  DialectHooks dialect_;  ///< chosen when the program opens (Options::dialect); a copy, read without a pointer
   std::unique_ptr<DialectState> dialect_state_;  ///< the dialect's own (null: none)
   std::vector<char> norm_;          ///< normalised text of the line
   std::size_t norm_len_ = 0;

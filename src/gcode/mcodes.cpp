@@ -119,7 +119,7 @@ void Engine::change_tool() {
             "M6 cannot change tools while cutter compensation is on: G40 first");
   out_.start_change();
   // A lathe turret indexes with the spindle turning (the Fanuc dialect's T0101).
-  if (!(dialect_->turret_keeps_spindle && opt_.machine == MachineKind::Lathe)) {
+  if (!(dialect_.turret_keeps_spindle && opt_.machine == MachineKind::Lathe)) {
     out_.stop_spindle_turning(0);
     st_.modal.spindle = canon::SpindleDirection::Stopped;
   }
@@ -414,7 +414,7 @@ void Engine::convert_overrides() {
 void Engine::convert_stop() {
   const int m = block_.m[kGroupStop];
   if (run_extension_m(m)) return;
-  if (dialect_->stop_code && dialect_->stop_code(*this, m)) return;  // its calls and returns (M98, M99)
+  if (dialect_.stop_code && dialect_.stop_code(*this, m)) return;  // its calls and returns (M98, M99)
   if (st_.modal.cutter_comp != CutterComp::Off && ext_ != nullptr && ext_->compensator) {
     const ExtensionSite site(*this, block_.m_position(kGroupStop));
     ext_->compensator->finish(*this);

@@ -260,7 +260,7 @@ void Parser::parse(std::string_view text, const ParseEnv& env, Block& b) {
   vacant_assignments.clear();
   Cursor c{text, 0, env};
   if (c.at() == '/') ++c.pos;
-  const bool numbered = env.syntax != nullptr && env.syntax->numbered_programs;
+  const bool numbered = env.syntax.numbered_programs;
   // Numbered programs: "O1000", ":1000" and "%O1000" on the first line of a file.
   if (numbered && c.at() == '%' && (c.at(1) == 'o' || c.at(1) == ':')) ++c.pos;
   if (c.at() == 'n') read_line_number(c, b);
@@ -437,7 +437,7 @@ void Parser::letter_without_word(const Cursor& c, char letter) {
 void Parser::read_comment(Cursor& c, Block& b) {
   const std::size_t start = ++c.pos;
   int depth = 1;  // comments may nest in some dialects (the lexer checked the parentheses)
-  const bool nested = c.env.syntax != nullptr && c.env.syntax->nested_comments;
+  const bool nested = c.env.syntax.nested_comments;
   for (; c.pos < c.text.size(); ++c.pos) {
     const char ch = c.text[c.pos];
     if (ch == '(' && nested) ++depth;
@@ -457,15 +457,15 @@ void Parser::read_word(Cursor& c, Block& b, char letter) {
   constexpr std::uint32_t kIntegerLetters = (1u << ('h' - 'a')) | (1u << ('l' - 'a')) | (1u << ('t' - 'a'));
   if ((kIntegerLetters >> (letter - 'a')) & 1u) {
     v = integer_word(c, letter, pos);
-    if (value_vacant_ && macro_variables(c)) return;
+    if (value_vacant_) return;  // only macro variables are vacant
   } else {
     const std::size_t start = c.pos;
     // A plain number (what real_value would pass on to real_number) read directly.
     const char c0 = c.at(), c1 = c.at(1);
     const bool plain = is_digit(c0) || c0 == '.' || ((c0 == '-' || c0 == '+') && (is_digit(c1) || c1 == '.'));
     v = plain ? real_number(c) : real_value(c);
-    if (value_vacant_ && macro_variables(c)) return;  // a word whose value is a vacant variable is left out
-    if (c.env.syntax != nullptr && c.env.syntax->decimal_points) note_decimal_point(c, b, letter, start);
+    if (value_vacant_) return;  // a word whose value is a vacant variable (macro variables only) is left out
+    if (c.env.syntax.decimal_points) note_decimal_point(c, b, letter, start);
     if (v < 0.0 && (letter == 'f' || letter == 's')) negative_rate(letter, v, pos);
     if (letter == 'x' && c.env.lathe_diameter) v /= 2.0;
   }
@@ -486,7 +486,7 @@ void Parser::repeated_word(const Block& b, char letter, int pos) {
 double Parser::integer_word(Cursor& c, char letter, int pos) {
   const char name[2] = {static_cast<char>(letter - 32), '\0'};
   const double v = integer_value(c, name);
-  if (value_vacant_ && macro_variables(c)) return v;
+  if (value_vacant_) return v;  // only macro variables are vacant
   if (letter == 'h' && v < -1) fail_at(pos, ErrorCode::HWordNegative, "H{}: the tool number of an offset is 0 or more", v);
   if (letter == 'l' && v < 0) fail_at(pos, ErrorCode::LWordNegative, "L{}: an L number cannot be negative", v);
   if (letter == 't' && v < 0) fail_at(pos, ErrorCode::ToolNegative, "T{}: tool numbers are 0 or more", v);
@@ -563,7 +563,7 @@ void Parser::read_g(Cursor& c, Block& b) {
 int Parser::code_group(int code, bool m_code, const ParseEnv& env) const noexcept {
   const int group = m_code ? m_group(code) : g_group(code);
   if (group >= 0) return group;
-  if (m_code && code == 98 && env.syntax != nullptr && env.syntax->m98_calls) return kGroupStop;
+  if (m_code && code == 98 && env.syntax.m98_calls) return kGroupStop;
   if (env.ext == nullptr || code < 0) return -1;
   const CodeHandler* h = nullptr;
   if (m_code && code < static_cast<int>(env.ext->m.size())) h = env.ext->m[static_cast<std::size_t>(code)].get();
@@ -631,7 +631,7 @@ void Parser::read_assignment(Cursor& c) {
     fail_at(static_cast<int>(c.pos), ErrorCode::EqualSignMissing,
             "#{} is not followed by '=': write #{}=value", index, index);
   ++c.pos;
-  if (c.env.syntax != nullptr && c.env.syntax->open_assignments) {
+  if (c.env.syntax.open_assignments) {
     // The right-hand side is an expression without brackets (#1 = #1 + 1); a bare vacant
     // variable makes the target vacant too.
     const double v = expression(c, true);
@@ -925,7 +925,7 @@ double Parser::unary(Cursor& c) {
     ++c.pos;
     return v;
   }
-  const bool own = c.env.syntax != nullptr && c.env.syntax->own_functions;
+  const bool own = c.env.syntax.own_functions;
   if (op == kAtan && own && c.at() == '[') {
     // ATAN[y,x] too: read the two halves as open expressions.
     std::size_t depth = 0, comma = std::string_view::npos, close = c.pos;
@@ -1033,7 +1033,7 @@ void Parser::read_o_word(Cursor& c, Block& b) {
   ++c.pos;
   std::string name;
   if (c.at() == '<') {
-    if (c.env.syntax != nullptr && c.env.syntax->numbered_programs)
+    if (c.env.syntax.numbered_programs)
       fail_at(pos, ErrorCode::DialectUnsupported, "o<name> is LinuxCNC syntax: Fanuc programs are numbered (O1000)");
     name = read_name(c);
   } else {
@@ -1064,7 +1064,7 @@ void Parser::read_o_word(Cursor& c, Block& b) {
               kOwordKeywords);
     }
     type = OWord::Program;   // "O1234" alone: a program number
-  } else if (c.env.syntax != nullptr && c.env.syntax->numbered_programs) {
+  } else if (c.env.syntax.numbered_programs) {
     fail_at(pos, ErrorCode::DialectUnsupported,
             "O-word statements are LinuxCNC syntax: the Fanuc dialect uses M98/M99, G65, GOTO, IF and WHILE");
   } else if (c.env.skipping_to.empty()) {  // lines passed over are not checked further (LinuxCNC)

@@ -48,6 +48,7 @@ struct SyntaxRules {
   bool own_functions = false;     ///< FIX, ROUND … and ATAN[y,x] as the dialect defines them
 };
 
+
 /// Interpreter facts that change how a line reads.
 struct ParseEnv {
   const double* parameters = nullptr;   ///< kParameterCount numbered parameters
@@ -61,7 +62,7 @@ struct ParseEnv {
   bool defining_sub = false;            ///< passing over `o<name> sub` .. `endsub`
   std::string_view defining_name;
   std::string_view skipping_to;         ///< label being skipped to ("" = not skipping)
-  const SyntaxRules* syntax = nullptr;  ///< the dialect's (null: LinuxCNC's)
+  SyntaxRules syntax;  ///< the dialect's (a copy: the parser tests a flag per word)
   const Extensions* ext = nullptr;      ///< modal groups of codes the core does not know
   /// Macro variables: #0..#999 without a value.
   const std::bitset<kFanucVariableCount>* vacant = nullptr;
@@ -94,7 +95,7 @@ class Parser {
   };
 
   static bool macro_variables(const Cursor& c) noexcept {
-    return c.env.syntax != nullptr && c.env.syntax->macro_variables;
+    return c.env.syntax.macro_variables;
   }
   void read_line_number(Cursor& c, Block& b);
   void read_item(Cursor& c, Block& b);
