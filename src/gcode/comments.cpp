@@ -67,7 +67,7 @@ std::string Engine::expand_parameters(std::string_view text) {
       if (i >= text.size() || text[i] != '>') break;
       ++i;
       double v = 0;
-      const bool found = named_value(name, v);
+      const bool found = params_.named_value(name, v);
       append_value(out, found, v);
     } else {
       out += '#';

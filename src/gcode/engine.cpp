@@ -29,7 +29,7 @@ Engine::Engine(Options options)
   norm_.resize(1 << 12);
   raw_.reserve(512);
   st_.modal.units = opt_.initial_units;
-  update_unit_factor();
+  offsets_.update_unit_factor();
   st_.parameters[5220] = 1.0;   // G54
   st_.parameters[5599] = 1.0;   // (DEBUG,...) messages on
   st_.frames.emplace_back();
@@ -38,7 +38,7 @@ Engine::Engine(Options options)
   if (opt_.tool_table) {
     for (const auto& e : opt_.tool_table->entries()) st_.tool.table.push_back(e);
   }
-  set_tool_parameters();
+  mcodes_.set_tool_parameters();
   letters_ = 0;
   for (char c : std::string_view("defghijklmpqrst")) letters_ |= 1u << (c - 'a');
   // A program letter reads if the machine has the axis the axis map sends it to.
@@ -113,8 +113,8 @@ void Engine::start() {
     const bool linear = !is_rotary(static_cast<Axis>(i));
     const double o = st_.parameters[static_cast<std::size_t>(base + 1 + i)];
     const double g = st_.parameters[static_cast<std::size_t>(5211 + i)];
-    st_.position.origin_offset[i] = linear ? user_to_program(o) : o;
-    st_.position.axis_offset[i] = linear ? user_to_program(g) : g;
+    st_.position.origin_offset[i] = linear ? offsets_.user_to_program(o) : o;
+    st_.position.axis_offset[i] = linear ? offsets_.user_to_program(g) : g;
   }
   st_.position.rotation_xy_deg = st_.parameters[static_cast<std::size_t>(base + 10)];
   out_.use_length_units(st_.modal.units);
@@ -252,7 +252,7 @@ RunStatus Engine::mdi_continue(canon::Sink& sink) {
   in_mdi_ = false;
   if (s == RunStatus::Error) {
     failed_ = false;
-    abandon_calls();
+    flow_.abandon_calls();
   }
   return s == RunStatus::Finished ? RunStatus::Ok : s;
 }
@@ -285,30 +285,15 @@ RunStatus Engine::mdi(std::string_view line, canon::Sink& sink) {
   in_mdi_ = false;
   if (s == RunStatus::Error) {   // an MDI error does not end the session
     failed_ = false;
-    abandon_calls();
+    flow_.abandon_calls();
   }
   return s == RunStatus::Finished ? RunStatus::Ok : s;
-}
-
-// An MDI line failed inside the subprogram it called: every call is left as if it had returned
-// (arguments or macro locals back as they were), so the next line runs in the session's frame.
-void Engine::abandon_calls() {
-  while (st_.frames.size() > 1) {
-    const CallFrame& f = st_.frames.back();
-    if (!(dialect_.leave_call && dialect_.leave_call(*this, f))) {
-      for (int i = 0; i < kSubArgumentCount; ++i)
-        st_.parameters[static_cast<std::size_t>(1 + i)] = f.saved_args[static_cast<std::size_t>(i)];
-    }
-    leave_frame();
-  }
-  st_.control.skipping_to.clear();
-  st_.control.seeking_sub.clear();
 }
 
 ParseEnv Engine::parse_env() const noexcept {
   ParseEnv env;
   env.parameters = st_.parameters.data();
-  env.host = const_cast<Engine*>(this);
+  env.host = const_cast<ParameterHost*>(&params_);
   env.letters = letters_;
   env.mapped_away = mapped_away_;
   env.lathe_diameter = st_.modal.lathe_diameter;
@@ -445,7 +430,7 @@ bool Engine::process_line() {
     if (in_mdi_ && block_.o_type != OWord::Call && block_.o_type != OWord::MacroCall && block_.o_type != OWord::M98)
       fail(ErrorCode::OwordInMdi,
            "only 'call' O-words and subprogram calls can be used in MDI: control flow needs a program file");
-    control_flow();
+    flow_.control_flow();
     if (dialect_.block_done && block_.o_type != OWord::BlockRange) dialect_.block_done(*this, true);
     if (in_mdi_) finish_mdi_call();
     return true;
@@ -531,7 +516,7 @@ void Engine::sub_not_found() {
 // The file ended while passing over a block to its end label: the block was never closed.
 void Engine::unclosed_block() {
   const std::string& key = st_.control.skipping_to;
-  const LabelInfo* l = find_label(key);
+  const LabelInfo* l = flow_.find_label(key);
   if (l == nullptr)
     fail(ErrorCode::OwordUnclosed, "the file ends inside an O-word block that is never closed");
   const char* kind = label_kind_name(l->kind);
@@ -672,7 +657,7 @@ Pose Engine::program_position(const Pose& machine_mm) const {
     const bool linear = i < 3 || i >= 6;
     m[i] = linear ? v / unit : v;
   }
-  return machine_to_program(m);
+  return offsets_.machine_to_program(m);
 }
 
 void Engine::set_machine_position(const Pose& machine_mm) {
@@ -693,26 +678,7 @@ void Engine::set_tool_table(const std::shared_ptr<const tools::ToolTable>& table
   if (index > 0 && static_cast<std::size_t>(index) < t.size() && t[static_cast<std::size_t>(index)].tool == t[0].tool)
     t[0] = t[static_cast<std::size_t>(index)];
   opt_.tool_table = table;
-  set_tool_parameters();
-}
-
-// --- extension facade ---------------------------------------------------------------------
-
-void Engine::straight(bool rapid, const Pose& end) { emit_straight(rapid, end); }
-void Engine::arc(const canon::ArcFeed& a) { emit_arc(a); }
-
-void Engine::programmed_move(int motion, const Block& words) {
-  if (motion != 0 && motion != 10 && motion != 20 && motion != 30)
-    fail(ErrorCode::Unsupported, "G{} cannot be programmed by an extension", motion / 10.0);
-  // The handler's block is block_: lend block_ to the move and give it back afterwards.
-  struct Restore {
-    Block& target;
-    Block saved;
-    ~Restore() { target = std::move(saved); }
-  } restore{block_, block_};
-  block_ = words;
-  block_.motion = motion;
-  convert_motion(motion);
+  mcodes_.set_tool_parameters();
 }
 
 Engine::SavedLine Engine::save_line() {
@@ -734,57 +700,6 @@ void Engine::restore_line(SavedLine& saved, const canon::BlockOrigin& n_from) {
   line_file_ = saved.file;
   line_offset_ = saved.offset;
   out_.set_origin(origin);
-}
-
-void Engine::read_subprogram(const std::string& name, std::uint32_t extra_letters,
-                             const std::function<void(const Block&)>& visit) {
-  // The executing block's line: the cycle's moves and errors belong to it afterwards.
-  struct Modes {
-    Engine& e;
-    std::uint32_t letters;
-    bool mdi;
-    ~Modes() {   // also on errors: an MDI session goes on with the machine's letters
-      e.letters_ = letters;
-      e.in_mdi_ = mdi;
-    }
-  } modes{*this, letters_, in_mdi_};
-  SavedLine saved = save_line();
-  letters_ |= extra_letters;
-  const std::size_t depth = st_.frames.size();
-  block_.clear();
-  block_.o_type = OWord::Call;
-  block_.o_name = name;
-  o_call();          // from MDI, a sub neither defined nor on the search path fails here
-  in_mdi_ = false;   // the sub's lines come from its file, also when MDI calls the cycle
-  while (st_.frames.size() > depth) {
-    const LineKind kind = read_block();
-    if (kind == LineKind::ProgramEnd) fail(ErrorCode::MissingProgramEnd, "the program ends inside the subprogram o<{}>", name);
-    if (kind == LineKind::Empty) continue;
-    if (block_.o_type != OWord::None) {
-      control_flow();
-      continue;
-    }
-    if (!st_.control.skipping_to.empty()) continue;
-    apply_assignments();
-    visit(block_);
-  }
-  // rs274 labels the cycle's moves with the N word of the last line it read.
-  const canon::BlockOrigin last = out_.origin();
-  restore_line(saved, last);
-}
-
-// A dialect's block ranges (G71/G72 P Q): the program's own blocks read, not run.
-void Engine::read_block_range(std::int64_t first, std::int64_t last, std::string_view what,
-                              const std::function<void(const Block&)>& visit) {
-  if (!dialect_.read_block_range)
-    fail(ErrorCode::DialectUnsupported, "{} P Q reads numbered blocks, which this dialect does not have",
-         what);
-  dialect_.read_block_range(*this, first, last, what, visit);
-}
-
-// The dialect's system variables (ParamHost).
-bool Engine::computed_variable(int index, double& value) {
-  return dialect_.computed_variable != nullptr && dialect_.computed_variable(*this, index, value);
 }
 
 InterpState Engine::snapshot() const {

@@ -12,8 +12,13 @@
 #include <string_view>
 #include <vector>
 
+#include "control_flow.hpp"
 #include "dialect_hooks.hpp"
+#include "extension_context.hpp"
 #include "gcode_error.hpp"
+#include "mcodes.hpp"
+#include "modal_codes.hpp"
+#include "offsets.hpp"
 #include "opencnc/canon/source_map.hpp"
 #include "opencnc/core/diagnostic.hpp"
 #include "opencnc/gcode/block.hpp"
@@ -22,6 +27,7 @@
 #include "opencnc/gcode/options.hpp"
 #include "opencnc/gcode/state.hpp"
 #include "output.hpp"
+#include "params.hpp"
 #include "parser.hpp"
 #include "source_file.hpp"
 
@@ -36,6 +42,9 @@ constexpr int axis_of_letter(char c) noexcept {
     default: return -1;
   }
 }
+/// (x, y) turned by `degrees` counterclockwise about the origin (G68 rotation, motion.cpp).
+void rotate_xy(double& x, double& y, double degrees) noexcept;
+
 inline constexpr char kAxisWordLetters[kAxisCount] = {'x', 'y', 'z', 'a', 'b', 'c', 'u', 'v', 'w'};
 
 /// "sub", "while", ... for a label kind; the keyword that ends its block; "o100" or
@@ -44,12 +53,19 @@ const char* label_kind_name(LabelKind k) noexcept;
 const char* label_end_keyword(LabelKind k) noexcept;
 std::string label_text(std::string_view key);
 
-class Engine final : public ParamHost, public ExecContext {
+class Engine final {
+  // The engine's parts, each a file of this folder, reach its state as friends.
   friend class FanucDialect;  // the Fanuc dialect's hooks run the engine's lines and calls
+  friend class FlowControl;
+  friend class ExtensionContext;
+  friend class ParameterHost;
+  friend class ModalCodes;
+  friend class Offsets;
+  friend class MCodes;
 
  public:
   explicit Engine(Options options);
-  ~Engine() override;
+  ~Engine();
 
   // --- driving (engine.cpp) --------------------------------------------------------------
   bool open_file(const std::string& path);
@@ -69,41 +85,15 @@ class Engine final : public ParamHost, public ExecContext {
   /// M0, M1, M60 and the stops inside cycles: in execute mode the interpreter waits for the
   /// operator's cycle start there (offsets and tools may change meanwhile).
   void request_stop_sync();
+  /// The block needs machine feedback before the next one (ExecContext::request_sync).
+  void request_sync(const SyncValues& assumed);
   InterpState snapshot() const;
   std::uint64_t segments() const noexcept { return out_.segments(); }
   const Diagnostics& diagnostics() const noexcept { return diags_; }
   std::shared_ptr<canon::SourceMap> sources() const noexcept { return sources_; }
-  const Options& options() const override { return opt_; }
+  const Options& options() const { return opt_; }
   /// The dialect's own state (DialectHooks::make_state), for its hooks.
   DialectState* dialect_state() noexcept { return dialect_state_.get(); }
-
-  // --- ParamHost (params.cpp) ------------------------------------------------------------
-  bool named_value(std::string_view name, double& value) override;
-  void declare_named(std::string_view name) override;
-  bool computed_variable(int index, double& value) override;  // the dialect's (DialectHooks)
-
-  // --- ExecContext (extension facade, engine.cpp) ----------------------------------------
-  InterpState& state() override { return st_; }
-  Pose end_point(const Block& block) override { return find_ends(block); }
-  canon::Sink& output() override { return out_; }
-  void straight(bool rapid, const Pose& end) override;
-  void arc(const canon::ArcFeed& arc) override;
-  ArcCentre arc_centre(const Block& block, int motion, const Pose& start, const Pose& end) override;
-  void programmed_move(int motion, const Block& words) override;
-  void read_subprogram(const std::string& name, std::uint32_t extra_letters,
-                       const std::function<void(const Block&)>& visit) override;
-  void read_block_range(std::int64_t first, std::int64_t last, std::string_view what,
-                        const std::function<void(const Block&)>& visit) override;
-  void open_queue() override { out_.open_queue(); }
-  void flush_queue() override { out_.flush_queue(); }
-  std::size_t queued() const override { return out_.queued(); }
-  void move_queued_end(canon::Plane plane, double first, double second) override {
-    out_.move_queued_end(plane, first, second);
-  }
-  void request_sync(const SyncValues& assumed) override;
-  [[noreturn]] void error(ErrorCode code, const std::string& message) override {
-    throw GcodeError(code, message, extension_at_);
-  }
 
  private:
   // Points the errors an extension raises through error() at `at` while it runs (an outer
@@ -155,6 +145,7 @@ class Engine final : public ParamHost, public ExecContext {
   [[gnu::always_inline]] inline LineKind read_block();
   LineKind next_block();  ///< read_block() out of line, for a dialect reading a block range
   bool process_line();
+  void finish_mdi_call();
   void report(const GcodeError& e);
   [[noreturn]] void sub_not_found();
   [[noreturn]] void unclosed_block();
@@ -198,17 +189,6 @@ class Engine final : public ParamHost, public ExecContext {
   void execute_block();
   void apply_assignments();
   void convert_g();
-  void convert_m();
-  void set_plane(int code);
-  void set_units(int code);
-  void set_lathe_mode(int code);
-  void set_control_mode(int code);
-  void set_distance_mode(int code);
-  void set_ijk_mode(int code);
-  void set_retract_mode(int code);
-  void set_feed_mode(int code);
-  void set_spindle_mode();
-  void set_cutter_comp(int code);
   bool run_extension_g(int code);
   bool run_extension_m(int code);
   [[noreturn]] void unsupported_g(int code, int at);
@@ -233,86 +213,11 @@ class Engine final : public ParamHost, public ExecContext {
   void emit_straight(bool rapid, const Pose& end);
   void emit_arc(const canon::ArcFeed& arc);
 
-  // offsets.cpp: coordinate systems, G10, G92/G52, G28/G30, tool length offset
-  void convert_modal_0(int code);
-  void set_coordinate_system(int code);
-  void g10_coordinate_system();
-  void g10_tool();
-  void axis_offsets(int code);
-  void go_home(int code);
-  void save_home(int code);
-  void tool_length_offset(int code);
-  Pose current_in_system(int system, bool without_tlo) const;
-  Pose machine_to_program(const Pose& machine_user) const;
-  Pose program_to_machine(const Pose& program) const;  ///< machine_to_program's inverse
-  void rotate(double& x, double& y, double degrees) const noexcept;
-  double user_to_program(double v) const noexcept { return v * user_to_program_factor_; }
-  double program_to_user(double v) const noexcept { return v / user_to_program_factor_; }
-  void update_unit_factor() noexcept;
-
-  // mcodes.cpp: M codes, tools, program stop/end
-  void convert_io();
-  void convert_tool_change_group();
-  void convert_spindle_group();
-  void convert_coolant();
-  void convert_overrides();
-  void select_tool(int tool);
-  void change_tool();
-  void move_to_tool_change(int at);  ///< `at`: where the M6 starts (its errors point there)
-  void set_tool_number(int tool);
-  void load_spindle(int index);
-  void set_tool_parameters();
-  int tool_index(int tool, int at) const;  ///< `at`: where the word naming the tool starts
-  int pocket_of(int index) const noexcept;
-  void convert_stop();
-  void end_program(int code);
-  SavedContext active_context() const;
-  void save_context(bool restore_on_return);
-  void restore_context(const SavedContext& saved);
-  void execute_text(std::string_view text);
-
   // comments.cpp
   void convert_comment(std::string_view comment);
   std::string expand_parameters(std::string_view text);
 
-  // control_flow.cpp: O-words
-  void control_flow();
-  void o_sub();
-  void o_return();
-  void o_call();
-  void o_do();
-  void o_while();
-  void o_repeat();
-  void o_if();
-  void o_elseif();
-  void o_else();
-  void o_endif();
-  void o_break_continue(bool is_break);
-  void o_end_loop();
-  void o_program();
-  void o_m98();
-  void o_m99();
-  void enter_sub(CallFrame frame, std::string name, std::string_view context_name);
-  [[noreturn]] void mixed_styles(const char* what) const;
-  void repeat_main();
-  LabelInfo* find_label(const std::string& name);
-  [[noreturn]] void unmatched(const char* keyword, const char* opener,
-                              const char* other_opener = nullptr) const;
-  [[noreturn]] void mismatched(const char* keyword, const LabelInfo& label) const;
-  void save_label(LabelKind kind);
-  void jump_to_label(const std::string& name);
-  bool open_sub_file(const std::string& name);
-  void count_loop();
-  void leave_frame();
-
-  // The dialect's side (DialectHooks: fanuc/ for the Fanuc dialect).
-  void finish_mdi_call();
-  void abandon_calls();
-
   // params.cpp
-  bool predefined_value(std::string_view name, double& value) const;
-  bool is_predefined(std::string_view name) const noexcept;
-  void store_named(const std::string& name, double value);
   void update_position_parameters();
 
   Options opt_;
@@ -349,8 +254,6 @@ class Engine final : public ParamHost, public ExecContext {
   bool units_programmed_ = false;   ///< a G20/G21 was met (for the units warning)
   bool warned_units_ = false;
   bool warned_spindle_ = false;
-  bool warned_repeat_ = false;      ///< M99 ended the main program (the repeat warning)
-  double user_to_program_factor_ = 1.0;
   std::uint32_t line_ = 0;          ///< line number of the block being executed
   std::uint32_t line_file_ = 0;     ///< its file
   std::uint64_t line_offset_ = 0;   ///< its byte offset
@@ -359,6 +262,12 @@ class Engine final : public ParamHost, public ExecContext {
   std::unique_ptr<DialectState> dialect_state_;  ///< the dialect's own (null: none)
   std::vector<char> norm_;          ///< normalised text of the line
   std::size_t norm_len_ = 0;
+  FlowControl flow_{*this};      ///< O-words and call frames
+  ExtensionContext ctx_{*this};  ///< what the extensions see
+  ParameterHost params_{*this};  ///< named parameters, the parser's host
+  ModalCodes modes_{*this};      ///< modal settings
+  Offsets offsets_{*this};       ///< units and coordinate transforms
+  MCodes mcodes_{*this};         ///< M codes and tools
 };
 
 }  // namespace opencnc::gcode

@@ -45,7 +45,7 @@ char plane_letter(canon::Plane p, int which) {
 
 }  // namespace
 
-void Engine::rotate(double& x, double& y, double degrees) const noexcept {
+void rotate_xy(double& x, double& y, double degrees) noexcept {
   const double t = degrees * kDegToRad;
   const double xx = x * std::cos(t) - y * std::sin(t);
   const double yy = x * std::sin(t) + y * std::cos(t);
@@ -78,10 +78,10 @@ Pose Engine::find_ends(const Block& b) {
               "polar coordinates (@ ^) cannot be used with G53: give X and Y");
     double cx = s.current[0] + s.axis_offset[0];
     double cy = s.current[1] + s.axis_offset[1];
-    rotate(cx, cy, s.rotation_xy_deg);
+    rotate_xy(cx, cy, s.rotation_xy_deg);
     double x = b.has('x') ? b.get('x') - s.origin_offset[0] - s.tool_offset[0] : cx;
     double y = b.has('y') ? b.get('y') - s.origin_offset[1] - s.tool_offset[1] : cy;
-    rotate(x, y, -s.rotation_xy_deg);
+    rotate_xy(x, y, -s.rotation_xy_deg);
     end[0] = x - s.axis_offset[0];
     end[1] = y - s.axis_offset[1];
     if (b.has('z')) end[2] = b.get('z') - s.origin_offset[2] - s.axis_offset[2] - s.tool_offset[2];
@@ -184,7 +184,7 @@ void Engine::convert_motion(int motion) {
 void Engine::emit_straight(bool rapid, const Pose& end) {
   if (st_.modal.cutter_comp != CutterComp::Off && st_.modal.comp_radius > 0.0 && ext_ != nullptr && ext_->compensator) {
     const ExtensionSite site(*this, block_.motion_position());
-    ext_->compensator->straight(*this, rapid, end);
+    ext_->compensator->straight(ctx_, rapid, end);
     return;
   }
   if (rapid) out_.straight_traverse(0, end);
@@ -333,10 +333,10 @@ void Engine::convert_arc(int motion) {
   if (st_.modal.cutter_comp != CutterComp::Off && st_.modal.comp_radius > 0.0 && m.plane != canon::Plane::YZ &&
       ext_ != nullptr && ext_->compensator) {
     const ExtensionSite site(*this, at);
-    ext_->compensator->arc(*this, b, motion, end);
+    ext_->compensator->arc(ctx_, b, motion, end);
     return;
   }
-  const ArcCentre c = arc_centre(b, motion, st_.position.current, end);
+  const ArcCentre c = ctx_.arc_centre(b, motion, st_.position.current, end);
   canon::ArcFeed arc;
   arc.plane = m.plane;
   arc.first_end = end[a1];
@@ -349,8 +349,8 @@ void Engine::convert_arc(int motion) {
   emit_arc(arc);
 }
 
-ArcCentre Engine::arc_centre(const Block& b, int motion, const Pose& start, const Pose& end) {
-  const canon::Plane p = st_.modal.plane;
+ArcCentre ExtensionContext::arc_centre(const Block& b, int motion, const Pose& start, const Pose& end) {
+  const canon::Plane p = e_.st_.modal.plane;
   // Plane axes (first, second, normal) and the centre offsets in that order (XZ: K then I).
   int a1 = 0, a2 = 1, a3 = 2;
   double off1 = b.get('i'), off2 = b.get('j');
@@ -358,9 +358,13 @@ ArcCentre Engine::arc_centre(const Block& b, int motion, const Pose& start, cons
   if (p == canon::Plane::YZ) a1 = 1, a2 = 2, a3 = 0, off1 = b.get('j'), off2 = b.get('k');
   const int turns = b.has('p') ? round_to_int(b.get('p')) : 1;
   ArcCentre c;
-  if (b.has('r')) arc_center_r(motion, start[a1], start[a2], end[a1], end[a2], b.get('r'), turns, c.first, c.second, c.turn);
-  else arc_center_ijk(motion, start[a1], start[a2], end[a1], end[a2], off1, off2, turns, c.first, c.second, c.turn);
-  inverse_time_arc(start[a1], start[a2], start[a3], c.first, c.second, c.turn, end[a1], end[a2], end[a3]);
+  if (b.has('r'))
+    e_.arc_center_r(motion, start[a1], start[a2], end[a1], end[a2], b.get('r'), turns, c.first, c.second,
+                    c.turn);
+  else
+    e_.arc_center_ijk(motion, start[a1], start[a2], end[a1], end[a2], off1, off2, turns, c.first, c.second,
+                      c.turn);
+  e_.inverse_time_arc(start[a1], start[a2], start[a3], c.first, c.second, c.turn, end[a1], end[a2], end[a3]);
   return c;
 }
 

@@ -102,7 +102,7 @@ void FanucDialect::go_to(std::int64_t n) {
   while (!loops.empty() &&
          !(loops.back().start.offset <= to.offset && to.offset < loops.back().after_end.offset))
     loops.pop_back();
-  e_.count_loop();
+  e_.flow_.count_loop();
   e_.jump_to(to);
 }
 
@@ -150,7 +150,7 @@ void FanucDialect::end_do() {
     fail(ErrorCode::FanucLoopStructure, "END {} on line {} does not close the DO {} of line {}", id, e_.line_,
          id, loop.start.line);
   loops.resize(k - 1);  // the loop and any left inside it by a GOTO
-  e_.count_loop();
+  e_.flow_.count_loop();
   e_.jump_to(loop.start);  // its WHILE decides whether it runs again
 }
 
@@ -259,7 +259,7 @@ void FanucDialect::block_done() {
   if (!f.range || e_.line_file_ != f.range_end.file || e_.line_offset_ != f.range_end.offset) return;
   e_.emit_straight(true, f.range_return);
   e_.jump_to(e_.st_.frames.back().return_to);
-  e_.leave_frame();
+  e_.flow_.leave_frame();
 }
 
 // M99: the next run of an M98 L / G65 L repeat, or back to the caller (to its block N P with
@@ -272,12 +272,12 @@ void FanucDialect::return_from_call() {
     const SourcePosition to = target > 0 ? sequence(f.body, target, "M99 P") : f.body;
     if (e_.opt_.mode == Mode::Scan) {
       e_.out_.comment("fanuc: M99 ends the main program here; on the machine it runs again");
-      e_.end_program(2);
+      e_.mcodes_.end_program(2);
       return;
     }
     f.loops.clear();
     f.started = target > 0;
-    e_.count_loop();
+    e_.flow_.count_loop();
     e_.jump_to(to);
     return;
   }
@@ -298,7 +298,7 @@ void FanucDialect::return_from_call() {
   }
   SourcePosition to = e_.st_.frames.back().return_to;
   if (target > 0) to = sequence(e_.st_.frames[e_.st_.frames.size() - 2].fanuc.body, target, "M99 P");
-  e_.leave_frame();
+  e_.flow_.leave_frame();
   auto& loops = e_.st_.frames.back().fanuc.loops;
   while (!loops.empty() &&
          !(loops.back().start.offset <= to.offset && to.offset < loops.back().after_end.offset))

@@ -153,7 +153,7 @@ void FanucDialect::assignments() {
     // bitset's out_of_range here).
     if (index < kFanucVariableCount) vacant.set(static_cast<std::size_t>(index));
   }
-  for (const auto& [name, value] : e_.parser_.named_assignments) e_.store_named(name, value);
+  for (const auto& [name, value] : e_.parser_.named_assignments) e_.params_.store_named(name, value);
 }
 
 }  // namespace opencnc::gcode
