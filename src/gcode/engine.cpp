@@ -406,8 +406,8 @@ Engine::LineKind Engine::read_block() {
   parser_.parse(text, parse_env(), block_);
   if (dialect_.translate) dialect_.translate(*this);
   if (!skipping) {
-    enhance_block();
-    check_block();
+    checks_.enhance_block();
+    checks_.check_block();
   }
   return LineKind::Block;
 }

@@ -12,6 +12,7 @@
 #include <string_view>
 #include <vector>
 
+#include "check.hpp"
 #include "control_flow.hpp"
 #include "dialect_hooks.hpp"
 #include "extension_context.hpp"
@@ -57,6 +58,7 @@ class Engine final {
   // The engine's parts, each a file of this folder, reach its state as friends.
   friend class FanucDialect;  // the Fanuc dialect's hooks run the engine's lines and calls
   friend class FlowControl;
+  friend class BlockChecks;
   friend class ExtensionContext;
   friend class ParameterHost;
   friend class ModalCodes;
@@ -163,28 +165,6 @@ class Engine final {
   ParseEnv parse_env() const noexcept;
   void apply_sync(const SyncValues& values);
 
-  // check.cpp: LinuxCNC's checks after reading a block
-  void enhance_block();
-  void check_block();
-  void check_g_codes();
-  void check_g10();
-  void check_other_codes();
-  void check_p_word();
-  void check_m98(const Block& b);
-  void check_extension(int code, int position);   ///< `code` must have a handler
-  /// The extension's handler of G code `code` (×10), nullptr if none (or code < 0).
-  const CodeHandler* extension_handler(int code) const noexcept {
-    return code >= 0 && ext_ != nullptr ? ext_->g[static_cast<std::size_t>(code)].get() : nullptr;
-  }
-  void check_word_rules(const Block& b);
-  void check_per_turn(const Block& b);
-  struct ExtensionClaims {
-    std::uint32_t words = 0;
-    bool axis_words = false;
-    bool all_words = false;
-  };
-  ExtensionClaims extension_claims() const;
-
   // execute.cpp: order of execution within a block
   void execute_block();
   void apply_assignments();
@@ -263,6 +243,7 @@ class Engine final {
   std::vector<char> norm_;          ///< normalised text of the line
   std::size_t norm_len_ = 0;
   FlowControl flow_{*this};      ///< O-words and call frames
+  BlockChecks checks_{*this};  ///< LinuxCNC's checks of a block read
   ExtensionContext ctx_{*this};  ///< what the extensions see
   ParameterHost params_{*this};  ///< named parameters, the parser's host
   ModalCodes modes_{*this};      ///< modal settings

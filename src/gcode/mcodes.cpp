@@ -361,8 +361,8 @@ void MCodes::execute_text(std::string_view text) {
                                e_.norm_.begin() + static_cast<std::ptrdiff_t>(e_.norm_len_));
   const std::size_t n = normalize_line(e_.raw_, e_.norm_.data());
   e_.parser_.parse(std::string_view(e_.norm_.data(), n), e_.parse_env(), e_.block_);
-  e_.enhance_block();
-  e_.check_block();
+  e_.checks_.enhance_block();
+  e_.checks_.check_block();
   e_.apply_assignments();
   e_.execute_block();
   e_.block_ = saved_block;
