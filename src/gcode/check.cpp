@@ -142,7 +142,7 @@ void BlockChecks::check_block() {
 BlockChecks::ExtensionClaims BlockChecks::extension_claims() const {
   ExtensionClaims claims;
   const int motion = e_.block_.g[kGroupMotion] != -1 ? e_.block_.g[kGroupMotion] : e_.block_.motion;
-  if (!e_.block_.extension_groups && extension_handler(motion) == nullptr) return claims;   // most blocks
+  if (!e_.block_.extension_groups && extension_handler(motion) == nullptr) return claims;  // most blocks
   auto ask = [&](int code) {
     const CodeHandler* h = extension_handler(code);
     if (h == nullptr) return;
@@ -152,7 +152,8 @@ BlockChecks::ExtensionClaims BlockChecks::extension_claims() const {
     claims.all_words = claims.all_words || t.all_words;
   };
   if (e_.block_.extension_groups) {
-    for (int group = kGroupScaling; group < kGGroupCount; ++group) ask(e_.block_.g[static_cast<std::size_t>(group)]);
+    for (int group = kGroupScaling; group < kGGroupCount; ++group)
+      ask(e_.block_.g[static_cast<std::size_t>(group)]);
   }
   ask(motion);
   return claims;
@@ -187,7 +188,8 @@ void BlockChecks::check_g_codes() {
     if (b.motion != 0 && b.motion != 10)
       fail_at(at0, ErrorCode::G53Motion, "G53 moves in machine coordinates with G0 or G1 only, not {}",
               g_name(b.motion));
-    if (b.g[kGroupDistance] == 910 || (b.g[kGroupDistance] != 900 && e_.st_.modal.distance == DistanceMode::Incremental))
+    if (b.g[kGroupDistance] == 910 ||
+        (b.g[kGroupDistance] != 900 && e_.st_.modal.distance == DistanceMode::Incremental))
       fail_at(at0, ErrorCode::G53Incremental,
               "G53 takes absolute machine coordinates: it cannot be used in G91 (add G90)");
   }

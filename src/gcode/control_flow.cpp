@@ -52,7 +52,7 @@ LabelInfo* FlowControl::find_label(const std::string& name) {
 void FlowControl::save_label(LabelKind kind) {
   LabelInfo info;
   info.kind = kind;
-  info.at = {e_.line_file_, e_.line_offset_, e_.line_};
+  info.at = {e_.line_.file, e_.line_.offset, e_.line_.number};
   e_.st_.control.labels[e_.block_.o_name] = info;
 }
 
@@ -121,7 +121,7 @@ void FlowControl::o_sub() {
     mixed_styles(fmt::format("o{} sub reached by M98", e_.block_.o_name).c_str());
   auto define = [&] {
     if (const LabelInfo* old = find_label(e_.block_.o_name)) {
-      if (old->at.line == e_.line_ && old->at.file == e_.line_file_)
+      if (old->at.line == e_.line_.number && old->at.file == e_.line_.file)
         fail(ErrorCode::OwordSubRedefined,
              "{} sub is read a second time: a subprogram cannot be defined inside a loop or an if",
              label_text(e_.block_.o_name));
@@ -143,7 +143,7 @@ void FlowControl::o_sub() {
   define();
   // A definition in the flow of the program: pass over its body.
   c.skipping_to = e_.block_.o_name;
-  c.skip_start_line = e_.line_;
+  c.skip_start_line = e_.line_.number;
   c.defining_sub = true;
   c.defining_name = e_.block_.o_name;
 }
@@ -224,18 +224,18 @@ void FlowControl::enter_sub(CallFrame frame, std::string name, std::string_view 
   c.skipping_to.clear();
   frame.sub = name;
   const std::uint32_t parent_context = e_.st_.frames.back().context;
-  const canon::SourceRef call_site{e_.line_file_, e_.line_, raw_column(e_.raw_, e_.block_.o_at)};
+  const canon::SourceRef call_site{e_.line_.file, e_.line_.number, raw_column(e_.line_.raw, e_.block_.o_at)};
   e_.st_.frames.push_back(std::move(frame));
   if (const std::size_t slash = name.rfind('/'); slash != std::string::npos) name = name.substr(slash + 1);
   if (const LabelInfo* l = find_label(name); l != nullptr && l->kind == LabelKind::Sub) {
     e_.jump_to(l->at);
   } else {
-    if (!open_sub_file(name) && e_.in_mdi_)
+    if (!open_sub_file(name) && e_.mdi_.active)
       fail(ErrorCode::OwordSubNotFound, "{} is not defined, and no file {}.ngc is on the subroutine path",
            m98 ? fmt::format("O{}", name) : fmt::format("o<{}>", name), name);
     c.skipping_to = name;
     c.seeking_sub = name;
-    c.skip_start_line = e_.line_;
+    c.skip_start_line = e_.line_.number;
   }
   e_.st_.frames.back().context =
       e_.sources_->context(parent_context, call_site, e_.st_.next.file, std::string(context_name));
@@ -278,7 +278,7 @@ void FlowControl::o_m98() {
   CallFrame frame;
   frame.kind = CallKind::Numbered;
   frame.return_to = e_.st_.next;
-  if (e_.block_.has('l') && e_.in_mdi_) {
+  if (e_.block_.has('l') && e_.mdi_.active) {
     // An MDI line is not read again: the body runs again from its M99 (L0: not at all).
     if (round_to_int(e_.block_.get('l')) == 0) return;
     frame.m98_runs_left = round_to_int(e_.block_.get('l')) - 1;
@@ -287,7 +287,7 @@ void FlowControl::o_m98() {
     --caller.m98_left;
     if (caller.m98_left > 0) {
       count_loop();
-      frame.return_to = {e_.line_file_, e_.line_offset_, e_.line_};
+      frame.return_to = {e_.line_.file, e_.line_.offset, e_.line_.number};
     } else {
       caller.m98_left = -1;
     }
@@ -340,7 +340,7 @@ void FlowControl::o_while() {
   ControlState& c = e_.st_.control;
   LabelInfo* l = find_label(e_.block_.o_name);
   if (l != nullptr) {
-    if (l->kind != LabelKind::Do && l->at.line != e_.line_)
+    if (l->kind != LabelKind::Do && l->at.line != e_.line_.number)
       fail(ErrorCode::OwordLabelDuplicate, "{} is already used on line {}: give this {} its own label",
            label_text(e_.block_.o_name), l->at.line, "while");
   } else {
@@ -351,7 +351,7 @@ void FlowControl::o_while() {
   if (l->kind == LabelKind::While) {
     if (e_.block_.o_value == 0.0) {
       c.skipping_to = e_.block_.o_name;
-      c.skip_start_line = e_.line_;
+      c.skip_start_line = e_.line_.number;
     }
     return;
   }
@@ -368,7 +368,7 @@ void FlowControl::o_repeat() {
   ControlState& c = e_.st_.control;
   LabelInfo* l = find_label(e_.block_.o_name);
   if (l != nullptr) {
-    if (l->at.line != e_.line_)
+    if (l->at.line != e_.line_.number)
       fail(ErrorCode::OwordLabelDuplicate, "{} is already used on line {}: give this {} its own label",
            label_text(e_.block_.o_name), l->at.line, "repeat");
   } else {
@@ -389,7 +389,7 @@ void FlowControl::o_repeat() {
     --l->repeat_left;
   } else {
     c.skipping_to = e_.block_.o_name;
-    c.skip_start_line = e_.line_;
+    c.skip_start_line = e_.line_.number;
     l->repeat_left = -1;
   }
 }
@@ -397,7 +397,7 @@ void FlowControl::o_repeat() {
 void FlowControl::o_if() {
   ControlState& c = e_.st_.control;
   if (const LabelInfo* l = find_label(e_.block_.o_name)) {
-    if (l->at.line != e_.line_)
+    if (l->at.line != e_.line_.number)
       fail(ErrorCode::OwordLabelDuplicate, "{} is already used on line {}: give this {} its own label",
            label_text(e_.block_.o_name), l->at.line, "if");
   } else {
@@ -408,7 +408,7 @@ void FlowControl::o_if() {
     c.executed_if = true;
   } else {
     c.skipping_to = e_.block_.o_name;
-    c.skip_start_line = e_.line_;
+    c.skip_start_line = e_.line_.number;
     c.executed_if = false;
   }
 }
@@ -435,7 +435,7 @@ void FlowControl::o_elseif() {
   if (l->kind != LabelKind::If) mismatched("elseif", *l);
   if (c.executed_if) {
     c.skipping_to = e_.block_.o_name;
-    c.skip_start_line = e_.line_;
+    c.skip_start_line = e_.line_.number;
     return;
   }
   if (e_.block_.o_value != 0.0) {
@@ -451,7 +451,7 @@ void FlowControl::o_else() {
   if (l->kind != LabelKind::If) mismatched("else", *l);
   if (c.executed_if) {
     c.skipping_to = e_.block_.o_name;
-    c.skip_start_line = e_.line_;
+    c.skip_start_line = e_.line_.number;
     return;
   }
   if (c.skipping_to == e_.block_.o_name) {
@@ -477,7 +477,7 @@ void FlowControl::o_break_continue(bool is_break) {
   if (l->kind != LabelKind::While && l->kind != LabelKind::Do) mismatched(what, *l);
   if (!is_break && c.skipping_to == e_.block_.o_name) return;
   c.skipping_to = e_.block_.o_name;
-  c.skip_start_line = e_.line_;
+  c.skip_start_line = e_.line_.number;
   if (is_break) c.doing_break = true;
   else c.doing_continue = true;
 }

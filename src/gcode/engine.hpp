@@ -17,8 +17,10 @@
 #include "dialect_hooks.hpp"
 #include "extension_context.hpp"
 #include "gcode_error.hpp"
+#include "line_bounds.hpp"
 #include "mcodes.hpp"
 #include "modal_codes.hpp"
+#include "motion_codes.hpp"
 #include "offsets.hpp"
 #include "opencnc/canon/source_map.hpp"
 #include "opencnc/core/diagnostic.hpp"
@@ -31,6 +33,7 @@
 #include "params.hpp"
 #include "parser.hpp"
 #include "source_file.hpp"
+#include "sync_points.hpp"
 
 namespace opencnc::gcode {
 
@@ -54,6 +57,24 @@ const char* label_kind_name(LabelKind k) noexcept;
 const char* label_end_keyword(LabelKind k) noexcept;
 std::string label_text(std::string_view key);
 
+/// The line being executed: where it is, its text as read and as the parser reads it.
+struct CurrentLine {
+  std::uint32_t number = 0;  ///< its line number
+  std::uint32_t file = 0;    ///< its file (SourceMap index)
+  std::uint64_t offset = 0;  ///< its byte offset
+  std::string raw;           ///< the raw line (for messages and N labels)
+  std::vector<char> norm;    ///< normalised text (lower case, no spaces); norm_len chars of it
+  std::size_t norm_len = 0;
+};
+
+/// The MDI line being run, and the source-map file that stands for MDI.
+struct MdiInput {
+  bool active = false;     ///< lines come from `line`, not from the program's files
+  std::string line;        ///< the operator's line
+  std::uint32_t file = 0;  ///< "<mdi>" in the source map, once `registered`
+  bool registered = false;
+};
+
 class Engine final {
   // The engine's parts, each a file of this folder, reach its state as friends.
   friend class FanucDialect;  // the Fanuc dialect's hooks run the engine's lines and calls
@@ -64,6 +85,7 @@ class Engine final {
   friend class ModalCodes;
   friend class Offsets;
   friend class MCodes;
+  friend class MotionCodes;
 
  public:
   explicit Engine(Options options);
@@ -78,8 +100,8 @@ class Engine final {
   RunStatus mdi(std::string_view line, canon::Sink& sink);
   RunStatus run_some(canon::Sink& sink, std::uint64_t max_blocks);
   RunStatus mdi_continue(canon::Sink& sink);
-  SyncKind pending_sync() const noexcept { return pending_sync_; }
-  const SyncValues& sync_request() const noexcept { return sync_request_; }
+  SyncKind pending_sync() const noexcept { return sync_.pending(); }
+  const SyncValues& sync_request() const noexcept { return sync_.request(); }
   void sync(const SyncValues& values);
   void set_machine_position(const Pose& machine_mm);
   Pose program_position(const Pose& machine_mm) const;
@@ -118,11 +140,7 @@ class Engine final {
   // profiles) and put back afterwards with the N label `n_from` (engine.cpp).
   struct SavedLine {
     Block block;
-    std::string raw;
-    std::vector<char> norm;
-    std::size_t norm_len = 0;
-    std::uint32_t line = 0, file = 0;
-    std::uint64_t offset = 0;
+    CurrentLine line;
     canon::BlockOrigin origin;
   };
   SavedLine save_line();
@@ -154,7 +172,6 @@ class Engine final {
   void reject_foreign_syntax(std::string_view text) const;
   [[noreturn]] void line_too_long() const;
   void warn_once(bool& done, ErrorCode code, std::string_view message);
-  void check_motion_habits(bool feed);
   void set_origin_from_line();
   SourceFile& current_file() {
     const std::uint32_t file = st_.next.file;
@@ -163,7 +180,6 @@ class Engine final {
   SourceFile& source_at(std::uint32_t file);
   void jump_to(const SourcePosition& pos);
   ParseEnv parse_env() const noexcept;
-  void apply_sync(const SyncValues& values);
 
   // execute.cpp: order of execution within a block
   void execute_block();
@@ -174,28 +190,6 @@ class Engine final {
   [[noreturn]] void unsupported_g(int code, int at);
   void check_spindle_number(bool all_allowed) const;
   void convert_extension_groups();
-
-  // motion.cpp
-  Pose find_ends(const Block& b);
-  [[noreturn]] static void polar_with_xy(const Block& b);
-  [[noreturn]] static void polar_at_origin(const Block& b);
-  void check_feed(std::string_view what) const;
-  void convert_motion(int motion);
-  void convert_straight(int motion);
-  void convert_arc(int motion);
-  void arc_center_ijk(int motion, double cur1, double cur2, double end1, double end2, double off1, double off2,
-                      int turns, double& c1, double& c2, int& turn) const;
-  void arc_center_r(int motion, double cur1, double cur2, double end1, double end2, double radius, int turns,
-                    double& c1, double& c2, int& turn) const;
-  void inverse_time_straight(const Pose& end);
-  void inverse_time_arc(double c1, double c2, double c3, double cx, double cy, int turn, double e1, double e2,
-                        double e3);
-  void emit_straight(bool rapid, const Pose& end);
-  void emit_arc(const canon::ArcFeed& arc);
-
-  // comments.cpp
-  void convert_comment(std::string_view comment);
-  std::string expand_parameters(std::string_view text);
 
   // params.cpp
   void update_position_parameters();
@@ -214,41 +208,24 @@ class Engine final {
   bool has_program_ = false;
   bool need_seek_ = true;
   bool failed_ = false;
-  bool in_mdi_ = false;
-  std::string mdi_line_;
-  SyncKind pending_sync_ = SyncKind::None;
-  SyncValues block_sync_;           ///< scan mode: feedback assumed at the end of this block
-  SyncValues sync_request_;         ///< execute mode: what the pending sync point asked for
-  bool stop_after_sync_ = false;    ///< execute mode: a program stop follows the pending sync
+  MdiInput mdi_;                    ///< the operator's line, when MDI runs
+  SyncPoints sync_;                 ///< what the machine must answer, or scan mode assumes
   std::uint64_t block_budget_ = 0;  ///< run_some(): blocks left to execute
-  bool block_sync_pending_ = false;
   std::uint32_t letters_ = 0;       ///< letter words with a reader (axis mask applied)
   int extension_at_ = -1;  ///< where the code of the running extension starts (its errors point there)
   std::uint32_t mapped_away_ = 0;   ///< axis letters the axis map sends to a missing axis
-  std::uint32_t mdi_file_ = 0;
-  bool in_mdi_file_ = false;        ///< "<mdi>" is registered in the source map
-  std::uint64_t skipped_lines_ = 0; ///< lines passed over while seeking a label
-  std::uint64_t lines_read_ = 0;    ///< every line, for the time bound (Limits::max_seconds)
-  double cpu_at_start_s_ = 0;       ///< the thread's CPU time at the first line
-  void check_time();
-  bool units_programmed_ = false;   ///< a G20/G21 was met (for the units warning)
-  bool warned_units_ = false;
-  bool warned_spindle_ = false;
-  std::uint32_t line_ = 0;          ///< line number of the block being executed
-  std::uint32_t line_file_ = 0;     ///< its file
-  std::uint64_t line_offset_ = 0;   ///< its byte offset
-  std::string raw_;                 ///< the raw line (for messages and N labels)
+  LineBounds bounds_;               ///< the runaway program's limits
+  CurrentLine line_;                ///< the line being executed: where, raw and normalised
   DialectHooks dialect_;  ///< chosen when the program opens (Options::dialect); a copy, read without a pointer
   std::unique_ptr<DialectState> dialect_state_;  ///< the dialect's own (null: none)
-  std::vector<char> norm_;          ///< normalised text of the line
-  std::size_t norm_len_ = 0;
   FlowControl flow_{*this};      ///< O-words and call frames
-  BlockChecks checks_{*this};  ///< LinuxCNC's checks of a block read
+  BlockChecks checks_{*this};    ///< LinuxCNC's checks of a block read
   ExtensionContext ctx_{*this};  ///< what the extensions see
   ParameterHost params_{*this};  ///< named parameters, the parser's host
   ModalCodes modes_{*this};      ///< modal settings
   Offsets offsets_{*this};       ///< units and coordinate transforms
   MCodes mcodes_{*this};         ///< M codes and tools
+  MotionCodes motion_{*this};    ///< end points, moves, arcs
 };
 
 }  // namespace opencnc::gcode

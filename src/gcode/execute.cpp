@@ -2,6 +2,7 @@
 // The order of execution within a block (LinuxCNC's): comment, spindle and feed modes, F,
 // S, T, M codes, G codes by modal group, motion, then stops.
 
+#include "comments.hpp"
 #include "engine.hpp"
 
 namespace opencnc::gcode {
@@ -14,7 +15,7 @@ void Engine::apply_assignments() {
 
 void Engine::execute_block() {
   const Block& b = block_;
-  if (b.has_comment && !b.comment.empty()) convert_comment(b.comment);
+  if (b.has_comment && !b.comment.empty()) convert_comment(b.comment, st_, params_, out_);
   if (b.dollar_flag && (b.g[kGroupSpindleMode] != -1 || b.g[kGroupFeedMode] != -1))
     check_spindle_number(false);
   if (b.g[kGroupSpindleMode] != -1) modes_.set_spindle_mode();
@@ -57,7 +58,7 @@ void Engine::convert_g() {
   if (b.g[kGroupRetract] != -1) modes_.set_retract_mode(b.g[kGroupRetract]);
   if (b.extension_groups) convert_extension_groups();
   if (b.g[kGroupNonModal] != -1) offsets_.convert_modal_0(b.g[kGroupNonModal]);
-  if (b.motion != -1) convert_motion(b.motion);
+  if (b.motion != -1) motion_.convert_motion(b.motion);
 }
 
 // --- extensions ---------------------------------------------------------------------------

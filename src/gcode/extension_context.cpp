@@ -15,7 +15,7 @@ const Options& ExtensionContext::options() const {
   return e_.opt_;
 }
 Pose ExtensionContext::end_point(const Block& block) {
-  return e_.find_ends(block);
+  return e_.motion_.find_ends(block);
 }
 canon::Sink& ExtensionContext::output() {
   return e_.out_;
@@ -39,10 +39,10 @@ void ExtensionContext::error(ErrorCode code, const std::string& message) {
   throw GcodeError(code, message, e_.extension_at_);
 }
 void ExtensionContext::straight(bool rapid, const Pose& end) {
-  e_.emit_straight(rapid, end);
+  e_.motion_.emit_straight(rapid, end);
 }
 void ExtensionContext::arc(const canon::ArcFeed& a) {
-  e_.emit_arc(a);
+  e_.motion_.emit_arc(a);
 }
 
 void ExtensionContext::programmed_move(int motion, const Block& words) {
@@ -56,7 +56,7 @@ void ExtensionContext::programmed_move(int motion, const Block& words) {
   } restore{e_.block_, e_.block_};
   e_.block_ = words;
   e_.block_.motion = motion;
-  e_.convert_motion(motion);
+  e_.motion_.convert_motion(motion);
 }
 
 void ExtensionContext::read_subprogram(const std::string& name, std::uint32_t extra_letters,
@@ -68,9 +68,9 @@ void ExtensionContext::read_subprogram(const std::string& name, std::uint32_t ex
     bool mdi;
     ~Modes() {  // also on errors: an MDI session goes on with the machine's letters
       e.letters_ = letters;
-      e.in_mdi_ = mdi;
+      e.mdi_.active = mdi;
     }
-  } modes{e_, e_.letters_, e_.in_mdi_};
+  } modes{e_, e_.letters_, e_.mdi_.active};
   Engine::SavedLine saved = e_.save_line();
   e_.letters_ |= extra_letters;
   const std::size_t depth = e_.st_.frames.size();
@@ -78,7 +78,7 @@ void ExtensionContext::read_subprogram(const std::string& name, std::uint32_t ex
   e_.block_.o_type = OWord::Call;
   e_.block_.o_name = name;
   e_.flow_.o_call();   // from MDI, a sub neither defined nor on the search path fails here
-  e_.in_mdi_ = false;  // the sub's lines come from its file, also when MDI calls the cycle
+  e_.mdi_.active = false;  // the sub's lines come from its file, also when MDI calls the cycle
   while (e_.st_.frames.size() > depth) {
     const Engine::LineKind kind = e_.next_block();
     if (kind == Engine::LineKind::ProgramEnd)

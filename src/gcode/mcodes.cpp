@@ -352,22 +352,22 @@ void MCodes::restore_context(const SavedContext& saved) {
 
 void MCodes::execute_text(std::string_view text) {
   const Block saved_block = e_.block_;
-  const std::string saved_raw = e_.raw_;
+  const std::string saved_raw = e_.line_.raw;
   auto saved_numbered = e_.parser_.numbered_assignments;
   auto saved_named = e_.parser_.named_assignments;
-  e_.raw_.assign(text);
-  if (e_.norm_.size() < e_.raw_.size() + 1) e_.norm_.resize(e_.raw_.size() + 1);
-  std::vector<char> saved_norm(e_.norm_.begin(),
-                               e_.norm_.begin() + static_cast<std::ptrdiff_t>(e_.norm_len_));
-  const std::size_t n = normalize_line(e_.raw_, e_.norm_.data());
-  e_.parser_.parse(std::string_view(e_.norm_.data(), n), e_.parse_env(), e_.block_);
+  e_.line_.raw.assign(text);
+  if (e_.line_.norm.size() < e_.line_.raw.size() + 1) e_.line_.norm.resize(e_.line_.raw.size() + 1);
+  std::vector<char> saved_norm(e_.line_.norm.begin(),
+                               e_.line_.norm.begin() + static_cast<std::ptrdiff_t>(e_.line_.norm_len));
+  const std::size_t n = normalize_line(e_.line_.raw, e_.line_.norm.data());
+  e_.parser_.parse(std::string_view(e_.line_.norm.data(), n), e_.parse_env(), e_.block_);
   e_.checks_.enhance_block();
   e_.checks_.check_block();
   e_.apply_assignments();
   e_.execute_block();
   e_.block_ = saved_block;
-  e_.raw_ = saved_raw;
-  std::copy(saved_norm.begin(), saved_norm.end(), e_.norm_.begin());
+  e_.line_.raw = saved_raw;
+  std::copy(saved_norm.begin(), saved_norm.end(), e_.line_.norm.begin());
   e_.parser_.numbered_assignments = std::move(saved_numbered);
   e_.parser_.named_assignments = std::move(saved_named);
 }
@@ -471,7 +471,7 @@ void MCodes::convert_stop() {
   if (e_.opt_.main_m99 == MainM99::Repeat) return repeat_main();
   // Read as rs274 reads it; a reader of the scan (a preflight, `opencnc check`) should know
   // that the machine will not stop here.
-  if (!e_.in_mdi_)
+  if (!e_.mdi_.active)
     e_.warn_once(warned_repeat_, ErrorCode::MainProgramRepeats,
                  "M99 in the main program: the scan ends here, but a run on the machine starts the program "
                  "again from its first line, endlessly, until the operator stops it");
@@ -499,7 +499,7 @@ void MCodes::repeat_main() {
   } else {
     e_.st_.blocks_executed = 0;
     e_.st_.loop_iterations = 0;
-    e_.skipped_lines_ = 0;
+    e_.bounds_.restart();
   }
   e_.jump_to(c.main_start);
 }
@@ -555,7 +555,7 @@ void MCodes::end_program(int code) {
   }
   if (code == 30) e_.out_.pallet_shuttle();
   e_.out_.program_end();
-  if (e_.st_.percent_delimited && !e_.in_mdi_) {
+  if (e_.st_.percent_delimited && !e_.mdi_.active) {
     // A '%'-delimited file should still have its closing '%' after M2/M30.
     SourceFile& f = e_.current_file();
     if (e_.need_seek_) {

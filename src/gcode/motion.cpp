@@ -53,23 +53,35 @@ void rotate_xy(double& x, double& y, double degrees) noexcept {
   y = yy;
 }
 
-void Engine::polar_with_xy(const Block& b) {
+// Habits of a program that LinuxCNC accepts but a preflight should point out (once each).
+void MotionCodes::check_habits(bool feed) {
+  if (e_.mdi_.active) return;
+  // (warn_once tests `done` too; testing it first spares a call on every later move)
+  if (!e_.offsets_.units_programmed() && !warned_units_)
+    e_.warn_once(warned_units_, ErrorCode::UnitsNotProgrammed,
+                 "motion before any G20/G21: the program relies on the machine's default units");
+  if (feed && e_.opt_.spindle && !warned_spindle_ && e_.st_.modal.spindle == canon::SpindleDirection::Stopped)
+    e_.warn_once(warned_spindle_, ErrorCode::FeedWithSpindleStopped,
+                 "feed move while the spindle is stopped");
+}
+
+void MotionCodes::polar_with_xy(const Block& b) {
   const char letter = b.has('x') ? 'x' : 'y';
   fail_at(b.word_position(letter), ErrorCode::PolarWithXy,
           "{} word beside a polar coordinate: give the point either as @ and ^ or as X and Y",
           letter == 'x' ? 'X' : 'Y');
 }
 
-void Engine::polar_at_origin(const Block& b) {
+void MotionCodes::polar_at_origin(const Block& b) {
   fail_at(
       b.polar_position(), ErrorCode::PolarAtOrigin,
       "incremental polar motion (G91) from the origin: the direction is undefined there, move off it first");
 }
 
-Pose Engine::find_ends(const Block& b) {
-  const PositionState& s = st_.position;
-  const bool comp = st_.modal.cutter_comp != CutterComp::Off;
-  const bool middle = !st_.modal.comp_first_move;
+Pose MotionCodes::find_ends(const Block& b) {
+  const PositionState& s = e_.st_.position;
+  const bool comp = e_.st_.modal.cutter_comp != CutterComp::Off;
+  const bool middle = !e_.st_.modal.comp_first_move;
   Pose end = s.current;
   if (b.g[kGroupNonModal] == 530) {
     // Machine coordinates: remove every offset from the words given.
@@ -94,14 +106,14 @@ Pose Engine::find_ends(const Block& b) {
     }
     return end;
   }
-  const bool xy_plane = st_.modal.plane == canon::Plane::XY;
-  const bool xz_plane = st_.modal.plane == canon::Plane::XZ;
+  const bool xy_plane = e_.st_.modal.plane == canon::Plane::XY;
+  const bool xz_plane = e_.st_.modal.plane == canon::Plane::XZ;
   // While compensation runs, unspecified in-plane coordinates continue from the programmed
   // point, not from the compensated tool position.
   const double from_x = comp && middle ? s.programmed[0] : s.current[0];
   const double from_y = comp && middle && xy_plane ? s.programmed[1] : s.current[1];
   const double from_z = comp && middle && xz_plane ? s.programmed[2] : s.current[2];
-  if (st_.modal.distance == DistanceMode::Absolute) {
+  if (e_.st_.modal.distance == DistanceMode::Absolute) {
     double x = b.has('x') ? b.get('x') : from_x;
     double y = b.has('y') ? b.get('y') : from_y;
     if (b.radius_flag || b.theta_flag) {
@@ -159,10 +171,10 @@ Pose Engine::find_ends(const Block& b) {
   return end;
 }
 
-void Engine::convert_motion(int motion) {
+void MotionCodes::convert_motion(int motion) {
   // A run of canned-cycle blocks keeps its initial level until a block moves otherwise.
   const bool cycle = motion == 730 || motion == 740 || (motion >= 810 && motion <= 890);
-  if (!cycle) st_.cycle.initial_level_valid = false;
+  if (!cycle) e_.st_.cycle.initial_level_valid = false;
   switch (motion) {
     case 0:
     case 10:
@@ -173,82 +185,85 @@ void Engine::convert_motion(int motion) {
       convert_arc(motion);
       return;
     case 800:
-      out_.comment("interpreter: motion mode set to none");
-      st_.modal.motion = 800;
+      e_.out_.comment("interpreter: motion mode set to none");
+      e_.st_.modal.motion = 800;
       return;
     default:
-      if (!run_extension_g(motion)) unsupported_g(motion, block_.motion_position());
+      if (!e_.run_extension_g(motion)) e_.unsupported_g(motion, e_.block_.motion_position());
   }
 }
 
-void Engine::emit_straight(bool rapid, const Pose& end) {
-  if (st_.modal.cutter_comp != CutterComp::Off && st_.modal.comp_radius > 0.0 && ext_ != nullptr && ext_->compensator) {
-    const ExtensionSite site(*this, block_.motion_position());
-    ext_->compensator->straight(ctx_, rapid, end);
+void MotionCodes::emit_straight(bool rapid, const Pose& end) {
+  if (e_.st_.modal.cutter_comp != CutterComp::Off && e_.st_.modal.comp_radius > 0.0 && e_.ext_ != nullptr &&
+      e_.ext_->compensator) {
+    const Engine::ExtensionSite site(e_, e_.block_.motion_position());
+    e_.ext_->compensator->straight(e_.ctx_, rapid, end);
     return;
   }
-  if (rapid) out_.straight_traverse(0, end);
-  else out_.straight_feed(0, end);
-  st_.position.current = end;
+  if (rapid) e_.out_.straight_traverse(0, end);
+  else e_.out_.straight_feed(0, end);
+  e_.st_.position.current = end;
 }
 
-void Engine::emit_arc(const canon::ArcFeed& arc) {
-  out_.arc_feed(0, arc);
-  st_.position.current = arc.end;
+void MotionCodes::emit_arc(const canon::ArcFeed& arc) {
+  e_.out_.arc_feed(0, arc);
+  e_.st_.position.current = arc.end;
 }
 
-void Engine::convert_straight(int motion) {
-  const Block& b = block_;
-  st_.modal.arc_not_allowed = false;
+void MotionCodes::convert_straight(int motion) {
+  const Block& b = e_.block_;
+  e_.st_.modal.arc_not_allowed = false;
   if (motion == 10) check_feed("G1");
-  st_.modal.motion = motion;
+  e_.st_.modal.motion = motion;
   const Pose end = find_ends(b);
-  check_motion_habits(motion == 10);
+  check_habits(motion == 10);
   if (motion == 10) inverse_time_straight(end);
-  if (st_.modal.cutter_comp != CutterComp::Off && st_.modal.comp_radius > 0.0 && b.g[kGroupNonModal] == 530)
+  if (e_.st_.modal.cutter_comp != CutterComp::Off && e_.st_.modal.comp_radius > 0.0 &&
+      b.g[kGroupNonModal] == 530)
     fail_at(b.g_position(kGroupNonModal), ErrorCode::CompG53,
             "G53 cannot be used while cutter compensation is on: G40 first");
   emit_straight(motion == 0, end);
 }
 
 // A feed move needs a feed rate in its feed mode (and a turning spindle per revolution).
-void Engine::check_feed(std::string_view what) const {
-  const int at = block_.motion_position();
-  switch (st_.modal.feed_mode) {
+void MotionCodes::check_feed(std::string_view what) const {
+  const int at = e_.block_.motion_position();
+  switch (e_.st_.modal.feed_mode) {
     case canon::FeedMode::UnitsPerMinute:
-      if (st_.modal.feed_rate == 0.0)
+      if (e_.st_.modal.feed_rate == 0.0)
         fail_at(at, ErrorCode::FeedZero, "{} needs a feed rate, and none is set: program an F word", what);
       break;
     case canon::FeedMode::UnitsPerRevolution:
-      if (st_.modal.feed_rate == 0.0)
+      if (e_.st_.modal.feed_rate == 0.0)
         fail_at(at, ErrorCode::FeedZero,
                 "{} in feed per revolution (G95) needs a feed rate, and none is set: program an F word",
                 what);
-      if (st_.modal.spindle_speed == 0.0)
+      if (e_.st_.modal.spindle_speed == 0.0)
         fail_at(at, ErrorCode::SpindleSpeedZero,
                 "{} in feed per revolution (G95) with the spindle speed at 0: program an S word", what);
       // rs274 only checks the speed; on the machine LinuxCNC's motion then waits for the
       // revolutions for ever, without a word. A preflight must say so.
-      if (st_.modal.spindle == canon::SpindleDirection::Stopped)
+      if (e_.st_.modal.spindle == canon::SpindleDirection::Stopped)
         fail_at(at, ErrorCode::SpindleStopped,
                 "{} in feed per revolution (G95) with the spindle stopped: start it with M3 or M4 first "
                 "(the move would wait for revolutions for ever)",
                 what);
       break;
     case canon::FeedMode::InverseTime:
-      if (!block_.has('f'))
+      if (!e_.block_.has('f'))
         fail_at(at, ErrorCode::InverseTimeFeedMissing,
                 "{} in inverse time mode (G93) needs its own F word on this line", what);
       break;
   }
 }
 
-void Engine::inverse_time_straight(const Pose& end) {
-  if (st_.modal.feed_mode != canon::FeedMode::InverseTime) return;
+void MotionCodes::inverse_time_straight(const Pose& end) {
+  if (e_.st_.modal.feed_mode != canon::FeedMode::InverseTime) return;
   // While compensation runs, the length is the programmed one (LinuxCNC's rule).
-  Pose c = st_.position.current;
-  if (st_.modal.cutter_comp != CutterComp::Off && st_.modal.comp_radius > 0.0 && !st_.modal.comp_first_move) {
-    for (int i = 0; i < 3; ++i) c[i] = st_.position.programmed[static_cast<std::size_t>(i)];
+  Pose c = e_.st_.position.current;
+  if (e_.st_.modal.cutter_comp != CutterComp::Off && e_.st_.modal.comp_radius > 0.0 &&
+      !e_.st_.modal.comp_first_move) {
+    for (int i = 0; i < 3; ++i) c[i] = e_.st_.position.programmed[static_cast<std::size_t>(i)];
   }
   constexpr double tiny = 1e-7;
   auto moved = [&](int a, int b2, int d) {
@@ -258,25 +273,25 @@ void Engine::inverse_time_straight(const Pose& end) {
     return std::sqrt(std::pow(end[a] - c[a], 2) + std::pow(end[b2] - c[b2], 2) + std::pow(end[d] - c[d], 2));
   };
   const double length = moved(0, 1, 2) ? dist(0, 1, 2) : moved(6, 7, 8) ? dist(6, 7, 8) : dist(3, 4, 5);
-  const double rate = std::max(0.1, length * block_.get('f'));
-  out_.set_feed_rate(rate);
-  st_.modal.feed_rate = rate;
+  const double rate = std::max(0.1, length * e_.block_.get('f'));
+  e_.out_.set_feed_rate(rate);
+  e_.st_.modal.feed_rate = rate;
 }
 
-void Engine::inverse_time_arc(double x1, double y1, double z1, double cx, double cy, int turn, double x2, double y2,
-                              double z2) {
-  if (st_.modal.feed_mode != canon::FeedMode::InverseTime) return;
+void MotionCodes::inverse_time_arc(double x1, double y1, double z1, double cx, double cy, int turn, double x2,
+                                   double y2, double z2) {
+  if (e_.st_.modal.feed_mode != canon::FeedMode::InverseTime) return;
   const double radius = std::hypot(cx - x1, cy - y1);
   const double theta = find_turn(x1, y1, cx, cy, turn, x2, y2);
   const double length = z2 == z1 ? radius * std::fabs(theta) : std::hypot(radius * theta, z2 - z1);
-  const double rate = std::max(0.1, length * block_.get('f'));
-  out_.set_feed_rate(rate);
-  st_.modal.feed_rate = rate;
+  const double rate = std::max(0.1, length * e_.block_.get('f'));
+  e_.out_.set_feed_rate(rate);
+  e_.st_.modal.feed_rate = rate;
 }
 
-void Engine::convert_arc(int motion) {
-  Block& b = block_;
-  const ModalState& m = st_.modal;
+void MotionCodes::convert_arc(int motion) {
+  Block& b = e_.block_;
+  const ModalState& m = e_.st_.modal;
   const int at = b.motion_position();
   const std::string name = g_name(motion);
   if (m.arc_not_allowed)
@@ -324,19 +339,19 @@ void Engine::convert_arc(int motion) {
               name, canon::plane_name(m.plane));
   }
   const Pose end = find_ends(b);
-  check_motion_habits(true);
-  st_.modal.motion = motion;
+  check_habits(true);
+  e_.st_.modal.motion = motion;
   // Plane axes: first, second, normal.
   int a1 = 0, a2 = 1, a3 = 2;
   if (m.plane == canon::Plane::XZ) a1 = 2, a2 = 0, a3 = 1;
   if (m.plane == canon::Plane::YZ) a1 = 1, a2 = 2, a3 = 0;
-  if (st_.modal.cutter_comp != CutterComp::Off && st_.modal.comp_radius > 0.0 && m.plane != canon::Plane::YZ &&
-      ext_ != nullptr && ext_->compensator) {
-    const ExtensionSite site(*this, at);
-    ext_->compensator->arc(ctx_, b, motion, end);
+  if (e_.st_.modal.cutter_comp != CutterComp::Off && e_.st_.modal.comp_radius > 0.0 &&
+      m.plane != canon::Plane::YZ && e_.ext_ != nullptr && e_.ext_->compensator) {
+    const Engine::ExtensionSite site(e_, at);
+    e_.ext_->compensator->arc(e_.ctx_, b, motion, end);
     return;
   }
-  const ArcCentre c = ctx_.arc_centre(b, motion, st_.position.current, end);
+  const ArcCentre c = e_.ctx_.arc_centre(b, motion, e_.st_.position.current, end);
   canon::ArcFeed arc;
   arc.plane = m.plane;
   arc.first_end = end[a1];
@@ -359,21 +374,22 @@ ArcCentre ExtensionContext::arc_centre(const Block& b, int motion, const Pose& s
   const int turns = b.has('p') ? round_to_int(b.get('p')) : 1;
   ArcCentre c;
   if (b.has('r'))
-    e_.arc_center_r(motion, start[a1], start[a2], end[a1], end[a2], b.get('r'), turns, c.first, c.second,
-                    c.turn);
+    e_.motion_.arc_center_r(motion, start[a1], start[a2], end[a1], end[a2], b.get('r'), turns, c.first,
+                            c.second, c.turn);
   else
-    e_.arc_center_ijk(motion, start[a1], start[a2], end[a1], end[a2], off1, off2, turns, c.first, c.second,
-                      c.turn);
-  e_.inverse_time_arc(start[a1], start[a2], start[a3], c.first, c.second, c.turn, end[a1], end[a2], end[a3]);
+    e_.motion_.arc_center_ijk(motion, start[a1], start[a2], end[a1], end[a2], off1, off2, turns, c.first,
+                              c.second, c.turn);
+  e_.motion_.inverse_time_arc(start[a1], start[a2], start[a3], c.first, c.second, c.turn, end[a1], end[a2],
+                              end[a3]);
   return c;
 }
 
-void Engine::arc_center_ijk(int motion, double cur1, double cur2, double end1, double end2, double off1, double off2,
-                            int turns, double& c1, double& c2, int& turn) const {
-  const bool inch = st_.modal.units == canon::Units::Inch;
+void MotionCodes::arc_center_ijk(int motion, double cur1, double cur2, double end1, double end2, double off1,
+                                 double off2, int turns, double& c1, double& c2, int& turn) const {
+  const bool inch = e_.st_.modal.units == canon::Units::Inch;
   const double radius_tol = inch ? kRadiusToleranceInch : kRadiusToleranceMm;
   const double spiral_tol = inch ? kSpiralToleranceInch : kSpiralToleranceMm;
-  if (st_.modal.ijk_distance == DistanceMode::Absolute) {
+  if (e_.st_.modal.ijk_distance == DistanceMode::Absolute) {
     c1 = off1;
     c2 = off2;
   } else {
@@ -382,9 +398,9 @@ void Engine::arc_center_ijk(int motion, double cur1, double cur2, double end1, d
   }
   const double r1 = std::hypot(c1 - cur1, c2 - cur2);
   const double r2 = std::hypot(c1 - end1, c2 - end2);
-  const canon::Plane p = st_.modal.plane;
+  const canon::Plane p = e_.st_.modal.plane;
   const char a = plane_letter(p, 0), b = plane_letter(p, 1);
-  const int at = first_offset_position(block_);
+  const int at = first_offset_position(e_.block_);
   if (r1 < radius_tol)
     fail_at(at, ErrorCode::ArcZeroRadius,
             "zero-radius arc: its centre ({}{:.4f}, {}{:.4f}) is the start point", a, c1, b, c2);
@@ -404,10 +420,11 @@ void Engine::arc_center_ijk(int motion, double cur1, double cur2, double end1, d
   turn = motion == 20 ? -turns : turns;
 }
 
-void Engine::arc_center_r(int motion, double cur1, double cur2, double end1, double end2, double radius, int turns,
-                          double& c1, double& c2, int& turn) const {
-  const double tolerance = st_.modal.units == canon::Units::Inch ? kRadiusToleranceInch : kRadiusToleranceMm;
-  const int at = block_.word_position('r');
+void MotionCodes::arc_center_r(int motion, double cur1, double cur2, double end1, double end2, double radius,
+                               int turns, double& c1, double& c2, int& turn) const {
+  const double tolerance =
+      e_.st_.modal.units == canon::Units::Inch ? kRadiusToleranceInch : kRadiusToleranceMm;
+  const int at = e_.block_.word_position('r');
   if (end1 == cur1 && end2 == cur2)
     fail_at(at, ErrorCode::ArcRadiusFullCircle,
             "an R arc that ends where it starts: R cannot give a full circle, give the centre with I/J/K "

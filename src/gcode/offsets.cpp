@@ -23,7 +23,7 @@ void Offsets::update_unit_factor() noexcept {
 void Offsets::set_units(int code) {
   // LinuxCNC lets the units change while compensation is on; the radius is converted below.
   const canon::Units units = code == 200 ? canon::Units::Inch : canon::Units::Mm;
-  e_.units_programmed_ = true;
+  units_programmed_ = true;
   e_.out_.use_length_units(units);
   if (e_.st_.modal.units == units) return;
   const double k = units == canon::Units::Inch ? 1.0 / 25.4 : 25.4;
@@ -370,7 +370,7 @@ void Offsets::axis_offsets(int code) {
 }
 
 void Offsets::go_home(int code) {
-  Pose end = e_.find_ends(e_.block_);
+  Pose end = e_.motion_.find_ends(e_.block_);
   if (e_.st_.modal.cutter_comp != CutterComp::Off)
     fail_at(e_.block_.g_position(kGroupNonModal), ErrorCode::CompG28G30,
             "{} cannot be used while cutter compensation is on: G40 first", g_name(code));

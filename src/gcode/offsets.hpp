@@ -28,6 +28,8 @@ class Offsets {
   /// A length in the user's units (Options::user_units) in the program's.
   double user_to_program(double v) const noexcept { return v * user_to_program_factor_; }
   void update_unit_factor() noexcept;
+  /// A G20 or G21 was met: the program does not rely on the machine's default units.
+  bool units_programmed() const noexcept { return units_programmed_; }
 
  private:
   void g10_coordinate_system();
@@ -40,6 +42,7 @@ class Offsets {
 
   Engine& e_;
   double user_to_program_factor_ = 1.0;
+  bool units_programmed_ = false;
 };
 
 }  // namespace opencnc::gcode

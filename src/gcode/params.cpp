@@ -64,7 +64,7 @@ bool ParameterHost::predefined_value(std::string_view name, double& v) const {
     case Sys::Vmajor: v = 2.9; break;
     case Sys::Vminor: v = 0.0; break;
     case Sys::Line:
-      v = e_.line_;
+      v = e_.line_.number;
       break;
     case Sys::MotionMode: v = m.motion; break;
     case Sys::Plane: {

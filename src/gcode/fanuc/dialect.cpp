@@ -22,7 +22,7 @@ FanucDialect::FanucDialect(Engine& e) : e_(e) {
 // Lines that start like another controller's program header or command ("%PM",
 // "%_N_PART_MPF", "$H", "$BR0137.MIN%") are named as such instead of failing on a character.
 void FanucDialect::foreign_syntax() {
-  const std::string& raw = e_.raw_;
+  const std::string& raw = e_.line_.raw;
   const std::size_t first = raw.find_first_not_of(" \t");
   if (first == std::string::npos) return;
   const char c = raw[first];
@@ -40,7 +40,7 @@ void FanucDialect::foreign_syntax() {
 // G71/G72 P Q: the shape's blocks read, not run (ExecContext::read_block_range).
 void FanucDialect::read_block_range(std::int64_t first, std::int64_t last, std::string_view what,
                                     const std::function<void(const Block&)>& visit) {
-  if (e_.in_mdi_)
+  if (e_.mdi_.active)
     fail(ErrorCode::OwordInMdi,
          "{} P Q reads the program's own blocks: it cannot run from MDI (as G70 P Q cannot)", what);
   const SourcePosition body = e_.st_.frames.back().fanuc.body;
@@ -74,7 +74,7 @@ void FanucDialect::read_block_range(std::int64_t first, std::int64_t last, std::
              what, first, last);
       visit(e_.block_);
     }
-    if (e_.line_file_ == to.file && e_.line_offset_ == to.offset) break;
+    if (e_.line_.file == to.file && e_.line_.offset == to.offset) break;
   }
   const SourcePosition after = e_.st_.next;
   e_.restore_line(saved, saved.origin);

@@ -107,7 +107,7 @@ void FanucDialect::go_to(std::int64_t n) {
 }
 
 void FanucDialect::while_do() {
-  const SourcePosition here{e_.line_file_, e_.line_offset_, e_.line_};
+  const SourcePosition here{e_.line_.file, e_.line_.offset, e_.line_.number};
   const int id = e_.block_.loop_id;
   auto& loops = e_.st_.frames.back().fanuc.loops;
   if (!loops.empty() && loops.back().start == here) loops.pop_back();  // a GOTO back to its own WHILE
@@ -147,8 +147,8 @@ void FanucDialect::end_do() {
   if (k == 0) fail(ErrorCode::FanucEndWithoutDo, "END {} without a running WHILE [..] DO {}", id, id);
   const FanucLoop loop = loops[k - 1];
   if (loop.after_end.file != e_.st_.next.file || loop.after_end.offset != e_.st_.next.offset)
-    fail(ErrorCode::FanucLoopStructure, "END {} on line {} does not close the DO {} of line {}", id, e_.line_,
-         id, loop.start.line);
+    fail(ErrorCode::FanucLoopStructure, "END {} on line {} does not close the DO {} of line {}", id,
+         e_.line_.number, id, loop.start.line);
   loops.resize(k - 1);  // the loop and any left inside it by a GOTO
   e_.flow_.count_loop();
   e_.jump_to(loop.start);  // its WHILE decides whether it runs again
@@ -187,7 +187,7 @@ void FanucDialect::call(std::uint32_t program, int count, bool macro) {
   }
   const std::uint32_t parent = e_.st_.frames.back().context;
   frame.context =
-      e_.sources_->context(parent, canon::SourceRef{e_.line_file_, e_.line_, 1}, at.file, frame.sub);
+      e_.sources_->context(parent, canon::SourceRef{e_.line_.file, e_.line_.number, 1}, at.file, frame.sub);
   e_.st_.frames.push_back(std::move(frame));
   e_.jump_to(at);
 }
@@ -223,7 +223,7 @@ void FanucDialect::range() {
   frame.fanuc.range_end = to;
   frame.fanuc.range_return = e_.st_.position.current;
   frame.context = e_.sources_->context(e_.st_.frames.back().context,
-                                       canon::SourceRef{e_.line_file_, e_.line_, 1}, from.file, "G70");
+                                       canon::SourceRef{e_.line_.file, e_.line_.number, 1}, from.file, "G70");
   e_.st_.frames.push_back(std::move(frame));
   e_.jump_to(from);
 }
@@ -256,8 +256,8 @@ bool FanucDialect::only_comments_between(const SourcePosition& from, const Sourc
 void FanucDialect::block_done() {
   if (e_.st_.frames.size() < 2) return;
   const FanucFrame& f = e_.st_.frames.back().fanuc;
-  if (!f.range || e_.line_file_ != f.range_end.file || e_.line_offset_ != f.range_end.offset) return;
-  e_.emit_straight(true, f.range_return);
+  if (!f.range || e_.line_.file != f.range_end.file || e_.line_.offset != f.range_end.offset) return;
+  e_.motion_.emit_straight(true, f.range_return);
   e_.jump_to(e_.st_.frames.back().return_to);
   e_.flow_.leave_frame();
 }
@@ -309,8 +309,8 @@ void FanucDialect::return_from_call() {
 // Where O`program` starts: a program line in the file being read or in the main program's
 // file, or a file O<program>.nc on the subroutine path.
 SourcePosition FanucDialect::find_program(std::uint32_t program) {
-  for (const std::uint32_t file : {e_.line_file_, e_.st_.frames.front().fanuc.body.file}) {
-    if (file >= e_.files_.size() || (e_.in_mdi_file_ && file == e_.mdi_file_))
+  for (const std::uint32_t file : {e_.line_.file, e_.st_.frames.front().fanuc.body.file}) {
+    if (file >= e_.files_.size() || (e_.mdi_.registered && file == e_.mdi_.file))
       continue;  // MDI lines: no file
     const auto& programs = index_.programs(file, e_.source_at(file));
     e_.need_seek_ = true;
