@@ -19,13 +19,17 @@ FEATURES_HEADING = "## The features"
 
 
 def layer_table(doc):
-    """[(layer, direct dependencies, is a feature)] from the tables' rows, in document order."""
-    rows, in_features = [], False
+    """[(layer, direct dependencies, is a feature)] from the rows of the tables whose last column is
+    "depends on" (other tables may name layers too), in document order."""
+    rows, in_features, in_layer_table, previous = [], False, False, ""
     for line in doc.read_text().splitlines():
         if line.startswith("## "):
             in_features = line.startswith(FEATURES_HEADING)
+        if line.startswith("|") and not previous.startswith("|"):  # a table's header row
+            in_layer_table = line.strip().strip("|").split("|")[-1].strip() == "depends on"
+        previous = line
         m = re.match(r"\|\s*`([a-z_]+)`\s*\|", line)
-        if m:
+        if m and in_layer_table:
             cells = [c.strip() for c in line.strip().strip("|").split("|")]
             rows.append((m.group(1), set(re.findall(r"[a-z_+]+", cells[-1])), in_features))
     names = {name for name, _, _ in rows}
