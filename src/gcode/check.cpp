@@ -119,7 +119,9 @@ void BlockChecks::enhance_block() {
 }
 
 void BlockChecks::check_block() {
-  check_g_codes();
+  // Tested here, not inside: most blocks have no code of the non-modal group, and the call cost
+  // more than the test (gcode_bench, docs/performance.md).
+  if (e_.block_.g[kGroupNonModal] != -1) check_g_codes();
   if (e_.block_.m_count > 4)
     fail_at(fifth_m_position(e_.block_), ErrorCode::TooManyMCodes,
             "a fifth M code on this line: a line may hold four at most");
@@ -140,9 +142,10 @@ void BlockChecks::check_block() {
 // words as their data, or all of their block's words. The motion code and the codes of the
 // groups only extensions know are asked.
 BlockChecks::ExtensionClaims BlockChecks::extension_claims() const {
+  const Block& b = e_.block_;
   ExtensionClaims claims;
-  const int motion = e_.block_.g[kGroupMotion] != -1 ? e_.block_.g[kGroupMotion] : e_.block_.motion;
-  if (!e_.block_.extension_groups && extension_handler(motion) == nullptr) return claims;  // most blocks
+  const int motion = b.g[kGroupMotion] != -1 ? b.g[kGroupMotion] : b.motion;
+  if (!b.extension_groups && extension_handler(motion) == nullptr) return claims;  // most blocks
   auto ask = [&](int code) {
     const CodeHandler* h = extension_handler(code);
     if (h == nullptr) return;
@@ -151,9 +154,8 @@ BlockChecks::ExtensionClaims BlockChecks::extension_claims() const {
     claims.axis_words = claims.axis_words || t.axis_words;
     claims.all_words = claims.all_words || t.all_words;
   };
-  if (e_.block_.extension_groups) {
-    for (int group = kGroupScaling; group < kGGroupCount; ++group)
-      ask(e_.block_.g[static_cast<std::size_t>(group)]);
+  if (b.extension_groups) {
+    for (int group = kGroupScaling; group < kGGroupCount; ++group) ask(b.g[static_cast<std::size_t>(group)]);
   }
   ask(motion);
   return claims;

@@ -30,7 +30,7 @@ void Engine::execute_block() {
     st_.modal.spindle_speed = b.get('s');
   }
   if (b.has('t')) mcodes_.select_tool(static_cast<int>(b.get('t')));
-  mcodes_.convert_m();
+  if (b.m_count != 0) mcodes_.convert_m();  // tested here: most blocks have none, and a call costs more
   convert_g();
   if (b.m[kGroupStop] != -1) mcodes_.convert_stop();
 }

@@ -12,7 +12,6 @@ namespace opencnc::gcode {
 
 // The block's M codes by modal group (LinuxCNC's order), then a user M code.
 void MCodes::convert_m() {
-  if (e_.block_.m_count == 0) return;
   convert_io();
   convert_tool_change_group();
   convert_spindle_group();

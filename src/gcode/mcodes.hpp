@@ -19,7 +19,7 @@ class MCodes {
   MCodes(const MCodes&) = delete;
   MCodes& operator=(const MCodes&) = delete;
 
-  void convert_m();
+  void convert_m();  ///< the block's M codes but the stops; the block has some (m_count > 0)
   void select_tool(int tool);
   /// M0, M1, M2, M30, M60, M99 of the block.
   void convert_stop();

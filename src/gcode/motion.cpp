@@ -54,13 +54,20 @@ void rotate_xy(double& x, double& y, double degrees) noexcept {
 }
 
 // Habits of a program that LinuxCNC accepts but a preflight should point out (once each).
+// Called on every move until nothing is left to be told (habits_settled_).
 void MotionCodes::check_habits(bool feed) {
+  const bool units_settled = warned_units_ || e_.offsets_.units_programmed();
+  // Both only ever become true: once they are, no move can be warned about again.
+  habits_settled_ = units_settled && (warned_spindle_ || !e_.opt_.spindle);
+  const bool units = !units_settled;
+  const bool spindle =
+      feed && !warned_spindle_ && e_.opt_.spindle && e_.st_.modal.spindle == canon::SpindleDirection::Stopped;
+  if (!units && !spindle) return;
   if (e_.mdi_.active) return;
-  // (warn_once tests `done` too; testing it first spares a call on every later move)
-  if (!e_.offsets_.units_programmed() && !warned_units_)
+  if (units)
     e_.warn_once(warned_units_, ErrorCode::UnitsNotProgrammed,
                  "motion before any G20/G21: the program relies on the machine's default units");
-  if (feed && e_.opt_.spindle && !warned_spindle_ && e_.st_.modal.spindle == canon::SpindleDirection::Stopped)
+  if (spindle)
     e_.warn_once(warned_spindle_, ErrorCode::FeedWithSpindleStopped,
                  "feed move while the spindle is stopped");
 }
@@ -216,8 +223,8 @@ void MotionCodes::convert_straight(int motion) {
   if (motion == 10) check_feed("G1");
   e_.st_.modal.motion = motion;
   const Pose end = find_ends(b);
-  check_habits(motion == 10);
-  if (motion == 10) inverse_time_straight(end);
+  if (!habits_settled_) check_habits(motion == 10);
+  if (motion == 10 && e_.st_.modal.feed_mode == canon::FeedMode::InverseTime) inverse_time_straight(end);
   if (e_.st_.modal.cutter_comp != CutterComp::Off && e_.st_.modal.comp_radius > 0.0 &&
       b.g[kGroupNonModal] == 530)
     fail_at(b.g_position(kGroupNonModal), ErrorCode::CompG53,
@@ -257,8 +264,8 @@ void MotionCodes::check_feed(std::string_view what) const {
   }
 }
 
+// G93 only (the caller tests the mode).
 void MotionCodes::inverse_time_straight(const Pose& end) {
-  if (e_.st_.modal.feed_mode != canon::FeedMode::InverseTime) return;
   // While compensation runs, the length is the programmed one (LinuxCNC's rule).
   Pose c = e_.st_.position.current;
   if (e_.st_.modal.cutter_comp != CutterComp::Off && e_.st_.modal.comp_radius > 0.0 &&
@@ -339,7 +346,7 @@ void MotionCodes::convert_arc(int motion) {
               name, canon::plane_name(m.plane));
   }
   const Pose end = find_ends(b);
-  check_habits(true);
+  if (!habits_settled_) check_habits(true);
   e_.st_.modal.motion = motion;
   // Plane axes: first, second, normal.
   int a1 = 0, a2 = 1, a3 = 2;

@@ -53,6 +53,9 @@ class MotionCodes {
   Engine& e_;
   bool warned_units_ = false;    ///< the program moved before any G20/G21 (said once)
   bool warned_spindle_ = false;  ///< it fed with the spindle stopped (said once)
+  /// Neither can be said any more (the units programmed or said, the spindle said or absent): the
+  /// moves skip the habits' checks (a call on every line otherwise, gcode_bench).
+  bool habits_settled_ = false;
 };
 
 }  // namespace opencnc::gcode
