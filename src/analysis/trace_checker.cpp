@@ -154,13 +154,58 @@ double arc_distance(const canon::ArcGeometry& g, const Pose& start, const Pose& 
   return best;
 }
 
+/// Distance from v to the path from b to c when the samples a, b, c (one period apart) lie on a
+/// circle: the arc through them from b to c (exact for circular blends, and within a third-order
+/// term of any smooth path); the chord when they are (nearly) in line.
+double arc_distance(const Pose& a, const Pose& b, const Pose& c, const Pose& v) {
+  Pose u{}, w{}, q{};
+  for (int i : kLinear) {
+    u[i] = a[i] - b[i];
+    w[i] = c[i] - b[i];
+    q[i] = v[i] - b[i];
+  }
+  const auto dot = [](const Pose& x, const Pose& y) {
+    double s = 0;
+    for (int i : kLinear) s += x[i] * y[i];
+    return s;
+  };
+  const double uu = dot(u, u), ww = dot(w, w), uw = dot(u, w), det = uu * ww - uw * uw;
+  if (!(det > 1e-12 * uu * ww)) return segment_distance(b, c, v);
+  // The centre o = b + α·u + β·w is as far from a and c as from b: 2(o − b)·u = |u|², 2(o − b)·w = |w|².
+  const double alpha = 0.5 * ww * (uu - uw) / det, beta = 0.5 * uu * (ww - uw) / det;
+  Pose ob{};  // b − o
+  for (int i : kLinear) ob[i] = -(alpha * u[i] + beta * w[i]);
+  const double r = std::sqrt(dot(ob, ob));
+  // Frame in the circle's plane: e1 towards b, e2 towards c's side; the arc from b to c is the
+  // one that does not pass a (behind b).
+  Pose e1{}, e2{}, oc{};
+  for (int i : kLinear) {
+    e1[i] = ob[i] / r;
+    oc[i] = w[i] + ob[i];  // c − o
+  }
+  const double c1 = dot(oc, e1);
+  for (int i : kLinear) e2[i] = oc[i] - c1 * e1[i];
+  const double n2 = std::sqrt(dot(e2, e2));
+  if (!(n2 > 0)) return segment_distance(b, c, v);
+  for (int i : kLinear) e2[i] /= n2;
+  const double sweep = std::atan2(dot(oc, e2), c1);  // in (0, π]
+  Pose ov{};                                         // v − o
+  for (int i : kLinear) ov[i] = q[i] + ob[i];
+  const double p1 = dot(ov, e1), p2 = dot(ov, e2);
+  const double psi = std::atan2(p2, p1);
+  if (psi < 0 || psi > sweep) return std::min(linear_distance(b, v), linear_distance(c, v));
+  const double in_plane = std::hypot(p1, p2), off2 = std::max(0.0, dot(ov, ov) - in_plane * in_plane);
+  return std::sqrt((in_plane - r) * (in_plane - r) + off2);
+}
+
 }  // namespace
 
 std::string TraceReport::summary() const {
   std::string s = fmt::format(
-      "time {:.3f} s, path {:.3f} mm, max contour error {:.6f} mm at {:.3f} s, "
-      "{} limit violations",
-      machining_time_s, path_length_mm, max_contour_error_mm, contour_error_time_s, limit_violations);
+      "time {:.3f} s, path {:.3f} mm, max contour error {:.6f} mm at {:.3f} s, corner miss {:.6f} mm "
+      "(move {}), {} limit violations",
+      machining_time_s, path_length_mm, max_contour_error_mm, contour_error_time_s, max_corner_miss_mm,
+      corner_miss_segment, limit_violations);
   if (limit_violations > 0) {
     s += fmt::format(" (first at {:.3f} s: axis {} derivative {} = {:.6g}, limit {:.6g})",
                      first_violation.time_s, kAxisLetters[static_cast<std::size_t>(first_violation.axis)],
@@ -227,7 +272,7 @@ void TraceChecker::check_limits(const Pose& x) {
     const double x1 = past_[0][i], x2 = past_[1][i], x3 = past_[2][i];
     const double v = std::fabs(x[i] - x1) / t;
     const double a = std::fabs(x[i] - 2 * x1 + x2) / t2;
-    const double j = std::fabs(x[i] - 3 * x1 + 3 * x2 - x3) / t3;
+    const double j = jerk_unknown_ ? 0.0 : std::fabs(x[i] - 3 * x1 + 3 * x2 - x3) / t3;
     AxisStats& st = report_.axes[k];
     st.max_velocity = std::max(st.max_velocity, v);
     st.max_acceleration = std::max(st.max_acceleration, a);
@@ -242,6 +287,42 @@ void TraceChecker::check_limits(const Pose& x) {
       }
     }
   }
+  jerk_unknown_ = false;
+}
+
+// The end points of the moves from the one before `first` to `last` are near the block the
+// sample lies on: each keeps its distance to the nearest chord between two samples so far (the
+// chord to this sample counts for those of the blocks it crossed too). Once the trace is on a
+// block starting two moves after one, that move's end point is passed: its distance counts.
+void TraceChecker::track_corners(const Pose& position, canon::SegmentId first, canon::SegmentId last) {
+  const canon::SegmentId n = program_->size();
+  const canon::SegmentId held = program_->first_held_move();  // end(id) needs id ≥ held
+  const canon::SegmentId lo = std::max<canon::SegmentId>(first > 0 ? first - 1 : 0, held);
+  const canon::SegmentId hi = std::min<canon::SegmentId>(last, n - 1);
+  if (lo > hi) return;
+  if (!corners_.empty() && lo < corner_base_) corners_.clear();  // a new run of the program
+  if (corners_.empty()) corner_base_ = lo;
+  while (corner_base_ + corners_.size() <= hi) corners_.push_back(1e300);
+  Pose second{};
+  for (int i : kLinear) second[i] = position[i] - 2 * past_[0][i] + past_[1][i];
+  const double bulge = linear_distance(second, Pose{});
+  for (std::size_t k = 0; k < corners_.size(); ++k) {
+    if (corner_base_ + k < held) continue;  // released: it keeps what it had (and counts below)
+    const Pose v = program_->end(corner_base_ + k);
+    double d = segment_distance(past_[0], position, v);
+    // The chord cuts inside a curved path by about |Δ²x|/8: where that could matter, the path
+    // between the samples is taken as the arc through this sample and the two before it.
+    if (d - bulge < corners_[k]) d = std::min(d, arc_distance(past_[1], past_[0], position, v));
+    corners_[k] = std::min(corners_[k], d);
+  }
+  while (!corners_.empty() && corner_base_ < lo) {
+    if (corners_.front() < 1e300 && corners_.front() > report_.max_corner_miss_mm) {
+      report_.max_corner_miss_mm = corners_.front();
+      report_.corner_miss_segment = corner_base_;
+    }
+    corners_.pop_front();
+    ++corner_base_;
+  }
 }
 
 void TraceChecker::add(const Pose& position, canon::SegmentId first, canon::SegmentId last) {
@@ -251,7 +332,11 @@ void TraceChecker::add(const Pose& position, canon::SegmentId first, canon::Segm
   report_.path_length_mm += linear_distance(position, past_[0]);
   if (program_ != nullptr && program_->size() > 0) {
     const canon::SegmentId n = program_->size();
-    const canon::SegmentId lo = first > 0 ? first - 1 : 0;
+    // (In a stream's window the moves before the first held one are gone, and start_of(id) needs
+    // the end of the move before id.)
+    const canon::SegmentId held = program_->first_held_move();
+    const canon::SegmentId lo =
+        std::max<canon::SegmentId>(first > 0 ? first - 1 : 0, held > 0 ? held + 1 : 0);
     const canon::SegmentId hi = std::min<canon::SegmentId>(last + 1, n - 1);
     // Merged blocks stand for hundreds of moves: start with the move that was nearest last time
     // and skip those whose bounding box is already farther than the best distance.
@@ -269,6 +354,7 @@ void TraceChecker::add(const Pose& position, canon::SegmentId first, canon::Segm
       report_.max_contour_error_mm = best;
       report_.contour_error_time_s = report_.machining_time_s;
     }
+    track_corners(position, first, last);
   }
   past_[2] = past_[1];
   past_[1] = past_[0];

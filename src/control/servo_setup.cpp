@@ -107,11 +107,13 @@ ServoConfig servo_config(const config::MachineProfile& profile,
       s.handwheel_steps[static_cast<std::size_t>(k)] = profile.handwheel.steps[static_cast<std::size_t>(k)];
   }
   // Field by field: the padding after filter_ticks stays the zero shared_setup() compares.
-  static_assert(sizeof(traj::InterpolatorConfig) == 24,
+  static_assert(sizeof(traj::InterpolatorConfig) == 40,
                 "a field was added to the interpolator's settings: copy it");
   s.interpolator.period_s = interpolator.period_s;
   s.interpolator.filter_ticks = interpolator.filter_ticks;
   s.interpolator.max_feed_override = interpolator.max_feed_override;
+  s.interpolator.max_path_accel = interpolator.max_path_accel;
+  s.interpolator.max_path_speed = interpolator.max_path_speed;
   s.spindle_max_rpm = profile.spindle.present ? profile.spindle.max_rpm : 0.0;
   s.coupling = coupling_config(profile.coupling);
   s.load_guard = load_guard_config(profile);

@@ -1,11 +1,14 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Per-axis limits → one speed cap and one acceleration budget along s, per block shape.
+// Per-axis limits → one speed cap, one acceleration budget and one jerk budget along s, per block
+// shape.
 //
 // With s(t) the path parameter, an axis moves as x(t) = g(s(t)), so
 //   ẋ = g'·v,   ẍ = g'·a + g''·v²,   x⃛ = g'·j + 3·g''·v·a + g'''·v³.
-// A block's (cap, accel) pair is chosen so that |ẋ|, |ẍ|, |x⃛| stay within the axis limits for
-// every v ≤ cap, |a| ≤ accel, and |j| ≤ 2·accel/T (the jerk of a moving average of length T over
-// a profile whose acceleration stays within ±accel).
+// A block's (cap, accel, jerk) triple is chosen so that |ẋ|, |ẍ|, |x⃛| stay within the axis
+// limits for every v ≤ cap, |a| ≤ accel and |j| ≤ jerk. With jerk limits the geometric term
+// g'''·v³ may take at most half of J at the cap (kJerkCapShare), the acceleration budget is the
+// largest that leaves a jerk budget of at least accel/T (so the moving average of length T can
+// always turn the acceleration round), and the jerk budget is what is left at that budget.
 #include "block_limits.hpp"
 
 #include <algorithm>
@@ -22,23 +25,23 @@ using traj::MotionBlock;
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr double kJerkCapShare = 0.5;  ///< part of the continuous jerk share v³·|g'''| may use
+constexpr double kJerkCapShare = 0.5;  ///< part of J the geometric jerk v³·|g'''| may use at the cap
 
 bool limited_jerk(const LimitParams& p, int i) {
   return p.filter_s > 0 && p.machine[i].max_jerk > 0;
 }
 
-RawLimits line_limits(const MotionBlock& b, double v_max, const LimitParams& p) {
-  RawLimits r{v_max, kInf};
+RawLimits line_limits(const MotionBlock& b, double v_max, const LimitParams& p, double jerk_scale) {
+  RawLimits r{v_max, kInf, kInf};
   for (int i = 0; i < kAxisCount; ++i) {
     const double d = std::fabs(b.lin[i]);
     if (d < 1e-15) continue;
     const AxisLimits& l = p.machine[i];
     r.cap = std::min(r.cap, l.max_velocity / d);
     r.accel = std::min(r.accel, l.max_acceleration / d);
-    if (limited_jerk(p, i))
-      r.accel = std::min(r.accel, (1 - p.step_share) * l.max_jerk * p.filter_s / (2 * d));
+    if (limited_jerk(p, i)) r.jerk = std::min(r.jerk, jerk_scale * l.max_jerk / d);
   }
+  if (r.jerk < kInf) r.accel = std::min(r.accel, r.jerk * p.filter_s);
   return r;
 }
 
@@ -49,11 +52,11 @@ double arc_accel(double k, double lambda, double q, double A) {
   return slack / (A * lambda + k * std::sqrt(lambda * lambda * q * q + slack));
 }
 
-/// Largest a in [0, a_hi] with f(a) ≤ budget for an increasing f (bisection; planning time only).
+/// Largest x in [0, x_hi] with f(x) ≤ budget for an increasing f (bisection; planning time only).
 template <typename F>
-double largest_within(F f, double budget, double a_hi) {
-  if (f(a_hi) <= budget) return a_hi;
-  double lo = 0, hi = a_hi;
+double largest_within(F f, double budget, double x_hi) {
+  if (f(x_hi) <= budget) return x_hi;
+  double lo = 0, hi = x_hi;
   if (f(lo) > budget) return 0;
   for (int it = 0; it < 60; ++it) {
     const double mid = 0.5 * (lo + hi);
@@ -74,7 +77,7 @@ double largest_within(F f, double budget, double a_hi) {
 // the arc's bounds (ρ = 0) plus terms of the order of ρ (0.001 for the arcs LinuxCNC accepts
 // with large radii). With ρ = 0 (an arc block) every added term is exactly zero: arcs use this
 // too.
-RawLimits arc_or_spiral_limits(const MotionBlock& b, double v_max, const LimitParams& p) {
+RawLimits arc_or_spiral_limits(const MotionBlock& b, double v_max, const LimitParams& p, double jerk_scale) {
   const double om = std::fabs(b.omega), rho = std::fabs(b.spiral);
   const double grow_max = std::max(1.0, 1.0 + b.spiral * b.omega * b.length);
   double ks[kAxisCount];
@@ -87,12 +90,13 @@ RawLimits arc_or_spiral_limits(const MotionBlock& b, double v_max, const LimitPa
     if (k > 0)
       cap = std::min(cap, std::sqrt(p.normal_share * l.max_acceleration / (om * k * (grow_max + 2 * rho))));
     if (k > 0 && limited_jerk(p, i)) {
-      cap = std::min(cap, std::cbrt(kJerkCapShare * (1 - p.step_share) * l.max_jerk /
-                                    (om * om * k * (grow_max + 3 * rho))));
+      cap = std::min(
+          cap, std::cbrt(kJerkCapShare * jerk_scale * l.max_jerk / (om * om * k * (grow_max + 3 * rho))));
     }
   }
-  double accel = kInf;
+  RawLimits r{cap, kInf, kInf};
   const double q = cap * cap * om;
+  const double T = p.filter_s, v = cap;
   for (int i = 0; i < kAxisCount; ++i) {
     const double k = ks[i], lam = std::fabs(b.lin[i]);
     if (k + lam < 1e-15) continue;
@@ -100,67 +104,196 @@ RawLimits arc_or_spiral_limits(const MotionBlock& b, double v_max, const LimitPa
     const double budget = l.max_acceleration - 2 * k * rho * q;
     double a = budget > 0 ? arc_accel(k * grow_max, lam + k * rho, q, budget) : 0.0;
     if (limited_jerk(p, i)) {
-      const double T = p.filter_s, v = cap;
-      const auto jerk = [&](double acc) {
-        const double j = 2 * acc / T;
+      const auto jerk = [&](double acc, double j) {
         return k * grow_max * std::hypot(j + v * v * v * om * om, 3 * v * acc * om) + lam * j +
                k * rho * (j + 6 * v * acc * om + 3 * v * v * v * om * om);
       };
-      a = largest_within(jerk, (1 - p.step_share) * l.max_jerk, a);
+      const double J = jerk_scale * l.max_jerk;
+      a = largest_within([&](double acc) { return jerk(acc, acc / T); }, J, a);
+      const double j_hi = J / (k * grow_max + lam + k * rho);  // the j terms alone reach J there
+      r.jerk = std::min(r.jerk, largest_within([&](double j) { return jerk(a, j); }, J, j_hi));
     }
-    accel = std::min(accel, a);
+    r.accel = std::min(r.accel, a);
   }
-  return {cap, accel};
+  return r;
 }
 
-// Cubic Bézier at t = s/L: per-axis bounds of g', g'', g''' from the control polygon (the
-// derivative of a Bézier is a Bézier of the differences, within their convex hull).
-RawLimits bezier_limits(const MotionBlock& b, double v_max, const LimitParams& p) {
-  const double L = b.length;
-  double cap = v_max;
+// Cubic or quintic Bézier at t = s/L. Per axis the caps use the largest |g'|, |g''|, |g'''| on the
+// block (D1, D2, D3): v·D1 ≤ V, v²·D2 ≤ α·A, v³·D3 ≤ J/2. The budget uses them where they occur
+// together: on each of kIntervals pieces of t, bounds G1, G2, G3 from the values at its ends and
+// the next derivative's bound (a function whose slope is at most M stays within
+// (f_a + f_b + M·Δs)/2 between a and b), and |ẍ| ≤ G1·|a| + G2·v², |x⃛| ≤ G1·|j| + 3·G2·v·|a| + G3·v³
+// there. Along a curve the axis that carries the curvature is rarely the one that carries the
+// tangent, so the budget at the cap is far above (A − v²·D2)/D1.
+double bernstein(const double* c, int n, double t);
+
+RawLimits bezier_limits(const MotionBlock& b, double v_max, const LimitParams& p, double jerk_scale) {
+  constexpr int kIntervals = 24;
   double d1[kAxisCount], d2[kAxisCount], d3[kAxisCount];
+  derivative_bounds(b, d1, d2, d3);
+  double cap = v_max;
   for (int i = 0; i < kAxisCount; ++i) {
-    const double p0 = b.base[i], p1 = b.u[i], p2 = b.w[i], p3 = b.lin[i];
-    d1[i] = 3 * std::max({std::fabs(p1 - p0), std::fabs(p2 - p1), std::fabs(p3 - p2)}) / L;
-    d2[i] = 6 * std::max(std::fabs(p2 - 2 * p1 + p0), std::fabs(p3 - 2 * p2 + p1)) / (L * L);
-    d3[i] = 6 * std::fabs(p3 - 3 * p2 + 3 * p1 - p0) / (L * L * L);
     if (d1[i] + d2[i] < 1e-15) continue;
     const AxisLimits& l = p.machine[i];
     if (d1[i] > 0) cap = std::min(cap, l.max_velocity / d1[i]);
     if (d2[i] > 0) cap = std::min(cap, std::sqrt(p.normal_share * l.max_acceleration / d2[i]));
-    if (d3[i] > 0 && limited_jerk(p, i)) {
-      cap = std::min(cap, std::cbrt(kJerkCapShare * (1 - p.step_share) * l.max_jerk / d3[i]));
-    }
+    if (d3[i] > 0 && limited_jerk(p, i))
+      cap = std::min(cap, std::cbrt(kJerkCapShare * jerk_scale * l.max_jerk / d3[i]));
   }
-  double accel = kInf;
+  RawLimits r{cap, kInf, kInf};
+  const double T = p.filter_s, L = b.length, ds = L / kIntervals;
+  const int n = b.kind == BlockKind::Quintic ? 5 : 3;
+  // Per axis the values of |g'|, |g''|, |g'''| at the ends of the pieces.
+  double g1[kAxisCount][kIntervals + 1], g2[kAxisCount][kIntervals + 1];
   for (int i = 0; i < kAxisCount; ++i) {
-    if (d1[i] + d2[i] < 1e-15) continue;
-    const AxisLimits& l = p.machine[i];
     if (d1[i] <= 0) continue;
-    accel = std::min(accel, (l.max_acceleration - cap * cap * d2[i]) / d1[i]);
-    if (limited_jerk(p, i)) {
-      const double budget = (1 - p.step_share) * l.max_jerk - cap * cap * cap * d3[i];
-      accel = std::min(accel, budget / (2 * d1[i] / p.filter_s + 3 * cap * d2[i]));
+    double c[6], e1[5], e2[4];
+    for (int k = 0; k <= n; ++k) c[k] = traj::detail::quintic_point(b, k)[i];
+    for (int k = 0; k < n; ++k) e1[k] = n * (c[k + 1] - c[k]);
+    for (int k = 0; k < n - 1; ++k) e2[k] = (n - 1) * (e1[k + 1] - e1[k]);
+    for (int q = 0; q <= kIntervals; ++q) {
+      const double t = static_cast<double>(q) / kIntervals;
+      g1[i][q] = std::fabs(bernstein(e1, n - 1, t)) / L;
+      g2[i][q] = std::fabs(bernstein(e2, n - 2, t)) / (L * L);
     }
   }
-  return {cap, std::max(accel, 0.0)};
+  const auto piece = [&](int i, int q, double& G1, double& G2) {
+    G1 = std::min(d1[i], 0.5 * (g1[i][q] + g1[i][q + 1] + d2[i] * ds));
+    G2 = std::min(d2[i], 0.5 * (g2[i][q] + g2[i][q + 1] + d3[i] * ds));
+  };
+  for (int i = 0; i < kAxisCount; ++i) {
+    if (d1[i] <= 0) continue;
+    const AxisLimits& l = p.machine[i];
+    for (int q = 0; q < kIntervals; ++q) {
+      double G1, G2;
+      piece(i, q, G1, G2);
+      if (G1 <= 0) continue;
+      r.accel = std::min(r.accel, (l.max_acceleration - cap * cap * G2) / G1);
+      if (limited_jerk(p, i)) {
+        const double left = jerk_scale * l.max_jerk - cap * cap * cap * d3[i];
+        r.accel = std::min(r.accel, left / (G1 / T + 3 * cap * G2));
+      }
+    }
+  }
+  r.accel = std::max(r.accel, 0.0);
+  for (int i = 0; i < kAxisCount; ++i) {
+    if (d1[i] <= 0 || !limited_jerk(p, i)) continue;
+    for (int q = 0; q < kIntervals; ++q) {
+      double G1, G2;
+      piece(i, q, G1, G2);
+      if (G1 <= 0) continue;
+      const double left =
+          jerk_scale * p.machine[i].max_jerk - cap * cap * cap * d3[i] - 3 * cap * G2 * r.accel;
+      r.jerk = std::min(r.jerk, std::max(left, 0.0) / G1);
+    }
+  }
+  return r;
 }
 
 }  // namespace
 
-RawLimits block_limits(const MotionBlock& b, double v_commanded_max, const LimitParams& p) noexcept {
+namespace {
+
+/// A Bernstein polynomial of degree n (coefficients c[0..n]) at t (de Casteljau).
+double bernstein(const double* c, int n, double t) {
+  double q[6];
+  for (int k = 0; k <= n; ++k) q[k] = c[k];
+  for (int level = n; level > 0; --level) {
+    for (int k = 0; k < level; ++k) q[k] += t * (q[k + 1] - q[k]);
+  }
+  return q[0];
+}
+
+/// The roots in (0, 1) of a Bernstein polynomial of degree n ≤ 5, in order (at most n). Between
+/// two consecutive roots of its derivative (found the same way) it is monotone, so each such piece
+/// holds at most one root, found by bisection where the sign changes: no root is missed, however
+/// close two of them lie.
+int bernstein_roots(const double* c, int n, double* roots) {
+  if (n <= 0) return 0;
+  double d[5];
+  for (int k = 0; k < n; ++k) d[k] = n * (c[k + 1] - c[k]);
+  double cuts[7];
+  int nc = 0;
+  cuts[nc++] = 0.0;
+  double inner[5];
+  const int ni = bernstein_roots(d, n - 1, inner);
+  for (int k = 0; k < ni; ++k) cuts[nc++] = inner[k];
+  cuts[nc++] = 1.0;
+  int found = 0;
+  for (int k = 0; k + 1 < nc; ++k) {
+    double lo = cuts[k], hi = cuts[k + 1];
+    double flo = bernstein(c, n, lo);
+    const double fhi = bernstein(c, n, hi);
+    if (flo == 0 || (flo < 0) == (fhi < 0)) continue;
+    for (int it = 0; it < 45 && hi - lo > 1e-12; ++it) {
+      const double mid = 0.5 * (lo + hi), fm = bernstein(c, n, mid);
+      if ((fm < 0) == (flo < 0)) {
+        lo = mid;
+        flo = fm;
+      } else {
+        hi = mid;
+      }
+    }
+    roots[found++] = 0.5 * (lo + hi);
+  }
+  return found;
+}
+
+/// Largest |p| on [0, 1] of a Bernstein polynomial of degree n ≤ 5: at the ends and at the roots
+/// of p' (bernstein_roots), its extrema.
+double max_abs_bernstein(const double* c, int n) {
+  double best = std::max(std::fabs(c[0]), std::fabs(c[n]));
+  if (n <= 1) return best;
+  double d[5], roots[5];
+  for (int k = 0; k < n; ++k) d[k] = n * (c[k + 1] - c[k]);
+  const int nr = bernstein_roots(d, n - 1, roots);
+  for (int k = 0; k < nr; ++k) best = std::max(best, std::fabs(bernstein(c, n, roots[k])));
+  return best;
+}
+
+}  // namespace
+
+// Per axis the derivatives of the Bézier in t are Béziers of the differences of the control
+// points; their largest magnitudes on [0, 1], divided by L, L², L³, are those along s.
+void derivative_bounds(const MotionBlock& b, double d1[kAxisCount], double d2[kAxisCount],
+                       double d3[kAxisCount]) noexcept {
+  const double L = b.length;
+  const int n = b.kind == BlockKind::Quintic ? 5 : 3;
+  for (int i = 0; i < kAxisCount; ++i) {
+    double c[6], e1[5], e2[4], e3[3];
+    bool moves = false;
+    for (int k = 0; k <= n; ++k) {
+      c[k] = traj::detail::quintic_point(b, k)[i];  // base, u, w, lin(, p4, p5)
+      moves = moves || c[k] != c[0];
+    }
+    if (!moves) {  // an axis the block does not move
+      d1[i] = d2[i] = d3[i] = 0;
+      continue;
+    }
+    for (int k = 0; k < n; ++k) e1[k] = n * (c[k + 1] - c[k]);
+    for (int k = 0; k < n - 1; ++k) e2[k] = (n - 1) * (e1[k + 1] - e1[k]);
+    for (int k = 0; k < n - 2; ++k) e3[k] = (n - 2) * (e2[k + 1] - e2[k]);
+    d1[i] = max_abs_bernstein(e1, n - 1) / L;
+    d2[i] = max_abs_bernstein(e2, n - 2) / (L * L);
+    d3[i] = max_abs_bernstein(e3, n - 3) / (L * L * L);
+  }
+}
+
+RawLimits block_limits(const MotionBlock& b, double v_commanded_max, const LimitParams& p,
+                       double jerk_scale) noexcept {
   switch (b.kind) {
     case BlockKind::Line:
-      return line_limits(b, v_commanded_max, p);
+      return line_limits(b, v_commanded_max, p, jerk_scale);
     case BlockKind::Arc:
     case BlockKind::Spiral:
-      return arc_or_spiral_limits(b, v_commanded_max, p);
+      return arc_or_spiral_limits(b, v_commanded_max, p, jerk_scale);
     case BlockKind::Bezier:
-      return bezier_limits(b, v_commanded_max, p);
+    case BlockKind::Quintic:
+      return bezier_limits(b, v_commanded_max, p, jerk_scale);
     case BlockKind::Marker:
       break;
   }
-  return {kInf, kInf};
+  return {kInf, kInf, kInf};
 }
 
 Pose curvature_step(const MotionBlock& prev, const MotionBlock& next) noexcept {

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Look-ahead window: widening for the moving average, curvature-step density, braking prefix,
-// backward pass, soft links.
+// Look-ahead window: curvature-step density, widening for the moving average (settling), braking
+// prefix, backward pass, soft links.
 #include "lookahead.hpp"
 
 #include <algorithm>
@@ -20,15 +20,12 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr std::size_t kSoftScan = 64;
 constexpr double kMinPiece = 1e-4;   ///< blocks are not split into pieces shorter than this
 constexpr double kSplitGain = 1e-3;  ///< nor for a limit less than this much (relative) lower
+/// Short blocks are split only where a limit falls below this share of their own: lesser ones
+/// cost little over the block's length, and every cut costs the settling a pass over the ranges.
+constexpr double kShortSplitShare = 0.5;
 
-bool is_marker(const PlannedBlock& p) {
-  return p.b.kind == BlockKind::Marker;
-}
 bool is_stop(const traj::MotionBlock& b) {
   return b.kind == BlockKind::Marker && b.marker != traj::MarkerKind::Report;
-}
-double end_s(const PlannedBlock& p) {
-  return p.start_s + p.b.length;
 }
 bool has_step(const Pose& s) {
   for (double v : s.v) {
@@ -36,36 +33,93 @@ bool has_step(const Pose& s) {
   }
   return false;
 }
+bool lower(double limit, double own, double share) {
+  return limit < own * share;
+}
 
 }  // namespace
 
+Lookahead::Lookahead(const WindowParams& p) : p_(p) {
+  if (widening()) {
+    half_window_ = 0.5 * p.filter_s + 3 * p.period_s;
+    jerk_window_ = 4 * p.period_s;
+    reach_ = std::max(p.v_bound * half_window_, p.step_window_s);
+  }
+}
+
 PlannedBlock& Lookahead::next_slot() {
-  PlannedBlock& pb = window_.spare();
-  pb.cap_raw = pb.accel_raw = pb.junction = 0;
+  PlannedBlock& pb = pending_.spare();
+  pb.raw = RawLimits{};
+  pb.v_max = pb.junction = 0;
   pb.step = Pose{};
   return pb;
 }
 
 void Lookahead::push_next() {
-  PlannedBlock& pb = window_.spare();
-  pb.start_s = total_s_;
-  pb.cap = pb.cap_raw;
-  pb.accel = pb.accel_raw;
-  pb.local = pb.entry = pb.prefix = 0;
+  PlannedBlock& pb = pending_.spare();
+  const bool marker = pb.b.kind == BlockKind::Marker;
+  if (cut_ && !marker) {  // the blocks before were settled as if a stop came here
+    pb.junction = 0;
+    cut_ = false;
+  }
+  if (!marker && pb.junction <= 0) ++epoch_;  // from rest: nothing before reaches it
   pb.step_sum = pb.step;
-  total_s_ += pb.b.length;
-  window_.commit_spare();
-  if (widening() && !is_marker(pb)) {
-    add_steps(window_.size() - 1);
-    widen_last();
+  Range& r = ranges_.append();
+  r.start = total_s_;
+  r.end = total_s_ + pb.b.length;
+  r.cap = pb.raw.cap;
+  r.accel = pb.raw.accel;
+  r.jerk = pb.raw.jerk;
+  r.junction = pb.junction;
+  r.epoch = epoch_;
+  r.marker = marker;
+  r.scaled = false;
+  if (marker && is_stop(pb.b)) ++epoch_;  // a stop: the generator waits there for the average
+  total_s_ = r.end;
+  pending_.commit_spare();
+  if (widening() && !marker) {
+    if (has_step(pb.step)) scale_near_step(pending_.size() - 1);
+    if (r.start < scaled_until_ && !r.scaled) {
+      const RawLimits s = block_limits(pb.b, pb.v_max, *p_.limits, 1 - p_.limits->step_share);
+      r.cap = std::min(r.cap, s.cap);
+      r.accel = std::min(r.accel, s.accel);
+      r.jerk = std::min(r.jerk, s.jerk);
+      r.scaled = true;
+    }
+    add_steps(pending_.size() - 1);
   }
   dirty_ = true;
+}
+
+void Lookahead::reopen() noexcept {
+  finished_ = false;
+  prev_stop_ = true;
+  pinned_ = 0;
+  ++epoch_;
+}
+
+// A curvature step is sampled with the jerk share η; the blocks around it, within the trace's
+// finite differences of it, keep within 1 − η (their limits are computed again).
+void Lookahead::scale_near_step(std::size_t m) {
+  const double at = range_of(m).start;
+  const double reach = p_.step_window_s + p_.v_bound * jerk_window_;
+  scaled_until_ = at + reach;
+  for (std::size_t j = m; j-- > 0;) {
+    Range& r = range_of(j);
+    if (r.end < at - reach) break;
+    if (r.marker || r.scaled) continue;  // (the scaled limits do not depend on which step asks)
+    const RawLimits s = block_limits(pending_[j].b, pending_[j].v_max, *p_.limits, 1 - p_.limits->step_share);
+    r.cap = std::min(r.cap, s.cap);
+    r.accel = std::min(r.accel, s.accel);
+    r.jerk = std::min(r.jerk, s.jerk);
+    r.scaled = true;
+  }
 }
 
 // Curvature steps closer than three servo periods of travel add up in a sampled jerk, so each
 // step's speed limit uses the sum of the steps around it: v² · Σ|Δg''| ≤ (4/3)·η·J·T_servo.
 void Lookahead::add_steps(std::size_t m) {
-  PlannedBlock& nb = window_[m];
+  PlannedBlock& nb = pending_[m];
   if (!has_step(nb.step)) return;
   const auto limit = [this](const Pose& sum) {
     double v = kInf;
@@ -75,111 +129,162 @@ void Lookahead::add_steps(std::size_t m) {
     }
     return v;
   };
-  lowered_.clear();
+  const double at = range_of(m).start;
   for (std::size_t j = m; j-- > 0;) {
-    PlannedBlock& jb = window_[j];
-    if (nb.start_s - jb.start_s > p_.step_window_s) break;
-    if (is_marker(jb) || !has_step(jb.step)) continue;
+    PlannedBlock& jb = pending_[j];
+    Range& jr = range_of(j);
+    if (at - jr.start > p_.step_window_s) break;
+    if (jr.marker || !has_step(jb.step)) continue;
     for (int i = 0; i < kAxisCount; ++i) {
       jb.step_sum[i] += nb.step[i];
       nb.step_sum[i] += jb.step[i];
     }
-    const double v = limit(jb.step_sum);
-    if (v < jb.junction) {
-      jb.junction = v;
-      lowered_.push_back({jb.start_s, v});
+    jr.junction = std::min(jr.junction, limit(jb.step_sum));
+  }
+  Range& nr = range_of(m);
+  nr.junction = std::min(nr.junction, limit(nb.step_sum));
+}
+
+bool Lookahead::can_settle_front() const noexcept {
+  if (finished_ || cut_ || !widening()) return true;
+  const Range& r = ranges_[ranges_.size() - pending_.size()];
+  return epoch_ > r.epoch || total_s_ - r.end >= reach_;
+}
+
+bool Lookahead::wants_more() const noexcept {
+  const std::size_t n = size();
+  if (n >= p_.hard_blocks) return false;
+  if (n < p_.soft_blocks) return true;
+  if (!pending_.empty() && !can_settle_front()) return true;
+  const double from = !settled_.empty() ? settled_.front().start_s : total_s_;
+  return total_s_ - from < p_.soft_length;
+}
+
+// The lowest raw limits of the ranges that reach [from, to] (the block's own among them).
+Lookahead::Widened Lookahead::widened_over(double from, double to, std::uint64_t epoch,
+                                           const Range& own) const {
+  Widened w{own.cap, own.accel, own.jerk};
+  for (std::size_t j = 0; j < ranges_.size(); ++j) {
+    const Range& r = ranges_[j];
+    if (r.start - reach_ >= to) break;  // ranges are in order of their start
+    if (r.marker || r.epoch != epoch) continue;
+    const double c = r.cap * half_window_;
+    if (r.start - c < to && r.end + c > from) {
+      w.cap = std::min(w.cap, r.cap);
+      w.accel = std::min(w.accel, r.accel);
+    }
+    const double cj = r.cap * jerk_window_;
+    if (r.start - cj < to && r.end + cj > from) w.jerk = std::min(w.jerk, r.jerk);
+    if (r.junction > 0 && r.junction < kInf) {
+      const double v = r.junction * half_window_;
+      if (r.start - v < to && r.start + v > from) w.cap = std::min(w.cap, r.junction);
     }
   }
-  nb.junction = std::min(nb.junction, limit(nb.step_sum));
-  // Widen the lowered junction limits only now: splitting blocks moves them in the deque.
-  for (const auto& [at, v] : lowered_) limit_range(at - v * p_.filter_s, at + v * p_.filter_s, v, kInf);
+  return w;
 }
 
-// The limits of the new last block reach back over the blocks before it, and theirs reach
-// forward over it.
-void Lookahead::widen_last() {
-  const PlannedBlock m = window_.back();
-  const double T = p_.filter_s;
-  const double start = m.start_s, end = end_s(m);
-  for (std::size_t j = window_.size(); j-- > 0;) {
-    const PlannedBlock jb = window_[j];
-    if (jb.start_s >= start) continue;  // the new block (or a piece of it)
-    if (start - end_s(jb) >= reach_) break;
-    if (is_marker(jb)) continue;
-    limit_range(start, end_s(jb) + jb.cap_raw * T, jb.cap_raw, jb.accel_raw);
-    if (jb.junction > 0 && jb.junction < kInf)
-      limit_range(start, jb.start_s + jb.junction * T, jb.junction, kInf);
+void Lookahead::append_settled(const traj::MotionBlock& b, double start_s, const Widened& w,
+                               double junction) {
+  SettledBlock& sb = settled_.append();
+  sb.b = b;
+  sb.start_s = start_s;
+  sb.prefix = next_prefix_;
+  sb.entry = 0;
+  if (b.kind == BlockKind::Marker) {
+    sb.local = is_stop(b) ? 0.0 : kInf;
+    sb.cap = sb.accel = sb.jerk = 0;
+    if (is_stop(b)) prev_stop_ = true;
+    return;
   }
-  limit_range(start - m.cap_raw * T, end, m.cap_raw, m.accel_raw);
-  if (m.junction > 0 && m.junction < kInf)
-    limit_range(start - m.junction * T, start + m.junction * T, m.junction, kInf);
+  sb.cap = w.cap;
+  sb.accel = w.accel;
+  sb.jerk = w.jerk;
+  sb.local = std::min({junction, sb.cap, prev_stop_ ? 0.0 : prev_path_cap_});
+  prev_path_cap_ = sb.cap;
+  prev_stop_ = false;
+  next_prefix_ += 2.0 * sb.accel * b.length;
 }
 
-// Lowers cap and budget of the path between s = from and s = to, splitting blocks that reach
-// beyond it (only unsettled blocks are ever in range).
-void Lookahead::limit_range(double from, double to, double cap, double accel) {
-  if (!(to > from)) return;
-  for (std::size_t k = window_.size(); k-- > settled_;) {
-    const double s0 = window_[k].start_s, s1 = end_s(window_[k]);
-    if (s1 <= from) break;
-    if (s0 >= to || is_marker(window_[k])) continue;
-    const double lo = std::max(from, s0), hi = std::min(to, s1);
-    if (!(hi > lo)) continue;
-    PlannedBlock& whole = window_[k];
-    // A rigid tap's blocks stay whole (the tap runs them as one motion): they take the lower
-    // limits throughout.
-    if (!(cap < whole.cap * (1 - kSplitGain) || accel < whole.accel * (1 - kSplitGain)) ||
-        (whole.b.flags & traj::kRigidTap)) {
-      whole.cap = std::min(whole.cap, cap);  // too small a change to be worth a split
-      whole.accel = std::min(whole.accel, accel);
-      continue;
+// The front pending block's limits are final: widen them, split the block where they change
+// (long blocks only), and append the pieces to the settled blocks.
+void Lookahead::settle_front() {
+  const PlannedBlock& pb = pending_.front();
+  const Range own = ranges_[ranges_.size() - pending_.size()];
+  if (pb.b.kind == BlockKind::Marker || !widening()) {
+    append_settled(pb.b, own.start, Widened{own.cap, own.accel, own.jerk}, own.junction);
+  } else {
+    const double share = pb.b.length <= 0.5 * reach_ ? kShortSplitShare : 1 - kSplitGain;
+    // Where a lower range begins or ends inside the block.
+    cuts_.clear();
+    const auto cut_at = [&](double x) {
+      if (x > own.start + kMinPiece && x < own.end - kMinPiece) cuts_.push_back(x);
+    };
+    for (std::size_t j = 0; j < ranges_.size(); ++j) {
+      const Range& r = ranges_[j];
+      if (r.start - reach_ >= own.end) break;
+      if (r.marker || r.epoch != own.epoch) continue;
+      if (lower(r.cap, own.cap, share) || lower(r.accel, own.accel, share)) {
+        cut_at(r.start - r.cap * half_window_);
+        cut_at(r.end + r.cap * half_window_);
+      }
+      if (lower(r.jerk, own.jerk, share)) {
+        cut_at(r.start - r.cap * jerk_window_);
+        cut_at(r.end + r.cap * jerk_window_);
+      }
+      if (r.junction > 0 && r.junction < kInf && lower(r.junction, own.cap, share)) {
+        cut_at(r.start - r.junction * half_window_);
+        cut_at(r.start + r.junction * half_window_);
+      }
     }
-    if (s1 - hi > kMinPiece && hi - s0 > kMinPiece) split(k, hi - s0);
-    std::size_t target = k;
-    if (lo - s0 > kMinPiece) {
-      split(k, lo - s0);
-      target = k + 1;
+    std::sort(cuts_.begin(), cuts_.end());
+    // The pieces between the cuts (none shorter than kMinPiece), then each run of pieces with the
+    // same limits as one block.
+    traj::MotionBlock rest = pb.b;
+    double at = own.start;
+    bool first = true;
+    std::size_t c = 0;
+    while (at < own.end) {
+      while (c < cuts_.size() && cuts_[c] - at < kMinPiece) ++c;
+      double next = c < cuts_.size() ? cuts_[c] : own.end;
+      const Widened piece = widened_over(at, next, own.epoch, own);
+      for (;;) {  // run on while the next piece has the same limits
+        std::size_t c2 = c + 1;
+        while (c2 < cuts_.size() && cuts_[c2] - next < kMinPiece) ++c2;
+        if (next >= own.end) break;
+        const double after_end = c2 < cuts_.size() ? cuts_[c2] : own.end;
+        const Widened after = widened_over(next, after_end, own.epoch, own);
+        if (after.cap != piece.cap || after.accel != piece.accel || after.jerk != piece.jerk) break;
+        c = c2;
+        next = after_end;
+      }
+      traj::MotionBlock head = rest;
+      if (next < own.end) {
+        trim_end(head, head.length - (next - at));
+        trim_start(rest, next - at);
+        rebase(rest, end_point(head));
+      }
+      append_settled(head, at, piece, first ? own.junction : kInf);
+      first = false;
+      at = next;
+      ++c;
     }
-    PlannedBlock& t = window_[target];
-    t.cap = std::min(t.cap, cap);
-    t.accel = std::min(t.accel, accel);
   }
+  pending_.pop_front();
+  // Ranges that can no longer reach the next block to settle.
+  const double next_start = pending_.empty() ? total_s_ : ranges_[ranges_.size() - pending_.size()].start;
+  while (ranges_.size() > pending_.size() && ranges_.front().end + reach_ < next_start) ranges_.pop_front();
 }
 
-void Lookahead::split(std::size_t k, double x) {
-  PlannedBlock tail = window_[k];
-  PlannedBlock& head = window_[k];
-  trim_end(head.b, head.b.length - x);
-  trim_start(tail.b, x);
-  rebase(tail.b, end_point(head.b));
-  tail.start_s = head.start_s + x;
-  tail.junction = kInf;
-  tail.step = Pose{};
-  tail.step_sum = Pose{};
-  window_.insert(k + 1, tail);
-}
-
-// Blocks whose widened limits can no longer change get their prefix and own entry limit.
 void Lookahead::settle() {
-  const std::size_t first_new = settled_;
-  while (settled_ < window_.size()) {
-    PlannedBlock& pb = window_[settled_];
-    if (!finished_ && widening() && total_s_ - end_s(pb) < reach_) break;
-    pb.prefix = next_prefix_;
-    if (is_marker(pb)) {
-      pb.local = is_stop(pb.b) ? 0.0 : kInf;
-      pb.accel = 0;
-      pb.cap = 0;
-      if (is_stop(pb.b)) prev_stop_ = true;
-    } else {
-      pb.local = std::min({pb.junction, pb.cap, prev_stop_ ? 0.0 : prev_path_cap_});
-      prev_path_cap_ = pb.cap;
-      prev_stop_ = false;
-      next_prefix_ += 2.0 * pb.accel * pb.b.length;
+  const std::size_t first_new = settled_.size();
+  while (!pending_.empty()) {
+    if (!can_settle_front()) {
+      if (pending_.size() < p_.hard_blocks) break;
+      cut_ = true;  // so many blocks within the reach: a stop after them keeps the memory bounded
     }
-    ++settled_;
+    settle_front();
   }
-  if (settled_ > first_new || finished_) backward_pass(first_new);
+  if (settled_.size() > first_new || finished_) backward_pass(first_new);
 }
 
 // Entry speeds from the end of the settled blocks backward, assuming a stop after them:
@@ -188,19 +293,19 @@ void Lookahead::settle() {
 // final, and so is everything before it.
 void Lookahead::backward_pass(std::size_t first_new) {
   double after = 0;
-  for (std::size_t k = settled_; k-- > 0;) {
-    PlannedBlock& pb = window_[k];
-    const double e = std::min(pb.local, std::sqrt(after * after + 2.0 * pb.accel * pb.b.length));
-    if (k < first_new && e == pb.entry) break;
-    pb.entry = e;
+  for (std::size_t k = settled_.size(); k-- > 0;) {
+    SettledBlock& sb = settled_[k];
+    const double e = std::min(sb.local, std::sqrt(after * after + 2.0 * sb.accel * sb.b.length));
+    if (k < first_new && e == sb.entry) break;
+    sb.entry = e;
     after = e;
   }
-  if (finished_ && settled_ == window_.size()) {
-    pinned_ = settled_;
+  if (finished_ && pending_.empty()) {
+    pinned_ = settled_.size();
     return;
   }
-  for (std::size_t k = settled_; k-- > pinned_;) {
-    if (window_[k].entry == window_[k].local) {
+  for (std::size_t k = settled_.size(); k-- > pinned_;) {
+    if (settled_[k].entry == settled_[k].local) {
       pinned_ = k + 1;
       break;
     }
@@ -208,7 +313,7 @@ void Lookahead::backward_pass(std::size_t first_new) {
 }
 
 std::uint64_t Lookahead::soft_link(std::uint64_t seq) {
-  const traj::MotionBlock& f = window_.front().b;
+  const traj::MotionBlock& f = settled_.front().b;
   if (f.kind == BlockKind::Marker) return traj::kNoBlock;
   // Same class and nominal speed as the block before: the first lower one further on is the same.
   if (last_link_ != traj::kNoBlock && last_link_ > seq && f.feed_class == last_link_class_ &&
@@ -222,23 +327,24 @@ std::uint64_t Lookahead::soft_link(std::uint64_t seq) {
 }
 
 std::uint64_t Lookahead::find_soft_link(std::uint64_t seq) const {
-  const traj::MotionBlock& f = window_.front().b;
-  const std::size_t n = std::min(window_.size(), kSoftScan + 1);
+  const traj::MotionBlock& f = settled_.front().b;
+  const std::size_t n = std::min(settled_.size(), kSoftScan + 1);
   for (std::size_t k = 1; k < n; ++k) {
-    const traj::MotionBlock& q = window_[k].b;
+    const traj::MotionBlock& q = settled_[k].b;
     if (q.kind == BlockKind::Marker) continue;
     if (q.feed_class != f.feed_class || q.feed < f.feed) return seq + k;
   }
-  if (finished_ && n == window_.size()) return traj::kNoBlock;
+  if (finished_ && pending_.empty() && n == settled_.size()) return traj::kNoBlock;
   return seq + n;  // not decided yet: the tick continues the walk from that block's own link
 }
 
-bool Lookahead::front_link_decided() const {
-  if (finished_ || window_.size() > kSoftScan || window_.empty()) return true;
-  const traj::MotionBlock& f = window_.front().b;
+bool Lookahead::front_link_decided() {
+  refresh();
+  if ((finished_ && pending_.empty()) || settled_.size() > kSoftScan || settled_.empty()) return true;
+  const traj::MotionBlock& f = settled_.front().b;
   if (f.kind == BlockKind::Marker) return true;
-  for (std::size_t k = 1; k < window_.size(); ++k) {
-    const traj::MotionBlock& q = window_[k].b;
+  for (std::size_t k = 1; k < settled_.size(); ++k) {
+    const traj::MotionBlock& q = settled_[k].b;
     if (q.kind == BlockKind::Marker) continue;
     if (q.feed_class != f.feed_class || q.feed < f.feed) return true;
   }
@@ -246,19 +352,19 @@ bool Lookahead::front_link_decided() const {
 }
 
 void Lookahead::front_for_queue(std::uint64_t seq, traj::MotionBlock& out) {
-  const PlannedBlock& pb = window_.front();
-  out = pb.b;
+  const SettledBlock& sb = settled_.front();
+  out = sb.b;
   out.seq = seq;
-  out.v_cap = pb.cap;
-  out.accel = pb.accel;
-  out.v_entry = pb.entry;
-  out.brake_prefix = pb.prefix;
+  out.v_cap = sb.cap;
+  out.accel = sb.accel;
+  out.jerk = std::isfinite(sb.jerk) ? sb.jerk : 0.0;
+  out.v_entry = sb.entry;
+  out.brake_prefix = sb.prefix;
   out.next_soft = soft_link(seq);
 }
 
 void Lookahead::pop_front() {
-  window_.pop_front();
-  if (settled_ > 0) --settled_;
+  settled_.pop_front();
   if (pinned_ > 0) --pinned_;
 }
 

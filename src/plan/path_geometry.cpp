@@ -244,6 +244,27 @@ void split_bezier(const MotionBlock& b, double t, MotionBlock* head, MotionBlock
   }
 }
 
+// The same for a quintic (de Casteljau on six points).
+void split_quintic(const MotionBlock& b, double t, MotionBlock* head, MotionBlock* tail) {
+  Pose q[6] = {b.base, b.u, b.w, b.lin, b.p4, b.p5};
+  Pose left[6], right[6];
+  for (int level = 0; level < 6; ++level) {
+    left[level] = q[0];
+    right[5 - level] = q[5 - level];
+    for (int k = 0; k + level < 5; ++k) q[k] = q[k] + t * (q[k + 1] - q[k]);
+  }
+  if (head != nullptr) {
+    head->base = left[0], head->u = left[1], head->w = left[2], head->lin = left[3], head->p4 = left[4];
+    head->p5 = left[5];
+    head->length = b.length * t;
+  }
+  if (tail != nullptr) {
+    tail->base = right[0], tail->u = right[1], tail->w = right[2], tail->lin = right[3], tail->p4 = right[4];
+    tail->p5 = right[5];
+    tail->length = b.length * (1 - t);
+  }
+}
+
 }  // namespace
 
 void trim_start(MotionBlock& b, double d) noexcept {
@@ -251,6 +272,10 @@ void trim_start(MotionBlock& b, double d) noexcept {
   b.segment_offset += d;
   if (b.kind == BlockKind::Bezier) {
     split_bezier(b, d / b.length, nullptr, &b);
+    return;
+  }
+  if (b.kind == BlockKind::Quintic) {
+    split_quintic(b, d / b.length, nullptr, &b);
     return;
   }
   const Pose p = traj::position_at(b, d);
@@ -272,6 +297,10 @@ void trim_end(MotionBlock& b, double d) noexcept {
   if (d <= 0) return;
   if (b.kind == BlockKind::Bezier) {
     split_bezier(b, (b.length - d) / b.length, &b, nullptr);
+    return;
+  }
+  if (b.kind == BlockKind::Quintic) {
+    split_quintic(b, (b.length - d) / b.length, &b, nullptr);
     return;
   }
   b.length -= d;
@@ -394,10 +423,12 @@ double needed_radius(const Pose& t, const Pose& n, const BlendNeed& need) {
 
 bool line_line_blend(const MotionBlock& in, double avail_in, const MotionBlock& out, double avail_out,
                      double tolerance, const BlendNeed& need, const CornerTurn& turn, Blend& result) {
-  // Circular fillet tangent to both lines: tangent length d, radius R = d / tan(θ/2), largest
-  // distance from the lines R·(1 − cos(θ/2)) ≤ tolerance, and no larger than the speed needs.
-  // From s = sin(θ/2) and c = cos(θ/2): tan(θ/2) = s/c and 1 − c = s²/(1 + c), without
-  // cancellation at small angles, so d ≤ tolerance·(1 + c)/(s·c).
+  // Circular fillet tangent to both lines: tangent length d, radius R = d / tan(θ/2). Its middle
+  // is nearest to the corner, R·(1/cos(θ/2) − 1) from it (and R·(1 − cos(θ/2)) from the lines):
+  // that distance ≤ tolerance, as LinuxCNC sizes its blend arcs, so that the path passes within
+  // the tolerance of the corner too (a hairpin is not cut off at its moves' middles). And no
+  // larger than the speed needs. From s = sin(θ/2) and c = cos(θ/2): tan(θ/2) = s/c and
+  // 1 − c = s²/(1 + c), without cancellation at small angles, so d ≤ tolerance·(1 + c)/s.
   const double theta = turn.angle, s = turn.half_sine, c2 = std::sqrt(1.0 - s * s);
   const double t2 = s / c2;
   const Pose& ta = turn.in;
@@ -405,7 +436,7 @@ bool line_line_blend(const MotionBlock& in, double avail_in, const MotionBlock& 
   n = n - dot(n, ta) * ta;
   n = (1.0 / norm(n)) * n;
   double d = std::min({avail_in, avail_out, needed_radius(ta, n, need) * t2});
-  if (tolerance > 0) d = std::min(d, tolerance * (1.0 + c2) / (s * c2));
+  if (tolerance > 0) d = std::min(d, tolerance * (1.0 + c2) / s);
   if (!(d >= kMinLength)) return false;
   const double radius = d / t2;
   MotionBlock& c = result.curve;  // the caller sets identity, class and feed
@@ -429,18 +460,18 @@ bool line_line_blend(const MotionBlock& in, double avail_in, const MotionBlock& 
 void bezier_at(const MotionBlock& in, const MotionBlock& out, double d, MotionBlock& c) {
   const Pose p0 = traj::position_at(in, in.length - d);
   const Pose p3 = traj::position_at(out, d);
-  Pose ta = traj::tangent_at(in, in.length - d), tb = traj::tangent_at(out, d);
-  ta = (1.0 / norm(ta)) * ta;
-  tb = (1.0 / norm(tb)) * tb;
-  const double theta = angle_between(ta, tb);
+  // The arms along dp/ds of the pieces (not only its direction): the velocity stays continuous
+  // where |dp/ds| is not exactly 1 (a spiral, a fitted run of short moves).
+  const Pose da = traj::tangent_at(in, in.length - d), db = traj::tangent_at(out, d);
+  const double theta = angle_between((1.0 / norm(da)) * da, (1.0 / norm(db)) * db);
   const double cq = std::cos(0.25 * theta);
   const double h = norm(p3 - p0) / (3.0 * cq * cq);
   c.line = in.line;  // the caller sets identity, class and feed
   c.context = in.context;
   c.kind = BlockKind::Bezier;
   c.base = p0;
-  c.u = p0 + h * ta;
-  c.w = p3 - h * tb;
+  c.u = p0 + h * da;
+  c.w = p3 - h * db;
   c.lin = p3;
   c.length = 3.0 * h;
   c.omega = 0;
@@ -467,13 +498,15 @@ bool bezier_blend(const MotionBlock& in, double avail_in, const MotionBlock& out
   Pose n = tb - ta;
   n = n - dot(n, ta) * ta;
   n = (1.0 / norm(n)) * n;
-  const double d_need = 2.0 * needed_radius(ta, n, need) * std::tan(0.5 * theta);
+  const double d_need =
+      theta > kTangentAngle ? 2.0 * needed_radius(ta, n, need) * std::tan(0.5 * theta) : avail_in;
   const double d_max = std::min({avail_in, avail_out, d_need});
   if (!(d_max >= kMinLength)) return false;
   const auto ok = [&](double d) {
     bezier_at(in, out, d, result.curve);
     if (result.curve.length < kMinLength) return false;
-    return tolerance <= 0 || bezier_deviation(result.curve, in, out) <= tolerance;
+    return tolerance <= 0 || (bezier_deviation(result.curve, in, out) <= tolerance &&
+                              point_to_curve(result.curve, end_point(in)) <= tolerance);
   };
   double d = d_max;
   if (!ok(d)) {
@@ -492,6 +525,120 @@ bool bezier_blend(const MotionBlock& in, double avail_in, const MotionBlock& out
 
 }  // namespace
 
+JoinPoint join_at(const MotionBlock& b, double s) noexcept {
+  return {traj::position_at(b, s), traj::tangent_at(b, s), traj::curvature_at(b, s)};
+}
+
+namespace {
+
+/// Control points of the G2 quintic for parameter length L.
+void g2_points(const JoinPoint& a, const JoinPoint& b, double L, MotionBlock& c) {
+  const double h = L / 5, k = L * L / 20;
+  c.base = a.p;
+  c.u = a.p + h * a.d1;
+  c.w = 2.0 * c.u - a.p + k * a.d2;
+  c.p5 = b.p;
+  c.p4 = b.p - h * b.d1;
+  c.lin = 2.0 * c.p4 - b.p + k * b.d2;
+  c.length = L;
+}
+
+/// Arc length of a quintic block (8-point Gauss-Legendre: the speed of a blend is smooth) and
+/// its smallest speed |dB/dt| among the nodes relative to L (a cusp makes it vanish).
+double quintic_arc_length(const MotionBlock& c, double& slowest) {
+  static constexpr double kNode[4] = {0.1834346424956498, 0.5255324099163290, 0.7966664774136267,
+                                      0.9602898564975363};
+  static constexpr double kWeight[4] = {0.3626837833783620, 0.3137066458778873, 0.2223810344533745,
+                                        0.1012285362903763};
+  double sum = 0;
+  slowest = 1e300;
+  for (int q = 0; q < 4; ++q) {
+    for (int side = -1; side <= 1; side += 2) {
+      const double t = 0.5 + side * 0.5 * kNode[q];
+      const double speed = norm(traj::tangent_at(c, t * c.length));  // |dB/dt| / L
+      slowest = std::min(slowest, speed);
+      sum += kWeight[q] * speed;
+    }
+  }
+  return 0.5 * sum * c.length;
+}
+
+}  // namespace
+
+bool make_g2_curve(const JoinPoint& a, const JoinPoint& b, MotionBlock& out) noexcept {
+  const double chord = norm(b.p - a.p);
+  if (!(chord >= kMinLength)) return false;
+  out.kind = BlockKind::Quintic;
+  out.omega = 0;
+  out.spiral = 0;
+  double L = chord;
+  for (int it = 0; it < 12; ++it) {
+    g2_points(a, b, L, out);
+    double slowest = 0;
+    const double next = quintic_arc_length(out, slowest);
+    if (!(slowest > 0.05) || !(next > 0)) return false;  // (nearly) a cusp: no useful curve
+    // Any L keeps the curve G2; its own length only makes |dp/ds| about 1 (the feed).
+    if (std::fabs(next - L) <= 1e-6 * L) {
+      L = next;
+      break;
+    }
+    L = next;
+  }
+  g2_points(a, b, L, out);
+  return std::isfinite(L) && L >= kMinLength;
+}
+
+double point_to_curve(const MotionBlock& c, const Pose& v) noexcept {
+  // The nearest of 16 samples, then a golden-section search between its neighbours: the distance
+  // to a point of the curve, so never below the true distance.
+  constexpr int kSamples = 16;
+  const auto dist = [&](double t) { return norm(traj::position_at(c, c.length * t) - v); };
+  int best_k = 0;
+  double best = dist(0.0);
+  for (int k = 1; k <= kSamples; ++k) {
+    const double d = dist(static_cast<double>(k) / kSamples);
+    if (d < best) {
+      best = d;
+      best_k = k;
+    }
+  }
+  constexpr double kGolden = 0.6180339887498949;
+  double a = std::max(0, best_k - 1) / static_cast<double>(kSamples);
+  double b = std::min(kSamples, best_k + 1) / static_cast<double>(kSamples);
+  double x1 = b - kGolden * (b - a), x2 = a + kGolden * (b - a), f1 = dist(x1), f2 = dist(x2);
+  for (int it = 0; it < 24; ++it) {
+    if (f1 < f2) {
+      b = x2;
+      x2 = x1;
+      f2 = f1;
+      x1 = b - kGolden * (b - a);
+      f1 = dist(x1);
+    } else {
+      a = x1;
+      x1 = x2;
+      f1 = f2;
+      x2 = a + kGolden * (b - a);
+      f2 = dist(x2);
+    }
+  }
+  return std::min({best, f1, f2});
+}
+
+bool blend_within(const MotionBlock& c, const MotionBlock& in, const MotionBlock& out,
+                  double tolerance) noexcept {
+  return point_to_curve(c, end_point(in)) <= tolerance &&
+         curve_within(
+             c, [&](const Pose& p) { return std::min(distance_to(in, p), distance_to(out, p)); }, tolerance);
+}
+
+double speed_scale_step(const MotionBlock& in, const MotionBlock& out) noexcept {
+  return std::fabs(norm(traj::tangent_at(in, in.length)) - norm(traj::tangent_at(out, 0.0)));
+}
+
+bool same_speed_scale(const MotionBlock& in, const MotionBlock& out) noexcept {
+  return speed_scale_step(in, out) <= 1e-9;
+}
+
 CornerTurn corner_turn(const MotionBlock& in, const MotionBlock& out) noexcept {
   CornerTurn t;
   t.in = end_tangent(in);
@@ -506,7 +653,11 @@ bool blend_corner(const MotionBlock& in, double avail_in, const MotionBlock& out
   const Pose& ta = turn.in;
   const Pose& tb = turn.out;
   const double theta = turn.angle;
-  if (theta <= kTangentAngle || theta >= kReversalAngle) return false;
+  if (theta >= kReversalAngle) return false;
+  if (theta <= kTangentAngle) {  // tangent, but |dp/ds| differs: a transition between the two
+    if (same_speed_scale(in, out)) return false;
+    return bezier_blend(in, avail_in, out, avail_out, tolerance, need, theta, ta, tb, result);
+  }
   if (in.kind == BlockKind::Line && out.kind == BlockKind::Line) {
     return line_line_blend(in, avail_in, out, avail_out, tolerance, need, turn, result);
   }

@@ -11,10 +11,7 @@
 
 #include <fmt/format.h>
 
-#include "block_limits.hpp"
-#include "lookahead.hpp"
-#include "path_geometry.hpp"
-#include "program_reader.hpp"
+#include "planner_impl.hpp"
 #include "vec.hpp"
 
 namespace opencnc::plan {
@@ -28,24 +25,29 @@ using traj::MotionBlock;
 
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
-
 bool bad(double v) {
   return !std::isfinite(v);
 }
 
-/// Moving-average length in servo periods: long enough that 2·A/T ≤ (1 − η)·J on every axis.
-int filter_ticks(const MachineLimits& m, const PlannerConfig& c) {
+/// Moving-average length in servo periods: T ≥ A/J on every axis, so that an acceleration ramp of
+/// the average from 0 to A takes its jerk to J at most (the time-optimal ramp when T = A/J).
+int filter_ticks(const MachineLimits& m, double servo_period_s) {
   double t = 0;
   for (int i = 0; i < kAxisCount; ++i) {
     if (!m.axes.has(static_cast<Axis>(i)) || m[i].max_jerk <= 0) continue;
-    t = std::max(t, 2.0 * m[i].max_acceleration / ((1.0 - c.jerk_step_share) * m[i].max_jerk));
+    t = std::max(t, m[i].max_acceleration / m[i].max_jerk);
   }
   if (t <= 0) return 1;
-  return std::max(2, static_cast<int>(std::ceil(t / c.servo_period_s - 1e-9)));
+  return std::max(2, static_cast<int>(std::ceil(t / servo_period_s - 1e-9)));
 }
 
 }  // namespace
+
+double jerk_filter_s(const MachineLimits& limits, double servo_period_s) noexcept {
+  if (!(servo_period_s > 0)) return 0;
+  const int ticks = filter_ticks(limits, servo_period_s);
+  return ticks > 1 ? ticks * servo_period_s : 0.0;
+}
 
 bool validate(const MachineLimits& limits, Diagnostics& diags) {
   bool ok = true;
@@ -67,54 +69,10 @@ bool validate(const MachineLimits& limits, Diagnostics& diags) {
   return ok;
 }
 
-struct Planner::Impl {
-  MachineLimits limits;
-  PlannerConfig config;
-  detail::LimitParams params;
-  int ticks = 1;
-  Diagnostics diags;
-  PlanStats stats;
-  bool config_ok = true;
-  bool failed = false;
-
-  const canon::Program* program = nullptr;
-  std::optional<detail::ProgramReader> reader;
-  std::optional<detail::Lookahead> window;
-  bool reading_done = false;
-  // Streams (start_stream): the program grows while it is planned.
-  bool streaming = false;
-  bool flush_asked = false;   ///< stream_flush(): plan what is readable to a stop
-  bool flushing = false;      ///< a flush is being published; reading waits until it is
-  bool input_waiting = false; ///< everything readable has been read
-  std::optional<Element> pending;          ///< last element; its end is decided by the next one
-  std::vector<MotionBlock> reports;        ///< Report markers waiting after `pending`
-  Pose last_end{};                         ///< exact end of the last emitted path block
-  bool continues = false;                  ///< `prev` runs on into the next path block (no stop)
-  MotionBlock prev;                        ///< the last emitted path block (with jerk limits)
-
-  Impl(const MachineLimits& l, const PlannerConfig& c);
-  void check_config();
-  void emit_path(const MotionBlock& b, double junction);
-  void emit_marker(const MotionBlock& m);
-  void emit_reports();
-  void publish_front(traj::BlockQueue& queue);
-  void on_element(Element& e);
-  void on_marker(const MotionBlock& m);
-  void flush_pending();
-  bool corner(Element& a, Element& e);
-  double commanded_max(const MotionBlock& b) const;
-  detail::BlendNeed blend_need(const MotionBlock& a, const MotionBlock& e) const;
-  bool blend_pays(const Element& a, const Element& e, const detail::Blend& blend) const;
-  bool read_one();
-  bool begin(const canon::Program& program, bool stream);
-  /// The reader has nothing for now: ends the program, a flush, or waits for input.
-  void out_of_input();
-};
-
 Planner::Impl::Impl(const MachineLimits& l, const PlannerConfig& c) : limits(l), config(c) {
   check_config();
   if (!config_ok) return;
-  ticks = filter_ticks(limits, config);
+  ticks = filter_ticks(limits, config.servo_period_s);
   params.machine = limits;
   params.normal_share = config.normal_accel_share;
   params.step_share = config.jerk_step_share;
@@ -174,13 +132,18 @@ void Planner::Impl::emit_path(const MotionBlock& block, double junction) {
   b = block;
   detail::rebase(b, last_end);
   if (b.length < detail::kMinLength) return;
-  const detail::RawLimits r = detail::block_limits(b, commanded_max(b), params);
-  if (b.feed_class == FeedClass::Rapid) b.feed = r.cap;
-  pb.cap_raw = r.cap;
-  pb.accel_raw = r.accel;
+  pb.v_max = std::min(commanded_max(b), speed_bound());
+  pb.raw = detail::block_limits(b, pb.v_max, params);
+  if (b.feed_class == FeedClass::Rapid) b.feed = pb.raw.cap;
   pb.junction = junction;
   if (params.filter_s > 0) {  // the curvature steps matter with jerk limits only
     if (continues && junction > 0) pb.step = detail::curvature_step(prev, b);
+    // A step whose largest sampled jerk, (3/4)·v²·|Δg''|/T_servo, is far below the axis's limit
+    // is rounding (the joins of the curvature-continuous blends): none.
+    for (int i = 0; i < kAxisCount; ++i) {
+      const double j = limits[i].max_jerk;
+      if (j > 0 && 0.75 * v_bound * v_bound * pb.step[i] / config.servo_period_s <= 1e-7 * j) pb.step[i] = 0;
+    }
     prev = b;
   }
   continues = true;
@@ -212,11 +175,14 @@ void Planner::Impl::emit_reports() {
 
 /// The curve between two elements: returns true when it blended (or the corner is tangent), false
 /// when the motion has to stop at the corner. Emits `a` (trimmed) and the blend.
-bool Planner::Impl::corner(Element& a, Element& e) {
+bool Planner::Impl::corner_g1(Element& a, Element& e) {
   if (a.stop_after || a.mode == canon::MotionControl::ExactStop) return false;
   if ((a.b.feed_class == FeedClass::SpindleSync) != (e.b.feed_class == FeedClass::SpindleSync)) return false;
   const detail::CornerTurn turn = detail::corner_turn(a.b, e.b);
-  if (turn.angle <= detail::kTangentAngle) {
+  const bool tangent = turn.angle <= detail::kTangentAngle;
+  if (tangent && (detail::same_speed_scale(a.b, e.b) ||
+                  (a.mode != canon::MotionControl::Continuous &&
+                   detail::speed_scale_step(a.b, e.b) <= detail::kSpeedScaleSlack))) {
     emit_path(a.b, a.junction);
     emit_reports();
     return true;
@@ -295,6 +261,7 @@ void Planner::Impl::on_element(Element& e) {
   if (pending) {
     e.junction = corner(*pending, e) ? kInf : 0.0;
     if (e.junction == 0) {  // no blend: `pending` ends with a stop at the corner
+      release_held();
       emit_path(pending->b, pending->junction);
       emit_reports();
     }
@@ -303,6 +270,7 @@ void Planner::Impl::on_element(Element& e) {
 }
 
 void Planner::Impl::flush_pending() {
+  release_held();
   if (pending) emit_path(pending->b, pending->junction);
   pending.reset();
   emit_reports();
@@ -325,6 +293,7 @@ bool Planner::Impl::read_one() {
   } else {
     on_element(it->element);
   }
+  stats.smoothed_runs = reader->smoothed_runs();
   stats.moves = reader->moves_read();
   stats.merged_moves = reader->merged();
   return true;
@@ -340,6 +309,13 @@ traj::InterpolatorConfig Planner::interpolator_config() const noexcept {
   c.period_s = impl_->config.servo_period_s;
   c.filter_ticks = impl_->ticks;
   c.max_feed_override = impl_->config.max_feed_override;
+  // No block's budget exceeds a line's in the best direction: √(Σ A_i²).
+  for (int i = 0; i < kAxisCount; ++i) {
+    if (impl_->limits.axes.has(static_cast<Axis>(i)))
+      c.max_path_accel += impl_->limits[i].max_acceleration * impl_->limits[i].max_acceleration;
+  }
+  c.max_path_accel = std::sqrt(c.max_path_accel);
+  c.max_path_speed = impl_->speed_bound();
   return c;
 }
 
@@ -392,11 +368,16 @@ bool Planner::Impl::begin(const canon::Program& program, bool stream) {
   m.flush_asked = m.flushing = m.input_waiting = false;
   m.program = &program;
   m.reader.emplace(program, stream);
+  m.reader->set_smoothing(m.config.smooth_short_moves && m.params.filter_s > 0);
   detail::WindowParams wp;
   wp.filter_s = m.params.filter_s;
+  wp.period_s = m.config.servo_period_s;
+  wp.limits = &m.params;
+  double a_min = kInf;
   for (int i = 0; i < kAxisCount; ++i) {
     if (!m.limits.axes.has(static_cast<Axis>(i))) continue;
     const AxisLimits& l = m.limits[i];
+    a_min = std::min(a_min, l.max_acceleration);
     wp.v_bound += l.max_velocity * l.max_velocity;
     if (wp.filter_s > 0 && l.max_jerk > 0) {
       wp.step_budget[static_cast<std::size_t>(i)] =
@@ -404,9 +385,16 @@ bool Planner::Impl::begin(const canon::Program& program, bool stream) {
     }
   }
   wp.v_bound = std::sqrt(wp.v_bound);
+  m.v_bound = wp.v_bound;
   wp.step_window_s = 3.0 * wp.v_bound * m.config.servo_period_s;
+  // The look-ahead never limits the speed: the window may hold the braking distance from the
+  // highest speed at the lowest acceleration, beyond the blocks still settling.
+  wp.soft_blocks = 2 * m.config.lookahead_moves + 16;
+  wp.soft_length = wp.v_bound * wp.v_bound / (2 * a_min) + wp.v_bound * (0.5 * wp.filter_s + 4 * wp.period_s);
   m.window.emplace(wp);
   m.reading_done = false;
+  m.g2 = m.params.filter_s > 0;
+  m.held.reset();
   m.pending.reset();
   m.reports.clear();
   m.last_end = program.start();
@@ -441,7 +429,6 @@ PlanStatus Planner::pump(traj::BlockQueue& queue) {
   Impl& m = *impl_;
   if (m.failed || m.program == nullptr) return PlanStatus::Failed;
   detail::Lookahead& w = *m.window;
-  const std::size_t max_window = 2 * m.config.lookahead_moves + 16;
   for (;;) {
     while (queue.free_slots() > 0 && w.publishable() > 0 && w.front_link_decided()) m.publish_front(queue);
     if (queue.free_slots() == 0) return PlanStatus::Working;
@@ -458,7 +445,7 @@ PlanStatus Planner::pump(traj::BlockQueue& queue) {
       if (!m.flush_asked) return PlanStatus::Working;
       m.input_waiting = false;
     }
-    if (w.size() >= max_window) {
+    if (!w.wants_more()) {
       // The window is full and nothing is final: publish the front with the entry speed it
       // has (a stop at the window's end is assumed, so it is on the safe side).
       if (w.settled() == 0) return PlanStatus::Working;
@@ -467,7 +454,7 @@ PlanStatus Planner::pump(traj::BlockQueue& queue) {
     }
     // Read a batch before looking for final blocks again: the backward pass then runs once
     // per batch instead of once per block.
-    for (int i = 0; i < 64 && w.size() < max_window; ++i) {
+    for (int i = 0; i < 64 && w.wants_more(); ++i) {
       if (!m.read_one()) {
         m.out_of_input();
         break;

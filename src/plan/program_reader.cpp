@@ -181,6 +181,7 @@ traj::MotionBlock& ProgramReader::new_marker() {
 
 void ProgramReader::add_marker(std::size_t index, MarkerKind kind) {
   const canon::Action& a = program_->action(index);
+  flush_smoother();
   flush_run();
   traj::MotionBlock& m = new_marker();
   m.marker = kind;
@@ -410,11 +411,51 @@ void ProgramReader::push_element(const Element& e) {
   it.element = e;
 }
 
+// Short feed lines go to the smoother first; what it does not take, or gives back unfitted, goes
+// on to G64 Q's merge. The merge's open run comes before the smoother's moves, so it is closed
+// when a smoother run begins and before fitted spans go out.
+void ProgramReader::take_element(const Element& e) {
+  if (smoothing_) {
+    if (!smoother_.accepts(e)) flush_smoother();
+    if (smoother_.accepts(e)) {
+      if (smoother_.empty()) flush_run();
+      smoother_.add(e);
+      if (smoother_.full()) {  // the fitted curve so far goes out; the run goes on without a kink
+        smoothed_.clear();
+        smoother_.flush_part(smoothed_);
+        put_smoothed();
+      }
+      return;
+    }
+  }
+  push_element(e);
+}
+
+void ProgramReader::flush_smoother() {
+  if (smoother_.empty()) return;
+  smoothed_.clear();
+  smoother_.flush(smoothed_);
+  put_smoothed();
+}
+
+void ProgramReader::put_smoothed() {
+  for (const Element& e : smoothed_) {
+    if (e.b.kind != traj::BlockKind::Bezier) {  // given back as it came
+      push_element(e);
+      continue;
+    }
+    flush_run();
+    Item& it = ready_.append();
+    it.is_marker = false;
+    it.element = e;
+  }
+}
+
 void ProgramReader::read_move(canon::SegmentId id) {
   ++moves_read_;
   Element e;
   if (!make_element(id, e)) return;
-  push_element(e);
+  take_element(e);
   if (e.stop_after) {  // the controller reads the probe result before anything goes on
     flush_run();
     traj::MotionBlock& m = new_marker();
@@ -441,11 +482,13 @@ bool ProgramReader::read_more() {
     read_actions_before(static_cast<std::uint32_t>(n));
     if (flush_) {
       flush_ = false;
+      flush_smoother();
       flush_run();
     }
     return ready_.size() != before;
   }
   read_actions_before(static_cast<std::uint32_t>(n));
+  flush_smoother();
   flush_run();
   if (!ended_) {  // a program without M2/M30 still ends with a stop
     traj::MotionBlock& m = new_marker();

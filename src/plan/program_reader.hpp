@@ -8,24 +8,15 @@
 #include <cstdint>
 #include <vector>
 
+#include "element.hpp"
 #include "opencnc/canon/program.hpp"
 #include "opencnc/core/diagnostic.hpp"
 #include "opencnc/plan/machine_limits.hpp"
 #include "opencnc/traj/motion_block.hpp"
 #include "ring.hpp"
+#include "run_smoother.hpp"
 
 namespace opencnc::plan::detail {
-
-/// A programmed move (or a merged run of them) ready for corner processing.
-struct Element {
-  traj::MotionBlock b;         ///< geometry, identity, class, flags, nominal speed
-  double orig_length = 0;      ///< length before any blend trimmed it
-  double merge_deviation = 0;  ///< largest distance of merged vertices from the line
-  canon::MotionControl mode = canon::MotionControl::Continuous;  ///< for the corner at its end
-  double tolerance = 0;                                          ///< G64 P (mm), 0 = none
-  bool stop_after = false;  ///< the motion must stop at its end (probe moves)
-  double junction = 0;      ///< speed limit where it starts (0: from rest, +∞: none)
-};
 
 /// One item of the program in execution order: a path element, or a marker (in element.b, its
 /// position filled in later).
@@ -52,6 +43,10 @@ class ProgramReader {
   Item* next();
   /// Streams: moves [0, moves) may be read (their actions too, and the actions after them).
   void readable(std::size_t moves) noexcept { readable_ = moves; }
+  /// Runs of short feed lines are fitted with one curve (run_smoother.hpp) before G64 Q may
+  /// merge what is left. Before the first next().
+  void set_smoothing(bool on) noexcept { smoothing_ = on; }
+  std::uint64_t smoothed_runs() const noexcept { return smoother_.fitted_runs(); }
   /// Streams: no more moves will come; the end of the readable part is the program's end.
   void seal() noexcept { streaming_ = false; }
   /// Streams: hand out what is held back for the next move to decide (a G64 Q merge), as at
@@ -72,6 +67,9 @@ class ProgramReader {
   void read_move(canon::SegmentId id);
   bool make_element(canon::SegmentId id, Element& e) const;
   void push_element(const Element& e);
+  void take_element(const Element& e);
+  void flush_smoother();
+  void put_smoothed();
   bool can_extend_run(const Element& e) const;
   void chord_small_arc(const Pose& start, const Pose& end, double feed, Element& e) const;
   double merge_budget() const noexcept;
@@ -84,6 +82,9 @@ class ProgramReader {
   bool streaming_ = false;  ///< more moves may come (until seal())
   bool gated_ = false;      ///< built for a stream: only readable() moves are read
   bool flush_ = false;
+  bool smoothing_ = false;
+  RunSmoother smoother_;
+  std::vector<Element> smoothed_;  ///< scratch: what a run became
   std::size_t readable_ = 0;
   Ring<Item> ready_;
   bool handed_out_ = false;  // ready_.front() was returned by next()

@@ -9,6 +9,8 @@
 #include <fmt/format.h>
 
 #include "opencnc/canon/program_builder.hpp"
+#include "opencnc/controller/servo_setup.hpp"
+#include "opencnc/plan/planner.hpp"
 #include "opencnc/retrace/path_scan.hpp"
 
 namespace opencnc::recovery {
@@ -100,6 +102,7 @@ RetraceFeature::RetraceFeature(std::shared_ptr<control::ProgramSource> source,
   for (const config::AxisProfile& a : profile.axes) {
     if (a.axis == Axis::X || a.axis == Axis::Y) min_accel_ = std::min(min_accel_, a.max_acceleration);
   }
+  jerk_filter_s_ = plan::jerk_filter_s(control::machine_limits(profile), profile.servo_period_s);
 }
 
 RetraceFeature::~RetraceFeature() {
@@ -336,11 +339,12 @@ void RetraceFeature::check_stop_at_a(const control::ControllerStatus& s) {
   if (c_->move > a_->move) return;  // B was ahead of A: the cut skipped forward past it
   const std::uint64_t move = base_move_ + s.run_segment;
   // The hold begins where the machine can still stop at A: the braking distance v²/2a (the
-  // slowest of X and Y) and one status period ahead of it, measured straight to A (never longer
-  // than along the path, so the stop comes at A or just before it).
+  // slowest of X and Y), with jerk limits the v·T/2 the commanded point trails the braking
+  // generator by (plan::jerk_filter_s), and one status period ahead of it, measured straight to A
+  // (never longer than along the path, so the stop comes at A or just before it).
   const bool passed = move > a_->move || (move == a_->move && s.segment_offset >= a_offset_);
   const double v = s.servo.path_velocity;
-  const double brake = v * v / (2 * min_accel_) + v * status_period_s_;
+  const double brake = v * v / (2 * min_accel_) + v * (0.5 * jerk_filter_s_ + status_period_s_);
   const bool near = move + 2 >= a_->move && std::hypot(a_->point[0] - s.servo.commanded[0],
                                                        a_->point[1] - s.servo.commanded[1]) <= brake;
   if (!passed && !near) return;

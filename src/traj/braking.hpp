@@ -17,4 +17,17 @@ inline double end_speed_limit(double K, double v, double A, double tau) noexcept
   return 0.5 * (std::sqrt(disc) - at);
 }
 
+/// The same when the generator can only begin to brake `coast` seconds after the piece (the
+/// jerk-limited average forbids turning its acceleration round sooner) and keeps at most its
+/// speed meanwhile, over path whose budget is at most `A_coast`:
+/// v_end² + 2A·Δs + 2·A_coast·v_end·coast ≤ K. Any thread; real-time safe.
+inline double end_speed_limit(double K, double v, double A, double tau, double coast,
+                              double A_coast) noexcept {
+  if (coast <= 0) return end_speed_limit(K, v, A, tau);
+  const double b = A * tau + 2.0 * A_coast * coast;
+  const double disc = b * b + 4.0 * (K - A * tau * v);
+  if (disc < 0) return -1.0;
+  return 0.5 * (std::sqrt(disc) - b);
+}
+
 }  // namespace opencnc::traj::detail

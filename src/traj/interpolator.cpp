@@ -47,6 +47,10 @@ void Interpolator::restart(const Pose& start) noexcept {
   still_ticks_ = config_.filter_ticks;
   history_.fill(0.0);
   history_pos_ = 0;
+  acc_lo_.fill(0.0);
+  acc_hi_.fill(0.0);
+  period_lo_ = period_hi_ = 0;
+  commit_end_ = full_end_ = -1e300;
   hold_ = aborting_ = waiting_ = false;
   released_seq_ = stop_seq_ = kNoBlock;
   step_from_seq_ = 0;
@@ -88,11 +92,82 @@ void Interpolator::handle_commands(const TickInput& in) noexcept {
   if (!in.single_block) stop_seq_ = kNoBlock;
 }
 
+// With jerk limits the commanded position is the average of the generator's over the last T, so
+// its jerk is (a(t) − a(t − T))/T: each acceleration of this period stays within Δ = J·T of those
+// of the period a window earlier (J the jerk budget where the commanded position is). After
+// accelerating, the generator therefore may not brake fully until that period has left the window
+// (at worst it coasts): the braking limits allow for that coast (docs/planner.md, "Jerk").
+Interpolator::Turn Interpolator::turn_bounds(const TickInput& in) noexcept {
+  Turn t;
+  const int m = config_.filter_ticks;
+  if (m <= 1) return t;
+  const std::size_t avail = queue_->available();
+  // The budget where the commanded position is; resting at the end of its block (a corner taken
+  // at rest, where the window's ranges stop), the motion leaves along the next block: its budget
+  // too.
+  double jerk = 0;
+  const std::size_t f_index = index_of(f_seq_);
+  for (std::size_t i = f_index, n = 0; i < avail && n < 8; ++i, ++n) {
+    const MotionBlock& b = queue_->peek(i);
+    if (b.kind == BlockKind::Marker) continue;
+    if (jerk > 0) {
+      jerk = std::min(jerk, b.jerk);
+      break;
+    }
+    jerk = b.jerk;
+    if (i != f_index || s_f_ - f_start_ < b.length) break;
+  }
+  if (jerk <= 0) return t;
+  t.active = true;
+  const double T = m * config_.period_s;
+  t.delta = jerk * T * (aborting_ ? std::max(1.0, in.abort_decel_scale) : 1.0);
+  const auto slot = [&](int k) { return static_cast<std::size_t>((history_pos_ + k) % m); };
+  t.lo_old = acc_hi_[slot(0)];
+  t.hi_old = acc_lo_[slot(0)];
+  int last = 0;
+  for (int k = 1; k < m; ++k) {
+    if (acc_hi_[slot(k)] > 0) last = k;
+  }
+  t.coast_hist = last * config_.period_s;
+  t.coast_full = m * config_.period_s;
+  // The budgets a coast may cross. If this period accelerates, the coast after it stays within
+  // (v + M·T_servo)·(T_servo + T) of the generator (M the planner's bound of every budget, the
+  // most v can gain in the period); the coasts the history asks for stay within the regions the
+  // accelerating periods committed to (commit_end_), which only shrink as the generator moves
+  // on. Over the region the largest budget, and M beyond the queued data or the scan (blocks
+  // that arrive later never raise it): a plan found feasible stays so.
+  const std::size_t u = index_of(u_seq_);
+  const double big =
+      config_.max_path_accel > 0 ? config_.max_path_accel : (u < avail ? queue_->peek(u).accel : 0.0);
+  full_end_ = s_u_ + (v_u_ + big * config_.period_s) * (config_.period_s + t.coast_full);
+  if (t.coast_hist <= 0) commit_end_ = -1e300;
+  const double hist_end = commit_end_;
+  double start = u_start_;
+  t.coast_accel_full = t.coast_accel_hist = 0;
+  std::size_t i = u;
+  int n = 0;
+  const double scan_end = std::max(full_end_, hist_end);  // the junctions within either are limits too
+  for (; i < avail && n < kCoastScan && start < scan_end; ++i, ++n) {
+    const double a = queue_->peek(i).accel;
+    if (start < full_end_) t.coast_accel_full = std::max(t.coast_accel_full, a);
+    if (start < hist_end) t.coast_accel_hist = std::max(t.coast_accel_hist, a);
+    start += queue_->peek(i).length;
+  }
+  if (start < full_end_) t.coast_accel_full = std::max(t.coast_accel_full, big);
+  if (start < hist_end) t.coast_accel_hist = std::max(t.coast_accel_hist, big);
+  const double scale = aborting_ ? std::max(1.0, in.abort_decel_scale) : 1.0;
+  t.coast_accel_full *= scale;
+  t.coast_accel_hist *= scale;
+  coast_count_ = n;
+  coast_from_ = u_seq_;
+  return t;
+}
+
 // One piece of constant acceleration inside block `b` (at queue index `index`): chooses the
 // acceleration from the target speed and every braking limit, then moves until the block end or
 // the end of the period.
-void Interpolator::step_piece(const TickInput& in, const MotionBlock& b, std::size_t index, double& tau,
-                              double& integral) noexcept {
+void Interpolator::step_piece(const TickInput& in, const MotionBlock& b, std::size_t index, const Turn& turn,
+                              double& tau, double& integral) noexcept {
   const std::size_t avail = queue_->available();
   const double x = s_u_ - u_start_;
   const double rem = b.length - x;
@@ -109,31 +184,53 @@ void Interpolator::step_piece(const TickInput& in, const MotionBlock& b, std::si
   const bool follow = b.feed_class == FeedClass::SpindleSync && !aborting_;
   if (follow) a = sync_acceleration(b, tau);
   const double a_follow = a;
-  const auto limit = [&](double K, bool at_block_end, double vq) {
+  // Braking limits: the largest acceleration with which each stays reachable. With jerk limits
+  // the generator may have to coast before it brakes; every limit then holds the same coast, so
+  // they are gathered as the lowest K, for a coast after this period if it accelerates (the full
+  // window) and if it does not (what the history asks for).
+  double a_full = A, k_min = 1e300;
+  const auto limit = [&](double K, std::size_t q_index, double vq) {
+    if (turn.active) {
+      k_min = std::min(k_min, K);
+      return;
+    }
     const double ve = end_speed_limit(K, v, A, tau);
     double aq;
     if (ve >= 0) {
       aq = (ve - v) / tau;
-    } else if (at_block_end && rem > 0) {
+    } else if (q_index == index + 1 && rem > 0) {
       aq = (vq * vq - v * v) / (2.0 * rem);  // reach vq exactly at the block end
     } else {
       aq = -A;
     }
-    a = std::min(a, aq);
+    a_full = std::min(a_full, aq);
   };
 
   // The next junction: the planner's backward pass holds every later hard limit in v_entry.
   if (index + 1 < avail) {
     const double e = queue_->peek(index + 1).v_entry;
-    limit(e * e + 2.0 * A * rem, true, e);
+    limit(e * e + 2.0 * A * rem, index + 1, e);
+  }
+  // Entry speeds assume braking can begin at once; a coast may carry the motion past the next
+  // junction, so every junction the coast can reach is a limit of its own (the first one beyond
+  // its reach holds every later one: its braking curve lies below theirs).
+  if (turn.active) {
+    const std::size_t last =
+        std::min(avail, index_of(coast_from_) + static_cast<std::size_t>(coast_count_) + 1);
+    for (std::size_t k = index + 2; k < last; ++k) {
+      const MotionBlock& q = queue_->peek(k);
+      limit(q.v_entry * q.v_entry + q.brake_prefix - c_s, k, q.v_entry);
+    }
   }
   // The end of the queued data: stopping there must stay possible.
   {
     const MotionBlock& last = queue_->peek(avail - 1);
-    limit(last.brake_prefix + 2.0 * last.accel * last.length - c_s, index + 1 == avail, 0.0);
+    limit(last.brake_prefix + 2.0 * last.accel * last.length - c_s, avail, 0.0);
   }
   // Lower nominal speeds further on (override-dependent, so checked here rather than planned).
-  const double reach_bound = (v + A * tau) * (v + A * tau);
+  // Points farther than any coast and braking from here can reach cannot bind.
+  double reach_bound = (v + A * tau) * (v + A * tau);
+  if (turn.active) reach_bound += 2.0 * turn.coast_accel_full * (v + A * tau) * (tau + turn.coast_full);
   std::uint64_t c = b.next_soft;
   for (int hop = 0; hop < kMaxSoftHops && c != kNoBlock && c > b.seq; ++hop) {
     const std::size_t ci = index_of(c);
@@ -143,19 +240,40 @@ void Interpolator::step_piece(const TickInput& in, const MotionBlock& b, std::si
     if (reach >= reach_bound) break;  // later points have a larger reach still
     if (q.kind != BlockKind::Marker) {
       const double vq = target_speed(in, q);
-      limit(vq * vq + reach, ci == index + 1, vq);
+      limit(vq * vq + reach, ci, vq);
     }
     c = q.next_soft;
   }
   // A committed single-block stop.
   if (stop_seq_ != kNoBlock && stop_seq_ > b.seq) {
     const std::size_t si = index_of(stop_seq_);
-    if (si < avail) limit(queue_->peek(si).brake_prefix - c_s, si == index + 1, 0.0);
+    if (si < avail) limit(queue_->peek(si).brake_prefix - c_s, si, 0.0);
+  }
+  if (turn.active) {
+    // Braking: if this period accelerates it commits the full window; a piece earlier in this
+    // period that accelerated has committed it already.
+    const auto bound = [&](double coast, double a_coast) {
+      if (k_min >= 1e300) return A;
+      const double ve = end_speed_limit(k_min, v, A, tau, coast, a_coast);
+      return ve >= 0 ? (ve - v) / tau : -A;
+    };
+    a_full = bound(turn.coast_full, turn.coast_accel_full);
+    const double a_hist = period_hi_ > 0 ? a_full : bound(turn.coast_hist, turn.coast_accel_hist);
+    // Within Δ of the acceleration a window earlier (0 is always allowed: the planner keeps
+    // every budget within Δ), and no positive acceleration unless braking stays possible
+    // after the full coast it commits to.
+    const double lo = std::min(0.0, turn.lo_old - turn.delta), hi = std::max(0.0, turn.hi_old + turn.delta);
+    a = std::clamp(a, std::max(a_min, lo), std::min(A, hi));
+    a = std::min(a, a_full > 0 ? a_full : std::min(a_hist, 0.0));
+  } else {
+    a = std::min(a, a_full);
   }
   a = std::clamp(a, a_min, A);
   // Braking for a limit ahead (the end of the thread): the motion leaves the spindle.
   if (follow && sync_ == Sync::Locked && a < a_follow - 1e-9 * A) sync_ = Sync::CatchUp;
 
+  period_lo_ = std::min(period_lo_, a);
+  period_hi_ = std::max(period_hi_, a);
   double t = tau;
   bool stops = false;
   if (a < 0 && v + a * tau <= 0) {
@@ -236,6 +354,8 @@ double Interpolator::advance_unfiltered(const TickInput& in) noexcept {
   double tau = config_.period_s, integral = 0;
   const double s_before = s_u_;
   const std::size_t avail = queue_->available();
+  const Turn turn = turn_bounds(in);
+  period_lo_ = period_hi_ = 0;
   for (int i = 0; i < kMaxPieces && tau > 0; ++i) {
     const std::size_t index = index_of(u_seq_);
     if (index >= avail || u_seq_ == stop_seq_) {
@@ -258,16 +378,21 @@ double Interpolator::advance_unfiltered(const TickInput& in) noexcept {
       continue;
     }
     // A corner passed at zero speed: the moving average must reach it before the motion goes on,
-    // or the commanded path would round it off.
-    if (b.v_entry == 0 && s_u_ == u_start_ && v_u_ == 0 && still_ticks_ < config_.filter_ticks) break;
+    // or the commanded path would round it off. With jerk limits it also rests there for the three
+    // periods the trace's third difference spans: a difference across the corner would add the
+    // kink of the axes' directions (Δg' times the motion within a period) to their jerk.
+    const int rest = config_.filter_ticks > 1 ? config_.filter_ticks + 3 : config_.filter_ticks;
+    if (b.v_entry == 0 && s_u_ == u_start_ && v_u_ == 0 && still_ticks_ < rest) break;
     if (b.flags & kRigidTap) {  // reached at rest; run_tap() moves the tap
       v_u_ = 0;
       break;
     }
     if (b.feed_class == FeedClass::SpindleSync && (sync_ == Sync::Off || sync_ == Sync::WaitIndex)) break;
-    step_piece(in, b, index, tau, integral);
+    step_piece(in, b, index, turn, tau, integral);
   }
   if (tau > 0) integral += s_u_ * tau;
+  if (turn.active && period_hi_ > 0)
+    commit_end_ = std::max(commit_end_, full_end_);  // the coast it commits to
   still_ticks_ = (s_u_ == s_before && v_u_ == 0) ? still_ticks_ + 1 : 0;
   return integral;
 }
@@ -276,6 +401,8 @@ double Interpolator::filter(double integral) noexcept {
   const int m = config_.filter_ticks;
   if (m <= 1) return s_u_;
   history_[static_cast<std::size_t>(history_pos_)] = integral;
+  acc_lo_[static_cast<std::size_t>(history_pos_)] = period_lo_;
+  acc_hi_[static_cast<std::size_t>(history_pos_)] = period_hi_;
   history_pos_ = history_pos_ + 1 == m ? 0 : history_pos_ + 1;
   if (still_ticks_ >= m) return s_u_;  // the window holds only the resting position
   double sum = 0;
@@ -289,7 +416,8 @@ void Interpolator::advance_filtered(TickOutput& out) noexcept {
     const std::size_t index = index_of(f_seq_);
     if (index >= avail || f_seq_ >= u_seq_) break;  // never ahead of the generator's block
     const MotionBlock& b = queue_->peek(index);
-    if (s_f_ < f_start_ + b.length - (b.kind == BlockKind::Marker ? 0.0 : kSnap)) break;
+    // Exactly: a commanded position put on the next block early would jump by the difference.
+    if (s_f_ < f_start_ + b.length) break;
     f_start_ += b.length;
     ++f_seq_;
   }
@@ -396,6 +524,7 @@ void Interpolator::pop_and_rebase() noexcept {
   u_start_ -= shift;
   s_f_ -= shift;
   f_start_ -= shift;
+  commit_end_ -= shift;
   sync_target_ -= shift;
   const double shift_dt = shift * config_.period_s;
   for (int i = 0; i < config_.filter_ticks; ++i) history_[static_cast<std::size_t>(i)] -= shift_dt;

@@ -70,6 +70,58 @@ TEST(TraceChecker, CountsEverySampleAndAxisAboveALimit) {
   EXPECT_NE(r.summary().find("2 limit violations"), std::string::npos);
 }
 
+// A trace that was already moving: its first two samples are the history, the one before them is
+// unknown, so the first checked sample has no jerk; from the next one on the jerk is measured.
+TEST(TraceChecker, AlreadyMovingTheFirstSampleHasNoJerkTheNextOnesHave) {
+  const canon::Program p = line_and_arc();
+  const auto limits = plan::MachineLimits::uniform(AxisMask::from_letters("XYZ"), 100, 1000, 1e5);
+  analysis::TraceChecker c(p, limits, 1e-3);
+  // x = J t³/6 with J = 9e4 from t = 0 (samples at 1 ms): a jerk-limited start.
+  const auto x = [](int n) { return 9e4 * std::pow(n * 1e-3, 3) / 6; };
+  c.start_moving(xy(x(1), 0), xy(x(0), 0));
+  c.add(xy(x(2), 0), 0, 0);
+  EXPECT_EQ(c.report().axes[0].max_jerk, 0.0);
+  for (int n = 3; n <= 10; ++n) c.add(xy(x(n), 0), 0, 0);
+  EXPECT_NEAR(c.report().axes[0].max_jerk, 9e4, 1e-3);
+  EXPECT_NEAR(c.report().axes[0].max_acceleration, 9e4 * 9e-3, 1e-6);  // second difference at sample 10
+  EXPECT_EQ(c.report().limit_violations, 0u);
+  // A jerk above the limit after the first sample is counted: 50 nm more adds 5e4 mm/s³ (and
+  // 50 mm/s², still within the acceleration limit).
+  c.add(xy(x(11) + 5e-5, 0), 0, 0);
+  EXPECT_EQ(c.report().limit_violations, 1u);
+  EXPECT_EQ(c.report().first_violation.derivative, 3);
+}
+
+// The corner miss: a trace that turns round at a hairpin's end passes its end point; one that
+// stays on the moves' middles (within 1 µm of both moves) misses it by half a move.
+TEST(TraceChecker, ACornerCutOffShowsAsACornerMissNotAsAContourError) {
+  canon::ProgramBuilder b;
+  b.set_feed_rate(600);
+  b.straight_feed(0, xy(1, 0));
+  b.straight_feed(1, xy(0, 0.001));
+  b.straight_feed(2, xy(1, 0.002));
+  const canon::Program p = b.take();
+  const auto limits = plan::MachineLimits::uniform(AxisMask::from_letters("XYZ"), 1e6, 1e9);
+  analysis::TraceChecker through(p, limits, 1e-3), cut(p, limits, 1e-3);
+  // Along the moves, 0.01 mm a sample, to the ends and back (the segment ids of each move).
+  for (int k = 1; k <= 300; ++k) {
+    const int move = (k - 1) / 100;
+    const double f = (k - 100 * move) / 100.0;
+    const double x = move == 1 ? 1 - f : f, y = move == 0 ? 0.0 : 0.001 * (move - 1 + f);
+    through.add(xy(x, y), static_cast<canon::SegmentId>(move), static_cast<canon::SegmentId>(move));
+  }
+  // From the middle of the first move on along x = 0.5 only: the end points are never visited.
+  for (int k = 1; k <= 300; ++k) {
+    const int move = (k - 1) / 100;
+    cut.add(xy(std::min(0.5, k * 0.01), 0.001 * (k / 100.0)), static_cast<canon::SegmentId>(move),
+            static_cast<canon::SegmentId>(move));
+  }
+  EXPECT_LE(through.report().max_corner_miss_mm, 1e-12);
+  EXPECT_LE(cut.report().max_contour_error_mm, 0.0015);  // within the moves' spread
+  EXPECT_NEAR(cut.report().max_corner_miss_mm, 0.5, 1e-3);
+  EXPECT_EQ(cut.report().corner_miss_segment, 0u);
+}
+
 TEST(TraceChecker, ContourErrorIsTheDistanceToTheNearestProgrammedMove) {
   const canon::Program p = line_and_arc();
   const auto limits = plan::MachineLimits::uniform(AxisMask::from_letters("XYZ"), 1e9, 1e12);

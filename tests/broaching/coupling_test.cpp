@@ -128,6 +128,23 @@ TEST(Coupling, ConstantPitchHeldEveryPeriodBothWays) {
   EXPECT_NEAR(s.commanded[Axis::Z], 20.0, 1e-9);
 }
 
+// With jerk limits on X, Z and C (100 times their accelerations) the law holds every period as
+// without: the coupling acts on the jerk-limited commands.
+TEST(Coupling, WithJerkLimitsTheLawIsHeldEveryPeriodBothWays) {
+  const CoupledRun r =
+      run("G21 G90 G0 X0 Z-10 C30\nM171 P60\nG1 X0.1 F60\nG1 Z80 F3000\nG1 X-0.2\nG0 Z-10\n"
+          "M175\nG0 Z20\nM2\n",
+          broach({"axis.x.max_jerk=10000", "axis.z.max_jerk=150000", "axis.c.max_jerk=360000"}));
+  ASSERT_TRUE(r.opened.accepted) << messages(r.opened);
+  EXPECT_GT(r.watch->coupled, 3000u);
+  EXPECT_TRUE(r.watch->backwards);
+  EXPECT_LT(r.watch->command_error_deg, 1e-9);
+  const ServoStatus s = r.rig->status().servo;
+  EXPECT_EQ(s.coupling.kind, motion::CouplingKind::Off);
+  EXPECT_NEAR(s.commanded[Axis::C], 30.0, 1e-9);
+  EXPECT_NEAR(s.commanded[Axis::Z], 20.0, 1e-9);
+}
+
 TEST(Coupling, EveryLawMeetsItsDefinitionInTheTick) {
   const CoupledRun r =
       run("G21 G90 G0 X0 Z0 C0\nM172 P600 Q-0.2\nG1 Z300 F6000\nM173 P1\nG1 Z700\nG1 Z650\n"

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "opencnc/analysis/reference_programs.hpp"
+#include "opencnc/analysis/simulate.hpp"
 #include "opencnc/canon/program_builder.hpp"
 #include "opencnc/plan/planner.hpp"
 #include "opencnc/traj/path_eval.hpp"
@@ -21,6 +22,8 @@ using traj::MotionBlock;
 
 namespace {
 
+const plan::MachineLimits kMillJerk =
+    plan::MachineLimits::uniform(AxisMask::from_letters("XYZ"), 100, 1000, 1e5);
 const plan::MachineLimits kMill = plan::MachineLimits::uniform(AxisMask::from_letters("XYZ"), 100, 1000);
 
 Pose xyz(double x, double y, double z = 0) {
@@ -141,9 +144,10 @@ TEST(Planner, ContinuousCornersGetArcsWithinTheTolerance) {
     const MotionBlock& arc = blocks[i];
     ASSERT_EQ(arc.kind, BlockKind::Arc);
     EXPECT_TRUE(arc.flags & traj::kBlend);
-    // A 90° fillet: radius r with r·(1 − cos 45°) = P, so the middle of the arc is P from both lines.
+    // A 90° fillet: radius r with r·(1/cos 45° − 1) = P, so the middle of the arc is P from the
+    // corner (as LinuxCNC sizes its blend arcs) and closer to both lines.
     const double r = 1.0 / std::fabs(arc.omega);
-    EXPECT_NEAR(r * (1 - std::cos(std::numbers::pi / 4)), P, 1e-12);
+    EXPECT_NEAR(r * (1 / std::cos(std::numbers::pi / 4) - 1), P, 1e-12);
     // Centripetal acceleration at the cap within 95 % of the axis limit.
     EXPECT_NEAR(arc.v_cap * arc.v_cap / r, 0.95 * 1000, 1e-6);
     const Pose end = traj::position_at(arc, arc.length);
@@ -165,7 +169,9 @@ TEST(Planner, ExactPathStopsAtCornersButNotWhereMovesAreTangent) {
   EXPECT_EQ(blocks[2].v_entry, 0.0);
 }
 
-TEST(Planner, NaiveCamToleranceMergesNearlyCollinearFeedLines) {
+TEST(Planner, NaiveCamToleranceMergesNearlyCollinearFeedLinesWithoutSmoothing) {
+  plan::PlannerConfig merging;  // G64 Q's merge, where runs of short moves are not fitted
+  merging.smooth_short_moves = false;
   const auto build = [](double q) {
     canon::ProgramBuilder b;
     b.set_motion_control_mode(canon::MotionControl::Continuous, 0.1);
@@ -175,13 +181,61 @@ TEST(Planner, NaiveCamToleranceMergesNearlyCollinearFeedLines) {
       b.straight_feed(static_cast<canon::SegmentId>(i - 1), xyz(i, i % 2 ? 0.004 : 0));
     return b.take();
   };
-  const auto merged = path_blocks(plan_all(build(0.01)));
+  const auto merged = path_blocks(plan_all(build(0.01), kMill, merging));
   ASSERT_EQ(merged.size(), 1u);
   EXPECT_EQ(merged[0].segment_first, 0u);
   EXPECT_EQ(merged[0].segment_last, 9u);
   // Unmerged: ten lines and nine small blends (just large enough for 2 × F10 mm/s).
-  const auto separate = path_blocks(plan_all(build(0)));
+  const auto separate = path_blocks(plan_all(build(0), kMill, merging));
   EXPECT_EQ(separate.size(), 19u);
+  // Without jerk limits smoothing does not apply: the same blocks.
+  EXPECT_EQ(path_blocks(plan_all(build(0))).size(), 19u);
+  // With jerk limits the run is one fitted curve instead, within P/2 of the moves.
+  const auto fitted = path_blocks(plan_all(build(0), kMillJerk));
+  ASSERT_FALSE(fitted.empty());
+  EXPECT_LT(fitted.size(), 10u);
+  EXPECT_EQ(fitted.front().segment_first, 0u);
+  EXPECT_EQ(fitted.back().segment_last, 9u);
+}
+
+TEST(Planner, RunsOfShortMovesBecomeOneCurvatureContinuousCurveWithinTheTolerance) {
+  // 2000 moves of 0.05-0.2 mm on a spiral, coordinates rounded to 0.1 µm (CAM output): the fitted
+  // spans join with the same point, tangent and curvature, run through at the feed's speed, and
+  // stay within G64 P of the moves (the trace checker measures against the programmed moves).
+  const canon::Program p = analysis::spiral_program(2000, 6000, {canon::MotionControl::Continuous, 0.01, 0});
+  plan::Planner planner(kMillJerk, {});
+  ASSERT_TRUE(planner.start(p));
+  auto q = std::make_unique<traj::BlockQueue>();
+  while (planner.pump(*q) == plan::PlanStatus::Working) {
+  }
+  EXPECT_GT(planner.stats().smoothed_runs, 0u);
+  std::size_t curves = 0, joins = 0;
+  for (std::size_t i = 1; i < q->available(); ++i) {
+    const MotionBlock& a = q->peek(i - 1);
+    const MotionBlock& b = q->peek(i);
+    const bool spans = a.kind == BlockKind::Bezier && b.kind == BlockKind::Bezier;
+    if (!spans || (a.flags & traj::kBlend) || (b.flags & traj::kBlend)) continue;  // fitted spans only
+    ++joins;
+    const Pose ta = traj::tangent_at(a, a.length), tb = traj::tangent_at(b, 0);
+    const Pose ka = traj::curvature_at(a, a.length), kb = traj::curvature_at(b, 0);
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_NEAR(ta[k], tb[k], 1e-9) << i;
+      EXPECT_NEAR(ka[k], kb[k], 1e-6) << i;
+    }
+  }
+  for (std::size_t i = 0; i < q->available(); ++i) curves += q->peek(i).kind == BlockKind::Bezier;
+  EXPECT_GT(curves, 20u);
+  EXPECT_GT(joins, 20u);
+  analysis::SimulationOptions unfitted;
+  unfitted.planner.smooth_short_moves = false;
+  const analysis::SimulationResult r = analysis::simulate(p, kMillJerk);
+  const analysis::SimulationResult lines = analysis::simulate(p, kMillJerk, unfitted);
+  EXPECT_EQ(r.report.limit_violations, 0u) << r.report.summary();
+  EXPECT_LE(r.report.max_contour_error_mm, 0.01) << r.report.summary();
+  // Faster than the same moves with their blends, and close to the feed (path / 100 mm/s, the
+  // start and the stop included).
+  EXPECT_LT(r.motion_time_s, 0.8 * lines.motion_time_s) << r.report.summary();
+  EXPECT_LE(r.motion_time_s, 1.1 * r.report.path_length_mm / 100.0) << r.report.summary();
 }
 
 TEST(Planner, ActionsBecomeMarkersInProgramOrder) {

@@ -27,6 +27,7 @@ void expect_clean(const analysis::SimulationResult& r, double tolerance) {
   EXPECT_TRUE(r.finished) << r.report.summary();
   EXPECT_EQ(r.report.limit_violations, 0u) << r.report.summary();
   EXPECT_LE(r.report.max_contour_error_mm, tolerance * (1 + 1e-9)) << r.report.summary();
+  EXPECT_LE(r.report.max_corner_miss_mm, tolerance * (1 + 1e-9)) << r.report.summary();
 }
 
 }  // namespace
@@ -50,6 +51,33 @@ TEST(TrajectoryScenario, SquareContinuousIsNeverSlowerThanExactStop) {
   EXPECT_LE(g61.motion_time_s, 4.448);  // LinuxCNC 2.9, same limits
   EXPECT_LE(g64.motion_time_s, 4.493);
   EXPECT_LE(g64.motion_time_s, g61.motion_time_s);
+}
+
+// A zigzag of 0.05 mm hairpins (X back and forth, Y creeping 0.1 µm a move) under G64 P0.01: the
+// moves overlap, so a path along their middles stays within 0.1 µm of them; the blends must still
+// pass within P of every turning point, with and without jerk limits.
+TEST(TrajectoryScenario, HairpinsAreBlendedWithinTheToleranceOfTheirTurningPoints) {
+  canon::ProgramBuilder b(AxisMask::from_letters("XYZ"));
+  b.set_motion_control_mode(canon::MotionControl::Continuous, 0.01);
+  b.set_feed_rate(6000);
+  for (int i = 0; i < 200; ++i) {
+    Pose p;
+    p[Axis::X] = (i % 2) * 0.05;
+    p[Axis::Y] = i * 1e-4;
+    b.straight_feed(static_cast<canon::SegmentId>(i), p);
+  }
+  const canon::Program program = b.take();
+  for (const plan::MachineLimits& limits : {kMill, kMillJerk}) {
+    const analysis::SimulationResult r = analysis::simulate(program, limits);
+    EXPECT_TRUE(r.finished) << r.report.summary();
+    EXPECT_EQ(r.report.limit_violations, 0u) << r.report.summary();
+    EXPECT_LE(r.report.max_contour_error_mm, 0.01) << r.report.summary();
+    // The blends turn within 0.01 mm of the hairpins' ends at about 6 mm/s: 6 µm between samples,
+    // which the checker's arc through three of them resolves to within 1 %.
+    EXPECT_LE(r.report.max_corner_miss_mm, 0.01 * 1.01) << r.report.summary();
+    // From tip to tip at least 0.05 − 2 × 0.01 mm a move: every hairpin is run.
+    EXPECT_GT(r.report.path_length_mm, 0.95 * 200 * (0.05 - 2 * 0.01)) << r.report.summary();
+  }
 }
 
 TEST(TrajectoryScenario, SmallAlternatingArcsKeepTheAccelerationLimit) {

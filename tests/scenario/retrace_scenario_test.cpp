@@ -83,9 +83,10 @@ class CutMoves final : public ControllerObserver {
   std::map<std::uint32_t, std::uint64_t> next_;
 };
 
-config::MachineProfile flame_cutter() {
-  const std::vector<std::string> sets = {"process.cutting.ignite_s=0.2", "process.cutting.preheat_s=0.3",
-                                         "process.cutting.pierce_s=0.2"};
+config::MachineProfile flame_cutter(std::vector<std::string> sets = {}) {
+  for (const char* s :
+       {"process.cutting.ignite_s=0.2", "process.cutting.preheat_s=0.3", "process.cutting.pierce_s=0.2"})
+    sets.emplace_back(s);
   const config::ProfileLoad load =
       config::load_profile(OPENCNC_SOURCE_DIR "/configs/flame-cutter.toml", sets);
   EXPECT_TRUE(load.profile.has_value());
@@ -110,8 +111,8 @@ canon::Program whole_program(const config::MachineProfile& profile, const std::s
   return copy;
 }
 
-TEST(RetraceScenario, PauseJogBackStartStopAgainAtAStepBackAndCutToTheEnd) {
-  const config::MachineProfile profile = flame_cutter();
+void pause_jog_back_start_stop_again_at_a_step_back_and_cut_to_the_end(
+    const config::MachineProfile& profile) {
   Scenario s(profile);
   auto feature = std::dynamic_pointer_cast<recovery::RetraceFeature>(s.machine().feature("retrace"));
   ASSERT_TRUE(feature);
@@ -206,6 +207,17 @@ TEST(RetraceScenario, PauseJogBackStartStopAgainAtAStepBackAndCutToTheEnd) {
     }
   }
   EXPECT_EQ(resumed, 2);
+}
+
+TEST(RetraceScenario, PauseJogBackStartStopAgainAtAStepBackAndCutToTheEnd) {
+  pause_jog_back_start_stop_again_at_a_step_back_and_cut_to_the_end(flame_cutter());
+}
+
+// The same with jerk-limited axes (the planner's curvature-continuous blends and the tick's
+// jerk-limited average): the retrace works as before.
+TEST(RetraceScenario, WithJerkLimitsTheRetraceWorksTheSame) {
+  pause_jog_back_start_stop_again_at_a_step_back_and_cut_to_the_end(
+      flame_cutter({"axis.x.max_jerk=20000", "axis.y.max_jerk=20000", "axis.z.max_jerk=20000"}));
 }
 
 }  // namespace

@@ -104,6 +104,35 @@ TEST(RunFromLineScenario, TheProgramStartsAtTheLineWithItsStateAfterTheApproach)
   EXPECT_NEAR(end[Axis::Z], 5.0, 1e-9);
 }
 
+// With jerk-limited axes the approach and the program from the line run as without them.
+TEST(RunFromLineScenario, WithJerkLimitsTheProgramStartsAtTheLineAfterTheApproach) {
+  TempProgram p("part.ngc", kProgram);
+  const config::MachineProfile profile =
+      mill({"axis.x.max_jerk=20000", "axis.y.max_jerk=20000", "axis.z.max_jerk=20000"});
+  Rig r(mill_source(profile), profile);
+  r.s.on(Mode::Auto);
+  r.s.must(Request::open(p.path()));
+  const Outcome o = r.run_from(6);
+  ASSERT_TRUE(o.accepted) << o.message;
+  ASSERT_TRUE(r.s.until([&] { return r.s.status().job == JobKind::Program; }, 100000));
+  EXPECT_NEAR(r.s.status().servo.commanded[Axis::X], 30.0, 1e-9);
+  EXPECT_NEAR(r.s.status().servo.commanded[Axis::Z], 0.0, 1e-9);
+  std::uint32_t first_line = 0;
+  ASSERT_TRUE(r.s.until(
+      [&] {
+        const ControllerStatus st = r.s.status();
+        if (first_line == 0 && st.job == JobKind::Program && st.location.line > 0)
+          first_line = st.location.line;
+        return !st.run_active && st.servo.state == State::Idle;
+      },
+      200000));
+  EXPECT_EQ(first_line, 6u);
+  const Pose end = r.s.status().servo.commanded;
+  EXPECT_NEAR(end[Axis::X], 10.0, 1e-9);
+  EXPECT_NEAR(end[Axis::Y], 20.0, 1e-9);
+  EXPECT_NEAR(end[Axis::Z], 5.0, 1e-9);
+}
+
 TEST(RunFromLineScenario, LinesWithoutAMovePastTheEndOrAfterAnInputAreRefused) {
   TempProgram p("part.ngc", kProgram);
   Rig r;

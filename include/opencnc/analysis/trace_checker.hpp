@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cstdint>
+#include <deque>
 #include <string>
 
 #include "opencnc/canon/program.hpp"
@@ -35,6 +36,13 @@ struct TraceReport {
   double path_length_mm = 0;        ///< sum of XYZ (and UVW) distances between samples
   double max_contour_error_mm = 0;  ///< largest distance of a sample to the programmed path
   double contour_error_time_s = 0;  ///< when it happened
+  /// The other side of the contour: the largest distance from a programmed move's end point (a
+  /// corner the path may round off) to the commanded path, the path between two samples taken as
+  /// the circular arc through them and the sample before. Over the end points the trace has passed
+  /// (a hairpin skipped by a blend between the moves' middles shows here, not in
+  /// max_contour_error_mm).
+  double max_corner_miss_mm = 0;
+  canon::SegmentId corner_miss_segment = 0;  ///< the move whose end point it is
   std::array<AxisStats, kAxisCount> axes{};
   std::uint64_t limit_violations = 0;  ///< samples × axes × derivatives above a limit
   Violation first_violation{};
@@ -49,7 +57,9 @@ struct TraceReport {
 /// first sample the machine is taken to be at rest there. A value counts as a violation when it
 /// exceeds the limit by more than `relative_tolerance` (jerk only where a jerk limit is set).
 /// The contour error of a sample is its distance to the nearest programmed move within one move
-/// of the segments the sample's block covers. Non-real-time; one checker per run.
+/// of the segments the sample's block covers; the corner miss of a move is the distance from its
+/// end point to the nearest chord between two samples on the blocks around it. Non-real-time; one checker per
+/// run.
 class TraceChecker {
  public:
   TraceChecker(const canon::Program& program, const plan::MachineLimits& limits, double period_s,
@@ -62,16 +72,21 @@ class TraceChecker {
   void set_program(const canon::Program* program) noexcept {
     program_ = program;
     nearest_ = 0;
+    corners_.clear();  // end points of the old program not yet passed: not measured
   }
   const canon::Program* program() const noexcept { return program_; }
 
   /// Where the machine rests before the first sample (the origin unless said). Before add().
-  void start_at(const Pose& position) { past_.fill(position); }
-  /// The two samples before the first one, newest first, when the trajectory was already moving
-  /// (its acceleration before them taken as zero). Before add().
+  void start_at(const Pose& position) {
+    past_.fill(position);
+    jerk_unknown_ = false;
+  }
+  /// The two samples before the first one, newest first, when the trajectory was already moving.
+  /// The sample before them is unknown, so the first sample's jerk (a third difference) is not
+  /// measured; its velocity and acceleration are. Before add().
   void start_moving(const Pose& newest, const Pose& previous) {
     past_ = {newest, previous, previous};
-    for (int i = 0; i < kAxisCount; ++i) past_[2][i] = 2 * previous[i] - newest[i];
+    jerk_unknown_ = true;
   }
   /// The acceleration and jerk limits of the next samples, times `scale` (≥ 1: a power-fail stop
   /// short of energy brakes harder than planned, up to the axes' peak deceleration).
@@ -93,7 +108,13 @@ class TraceChecker {
   double period_s_;
   double tolerance_;
   double accel_scale_ = 1;        ///< set_acceleration_scale
+  void track_corners(const Pose& position, canon::SegmentId first, canon::SegmentId last);
+
   std::array<Pose, 3> past_{};    ///< the three previous samples, newest first
+  /// Distance so far from the end point of moves corner_base_, corner_base_ + 1, … to the path.
+  std::deque<double> corners_;
+  canon::SegmentId corner_base_ = 0;
+  bool jerk_unknown_ = false;     ///< the oldest of them is not known (start_moving)
   canon::SegmentId nearest_ = 0;  ///< the move nearest to the last sample
   TraceReport report_;
 };

@@ -21,6 +21,12 @@ namespace opencnc::plan {
 bool check_move(const canon::Program& program, canon::SegmentId id, const MachineLimits& limits,
                 Diagnostics& diags);
 
+/// Length in seconds of the moving average on s that meets the jerk limits (docs/planner.md,
+/// "Jerk"): the largest A/J of the axes with a jerk limit, in whole servo periods; 0 without jerk
+/// limits. The commanded position trails the path generator by up to half of it, so a feed hold
+/// taken at speed v travels v·T/2 beyond the generator's braking distance. Any thread.
+double jerk_filter_s(const MachineLimits& limits, double servo_period_s) noexcept;
+
 /// Planner settings (the machine profile's [trajectory] part).
 struct PlannerConfig {
   double servo_period_s = 1e-3;        ///< must equal the interpolator's period
@@ -29,9 +35,13 @@ struct PlannerConfig {
   /// Largest share of an axis's acceleration that the centripetal part may take on arcs and
   /// blends; the rest stays available along the path. In (0, 1).
   double normal_accel_share = 0.95;
-  /// With jerk limits: share of each axis's jerk reserved for the curvature steps where a line
-  /// meets an arc (sampled at the servo period). In (0, 1).
+  /// With jerk limits: share of each axis's jerk reserved where a curvature step is left (a
+  /// line meeting an arc tangentially under G61, sampled at the servo period). In (0, 1).
   double jerk_step_share = 0.5;
+  /// With jerk limits, runs of short feed lines are replaced by one curvature-continuous curve
+  /// within the G64 P tolerance before G64 Q may merge what is left (docs/planner.md, "Runs of
+  /// short moves"). Without jerk limits the moves keep their circular blends.
+  bool smooth_short_moves = true;
 };
 
 enum class PlanStatus : std::uint8_t {
@@ -45,6 +55,7 @@ struct PlanStats {
   std::uint64_t moves = 0;         ///< programmed moves read
   std::uint64_t merged_moves = 0;  ///< moves folded into a previous line by G64 Q
   std::uint64_t blends = 0;        ///< corners replaced by a blend curve
+  std::uint64_t smoothed_runs = 0;  ///< runs of short moves replaced by one fitted curve
   std::uint64_t blocks = 0;        ///< blocks published (path blocks and markers)
 };
 

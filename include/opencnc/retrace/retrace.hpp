@@ -109,6 +109,7 @@ class RetraceFeature final : public control::Feature {
   config::CuttingProfile cutting_;
   double status_period_s_ = 0.001;
   double min_accel_ = 1e300;  ///< the smaller of X's and Y's acceleration limits, mm/s²
+  double jerk_filter_s_ = 0;  ///< the planner's moving average for the jerk limits (0: none), s
   control::FeatureHost* host_ = nullptr;
 
   std::thread builder_;

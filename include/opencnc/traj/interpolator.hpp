@@ -21,6 +21,11 @@ struct InterpolatorConfig {
   double period_s = 1e-3;          ///< servo period
   int filter_ticks = 1;            ///< moving-average length on s in periods (1 = none: no jerk limit)
   double max_feed_override = 2.0;  ///< feed override inputs are clamped to [0, this]
+  /// The largest acceleration budget any block may have (s-units/s²): bounds the braking a
+  /// jerk-limited generator loses while it may not yet turn its acceleration round.
+  double max_path_accel = 0;
+  /// The largest speed along s any block may have (s-units/s): how far such a coast may reach.
+  double max_path_speed = 0;
 };
 
 /// Inputs sampled once per tick. Levels stay as long as the condition holds; `cycle_start`,
@@ -125,9 +130,21 @@ class Interpolator {
   std::uint64_t ticks() const noexcept { return ticks_; }
 
  private:
+  /// This period's bounds from the jerk budget where the commanded position is (see turn_).
+  struct Turn {
+    bool active = false;
+    double delta = 0;   ///< the acceleration may differ from T earlier by at most this
+    double lo_old = 0;  ///< the period T earlier: highest and lowest acceleration
+    double hi_old = 0;
+    double coast_hist = 0;  ///< time after this period before full braking is allowed (history)
+    double coast_full = 0;  ///< the same if this period accelerates
+    double coast_accel_hist = 0;  ///< the largest budget either coast may cross
+    double coast_accel_full = 0;
+  };
   void handle_commands(const TickInput& in) noexcept;
   double advance_unfiltered(const TickInput& in) noexcept;
-  void step_piece(const TickInput& in, const MotionBlock& b, std::size_t index, double& tau,
+  Turn turn_bounds(const TickInput& in) noexcept;
+  void step_piece(const TickInput& in, const MotionBlock& b, std::size_t index, const Turn& turn, double& tau,
                   double& integral) noexcept;
   void commit_single_block_stop(std::size_t available) noexcept;
   double target_speed(const TickInput& in, const MotionBlock& b) const noexcept;
@@ -168,6 +185,19 @@ class Interpolator {
   // Moving-average history: ∫ s dt over each of the last filter_ticks periods.
   std::array<double, kMaxFilterTicks> history_{};
   int history_pos_ = 0;
+  // The generator's lowest and highest acceleration in each of those periods (0 counts: rest).
+  // The average's jerk is (a(t) − a(t − T))/T, so keeping every acceleration within the block's
+  // jerk budget × T of the one a window earlier keeps the commanded jerk within it.
+  std::array<double, kMaxFilterTicks> acc_lo_{}, acc_hi_{};
+  double period_lo_ = 0, period_hi_ = 0;  ///< this period's
+  // This tick: the blocks from the generator's as far as a coast before braking can reach
+  // (turn_bounds): how many, from which.
+  static constexpr int kCoastScan = 256;
+  int coast_count_ = 0;
+  std::uint64_t coast_from_ = 0;
+  double full_end_ = -1e300;  ///< this tick: where a coast after accelerating may reach (global s)
+  double commit_end_ =
+      -1e300;  ///< where the coasts the accelerating periods in the window committed to may reach
 
   // Operator state.
   bool hold_ = false, aborting_ = false;

@@ -21,6 +21,8 @@ enum class BlockKind : std::uint8_t {
   Spiral,  ///< p(s) = base + sin θ·w + (1 − cos θ)·u + ρθ·(sin θ·w − cos θ·u) + s·lin, θ = ωs,
            ///< ρ = `spiral`: an arc whose radius goes linearly with the angle from r = |u| to
            ///< r·(1 + ρθ_end) (LinuxCNC's arcs whose end is off the start circle)
+  Quintic,  ///< quintic Bézier with control points base, u, w, lin, p4, p5 at t = s / length: the
+            ///< curvature-continuous corner blends and transitions of the jerk-limited planner
 };
 
 /// What the tick does at a marker.
@@ -93,11 +95,16 @@ struct MotionBlock {
   double spiral = 0;             ///< Spiral: relative change of the radius per radian
   double tap_scale = 1;          ///< rigid tap: spindle speed factor on the way out (G33.1 I)
   Pose base{}, u{}, w{}, lin{};  ///< see BlockKind
+  Pose p4{}, p5{};               ///< Quintic: the fifth and sixth control points
 
   // --- limits ------------------------------------------------------------------------------
   double v_cap = 0;                    ///< hard speed limit along s (s-units/s)
   double feed = 0;                     ///< nominal speed at 100 % (see FeedClass)
   double accel = 0;                    ///< acceleration budget along s (s-units/s²), > 0 for path blocks
+  /// Jerk budget along s (s-units/s³) while the commanded position is in this block: the rate at
+  /// which the commanded acceleration along s may change there (docs/planner.md, "Jerk"). 0: not
+  /// limited.
+  double jerk = 0;
   double v_entry = 0;                  ///< largest speed allowed at s = 0 (backward pass)
   double brake_prefix = 0;             ///< C at s = 0
   std::uint64_t next_soft = kNoBlock;  ///< first later block whose nominal speed may be lower
