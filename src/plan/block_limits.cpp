@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 
 #include "opencnc/traj/path_eval.hpp"
 
@@ -25,6 +26,7 @@ using traj::MotionBlock;
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kPi = std::numbers::pi;
 constexpr double kJerkCapShare = 0.5;  ///< part of J the geometric jerk v³·|g'''| may use at the cap
 
 bool limited_jerk(const LimitParams& p, int i) {
@@ -63,6 +65,90 @@ double largest_within(F f, double budget, double x_hi) {
     (f(mid) <= budget ? lo : hi) = mid;
   }
   return lo;
+}
+
+/// Smallest and largest of R·cos(φ − ψ) for φ in [lo, hi]: the ends and the extrema inside.
+void cos_range(double R, double psi, double lo, double hi, double& mn, double& mx) {
+  mn = std::min(R * std::cos(lo - psi), R * std::cos(hi - psi));
+  mx = std::max(R * std::cos(lo - psi), R * std::cos(hi - psi));
+  if (hi - lo >= 2 * kPi) {
+    mn = -R;
+    mx = R;
+    return;
+  }
+  for (double m = std::ceil((lo - psi) / kPi); psi + m * kPi <= hi; m += 1) {
+    if (std::fmod(std::fabs(m), 2.0) < 0.5) {
+      mx = R;
+    } else {
+      mn = -R;
+    }
+  }
+}
+
+/// Limits of a circular arc over the angle it sweeps (no jerk limit). The whole-circle bounds
+/// (arc_or_spiral_limits) take each axis's largest |g'| and |g''| on the full circle; a corner
+/// fillet sweeps a few degrees, over which a diagonal pair of axes keeps |g'_i| near 0.7 instead
+/// of 1, so the fillet may run as fast as the lines it joins (LinuxCNC's blend arcs do). Per axis,
+/// with φ = ω·s,  g'_i = ω·(w_i·cos φ + u_i·sin φ) + λ_i  and  g''_i = ω²·(u_i·cos φ − w_i·sin φ):
+/// shifted R·cos(φ − ψ), whose extrema over the sweep are exact (cos_range). The budget is
+/// (A_i − v²·G2)/G1 with G1, G2 bounds of |g'_i|, |g''_i| on each of 24 pieces of the sweep (the
+/// values at its ends and the next derivative's bound: |g''_i| ≤ D2, |g'''_i| ≤ |ω|³·r_i). The cap
+/// is the highest at which that budget still reaches the whole-circle budget `a_min` (a higher
+/// cap with less budget would trade braking for speed): bisection between the two caps.
+/// {cap −1}: no better than the whole-circle limits.
+RawLimits arc_sweep_limits(const MotionBlock& b, double v_max, const LimitParams& p, double cap_lo,
+                           double a_min) {
+  constexpr int kPieces = 24;
+  const double om = b.omega, aom = std::fabs(om), L = b.length;
+  const double lo = std::min(0.0, om * L), hi = std::max(0.0, om * L), dphi = (hi - lo) / kPieces;
+  double cap = v_max;
+  double d1[kAxisCount]{}, d2[kAxisCount]{}, d3[kAxisCount]{};
+  for (int i = 0; i < kAxisCount; ++i) {
+    const double r = std::hypot(b.u[i], b.w[i]), lam = b.lin[i];
+    if (aom * r + std::fabs(lam) < 1e-15) continue;
+    double mn = 0, mx = 0;
+    if (r > 0) cos_range(aom * r, std::atan2(om * b.u[i], om * b.w[i]), lo, hi, mn, mx);
+    d1[i] = std::max(std::fabs(mn + lam), std::fabs(mx + lam));
+    mn = mx = 0;
+    if (r > 0) cos_range(om * om * r, std::atan2(-b.w[i], b.u[i]), lo, hi, mn, mx);
+    d2[i] = std::max(std::fabs(mn), std::fabs(mx));
+    d3[i] = aom * om * om * r;
+    const AxisLimits& l = p.machine[i];
+    if (d1[i] > 0) cap = std::min(cap, l.max_velocity / d1[i]);
+    if (d2[i] > 0) cap = std::min(cap, std::sqrt(p.normal_share * l.max_acceleration / d2[i]));
+  }
+  if (cap <= cap_lo) return {-1, 0, 0};
+  double g1[kAxisCount][kPieces + 1], g2[kAxisCount][kPieces + 1];
+  for (int i = 0; i < kAxisCount; ++i) {
+    for (int q = 0; q <= kPieces; ++q) {
+      const double f = lo + q * dphi, c = std::cos(f), sn = std::sin(f);
+      g1[i][q] = std::fabs(om * (b.w[i] * c + b.u[i] * sn) + b.lin[i]);
+      g2[i][q] = std::fabs(om * om * (b.u[i] * c - b.w[i] * sn));
+    }
+  }
+  const double ds = L / kPieces;
+  const auto budget = [&](double v) {
+    double a = kInf;
+    for (int i = 0; i < kAxisCount; ++i) {
+      if (d1[i] <= 0) continue;
+      for (int q = 0; q < kPieces; ++q) {
+        const double G1 = std::min(d1[i], 0.5 * (g1[i][q] + g1[i][q + 1] + d2[i] * ds));
+        const double G2 = std::min(d2[i], 0.5 * (g2[i][q] + g2[i][q + 1] + d3[i] * ds));
+        if (G1 > 0) a = std::min(a, (p.machine[i].max_acceleration - v * v * G2) / G1);
+      }
+    }
+    return std::max(a, 0.0);
+  };
+  if (budget(cap_lo) < a_min) return {-1, 0, 0};
+  if (budget(cap) < a_min) {
+    double c_lo = cap_lo, c_hi = cap;
+    for (int it = 0; it < 30; ++it) {
+      const double mid = 0.5 * (c_lo + c_hi);
+      (budget(mid) >= a_min ? c_lo : c_hi) = mid;
+    }
+    cap = c_lo;
+  }
+  return {cap, budget(cap), kInf};
 }
 
 // Circle or helix: g' = ω·(cos·w + sin·u) + λ, g'' = ω²·(cos·u − sin·w), g''' = −ω²·g'_circle.
@@ -114,6 +200,10 @@ RawLimits arc_or_spiral_limits(const MotionBlock& b, double v_max, const LimitPa
       r.jerk = std::min(r.jerk, largest_within([&](double j) { return jerk(a, j); }, J, j_hi));
     }
     r.accel = std::min(r.accel, a);
+  }
+  if (b.spiral == 0 && r.jerk == kInf && p.filter_s <= 0 && r.cap < v_max) {
+    const RawLimits sweep = arc_sweep_limits(b, v_max, p, r.cap, r.accel);
+    if (sweep.cap > r.cap) return sweep;
   }
   return r;
 }
