@@ -94,7 +94,7 @@ void cos_range(double R, double psi, double lo, double hi, double& mn, double& m
 /// (A_i − v²·G2)/G1 with G1, G2 bounds of |g'_i|, |g''_i| on each of 24 pieces of the sweep (the
 /// values at its ends and the next derivative's bound: |g''_i| ≤ D2, |g'''_i| ≤ |ω|³·r_i). The cap
 /// is the highest at which that budget still reaches the whole-circle budget `a_min` (a higher
-/// cap with less budget would trade braking for speed): bisection between the two caps.
+/// cap with less budget would trade braking for speed).
 /// {cap −1}: no better than the whole-circle limits.
 RawLimits arc_sweep_limits(const MotionBlock& b, double v_max, const LimitParams& p, double cap_lo,
                            double a_min) {
@@ -118,37 +118,42 @@ RawLimits arc_sweep_limits(const MotionBlock& b, double v_max, const LimitParams
     if (d2[i] > 0) cap = std::min(cap, std::sqrt(p.normal_share * l.max_acceleration / d2[i]));
   }
   if (cap <= cap_lo) return {-1, 0, 0};
-  double g1[kAxisCount][kPieces + 1], g2[kAxisCount][kPieces + 1];
+  // Per piece G1 ≥ |g'_i| and G2 ≥ |g''_i| on it. The budget at v is min (A_i − v²·G2)/G1, so the
+  // cap at which it still reaches a_min is v² = min (A_i − a_min·G1)/G2, in closed form.
+  const double ds = L / kPieces, cd = std::cos(dphi), sd = std::sin(dphi);
+  double G1[kAxisCount][kPieces], G2[kAxisCount][kPieces];
+  double v2 = cap * cap;
   for (int i = 0; i < kAxisCount; ++i) {
-    for (int q = 0; q <= kPieces; ++q) {
-      const double f = lo + q * dphi, c = std::cos(f), sn = std::sin(f);
-      g1[i][q] = std::fabs(om * (b.w[i] * c + b.u[i] * sn) + b.lin[i]);
-      g2[i][q] = std::fabs(om * om * (b.u[i] * c - b.w[i] * sn));
+    if (d1[i] <= 0) continue;
+    double c = std::cos(lo), sn = std::sin(lo);  // the sample angle, turned by dphi each step
+    double g1_prev = std::fabs(om * (b.w[i] * c + b.u[i] * sn) + b.lin[i]);
+    double g2_prev = std::fabs(om * om * (b.u[i] * c - b.w[i] * sn));
+    const double A = p.machine[i].max_acceleration;
+    for (int q = 0; q < kPieces; ++q) {
+      const double c_next = c * cd - sn * sd;
+      sn = sn * cd + c * sd;
+      c = c_next;
+      const double g1 = std::fabs(om * (b.w[i] * c + b.u[i] * sn) + b.lin[i]);
+      const double g2 = std::fabs(om * om * (b.u[i] * c - b.w[i] * sn));
+      G1[i][q] = std::min(d1[i], 0.5 * (g1_prev + g1 + d2[i] * ds));
+      G2[i][q] = std::min(d2[i], 0.5 * (g2_prev + g2 + d3[i] * ds));
+      g1_prev = g1;
+      g2_prev = g2;
+      const double room = A - a_min * G1[i][q];
+      if (room < 0) return {-1, 0, 0};
+      if (G2[i][q] > 0) v2 = std::min(v2, room / G2[i][q]);
     }
   }
-  const double ds = L / kPieces;
-  const auto budget = [&](double v) {
-    double a = kInf;
-    for (int i = 0; i < kAxisCount; ++i) {
-      if (d1[i] <= 0) continue;
-      for (int q = 0; q < kPieces; ++q) {
-        const double G1 = std::min(d1[i], 0.5 * (g1[i][q] + g1[i][q + 1] + d2[i] * ds));
-        const double G2 = std::min(d2[i], 0.5 * (g2[i][q] + g2[i][q + 1] + d3[i] * ds));
-        if (G1 > 0) a = std::min(a, (p.machine[i].max_acceleration - v * v * G2) / G1);
-      }
+  cap = std::sqrt(v2);
+  if (cap <= cap_lo) return {-1, 0, 0};
+  double a = kInf;
+  for (int i = 0; i < kAxisCount; ++i) {
+    if (d1[i] <= 0) continue;
+    for (int q = 0; q < kPieces; ++q) {
+      if (G1[i][q] > 0) a = std::min(a, (p.machine[i].max_acceleration - v2 * G2[i][q]) / G1[i][q]);
     }
-    return std::max(a, 0.0);
-  };
-  if (budget(cap_lo) < a_min) return {-1, 0, 0};
-  if (budget(cap) < a_min) {
-    double c_lo = cap_lo, c_hi = cap;
-    for (int it = 0; it < 30; ++it) {
-      const double mid = 0.5 * (c_lo + c_hi);
-      (budget(mid) >= a_min ? c_lo : c_hi) = mid;
-    }
-    cap = c_lo;
   }
-  return {cap, budget(cap), kInf};
+  return {cap, std::max(a, 0.0), kInf};
 }
 
 // Circle or helix: g' = ω·(cos·w + sin·u) + λ, g'' = ω²·(cos·u − sin·w), g''' = −ω²·g'_circle.
