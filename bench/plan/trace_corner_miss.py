@@ -54,8 +54,12 @@ def segment_distance(p, a, b):
 
 
 def main():
+    usage = "usage: trace_corner_miss.py PROGRAM.canon TRACE.csv [TOLERANCE_MM]"
+    if len(sys.argv) > 1 and sys.argv[1] in ("-h", "--help"):
+        print(usage)
+        return 0
     if len(sys.argv) < 3:
-        print(__doc__ or "usage: trace_corner_miss.py PROGRAM.canon TRACE.csv [TOLERANCE_MM]")
+        print(usage, file=sys.stderr)
         return 2
     with open(sys.argv[1]) as f:
         points = end_points(f)
