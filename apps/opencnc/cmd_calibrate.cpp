@@ -18,9 +18,9 @@
 #include "commands.hpp"
 #include "opencnc/config/profile_loader.hpp"
 #include "opencnc/config/profile_writer.hpp"
-#include "opencnc/controller/calibration.hpp"
 #include "opencnc/controller/run_recorder.hpp"
 #include "opencnc/core/atomic_file.hpp"
+#include "opencnc/drill/calibration.hpp"
 
 namespace opencnc::cli {
 

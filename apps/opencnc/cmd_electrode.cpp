@@ -19,10 +19,11 @@
 #include "numeric_options.hpp"
 #include "opencnc/config/profile_loader.hpp"
 #include "opencnc/config/toml_edit.hpp"
-#include "opencnc/controller/electrode_setting.hpp"
 #include "opencnc/controller/gcode_source.hpp"
 #include "opencnc/controller/sim_rig.hpp"
 #include "opencnc/core/atomic_file.hpp"
+#include "opencnc/edm/electrode_setting.hpp"
+#include "opencnc/features/features.hpp"
 
 namespace opencnc::cli {
 
@@ -45,7 +46,7 @@ double electrode_um(double mm) {
   return std::round(mm * 1e4) / 10;  // µm to a tenth
 }
 
-nlohmann::json json_point(const control::Point3& p) {
+nlohmann::json json_point(const Vec3& p) {
   return {p[0], p[1], p[2]};
 }
 
@@ -75,20 +76,6 @@ void print_electrode(const control::ElectrodeResult& r) {
              r.tool, r.offset[0], r.offset[1], r.offset[2], r.previous[0], r.previous[1], r.previous[2]);
   fmt::print("fit: residual {:.1f} µm rms, {:.1f} µm at most\n", 1000 * r.rms_residual_mm,
              1000 * r.max_residual_mm);
-}
-
-/// The profile's tool table: the file itself with --write (every change written back), else a
-/// copy in memory.
-std::shared_ptr<tools::ToolTableService> electrode_tool_table(const config::MachineProfile& p, bool write) {
-  Diagnostics d;
-  std::shared_ptr<tools::ToolTableService> t;
-  if (write) {
-    t = tools::FileToolTable::open(p.interpreter.tool_table, d);
-  } else if (auto table = tools::ToolTable::load(p.interpreter.tool_table, d)) {
-    t = std::make_shared<tools::MemoryToolTable>(std::move(*table));
-  }
-  for (const Diagnostic& i : d.items()) fmt::print(stderr, "{} [{}]\n", i.format(), i.code);
-  return d.has_errors() ? nullptr : t;
 }
 
 bool machine_ready(control::SimRig& rig) {
@@ -137,25 +124,30 @@ std::optional<int> open_session(const config::MachineProfile& profile, const std
     if (files.empty()) return kExitUsage;
     s.report = std::move(files[0]);
   }
-  const std::shared_ptr<tools::ToolTableService> table = electrode_tool_table(profile, write_table);
-  if (!table) return kExitUsage;
+  // The machine as every front end sets it up; its tool table the file itself with --write (every
+  // change written back), else a copy in memory.
+  Diagnostics d;
+  control::MachineSetup::Options asked;
+  if (!write_table) asked.settings["tool-table"] = "memory";
+  std::unique_ptr<control::MachineSetup> machine = features::machine_setup(profile, d, std::move(asked));
+  for (const Diagnostic& i : d.items()) fmt::print(stderr, "{} [{}]\n", i.format(), i.code);
+  if (!machine) return kExitUsage;
+  s.feature = std::dynamic_pointer_cast<control::ElectrodeSetting>(machine->feature("electrode"));
+  if (!s.feature) {
+    fmt::print(stderr, "error: {} has no reference sphere and tool table to set electrodes with\n", path);
+    return kExitUsage;
+  }
+  const std::shared_ptr<tools::ToolTableService> table = machine->source_config().tools;
   const tools::ToolEntry* entry = table->snapshot()->tool(tool);
   if (entry == nullptr) {
     fmt::print(stderr, "error: tool {} is not in {}\n", tool, profile.interpreter.tool_table);
     return kExitUsage;
   }
-  Diagnostics d;
-  std::optional<control::GcodeSourceConfig> config = control::GcodeProgramSource::config_for(profile, d);
-  if (!config) return kExitProgram;
-  config->tools = table;
-  s.rig = std::make_unique<control::SimRig>(
-      profile, std::make_shared<control::GcodeProgramSource>(std::move(*config)));
+  s.rig = std::make_unique<control::SimRig>(profile, *machine);
   // The simulated electrode: where the table says, unless --sim-electrode puts it elsewhere.
-  control::Point3 truth{entry->offset[0], entry->offset[1], entry->offset[2]};
+  Vec3 truth{entry->offset[0], entry->offset[1], entry->offset[2]};
   if (sim_electrode.size() == 3) truth = {sim_electrode[0], sim_electrode[1], sim_electrode[2]};
   s.rig->machine().set_electrode(truth, entry->diameter / 2);
-  s.feature = std::make_shared<control::ElectrodeSetting>(table, profile);
-  s.rig->controller().add_feature(s.feature, control::ObserverOptions{profile.servo_period_s, true});
   if (!machine_ready(*s.rig)) return kExitProgram;
   return std::nullopt;
 }

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // `opencnc check`, `opencnc canon` and `opencnc scan`: the G-code interpreter on files.
+#include <fmt/format.h>
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
@@ -15,9 +16,8 @@
 #include "numeric_options.hpp"
 #include "opencnc/canon/rs274_printer.hpp"
 #include "opencnc/core/axis_map.hpp"
-#include "opencnc/gcode/coupling_codes.hpp"
+#include "opencnc/features/features.hpp"
 #include "opencnc/gcode/dialect.hpp"
-#include "opencnc/gcode/edm_codes.hpp"
 #include "opencnc/gcode/interpreter.hpp"
 #include "opencnc/gcode/rs274_driver.hpp"
 #include "opencnc/gcode/standard_extensions.hpp"
@@ -60,12 +60,13 @@ void add_interp_options(CLI::App* cmd, InterpArgs& a) {
       ->check(CLI::IsMember({"linuxcnc", "fanuc"}, CLI::ignore_case));
   cmd->add_option("--machine", a.machine, "mill or lathe, for Fanuc programs (default: guessed from the program's axis words)")
       ->check(CLI::IsMember({"mill", "lathe"}, CLI::ignore_case));
-  cmd->add_option(
-         "--codes", a.codes,
-         "code modules beyond the standard ones: coupling (M171-M175, the broaching codes of a machine "
-         "with a [coupling] section), edm (M180 P<n> selects machining condition n, 1-99, and switches "
-         "the generator on, M181 switches it off: the codes of a machine with an [edm] section)")
-      ->check(CLI::IsMember({"coupling", "edm"}));
+  std::string help = "code modules beyond the standard ones: ";
+  std::vector<std::string> names;
+  for (const features::CodeModules& m : features::code_modules()) {
+    help += fmt::format("{}{} ({})", names.empty() ? "" : ", ", m.name, m.help);
+    names.emplace_back(m.name);
+  }
+  cmd->add_option("--codes", a.codes, help)->check(CLI::IsMember(names));
   cmd->add_option("--axis-map", a.axis_map, "axis exchange, program letter = machine axis (e.g. X=Y,Y=X)");
   cmd->add_option("--max-blocks", a.max_blocks,
                   "stop with gcode.limit-blocks after this many blocks (loop bodies count each time; default "
@@ -110,13 +111,14 @@ bool make_options(const InterpArgs& a, const std::string& file, gcode::Options& 
     std::fprintf(stderr, "--axis-map: %s\n", problem.c_str());
     return false;
   }
-  const auto wanted = [&](const char* module) {
+  const auto wanted = [&](std::string_view module) {
     return std::find(a.codes.begin(), a.codes.end(), module) != a.codes.end();
   };
-  o.extensions =
-      wanted("coupling") ? gcode::coupling_extensions(o.dialect) : gcode::standard_extensions(o.dialect);
-  // Without a profile any condition number 1-99 is one: the machine's are checked when it opens.
-  if (wanted("edm")) o.extensions = gcode::edm_extensions(o.dialect, {}, o.extensions);
+  // The features' modules asked for, in their order (without a profile any EDM condition number
+  // 1-99 is one: the machine's are checked when it opens the program).
+  o.extensions = gcode::standard_extensions(o.dialect);
+  for (const features::CodeModules& m : features::code_modules())
+    if (wanted(m.name)) o.extensions = features::with_code_modules(m.name, o.dialect, o.extensions);
   o.block_delete = a.block_delete;
   o.limits.max_blocks = a.max_blocks;
   o.limits.max_seconds = a.max_seconds;

@@ -11,7 +11,7 @@
 #include "cli_files.hpp"
 #include "commands.hpp"
 #include "numeric_options.hpp"
-#include "opencnc/cam/helix_job.hpp"
+#include "opencnc/broaching/helix_job.hpp"
 
 namespace opencnc::cli {
 

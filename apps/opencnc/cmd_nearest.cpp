@@ -16,8 +16,9 @@
 #include "numeric_options.hpp"
 #include "opencnc/config/profile_loader.hpp"
 #include "opencnc/controller/gcode_source.hpp"
+#include "opencnc/features/features.hpp"
 #include "opencnc/gcode/standard_extensions.hpp"
-#include "opencnc/recovery/path_scan.hpp"
+#include "opencnc/retrace/path_scan.hpp"
 
 namespace opencnc::cli {
 
@@ -50,10 +51,14 @@ std::shared_ptr<control::GcodeProgramSource> make_source(const NearestOptions& o
     rc = unreadable ? kExitUsage : kExitProgram;
     return nullptr;
   }
-  auto source = control::GcodeProgramSource::create(*load.profile, d);
+  // The program as the machine runs it: its features' passes and codes (features::machine_setup).
+  std::unique_ptr<control::MachineSetup> machine = features::machine_setup(*load.profile, d);
   for (const Diagnostic& x : d.items()) fmt::print(stderr, "{}\n", x.format());
-  if (!source) rc = kExitProgram;
-  return source;
+  if (!machine) {
+    rc = kExitProgram;
+    return nullptr;
+  }
+  return machine->source();
 }
 
 nlohmann::json point_json(const recovery::PathPoint& p, const recovery::PathIndex& ix) {
@@ -83,7 +88,7 @@ int run_nearest(const NearestOptions& o) {
   recovery::QueryOptions q;
   q.metric = o.three_d ? recovery::Metric::Xyz : recovery::Metric::Xy;
   q.margin_mm = o.margin_mm;
-  const recovery::Vec3 b{o.point[0], o.point[1], o.point.size() > 2 ? o.point[2] : 0.0};
+  const Vec3 b{o.point[0], o.point[1], o.point.size() > 2 ? o.point[2] : 0.0};
   const recovery::Nearest n = ix.nearest(b, q);
   if (!n.found) {
     fmt::print(stderr, "error: {} has no feed moves\n", o.file);

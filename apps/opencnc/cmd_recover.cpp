@@ -13,15 +13,16 @@
 
 #include "cli_files.hpp"
 #include "commands.hpp"
+#include "opencnc/broaching/breakpoint_journal.hpp"
+#include "opencnc/broaching/recovery_wait.hpp"
+#include "opencnc/broaching/sim_bore.hpp"
 #include "opencnc/config/profile_loader.hpp"
 #include "opencnc/controller/gcode_source.hpp"
 #include "opencnc/controller/run_recorder.hpp"
 #include "opencnc/controller/servo_setup.hpp"
 #include "opencnc/controller/sim_rig.hpp"
+#include "opencnc/features/features.hpp"
 #include "opencnc/motion/coupling.hpp"
-#include "opencnc/recovery/breakpoint_journal.hpp"
-#include "opencnc/recovery/recovery_wait.hpp"
-#include "opencnc/recovery/sim_bore.hpp"
 
 namespace opencnc::cli {
 
@@ -164,16 +165,24 @@ int recover(const RecoverOptions& o) {
     return kExitProgram;
   }
 
+  // The machine as every front end sets it up, the journal among its features.
   Diagnostics d;
-  auto source = control::GcodeProgramSource::create(profile, d);
-  control::SimRig rig(profile, source);
-  std::string error;
-  auto journal = recovery::BreakpointJournal::open(o.journal, source, &error);
+  std::unique_ptr<control::MachineSetup> machine =
+      features::machine_setup(profile, d, control::MachineSetup::Options::with("journal", o.journal));
+  for (const Diagnostic& x : d.items()) {
+    if (x.code == "setting.journal")
+      fmt::print(stderr, "error: --journal {}: {}\n", o.journal, x.message);
+    else
+      fmt::print(stderr, "{}\n", x.format());
+  }
+  if (!machine) return kExitUsage;
+  auto journal = std::dynamic_pointer_cast<recovery::BreakpointJournal>(machine->feature("journal"));
   if (!journal) {
-    fmt::print(stderr, "error: --journal {}: {}\n", o.journal, error);
+    fmt::print(stderr, "error: --journal {}: {} has no power monitor ([power] monitor)\n", o.journal,
+               o.machine);
     return kExitUsage;
   }
-  rig.controller().add_feature(journal, control::ObserverOptions{profile.servo_period_s, true});
+  control::SimRig rig(profile, *machine);
   std::optional<control::TraceCsvWriter> csv;
   if (files[0]) csv.emplace(*files[0], profile.axis_mask(), profile.servo_period_s);
   auto trace =

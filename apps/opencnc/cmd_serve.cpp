@@ -181,7 +181,7 @@ int serve(const ServeOptions& o) {
   fmt::print("  open      http://{}:{}/#token={}\n", host_part, server.port(), tokens->operator_token());
   fmt::print("  operator  {}\n  admin     in {}\n  history   {}\n", tokens->operator_token(),
              tokens->origin(), (data / "history.sqlite").string());
-  if (features->journal()) fmt::print("  journal   {}\n", fo.journal_dir);
+  if (features->has("journal")) fmt::print("  journal   {}\n", fo.journal_dir);
   fmt::print("  features  {}\n  Ctrl-C stops.\n", fmt::join(features->names(), ", "));
   std::fflush(stdout);
 

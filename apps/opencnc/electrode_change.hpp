@@ -12,7 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "opencnc/controller/controller.hpp"
-#include "opencnc/controller/electrode_setting.hpp"
+#include "opencnc/edm/electrode_setting.hpp"
 
 namespace opencnc::machine {
 class SimMachine;
@@ -23,7 +23,7 @@ namespace opencnc::cli {
 /// One change: at `at_s` seconds into the program, a new electrode whose true offsets are `offset`.
 struct ElectrodeChangeAt {
   double at_s = 0;
-  std::array<double, 3> offset{};
+  Vec3 offset{};
 };
 
 /// "30:0.02,-0.01,0.05" → {30, {0.02, −0.01, 0.05}}; nullopt if it is not that (finite, time ≥ 0).

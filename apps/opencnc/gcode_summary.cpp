@@ -15,9 +15,11 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.hpp"
+#include "opencnc/canon/arc_geometry.hpp"
 #include "opencnc/canon/program_builder.hpp"
 #include "opencnc/canon/tee_sink.hpp"
 #include "opencnc/controller/gcode_source.hpp"
+#include "opencnc/features/features.hpp"
 #include "opencnc/gcode/interpreter.hpp"
 #include "progress.hpp"
 
@@ -38,41 +40,20 @@ struct Box {
   bool empty() const { return !(lo[0] <= hi[0]); }
 };
 
-// Axis indices (first, second, normal) of an arc plane among X, Y, Z.
-void plane_axes(canon::Plane p, int& a, int& b, int& n) {
-  switch (p) {
-    case canon::Plane::YZ: a = 1, b = 2, n = 0; return;
-    case canon::Plane::XZ: a = 2, b = 0, n = 1; return;
-    default: a = 0, b = 1, n = 2; return;
-  }
-}
-
-// Swept angle (radians, signed: + counterclockwise) from angle `a0` to `a1` with LinuxCNC's
-// turn count (|turns| - 1 extra full circles).
-double swept(double a0, double a1, int turns) {
-  const double two_pi = 2 * std::numbers::pi;
-  if (turns > 0) {
-    double d = a1 - a0;
-    while (d <= 0) d += two_pi;
-    return d + (turns - 1) * two_pi;
-  }
-  double d = a1 - a0;
-  while (d >= 0) d -= two_pi;
-  return d + (turns + 1) * two_pi;
-}
-
 // Adds an arc (in XYZ of the plane axes) to `box`; returns its length.
-double arc_extent(const double start[3], const double end[3], const double center[3], canon::Plane plane, int turns,
-                  Box& box) {
-  int a, b, n;
-  plane_axes(plane, a, b, n);
+double arc_extent(const double start[3], const double end[3], const Vec3& center, canon::Plane plane,
+                  int turns, Box& box) {
+  // The plane's axes within its triple (the centre is given in it).
+  const canon::PlaneAxes axes = canon::plane_axes(plane);
+  const int base = canon::plane_base(plane);
+  const int a = axes.first - base, b = axes.second - base, n = axes.normal - base;
   // An arc whose end is off its start circle runs as a spiral between the two radii: the
   // larger one bounds its extremes.
   const double r = std::max(std::hypot(start[a] - center[a], start[b] - center[b]),
                             std::hypot(end[a] - center[a], end[b] - center[b]));
   const double a0 = std::atan2(start[b] - center[b], start[a] - center[a]);
   const double a1 = std::atan2(end[b] - center[b], end[a] - center[a]);
-  const double sweep = swept(a0, a1, turns);
+  const double sweep = canon::arc_sweep(std::remainder(a1 - a0, 2 * std::numbers::pi), turns);
   box.add(start[0], start[1], start[2]);
   box.add(end[0], end[1], end[2]);
   for (int q = 0; q < 4; ++q) {   // the four axis extremes of the circle, if swept
@@ -240,13 +221,14 @@ class WorkWatcher final : public canon::Sink {
   void straight_traverse(canon::SegmentId, const Pose& end) override { move(end); }
   void straight_feed(canon::SegmentId, const Pose& end) override { move(end); }
   void arc_feed(canon::SegmentId, const canon::ArcFeed& arc) override {
-    int a, b, n;
-    plane_axes(arc.plane, a, b, n);
-    double s[3] = {pos_[0], pos_[1], pos_[2]}, e[3] = {arc.end[0], arc.end[1], arc.end[2]}, c[3];
-    c[a] = arc.first_center;
-    c[b] = arc.second_center;
-    c[n] = s[n];
-    if (within_reach(s) && within_reach(e) && within_reach(c))
+    const canon::PlaneAxes axes = canon::plane_axes(arc.plane);
+    const int base = canon::plane_base(arc.plane);
+    double s[3] = {pos_[0], pos_[1], pos_[2]}, e[3] = {arc.end[0], arc.end[1], arc.end[2]};
+    Vec3 c;
+    c[axes.first - base] = arc.first_center;
+    c[axes.second - base] = arc.second_center;
+    c[axes.normal - base] = s[axes.normal - base];
+    if (within_reach(s) && within_reach(e) && within_reach(c.v.data()))
       arc_extent(s, e, c, arc.plane, arc.rotation, box_);
     for (int i = 0; i < 3; ++i) pos_[i] = arc.end[i];
     meter_.catch_up();
@@ -391,8 +373,9 @@ TimeEstimate estimate_machining_time(const std::string& file, const config::Mach
   TimeEstimate e;
   // The options the run's own source gives this file (dialect comment, modules, tool table).
   Diagnostics diags;
-  const auto source = control::GcodeProgramSource::create(profile, diags);
-  if (!source) return e;
+  const std::unique_ptr<control::MachineSetup> machine = features::machine_setup(profile, diags);
+  if (!machine) return e;
+  const auto& source = machine->source();
   ProgramScan scan(source->options_for(file, {}));
   if (!scan.open(file)) return e;
   InterpreterProgress progress("checking the machining time of " + file, false);

@@ -1,23 +1,12 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// `opencnc run --journal DIR`: opening the journal feature and reporting what it wrote.
+// `opencnc run --journal DIR`: what the journal feature wrote, in the report.
 #include "run_journal.hpp"
 
 #include <fmt/format.h>
 
-#include "opencnc/controller/gcode_source.hpp"
-#include "opencnc/recovery/sim_bore.hpp"
+#include "opencnc/broaching/sim_bore.hpp"
 
 namespace opencnc::cli {
-
-std::shared_ptr<recovery::BreakpointJournal> open_run_journal(const std::string& dir,
-                                                              const config::MachineProfile& profile) {
-  Diagnostics d;
-  std::shared_ptr<control::GcodeProgramSource> source = control::GcodeProgramSource::create(profile, d);
-  std::string error;
-  auto journal = recovery::BreakpointJournal::open(dir, source, &error);
-  if (!journal) fmt::print(stderr, "error: --journal {}: {}\n", dir, error);
-  return journal;
-}
 
 nlohmann::json finish_run_journal(recovery::BreakpointJournal& journal, const std::string& dir,
                                   const std::vector<float>& sim_bore) {

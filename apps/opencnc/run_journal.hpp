@@ -9,15 +9,10 @@
 
 #include <nlohmann/json.hpp>
 
+#include "opencnc/broaching/breakpoint_journal.hpp"
 #include "opencnc/config/machine_profile.hpp"
-#include "opencnc/recovery/breakpoint_journal.hpp"
 
 namespace opencnc::cli {
-
-/// The journal feature writing into `dir` (created if missing), with the profile's interpreter
-/// options for the modal digest; nullptr after printing why. CLI thread, before the run.
-std::shared_ptr<recovery::BreakpointJournal> open_run_journal(const std::string& dir,
-                                                              const config::MachineProfile& profile);
 
 /// Waits for the writer, prints what the journal holds and returns it as the report's `journal`:
 /// `written`, `valid`, `stage`, `segment`, `line`, `file`, `segment_offset_mm`,

@@ -5,6 +5,7 @@
 #include <poll.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cstdint>
@@ -22,10 +23,11 @@
 #include "opencnc/control/triple_buffer.hpp"
 #include "opencnc/controller/gcode_source.hpp"
 #include "opencnc/controller/hal_link.hpp"
+#include "opencnc/controller/machine_setup.hpp"
 #include "opencnc/controller/servo_setup.hpp"
 #include "opencnc/controller/sim_rig.hpp"
 #include "opencnc/core/atomic_file.hpp"
-#include "opencnc/toolguard/tool_guard.hpp"
+#include "opencnc/features/features.hpp"
 #include "stop_signals.hpp"
 
 namespace opencnc::cli {
@@ -38,9 +40,22 @@ using control::ControllerEventKind;
 using control::Request;
 using control::State;
 
+void print_one(const Diagnostic& d) {
+  fmt::print(stderr, "{}{}\n", d.format(), d.code.empty() ? "" : fmt::format(" [{}]", d.code));
+}
+
 void print(const Diagnostics& diags) {
+  for (const Diagnostic& d : diags.items()) print_one(d);
+}
+
+/// The features' set-up problems: one with a setting the command line gave (`setting.NAME`) names
+/// its option (`--NAME FILE: why`), as the option's own checks do.
+void print_setup(const Diagnostics& diags) {
   for (const Diagnostic& d : diags.items()) {
-    fmt::print(stderr, "{}{}\n", d.format(), d.code.empty() ? "" : fmt::format(" [{}]", d.code));
+    if (d.code.rfind("setting.", 0) == 0)
+      fmt::print(stderr, "error: --{} {}: {}\n", d.code.substr(8), d.file, d.message);
+    else
+      print_one(d);
   }
 }
 
@@ -57,24 +72,16 @@ class Driver {
   virtual void set_hand_target(int joint, double target, double speed) = 0;
   /// The simulated mains fail (virtual time only: cmd_run refuses --inject with --realtime or --hal).
   virtual void cut_mains() = 0;
-  /// The simulated broach's cutter wears to `factor` (virtual time only, as cut_mains).
-  virtual void set_tool_dull(double factor) = 0;
-  /// A short in the simulated EDM gap (virtual time only, as cut_mains).
-  virtual void inject_edm_short() {}
   /// A simulated analog input goes to `value` over `ramp_s` (0: at once). Virtual time only.
   virtual void drive_analog(int /*channel*/, double /*value*/, double /*ramp_s*/) {}
-  /// The simulated broach's workpiece (virtual time only: empty otherwise).
-  virtual std::vector<float> sim_bore() { return {}; }
-  /// The simulated machine (virtual time only; null elsewhere).
+  /// The simulated machine (virtual time only; null elsewhere): the features' injected faults.
   virtual machine::SimMachine* sim_machine() { return nullptr; }
-  /// The simulated spark gap's figures (virtual time only; nothing elsewhere).
-  virtual std::optional<SimEdmFigures> sim_edm() { return std::nullopt; }
 };
 
 class VirtualDriver final : public Driver {
  public:
   VirtualDriver(const config::MachineProfile& p, std::shared_ptr<control::ProgramSource> s)
-      : rig_(p, std::move(s)), edm_sim_(p.edm.sim.present) {}
+      : rig_(p, std::move(s)) {}
   void advance() override { rig_.step(); }
   control::Controller& controller() override { return rig_.controller(); }
   bool ticks_by_itself() const override { return false; }
@@ -82,8 +89,6 @@ class VirtualDriver final : public Driver {
     rig_.machine().set_hand_target(joint, target, speed);
   }
   void cut_mains() override { rig_.machine().set_mains_ok(false); }
-  void set_tool_dull(double factor) override { rig_.machine().set_tool_dull(factor); }
-  void inject_edm_short() override { rig_.machine().inject_edm_short(); }
   machine::SimMachine* sim_machine() override { return &rig_.machine(); }
   void drive_analog(int channel, double value, double ramp_s) override {
     machine::SimMachine& m = rig_.machine();
@@ -93,19 +98,9 @@ class VirtualDriver final : public Driver {
       m.set_analog_input(channel, value);
     }
   }
-  std::vector<float> sim_bore() override {
-    const std::span<const float> b = rig_.machine().broach_bore();
-    return {b.begin(), b.end()};
-  }
-  std::optional<SimEdmFigures> sim_edm() override {
-    if (!edm_sim_) return std::nullopt;
-    const machine::SimEdmProcess& e = rig_.machine().edm();
-    return SimEdmFigures{e.cavity_oversize_max_mm(), e.electrode_wear_max_mm(), e.depth_max_mm()};
-  }
 
  private:
   control::SimRig rig_;
-  bool edm_sim_ = false;
 };
 
 /// The simulated machine behind a real-time servo: the servo thread alone touches it, so the
@@ -162,7 +157,6 @@ class RealtimeDriver final : public Driver {
     sim_->set_hand_target(joint, target, speed);
   }
   void cut_mains() override {}  // the servo thread alone touches the machine; refused before
-  void set_tool_dull(double) override {}
 
  private:
   std::unique_ptr<control::ServoChannels> channels_;
@@ -191,7 +185,6 @@ class HalDriver final : public Driver {
   bool ticks_by_itself() const override { return true; }
   void set_hand_target(int, double, double) override {}  // a real hand moves a real axis
   void cut_mains() override {}  // real mains: nothing to simulate (cmd_run refuses --inject with --hal)
-  void set_tool_dull(double) override {}
 
  private:
   std::unique_ptr<control::HalLink> link_;
@@ -344,56 +337,32 @@ class StopOnThePath {
   bool held_ = false, aborted_ = false, over_time_ = false;
 };
 
+/// The operator at the terminal for a feature that holds the program and asks (SessionOperator).
+class TerminalOperator final : public SessionOperator {
+ public:
+  TerminalOperator(Driver& d, const SessionOptions& o, OperatorInput& input) : d_(d), o_(o), input_(input) {}
+  std::optional<std::string> ask(const std::string& question) override {
+    if (o_.unattended || input_.closed()) return std::nullopt;
+    fmt::print(stderr, "\n{}\n", question);
+    std::optional<std::string> answer;
+    while (!answer && !input_.closed()) {
+      answer = input_.line(d_.ticks_by_itself() ? 10 : -1);
+      if (!answer && d_.ticks_by_itself()) d_.advance();
+    }
+    return answer;
+  }
+  bool must(Request r) override { return cli::must(d_, std::move(r)); }
+  void submit(Request r) override { d_.controller().submit(std::move(r)); }
+
+ private:
+  Driver& d_;
+  const SessionOptions& o_;
+  OperatorInput& input_;
+};
+
 /// Follows the job started by cycle start until it ends, with the operator where it waits (and
-/// the machine's hand at the hand-fed axes).
-/// The tool guard holds the program before a tool cuts (its note, with the differences, is
-/// printed): the operator at the terminal accepts the live values or restores the backup, and
-/// the program goes on; anything else, --unattended or no terminal aborts it (nothing is ever
-/// accepted without the operator). Returns false when the run was aborted.
-bool answer_tool_guard(Driver& d, const SessionOptions& o, OperatorInput& input) {
-  if (!o.unattended && !input.closed()) {
-    fmt::print(stderr,
-               "\nthe tool guard holds the program: type accept (the live values become the backup) or "
-               "restore (the backup's values become live) and Enter; anything else aborts\n");
-    std::optional<std::string> answer;
-    while (!answer && !input.closed()) {
-      answer = input.line(d.ticks_by_itself() ? 10 : -1);
-      if (!answer && d.ticks_by_itself()) d.advance();
-    }
-    if (answer && (*answer == "accept" || *answer == "restore")) {
-      if (must(d, Request::feature("tool-guard", *answer))) return true;
-    }
-  }
-  fmt::print(
-      stderr,
-      "error: the tool guard holds the program before the tool cuts; it is aborted: accept or restore "
-      "(`opencnc tools --db STORE accept|restore`, or at the terminal without --unattended), then run it "
-      "again\n");
-  d.controller().submit(Request::simple(CommandKind::Abort));
-  return false;
-}
-
-/// The load guard held the feed (its note says at what load): the operator at the terminal resumes
-/// (the cutter checked) or aborts; --unattended or no terminal aborts, since nothing would resume.
-/// Returns false when the run was aborted.
-bool answer_load_hold(Driver& d, const SessionOptions& o, OperatorInput& input) {
-  if (!o.unattended && !input.closed()) {
-    fmt::print(stderr,
-               "\nthe load guard holds the feed: type resume and Enter to cut on; anything else aborts\n");
-    std::optional<std::string> answer;
-    while (!answer && !input.closed()) {
-      answer = input.line(d.ticks_by_itself() ? 10 : -1);
-      if (!answer && d.ticks_by_itself()) d.advance();
-    }
-    if (answer && *answer == "resume" && must(d, Request::simple(CommandKind::Resume))) return true;
-  }
-  fmt::print(
-      stderr,
-      "error: the load guard held the feed (the cutter's load passed its hold level); the run is aborted\n");
-  d.controller().submit(Request::simple(CommandKind::Abort));
-  return false;
-}
-
+/// the machine's hand at the hand-fed axes); a feature that holds the program asks the operator
+/// through SessionHooks::on_event.
 void follow(Driver& d, control::EventCursor& cursor, const SessionOptions& o, const SessionHooks& hooks,
             SessionEnd& end) {
   StopOnThePath stop(o);
@@ -402,8 +371,8 @@ void follow(Driver& d, control::EventCursor& cursor, const SessionOptions& o, co
   std::uint32_t job = 0;
   std::uint64_t asked_tick = ~std::uint64_t{0};  // the wait already answered (by its start tick)
   std::uint64_t n = 0;
-  bool mains_cut = false, dulled = false, edm_shorted = false, analog_driven = false;
-  bool guard_abort = false, load_hold = false, load_abort = false, alarm_abort = false;
+  TerminalOperator op(d, o, input);
+  bool mains_cut = false, analog_driven = false, alarm_abort = false;
   for (;;) {
     d.advance();
     std::optional<ControllerEvent> ended;
@@ -412,26 +381,13 @@ void follow(Driver& d, control::EventCursor& cursor, const SessionOptions& o, co
       if (e.kind == ControllerEventKind::JobStarted && job == 0 && e.job == control::JobKind::Program)
         job = e.job_id;
       if (e.kind == ControllerEventKind::JobEnded && e.job_id == job) ended = e;
-      if (e.kind == ControllerEventKind::Note && e.code == "tools.guard-hold" && !guard_abort)
-        guard_abort = !answer_tool_guard(d, o, input);
-      if (e.kind == ControllerEventKind::Servo && e.servo.kind == control::EventKind::LoadGuard)
-        load_hold = e.servo.action == static_cast<std::uint32_t>(control::LoadAction::Hold);
-      if (e.kind == ControllerEventKind::Note && e.code == "control.load" && load_hold && !load_abort)
-        load_abort = !answer_load_hold(d, o, input);  // after its note is printed
+      if (hooks.on_event) hooks.on_event(e, op);  // a feature that holds the program asks the operator
     }
     const control::ControllerStatus st = d.controller().status();
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (o.mains_off_s >= 0 && !mains_cut && st.servo.time_s >= o.mains_off_s) {
       d.cut_mains();  // the servo sees it at its next period
       mains_cut = true;
-    }
-    if (o.tool_dull_s >= 0 && !dulled && st.servo.time_s >= o.tool_dull_s) {
-      d.set_tool_dull(o.tool_dull_factor);
-      dulled = true;
-    }
-    if (o.edm_short_s >= 0 && !edm_shorted && st.servo.time_s >= o.edm_short_s) {
-      d.inject_edm_short();
-      edm_shorted = true;
     }
     if (o.analog && !analog_driven && st.servo.time_s >= o.analog->at_s) {
       d.drive_analog(o.analog->channel, o.analog->value, o.analog->ramp_s);
@@ -552,12 +508,29 @@ SessionEnd run_session(const SessionOptions& o, const SessionHooks& hooks) {
     end.exit_code = kExitUsage;
     return end;
   }
+  // The machine as its features set it up (features::set_up), as every front end does.
   Diagnostics diags;
-  // The profile's G-code source; with [tool_guard], the tool store and the guard's feature.
-  std::optional<toolguard::Setup> setup = toolguard::setup(end.profile, diags, o.tool_table_in_memory);
+  control::MachineSetup::Options asked;
+  asked.reports = o.reports;
+  asked.settings = o.settings;
+  if (o.tool_table_in_memory) asked.settings["tool-table"] = "memory";
+  std::unique_ptr<control::MachineSetup> setup = control::MachineSetup::create(end.profile, asked, diags);
   print(diags);
   if (!setup) return end;
-  const std::shared_ptr<control::ProgramSource> source = setup->source;
+  const bool set_up = features::set_up(*setup);
+  print_setup(setup->diagnostics());
+  if (!set_up) {  // a setting the command line gave is a usage error; the profile's, the program's
+    const auto& items = setup->diagnostics().items();
+    if (std::any_of(items.begin(), items.end(),
+                    [](const Diagnostic& d) { return d.code.rfind("setting.", 0) == 0; }))
+      end.exit_code = kExitUsage;
+    return end;
+  }
+  if (hooks.set_up && !hooks.set_up(*setup)) {
+    end.exit_code = kExitUsage;
+    return end;
+  }
+  const std::shared_ptr<control::ProgramSource> source = setup->source();
 
   std::unique_ptr<Driver> driver;
   if (o.hal) {
@@ -583,12 +556,7 @@ SessionEnd run_session(const SessionOptions& o, const SessionHooks& hooks) {
     driver = std::make_unique<VirtualDriver>(end.profile, source);
   }
   Driver& d = *driver;
-  if (setup->feature) d.controller().add_feature(setup->feature);
-  if (hooks.features) {
-    for (auto& f : hooks.features(end.profile, setup->source->tools()))
-      d.controller().add_feature(std::move(f),
-                                 control::ObserverOptions{end.profile.servo_period_s, hooks.features_trace});
-  }
+  setup->install(d.controller());
   const control::ServoConfig& sc = d.controller().servo_config();
   // Through HAL the machine may already be on: a previous controller left it idle.
   const bool on = o.hal && d.controller().status().servo.state == State::Idle;
@@ -606,8 +574,7 @@ SessionEnd run_session(const SessionOptions& o, const SessionHooks& hooks) {
   control::EventCursor cursor(d.controller().events());
   if (!must(d, Request::simple(CommandKind::CycleStart))) return end;
   follow(d, cursor, o, hooks, end);
-  end.sim_bore = d.sim_bore();
-  end.sim_edm = d.sim_edm();
+  if (hooks.finished) hooks.finished(d.sim_machine());
   end.exit_code = end.finished ? kExitOk : end.stopped_by != 0 ? 128 + end.stopped_by : kExitProgram;
   return end;
 }

@@ -6,6 +6,7 @@
 
 #include <atomic>
 #include <functional>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -15,6 +16,7 @@
 #include "opencnc/config/machine_profile.hpp"
 #include "opencnc/control/status.hpp"
 #include "opencnc/controller/controller.hpp"
+#include "opencnc/controller/machine_setup.hpp"
 #include "opencnc/tools/tool_table_service.hpp"
 
 namespace opencnc::machine {
@@ -43,11 +45,6 @@ struct SessionOptions {
   double max_time_s = 0;
   /// Virtual time: the simulated mains fail at this servo time (s); negative: never.
   double mains_off_s = -1;
-  /// Virtual time: the broach's cutter wears to `tool_dull_factor` at this servo time (s); negative: never.
-  double tool_dull_s = -1;
-  double tool_dull_factor = 1;
-  /// Virtual time: a short in the simulated EDM gap at this servo time (s); negative: never.
-  double edm_short_s = -1;
   /// Virtual time: a simulated analog input driven to `value` from servo time `at_s`, over `ramp_s`
   /// (0: at once) — a process input (dielectric level, a temperature) drifting out of range.
   struct AnalogInjection {
@@ -58,14 +55,10 @@ struct SessionOptions {
   /// The program's tool table is a copy in memory: what the run changes in it (a simulated
   /// electrode's measurement, `run --electrode-change`) does not reach the profile's file.
   bool tool_table_in_memory = false;
-};
-
-/// The simulated spark gap's ground truth at the end of a run in virtual time (docs/edm.md):
-/// what a real machine shows only when the work is measured.
-struct SimEdmFigures {
-  double cavity_oversize_mm = 0;  ///< the widest cavity's oversize per side beyond the electrode
-  double electrode_wear_mm = 0;   ///< the most length an electrode lost
-  double cavity_depth_mm = 0;     ///< the deepest front below the work's surface
+  /// The run writes a report: the features add the observers of its sections.
+  bool reports = false;
+  /// Settings for the features' setup by name (control::MachineSetup::Options): "journal".
+  std::map<std::string, std::string, std::less<>> settings;
 };
 
 /// What a session ended with.
@@ -79,39 +72,51 @@ struct SessionEnd {
   double wall_s = 0;           ///< wall-clock time of the run
   config::MachineProfile profile;
   std::optional<control::OpenProgram> program;  ///< the program as opened (its preflight)
-  /// The simulated broach's workpiece as the run left it (virtual time on a machine with a
-  /// simulated broach; empty otherwise): `--journal` keeps it beside the breakpoint.
-  std::vector<float> sim_bore;
-  std::optional<SimEdmFigures> sim_edm;         ///< in virtual time on a machine with [edm.sim]
+};
+
+/// Observers to attach for a run, with their options.
+using SessionObservers =
+    std::vector<std::pair<std::shared_ptr<control::ControllerObserver>, control::ObserverOptions>>;
+
+/// The operator at the terminal, for a feature that holds the program and asks (the tool guard's
+/// accept or restore, the load guard's resume). Controller thread (the session's loop).
+class SessionOperator {
+ public:
+  virtual ~SessionOperator() = default;
+  /// Prints `question` and waits for a line, the machine going on meanwhile; nothing when no one
+  /// can answer (--unattended, stdin closed).
+  virtual std::optional<std::string> ask(const std::string& question) = 0;
+  /// Sends a request and waits for its answer (printing a refusal); whether it was accepted.
+  virtual bool must(control::Request r) = 0;
+  /// Sends a request.
+  virtual void submit(control::Request r) = 0;
 };
 
 /// Observers attached before the program starts (a run recorder, a trace writer), and progress.
 struct SessionHooks {
   /// Called once the program is open and checked, before it starts: return the observers to
   /// attach (with their options) for the run.
-  std::function<
-      std::vector<std::pair<std::shared_ptr<control::ControllerObserver>, control::ObserverOptions>>(
-          const config::MachineProfile&, const control::OpenProgram&)>
-      opened;
+  std::function<SessionObservers(const config::MachineProfile&, const control::OpenProgram&)> opened;
   /// Called once the program is open and checked, before `opened`: false ends the session there
   /// (nothing has moved; it has said why). A program the preflight refused never gets here, so a
   /// second look at it (the machining time against --max-time) is made only of a finite program.
   std::function<bool(const config::MachineProfile&, const control::OpenProgram&)> may_start;
   /// Now and then with the status (for progress).
   std::function<void(const control::ControllerStatus&, double elapsed_wall_s)> progress;
-  /// Features added to the controller before the program is opened (the retrace feature), each
-  /// following the status every servo period.
-  /// They get the program source's tool table (G43 reads it, electrode setting writes it).
-  std::function<std::vector<std::shared_ptr<control::Feature>>(
-      const config::MachineProfile&, const std::shared_ptr<tools::ToolTableService>&)>
-      features;
-  /// The features follow the trace too (the breakpoint journal reads the interrupted move from it).
-  bool features_trace = false;
+  /// Once the machine's features are set up (features::set_up), before the controller is built:
+  /// the command line takes the features it drives. False stops the session (after printing why).
+  std::function<bool(control::MachineSetup&)> set_up;
   /// Every period of the run, with the controller and (in virtual time, else null) the simulated
   /// machine: a scripted operator (`run --retrace`, `run --electrode-change`).
   std::function<void(control::Controller&, const control::ControllerStatus&, machine::SimMachine*)> tick;
   /// When the program's job ends: true if the session goes on with the job that resumes it.
   std::function<bool(const control::ControllerEvent&)> goes_on;
+  /// Every event of the run, after it is printed: a feature that holds the program asks the
+  /// operator (and aborts when no one answers).
+  std::function<void(const control::ControllerEvent&, SessionOperator&)> on_event;
+  /// The session ends, with the simulated machine (virtual time; else null): what the features
+  /// keep of it (the simulated bore, the spark gap's figures).
+  std::function<void(machine::SimMachine*)> finished;
 };
 
 /// Runs `o.file` on the simulated machine of `o.machine`; prints problems and program messages

@@ -25,6 +25,7 @@
 #include "opencnc/controller/run_recorder.hpp"
 #include "opencnc/controller/servo_setup.hpp"
 #include "opencnc/controller/sim_rig.hpp"
+#include "opencnc/features/features.hpp"
 
 using namespace opencnc;
 using namespace opencnc::control;
@@ -54,7 +55,7 @@ bool ask(SimRig& rig, Request r, std::string& why) {
 
 void run(const config::MachineProfile& profile, const Job& job, bool report, int service_every) {
   Diagnostics diags;
-  SimRig rig(profile, GcodeProgramSource::create(profile, diags), service_every);
+  SimRig rig(profile, *features::machine_setup(profile, diags), service_every);
   std::string why;
   if (!ask(rig, Request::simple(CommandKind::MachineOn), why) ||
       !ask(rig, Request::set_mode(Mode::Auto), why)) {

@@ -20,6 +20,7 @@
 #include "opencnc/config/profile_loader.hpp"
 #include "opencnc/controller/gcode_source.hpp"
 #include "opencnc/controller/sim_rig.hpp"
+#include "opencnc/features/features.hpp"
 
 using namespace opencnc;
 using namespace opencnc::control;
@@ -88,7 +89,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   Diagnostics diags;
-  SimRig rig(*load.profile, GcodeProgramSource::create(*load.profile, diags));
+  SimRig rig(*load.profile, *features::machine_setup(*load.profile, diags));
   if (!ask(rig, Request::simple(CommandKind::MachineOn)) || !ask(rig, Request::set_mode(Mode::Auto))) return 1;
 
   const auto t_open = Clock::now();

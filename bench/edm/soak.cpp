@@ -31,6 +31,7 @@
 #include "opencnc/config/profile_loader.hpp"
 #include "opencnc/controller/gcode_source.hpp"
 #include "opencnc/controller/sim_rig.hpp"
+#include "opencnc/features/features.hpp"
 
 using namespace opencnc;
 using namespace opencnc::control;
@@ -185,7 +186,7 @@ int main(int argc, char** argv) {
   const std::string program = (dir / "channel.ngc").string();
   std::ofstream(program) << kChannel;
   Diagnostics d;
-  SimRig rig(profile, GcodeProgramSource::create(profile, d));
+  SimRig rig(profile, *features::machine_setup(profile, d));
   rig.step();
   if (!accepted(rig, Request::simple(CommandKind::MachineOn)) || !home_all(rig) ||
       !accepted(rig, Request::set_mode(Mode::Auto)))

@@ -20,6 +20,7 @@
 
 #include "opencnc/config/profile_loader.hpp"
 #include "opencnc/controller/gcode_source.hpp"
+#include "opencnc/features/features.hpp"
 #include "opencnc/hmi/machine_host.hpp"
 #include "opencnc/hmi/server.hpp"
 #include "servo_accounting.hpp"
@@ -166,7 +167,7 @@ int main(int argc, char** argv) {
   const auto load = config::load_profile(OPENCNC_SOURCE_DIR "/configs/mill-3axis.toml");
   if (!load.ok()) return 1;
   Diagnostics d;
-  auto source = control::GcodeProgramSource::create(*load.profile, d);
+  auto source = features::machine_setup(*load.profile, d)->source();
   hmi::HostOptions ho;
   ho.servo_cpu = servo_cpu;  // the clients' threads start after host.start(): they keep off it too
   hmi::MachineHost host(*load.profile, source, ho);

@@ -6,7 +6,7 @@
 // planner and the tick ran (docs/performance.md, "Jerk-limited motion").
 //
 //   jerk_table [--lcnc TIMES.tsv] [--jerks 0,1e5,2e4] [--cpu-limit S] [--lookahead N]
-//              [--tol P] [--tool-table FILE] [--no-check] FILES...
+//              [--tol P] [--tool-table FILE] [--no-check] [--trace CSV] FILES...
 //
 // The machine is configs/mill-3axis.toml's: X Y Z at 100 mm/s and 1000 mm/s², 1 ms, 200 moves of
 // look-ahead; the jerk J on all three axes. Before each program the interpreter runs the MDI line
@@ -15,7 +15,9 @@
 // interpreted once by opencnc's interpreter into a canon::Program, then planned and run in virtual time
 // (analysis::simulate) twice per J: without the trace checker for the CPU time (planner + tick,
 // one thread), then with it for the metrics. A run whose CPU time passes --cpu-limit (default 120 s)
-// is aborted and reported as not finished, with the motion time it reached.
+// is aborted and reported as not finished, with the motion time it reached. --trace writes the
+// first J's commanded trajectory of the (one) program, one line a period: "time,line,x,y,z,v"
+// (the columns of the LinuxCNC harness's --trace, to compare the feed along the program).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -78,6 +80,7 @@ struct Args {
   double tolerance = 0.01;
   std::string tool_table;
   bool check = true;
+  std::string trace;        ///< CSV of the first J's trajectory
   double normal_share = 0;  ///< 0: the planner's default
   std::vector<std::string> files;
 };
@@ -103,6 +106,8 @@ bool parse(int argc, char** argv, Args& a) {
       a.tool_table = value();
     } else if (s == "--normal-share") {
       a.normal_share = std::strtod(value().c_str(), nullptr);
+    } else if (s == "--trace") {
+      a.trace = value();
     } else if (s == "--no-check") {
       a.check = false;
     } else if (s == "-h" || s == "--help") {
@@ -169,6 +174,14 @@ Run run(const canon::Program& program, double jerk, const Args& args) {
   if (args.normal_share > 0) opt.planner.normal_accel_share = args.normal_share;
   opt.max_time_s = 48 * 3600;
   Run r;
+  std::FILE* trace = nullptr;
+  if (!args.trace.empty() && jerk == args.jerks.front()) trace = std::fopen(args.trace.c_str(), "w");
+  if (trace != nullptr) {
+    opt.observe = [trace](std::uint64_t n, const traj::TickOutput& o) {
+      fmt::print(trace, "{:.3f},{},{:.6f},{:.6f},{:.6f},{:.4f}\n", 1e-3 * static_cast<double>(n), o.line,
+                 o.position[0], o.position[1], o.position[2], o.path_velocity);
+    };
+  }
   for (int pass = 0; pass < (args.check ? 2 : 1); ++pass) {
     opt.check = pass == 1;
     const double c0 = cpu_seconds();
@@ -177,6 +190,11 @@ Run run(const canon::Program& program, double jerk, const Args& args) {
       if (n % 4096 == 0 && cpu_seconds() - c0 > args.cpu_limit_s) in.abort = true;
     };
     const analysis::SimulationResult s = analysis::simulate(program, limits, opt);
+    if (trace != nullptr) {
+      std::fclose(trace);
+      trace = nullptr;
+      opt.observe = nullptr;
+    }
     if (pass == 0) {
       r.cpu_s = cpu_seconds() - c0;
       r.finished = s.finished;
@@ -205,7 +223,7 @@ int main(int argc, char** argv) {
   if (!parse(argc, argv, args)) {
     std::fprintf(stderr,
                  "usage: jerk_table [--lcnc TIMES.tsv] [--jerks 0,1e5,2e4] [--cpu-limit S] [--lookahead N] "
-                 "[--tol P] [--tool-table FILE] [--no-check] FILES...\n");
+                 "[--tol P] [--tool-table FILE] [--no-check] [--trace CSV] FILES...\n");
     return 2;
   }
   const std::map<std::string, double> lcnc =

@@ -6,6 +6,8 @@
 #include <string_view>
 #include <vector>
 
+#include "opencnc/canon/arc_geometry.hpp"
+
 namespace opencnc::bench {
 
 namespace {
@@ -88,12 +90,10 @@ std::size_t read_rs274_listing(std::istream& in, canon::Sink& sink) {
       arc.second_center = num(a[3]);
       arc.rotation = static_cast<int>(num(a[4]));
       arc.axis_end = num(a[5]);
-      int first = 0, second = 1, normal = 2;
-      if (plane == canon::Plane::YZ) first = 1, second = 2, normal = 0;
-      if (plane == canon::Plane::XZ) first = 2, second = 0, normal = 1;
-      arc.end[first] = arc.first_end;
-      arc.end[second] = arc.second_end;
-      arc.end[normal] = arc.axis_end;
+      const canon::PlaneAxes axes = canon::plane_axes(plane);  // rs274 prints the XYZ planes only
+      arc.end[axes.first] = arc.first_end;
+      arc.end[axes.second] = arc.second_end;
+      arc.end[axes.normal] = arc.axis_end;
       for (int i = 0; i < 3; ++i) arc.end[3 + i] = num(a[6 + static_cast<std::size_t>(i)]);
       sink.arc_feed(id++, arc);
     } else if (name == "SELECT_PLANE" && !a.empty()) {

@@ -32,7 +32,7 @@
 
 #include <fmt/format.h>
 
-#include "opencnc/recovery/journal.hpp"
+#include "opencnc/broaching/journal.hpp"
 
 namespace {
 

@@ -20,10 +20,11 @@
 #include <string_view>
 #include <thread>
 
+#include "opencnc/broaching/breakpoint_journal.hpp"
 #include "opencnc/config/profile_loader.hpp"
 #include "opencnc/controller/gcode_source.hpp"
 #include "opencnc/controller/sim_rig.hpp"
-#include "opencnc/recovery/breakpoint_journal.hpp"
+#include "opencnc/features/features.hpp"
 
 namespace {
 
@@ -37,12 +38,13 @@ using namespace opencnc;
   std::uniform_real_distribution<double> at(0.3, 4.0);
   for (;;) {
     Diagnostics d;
-    auto source = control::GcodeProgramSource::create(profile, d);
-    control::SimRig rig(profile, source);
-    std::string error;
-    auto journal = recovery::BreakpointJournal::open(dir.string(), source, &error);
+    auto machine =
+        features::machine_setup(profile, d, control::MachineSetup::Options::with("journal", dir.string()));
+    if (!machine) ::_exit(2);
+    auto journal = std::dynamic_pointer_cast<recovery::BreakpointJournal>(machine->feature("journal"));
     if (!journal) ::_exit(2);
-    rig.controller().add_feature(journal, control::ObserverOptions{profile.servo_period_s, true});
+    std::string error;
+    control::SimRig rig(profile, *machine);
     rig.step();
     rig.request(control::Request::simple(control::CommandKind::MachineOn));
     rig.request(control::Request::set_mode(control::Mode::Auto));

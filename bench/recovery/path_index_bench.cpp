@@ -22,7 +22,7 @@
 #include <fmt/format.h>
 
 #include "opencnc/canon/program_builder.hpp"
-#include "opencnc/recovery/path_index.hpp"
+#include "opencnc/retrace/path_index.hpp"
 
 using namespace opencnc;
 using Clock = std::chrono::steady_clock;
@@ -163,7 +163,7 @@ int main(int argc, char** argv) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> ux(0, 3000),
       uy(0, cell * std::ceil(static_cast<double>(parts) / cols));
-  std::vector<recovery::Vec3> points(static_cast<std::size_t>(queries));
+  std::vector<Vec3> points(static_cast<std::size_t>(queries));
   for (auto& q : points) q = {ux(rng), uy(rng), 0};
   recovery::QueryOptions options;
   options.margin_mm = static_cast<double>(margin_um) / 1000;

@@ -23,13 +23,14 @@
 #include <string_view>
 #include <vector>
 
+#include "opencnc/broaching/breakpoint_journal.hpp"
+#include "opencnc/broaching/power_fail_recorder.hpp"
+#include "opencnc/broaching/recovery_wait.hpp"
 #include "opencnc/config/profile_loader.hpp"
 #include "opencnc/controller/gcode_source.hpp"
-#include "opencnc/controller/power_fail_recorder.hpp"
 #include "opencnc/controller/servo_setup.hpp"
 #include "opencnc/controller/sim_rig.hpp"
-#include "opencnc/recovery/breakpoint_journal.hpp"
-#include "opencnc/recovery/recovery_wait.hpp"
+#include "opencnc/features/features.hpp"
 
 namespace {
 
@@ -54,11 +55,10 @@ struct Rig {
       std::vector<std::string> sets = {}) {
     profile = *config::load_profile(profile_path, sets).profile;
     Diagnostics d;
-    auto source = control::GcodeProgramSource::create(profile, d);
-    rig = std::make_unique<control::SimRig>(profile, source);
-    std::string error;
-    journal = recovery::BreakpointJournal::open(journal_dir.string(), source, &error);
-    rig->controller().add_feature(journal, control::ObserverOptions{profile.servo_period_s, true});
+    auto machine = features::machine_setup(
+        profile, d, control::MachineSetup::Options::with("journal", journal_dir.string()));
+    rig = std::make_unique<control::SimRig>(profile, *machine);
+    journal = std::dynamic_pointer_cast<recovery::BreakpointJournal>(machine->feature("journal"));
     grooves = std::make_shared<Grooves>();
     rig->controller().attach(grooves, control::ObserverOptions{0, true});
     rig->step();

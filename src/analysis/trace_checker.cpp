@@ -8,6 +8,10 @@
 
 #include <fmt/format.h>
 
+#include "opencnc/canon/arc_geometry.hpp"
+#include "opencnc/core/minimise.hpp"
+#include "opencnc/core/vec3.hpp"
+
 namespace opencnc::analysis {
 
 namespace {
@@ -55,30 +59,9 @@ double line_distance(const Pose& a, const Pose& b, const Pose& p) {
 /// Smallest f(a) for a within a quarter turn of a0 and inside [0, sweep] (golden section).
 template <typename F>
 double nearest_angle(F f, double a0, double sweep) {
-  double lo = std::max(0.0, a0 - 0.25 * std::numbers::pi), hi = std::min(sweep, a0 + 0.25 * std::numbers::pi);
-  const double g = 0.5 * (std::sqrt(5.0) - 1);
-  double x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo), f1 = f(x1), f2 = f(x2);
-  for (int i = 0; i < 40 && hi - lo > 1e-12; ++i) {
-    if (f1 < f2) {
-      hi = x2, x2 = x1, f2 = f1, x1 = hi - g * (hi - lo), f1 = f(x1);
-    } else {
-      lo = x1, x1 = x2, f1 = f2, x2 = lo + g * (hi - lo), f2 = f(x2);
-    }
-  }
-  return std::min({f1, f2, f(a0)});
-}
-
-struct V3 {
-  double x, y, z;
-};
-double dot(V3 a, V3 b) {
-  return a.x * b.x + a.y * b.y + a.z * b.z;
-}
-V3 sub(V3 a, V3 b) {
-  return {a.x - b.x, a.y - b.y, a.z - b.z};
-}
-V3 scale(double k, V3 a) {
-  return {k * a.x, k * a.y, k * a.z};
+  const double lo = std::max(0.0, a0 - 0.25 * std::numbers::pi),
+               hi = std::min(sweep, a0 + 0.25 * std::numbers::pi);
+  return std::min(golden_section(f, lo, hi, 40, 1e-12).f, f(a0));
 }
 
 // The turn k (whole, ≥ 0, unclamped above) whose point at the sample's own angle, a = phi + 2πk, is
@@ -89,17 +72,16 @@ V3 scale(double k, V3 a) {
 // on one of the two turns around it: k0 = floor((f* sweep − phi) / 2π) or k0 + 1. So the nearest
 // turn is found in O(1) instead of walking every turn of a helix (1000 evaluations per sample for
 // 1000 turns).
-double nearest_turn(const Pose& start, const Pose& end, const Pose& p, V3 c, V3 n, int b0, double r0,
-                    double r1, double q_radius, double phi, double sweep) {
+double nearest_turn(const Pose& start, const Pose& end, const Pose& p, const Vec3& c, const Vec3& n, int b0,
+                    double r0, double r1, double q_radius, double phi, double sweep) {
   double a2 = 0, b = 0;
   const auto term = [&](double alpha, double beta) {  // one component: alpha + beta f
     a2 += beta * beta;
     b += 2 * alpha * beta;
   };
   term(q_radius - r0, -(r1 - r0));
-  const V3 s{start[b0], start[b0 + 1], start[b0 + 2]}, e{end[b0], end[b0 + 1], end[b0 + 2]};
-  const V3 pp{p[b0], p[b0 + 1], p[b0 + 2]};
-  term(dot(sub(s, c), n) - dot(sub(pp, c), n), dot(sub(e, s), n));
+  const Vec3 s = take3(start, b0), e = take3(end, b0), pp = take3(p, b0);
+  term(dot(s - c, n) - dot(pp - c, n), dot(e - s, n));
   for (int i : kLinear) {
     if (i < b0 || i > b0 + 2) term(start[i] - p[i], end[i] - start[i]);
   }
@@ -114,26 +96,24 @@ double nearest_turn(const Pose& start, const Pose& end, const Pose& p, V3 c, V3 
 // arc also moves along its axis or changes radius, a golden-section search around it finds the
 // nearest point.
 double arc_distance(const canon::ArcGeometry& g, const Pose& start, const Pose& end, const Pose& p) {
-  const int b0 =
-      (g.plane == canon::Plane::XY || g.plane == canon::Plane::YZ || g.plane == canon::Plane::XZ) ? 0 : 6;
-  const V3 n{g.normal[0], g.normal[1], g.normal[2]}, c{g.center[0], g.center[1], g.center[2]};
+  const int b0 = canon::plane_base(g.plane);
+  const Vec3& n = g.normal;
+  const Vec3& c = g.center;
   const auto in_plane = [&](const Pose& q) {
-    const V3 v = sub(V3{q[b0], q[b0 + 1], q[b0 + 2]}, c);
-    return sub(v, scale(dot(v, n), n));
+    const Vec3 v = take3(q, b0) - c;
+    return v - dot(v, n) * n;
   };
-  const V3 rs = in_plane(start), re = in_plane(end);
+  const Vec3 rs = in_plane(start), re = in_plane(end);
   const double r0 = std::sqrt(dot(rs, rs)), r1 = std::sqrt(dot(re, re));
   if (r0 <= 0) return linear_distance(start, p);
-  const V3 e1 = scale(1 / r0, rs);
-  const V3 e2{n.y * e1.z - n.z * e1.y, n.z * e1.x - n.x * e1.z, n.x * e1.y - n.y * e1.x};
+  const Vec3 e1 = (1 / r0) * rs;
+  const Vec3 e2 = cross(n, e1);
   const double phi_end = std::atan2(dot(re, e2), dot(re, e1));
   const bool ccw = g.turns >= 0;
-  const bool full = std::fabs(phi_end) < 1e-9;
-  double sweep = ccw ? (full ? kTwoPi : (phi_end > 0 ? phi_end : phi_end + kTwoPi))
-                     : (full ? kTwoPi : (phi_end < 0 ? -phi_end : kTwoPi - phi_end));
-  sweep += kTwoPi * std::max(0, std::abs(g.turns) - 1);
+  const double sweep =
+      std::fabs(canon::arc_sweep(phi_end, g.turns));  // its size: the angles below run with it
 
-  const V3 q = in_plane(p);
+  const Vec3 q = in_plane(p);
   double phi = std::atan2(dot(q, e2), dot(q, e1));
   if (!ccw) phi = -phi;
   if (phi < 0) phi += kTwoPi;
@@ -142,17 +122,16 @@ double arc_distance(const canon::ArcGeometry& g, const Pose& start, const Pose& 
     const double r = r0 + (r1 - r0) * f, ang = ccw ? a : -a;
     Pose x;
     for (int i = 0; i < kAxisCount; ++i) x[i] = start[i] + f * (end[i] - start[i]);
-    const V3 axial = scale(dot(sub(V3{x[b0], x[b0 + 1], x[b0 + 2]}, c), n), n);
-    x[b0] = c.x + r * (std::cos(ang) * e1.x + std::sin(ang) * e2.x) + axial.x;
-    x[b0 + 1] = c.y + r * (std::cos(ang) * e1.y + std::sin(ang) * e2.y) + axial.y;
-    x[b0 + 2] = c.z + r * (std::cos(ang) * e1.z + std::sin(ang) * e2.z) + axial.z;
+    const Vec3 axial = dot(take3(x, b0) - c, n) * n;
+    for (int k = 0; k < 3; ++k)
+      x[b0 + k] = c[k] + r * (std::cos(ang) * e1[k] + std::sin(ang) * e2[k]) + axial[k];
     return linear_distance(x, p);
   };
   double rest = 0;  // motion besides the circle: helix rise, other axes, radius change
   for (int i : kLinear) {
     if (i < b0 || i > b0 + 2) rest += std::fabs(end[i] - start[i]);
   }
-  const V3 rise = sub(V3{end[b0], end[b0 + 1], end[b0 + 2]}, V3{start[b0], start[b0 + 1], start[b0 + 2]});
+  const Vec3 rise = take3(end, b0) - take3(start, b0);
   rest += std::fabs(dot(rise, n)) + std::fabs(r1 - r0);
   double best = std::min(linear_distance(start, p), linear_distance(end, p));
   const double last_turn = std::floor((sweep - phi) / kTwoPi);  // turns k with phi + 2πk on the arc
@@ -257,8 +236,7 @@ double TraceChecker::box_distance(canon::SegmentId id, const Pose& p) const {
   if (program_->move(id).kind == canon::MoveKind::RigidTap) return 0;  // its line has no box
   if (program_->move(id).kind == canon::MoveKind::Arc) {
     const canon::ArcGeometry& g = program_->arc(id);
-    const int b0 =
-        (g.plane == canon::Plane::XY || g.plane == canon::Plane::YZ || g.plane == canon::Plane::XZ) ? 0 : 6;
+    const int b0 = canon::plane_base(g.plane);
     double r2 = 0, e2 = 0;
     for (int k = 0; k < 3; ++k) {
       r2 += (a[b0 + k] - g.center[k]) * (a[b0 + k] - g.center[k]);

@@ -6,6 +6,7 @@
 #include <numbers>
 #include <vector>
 
+#include "opencnc/canon/arc_geometry.hpp"
 #include "opencnc/canon/nurbs.hpp"
 
 namespace opencnc::canon {
@@ -229,42 +230,26 @@ void ProgramBuilder::rigid_tap(SegmentId id, const Pose& end, double scale) {
 }
 
 void ProgramBuilder::arc_feed(SegmentId id, const ArcFeed& arc) {
-  // Axis indices of the plane: first, second, normal (first × second = +normal).
-  int first = 0, second = 1, normal = 2;
-  switch (arc.plane) {
-    case Plane::XY: first = 0; second = 1; normal = 2; break;
-    case Plane::YZ: first = 1; second = 2; normal = 0; break;
-    case Plane::XZ: first = 2; second = 0; normal = 1; break;
-    case Plane::UV: first = 6; second = 7; normal = 8; break;
-    case Plane::VW: first = 7; second = 8; normal = 6; break;
-    case Plane::UW: first = 8; second = 6; normal = 7; break;
-  }
+  const PlaneAxes axes = plane_axes(arc.plane);
   const Pose machine_end = to_machine(arc.end);
   Pose center_c = arc.end;
-  center_c[first] = arc.first_center;
-  center_c[second] = arc.second_center;
+  center_c[axes.first] = arc.first_center;
+  center_c[axes.second] = arc.second_center;
   const Pose center_m = to_machine(center_c);
 
-  const int base = (arc.plane == Plane::XY || arc.plane == Plane::YZ || arc.plane == Plane::XZ) ? 0 : 6;
-  double n[3] = {0, 0, 0};
-  n[normal - base] = 1.0;
+  const int base = plane_base(arc.plane);
+  Vec3 n{0, 0, 0};
+  n[axes.normal - base] = 1.0;
   if (base == 0) {  // the XY rotation turns the plane's normal about Z
     const double nx = n[0], ny = n[1];
     n[0] = nx * rot_cos_ - ny * rot_sin_;
     n[1] = nx * rot_sin_ + ny * rot_cos_;
   }
   // The centre lies on the plane through the start point (the helix rises along the normal).
-  double c[3], s[3];
-  for (int k = 0; k < 3; ++k) {
-    c[k] = center_m[base + k];
-    s[k] = position_[base + k];
-  }
-  const double d = (c[0] - s[0]) * n[0] + (c[1] - s[1]) * n[1] + (c[2] - s[2]) * n[2];
+  const Vec3 c = take3(center_m, base), s = take3(position_, base);
   ArcGeometry g;
-  for (int k = 0; k < 3; ++k) {
-    g.center[k] = c[k] - d * n[k];
-    g.normal[k] = n[k];
-  }
+  g.center = c - dot(c - s, n) * n;
+  g.normal = n;
   g.turns = arc.rotation;
   g.plane = arc.plane;
   g.feed = current_feed_index();

@@ -286,6 +286,11 @@ ProfileEditResult edit_profile(const MachineProfile& live, std::span<const Profi
   }
   r.profile = std::move(load.profile);
   r.text = std::move(text);
+  if (std::all_of(r.changes.begin(), r.changes.end(),
+                  [](const ProfileChange& c) { return c.key.rfind("edm.condition.", 0) == 0; }))
+    r.subject = "machining conditions";
+  if (std::any_of(conditions.begin(), conditions.end(), [](const ConditionChange& c) { return c.remove; }))
+    r.deletes = "a condition";
   return r;
 }
 

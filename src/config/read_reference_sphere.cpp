@@ -14,7 +14,7 @@ namespace opencnc::config::detail {
 namespace {
 
 /// `key` as [x, y, z] (three finite numbers); reports and returns false otherwise.
-bool read_point(Section& s, std::string_view key, std::array<double, 3>& out) {
+bool read_point(Section& s, std::string_view key, Vec3& out) {
   const toml::node* n = s.find(key);
   if (n == nullptr) {
     s.missing(key);
@@ -54,9 +54,9 @@ bool read_b_axis(Section& s, std::string_view key, std::array<double, 2>& out) {
 constexpr double kMaxTiltFromYDeg = 10.0;
 
 /// `key` (when present) as a direction [x, y, z] within kMaxTiltFromYDeg of Y, made a unit vector.
-void read_b_direction(Section& s, std::string_view key, std::array<double, 3>& out) {
+void read_b_direction(Section& s, std::string_view key, Vec3& out) {
   if (!s.has(key)) return;
-  std::array<double, 3> d{};
+  Vec3 d{};
   if (!read_point(s, key, d)) return;
   const double length = std::hypot(d[0], d[1], d[2]);
   if (!(length > 0) || d[1] < length * std::cos(kMaxTiltFromYDeg * std::numbers::pi / 180)) {

@@ -52,26 +52,10 @@ void Servo::engage_coupling(const MachineAction& a) noexcept {
     release_coupling();
     return;
   }
-  switch (kind) {
-    case motion::CouplingKind::ConstantPitch:
-      law_ = motion::CouplingLaw::constant(a.value);
-      break;
-    case motion::CouplingKind::LinearPitch:
-      law_ = motion::CouplingLaw::linear(a.value, a.value2);
-      break;
-    case motion::CouplingKind::PitchTable:
-    case motion::CouplingKind::Cam: {
-      const int t = a.index2 - 1;
-      if (t < 0 || t >= motion::kMaxCouplingTables || cc.table_kind[static_cast<std::size_t>(t)] != kind) {
-        release_coupling();
-        return;
-      }
-      law_ = motion::CouplingLaw::tabulated(kind, cc.tables[static_cast<std::size_t>(t)]);
-      break;
-    }
-    default:
-      release_coupling();
-      return;
+  law_ = motion::law_for(cc, kind, a.value, a.value2, a.index2);
+  if (!law_.active()) {  // a kind or table the machine does not have
+    release_coupling();
+    return;
   }
   coupling_.kind = kind;
   coupling_.master_axis = cc.master_axis;

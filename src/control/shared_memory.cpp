@@ -61,9 +61,9 @@ std::uint64_t shared_layout_id() noexcept {
   return h;
 }
 
-std::unique_ptr<SharedMemory> SharedMemory::create(const std::string& name, std::int64_t period_ns,
-                                                   std::uint32_t heartbeat_timeout_ticks,
-                                                   std::string& error) {
+std::unique_ptr<SegmentMapping> SegmentMapping::create(const std::string& name, std::int64_t period_ns,
+                                                       std::uint32_t heartbeat_timeout_ticks,
+                                                       std::string& error) {
   if (!valid_name(name, error)) return nullptr;
   ::shm_unlink(name.c_str());  // a stale segment of a previous run (ENOENT otherwise)
   const int fd = ::shm_open(name.c_str(), O_RDWR | O_CREAT | O_EXCL, 0660);
@@ -88,10 +88,10 @@ std::unique_ptr<SharedMemory> SharedMemory::create(const std::string& name, std:
   s->header.size_bytes = sizeof(SharedSegment);
   s->header.layout_id = shared_layout_id();
   s->header.magic = kSharedMagic;  // last: a controller attaching now finds it whole or refuses it
-  return std::unique_ptr<SharedMemory>(new SharedMemory(name, s, true));
+  return std::unique_ptr<SegmentMapping>(new SegmentMapping(name, s, true));
 }
 
-std::unique_ptr<SharedMemory> SharedMemory::attach(const std::string& name, std::string& error) {
+std::unique_ptr<SegmentMapping> SegmentMapping::attach(const std::string& name, std::string& error) {
   if (!valid_name(name, error)) return nullptr;
   const int fd = ::shm_open(name.c_str(), O_RDWR, 0);
   if (fd < 0) {
@@ -125,10 +125,10 @@ std::unique_ptr<SharedMemory> SharedMemory::attach(const std::string& name, std:
     ::munmap(p, mapped);
     return nullptr;
   }
-  return std::unique_ptr<SharedMemory>(new SharedMemory(name, static_cast<SharedSegment*>(p), false));
+  return std::unique_ptr<SegmentMapping>(new SegmentMapping(name, static_cast<SharedSegment*>(p), false));
 }
 
-SharedMemory::~SharedMemory() {
+SegmentMapping::~SegmentMapping() {
   if (owner_) {
     segment_->~SharedSegment();
     ::shm_unlink(name_.c_str());

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // A whole canonical program (built by a generator or a test) as a stream: all there, never waiting.
+#include "opencnc/canon/program_tail.hpp"
 #include "opencnc/controller/program_source.hpp"
-#include "opencnc/controller/program_tools.hpp"
 
 namespace opencnc::control {
 
@@ -10,7 +10,7 @@ namespace {
 class CanonStream final : public ProgramStream {
  public:
   CanonStream(std::shared_ptr<const canon::Program> program, const Pose& start) : program_(std::move(program)) {
-    if (program_->start() != start) program_ = program_tail(*program_, 0, start);
+    if (program_->start() != start) program_ = canon::program_tail(*program_, 0, start);
   }
   const canon::Program& program() const override { return *program_; }
   StreamState read(std::size_t /*more_moves*/) override { return StreamState::Finished; }
@@ -18,7 +18,7 @@ class CanonStream final : public ProgramStream {
   const SyncRequest& sync_request() const override { return sync_; }
   void answer(const SyncAnswer& /*a*/) override {}
   void restart_at(const Pose& start, std::size_t from_move) override {
-    program_ = program_tail(*program_, from_move, start);
+    program_ = canon::program_tail(*program_, from_move, start);
   }
   void release(std::size_t /*move*/, std::size_t /*action*/) override {}  // shared: it may run again
   const Diagnostics& diagnostics() const override { return diags_; }

@@ -24,29 +24,6 @@ constexpr std::size_t kKeptOutcomes = 4096;
 /// Status details that cost strings (where the interpreter is) refresh at most this often.
 constexpr double kLocationRefreshS = 0.01;
 
-/// The load guard's message: what the load was, the level it passed, what the tick did.
-std::string load_guard_text(const ServoEvent& e, const config::BroachingProfile& b) {
-  const char axis = e.axis >= 0 && e.axis < kAxisCount ? kAxisLetters[static_cast<std::size_t>(e.axis)] : '?';
-  switch (static_cast<LoadAction>(e.action)) {
-    case LoadAction::Hold:
-      return fmt::format(
-          "broaching load {:.2f} kN above the hold level {:g} kN: feed hold (the coupling holds; "
-          "check the cutter, then resume)",
-          e.value, b.hold_kn);
-    case LoadAction::Retract:
-      return fmt::format(
-          "broaching load {:.2f} kN above the retract level {:g} kN: the run stops on the helix "
-          "and {} lifts the cutter by {:g} mm",
-          e.value, b.retract_kn, axis, b.retract_lift);
-    case LoadAction::Lifted:
-      return fmt::format("the cutter is lifted ({} by {:g} mm); the run was stopped by an overload", axis,
-                         b.retract_lift);
-    case LoadAction::None:
-      break;
-  }
-  return "load guard";
-}
-
 std::string refusal_text(Refusal r) {
   switch (r) {
     case Refusal::None:
@@ -189,7 +166,7 @@ Controller::Controller(const config::MachineProfile& profile, ServoChannels& cha
       planner_config_(control::planner_config(profile)),
       channels_(&channels),
       source_(std::move(source)),
-      check_(std::make_unique<MachineMoveCheck>(servo_config_, limits_)),
+      check_(make_move_check()),
       shown_profile_(profile),
       location_every_(static_cast<std::uint64_t>(kLocationRefreshS / servo_config_.period_s) + 1),
       tasks_(std::make_unique<detail::TaskRunner>(options.long_work_on_thread)) {
@@ -271,6 +248,23 @@ void Controller::detach(std::uint64_t id) {
   inbox_filled_.store(true, std::memory_order_release);
 }
 
+void Controller::add_move_reach(MoveReachFactory reach) {
+  std::lock_guard lock(inbox_mutex_);
+  reaches_to_add_.push_back(std::move(reach));
+}
+
+void Controller::add_texts(std::shared_ptr<const EventTexts> texts) {
+  std::lock_guard lock(inbox_mutex_);
+  texts_to_add_.push_back(std::move(texts));
+}
+
+std::unique_ptr<MachineMoveCheck> Controller::make_move_check() const {
+  std::vector<std::unique_ptr<MoveReach>> reaches;
+  for (const MoveReachFactory& f : reaches_)
+    if (std::unique_ptr<MoveReach> r = f(servo_config_)) reaches.push_back(std::move(r));
+  return std::make_unique<MachineMoveCheck>(servo_config_, limits_, std::move(reaches));
+}
+
 bool Controller::add_feature(std::shared_ptr<Feature> feature, ObserverOptions options) {
   std::lock_guard lock(inbox_mutex_);
   const std::string name(feature->name());
@@ -322,11 +316,20 @@ void Controller::take_attachments() {
   std::vector<Attached> attach;
   std::vector<std::uint64_t> detach;
   std::vector<std::shared_ptr<Feature>> features;
+  std::vector<MoveReachFactory> reaches;
+  std::vector<std::shared_ptr<const EventTexts>> texts;
   {
     std::lock_guard lock(inbox_mutex_);
     attach.swap(to_attach_);
     detach.swap(to_detach_);
     features.swap(features_to_add_);
+    reaches.swap(reaches_to_add_);
+    texts.swap(texts_to_add_);
+  }
+  for (auto& t : texts) texts_.push_back(std::move(t));
+  if (!reaches.empty()) {
+    for (auto& r : reaches) reaches_.push_back(std::move(r));
+    check_ = make_move_check();
   }
   for (Attached& a : attach) {
     a.cursor = log_.last();  // from now on
@@ -389,6 +392,14 @@ void Controller::on_event(const ServoEvent& e) {
   ce.servo = e;
   ce.segment = e.segment;
   log(ce);
+  // A feature's stage of the tick raised it: the feature has its words.
+  for (const auto& t : texts_) {
+    if (e.kind == EventKind::Fault) break;  // faults are described below (describe)
+    if (std::optional<EventNote> n = t->event_note(e, profile_, servo_config_)) {
+      note(n->severity, std::move(n->code), std::move(n->text));
+      break;
+    }
+  }
   switch (e.kind) {
     case EventKind::Accepted:
     case EventKind::Refused:
@@ -409,21 +420,10 @@ void Controller::on_event(const ServoEvent& e) {
                               e.kind == EventKind::ProcessAlarmCleared));
       break;
     case EventKind::Interlock:
-    case EventKind::HandAxisMoved:
-      note(Severity::Warning, e.kind == EventKind::Interlock ? "control.interlock" : "control.hand-axis",
-           interlock_text(e));
-      break;
-    case EventKind::LoadGuard:
-      note(Severity::Warning, "control.load", interlock_text(e));
+      note(Severity::Warning, "control.interlock", interlock_text(e));
       break;
     case EventKind::LimitSeek:
       note(e.action == 1 ? Severity::Note : Severity::Error, "control.seek-limit", seek_text(e));
-      break;
-    case EventKind::EdmRetractLimit:
-      note(Severity::Warning, "control.edm.retract-limit",
-           fmt::format("EDM condition {}: backing off reached the end of the path memory {:.3f} mm behind "
-                       "the program; the electrode holds there and can go back no further",
-                       e.action, e.value));
       break;
     default:
       break;
@@ -1037,13 +1037,13 @@ std::string Controller::wait_text() const {
   if (job_->held_at_sync() && !held_by_.empty())
     return fmt::format("the {} to let the program go on past the {} (see its note)", held_by_,
                        to_string(job_->sync_wait()));
+  for (const auto& t : texts_)  // a feature's stage holds the run
+    if (std::optional<std::string> w = t->wait_text(s)) return *w;
   switch (s.wait) {
     case Wait::None:
       return {};
     case Wait::Dwell:
-      return s.coupling_wait
-                 ? "the coupled axes to stand on their commands before the law takes them (M171-M174)"
-                 : "a dwell";
+      return "a dwell";
     case Wait::Spindle:
       return "the spindle to reach its speed";
     case Wait::ToolChanger:
@@ -1061,13 +1061,8 @@ std::string Controller::wait_text() const {
         return fmt::format("the interpreter, at the {} of {}", to_string(published_.sync_wait),
                            to_string(published_.sync_location));
       return "the planner";
-    case Wait::HandAxis: {
-      const HandWait& h = s.hand_wait;
-      const char axis =
-          h.axis >= 0 && h.axis < kAxisCount ? kAxisLetters[static_cast<std::size_t>(h.axis)] : '?';
-      return fmt::format("the operator to bring the hand-fed {} {} {:.3f} mm", axis,
-                         h.retract ? "up to" : "down to", h.target);
-    }
+    case Wait::HandAxis:
+      return "the operator at a hand-fed axis";
     case Wait::Interlock: {
       const auto& texts = profile_.interlocks.rule_texts;
       const auto rule = static_cast<std::size_t>(s.interlock_rule);
@@ -1139,13 +1134,6 @@ void Controller::finish(std::uint64_t id, Refusal refusal, std::string message, 
 }
 
 std::string Controller::interlock_text(const ServoEvent& e) const {
-  if (e.kind == EventKind::LoadGuard) return load_guard_text(e, profile_.broaching);
-  if (e.kind == EventKind::HandAxisMoved) {
-    const char axis =
-        e.axis >= 0 && e.axis < kAxisCount ? kAxisLetters[static_cast<std::size_t>(e.axis)] : '?';
-    return fmt::format("{} left the position the program needs ({:.4f} mm) while the table moved: feed hold",
-                       axis, e.value);
-  }
   const auto& texts = profile_.interlocks.rule_texts;
   const std::string rule = e.action < texts.size() ? texts[e.action] : std::string("?");
   const char* what = e.command == CommandKind::SpindleOff ? "stopped the spindle"
@@ -1174,6 +1162,8 @@ std::string Controller::seek_text(const ServoEvent& e) const {
 }
 
 std::string Controller::describe(const Fault& f) const {
+  for (const auto& t : texts_)  // a feature's stage raised it
+    if (std::optional<std::string> text = t->fault_text(f, profile_, servo_config_)) return *text;
   const char axis = f.axis >= 0 && f.axis < kAxisCount ? kAxisLetters[static_cast<std::size_t>(f.axis)] : '?';
   const JointConfig* jc = nullptr;
   for (int j = 0; j < servo_config_.joint_count; ++j) {
@@ -1207,26 +1197,16 @@ std::string Controller::describe(const Fault& f) const {
     case FaultKind::Stall:
       return fmt::format("the {} stepper stalled at {:.4f} {}: steps were lost, home it again", axis, f.value,
                          unit);
-    case FaultKind::EdmShort:
-      return fmt::format(
-          "the EDM gap stayed shorted for {:.2f} s, longer than condition {}'s short_timeout_s ({} s): "
-          "the program was stopped with the generator off; clear the gap (debris, a bridge, the electrode "
-          "on the work) before going on",
-          f.value, static_cast<int>(f.axis), f.limit);
     case FaultKind::SeekNoSwitch:
       return fmt::format(
           "seeking its limit, {} went {:.4f} {} (its soft limit {} {} and the overtravel) without the limit "
           "switch tripping: check the switch and its wiring, then home {} again",
           axis, f.value, unit, f.limit, unit, axis);
-    case FaultKind::CouplingPosition:
-      return fmt::format(
-          "the coupling code waited for {} to stand on its command, but it stayed {:.6f} {} off "
-          "(within {:.6f} {} needed, [coupling] engage_tolerance_um, for engage_timeout_s): the drive "
-          "does not settle; check its tuning, or allow more",
-          axis, f.value, unit, f.limit, unit);
     case FaultKind::ProcessAlarm:
       return detail::alarm_text(profile_.alarms, static_cast<std::size_t>(f.axis), f.value, f.value < f.limit,
                                 false);
+    default:  // a feature's stage's, described by the feature
+      break;
   }
   return "fault";
 }

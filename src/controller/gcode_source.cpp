@@ -10,13 +10,11 @@
 #include <fmt/format.h>
 
 #include "opencnc/canon/program_builder.hpp"
+#include "opencnc/canon/replay_filter.hpp"
 #include "opencnc/canon/tee_sink.hpp"
 #include "opencnc/controller/preflight.hpp"
-#include "opencnc/gcode/coupling_codes.hpp"
 #include "opencnc/gcode/dialect.hpp"
-#include "opencnc/gcode/edm_codes.hpp"
 #include "opencnc/gcode/standard_extensions.hpp"
-#include "replay_filter.hpp"
 
 namespace opencnc::control {
 
@@ -96,19 +94,36 @@ void append(Diagnostics& to, const Diagnostics& from, std::size_t first = 0) {
   for (std::size_t i = first; i < from.items().size(); ++i) to.add(from.items()[i]);
 }
 
+/// A canonical sink after the builder (in a TeeSink): after every call that appends moves it runs
+/// a feature's pass over them. `program` is where the builder appends.
+class PassSink final : public canon::Sink {
+ public:
+  PassSink(MovePass& pass, canon::Program& program) : pass_(pass), program_(program) {}
+  void straight_traverse(canon::SegmentId, const Pose&) override { pass_.process(program_); }
+  void straight_feed(canon::SegmentId, const Pose&) override { pass_.process(program_); }
+  void arc_feed(canon::SegmentId, const canon::ArcFeed&) override { pass_.process(program_); }
+  void straight_probe(canon::SegmentId, const Pose&) override { pass_.process(program_); }
+  void rigid_tap(canon::SegmentId, const Pose&, double) override { pass_.process(program_); }
+  void nurbs_feed(canon::SegmentId, int, std::span<const canon::NurbsPoint>) override {
+    pass_.process(program_);
+  }
+
+ private:
+  MovePass& pass_;
+  canon::Program& program_;
+};
+
+using SourceParts = std::vector<std::shared_ptr<const SourcePart>>;
+
 /// The interpreter, its builder and sinks for one program (or the MDI session's line): what a
 /// stream and a preflight scan share.
 class Pipeline {
  public:
   Pipeline(gcode::Interpreter& interp, const Pose& start, double tolerance_mm, tools::ToolTableService* tools,
-           const MovePasses& passes)
-      : interp_(&interp),
-        tolerance_mm_(tolerance_mm),
-        writer_(tools),
-        hand_(passes.hand),
-        hand_axes_any_(passes.hand.any()),
-        coupling_(passes.coupling),
-        coupled_(passes.coupling.any()) {
+           const SourceParts& parts)
+      : interp_(&interp), tolerance_mm_(tolerance_mm), writer_(tools) {
+    for (const auto& part : parts)
+      if (std::unique_ptr<MovePass> pass = part->pass()) passes_.push_back(std::move(pass));
     auto b = std::make_unique<canon::ProgramBuilder>(interp.options().axes, start);
     b->program().set_sources(interp.sources());
     attach(std::move(b), interp.state().modal.units);
@@ -119,12 +134,13 @@ class Pipeline {
   const canon::Program& program() const noexcept { return builder_->program(); }
   canon::Sink& sink() noexcept { return *sink_; }
   ToolTableWriter& writer() noexcept { return writer_; }
-  /// What the hand-axis pass refused (moves of hand-fed axes it cannot wait for).
-  const Diagnostics& hand_failures() const noexcept { return hand_.failures(); }
-  /// What the coupling pass refused (moves the law would drive past the slave's limits).
-  const Diagnostics& coupling_failures() const noexcept { return coupling_.failures(); }
+  /// What the features' passes refused (moves they cannot rewrite), pass by pass.
+  void append_pass_failures(Diagnostics& to) const {
+    for (const auto& pass : passes_) append(to, pass->failures());
+  }
   bool passes_failed() const noexcept {
-    return !hand_.failures().items().empty() || !coupling_.failures().items().empty();
+    return std::any_of(passes_.begin(), passes_.end(),
+                       [](const auto& pass) { return !pass->failures().items().empty(); });
   }
 
   /// A new leg at `start`: the builder's continuation; the old one is kept until the next leg
@@ -141,37 +157,27 @@ class Pipeline {
     tolerance_ = std::make_unique<DefaultTolerance>(*builder_, tolerance_mm_, units);
     inner_ = std::make_unique<canon::TeeSink>(*builder_, *tolerance_);
     outer_ = std::make_unique<canon::TeeSink>(*inner_, writer_);
-    // After the builder has appended a move, the hand-axis pass rewrites it (hand-fed axes only).
-    hand_.restart();
     sink_ = outer_.get();
-    if (hand_axes_any_) {
-      hand_sink_ = std::make_unique<HandAxisSink>(hand_, builder_->program());
-      with_hand_ = std::make_unique<canon::TeeSink>(*sink_, *hand_sink_);
-      sink_ = with_hand_.get();
-    }
-    // Then the coupling pass: the slave's coordinates by the law (coupling_pass.hpp).
-    coupling_.restart();
-    if (coupled_) {
-      coupling_sink_ = std::make_unique<CouplingSink>(coupling_, builder_->program());
-      with_coupling_ = std::make_unique<canon::TeeSink>(*sink_, *coupling_sink_);
-      sink_ = with_coupling_.get();
+    // After the builder has appended a move, the features' passes rewrite it, in their order.
+    tees_.clear();
+    pass_sinks_.clear();
+    for (const auto& pass : passes_) {
+      pass->restart();
+      pass_sinks_.push_back(std::make_unique<PassSink>(*pass, builder_->program()));
+      tees_.push_back(std::make_unique<canon::TeeSink>(*sink_, *pass_sinks_.back()));
+      sink_ = tees_.back().get();
     }
   }
 
   gcode::Interpreter* interp_;
   double tolerance_mm_;
   ToolTableWriter writer_;
-  HandAxisFilter hand_;
-  bool hand_axes_any_;
+  std::vector<std::unique_ptr<MovePass>> passes_;
   std::unique_ptr<canon::ProgramBuilder> builder_, previous_;
   std::unique_ptr<DefaultTolerance> tolerance_;
   std::unique_ptr<canon::TeeSink> inner_, outer_;
-  std::unique_ptr<HandAxisSink> hand_sink_;
-  std::unique_ptr<canon::TeeSink> with_hand_;
-  CouplingPass coupling_;
-  bool coupled_;
-  std::unique_ptr<CouplingSink> coupling_sink_;
-  std::unique_ptr<canon::TeeSink> with_coupling_;
+  std::vector<std::unique_ptr<PassSink>> pass_sinks_;
+  std::vector<std::unique_ptr<canon::TeeSink>> tees_;
   canon::Sink* sink_ = nullptr;
 };
 
@@ -196,35 +202,35 @@ class GcodeStream final : public ProgramStream {
  public:
   /// A file: owns its interpreter.
   GcodeStream(const gcode::Options& o, const std::string& path, const Pose& start, double tolerance_mm,
-              std::shared_ptr<tools::ToolTableService> tools, const MovePasses& passes)
+              std::shared_ptr<tools::ToolTableService> tools, const SourceParts& parts)
       : owned_(std::make_unique<gcode::Interpreter>(o)),
         interp_(owned_.get()),
         tools_(std::move(tools)),
-        pipe_(*interp_, start, tolerance_mm, tools_.get(), passes) {
+        pipe_(*interp_, start, tolerance_mm, tools_.get(), parts) {
     tools_version_ = tools_ ? tools_->version() : 0;
     if (!begin_program(*interp_, pipe_, path, start, tolerance_mm)) fail();
   }
   /// A file resumed at segment `first`: the interpreter runs it from the start, placed at
   /// `program_start` (where the program first started), and everything before the segment is
-  /// replayed quietly (detail::ReplayFilter); the moves begin at `start` with the rest of it.
+  /// replayed quietly (canon::ReplayFilter); the moves begin at `start` with the rest of it.
   GcodeStream(const gcode::Options& o, const std::string& path, const Pose& program_start, const Pose& start,
               canon::SegmentId first, double tolerance_mm, std::shared_ptr<tools::ToolTableService> tools,
-              const MovePasses& passes)
+              const SourceParts& parts)
       : owned_(std::make_unique<gcode::Interpreter>(o)),
         interp_(owned_.get()),
         tools_(std::move(tools)),
-        pipe_(*interp_, start, tolerance_mm, tools_.get(), passes) {
+        pipe_(*interp_, start, tolerance_mm, tools_.get(), parts) {
     tools_version_ = tools_ ? tools_->version() : 0;
-    replay_ = std::make_unique<detail::ReplayFilter>(pipe_.sink(), first);
+    replay_ = std::make_unique<canon::ReplayFilter>(pipe_.sink(), first);
     first_segment_ = first;
     if (!begin_program(*interp_, pipe_, path, program_start, tolerance_mm)) fail();
   }
   /// An MDI line on the session's interpreter (already placed and up to date).
   GcodeStream(gcode::Interpreter& session, std::string line, const Pose& start, double tolerance_mm,
-              std::shared_ptr<tools::ToolTableService> tools, const MovePasses& passes)
+              std::shared_ptr<tools::ToolTableService> tools, const SourceParts& parts)
       : interp_(&session),
         tools_(std::move(tools)),
-        pipe_(session, start, tolerance_mm, tools_.get(), passes),
+        pipe_(session, start, tolerance_mm, tools_.get(), parts),
         mdi_line_(std::move(line)),
         mdi_(true) {
     tools_version_ = tools_ ? tools_->version() : 0;
@@ -296,8 +302,7 @@ class GcodeStream final : public ProgramStream {
   void on_status(gcode::RunStatus s) {
     if (!pipe_.writer().failures().items().empty() || pipe_.passes_failed()) {
       append(diags_, pipe_.writer().failures());
-      append(diags_, pipe_.hand_failures());
-      append(diags_, pipe_.coupling_failures());
+      pipe_.append_pass_failures(diags_);
       state_ = StreamState::Error;
       return;
     }
@@ -405,7 +410,7 @@ class GcodeStream final : public ProgramStream {
   std::size_t first_diagnostic_ = 0;
   std::string mdi_line_;
   bool mdi_ = false, mdi_started_ = false;
-  std::unique_ptr<detail::ReplayFilter> replay_;  ///< resuming: what comes before the first segment
+  std::unique_ptr<canon::ReplayFilter> replay_;  ///< resuming: what comes before the first segment
   canon::SegmentId first_segment_ = 0;
 };
 
@@ -415,8 +420,8 @@ class GcodeStream final : public ProgramStream {
 class Scan {
  public:
   Scan(const gcode::Options& o, const std::string& path, const Pose& start, double tolerance_mm,
-       const MovePasses& passes, ScanCancel cancel = {})
-      : interp_(o), pipe_(interp_, start, tolerance_mm, nullptr, passes), cancel_(cancel) {
+       const SourceParts& parts, ScanCancel cancel = {})
+      : interp_(o), pipe_(interp_, start, tolerance_mm, nullptr, parts), cancel_(cancel) {
     ok_ = begin_program(interp_, pipe_, path, start, tolerance_mm);
     done_ = !ok_;
   }
@@ -439,8 +444,7 @@ class Scan {
   bool ok() const noexcept { return ok_; }
   bool cancelled() const noexcept { return cancelled_; }
   const Diagnostics& diagnostics() const noexcept { return interp_.diagnostics(); }
-  const Diagnostics& hand_failures() const noexcept { return pipe_.hand_failures(); }
-  const Diagnostics& coupling_failures() const noexcept { return pipe_.coupling_failures(); }
+  void append_pass_failures(Diagnostics& to) const { pipe_.append_pass_failures(to); }
   void release(std::size_t move, std::size_t action) { pipe_.builder().program().release_before(move, action); }
 
  private:
@@ -460,9 +464,7 @@ bool same_move(const canon::Program& a, const canon::Program& b, canon::SegmentI
   if (ma.kind != canon::MoveKind::Arc) return true;
   const canon::ArcGeometry& ga = a.arc(k);
   const canon::ArcGeometry& gb = b.arc(k);
-  return ga.turns == gb.turns && ga.plane == gb.plane &&
-         std::equal(std::begin(ga.center), std::end(ga.center), std::begin(gb.center)) &&
-         std::equal(std::begin(ga.normal), std::end(ga.normal), std::begin(gb.normal));
+  return ga.turns == gb.turns && ga.plane == gb.plane && ga.center == gb.center && ga.normal == gb.normal;
 }
 
 /// The sync point an action or a move stands for (None if it is none).
@@ -576,18 +578,18 @@ class PreflightRun {
 
 /// One preflight pass; with `classify`, a second scan with other answers runs in step with it.
 Preflight preflight_pass(const gcode::Options& o, const std::string& path, const Pose& start,
-                         double tolerance_mm, const MovePasses& passes, MoveCheck& check, bool classify,
+                         double tolerance_mm, const SourceParts& parts, MoveCheck& check, bool classify,
                          ScanCancel cancel) {
   Preflight out;
   gcode::Options main = o;
   main.mode = gcode::Mode::Scan;
   main.scan_assumption = gcode::ScanAssumption::Rs274;
-  Scan scan(main, path, start, tolerance_mm, passes, cancel);
+  Scan scan(main, path, start, tolerance_mm, parts, cancel);
   std::unique_ptr<Scan> other;
   if (classify) {
     gcode::Options alt = main;
     alt.scan_assumption = gcode::ScanAssumption::Other;
-    other = std::make_unique<Scan>(alt, path, start, tolerance_mm, passes);
+    other = std::make_unique<Scan>(alt, path, start, tolerance_mm, parts);
   }
   PreflightRun run(check, out);
   while (!scan.done() || run.checked() < scan.program().size()) {
@@ -600,8 +602,7 @@ Preflight preflight_pass(const gcode::Options& o, const std::string& path, const
     if (scan.done() && run.checked() >= scan.program().size()) break;
   }
   append(out.diagnostics, scan.diagnostics());
-  append(out.diagnostics, scan.hand_failures());
-  append(out.diagnostics, scan.coupling_failures());
+  scan.append_pass_failures(out.diagnostics);
   if (scan.cancelled())
     out.diagnostics.error(path, 0, 0, "the check was cancelled: an e-stop, machine off or abort was sent",
                           "control.cancelled");
@@ -609,20 +610,6 @@ Preflight preflight_pass(const gcode::Options& o, const std::string& path, const
     out.diagnostics.error(path, 0, 0, "the program cannot be read", "control.program");
   check.finish(out.diagnostics);
   return out;
-}
-
-/// True when `a` and `b` are both null or hold the same numbers.
-bool same_numbers(const std::shared_ptr<const std::vector<int>>& a, const std::shared_ptr<const std::vector<int>>& b) {
-  return a && b ? *a == *b : a == b;
-}
-
-/// The numbers of the machine's machining conditions, for M180's P; null without [edm].
-std::shared_ptr<const std::vector<int>> edm_condition_numbers(const config::MachineProfile& profile) {
-  if (!profile.edm.present) return nullptr;
-  const machine::EdmConfig& edm = profile.edm.config;
-  auto numbers = std::make_shared<std::vector<int>>();
-  for (int i = 0; i < edm.condition_count; ++i) numbers->push_back(edm.conditions[static_cast<std::size_t>(i)].number);
-  return numbers;
 }
 
 }  // namespace
@@ -659,10 +646,6 @@ std::optional<GcodeSourceConfig> GcodeProgramSource::config_for(const config::Ma
     if (!c.tools) return std::nullopt;
   }
   c.default_tolerance_mm = profile.planner.default_tolerance;
-  c.hand = hand_axes(profile);
-  c.coupling = coupled_axes(profile);
-  if (c.coupling.any()) c.extensions = gcode::coupling_extensions;
-  c.edm_conditions = edm_condition_numbers(profile);
   return c;
 }
 
@@ -670,20 +653,25 @@ GcodeProgramSource::GcodeProgramSource(GcodeSourceConfig config) : config_(std::
 
 GcodeProgramSource::~GcodeProgramSource() = default;
 
-// A program opened after this reads M180 against the new numbers; the MDI session starts afresh at
-// its next line if they differ from its own (its interpreter holds the modules it was made with).
+// A program opened after this reads with the parts for the new profile; the MDI session starts
+// afresh at its next line when a part changed (its interpreter holds the modules it was made with).
 void GcodeProgramSource::profile_changed(const config::MachineProfile& profile) {
-  std::shared_ptr<const std::vector<int>> numbers = edm_condition_numbers(profile);
-  if (same_numbers(numbers, config_.edm_conditions)) return;
-  config_.edm_conditions = std::move(numbers);
-  ++conditions_changed_;
+  bool changed = false;
+  std::lock_guard lock(parts_mutex_);
+  for (std::shared_ptr<const SourcePart>& part : config_.parts) {
+    if (std::shared_ptr<const SourcePart> next = part->for_profile(profile)) {
+      part = std::move(next);
+      changed = true;
+    }
+  }
+  if (changed) ++parts_changed_;
 }
 
 gcode::Options GcodeProgramSource::options_for(const std::string& path, const LoadOptions& options) const {
   gcode::Options o = config_.options;
   if (!path.empty()) o.dialect = gcode::dialect_marker(path).value_or(o.dialect);
-  o.extensions = config_.extensions ? config_.extensions(o.dialect) : gcode::standard_extensions(o.dialect);
-  if (config_.edm_conditions) o.extensions = gcode::edm_extensions(o.dialect, *config_.edm_conditions, o.extensions);
+  o.extensions = gcode::standard_extensions(o.dialect);
+  for (const auto& part : parts()) o.extensions = part->modules(o.dialect, o.extensions);
   o.block_delete = options.block_delete;
   if (config_.tools) o.tool_table = config_.tools->snapshot();
   return o;
@@ -693,12 +681,12 @@ Preflight GcodeProgramSource::preflight(const std::string& path, const Pose& sta
                                         MoveCheck& check) {
   const gcode::Options o = options_for(path, options);
   Preflight first =
-      preflight_pass(o, path, start, config_.default_tolerance_mm, passes(), check, false, options.cancel);
+      preflight_pass(o, path, start, config_.default_tolerance_mm, parts(), check, false, options.cancel);
   if (first.summary.sync_points == 0 || options.cancel.requested()) return first;
   // Sync points: the checks of the moves after them rest on assumed answers. A second pass, beside
   // a scan with other answers, tells which moves those are.
   Preflight second =
-      preflight_pass(o, path, start, config_.default_tolerance_mm, passes(), check, true, options.cancel);
+      preflight_pass(o, path, start, config_.default_tolerance_mm, parts(), check, true, options.cancel);
   return second;
 }
 
@@ -709,7 +697,7 @@ std::unique_ptr<ProgramStream> GcodeProgramSource::execute(const std::string& pa
   // As LinuxCNC's task runs it, M99 in the main program starts it again until the operator
   // stops the run (the preflight scans it once, as rs274 reads it).
   o.main_m99 = gcode::MainM99::Repeat;
-  return std::make_unique<GcodeStream>(o, path, start, config_.default_tolerance_mm, config_.tools, passes());
+  return std::make_unique<GcodeStream>(o, path, start, config_.default_tolerance_mm, config_.tools, parts());
 }
 
 std::unique_ptr<ProgramStream> GcodeProgramSource::resume(const std::string& path, const Pose& program_start,
@@ -718,13 +706,13 @@ std::unique_ptr<ProgramStream> GcodeProgramSource::resume(const std::string& pat
   gcode::Options o = options_for(path, options);
   o.mode = gcode::Mode::Execute;
   return std::make_unique<GcodeStream>(o, path, program_start, start, segment, config_.default_tolerance_mm,
-                                       config_.tools, passes());
+                                       config_.tools, parts());
 }
 
 std::unique_ptr<ProgramStream> GcodeProgramSource::mdi(std::string_view line, const Pose& start) {
-  if (mdi_ && !same_numbers(mdi_conditions_, config_.edm_conditions)) mdi_.reset();
+  if (mdi_ && mdi_parts_ != parts_changed_) mdi_.reset();
   if (!mdi_) {
-    mdi_conditions_ = config_.edm_conditions;
+    mdi_parts_ = parts_changed_;
     gcode::Options o = options_for("", {});
     o.mode = gcode::Mode::Execute;
     mdi_ = std::make_unique<gcode::Interpreter>(o);
@@ -738,8 +726,42 @@ std::unique_ptr<ProgramStream> GcodeProgramSource::mdi(std::string_view line, co
   }
   mdi_->set_machine_position(start);
   auto stream = std::make_unique<GcodeStream>(*mdi_, std::string(line), start, config_.default_tolerance_mm,
-                                              config_.tools, passes());
+                                              config_.tools, parts());
   return stream;
+}
+
+std::vector<std::shared_ptr<const SourcePart>> GcodeProgramSource::parts() const {
+  std::lock_guard lock(parts_mutex_);
+  return config_.parts;
+}
+
+Diagnostics GcodeProgramSource::scan(const std::string& path, const Pose& start, const LoadOptions& options,
+                                     ScanReader& reader) const {
+  gcode::Options o = options_for(path, options);
+  o.mode = gcode::Mode::Scan;
+  o.scan_assumption = gcode::ScanAssumption::Rs274;
+  Scan scan(o, path, start, config_.default_tolerance_mm, parts(), options.cancel);
+  std::size_t next_move = 0, next_action = 0;
+  bool more = true;
+  while (more) {
+    scan.read_to(scan.program().size() + kScanBatch);
+    const canon::Program& p = scan.program();
+    for (; more && next_move < p.size(); ++next_move) {
+      for (; more && next_action < p.action_count() && p.action(next_action).before_move <= next_move;
+           ++next_action)
+        more = reader.action(p, next_action);
+      if (more) more = reader.move(p, next_move);
+    }
+    if (scan.done()) {
+      for (; more && next_action < p.action_count(); ++next_action) more = reader.action(p, next_action);
+      break;
+    }
+    scan.release(next_move, next_action);  // the last move seen is kept: the next one starts there
+  }
+  Diagnostics out;
+  append(out, scan.diagnostics());
+  scan.append_pass_failures(out);
+  return out;
 }
 
 // --- locations -------------------------------------------------------------------------------

@@ -36,7 +36,7 @@ bool other_controller(const SharedHeader& h) {
 
 std::unique_ptr<HalLink> HalLink::attach(const std::string& name, const config::MachineProfile& profile,
                                          std::string& error, std::chrono::milliseconds wait) {
-  auto memory = SharedMemory::attach(name, error);
+  auto memory = SegmentMapping::attach(name, error);
   if (!memory) return nullptr;
   SharedSegment& s = memory->segment();
   SharedHeader& h = s.header;

@@ -8,8 +8,9 @@
 
 #include <fmt/format.h>
 
+#include "opencnc/canon/program_tail.hpp"
+#include "opencnc/control/machine_action.hpp"
 #include "opencnc/controller/preflight.hpp"
-#include "opencnc/controller/program_tools.hpp"
 
 namespace opencnc::control::detail {
 
@@ -363,8 +364,7 @@ void Job::push_actions() {
   const canon::Program& p = stream_->program();
   offsets_.scan(p);  // every action read, before release() may free it
   while (leg_.next_action < p.action_count() && p.action(leg_.next_action).before_move <= leg_.checked) {
-    const auto a =
-        machine_action(p, leg_.next_action, host_.servo != nullptr ? &host_.servo->coupling : nullptr);
+    const auto a = machine_action(p, leg_.next_action, host_.servo);
     if (a && !host_.channels->actions.try_push(*a)) break;
     ++leg_.next_action;
   }

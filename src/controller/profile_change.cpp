@@ -1,12 +1,13 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Controller: the machine profile's editable keys changed while nothing moves — the file edited
 // and loaded again, written back, the planner's limits and move checks swapped, the joints'
-// limits, pitch tables and EDM conditions staged in the tick and applied by one command (all of
-// them or none).
+// limits and the tick's tables staged in the tick and applied by one command (all of them or
+// none).
 #include <fmt/format.h>
 
 #include <algorithm>
 
+#include "opencnc/control/stage_tables.hpp"
 #include "opencnc/controller/controller.hpp"
 #include "opencnc/controller/preflight.hpp"
 #include "opencnc/controller/servo_setup.hpp"
@@ -41,12 +42,6 @@ std::string change_text(const std::vector<config::ProfileChange>& changes) {
   return s;
 }
 
-/// True when every change is of a machining condition (`edm.condition.…`): the audit says so.
-bool only_conditions(const std::vector<config::ProfileChange>& changes) {
-  return std::all_of(changes.begin(), changes.end(),
-                     [](const config::ProfileChange& c) { return c.key.rfind("edm.condition.", 0) == 0; });
-}
-
 JointLimits joint_limits(const ServoConfig& s, int joint) {
   const JointConfig& j = s.joints[static_cast<std::size_t>(joint)];
   JointLimits l{j.max_velocity, j.max_acceleration,    j.min_limit,
@@ -58,17 +53,6 @@ JointLimits joint_limits(const ServoConfig& s, int joint) {
     l.takeup_acceleration = c.max_acceleration;
   }
   return l;
-}
-
-/// Bit j: joint j is compensated in `next` (its table is staged at every change, changed or not:
-/// a stage left in the tick by a change whose commands did not all fit in the ring is then
-/// always overwritten before the next apply; an unchanged table switches without any take-up).
-std::uint16_t compensated_joints(const ServoConfig& next) {
-  std::uint16_t mask = 0;
-  for (int j = 0; j < next.joint_count && j < motion::kMaxCompensatedJoints; ++j)
-    if (next.compensation.joints[static_cast<std::size_t>(j)].enabled)
-      mask = static_cast<std::uint16_t>(mask | (1u << j));
-  return mask;
 }
 
 /// The homed joint of `next` whose axis stands outside its new soft limits, as a message; "".
@@ -97,9 +81,9 @@ void Controller::swap_profile(config::MachineProfile profile) {
   profile_ = std::move(profile);
   servo_config_ = control::servo_config(profile_);
   limits_ = machine_limits(profile_);
-  check_ = std::make_unique<MachineMoveCheck>(servo_config_, limits_);
+  check_ = make_move_check();
   ++limits_version_;  // the open program is checked again before it starts
-  if (source_) source_->profile_changed(profile_);  // M180 selects from the conditions now defined
+  if (source_) source_->profile_changed(profile_);  // a program reads with the profile now in force
   std::lock_guard lock(out_mutex_);
   shown_profile_ = profile_;
 }
@@ -128,11 +112,11 @@ void Controller::edit_profile(std::uint64_t id, const requests::EditProfile& r) 
   const ServoConfig next = control::servo_config(*edit.profile);
   if (const std::string why = outside_new_limits(next, s); !why.empty())
     return finish(id, Refusal::SoftLimit, why);
-  if (Diagnostics selects; !open_program_keeps_its_conditions(r, *edit.profile, selects)) {
-    std::string why = selects.items().front().format();
+  if (Diagnostics needs; *edit.deletes != '\0' && !open_program_passes(*edit.profile, needs)) {
+    std::string why = needs.items().front().format();
     return finish(id, Refusal::ProgramError,
-                  fmt::format("the open program selects a condition this would delete: {}", why),
-                  std::move(selects));
+                  fmt::format("the open program selects {} this would delete: {}", edit.deletes, why),
+                  std::move(needs));
   }
   std::string old_text, error;
   std::vector<config::FileText> old_files;  // a comp file the table is written into
@@ -143,10 +127,14 @@ void Controller::edit_profile(std::uint64_t id, const requests::EditProfile& r) 
     return finish(id, Refusal::BadValue,
                   fmt::format("{}: cannot write the profile: {}", profile_.source, error));
   }
-  ProfileChange pending{
-      id, new_id(), profile_, std::move(old_text), change_text(edit.changes), r.who, std::move(old_files),
-      only_conditions(edit.changes) ? "machining conditions" : "machine parameters"};
-  const std::uint16_t tables = compensated_joints(next);
+  ProfileChange pending{id,
+                        new_id(),
+                        profile_,
+                        std::move(old_text),
+                        change_text(edit.changes),
+                        r.who,
+                        std::move(old_files),
+                        edit.subject};
   swap_profile(std::move(*edit.profile));
   bool queued = true;
   for (int j = 0; j < next.joint_count && queued; ++j) {
@@ -157,9 +145,10 @@ void Controller::edit_profile(std::uint64_t id, const requests::EditProfile& r) 
     c.limits = joint_limits(next, j);
     queued = send(c);
   }
-  for (int j = 0; j < motion::kMaxCompensatedJoints && queued; ++j)
-    if (tables & (1u << j)) queued = stage_pitch_table(j, next, pending);
-  if (next.edm.enabled && queued) queued = stage_edm_conditions(next, pending);
+  for (const Command& stage : stage_tables(*channels_, next, pending.stage_id)) {
+    if (!queued) break;
+    queued = send(stage);
+  }
   Command apply;
   apply.id = id;
   apply.kind = CommandKind::ApplyJointLimits;
@@ -173,54 +162,27 @@ void Controller::edit_profile(std::uint64_t id, const requests::EditProfile& r) 
   }
 }
 
-// A condition deleted that the open program selects: its preflight with the edited profile's
-// conditions fails at the line of its M180 (`edm.condition`), and those errors go to `selects`.
+// An edit that deletes something the open program may need (a machining condition its M180
+// selects): its preflight with the edited profile fails at the line that needs it. Those errors,
+// the ones its preflight with the present profile from the same position has not, go to `needs`.
 // The source is put back to the present profile either way (swap_profile() moves it on).
-bool Controller::open_program_keeps_its_conditions(const requests::EditProfile& r,
-                                                   const config::MachineProfile& next, Diagnostics& selects) {
-  const bool deletes = std::any_of(r.conditions.begin(), r.conditions.end(),
-                                   [](const config::ConditionChange& c) { return c.remove; });
-  const std::optional<OpenProgram> op = deletes && source_ ? open_program() : std::nullopt;
+bool Controller::open_program_passes(const config::MachineProfile& next, Diagnostics& needs) {
+  const std::optional<OpenProgram> op = source_ ? open_program() : std::nullopt;
   if (!op || op->path.empty()) return true;
+  const Preflight now = preflight_file(op->path, servo().commanded, block_delete_, {});
   source_->profile_changed(next);
-  const Preflight pf = preflight_file(op->path, servo().commanded, block_delete_, {});
+  const Preflight then = preflight_file(op->path, servo().commanded, block_delete_, {});
   source_->profile_changed(profile_);
-  constexpr std::string_view code = "edm.condition";
-  for (const Diagnostic& d : pf.diagnostics.items())
-    if (d.severity == Severity::Error && d.code.size() >= code.size() &&
-        d.code.compare(d.code.size() - code.size(), code.size(), code) == 0)
-      selects.add(d);
-  return selects.items().empty();
-}
-
-// The joint's new table into the buffer its tick does not read, as the tick publishes it (not as
-// this controller remembers it: the tick may have outlived the controller that switched it).
-// Nothing else is in flight: one change at a time. Named by a StagePitchTable. Returns false when
-// the ring is full.
-bool Controller::stage_pitch_table(int joint, const ServoConfig& next, const ProfileChange& pending) {
-  const auto j = static_cast<std::size_t>(joint);
-  const motion::JointCompensation& c = next.compensation.joints[j];
-  const std::int8_t reading = channels_->pitch_tables.reading[j].index.load(std::memory_order_acquire);
-  const auto buffer = static_cast<std::uint8_t>(reading == 0 ? 1 : 0);
-  channels_->pitch_tables.joints[j][buffer] = c.pitch;
-  Command stage;
-  stage.id = pending.stage_id;
-  stage.kind = CommandKind::StagePitchTable;
-  stage.axis = static_cast<std::int8_t>(joint);
-  stage.table_buffer = buffer;
-  return send(stage);
-}
-
-// The machining conditions into the channels' table (the tick reads it only in the apply, and no
-// other change is in flight), named by a StageEdmConditions: staged at every change of an EDM's
-// profile, changed or not, as the pitch tables are. Returns false when the ring is full.
-bool Controller::stage_edm_conditions(const ServoConfig& next, const ProfileChange& pending) {
-  channels_->edm_conditions.conditions = next.edm.conditions;
-  channels_->edm_conditions.count = next.edm.condition_count;
-  Command stage;
-  stage.id = pending.stage_id;
-  stage.kind = CommandKind::StageEdmConditions;
-  return send(stage);
+  const auto same = [](const Diagnostic& a, const Diagnostic& b) {
+    return a.code == b.code && a.file == b.file && a.line == b.line && a.message == b.message;
+  };
+  for (const Diagnostic& d : then.diagnostics.items()) {
+    const auto& had = now.diagnostics.items();
+    if (d.severity == Severity::Error &&
+        std::none_of(had.begin(), had.end(), [&](const Diagnostic& x) { return same(x, d); }))
+      needs.add(d);
+  }
+  return needs.items().empty();
 }
 
 bool Controller::settle_profile_change(const ServoEvent& e) {

@@ -14,6 +14,12 @@ SimRig::SimRig(const config::MachineProfile& profile, std::shared_ptr<ProgramSou
       controller_(std::make_unique<Controller>(profile, *channels_, std::move(source), options)),
       service_every_(service_every < 1 ? 1 : service_every) {}
 
+SimRig::SimRig(const config::MachineProfile& profile, MachineSetup& setup, int service_every,
+               ControllerOptions options)
+    : SimRig(profile, setup.source(), service_every, options) {
+  setup.install(*controller_);
+}
+
 SimRig::~SimRig() = default;
 
 void SimRig::step() {

@@ -9,6 +9,8 @@
 
 #include <fmt/format.h>
 
+#include "opencnc/canon/arc_geometry.hpp"
+
 namespace opencnc::gcode {
 
 namespace {
@@ -24,15 +26,8 @@ struct PlaneAxes {
 };
 
 PlaneAxes axes_of(canon::Plane p) noexcept {
-  switch (p) {
-    case canon::Plane::XY: return {0, 1, 2, "XY", false};
-    case canon::Plane::YZ: return {1, 2, 0, "YZ", false};
-    case canon::Plane::XZ: return {2, 0, 1, "XZ", false};
-    case canon::Plane::UV: return {6, 7, 8, "UV", true};
-    case canon::Plane::VW: return {7, 8, 6, "VW", true};
-    case canon::Plane::UW: return {8, 6, 7, "UW", true};
-  }
-  return {};
+  const canon::PlaneAxes x = canon::plane_axes(p);
+  return {x.first, x.second, x.normal, canon::plane_name(p), canon::plane_base(p) != 0};
 }
 
 char word_letter(int axis) noexcept { return "xyzabcuvw"[axis]; }

@@ -40,15 +40,19 @@ int fifth_m_position(const Block& b) noexcept {
 
 }  // namespace
 
-void Engine::enhance_block() {
-  Block& b = block_;
+const CodeHandler* BlockChecks::extension_handler(int code) const noexcept {
+  return code >= 0 && e_.ext_ != nullptr ? e_.ext_->g[static_cast<std::size_t>(code)].get() : nullptr;
+}
+
+void BlockChecks::enhance_block() {
+  Block& b = e_.block_;
   const bool polar = b.radius_flag || b.theta_flag;
   if (polar) {
     const int at = b.polar_position();
-    if (!((letters_ >> ('x' - 'a')) & 1u) || !((letters_ >> ('y' - 'a')) & 1u))
+    if (!((e_.letters_ >> ('x' - 'a')) & 1u) || !((e_.letters_ >> ('y' - 'a')) & 1u))
       fail_at(at, ErrorCode::PolarNotAvailable,
               "polar coordinates (@ ^) need both an X and a Y axis, which this machine lacks");
-    if (st_.modal.plane != canon::Plane::XY)
+    if (e_.st_.modal.plane != canon::Plane::XY)
       fail_at(at, ErrorCode::PolarNotAvailable,
               "polar coordinates (@ ^) work only in the XY plane: select G17 first");
     for (char c : {'x', 'y'}) {
@@ -62,7 +66,7 @@ void Engine::enhance_block() {
   const bool ijk = b.has('i') || b.has('j') || b.has('k');
   const int mode0 = b.g[kGroupNonModal];
   const int mode1 = b.g[kGroupMotion];
-  const ExtensionClaims claims = ext_ != nullptr ? extension_claims() : ExtensionClaims{};
+  const ExtensionClaims claims = e_.ext_ != nullptr ? extension_claims() : ExtensionClaims{};
   const bool covets =
       mode0 == 100 || mode0 == 280 || mode0 == 300 || mode0 == 520 || mode0 == 920 || claims.axis_words;
   auto no_polar_offset = [&] {
@@ -101,44 +105,47 @@ void Engine::enhance_block() {
   } else if (axis || polar) {
     // G43.1 and G43.2 read the axis words themselves.
     const bool tool_offset_axes = b.g[kGroupToolLength] == 431 || b.g[kGroupToolLength] == 432;
-    if ((st_.modal.motion == -1 || st_.modal.motion == 800) && !tool_offset_axes)
+    if ((e_.st_.modal.motion == -1 || e_.st_.modal.motion == 800) && !tool_offset_axes)
       fail_at(b.first_axis_position(), ErrorCode::AxisWordsUnused,
               "axis words, but no motion mode is active (G80) and no code on this line uses them: program "
               "G0, G1, G2 or G3");
-    if (!tool_offset_axes) b.motion = st_.modal.motion;
-  } else if (ijk && is_arc(st_.modal.motion)) {
-    b.motion = st_.modal.motion;
+    if (!tool_offset_axes) b.motion = e_.st_.modal.motion;
+  } else if (ijk && is_arc(e_.st_.modal.motion)) {
+    b.motion = e_.st_.modal.motion;
   }
   if (polar && b.motion == -1)
     fail_at(b.polar_position(), ErrorCode::PolarWithoutMotion,
             "polar coordinates (@ ^) give motion end points, and this line has no motion");
 }
 
-void Engine::check_block() {
-  check_g_codes();
-  if (block_.m_count > 4)
-    fail_at(fifth_m_position(block_), ErrorCode::TooManyMCodes,
+void BlockChecks::check_block() {
+  // Tested here, not inside: most blocks have no code of the non-modal group, and the call cost
+  // more than the test (gcode_bench, docs/performance.md).
+  if (e_.block_.g[kGroupNonModal] != -1) check_g_codes();
+  if (e_.block_.m_count > 4)
+    fail_at(fifth_m_position(e_.block_), ErrorCode::TooManyMCodes,
             "a fifth M code on this line: a line may hold four at most");
   check_other_codes();
-  if (ext_ == nullptr) return;
+  if (e_.ext_ == nullptr) return;
   // Only groups that can hold an extension's code are looked at, and the test for a handler
   // stays here: a call per group would cost more than the checks of a typical block together.
-  for (std::uint32_t groups = extension_groups_; groups != 0; groups &= groups - 1) {
+  for (std::uint32_t groups = e_.extension_groups_; groups != 0; groups &= groups - 1) {
     const int group = std::countr_zero(groups);
-    const int code = block_.g[static_cast<std::size_t>(group)];
-    if (extension_handler(code) != nullptr) check_extension(code, block_.g_position(group));
+    const int code = e_.block_.g[static_cast<std::size_t>(group)];
+    if (extension_handler(code) != nullptr) check_extension(code, e_.block_.g_position(group));
   }
-  if (block_.motion != block_.g[kGroupMotion] && extension_handler(block_.motion) != nullptr)
-    check_extension(block_.motion, block_.first_axis_position());
+  if (e_.block_.motion != e_.block_.g[kGroupMotion] && extension_handler(e_.block_.motion) != nullptr)
+    check_extension(e_.block_.motion, e_.block_.first_axis_position());
 }
 
 // What the extension codes of the block claim (their Traits): words they take, the axis
 // words as their data, or all of their block's words. The motion code and the codes of the
 // groups only extensions know are asked.
-Engine::ExtensionClaims Engine::extension_claims() const {
+BlockChecks::ExtensionClaims BlockChecks::extension_claims() const {
+  const Block& b = e_.block_;
   ExtensionClaims claims;
-  const int motion = block_.g[kGroupMotion] != -1 ? block_.g[kGroupMotion] : block_.motion;
-  if (!block_.extension_groups && extension_handler(motion) == nullptr) return claims;   // most blocks
+  const int motion = b.g[kGroupMotion] != -1 ? b.g[kGroupMotion] : b.motion;
+  if (!b.extension_groups && extension_handler(motion) == nullptr) return claims;  // most blocks
   auto ask = [&](int code) {
     const CodeHandler* h = extension_handler(code);
     if (h == nullptr) return;
@@ -147,20 +154,20 @@ Engine::ExtensionClaims Engine::extension_claims() const {
     claims.axis_words = claims.axis_words || t.axis_words;
     claims.all_words = claims.all_words || t.all_words;
   };
-  if (block_.extension_groups) {
-    for (int group = kGroupScaling; group < kGGroupCount; ++group) ask(block_.g[static_cast<std::size_t>(group)]);
+  if (b.extension_groups) {
+    for (int group = kGroupScaling; group < kGGroupCount; ++group) ask(b.g[static_cast<std::size_t>(group)]);
   }
   ask(motion);
   return claims;
 }
 
-void Engine::check_extension(int code, int position) {
-  if (auto problem = extension_handler(code)->check(block_, code, st_))
+void BlockChecks::check_extension(int code, int position) {
+  if (auto problem = extension_handler(code)->check(e_.block_, code, e_.st_))
     throw GcodeError(problem->code, problem->message, position);
 }
 
-void Engine::check_g_codes() {
-  const Block& b = block_;
+void BlockChecks::check_g_codes() {
+  const Block& b = e_.block_;
   const int mode0 = b.g[kGroupNonModal];
   const int mode1 = b.g[kGroupMotion];
   const int at0 = b.g_position(kGroupNonModal);
@@ -183,14 +190,15 @@ void Engine::check_g_codes() {
     if (b.motion != 0 && b.motion != 10)
       fail_at(at0, ErrorCode::G53Motion, "G53 moves in machine coordinates with G0 or G1 only, not {}",
               g_name(b.motion));
-    if (b.g[kGroupDistance] == 910 || (b.g[kGroupDistance] != 900 && st_.modal.distance == DistanceMode::Incremental))
+    if (b.g[kGroupDistance] == 910 ||
+        (b.g[kGroupDistance] != 900 && e_.st_.modal.distance == DistanceMode::Incremental))
       fail_at(at0, ErrorCode::G53Incremental,
               "G53 takes absolute machine coordinates: it cannot be used in G91 (add G90)");
   }
 }
 
-void Engine::check_g10() {
-  const Block& b = block_;
+void BlockChecks::check_g10() {
+  const Block& b = e_.block_;
   const double p = b.p_or(-1.0);
   const int p_int = round_to_int(p);
   const int l = b.has('l') ? static_cast<int>(b.get('l')) : -1;
@@ -218,21 +226,21 @@ void Engine::check_g10() {
   }
 }
 
-void Engine::check_other_codes() {
+void BlockChecks::check_other_codes() {
   // Words that extension codes take are theirs to check: the rules see the block without them.
-  if (ext_ != nullptr) {
+  if (e_.ext_ != nullptr) {
     const ExtensionClaims claims = extension_claims();
     if (claims.all_words) return;
     if (claims.words != 0) {
-      Block without_claimed = block_;
+      Block without_claimed = e_.block_;
       without_claimed.words &= ~claims.words;
       return check_word_rules(without_claimed);
     }
   }
-  check_word_rules(block_);
+  check_word_rules(e_.block_);
 }
 
-void Engine::check_word_rules(const Block& b) {
+void BlockChecks::check_word_rules(const Block& b) {
   if (b.o_type == OWord::M98) return check_m98(b);
   const int motion = b.motion;
   const int m5 = b.m[kGroupIo], m6 = b.m[kGroupToolChange], m7 = b.m[kGroupSpindle], m9 = b.m[kGroupOverride];
@@ -313,9 +321,9 @@ void Engine::check_word_rules(const Block& b) {
 // states (0.0001 mm, 0.00001 in) is a move that never ends: K0 would stand still at the spindle's
 // full speed for ever. LinuxCNC's rs274 passes them; opencnc refuses them where they are written
 // (docs/conformance.md, "Stricter than LinuxCNC").
-void Engine::check_per_turn(const Block& b) {
+void BlockChecks::check_per_turn(const Block& b) {
   const int units = b.g[kGroupUnits];
-  const bool inch = units == 200 || (units == -1 && st_.modal.units == canon::Units::Inch);
+  const bool inch = units == 200 || (units == -1 && e_.st_.modal.units == canon::Units::Inch);
   const double least = inch ? 1e-5 : 1e-4;
   const char* unit = inch ? "in" : "mm";
   const int motion = b.motion;
@@ -330,7 +338,7 @@ void Engine::check_per_turn(const Block& b) {
             b.get('p'), least, unit);
   const int feed_mode = b.g[kGroupFeedMode];
   const bool per_turn =
-      feed_mode == 950 || (feed_mode == -1 && st_.modal.feed_mode == canon::FeedMode::UnitsPerRevolution);
+      feed_mode == 950 || (feed_mode == -1 && e_.st_.modal.feed_mode == canon::FeedMode::UnitsPerRevolution);
   if (per_turn && b.has('f') && b.get('f') != 0 && small(b.get('f')))
     fail_at(b.word_position('f'), ErrorCode::PerTurnTooSmall,
             "G95 F{}: a feed below {} {} per turn never ends (the least increment a program states)",
@@ -342,7 +350,7 @@ void Engine::check_per_turn(const Block& b) {
 // LinuxCNC's word rules apply to the others; what they let through (axis words of a modal
 // motion, F, S, T, other codes), LinuxCNC reads and ignores: refused here, since a reader
 // would expect it to act.
-void Engine::check_m98(const Block& b) {
+void BlockChecks::check_m98(const Block& b) {
   const int at = b.o_at;
   if (!b.has('p'))
     fail_at(at, ErrorCode::FanucCallProgramMissing,
@@ -374,8 +382,8 @@ void Engine::check_m98(const Block& b) {
 }
 
 // P: which codes use it, and the values arcs (turns) and M19 (direction) accept.
-void Engine::check_p_word() {
-  const Block& b = block_;
+void BlockChecks::check_p_word() {
+  const Block& b = e_.block_;
   const int motion = b.motion;
   const int m5 = b.m[kGroupIo], m7 = b.m[kGroupSpindle], m9 = b.m[kGroupOverride];
   const int g0 = b.g[kGroupNonModal], g13 = b.g[kGroupControl];

@@ -5,7 +5,11 @@
 #include <cmath>
 #include <cstdio>
 
-#include "engine.hpp"
+#include "comments.hpp"
+#include "gcode_error.hpp"
+#include "opencnc/gcode/state.hpp"
+#include "output.hpp"
+#include "params.hpp"
 
 namespace opencnc::gcode {
 
@@ -31,9 +35,8 @@ void append_value(std::string& out, bool found, double value) {
   else out.append(buf, static_cast<std::size_t>(n));
 }
 
-}  // namespace
-
-std::string Engine::expand_parameters(std::string_view text) {
+// The comment's text with #n and #<name> replaced by their values ("######" for none).
+std::string expand_parameters(std::string_view text, const InterpState& st, ParameterHost& params) {
   std::string out;
   std::size_t i = 0;
   while (i < text.size()) {
@@ -55,7 +58,7 @@ std::string Engine::expand_parameters(std::string_view text) {
         ++i;
       }
       const bool found = n >= 0 && n < kParameterCount;
-      append_value(out, found, found ? st_.parameters[static_cast<std::size_t>(n)] : 0.0);
+      append_value(out, found, found ? st.parameters[static_cast<std::size_t>(n)] : 0.0);
     } else if (text[i] == '<') {
       ++i;
       std::string name;
@@ -67,7 +70,7 @@ std::string Engine::expand_parameters(std::string_view text) {
       if (i >= text.size() || text[i] != '>') break;
       ++i;
       double v = 0;
-      const bool found = named_value(name, v);
+      const bool found = params.named_value(name, v);
       append_value(out, found, v);
     } else {
       out += '#';
@@ -76,31 +79,34 @@ std::string Engine::expand_parameters(std::string_view text) {
   return out;
 }
 
-void Engine::convert_comment(std::string_view comment) {
+}  // namespace
+
+void convert_comment(std::string_view comment, const InterpState& st, ParameterHost& params, Output& out) {
+  auto expand = [&](std::string_view text) { return expand_parameters(text, st, params); };
   std::size_t start = 0;
   while (start < comment.size() && std::isspace(static_cast<unsigned char>(comment[start]))) ++start;
   const std::string_view c = comment.substr(start);
   if (starts_with_nocase(c, "msg,")) {
-    out_.message(c.substr(4));
+    out.message(c.substr(4));
   } else if (starts_with_nocase(c, "debug,")) {
-    const std::string text = expand_parameters(c.substr(6));
-    if (st_.parameters[5599] > 0.0) out_.message(text);
+    const std::string text = expand(c.substr(6));
+    if (st.parameters[5599] > 0.0) out.message(text);
   } else if (starts_with_nocase(c, "print,")) {
-    out_.print(expand_parameters(c.substr(6)));
+    out.print(expand(c.substr(6)));
   } else if (starts_with_nocase(c, "log,")) {
-    out_.log(expand_parameters(c.substr(4)));
+    out.log(expand(c.substr(4)));
   } else if (starts_with_nocase(c, "logopen,")) {
-    out_.log_open(c.substr(8));
+    out.log_open(c.substr(8));
   } else if (starts_with_nocase(c, "logappend,")) {
-    out_.log_append(c.substr(10));
+    out.log_append(c.substr(10));
   } else if (starts_with_nocase(c, "abort,")) {
-    fail(ErrorCode::Abort, "{}", expand_parameters(c.substr(6)));
+    fail(ErrorCode::Abort, "{}", expand(c.substr(6)));
   } else if (starts_with_nocase(c, "py,") || starts_with_nocase(c, "pyrun,") || starts_with_nocase(c, "pyreload")) {
     fail(ErrorCode::Unsupported, "embedded Python comments are not supported");
   } else if (c.size() == 8 && starts_with_nocase(c, "logclose")) {
-    out_.log_close();
+    out.log_close();
   } else {
-    out_.comment(c);
+    out.comment(c);
   }
 }
 

@@ -7,6 +7,7 @@
 
 #include "arc_math.hpp"
 #include "gcode_error.hpp"
+#include "opencnc/canon/arc_geometry.hpp"
 
 namespace opencnc::gcode::comp {
 
@@ -14,9 +15,9 @@ CompPath::CompPath(ExecContext& ctx)
     : ctx_(ctx),
       st_(ctx.state()),
       plane_(st_.modal.plane),
-      a1_(plane_ == canon::Plane::XZ ? 2 : 0),
-      a2_(plane_ == canon::Plane::XZ ? 0 : 1),
-      a3_(plane_ == canon::Plane::XZ ? 1 : 2),
+      a1_(canon::plane_axes(plane_).first),  // comp runs in G17 and G18 only
+      a2_(canon::plane_axes(plane_).second),
+      a3_(canon::plane_axes(plane_).normal),
       left_(st_.modal.cutter_comp == CutterComp::Left),
       radius_(st_.modal.comp_radius) {}
 

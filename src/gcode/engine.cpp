@@ -4,14 +4,16 @@
 
 #include <algorithm>
 #include <cstring>
-#include <ctime>
 #include <utility>
 
 #include "lexer.hpp"
 
 namespace opencnc::gcode {
 
-Engine::Engine(Options options) : opt_(std::move(options)), sources_(std::make_shared<canon::SourceMap>()) {
+Engine::Engine(Options options)
+    : opt_(std::move(options)),
+      sources_(std::make_shared<canon::SourceMap>()),
+      dialect_(dialect_hooks(opt_.dialect)) {
   ext_ = opt_.extensions.get();
   // The G groups where a code with an extension handler can stand (its core group, else the
   // one its traits name): check_block looks for handlers in these only.
@@ -23,10 +25,10 @@ Engine::Engine(Options options) : opt_(std::move(options)), sources_(std::make_s
   out_.configure(opt_);
   out_.track(&st_.position);
   out_.transform_state(&st_);
-  norm_.resize(1 << 12);
-  raw_.reserve(512);
+  line_.norm.resize(1 << 12);
+  line_.raw.reserve(512);
   st_.modal.units = opt_.initial_units;
-  update_unit_factor();
+  offsets_.update_unit_factor();
   st_.parameters[5220] = 1.0;   // G54
   st_.parameters[5599] = 1.0;   // (DEBUG,...) messages on
   st_.frames.emplace_back();
@@ -35,7 +37,7 @@ Engine::Engine(Options options) : opt_(std::move(options)), sources_(std::make_s
   if (opt_.tool_table) {
     for (const auto& e : opt_.tool_table->entries()) st_.tool.table.push_back(e);
   }
-  set_tool_parameters();
+  mcodes_.set_tool_parameters();
   letters_ = 0;
   for (char c : std::string_view("defghijklmpqrst")) letters_ |= 1u << (c - 'a');
   // A program letter reads if the machine has the axis the axis map sends it to.
@@ -44,12 +46,7 @@ Engine::Engine(Options options) : opt_(std::move(options)), sources_(std::make_s
     if (opt_.axes.has(opt_.axis_map[static_cast<std::size_t>(i)])) letters_ |= bit;
     else if (opt_.axes.has(static_cast<Axis>(i))) mapped_away_ |= bit;
   }
-  if (fanuc()) {
-    // #0, the locals and the commons start vacant; on a lathe U and W are incremental X and Z.
-    st_.fanuc.vacant.set();
-    for (int i = 34; i < 100; ++i) st_.fanuc.vacant.reset(static_cast<std::size_t>(i));
-    if (opt_.machine == MachineKind::Lathe) letters_ |= (1u << ('u' - 'a')) | (1u << ('w' - 'a'));
-  }
+  if (dialect_.make_state) dialect_state_ = dialect_.make_state(*this);
 }
 
 Engine::~Engine() = default;
@@ -115,8 +112,8 @@ void Engine::start() {
     const bool linear = !is_rotary(static_cast<Axis>(i));
     const double o = st_.parameters[static_cast<std::size_t>(base + 1 + i)];
     const double g = st_.parameters[static_cast<std::size_t>(5211 + i)];
-    st_.position.origin_offset[i] = linear ? user_to_program(o) : o;
-    st_.position.axis_offset[i] = linear ? user_to_program(g) : g;
+    st_.position.origin_offset[i] = linear ? offsets_.user_to_program(o) : o;
+    st_.position.axis_offset[i] = linear ? offsets_.user_to_program(g) : g;
   }
   st_.position.rotation_xy_deg = st_.parameters[static_cast<std::size_t>(base + 10)];
   out_.use_length_units(st_.modal.units);
@@ -124,12 +121,12 @@ void Engine::start() {
   out_.set_g92_offset(st_.position.axis_offset);
   out_.set_xy_rotation(st_.position.rotation_xy_deg);
   out_.set_feed_reference(canon::FeedReference::Xyz);
-  if (fanuc()) fanuc_start();
+  if (dialect_.start) dialect_.start(*this);
   if (!has_program_) return;
   // A program whose first non-blank line is a lone '%' must end with another '%'.
   SourceFile& f = current_file();
   f.seek(0);
-  line_file_ = st_.next.file;
+  line_.file = st_.next.file;
   RawLine line;
   std::uint32_t n = 0;
   // The first line that is not blank, false at the end of the file.
@@ -137,7 +134,7 @@ void Engine::start() {
     while (f.next(line)) {
       ++n;
       if (line.text.size() + (line.newline ? 1 : 0) > kMaxLineLength) {
-        line_ = n;
+        line_.number = n;
         line_too_long();
       }
       if (!trim_raw_line(line.text).empty()) return true;
@@ -146,8 +143,8 @@ void Engine::start() {
   };
   // An empty program is reported on its first line, as every other error is placed.
   const auto empty = [&](std::string_view what) {
-    line_ = 1;
-    raw_.clear();
+    line_.number = 1;
+    line_.raw.clear();
     fail(ErrorCode::ProgramEmpty, "the program file {}: there is nothing to run", what);
   };
   if (!next_text()) empty(n == 0 ? "is empty" : "holds blank lines only");
@@ -159,8 +156,8 @@ void Engine::start() {
     st_.percent_delimited = true;
     st_.next = {st_.next.file, body, 2};  // LinuxCNC counts the '%' line as line 1
   } else {
-    // Fanuc: "%O1000(NAME)" opens the tape and numbers the program on one line.
-    st_.percent_delimited = fanuc() && first.front() == '%' && fanuc_program_number(first).has_value();
+    // A dialect's header: "%O1000(NAME)" opens the tape and numbers the program on one line.
+    st_.percent_delimited = dialect_.program_header != nullptr && dialect_.program_header(first);
     st_.next = {st_.next.file, 0, 1};
   }
   st_.frames.front().fanuc.body = st_.next;
@@ -173,12 +170,12 @@ void Engine::start() {
 RunStatus Engine::guarded(canon::Sink& sink, bool (Engine::*body)()) {
   out_.attach(&sink);
   if (failed_) return RunStatus::Error;
-  if (pending_sync_ != SyncKind::None) return RunStatus::NeedSync;
+  if (sync_.pending() != SyncKind::None) return RunStatus::NeedSync;
   if (st_.ended && started_) return RunStatus::Finished;
   try {
     if (!started_) start();
     const bool more = (this->*body)();
-    if (pending_sync_ != SyncKind::None) return RunStatus::NeedSync;
+    if (sync_.pending() != SyncKind::None) return RunStatus::NeedSync;
     return more ? RunStatus::Ok : RunStatus::Finished;
   } catch (const GcodeError& e) {
     report(e);
@@ -192,31 +189,6 @@ void Engine::require_program() {
     diags_.error("", 0, 0, "no program is open", std::string(error_id(ErrorCode::NoProgram)));
     failed_ = true;
   }
-}
-
-namespace {
-
-// The thread's CPU time, not the wall clock: a loaded machine does not make a program fail its check.
-double thread_cpu_s() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-}
-
-}  // namespace
-
-void Engine::check_time() {
-  const double now = thread_cpu_s();
-  if (lines_read_ == 1) {
-    cpu_at_start_s_ = now;
-    return;
-  }
-  if (now - cpu_at_start_s_ > opt_.limits.max_seconds)
-    fail(ErrorCode::LimitTime,
-         "the program was still running here after {:g} s of checking ({} blocks; limit max_seconds): an "
-         "endless "
-         "loop?",
-         opt_.limits.max_seconds, st_.blocks_executed);
 }
 
 RunStatus Engine::step(canon::Sink& sink) {
@@ -242,19 +214,19 @@ bool Engine::run_budget() {
   while (!st_.ended && block_budget_ > 0) {
     --block_budget_;
     process_line();
-    if (pending_sync_ != SyncKind::None) return true;
+    if (sync_.pending() != SyncKind::None) return true;
   }
   return !st_.ended;
 }
 
 // After a sync point inside a subprogram an MDI line called: the call runs on to its return.
 RunStatus Engine::mdi_continue(canon::Sink& sink) {
-  in_mdi_ = true;
+  mdi_.active = true;
   const RunStatus s = guarded(sink, &Engine::continue_mdi_call);
-  in_mdi_ = false;
+  mdi_.active = false;
   if (s == RunStatus::Error) {
     failed_ = false;
-    abandon_calls();
+    flow_.abandon_calls();
   }
   return s == RunStatus::Finished ? RunStatus::Ok : s;
 }
@@ -270,52 +242,32 @@ bool Engine::step_block() {
 bool Engine::run_blocks() {
   while (!st_.ended) {
     process_line();
-    if (pending_sync_ != SyncKind::None) return true;
+    if (sync_.pending() != SyncKind::None) return true;
   }
   return false;
 }
 
 RunStatus Engine::mdi(std::string_view line, canon::Sink& sink) {
-  if (!in_mdi_file_) {
-    mdi_file_ = sources_->add_file("<mdi>");
-    in_mdi_file_ = true;
+  if (!mdi_.registered) {
+    mdi_.file = sources_->add_file("<mdi>");
+    mdi_.registered = true;
   }
-  mdi_line_.assign(line);
-  in_mdi_ = true;
+  mdi_.line.assign(line);
+  mdi_.active = true;
   st_.ended = false;   // MDI also works after a program end
   const RunStatus s = guarded(sink, &Engine::process_line);
-  in_mdi_ = false;
+  mdi_.active = false;
   if (s == RunStatus::Error) {   // an MDI error does not end the session
     failed_ = false;
-    abandon_calls();
+    flow_.abandon_calls();
   }
   return s == RunStatus::Finished ? RunStatus::Ok : s;
-}
-
-// An MDI line failed inside the subprogram it called: every call is left as if it had returned
-// (arguments or macro locals back as they were), so the next line runs in the session's frame.
-void Engine::abandon_calls() {
-  while (st_.frames.size() > 1) {
-    const CallFrame& f = st_.frames.back();
-    if (f.fanuc.macro) {
-      for (std::size_t i = 1; i <= kFanucLocalCount; ++i) {
-        st_.parameters[i] = f.fanuc.saved_locals[i - 1];
-        st_.fanuc.vacant[i] = f.fanuc.saved_vacant[i];
-      }
-    } else if (!fanuc()) {
-      for (int i = 0; i < kSubArgumentCount; ++i)
-        st_.parameters[static_cast<std::size_t>(1 + i)] = f.saved_args[static_cast<std::size_t>(i)];
-    }
-    leave_frame();
-  }
-  st_.control.skipping_to.clear();
-  st_.control.seeking_sub.clear();
 }
 
 ParseEnv Engine::parse_env() const noexcept {
   ParseEnv env;
   env.parameters = st_.parameters.data();
-  env.host = const_cast<Engine*>(this);
+  env.host = const_cast<ParameterHost*>(&params_);
   env.letters = letters_;
   env.mapped_away = mapped_away_;
   env.lathe_diameter = st_.modal.lathe_diameter;
@@ -325,21 +277,21 @@ ParseEnv Engine::parse_env() const noexcept {
   env.defining_sub = st_.control.defining_sub;
   env.defining_name = st_.control.defining_name;
   env.skipping_to = st_.control.skipping_to;
-  env.dialect = opt_.dialect;
+  env.syntax = dialect_.syntax;
   env.ext = ext_;
   env.vacant = &st_.fanuc.vacant;
   return env;
 }
 
-// Reads the next line into raw_/norm_; false at the end of the file.
+// Reads the next line into line_.raw/line_.norm; false at the end of the file.
 bool Engine::read_line() {
   update_position_parameters();
-  if (in_mdi_) {
-    line_file_ = mdi_file_;
-    line_ = 1;
-    line_offset_ = 0;
-    raw_.assign(trim_raw_line(mdi_line_));
-    if (mdi_line_.size() > kMaxLineLength) line_too_long();
+  if (mdi_.active) {
+    line_.file = mdi_.file;
+    line_.number = 1;
+    line_.offset = 0;
+    line_.raw.assign(trim_raw_line(mdi_.line));
+    if (mdi_.line.size() > kMaxLineLength) line_too_long();
     return true;
   }
   SourceFile& f = current_file();
@@ -349,12 +301,12 @@ bool Engine::read_line() {
   }
   RawLine line;
   if (!f.next(line)) return false;
-  line_file_ = st_.next.file;
-  line_ = st_.next.line;
-  line_offset_ = line.offset;
+  line_.file = st_.next.file;
+  line_.number = st_.next.line;
+  line_.offset = line.offset;
   st_.next.offset = f.tell();
   ++st_.next.line;
-  raw_.assign(trim_raw_line(line.text));
+  line_.raw.assign(trim_raw_line(line.text));
   if (line.text.size() + (line.newline ? 1 : 0) > kMaxLineLength) line_too_long();
   return true;
 }
@@ -363,19 +315,19 @@ bool Engine::read_line() {
 void Engine::line_too_long() const {
   throw GcodeError(ErrorCode::LineTooLong,
                    fmt::format("a line longer than {} characters: split it", kMaxLineLength - 1), -1,
-                   Where{line_file_, line_, static_cast<std::uint32_t>(kMaxLineLength)});
+                   Where{line_.file, line_.number, static_cast<std::uint32_t>(kMaxLineLength)});
 }
 
 // Written in place: an origin built on the stack and copied costs a failed store forwarding
 // (a wide load of narrow stores just made) on every line.
 void Engine::set_origin_from_line() {
   canon::BlockOrigin& o = out_.new_origin();
-  o.file = line_file_;
-  o.line = line_;
+  o.file = line_.file;
+  o.line = line_.number;
   o.context = st_.frames.back().context;
   std::memset(o.n_digits, 0, sizeof o.n_digits);
   std::string_view digits;
-  o.n_present = leading_n_digits(raw_, digits);
+  o.n_present = leading_n_digits(line_.raw, digits);
   o.n_length = 0;
   if (o.n_present) {
     const std::size_t n = std::min(digits.size(), sizeof(o.n_digits));
@@ -387,10 +339,10 @@ void Engine::set_origin_from_line() {
 // Reads the next line into block_ (parsed and checked unless a label is being sought).
 Engine::LineKind Engine::read_block() {
   if (!read_line()) {
-    line_file_ = st_.next.file;
-    line_ = st_.next.line;
-    raw_.clear();
-    if (fanuc()) fanuc_end_of_file();
+    line_.file = st_.next.file;
+    line_.number = st_.next.line;
+    line_.raw.clear();
+    if (dialect_.end_of_file) dialect_.end_of_file(*this);
     if (!st_.control.seeking_sub.empty()) sub_not_found();
     if (!st_.control.skipping_to.empty()) unclosed_block();
     if (st_.percent_delimited)
@@ -399,37 +351,36 @@ Engine::LineKind Engine::read_block() {
     fail(ErrorCode::MissingProgramEnd,
          "the file ends without a program end: finish the program with M2 or M30");
   }
-  if (norm_.size() < raw_.size() + 1) norm_.resize(raw_.size() + 1);
+  if (line_.norm.size() < line_.raw.size() + 1) line_.norm.resize(line_.raw.size() + 1);
   set_origin_from_line();
-  norm_len_ = normalize_line(raw_, norm_.data(), fanuc());
-  const std::string_view text(norm_.data(), norm_len_);
-  if (text == "%" && fanuc() && !in_mdi_ && fanuc_percent_line()) return LineKind::Empty;
-  if (text == "%" && st_.percent_delimited && !in_mdi_) {
+  line_.norm_len = normalize_line(line_.raw, line_.norm.data(), dialect_.syntax.nested_comments);
+  const std::string_view text(line_.norm.data(), line_.norm_len);
+  if (text == "%" && dialect_.percent_line && !mdi_.active && dialect_.percent_line(*this))
+    return LineKind::Empty;
+  if (text == "%" && st_.percent_delimited && !mdi_.active) {
     // Nothing after the closing '%' belongs to the program, not even a subprogram (LinuxCNC).
     if (!st_.control.seeking_sub.empty()) sub_not_found();
     return LineKind::ProgramEnd;
   }
   if (text.empty() || (text.front() == '/' && opt_.block_delete)) return LineKind::Empty;
-  if (fanuc() && (text.front() == '$' || text.front() == '%')) check_foreign_syntax();
+  const bool foreign_start = text.front() == '$' || text.front() == '%';  // tested first: most lines are not
+  if (foreign_start && dialect_.foreign_syntax != nullptr) dialect_.foreign_syntax(*this);
 
   const bool skipping = !st_.control.skipping_to.empty();
-  if (opt_.limits.max_seconds > 0 && opt_.mode == Mode::Scan && (lines_read_++ & 4095) == 0) check_time();
-  if (skipping) {
-    if (opt_.limits.max_skipped_lines != 0 && ++skipped_lines_ > opt_.limits.max_skipped_lines)
-      fail(ErrorCode::LimitSkippedLines, "more than {} lines passed over while looking for a label (limit max_skipped_lines)",
-           opt_.limits.max_skipped_lines);
-  } else if (opt_.limits.max_blocks != 0 && ++st_.blocks_executed > opt_.limits.max_blocks) {
-    fail(ErrorCode::LimitBlocks, "more than {} blocks executed (limit max_blocks)", opt_.limits.max_blocks);
-  }
-  if (!skipping && (text.front() == '%' || text.front() == '$') && opt_.dialect == Dialect::LinuxCnc)
+  bounds_.count(opt_, skipping, st_.blocks_executed);
+  if (!skipping && foreign_start && dialect_.foreign_syntax == nullptr)
     reject_foreign_syntax(text);
   parser_.parse(text, parse_env(), block_);
-  if (fanuc()) fanuc_translate();
+  if (dialect_.translate) dialect_.translate(*this);
   if (!skipping) {
-    enhance_block();
-    check_block();
+    checks_.enhance_block();
+    checks_.check_block();
   }
   return LineKind::Block;
+}
+
+Engine::LineKind Engine::next_block() {
+  return read_block();
 }
 
 // Reads and executes one line. Returns when the line is done (or the program ended).
@@ -443,56 +394,38 @@ bool Engine::process_line() {
     case LineKind::Block: break;
   }
   if (block_.o_type != OWord::None) {
-    if (in_mdi_ && block_.o_type != OWord::Call && block_.o_type != OWord::MacroCall && block_.o_type != OWord::M98)
+    if (mdi_.active && block_.o_type != OWord::Call && block_.o_type != OWord::MacroCall &&
+        block_.o_type != OWord::M98)
       fail(ErrorCode::OwordInMdi,
            "only 'call' O-words and subprogram calls can be used in MDI: control flow needs a program file");
-    control_flow();
-    if (fanuc() && block_.o_type != OWord::BlockRange) fanuc_block_done();
-    if (in_mdi_) finish_mdi_call();
+    flow_.control_flow();
+    if (dialect_.block_done && block_.o_type != OWord::BlockRange) dialect_.block_done(*this, true);
+    if (mdi_.active) finish_mdi_call();
     return true;
   }
   if (!st_.control.skipping_to.empty()) return true;
-  if (fanuc()) fanuc_assignments();
-  else apply_assignments();
+  const DialectHooks& dialect = dialect_;
+  if (dialect.assignments != nullptr) {
+    dialect.assignments(*this);
+  } else {
+    apply_assignments();
+  }
   execute_block();
-  if (fanuc()) {
-    fanuc_after_block();
-    fanuc_block_done();
-    if (in_mdi_) finish_mdi_call();
+  if (dialect.block_done != nullptr) {
+    dialect.block_done(*this, false);
+    if (mdi_.active) finish_mdi_call();
   }
-  if (block_sync_pending_) {
-    block_sync_pending_ = false;
-    if (block_sync_.kind == SyncKind::ToolChange) block_sync_.position = st_.position.canon_position;
-    apply_sync(block_sync_);
-  }
+  sync_.end_of_block(st_);
   return true;
 }
 
 // An MDI line that called a subprogram runs it to the end before returning.
 void Engine::finish_mdi_call() {
-  while (st_.frames.size() > 1 && !failed_ && !st_.ended && pending_sync_ == SyncKind::None) {
-    in_mdi_ = false;
+  while (st_.frames.size() > 1 && !failed_ && !st_.ended && sync_.pending() == SyncKind::None) {
+    mdi_.active = false;
     process_line();
-    in_mdi_ = true;
+    mdi_.active = true;
   }
-}
-
-// Lines that start like another controller's program header or command ("%PM",
-// "%_N_PART_MPF", "$H", "$BR0137.MIN%") are named as such instead of failing on a character.
-void Engine::check_foreign_syntax() {
-  const std::size_t first = raw_.find_first_not_of(" \t");
-  if (first == std::string::npos) return;
-  const char c = raw_[first];
-  const char next = first + 1 < raw_.size() ? raw_[first + 1] : '\0';
-  const bool dollar = c == '$' && ((next >= 'A' && next <= 'Z') || (next >= 'a' && next <= 'z'));
-  const bool percent = c == '%' && next != '\0' && next != ' ' && next != '\t' &&
-                       !(fanuc() && fanuc_program_number(raw_).has_value());
-  if (!dollar && !percent) return;
-  const std::size_t end = raw_.find_first_of(" \t(", first);
-  const std::string construct = raw_.substr(first, end == std::string::npos ? std::string::npos : end - first);
-  fail(ErrorCode::DialectUnsupported, "'{}' is another controller's syntax ({}), not {} G-code", construct,
-       dollar ? "a command or program header starting with '$'" : "a program header starting with '%'",
-       fanuc() ? "Fanuc" : "LinuxCNC");
 }
 
 // --- errors -------------------------------------------------------------------------------
@@ -500,7 +433,7 @@ void Engine::check_foreign_syntax() {
 // Program headers and commands of other controllers, which no line of this dialect starts
 // with: named, so that the reader knows the file is not LinuxCNC G-code at all.
 void Engine::reject_foreign_syntax(std::string_view text) const {
-  std::string_view raw = raw_;
+  std::string_view raw = line_.raw;
   raw.remove_prefix(std::min(raw.size(), raw.find_first_not_of(" \t")));
   const std::string_view token = raw.substr(0, raw.find_first_of(" \t(;"));
   auto foreign = [&](std::string_view what) {
@@ -547,7 +480,7 @@ void Engine::sub_not_found() {
 // The file ended while passing over a block to its end label: the block was never closed.
 void Engine::unclosed_block() {
   const std::string& key = st_.control.skipping_to;
-  const LabelInfo* l = find_label(key);
+  const LabelInfo* l = flow_.find_label(key);
   if (l == nullptr)
     fail(ErrorCode::OwordUnclosed, "the file ends inside an O-word block that is never closed");
   const char* kind = label_kind_name(l->kind);
@@ -570,17 +503,17 @@ void Engine::unclosed_block() {
 }
 
 void Engine::report(const GcodeError& e) {
-  std::uint32_t file_index = line_file_;
-  std::uint32_t line = line_;
+  std::uint32_t file_index = line_.file;
+  std::uint32_t line = line_.number;
   std::uint32_t col = 0;
   if (const auto& w = e.where()) {
     file_index = w->file;
     line = w->line;
     col = w->col;
   } else if (e.position() >= 0) {
-    col = raw_column(raw_, e.position(), fanuc());
+    col = raw_column(line_.raw, e.position(), dialect_.syntax.nested_comments);
   } else {
-    const std::size_t first = raw_.find_first_not_of(" \t");
+    const std::size_t first = line_.raw.find_first_not_of(" \t");
     col = first == std::string::npos ? 1 : static_cast<std::uint32_t>(first + 1);
   }
   const std::string file = file_index < sources_->file_count() ? sources_->file(file_index) : std::string();
@@ -590,87 +523,26 @@ void Engine::report(const GcodeError& e) {
 void Engine::warn_once(bool& done, ErrorCode code, std::string_view message) {
   if (done) return;
   done = true;
-  const std::size_t first = raw_.find_first_not_of(" \t");
+  const std::size_t first = line_.raw.find_first_not_of(" \t");
   const auto col = first == std::string::npos ? 1u : static_cast<std::uint32_t>(first + 1);
-  const std::string file = line_file_ < sources_->file_count() ? sources_->file(line_file_) : std::string();
-  diags_.warning(file, line_, col, std::string(message), std::string(error_id(code)));
-}
-
-// Habits of a program that LinuxCNC accepts but a preflight should point out (once each).
-void Engine::check_motion_habits(bool feed) {
-  if (in_mdi_) return;
-  // (warn_once tests `done` too; testing it first spares a call on every later move)
-  if (!units_programmed_ && !warned_units_)
-    warn_once(warned_units_, ErrorCode::UnitsNotProgrammed,
-              "motion before any G20/G21: the program relies on the machine's default units");
-  if (feed && opt_.spindle && !warned_spindle_ && st_.modal.spindle == canon::SpindleDirection::Stopped)
-    warn_once(warned_spindle_, ErrorCode::FeedWithSpindleStopped, "feed move while the spindle is stopped");
+  const std::string file = line_.file < sources_->file_count() ? sources_->file(line_.file) : std::string();
+  diags_.warning(file, line_.number, col, std::string(message), std::string(error_id(code)));
 }
 
 // --- sync points --------------------------------------------------------------------------
 
 void Engine::request_sync(const SyncValues& assumed) {
-  if (opt_.mode == Mode::Execute) {
-    // A block may stop after asking for feedback (M66 P0 M0): the feedback first, then the stop.
-    if (assumed.kind == SyncKind::ProgramStop) {
-      if (pending_sync_ == SyncKind::None) {
-        pending_sync_ = SyncKind::ProgramStop;
-        sync_request_ = assumed;
-      } else {
-        stop_after_sync_ = true;
-      }
-      return;
-    }
-    if (pending_sync_ == SyncKind::ProgramStop) stop_after_sync_ = true;
-    pending_sync_ = assumed.kind;
-    sync_request_ = assumed;
-    return;
-  }
-  if (assumed.kind == SyncKind::ProgramStop) return;  // nothing to assume: the scan goes on
-  // Scan mode: the assumed feedback arrives when the block is done (LinuxCNC reads it
-  // before the next block), so later codes of the same block do not see it.
-  block_sync_ = assumed;
-  block_sync_pending_ = true;
+  sync_.ask(assumed, opt_.mode);
 }
 
 void Engine::sync(const SyncValues& values) {
-  if (pending_sync_ == SyncKind::None) return;
-  apply_sync(values);
-  const bool no_contact =
-      sync_request_.kind == SyncKind::Probe && sync_request_.contact_required && !values.probe_tripped;
-  const bool seeks_contact = sync_request_.seeks_contact;
-  pending_sync_ = stop_after_sync_ ? SyncKind::ProgramStop : SyncKind::None;
-  if (stop_after_sync_) sync_request_ = SyncValues{SyncKind::ProgramStop};
-  stop_after_sync_ = false;
-  if (no_contact) {
-    // The probe block is still the current line: the error points at it.
-    // LinuxCNC's words for it.
-    report(GcodeError(ErrorCode::ProbeNoContact, seeks_contact ? "G38.2 move finished without making contact"
-                                                               : "G38.4 move finished without breaking contact"));
-    failed_ = true;
-    pending_sync_ = SyncKind::None;
-  }
-}
-
-void Engine::apply_sync(const SyncValues& values) {
-  auto& p = st_.parameters;
-  switch (values.kind) {
-    case SyncKind::Probe:
-      for (int i = 0; i < kAxisCount; ++i) p[static_cast<std::size_t>(5061 + i)] = values.probe_position[i];
-      p[5070] = values.probe_tripped ? 1.0 : 0.0;
-      st_.position.current = values.position;
-      st_.position.canon_position = values.position;
-      break;
-    case SyncKind::Input:
-      p[5399] = values.input_value;
-      break;
-    case SyncKind::ToolChange:
-      st_.position.current = values.position;
-      break;
-    case SyncKind::ProgramStop:
-    case SyncKind::None:
-      break;
-  }
+  const SyncPoints::Answer answer = sync_.answer(values, st_);
+  if (answer == SyncPoints::Answer::Done) return;
+  // The probe block is still the current line: the error points at it. LinuxCNC's words for it.
+  report(GcodeError(ErrorCode::ProbeNoContact, answer == SyncPoints::Answer::NoContact
+                                                   ? "G38.2 move finished without making contact"
+                                                   : "G38.4 move finished without breaking contact"));
+  failed_ = true;
 }
 
 void Engine::request_stop_sync() {
@@ -688,7 +560,7 @@ Pose Engine::program_position(const Pose& machine_mm) const {
     const bool linear = i < 3 || i >= 6;
     m[i] = linear ? v / unit : v;
   }
-  return machine_to_program(m);
+  return offsets_.machine_to_program(m);
 }
 
 void Engine::set_machine_position(const Pose& machine_mm) {
@@ -709,32 +581,14 @@ void Engine::set_tool_table(const std::shared_ptr<const tools::ToolTable>& table
   if (index > 0 && static_cast<std::size_t>(index) < t.size() && t[static_cast<std::size_t>(index)].tool == t[0].tool)
     t[0] = t[static_cast<std::size_t>(index)];
   opt_.tool_table = table;
-  set_tool_parameters();
-}
-
-// --- extension facade ---------------------------------------------------------------------
-
-void Engine::straight(bool rapid, const Pose& end) { emit_straight(rapid, end); }
-void Engine::arc(const canon::ArcFeed& a) { emit_arc(a); }
-
-void Engine::programmed_move(int motion, const Block& words) {
-  if (motion != 0 && motion != 10 && motion != 20 && motion != 30)
-    fail(ErrorCode::Unsupported, "G{} cannot be programmed by an extension", motion / 10.0);
-  // The handler's block is block_: lend block_ to the move and give it back afterwards.
-  struct Restore {
-    Block& target;
-    Block saved;
-    ~Restore() { target = std::move(saved); }
-  } restore{block_, block_};
-  block_ = words;
-  block_.motion = motion;
-  convert_motion(motion);
+  mcodes_.set_tool_parameters();
 }
 
 Engine::SavedLine Engine::save_line() {
   // The block's comment views the old buffer: it moves out with it.
-  return SavedLine{block_, raw_, std::exchange(norm_, std::vector<char>(norm_.size())), norm_len_, line_, line_file_,
-                   line_offset_, out_.origin()};
+  std::vector<char> norm = std::exchange(line_.norm, std::vector<char>(line_.norm.size()));
+  CurrentLine line{line_.number, line_.file, line_.offset, line_.raw, std::move(norm), line_.norm_len};
+  return SavedLine{block_, std::move(line), out_.origin()};
 }
 
 void Engine::restore_line(SavedLine& saved, const canon::BlockOrigin& n_from) {
@@ -743,89 +597,8 @@ void Engine::restore_line(SavedLine& saved, const canon::BlockOrigin& n_from) {
   origin.n_length = n_from.n_length;
   std::memcpy(origin.n_digits, n_from.n_digits, sizeof origin.n_digits);
   block_ = std::move(saved.block);
-  raw_ = std::move(saved.raw);
-  norm_ = std::move(saved.norm);
-  norm_len_ = saved.norm_len;
-  line_ = saved.line;
-  line_file_ = saved.file;
-  line_offset_ = saved.offset;
+  line_ = std::move(saved.line);
   out_.set_origin(origin);
-}
-
-void Engine::read_subprogram(const std::string& name, std::uint32_t extra_letters,
-                             const std::function<void(const Block&)>& visit) {
-  // The executing block's line: the cycle's moves and errors belong to it afterwards.
-  struct Modes {
-    Engine& e;
-    std::uint32_t letters;
-    bool mdi;
-    ~Modes() {   // also on errors: an MDI session goes on with the machine's letters
-      e.letters_ = letters;
-      e.in_mdi_ = mdi;
-    }
-  } modes{*this, letters_, in_mdi_};
-  SavedLine saved = save_line();
-  letters_ |= extra_letters;
-  const std::size_t depth = st_.frames.size();
-  block_.clear();
-  block_.o_type = OWord::Call;
-  block_.o_name = name;
-  o_call();          // from MDI, a sub neither defined nor on the search path fails here
-  in_mdi_ = false;   // the sub's lines come from its file, also when MDI calls the cycle
-  while (st_.frames.size() > depth) {
-    const LineKind kind = read_block();
-    if (kind == LineKind::ProgramEnd) fail(ErrorCode::MissingProgramEnd, "the program ends inside the subprogram o<{}>", name);
-    if (kind == LineKind::Empty) continue;
-    if (block_.o_type != OWord::None) {
-      control_flow();
-      continue;
-    }
-    if (!st_.control.skipping_to.empty()) continue;
-    apply_assignments();
-    visit(block_);
-  }
-  // rs274 labels the cycle's moves with the N word of the last line it read.
-  const canon::BlockOrigin last = out_.origin();
-  restore_line(saved, last);
-}
-
-// Fanuc G71/G72 P Q: the shape's blocks read, not run (ExecContext::read_block_range).
-void Engine::read_block_range(std::int64_t first, std::int64_t last, std::string_view what,
-                              const std::function<void(const Block&)>& visit) {
-  if (in_mdi_)
-    fail(ErrorCode::OwordInMdi, "{} P Q reads the program's own blocks: it cannot run from MDI (as G70 P Q cannot)", what);
-  const SourcePosition body = st_.frames.back().fanuc.body;
-  const SourcePosition from = fanuc_sequence(body, first, fmt::format("{} P", what));
-  const SourcePosition to = fanuc_sequence(body, last, fmt::format("{} Q", what));
-  if (to.file != from.file || to.offset < from.offset)
-    fail(ErrorCode::FanucGotoTargetMissing, "{} P{} Q{}: block N{} comes before N{}", what, first, last, last, first);
-  // Errors of the shape's blocks point at them, not at the cycle's code.
-  struct Site {
-    int& slot;
-    int saved;
-    ~Site() { slot = saved; }
-  } site{extension_at_, std::exchange(extension_at_, -1)};
-  const SourcePosition resume = st_.next;
-  SavedLine saved = save_line();
-  const double p = fanuc_p_, l = fanuc_l_, clamp = fanuc_clamp_;   // the block's own, reset per line read
-  jump_to(from);
-  for (;;) {
-    const LineKind kind = read_block();
-    if (kind == LineKind::ProgramEnd)
-      fail(ErrorCode::MissingProgramEnd, "the program ends inside the shape of {} P{} Q{}", what, first, last);
-    if (kind == LineKind::Block) {
-      if (block_.o_type != OWord::None || !parser_.numbered_assignments.empty() || !parser_.named_assignments.empty())
-        fail(ErrorCode::FanucProfileBlock,
-             "the shape of {} P{} Q{} cannot hold macro statements, assignments, calls or G70 (only its moves are read)",
-             what, first, last);
-      visit(block_);
-    }
-    if (line_file_ == to.file && line_offset_ == to.offset) break;
-  }
-  const SourcePosition after = st_.next;
-  restore_line(saved, saved.origin);
-  fanuc_p_ = p, fanuc_l_ = l, fanuc_clamp_ = clamp;
-  jump_to(only_comments_between(resume, from) ? after : resume);
 }
 
 InterpState Engine::snapshot() const {

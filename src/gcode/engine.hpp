@@ -12,6 +12,16 @@
 #include <string_view>
 #include <vector>
 
+#include "check.hpp"
+#include "control_flow.hpp"
+#include "dialect_hooks.hpp"
+#include "extension_context.hpp"
+#include "gcode_error.hpp"
+#include "line_bounds.hpp"
+#include "mcodes.hpp"
+#include "modal_codes.hpp"
+#include "motion_codes.hpp"
+#include "offsets.hpp"
 #include "opencnc/canon/source_map.hpp"
 #include "opencnc/core/diagnostic.hpp"
 #include "opencnc/gcode/block.hpp"
@@ -19,11 +29,11 @@
 #include "opencnc/gcode/interpreter.hpp"
 #include "opencnc/gcode/options.hpp"
 #include "opencnc/gcode/state.hpp"
-#include "fanuc_index.hpp"
-#include "gcode_error.hpp"
 #include "output.hpp"
+#include "params.hpp"
 #include "parser.hpp"
 #include "source_file.hpp"
+#include "sync_points.hpp"
 
 namespace opencnc::gcode {
 
@@ -36,6 +46,9 @@ constexpr int axis_of_letter(char c) noexcept {
     default: return -1;
   }
 }
+/// (x, y) turned by `degrees` counterclockwise about the origin (G68 rotation, motion.cpp).
+void rotate_xy(double& x, double& y, double degrees) noexcept;
+
 inline constexpr char kAxisWordLetters[kAxisCount] = {'x', 'y', 'z', 'a', 'b', 'c', 'u', 'v', 'w'};
 
 /// "sub", "while", ... for a label kind; the keyword that ends its block; "o100" or
@@ -44,10 +57,39 @@ const char* label_kind_name(LabelKind k) noexcept;
 const char* label_end_keyword(LabelKind k) noexcept;
 std::string label_text(std::string_view key);
 
-class Engine final : public ParamHost, public ExecContext {
+/// The line being executed: where it is, its text as read and as the parser reads it.
+struct CurrentLine {
+  std::uint32_t number = 0;  ///< its line number
+  std::uint32_t file = 0;    ///< its file (SourceMap index)
+  std::uint64_t offset = 0;  ///< its byte offset
+  std::string raw;           ///< the raw line (for messages and N labels)
+  std::vector<char> norm;    ///< normalised text (lower case, no spaces); norm_len chars of it
+  std::size_t norm_len = 0;
+};
+
+/// The MDI line being run, and the source-map file that stands for MDI.
+struct MdiInput {
+  bool active = false;     ///< lines come from `line`, not from the program's files
+  std::string line;        ///< the operator's line
+  std::uint32_t file = 0;  ///< "<mdi>" in the source map, once `registered`
+  bool registered = false;
+};
+
+class Engine final {
+  // The engine's parts, each a file of this folder, reach its state as friends.
+  friend class FanucDialect;  // the Fanuc dialect's hooks run the engine's lines and calls
+  friend class FlowControl;
+  friend class BlockChecks;
+  friend class ExtensionContext;
+  friend class ParameterHost;
+  friend class ModalCodes;
+  friend class Offsets;
+  friend class MCodes;
+  friend class MotionCodes;
+
  public:
   explicit Engine(Options options);
-  ~Engine() override;
+  ~Engine();
 
   // --- driving (engine.cpp) --------------------------------------------------------------
   bool open_file(const std::string& path);
@@ -58,8 +100,8 @@ class Engine final : public ParamHost, public ExecContext {
   RunStatus mdi(std::string_view line, canon::Sink& sink);
   RunStatus run_some(canon::Sink& sink, std::uint64_t max_blocks);
   RunStatus mdi_continue(canon::Sink& sink);
-  SyncKind pending_sync() const noexcept { return pending_sync_; }
-  const SyncValues& sync_request() const noexcept { return sync_request_; }
+  SyncKind pending_sync() const noexcept { return sync_.pending(); }
+  const SyncValues& sync_request() const noexcept { return sync_.request(); }
   void sync(const SyncValues& values);
   void set_machine_position(const Pose& machine_mm);
   Pose program_position(const Pose& machine_mm) const;
@@ -67,39 +109,15 @@ class Engine final : public ParamHost, public ExecContext {
   /// M0, M1, M60 and the stops inside cycles: in execute mode the interpreter waits for the
   /// operator's cycle start there (offsets and tools may change meanwhile).
   void request_stop_sync();
+  /// The block needs machine feedback before the next one (ExecContext::request_sync).
+  void request_sync(const SyncValues& assumed);
   InterpState snapshot() const;
   std::uint64_t segments() const noexcept { return out_.segments(); }
   const Diagnostics& diagnostics() const noexcept { return diags_; }
   std::shared_ptr<canon::SourceMap> sources() const noexcept { return sources_; }
-  const Options& options() const override { return opt_; }
-
-  // --- ParamHost (params.cpp) ------------------------------------------------------------
-  bool named_value(std::string_view name, double& value) override;
-  void declare_named(std::string_view name) override;
-  bool fanuc_variable(int index, double& value) override;   // fanuc_vars.cpp
-
-  // --- ExecContext (extension facade, engine.cpp) ----------------------------------------
-  InterpState& state() override { return st_; }
-  Pose end_point(const Block& block) override { return find_ends(block); }
-  canon::Sink& output() override { return out_; }
-  void straight(bool rapid, const Pose& end) override;
-  void arc(const canon::ArcFeed& arc) override;
-  ArcCentre arc_centre(const Block& block, int motion, const Pose& start, const Pose& end) override;
-  void programmed_move(int motion, const Block& words) override;
-  void read_subprogram(const std::string& name, std::uint32_t extra_letters,
-                       const std::function<void(const Block&)>& visit) override;
-  void read_block_range(std::int64_t first, std::int64_t last, std::string_view what,
-                        const std::function<void(const Block&)>& visit) override;
-  void open_queue() override { out_.open_queue(); }
-  void flush_queue() override { out_.flush_queue(); }
-  std::size_t queued() const override { return out_.queued(); }
-  void move_queued_end(canon::Plane plane, double first, double second) override {
-    out_.move_queued_end(plane, first, second);
-  }
-  void request_sync(const SyncValues& assumed) override;
-  [[noreturn]] void error(ErrorCode code, const std::string& message) override {
-    throw GcodeError(code, message, extension_at_);
-  }
+  const Options& options() const { return opt_; }
+  /// The dialect's own state (DialectHooks::make_state), for its hooks.
+  DialectState* dialect_state() noexcept { return dialect_state_.get(); }
 
  private:
   // Points the errors an extension raises through error() at `at` while it runs (an outer
@@ -122,11 +140,7 @@ class Engine final : public ParamHost, public ExecContext {
   // profiles) and put back afterwards with the N label `n_from` (engine.cpp).
   struct SavedLine {
     Block block;
-    std::string raw;
-    std::vector<char> norm;
-    std::size_t norm_len = 0;
-    std::uint32_t line = 0, file = 0;
-    std::uint64_t offset = 0;
+    CurrentLine line;
     canon::BlockOrigin origin;
   };
   SavedLine save_line();
@@ -149,16 +163,16 @@ class Engine final : public ParamHost, public ExecContext {
   // Inlined into its two callers in engine.cpp: as a call it cost 2-3 % of gcode_bench's
   // lines/s on the per-line path.
   [[gnu::always_inline]] inline LineKind read_block();
+  LineKind next_block();  ///< read_block() out of line, for a dialect reading a block range
   bool process_line();
+  void finish_mdi_call();
   void report(const GcodeError& e);
   [[noreturn]] void sub_not_found();
   [[noreturn]] void unclosed_block();
   void reject_foreign_syntax(std::string_view text) const;
   [[noreturn]] void line_too_long() const;
   void warn_once(bool& done, ErrorCode code, std::string_view message);
-  void check_motion_habits(bool feed);
   void set_origin_from_line();
-  void check_foreign_syntax();
   SourceFile& current_file() {
     const std::uint32_t file = st_.next.file;
     return file < files_.size() && files_[file] ? *files_[file] : source_at(file);
@@ -166,183 +180,18 @@ class Engine final : public ParamHost, public ExecContext {
   SourceFile& source_at(std::uint32_t file);
   void jump_to(const SourcePosition& pos);
   ParseEnv parse_env() const noexcept;
-  void apply_sync(const SyncValues& values);
-
-  // check.cpp: LinuxCNC's checks after reading a block
-  void enhance_block();
-  void check_block();
-  void check_g_codes();
-  void check_g10();
-  void check_other_codes();
-  void check_p_word();
-  void check_m98(const Block& b);
-  void check_extension(int code, int position);   ///< `code` must have a handler
-  /// The extension's handler of G code `code` (×10), nullptr if none (or code < 0).
-  const CodeHandler* extension_handler(int code) const noexcept {
-    return code >= 0 && ext_ != nullptr ? ext_->g[static_cast<std::size_t>(code)].get() : nullptr;
-  }
-  void check_word_rules(const Block& b);
-  void check_per_turn(const Block& b);
-  struct ExtensionClaims {
-    std::uint32_t words = 0;
-    bool axis_words = false;
-    bool all_words = false;
-  };
-  ExtensionClaims extension_claims() const;
 
   // execute.cpp: order of execution within a block
   void execute_block();
   void apply_assignments();
   void convert_g();
-  void convert_m();
-  void set_plane(int code);
-  void set_units(int code);
-  void set_lathe_mode(int code);
-  void set_control_mode(int code);
-  void set_distance_mode(int code);
-  void set_ijk_mode(int code);
-  void set_retract_mode(int code);
-  void set_feed_mode(int code);
-  void set_spindle_mode();
-  void set_cutter_comp(int code);
   bool run_extension_g(int code);
   bool run_extension_m(int code);
   [[noreturn]] void unsupported_g(int code, int at);
   void check_spindle_number(bool all_allowed) const;
   void convert_extension_groups();
 
-  // motion.cpp
-  Pose find_ends(const Block& b);
-  [[noreturn]] static void polar_with_xy(const Block& b);
-  [[noreturn]] static void polar_at_origin(const Block& b);
-  void check_feed(std::string_view what) const;
-  void convert_motion(int motion);
-  void convert_straight(int motion);
-  void convert_arc(int motion);
-  void arc_center_ijk(int motion, double cur1, double cur2, double end1, double end2, double off1, double off2,
-                      int turns, double& c1, double& c2, int& turn) const;
-  void arc_center_r(int motion, double cur1, double cur2, double end1, double end2, double radius, int turns,
-                    double& c1, double& c2, int& turn) const;
-  void inverse_time_straight(const Pose& end);
-  void inverse_time_arc(double c1, double c2, double c3, double cx, double cy, int turn, double e1, double e2,
-                        double e3);
-  void emit_straight(bool rapid, const Pose& end);
-  void emit_arc(const canon::ArcFeed& arc);
-
-  // offsets.cpp: coordinate systems, G10, G92/G52, G28/G30, tool length offset
-  void convert_modal_0(int code);
-  void set_coordinate_system(int code);
-  void g10_coordinate_system();
-  void g10_tool();
-  void axis_offsets(int code);
-  void go_home(int code);
-  void save_home(int code);
-  void tool_length_offset(int code);
-  Pose current_in_system(int system, bool without_tlo) const;
-  Pose machine_to_program(const Pose& machine_user) const;
-  Pose program_to_machine(const Pose& program) const;  ///< machine_to_program's inverse
-  void rotate(double& x, double& y, double degrees) const noexcept;
-  double user_to_program(double v) const noexcept { return v * user_to_program_factor_; }
-  double program_to_user(double v) const noexcept { return v / user_to_program_factor_; }
-  void update_unit_factor() noexcept;
-
-  // mcodes.cpp: M codes, tools, program stop/end
-  void convert_io();
-  void convert_tool_change_group();
-  void convert_spindle_group();
-  void convert_coolant();
-  void convert_overrides();
-  void select_tool(int tool);
-  void change_tool();
-  void move_to_tool_change(int at);  ///< `at`: where the M6 starts (its errors point there)
-  void set_tool_number(int tool);
-  void load_spindle(int index);
-  void set_tool_parameters();
-  int tool_index(int tool, int at) const;  ///< `at`: where the word naming the tool starts
-  int pocket_of(int index) const noexcept;
-  void convert_stop();
-  void end_program(int code);
-  SavedContext active_context() const;
-  void save_context(bool restore_on_return);
-  void restore_context(const SavedContext& saved);
-  void execute_text(std::string_view text);
-
-  // comments.cpp
-  void convert_comment(std::string_view comment);
-  std::string expand_parameters(std::string_view text);
-
-  // control_flow.cpp: O-words
-  void control_flow();
-  void o_sub();
-  void o_return();
-  void o_call();
-  void o_do();
-  void o_while();
-  void o_repeat();
-  void o_if();
-  void o_elseif();
-  void o_else();
-  void o_endif();
-  void o_break_continue(bool is_break);
-  void o_end_loop();
-  void o_program();
-  void o_m98();
-  void o_m99();
-  void enter_sub(CallFrame frame, std::string name, std::string_view context_name);
-  [[noreturn]] void mixed_styles(const char* what) const;
-  void repeat_main();
-  LabelInfo* find_label(const std::string& name);
-  [[noreturn]] void unmatched(const char* keyword, const char* opener,
-                              const char* other_opener = nullptr) const;
-  [[noreturn]] void mismatched(const char* keyword, const LabelInfo& label) const;
-  void save_label(LabelKind kind);
-  void jump_to_label(const std::string& name);
-  bool open_sub_file(const std::string& name);
-  void count_loop();
-  void leave_frame();
-
-  // fanuc_flow.cpp: the Fanuc dialect's programs, calls and loops
-  bool fanuc() const noexcept { return opt_.dialect == Dialect::Fanuc; }
-  void fanuc_start();
-  bool fanuc_percent_line();
-  void fanuc_end_of_file();
-  void fanuc_control_flow();
-  void fanuc_program_line();
-  void fanuc_goto(std::int64_t n);
-  void fanuc_while();
-  void fanuc_end();
-  void fanuc_call(std::uint32_t program, int count, bool macro);
-  void fanuc_range();
-  void fanuc_block_done();
-  void fanuc_return();
-  SourcePosition fanuc_find_program(std::uint32_t program);
-  bool fanuc_program_file(std::uint32_t program, SourcePosition& at);
-  const FanucIndex::Region& fanuc_region(const SourcePosition& start);
-  SourcePosition fanuc_sequence(const SourcePosition& program_start, std::int64_t n, std::string_view what);
-  std::string fanuc_program_name(const FanucFrame& f) const;
-  bool only_comments_between(const SourcePosition& from, const SourcePosition& to);
-  void finish_mdi_call();
-  void abandon_calls();
-
-  // fanuc_translate.cpp: Fanuc words and codes rewritten into the core's before the checks
-  void fanuc_translate();
-  void fanuc_lathe_words();
-  void fanuc_lathe_tool();
-  void fanuc_lathe_codes();
-  void fanuc_dwell();
-  void fanuc_transform_conflicts();
-  void fanuc_after_block();
-  bool block_has_content() const noexcept;
-
-  // fanuc_vars.cpp: system variables, vacancy, #3000 alarms and #3006 stops
-  double fanuc_computed(int index) const;
-  double fanuc_modal(int group) const;
-  void fanuc_assignments();
-
   // params.cpp
-  bool predefined_value(std::string_view name, double& value) const;
-  bool is_predefined(std::string_view name) const noexcept;
-  void store_named(const std::string& name, double value);
   void update_position_parameters();
 
   Options opt_;
@@ -359,40 +208,24 @@ class Engine final : public ParamHost, public ExecContext {
   bool has_program_ = false;
   bool need_seek_ = true;
   bool failed_ = false;
-  bool in_mdi_ = false;
-  std::string mdi_line_;
-  SyncKind pending_sync_ = SyncKind::None;
-  SyncValues block_sync_;           ///< scan mode: feedback assumed at the end of this block
-  SyncValues sync_request_;         ///< execute mode: what the pending sync point asked for
-  bool stop_after_sync_ = false;    ///< execute mode: a program stop follows the pending sync
+  MdiInput mdi_;                    ///< the operator's line, when MDI runs
+  SyncPoints sync_;                 ///< what the machine must answer, or scan mode assumes
   std::uint64_t block_budget_ = 0;  ///< run_some(): blocks left to execute
-  bool block_sync_pending_ = false;
   std::uint32_t letters_ = 0;       ///< letter words with a reader (axis mask applied)
   int extension_at_ = -1;  ///< where the code of the running extension starts (its errors point there)
   std::uint32_t mapped_away_ = 0;   ///< axis letters the axis map sends to a missing axis
-  std::uint32_t mdi_file_ = 0;
-  bool in_mdi_file_ = false;        ///< "<mdi>" is registered in the source map
-  std::uint64_t skipped_lines_ = 0; ///< lines passed over while seeking a label
-  std::uint64_t lines_read_ = 0;    ///< every line, for the time bound (Limits::max_seconds)
-  double cpu_at_start_s_ = 0;       ///< the thread's CPU time at the first line
-  void check_time();
-  bool units_programmed_ = false;   ///< a G20/G21 was met (for the units warning)
-  bool warned_units_ = false;
-  bool warned_spindle_ = false;
-  bool warned_repeat_ = false;      ///< M99 ended the main program (the repeat warning)
-  double user_to_program_factor_ = 1.0;
-  std::uint32_t line_ = 0;          ///< line number of the block being executed
-  std::uint32_t line_file_ = 0;     ///< its file
-  std::uint64_t line_offset_ = 0;   ///< its byte offset
-  std::string raw_;                 ///< the raw line (for messages and N labels)
-  // Fanuc dialect
-  FanucIndex fanuc_index_;          ///< program lines, sequence numbers, loops of the files read
-  std::map<std::uint32_t, SourcePosition> fanuc_programs_;   ///< O number → program line found
-  double fanuc_p_ = -1;             ///< M98/M99 P of the block (taken out before the checks)
-  double fanuc_l_ = -1;             ///< M98 L of the block
-  double fanuc_clamp_ = -1;         ///< G50 S / G92 S of the block
-  std::vector<char> norm_;          ///< normalised text of the line
-  std::size_t norm_len_ = 0;
+  LineBounds bounds_;               ///< the runaway program's limits
+  CurrentLine line_;                ///< the line being executed: where, raw and normalised
+  DialectHooks dialect_;  ///< chosen when the program opens (Options::dialect); a copy, read without a pointer
+  std::unique_ptr<DialectState> dialect_state_;  ///< the dialect's own (null: none)
+  FlowControl flow_{*this};      ///< O-words and call frames
+  BlockChecks checks_{*this};    ///< LinuxCNC's checks of a block read
+  ExtensionContext ctx_{*this};  ///< what the extensions see
+  ParameterHost params_{*this};  ///< named parameters, the parser's host
+  ModalCodes modes_{*this};      ///< modal settings
+  Offsets offsets_{*this};       ///< units and coordinate transforms
+  MCodes mcodes_{*this};         ///< M codes and tools
+  MotionCodes motion_{*this};    ///< end points, moves, arcs
 };
 
 }  // namespace opencnc::gcode

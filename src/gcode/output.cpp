@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "gcode_error.hpp"
+#include "opencnc/canon/arc_geometry.hpp"
 
 namespace opencnc::gcode {
 
@@ -31,35 +32,20 @@ Pose Output::map_pose(const Pose& p) const noexcept {
   return out;
 }
 
-namespace {
-// Axis indices (first, second, normal) of a canonical plane.
-std::array<int, 3> plane_axes(canon::Plane p) noexcept {
-  switch (p) {
-    case canon::Plane::XY: return {0, 1, 2};
-    case canon::Plane::YZ: return {1, 2, 0};
-    case canon::Plane::XZ: return {2, 0, 1};
-    case canon::Plane::UV: return {6, 7, 8};
-    case canon::Plane::VW: return {7, 8, 6};
-    case canon::Plane::UW: return {8, 6, 7};
-  }
-  return {0, 1, 2};
-}
-}  // namespace
-
 void Output::map_arc(canon::ArcFeed& arc) const {
   if (identity_map_) return;
-  const auto axes = plane_axes(arc.plane);
-  const int first = index(axis_map_[static_cast<std::size_t>(axes[0])]);
-  const int second = index(axis_map_[static_cast<std::size_t>(axes[1])]);
-  const int normal = index(axis_map_[static_cast<std::size_t>(axes[2])]);
+  const canon::PlaneAxes axes = canon::plane_axes(arc.plane);
+  const int first = index(axis_map_[static_cast<std::size_t>(axes.first)]);
+  const int second = index(axis_map_[static_cast<std::size_t>(axes.second)]);
+  const int normal = index(axis_map_[static_cast<std::size_t>(axes.normal)]);
   static constexpr canon::Plane kPlanes[] = {canon::Plane::XY, canon::Plane::YZ, canon::Plane::XZ,
                                              canon::Plane::UV, canon::Plane::VW, canon::Plane::UW};
   for (canon::Plane p : kPlanes) {
-    const auto t = plane_axes(p);
-    if (t[2] != normal) continue;
-    if (t[0] == first && t[1] == second) {
+    const canon::PlaneAxes t = canon::plane_axes(p);
+    if (t.normal != normal) continue;
+    if (t.first == first && t.second == second) {
       arc.plane = p;
-    } else if (t[0] == second && t[1] == first) {
+    } else if (t.first == second && t.second == first) {
       // Exchanging the plane's two axes mirrors the arc: swap them and reverse the turn.
       arc.plane = p;
       std::swap(arc.first_end, arc.second_end);
@@ -97,16 +83,16 @@ bool Output::enqueue(Queued&& q) {
 }
 
 void Output::move_queued_end(canon::Plane plane, double first, double second) noexcept {
-  const auto axes = plane_axes(plane);
+  const canon::PlaneAxes axes = canon::plane_axes(plane);
   for (Queued& q : queue_) {
     if (q.kind == Queued::Kind::Arc) {
       q.arc.first_end = first;
       q.arc.second_end = second;
-      q.arc.end[axes[0]] = first;
-      q.arc.end[axes[1]] = second;
+      q.arc.end[axes.first] = first;
+      q.arc.end[axes.second] = second;
     } else if (q.kind == Queued::Kind::Traverse || q.kind == Queued::Kind::Feed) {
-      q.pose[axes[0]] = first;
-      q.pose[axes[1]] = second;
+      q.pose[axes.first] = first;
+      q.pose[axes.second] = second;
     }
   }
 }

@@ -48,20 +48,24 @@ const SysName* find_system(std::string_view name) noexcept {
   return (it != kSystem.end() && it->name == name) ? &*it : nullptr;
 }
 
+bool is_predefined(std::string_view name) noexcept {
+  return find_system(name) != nullptr;
+}
+
 }  // namespace
 
-bool Engine::is_predefined(std::string_view name) const noexcept { return find_system(name) != nullptr; }
-
-bool Engine::predefined_value(std::string_view name, double& v) const {
+bool ParameterHost::predefined_value(std::string_view name, double& v) const {
   const SysName* s = find_system(name);
   if (s == nullptr) return false;
-  const ModalState& m = st_.modal;
-  const PositionState& p = st_.position;
+  const ModalState& m = e_.st_.modal;
+  const PositionState& p = e_.st_.position;
   auto b = [](bool x) { return x ? 1.0 : 0.0; };
   switch (s->id) {
     case Sys::Vmajor: v = 2.9; break;
     case Sys::Vminor: v = 0.0; break;
-    case Sys::Line: v = line_; break;
+    case Sys::Line:
+      v = e_.line_.number;
+      break;
     case Sys::MotionMode: v = m.motion; break;
     case Sys::Plane: {
       static constexpr int kCodes[] = {170, 190, 180, 171, 191, 181};
@@ -100,10 +104,18 @@ bool Engine::predefined_value(std::string_view name, double& v) const {
     case Sys::FeedHold: v = b(m.feed_hold); break;
     case Sys::Feed: v = m.feed_rate; break;
     case Sys::Rpm: v = std::abs(m.spindle_speed); break;
-    case Sys::CurrentTool: v = st_.tool.table[0].tool; break;
-    case Sys::CurrentPocket: v = pocket_of(st_.tool.current_index); break;
-    case Sys::SelectedPocket: v = pocket_of(st_.tool.selected_index); break;
-    case Sys::SelectedTool: v = st_.tool.selected_tool; break;
+    case Sys::CurrentTool:
+      v = e_.st_.tool.table[0].tool;
+      break;
+    case Sys::CurrentPocket:
+      v = e_.mcodes_.pocket_of(e_.st_.tool.current_index);
+      break;
+    case Sys::SelectedPocket:
+      v = e_.mcodes_.pocket_of(e_.st_.tool.selected_index);
+      break;
+    case Sys::SelectedTool:
+      v = e_.st_.tool.selected_tool;
+      break;
     case Sys::X: v = p.current[0]; break;
     case Sys::Y: v = p.current[1]; break;
     case Sys::Z: v = p.current[2]; break;
@@ -113,47 +125,59 @@ bool Engine::predefined_value(std::string_view name, double& v) const {
     case Sys::U: v = p.current[6]; break;
     case Sys::V: v = p.current[7]; break;
     case Sys::W: v = p.current[8]; break;
-    case Sys::Value: v = st_.control.return_value; break;
-    case Sys::ValueReturned: v = b(st_.control.value_returned); break;
-    case Sys::CallLevel: v = static_cast<double>(st_.frames.size() - 1); break;
+    case Sys::Value:
+      v = e_.st_.control.return_value;
+      break;
+    case Sys::ValueReturned:
+      v = b(e_.st_.control.value_returned);
+      break;
+    case Sys::CallLevel:
+      v = static_cast<double>(e_.st_.frames.size() - 1);
+      break;
     case Sys::RemapLevel: v = 0; break;
   }
   return true;
 }
 
-bool Engine::named_value(std::string_view name, double& value) {
+bool ParameterHost::named_value(std::string_view name, double& value) {
   if (!name.empty() && name.front() == '_') {
     if (predefined_value(name, value)) return true;
-    auto it = st_.globals.find(name);
-    if (it == st_.globals.end()) return false;
+    auto it = e_.st_.globals.find(name);
+    if (it == e_.st_.globals.end()) return false;
     value = it->second.value;
     return true;
   }
-  const auto& locals = st_.frames.back().locals;
+  const auto& locals = e_.st_.frames.back().locals;
   auto it = locals.find(name);
   if (it == locals.end()) return false;
   value = it->second.value;
   return true;
 }
 
-void Engine::declare_named(std::string_view name) {
+void ParameterHost::declare_named(std::string_view name) {
   if (!name.empty() && name.front() == '_') {
-    if (is_predefined(name) || st_.globals.find(name) != st_.globals.end()) return;
-    st_.globals.emplace(std::string(name), NamedValue{});
+    if (is_predefined(name) || e_.st_.globals.find(name) != e_.st_.globals.end()) return;
+    e_.st_.globals.emplace(std::string(name), NamedValue{});
     return;
   }
-  auto& locals = st_.frames.back().locals;
+  auto& locals = e_.st_.frames.back().locals;
   if (locals.find(name) == locals.end()) locals.emplace(std::string(name), NamedValue{});
 }
 
-void Engine::store_named(const std::string& name, double value) {
+void ParameterHost::store_named(const std::string& name, double value) {
   if (is_predefined(name))
     fail(ErrorCode::ParameterReadOnly, "#<{}> is read-only: the interpreter sets it (choose another name)",
          name);
-  NamedParameters& scope = (!name.empty() && name.front() == '_') ? st_.globals : st_.frames.back().locals;
+  NamedParameters& scope =
+      (!name.empty() && name.front() == '_') ? e_.st_.globals : e_.st_.frames.back().locals;
   NamedValue& v = scope[name];
   v.value = value;
   v.set = true;
+}
+
+// Variables the dialect computes (DialectHooks::computed_variable).
+bool ParameterHost::computed_variable(int index, double& value) {
+  return e_.dialect_.computed_variable != nullptr && e_.dialect_.computed_variable(e_, index, value);
 }
 
 void Engine::update_position_parameters() {

@@ -260,18 +260,18 @@ void Parser::parse(std::string_view text, const ParseEnv& env, Block& b) {
   vacant_assignments.clear();
   Cursor c{text, 0, env};
   if (c.at() == '/') ++c.pos;
-  const bool fanuc = env.fanuc();
-  // Fanuc program numbers: "O1000", ":1000" and "%O1000" on the first line of a file.
-  if (fanuc && c.at() == '%' && (c.at(1) == 'o' || c.at(1) == ':')) ++c.pos;
+  const bool numbered = env.syntax.numbered_programs;
+  // Numbered programs: "O1000", ":1000" and "%O1000" on the first line of a file.
+  if (numbered && c.at() == '%' && (c.at(1) == 'o' || c.at(1) == ':')) ++c.pos;
   if (c.at() == 'n') read_line_number(c, b);
 
-  if (fanuc) {
+  if (numbered) {
     if (read_fanuc_statement(c, b)) return;
   } else if (read_numbered_statement(c, b)) {
     return;
   }
 
-  if (c.at() == 'o' || (fanuc && c.at() == ':')) {
+  if (c.at() == 'o' || (numbered && c.at() == ':')) {
     read_o_word(c, b);
     if (!env.skipping_to.empty()) return;
     while (c.pos < text.size()) {
@@ -436,10 +436,11 @@ void Parser::letter_without_word(const Cursor& c, char letter) {
 
 void Parser::read_comment(Cursor& c, Block& b) {
   const std::size_t start = ++c.pos;
-  int depth = 1;   // Fanuc comments may nest (the lexer checked the parentheses)
+  int depth = 1;  // comments may nest in some dialects (the lexer checked the parentheses)
+  const bool nested = c.env.syntax.nested_comments;
   for (; c.pos < c.text.size(); ++c.pos) {
     const char ch = c.text[c.pos];
-    if (ch == '(' && c.env.fanuc()) ++depth;
+    if (ch == '(' && nested) ++depth;
     if (ch == ')' && --depth == 0) break;
   }
   b.comment = c.text.substr(start, c.pos - start);
@@ -456,17 +457,15 @@ void Parser::read_word(Cursor& c, Block& b, char letter) {
   constexpr std::uint32_t kIntegerLetters = (1u << ('h' - 'a')) | (1u << ('l' - 'a')) | (1u << ('t' - 'a'));
   if ((kIntegerLetters >> (letter - 'a')) & 1u) {
     v = integer_word(c, letter, pos);
-    if (value_vacant_ && c.env.fanuc()) return;
+    if (value_vacant_) return;  // only macro variables are vacant
   } else {
     const std::size_t start = c.pos;
     // A plain number (what real_value would pass on to real_number) read directly.
     const char c0 = c.at(), c1 = c.at(1);
     const bool plain = is_digit(c0) || c0 == '.' || ((c0 == '-' || c0 == '+') && (is_digit(c1) || c1 == '.'));
     v = plain ? real_number(c) : real_value(c);
-    if (c.env.fanuc()) {
-      if (value_vacant_) return;   // Fanuc: a word whose value is a vacant variable is left out
-      note_decimal_point(c, b, letter, start);
-    }
+    if (value_vacant_) return;  // a word whose value is a vacant variable (macro variables only) is left out
+    if (c.env.syntax.decimal_points) note_decimal_point(c, b, letter, start);
     if (v < 0.0 && (letter == 'f' || letter == 's')) negative_rate(letter, v, pos);
     if (letter == 'x' && c.env.lathe_diameter) v /= 2.0;
   }
@@ -487,7 +486,7 @@ void Parser::repeated_word(const Block& b, char letter, int pos) {
 double Parser::integer_word(Cursor& c, char letter, int pos) {
   const char name[2] = {static_cast<char>(letter - 32), '\0'};
   const double v = integer_value(c, name);
-  if (value_vacant_ && c.env.fanuc()) return v;
+  if (value_vacant_) return v;  // only macro variables are vacant
   if (letter == 'h' && v < -1) fail_at(pos, ErrorCode::HWordNegative, "H{}: the tool number of an offset is 0 or more", v);
   if (letter == 'l' && v < 0) fail_at(pos, ErrorCode::LWordNegative, "L{}: an L number cannot be negative", v);
   if (letter == 't' && v < 0) fail_at(pos, ErrorCode::ToolNegative, "T{}: tool numbers are 0 or more", v);
@@ -559,12 +558,12 @@ void Parser::read_g(Cursor& c, Block& b) {
   b.g_at[static_cast<std::size_t>(group)] = position_byte(static_cast<std::size_t>(pos));
 }
 
-// The modal group of a G (×10) or M code: the core's, M98 in the Fanuc dialect, or the one an
-// extension gives a code the core does not know.
+// The modal group of a G (×10) or M code: the core's, M98 where it is a call (SyntaxRules::
+// m98_calls), or the one an extension gives a code the core does not know.
 int Parser::code_group(int code, bool m_code, const ParseEnv& env) const noexcept {
   const int group = m_code ? m_group(code) : g_group(code);
   if (group >= 0) return group;
-  if (m_code && code == 98 && env.fanuc()) return kGroupStop;
+  if (m_code && code == 98 && env.syntax.m98_calls) return kGroupStop;
   if (env.ext == nullptr || code < 0) return -1;
   const CodeHandler* h = nullptr;
   if (m_code && code < static_cast<int>(env.ext->m.size())) h = env.ext->m[static_cast<std::size_t>(code)].get();
@@ -619,7 +618,7 @@ void Parser::read_assignment(Cursor& c) {
     return;
   }
   const int index = integer_value(c, "a parameter number");
-  if (c.env.fanuc()) {
+  if (macro_variables(c)) {
     check_fanuc_assignment(index, pos);
   } else {
     if (index < 1 || index >= kParameterCount)
@@ -632,9 +631,9 @@ void Parser::read_assignment(Cursor& c) {
     fail_at(static_cast<int>(c.pos), ErrorCode::EqualSignMissing,
             "#{} is not followed by '=': write #{}=value", index, index);
   ++c.pos;
-  if (c.env.fanuc()) {
-    // Fanuc: the right-hand side is an expression without brackets (#1 = #1 + 1); a bare
-    // vacant variable makes the target vacant too.
+  if (c.env.syntax.open_assignments) {
+    // The right-hand side is an expression without brackets (#1 = #1 + 1); a bare vacant
+    // variable makes the target vacant too.
     const double v = expression(c, true);
     numbered_assignments.emplace_back(index, v);
     if (value_vacant_) vacant_assignments.push_back(index);
@@ -786,7 +785,7 @@ double Parser::expression(Cursor& c, bool open) {
   bool vacant[8];
   int ops[8];
   int op_pos[8];
-  const bool fanuc = c.env.fanuc();
+  const bool vacancy = macro_variables(c);
   if (!open) ++c.pos;   // '['
   values[0] = real_value(c);
   vacant[0] = value_vacant_;
@@ -805,7 +804,7 @@ double Parser::expression(Cursor& c, bool open) {
     }
     for (;;) {
       const int op = ops[top - 1];
-      if (fanuc && (op == kEq || op == kNe) && (vacant[top - 1] || vacant[top])) {
+      if (vacancy && (op == kEq || op == kNe) && (vacant[top - 1] || vacant[top])) {
         const bool same = vacant[top - 1] && vacant[top];
         values[top - 1] = (op == kEq) == same ? 1.0 : 0.0;
       } else {
@@ -926,9 +925,9 @@ double Parser::unary(Cursor& c) {
     ++c.pos;
     return v;
   }
-  const bool fanuc = c.env.fanuc();
-  if (op == kAtan && fanuc && c.at() == '[') {
-    // Fanuc also writes ATAN[y,x]: read the two halves as open expressions.
+  const bool own = c.env.syntax.own_functions;
+  if (op == kAtan && own && c.at() == '[') {
+    // ATAN[y,x] too: read the two halves as open expressions.
     std::size_t depth = 0, comma = std::string_view::npos, close = c.pos;
     for (; close < c.text.size(); ++close) {
       const char ch2 = c.text[close];
@@ -955,9 +954,9 @@ double Parser::unary(Cursor& c) {
               "ATAN's second argument goes in brackets: ATAN[y]/[x]");
     const double x = expression(c);
     const double angle = static_cast<double>(std::atan2(arg, x) * 180.0L / kPi);   // double atan2, long double scaling
-    return fanuc ? fanuc_unary(kAtan, angle, pos) : angle;
+    return own ? fanuc_unary(kAtan, angle, pos) : angle;
   }
-  return fanuc ? fanuc_unary(op, arg, pos) : apply_unary(op, arg, pos);
+  return own ? fanuc_unary(op, arg, pos) : apply_unary(op, arg, pos);
 }
 
 // The Fanuc functions that differ from LinuxCNC's (Fanuc's defaults): FIX drops the fraction
@@ -1001,8 +1000,8 @@ double Parser::parameter(Cursor& c, bool exists_only) {
   }
   const int index = integer_value(c, "a parameter number");
   if (exists_only) return (index >= 1 && index < kParameterCount) ? 1.0 : 0.0;
-  if (c.env.fanuc()) {
-    // Fanuc: #0 and unassigned locals and commons are vacant (0 in arithmetic); some system
+  if (macro_variables(c)) {
+    // #0 and unassigned locals and commons are vacant (0 in arithmetic); some system
     // variables are computed from the state.
     if (index < 0 || index >= kParameterCount)
       fail_at(pos, ErrorCode::ParameterOutOfRange, "variable #{} does not exist", index);
@@ -1013,7 +1012,7 @@ double Parser::parameter(Cursor& c, bool exists_only) {
     value_vacant_ = false;
     double v = 0;
     try {
-      if (c.env.host->fanuc_variable(index, v)) return v;
+      if (c.env.host->computed_variable(index, v)) return v;
     } catch (GcodeError& e) {
       e.set_position(pos);
       throw;
@@ -1034,7 +1033,7 @@ void Parser::read_o_word(Cursor& c, Block& b) {
   ++c.pos;
   std::string name;
   if (c.at() == '<') {
-    if (c.env.fanuc())
+    if (c.env.syntax.numbered_programs)
       fail_at(pos, ErrorCode::DialectUnsupported, "o<name> is LinuxCNC syntax: Fanuc programs are numbered (O1000)");
     name = read_name(c);
   } else {
@@ -1065,7 +1064,7 @@ void Parser::read_o_word(Cursor& c, Block& b) {
               kOwordKeywords);
     }
     type = OWord::Program;   // "O1234" alone: a program number
-  } else if (c.env.fanuc()) {
+  } else if (c.env.syntax.numbered_programs) {
     fail_at(pos, ErrorCode::DialectUnsupported,
             "O-word statements are LinuxCNC syntax: the Fanuc dialect uses M98/M99, G65, GOTO, IF and WHILE");
   } else if (c.env.skipping_to.empty()) {  // lines passed over are not checked further (LinuxCNC)

@@ -24,11 +24,30 @@ class ParamHost {
   virtual bool named_value(std::string_view name, double& value) = 0;
   /// #<name>=... declares the name while the line is read (LinuxCNC does the same).
   virtual void declare_named(std::string_view name) = 0;
-  /// Fanuc dialect: the value of system variable #index when it is computed rather than
-  /// stored (modal information, positions); false for stored variables. Throws GcodeError
-  /// for variables the dialect does not provide.
-  virtual bool fanuc_variable(int /*index*/, double& /*value*/) { return false; }
+  /// Macro variables (SyntaxRules::macro_variables): the value of system variable #index when
+  /// the dialect computes it rather than stores it (modal information, positions); false for
+  /// stored variables. Throws GcodeError for variables the dialect does not provide.
+  virtual bool computed_variable(int /*index*/, double& /*value*/) { return false; }
 };
+
+/// How a dialect's lines read where they differ from LinuxCNC's, each rule a flag: the dialect's
+/// hooks (dialect_hooks.hpp) give them once when a program opens. LinuxCNC's are all false.
+struct SyntaxRules {
+  /// Programs numbered O1000 (":1000"; "%O1000" on a first line) and the dialect's statements
+  /// (GOTO, IF, WHILE … DO, END, G65: read_fanuc_statement); o<name> and O-word statements are
+  /// another dialect's then.
+  bool numbered_programs = false;
+  bool nested_comments = false;  ///< (a (b) c) is one comment
+  /// Macro variables: #0 and unassigned locals and commons are vacant (0 in arithmetic, a word
+  /// whose value is one left out, equal only to another vacant one), assignments check their own
+  /// ranges, system variables may be computed by the host (ParamHost::computed_variable).
+  bool macro_variables = false;
+  bool decimal_points = false;    ///< a word notes whether it was written with a decimal point
+  bool open_assignments = false;  ///< #1 = #1 + 1: the right-hand side runs to the line's end
+  bool m98_calls = false;         ///< M98 is a subprogram call, in the stop group
+  bool own_functions = false;     ///< FIX, ROUND … and ATAN[y,x] as the dialect defines them
+};
+
 
 /// Interpreter facts that change how a line reads.
 struct ParseEnv {
@@ -43,11 +62,10 @@ struct ParseEnv {
   bool defining_sub = false;            ///< passing over `o<name> sub` .. `endsub`
   std::string_view defining_name;
   std::string_view skipping_to;         ///< label being skipped to ("" = not skipping)
-  Dialect dialect = Dialect::LinuxCnc;
+  SyntaxRules syntax;  ///< the dialect's (a copy: the parser tests a flag per word)
   const Extensions* ext = nullptr;      ///< modal groups of codes the core does not know
-  /// Fanuc: variables #0..#999 without a value.
+  /// Macro variables: #0..#999 without a value.
   const std::bitset<kFanucVariableCount>* vacant = nullptr;
-  bool fanuc() const noexcept { return dialect == Dialect::Fanuc; }
 };
 
 /// Reads blocks. Reuses its buffers; after warm-up a block allocates nothing unless it has
@@ -63,7 +81,7 @@ class Parser {
 
   std::vector<std::pair<int, double>> numbered_assignments;
   std::vector<std::pair<std::string, double>> named_assignments;
-  /// Fanuc: numbered assignments whose value is vacant (`#2 = #0`, `#2 = #1` with #1 vacant).
+  /// Macro variables: numbered assignments whose value is vacant (`#2 = #0`, `#2 = #1` with #1 vacant).
   std::vector<int> vacant_assignments;
 
  private:
@@ -76,6 +94,9 @@ class Parser {
     char at(std::size_t ahead) const noexcept { return pos + ahead < text.size() ? text[pos + ahead] : '\0'; }
   };
 
+  static bool macro_variables(const Cursor& c) noexcept {
+    return c.env.syntax.macro_variables;
+  }
   void read_line_number(Cursor& c, Block& b);
   void read_item(Cursor& c, Block& b);
   [[noreturn, gnu::cold]] static void letter_without_word(const Cursor& c, char letter);
@@ -98,15 +119,15 @@ class Parser {
   static int plain_code(Cursor& c) noexcept;
   [[gnu::always_inline]] inline double real_number(Cursor& c);
   [[noreturn, gnu::cold]] static void bad_number(const char* start, const char* limit, const char* text, bool unreadable);
-  /// A bracketed expression; `open`: a Fanuc assignment's right-hand side, which runs to the
-  /// end of the line or a comment without brackets.
+  /// A bracketed expression; `open`: an open assignment's right-hand side (SyntaxRules::
+  /// open_assignments), which runs to the end of the line or a comment without brackets.
   double expression(Cursor& c, bool open = false);
   double parameter(Cursor& c, bool exists_only);
   double unary(Cursor& c);
   int binary_operator(Cursor& c, bool open);
   int code_group(int code, bool m_code, const ParseEnv& env) const noexcept;
 
-  // fanuc_parse.cpp: the Fanuc dialect's statements
+  // fanuc/parse.cpp: the Fanuc dialect's statements
   bool read_fanuc_statement(Cursor& c, Block& b);
   void read_goto(Cursor& c, Block& b);
   void read_if(Cursor& c, Block& b);
@@ -117,7 +138,7 @@ class Parser {
   void check_fanuc_assignment(int index, int pos) const;
   double fanuc_unary(int op, double x, int pos) const;
 
-  bool value_vacant_ = false;   ///< Fanuc: the last real_value was a bare vacant variable
+  bool value_vacant_ = false;  ///< macro variables: the last real_value was a bare vacant variable
 };
 
 /// G code (×10) → modal group, -1 if unknown. M code → group, -1 if unknown.

@@ -2,13 +2,13 @@
 // Registers the interpreter modules: one line per module, in the order they take effect.
 #include "opencnc/gcode/standard_extensions.hpp"
 
-#include "opencnc/gcode/cutter_comp.hpp"
+#include "dialect_hooks.hpp"
 #include "opencnc/gcode/canned_cycles.hpp"
-#include "opencnc/gcode/probing.hpp"
-#include "opencnc/gcode/threading.hpp"
+#include "opencnc/gcode/cutter_comp.hpp"
 #include "opencnc/gcode/lathe_cycles.hpp"
+#include "opencnc/gcode/probing.hpp"
 #include "opencnc/gcode/splines.hpp"
-#include "fanuc_codes.hpp"
+#include "opencnc/gcode/threading.hpp"
 
 namespace opencnc::gcode {
 
@@ -20,7 +20,7 @@ std::shared_ptr<const Extensions> standard_extensions(Dialect dialect) {
   add_probing(*ext);
   add_splines(*ext);
   add_lathe_cycles(*ext);
-  if (dialect == Dialect::Fanuc) add_fanuc_codes(*ext);
+  if (const auto add = dialect_hooks(dialect).add_codes) add(*ext);  // the dialect's own
   return ext;
 }
 

@@ -6,23 +6,12 @@
 #include <cmath>
 #include <memory>
 
-#include "fanuc_codes.hpp"
+#include "fanuc/codes.hpp"
 #include "gcode_error.hpp"
+#include "opencnc/canon/arc_geometry.hpp"
 #include "opencnc/gcode/extension.hpp"
 
 namespace opencnc::gcode {
-
-std::array<int, 3> plane_axis_indices(canon::Plane p) noexcept {
-  switch (p) {
-    case canon::Plane::XY: return {0, 1, 2};
-    case canon::Plane::YZ: return {1, 2, 0};
-    case canon::Plane::XZ: return {2, 0, 1};
-    case canon::Plane::UV: return {6, 7, 8};
-    case canon::Plane::VW: return {7, 8, 6};
-    case canon::Plane::UW: return {8, 6, 7};
-  }
-  return {0, 1, 2};
-}
 
 void sin_cos_deg(double degrees, double& s, double& c) noexcept {
   const double turns = degrees / 90.0;
@@ -63,34 +52,34 @@ Pose transform_point(const TransformState& t, const Pose& p, TransformStage last
     for (int i = 0; i < 3; ++i) q[i] = t.scale_centre[i] + t.scale[static_cast<std::size_t>(i)] * (q[i] - t.scale_centre[i]);
   }
   if (t.rotating && has_stage(last, TransformStage::Rotate)) {
-    const auto axes = plane_axis_indices(t.rotation_plane);
+    const canon::PlaneAxes axes = canon::plane_axes(t.rotation_plane);
     double s, c;
     sin_cos_deg(t.rotation_deg, s, c);
-    const double d1 = q[axes[0]] - t.rotation_centre1;
-    const double d2 = q[axes[1]] - t.rotation_centre2;
-    q[axes[0]] = t.rotation_centre1 + d1 * c - d2 * s;
-    q[axes[1]] = t.rotation_centre2 + d1 * s + d2 * c;
+    const double d1 = q[axes.first] - t.rotation_centre1;
+    const double d2 = q[axes.second] - t.rotation_centre2;
+    q[axes.first] = t.rotation_centre1 + d1 * c - d2 * s;
+    q[axes.second] = t.rotation_centre2 + d1 * s + d2 * c;
   }
   return q;
 }
 
 ArcTransform transform_arc(const TransformState& t, canon::ArcFeed& arc) noexcept {
-  const auto axes = plane_axis_indices(arc.plane);
-  const double s1 = scale_of(t, axes[0]), s2 = scale_of(t, axes[1]);
+  const canon::PlaneAxes axes = canon::plane_axes(arc.plane);
+  const double s1 = scale_of(t, axes.first), s2 = scale_of(t, axes.second);
   if (std::fabs(std::fabs(s1) - std::fabs(s2)) > 1e-12 * std::max(std::fabs(s1), std::fabs(s2)))
     return ArcTransform::NonUniformScale;
   if (t.rotating && t.rotation_plane != arc.plane) return ArcTransform::OtherPlane;
   Pose centre = arc.end;
-  centre[axes[0]] = arc.first_center;
-  centre[axes[1]] = arc.second_center;
+  centre[axes.first] = arc.first_center;
+  centre[axes.second] = arc.second_center;
   const Pose end = transform_point(t, arc.end);
   const Pose c = transform_point(t, centre);
-  const bool flip = (mirrored(t, axes[0]) != mirrored(t, axes[1])) != ((s1 < 0.0) != (s2 < 0.0));
-  arc.first_end = end[axes[0]];
-  arc.second_end = end[axes[1]];
-  arc.axis_end = end[axes[2]];
-  arc.first_center = c[axes[0]];
-  arc.second_center = c[axes[1]];
+  const bool flip = (mirrored(t, axes.first) != mirrored(t, axes.second)) != ((s1 < 0.0) != (s2 < 0.0));
+  arc.first_end = end[axes.first];
+  arc.second_end = end[axes.second];
+  arc.axis_end = end[axes.normal];
+  arc.first_center = c[axes.first];
+  arc.second_center = c[axes.second];
   arc.end = end;
   if (flip) arc.rotation = -arc.rotation;
   return ArcTransform::Ok;
@@ -197,9 +186,9 @@ class RotateOn final : public CodeHandler {
     const canon::Plane p = b.g[kGroupPlane] != -1 ? plane_of(b.g[kGroupPlane]) : s.modal.plane;
     if (p != canon::Plane::XY && p != canon::Plane::XZ && p != canon::Plane::YZ)
       return Rejection{ErrorCode::FanucRotationPlane, "G68 rotates in the XY, ZX or YZ plane only (G17, G18, G19)"};
-    const auto axes = plane_axis_indices(p);
+    const canon::PlaneAxes axes = canon::plane_axes(p);
     for (int i = 0; i < kAxisCount; ++i) {
-      if (b.has(kLetters[i]) && i != axes[0] && i != axes[1])
+      if (b.has(kLetters[i]) && i != axes.first && i != axes.second)
         return Rejection{ErrorCode::UnusedWord,
                          fmt::format("{} word with G68: the centre is given in the plane's two axes", static_cast<char>(kLetters[i] - 32))};
     }
@@ -208,15 +197,15 @@ class RotateOn final : public CodeHandler {
   void execute(ExecContext& ctx, const Block& b, int) override {
     InterpState& s = ctx.state();
     TransformState& t = s.fanuc.transform;
-    const auto axes = plane_axis_indices(s.modal.plane);
+    const canon::PlaneAxes axes = canon::plane_axes(s.modal.plane);
     Pose centre = s.position.current;
-    centre[axes[0]] = centre_word(s, b, axes[0]);
-    centre[axes[1]] = centre_word(s, b, axes[1]);
+    centre[axes.first] = centre_word(s, b, axes.first);
+    centre[axes.second] = centre_word(s, b, axes.second);
     // Fanuc scales (and mirrors) the centre of a rotation programmed while G51 (G51.1) is on.
     const Pose c = transform_point(t, centre, TransformStage::Scale);
     t.rotation_plane = s.modal.plane;
-    t.rotation_centre1 = c[axes[0]];
-    t.rotation_centre2 = c[axes[1]];
+    t.rotation_centre1 = c[axes.first];
+    t.rotation_centre2 = c[axes.second];
     t.rotation_deg = b.get('r');
     t.rotating = true;
   }
@@ -243,11 +232,12 @@ class FanucTransform final : public CoordinateTransform {
     switch (transform_arc(t, a)) {
       case ArcTransform::Ok: return;
       case ArcTransform::NonUniformScale: {
-        const auto axes = plane_axis_indices(a.plane);
+        const canon::PlaneAxes axes = canon::plane_axes(a.plane);
         fail(ErrorCode::FanucArcNonUniformScale,
-             "G51 scales {} by {} and {} by {}: an arc in that plane would become an ellipse (use equal factors)",
-             letter(static_cast<Axis>(axes[0])), scale_of(t, axes[0]), letter(static_cast<Axis>(axes[1])),
-             scale_of(t, axes[1]));
+             "G51 scales {} by {} and {} by {}: an arc in that plane would become an ellipse (use equal "
+             "factors)",
+             letter(static_cast<Axis>(axes.first)), scale_of(t, axes.first),
+             letter(static_cast<Axis>(axes.second)), scale_of(t, axes.second));
       }
       case ArcTransform::OtherPlane:
         fail(ErrorCode::FanucRotationPlaneChange, "an arc outside the plane of the G68 rotation");

@@ -55,7 +55,7 @@ struct Component {
   int comp_id = -1;
   hal::MachinePins* pins = nullptr;  // in HAL shared memory (halcmd relinks the pointers)
   StatusPins* status = nullptr;
-  std::unique_ptr<control::SharedMemory> segment;
+  std::unique_ptr<control::SegmentMapping> segment;
   std::unique_ptr<hal::HalMachine> machine;
   std::unique_ptr<control::SharedServoHost> host;  // built before the thread runs
   bool period_known = false;
@@ -212,7 +212,7 @@ extern "C" int rtapi_app_main(void) {
     return fail(c, "cannot create the pins");
   std::string error;
   const std::string name = shm != nullptr && shm[0] != '\0' ? shm : "/opencnc";
-  c->segment = control::SharedMemory::create(name, 0, 1, error);
+  c->segment = control::SegmentMapping::create(name, 0, 1, error);
   if (!c->segment) return fail(c, error.c_str());
   c->machine = std::make_unique<hal::HalMachine>(*c->pins);
   c->host = std::make_unique<control::SharedServoHost>(c->segment->segment(), *c->machine);

@@ -9,8 +9,8 @@
 #include <fmt/format.h>
 
 #include "opencnc/control/command.hpp"
-#include "opencnc/controller/run_from_line.hpp"
 #include "opencnc/hmi/api_admin.hpp"
+#include "opencnc/run_from_line/run_from_line.hpp"
 #include "opencnc/tools/tool_data.hpp"
 
 namespace opencnc::hmi {

@@ -9,10 +9,10 @@
 
 #include <fmt/format.h>
 
-#include "opencnc/controller/electrode_setting.hpp"
+#include "opencnc/broaching/breakpoint_journal.hpp"
+#include "opencnc/edm/electrode_setting.hpp"
 #include "opencnc/hmi/api.hpp"
-#include "opencnc/recovery/breakpoint_journal.hpp"
-#include "opencnc/recovery/retrace.hpp"
+#include "opencnc/retrace/retrace.hpp"
 
 namespace opencnc::hmi {
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The toolpath of a program as polylines for the HMI's 3D view.
+// The toolpath of a program as polylines for the HMI's 3D view, as the program source makes it.
 #include "opencnc/hmi/preview.hpp"
 
 #include <cmath>
@@ -7,8 +7,8 @@
 #include <set>
 #include <vector>
 
-#include "opencnc/canon/program_builder.hpp"
-#include "opencnc/gcode/interpreter.hpp"
+#include "opencnc/canon/arc_geometry.hpp"
+#include "opencnc/core/vec3.hpp"
 
 namespace opencnc::hmi {
 
@@ -18,25 +18,21 @@ using nlohmann::json;
 
 constexpr double kChordDeg = 5;  ///< an arc is drawn with a chord every this many degrees
 
-/// Appends the points of arc `id` after its start (chords every kChordDeg, the helix linear).
+/// Appends the points of arc `id` after its start (chords every kChordDeg, the helix linear). An
+/// arc of the U V W planes moves X Y Z along a line: its end point only.
 void arc_points(const canon::Program& p, canon::SegmentId id, std::vector<double>& out) {
   const canon::ArcGeometry& g = p.arc(id);
   const Pose s = p.start_of(id), e = p.end(id);
-  const double c[3] = {g.center[0], g.center[1], g.center[2]};
-  const double n[3] = {g.normal[0], g.normal[1], g.normal[2]};
-  const double r0[3] = {s[0] - c[0], s[1] - c[1], s[2] - c[2]};
-  const double along0 = r0[0] * n[0] + r0[1] * n[1] + r0[2] * n[2];
-  const double u[3] = {r0[0] - along0 * n[0], r0[1] - along0 * n[1], r0[2] - along0 * n[2]};
-  const double v[3] = {n[1] * u[2] - n[2] * u[1], n[2] * u[0] - n[0] * u[2], n[0] * u[1] - n[1] * u[0]};
-  const double re[3] = {e[0] - c[0], e[1] - c[1], e[2] - c[2]};
-  const double radius2 = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
-  const double along_e = re[0] * n[0] + re[1] * n[1] + re[2] * n[2];
-  double sweep = radius2 > 0 ? std::atan2((re[0] * v[0] + re[1] * v[1] + re[2] * v[2]) / radius2,
-                                          (re[0] * u[0] + re[1] * u[1] + re[2] * u[2]) / radius2)
-                             : 0.0;
-  if (sweep <= 1e-9) sweep += 2 * std::numbers::pi;
-  sweep += 2 * std::numbers::pi * (std::abs(g.turns) - 1);
-  const int steps = std::max(1, static_cast<int>(std::ceil(sweep * 180 / std::numbers::pi / kChordDeg)));
+  const Vec3 &c = g.center, &n = g.normal;
+  const Vec3 r0 = take3(s) - c, re = take3(e) - c;
+  const double along0 = dot(r0, n), along_e = dot(re, n);
+  const Vec3 u = r0 - along0 * n, v = cross(n, u);
+  const double radius2 = dot(u, u);
+  const double sweep = canon::plane_base(g.plane) == 0 && radius2 > 0
+                           ? canon::arc_sweep(std::atan2(dot(re, v) / radius2, dot(re, u) / radius2), g.turns)
+                           : 0.0;
+  const int steps =
+      std::max(1, static_cast<int>(std::ceil(std::fabs(sweep) * 180 / std::numbers::pi / kChordDeg)));
   for (int k = 1; k < steps; ++k) {
     const double t = static_cast<double>(k) / steps, a = sweep * t;
     const double along = along0 + (along_e - along0) * t;
@@ -45,70 +41,73 @@ void arc_points(const canon::Program& p, canon::SegmentId id, std::vector<double
   for (int i = 0; i < 3; ++i) out.push_back(e[i]);
 }
 
-/// The tools the program puts in the spindle (M6 after a T, M61 Q), each once, in number order.
-std::vector<int> program_tools(const canon::Program& p) {
-  std::set<int> tools;
-  int selected = 0;
-  for (std::size_t a = 0; a < p.action_count(); ++a) {
-    const canon::Action& x = p.action(a);
-    if (x.kind == canon::ActionKind::SelectTool) selected = x.index;
-    if (x.kind == canon::ActionKind::ChangeTool && selected > 0) tools.insert(selected);
-    if (x.kind == canon::ActionKind::ChangeToolNumber && x.index > 0) tools.insert(x.index);
+/// Builds the polylines (rapids and feeds apart) and notes the tools the program puts in the
+/// spindle (M6 after a T, M61 Q), as the scan shows them; stops after `max_moves` moves.
+class PreviewReader final : public control::ScanReader {
+ public:
+  PreviewReader(const Pose& start, std::size_t max_moves) : max_moves_(max_moves) {
+    pts_ = {start[0], start[1], start[2]};
   }
-  return {tools.begin(), tools.end()};
-}
+  bool action(const canon::Program& p, std::size_t index) override {
+    const canon::Action& x = p.action(index);
+    if (x.kind == canon::ActionKind::SelectTool) selected_ = x.index;
+    if (x.kind == canon::ActionKind::ChangeTool && selected_ > 0) tools_.insert(selected_);
+    if (x.kind == canon::ActionKind::ChangeToolNumber && x.index > 0) tools_.insert(x.index);
+    return true;
+  }
+  bool move(const canon::Program& p, canon::SegmentId id) override {
+    if (moves_ >= max_moves_) {
+      truncated_ = true;
+      return false;
+    }
+    ++moves_;
+    const canon::Move& m = p.move(id);
+    const bool r = m.kind == canon::MoveKind::Traverse;
+    if (r != rapid_) {
+      flush();
+      rapid_ = r;
+    }
+    if (m.kind == canon::MoveKind::Arc) {
+      arc_points(p, id, pts_);
+    } else {
+      const Pose e = p.end(id);
+      pts_.insert(pts_.end(), {e[0], e[1], e[2]});
+    }
+    return true;
+  }
+  json result(json diagnostics) {
+    flush();
+    return {{"polylines", lines_},
+            {"moves", moves_},
+            {"truncated", truncated_},
+            {"diagnostics", std::move(diagnostics)},
+            {"tools", std::vector<int>(tools_.begin(), tools_.end())}};
+  }
+
+ private:
+  void flush() {
+    if (pts_.size() > 3) lines_.push_back({{"rapid", rapid_}, {"points", pts_}});
+    pts_.assign(pts_.end() - 3, pts_.end());
+  }
+
+  std::size_t max_moves_;
+  std::size_t moves_ = 0;
+  bool truncated_ = false, rapid_ = false;
+  std::vector<double> pts_;
+  json lines_ = json::array();
+  int selected_ = 0;
+  std::set<int> tools_;
+};
 
 }  // namespace
 
 json program_preview(const control::GcodeProgramSource& source, const std::string& path, const Pose& start,
                      std::size_t max_moves) {
-  gcode::Options options = source.options_for(path, {});
-  options.mode = gcode::Mode::Scan;
-  gcode::Interpreter interp(options);
-  canon::ProgramBuilder builder(kXyzabc, start);
+  PreviewReader reader(start, max_moves);
+  const Diagnostics d = source.scan(path, start, {}, reader);
   json diags = json::array();
-  bool truncated = false;
-  if (interp.open(path)) {
-    for (;;) {
-      const gcode::RunStatus rs = interp.run(builder, 1000);
-      if (rs != gcode::RunStatus::Ok) break;
-      if (builder.program().size() >= max_moves) {
-        truncated = true;
-        break;
-      }
-    }
-  }
-  for (const Diagnostic& d : interp.diagnostics().items()) diags.push_back(d.format());
-  const canon::Program& p = builder.program();
-  json lines = json::array();
-  std::vector<double> pts;
-  bool rapid = false;
-  auto flush = [&] {
-    if (pts.size() > 3) lines.push_back({{"rapid", rapid}, {"points", pts}});
-    pts.assign(pts.end() - 3, pts.end());
-  };
-  const Pose s = p.start();
-  pts = {s[0], s[1], s[2]};
-  for (canon::SegmentId id = 0; id < p.size(); ++id) {
-    const canon::Move& m = p.move(id);
-    const bool r = m.kind == canon::MoveKind::Traverse;
-    if (r != rapid) {
-      flush();
-      rapid = r;
-    }
-    if (m.kind == canon::MoveKind::Arc) {
-      arc_points(p, id, pts);
-    } else {
-      const Pose e = p.end(id);
-      pts.insert(pts.end(), {e[0], e[1], e[2]});
-    }
-  }
-  flush();
-  return {{"polylines", lines},
-          {"moves", p.size()},
-          {"truncated", truncated},
-          {"diagnostics", diags},
-          {"tools", program_tools(p)}};
+  for (const Diagnostic& x : d.items()) diags.push_back(x.format());
+  return reader.result(std::move(diags));
 }
 
 }  // namespace opencnc::hmi

@@ -221,18 +221,63 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
   void audit(const std::string& remote, std::optional<Role> role, const HttpRequest& req, int status,
              std::string result);
 
-  // Routes (docs/api.md).
+  // --- routes (docs/api.md) ---
+  /// Who may call a route.
+  enum class Access : std::uint8_t {
+    Anyone,           ///< no token asked: the front end's files, the answer naming the API's version
+    Token,            ///< a valid token, either role
+    TokenOrLoopback,  ///< a token, or a GET to a server that listens on loopback only
+    Admin,            ///< the admin's token (another role: 403, audited)
+  };
+  /// Where a route's answer is made.
+  enum class Runs : std::uint8_t {
+    Io,        ///< on the io thread: it reads memory only
+    Blocking,  ///< on the blocking pool: it reads a file or the database
+  };
+  /// A route's answer, made at once (where `Runs` says): the role is the caller's (Operator for an
+  /// unauthenticated loopback GET).
+  using Answer = HttpResponse (Impl::*)(const HttpRequest&, const Target&, Role);
+  /// A route that sends its answer itself, later (a command waits for the controller's answer).
+  using Start = void (Impl::*)(const std::shared_ptr<HttpSession>&, const HttpRequest&, Role);
+  /// One row of the route table: a request whose path matches is answered by this row alone.
+  struct Route {
+    std::uint8_t methods;   ///< bits of Method: what it answers; others get 405
+    std::string_view path;  ///< the path, or its beginning when `prefix`
+    bool prefix = false;
+    Access access = Access::Token;
+    Runs runs = Runs::Io;
+    std::string_view wrong_method = "only GET here";  ///< the 405's words
+    std::string_view admin_only = {};                 ///< Admin: what the 403 names ("the audit trail")
+    Answer answer = nullptr;                          ///< or:
+    Start start = nullptr;
+  };
+  enum Method : std::uint8_t { kGet = 1, kHead = 2, kPost = 4, kAnyMethod = 0xff };
+  /// The route for `path`: the first row of the table that matches (the last one matches all).
+  static const Route& route_for(std::string_view path) noexcept;
+
   void command(const std::shared_ptr<HttpSession>& s, const HttpRequest& req, Role role);
+  void stream_ticket(const std::shared_ptr<HttpSession>& s, const HttpRequest& req, Role role);
+  void preview(const std::shared_ptr<HttpSession>& s, const HttpRequest& req, Role role);
   void wait_outcome(const std::shared_ptr<HttpSession>& s, HttpRequest req, std::uint64_t id,
                     std::chrono::steady_clock::time_point deadline, bool profile_edit = false);
   HttpResponse tool_change(const HttpRequest& req, const ToolChange& c);
-  HttpResponse get(const HttpRequest& req, const Target& t, Role role);
-  HttpResponse program_info(const HttpRequest& req);
-  HttpResponse program_text(const HttpRequest& req, const Target& t);
-  void preview(const std::shared_ptr<HttpSession>& s, const HttpRequest& req);
-  HttpResponse programs(const HttpRequest& req);
-  HttpResponse tools_table(const HttpRequest& req);
-  HttpResponse static_file(const HttpRequest& req, const Target& t);
+  HttpResponse status(const HttpRequest& req, const Target& t, Role role);
+  HttpResponse machine_info(const HttpRequest& req, const Target& t, Role role);
+  HttpResponse parameters(const HttpRequest& req, const Target& t, Role role);
+  HttpResponse compensation(const HttpRequest& req, const Target& t, Role role);
+  HttpResponse conditions(const HttpRequest& req, const Target& t, Role role);
+  HttpResponse program_info(const HttpRequest& req, const Target& t, Role role);
+  HttpResponse program_text(const HttpRequest& req, const Target& t, Role role);
+  HttpResponse programs(const HttpRequest& req, const Target& t, Role role);
+  HttpResponse tools_table(const HttpRequest& req, const Target& t, Role role);
+  HttpResponse events(const HttpRequest& req, const Target& t, Role role);
+  HttpResponse command_outcome(const HttpRequest& req, const Target& t, Role role);
+  HttpResponse history_jobs(const HttpRequest& req, const Target& t, Role role);
+  HttpResponse audit_trail(const HttpRequest& req, const Target& t, Role role);
+  HttpResponse server_info(const HttpRequest& req, const Target& t, Role role);
+  HttpResponse no_such_call(const HttpRequest& req, const Target& t, Role role);
+  HttpResponse other_version(const HttpRequest& req, const Target& t, Role role);
+  HttpResponse static_file(const HttpRequest& req, const Target& t, Role role);
   std::string relative_program(const std::string& path) const;
 };
 
@@ -449,130 +494,196 @@ void Server::Impl::audit(const std::string& remote, std::optional<Role> role, co
                   req.body(), status, std::move(result)});
 }
 
+// The route table: what each path answers, who may call it, where its answer is made. The first
+// row that matches a request's path is its route; the WebSocket stream is upgraded before this
+// (upgrade()).
+const Server::Impl::Route& Server::Impl::route_for(std::string_view path) noexcept {
+  using I = Impl;
+  static constexpr Route kRoutes[] = {
+      {.methods = kGet, .path = "/api/v1/status", .access = Access::TokenOrLoopback, .answer = &I::status},
+      {.methods = kGet, .path = "/api/v1/machine", .answer = &I::machine_info},
+      {.methods = kGet, .path = "/api/v1/parameters", .answer = &I::parameters},
+      {.methods = kGet, .path = "/api/v1/compensation", .answer = &I::compensation},
+      {.methods = kGet, .path = "/api/v1/conditions", .answer = &I::conditions},
+      {.methods = kGet, .path = "/api/v1/program", .answer = &I::program_info},
+      {.methods = kGet, .path = "/api/v1/program/text", .runs = Runs::Blocking, .answer = &I::program_text},
+      {.methods = kGet, .path = "/api/v1/program/preview", .start = &I::preview},
+      {.methods = kGet, .path = "/api/v1/programs", .runs = Runs::Blocking, .answer = &I::programs},
+      {.methods = kGet, .path = "/api/v1/tools", .answer = &I::tools_table},
+      {.methods = kGet, .path = "/api/v1/events", .answer = &I::events},
+      {.methods = kPost,
+       .path = "/api/v1/commands",
+       .wrong_method = "commands are POSTed",
+       .start = &I::command},
+      {.methods = kGet, .path = "/api/v1/commands/", .prefix = true, .answer = &I::command_outcome},
+      {.methods = kPost,
+       .path = "/api/v1/stream-ticket",
+       .wrong_method = "stream tickets are POSTed",
+       .start = &I::stream_ticket},
+      {.methods = kGet, .path = "/api/v1/history", .runs = Runs::Blocking, .answer = &I::history_jobs},
+      {.methods = kGet,
+       .path = "/api/v1/audit",
+       .access = Access::Admin,
+       .runs = Runs::Blocking,
+       .admin_only = "the audit trail",
+       .answer = &I::audit_trail},
+      {.methods = kGet, .path = "/api/v1/server", .answer = &I::server_info},
+      // Any other call of this version: a token first, then GET, then "no such call".
+      {.methods = kGet, .path = "/api/v1/", .prefix = true, .answer = &I::no_such_call},
+      {.methods = kAnyMethod,
+       .path = "/api/",
+       .prefix = true,
+       .access = Access::Anyone,
+       .answer = &I::other_version},
+      // Everything else is the front end's files.
+      {.methods = kGet | kHead,
+       .path = "/",
+       .prefix = true,
+       .access = Access::Anyone,
+       .runs = Runs::Blocking,
+       .answer = &I::static_file},
+  };
+  for (const Route& r : kRoutes) {
+    if (r.prefix ? path.starts_with(r.path) : path == r.path) return r;
+  }
+  return kRoutes[std::size(kRoutes) - 1];  // a path that does not start with '/': a file not found
+}
+
 void Server::Impl::handle(const std::shared_ptr<HttpSession>& s, HttpRequest req) {
   ++http_requests;
   const Target t = parse_target(sv(req.target()));
-  if (!t.path.starts_with("/api/")) {
-    if (req.method() != http::verb::get && req.method() != http::verb::head) {
-      return s->send(error_response(req, 405, "only GET here"));
+  const Route& r = route_for(t.path);
+  std::optional<Role> role;
+  if (r.access != Access::Anyone) {
+    role = tokens.role_of(token_of(req));
+    const bool open = r.access == Access::TokenOrLoopback && req.method() == http::verb::get && loopback;
+    if (!role && !open) {
+      audit(s->remote(), role, req, 401, token_of(req).empty() ? "no token" : "no valid token");
+      return s->send(error_response(req, 401, "a valid token is needed (Authorization: Bearer TOKEN)"));
     }
-    return off_io(s, [self = shared_from_this(), req, t] { return self->static_file(req, t); });
   }
-  if (!t.path.starts_with("/api/v1/"))
-    return s->send(error_response(req, 404, "this server speaks /api/v1/"));
-  const std::optional<Role> role = tokens.role_of(token_of(req));
-  const bool is_get = req.method() == http::verb::get;
-  if (!role && !(is_get && t.path == "/api/v1/status" && loopback)) {
-    audit(s->remote(), role, req, 401, token_of(req).empty() ? "no token" : "no valid token");
-    return s->send(error_response(req, 401, "a valid token is needed (Authorization: Bearer TOKEN)"));
+  const std::uint8_t method = req.method() == http::verb::get    ? kGet
+                              : req.method() == http::verb::head ? kHead
+                              : req.method() == http::verb::post ? kPost
+                                                                 : 0x80;  // only kAnyMethod has it
+  if ((r.methods & method) == 0) return s->send(error_response(req, 405, std::string(r.wrong_method)));
+  if (r.access == Access::Admin && role != Role::Admin) {
+    audit(s->remote(), role, req, 403, "needs the admin role");
+    return s->send(error_response(req, 403, fmt::format("{} is for the admin", r.admin_only)));
   }
-  if (t.path == "/api/v1/commands") {
-    if (req.method() != http::verb::post) return s->send(error_response(req, 405, "commands are POSTed"));
-    return command(s, req, *role);
-  }
-  if (t.path == "/api/v1/stream-ticket") {
-    if (req.method() != http::verb::post) return s->send(error_response(req, 405, "stream tickets are POSTed"));
-    std::string error;
-    const auto ticket = tickets.issue(*role, StreamTickets::Clock::now(), &error);
-    if (!ticket) return s->send(error_response(req, 503, error));
-    return s->send(
-        json_response(req, 200, {{"ticket", *ticket}, {"expires_in_s", StreamTickets::kLifetime.count()}}));
-  }
-  if (!is_get) return s->send(error_response(req, 405, "only GET here"));
-  if (t.path == "/api/v1/program/preview") return preview(s, req);
-  // What reads a file or the database goes off the io thread; the rest is in memory.
-  const bool reads_disk = t.path == "/api/v1/program/text" || t.path == "/api/v1/programs" ||
-                          t.path == "/api/v1/history" || t.path == "/api/v1/audit";
-  auto answer = [self = shared_from_this(), s, req, t, role] {
-    HttpResponse res = self->get(req, t, role.value_or(Role::Operator));
-    if (res.result_int() == 403) self->audit(s->remote(), role, req, 403, "needs the admin role");
-    return res;
-  };
-  if (reads_disk) return off_io(s, std::move(answer));
+  const Role as = role.value_or(Role::Operator);
+  if (r.start != nullptr) return (this->*r.start)(s, req, as);
+  auto answer = [self = shared_from_this(), req, t, as, a = r.answer] { return ((*self).*a)(req, t, as); };
+  if (r.runs == Runs::Blocking) return off_io(s, std::move(answer));
   s->send(answer());
 }
 
-HttpResponse Server::Impl::get(const HttpRequest& req, const Target& t, Role role) {
-  const std::string& p = t.path;
-  if (p == "/api/v1/status") return json_response(req, 200, status_object());
-  if (p == "/api/v1/machine") return json_response(req, 200, machine_json(*machine()));
-  if (p == "/api/v1/parameters") return json_response(req, 200, parameters_json(*machine()));
-  if (p == "/api/v1/compensation") return json_response(req, 200, compensation_json(*machine()));
-  if (p == "/api/v1/conditions") return json_response(req, 200, conditions_json(*machine()));
-  if (p == "/api/v1/program") return program_info(req);
-  if (p == "/api/v1/program/text") return program_text(req, t);
-  if (p == "/api/v1/programs") return programs(req);
-  if (p == "/api/v1/tools") return tools_table(req);
-  if (p == "/api/v1/events") {
-    const auto after = static_cast<std::uint64_t>(query_int(t, "after", 0, 0, INT32_MAX));
-    const auto max = static_cast<std::size_t>(query_int(t, "max", 1000, 1, 4096));
-    std::uint64_t lost = 0;
-    json list = json::array();
-    for (const auto& e : controller.events().read_after(after, max, &lost)) list.push_back(event_json(e));
-    return json_response(req, 200, {{"events", list}, {"lost", lost}, {"last", controller.events().last()}});
+void Server::Impl::stream_ticket(const std::shared_ptr<HttpSession>& s, const HttpRequest& req, Role role) {
+  std::string error;
+  const auto ticket = tickets.issue(role, StreamTickets::Clock::now(), &error);
+  if (!ticket) return s->send(error_response(req, 503, error));
+  s->send(json_response(req, 200, {{"ticket", *ticket}, {"expires_in_s", StreamTickets::kLifetime.count()}}));
+}
+
+HttpResponse Server::Impl::status(const HttpRequest& req, const Target&, Role) {
+  return json_response(req, 200, status_object());
+}
+
+HttpResponse Server::Impl::machine_info(const HttpRequest& req, const Target&, Role) {
+  return json_response(req, 200, machine_json(*machine()));
+}
+
+HttpResponse Server::Impl::parameters(const HttpRequest& req, const Target&, Role) {
+  return json_response(req, 200, parameters_json(*machine()));
+}
+
+HttpResponse Server::Impl::compensation(const HttpRequest& req, const Target&, Role) {
+  return json_response(req, 200, compensation_json(*machine()));
+}
+
+HttpResponse Server::Impl::conditions(const HttpRequest& req, const Target&, Role) {
+  return json_response(req, 200, conditions_json(*machine()));
+}
+
+HttpResponse Server::Impl::events(const HttpRequest& req, const Target& t, Role) {
+  const auto after = static_cast<std::uint64_t>(query_int(t, "after", 0, 0, INT32_MAX));
+  const auto max = static_cast<std::size_t>(query_int(t, "max", 1000, 1, 4096));
+  std::uint64_t lost = 0;
+  json list = json::array();
+  for (const auto& e : controller.events().read_after(after, max, &lost)) list.push_back(event_json(e));
+  return json_response(req, 200, {{"events", list}, {"lost", lost}, {"last", controller.events().last()}});
+}
+
+HttpResponse Server::Impl::command_outcome(const HttpRequest& req, const Target& t, Role) {
+  std::uint64_t id = 0;
+  try {
+    id = std::stoull(t.path.substr(std::string_view("/api/v1/commands/").size()));
+  } catch (const std::exception&) {
+    return error_response(req, 400, "a command id is a number");
   }
-  if (p.starts_with("/api/v1/commands/")) {
-    std::uint64_t id = 0;
-    try {
-      id = std::stoull(p.substr(17));
-    } catch (const std::exception&) {
-      return error_response(req, 400, "a command id is a number");
-    }
-    if (const auto o = controller.outcome(id)) return json_response(req, 200, outcome_json(id, *o));
-    return error_response(req, 404, fmt::format("no answer to command {} (yet)", id));
+  if (const auto o = controller.outcome(id)) return json_response(req, 200, outcome_json(id, *o));
+  return error_response(req, 404, fmt::format("no answer to command {} (yet)", id));
+}
+
+HttpResponse Server::Impl::history_jobs(const HttpRequest& req, const Target& t, Role) {
+  if (!history) return json_response(req, 200, json::array());
+  json list = json::array();
+  for (const JobRecord& r : history->jobs(query_int(t, "limit", 50, 1, 1000))) {
+    list.push_back({{"id", r.id},
+                    {"job_id", r.job_id},
+                    {"kind", r.kind},
+                    {"program", r.program},
+                    {"started", r.started_utc},
+                    {"ended", r.ended_utc},
+                    {"outcome", r.outcome},
+                    {"machining_s", r.machining_s},
+                    {"end_line", r.end_line},
+                    {"alarms", r.alarms}});
   }
-  if (p == "/api/v1/history") {
-    if (!history) return json_response(req, 200, json::array());
-    json list = json::array();
-    for (const JobRecord& r : history->jobs(query_int(t, "limit", 50, 1, 1000))) {
+  return json_response(req, 200, list);
+}
+
+HttpResponse Server::Impl::audit_trail(const HttpRequest& req, const Target& t, Role) {
+  json list = json::array();
+  if (history) {
+    for (const AuditRecord& r : history->audit(query_int(t, "limit", 100, 1, 1000))) {
       list.push_back({{"id", r.id},
-                      {"job_id", r.job_id},
-                      {"kind", r.kind},
-                      {"program", r.program},
-                      {"started", r.started_utc},
-                      {"ended", r.ended_utc},
-                      {"outcome", r.outcome},
-                      {"machining_s", r.machining_s},
-                      {"end_line", r.end_line},
-                      {"alarms", r.alarms}});
+                      {"time", r.time_utc},
+                      {"role", r.role},
+                      {"remote", r.remote},
+                      {"action", r.action},
+                      {"body", r.body},
+                      {"status", r.status},
+                      {"result", r.result}});
     }
-    return json_response(req, 200, list);
   }
-  if (p == "/api/v1/audit") {
-    if (role != Role::Admin) return error_response(req, 403, "the audit trail is for the admin");
-    json list = json::array();
-    if (history) {
-      for (const AuditRecord& r : history->audit(query_int(t, "limit", 100, 1, 1000))) {
-        list.push_back({{"id", r.id},
-                        {"time", r.time_utc},
-                        {"role", r.role},
-                        {"remote", r.remote},
-                        {"action", r.action},
-                        {"body", r.body},
-                        {"status", r.status},
-                        {"result", r.result}});
-      }
-    }
-    return json_response(req, 200, list);
+  return json_response(req, 200, list);
+}
+
+HttpResponse Server::Impl::server_info(const HttpRequest& req, const Target&, Role role) {
+  std::size_t clients = 0;
+  {
+    std::lock_guard lock(sessions_mutex);
+    clients = sessions.size();
   }
-  if (p == "/api/v1/server") {
-    std::size_t clients = 0;
-    {
-      std::lock_guard lock(sessions_mutex);
-      clients = sessions.size();
-    }
-    return json_response(req, 200,
-                         {{"address", config.address},
-                          {"port", port},
-                          {"loopback_only", loopback},
-                          {"stream_hz", config.stream_hz},
-                          {"clients", clients},
-                          {"dropped", dropped.load()},
-                          {"tokens", tokens.origin()},
-                          {"role", to_string(role)},
-                          {"programs", config.programs_dir.string()}});
-  }
-  return error_response(req, 404, fmt::format("no such call: GET {}", p));
+  return json_response(req, 200,
+                       {{"address", config.address},
+                        {"port", port},
+                        {"loopback_only", loopback},
+                        {"stream_hz", config.stream_hz},
+                        {"clients", clients},
+                        {"dropped", dropped.load()},
+                        {"tokens", tokens.origin()},
+                        {"role", to_string(role)},
+                        {"programs", config.programs_dir.string()}});
+}
+
+HttpResponse Server::Impl::no_such_call(const HttpRequest& req, const Target& t, Role) {
+  return error_response(req, 404, fmt::format("no such call: GET {}", t.path));
+}
+
+HttpResponse Server::Impl::other_version(const HttpRequest& req, const Target&, Role) {
+  return error_response(req, 404, "this server speaks /api/v1/");
 }
 
 void Server::Impl::command(const std::shared_ptr<HttpSession>& s, const HttpRequest& req, Role role) {
@@ -683,7 +794,7 @@ std::string Server::Impl::relative_program(const std::string& path) const {
                                                              : rel.string();
 }
 
-HttpResponse Server::Impl::program_info(const HttpRequest& req) {
+HttpResponse Server::Impl::program_info(const HttpRequest& req, const Target&, Role) {
   const auto open = controller.open_program();
   if (!open) return json_response(req, 200, {{"open", false}});
   const control::PreflightSummary& s = open->preflight.summary;
@@ -700,7 +811,7 @@ HttpResponse Server::Impl::program_info(const HttpRequest& req) {
                         {"max", {s.max[0], s.max[1], s.max[2]}}});
 }
 
-HttpResponse Server::Impl::program_text(const HttpRequest& req, const Target& t) {
+HttpResponse Server::Impl::program_text(const HttpRequest& req, const Target& t, Role) {
   const auto open = controller.open_program();
   if (!open || open->path.empty()) return error_response(req, 404, "no program file is open");
   const int from = query_int(t, "from", 1, 1, INT32_MAX);
@@ -718,7 +829,7 @@ HttpResponse Server::Impl::program_text(const HttpRequest& req, const Target& t)
   return json_response(req, 200, {{"from", from}, {"lines", lines}, {"more", more}});
 }
 
-void Server::Impl::preview(const std::shared_ptr<HttpSession>& s, const HttpRequest& req) {
+void Server::Impl::preview(const std::shared_ptr<HttpSession>& s, const HttpRequest& req, Role) {
   const auto open = controller.open_program();
   if (!open || open->path.empty() || !source)
     return s->send(error_response(req, 404, "no program file is open"));
@@ -742,7 +853,7 @@ void Server::Impl::preview(const std::shared_ptr<HttpSession>& s, const HttpRequ
   });
 }
 
-HttpResponse Server::Impl::programs(const HttpRequest& req) {
+HttpResponse Server::Impl::programs(const HttpRequest& req, const Target&, Role) {
   json list = json::array();
   std::error_code ec;
   std::vector<std::string> names;
@@ -759,7 +870,7 @@ HttpResponse Server::Impl::programs(const HttpRequest& req) {
   return json_response(req, 200, list);
 }
 
-HttpResponse Server::Impl::tools_table(const HttpRequest& req) {
+HttpResponse Server::Impl::tools_table(const HttpRequest& req, const Target&, Role) {
   json list = json::array();
   if (const auto service = source ? source->tools() : nullptr) {
     for (const tools::ToolEntry& e : service->snapshot()->entries()) {
@@ -773,7 +884,7 @@ HttpResponse Server::Impl::tools_table(const HttpRequest& req) {
   return json_response(req, 200, list);
 }
 
-HttpResponse Server::Impl::static_file(const HttpRequest& req, const Target& t) {
+HttpResponse Server::Impl::static_file(const HttpRequest& req, const Target& t, Role) {
   if (config.static_dir.empty())
     return error_response(req, 404, "no front end is served (build it: scripts/hmi.sh)");
   std::string rel = t.path == "/" ? "index.html" : t.path.substr(1);

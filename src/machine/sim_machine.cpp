@@ -207,8 +207,7 @@ void SimMachine::mount(std::int32_t tool) noexcept {
   if (config_.edm.present) edm_.mount(tool);
 }
 
-void SimMachine::replace_electrode(std::int32_t tool, const std::array<double, 3>& offset,
-                                   double tip_radius) noexcept {
+void SimMachine::replace_electrode(std::int32_t tool, const Vec3& offset, double tip_radius) noexcept {
   int k = 0;
   while (k < config_.electrode_count && config_.electrodes[static_cast<std::size_t>(k)].tool != tool) ++k;
   if (k == kMaxSimElectrodes) return;
@@ -219,8 +218,8 @@ void SimMachine::replace_electrode(std::int32_t tool, const std::array<double, 3
 }
 
 // The mounted electrode's offsets as the sphere sees them: shorter along the tool axis by its wear.
-std::array<double, 3> SimMachine::worn_offset() const noexcept {
-  std::array<double, 3> o = electrode_.offset;
+Vec3 SimMachine::worn_offset() const noexcept {
+  Vec3 o = electrode_.offset;
   const SimEdmConfig& e = config_.edm;
   if (e.present && e.offset_axis >= 0)
     o[static_cast<std::size_t>(e.offset_axis)] += e.work_direction * edm_.electrode_wear_mm();
@@ -334,7 +333,7 @@ void SimMachine::sample_probe() noexcept {
 // The electrode against the reference sphere: the encoders latched where the contact changed,
 // in proportion between the last two samples (the gap changes smoothly over one period).
 void SimMachine::sample_sphere_probe() noexcept {
-  std::array<double, 3> p{};
+  Vec3 p{};
   for (std::size_t k = 0; k < 3; ++k) {
     const int j = config_.probe.sphere.joints[k];
     p[k] = j >= 0 ? joints_[static_cast<std::size_t>(j)].table_position() : 0.0;

@@ -13,19 +13,19 @@ namespace opencnc::machine {
 void SimSphereProbe::turn(double b_deg) noexcept {
   if (target_.b_joint < 0) return;
   constexpr double kRad = 3.14159265358979323846 / 180;
-  const std::array<double, 3> on_axis{target_.b_axis[0], target_.centre[1], target_.b_axis[1]};
+  const Vec3 on_axis{target_.b_axis[0], target_.centre[1], target_.b_axis[1]};
   centre_ =
       rotate_about(target_.centre, on_axis, target_.b_direction, (b_deg - target_.b_at_centre_deg) * kRad);
 }
 
-double SimSphereProbe::gap(const std::array<double, 3>& p) const noexcept {
+double SimSphereProbe::gap(const Vec3& p) const noexcept {
   const double dx = p[0] - offset_[0] - centre_[0];
   const double dy = p[1] - offset_[1] - centre_[1];
   const double dz = p[2] - offset_[2] + tip_radius_ - centre_[2];
   return std::sqrt(dx * dx + dy * dy + dz * dz) - target_.radius - tip_radius_;
 }
 
-bool SimSphereProbe::update(const std::array<double, 3>& p, SplitMix64& rng) noexcept {
+bool SimSphereProbe::update(const Vec3& p, SplitMix64& rng) noexcept {
   if (!target_.present) return false;
   const double g = gap(p);
   const double jitter = target_.noise > 0 ? target_.noise * rng.symmetric() : 0.0;

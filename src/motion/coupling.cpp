@@ -273,4 +273,24 @@ double CouplingLaw::max_curvature(double a, double b) const noexcept {
   return best;
 }
 
+CouplingLaw law_for(const CouplingConfig& config, CouplingKind kind, double pitch_mm, double rate,
+                    int table) noexcept {
+  switch (kind) {
+    case CouplingKind::ConstantPitch:
+      return CouplingLaw::constant(pitch_mm);
+    case CouplingKind::LinearPitch:
+      return CouplingLaw::linear(pitch_mm, rate);
+    case CouplingKind::PitchTable:
+    case CouplingKind::Cam: {
+      const int t = table - 1;
+      if (t < 0 || t >= kMaxCouplingTables || config.table_kind[static_cast<std::size_t>(t)] != kind)
+        return {};
+      return CouplingLaw::tabulated(kind, config.tables[static_cast<std::size_t>(t)]);
+    }
+    case CouplingKind::Off:
+      break;
+  }
+  return {};
+}
+
 }  // namespace opencnc::motion

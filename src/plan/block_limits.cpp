@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 
 #include "opencnc/traj/path_eval.hpp"
 
@@ -25,6 +26,7 @@ using traj::MotionBlock;
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kPi = std::numbers::pi;
 constexpr double kJerkCapShare = 0.5;  ///< part of J the geometric jerk v³·|g'''| may use at the cap
 
 bool limited_jerk(const LimitParams& p, int i) {
@@ -63,6 +65,95 @@ double largest_within(F f, double budget, double x_hi) {
     (f(mid) <= budget ? lo : hi) = mid;
   }
   return lo;
+}
+
+/// Smallest and largest of R·cos(φ − ψ) for φ in [lo, hi]: the ends and the extrema inside.
+void cos_range(double R, double psi, double lo, double hi, double& mn, double& mx) {
+  mn = std::min(R * std::cos(lo - psi), R * std::cos(hi - psi));
+  mx = std::max(R * std::cos(lo - psi), R * std::cos(hi - psi));
+  if (hi - lo >= 2 * kPi) {
+    mn = -R;
+    mx = R;
+    return;
+  }
+  for (double m = std::ceil((lo - psi) / kPi); psi + m * kPi <= hi; m += 1) {
+    if (std::fmod(std::fabs(m), 2.0) < 0.5) {
+      mx = R;
+    } else {
+      mn = -R;
+    }
+  }
+}
+
+/// Limits of a circular arc over the angle it sweeps (no jerk limit). The whole-circle bounds
+/// (arc_or_spiral_limits) take each axis's largest |g'| and |g''| on the full circle; a corner
+/// fillet sweeps a few degrees, over which a diagonal pair of axes keeps |g'_i| near 0.7 instead
+/// of 1, so the fillet may run as fast as the lines it joins (LinuxCNC's blend arcs do). Per axis,
+/// with φ = ω·s,  g'_i = ω·(w_i·cos φ + u_i·sin φ) + λ_i  and  g''_i = ω²·(u_i·cos φ − w_i·sin φ):
+/// shifted R·cos(φ − ψ), whose extrema over the sweep are exact (cos_range). The budget is
+/// (A_i − v²·G2)/G1 with G1, G2 bounds of |g'_i|, |g''_i| on each of 24 pieces of the sweep (the
+/// values at its ends and the next derivative's bound: |g''_i| ≤ D2, |g'''_i| ≤ |ω|³·r_i). The cap
+/// is the highest at which that budget still reaches the whole-circle budget `a_min` (a higher
+/// cap with less budget would trade braking for speed).
+/// {cap −1}: no better than the whole-circle limits.
+RawLimits arc_sweep_limits(const MotionBlock& b, double v_max, const LimitParams& p, double cap_lo,
+                           double a_min) {
+  constexpr int kPieces = 24;
+  const double om = b.omega, aom = std::fabs(om), L = b.length;
+  const double lo = std::min(0.0, om * L), hi = std::max(0.0, om * L), dphi = (hi - lo) / kPieces;
+  double cap = v_max;
+  double d1[kAxisCount]{}, d2[kAxisCount]{}, d3[kAxisCount]{};
+  for (int i = 0; i < kAxisCount; ++i) {
+    const double r = std::hypot(b.u[i], b.w[i]), lam = b.lin[i];
+    if (aom * r + std::fabs(lam) < 1e-15) continue;
+    double mn = 0, mx = 0;
+    if (r > 0) cos_range(aom * r, std::atan2(om * b.u[i], om * b.w[i]), lo, hi, mn, mx);
+    d1[i] = std::max(std::fabs(mn + lam), std::fabs(mx + lam));
+    mn = mx = 0;
+    if (r > 0) cos_range(om * om * r, std::atan2(-b.w[i], b.u[i]), lo, hi, mn, mx);
+    d2[i] = std::max(std::fabs(mn), std::fabs(mx));
+    d3[i] = aom * om * om * r;
+    const AxisLimits& l = p.machine[i];
+    if (d1[i] > 0) cap = std::min(cap, l.max_velocity / d1[i]);
+    if (d2[i] > 0) cap = std::min(cap, std::sqrt(p.normal_share * l.max_acceleration / d2[i]));
+  }
+  if (cap <= cap_lo) return {-1, 0, 0};
+  // Per piece G1 ≥ |g'_i| and G2 ≥ |g''_i| on it. The budget at v is min (A_i − v²·G2)/G1, so the
+  // cap at which it still reaches a_min is v² = min (A_i − a_min·G1)/G2, in closed form.
+  const double ds = L / kPieces, cd = std::cos(dphi), sd = std::sin(dphi);
+  double G1[kAxisCount][kPieces], G2[kAxisCount][kPieces];
+  double v2 = cap * cap;
+  for (int i = 0; i < kAxisCount; ++i) {
+    if (d1[i] <= 0) continue;
+    double c = std::cos(lo), sn = std::sin(lo);  // the sample angle, turned by dphi each step
+    double g1_prev = std::fabs(om * (b.w[i] * c + b.u[i] * sn) + b.lin[i]);
+    double g2_prev = std::fabs(om * om * (b.u[i] * c - b.w[i] * sn));
+    const double A = p.machine[i].max_acceleration;
+    for (int q = 0; q < kPieces; ++q) {
+      const double c_next = c * cd - sn * sd;
+      sn = sn * cd + c * sd;
+      c = c_next;
+      const double g1 = std::fabs(om * (b.w[i] * c + b.u[i] * sn) + b.lin[i]);
+      const double g2 = std::fabs(om * om * (b.u[i] * c - b.w[i] * sn));
+      G1[i][q] = std::min(d1[i], 0.5 * (g1_prev + g1 + d2[i] * ds));
+      G2[i][q] = std::min(d2[i], 0.5 * (g2_prev + g2 + d3[i] * ds));
+      g1_prev = g1;
+      g2_prev = g2;
+      const double room = A - a_min * G1[i][q];
+      if (room < 0) return {-1, 0, 0};
+      if (G2[i][q] > 0) v2 = std::min(v2, room / G2[i][q]);
+    }
+  }
+  cap = std::sqrt(v2);
+  if (cap <= cap_lo) return {-1, 0, 0};
+  double a = kInf;
+  for (int i = 0; i < kAxisCount; ++i) {
+    if (d1[i] <= 0) continue;
+    for (int q = 0; q < kPieces; ++q) {
+      if (G1[i][q] > 0) a = std::min(a, (p.machine[i].max_acceleration - v2 * G2[i][q]) / G1[i][q]);
+    }
+  }
+  return {cap, std::max(a, 0.0), kInf};
 }
 
 // Circle or helix: g' = ω·(cos·w + sin·u) + λ, g'' = ω²·(cos·u − sin·w), g''' = −ω²·g'_circle.
@@ -114,6 +205,10 @@ RawLimits arc_or_spiral_limits(const MotionBlock& b, double v_max, const LimitPa
       r.jerk = std::min(r.jerk, largest_within([&](double j) { return jerk(a, j); }, J, j_hi));
     }
     r.accel = std::min(r.accel, a);
+  }
+  if (b.spiral == 0 && r.jerk == kInf && p.filter_s <= 0 && r.cap < v_max) {
+    const RawLimits sweep = arc_sweep_limits(b, v_max, p, r.cap, r.accel);
+    if (sweep.cap > r.cap) return sweep;
   }
   return r;
 }
@@ -210,6 +305,11 @@ double bernstein(const double* c, int n, double t) {
 /// close two of them lie.
 int bernstein_roots(const double* c, int n, double* roots) {
   if (n <= 0) return 0;
+  if (n == 1) {  // a line: its root in closed form
+    if (c[0] == 0 || (c[0] < 0) == (c[1] < 0)) return 0;
+    roots[0] = c[0] / (c[0] - c[1]);
+    return 1;
+  }
   double d[5];
   for (int k = 0; k < n; ++k) d[k] = n * (c[k + 1] - c[k]);
   double cuts[7];
@@ -223,15 +323,29 @@ int bernstein_roots(const double* c, int n, double* roots) {
   for (int k = 0; k + 1 < nc; ++k) {
     double lo = cuts[k], hi = cuts[k + 1];
     double flo = bernstein(c, n, lo);
-    const double fhi = bernstein(c, n, hi);
+    double fhi = bernstein(c, n, hi);
     if (flo == 0 || (flo < 0) == (fhi < 0)) continue;
-    for (int it = 0; it < 45 && hi - lo > 1e-12; ++it) {
-      const double mid = 0.5 * (lo + hi), fm = bernstein(c, n, mid);
-      if ((fm < 0) == (flo < 0)) {
-        lo = mid;
-        flo = fm;
+    // Regula falsi with the Illinois modification (the end kept twice has its value halved):
+    // the bracket shrinks superlinearly, a few evaluations instead of bisection's 40.
+    int kept = 0;
+    for (int it = 0; it < 60 && hi - lo > 1e-12; ++it) {
+      double x = (lo * fhi - hi * flo) / (fhi - flo);
+      if (!(x > lo && x < hi)) x = 0.5 * (lo + hi);
+      const double fx = bernstein(c, n, x);
+      if (fx == 0) {
+        lo = hi = x;
+        break;
+      }
+      if ((fx < 0) == (flo < 0)) {
+        lo = x;
+        flo = fx;
+        if (kept == -1) fhi *= 0.5;
+        kept = -1;
       } else {
-        hi = mid;
+        hi = x;
+        fhi = fx;
+        if (kept == 1) flo *= 0.5;
+        kept = 1;
       }
     }
     roots[found++] = 0.5 * (lo + hi);

@@ -216,8 +216,14 @@ void Lookahead::settle_front() {
     const double share = pb.b.length <= 0.5 * reach_ ? kShortSplitShare : 1 - kSplitGain;
     // Where a lower range begins or ends inside the block.
     cuts_.clear();
+    // A limit that begins or ends within kMinPiece of the block's end is cut 1.5 kMinPiece from
+    // it (the piece then holds it a little longer than needed; the pieces below skip cuts closer
+    // than kMinPiece): dropping the cut would hold it over the whole block (a 10 µm hairpin
+    // blend's 0.005 mm/s over each 1.6 mm move beside it).
+    const bool splittable = pb.b.length > 4 * kMinPiece;
     const auto cut_at = [&](double x) {
-      if (x > own.start + kMinPiece && x < own.end - kMinPiece) cuts_.push_back(x);
+      if (splittable && x > own.start && x < own.end)
+        cuts_.push_back(std::clamp(x, own.start + 1.5 * kMinPiece, own.end - 1.5 * kMinPiece));
     };
     for (std::size_t j = 0; j < ranges_.size(); ++j) {
       const Range& r = ranges_[j];
@@ -237,6 +243,19 @@ void Lookahead::settle_front() {
       }
     }
     std::sort(cuts_.begin(), cuts_.end());
+    // Of cuts closer than kMinPiece keep the later one in the block's first half (where limits
+    // mostly end: the piece before holds them) and the earlier one in its second half (where they
+    // mostly begin), so that the moved cuts above do not swallow a neighbour's.
+    std::size_t kept = 0;
+    const double middle = 0.5 * (own.start + own.end);
+    for (std::size_t k = 0; k < cuts_.size(); ++k) {
+      if (kept > 0 && cuts_[k] - cuts_[kept - 1] < kMinPiece) {
+        if (cuts_[k] < middle) cuts_[kept - 1] = cuts_[k];
+        continue;
+      }
+      cuts_[kept++] = cuts_[k];
+    }
+    cuts_.resize(kept);
     // The pieces between the cuts (none shorter than kMinPiece), then each run of pieces with the
     // same limits as one block.
     traj::MotionBlock rest = pb.b;

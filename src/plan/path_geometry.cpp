@@ -8,6 +8,9 @@
 
 #include <fmt/format.h>
 
+#include "opencnc/canon/arc_geometry.hpp"
+#include "opencnc/core/minimise.hpp"
+#include "opencnc/core/vec3.hpp"
 #include "opencnc/traj/path_eval.hpp"
 #include "vec.hpp"
 
@@ -18,53 +21,6 @@ using traj::BlockKind;
 namespace {
 
 constexpr double kPi = std::numbers::pi;
-
-int plane_base(canon::Plane p) noexcept {
-  return (p == canon::Plane::XY || p == canon::Plane::YZ || p == canon::Plane::XZ) ? 0 : 6;
-}
-
-struct Vec3 {
-  double x = 0, y = 0, z = 0;
-};
-Vec3 sub3(Vec3 a, Vec3 b) {
-  return {a.x - b.x, a.y - b.y, a.z - b.z};
-}
-Vec3 add3(Vec3 a, Vec3 b) {
-  return {a.x + b.x, a.y + b.y, a.z + b.z};
-}
-Vec3 mul3(double k, Vec3 a) {
-  return {k * a.x, k * a.y, k * a.z};
-}
-double dot3(Vec3 a, Vec3 b) {
-  return a.x * b.x + a.y * b.y + a.z * b.z;
-}
-Vec3 cross3(Vec3 a, Vec3 b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
-
-Vec3 take3(const Pose& p, int base) {
-  return {p[base], p[base + 1], p[base + 2]};
-}
-void put3(Pose& p, int base, Vec3 v) {
-  p[base] = v.x;
-  p[base + 1] = v.y;
-  p[base + 2] = v.z;
-}
-
-/// Arc sweep (signed radians) from the end point's angle `phi` ∈ (−π, π] in the frame of the
-/// start point, the direction and LinuxCNC's turn count (|turns| − 1 extra full circles).
-double arc_sweep(double phi, int turns) noexcept {
-  const bool ccw = turns >= 0;
-  const double full = std::fabs(phi) < 1e-9;  // end on start: a whole circle
-  double sweep;
-  if (ccw) {
-    sweep = full ? 2 * kPi : (phi > 0 ? phi : phi + 2 * kPi);
-  } else {
-    sweep = full ? -2 * kPi : (phi < 0 ? phi : phi - 2 * kPi);
-  }
-  const int extra = std::max(0, std::abs(turns) - 1);
-  return sweep + (ccw ? 1.0 : -1.0) * 2 * kPi * extra;
-}
 
 }  // namespace
 
@@ -127,29 +83,29 @@ double spiral_length(double r0, double rho, double h, double sweep) noexcept {
 
 bool make_arc(const Pose& start, const Pose& end, const canon::ArcGeometry& arc, MotionBlock& out,
               std::string& error) {
-  const int b0 = plane_base(arc.plane);
-  const Vec3 n{arc.normal[0], arc.normal[1], arc.normal[2]};
-  const Vec3 c{arc.center[0], arc.center[1], arc.center[2]};
+  const int b0 = canon::plane_base(arc.plane);
+  const Vec3& n = arc.normal;
+  const Vec3& c = arc.center;
   const Vec3 s3 = take3(start, b0), e3 = take3(end, b0);
-  Vec3 rs = sub3(s3, c);
-  rs = sub3(rs, mul3(dot3(rs, n), n));
-  const double r = std::sqrt(dot3(rs, rs));
+  Vec3 rs = s3 - c;
+  rs = rs - dot(rs, n) * n;
+  const double r = std::sqrt(dot(rs, rs));
   {
     // An arc whose circle is smaller than a nanometre at both ends (which the interpreter, as
     // LinuxCNC's, accepts) is its chord to within that nanometre: run it as a line rather than
     // refuse at run time what the check passed.
-    Vec3 re = sub3(e3, c);
-    re = sub3(re, mul3(dot3(re, n), n));
-    if (r < kPointArcMm && std::sqrt(dot3(re, re)) < kPointArcMm) return make_line(start, end, out);
+    Vec3 re = e3 - c;
+    re = re - dot(re, n) * n;
+    if (r < kPointArcMm && std::sqrt(dot(re, re)) < kPointArcMm) return make_line(start, end, out);
   }
   if (!(r >= 1e-9)) {
     error = "the arc's start point lies on its centre (radius zero)";
     return false;
   }
-  const Vec3 e1 = mul3(1.0 / r, rs), e2 = cross3(n, e1);
-  Vec3 re = sub3(e3, c);
-  re = sub3(re, mul3(dot3(re, n), n));
-  const double ex = dot3(re, e1), ey = dot3(re, e2);
+  const Vec3 e1 = (1.0 / r) * rs, e2 = cross(n, e1);
+  Vec3 re = e3 - c;
+  re = re - dot(re, n) * n;
+  const double ex = dot(re, e1), ey = dot(re, e2);
   const double r_end = std::hypot(ex, ey);
   const double off = std::fabs(r_end - r);
   if (!(r_end >= 1e-9) || off > 100 * kSpiralAbsMm ||
@@ -170,17 +126,17 @@ bool make_arc(const Pose& start, const Pose& end, const canon::ArcGeometry& arc,
     cx = k * dx;
     cy = k * dy;
   }
-  const Vec3 c2 = add3(c, add3(mul3(cx, e1), mul3(cy, e2)));
-  const Vec3 rs2 = sub3(s3, c2);
-  const double r2 = std::sqrt(dot3(rs2, rs2));
-  const Vec3 f1 = mul3(1.0 / r2, rs2), f2 = cross3(n, f1);
-  const Vec3 re2 = sub3(re, add3(mul3(cx, e1), mul3(cy, e2)));
-  const double phi = std::atan2(dot3(re2, f2), dot3(re2, f1));
-  const double sweep = arc_sweep(phi, arc.turns == 0 ? 1 : arc.turns);
+  const Vec3 c2 = c + (cx * e1 + cy * e2);
+  const Vec3 rs2 = s3 - c2;
+  const double r2 = std::sqrt(dot(rs2, rs2));
+  const Vec3 f1 = (1.0 / r2) * rs2, f2 = cross(n, f1);
+  const Vec3 re2 = re - (cx * e1 + cy * e2);
+  const double phi = std::atan2(dot(re2, f2), dot(re2, f1));
+  const double sweep = canon::arc_sweep(phi, arc.turns == 0 ? 1 : arc.turns);
 
   Pose U{}, W{};
-  put3(U, b0, mul3(-r2, f1));  // toward the centre
-  put3(W, b0, mul3(r2, f2));   // counterclockwise tangent, length r
+  put3(U, b0, -r2 * f1);  // toward the centre
+  put3(W, b0, r2 * f2);   // counterclockwise tangent, length r
   const Pose circle = std::sin(sweep) * W + (1.0 - std::cos(sweep)) * U;
   const Pose rest = end - start - circle;  // helix rise and every other axis, moved linearly
   const double len = std::hypot(r2 * sweep, norm(rest));
@@ -201,20 +157,20 @@ bool make_arc(const Pose& start, const Pose& end, const canon::ArcGeometry& arc,
 // spiral's length, θ = ω·s, so the speed along the curve follows the radius within their ratio.
 bool make_spiral(const Pose& start, const Pose& end, const canon::ArcGeometry& arc, double r0, double r1,
                  MotionBlock& out) {
-  const int b0 = plane_base(arc.plane);
-  const Vec3 n{arc.normal[0], arc.normal[1], arc.normal[2]};
-  const Vec3 c{arc.center[0], arc.center[1], arc.center[2]};
-  Vec3 rs = sub3(take3(start, b0), c);
-  rs = sub3(rs, mul3(dot3(rs, n), n));
-  const Vec3 e1 = mul3(1.0 / r0, rs), e2 = cross3(n, e1);
-  Vec3 re = sub3(take3(end, b0), c);
-  re = sub3(re, mul3(dot3(re, n), n));
-  const double phi = std::atan2(dot3(re, e2), dot3(re, e1));
-  const double sweep = arc_sweep(phi, arc.turns == 0 ? 1 : arc.turns);
+  const int b0 = canon::plane_base(arc.plane);
+  const Vec3& n = arc.normal;
+  const Vec3& c = arc.center;
+  Vec3 rs = take3(start, b0) - c;
+  rs = rs - dot(rs, n) * n;
+  const Vec3 e1 = (1.0 / r0) * rs, e2 = cross(n, e1);
+  Vec3 re = take3(end, b0) - c;
+  re = re - dot(re, n) * n;
+  const double phi = std::atan2(dot(re, e2), dot(re, e1));
+  const double sweep = canon::arc_sweep(phi, arc.turns == 0 ? 1 : arc.turns);
   const double rho = (r1 - r0) / (r0 * sweep);
   Pose U{}, W{};
-  put3(U, b0, mul3(-r0, e1));
-  put3(W, b0, mul3(r0, e2));
+  put3(U, b0, -r0 * e1);
+  put3(W, b0, r0 * e2);
   const double grow = rho * sweep, sn = std::sin(sweep), cs = std::cos(sweep);
   const Pose turn = sn * W + (1.0 - cs) * U + grow * (sn * W - cs * U);
   const Pose rest = end - start - turn;
@@ -397,18 +353,9 @@ double nearest_on(const MotionBlock& b, const Pose& p, double s0) noexcept {
     }
     s = next;
   }
-  double lo = std::max(0.0, s0 - reach), hi = std::min(b.length, s0 + reach);
-  const double g = 0.5 * (std::sqrt(5.0) - 1);
   const auto d = [&](double x) { return norm(p - traj::position_at(b, x)); };
-  double x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo), f1 = d(x1), f2 = d(x2);
-  for (int i = 0; i < 60 && hi - lo > 1e-12; ++i) {
-    if (f1 < f2) {
-      hi = x2, x2 = x1, f2 = f1, x1 = hi - g * (hi - lo), f1 = d(x1);
-    } else {
-      lo = x1, x1 = x2, f1 = f2, x2 = lo + g * (hi - lo), f2 = d(x2);
-    }
-  }
-  return std::min({f1, f2, d(s0)});
+  const Minimum m = golden_section(d, std::max(0.0, s0 - reach), std::min(b.length, s0 + reach), 60, 1e-12);
+  return std::min(m.f, d(s0));
 }
 
 }  // namespace
@@ -452,6 +399,10 @@ double distance_to(const MotionBlock& b, const Pose& p) noexcept {
     double best = std::min(norm(p - b.base), norm(p - end_point(b)));
     for (double a = phi; a <= std::fabs(sweep); a += 2 * kPi)
       best = std::min(best, nearest_on(b, p, a / std::fabs(b.omega)));
+    // Searches from the ends only where p's angle lies outside the sweep: inside, the search from
+    // that angle finds the nearest point (every result is the distance to a point of the curve, so
+    // skipping a search can only overstate the distance, never understate it).
+    if (phi <= std::fabs(sweep)) return best;
     return std::min({best, nearest_on(b, p, 0.0), nearest_on(b, p, b.length)});
   }
   // Bézier: sampled (only used for short blend curves).
@@ -531,16 +482,24 @@ void bezier_at(const MotionBlock& in, const MotionBlock& out, double d, MotionBl
 }
 
 /// Largest distance from the Bézier to the two programmed blocks (sampled, plus the most the
-/// curve can move between samples).
-double bezier_deviation(const MotionBlock& c, const MotionBlock& in, const MotionBlock& out) {
+/// curve can move between samples); once it passes `stop_above` the rest is not sampled.
+double bezier_deviation(const MotionBlock& c, const MotionBlock& in, const MotionBlock& out,
+                        double stop_above) {
   constexpr int kSamples = 32;
   const double arm = std::max({norm(c.u - c.base), norm(c.w - c.u), norm(c.lin - c.w)});
+  const double margin = 3.0 * arm / (2.0 * kSamples);
   double worst = 0;
-  for (int k = 1; k < kSamples; ++k) {
+  // From the middle outwards, the block on the sample's side first: the largest distance is
+  // usually found first, and a sample nearer than it to one block needs no other distance.
+  for (int m = 0; m < kSamples - 1 && worst + margin <= stop_above; ++m) {
+    const int k = kSamples / 2 + (m % 2 == 0 ? m / 2 : -(m + 1) / 2);
     const Pose p = traj::position_at(c, c.length * k / kSamples);
-    worst = std::max(worst, std::min(distance_to(in, p), distance_to(out, p)));
+    const MotionBlock& near = 2 * k <= kSamples ? in : out;
+    const MotionBlock& far = 2 * k <= kSamples ? out : in;
+    const double d_near = distance_to(near, p);
+    if (d_near > worst) worst = std::max(worst, std::min(d_near, distance_to(far, p)));
   }
-  return worst + 3.0 * arm / (2.0 * kSamples);
+  return worst + margin;
 }
 
 bool bezier_blend(const MotionBlock& in, double avail_in, const MotionBlock& out, double avail_out,
@@ -558,13 +517,13 @@ bool bezier_blend(const MotionBlock& in, double avail_in, const MotionBlock& out
   const auto ok = [&](double d) {
     bezier_at(in, out, d, result.curve);
     if (result.curve.length < kMinLength) return false;
-    return tolerance <= 0 || (bezier_deviation(result.curve, in, out) <= tolerance &&
-                              point_to_curve(result.curve, end_point(in)) <= tolerance);
+    return tolerance <= 0 || (point_to_curve(result.curve, end_point(in)) <= tolerance &&
+                              bezier_deviation(result.curve, in, out, tolerance) <= tolerance);
   };
   double d = d_max;
-  if (!ok(d)) {
+  if (!ok(d)) {  // to 10⁻⁴ of d_max: a blend 0.01 % shorter costs nothing measurable
     double lo = 0, hi = d_max;
-    for (int i = 0; i < 40 && hi - lo > 1e-9 * d_max; ++i) {
+    for (int i = 0; i < 40 && hi - lo > 1e-4 * d_max; ++i) {
       const double mid = 0.5 * (lo + hi);
       (ok(mid) ? lo : hi) = mid;
     }

@@ -90,10 +90,10 @@ namespace opencnc::plan {
 
 bool check_move(const canon::Program& program, canon::SegmentId id, const MachineLimits& limits,
                 Diagnostics& diags) {
+  using canon::MoveKind;
   using detail::file_name;
   using detail::finite_pose;
   using detail::make_arc;
-  using canon::MoveKind;
   const std::size_t before = diags.error_count();
   const auto fail = [&](std::string msg, const char* code) {
     // Column 1: the block that made the move (the planner knows lines, not words).
@@ -311,10 +311,15 @@ double ProgramReader::merge_budget() const noexcept {
   return tolerance_ > 0 ? std::min(naive_tolerance_, tolerance_) : naive_tolerance_;
 }
 
-// G64 Q: a run of feed lines whose inner vertices all lie within Q of the line from the run's
-// start to the candidate end (and in order along it) becomes that one line. With a blend
-// tolerance P the merge uses at most P/2, and the blends then keep within P minus the merge's
-// deviation, so the path stays within P of the programmed one.
+// G64 Q: a run of feed lines whose inner vertices all lie within Q of the segment from the run's
+// start to the candidate end (and in order along it, up to a step back of Q: CAM output's
+// jitter) becomes that one line. With a blend tolerance P the merge uses at most P/2, and the
+// blends then keep within P minus the merge's deviation, so the path stays within P of the
+// programmed one. Both ways: each programmed move lies within Q of the segment (its ends do, and
+// the points within Q of a segment form a convex set), and each point of the segment within Q of
+// a programmed move (the nearest points of consecutive vertices on the segment, both within Q of
+// the move between them, span a piece of the segment within Q of it; the pieces chain from the
+// start to the end, in order or not).
 bool ProgramReader::can_extend_run(const Element& e) const {
   if (!run_active_ || run_points_.size() >= kMaxRunPoints) return false;
   if (e.b.kind != traj::BlockKind::Line || e.b.feed_class != FeedClass::Feed || e.stop_after) return false;
@@ -335,9 +340,10 @@ bool ProgramReader::can_extend_run(const Element& e) const {
   // run is checked again for each new end, so this is the planner's inner loop on dense paths.
   double last = 0;
   const auto inside = [&](double t, double r_squared) {
-    if (t < last || t > len) return false;
-    last = t;
-    return r_squared - t * t <= q * q;
+    if (t < last - q) return false;
+    last = std::max(last, t);
+    const double beyond = t < 0 ? -t : (t > len ? t - len : 0.0);
+    return r_squared - t * t + beyond * beyond <= q * q;
   };
   for (std::size_t k = 0; k < run_points_.size(); ++k) {
     double t = 0;
@@ -372,7 +378,8 @@ void ProgramReader::flush_run() {
     e.b.feed = run_feed_ / 60.0 * feed_length_ratio(run_start_, end, e.b);
     e.orig_length = e.b.length;
     double dev = 0;
-    for (const Pose& r : run_points_) dev = std::max(dev, norm(r - dot(r, e.b.lin) * e.b.lin));
+    for (const Pose& r : run_points_)  // to the segment: a vertex may lie a little beyond an end
+      dev = std::max(dev, norm(r - std::clamp(dot(r, e.b.lin), 0.0, e.b.length) * e.b.lin));
     e.merge_deviation = dev + run_floor_;
   }
   run_points_.clear();

@@ -4,6 +4,7 @@
 #include "opencnc/toolguard/tool_guard.hpp"
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include "check_code.hpp"
 #include "opencnc/gcode/standard_extensions.hpp"
@@ -151,42 +152,91 @@ control::Outcome ToolGuard::handle(const control::requests::Feature& request, co
   return o;
 }
 
-std::optional<Setup> setup(const config::MachineProfile& profile, Diagnostics& diags,
-                           bool tool_table_in_memory) {
-  std::optional<control::GcodeSourceConfig> c = control::GcodeProgramSource::config_for(profile, diags);
-  if (!c) return std::nullopt;
-  if (tool_table_in_memory && c->tools && !profile.tool_guard.present)
-    c->tools = std::make_shared<tools::MemoryToolTable>(*c->tools->snapshot());
-  Setup s;
-  const config::ToolGuardProfile& g = profile.tool_guard;
-  if (g.present) {
-    std::string error;
-    s.store = store::ToolStore::open(g.store, &error, false);
-    if (!s.store) {
-      diags.error(
-          profile.source, 0, 0,
-          fmt::format("tool_guard.store: {} (create it with `opencnc tools --db {} import TABLE` and back it "
-                      "up with `opencnc tools --db {} backup`)",
-                      error, g.store, g.store),
-          "tools.store");
-      return std::nullopt;
-    }
-    c->tools = s.store;
-    if (g.check_mcode > 0) {
-      auto code = std::make_shared<CheckCode>(s.store, tolerances(g));
-      const auto m = static_cast<std::size_t>(g.check_mcode);
-      // On top of the modules the profile already brings (the coupling codes of a broach).
-      auto base = c->extensions;
-      c->extensions = [code, m, base](gcode::Dialect d) {
-        auto ext = std::make_shared<gcode::Extensions>(base ? *base(d) : *gcode::standard_extensions(d));
-        ext->m[m] = code;
-        return std::shared_ptr<const gcode::Extensions>(std::move(ext));
-      };
-    }
-    s.feature = std::make_shared<ToolGuard>(s.store, g, profile.tool_changer_pockets);
+namespace {
+
+/// The check M-code (M160 or the profile's) on top of the modules the profile already brings.
+class CheckModule final : public control::SourcePart {
+ public:
+  CheckModule(std::shared_ptr<CheckCode> code, std::size_t m) : code_(std::move(code)), m_(m) {}
+  std::shared_ptr<const gcode::Extensions> modules(
+      gcode::Dialect, std::shared_ptr<const gcode::Extensions> base) const override {
+    auto ext = std::make_shared<gcode::Extensions>(*base);
+    ext->m[m_] = code_;
+    return ext;
   }
-  s.source = std::make_shared<control::GcodeProgramSource>(std::move(*c));
-  return s;
+
+ private:
+  std::shared_ptr<CheckCode> code_;
+  std::size_t m_;
+};
+
+/// While the guard holds the program at a tool change (the controller's wait text names the
+/// feature that holds), the differences of the whole live table from the backup, for the dialog.
+/// The check reads the store (SQLite): it runs once when the hold begins and again only when the
+/// store has changed, not at every status.
+class State final : public control::FeatureState {
+ public:
+  State(std::shared_ptr<store::ToolStore> store, const config::ToolGuardProfile& guard)
+      : store_(std::move(store)), guard_(guard) {}
+  std::string state_key() const override { return "tool_guard"; }
+  std::string state_json(const control::ControllerStatus& s) override {
+    using nlohmann::json;
+    const bool holding = s.wait_text.find("the tool-guard ") != std::string::npos;
+    if (!holding) {
+      holding_ = false;
+      report_ = nullptr;
+    } else if (!holding_ || store_->changes() != checked_) {
+      holding_ = true;
+      checked_ = store_->changes();
+      const CheckResult r = check(*store_, tolerances(guard_));
+      json lines = json::array(), tools = json::array();
+      for (const tools::Difference& d : r.differences) {
+        lines.push_back(d.text());
+        tools.push_back(d.tool);  // the dialog lists the program's tools first
+      }
+      report_ = {
+          {"ok", r.ok()},
+          {"error", r.error},
+          {"backup", r.backup ? json{{"id", r.backup->id}, {"taken", r.backup->taken_utc}} : json(nullptr)},
+          {"differences", lines},
+          {"difference_tools", tools},
+          {"report", r.report()}};
+    }
+    return json{{"store", guard_.store}, {"holding", holding}, {"check", report_}}.dump();
+  }
+
+ private:
+  std::shared_ptr<store::ToolStore> store_;
+  config::ToolGuardProfile guard_;
+  bool holding_ = false;
+  std::uint64_t checked_ = ~std::uint64_t{0};
+  nlohmann::json report_;
+};
+
+}  // namespace
+
+bool setup(const config::MachineProfile& profile, control::MachineSetup& host) {
+  const config::ToolGuardProfile& g = profile.tool_guard;
+  if (!g.present) return true;
+  std::string error;
+  std::shared_ptr<store::ToolStore> store = store::ToolStore::open(g.store, &error, false);
+  if (!store) {
+    host.diagnostics().error(
+        profile.source, 0, 0,
+        fmt::format("tool_guard.store: {} (create it with `opencnc tools --db {} import TABLE` and back it "
+                    "up with `opencnc tools --db {} backup`)",
+                    error, g.store, g.store),
+        "tools.store");
+    return false;
+  }
+  host.source_config().tools = store;
+  if (g.check_mcode > 0)
+    host.add_source_part(std::make_shared<CheckModule>(std::make_shared<CheckCode>(store, tolerances(g)),
+                                                       static_cast<std::size_t>(g.check_mcode)));
+  host.add_feature(std::make_shared<ToolGuard>(store, g, profile.tool_changer_pockets),
+                   control::ObserverOptions{profile.servo_period_s, false});
+  host.add_state(std::make_shared<State>(store, g));
+  return true;
 }
 
 }  // namespace opencnc::toolguard

@@ -50,7 +50,7 @@ TEST(ReferenceSphere, IsReadWithItsDefaultsAndMadeTheSimulatedProbe) {
   ASSERT_TRUE(load.ok()) << first_error(load);
   const ReferenceSphereProfile& s = load.profile->probe.reference_sphere;
   EXPECT_TRUE(s.present);
-  EXPECT_EQ(s.position, (std::array<double, 3>{100, 50, -150}));
+  EXPECT_EQ(s.position, (Vec3{100, 50, -150}));
   EXPECT_EQ(s.touches_around, 4);
   EXPECT_EQ(s.clearance, 1.0);
   const machine::SimMachineConfig c = sim_machine_config(*load.profile);
@@ -85,7 +85,7 @@ TEST(ReferenceSphere, BsAxisIsReadAndItsDirectionMadeAUnitVector) {
   const ProfileLoad plain = parse_profile(kBase + b + kSphere, "p.toml");
   ASSERT_TRUE(plain.ok()) << first_error(plain);
   EXPECT_FALSE(plain.profile->probe.reference_sphere.has_b_axis);
-  EXPECT_EQ(plain.profile->probe.reference_sphere.b_axis_direction, (std::array<double, 3>{0, 1, 0}));
+  EXPECT_EQ(plain.profile->probe.reference_sphere.b_axis_direction, (Vec3{0, 1, 0}));
 }
 
 TEST(SimElectrodes, AreReadIntoTheSimulatedMachine) {
@@ -98,7 +98,7 @@ TEST(SimElectrodes, AreReadIntoTheSimulatedMachine) {
   const machine::SimMachineConfig c = sim_machine_config(*load.profile);
   ASSERT_EQ(c.electrode_count, 2);
   EXPECT_EQ(c.electrodes[0].tool, 3);
-  EXPECT_EQ(c.electrodes[0].offset, (std::array<double, 3>{0.1, -0.2, 50.5}));
+  EXPECT_EQ(c.electrodes[0].offset, (Vec3{0.1, -0.2, 50.5}));
   EXPECT_EQ(c.electrodes[0].tip_radius, 0.8);
   EXPECT_EQ(c.electrodes[1].tool, 4);
   EXPECT_EQ(c.electrodes[1].tip_radius, 0.0) << "a point tip unless said";

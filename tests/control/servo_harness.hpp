@@ -10,9 +10,10 @@
 #include <vector>
 
 #include "opencnc/canon/program.hpp"
+#include "opencnc/canon/program_tail.hpp"
 #include "opencnc/config/machine_profile.hpp"
+#include "opencnc/control/machine_action.hpp"
 #include "opencnc/control/servo.hpp"
-#include "opencnc/controller/program_tools.hpp"
 #include "opencnc/controller/servo_setup.hpp"
 #include "opencnc/machine/sim_machine.hpp"
 #include "opencnc/plan/planner.hpp"
@@ -77,7 +78,7 @@ class ServoHarness {
 
   /// Plans `program` (started where the machine stands) and asks the servo to run it.
   Refusal run(const canon::Program& program, Mode mode) {
-    program_ = program_tail(program, 0, status().commanded);
+    program_ = canon::program_tail(program, 0, status().commanded);
     planner_ = std::make_unique<plan::Planner>(machine_limits(profile_), planner_config(profile_));
     EXPECT_TRUE(planner_->start(*program_));
     next_action_ = 0;

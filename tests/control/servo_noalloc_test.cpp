@@ -23,6 +23,7 @@
 #include "opencnc/controller/gcode_source.hpp"
 #include "opencnc/controller/servo_setup.hpp"
 #include "opencnc/controller/sim_rig.hpp"
+#include "opencnc/features/features.hpp"
 #include "opencnc/machine/sim_machine.hpp"
 #include "test_profiles.hpp"
 
@@ -37,7 +38,7 @@ class Armed {
  public:
   explicit Armed(const config::MachineProfile& p) {
     Diagnostics d;
-    rig_ = std::make_unique<SimRig>(p, GcodeProgramSource::create(p, d));
+    rig_ = std::make_unique<SimRig>(p, *features::machine_setup(p, d));
     rig_->channels().trace_enabled = true;
   }
   void tick() {
@@ -419,7 +420,8 @@ class SimBackend final : public ConfigurableMachine {
 TEST(ServoAllocations, NoneInsideTheSharedMemoryHostsTick) {
   const config::MachineProfile p = mill();
   std::string error;
-  auto segment = SharedMemory::create("/opencnc-noalloc-" + std::to_string(::getpid()), 1'000'000, 20, error);
+  auto segment =
+      SegmentMapping::create("/opencnc-noalloc-" + std::to_string(::getpid()), 1'000'000, 20, error);
   ASSERT_TRUE(segment) << error;
   SharedSegment& s = segment->segment();
   SimBackend backend(p);

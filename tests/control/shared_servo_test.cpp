@@ -55,7 +55,7 @@ class SharedRig {
   explicit SharedRig(const config::MachineProfile& p, const char* name, std::uint32_t timeout_ticks = 50)
       : profile_(p), backend_(p) {
     std::string error;
-    owner_ = SharedMemory::create(segment_name(name), 1'000'000, timeout_ticks, error);
+    owner_ = SegmentMapping::create(segment_name(name), 1'000'000, timeout_ticks, error);
     EXPECT_TRUE(owner_) << error;
     host_ = std::make_unique<SharedServoHost>(owner_->segment(), backend_);
     attach();
@@ -65,7 +65,7 @@ class SharedRig {
   void attach(const SharedSetup* setup = nullptr) {
     std::string error;
     controller_.reset();
-    mapping_ = SharedMemory::attach(owner_->name(), error);
+    mapping_ = SegmentMapping::attach(owner_->name(), error);
     ASSERT_TRUE(mapping_) << error;
     drain_stale_output(mapping_->segment());
     controller_ = std::make_unique<Controller>(profile_, mapping_->segment().channels);
@@ -97,32 +97,32 @@ class SharedRig {
   bool beating = true;
   config::MachineProfile profile_;
   SimBackend backend_;
-  std::unique_ptr<SharedMemory> owner_, mapping_;
+  std::unique_ptr<SegmentMapping> owner_, mapping_;
   std::unique_ptr<SharedServoHost> host_;
   std::unique_ptr<Controller> controller_;
 };
 
-TEST(SharedMemory, RefusesAForeignOrOtherBuildSegment) {
+TEST(SegmentMapping, RefusesAForeignOrOtherBuildSegment) {
   std::string error;
-  EXPECT_FALSE(SharedMemory::attach(segment_name("absent"), error));
+  EXPECT_FALSE(SegmentMapping::attach(segment_name("absent"), error));
   EXPECT_NE(error.find("is the HAL component opencnc_rt loaded"), std::string::npos) << error;
   error.clear();
-  EXPECT_FALSE(SharedMemory::create("no-slash", 1'000'000, 10, error));
+  EXPECT_FALSE(SegmentMapping::create("no-slash", 1'000'000, 10, error));
   EXPECT_NE(error.find("must be one '/'"), std::string::npos) << error;
 
   error.clear();
-  auto owner = SharedMemory::create(segment_name("layout"), 1'000'000, 10, error);
+  auto owner = SegmentMapping::create(segment_name("layout"), 1'000'000, 10, error);
   ASSERT_TRUE(owner) << error;
   EXPECT_EQ(owner->segment().header.layout_id, shared_layout_id());
-  EXPECT_TRUE(SharedMemory::attach(owner->name(), error)) << error;
+  EXPECT_TRUE(SegmentMapping::attach(owner->name(), error)) << error;
 
   owner->segment().header.layout_id ^= 1;  // a tick of another build
-  EXPECT_FALSE(SharedMemory::attach(owner->name(), error));
+  EXPECT_FALSE(SegmentMapping::attach(owner->name(), error));
   EXPECT_NE(error.find("built from another opencnc"), std::string::npos) << error;
   owner->segment().header.layout_id ^= 1;
   owner->segment().header.magic = 0;  // not ours
   error.clear();
-  EXPECT_FALSE(SharedMemory::attach(owner->name(), error));
+  EXPECT_FALSE(SegmentMapping::attach(owner->name(), error));
   EXPECT_NE(error.find("is not an opencnc segment"), std::string::npos) << error;
 }
 
@@ -143,7 +143,7 @@ TEST(SharedSetup, IsTheSameBytesForTheSameProfile) {
 TEST(SharedServoHost, SafeOutputsUntilASetupIsTaken) {
   const config::MachineProfile p = mill();
   std::string error;
-  auto owner = SharedMemory::create(segment_name("safe"), 1'000'000, 10, error);
+  auto owner = SegmentMapping::create(segment_name("safe"), 1'000'000, 10, error);
   ASSERT_TRUE(owner) << error;
   SimBackend backend(p);
   SharedServoHost host(owner->segment(), backend);

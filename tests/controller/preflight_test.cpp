@@ -8,8 +8,9 @@
 #include <random>
 
 #include "opencnc/canon/program_builder.hpp"
+#include "opencnc/canon/program_tail.hpp"
+#include "opencnc/control/machine_action.hpp"
 #include "opencnc/controller/preflight.hpp"
-#include "opencnc/controller/program_tools.hpp"
 
 namespace opencnc::control {
 namespace {
@@ -151,7 +152,7 @@ TEST(ProgramTail, RestartsFromAPositionKeepingThePathSettings) {
   b.straight_feed(1, xyz(10, 10));
   b.straight_feed(2, xyz(0, 10));
   const canon::Program p = b.take();
-  const auto t = program_tail(p, 1, xyz(9, 1));
+  const auto t = canon::program_tail(p, 1, xyz(9, 1));
   ASSERT_EQ(t->size(), 2u);
   EXPECT_EQ(t->start(), xyz(9, 1));
   EXPECT_EQ(t->end(0), xyz(10, 10));
@@ -167,7 +168,7 @@ TEST(ProgramTail, RestartsFromAPositionKeepingThePathSettings) {
   EXPECT_TRUE(path_mode);  // settings before the tail are kept
   EXPECT_FALSE(flood);     // what the machine already did is not done again
   EXPECT_TRUE(message);    // actions at the tail's start are kept
-  const auto whole = program_tail(p, 0, xyz(1, 1));
+  const auto whole = canon::program_tail(p, 0, xyz(1, 1));
   EXPECT_EQ(whole->size(), 3u);
   EXPECT_EQ(whole->start_of(0), xyz(1, 1));
 }

@@ -14,6 +14,7 @@
 #include "../control/test_profiles.hpp"
 #include "opencnc/config/profile_loader.hpp"
 #include "opencnc/controller/gcode_source.hpp"
+#include "opencnc/features/features.hpp"
 
 namespace opencnc::control {
 namespace {
@@ -22,7 +23,7 @@ class ResumeTest : public ::testing::Test {
  protected:
   void SetUp() override {
     Diagnostics d;
-    source_ = GcodeProgramSource::create(test::mill(), d);
+    source_ = features::machine_setup(test::mill(), d)->source();
     dir_ = std::filesystem::temp_directory_path() /
            ("opencnc-resume-" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
     std::filesystem::create_directories(dir_);
@@ -143,7 +144,7 @@ TEST_F(ResumeTest, TheProcessCodeInForceAtSegmentKIsSelectedAgain) {
   const config::MachineProfile edm =
       test::loaded(config::load_profile(OPENCNC_SOURCE_DIR "/configs/edm-5axis.toml"));
   Diagnostics d;
-  auto source = GcodeProgramSource::create(edm, d);
+  auto source = features::machine_setup(edm, d)->source();
   const std::string path = write(
       "G21 G90\nG0 Z-19.97\nM180 P1\nG1 Z-20.0 F60\nM180 P2\nG1 Z-20.01 F30\nG1 Z-20.02\nM181\nG0 Z0\n"
       "G0 Z-19.98\nM180 P3\nG1 Z-20.03 F20\nM2\n");

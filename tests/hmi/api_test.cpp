@@ -4,8 +4,8 @@
 #include <gtest/gtest.h>
 
 #include "../control/test_profiles.hpp"
-#include "opencnc/controller/run_from_line.hpp"
 #include "opencnc/hmi/api.hpp"
+#include "opencnc/run_from_line/run_from_line.hpp"
 
 namespace opencnc::hmi {
 namespace {

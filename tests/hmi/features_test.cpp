@@ -11,16 +11,16 @@
 #include <thread>
 
 #include "../control/test_profiles.hpp"
+#include "opencnc/broaching/breakpoint_journal.hpp"
 #include "opencnc/config/profile_loader.hpp"
-#include "opencnc/controller/electrode_setting.hpp"
 #include "opencnc/controller/gcode_source.hpp"
 #include "opencnc/core/atomic_file.hpp"
+#include "opencnc/edm/electrode_setting.hpp"
 #include "opencnc/hmi/api.hpp"
 #include "opencnc/hmi/machine_features.hpp"
 #include "opencnc/hmi/machine_host.hpp"
 #include "opencnc/hmi/server.hpp"
-#include "opencnc/recovery/breakpoint_journal.hpp"
-#include "opencnc/recovery/retrace.hpp"
+#include "opencnc/retrace/retrace.hpp"
 #include "opencnc/store/tool_store.hpp"
 #include "opencnc/tools/tool_text.hpp"
 #include "server_rig.hpp"
@@ -218,7 +218,7 @@ TEST(MachineFeatures, EachProfileGetsTheFeaturesItCallsFor) {
   Diagnostics bad;
   EXPECT_FALSE(MachineFeatures::create(load("broach-zc.toml"), {"/proc/opencnc-journal"}, bad));
   ASSERT_FALSE(bad.items().empty());
-  EXPECT_EQ(bad.items()[0].code, "hmi.journal");
+  EXPECT_EQ(bad.items()[0].code, "setting.journal");
   std::filesystem::remove_all(dir);
 }
 

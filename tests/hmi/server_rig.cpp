@@ -10,11 +10,12 @@
 
 #include "opencnc/config/profile_loader.hpp"
 #include "opencnc/controller/gcode_source.hpp"
-#include "opencnc/controller/run_from_line.hpp"
 #include "opencnc/core/atomic_file.hpp"
+#include "opencnc/features/features.hpp"
 #include "opencnc/hmi/history.hpp"
 #include "opencnc/hmi/machine_features.hpp"
 #include "opencnc/hmi/machine_host.hpp"
+#include "opencnc/run_from_line/setup.hpp"
 
 namespace opencnc::hmi::test {
 
@@ -69,14 +70,18 @@ ServerRig::ServerRig(RigOptions o) : dir(fresh_folder()) {
     EXPECT_TRUE(features) << (d.items().empty() ? "" : d.items()[0].format());
     source = features->source();
   } else {
-    source = control::GcodeProgramSource::create(profile, d);
+    source = features::machine_setup(profile, d)->source();  // the features' codes and passes, no feature
   }
   if (o.history) history = History::open(dir / "history.sqlite", &error);
   host = std::make_unique<MachineHost>(profile, source, HostOptions{false, 200});
   if (history) host->controller().attach(std::make_shared<HistoryRecorder>(*history, profile.servo_period_s));
   if (features) features->install(host->controller());
-  if (o.run_from_line)
-    host->controller().add_feature(control::RunFromLineFeature::create(profile, source->tools(), d));
+  if (o.run_from_line) {  // run from line alone, as its setup adds it, reading the server's tool table
+    auto machine = control::MachineSetup::create(profile, {}, d);
+    machine->source_config().tools = source->tools();
+    run_from_line::setup(profile, *machine);
+    machine->install(host->controller());
+  }
   host->start(nullptr);
   ServerConfig sc = o.server;
   sc.address = o.address;

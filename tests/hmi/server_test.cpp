@@ -77,6 +77,31 @@ TEST(Server, BadRequestsGetA4xxWithAMessageAndChangeNothing) {
   EXPECT_EQ(get(rig.port, "/api/v1/commands/" + off.body["id"].dump(), kOperator).body["accepted"], false);
 }
 
+// The route table's order of refusals: a token first (but for the loopback status), then the method
+// (each route's own words), then the role; a path outside /api/v1/ is named as another version.
+TEST(Server, EveryPathGetsItsRoutesRefusalsInOrder) {
+  ServerRig rig(mill());
+  EXPECT_EQ(call(rig.port, Method::Post, "/api/v1/machine", "", "{}").status, 401);
+  const Reply wrong = call(rig.port, Method::Post, "/api/v1/machine", kOperator, "{}");
+  EXPECT_EQ(wrong.status, 405);
+  EXPECT_EQ(wrong.body["error"], "only GET here");
+  EXPECT_EQ(call(rig.port, Method::Post, "/api/v1/status", "", "{}").status, 401);  // only GET is open
+  EXPECT_EQ(call(rig.port, Method::Post, "/api/v1/nothing", kOperator, "{}").status, 405);
+  const Reply none = get(rig.port, "/api/v1/nothing", kOperator);
+  EXPECT_EQ(none.body["error"], "no such call: GET /api/v1/nothing");
+  EXPECT_EQ(get(rig.port, "/api/v1/stream-ticket", kOperator).body["error"], "stream tickets are POSTed");
+  EXPECT_EQ(get(rig.port, "/api/v1/commands", kOperator).body["error"], "commands are POSTed");
+  EXPECT_EQ(get(rig.port, "/api/v1/commands/x", kOperator).status, 400);
+  const Reply admin = get(rig.port, "/api/v1/audit", kOperator);
+  EXPECT_EQ(admin.status, 403);
+  EXPECT_EQ(admin.body["error"], "the audit trail is for the admin");
+  EXPECT_EQ(call(rig.port, Method::Post, "/api/v1/audit", kOperator, "{}").status, 405);  // before the role
+  const Reply other = get(rig.port, "/api/v2/status");
+  EXPECT_EQ(other.status, 404);
+  EXPECT_EQ(other.body["error"], "this server speaks /api/v1/");
+  EXPECT_EQ(call(rig.port, Method::Post, "/index.html", "", "{}").status, 405);  // the front end's files
+}
+
 // The second hostile probe (issue 29): a number no double holds aborted the server; refused tokens
 // on GET calls left no audit row.
 TEST(Server, ANumberTooLargeForADoubleIsA400AndTheServerGoesOn) {

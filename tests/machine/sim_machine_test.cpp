@@ -366,13 +366,13 @@ TEST(SimMachine, AToolChangeMountsTheToolsTrueElectrodeInTheGapAndAtTheSphere) {
   EXPECT_EQ(m.mounted_tool(), 5);
   m.write(out);
   EXPECT_NEAR(m.edm().gap_mm(), 0.2, 1e-9) << "tool 5's electrode is 0.3 mm long";
-  EXPECT_EQ(m.sphere_probe().offset(), (std::array<double, 3>{0.1, 0.2, 0.3}));
+  EXPECT_EQ(m.sphere_probe().offset(), (Vec3{0.1, 0.2, 0.3}));
   EXPECT_EQ(m.sphere_probe().tip_radius(), 0.8);
   // The operator replaces it with a shorter one: the gap and the sphere see it at once.
   m.replace_electrode(5, {0, 0, 0.1}, 0);
   m.write(out);
   EXPECT_NEAR(m.edm().gap_mm(), 0.4, 1e-9);
-  EXPECT_EQ(m.sphere_probe().offset(), (std::array<double, 3>{0, 0, 0.1}));
+  EXPECT_EQ(m.sphere_probe().offset(), (Vec3{0, 0, 0.1}));
   EXPECT_EQ(m.electrode().tool, 5);
 }
 

@@ -42,7 +42,7 @@ TEST(SimSphereProbe, TheContactFollowsTheTurnedSphere) {
   SimSphereProbe p(on_b(0));
   SplitMix64 rng{3};
   p.set_electrode({0, 0, 0}, 0);
-  const std::array<double, 3> top_at_0{100, 50, -145};  // the point tip on the sphere's top at B 0
+  const Vec3 top_at_0{100, 50, -145};  // the point tip on the sphere's top at B 0
   p.turn(0);
   EXPECT_NEAR(p.gap(top_at_0), 0, 1e-12);
   EXPECT_TRUE(p.update({100, 50, -145.0001}, rng));

@@ -134,5 +134,26 @@ TEST(CouplingLaw, ExtentFindsACamsOvershootBetweenPoints) {
   EXPECT_DOUBLE_EQ(phi, 720.0);
 }
 
+TEST(CouplingLaw, ACodesLawComesFromItsKindAndTheMachinesTables) {
+  CouplingConfig config;
+  config.enabled = true;
+  config.table_kind[0] = CouplingKind::PitchTable;
+  config.tables[0] = table({{0, 10}, {100, 12}});
+  config.table_kind[2] = CouplingKind::Cam;
+  config.tables[2] = table({{0, 0}, {10, 30}, {20, 40}});
+  EXPECT_DOUBLE_EQ(law_for(config, CouplingKind::ConstantPitch, 8, 0, 0).slave(4), 180);
+  EXPECT_DOUBLE_EQ(law_for(config, CouplingKind::LinearPitch, 10, 0.02, 0).slave(60),
+                   CouplingLaw::linear(10, 0.02).slave(60));
+  EXPECT_DOUBLE_EQ(law_for(config, CouplingKind::PitchTable, 0, 0, 1).slave(60),
+                   CouplingLaw::tabulated(CouplingKind::PitchTable, config.tables[0]).slave(60));
+  EXPECT_EQ(law_for(config, CouplingKind::Cam, 0, 0, 3).kind(), CouplingKind::Cam);
+  // What the machine does not have is no law: a missing table, a table of the other kind, Off.
+  EXPECT_FALSE(law_for(config, CouplingKind::PitchTable, 0, 0, 2).active());
+  EXPECT_FALSE(law_for(config, CouplingKind::Cam, 0, 0, 1).active());
+  EXPECT_FALSE(law_for(config, CouplingKind::PitchTable, 0, 0, 0).active());
+  EXPECT_FALSE(law_for(config, CouplingKind::PitchTable, 0, 0, kMaxCouplingTables + 1).active());
+  EXPECT_FALSE(law_for(config, CouplingKind::Off, 8, 0, 0).active());
+}
+
 }  // namespace
 }  // namespace opencnc::motion

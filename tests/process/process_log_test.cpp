@@ -15,6 +15,7 @@
 #include "opencnc/controller/controller.hpp"
 #include "opencnc/controller/gcode_source.hpp"
 #include "opencnc/controller/sim_rig.hpp"
+#include "opencnc/features/features.hpp"
 #include "opencnc/process/process_log.hpp"
 #include "opencnc/store/database.hpp"
 
@@ -46,7 +47,7 @@ std::uint64_t run_logged(const std::string& path, LogFormat format) {
       p.axis_mask(), p.broaching.log_rate_hz, p.servo_period_s, p.coupling.radius_mm, program, p.name};
   auto log = std::make_shared<ProcessLog>(setup, format, *out);
   Diagnostics d;
-  SimRig rig(p, GcodeProgramSource::create(p, d));
+  SimRig rig(p, *features::machine_setup(p, d));
   rig.controller().attach(log, ObserverOptions{0, true});
   rig.step();
   EXPECT_TRUE(rig.request(Request::simple(CommandKind::MachineOn)).accepted);

@@ -12,8 +12,8 @@
 #include <fmt/format.h>
 
 #include "opencnc/config/profile_loader.hpp"
-#include "opencnc/controller/b_axis_fit.hpp"
-#include "opencnc/controller/electrode_setting.hpp"
+#include "opencnc/edm/b_axis_fit.hpp"
+#include "opencnc/edm/electrode_setting.hpp"
 #include "scenario.hpp"
 
 namespace opencnc::control::test {
@@ -47,22 +47,23 @@ std::shared_ptr<tools::MemoryToolTable> electrode_table() {
 /// The whole controller with the electrode feature, on `sim` (the simulated machine's profile)
 /// while the feature and the program source use `profile`.
 struct Rig {
+  /// The features `profile` calls for (as every front end sets them up) on the test's tool table,
+  /// on the simulated machine of `sim` (the truth the profile may not know).
   explicit Rig(const config::MachineProfile& profile, const config::MachineProfile& sim)
-      : tools(electrode_table()), scenario(sim, source(profile, tools)) {
-    feature = std::make_shared<ElectrodeSetting>(tools, profile);
-    EXPECT_TRUE(
-        scenario.rig().controller().add_feature(feature, ObserverOptions{profile.servo_period_s, true}));
+      : tools(electrode_table()), machine(set_up(profile, tools)), scenario(sim, machine->source()) {
+    feature = std::dynamic_pointer_cast<ElectrodeSetting>(machine->feature("electrode"));
+    EXPECT_TRUE(feature);
+    machine->install(scenario.rig().controller());
     scenario.must(Request::simple(CommandKind::MachineOn));
   }
   explicit Rig(const config::MachineProfile& profile) : Rig(profile, profile) {}
 
-  static std::shared_ptr<ProgramSource> source(const config::MachineProfile& p,
-                                               std::shared_ptr<tools::MemoryToolTable> t) {
+  static std::unique_ptr<MachineSetup> set_up(const config::MachineProfile& p,
+                                              std::shared_ptr<tools::MemoryToolTable> t) {
     Diagnostics d;
-    std::optional<GcodeSourceConfig> c = GcodeProgramSource::config_for(p, d);
-    EXPECT_TRUE(c.has_value());
-    c->tools = std::move(t);
-    return std::make_shared<GcodeProgramSource>(std::move(*c));
+    auto m = features::machine_setup(p, d, control::MachineSetup::Options::with_tools(std::move(t)));
+    EXPECT_TRUE(m) << (d.items().empty() ? "" : d.items()[0].format());
+    return m;
   }
   /// Measures `tool`; the result once the feature is idle again.
   ElectrodeResult measure(int tool) {
@@ -71,19 +72,20 @@ struct Rig {
     EXPECT_TRUE(feature->last().has_value());
     return feature->last().value_or(ElectrodeResult{});
   }
-  Point3 table_offset(int tool) const {
+  Vec3 table_offset(int tool) const {
     const tools::ToolEntry* e = tools->snapshot()->tool(tool);
     return {e->offset[0], e->offset[1], e->offset[2]};
   }
 
   std::shared_ptr<tools::MemoryToolTable> tools;
+  std::unique_ptr<MachineSetup> machine;
   Scenario scenario;
   std::shared_ptr<ElectrodeSetting> feature;
 };
 
 TEST(ElectrodeSetting, MeasuresAnOffsetElectrodeWithinAMicrometreAndStoresIt) {
   Rig r(edm_profile());
-  const Point3 truth{0.2, -0.1, 50.5};  // tool 1 is off its table entry by (0.2, −0.1, 0.5)
+  const Vec3 truth{0.2, -0.1, 50.5};  // tool 1 is off its table entry by (0.2, −0.1, 0.5)
   r.scenario.sim().set_electrode(truth, 0);
   const ElectrodeResult m = r.measure(1);
   ASSERT_TRUE(m.ok) << m.message;
@@ -98,7 +100,7 @@ TEST(ElectrodeSetting, MeasuresAnOffsetElectrodeWithinAMicrometreAndStoresIt) {
 
 TEST(ElectrodeSetting, ABallTippedElectrodeIsMeasuredToItsLowestPoint) {
   Rig r(edm_profile({"probe.reference_sphere.touches_around=6"}));
-  const Point3 truth{-0.3, 0.15, 39.8};
+  const Vec3 truth{-0.3, 0.15, 39.8};
   r.scenario.sim().set_electrode(truth, 3.0);
   const ElectrodeResult m = r.measure(2);
   ASSERT_TRUE(m.ok) << m.message;
@@ -116,7 +118,7 @@ std::vector<std::string> fast_then_slow(std::vector<std::string> more = {}) {
 
 TEST(ElectrodeSetting, FastThenSlowTouchesMeasureToATenthOfAMicrometre) {
   Rig r(edm_profile(fast_then_slow()));
-  const Point3 truth{0.2, -0.1, 50.5};
+  const Vec3 truth{0.2, -0.1, 50.5};
   r.scenario.sim().set_electrode(truth, 0);
   const ElectrodeResult m = r.measure(1);
   ASSERT_TRUE(m.ok) << m.message;
@@ -152,7 +154,7 @@ TEST(ElectrodeSetting, TheSphereTurnsWithBAndIsMeasuredAtItsAngle) {
   const machine::SimSphereProbe& sphere = r.scenario.sim().sphere_probe();
   EXPECT_NEAR(sphere.centre()[0], 100.0, 1e-9) << "at B 0 the sphere is where it was mounted";
   EXPECT_NEAR(sphere.centre()[2], -150.0, 1e-9);
-  const Point3 truth{-0.15, 0.25, 49.7};
+  const Vec3 truth{-0.15, 0.25, 49.7};
   r.scenario.sim().set_electrode(truth, 0);
   const ElectrodeResult m = r.measure(1);
   ASSERT_TRUE(m.ok) << m.message;
@@ -192,7 +194,7 @@ TEST(ElectrodeSetting, CalibrateBFindsTheTrueAxisWithinAMicrometre) {
   EXPECT_NEAR(c.fit.axis.direction[2], -0.0001 / n, 2e-5);
   EXPECT_NEAR(c.fit.radius_mm, std::hypot(0.012, 20.015), 0.001);
   EXPECT_LT(c.fit.max_residual_mm, 0.001);
-  EXPECT_EQ(r.table_offset(1), (Point3{0, 0, 50})) << "the tool table is not touched";
+  EXPECT_EQ(r.table_offset(1), (Vec3{0, 0, 50})) << "the tool table is not touched";
   const config::ReferenceSphereProfile now = r.feature->sphere();
   EXPECT_TRUE(now.has_b_axis);
   EXPECT_EQ(now.b_axis, c.fit.axis.crossing) << "kept for the measurements that follow";
@@ -201,7 +203,7 @@ TEST(ElectrodeSetting, CalibrateBFindsTheTrueAxisWithinAMicrometre) {
 
 TEST(ElectrodeSetting, WithBTurnedTheElectrodeIsRightOnlyAboutTheMeasuredAxis) {
   Rig r(edm_profile(b_axis_off_nominal()));
-  const Point3 truth{0.2, -0.1, 50.5};
+  const Vec3 truth{0.2, -0.1, 50.5};
   r.scenario.sim().set_electrode(truth, 0);
   const machine::SimSphereProbe& sphere = r.scenario.sim().sphere_probe();
   // About the drawing's axis, with B at 40°: the sphere is not where the touches are aimed, and
@@ -214,7 +216,7 @@ TEST(ElectrodeSetting, WithBTurnedTheElectrodeIsRightOnlyAboutTheMeasuredAxis) {
   const ElectrodeResult nominal = measure_at_40();
   ASSERT_TRUE(nominal.ok) << nominal.message;
   EXPECT_EQ(r.scenario.status().servo.commanded[Axis::B], 40.0);
-  const Point3 expected = sphere_centre_at(r.feature->sphere(), 40);
+  const Vec3 expected = sphere_centre_at(r.feature->sphere(), 40);
   double off = 0;
   for (std::size_t i = 0; i < 3; ++i) {
     const double error = sphere.centre()[i] - expected[i];
@@ -228,7 +230,7 @@ TEST(ElectrodeSetting, WithBTurnedTheElectrodeIsRightOnlyAboutTheMeasuredAxis) {
   ASSERT_TRUE(calibrate_b(r, {-40, 0, 40}).ok);
   const ElectrodeResult measured = measure_at_40();
   ASSERT_TRUE(measured.ok) << measured.message;
-  const Point3 now = sphere_centre_at(r.feature->sphere(), 40);
+  const Vec3 now = sphere_centre_at(r.feature->sphere(), 40);
   for (std::size_t i = 0; i < 3; ++i) {
     EXPECT_NEAR(now[i], sphere.centre()[i], 0.001)
         << "the sphere where the measured axis turns it, axis " << i;
@@ -285,7 +287,7 @@ TEST(ElectrodeSetting, AMissingSphereIsRefusedAndNothingStored) {
   EXPECT_FALSE(m.ok);
   EXPECT_EQ(m.code, "electrode.missing-touch");
   EXPECT_NE(m.message.find("touch from +X met nothing"), std::string::npos) << m.message;
-  EXPECT_EQ(r.table_offset(1), (Point3{0, 0, 50}));
+  EXPECT_EQ(r.table_offset(1), (Vec3{0, 0, 50}));
   bool noted = false;
   for (const ControllerEvent& e : log.next(1 << 16))
     noted |= e.kind == ControllerEventKind::Note && e.code == "electrode.missing-touch";
@@ -299,7 +301,7 @@ TEST(ElectrodeSetting, AContactClosedBeforeTheTouchIsNotATouch) {
   const ElectrodeResult m = r.measure(1);
   EXPECT_FALSE(m.ok);
   EXPECT_EQ(m.code, "electrode.contact-at-start") << m.message;
-  EXPECT_EQ(r.table_offset(1), (Point3{0, 0, 50}));
+  EXPECT_EQ(r.table_offset(1), (Vec3{0, 0, 50}));
 }
 
 TEST(ElectrodeSetting, ASphereFartherThanAllowedIsRefused) {
@@ -309,7 +311,7 @@ TEST(ElectrodeSetting, ASphereFartherThanAllowedIsRefused) {
   EXPECT_FALSE(m.ok);
   EXPECT_EQ(m.code, "electrode.far") << m.message;
   EXPECT_NEAR(m.offset[0], 0.7, 0.001) << "what was found is reported";
-  EXPECT_EQ(r.table_offset(1), (Point3{0, 0, 50}));
+  EXPECT_EQ(r.table_offset(1), (Vec3{0, 0, 50}));
 }
 
 TEST(ElectrodeSetting, TouchesOffTheSphereExceedTheTolerance) {
@@ -320,7 +322,7 @@ TEST(ElectrodeSetting, TouchesOffTheSphereExceedTheTolerance) {
   EXPECT_FALSE(m.ok);
   EXPECT_EQ(m.code, "electrode.fit") << m.message;
   EXPECT_GT(m.max_residual_mm, 0.002);
-  EXPECT_EQ(r.table_offset(1), (Point3{0, 0, 50}));
+  EXPECT_EQ(r.table_offset(1), (Vec3{0, 0, 50}));
 }
 
 TEST(ElectrodeSetting, RefusesWhatItCannotMeasure) {
@@ -366,7 +368,7 @@ TEST(ElectrodeSetting, AWornElectrodeIsReplacedMidJobAndTheJobGoesOnWhereItStopp
   EXPECT_EQ(stop->position[2], 30.0) << "on the G1 X40 at Z-20 + 50";
 
   // The new electrode is 0.2, −0.1 and 0.5 mm off the worn one's offsets.
-  const Point3 truth{0.2, -0.1, 50.5};
+  const Vec3 truth{0.2, -0.1, 50.5};
   r.scenario.sim().set_electrode(truth, 0);
   const ElectrodeResult m = r.measure(1);
   ASSERT_TRUE(m.ok) << m.message;

@@ -12,7 +12,8 @@
 #include <vector>
 
 #include "opencnc/config/profile_loader.hpp"
-#include "opencnc/recovery/retrace.hpp"
+#include "opencnc/features/features.hpp"
+#include "opencnc/retrace/retrace.hpp"
 #include "scenario.hpp"
 
 namespace opencnc::control::test {
@@ -95,7 +96,7 @@ config::MachineProfile flame_cutter(std::vector<std::string> sets = {}) {
 /// The whole program as the controller's G-code source runs it, every move kept.
 canon::Program whole_program(const config::MachineProfile& profile, const std::string& path) {
   Diagnostics d;
-  auto source = GcodeProgramSource::create(profile, d);
+  auto source = features::machine_setup(profile, d)->source();
   auto stream = source->execute(path, Pose{}, {});
   while (stream->state() == StreamState::Reading) stream->read(100000);
   EXPECT_EQ(stream->state(), StreamState::Finished);
@@ -113,9 +114,8 @@ canon::Program whole_program(const config::MachineProfile& profile, const std::s
 void pause_jog_back_start_stop_again_at_a_step_back_and_cut_to_the_end(
     const config::MachineProfile& profile) {
   Scenario s(profile);
-  Diagnostics d;
-  auto feature = std::make_shared<recovery::RetraceFeature>(GcodeProgramSource::create(profile, d), profile);
-  ASSERT_TRUE(s.rig().controller().add_feature(feature, ObserverOptions{profile.servo_period_s, false}));
+  auto feature = std::dynamic_pointer_cast<recovery::RetraceFeature>(s.machine().feature("retrace"));
+  ASSERT_TRUE(feature);
   auto cuts = std::make_shared<CutMoves>();
   s.rig().controller().attach(cuts, ObserverOptions{0, true});
   TempProgram p("nest.ngc", kNest);

@@ -13,7 +13,9 @@
 
 #include "../control/test_profiles.hpp"
 #include "opencnc/controller/gcode_source.hpp"
-#include "opencnc/controller/run_from_line.hpp"
+#include "opencnc/features/features.hpp"
+#include "opencnc/run_from_line/run_from_line.hpp"
+#include "opencnc/run_from_line/setup.hpp"
 #include "scenario.hpp"
 
 namespace opencnc::control::test {
@@ -35,15 +37,24 @@ constexpr const char* kProgram =
 
 std::shared_ptr<GcodeProgramSource> mill_source(const config::MachineProfile& profile = mill()) {
   Diagnostics d;
-  return GcodeProgramSource::create(profile, d);
+  return features::machine_setup(profile, d)->source();
+}
+
+/// The feature as every front end sets it up: run_from_line::setup on a machine of `source`'s.
+std::shared_ptr<RunFromLineFeature> set_up_feature(const config::MachineProfile& profile,
+                                                   const std::shared_ptr<GcodeProgramSource>& source) {
+  Diagnostics d;
+  auto machine = MachineSetup::create(profile, {}, d);
+  machine->source_config().tools = source->tools();
+  run_from_line::setup(profile, *machine);
+  return std::dynamic_pointer_cast<RunFromLineFeature>(machine->feature("run-from-line"));
 }
 
 struct Rig {
   explicit Rig(std::shared_ptr<GcodeProgramSource> source = mill_source(),
                const config::MachineProfile& profile = mill())
       : s(profile, source) {
-    Diagnostics d;
-    feature = RunFromLineFeature::create(profile, source->tools(), d);
+    feature = set_up_feature(profile, source);
     EXPECT_TRUE(feature);
     EXPECT_TRUE(s.rig().controller().add_feature(feature));
     s.ticks(1);
@@ -173,7 +184,7 @@ TEST(RunFromLineScenario, TheApproachFeedIsPerMinuteUnderInverseTimeAndPerRevolu
                 "G94 G1 X0 F300\n"    // 9
                 "M2\n");              // 10
   Diagnostics d;
-  const auto source = GcodeProgramSource::create(mill(), d);
+  const auto source = features::machine_setup(mill(), d)->source();
   const double expected[][2] = {{4, 600}, {5, 60}, {6, 100}, {8, 250}, {9, 300}};
   for (const auto& [line, feed] : expected) {
     std::string why;
@@ -340,7 +351,7 @@ class GatedSource final : public ProgramSource {
 // stays idle; once the scan ends the request gets its answer and the program runs from the line.
 TEST(RunFromLineScenario, TheControllerAnswersWhileTheScanRunsAndNothingStarts) {
   TempProgram p("part.ngc", kProgram);
-  Scenario s(mill());
+  Scenario s(mill(), mill_source());  // no feature: the test's own run from line, on a gated source
   auto gate = std::make_shared<GatedSource>(mill_source());
   ASSERT_TRUE(s.rig().controller().add_feature(std::make_shared<RunFromLineFeature>(gate)));
   struct Open {  // a failed assertion still lets the scan's thread end before the rig goes

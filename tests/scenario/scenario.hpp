@@ -15,6 +15,7 @@
 #include "opencnc/controller/run_recorder.hpp"
 #include "opencnc/controller/servo_setup.hpp"
 #include "opencnc/controller/sim_rig.hpp"
+#include "opencnc/features/features.hpp"
 
 namespace opencnc::control::test {
 
@@ -72,14 +73,18 @@ class SampleKeeper final : public ControllerObserver {
 
 class Scenario {
  public:
-  explicit Scenario(const config::MachineProfile& profile) : Scenario(profile, make_source(profile)) {}
-  /// With a program source of the test's own (a tool table in memory, code modules).
+  /// The machine as its features set it up (features::machine_setup), as every front end does.
+  explicit Scenario(const config::MachineProfile& profile) : profile_(profile) {
+    Diagnostics d;
+    machine_ = features::machine_setup(profile, d);
+    EXPECT_TRUE(machine_ != nullptr) << (d.items().empty() ? "" : d.items()[0].format());
+    rig_ = std::make_unique<SimRig>(profile, *machine_);
+    start();
+  }
+  /// With a program source of the test's own (a tool table in memory, code modules) and no feature.
   Scenario(const config::MachineProfile& profile, std::shared_ptr<ProgramSource> source) : profile_(profile) {
     rig_ = std::make_unique<SimRig>(profile, std::move(source));
-    keeper_ =
-        std::make_shared<SampleKeeper>(machine_limits(profile), axis_limits(profile), profile.servo_period_s);
-    rig_->controller().attach(keeper_, ObserverOptions{0, true});
-    rig_->step();  // the observer is attached from here on
+    start();
   }
 
   Outcome ask(Request r) {
@@ -132,20 +137,23 @@ class Scenario {
 
   ControllerStatus status() const { return rig_->status(); }
   SimRig& rig() { return *rig_; }
+  /// The machine's features as set up (the first constructor).
+  MachineSetup& machine() { return *machine_; }
   machine::SimMachine& sim() { return rig_->machine(); }
   const std::vector<TraceSample>& samples() const { return keeper_->samples(); }
   void forget_samples() { keeper_->forget(); }
   const std::string& message() const { return last_message_; }
 
  private:
-  static std::shared_ptr<ProgramSource> make_source(const config::MachineProfile& profile) {
-    Diagnostics d;
-    auto source = GcodeProgramSource::create(profile, d);
-    EXPECT_TRUE(source != nullptr);
-    return source;
+  void start() {
+    keeper_ = std::make_shared<SampleKeeper>(machine_limits(profile_), axis_limits(profile_),
+                                             profile_.servo_period_s);
+    rig_->controller().attach(keeper_, ObserverOptions{0, true});
+    rig_->step();  // the observer is attached from here on
   }
 
   config::MachineProfile profile_;
+  std::unique_ptr<MachineSetup> machine_;  ///< the features' set-up (null with a source of the test's own)
   std::unique_ptr<SimRig> rig_;
   std::shared_ptr<SampleKeeper> keeper_;
   std::string last_message_;

@@ -19,11 +19,12 @@
 #include <thread>
 
 #include "../control/test_profiles.hpp"
+#include "opencnc/broaching/breakpoint_journal.hpp"
 #include "opencnc/controller/gcode_source.hpp"
-#include "opencnc/controller/run_from_line.hpp"
 #include "opencnc/controller/servo_setup.hpp"
 #include "opencnc/core/atomic_file.hpp"
-#include "opencnc/recovery/breakpoint_journal.hpp"
+#include "opencnc/features/features.hpp"
+#include "opencnc/run_from_line/run_from_line.hpp"
 #include "opencnc/toolguard/tool_guard.hpp"
 #include "opencnc/tools/tool_text.hpp"
 #include "scenario.hpp"
@@ -137,7 +138,7 @@ class SplitRig {
 
 std::shared_ptr<GcodeProgramSource> source_for(const config::MachineProfile& p) {
   Diagnostics d;
-  return GcodeProgramSource::create(p, d);
+  return features::machine_setup(p, d)->source();
 }
 
 /// Machine on with the spindle at 3000 rpm, then Auto mode.
@@ -193,11 +194,11 @@ TEST(StopLane, AnAbortActsInTheNextPeriodWhileACycleStartChecksTheProgramAgain) 
 TEST(StopLane, AnEStopActsInTheNextPeriodWhileRunFromLineScans) {
   TempProgram p("part.ngc", kLong);
   const config::MachineProfile profile = mill();
-  auto source = source_for(profile);
-  SplitRig r(profile, source);
   Diagnostics d;
-  auto feature = RunFromLineFeature::create(profile, source->tools(), d);
-  ASSERT_TRUE(r.controller().add_feature(feature));
+  auto machine = features::machine_setup(profile, d);  // run from line, as every front end sets it up
+  ASSERT_TRUE(machine);
+  SplitRig r(profile, machine->source());
+  machine->install(r.controller());
   spindle_running(r);
   r.must(Request::open(p.path()));
   const std::uint64_t scan =
@@ -227,10 +228,10 @@ TEST(StopLane, AnEStopActsInTheNextPeriodWhileTheToolStoreWaitsForItsLock) {
       config::load_profile(std::string(OPENCNC_SOURCE_DIR) + "/configs/hmc-toolcheck.toml", sets);
   ASSERT_TRUE(load.ok());
   Diagnostics d;
-  std::optional<toolguard::Setup> setup = toolguard::setup(*load.profile, d);
-  ASSERT_TRUE(setup);
-  SplitRig r(*load.profile, setup->source);
-  ASSERT_TRUE(r.controller().add_feature(setup->feature));
+  auto machine = features::machine_setup(*load.profile, d);  // the guard, as every front end sets it up
+  ASSERT_TRUE(machine) << (d.items().empty() ? "" : d.items()[0].format());
+  SplitRig r(*load.profile, machine->source());
+  machine->install(r.controller());
   spindle_running(r);
   // Another writer holds the database: the guard's backup waits for it (SQLite's busy wait).
   sqlite3* other = nullptr;

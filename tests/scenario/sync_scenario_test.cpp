@@ -7,8 +7,9 @@
 #include <string>
 
 #include "../control/test_profiles.hpp"
-#include "opencnc/controller/gcode_source.hpp"
 #include "opencnc/canon/program_builder.hpp"
+#include "opencnc/controller/gcode_source.hpp"
+#include "opencnc/features/features.hpp"
 #include "opencnc/gcode/standard_extensions.hpp"
 #include "opencnc/tools/tool_table_service.hpp"
 
@@ -190,7 +191,7 @@ TEST(SyncScenario, ToolDataChangedDuringAToolChangeCountsAfterIt) {
   auto tools = std::make_shared<tools::MemoryToolTable>(table);
   const config::MachineProfile profile = mill();
   Diagnostics d;
-  auto base = GcodeProgramSource::create(profile, d);
+  auto base = features::machine_setup(profile, d)->source();
   GcodeSourceConfig c;
   c.options = base->options_for("", {});
   c.tools = tools;
@@ -229,7 +230,7 @@ TEST(SyncScenario, G10L1WritesTheMachinesToolTable) {
   const config::MachineProfile profile = mill();
   Diagnostics d;
   GcodeSourceConfig c;
-  c.options = GcodeProgramSource::create(profile, d)->options_for("", {});
+  c.options = features::machine_setup(profile, d)->source()->options_for("", {});
   c.tools = tools;
   Scenario s(profile, std::make_shared<GcodeProgramSource>(c));
   TempProgram p("g10.ngc", "G21 G90\nT2 M6\nG10 L1 P2 Z42.5 R3\nG43 H2\nG0 Z0\nM2\n");

@@ -49,9 +49,7 @@ class Guarded {
         config::load_profile(std::string(OPENCNC_SOURCE_DIR) + "/configs/hmc-toolcheck.toml", sets);
     for (const auto& x : load.diagnostics.items()) ADD_FAILURE() << x.format();
     profile_ = *load.profile;
-    setup_ = *toolguard::setup(profile_, d);
-    scenario_ = std::make_unique<Scenario>(profile_, setup_.source);
-    scenario_->rig().controller().add_feature(setup_.feature);
+    scenario_ = std::make_unique<Scenario>(profile_);  // the guard as every front end sets it up
     cursor_ = std::make_unique<EventCursor>(scenario_->rig().controller().events(), true);
     scenario_->on(Mode::Auto);
   }
@@ -74,7 +72,6 @@ class Guarded {
   store::test::TempDb db_;
   std::shared_ptr<store::ToolStore> store_;
   config::MachineProfile profile_;
-  toolguard::Setup setup_;
   std::unique_ptr<Scenario> scenario_;
   std::unique_ptr<EventCursor> cursor_;
 };

@@ -13,6 +13,7 @@
 #include "opencnc/canon/types.hpp"
 #include "opencnc/core/axes.hpp"
 #include "opencnc/core/chunked_vector.hpp"
+#include "opencnc/core/vec3.hpp"
 
 namespace opencnc::canon {
 
@@ -49,8 +50,8 @@ static_assert(sizeof(Move) == 16);
 /// Geometry of an arc or helix in machine coordinates (mm), in the plane's axis triple
 /// (X,Y,Z for XY/YZ/XZ; U,V,W for UV/VW/UW).
 struct ArcGeometry {
-  double center[3] = {0, 0, 0};  ///< on the plane through the start point
-  double normal[3] = {0, 0, 1};  ///< unit normal; rotation is counterclockwise about it
+  Vec3 center{0, 0, 0};          ///< on the plane through the start point
+  Vec3 normal{0, 0, 1};          ///< unit normal; rotation is counterclockwise about it
   std::int32_t turns = 1;        ///< LinuxCNC's rotation: |turns|-1 extra full circles; sign = direction
   Plane plane = Plane::XY;
   std::uint32_t feed = 0;        ///< index into feeds
@@ -132,6 +133,23 @@ struct Action {
   std::uint32_t pose = 0;   ///< index into poses of actions (offsets)
   std::uint32_t origin = 0;  ///< AxisCoupling: 1 + index into poses of the law's origin (0: none)
 };
+
+/// Whether `a` refers to a pose of its program's action poses (`pose`): the offsets, a surface
+/// speed's spindle axis (index2 = 1), a coupling's rate, a process code's Q.
+constexpr bool has_pose(const Action& a) noexcept {
+  switch (a.kind) {
+    case ActionKind::ToolLengthOffset:
+    case ActionKind::WorkOffset:
+    case ActionKind::G92Offset:
+    case ActionKind::AxisCoupling:
+    case ActionKind::ProcessCode:
+      return true;
+    case ActionKind::SpindleSpeed:
+      return a.index2 == 1;
+    default:
+      return false;
+  }
+}
 
 /// The expanded program. Positions in machine coordinates (mm, degrees) with every offset,
 /// unit conversion and rotation applied. Built by canon::ProgramBuilder; read by the planner,

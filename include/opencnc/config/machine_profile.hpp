@@ -10,6 +10,7 @@
 
 #include "opencnc/core/axes.hpp"
 #include "opencnc/core/axis_map.hpp"
+#include "opencnc/core/vec3.hpp"
 #include "opencnc/machine/interlocks.hpp"
 #include "opencnc/machine/machine_io.hpp"
 #include "opencnc/machine/process_alarms.hpp"
@@ -126,7 +127,7 @@ struct PowerProfile {
 /// Machine coordinates, mm; feeds mm/min.
 struct ReferenceSphereProfile {
   bool present = false;
-  std::array<double, 3> position{};  ///< the sphere's centre (with B at `b_deg` on a machine with B)
+  Vec3 position{};  ///< the sphere's centre (with B at `b_deg` on a machine with B)
   double diameter = 0;
   double b_deg = 0;            ///< the B angle the routine turns to first (machines with B)
   double clearance = 1;        ///< each touch starts this far off the surface and probes as far past it
@@ -145,7 +146,7 @@ struct ReferenceSphereProfile {
   /// electrode setting reads it to find the sphere at any B (absent: only at `b_deg`).
   bool has_b_axis = false;
   std::array<double, 2> b_axis{};
-  std::array<double, 3> b_axis_direction{0, 1, 0};
+  Vec3 b_axis_direction{0, 1, 0};
   bool sim = false;            ///< the simulated probe touches this sphere
   double sim_hysteresis = 0.0005;
   double sim_noise = 0.0002;
@@ -154,7 +155,7 @@ struct ReferenceSphereProfile {
   /// the controller does not know; `position` is its centre with B at `b_deg`).
   bool sim_turns_with_b = false;
   std::array<double, 2> sim_b_axis{};
-  std::array<double, 3> sim_b_direction{0, 1, 0};
+  Vec3 sim_b_direction{0, 1, 0};
 };
 
 struct ProbeProfile {

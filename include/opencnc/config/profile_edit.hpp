@@ -95,6 +95,12 @@ struct ProfileEditResult {
   std::vector<ProfileChange> changes;  ///< in the order asked
   std::string error;                   ///< a refusal of the request itself (a key not editable …)
   Diagnostics diagnostics;             ///< the loader's on the new text (`file:line:col: message`)
+  /// What the change is of, for the audit and the log: "machining conditions" when every change
+  /// is a condition's, else "machine parameters".
+  const char* subject = "machine parameters";
+  /// What the change deletes, for a refusal when the open program still needs it ("a condition");
+  /// "" when it deletes nothing.
+  const char* deletes = "";
   bool ok() const noexcept { return profile.has_value(); }
 };
 

@@ -17,27 +17,27 @@ namespace opencnc::control {
 std::uint64_t shared_layout_id() noexcept;
 
 /// A mapping of a named segment ("/opencnc" style: one leading slash, no other).
-class SharedMemory {
+class SegmentMapping {
  public:
   /// Creates the segment `name` anew (a stale one of that name is unlinked first: mappings of
   /// it stay valid but are no longer found), initialises the header, the set-up and the
   /// channels, and maps it. Nothing on failure, with `error` saying why. Setup thread.
-  static std::unique_ptr<SharedMemory> create(const std::string& name, std::int64_t period_ns,
-                                              std::uint32_t heartbeat_timeout_ticks, std::string& error);
+  static std::unique_ptr<SegmentMapping> create(const std::string& name, std::int64_t period_ns,
+                                                std::uint32_t heartbeat_timeout_ticks, std::string& error);
   /// Maps an existing segment and checks it: ours (magic), of this build (layout id, size).
   /// Nothing on failure, with `error` saying why. Controller's setup thread.
-  static std::unique_ptr<SharedMemory> attach(const std::string& name, std::string& error);
+  static std::unique_ptr<SegmentMapping> attach(const std::string& name, std::string& error);
 
-  ~SharedMemory();
-  SharedMemory(const SharedMemory&) = delete;
-  SharedMemory& operator=(const SharedMemory&) = delete;
+  ~SegmentMapping();
+  SegmentMapping(const SegmentMapping&) = delete;
+  SegmentMapping& operator=(const SegmentMapping&) = delete;
 
   /// Any thread (the fields say who writes what).
   SharedSegment& segment() noexcept { return *segment_; }
   const std::string& name() const noexcept { return name_; }
 
  private:
-  SharedMemory(std::string name, SharedSegment* segment, bool owner) noexcept
+  SegmentMapping(std::string name, SharedSegment* segment, bool owner) noexcept
       : name_(std::move(name)), segment_(segment), owner_(owner) {}
   std::string name_;
   SharedSegment* segment_;

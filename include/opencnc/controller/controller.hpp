@@ -24,6 +24,7 @@
 #include "opencnc/control/servo_config.hpp"
 #include "opencnc/controller/controller_status.hpp"
 #include "opencnc/controller/events.hpp"
+#include "opencnc/controller/extensions.hpp"
 #include "opencnc/controller/observer.hpp"
 #include "opencnc/controller/program_source.hpp"
 #include "opencnc/controller/request.hpp"
@@ -89,6 +90,13 @@ class Controller final : private FeatureHost {
   bool add_feature(std::shared_ptr<Feature> feature, ObserverOptions options = {});
   /// The open program (its preflight summary and warnings), if any. Any thread.
   std::optional<OpenProgram> open_program() const;
+  /// Adds what a feature's process adds around a move to the soft-limit check of every move (the
+  /// preflight's and the running program's), from the next service() on. Any thread; before the
+  /// controller checks a program (a set-up's install()).
+  void add_move_reach(MoveReachFactory reach);
+  /// Adds the words of a feature's events, faults and waits (extensions.hpp), from the next
+  /// service() on. Any thread.
+  void add_texts(std::shared_ptr<const EventTexts> texts);
 
   /// The periodic work: reads the servo's events, status and trace, handles queued requests,
   /// keeps the interpreter and the planner ahead of the servo, tells the observers. Controller
@@ -135,10 +143,9 @@ class Controller final : private FeatureHost {
   void edit_profile(std::uint64_t id, const requests::EditProfile& r);
   bool settle_profile_change(const ServoEvent& e);
   struct ProfileChange;
-  bool stage_pitch_table(int joint, const ServoConfig& next, const ProfileChange& pending);
-  bool stage_edm_conditions(const ServoConfig& next, const ProfileChange& pending);
-  bool open_program_keeps_its_conditions(const requests::EditProfile& r, const config::MachineProfile& next,
-                                         Diagnostics& selects);
+  bool open_program_passes(const config::MachineProfile& next, Diagnostics& needs);
+  /// The move check of the servo configuration in force, with the features' reaches.
+  std::unique_ptr<MachineMoveCheck> make_move_check() const;
   void swap_profile(config::MachineProfile profile);
   bool features_allow_start(std::uint64_t id, const StartCheck& start);
   bool features_allow_continue(const SyncCheck& sync);
@@ -185,6 +192,8 @@ class Controller final : private FeatureHost {
   plan::PlannerConfig planner_config_;
   ServoChannels* channels_;
   std::shared_ptr<ProgramSource> source_;
+  std::vector<MoveReachFactory> reaches_;  ///< controller thread: the features' (add_move_reach)
+  std::vector<std::shared_ptr<const EventTexts>> texts_;  ///< controller thread: the features' (add_texts)
   std::unique_ptr<MachineMoveCheck> check_;
   EventLog log_;
 
@@ -208,6 +217,8 @@ class Controller final : private FeatureHost {
   std::vector<Attached> to_attach_;
   std::vector<std::uint64_t> to_detach_;
   std::vector<std::shared_ptr<Feature>> features_to_add_;
+  std::vector<MoveReachFactory> reaches_to_add_;
+  std::vector<std::shared_ptr<const EventTexts>> texts_to_add_;
 
   mutable std::mutex out_mutex_;  ///< outcomes, the published status, the open program
   /// The answer to request `id` at `id % size()`, kept until a later id takes its place: slots built

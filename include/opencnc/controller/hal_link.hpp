@@ -36,10 +36,10 @@ class HalLink {
   const SharedHeader& header() const noexcept { return memory_->segment().header; }
 
  private:
-  explicit HalLink(std::unique_ptr<SharedMemory> memory) noexcept : memory_(std::move(memory)) {}
+  explicit HalLink(std::unique_ptr<SegmentMapping> memory) noexcept : memory_(std::move(memory)) {}
   void beat_every(std::chrono::nanoseconds interval);
 
-  std::unique_ptr<SharedMemory> memory_;
+  std::unique_ptr<SegmentMapping> memory_;
   std::atomic<bool> stop_{false};
   std::thread beat_;
 };

@@ -1,9 +1,11 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// From a machine profile to the settings of the servo tick and of the planner that feeds it.
+// From a machine profile to the limits and settings of the planner, and the servo's settings that
+// match them (control/servo_setup.hpp has each stage's).
 #pragma once
 
 #include "opencnc/config/machine_profile.hpp"
 #include "opencnc/control/servo_config.hpp"
+#include "opencnc/control/servo_setup.hpp"
 #include "opencnc/control/shared_channels.hpp"
 #include "opencnc/plan/machine_limits.hpp"
 #include "opencnc/plan/planner.hpp"
@@ -25,15 +27,9 @@ plan::PlannerConfig planner_config(const config::MachineProfile& profile);
 /// The servo's view of the machine. The interpolator settings are those of a planner made with
 /// machine_limits() and planner_config(), so blocks and tick agree. Non-real-time.
 ServoConfig servo_config(const config::MachineProfile& profile);
-/// The tick's fixed-size copy of the profile's [coupling] (tables numbered from 1 in programs).
-/// Non-real-time; any thread.
-motion::CouplingConfig coupling_config(const config::CouplingProfile& coupling);
-/// The load guard's levels from `[process.broaching]` (disabled without it). Any thread.
-LoadGuardConfig load_guard_config(const config::MachineProfile& profile);
 
-/// What a tick in another process (the HAL component) is handed: servo_config() and what the
-/// profile declares wired (the capabilities the simulated machine of the profile would have:
-/// joints and their drives, switches, index, spindle, probe, I/O counts). Non-real-time.
+/// What a tick in another process (the HAL component) is handed for `profile`: its servo_config()
+/// and the capabilities it declares wired. Non-real-time.
 SharedSetup shared_setup(const config::MachineProfile& profile);
 
 }  // namespace opencnc::control

@@ -12,6 +12,7 @@
 #include "opencnc/control/channels.hpp"
 #include "opencnc/control/servo.hpp"
 #include "opencnc/controller/controller.hpp"
+#include "opencnc/controller/machine_setup.hpp"
 #include "opencnc/machine/sim_machine.hpp"
 
 namespace opencnc::control {
@@ -24,6 +25,10 @@ class SimRig {
   /// is checked (paced virtual time for a server), and runs no longer repeat bit for bit.
   explicit SimRig(const config::MachineProfile& profile, std::shared_ptr<ProgramSource> source = nullptr,
                   int service_every = 1, ControllerOptions options = {});
+  /// The machine as its features set it up: `setup`'s program source, and its features,
+  /// observers, texts and move reaches installed on the controller.
+  SimRig(const config::MachineProfile& profile, MachineSetup& setup, int service_every = 1,
+         ControllerOptions options = {});
   ~SimRig();
 
   /// One servo period (with the controller's work first when it is due).

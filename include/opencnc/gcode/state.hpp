@@ -12,6 +12,7 @@
 
 #include "opencnc/canon/types.hpp"
 #include "opencnc/core/axes.hpp"
+#include "opencnc/core/vec3.hpp"
 #include "opencnc/tools/tool_table.hpp"
 
 namespace opencnc::gcode {
@@ -66,7 +67,7 @@ struct PositionState {
   Pose axis_offset{};        ///< G92 / G52
   Pose tool_offset{};        ///< tool length offset (G43...)
   double rotation_xy_deg = 0;
-  std::array<double, 3> programmed{};  ///< programmed point while cutter compensation runs
+  Vec3 programmed{};  ///< programmed point while cutter compensation runs
   /// The position as the canonical calls state it: the last motion's end, moved when G5x or
   /// G92 offsets or the units change (not by rotation or tool offsets). After a tool change
   /// the scan mode continues from here, as the stand-alone rs274 does.

@@ -32,9 +32,6 @@ enum class ArcTransform : std::uint8_t {
 /// Any thread; real-time safe.
 ArcTransform transform_arc(const TransformState& t, canon::ArcFeed& arc) noexcept;
 
-/// Axis indices (first, second, normal) of a canonical plane.
-std::array<int, 3> plane_axis_indices(canon::Plane plane) noexcept;
-
 /// sin and cos of an angle in degrees, exact at multiples of 90 degrees (so that a quarter
 /// turn does not leave 6e-17 residues in coordinates).
 void sin_cos_deg(double degrees, double& s, double& c) noexcept;

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// MachineFeatures — the controller features a profile calls for, as `opencnc serve` installs them
-// (power-fail journal, electrode setting, retrace, tool guard, run from line), and a board that
-// snapshots their state on the controller's thread for the HMI's status (docs/hmi.md, "Features").
+// MachineFeatures — the controller features a profile calls for, set up as every front end sets
+// them up (features::set_up on a control::MachineSetup), and a board that snapshots their state on
+// the controller's thread for the HMI's status (docs/hmi.md, "Features").
 #pragma once
 
 #include <memory>
@@ -13,22 +13,8 @@
 
 #include "opencnc/config/machine_profile.hpp"
 #include "opencnc/controller/controller.hpp"
+#include "opencnc/controller/machine_setup.hpp"
 #include "opencnc/core/diagnostic.hpp"
-
-namespace opencnc::control {
-class GcodeProgramSource;
-class ElectrodeSetting;
-}  // namespace opencnc::control
-namespace opencnc::recovery {
-class BreakpointJournal;
-class RetraceFeature;
-}  // namespace opencnc::recovery
-namespace opencnc::store {
-class ToolStore;
-}
-namespace opencnc::toolguard {
-class ToolGuard;
-}
 
 namespace opencnc::hmi {
 
@@ -42,11 +28,11 @@ struct FeatureOptions {
 /// before the controller runs; status() from any thread.
 class MachineFeatures {
  public:
-  /// The profile's program source (with `[tool_guard]`, the tool store as its table) and the
-  /// features it calls for: "journal" with a power monitor and a journal folder, "electrode"
-  /// with `[probe.reference_sphere]` and a tool table, "retrace" with `[process.cutting]`,
-  /// "tool-guard" with `[tool_guard]`, "run-from-line" always. Nullptr with the reasons in `diags`
-  /// (a journal folder or tool store that cannot be opened).
+  /// The profile's program source and the features it calls for (features::set_up): with
+  /// `[tool_guard]` the tool store as its table and "tool-guard", "journal" with a power monitor
+  /// and a journal folder, "electrode" with `[probe.reference_sphere]` and a tool table,
+  /// "retrace" with `[process.cutting]`, "run-from-line" always. Nullptr with the reasons in
+  /// `diags` (a journal folder or tool store that cannot be opened).
   static std::unique_ptr<MachineFeatures> create(const config::MachineProfile& profile,
                                                  const FeatureOptions& options, Diagnostics& diags);
   ~MachineFeatures();
@@ -59,34 +45,21 @@ class MachineFeatures {
   void install(control::Controller& controller);
   /// The names of the installed features, in installation order. Any thread.
   const std::vector<std::string>& names() const noexcept { return names_; }
+  /// Whether feature `name` is installed. Any thread.
+  bool has(std::string_view name) const;
   /// The features' state as of the controller's last status period (docs/api.md, "features"):
-  /// `{"installed": […], "journal": {…}, "retrace": {…}, "electrode": {…}, "tool_guard": {…}}`,
-  /// each present when its feature is. Any thread.
+  /// `{"installed": […], "journal": {…}, "retrace": {…}, "electrode": {…}, "tool_guard": {…},
+  /// "edm": {…}}`, each present when its feature is. Any thread.
   nlohmann::json status() const;
-
-  /// The journal feature (null without it). Any thread (its accessors say which).
-  const std::shared_ptr<recovery::BreakpointJournal>& journal() const noexcept { return journal_; }
 
  private:
   class Board;
   MachineFeatures() = default;
-  nlohmann::json snapshot(const control::ControllerStatus& s);          // controller thread
-  nlohmann::json tool_guard_state(const control::ControllerStatus& s);  // controller thread
+  nlohmann::json snapshot(const control::ControllerStatus& s);  // controller thread
 
-  config::MachineProfile profile_;
+  std::unique_ptr<control::MachineSetup> setup_;
   std::shared_ptr<control::GcodeProgramSource> source_;
-  std::shared_ptr<store::ToolStore> store_;
-  std::shared_ptr<toolguard::ToolGuard> guard_;
-  std::shared_ptr<recovery::BreakpointJournal> journal_;
-  std::shared_ptr<recovery::RetraceFeature> retrace_;
-  std::shared_ptr<control::ElectrodeSetting> electrode_;
-  std::vector<std::shared_ptr<control::Feature>> features_;
   std::vector<std::string> names_;
-
-  // The tool guard's check while it holds, run again only when the store changed.
-  bool guard_holding_ = false;
-  std::uint64_t guard_checked_ = ~std::uint64_t{0};
-  nlohmann::json guard_report_;
 
   mutable std::mutex mutex_;
   nlohmann::json state_;  ///< the board's last snapshot

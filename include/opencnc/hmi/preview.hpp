@@ -12,8 +12,10 @@
 
 namespace opencnc::hmi {
 
-/// Scans `path` (the interpreter in scan mode, the options the source gives the file) from the
-/// machine position `start`, at most `max_moves` moves, into
+/// Scans `path` through `source` (GcodeProgramSource::scan: the interpreter in scan mode with the
+/// options the source gives the file, every move through the machine's passes, as the preflight
+/// checks it and the machine runs it) from the machine position `start`, at most `max_moves`
+/// moves, into
 /// `{"polylines": [{"rapid": bool, "points": [x, y, z, …]}], "moves": n, "truncated": bool,
 ///   "diagnostics": [...], "tools": [the tools its M6/M61 put in the spindle]}`. Non-real-time;
 /// any thread but the controller's (it may take a while).

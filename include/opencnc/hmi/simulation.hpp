@@ -6,12 +6,14 @@
 #include <array>
 #include <string>
 
+#include "opencnc/core/vec3.hpp"
+
 namespace opencnc::hmi {
 
 struct SimulationEvent {
   /// "mains-off", "mains-on", "electrode" (the simulated electrode's true offsets and tip).
   std::string event;
-  std::array<double, 3> offset_mm{};  ///< electrode: X, Y, Z as a tool table holds them
+  Vec3 offset_mm{};                   ///< electrode: X, Y, Z as a tool table holds them
   double tip_radius_mm = 0;           ///< electrode: its tip's ball
 };
 

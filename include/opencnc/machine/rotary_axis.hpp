@@ -3,24 +3,23 @@
 // does to what is mounted on it.
 #pragma once
 
-#include <array>
 #include <cmath>
+
+#include "opencnc/core/vec3.hpp"
 
 namespace opencnc::machine {
 
 /// `p` turned by `angle_rad` about the line through `on_axis` along the unit vector `direction`,
 /// right-handed (about +Y: +Z toward +X). Any thread; real-time safe.
-inline std::array<double, 3> rotate_about(const std::array<double, 3>& p,
-                                          const std::array<double, 3>& on_axis,
-                                          const std::array<double, 3>& direction, double angle_rad) noexcept {
+inline Vec3 rotate_about(const Vec3& p, const Vec3& on_axis, const Vec3& direction,
+                         double angle_rad) noexcept {
   const double c = std::cos(angle_rad), s = std::sin(angle_rad);
-  const std::array<double, 3> v{p[0] - on_axis[0], p[1] - on_axis[1], p[2] - on_axis[2]};
-  const std::array<double, 3>& d = direction;
-  const std::array<double, 3> cross{d[1] * v[2] - d[2] * v[1], d[2] * v[0] - d[0] * v[2],
-                                    d[0] * v[1] - d[1] * v[0]};
-  const double along = (d[0] * v[0] + d[1] * v[1] + d[2] * v[2]) * (1 - c);
-  std::array<double, 3> out{};
-  for (std::size_t i = 0; i < 3; ++i) out[i] = on_axis[i] + v[i] * c + cross[i] * s + d[i] * along;
+  const Vec3 v = p - on_axis;
+  const Vec3& d = direction;
+  const Vec3 across = cross(d, v);
+  const double along = dot(d, v) * (1 - c);
+  Vec3 out{};
+  for (int i = 0; i < 3; ++i) out[i] = on_axis[i] + v[i] * c + across[i] * s + d[i] * along;
   return out;
 }
 

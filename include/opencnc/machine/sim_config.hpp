@@ -7,6 +7,7 @@
 #include <limits>
 #include <vector>
 
+#include "opencnc/core/vec3.hpp"
 #include "opencnc/machine/edm.hpp"
 #include "opencnc/machine/machine_io.hpp"
 
@@ -161,7 +162,7 @@ struct SimPowerConfig {
 struct SimSphereTarget {
   bool present = false;
   std::array<int, 3> joints{-1, -1, -1};  ///< the joints of X, Y and Z
-  std::array<double, 3> centre{};
+  Vec3 centre{};
   double radius = 0;
   double hysteresis = 0.0005;  ///< once touching, the contact opens this far off the surface
   double noise = 0.0002;       ///< ± mm, uniform, per sample
@@ -170,7 +171,7 @@ struct SimSphereTarget {
   /// `centre` is where it is with B at `b_at_centre_deg`.
   int b_joint = -1;
   std::array<double, 2> b_axis{};
-  std::array<double, 3> b_direction{0, 1, 0};
+  Vec3 b_direction{0, 1, 0};
   double b_at_centre_deg = 0;
 };
 
@@ -224,7 +225,7 @@ inline constexpr int kMaxSimElectrodes = 32;
 /// the spark gap burns and the reference sphere is touched where it really is.
 struct SimElectrode {
   std::int32_t tool = 0;
-  std::array<double, 3> offset{};
+  Vec3 offset{};
   double tip_radius = 0;
 };
 

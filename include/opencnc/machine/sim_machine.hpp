@@ -5,6 +5,7 @@
 #include <array>
 #include <cstdint>
 
+#include "opencnc/core/vec3.hpp"
 #include "opencnc/machine/machine_io.hpp"
 #include "opencnc/machine/sim_broach_load.hpp"
 #include "opencnc/machine/sim_config.hpp"
@@ -74,13 +75,13 @@ class SimMachine final : public MachineIO {
   /// The electrode in the spindle is replaced by another one (the same tool number): its true
   /// offsets (as an exact tool table would hold them, mm) and tip radius. The reference sphere
   /// is touched and the spark gap burns where it really is; it is new (no wear).
-  void set_electrode(const std::array<double, 3>& offset, double tip_radius) noexcept {
+  void set_electrode(const Vec3& offset, double tip_radius) noexcept {
     replace_electrode(mounted_tool_, offset, tip_radius);
   }
   /// The operator puts a new electrode in for `tool` (in the spindle now or in its pocket): its
   /// true offsets and tip radius, no wear; a tool change mounts it. Ignored beyond
   /// kMaxSimElectrodes tools.
-  void replace_electrode(std::int32_t tool, const std::array<double, 3>& offset, double tip_radius) noexcept;
+  void replace_electrode(std::int32_t tool, const Vec3& offset, double tip_radius) noexcept;
   /// The operator turns the handwheel by `counts` (+ = clockwise); ignored without one.
   void turn_handwheel(std::int32_t counts) noexcept;
 
@@ -116,7 +117,7 @@ class SimMachine final : public MachineIO {
   void update_broach() noexcept;
   void step_edm() noexcept;
   void mount(std::int32_t tool) noexcept;
-  std::array<double, 3> worn_offset() const noexcept;
+  Vec3 worn_offset() const noexcept;
   void sample() noexcept;
   void sample_probe() noexcept;
   void sample_sphere_probe() noexcept;

@@ -4,6 +4,7 @@
 
 #include <array>
 
+#include "opencnc/core/vec3.hpp"
 #include "opencnc/machine/sim_config.hpp"
 #include "opencnc/machine/sim_switch.hpp"
 
@@ -22,29 +23,29 @@ class SimSphereProbe {
 
   bool present() const noexcept { return target_.present; }
   /// The electrode in the spindle: its offsets (X, Y, Z) and tip radius, mm.
-  void set_electrode(const std::array<double, 3>& offset, double tip_radius) noexcept {
+  void set_electrode(const Vec3& offset, double tip_radius) noexcept {
     offset_ = offset;
     tip_radius_ = tip_radius;
   }
-  const std::array<double, 3>& offset() const noexcept { return offset_; }
+  const Vec3& offset() const noexcept { return offset_; }
   double tip_radius() const noexcept { return tip_radius_; }
   /// B stands at `b_deg`: a sphere that turns with B has its centre turned about B's true axis
   /// by b_deg − b_at_centre_deg (right-handed about its direction; about +Y, +B turns Z toward X).
   void turn(double b_deg) noexcept;
   /// The sphere's centre now, machine coordinates.
-  const std::array<double, 3>& centre() const noexcept { return centre_; }
+  const Vec3& centre() const noexcept { return centre_; }
   /// The distance between the tip's surface and the sphere's at table positions `p` (X, Y, Z):
   /// negative when they overlap.
-  double gap(const std::array<double, 3>& p) const noexcept;
+  double gap(const Vec3& p) const noexcept;
   /// Samples the contact at `p`; draws one noise value when noise > 0. After a change of state,
   /// edge_fraction() says where between the previous sample and this one it happened.
-  bool update(const std::array<double, 3>& p, SplitMix64& rng) noexcept;
+  bool update(const Vec3& p, SplitMix64& rng) noexcept;
   double edge_fraction() const noexcept { return edge_fraction_; }
 
  private:
   SimSphereTarget target_{};
-  std::array<double, 3> centre_{};
-  std::array<double, 3> offset_{};
+  Vec3 centre_{};
+  Vec3 offset_{};
   double tip_radius_ = 0;
   bool active_ = false;
   bool sampled_ = false;

@@ -109,4 +109,11 @@ struct CouplingConfig {
   std::array<CouplingTable, kMaxCouplingTables> tables{};
 };
 
+/// The law a coupling names by its kind: a constant pitch `pitch_mm`, a linear one from `pitch_mm`
+/// changing by `rate` mm per mm, or the machine's table number `table` (1-based) of that kind.
+/// Off for kind Off and for a table the machine does not have (or has of the other kind). Any
+/// thread; RT-safe.
+CouplingLaw law_for(const CouplingConfig& config, CouplingKind kind, double pitch_mm, double rate,
+                    int table) noexcept;
+
 }  // namespace opencnc::motion

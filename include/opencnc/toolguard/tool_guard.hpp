@@ -12,6 +12,7 @@
 
 #include "opencnc/config/machine_profile.hpp"
 #include "opencnc/controller/gcode_source.hpp"
+#include "opencnc/controller/machine_setup.hpp"
 #include "opencnc/controller/observer.hpp"
 #include "opencnc/store/tool_store.hpp"
 #include "opencnc/tools/tool_check.hpp"
@@ -70,20 +71,13 @@ class ToolGuard final : public control::Feature {
   int held_tool_ = 0;  ///< the tool T of the tool change being checked
 };
 
-/// The G-code source and the feature for a profile: with [tool_guard], the tool store as the
-/// interpreter's tool table, the check M-code among the standard modules, and the ToolGuard
-/// feature; without it, the profile's standard source and no feature.
-struct Setup {
-  std::shared_ptr<control::GcodeProgramSource> source;
-  std::shared_ptr<store::ToolStore> store;  ///< null without [tool_guard]
-  std::shared_ptr<ToolGuard> feature;       ///< null without [tool_guard]
-};
-
-/// Builds the Setup; problems (a store that cannot be opened) land in `diags` and give nothing.
-/// `tool_table_in_memory`: without a tool store, the profile's tool table file is read into a
-/// table in memory that G10 L1 and electrode setting change instead of the file (a simulation's
-/// own measurements). Non-real-time; one thread.
-std::optional<Setup> setup(const config::MachineProfile& profile, Diagnostics& diags,
-                           bool tool_table_in_memory = false);
+/// The tool guard's parts on `host` for a profile with [tool_guard]: the tool store as the
+/// program source's tool table, the check M-code among its modules (a code module on top of the
+/// others), the ToolGuard feature ("tool-guard", following the status) and, for a front end, its
+/// state while it holds (`tool_guard`: the differences of the whole live table from the backup).
+/// Nothing on another machine. False with the reasons in host.diagnostics() (a store that cannot
+/// be opened). Set up before the features that take the source's tool table. Non-real-time; one
+/// thread, before the controller runs.
+bool setup(const config::MachineProfile& profile, control::MachineSetup& host);
 
 }  // namespace opencnc::toolguard
