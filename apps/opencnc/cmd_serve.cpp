@@ -10,11 +10,15 @@
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
+#include <optional>
 #include <thread>
 
 #include "commands.hpp"
 #include "numeric_options.hpp"
 #include "opencnc/config/profile_loader.hpp"
+#include "opencnc/connect/agent.hpp"
+#include "opencnc/connect/mqtt_publisher.hpp"
+#include "opencnc/connect/status_sampler.hpp"
 #include "opencnc/controller/gcode_source.hpp"
 #include "opencnc/hmi/history.hpp"
 #include "opencnc/hmi/machine_features.hpp"
@@ -41,6 +45,10 @@ struct ServeOptions {
   double speed = 0;  ///< 0: real time on a periodic thread; else paced virtual time
   double stream_hz = 30;
   int servo_cpu = -1;  ///< real time: the servo thread's own CPU; the server keeps off it
+  std::string device_name;   ///< the MTConnect device's name ("" = the profile's)
+  double mtconnect_hz = 10;  ///< status samples per second into the MTConnect agent
+  std::string mqtt;          ///< mqtt://HOST:PORT ("" = no MQTT)
+  int mqtt_keepalive_s = 5;
 };
 
 /// `$XDG_STATE_HOME/opencnc`, else `~/.local/state/opencnc`.
@@ -105,6 +113,15 @@ int serve(const ServeOptions& o) {
                o.listen);
     return kExitUsage;
   }
+  std::optional<connect::MqttAddress> broker;
+  if (!o.mqtt.empty()) {
+    std::string why;
+    broker = connect::parse_mqtt_url(o.mqtt, &why);
+    if (!broker) {
+      fmt::print(stderr, "error: --mqtt: {}\n", why);
+      return kExitUsage;
+    }
+  }
   const config::ProfileLoad load = config::load_profile(o.machine, o.sets);
   for (const Diagnostic& d : load.diagnostics.items()) fmt::print(stderr, "{}\n", d.format());
   if (!load.ok()) return kExitProgram;
@@ -152,7 +169,40 @@ int serve(const ServeOptions& o) {
   }
   for (const std::string& w : warnings) fmt::print(stderr, "warning: {}\n", w);
 
+  // The MTConnect agent, sampled on a thread of its own, and its MQTT publisher (docs/connectivity.md).
+  connect::AgentOptions ao;
+  ao.sender = [] {
+    char name[256] = {};
+    return ::gethostname(name, sizeof name - 1) == 0 && name[0] != 0 ? std::string(name) : std::string("opencnc");
+  }();
+  ao.device_name = o.device_name;
+  ao.start_us = connect::StatusSampler::wall_us();
+  ao.instance_id = static_cast<std::uint64_t>(ao.start_us / 1000000);
+  const std::unique_ptr<connect::Agent> agent = connect::Agent::for_profile(profile, ao);
+  connect::StatusSampler sampler(
+      *agent, [&host] { return host.controller().status(); },
+      [&source] {
+        std::vector<connect::ToolAsset> list;
+        if (const auto service = source ? source->tools() : nullptr) {
+          for (const tools::ToolEntry& e : service->snapshot()->entries())
+            list.push_back(connect::ToolAsset{e.tool, e.pocket, e.offset[index(Axis::Z)], e.diameter, e.comment,
+                                              connect::StatusSampler::wall_us()});
+        }
+        return list;
+      },
+      connect::SamplerOptions{std::chrono::milliseconds(static_cast<int>(1000.0 / o.mtconnect_hz)), std::chrono::seconds(2)});
+  sampler.start();
+  std::unique_ptr<connect::MqttPublisher> mqtt;
+  if (broker) {
+    connect::MqttOptions mo;
+    mo.broker = *broker;
+    mo.keepalive_s = o.mqtt_keepalive_s;
+    mqtt = std::make_unique<connect::MqttPublisher>(*agent, mo);
+    mqtt->start();
+  }
+
   hmi::ServerConfig sc;
+  sc.mtconnect = agent.get();
   sc.address = address;
   sc.port = port;
   sc.programs_dir = !o.programs_dir.empty() ? fs::path(o.programs_dir)
@@ -182,6 +232,9 @@ int serve(const ServeOptions& o) {
   fmt::print("  operator  {}\n  admin     in {}\n  history   {}\n", tokens->operator_token(),
              tokens->origin(), (data / "history.sqlite").string());
   if (features->has("journal")) fmt::print("  journal   {}\n", fo.journal_dir);
+  fmt::print("  mtconnect http://{}:{}/probe  (device {}, {})\n", host_part, server.port(), agent->model().name(),
+             agent->model().uuid());
+  if (broker) fmt::print("  mqtt      {}:{} topics {}/…/{}\n", broker->host, broker->port, "MTConnect", agent->model().uuid());
   fmt::print("  features  {}\n  Ctrl-C stops.\n", fmt::join(features->names(), ", "));
   std::fflush(stdout);
 
@@ -190,6 +243,8 @@ int serve(const ServeOptions& o) {
   fmt::print("\nopencnc serve: {}: stopping (a run in progress is aborted on the path)\n",
              signal_name(StopSignals::requested().load()));
   server.stop();
+  sampler.stop();  // the machine UNAVAILABLE, then published as such
+  if (mqtt) mqtt->stop(2000);
   host.controller().submit(control::Request::simple(control::CommandKind::FeedHold));
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   host.controller().submit(control::Request::simple(control::CommandKind::Abort));
@@ -236,6 +291,18 @@ void add_serve_command(CLI::App& app, Registry& registry) {
   cmd->add_option("--stream-hz", opts->stream_hz,
                   "Status messages per second on the WebSocket stream (default 30)")
       ->check(finite_range(1, 1000));
+  cmd->add_option("--device-name", opts->device_name,
+                  "The machine's name to MTConnect and MQTT (default: the profile's; machines of one profile "
+                  "in one shop need their own)");
+  cmd->add_option("--mtconnect-hz", opts->mtconnect_hz,
+                  "Status samples per second into the MTConnect agent (default 10)")
+      ->check(finite_range(0.1, 1000));
+  cmd->add_option("--mqtt", opts->mqtt,
+                  "Publish the machine's observations to this MQTT broker: mqtt://HOST[:PORT] (docs/connectivity.md)");
+  cmd->add_option("--mqtt-keepalive", opts->mqtt_keepalive_s,
+                  "Seconds between keep-alives; the broker marks the machine unavailable after 1.5 of them "
+                  "without a word (default 5)")
+      ->check(CLI::Range(5, 65535));
   cmd->callback([opts, &registry] { registry.set_result(serve(*opts)); });
 }
 

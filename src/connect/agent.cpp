@@ -194,6 +194,11 @@ std::uint64_t Agent::next_sequence() const {
   return buffer_.next_sequence();
 }
 
+std::uint64_t Agent::first_sequence() const {
+  std::lock_guard lock(mutex_);
+  return buffer_.first_sequence();
+}
+
 std::vector<Observation> Agent::observations(std::uint64_t from, std::size_t max, std::uint64_t* first) const {
   std::lock_guard lock(mutex_);
   const std::uint64_t start = std::max(from, buffer_.first_sequence());
@@ -413,12 +418,10 @@ std::string streams_document(const DeviceModel& model, const AgentOptions& optio
         w.attribute("sequence", fmt::format("{}", o->sequence));
         w.attribute("timestamp", iso_time(o->time_us));
         if (category == Category::Condition) {
-          if (!o->native_code.empty()) {
-            w.attribute("nativeCode", o->native_code);
-            w.attribute("conditionId", o->native_code);
-          } else if (o->level == Level::Warning || o->level == Level::Fault) {
-            w.attribute("conditionId", item.id);
-          }
+          // conditionId ties a Warning or Fault to its Normal; the schema allows it on those two only.
+          const bool active = o->level == Level::Warning || o->level == Level::Fault;
+          if (!o->native_code.empty()) w.attribute("nativeCode", o->native_code);
+          if (active) w.attribute("conditionId", o->native_code.empty() ? item.id : o->native_code);
           if (!o->value.empty()) w.text(o->value);
         } else {
           if (item.type == "ASSET_CHANGED" || item.type == "ASSET_REMOVED")

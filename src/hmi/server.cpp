@@ -2,6 +2,7 @@
 // The HMI server on Boost.Beast: HTTP sessions (the JSON API, the front end's files) and
 // WebSocket sessions (status at a steady rate, each client's own cursor on the event log).
 #include "opencnc/hmi/server.hpp"
+#include "opencnc/connect/status_sampler.hpp"
 
 #include <atomic>
 #include <chrono>
@@ -203,6 +204,7 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
   std::mutex sessions_mutex;
   std::vector<std::weak_ptr<WsSession>> sessions;
   std::atomic<std::uint64_t> dropped{0}, stream_ticks{0}, status_messages{0}, http_requests{0};
+  std::atomic<std::uint64_t> mtc_streams{0}, mtc_dropped{0}, mtc_parts{0};
 
   std::mutex preview_mutex;
   std::string preview_key;
@@ -278,6 +280,8 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
   HttpResponse no_such_call(const HttpRequest& req, const Target& t, Role role);
   HttpResponse other_version(const HttpRequest& req, const Target& t, Role role);
   HttpResponse static_file(const HttpRequest& req, const Target& t, Role role);
+  HttpResponse mtconnect(const HttpRequest& req, const Target& t, Role role);
+  void mtconnect_sample(const std::shared_ptr<HttpSession>& s, const HttpRequest& req, Role role);
   std::string relative_program(const std::string& path) const;
 };
 
@@ -308,6 +312,8 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   }
   net::any_io_executor executor() { return stream_.get_executor(); }
   const std::string& remote() const { return remote_; }
+  /// The connection, for an answer that streams (the session ends here).
+  tcp::socket take_socket() { return stream_.release_socket(); }
 
  private:
   void read() {
@@ -338,6 +344,105 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   std::optional<http::request_parser<http::string_body>> parser_;
   std::shared_ptr<Server::Impl> server_;
   std::string remote_;
+};
+
+/// One MTConnect /sample?interval= stream (docs/connectivity.md): a multipart/x-mixed-replace
+/// answer, chunked, a document at most every `interval` with what is new, an empty one after
+/// `heartbeat` without news. One write at a time: a reader that takes longer than the server's
+/// write timeout over one part is dropped, and nobody else waits for it.
+class MtcStream : public std::enable_shared_from_this<MtcStream> {
+ public:
+  MtcStream(tcp::socket socket, std::shared_ptr<Server::Impl> server, connect::AgentRequest request,
+            std::chrono::milliseconds interval, std::chrono::milliseconds heartbeat)
+      : stream_(std::move(socket)),
+        timer_(stream_.get_executor()),
+        server_(std::move(server)),
+        request_(std::move(request)),
+        interval_(interval),
+        heartbeat_(heartbeat) {}
+
+  /// Sends the header, then the first document at once.
+  void run(std::uint64_t from, unsigned http_version) {
+    from_ = from;
+    ++server_->mtc_streams;
+    tick_due_ = true;
+    write(std::make_shared<std::string>(fmt::format(
+              "HTTP/{}.{} 200 OK\r\nServer: opencnc\r\nContent-Type: multipart/x-mixed-replace;boundary={}\r\n"
+              "Transfer-Encoding: chunked\r\nCache-Control: no-cache, private\r\nConnection: close\r\n\r\n",
+              http_version / 10, http_version % 10, kBoundary)),
+          false);
+  }
+
+ private:
+  static constexpr std::string_view kBoundary = "opencnc-mtconnect-part";
+
+  void write(std::shared_ptr<std::string> bytes, bool last) {
+    writing_ = true;
+    stream_.expires_after(
+        std::chrono::milliseconds(static_cast<std::int64_t>(server_->config.mtconnect_write_timeout_s * 1000.0)));
+    net::async_write(stream_, net::buffer(*bytes), [self = shared_from_this(), bytes, last](beast::error_code ec,
+                                                                                           std::size_t) {
+      self->writing_ = false;
+      if (ec) return self->end(ec == beast::error::timeout);
+      self->last_sent_ = std::chrono::steady_clock::now();
+      if (last) return self->end(false);
+      if (self->tick_due_) {
+        self->tick_due_ = false;
+        self->tick();
+      }
+    });
+  }
+  /// One part as a chunk of the chunked body.
+  static std::shared_ptr<std::string> part(const std::string& document) {
+    const std::string body = fmt::format("--{}\r\nContent-type: text/xml\r\nContent-length: {}\r\n\r\n{}\r\n",
+                                         kBoundary, document.size(), document);
+    return std::make_shared<std::string>(fmt::format("{:x}\r\n{}\r\n", body.size(), body));
+  }
+  /// What is new since the last part (or a heartbeat), then the next look after `interval`.
+  void tick() {
+    if (ended_) return;
+    if (server_->stopping) return end(false);
+    connect::AgentRequest r = request_;
+    r.query["from"] = std::to_string(from_);
+    const connect::SampleAnswer a = server_->config.mtconnect->sample(r, connect::StatusSampler::wall_us());
+    if (a.response.status != 200) {  // the reader fell behind the buffer: the error is the last part
+      ++server_->mtc_parts;
+      auto last = part(a.response.body);
+      last->append("0\r\n\r\n");
+      return write(last, true);
+    }
+    if (!a.empty || std::chrono::steady_clock::now() - last_sent_ >= heartbeat_) {
+      from_ = a.next_from;
+      ++server_->mtc_parts;
+      write(part(a.response.body), false);
+    }
+    timer_.expires_after(interval_);
+    timer_.async_wait([self = shared_from_this()](beast::error_code ec) {
+      if (ec || self->ended_) return;
+      if (self->writing_)
+        self->tick_due_ = true;  // after the part being written
+      else
+        self->tick();
+    });
+  }
+  void end(bool stalled) {
+    if (ended_) return;
+    ended_ = true;
+    if (stalled) ++server_->mtc_dropped;
+    --server_->mtc_streams;
+    beast::error_code ec;
+    stream_.socket().close(ec);
+    timer_.cancel();
+  }
+
+  beast::tcp_stream stream_;
+  net::steady_timer timer_;
+  std::shared_ptr<Server::Impl> server_;
+  connect::AgentRequest request_;
+  std::chrono::milliseconds interval_, heartbeat_;
+  std::uint64_t from_ = 0;
+  std::chrono::steady_clock::time_point last_sent_{};
+  bool ended_ = false, writing_ = false, tick_due_ = false;
 };
 
 /// One WebSocket client of the stream: status at the server's rate and the event log from its
@@ -535,6 +640,16 @@ const Server::Impl::Route& Server::Impl::route_for(std::string_view path) noexce
        .prefix = true,
        .access = Access::Anyone,
        .answer = &I::other_version},
+      // MTConnect (docs/connectivity.md): read-only, open on loopback like the status.
+      {.methods = kGet, .path = "/probe", .access = Access::TokenOrLoopback, .runs = Runs::Blocking,
+       .answer = &I::mtconnect},
+      {.methods = kGet, .path = "/current", .access = Access::TokenOrLoopback, .runs = Runs::Blocking,
+       .answer = &I::mtconnect},
+      {.methods = kGet, .path = "/sample", .access = Access::TokenOrLoopback, .start = &I::mtconnect_sample},
+      {.methods = kGet, .path = "/assets", .access = Access::TokenOrLoopback, .runs = Runs::Blocking,
+       .answer = &I::mtconnect},
+      {.methods = kGet, .path = "/mtconnect/", .prefix = true, .access = Access::TokenOrLoopback,
+       .start = &I::mtconnect_sample},
       // Everything else is the front end's files.
       {.methods = kGet | kHead,
        .path = "/",
@@ -884,6 +999,68 @@ HttpResponse Server::Impl::tools_table(const HttpRequest& req, const Target&, Ro
   return json_response(req, 200, list);
 }
 
+// --- MTConnect (docs/connectivity.md) -------------------------------------------------------
+
+namespace {
+
+/// The agent's request for `target`: the path below /mtconnect when it is there.
+connect::AgentRequest mtconnect_request(std::string_view target) {
+  connect::AgentRequest r = connect::parse_agent_request(target);
+  constexpr std::string_view base = "/mtconnect";
+  if (r.path.starts_with(base)) r.path.erase(0, base.size());
+  return r;
+}
+
+HttpResponse agent_response(const HttpRequest& req, const connect::AgentResponse& a) {
+  HttpResponse res{static_cast<http::status>(a.status), req.version()};
+  res.set(http::field::content_type, a.content_type);
+  res.set(http::field::cache_control, "no-cache, private");
+  res.keep_alive(req.keep_alive());
+  res.body() = a.body;
+  res.prepare_payload();
+  return res;
+}
+
+}  // namespace
+
+HttpResponse Server::Impl::mtconnect(const HttpRequest& req, const Target&, Role) {
+  if (config.mtconnect == nullptr) return error_response(req, 404, "this server has no MTConnect agent");
+  return agent_response(req, config.mtconnect->respond(mtconnect_request(sv(req.target())),
+                                                       connect::StatusSampler::wall_us()));
+}
+
+void Server::Impl::mtconnect_sample(const std::shared_ptr<HttpSession>& s, const HttpRequest& req, Role role) {
+  const connect::AgentRequest r = mtconnect_request(sv(req.target()));
+  const bool sample = r.path == "/sample" || r.path.ends_with("/sample");
+  const auto interval = r.query.find("interval");
+  if (config.mtconnect == nullptr || !sample || interval == r.query.end()) {
+    auto answer = [self = shared_from_this(), req, role] { return self->mtconnect(req, Target{}, role); };
+    return off_io(s, std::move(answer));
+  }
+  // A stream: its parameters checked by a first answer, which must succeed.
+  auto number = [&](std::string_view name, long fallback, long max) -> std::optional<long> {
+    auto it = r.query.find(name);
+    if (it == r.query.end()) return fallback;
+    char* end = nullptr;
+    const long v = std::strtol(it->second.c_str(), &end, 10);
+    if (it->second.empty() || *end != 0 || v < 0 || v > max) return std::nullopt;
+    return v;
+  };
+  const auto every = number("interval", 0, 3600000), beat = number("heartbeat", 10000, 3600000);
+  if (!every || !beat || *beat < 10)
+    return s->send(error_response(req, 400, "interval and heartbeat are milliseconds (heartbeat ≥ 10)"));
+  connect::AgentRequest first = r;
+  first.query.erase("interval");
+  first.query.erase("heartbeat");
+  const connect::SampleAnswer check = config.mtconnect->sample(first, connect::StatusSampler::wall_us());
+  if (check.response.status != 200) return s->send(agent_response(req, check.response));
+  const auto from = first.query.count("from") ? std::stoull(first.query.at("from")) : config.mtconnect->first_sequence();
+  auto stream = std::make_shared<MtcStream>(s->take_socket(), shared_from_this(), first,
+                                            std::chrono::milliseconds(std::max(*every, 10L)),
+                                            std::chrono::milliseconds(*beat));
+  stream->run(from, req.version());
+}
+
 HttpResponse Server::Impl::static_file(const HttpRequest& req, const Target& t, Role) {
   if (config.static_dir.empty())
     return error_response(req, 404, "no front end is served (build it: scripts/hmi.sh)");
@@ -981,6 +1158,9 @@ ServerStats Server::stats() const {
   st.stream_ticks = impl_->stream_ticks;
   st.status_messages = impl_->status_messages;
   st.http_requests = impl_->http_requests;
+  st.mtconnect_streams = impl_->mtc_streams;
+  st.mtconnect_dropped = impl_->mtc_dropped;
+  st.mtconnect_parts = impl_->mtc_parts;
   return st;
 }
 

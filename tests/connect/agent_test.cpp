@@ -122,21 +122,48 @@ void observe(Agent& agent, Scenario& s, int periods, int every = 10) {
 
 class EveryProfile : public ::testing::TestWithParam<std::string> {};
 
+/// A status with something in every item a profile may have: the machine moving, a fault of an
+/// axis, every process alarm active, the EDM gap shorted, a coupling engaged, on battery.
+control::ControllerStatus busy_status(const config::MachineProfile& p, int i) {
+  control::ControllerStatus s;
+  s.servo.state = i % 3 == 0 ? control::State::Running : i % 3 == 1 ? control::State::Held : control::State::Faulted;
+  s.servo.mode = control::Mode::Auto;
+  s.servo.estop_input_ok = true;
+  s.servo.run_active = true;
+  s.servo.line = static_cast<std::uint32_t>(10 + i);
+  s.program_name = "part <1> & \"2\".ngc";
+  for (int a = 0; a < kAxisCount; ++a) s.servo.actual[static_cast<std::size_t>(a)] = 1.5 * a + 0.25 * i;
+  s.servo.commanded = s.servo.actual;
+  s.servo.path_velocity = 12.5 * i;
+  s.servo.spindle_rpm = s.servo.spindle_rpm_actual = 1000 + i;
+  if (s.servo.state == control::State::Faulted) {
+    s.servo.fault = control::Fault{control::FaultKind::SoftLimit, 2, 5, 4, 7};
+    s.fault_text = "Z beyond its soft limit";
+  }
+  s.servo.alarms_active = static_cast<std::uint16_t>((1u << p.alarms.alarms.count) - 1u);
+  s.servo.edm.on = true;
+  s.servo.edm.gap_state = machine::GapState::Short;
+  s.servo.edm.gap_voltage_v = 3.5;
+  s.servo.coupling.kind = motion::CouplingKind::ConstantPitch;
+  s.servo.mains_ok = false;
+  s.servo.on_battery = true;
+  s.servo.load_kn = 1.25;
+  return s;
+}
+
 TEST_P(EveryProfile, EveryDocumentIsValidMTConnect27) {
   const auto p = profile(GetParam());
   auto agent = Agent::for_profile(p, AgentOptions{"test-host", "", 7, 4096, 1000});
-  Scenario s(p);
-  observe(*agent, s, 50);
-  s.on(control::Mode::Mdi);
-  observe(*agent, s, 200);
+  for (int i = 0; i < 6; ++i) agent->observe(busy_status(p, i), kEpochUs + i * 100000);
+  agent->observe(control::ControllerStatus{}, kEpochUs + 700000);  // everything back to rest
   agent->set_tools({ToolAsset{1, 3, 120.5, 10, "end mill <10 mm> & co", kEpochUs}, ToolAsset{2, 0, 80, 6, "", kEpochUs}},
                    kEpochUs + 1);
 
   const auto probe = ask(*agent, "/probe");
   EXPECT_EQ(probe.status, 200);
   EXPECT_EQ(invalid(probe.body, "MTConnectDevices"), "") << probe.body;
-  for (const std::string target : {"/current", "/sample", "/sample?from=1&count=5", "/current?at=3",
-                                   "/current?path=//Axes//DataItem[@type=\"POSITION\"]"}) {
+  for (const std::string target : {"/current", "/sample?count=1000", "/sample?from=1&count=5", "/current?at=3",
+                                   "/current?at=60", "/current?path=//Axes//DataItem[@type=\"POSITION\"]"}) {
     const auto r = ask(*agent, target);
     EXPECT_EQ(r.status, 200) << target;
     EXPECT_EQ(invalid(r.body, "MTConnectStreams"), "") << target << "\n" << r.body;

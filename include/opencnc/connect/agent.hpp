@@ -92,6 +92,8 @@ class Agent {
   SampleAnswer sample(const AgentRequest& request, std::int64_t now_us) const;
   /// The next sequence number (observations are < it). Any thread.
   std::uint64_t next_sequence() const;
+  /// The oldest sequence number still in the buffer. Any thread.
+  std::uint64_t first_sequence() const;
   /// Observations from `from` on (the oldest retained when `from` is older: `*first` says where the
   /// answer begins), at most `max`. Any thread.
   std::vector<Observation> observations(std::uint64_t from, std::size_t max, std::uint64_t* first = nullptr) const;

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "opencnc/config/machine_profile.hpp"
+#include "opencnc/connect/agent.hpp"
 #include "opencnc/controller/controller.hpp"
 #include "opencnc/hmi/simulation.hpp"
 #include "opencnc/hmi/tokens.hpp"
@@ -40,6 +41,11 @@ struct ServerConfig {
   /// The simulated machine's controls (`{"kind": "simulate", …}`, admin): applies the event and
   /// returns "" or why it cannot. Empty: none (a 409).
   std::function<std::string(const SimulationEvent&)> simulate;
+  /// The machine's MTConnect agent (docs/connectivity.md): /probe, /current, /sample (streamed with
+  /// `interval`), /assets, also under /mtconnect/ (null: those answer 404). It must outlive the server.
+  const connect::Agent* mtconnect = nullptr;
+  /// How long a streamed /sample may wait for its reader before it is dropped as one that stopped.
+  double mtconnect_write_timeout_s = 10;
 };
 
 /// Counters of the server. Any thread.
@@ -49,6 +55,9 @@ struct ServerStats {
   std::uint64_t stream_ticks = 0;     ///< status snapshots made for the stream so far
   std::uint64_t status_messages = 0;  ///< status messages queued to clients so far
   std::uint64_t http_requests = 0;
+  std::size_t mtconnect_streams = 0;        ///< MTConnect /sample?interval= streams open now
+  std::uint64_t mtconnect_dropped = 0;      ///< streams dropped because their reader stopped
+  std::uint64_t mtconnect_parts = 0;        ///< documents sent on those streams so far
 };
 
 /// The server. start()/stop() from one thread; the rest from any.
