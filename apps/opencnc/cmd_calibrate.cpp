@@ -63,13 +63,13 @@ std::optional<AxisMask> positioning_axes(const config::MachineProfile& p, const 
 
 /// A file we may write an output to: not the profile we read, not a folder or a device, not a
 /// read-only file.
-nlohmann::json figures(const control::AxisPositioning& a) {
+nlohmann::json figures(const drill::AxisPositioning& a) {
   return {{"accuracy_um", um(a.accuracy)},
           {"repeatability_um", um(a.repeatability)},
           {"reversal_um", um(a.reversal)}};
 }
 
-void print_homing(const control::HomingSpread& h) {
+void print_homing(const drill::HomingSpread& h) {
   fmt::print("homing: {} runs from random start positions, {:.1f} to {:.1f} °C\n", h.runs,
              h.temperature_min_c, h.temperature_max_c);
   for (int i = 0; i < kAxisCount; ++i) {
@@ -80,14 +80,14 @@ void print_homing(const control::HomingSpread& h) {
   }
 }
 
-void print_positioning(const control::Positioning& before, const control::Positioning& profile,
-                       const control::Positioning& after, const control::PositioningOptions& o) {
+void print_positioning(const drill::Positioning& before, const drill::Positioning& profile,
+                       const drill::Positioning& after, const drill::PositioningOptions& o) {
   fmt::print("positioning (ISO 230-2 style): targets every {} mm, {} approaches from each direction\n",
              o.interval, o.approaches);
   for (int i = 0; i < kAxisCount; ++i) {
     if (!before.axes.has(static_cast<Axis>(i))) continue;
     const auto ui = static_cast<std::size_t>(i);
-    const auto line = [&](const char* what, const control::AxisPositioning& a) {
+    const auto line = [&](const char* what, const drill::AxisPositioning& a) {
       fmt::print("  {}  {:<7}  accuracy {:7.1f} µm   repeatability {:7.1f} µm   reversal {:7.1f} µm\n",
                  what[0] == 'b' ? letter(static_cast<Axis>(i)) : ' ', what, um(a.accuracy),
                  um(a.repeatability), um(a.reversal));
@@ -180,14 +180,14 @@ int calibrate(const CalibrateOptions& o) {
   nlohmann::json out = nlohmann::json::object();
   try {
     if (o.homing_runs > 0) {
-      std::optional<control::TraceCsvWriter> csv;
+      std::optional<controller::TraceCsvWriter> csv;
       if (trace_file) csv.emplace(*trace_file, profile.axis_mask(), profile.servo_period_s);
-      control::HomingSpreadOptions ho;
+      drill::HomingSpreadOptions ho;
       ho.runs = o.homing_runs;
       ho.seed = o.seed;
       ho.temperature_swing_c = o.temperature_swing_c;
       if (csv) ho.trace = [&](const control::TraceSample& s) { csv->add(s); };
-      const control::HomingSpread h = control::homing_spread(profile, ho);
+      const drill::HomingSpread h = drill::homing_spread(profile, ho);
       if (trace_file && !commit(*trace_file)) return kExitUsage;
       if (h.axes.count() == 0)
         fmt::print(stderr, "warning: no axis homes by decel_midpoint: no homing figures\n");
@@ -201,28 +201,26 @@ int calibrate(const CalibrateOptions& o) {
       }
     }
     if (o.positioning) {
-      control::PositioningOptions po;
+      drill::PositioningOptions po;
       po.axes = *axes;
       po.seed = o.seed;
-      const control::Positioning before =
-          control::measure_positioning(control::without_compensation(profile), po);
+      const drill::Positioning before = drill::measure_positioning(drill::without_compensation(profile), po);
       // With the profile's own tables too, where it has some: how good they are.
-      control::PositioningOptions with_own = po;
+      drill::PositioningOptions with_own = po;
       with_own.axes = AxisMask{};
       for (const config::AxisProfile& a : profile.axes) {
         if (po.axes.has(a.axis) && a.compensation.present) with_own.axes.set(a.axis);
       }
-      const control::Positioning own = with_own.axes.count() > 0
-                                           ? control::measure_positioning(profile, with_own)
-                                           : control::Positioning{};
+      const drill::Positioning own =
+          with_own.axes.count() > 0 ? drill::measure_positioning(profile, with_own) : drill::Positioning{};
       config::MachineProfile compensated = profile;
       std::vector<std::pair<Axis, config::CompensationProfile>> tables;
       for (config::AxisProfile& a : compensated.axes) {
         if (!before.axes.has(a.axis)) continue;
-        a.compensation = control::compensation_from(before.axis[static_cast<std::size_t>(index(a.axis))], a);
+        a.compensation = drill::compensation_from(before.axis[static_cast<std::size_t>(index(a.axis))], a);
         tables.emplace_back(a.axis, a.compensation);
       }
-      const control::Positioning after = control::measure_positioning(compensated, po);
+      const drill::Positioning after = drill::measure_positioning(compensated, po);
       if (!o.json) print_positioning(before, own, after, po);
       nlohmann::json& j = out["positioning"] = nlohmann::json::object();
       for (int i = 0; i < kAxisCount; ++i) {

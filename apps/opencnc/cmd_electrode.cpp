@@ -50,7 +50,7 @@ nlohmann::json json_point(const Vec3& p) {
   return {p[0], p[1], p[2]};
 }
 
-nlohmann::json result_json(const control::ElectrodeResult& r) {
+nlohmann::json result_json(const edm::ElectrodeResult& r) {
   nlohmann::json touches = nlohmann::json::array();
   for (std::size_t i = 0; i < r.touched.size(); ++i)
     touches.push_back({{"from", i < r.names.size() ? r.names[i] : ""}, {"at", json_point(r.touched[i])}});
@@ -67,7 +67,7 @@ nlohmann::json result_json(const control::ElectrodeResult& r) {
   return j;
 }
 
-void print_electrode(const control::ElectrodeResult& r) {
+void print_electrode(const edm::ElectrodeResult& r) {
   for (std::size_t i = 0; i < r.touched.size(); ++i)
     fmt::print("  touch {:<5} X{:.4f} Y{:.4f} Z{:.4f}\n", i < r.names.size() ? r.names[i] : "",
                r.touched[i][0], r.touched[i][1], r.touched[i][2]);
@@ -78,11 +78,11 @@ void print_electrode(const control::ElectrodeResult& r) {
              1000 * r.max_residual_mm);
 }
 
-bool machine_ready(control::SimRig& rig) {
+bool machine_ready(controller::SimRig& rig) {
   using control::CommandKind;
-  using control::Request;
+  using controller::Request;
   const auto must = [&](Request r) {
-    const control::Outcome o = rig.request(std::move(r), 100000);
+    const controller::Outcome o = rig.request(std::move(r), 100000);
     if (!o.accepted) fmt::print(stderr, "error: the machine refused: {}\n", o.message);
     return o.accepted;
   };
@@ -97,8 +97,8 @@ bool machine_ready(control::SimRig& rig) {
 /// The simulated machine with the electrode feature, homed, tool `tool`'s electrode in the spindle
 /// (where the table says, or `sim_electrode`), and the report file opened.
 struct SphereSession {
-  std::unique_ptr<control::SimRig> rig;
-  std::shared_ptr<control::ElectrodeSetting> feature;
+  std::unique_ptr<controller::SimRig> rig;
+  std::shared_ptr<edm::ElectrodeSetting> feature;
   std::unique_ptr<OutputFile> report;
 };
 
@@ -127,12 +127,12 @@ std::optional<int> open_session(const config::MachineProfile& profile, const std
   // The machine as every front end sets it up; its tool table the file itself with --write (every
   // change written back), else a copy in memory.
   Diagnostics d;
-  control::MachineSetup::Options asked;
+  controller::MachineSetup::Options asked;
   if (!write_table) asked.settings["tool-table"] = "memory";
-  std::unique_ptr<control::MachineSetup> machine = features::machine_setup(profile, d, std::move(asked));
+  std::unique_ptr<controller::MachineSetup> machine = features::machine_setup(profile, d, std::move(asked));
   for (const Diagnostic& i : d.items()) fmt::print(stderr, "{} [{}]\n", i.format(), i.code);
   if (!machine) return kExitUsage;
-  s.feature = std::dynamic_pointer_cast<control::ElectrodeSetting>(machine->feature("electrode"));
+  s.feature = std::dynamic_pointer_cast<edm::ElectrodeSetting>(machine->feature("electrode"));
   if (!s.feature) {
     fmt::print(stderr, "error: {} has no reference sphere and tool table to set electrodes with\n", path);
     return kExitUsage;
@@ -143,7 +143,7 @@ std::optional<int> open_session(const config::MachineProfile& profile, const std
     fmt::print(stderr, "error: tool {} is not in {}\n", tool, profile.interpreter.tool_table);
     return kExitUsage;
   }
-  s.rig = std::make_unique<control::SimRig>(profile, *machine);
+  s.rig = std::make_unique<controller::SimRig>(profile, *machine);
   // The simulated electrode: where the table says, unless --sim-electrode puts it elsewhere.
   Vec3 truth{entry->offset[0], entry->offset[1], entry->offset[2]};
   if (sim_electrode.size() == 3) truth = {sim_electrode[0], sim_electrode[1], sim_electrode[2]};
@@ -154,14 +154,14 @@ std::optional<int> open_session(const config::MachineProfile& profile, const std
 
 /// Asks the feature and runs the machine until it is idle again; false (said on stderr) if refused.
 bool run_feature(SphereSession& s, const std::string& action, std::any args, bool quiet) {
-  const control::Outcome asked =
-      s.rig->request(control::Request::feature("electrode", action, std::move(args)));
+  const controller::Outcome asked =
+      s.rig->request(controller::Request::feature("electrode", action, std::move(args)));
   if (!asked.accepted) {
     fmt::print(stderr, "error: {}\n", asked.message);
     return false;
   }
   if (!quiet) fmt::print("{}\n", asked.message);
-  s.rig->run_until([&] { return s.feature->phase() == control::ElectrodePhase::Idle; }, kElectrodeMaxTicks);
+  s.rig->run_until([&] { return s.feature->phase() == edm::ElectrodePhase::Idle; }, kElectrodeMaxTicks);
   return true;
 }
 
@@ -174,10 +174,10 @@ int electrode_set(const ElectrodeOptions& o) {
   if (const std::optional<int> failed =
           open_session(profile, o.profile, o.tool, o.sim_electrode, o.write, o.report, s))
     return *failed;
-  control::SimRig& rig = *s.rig;
+  controller::SimRig& rig = *s.rig;
   const std::uint64_t started = rig.ticks();
-  if (!run_feature(s, "measure", control::ElectrodeMeasure{o.tool}, o.json)) return kExitProgram;
-  const std::optional<control::ElectrodeResult> r = s.feature->last();
+  if (!run_feature(s, "measure", edm::ElectrodeMeasure{o.tool}, o.json)) return kExitProgram;
+  const std::optional<edm::ElectrodeResult> r = s.feature->last();
   if (!r) {
     fmt::print(stderr, "error: the measurement did not end in {} s of machine time\n",
                static_cast<double>(kElectrodeMaxTicks) * profile.servo_period_s);
@@ -206,7 +206,7 @@ struct BAxisOptions {
   std::string report;
 };
 
-nlohmann::json b_axis_json(const control::BAxisResult& r) {
+nlohmann::json b_axis_json(const edm::BAxisResult& r) {
   nlohmann::json centres = nlohmann::json::array();
   for (std::size_t k = 0; k < r.centres.size(); ++k)
     centres.push_back({{"b_deg", r.angles_deg[k]}, {"centre", json_point(r.centres[k])}});
@@ -238,7 +238,7 @@ std::string toml_list(std::span<const double> v) {
 
 /// The profile's text with the measured axis in [probe.reference_sphere], written over the file
 /// (replace_profile_text) once it reads back as the same profile with that axis.
-bool write_b_axis(const std::string& path, const std::string& original, const control::BAxisLine& axis,
+bool write_b_axis(const std::string& path, const std::string& original, const edm::BAxisLine& axis,
                   std::string& why) {
   std::optional<std::string> text =
       config::with_toml_value(original, "probe.reference_sphere.b_axis", toml_list(axis.crossing), why);
@@ -286,8 +286,8 @@ int calibrate_b(const BAxisOptions& o) {
           open_session(profile, o.profile, o.tool, o.sim_electrode, false, o.report, s))
     return *failed;
   const std::uint64_t started = s.rig->ticks();
-  if (!run_feature(s, "calibrate-b", control::BAxisCalibrate{o.tool, angles}, o.json)) return kExitProgram;
-  const std::optional<control::BAxisResult> r = s.feature->last_b_axis();
+  if (!run_feature(s, "calibrate-b", edm::BAxisCalibrate{o.tool, angles}, o.json)) return kExitProgram;
+  const std::optional<edm::BAxisResult> r = s.feature->last_b_axis();
   if (!r) {
     fmt::print(stderr, "error: the calibration did not end in {} s of machine time\n",
                static_cast<double>(kElectrodeMaxTicks) * profile.servo_period_s);

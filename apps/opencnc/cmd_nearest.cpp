@@ -35,13 +35,13 @@ struct NearestOptions {
 };
 
 /// The profile's G-code source, or a plain one (millimetres, X Y Z A B C, no tool table).
-std::shared_ptr<control::GcodeProgramSource> make_source(const NearestOptions& o, int& rc) {
+std::shared_ptr<controller::GcodeProgramSource> make_source(const NearestOptions& o, int& rc) {
   Diagnostics d;
   if (o.machine.empty()) {
-    control::GcodeSourceConfig c;
+    controller::GcodeSourceConfig c;
     c.options.user_units = canon::Units::Mm;
     c.options.initial_units = canon::Units::Mm;
-    return std::make_shared<control::GcodeProgramSource>(std::move(c));
+    return std::make_shared<controller::GcodeProgramSource>(std::move(c));
   }
   const config::ProfileLoad load = config::load_profile(o.machine, o.sets);
   for (const Diagnostic& x : load.diagnostics.items()) fmt::print(stderr, "{}\n", x.format());
@@ -52,7 +52,7 @@ std::shared_ptr<control::GcodeProgramSource> make_source(const NearestOptions& o
     return nullptr;
   }
   // The program as the machine runs it: its features' passes and codes (features::machine_setup).
-  std::unique_ptr<control::MachineSetup> machine = features::machine_setup(*load.profile, d);
+  std::unique_ptr<controller::MachineSetup> machine = features::machine_setup(*load.profile, d);
   for (const Diagnostic& x : d.items()) fmt::print(stderr, "{}\n", x.format());
   if (!machine) {
     rc = kExitProgram;
@@ -66,7 +66,7 @@ nlohmann::json point_json(const recovery::PathPoint& p, const recovery::PathInde
   j["distance"] = p.distance_mm;
   j["point"] = {p.point[0], p.point[1], p.point[2]};
   j["segment"] = p.segment;
-  const control::SourceLocation l = control::locate(*ix.sources(), p.context, p.line);
+  const controller::SourceLocation l = controller::locate(*ix.sources(), p.context, p.line);
   j["line"] = fmt::format("{}:{}", l.file, l.line);
   j["calls"] = l.calls;
   j["param"] = p.param;
@@ -108,7 +108,7 @@ int run_nearest(const NearestOptions& o) {
     const recovery::PathPoint& p = n.candidates[i];
     fmt::print("{} ({:.4f}, {:.4f}, {:.4f})  {:.4f} mm away  segment {}  {}\n",
                i == 0 ? "nearest  " : "candidate", p.point[0], p.point[1], p.point[2], p.distance_mm,
-               p.segment, control::to_string(control::locate(*ix.sources(), p.context, p.line)));
+               p.segment, controller::to_string(controller::locate(*ix.sources(), p.context, p.line)));
   }
   fmt::print("{} feed moves indexed in {:.3f} s\n", ix.size(), build_s);
   return kExitOk;

@@ -416,10 +416,10 @@ bool check_sources(const PlotOptions& o) {
 }
 
 /// The program run's samples, as the plot draws them.
-class PlotRecorder final : public control::ControllerObserver {
+class PlotRecorder final : public controller::ControllerObserver {
  public:
   explicit PlotRecorder(Trace& tr) : tr_(tr) {}
-  void on_trace(const control::TraceSample& s, const control::TraceContext&) override {
+  void on_trace(const control::TraceSample& s, const controller::TraceContext&) override {
     if (s.activity != control::Activity::Program) return;
     tr_.samples.push_back(Sample{static_cast<double>(s.tick) * tr_.period_s, s.rapid, s.path_velocity,
                                  s.commanded, s.following_error, s.actual, s.home_level, s.homing_phase});
@@ -450,11 +450,12 @@ int plot(const PlotOptions& o) {
     title = "opencnc trace " + o.trace;
   } else {
     SessionHooks hooks;
-    hooks.opened = [&](const config::MachineProfile& p, const control::OpenProgram&) {
+    hooks.opened = [&](const config::MachineProfile& p, const controller::OpenProgram&) {
       tr.axes = p.axis_mask();
       tr.period_s = p.servo_period_s;
-      std::vector<std::pair<std::shared_ptr<control::ControllerObserver>, control::ObserverOptions>> out;
-      out.emplace_back(std::make_shared<PlotRecorder>(tr), control::ObserverOptions{0, true});
+      std::vector<std::pair<std::shared_ptr<controller::ControllerObserver>, controller::ObserverOptions>>
+          out;
+      out.emplace_back(std::make_shared<PlotRecorder>(tr), controller::ObserverOptions{0, true});
       return out;
     };
     SessionOptions session = o.session;

@@ -36,9 +36,9 @@ struct RecoverOptions {
 };
 
 /// The trace to a CSV and the recovery's largest helix error (feedback, coupled periods).
-class RecoverTrace final : public control::ControllerObserver {
+class RecoverTrace final : public controller::ControllerObserver {
  public:
-  RecoverTrace(control::TraceCsvWriter* csv, const recovery::BreakpointCoupling& c,
+  RecoverTrace(controller::TraceCsvWriter* csv, const recovery::BreakpointCoupling& c,
                const motion::CouplingConfig& config, double radius_mm)
       : csv_(csv), c_(c), radius_mm_(radius_mm) {
     const auto kind = static_cast<motion::CouplingKind>(c.kind);
@@ -50,12 +50,12 @@ class RecoverTrace final : public control::ControllerObserver {
       law_ = motion::CouplingLaw::tabulated(kind, config.tables[static_cast<std::size_t>(c.table - 1)]);
   }
   // Only while the tick holds the breakpoint's law (its origin): later grooves have laws of their own.
-  void on_status(const control::ControllerStatus& s) override {
+  void on_status(const controller::ControllerStatus& s) override {
     const control::CouplingStatus& k = s.servo.coupling;
     same_law_ = static_cast<std::uint8_t>(k.kind) == c_.kind && k.master_origin == c_.master_origin &&
                 k.slave_origin == c_.slave_origin;
   }
-  void on_trace(const control::TraceSample& s, const control::TraceContext&) override {
+  void on_trace(const control::TraceSample& s, const controller::TraceContext&) override {
     if (s.activity != control::Activity::Program) return;
     if (csv_ != nullptr) csv_->add(s);
     // The law of the breakpoint holds while the recovery runs on the interrupted move's groove.
@@ -68,7 +68,7 @@ class RecoverTrace final : public control::ControllerObserver {
   double helix_error_um() const { return worst_um * std::numbers::pi / 180 * radius_mm_ * 1000; }
 
  private:
-  control::TraceCsvWriter* csv_;
+  controller::TraceCsvWriter* csv_;
   recovery::BreakpointCoupling c_;
   motion::CouplingLaw law_;
   double radius_mm_;
@@ -99,7 +99,7 @@ std::optional<recovery::BreakpointRecord> read_record(const std::string& dir) {
 /// The simulated workpiece as the run that wrote the record left it (`opencnc run --journal` keeps
 /// it beside the journal): the machine powers up with the groove already cut. Without it (or one of
 /// another breakpoint) the simulated bore is uncut, and the load guard meets the groove as a chip.
-void restore_bore(control::SimRig& rig, const std::string& dir, const recovery::BreakpointRecord& r) {
+void restore_bore(controller::SimRig& rig, const std::string& dir, const recovery::BreakpointRecord& r) {
   if (rig.machine().broach_bore().empty()) return;  // no simulated broach
   std::string error;
   const std::optional<recovery::SimBore> b = recovery::load_sim_bore(dir, &error);
@@ -167,8 +167,8 @@ int recover(const RecoverOptions& o) {
 
   // The machine as every front end sets it up, the journal among its features.
   Diagnostics d;
-  std::unique_ptr<control::MachineSetup> machine =
-      features::machine_setup(profile, d, control::MachineSetup::Options::with("journal", o.journal));
+  std::unique_ptr<controller::MachineSetup> machine =
+      features::machine_setup(profile, d, controller::MachineSetup::Options::with("journal", o.journal));
   for (const Diagnostic& x : d.items()) {
     if (x.code == "setting.journal")
       fmt::print(stderr, "error: --journal {}: {}\n", o.journal, x.message);
@@ -182,17 +182,17 @@ int recover(const RecoverOptions& o) {
                o.machine);
     return kExitUsage;
   }
-  control::SimRig rig(profile, *machine);
-  std::optional<control::TraceCsvWriter> csv;
+  controller::SimRig rig(profile, *machine);
+  std::optional<controller::TraceCsvWriter> csv;
   if (files[0]) csv.emplace(*files[0], profile.axis_mask(), profile.servo_period_s);
   auto trace =
       std::make_shared<RecoverTrace>(csv ? &*csv : nullptr, r->coupling,
                                      control::coupling_config(profile.coupling), profile.coupling.radius_mm);
-  rig.controller().attach(trace, control::ObserverOptions{profile.servo_period_s, true});
+  rig.controller().attach(trace, controller::ObserverOptions{profile.servo_period_s, true});
   restore_bore(rig, o.journal, *r);
   rig.step();
-  if (!rig.request(control::Request::simple(control::CommandKind::MachineOn)).accepted ||
-      !rig.request(control::Request::set_mode(control::Mode::Auto)).accepted) {
+  if (!rig.request(controller::Request::simple(control::CommandKind::MachineOn)).accepted ||
+      !rig.request(controller::Request::set_mode(control::Mode::Auto)).accepted) {
     fmt::print(stderr, "error: the machine does not come on\n");
     return kExitProgram;
   }
@@ -201,7 +201,8 @@ int recover(const RecoverOptions& o) {
     args = recovery::ResumeArgs{o.tolerance_mm, o.tolerance_deg, o.run_in_mm, o.speed_mm_min};
   if (o.choice == "retract")
     args = recovery::RetractArgs{o.distance_mm, o.direction == "onward", o.speed_mm_min};
-  const control::Outcome answer = rig.request(control::Request::feature("journal", o.choice, args), 100000);
+  const controller::Outcome answer =
+      rig.request(controller::Request::feature("journal", o.choice, args), 100000);
   bool done = false;
   std::string why = answer.message;
   if (answer.accepted) {

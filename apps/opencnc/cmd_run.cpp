@@ -141,7 +141,7 @@ bool within_max_time(const RunOptions& o, const config::MachineProfile& profile)
 class ProgressBar {
  public:
   explicit ProgressBar(double total_mm) : total_mm_(total_mm) {}
-  void show(const control::ControllerStatus& st, double run_start_s, double done_mm) {
+  void show(const controller::ControllerStatus& st, double run_start_s, double done_mm) {
     const double done = total_mm_ > 0 ? std::min(1.0, done_mm / total_mm_) : st.progress;
     const double elapsed = st.servo.time_s - run_start_s;
     const int width = 30, filled = static_cast<int>(done * width + 0.5);
@@ -159,22 +159,23 @@ class ProgressBar {
 };
 
 /// The trace CSV, one row per period of the program run.
-class TraceObserver final : public control::ControllerObserver {
+class TraceObserver final : public controller::ControllerObserver {
  public:
-  explicit TraceObserver(control::TraceCsvWriter& w) : w_(w) {}
-  void on_trace(const control::TraceSample& s, const control::TraceContext&) override {
+  explicit TraceObserver(controller::TraceCsvWriter& w) : w_(w) {}
+  void on_trace(const control::TraceSample& s, const controller::TraceContext&) override {
     if (s.activity == control::Activity::Program) w_.add(s);
   }
 
  private:
-  control::TraceCsvWriter& w_;
+  controller::TraceCsvWriter& w_;
 };
 
 std::string axis_name(int i) {
   return std::string(1, kAxisLetters[static_cast<std::size_t>(i)]);
 }
 
-void print_report(const control::RunReport& r, const config::MachineProfile& profile, const SessionEnd& end) {
+void print_report(const controller::RunReport& r, const config::MachineProfile& profile,
+                  const SessionEnd& end) {
   fmt::print("machining time      {:.3f} s (motion {:.3f} s)\n", r.machining_time_s, r.motion_time_s);
   fmt::print("path length         {:.3f} mm\n", r.path_length_mm);
   fmt::print("max following error {:.4f} mm{}\n", r.max_following_error_mm,
@@ -199,7 +200,7 @@ void print_report(const control::RunReport& r, const config::MachineProfile& pro
   }
 }
 
-nlohmann::json report_json(const control::RunReport& r, const RunOptions& o, const SessionEnd& end) {
+nlohmann::json report_json(const controller::RunReport& r, const RunOptions& o, const SessionEnd& end) {
   nlohmann::json j;
   j["program"] = o.session.file;
   j["machine"] = end.profile.name;
@@ -265,7 +266,7 @@ int run(const RunOptions& o, const std::vector<std::unique_ptr<RunFeature>>& fea
     for (std::size_t k = 0; k < f->outputs().size(); ++k) mine.push_back(files[i++].get());
     f->take_outputs(mine);
   }
-  std::shared_ptr<control::RunRecorder> recorder;
+  std::shared_ptr<controller::RunRecorder> recorder;
   SessionOptions session = o.session;
   session.reports = true;
   if (!o.inject.empty()) {
@@ -288,46 +289,47 @@ int run(const RunOptions& o, const std::vector<std::unique_ptr<RunFeature>>& fea
   }
   for (const auto& f : features)
     if (!f->check(profile ? &*profile : nullptr, session)) return kExitUsage;
-  std::optional<control::TraceCsvWriter> csv;
+  std::optional<controller::TraceCsvWriter> csv;
   std::optional<ProgressBar> bar;
   const bool tty = ::isatty(STDOUT_FILENO) != 0;
   double run_start_s = -1;
   SessionHooks hooks;
-  hooks.set_up = [&](control::MachineSetup& machine) {
+  hooks.set_up = [&](controller::MachineSetup& machine) {
     for (const auto& f : features)
       if (!f->set_up(machine)) return false;
     return true;
   };
   // The machining time against --max-time: once the preflight has passed (an endless program is
   // refused there, in seconds, not estimated first).
-  hooks.may_start = [&](const config::MachineProfile& machine, const control::OpenProgram&) {
+  hooks.may_start = [&](const config::MachineProfile& machine, const controller::OpenProgram&) {
     return within_max_time(o, machine);
   };
-  hooks.opened = [&](const config::MachineProfile& machine, const control::OpenProgram& program) {
+  hooks.opened = [&](const config::MachineProfile& machine, const controller::OpenProgram& program) {
     SessionObservers out;
-    const plan::MachineLimits axes = control::axis_limits(machine);  // the drives' commands: the axes' own
-    recorder = std::make_shared<control::RunRecorder>(control::machine_limits(machine),
-                                                      machine.servo_period_s, &axes);
-    out.emplace_back(recorder, control::ObserverOptions{0, true});
+    const plan::MachineLimits axes = controller::axis_limits(machine);  // the drives' commands: the axes' own
+    recorder = std::make_shared<controller::RunRecorder>(controller::machine_limits(machine),
+                                                         machine.servo_period_s, &axes);
+    out.emplace_back(recorder, controller::ObserverOptions{0, true});
     for (const auto& f : features) f->opened(machine, out);
     if (trace_file != nullptr) {
       csv.emplace(*trace_file, machine.axis_mask(), machine.servo_period_s);
-      out.emplace_back(std::make_shared<TraceObserver>(*csv), control::ObserverOptions{0, true});
+      out.emplace_back(std::make_shared<TraceObserver>(*csv), controller::ObserverOptions{0, true});
     }
     if (tty) bar.emplace(program.preflight.summary.path_length_mm);
     return out;
   };
-  hooks.progress = [&](const control::ControllerStatus& st, double) {
+  hooks.progress = [&](const controller::ControllerStatus& st, double) {
     if (run_start_s < 0) run_start_s = st.servo.time_s;
     if (bar) bar->show(st, run_start_s, recorder->report().path_length_mm);
   };
-  hooks.tick = [&](control::Controller& c, const control::ControllerStatus& st, machine::SimMachine* sim) {
+  hooks.tick = [&](controller::Controller& c, const controller::ControllerStatus& st,
+                   machine::SimMachine* sim) {
     for (const auto& f : features) f->tick(c, st, sim);
   };
-  hooks.goes_on = [&](const control::ControllerEvent& e) {
+  hooks.goes_on = [&](const controller::ControllerEvent& e) {
     return std::any_of(features.begin(), features.end(), [&](const auto& f) { return f->goes_on(e); });
   };
-  hooks.on_event = [&](const control::ControllerEvent& e, SessionOperator& op) {
+  hooks.on_event = [&](const controller::ControllerEvent& e, SessionOperator& op) {
     for (const auto& f : features) f->on_event(e, op);
   };
   hooks.finished = [&](machine::SimMachine* sim) {
@@ -342,7 +344,7 @@ int run(const RunOptions& o, const std::vector<std::unique_ptr<RunFeature>>& fea
   if (!recorder) return end.exit_code;  // nothing ran; the outputs are left as they were
   int rc = end.exit_code;
   if (trace_file != nullptr && !commit_trace(*trace_file)) rc = kExitUsage;
-  const control::RunReport r = recorder->report();
+  const controller::RunReport r = recorder->report();
   print_report(r, end.profile, end);
   nlohmann::json j = report_json(r, o, end);
   for (const auto& f : features)  // each feature's lines and part of the report

@@ -83,19 +83,19 @@ bool split_listen(const std::string& listen, std::string& address, std::uint16_t
 }
 
 /// Puts the machine in Auto and opens `program`, waiting for the answers.
-bool open_program(control::Controller& c, const std::string& program) {
-  auto ask = [&c](control::Request r) {
+bool open_program(controller::Controller& c, const std::string& program) {
+  auto ask = [&c](controller::Request r) {
     const std::uint64_t id = c.submit(std::move(r));
     for (int k = 0; k < 30000; ++k) {
       if (auto o = c.outcome(id)) return *o;
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
     }
-    return control::Outcome{false, control::Refusal::Busy, "the controller does not answer", {}};
+    return controller::Outcome{false, control::Refusal::Busy, "the controller does not answer", {}};
   };
-  for (auto r : {control::Request::simple(control::CommandKind::MachineOn),
-                 control::Request::set_mode(control::Mode::Auto), control::Request::open(program)}) {
+  for (auto r : {controller::Request::simple(control::CommandKind::MachineOn),
+                 controller::Request::set_mode(control::Mode::Auto), controller::Request::open(program)}) {
     const std::string name = r.name();
-    const control::Outcome o = ask(std::move(r));
+    const controller::Outcome o = ask(std::move(r));
     for (const Diagnostic& d : o.diagnostics.items()) fmt::print(stderr, "{}\n", d.format());
     if (!o.accepted && name == "open") {
       fmt::print(stderr, "error: {}: {}\n", program, o.message);
@@ -142,7 +142,7 @@ int serve(const ServeOptions& o) {
   const std::unique_ptr<hmi::MachineFeatures> features = hmi::MachineFeatures::create(profile, fo, diags);
   for (const Diagnostic& d : diags.items()) fmt::print(stderr, "{}\n", d.format());
   if (!features) return kExitUsage;
-  const std::shared_ptr<control::GcodeProgramSource> source = features->source();
+  const std::shared_ptr<controller::GcodeProgramSource> source = features->source();
   std::string error;
   const auto tokens = hmi::Tokens::load(data / "tokens", &error);
   if (!tokens) {
@@ -245,9 +245,9 @@ int serve(const ServeOptions& o) {
   server.stop();
   sampler.stop();  // the machine UNAVAILABLE, then published as such
   if (mqtt) mqtt->stop(2000);
-  host.controller().submit(control::Request::simple(control::CommandKind::FeedHold));
+  host.controller().submit(controller::Request::simple(control::CommandKind::FeedHold));
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
-  host.controller().submit(control::Request::simple(control::CommandKind::Abort));
+  host.controller().submit(controller::Request::simple(control::CommandKind::Abort));
   std::this_thread::sleep_for(std::chrono::milliseconds(200));
   host.stop();
   history->flush();

@@ -25,8 +25,8 @@ std::optional<ElectrodeChangeAt> parse_electrode_change(const std::string& text)
 }
 
 ElectrodeChangeScript::ElectrodeChangeScript(std::vector<ElectrodeChangeAt> steps,
-                                             std::shared_ptr<control::ElectrodeSetting> feature,
-                                             Axis tool_axis, double lift_mm, double min_mm, double max_mm)
+                                             std::shared_ptr<edm::ElectrodeSetting> feature, Axis tool_axis,
+                                             double lift_mm, double min_mm, double max_mm)
     : steps_(std::move(steps)),
       feature_(std::move(feature)),
       tool_axis_(tool_axis),
@@ -40,25 +40,25 @@ void ElectrodeChangeScript::fail(const std::string& why) {
 }
 
 // The last request's outcome: false while it is not known; a refusal ends the changes.
-bool ElectrodeChangeScript::answered(control::Controller& c) {
+bool ElectrodeChangeScript::answered(controller::Controller& c) {
   if (asked_ == 0) return true;
-  const std::optional<control::Outcome> o = c.outcome(asked_);
+  const std::optional<controller::Outcome> o = c.outcome(asked_);
   if (!o) return false;
   asked_ = 0;
   if (!o->accepted) fail(o->message);
   return o->accepted;
 }
 
-void ElectrodeChangeScript::tick(control::Controller& c, const control::ControllerStatus& st,
+void ElectrodeChangeScript::tick(controller::Controller& c, const controller::ControllerStatus& st,
                                  machine::SimMachine* sim) {
-  using control::Request;
-  if (t0_ < 0 && st.run_active && st.job == control::JobKind::Program) t0_ = st.servo.time_s;
+  using controller::Request;
+  if (t0_ < 0 && st.run_active && st.job == controller::JobKind::Program) t0_ = st.servo.time_s;
   if (stage_ == Stage::Failed || !answered(c)) return;
   const bool idle = st.servo.state == control::State::Idle && !st.run_active;
   switch (stage_) {
     case Stage::Waiting:
       if (next_ >= steps_.size() || t0_ < 0 || st.servo.time_s - t0_ < steps_[next_].at_s) return;
-      if (!st.run_active || st.job != control::JobKind::Program) return;  // between jobs: at the next
+      if (!st.run_active || st.job != controller::JobKind::Program) return;  // between jobs: at the next
       if (sim == nullptr || st.servo.tool <= 0)
         return fail("no simulated machine, or no tool in the spindle");
       records_.push_back(ElectrodeChangeRecord{st.servo.time_s - t0_, st.servo.tool, 0, {}, false});
@@ -89,13 +89,13 @@ void ElectrodeChangeScript::tick(control::Controller& c, const control::Controll
       const machine::SimElectrode& now = sim->electrode();
       sim->replace_electrode(records_.back().tool, steps_[next_].offset, now.tip_radius);
       asked_ =
-          c.submit(Request::feature("electrode", "measure", control::ElectrodeMeasure{records_.back().tool}));
+          c.submit(Request::feature("electrode", "measure", edm::ElectrodeMeasure{records_.back().tool}));
       stage_ = Stage::Measuring;
       return;
     }
     case Stage::Measuring: {
-      if (feature_->phase() != control::ElectrodePhase::Idle || !idle) return;
-      const std::optional<control::ElectrodeResult> r = feature_->last();
+      if (feature_->phase() != edm::ElectrodePhase::Idle || !idle) return;
+      const std::optional<edm::ElectrodeResult> r = feature_->last();
       if (!r || !r->ok) return fail(r ? r->message : "no measurement");
       records_.back().measured = *r;
       asked_ = c.submit(Request::feature("electrode", "resume"));
@@ -103,8 +103,8 @@ void ElectrodeChangeScript::tick(control::Controller& c, const control::Controll
       return;
     }
     case Stage::Resuming:
-      if (feature_->phase() != control::ElectrodePhase::Idle || !st.run_active ||
-          st.job != control::JobKind::Program)
+      if (feature_->phase() != edm::ElectrodePhase::Idle || !st.run_active ||
+          st.job != controller::JobKind::Program)
         return;
       records_.back().resumed = true;
       stage_ = Stage::Waiting;
@@ -115,14 +115,14 @@ void ElectrodeChangeScript::tick(control::Controller& c, const control::Controll
   }
 }
 
-bool ElectrodeChangeScript::goes_on(const control::ControllerEvent& e) const {
-  return e.end == control::JobEnd::Aborted && stage_ != Stage::Waiting && stage_ != Stage::Failed;
+bool ElectrodeChangeScript::goes_on(const controller::ControllerEvent& e) const {
+  return e.end == controller::JobEnd::Aborted && stage_ != Stage::Waiting && stage_ != Stage::Failed;
 }
 
 nlohmann::json ElectrodeChangeScript::json() const {
   nlohmann::json out = nlohmann::json::array();
   for (const ElectrodeChangeRecord& r : records_) {
-    const control::ElectrodeResult& m = r.measured;
+    const edm::ElectrodeResult& m = r.measured;
     out.push_back({{"at_s", r.at_s},
                    {"tool", r.tool},
                    {"segment", r.segment},

@@ -34,7 +34,7 @@ struct ElectrodeChangeRecord {
   double at_s = 0;            ///< when the operator stopped the job (program time)
   int tool = 0;               ///< the tool in the spindle, replaced and measured
   std::uint64_t segment = 0;  ///< where the job stopped
-  control::ElectrodeResult measured;
+  edm::ElectrodeResult measured;
   bool resumed = false;  ///< the job went on from the stop point
 };
 
@@ -47,14 +47,13 @@ class ElectrodeChangeScript {
  public:
   /// `tool_axis` the electrode's axis, `lift_mm` signed (away from the work), the lifted position
   /// kept within [min_mm, max_mm] (the axis' soft limits).
-  ElectrodeChangeScript(std::vector<ElectrodeChangeAt> steps,
-                        std::shared_ptr<control::ElectrodeSetting> feature, Axis tool_axis, double lift_mm,
-                        double min_mm, double max_mm);
+  ElectrodeChangeScript(std::vector<ElectrodeChangeAt> steps, std::shared_ptr<edm::ElectrodeSetting> feature,
+                        Axis tool_axis, double lift_mm, double min_mm, double max_mm);
 
   /// Every period of the run.
-  void tick(control::Controller& c, const control::ControllerStatus& st, machine::SimMachine* sim);
+  void tick(controller::Controller& c, const controller::ControllerStatus& st, machine::SimMachine* sim);
   /// The program's job ended: the session goes on while a change is under way.
-  bool goes_on(const control::ControllerEvent& e) const;
+  bool goes_on(const controller::ControllerEvent& e) const;
   const std::vector<ElectrodeChangeRecord>& records() const { return records_; }
   /// The report's `electrode_changes`.
   nlohmann::json json() const;
@@ -62,10 +61,10 @@ class ElectrodeChangeScript {
  private:
   enum class Stage : std::uint8_t { Waiting, Holding, Aborting, Lifting, Measuring, Resuming, Failed };
   void fail(const std::string& why);
-  bool answered(control::Controller& c);
+  bool answered(controller::Controller& c);
 
   std::vector<ElectrodeChangeAt> steps_;
-  std::shared_ptr<control::ElectrodeSetting> feature_;
+  std::shared_ptr<edm::ElectrodeSetting> feature_;
   Axis tool_axis_ = Axis::Z;
   double lift_mm_ = 10, min_mm_ = 0, max_mm_ = 0;
   std::size_t next_ = 0;

@@ -373,7 +373,7 @@ TimeEstimate estimate_machining_time(const std::string& file, const config::Mach
   TimeEstimate e;
   // The options the run's own source gives this file (dialect comment, modules, tool table).
   Diagnostics diags;
-  const std::unique_ptr<control::MachineSetup> machine = features::machine_setup(profile, diags);
+  const std::unique_ptr<controller::MachineSetup> machine = features::machine_setup(profile, diags);
   if (!machine) return e;
   const auto& source = machine->source();
   ProgramScan scan(source->options_for(file, {}));

@@ -19,7 +19,7 @@ namespace opencnc::cli {
 namespace {
 
 using control::CommandKind;
-using control::Request;
+using controller::Request;
 
 class BroachingRun final : public RunFeature {
  public:
@@ -52,7 +52,7 @@ class BroachingRun final : public RunFeature {
     if (!journal_dir_.empty()) session.settings["journal"] = journal_dir_;
     return true;
   }
-  bool set_up(control::MachineSetup& machine) override {
+  bool set_up(controller::MachineSetup& machine) override {
     if (journal_dir_.empty()) return true;
     journal_ = std::dynamic_pointer_cast<recovery::BreakpointJournal>(machine.feature("journal"));
     if (!journal_) {
@@ -66,12 +66,13 @@ class BroachingRun final : public RunFeature {
   }
   void opened(const config::MachineProfile& machine, SessionObservers& out) override {
     if (!mains_off_) return;  // the stop after the injected power failure, measured
-    power_ = std::make_shared<control::PowerFailRecorder>(control::coupling_config(machine.coupling),
-                                                          control::machine_limits(machine),
-                                                          machine.servo_period_s, machine.coupling.radius_mm);
-    out.emplace_back(power_, control::ObserverOptions{machine.servo_period_s, true});
+    power_ = std::make_shared<broaching::PowerFailRecorder>(
+        control::coupling_config(machine.coupling), controller::machine_limits(machine),
+        machine.servo_period_s, machine.coupling.radius_mm);
+    out.emplace_back(power_, controller::ObserverOptions{machine.servo_period_s, true});
   }
-  void tick(control::Controller&, const control::ControllerStatus& st, machine::SimMachine* sim) override {
+  void tick(controller::Controller&, const controller::ControllerStatus& st,
+            machine::SimMachine* sim) override {
     if (dull_s_ >= 0 && !dulled_ && sim != nullptr && st.servo.time_s >= dull_s_) {
       sim->set_tool_dull(dull_factor_);
       dulled_ = true;
@@ -80,8 +81,8 @@ class BroachingRun final : public RunFeature {
   // The load guard held the feed (its note says at what load): the operator at the terminal
   // resumes (the cutter checked) or aborts; --unattended or no terminal aborts, since nothing
   // would resume.
-  bool on_event(const control::ControllerEvent& e, SessionOperator& op) override {
-    using control::ControllerEventKind;
+  bool on_event(const controller::ControllerEvent& e, SessionOperator& op) override {
+    using controller::ControllerEventKind;
     if (e.kind == ControllerEventKind::Servo && e.servo.kind == control::EventKind::LoadGuard)
       hold_ = e.servo.action == static_cast<std::uint32_t>(control::LoadAction::Hold);
     if (!(e.kind == ControllerEventKind::Note && e.code == "control.load" && hold_ && !aborted_)) return true;
@@ -113,7 +114,7 @@ class BroachingRun final : public RunFeature {
   std::string journal_dir_;
   double dull_s_ = -1, dull_factor_ = 1;
   bool dulled_ = false, mains_off_ = false, hold_ = false, aborted_ = false;
-  std::shared_ptr<control::PowerFailRecorder> power_;
+  std::shared_ptr<broaching::PowerFailRecorder> power_;
   std::shared_ptr<recovery::BreakpointJournal> journal_;
   std::vector<float> bore_;
 };

@@ -77,11 +77,11 @@ class EdmRun final : public RunFeature {
     for (const std::string& text : changes_text_) changes_.push_back(*parse_electrode_change(text));
     return true;
   }
-  bool set_up(control::MachineSetup& machine) override {
+  bool set_up(controller::MachineSetup& machine) override {
     for (const auto& [observer, options] : machine.observers())  // the burn's report section
-      if (auto e = std::dynamic_pointer_cast<control::EdmRecorder>(observer)) recorder_ = e;
+      if (auto e = std::dynamic_pointer_cast<edm::EdmRecorder>(observer)) recorder_ = e;
     if (changes_.empty()) return true;
-    auto electrode = std::dynamic_pointer_cast<control::ElectrodeSetting>(machine.feature("electrode"));
+    auto electrode = std::dynamic_pointer_cast<edm::ElectrodeSetting>(machine.feature("electrode"));
     if (!electrode) {
       fmt::print(stderr, "error: --electrode-change: the machine has no tool table for the electrodes\n");
       return false;
@@ -94,14 +94,17 @@ class EdmRun final : public RunFeature {
                      a != nullptr ? a->max_limit : 1e9);
     return true;
   }
-  void tick(control::Controller& c, const control::ControllerStatus& st, machine::SimMachine* sim) override {
+  void tick(controller::Controller& c, const controller::ControllerStatus& st,
+            machine::SimMachine* sim) override {
     if (short_s_ >= 0 && !shorted_ && sim != nullptr && st.servo.time_s >= short_s_) {
       sim->inject_edm_short();
       shorted_ = true;
     }
     if (changer_) changer_->tick(c, st, sim);
   }
-  bool goes_on(const control::ControllerEvent& e) const override { return changer_ && changer_->goes_on(e); }
+  bool goes_on(const controller::ControllerEvent& e) const override {
+    return changer_ && changer_->goes_on(e);
+  }
   void finished(machine::SimMachine* sim) override {
     if (sim == nullptr || !sim_gap_) return;
     const machine::SimEdmProcess& e = sim->edm();
@@ -125,7 +128,7 @@ class EdmRun final : public RunFeature {
     }
     if (changer_) {
       for (const ElectrodeChangeRecord& x : changer_->records()) {
-        const control::ElectrodeResult& m = x.measured;
+        const edm::ElectrodeResult& m = x.measured;
         fmt::print(
             "electrode change    at {:.3f} s, tool {}, segment {}: measured X{:.4f} Y{:.4f} Z{:.4f} (was "
             "X{:.4f} Y{:.4f} Z{:.4f}), {}\n",
@@ -143,7 +146,7 @@ class EdmRun final : public RunFeature {
   std::optional<ElectrodeChangeScript> changer_;
   double short_s_ = -1;
   bool shorted_ = false, sim_gap_ = false;
-  std::shared_ptr<control::EdmRecorder> recorder_;
+  std::shared_ptr<edm::EdmRecorder> recorder_;
   std::optional<SimFigures> sim_;
 };
 

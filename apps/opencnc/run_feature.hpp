@@ -58,17 +58,17 @@ class RunFeature {
   virtual bool check(const config::MachineProfile* /*profile*/, SessionOptions& /*session*/) { return true; }
   /// The machine's features are set up: it takes the ones it drives (its own and their
   /// observers). False after printing why.
-  virtual bool set_up(control::MachineSetup& /*machine*/) { return true; }
+  virtual bool set_up(controller::MachineSetup& /*machine*/) { return true; }
   /// The program is open and checked: observers for its run.
   virtual void opened(const config::MachineProfile& /*machine*/, SessionObservers& /*out*/) {}
   /// Every period of the run (in virtual time with the simulated machine, else null).
-  virtual void tick(control::Controller& /*c*/, const control::ControllerStatus& /*st*/,
+  virtual void tick(controller::Controller& /*c*/, const controller::ControllerStatus& /*st*/,
                     machine::SimMachine* /*sim*/) {}
   /// An event of the run: the operator's answer where the feature holds the program. False when
   /// the run was aborted.
-  virtual bool on_event(const control::ControllerEvent& /*e*/, SessionOperator& /*op*/) { return true; }
+  virtual bool on_event(const controller::ControllerEvent& /*e*/, SessionOperator& /*op*/) { return true; }
   /// The program's job ended: true when the session goes on with the job that resumes it.
-  virtual bool goes_on(const control::ControllerEvent& /*e*/) const { return false; }
+  virtual bool goes_on(const controller::ControllerEvent& /*e*/) const { return false; }
   /// The session ends: what it keeps of the simulated machine (virtual time; else null).
   virtual void finished(machine::SimMachine* /*sim*/) {}
   /// Its lines of the report on stdout and its part of the report's JSON; false when something

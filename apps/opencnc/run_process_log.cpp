@@ -45,7 +45,7 @@ class ProcessLogRun final : public RunFeature {
                                    program_,
                                    machine.name};
     log_ = std::make_shared<process::ProcessLog>(setup, *format_, *file_);
-    out.emplace_back(log_, control::ObserverOptions{0, true});
+    out.emplace_back(log_, controller::ObserverOptions{0, true});
   }
   bool report(nlohmann::json&) override {
     if (!log_) return true;

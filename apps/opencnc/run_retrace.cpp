@@ -35,12 +35,12 @@ class RetraceScript {
   RetraceScript(std::vector<RetraceAt> steps, std::shared_ptr<recovery::RetraceFeature> feature)
       : steps_(std::move(steps)), feature_(std::move(feature)) {}
 
-  void tick(control::Controller& c, const control::ControllerStatus& st) {
-    using control::Request;
-    if (t0_ < 0 && st.run_active && st.job == control::JobKind::Program) t0_ = st.servo.time_s;
+  void tick(controller::Controller& c, const controller::ControllerStatus& st) {
+    using controller::Request;
+    if (t0_ < 0 && st.run_active && st.job == controller::JobKind::Program) t0_ = st.servo.time_s;
     if (stage_ != Stage::Waiting && asked_ != 0 && !c.outcome(asked_)) return;  // not answered yet
     if (stage_ != Stage::Waiting && asked_ != 0) {
-      const control::Outcome o = *c.outcome(asked_);
+      const controller::Outcome o = *c.outcome(asked_);
       asked_ = 0;
       if (!o.accepted) {
         fmt::print(stderr, "error: retrace at {:g} s: {}\n", steps_[next_].at_s, o.message);
@@ -53,7 +53,7 @@ class RetraceScript {
     switch (stage_) {
       case Stage::Waiting:
         if (next_ >= steps_.size() || t0_ < 0 || st.servo.time_s - t0_ < steps_[next_].at_s) return;
-        if (!st.run_active || st.job != control::JobKind::Program) return;  // between jobs: at the next
+        if (!st.run_active || st.job != controller::JobKind::Program) return;  // between jobs: at the next
         asked_ = c.submit(Request::feature("retrace", "pause"));
         stage_ = Stage::Pausing;
         return;
@@ -82,8 +82,8 @@ class RetraceScript {
     }
   }
   /// The program's job ended: the session goes on while a retrace is under way.
-  bool goes_on(const control::ControllerEvent& e) const {
-    return e.end == control::JobEnd::Aborted && stage_ != Stage::Waiting;
+  bool goes_on(const controller::ControllerEvent& e) const {
+    return e.end == controller::JobEnd::Aborted && stage_ != Stage::Waiting;
   }
   /// The times of the retraces that started, in order.
   const std::vector<double>& times() const { return times_; }
@@ -143,7 +143,7 @@ class RetraceRun final : public RunFeature {
       steps_.push_back(*parse_retrace(text));  // checked by the option
     return true;
   }
-  bool set_up(control::MachineSetup& machine) override {
+  bool set_up(controller::MachineSetup& machine) override {
     if (steps_.empty()) return true;
     feature_ = std::dynamic_pointer_cast<recovery::RetraceFeature>(machine.feature("retrace"));
     if (!feature_) {
@@ -153,10 +153,11 @@ class RetraceRun final : public RunFeature {
     script_.emplace(steps_, feature_);
     return true;
   }
-  void tick(control::Controller& c, const control::ControllerStatus& st, machine::SimMachine*) override {
+  void tick(controller::Controller& c, const controller::ControllerStatus& st,
+            machine::SimMachine*) override {
     if (script_) script_->tick(c, st);
   }
-  bool goes_on(const control::ControllerEvent& e) const override { return script_ && script_->goes_on(e); }
+  bool goes_on(const controller::ControllerEvent& e) const override { return script_ && script_->goes_on(e); }
   bool report(nlohmann::json& j) override {
     if (!feature_) return true;
     const std::vector<recovery::RetraceRecord> records = feature_->records();

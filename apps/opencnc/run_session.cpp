@@ -35,10 +35,10 @@ namespace opencnc::cli {
 namespace {
 
 using control::CommandKind;
-using control::ControllerEvent;
-using control::ControllerEventKind;
-using control::Request;
 using control::State;
+using controller::ControllerEvent;
+using controller::ControllerEventKind;
+using controller::Request;
 
 void print_one(const Diagnostic& d) {
   fmt::print(stderr, "{}{}\n", d.format(), d.code.empty() ? "" : fmt::format(" [{}]", d.code));
@@ -65,7 +65,7 @@ class Driver {
  public:
   virtual ~Driver() = default;
   virtual void advance() = 0;
-  virtual control::Controller& controller() = 0;
+  virtual controller::Controller& controller() = 0;
   /// Whether time goes on by itself (a real-time servo) while the session waits for the operator.
   virtual bool ticks_by_itself() const = 0;
   /// The simulated operator's hand moves hand-fed joint `joint` toward `target` at `speed`.
@@ -80,10 +80,10 @@ class Driver {
 
 class VirtualDriver final : public Driver {
  public:
-  VirtualDriver(const config::MachineProfile& p, std::shared_ptr<control::ProgramSource> s)
+  VirtualDriver(const config::MachineProfile& p, std::shared_ptr<controller::ProgramSource> s)
       : rig_(p, std::move(s)) {}
   void advance() override { rig_.step(); }
-  control::Controller& controller() override { return rig_.controller(); }
+  controller::Controller& controller() override { return rig_.controller(); }
   bool ticks_by_itself() const override { return false; }
   void set_hand_target(int joint, double target, double speed) override {
     rig_.machine().set_hand_target(joint, target, speed);
@@ -100,7 +100,7 @@ class VirtualDriver final : public Driver {
   }
 
  private:
-  control::SimRig rig_;
+  controller::SimRig rig_;
 };
 
 /// The simulated machine behind a real-time servo: the servo thread alone touches it, so the
@@ -130,15 +130,15 @@ class HandedSimMachine final : public machine::MachineIO {
 
 /// A tick that runs by itself (a real-time thread, HAL) is never kept waiting by the controller:
 /// its long work (preflights) runs on a thread of its own.
-constexpr control::ControllerOptions kTickByItself{.long_work_on_thread = true};
+constexpr controller::ControllerOptions kTickByItself{.long_work_on_thread = true};
 
 class RealtimeDriver final : public Driver {
  public:
-  RealtimeDriver(const config::MachineProfile& p, std::shared_ptr<control::ProgramSource> s)
+  RealtimeDriver(const config::MachineProfile& p, std::shared_ptr<controller::ProgramSource> s)
       : channels_(std::make_unique<control::ServoChannels>()),
         sim_(std::make_unique<HandedSimMachine>(config::sim_machine_config(p))),
-        servo_(std::make_unique<control::Servo>(control::servo_config(p), *channels_, *sim_)),
-        controller_(std::make_unique<control::Controller>(p, *channels_, std::move(s), kTickByItself)),
+        servo_(std::make_unique<control::Servo>(controller::servo_config(p), *channels_, *sim_)),
+        controller_(std::make_unique<controller::Controller>(p, *channels_, std::move(s), kTickByItself)),
         period_(std::chrono::duration<double>(p.servo_period_s)),
         clock_(control::RealtimeClock::Options{static_cast<std::int64_t>(p.servo_period_s * 1e9 + 0.5)}) {}
   ~RealtimeDriver() override { clock_.stop(); }
@@ -151,7 +151,7 @@ class RealtimeDriver final : public Driver {
     controller_->service();
     std::this_thread::sleep_for(period_);
   }
-  control::Controller& controller() override { return *controller_; }
+  controller::Controller& controller() override { return *controller_; }
   bool ticks_by_itself() const override { return true; }
   void set_hand_target(int joint, double target, double speed) override {
     sim_->set_hand_target(joint, target, speed);
@@ -162,38 +162,39 @@ class RealtimeDriver final : public Driver {
   std::unique_ptr<control::ServoChannels> channels_;
   std::unique_ptr<HandedSimMachine> sim_;
   std::unique_ptr<control::Servo> servo_;
-  std::unique_ptr<control::Controller> controller_;
+  std::unique_ptr<controller::Controller> controller_;
   std::chrono::duration<double> period_;
   control::RealtimeClock clock_;
 };
 
 /// The tick runs in LinuxCNC's HAL (opencnc_rt.so); this process is the controller only, linked
-/// to it through shared memory (control::HalLink: set-up, heartbeat).
+/// to it through shared memory (controller::HalLink: set-up, heartbeat).
 class HalDriver final : public Driver {
  public:
-  HalDriver(const config::MachineProfile& p, std::shared_ptr<control::ProgramSource> s,
-            std::unique_ptr<control::HalLink> link)
+  HalDriver(const config::MachineProfile& p, std::shared_ptr<controller::ProgramSource> s,
+            std::unique_ptr<controller::HalLink> link)
       : link_(std::move(link)),
-        controller_(std::make_unique<control::Controller>(p, link_->channels(), std::move(s), kTickByItself)),
+        controller_(
+            std::make_unique<controller::Controller>(p, link_->channels(), std::move(s), kTickByItself)),
         period_(std::chrono::duration<double>(p.servo_period_s)) {}
   ~HalDriver() override { controller_.reset(); }  // before the link: it unmaps the channels
   void advance() override {
     controller_->service();
     std::this_thread::sleep_for(period_);
   }
-  control::Controller& controller() override { return *controller_; }
+  controller::Controller& controller() override { return *controller_; }
   bool ticks_by_itself() const override { return true; }
   void set_hand_target(int, double, double) override {}  // a real hand moves a real axis
   void cut_mains() override {}  // real mains: nothing to simulate (cmd_run refuses --inject with --hal)
 
  private:
-  std::unique_ptr<control::HalLink> link_;
-  std::unique_ptr<control::Controller> controller_;
+  std::unique_ptr<controller::HalLink> link_;
+  std::unique_ptr<controller::Controller> controller_;
   std::chrono::duration<double> period_;
 };
 
 /// Submits `r` and advances until it is answered.
-control::Outcome ask(Driver& d, Request r) {
+controller::Outcome ask(Driver& d, Request r) {
   const std::uint64_t id = d.controller().submit(std::move(r));
   for (int i = 0; i < 100000; ++i) {
     d.advance();
@@ -204,7 +205,7 @@ control::Outcome ask(Driver& d, Request r) {
 
 bool must(Driver& d, Request r) {
   const std::string name = r.name();
-  const control::Outcome o = ask(d, std::move(r));
+  const controller::Outcome o = ask(d, std::move(r));
   print(o.diagnostics);
   if (!o.accepted) fmt::print(stderr, "error: {}: {}\n", name, o.message);
   return o.accepted;
@@ -270,7 +271,7 @@ struct OperatorWait {
   Request go_on = Request::simple(CommandKind::CycleStart);
 };
 
-std::optional<OperatorWait> operator_wait(const control::ControllerStatus& st) {
+std::optional<OperatorWait> operator_wait(const controller::ControllerStatus& st) {
   if (st.servo.state == State::Stopped)
     return OperatorWait{st.wait_text, Request::simple(CommandKind::CycleStart)};
   if (st.servo.wait == control::Wait::ManualToolChange)
@@ -307,7 +308,7 @@ class StopOnThePath {
  public:
   StopOnThePath(const SessionOptions& o) : flag_(o.stop), count_(o.stops), max_time_s_(o.max_time_s) {}
   bool requested() const noexcept { return signal() != 0 || over_time_; }
-  void step(Driver& d, const control::ControllerStatus& st, SessionEnd& end) {
+  void step(Driver& d, const controller::ControllerStatus& st, SessionEnd& end) {
     if (run_start_s_ < 0) run_start_s_ = st.servo.time_s;
     if (max_time_s_ > 0 && !over_time_ && signal() == 0 && st.servo.time_s - run_start_s_ > max_time_s_) {
       over_time_ = end.over_max_time = true;
@@ -363,7 +364,7 @@ class TerminalOperator final : public SessionOperator {
 /// Follows the job started by cycle start until it ends, with the operator where it waits (and
 /// the machine's hand at the hand-fed axes); a feature that holds the program asks the operator
 /// through SessionHooks::on_event.
-void follow(Driver& d, control::EventCursor& cursor, const SessionOptions& o, const SessionHooks& hooks,
+void follow(Driver& d, controller::EventCursor& cursor, const SessionOptions& o, const SessionHooks& hooks,
             SessionEnd& end) {
   StopOnThePath stop(o);
   const auto t0 = std::chrono::steady_clock::now();
@@ -378,12 +379,12 @@ void follow(Driver& d, control::EventCursor& cursor, const SessionOptions& o, co
     std::optional<ControllerEvent> ended;
     for (const ControllerEvent& e : cursor.next()) {
       print_event(e);
-      if (e.kind == ControllerEventKind::JobStarted && job == 0 && e.job == control::JobKind::Program)
+      if (e.kind == ControllerEventKind::JobStarted && job == 0 && e.job == controller::JobKind::Program)
         job = e.job_id;
       if (e.kind == ControllerEventKind::JobEnded && e.job_id == job) ended = e;
       if (hooks.on_event) hooks.on_event(e, op);  // a feature that holds the program asks the operator
     }
-    const control::ControllerStatus st = d.controller().status();
+    const controller::ControllerStatus st = d.controller().status();
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (o.mains_off_s >= 0 && !mains_cut && st.servo.time_s >= o.mains_off_s) {
       d.cut_mains();  // the servo sees it at its next period
@@ -413,7 +414,7 @@ void follow(Driver& d, control::EventCursor& cursor, const SessionOptions& o, co
     }
     if (ended) {
       end.wall_s = wall;
-      end.finished = ended->end == control::JobEnd::Finished;
+      end.finished = ended->end == controller::JobEnd::Finished;
       if (!end.finished) {
         // (a fault was printed as its note already)
         if (!st.fault_text.empty())
@@ -425,7 +426,7 @@ void follow(Driver& d, control::EventCursor& cursor, const SessionOptions& o, co
           end.fault =
               fmt::format("stopped by --max-time {:g} s (feed hold on the path, then abort)", o.max_time_s);
         else
-          end.fault = fmt::format("the program ended: {}", control::to_string(ended->end));
+          end.fault = fmt::format("the program ended: {}", controller::to_string(ended->end));
         if (st.fault_text.empty()) fmt::print(stderr, "error: {}\n", end.fault);
         end.limit_touched = st.servo.fault.kind == control::FaultKind::SoftLimit ||
                             st.servo.fault.kind == control::FaultKind::LimitSwitch;
@@ -468,15 +469,15 @@ void follow(Driver& d, control::EventCursor& cursor, const SessionOptions& o, co
 }
 
 /// What the preflight could only check with assumed answers (a probe's trip, an input's value).
-void note_assumptions(const control::PreflightSummary& s) {
+void note_assumptions(const controller::PreflightSummary& s) {
   if (s.assumed_moves == 0) return;
   std::string lines;
-  for (const control::SourceLocation& l : s.assumed_lines) {
+  for (const controller::SourceLocation& l : s.assumed_lines) {
     if (lines.size() > 200) {
       lines += ", …";
       break;
     }
-    lines += (lines.empty() ? "" : ", ") + control::to_string(l);
+    lines += (lines.empty() ? "" : ", ") + controller::to_string(l);
   }
   const auto plural = [](std::uint64_t n, const char* one, const char* many) {
     return fmt::format("{} {}", n, n == 1 ? one : many);
@@ -510,11 +511,12 @@ SessionEnd run_session(const SessionOptions& o, const SessionHooks& hooks) {
   }
   // The machine as its features set it up (features::set_up), as every front end does.
   Diagnostics diags;
-  control::MachineSetup::Options asked;
+  controller::MachineSetup::Options asked;
   asked.reports = o.reports;
   asked.settings = o.settings;
   if (o.tool_table_in_memory) asked.settings["tool-table"] = "memory";
-  std::unique_ptr<control::MachineSetup> setup = control::MachineSetup::create(end.profile, asked, diags);
+  std::unique_ptr<controller::MachineSetup> setup =
+      controller::MachineSetup::create(end.profile, asked, diags);
   print(diags);
   if (!setup) return end;
   const bool set_up = features::set_up(*setup);
@@ -530,12 +532,12 @@ SessionEnd run_session(const SessionOptions& o, const SessionHooks& hooks) {
     end.exit_code = kExitUsage;
     return end;
   }
-  const std::shared_ptr<control::ProgramSource> source = setup->source();
+  const std::shared_ptr<controller::ProgramSource> source = setup->source();
 
   std::unique_ptr<Driver> driver;
   if (o.hal) {
     std::string error;
-    auto link = control::HalLink::attach(o.hal_shm, end.profile, error);
+    auto link = controller::HalLink::attach(o.hal_shm, end.profile, error);
     if (!link) {
       fmt::print(stderr, "error: --hal: {}\n", error);
       end.exit_code = kExitUsage;
@@ -571,7 +573,7 @@ SessionEnd run_session(const SessionOptions& o, const SessionHooks& hooks) {
     for (auto& [observer, options] : hooks.opened(end.profile, *end.program))
       d.controller().attach(observer, options);
   }
-  control::EventCursor cursor(d.controller().events());
+  controller::EventCursor cursor(d.controller().events());
   if (!must(d, Request::simple(CommandKind::CycleStart))) return end;
   follow(d, cursor, o, hooks, end);
   if (hooks.finished) hooks.finished(d.sim_machine());

@@ -57,7 +57,7 @@ struct SessionOptions {
   bool tool_table_in_memory = false;
   /// The run writes a report: the features add the observers of its sections.
   bool reports = false;
-  /// Settings for the features' setup by name (control::MachineSetup::Options): "journal".
+  /// Settings for the features' setup by name (controller::MachineSetup::Options): "journal".
   std::map<std::string, std::string, std::less<>> settings;
 };
 
@@ -71,12 +71,12 @@ struct SessionEnd {
   bool over_max_time = false;  ///< SessionOptions::max_time_s stopped it
   double wall_s = 0;           ///< wall-clock time of the run
   config::MachineProfile profile;
-  std::optional<control::OpenProgram> program;  ///< the program as opened (its preflight)
+  std::optional<controller::OpenProgram> program;  ///< the program as opened (its preflight)
 };
 
 /// Observers to attach for a run, with their options.
 using SessionObservers =
-    std::vector<std::pair<std::shared_ptr<control::ControllerObserver>, control::ObserverOptions>>;
+    std::vector<std::pair<std::shared_ptr<controller::ControllerObserver>, controller::ObserverOptions>>;
 
 /// The operator at the terminal, for a feature that holds the program and asks (the tool guard's
 /// accept or restore, the load guard's resume). Controller thread (the session's loop).
@@ -87,33 +87,34 @@ class SessionOperator {
   /// can answer (--unattended, stdin closed).
   virtual std::optional<std::string> ask(const std::string& question) = 0;
   /// Sends a request and waits for its answer (printing a refusal); whether it was accepted.
-  virtual bool must(control::Request r) = 0;
+  virtual bool must(controller::Request r) = 0;
   /// Sends a request.
-  virtual void submit(control::Request r) = 0;
+  virtual void submit(controller::Request r) = 0;
 };
 
 /// Observers attached before the program starts (a run recorder, a trace writer), and progress.
 struct SessionHooks {
   /// Called once the program is open and checked, before it starts: return the observers to
   /// attach (with their options) for the run.
-  std::function<SessionObservers(const config::MachineProfile&, const control::OpenProgram&)> opened;
+  std::function<SessionObservers(const config::MachineProfile&, const controller::OpenProgram&)> opened;
   /// Called once the program is open and checked, before `opened`: false ends the session there
   /// (nothing has moved; it has said why). A program the preflight refused never gets here, so a
   /// second look at it (the machining time against --max-time) is made only of a finite program.
-  std::function<bool(const config::MachineProfile&, const control::OpenProgram&)> may_start;
+  std::function<bool(const config::MachineProfile&, const controller::OpenProgram&)> may_start;
   /// Now and then with the status (for progress).
-  std::function<void(const control::ControllerStatus&, double elapsed_wall_s)> progress;
+  std::function<void(const controller::ControllerStatus&, double elapsed_wall_s)> progress;
   /// Once the machine's features are set up (features::set_up), before the controller is built:
   /// the command line takes the features it drives. False stops the session (after printing why).
-  std::function<bool(control::MachineSetup&)> set_up;
+  std::function<bool(controller::MachineSetup&)> set_up;
   /// Every period of the run, with the controller and (in virtual time, else null) the simulated
   /// machine: a scripted operator (`run --retrace`, `run --electrode-change`).
-  std::function<void(control::Controller&, const control::ControllerStatus&, machine::SimMachine*)> tick;
+  std::function<void(controller::Controller&, const controller::ControllerStatus&, machine::SimMachine*)>
+      tick;
   /// When the program's job ends: true if the session goes on with the job that resumes it.
-  std::function<bool(const control::ControllerEvent&)> goes_on;
+  std::function<bool(const controller::ControllerEvent&)> goes_on;
   /// Every event of the run, after it is printed: a feature that holds the program asks the
   /// operator (and aborts when no one answers).
-  std::function<void(const control::ControllerEvent&, SessionOperator&)> on_event;
+  std::function<void(const controller::ControllerEvent&, SessionOperator&)> on_event;
   /// The session ends, with the simulated machine (virtual time; else null): what the features
   /// keep of it (the simulated bore, the spark gap's figures).
   std::function<void(machine::SimMachine*)> finished;

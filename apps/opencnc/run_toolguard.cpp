@@ -9,7 +9,7 @@ namespace opencnc::cli {
 namespace {
 
 using control::CommandKind;
-using control::Request;
+using controller::Request;
 
 // The tool guard holds the program before a tool cuts (its note, with the differences, is
 // printed): the operator at the terminal accepts the live values or restores the backup, and the
@@ -17,8 +17,9 @@ using control::Request;
 // without the operator).
 class ToolGuardRun final : public RunFeature {
  public:
-  bool on_event(const control::ControllerEvent& e, SessionOperator& op) override {
-    if (e.kind != control::ControllerEventKind::Note || e.code != "tools.guard-hold" || aborted_) return true;
+  bool on_event(const controller::ControllerEvent& e, SessionOperator& op) override {
+    if (e.kind != controller::ControllerEventKind::Note || e.code != "tools.guard-hold" || aborted_)
+      return true;
     const std::optional<std::string> answer = op.ask(
         "the tool guard holds the program: type accept (the live values become the backup) or restore (the "
         "backup's values become live) and Enter; anything else aborts");

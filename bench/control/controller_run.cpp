@@ -29,6 +29,7 @@
 
 using namespace opencnc;
 using namespace opencnc::control;
+using namespace opencnc::controller;
 
 namespace {
 

@@ -23,6 +23,7 @@
 
 using namespace opencnc;
 using namespace opencnc::control;
+using namespace opencnc::controller;
 
 namespace {
 

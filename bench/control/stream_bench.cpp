@@ -24,6 +24,7 @@
 
 using namespace opencnc;
 using namespace opencnc::control;
+using namespace opencnc::controller;
 using Clock = std::chrono::steady_clock;
 
 namespace {

@@ -35,6 +35,7 @@
 
 using namespace opencnc;
 using namespace opencnc::control;
+using namespace opencnc::controller;
 
 namespace {
 

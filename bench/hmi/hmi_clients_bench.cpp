@@ -183,10 +183,10 @@ int main(int argc, char** argv) {
   std::string error;
   if (!server.start(&error)) return std::fprintf(stderr, "error: %s\n", error.c_str()), 1;
 
-  control::Controller& c = host.controller();
-  for (auto r : {control::Request::simple(control::CommandKind::MachineOn),
-                 control::Request::set_mode(control::Mode::Auto),
-                 control::Request::open(OPENCNC_SOURCE_DIR "/examples/bracket.ngc")}) {
+  controller::Controller& c = host.controller();
+  for (auto r : {controller::Request::simple(control::CommandKind::MachineOn),
+                 controller::Request::set_mode(control::Mode::Auto),
+                 controller::Request::open(OPENCNC_SOURCE_DIR "/examples/bracket.ngc")}) {
     const auto id = c.submit(std::move(r));
     while (!c.outcome(id)) std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
@@ -213,9 +213,9 @@ int main(int argc, char** argv) {
   while (std::chrono::steady_clock::now() - t0 < std::chrono::duration<double>(seconds)) {
     const auto s = c.status();
     if (s.servo.state == control::State::Idle && !s.run_active)
-      c.submit(control::Request::simple(control::CommandKind::CycleStart));
+      c.submit(controller::Request::simple(control::CommandKind::CycleStart));
     if (s.servo.wait == control::Wait::ManualToolChange)
-      c.submit(control::Request::simple(control::CommandKind::ToolChanged));
+      c.submit(controller::Request::simple(control::CommandKind::ToolChanged));
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -39,17 +39,17 @@ using namespace opencnc;
   for (;;) {
     Diagnostics d;
     auto machine =
-        features::machine_setup(profile, d, control::MachineSetup::Options::with("journal", dir.string()));
+        features::machine_setup(profile, d, controller::MachineSetup::Options::with("journal", dir.string()));
     if (!machine) ::_exit(2);
     auto journal = std::dynamic_pointer_cast<recovery::BreakpointJournal>(machine->feature("journal"));
     if (!journal) ::_exit(2);
     std::string error;
-    control::SimRig rig(profile, *machine);
+    controller::SimRig rig(profile, *machine);
     rig.step();
-    rig.request(control::Request::simple(control::CommandKind::MachineOn));
-    rig.request(control::Request::set_mode(control::Mode::Auto));
-    rig.request(control::Request::open(OPENCNC_SOURCE_DIR "/examples/broach-constant.ngc"), 1000000);
-    rig.request(control::Request::simple(control::CommandKind::CycleStart));
+    rig.request(controller::Request::simple(control::CommandKind::MachineOn));
+    rig.request(controller::Request::set_mode(control::Mode::Auto));
+    rig.request(controller::Request::open(OPENCNC_SOURCE_DIR "/examples/broach-constant.ngc"), 1000000);
+    rig.request(controller::Request::simple(control::CommandKind::CycleStart));
     const double cut = at(rng);
     rig.run_until([&] { return rig.status().servo.time_s >= cut; }, 10'000'000);
     rig.machine().set_mains_ok(false);

@@ -35,13 +35,13 @@
 namespace {
 
 using namespace opencnc;
-using control::Request;
+using controller::Request;
 
 /// The feedback of every coupled period of the main program, by the interpreter's segment id.
-class Grooves final : public control::ControllerObserver {
+class Grooves final : public controller::ControllerObserver {
  public:
-  void on_trace(const control::TraceSample& s, const control::TraceContext& c) override {
-    if (c.job != control::JobKind::Program || c.program == nullptr || !s.coupled ||
+  void on_trace(const control::TraceSample& s, const controller::TraceContext& c) override {
+    if (c.job != controller::JobKind::Program || c.program == nullptr || !s.coupled ||
         s.segment >= c.program->size())
       return;
     if (c.program->move(s.segment).kind != canon::MoveKind::Feed) return;
@@ -56,17 +56,17 @@ struct Rig {
     profile = *config::load_profile(profile_path, sets).profile;
     Diagnostics d;
     auto machine = features::machine_setup(
-        profile, d, control::MachineSetup::Options::with("journal", journal_dir.string()));
-    rig = std::make_unique<control::SimRig>(profile, *machine);
+        profile, d, controller::MachineSetup::Options::with("journal", journal_dir.string()));
+    rig = std::make_unique<controller::SimRig>(profile, *machine);
     journal = std::dynamic_pointer_cast<recovery::BreakpointJournal>(machine->feature("journal"));
     grooves = std::make_shared<Grooves>();
-    rig->controller().attach(grooves, control::ObserverOptions{0, true});
+    rig->controller().attach(grooves, controller::ObserverOptions{0, true});
     rig->step();
     rig->request(Request::simple(control::CommandKind::MachineOn));
     rig->request(Request::set_mode(control::Mode::Auto));
   }
   config::MachineProfile profile;
-  std::unique_ptr<control::SimRig> rig;
+  std::unique_ptr<controller::SimRig> rig;
   std::shared_ptr<recovery::BreakpointJournal> journal;
   std::shared_ptr<Grooves> grooves;
 };
@@ -255,14 +255,14 @@ int main(int argc, char** argv) {
     const double cut_s = at(rng);
     const auto dir = root / fmt::format("cut-{}", k);
     recovery::BreakpointRecord r;
-    control::PowerFailReport pf;
+    broaching::PowerFailReport pf;
     std::vector<float> bore;  // the workpiece as the cut left it
     {
       Rig cut(profile_path, dir, profile_sets);
-      auto recorder = std::make_shared<control::PowerFailRecorder>(
-          control::coupling_config(cut.profile.coupling), control::machine_limits(cut.profile),
+      auto recorder = std::make_shared<broaching::PowerFailRecorder>(
+          control::coupling_config(cut.profile.coupling), controller::machine_limits(cut.profile),
           cut.profile.servo_period_s, cut.profile.coupling.radius_mm);
-      cut.rig->controller().attach(recorder, control::ObserverOptions{cut.profile.servo_period_s, true});
+      cut.rig->controller().attach(recorder, controller::ObserverOptions{cut.profile.servo_period_s, true});
       cut.rig->request(Request::open(program), 1000000);
       cut.rig->request(Request::simple(control::CommandKind::CycleStart));
       cut.rig->run_until([&] { return cut.rig->status().servo.time_s >= cut_s; }, 100'000'000);
@@ -293,7 +293,7 @@ int main(int argc, char** argv) {
       }
       Rig after(profile_path, dir, sets);
       after.rig->machine().restore_broach_bore(bore);  // the groove cut before the power failed
-      const control::Outcome o = after.rig->request(Request::feature("journal", "resume"), 1000000);
+      const controller::Outcome o = after.rig->request(Request::feature("journal", "resume"), 1000000);
       // Bounded: the rest of the job cannot take longer than the whole of it.
       const std::string why =
           o.accepted ? recovery::run_recovery(*after.rig, *after.journal, {length_s + 10, 2.0}) : o.message;

@@ -17,7 +17,7 @@
 
 namespace opencnc::recovery {
 
-using control::ControllerEventKind;
+using controller::ControllerEventKind;
 
 namespace {
 
@@ -69,14 +69,14 @@ void at_normal_priority(bool fifo, bool rt_io, F&& f) {
 }  // namespace
 
 std::shared_ptr<BreakpointJournal> BreakpointJournal::open(
-    const std::string& dir, std::shared_ptr<control::GcodeProgramSource> source, std::string* error) {
+    const std::string& dir, std::shared_ptr<controller::GcodeProgramSource> source, std::string* error) {
   std::unique_ptr<Journal> j = Journal::open(dir, error);
   if (!j) return nullptr;
   return std::shared_ptr<BreakpointJournal>(new BreakpointJournal(std::move(j), std::move(source)));
 }
 
 BreakpointJournal::BreakpointJournal(std::unique_ptr<Journal> journal,
-                                     std::shared_ptr<control::GcodeProgramSource> source)
+                                     std::shared_ptr<controller::GcodeProgramSource> source)
     : journal_(std::move(journal)), source_(std::move(source)) {
   // A record left by an earlier run (the power came back): what recovery offers.
   if (const std::optional<JournalRecord> raw = journal_->read()) written_ = decode(raw->payload, &error_);
@@ -93,7 +93,7 @@ BreakpointJournal::~BreakpointJournal() {
   writer_.join();
 }
 
-void BreakpointJournal::on_event(const control::ControllerEvent& e) {
+void BreakpointJournal::on_event(const controller::ControllerEvent& e) {
   recovery_event(e);
   if (e.kind != ControllerEventKind::ProgramOpened || host_ == nullptr) return;
   // Resume replays from where the program was placed when it was opened (the controller's rule);
@@ -115,16 +115,16 @@ void BreakpointJournal::on_event(const control::ControllerEvent& e) {
   post(std::move(w));
 }
 
-void BreakpointJournal::on_status(const control::ControllerStatus& s) {
+void BreakpointJournal::on_status(const controller::ControllerStatus& s) {
   if (!stopping_) {
     if (s.servo.mains_ok && !s.servo.on_battery) before_ = s.servo;
-    if (s.run_active && s.job == control::JobKind::Program) {
+    if (s.run_active && s.job == controller::JobKind::Program) {
       job_move_ = s.run_segment;
       segment_offset_ = s.segment_offset;
     }
     return;
   }
-  if (s.run_active && s.job == control::JobKind::Program) {
+  if (s.run_active && s.job == controller::JobKind::Program) {
     job_move_ = s.run_segment;
     segment_offset_ = s.segment_offset;
   }
@@ -132,7 +132,7 @@ void BreakpointJournal::on_status(const control::ControllerStatus& s) {
   if (!completed_ && s.servo.state == control::State::Faulted) complete_record();
 }
 
-void BreakpointJournal::on_trace(const control::TraceSample& s, const control::TraceContext& c) {
+void BreakpointJournal::on_trace(const control::TraceSample& s, const controller::TraceContext& c) {
   if (stopping_ && !completed_ && s.state != control::State::Faulted) {
     // Where the stop has brought the axes so far (the drives are disabled once it rests, and
     // the command then follows the feedback: the record keeps the last period before that).
@@ -141,12 +141,12 @@ void BreakpointJournal::on_trace(const control::TraceSample& s, const control::T
     record_.rest_time_s = static_cast<double>(s.tick) * period_s();
     return;
   }
-  if (!s.power_stop || stopping_ || c.job != control::JobKind::Program || c.program == nullptr) return;
+  if (!s.power_stop || stopping_ || c.job != controller::JobKind::Program || c.program == nullptr) return;
   begin_record(s, c);
 }
 
 // The first period of the stop: everything but where the motion will rest.
-void BreakpointJournal::begin_record(const control::TraceSample& s, const control::TraceContext& c) {
+void BreakpointJournal::begin_record(const control::TraceSample& s, const controller::TraceContext& c) {
   const Clock::time_point signal = Clock::now();
   stopping_ = true;
   completed_ = false;
@@ -328,9 +328,9 @@ void BreakpointJournal::write_one(Work& w) {
   }
 }
 
-control::Outcome BreakpointJournal::handle(const control::requests::Feature& request,
-                                           control::FeatureHost& host) {
-  control::Outcome o;
+controller::Outcome BreakpointJournal::handle(const controller::requests::Feature& request,
+                                              controller::FeatureHost& host) {
+  controller::Outcome o;
   const std::optional<BreakpointRecord> r = last_written();
   if (request.action == "show") {
     o.accepted = true;

@@ -15,9 +15,9 @@
 
 namespace opencnc::recovery {
 
-using control::ControllerEventKind;
-using control::Outcome;
 using control::Refusal;
+using controller::ControllerEventKind;
+using controller::Outcome;
 
 namespace {
 
@@ -56,8 +56,8 @@ std::string moved_axis(const config::MachineProfile& profile, const Pose& actual
 }  // namespace
 
 Outcome BreakpointJournal::start_resume(const BreakpointRecord& r, const ResumeArgs& args,
-                                        control::FeatureHost& host) {
-  const control::ControllerStatus& st = host.current_status();
+                                        controller::FeatureHost& host) {
+  const controller::ControllerStatus& st = host.current_status();
   const std::optional<FileHash> h = hash_file(r.program_path);
   if (!h)
     return refuse(Refusal::NoProgram, "cannot read " + r.program_path + ": the program the record names");
@@ -86,7 +86,7 @@ Outcome BreakpointJournal::start_resume(const BreakpointRecord& r, const ResumeA
   resume_args_ = args;
   phase_ = RecoveryPhase::Opening;
   recovery_error_.clear();
-  pending_ = host.submit(control::Request::open(r.program_path));
+  pending_ = host.submit(controller::Request::open(r.program_path));
   Outcome o;
   o.accepted = true;
   o.message = fmt::format("resuming {} at segment {} (line {})", r.program_path, r.segment, r.line);
@@ -98,7 +98,7 @@ Outcome BreakpointJournal::start_resume(const BreakpointRecord& r, const ResumeA
 std::shared_ptr<const canon::Program> BreakpointJournal::along_helix(const BreakpointRecord& r,
                                                                      double distance_mm, bool onward,
                                                                      double speed_mm_min,
-                                                                     control::FeatureHost& host,
+                                                                     controller::FeatureHost& host,
                                                                      std::string* why) const {
   const int m = r.coupling.master_axis, s = r.coupling.slave_axis;
   if (r.coupling.kind == 0 || m < 0 || s < 0) {
@@ -138,7 +138,7 @@ std::shared_ptr<const canon::Program> BreakpointJournal::along_helix(const Break
 }
 
 Outcome BreakpointJournal::start_retract(const BreakpointRecord& r, const RetractArgs& args,
-                                         control::FeatureHost& host) {
+                                         controller::FeatureHost& host) {
   if (!(args.distance_mm > 0) || !(args.speed_mm_min > 0) || !std::isfinite(args.distance_mm) ||
       !std::isfinite(args.speed_mm_min)) {
     return refuse(Refusal::BadValue, "retract needs a distance and a speed above 0");
@@ -149,7 +149,7 @@ Outcome BreakpointJournal::start_retract(const BreakpointRecord& r, const Retrac
   recovering_ = r;
   phase_ = RecoveryPhase::Retracting;
   recovery_error_.clear();
-  pending_ = host.submit(control::Request::run_auxiliary("breakpoint retract", std::move(program)));
+  pending_ = host.submit(controller::Request::run_auxiliary("breakpoint retract", std::move(program)));
   Outcome o;
   o.accepted = true;
   o.message = fmt::format("retracting {} by {} mm {} with {} on the law",
@@ -159,7 +159,7 @@ Outcome BreakpointJournal::start_retract(const BreakpointRecord& r, const Retrac
 }
 
 // The steps of a choice under way: the answers to what it asked, the job's end.
-void BreakpointJournal::recovery_event(const control::ControllerEvent& e) {
+void BreakpointJournal::recovery_event(const controller::ControllerEvent& e) {
   if (phase_ == RecoveryPhase::None || phase_ == RecoveryPhase::Done || phase_ == RecoveryPhase::Failed)
     return;
   if (e.kind == ControllerEventKind::Answer && e.request_id == pending_) {
@@ -168,18 +168,19 @@ void BreakpointJournal::recovery_event(const control::ControllerEvent& e) {
     return;
   }
   if (e.kind == ControllerEventKind::JobEnded && phase_ == RecoveryPhase::RunningIn &&
-      e.job == control::JobKind::Auxiliary) {
-    if (e.end != control::JobEnd::Finished)
+      e.job == controller::JobKind::Auxiliary) {
+    if (e.end != controller::JobEnd::Finished)
       return finish_recovery(false, "the run-in did not complete: " + e.text);
     phase_ = RecoveryPhase::Resuming;
-    pending_ = host_->submit(control::Request::resume(recovering_.segment, recovering_.program_start));
+    pending_ = host_->submit(controller::Request::resume(recovering_.segment, recovering_.program_start));
     return;
   }
   if (e.kind == ControllerEventKind::JobEnded) {
-    const bool mine = (phase_ == RecoveryPhase::Resuming && e.job == control::JobKind::Program) ||
-                      (phase_ == RecoveryPhase::Retracting && e.job == control::JobKind::Auxiliary);
+    const bool mine = (phase_ == RecoveryPhase::Resuming && e.job == controller::JobKind::Program) ||
+                      (phase_ == RecoveryPhase::Retracting && e.job == controller::JobKind::Auxiliary);
     if (mine)
-      finish_recovery(e.end == control::JobEnd::Finished, e.end == control::JobEnd::Finished ? "" : e.text);
+      finish_recovery(e.end == controller::JobEnd::Finished,
+                      e.end == controller::JobEnd::Finished ? "" : e.text);
   }
 }
 
@@ -198,11 +199,11 @@ void BreakpointJournal::run_in() {
       back > 0 ? along_helix(r, back, false, resume_args_.run_in_speed_mm_min, *host_, &why) : nullptr;
   if (program) {
     phase_ = RecoveryPhase::RunningIn;
-    pending_ = host_->submit(control::Request::run_auxiliary("breakpoint run-in", std::move(program)));
+    pending_ = host_->submit(controller::Request::run_auxiliary("breakpoint run-in", std::move(program)));
     return;
   }
   phase_ = RecoveryPhase::Resuming;
-  pending_ = host_->submit(control::Request::resume(r.segment, r.program_start));
+  pending_ = host_->submit(controller::Request::resume(r.segment, r.program_start));
 }
 
 void BreakpointJournal::finish_recovery(bool ok, std::string why) {

@@ -9,7 +9,7 @@
 
 #include "opencnc/controller/servo_setup.hpp"
 
-namespace opencnc::control {
+namespace opencnc::broaching {
 
 namespace {
 
@@ -29,9 +29,9 @@ std::string file_name(const canon::Program& p, std::uint32_t context) {
 
 CoupledAxes coupled_axes(const config::MachineProfile& profile) {
   CoupledAxes c;
-  c.config = coupling_config(profile.coupling);
+  c.config = control::coupling_config(profile.coupling);
   if (!c.config.enabled) return c;
-  const plan::MachineLimits limits = machine_limits(profile);
+  const plan::MachineLimits limits = controller::machine_limits(profile);
   const auto master = static_cast<std::size_t>(c.config.master_axis);
   const auto slave = static_cast<std::size_t>(c.config.slave_axis);
   c.master_velocity = limits.axis[master].max_velocity;
@@ -190,4 +190,4 @@ void CouplingPass::fail(const canon::Program& program, std::uint32_t context, st
   failures_.error(file_name(program, context), line, 0, std::move(message), "control.coupling");
 }
 
-}  // namespace opencnc::control
+}  // namespace opencnc::broaching

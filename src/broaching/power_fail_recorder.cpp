@@ -12,7 +12,7 @@
 
 #include "opencnc/controller/controller_status.hpp"
 
-namespace opencnc::control {
+namespace opencnc::broaching {
 
 namespace {
 
@@ -25,16 +25,16 @@ PowerFailRecorder::PowerFailRecorder(const motion::CouplingConfig& coupling,
                                      const plan::MachineLimits& limits, double period_s, double radius_mm)
     : coupling_(coupling), limits_(limits), period_s_(period_s), radius_mm_(radius_mm) {}
 
-motion::CouplingLaw PowerFailRecorder::law_of(const CouplingStatus& c) const {
+motion::CouplingLaw PowerFailRecorder::law_of(const control::CouplingStatus& c) const {
   return motion::law_for(coupling_, c.kind, c.pitch_mm, c.pitch_rate, c.table);
 }
 
-void PowerFailRecorder::on_status(const ControllerStatus& s) {
+void PowerFailRecorder::on_status(const controller::ControllerStatus& s) {
   if (stopping_) {
     report_.dc_link_min_v = std::min(report_.dc_link_min_v, s.servo.dc_link_v);
   }
   if (s.servo.coupling.kind == motion::CouplingKind::Off) return;
-  const CouplingStatus& c = s.servo.coupling;
+  const control::CouplingStatus& c = s.servo.coupling;
   if (c.kind != status_.kind || c.table != status_.table || c.pitch_mm != status_.pitch_mm ||
       c.pitch_rate != status_.pitch_rate || c.master_origin != status_.master_origin ||
       c.slave_origin != status_.slave_origin) {
@@ -49,7 +49,7 @@ double PowerFailRecorder::helix_error_um(double master, double slave) const {
   return std::fabs(slave - law) * std::numbers::pi / 180.0 * radius_mm_ * 1000.0;
 }
 
-void PowerFailRecorder::on_trace(const TraceSample& s, const TraceContext&) {
+void PowerFailRecorder::on_trace(const control::TraceSample& s, const controller::TraceContext&) {
   const int m = coupling_.master_axis, sl = coupling_.slave_axis;
   if (s.power_stop && !report_.happened) {
     report_.happened = true;
@@ -81,7 +81,8 @@ void PowerFailRecorder::on_trace(const TraceSample& s, const TraceContext&) {
 
 // Each axis from its commanded position and velocity at the signal, braking at its own
 // acceleration limit until it rests, period by period; the helix error of the pair throughout.
-void PowerFailRecorder::simulate_independent_stop(const TraceSample& before, const TraceSample& at) {
+void PowerFailRecorder::simulate_independent_stop(const control::TraceSample& before,
+                                                  const control::TraceSample& at) {
   const int axes[2] = {coupling_.master_axis, coupling_.slave_axis};
   double x[2], v[2], a[2];
   for (int k = 0; k < 2; ++k) {
@@ -139,4 +140,4 @@ std::string PowerFailRecorder::report_json() const {
   return j.dump();
 }
 
-}  // namespace opencnc::control
+}  // namespace opencnc::broaching

@@ -14,7 +14,7 @@ bool ended(RecoveryPhase p) {
 
 }  // namespace
 
-std::string run_recovery(control::SimRig& rig, const BreakpointJournal& journal, RecoveryWait wait) {
+std::string run_recovery(controller::SimRig& rig, const BreakpointJournal& journal, RecoveryWait wait) {
   const double period_s = rig.controller().profile().servo_period_s;
   const auto periods = [&](double s) { return static_cast<std::uint64_t>(s / period_s) + 1; };
   std::string why;
@@ -24,7 +24,7 @@ std::string run_recovery(control::SimRig& rig, const BreakpointJournal& journal,
   rig.run_until(
       [&] {
         if (ended(journal.phase())) return true;
-        const control::ControllerStatus st = rig.status();
+        const controller::ControllerStatus st = rig.status();
         idle = st.run_active ? 0 : idle + 1;
         if (idle >= stall) {
           why = fmt::format("no job ran for {} s and the choice did not end", wait.stall_s);
@@ -37,7 +37,7 @@ std::string run_recovery(control::SimRig& rig, const BreakpointJournal& journal,
                                   st.servo.load_kn)
                     : "a fault stopped it: " + st.fault_text;
           if (st.servo.state == control::State::Held)
-            rig.controller().submit(control::Request::simple(control::CommandKind::Abort));
+            rig.controller().submit(controller::Request::simple(control::CommandKind::Abort));
           aborted = true;
         }
         return false;

@@ -16,21 +16,21 @@ namespace opencnc::broaching {
 namespace {
 
 /// M171-M175 on top of the dialect's modules, and the coupling pass over every program's moves.
-class Coupling final : public control::SourcePart {
+class Coupling final : public controller::SourcePart {
  public:
-  explicit Coupling(const control::CoupledAxes& axes) : axes_(axes) {}
+  explicit Coupling(const broaching::CoupledAxes& axes) : axes_(axes) {}
   std::shared_ptr<const gcode::Extensions> modules(
       gcode::Dialect, std::shared_ptr<const gcode::Extensions> base) const override {
     auto ext = std::make_shared<gcode::Extensions>(*base);
     gcode::add_coupling_codes(*ext);
     return ext;
   }
-  std::unique_ptr<control::MovePass> pass() const override {
-    return std::make_unique<control::CouplingPass>(axes_);
+  std::unique_ptr<controller::MovePass> pass() const override {
+    return std::make_unique<broaching::CouplingPass>(axes_);
   }
 
  private:
-  control::CoupledAxes axes_;
+  broaching::CoupledAxes axes_;
 };
 
 const char* phase_name(recovery::RecoveryPhase p) {
@@ -41,12 +41,12 @@ const char* phase_name(recovery::RecoveryPhase p) {
 
 /// The journal's state for a front end (docs/api.md, "features"): the record written last, the
 /// recovery's phase, what a dialog may offer and the resume's values it offers.
-class JournalState final : public control::FeatureState {
+class JournalState final : public controller::FeatureState {
  public:
   JournalState(std::shared_ptr<recovery::BreakpointJournal> journal, const config::MachineProfile& profile)
       : journal_(std::move(journal)), profile_(profile) {}
   std::string state_key() const override { return "journal"; }
-  std::string state_json(const control::ControllerStatus& s) override {
+  std::string state_json(const controller::ControllerStatus& s) override {
     using nlohmann::json;
     json r = nullptr;
     if (const std::optional<recovery::BreakpointRecord> rec = journal_->last_written()) {
@@ -95,8 +95,8 @@ class JournalState final : public control::FeatureState {
 
 }  // namespace
 
-bool setup(const config::MachineProfile& profile, control::MachineSetup& host) {
-  const control::CoupledAxes axes = control::coupled_axes(profile);
+bool setup(const config::MachineProfile& profile, controller::MachineSetup& host) {
+  const broaching::CoupledAxes axes = broaching::coupled_axes(profile);
   if (axes.any()) host.add_source_part(std::make_shared<Coupling>(axes));
   if (axes.any() || profile.broaching.present) host.add_texts(std::make_shared<Texts>());
   // The journal follows the trace (it builds its record from the interrupted move) and the status.
@@ -109,7 +109,7 @@ bool setup(const config::MachineProfile& profile, control::MachineSetup& host) {
                                "setting.journal");
       return false;
     }
-    host.add_feature(journal, control::ObserverOptions{profile.servo_period_s, true});
+    host.add_feature(journal, controller::ObserverOptions{profile.servo_period_s, true});
     host.add_state(std::make_shared<JournalState>(journal, profile));
   }
   return true;

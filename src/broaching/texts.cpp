@@ -37,11 +37,11 @@ std::string load_guard_text(const control::ServoEvent& e, const config::Broachin
 
 }  // namespace
 
-std::optional<control::EventNote> Texts::event_note(const control::ServoEvent& e,
-                                                    const config::MachineProfile& profile,
-                                                    const control::ServoConfig&) const {
+std::optional<controller::EventNote> Texts::event_note(const control::ServoEvent& e,
+                                                       const config::MachineProfile& profile,
+                                                       const control::ServoConfig&) const {
   if (e.kind != control::EventKind::LoadGuard) return std::nullopt;
-  return control::EventNote{Severity::Warning, "control.load", load_guard_text(e, profile.broaching)};
+  return controller::EventNote{Severity::Warning, "control.load", load_guard_text(e, profile.broaching)};
 }
 
 std::optional<std::string> Texts::fault_text(const control::Fault& f, const config::MachineProfile&,

@@ -9,11 +9,11 @@ namespace opencnc::broaching {
 
 /// The load guard's event (LoadGuard), the coupling's wait (a dwell while the coupled axes
 /// settle) and fault (CouplingPosition) in words. Controller thread.
-class Texts final : public control::EventTexts {
+class Texts final : public controller::EventTexts {
  public:
-  std::optional<control::EventNote> event_note(const control::ServoEvent& e,
-                                               const config::MachineProfile& profile,
-                                               const control::ServoConfig& servo) const override;
+  std::optional<controller::EventNote> event_note(const control::ServoEvent& e,
+                                                  const config::MachineProfile& profile,
+                                                  const control::ServoConfig& servo) const override;
   std::optional<std::string> fault_text(const control::Fault& f, const config::MachineProfile& profile,
                                         const control::ServoConfig& servo) const override;
   std::optional<std::string> wait_text(const control::ServoStatus& s) const override;

@@ -120,7 +120,7 @@ void Agent::add(std::size_t item, Level level, std::string native_code, std::str
   buffer_.add(std::move(o));
 }
 
-void Agent::observe(const control::ControllerStatus& status, std::int64_t time_us) {
+void Agent::observe(const controller::ControllerStatus& status, std::int64_t time_us) {
   ValueSink sink(model_.items().size());
   for (const auto& c : contributions_) c->observe(status, sink);
   std::lock_guard lock(mutex_);

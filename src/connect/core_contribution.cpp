@@ -16,7 +16,7 @@ constexpr int kFeed = 3;  // mm/s
 
 std::string lower(char c) { return std::string(1, static_cast<char>(c - 'A' + 'a')); }
 
-const char* execution(const control::ControllerStatus& s) {
+const char* execution(const controller::ControllerStatus& s) {
   using control::State;
   const auto& v = s.servo;
   switch (v.state) {
@@ -121,7 +121,7 @@ void CoreContribution::describe(DeviceModel& model) {
   position_ = item(path, "path_pos", Category::Sample, "PATH_POSITION", "PathPosition", "ACTUAL", "MILLIMETER_3D");
 }
 
-void CoreContribution::observe(const control::ControllerStatus& s, ValueSink& out) const {
+void CoreContribution::observe(const controller::ControllerStatus& s, ValueSink& out) const {
   const auto& v = s.servo;
   for (const auto& a : axes_) {
     const auto i = static_cast<std::size_t>(a.axis);

@@ -14,7 +14,7 @@ class CoreContribution final : public Contribution {
  public:
   explicit CoreContribution(const config::MachineProfile& profile);
   void describe(DeviceModel& model) override;
-  void observe(const control::ControllerStatus& status, ValueSink& out) const override;
+  void observe(const controller::ControllerStatus& status, ValueSink& out) const override;
 
  private:
   struct AxisItems {

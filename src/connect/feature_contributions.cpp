@@ -24,7 +24,7 @@ void EdmContribution::describe(DeviceModel& model) {
   gap_ = model.add_item(DataItem{"edm_gap", Category::Condition, "VOLTAGE_DC", {}, {}, {}, path});
 }
 
-void EdmContribution::observe(const control::ControllerStatus& s, ValueSink& out) const {
+void EdmContribution::observe(const controller::ControllerStatus& s, ValueSink& out) const {
   const auto& e = s.servo.edm;
   out.set(gap_voltage_, e.on ? fmt::format("{:.1f}", e.gap_voltage_v) : std::string("UNAVAILABLE"));
   if (!e.on) return;
@@ -58,7 +58,7 @@ void CouplingContribution::describe(DeviceModel& model) {
         DataItem{lower(master_) + "_force", Category::Sample, "LINEAR_FORCE", {}, "NEWTON", "LinearForce", master});
 }
 
-void CouplingContribution::observe(const control::ControllerStatus& s, ValueSink& out) const {
+void CouplingContribution::observe(const controller::ControllerStatus& s, ValueSink& out) const {
   const bool coupled = s.servo.coupling.kind != motion::CouplingKind::Off;
   // Uncoupled, the axes have no coupling to report: AXIS_COUPLING has no value for "none".
   out.set(master_coupling_, coupled ? "MASTER" : "UNAVAILABLE");
@@ -75,7 +75,7 @@ void PowerContribution::describe(DeviceModel& model) {
   power_ = model.add_item(DataItem{"power", Category::Condition, "SYSTEM", {}, {}, {}, controller});
 }
 
-void PowerContribution::observe(const control::ControllerStatus& s, ValueSink& out) const {
+void PowerContribution::observe(const controller::ControllerStatus& s, ValueSink& out) const {
   out.set(mains_, s.servo.mains_ok ? "ON" : "OFF");
   if (s.servo.on_battery)
     out.condition(power_, Level::Warning, "power.on-battery",

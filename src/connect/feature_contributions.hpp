@@ -12,7 +12,7 @@ namespace opencnc::connect {
 class EdmContribution final : public Contribution {
  public:
   void describe(DeviceModel& model) override;
-  void observe(const control::ControllerStatus& status, ValueSink& out) const override;
+  void observe(const controller::ControllerStatus& status, ValueSink& out) const override;
 
  private:
   std::size_t gap_voltage_ = 0, gap_ = 0;
@@ -24,7 +24,7 @@ class CouplingContribution final : public Contribution {
  public:
   CouplingContribution(Axis master, Axis slave, bool load);
   void describe(DeviceModel& model) override;
-  void observe(const control::ControllerStatus& status, ValueSink& out) const override;
+  void observe(const controller::ControllerStatus& status, ValueSink& out) const override;
 
  private:
   Axis master_, slave_;
@@ -36,7 +36,7 @@ class CouplingContribution final : public Contribution {
 class PowerContribution final : public Contribution {
  public:
   void describe(DeviceModel& model) override;
-  void observe(const control::ControllerStatus& status, ValueSink& out) const override;
+  void observe(const controller::ControllerStatus& status, ValueSink& out) const override;
 
  private:
   std::size_t mains_ = 0, power_ = 0;

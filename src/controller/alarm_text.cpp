@@ -4,7 +4,7 @@
 
 #include <fmt/format.h>
 
-namespace opencnc::control::detail {
+namespace opencnc::controller::detail {
 
 std::string alarm_text(const config::AlarmProfile& alarms, std::size_t index, double value, bool low,
                        bool cleared) {
@@ -22,4 +22,4 @@ std::string alarm_text(const config::AlarmProfile& alarms, std::size_t index, do
                      low ? a.low : a.high, unit, what);
 }
 
-}  // namespace opencnc::control::detail
+}  // namespace opencnc::controller::detail

@@ -3,7 +3,7 @@
 #include "opencnc/canon/program_tail.hpp"
 #include "opencnc/controller/program_source.hpp"
 
-namespace opencnc::control {
+namespace opencnc::controller {
 
 namespace {
 
@@ -42,4 +42,4 @@ std::unique_ptr<ProgramStream> canon_stream(std::shared_ptr<const canon::Program
   return std::make_unique<CanonStream>(std::move(program), start);
 }
 
-}  // namespace opencnc::control
+}  // namespace opencnc::controller

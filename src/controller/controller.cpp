@@ -16,7 +16,7 @@
 #include "opencnc/controller/servo_setup.hpp"
 #include "task_runner.hpp"
 
-namespace opencnc::control {
+namespace opencnc::controller {
 
 namespace {
 
@@ -24,50 +24,50 @@ constexpr std::size_t kKeptOutcomes = 4096;
 /// Status details that cost strings (where the interpreter is) refresh at most this often.
 constexpr double kLocationRefreshS = 0.01;
 
-std::string refusal_text(Refusal r) {
+std::string refusal_text(control::Refusal r) {
   switch (r) {
-    case Refusal::None:
+    case control::Refusal::None:
       return "";
-    case Refusal::EStopActive:
+    case control::Refusal::EStopActive:
       return "the machine is e-stopped: reset it first";
-    case Refusal::EStopInput:
+    case control::Refusal::EStopInput:
       return "the e-stop chain is still open";
-    case Refusal::MachineOff:
+    case control::Refusal::MachineOff:
       return "the machine is off: turn it on first";
-    case Refusal::Faulted:
+    case control::Refusal::Faulted:
       return "a fault stopped the machine: reset it first";
-    case Refusal::FaultPersists:
+    case control::Refusal::FaultPersists:
       return "the cause of the fault is still there";
-    case Refusal::WrongMode:
+    case control::Refusal::WrongMode:
       return "not possible in this mode";
-    case Refusal::Busy:
+    case control::Refusal::Busy:
       return "something is running or held";
-    case Refusal::NotHomed:
+    case control::Refusal::NotHomed:
       return "the machine must be homed first";
-    case Refusal::NotApplicable:
+    case control::Refusal::NotApplicable:
       return "nothing to do in this state";
-    case Refusal::BadValue:
+    case control::Refusal::BadValue:
       return "a value is out of range";
-    case Refusal::LimitSwitch:
+    case control::Refusal::LimitSwitch:
       return "a limit switch is active";
-    case Refusal::NoProgram:
+    case control::Refusal::NoProgram:
       return "no program is open";
-    case Refusal::ProgramError:
+    case control::Refusal::ProgramError:
       return "the program has errors";
-    case Refusal::SoftLimit:
+    case control::Refusal::SoftLimit:
       return "the program would cross a soft limit";
-    case Refusal::StartMismatch:
+    case control::Refusal::StartMismatch:
       return "the motion does not start where the machine is";
-    case Refusal::Interlock:
+    case control::Refusal::Interlock:
       return "an interlock rule of the machine forbids it now";
-    case Refusal::HandAxis:
+    case control::Refusal::HandAxis:
       return "the axis is moved by hand (or is not where the program needs it)";
-    case Refusal::FeatureCheck:
+    case control::Refusal::FeatureCheck:
       return "a check before the start failed";
-    case Refusal::NoLimitSwitch:
+    case control::Refusal::NoLimitSwitch:
       return "the axis has no limit switch on that side to seek (the profile's limit_min/limit_max and "
              "seek_velocity)";
-    case Refusal::Superseded:
+    case control::Refusal::Superseded:
       return "a stop (e-stop, machine off, abort or feed hold) sent after it acted first: it was dropped; "
              "send it again if it is still meant";
   }
@@ -76,44 +76,44 @@ std::string refusal_text(Refusal r) {
 
 /// What the operator can do about a refusal of `command`, where the generic text would leave them
 /// guessing ("nothing to do in this state"); "" when the generic text says it.
-std::string what_next(CommandKind command, Refusal r) {
+std::string what_next(control::CommandKind command, control::Refusal r) {
   switch (r) {
-    case Refusal::NotApplicable:
+    case control::Refusal::NotApplicable:
       switch (command) {
-        case CommandKind::MachineOn:
+        case control::CommandKind::MachineOn:
           return "the machine is already on";
-        case CommandKind::MachineOff:
+        case control::CommandKind::MachineOff:
           return "the machine is already off";
-        case CommandKind::FeedHold:
+        case control::CommandKind::FeedHold:
           return "nothing is running to hold";
-        case CommandKind::Resume:
+        case control::CommandKind::Resume:
           return "nothing is held: resume continues after a feed hold";
-        case CommandKind::CycleStart:
+        case control::CommandKind::CycleStart:
           return "nothing is held or stopped to continue, and no program is open to start: open one (Auto), "
                  "then cycle start";
-        case CommandKind::Reset:
+        case control::CommandKind::Reset:
           return "nothing to reset: the machine is neither e-stopped nor faulted";
-        case CommandKind::Abort:
+        case control::CommandKind::Abort:
           return "nothing is running to abort";
-        case CommandKind::ToolChanged:
+        case control::CommandKind::ToolChanged:
           return "no manual tool change is waiting";
         default:
           return "";
       }
-    case Refusal::WrongMode:
+    case control::Refusal::WrongMode:
       switch (command) {
-        case CommandKind::JogContinuous:
-        case CommandKind::JogIncrement:
-        case CommandKind::Home:
-        case CommandKind::SeekLimit:
-        case CommandKind::SpindleOn:
-        case CommandKind::Coolant:
+        case control::CommandKind::JogContinuous:
+        case control::CommandKind::JogIncrement:
+        case control::CommandKind::Home:
+        case control::CommandKind::SeekLimit:
+        case control::CommandKind::SpindleOn:
+        case control::CommandKind::Coolant:
           return "that is done in Manual mode: switch to MANUAL first";
         default:
           return "";
       }
-    case Refusal::Busy:
-      return command == CommandKind::SetMode
+    case control::Refusal::Busy:
+      return command == control::CommandKind::SetMode
                  ? "the mode changes while nothing runs: wait for the end, or abort"
                  : "";
     default:
@@ -122,16 +122,16 @@ std::string what_next(CommandKind command, Refusal r) {
 }
 
 /// The refusal the servo would give for a run in `state`.
-Refusal not_idle(State s) {
+control::Refusal not_idle(control::State s) {
   switch (s) {
-    case State::EStopped:
-      return Refusal::EStopActive;
-    case State::Off:
-      return Refusal::MachineOff;
-    case State::Faulted:
-      return Refusal::Faulted;
+    case control::State::EStopped:
+      return control::Refusal::EStopActive;
+    case control::State::Off:
+      return control::Refusal::MachineOff;
+    case control::State::Faulted:
+      return control::Refusal::Faulted;
     default:
-      return Refusal::Busy;
+      return control::Refusal::Busy;
   }
 }
 
@@ -142,8 +142,8 @@ bool has_code(const Diagnostics& d, const char* code) {
   return false;
 }
 
-Refusal program_refusal(const Diagnostics& d) {
-  return has_code(d, "control.soft-limit") ? Refusal::SoftLimit : Refusal::ProgramError;
+control::Refusal program_refusal(const Diagnostics& d) {
+  return has_code(d, "control.soft-limit") ? control::Refusal::SoftLimit : control::Refusal::ProgramError;
 }
 
 /// A file's size and change time: a program that changed on disk since its preflight is checked again.
@@ -158,12 +158,12 @@ std::string file_stamp(const std::string& path) {
 
 }  // namespace
 
-Controller::Controller(const config::MachineProfile& profile, ServoChannels& channels,
+Controller::Controller(const config::MachineProfile& profile, control::ServoChannels& channels,
                        std::shared_ptr<ProgramSource> source, ControllerOptions options)
     : profile_(profile),
-      servo_config_(control::servo_config(profile)),
+      servo_config_(controller::servo_config(profile)),
       limits_(machine_limits(profile)),
-      planner_config_(control::planner_config(profile)),
+      planner_config_(controller::planner_config(profile)),
       channels_(&channels),
       source_(std::move(source)),
       check_(make_move_check()),
@@ -187,7 +187,7 @@ std::uint64_t Controller::submit(Request r) {
   if (is_stop(r)) stop_seq_.store(seq, std::memory_order_relaxed);
   if (is_halt(r)) halt_seq_.store(seq, std::memory_order_relaxed);
   if (takes_urgent_lane(r)) {
-    std::optional<Command> c = to_command(r);
+    std::optional<control::Command> c = to_command(r);
     if (c) {
       c->id = id;
       c->seq = seq;
@@ -205,7 +205,7 @@ std::uint64_t Controller::next_seq() {
   return ++next_seq_;
 }
 
-bool Controller::send(Command c) {
+bool Controller::send(control::Command c) {
   if (c.seq == 0) c.seq = next_seq();
   return channels_->commands.try_push(c);
 }
@@ -357,7 +357,7 @@ void Controller::read_servo() {
     channels_->status.update();
   }
   deliver_trace();
-  ServoEvent e;
+  control::ServoEvent e;
   while (channels_->events.try_pop(e)) on_event(e);
 }
 
@@ -365,7 +365,7 @@ void Controller::read_servo() {
 // still held (they are freed only after this, in the job's service).
 void Controller::deliver_trace() {
   if (!channels_->trace_enabled.load(std::memory_order_relaxed)) return;
-  TraceSample s;
+  control::TraceSample s;
   while (channels_->trace.try_pop(s)) {
     TraceContext c;
     if (job_ && s.run_id == job_->run_id()) {
@@ -386,7 +386,7 @@ void Controller::deliver_trace() {
   }
 }
 
-void Controller::on_event(const ServoEvent& e) {
+void Controller::on_event(const control::ServoEvent& e) {
   ControllerEvent ce;
   ce.kind = ControllerEventKind::Servo;
   ce.servo = e;
@@ -394,35 +394,36 @@ void Controller::on_event(const ServoEvent& e) {
   log(ce);
   // A feature's stage of the tick raised it: the feature has its words.
   for (const auto& t : texts_) {
-    if (e.kind == EventKind::Fault) break;  // faults are described below (describe)
+    if (e.kind == control::EventKind::Fault) break;  // faults are described below (describe)
     if (std::optional<EventNote> n = t->event_note(e, profile_, servo_config_)) {
       note(n->severity, std::move(n->code), std::move(n->text));
       break;
     }
   }
   switch (e.kind) {
-    case EventKind::Accepted:
-    case EventKind::Refused:
+    case control::EventKind::Accepted:
+    case control::EventKind::Refused:
       if (!settle_profile_change(e)) finish(e.command_id, e.refusal, what_next(e.command, e.refusal));
       break;
-    case EventKind::Fault:
+    case control::EventKind::Fault:
       note(Severity::Error, fault_code(e.fault.kind), describe(e.fault));
       break;
-    case EventKind::Message:
+    case control::EventKind::Message:
       if (job_) {
         if (const auto text = job_->message(e.run_id, e.action)) note(Severity::Note, "", *text);
       }
       break;
-    case EventKind::ProcessAlarm:
-    case EventKind::ProcessAlarmCleared:
-      note(e.kind == EventKind::ProcessAlarm ? Severity::Warning : Severity::Note, "control.process-alarm",
+    case control::EventKind::ProcessAlarm:
+    case control::EventKind::ProcessAlarmCleared:
+      note(e.kind == control::EventKind::ProcessAlarm ? Severity::Warning : Severity::Note,
+           "control.process-alarm",
            detail::alarm_text(profile_.alarms, e.action, e.value, e.axis == 0,
-                              e.kind == EventKind::ProcessAlarmCleared));
+                              e.kind == control::EventKind::ProcessAlarmCleared));
       break;
-    case EventKind::Interlock:
+    case control::EventKind::Interlock:
       note(Severity::Warning, "control.interlock", interlock_text(e));
       break;
-    case EventKind::LimitSeek:
+    case control::EventKind::LimitSeek:
       note(e.action == 1 ? Severity::Note : Severity::Error, "control.seek-limit", seek_text(e));
       break;
     default:
@@ -457,7 +458,7 @@ void Controller::handle(std::uint64_t id, Request& r) {
         } else if constexpr (std::is_same_v<T, requests::SetSwitch>) {
           if (body.which == SwitchKind::BlockDelete) {
             block_delete_ = body.on;
-            finish(id, Refusal::None);
+            finish(id, control::Refusal::None);
           } else {
             handle_servo(id, r);
           }
@@ -470,19 +471,20 @@ void Controller::handle(std::uint64_t id, Request& r) {
 
 void Controller::handle_servo(std::uint64_t id, const Request& r) {
   if (const auto* s = std::get_if<requests::Servo>(&r.body)) {
-    if (s->kind == CommandKind::CycleStart) return cycle_start(id, r);
-    if (s->kind == CommandKind::StartRun) return finish(id, Refusal::BadValue, "start-run is the controller's own command");
+    if (s->kind == control::CommandKind::CycleStart) return cycle_start(id, r);
+    if (s->kind == control::CommandKind::StartRun)
+      return finish(id, control::Refusal::BadValue, "start-run is the controller's own command");
   }
-  const std::optional<Command> c = to_command(r);
-  if (!c) return finish(id, Refusal::BadValue, "this request has no servo command");
+  const std::optional<control::Command> c = to_command(r);
+  if (!c) return finish(id, control::Refusal::BadValue, "this request has no servo command");
   forward(id, *c);
 }
 
-void Controller::forward(std::uint64_t id, const Command& command) {
-  Command c = command;
+void Controller::forward(std::uint64_t id, const control::Command& command) {
+  control::Command c = command;
   c.id = id;
   c.seq = handling_seq_;
-  if (!send(c)) finish(id, Refusal::Busy, "the servo's command queue is full");
+  if (!send(c)) finish(id, control::Refusal::Busy, "the servo's command queue is full");
 }
 
 // --- long work -------------------------------------------------------------------------------
@@ -508,7 +510,8 @@ void Controller::finish_long_work() {
   long_.reset();
   handling_seq_ = l.seq;
   if (!l.failure->empty()) {
-    finish(l.id, Refusal::ProgramError, fmt::format("the program could not be checked: {}", *l.failure));
+    finish(l.id, control::Refusal::ProgramError,
+           fmt::format("the program could not be checked: {}", *l.failure));
   } else {
     l.then();
   }
@@ -518,26 +521,27 @@ void Controller::finish_long_work() {
 bool Controller::superseded(std::uint64_t id, bool halts_only) {
   const std::uint64_t after = (halts_only ? halt_seq_ : stop_seq_).load(std::memory_order_relaxed);
   if (handling_seq_ == 0 || after <= handling_seq_) return false;
-  finish(id, Refusal::Superseded, refusal_text(Refusal::Superseded));
+  finish(id, control::Refusal::Superseded, refusal_text(control::Refusal::Superseded));
   return true;
 }
 
-bool Controller::ready_for_job(std::uint64_t id, Mode mode, const char* what) {
+bool Controller::ready_for_job(std::uint64_t id, control::Mode mode, const char* what) {
   if (job_) {
-    finish(id, Refusal::Busy, "a program is running");
+    finish(id, control::Refusal::Busy, "a program is running");
     return false;
   }
   if (servo().mode != mode) {
-    finish(id, Refusal::WrongMode, fmt::format("{} need{} {} mode", what, std::string_view(what).ends_with('s') ? "" : "s",
-                                               to_string(mode)));
+    finish(id, control::Refusal::WrongMode,
+           fmt::format("{} need{} {} mode", what, std::string_view(what).ends_with('s') ? "" : "s",
+                       to_string(mode)));
     return false;
   }
-  if (servo().state != State::Idle) {
+  if (servo().state != control::State::Idle) {
     finish(id, not_idle(servo().state), refusal_text(not_idle(servo().state)));
     return false;
   }
   if (servo_config_.homing_required && !servo().all_homed) {
-    finish(id, Refusal::NotHomed, refusal_text(Refusal::NotHomed));
+    finish(id, control::Refusal::NotHomed, refusal_text(control::Refusal::NotHomed));
     return false;
   }
   return true;
@@ -568,8 +572,9 @@ Preflight Controller::preflight_canon(const canon::Program& program) {
 // stamp and the source's version are taken before it reads, so that a change made while it reads
 // is a change after the check.
 void Controller::open_file(std::uint64_t id, const std::string& path) {
-  if (job_) return finish(id, Refusal::Busy, "a program is running");
-  if (servo().mode != Mode::Auto) return finish(id, Refusal::WrongMode, "programs are opened in Auto mode");
+  if (job_) return finish(id, control::Refusal::Busy, "a program is running");
+  if (servo().mode != control::Mode::Auto)
+    return finish(id, control::Refusal::WrongMode, "programs are opened in Auto mode");
   if (superseded(id, true)) return;
   const Pose at = servo().commanded;
   const bool block_delete = block_delete_;
@@ -608,13 +613,14 @@ void Controller::finish_open(std::uint64_t id, const std::string& path, Prefligh
   e.kind = ControllerEventKind::ProgramOpened;
   e.text = path;
   log(std::move(e));
-  finish(id, Refusal::None, {}, std::move(pf.diagnostics));
+  finish(id, control::Refusal::None, {}, std::move(pf.diagnostics));
 }
 
 void Controller::open_canon(std::uint64_t id, std::shared_ptr<const canon::Program> program, std::string name) {
-  if (job_) return finish(id, Refusal::Busy, "a program is running");
-  if (servo().mode != Mode::Auto) return finish(id, Refusal::WrongMode, "programs are opened in Auto mode");
-  if (!program) return finish(id, Refusal::BadValue, "no program given");
+  if (job_) return finish(id, control::Refusal::Busy, "a program is running");
+  if (servo().mode != control::Mode::Auto)
+    return finish(id, control::Refusal::WrongMode, "programs are opened in Auto mode");
+  if (!program) return finish(id, control::Refusal::BadValue, "no program given");
   if (superseded(id, true)) return;
   auto pf = std::make_shared<Preflight>();
   run_long(
@@ -638,35 +644,39 @@ void Controller::open_canon(std::uint64_t id, std::shared_ptr<const canon::Progr
         e.kind = ControllerEventKind::ProgramOpened;
         e.text = name;
         log(std::move(e));
-        finish(id, Refusal::None, {}, std::move(pf->diagnostics));
+        finish(id, control::Refusal::None, {}, std::move(pf->diagnostics));
       });
 }
 
 void Controller::mdi(std::uint64_t id, const std::string& line) {
-  if (!ready_for_job(id, Mode::Mdi, "MDI lines")) return;
-  if (!source_) return finish(id, Refusal::ProgramError, "this controller has no G-code interpreter");
-  start_job(id, JobKind::Mdi, line, Mode::Mdi, source_->mdi(line, servo().commanded));
+  if (!ready_for_job(id, control::Mode::Mdi, "MDI lines")) return;
+  if (!source_)
+    return finish(id, control::Refusal::ProgramError, "this controller has no G-code interpreter");
+  start_job(id, JobKind::Mdi, line, control::Mode::Mdi, source_->mdi(line, servo().commanded));
 }
 
 void Controller::cycle_start(std::uint64_t id, const Request& r) {
   std::optional<OpenProgram> op = open_program();
   // A program open and the machine idle in Manual or MDI (after homing, a jog, an MDI line): the
   // mode follows, as the operator means to run it (docs/controller.md, "Cycle start").
-  const bool mode_follows = !job_ && op && servo().mode != Mode::Auto && servo().state == State::Idle;
-  if (job_ || (servo().mode != Mode::Auto && !mode_follows)) {  // the servo continues (M0, hold) or says no
-    const std::optional<Command> c = to_command(r);
+  const bool mode_follows =
+      !job_ && op && servo().mode != control::Mode::Auto && servo().state == control::State::Idle;
+  if (job_ ||
+      (servo().mode != control::Mode::Auto && !mode_follows)) {  // the servo continues (M0, hold) or says no
+    const std::optional<control::Command> c = to_command(r);
     return forward(id, *c);
   }
   if (!op)
-    return finish(id, Refusal::NoProgram,
+    return finish(id, control::Refusal::NoProgram,
                   "no program is open: open one (the Program screen, or open FILE), then cycle start");
-  if (!ready_for_job(id, mode_follows ? servo().mode : Mode::Auto, "programs")) return;
+  if (!ready_for_job(id, mode_follows ? servo().mode : control::Mode::Auto, "programs")) return;
   if (!features_allow_start(id, {JobKind::Program, op->name})) return;
   if (op->program) {
     // Checked when opened, unless the machine stands elsewhere or its limits changed since.
     const bool same_start =
         op->program->start() == servo().commanded && open_limits_version_ == limits_version_;
-    start_job(id, JobKind::Program, op->name, Mode::Auto, canon_stream(op->program, servo().commanded), same_start);
+    start_job(id, JobKind::Program, op->name, control::Mode::Auto,
+              canon_stream(op->program, servo().commanded), same_start);
     return;
   }
   // The preflight holds for the position, the switches and the file it was made with: anything
@@ -689,7 +699,8 @@ void Controller::cycle_start(std::uint64_t id, const Request& r) {
     return;
   }
   // Up to its first sync point the program is the one the preflight checked.
-  start_job(id, JobKind::Program, op->name, Mode::Auto, source_->execute(op->path, at, {block_delete}), true);
+  start_job(id, JobKind::Program, op->name, control::Mode::Auto,
+            source_->execute(op->path, at, {block_delete}), true);
 }
 
 // The open program checked again for a cycle start: it starts if nothing changed meanwhile (only
@@ -709,20 +720,21 @@ void Controller::start_checked(std::uint64_t id, const std::string& path, Prefli
   {
     std::lock_guard lock(out_mutex_);
     if (!open_ || open_->path != path)
-      return finish(id, Refusal::NoProgram, refusal_text(Refusal::NoProgram));
+      return finish(id, control::Refusal::NoProgram, refusal_text(control::Refusal::NoProgram));
     open_->preflight = std::move(pf);
     name = open_->name;
   }
   // (The cycle start it answers may have been pressed in Manual or MDI: the mode follows.)
   if (!ready_for_job(id, servo().mode, "programs")) return;
   if (servo().commanded != at)
-    return finish(id, Refusal::StartMismatch,
+    return finish(id, control::Refusal::StartMismatch,
                   "the machine moved while the program was checked: start it again");
-  start_job(id, JobKind::Program, name, Mode::Auto, source_->execute(path, at, {block_delete}), true);
+  start_job(id, JobKind::Program, name, control::Mode::Auto, source_->execute(path, at, {block_delete}),
+            true);
 }
 
 void Controller::run_auxiliary(std::uint64_t id, const requests::RunAuxiliary& r) {
-  if (!ready_for_job(id, Mode::Auto, "auxiliary programs")) return;
+  if (!ready_for_job(id, control::Mode::Auto, "auxiliary programs")) return;
   const std::string name = r.name.empty() ? (r.path.empty() ? "auxiliary" : r.path) : r.name;
   if (!features_allow_start(id, {JobKind::Auxiliary, name})) return;
   if (superseded(id, false)) return;
@@ -739,14 +751,15 @@ void Controller::run_auxiliary(std::uint64_t id, const requests::RunAuxiliary& r
         if (!pf->ok())
           return finish(id, program_refusal(pf->diagnostics), refusal_text(program_refusal(pf->diagnostics)),
                         pf->diagnostics);
-        if (!ready_for_job(id, Mode::Auto, "auxiliary programs")) return;
+        if (!ready_for_job(id, control::Mode::Auto, "auxiliary programs")) return;
         if (servo().commanded != at)
-          return finish(id, Refusal::StartMismatch,
+          return finish(id, control::Refusal::StartMismatch,
                         "the machine moved while the program was checked: start it again");
         if (program)
-          return start_job(id, JobKind::Auxiliary, name, Mode::Auto, canon_stream(program, at),
+          return start_job(id, JobKind::Auxiliary, name, control::Mode::Auto, canon_stream(program, at),
                            program->start() == at);
-        start_job(id, JobKind::Auxiliary, name, Mode::Auto, source_->execute(path, at, {block_delete}), true);
+        start_job(id, JobKind::Auxiliary, name, control::Mode::Auto,
+                  source_->execute(path, at, {block_delete}), true);
       });
 }
 
@@ -762,8 +775,8 @@ bool Controller::features_allow_start(std::uint64_t id, const StartCheck& start)
       why = ex.what();
     }
     if (!ok) {
-      finish(id, Refusal::FeatureCheck,
-             fmt::format("{}: {}", name, why.empty() ? refusal_text(Refusal::FeatureCheck) : why));
+      finish(id, control::Refusal::FeatureCheck,
+             fmt::format("{}: {}", name, why.empty() ? refusal_text(control::Refusal::FeatureCheck) : why));
       return false;
     }
   }
@@ -794,9 +807,10 @@ bool Controller::features_allow_continue(const SyncCheck& sync) {
 
 void Controller::resume_program(std::uint64_t id, const requests::ResumeProgram& r) {
   std::optional<OpenProgram> op = open_program();
-  if (!op) return finish(id, Refusal::NoProgram, refusal_text(Refusal::NoProgram));
-  if (op->path.empty()) return finish(id, Refusal::BadValue, "only a program file can be resumed at a segment");
-  if (!ready_for_job(id, Mode::Auto, "programs")) return;
+  if (!op) return finish(id, control::Refusal::NoProgram, refusal_text(control::Refusal::NoProgram));
+  if (op->path.empty())
+    return finish(id, control::Refusal::BadValue, "only a program file can be resumed at a segment");
+  if (!ready_for_job(id, control::Mode::Auto, "programs")) return;
   if (!features_allow_start(id, {JobKind::Program, op->name})) return;
   if (superseded(id, false)) return;
   const Pose at = servo().commanded;
@@ -805,7 +819,8 @@ void Controller::resume_program(std::uint64_t id, const requests::ResumeProgram&
   auto stream = std::make_shared<std::unique_ptr<ProgramStream>>(
       source_->resume(op->path, r.program_start.value_or(open_at_), at, r.segment, {block_delete_, cancel}));
   if (!*stream)
-    return finish(id, Refusal::BadValue, "this controller's program source cannot resume at a segment");
+    return finish(id, control::Refusal::BadValue,
+                  "this controller's program source cannot resume at a segment");
   // The replay up to the segment (long work): a program that cannot get there starts nothing.
   run_long(
       id,
@@ -815,19 +830,19 @@ void Controller::resume_program(std::uint64_t id, const requests::ResumeProgram&
       },
       [this, id, stream, at, name = op->name] {
         if (superseded(id, false)) return;
-        if (!ready_for_job(id, Mode::Auto, "programs")) return;
+        if (!ready_for_job(id, control::Mode::Auto, "programs")) return;
         if (servo().commanded != at)
-          return finish(id, Refusal::StartMismatch,
+          return finish(id, control::Refusal::StartMismatch,
                         "the machine moved while the program was replayed: start it again");
         // Every move is checked before it runs (the preflight's moves began elsewhere).
-        start_job(id, JobKind::Program, name, Mode::Auto, std::move(*stream), false);
+        start_job(id, JobKind::Program, name, control::Mode::Auto, std::move(*stream), false);
       });
 }
 
 void Controller::feature(std::uint64_t id, const requests::Feature& r) {
   const auto it = features_.find(r.feature);
   if (it == features_.end())
-    return finish(id, Refusal::BadValue, fmt::format("there is no feature named '{}'", r.feature));
+    return finish(id, control::Refusal::BadValue, fmt::format("there is no feature named '{}'", r.feature));
   Outcome o;
   handling_ = id;
   deferred_ = false;
@@ -836,7 +851,7 @@ void Controller::feature(std::uint64_t id, const requests::Feature& r) {
   } catch (const std::exception& ex) {
     deferred_ = false;  // a feature that fails answers now, deferred or not
     o.accepted = false;
-    o.refusal = Refusal::BadValue;
+    o.refusal = control::Refusal::BadValue;
     o.message = fmt::format("{}: {}", r.feature, ex.what());
   }
   handling_ = 0;
@@ -855,8 +870,10 @@ void Controller::answer_after(std::function<void()> work, std::function<Outcome(
 }
 
 void Controller::answer(std::uint64_t id, Outcome o) {
-  finish(id, o.accepted ? Refusal::None : (o.refusal == Refusal::None ? Refusal::BadValue : o.refusal), o.message,
-         std::move(o.diagnostics));
+  finish(id,
+         o.accepted ? control::Refusal::None
+                    : (o.refusal == control::Refusal::None ? control::Refusal::BadValue : o.refusal),
+         o.message, std::move(o.diagnostics));
 }
 
 // Features whose work runs on threads of their own look whether it is done.
@@ -872,16 +889,16 @@ void Controller::poll_features() {
 
 // --- jobs ------------------------------------------------------------------------------------
 
-void Controller::start_job(std::uint64_t id, JobKind kind, std::string name, Mode mode,
+void Controller::start_job(std::uint64_t id, JobKind kind, std::string name, control::Mode mode,
                            std::unique_ptr<ProgramStream> stream, bool prechecked) {
   if (servo().mode != mode) {
     // A program started from Manual or MDI: the mode follows, ahead of the StartRun in the queue.
-    Command m;
-    m.kind = CommandKind::SetMode;
+    control::Command m;
+    m.kind = control::CommandKind::SetMode;
     m.mode = mode;
     m.id = new_id();
     m.seq = handling_seq_;
-    if (!send(m)) return finish(id, Refusal::Busy, "the servo's command queue is full");
+    if (!send(m)) return finish(id, control::Refusal::Busy, "the servo's command queue is full");
   }
   detail::JobHost host;
   host.channels = channels_;
@@ -894,7 +911,7 @@ void Controller::start_job(std::uint64_t id, JobKind kind, std::string name, Mod
   host.prechecked = prechecked;
   host.next_command_id = [this] { return new_id(); };
   host.log = [this](ControllerEvent e) { log(std::move(e)); };
-  host.send = [this](const Command& c) { return send(c); };
+  host.send = [this](const control::Command& c) { return send(c); };
   host.request_seq = handling_seq_;
   host.next_run_id = [this] { return ++run_counter_; };
   host.may_continue = [this](const SyncCheck& c) { return features_allow_continue(c); };
@@ -904,7 +921,7 @@ void Controller::start_job(std::uint64_t id, JobKind kind, std::string name, Mod
   job->set_initial_offsets(kind == JobKind::Mdi ? mdi_offsets_ : published_.offsets);
   Diagnostics d;
   if (!job->start(id, d)) {
-    const Refusal why = program_refusal(d);
+    const control::Refusal why = program_refusal(d);
     return finish(id, why, refusal_text(why), std::move(d));
   }
   job_ = std::move(job);
@@ -951,7 +968,7 @@ void Controller::publish() {
   p.program_moves = open_ ? open_->preflight.summary.moves : 0;
   p.program_length_mm = open_ ? open_->preflight.summary.path_length_mm : 0;
   p.run_active = job_ != nullptr;
-  const ServoStatus& s = servo();
+  const control::ServoStatus& s = servo();
   p.servo = s;  // FeatureHost::current_status() is this, servo snapshot included
   if (job_) {
     const bool same_run = s.run_id == job_->run_id();
@@ -981,7 +998,7 @@ void Controller::publish() {
     p.wait_text = wait_text();
     wait_key_ = key;
   }
-  if (s.fault.kind == FaultKind::None) {
+  if (s.fault.kind == control::FaultKind::None) {
     if (!p.fault_text.empty()) p.fault_text.clear();
   } else if (s.fault.tick != described_fault_tick_) {
     p.fault_text = describe(s.fault);
@@ -995,7 +1012,7 @@ void Controller::publish() {
 // The offsets of the move at the commanded position, and what is left of that move.
 void Controller::update_offsets(bool same_run) {
   ControllerStatus& p = published_;
-  const ServoStatus& s = servo();
+  const control::ServoStatus& s = servo();
   p.distance_to_go = Pose{};
   if (!same_run) return;
   p.offsets = job_->offsets_at(s.segment);
@@ -1009,7 +1026,7 @@ void Controller::update_offsets(bool same_run) {
 // kLocationRefreshS of servo time) where the interpreter reads.
 void Controller::update_locations() {
   ControllerStatus& p = published_;
-  const ServoStatus& s = servo();
+  const control::ServoStatus& s = servo();
   if (s.run_id == job_->run_id() && (s.context != located_context_ || s.line != located_line_ || s.run_id != located_run_)) {
     p.location = job_->locate_servo(s.context, s.line);
     located_context_ = s.context;
@@ -1025,45 +1042,45 @@ void Controller::update_locations() {
 }
 
 std::string Controller::wait_text() const {
-  const ServoStatus& s = servo();
+  const control::ServoStatus& s = servo();
   if (!job_) return {};
-  if (s.state == State::Stopped) {
-    const char* why = s.stop_reason == StopReason::SingleBlock    ? "single block"
-                      : s.stop_reason == StopReason::OptionalStop ? "M1"
-                                                                  : "M0";
+  if (s.state == control::State::Stopped) {
+    const char* why = s.stop_reason == control::StopReason::SingleBlock    ? "single block"
+                      : s.stop_reason == control::StopReason::OptionalStop ? "M1"
+                                                                           : "M0";
     return fmt::format("the operator's cycle start ({} at {})", why, to_string(published_.location));
   }
-  if (s.state == State::Held) return "the operator's resume (feed hold)";
+  if (s.state == control::State::Held) return "the operator's resume (feed hold)";
   if (job_->held_at_sync() && !held_by_.empty())
     return fmt::format("the {} to let the program go on past the {} (see its note)", held_by_,
                        to_string(job_->sync_wait()));
   for (const auto& t : texts_)  // a feature's stage holds the run
     if (std::optional<std::string> w = t->wait_text(s)) return *w;
   switch (s.wait) {
-    case Wait::None:
+    case control::Wait::None:
       return {};
-    case Wait::Dwell:
+    case control::Wait::Dwell:
       return "a dwell";
-    case Wait::Spindle:
+    case control::Wait::Spindle:
       return "the spindle to reach its speed";
-    case Wait::ToolChanger:
+    case control::Wait::ToolChanger:
       return fmt::format("the tool changer (T{})", s.prepared_tool);
-    case Wait::ManualToolChange:
+    case control::Wait::ManualToolChange:
       return fmt::format("the operator to put tool T{} in the spindle and confirm", s.prepared_tool);
-    case Wait::Input:
+    case control::Wait::Input:
       return "an input (M66)";
-    case Wait::Orient:
+    case control::Wait::Orient:
       return "the spindle orientation (M19)";
-    case Wait::Probe:
+    case control::Wait::Probe:
       return "the probe";
-    case Wait::Starved:
+    case control::Wait::Starved:
       if (published_.sync_wait != SyncKind::None)
         return fmt::format("the interpreter, at the {} of {}", to_string(published_.sync_wait),
                            to_string(published_.sync_location));
       return "the planner";
-    case Wait::HandAxis:
+    case control::Wait::HandAxis:
       return "the operator at a hand-fed axis";
-    case Wait::Interlock: {
+    case control::Wait::Interlock: {
       const auto& texts = profile_.interlocks.rule_texts;
       const auto rule = static_cast<std::size_t>(s.interlock_rule);
       return fmt::format("the interlock \"{}\" to let the spindle start",
@@ -1111,11 +1128,11 @@ void Controller::note(Severity s, std::string code, std::string text) {
   log(std::move(e));
 }
 
-void Controller::finish(std::uint64_t id, Refusal refusal, std::string message, Diagnostics diags) {
+void Controller::finish(std::uint64_t id, control::Refusal refusal, std::string message, Diagnostics diags) {
   ControllerEvent e;
   e.kind = ControllerEventKind::Answer;
   e.request_id = id;
-  e.accepted = refusal == Refusal::None;
+  e.accepted = refusal == control::Refusal::None;
   e.code = refusal_code(refusal);
   e.severity = e.accepted ? Severity::Note : Severity::Error;
   {
@@ -1124,7 +1141,7 @@ void Controller::finish(std::uint64_t id, Refusal refusal, std::string message, 
     e.text = message.empty() ? refusal_text(refusal) : std::move(message);
     if (k.id <= id) {  // a later request's answer already there: this one is older than any kept
       k.id = id;
-      k.outcome.accepted = refusal == Refusal::None;
+      k.outcome.accepted = refusal == control::Refusal::None;
       k.outcome.refusal = refusal;
       k.outcome.message = e.text;
       k.outcome.diagnostics = std::move(diags);
@@ -1133,23 +1150,23 @@ void Controller::finish(std::uint64_t id, Refusal refusal, std::string message, 
   log(std::move(e));
 }
 
-std::string Controller::interlock_text(const ServoEvent& e) const {
+std::string Controller::interlock_text(const control::ServoEvent& e) const {
   const auto& texts = profile_.interlocks.rule_texts;
   const std::string rule = e.action < texts.size() ? texts[e.action] : std::string("?");
-  const char* what = e.command == CommandKind::SpindleOff ? "stopped the spindle"
-                     : e.command == CommandKind::Coolant  ? "stopped the coolant"
-                     : e.command == CommandKind::FeedHold ? "held the motion"
-                     : e.command == CommandKind::JogStop  ? "stopped the jog"
-                                                          : "e-stopped the machine";
+  const char* what = e.command == control::CommandKind::SpindleOff ? "stopped the spindle"
+                     : e.command == control::CommandKind::Coolant  ? "stopped the coolant"
+                     : e.command == control::CommandKind::FeedHold ? "held the motion"
+                     : e.command == control::CommandKind::JogStop  ? "stopped the jog"
+                                                                   : "e-stopped the machine";
   return fmt::format("interlock \"{}\" {}", rule, what);
 }
 
 // What a seek found, in the units of the axis; the rest position is in the status.
-std::string Controller::seek_text(const ServoEvent& e) const {
+std::string Controller::seek_text(const control::ServoEvent& e) const {
   const char axis = e.axis >= 0 && e.axis < kAxisCount ? kAxisLetters[static_cast<std::size_t>(e.axis)] : '?';
   const control::ServoStatus& s = servo();
   for (int j = 0; j < servo_config_.joint_count; ++j) {
-    const JointConfig& jc = servo_config_.joints[static_cast<std::size_t>(j)];
+    const control::JointConfig& jc = servo_config_.joints[static_cast<std::size_t>(j)];
     if (jc.axis != e.axis) continue;
     const char* unit = jc.rotary ? "deg" : "mm";
     const control::LimitSeekStatus& st = s.seek[static_cast<std::size_t>(j)];
@@ -1161,48 +1178,48 @@ std::string Controller::seek_text(const ServoEvent& e) const {
   return fmt::format("{}: limit seek at {:.4f}", axis, e.value);
 }
 
-std::string Controller::describe(const Fault& f) const {
+std::string Controller::describe(const control::Fault& f) const {
   for (const auto& t : texts_)  // a feature's stage raised it
     if (std::optional<std::string> text = t->fault_text(f, profile_, servo_config_)) return *text;
   const char axis = f.axis >= 0 && f.axis < kAxisCount ? kAxisLetters[static_cast<std::size_t>(f.axis)] : '?';
-  const JointConfig* jc = nullptr;
+  const control::JointConfig* jc = nullptr;
   for (int j = 0; j < servo_config_.joint_count; ++j) {
     if (servo_config_.joints[static_cast<std::size_t>(j)].axis == f.axis)
       jc = &servo_config_.joints[static_cast<std::size_t>(j)];
   }
   const char* unit = jc != nullptr && jc->rotary ? "deg" : "mm";
   switch (f.kind) {
-    case FaultKind::None:
+    case control::FaultKind::None:
       return "";
-    case FaultKind::LimitSwitch:
+    case control::FaultKind::LimitSwitch:
       return fmt::format("limit switch on {} tripped at {:.4f} {}", axis, f.value, unit);
-    case FaultKind::AmpFault:
+    case control::FaultKind::AmpFault:
       return fmt::format("the {} drive reports a fault (at {:.4f} {})", axis, f.value, unit);
-    case FaultKind::FollowingError:
+    case control::FaultKind::FollowingError:
       return fmt::format("following error on {}: {:.4f} {}, more than the {} {} allowed", axis, f.value, unit,
                          f.limit, unit);
-    case FaultKind::SoftLimit:
+    case control::FaultKind::SoftLimit:
       return fmt::format("{} was commanded to {:.4f} {}, beyond its soft limit of {} {}", axis, f.value, unit,
                          f.limit, unit);
-    case FaultKind::PowerLoss:
+    case control::FaultKind::PowerLoss:
       return fmt::format(
           "power failure: mains lost or running on the UPS (DC link {:.0f} V); the motion was "
           "stopped on the path",
           f.value);
-    case FaultKind::Homing:
+    case control::FaultKind::Homing:
       return fmt::format(
           "homing {} failed at {:.4f} {}: a limit switch, or the home sensor not on the "
           "deceleration dog",
           axis, f.value, unit);
-    case FaultKind::Stall:
+    case control::FaultKind::Stall:
       return fmt::format("the {} stepper stalled at {:.4f} {}: steps were lost, home it again", axis, f.value,
                          unit);
-    case FaultKind::SeekNoSwitch:
+    case control::FaultKind::SeekNoSwitch:
       return fmt::format(
           "seeking its limit, {} went {:.4f} {} (its soft limit {} {} and the overtravel) without the limit "
           "switch tripping: check the switch and its wiring, then home {} again",
           axis, f.value, unit, f.limit, unit, axis);
-    case FaultKind::ProcessAlarm:
+    case control::FaultKind::ProcessAlarm:
       return detail::alarm_text(profile_.alarms, static_cast<std::size_t>(f.axis), f.value, f.value < f.limit,
                                 false);
     default:  // a feature's stage's, described by the feature
@@ -1211,4 +1228,4 @@ std::string Controller::describe(const Fault& f) const {
   return "fault";
 }
 
-}  // namespace opencnc::control
+}  // namespace opencnc::controller

@@ -7,7 +7,7 @@
 #include <cstring>
 #include <string_view>
 
-namespace opencnc::control {
+namespace opencnc::controller {
 
 /// One entry as the ring keeps it: plain bytes, so appending copies and never allocates.
 struct StoredEvent {
@@ -15,7 +15,7 @@ struct StoredEvent {
   std::uint64_t tick = 0;
   std::uint64_t request_id = 0;
   std::uint64_t segment = 0;
-  ServoEvent servo{};
+  control::ServoEvent servo{};
   std::uint32_t job_id = 0;
   std::uint32_t line = 0;
   ControllerEventKind kind = ControllerEventKind::Note;
@@ -223,4 +223,4 @@ std::vector<ControllerEvent> EventCursor::next(std::size_t max) {
   return out;
 }
 
-}  // namespace opencnc::control
+}  // namespace opencnc::controller

@@ -16,7 +16,7 @@
 #include "opencnc/gcode/dialect.hpp"
 #include "opencnc/gcode/standard_extensions.hpp"
 
-namespace opencnc::control {
+namespace opencnc::controller {
 
 namespace {
 
@@ -801,4 +801,4 @@ const char* to_string(SyncKind k) noexcept {
   return "";
 }
 
-}  // namespace opencnc::control
+}  // namespace opencnc::controller

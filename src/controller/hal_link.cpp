@@ -13,7 +13,7 @@
 
 #include "opencnc/controller/servo_setup.hpp"
 
-namespace opencnc::control {
+namespace opencnc::controller {
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -27,7 +27,7 @@ bool wait_for(const std::function<bool()>& done, std::chrono::milliseconds limit
   return true;
 }
 
-bool other_controller(const SharedHeader& h) {
+bool other_controller(const control::SharedHeader& h) {
   const auto pid = static_cast<pid_t>(h.controller_pid.load());
   return pid != 0 && pid != ::getpid() && h.controller_alive.load() && ::kill(pid, 0) == 0;
 }
@@ -36,10 +36,10 @@ bool other_controller(const SharedHeader& h) {
 
 std::unique_ptr<HalLink> HalLink::attach(const std::string& name, const config::MachineProfile& profile,
                                          std::string& error, std::chrono::milliseconds wait) {
-  auto memory = SegmentMapping::attach(name, error);
+  auto memory = control::SegmentMapping::attach(name, error);
   if (!memory) return nullptr;
-  SharedSegment& s = memory->segment();
-  SharedHeader& h = s.header;
+  control::SharedSegment& s = memory->segment();
+  control::SharedHeader& h = s.header;
   if (!wait_for([&] { return h.ticks.load() > 0 && h.period_ns > 0; }, wait)) {
     error = fmt::format(
         "the HAL component behind {} does not tick: add its function to a thread and start it "
@@ -93,4 +93,4 @@ HalLink::~HalLink() {
   memory_->segment().header.controller_pid.store(0);
 }
 
-}  // namespace opencnc::control
+}  // namespace opencnc::controller

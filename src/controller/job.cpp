@@ -12,7 +12,7 @@
 #include "opencnc/control/machine_action.hpp"
 #include "opencnc/controller/preflight.hpp"
 
-namespace opencnc::control::detail {
+namespace opencnc::controller::detail {
 
 namespace {
 
@@ -21,7 +21,7 @@ constexpr std::size_t kReadBatch = 512;
 /// Actions looked at (backwards from the newest) for the one a sync point stands for.
 constexpr std::size_t kSyncActionScan = 64;
 
-SyncAnswer at_rest(SyncKind kind, const ServoStatus& s) {
+SyncAnswer at_rest(SyncKind kind, const control::ServoStatus& s) {
   SyncAnswer a;
   a.kind = kind;
   a.position = s.commanded;
@@ -31,8 +31,8 @@ SyncAnswer at_rest(SyncKind kind, const ServoStatus& s) {
 
 }  // namespace
 
-Job::Job(JobKind kind, std::uint32_t id, std::string name, Mode mode, std::unique_ptr<ProgramStream> stream,
-         JobHost host)
+Job::Job(JobKind kind, std::uint32_t id, std::string name, control::Mode mode,
+         std::unique_ptr<ProgramStream> stream, JobHost host)
     : kind_(kind),
       id_(id),
       name_(std::move(name)),
@@ -70,14 +70,14 @@ bool Job::begin_leg(std::uint64_t command_id, Diagnostics& diags) {
   leg_.time_first = 0;
   released_to_ = 0;
   waiting_ = false;
-  const ServoStatus& s = host_.channels->status.front();
+  const control::ServoStatus& s = host_.channels->status.front();
   read_ahead(s);
   if (failing_) {  // nothing has moved: the request is refused with the reasons
     for (const Diagnostic& d : errors_.items()) diags.add(d);
     return false;
   }
-  Command c;
-  c.kind = CommandKind::StartRun;
+  control::Command c;
+  c.kind = control::CommandKind::StartRun;
   c.id = command_id;
   c.seq = first_leg ? host_.request_seq : 0;
   c.run_id = leg_.run_id;
@@ -95,7 +95,7 @@ bool Job::begin_leg(std::uint64_t command_id, Diagnostics& diags) {
 
 // --- reading ahead ---------------------------------------------------------------------------
 
-void Job::read_ahead(const ServoStatus& s) {
+void Job::read_ahead(const control::ServoStatus& s) {
   while (!failing_ && !waiting_ && stream_->state() == StreamState::Reading && wants_more(s)) {
     const std::size_t before = stream_->program().size();
     stream_->read(kReadBatch);
@@ -123,7 +123,7 @@ void Job::read_ahead(const ServoStatus& s) {
 
 // The planner's look-ahead always gets what it asks for; beyond that the interpreter stays within
 // the profile's read-ahead, in moves and in seconds of programmed motion.
-bool Job::wants_more(const ServoStatus& s) const {
+bool Job::wants_more(const control::ServoStatus& s) const {
   if (leg_.planner->wants_input()) return true;
   const std::size_t at = s.run_id == leg_.run_id ? static_cast<std::size_t>(s.segment) : 0;
   const std::size_t ahead = leg_.checked > at ? leg_.checked - at : 0;
@@ -248,23 +248,23 @@ void Job::answer(const SyncAnswer& a) {
 
 // --- servo events ------------------------------------------------------------------------------
 
-void Job::on_servo_event(const ServoEvent& e, const ServoStatus& s) {
+void Job::on_servo_event(const control::ServoEvent& e, const control::ServoStatus& s) {
   if (ended_) return;
   switch (e.kind) {
-    case EventKind::Refused:
-      if (e.command == CommandKind::StartRun && e.command_id == leg_.command_id)
-        finish(e.refusal == Refusal::Superseded ? JobEnd::Aborted : JobEnd::Fault);
+    case control::EventKind::Refused:
+      if (e.command == control::CommandKind::StartRun && e.command_id == leg_.command_id)
+        finish(e.refusal == control::Refusal::Superseded ? JobEnd::Aborted : JobEnd::Fault);
       return;
-    case EventKind::InputRead:
+    case control::EventKind::InputRead:
       if (e.run_id == leg_.run_id) input_value_ = e.value;
       return;
-    case EventKind::ProbeTripped:
+    case control::EventKind::ProbeTripped:
       if (e.run_id == leg_.run_id) {
         leg_.tripped = true;
         leg_.tripped_segment = e.segment;
       }
       return;
-    case EventKind::SyncPassed:
+    case control::EventKind::SyncPassed:
       if (e.run_id != leg_.run_id || !waiting_ || e.action != waiting_action_) return;
       {
         SyncAnswer a = at_rest(stream_->sync_request().kind, s);
@@ -273,14 +273,14 @@ void Job::on_servo_event(const ServoEvent& e, const ServoStatus& s) {
         answer_when_allowed();
       }
       return;
-    case EventKind::RunEnded:
+    case control::EventKind::RunEnded:
       if (e.run_id != leg_.run_id) return;
       leg_.ended = true;
       switch (e.run_end) {
-        case RunEnd::Finished:
+        case control::RunEnd::Finished:
           finish(failing_ ? JobEnd::Error : JobEnd::Finished);
           return;
-        case RunEnd::ProbeTripped: {
+        case control::RunEnd::ProbeTripped: {
           // The machine stopped inside the probe move: the interpreter learns where, and what
           // follows runs from there in a new leg.
           std::size_t from = stream_->program().size();
@@ -308,12 +308,12 @@ void Job::on_servo_event(const ServoEvent& e, const ServoStatus& s) {
           }
           return;
         }
-        case RunEnd::Aborted:
+        case control::RunEnd::Aborted:
           finish(failing_ ? JobEnd::Error : JobEnd::Aborted);
           return;
-        case RunEnd::Faulted:
-        case RunEnd::EStopped:
-        case RunEnd::MachineOff:
+        case control::RunEnd::Faulted:
+        case control::RunEnd::EStopped:
+        case control::RunEnd::MachineOff:
           finish(JobEnd::Fault);
           return;
       }
@@ -343,7 +343,7 @@ void Job::answer_when_allowed() {
   answer(a);
 }
 
-void Job::service(const ServoStatus& s) {
+void Job::service(const control::ServoStatus& s) {
   if (ended_) return;
   answer_when_allowed();
   if (!failing_) read_ahead(s);
@@ -352,8 +352,8 @@ void Job::service(const ServoStatus& s) {
   if (failing_ && !abort_sent_ && s.run_id == leg_.run_id && s.motion == traj::RunState::Starved &&
       s.path_velocity == 0 && host_.channels->blocks.available() == 0) {
     // Stopped at the end of the last good move: the run ends there.
-    Command c;
-    c.kind = CommandKind::Abort;
+    control::Command c;
+    c.kind = control::CommandKind::Abort;
     c.id = host_.next_command_id();
     abort_sent_ = host_.send(c);
   }
@@ -383,7 +383,7 @@ void Job::pump() {
 
 // What every reader has passed is freed: the planner's reader, the servo (and the trace samples on
 // its moves, which every observer has seen by now), the actions whose records are queued.
-void Job::release(const ServoStatus& s) {
+void Job::release(const control::ServoStatus& s) {
   const canon::Program& p = stream_->program();
   std::size_t move = std::min(leg_.checked, leg_.planner->oldest_move_needed());
   if (s.run_id == leg_.run_id) move = std::min(move, static_cast<std::size_t>(s.segment_first));
@@ -451,4 +451,4 @@ TraceContext Job::trace_context(std::uint32_t run_id) const {
   return c;
 }
 
-}  // namespace opencnc::control::detail
+}  // namespace opencnc::controller::detail

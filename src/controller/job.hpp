@@ -20,12 +20,12 @@
 #include "opencnc/controller/program_source.hpp"
 #include "opencnc/plan/planner.hpp"
 
-namespace opencnc::control::detail {
+namespace opencnc::controller::detail {
 
 /// What a job uses of the controller.
 struct JobHost {
-  ServoChannels* channels = nullptr;
-  const ServoConfig* servo = nullptr;
+  control::ServoChannels* channels = nullptr;
+  const control::ServoConfig* servo = nullptr;
   const plan::MachineLimits* limits = nullptr;
   const plan::PlannerConfig* planner = nullptr;
   MoveCheck* check = nullptr;
@@ -39,7 +39,7 @@ struct JobHost {
   std::function<std::uint64_t()> next_command_id;
   std::function<void(ControllerEvent)> log;
   /// Sends a servo command; false when the queue is full.
-  std::function<bool(const Command&)> send;
+  std::function<bool(const control::Command&)> send;
   /// The send order of the request that started the job: its first StartRun carries it, so that a
   /// stop sent after the request drops the start (Command::seq); later legs take a new number.
   std::uint64_t request_seq = 0;
@@ -52,8 +52,8 @@ struct JobHost {
 
 class Job {
  public:
-  Job(JobKind kind, std::uint32_t id, std::string name, Mode mode, std::unique_ptr<ProgramStream> stream,
-      JobHost host);
+  Job(JobKind kind, std::uint32_t id, std::string name, control::Mode mode,
+      std::unique_ptr<ProgramStream> stream, JobHost host);
   ~Job();
 
   /// Reads the first moves, checks them, plans, queues the first blocks and sends StartRun with
@@ -61,9 +61,9 @@ class Job {
   /// job). False, with the reasons in `diags`, when the program fails before any motion.
   bool start(std::uint64_t command_id, Diagnostics& diags);
   /// One servo event (in order) with the status read in the same service.
-  void on_servo_event(const ServoEvent& e, const ServoStatus& s);
+  void on_servo_event(const control::ServoEvent& e, const control::ServoStatus& s);
   /// The periodic work: read ahead, answer sync points, feed the planner, free what is passed.
-  void service(const ServoStatus& s);
+  void service(const control::ServoStatus& s);
 
   bool ended() const noexcept { return ended_; }
   /// The machine has answered the sync point, but a feature holds the interpreter there.
@@ -75,7 +75,7 @@ class Job {
   JobKind kind() const noexcept { return kind_; }
   std::uint32_t id() const noexcept { return id_; }
   const std::string& name() const noexcept { return name_; }
-  Mode mode() const noexcept { return mode_; }
+  control::Mode mode() const noexcept { return mode_; }
   std::uint32_t run_id() const noexcept { return leg_.run_id; }
   /// Job move number of the servo's move `segment` of the current run.
   std::uint64_t job_segment(std::uint64_t segment) const noexcept { return leg_.first_move + segment; }
@@ -118,15 +118,15 @@ class Job {
   };
 
   bool begin_leg(std::uint64_t command_id, Diagnostics& diags);
-  void read_ahead(const ServoStatus& s);
-  bool wants_more(const ServoStatus& s) const;
+  void read_ahead(const control::ServoStatus& s);
+  bool wants_more(const control::ServoStatus& s) const;
   void check_new_moves();
   void enter_sync();
   void answer(const SyncAnswer& a);
   void answer_when_allowed();
   void push_actions();
   void pump();
-  void release(const ServoStatus& s);
+  void release(const control::ServoStatus& s);
   void fail(const Diagnostics& why);
   void finish(JobEnd end);
   double nominal_time(canon::SegmentId move) const;
@@ -135,7 +135,7 @@ class Job {
   JobKind kind_;
   std::uint32_t id_;
   std::string name_;
-  Mode mode_;
+  control::Mode mode_;
   std::unique_ptr<ProgramStream> stream_;
   JobHost host_;
   Leg leg_;
@@ -155,4 +155,4 @@ class Job {
   Diagnostics errors_;
 };
 
-}  // namespace opencnc::control::detail
+}  // namespace opencnc::controller::detail

@@ -2,7 +2,7 @@
 // MachineSetup: the features' parts collected, the sources made from them, the controller given them.
 #include "opencnc/controller/machine_setup.hpp"
 
-namespace opencnc::control {
+namespace opencnc::controller {
 
 std::unique_ptr<MachineSetup> MachineSetup::create(const config::MachineProfile& profile, Options options,
                                                    Diagnostics& diags) {
@@ -76,4 +76,4 @@ std::shared_ptr<Feature> MachineSetup::feature(std::string_view name) const {
   return nullptr;
 }
 
-}  // namespace opencnc::control
+}  // namespace opencnc::controller

@@ -2,7 +2,7 @@
 // OffsetTrack: offset actions of a job's stream folded into the offsets of each move.
 #include "offset_track.hpp"
 
-namespace opencnc::control::detail {
+namespace opencnc::controller::detail {
 
 void OffsetTrack::scan(const canon::Program& p) {
   if (next_action_ < p.first_held_action()) next_action_ = p.first_held_action();
@@ -51,4 +51,4 @@ void OffsetTrack::restart(std::size_t from) {
   next_action_ = 0;
 }
 
-}  // namespace opencnc::control::detail
+}  // namespace opencnc::controller::detail

@@ -10,7 +10,7 @@
 #include "opencnc/canon/program.hpp"
 #include "opencnc/controller/controller_status.hpp"
 
-namespace opencnc::control::detail {
+namespace opencnc::controller::detail {
 
 /// Offset changes of a job's stream, keyed by the move they come before. Controller thread.
 class OffsetTrack {
@@ -36,4 +36,4 @@ class OffsetTrack {
   std::size_t next_action_ = 0;
 };
 
-}  // namespace opencnc::control::detail
+}  // namespace opencnc::controller::detail

@@ -14,7 +14,7 @@
 #include "opencnc/core/vec3.hpp"
 #include "opencnc/plan/planner.hpp"
 
-namespace opencnc::control {
+namespace opencnc::controller {
 
 namespace {
 
@@ -116,10 +116,10 @@ namespace {
 /// kMaxReported are listed. Returns whether the move stays inside. `why`: what widened the extent
 /// beyond the programmed path (a MoveReach's words), "" for none.
 bool check_extent(const canon::Program& program, canon::SegmentId id, const Extent& e, const std::string& why,
-                  const ServoConfig& config, Diagnostics& diags, int& errors) {
+                  const control::ServoConfig& config, Diagnostics& diags, int& errors) {
   bool inside = true;
   for (int j = 0; j < config.joint_count; ++j) {
-    const JointConfig& jc = config.joints[static_cast<std::size_t>(j)];
+    const control::JointConfig& jc = config.joints[static_cast<std::size_t>(j)];
     if (jc.wrapped) continue;
     const bool high = e.max[jc.axis] > jc.max_limit + kSlack, low = e.min[jc.axis] < jc.min_limit - kSlack;
     if (!high && !low) continue;
@@ -146,7 +146,8 @@ void report_unlisted(int errors, Diagnostics& diags) {
 
 }  // namespace
 
-bool check_soft_limits(const canon::Program& program, const ServoConfig& config, Diagnostics& diags) {
+bool check_soft_limits(const canon::Program& program, const control::ServoConfig& config,
+                       Diagnostics& diags) {
   int errors = 0;
   for (canon::SegmentId id = 0; id < program.size(); ++id)
     check_extent(program, id, move_extent(program, id), "", config, diags, errors);
@@ -154,7 +155,7 @@ bool check_soft_limits(const canon::Program& program, const ServoConfig& config,
   return errors == 0;
 }
 
-MachineMoveCheck::MachineMoveCheck(const ServoConfig& config, const plan::MachineLimits& limits,
+MachineMoveCheck::MachineMoveCheck(const control::ServoConfig& config, const plan::MachineLimits& limits,
                                    std::vector<std::unique_ptr<MoveReach>> reaches)
     : config_(config), limits_(limits), reaches_(std::move(reaches)) {}
 
@@ -174,4 +175,4 @@ void MachineMoveCheck::finish(Diagnostics& diags) {
   for (const auto& r : reaches_) r->reset();  // the next scan starts from its program's start
 }
 
-}  // namespace opencnc::control
+}  // namespace opencnc::controller

@@ -13,7 +13,7 @@
 #include "opencnc/controller/servo_setup.hpp"
 #include "opencnc/core/atomic_file.hpp"
 
-namespace opencnc::control {
+namespace opencnc::controller {
 
 namespace {
 
@@ -42,10 +42,10 @@ std::string change_text(const std::vector<config::ProfileChange>& changes) {
   return s;
 }
 
-JointLimits joint_limits(const ServoConfig& s, int joint) {
-  const JointConfig& j = s.joints[static_cast<std::size_t>(joint)];
-  JointLimits l{j.max_velocity, j.max_acceleration,    j.min_limit,
-                j.max_limit,    j.max_following_error, j.home.final_velocity};
+control::JointLimits joint_limits(const control::ServoConfig& s, int joint) {
+  const control::JointConfig& j = s.joints[static_cast<std::size_t>(joint)];
+  control::JointLimits l{j.max_velocity, j.max_acceleration,    j.min_limit,
+                         j.max_limit,    j.max_following_error, j.home.final_velocity};
   if (static_cast<std::size_t>(joint) < s.compensation.joints.size()) {
     const motion::JointCompensation& c = s.compensation.joints[static_cast<std::size_t>(joint)];
     l.backlash = c.backlash;
@@ -56,9 +56,9 @@ JointLimits joint_limits(const ServoConfig& s, int joint) {
 }
 
 /// The homed joint of `next` whose axis stands outside its new soft limits, as a message; "".
-std::string outside_new_limits(const ServoConfig& next, const ServoStatus& s) {
+std::string outside_new_limits(const control::ServoConfig& next, const control::ServoStatus& s) {
   for (int j = 0; j < next.joint_count; ++j) {
-    const JointConfig& jc = next.joints[static_cast<std::size_t>(j)];
+    const control::JointConfig& jc = next.joints[static_cast<std::size_t>(j)];
     if (!s.joints[static_cast<std::size_t>(j)].homed || jc.wrapped || jc.drive == machine::JointDrive::Manual)
       continue;
     const double x = s.commanded[jc.axis];
@@ -79,7 +79,7 @@ config::MachineProfile Controller::current_profile() const {
 
 void Controller::swap_profile(config::MachineProfile profile) {
   profile_ = std::move(profile);
-  servo_config_ = control::servo_config(profile_);
+  servo_config_ = controller::servo_config(profile_);
   limits_ = machine_limits(profile_);
   check_ = make_move_check();
   ++limits_version_;  // the open program is checked again before it starts
@@ -92,39 +92,40 @@ void Controller::swap_profile(config::MachineProfile profile) {
 // the controller's side at once (so a request after this one plans with the new limits), then
 // the tick's side; settle_profile_change() keeps it or puts everything back.
 void Controller::edit_profile(std::uint64_t id, const requests::EditProfile& r) {
-  const ServoStatus& s = servo();
-  if (profile_change_) return finish(id, Refusal::Busy, "another change of the profile is being applied");
-  if (job_ || s.activity != Activity::None || s.state == State::Running || s.state == State::Held ||
-      s.state == State::Stopped)
-    return finish(id, Refusal::Busy,
+  const control::ServoStatus& s = servo();
+  if (profile_change_)
+    return finish(id, control::Refusal::Busy, "another change of the profile is being applied");
+  if (job_ || s.activity != control::Activity::None || s.state == control::State::Running ||
+      s.state == control::State::Held || s.state == control::State::Stopped)
+    return finish(id, control::Refusal::Busy,
                   "machine parameters change only while nothing runs (no program, MDI line, jog or homing)");
   config::ProfileEditResult edit = config::edit_profile(profile_, r.edits, r.conditions);
-  if (!edit.error.empty()) return finish(id, Refusal::BadValue, edit.error);
+  if (!edit.error.empty()) return finish(id, control::Refusal::BadValue, edit.error);
   if (!edit.ok()) {
     const Diagnostic* first = nullptr;
     for (const Diagnostic& d : edit.diagnostics.items())
       if (d.severity == Severity::Error && !first) first = &d;
     return finish(
-        id, Refusal::BadValue,
+        id, control::Refusal::BadValue,
         first ? "the profile refuses the change: " + first->format() : "the profile refuses the change",
         std::move(edit.diagnostics));
   }
-  const ServoConfig next = control::servo_config(*edit.profile);
+  const control::ServoConfig next = controller::servo_config(*edit.profile);
   if (const std::string why = outside_new_limits(next, s); !why.empty())
-    return finish(id, Refusal::SoftLimit, why);
+    return finish(id, control::Refusal::SoftLimit, why);
   if (Diagnostics needs; *edit.deletes != '\0' && !open_program_passes(*edit.profile, needs)) {
     std::string why = needs.items().front().format();
-    return finish(id, Refusal::ProgramError,
+    return finish(id, control::Refusal::ProgramError,
                   fmt::format("the open program selects {} this would delete: {}", edit.deletes, why),
                   std::move(needs));
   }
   std::string old_text, error;
   std::vector<config::FileText> old_files;  // a comp file the table is written into
-  if (!write_files(edit.files, old_files, error)) return finish(id, Refusal::BadValue, error);
+  if (!write_files(edit.files, old_files, error)) return finish(id, control::Refusal::BadValue, error);
   if (!read_file(profile_.source, old_text, &error) ||
       !write_file_atomically(profile_.source, edit.text, &error)) {
     for (const config::FileText& back : old_files) write_file_atomically(back.path, back.text, nullptr);
-    return finish(id, Refusal::BadValue,
+    return finish(id, control::Refusal::BadValue,
                   fmt::format("{}: cannot write the profile: {}", profile_.source, error));
   }
   ProfileChange pending{id,
@@ -138,26 +139,26 @@ void Controller::edit_profile(std::uint64_t id, const requests::EditProfile& r) 
   swap_profile(std::move(*edit.profile));
   bool queued = true;
   for (int j = 0; j < next.joint_count && queued; ++j) {
-    Command c;
+    control::Command c;
     c.id = pending.stage_id;
-    c.kind = CommandKind::StageJointLimits;
+    c.kind = control::CommandKind::StageJointLimits;
     c.axis = static_cast<std::int8_t>(j);
     c.limits = joint_limits(next, j);
     queued = send(c);
   }
-  for (const Command& stage : stage_tables(*channels_, next, pending.stage_id)) {
+  for (const control::Command& stage : stage_tables(*channels_, next, pending.stage_id)) {
     if (!queued) break;
     queued = send(stage);
   }
-  Command apply;
+  control::Command apply;
   apply.id = id;
-  apply.kind = CommandKind::ApplyJointLimits;
+  apply.kind = control::CommandKind::ApplyJointLimits;
   profile_change_ = std::move(pending);
   if (!queued || !send(apply)) {
-    ServoEvent refused;
-    refused.kind = EventKind::Refused;
+    control::ServoEvent refused;
+    refused.kind = control::EventKind::Refused;
     refused.command_id = id;
-    refused.refusal = Refusal::Busy;
+    refused.refusal = control::Refusal::Busy;
     settle_profile_change(refused);  // the stages already queued are dropped by the next apply
   }
 }
@@ -185,17 +186,17 @@ bool Controller::open_program_passes(const config::MachineProfile& next, Diagnos
   return needs.items().empty();
 }
 
-bool Controller::settle_profile_change(const ServoEvent& e) {
+bool Controller::settle_profile_change(const control::ServoEvent& e) {
   if (!profile_change_) return false;
   if (e.command_id == profile_change_->stage_id) return true;  // the apply answers for all
   if (e.command_id != profile_change_->id) return false;
   ProfileChange change = std::move(*profile_change_);
   profile_change_.reset();
-  if (e.kind == EventKind::Accepted) {
+  if (e.kind == control::EventKind::Accepted) {
     note(Severity::Note, "control.profile",
          fmt::format("{}{} changed: {} ({})", change.who.empty() ? "" : change.who + ": ", change.what,
                      change.message, profile_.source));
-    finish(change.id, Refusal::None, change.message);
+    finish(change.id, control::Refusal::None, change.message);
     return true;
   }
   // The tick said no (something started moving meanwhile): the files and the limits as they were.
@@ -206,7 +207,7 @@ bool Controller::settle_profile_change(const ServoEvent& e) {
     if (std::string why; !write_file_atomically(back.path, back.text, &why))
       error += fmt::format("{}{}: {}", error.empty() ? "" : "; ", back.path, why);
   swap_profile(std::move(change.old_profile));
-  finish(change.id, e.refusal == Refusal::None ? Refusal::Busy : e.refusal,
+  finish(change.id, e.refusal == control::Refusal::None ? control::Refusal::Busy : e.refusal,
          error.empty() ? fmt::format("the machine would not take the new limits now: nothing changed")
                        : fmt::format("the machine would not take the new limits now, and a file could not be "
                                      "restored: {}",
@@ -214,4 +215,4 @@ bool Controller::settle_profile_change(const ServoEvent& e) {
   return true;
 }
 
-}  // namespace opencnc::control
+}  // namespace opencnc::controller

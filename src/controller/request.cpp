@@ -4,7 +4,7 @@
 
 #include <type_traits>
 
-namespace opencnc::control {
+namespace opencnc::controller {
 
 namespace {
 
@@ -39,8 +39,8 @@ const char* switch_name(SwitchKind k) {
   return "switch";
 }
 
-Command command(CommandKind k) {
-  Command c;
+control::Command command(control::CommandKind k) {
+  control::Command c;
   c.kind = k;
   return c;
 }
@@ -76,77 +76,79 @@ std::string Request::name() const {
                     body);
 }
 
-std::optional<Command> to_command(const Request& r) {
+std::optional<control::Command> to_command(const Request& r) {
   return std::visit(
       Overload{
-          [](const requests::Servo& s) -> std::optional<Command> { return command(s.kind); },
-          [](const requests::SetMode& s) -> std::optional<Command> {
-            Command c = command(CommandKind::SetMode);
+          [](const requests::Servo& s) -> std::optional<control::Command> { return command(s.kind); },
+          [](const requests::SetMode& s) -> std::optional<control::Command> {
+            control::Command c = command(control::CommandKind::SetMode);
             c.mode = s.mode;
             return c;
           },
-          [](const requests::Jog& s) -> std::optional<Command> {
-            Command c = command(CommandKind::JogContinuous);
+          [](const requests::Jog& s) -> std::optional<control::Command> {
+            control::Command c = command(control::CommandKind::JogContinuous);
             c.axis = axis_index(s.axis);
             c.value = s.velocity;
             return c;
           },
-          [](const requests::JogBy& s) -> std::optional<Command> {
-            Command c = command(CommandKind::JogIncrement);
+          [](const requests::JogBy& s) -> std::optional<control::Command> {
+            control::Command c = command(control::CommandKind::JogIncrement);
             c.axis = axis_index(s.axis);
             c.value = s.distance;
             c.value2 = s.speed;
             return c;
           },
-          [](const requests::JogStop& s) -> std::optional<Command> {
-            Command c = command(CommandKind::JogStop);
+          [](const requests::JogStop& s) -> std::optional<control::Command> {
+            control::Command c = command(control::CommandKind::JogStop);
             c.axis = axis_index(s.axis);
             return c;
           },
-          [](const requests::Home& s) -> std::optional<Command> {
-            Command c = command(CommandKind::Home);
+          [](const requests::Home& s) -> std::optional<control::Command> {
+            control::Command c = command(control::CommandKind::Home);
             c.axis = axis_index(s.axis);
             return c;
           },
-          [](const requests::SeekLimit& s) -> std::optional<Command> {
-            Command c = command(CommandKind::SeekLimit);
+          [](const requests::SeekLimit& s) -> std::optional<control::Command> {
+            control::Command c = command(control::CommandKind::SeekLimit);
             c.axis = axis_index(s.axis);
             c.value = s.direction;
             return c;
           },
-          [](const requests::SetOverride& s) -> std::optional<Command> {
-            Command c = command(s.which == OverrideKind::Feed    ? CommandKind::SetFeedOverride
-                                : s.which == OverrideKind::Rapid ? CommandKind::SetRapidOverride
-                                                                 : CommandKind::SetSpindleOverride);
+          [](const requests::SetOverride& s) -> std::optional<control::Command> {
+            control::Command c =
+                command(s.which == OverrideKind::Feed    ? control::CommandKind::SetFeedOverride
+                        : s.which == OverrideKind::Rapid ? control::CommandKind::SetRapidOverride
+                                                         : control::CommandKind::SetSpindleOverride);
             c.value = s.value;
             return c;
           },
-          [](const requests::SetSwitch& s) -> std::optional<Command> {
+          [](const requests::SetSwitch& s) -> std::optional<control::Command> {
             if (s.which == SwitchKind::BlockDelete) return std::nullopt;  // the controller's
-            Command c = command(s.which == SwitchKind::SingleBlock ? CommandKind::SetSingleBlock
-                                                                   : CommandKind::SetOptionalStop);
+            control::Command c =
+                command(s.which == SwitchKind::SingleBlock ? control::CommandKind::SetSingleBlock
+                                                           : control::CommandKind::SetOptionalStop);
             c.flag = s.on;
             return c;
           },
-          [](const requests::SpindleOn& s) -> std::optional<Command> {
-            Command c = command(CommandKind::SpindleOn);
+          [](const requests::SpindleOn& s) -> std::optional<control::Command> {
+            control::Command c = command(control::CommandKind::SpindleOn);
             c.value = s.rpm;
             c.flag = s.clockwise;
             return c;
           },
-          [](const requests::SetCoolant& s) -> std::optional<Command> {
-            Command c = command(CommandKind::Coolant);
+          [](const requests::SetCoolant& s) -> std::optional<control::Command> {
+            control::Command c = command(control::CommandKind::Coolant);
             c.coolant = s.which;
             c.flag = s.on;
             return c;
           },
-          [](const requests::SetHandwheel& s) -> std::optional<Command> {
-            Command c = command(CommandKind::SetHandwheel);
+          [](const requests::SetHandwheel& s) -> std::optional<control::Command> {
+            control::Command c = command(control::CommandKind::SetHandwheel);
             c.axis = axis_index(s.axis);
             c.value = s.step;
             return c;
           },
-          [](const auto&) -> std::optional<Command> { return std::nullopt; },
+          [](const auto&) -> std::optional<control::Command> { return std::nullopt; },
       },
       r.body);
 }
@@ -154,11 +156,11 @@ std::optional<Command> to_command(const Request& r) {
 bool takes_urgent_lane(const Request& r) {
   if (const auto* s = std::get_if<requests::Servo>(&r.body)) {
     switch (s->kind) {
-      case CommandKind::EStop:
-      case CommandKind::MachineOff:
-      case CommandKind::Abort:
-      case CommandKind::FeedHold:
-      case CommandKind::SpindleOff:
+      case control::CommandKind::EStop:
+      case control::CommandKind::MachineOff:
+      case control::CommandKind::Abort:
+      case control::CommandKind::FeedHold:
+      case control::CommandKind::SpindleOff:
         return true;
       default:
         return false;
@@ -171,13 +173,14 @@ bool takes_urgent_lane(const Request& r) {
 
 bool is_halt(const Request& r) {
   const auto* s = std::get_if<requests::Servo>(&r.body);
-  return s != nullptr && (s->kind == CommandKind::EStop || s->kind == CommandKind::MachineOff ||
-                          s->kind == CommandKind::Abort);
+  return s != nullptr &&
+         (s->kind == control::CommandKind::EStop || s->kind == control::CommandKind::MachineOff ||
+          s->kind == control::CommandKind::Abort);
 }
 
 bool is_stop(const Request& r) {
   const auto* s = std::get_if<requests::Servo>(&r.body);
-  return is_halt(r) || (s != nullptr && s->kind == CommandKind::FeedHold);
+  return is_halt(r) || (s != nullptr && s->kind == control::CommandKind::FeedHold);
 }
 
-}  // namespace opencnc::control
+}  // namespace opencnc::controller

@@ -7,7 +7,7 @@
 
 #include <fmt/format.h>
 
-namespace opencnc::control {
+namespace opencnc::controller {
 
 namespace {
 
@@ -72,8 +72,8 @@ void RunRecorder::begin(const Pose& start) {
 
 // Axes nothing plans (hand-fed ones) move as the operator moves them: the path, its contour and
 // the limits are those of the planned axes, so the others are held where the run started.
-TraceSample RunRecorder::planned_axes(const TraceSample& in) const {
-  TraceSample s = in;
+control::TraceSample RunRecorder::planned_axes(const control::TraceSample& in) const {
+  control::TraceSample s = in;
   for (int i = 0; i < kAxisCount; ++i) {
     if (limits_.axes.has(static_cast<Axis>(i))) continue;
     s.commanded[i] = s.actual[i] = s.output[i] = start_[i];
@@ -82,7 +82,7 @@ TraceSample RunRecorder::planned_axes(const TraceSample& in) const {
   return s;
 }
 
-void RunRecorder::add(const TraceSample& s, const TraceContext& c) {
+void RunRecorder::add(const control::TraceSample& s, const TraceContext& c) {
   if (c.program != commanded_.program()) {
     commanded_.set_program(c.program);
     actual_.set_program(c.program);
@@ -108,9 +108,9 @@ void RunRecorder::add(const TraceSample& s, const TraceContext& c) {
   add(s);
 }
 
-void RunRecorder::add(const TraceSample& in) {
+void RunRecorder::add(const control::TraceSample& in) {
   if (!started_) begin(in.commanded);
-  const TraceSample s = planned_axes(in);
+  const control::TraceSample s = planned_axes(in);
   // The compensation may still be taking something up when the run starts (the table switched
   // on at homing a moment ago): the drives' commands are checked from the third period on, with
   // the first two as their history.
@@ -168,7 +168,7 @@ TraceCsvWriter::TraceCsvWriter(OutputFile& out, AxisMask axes, double period_s)
   out_.write(head + '\n');
 }
 
-bool TraceCsvWriter::add(const TraceSample& s) {
+bool TraceCsvWriter::add(const control::TraceSample& s) {
   row_.clear();
   fmt::format_to(std::back_inserter(row_), "{:.4f},{},{},{},{},{},{:.6g}",
                  static_cast<double>(s.tick) * period_s_, to_string(s.state), motion_name(s.motion),
@@ -183,4 +183,4 @@ bool TraceCsvWriter::add(const TraceSample& s) {
   return out_.write(row_);
 }
 
-}  // namespace opencnc::control
+}  // namespace opencnc::controller

@@ -4,7 +4,7 @@
 
 #include <algorithm>
 
-namespace opencnc::control {
+namespace opencnc::controller {
 
 namespace {
 
@@ -39,13 +39,13 @@ plan::PlannerConfig planner_config(const config::MachineProfile& profile) {
   return c;
 }
 
-ServoConfig servo_config(const config::MachineProfile& profile) {
-  return servo_config(profile,
-                      plan::Planner(machine_limits(profile), planner_config(profile)).interpolator_config());
+control::ServoConfig servo_config(const config::MachineProfile& profile) {
+  return control::servo_config(
+      profile, plan::Planner(machine_limits(profile), planner_config(profile)).interpolator_config());
 }
 
-SharedSetup shared_setup(const config::MachineProfile& profile) {
-  return shared_setup(profile, servo_config(profile));
+control::SharedSetup shared_setup(const config::MachineProfile& profile) {
+  return control::shared_setup(profile, controller::servo_config(profile));
 }
 
-}  // namespace opencnc::control
+}  // namespace opencnc::controller

@@ -4,13 +4,13 @@
 
 #include "opencnc/controller/servo_setup.hpp"
 
-namespace opencnc::control {
+namespace opencnc::controller {
 
 SimRig::SimRig(const config::MachineProfile& profile, std::shared_ptr<ProgramSource> source,
                int service_every, ControllerOptions options)
-    : channels_(std::make_unique<ServoChannels>()),
+    : channels_(std::make_unique<control::ServoChannels>()),
       machine_(std::make_unique<machine::SimMachine>(config::sim_machine_config(profile))),
-      servo_(std::make_unique<Servo>(servo_config(profile), *channels_, *machine_)),
+      servo_(std::make_unique<control::Servo>(servo_config(profile), *channels_, *machine_)),
       controller_(std::make_unique<Controller>(profile, *channels_, std::move(source), options)),
       service_every_(service_every < 1 ? 1 : service_every) {}
 
@@ -48,7 +48,7 @@ Outcome SimRig::request(Request r, std::uint64_t max_ticks) {
     controller_->service();
     o = controller_->outcome(id);
   }
-  return o ? *o : Outcome{false, Refusal::Busy, "no answer", {}};
+  return o ? *o : Outcome{false, control::Refusal::Busy, "no answer", {}};
 }
 
-}  // namespace opencnc::control
+}  // namespace opencnc::controller

@@ -4,7 +4,7 @@
 
 #include <utility>
 
-namespace opencnc::control::detail {
+namespace opencnc::controller::detail {
 
 TaskRunner::~TaskRunner() {
   if (!thread_.joinable()) return;
@@ -46,4 +46,4 @@ void TaskRunner::loop() {
   }
 }
 
-}  // namespace opencnc::control::detail
+}  // namespace opencnc::controller::detail

@@ -11,7 +11,7 @@
 #include <mutex>
 #include <thread>
 
-namespace opencnc::control::detail {
+namespace opencnc::controller::detail {
 
 /// One task at a time. start(), idle(), finished() and collect() from the controller's thread.
 class TaskRunner {
@@ -45,4 +45,4 @@ class TaskRunner {
   std::thread thread_;
 };
 
-}  // namespace opencnc::control::detail
+}  // namespace opencnc::controller::detail

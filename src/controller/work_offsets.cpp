@@ -5,7 +5,7 @@
 
 #include "opencnc/controller/controller_status.hpp"
 
-namespace opencnc::control {
+namespace opencnc::controller {
 
 const char* work_system_name(std::uint8_t system) noexcept {
   static constexpr const char* kNames[] = {"G54", "G55",   "G56",   "G57",  "G58",
@@ -28,4 +28,4 @@ Pose work_position(const Pose& machine, const WorkOffsets& o) noexcept {
   return p;
 }
 
-}  // namespace opencnc::control
+}  // namespace opencnc::controller

@@ -17,7 +17,7 @@
 #include "opencnc/drill/setup.hpp"
 #include "opencnc/machine/sim_switch.hpp"
 
-namespace opencnc::control {
+namespace opencnc::drill {
 
 namespace {
 
@@ -33,23 +33,23 @@ double spread(const std::vector<double>& v) {
 }
 
 /// Hands every servo period's sample (homing included) to a function.
-class TraceForward final : public ControllerObserver {
+class TraceForward final : public controller::ControllerObserver {
  public:
-  explicit TraceForward(std::function<void(const TraceSample&)> f) : f_(std::move(f)) {}
-  void on_trace(const TraceSample& s, const TraceContext&) override { f_(s); }
+  explicit TraceForward(std::function<void(const control::TraceSample&)> f) : f_(std::move(f)) {}
+  void on_trace(const control::TraceSample& s, const controller::TraceContext&) override { f_(s); }
 
  private:
-  std::function<void(const TraceSample&)> f_;
+  std::function<void(const control::TraceSample&)> f_;
 };
 
 /// Runs `rig` until `done` holds; throws with the machine's fault when it faults or when
 /// `max_ticks` pass.
 template <typename F>
-void run_until(SimRig& rig, F done, std::uint64_t max_ticks, const char* what) {
+void run_until(controller::SimRig& rig, F done, std::uint64_t max_ticks, const char* what) {
   for (std::uint64_t i = 0; i < max_ticks; ++i) {
     rig.step();
-    const ControllerStatus s = rig.status();
-    if (s.servo.state == State::Faulted || s.servo.state == State::EStopped)
+    const controller::ControllerStatus s = rig.status();
+    if (s.servo.state == control::State::Faulted || s.servo.state == control::State::EStopped)
       throw std::runtime_error(fmt::format("{}: the machine stopped: {}", what, s.fault_text));
     if (done(s)) return;
   }
@@ -57,21 +57,24 @@ void run_until(SimRig& rig, F done, std::uint64_t max_ticks, const char* what) {
                                        static_cast<double>(max_ticks) * rig.servo().config().period_s));
 }
 
-void must(SimRig& rig, Request r, const char* what) {
-  const Outcome o = rig.request(std::move(r), 100000);
+void must(controller::SimRig& rig, controller::Request r, const char* what) {
+  const controller::Outcome o = rig.request(std::move(r), 100000);
   if (o.accepted) return;
   std::string why = o.message;
   for (const Diagnostic& d : o.diagnostics.items()) why += "; " + d.format();
   throw std::runtime_error(fmt::format("{}: {}", what, why));
 }
 
-void home(SimRig& rig) {
-  must(rig, Request::simple(CommandKind::MachineOn), "machine on");
+void home(controller::SimRig& rig) {
+  must(rig, controller::Request::simple(control::CommandKind::MachineOn), "machine on");
   if (!rig.controller().servo_config().homing_required) return;
-  must(rig, Request::set_mode(Mode::Manual), "manual mode");
-  must(rig, Request::home(), "home");
+  must(rig, controller::Request::set_mode(control::Mode::Manual), "manual mode");
+  must(rig, controller::Request::home(), "home");
   run_until(
-      rig, [](const ControllerStatus& s) { return s.servo.state == State::Idle && s.servo.all_homed; },
+      rig,
+      [](const controller::ControllerStatus& s) {
+        return s.servo.state == control::State::Idle && s.servo.all_homed;
+      },
       2'000'000, "homing");
 }
 
@@ -105,7 +108,8 @@ void evaluate(const std::vector<std::vector<double>>& up, const std::vector<std:
 }
 
 /// The linear cycles of one axis: up through the targets, back down, `approaches` times.
-AxisPositioning measure_axis(SimRig& rig, const config::AxisProfile& ax, const PositioningOptions& o) {
+AxisPositioning measure_axis(controller::SimRig& rig, const config::AxisProfile& ax,
+                             const PositioningOptions& o) {
   AxisPositioning a;
   const double home = ax.homing.position;
   const auto k0 = static_cast<long>(std::ceil((ax.min_limit + o.overrun - home) / o.interval - 1e-9));
@@ -117,10 +121,13 @@ AxisPositioning measure_axis(SimRig& rig, const config::AxisProfile& ax, const P
   const auto dwell = static_cast<std::uint64_t>(std::llround(o.dwell_s / period));
   const machine::SimJoint& joint = rig.machine().joint(ax.joint);
   const auto move = [&](double x) {
-    must(rig, Request::mdi(fmt::format("G90 G1 {}{:.6f} F{}", letter(ax.axis), x, o.feed)),
+    must(rig, controller::Request::mdi(fmt::format("G90 G1 {}{:.6f} F{}", letter(ax.axis), x, o.feed)),
          "positioning move");
     run_until(
-        rig, [](const ControllerStatus& s) { return !s.run_active && s.servo.state == State::Idle; },
+        rig,
+        [](const controller::ControllerStatus& s) {
+          return !s.run_active && s.servo.state == control::State::Idle;
+        },
         10'000'000, "positioning move");
     rig.run(dwell);
   };
@@ -168,16 +175,16 @@ HomingSpread homing_spread(const config::MachineProfile& profile, const HomingSp
     p.sim_temperature_c = profile.sim_temperature_c + o.temperature_swing_c * (unit(rng) - 0.5);
     r.temperature_min_c = std::min(r.temperature_min_c, p.sim_temperature_c);
     r.temperature_max_c = std::max(r.temperature_max_c, p.sim_temperature_c);
-    SimRig rig(p);
+    controller::SimRig rig(p);
     if (run == 0 && o.trace) {
-      rig.controller().attach(std::make_shared<TraceForward>(o.trace), ObserverOptions{0, true});
+      rig.controller().attach(std::make_shared<TraceForward>(o.trace), controller::ObserverOptions{0, true});
       rig.step();  // attached from here on
     }
     home(rig);
-    const ServoStatus s = rig.status().servo;
+    const control::ServoStatus s = rig.status().servo;
     for (const config::AxisProfile& a : p.axes) {
       if (!r.axes.has(a.axis)) continue;
-      const HomingStatus& h = s.homing[static_cast<std::size_t>(a.joint)];
+      const control::HomingStatus& h = s.homing[static_cast<std::size_t>(a.joint)];
       r.midpoint[static_cast<std::size_t>(index(a.axis))].push_back(0.5 * (h.rising_edge + h.falling_edge));
       r.rising[static_cast<std::size_t>(index(a.axis))].push_back(h.rising_edge);
     }
@@ -195,12 +202,12 @@ Positioning measure_positioning(const config::MachineProfile& profile, const Pos
   config::MachineProfile p = profile;
   p.sim_seed = o.seed;
   Diagnostics diags;
-  std::unique_ptr<MachineSetup> machine = MachineSetup::create(p, {}, diags);
+  std::unique_ptr<controller::MachineSetup> machine = controller::MachineSetup::create(p, {}, diags);
   if (!machine) throw std::runtime_error("the profile's tool table cannot be read");
   drill::setup(p, *machine);  // the machine's hand-fed axes wait for the operator, as in a run
-  SimRig rig(p, *machine);
+  controller::SimRig rig(p, *machine);
   home(rig);
-  must(rig, Request::set_mode(Mode::Mdi), "MDI mode");
+  must(rig, controller::Request::set_mode(control::Mode::Mdi), "MDI mode");
   Positioning r;
   for (const config::AxisProfile& ax : p.axes) {
     if (!o.axes.has(ax.axis)) continue;
@@ -231,4 +238,4 @@ config::CompensationProfile compensation_from(const AxisPositioning& m, const co
   return c;
 }
 
-}  // namespace opencnc::control
+}  // namespace opencnc::drill

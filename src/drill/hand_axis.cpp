@@ -7,7 +7,7 @@
 
 #include "opencnc/canon/arc_geometry.hpp"
 
-namespace opencnc::control {
+namespace opencnc::drill {
 
 namespace {
 
@@ -119,4 +119,4 @@ void HandAxisFilter::process_move(canon::Program& program, canon::SegmentId id) 
   for (int k = 0; k < plunges; ++k) program.add_action(after[static_cast<std::size_t>(k)]);
 }
 
-}  // namespace opencnc::control
+}  // namespace opencnc::drill

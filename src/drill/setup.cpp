@@ -15,24 +15,24 @@ char axis_letter(int axis) {
 }
 
 /// The hand-axis pass over every program's moves.
-class HandAxes final : public control::SourcePart {
+class HandAxisPart final : public controller::SourcePart {
  public:
-  explicit HandAxes(const control::HandAxes& hand) : hand_(hand) {}
-  std::unique_ptr<control::MovePass> pass() const override {
-    return std::make_unique<control::HandAxisFilter>(hand_);
+  explicit HandAxisPart(const drill::HandAxes& hand) : hand_(hand) {}
+  std::unique_ptr<controller::MovePass> pass() const override {
+    return std::make_unique<drill::HandAxisFilter>(hand_);
   }
 
  private:
-  control::HandAxes hand_;
+  drill::HandAxes hand_;
 };
 
 /// What the run waits for at a hand-fed axis, and the axis that left its place, in words.
-class Texts final : public control::EventTexts {
+class Texts final : public controller::EventTexts {
  public:
-  std::optional<control::EventNote> event_note(const control::ServoEvent& e, const config::MachineProfile&,
-                                               const control::ServoConfig&) const override {
+  std::optional<controller::EventNote> event_note(const control::ServoEvent& e, const config::MachineProfile&,
+                                                  const control::ServoConfig&) const override {
     if (e.kind != control::EventKind::HandAxisMoved) return std::nullopt;
-    return control::EventNote{
+    return controller::EventNote{
         Severity::Warning, "control.hand-axis",
         fmt::format("{} left the position the program needs ({:.4f} mm) while the table moved: feed hold",
                     axis_letter(e.axis), e.value)};
@@ -47,10 +47,10 @@ class Texts final : public control::EventTexts {
 
 }  // namespace
 
-bool setup(const config::MachineProfile& profile, control::MachineSetup& host) {
-  const control::HandAxes hand = control::hand_axes(profile);
+bool setup(const config::MachineProfile& profile, controller::MachineSetup& host) {
+  const drill::HandAxes hand = drill::hand_axes(profile);
   if (!hand.any()) return true;
-  host.add_source_part(std::make_shared<HandAxes>(hand));
+  host.add_source_part(std::make_shared<HandAxisPart>(hand));
   host.add_texts(std::make_shared<Texts>());
   return true;
 }

@@ -12,7 +12,7 @@
 
 #include "opencnc/machine/rotary_axis.hpp"
 
-namespace opencnc::control {
+namespace opencnc::edm {
 
 namespace {
 
@@ -128,4 +128,4 @@ std::optional<BAxisFit> fit_b_axis(std::span<const double> angles_deg, std::span
   return fit;
 }
 
-}  // namespace opencnc::control
+}  // namespace opencnc::edm

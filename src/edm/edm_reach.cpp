@@ -40,7 +40,7 @@ Reach wider(Reach a, const Reach& b) {
 
 /// The move's extent widened by an EDM orbit (both orbit axes) and axis jump (the tool axis, away
 /// from the work); a jump along the path stays on the path.
-void widen_by(const machine::EdmConfig& edm, const Reach& r, control::Extent& e) {
+void widen_by(const machine::EdmConfig& edm, const Reach& r, controller::Extent& e) {
   for (const std::int8_t a : edm.orbit_axes) {
     e.min[a] -= r.orbit_mm;
     e.max[a] += r.orbit_mm;
@@ -66,7 +66,7 @@ std::string reason(const Reach& r) {
 /// The shortest time move `id` can take: its widest axis' travel at that axis' max_velocity.
 double shortest_time_s(const canon::Program& program, canon::SegmentId id,
                        const control::ServoConfig& config) {
-  const control::Extent e = control::move_extent(program, id);
+  const controller::Extent e = controller::move_extent(program, id);
   double t = 0;
   for (int j = 0; j < config.joint_count; ++j) {
     const control::JointConfig& jc = config.joints[static_cast<std::size_t>(j)];
@@ -77,7 +77,8 @@ double shortest_time_s(const canon::Program& program, canon::SegmentId id,
 
 }  // namespace
 
-std::string ReachCheck::widen(const canon::Program& program, canon::SegmentId move, control::Extent& extent) {
+std::string ReachCheck::widen(const canon::Program& program, canon::SegmentId move,
+                              controller::Extent& extent) {
   if (!config_.edm.enabled) return "";
   const Reach r = reach_at(program, move);
   widen_by(config_.edm, r, extent);

@@ -25,10 +25,11 @@ struct Reach {
 /// back to the centre (its radius at the rate it grew) or a jump coming down: every move that may
 /// start within that time — each move's shortest possible time its widest axis' travel at that
 /// axis' max_velocity, so the count errs toward more moves. Non-real-time; one thread.
-class ReachCheck final : public control::MoveReach {
+class ReachCheck final : public controller::MoveReach {
  public:
   explicit ReachCheck(const control::ServoConfig& config) : config_(config) {}
-  std::string widen(const canon::Program& program, canon::SegmentId move, control::Extent& extent) override;
+  std::string widen(const canon::Program& program, canon::SegmentId move,
+                    controller::Extent& extent) override;
   void reset() override { program_ = nullptr; }
 
  private:

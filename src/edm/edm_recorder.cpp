@@ -8,12 +8,12 @@
 #include <algorithm>
 #include <cmath>
 
-namespace opencnc::control {
+namespace opencnc::edm {
 
 EdmRecorder::EdmRecorder(const machine::EdmConfig& edm, double period_s) : edm_(edm), period_s_(period_s) {}
 
-void EdmRecorder::on_trace(const TraceSample& s, const TraceContext& /*c*/) {
-  const EdmStatus& e = s.edm;
+void EdmRecorder::on_trace(const control::TraceSample& s, const controller::TraceContext& /*c*/) {
+  const control::EdmStatus& e = s.edm;
   if (first_) {
     jumps_at_start_ = e.jumps;
     first_ = false;
@@ -99,4 +99,4 @@ std::string EdmRecorder::report_json() const {
   return j.dump();
 }
 
-}  // namespace opencnc::control
+}  // namespace opencnc::edm

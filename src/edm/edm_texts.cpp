@@ -6,11 +6,11 @@
 
 namespace opencnc::edm {
 
-std::optional<control::EventNote> Texts::event_note(const control::ServoEvent& e,
-                                                    const config::MachineProfile&,
-                                                    const control::ServoConfig&) const {
+std::optional<controller::EventNote> Texts::event_note(const control::ServoEvent& e,
+                                                       const config::MachineProfile&,
+                                                       const control::ServoConfig&) const {
   if (e.kind != control::EventKind::EdmRetractLimit) return std::nullopt;
-  return control::EventNote{
+  return controller::EventNote{
       Severity::Warning, "control.edm.retract-limit",
       fmt::format("EDM condition {}: backing off reached the end of the path memory {:.3f} mm behind "
                   "the program; the electrode holds there and can go back no further",

@@ -7,11 +7,11 @@
 namespace opencnc::edm {
 
 /// The gap servo's event (EdmRetractLimit) and fault (EdmShort) in words. Controller thread.
-class Texts final : public control::EventTexts {
+class Texts final : public controller::EventTexts {
  public:
-  std::optional<control::EventNote> event_note(const control::ServoEvent& e,
-                                               const config::MachineProfile& profile,
-                                               const control::ServoConfig& servo) const override;
+  std::optional<controller::EventNote> event_note(const control::ServoEvent& e,
+                                                  const config::MachineProfile& profile,
+                                                  const control::ServoConfig& servo) const override;
   std::optional<std::string> fault_text(const control::Fault& f, const config::MachineProfile& profile,
                                         const control::ServoConfig& servo) const override;
 };

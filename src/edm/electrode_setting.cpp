@@ -14,19 +14,19 @@
 #include "opencnc/canon/program_builder.hpp"
 #include "opencnc/edm/sphere_fit.hpp"
 
-namespace opencnc::control {
+namespace opencnc::edm {
 
 namespace {
 
-Outcome refuse(std::string why) {
-  Outcome o;
-  o.refusal = Refusal::BadValue;
+controller::Outcome refuse(std::string why) {
+  controller::Outcome o;
+  o.refusal = control::Refusal::BadValue;
   o.message = std::move(why);
   return o;
 }
 
-Outcome accept(std::string message) {
-  Outcome o;
+controller::Outcome accept(std::string message) {
+  controller::Outcome o;
   o.accepted = true;
   o.message = std::move(message);
   return o;
@@ -285,7 +285,8 @@ void ElectrodeSetting::set_phase(ElectrodePhase p) {
   phase_ = p;
 }
 
-Outcome ElectrodeSetting::handle(const requests::Feature& request, FeatureHost& host) {
+controller::Outcome ElectrodeSetting::handle(const controller::requests::Feature& request,
+                                             controller::FeatureHost& host) {
   host_ = &host;
   if (request.action == "measure") {
     const auto* args = std::any_cast<ElectrodeMeasure>(&request.args);
@@ -304,8 +305,9 @@ Outcome ElectrodeSetting::handle(const requests::Feature& request, FeatureHost& 
       fmt::format("electrode: unknown action \"{}\" (measure, write, resume, calibrate-b)", request.action));
 }
 
-Outcome ElectrodeSetting::measure(const ElectrodeMeasure& args, FeatureHost& host) {
-  if (std::optional<Outcome> refused = start_measurement(args.tool, args.b_deg, host)) return *refused;
+controller::Outcome ElectrodeSetting::measure(const ElectrodeMeasure& args, controller::FeatureHost& host) {
+  if (std::optional<controller::Outcome> refused = start_measurement(args.tool, args.b_deg, host))
+    return *refused;
   write_ = args.write;
   set_phase(ElectrodePhase::Measuring);
   next_touch();
@@ -315,13 +317,13 @@ Outcome ElectrodeSetting::measure(const ElectrodeMeasure& args, FeatureHost& hos
 
 // The checks and the plan of one measurement with B at `b_deg` (the profile's b if absent): a
 // refusal, or nothing when the touches are planned.
-std::optional<Outcome> ElectrodeSetting::start_measurement(int tool, std::optional<double> b_deg,
-                                                           FeatureHost& host) {
+std::optional<controller::Outcome> ElectrodeSetting::start_measurement(int tool, std::optional<double> b_deg,
+                                                                       controller::FeatureHost& host) {
   if (!sphere_.present) return refuse("the profile has no [probe.reference_sphere]");
   if (phase() != ElectrodePhase::Idle)
     return refuse(fmt::format("electrode setting is {}", to_string(phase())));
-  const ControllerStatus& s = host.current_status();
-  if (s.servo.state != State::Idle || s.run_active)
+  const controller::ControllerStatus& s = host.current_status();
+  if (s.servo.state != control::State::Idle || s.run_active)
     return refuse(fmt::format("the machine is not idle ({}{})", to_string(s.servo.state),
                               s.run_active ? ", a job runs" : ""));
   if (!s.servo.all_homed) return refuse("the machine is not homed");
@@ -359,7 +361,7 @@ std::optional<Outcome> ElectrodeSetting::start_measurement(int tool, std::option
   return std::nullopt;
 }
 
-Outcome ElectrodeSetting::calibrate_b(const BAxisCalibrate& args, FeatureHost& host) {
+controller::Outcome ElectrodeSetting::calibrate_b(const BAxisCalibrate& args, controller::FeatureHost& host) {
   if (!axes_.has(Axis::B)) return refuse("the machine has no B axis");
   std::vector<double> distinct = args.angles_deg;
   std::sort(distinct.begin(), distinct.end());
@@ -373,7 +375,7 @@ Outcome ElectrodeSetting::calibrate_b(const BAxisCalibrate& args, FeatureHost& h
         "calibrate-b looks for the sphere where B's nominal axis turns it: give "
         "probe.reference_sphere.b_axis "
         "from the machine's drawing (within the touches' clearance)");
-  if (std::optional<Outcome> refused = start_measurement(args.tool, args.angles_deg[0], host))
+  if (std::optional<controller::Outcome> refused = start_measurement(args.tool, args.angles_deg[0], host))
     return *refused;
   calibration_ = BAxisResult{};
   calibration_.tool = args.tool;
@@ -398,7 +400,8 @@ void ElectrodeSetting::next_calibration_angle(const ElectrodeResult& r) {
   c.centres.push_back(r.centre);
   if (c.centres.size() < c.angles_deg.size()) {
     set_phase(ElectrodePhase::Idle);
-    if (std::optional<Outcome> refused = start_measurement(c.tool, c.angles_deg[c.centres.size()], *host_)) {
+    if (std::optional<controller::Outcome> refused =
+            start_measurement(c.tool, c.angles_deg[c.centres.size()], *host_)) {
       c.code = "electrode.refused";
       c.message = fmt::format("with B at {:g}°: {}", c.angles_deg[c.centres.size()], refused->message);
       return finish_calibration();
@@ -454,19 +457,19 @@ void ElectrodeSetting::next_touch() {
   next_aux_ = touch_program(axes_, host_->current_status().servo.commanded, t, at_,
                             touch_ == 0 && axes_.has(Axis::B));
   next_aux_name_ = fmt::format("electrode touch {}", t.name);
-  if (host_->current_status().servo.mode != Mode::Auto)
-    pending_ = host_->submit(Request::set_mode(Mode::Auto));
+  if (host_->current_status().servo.mode != control::Mode::Auto)
+    pending_ = host_->submit(controller::Request::set_mode(control::Mode::Auto));
 }
 
-Outcome ElectrodeSetting::resume(FeatureHost& host) {
+controller::Outcome ElectrodeSetting::resume(controller::FeatureHost& host) {
   if (phase() != ElectrodePhase::Idle)
     return refuse(fmt::format("electrode setting is {}", to_string(phase())));
   const std::optional<ProgramStop> at = stop();
   if (!at) return refuse("no program stopped before its end since it was opened");
   const std::optional<ElectrodeResult> r = last();
   if (!r || !r->ok || !stop_offset_) return refuse("measure the new electrode first (electrode measure)");
-  const ControllerStatus& s = host.current_status();
-  if (s.servo.state != State::Idle || s.run_active) return refuse("the machine is not idle");
+  const controller::ControllerStatus& s = host.current_status();
+  if (s.servo.state != control::State::Idle || s.run_active) return refuse("the machine is not idle");
   // The program's path moves with the tool's offsets (G43 adds them): so does the point to go on from.
   Pose target = at->position;
   for (std::size_t i = 0; i < 3; ++i) target[static_cast<int>(i)] += r->offset[i] - (*stop_offset_)[i];
@@ -496,40 +499,43 @@ Outcome ElectrodeSetting::resume(FeatureHost& host) {
   next_aux_ = std::make_shared<canon::Program>(b.take());
   next_aux_name_ = "electrode approach";
   set_phase(ElectrodePhase::Approaching);
-  if (s.servo.mode != Mode::Auto) pending_ = host.submit(Request::set_mode(Mode::Auto));
+  if (s.servo.mode != control::Mode::Auto)
+    pending_ = host.submit(controller::Request::set_mode(control::Mode::Auto));
   return accept(
       fmt::format("back to where the program stopped (segment {}), moved by the new offsets", at->segment));
 }
 
 // --- the state machine -----------------------------------------------------------------------
 
-void ElectrodeSetting::on_trace(const TraceSample& s, const TraceContext& c) {
-  if (c.job != JobKind::Program || c.program == nullptr || s.activity != Activity::Program) return;
+void ElectrodeSetting::on_trace(const control::TraceSample& s, const controller::TraceContext& c) {
+  if (c.job != controller::JobKind::Program || c.program == nullptr ||
+      s.activity != control::Activity::Program)
+    return;
   if (s.segment < c.program->first_held_move() || s.segment >= c.program->size()) return;
   running_segment_ = c.program->segment_of(s.segment);
   running_position_ = s.commanded;
   running_seen_ = true;
 }
 
-void ElectrodeSetting::on_event(const ControllerEvent& e) {
+void ElectrodeSetting::on_event(const controller::ControllerEvent& e) {
   switch (e.kind) {
-    case ControllerEventKind::ProgramOpened: {
+    case controller::ControllerEventKind::ProgramOpened: {
       std::lock_guard lock(mutex_);
       stop_.reset();
       stop_offset_.reset();
       running_seen_ = false;
       return;
     }
-    case ControllerEventKind::JobStarted:
-      if (e.job == JobKind::Program) {
+    case controller::ControllerEventKind::JobStarted:
+      if (e.job == controller::JobKind::Program) {
         running_seen_ = false;
         if (phase() == ElectrodePhase::Resuming) set_phase(ElectrodePhase::Idle);
       }
       return;
-    case ControllerEventKind::JobEnded:
-      if (e.job == JobKind::Program) {
+    case controller::ControllerEventKind::JobEnded:
+      if (e.job == controller::JobKind::Program) {
         std::lock_guard lock(mutex_);
-        if (e.end == JobEnd::Finished) {
+        if (e.end == controller::JobEnd::Finished) {
           stop_.reset();
         } else if (running_seen_) {
           stop_ = ProgramStop{running_segment_, running_position_};
@@ -537,9 +543,9 @@ void ElectrodeSetting::on_event(const ControllerEvent& e) {
         }
         return;
       }
-      if (e.job == JobKind::Auxiliary) when_aux_ended(e);
+      if (e.job == controller::JobKind::Auxiliary) when_aux_ended(e);
       return;
-    case ControllerEventKind::Answer:
+    case controller::ControllerEventKind::Answer:
       if (e.request_id == pending_ && !e.accepted && phase() != ElectrodePhase::Idle) {
         next_aux_.reset();
         const ElectrodePhase was = phase();
@@ -554,23 +560,25 @@ void ElectrodeSetting::on_event(const ControllerEvent& e) {
   }
 }
 
-void ElectrodeSetting::on_status(const ControllerStatus& s) {
+void ElectrodeSetting::on_status(const controller::ControllerStatus& s) {
   // Auto mode asked for an auxiliary program: it starts once the servo has switched.
-  if (!next_aux_ || s.servo.mode != Mode::Auto || s.servo.state != State::Idle || s.run_active) return;
+  if (!next_aux_ || s.servo.mode != control::Mode::Auto || s.servo.state != control::State::Idle ||
+      s.run_active)
+    return;
   auto program = std::move(next_aux_);
   next_aux_.reset();
-  pending_ = host_->submit(Request::run_auxiliary(next_aux_name_, std::move(program)));
+  pending_ = host_->submit(controller::Request::run_auxiliary(next_aux_name_, std::move(program)));
 }
 
-void ElectrodeSetting::when_aux_ended(const ControllerEvent& e) {
+void ElectrodeSetting::when_aux_ended(const controller::ControllerEvent& e) {
   if (host_ == nullptr) return;
   switch (phase()) {
     case ElectrodePhase::Measuring:
     case ElectrodePhase::Calibrating: {
-      if (e.end != JobEnd::Finished)
+      if (e.end != controller::JobEnd::Finished)
         return fail("electrode.stopped", fmt::format("the touch from {} did not finish ({})",
                                                      plan_[touch_].name, to_string(e.end)));
-      const ServoStatus& servo = host_->current_status().servo;
+      const control::ServoStatus& servo = host_->current_status().servo;
       const SphereTouch& t = slow_ ? slow_line_ : plan_[touch_];
       const char* const stage = slow_ ? "slow touch" : "touch";
       const double within = slow_ ? at_.back_off : at_.clearance;
@@ -589,13 +597,13 @@ void ElectrodeSetting::when_aux_ended(const ControllerEvent& e) {
       return touched(at);
     }
     case ElectrodePhase::Approaching:
-      if (e.end != JobEnd::Finished) {
+      if (e.end != controller::JobEnd::Finished) {
         host_->note(Severity::Error, "electrode.stopped", "electrode resume: the approach did not finish");
         set_phase(ElectrodePhase::Idle);
         return;
       }
       set_phase(ElectrodePhase::Resuming);
-      pending_ = host_->submit(Request::resume(stop()->segment));
+      pending_ = host_->submit(controller::Request::resume(stop()->segment));
       return;
     default:
       return;
@@ -611,8 +619,8 @@ void ElectrodeSetting::touched(const Vec3& at) {
                                    slow_line_);
     next_aux_name_ = fmt::format("electrode slow touch {}", plan_[touch_].name);
     slow_ = true;
-    if (host_->current_status().servo.mode != Mode::Auto)
-      pending_ = host_->submit(Request::set_mode(Mode::Auto));
+    if (host_->current_status().servo.mode != control::Mode::Auto)
+      pending_ = host_->submit(controller::Request::set_mode(control::Mode::Auto));
     return;
   }
   touched_.push_back(at);
@@ -658,7 +666,7 @@ bool ElectrodeSetting::store(ElectrodeResult& r) {
 
 // After a measurement kept for the operator's look: stored only if the table still holds the
 // offsets it was measured against (nobody changed the tool meanwhile).
-Outcome ElectrodeSetting::write() {
+controller::Outcome ElectrodeSetting::write() {
   if (phase() != ElectrodePhase::Idle)
     return refuse(fmt::format("electrode setting is {}", to_string(phase())));
   std::optional<ElectrodeResult> r = last();
@@ -707,7 +715,7 @@ void ElectrodeSetting::fail(std::string code, std::string message) {
   host_->note(Severity::Error, r.code, fmt::format("electrode setting: {} (nothing stored)", r.message));
 }
 
-std::string ElectrodeSetting::state_json(const ControllerStatus&) {
+std::string ElectrodeSetting::state_json(const controller::ControllerStatus&) {
   using nlohmann::json;
   json last = nullptr;
   if (const std::optional<ElectrodeResult> r = this->last()) {
@@ -739,4 +747,4 @@ std::string ElectrodeSetting::state_json(const ControllerStatus&) {
       .dump();
 }
 
-}  // namespace opencnc::control
+}  // namespace opencnc::edm

@@ -28,7 +28,7 @@ std::vector<int> condition_numbers(const config::MachineProfile& profile) {
 }
 
 /// M180/M181 on top of the dialect's modules, M180 P checked against the profile's conditions.
-class Codes final : public control::SourcePart {
+class Codes final : public controller::SourcePart {
  public:
   explicit Codes(std::vector<int> numbers) : numbers_(std::move(numbers)) {}
   std::shared_ptr<const gcode::Extensions> modules(
@@ -36,7 +36,7 @@ class Codes final : public control::SourcePart {
     return gcode::edm_extensions(dialect, numbers_, std::move(base));
   }
   // A condition added or deleted: programs opened afterwards read M180 against the new numbers.
-  std::shared_ptr<const control::SourcePart> for_profile(
+  std::shared_ptr<const controller::SourcePart> for_profile(
       const config::MachineProfile& profile) const override {
     std::vector<int> numbers = condition_numbers(profile);
     return numbers == numbers_ ? nullptr : std::make_shared<Codes>(std::move(numbers));
@@ -51,11 +51,11 @@ class Codes final : public control::SourcePart {
 /// condition's selection to M181. At the rate the front end asks for its state, so a depth the
 /// electrode held between two of its statuses only is missed (the report's, from every period, is
 /// exact).
-class Depth final : public control::FeatureState {
+class Depth final : public controller::FeatureState {
  public:
   explicit Depth(const machine::EdmConfig& edm) : edm_(edm) {}
   std::string state_key() const override { return "edm"; }
-  std::string state_json(const control::ControllerStatus& s) override {
+  std::string state_json(const controller::ControllerStatus& s) override {
     const double along = s.servo.actual[static_cast<std::size_t>(edm_.tool_axis)];
     if (!s.servo.edm.on) {
       burning_ = false;
@@ -76,24 +76,24 @@ class Depth final : public control::FeatureState {
 
 }  // namespace
 
-bool setup(const config::MachineProfile& profile, control::MachineSetup& host) {
+bool setup(const config::MachineProfile& profile, controller::MachineSetup& host) {
   if (profile.edm.present) {
     host.add_source_part(std::make_shared<Codes>(condition_numbers(profile)));
-    host.add_move_reach([](const control::ServoConfig& servo) -> std::unique_ptr<control::MoveReach> {
+    host.add_move_reach([](const control::ServoConfig& servo) -> std::unique_ptr<controller::MoveReach> {
       if (!servo.edm.enabled) return nullptr;
       return std::make_unique<ReachCheck>(servo);
     });
     host.add_texts(std::make_shared<Texts>());
     host.add_state(std::make_shared<Depth>(profile.edm.config));
     if (host.reports())
-      host.add_observer(std::make_shared<control::EdmRecorder>(profile.edm.config, profile.servo_period_s),
-                        control::ObserverOptions{0, true});
+      host.add_observer(std::make_shared<edm::EdmRecorder>(profile.edm.config, profile.servo_period_s),
+                        controller::ObserverOptions{0, true});
   }
   // The electrode setting measures into the program source's tool table; it follows the trace
   // (the segment a stopped program stood at).
   if (profile.probe.reference_sphere.present && host.source_config().tools) {
-    auto electrode = std::make_shared<control::ElectrodeSetting>(host.source_config().tools, profile);
-    host.add_feature(electrode, control::ObserverOptions{profile.servo_period_s, true});
+    auto electrode = std::make_shared<edm::ElectrodeSetting>(host.source_config().tools, profile);
+    host.add_feature(electrode, controller::ObserverOptions{profile.servo_period_s, true});
     host.add_state(electrode);
   }
   return true;

@@ -8,7 +8,7 @@
 #include <algorithm>
 #include <cmath>
 
-namespace opencnc::control {
+namespace opencnc::edm {
 
 namespace {
 
@@ -53,4 +53,4 @@ std::optional<SphereFit> fit_sphere(std::span<const Vec3> points, double radius,
   return fit;
 }
 
-}  // namespace opencnc::control
+}  // namespace opencnc::edm

@@ -13,17 +13,17 @@
 
 namespace opencnc::features {
 
-bool set_up(control::MachineSetup& host) {
+bool set_up(controller::MachineSetup& host) {
   const config::MachineProfile& p = host.profile();
   return toolguard::setup(p, host) && drill::setup(p, host) && broaching::setup(p, host) &&
          edm::setup(p, host) && retrace::setup(p, host) && run_from_line::setup(p, host);
 }
 
-std::unique_ptr<control::MachineSetup> machine_setup(const config::MachineProfile& profile,
-                                                     Diagnostics& diags,
-                                                     control::MachineSetup::Options options) {
-  std::unique_ptr<control::MachineSetup> m =
-      control::MachineSetup::create(profile, std::move(options), diags);
+std::unique_ptr<controller::MachineSetup> machine_setup(const config::MachineProfile& profile,
+                                                        Diagnostics& diags,
+                                                        controller::MachineSetup::Options options) {
+  std::unique_ptr<controller::MachineSetup> m =
+      controller::MachineSetup::create(profile, std::move(options), diags);
   if (!m) return nullptr;
   const bool ok = set_up(*m);
   for (const Diagnostic& d : m->diagnostics().items()) diags.add(d);

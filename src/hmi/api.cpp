@@ -18,7 +18,7 @@ namespace opencnc::hmi {
 namespace {
 
 using control::CommandKind;
-using control::Request;
+using controller::Request;
 using nlohmann::json;
 
 /// Thrown inside parse_command for a field that is missing, mistyped or out of range.
@@ -268,7 +268,7 @@ Command parse(const json& body, const config::MachineProfile& p, const std::file
     if (line != std::floor(line) || line < 1 || line > 1e9)
       throw Bad{422, "\"line\" must be a line number from 1"};
     return Request::feature("run-from-line", "start",
-                            control::RunFromLineArgs{static_cast<std::uint32_t>(line)});
+                            run_from_line::RunFromLineArgs{static_cast<std::uint32_t>(line)});
   }
   if (kind == "simulate") return simulation_event(body);
   if (kind == "feature") {
@@ -309,7 +309,7 @@ const char* severity_name(Severity s) {
   return s == Severity::Error ? "error" : s == Severity::Warning ? "warning" : "note";
 }
 
-json location_json(const control::SourceLocation& l) {
+json location_json(const controller::SourceLocation& l) {
   return {{"file", l.file}, {"line", l.line}, {"calls", l.calls}};
 }
 
@@ -343,7 +343,7 @@ std::variant<Command, ApiError> parse_command(const json& body, const config::Ma
   }
 }
 
-json status_json(const control::ControllerStatus& s, const config::MachineProfile& profile) {
+json status_json(const controller::ControllerStatus& s, const config::MachineProfile& profile) {
   const control::ServoStatus& v = s.servo;
   json fe = json::object(), homed = json::object(), seek = json::object();
   for (const config::AxisProfile& a : profile.axes) {
@@ -370,10 +370,10 @@ json status_json(const control::ControllerStatus& s, const config::MachineProfil
       {"wait_text", s.wait_text},
       {"machine", axes_json(v.actual, n, profile)},
       {"commanded", axes_json(v.commanded, n, profile)},
-      {"work", axes_json(control::work_position(v.actual, s.offsets), n, profile)},
+      {"work", axes_json(controller::work_position(v.actual, s.offsets), n, profile)},
       {"distance_to_go", axes_json(s.distance_to_go, n, profile)},
       {"offsets",
-       {{"system", control::work_system_name(s.offsets.system)},
+       {{"system", controller::work_system_name(s.offsets.system)},
         {"g5x", axes_json(s.offsets.g5x, n, profile)},
         {"g92", axes_json(s.offsets.g92, n, profile)},
         {"tool", axes_json(s.offsets.tool, n, profile)},
@@ -402,7 +402,7 @@ json status_json(const control::ControllerStatus& s, const config::MachineProfil
       {"fault", s.fault_text},
       {"program", {{"name", s.program_name}, {"moves", s.program_moves}, {"length_mm", s.program_length_mm}}},
       {"job",
-       {{"kind", control::to_string(s.job)},
+       {{"kind", controller::to_string(s.job)},
         {"id", s.job_id},
         {"name", s.job_name},
         {"active", s.run_active},
@@ -410,7 +410,7 @@ json status_json(const control::ControllerStatus& s, const config::MachineProfil
         {"progress", s.progress},
         {"location", location_json(s.location)},
         {"interpreter", location_json(s.interpreter)}}},
-      {"sync_wait", control::to_string(s.sync_wait)},
+      {"sync_wait", controller::to_string(s.sync_wait)},
       {"runs_finished", s.runs_finished},
       {"limits_version", s.limits_version},
   };
@@ -418,29 +418,29 @@ json status_json(const control::ControllerStatus& s, const config::MachineProfil
   return j;
 }
 
-json event_json(const control::ControllerEvent& e) {
+json event_json(const controller::ControllerEvent& e) {
   json j{{"seq", e.seq},
          {"tick", e.tick},
-         {"kind", control::to_string(e.kind)},
+         {"kind", controller::to_string(e.kind)},
          {"severity", severity_name(e.severity)},
          {"code", e.code},
          {"text", e.text}};
   switch (e.kind) {
-    case control::ControllerEventKind::Answer:
+    case controller::ControllerEventKind::Answer:
       j["request"] = e.request_id;
       j["accepted"] = e.accepted;
       break;
-    case control::ControllerEventKind::JobStarted:
-    case control::ControllerEventKind::JobEnded:
-      j["job"] = {{"kind", control::to_string(e.job)}, {"id", e.job_id}};
-      if (e.kind == control::ControllerEventKind::JobEnded) {
-        j["end"] = control::to_string(e.end);
+    case controller::ControllerEventKind::JobStarted:
+    case controller::ControllerEventKind::JobEnded:
+      j["job"] = {{"kind", controller::to_string(e.job)}, {"id", e.job_id}};
+      if (e.kind == controller::ControllerEventKind::JobEnded) {
+        j["end"] = controller::to_string(e.end);
         j["location"] = location_json(e.location);
       }
       break;
-    case control::ControllerEventKind::SyncWait:
-    case control::ControllerEventKind::SyncDone:
-      j["sync"] = control::to_string(e.sync);
+    case controller::ControllerEventKind::SyncWait:
+    case controller::ControllerEventKind::SyncDone:
+      j["sync"] = controller::to_string(e.sync);
       j["location"] = location_json(e.location);
       break;
     default:
@@ -449,7 +449,7 @@ json event_json(const control::ControllerEvent& e) {
   return j;
 }
 
-json outcome_json(std::uint64_t id, const control::Outcome& o) {
+json outcome_json(std::uint64_t id, const controller::Outcome& o) {
   json diags = json::array();
   for (const Diagnostic& d : o.diagnostics.items()) {
     diags.push_back({{"severity", severity_name(d.severity)}, {"text", d.format()}, {"code", d.code}});

@@ -50,7 +50,7 @@ ParametersRequest parameters_request(const json& body, const config::MachineProf
     }
     edits.push_back({key, config::toml_number(v)});
   }
-  r.request = control::Request::edit_profile(std::move(edits));
+  r.request = controller::Request::edit_profile(std::move(edits));
   return r;
 }
 
@@ -148,7 +148,7 @@ ParametersRequest compensation_request(const json& body, const config::MachinePr
   }
   edits.push_back({base + "forward", forward});
   edits.push_back({base + "reverse", reverse});
-  r.request = control::Request::edit_profile(std::move(edits));
+  r.request = controller::Request::edit_profile(std::move(edits));
   return r;
 }
 
@@ -288,7 +288,7 @@ ParametersRequest conditions_request(const json& body, const config::MachineProf
     if (toml.empty()) return r;
     edits.push_back({fmt::format("edm.condition.{}.{}", n, key), toml});
   }
-  r.request = control::Request::edit_profile(std::move(edits));
+  r.request = controller::Request::edit_profile(std::move(edits));
   return r;
 }
 
@@ -332,7 +332,7 @@ ParametersRequest condition_change_request(const json& body, const config::Machi
       return r;
     }
   }
-  r.request = control::Request::change_conditions({change});
+  r.request = controller::Request::change_conditions({change});
   return r;
 }
 

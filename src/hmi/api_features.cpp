@@ -18,7 +18,7 @@ namespace opencnc::hmi {
 
 namespace {
 
-using control::Request;
+using controller::Request;
 using nlohmann::json;
 
 struct Refused {
@@ -132,7 +132,7 @@ Request electrode(const std::string& action, const json& body) {
       write = body["write"].get<bool>();
     }
     if (write) confirmed(body, "storing the measured offsets");
-    control::ElectrodeMeasure m{static_cast<int>(t), write, std::nullopt};
+    edm::ElectrodeMeasure m{static_cast<int>(t), write, std::nullopt};
     if (body.contains("b_deg")) m.b_deg = required(body, "b_deg", -100000, 100000);
     return Request::feature("electrode", "measure", m);
   }
@@ -142,7 +142,7 @@ Request electrode(const std::string& action, const json& body) {
     const auto angles = body.find("angles_deg");
     if (angles == body.end() || !angles->is_array() || angles->size() < 3 || angles->size() > 64)
       throw Refused{400, "\"angles_deg\" must be a list of 3 to 64 B angles, degrees"};
-    control::BAxisCalibrate c{static_cast<int>(t), {}};
+    edm::BAxisCalibrate c{static_cast<int>(t), {}};
     for (const json& a : *angles) {
       if (!a.is_number() || !std::isfinite(a.get<double>()))
         throw Refused{400, "\"angles_deg\" must be a list of 3 to 64 B angles, degrees"};
@@ -181,8 +181,8 @@ Request tool_guard(const std::string& action, const json& body) {
 
 }  // namespace
 
-std::variant<control::Request, ApiError> parse_feature_command(const json& body,
-                                                               const config::MachineProfile& profile) {
+std::variant<controller::Request, ApiError> parse_feature_command(const json& body,
+                                                                  const config::MachineProfile& profile) {
   try {
     const std::string feature = text_or(body, "feature", "");
     const std::string action = text_or(body, "action", "");

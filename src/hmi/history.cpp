@@ -230,13 +230,13 @@ std::string History::last_error() const {
   return last_error_;
 }
 
-void HistoryRecorder::on_event(const control::ControllerEvent& e) {
-  using control::ControllerEventKind;
+void HistoryRecorder::on_event(const controller::ControllerEvent& e) {
+  using controller::ControllerEventKind;
   if (e.kind == ControllerEventKind::JobStarted &&
-      (e.job == control::JobKind::Program || e.job == control::JobKind::Auxiliary)) {
+      (e.job == controller::JobKind::Program || e.job == controller::JobKind::Auxiliary)) {
     JobRecord r;
     r.job_id = e.job_id;
-    r.kind = control::to_string(e.job);
+    r.kind = controller::to_string(e.job);
     r.program = e.text;
     r.started_utc = utc_now();
     running_ = std::move(r);
@@ -246,7 +246,7 @@ void HistoryRecorder::on_event(const control::ControllerEvent& e) {
     running_->alarms.push_back(e.code.empty() ? e.text : fmt::format("{} [{}]", e.text, e.code));
   } else if (running_ && e.kind == ControllerEventKind::JobEnded && e.job_id == running_->job_id) {
     running_->ended_utc = utc_now();
-    running_->outcome = control::to_string(e.end);
+    running_->outcome = controller::to_string(e.end);
     running_->machining_s = static_cast<double>(e.tick - started_tick_) * period_s_;
     running_->end_line = e.location.line;
     history_->add(std::move(*running_));

@@ -12,10 +12,10 @@ namespace opencnc::hmi {
 using nlohmann::json;
 
 /// Follows the status on the controller's thread and stores the features' state for the server.
-class MachineFeatures::Board final : public control::ControllerObserver {
+class MachineFeatures::Board final : public controller::ControllerObserver {
  public:
   explicit Board(MachineFeatures& owner) : owner_(owner) {}
-  void on_status(const control::ControllerStatus& s) override {
+  void on_status(const controller::ControllerStatus& s) override {
     json j = owner_.snapshot(s);
     std::lock_guard lock(owner_.mutex_);
     owner_.state_ = std::move(j);
@@ -27,9 +27,10 @@ class MachineFeatures::Board final : public control::ControllerObserver {
 
 std::unique_ptr<MachineFeatures> MachineFeatures::create(const config::MachineProfile& profile,
                                                          const FeatureOptions& options, Diagnostics& diags) {
-  control::MachineSetup::Options o;
+  controller::MachineSetup::Options o;
   if (!options.journal_dir.empty()) o.settings["journal"] = options.journal_dir;
-  std::unique_ptr<control::MachineSetup> setup = control::MachineSetup::create(profile, std::move(o), diags);
+  std::unique_ptr<controller::MachineSetup> setup =
+      controller::MachineSetup::create(profile, std::move(o), diags);
   if (!setup) return nullptr;
   const bool ok = features::set_up(*setup);
   for (const Diagnostic& d : setup->diagnostics().items()) diags.add(d);
@@ -48,12 +49,13 @@ bool MachineFeatures::has(std::string_view name) const {
   return std::find(names_.begin(), names_.end(), name) != names_.end();
 }
 
-void MachineFeatures::install(control::Controller& controller) {
+void MachineFeatures::install(controller::Controller& controller) {
   setup_->install(controller);
   // Attached after the features: it sees their state of the same period. 50 Hz is above the
   // stream's default rate.
   const double period = setup_->profile().servo_period_s;
-  controller.attach(std::make_shared<Board>(*this), control::ObserverOptions{std::max(period, 0.02), false});
+  controller.attach(std::make_shared<Board>(*this),
+                    controller::ObserverOptions{std::max(period, 0.02), false});
 }
 
 json MachineFeatures::status() const {
@@ -61,7 +63,7 @@ json MachineFeatures::status() const {
   return state_;
 }
 
-json MachineFeatures::snapshot(const control::ControllerStatus& s) {
+json MachineFeatures::snapshot(const controller::ControllerStatus& s) {
   json j{{"installed", names_}};
   for (const auto& state : setup_->states()) j[state->state_key()] = json::parse(state->state_json(s));
   return j;

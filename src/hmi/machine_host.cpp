@@ -18,23 +18,23 @@
 namespace opencnc::hmi {
 
 MachineHost::MachineHost(const config::MachineProfile& profile,
-                         std::shared_ptr<control::ProgramSource> source, HostOptions options)
+                         std::shared_ptr<controller::ProgramSource> source, HostOptions options)
     : options_(options), period_s_(profile.servo_period_s) {
   if (options_.realtime) {
     channels_ = std::make_unique<control::ServoChannels>();
     sim_ = std::make_unique<machine::SimMachine>(config::sim_machine_config(profile));
-    servo_ = std::make_unique<control::Servo>(control::servo_config(profile), *channels_, *sim_);
+    servo_ = std::make_unique<control::Servo>(controller::servo_config(profile), *channels_, *sim_);
     // The servo ticks by itself: the controller's long work never holds back its loop.
-    controller_ = std::make_unique<control::Controller>(
-        profile, *channels_, std::move(source), control::ControllerOptions{.long_work_on_thread = true});
+    controller_ = std::make_unique<controller::Controller>(
+        profile, *channels_, std::move(source), controller::ControllerOptions{.long_work_on_thread = true});
     control::RealtimeClock::Options clock;
     clock.period_ns = static_cast<std::int64_t>(profile.servo_period_s * 1e9 + 0.5);
     clock.cpu = options_.servo_cpu;
     clock_ = std::make_unique<control::RealtimeClock>(clock);
   } else {
     // Paced virtual time keeps up with the wall clock while a program is checked, as real time would.
-    rig_ = std::make_unique<control::SimRig>(profile, std::move(source), 1,
-                                             control::ControllerOptions{.long_work_on_thread = true});
+    rig_ = std::make_unique<controller::SimRig>(profile, std::move(source), 1,
+                                                controller::ControllerOptions{.long_work_on_thread = true});
   }
 }
 
@@ -88,7 +88,7 @@ void MachineHost::stop() {
   if (clock_) clock_->stop();
 }
 
-control::Controller& MachineHost::controller() noexcept {
+controller::Controller& MachineHost::controller() noexcept {
   return rig_ ? rig_->controller() : *controller_;
 }
 

@@ -43,7 +43,7 @@ void arc_points(const canon::Program& p, canon::SegmentId id, std::vector<double
 
 /// Builds the polylines (rapids and feeds apart) and notes the tools the program puts in the
 /// spindle (M6 after a T, M61 Q), as the scan shows them; stops after `max_moves` moves.
-class PreviewReader final : public control::ScanReader {
+class PreviewReader final : public controller::ScanReader {
  public:
   PreviewReader(const Pose& start, std::size_t max_moves) : max_moves_(max_moves) {
     pts_ = {start[0], start[1], start[2]};
@@ -101,7 +101,7 @@ class PreviewReader final : public control::ScanReader {
 
 }  // namespace
 
-json program_preview(const control::GcodeProgramSource& source, const std::string& path, const Pose& start,
+json program_preview(const controller::GcodeProgramSource& source, const std::string& path, const Pose& start,
                      std::size_t max_moves) {
   PreviewReader reader(start, max_moves);
   const Diagnostics d = source.scan(path, start, {}, reader);

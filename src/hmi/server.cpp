@@ -148,8 +148,8 @@ class HttpSession;
 class WsSession;
 
 struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
-  Impl(control::Controller& c, const config::MachineProfile& p, Tokens t, History* h,
-       const control::GcodeProgramSource* s, ServerConfig cfg)
+  Impl(controller::Controller& c, const config::MachineProfile& p, Tokens t, History* h,
+       const controller::GcodeProgramSource* s, ServerConfig cfg)
       : controller(c),
         profile(std::make_shared<const config::MachineProfile>(p)),
         tokens(std::move(t)),
@@ -162,7 +162,7 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
     stream_timer.emplace(ioc);
   }
 
-  control::Controller& controller;
+  controller::Controller& controller;
   /// The profile in force (replaced after an accepted set-parameters): any io thread.
   std::shared_ptr<const config::MachineProfile> machine() const {
     std::lock_guard lock(profile_mutex);
@@ -173,7 +173,7 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
   Tokens tokens;
   StreamTickets tickets;
   History* history;
-  const control::GcodeProgramSource* source;
+  const controller::GcodeProgramSource* source;
   ServerConfig config;
 
   /// Destroyed by Server::stop() after its threads ended: that destroys the handlers still
@@ -471,7 +471,7 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
     if (closed_) return;
     queue_.push_back(status);
     ++server_->status_messages;
-    std::vector<control::ControllerEvent> events = cursor_.next(kEventsPerMessage);
+    std::vector<controller::ControllerEvent> events = cursor_.next(kEventsPerMessage);
     if (!events.empty() || cursor_.lost() != reported_lost_) {
       json list = json::array();
       for (const auto& e : events) list.push_back(event_json(e));
@@ -524,7 +524,7 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
 
   websocket::stream<beast::tcp_stream> ws_;
   std::shared_ptr<Server::Impl> server_;
-  control::EventCursor cursor_;
+  controller::EventCursor cursor_;
   std::uint64_t reported_lost_ = 0;
   std::deque<std::shared_ptr<const std::string>> queue_;
   beast::flat_buffer in_;
@@ -840,8 +840,8 @@ void Server::Impl::command(const std::shared_ptr<HttpSession>& s, const HttpRequ
       return res;
     });
   }
-  auto& request = std::get<control::Request>(c);
-  auto* edit = std::get_if<control::requests::EditProfile>(&request.body);
+  auto& request = std::get<controller::Request>(c);
+  auto* edit = std::get_if<controller::requests::EditProfile>(&request.body);
   if (edit) edit->who = fmt::format("{}@{}", to_string(role), s->remote());
   const std::uint64_t id = controller.submit(std::move(request));
   const auto deadline =
@@ -912,7 +912,7 @@ std::string Server::Impl::relative_program(const std::string& path) const {
 HttpResponse Server::Impl::program_info(const HttpRequest& req, const Target&, Role) {
   const auto open = controller.open_program();
   if (!open) return json_response(req, 200, {{"open", false}});
-  const control::PreflightSummary& s = open->preflight.summary;
+  const controller::PreflightSummary& s = open->preflight.summary;
   json warnings = json::array();
   for (const Diagnostic& d : open->preflight.diagnostics.items()) warnings.push_back(d.format());
   return json_response(req, 200,
@@ -1080,8 +1080,8 @@ HttpResponse Server::Impl::static_file(const HttpRequest& req, const Target& t, 
 
 // --- public ---------------------------------------------------------------------------------
 
-Server::Server(control::Controller& controller, const config::MachineProfile& profile, Tokens tokens,
-               History* history, const control::GcodeProgramSource* source, ServerConfig config)
+Server::Server(controller::Controller& controller, const config::MachineProfile& profile, Tokens tokens,
+               History* history, const controller::GcodeProgramSource* source, ServerConfig config)
     : impl_(std::make_shared<Impl>(controller, profile, std::move(tokens), history, source,
                                    std::move(config))) {}
 

@@ -130,7 +130,7 @@ ProcessLog::~ProcessLog() {
   }
 }
 
-void ProcessLog::on_trace(const control::TraceSample& s, const control::TraceContext&) {
+void ProcessLog::on_trace(const control::TraceSample& s, const controller::TraceContext&) {
   // The feed of the linear axes from this sample and the one before (the path velocity would mix
   // in the degrees of a coupled C).
   double feed_mm_s = 0;

@@ -9,7 +9,7 @@ namespace {
 /// Adds the moves of the scan to the index. A preflight of a program with sync points scans it
 /// twice (the second time beside a scan with other answers): the second pass starts again at
 /// move 0 and replaces the first.
-class IndexingCheck final : public control::MoveCheck {
+class IndexingCheck final : public controller::MoveCheck {
  public:
   bool check(const canon::Program& program, canon::SegmentId move, Diagnostics& /*diags*/) override {
     if (move < next_) index_ = PathIndex{};
@@ -26,10 +26,10 @@ class IndexingCheck final : public control::MoveCheck {
 
 }  // namespace
 
-PathIndex scan_path(control::ProgramSource& source, const std::string& path, const Pose& start,
-                    const control::LoadOptions& options, Diagnostics& diags) {
+PathIndex scan_path(controller::ProgramSource& source, const std::string& path, const Pose& start,
+                    const controller::LoadOptions& options, Diagnostics& diags) {
   IndexingCheck check;
-  const control::Preflight p = source.preflight(path, start, options, check);
+  const controller::Preflight p = source.preflight(path, start, options, check);
   for (const Diagnostic& d : p.diagnostics.items()) diags.add(d);
   PathIndex index = check.take();
   index.finish();

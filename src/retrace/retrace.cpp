@@ -16,13 +16,13 @@
 namespace opencnc::recovery {
 
 using control::CommandKind;
-using control::ControllerEventKind;
-using control::JobEnd;
-using control::JobKind;
 using control::Mode;
-using control::Outcome;
-using control::Request;
 using control::State;
+using controller::ControllerEventKind;
+using controller::JobEnd;
+using controller::JobKind;
+using controller::Outcome;
+using controller::Request;
 
 namespace {
 
@@ -35,7 +35,8 @@ Outcome refuse(std::string why) {
 }
 
 // Start and step move the machine: only from a pause with the machine standing and no job.
-std::optional<Outcome> refuse_unless_paused_and_idle(RetracePhase phase, const control::ControllerStatus& s) {
+std::optional<Outcome> refuse_unless_paused_and_idle(RetracePhase phase,
+                                                     const controller::ControllerStatus& s) {
   if (phase != RetracePhase::Paused)
     return refuse(fmt::format("retrace is {}, not paused", to_string(phase)));
   if (s.servo.state != State::Idle || s.run_active)
@@ -96,13 +97,13 @@ const char* to_string(RetracePhase p) noexcept {
   return "";
 }
 
-RetraceFeature::RetraceFeature(std::shared_ptr<control::ProgramSource> source,
+RetraceFeature::RetraceFeature(std::shared_ptr<controller::ProgramSource> source,
                                const config::MachineProfile& profile)
     : source_(std::move(source)), cutting_(profile.cutting), status_period_s_(profile.servo_period_s) {
   for (const config::AxisProfile& a : profile.axes) {
     if (a.axis == Axis::X || a.axis == Axis::Y) min_accel_ = std::min(min_accel_, a.max_acceleration);
   }
-  jerk_filter_s_ = plan::jerk_filter_s(control::machine_limits(profile), profile.servo_period_s);
+  jerk_filter_s_ = plan::jerk_filter_s(controller::machine_limits(profile), profile.servo_period_s);
 }
 
 RetraceFeature::~RetraceFeature() {
@@ -141,12 +142,12 @@ const PathIndex* RetraceFeature::index() {
 
 std::string RetraceFeature::describe(const PathPoint& p) const {
   if (!index_ || !index_->sources()) return fmt::format("line {}", p.line);
-  return control::to_string(control::locate(*index_->sources(), p.context, p.line));
+  return controller::to_string(controller::locate(*index_->sources(), p.context, p.line));
 }
 
 // --- requests --------------------------------------------------------------------------------
 
-Outcome RetraceFeature::handle(const control::requests::Feature& r, control::FeatureHost& host) {
+Outcome RetraceFeature::handle(const controller::requests::Feature& r, controller::FeatureHost& host) {
   host_ = &host;
   if (r.action == "pause") return pause(host);
   if (r.action == "start") {
@@ -178,8 +179,8 @@ Outcome RetraceFeature::handle(const control::requests::Feature& r, control::Fea
   return refuse(fmt::format("retrace has no action '{}' (pause, start, step, nearest, index)", r.action));
 }
 
-Outcome RetraceFeature::pause(control::FeatureHost& host) {
-  const control::ControllerStatus& s = host.current_status();
+Outcome RetraceFeature::pause(controller::FeatureHost& host) {
+  const controller::ControllerStatus& s = host.current_status();
   if (phase() != RetracePhase::Idle && phase() != RetracePhase::Cutting)
     return refuse(fmt::format("retrace is {}", to_string(phase())));
   if (!s.run_active || s.job != JobKind::Program) return refuse("no program is running");
@@ -188,9 +189,9 @@ Outcome RetraceFeature::pause(control::FeatureHost& host) {
   return accept("feed hold; the torch goes out when the machine stands");
 }
 
-Outcome RetraceFeature::start(const RetraceStart& args, control::FeatureHost& host) {
+Outcome RetraceFeature::start(const RetraceStart& args, controller::FeatureHost& host) {
   if (std::optional<Outcome> no = refuse_unless_paused_and_idle(phase(), host.current_status())) return *no;
-  const control::ControllerStatus& s = host.current_status();
+  const controller::ControllerStatus& s = host.current_status();
   const PathIndex* ix = index();
   if (ix == nullptr) return refuse("no program is open");
   QueryOptions q;
@@ -226,9 +227,9 @@ Outcome RetraceFeature::start(const RetraceStart& args, control::FeatureHost& ho
                             c.point[1], c.segment, rec.line, c.distance_mm));
 }
 
-Outcome RetraceFeature::step(const RetraceStep& args, control::FeatureHost& host) {
+Outcome RetraceFeature::step(const RetraceStep& args, controller::FeatureHost& host) {
   if (std::optional<Outcome> no = refuse_unless_paused_and_idle(phase(), host.current_status())) return *no;
-  const control::ControllerStatus& s = host.current_status();
+  const controller::ControllerStatus& s = host.current_status();
   const PathIndex* ix = index();
   if (ix == nullptr || ix->size() == 0) return refuse("no program is open");
   if (!cursor_set_) {
@@ -247,7 +248,7 @@ Outcome RetraceFeature::step(const RetraceStep& args, control::FeatureHost& host
 
 // --- the state machine -----------------------------------------------------------------------
 
-void RetraceFeature::on_event(const control::ControllerEvent& e) {
+void RetraceFeature::on_event(const controller::ControllerEvent& e) {
   switch (e.kind) {
     case ControllerEventKind::ProgramOpened:
       if (host_ != nullptr) build_index(e.text, host_->current_status().servo.commanded);
@@ -273,7 +274,7 @@ void RetraceFeature::on_event(const control::ControllerEvent& e) {
   }
 }
 
-void RetraceFeature::on_status(const control::ControllerStatus& s) {
+void RetraceFeature::on_status(const controller::ControllerStatus& s) {
   if (phase() == RetracePhase::Holding) return when_held(s);
   if (phase() == RetracePhase::Cutting) return check_stop_at_a(s);
   // Auto mode asked for an auxiliary program: it starts once the servo has switched.
@@ -284,7 +285,7 @@ void RetraceFeature::on_status(const control::ControllerStatus& s) {
   }
 }
 
-void RetraceFeature::when_held(const control::ControllerStatus& s) {
+void RetraceFeature::when_held(const controller::ControllerStatus& s) {
   if (s.servo.state != State::Held || s.servo.path_velocity != 0 || host_ == nullptr) return;
   a_position_ = xyz(s.servo.commanded);
   a_offset_ = s.segment_offset;
@@ -299,7 +300,7 @@ void RetraceFeature::when_held(const control::ControllerStatus& s) {
   set_phase(RetracePhase::Stopping);
 }
 
-void RetraceFeature::when_job_ended(const control::ControllerEvent& e) {
+void RetraceFeature::when_job_ended(const controller::ControllerEvent& e) {
   if (host_ == nullptr) return;
   switch (phase()) {
     case RetracePhase::Stopping:
@@ -334,7 +335,7 @@ void RetraceFeature::when_job_ended(const control::ControllerEvent& e) {
   }
 }
 
-void RetraceFeature::check_stop_at_a(const control::ControllerStatus& s) {
+void RetraceFeature::check_stop_at_a(const controller::ControllerStatus& s) {
   if (!stop_at_a_ || !a_ || !c_ || !s.run_active || s.job != JobKind::Program || host_ == nullptr) return;
   if (c_->move > a_->move) return;  // B was ahead of A: the cut skipped forward past it
   const std::uint64_t move = base_move_ + s.run_segment;

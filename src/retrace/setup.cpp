@@ -16,11 +16,11 @@ nlohmann::json point(const Vec3& v) {
 
 /// The retrace's state for a front end (docs/api.md, "features"): its phase, how many retraces
 /// and the last one (A where it paused, B where it was brought, C the nearest point of the path).
-class State final : public control::FeatureState {
+class State final : public controller::FeatureState {
  public:
   explicit State(std::shared_ptr<recovery::RetraceFeature> feature) : feature_(std::move(feature)) {}
   std::string state_key() const override { return "retrace"; }
-  std::string state_json(const control::ControllerStatus&) override {
+  std::string state_json(const controller::ControllerStatus&) override {
     using nlohmann::json;
     json last = nullptr;
     const std::vector<recovery::RetraceRecord> records = feature_->records();
@@ -45,10 +45,10 @@ class State final : public control::FeatureState {
 
 }  // namespace
 
-bool setup(const config::MachineProfile& profile, control::MachineSetup& host) {
+bool setup(const config::MachineProfile& profile, controller::MachineSetup& host) {
   if (!profile.cutting.present) return true;
   auto feature = std::make_shared<recovery::RetraceFeature>(host.make_source(), profile);
-  host.add_feature(feature, control::ObserverOptions{profile.servo_period_s, false});
+  host.add_feature(feature, controller::ObserverOptions{profile.servo_period_s, false});
   host.add_state(std::make_shared<State>(feature));
   return true;
 }

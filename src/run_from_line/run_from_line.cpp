@@ -11,7 +11,7 @@
 #include "opencnc/controller/controller_status.hpp"
 #include "opencnc/controller/gcode_source.hpp"
 
-namespace opencnc::control {
+namespace opencnc::run_from_line {
 
 namespace {
 
@@ -110,7 +110,7 @@ double feed_per_minute(const canon::Program& p, std::size_t move, const MachineS
   return m.css ? 0 : f * m.speed;
 }
 
-LineStart line_start(const canon::Program& p, std::size_t move, const ProgramStream& s,
+LineStart line_start(const canon::Program& p, std::size_t move, const controller::ProgramStream& s,
                      const MachineState& m) {
   LineStart l;
   l.segment = p.segment_of(move);
@@ -130,11 +130,11 @@ LineStart line_start(const canon::Program& p, std::size_t move, const ProgramStr
 
 }  // namespace
 
-std::optional<LineStart> find_line_start(ProgramSource& source, const std::string& path,
+std::optional<LineStart> find_line_start(controller::ProgramSource& source, const std::string& path,
                                          const Pose& program_start, std::uint32_t line,
-                                         const LoadOptions& options, std::string* why,
+                                         const controller::LoadOptions& options, std::string* why,
                                          const std::atomic<bool>* cancel) {
-  std::unique_ptr<ProgramStream> s = source.execute(path, program_start, options);
+  std::unique_ptr<controller::ProgramStream> s = source.execute(path, program_start, options);
   std::uint32_t last_line = 0;  // the main file's line of the last move seen
   std::size_t scanned = 0, next_action = 0;
   MachineState state;  // what the program has set before the move scanned
@@ -165,25 +165,25 @@ std::optional<LineStart> find_line_start(ProgramSource& source, const std::strin
     // What is passed is freed (the last move stays: the next one starts at its end).
     if (scanned > 1) s->release(scanned - 1, p.action_count());
     switch (s->state()) {
-      case StreamState::Reading:
+      case controller::StreamState::Reading:
         s->read(kScanBatch);
         break;
-      case StreamState::Sync: {
-        const SyncRequest& r = s->sync_request();
-        if (r.kind == SyncKind::Probe || r.kind == SyncKind::Input) {
+      case controller::StreamState::Sync: {
+        const controller::SyncRequest& r = s->sync_request();
+        if (r.kind == controller::SyncKind::Probe || r.kind == controller::SyncKind::Input) {
           *why = fmt::format(
               "line {} comes after the {} at {}: its answer is not known again, so the program "
               "cannot be replayed past it (run from a line before it)",
               line, to_string(r.kind), to_string(r.where));
           return std::nullopt;
         }
-        SyncAnswer a;  // a stop or a tool change: the program goes on from there
+        controller::SyncAnswer a;  // a stop or a tool change: the program goes on from there
         a.kind = r.kind;
         a.position = p.empty() ? program_start : p.end(static_cast<canon::SegmentId>(p.size() - 1));
         s->answer(a);
         break;
       }
-      case StreamState::Finished:
+      case controller::StreamState::Finished:
         if (line > last_line && line >= s->location().line) {
           *why = fmt::format("line {} is past the program's end (line {}; its last move is on line {})", line,
                              s->location().line, last_line);
@@ -194,7 +194,7 @@ std::optional<LineStart> find_line_start(ProgramSource& source, const std::strin
             "called): choose the line of a move",
             line);
         return std::nullopt;
-      case StreamState::Error:
+      case controller::StreamState::Error:
         *why = s->diagnostics().items().empty() ? std::string("the program failed")
                                                 : s->diagnostics().items().front().format();
         return std::nullopt;
@@ -234,9 +234,10 @@ RunFromLineFeature::~RunFromLineFeature() {
   }
 }
 
-Outcome RunFromLineFeature::handle(const requests::Feature& request, FeatureHost& host) {
-  Outcome o;
-  o.refusal = Refusal::BadValue;
+controller::Outcome RunFromLineFeature::handle(const controller::requests::Feature& request,
+                                               controller::FeatureHost& host) {
+  controller::Outcome o;
+  o.refusal = control::Refusal::BadValue;
   if (request.action != "start") {
     o.message = fmt::format("run-from-line has no action '{}' (start)", request.action);
     return o;
@@ -246,25 +247,25 @@ Outcome RunFromLineFeature::handle(const requests::Feature& request, FeatureHost
     o.message = "run-from-line start needs a line (1 or more)";
     return o;
   }
-  const ControllerStatus& s = host.current_status();
+  const controller::ControllerStatus& s = host.current_status();
   if (s.program_name.empty()) {
-    o.refusal = Refusal::NoProgram;
+    o.refusal = control::Refusal::NoProgram;
     o.message = "no program is open";
     return o;
   }
   if (s.run_active || pending_ || scan_) {
-    o.refusal = Refusal::Busy;
+    o.refusal = control::Refusal::Busy;
     o.message = scan_ ? fmt::format("run from line {}: the scan of the program is under way", scan_->line)
                       : "a program is running";
     return o;
   }
-  if (s.servo.mode != Mode::Auto) {
-    o.refusal = Refusal::WrongMode;
+  if (s.servo.mode != control::Mode::Auto) {
+    o.refusal = control::Refusal::WrongMode;
     o.message = "run from line needs auto mode";
     return o;
   }
-  if (s.servo.state != State::Idle) {
-    o.refusal = Refusal::Busy;
+  if (s.servo.state != control::State::Idle) {
+    o.refusal = control::Refusal::Busy;
     o.message = fmt::format("the machine is {}, not idle", to_string(s.servo.state));
     return o;
   }
@@ -278,7 +279,7 @@ Outcome RunFromLineFeature::handle(const requests::Feature& request, FeatureHost
   scan.line = args->line;
   scan.opened = opened_;
   scan.thread = std::thread([&scan, source = source_, tools = tools_, path = s.program_name,
-                             from = program_start_, options = LoadOptions{s.block_delete}] {
+                             from = program_start_, options = controller::LoadOptions{s.block_delete}] {
     try {
       if (tools) tools->reset();
       scan.at = find_line_start(*source, path, from, scan.line, options, &scan.why, &scan.cancel);
@@ -291,26 +292,26 @@ Outcome RunFromLineFeature::handle(const requests::Feature& request, FeatureHost
   return o;
 }
 
-void RunFromLineFeature::poll(FeatureHost& host) {
+void RunFromLineFeature::poll(controller::FeatureHost& host) {
   if (!scan_ || !scan_->done.load(std::memory_order_acquire)) return;
   scan_->thread.join();
   const std::unique_ptr<Scan> scan = std::move(scan_);
-  Outcome o;
-  o.refusal = Refusal::BadValue;
-  const ControllerStatus& s = host.current_status();
+  controller::Outcome o;
+  o.refusal = control::Refusal::BadValue;
+  const controller::ControllerStatus& s = host.current_status();
   if (!scan->at) {
     o.message = scan->why;
   } else if (scan->opened != opened_) {
-    o.refusal = Refusal::NoProgram;
+    o.refusal = control::Refusal::NoProgram;
     o.message = fmt::format("run from line {}: another program was opened during the scan", scan->line);
-  } else if (s.servo.mode != Mode::Auto || s.servo.state != State::Idle || s.run_active) {
-    o.refusal = s.servo.mode != Mode::Auto ? Refusal::WrongMode : Refusal::Busy;
+  } else if (s.servo.mode != control::Mode::Auto || s.servo.state != control::State::Idle || s.run_active) {
+    o.refusal = s.servo.mode != control::Mode::Auto ? control::Refusal::WrongMode : control::Refusal::Busy;
     o.message = fmt::format("run from line {}: the machine left auto mode or idle during the scan ({}, {})",
                             scan->line, to_string(s.servo.mode), to_string(s.servo.state));
   } else {
     start_approach(*scan, host);
     o.accepted = true;
-    o.refusal = Refusal::None;
+    o.refusal = control::Refusal::None;
     o.message = fmt::format("from line {} (segment {}, {}): the approach{}, then the program", scan->line,
                             scan->at->segment, to_string(scan->at->where),
                             scan->at->tool >= 0 && scan->at->tool != s.servo.tool
@@ -321,17 +322,18 @@ void RunFromLineFeature::poll(FeatureHost& host) {
 }
 
 // While the scan runs the machine stays idle: nothing else may start.
-bool RunFromLineFeature::allow_start(const StartCheck& /*start*/, FeatureHost& /*host*/, std::string* why) {
+bool RunFromLineFeature::allow_start(const controller::StartCheck& /*start*/,
+                                     controller::FeatureHost& /*host*/, std::string* why) {
   if (!scan_) return true;
   *why = fmt::format("run from line {}: the scan of the program is under way", scan_->line);
   return false;
 }
 
-void RunFromLineFeature::start_approach(Scan& scan, FeatureHost& host) {
-  const ControllerStatus& s = host.current_status();
+void RunFromLineFeature::start_approach(Scan& scan, controller::FeatureHost& host) {
+  const controller::ControllerStatus& s = host.current_status();
   pending_ = scan.at;
   pending_line_ = scan.line;
-  approach_request_ = host.submit(Request::run_auxiliary(
+  approach_request_ = host.submit(controller::Request::run_auxiliary(
       fmt::format("approach to line {}", scan.line), approach(s.servo.commanded, s.servo.tool, *scan.at)));
 }
 
@@ -412,28 +414,30 @@ std::shared_ptr<const canon::Program> RunFromLineFeature::approach(const Pose& m
   return std::make_shared<const canon::Program>(b.take());
 }
 
-void RunFromLineFeature::on_event(const ControllerEvent& e) {
+void RunFromLineFeature::on_event(const controller::ControllerEvent& e) {
   if (!host_) return;
   // Where the program starts from, as the controller's own resume takes it: where the machine
   // stood when the program was opened or last started by the operator.
-  const bool started = e.kind == ControllerEventKind::JobStarted && e.job == JobKind::Program;
-  if (e.kind == ControllerEventKind::ProgramOpened) ++opened_;
-  if (e.kind == ControllerEventKind::ProgramOpened || (started && !resuming_)) {
+  const bool started =
+      e.kind == controller::ControllerEventKind::JobStarted && e.job == controller::JobKind::Program;
+  if (e.kind == controller::ControllerEventKind::ProgramOpened) ++opened_;
+  if (e.kind == controller::ControllerEventKind::ProgramOpened || (started && !resuming_)) {
     program_start_ = host_->current_status().servo.commanded;
   }
   if (started) resuming_ = false;
   if (!pending_) return;
-  if (e.kind == ControllerEventKind::Answer && e.request_id == approach_request_ && !e.accepted) {
+  if (e.kind == controller::ControllerEventKind::Answer && e.request_id == approach_request_ && !e.accepted) {
     pending_.reset();
     host_->note(Severity::Warning, "control.run-from-line",
                 fmt::format("run from line {}: the approach was refused: {}", pending_line_, e.text));
     return;
   }
   const std::string name = fmt::format("approach to line {}", pending_line_);
-  if (e.kind == ControllerEventKind::JobEnded && e.job == JobKind::Auxiliary && e.text.starts_with(name)) {
+  if (e.kind == controller::ControllerEventKind::JobEnded && e.job == controller::JobKind::Auxiliary &&
+      e.text.starts_with(name)) {
     const LineStart at = *pending_;
     pending_.reset();
-    if (e.end != JobEnd::Finished) {
+    if (e.end != controller::JobEnd::Finished) {
       host_->note(
           Severity::Warning, "control.run-from-line",
           fmt::format("run from line {}: the approach did not finish ({}); the program was not started",
@@ -441,8 +445,8 @@ void RunFromLineFeature::on_event(const ControllerEvent& e) {
       return;
     }
     resuming_ = true;
-    host_->submit(Request::resume(at.segment, program_start_));
+    host_->submit(controller::Request::resume(at.segment, program_start_));
   }
 }
 
-}  // namespace opencnc::control
+}  // namespace opencnc::run_from_line

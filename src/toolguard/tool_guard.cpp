@@ -68,7 +68,7 @@ std::string beyond_magazine(store::ToolStore& store, int pockets) {
 
 }  // namespace
 
-bool ToolGuard::allow_start(const control::StartCheck& /*start*/, control::FeatureHost& /*host*/,
+bool ToolGuard::allow_start(const controller::StartCheck& /*start*/, controller::FeatureHost& /*host*/,
                             std::string* why) {
   held_ = false;
   if (!profile_.check_at_start) return true;
@@ -81,8 +81,8 @@ bool ToolGuard::allow_start(const control::StartCheck& /*start*/, control::Featu
 
 // At the tool change the check covers the edges of the tool going into the spindle: the
 // program stands there until they pass (the note is repeated only when the table changed).
-bool ToolGuard::allow_continue(const control::SyncCheck& sync, control::FeatureHost& host) {
-  if (!profile_.check_at_tool_change || sync.kind != control::SyncKind::ToolChange || sync.tool_index <= 0)
+bool ToolGuard::allow_continue(const controller::SyncCheck& sync, controller::FeatureHost& host) {
+  if (!profile_.check_at_tool_change || sync.kind != controller::SyncKind::ToolChange || sync.tool_index <= 0)
     return true;
   const std::uint64_t v = store_->changes();
   if (held_ && v == held_version_) return false;
@@ -107,12 +107,13 @@ bool ToolGuard::allow_continue(const control::SyncCheck& sync, control::FeatureH
   host.note(Severity::Error, "tools.guard-hold",
             fmt::format("held before T{} cuts ({}): {}\naccept the live values or restore the backup "
                         "(tool-guard accept|restore)",
-                        held_tool_, control::to_string(sync.where), r.report()));
+                        held_tool_, controller::to_string(sync.where), r.report()));
   return false;
 }
 
-control::Outcome ToolGuard::handle(const control::requests::Feature& request, control::FeatureHost& host) {
-  control::Outcome o;
+controller::Outcome ToolGuard::handle(const controller::requests::Feature& request,
+                                      controller::FeatureHost& host) {
+  controller::Outcome o;
   if (request.action == "check") {
     const CheckResult r = check(*store_, tolerances_);
     o.accepted = r.ok();
@@ -127,7 +128,7 @@ control::Outcome ToolGuard::handle(const control::requests::Feature& request, co
   }
   std::optional<std::int64_t> chosen;
   if (const auto* id = std::any_cast<std::int64_t>(&request.args)) chosen = *id;
-  auto out = std::make_shared<control::Outcome>();
+  auto out = std::make_shared<controller::Outcome>();
   host.answer_after(
       [out, store = store_, action = request.action, chosen] {
         std::string error;
@@ -155,7 +156,7 @@ control::Outcome ToolGuard::handle(const control::requests::Feature& request, co
 namespace {
 
 /// The check M-code (M160 or the profile's) on top of the modules the profile already brings.
-class CheckModule final : public control::SourcePart {
+class CheckModule final : public controller::SourcePart {
  public:
   CheckModule(std::shared_ptr<CheckCode> code, std::size_t m) : code_(std::move(code)), m_(m) {}
   std::shared_ptr<const gcode::Extensions> modules(
@@ -174,12 +175,12 @@ class CheckModule final : public control::SourcePart {
 /// feature that holds), the differences of the whole live table from the backup, for the dialog.
 /// The check reads the store (SQLite): it runs once when the hold begins and again only when the
 /// store has changed, not at every status.
-class State final : public control::FeatureState {
+class State final : public controller::FeatureState {
  public:
   State(std::shared_ptr<store::ToolStore> store, const config::ToolGuardProfile& guard)
       : store_(std::move(store)), guard_(guard) {}
   std::string state_key() const override { return "tool_guard"; }
-  std::string state_json(const control::ControllerStatus& s) override {
+  std::string state_json(const controller::ControllerStatus& s) override {
     using nlohmann::json;
     const bool holding = s.wait_text.find("the tool-guard ") != std::string::npos;
     if (!holding) {
@@ -215,7 +216,7 @@ class State final : public control::FeatureState {
 
 }  // namespace
 
-bool setup(const config::MachineProfile& profile, control::MachineSetup& host) {
+bool setup(const config::MachineProfile& profile, controller::MachineSetup& host) {
   const config::ToolGuardProfile& g = profile.tool_guard;
   if (!g.present) return true;
   std::string error;
@@ -234,7 +235,7 @@ bool setup(const config::MachineProfile& profile, control::MachineSetup& host) {
     host.add_source_part(std::make_shared<CheckModule>(std::make_shared<CheckCode>(store, tolerances(g)),
                                                        static_cast<std::size_t>(g.check_mcode)));
   host.add_feature(std::make_shared<ToolGuard>(store, g, profile.tool_changer_pockets),
-                   control::ObserverOptions{profile.servo_period_s, false});
+                   controller::ObserverOptions{profile.servo_period_s, false});
   host.add_state(std::make_shared<State>(store, g));
   return true;
 }

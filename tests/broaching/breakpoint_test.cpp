@@ -29,9 +29,9 @@ namespace opencnc::recovery {
 namespace {
 
 using control::CommandKind;
-using control::Request;
-using control::SimRig;
 using control::State;
+using controller::Request;
+using controller::SimRig;
 
 std::filesystem::path fresh_dir() {
   const auto dir =
@@ -192,7 +192,8 @@ TEST(BreakpointJournal, WritesTheRecordWhenTheMainsFail) {
   const config::MachineProfile p = broach();
   const std::string program = OPENCNC_SOURCE_DIR "/examples/broach-constant.ngc";
   Diagnostics d;
-  auto machine = features::machine_setup(p, d, control::MachineSetup::Options::with("journal", dir.string()));
+  auto machine =
+      features::machine_setup(p, d, controller::MachineSetup::Options::with("journal", dir.string()));
   ASSERT_TRUE(machine) << (d.items().empty() ? "" : d.items()[0].format());
   auto source = machine->source();
   SimRig rig(p, *machine);

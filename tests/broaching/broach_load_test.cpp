@@ -16,11 +16,11 @@
 #include "opencnc/controller/sim_rig.hpp"
 #include "opencnc/features/features.hpp"
 
-namespace opencnc::control::test {
+namespace opencnc::controller::test {
 namespace {
 
 config::MachineProfile broach() {
-  return loaded(config::load_profile(OPENCNC_SOURCE_DIR "/configs/broach-zc.toml"));
+  return control::test::loaded(config::load_profile(OPENCNC_SOURCE_DIR "/configs/broach-zc.toml"));
 }
 
 std::string write_program(const std::string& text) {
@@ -69,23 +69,23 @@ struct LoadRun {
     events = std::make_unique<EventCursor>(rig->controller().events());
     rig->machine().set_tool_dull(dull);
     rig->step();
-    EXPECT_TRUE(rig->request(Request::simple(CommandKind::MachineOn)).accepted);
-    EXPECT_TRUE(rig->request(Request::set_mode(Mode::Auto)).accepted);
+    EXPECT_TRUE(rig->request(Request::simple(control::CommandKind::MachineOn)).accepted);
+    EXPECT_TRUE(rig->request(Request::set_mode(control::Mode::Auto)).accepted);
     EXPECT_TRUE(rig->request(Request::open(write_program(program)), 100000).accepted);
-    EXPECT_TRUE(rig->request(Request::simple(CommandKind::CycleStart)).accepted);
+    EXPECT_TRUE(rig->request(Request::simple(control::CommandKind::CycleStart)).accepted);
   }
   /// The load guard's actions and notes seen since the last call.
-  std::vector<LoadAction> actions(std::vector<std::string>* notes = nullptr) {
-    std::vector<LoadAction> out;
+  std::vector<control::LoadAction> actions(std::vector<std::string>* notes = nullptr) {
+    std::vector<control::LoadAction> out;
     for (const ControllerEvent& e : events->next()) {
-      if (e.kind == ControllerEventKind::Servo && e.servo.kind == EventKind::LoadGuard)
-        out.push_back(static_cast<LoadAction>(e.servo.action));
+      if (e.kind == ControllerEventKind::Servo && e.servo.kind == control::EventKind::LoadGuard)
+        out.push_back(static_cast<control::LoadAction>(e.servo.action));
       if (notes != nullptr && e.kind == ControllerEventKind::Note && e.code == "control.load")
         notes->push_back(e.text);
     }
     return out;
   }
-  bool idle() const { return !rig->status().run_active && rig->status().servo.state == State::Idle; }
+  bool idle() const { return !rig->status().run_active && rig->status().servo.state == control::State::Idle; }
 };
 
 TEST(BroachLoad, SharpCutsPassUntouched) {
@@ -94,51 +94,52 @@ TEST(BroachLoad, SharpCutsPassUntouched) {
   EXPECT_TRUE(r.actions().empty());
   // 0.1 mm at 3 m/min: 2500 × 10 × 0.1 × 1.15 N, the cell's noise on top.
   EXPECT_NEAR(r.watch->max_kn, 2.875, 0.05);
-  EXPECT_EQ(r.rig->status().servo.load_action, LoadAction::None);
+  EXPECT_EQ(r.rig->status().servo.load_action, control::LoadAction::None);
 }
 
 TEST(BroachLoad, AWornCutterHoldsTheFeedOnTheHelix) {
   LoadRun r(strokes({0.1}), 1.8);  // 5.2 kN: above the hold level (4), below the retract (6)
   std::vector<std::string> notes;
-  ASSERT_TRUE(r.rig->run_until([&] { return r.rig->status().servo.state == State::Held; }, 10000));
+  ASSERT_TRUE(r.rig->run_until([&] { return r.rig->status().servo.state == control::State::Held; }, 10000));
   ASSERT_TRUE(r.rig->run_until([&] { return r.rig->status().servo.path_velocity == 0; }, 1000));
   r.rig->run(20);
-  const ServoStatus s = r.rig->status().servo;
-  EXPECT_EQ(r.actions(&notes), std::vector<LoadAction>{LoadAction::Hold});
+  const control::ServoStatus s = r.rig->status().servo;
+  EXPECT_EQ(r.actions(&notes), std::vector<control::LoadAction>{control::LoadAction::Hold});
   ASSERT_EQ(notes.size(), 1u);
   EXPECT_NE(notes[0].find("above the hold level 4 kN: feed hold"), std::string::npos) << notes[0];
-  EXPECT_EQ(s.load_action, LoadAction::Hold);
+  EXPECT_EQ(s.load_action, control::LoadAction::Hold);
   EXPECT_TRUE(s.run_active);
   EXPECT_NE(s.coupling.kind, motion::CouplingKind::Off);  // the coupling holds through the stop
   EXPECT_GT(s.commanded[Axis::Z], 0.0);                   // stopped inside the bore
   EXPECT_LT(r.watch->helix_error_deg, 1e-9);
   EXPECT_NEAR(s.commanded[Axis::X], 0.1, 1e-9);  // the cutter stays where it was
   // The operator changes nothing and resumes: the worn cutter holds the feed again.
-  ASSERT_TRUE(r.rig->request(Request::simple(CommandKind::Resume)).accepted);
-  ASSERT_TRUE(
-      r.rig->run_until([&] { return r.actions() == std::vector<LoadAction>{LoadAction::Hold}; }, 5000));
-  ASSERT_TRUE(r.rig->request(Request::simple(CommandKind::Abort)).accepted);
+  ASSERT_TRUE(r.rig->request(Request::simple(control::CommandKind::Resume)).accepted);
+  ASSERT_TRUE(r.rig->run_until(
+      [&] { return r.actions() == std::vector<control::LoadAction>{control::LoadAction::Hold}; }, 5000));
+  ASSERT_TRUE(r.rig->request(Request::simple(control::CommandKind::Abort)).accepted);
   ASSERT_TRUE(r.rig->run_until([&] { return r.idle(); }, 5000));
 }
 
 TEST(BroachLoad, AnOverloadStopsOnTheHelixAndLiftsTheCutter) {
   LoadRun r(strokes({0.3}));  // 0.3 mm at once: 8.6 kN, above the retract level (6)
   std::vector<std::string> notes;
-  std::vector<LoadAction> seen;
+  std::vector<control::LoadAction> seen;
   ASSERT_TRUE(r.rig->run_until(
       [&] {
-        for (const LoadAction a : r.actions(&notes)) seen.push_back(a);
-        return !seen.empty() && seen.back() == LoadAction::Lifted;
+        for (const control::LoadAction a : r.actions(&notes)) seen.push_back(a);
+        return !seen.empty() && seen.back() == control::LoadAction::Lifted;
       },
       10000));
-  EXPECT_EQ(seen, (std::vector<LoadAction>{LoadAction::Retract, LoadAction::Lifted}));
+  EXPECT_EQ(seen,
+            (std::vector<control::LoadAction>{control::LoadAction::Retract, control::LoadAction::Lifted}));
   ASSERT_EQ(notes.size(), 2u);
   EXPECT_NE(notes[0].find("above the retract level 6 kN"), std::string::npos) << notes[0];
   r.rig->run(5);
-  const ServoStatus s = r.rig->status().servo;
+  const control::ServoStatus s = r.rig->status().servo;
   EXPECT_FALSE(r.rig->status().run_active);  // the run was stopped
-  EXPECT_EQ(s.state, State::Idle);
-  EXPECT_EQ(s.load_action, LoadAction::Lifted);
+  EXPECT_EQ(s.state, control::State::Idle);
+  EXPECT_EQ(s.load_action, control::LoadAction::Lifted);
   EXPECT_NEAR(s.commanded[Axis::X], 0.3 - 0.5, 1e-9);  // lifted off the wall by retract_lift
   EXPECT_GT(s.commanded[Axis::Z], 0.0);
   EXPECT_LT(r.watch->helix_error_deg, 1e-9);  // C on the law until the path rested
@@ -148,4 +149,4 @@ TEST(BroachLoad, AnOverloadStopsOnTheHelixAndLiftsTheCutter) {
 }
 
 }  // namespace
-}  // namespace opencnc::control::test
+}  // namespace opencnc::controller::test

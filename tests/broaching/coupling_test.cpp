@@ -22,11 +22,11 @@
 #include "opencnc/features/features.hpp"
 #include "opencnc/motion/coupling.hpp"
 
-namespace opencnc::control::test {
+namespace opencnc::controller::test {
 namespace {
 
 config::MachineProfile broach(std::vector<std::string> sets = {}) {
-  return loaded(config::load_profile(OPENCNC_SOURCE_DIR "/configs/broach-zc.toml", sets));
+  return control::test::loaded(config::load_profile(OPENCNC_SOURCE_DIR "/configs/broach-zc.toml", sets));
 }
 
 /// Every coupled period: the tick's command of C against the law evaluated here from the status's
@@ -36,7 +36,7 @@ class HelixWatch final : public ControllerObserver {
   explicit HelixWatch(motion::CouplingConfig c) : config_(c) {}
   void on_status(const ControllerStatus& s) override {
     waited_in_position = waited_in_position || s.servo.coupling_wait;
-    const CouplingStatus& c = s.servo.coupling;
+    const control::CouplingStatus& c = s.servo.coupling;
     if (c.kind == motion::CouplingKind::Off) return;
     ++coupled;
     kinds.push_back(c.kind);
@@ -48,7 +48,7 @@ class HelixWatch final : public ControllerObserver {
     if (previous_z_ > s.servo.commanded[Axis::Z] + 1e-6) backwards = true;
     previous_z_ = s.servo.commanded[Axis::Z];
   }
-  motion::CouplingLaw law_of(const CouplingStatus& c) const {
+  motion::CouplingLaw law_of(const control::CouplingStatus& c) const {
     switch (c.kind) {
       case motion::CouplingKind::ConstantPitch:
         return motion::CouplingLaw::constant(c.pitch_mm);
@@ -91,16 +91,17 @@ CoupledRun run(const std::string& text, const config::MachineProfile& profile = 
   CoupledRun r;
   Diagnostics d;
   r.rig = std::make_unique<SimRig>(profile, *features::machine_setup(profile, d));
-  r.watch = std::make_shared<HelixWatch>(coupling_config(profile.coupling));
+  r.watch = std::make_shared<HelixWatch>(control::coupling_config(profile.coupling));
   r.rig->controller().attach(r.watch, ObserverOptions{0.001, false});
   r.rig->step();
-  EXPECT_TRUE(r.rig->request(Request::simple(CommandKind::MachineOn)).accepted);
-  EXPECT_TRUE(r.rig->request(Request::set_mode(Mode::Auto)).accepted);
+  EXPECT_TRUE(r.rig->request(Request::simple(control::CommandKind::MachineOn)).accepted);
+  EXPECT_TRUE(r.rig->request(Request::set_mode(control::Mode::Auto)).accepted);
   r.opened = r.rig->request(Request::open(write_program(text)), 100000);
   if (!r.opened.accepted) return r;
-  EXPECT_TRUE(r.rig->request(Request::simple(CommandKind::CycleStart)).accepted);
+  EXPECT_TRUE(r.rig->request(Request::simple(control::CommandKind::CycleStart)).accepted);
   EXPECT_TRUE(r.rig->run_until(
-      [&] { return !r.rig->status().run_active && r.rig->status().servo.state == State::Idle; }, 200000));
+      [&] { return !r.rig->status().run_active && r.rig->status().servo.state == control::State::Idle; },
+      200000));
   return r;
 }
 
@@ -121,7 +122,7 @@ TEST(Coupling, ConstantPitchHeldEveryPeriodBothWays) {
   // The feedback's helix error is the drives' tracking (Z and C lag differently while they
   // accelerate): 0.15° at this steep pitch (6°/mm), bounded here so that a change shows.
   EXPECT_LT(r.watch->actual_error_deg, 0.2);
-  const ServoStatus s = r.rig->status().servo;
+  const control::ServoStatus s = r.rig->status().servo;
   EXPECT_EQ(s.coupling.kind, motion::CouplingKind::Off);  // released at M175 (and at the run's end)
   // Back at Z −10 the law gives C 30 again; after M175 C stays where the law left it.
   EXPECT_NEAR(s.commanded[Axis::C], 30.0, 1e-9);
@@ -139,7 +140,7 @@ TEST(Coupling, WithJerkLimitsTheLawIsHeldEveryPeriodBothWays) {
   EXPECT_GT(r.watch->coupled, 3000u);
   EXPECT_TRUE(r.watch->backwards);
   EXPECT_LT(r.watch->command_error_deg, 1e-9);
-  const ServoStatus s = r.rig->status().servo;
+  const control::ServoStatus s = r.rig->status().servo;
   EXPECT_EQ(s.coupling.kind, motion::CouplingKind::Off);
   EXPECT_NEAR(s.commanded[Axis::C], 30.0, 1e-9);
   EXPECT_NEAR(s.commanded[Axis::Z], 20.0, 1e-9);
@@ -205,8 +206,8 @@ TEST(Coupling, TheDemoJobsPassTheBroachsPreflight) {
     const config::MachineProfile p = broach();
     SimRig rig(p, *features::machine_setup(p, d));
     rig.step();
-    ASSERT_TRUE(rig.request(Request::simple(CommandKind::MachineOn)).accepted);
-    ASSERT_TRUE(rig.request(Request::set_mode(Mode::Auto)).accepted);
+    ASSERT_TRUE(rig.request(Request::simple(control::CommandKind::MachineOn)).accepted);
+    ASSERT_TRUE(rig.request(Request::set_mode(control::Mode::Auto)).accepted);
     const Outcome o = rig.request(Request::open(std::string(OPENCNC_SOURCE_DIR "/examples/") + job), 100000);
     EXPECT_TRUE(o.accepted) << job << "\n" << messages(o);
   }
@@ -217,21 +218,22 @@ TEST(Coupling, TheDemoJobsPassTheBroachsPreflight) {
 struct PowerFailRun {
   PowerFailRun(const config::MachineProfile& p, const std::string& program, bool flood)
       : rig(p, *features::machine_setup(p, diags)),
-        recorder(std::make_shared<PowerFailRecorder>(coupling_config(p.coupling), machine_limits(p),
-                                                     p.servo_period_s, p.coupling.radius_mm)) {
+        recorder(std::make_shared<broaching::PowerFailRecorder>(control::coupling_config(p.coupling),
+                                                                machine_limits(p), p.servo_period_s,
+                                                                p.coupling.radius_mm)) {
     rig.controller().attach(recorder, ObserverOptions{p.servo_period_s, true});
     rig.step();
-    EXPECT_TRUE(rig.request(Request::simple(CommandKind::MachineOn)).accepted);
+    EXPECT_TRUE(rig.request(Request::simple(control::CommandKind::MachineOn)).accepted);
     if (flood) {
-      EXPECT_TRUE(rig.request(Request::coolant(Coolant::Flood, true)).accepted);
+      EXPECT_TRUE(rig.request(Request::coolant(control::Coolant::Flood, true)).accepted);
     }
-    EXPECT_TRUE(rig.request(Request::set_mode(Mode::Auto)).accepted);
+    EXPECT_TRUE(rig.request(Request::set_mode(control::Mode::Auto)).accepted);
     EXPECT_TRUE(rig.request(Request::open(program), 100000).accepted);
-    EXPECT_TRUE(rig.request(Request::simple(CommandKind::CycleStart)).accepted);
+    EXPECT_TRUE(rig.request(Request::simple(control::CommandKind::CycleStart)).accepted);
   }
   Diagnostics diags;
   SimRig rig;
-  std::shared_ptr<PowerFailRecorder> recorder;
+  std::shared_ptr<broaching::PowerFailRecorder> recorder;
 };
 
 // Fault injection: the mains fail at instants through the constant-pitch demo job (cutting,
@@ -252,10 +254,11 @@ TEST(Coupling, PowerFailStopsOnTheHelix) {
     rig.run(4);
     EXPECT_TRUE(rig.status().servo.aborting) << cut_s;  // the stop is under way …
     EXPECT_FALSE(rig.status().servo.flood) << cut_s;    // … with the process already off
-    ASSERT_TRUE(rig.run_until([&] { return rig.status().servo.state == State::Faulted; }, 5000)) << cut_s;
-    EXPECT_EQ(rig.status().servo.fault.kind, FaultKind::PowerLoss);
+    ASSERT_TRUE(rig.run_until([&] { return rig.status().servo.state == control::State::Faulted; }, 5000))
+        << cut_s;
+    EXPECT_EQ(rig.status().servo.fault.kind, control::FaultKind::PowerLoss);
     EXPECT_FALSE(rig.status().servo.drives_enabled);
-    const PowerFailReport r = run.recorder->report();
+    const broaching::PowerFailReport r = run.recorder->report();
     ASSERT_TRUE(r.happened && r.coupled) << cut_s;
     EXPECT_LE(r.coupled_error_um, 1.0) << cut_s;
     EXPECT_LT(r.coupled_command_error_um, 1e-3) << cut_s;
@@ -292,16 +295,16 @@ TEST(Coupling, ADriveThatDoesNotSettleStopsTheRunWithAFault) {
   Diagnostics d;
   SimRig rig(p, *features::machine_setup(p, d));
   rig.step();
-  ASSERT_TRUE(rig.request(Request::simple(CommandKind::MachineOn)).accepted);
-  ASSERT_TRUE(rig.request(Request::set_mode(Mode::Auto)).accepted);
+  ASSERT_TRUE(rig.request(Request::simple(control::CommandKind::MachineOn)).accepted);
+  ASSERT_TRUE(rig.request(Request::set_mode(control::Mode::Auto)).accepted);
   ASSERT_TRUE(
       rig.request(Request::open(write_program("G21 G90\nG0 Z-10 C180\nM171 P600\nG1 Z50 F3000\nM2\n")),
                   100000)
           .accepted);
-  ASSERT_TRUE(rig.request(Request::simple(CommandKind::CycleStart)).accepted);
-  ASSERT_TRUE(rig.run_until([&] { return rig.status().servo.state == State::Faulted; }, 20000));
+  ASSERT_TRUE(rig.request(Request::simple(control::CommandKind::CycleStart)).accepted);
+  ASSERT_TRUE(rig.run_until([&] { return rig.status().servo.state == control::State::Faulted; }, 20000));
   const ControllerStatus s = rig.status();
-  EXPECT_EQ(s.servo.fault.kind, FaultKind::CouplingPosition);
+  EXPECT_EQ(s.servo.fault.kind, control::FaultKind::CouplingPosition);
   EXPECT_EQ(s.servo.fault.axis, index(Axis::C));
   EXPECT_GT(s.servo.fault.value, s.servo.fault.limit);
   EXPECT_NE(s.fault_text.find("engage_tolerance_um"), std::string::npos) << s.fault_text;
@@ -323,7 +326,7 @@ TEST(Coupling, APowerFailOnANearlyEmptyDcLinkBrakesHarderAndStaysOnTheHelix) {
     SimRig& rig = run.rig;
     EXPECT_TRUE(rig.run_until([&] { return rig.status().servo.time_s >= cut_s; }, 20000));
     rig.machine().set_mains_ok(false);
-    EXPECT_TRUE(rig.run_until([&] { return rig.status().servo.state == State::Faulted; }, 5000));
+    EXPECT_TRUE(rig.run_until([&] { return rig.status().servo.state == control::State::Faulted; }, 5000));
     return std::pair{run.recorder->report(), rig.status().servo.fault.kind};
   };
   std::vector<std::string> small = empty_ups;
@@ -338,7 +341,7 @@ TEST(Coupling, APowerFailOnANearlyEmptyDcLinkBrakesHarderAndStaysOnTheHelix) {
     EXPECT_EQ(normal.coupled_error_um, with_ups.coupled_error_um) << cut_s;
     EXPECT_GT(normal.energy_at_signal_j, 350.0) << cut_s;
     const auto [short_stop, short_fault] = cut(small, cut_s);
-    EXPECT_EQ(short_fault, FaultKind::PowerLoss) << cut_s;  // at rest, the drives still powered
+    EXPECT_EQ(short_fault, control::FaultKind::PowerLoss) << cut_s;  // at rest, the drives still powered
     EXPECT_GT(short_stop.decel_scale, 1.5) << cut_s;
     EXPECT_LE(short_stop.decel_scale, 4.0) << cut_s;  // Z 6000 / 1500, C 14400 / 3600
     EXPECT_LT(short_stop.stop_distance_mm, 0.6 * normal.stop_distance_mm) << cut_s;
@@ -350,7 +353,7 @@ TEST(Coupling, APowerFailOnANearlyEmptyDcLinkBrakesHarderAndStaysOnTheHelix) {
   }
   const auto [planned, planned_fault] = cut(no_margin, 3.2);  // no peak above the plan
   EXPECT_EQ(planned.decel_scale, 1.0);
-  EXPECT_EQ(planned_fault, FaultKind::AmpFault);  // the drives' undervoltage, before rest
+  EXPECT_EQ(planned_fault, control::FaultKind::AmpFault);  // the drives' undervoltage, before rest
 }
 
 // The 100-cut sweep's outlier (3.18 µm, the mains cut 10–40 ms after a rapid return arrived,
@@ -370,8 +373,8 @@ TEST(Coupling, APowerFailWhileTheAxesSettleAfterAReturnStaysOnTheHelix) {
     EXPECT_TRUE(rig.run_until([&] { return rig.status().servo.commanded[Axis::Z] <= -10 + 1e-9; }, 2000));
     rig.run(10);
     rig.machine().set_mains_ok(false);
-    EXPECT_TRUE(rig.run_until([&] { return rig.status().servo.state == State::Faulted; }, 5000));
-    const PowerFailReport r = run.recorder->report();
+    EXPECT_TRUE(rig.run_until([&] { return rig.status().servo.state == control::State::Faulted; }, 5000));
+    const broaching::PowerFailReport r = run.recorder->report();
     EXPECT_TRUE(r.happened && r.coupled);
     return r.coupled_error_um;
   };
@@ -383,4 +386,4 @@ TEST(Coupling, APowerFailWhileTheAxesSettleAfterAReturnStaysOnTheHelix) {
 }
 
 }  // namespace
-}  // namespace opencnc::control::test
+}  // namespace opencnc::controller::test

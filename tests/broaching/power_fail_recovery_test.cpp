@@ -29,9 +29,9 @@ namespace opencnc::recovery {
 namespace {
 
 using control::CommandKind;
-using control::Request;
-using control::SimRig;
 using control::State;
+using controller::Request;
+using controller::SimRig;
 
 constexpr double kCutS = 3.2;  // into the first cutting stroke
 /// A short broaching job (the demo job's first strokes, shortened so that ASan runs stay short):
@@ -67,14 +67,14 @@ std::filesystem::path fresh_dir(const std::string& what) {
 }
 
 /// Every period's feedback of X, Z, C and whether C was coupled.
-class Samples final : public control::ControllerObserver {
+class Samples final : public controller::ControllerObserver {
  public:
   struct Row {
     double x, z, c;
     bool coupled;
-    control::JobKind job;
+    controller::JobKind job;
   };
-  void on_trace(const control::TraceSample& s, const control::TraceContext& c) override {
+  void on_trace(const control::TraceSample& s, const controller::TraceContext& c) override {
     rows.push_back({s.actual[Axis::X], s.actual[Axis::Z], s.actual[Axis::C], s.coupled, c.job});
   }
   std::vector<Row> rows;
@@ -87,13 +87,13 @@ struct Machine {
             control::test::loaded(config::load_profile(OPENCNC_SOURCE_DIR "/configs/broach-zc.toml", sets))) {
     Diagnostics d;
     auto machine =
-        features::machine_setup(profile, d, control::MachineSetup::Options::with("journal", dir.string()));
+        features::machine_setup(profile, d, controller::MachineSetup::Options::with("journal", dir.string()));
     EXPECT_TRUE(machine) << (d.items().empty() ? "" : d.items()[0].format());
     rig = std::make_unique<SimRig>(profile, *machine);
     journal = std::dynamic_pointer_cast<BreakpointJournal>(machine->feature("journal"));
     EXPECT_TRUE(journal);
     samples = std::make_shared<Samples>();
-    rig->controller().attach(samples, control::ObserverOptions{0, true});
+    rig->controller().attach(samples, controller::ObserverOptions{0, true});
     rig->step();
     EXPECT_TRUE(rig->request(Request::simple(CommandKind::MachineOn)).accepted);
     EXPECT_TRUE(rig->request(Request::set_mode(control::Mode::Auto)).accepted);
@@ -110,8 +110,8 @@ struct Machine {
     return journal->last_written().value_or(BreakpointRecord{});
   }
   /// Asks for a recovery choice and runs until it has completed or failed.
-  control::Outcome choose(const std::string& action, std::any args = {}) {
-    const control::Outcome o = rig->request(Request::feature("journal", action, std::move(args)), 100000);
+  controller::Outcome choose(const std::string& action, std::any args = {}) {
+    const controller::Outcome o = rig->request(Request::feature("journal", action, std::move(args)), 100000);
     if (o.accepted) {
       rig->run_until(
           [&] {
@@ -152,7 +152,7 @@ double groove_deviation_um(const std::vector<Samples::Row>& rows, const std::vec
   double worst = 0;
   *compared = 0;
   for (const auto& r : rows) {
-    if (r.job != control::JobKind::Program) continue;  // the run-in
+    if (r.job != controller::JobKind::Program) continue;  // the run-in
     if (r.z > z1) break;  // the stroke's end: the rows after belong to later strokes
     if (!r.coupled || std::fabs(r.x - x) >= 0.002 || r.z < z0 || r.z > z1) continue;
     const auto it = std::lower_bound(line.begin(), line.end(), std::pair{r.z, -1e300});
@@ -190,7 +190,7 @@ TEST(PowerFailRecovery, ResumedGrooveMatchesTheUninterruptedRun) {
   // guard's own levels: the run-in and the rest of the groove meet no chip they have cut already.
   Machine after(dir, power_up_at(r));
   ASSERT_TRUE(after.rig->machine().restore_broach_bore(bore));
-  const control::Outcome o = after.choose("resume");
+  const controller::Outcome o = after.choose("resume");
   ASSERT_TRUE(o.accepted) << o.message;
   EXPECT_EQ(after.journal->phase(), RecoveryPhase::Done) << after.journal->recovery_error();
   EXPECT_EQ(after.rig->status().runs_finished, 2u);  // the run-in (auxiliary), then the program
@@ -222,7 +222,7 @@ TEST(PowerFailRecovery, ResumesIntoTheGrooveCutBeforeWithTheLoadGuardsLevels) {
   }
   {
     Machine uncut(dir, power_up_at(r));  // the bore not restored
-    const control::Outcome o = uncut.rig->request(Request::feature("journal", "resume"), 100000);
+    const controller::Outcome o = uncut.rig->request(Request::feature("journal", "resume"), 100000);
     ASSERT_TRUE(o.accepted) << o.message;
     const std::string why = run_recovery(*uncut.rig, *uncut.journal, {60.0, 2.0});
     EXPECT_NE(why.find("the feed was held (load 5."), std::string::npos) << why;
@@ -233,7 +233,7 @@ TEST(PowerFailRecovery, ResumesIntoTheGrooveCutBeforeWithTheLoadGuardsLevels) {
   }
   Machine after(dir, power_up_at(r));
   ASSERT_TRUE(after.rig->machine().restore_broach_bore(bore));
-  const control::Outcome o = after.rig->request(Request::feature("journal", "resume"), 100000);
+  const controller::Outcome o = after.rig->request(Request::feature("journal", "resume"), 100000);
   ASSERT_TRUE(o.accepted) << o.message;
   EXPECT_EQ(run_recovery(*after.rig, *after.journal, {60.0, 2.0}), "");
   EXPECT_EQ(after.rig->status().servo.load_action, control::LoadAction::None);
@@ -253,7 +253,7 @@ TEST(PowerFailRecovery, ResumesInTheSecondGroove) {
     ASSERT_EQ(r.coupling.slave_origin, 180.0);
   }
   Machine after(dir, power_up_at(r));
-  const control::Outcome o = after.choose("resume");
+  const controller::Outcome o = after.choose("resume");
   ASSERT_TRUE(o.accepted) << o.message;
   EXPECT_EQ(after.journal->phase(), RecoveryPhase::Done) << after.journal->recovery_error();
   EXPECT_EQ(after.rig->status().servo.fault.kind, control::FaultKind::None);
@@ -269,7 +269,7 @@ TEST(PowerFailRecovery, RetractKeepsTheHelix) {
     r = cut.cut_mains(kProgram, kCutS);
   }
   Machine after(dir, power_up_at(r));
-  const control::Outcome o = after.choose("retract", RetractArgs{40.0, false, 600.0});
+  const controller::Outcome o = after.choose("retract", RetractArgs{40.0, false, 600.0});
   ASSERT_TRUE(o.accepted) << o.message;
   EXPECT_EQ(after.journal->phase(), RecoveryPhase::Done) << after.journal->recovery_error();
   EXPECT_NEAR(after.rig->status().servo.commanded[Axis::Z], r.actual[Axis::Z] - 40.0, 1e-9);
@@ -279,7 +279,7 @@ TEST(PowerFailRecovery, RetractKeepsTheHelix) {
   double worst_um = 0;
   int n = 0;
   for (const auto& row : after.samples->rows) {
-    if (row.job != control::JobKind::Auxiliary) continue;
+    if (row.job != controller::JobKind::Auxiliary) continue;
     const double law =
         r.coupling.slave_origin + 360.0 * (row.z - r.coupling.master_origin) / r.coupling.pitch_mm;
     const double e = std::fabs(std::remainder(row.c - law, 360.0)) * std::numbers::pi / 180 *
@@ -304,18 +304,18 @@ TEST(PowerFailRecovery, AChangedProgramOrAMovedAxisIsRefused) {
   }
   {
     Machine moved(dir, power_up_at(r, 0.5));
-    const control::Outcome o = moved.choose("resume");
+    const controller::Outcome o = moved.choose("resume");
     EXPECT_FALSE(o.accepted);
     EXPECT_NE(o.message.find("Z is 0.5000 mm from where it came to rest"), std::string::npos) << o.message;
     EXPECT_TRUE(moved.journal->last_written()->valid);
   }
   std::ofstream(program, std::ios::app) << "(edited after the power failure)\n";
   Machine after(dir, power_up_at(r));
-  const control::Outcome o = after.choose("resume");
+  const controller::Outcome o = after.choose("resume");
   EXPECT_FALSE(o.accepted);
   EXPECT_NE(o.message.find("changed since the power failed"), std::string::npos) << o.message;
   EXPECT_TRUE(after.journal->last_written()->valid);  // the choice is still the operator's
-  const control::Outcome d = after.choose("discard");
+  const controller::Outcome d = after.choose("discard");
   EXPECT_TRUE(d.accepted);
   EXPECT_FALSE(after.journal->last_written()->valid);
   std::filesystem::remove(program);

@@ -24,7 +24,7 @@ namespace opencnc::connect {
 namespace {
 
 namespace fs = std::filesystem;
-using control::test::Scenario;
+using controller::test::Scenario;
 
 constexpr std::int64_t kEpochUs = 1796601600LL * 1000000;  // 2026-12-07T00:00:00Z
 
@@ -124,8 +124,8 @@ class EveryProfile : public ::testing::TestWithParam<std::string> {};
 
 /// A status with something in every item a profile may have: the machine moving, a fault of an
 /// axis, every process alarm active, the EDM gap shorted, a coupling engaged, on battery.
-control::ControllerStatus busy_status(const config::MachineProfile& p, int i) {
-  control::ControllerStatus s;
+controller::ControllerStatus busy_status(const config::MachineProfile& p, int i) {
+  controller::ControllerStatus s;
   s.servo.state = i % 3 == 0 ? control::State::Running : i % 3 == 1 ? control::State::Held : control::State::Faulted;
   s.servo.mode = control::Mode::Auto;
   s.servo.estop_input_ok = true;
@@ -155,7 +155,7 @@ TEST_P(EveryProfile, EveryDocumentIsValidMTConnect27) {
   const auto p = profile(GetParam());
   auto agent = Agent::for_profile(p, AgentOptions{"test-host", "", 7, 4096, 1000});
   for (int i = 0; i < 6; ++i) agent->observe(busy_status(p, i), kEpochUs + i * 100000);
-  agent->observe(control::ControllerStatus{}, kEpochUs + 700000);  // everything back to rest
+  agent->observe(controller::ControllerStatus{}, kEpochUs + 700000);  // everything back to rest
   agent->set_tools({ToolAsset{1, 3, 120.5, 10, "end mill <10 mm> & co", kEpochUs}, ToolAsset{2, 0, 80, 6, "", kEpochUs}},
                    kEpochUs + 1);
 
@@ -219,7 +219,7 @@ TEST(Agent, AMachineThatRunsShowsItsPositionsStateAndProgramValues) {
     EXPECT_EQ(c.one("//m:Execution"), "STOPPED");  // the machine is off
   }
   s.on(control::Mode::Mdi);
-  s.must(control::Request::mdi("G0 X12.5 Y-3"));
+  s.must(controller::Request::mdi("G0 X12.5 Y-3"));
   observe(*agent, s, 5000);
   Xml c(ask(*agent, "/current").body);
   EXPECT_EQ(c.one("//m:Execution"), "READY");
@@ -245,7 +245,7 @@ TEST(Agent, SampleWalksEverySequenceOnceInOrderAndRefusesWhatTheBufferForgot) {
   auto agent = Agent::for_profile(p, AgentOptions{"h", "", 1, 64, 1000});
   Scenario s(p);
   s.on(control::Mode::Mdi);
-  s.must(control::Request::mdi("G1 X20 F600"));
+  s.must(controller::Request::mdi("G1 X20 F600"));
   observe(*agent, s, 3000);
   const std::uint64_t next = agent->next_sequence();
   ASSERT_GT(next, 200u);  // the buffer of 64 has turned over
@@ -279,7 +279,7 @@ TEST(Agent, SampleWalksEverySequenceOnceInOrderAndRefusesWhatTheBufferForgot) {
 TEST(Agent, AFaultIsAConditionOfItsAxisAndClearsToNormal) {
   const auto p = profile("mill-3axis");
   auto agent = Agent::for_profile(p, {});
-  control::ControllerStatus st;
+  controller::ControllerStatus st;
   st.servo.state = control::State::Idle;
   st.servo.estop_input_ok = true;
   agent->observe(st, kEpochUs);
@@ -308,7 +308,7 @@ TEST(Agent, AFaultIsAConditionOfItsAxisAndClearsToNormal) {
 TEST(Agent, AnAgentWhoseControllerWentAwayShowsEverythingUnavailable) {
   const auto p = profile("mill-3axis");
   auto agent = Agent::for_profile(p, {});
-  control::ControllerStatus st;
+  controller::ControllerStatus st;
   agent->observe(st, kEpochUs);
   agent->mark_unavailable(kEpochUs + 1);
   Xml c(ask(*agent, "/current").body);

@@ -165,8 +165,8 @@ class Subscriber {
 };
 
 /// A status that moves a little at each call: X, Y and the feed change, every 50th call the mode.
-inline control::ControllerStatus moving_status(std::uint64_t i) {
-  control::ControllerStatus s;
+inline controller::ControllerStatus moving_status(std::uint64_t i) {
+  controller::ControllerStatus s;
   s.servo.state = control::State::Running;
   s.servo.estop_input_ok = true;
   s.servo.mode = i / 50 % 2 ? control::Mode::Auto : control::Mode::Mdi;

@@ -26,7 +26,7 @@ class ServoHarness {
       : profile_(profile),
         channels_(std::make_unique<ServoChannels>()),
         sim_(std::make_unique<machine::SimMachine>(config::sim_machine_config(profile))),
-        servo_(std::make_unique<Servo>(servo_config(profile), *channels_, *sim_)) {
+        servo_(std::make_unique<Servo>(controller::servo_config(profile), *channels_, *sim_)) {
     tick();
   }
 
@@ -79,7 +79,8 @@ class ServoHarness {
   /// Plans `program` (started where the machine stands) and asks the servo to run it.
   Refusal run(const canon::Program& program, Mode mode) {
     program_ = canon::program_tail(program, 0, status().commanded);
-    planner_ = std::make_unique<plan::Planner>(machine_limits(profile_), planner_config(profile_));
+    planner_ = std::make_unique<plan::Planner>(controller::machine_limits(profile_),
+                                               controller::planner_config(profile_));
     EXPECT_TRUE(planner_->start(*program_));
     next_action_ = 0;
     Command c;

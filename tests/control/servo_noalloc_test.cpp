@@ -38,7 +38,7 @@ class Armed {
  public:
   explicit Armed(const config::MachineProfile& p) {
     Diagnostics d;
-    rig_ = std::make_unique<SimRig>(p, *features::machine_setup(p, d));
+    rig_ = std::make_unique<controller::SimRig>(p, *features::machine_setup(p, d));
     rig_->channels().trace_enabled = true;
   }
   void tick() {
@@ -57,7 +57,7 @@ class Armed {
     }
     return false;
   }
-  void ask(Request r) {
+  void ask(controller::Request r) {
     const std::uint64_t id = rig_->controller().submit(std::move(r));
     until([&] { return rig_->controller().outcome(id).has_value(); }, 100);
   }
@@ -65,10 +65,10 @@ class Armed {
   bool idle() {
     return until([&] { return state() == State::Idle && !rig_->status().run_active; }, 200000);
   }
-  SimRig& rig() { return *rig_; }
+  controller::SimRig& rig() { return *rig_; }
 
  private:
-  std::unique_ptr<SimRig> rig_;
+  std::unique_ptr<controller::SimRig> rig_;
 };
 
 TEST(ServoAllocations, NoneInsideTheTick) {
@@ -81,29 +81,29 @@ TEST(ServoAllocations, NoneInsideTheTick) {
                             "G4 P0.05\nM0\nG1 X250 Y20\nM9\nM5\nM2\n";
   g_allocations = 0;
   Armed a(homing_mill({"interpreter.tool_table=\"" + tools + "\""}));
-  a.ask(Request::simple(CommandKind::MachineOn));
-  a.ask(Request::set_mode(Mode::Manual));
-  a.ask(Request::home());
+  a.ask(controller::Request::simple(CommandKind::MachineOn));
+  a.ask(controller::Request::set_mode(Mode::Manual));
+  a.ask(controller::Request::home());
   ASSERT_TRUE(a.idle());
-  a.ask(Request::jog(Axis::X, -30));
+  a.ask(controller::Request::jog(Axis::X, -30));
   a.until([] { return false; }, 300);
-  a.ask(Request::jog_stop());
+  a.ask(controller::Request::jog_stop());
   ASSERT_TRUE(a.idle());
-  a.ask(Request::set_mode(Mode::Mdi));
-  a.ask(Request::mdi("G91 G1 Y2 F600"));
+  a.ask(controller::Request::set_mode(Mode::Mdi));
+  a.ask(controller::Request::mdi("G91 G1 Y2 F600"));
   ASSERT_TRUE(a.idle());
-  a.ask(Request::set_mode(Mode::Auto));
-  a.ask(Request::optional_stop(true));
-  a.ask(Request::open(program));
-  a.ask(Request::simple(CommandKind::CycleStart));
+  a.ask(controller::Request::set_mode(Mode::Auto));
+  a.ask(controller::Request::optional_stop(true));
+  a.ask(controller::Request::open(program));
+  a.ask(controller::Request::simple(CommandKind::CycleStart));
   int n = 0;
   ASSERT_TRUE(a.until(
       [&] {
         ++n;
-        if (n == 900) a.ask(Request::feed_override(1.7));
-        if (n == 2000) a.ask(Request::simple(CommandKind::FeedHold));
-        if (n == 2300) a.ask(Request::simple(CommandKind::Resume));
-        if (a.state() == State::Stopped) a.ask(Request::simple(CommandKind::CycleStart));
+        if (n == 900) a.ask(controller::Request::feed_override(1.7));
+        if (n == 2000) a.ask(controller::Request::simple(CommandKind::FeedHold));
+        if (n == 2300) a.ask(controller::Request::simple(CommandKind::Resume));
+        if (a.state() == State::Stopped) a.ask(controller::Request::simple(CommandKind::CycleStart));
         return a.state() == State::Idle && !a.rig().status().run_active;
       },
       200000));
@@ -142,10 +142,10 @@ TEST(ServoAllocations, NoneWhileRigidTappingOrUnderConstantSurfaceSpeed) {
                             "G0 X10 Y10 Z3\nG33.1 Z-8 K1.25 I1.5\nG0 Z20\nM5\nM2\n";
   g_allocations = 0;
   Armed a(mill());
-  a.ask(Request::simple(CommandKind::MachineOn));
-  a.ask(Request::set_mode(Mode::Auto));
-  a.ask(Request::open(program));
-  a.ask(Request::simple(CommandKind::CycleStart));
+  a.ask(controller::Request::simple(CommandKind::MachineOn));
+  a.ask(controller::Request::set_mode(Mode::Auto));
+  a.ask(controller::Request::open(program));
+  a.ask(controller::Request::simple(CommandKind::CycleStart));
   ASSERT_TRUE(a.until([&] { return a.state() == State::Idle && !a.rig().status().run_active; }, 200000));
   EXPECT_EQ(a.rig().status().runs_finished, 1u);
   EXPECT_NEAR(a.rig().status().servo.commanded[Axis::Z], 20.0, 1e-9);
@@ -167,18 +167,18 @@ TEST(ServoAllocations, NoneInsideTheCoupledTick) {
   const std::vector<std::string> empty_link = {"power.sim.ups_runtime_s=0",
                                                "power.dc_link_capacitance_f=0.00004"};
   Armed a(loaded(config::load_profile(OPENCNC_SOURCE_DIR "/configs/broach-zc.toml", empty_link)));
-  a.ask(Request::simple(CommandKind::MachineOn));
-  a.ask(Request::set_mode(Mode::Auto));
-  a.ask(Request::open(program));
-  a.ask(Request::simple(CommandKind::CycleStart));
+  a.ask(controller::Request::simple(CommandKind::MachineOn));
+  a.ask(controller::Request::set_mode(Mode::Auto));
+  a.ask(controller::Request::open(program));
+  a.ask(controller::Request::simple(CommandKind::CycleStart));
   int n = 0;
   bool coupled_seen = false;
   ASSERT_TRUE(a.until(
       [&] {
         ++n;
         coupled_seen = coupled_seen || a.rig().status().servo.coupling.kind != motion::CouplingKind::Off;
-        if (n == 300) a.ask(Request::simple(CommandKind::FeedHold));
-        if (n == 600) a.ask(Request::simple(CommandKind::Resume));
+        if (n == 300) a.ask(controller::Request::simple(CommandKind::FeedHold));
+        if (n == 600) a.ask(controller::Request::simple(CommandKind::Resume));
         if (a.rig().status().servo.commanded[Axis::Z] > 150) a.rig().machine().set_mains_ok(false);
         return a.state() == State::Faulted;
       },
@@ -199,10 +199,10 @@ TEST(ServoAllocations, NoneInsideTheLoadGuard) {
   g_allocations = 0;
   Armed a(loaded(config::load_profile(OPENCNC_SOURCE_DIR "/configs/broach-zc.toml")));
   a.rig().machine().set_tool_dull(1.8);
-  a.ask(Request::simple(CommandKind::MachineOn));
-  a.ask(Request::set_mode(Mode::Auto));
-  a.ask(Request::open(program));
-  a.ask(Request::simple(CommandKind::CycleStart));
+  a.ask(controller::Request::simple(CommandKind::MachineOn));
+  a.ask(controller::Request::set_mode(Mode::Auto));
+  a.ask(controller::Request::open(program));
+  a.ask(controller::Request::simple(CommandKind::CycleStart));
   bool held = false;
   ASSERT_TRUE(a.until(
       [&] {
@@ -210,7 +210,7 @@ TEST(ServoAllocations, NoneInsideTheLoadGuard) {
         if (!held && s.state == State::Held && s.path_velocity == 0) {
           held = true;
           a.rig().machine().set_tool_dull(3.0);  // worse: the resumed cut overloads
-          a.ask(Request::simple(CommandKind::Resume));
+          a.ask(controller::Request::simple(CommandKind::Resume));
         }
         return held && s.load_action == LoadAction::Lifted;
       },
@@ -222,8 +222,8 @@ TEST(ServoAllocations, NoneInsideTheLoadGuard) {
 // The event log keeps its entries in a ring built once: a job that runs for days appends events
 // without the log's memory growing (the strings are copied into fixed fields).
 TEST(ServoAllocations, NoneWhenTheEventLogAppends) {
-  EventLog log(8);
-  ControllerEvent e;
+  controller::EventLog log(8);
+  controller::ControllerEvent e;
   e.text = std::string(400, 'x');  // longer than its field: cut, not stored on the heap
   e.code = "control.fault.stall";
   e.location.file = "part.ngc";
@@ -248,16 +248,16 @@ TEST(ServoAllocations, NoneInsideTheEdmTick) {
   g_allocations = 0;
   const std::vector<std::string> sets = {"edm.sim.electrode_area_mm2=5"};
   Armed a(loaded(config::load_profile(OPENCNC_SOURCE_DIR "/configs/edm-5axis.toml", sets)));
-  a.ask(Request::simple(CommandKind::MachineOn));
-  a.ask(Request::set_mode(Mode::Manual));
-  a.ask(Request::home());  // on the reference cams
+  a.ask(controller::Request::simple(CommandKind::MachineOn));
+  a.ask(controller::Request::set_mode(Mode::Manual));
+  a.ask(controller::Request::home());  // on the reference cams
   ASSERT_TRUE(a.idle());
-  a.ask(Request::seek_limit(Axis::Z, +1));  // to Z's + limit switch, latched, backed off
+  a.ask(controller::Request::seek_limit(Axis::Z, +1));  // to Z's + limit switch, latched, backed off
   ASSERT_TRUE(a.idle());
   ASSERT_TRUE(a.rig().status().servo.seek[2].found);
-  a.ask(Request::set_mode(Mode::Auto));
-  a.ask(Request::open(program));
-  a.ask(Request::simple(CommandKind::CycleStart));
+  a.ask(controller::Request::set_mode(Mode::Auto));
+  a.ask(controller::Request::open(program));
+  a.ask(controller::Request::simple(CommandKind::CycleStart));
   int n = 0;
   bool shorted = false, jumped = false, orbited = false, backed = false;
   ASSERT_TRUE(a.until(
@@ -270,8 +270,8 @@ TEST(ServoAllocations, NoneInsideTheEdmTick) {
           a.rig().machine().inject_edm_short();
           shorted = true;
         }
-        if (n == 400) a.ask(Request::simple(CommandKind::FeedHold));
-        if (n == 450) a.ask(Request::simple(CommandKind::Resume));
+        if (n == 400) a.ask(controller::Request::simple(CommandKind::FeedHold));
+        if (n == 450) a.ask(controller::Request::simple(CommandKind::Resume));
         if (shorted) ++n;
         return a.state() == State::Idle && !a.rig().status().run_active;
       },
@@ -317,17 +317,17 @@ TEST(ServoAllocations, NoneInsideTheEdmTick) {
 TEST(ServoAllocations, NoneInsideTheDrillsTick) {
   g_allocations = 0;
   Armed a(drill());
-  a.ask(Request::simple(CommandKind::MachineOn));
-  a.ask(Request::set_mode(Mode::Manual));
-  a.ask(Request::home());
+  a.ask(controller::Request::simple(CommandKind::MachineOn));
+  a.ask(controller::Request::set_mode(Mode::Manual));
+  a.ask(controller::Request::home());
   ASSERT_TRUE(a.idle());
-  a.ask(Request::handwheel(Axis::X, 0.01));
+  a.ask(controller::Request::handwheel(Axis::X, 0.01));
   a.rig().machine().turn_handwheel(40);
   a.until([] { return false; }, 50);
   ASSERT_TRUE(a.idle());
-  a.ask(Request::set_mode(Mode::Auto));
-  a.ask(Request::open(OPENCNC_SOURCE_DIR "/examples/drill-bearing-cap.ngc"));
-  a.ask(Request::simple(CommandKind::CycleStart));
+  a.ask(controller::Request::set_mode(Mode::Auto));
+  a.ask(controller::Request::open(OPENCNC_SOURCE_DIR "/examples/drill-bearing-cap.ngc"));
+  a.ask(controller::Request::simple(CommandKind::CycleStart));
   int changing = 0;
   ASSERT_TRUE(a.until(
       [&] {
@@ -335,7 +335,7 @@ TEST(ServoAllocations, NoneInsideTheDrillsTick) {
         if (v.wait == Wait::HandAxis)
           a.rig().machine().set_hand_target(2, v.hand_wait.target, v.hand_wait.retract ? 60.0 : 20.0);
         if (v.wait == Wait::ManualToolChange && ++changing % 500 == 0)
-          a.rig().controller().submit(Request::simple(CommandKind::ToolChanged));
+          a.rig().controller().submit(controller::Request::simple(CommandKind::ToolChanged));
         return a.state() == State::Idle && !a.rig().status().run_active && a.rig().status().servo.all_homed;
       },
       2'000'000));
@@ -354,8 +354,8 @@ TEST(ServoAllocations, NoneInsideTheDrillsTick) {
   ASSERT_TRUE(a.rig().channels().commands.try_push(stage) && a.rig().channels().commands.try_push(apply));
   a.until([] { return false; }, 100);
   EXPECT_EQ(&a.rig().servo().compensation().pitch_table(0), &next);
-  a.ask(Request::set_mode(Mode::Manual));
-  a.ask(Request::jog(Axis::X, 30));
+  a.ask(controller::Request::set_mode(Mode::Manual));
+  a.ask(controller::Request::jog(Axis::X, 30));
   a.until([] { return false; }, 200);
   a.rig().machine().set_external_effort(0, -3000);  // a stall the X drive detects
   a.until([] { return false; }, 50);
@@ -372,14 +372,14 @@ TEST(ServoAllocations, NoneWithProcessAlarmsAndAReferenceSphere) {
   ASSERT_TRUE(load.ok());
   g_allocations = 0;
   Armed a(*load.profile);
-  a.ask(Request::simple(CommandKind::MachineOn));
-  a.ask(Request::set_mode(Mode::Mdi));
-  a.ask(Request::mdi("G0 X110 Y50 Z-150"));
+  a.ask(controller::Request::simple(CommandKind::MachineOn));
+  a.ask(controller::Request::set_mode(Mode::Mdi));
+  a.ask(controller::Request::mdi("G0 X110 Y50 Z-150"));
   ASSERT_TRUE(a.idle());
-  a.ask(Request::mdi("G38.2 X100 F600"));  // the simulated sphere's probe: contact at X105
+  a.ask(controller::Request::mdi("G38.2 X100 F600"));  // the simulated sphere's probe: contact at X105
   ASSERT_TRUE(a.idle());
   EXPECT_NEAR(a.rig().status().servo.probe_position[Axis::X], 105.0, 0.001);
-  a.ask(Request::mdi("G1 X0 F3000"));
+  a.ask(controller::Request::mdi("G1 X0 F3000"));
   a.until([] { return false; }, 200);
   a.rig().machine().drift_analog_input(2, 80, 100);  // resistor box: a message
   a.until([] { return false; }, 200);
@@ -388,7 +388,7 @@ TEST(ServoAllocations, NoneWithProcessAlarmsAndAReferenceSphere) {
   EXPECT_EQ(a.state(), State::Held);
   a.rig().machine().set_analog_input(1, 30);
   a.until([] { return false; }, 5);
-  a.ask(Request::simple(CommandKind::CycleStart));
+  a.ask(controller::Request::simple(CommandKind::CycleStart));
   a.until([] { return false; }, 50);
   a.rig().machine().drift_analog_input(0, 20, 100);  // dielectric level: stop and fault
   a.until([] { return false; }, 1000);
@@ -426,7 +426,7 @@ TEST(ServoAllocations, NoneInsideTheSharedMemoryHostsTick) {
   SharedSegment& s = segment->segment();
   SimBackend backend(p);
   SharedServoHost host(s, backend);
-  const SharedSetup setup = shared_setup(p);
+  const SharedSetup setup = controller::shared_setup(p);
   Command c;
   c.kind = CommandKind::MachineOn;
   c.id = 1;
@@ -460,7 +460,7 @@ TEST(ServoAllocations, NoneInsideTheSharedMemoryHostsTick) {
   for (int i = 0; i < 500; ++i) host.tick();  // the heartbeat stops
   g_armed = false;
   EXPECT_EQ(s.header.heartbeat_losses.load(), 1u);
-  offer_setup(s, shared_setup(mill({"servo_period_s=0.0005"})));
+  offer_setup(s, controller::shared_setup(mill({"servo_period_s=0.0005"})));
   beat_and_tick(5);
   EXPECT_EQ(s.header.setup_taken.load(), 2u);
   EXPECT_EQ(g_allocations.load(), 0);

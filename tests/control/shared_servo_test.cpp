@@ -68,9 +68,9 @@ class SharedRig {
     mapping_ = SegmentMapping::attach(owner_->name(), error);
     ASSERT_TRUE(mapping_) << error;
     drain_stale_output(mapping_->segment());
-    controller_ = std::make_unique<Controller>(profile_, mapping_->segment().channels);
+    controller_ = std::make_unique<controller::Controller>(profile_, mapping_->segment().channels);
     const std::uint64_t g = setup ? offer_setup(mapping_->segment(), *setup)  // its bytes, padding too
-                                  : offer_setup(mapping_->segment(), shared_setup(profile_));
+                                  : offer_setup(mapping_->segment(), controller::shared_setup(profile_));
     for (int i = 0; i < 10 && !setup_taken(mapping_->segment(), g); ++i) step();
     ASSERT_TRUE(setup_taken(mapping_->segment(), g));
   }
@@ -86,11 +86,11 @@ class SharedRig {
     }
     return false;
   }
-  Outcome ask(Request r) {
+  controller::Outcome ask(controller::Request r) {
     const std::uint64_t id = controller_->submit(std::move(r));
-    std::optional<Outcome> o;
+    std::optional<controller::Outcome> o;
     until([&] { return (o = controller_->outcome(id)).has_value(); }, 1000);
-    return o.value_or(Outcome{});
+    return o.value_or(controller::Outcome{});
   }
   ServoStatus status() const { return controller_->status().servo; }
 
@@ -99,7 +99,7 @@ class SharedRig {
   SimBackend backend_;
   std::unique_ptr<SegmentMapping> owner_, mapping_;
   std::unique_ptr<SharedServoHost> host_;
-  std::unique_ptr<Controller> controller_;
+  std::unique_ptr<controller::Controller> controller_;
 };
 
 TEST(SegmentMapping, RefusesAForeignOrOtherBuildSegment) {
@@ -133,7 +133,7 @@ TEST(SharedSetup, IsTheSameBytesForTheSameProfile) {
   // integers, which ASan's filled allocations show).
   const config::MachineProfile edm = loaded(config::load_profile(OPENCNC_SOURCE_DIR "/configs/edm-5axis.toml"));
   for (const config::MachineProfile& p : {mill(), drill(), edm}) {
-    const SharedSetup a = shared_setup(p), b = shared_setup(p);
+    const SharedSetup a = controller::shared_setup(p), b = controller::shared_setup(p);
     const auto* pa = reinterpret_cast<const unsigned char*>(&a);
     const auto* pb = reinterpret_cast<const unsigned char*>(&b);
     for (std::size_t i = 0; i < sizeof a; ++i) ASSERT_EQ(pa[i], pb[i]) << p.name << " byte " << i;
@@ -152,7 +152,7 @@ TEST(SharedServoHost, SafeOutputsUntilASetupIsTaken) {
   EXPECT_FALSE(backend.last().estop_release);
   for (const auto& j : backend.last().joints) EXPECT_FALSE(j.enable);
   EXPECT_EQ(owner->segment().header.ticks.load(), 5u);
-  const std::uint64_t g = offer_setup(owner->segment(), shared_setup(p));
+  const std::uint64_t g = offer_setup(owner->segment(), controller::shared_setup(p));
   host.tick();
   EXPECT_TRUE(setup_taken(owner->segment(), g));
   EXPECT_TRUE(host.running());
@@ -161,14 +161,14 @@ TEST(SharedServoHost, SafeOutputsUntilASetupIsTaken) {
 
 TEST(SharedServoHost, AControllerOverSharedMemoryJogsTheMachine) {
   SharedRig rig(mill(), "jog");
-  ASSERT_TRUE(rig.ask(Request::simple(CommandKind::MachineOn)).accepted);
-  ASSERT_TRUE(rig.ask(Request::set_mode(Mode::Manual)).accepted);
+  ASSERT_TRUE(rig.ask(controller::Request::simple(CommandKind::MachineOn)).accepted);
+  ASSERT_TRUE(rig.ask(controller::Request::set_mode(Mode::Manual)).accepted);
   const double x0 = rig.status().commanded[0];
-  ASSERT_TRUE(rig.ask(Request::jog(Axis::X, 20)).accepted);
+  ASSERT_TRUE(rig.ask(controller::Request::jog(Axis::X, 20)).accepted);
   rig.until([] { return false; }, 500);
   EXPECT_GT(rig.status().commanded[0], x0 + 5);
   EXPECT_TRUE(rig.status().drives_enabled);
-  ASSERT_TRUE(rig.ask(Request::jog_stop()).accepted);
+  ASSERT_TRUE(rig.ask(controller::Request::jog_stop()).accepted);
   EXPECT_TRUE(rig.until([&] { return rig.status().state == State::Idle; }, 500));
 }
 
@@ -177,9 +177,9 @@ TEST(SharedServoHost, AControllerOverSharedMemoryJogsTheMachine) {
 // controller attaches to the same tick (same set-up: the servo and its state stay) and resets.
 TEST(SharedServoHost, ASilentControllerStopsTheMachineAndANewOneTakesOver) {
   SharedRig rig(mill(), "heartbeat", 50);
-  ASSERT_TRUE(rig.ask(Request::simple(CommandKind::MachineOn)).accepted);
-  ASSERT_TRUE(rig.ask(Request::set_mode(Mode::Manual)).accepted);
-  ASSERT_TRUE(rig.ask(Request::jog(Axis::X, 30)).accepted);
+  ASSERT_TRUE(rig.ask(controller::Request::simple(CommandKind::MachineOn)).accepted);
+  ASSERT_TRUE(rig.ask(controller::Request::set_mode(Mode::Manual)).accepted);
+  ASSERT_TRUE(rig.ask(controller::Request::jog(Axis::X, 30)).accepted);
   rig.until([] { return false; }, 400);
   const std::uint64_t built_before = rig.host_->servos_built();
   ASSERT_EQ(built_before, 1u);
@@ -208,8 +208,8 @@ TEST(SharedServoHost, ASilentControllerStopsTheMachineAndANewOneTakesOver) {
   EXPECT_EQ(rig.host_->servos_built(), built_before);  // same set-up: the servo (and its state) stayed
   rig.until([&] { return rig.status().state == State::Faulted; }, 10);
   EXPECT_EQ(rig.status().fault.kind, FaultKind::PowerLoss);
-  ASSERT_TRUE(rig.ask(Request::simple(CommandKind::Reset)).accepted);
-  EXPECT_TRUE(rig.ask(Request::simple(CommandKind::MachineOn)).accepted);
+  ASSERT_TRUE(rig.ask(controller::Request::simple(CommandKind::Reset)).accepted);
+  EXPECT_TRUE(rig.ask(controller::Request::simple(CommandKind::MachineOn)).accepted);
 }
 
 /// The drill's profile and tool table copied to a directory of this test's own (profile edits
@@ -244,7 +244,8 @@ TEST(SharedServoHost, ANewControllerNeverWritesThePitchBufferTheTickReads) {
     return std::string("[0, -0.002, -0.004, -0.0045, ") + fifth + ", -0.007, -0.009, -0.0105, -0.012]";
   };
   for (const char* fifth : {"-0.006", "-0.007", "-0.005"}) {
-    const Outcome o = rig.ask(Request::edit_profile({{"axis.y.compensation.forward", forward(fifth)}}, "admin"));
+    const controller::Outcome o = rig.ask(
+        controller::Request::edit_profile({{"axis.y.compensation.forward", forward(fifth)}}, "admin"));
     ASSERT_TRUE(o.accepted) << o.message;
   }
   ASSERT_EQ(area.reading[1].index.load(), 0);
@@ -273,7 +274,8 @@ TEST(SharedServoHost, ANewControllerNeverWritesThePitchBufferTheTickReads) {
   ASSERT_GT(rig.owner_->segment().header.setup_taken.load(), taken);
   ASSERT_EQ(area.reading[1].index.load(), 0) << "the set-up differs: the servo was rebuilt";
 
-  const Outcome o = rig.ask(Request::edit_profile({{"axis.y.compensation.forward", forward("-0.008")}}, "admin"));
+  const controller::Outcome o = rig.ask(
+      controller::Request::edit_profile({{"axis.y.compensation.forward", forward("-0.008")}}, "admin"));
   ASSERT_TRUE(o.accepted) << o.message;
   EXPECT_EQ(area.reading[1].index.load(), 1);
   const Servo* servo = rig.host_->servo();

@@ -7,7 +7,7 @@
 
 #include "opencnc/controller/events.hpp"
 
-namespace opencnc::control::test {
+namespace opencnc::controller::test {
 namespace {
 
 ControllerEvent full_event() {
@@ -17,8 +17,8 @@ ControllerEvent full_event() {
   e.severity = Severity::Error;
   e.code = "control.edm.short";
   e.text = "part.ngc:12:1: the short did not clear";
-  e.servo.kind = EventKind::Fault;
-  e.servo.fault.kind = FaultKind::Stall;
+  e.servo.kind = control::EventKind::Fault;
+  e.servo.fault.kind = control::FaultKind::Stall;
   e.servo.value = 2.5;
   e.request_id = 77;
   e.accepted = true;
@@ -122,4 +122,4 @@ TEST(EventLogEntries, TheRingOverwritesTheOldestInOrder) {
 }
 
 }  // namespace
-}  // namespace opencnc::control::test
+}  // namespace opencnc::controller::test

@@ -15,7 +15,7 @@
 #include "opencnc/controller/events.hpp"
 #include "opencnc/controller/sim_rig.hpp"
 
-namespace opencnc::control::test {
+namespace opencnc::controller::test {
 namespace {
 
 /// Keeps what it is told.
@@ -23,9 +23,9 @@ class Recorder final : public ControllerObserver {
  public:
   void on_event(const ControllerEvent& e) override { events.push_back(e); }
   void on_status(const ControllerStatus& s) override { status_ticks.push_back(s.servo.tick); }
-  void on_trace(const TraceSample& s, const TraceContext& c) override {
+  void on_trace(const control::TraceSample& s, const TraceContext& c) override {
     ++samples;
-    if (s.activity == Activity::Program && c.program != nullptr) ++with_program;
+    if (s.activity == control::Activity::Program && c.program != nullptr) ++with_program;
   }
   std::vector<ControllerEvent> events;
   std::vector<std::uint64_t> status_ticks;
@@ -50,8 +50,9 @@ std::shared_ptr<const canon::Program> line_x(const Pose& from, double to, double
 }
 
 bool run_until_idle(SimRig& rig, std::uint64_t max_ticks = 100000) {
-  return rig.run_until([&] { return !rig.status().run_active && rig.status().servo.state == State::Idle; },
-                       max_ticks);
+  return rig.run_until(
+      [&] { return !rig.status().run_active && rig.status().servo.state == control::State::Idle; },
+      max_ticks);
 }
 
 TEST(EventLog, NumbersEntriesAndCursorsCountWhatTheyMissed) {
@@ -81,32 +82,32 @@ TEST(EventLog, NumbersEntriesAndCursorsCountWhatTheyMissed) {
 // The answers are kept in slots built with the controller: the last 4096 requests' answers can be
 // read, older ones are gone, and answering more never grows the controller.
 TEST(Hub, KeepsTheAnswersOfTheLatestRequestsInFixedSlots) {
-  SimRig rig(mill());
+  SimRig rig(control::test::mill());
   Controller& c = rig.controller();
-  const std::uint64_t first = c.submit(Request::set_mode(Mode::Auto));
+  const std::uint64_t first = c.submit(Request::set_mode(control::Mode::Auto));
   std::uint64_t last = first;
-  for (int i = 0; i < 4200; ++i) last = c.submit(Request::set_mode(Mode::Manual));
+  for (int i = 0; i < 4200; ++i) last = c.submit(Request::set_mode(control::Mode::Manual));
   ASSERT_TRUE(rig.run_until([&] { return c.outcome(last).has_value() && c.outcome(last - 4095).has_value(); },
                             20000));
   EXPECT_FALSE(c.outcome(first).has_value());  // 4200 later answers took its place
   const std::optional<Outcome> o = c.outcome(last);
   ASSERT_TRUE(o.has_value());
-  EXPECT_EQ(o->accepted, o->refusal == Refusal::None);
+  EXPECT_EQ(o->accepted, o->refusal == control::Refusal::None);
   EXPECT_FALSE(c.outcome(last + 1).has_value());  // not asked yet
 }
 
 TEST(Hub, ObserversEachSeeEveryEventFromWhenTheyAttached) {
-  SimRig rig(mill());
+  SimRig rig(control::test::mill());
   auto first = std::make_shared<Recorder>();
   auto second = std::make_shared<Recorder>();
   rig.controller().attach(first, ObserverOptions{0.01, true});
   rig.step();
-  ASSERT_TRUE(rig.request(Request::simple(CommandKind::MachineOn)).accepted);
+  ASSERT_TRUE(rig.request(Request::simple(control::CommandKind::MachineOn)).accepted);
   rig.controller().attach(second);
   rig.step();
-  ASSERT_TRUE(rig.request(Request::set_mode(Mode::Auto)).accepted);
+  ASSERT_TRUE(rig.request(Request::set_mode(control::Mode::Auto)).accepted);
   ASSERT_TRUE(rig.request(Request::open(line_x(rig.status().servo.commanded, 10), "line")).accepted);
-  ASSERT_TRUE(rig.request(Request::simple(CommandKind::CycleStart)).accepted);
+  ASSERT_TRUE(rig.request(Request::simple(control::CommandKind::CycleStart)).accepted);
   ASSERT_TRUE(run_until_idle(rig));
   rig.run(20);
   // Both saw the job start and end; neither took them from the other.
@@ -129,12 +130,12 @@ TEST(Hub, AnObserverThatThrowsIsDetachedWithANote) {
   struct Bad final : ControllerObserver {
     void on_event(const ControllerEvent&) override { throw std::runtime_error("disk full"); }
   };
-  SimRig rig(mill());
+  SimRig rig(control::test::mill());
   auto log = std::make_shared<Recorder>();
   const std::uint64_t bad = rig.controller().attach(std::make_shared<Bad>());
   rig.controller().attach(log);
   rig.step();
-  ASSERT_TRUE(rig.request(Request::simple(CommandKind::MachineOn)).accepted);
+  ASSERT_TRUE(rig.request(Request::simple(control::CommandKind::MachineOn)).accepted);
   rig.run(3);
   bool noted = false;
   for (const auto& e : log->events) noted = noted || (e.code == "control.observer" && e.text.find("disk full") != std::string::npos);
@@ -152,7 +153,7 @@ class CheckRoutine final : public Feature {
   Outcome handle(const requests::Feature& r, FeatureHost& host) override {
     Outcome o;
     if (r.action != "probe-x") {
-      o.refusal = Refusal::BadValue;
+      o.refusal = control::Refusal::BadValue;
       o.message = "unknown action " + r.action;
       return o;
     }
@@ -169,13 +170,13 @@ class CheckRoutine final : public Feature {
 };
 
 TEST(Hub, AFeatureRunsAProgramOfItsOwnAndTheOpenProgramStays) {
-  SimRig rig(mill());
+  SimRig rig(control::test::mill());
   auto check = std::make_shared<CheckRoutine>();
   ASSERT_TRUE(rig.controller().add_feature(check));
   EXPECT_FALSE(rig.controller().add_feature(std::make_shared<CheckRoutine>()));  // the name is taken
-  ASSERT_TRUE(rig.request(Request::simple(CommandKind::MachineOn)).accepted);
+  ASSERT_TRUE(rig.request(Request::simple(control::CommandKind::MachineOn)).accepted);
   EXPECT_NE(check->attached_to, nullptr);
-  ASSERT_TRUE(rig.request(Request::set_mode(Mode::Auto)).accepted);
+  ASSERT_TRUE(rig.request(Request::set_mode(control::Mode::Auto)).accepted);
   ASSERT_TRUE(rig.request(Request::open(line_x(rig.status().servo.commanded, 30), "main")).accepted);
   // The feature's request: its own program runs, the open one stays open.
   ASSERT_TRUE(rig.request(Request::feature("check", "probe-x", 12.0)).accepted);
@@ -187,7 +188,7 @@ TEST(Hub, AFeatureRunsAProgramOfItsOwnAndTheOpenProgramStays) {
   EXPECT_NEAR(rig.status().servo.commanded[Axis::X], 12.0, 1e-9);
   EXPECT_EQ(rig.status().program_name, "main");
   // Cycle start runs the main program (from where the machine stands now).
-  ASSERT_TRUE(rig.request(Request::simple(CommandKind::CycleStart)).accepted);
+  ASSERT_TRUE(rig.request(Request::simple(control::CommandKind::CycleStart)).accepted);
   ASSERT_TRUE(run_until_idle(rig));
   EXPECT_NEAR(rig.status().servo.commanded[Axis::X], 30.0, 1e-9);
   // Unknown features and actions are refused with words.
@@ -195,33 +196,33 @@ TEST(Hub, AFeatureRunsAProgramOfItsOwnAndTheOpenProgramStays) {
   EXPECT_FALSE(none.accepted);
   EXPECT_NE(none.message.find("nothing"), std::string::npos);
   const Outcome bad = rig.request(Request::feature("check", "fly"));
-  EXPECT_EQ(bad.refusal, Refusal::BadValue);
+  EXPECT_EQ(bad.refusal, control::Refusal::BadValue);
   EXPECT_NE(bad.message.find("fly"), std::string::npos);
 }
 
 TEST(Hub, AuxiliaryProgramsNeedAutoModeAndAnIdleMachine) {
-  SimRig rig(mill());
-  ASSERT_TRUE(rig.request(Request::simple(CommandKind::MachineOn)).accepted);
+  SimRig rig(control::test::mill());
+  ASSERT_TRUE(rig.request(Request::simple(control::CommandKind::MachineOn)).accepted);
   const auto p = line_x(rig.status().servo.commanded, 5);
-  EXPECT_EQ(rig.request(Request::run_auxiliary("x", p)).refusal, Refusal::WrongMode);  // Manual
-  ASSERT_TRUE(rig.request(Request::set_mode(Mode::Auto)).accepted);
+  EXPECT_EQ(rig.request(Request::run_auxiliary("x", p)).refusal, control::Refusal::WrongMode);  // Manual
+  ASSERT_TRUE(rig.request(Request::set_mode(control::Mode::Auto)).accepted);
   ASSERT_TRUE(rig.request(Request::run_auxiliary("x", p)).accepted);
-  EXPECT_EQ(rig.request(Request::run_auxiliary("y", p)).refusal, Refusal::Busy);
+  EXPECT_EQ(rig.request(Request::run_auxiliary("y", p)).refusal, control::Refusal::Busy);
   ASSERT_TRUE(run_until_idle(rig));
 }
 
 TEST(Requests, CarryTypedFieldsToTheServo) {
-  const auto mist = to_command(Request::coolant(Coolant::Mist, true));
+  const auto mist = to_command(Request::coolant(control::Coolant::Mist, true));
   ASSERT_TRUE(mist.has_value());
-  EXPECT_EQ(mist->kind, CommandKind::Coolant);
-  EXPECT_EQ(mist->coolant, Coolant::Mist);
+  EXPECT_EQ(mist->kind, control::CommandKind::Coolant);
+  EXPECT_EQ(mist->coolant, control::Coolant::Mist);
   EXPECT_TRUE(mist->flag);
   const auto jog = to_command(Request::jog_by(Axis::Z, -1.5, 4));
   EXPECT_EQ(jog->axis, index(Axis::Z));
   EXPECT_EQ(jog->value, -1.5);
   EXPECT_EQ(jog->value2, 4);
   EXPECT_EQ(to_command(Request::home())->axis, -1);
-  EXPECT_EQ(to_command(Request::rapid_override(0.5))->kind, CommandKind::SetRapidOverride);
+  EXPECT_EQ(to_command(Request::rapid_override(0.5))->kind, control::CommandKind::SetRapidOverride);
   EXPECT_FALSE(to_command(Request::open("part.ngc")).has_value());   // the controller's own
   EXPECT_FALSE(to_command(Request::block_delete(true)).has_value());
   EXPECT_EQ(Request::mdi("G0 X1").name(), "mdi");
@@ -229,10 +230,10 @@ TEST(Requests, CarryTypedFieldsToTheServo) {
 }
 
 TEST(Requests, TheControllersOwnStartRunIsRefused) {
-  SimRig rig(mill());
-  const Outcome o = rig.request(Request::simple(CommandKind::StartRun));
-  EXPECT_EQ(o.refusal, Refusal::BadValue);
+  SimRig rig(control::test::mill());
+  const Outcome o = rig.request(Request::simple(control::CommandKind::StartRun));
+  EXPECT_EQ(o.refusal, control::Refusal::BadValue);
 }
 
 }  // namespace
-}  // namespace opencnc::control::test
+}  // namespace opencnc::controller::test

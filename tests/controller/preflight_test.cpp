@@ -12,7 +12,7 @@
 #include "opencnc/control/machine_action.hpp"
 #include "opencnc/controller/preflight.hpp"
 
-namespace opencnc::control {
+namespace opencnc::controller {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
@@ -121,7 +121,7 @@ TEST(Preflight, SoftLimitErrorsNameTheLineAndTheAxis) {
   b.begin_block(o);
   arc(b, 1, 10, 20, 10, 10, 1, 0);  // counterclockwise around (10, 10): reaches X 20
   const canon::Program p = b.take();
-  ServoConfig c;
+  control::ServoConfig c;
   c.joint_count = 3;
   for (int j = 0; j < 3; ++j) {
     c.joints[static_cast<std::size_t>(j)].axis = static_cast<std::int8_t>(j);
@@ -182,16 +182,16 @@ TEST(MachineActions, OnlyMarkerActionsBecomeRecords) {
   b.wait_for_input(2, false, 0, 0);
   const canon::Program p = b.take();
   ASSERT_EQ(p.action_count(), 5u);
-  EXPECT_EQ(machine_action(p, 0)->code, ActionCode::SpindleSpeed);
-  EXPECT_EQ(machine_action(p, 0)->value, 2500);
-  EXPECT_EQ(machine_action(p, 1)->code, ActionCode::SpindleCw);
-  EXPECT_FALSE(machine_action(p, 2).has_value());
-  EXPECT_EQ(machine_action(p, 3)->code, ActionCode::DigitalOutput);
-  EXPECT_EQ(machine_action(p, 3)->index, 3);
-  EXPECT_EQ(machine_action(p, 3)->index2, 1);
-  EXPECT_EQ(machine_action(p, 4)->code, ActionCode::WaitInput);
-  EXPECT_FALSE(machine_action(p, 4)->digital);
+  EXPECT_EQ(control::machine_action(p, 0)->code, control::ActionCode::SpindleSpeed);
+  EXPECT_EQ(control::machine_action(p, 0)->value, 2500);
+  EXPECT_EQ(control::machine_action(p, 1)->code, control::ActionCode::SpindleCw);
+  EXPECT_FALSE(control::machine_action(p, 2).has_value());
+  EXPECT_EQ(control::machine_action(p, 3)->code, control::ActionCode::DigitalOutput);
+  EXPECT_EQ(control::machine_action(p, 3)->index, 3);
+  EXPECT_EQ(control::machine_action(p, 3)->index2, 1);
+  EXPECT_EQ(control::machine_action(p, 4)->code, control::ActionCode::WaitInput);
+  EXPECT_FALSE(control::machine_action(p, 4)->digital);
 }
 
 }  // namespace
-}  // namespace opencnc::control
+}  // namespace opencnc::controller

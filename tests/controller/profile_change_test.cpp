@@ -22,7 +22,7 @@
 #include "opencnc/controller/sim_rig.hpp"
 #include "opencnc/core/atomic_file.hpp"
 
-namespace opencnc::control::test {
+namespace opencnc::controller::test {
 namespace {
 
 std::shared_ptr<const canon::Program> line_x(const Pose& from, double to, double feed_mm_min) {
@@ -45,8 +45,8 @@ class ProfileChange : public ::testing::Test {
     ASSERT_TRUE(write_file_atomically(path_, original_, nullptr));
     std::filesystem::copy_file(OPENCNC_SOURCE_DIR "/configs/mill-3axis.tbl", dir_ / "mill-3axis.tbl",
                                std::filesystem::copy_options::overwrite_existing);
-    rig_ = std::make_unique<SimRig>(loaded(config::load_profile(path_)));
-    ASSERT_TRUE(rig_->request(Request::simple(CommandKind::MachineOn)).accepted);
+    rig_ = std::make_unique<SimRig>(control::test::loaded(config::load_profile(path_)));
+    ASSERT_TRUE(rig_->request(Request::simple(control::CommandKind::MachineOn)).accepted);
   }
   void TearDown() override {
     rig_.reset();
@@ -62,7 +62,8 @@ class ProfileChange : public ::testing::Test {
   }
   bool idle() {
     return rig_->run_until(
-        [&] { return rig_->status().servo.state == State::Idle && !rig_->status().run_active; }, 100000);
+        [&] { return rig_->status().servo.state == control::State::Idle && !rig_->status().run_active; },
+        100000);
   }
   /// The fastest |velocity| of X while `ticks` periods run.
   double fastest_x(std::uint64_t ticks) {
@@ -110,7 +111,7 @@ TEST_F(ProfileChange, RefusedWhileAJogRunsAndNothingChanges) {
   rig_->run(50);
   const Outcome o = edit({{"axis.x.max_velocity", "20.0"}});
   EXPECT_FALSE(o.accepted);
-  EXPECT_EQ(o.refusal, Refusal::Busy);
+  EXPECT_EQ(o.refusal, control::Refusal::Busy);
   EXPECT_EQ(file(), original_);
   EXPECT_EQ(rig_->servo().config().joints[0].max_velocity, 100.0);
   EXPECT_EQ(rig_->controller().profile().axes[0].max_velocity, 100.0);
@@ -122,7 +123,7 @@ TEST_F(ProfileChange, TheTickRefusingTheApplyPutsTheFileAndTheLimitsBack) {
   rig_->controller().submit(Request::jog(Axis::X, 50));
   const Outcome o = edit({{"axis.x.max_velocity", "20.0"}});
   EXPECT_FALSE(o.accepted);
-  EXPECT_EQ(o.refusal, Refusal::Busy) << o.message;
+  EXPECT_EQ(o.refusal, control::Refusal::Busy) << o.message;
   EXPECT_EQ(o.message, "the machine would not take the new limits now: nothing changed");
   EXPECT_EQ(file(), original_);
   EXPECT_EQ(rig_->servo().config().joints[0].max_velocity, 100.0);
@@ -131,16 +132,16 @@ TEST_F(ProfileChange, TheTickRefusingTheApplyPutsTheFileAndTheLimitsBack) {
 }
 
 TEST_F(ProfileChange, AProgramMoveAfterTheChangeObeysTheNewLimit) {
-  ASSERT_TRUE(rig_->request(Request::set_mode(Mode::Auto)).accepted);
+  ASSERT_TRUE(rig_->request(Request::set_mode(control::Mode::Auto)).accepted);
   const Pose at = rig_->status().servo.commanded;
   ASSERT_TRUE(rig_->request(Request::open(line_x(at, 100, 6000), "line")).accepted);
   ASSERT_TRUE(edit({{"axis.x.max_velocity", "25.0"}}).accepted);
-  ASSERT_TRUE(rig_->request(Request::simple(CommandKind::CycleStart)).accepted);
+  ASSERT_TRUE(rig_->request(Request::simple(control::CommandKind::CycleStart)).accepted);
   double v = 0;
   ASSERT_TRUE(rig_->run_until(
       [&] {
         v = std::max(v, std::fabs(rig_->status().servo.joints[0].velocity));
-        return rig_->status().servo.state == State::Idle && !rig_->status().run_active;
+        return rig_->status().servo.state == control::State::Idle && !rig_->status().run_active;
       },
       100000));
   EXPECT_LE(v, 25.0 + 1e-6);
@@ -149,20 +150,20 @@ TEST_F(ProfileChange, AProgramMoveAfterTheChangeObeysTheNewLimit) {
 }
 
 TEST_F(ProfileChange, NewSoftLimitsAreCheckedBeforeTheOpenProgramStartsAndWhereTheMachineStands) {
-  ASSERT_TRUE(rig_->request(Request::set_mode(Mode::Auto)).accepted);
+  ASSERT_TRUE(rig_->request(Request::set_mode(control::Mode::Auto)).accepted);
   const Pose at = rig_->status().servo.commanded;
   ASSERT_TRUE(rig_->request(Request::open(line_x(at, 100, 3000), "line")).accepted);
   ASSERT_TRUE(edit({{"axis.x.max_limit", "50.0"}}).accepted);
-  const Outcome start = rig_->request(Request::simple(CommandKind::CycleStart));
+  const Outcome start = rig_->request(Request::simple(control::CommandKind::CycleStart));
   EXPECT_FALSE(start.accepted);
-  EXPECT_EQ(start.refusal, Refusal::SoftLimit) << start.message;
+  EXPECT_EQ(start.refusal, control::Refusal::SoftLimit) << start.message;
   EXPECT_EQ(rig_->status().servo.commanded[Axis::X], at[Axis::X]);
-  ASSERT_TRUE(rig_->request(Request::set_mode(Mode::Manual)).accepted);
+  ASSERT_TRUE(rig_->request(Request::set_mode(control::Mode::Manual)).accepted);
   ASSERT_TRUE(rig_->request(Request::jog_by(Axis::X, 40, 50)).accepted);
   ASSERT_TRUE(idle());
   const Outcome outside = edit({{"axis.x.max_limit", "30.0"}});
   EXPECT_FALSE(outside.accepted);
-  EXPECT_EQ(outside.refusal, Refusal::SoftLimit);
+  EXPECT_EQ(outside.refusal, control::Refusal::SoftLimit);
   EXPECT_EQ(outside.message,
             "X stands at 40.0000, outside the new soft limits -2000.0000 … 30.0000: move it inside first");
   EXPECT_EQ(rig_->servo().config().joints[0].max_limit, 50.0);
@@ -171,7 +172,7 @@ TEST_F(ProfileChange, NewSoftLimitsAreCheckedBeforeTheOpenProgramStartsAndWhereT
 TEST_F(ProfileChange, ABadValueGetsTheProfilesMessageAndChangesNothing) {
   const Outcome o = edit({{"axis.y.max_acceleration", "-1.0"}});
   EXPECT_FALSE(o.accepted);
-  EXPECT_EQ(o.refusal, Refusal::BadValue);
+  EXPECT_EQ(o.refusal, control::Refusal::BadValue);
   ASSERT_FALSE(o.diagnostics.items().empty());
   EXPECT_EQ(o.diagnostics.items().front().file, path_);
   EXPECT_EQ(o.message.rfind("the profile refuses the change: " + path_ + ":", 0), 0u) << o.message;
@@ -187,10 +188,10 @@ TEST_F(ProfileChange, ABadValueGetsTheProfilesMessageAndChangesNothing) {
 }
 
 TEST(ServoLimits, AStagedSetAppliesWhileIdleAndABadStageRefusesTheApply) {
-  SimRig rig(mill());
-  ASSERT_TRUE(rig.request(Request::simple(CommandKind::MachineOn)).accepted);
-  auto send = [&](CommandKind k, int joint, JointLimits l) {
-    Command c;
+  SimRig rig(control::test::mill());
+  ASSERT_TRUE(rig.request(Request::simple(control::CommandKind::MachineOn)).accepted);
+  auto send = [&](control::CommandKind k, int joint, control::JointLimits l) {
+    control::Command c;
     c.id = 9000 + static_cast<std::uint64_t>(rig.ticks());
     c.kind = k;
     c.axis = static_cast<std::int8_t>(joint);
@@ -198,28 +199,28 @@ TEST(ServoLimits, AStagedSetAppliesWhileIdleAndABadStageRefusesTheApply) {
     EXPECT_TRUE(rig.channels().commands.try_push(c));
     return c.id;
   };
-  const JointLimits slow{10, 100, -5, 5, 0.2, 10};
-  send(CommandKind::StageJointLimits, 1, {10, 100, 5, -5, 0.2, 10});  // min above max
-  const std::uint64_t bad = send(CommandKind::ApplyJointLimits, -1, {});
+  const control::JointLimits slow{10, 100, -5, 5, 0.2, 10};
+  send(control::CommandKind::StageJointLimits, 1, {10, 100, 5, -5, 0.2, 10});  // min above max
+  const std::uint64_t bad = send(control::CommandKind::ApplyJointLimits, -1, {});
   rig.run(3);
   ASSERT_TRUE(rig.controller().outcome(bad).has_value());
-  EXPECT_EQ(rig.controller().outcome(bad)->refusal, Refusal::BadValue);
+  EXPECT_EQ(rig.controller().outcome(bad)->refusal, control::Refusal::BadValue);
   EXPECT_EQ(rig.servo().config().joints[1].max_velocity, 100.0);
-  send(CommandKind::StageJointLimits, 1, slow);
-  const std::uint64_t good = send(CommandKind::ApplyJointLimits, -1, {});
+  send(control::CommandKind::StageJointLimits, 1, slow);
+  const std::uint64_t good = send(control::CommandKind::ApplyJointLimits, -1, {});
   rig.run(3);
   EXPECT_TRUE(rig.controller().outcome(good)->accepted);
   EXPECT_EQ(rig.servo().config().joints[1].max_limit, 5.0);
   EXPECT_EQ(rig.servo().config().joints[0].max_limit, 2000.0);
-  const std::uint64_t none = send(CommandKind::ApplyJointLimits, -1, {});
+  const std::uint64_t none = send(control::CommandKind::ApplyJointLimits, -1, {});
   rig.run(3);
-  EXPECT_EQ(rig.controller().outcome(none)->refusal, Refusal::NotApplicable);
+  EXPECT_EQ(rig.controller().outcome(none)->refusal, control::Refusal::NotApplicable);
 }
 
 }  // namespace
-}  // namespace opencnc::control::test
+}  // namespace opencnc::controller::test
 
-namespace opencnc::control::test {
+namespace opencnc::controller::test {
 namespace {
 
 // The drill's X has a pitch table with backlash: its backlash and take-up limits are editable, the
@@ -235,7 +236,7 @@ TEST(ProfileChangeCompensation, BacklashAndTakeUpLimitsReachTheTickAndTheReserve
   std::string original;
   ASSERT_TRUE(read_file(path, original, nullptr));
   {
-    SimRig rig(loaded(config::load_profile(path)));
+    SimRig rig(control::test::loaded(config::load_profile(path)));
     const Outcome o = rig.request(Request::edit_profile(
         {{"axis.x.compensation.backlash", "0.05"}, {"axis.x.compensation.takeup_velocity", "4.0"}}));
     ASSERT_TRUE(o.accepted) << o.message;
@@ -244,7 +245,7 @@ TEST(ProfileChangeCompensation, BacklashAndTakeUpLimitsReachTheTickAndTheReserve
     const motion::JointCompensation& c = rig.servo().config().compensation.joints[0];
     EXPECT_EQ(c.backlash, 0.05);
     EXPECT_EQ(c.max_velocity, 4.0);
-    const ServoConfig expected = control::servo_config(rig.controller().profile());
+    const control::ServoConfig expected = controller::servo_config(rig.controller().profile());
     EXPECT_EQ(rig.servo().config().joints[0].max_velocity, expected.joints[0].max_velocity);
     EXPECT_LT(rig.servo().config().joints[0].max_velocity,
               rig.controller().profile().axes[0].max_velocity - 4.0);
@@ -275,7 +276,7 @@ TEST(ProfileChangeCompensation, APitchTableReachesTheTickAndABadOneChangesNothin
                                std::filesystem::copy_options::overwrite_existing);
   const std::string path = (dir / "drill-retrofit.toml").string();
   {
-    SimRig rig(loaded(config::load_profile(path)));
+    SimRig rig(control::test::loaded(config::load_profile(path)));
     const std::string y = "[0, -0.002, -0.004, -0.0045, -0.006, -0.007, -0.009, -0.0105, -0.012]";
     const Outcome o = rig.request(Request::edit_profile({{"axis.y.compensation.forward", y}}, "admin"));
     ASSERT_TRUE(o.accepted) << o.message;
@@ -291,7 +292,7 @@ TEST(ProfileChangeCompensation, APitchTableReachesTheTickAndABadOneChangesNothin
     const Outcome steep =
         rig.request(Request::edit_profile({{"axis.y.compensation.forward", "[0, 0, 0, 0, 0, 0, 0, 0, 2]"}}));
     EXPECT_FALSE(steep.accepted);
-    EXPECT_EQ(steep.refusal, Refusal::BadValue);
+    EXPECT_EQ(steep.refusal, control::Refusal::BadValue);
     EXPECT_NE(steep.message.find(path + ":"), std::string::npos) << steep.message;
     std::string after;
     ASSERT_TRUE(read_file(path, after, nullptr));
@@ -301,18 +302,18 @@ TEST(ProfileChangeCompensation, APitchTableReachesTheTickAndABadOneChangesNothin
     motion::PitchTable& bad = rig.channels().pitch_tables.joints[1][1];
     bad = t;
     bad.position[3] = bad.position[2];
-    Command stage;
+    control::Command stage;
     stage.id = 77001;
-    stage.kind = CommandKind::StagePitchTable;
+    stage.kind = control::CommandKind::StagePitchTable;
     stage.axis = 1;
     stage.table_buffer = 1;
-    Command apply;
+    control::Command apply;
     apply.id = 77002;
-    apply.kind = CommandKind::ApplyJointLimits;
+    apply.kind = control::CommandKind::ApplyJointLimits;
     ASSERT_TRUE(rig.channels().commands.try_push(stage) && rig.channels().commands.try_push(apply));
     rig.run(3);
     ASSERT_TRUE(rig.controller().outcome(77002).has_value());
-    EXPECT_EQ(rig.controller().outcome(77002)->refusal, Refusal::BadValue);
+    EXPECT_EQ(rig.controller().outcome(77002)->refusal, control::Refusal::BadValue);
     EXPECT_EQ(&rig.servo().compensation().pitch_table(1), &t);
   }
   std::filesystem::remove_all(dir);
@@ -334,8 +335,8 @@ TEST(ProfileChangeCompensation, ACompFilesTableIsPutBackWhenTheTickRefusesAndWri
   std::filesystem::copy_file(OPENCNC_SOURCE_DIR "/configs/drill-retrofit.tbl", dir / "drill-retrofit.tbl",
                              std::filesystem::copy_options::overwrite_existing);
   {
-    SimRig rig(loaded(config::load_profile(path)));
-    ASSERT_TRUE(rig.request(Request::simple(CommandKind::MachineOn)).accepted);
+    SimRig rig(control::test::loaded(config::load_profile(path)));
+    ASSERT_TRUE(rig.request(Request::simple(control::CommandKind::MachineOn)).accepted);
     const std::string forward = "[0, -0.002, -0.004, -0.0045, -0.006, -0.007, -0.009, -0.0105, -0.012]";
     rig.controller().submit(Request::jog(Axis::X, 5));
     const Outcome refused =
@@ -347,7 +348,7 @@ TEST(ProfileChangeCompensation, ACompFilesTableIsPutBackWhenTheTickRefusesAndWri
     EXPECT_EQ(now, opencnc::test::kDrillYComp);
     EXPECT_EQ(rig.controller().profile().axes[1].compensation.forward[4], -0.005);
     ASSERT_TRUE(rig.request(Request::jog_stop()).accepted);
-    ASSERT_TRUE(rig.run_until([&] { return rig.status().servo.state == State::Idle; }, 10000));
+    ASSERT_TRUE(rig.run_until([&] { return rig.status().servo.state == control::State::Idle; }, 10000));
     const Outcome o = rig.request(Request::edit_profile({{"axis.y.compensation.forward", forward}}, "admin"));
     ASSERT_TRUE(o.accepted) << o.message;
     ASSERT_TRUE(read_file(comp, now, nullptr));
@@ -358,4 +359,4 @@ TEST(ProfileChangeCompensation, ACompFilesTableIsPutBackWhenTheTickRefusesAndWri
 }
 
 }  // namespace
-}  // namespace opencnc::control::test
+}  // namespace opencnc::controller::test

@@ -16,14 +16,14 @@
 #include "opencnc/controller/gcode_source.hpp"
 #include "opencnc/features/features.hpp"
 
-namespace opencnc::control {
+namespace opencnc::controller {
 namespace {
 
 class ResumeTest : public ::testing::Test {
  protected:
   void SetUp() override {
     Diagnostics d;
-    source_ = features::machine_setup(test::mill(), d)->source();
+    source_ = features::machine_setup(control::test::mill(), d)->source();
     dir_ = std::filesystem::temp_directory_path() /
            ("opencnc-resume-" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
     std::filesystem::create_directories(dir_);
@@ -142,7 +142,7 @@ TEST_F(ResumeTest, APastProbeOrInputOrTheEndCannotBeReplayed) {
 // before segment k is passed again before k's move, earlier ones not; codes after k pass live.
 TEST_F(ResumeTest, TheProcessCodeInForceAtSegmentKIsSelectedAgain) {
   const config::MachineProfile edm =
-      test::loaded(config::load_profile(OPENCNC_SOURCE_DIR "/configs/edm-5axis.toml"));
+      control::test::loaded(config::load_profile(OPENCNC_SOURCE_DIR "/configs/edm-5axis.toml"));
   Diagnostics d;
   auto source = features::machine_setup(edm, d)->source();
   const std::string path = write(
@@ -188,4 +188,4 @@ TEST_F(ResumeTest, TheProcessCodeInForceAtSegmentKIsSelectedAgain) {
 }
 
 }  // namespace
-}  // namespace opencnc::control
+}  // namespace opencnc::controller

@@ -10,7 +10,7 @@
 #include "opencnc/config/profile_writer.hpp"
 #include "opencnc/drill/calibration.hpp"
 
-namespace opencnc::control {
+namespace opencnc::controller {
 namespace {
 
 config::MachineProfile drill() {
@@ -22,10 +22,10 @@ config::MachineProfile drill() {
 // The target: the midpoint's spread at most 1 µm, and smaller than a single edge's (which
 // drifts 2 µm/K with the 10 K the runs span).
 TEST(Calibration, MidpointSpreadIsBelowAMicrometreAndBelowTheSingleEdge) {
-  HomingSpreadOptions o;
+  drill::HomingSpreadOptions o;
   o.runs = 8;
   o.seed = 3;
-  const HomingSpread h = homing_spread(drill(), o);
+  const drill::HomingSpread h = drill::homing_spread(drill(), o);
   EXPECT_EQ(h.axes, AxisMask::from_letters("XY"));
   EXPECT_EQ(h.runs, 8);
   for (Axis a : {Axis::X, Axis::Y}) {
@@ -42,10 +42,10 @@ TEST(Calibration, MidpointSpreadIsBelowAMicrometreAndBelowTheSingleEdge) {
 // is left is the steppers' 1.5625 µm step.
 TEST(Calibration, PositioningBeforeAndAfterTheMeasuredTable) {
   const config::MachineProfile p = drill();
-  PositioningOptions o;
+  drill::PositioningOptions o;
   o.axes = AxisMask::from_letters("Y");
-  const Positioning before = measure_positioning(without_compensation(p), o);
-  const AxisPositioning& b = before.axis[index(Axis::Y)];
+  const drill::Positioning before = drill::measure_positioning(drill::without_compensation(p), o);
+  const drill::AxisPositioning& b = before.axis[index(Axis::Y)];
   ASSERT_EQ(b.targets.size(), 9u);  // 0 … 400 every 50 within −5 … 405
   EXPECT_EQ(b.targets.front(), 0.0);
   EXPECT_EQ(b.targets.back(), 400.0);
@@ -55,14 +55,14 @@ TEST(Calibration, PositioningBeforeAndAfterTheMeasuredTable) {
   EXPECT_NEAR(b.accuracy, 0.027, 0.001);
   config::MachineProfile compensated = p;
   for (config::AxisProfile& ax : compensated.axes) {
-    if (ax.axis == Axis::Y) ax.compensation = compensation_from(b, ax);
+    if (ax.axis == Axis::Y) ax.compensation = drill::compensation_from(b, ax);
   }
   const config::CompensationProfile& y = compensated.find(Axis::Y)->compensation;
   EXPECT_EQ(y.backlash, 0.0);
   EXPECT_EQ(y.forward, b.mean_up);
   EXPECT_EQ(y.takeup_velocity, 2.0);  // the profile's take-up limits stay
-  const Positioning after = measure_positioning(compensated, o);
-  const AxisPositioning& a = after.axis[index(Axis::Y)];
+  const drill::Positioning after = drill::measure_positioning(compensated, o);
+  const drill::AxisPositioning& a = after.axis[index(Axis::Y)];
   EXPECT_LE(a.accuracy, 0.002);
   EXPECT_LE(a.repeatability, 0.002);
   EXPECT_LE(a.reversal, 0.0016);
@@ -138,4 +138,4 @@ TEST(ProfileWriter, RefusesWhatItCannotEditSafely) {
 }
 
 }  // namespace
-}  // namespace opencnc::control
+}  // namespace opencnc::controller

@@ -16,7 +16,7 @@
 #include "opencnc/drill/hand_axis.hpp"
 #include "opencnc/features/features.hpp"
 
-namespace opencnc::control {
+namespace opencnc::controller {
 namespace {
 
 config::MachineProfile drill() {
@@ -146,4 +146,4 @@ TEST(HandAxisPass, ArcsHelicesAndTargetsBeyondTheStrokeAreRefusedAtTheirLine) {
 }
 
 }  // namespace
-}  // namespace opencnc::control
+}  // namespace opencnc::controller

@@ -22,7 +22,7 @@
 #include "opencnc/features/features.hpp"
 #include "opencnc/tools/tool_table_service.hpp"
 
-namespace opencnc::control::test {
+namespace opencnc::controller::test {
 namespace {
 
 config::MachineProfile edm_machine() {
@@ -51,18 +51,18 @@ Burnt run(const std::string& text, const config::MachineProfile& profile) {
   r.rig->controller().attach(r.samples, ObserverOptions{0, true});
   r.rig->step();
   EXPECT_TRUE(on_and_homed(*r.rig));
-  EXPECT_TRUE(r.rig->request(Request::set_mode(Mode::Auto)).accepted);
+  EXPECT_TRUE(r.rig->request(Request::set_mode(control::Mode::Auto)).accepted);
   const Outcome opened = r.rig->request(Request::open(path), 100000);
   EXPECT_TRUE(opened.accepted) << opened.message;
   if (!opened.accepted) return r;
-  EXPECT_TRUE(r.rig->request(Request::simple(CommandKind::CycleStart)).accepted);
+  EXPECT_TRUE(r.rig->request(Request::simple(control::CommandKind::CycleStart)).accepted);
   r.finished = r.rig->run_until(
       [&] {
-        const EdmStatus& e = r.rig->status().servo.edm;
+        const control::EdmStatus& e = r.rig->status().servo.edm;
         const machine::SimEdmProcess& sim = r.rig->machine().edm();
         if (e.condition == 2 && r.oversize_before_orbit_mm < 0)
           r.oversize_before_orbit_mm = sim.cavity_oversize_mm();
-        return !r.rig->status().run_active && r.rig->status().servo.state == State::Idle;
+        return !r.rig->status().run_active && r.rig->status().servo.state == control::State::Idle;
       },
       60000);
   return r;
@@ -79,7 +79,7 @@ TEST(EdmCavity, AFinishingOrbitWidensTheCavityByItsRadiusPlusTheSideGap) {
   // The orbit's radius from the trace: the commanded X, Y's farthest from the burn's centre (0, 0)
   // while condition 2 burnt.
   double radius = 0;
-  for (const TraceSample& s : r.samples->all)
+  for (const control::TraceSample& s : r.samples->all)
     if (s.edm.condition == 2 && s.edm.generator)
       radius = std::max(radius, std::hypot(s.commanded[Axis::X], s.commanded[Axis::Y]));
   EXPECT_NEAR(radius, 0.05, 1e-6);
@@ -129,29 +129,30 @@ struct ElectrodeRig {
     tools = std::make_shared<tools::MemoryToolTable>(std::move(t));
     Diagnostics d;
     auto machine = features::machine_setup(
-        profile, d, control::MachineSetup::Options::with_tools(tools));  // the test's tool table
+        profile, d, controller::MachineSetup::Options::with_tools(tools));  // the test's tool table
     EXPECT_TRUE(machine);
     rig = std::make_unique<SimRig>(profile, *machine);
-    feature = std::dynamic_pointer_cast<ElectrodeSetting>(machine->feature("electrode"));
+    feature = std::dynamic_pointer_cast<edm::ElectrodeSetting>(machine->feature("electrode"));
     EXPECT_TRUE(feature);
     rig->step();
     EXPECT_TRUE(on_and_homed(*rig));
   }
   bool idle() {
     return rig->run_until(
-        [&] { return !rig->status().run_active && rig->status().servo.state == State::Idle; }, 100000);
+        [&] { return !rig->status().run_active && rig->status().servo.state == control::State::Idle; },
+        100000);
   }
   void mdi(const std::string& line) {
-    EXPECT_TRUE(rig->request(Request::set_mode(Mode::Mdi)).accepted);
+    EXPECT_TRUE(rig->request(Request::set_mode(control::Mode::Mdi)).accepted);
     const Outcome o = rig->request(Request::mdi(line), 100000);
     EXPECT_TRUE(o.accepted) << o.message;
     EXPECT_TRUE(idle());
   }
-  ElectrodeResult measure(int tool) {
-    const Outcome o = rig->request(Request::feature("electrode", "measure", ElectrodeMeasure{tool}));
+  edm::ElectrodeResult measure(int tool) {
+    const Outcome o = rig->request(Request::feature("electrode", "measure", edm::ElectrodeMeasure{tool}));
     EXPECT_TRUE(o.accepted) << o.message;
-    EXPECT_TRUE(rig->run_until([&] { return feature->phase() == ElectrodePhase::Idle; }, 100000));
-    return feature->last().value_or(ElectrodeResult{});
+    EXPECT_TRUE(rig->run_until([&] { return feature->phase() == edm::ElectrodePhase::Idle; }, 100000));
+    return feature->last().value_or(edm::ElectrodeResult{});
   }
   /// Opens `text` (written to a file for the test) and starts it.
   void start(const std::string& text, const std::string& name) {
@@ -159,10 +160,10 @@ struct ElectrodeRig {
     std::filesystem::create_directories(dir);
     const std::string path = (dir / "p.ngc").string();
     std::ofstream(path) << text;
-    EXPECT_TRUE(rig->request(Request::set_mode(Mode::Auto)).accepted);
+    EXPECT_TRUE(rig->request(Request::set_mode(control::Mode::Auto)).accepted);
     const Outcome opened = rig->request(Request::open(path), 100000);
     EXPECT_TRUE(opened.accepted) << opened.message;
-    EXPECT_TRUE(rig->request(Request::simple(CommandKind::CycleStart)).accepted);
+    EXPECT_TRUE(rig->request(Request::simple(control::CommandKind::CycleStart)).accepted);
   }
   /// … and runs it to its end.
   bool run(const std::string& text, const std::string& name) {
@@ -173,7 +174,7 @@ struct ElectrodeRig {
 
   std::shared_ptr<tools::MemoryToolTable> tools;
   std::unique_ptr<SimRig> rig;
-  std::shared_ptr<ElectrodeSetting> feature;
+  std::shared_ptr<edm::ElectrodeSetting> feature;
 };
 
 /// Tool 1 burns 60 µm below the surface at X0 Y0 with its table offsets (G43).
@@ -198,7 +199,7 @@ TEST(EdmElectrode, AnUnmeasuredElectrodeBurnsOffByItsErrorAMeasuredOneWhereProgr
   ASSERT_TRUE(unmeasured.run(kBurnWithG43, "unmeasured"));
   ElectrodeRig measured(p, {0, 0, 0});
   measured.mdi("T1 M6");
-  const ElectrodeResult m = measured.measure(1);
+  const edm::ElectrodeResult m = measured.measure(1);
   ASSERT_TRUE(m.ok) << m.message;
   for (std::size_t i = 0; i < 3; ++i) EXPECT_NEAR(m.offset[i], truth[i], kTwoSteps) << "axis " << i;
   ASSERT_TRUE(measured.run(kBurnWithG43, "measured"));
@@ -234,14 +235,14 @@ TEST(EdmElectrode, AWornElectrodeReplacedMidJobFinishesTheCavityAsAnUninterrupte
   ASSERT_TRUE(changed.measure(1).ok);
   changed.start(kBurnWithG43, "changed");
   ASSERT_TRUE(changed.rig->run_until([&] { return changed.sim().depth_mm() > 0.035; }, 100000));
-  ASSERT_TRUE(changed.rig->request(Request::simple(CommandKind::FeedHold)).accepted);
+  ASSERT_TRUE(changed.rig->request(Request::simple(control::CommandKind::FeedHold)).accepted);
   ASSERT_TRUE(changed.rig->run_until(
       [&] {
-        return changed.rig->status().servo.state == State::Held &&
+        return changed.rig->status().servo.state == control::State::Held &&
                changed.rig->status().servo.path_velocity == 0;
       },
       5000));
-  ASSERT_TRUE(changed.rig->request(Request::simple(CommandKind::Abort)).accepted);
+  ASSERT_TRUE(changed.rig->request(Request::simple(control::CommandKind::Abort)).accepted);
   ASSERT_TRUE(changed.idle());
   ASSERT_TRUE(changed.feature->stop().has_value());
   const double worn_mm = changed.sim().electrode_wear_mm();
@@ -249,7 +250,7 @@ TEST(EdmElectrode, AWornElectrodeReplacedMidJobFinishesTheCavityAsAnUninterrupte
   changed.mdi("G53 G0 Z-10");  // out of the cavity
   const Vec3 fresh{0.07, -0.01, 0.09};
   changed.rig->machine().replace_electrode(1, fresh, 0.8);
-  const ElectrodeResult m = changed.measure(1);
+  const edm::ElectrodeResult m = changed.measure(1);
   ASSERT_TRUE(m.ok) << m.message;
   for (std::size_t i = 0; i < 3; ++i) EXPECT_NEAR(m.offset[i], fresh[i], kTwoSteps) << "axis " << i;
   const std::uint64_t finished = changed.rig->status().runs_finished;
@@ -274,4 +275,4 @@ TEST(EdmElectrode, AWornElectrodeReplacedMidJobFinishesTheCavityAsAnUninterrupte
 }
 
 }  // namespace
-}  // namespace opencnc::control::test
+}  // namespace opencnc::controller::test

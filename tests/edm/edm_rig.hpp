@@ -14,29 +14,31 @@
 #include "opencnc/controller/controller.hpp"
 #include "opencnc/controller/sim_rig.hpp"
 
-namespace opencnc::control::test {
+namespace opencnc::controller::test {
 
 /// edm-5axis with a smaller electrode (5 mm²: four times the depth per discharge) so that a burn
 /// of a few hundredths takes seconds of virtual time; `sets` after it.
 inline config::MachineProfile edm_profile(std::vector<std::string> sets = {}) {
   sets.insert(sets.begin(), "edm.sim.electrode_area_mm2=5");
-  return loaded(config::load_profile(OPENCNC_SOURCE_DIR "/configs/edm-5axis.toml", sets));
+  return control::test::loaded(config::load_profile(OPENCNC_SOURCE_DIR "/configs/edm-5axis.toml", sets));
 }
 
 /// Machine on and every axis homed on its switches (the EDM's steppers know nothing at power-up).
 inline bool on_and_homed(SimRig& rig) {
-  if (!rig.request(Request::simple(CommandKind::MachineOn)).accepted) return false;
-  if (!rig.request(Request::set_mode(Mode::Manual)).accepted || !rig.request(Request::home()).accepted)
+  if (!rig.request(Request::simple(control::CommandKind::MachineOn)).accepted) return false;
+  if (!rig.request(Request::set_mode(control::Mode::Manual)).accepted ||
+      !rig.request(Request::home()).accepted)
     return false;
   return rig.run_until(
-      [&] { return rig.status().servo.state == State::Idle && rig.status().servo.all_homed; }, 60000);
+      [&] { return rig.status().servo.state == control::State::Idle && rig.status().servo.all_homed; },
+      60000);
 }
 
 /// Every trace sample of the run.
 class Samples final : public ControllerObserver {
  public:
-  void on_trace(const TraceSample& s, const TraceContext&) override { all.push_back(s); }
-  std::vector<TraceSample> all;
+  void on_trace(const control::TraceSample& s, const TraceContext&) override { all.push_back(s); }
+  std::vector<control::TraceSample> all;
 };
 
 /// `text` written to `<tmp>/<prefix>-<the running test's name>/p.ngc`; its path.
@@ -49,4 +51,4 @@ inline std::string write_program(const std::string& text, const std::string& pre
   return path;
 }
 
-}  // namespace opencnc::control::test
+}  // namespace opencnc::controller::test

@@ -27,7 +27,7 @@
 #include "opencnc/features/features.hpp"
 #include "opencnc/run_from_line/run_from_line.hpp"
 
-namespace opencnc::control::test {
+namespace opencnc::controller::test {
 namespace {
 
 config::MachineProfile edm(std::vector<std::string> sets = {}) {
@@ -40,11 +40,11 @@ std::string write_program(const std::string& text) {
 
 struct EdmRun {
   std::unique_ptr<SimRig> rig;
-  std::shared_ptr<EdmRecorder> recorder;
+  std::shared_ptr<edm::EdmRecorder> recorder;
   std::shared_ptr<Samples> samples;
   Outcome opened;
   bool finished = false;
-  EdmReport report;
+  edm::EdmReport report;
 };
 
 /// Opens `text` and runs it to its end; `each` is called between periods (fault injection).
@@ -53,20 +53,20 @@ EdmRun run(const std::string& text, const config::MachineProfile& profile = edm(
   EdmRun r;
   Diagnostics d;
   r.rig = std::make_unique<SimRig>(profile, *features::machine_setup(profile, d));
-  r.recorder = std::make_shared<EdmRecorder>(profile.edm.config, profile.servo_period_s);
+  r.recorder = std::make_shared<edm::EdmRecorder>(profile.edm.config, profile.servo_period_s);
   r.samples = std::make_shared<Samples>();
   r.rig->controller().attach(r.recorder, ObserverOptions{0, true});
   r.rig->controller().attach(r.samples, ObserverOptions{0, true});
   r.rig->step();
   EXPECT_TRUE(on_and_homed(*r.rig));
-  EXPECT_TRUE(r.rig->request(Request::set_mode(Mode::Auto)).accepted);
+  EXPECT_TRUE(r.rig->request(Request::set_mode(control::Mode::Auto)).accepted);
   r.opened = r.rig->request(Request::open(write_program(text)), 100000);
   if (!r.opened.accepted) return r;
-  EXPECT_TRUE(r.rig->request(Request::simple(CommandKind::CycleStart)).accepted);
+  EXPECT_TRUE(r.rig->request(Request::simple(control::CommandKind::CycleStart)).accepted);
   r.finished = r.rig->run_until(
       [&] {
         if (each) each(*r.rig);
-        return !r.rig->status().run_active && r.rig->status().servo.state == State::Idle;
+        return !r.rig->status().run_active && r.rig->status().servo.state == control::State::Idle;
       },
       60000);
   r.report = r.recorder->report();
@@ -97,7 +97,7 @@ TEST(Edm, AnInjectedShortIsBackedOffAlongThePathAndRecovered) {
   bool injected = false;
   double backlog_max = 0;
   const EdmRun r = run(burn(1, 0.03), edm(), [&](SimRig& rig) {
-    const ServoStatus& s = rig.status().servo;
+    const control::ServoStatus& s = rig.status().servo;
     backlog_max = std::max(backlog_max, s.edm.backlog_mm);
     if (!injected && s.time_s > 0.5 && s.edm.generator && s.edm.gap_state == machine::GapState::Normal) {
       rig.machine().inject_edm_short();
@@ -125,28 +125,29 @@ TEST(Edm, AShortThatNeverClearsStopsTheMachineWithAFault) {
   Diagnostics d;
   SimRig rig(p, *features::machine_setup(p, d));
   EventCursor events(rig.controller().events());
-  auto recorder = std::make_shared<EdmRecorder>(p.edm.config, p.servo_period_s);
+  auto recorder = std::make_shared<edm::EdmRecorder>(p.edm.config, p.servo_period_s);
   rig.controller().attach(recorder, ObserverOptions{0, true});
   rig.step();
   ASSERT_TRUE(on_and_homed(rig));
-  ASSERT_TRUE(rig.request(Request::set_mode(Mode::Auto)).accepted);
+  ASSERT_TRUE(rig.request(Request::set_mode(control::Mode::Auto)).accepted);
   ASSERT_TRUE(rig.request(Request::open(write_program(burn(1, 0.03))), 100000).accepted);
-  ASSERT_TRUE(rig.request(Request::simple(CommandKind::CycleStart)).accepted);
+  ASSERT_TRUE(rig.request(Request::simple(control::CommandKind::CycleStart)).accepted);
   double shorted_at = -1, limit_at = -1;
   ASSERT_TRUE(rig.run_until(
       [&] {
-        const ServoStatus& s = rig.status().servo;
+        const control::ServoStatus& s = rig.status().servo;
         if (shorted_at < 0 && s.edm.generator && s.edm.gap_state == machine::GapState::Normal) {
           rig.machine().inject_edm_short();
           shorted_at = s.time_s;
         }
         if (limit_at < 0 && s.edm.retract_limit) limit_at = s.time_s;
-        return s.state == State::Faulted || (!rig.status().run_active && s.state == State::Idle);
+        return s.state == control::State::Faulted ||
+               (!rig.status().run_active && s.state == control::State::Idle);
       },
       40000));
-  const ServoStatus s = rig.status().servo;
-  ASSERT_EQ(s.state, State::Faulted);
-  EXPECT_EQ(s.fault.kind, FaultKind::EdmShort);
+  const control::ServoStatus s = rig.status().servo;
+  ASSERT_EQ(s.state, control::State::Faulted);
+  EXPECT_EQ(s.fault.kind, control::FaultKind::EdmShort);
   ASSERT_GE(shorted_at, 0);
   ASSERT_GE(limit_at, shorted_at);
   // The short is timed from its first period: the fault comes 8 s later, to a period or two.
@@ -172,7 +173,7 @@ TEST(Edm, AShortThatNeverClearsStopsTheMachineWithAFault) {
   EXPECT_TRUE(told_fault);
   // The report counts the short that never cleared, with its 8 s until the fault.
   rig.run_until([] { return false; }, 5);
-  const EdmReport report = recorder->report();
+  const edm::EdmReport report = recorder->report();
   EXPECT_EQ(report.shorts, 1u);
   EXPECT_EQ(report.shorts_uncleared, 1u);
   EXPECT_NEAR(report.short_recovery_max_s, 8.0, 0.003);
@@ -183,7 +184,7 @@ TEST(Edm, TheShortTimeCountsOnlyAnUnbrokenShort) {
   int shorts = 0;
   double start = -1;  // the run's (after homing)
   const EdmRun r = run(burn(1, 0.03), edm({"edm.short_timeout_s=0.05"}), [&](SimRig& rig) {
-    const ServoStatus& s = rig.status().servo;
+    const control::ServoStatus& s = rig.status().servo;
     if (start < 0) start = s.time_s;
     if (shorts < 3 && s.time_s - start > 0.3 * (shorts + 1) && s.edm.generator &&
         s.edm.gap_state == machine::GapState::Normal) {
@@ -193,7 +194,7 @@ TEST(Edm, TheShortTimeCountsOnlyAnUnbrokenShort) {
   });
   ASSERT_TRUE(r.finished);
   EXPECT_EQ(shorts, 3);
-  EXPECT_EQ(r.rig->status().servo.state, State::Idle);
+  EXPECT_EQ(r.rig->status().servo.state, control::State::Idle);
   EXPECT_GE(r.report.shorts, 3u);
   EXPECT_EQ(r.report.shorts_uncleared, 0u);  // each cleared before the burn ended
 }
@@ -220,20 +221,20 @@ TEST(Edm, AResumedProgramSelectsTheConditionInForceAgain) {
   SimRig rig(p, *features::machine_setup(p, d));
   rig.step();
   ASSERT_TRUE(on_and_homed(rig));
-  ASSERT_TRUE(rig.request(Request::set_mode(Mode::Mdi)).accepted);
+  ASSERT_TRUE(rig.request(Request::set_mode(control::Mode::Mdi)).accepted);
   ASSERT_TRUE(rig.request(Request::mdi("G0 Z-19.995"), 100000).accepted);  // on segment k's line
   ASSERT_TRUE(rig.run_until(
-      [&] { return rig.status().servo.state == State::Idle && !rig.status().run_active; }, 20000));
-  ASSERT_TRUE(rig.request(Request::set_mode(Mode::Auto)).accepted);
+      [&] { return rig.status().servo.state == control::State::Idle && !rig.status().run_active; }, 20000));
+  ASSERT_TRUE(rig.request(Request::set_mode(control::Mode::Auto)).accepted);
   ASSERT_TRUE(rig.request(Request::open(path), 100000).accepted);
   const Outcome resumed = rig.request(Request::resume(k), 100000);
   ASSERT_TRUE(resumed.accepted) << resumed.message;
   int condition_when_burning = -1;
   ASSERT_TRUE(rig.run_until(
       [&] {
-        const EdmStatus& e = rig.status().servo.edm;
+        const control::EdmStatus& e = rig.status().servo.edm;
         if (e.generator && condition_when_burning < 0) condition_when_burning = e.condition;
-        return !rig.status().run_active && rig.status().servo.state == State::Idle;
+        return !rig.status().run_active && rig.status().servo.state == control::State::Idle;
       },
       60000));
   EXPECT_EQ(condition_when_burning, 2);
@@ -247,7 +248,7 @@ TEST(Edm, JumpsLiftTheElectrodeEveryPeriodWithTheGeneratorOff) {
   std::vector<double> starts;  // machining time at each jump's start
   double machining = 0, lift_max = 0;
   bool was = false;
-  for (const TraceSample& s : r.samples->all) {
+  for (const control::TraceSample& s : r.samples->all) {
     if (s.edm.jumping) {
       EXPECT_FALSE(s.edm.generator);
       lift_max = std::max(lift_max, s.edm.jump_lift_mm);
@@ -270,7 +271,7 @@ struct OrbitSeen {
 
 OrbitSeen orbit_of(const EdmRun& r, double radius) {
   OrbitSeen o;
-  for (const TraceSample& s : r.samples->all) {
+  for (const control::TraceSample& s : r.samples->all) {
     const double x = s.commanded[Axis::X], y = s.commanded[Axis::Y];
     const double rr = std::hypot(x, y);
     o.r_max = std::max(o.r_max, rr);
@@ -292,7 +293,7 @@ TEST(Edm, ACircleOrbitGrowsInStepsToItsRadius) {
   EXPECT_EQ(o.round, o.at_full);  // a circle: every sample at the full radius is on it
   // Grew a step per turn: a turn (1 s; the orbit turns through the jumps) after it began, one step.
   double turning = 0;
-  for (const TraceSample& s : r.samples->all) {
+  for (const control::TraceSample& s : r.samples->all) {
     if (s.edm.orbit_radius_mm > 0) turning += 0.001;
     if (turning > 0.95 && turning < 0.97) {
       EXPECT_NEAR(s.edm.orbit_radius_mm, 0.01, 1e-9);
@@ -358,7 +359,7 @@ TEST(Edm, ThePreflightSeesTheOrbitAndTheJump) {
     SimRig rig(p, *features::machine_setup(p, d));
     rig.step();
     ASSERT_TRUE(on_and_homed(rig));
-    ASSERT_TRUE(rig.request(Request::set_mode(Mode::Auto)).accepted);
+    ASSERT_TRUE(rig.request(Request::set_mode(control::Mode::Auto)).accepted);
     const Outcome o = rig.request(Request::open(write_program(c.program)), 100000);
     if (c.message.empty()) {
       EXPECT_TRUE(o.accepted) << o.message
@@ -405,7 +406,8 @@ struct EditableEdm {
   const std::string path;
   /// The profile as edited so far, with the small electrode the burns use.
   config::MachineProfile profile() const {
-    return loaded(config::load_profile(path, std::vector<std::string>{"edm.sim.electrode_area_mm2=5"}));
+    return control::test::loaded(
+        config::load_profile(path, std::vector<std::string>{"edm.sim.electrode_area_mm2=5"}));
   }
 };
 
@@ -430,29 +432,29 @@ TEST(Edm, AnEditedConditionIsTheOneAProgramSelectsAfterwards) {
     EXPECT_NE(text.find("number = 1\non_time_us = 100.0"), std::string::npos);
     EXPECT_NE(text.find("jump_height_mm = 0.25\njump_period_s = 0.25      # T_on"), std::string::npos);
 
-    ASSERT_TRUE(rig.request(Request::set_mode(Mode::Auto)).accepted);
+    ASSERT_TRUE(rig.request(Request::set_mode(control::Mode::Auto)).accepted);
     ASSERT_TRUE(rig.request(Request::open(write_program(burn(1, 0.01))), 100000).accepted);
-    ASSERT_TRUE(rig.request(Request::simple(CommandKind::CycleStart)).accepted);
+    ASSERT_TRUE(rig.request(Request::simple(control::CommandKind::CycleStart)).accepted);
     ASSERT_TRUE(rig.run_until(
-        [&] { return !rig.status().run_active && rig.status().servo.state == State::Idle; }, 60000));
+        [&] { return !rig.status().run_active && rig.status().servo.state == control::State::Idle; }, 60000));
     double lift_max = 0;
-    for (const TraceSample& s : samples->all) lift_max = std::max(lift_max, s.edm.jump_lift_mm);
+    for (const control::TraceSample& s : samples->all) lift_max = std::max(lift_max, s.edm.jump_lift_mm);
     EXPECT_NEAR(lift_max, 0.25, 1e-9);
 
-    EdmConditionTable& bad = rig.channels().edm_conditions;
+    control::EdmConditionTable& bad = rig.channels().edm_conditions;
     bad.conditions = rig.servo().config().edm.conditions;
     bad.count = rig.servo().config().edm.condition_count;
     bad.conditions[0].servo_reference_v = bad.conditions[0].voltage_v;  // the gap would never burn
-    Command stage;
+    control::Command stage;
     stage.id = 78001;
-    stage.kind = CommandKind::StageEdmConditions;
-    Command apply;
+    stage.kind = control::CommandKind::StageEdmConditions;
+    control::Command apply;
     apply.id = 78002;
-    apply.kind = CommandKind::ApplyJointLimits;
+    apply.kind = control::CommandKind::ApplyJointLimits;
     ASSERT_TRUE(rig.channels().commands.try_push(stage) && rig.channels().commands.try_push(apply));
     rig.run(3);
     ASSERT_TRUE(rig.controller().outcome(78002).has_value());
-    EXPECT_EQ(rig.controller().outcome(78002)->refusal, Refusal::BadValue);
+    EXPECT_EQ(rig.controller().outcome(78002)->refusal, control::Refusal::BadValue);
     EXPECT_EQ(rig.servo().config().edm.find(1)->servo_reference_v, 45.0);
   }
 }
@@ -474,7 +476,7 @@ TEST(Edm, AnAddedConditionIsSelectableAndADeletedOneIsNot) {
     rig.controller().attach(samples, ObserverOptions{0, true});
     rig.step();
     ASSERT_TRUE(on_and_homed(rig));
-    ASSERT_TRUE(rig.request(Request::set_mode(Mode::Auto)).accepted);
+    ASSERT_TRUE(rig.request(Request::set_mode(control::Mode::Auto)).accepted);
     const std::string five = write_program(burn(5, 0.01));
     const Outcome unknown = rig.request(Request::open(five), 100000);
     ASSERT_FALSE(unknown.accepted);  // no condition 5 yet
@@ -487,39 +489,41 @@ TEST(Edm, AnAddedConditionIsSelectableAndADeletedOneIsNot) {
     // The open program selects 5 at its line 3: it stays.
     o = rig.request(Request::change_conditions({{5, true, 0}}, "admin"));
     ASSERT_FALSE(o.accepted);
-    EXPECT_EQ(o.refusal, Refusal::ProgramError);
+    EXPECT_EQ(o.refusal, control::Refusal::ProgramError);
     EXPECT_NE(o.message.find(five + ":3:"), std::string::npos) << o.message;
-    ASSERT_TRUE(rig.request(Request::simple(CommandKind::CycleStart)).accepted);
+    ASSERT_TRUE(rig.request(Request::simple(control::CommandKind::CycleStart)).accepted);
     int condition = 0;
     ASSERT_TRUE(rig.run_until(
         [&] {
           condition = std::max(condition, rig.status().servo.edm.condition);
-          return !rig.status().run_active && rig.status().servo.state == State::Idle;
+          return !rig.status().run_active && rig.status().servo.state == control::State::Idle;
         },
         60000));
     EXPECT_EQ(condition, 5);
     double lift_max = 0;
-    for (const TraceSample& s : samples->all) lift_max = std::max(lift_max, s.edm.jump_lift_mm);
+    for (const control::TraceSample& s : samples->all) lift_max = std::max(lift_max, s.edm.jump_lift_mm);
     EXPECT_NEAR(lift_max, 0.15, 1e-9);
     // Run from line 4 scans past the M180 P5 at line 3: its source knows the added condition too.
-    const Outcome from = rig.request(Request::feature("run-from-line", "start", RunFromLineArgs{4}), 100000);
+    const Outcome from =
+        rig.request(Request::feature("run-from-line", "start", run_from_line::RunFromLineArgs{4}), 100000);
     EXPECT_TRUE(from.accepted) << from.message;
     // The approach (an auxiliary job), then the program from line 4 to its end.
     ASSERT_TRUE(
         rig.run_until([&] { return rig.status().run_active && rig.status().job == JobKind::Program; }, 60000))
         << rig.status().fault_text;
     ASSERT_TRUE(rig.run_until(
-        [&] { return !rig.status().run_active && rig.status().servo.state == State::Idle; }, 60000))
+        [&] { return !rig.status().run_active && rig.status().servo.state == control::State::Idle; }, 60000))
         << rig.status().fault_text;
     EXPECT_TRUE(rig.status().fault_text.empty()) << rig.status().fault_text;
     // 9 deleted: an MDI line (its session made before) and a program opened afterwards that
     // select it get the interpreter's message.
-    const Outcome to_mdi = rig.request(Request::set_mode(Mode::Mdi));
+    const Outcome to_mdi = rig.request(Request::set_mode(control::Mode::Mdi));
     ASSERT_TRUE(to_mdi.accepted) << to_mdi.message;
     const auto mdi = [&](const char* line) {
       const Outcome m = rig.request(Request::mdi(line), 100000);
-      rig.run_until([&] { return !rig.status().run_active && rig.status().servo.state == State::Idle; },
-                    20000);
+      rig.run_until(
+          [&] { return !rig.status().run_active && rig.status().servo.state == control::State::Idle; },
+          20000);
       return m;
     };
     ASSERT_TRUE(mdi("G0 Z0").accepted);
@@ -530,7 +534,7 @@ TEST(Edm, AnAddedConditionIsSelectableAndADeletedOneIsNot) {
     EXPECT_FALSE(m9.accepted);
     ASSERT_FALSE(m9.diagnostics.items().empty());
     EXPECT_NE(m9.diagnostics.items().front().message.find("(1, 2, 3, 5)"), std::string::npos);
-    ASSERT_TRUE(rig.request(Request::set_mode(Mode::Auto)).accepted);
+    ASSERT_TRUE(rig.request(Request::set_mode(control::Mode::Auto)).accepted);
     const std::string nine = write_program(burn(9, 0.01));
     o = rig.request(Request::open(nine), 100000);
     ASSERT_FALSE(o.accepted);
@@ -557,18 +561,18 @@ TEST(EdmSeek, TheControllerSaysWhereTheLimitSwitchTripped) {
   SimRig rig(p, *features::machine_setup(p, d));
   EventCursor events(rig.controller().events());
   rig.step();
-  ASSERT_TRUE(rig.request(Request::simple(CommandKind::MachineOn)).accepted);
-  ASSERT_TRUE(rig.request(Request::set_mode(Mode::Manual)).accepted);
+  ASSERT_TRUE(rig.request(Request::simple(control::CommandKind::MachineOn)).accepted);
+  ASSERT_TRUE(rig.request(Request::set_mode(control::Mode::Manual)).accepted);
   const Outcome refused = rig.request(Request::seek_limit(Axis::C, -1));
   EXPECT_FALSE(refused.accepted);
-  EXPECT_EQ(refused.refusal, Refusal::NoLimitSwitch);
+  EXPECT_EQ(refused.refusal, control::Refusal::NoLimitSwitch);
   EXPECT_NE(refused.message.find("no limit switch on that side"), std::string::npos) << refused.message;
   ASSERT_TRUE(rig.request(Request::seek_limit(Axis::Y, +1)).accepted);
   bool running_shown = false;
   ASSERT_TRUE(rig.run_until(
       [&] {
-        running_shown = running_shown || rig.status().servo.seek[1].phase == SeekPhase::Search;
-        return rig.status().servo.state == State::Idle;
+        running_shown = running_shown || rig.status().servo.seek[1].phase == control::SeekPhase::Search;
+        return rig.status().servo.state == control::State::Idle;
       },
       20000));
   EXPECT_TRUE(running_shown);
@@ -576,7 +580,7 @@ TEST(EdmSeek, TheControllerSaysWhereTheLimitSwitchTripped) {
   for (const ControllerEvent& e : events.next()) {
     if (e.code == "control.seek-limit") note = e.text;
   }
-  const LimitSeekStatus st = rig.status().servo.seek[1];
+  const control::LimitSeekStatus st = rig.status().servo.seek[1];
   EXPECT_TRUE(st.found);
   EXPECT_NEAR(st.tripped_at, 101.0, 0.002);  // the switch's noise: 1 µm
   EXPECT_NEAR(st.rest_at, 100.49, 0.002);    // not homed: 0.5 mm off where it released
@@ -588,7 +592,8 @@ TEST(EdmSeek, TheControllerSaysWhereTheLimitSwitchTripped) {
 bool comes_to_rest(SimRig& rig, std::uint64_t ticks) {
   return rig.run_until(
       [&] {
-        return rig.status().servo.state == State::Idle && rig.status().servo.activity == Activity::None;
+        return rig.status().servo.state == control::State::Idle &&
+               rig.status().servo.activity == control::Activity::None;
       },
       ticks);
 }
@@ -612,7 +617,7 @@ TEST(EdmJog, ZJogsOnTheHomedMachineEnd) {
   EXPECT_NEAR(z(), -4.999, 1e-9);
   ASSERT_TRUE(rig.request(Request::jog(Axis::Z, 20.0)).accepted);
   rig.run(200);
-  EXPECT_EQ(rig.status().servo.state, State::Running);
+  EXPECT_EQ(rig.status().servo.state, control::State::Running);
   ASSERT_TRUE(rig.request(Request::jog_stop(Axis::Z)).accepted);
   ASSERT_TRUE(comes_to_rest(rig, 500)) << "stopped from 20 mm/s at 2 m/s²: 10 ms";
   EXPECT_GT(z(), -1.0);
@@ -623,4 +628,4 @@ TEST(EdmJog, ZJogsOnTheHomedMachineEnd) {
 }
 
 }  // namespace
-}  // namespace opencnc::control::test
+}  // namespace opencnc::controller::test

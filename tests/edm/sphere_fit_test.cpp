@@ -10,7 +10,7 @@
 #include "opencnc/edm/b_axis_fit.hpp"
 #include "opencnc/edm/sphere_fit.hpp"
 
-namespace opencnc::control {
+namespace opencnc::edm {
 namespace {
 
 using P = Vec3;
@@ -132,4 +132,4 @@ TEST(BAxisFit, RefusesCentresThatFixNoAxis) {
 }
 
 }  // namespace
-}  // namespace opencnc::control
+}  // namespace opencnc::edm

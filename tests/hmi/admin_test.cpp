@@ -107,8 +107,8 @@ TEST(ApiAdmin, SetParametersIsTheAdminsAndBecomesAnEditProfileRequest) {
                     OPENCNC_SOURCE_DIR "/examples");
   const auto* c = std::get_if<Command>(&parsed);
   ASSERT_NE(c, nullptr);
-  const auto& r = std::get<control::Request>(*c);
-  const auto& e = std::get<control::requests::EditProfile>(r.body);
+  const auto& r = std::get<controller::Request>(*c);
+  const auto& e = std::get<controller::requests::EditProfile>(r.body);
   ASSERT_EQ(e.edits.size(), 1u);
   EXPECT_EQ(e.edits[0].key, "axis.y.max_limit");
   EXPECT_EQ(e.edits[0].value, "500.5");

@@ -17,10 +17,10 @@ class ApiParse : public ::testing::Test {
   config::MachineProfile profile = control::test::mill();
   std::filesystem::path programs = OPENCNC_SOURCE_DIR "/examples";
 
-  control::Request request(const json& body) {
+  controller::Request request(const json& body) {
     auto r = parse_command(body, profile, programs);
     EXPECT_TRUE(std::holds_alternative<Command>(r)) << std::get<ApiError>(r).message;
-    return std::get<control::Request>(std::get<Command>(r));
+    return std::get<controller::Request>(std::get<Command>(r));
   }
   ApiError error(const json& body) {
     auto r = parse_command(body, profile, programs);
@@ -33,33 +33,35 @@ TEST_F(ApiParse, EachKindBecomesItsRequest) {
   EXPECT_EQ(request({{"kind", "cycle-start"}}).name(), "cycle-start");
   EXPECT_EQ(request({{"kind", "tool-changed"}}).name(), "tool-changed");
   const auto jog =
-      std::get<control::requests::Jog>(request({{"kind", "jog"}, {"axis", "y"}, {"velocity", -20}}).body);
+      std::get<controller::requests::Jog>(request({{"kind", "jog"}, {"axis", "y"}, {"velocity", -20}}).body);
   EXPECT_EQ(jog.axis, Axis::Y);
   EXPECT_EQ(jog.velocity, -20);
-  const auto by = std::get<control::requests::JogBy>(
+  const auto by = std::get<controller::requests::JogBy>(
       request({{"kind", "jog-by"}, {"axis", "Z"}, {"distance", 0.1}, {"speed", 5}}).body);
   EXPECT_EQ(by.distance, 0.1);
-  EXPECT_FALSE(std::get<control::requests::Home>(request({{"kind", "home"}}).body).axis);
-  EXPECT_EQ(std::get<control::requests::Home>(request({{"kind", "home"}, {"axis", "X"}}).body).axis, Axis::X);
-  const auto seek = std::get<control::requests::SeekLimit>(
+  EXPECT_FALSE(std::get<controller::requests::Home>(request({{"kind", "home"}}).body).axis);
+  EXPECT_EQ(std::get<controller::requests::Home>(request({{"kind", "home"}, {"axis", "X"}}).body).axis,
+            Axis::X);
+  const auto seek = std::get<controller::requests::SeekLimit>(
       request({{"kind", "seek-limit"}, {"axis", "Z"}, {"direction", "-"}}).body);
   EXPECT_EQ(seek.axis, Axis::Z);
   EXPECT_EQ(seek.direction, -1);
   EXPECT_EQ(error({{"kind", "seek-limit"}, {"axis", "Z"}, {"direction", "up"}}).status, 400);
   EXPECT_EQ(request({{"kind", "override"}, {"which", "feed"}, {"value", 1.5}}).name(), "feed-override");
   EXPECT_EQ(request({{"kind", "switch"}, {"which", "single-block"}, {"on", true}}).name(), "single-block");
-  EXPECT_EQ(std::get<control::requests::SetMode>(request({{"kind", "mode"}, {"mode", "mdi"}}).body).mode,
+  EXPECT_EQ(std::get<controller::requests::SetMode>(request({{"kind", "mode"}, {"mode", "mdi"}}).body).mode,
             control::Mode::Mdi);
-  EXPECT_EQ(std::get<control::requests::Mdi>(request({{"kind", "mdi"}, {"line", "G0 X1"}}).body).line,
+  EXPECT_EQ(std::get<controller::requests::Mdi>(request({{"kind", "mdi"}, {"line", "G0 X1"}}).body).line,
             "G0 X1");
   const auto open =
-      std::get<control::requests::OpenFile>(request({{"kind", "open"}, {"program", "bracket.ngc"}}).body);
+      std::get<controller::requests::OpenFile>(request({{"kind", "open"}, {"program", "bracket.ngc"}}).body);
   EXPECT_TRUE(open.path.ends_with("examples/bracket.ngc"));
   EXPECT_EQ(request({{"kind", "coolant"}, {"which", "mist"}, {"on", true}}).name(), "coolant");
   EXPECT_EQ(request({{"kind", "spindle-on"}, {"rpm", 1000}}).name(), "spindle-on");
-  const auto from = std::get<control::requests::Feature>(request({{"kind", "run-from-line"}, {"line", 66}}).body);
+  const auto from =
+      std::get<controller::requests::Feature>(request({{"kind", "run-from-line"}, {"line", 66}}).body);
   EXPECT_EQ(from.feature, "run-from-line");
-  EXPECT_EQ(std::any_cast<control::RunFromLineArgs>(from.args).line, 66u);
+  EXPECT_EQ(std::any_cast<run_from_line::RunFromLineArgs>(from.args).line, 66u);
   EXPECT_EQ(error({{"kind", "run-from-line"}, {"line", 2.5}}).status, 422);
   EXPECT_EQ(error({{"kind", "run-from-line"}, {"line", "x"}}).status, 400);
 }
@@ -111,7 +113,7 @@ TEST(ApiRoles, AdminOnlyForToolDataOperatorForTheRest) {
 
 TEST(ApiJson, StatusCarriesWhatTheScreensShow) {
   const config::MachineProfile p = control::test::mill();
-  control::ControllerStatus s;
+  controller::ControllerStatus s;
   s.servo.state = control::State::Held;
   s.servo.actual[0] = 12.5;
   s.wait_text = "the operator's resume (feed hold)";

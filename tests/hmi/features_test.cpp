@@ -43,10 +43,10 @@ class FeatureParse : public ::testing::Test {
  protected:
   config::MachineProfile profile = control::test::mill();
 
-  control::requests::Feature request(const json& body) {
+  controller::requests::Feature request(const json& body) {
     auto r = parse_command(body, profile, OPENCNC_SOURCE_DIR "/examples");
     EXPECT_TRUE(std::holds_alternative<Command>(r)) << std::get<ApiError>(r).message;
-    return std::get<control::requests::Feature>(std::get<control::Request>(std::get<Command>(r)).body);
+    return std::get<controller::requests::Feature>(std::get<controller::Request>(std::get<Command>(r)).body);
   }
   ApiError error(const json& body) {
     auto r = parse_command(body, profile, OPENCNC_SOURCE_DIR "/examples");
@@ -111,9 +111,9 @@ TEST_F(FeatureParse, RetraceElectrodeAndToolGuardActions) {
   EXPECT_EQ(request({{"kind", "feature"}, {"feature", "retrace"}, {"action", "pause"}}).action, "pause");
   const auto measure =
       request({{"kind", "feature"}, {"feature", "electrode"}, {"action", "measure"}, {"tool", 3}});
-  EXPECT_EQ(std::any_cast<control::ElectrodeMeasure>(measure.args).tool, 3);
+  EXPECT_EQ(std::any_cast<edm::ElectrodeMeasure>(measure.args).tool, 3);
   EXPECT_FALSE(
-      std::any_cast<control::ElectrodeMeasure>(measure.args).write);  // shown first, stored on confirmation
+      std::any_cast<edm::ElectrodeMeasure>(measure.args).write);  // shown first, stored on confirmation
   EXPECT_EQ(error({{"kind", "feature"},
                    {"feature", "electrode"},
                    {"action", "measure"},
@@ -123,9 +123,8 @@ TEST_F(FeatureParse, RetraceElectrodeAndToolGuardActions) {
             400);
   const auto at_b = request(
       {{"kind", "feature"}, {"feature", "electrode"}, {"action", "measure"}, {"tool", 3}, {"b_deg", 40}});
-  EXPECT_EQ(std::any_cast<control::ElectrodeMeasure>(at_b.args).b_deg, 40.0);
-  EXPECT_FALSE(std::any_cast<control::ElectrodeMeasure>(measure.args).b_deg.has_value())
-      << "at the profile's b";
+  EXPECT_EQ(std::any_cast<edm::ElectrodeMeasure>(at_b.args).b_deg, 40.0);
+  EXPECT_FALSE(std::any_cast<edm::ElectrodeMeasure>(measure.args).b_deg.has_value()) << "at the profile's b";
   const json calibrate = {{"kind", "feature"},
                           {"feature", "electrode"},
                           {"action", "calibrate-b"},
@@ -134,7 +133,7 @@ TEST_F(FeatureParse, RetraceElectrodeAndToolGuardActions) {
   EXPECT_EQ(error(calibrate).status, 400) << "B turns and the axis in use changes: confirmed";
   json confirmed_calibrate = calibrate;
   confirmed_calibrate["confirmed"] = true;
-  EXPECT_EQ(std::any_cast<control::BAxisCalibrate>(request(confirmed_calibrate).args).angles_deg,
+  EXPECT_EQ(std::any_cast<edm::BAxisCalibrate>(request(confirmed_calibrate).args).angles_deg,
             (std::vector<double>{-45, 0, 45}));
   json two_angles = confirmed_calibrate;
   two_angles["angles_deg"] = {0, 45};

@@ -17,11 +17,11 @@ std::filesystem::path fresh_db(const char* name) {
   return d / "history.sqlite";
 }
 
-control::ControllerEvent event(control::ControllerEventKind kind, std::uint64_t tick) {
-  control::ControllerEvent e;
+controller::ControllerEvent event(controller::ControllerEventKind kind, std::uint64_t tick) {
+  controller::ControllerEvent e;
   e.kind = kind;
   e.tick = tick;
-  e.job = control::JobKind::Program;
+  e.job = controller::JobKind::Program;
   e.job_id = 7;
   return e;
 }
@@ -31,19 +31,19 @@ TEST(History, TheRecorderWritesEachJobWithItsAlarms) {
   auto h = History::open(fresh_db("jobs"), &error);
   ASSERT_TRUE(h) << error;
   HistoryRecorder r(*h, 0.001);
-  auto started = event(control::ControllerEventKind::JobStarted, 1000);
+  auto started = event(controller::ControllerEventKind::JobStarted, 1000);
   started.text = "bracket.ngc";
   r.on_event(started);
-  auto alarm = event(control::ControllerEventKind::Note, 1500);
+  auto alarm = event(controller::ControllerEventKind::Note, 1500);
   alarm.severity = Severity::Warning;
   alarm.code = "control.interlock";
   alarm.text = "interlock held the feed";
   r.on_event(alarm);
-  auto mdi = event(control::ControllerEventKind::JobStarted, 1600);
-  mdi.job = control::JobKind::Mdi;  // not a job of the history, and it does not end the program's
+  auto mdi = event(controller::ControllerEventKind::JobStarted, 1600);
+  mdi.job = controller::JobKind::Mdi;  // not a job of the history, and it does not end the program's
   r.on_event(mdi);
-  auto ended = event(control::ControllerEventKind::JobEnded, 3500);
-  ended.end = control::JobEnd::Aborted;
+  auto ended = event(controller::ControllerEventKind::JobEnded, 3500);
+  ended.end = controller::JobEnd::Aborted;
   ended.location.line = 42;
   r.on_event(ended);
   h->flush();

@@ -38,7 +38,7 @@ struct MtcRig {
     connect::StatusSampler::StatusFn status = [this] { return rig->host->controller().status(); };
     if (synthetic)
       status = [i = 0]() mutable {
-        control::ControllerStatus s;
+        controller::ControllerStatus s;
         ++i;
         for (int a = 0; a < kAxisCount; ++a) s.servo.actual[static_cast<std::size_t>(a)] = 0.001 * i * (a + 1);
         s.servo.commanded = s.servo.actual;

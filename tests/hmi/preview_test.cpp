@@ -30,7 +30,7 @@ config::MachineProfile profile(const std::string& name) {
 
 json preview_of(const std::string& text) {
   Diagnostics d;
-  const auto source = control::GcodeProgramSource::create(profile("mill-3axis.toml"), d);
+  const auto source = controller::GcodeProgramSource::create(profile("mill-3axis.toml"), d);
   EXPECT_TRUE(source);
   return program_preview(*source, write_program("opencnc-preview-test.ngc", text), Pose{});
 }
@@ -88,9 +88,9 @@ TEST(Preview, ShowsTheProgramTheFeaturesPassesMake) {
 
   // What runs: the same source's stream, read to its end.
   const auto stream = setup->source()->execute(path, Pose{}, {});
-  while (stream->read(1000) == control::StreamState::Reading) {
+  while (stream->read(1000) == controller::StreamState::Reading) {
   }
-  ASSERT_EQ(stream->state(), control::StreamState::Finished);
+  ASSERT_EQ(stream->state(), controller::StreamState::Finished);
   const canon::Program& run = stream->program();
   ASSERT_EQ(pts.size(), 3 * (1 + run.size()));
   for (canon::SegmentId id = 0; id < run.size(); ++id) {
@@ -100,7 +100,7 @@ TEST(Preview, ShowsTheProgramTheFeaturesPassesMake) {
   }
 
   // Without the feature's pass the same program would draw the quill's plunge to Z-88.
-  const auto plain = control::GcodeProgramSource::create(profile("drill-retrofit.toml"), d);
+  const auto plain = controller::GcodeProgramSource::create(profile("drill-retrofit.toml"), d);
   ASSERT_TRUE(plain);
   const std::vector<double> raw = all_points(program_preview(*plain, path, Pose{}));
   double lowest_z = 0;

@@ -77,7 +77,7 @@ ServerRig::ServerRig(RigOptions o) : dir(fresh_folder()) {
   if (history) host->controller().attach(std::make_shared<HistoryRecorder>(*history, profile.servo_period_s));
   if (features) features->install(host->controller());
   if (o.run_from_line) {  // run from line alone, as its setup adds it, reading the server's tool table
-    auto machine = control::MachineSetup::create(profile, {}, d);
+    auto machine = controller::MachineSetup::create(profile, {}, d);
     machine->source_config().tools = source->tools();
     run_from_line::setup(profile, *machine);
     machine->install(host->controller());

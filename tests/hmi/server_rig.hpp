@@ -14,7 +14,7 @@
 #include "opencnc/config/machine_profile.hpp"
 #include "opencnc/hmi/server.hpp"
 
-namespace opencnc::control {
+namespace opencnc::controller {
 class GcodeProgramSource;
 }
 
@@ -65,7 +65,7 @@ struct ServerRig {
   std::string profile_path;      ///< the copy's path when `profile_copy`
   std::string profile_original;  ///< its text when the rig started
   config::MachineProfile profile;
-  std::shared_ptr<control::GcodeProgramSource> source;
+  std::shared_ptr<controller::GcodeProgramSource> source;
   std::unique_ptr<History> history;
   std::unique_ptr<MachineFeatures> features;
   std::unique_ptr<MachineHost> host;

@@ -429,7 +429,7 @@ TEST(MachineHost, InRealTimeTheServoTicksByItselfAndTheControllerAnswers) {
   MachineHost host(profile, nullptr, HostOptions{true, 1});
   ASSERT_TRUE(host.start(nullptr));  // SCHED_FIFO or, with a warning, a normal thread
   const std::uint64_t id =
-      host.controller().submit(control::Request::simple(control::CommandKind::MachineOn));
+      host.controller().submit(controller::Request::simple(control::CommandKind::MachineOn));
   const auto end = Clock::now() + std::chrono::seconds(10);
   while (!host.controller().outcome(id) && Clock::now() < end)
     std::this_thread::sleep_for(std::chrono::milliseconds(1));

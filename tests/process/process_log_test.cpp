@@ -23,6 +23,7 @@ namespace opencnc::process {
 namespace {
 
 using namespace control;
+using namespace controller;
 
 std::filesystem::path folder() {
   const auto dir =

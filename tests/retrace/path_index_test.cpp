@@ -30,7 +30,7 @@ PathIndex index_of(const std::string& text, Diagnostics* diags_out = nullptr) {
   const std::string path = (dir / "p.ngc").string();
   std::ofstream(path) << text;
   Diagnostics d;
-  auto source = control::MachineSetup::create(control::test::mill(), {}, d)->source();
+  auto source = controller::MachineSetup::create(control::test::mill(), {}, d)->source();
   PathIndex index = scan_path(*source, path, Pose{}, {}, d);
   std::filesystem::remove_all(dir);
   EXPECT_FALSE(d.has_errors()) << (d.items().empty() ? "" : d.items()[0].format());

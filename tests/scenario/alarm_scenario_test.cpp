@@ -10,7 +10,7 @@
 #include "opencnc/config/profile_loader.hpp"
 #include "scenario.hpp"
 
-namespace opencnc::control::test {
+namespace opencnc::controller::test {
 namespace {
 
 config::MachineProfile edm_profile() {
@@ -36,15 +36,15 @@ std::vector<std::string> alarm_notes(EventCursor& cursor) {
 
 TEST(AlarmScenario, AMessageAlarmWarnsAndTheProgramGoesOn) {
   Scenario s(edm_profile());
-  s.on(Mode::Auto);
+  s.on(control::Mode::Auto);
   TempProgram p("cut.ngc", kCut);
   EventCursor log(s.rig().controller().events());
   s.must(Request::open(p.path()));
-  s.must(Request::simple(CommandKind::CycleStart));
+  s.must(Request::simple(control::CommandKind::CycleStart));
   s.ticks(500);
   s.sim().drift_analog_input(kBoxTemperature, 75, 20);  // 35 → 75 °C in 2 s: past 70 after 1.75 s
   ASSERT_TRUE(s.until([&] { return (s.status().servo.alarms_active & (1u << 2)) != 0; }, 3000));
-  EXPECT_EQ(s.status().servo.state, State::Running);
+  EXPECT_EQ(s.status().servo.state, control::State::Running);
   s.sim().drift_analog_input(kBoxTemperature, 60, 20);  // clears below 67 (70 less the hysteresis)
   ASSERT_TRUE(s.until([&] { return s.status().servo.alarms_active == 0; }, 3000));
   EXPECT_LE(s.sim().analog_input(kBoxTemperature), 67.0);
@@ -60,26 +60,27 @@ TEST(AlarmScenario, AMessageAlarmWarnsAndTheProgramGoesOn) {
 
 TEST(AlarmScenario, AFeedHoldAlarmHoldsUntilTheInputIsBackByTheHysteresis) {
   Scenario s(edm_profile());
-  s.on(Mode::Auto);
+  s.on(control::Mode::Auto);
   TempProgram p("cut.ngc", kCut);
   EventCursor log(s.rig().controller().events());
   s.must(Request::open(p.path()));
-  s.must(Request::simple(CommandKind::CycleStart));
+  s.must(Request::simple(control::CommandKind::CycleStart));
   s.ticks(1000);
   s.sim().set_analog_input(kOilTemperature, 40.5);
   ASSERT_TRUE(s.until(
-      [&] { return s.status().servo.state == State::Held && s.status().servo.path_velocity == 0; }, 2000));
+      [&] { return s.status().servo.state == control::State::Held && s.status().servo.path_velocity == 0; },
+      2000));
   const double x = s.status().servo.commanded[Axis::X];
   EXPECT_GT(x, 5.0);
   EXPECT_LT(x, 20.0) << "held on the path";
   s.sim().set_analog_input(kOilTemperature, 39.5);  // below the bound, not by the hysteresis
   s.ticks(10);
-  EXPECT_EQ(s.ask(Request::simple(CommandKind::CycleStart)).refusal, Refusal::Interlock);
-  EXPECT_EQ(s.status().servo.state, State::Held);
+  EXPECT_EQ(s.ask(Request::simple(control::CommandKind::CycleStart)).refusal, control::Refusal::Interlock);
+  EXPECT_EQ(s.status().servo.state, control::State::Held);
   s.sim().set_analog_input(kOilTemperature, 38.9);
   s.ticks(10);
   EXPECT_EQ(s.status().servo.alarms_active, 0u);
-  s.must(Request::simple(CommandKind::CycleStart));
+  s.must(Request::simple(control::CommandKind::CycleStart));
   ASSERT_TRUE(s.until([&] { return !s.status().run_active; }, 10000));
   EXPECT_EQ(s.status().runs_finished, 1u);
   EXPECT_EQ(s.report().max_following_error_mm < 0.5, true);
@@ -94,32 +95,32 @@ TEST(AlarmScenario, AFeedHoldAlarmHoldsUntilTheInputIsBackByTheHysteresis) {
 
 TEST(AlarmScenario, AStopAlarmFaultsAndResetWaitsForTheLevel) {
   Scenario s(edm_profile());
-  s.on(Mode::Auto);
+  s.on(control::Mode::Auto);
   TempProgram p("cut.ngc", kCut);
   s.must(Request::open(p.path()));
-  s.must(Request::simple(CommandKind::CycleStart));
+  s.must(Request::simple(control::CommandKind::CycleStart));
   s.ticks(500);
   s.sim().drift_analog_input(kLevel, 30, 50);  // 80 → 30 mm in 1 s: below 40 after 0.8 s
-  ASSERT_TRUE(s.until([&] { return s.status().servo.state == State::Faulted; }, 2000));
+  ASSERT_TRUE(s.until([&] { return s.status().servo.state == control::State::Faulted; }, 2000));
   EXPECT_LE(s.sim().analog_input(kLevel), 40.0);
   EXPECT_GT(s.sim().analog_input(kLevel), 39.8) << "within two periods (0.05 mm each) of the crossing";
   EXPECT_FALSE(s.status().run_active);
-  EXPECT_EQ(s.status().servo.fault.kind, FaultKind::ProcessAlarm);
+  EXPECT_EQ(s.status().servo.fault.kind, control::FaultKind::ProcessAlarm);
   EXPECT_EQ(s.status().fault_text.rfind("alarm dielectric_level: input 0 reads", 0), 0u)
       << s.status().fault_text;
   EXPECT_NE(s.status().fault_text.find("below its low bound of 40 mm: the machine stopped"),
             std::string::npos);
   ASSERT_TRUE(s.until([&] { return s.sim().analog_input(kLevel) == 30; }, 2000));
-  EXPECT_EQ(s.ask(Request::simple(CommandKind::Reset)).refusal, Refusal::FaultPersists);
+  EXPECT_EQ(s.ask(Request::simple(control::CommandKind::Reset)).refusal, control::Refusal::FaultPersists);
   s.sim().set_analog_input(kLevel, 41);  // above the bound, not by the hysteresis
   s.ticks(5);
-  EXPECT_EQ(s.ask(Request::simple(CommandKind::Reset)).refusal, Refusal::FaultPersists);
+  EXPECT_EQ(s.ask(Request::simple(control::CommandKind::Reset)).refusal, control::Refusal::FaultPersists);
   s.sim().set_analog_input(kLevel, 43);
   s.ticks(5);
-  s.must(Request::simple(CommandKind::Reset));
-  s.must(Request::simple(CommandKind::MachineOn));
+  s.must(Request::simple(control::CommandKind::Reset));
+  s.must(Request::simple(control::CommandKind::MachineOn));
   s.ticks(5);
-  EXPECT_EQ(s.status().servo.state, State::Idle);
+  EXPECT_EQ(s.status().servo.state, control::State::Idle);
 }
 
 TEST(AlarmScenario, AMachineSwitchedOnWithTheLevelLowFaultsAgain) {
@@ -127,10 +128,10 @@ TEST(AlarmScenario, AMachineSwitchedOnWithTheLevelLowFaultsAgain) {
   s.sim().set_analog_input(kLevel, 10);
   s.ticks(5);
   EXPECT_EQ(s.status().servo.alarms_active, 1u);
-  s.ask(Request::simple(CommandKind::MachineOn));
+  s.ask(Request::simple(control::CommandKind::MachineOn));
   s.ticks(5);
-  EXPECT_EQ(s.status().servo.state, State::Faulted);
+  EXPECT_EQ(s.status().servo.state, control::State::Faulted);
 }
 
 }  // namespace
-}  // namespace opencnc::control::test
+}  // namespace opencnc::controller::test

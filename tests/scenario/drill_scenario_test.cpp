@@ -15,7 +15,7 @@
 #include "../control/test_profiles.hpp"
 #include "scenario.hpp"
 
-namespace opencnc::control::test {
+namespace opencnc::controller::test {
 namespace {
 
 constexpr int kX = 0, kY = 1, kZ = 2;
@@ -34,26 +34,26 @@ class Operator {
 
   /// One look at the machine, every period.
   void act() {
-    const ServoStatus& v = status_ = s_.status().servo;
-    if (v.wait == Wait::HandAxis && v.hand_wait.axis == kZ) {
+    const control::ServoStatus& v = status_ = s_.status().servo;
+    if (v.wait == control::Wait::HandAxis && v.hand_wait.axis == kZ) {
       s_.sim().set_hand_target(kZ, v.hand_wait.target, v.hand_wait.retract ? 40.0 : 3.0);
       if (!v.hand_wait.retract) plunged_to_ = v.hand_wait.target;
     }
-    if (v.wait == Wait::ManualToolChange) {
+    if (v.wait == control::Wait::ManualToolChange) {
       if (++changing_ == 3000) {
-        s_.rig().controller().submit(Request::simple(CommandKind::ToolChanged));
+        s_.rig().controller().submit(Request::simple(control::CommandKind::ToolChanged));
         ++tool_changes_;
       }
     } else {
       changing_ = 0;
     }
   }
-  const ServoStatus& status() const { return status_; }
+  const control::ServoStatus& status() const { return status_; }
   int tool_changes() const { return tool_changes_; }
 
  private:
   Scenario& s_;
-  ServoStatus status_{};
+  control::ServoStatus status_{};
   int changing_ = 0;
   int tool_changes_ = 0;
   double plunged_to_ = 0;
@@ -68,10 +68,10 @@ double table_y(Scenario& s) {
 }
 
 void home(Scenario& s) {
-  s.on(Mode::Manual);
+  s.on(control::Mode::Manual);
   s.must(Request::home());
-  ASSERT_TRUE(
-      s.until([&] { return s.status().servo.state == State::Idle && s.status().servo.all_homed; }, 100000));
+  ASSERT_TRUE(s.until(
+      [&] { return s.status().servo.state == control::State::Idle && s.status().servo.all_homed; }, 100000));
 }
 
 struct Hole {
@@ -80,9 +80,9 @@ struct Hole {
 };
 
 TEST(DrillScenario, BearingCapHolesWithinFiveMicrometres) {
-  Scenario s(drill());
+  Scenario s(control::test::drill());
   home(s);
-  s.must(Request::set_mode(Mode::Auto));
+  s.must(Request::set_mode(control::Mode::Auto));
   s.must(Request::open(kProgram));
   Operator op(s);
   // While the quill is down in a hole the table must stand where the program put it.
@@ -91,7 +91,7 @@ TEST(DrillScenario, BearingCapHolesWithinFiveMicrometres) {
   int cutting_without_spindle = 0;  // periods with the tool in the part and the spindle not at speed
   bool down = false;
   EventCursor events(s.rig().controller().events());
-  s.must(Request::simple(CommandKind::CycleStart));
+  s.must(Request::simple(control::CommandKind::CycleStart));
   const bool finished = s.until(
       [&] {
         op.act();
@@ -131,8 +131,8 @@ TEST(DrillScenario, BearingCapHolesWithinFiveMicrometres) {
                                     << r.first_output_violation.limit;
   EXPECT_GT(r.max_compensation_mm, 0.03);
   // After the part the machine homes again: nothing was lost, the origin is where it was.
-  ASSERT_TRUE(
-      s.until([&] { return s.status().servo.state == State::Idle && s.status().servo.all_homed; }, 100000));
+  ASSERT_TRUE(s.until(
+      [&] { return s.status().servo.state == control::State::Idle && s.status().servo.all_homed; }, 100000));
   EXPECT_LE(std::abs(s.status().servo.homing[kX].origin_shift), 0.001);
   EXPECT_LE(std::abs(s.status().servo.homing[kY].origin_shift), 0.001);
   EXPECT_EQ(s.status().servo.commanded[Axis::X], 0.0);
@@ -141,17 +141,17 @@ TEST(DrillScenario, BearingCapHolesWithinFiveMicrometres) {
 // Steps lost without a stall detector (Y) go unseen during the part; homing again after it finds
 // them: the positions had been off by what was lost.
 TEST(DrillScenario, HomingAfterThePartFindsLostSteps) {
-  Scenario s(drill());
+  Scenario s(control::test::drill());
   home(s);
-  s.must(Request::set_mode(Mode::Auto));
+  s.must(Request::set_mode(control::Mode::Auto));
   TempProgram p("y.ngc", "G21 G90\nG0 X20 Y100\nG4 P0.5\nG1 Y101 F600\nG4 P0.5\nG0 Y10\nM30\n");
   s.must(Request::open(p.path()));
-  s.must(Request::simple(CommandKind::CycleStart));
+  s.must(Request::simple(control::CommandKind::CycleStart));
   int pushed = 0;
   ASSERT_TRUE(s.until(
       [&] {
         // A chip jams the saddle for 20 ms as the short move starts: more than the motor can pull.
-        const ServoStatus& v = s.status().servo;
+        const control::ServoStatus& v = s.status().servo;
         if (pushed == 0 && v.line == 4 && v.path_velocity > 0) {
           s.sim().set_external_effort(kY, -1500.0);
           pushed = 1;
@@ -164,8 +164,8 @@ TEST(DrillScenario, HomingAfterThePartFindsLostSteps) {
   ASSERT_EQ(s.status().runs_finished, 1u) << s.status().fault_text;
   const double lost_mm = static_cast<double>(s.sim().joint(kY).lost_steps()) / 640.0;
   EXPECT_GT(lost_mm, 1.0);
-  ASSERT_TRUE(
-      s.until([&] { return s.status().servo.state == State::Idle && s.status().servo.all_homed; }, 100000));
+  ASSERT_TRUE(s.until(
+      [&] { return s.status().servo.state == control::State::Idle && s.status().servo.all_homed; }, 100000));
   EXPECT_NEAR(s.status().servo.homing[kY].origin_shift, lost_mm, 0.002);
   EXPECT_LE(std::abs(s.status().servo.homing[kX].origin_shift), 0.001);
   // Homed again, the table stands where the controller says.
@@ -177,34 +177,34 @@ TEST(DrillScenario, HomingAfterThePartFindsLostSteps) {
 // traverses, the run holds (with a warning naming the axis), cycle start is refused until the
 // quill is back up, and then the run goes on to its end.
 TEST(DrillScenario, TheQuillLeavingItsPlaceHoldsTheTable) {
-  Scenario s(drill());
+  Scenario s(control::test::drill());
   home(s);
-  s.must(Request::set_mode(Mode::Auto));
+  s.must(Request::set_mode(control::Mode::Auto));
   TempProgram p("q.ngc", "G21 G90\nG0 X20 Y20\nG1 Z-5 F100\nG0 Z0\nG0 X300\nM30\n");
   s.must(Request::open(p.path()));
   Operator op(s);
   EventCursor events(s.rig().controller().events());
-  s.must(Request::simple(CommandKind::CycleStart));
+  s.must(Request::simple(control::CommandKind::CycleStart));
   bool pushed = false;
   ASSERT_TRUE(s.until(
       [&] {
         op.act();
-        const ServoStatus& v = s.status().servo;
+        const control::ServoStatus& v = s.status().servo;
         if (!pushed && v.commanded[Axis::X] > 100.0) {
           s.sim().set_hand_target(kZ, -2.0, 20.0);  // the operator lowers the quill on the way
           pushed = true;
         }
-        return v.state == State::Held;
+        return v.state == control::State::Held;
       },
       200000));
   int warnings = 0;
   for (const ControllerEvent& e : events.next()) warnings += e.code == "control.hand-axis";
   EXPECT_EQ(warnings, 1);
   ASSERT_TRUE(s.until([&] { return s.status().servo.path_velocity == 0; }, 5000));
-  EXPECT_EQ(s.ask(Request::simple(CommandKind::CycleStart)).refusal, Refusal::HandAxis);
+  EXPECT_EQ(s.ask(Request::simple(control::CommandKind::CycleStart)).refusal, control::Refusal::HandAxis);
   s.sim().set_hand_target(kZ, 0.0, 20.0);
   s.ticks(1000);
-  s.must(Request::simple(CommandKind::CycleStart));
+  s.must(Request::simple(control::CommandKind::CycleStart));
   ASSERT_TRUE(s.until([&] { return !s.status().run_active; }, 100000));
   EXPECT_EQ(s.status().runs_finished, 1u) << s.status().fault_text;
   EXPECT_EQ(s.status().servo.commanded[Axis::X], 300.0);
@@ -214,16 +214,16 @@ TEST(DrillScenario, TheQuillLeavingItsPlaceHoldsTheTable) {
 // (Wait::Interlock, the rule in status) and starts the spindle once the quill is back at the top
 // ("stop spindle when tool_up" stops a turning spindle, not a start that waits), then the move.
 TEST(DrillScenario, ASpindleStartWaitsForItsInterlock) {
-  Scenario s(drill());
+  Scenario s(control::test::drill());
   home(s);
   s.sim().set_hand_target(kZ, -5.0, 20.0);
   s.ticks(1000);
-  s.must(Request::set_mode(Mode::Mdi));
+  s.must(Request::set_mode(control::Mode::Mdi));
   s.must(Request::mdi("M3 S600 G1 X30 F300"));
-  ASSERT_TRUE(s.until([&] { return s.status().servo.wait == Wait::Interlock; }, 5000));
+  ASSERT_TRUE(s.until([&] { return s.status().servo.wait == control::Wait::Interlock; }, 5000));
   EXPECT_EQ(s.status().servo.interlock_rule, 2);
   s.ticks(500);
-  EXPECT_EQ(s.status().servo.wait, Wait::Interlock);
+  EXPECT_EQ(s.status().servo.wait, control::Wait::Interlock);
   EXPECT_EQ(s.status().servo.commanded[Axis::X], 0.0);
   EXPECT_EQ(s.sim().spindle().speed_rps(), 0.0);
   s.sim().set_hand_target(kZ, 0.0, 20.0);
@@ -244,19 +244,19 @@ double coast_bound(const config::MachineProfile& p, Axis a, double v) {
 }
 
 TEST(DrillScenario, EStopDuringAProgramStopsAndRefusesMotionUntilResetAndHomed) {
-  const config::MachineProfile profile = drill();
+  const config::MachineProfile profile = control::test::drill();
   Scenario s(profile);
   home(s);
-  s.must(Request::set_mode(Mode::Auto));
+  s.must(Request::set_mode(control::Mode::Auto));
   TempProgram p("x.ngc", "G21 G90\nG0 X500 Y20\nM30\n");
   s.must(Request::open(p.path()));
-  s.must(Request::simple(CommandKind::CycleStart));
+  s.must(Request::simple(control::CommandKind::CycleStart));
   ASSERT_TRUE(s.until([&] { return s.status().servo.joints[kX].commanded > 200.0; }, 100000));
   const double v = std::abs(s.status().servo.joints[kX].velocity);
   EXPECT_GT(v, 40.0);
   const double at = s.sim().joint(kX).table_position();
   s.sim().set_estop_pressed(true);
-  ASSERT_TRUE(s.until([&] { return s.status().servo.state == State::EStopped; }, 10));
+  ASSERT_TRUE(s.until([&] { return s.status().servo.state == control::State::EStopped; }, 10));
   s.ticks(2000);
   EXPECT_FALSE(s.status().run_active);
   EXPECT_FALSE(s.status().servo.drives_enabled);
@@ -266,19 +266,19 @@ TEST(DrillScenario, EStopDuringAProgramStopsAndRefusesMotionUntilResetAndHomed) 
   EXPECT_EQ(s.sim().joint(kX).velocity(), 0.0);
   // Motion is refused until reset; reset until the button is released; then the steppers, which
   // lost their place without power, must home again before a program may run.
-  EXPECT_EQ(s.ask(Request::simple(CommandKind::CycleStart)).refusal, Refusal::EStopActive);
-  EXPECT_EQ(s.ask(Request::simple(CommandKind::Reset)).refusal, Refusal::EStopInput);
+  EXPECT_EQ(s.ask(Request::simple(control::CommandKind::CycleStart)).refusal, control::Refusal::EStopActive);
+  EXPECT_EQ(s.ask(Request::simple(control::CommandKind::Reset)).refusal, control::Refusal::EStopInput);
   s.sim().set_estop_pressed(false);
   s.ticks(2);
-  s.must(Request::simple(CommandKind::Reset));
-  s.must(Request::simple(CommandKind::MachineOn));
+  s.must(Request::simple(control::CommandKind::Reset));
+  s.must(Request::simple(control::CommandKind::MachineOn));
   EXPECT_FALSE(s.status().servo.all_homed);
-  EXPECT_EQ(s.ask(Request::simple(CommandKind::CycleStart)).refusal, Refusal::NotHomed);
-  s.must(Request::set_mode(Mode::Manual));
+  EXPECT_EQ(s.ask(Request::simple(control::CommandKind::CycleStart)).refusal, control::Refusal::NotHomed);
+  s.must(Request::set_mode(control::Mode::Manual));
   s.must(Request::home());
-  ASSERT_TRUE(
-      s.until([&] { return s.status().servo.state == State::Idle && s.status().servo.all_homed; }, 100000));
-  s.must(Request::set_mode(Mode::Auto));
+  ASSERT_TRUE(s.until(
+      [&] { return s.status().servo.state == control::State::Idle && s.status().servo.all_homed; }, 100000));
+  s.must(Request::set_mode(control::Mode::Auto));
   EXPECT_TRUE(s.start_and_finish());
 }
 
@@ -291,28 +291,28 @@ struct LimitCase {
 // Every hard limit, met at full speed: the machine stops within the coasting distance past the
 // switch, refuses to go further, may jog off it after reset, and must home before a program.
 TEST(DrillScenario, EveryHardLimitStopsTheMachineAndRefusesMotionPastIt) {
-  const config::MachineProfile profile = drill();
+  const config::MachineProfile profile = control::test::drill();
   for (const LimitCase& c : {LimitCase{Axis::X, -1, -12.0}, LimitCase{Axis::X, 1, 612.0},
                              LimitCase{Axis::Y, -1, -12.0}, LimitCase{Axis::Y, 1, 412.0}}) {
     SCOPED_TRACE(std::string(1, letter(c.axis)) + (c.direction > 0 ? "+" : "-"));
     const int j = index(c.axis);
-    Scenario s(drill({std::string("axis.") + letter(c.axis) + ".sim.start_position=" +
-                      (c.direction > 0 ? std::to_string(c.switch_at - 30) : "20.0")}));
-    s.on(Mode::Manual);
-    ASSERT_EQ(s.status().servo.state, State::Idle);
+    Scenario s(control::test::drill({std::string("axis.") + letter(c.axis) + ".sim.start_position=" +
+                                     (c.direction > 0 ? std::to_string(c.switch_at - 30) : "20.0")}));
+    s.on(control::Mode::Manual);
+    ASSERT_EQ(s.status().servo.state, control::State::Idle);
     // Unhomed: no soft limits, so a jog at full speed runs into the switch.
     s.must(Request::jog(c.axis, c.direction * 48.0));
-    ASSERT_TRUE(s.until([&] { return s.status().servo.state == State::Faulted; }, 100000));
-    EXPECT_EQ(s.status().servo.fault.kind, FaultKind::LimitSwitch);
+    ASSERT_TRUE(s.until([&] { return s.status().servo.state == control::State::Faulted; }, 100000));
+    EXPECT_EQ(s.status().servo.fault.kind, control::FaultKind::LimitSwitch);
     EXPECT_EQ(s.status().servo.fault.axis, j);
     s.ticks(2000);
     const double past = c.direction * (s.sim().joint(j).table_position() - c.switch_at);
     EXPECT_GE(past, 0.0);
     EXPECT_LE(past, coast_bound(profile, c.axis, 48.0) + 0.05);
-    EXPECT_EQ(s.ask(Request::jog(c.axis, c.direction * 10.0)).refusal, Refusal::Faulted);
-    s.must(Request::simple(CommandKind::Reset));
-    s.must(Request::simple(CommandKind::MachineOn));
-    EXPECT_EQ(s.ask(Request::jog(c.axis, c.direction * 10.0)).refusal, Refusal::LimitSwitch);
+    EXPECT_EQ(s.ask(Request::jog(c.axis, c.direction * 10.0)).refusal, control::Refusal::Faulted);
+    s.must(Request::simple(control::CommandKind::Reset));
+    s.must(Request::simple(control::CommandKind::MachineOn));
+    EXPECT_EQ(s.ask(Request::jog(c.axis, c.direction * 10.0)).refusal, control::Refusal::LimitSwitch);
     s.must(Request::jog(c.axis, -c.direction * 10.0));  // off the switch
     ASSERT_TRUE(s.until(
         [&] {
@@ -321,23 +321,23 @@ TEST(DrillScenario, EveryHardLimitStopsTheMachineAndRefusesMotionPastIt) {
         },
         20000));
     s.must(Request::jog_stop());
-    ASSERT_TRUE(s.until([&] { return s.status().servo.state == State::Idle; }, 20000));
-    s.must(Request::set_mode(Mode::Mdi));
-    EXPECT_EQ(s.ask(Request::mdi("G0 X10 Y10")).refusal, Refusal::NotHomed);
+    ASSERT_TRUE(s.until([&] { return s.status().servo.state == control::State::Idle; }, 20000));
+    s.must(Request::set_mode(control::Mode::Mdi));
+    EXPECT_EQ(s.ask(Request::mdi("G0 X10 Y10")).refusal, control::Refusal::NotHomed);
   }
 }
 
 // A limit switch met by a program (a switch set inside the travel: an obstacle on the way).
 TEST(DrillScenario, HardLimitDuringAProgram) {
-  const config::MachineProfile profile = drill({"axis.x.switches.limit_max=300.0"});
+  const config::MachineProfile profile = control::test::drill({"axis.x.switches.limit_max=300.0"});
   Scenario s(profile);
   home(s);
-  s.must(Request::set_mode(Mode::Auto));
+  s.must(Request::set_mode(control::Mode::Auto));
   TempProgram p("x.ngc", "G21 G90\nG0 X500 Y20\nM30\n");
   s.must(Request::open(p.path()));
-  s.must(Request::simple(CommandKind::CycleStart));
-  ASSERT_TRUE(s.until([&] { return s.status().servo.state == State::Faulted; }, 100000));
-  EXPECT_EQ(s.status().servo.fault.kind, FaultKind::LimitSwitch);
+  s.must(Request::simple(control::CommandKind::CycleStart));
+  ASSERT_TRUE(s.until([&] { return s.status().servo.state == control::State::Faulted; }, 100000));
+  EXPECT_EQ(s.status().servo.fault.kind, control::FaultKind::LimitSwitch);
   s.ticks(2000);
   EXPECT_FALSE(s.status().run_active);
   const double past = s.sim().joint(kX).table_position() - 300.0;
@@ -385,7 +385,7 @@ std::string seed_errors_plus(double shift) {
 // the other way is lost in the screw's backlash until the axis reverses: docs/compensation.md).
 TEST(DrillScenario, APitchTableChangeMovesTheTableByItsDifferenceWithoutAStep) {
   DrillCopy copy;
-  Scenario s(loaded(config::load_profile(copy.profile())));
+  Scenario s(control::test::loaded(config::load_profile(copy.profile())));
   home(s);
   s.must(Request::jog_by(Axis::X, 175.0 - s.status().servo.commanded[Axis::X], 40));
   ASSERT_TRUE(s.idle());
@@ -400,7 +400,7 @@ TEST(DrillScenario, APitchTableChangeMovesTheTableByItsDifferenceWithoutAStep) {
         {{"axis.x.compensation.forward", errors}, {"axis.x.compensation.reverse", errors}}, "admin"));
     s.ticks(300);
     double fastest = 0;
-    const std::vector<TraceSample>& t = s.samples();
+    const std::vector<control::TraceSample>& t = s.samples();
     for (std::size_t i = 1; i < t.size(); ++i)
       fastest = std::max(fastest, std::abs(t[i].output[Axis::X] - t[i - 1].output[Axis::X]) / 1e-3);
     EXPECT_GT(fastest, 0.5);  // it moved, at up to the take-up velocity
@@ -414,4 +414,4 @@ TEST(DrillScenario, APitchTableChangeMovesTheTableByItsDifferenceWithoutAStep) {
 }
 
 }  // namespace
-}  // namespace opencnc::control::test
+}  // namespace opencnc::controller::test

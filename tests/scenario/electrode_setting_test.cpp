@@ -16,7 +16,7 @@
 #include "opencnc/edm/electrode_setting.hpp"
 #include "scenario.hpp"
 
-namespace opencnc::control::test {
+namespace opencnc::controller::test {
 namespace {
 
 config::MachineProfile edm_profile(const std::vector<std::string>& sets = {}) {
@@ -51,26 +51,26 @@ struct Rig {
   /// on the simulated machine of `sim` (the truth the profile may not know).
   explicit Rig(const config::MachineProfile& profile, const config::MachineProfile& sim)
       : tools(electrode_table()), machine(set_up(profile, tools)), scenario(sim, machine->source()) {
-    feature = std::dynamic_pointer_cast<ElectrodeSetting>(machine->feature("electrode"));
+    feature = std::dynamic_pointer_cast<edm::ElectrodeSetting>(machine->feature("electrode"));
     EXPECT_TRUE(feature);
     machine->install(scenario.rig().controller());
-    scenario.must(Request::simple(CommandKind::MachineOn));
+    scenario.must(Request::simple(control::CommandKind::MachineOn));
   }
   explicit Rig(const config::MachineProfile& profile) : Rig(profile, profile) {}
 
   static std::unique_ptr<MachineSetup> set_up(const config::MachineProfile& p,
                                               std::shared_ptr<tools::MemoryToolTable> t) {
     Diagnostics d;
-    auto m = features::machine_setup(p, d, control::MachineSetup::Options::with_tools(std::move(t)));
+    auto m = features::machine_setup(p, d, controller::MachineSetup::Options::with_tools(std::move(t)));
     EXPECT_TRUE(m) << (d.items().empty() ? "" : d.items()[0].format());
     return m;
   }
   /// Measures `tool`; the result once the feature is idle again.
-  ElectrodeResult measure(int tool) {
-    scenario.must(Request::feature("electrode", "measure", ElectrodeMeasure{tool}));
-    EXPECT_TRUE(scenario.until([&] { return feature->phase() == ElectrodePhase::Idle; }, 60000));
+  edm::ElectrodeResult measure(int tool) {
+    scenario.must(Request::feature("electrode", "measure", edm::ElectrodeMeasure{tool}));
+    EXPECT_TRUE(scenario.until([&] { return feature->phase() == edm::ElectrodePhase::Idle; }, 60000));
     EXPECT_TRUE(feature->last().has_value());
-    return feature->last().value_or(ElectrodeResult{});
+    return feature->last().value_or(edm::ElectrodeResult{});
   }
   Vec3 table_offset(int tool) const {
     const tools::ToolEntry* e = tools->snapshot()->tool(tool);
@@ -80,14 +80,14 @@ struct Rig {
   std::shared_ptr<tools::MemoryToolTable> tools;
   std::unique_ptr<MachineSetup> machine;
   Scenario scenario;
-  std::shared_ptr<ElectrodeSetting> feature;
+  std::shared_ptr<edm::ElectrodeSetting> feature;
 };
 
 TEST(ElectrodeSetting, MeasuresAnOffsetElectrodeWithinAMicrometreAndStoresIt) {
   Rig r(edm_profile());
   const Vec3 truth{0.2, -0.1, 50.5};  // tool 1 is off its table entry by (0.2, −0.1, 0.5)
   r.scenario.sim().set_electrode(truth, 0);
-  const ElectrodeResult m = r.measure(1);
+  const edm::ElectrodeResult m = r.measure(1);
   ASSERT_TRUE(m.ok) << m.message;
   ASSERT_EQ(m.touched.size(), 5u) << "four around and one from above";
   for (std::size_t i = 0; i < 3; ++i) {
@@ -102,7 +102,7 @@ TEST(ElectrodeSetting, ABallTippedElectrodeIsMeasuredToItsLowestPoint) {
   Rig r(edm_profile({"probe.reference_sphere.touches_around=6"}));
   const Vec3 truth{-0.3, 0.15, 39.8};
   r.scenario.sim().set_electrode(truth, 3.0);
-  const ElectrodeResult m = r.measure(2);
+  const edm::ElectrodeResult m = r.measure(2);
   ASSERT_TRUE(m.ok) << m.message;
   ASSERT_EQ(m.touched.size(), 7u);
   EXPECT_EQ(m.names[1], "60°");
@@ -120,7 +120,7 @@ TEST(ElectrodeSetting, FastThenSlowTouchesMeasureToATenthOfAMicrometre) {
   Rig r(edm_profile(fast_then_slow()));
   const Vec3 truth{0.2, -0.1, 50.5};
   r.scenario.sim().set_electrode(truth, 0);
-  const ElectrodeResult m = r.measure(1);
+  const edm::ElectrodeResult m = r.measure(1);
   ASSERT_TRUE(m.ok) << m.message;
   ASSERT_EQ(m.touched.size(), 5u);
   ASSERT_EQ(m.fast_touched.size(), 5u) << "each direction touched fast first";
@@ -135,8 +135,8 @@ TEST(ElectrodeSetting, FastThenSlowTouchesMeasureToATenthOfAMicrometre) {
     EXPECT_NEAR(m.offset[i], truth[i], 1e-4) << "axis " << i;
     EXPECT_EQ(r.table_offset(1)[i], m.offset[i]);
   }
-  const ElectrodeResult refit =
-      evaluate_touches(r.feature->profile_sphere(), 1, m.previous, 0, m.names, m.touched);
+  const edm::ElectrodeResult refit =
+      edm::evaluate_touches(r.feature->profile_sphere(), 1, m.previous, 0, m.names, m.touched);
   for (std::size_t i = 0; i < 3; ++i)
     EXPECT_EQ(refit.offset[i], m.offset[i]) << "the slow touches are fitted";
   EXPECT_EQ(r.scenario.status().servo.commanded[Axis::Z], -60.0) << "left at the safe height";
@@ -156,7 +156,7 @@ TEST(ElectrodeSetting, TheSphereTurnsWithBAndIsMeasuredAtItsAngle) {
   EXPECT_NEAR(sphere.centre()[2], -150.0, 1e-9);
   const Vec3 truth{-0.15, 0.25, 49.7};
   r.scenario.sim().set_electrode(truth, 0);
-  const ElectrodeResult m = r.measure(1);
+  const edm::ElectrodeResult m = r.measure(1);
   ASSERT_TRUE(m.ok) << m.message;
   EXPECT_EQ(r.scenario.status().servo.commanded[Axis::B], 30.0);
   // Turned with the B table (where its steps put it: within 0.1 µm at 20 mm from the axis).
@@ -173,18 +173,18 @@ std::vector<std::string> b_axis_off_nominal() {
                          "probe.reference_sphere.sim.b_axis_direction=[0.0002, 1.0, -0.0001]"});
 }
 
-BAxisResult calibrate_b(Rig& r, std::vector<double> angles) {
-  r.scenario.must(Request::feature("electrode", "calibrate-b", BAxisCalibrate{1, std::move(angles)}));
-  EXPECT_TRUE(r.scenario.until([&] { return r.feature->phase() == ElectrodePhase::Idle; }, 200000));
+edm::BAxisResult calibrate_b(Rig& r, std::vector<double> angles) {
+  r.scenario.must(Request::feature("electrode", "calibrate-b", edm::BAxisCalibrate{1, std::move(angles)}));
+  EXPECT_TRUE(r.scenario.until([&] { return r.feature->phase() == edm::ElectrodePhase::Idle; }, 200000));
   EXPECT_TRUE(r.feature->last_b_axis().has_value());
-  return r.feature->last_b_axis().value_or(BAxisResult{});
+  return r.feature->last_b_axis().value_or(edm::BAxisResult{});
 }
 
 TEST(ElectrodeSetting, CalibrateBFindsTheTrueAxisWithinAMicrometre) {
   Rig r(edm_profile(b_axis_off_nominal()));
   // An electrode 0.2, −0.1, 0.5 mm off its table entry: it moves every centre alike, not the axis.
   r.scenario.sim().set_electrode({0.2, -0.1, 50.5}, 0);
-  const BAxisResult c = calibrate_b(r, {-40, 0, 40});
+  const edm::BAxisResult c = calibrate_b(r, {-40, 0, 40});
   ASSERT_TRUE(c.ok) << c.message;
   ASSERT_EQ(c.centres.size(), 3u);
   EXPECT_NEAR(c.fit.axis.crossing[0], 100.012, 0.001);
@@ -209,14 +209,14 @@ TEST(ElectrodeSetting, WithBTurnedTheElectrodeIsRightOnlyAboutTheMeasuredAxis) {
   // About the drawing's axis, with B at 40°: the sphere is not where the touches are aimed, and
   // the offsets come out wrong by as much (the sphere's true centre less the expected one).
   const auto measure_at_40 = [&] {
-    r.scenario.must(Request::feature("electrode", "measure", ElectrodeMeasure{1, true, 40.0}));
-    EXPECT_TRUE(r.scenario.until([&] { return r.feature->phase() == ElectrodePhase::Idle; }, 60000));
-    return r.feature->last().value_or(ElectrodeResult{});
+    r.scenario.must(Request::feature("electrode", "measure", edm::ElectrodeMeasure{1, true, 40.0}));
+    EXPECT_TRUE(r.scenario.until([&] { return r.feature->phase() == edm::ElectrodePhase::Idle; }, 60000));
+    return r.feature->last().value_or(edm::ElectrodeResult{});
   };
-  const ElectrodeResult nominal = measure_at_40();
+  const edm::ElectrodeResult nominal = measure_at_40();
   ASSERT_TRUE(nominal.ok) << nominal.message;
   EXPECT_EQ(r.scenario.status().servo.commanded[Axis::B], 40.0);
-  const Vec3 expected = sphere_centre_at(r.feature->sphere(), 40);
+  const Vec3 expected = edm::sphere_centre_at(r.feature->sphere(), 40);
   double off = 0;
   for (std::size_t i = 0; i < 3; ++i) {
     const double error = sphere.centre()[i] - expected[i];
@@ -228,9 +228,9 @@ TEST(ElectrodeSetting, WithBTurnedTheElectrodeIsRightOnlyAboutTheMeasuredAxis) {
   // B's axis measured: the same measurement at 40° lands on the sphere where it really is.
   r.scenario.sim().set_electrode(truth, 0);
   ASSERT_TRUE(calibrate_b(r, {-40, 0, 40}).ok);
-  const ElectrodeResult measured = measure_at_40();
+  const edm::ElectrodeResult measured = measure_at_40();
   ASSERT_TRUE(measured.ok) << measured.message;
-  const Vec3 now = sphere_centre_at(r.feature->sphere(), 40);
+  const Vec3 now = edm::sphere_centre_at(r.feature->sphere(), 40);
   for (std::size_t i = 0; i < 3; ++i) {
     EXPECT_NEAR(now[i], sphere.centre()[i], 0.001)
         << "the sphere where the measured axis turns it, axis " << i;
@@ -245,13 +245,13 @@ TEST(ElectrodeSetting, CalibrateBWithTheSphereNotWhereTheDrawingsAxisTurnsItChan
                                     "probe.reference_sphere.sim.b_axis=[100.0, -170.0]"})));
   r.scenario.sim().set_electrode({0, 0, 50}, 0);
   EventCursor log(r.scenario.rig().controller().events());
-  const BAxisResult c = calibrate_b(r, {0, 40, -40});
+  const edm::BAxisResult c = calibrate_b(r, {0, 40, -40});
   EXPECT_FALSE(c.ok);
   EXPECT_EQ(c.centres.size(), 1u) << "B at 0 is where the profile's position holds";
   EXPECT_EQ(c.code.rfind("electrode.", 0), 0u) << c.code;
   EXPECT_EQ(c.message.rfind("with B at 40°: ", 0), 0u) << c.message;
   EXPECT_EQ(r.feature->sphere().b_axis, (std::array<double, 2>{100.0, -165.0})) << "the axis unchanged";
-  EXPECT_EQ(r.feature->phase(), ElectrodePhase::Idle);
+  EXPECT_EQ(r.feature->phase(), edm::ElectrodePhase::Idle);
   bool noted = false;
   for (const ControllerEvent& e : log.next(1 << 16))
     noted |= e.kind == ControllerEventKind::Note && e.code == c.code &&
@@ -262,20 +262,21 @@ TEST(ElectrodeSetting, CalibrateBWithTheSphereNotWhereTheDrawingsAxisTurnsItChan
 TEST(ElectrodeSetting, CalibrateBRefusesWhatItCannotMeasure) {
   Rig r(edm_profile(b_axis_off_nominal()));
   const auto refused = [&](std::vector<double> angles) {
-    return !r.scenario.ask(Request::feature("electrode", "calibrate-b", BAxisCalibrate{1, std::move(angles)}))
+    return !r.scenario
+                .ask(Request::feature("electrode", "calibrate-b", edm::BAxisCalibrate{1, std::move(angles)}))
                 .accepted;
   };
   EXPECT_TRUE(refused({0, 40})) << "two angles fix no circle";
   EXPECT_TRUE(refused({0, 40, 40})) << "nor three with two alike";
   Rig without(edm_profile(fast_then_slow()));  // no nominal axis to look for the sphere about
-  const Outcome o =
-      without.scenario.ask(Request::feature("electrode", "calibrate-b", BAxisCalibrate{1, {-40, 0, 40}}));
+  const Outcome o = without.scenario.ask(
+      Request::feature("electrode", "calibrate-b", edm::BAxisCalibrate{1, {-40, 0, 40}}));
   EXPECT_FALSE(o.accepted);
   EXPECT_NE(o.message.find("b_axis"), std::string::npos) << o.message;
   const Outcome at =
-      without.scenario.ask(Request::feature("electrode", "measure", ElectrodeMeasure{1, true, 30.0}));
+      without.scenario.ask(Request::feature("electrode", "measure", edm::ElectrodeMeasure{1, true, 30.0}));
   EXPECT_FALSE(at.accepted) << "B's axis unknown: only at b";
-  EXPECT_EQ(r.feature->phase(), ElectrodePhase::Idle);
+  EXPECT_EQ(r.feature->phase(), edm::ElectrodePhase::Idle);
 }
 
 TEST(ElectrodeSetting, AMissingSphereIsRefusedAndNothingStored) {
@@ -283,7 +284,7 @@ TEST(ElectrodeSetting, AMissingSphereIsRefusedAndNothingStored) {
   Rig r(edm_profile(), edm_profile({"probe.reference_sphere.position=[130.0, 50.0, -150.0]"}));
   r.scenario.sim().set_electrode({0, 0, 50}, 0);
   EventCursor log(r.scenario.rig().controller().events());
-  const ElectrodeResult m = r.measure(1);
+  const edm::ElectrodeResult m = r.measure(1);
   EXPECT_FALSE(m.ok);
   EXPECT_EQ(m.code, "electrode.missing-touch");
   EXPECT_NE(m.message.find("touch from +X met nothing"), std::string::npos) << m.message;
@@ -298,7 +299,7 @@ TEST(ElectrodeSetting, AContactClosedBeforeTheTouchIsNotATouch) {
   // 3 mm off in X: the electrode goes down into the sphere beside it and is in contact at the start.
   Rig r(edm_profile());
   r.scenario.sim().set_electrode({3, 0, 50}, 0);
-  const ElectrodeResult m = r.measure(1);
+  const edm::ElectrodeResult m = r.measure(1);
   EXPECT_FALSE(m.ok);
   EXPECT_EQ(m.code, "electrode.contact-at-start") << m.message;
   EXPECT_EQ(r.table_offset(1), (Vec3{0, 0, 50}));
@@ -307,7 +308,7 @@ TEST(ElectrodeSetting, AContactClosedBeforeTheTouchIsNotATouch) {
 TEST(ElectrodeSetting, ASphereFartherThanAllowedIsRefused) {
   Rig r(edm_profile({"probe.reference_sphere.max_deviation=0.5"}));
   r.scenario.sim().set_electrode({0.7, 0, 50}, 0);
-  const ElectrodeResult m = r.measure(1);
+  const edm::ElectrodeResult m = r.measure(1);
   EXPECT_FALSE(m.ok);
   EXPECT_EQ(m.code, "electrode.far") << m.message;
   EXPECT_NEAR(m.offset[0], 0.7, 0.001) << "what was found is reported";
@@ -318,7 +319,7 @@ TEST(ElectrodeSetting, TouchesOffTheSphereExceedTheTolerance) {
   // A sphere 0.04 mm larger than the profile's (dirt, the wrong sphere): no centre fits.
   Rig r(edm_profile(), edm_profile({"probe.reference_sphere.diameter=10.04"}));
   r.scenario.sim().set_electrode({0, 0, 50}, 0);
-  const ElectrodeResult m = r.measure(1);
+  const edm::ElectrodeResult m = r.measure(1);
   EXPECT_FALSE(m.ok);
   EXPECT_EQ(m.code, "electrode.fit") << m.message;
   EXPECT_GT(m.max_residual_mm, 0.002);
@@ -327,12 +328,12 @@ TEST(ElectrodeSetting, TouchesOffTheSphereExceedTheTolerance) {
 
 TEST(ElectrodeSetting, RefusesWhatItCannotMeasure) {
   Rig r(edm_profile());
-  EXPECT_FALSE(r.scenario.ask(Request::feature("electrode", "measure", ElectrodeMeasure{9})).accepted);
+  EXPECT_FALSE(r.scenario.ask(Request::feature("electrode", "measure", edm::ElectrodeMeasure{9})).accepted);
   EXPECT_NE(r.scenario.message().find("tool 9 is not in the tool table"), std::string::npos);
   EXPECT_FALSE(r.scenario.ask(Request::feature("electrode", "resume")).accepted);
   EXPECT_FALSE(r.scenario.ask(Request::feature("electrode", "measure")).accepted);
   Rig low(edm_profile({"probe.reference_sphere.safe_z=-100"}));
-  EXPECT_FALSE(low.scenario.ask(Request::feature("electrode", "measure", ElectrodeMeasure{1})).accepted);
+  EXPECT_FALSE(low.scenario.ask(Request::feature("electrode", "measure", edm::ElectrodeMeasure{1})).accepted);
   EXPECT_NE(low.scenario.message().find("safe_z"), std::string::npos) << low.scenario.message();
 }
 
@@ -350,19 +351,20 @@ TEST(ElectrodeSetting, AWornElectrodeIsReplacedMidJobAndTheJobGoesOnWhereItStopp
   Rig r(edm_profile());
   r.scenario.sim().set_electrode({0, 0, 50}, 0);
   TempProgram p("job.ngc", kJob);
-  r.scenario.must(Request::set_mode(Mode::Auto));
+  r.scenario.must(Request::set_mode(control::Mode::Auto));
   r.scenario.must(Request::open(p.path()));
-  r.scenario.must(Request::simple(CommandKind::CycleStart));
+  r.scenario.must(Request::simple(control::CommandKind::CycleStart));
   ASSERT_TRUE(r.scenario.until([&] { return r.scenario.status().servo.commanded[Axis::X] > 20; }, 20000));
-  r.scenario.must(Request::simple(CommandKind::FeedHold));
+  r.scenario.must(Request::simple(control::CommandKind::FeedHold));
   ASSERT_TRUE(r.scenario.until(
       [&] {
-        return r.scenario.status().servo.state == State::Held && r.scenario.status().servo.path_velocity == 0;
+        return r.scenario.status().servo.state == control::State::Held &&
+               r.scenario.status().servo.path_velocity == 0;
       },
       5000));
-  r.scenario.must(Request::simple(CommandKind::Abort));
+  r.scenario.must(Request::simple(control::CommandKind::Abort));
   ASSERT_TRUE(r.scenario.idle());
-  const std::optional<ProgramStop> stop = r.feature->stop();
+  const std::optional<edm::ProgramStop> stop = r.feature->stop();
   ASSERT_TRUE(stop.has_value());
   EXPECT_GT(stop->position[0], 20);
   EXPECT_EQ(stop->position[2], 30.0) << "on the G1 X40 at Z-20 + 50";
@@ -370,13 +372,14 @@ TEST(ElectrodeSetting, AWornElectrodeIsReplacedMidJobAndTheJobGoesOnWhereItStopp
   // The new electrode is 0.2, −0.1 and 0.5 mm off the worn one's offsets.
   const Vec3 truth{0.2, -0.1, 50.5};
   r.scenario.sim().set_electrode(truth, 0);
-  const ElectrodeResult m = r.measure(1);
+  const edm::ElectrodeResult m = r.measure(1);
   ASSERT_TRUE(m.ok) << m.message;
   EventCursor log(r.scenario.rig().controller().events());
   r.scenario.must(Request::feature("electrode", "resume"));
   const std::uint64_t finished = r.scenario.status().runs_finished;
   ASSERT_TRUE(r.scenario.until(
-      [&] { return r.feature->phase() == ElectrodePhase::Idle && r.scenario.status().run_active; }, 60000));
+      [&] { return r.feature->phase() == edm::ElectrodePhase::Idle && r.scenario.status().run_active; },
+      60000));
   // Where the resumed program started: the stop point moved by the measured change.
   const Pose at = r.scenario.status().servo.commanded;
   for (int i = 0; i < 3; ++i)
@@ -401,4 +404,4 @@ TEST(ElectrodeSetting, AWornElectrodeIsReplacedMidJobAndTheJobGoesOnWhereItStopp
 }
 
 }  // namespace
-}  // namespace opencnc::control::test
+}  // namespace opencnc::controller::test

@@ -15,14 +15,14 @@
 #include "opencnc/gcode/standard_extensions.hpp"
 #include "scenario.hpp"
 
-namespace opencnc::control::test {
+namespace opencnc::controller::test {
 namespace {
 
 /// The shipped mill with J = 100 × A on every axis (1e5 mm/s³).
 config::MachineProfile jerk_mill(std::vector<std::string> sets = {}) {
   for (const char* s : {"axis.x.max_jerk=100000", "axis.y.max_jerk=100000", "axis.z.max_jerk=100000"})
     sets.emplace_back(s);
-  return mill(sets);
+  return control::test::mill(sets);
 }
 
 /// A dense spiral of short moves (CAM output, 0.1 µm coordinates) within G64 P0.01.
@@ -40,10 +40,10 @@ std::string dense_spiral(int moves) {
 // runs, the held blends and the window's settling do not depend on how far the program was read.
 TEST(JerkScenario, StreamingMovesExactlyAsTheWholeProgram) {
   TempProgram p("spiral.ngc", dense_spiral(3000));
-  std::vector<TraceSample> streamed, whole;
+  std::vector<control::TraceSample> streamed, whole;
   {
     Scenario s(jerk_mill({"interpreter.readahead_moves=10"}));
-    s.on(Mode::Auto);
+    s.on(control::Mode::Auto);
     ASSERT_TRUE(s.run_file(p.path(), 400000)) << s.message();
     streamed = s.samples();
     const RunReport r = s.report();
@@ -52,7 +52,7 @@ TEST(JerkScenario, StreamingMovesExactlyAsTheWholeProgram) {
   }
   {
     Scenario s(jerk_mill());
-    s.on(Mode::Auto);
+    s.on(control::Mode::Auto);
     gcode::Options o;
     o.axes = AxisMask::from_letters("XYZ");
     o.initial_units = canon::Units::Mm;
@@ -81,16 +81,16 @@ TEST(JerkScenario, StreamingMovesExactlyAsTheWholeProgram) {
 TEST(JerkScenario, FeedHoldInAFittedRunStopsOnThePathAndResumes) {
   Scenario s(jerk_mill());
   TempProgram p("spiral.ngc", dense_spiral(1500));
-  s.on(Mode::Auto);
+  s.on(control::Mode::Auto);
   s.must(Request::open(p.path()));
-  s.must(Request::simple(CommandKind::CycleStart));
+  s.must(Request::simple(control::CommandKind::CycleStart));
   ASSERT_TRUE(s.until([&] { return s.status().location.line > 700; }, 100000));
-  s.must(Request::simple(CommandKind::FeedHold));
+  s.must(Request::simple(control::CommandKind::FeedHold));
   ASSERT_TRUE(s.until([&] { return s.status().servo.motion == traj::RunState::Held; }, 5000));
   const Pose held = s.status().servo.commanded;
   s.ticks(200);
   EXPECT_EQ(s.status().servo.commanded, held);
-  s.must(Request::simple(CommandKind::Resume));
+  s.must(Request::simple(control::CommandKind::Resume));
   ASSERT_TRUE(s.idle(100000));
   const RunReport r = s.report();
   EXPECT_EQ(r.limit_violations, 0u);
@@ -103,9 +103,9 @@ TEST(JerkScenario, OverridesChangingMidMoveKeepTheLimits) {
   Scenario s(jerk_mill());
   TempProgram p("moves.ngc",
                 "G21 G90 G64 P0.05\nG0 X0 Y0\nG1 X60 Y10 F3000\nG1 X60 Y60\nG3 X20 Y60 R20\nG0 X0 Y0\nM2\n");
-  s.on(Mode::Auto);
+  s.on(control::Mode::Auto);
   s.must(Request::open(p.path()));
-  s.must(Request::simple(CommandKind::CycleStart));
+  s.must(Request::simple(control::CommandKind::CycleStart));
   const double steps[] = {0.5, 0.0, 2.0, 0.3, 1.2, 2.0};
   for (double f : steps) {
     s.ticks(150);
@@ -125,7 +125,7 @@ TEST(JerkScenario, AProbeSyncPointStopsAndTheProgramGoesOnFromItsResult) {
   Scenario s(jerk_mill());
   TempProgram p("probe.ngc",
                 "G21 G90 G54\nG0 X10 Y10 Z0\nG38.2 Z-100 F300\nG0 Z[#5063+5]\nG1 X20 F1200\nM2\n");
-  s.on(Mode::Auto);
+  s.on(control::Mode::Auto);
   ASSERT_TRUE(s.run_file(p.path())) << s.message();
   const ControllerStatus st = s.status();
   EXPECT_NEAR(st.servo.commanded[Axis::Z], -45.0, 0.001);
@@ -135,4 +135,4 @@ TEST(JerkScenario, AProbeSyncPointStopsAndTheProgramGoesOnFromItsResult) {
 }
 
 }  // namespace
-}  // namespace opencnc::control::test
+}  // namespace opencnc::controller::test

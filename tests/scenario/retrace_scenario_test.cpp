@@ -16,7 +16,7 @@
 #include "opencnc/retrace/retrace.hpp"
 #include "scenario.hpp"
 
-namespace opencnc::control::test {
+namespace opencnc::controller::test {
 namespace {
 
 using recovery::RetracePhase;
@@ -69,8 +69,8 @@ class CutMoves final : public ControllerObserver {
     Pose end;
     canon::MoveKind kind;
   };
-  void on_trace(const TraceSample& s, const TraceContext& c) override {
-    if (c.job != JobKind::Program || c.program == nullptr || s.activity != Activity::Program) return;
+  void on_trace(const control::TraceSample& s, const TraceContext& c) override {
+    if (c.job != JobKind::Program || c.program == nullptr || s.activity != control::Activity::Program) return;
     auto& next = next_[c.job_id];
     for (std::uint64_t m = std::max<std::uint64_t>(next, c.program->first_held_move());
          m <= s.segment && m < c.program->size(); ++m)
@@ -120,11 +120,11 @@ void pause_jog_back_start_stop_again_at_a_step_back_and_cut_to_the_end(
   s.rig().controller().attach(cuts, ObserverOptions{0, true});
   TempProgram p("nest.ngc", kNest);
   const canon::Program whole = whole_program(profile, p.path());
-  s.on(Mode::Auto);
+  s.on(control::Mode::Auto);
   s.must(Request::open(p.path()));
-  s.must(Request::simple(CommandKind::CycleStart));
+  s.must(Request::simple(control::CommandKind::CycleStart));
   const auto phase_is = [&](RetracePhase ph) {
-    return [&, ph] { return feature->phase() == ph && s.status().servo.state == State::Idle; };
+    return [&, ph] { return feature->phase() == ph && s.status().servo.state == control::State::Idle; };
   };
 
   // A: in the third part's left side, the torch cutting.
@@ -137,7 +137,7 @@ void pause_jog_back_start_stop_again_at_a_step_back_and_cut_to_the_end(
   EXPECT_EQ(s.status().servo.digital_out & 0x7u, 0x7u);
   s.must(Request::feature("retrace", "pause"));
   ASSERT_TRUE(s.until(phase_is(RetracePhase::Paused), 20000));
-  ASSERT_TRUE(s.until([&] { return s.status().servo.mode == Mode::Manual; }, 100));
+  ASSERT_TRUE(s.until([&] { return s.status().servo.mode == control::Mode::Manual; }, 100));
   const Pose a = s.status().servo.commanded;
   EXPECT_EQ(s.status().servo.digital_out & 0x7u, 0u) << "the torch is out";
   EXPECT_DOUBLE_EQ(a[2], 40.0) << "at the safe height";
@@ -159,10 +159,10 @@ void pause_jog_back_start_stop_again_at_a_step_back_and_cut_to_the_end(
   EXPECT_NEAR(a2[1], a[1], 0.2);
 
   // A step 5 mm back along the path, then on from there to the end.
-  ASSERT_TRUE(s.until([&] { return s.status().servo.mode == Mode::Manual; }, 100));
+  ASSERT_TRUE(s.until([&] { return s.status().servo.mode == control::Mode::Manual; }, 100));
   s.must(Request::feature("retrace", "step", recovery::RetraceStep{-5}));
   ASSERT_TRUE(s.until(phase_is(RetracePhase::Paused), 20000));
-  ASSERT_TRUE(s.until([&] { return s.status().servo.mode == Mode::Manual; }, 100));
+  ASSERT_TRUE(s.until([&] { return s.status().servo.mode == control::Mode::Manual; }, 100));
   EventCursor log(s.rig().controller().events());
   s.must(Request::feature("retrace", "start"));
   ASSERT_TRUE(
@@ -221,4 +221,4 @@ TEST(RetraceScenario, WithJerkLimitsTheRetraceWorksTheSame) {
 }
 
 }  // namespace
-}  // namespace opencnc::control::test
+}  // namespace opencnc::controller::test

@@ -18,7 +18,7 @@
 #include "opencnc/run_from_line/setup.hpp"
 #include "scenario.hpp"
 
-namespace opencnc::control::test {
+namespace opencnc::controller::test {
 namespace {
 
 constexpr const char* kProgram =
@@ -35,24 +35,25 @@ constexpr const char* kProgram =
     "o<unused> endsub\n"  // 11
     "M2\n";               // 12
 
-std::shared_ptr<GcodeProgramSource> mill_source(const config::MachineProfile& profile = mill()) {
+std::shared_ptr<GcodeProgramSource> mill_source(
+    const config::MachineProfile& profile = control::test::mill()) {
   Diagnostics d;
   return features::machine_setup(profile, d)->source();
 }
 
 /// The feature as every front end sets it up: run_from_line::setup on a machine of `source`'s.
-std::shared_ptr<RunFromLineFeature> set_up_feature(const config::MachineProfile& profile,
-                                                   const std::shared_ptr<GcodeProgramSource>& source) {
+std::shared_ptr<run_from_line::RunFromLineFeature> set_up_feature(
+    const config::MachineProfile& profile, const std::shared_ptr<GcodeProgramSource>& source) {
   Diagnostics d;
   auto machine = MachineSetup::create(profile, {}, d);
   machine->source_config().tools = source->tools();
   run_from_line::setup(profile, *machine);
-  return std::dynamic_pointer_cast<RunFromLineFeature>(machine->feature("run-from-line"));
+  return std::dynamic_pointer_cast<run_from_line::RunFromLineFeature>(machine->feature("run-from-line"));
 }
 
 struct Rig {
   explicit Rig(std::shared_ptr<GcodeProgramSource> source = mill_source(),
-               const config::MachineProfile& profile = mill())
+               const config::MachineProfile& profile = control::test::mill())
       : s(profile, source) {
     feature = set_up_feature(profile, source);
     EXPECT_TRUE(feature);
@@ -62,19 +63,20 @@ struct Rig {
   /// The answer comes once the scan on the feature's thread has ended: the machine ticks meanwhile.
   Outcome run_from(std::uint32_t line) {
     Controller& c = s.rig().controller();
-    const std::uint64_t id = c.submit(Request::feature("run-from-line", "start", RunFromLineArgs{line}));
+    const std::uint64_t id =
+        c.submit(Request::feature("run-from-line", "start", run_from_line::RunFromLineArgs{line}));
     std::optional<Outcome> o;
     EXPECT_TRUE(s.until([&] { return (o = c.outcome(id)).has_value(); }, 1000000));
     return o.value_or(Outcome{});
   }
   Scenario s;
-  std::shared_ptr<RunFromLineFeature> feature;
+  std::shared_ptr<run_from_line::RunFromLineFeature> feature;
 };
 
 TEST(RunFromLineScenario, TheProgramStartsAtTheLineWithItsStateAfterTheApproach) {
   TempProgram p("part.ngc", kProgram);
   Rig r;
-  r.s.on(Mode::Auto);
+  r.s.on(control::Mode::Auto);
   r.s.must(Request::open(p.path()));
   const Outcome o = r.run_from(6);
   ASSERT_TRUE(o.accepted) << o.message;
@@ -94,7 +96,7 @@ TEST(RunFromLineScenario, TheProgramStartsAtTheLineWithItsStateAfterTheApproach)
         if (st.job == JobKind::Program && (st.location.line == 6 || st.location.line == 7)) {  // M2 sets G54
           EXPECT_EQ(st.offsets.system, 2);
         }
-        return !st.run_active && st.servo.state == State::Idle;
+        return !st.run_active && st.servo.state == control::State::Idle;
       },
       200000));
   EXPECT_EQ(first_line, 6u);
@@ -108,9 +110,9 @@ TEST(RunFromLineScenario, TheProgramStartsAtTheLineWithItsStateAfterTheApproach)
 TEST(RunFromLineScenario, WithJerkLimitsTheProgramStartsAtTheLineAfterTheApproach) {
   TempProgram p("part.ngc", kProgram);
   const config::MachineProfile profile =
-      mill({"axis.x.max_jerk=20000", "axis.y.max_jerk=20000", "axis.z.max_jerk=20000"});
+      control::test::mill({"axis.x.max_jerk=20000", "axis.y.max_jerk=20000", "axis.z.max_jerk=20000"});
   Rig r(mill_source(profile), profile);
-  r.s.on(Mode::Auto);
+  r.s.on(control::Mode::Auto);
   r.s.must(Request::open(p.path()));
   const Outcome o = r.run_from(6);
   ASSERT_TRUE(o.accepted) << o.message;
@@ -123,7 +125,7 @@ TEST(RunFromLineScenario, WithJerkLimitsTheProgramStartsAtTheLineAfterTheApproac
         const ControllerStatus st = r.s.status();
         if (first_line == 0 && st.job == JobKind::Program && st.location.line > 0)
           first_line = st.location.line;
-        return !st.run_active && st.servo.state == State::Idle;
+        return !st.run_active && st.servo.state == control::State::Idle;
       },
       200000));
   EXPECT_EQ(first_line, 6u);
@@ -136,7 +138,7 @@ TEST(RunFromLineScenario, WithJerkLimitsTheProgramStartsAtTheLineAfterTheApproac
 TEST(RunFromLineScenario, LinesWithoutAMovePastTheEndOrAfterAnInputAreRefused) {
   TempProgram p("part.ngc", kProgram);
   Rig r;
-  r.s.on(Mode::Auto);
+  r.s.on(control::Mode::Auto);
   r.s.must(Request::open(p.path()));
   const Pose before = r.s.status().servo.commanded;
   Outcome o = r.run_from(10);  // in a subroutine that is never called
@@ -148,7 +150,7 @@ TEST(RunFromLineScenario, LinesWithoutAMovePastTheEndOrAfterAnInputAreRefused) {
             std::string::npos)
       << o.message;
   o = r.run_from(0);
-  EXPECT_EQ(o.refusal, Refusal::BadValue);
+  EXPECT_EQ(o.refusal, control::Refusal::BadValue);
   r.s.ticks(50);
   EXPECT_FALSE(r.s.status().run_active);
   EXPECT_EQ(r.s.status().servo.commanded, before);
@@ -163,8 +165,8 @@ TEST(RunFromLineScenario, LinesWithoutAMovePastTheEndOrAfterAnInputAreRefused) {
   ASSERT_TRUE(r.s.idle(200000));
   EXPECT_NEAR(r.s.status().servo.commanded[Axis::X], 10.0, 1e-9);
   // Manual mode: refused
-  r.s.must(Request::set_mode(Mode::Manual));
-  EXPECT_EQ(r.run_from(2).refusal, Refusal::WrongMode);
+  r.s.must(Request::set_mode(control::Mode::Manual));
+  EXPECT_EQ(r.run_from(2).refusal, control::Refusal::WrongMode);
 }
 
 
@@ -184,17 +186,18 @@ TEST(RunFromLineScenario, TheApproachFeedIsPerMinuteUnderInverseTimeAndPerRevolu
                 "G94 G1 X0 F300\n"    // 9
                 "M2\n");              // 10
   Diagnostics d;
-  const auto source = features::machine_setup(mill(), d)->source();
+  const auto source = features::machine_setup(control::test::mill(), d)->source();
   const double expected[][2] = {{4, 600}, {5, 60}, {6, 100}, {8, 250}, {9, 300}};
   for (const auto& [line, feed] : expected) {
     std::string why;
-    const auto at = find_line_start(*source, p.path(), Pose{}, static_cast<std::uint32_t>(line), {}, &why);
+    const auto at =
+        run_from_line::find_line_start(*source, p.path(), Pose{}, static_cast<std::uint32_t>(line), {}, &why);
     ASSERT_TRUE(at.has_value()) << why;
     EXPECT_NEAR(at->feed_mm_per_min, feed, 1e-9) << "line " << line;
   }
   TempProgram q("no-speed.ngc", "G21 G90 G96 S100 D3000 M3\nG95 G1 X5 F0.1\nM2\n");
   std::string why;
-  EXPECT_FALSE(find_line_start(*source, q.path(), Pose{}, 2, {}, &why).has_value());
+  EXPECT_FALSE(run_from_line::find_line_start(*source, q.path(), Pose{}, 2, {}, &why).has_value());
   EXPECT_NE(why.find("line 2 feeds per revolution (G95) and no spindle speed in rpm is set before it"),
             std::string::npos)
       << why;
@@ -224,18 +227,18 @@ constexpr const char* kTwoTools =
 TEST(RunFromLineScenario, TheApproachChangesToTheLinesToolThenStartsTheSpindleAndCoolant) {
   TempProgram p("tools.ngc", kTwoTools);
   Rig r;
-  r.s.on(Mode::Auto);
+  r.s.on(control::Mode::Auto);
   r.s.must(Request::open(p.path()));
   ASSERT_EQ(r.s.status().servo.tool, 0);
   const Outcome o = r.run_from(12);
   ASSERT_TRUE(o.accepted) << o.message;
   EXPECT_NE(o.message.find("with tool 2 changed in"), std::string::npos) << o.message;
-  ASSERT_TRUE(r.s.until([&] { return r.s.status().servo.wait == Wait::ManualToolChange; }, 5000));
+  ASSERT_TRUE(r.s.until([&] { return r.s.status().servo.wait == control::Wait::ManualToolChange; }, 5000));
   EXPECT_EQ(r.s.status().job, JobKind::Auxiliary);
   EXPECT_EQ(r.s.status().servo.prepared_tool, 2);
   EXPECT_FALSE(r.s.status().servo.flood);  // nothing after the change has run
   const Pose at_change = r.s.status().servo.commanded;
-  r.s.must(Request::simple(CommandKind::ToolChanged));
+  r.s.must(Request::simple(control::CommandKind::ToolChanged));
   ASSERT_TRUE(r.s.until([&] { return r.s.status().job == JobKind::Program; }, 100000));
   ControllerStatus st = r.s.status();
   EXPECT_EQ(st.servo.tool, 2);
@@ -250,8 +253,8 @@ TEST(RunFromLineScenario, TheApproachChangesToTheLinesToolThenStartsTheSpindleAn
   ASSERT_TRUE(r.s.until(
       [&] {
         const ControllerStatus now = r.s.status();
-        EXPECT_NE(now.servo.wait, Wait::ManualToolChange);  // no change after line 12
-        return !now.run_active && now.servo.state == State::Idle;
+        EXPECT_NE(now.servo.wait, control::Wait::ManualToolChange);  // no change after line 12
+        return !now.run_active && now.servo.state == control::State::Idle;
       },
       200000));
   st = r.s.status();
@@ -265,7 +268,7 @@ TEST(RunFromLineScenario, TheApproachChangesToTheLinesToolThenStartsTheSpindleAn
   EXPECT_EQ(again.message.find("changed in"), std::string::npos) << again.message;
   ASSERT_TRUE(r.s.until(
       [&] {
-        EXPECT_NE(r.s.status().servo.wait, Wait::ManualToolChange);
+        EXPECT_NE(r.s.status().servo.wait, control::Wait::ManualToolChange);
         return r.s.status().job == JobKind::Program;
       },
       100000));
@@ -278,9 +281,9 @@ TEST(RunFromLineScenario, TheApproachChangesToTheLinesToolThenStartsTheSpindleAn
 // there to the line, whose segment is found with the M6 moves counted as the program counts them.
 TEST(RunFromLineScenario, TheApproachChangesTheToolAtTheToolChangePosition) {
   TempProgram p("tools.ngc", kTwoTools);
-  const config::MachineProfile profile = mill({"tool_change.position={X=-50,Y=40,Z=150}"});
+  const config::MachineProfile profile = control::test::mill({"tool_change.position={X=-50,Y=40,Z=150}"});
   Rig r(mill_source(profile), profile);
-  r.s.on(Mode::Auto);
+  r.s.on(control::Mode::Auto);
   r.s.must(Request::open(p.path()));
   const Outcome o = r.run_from(12);
   ASSERT_TRUE(o.accepted) << o.message;
@@ -290,7 +293,7 @@ TEST(RunFromLineScenario, TheApproachChangesTheToolAtTheToolChangePosition) {
         const Pose c = r.s.status().servo.commanded;
         if (c[Axis::Z] < 150.0 - 1e-9)
           xy_while_z_rose = std::max({xy_while_z_rose, std::abs(c[Axis::X]), std::abs(c[Axis::Y])});
-        return r.s.status().servo.wait == Wait::ManualToolChange;
+        return r.s.status().servo.wait == control::Wait::ManualToolChange;
       },
       10000));
   EXPECT_EQ(xy_while_z_rose, 0.0);
@@ -298,7 +301,7 @@ TEST(RunFromLineScenario, TheApproachChangesTheToolAtTheToolChangePosition) {
   EXPECT_NEAR(at_change[Axis::X], -50.0, 1e-9);
   EXPECT_NEAR(at_change[Axis::Y], 40.0, 1e-9);
   EXPECT_NEAR(at_change[Axis::Z], 150.0, 1e-9);
-  r.s.must(Request::simple(CommandKind::ToolChanged));
+  r.s.must(Request::simple(control::CommandKind::ToolChanged));
   ASSERT_TRUE(r.s.until([&] { return r.s.status().job == JobKind::Program; }, 100000));
   // Line 12's move starts at X10 Y10 Z−2 with T2's 62.5 mm, reached from the tool-change position.
   EXPECT_NEAR(r.s.status().servo.commanded[Axis::X], 10.0, 1e-9);
@@ -351,17 +354,19 @@ class GatedSource final : public ProgramSource {
 // stays idle; once the scan ends the request gets its answer and the program runs from the line.
 TEST(RunFromLineScenario, TheControllerAnswersWhileTheScanRunsAndNothingStarts) {
   TempProgram p("part.ngc", kProgram);
-  Scenario s(mill(), mill_source());  // no feature: the test's own run from line, on a gated source
+  Scenario s(control::test::mill(),
+             mill_source());  // no feature: the test's own run from line, on a gated source
   auto gate = std::make_shared<GatedSource>(mill_source());
-  ASSERT_TRUE(s.rig().controller().add_feature(std::make_shared<RunFromLineFeature>(gate)));
+  ASSERT_TRUE(s.rig().controller().add_feature(std::make_shared<run_from_line::RunFromLineFeature>(gate)));
   struct Open {  // a failed assertion still lets the scan's thread end before the rig goes
     std::shared_ptr<GatedSource> gate;
     ~Open() { gate->release(); }
   } open{gate};
-  s.on(Mode::Auto);
+  s.on(control::Mode::Auto);
   s.must(Request::open(p.path()));
   Controller& c = s.rig().controller();
-  const std::uint64_t id = c.submit(Request::feature("run-from-line", "start", RunFromLineArgs{6}));
+  const std::uint64_t id =
+      c.submit(Request::feature("run-from-line", "start", run_from_line::RunFromLineArgs{6}));
   s.ticks(2);
   ASSERT_TRUE(gate->wait_entered());
   const std::uint64_t tick = s.status().servo.tick;
@@ -369,13 +374,14 @@ TEST(RunFromLineScenario, TheControllerAnswersWhileTheScanRunsAndNothingStarts) 
   EXPECT_GE(s.status().servo.tick, tick + 100);  // the status goes on
   EXPECT_FALSE(c.outcome(id).has_value());
   EXPECT_TRUE(s.ask(Request::feed_override(0.5)).accepted);
-  const Outcome start = s.ask(Request::simple(CommandKind::CycleStart));
-  EXPECT_EQ(start.refusal, Refusal::FeatureCheck);
+  const Outcome start = s.ask(Request::simple(control::CommandKind::CycleStart));
+  EXPECT_EQ(start.refusal, control::Refusal::FeatureCheck);
   EXPECT_NE(start.message.find("run from line 6: the scan of the program is under way"), std::string::npos)
       << start.message;
-  EXPECT_EQ(s.ask(Request::feature("run-from-line", "start", RunFromLineArgs{7})).refusal, Refusal::Busy);
+  EXPECT_EQ(s.ask(Request::feature("run-from-line", "start", run_from_line::RunFromLineArgs{7})).refusal,
+            control::Refusal::Busy);
   EXPECT_FALSE(s.status().run_active);
-  EXPECT_EQ(s.status().servo.state, State::Idle);
+  EXPECT_EQ(s.status().servo.state, control::State::Idle);
   gate->release();
   std::optional<Outcome> o;
   ASSERT_TRUE(s.until([&] { return (o = c.outcome(id)).has_value(); }, 1000000));
@@ -397,15 +403,15 @@ TEST(RunFromLineScenario, TheScanReadsTheLiveToolTableAndWritesOnlyItsOwnCopy) {
   t1.offset[Axis::Z] = 45;
   ASSERT_TRUE(table.add(t1));
   auto live = std::make_shared<tools::MemoryToolTable>(table);
-  auto scan = std::make_shared<ScanToolTable>(live);
+  auto scan = std::make_shared<run_from_line::ScanToolTable>(live);
   Diagnostics d;
-  std::optional<GcodeSourceConfig> config = GcodeProgramSource::config_for(mill(), d);
+  std::optional<GcodeSourceConfig> config = GcodeProgramSource::config_for(control::test::mill(), d);
   ASSERT_TRUE(config);
   config->tools = scan;
   GcodeProgramSource source(std::move(*config));
   TempProgram p("g10.ngc", "G21 G90\nT1 M6\nG10 L1 P1 Z99\nG43\nG0 X1 Z5\nM2\n");
   std::string why;
-  const auto at = find_line_start(source, p.path(), Pose{}, 5, {}, &why);
+  const auto at = run_from_line::find_line_start(source, p.path(), Pose{}, 5, {}, &why);
   ASSERT_TRUE(at.has_value()) << why;
   EXPECT_NEAR(at->tool_offset[Axis::Z], 99.0, 1e-9);  // the program's own G10 holds at the line
   EXPECT_EQ(at->tool, 1);
@@ -418,4 +424,4 @@ TEST(RunFromLineScenario, TheScanReadsTheLiveToolTableAndWritesOnlyItsOwnCopy) {
 }
 
 }  // namespace
-}  // namespace opencnc::control::test
+}  // namespace opencnc::controller::test

@@ -17,9 +17,9 @@
 #include "opencnc/controller/sim_rig.hpp"
 #include "opencnc/features/features.hpp"
 
-namespace opencnc::control::test {
+namespace opencnc::controller::test {
 
-inline std::ostream& operator<<(std::ostream& os, State s) {
+inline std::ostream& operator<<(std::ostream& os, control::State s) {
   return os << to_string(s);
 }
 
@@ -53,21 +53,21 @@ class SampleKeeper final : public ControllerObserver {
       : limits_(limits), output_limits_(output_limits), period_s_(period_s) {
     forget();
   }
-  void on_trace(const TraceSample& s, const TraceContext& c) override {
+  void on_trace(const control::TraceSample& s, const TraceContext& c) override {
     samples_.push_back(s);
-    if (s.activity == Activity::Program) recorder_->add(s, c);
+    if (s.activity == control::Activity::Program) recorder_->add(s, c);
   }
   void forget() {
     samples_.clear();
     recorder_ = std::make_unique<RunRecorder>(limits_, period_s_, &output_limits_);
   }
-  const std::vector<TraceSample>& samples() const { return samples_; }
+  const std::vector<control::TraceSample>& samples() const { return samples_; }
   RunReport report() const { return recorder_->report(); }
 
  private:
   plan::MachineLimits limits_, output_limits_;
   double period_s_;
-  std::vector<TraceSample> samples_;
+  std::vector<control::TraceSample> samples_;
   std::unique_ptr<RunRecorder> recorder_;
 };
 
@@ -100,8 +100,8 @@ class Scenario {
     const Outcome o = ask(std::move(r));
     ASSERT_TRUE(o.accepted) << name << ": " << last_message_;
   }
-  void on(Mode m) {
-    must(Request::simple(CommandKind::MachineOn));
+  void on(control::Mode m) {
+    must(Request::simple(control::CommandKind::MachineOn));
     must(Request::set_mode(m));
   }
 
@@ -125,11 +125,12 @@ class Scenario {
   bool start_and_finish(std::uint64_t max_ticks = 200000) {
     const std::uint64_t finished = status().runs_finished;
     keeper_->forget();
-    must(Request::simple(CommandKind::CycleStart));
+    must(Request::simple(control::CommandKind::CycleStart));
     return until([&] { return !status().run_active && status().runs_finished > finished; }, max_ticks);
   }
   bool idle(std::uint64_t max_ticks = 100000) {
-    return until([&] { return status().servo.state == State::Idle && !status().run_active; }, max_ticks);
+    return until([&] { return status().servo.state == control::State::Idle && !status().run_active; },
+                 max_ticks);
   }
 
   /// The report of the program runs since the last start_and_finish() or forget_samples().
@@ -140,7 +141,7 @@ class Scenario {
   /// The machine's features as set up (the first constructor).
   MachineSetup& machine() { return *machine_; }
   machine::SimMachine& sim() { return rig_->machine(); }
-  const std::vector<TraceSample>& samples() const { return keeper_->samples(); }
+  const std::vector<control::TraceSample>& samples() const { return keeper_->samples(); }
   void forget_samples() { keeper_->forget(); }
   const std::string& message() const { return last_message_; }
 
@@ -159,4 +160,4 @@ class Scenario {
   std::string last_message_;
 };
 
-}  // namespace opencnc::control::test
+}  // namespace opencnc::controller::test

@@ -13,7 +13,7 @@
 #include "../control/test_profiles.hpp"
 #include "scenario.hpp"
 
-namespace opencnc::control::test {
+namespace opencnc::controller::test {
 namespace {
 
 constexpr double kTwoPi = 6.283185307179586;
@@ -33,7 +33,7 @@ std::vector<Period> run_recording(Scenario& s, const std::string& path, bool& fi
   s.must(Request::open(path));
   const std::uint64_t before = s.status().runs_finished;
   s.forget_samples();
-  s.must(Request::simple(CommandKind::CycleStart));
+  s.must(Request::simple(control::CommandKind::CycleStart));
   std::vector<Period> periods;
   finished = s.until(
       [&] {
@@ -56,7 +56,7 @@ std::vector<Period> run_recording(Scenario& s, const std::string& path, bool& fi
 }  // namespace
 
 TEST(SpindleScenario, RigidTapFollowsTheSpindleThroughItsReversalAndComesBackOut) {
-  Scenario s(mill());
+  Scenario s(control::test::mill());
   TempProgram p("tap.ngc",
                 "G21 G90\n"                // 1
                 "S600 M3\n"                // 2
@@ -65,7 +65,7 @@ TEST(SpindleScenario, RigidTapFollowsTheSpindleThroughItsReversalAndComesBackOut
                 "G0 Z20\n"                 // 5
                 "M5\n"                     // 6
                 "M2\n");
-  s.on(Mode::Auto);
+  s.on(control::Mode::Auto);
   bool finished = false;
   const std::vector<Period> t = run_recording(s, p.path(), finished);
   ASSERT_TRUE(finished) << s.message();
@@ -112,7 +112,7 @@ TEST(SpindleScenario, RigidTapFollowsTheSpindleThroughItsReversalAndComesBackOut
 }
 
 TEST(SpindleScenario, ConstantSurfaceSpeedDrivesTheSpindleFromXEveryPeriod) {
-  Scenario s(mill());
+  Scenario s(control::test::mill());
   TempProgram p("css.ngc",
                 "G21 G90 G18\n"        // 1
                 "G10 L2 P1 X7\n"       // 2: the spindle axis at machine X 7
@@ -123,7 +123,7 @@ TEST(SpindleScenario, ConstantSurfaceSpeedDrivesTheSpindleFromXEveryPeriod) {
                 "G1 X30\n"             // 7
                 "M5\n"                 // 8
                 "M2\n");
-  s.on(Mode::Auto);
+  s.on(control::Mode::Auto);
   bool finished = false;
   const std::vector<Period> t = run_recording(s, p.path(), finished);
   ASSERT_TRUE(finished) << s.message();
@@ -149,9 +149,9 @@ TEST(SpindleScenario, ConstantSurfaceSpeedDrivesTheSpindleFromXEveryPeriod) {
 }
 
 TEST(SpindleScenario, ConstantSurfaceSpeedWithoutDIsBoundByTheSpindlesMaximum) {
-  Scenario s(mill());
+  Scenario s(control::test::mill());
   TempProgram p("css2.ngc", "G21 G90\nG0 X40\nG96 S200 M3\nG1 X0.5 F900\nM5\nM2\n");
-  s.on(Mode::Auto);
+  s.on(control::Mode::Auto);
   bool finished = false;
   const std::vector<Period> t = run_recording(s, p.path(), finished);
   ASSERT_TRUE(finished) << s.message();
@@ -163,7 +163,7 @@ TEST(SpindleScenario, ConstantSurfaceSpeedWithoutDIsBoundByTheSpindlesMaximum) {
 }
 
 TEST(SpindleScenario, ArcsOffTheirCircleRunAsSpiralsWithinTheLimits) {
-  Scenario s(mill());
+  Scenario s(control::test::mill());
   TempProgram p("spiral.ngc",
                 "G21 G90 G64 P0.01 F2400\n"
                 "G0 X5 Y0\n"
@@ -172,7 +172,7 @@ TEST(SpindleScenario, ArcsOffTheirCircleRunAsSpiralsWithinTheLimits) {
                 "G1 X0 Y300\n"
                 "G2 X0 Y-299.75 I0 J-300\n"
                 "M2\n");
-  s.on(Mode::Auto);
+  s.on(control::Mode::Auto);
   ASSERT_TRUE(s.run_file(p.path())) << s.message();
   const RunReport r = s.report();
   EXPECT_EQ(r.limit_violations, 0u);
@@ -183,7 +183,7 @@ TEST(SpindleScenario, ArcsOffTheirCircleRunAsSpiralsWithinTheLimits) {
 // M99 in the main program: LinuxCNC's task starts the program again from its first line with the
 // state as it is (the counter below goes on counting), until the operator stops the run.
 TEST(EndlessProgramScenario, M99InTheMainProgramRepeatsItUntilTheOperatorStops) {
-  Scenario s(mill());
+  Scenario s(control::test::mill());
   TempProgram p("warmup.ngc",
                 "G21 G90 F6000\n"
                 "#<_pass> = [#<_pass> + 1]\n"
@@ -191,7 +191,7 @@ TEST(EndlessProgramScenario, M99InTheMainProgramRepeatsItUntilTheOperatorStops) 
                 "G1 Y10\n"
                 "G0 Y0\n"
                 "M99\n");
-  s.on(Mode::Auto);
+  s.on(control::Mode::Auto);
   const Outcome opened = s.ask(Request::open(p.path()));
   ASSERT_TRUE(opened.accepted) << s.message();
   // The preflight reads the program once, as rs274 does, and says that a run repeats it.
@@ -199,15 +199,15 @@ TEST(EndlessProgramScenario, M99InTheMainProgramRepeatsItUntilTheOperatorStops) 
   for (const auto& d : opened.diagnostics.items()) warned = warned || d.code == "gcode.main-program-repeats";
   EXPECT_TRUE(warned) << s.message();
   const std::uint64_t finished = s.status().runs_finished;
-  s.must(Request::simple(CommandKind::CycleStart));
+  s.must(Request::simple(control::CommandKind::CycleStart));
   // Ten passes: X steps 2 mm each time round.
   ASSERT_TRUE(s.until([&] { return s.status().servo.commanded[Axis::X] >= 20.0 - 1e-9; }, 200000));
   EXPECT_TRUE(s.status().run_active);
-  s.must(Request::simple(CommandKind::Abort));
+  s.must(Request::simple(control::CommandKind::Abort));
   ASSERT_TRUE(s.idle(20000));
   EXPECT_FALSE(s.status().run_active);
   EXPECT_EQ(s.status().runs_finished, finished);  // stopped, never finished
   EXPECT_EQ(s.report().limit_violations, 0u);
 }
 
-}  // namespace opencnc::control::test
+}  // namespace opencnc::controller::test

@@ -30,7 +30,7 @@
 #include "scenario.hpp"
 #include "temp_db.hpp"
 
-namespace opencnc::control::test {
+namespace opencnc::controller::test {
 namespace {
 
 using namespace std::chrono_literals;
@@ -57,7 +57,7 @@ class KeptOutputs final : public machine::MachineIO {
 class SplitRig {
  public:
   SplitRig(const config::MachineProfile& profile, std::shared_ptr<ProgramSource> source)
-      : channels_(std::make_unique<ServoChannels>()),
+      : channels_(std::make_unique<control::ServoChannels>()),
         sim_(config::sim_machine_config(profile)),
         io_(sim_),
         servo_(servo_config(profile), *channels_, io_),
@@ -96,7 +96,7 @@ class SplitRig {
     const std::uint64_t id = controller_.submit(std::move(r));
     std::optional<Outcome> o;
     EXPECT_TRUE(until([&] { return (o = controller_.outcome(id)).has_value(); }));
-    return o.value_or(Outcome{false, Refusal::Busy, "no answer", {}});
+    return o.value_or(Outcome{false, control::Refusal::Busy, "no answer", {}});
   }
   void must(Request r) {
     const std::string name = r.name();
@@ -122,15 +122,15 @@ class SplitRig {
   }
 
   Controller& controller() { return controller_; }
-  Servo& servo() { return servo_; }
+  control::Servo& servo() { return servo_; }
   machine::SimMachine& sim() { return sim_; }
   const machine::MachineOutputs& outputs() const { return io_.last(); }
 
  private:
-  std::unique_ptr<ServoChannels> channels_;
+  std::unique_ptr<control::ServoChannels> channels_;
   machine::SimMachine sim_;
   KeptOutputs io_;
-  Servo servo_;
+  control::Servo servo_;
   Controller controller_;
   std::atomic<bool> stop_{false};
   std::thread thread_;
@@ -143,11 +143,11 @@ std::shared_ptr<GcodeProgramSource> source_for(const config::MachineProfile& p) 
 
 /// Machine on with the spindle at 3000 rpm, then Auto mode.
 void spindle_running(SplitRig& r) {
-  r.must(Request::simple(CommandKind::MachineOn));
-  r.must(Request::set_mode(Mode::Manual));
+  r.must(Request::simple(control::CommandKind::MachineOn));
+  r.must(Request::set_mode(control::Mode::Manual));
   r.must(Request::spindle_on(3000, true));
   ASSERT_TRUE(r.until([&] { return r.outputs().spindle.speed_rpm == 3000; }));
-  r.must(Request::set_mode(Mode::Auto));
+  r.must(Request::set_mode(control::Mode::Auto));
 }
 
 /// The reproduction: an endless moving loop (refused only by the preflight's bounds).
@@ -159,33 +159,33 @@ constexpr const char* kLong =
 
 TEST(StopLane, AnEStopActsInTheNextPeriodWhileAnEndlessProgramIsChecked) {
   TempProgram p("endless.ngc", kEndless);
-  SplitRig r(mill(), source_for(mill()));
+  SplitRig r(control::test::mill(), source_for(control::test::mill()));
   spindle_running(r);
   const std::uint64_t open = r.controller().submit(Request::open(p.path()));
   r.ticks(20);  // the controller takes the open and checks the program on its task thread
-  EXPECT_EQ(r.periods_to_apply(Request::simple(CommandKind::EStop)), 1u);
-  EXPECT_EQ(r.servo().state(), State::EStopped);
+  EXPECT_EQ(r.periods_to_apply(Request::simple(control::CommandKind::EStop)), 1u);
+  EXPECT_EQ(r.servo().state(), control::State::EStopped);
   EXPECT_TRUE(r.everything_off());
   // The e-stop cancelled the check (an endless program is never answered before it): nothing opened.
   std::optional<Outcome> o;
   ASSERT_TRUE(r.until([&] { return (o = r.controller().outcome(open)).has_value(); }));
-  EXPECT_EQ(o->refusal, Refusal::Superseded) << o->message;
+  EXPECT_EQ(o->refusal, control::Refusal::Superseded) << o->message;
   EXPECT_FALSE(r.controller().open_program());
 }
 
 TEST(StopLane, AnAbortActsInTheNextPeriodWhileACycleStartChecksTheProgramAgain) {
   TempProgram p("part.ngc", "G21 G90 F600\nG1 X1\nM2\n");
-  SplitRig r(mill(), source_for(mill()));
+  SplitRig r(control::test::mill(), source_for(control::test::mill()));
   spindle_running(r);
   r.must(Request::open(p.path()));
   std::ofstream(p.path()) << kLong;  // changed since its check: the cycle start checks it again
   const Pose before = r.controller().status().servo.commanded;
-  const std::uint64_t start = r.controller().submit(Request::simple(CommandKind::CycleStart));
+  const std::uint64_t start = r.controller().submit(Request::simple(control::CommandKind::CycleStart));
   r.ticks(20);
-  EXPECT_EQ(r.periods_to_apply(Request::simple(CommandKind::Abort)), 1u);
+  EXPECT_EQ(r.periods_to_apply(Request::simple(control::CommandKind::Abort)), 1u);
   std::optional<Outcome> o;
   ASSERT_TRUE(r.until([&] { return (o = r.controller().outcome(start)).has_value(); }));
-  EXPECT_EQ(o->refusal, Refusal::Superseded) << o->message;
+  EXPECT_EQ(o->refusal, control::Refusal::Superseded) << o->message;
   r.ticks(50);
   EXPECT_FALSE(r.controller().status().run_active);
   EXPECT_EQ(r.controller().status().servo.commanded, before) << "the aborted start moved the machine";
@@ -193,7 +193,7 @@ TEST(StopLane, AnAbortActsInTheNextPeriodWhileACycleStartChecksTheProgramAgain) 
 
 TEST(StopLane, AnEStopActsInTheNextPeriodWhileRunFromLineScans) {
   TempProgram p("part.ngc", kLong);
-  const config::MachineProfile profile = mill();
+  const config::MachineProfile profile = control::test::mill();
   Diagnostics d;
   auto machine = features::machine_setup(profile, d);  // run from line, as every front end sets it up
   ASSERT_TRUE(machine);
@@ -202,9 +202,9 @@ TEST(StopLane, AnEStopActsInTheNextPeriodWhileRunFromLineScans) {
   spindle_running(r);
   r.must(Request::open(p.path()));
   const std::uint64_t scan =
-      r.controller().submit(Request::feature("run-from-line", "start", RunFromLineArgs{8}));
+      r.controller().submit(Request::feature("run-from-line", "start", run_from_line::RunFromLineArgs{8}));
   r.ticks(5);
-  EXPECT_EQ(r.periods_to_apply(Request::simple(CommandKind::EStop)), 1u);
+  EXPECT_EQ(r.periods_to_apply(Request::simple(control::CommandKind::EStop)), 1u);
   EXPECT_TRUE(r.everything_off());
   ASSERT_TRUE(r.until([&] { return r.controller().outcome(scan).has_value(); }));
   r.ticks(50);
@@ -239,7 +239,7 @@ TEST(StopLane, AnEStopActsInTheNextPeriodWhileTheToolStoreWaitsForItsLock) {
   ASSERT_EQ(sqlite3_exec(other, "BEGIN EXCLUSIVE", nullptr, nullptr, nullptr), SQLITE_OK);
   const std::uint64_t accept = r.controller().submit(Request::feature("tool-guard", "accept"));
   r.ticks(20);
-  EXPECT_EQ(r.periods_to_apply(Request::simple(CommandKind::EStop)), 1u);
+  EXPECT_EQ(r.periods_to_apply(Request::simple(control::CommandKind::EStop)), 1u);
   EXPECT_TRUE(r.everything_off());
   EXPECT_FALSE(r.controller().outcome(accept)) << "the write did not wait for the lock";
   sqlite3_exec(other, "COMMIT", nullptr, nullptr, nullptr);
@@ -254,7 +254,7 @@ TEST(StopLane, AnEStopActsInTheNextPeriodWhileTheJournalWritesTheBreakpoint) {
                 "G21 G90 G94 G17 G40 G49\nG64 P0.005\nG0 X-0.5\nG0 Z-10 C0\nM171 P600\nG1 X0.1 F60\n"
                 "G1 Z310 F3000\nG1 X-0.4 F60\nG0 Z-10\nM175\nM2\n");
   const config::MachineProfile profile =
-      loaded(config::load_profile(OPENCNC_SOURCE_DIR "/configs/broach-zc.toml"));
+      control::test::loaded(config::load_profile(OPENCNC_SOURCE_DIR "/configs/broach-zc.toml"));
   auto source = source_for(profile);
   SplitRig r(profile, source);
   const auto dir = std::filesystem::path(p.path()).parent_path() / "journal";
@@ -263,10 +263,10 @@ TEST(StopLane, AnEStopActsInTheNextPeriodWhileTheJournalWritesTheBreakpoint) {
   auto journal = recovery::BreakpointJournal::open(dir.string(), source, &error);
   ASSERT_TRUE(journal) << error;
   ASSERT_TRUE(r.controller().add_feature(journal, ObserverOptions{profile.servo_period_s, true}));
-  r.must(Request::simple(CommandKind::MachineOn));
-  r.must(Request::set_mode(Mode::Auto));
+  r.must(Request::simple(control::CommandKind::MachineOn));
+  r.must(Request::set_mode(control::Mode::Auto));
   r.must(Request::open(p.path()));
-  r.must(Request::simple(CommandKind::CycleStart));
+  r.must(Request::simple(control::CommandKind::CycleStart));
   ASSERT_TRUE(r.until([&] { return r.controller().status().servo.time_s >= 3.2; }));
   r.sim().set_mains_ok(false);  // the power-fail stop: the journal writes the record of the signal
   r.ticks(2);
@@ -275,9 +275,10 @@ TEST(StopLane, AnEStopActsInTheNextPeriodWhileTheJournalWritesTheBreakpoint) {
   while (!journal->last_written() && std::chrono::steady_clock::now() < give_up)
     std::this_thread::sleep_for(1ms);
   ASSERT_TRUE(journal->last_written()) << "the journal wrote no record";
-  ASSERT_NE(r.servo().state(), State::Faulted) << "the axes came to rest before the e-stop could be sent";
+  ASSERT_NE(r.servo().state(), control::State::Faulted)
+      << "the axes came to rest before the e-stop could be sent";
   // The axes still stopping on the helix, the journal's writer about to write the at-rest record.
-  EXPECT_EQ(r.periods_to_apply(Request::simple(CommandKind::EStop)), 1u);
+  EXPECT_EQ(r.periods_to_apply(Request::simple(control::CommandKind::EStop)), 1u);
   EXPECT_TRUE(r.everything_off());
 }
 
@@ -291,7 +292,7 @@ class StuckFeature final : public Feature {
     inside_ = true;
     changed_.notify_all();
     changed_.wait(lock, [this] { return released_; });
-    return Outcome{true, Refusal::None, "released", {}};
+    return Outcome{true, control::Refusal::None, "released", {}};
   }
   void wait_inside() {
     std::unique_lock lock(mutex_);
@@ -310,29 +311,29 @@ class StuckFeature final : public Feature {
 };
 
 struct StopCase {
-  CommandKind stop;
-  State after;  ///< the servo's state the period after
+  control::CommandKind stop;
+  control::State after;  ///< the servo's state the period after
 };
 
 class StopsWhileStuck : public ::testing::TestWithParam<StopCase> {};
 
 TEST_P(StopsWhileStuck, TheStopActsInTheNextPeriod) {
   TempProgram p("part.ngc", "G21 G90 M3 S3000\nG1 X150 F1200\nM2\n");
-  SplitRig r(mill(), source_for(mill()));
+  SplitRig r(control::test::mill(), source_for(control::test::mill()));
   auto stuck = std::make_shared<StuckFeature>();
   ASSERT_TRUE(r.controller().add_feature(stuck));
-  r.must(Request::simple(CommandKind::MachineOn));
-  r.must(Request::set_mode(Mode::Auto));
+  r.must(Request::simple(control::CommandKind::MachineOn));
+  r.must(Request::set_mode(control::Mode::Auto));
   r.must(Request::open(p.path()));
-  r.must(Request::simple(CommandKind::CycleStart));
-  ASSERT_TRUE(
-      r.until([&] { return r.servo().state() == State::Running && r.outputs().spindle.speed_rpm == 3000; }));
+  r.must(Request::simple(control::CommandKind::CycleStart));
+  ASSERT_TRUE(r.until(
+      [&] { return r.servo().state() == control::State::Running && r.outputs().spindle.speed_rpm == 3000; }));
   r.ticks(300);
   const std::uint64_t id = r.controller().submit(Request::feature("stuck", "wait"));
   stuck->wait_inside();  // the controller's thread is held from here on
   EXPECT_EQ(r.periods_to_apply(Request::simple(GetParam().stop)), 1u);
   EXPECT_EQ(r.servo().state(), GetParam().after);
-  if (GetParam().stop == CommandKind::EStop) {
+  if (GetParam().stop == control::CommandKind::EStop) {
     EXPECT_TRUE(r.everything_off());
   }
   stuck->release();
@@ -340,17 +341,17 @@ TEST_P(StopsWhileStuck, TheStopActsInTheNextPeriod) {
 }
 
 INSTANTIATE_TEST_SUITE_P(EveryStop, StopsWhileStuck,
-                         ::testing::Values(StopCase{CommandKind::EStop, State::EStopped},
-                                           StopCase{CommandKind::MachineOff, State::Off},
-                                           StopCase{CommandKind::FeedHold, State::Held},
-                                           StopCase{CommandKind::Abort, State::Idle}),
+                         ::testing::Values(StopCase{control::CommandKind::EStop, control::State::EStopped},
+                                           StopCase{control::CommandKind::MachineOff, control::State::Off},
+                                           StopCase{control::CommandKind::FeedHold, control::State::Held},
+                                           StopCase{control::CommandKind::Abort, control::State::Idle}),
                          [](const ::testing::TestParamInfo<StopCase>& p) {
                            switch (p.param.stop) {
-                             case CommandKind::EStop:
+                             case control::CommandKind::EStop:
                                return std::string("EStop");
-                             case CommandKind::MachineOff:
+                             case control::CommandKind::MachineOff:
                                return std::string("MachineOff");
-                             case CommandKind::FeedHold:
+                             case control::CommandKind::FeedHold:
                                return std::string("FeedHold");
                              default:
                                return std::string("Abort");
@@ -358,4 +359,4 @@ INSTANTIATE_TEST_SUITE_P(EveryStop, StopsWhileStuck,
                          });
 
 }  // namespace
-}  // namespace opencnc::control::test
+}  // namespace opencnc::controller::test

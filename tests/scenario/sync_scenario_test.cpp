@@ -17,7 +17,7 @@
 #include <cmath>
 #include "scenario.hpp"
 
-namespace opencnc::control::test {
+namespace opencnc::controller::test {
 namespace {
 
 /// The errors the log noted since the cursor was made, in words.
@@ -32,14 +32,14 @@ std::string noted_errors(EventCursor& c) {
 // The simulated probe of the mill meets the top of a part at Z −50: the program probes it and
 // machines relative to what it found, not to what it assumed.
 TEST(SyncScenario, ProbeTheTopOfAPartAndMachineRelativeToIt) {
-  Scenario s(mill());
+  Scenario s(control::test::mill());
   TempProgram p("probe.ngc",
                 "G21 G90 G54\n"
                 "G0 X10 Y10 Z0\n"
                 "G38.2 Z-100 F300\n"
                 "G0 Z[#5063+5]\n"
                 "M2\n");
-  s.on(Mode::Auto);
+  s.on(control::Mode::Auto);
   EventCursor log(s.rig().controller().events());
   ASSERT_TRUE(s.run_file(p.path())) << s.message();
   const ControllerStatus st = s.status();
@@ -63,7 +63,7 @@ TEST(SyncScenario, ProbeTheTopOfAPartAndMachineRelativeToIt) {
 // Either way the moves after it start from what the probe found, not from the probe move's end.
 TEST(SyncScenario, WorkOffsetSetFromAProbedPoint) {
   for (const char* set : {"G10 L2 P1 Z[#5223 + #5063]", "G10 L20 P1 Z0"}) {
-    Scenario s(mill());
+    Scenario s(control::test::mill());
     TempProgram p("touch.ngc", fmt::format("G21 G90 G54\n"
                                            "G0 X0 Y0 Z-20\n"
                                            "G38.2 Z-80 F200\n"
@@ -72,7 +72,7 @@ TEST(SyncScenario, WorkOffsetSetFromAProbedPoint) {
                                            "G1 X5 F600\n"
                                            "M2\n",
                                            set));
-    s.on(Mode::Auto);
+    s.on(control::Mode::Auto);
     ASSERT_TRUE(s.run_file(p.path())) << s.message();
     const bool at_trip = std::string(set).find("L2 ") != std::string::npos;
     // 2 mm above the part at −50 (the machine stops 0.0066 mm past the trip at 3.3 mm/s).
@@ -93,10 +93,10 @@ TEST(SyncScenario, M66BranchesOnTheInputTheMachineReads) {
       "o100 endif\n"
       "M2\n";
   for (const bool on : {true, false}) {
-    Scenario s(mill());
+    Scenario s(control::test::mill());
     TempProgram p("m66.ngc", text);
     s.sim().set_digital_input(1, on);
-    s.on(Mode::Auto);
+    s.on(control::Mode::Auto);
     ASSERT_TRUE(s.run_file(p.path())) << s.message();
     EXPECT_NEAR(s.status().servo.commanded[Axis::X], on ? 10.0 : 20.0, 1e-9) << on;
   }
@@ -105,17 +105,17 @@ TEST(SyncScenario, M66BranchesOnTheInputTheMachineReads) {
 // A probe move that ends without contact: LinuxCNC's error, on the probe's line, and nothing after
 // it moves.
 TEST(SyncScenario, AProbeThatMissesStopsTheProgramWithLinuxCncsError) {
-  Scenario s(mill());
+  Scenario s(control::test::mill());
   TempProgram p("miss.ngc",
                 "G21 G90\n"
                 "G0 X0 Y0 Z0\n"
                 "G38.2 Z-30 F600\n"  // the part is at −50: no contact
                 "G0 X50\n"
                 "M2\n");
-  s.on(Mode::Auto);
+  s.on(control::Mode::Auto);
   EventCursor log(s.rig().controller().events());
   s.must(Request::open(p.path()));
-  s.must(Request::simple(CommandKind::CycleStart));
+  s.must(Request::simple(control::CommandKind::CycleStart));
   ASSERT_TRUE(s.idle(50000));
   const std::string errors = noted_errors(log);
   EXPECT_NE(errors.find("miss.ngc:3"), std::string::npos) << errors;
@@ -130,7 +130,7 @@ TEST(SyncScenario, AProbeThatMissesStopsTheProgramWithLinuxCncsError) {
 // after the probe would cross the Z soft limit. The program opens with a warning that names the
 // line; with the real probe result the move is checked again before it runs.
 TEST(SyncScenario, MovesThatRestOnAnAssumedValueAreCheckedAgainWithTheRealOne) {
-  Scenario s(mill({"axis.z.min_limit=-120"}));
+  Scenario s(control::test::mill({"axis.z.min_limit=-120"}));
   TempProgram p("assumed.ngc",
                 "G21 G90\n"
                 "G0 X0 Y0 Z0\n"
@@ -138,7 +138,7 @@ TEST(SyncScenario, MovesThatRestOnAnAssumedValueAreCheckedAgainWithTheRealOne) {
                 "G0 Z[#5063-40]\n"  // assumed: −150, beyond −120; real: −90
                 "G0 Z0\n"
                 "M2\n");
-  s.on(Mode::Auto);
+  s.on(control::Mode::Auto);
   const Outcome o = s.ask(Request::open(p.path()));
   ASSERT_TRUE(o.accepted) << s.message();
   bool warned = false;
@@ -158,7 +158,7 @@ TEST(SyncScenario, MovesThatRestOnAnAssumedValueAreCheckedAgainWithTheRealOne) {
 
 // A probed value that drives a move past a soft limit: the machine stops before that move.
 TEST(SyncScenario, AProbedValueThatCrossesASoftLimitStopsBeforeTheMove) {
-  Scenario s(mill({"axis.z.min_limit=-120"}));
+  Scenario s(control::test::mill({"axis.z.min_limit=-120"}));
   TempProgram p("deep.ngc",
                 "G21 G90\n"
                 "G0 X0 Y0 Z0\n"
@@ -166,10 +166,10 @@ TEST(SyncScenario, AProbedValueThatCrossesASoftLimitStopsBeforeTheMove) {
                 "G0 Z[#5063-80]\n"  // real: −130, beyond −120
                 "G0 X30\n"
                 "M2\n");
-  s.on(Mode::Auto);
+  s.on(control::Mode::Auto);
   EventCursor log(s.rig().controller().events());
   s.must(Request::open(p.path()));
-  s.must(Request::simple(CommandKind::CycleStart));
+  s.must(Request::simple(control::CommandKind::CycleStart));
   ASSERT_TRUE(s.idle(50000));
   const std::string errors = noted_errors(log);
   EXPECT_NE(errors.find("deep.ngc:4"), std::string::npos) << errors;
@@ -189,7 +189,7 @@ TEST(SyncScenario, ToolDataChangedDuringAToolChangeCountsAfterIt) {
   t1.offset[Axis::Z] = 10.0;
   table.add(t1);
   auto tools = std::make_shared<tools::MemoryToolTable>(table);
-  const config::MachineProfile profile = mill();
+  const config::MachineProfile profile = control::test::mill();
   Diagnostics d;
   auto base = features::machine_setup(profile, d)->source();
   GcodeSourceConfig c;
@@ -202,17 +202,17 @@ TEST(SyncScenario, ToolDataChangedDuringAToolChangeCountsAfterIt) {
                 "G43 H1\n"
                 "G0 Z0\n"
                 "M2\n");
-  s.on(Mode::Auto);
+  s.on(control::Mode::Auto);
   s.must(Request::open(p.path()));
-  s.must(Request::simple(CommandKind::CycleStart));
-  ASSERT_TRUE(s.until([&] { return s.status().servo.wait == Wait::ManualToolChange; }, 20000));
+  s.must(Request::simple(control::CommandKind::CycleStart));
+  ASSERT_TRUE(s.until([&] { return s.status().servo.wait == control::Wait::ManualToolChange; }, 20000));
   EXPECT_EQ(s.status().sync_wait, SyncKind::ToolChange);
   EXPECT_NE(s.status().wait_text.find("T1"), std::string::npos) << s.status().wait_text;
   // The operator measures the new tool: 25 mm long, not 10.
   tools::ToolEntry measured = tools->snapshot()->at_index(1);
   measured.offset[Axis::Z] = 25.0;
   ASSERT_TRUE(tools->update(1, measured, tools::ChangeSource::Operator, d));
-  s.must(Request::simple(CommandKind::ToolChanged));
+  s.must(Request::simple(control::CommandKind::ToolChanged));
   ASSERT_TRUE(s.idle(20000));
   EXPECT_NEAR(s.status().servo.commanded[Axis::Z], 25.0, 1e-9);  // Z0 of the tool tip
 }
@@ -227,21 +227,22 @@ TEST(SyncScenario, G10L1WritesTheMachinesToolTable) {
   t2.offset[Axis::Z] = 30.0;
   table.add(t2);
   auto tools = std::make_shared<tools::MemoryToolTable>(table);
-  const config::MachineProfile profile = mill();
+  const config::MachineProfile profile = control::test::mill();
   Diagnostics d;
   GcodeSourceConfig c;
   c.options = features::machine_setup(profile, d)->source()->options_for("", {});
   c.tools = tools;
   Scenario s(profile, std::make_shared<GcodeProgramSource>(c));
   TempProgram p("g10.ngc", "G21 G90\nT2 M6\nG10 L1 P2 Z42.5 R3\nG43 H2\nG0 Z0\nM2\n");
-  s.on(Mode::Auto);
+  s.on(control::Mode::Auto);
   s.must(Request::open(p.path()));
   ASSERT_TRUE(tools->snapshot()->at_index(1).offset[Axis::Z] == 30.0);  // the preflight wrote nothing
-  s.must(Request::simple(CommandKind::CycleStart));
+  s.must(Request::simple(control::CommandKind::CycleStart));
   ASSERT_TRUE(s.until(
       [&] {
-        if (s.status().servo.wait == Wait::ManualToolChange) s.rig().controller().submit(Request::simple(CommandKind::ToolChanged));
-        return !s.status().run_active && s.status().servo.state == State::Idle;
+        if (s.status().servo.wait == control::Wait::ManualToolChange)
+          s.rig().controller().submit(Request::simple(control::CommandKind::ToolChanged));
+        return !s.status().run_active && s.status().servo.state == control::State::Idle;
       },
       50000));
   const tools::ToolEntry now = tools->snapshot()->at_index(1);
@@ -255,18 +256,18 @@ TEST(SyncScenario, G10L1WritesTheMachinesToolTable) {
 
 // M0: the interpreter stops reading at the stop; status says what the run waits for.
 TEST(SyncScenario, TheInterpreterWaitsAtAProgramStop) {
-  Scenario s(mill());
+  Scenario s(control::test::mill());
   TempProgram p("stop.ngc", "G21 G90\nG0 X5\nM0\nG0 X10\nG0 X20\nM2\n");
-  s.on(Mode::Auto);
+  s.on(control::Mode::Auto);
   s.must(Request::open(p.path()));
-  s.must(Request::simple(CommandKind::CycleStart));
-  ASSERT_TRUE(s.until([&] { return s.status().servo.state == State::Stopped; }, 20000));
+  s.must(Request::simple(control::CommandKind::CycleStart));
+  ASSERT_TRUE(s.until([&] { return s.status().servo.state == control::State::Stopped; }, 20000));
   const ControllerStatus st = s.status();
   EXPECT_EQ(st.sync_wait, SyncKind::ProgramStop);
   EXPECT_EQ(st.interpreter_moves, 1u);  // nothing after the M0 has been read
   EXPECT_NE(st.wait_text.find("cycle start"), std::string::npos) << st.wait_text;
   EXPECT_NE(st.wait_text.find("stop.ngc:3"), std::string::npos) << st.wait_text;
-  s.must(Request::simple(CommandKind::CycleStart));
+  s.must(Request::simple(control::CommandKind::CycleStart));
   ASSERT_TRUE(s.idle(20000));
   EXPECT_NEAR(s.status().servo.commanded[Axis::X], 20.0, 1e-9);
   EXPECT_EQ(s.status().runs_finished, 1u);
@@ -281,16 +282,17 @@ TEST(SyncScenario, StreamingMovesExactlyAsTheWholeProgram) {
     text += fmt::format("G1 X{:.3f} Y{:.3f}\n", 20 * std::cos(i * 0.01) + 0.001 * i, 20 * std::sin(i * 0.01));
   text += "M2\n";
   TempProgram p("spiral.ngc", text);
-  std::vector<TraceSample> streamed, whole;
+  std::vector<control::TraceSample> streamed, whole;
   {
-    Scenario s(mill({"interpreter.readahead_moves=10"}));  // the least read-ahead: the planner asks
-    s.on(Mode::Auto);
+    Scenario s(
+        control::test::mill({"interpreter.readahead_moves=10"}));  // the least read-ahead: the planner asks
+    s.on(control::Mode::Auto);
     ASSERT_TRUE(s.run_file(p.path(), 400000)) << s.message();
     streamed = s.samples();
   }
   {
-    Scenario s(mill());
-    s.on(Mode::Auto);
+    Scenario s(control::test::mill());
+    s.on(control::Mode::Auto);
     // The same program interpreted up front (scan mode) into one canon::Program.
     gcode::Options o;
     o.axes = AxisMask::from_letters("XYZ");
@@ -317,15 +319,15 @@ TEST(SyncScenario, StreamingMovesExactlyAsTheWholeProgram) {
 }
 
 }  // namespace
-}  // namespace opencnc::control::test
+}  // namespace opencnc::controller::test
 
-namespace opencnc::control::test {
+namespace opencnc::controller::test {
 namespace {
 
 /// The most moves a run's program window held at once.
 class WindowWatch final : public ControllerObserver {
  public:
-  void on_trace(const TraceSample&, const TraceContext& c) override {
+  void on_trace(const control::TraceSample&, const TraceContext& c) override {
     if (c.program == nullptr) return;
     most = std::max(most, c.program->size() - c.program->first_held_move());
     moves = std::max<std::uint64_t>(moves, c.first_move + c.program->size());
@@ -338,7 +340,7 @@ class WindowWatch final : public ControllerObserver {
 // the machine has passed is freed as it goes. (Chords of 0.5 mm round a circle: the blends keep
 // within P of every corner, so a zigzag of hairpins would crawl at each of them.)
 TEST(StreamScenario, ALongProgramRunsInABoundedWindow) {
-  Scenario s(mill());
+  Scenario s(control::test::mill());
   TempProgram p("long.ngc",
                 "G21 G90 G64 P0.01 F6000\n"
                 "#1 = 0\n"
@@ -349,7 +351,7 @@ TEST(StreamScenario, ALongProgramRunsInABoundedWindow) {
                 "M2\n");
   auto watch = std::make_shared<WindowWatch>();
   s.rig().controller().attach(watch, ObserverOptions{0, true});
-  s.on(Mode::Auto);
+  s.on(control::Mode::Auto);
   ASSERT_TRUE(s.run_file(p.path(), 2'000'000)) << s.message();
   EXPECT_EQ(watch->moves, 120000u) << watch->most;
   EXPECT_GT(watch->most, 2000u);   // the read-ahead and the planner's window
@@ -359,9 +361,9 @@ TEST(StreamScenario, ALongProgramRunsInABoundedWindow) {
 }
 
 }  // namespace
-}  // namespace opencnc::control::test
+}  // namespace opencnc::controller::test
 
-namespace opencnc::control::test {
+namespace opencnc::controller::test {
 namespace {
 
 // The program's own dialect comment wins over the profile's default, and an O-numbered Fanuc
@@ -369,31 +371,31 @@ namespace {
 TEST(DialectScenario, RunReadsTheProgramInItsOwnDialect) {
   const char* fanuc = "%\nO0001 (BRACKET)\nG21 G90 G54\nG0 X10. Y5.\nG1 X20. F600\nM30\n%\n";
   {
-    Scenario s(mill({"interpreter.dialect=\"fanuc\""}));
+    Scenario s(control::test::mill({"interpreter.dialect=\"fanuc\""}));
     TempProgram p("o0001.nc", fanuc);
-    s.on(Mode::Auto);
+    s.on(control::Mode::Auto);
     ASSERT_TRUE(s.run_file(p.path())) << s.message();
     EXPECT_NEAR(s.status().servo.commanded[Axis::X], 20.0, 1e-9);
   }
   {
-    Scenario s(mill());  // LinuxCNC by default: the comment says Fanuc
+    Scenario s(control::test::mill());  // LinuxCNC by default: the comment says Fanuc
     TempProgram p("marked.nc", std::string("(dialect: fanuc)\n") + (fanuc + 2));
-    s.on(Mode::Auto);
+    s.on(control::Mode::Auto);
     ASSERT_TRUE(s.run_file(p.path())) << s.message();
     EXPECT_NEAR(s.status().servo.commanded[Axis::Y], 5.0, 1e-9);
   }
 }
 
 }  // namespace
-}  // namespace opencnc::control::test
+}  // namespace opencnc::controller::test
 
-namespace opencnc::control::test {
+namespace opencnc::controller::test {
 namespace {
 
 // Status says exactly where in the program the machine is: the move, the path length into it, the
 // line and the calls that led there (what a breakpoint journal records).
 TEST(StatusScenario, SaysTheMoveThePlaceInItAndTheCallStack) {
-  Scenario s(mill());
+  Scenario s(control::test::mill());
   TempProgram p("calls.ngc",
                 "o<side> sub\n"
                 "  G1 X[#1] F600\n"
@@ -402,9 +404,9 @@ TEST(StatusScenario, SaysTheMoveThePlaceInItAndTheCallStack) {
                 "G0 X0 Y0\n"
                 "o<side> call [40]\n"
                 "M2\n");
-  s.on(Mode::Auto);
+  s.on(control::Mode::Auto);
   s.must(Request::open(p.path()));
-  s.must(Request::simple(CommandKind::CycleStart));
+  s.must(Request::simple(control::CommandKind::CycleStart));
   ASSERT_TRUE(s.until([&] { return s.status().servo.commanded[Axis::X] > 10.0; }, 20000));
   const ControllerStatus st = s.status();
   EXPECT_EQ(st.job, JobKind::Program);
@@ -418,15 +420,15 @@ TEST(StatusScenario, SaysTheMoveThePlaceInItAndTheCallStack) {
 }
 
 }  // namespace
-}  // namespace opencnc::control::test
+}  // namespace opencnc::controller::test
 
-namespace opencnc::control::test {
+namespace opencnc::controller::test {
 namespace {
 
 // MDI lines meet the machine too: a probe typed by the operator sets #5063 for the next line.
 TEST(MdiSyncScenario, AProbeInMdiSetsItsParameters) {
-  Scenario s(mill());
-  s.on(Mode::Mdi);
+  Scenario s(control::test::mill());
+  s.on(control::Mode::Mdi);
   s.must(Request::mdi("G21 G90 G0 X5 Y5 Z0"));
   ASSERT_TRUE(s.idle(20000));
   s.must(Request::mdi("G38.2 Z-100 F300"));
@@ -438,4 +440,4 @@ TEST(MdiSyncScenario, AProbeInMdiSetsItsParameters) {
 }
 
 }  // namespace
-}  // namespace opencnc::control::test
+}  // namespace opencnc::controller::test

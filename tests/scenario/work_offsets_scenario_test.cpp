@@ -8,7 +8,7 @@
 #include "../control/test_profiles.hpp"
 #include "scenario.hpp"
 
-namespace opencnc::control::test {
+namespace opencnc::controller::test {
 namespace {
 
 // Runs until the commanded X passes `x` on a move of `line`.
@@ -31,10 +31,10 @@ TEST(WorkOffsetsScenario, AG55OffsetAndAG92ShiftShowUpExactly) {
                 "G92 X0\n"                 // 6: X here (30) becomes 0
                 "G1 X15\n"                 // 7
                 "M2\n");
-  Scenario s(mill());
-  s.on(Mode::Auto);
+  Scenario s(control::test::mill());
+  s.on(control::Mode::Auto);
   s.must(Request::open(p.path()));
-  s.must(Request::simple(CommandKind::CycleStart));
+  s.must(Request::simple(control::CommandKind::CycleStart));
 
   ASSERT_TRUE(until_past(s, 5, 20.0));
   ControllerStatus st = s.status();
@@ -71,8 +71,8 @@ TEST(WorkOffsetsScenario, AG55OffsetAndAG92ShiftShowUpExactly) {
 }
 
 TEST(WorkOffsetsScenario, TheToolLengthOffsetAndTheMdiSessionsOffsetsCarryOver) {
-  Scenario s(mill());
-  s.on(Mode::Mdi);
+  Scenario s(control::test::mill());
+  s.on(control::Mode::Mdi);
   s.must(Request::mdi("G21 G90 G10 L2 P1 X1 Y2 Z3"));
   ASSERT_TRUE(s.idle());
   s.must(Request::mdi("G54 G43.1 Z4"));  // a dynamic tool length offset
@@ -104,4 +104,4 @@ TEST(WorkOffsets, WorkPositionUndoesTheRotation) {
 }
 
 }  // namespace
-}  // namespace opencnc::control::test
+}  // namespace opencnc::controller::test

@@ -11,7 +11,7 @@
 #include "scenario.hpp"
 #include "temp_db.hpp"
 
-namespace opencnc::control::test {
+namespace opencnc::controller::test {
 namespace {
 
 using tools::Param;
@@ -51,7 +51,7 @@ class Guarded {
     profile_ = *load.profile;
     scenario_ = std::make_unique<Scenario>(profile_);  // the guard as every front end sets it up
     cursor_ = std::make_unique<EventCursor>(scenario_->rig().controller().events(), true);
-    scenario_->on(Mode::Auto);
+    scenario_->on(control::Mode::Auto);
   }
   Scenario& s() { return *scenario_; }
   store::ToolStore& store() { return *store_; }
@@ -82,9 +82,9 @@ TEST(ToolGuardScenario, TheTypoIsCaughtBeforeTheFirstCutNamingToolAndEdge) {
   g.set(3, 1, Param::Length1, 105.25);  // 150.25 typed as 105.25
   g.s().must(Request::open(p.path()));
   const Pose before = g.s().status().servo.commanded;
-  const Outcome o = g.s().ask(Request::simple(CommandKind::CycleStart));
+  const Outcome o = g.s().ask(Request::simple(control::CommandKind::CycleStart));
   EXPECT_FALSE(o.accepted);
-  EXPECT_EQ(o.refusal, Refusal::FeatureCheck);
+  EXPECT_EQ(o.refusal, control::Refusal::FeatureCheck);
   EXPECT_NE(o.message.find("T3 D1 length1: backup 150.25, live 105.25"), std::string::npos) << o.message;
   g.s().ticks(200);
   EXPECT_FALSE(g.s().status().run_active);
@@ -103,7 +103,7 @@ TEST(ToolGuardScenario, WearWithinTheBandPasses) {
 void hold_at_tool_change(Guarded& g, const std::string& choice, double expected_z) {
   TempProgram p("demo.ngc", kProgram);
   g.s().must(Request::open(p.path()));
-  g.s().must(Request::simple(CommandKind::CycleStart));
+  g.s().must(Request::simple(control::CommandKind::CycleStart));
   g.set(3, 1, Param::Length1, 105.25);
   ASSERT_TRUE(
       g.s().until([&] { return g.s().status().wait_text.find("tool-guard") != std::string::npos; }, 40000))
@@ -141,7 +141,7 @@ TEST(ToolGuardScenario, RestoreAfterARefusedStartLetsTheProgramRun) {
   TempProgram p("demo.ngc", kProgram);
   g.set(5, 2, Param::Radius, 0.8);
   g.s().must(Request::open(p.path()));
-  EXPECT_FALSE(g.s().ask(Request::simple(CommandKind::CycleStart)).accepted);
+  EXPECT_FALSE(g.s().ask(Request::simple(control::CommandKind::CycleStart)).accepted);
   g.s().must(Request::feature("tool-guard", "restore"));
   EXPECT_EQ(*g.store().live(), *g.store().backup_set(1));
   ASSERT_TRUE(g.s().start_and_finish(60000)) << g.s().message();
@@ -169,4 +169,4 @@ TEST(ToolGuardScenario, TheProfileSaysWhenToCheck) {
 }
 
 }  // namespace
-}  // namespace opencnc::control::test
+}  // namespace opencnc::controller::test

@@ -19,7 +19,7 @@
 #include "opencnc/controller/observer.hpp"
 #include "opencnc/gcode/options.hpp"
 
-namespace opencnc::control {
+namespace opencnc::controller {
 class GcodeProgramSource;
 }
 
@@ -59,24 +59,25 @@ enum class RecoveryPhase : std::uint8_t { None, Opening, RunningIn, Resuming, Re
 /// Requests: `Request::feature("journal", "show")` says what the journal holds; after the power
 /// returns, with a valid record, "resume" (ResumeArgs), "retract" (RetractArgs) and "discard" —
 /// each clears the valid flag once it has completed (docs/broaching.md, "Recovery").
-class BreakpointJournal final : public control::Feature {
+class BreakpointJournal final : public controller::Feature {
  public:
   /// Opens the journal in `dir` (created if missing); `source` gives the interpreter options of
   /// a file for the modal digest (null: the digest stays 0). Nullptr with `*error` on failure.
   /// Controller thread (or before the controller runs).
   static std::shared_ptr<BreakpointJournal> open(const std::string& dir,
-                                                 std::shared_ptr<control::GcodeProgramSource> source,
+                                                 std::shared_ptr<controller::GcodeProgramSource> source,
                                                  std::string* error);
   ~BreakpointJournal() override;
   BreakpointJournal(const BreakpointJournal&) = delete;
   BreakpointJournal& operator=(const BreakpointJournal&) = delete;
 
   std::string_view name() const override { return "journal"; }
-  void attached(control::FeatureHost& host) override { host_ = &host; }
-  void on_event(const control::ControllerEvent& e) override;
-  void on_status(const control::ControllerStatus& s) override;
-  void on_trace(const control::TraceSample& s, const control::TraceContext& c) override;
-  control::Outcome handle(const control::requests::Feature& request, control::FeatureHost& host) override;
+  void attached(controller::FeatureHost& host) override { host_ = &host; }
+  void on_event(const controller::ControllerEvent& e) override;
+  void on_status(const controller::ControllerStatus& s) override;
+  void on_trace(const control::TraceSample& s, const controller::TraceContext& c) override;
+  controller::Outcome handle(const controller::requests::Feature& request,
+                             controller::FeatureHost& host) override;
 
   /// Waits until everything handed to the writer is durable (or failed). Any thread but the writer.
   void flush();
@@ -105,30 +106,30 @@ class BreakpointJournal final : public control::Feature {
     gcode::Options options;                   ///< the program's interpreter options (digest)
   };
 
-  BreakpointJournal(std::unique_ptr<Journal> journal, std::shared_ptr<control::GcodeProgramSource> source);
+  BreakpointJournal(std::unique_ptr<Journal> journal, std::shared_ptr<controller::GcodeProgramSource> source);
   void post(Work w);
   void writer_loop();
   void write_one(Work& w);
   void set_writer_status(bool fifo, bool rt_io);
-  void begin_record(const control::TraceSample& s, const control::TraceContext& c);
+  void begin_record(const control::TraceSample& s, const controller::TraceContext& c);
   void complete_record();
   // Recovery (breakpoint_recovery.cpp).
-  control::Outcome start_resume(const BreakpointRecord& r, const ResumeArgs& args,
-                                control::FeatureHost& host);
-  control::Outcome start_retract(const BreakpointRecord& r, const RetractArgs& args,
-                                 control::FeatureHost& host);
+  controller::Outcome start_resume(const BreakpointRecord& r, const ResumeArgs& args,
+                                   controller::FeatureHost& host);
+  controller::Outcome start_retract(const BreakpointRecord& r, const RetractArgs& args,
+                                    controller::FeatureHost& host);
   std::shared_ptr<const canon::Program> along_helix(const BreakpointRecord& r, double distance_mm,
                                                     bool onward, double speed_mm_min,
-                                                    control::FeatureHost& host, std::string* why) const;
-  void recovery_event(const control::ControllerEvent& e);
+                                                    controller::FeatureHost& host, std::string* why) const;
+  void recovery_event(const controller::ControllerEvent& e);
   void run_in();
   void finish_recovery(bool ok, std::string why);
   void clear_valid();
   double period_s() const { return host_ != nullptr ? host_->profile().servo_period_s : 0.0; }
 
   std::unique_ptr<Journal> journal_;
-  std::shared_ptr<control::GcodeProgramSource> source_;
-  control::FeatureHost* host_ = nullptr;
+  std::shared_ptr<controller::GcodeProgramSource> source_;
+  controller::FeatureHost* host_ = nullptr;
 
   // Controller thread: the program, what the servo did before the signal, the stop under way.
   std::string path_;

@@ -10,7 +10,7 @@
 #include "opencnc/core/diagnostic.hpp"
 #include "opencnc/motion/coupling.hpp"
 
-namespace opencnc::control {
+namespace opencnc::broaching {
 
 /// The machine's coupling and the limits the pass checks the slave against.
 struct CoupledAxes {
@@ -36,7 +36,7 @@ CoupledAxes coupled_axes(const config::MachineProfile& profile);
 /// on which the law's slope or curvature would take the slave past its velocity or past 5 % of
 /// its acceleration at the fastest the planner may run it (the planner sees the chord only).
 /// Non-real-time; one thread (the program's builder's).
-class CouplingPass final : public MovePass {
+class CouplingPass final : public controller::MovePass {
  public:
   explicit CouplingPass(const CoupledAxes& axes) : axes_(axes) {}
 
@@ -66,4 +66,4 @@ class CouplingPass final : public MovePass {
   Diagnostics failures_;
 };
 
-}  // namespace opencnc::control
+}  // namespace opencnc::broaching

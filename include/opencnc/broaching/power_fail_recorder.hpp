@@ -12,7 +12,7 @@
 #include "opencnc/motion/coupling.hpp"
 #include "opencnc/plan/machine_limits.hpp"
 
-namespace opencnc::control {
+namespace opencnc::broaching {
 
 /// The figures of one power-fail stop (valid once `stopped`).
 struct PowerFailReport {
@@ -38,15 +38,15 @@ struct PowerFailReport {
 
 /// An observer (trace and status every period) of a run that may meet a power failure.
 /// Controller thread; non-real-time.
-class PowerFailRecorder final : public ControllerObserver, public ReportSection {
+class PowerFailRecorder final : public controller::ControllerObserver, public controller::ReportSection {
  public:
   /// `coupling`: the machine's (its tables); `limits`: the planner's (the independent stop brakes
   /// at them); `radius_mm`: where the helix error is measured (the bore's radius).
   PowerFailRecorder(const motion::CouplingConfig& coupling, const plan::MachineLimits& limits,
                     double period_s, double radius_mm);
 
-  void on_status(const ControllerStatus& s) override;
-  void on_trace(const TraceSample& s, const TraceContext& c) override;
+  void on_status(const controller::ControllerStatus& s) override;
+  void on_trace(const control::TraceSample& s, const controller::TraceContext& c) override;
   PowerFailReport report() const { return report_; }
 
   std::string report_key() const override { return "power_fail"; }
@@ -57,19 +57,19 @@ class PowerFailRecorder final : public ControllerObserver, public ReportSection 
   std::string report_json() const override;
 
  private:
-  motion::CouplingLaw law_of(const CouplingStatus& c) const;
+  motion::CouplingLaw law_of(const control::CouplingStatus& c) const;
   double helix_error_um(double master, double slave) const;
-  void simulate_independent_stop(const TraceSample& before, const TraceSample& at);
+  void simulate_independent_stop(const control::TraceSample& before, const control::TraceSample& at);
 
   motion::CouplingConfig coupling_;
   plan::MachineLimits limits_;
   double period_s_, radius_mm_;
-  CouplingStatus status_{};  ///< the coupling of the last coupled status
+  control::CouplingStatus status_{};  ///< the coupling of the last coupled status
   motion::CouplingLaw law_{};
-  std::optional<TraceSample> previous_;
+  std::optional<control::TraceSample> previous_;
   bool stopping_ = false;
   double master_at_signal_ = 0;
   PowerFailReport report_;
 };
 
-}  // namespace opencnc::control
+}  // namespace opencnc::broaching

@@ -20,6 +20,6 @@ struct RecoveryWait {
 /// load guard: nobody here resumes it) or a fault aborts the job, which ends the choice as failed;
 /// a stall or `wait.max_s` ends the wait. Returns "" when it completed, otherwise why not (the
 /// journal's error, the load at the hold, the fault). The thread that drives `rig`.
-std::string run_recovery(control::SimRig& rig, const BreakpointJournal& journal, RecoveryWait wait = {});
+std::string run_recovery(controller::SimRig& rig, const BreakpointJournal& journal, RecoveryWait wait = {});
 
 }  // namespace opencnc::recovery

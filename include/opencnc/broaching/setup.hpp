@@ -14,6 +14,6 @@ namespace opencnc::broaching {
 /// ("journal", following the status and the trace; its state `journal`), its sources made by
 /// `host`. False with the reasons in host.diagnostics() (a journal folder that cannot be opened).
 /// Before the controller runs, on the thread that sets it up.
-bool setup(const config::MachineProfile& profile, control::MachineSetup& host);
+bool setup(const config::MachineProfile& profile, controller::MachineSetup& host);
 
 }  // namespace opencnc::broaching

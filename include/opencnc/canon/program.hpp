@@ -107,7 +107,7 @@ enum class ActionKind : std::uint8_t {
   OptionalStop,
   PalletShuttle,
   ProgramEnd,
-  /// Not from the interpreter: the controller's hand-axis pass (control::HandAxisFilter) puts
+  /// Not from the interpreter: the controller's hand-axis pass (drill::HandAxisFilter) puts
   /// it where a move of a hand-fed axis was. index = axis, value = machine position, index2 = +1:
   /// a retract (the move went in +), 0: a plunge.
   HandAxisWait,

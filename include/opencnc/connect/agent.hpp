@@ -79,7 +79,7 @@ class Agent {
 
   /// Samples `status` at `time_us` (µs since 1970 UTC): every value that changed becomes an
   /// observation. The first call also marks the device AVAILABLE. Any one thread at a time.
-  void observe(const control::ControllerStatus& status, std::int64_t time_us);
+  void observe(const controller::ControllerStatus& status, std::int64_t time_us);
   /// The controller went away: AVAILABILITY UNAVAILABLE, every other item UNAVAILABLE.
   void mark_unavailable(std::int64_t time_us);
   /// Replaces the tool assets (the tool store's tools); changed ones get ASSET_CHANGED.

@@ -50,7 +50,7 @@ class Contribution {
   /// Adds the components and items this contribution observes. Once, before any observe().
   virtual void describe(DeviceModel& model) = 0;
   /// Writes its items' values from `status`. The agent's sampling thread.
-  virtual void observe(const control::ControllerStatus& status, ValueSink& out) const = 0;
+  virtual void observe(const controller::ControllerStatus& status, ValueSink& out) const = 0;
 };
 
 /// The contributions a machine profile calls for: the core, then the features the profile has

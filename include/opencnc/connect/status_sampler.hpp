@@ -21,7 +21,7 @@ struct SamplerOptions {
 
 class StatusSampler {
  public:
-  using StatusFn = std::function<control::ControllerStatus()>;
+  using StatusFn = std::function<controller::ControllerStatus()>;
   using ToolsFn = std::function<std::vector<ToolAsset>()>;
   /// `status` (any thread may call it: Controller::status), `tools` (may be empty: no assets).
   /// The agent must outlive the sampler.

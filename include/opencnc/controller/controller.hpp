@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// control::Controller — the non-real-time half of the controller and the one API of every front
+// controller::Controller — the non-real-time half of the controller and the one API of every front
 // end: requests in (thread-safe), status, answers and a numbered event log out. It is a hub:
 // observers follow its events, status and trace; features answer requests of their own; jobs (the
 // main program, MDI lines, auxiliary programs) stream through the interpreter in execute mode
@@ -31,7 +31,7 @@
 #include "opencnc/core/diagnostic.hpp"
 #include "opencnc/plan/planner.hpp"
 
-namespace opencnc::control {
+namespace opencnc::controller {
 
 namespace detail {
 class Job;
@@ -64,7 +64,7 @@ class Controller final : private FeatureHost {
  public:
   /// `channels` must outlive the controller; `source` turns G-code into programs (may be null:
   /// then only programs given as canon::Program can run).
-  Controller(const config::MachineProfile& profile, ServoChannels& channels,
+  Controller(const config::MachineProfile& profile, control::ServoChannels& channels,
              std::shared_ptr<ProgramSource> source = nullptr, ControllerOptions options = {});
   ~Controller() override;
   Controller(const Controller&) = delete;
@@ -105,7 +105,7 @@ class Controller final : private FeatureHost {
 
   /// The servo configuration and the profile in force. Controller thread (they change with an
   /// EditProfile request).
-  const ServoConfig& servo_config() const noexcept { return servo_config_; }
+  const control::ServoConfig& servo_config() const noexcept { return servo_config_; }
   const config::MachineProfile& profile() const noexcept override { return profile_; }
   /// A copy of the profile in force (after the last EditProfile). Any thread.
   config::MachineProfile current_profile() const;
@@ -129,7 +129,7 @@ class Controller final : private FeatureHost {
 
   void read_servo();
   void deliver_trace();
-  void on_event(const ServoEvent& e);
+  void on_event(const control::ServoEvent& e);
   void handle(std::uint64_t id, Request& r);
   void handle_servo(std::uint64_t id, const Request& r);
   void open_file(std::uint64_t id, const std::string& path);
@@ -141,7 +141,7 @@ class Controller final : private FeatureHost {
   void feature(std::uint64_t id, const requests::Feature& r);
   // Profile edits (profile_change.cpp).
   void edit_profile(std::uint64_t id, const requests::EditProfile& r);
-  bool settle_profile_change(const ServoEvent& e);
+  bool settle_profile_change(const control::ServoEvent& e);
   struct ProfileChange;
   bool open_program_passes(const config::MachineProfile& next, Diagnostics& needs);
   /// The move check of the servo configuration in force, with the features' reaches.
@@ -150,7 +150,7 @@ class Controller final : private FeatureHost {
   bool features_allow_start(std::uint64_t id, const StartCheck& start);
   bool features_allow_continue(const SyncCheck& sync);
   /// Refuses when a job cannot start now (mode `mode`, idle, homed, no job running).
-  bool ready_for_job(std::uint64_t id, Mode mode, const char* what);
+  bool ready_for_job(std::uint64_t id, control::Mode mode, const char* what);
   Preflight preflight_file(const std::string& path, const Pose& at, bool block_delete, ScanCancel cancel);
   Preflight preflight_canon(const canon::Program& program);
   /// `work` as the long task of request `id` (on the task thread, or at once), then `then` on the
@@ -167,13 +167,13 @@ class Controller final : private FeatureHost {
                      bool block_delete, std::string stamp, std::uint64_t version);
   /// Sends a command to the tick in the order of sending: `c.seq` as set (a request's own), or
   /// the next number. False when the queue is full. Controller thread.
-  bool send(Command c);
-  void start_job(std::uint64_t id, JobKind kind, std::string name, Mode mode, std::unique_ptr<ProgramStream> stream,
-                 bool prechecked = false);
+  bool send(control::Command c);
+  void start_job(std::uint64_t id, JobKind kind, std::string name, control::Mode mode,
+                 std::unique_ptr<ProgramStream> stream, bool prechecked = false);
   void end_job();
-  void forward(std::uint64_t id, const Command& c);
+  void forward(std::uint64_t id, const control::Command& c);
   std::uint64_t next_seq();
-  void finish(std::uint64_t id, Refusal refusal, std::string message = {}, Diagnostics diags = {});
+  void finish(std::uint64_t id, control::Refusal refusal, std::string message = {}, Diagnostics diags = {});
   void log(ControllerEvent e);
   void publish();
   void update_locations();
@@ -181,16 +181,16 @@ class Controller final : private FeatureHost {
   std::string wait_text() const;
   void tell_observers();
   void take_attachments();
-  std::string describe(const Fault& f) const;
-  std::string interlock_text(const ServoEvent& e) const;
-  std::string seek_text(const ServoEvent& e) const;
+  std::string describe(const control::Fault& f) const;
+  std::string interlock_text(const control::ServoEvent& e) const;
+  std::string seek_text(const control::ServoEvent& e) const;
   std::uint64_t new_id();
 
   config::MachineProfile profile_;
-  ServoConfig servo_config_;
+  control::ServoConfig servo_config_;
   plan::MachineLimits limits_;
   plan::PlannerConfig planner_config_;
-  ServoChannels* channels_;
+  control::ServoChannels* channels_;
   std::shared_ptr<ProgramSource> source_;
   std::vector<MoveReachFactory> reaches_;  ///< controller thread: the features' (add_move_reach)
   std::vector<std::shared_ptr<const EventTexts>> texts_;  ///< controller thread: the features' (add_texts)
@@ -234,7 +234,7 @@ class Controller final : private FeatureHost {
 
   // Controller thread only.
   /// The servo's status as last read (the triple buffer's reader slot).
-  const ServoStatus& servo() const noexcept { return channels_->status.front(); }
+  const control::ServoStatus& servo() const noexcept { return channels_->status.front(); }
   std::vector<Attached> observers_;
   std::map<std::string, std::shared_ptr<Feature>, std::less<>> features_;
   std::string held_by_;  ///< the feature that holds the job at a sync point ("" while none does)
@@ -275,17 +275,18 @@ class Controller final : private FeatureHost {
   std::uint64_t interpreter_seen_ = ~std::uint64_t{0};
   std::uint64_t location_every_ = 1;  ///< servo periods between refreshes of the interpreter's place
   struct WaitKey {
-    State state = State::Off;
-    Wait wait = Wait::None;
-    StopReason stop = StopReason::None;
+    control::State state = control::State::Off;
+    control::Wait wait = control::Wait::None;
+    control::StopReason stop = control::StopReason::None;
     SyncKind sync = SyncKind::None;
     std::uint32_t line = 0, context = 0;
     bool job = false;
     bool operator==(const WaitKey&) const = default;
   };
-  WaitKey wait_key_{State::Off, Wait::None, StopReason::None, SyncKind::None, ~0u, ~0u, false};
+  WaitKey wait_key_{
+      control::State::Off, control::Wait::None, control::StopReason::None, SyncKind::None, ~0u, ~0u, false};
   /// Last: destroyed (its thread joined) before everything its task may use.
   std::unique_ptr<detail::TaskRunner> tasks_;
 };
 
-}  // namespace opencnc::control
+}  // namespace opencnc::controller

@@ -9,7 +9,7 @@
 #include "opencnc/control/status.hpp"
 #include "opencnc/controller/program_source.hpp"
 
-namespace opencnc::control {
+namespace opencnc::controller {
 
 /// What a run executes.
 enum class JobKind : std::uint8_t {
@@ -51,7 +51,7 @@ Pose work_position(const Pose& machine, const WorkOffsets& o) noexcept;
 
 /// The status a front end shows (Controller::status()).
 struct ControllerStatus {
-  ServoStatus servo;
+  control::ServoStatus servo;
 
   // The open (main) program.
   std::string program_name;        ///< "" = none
@@ -94,4 +94,4 @@ struct ControllerStatus {
   std::uint32_t limits_version = 0;
 };
 
-}  // namespace opencnc::control
+}  // namespace opencnc::controller

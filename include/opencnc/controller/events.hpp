@@ -15,7 +15,7 @@
 #include "opencnc/controller/controller_status.hpp"
 #include "opencnc/core/diagnostic.hpp"
 
-namespace opencnc::control {
+namespace opencnc::controller {
 
 enum class ControllerEventKind : std::uint8_t {
   Servo,          ///< `servo`: what the servo reported (state changes, faults, homing, …)
@@ -39,7 +39,7 @@ struct ControllerEvent {
   Severity severity = Severity::Note;
   std::string code;  ///< stable problem code (control.*, gcode.*) or ""
   std::string text;  ///< in words
-  ServoEvent servo{};
+  control::ServoEvent servo{};
   std::uint64_t request_id = 0;
   bool accepted = false;
   JobKind job = JobKind::None;
@@ -102,4 +102,4 @@ class EventCursor {
   std::uint64_t lost_ = 0;
 };
 
-}  // namespace opencnc::control
+}  // namespace opencnc::controller

@@ -27,7 +27,7 @@ namespace opencnc::gcode {
 struct Extensions;
 }
 
-namespace opencnc::control {
+namespace opencnc::controller {
 
 /// A pass over a program's moves as the builder appends them: it may rewrite the moves just
 /// appended (a hand-fed axis held, a coupled slave's coordinate) and add actions before them.
@@ -75,18 +75,21 @@ class EventTexts {
  public:
   virtual ~EventTexts() = default;
   /// The note an event of the servo gets in the log.
-  virtual std::optional<EventNote> event_note(const ServoEvent& /*e*/,
+  virtual std::optional<EventNote> event_note(const control::ServoEvent& /*e*/,
                                               const config::MachineProfile& /*profile*/,
-                                              const ServoConfig& /*servo*/) const {
+                                              const control::ServoConfig& /*servo*/) const {
     return std::nullopt;
   }
   /// A fault's description (its code is control::fault_code's).
-  virtual std::optional<std::string> fault_text(const Fault& /*f*/, const config::MachineProfile& /*profile*/,
-                                                const ServoConfig& /*servo*/) const {
+  virtual std::optional<std::string> fault_text(const control::Fault& /*f*/,
+                                                const config::MachineProfile& /*profile*/,
+                                                const control::ServoConfig& /*servo*/) const {
     return std::nullopt;
   }
   /// What the run waits for ("the coupled axes to stand …"), when it is the feature's stage.
-  virtual std::optional<std::string> wait_text(const ServoStatus& /*s*/) const { return std::nullopt; }
+  virtual std::optional<std::string> wait_text(const control::ServoStatus& /*s*/) const {
+    return std::nullopt;
+  }
 };
 
 /// An observer's section of a run's report (the EDM's burn, a power failure's stop): what the
@@ -115,4 +118,4 @@ class FeatureState {
   virtual std::string state_json(const ControllerStatus& status) = 0;
 };
 
-}  // namespace opencnc::control
+}  // namespace opencnc::controller

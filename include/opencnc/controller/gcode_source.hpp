@@ -22,7 +22,7 @@ namespace opencnc::gcode {
 struct Extensions;
 }
 
-namespace opencnc::control {
+namespace opencnc::controller {
 
 /// How the G-code source is set up.
 struct GcodeSourceConfig {
@@ -60,7 +60,7 @@ class GcodeProgramSource final : public ProgramSource {
  public:
   /// The profile's dialect, machine kind, axes and axis map, subroutine path, default tolerance,
   /// and its tool table file as a tools::FileToolTable (G10 L1 writes it back), without any
-  /// feature's parts (control::MachineSetup adds them); problems with it land in `diags` (errors:
+  /// feature's parts (controller::MachineSetup adds them); problems with it land in `diags` (errors:
   /// nullptr).
   static std::shared_ptr<GcodeProgramSource> create(const config::MachineProfile& profile, Diagnostics& diags);
   /// create()'s configuration, for a set-up that adds to it before building the source; nothing
@@ -110,4 +110,4 @@ class GcodeProgramSource final : public ProgramSource {
   std::uint64_t mdi_parts_ = 0;      ///< parts_changed_ when mdi_ was made (its modules)
 };
 
-}  // namespace opencnc::control
+}  // namespace opencnc::controller

@@ -15,7 +15,7 @@
 #include "opencnc/control/channels.hpp"
 #include "opencnc/control/shared_memory.hpp"
 
-namespace opencnc::control {
+namespace opencnc::controller {
 
 class HalLink {
  public:
@@ -31,17 +31,17 @@ class HalLink {
   HalLink& operator=(const HalLink&) = delete;
 
   /// The channels to give the Controller. Controller thread.
-  ServoChannels& channels() noexcept { return memory_->segment().channels; }
+  control::ServoChannels& channels() noexcept { return memory_->segment().channels; }
   /// The tick's header (heartbeat, losses, ticks). Any thread.
-  const SharedHeader& header() const noexcept { return memory_->segment().header; }
+  const control::SharedHeader& header() const noexcept { return memory_->segment().header; }
 
  private:
-  explicit HalLink(std::unique_ptr<SegmentMapping> memory) noexcept : memory_(std::move(memory)) {}
+  explicit HalLink(std::unique_ptr<control::SegmentMapping> memory) noexcept : memory_(std::move(memory)) {}
   void beat_every(std::chrono::nanoseconds interval);
 
-  std::unique_ptr<SegmentMapping> memory_;
+  std::unique_ptr<control::SegmentMapping> memory_;
   std::atomic<bool> stop_{false};
   std::thread beat_;
 };
 
-}  // namespace opencnc::control
+}  // namespace opencnc::controller

@@ -21,7 +21,7 @@
 #include "opencnc/controller/observer.hpp"
 #include "opencnc/core/diagnostic.hpp"
 
-namespace opencnc::control {
+namespace opencnc::controller {
 
 /// The host a feature's setup adds its parts to, and what a front end takes from it. Built and set
 /// up on one thread before the controller runs; the sources it makes are the controller's and the
@@ -125,4 +125,4 @@ class MachineSetup {
   std::vector<std::shared_ptr<FeatureState>> states_;
 };
 
-}  // namespace opencnc::control
+}  // namespace opencnc::controller

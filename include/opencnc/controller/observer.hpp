@@ -17,12 +17,12 @@
 #include "opencnc/controller/events.hpp"
 #include "opencnc/controller/request.hpp"
 
-namespace opencnc::control {
+namespace opencnc::controller {
 
 /// The answer to a request.
 struct Outcome {
   bool accepted = false;
-  Refusal refusal = Refusal::None;
+  control::Refusal refusal = control::Refusal::None;
   std::string message;      ///< why it was refused, in words
   Diagnostics diagnostics;  ///< program problems (open, MDI, cycle start)
 };
@@ -49,7 +49,7 @@ class ControllerObserver {
   /// The status, at the rate asked for (ObserverOptions::status_period_s).
   virtual void on_status(const ControllerStatus& /*s*/) {}
   /// Every servo period of a program run while tracing (ObserverOptions::trace).
-  virtual void on_trace(const TraceSample& /*s*/, const TraceContext& /*c*/) {}
+  virtual void on_trace(const control::TraceSample& /*s*/, const TraceContext& /*c*/) {}
 };
 
 struct ObserverOptions {
@@ -124,4 +124,4 @@ class Feature : public ControllerObserver {
   virtual void poll(FeatureHost& /*host*/) {}
 };
 
-}  // namespace opencnc::control
+}  // namespace opencnc::controller

@@ -15,7 +15,7 @@
 #include "opencnc/core/diagnostic.hpp"
 #include "opencnc/plan/machine_limits.hpp"
 
-namespace opencnc::control {
+namespace opencnc::controller {
 
 /// Axis-aligned extent of a move, every axis, machine coordinates.
 struct Extent {
@@ -34,7 +34,7 @@ double move_length(const canon::Program& program, canon::SegmentId id);
 /// `config` (wrapped rotary joints have none). Adds one `control.soft-limit` error per move and
 /// axis that would cross a limit, with the move's file and line, and returns false if there was
 /// any. Non-real-time; O(moves).
-bool check_soft_limits(const canon::Program& program, const ServoConfig& config, Diagnostics& diags);
+bool check_soft_limits(const canon::Program& program, const control::ServoConfig& config, Diagnostics& diags);
 
 /// What a machine's process adds around a programmed move while it runs (an EDM's orbit and axis
 /// jump), for the soft-limit check of every move: an extension point of the check (a feature adds
@@ -53,7 +53,7 @@ class MoveReach {
 
 /// Makes a feature's MoveReach for the servo configuration in force (again after a profile edit;
 /// null: nothing on this machine).
-using MoveReachFactory = std::function<std::unique_ptr<MoveReach>(const ServoConfig&)>;
+using MoveReachFactory = std::function<std::unique_ptr<MoveReach>(const control::ServoConfig&)>;
 
 /// What every move passes before it may run: the planner's own checks (plan::check_move) and the
 /// soft limits of the joints (as check_soft_limits) by the move's extent widened by what the
@@ -62,7 +62,7 @@ using MoveReachFactory = std::function<std::unique_ptr<MoveReach>(const ServoCon
 /// input value may have changed it). Non-real-time; one thread.
 class MachineMoveCheck final : public MoveCheck {
  public:
-  MachineMoveCheck(const ServoConfig& config, const plan::MachineLimits& limits,
+  MachineMoveCheck(const control::ServoConfig& config, const plan::MachineLimits& limits,
                    std::vector<std::unique_ptr<MoveReach>> reaches = {});
   bool check(const canon::Program& program, canon::SegmentId move, Diagnostics& diags) override;
   /// Soft-limit crossings after the first few are counted, not listed: adds one line for them
@@ -70,10 +70,10 @@ class MachineMoveCheck final : public MoveCheck {
   void finish(Diagnostics& diags) override;
 
  private:
-  ServoConfig config_;
+  control::ServoConfig config_;
   plan::MachineLimits limits_;
   std::vector<std::unique_ptr<MoveReach>> reaches_;
   int soft_limit_errors_ = 0;
 };
 
-}  // namespace opencnc::control
+}  // namespace opencnc::controller

@@ -19,7 +19,7 @@ namespace opencnc::config {
 struct MachineProfile;
 }
 
-namespace opencnc::control {
+namespace opencnc::controller {
 
 /// Ends a long scan early: a halt (e-stop, machine off, abort) was sent after the request that
 /// started it. Plain data; reads one atomic.
@@ -192,4 +192,4 @@ std::string to_string(const SourceLocation& l);
 /// of the program from a move (program_tail). Controller thread.
 std::unique_ptr<ProgramStream> canon_stream(std::shared_ptr<const canon::Program> program, const Pose& start);
 
-}  // namespace opencnc::control
+}  // namespace opencnc::controller

@@ -16,7 +16,7 @@
 #include "opencnc/control/command.hpp"
 #include "opencnc/core/axes.hpp"
 
-namespace opencnc::control {
+namespace opencnc::controller {
 
 /// Which override a SetOverride request sets (ranges: feed and spindle 0–2, rapid 0–1).
 enum class OverrideKind : std::uint8_t { Feed, Rapid, Spindle };
@@ -33,10 +33,10 @@ namespace requests {
 /// A servo command without arguments: EStop, Reset, MachineOn, MachineOff, CycleStart, FeedHold,
 /// Resume, Abort, ToolChanged, SpindleOff.
 struct Servo {
-  CommandKind kind = CommandKind::Abort;
+  control::CommandKind kind = control::CommandKind::Abort;
 };
 struct SetMode {
-  Mode mode = Mode::Manual;
+  control::Mode mode = control::Mode::Manual;
 };
 /// Continuous jog at a signed speed (units/s); stops at the soft limit or on JogStop.
 struct Jog {
@@ -79,7 +79,7 @@ struct SpindleOn {
 };
 /// Manual coolant (Manual mode).
 struct SetCoolant {
-  Coolant which = Coolant::Flood;
+  control::Coolant which = control::Coolant::Flood;
   bool on = false;
 };
 /// Puts the handwheel on an axis (none: off every axis) with a step (units per count, one of the
@@ -154,8 +154,8 @@ struct Request {
   RequestBody body;
 
   /// A servo command without arguments (see requests::Servo).
-  static Request simple(CommandKind k) { return {requests::Servo{k}}; }
-  static Request set_mode(Mode m) { return {requests::SetMode{m}}; }
+  static Request simple(control::CommandKind k) { return {requests::Servo{k}}; }
+  static Request set_mode(control::Mode m) { return {requests::SetMode{m}}; }
   static Request jog(Axis a, double velocity) { return {requests::Jog{a, velocity}}; }
   static Request jog_by(Axis a, double distance, double speed) { return {requests::JogBy{a, distance, speed}}; }
   static Request jog_stop(std::optional<Axis> a = {}) { return {requests::JogStop{a}}; }
@@ -168,7 +168,7 @@ struct Request {
   static Request optional_stop(bool on) { return {requests::SetSwitch{SwitchKind::OptionalStop, on}}; }
   static Request block_delete(bool on) { return {requests::SetSwitch{SwitchKind::BlockDelete, on}}; }
   static Request spindle_on(double rpm, bool clockwise) { return {requests::SpindleOn{rpm, clockwise}}; }
-  static Request coolant(Coolant which, bool on) { return {requests::SetCoolant{which, on}}; }
+  static Request coolant(control::Coolant which, bool on) { return {requests::SetCoolant{which, on}}; }
   static Request handwheel(std::optional<Axis> a, double step) { return {requests::SetHandwheel{a, step}}; }
   static Request open(std::string path) { return {requests::OpenFile{std::move(path)}}; }
   static Request open(std::shared_ptr<const canon::Program> p, std::string name) {
@@ -199,7 +199,7 @@ struct Request {
 };
 
 /// The servo command a request stands for (nothing for the controller's own requests). Any thread.
-std::optional<Command> to_command(const Request& r);
+std::optional<control::Command> to_command(const Request& r);
 
 /// The urgent lane (docs/controller.md, "Stops never wait"): an e-stop, machine off, abort, feed
 /// hold, jog stop, spindle off, coolant off or an override goes from the thread that submits it
@@ -212,4 +212,4 @@ bool is_stop(const Request& r);
 /// a replay) for requests sent before it. Any thread.
 bool is_halt(const Request& r);
 
-}  // namespace opencnc::control
+}  // namespace opencnc::controller

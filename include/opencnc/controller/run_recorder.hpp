@@ -16,7 +16,7 @@
 #include "opencnc/core/output_file.hpp"
 #include "opencnc/plan/machine_limits.hpp"
 
-namespace opencnc::control {
+namespace opencnc::controller {
 
 /// What `opencnc run` reports (docs/controller.md lists the JSON keys).
 struct RunReport {
@@ -41,9 +41,9 @@ struct RunReport {
 /// the Program activity's samples), or feed it samples with add(). Non-real-time.
 class RunRecorder final : public ControllerObserver {
  public:
-  /// `limits`: what the commanded trajectory was planned within (control::machine_limits);
+  /// `limits`: what the commanded trajectory was planned within (controller::machine_limits);
   /// `output_limits`: what the drives' commands, with the compensation, must stay within
-  /// (control::axis_limits; by default `limits`). Axes outside `limits` (hand-fed ones) do not
+  /// (controller::axis_limits; by default `limits`). Axes outside `limits` (hand-fed ones) do not
   /// count: they are taken to stay where the run started.
   RunRecorder(const plan::MachineLimits& limits, double period_s,
               const plan::MachineLimits* output_limits = nullptr);
@@ -54,18 +54,18 @@ class RunRecorder final : public ControllerObserver {
 
   /// One period of a run, with the program window its segment ids refer to (null: none; the
   /// contour error is not measured then). In order.
-  void add(const TraceSample& s, const TraceContext& c);
+  void add(const control::TraceSample& s, const TraceContext& c);
   /// One period of the run of the program given at construction.
-  void add(const TraceSample& s);
+  void add(const control::TraceSample& s);
   RunReport report() const;
 
-  void on_trace(const TraceSample& s, const TraceContext& c) override {
-    if (s.activity == Activity::Program) add(s, c);
+  void on_trace(const control::TraceSample& s, const TraceContext& c) override {
+    if (s.activity == control::Activity::Program) add(s, c);
   }
 
  private:
   void begin(const Pose& start);
-  TraceSample planned_axes(const TraceSample& s) const;
+  control::TraceSample planned_axes(const control::TraceSample& s) const;
   const canon::Program* fixed_ = nullptr;
   bool started_ = false;
   std::uint32_t run_id_ = 0;  ///< the servo run of the last sample (a new one starts at rest)
@@ -89,7 +89,7 @@ class TraceCsvWriter {
   /// Writes the header for the axes in `axes`; `out` must outlive the writer.
   TraceCsvWriter(OutputFile& out, AxisMask axes, double period_s);
   /// One row; false once the output has failed (OutputFile::commit says why).
-  bool add(const TraceSample& s);
+  bool add(const control::TraceSample& s);
 
  private:
   OutputFile& out_;
@@ -98,4 +98,4 @@ class TraceCsvWriter {
   std::string row_;
 };
 
-}  // namespace opencnc::control
+}  // namespace opencnc::controller

@@ -10,7 +10,7 @@
 #include "opencnc/plan/machine_limits.hpp"
 #include "opencnc/plan/planner.hpp"
 
-namespace opencnc::control {
+namespace opencnc::controller {
 
 /// Limits the planner plans with: of every driven axis, its velocity and acceleration less what
 /// its compensation may use (config::compensation_reserve), and its jerk. Manual (hand-fed) axes
@@ -26,10 +26,10 @@ plan::PlannerConfig planner_config(const config::MachineProfile& profile);
 
 /// The servo's view of the machine. The interpolator settings are those of a planner made with
 /// machine_limits() and planner_config(), so blocks and tick agree. Non-real-time.
-ServoConfig servo_config(const config::MachineProfile& profile);
+control::ServoConfig servo_config(const config::MachineProfile& profile);
 
 /// What a tick in another process (the HAL component) is handed for `profile`: its servo_config()
 /// and the capabilities it declares wired. Non-real-time.
-SharedSetup shared_setup(const config::MachineProfile& profile);
+control::SharedSetup shared_setup(const config::MachineProfile& profile);
 
-}  // namespace opencnc::control
+}  // namespace opencnc::controller

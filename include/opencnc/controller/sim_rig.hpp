@@ -15,7 +15,7 @@
 #include "opencnc/controller/machine_setup.hpp"
 #include "opencnc/machine/sim_machine.hpp"
 
-namespace opencnc::control {
+namespace opencnc::controller {
 
 /// Owns the simulated machine, the channels, the servo and the controller. One thread.
 class SimRig {
@@ -42,19 +42,19 @@ class SimRig {
 
   Controller& controller() noexcept { return *controller_; }
   machine::SimMachine& machine() noexcept { return *machine_; }
-  Servo& servo() noexcept { return *servo_; }
-  ServoChannels& channels() noexcept { return *channels_; }
+  control::Servo& servo() noexcept { return *servo_; }
+  control::ServoChannels& channels() noexcept { return *channels_; }
   /// The controller's status (as of its last service).
   ControllerStatus status() const { return controller_->status(); }
   std::uint64_t ticks() const noexcept { return ticks_; }
 
  private:
-  std::unique_ptr<ServoChannels> channels_;
+  std::unique_ptr<control::ServoChannels> channels_;
   std::unique_ptr<machine::SimMachine> machine_;
-  std::unique_ptr<Servo> servo_;
+  std::unique_ptr<control::Servo> servo_;
   std::unique_ptr<Controller> controller_;
   int service_every_;
   std::uint64_t ticks_ = 0;
 };
 
-}  // namespace opencnc::control
+}  // namespace opencnc::controller

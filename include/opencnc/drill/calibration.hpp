@@ -13,7 +13,7 @@
 #include "opencnc/control/status.hpp"
 #include "opencnc/core/axes.hpp"
 
-namespace opencnc::control {
+namespace opencnc::drill {
 
 /// What `homing_spread` does.
 struct HomingSpreadOptions {
@@ -22,7 +22,7 @@ struct HomingSpreadOptions {
   /// Each run's temperature is drawn uniformly in the profile's ± half this (°C): the shop over a day.
   double temperature_swing_c = 10;
   /// Called with every servo period of the first run (for a trace), if set.
-  std::function<void(const TraceSample&)> trace;
+  std::function<void(const control::TraceSample&)> trace;
 };
 
 /// Of every axis that homes on a decel_midpoint sensor: the origin each run found (the middle of
@@ -87,4 +87,4 @@ config::MachineProfile without_compensation(const config::MachineProfile& profil
 config::CompensationProfile compensation_from(const AxisPositioning& measured,
                                               const config::AxisProfile& axis);
 
-}  // namespace opencnc::control
+}  // namespace opencnc::drill

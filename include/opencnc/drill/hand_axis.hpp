@@ -11,7 +11,7 @@
 #include "opencnc/core/axes.hpp"
 #include "opencnc/core/diagnostic.hpp"
 
-namespace opencnc::control {
+namespace opencnc::drill {
 
 /// The hand-fed axes of a machine and what the pass checks against.
 struct HandAxes {
@@ -33,7 +33,7 @@ HandAxes hand_axes(const config::MachineProfile& profile);
 /// hand axis, helices, probes and spindle-synchronised moves cannot move one, and a target beyond
 /// the axis' soft limits is refused: errors at the move's line (code control.hand-axis) in
 /// failures(). Non-real-time; one thread (the program's builder's).
-class HandAxisFilter final : public MovePass {
+class HandAxisFilter final : public controller::MovePass {
  public:
   explicit HandAxisFilter(const HandAxes& hand) : hand_(hand) {}
 
@@ -58,4 +58,4 @@ class HandAxisFilter final : public MovePass {
   Diagnostics failures_;
 };
 
-}  // namespace opencnc::control
+}  // namespace opencnc::drill

@@ -11,6 +11,6 @@ namespace opencnc::drill {
 /// programmed moves into waits for the operator (hand_axis.hpp), their wait and their event (an
 /// axis that left where the program needs it) in words. Nothing on another machine. True (it
 /// cannot fail). Before the controller runs, on the thread that sets it up.
-bool setup(const config::MachineProfile& profile, control::MachineSetup& host);
+bool setup(const config::MachineProfile& profile, controller::MachineSetup& host);
 
 }  // namespace opencnc::drill

@@ -12,7 +12,7 @@
 #include "opencnc/config/machine_profile.hpp"
 #include "opencnc/core/vec3.hpp"
 
-namespace opencnc::control {
+namespace opencnc::edm {
 
 /// A rotary axis as a line: where it crosses the plane Y = the sphere's centre (X, Z) and its
 /// unit direction (+B right-handed about it).
@@ -46,4 +46,4 @@ std::optional<BAxisFit> fit_b_axis(std::span<const double> angles_deg, std::span
 /// b_deg − b. Without a b_axis, `position` (only right at b). Any thread.
 Vec3 sphere_centre_at(const config::ReferenceSphereProfile& sphere, double b_deg);
 
-}  // namespace opencnc::control
+}  // namespace opencnc::edm

@@ -9,7 +9,7 @@
 #include "opencnc/controller/observer.hpp"
 #include "opencnc/machine/edm.hpp"
 
-namespace opencnc::control {
+namespace opencnc::edm {
 
 /// What `opencnc run --report` writes under `edm`.
 struct EdmReport {
@@ -29,10 +29,10 @@ struct EdmReport {
 };
 
 /// Controller thread (an observer with trace on); its report section (`edm`) after the run.
-class EdmRecorder final : public ControllerObserver, public ReportSection {
+class EdmRecorder final : public controller::ControllerObserver, public controller::ReportSection {
  public:
   EdmRecorder(const machine::EdmConfig& edm, double period_s);
-  void on_trace(const TraceSample& s, const TraceContext& c) override;
+  void on_trace(const control::TraceSample& s, const controller::TraceContext& c) override;
   EdmReport report() const;
 
   std::string report_key() const override { return "edm"; }
@@ -59,4 +59,4 @@ class EdmRecorder final : public ControllerObserver, public ReportSection {
   std::uint32_t jumps_at_start_ = 0, jumps_now_ = 0;
 };
 
-}  // namespace opencnc::control
+}  // namespace opencnc::edm

@@ -18,7 +18,7 @@
 #include "opencnc/edm/b_axis_fit.hpp"
 #include "opencnc/tools/tool_table_service.hpp"
 
-namespace opencnc::control {
+namespace opencnc::edm {
 
 /// One touch of the sphere: the controlled point's machine position where it starts and where
 /// its probe move ends if it touches nothing (each `clearance` off the surface, outside and
@@ -134,20 +134,21 @@ const char* to_string(ElectrodePhase p) noexcept;
 /// safe height, over, down), then requests::ResumeProgram at its segment. Attach it with
 /// `trace = true` (it follows the main program's segment) and a status period. Controller thread;
 /// last() and stop() from any thread.
-class ElectrodeSetting final : public Feature, public FeatureState {
+class ElectrodeSetting final : public controller::Feature, public controller::FeatureState {
  public:
   ElectrodeSetting(std::shared_ptr<tools::ToolTableService> tools, const config::MachineProfile& profile);
   /// The state a front end shows (docs/api.md, "features"): `phase`, the last measurement
   /// (`last`), the last B-axis calibration (`b_axis`), `stopped_program`.
   std::string state_key() const override { return "electrode"; }
-  std::string state_json(const ControllerStatus& status) override;
+  std::string state_json(const controller::ControllerStatus& status) override;
 
   std::string_view name() const override { return "electrode"; }
-  void attached(FeatureHost& host) override { host_ = &host; }
-  Outcome handle(const requests::Feature& request, FeatureHost& host) override;
-  void on_event(const ControllerEvent& e) override;
-  void on_status(const ControllerStatus& s) override;
-  void on_trace(const TraceSample& s, const TraceContext& c) override;
+  void attached(controller::FeatureHost& host) override { host_ = &host; }
+  controller::Outcome handle(const controller::requests::Feature& request,
+                             controller::FeatureHost& host) override;
+  void on_event(const controller::ControllerEvent& e) override;
+  void on_status(const controller::ControllerStatus& s) override;
+  void on_trace(const control::TraceSample& s, const controller::TraceContext& c) override;
 
   ElectrodePhase phase() const;
   std::optional<ElectrodeResult> last() const;
@@ -160,15 +161,16 @@ class ElectrodeSetting final : public Feature, public FeatureState {
   std::optional<ProgramStop> stop() const;
 
  private:
-  Outcome measure(const ElectrodeMeasure& args, FeatureHost& host);
-  Outcome calibrate_b(const BAxisCalibrate& args, FeatureHost& host);
-  std::optional<Outcome> start_measurement(int tool, std::optional<double> b_deg, FeatureHost& host);
+  controller::Outcome measure(const ElectrodeMeasure& args, controller::FeatureHost& host);
+  controller::Outcome calibrate_b(const BAxisCalibrate& args, controller::FeatureHost& host);
+  std::optional<controller::Outcome> start_measurement(int tool, std::optional<double> b_deg,
+                                                       controller::FeatureHost& host);
   void next_calibration_angle(const ElectrodeResult& r);
   void finish_calibration();
-  Outcome resume(FeatureHost& host);
-  Outcome write();
+  controller::Outcome resume(controller::FeatureHost& host);
+  controller::Outcome write();
   bool store(ElectrodeResult& r);
-  void when_aux_ended(const ControllerEvent& e);
+  void when_aux_ended(const controller::ControllerEvent& e);
   void next_touch();
   void touched(const Vec3& at);
   void finish_measurement();
@@ -180,7 +182,7 @@ class ElectrodeSetting final : public Feature, public FeatureState {
   config::ReferenceSphereProfile sphere_;  ///< with the calibrated B axis (guarded by mutex_)
   config::ReferenceSphereProfile at_;      ///< the sphere where the measurement under way finds it
   AxisMask axes_;
-  FeatureHost* host_ = nullptr;
+  controller::FeatureHost* host_ = nullptr;
 
   // The measurement under way.
   int tool_ = 0;
@@ -212,4 +214,4 @@ class ElectrodeSetting final : public Feature, public FeatureState {
   std::optional<ProgramStop> stop_;
 };
 
-}  // namespace opencnc::control
+}  // namespace opencnc::edm

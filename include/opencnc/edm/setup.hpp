@@ -15,6 +15,6 @@ namespace opencnc::edm {
 /// electrode setting ("electrode", following the status and the trace; its state `electrode`).
 /// Nothing on another machine. False with the reasons in host.diagnostics(). Before the
 /// controller runs, on the thread that sets it up.
-bool setup(const config::MachineProfile& profile, control::MachineSetup& host);
+bool setup(const config::MachineProfile& profile, controller::MachineSetup& host);
 
 }  // namespace opencnc::edm

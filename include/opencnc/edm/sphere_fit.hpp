@@ -9,7 +9,7 @@
 
 #include "opencnc/core/vec3.hpp"
 
-namespace opencnc::control {
+namespace opencnc::edm {
 
 /// The centre that best fits the points, with the residuals |p − centre| − radius, mm.
 struct SphereFit {
@@ -27,4 +27,4 @@ struct SphereFit {
 /// 50 steps. Any thread; not real-time.
 std::optional<SphereFit> fit_sphere(std::span<const Vec3> points, double radius, const Vec3& guess);
 
-}  // namespace opencnc::control
+}  // namespace opencnc::edm

@@ -18,13 +18,13 @@ namespace opencnc::features {
 /// from line — those that add passes and modules before those that make program sources of their
 /// own. Each adds what the profile calls for. False at the first that fails (its reasons in
 /// host.diagnostics()). Before the controller runs, on the thread that sets it up.
-bool set_up(control::MachineSetup& host);
+bool set_up(controller::MachineSetup& host);
 
-/// A machine with every feature `profile` calls for (control::MachineSetup::create, then set_up),
+/// A machine with every feature `profile` calls for (controller::MachineSetup::create, then set_up),
 /// for the tools and tests that take the whole set; null with the reasons in `diags`.
-std::unique_ptr<control::MachineSetup> machine_setup(const config::MachineProfile& profile,
-                                                     Diagnostics& diags,
-                                                     control::MachineSetup::Options options = {});
+std::unique_ptr<controller::MachineSetup> machine_setup(const config::MachineProfile& profile,
+                                                        Diagnostics& diags,
+                                                        controller::MachineSetup::Options options = {});
 
 /// A feature's code modules a program may be checked with without a machine (`opencnc check
 /// --codes NAME`).

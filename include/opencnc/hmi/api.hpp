@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The HMI's JSON API as plain functions: a command body to a typed control::Request (with the
+// The HMI's JSON API as plain functions: a command body to a typed controller::Request (with the
 // checks that make a bad one a 4xx and change nothing), and status, events and outcomes to JSON.
 #pragma once
 
@@ -40,7 +40,7 @@ struct ToolChange {
   std::optional<double> diameter_mm, z_offset_mm;
   std::string comment;
 };
-using Command = std::variant<control::Request, ToolChange, SimulationEvent>;
+using Command = std::variant<controller::Request, ToolChange, SimulationEvent>;
 
 /// The role a command kind needs (admin for tool data and the simulation, else operator); nothing for an
 /// unknown kind.
@@ -57,19 +57,19 @@ std::variant<Command, ApiError> parse_command(const nlohmann::json& body,
 /// the journal, retrace, electrode and tool-guard actions with their fields checked, the ones
 /// that move the machine or change kept data only with `"confirmed": true` (docs/api.md,
 /// "Features"). Any thread.
-std::variant<control::Request, ApiError> parse_feature_command(const nlohmann::json& body,
-                                                               const config::MachineProfile& profile);
+std::variant<controller::Request, ApiError> parse_feature_command(const nlohmann::json& body,
+                                                                  const config::MachineProfile& profile);
 
 /// The process side of the status: `power`, `load` (a load guard), `alarms` (the profile's
 /// process alarms with their state), `edm` (a machine with [edm]). Any thread.
 nlohmann::json process_json(const control::ServoStatus& s, const config::MachineProfile& profile);
 
 /// The status as the API sends it (docs/api.md, "Status"). Any thread.
-nlohmann::json status_json(const control::ControllerStatus& s, const config::MachineProfile& profile);
+nlohmann::json status_json(const controller::ControllerStatus& s, const config::MachineProfile& profile);
 /// One event of the log. Any thread.
-nlohmann::json event_json(const control::ControllerEvent& e);
+nlohmann::json event_json(const controller::ControllerEvent& e);
 /// A request's answer. Any thread.
-nlohmann::json outcome_json(std::uint64_t id, const control::Outcome& o);
+nlohmann::json outcome_json(std::uint64_t id, const controller::Outcome& o);
 /// The machine: axes with their limits, period, handwheel steps, override ranges. Any thread.
 nlohmann::json machine_json(const config::MachineProfile& profile);
 

@@ -18,7 +18,7 @@ namespace opencnc::hmi {
 /// EditProfile request, or the HTTP status and message of why not (400 malformed, 422 a key
 /// that is not editable or a value that is not a finite number). Any thread.
 struct ParametersRequest {
-  std::optional<control::Request> request;
+  std::optional<controller::Request> request;
   int status = 400;
   std::string message;
 };

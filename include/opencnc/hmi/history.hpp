@@ -89,10 +89,10 @@ std::string utc_now();
 
 /// Turns the event log into job records: a ControllerObserver (controller thread) that hands
 /// each finished program or auxiliary job to the History (which writes on its own thread).
-class HistoryRecorder final : public control::ControllerObserver {
+class HistoryRecorder final : public controller::ControllerObserver {
  public:
   HistoryRecorder(History& history, double servo_period_s) : history_(&history), period_s_(servo_period_s) {}
-  void on_event(const control::ControllerEvent& e) override;
+  void on_event(const controller::ControllerEvent& e) override;
 
  private:
   History* history_;

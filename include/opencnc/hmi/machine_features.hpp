@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // MachineFeatures — the controller features a profile calls for, set up as every front end sets
-// them up (features::set_up on a control::MachineSetup), and a board that snapshots their state on
+// them up (features::set_up on a controller::MachineSetup), and a board that snapshots their state on
 // the controller's thread for the HMI's status (docs/hmi.md, "Features").
 #pragma once
 
@@ -40,9 +40,9 @@ class MachineFeatures {
   MachineFeatures& operator=(const MachineFeatures&) = delete;
 
   /// The program source the controller and the server use. Any thread.
-  const std::shared_ptr<control::GcodeProgramSource>& source() const noexcept { return source_; }
+  const std::shared_ptr<controller::GcodeProgramSource>& source() const noexcept { return source_; }
   /// Adds the features and the board that follows them to `controller` (before it runs).
-  void install(control::Controller& controller);
+  void install(controller::Controller& controller);
   /// The names of the installed features, in installation order. Any thread.
   const std::vector<std::string>& names() const noexcept { return names_; }
   /// Whether feature `name` is installed. Any thread.
@@ -55,10 +55,10 @@ class MachineFeatures {
  private:
   class Board;
   MachineFeatures() = default;
-  nlohmann::json snapshot(const control::ControllerStatus& s);  // controller thread
+  nlohmann::json snapshot(const controller::ControllerStatus& s);  // controller thread
 
-  std::unique_ptr<control::MachineSetup> setup_;
-  std::shared_ptr<control::GcodeProgramSource> source_;
+  std::unique_ptr<controller::MachineSetup> setup_;
+  std::shared_ptr<controller::GcodeProgramSource> source_;
   std::vector<std::string> names_;
 
   mutable std::mutex mutex_;

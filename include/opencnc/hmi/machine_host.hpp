@@ -20,9 +20,12 @@
 #include "opencnc/hmi/simulation.hpp"
 
 namespace opencnc::control {
-class SimRig;
 class Servo;
 }  // namespace opencnc::control
+
+namespace opencnc::controller {
+class SimRig;
+}  // namespace opencnc::controller
 
 namespace opencnc::machine {
 class SimMachine;
@@ -44,7 +47,7 @@ struct HostOptions {
 /// from any (its API is thread-safe).
 class MachineHost {
  public:
-  MachineHost(const config::MachineProfile& profile, std::shared_ptr<control::ProgramSource> source,
+  MachineHost(const config::MachineProfile& profile, std::shared_ptr<controller::ProgramSource> source,
               HostOptions options);
   ~MachineHost();
   MachineHost(const MachineHost&) = delete;
@@ -57,7 +60,7 @@ class MachineHost {
   /// Stops and joins the threads. Idempotent.
   void stop();
 
-  control::Controller& controller() noexcept;
+  controller::Controller& controller() noexcept;
   /// Servo periods run so far; periods whose tick finished after the next deadline (real time
   /// only); the servo thread's wake-up latency (real time only, else null). Any thread.
   std::uint64_t ticks() const noexcept;
@@ -83,10 +86,10 @@ class MachineHost {
   std::unique_ptr<control::ServoChannels> channels_;
   std::unique_ptr<machine::SimMachine> sim_;
   std::unique_ptr<control::Servo> servo_;
-  std::unique_ptr<control::Controller> controller_;
+  std::unique_ptr<controller::Controller> controller_;
   std::unique_ptr<control::RealtimeClock> clock_;
   // Paced virtual time.
-  std::unique_ptr<control::SimRig> rig_;
+  std::unique_ptr<controller::SimRig> rig_;
   std::atomic<std::uint64_t> paced_ticks_{0};
   std::mutex simulate_mutex_;
   std::condition_variable simulate_applied_cv_;

@@ -19,7 +19,7 @@ namespace opencnc::hmi {
 /// `{"polylines": [{"rapid": bool, "points": [x, y, z, …]}], "moves": n, "truncated": bool,
 ///   "diagnostics": [...], "tools": [the tools its M6/M61 put in the spindle]}`. Non-real-time;
 /// any thread but the controller's (it may take a while).
-nlohmann::json program_preview(const control::GcodeProgramSource& source, const std::string& path,
+nlohmann::json program_preview(const controller::GcodeProgramSource& source, const std::string& path,
                                const Pose& start, std::size_t max_moves = 200000);
 
 }  // namespace opencnc::hmi

@@ -17,7 +17,7 @@
 #include "opencnc/hmi/simulation.hpp"
 #include "opencnc/hmi/tokens.hpp"
 
-namespace opencnc::control {
+namespace opencnc::controller {
 class GcodeProgramSource;
 }
 
@@ -65,8 +65,8 @@ class Server {
  public:
   /// `controller`, `history` (may be null) and `source` (may be null: no preview, no tool data)
   /// must outlive the server.
-  Server(control::Controller& controller, const config::MachineProfile& profile, Tokens tokens,
-         History* history, const control::GcodeProgramSource* source, ServerConfig config);
+  Server(controller::Controller& controller, const config::MachineProfile& profile, Tokens tokens,
+         History* history, const controller::GcodeProgramSource* source, ServerConfig config);
   ~Server();
   Server(const Server&) = delete;
   Server& operator=(const Server&) = delete;

@@ -48,7 +48,7 @@ struct ProcessLogSetup {
 /// or into a SQLite database in a temporary folder whose bytes become the OutputFile at finish()
 /// — so neither the tick nor the controller's thread waits for the disk. The OutputFile is
 /// committed by the caller after finish(), as for any output.
-class ProcessLog final : public control::ControllerObserver {
+class ProcessLog final : public controller::ControllerObserver {
  public:
   /// `out` must outlive the log. Controller's thread (setup).
   ProcessLog(ProcessLogSetup setup, LogFormat format, OutputFile& out);
@@ -57,7 +57,7 @@ class ProcessLog final : public control::ControllerObserver {
   ProcessLog& operator=(const ProcessLog&) = delete;
 
   /// Controller's thread (the hub calls it).
-  void on_trace(const control::TraceSample& s, const control::TraceContext& c) override;
+  void on_trace(const control::TraceSample& s, const controller::TraceContext& c) override;
   /// Writes what is queued, ends the writer and (SQLite) hands the database to the OutputFile.
   /// False with `*error` set if anything failed. Any thread but the hub's callbacks; once.
   bool finish(std::string* error);

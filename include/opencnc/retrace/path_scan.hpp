@@ -14,7 +14,7 @@ namespace opencnc::recovery {
 /// The index of `path` run from `start` (machine coordinates), with the problems the scan met
 /// in `diags` (an index of a program with errors holds the moves before the first one).
 /// Non-real-time; call on a thread of its own for a large program (`source` is used only by it).
-PathIndex scan_path(control::ProgramSource& source, const std::string& path, const Pose& start,
-                    const control::LoadOptions& options, Diagnostics& diags);
+PathIndex scan_path(controller::ProgramSource& source, const std::string& path, const Pose& start,
+                    const controller::LoadOptions& options, Diagnostics& diags);
 
 }  // namespace opencnc::recovery

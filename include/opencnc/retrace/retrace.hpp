@@ -65,22 +65,23 @@ const char* to_string(RetracePhase p) noexcept;
 /// The feature. Its path index is built on a thread of its own when a program is opened, with
 /// a program source of its own (the same profile: dialect, modules, tool table), from where
 /// the machine stands. Controller thread for everything but records(), phase() (any thread).
-class RetraceFeature final : public control::Feature {
+class RetraceFeature final : public controller::Feature {
  public:
   /// `source` is the feature's own (its index is scanned on a thread of its own); the profile
   /// gives the torch sequences ([process.cutting]) and the accelerations to stop at A in. Add it
   /// with Controller::add_feature(feature, {servo period, false}): it follows the status every
   /// period.
-  RetraceFeature(std::shared_ptr<control::ProgramSource> source, const config::MachineProfile& profile);
+  RetraceFeature(std::shared_ptr<controller::ProgramSource> source, const config::MachineProfile& profile);
   ~RetraceFeature() override;
 
   std::string_view name() const override { return "retrace"; }
-  void attached(control::FeatureHost& host) override { host_ = &host; }
+  void attached(controller::FeatureHost& host) override { host_ = &host; }
   /// "pause", "start" (RetraceStart), "step" (RetraceStep), "nearest" (Vec3: the answer's message
   /// names C), "index" (waits for the index; the message gives its size).
-  control::Outcome handle(const control::requests::Feature& request, control::FeatureHost& host) override;
-  void on_event(const control::ControllerEvent& e) override;
-  void on_status(const control::ControllerStatus& s) override;
+  controller::Outcome handle(const controller::requests::Feature& request,
+                             controller::FeatureHost& host) override;
+  void on_event(const controller::ControllerEvent& e) override;
+  void on_status(const controller::ControllerStatus& s) override;
 
   /// Every retrace so far. Any thread.
   std::vector<RetraceRecord> records() const;
@@ -89,14 +90,14 @@ class RetraceFeature final : public control::Feature {
   const PathIndex* index();
 
  private:
-  control::Outcome pause(control::FeatureHost& host);
-  control::Outcome start(const RetraceStart& args, control::FeatureHost& host);
-  control::Outcome step(const RetraceStep& args, control::FeatureHost& host);
+  controller::Outcome pause(controller::FeatureHost& host);
+  controller::Outcome start(const RetraceStart& args, controller::FeatureHost& host);
+  controller::Outcome step(const RetraceStep& args, controller::FeatureHost& host);
   void build_index(const std::string& path, const Pose& start);
   void join();
-  void when_held(const control::ControllerStatus& s);
-  void when_job_ended(const control::ControllerEvent& e);
-  void check_stop_at_a(const control::ControllerStatus& s);
+  void when_held(const controller::ControllerStatus& s);
+  void when_job_ended(const controller::ControllerEvent& e);
+  void check_stop_at_a(const controller::ControllerStatus& s);
   void run_auxiliary(const char* name, std::shared_ptr<const canon::Program> program);
   std::shared_ptr<const canon::Program> torch_off_program(const Pose& at) const;
   std::shared_ptr<const canon::Program> approach_program(const Pose& b, const Vec3& c) const;
@@ -105,12 +106,12 @@ class RetraceFeature final : public control::Feature {
   std::string describe(const PathPoint& p) const;
   void set_phase(RetracePhase p) noexcept { phase_.store(p); }
 
-  std::shared_ptr<control::ProgramSource> source_;
+  std::shared_ptr<controller::ProgramSource> source_;
   config::CuttingProfile cutting_;
   double status_period_s_ = 0.001;
   double min_accel_ = 1e300;  ///< the smaller of X's and Y's acceleration limits, mm/s²
   double jerk_filter_s_ = 0;  ///< the planner's moving average for the jerk limits (0: none), s
-  control::FeatureHost* host_ = nullptr;
+  controller::FeatureHost* host_ = nullptr;
 
   std::thread builder_;
   std::unique_ptr<PathIndex> index_, building_;

@@ -10,6 +10,6 @@ namespace opencnc::retrace {
 /// With [process.cutting]: the retrace feature ("retrace", following the status; its state
 /// `retrace`), scanning with a source of its own made by `host`. Nothing on another machine. True
 /// (it cannot fail). Before the controller runs, on the thread that sets it up.
-bool setup(const config::MachineProfile& profile, control::MachineSetup& host);
+bool setup(const config::MachineProfile& profile, controller::MachineSetup& host);
 
 }  // namespace opencnc::retrace

@@ -19,7 +19,7 @@
 #include "opencnc/controller/program_source.hpp"
 #include "opencnc/tools/tool_table_service.hpp"
 
-namespace opencnc::control {
+namespace opencnc::run_from_line {
 
 /// Arguments of "start".
 struct RunFromLineArgs {
@@ -55,7 +55,7 @@ struct LineStart {
   /// Its feed in mm/min (0 for a G0): under G93 the move's own (the interpreter's length × F),
   /// under G95 F × the spindle speed set before it.
   double feed_mm_per_min = 0;
-  SourceLocation where;  ///< its block, with the calls that led there
+  controller::SourceLocation where;  ///< its block, with the calls that led there
   /// The tool the program has in the spindle there: the T of the last M6 (or M61) before the
   /// line; −1 when none comes before it (the program runs with the machine's tool).
   int tool = -1;
@@ -76,9 +76,9 @@ struct LineStart {
 /// or the program reads a probe or an input before it (the replay cannot know its answer), or
 /// `cancel` was set. Any one thread at a time per `source`; bounded memory (what it has passed
 /// is released).
-std::optional<LineStart> find_line_start(ProgramSource& source, const std::string& path,
+std::optional<LineStart> find_line_start(controller::ProgramSource& source, const std::string& path,
                                          const Pose& program_start, std::uint32_t line,
-                                         const LoadOptions& options, std::string* why,
+                                         const controller::LoadOptions& options, std::string* why,
                                          const std::atomic<bool>* cancel = nullptr);
 
 /// The feature. "start" needs the open program (a file), Auto mode and an idle machine; it
@@ -89,22 +89,24 @@ std::optional<LineStart> find_line_start(ProgramSource& source, const std::strin
 /// one, docs/tool-change.md; the spindle and coolant as the program has them
 /// there, rapid up to the higher of the two Z, across, down at the move's own feed) and, once that
 /// has finished, resumes the program there. Controller thread.
-class RunFromLineFeature final : public Feature {
+class RunFromLineFeature final : public controller::Feature {
  public:
   /// `source`: a program source of the feature's own for its scans (same profile and tool table
   /// as the controller's, so the segments and offsets are the same); used by the scan's thread.
   /// `tools`: the scan table behind `source` (reset before each scan), if it has one.
-  explicit RunFromLineFeature(std::shared_ptr<ProgramSource> source,
+  explicit RunFromLineFeature(std::shared_ptr<controller::ProgramSource> source,
                               std::shared_ptr<ScanToolTable> tools = nullptr)
       : source_(std::move(source)), tools_(std::move(tools)) {}
   ~RunFromLineFeature() override;  ///< stops a scan under way and waits for its thread
 
   std::string_view name() const override { return "run-from-line"; }
-  Outcome handle(const requests::Feature& request, FeatureHost& host) override;
-  void poll(FeatureHost& host) override;
-  bool allow_start(const StartCheck& start, FeatureHost& host, std::string* why) override;
-  void on_event(const ControllerEvent& e) override;
-  void attached(FeatureHost& host) override { host_ = &host; }
+  controller::Outcome handle(const controller::requests::Feature& request,
+                             controller::FeatureHost& host) override;
+  void poll(controller::FeatureHost& host) override;
+  bool allow_start(const controller::StartCheck& start, controller::FeatureHost& host,
+                   std::string* why) override;
+  void on_event(const controller::ControllerEvent& e) override;
+  void attached(controller::FeatureHost& host) override { host_ = &host; }
 
   /// Whether a scan is under way. Controller thread.
   bool scanning() const noexcept { return scan_ != nullptr; }
@@ -122,13 +124,13 @@ class RunFromLineFeature final : public Feature {
   };
   std::shared_ptr<const canon::Program> approach(const Pose& machine, int spindle_tool,
                                                  const LineStart& to) const;
-  void start_approach(Scan& scan, FeatureHost& host);
+  void start_approach(Scan& scan, controller::FeatureHost& host);
 
-  std::shared_ptr<ProgramSource> source_;
+  std::shared_ptr<controller::ProgramSource> source_;
   std::shared_ptr<ScanToolTable> tools_;
   std::unique_ptr<Scan> scan_;
   std::uint64_t opened_ = 0;  ///< counts ProgramOpened events
-  FeatureHost* host_ = nullptr;
+  controller::FeatureHost* host_ = nullptr;
   Pose program_start_{};  ///< where the machine stood when the open program was opened
   /// The resume that follows the approach, while it runs.
   std::optional<LineStart> pending_;
@@ -137,4 +139,4 @@ class RunFromLineFeature final : public Feature {
   bool resuming_ = false;  ///< the resume was asked: its JobStarted is not the operator's start
 };
 
-}  // namespace opencnc::control
+}  // namespace opencnc::run_from_line

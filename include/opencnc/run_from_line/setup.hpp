@@ -11,6 +11,6 @@ namespace opencnc::run_from_line {
 /// with a source of its own made by `host` whose tool table is the controller's with the scan's
 /// G10 writes kept apart. True (it cannot fail). Before the controller runs, on the thread that
 /// sets it up.
-bool setup(const config::MachineProfile& profile, control::MachineSetup& host);
+bool setup(const config::MachineProfile& profile, controller::MachineSetup& host);
 
 }  // namespace opencnc::run_from_line

@@ -47,7 +47,7 @@ CheckResult check(store::ToolStore& store, const tools::CheckTolerances& toleran
 /// current one). Every result is a note with the difference lines. Accept and restore write the
 /// store, which may wait for another writer's lock: they are the controller's long work
 /// (FeatureHost::answer_after), so its loop never waits for the database. Controller thread.
-class ToolGuard final : public control::Feature {
+class ToolGuard final : public controller::Feature {
  public:
   /// `pockets`: the magazine's pockets (0: not checked); a tool in a pocket beyond it refuses
   /// the start like a difference.
@@ -55,9 +55,11 @@ class ToolGuard final : public control::Feature {
             int pockets = 0);
 
   std::string_view name() const override { return "tool-guard"; }
-  bool allow_start(const control::StartCheck& start, control::FeatureHost& host, std::string* why) override;
-  bool allow_continue(const control::SyncCheck& sync, control::FeatureHost& host) override;
-  control::Outcome handle(const control::requests::Feature& request, control::FeatureHost& host) override;
+  bool allow_start(const controller::StartCheck& start, controller::FeatureHost& host,
+                   std::string* why) override;
+  bool allow_continue(const controller::SyncCheck& sync, controller::FeatureHost& host) override;
+  controller::Outcome handle(const controller::requests::Feature& request,
+                             controller::FeatureHost& host) override;
 
  private:
   std::shared_ptr<store::ToolStore> store_;
@@ -78,6 +80,6 @@ class ToolGuard final : public control::Feature {
 /// Nothing on another machine. False with the reasons in host.diagnostics() (a store that cannot
 /// be opened). Set up before the features that take the source's tool table. Non-real-time; one
 /// thread, before the controller runs.
-bool setup(const config::MachineProfile& profile, control::MachineSetup& host);
+bool setup(const config::MachineProfile& profile, controller::MachineSetup& host);
 
 }  // namespace opencnc::toolguard
