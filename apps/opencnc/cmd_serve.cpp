@@ -173,7 +173,8 @@ int serve(const ServeOptions& o) {
   connect::AgentOptions ao;
   ao.sender = [] {
     char name[256] = {};
-    return ::gethostname(name, sizeof name - 1) == 0 && name[0] != 0 ? std::string(name) : std::string("opencnc");
+    return ::gethostname(name, sizeof name - 1) == 0 && name[0] != 0 ? std::string(name)
+                                                                     : std::string("opencnc");
   }();
   ao.device_name = o.device_name;
   ao.start_us = connect::StatusSampler::wall_us();
@@ -185,12 +186,13 @@ int serve(const ServeOptions& o) {
         std::vector<connect::ToolAsset> list;
         if (const auto service = source ? source->tools() : nullptr) {
           for (const tools::ToolEntry& e : service->snapshot()->entries())
-            list.push_back(connect::ToolAsset{e.tool, e.pocket, e.offset[index(Axis::Z)], e.diameter, e.comment,
-                                              connect::StatusSampler::wall_us()});
+            list.push_back(connect::ToolAsset{e.tool, e.pocket, e.offset[index(Axis::Z)], e.diameter,
+                                              e.comment, connect::StatusSampler::wall_us()});
         }
         return list;
       },
-      connect::SamplerOptions{std::chrono::milliseconds(static_cast<int>(1000.0 / o.mtconnect_hz)), std::chrono::seconds(2)});
+      connect::SamplerOptions{std::chrono::milliseconds(static_cast<int>(1000.0 / o.mtconnect_hz)),
+                              std::chrono::seconds(2)});
   sampler.start();
   std::unique_ptr<connect::MqttPublisher> mqtt;
   if (broker) {
@@ -232,9 +234,11 @@ int serve(const ServeOptions& o) {
   fmt::print("  operator  {}\n  admin     in {}\n  history   {}\n", tokens->operator_token(),
              tokens->origin(), (data / "history.sqlite").string());
   if (features->has("journal")) fmt::print("  journal   {}\n", fo.journal_dir);
-  fmt::print("  mtconnect http://{}:{}/probe  (device {}, {})\n", host_part, server.port(), agent->model().name(),
-             agent->model().uuid());
-  if (broker) fmt::print("  mqtt      {}:{} topics {}/…/{}\n", broker->host, broker->port, "MTConnect", agent->model().uuid());
+  fmt::print("  mtconnect http://{}:{}/probe  (device {}, {})\n", host_part, server.port(),
+             agent->model().name(), agent->model().uuid());
+  if (broker)
+    fmt::print("  mqtt      {}:{} topics {}/…/{}\n", broker->host, broker->port, "MTConnect",
+               agent->model().uuid());
   fmt::print("  features  {}\n  Ctrl-C stops.\n", fmt::join(features->names(), ", "));
   std::fflush(stdout);
 
@@ -297,8 +301,9 @@ void add_serve_command(CLI::App& app, Registry& registry) {
   cmd->add_option("--mtconnect-hz", opts->mtconnect_hz,
                   "Status samples per second into the MTConnect agent (default 10)")
       ->check(finite_range(0.1, 1000));
-  cmd->add_option("--mqtt", opts->mqtt,
-                  "Publish the machine's observations to this MQTT broker: mqtt://HOST[:PORT] (docs/connectivity.md)");
+  cmd->add_option(
+      "--mqtt", opts->mqtt,
+      "Publish the machine's observations to this MQTT broker: mqtt://HOST[:PORT] (docs/connectivity.md)");
   cmd->add_option("--mqtt-keepalive", opts->mqtt_keepalive_s,
                   "Seconds between keep-alives; the broker marks the machine unavailable after 1.5 of them "
                   "without a word (default 5)")

@@ -76,7 +76,8 @@ AgentRequest parse_agent_request(std::string_view target) {
     const std::string_view pair = rest.substr(0, amp);
     const auto eq = pair.find('=');
     if (!pair.empty())
-      r.query[decode(pair.substr(0, eq))] = eq == std::string_view::npos ? std::string() : decode(pair.substr(eq + 1));
+      r.query[decode(pair.substr(0, eq))] =
+          eq == std::string_view::npos ? std::string() : decode(pair.substr(eq + 1));
     rest = amp == std::string_view::npos ? std::string_view() : rest.substr(amp + 1);
   }
   return r;
@@ -87,14 +88,18 @@ struct Agent::Header {
   std::uint64_t first = 1, last = 0, next = 1;
 };
 
-Agent::Agent(DeviceModel model, std::vector<std::unique_ptr<Contribution>> contributions, AgentOptions options)
+Agent::Agent(DeviceModel model, std::vector<std::unique_ptr<Contribution>> contributions,
+             AgentOptions options)
     : model_(std::move(model)),
       contributions_(std::move(contributions)),
       options_(std::move(options)),
       buffer_(0, 1) {
-  availability_ = model_.add_item(DataItem{"avail", Category::Event, "AVAILABILITY", {}, {}, "Availability", 0});
-  asset_changed_ = model_.add_item(DataItem{"asset_chg", Category::Event, "ASSET_CHANGED", {}, {}, "AssetChanged", 0});
-  asset_removed_ = model_.add_item(DataItem{"asset_rem", Category::Event, "ASSET_REMOVED", {}, {}, "AssetRemoved", 0});
+  availability_ =
+      model_.add_item(DataItem{"avail", Category::Event, "AVAILABILITY", {}, {}, "Availability", 0});
+  asset_changed_ =
+      model_.add_item(DataItem{"asset_chg", Category::Event, "ASSET_CHANGED", {}, {}, "AssetChanged", 0});
+  asset_removed_ =
+      model_.add_item(DataItem{"asset_rem", Category::Event, "ASSET_REMOVED", {}, {}, "AssetRemoved", 0});
   for (auto& c : contributions_) c->describe(model_);
   buffer_ = ObservationBuffer(model_.items().size(), options_.buffer_size);
   for (std::size_t i = 0; i < model_.items().size(); ++i)
@@ -103,14 +108,16 @@ Agent::Agent(DeviceModel model, std::vector<std::unique_ptr<Contribution>> contr
 }
 
 std::unique_ptr<Agent> Agent::for_profile(const config::MachineProfile& profile, AgentOptions options) {
-  const std::string name =
-      !options.device_name.empty() ? options.device_name : profile.name.empty() ? std::string("opencnc") : profile.name;
+  const std::string name = !options.device_name.empty() ? options.device_name
+                           : profile.name.empty()       ? std::string("opencnc")
+                                                        : profile.name;
   DeviceModel model(name, "opencnc-" + xml_id(name),
                     profile.description.empty() ? std::string("opencnc machine") : profile.description);
   return std::make_unique<Agent>(std::move(model), contributions_for(profile), std::move(options));
 }
 
-void Agent::add(std::size_t item, Level level, std::string native_code, std::string value, std::int64_t time_us) {
+void Agent::add(std::size_t item, Level level, std::string native_code, std::string value,
+                std::int64_t time_us) {
   Observation o;
   o.time_us = time_us;
   o.item = static_cast<std::uint32_t>(item);
@@ -162,7 +169,8 @@ void Agent::mark_unavailable(std::int64_t time_us) {
     if (i == asset_changed_ || i == asset_removed_) continue;
     const auto& s = buffer_.current()[i];
     if (items[i].category == Category::Condition) {
-      if (s.last.level != Level::Unavailable || !s.active.empty()) add(i, Level::Unavailable, {}, {}, time_us);
+      if (s.last.level != Level::Unavailable || !s.active.empty())
+        add(i, Level::Unavailable, {}, {}, time_us);
     } else if (s.last.value != "UNAVAILABLE") {
       add(i, Level::Unavailable, {}, "UNAVAILABLE", time_us);
     }
@@ -171,7 +179,8 @@ void Agent::mark_unavailable(std::int64_t time_us) {
 }
 
 void Agent::set_tools(std::vector<ToolAsset> tools, std::int64_t time_us) {
-  std::sort(tools.begin(), tools.end(), [](const ToolAsset& a, const ToolAsset& b) { return a.number < b.number; });
+  std::sort(tools.begin(), tools.end(),
+            [](const ToolAsset& a, const ToolAsset& b) { return a.number < b.number; });
   std::lock_guard lock(mutex_);
   auto find = [](const std::vector<ToolAsset>& list, int number) -> const ToolAsset* {
     for (const auto& t : list)
@@ -185,7 +194,8 @@ void Agent::set_tools(std::vector<ToolAsset> tools, std::int64_t time_us) {
       add(asset_changed_, Level::Unavailable, {}, fmt::format("T{}", t.number), time_us);
   }
   for (const auto& t : tools_)
-    if (find(tools, t.number) == nullptr) add(asset_removed_, Level::Unavailable, {}, fmt::format("T{}", t.number), time_us);
+    if (find(tools, t.number) == nullptr)
+      add(asset_removed_, Level::Unavailable, {}, fmt::format("T{}", t.number), time_us);
   tools_ = std::move(tools);
 }
 
@@ -199,12 +209,14 @@ std::uint64_t Agent::first_sequence() const {
   return buffer_.first_sequence();
 }
 
-std::vector<Observation> Agent::observations(std::uint64_t from, std::size_t max, std::uint64_t* first) const {
+std::vector<Observation> Agent::observations(std::uint64_t from, std::size_t max,
+                                             std::uint64_t* first) const {
   std::lock_guard lock(mutex_);
   const std::uint64_t start = std::max(from, buffer_.first_sequence());
   if (first != nullptr) *first = start;
   std::vector<Observation> out;
-  for (std::uint64_t s = start; s < buffer_.next_sequence() && out.size() < max; ++s) out.push_back(buffer_.at(s));
+  for (std::uint64_t s = start; s < buffer_.next_sequence() && out.size() < max; ++s)
+    out.push_back(buffer_.at(s));
   return out;
 }
 
@@ -232,14 +244,16 @@ AgentResponse Agent::respond(const AgentRequest& request, std::int64_t now_us) c
     const std::string_view device = rest.substr(0, slash);
     call = rest.substr(slash + 1);
     if (device != model_.name() && device != model_.uuid())
-      return error("NO_DEVICE", fmt::format("no device named '{}' here: this agent serves '{}'", device, model_.name()),
+      return error("NO_DEVICE",
+                   fmt::format("no device named '{}' here: this agent serves '{}'", device, model_.name()),
                    request, now_us);
   }
   if (call == "probe") return probe(request, now_us);
   if (call == "current") return current(request, now_us);
   if (call == "sample") return sample(request, now_us).response;
   if (call == "assets" || call == "asset") return assets(request, now_us);
-  return error("INVALID_URI", fmt::format("'{}' is not a request this agent answers (probe, current, sample, assets)", path),
+  return error("INVALID_URI",
+               fmt::format("'{}' is not a request this agent answers (probe, current, sample, assets)", path),
                request, now_us);
 }
 
@@ -258,15 +272,18 @@ AgentResponse Agent::error(std::string_view code, std::string message, const Age
   w.end();
   w.start("Errors");
   static constexpr std::pair<std::string_view, std::string_view> kElements[] = {
-      {"NO_DEVICE", "NoDevice"},         {"INVALID_URI", "InvalidURI"},
-      {"OUT_OF_RANGE", "OutOfRange"},    {"INVALID_XPATH", "InvalidXPath"},
-      {"INVALID_REQUEST", "InvalidRequest"}, {"ASSET_NOT_FOUND", "AssetNotFound"},
+      {"NO_DEVICE", "NoDevice"},
+      {"INVALID_URI", "InvalidURI"},
+      {"OUT_OF_RANGE", "OutOfRange"},
+      {"INVALID_XPATH", "InvalidXPath"},
+      {"INVALID_REQUEST", "InvalidRequest"},
+      {"ASSET_NOT_FOUND", "AssetNotFound"},
       {"INVALID_PARAMETER_VALUE", "InvalidParameterValue"},
   };
   // OutOfRange and InvalidParameterValue cite the parameter, and the schema knows only some by
   // name (not `at`): an error about another one is an InvalidRequest.
-  static constexpr std::string_view kParameters[] = {"device", "deviceType", "path", "from", "count", "interval",
-                                                     "heartbeat"};
+  static constexpr std::string_view kParameters[] = {"device", "deviceType", "path",     "from",
+                                                     "count",  "interval",   "heartbeat"};
   const bool cites = code == "OUT_OF_RANGE" || code == "INVALID_PARAMETER_VALUE";
   if (cites && std::find(std::begin(kParameters), std::end(kParameters), parameter) == std::end(kParameters))
     code = "INVALID_REQUEST";
@@ -409,7 +426,10 @@ std::string streams_document(const DeviceModel& model, const AgentOptions& optio
           if (!comps[c].name.empty()) w.attribute("name", comps[c].name);
           opened = true;
         }
-        if (!group) w.start(category == Category::Sample ? "Samples" : category == Category::Event ? "Events" : "Condition");
+        if (!group)
+          w.start(category == Category::Sample  ? "Samples"
+                  : category == Category::Event ? "Events"
+                                                : "Condition");
         group = true;
         w.start(category == Category::Condition ? std::string(to_string(o->level)) : item.element);
         w.attribute("dataItemId", item.id);
@@ -451,7 +471,8 @@ AgentResponse Agent::current(const AgentRequest& request, std::int64_t now_us) c
     selected = std::move(*s);
   }
   const Number at = number(request, "at");
-  if (!at.ok) return error("INVALID_PARAMETER_VALUE", "'at' must be a sequence number", request, now_us, "at");
+  if (!at.ok)
+    return error("INVALID_PARAMETER_VALUE", "'at' must be a sequence number", request, now_us, "at");
   if (request.query.count("interval") != 0U)
     return error("INVALID_REQUEST", "/current with an interval is streamed by the server, not answered here",
                  request, now_us);
@@ -461,9 +482,10 @@ AgentResponse Agent::current(const AgentRequest& request, std::int64_t now_us) c
   std::uint64_t next = buffer_.next_sequence();
   if (at.present) {
     if (at.value < buffer_.first_sequence() || at.value >= buffer_.next_sequence())
-      return error("OUT_OF_RANGE",
-                   fmt::format("'at' must lie between {} and {}", buffer_.first_sequence(), buffer_.last_sequence()),
-                   request, now_us, "at");
+      return error(
+          "OUT_OF_RANGE",
+          fmt::format("'at' must lie between {} and {}", buffer_.first_sequence(), buffer_.last_sequence()),
+          request, now_us, "at");
     state = buffer_.state_at(at.value);
     view = &state;
     next = at.value + 1;
@@ -488,8 +510,8 @@ AgentResponse Agent::current(const AgentRequest& request, std::int64_t now_us) c
     }
   }
   return AgentResponse{200, "text/xml; charset=utf-8",
-                       streams_document(model_, options_, now_us, buffer_.first_sequence(), buffer_.last_sequence(),
-                                        next, list)};
+                       streams_document(model_, options_, now_us, buffer_.first_sequence(),
+                                        buffer_.last_sequence(), next, list)};
 }
 
 SampleAnswer Agent::sample(const AgentRequest& request, std::int64_t now_us) const {
@@ -507,23 +529,24 @@ SampleAnswer Agent::sample(const AgentRequest& request, std::int64_t now_us) con
   const Number from = number(request, "from"), count = number(request, "count");
   for (const auto& [name, n] : {std::pair{"from", from}, std::pair{"count", count}}) {
     if (!n.ok) {
-      answer.response = error("INVALID_PARAMETER_VALUE", fmt::format("'{}' must be a whole number ≥ 0", name), request,
-                              now_us, name);
+      answer.response = error("INVALID_PARAMETER_VALUE", fmt::format("'{}' must be a whole number ≥ 0", name),
+                              request, now_us, name);
       return answer;
     }
   }
   const std::uint64_t wanted = count.present ? count.value : 100;
   if (wanted == 0 || wanted > options_.max_count) {
-    answer.response = error("OUT_OF_RANGE", fmt::format("'count' must lie between 1 and {}", options_.max_count),
-                            request, now_us, "count");
+    answer.response =
+        error("OUT_OF_RANGE", fmt::format("'count' must lie between 1 and {}", options_.max_count), request,
+              now_us, "count");
     return answer;
   }
   std::lock_guard lock(mutex_);
   const std::uint64_t first = buffer_.first_sequence(), next = buffer_.next_sequence();
   const std::uint64_t start = from.present ? from.value : first;
   if (start < first || start > next) {
-    answer.response = error("OUT_OF_RANGE", fmt::format("'from' must lie between {} and {}", first, next), request,
-                            now_us, "from");
+    answer.response = error("OUT_OF_RANGE", fmt::format("'from' must lie between {} and {}", first, next),
+                            request, now_us, "from");
     return answer;
   }
   std::vector<const Observation*> list;
@@ -534,8 +557,9 @@ SampleAnswer Agent::sample(const AgentRequest& request, std::int64_t now_us) con
   }
   answer.next_from = s;
   answer.empty = list.empty();
-  answer.response = AgentResponse{200, "text/xml; charset=utf-8",
-                                  streams_document(model_, options_, now_us, first, buffer_.last_sequence(), s, list)};
+  answer.response =
+      AgentResponse{200, "text/xml; charset=utf-8",
+                    streams_document(model_, options_, now_us, first, buffer_.last_sequence(), s, list)};
   return answer;
 }
 
@@ -613,7 +637,8 @@ void ValueSink::set(std::size_t item, std::string value) {
 
 void ValueSink::set(std::size_t item, double value, int decimals) {
   std::string text = fmt::format("{:.{}f}", value, decimals);
-  if (text.starts_with('-') && text.find_first_not_of("-0.") == std::string::npos) text.erase(0, 1);  // no "-0.0000"
+  if (text.starts_with('-') && text.find_first_not_of("-0.") == std::string::npos)
+    text.erase(0, 1);  // no "-0.0000"
   set(item, std::move(text));
 }
 

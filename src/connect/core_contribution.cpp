@@ -5,7 +5,6 @@
 
 #include <fmt/format.h>
 
-
 namespace opencnc::connect {
 
 namespace {
@@ -14,7 +13,9 @@ constexpr int kMm = 4;    // 0.1 µm, the resolution of the status
 constexpr int kDeg = 4;   // 0.0001°
 constexpr int kFeed = 3;  // mm/s
 
-std::string lower(char c) { return std::string(1, static_cast<char>(c - 'A' + 'a')); }
+std::string lower(char c) {
+  return std::string(1, static_cast<char>(c - 'A' + 'a'));
+}
 
 const char* execution(const controller::ControllerStatus& s) {
   using control::State;
@@ -23,26 +24,35 @@ const char* execution(const controller::ControllerStatus& s) {
     case State::Running:
       if (v.wait != control::Wait::None && v.wait != control::Wait::Starved) return "WAIT";
       return "ACTIVE";
-    case State::Held: return "FEED_HOLD";
+    case State::Held:
+      return "FEED_HOLD";
     case State::Stopped:
       switch (v.stop_reason) {
-        case control::StopReason::ProgramStop: return "PROGRAM_STOPPED";
-        case control::StopReason::OptionalStop: return "OPTIONAL_STOP";
-        default: return "INTERRUPTED";  // single block: waits for cycle start between blocks
+        case control::StopReason::ProgramStop:
+          return "PROGRAM_STOPPED";
+        case control::StopReason::OptionalStop:
+          return "OPTIONAL_STOP";
+        default:
+          return "INTERRUPTED";  // single block: waits for cycle start between blocks
       }
-    case State::Idle: return "READY";
+    case State::Idle:
+      return "READY";
     case State::EStopped:
     case State::Off:
-    case State::Faulted: return "STOPPED";
+    case State::Faulted:
+      return "STOPPED";
   }
   return "UNAVAILABLE";
 }
 
 const char* controller_mode(control::Mode m) {
   switch (m) {
-    case control::Mode::Manual: return "MANUAL";
-    case control::Mode::Mdi: return "MANUAL_DATA_INPUT";
-    case control::Mode::Auto: return "AUTOMATIC";
+    case control::Mode::Manual:
+      return "MANUAL";
+    case control::Mode::Mdi:
+      return "MANUAL_DATA_INPUT";
+    case control::Mode::Auto:
+      return "AUTOMATIC";
   }
   return "UNAVAILABLE";
 }
@@ -55,12 +65,15 @@ AxisFault axis_fault(control::FaultKind k) {
     case FaultKind::LimitSwitch:
     case FaultKind::SoftLimit:
     case FaultKind::Homing:
-    case FaultKind::SeekNoSwitch: return AxisFault::Travel;
+    case FaultKind::SeekNoSwitch:
+      return AxisFault::Travel;
     case FaultKind::AmpFault:
     case FaultKind::FollowingError:
     case FaultKind::Stall:
-    case FaultKind::CouplingPosition: return AxisFault::Actuator;
-    default: return AxisFault::None;
+    case FaultKind::CouplingPosition:
+      return AxisFault::Actuator;
+    default:
+      return AxisFault::None;
   }
 }
 
@@ -71,8 +84,8 @@ CoreContribution::CoreContribution(const config::MachineProfile& profile) : prof
 void CoreContribution::describe(DeviceModel& model) {
   auto item = [&](int component, std::string id, Category category, std::string type, std::string element,
                   std::string sub_type = {}, std::string units = {}) {
-    return model.add_item(DataItem{std::move(id), category, std::move(type), std::move(sub_type), std::move(units),
-                                   std::move(element), component});
+    return model.add_item(DataItem{std::move(id), category, std::move(type), std::move(sub_type),
+                                   std::move(units), std::move(element), component});
   };
   const int axes = model.add_component(0, "Axes", "axes");
   for (const auto& a : profile_.axes) {
@@ -99,7 +112,8 @@ void CoreContribution::describe(DeviceModel& model) {
                            "REVOLUTION/MINUTE");
     spindle_->commanded = item(c, "s_speed_cmd", Category::Sample, "ROTARY_VELOCITY", "RotaryVelocity",
                                "COMMANDED", "REVOLUTION/MINUTE");
-    spindle_->override_ = item(c, "s_ovr", Category::Event, "ROTARY_VELOCITY_OVERRIDE", "RotaryVelocityOverride");
+    spindle_->override_ =
+        item(c, "s_ovr", Category::Event, "ROTARY_VELOCITY_OVERRIDE", "RotaryVelocityOverride");
     spindle_->mode = item(c, "s_mode", Category::Event, "ROTARY_MODE", "RotaryMode");
     spindle_->load = item(c, "s_load", Category::Sample, "LOAD", "Load", {}, "PERCENT");
   }
@@ -113,12 +127,14 @@ void CoreContribution::describe(DeviceModel& model) {
   line_ = item(path, "line", Category::Event, "LINE_NUMBER", "LineNumber", "ABSOLUTE");
   tool_ = item(path, "tool", Category::Event, "TOOL_NUMBER", "ToolNumber");
   part_count_ = item(path, "part_count", Category::Event, "PART_COUNT", "PartCount", "ALL");
-  feed_ = item(path, "feed", Category::Sample, "PATH_FEEDRATE", "PathFeedrate", "ACTUAL", "MILLIMETER/SECOND");
-  feed_override_ = item(path, "feed_ovr", Category::Event, "PATH_FEEDRATE_OVERRIDE", "PathFeedrateOverride",
-                        "PROGRAMMED");
-  rapid_override_ = item(path, "rapid_ovr", Category::Event, "PATH_FEEDRATE_OVERRIDE", "PathFeedrateOverride",
-                         "RAPID");
-  position_ = item(path, "path_pos", Category::Sample, "PATH_POSITION", "PathPosition", "ACTUAL", "MILLIMETER_3D");
+  feed_ =
+      item(path, "feed", Category::Sample, "PATH_FEEDRATE", "PathFeedrate", "ACTUAL", "MILLIMETER/SECOND");
+  feed_override_ =
+      item(path, "feed_ovr", Category::Event, "PATH_FEEDRATE_OVERRIDE", "PathFeedrateOverride", "PROGRAMMED");
+  rapid_override_ =
+      item(path, "rapid_ovr", Category::Event, "PATH_FEEDRATE_OVERRIDE", "PathFeedrateOverride", "RAPID");
+  position_ =
+      item(path, "path_pos", Category::Sample, "PATH_POSITION", "PathPosition", "ACTUAL", "MILLIMETER_3D");
 }
 
 void CoreContribution::observe(const controller::ControllerStatus& s, ValueSink& out) const {
@@ -147,7 +163,8 @@ void CoreContribution::observe(const controller::ControllerStatus& s, ValueSink&
   out.set(feed_, v.path_velocity, kFeed);
   out.set(feed_override_, v.feed_override * 100.0, 0);
   out.set(rapid_override_, v.rapid_override * 100.0, 0);
-  out.set(position_, fmt::format("{:.{}f} {:.{}f} {:.{}f}", v.actual[0], kMm, v.actual[1], kMm, v.actual[2], kMm));
+  out.set(position_,
+          fmt::format("{:.{}f} {:.{}f} {:.{}f}", v.actual[0], kMm, v.actual[1], kMm, v.actual[2], kMm));
 
   // A fault of one axis goes to that axis; every other fault, and the process alarms, to the system.
   const auto& f = v.fault;
@@ -158,7 +175,8 @@ void CoreContribution::observe(const controller::ControllerStatus& s, ValueSink&
     for (const auto& a : axes_)
       if (a.axis == f.axis) axis = &a;
     if (where != AxisFault::None && axis != nullptr)
-      out.condition(where == AxisFault::Travel ? axis->travel : axis->actuator, Level::Fault, code, s.fault_text);
+      out.condition(where == AxisFault::Travel ? axis->travel : axis->actuator, Level::Fault, code,
+                    s.fault_text);
     else
       out.condition(system_, Level::Fault, code, s.fault_text);
   }

@@ -9,9 +9,12 @@ namespace opencnc::connect {
 
 const char* to_string(Category c) noexcept {
   switch (c) {
-    case Category::Sample: return "SAMPLE";
-    case Category::Event: return "EVENT";
-    case Category::Condition: return "CONDITION";
+    case Category::Sample:
+      return "SAMPLE";
+    case Category::Event:
+      return "EVENT";
+    case Category::Condition:
+      return "CONDITION";
   }
   return "EVENT";
 }
@@ -58,7 +61,8 @@ std::string xml_id(std::string_view text) {
     const auto u = static_cast<unsigned char>(c);
     id += std::isalnum(u) || c == '_' || c == '-' ? c : '_';
   }
-  if (id.empty() || std::isdigit(static_cast<unsigned char>(id.front())) || id.front() == '-') id.insert(0, "_");
+  if (id.empty() || std::isdigit(static_cast<unsigned char>(id.front())) || id.front() == '-')
+    id.insert(0, "_");
   return id;
 }
 

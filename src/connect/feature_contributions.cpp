@@ -11,7 +11,9 @@ namespace opencnc::connect {
 
 namespace {
 
-std::string lower(Axis a) { return std::string(1, static_cast<char>(letter(a) - 'A' + 'a')); }
+std::string lower(Axis a) {
+  return std::string(1, static_cast<char>(letter(a) - 'A' + 'a'));
+}
 
 }  // namespace
 
@@ -47,15 +49,15 @@ void CouplingContribution::describe(DeviceModel& model) {
     throw std::invalid_argument(fmt::format("connect: the coupled axis {} is not in the device", letter(a)));
   };
   const int master = component(master_), slave = component(slave_);
-  master_coupling_ = model.add_item(
-      DataItem{lower(master_) + "_coupling", Category::Event, "AXIS_COUPLING", {}, {}, "AxisCoupling", master});
+  master_coupling_ = model.add_item(DataItem{
+      lower(master_) + "_coupling", Category::Event, "AXIS_COUPLING", {}, {}, "AxisCoupling", master});
   slave_coupling_ = model.add_item(
       DataItem{lower(slave_) + "_coupling", Category::Event, "AXIS_COUPLING", {}, {}, "AxisCoupling", slave});
   coupled_axes_ = model.add_item(
       DataItem{lower(slave_) + "_coupled", Category::Event, "COUPLED_AXES", {}, {}, "CoupledAxes", slave});
   if (has_load_)
-    load_ = model.add_item(
-        DataItem{lower(master_) + "_force", Category::Sample, "LINEAR_FORCE", {}, "NEWTON", "LinearForce", master});
+    load_ = model.add_item(DataItem{
+        lower(master_) + "_force", Category::Sample, "LINEAR_FORCE", {}, "NEWTON", "LinearForce", master});
 }
 
 void CouplingContribution::observe(const controller::ControllerStatus& s, ValueSink& out) const {
@@ -71,15 +73,17 @@ void CouplingContribution::observe(const controller::ControllerStatus& s, ValueS
 
 void PowerContribution::describe(DeviceModel& model) {
   const int controller = model.find_component("Controller");
-  mains_ = model.add_item(DataItem{"mains", Category::Event, "POWER_STATE", "LINE", {}, "PowerState", controller});
+  mains_ =
+      model.add_item(DataItem{"mains", Category::Event, "POWER_STATE", "LINE", {}, "PowerState", controller});
   power_ = model.add_item(DataItem{"power", Category::Condition, "SYSTEM", {}, {}, {}, controller});
 }
 
 void PowerContribution::observe(const controller::ControllerStatus& s, ValueSink& out) const {
   out.set(mains_, s.servo.mains_ok ? "ON" : "OFF");
   if (s.servo.on_battery)
-    out.condition(power_, Level::Warning, "power.on-battery",
-                  fmt::format("mains lost: the control runs on its UPS (DC link {:.0f} V)", s.servo.dc_link_v));
+    out.condition(
+        power_, Level::Warning, "power.on-battery",
+        fmt::format("mains lost: the control runs on its UPS (DC link {:.0f} V)", s.servo.dc_link_v));
 }
 
 // --- The set a profile calls for ---------------------------------------------------------------

@@ -16,8 +16,8 @@ std::string iso_time(std::int64_t us) {
   const auto micro = static_cast<int>(us - static_cast<std::int64_t>(seconds) * 1000000);
   std::tm tm{};
   gmtime_r(&seconds, &tm);
-  return fmt::format("{:04}-{:02}-{:02}T{:02}:{:02}:{:02}.{:06}Z", tm.tm_year + 1900, tm.tm_mon + 1, tm.tm_mday,
-                     tm.tm_hour, tm.tm_min, tm.tm_sec, micro);
+  return fmt::format("{:04}-{:02}-{:02}T{:02}:{:02}:{:02}.{:06}Z", tm.tm_year + 1900, tm.tm_mon + 1,
+                     tm.tm_mday, tm.tm_hour, tm.tm_min, tm.tm_sec, micro);
 }
 
 namespace {
@@ -42,7 +42,9 @@ json observation(const DeviceModel& model, const Observation& o) {
 }
 
 json header(const DeviceModel& model, const AgentOptions& options) {
-  return json{{"device", model.name()}, {"uuid", model.uuid()}, {"sender", options.sender},
+  return json{{"device", model.name()},
+              {"uuid", model.uuid()},
+              {"sender", options.sender},
               {"instanceId", options.instance_id}};
 }
 
@@ -73,8 +75,8 @@ std::string probe_json(const DeviceModel& model, const AgentOptions& options) {
   return j.dump();
 }
 
-std::string sample_json(const DeviceModel& model, const AgentOptions& options, std::span<const Observation> batch,
-                        const Gap& gap, std::uint64_t dropped_total) {
+std::string sample_json(const DeviceModel& model, const AgentOptions& options,
+                        std::span<const Observation> batch, const Gap& gap, std::uint64_t dropped_total) {
   json j = header(model, options);
   j["firstSequence"] = batch.empty() ? 0 : batch.front().sequence;
   j["lastSequence"] = batch.empty() ? 0 : batch.back().sequence;

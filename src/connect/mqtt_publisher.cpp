@@ -13,8 +13,8 @@
 #include <mosquitto.h>
 
 #include <algorithm>
-#include <charconv>
 #include <cerrno>
+#include <charconv>
 #include <chrono>
 #include <cstring>
 #include <stdexcept>
@@ -24,7 +24,8 @@ namespace opencnc::connect {
 namespace {
 
 std::int64_t now_ms() {
-  return std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now().time_since_epoch())
+  return std::chrono::duration_cast<std::chrono::milliseconds>(
+             std::chrono::steady_clock::now().time_since_epoch())
       .count();
 }
 
@@ -49,10 +50,12 @@ std::optional<MqttAddress> parse_mqtt_url(std::string_view url, std::string* err
   std::string_view host = rest, port;
   if (rest.starts_with('[')) {  // [::1]:1883
     const auto close = rest.find(']');
-    if (close == std::string_view::npos) return fail(fmt::format("'{}': an IPv6 address without its ']'", url));
+    if (close == std::string_view::npos)
+      return fail(fmt::format("'{}': an IPv6 address without its ']'", url));
     host = rest.substr(1, close - 1);
     const std::string_view after = rest.substr(close + 1);
-    if (!after.empty() && after.front() != ':') return fail(fmt::format("'{}': expected ':PORT' after ']'", url));
+    if (!after.empty() && after.front() != ':')
+      return fail(fmt::format("'{}': expected ':PORT' after ']'", url));
     if (!after.empty()) port = after.substr(1);
   } else if (const auto colon = rest.rfind(':'); colon != std::string_view::npos) {
     host = rest.substr(0, colon);
@@ -90,7 +93,9 @@ MqttPublisher::MqttPublisher(const Agent& agent, MqttOptions options)
   current_published_at_ = 0;
 }
 
-MqttPublisher::~MqttPublisher() { stop(0); }
+MqttPublisher::~MqttPublisher() {
+  stop(0);
+}
 
 void MqttPublisher::start() {
   if (thread_.joinable()) return;
@@ -116,8 +121,8 @@ void MqttPublisher::stop(int drain_ms) {
     // A clean disconnect does not send the will: say it ourselves, and wait for it to leave.
     int mid = 0;
     const char* word = "UNAVAILABLE";
-    mosquitto_publish(client_, &mid, availability_topic_.c_str(), static_cast<int>(std::char_traits<char>::length(word)),
-                      word, 1, true);
+    mosquitto_publish(client_, &mid, availability_topic_.c_str(),
+                      static_cast<int>(std::char_traits<char>::length(word)), word, 1, true);
     lock.unlock();
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
     lock.lock();
@@ -164,7 +169,8 @@ void MqttPublisher::on_disconnect(struct mosquitto*, void* self, int rc) {
 void MqttPublisher::on_publish(struct mosquitto*, void* self, int mid) {
   auto* p = static_cast<MqttPublisher*>(self);
   std::lock_guard lock(p->mutex_);
-  auto it = std::find_if(p->pending_.begin(), p->pending_.end(), [&](const Batch& b) { return b.mid == mid; });
+  auto it =
+      std::find_if(p->pending_.begin(), p->pending_.end(), [&](const Batch& b) { return b.mid == mid; });
   if (it == p->pending_.end()) return;  // the availability or the current state
   ++p->stats_.batches_acked;
   p->stats_.observations_acked += it->count;
@@ -174,19 +180,20 @@ void MqttPublisher::on_publish(struct mosquitto*, void* self, int mid) {
 
 void MqttPublisher::connect_client() {
   // Called with the mutex held.
-  client_ = mosquitto_new(fmt::format("opencnc-{}-{}", agent_.model().uuid(), agent_.options().instance_id).c_str(),
-                          true, this);
+  client_ = mosquitto_new(
+      fmt::format("opencnc-{}-{}", agent_.model().uuid(), agent_.options().instance_id).c_str(), true, this);
   if (client_ == nullptr) return;
   const char* will = "UNAVAILABLE";
-  mosquitto_will_set(client_, availability_topic_.c_str(), static_cast<int>(std::char_traits<char>::length(will)),
-                     will, 1, true);
+  mosquitto_will_set(client_, availability_topic_.c_str(),
+                     static_cast<int>(std::char_traits<char>::length(will)), will, 1, true);
   mosquitto_connect_callback_set(client_, &MqttPublisher::on_connect);
   mosquitto_disconnect_callback_set(client_, &MqttPublisher::on_disconnect);
   mosquitto_publish_callback_set(client_, &MqttPublisher::on_publish);
   // One batch in flight is enough on loopback, more keep a distant broker's line full.
   mosquitto_max_inflight_messages_set(client_, 32);
   lost_ = false;
-  int rc = mosquitto_connect_async(client_, options_.broker.host.c_str(), options_.broker.port, options_.keepalive_s);
+  int rc = mosquitto_connect_async(client_, options_.broker.host.c_str(), options_.broker.port,
+                                   options_.keepalive_s);
   if (rc == MOSQ_ERR_SUCCESS) rc = mosquitto_loop_start(client_);
   if (rc != MOSQ_ERR_SUCCESS) {
     lost_ = true;
@@ -262,7 +269,8 @@ void MqttPublisher::publish_pending() {
   for (auto& b : pending_) {
     if (b.mid != -1) continue;
     int mid = 0;
-    const std::string payload = sample_json(agent_.model(), agent_.options(), b.observations, b.gap, dropped_);
+    const std::string payload =
+        sample_json(agent_.model(), agent_.options(), b.observations, b.gap, dropped_);
     const int rc = mosquitto_publish(client_, &mid, sample_topic_.c_str(), static_cast<int>(payload.size()),
                                      payload.data(), 1, false);
     if (rc != MOSQ_ERR_SUCCESS) return;  // the connection went: the loop notices
@@ -276,8 +284,8 @@ void MqttPublisher::publish_current(bool force) {
   const std::uint64_t next = agent_.next_sequence();
   if (!force && (now < current_due_ms_ || next == current_published_at_)) return;
   const std::string payload = current_json(agent_.model(), agent_.options(), agent_.snapshot(), next);
-  if (mosquitto_publish(client_, nullptr, current_topic_.c_str(), static_cast<int>(payload.size()), payload.data(), 1,
-                        true) == MOSQ_ERR_SUCCESS) {
+  if (mosquitto_publish(client_, nullptr, current_topic_.c_str(), static_cast<int>(payload.size()),
+                        payload.data(), 1, true) == MOSQ_ERR_SUCCESS) {
     current_published_at_ = next;
     current_due_ms_ = now + options_.current_every_ms;
   }
@@ -294,7 +302,8 @@ void MqttPublisher::run() {
       lock.unlock();
       drop_client();
       lock.lock();
-      backoff_ms_ = backoff_ms_ == 0 ? options_.reconnect_min_ms : std::min(backoff_ms_ * 2, options_.reconnect_max_ms);
+      backoff_ms_ =
+          backoff_ms_ == 0 ? options_.reconnect_min_ms : std::min(backoff_ms_ * 2, options_.reconnect_max_ms);
       reconnect_at_ms_ = now_ms() + backoff_ms_;
       continue;
     }
@@ -302,7 +311,8 @@ void MqttPublisher::run() {
       if (just_connected_) {
         just_connected_ = false;
         const std::string probe = probe_json(agent_.model(), agent_.options());
-        mosquitto_publish(client_, nullptr, probe_topic_.c_str(), static_cast<int>(probe.size()), probe.data(), 1, true);
+        mosquitto_publish(client_, nullptr, probe_topic_.c_str(), static_cast<int>(probe.size()),
+                          probe.data(), 1, true);
         const char* word = "AVAILABLE";
         mosquitto_publish(client_, nullptr, availability_topic_.c_str(),
                           static_cast<int>(std::char_traits<char>::length(word)), word, 1, true);

@@ -9,10 +9,14 @@ namespace opencnc::connect {
 
 const char* to_string(Level l) noexcept {
   switch (l) {
-    case Level::Unavailable: return "Unavailable";
-    case Level::Normal: return "Normal";
-    case Level::Warning: return "Warning";
-    case Level::Fault: return "Fault";
+    case Level::Unavailable:
+      return "Unavailable";
+    case Level::Normal:
+      return "Normal";
+    case Level::Warning:
+      return "Warning";
+    case Level::Fault:
+      return "Fault";
   }
   return "Unavailable";
 }
@@ -62,7 +66,8 @@ const Observation& ObservationBuffer::at(std::uint64_t sequence) const {
 }
 
 std::vector<ItemState> ObservationBuffer::state_at(std::uint64_t sequence) const {
-  if (sequence + 1 < first_ || sequence >= next_) throw std::out_of_range("connect: sequence not in the buffer");
+  if (sequence + 1 < first_ || sequence >= next_)
+    throw std::out_of_range("connect: sequence not in the buffer");
   std::vector<ItemState> state = before_first_;
   for (std::uint64_t s = first_; s <= sequence; ++s) apply(state, at(s));
   return state;

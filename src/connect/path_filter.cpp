@@ -11,8 +11,12 @@ namespace opencnc::connect {
 
 namespace {
 
-const xmlChar* x(const char* s) { return reinterpret_cast<const xmlChar*>(s); }
-const xmlChar* x(const std::string& s) { return x(s.c_str()); }
+const xmlChar* x(const char* s) {
+  return reinterpret_cast<const xmlChar*>(s);
+}
+const xmlChar* x(const std::string& s) {
+  return x(s.c_str());
+}
 
 struct DocFree {
   void operator()(xmlDocPtr d) const { xmlFreeDoc(d); }
@@ -75,12 +79,14 @@ void quiet(void*, xmlErrorPtr) {}
 
 }  // namespace
 
-std::optional<std::vector<bool>> select_items(const DeviceModel& model, std::string_view xpath, std::string* error) {
+std::optional<std::vector<bool>> select_items(const DeviceModel& model, std::string_view xpath,
+                                              std::string* error) {
   auto doc = probe_tree(model);
   std::unique_ptr<xmlXPathContext, ContextFree> ctx(xmlXPathNewContext(doc.get()));
   // libxml2 reports a malformed expression on stderr by default: the caller reports it instead.
   xmlSetStructuredErrorFunc(nullptr, quiet);
-  std::unique_ptr<xmlXPathObject, ObjectFree> result(xmlXPathEvalExpression(x(std::string(xpath)), ctx.get()));
+  std::unique_ptr<xmlXPathObject, ObjectFree> result(
+      xmlXPathEvalExpression(x(std::string(xpath)), ctx.get()));
   xmlSetStructuredErrorFunc(nullptr, nullptr);
   if (!result) {
     if (error) *error = "the path is not a valid XPath expression: " + std::string(xpath);
@@ -89,7 +95,8 @@ std::optional<std::vector<bool>> select_items(const DeviceModel& model, std::str
   std::vector<bool> selected(model.items().size(), false);
   bool any = false;
   if (result->type == XPATH_NODESET && result->nodesetval != nullptr) {
-    for (int i = 0; i < result->nodesetval->nodeNr; ++i) mark(model, result->nodesetval->nodeTab[i], selected);
+    for (int i = 0; i < result->nodesetval->nodeNr; ++i)
+      mark(model, result->nodesetval->nodeTab[i], selected);
     for (bool b : selected) any = any || b;
   }
   if (!any) {

@@ -14,6 +14,7 @@ namespace opencnc::connect {
 /// The items `xpath` selects (a DataItem, or every DataItem under a selected component), as a flag
 /// per item; or the reason it selects none in `error`. The expression sees the probe document's
 /// elements without their namespace (`//Axes//DataItem[@type="POSITION"]`), as MTConnect agents do.
-std::optional<std::vector<bool>> select_items(const DeviceModel& model, std::string_view xpath, std::string* error);
+std::optional<std::vector<bool>> select_items(const DeviceModel& model, std::string_view xpath,
+                                              std::string* error);
 
 }  // namespace opencnc::connect

@@ -7,10 +7,13 @@ namespace opencnc::connect {
 StatusSampler::StatusSampler(Agent& agent, StatusFn status, ToolsFn tools, SamplerOptions options)
     : agent_(agent), status_(std::move(status)), tools_(std::move(tools)), options_(options) {}
 
-StatusSampler::~StatusSampler() { stop(); }
+StatusSampler::~StatusSampler() {
+  stop();
+}
 
 std::int64_t StatusSampler::wall_us() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
+  return std::chrono::duration_cast<std::chrono::microseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
       .count();
 }
 

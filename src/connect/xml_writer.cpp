@@ -8,7 +8,9 @@ namespace opencnc::connect {
 
 namespace {
 
-const xmlChar* x(const std::string& s) { return reinterpret_cast<const xmlChar*>(s.c_str()); }
+const xmlChar* x(const std::string& s) {
+  return reinterpret_cast<const xmlChar*>(s.c_str());
+}
 
 void check(int rc, const char* what) {
   if (rc < 0) throw std::runtime_error(std::string("connect: libxml2 could not write ") + what);
@@ -42,9 +44,13 @@ void XmlWriter::attribute(std::string_view name, std::string_view value) {
   check(xmlTextWriterWriteAttribute(writer_, x(std::string(name)), x(std::string(value))), "an attribute");
 }
 
-void XmlWriter::text(std::string_view text) { check(xmlTextWriterWriteString(writer_, x(std::string(text))), "a text"); }
+void XmlWriter::text(std::string_view text) {
+  check(xmlTextWriterWriteString(writer_, x(std::string(text))), "a text");
+}
 
-void XmlWriter::end() { check(xmlTextWriterEndElement(writer_), "an element's end"); }
+void XmlWriter::end() {
+  check(xmlTextWriterEndElement(writer_), "an element's end");
+}
 
 std::string XmlWriter::finish() {
   check(xmlTextWriterEndDocument(writer_), "the document's end");

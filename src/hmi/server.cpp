@@ -366,11 +366,12 @@ class MtcStream : public std::enable_shared_from_this<MtcStream> {
     from_ = from;
     ++server_->mtc_streams;
     tick_due_ = true;
-    write(std::make_shared<std::string>(fmt::format(
-              "HTTP/{}.{} 200 OK\r\nServer: opencnc\r\nContent-Type: multipart/x-mixed-replace;boundary={}\r\n"
-              "Transfer-Encoding: chunked\r\nCache-Control: no-cache, private\r\nConnection: close\r\n\r\n",
-              http_version / 10, http_version % 10, kBoundary)),
-          false);
+    write(
+        std::make_shared<std::string>(fmt::format(
+            "HTTP/{}.{} 200 OK\r\nServer: opencnc\r\nContent-Type: multipart/x-mixed-replace;boundary={}\r\n"
+            "Transfer-Encoding: chunked\r\nCache-Control: no-cache, private\r\nConnection: close\r\n\r\n",
+            http_version / 10, http_version % 10, kBoundary)),
+        false);
   }
 
  private:
@@ -378,19 +379,19 @@ class MtcStream : public std::enable_shared_from_this<MtcStream> {
 
   void write(std::shared_ptr<std::string> bytes, bool last) {
     writing_ = true;
-    stream_.expires_after(
-        std::chrono::milliseconds(static_cast<std::int64_t>(server_->config.mtconnect_write_timeout_s * 1000.0)));
-    net::async_write(stream_, net::buffer(*bytes), [self = shared_from_this(), bytes, last](beast::error_code ec,
-                                                                                           std::size_t) {
-      self->writing_ = false;
-      if (ec) return self->end(ec == beast::error::timeout);
-      self->last_sent_ = std::chrono::steady_clock::now();
-      if (last) return self->end(false);
-      if (self->tick_due_) {
-        self->tick_due_ = false;
-        self->tick();
-      }
-    });
+    stream_.expires_after(std::chrono::milliseconds(
+        static_cast<std::int64_t>(server_->config.mtconnect_write_timeout_s * 1000.0)));
+    net::async_write(stream_, net::buffer(*bytes),
+                     [self = shared_from_this(), bytes, last](beast::error_code ec, std::size_t) {
+                       self->writing_ = false;
+                       if (ec) return self->end(ec == beast::error::timeout);
+                       self->last_sent_ = std::chrono::steady_clock::now();
+                       if (last) return self->end(false);
+                       if (self->tick_due_) {
+                         self->tick_due_ = false;
+                         self->tick();
+                       }
+                     });
   }
   /// One part as a chunk of the chunked body.
   static std::shared_ptr<std::string> part(const std::string& document) {
@@ -641,14 +642,26 @@ const Server::Impl::Route& Server::Impl::route_for(std::string_view path) noexce
        .access = Access::Anyone,
        .answer = &I::other_version},
       // MTConnect (docs/connectivity.md): read-only, open on loopback like the status.
-      {.methods = kGet, .path = "/probe", .access = Access::TokenOrLoopback, .runs = Runs::Blocking,
+      {.methods = kGet,
+       .path = "/probe",
+       .access = Access::TokenOrLoopback,
+       .runs = Runs::Blocking,
        .answer = &I::mtconnect},
-      {.methods = kGet, .path = "/current", .access = Access::TokenOrLoopback, .runs = Runs::Blocking,
+      {.methods = kGet,
+       .path = "/current",
+       .access = Access::TokenOrLoopback,
+       .runs = Runs::Blocking,
        .answer = &I::mtconnect},
       {.methods = kGet, .path = "/sample", .access = Access::TokenOrLoopback, .start = &I::mtconnect_sample},
-      {.methods = kGet, .path = "/assets", .access = Access::TokenOrLoopback, .runs = Runs::Blocking,
+      {.methods = kGet,
+       .path = "/assets",
+       .access = Access::TokenOrLoopback,
+       .runs = Runs::Blocking,
        .answer = &I::mtconnect},
-      {.methods = kGet, .path = "/mtconnect/", .prefix = true, .access = Access::TokenOrLoopback,
+      {.methods = kGet,
+       .path = "/mtconnect/",
+       .prefix = true,
+       .access = Access::TokenOrLoopback,
        .start = &I::mtconnect_sample},
       // Everything else is the front end's files.
       {.methods = kGet | kHead,
@@ -1025,11 +1038,12 @@ HttpResponse agent_response(const HttpRequest& req, const connect::AgentResponse
 
 HttpResponse Server::Impl::mtconnect(const HttpRequest& req, const Target&, Role) {
   if (config.mtconnect == nullptr) return error_response(req, 404, "this server has no MTConnect agent");
-  return agent_response(req, config.mtconnect->respond(mtconnect_request(sv(req.target())),
-                                                       connect::StatusSampler::wall_us()));
+  return agent_response(
+      req, config.mtconnect->respond(mtconnect_request(sv(req.target())), connect::StatusSampler::wall_us()));
 }
 
-void Server::Impl::mtconnect_sample(const std::shared_ptr<HttpSession>& s, const HttpRequest& req, Role role) {
+void Server::Impl::mtconnect_sample(const std::shared_ptr<HttpSession>& s, const HttpRequest& req,
+                                    Role role) {
   const connect::AgentRequest r = mtconnect_request(sv(req.target()));
   const bool sample = r.path == "/sample" || r.path.ends_with("/sample");
   const auto interval = r.query.find("interval");
@@ -1054,7 +1068,8 @@ void Server::Impl::mtconnect_sample(const std::shared_ptr<HttpSession>& s, const
   first.query.erase("heartbeat");
   const connect::SampleAnswer check = config.mtconnect->sample(first, connect::StatusSampler::wall_us());
   if (check.response.status != 200) return s->send(agent_response(req, check.response));
-  const auto from = first.query.count("from") ? std::stoull(first.query.at("from")) : config.mtconnect->first_sequence();
+  const auto from =
+      first.query.count("from") ? std::stoull(first.query.at("from")) : config.mtconnect->first_sequence();
   auto stream = std::make_shared<MtcStream>(s->take_socket(), shared_from_this(), first,
                                             std::chrono::milliseconds(std::max(*every, 10L)),
                                             std::chrono::milliseconds(*beat));

@@ -54,11 +54,15 @@ std::string invalid(const std::string& xml, const std::string& name) {
     if (schema == nullptr) return "the schema " + file + " does not compile";
   }
   std::string errors;
-  xmlDocPtr doc = xmlReadMemory(xml.data(), static_cast<int>(xml.size()), "doc.xml", nullptr, XML_PARSE_NONET);
+  xmlDocPtr doc =
+      xmlReadMemory(xml.data(), static_cast<int>(xml.size()), "doc.xml", nullptr, XML_PARSE_NONET);
   if (doc == nullptr) return "not well-formed XML";
   xmlSchemaValidCtxtPtr v = xmlSchemaNewValidCtxt(schema);
   xmlSchemaSetValidStructuredErrors(
-      v, [](void* out, xmlErrorPtr e) { *static_cast<std::string*>(out) += fmt::format("line {}: {}", e->line, e->message); },
+      v,
+      [](void* out, xmlErrorPtr e) {
+        *static_cast<std::string*>(out) += fmt::format("line {}: {}", e->line, e->message);
+      },
       &errors);
   const int rc = xmlSchemaValidateDoc(v, doc);
   xmlSchemaFreeValidCtxt(v);
@@ -126,7 +130,9 @@ class EveryProfile : public ::testing::TestWithParam<std::string> {};
 /// axis, every process alarm active, the EDM gap shorted, a coupling engaged, on battery.
 controller::ControllerStatus busy_status(const config::MachineProfile& p, int i) {
   controller::ControllerStatus s;
-  s.servo.state = i % 3 == 0 ? control::State::Running : i % 3 == 1 ? control::State::Held : control::State::Faulted;
+  s.servo.state = i % 3 == 0   ? control::State::Running
+                  : i % 3 == 1 ? control::State::Held
+                               : control::State::Faulted;
   s.servo.mode = control::Mode::Auto;
   s.servo.estop_input_ok = true;
   s.servo.run_active = true;
@@ -156,22 +162,25 @@ TEST_P(EveryProfile, EveryDocumentIsValidMTConnect27) {
   auto agent = Agent::for_profile(p, AgentOptions{"test-host", "", 7, 4096, 1000});
   for (int i = 0; i < 6; ++i) agent->observe(busy_status(p, i), kEpochUs + i * 100000);
   agent->observe(controller::ControllerStatus{}, kEpochUs + 700000);  // everything back to rest
-  agent->set_tools({ToolAsset{1, 3, 120.5, 10, "end mill <10 mm> & co", kEpochUs}, ToolAsset{2, 0, 80, 6, "", kEpochUs}},
-                   kEpochUs + 1);
+  agent->set_tools(
+      {ToolAsset{1, 3, 120.5, 10, "end mill <10 mm> & co", kEpochUs}, ToolAsset{2, 0, 80, 6, "", kEpochUs}},
+      kEpochUs + 1);
 
   const auto probe = ask(*agent, "/probe");
   EXPECT_EQ(probe.status, 200);
   EXPECT_EQ(invalid(probe.body, "MTConnectDevices"), "") << probe.body;
-  for (const std::string target : {"/current", "/sample?count=1000", "/sample?from=1&count=5", "/current?at=3",
-                                   "/current?at=60", "/current?path=//Axes//DataItem[@type=\"POSITION\"]"}) {
+  for (const std::string target :
+       {"/current", "/sample?count=1000", "/sample?from=1&count=5", "/current?at=3", "/current?at=60",
+        "/current?path=//Axes//DataItem[@type=\"POSITION\"]"}) {
     const auto r = ask(*agent, target);
     EXPECT_EQ(r.status, 200) << target;
     EXPECT_EQ(invalid(r.body, "MTConnectStreams"), "") << target << "\n" << r.body;
   }
   const auto assets = ask(*agent, "/assets");
   EXPECT_EQ(invalid(assets.body, "MTConnectAssets"), "") << assets.body;
-  for (const std::string target : {"/sample?from=999999", "/sample?count=0", "/sample?from=x", "/current?path=//Nope",
-                                   "/current?path=((", "/other/probe", "/nothing", "/current?at=999999"}) {
+  for (const std::string target :
+       {"/sample?from=999999", "/sample?count=0", "/sample?from=x", "/current?path=//Nope",
+        "/current?path=((", "/other/probe", "/nothing", "/current?at=999999"}) {
     const auto r = ask(*agent, target);
     EXPECT_NE(r.status, 200) << target;
     EXPECT_EQ(invalid(r.body, "MTConnectError"), "") << target << "\n" << r.body;
@@ -179,8 +188,8 @@ TEST_P(EveryProfile, EveryDocumentIsValidMTConnect27) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Connect, EveryProfile,
-                         ::testing::Values("mill-3axis", "mill-4axis", "drill-retrofit", "edm-5axis", "broach-zc",
-                                           "flame-cutter", "hmc-toolcheck"),
+                         ::testing::Values("mill-3axis", "mill-4axis", "drill-retrofit", "edm-5axis",
+                                           "broach-zc", "flame-cutter", "hmc-toolcheck"),
                          [](const ::testing::TestParamInfo<std::string>& param) {
                            std::string n = param.param;
                            std::replace(n.begin(), n.end(), '-', '_');
@@ -228,7 +237,8 @@ TEST(Agent, AMachineThatRunsShowsItsPositionsStateAndProgramValues) {
   EXPECT_EQ(c.one("//m:Position[@dataItemId='y_cmd']"), "-3.0000");
   EXPECT_EQ(c.one("//m:EmergencyStop"), "ARMED");
   EXPECT_EQ(c.one("//m:PathFeedrateOverride[@subType='PROGRAMMED']"), "100");
-  EXPECT_EQ(c.all("//m:Condition/m:Normal").size(), 1u + 2u * 3u);  // system, and travel and actuator per axis
+  EXPECT_EQ(c.all("//m:Condition/m:Normal").size(),
+            1u + 2u * 3u);  // system, and travel and actuator per axis
   // The move was seen under way: some sample shows X between its ends at a feed above zero.
   Xml all(ask(*agent, "/sample?count=10000&path=//Linear[@name=\"X\"]//DataItem[@subType=\"ACTUAL\"]").body);
   const auto xs = all.all("//m:Position");
@@ -337,8 +347,9 @@ TEST(Agent, RequestsAreDecodedAndTheDeviceMayBeNamed) {
 TEST(Agent, ToolsAreCuttingToolAssetsAndTheirChangesEvents) {
   auto agent = Agent::for_profile(profile("mill-3axis"), {});
   agent->set_tools({ToolAsset{5, 2, 100, 8, "drill", kEpochUs}}, kEpochUs);
-  agent->set_tools({ToolAsset{5, 2, 100.25, 8, "drill", kEpochUs + 5}, ToolAsset{6, 0, 50, 4, "", kEpochUs + 5}},
-                   kEpochUs + 5);
+  agent->set_tools(
+      {ToolAsset{5, 2, 100.25, 8, "drill", kEpochUs + 5}, ToolAsset{6, 0, 50, 4, "", kEpochUs + 5}},
+      kEpochUs + 5);
   agent->set_tools({ToolAsset{6, 0, 50, 4, "", kEpochUs + 5}}, kEpochUs + 9);
   Xml a(ask(*agent, "/assets").body);
   EXPECT_EQ(a.all("//m:CuttingTool/@assetId"), (std::vector<std::string>{"T6"}));

@@ -5,11 +5,11 @@
 
 #include <fcntl.h>
 #include <mosquitto.h>
+#include <netinet/in.h>
 #include <signal.h>
 #include <spawn.h>
 #include <sys/socket.h>
 #include <sys/wait.h>
-#include <netinet/in.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -58,8 +58,8 @@ class Broker {
  public:
   /// `start`: false leaves the broker down until start() (a machine that starts before its broker).
   explicit Broker(bool start_now = true) : port_(free_port()) {
-    conf_ = std::filesystem::temp_directory_path() / ("opencnc-mosquitto-" + std::to_string(::getpid()) + "-" +
-                                                      std::to_string(port_) + ".conf");
+    conf_ = std::filesystem::temp_directory_path() /
+            ("opencnc-mosquitto-" + std::to_string(::getpid()) + "-" + std::to_string(port_) + ".conf");
     std::ofstream(conf_) << "listener " << port_ << " 127.0.0.1\nallow_anonymous true\npersistence false\n"
                          << (::getuid() == 0 ? "user root\n" : "");
     if (start_now) start();
@@ -139,7 +139,8 @@ class Subscriber {
  private:
   void take(const mosquitto_message* msg) {
     const std::string topic = msg->topic;
-    const std::string payload(static_cast<const char*>(msg->payload), static_cast<std::size_t>(msg->payloadlen));
+    const std::string payload(static_cast<const char*>(msg->payload),
+                              static_cast<std::size_t>(msg->payloadlen));
     const auto a = topic.find('/'), b = topic.find('/', a + 1);
     if (a == std::string::npos || b == std::string::npos) return;
     const std::string kind = topic.substr(a + 1, b - a - 1), uuid = topic.substr(b + 1);

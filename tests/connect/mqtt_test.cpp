@@ -46,8 +46,8 @@ bool eventually(F done, std::chrono::milliseconds limit = 10s) {
 }
 
 /// Sequences in [from, to) missing from `seen`, and those seen more than once.
-std::pair<std::uint64_t, std::uint64_t> missing_and_twice(const std::multiset<std::uint64_t>& seen, std::uint64_t from,
-                                                          std::uint64_t to) {
+std::pair<std::uint64_t, std::uint64_t> missing_and_twice(const std::multiset<std::uint64_t>& seen,
+                                                          std::uint64_t from, std::uint64_t to) {
   std::uint64_t missing = 0, twice = 0;
   for (std::uint64_t s = from; s < to; ++s) {
     const auto n = seen.count(s);
@@ -94,13 +94,15 @@ TEST(Mqtt, EverySequenceArrivesOnceWithTheDeviceAndItsStateRetained) {
   for (int m = 0; m < 3; ++m) {
     const std::string uuid = agents[static_cast<std::size_t>(m)]->model().uuid();
     const std::uint64_t next = agents[static_cast<std::size_t>(m)]->next_sequence();
-    ASSERT_TRUE(eventually([&] { return sub.devices()[uuid].sequences.size() >= next - first[static_cast<std::size_t>(m)]; }))
-        << uuid;
+    ASSERT_TRUE(eventually([&] {
+      return sub.devices()[uuid].sequences.size() >= next - first[static_cast<std::size_t>(m)];
+    })) << uuid;
     const auto d = sub.devices()[uuid];
     const auto [missing, twice] = missing_and_twice(d.sequences, first[static_cast<std::size_t>(m)], next);
     EXPECT_EQ(missing, 0u) << uuid;
     EXPECT_EQ(twice, 0u) << uuid;
-    EXPECT_GT(next - first[static_cast<std::size_t>(m)], 900u);  // several items changed in each of 300 samples
+    EXPECT_GT(next - first[static_cast<std::size_t>(m)],
+              900u);  // several items changed in each of 300 samples
     EXPECT_TRUE(d.probe);
     EXPECT_TRUE(d.current);
     ASSERT_FALSE(d.availability.empty());
@@ -113,7 +115,8 @@ TEST(Mqtt, EverySequenceArrivesOnceWithTheDeviceAndItsStateRetained) {
   Subscriber late(broker.port());
   EXPECT_TRUE(eventually([&] {
     auto d = late.devices();
-    return d.size() == 3 && std::all_of(d.begin(), d.end(), [](const auto& kv) { return kv.second.probe && kv.second.current; });
+    return d.size() == 3 && std::all_of(d.begin(), d.end(),
+                                        [](const auto& kv) { return kv.second.probe && kv.second.current; });
   }));
 }
 
@@ -139,7 +142,8 @@ TEST(Mqtt, AMachineReconnectsAfterTheBrokerRestartsAndLosesNothingPublishedAfter
   // What the broker acknowledged reached the subscriber, once (a kill loses what it had not yet
   // passed on: the broker keeps no persistence here, as a restarted one without it would not).
   const std::uint64_t before_kill = agent->next_sequence();
-  ASSERT_TRUE(eventually([&] { return sub->devices()[agent->model().uuid()].sequences.size() >= before_kill - first; }));
+  ASSERT_TRUE(eventually(
+      [&] { return sub->devices()[agent->model().uuid()].sequences.size() >= before_kill - first; }));
   broker.kill();
   const std::uint64_t at_kill = agent->next_sequence();
   run(150);  // queued while the broker is away
@@ -208,10 +212,12 @@ TEST(Mqtt, AKilledMachineIsUnavailableWithinItsKeepAlive) {
   Subscriber sub(broker.port());
   ASSERT_TRUE(eventually([&] { return sub.subscribed(); }));
   const std::string exe = (std::filesystem::path(MQTT_MACHINE)).string();
-  const std::string profile = (std::filesystem::path(OPENCNC_SOURCE_DIR) / "configs/mill-3axis.toml").string();
+  const std::string profile =
+      (std::filesystem::path(OPENCNC_SOURCE_DIR) / "configs/mill-3axis.toml").string();
   const std::string port = std::to_string(broker.port());
   std::vector<char*> argv{const_cast<char*>(exe.c_str()), const_cast<char*>(profile.c_str()),
-                          const_cast<char*>("mill-k"), const_cast<char*>(port.c_str()), const_cast<char*>("5"), nullptr};
+                          const_cast<char*>("mill-k"),    const_cast<char*>(port.c_str()),
+                          const_cast<char*>("5"),         nullptr};
   pid_t pid = -1;
   ASSERT_EQ(::posix_spawn(&pid, exe.c_str(), nullptr, nullptr, argv.data(), environ), 0);
   struct Reaper {  // the machine never outlives a failed assertion
@@ -236,7 +242,8 @@ TEST(Mqtt, AKilledMachineIsUnavailableWithinItsKeepAlive) {
   const auto seen = sub.devices()[uuid].unavailable_at - killed;
   // The broker gives up on a silent client after 1.5 keep-alives (7.5 s here); it checks each second.
   EXPECT_LE(std::chrono::duration_cast<std::chrono::milliseconds>(seen).count(), 8500);
-  RecordProperty("unavailable_after_ms", static_cast<int>(std::chrono::duration_cast<std::chrono::milliseconds>(seen).count()));
+  RecordProperty("unavailable_after_ms",
+                 static_cast<int>(std::chrono::duration_cast<std::chrono::milliseconds>(seen).count()));
 }
 
 }  // namespace

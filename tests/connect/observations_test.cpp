@@ -27,7 +27,8 @@ TEST(ObservationBuffer, NumbersObservationsAndForgetsTheOldestWhenFull) {
   EXPECT_EQ(b.first_sequence(), 1u);
   EXPECT_EQ(b.next_sequence(), 1u);
   EXPECT_EQ(b.current()[0].last.value, "UNAVAILABLE");
-  for (int i = 0; i < 5; ++i) EXPECT_EQ(b.add(value(static_cast<std::uint32_t>(i % 2), std::to_string(i))), i + 1u);
+  for (int i = 0; i < 5; ++i)
+    EXPECT_EQ(b.add(value(static_cast<std::uint32_t>(i % 2), std::to_string(i))), i + 1u);
   EXPECT_EQ(b.first_sequence(), 3u);
   EXPECT_EQ(b.last_sequence(), 5u);
   EXPECT_EQ(b.next_sequence(), 6u);

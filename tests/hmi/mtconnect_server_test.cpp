@@ -27,10 +27,11 @@ using namespace std::chrono_literals;
 struct MtcRig {
   /// `synthetic`: the agent samples a status that changes at every sample (a busy machine) instead
   /// of the rig's controller.
-  explicit MtcRig(double write_timeout_s = 10, std::chrono::milliseconds period = 20ms, bool synthetic = false,
-                  std::size_t buffer = 4096) {
+  explicit MtcRig(double write_timeout_s = 10, std::chrono::milliseconds period = 20ms,
+                  bool synthetic = false, std::size_t buffer = 4096) {
     const auto load = config::load_profile(OPENCNC_SOURCE_DIR "/configs/mill-3axis.toml");
-    agent = connect::Agent::for_profile(*load.profile, connect::AgentOptions{"test", "", 1, buffer, 10000, 0});
+    agent =
+        connect::Agent::for_profile(*load.profile, connect::AgentOptions{"test", "", 1, buffer, 10000, 0});
     RigOptions o;
     o.server.mtconnect = agent.get();
     o.server.mtconnect_write_timeout_s = write_timeout_s;
@@ -40,13 +41,14 @@ struct MtcRig {
       status = [i = 0]() mutable {
         controller::ControllerStatus s;
         ++i;
-        for (int a = 0; a < kAxisCount; ++a) s.servo.actual[static_cast<std::size_t>(a)] = 0.001 * i * (a + 1);
+        for (int a = 0; a < kAxisCount; ++a)
+          s.servo.actual[static_cast<std::size_t>(a)] = 0.001 * i * (a + 1);
         s.servo.commanded = s.servo.actual;
         s.servo.path_velocity = i % 1000;
         return s;
       };
-    sampler = std::make_unique<connect::StatusSampler>(*agent, std::move(status), nullptr,
-        connect::SamplerOptions{period, std::chrono::milliseconds(1000)});
+    sampler = std::make_unique<connect::StatusSampler>(
+        *agent, std::move(status), nullptr, connect::SamplerOptions{period, std::chrono::milliseconds(1000)});
     sampler->start();
   }
   ~MtcRig() { sampler->stop(); }

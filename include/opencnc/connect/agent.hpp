@@ -96,7 +96,8 @@ class Agent {
   std::uint64_t first_sequence() const;
   /// Observations from `from` on (the oldest retained when `from` is older: `*first` says where the
   /// answer begins), at most `max`. Any thread.
-  std::vector<Observation> observations(std::uint64_t from, std::size_t max, std::uint64_t* first = nullptr) const;
+  std::vector<Observation> observations(std::uint64_t from, std::size_t max,
+                                        std::uint64_t* first = nullptr) const;
   /// Every item's current observation (each active condition of a condition item, else its last),
   /// in model order: what a new SHDR client or a retained MQTT message starts from. Any thread.
   std::vector<Observation> snapshot() const;

@@ -21,8 +21,8 @@ struct Gap {
 std::string probe_json(const DeviceModel& model, const AgentOptions& options);
 /// `MTConnect/Sample/<uuid>`: a batch of consecutive observations with its sequence range and the
 /// gap before it, if any.
-std::string sample_json(const DeviceModel& model, const AgentOptions& options, std::span<const Observation> batch,
-                        const Gap& gap, std::uint64_t dropped_total);
+std::string sample_json(const DeviceModel& model, const AgentOptions& options,
+                        std::span<const Observation> batch, const Gap& gap, std::uint64_t dropped_total);
 /// `MTConnect/Current/<uuid>`: every item's current observation and the next sequence.
 std::string current_json(const DeviceModel& model, const AgentOptions& options,
                          std::span<const Observation> snapshot, std::uint64_t next_sequence);

@@ -43,13 +43,13 @@ struct MqttOptions {
 
 struct MqttStats {
   bool connected = false;
-  std::uint64_t connects = 0;          ///< successful connections (1 + reconnections)
-  std::uint64_t batches_acked = 0;     ///< batches the broker acknowledged (PUBACK)
+  std::uint64_t connects = 0;       ///< successful connections (1 + reconnections)
+  std::uint64_t batches_acked = 0;  ///< batches the broker acknowledged (PUBACK)
   std::uint64_t observations_acked = 0;
-  std::uint64_t dropped = 0;           ///< observations never published (queue full, buffer turned over)
-  std::uint64_t queued = 0;            ///< observations waiting for the broker now
-  std::uint64_t next_sequence = 0;     ///< the next observation to be queued
-  std::string last_error;              ///< why the last connection failed or was lost ("" = none yet)
+  std::uint64_t dropped = 0;        ///< observations never published (queue full, buffer turned over)
+  std::uint64_t queued = 0;         ///< observations waiting for the broker now
+  std::uint64_t next_sequence = 0;  ///< the next observation to be queued
+  std::string last_error;           ///< why the last connection failed or was lost ("" = none yet)
 };
 
 /// The topics of a device: `<prefix>/<kind>/<uuid>` for kind Probe, Current, Sample, Availability.
@@ -99,7 +99,7 @@ class MqttPublisher {
   std::deque<Batch> pending_;
   std::uint64_t next_ = 0;  ///< the next sequence to read from the agent
   std::uint64_t queued_ = 0, dropped_ = 0;
-  Gap gap_;                 ///< dropped before the next batch to be made
+  Gap gap_;                                 ///< dropped before the next batch to be made
   std::uint64_t current_published_at_ = 0;  ///< the next sequence at the last retained current state
   std::int64_t current_due_ms_ = 0;
   int backoff_ms_ = 0;

@@ -55,9 +55,9 @@ struct ServerStats {
   std::uint64_t stream_ticks = 0;     ///< status snapshots made for the stream so far
   std::uint64_t status_messages = 0;  ///< status messages queued to clients so far
   std::uint64_t http_requests = 0;
-  std::size_t mtconnect_streams = 0;        ///< MTConnect /sample?interval= streams open now
-  std::uint64_t mtconnect_dropped = 0;      ///< streams dropped because their reader stopped
-  std::uint64_t mtconnect_parts = 0;        ///< documents sent on those streams so far
+  std::size_t mtconnect_streams = 0;    ///< MTConnect /sample?interval= streams open now
+  std::uint64_t mtconnect_dropped = 0;  ///< streams dropped because their reader stopped
+  std::uint64_t mtconnect_parts = 0;    ///< documents sent on those streams so far
 };
 
 /// The server. start()/stop() from one thread; the rest from any.
