@@ -61,8 +61,8 @@ std::string xml_id(std::string_view text) {
     const auto u = static_cast<unsigned char>(c);
     id += std::isalnum(u) || c == '_' || c == '-' ? c : '_';
   }
-  if (id.empty() || std::isdigit(static_cast<unsigned char>(id.front())) || id.front() == '-')
-    id.insert(0, "_");
+  // Not id.insert(0, "_"): GCC 12 warns of an overlapping copy inside it (-Wrestrict, a false alarm).
+  if (id.empty() || std::isdigit(static_cast<unsigned char>(id.front())) || id.front() == '-') id = "_" + id;
   return id;
 }
 
