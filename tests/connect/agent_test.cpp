@@ -42,10 +42,18 @@ const fs::path& schema_dir() {
   return dir;
 }
 
+/// The compiled schemas, kept for the process and freed at its end (LeakSanitizer counts them).
+struct Schemas {
+  std::map<std::string, xmlSchemaPtr> byName;
+  ~Schemas() {
+    for (auto& [name, schema] : byName) xmlSchemaFree(schema);
+  }
+};
+
 /// Validates `xml` against the schema `name` ("MTConnectStreams"); "" = valid, else libxml2's words.
 std::string invalid(const std::string& xml, const std::string& name) {
-  static std::map<std::string, xmlSchemaPtr> schemas;
-  auto& schema = schemas[name];
+  static Schemas schemas;
+  auto& schema = schemas.byName[name];
   if (schema == nullptr) {
     const std::string file = (schema_dir() / (name + "_2.7_1.0.xsd")).string();
     xmlSchemaParserCtxtPtr p = xmlSchemaNewParserCtxt(file.c_str());
