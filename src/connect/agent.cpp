@@ -24,6 +24,17 @@ constexpr const char* kAssetsNs = "urn:mtconnect.org:MTConnectAssets:2.7";
 constexpr const char* kErrorNs = "urn:mtconnect.org:MTConnectError:2.7";
 constexpr std::size_t kAssetBufferSize = 1024;
 
+/// Opens a document's Header with the attributes every MTConnect document has; the caller adds its
+/// own (bufferSize, sequences, asset counts) and closes it.
+void start_header(XmlWriter& w, const AgentOptions& options, std::int64_t now_us) {
+  w.start("Header");
+  w.attribute("creationTime", iso_time(now_us));
+  w.attribute("sender", options.sender);
+  w.attribute("instanceId", fmt::format("{}", options.instance_id));
+  w.attribute("version", kVersion);
+  w.attribute("deviceModelChangeTime", iso_time(0));
+}
+
 int hex(char c) {
   if (c >= '0' && c <= '9') return c - '0';
   if (c >= 'a' && c <= 'f') return c - 'a' + 10;
@@ -82,11 +93,6 @@ AgentRequest parse_agent_request(std::string_view target) {
   }
   return r;
 }
-
-struct Agent::Header {
-  std::int64_t now_us = 0;
-  std::uint64_t first = 1, last = 0, next = 1;
-};
 
 Agent::Agent(DeviceModel model, std::vector<std::unique_ptr<Contribution>> contributions,
              AgentOptions options)
@@ -262,12 +268,7 @@ AgentResponse Agent::error(std::string_view code, std::string message, const Age
   XmlWriter w;
   w.start("MTConnectError");
   w.attribute("xmlns", kErrorNs);
-  w.start("Header");
-  w.attribute("creationTime", iso_time(now_us));
-  w.attribute("sender", options_.sender);
-  w.attribute("instanceId", fmt::format("{}", options_.instance_id));
-  w.attribute("version", kVersion);
-  w.attribute("deviceModelChangeTime", iso_time(0));
+  start_header(w, options_, now_us);
   w.attribute("bufferSize", fmt::format("{}", options_.buffer_size));
   w.end();
   w.start("Errors");
@@ -327,12 +328,7 @@ AgentResponse Agent::probe(const AgentRequest&, std::int64_t now_us) const {
   XmlWriter w;
   w.start("MTConnectDevices");
   w.attribute("xmlns", kDevicesNs);
-  w.start("Header");
-  w.attribute("creationTime", iso_time(now_us));
-  w.attribute("sender", options_.sender);
-  w.attribute("instanceId", fmt::format("{}", options_.instance_id));
-  w.attribute("version", kVersion);
-  w.attribute("deviceModelChangeTime", iso_time(0));
+  start_header(w, options_, now_us);
   w.attribute("bufferSize", fmt::format("{}", options_.buffer_size));
   w.attribute("assetBufferSize", fmt::format("{}", kAssetBufferSize));
   {
@@ -395,12 +391,7 @@ std::string streams_document(const DeviceModel& model, const AgentOptions& optio
   XmlWriter w;
   w.start("MTConnectStreams");
   w.attribute("xmlns", kStreamsNs);
-  w.start("Header");
-  w.attribute("creationTime", iso_time(now_us));
-  w.attribute("sender", options.sender);
-  w.attribute("instanceId", fmt::format("{}", options.instance_id));
-  w.attribute("version", kVersion);
-  w.attribute("deviceModelChangeTime", iso_time(0));
+  start_header(w, options, now_us);
   w.attribute("bufferSize", fmt::format("{}", options.buffer_size));
   w.attribute("firstSequence", fmt::format("{}", first));
   w.attribute("lastSequence", fmt::format("{}", last));
@@ -568,12 +559,7 @@ AgentResponse Agent::assets(const AgentRequest& request, std::int64_t now_us) co
   XmlWriter w;
   w.start("MTConnectAssets");
   w.attribute("xmlns", kAssetsNs);
-  w.start("Header");
-  w.attribute("creationTime", iso_time(now_us));
-  w.attribute("sender", options_.sender);
-  w.attribute("instanceId", fmt::format("{}", options_.instance_id));
-  w.attribute("version", kVersion);
-  w.attribute("deviceModelChangeTime", iso_time(0));
+  start_header(w, options_, now_us);
   w.attribute("assetBufferSize", fmt::format("{}", kAssetBufferSize));
   w.attribute("assetCount", fmt::format("{}", tools_.size()));
   w.end();

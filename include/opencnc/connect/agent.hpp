@@ -106,7 +106,6 @@ class Agent {
   const DeviceModel& model() const noexcept { return model_; }
 
  private:
-  struct Header;
   AgentResponse probe(const AgentRequest& request, std::int64_t now_us) const;
   AgentResponse current(const AgentRequest& request, std::int64_t now_us) const;
   AgentResponse assets(const AgentRequest& request, std::int64_t now_us) const;
