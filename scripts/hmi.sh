@@ -13,8 +13,9 @@ usage: scripts/hmi.sh [--test] [--e2e [--opencnc PATH]]
   --test       also its unit tests (vitest)
   --e2e        also the end-to-end test: build/opencnc serve on the simulated mill, driven in
                Debian's headless Chromium (/usr/bin/chromium) by playwright-core: home, open the
-               bracket program, run it with hold and resume, find it in the history; screenshots
-               in web/e2e/artifacts (build build/opencnc first)
+               bracket program, run it with hold and resume, find it in the history; then the
+               fleet view (opencnc fleet) with two mills publishing to a mosquitto broker, one of
+               them killed; screenshots in web/e2e/artifacts (build build/opencnc first)
   --opencnc PATH  the opencnc the end-to-end test serves with (default build/opencnc; CI uses the
                sanitized build-asan/opencnc)
   -h, --help   this text
@@ -54,4 +55,5 @@ if ((e2e)); then
     exit 2
   fi
   node e2e/run.mjs --opencnc "$opencnc"
+  node e2e/fleet.mjs --opencnc "$opencnc"
 fi

@@ -14,10 +14,12 @@
 #include <thread>
 
 #include "commands.hpp"
+#include "listen_address.hpp"
 #include "numeric_options.hpp"
 #include "opencnc/config/profile_loader.hpp"
 #include "opencnc/connect/agent.hpp"
 #include "opencnc/connect/mqtt_publisher.hpp"
+#include "opencnc/connect/shdr_adapter.hpp"
 #include "opencnc/connect/status_sampler.hpp"
 #include "opencnc/controller/gcode_source.hpp"
 #include "opencnc/hmi/history.hpp"
@@ -49,6 +51,8 @@ struct ServeOptions {
   double mtconnect_hz = 10;  ///< status samples per second into the MTConnect agent
   std::string mqtt;          ///< mqtt://HOST:PORT ("" = no MQTT)
   int mqtt_keepalive_s = 5;
+  std::string shdr;     ///< ADDRESS:PORT of the SHDR adapter's listener ("" = none)
+  std::string hmi_url;  ///< how the fleet view links to this HMI ("" = from --listen)
 };
 
 /// `$XDG_STATE_HOME/opencnc`, else `~/.local/state/opencnc`.
@@ -56,30 +60,6 @@ fs::path default_data_dir() {
   if (const char* x = std::getenv("XDG_STATE_HOME"); x && *x) return fs::path(x) / "opencnc";
   const char* home = std::getenv("HOME");
   return fs::path(home && *home ? home : ".") / ".local" / "state" / "opencnc";
-}
-
-/// The built front end beside the executable: <build>/../web/dist.
-fs::path default_static_dir() {
-  std::error_code ec;
-  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  return ec ? fs::path{} : exe.parent_path().parent_path() / "web" / "dist";
-}
-
-bool split_listen(const std::string& listen, std::string& address, std::uint16_t& port) {
-  const std::size_t colon = listen.rfind(':');
-  if (colon == std::string::npos || colon == 0) return false;
-  address = listen.substr(0, colon);
-  if (address.size() > 2 && address.front() == '[' && address.back() == ']')
-    address = address.substr(1, address.size() - 2);
-  try {
-    std::size_t used = 0;
-    const int p = std::stoi(listen.substr(colon + 1), &used);
-    if (used != listen.size() - colon - 1 || p < 0 || p > 65535) return false;
-    port = static_cast<std::uint16_t>(p);
-  } catch (const std::exception&) {
-    return false;
-  }
-  return true;
 }
 
 /// Puts the machine in Auto and opens `program`, waiting for the answers.
@@ -111,6 +91,12 @@ int serve(const ServeOptions& o) {
   if (!split_listen(o.listen, address, port)) {
     fmt::print(stderr, "error: --listen: expected ADDRESS:PORT (127.0.0.1:8080, [::1]:8080), not \"{}\"\n",
                o.listen);
+    return kExitUsage;
+  }
+  std::string shdr_address;
+  std::uint16_t shdr_port = 0;
+  if (!o.shdr.empty() && !split_listen(o.shdr, shdr_address, shdr_port)) {
+    fmt::print(stderr, "error: --shdr: expected ADDRESS:PORT (127.0.0.1:7878), not \"{}\"\n", o.shdr);
     return kExitUsage;
   }
   std::optional<connect::MqttAddress> broker;
@@ -194,14 +180,6 @@ int serve(const ServeOptions& o) {
       connect::SamplerOptions{std::chrono::milliseconds(static_cast<int>(1000.0 / o.mtconnect_hz)),
                               std::chrono::seconds(2)});
   sampler.start();
-  std::unique_ptr<connect::MqttPublisher> mqtt;
-  if (broker) {
-    connect::MqttOptions mo;
-    mo.broker = *broker;
-    mo.keepalive_s = o.mqtt_keepalive_s;
-    mqtt = std::make_unique<connect::MqttPublisher>(*agent, mo);
-    mqtt->start();
-  }
 
   hmi::ServerConfig sc;
   sc.mtconnect = agent.get();
@@ -224,10 +202,35 @@ int serve(const ServeOptions& o) {
     fmt::print(stderr, "error: {}\n", error);
     return kExitUsage;
   }
-  if (!o.program.empty() && !open_program(host.controller(), o.program)) return kExitProgram;
-
   const std::string host_part =
       address.find(':') != std::string::npos ? fmt::format("[{}]", address) : address;
+  std::unique_ptr<connect::MqttPublisher> mqtt;
+  if (broker) {
+    connect::MqttOptions mo;
+    mo.broker = *broker;
+    mo.keepalive_s = o.mqtt_keepalive_s;
+    mo.hmi_url = !o.hmi_url.empty() ? o.hmi_url
+                 : address == "0.0.0.0" || address == "::"
+                     ? fmt::format("http://{}:{}/", ao.sender, server.port())  // a wildcard: the host's name
+                     : fmt::format("http://{}:{}/", host_part, server.port());
+    mqtt = std::make_unique<connect::MqttPublisher>(*agent, mo);
+    mqtt->start();
+  }
+  std::unique_ptr<connect::ShdrAdapter> shdr;
+  if (!o.shdr.empty()) {
+    connect::ShdrOptions so;
+    so.host = shdr_address;
+    so.port = shdr_port;
+    shdr = std::make_unique<connect::ShdrAdapter>(*agent, so);
+    try {
+      shdr->start();
+    } catch (const std::system_error& e) {
+      fmt::print(stderr, "error: --shdr: {}\n", e.what());
+      return kExitUsage;
+    }
+  }
+  if (!o.program.empty() && !open_program(host.controller(), o.program)) return kExitProgram;
+
   fmt::print("opencnc serve: {} on the simulated machine ({})\n", profile.name,
              o.speed == 0 ? "real time" : fmt::format("virtual time at {}x", o.speed));
   fmt::print("  open      http://{}:{}/#token={}\n", host_part, server.port(), tokens->operator_token());
@@ -239,6 +242,9 @@ int serve(const ServeOptions& o) {
   if (broker)
     fmt::print("  mqtt      {}:{} topics {}/…/{}\n", broker->host, broker->port, "MTConnect",
                agent->model().uuid());
+  if (shdr)
+    fmt::print("  shdr      {}:{} (an MTConnect agent's adapter; device {})\n", shdr_address, shdr->port(),
+               agent->model().uuid());
   fmt::print("  features  {}\n  Ctrl-C stops.\n", fmt::join(features->names(), ", "));
   std::fflush(stdout);
 
@@ -249,6 +255,10 @@ int serve(const ServeOptions& o) {
   server.stop();
   sampler.stop();  // the machine UNAVAILABLE, then published as such
   if (mqtt) mqtt->stop(2000);
+  if (shdr) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));  // the UNAVAILABLE lines leave first
+    shdr->stop();
+  }
   host.controller().submit(controller::Request::simple(control::CommandKind::FeedHold));
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   host.controller().submit(controller::Request::simple(control::CommandKind::Abort));
@@ -308,6 +318,14 @@ void add_serve_command(CLI::App& app, Registry& registry) {
                   "Seconds between keep-alives; the broker marks the machine unavailable after 1.5 of them "
                   "without a word (default 5)")
       ->check(CLI::Range(5, 65535));
+  cmd->add_option(
+      "--hmi-url", opts->hmi_url,
+      "How the fleet view links to this machine's HMI (default: http://ADDRESS:PORT/ of --listen, "
+      "the host's name for 0.0.0.0 or ::)");
+  cmd->add_option(
+      "--shdr", opts->shdr,
+      "Serve the machine's observations as an SHDR adapter on ADDRESS:PORT (127.0.0.1:7878), for a "
+      "site's own MTConnect agent (docs/connectivity.md)");
   cmd->callback([opts, &registry] { registry.set_result(serve(*opts)); });
 }
 

@@ -18,6 +18,7 @@ void register_all(CLI::App& app, Registry& registry) {
   add_tools_command(app, registry);
   add_nearest_command(app, registry);
   add_serve_command(app, registry);
+  add_fleet_command(app, registry);
   add_helix_command(app, registry);
   add_recover_command(app, registry);
 }

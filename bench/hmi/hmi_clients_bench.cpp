@@ -1,12 +1,14 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // hmi_clients_bench: the simulated mill with a real-time servo thread runs the bracket program
 // over and over while N WebSocket clients read the status stream (and S more connect and never
-// read); prints the servo's overruns and wake-up latency, what the clients received, and who was
-// dropped; and where the servo's lost periods went (stolen by the hypervisor, waiting for its CPU,
-// preempted). Run it with --clients 0 for the baseline of the same machine.
+// read), and M MTConnect `/sample?interval=` streams (and T more that never read); prints the
+// servo's overruns and wake-up latency, what the clients received, and who was dropped; and where
+// the servo's lost periods went (stolen by the hypervisor, waiting for its CPU, preempted). Run it
+// with --clients 0 --mtconnect 0 for the baseline of the same machine.
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include <array>
 #include <boost/asio/connect.hpp>
 #include <boost/asio/ip/tcp.hpp>
 #include <boost/beast/core.hpp>
@@ -19,6 +21,8 @@
 #include <vector>
 
 #include "opencnc/config/profile_loader.hpp"
+#include "opencnc/connect/agent.hpp"
+#include "opencnc/connect/status_sampler.hpp"
 #include "opencnc/controller/gcode_source.hpp"
 #include "opencnc/features/features.hpp"
 #include "opencnc/hmi/machine_host.hpp"
@@ -35,6 +39,43 @@ using tcp = net::ip::tcp;
 using namespace opencnc;
 
 const std::string kToken = "bench-operator-token-0123456789";
+
+/// One MTConnect stream: `GET /sample?interval=…`, then reads the multipart answer as it comes
+/// (or, stalled, never reads a byte of it).
+struct MtcStream : std::enable_shared_from_this<MtcStream> {
+  MtcStream(net::io_context& ioc, bool stalled) : socket(ioc), stalled(stalled) {}
+  void start(std::uint16_t port, int interval_ms) {
+    socket.open(tcp::v4());
+    if (stalled) socket.set_option(net::socket_base::receive_buffer_size(4096));
+    request = "GET /sample?interval=" + std::to_string(interval_ms) +
+              "&heartbeat=1000 HTTP/1.1\r\nHost: 127.0.0.1\r\nAuthorization: Bearer " + kToken + "\r\n\r\n";
+    socket.async_connect(tcp::endpoint(net::ip::make_address("127.0.0.1"), port), [self = shared_from_this()](
+                                                                                      beast::error_code ec) {
+      if (ec) return;
+      net::async_write(self->socket, net::buffer(self->request), [self](beast::error_code e, std::size_t) {
+        self->connected = !e;
+        if (!e && !self->stalled) self->read();
+      });
+    });
+  }
+  void read() {
+    socket.async_read_some(net::buffer(chunk),
+                           [self = shared_from_this()](beast::error_code ec, std::size_t n) {
+                             if (ec) {
+                               self->closed = true;
+                               return;
+                             }
+                             self->bytes += n;
+                             self->read();
+                           });
+  }
+  tcp::socket socket;
+  bool stalled;
+  std::string request;
+  std::array<char, 65536> chunk{};
+  bool connected = false, closed = false;
+  std::uint64_t bytes = 0;
+};
 
 /// One client: connects, then reads every message (or, stalled, never reads one).
 struct Client : std::enable_shared_from_this<Client> {
@@ -131,7 +172,9 @@ void print_accounting(const bench::ServoAccounting& a, const std::vector<control
 int usage() {
   std::fprintf(
       stderr,
-      "usage: hmi_clients_bench [--clients N (100)] [--stalled S (5)] [--seconds T (30)] [--hz R (30)] [--servo-cpu N]\n"
+      "usage: hmi_clients_bench [--clients N (100)] [--stalled S (5)] [--seconds T (30)] [--hz R (30)] "
+      "[--servo-cpu N]\n"
+      "                         [--mtconnect M (0)] [--mtconnect-stalled T (0)] [--interval MS (100)]\n"
       "                         [--overruns] (list each overrun with what was seen around it)\n");
   return 2;
 }
@@ -139,7 +182,7 @@ int usage() {
 }  // namespace
 
 int main(int argc, char** argv) {
-  int clients = 100, stalled = 5;
+  int clients = 100, stalled = 5, mtconnect = 0, mtconnect_stalled = 0, interval_ms = 100;
   double seconds = 30, hz = 30;
   int servo_cpu = -1;
   bool list_overruns = false;
@@ -159,6 +202,12 @@ int main(int argc, char** argv) {
       seconds = std::atof(argv[++i]);
     else if (a == "--hz")
       hz = std::atof(argv[++i]);
+    else if (a == "--mtconnect")
+      mtconnect = std::atoi(argv[++i]);
+    else if (a == "--mtconnect-stalled")
+      mtconnect_stalled = std::atoi(argv[++i]);
+    else if (a == "--interval")
+      interval_ms = std::atoi(argv[++i]);
     else if (a == "--servo-cpu")
       servo_cpu = std::atoi(argv[++i]);
     else
@@ -174,7 +223,15 @@ int main(int argc, char** argv) {
   std::vector<std::string> warnings;
   host.start(&warnings);
   for (const auto& w : warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+  // The MTConnect agent, sampled at 10 Hz as `opencnc serve` does.
+  const auto agent = connect::Agent::for_profile(*load.profile, connect::AgentOptions{});
+  connect::StatusSampler sampler(
+      *agent, [&host] { return host.controller().status(); },
+      [] { return std::vector<connect::ToolAsset>{}; },
+      connect::SamplerOptions{std::chrono::milliseconds(100), std::chrono::seconds(2)});
+  sampler.start();
   hmi::ServerConfig sc;
+  sc.mtconnect = agent.get();
   sc.port = 0;
   sc.stream_hz = hz;
   sc.programs_dir = OPENCNC_SOURCE_DIR "/examples";
@@ -195,6 +252,11 @@ int main(int argc, char** argv) {
   for (int k = 0; k < clients + stalled; ++k) {
     all.push_back(std::make_shared<Client>(ioc, k >= clients));
     all.back()->start(server.port(), k >= clients ? 4096 : 0);
+  }
+  std::vector<std::shared_ptr<MtcStream>> streams;
+  for (int k = 0; k < mtconnect + mtconnect_stalled; ++k) {
+    streams.push_back(std::make_shared<MtcStream>(ioc, k >= mtconnect));
+    streams.back()->start(server.port(), interval_ms);
   }
   std::thread io([&ioc] {
     auto guard = net::make_work_guard(ioc);
@@ -231,6 +293,7 @@ int main(int argc, char** argv) {
   ioc.stop();
   io.join();
   server.stop();
+  sampler.stop();
   host.stop();
 
   std::uint64_t min_msgs = UINT64_MAX, max_msgs = 0, sum = 0, bytes = 0;
@@ -262,6 +325,22 @@ int main(int argc, char** argv) {
   std::printf("programs finished: %llu, the last at %.0f %% (line %u)%s%s; process CPU %.2f s (%.0f %% of one core)\n",
               static_cast<unsigned long long>(finished), 100 * last.progress, last.location.line,
               last.fault_text.empty() ? "" : ", fault: ", last.fault_text.c_str(), cpu, 100 * cpu / wall);
+  if (mtconnect + mtconnect_stalled > 0) {
+    std::uint64_t low = UINT64_MAX, high = 0;
+    int open = 0;
+    for (int k = 0; k < mtconnect; ++k) {
+      const MtcStream& s = *streams[static_cast<std::size_t>(k)];
+      low = std::min(low, s.bytes);
+      high = std::max(high, s.bytes);
+      open += s.connected && !s.closed;
+    }
+    std::printf(
+        "mtconnect streams: %d of %d reading to the end, %.1f..%.1f kB each, %llu parts sent; "
+        "%d stalled, %llu dropped by the server\n",
+        open, mtconnect, mtconnect ? static_cast<double>(low) / 1e3 : 0.0, static_cast<double>(high) / 1e3,
+        static_cast<unsigned long long>(stats.mtconnect_parts), mtconnect_stalled,
+        static_cast<unsigned long long>(stats.mtconnect_dropped));
+  }
   print_accounting(accounting, log, ticks, list_overruns);
   return 0;
 }

@@ -137,6 +137,7 @@ void Agent::observe(const controller::ControllerStatus& status, std::int64_t tim
   ValueSink sink(model_.items().size());
   for (const auto& c : contributions_) c->observe(status, sink);
   std::lock_guard lock(mutex_);
+  progress_ = status.progress;
   if (!observed_) {
     observed_ = true;
     add(availability_, Level::Unavailable, {}, "AVAILABLE", time_us);
@@ -210,6 +211,11 @@ std::uint64_t Agent::next_sequence() const {
   return buffer_.next_sequence();
 }
 
+double Agent::progress() const {
+  std::lock_guard lock(mutex_);
+  return progress_;
+}
+
 std::uint64_t Agent::first_sequence() const {
   std::lock_guard lock(mutex_);
   return buffer_.first_sequence();
@@ -226,8 +232,9 @@ std::vector<Observation> Agent::observations(std::uint64_t from, std::size_t max
   return out;
 }
 
-std::vector<Observation> Agent::snapshot() const {
+std::vector<Observation> Agent::snapshot(std::uint64_t* next) const {
   std::lock_guard lock(mutex_);
+  if (next != nullptr) *next = buffer_.next_sequence();
   std::vector<Observation> out;
   for (const auto& s : buffer_.current()) {
     if (!s.active.empty())

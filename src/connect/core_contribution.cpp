@@ -5,6 +5,8 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
+
 namespace opencnc::connect {
 
 namespace {
@@ -93,7 +95,9 @@ void CoreContribution::describe(DeviceModel& model) {
     const std::string p = lower(l);
     AxisItems ai;
     ai.axis = static_cast<int>(a.axis);
+    ai.joint = a.joint;
     ai.rotary = a.rotary;
+    ai.peak_effort = a.sim.peak_effort;
     const int c = model.add_component(axes, a.rotary ? "Rotary" : "Linear", p, std::string(1, l));
     const std::string type = a.rotary ? "ANGLE" : "POSITION";
     const std::string element = a.rotary ? "Angle" : "Position";
@@ -144,7 +148,13 @@ void CoreContribution::observe(const controller::ControllerStatus& s, ValueSink&
     const int decimals = a.rotary ? kDeg : kMm;
     out.set(a.actual, v.actual[i], decimals);
     out.set(a.commanded, v.commanded[i], decimals);
-    out.set(a.load, "UNAVAILABLE");  // MachineIO carries no drive load yet
+    // LOAD: the drive's effort as a share of its peak, where the drive reports it (the simulated
+    // machine's do; the HAL machine has no pin for it yet).
+    const auto& joint = v.joints[static_cast<std::size_t>(a.joint)];
+    if (joint.effort_valid && a.peak_effort > 0)
+      out.set(a.load, 100.0 * std::abs(joint.effort) / a.peak_effort, 1);
+    else
+      out.set(a.load, "UNAVAILABLE");
   }
   if (spindle_) {
     out.set(spindle_->speed, v.spindle_rpm_actual, 1);

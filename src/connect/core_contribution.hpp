@@ -18,8 +18,9 @@ class CoreContribution final : public Contribution {
 
  private:
   struct AxisItems {
-    int axis = 0;
+    int axis = 0, joint = 0;
     bool rotary = false;
+    double peak_effort = 0;  ///< the drive's peak force or torque: LOAD's 100 %
     std::size_t actual = 0, commanded = 0, load = 0, travel = 0, actuator = 0;
   };
   struct SpindleItems {

@@ -50,7 +50,7 @@ json header(const DeviceModel& model, const AgentOptions& options) {
 
 }  // namespace
 
-std::string probe_json(const DeviceModel& model, const AgentOptions& options) {
+std::string probe_json(const DeviceModel& model, const AgentOptions& options, std::string_view hmi_url) {
   json j = header(model, options);
   json components = json::array();
   for (const auto& c : model.components()) {
@@ -70,6 +70,7 @@ std::string probe_json(const DeviceModel& model, const AgentOptions& options) {
     items.push_back(std::move(e));
   }
   j["description"] = model.description();
+  if (!hmi_url.empty()) j["hmi"] = hmi_url;
   j["components"] = std::move(components);
   j["dataItems"] = std::move(items);
   return j.dump();
@@ -89,9 +90,11 @@ std::string sample_json(const DeviceModel& model, const AgentOptions& options,
 }
 
 std::string current_json(const DeviceModel& model, const AgentOptions& options,
-                         std::span<const Observation> snapshot, std::uint64_t next_sequence) {
+                         std::span<const Observation> snapshot, std::uint64_t next_sequence,
+                         double progress) {
   json j = header(model, options);
   j["nextSequence"] = next_sequence;
+  j["progress"] = progress;
   json list = json::array();
   for (const auto& o : snapshot) list.push_back(observation(model, o));
   j["observations"] = std::move(list);

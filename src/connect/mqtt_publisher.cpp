@@ -283,7 +283,8 @@ void MqttPublisher::publish_current(bool force) {
   const std::int64_t now = now_ms();
   const std::uint64_t next = agent_.next_sequence();
   if (!force && (now < current_due_ms_ || next == current_published_at_)) return;
-  const std::string payload = current_json(agent_.model(), agent_.options(), agent_.snapshot(), next);
+  const std::string payload =
+      current_json(agent_.model(), agent_.options(), agent_.snapshot(), next, agent_.progress());
   if (mosquitto_publish(client_, nullptr, current_topic_.c_str(), static_cast<int>(payload.size()),
                         payload.data(), 1, true) == MOSQ_ERR_SUCCESS) {
     current_published_at_ = next;
@@ -310,7 +311,7 @@ void MqttPublisher::run() {
     if (client_ != nullptr && connected_) {
       if (just_connected_) {
         just_connected_ = false;
-        const std::string probe = probe_json(agent_.model(), agent_.options());
+        const std::string probe = probe_json(agent_.model(), agent_.options(), options_.hmi_url);
         mosquitto_publish(client_, nullptr, probe_topic_.c_str(), static_cast<int>(probe.size()),
                           probe.data(), 1, true);
         const char* word = "AVAILABLE";

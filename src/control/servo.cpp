@@ -411,6 +411,8 @@ void Servo::fill_status(ServoStatus& s) const noexcept {
     js.actual = position_[uj] + offset_[uj];
     js.following_error = following_error_[uj];
     js.velocity = joint_velocity_[uj];
+    js.effort_valid = caps_.joints[uj].effort;
+    js.effort = js.effort_valid ? ji.effort : 0.0;
     js.homed = homed_[uj];
     js.homing = (homing_active_ | homing_pending_) & (1u << j);
     js.limit_neg = ji.limit_neg;

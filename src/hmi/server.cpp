@@ -8,7 +8,6 @@
 #include <chrono>
 #include <fstream>
 #include <mutex>
-#include <sstream>
 #include <thread>
 #include <vector>
 
@@ -28,6 +27,7 @@
 #include "opencnc/hmi/history.hpp"
 #include "opencnc/hmi/machine_features.hpp"
 #include "opencnc/hmi/preview.hpp"
+#include "opencnc/hmi/static_files.hpp"
 #include "opencnc/hmi/stream_tickets.hpp"
 #include "opencnc/tools/tool_table_service.hpp"
 
@@ -118,18 +118,6 @@ HttpResponse error_response(const HttpRequest& req, int status, std::string mess
   HttpResponse res = json_response(req, status, {{"error", std::move(message)}});
   if (status == 401) res.set(http::field::www_authenticate, "Bearer");
   return res;
-}
-
-std::string_view mime_type(const std::filesystem::path& p) {
-  const std::string e = p.extension().string();
-  if (e == ".html") return "text/html; charset=utf-8";
-  if (e == ".js") return "text/javascript";
-  if (e == ".css") return "text/css";
-  if (e == ".svg") return "image/svg+xml";
-  if (e == ".png") return "image/png";
-  if (e == ".json" || e == ".map") return "application/json";
-  if (e == ".ico") return "image/x-icon";
-  return "application/octet-stream";
 }
 
 int query_int(const Target& t, const char* name, int fallback, int lo, int hi) {
@@ -1079,17 +1067,10 @@ void Server::Impl::mtconnect_sample(const std::shared_ptr<HttpSession>& s, const
 HttpResponse Server::Impl::static_file(const HttpRequest& req, const Target& t, Role) {
   if (config.static_dir.empty())
     return error_response(req, 404, "no front end is served (build it: scripts/hmi.sh)");
-  std::string rel = t.path == "/" ? "index.html" : t.path.substr(1);
-  const std::filesystem::path p(rel);
-  for (const auto& part : p) {
-    if (part == ".." || part.string().starts_with(".")) return error_response(req, 404, "no such file");
-  }
-  std::ifstream in(config.static_dir / p, std::ios::binary);
-  if (!in) return error_response(req, 404, fmt::format("no such file: {}", t.path));
-  std::ostringstream body;
-  body << in.rdbuf();
-  HttpResponse res = respond(req, http::status::ok, body.str(), mime_type(p));
-  if (t.path.starts_with("/assets/")) res.set(http::field::cache_control, "max-age=31536000, immutable");
+  std::optional<StaticFile> file = read_static_file(config.static_dir, t.path);
+  if (!file) return error_response(req, 404, fmt::format("no such file: {}", t.path));
+  HttpResponse res = respond(req, http::status::ok, std::move(file->body), file->type);
+  if (file->immutable) res.set(http::field::cache_control, "max-age=31536000, immutable");
   return res;
 }
 

@@ -256,6 +256,17 @@ TEST(Agent, AMachineThatRunsShowsItsPositionsStateAndProgramValues) {
     const double x = std::stod(v);
     return x > 0.5 && x < 12;
   }));
+  // X's drive pushed its table: its load rose above rest, never past the drive's peak (100 %).
+  Xml loads(ask(*agent, "/sample?count=10000&path=//Linear[@name=\"X\"]//DataItem[@type=\"LOAD\"]").body);
+  const auto ls = loads.all("//m:Load");
+  ASSERT_GT(ls.size(), 2u);
+  double peak = 0;
+  for (const std::string& v : ls)
+    if (v != "UNAVAILABLE") peak = std::max(peak, std::stod(v));
+  EXPECT_GT(peak, 1.0);
+  EXPECT_LE(peak, 100.0);
+  EXPECT_NE(c.one("//m:Load[@dataItemId='x_load']"), "UNAVAILABLE");
+  EXPECT_EQ(c.one("//m:Load[@dataItemId='s_load']"), "UNAVAILABLE");  // no spindle torque in the inputs
 }
 
 TEST(Agent, SampleWalksEverySequenceOnceInOrderAndRefusesWhatTheBufferForgot) {

@@ -165,6 +165,37 @@ class Subscriber {
   std::map<std::string, Device> devices_;
 };
 
+#ifdef MQTT_MACHINE
+/// A machine publishing in a process of its own (tests/connect/mqtt_machine.cpp), killed with
+/// SIGKILL by kill() or at the latest when this goes: a killed machine closes no connection.
+class MachineProcess {
+ public:
+  /// `profile` below the source folder ("configs/mill-3axis.toml").
+  MachineProcess(const std::string& profile, const std::string& name, int port, int keepalive_s) {
+    const std::string exe = MQTT_MACHINE;
+    const std::string file = (std::filesystem::path(OPENCNC_SOURCE_DIR) / profile).string();
+    const std::string p = std::to_string(port), k = std::to_string(keepalive_s);
+    std::vector<char*> argv{const_cast<char*>(exe.c_str()),  const_cast<char*>(file.c_str()),
+                            const_cast<char*>(name.c_str()), const_cast<char*>(p.c_str()),
+                            const_cast<char*>(k.c_str()),    nullptr};
+    if (::posix_spawn(&pid_, exe.c_str(), nullptr, nullptr, argv.data(), environ) != 0) pid_ = -1;
+  }
+  ~MachineProcess() { kill(); }
+  MachineProcess(const MachineProcess&) = delete;
+  MachineProcess& operator=(const MachineProcess&) = delete;
+  bool running() const { return pid_ > 0; }
+  void kill() {
+    if (pid_ <= 0) return;
+    ::kill(pid_, SIGKILL);
+    ::waitpid(pid_, nullptr, 0);
+    pid_ = -1;
+  }
+
+ private:
+  pid_t pid_ = -1;
+};
+#endif
+
 /// A status that moves a little at each call: X, Y and the feed change, every 50th call the mode.
 inline controller::ControllerStatus moving_status(std::uint64_t i) {
   controller::ControllerStatus s;

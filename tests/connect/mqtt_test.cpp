@@ -216,32 +216,14 @@ TEST(Mqtt, AKilledMachineIsUnavailableWithinItsKeepAlive) {
   Broker broker;
   Subscriber sub(broker.port());
   ASSERT_TRUE(eventually([&] { return sub.subscribed(); }));
-  const std::string exe = (std::filesystem::path(MQTT_MACHINE)).string();
-  const std::string profile =
-      (std::filesystem::path(OPENCNC_SOURCE_DIR) / "configs/mill-3axis.toml").string();
-  const std::string port = std::to_string(broker.port());
-  std::vector<char*> argv{const_cast<char*>(exe.c_str()), const_cast<char*>(profile.c_str()),
-                          const_cast<char*>("mill-k"),    const_cast<char*>(port.c_str()),
-                          const_cast<char*>("5"),         nullptr};
-  pid_t pid = -1;
-  ASSERT_EQ(::posix_spawn(&pid, exe.c_str(), nullptr, nullptr, argv.data(), environ), 0);
-  struct Reaper {  // the machine never outlives a failed assertion
-    pid_t& pid;
-    ~Reaper() {
-      if (pid > 0) {
-        ::kill(pid, SIGKILL);
-        ::waitpid(pid, nullptr, 0);
-      }
-    }
-  } reaper{pid};
+  test::MachineProcess machine_k("configs/mill-3axis.toml", "mill-k", broker.port(), 5);
+  ASSERT_TRUE(machine_k.running());
   const std::string uuid = "opencnc-mill-k";
   ASSERT_TRUE(eventually([&] {
     auto d = sub.devices()[uuid];
     return !d.availability.empty() && d.availability.back() == "AVAILABLE" && d.sequences.size() > 50;
   }));
-  ::kill(pid, SIGKILL);
-  ::waitpid(pid, nullptr, 0);
-  pid = -1;
+  machine_k.kill();
   const auto killed = std::chrono::steady_clock::now();
   ASSERT_TRUE(eventually([&] { return sub.devices()[uuid].availability.back() == "UNAVAILABLE"; }, 12s));
   const auto seen = sub.devices()[uuid].unavailable_at - killed;

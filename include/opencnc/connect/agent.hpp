@@ -99,9 +99,14 @@ class Agent {
   std::vector<Observation> observations(std::uint64_t from, std::size_t max,
                                         std::uint64_t* first = nullptr) const;
   /// Every item's current observation (each active condition of a condition item, else its last),
-  /// in model order: what a new SHDR client or a retained MQTT message starts from. Any thread.
-  std::vector<Observation> snapshot() const;
+  /// in model order: what a new SHDR client or a retained MQTT message starts from; `*next` (if
+  /// given) the next sequence at that instant, read under the same lock, so that a reader going on
+  /// from it misses nothing. Any thread.
+  std::vector<Observation> snapshot(std::uint64_t* next = nullptr) const;
   const AgentOptions& options() const noexcept { return options_; }
+  /// The running program's progress at the last sample (0 … 1 of its path; MTConnect has no data
+  /// item for it, the fleet view's MQTT state carries it). Any thread.
+  double progress() const;
 
   const DeviceModel& model() const noexcept { return model_; }
 
@@ -121,6 +126,7 @@ class Agent {
   ObservationBuffer buffer_;
   std::vector<ToolAsset> tools_;
   bool observed_ = false;
+  double progress_ = 0;
 };
 
 }  // namespace opencnc::connect

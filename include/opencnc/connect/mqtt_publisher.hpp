@@ -39,6 +39,7 @@ struct MqttOptions {
   int poll_ms = 50;                  ///< how often the agent's new observations are read
   int current_every_ms = 1000;       ///< how often the retained current state is refreshed
   int reconnect_min_ms = 250, reconnect_max_ms = 8000;  ///< the back-off doubles from min to max
+  std::string hmi_url;  ///< the machine's own HMI, told to the fleet view in the device message ("" = none)
 };
 
 struct MqttStats {

@@ -60,6 +60,8 @@ struct JointStatus {
   double actual = 0;           ///< feedback in machine coordinates
   double following_error = 0;  ///< reference − feedback, units
   double velocity = 0;         ///< commanded, units/s
+  double effort = 0;           ///< the drive's force N or torque N·m, as it reports it
+  bool effort_valid = false;   ///< the drive reports its effort (MachineCapabilities)
   bool homed = false;
   bool homing = false;
   bool limit_neg = false, limit_pos = false, home_switch = false, amp_fault = false;
