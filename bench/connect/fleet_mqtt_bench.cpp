@@ -111,7 +111,9 @@ int main(int argc, char** argv) {
     return t0 +
            std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::duration<double>(s / speed));
   };
-  connect::test::Subscriber* before = sub.get();
+  // What the first subscriber received, kept when the broker dies (it would reconnect to the new
+  // one and count what the second one receives twice).
+  std::map<std::string, connect::test::Subscriber::Device> devices_before;
   std::unique_ptr<connect::test::Subscriber> after;
   for (std::uint64_t k = 0; k < samples; ++k) {
     const double v = static_cast<double>(k) / hz;
@@ -120,6 +122,8 @@ int main(int argc, char** argv) {
       for (auto& x : fleet) x.at_kill = x.agent->next_sequence();
       broker.kill();
       killed = std::chrono::steady_clock::now();
+      devices_before = sub->devices();
+      sub.reset();
     }
     if (restart && killed != std::chrono::steady_clock::time_point{} &&
         restarted == std::chrono::steady_clock::time_point{} &&
@@ -136,7 +140,7 @@ int main(int argc, char** argv) {
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   for (auto& x : fleet) x.pub->stop(30000);
-  connect::test::Subscriber& last = after ? *after : *before;
+  connect::test::Subscriber& last = after ? *after : *sub;
   // The broker may still be passing the last batches on.
   std::uint64_t expected = 0;
   for (auto& x : fleet) expected += x.agent->next_sequence() - (after ? x.at_restart : x.first);
@@ -151,7 +155,8 @@ int main(int argc, char** argv) {
 
   std::uint64_t published = 0, once = 0, twice = 0, missing = 0, in_gaps = 0, lost_in_broker = 0,
                 lost_after_restart = 0, reported_gap = 0, dropped = 0, not_reconnected = 0;
-  const auto devices_before = before->devices();
+  if (!restart) devices_before = sub->devices();
+  const auto& received_before = devices_before;
   const auto devices_after = after ? after->devices() : decltype(devices_before){};
   for (auto& x : fleet) {
     const std::string& uuid = x.agent->model().uuid();
@@ -160,7 +165,7 @@ int main(int argc, char** argv) {
     if (restart && st.connects < 2) ++not_reconnected;
     std::multiset<std::uint64_t> seen;
     std::vector<nlohmann::json> gaps;
-    for (const auto* devs : {&devices_before, &devices_after}) {
+    for (const auto* devs : {&received_before, &devices_after}) {
       const auto it = devs->find(uuid);
       if (it == devs->end()) continue;
       seen.insert(it->second.sequences.begin(), it->second.sequences.end());

@@ -230,19 +230,36 @@ Gap merge(const Gap& a, const Gap& b) {
 }  // namespace
 
 void MqttPublisher::queue_new_observations() {
-  // With the mutex held: read the agent's new observations into batches.
+  // With the mutex held: read the agent's new observations into batches. New observations join
+  // the last batch while it is unsent and not full: after an outage the backlog leaves in a few
+  // full messages rather than one per poll (a broker queues a bounded number of messages for each
+  // subscriber — mosquitto 1000 by default — and drops the rest).
+  const std::size_t most = std::min(options_.batch_size, options_.queue_limit);  // a batch's size
   while (true) {
+    Batch* open = !pending_.empty() && pending_.back().mid == -1 && gap_.count == 0 &&
+                          pending_.back().count < most
+                      ? &pending_.back()
+                      : nullptr;
     std::uint64_t first = 0;
-    std::vector<Observation> batch = agent_.observations(next_, options_.batch_size, &first);
+    std::vector<Observation> batch = agent_.observations(next_, open ? most - open->count : most, &first);
     if (first > next_) {  // the agent's buffer turned over before we read these
       dropped_ += first - next_;
       gap_ = merge(gap_, Gap{next_, first - 1, first - next_});
+      open = nullptr;  // the gap goes with the next batch
     }
     if (batch.empty()) {
       next_ = std::max(next_, first);
       return;
     }
     next_ = batch.back().sequence + 1;
+    if (open != nullptr) {
+      open->last = batch.back().sequence;
+      open->count += batch.size();
+      queued_ += batch.size();
+      open->observations.insert(open->observations.end(), std::make_move_iterator(batch.begin()),
+                                std::make_move_iterator(batch.end()));
+      continue;
+    }
     Batch b;
     b.first = batch.front().sequence;
     b.last = batch.back().sequence;
