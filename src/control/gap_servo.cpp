@@ -144,9 +144,29 @@ void GapServo::begin_run(const Pose& at) noexcept {
   turns_ = 0;
   orbit_[0] = orbit_[1] = 0;
   shape_ = OrbitKind::None;
+  finishing_ = status_.finishing = false;
+  lateral_v_ = full_turn_ = 0;
+  base_ = EdmCondition{};
+  adaptive_.reset();
 }
 
+// Under a condition with the finishing cycle the burn's end waits: the code is kept until the
+// orbit is full at the path's end and has turned there (run_finish), the interpolator waiting.
 bool GapServo::apply_code(int code, double p) noexcept {
+  if (finishing_ || (status_.on && cond_.orbit_finish && cond_.orbit != OrbitKind::None)) {
+    if (!finishing_) {
+      finishing_ = true;
+      full_turn_ = lateral_v_ = 0;
+    }
+    pending_code_ = code;
+    pending_p_ = p;
+    return code == machine::kEdmOffCode ||
+           (code == machine::kEdmConditionCode && config_.find(static_cast<int>(std::lround(p))) != nullptr);
+  }
+  return select(code, p);
+}
+
+bool GapServo::select(int code, double p) noexcept {
   const EdmCondition* c =
       code == machine::kEdmConditionCode ? config_.find(static_cast<int>(std::lround(p))) : nullptr;
   if (c == nullptr) {
@@ -154,7 +174,8 @@ bool GapServo::apply_code(int code, double p) noexcept {
     status_.condition = 0;
     return code == machine::kEdmOffCode;
   }
-  cond_ = *c;
+  cond_ = base_ = *c;
+  adaptive_.reset();
   status_.on = true;
   status_.condition = c->number;
   turns_ = 0;  // the orbit grows again, a step per turn, from where its radius stands
@@ -184,7 +205,8 @@ Pose GapServo::step(const GapInputs& in) noexcept {
   if (at_head) s_ = memory_.head_s();
   status_.gap_voltage_v = in.gap_voltage_v;
   status_.gap_state = in.gap_state;
-  const bool machining = config_.enabled && status_.on && !in.rapid && !in.hold;
+  // The finishing cycle machines on at the path's end while the head waits in the next block.
+  const bool machining = config_.enabled && status_.on && !in.hold && (finishing_ || !in.rapid);
   // A short is timed while machining; a hold leaves the count where it stands (the gap is still
   // shorted when the program goes on), anything else (a rapid, M181) ends it.
   if (machining && in.gap_state == machine::GapState::Short)
@@ -201,6 +223,8 @@ Pose GapServo::step(const GapInputs& in) noexcept {
     }
     return_offsets();
     status_.generator = false;
+  } else if (finishing_) {
+    run_finish(in, jump_due());
   } else {
     // A jump that is due waits until the servo has braked to rest (no step of velocity).
     const bool due = jump_due();
@@ -210,6 +234,7 @@ Pose GapServo::step(const GapInputs& in) noexcept {
     run_orbit();
     status_.generator = jump_ == Jump::Idle;
     if (status_.generator) machining_s_ += period_s_;
+    adapt(in);
   }
   Pose p = memory_.at(s_);
   p[config_.tool_axis] += config_.lift_direction * lift_;
@@ -228,7 +253,76 @@ Pose GapServo::step(const GapInputs& in) noexcept {
   status_.orbit_radius_mm = radius_;
   status_.orbit_offset[0] = orbit_[0];
   status_.orbit_offset[1] = orbit_[1];
+  status_.finishing = finishing_;
+  status_.servo_reference_v = cond_.servo_reference_v;
+  status_.gain_mm_s_per_v = cond_.gain_mm_s_per_v;
+  status_.jump_period_s = cond_.jump_period_s;
+  status_.jump_height_mm = cond_.jump_height_mm;
   return p;
+}
+
+// The finishing cycle, a period: the path rests at its end (the interpolator waits), the electrode
+// comes back to it along the path after a short; the gap servo's law drives the orbit's radius
+// instead (the lateral servo: out while the gap voltage is above the reference, in below it, in at
+// once on a short), up to the condition's radius. Once a whole turn has burnt at that radius, the
+// code the burn's end brought is applied.
+void GapServo::run_finish(const GapInputs& in, bool due) noexcept {
+  const bool shorted = in.gap_state == machine::GapState::Short;
+  double lateral = 0;
+  if (jump_ == Jump::Idle) {
+    const double v = servo_speed(in, due);
+    if (shorted || s_ < memory_.head_s() - 1e-12) {
+      move_electrode(v, in);
+    } else {
+      v_ = 0;  // at the path's end: the radius takes the law
+    }
+    feed_scale_ = 0;
+    if (!due) {
+      lateral = shorted ? -cond_.max_retract_mm_s
+                        : cond_.gain_mm_s_per_v * (status_.filtered_voltage_v - cond_.servo_reference_v);
+    }
+  }
+  run_jump(due && v_ == 0 && lateral_v_ == 0 && !shorted);
+  feed_scale_ = 0;
+  run_lateral(lateral);
+  status_.generator = jump_ == Jump::Idle;
+  if (status_.generator) machining_s_ += period_s_;
+  adapt(in);
+  if (full_turn_ >= 1) {
+    finishing_ = false;
+    lateral_v_ = 0;
+    select(pending_code_, pending_p_);
+  }
+}
+
+// The orbit's radius at the lateral servo's speed, at most the growth's radial rate and within
+// the tool axis' acceleration, between the centre and the condition's radius; it turns at its
+// period as ever. A shape still spiralling in from another condition goes on doing so first.
+void GapServo::run_lateral(double target) noexcept {
+  if (shape_ != cond_.orbit || cond_.orbit_period_s <= 0) {
+    run_orbit();
+    return;
+  }
+  draw_period_s_ = cond_.orbit_period_s;
+  const double step = cond_.orbit_step_mm > 0 ? cond_.orbit_step_mm : cond_.orbit_radius_mm;
+  draw_rate_ = step / (0.25 * cond_.orbit_period_s);
+  const double dv = accel_ * period_s_;
+  lateral_v_ = std::clamp(std::clamp(target, -draw_rate_, draw_rate_), lateral_v_ - dv, lateral_v_ + dv);
+  turn();
+  const double r = std::clamp(radius_ + lateral_v_ * period_s_, 0.0, cond_.orbit_radius_mm);
+  if (r != radius_ + lateral_v_ * period_s_) lateral_v_ = 0;  // at the centre or the full size
+  radius_ = r;
+  orbit_offset(shape_, phase_, radius_, orbit_);
+  if (radius_ >= cond_.orbit_radius_mm - 1e-9 && jump_ == Jump::Idle) full_turn_ += period_s_ / draw_period_s_;
+}
+
+// Adaptive control: every machining period in which the gap sparks (or shorts) feeds the window;
+// at its end the settings in force move within the condition's bounds (edm_adaptive.hpp).
+void GapServo::adapt(const GapInputs& in) noexcept {
+  if (!cond_.adaptive || !status_.generator || in.gap_state == machine::GapState::Open) return;
+  if (adaptive_.sample(in.gap_state, in.gap_voltage_v, base_, cond_)) ++status_.adaptations;
+  status_.abnormal_share = static_cast<float>(adaptive_.abnormal_share());
+  status_.voltage_spread = static_cast<float>(adaptive_.voltage_spread());
 }
 
 // Behind the head with nothing to machine: forward to it at the larger of the last condition's
