@@ -152,6 +152,7 @@ void read_orbit(Section& t, EdmCondition& c, const MachineProfile& p) {
 // The finishing cycle needs an orbit to finish.
 void read_finish(Section& t, EdmCondition& c) {
   c.orbit_finish = t.boolean_or("orbit_finish", false);
+  c.lateral_servo = t.boolean_or("lateral_servo", false);
   if (c.orbit_finish && c.orbit == machine::OrbitKind::None)
     t.error("orbit_finish", fmt::format("{} needs an orbit (orbit = \"circle\", \"square\" or \"star\")",
                                         t.key_path("orbit_finish")),
@@ -236,6 +237,7 @@ void read_conditions(Section& s, MachineProfile& p) {
                "side_gap_mm",
                "electrode_wear_ratio",
                "orbit_finish",
+               "lateral_servo",
                "adaptive",
                "servo_reference_min_v",
                "servo_reference_max_v",

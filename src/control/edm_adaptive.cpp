@@ -18,6 +18,8 @@ constexpr double kLagging = 0.05;
 /// The voltage's spread above this share of the reference (with the mean near it): the servo
 /// hunts around the reference.
 constexpr double kHunting = 0.08;
+/// … the mean this close to the reference: the spread is the servo's own, not a transient's.
+constexpr double kCentred = 0.02;
 
 /// `x` scaled by `f` within [lo, hi]; lo = hi (or an empty range) keeps it.
 double scaled(double x, double f, double lo, double hi) noexcept {
@@ -42,8 +44,8 @@ void EdmAdaptive::reset() noexcept {
 //   lifts higher (× 1.2), the reference rises by 1 V (a wider gap);
 // - clean (below 0.5 %): the jump comes later (× 1.05) and lifts less (× 0.97), the reference
 //   falls by 0.25 V (a closer gap removes faster);
-// - the gain rises (× 1.1) while the window's mean stays more than 5 % off the reference (the
-//   servo lags) and falls (× 0.9) when the spread is above 8 % with the mean near it (it hunts).
+// - the gain rises (× 1.25) while the window's mean stays more than 5 % off the reference (the
+//   servo lags) and falls (× 0.9) when the spread is above 8 % with the mean within 2 % (it hunts).
 bool EdmAdaptive::sample(machine::GapState state, double voltage_v, const machine::EdmCondition& base,
                          machine::EdmCondition& active) noexcept {
   ++n_;
@@ -70,8 +72,8 @@ bool EdmAdaptive::sample(machine::GapState state, double voltage_v, const machin
         shifted(active.servo_reference_v, -0.25, base.servo_reference_min_v, base.servo_reference_max_v);
   }
   if (std::fabs(mean - ref) > kLagging * ref)
-    active.gain_mm_s_per_v = scaled(active.gain_mm_s_per_v, 1.1, base.gain_min_mm_s_per_v, base.gain_max_mm_s_per_v);
-  else if (spread_ > kHunting)
+    active.gain_mm_s_per_v = scaled(active.gain_mm_s_per_v, 1.25, base.gain_min_mm_s_per_v, base.gain_max_mm_s_per_v);
+  else if (spread_ > kHunting && std::fabs(mean - ref) < kCentred * ref)
     active.gain_mm_s_per_v = scaled(active.gain_mm_s_per_v, 0.9, base.gain_min_mm_s_per_v, base.gain_max_mm_s_per_v);
   n_ = arcs_ = shorts_ = 0;
   sum_ = sum2_ = 0;

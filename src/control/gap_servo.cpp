@@ -141,6 +141,7 @@ void GapServo::begin_run(const Pose& at) noexcept {
   status_.short_s = 0;
   status_.retract_limit = reached_retract_limit_ = pressing_limit_ = false;
   phase_ = radius_ = 0;
+  orbit_rate_ = 1;
   turns_ = 0;
   orbit_[0] = orbit_[1] = 0;
   shape_ = OrbitKind::None;
@@ -157,6 +158,8 @@ bool GapServo::apply_code(int code, double p) noexcept {
     if (!finishing_) {
       finishing_ = true;
       full_turn_ = lateral_v_ = 0;
+      // Where the burn's path ended (the head may already have begun the next block this period).
+      finish_s_ = std::min(s_, memory_.head_s());
     }
     pending_code_ = code;
     pending_p_ = p;
@@ -202,7 +205,7 @@ Pose GapServo::step(const GapInputs& in) noexcept {
   // An electrode at the head goes with it (the interpolator moved at the speed the servo asked).
   const bool at_head = s_ >= memory_.head_s() - 1e-12;
   memory_.advance(in.head, config_.path_spacing_mm, in.new_block);
-  if (at_head) s_ = memory_.head_s();
+  if (at_head && !finishing_) s_ = memory_.head_s();  // finishing: the burn's end, not the head, is its end
   status_.gap_voltage_v = in.gap_voltage_v;
   status_.gap_state = in.gap_state;
   // The finishing cycle machines on at the path's end while the head waits in the next block.
@@ -228,10 +231,11 @@ Pose GapServo::step(const GapInputs& in) noexcept {
   } else {
     // A jump that is due waits until the servo has braked to rest (no step of velocity).
     const bool due = jump_due();
+    law_mm_s_ = 0;
     if (jump_ == Jump::Idle) move_electrode(servo_speed(in, due), in);
     run_jump(due && v_ == 0 && in.gap_state != machine::GapState::Short);
     if (jump_ != Jump::Idle) feed_scale_ = 0;
-    run_orbit();
+    run_orbit(in);
     status_.generator = jump_ == Jump::Idle;
     if (status_.generator) machining_s_ += period_s_;
     adapt(in);
@@ -269,10 +273,12 @@ Pose GapServo::step(const GapInputs& in) noexcept {
 void GapServo::run_finish(const GapInputs& in, bool due) noexcept {
   const bool shorted = in.gap_state == machine::GapState::Short;
   double lateral = 0;
+  law_mm_s_ = 0;
   if (jump_ == Jump::Idle) {
     const double v = servo_speed(in, due);
-    if (shorted || s_ < memory_.head_s() - 1e-12) {
-      move_electrode(v, in);
+    if (shorted || s_ < finish_s_ - 1e-12) {
+      v_ = v;
+      s_ = std::clamp(s_ + v * period_s_, memory_.tail_s(), finish_s_);
     } else {
       v_ = 0;  // at the path's end: the radius takes the law
     }
@@ -284,7 +290,7 @@ void GapServo::run_finish(const GapInputs& in, bool due) noexcept {
   }
   run_jump(due && v_ == 0 && lateral_v_ == 0 && !shorted);
   feed_scale_ = 0;
-  run_lateral(lateral);
+  run_lateral(in, lateral);
   status_.generator = jump_ == Jump::Idle;
   if (status_.generator) machining_s_ += period_s_;
   adapt(in);
@@ -298,22 +304,27 @@ void GapServo::run_finish(const GapInputs& in, bool due) noexcept {
 // The orbit's radius at the lateral servo's speed, at most the growth's radial rate and within
 // the tool axis' acceleration, between the centre and the condition's radius; it turns at its
 // period as ever. A shape still spiralling in from another condition goes on doing so first.
-void GapServo::run_lateral(double target) noexcept {
+void GapServo::run_lateral(const GapInputs& in, double target) noexcept {
   if (shape_ != cond_.orbit || cond_.orbit_period_s <= 0) {
-    run_orbit();
+    run_orbit(in);
     return;
   }
   draw_period_s_ = cond_.orbit_period_s;
   const double step = cond_.orbit_step_mm > 0 ? cond_.orbit_step_mm : cond_.orbit_radius_mm;
   draw_rate_ = step / (0.25 * cond_.orbit_period_s);
   const double dv = accel_ * period_s_;
-  lateral_v_ = std::clamp(std::clamp(target, -draw_rate_, draw_rate_), lateral_v_ - dv, lateral_v_ + dv);
+  // Out at most at the condition's forward speed, in at the growth's rate (at once on a short).
+  const double limited = std::clamp(target, in.gap_state == machine::GapState::Short ? target : -draw_rate_,
+                                    cond_.max_forward_mm_s);
+  lateral_v_ = std::clamp(limited, lateral_v_ - dv, lateral_v_ + dv);
+  if (cond_.lateral_servo) follow_gap(in.gap_state == machine::GapState::Short);
   turn();
   const double r = std::clamp(radius_ + lateral_v_ * period_s_, 0.0, cond_.orbit_radius_mm);
   if (r != radius_ + lateral_v_ * period_s_) lateral_v_ = 0;  // at the centre or the full size
   radius_ = r;
   orbit_offset(shape_, phase_, radius_, orbit_);
-  if (radius_ >= cond_.orbit_radius_mm - 1e-9 && jump_ == Jump::Idle) full_turn_ += period_s_ / draw_period_s_;
+  if (radius_ >= cond_.orbit_radius_mm - 1e-9 && jump_ == Jump::Idle)
+    full_turn_ += orbit_rate_ * period_s_ / draw_period_s_;
 }
 
 // Adaptive control: every machining period in which the gap sparks (or shorts) feeds the window;
@@ -349,6 +360,7 @@ double GapServo::servo_speed(const GapInputs& in, bool brake) noexcept {
   if (in.gap_state == machine::GapState::Short) target = -cond_.max_retract_mm_s;
   target = std::clamp(target, -cond_.max_retract_mm_s, cond_.max_forward_mm_s);
   if (brake && in.gap_state != machine::GapState::Short) target = 0;
+  law_mm_s_ = target;
   const double dv = accel_ * period_s_;
   return std::clamp(target, v_ - dv, v_ + dv);
 }
@@ -424,7 +436,7 @@ double GapServo::approach(double x, double target, double& v, double v_max, doub
 // The orbit turns at its period while the condition machines (through jumps and shorts too:
 // stopping it would be a step of velocity); its radius grows by a step per turn toward the final
 // radius, at a step per quarter turn, so that the shape spirals out and never jumps.
-void GapServo::run_orbit() noexcept {
+void GapServo::run_orbit(const GapInputs& in) noexcept {
   // Another shape (or none): the one drawn spirals in to the centre first, the new one grows from it.
   if (shape_ != cond_.orbit || cond_.orbit_period_s <= 0) {
     return_offsets();
@@ -434,14 +446,51 @@ void GapServo::run_orbit() noexcept {
   draw_period_s_ = cond_.orbit_period_s;
   const double step = cond_.orbit_step_mm > 0 ? cond_.orbit_step_mm : cond_.orbit_radius_mm;
   draw_rate_ = step / (0.25 * cond_.orbit_period_s);
-  turn();
   const double goal = std::min(cond_.orbit_radius_mm, step * (turns_ + 1));
-  radius_ += std::clamp(goal - radius_, -draw_rate_ * period_s_, draw_rate_ * period_s_);
+  if (cond_.lateral_servo) {
+    // A short draws the orbit in at the retract speed (within the acceleration), as the path
+    // backs off: the short may be at a side wall.
+    const bool shorted = in.gap_state == machine::GapState::Short;
+    follow_gap(shorted);
+    turn();
+    const double grow = std::clamp((goal - radius_) / period_s_, -draw_rate_, draw_rate_);
+    const double dv = accel_ * period_s_;
+    // Below the reference the orbit draws in at the law's speed as the path backs off at it (the
+    // narrowest gap may be at a side wall): the servo acts along both.
+    const double target = law_mm_s_ < 0 ? law_mm_s_ : grow;
+    lateral_v_ = std::clamp(shorted ? -cond_.max_retract_mm_s : target, lateral_v_ - dv, lateral_v_ + dv);
+    radius_ = std::max(0.0, radius_ + lateral_v_ * period_s_);
+    if (radius_ == 0) lateral_v_ = 0;
+  } else {
+    turn();
+    radius_ += std::clamp(goal - radius_, -draw_rate_ * period_s_, draw_rate_ * period_s_);
+  }
   orbit_offset(shape_, phase_, radius_, orbit_);
 }
 
+// The lateral servo's share of the orbit: it turns at its period while the filtered gap voltage is
+// at the reference or above and slows to a stop as it falls to half the reference (a short: at
+// once), the orbit's speed changing within a quarter of the tool axis' acceleration, so that the
+// electrode does not run into a side wall faster than the side discharges burn it back.
+void GapServo::follow_gap(bool shorted) noexcept {
+  const double ref = cond_.servo_reference_v;
+  // In the finishing cycle at the full radius the last turn goes up to twice as fast while the gap
+  // is wide (the walls there are burnt already): it ends sooner, not with the gap open.
+  const double fastest = finishing_ && radius_ >= cond_.orbit_radius_mm - 1e-9 ? 2.0 : 1.0;
+  const double target =
+      shorted || ref <= 0 ? 0.0
+                          : std::clamp((status_.filtered_voltage_v - 0.5 * ref) / (0.5 * ref), 0.0, fastest);
+  const double r = std::max(radius_, 1e-6);
+  const double per_turn = cond_.orbit == OrbitKind::Circle   ? 6.283185307179586 * r
+                          : cond_.orbit == OrbitKind::Square ? 12 * r
+                                                             : 8 * 3.141592653589793 * r;
+  const double peak_mm_s = per_turn / draw_period_s_;
+  const double dk = 0.25 * accel_ * period_s_ / peak_mm_s;
+  orbit_rate_ += std::clamp(target - orbit_rate_, -dk, dk);
+}
+
 void GapServo::turn() noexcept {
-  phase_ += period_s_ / draw_period_s_;
+  phase_ += orbit_rate_ * period_s_ / draw_period_s_;
   if (phase_ >= 1) {
     phase_ -= 1;
     ++turns_;
@@ -455,6 +504,7 @@ void GapServo::return_offsets() noexcept {
     radius_ = orbit_[0] = orbit_[1] = phase_ = 0;
     turns_ = 0;
     shape_ = OrbitKind::None;
+    orbit_rate_ = 1;  // at the centre the orbit stands still: its speed starts afresh
     return;
   }
   turn();

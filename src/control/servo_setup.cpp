@@ -183,6 +183,7 @@ void plain_edm_config(const machine::EdmConfig& e, machine::EdmConfig& out) {
     o.orbit_period_s = c.orbit_period_s;
     o.orbit_finish = c.orbit_finish;
     o.adaptive = c.adaptive;
+    o.lateral_servo = c.lateral_servo;
     o.servo_reference_min_v = c.servo_reference_min_v;
     o.servo_reference_max_v = c.servo_reference_max_v;
     o.gain_min_mm_s_per_v = c.gain_min_mm_s_per_v;

@@ -98,12 +98,13 @@ class GapServo {
   bool select(int code, double p) noexcept;
   double servo_speed(const GapInputs& in, bool brake) noexcept;
   void run_finish(const GapInputs& in, bool due) noexcept;
-  void run_lateral(double target) noexcept;
+  void run_lateral(const GapInputs& in, double target) noexcept;
   void adapt(const GapInputs& in) noexcept;
   bool jump_due() const noexcept;
   void move_electrode(double v, const GapInputs& in) noexcept;
   void run_jump(bool may_start) noexcept;
-  void run_orbit() noexcept;
+  void run_orbit(const GapInputs& in) noexcept;
+  void follow_gap(bool shorted) noexcept;
   void turn() noexcept;
   void return_offsets() noexcept;
   void catch_up() noexcept;
@@ -117,6 +118,7 @@ class GapServo {
   double s_ = 0;        ///< the electrode's path length on the memory
   double v_ = 0;        ///< its signed speed along the path
   double catch_v_ = 0;  ///< its speed walking up to the head with nothing to machine
+  double law_mm_s_ = 0;  ///< the law's speed target this period (before the acceleration limit)
   double feed_scale_ = 1;
   bool reached_retract_limit_ = false;
   bool pressing_limit_ = false;  ///< backing off against the end of the memory (until it lets go)
@@ -129,6 +131,7 @@ class GapServo {
   double machining_s_ = 0;
   // Orbit: phase (turns, 0 … 1), the radius now and the turns completed.
   double phase_ = 0, radius_ = 0;
+  double orbit_rate_ = 1;  ///< the share of its period's speed the orbit turns at (the lateral servo)
   int turns_ = 0;
   OrbitKind shape_ = OrbitKind::None;  ///< the shape drawn now (a new condition's waits for the centre)
   double draw_period_s_ = 1, draw_rate_ = 0;  ///< its period and its radial rate (mm/s)
@@ -139,6 +142,7 @@ class GapServo {
   double pending_p_ = 0;
   double lateral_v_ = 0;
   double full_turn_ = 0;  ///< turns burnt at the full radius (1: done)
+  double finish_s_ = 0;   ///< the path length where the burn's path ended
   // Adaptive control: the condition's own settings and bounds (cond_ holds those in force).
   EdmCondition base_{};
   EdmAdaptive adaptive_;

@@ -64,6 +64,9 @@ struct EdmCondition {
   /// orbit has grown to its radius and turned once there, the gap servo acting along the orbit's
   /// radius meanwhile (the lateral servo). Needs an orbit.
   bool orbit_finish = false;
+  /// The lateral servo: the orbit slows as the gap voltage falls below the reference (stops and
+  /// draws in on a short), and in the finishing cycle the gap servo drives its radius.
+  bool lateral_servo = false;
   // Adaptive control (off: the values above hold): the bounds within which the gap's state moves
   // the servo's reference and gain and the jump's period and height (each min = max: fixed).
   bool adaptive = false;
