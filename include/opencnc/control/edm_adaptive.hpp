@@ -15,8 +15,8 @@ namespace opencnc::control {
 /// settings by it. Servo thread only; real-time safe.
 class EdmAdaptive {
  public:
-  /// Periods of machining (the generator pulsing) per window: 50 ms at 1 kHz.
-  static constexpr int kWindow = 50;
+  /// Periods of machining (the gap sparking) per window: 25 ms at 1 kHz.
+  static constexpr int kWindow = 25;
 
   /// A new condition: the window starts empty.
   void reset() noexcept;
