@@ -154,8 +154,9 @@ void read_finish(Section& t, EdmCondition& c) {
   c.orbit_finish = t.boolean_or("orbit_finish", false);
   c.lateral_servo = t.boolean_or("lateral_servo", false);
   if (c.orbit_finish && c.orbit == machine::OrbitKind::None)
-    t.error("orbit_finish", fmt::format("{} needs an orbit (orbit = \"circle\", \"square\" or \"star\")",
-                                        t.key_path("orbit_finish")),
+    t.error("orbit_finish",
+            fmt::format("{} needs an orbit (orbit = \"circle\", \"square\" or \"star\")",
+                        t.key_path("orbit_finish")),
             "config.range");
 }
 
@@ -190,7 +191,8 @@ void read_adaptive(Section& t, EdmCondition& c, const MachineProfile& p) {
   }
   if (c.voltage_v > 0 && c.servo_reference_max_v >= c.voltage_v)
     t.error("servo_reference_max_v",
-            fmt::format("{} must be below voltage_v ({} V)", t.key_path("servo_reference_max_v"), show(c.voltage_v)),
+            fmt::format("{} must be below voltage_v ({} V)", t.key_path("servo_reference_max_v"),
+                        show(c.voltage_v)),
             "config.range");
   const double memory_mm = 0.5 * machine::kEdmPathPoints * p.edm.config.path_spacing_mm;
   if (c.jump_mode == machine::JumpMode::Path && c.jump_height_max_mm > memory_mm)
@@ -275,12 +277,12 @@ void read_conditions(Section& s, MachineProfile& p) {
 void read_edm_sim(Section& s, MachineProfile& p) {
   const toml::table* st = s.subtable("sim");
   if (st == nullptr) return;
-  Section m(*st, "edm.sim",
-            {"surface_mm", "work", "electrode_area_mm2", "removal_mm3_per_a_us", "breakdown_um_per_v",
-             "discharge_voltage_v", "debris_per_mm3", "flush_time_s", "jump_flush_time_s", "arc_threshold",
-             "noise_v", "short_bridge_mm", "orientation", "side_walls", "electrode_perimeter_mm",
-             "short_debris"},
-            s.reporter());
+  Section m(
+      *st, "edm.sim",
+      {"surface_mm", "work", "electrode_area_mm2", "removal_mm3_per_a_us", "breakdown_um_per_v",
+       "discharge_voltage_v", "debris_per_mm3", "flush_time_s", "jump_flush_time_s", "arc_threshold",
+       "noise_v", "short_bridge_mm", "orientation", "side_walls", "electrode_perimeter_mm", "short_debris"},
+      s.reporter());
   machine::SimEdmConfig& c = p.edm.sim;
   c.present = true;
   const AxisProfile* tool = p.find(static_cast<Axis>(p.edm.config.tool_axis));

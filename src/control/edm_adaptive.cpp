@@ -62,23 +62,28 @@ bool EdmAdaptive::sample(machine::GapState state, double voltage_v, const machin
   const machine::EdmCondition before = active;
   if (abnormal_ > kUnstable) {
     active.jump_period_s = scaled(active.jump_period_s, 0.8, base.jump_period_min_s, base.jump_period_max_s);
-    active.jump_height_mm = scaled(active.jump_height_mm, 1.2, base.jump_height_min_mm, base.jump_height_max_mm);
+    active.jump_height_mm =
+        scaled(active.jump_height_mm, 1.2, base.jump_height_min_mm, base.jump_height_max_mm);
     active.servo_reference_v =
         shifted(active.servo_reference_v, 1.0, base.servo_reference_min_v, base.servo_reference_max_v);
   } else if (abnormal_ <= kClean) {
     active.jump_period_s = scaled(active.jump_period_s, 1.05, base.jump_period_min_s, base.jump_period_max_s);
-    active.jump_height_mm = scaled(active.jump_height_mm, 0.97, base.jump_height_min_mm, base.jump_height_max_mm);
+    active.jump_height_mm =
+        scaled(active.jump_height_mm, 0.97, base.jump_height_min_mm, base.jump_height_max_mm);
     active.servo_reference_v =
         shifted(active.servo_reference_v, -0.25, base.servo_reference_min_v, base.servo_reference_max_v);
   }
   if (std::fabs(mean - ref) > kLagging * ref)
-    active.gain_mm_s_per_v = scaled(active.gain_mm_s_per_v, 1.25, base.gain_min_mm_s_per_v, base.gain_max_mm_s_per_v);
+    active.gain_mm_s_per_v =
+        scaled(active.gain_mm_s_per_v, 1.25, base.gain_min_mm_s_per_v, base.gain_max_mm_s_per_v);
   else if (spread_ > kHunting && std::fabs(mean - ref) < kCentred * ref)
-    active.gain_mm_s_per_v = scaled(active.gain_mm_s_per_v, 0.9, base.gain_min_mm_s_per_v, base.gain_max_mm_s_per_v);
+    active.gain_mm_s_per_v =
+        scaled(active.gain_mm_s_per_v, 0.9, base.gain_min_mm_s_per_v, base.gain_max_mm_s_per_v);
   n_ = arcs_ = shorts_ = 0;
   sum_ = sum2_ = 0;
   return active.jump_period_s != before.jump_period_s || active.jump_height_mm != before.jump_height_mm ||
-         active.servo_reference_v != before.servo_reference_v || active.gain_mm_s_per_v != before.gain_mm_s_per_v;
+         active.servo_reference_v != before.servo_reference_v ||
+         active.gain_mm_s_per_v != before.gain_mm_s_per_v;
 }
 
 }  // namespace opencnc::control

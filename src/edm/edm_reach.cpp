@@ -19,7 +19,8 @@ Reach reach_of(const machine::EdmCondition& c) {
     r.orbit_condition = c.number;
   }
   if (c.jump_period_s > 0 && c.jump_mode == machine::JumpMode::Axis) {
-    r.jump_mm = std::max(c.jump_height_mm, c.adaptive ? c.jump_height_max_mm : 0.0);  // adaptive control may lift higher
+    r.jump_mm = std::max(c.jump_height_mm,
+                         c.adaptive ? c.jump_height_max_mm : 0.0);  // adaptive control may lift higher
     r.jump_condition = c.number;
   }
   return r;

@@ -37,7 +37,9 @@ void EdmRecorder::on_trace(const control::TraceSample& s, const controller::Trac
     ++machining_;
     // The reference in force (adaptive control moves it); a trace without it: the condition's.
     const machine::EdmCondition* c = edm_.find(e.condition);
-    const double ref = e.servo_reference_v > 0 ? e.servo_reference_v : c != nullptr ? c->servo_reference_v : 0.0;
+    const double ref = e.servo_reference_v > 0 ? e.servo_reference_v
+                       : c != nullptr          ? c->servo_reference_v
+                                               : 0.0;
     if (ref > 0 && std::fabs(e.gap_voltage_v - ref) <= 0.1 * ref) ++in_band_;
     if (e.finishing) ++finishing_;
     note_settings(e);
@@ -101,11 +103,12 @@ std::string EdmRecorder::report_text() const {
              "edm gap             {} shorts ({} never cleared; longest {:.3f} s), {} arcs ({} periods)\n",
              e.shorts, e.shorts_uncleared, e.short_recovery_max_s, e.arcs, e.arc_periods) +
          (e.adaptations > 0 || e.finishing_s > 0
-              ? fmt::format("edm control         {:.1f} s finishing cycle, {} adaptations: reference {:.1f}–{:.1f} V, "
+              ? fmt::format("edm control         {:.1f} s finishing cycle, {} adaptations: reference "
+                            "{:.1f}–{:.1f} V, "
                             "gain {:.4f}–{:.4f} mm/s/V, jump every {:.3f}–{:.3f} s, {:.3f}–{:.3f} mm high\n",
                             e.finishing_s, e.adaptations, e.servo_reference_v[0], e.servo_reference_v[1],
-                            e.gain_mm_s_per_v[0], e.gain_mm_s_per_v[1], e.jump_period_s[0], e.jump_period_s[1],
-                            e.jump_height_mm[0], e.jump_height_mm[1])
+                            e.gain_mm_s_per_v[0], e.gain_mm_s_per_v[1], e.jump_period_s[0],
+                            e.jump_period_s[1], e.jump_height_mm[0], e.jump_height_mm[1])
               : std::string());
 }
 

@@ -8,7 +8,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <fstream>
 #include <memory>
 #include <sstream>
@@ -38,19 +37,20 @@ class PerCondition final : public ControllerObserver {
  public:
   void on_trace(const control::TraceSample& s, const TraceContext&) override {
     const control::EdmStatus& e = s.edm;
+    if (!e.on && burning && last == machine::GapState::Arc) ++arcs_at_burn_end;
+    if (e.generator) last = e.gap_state;
     if (!e.on) burning = false;
     if (e.on && e.generator && e.gap_state != machine::GapState::Open) burning = true;
     if (!burning || !e.generator) return;
-    if (e.condition == std::atoi(std::getenv("EDM_DEBUG") ? std::getenv("EDM_DEBUG") : "0") && (s.tick % 10 == 0))
-      std::printf("t %llu fin %d r %.4f V %.1f Vf %.1f ref %.1f st %d cmdZ %.4f g %.3f\n", (unsigned long long)s.tick,
-                  e.finishing, e.orbit_radius_mm, e.gap_voltage_v, e.filtered_voltage_v, e.servo_reference_v,
-                  (int)e.gap_state, s.commanded[Axis::Z], e.gain_mm_s_per_v);
     const auto c = static_cast<std::size_t>(std::clamp(e.condition, 0, 4) + (e.finishing ? 5 : 0));
     ++n[c];
     const double ref = e.servo_reference_v;
-    if (std::fabs(e.gap_voltage_v - ref) <= 0.1 * ref) ++in[c];
-    else if (e.gap_state == machine::GapState::Open) ++open[c];
-    else if (e.gap_voltage_v > ref) ++above[c];
+    if (std::fabs(e.gap_voltage_v - ref) <= 0.1 * ref)
+      ++in[c];
+    else if (e.gap_state == machine::GapState::Open)
+      ++open[c];
+    else if (e.gap_voltage_v > ref)
+      ++above[c];
     if (e.gap_state == machine::GapState::Short) ++shorts[c];
   }
   std::string text() const {
@@ -58,11 +58,13 @@ class PerCondition final : public ControllerObserver {
     for (int c = 0; c < 10; ++c)
       if (n[c] > 0)
         o << "condition " << c % 5 << (c >= 5 ? " finishing" : "") << ": " << n[c] << " periods, in band "
-          << static_cast<double>(in[c]) / n[c] << ", open " << static_cast<double>(open[c]) / n[c] << ", above "
-          << static_cast<double>(above[c]) / n[c] << ", shorted " << shorts[c] << "\n";
+          << static_cast<double>(in[c]) / n[c] << ", open " << static_cast<double>(open[c]) / n[c]
+          << ", above " << static_cast<double>(above[c]) / n[c] << ", shorted " << shorts[c] << "\n";
     return o.str();
   }
   bool burning = false;
+  machine::GapState last = machine::GapState::Open;
+  int arcs_at_burn_end = 0;
   long open[10] = {};
   long n[10] = {}, in[10] = {}, above[10] = {}, shorts[10] = {};
 };
@@ -105,24 +107,82 @@ config::MachineProfile channel_machine(std::vector<std::string> sets = {}) {
   return control::test::loaded(config::load_profile(OPENCNC_SOURCE_DIR "/configs/edm-5axis.toml", sets));
 }
 
+/// What a run's figures are, in one line (printed: the figures docs/edm.md quotes).
+void print(const char* what, const Channel& r) {
+  const edm::EdmReport e = r.report();
+  std::printf(
+      "%s: %.2f s machining of %.2f s, in band %.4f, %llu jumps, %llu shorts (%llu uncleared, longest "
+      "%.3f s), %llu arcs (%llu periods), finishing %.2f s, %llu adaptations, wear %.5f mm, depth %.5f mm, "
+      "oversize %.5f mm\n%s",
+      what, e.machining_s, r.seconds, e.gap_voltage_in_band_fraction,
+      static_cast<unsigned long long>(e.jumps), static_cast<unsigned long long>(e.shorts),
+      static_cast<unsigned long long>(e.shorts_uncleared), e.short_recovery_max_s,
+      static_cast<unsigned long long>(e.arcs), static_cast<unsigned long long>(e.arc_periods), e.finishing_s,
+      static_cast<unsigned long long>(e.adaptations), r.sim().electrode_wear_max_mm(), r.sim().depth_max_mm(),
+      r.sim().cavity_oversize_max_mm(), r.per->text().c_str());
+}
+
+/// The frontal gap at which the simulated discharges' mean voltage is `c`'s reference: the share
+/// x of the breakdown gap with (U0·t_d + Ue·t_on)/(t_d + t_on + t_off) = Ur, t_d = t_on·x/(1 − x).
+double frontal_gap_mm(const machine::EdmCondition& c, const machine::SimEdmConfig& sim) {
+  const double ur = c.servo_reference_v, ue = sim.discharge_voltage_v;
+  const double td = (ur * (c.on_time_us + c.off_time_us) - ue * c.on_time_us) / (c.voltage_v - ur);
+  return td / (c.on_time_us + td) * sim.breakdown_um_per_v * 1e-3 * c.voltage_v;
+}
+
 TEST(EdmTurbine, WithoutDwellTheFinishingCycleHoldsTheGapAndBurnsTheCavityToSize) {
   const config::MachineProfile p = channel_machine();
   const Channel r = run_channel(p);
   ASSERT_TRUE(r.finished);
+  print("adaptive", r);
   const edm::EdmReport e = r.report();
-  std::printf("%s", r.per->text().c_str());
-  std::printf("machining %.2f s of %.2f s, in band %.4f, jumps %llu, shorts %llu (uncleared %llu, longest %.3f s), "
-              "arcs %llu, finishing %.2f s, adaptations %llu\n",
-              e.machining_s, r.seconds, e.gap_voltage_in_band_fraction, static_cast<unsigned long long>(e.jumps),
-              static_cast<unsigned long long>(e.shorts), static_cast<unsigned long long>(e.shorts_uncleared),
-              e.short_recovery_max_s, static_cast<unsigned long long>(e.arcs), e.finishing_s,
-              static_cast<unsigned long long>(e.adaptations));
+  EXPECT_GE(e.gap_voltage_in_band_fraction, 0.88);
+  EXPECT_EQ(e.shorts_uncleared, 0u);  // every short recovered
+  EXPECT_LT(e.short_recovery_max_s, 0.1);
+  EXPECT_GT(e.finishing_s, 1.0);  // the cycle held both flanks' burns
+  EXPECT_GT(e.adaptations, 0u);
+  // No arc left standing: the last period of every burn sparked normally or was open (the
+  // recorder's arcs all ended); here: the gap's state at the end of each burn.
+  EXPECT_EQ(r.per->arcs_at_burn_end, 0);
+  // The cavity of each flank (B −30, B +30): the finishing square's reach in each direction
+  // (half-side r: r·(|cos θ| + |sin θ|)) plus condition 3's side gap; its depth the program's
+  // 0.095 mm less the finishing electrode's wear plus the frontal gap at condition 3's reference.
+  const machine::EdmCondition& finish = *p.edm.config.find(3);
   const machine::SimEdmProcess& sim = r.sim();
-  std::printf("oversize %.5f, depth %.5f, wear %.5f\n", sim.cavity_oversize_max_mm(), sim.depth_max_mm(),
-              sim.electrode_wear_max_mm());
-  std::printf("reference %.1f-%.1f gain %.4f-%.4f period %.3f-%.3f height %.3f-%.3f\n", e.servo_reference_v[0],
-              e.servo_reference_v[1], e.gain_mm_s_per_v[0], e.gain_mm_s_per_v[1], e.jump_period_s[0],
-              e.jump_period_s[1], e.jump_height_mm[0], e.jump_height_mm[1]);
+  ASSERT_EQ(sim.fronts(), 2);
+  constexpr double kPi = 3.14159265358979323846;
+  for (int f = 0; f < 2; ++f) {
+    for (int k = 0; k < machine::SimEdmProcess::kSides; ++k) {
+      const double a = 2 * kPi * k / machine::SimEdmProcess::kSides;
+      const double size =
+          finish.orbit_radius_mm * (std::fabs(std::cos(a)) + std::fabs(std::sin(a))) + finish.side_gap_mm;
+      EXPECT_NEAR(sim.wall_mm(f, k), size, 0.005) << "front " << f << ", direction " << k;
+    }
+    const double depth = 0.095 - sim.electrode_wear_mm() + frontal_gap_mm(finish, p.edm.sim);
+    EXPECT_NEAR(sim.front_depth_mm(f), depth, 0.005) << "front " << f;
+  }
+}
+
+TEST(EdmTurbine, AdaptiveControlAgainstFixedParametersOnTheSameJobAndSeed) {
+  config::MachineProfile fixed = channel_machine();
+  for (int i = 0; i < fixed.edm.config.condition_count; ++i)
+    fixed.edm.config.conditions[static_cast<std::size_t>(i)].adaptive = false;
+  const Channel a = run_channel(channel_machine());
+  const Channel f = run_channel(fixed);
+  ASSERT_TRUE(a.finished);
+  ASSERT_TRUE(f.finished);
+  print("adaptive", a);
+  print("fixed", f);
+  EXPECT_EQ(f.report().adaptations, 0u);
+  EXPECT_EQ(f.report().gain_mm_s_per_v[0], 0.01);  // condition 3's, unmoved
+  EXPECT_GT(a.report().gap_voltage_in_band_fraction, f.report().gap_voltage_in_band_fraction + 0.05);
+  EXPECT_LT(a.report().machining_s, f.report().machining_s);
+  EXPECT_EQ(a.report().shorts_uncleared + f.report().shorts_uncleared, 0u);
+  // Deterministic: the same job and seed again, the same figures to the bit.
+  const Channel again = run_channel(channel_machine());
+  EXPECT_EQ(again.report().gap_voltage_in_band_fraction, a.report().gap_voltage_in_band_fraction);
+  EXPECT_EQ(again.sim().cavity_oversize_max_mm(), a.sim().cavity_oversize_max_mm());
+  EXPECT_EQ(again.sim().electrode_wear_max_mm(), a.sim().electrode_wear_max_mm());
 }
 
 }  // namespace

@@ -32,9 +32,9 @@ struct EdmStatus {
   double gain_mm_s_per_v = 0;
   double jump_period_s = 0;
   double jump_height_mm = 0;
-  float abnormal_share = 0;        ///< adaptive control's last window: share of arc and short periods
-  float voltage_spread = 0;        ///< … and the gap voltage's standard deviation over the reference
-  std::uint32_t adaptations = 0;   ///< windows in which adaptive control changed a setting (since start)
+  float abnormal_share = 0;       ///< adaptive control's last window: share of arc and short periods
+  float voltage_spread = 0;       ///< … and the gap voltage's standard deviation over the reference
+  std::uint32_t adaptations = 0;  ///< windows in which adaptive control changed a setting (since start)
 };
 
 static_assert(std::is_trivially_copyable_v<EdmStatus>);

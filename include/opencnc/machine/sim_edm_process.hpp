@@ -75,6 +75,18 @@ class SimEdmProcess {
   double cavity_centre_mm(int i) const noexcept {
     return front_index_ < 0 || i < 0 || i > 1 ? 0.0 : centre_[static_cast<std::size_t>(2 * front_index_ + i)];
   }
+  /// The fronts burnt so far (one per orientation), and front f's depth and wall in direction k.
+  int fronts() const noexcept { return fronts_; }
+  double front_depth_mm(int front) const noexcept {
+    return front < 0 || front >= fronts_
+               ? 0.0
+               : (front_[static_cast<std::size_t>(front)] - config_.surface_mm) * config_.work_direction;
+  }
+  double wall_mm(int front, int k) const noexcept {
+    return front < 0 || front >= fronts_ || k < 0 || k >= kSides
+               ? 0.0
+               : wall_[static_cast<std::size_t>(front * kSides + k)];
+  }
   /// The side gap of the condition burning now (or last), mm.
   double side_gap_mm() const noexcept { return side_gap_mm_; }
 
