@@ -323,7 +323,10 @@ void GapServo::run_lateral(const GapInputs& in, double target) noexcept {
   if (r != radius_ + lateral_v_ * period_s_) lateral_v_ = 0;  // at the centre or the full size
   radius_ = r;
   orbit_offset(shape_, phase_, radius_, orbit_);
-  if (radius_ >= cond_.orbit_radius_mm - 1e-9 && jump_ == Jump::Idle)
+  // The turn at full size counts where it burns: sparking, with the electrode at the burn's end
+  // (not lifted, not backed off up the path after a short: there it burns nothing).
+  const bool sparking = in.gap_state == machine::GapState::Normal || in.gap_state == machine::GapState::Arc;
+  if (radius_ >= cond_.orbit_radius_mm - 1e-9 && jump_ == Jump::Idle && sparking && s_ >= finish_s_ - 1e-9)
     full_turn_ += orbit_rate_ * period_s_ / draw_period_s_;
 }
 
