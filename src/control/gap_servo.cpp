@@ -157,7 +157,7 @@ bool GapServo::apply_code(int code, double p) noexcept {
   if (finishing_ || (status_.on && cond_.orbit_finish && cond_.orbit != OrbitKind::None)) {
     if (!finishing_) {
       finishing_ = true;
-      full_turn_ = lateral_v_ = 0;
+      full_turn_ = 0;  // the radius goes on at the speed it has (no step of velocity)
       // Where the burn's path ended (the head may already have begun the next block this period).
       finish_s_ = std::min(s_, memory_.head_s());
     }
@@ -301,9 +301,10 @@ void GapServo::run_finish(const GapInputs& in, bool due) noexcept {
   }
 }
 
-// The orbit's radius at the lateral servo's speed, at most the growth's radial rate and within
-// the tool axis' acceleration, between the centre and the condition's radius; it turns at its
-// period as ever. A shape still spiralling in from another condition goes on doing so first.
+// The orbit's radius at the lateral servo's speed (out at most at the condition's forward speed,
+// in at the growth's rate, at the retract speed on a short) within the tool axis' acceleration,
+// between the centre and the condition's radius; it turns as the lateral servo lets it. A shape
+// still spiralling in from another condition goes on doing so first.
 void GapServo::run_lateral(const GapInputs& in, double target) noexcept {
   if (shape_ != cond_.orbit || cond_.orbit_period_s <= 0) {
     run_orbit(in);
@@ -313,7 +314,6 @@ void GapServo::run_lateral(const GapInputs& in, double target) noexcept {
   const double step = cond_.orbit_step_mm > 0 ? cond_.orbit_step_mm : cond_.orbit_radius_mm;
   draw_rate_ = step / (0.25 * cond_.orbit_period_s);
   const double dv = accel_ * period_s_;
-  // Out at most at the condition's forward speed, in at the growth's rate (at once on a short).
   const double limited = std::clamp(target, in.gap_state == machine::GapState::Short ? target : -draw_rate_,
                                     cond_.max_forward_mm_s);
   lateral_v_ = std::clamp(limited, lateral_v_ - dv, lateral_v_ + dv);
