@@ -149,6 +149,59 @@ void read_orbit(Section& t, EdmCondition& c, const MachineProfile& p) {
             "config.range");
 }
 
+// The finishing cycle needs an orbit to finish.
+void read_finish(Section& t, EdmCondition& c) {
+  c.orbit_finish = t.boolean_or("orbit_finish", false);
+  c.lateral_servo = t.boolean_or("lateral_servo", false);
+  if (c.orbit_finish && c.orbit == machine::OrbitKind::None)
+    t.error("orbit_finish",
+            fmt::format("{} needs an orbit (orbit = \"circle\", \"square\" or \"star\")",
+                        t.key_path("orbit_finish")),
+            "config.range");
+}
+
+// Adaptive control's bounds: each setting moves between its min and max (absent: the setting
+// itself, so that it stays); the condition's own value must lie within them.
+void read_adaptive(Section& t, EdmCondition& c, const MachineProfile& p) {
+  c.adaptive = t.boolean_or("adaptive", false);
+  struct Bound2 {
+    const char* min_key;
+    const char* max_key;
+    double value;
+    double* lo;
+    double* hi;
+  };
+  const Bound2 bounds[] = {
+      {"servo_reference_min_v", "servo_reference_max_v", c.servo_reference_v, &c.servo_reference_min_v,
+       &c.servo_reference_max_v},
+      {"gain_min_mm_s_per_v", "gain_max_mm_s_per_v", c.gain_mm_s_per_v, &c.gain_min_mm_s_per_v,
+       &c.gain_max_mm_s_per_v},
+      {"jump_period_min_s", "jump_period_max_s", c.jump_period_s, &c.jump_period_min_s, &c.jump_period_max_s},
+      {"jump_height_min_mm", "jump_height_max_mm", c.jump_height_mm, &c.jump_height_min_mm,
+       &c.jump_height_max_mm},
+  };
+  for (const Bound2& b : bounds) {
+    *b.lo = t.number_or(b.min_key, b.value, Bound::Positive);
+    *b.hi = t.number_or(b.max_key, b.value, Bound::Positive);
+    if (b.value > 0 && (*b.lo > b.value || *b.hi < b.value))
+      t.error(*b.lo > b.value ? b.min_key : b.max_key,
+              fmt::format("{} and {} must enclose the condition's own value ({})", t.key_path(b.min_key),
+                          t.key_path(b.max_key), show(b.value)),
+              "config.range");
+  }
+  if (c.voltage_v > 0 && c.servo_reference_max_v >= c.voltage_v)
+    t.error("servo_reference_max_v",
+            fmt::format("{} must be below voltage_v ({} V)", t.key_path("servo_reference_max_v"),
+                        show(c.voltage_v)),
+            "config.range");
+  const double memory_mm = 0.5 * machine::kEdmPathPoints * p.edm.config.path_spacing_mm;
+  if (c.jump_mode == machine::JumpMode::Path && c.jump_height_max_mm > memory_mm)
+    t.error("jump_height_max_mm",
+            fmt::format("{}: a jump along the path may lift at most {} mm", t.key_path("jump_height_max_mm"),
+                        show(memory_mm)),
+            "config.range");
+}
+
 void read_conditions(Section& s, MachineProfile& p) {
   const toml::node* n = s.find("condition");
   const toml::array* list = n != nullptr ? n->as_array() : nullptr;
@@ -184,7 +237,18 @@ void read_conditions(Section& s, MachineProfile& p) {
                "orbit_period_s",
                "short_timeout_s",
                "side_gap_mm",
-               "electrode_wear_ratio"},
+               "electrode_wear_ratio",
+               "orbit_finish",
+               "lateral_servo",
+               "adaptive",
+               "servo_reference_min_v",
+               "servo_reference_max_v",
+               "gain_min_mm_s_per_v",
+               "gain_max_mm_s_per_v",
+               "jump_period_min_s",
+               "jump_period_max_s",
+               "jump_height_min_mm",
+               "jump_height_max_mm"},
               s.reporter());
     EdmCondition c;
     const auto number = t.integer("number", 1, 99);
@@ -197,6 +261,8 @@ void read_conditions(Section& s, MachineProfile& p) {
     read_servo(t, c, p);
     read_jump(t, c, p);
     read_orbit(t, c, p);
+    read_finish(t, c);
+    read_adaptive(t, c, p);
     c.side_gap_mm = t.number_or("side_gap_mm", 0, Bound::NonNegative);
     c.electrode_wear_ratio = t.number_or("electrode_wear_ratio", 0, Bound::NonNegative);
     if (c.electrode_wear_ratio >= 1)
@@ -211,11 +277,12 @@ void read_conditions(Section& s, MachineProfile& p) {
 void read_edm_sim(Section& s, MachineProfile& p) {
   const toml::table* st = s.subtable("sim");
   if (st == nullptr) return;
-  Section m(*st, "edm.sim",
-            {"surface_mm", "work", "electrode_area_mm2", "removal_mm3_per_a_us", "breakdown_um_per_v",
-             "discharge_voltage_v", "debris_per_mm3", "flush_time_s", "jump_flush_time_s", "arc_threshold",
-             "noise_v", "short_bridge_mm", "orientation"},
-            s.reporter());
+  Section m(
+      *st, "edm.sim",
+      {"surface_mm", "work", "electrode_area_mm2", "removal_mm3_per_a_us", "breakdown_um_per_v",
+       "discharge_voltage_v", "debris_per_mm3", "flush_time_s", "jump_flush_time_s", "arc_threshold",
+       "noise_v", "short_bridge_mm", "orientation", "side_walls", "electrode_perimeter_mm", "short_debris"},
+      s.reporter());
   machine::SimEdmConfig& c = p.edm.sim;
   c.present = true;
   const AxisProfile* tool = p.find(static_cast<Axis>(p.edm.config.tool_axis));
@@ -237,6 +304,11 @@ void read_edm_sim(Section& s, MachineProfile& p) {
   if (c.arc_threshold >= 1) m.error("arc_threshold", "edm.sim.arc_threshold must be below 1", "config.range");
   c.noise_v = m.number_or("noise_v", c.noise_v, Bound::NonNegative);
   c.short_bridge_mm = m.number_or("short_bridge_mm", c.short_bridge_mm, Bound::Positive);
+  c.side_walls = m.choice<machine::SideWalls>(
+      "side_walls", {{"envelope", machine::SideWalls::Envelope}, {"removal", machine::SideWalls::Removal}},
+      machine::SideWalls::Envelope);
+  c.electrode_perimeter_mm = m.number_or("electrode_perimeter_mm", c.electrode_perimeter_mm, Bound::Positive);
+  c.short_debris = m.number_or("short_debris", c.short_debris, Bound::NonNegative);
   const machine::EdmConfig& e = p.edm.config;
   for (int i = 0; i < 2; ++i) {  // the orbit's plane: the electrode's lateral position
     const AxisProfile* a = p.find(static_cast<Axis>(e.orbit_axes[i]));
@@ -245,7 +317,8 @@ void read_edm_sim(Section& s, MachineProfile& p) {
   }
   for (int i = 0; i < e.condition_count; ++i) {
     const EdmCondition& k = e.conditions[static_cast<std::size_t>(i)];
-    c.conditions[static_cast<std::size_t>(i)] = {k.number, k.side_gap_mm, k.electrode_wear_ratio};
+    c.conditions[static_cast<std::size_t>(i)] = {k.number, k.side_gap_mm, k.electrode_wear_ratio,
+                                                 k.servo_reference_v};
   }
   c.condition_count = e.condition_count;
   const toml::node* o = m.find("orientation");

@@ -141,12 +141,35 @@ void GapServo::begin_run(const Pose& at) noexcept {
   status_.short_s = 0;
   status_.retract_limit = reached_retract_limit_ = pressing_limit_ = false;
   phase_ = radius_ = 0;
+  orbit_rate_ = 1;
   turns_ = 0;
   orbit_[0] = orbit_[1] = 0;
   shape_ = OrbitKind::None;
+  finishing_ = status_.finishing = false;
+  lateral_v_ = full_turn_ = 0;
+  base_ = EdmCondition{};
+  adaptive_.reset();
 }
 
+// Under a condition with the finishing cycle the burn's end waits: the code is kept until the
+// orbit is full at the path's end and has turned there (run_finish), the interpolator waiting.
 bool GapServo::apply_code(int code, double p) noexcept {
+  if (finishing_ || (status_.on && cond_.orbit_finish && cond_.orbit != OrbitKind::None)) {
+    if (!finishing_) {
+      finishing_ = true;
+      full_turn_ = 0;  // the radius goes on at the speed it has (no step of velocity)
+      // Where the burn's path ended (the head may already have begun the next block this period).
+      finish_s_ = std::min(s_, memory_.head_s());
+    }
+    pending_code_ = code;
+    pending_p_ = p;
+    return code == machine::kEdmOffCode ||
+           (code == machine::kEdmConditionCode && config_.find(static_cast<int>(std::lround(p))) != nullptr);
+  }
+  return select(code, p);
+}
+
+bool GapServo::select(int code, double p) noexcept {
   const EdmCondition* c =
       code == machine::kEdmConditionCode ? config_.find(static_cast<int>(std::lround(p))) : nullptr;
   if (c == nullptr) {
@@ -154,7 +177,8 @@ bool GapServo::apply_code(int code, double p) noexcept {
     status_.condition = 0;
     return code == machine::kEdmOffCode;
   }
-  cond_ = *c;
+  cond_ = base_ = *c;
+  adaptive_.reset();
   status_.on = true;
   status_.condition = c->number;
   turns_ = 0;  // the orbit grows again, a step per turn, from where its radius stands
@@ -181,10 +205,11 @@ Pose GapServo::step(const GapInputs& in) noexcept {
   // An electrode at the head goes with it (the interpolator moved at the speed the servo asked).
   const bool at_head = s_ >= memory_.head_s() - 1e-12;
   memory_.advance(in.head, config_.path_spacing_mm, in.new_block);
-  if (at_head) s_ = memory_.head_s();
+  if (at_head && !finishing_) s_ = memory_.head_s();  // finishing: the burn's end, not the head, is its end
   status_.gap_voltage_v = in.gap_voltage_v;
   status_.gap_state = in.gap_state;
-  const bool machining = config_.enabled && status_.on && !in.rapid && !in.hold;
+  // The finishing cycle machines on at the path's end while the head waits in the next block.
+  const bool machining = config_.enabled && status_.on && !in.hold && (finishing_ || !in.rapid);
   // A short is timed while machining; a hold leaves the count where it stands (the gap is still
   // shorted when the program goes on), anything else (a rapid, M181) ends it.
   if (machining && in.gap_state == machine::GapState::Short)
@@ -201,15 +226,19 @@ Pose GapServo::step(const GapInputs& in) noexcept {
     }
     return_offsets();
     status_.generator = false;
+  } else if (finishing_) {
+    run_finish(in, jump_due());
   } else {
     // A jump that is due waits until the servo has braked to rest (no step of velocity).
     const bool due = jump_due();
+    law_mm_s_ = 0;
     if (jump_ == Jump::Idle) move_electrode(servo_speed(in, due), in);
     run_jump(due && v_ == 0 && in.gap_state != machine::GapState::Short);
     if (jump_ != Jump::Idle) feed_scale_ = 0;
-    run_orbit();
+    run_orbit(in);
     status_.generator = jump_ == Jump::Idle;
     if (status_.generator) machining_s_ += period_s_;
+    adapt(in);
   }
   Pose p = memory_.at(s_);
   p[config_.tool_axis] += config_.lift_direction * lift_;
@@ -228,7 +257,86 @@ Pose GapServo::step(const GapInputs& in) noexcept {
   status_.orbit_radius_mm = radius_;
   status_.orbit_offset[0] = orbit_[0];
   status_.orbit_offset[1] = orbit_[1];
+  status_.finishing = finishing_;
+  status_.servo_reference_v = cond_.servo_reference_v;
+  status_.gain_mm_s_per_v = cond_.gain_mm_s_per_v;
+  status_.jump_period_s = cond_.jump_period_s;
+  status_.jump_height_mm = cond_.jump_height_mm;
   return p;
+}
+
+// The finishing cycle, a period: the path rests at its end (the interpolator waits), the electrode
+// comes back to it along the path after a short; the gap servo's law drives the orbit's radius
+// instead (the lateral servo: out while the gap voltage is above the reference, in below it, in at
+// once on a short), up to the condition's radius. Once a whole turn has burnt at that radius, the
+// code the burn's end brought is applied.
+void GapServo::run_finish(const GapInputs& in, bool due) noexcept {
+  const bool shorted = in.gap_state == machine::GapState::Short;
+  double lateral = 0;
+  law_mm_s_ = 0;
+  if (jump_ == Jump::Idle) {
+    const double v = servo_speed(in, due);
+    if (shorted || s_ < finish_s_ - 1e-12) {
+      v_ = v;
+      s_ = std::clamp(s_ + v * period_s_, memory_.tail_s(), finish_s_);
+    } else {
+      v_ = 0;  // at the path's end: the radius takes the law
+    }
+    feed_scale_ = 0;
+    if (!due) {
+      lateral = shorted ? -cond_.max_retract_mm_s
+                        : cond_.gain_mm_s_per_v * (status_.filtered_voltage_v - cond_.servo_reference_v);
+    }
+  }
+  run_jump(due && v_ == 0 && lateral_v_ == 0 && !shorted);
+  feed_scale_ = 0;
+  run_lateral(in, lateral);
+  status_.generator = jump_ == Jump::Idle;
+  if (status_.generator) machining_s_ += period_s_;
+  adapt(in);
+  if (full_turn_ >= 1) {
+    finishing_ = false;
+    lateral_v_ = 0;
+    select(pending_code_, pending_p_);
+  }
+}
+
+// The orbit's radius at the lateral servo's speed (out at most at the condition's forward speed,
+// in at the growth's rate, at the retract speed on a short) within the tool axis' acceleration,
+// between the centre and the condition's radius; it turns as the lateral servo lets it. A shape
+// still spiralling in from another condition goes on doing so first.
+void GapServo::run_lateral(const GapInputs& in, double target) noexcept {
+  if (shape_ != cond_.orbit || cond_.orbit_period_s <= 0) {
+    run_orbit(in);
+    return;
+  }
+  draw_period_s_ = cond_.orbit_period_s;
+  const double step = cond_.orbit_step_mm > 0 ? cond_.orbit_step_mm : cond_.orbit_radius_mm;
+  draw_rate_ = step / (0.25 * cond_.orbit_period_s);
+  const double dv = accel_ * period_s_;
+  const double limited = std::clamp(target, in.gap_state == machine::GapState::Short ? target : -draw_rate_,
+                                    cond_.max_forward_mm_s);
+  lateral_v_ = std::clamp(limited, lateral_v_ - dv, lateral_v_ + dv);
+  if (cond_.lateral_servo) follow_gap(in.gap_state == machine::GapState::Short);
+  turn();
+  const double r = std::clamp(radius_ + lateral_v_ * period_s_, 0.0, cond_.orbit_radius_mm);
+  if (r != radius_ + lateral_v_ * period_s_) lateral_v_ = 0;  // at the centre or the full size
+  radius_ = r;
+  orbit_offset(shape_, phase_, radius_, orbit_);
+  // The turn at full size counts where it burns: sparking, with the electrode at the burn's end
+  // (not lifted, not backed off up the path after a short: there it burns nothing).
+  const bool sparking = in.gap_state == machine::GapState::Normal || in.gap_state == machine::GapState::Arc;
+  if (radius_ >= cond_.orbit_radius_mm - 1e-9 && jump_ == Jump::Idle && sparking && s_ >= finish_s_ - 1e-9)
+    full_turn_ += orbit_rate_ * period_s_ / draw_period_s_;
+}
+
+// Adaptive control: every machining period in which the gap sparks (or shorts) feeds the window;
+// at its end the settings in force move within the condition's bounds (edm_adaptive.hpp).
+void GapServo::adapt(const GapInputs& in) noexcept {
+  if (!cond_.adaptive || !status_.generator || in.gap_state == machine::GapState::Open) return;
+  if (adaptive_.sample(in.gap_state, in.gap_voltage_v, base_, cond_)) ++status_.adaptations;
+  status_.abnormal_share = static_cast<float>(adaptive_.abnormal_share());
+  status_.voltage_spread = static_cast<float>(adaptive_.voltage_spread());
 }
 
 // Behind the head with nothing to machine: forward to it at the larger of the last condition's
@@ -255,6 +363,7 @@ double GapServo::servo_speed(const GapInputs& in, bool brake) noexcept {
   if (in.gap_state == machine::GapState::Short) target = -cond_.max_retract_mm_s;
   target = std::clamp(target, -cond_.max_retract_mm_s, cond_.max_forward_mm_s);
   if (brake && in.gap_state != machine::GapState::Short) target = 0;
+  law_mm_s_ = target;
   const double dv = accel_ * period_s_;
   return std::clamp(target, v_ - dv, v_ + dv);
 }
@@ -330,7 +439,7 @@ double GapServo::approach(double x, double target, double& v, double v_max, doub
 // The orbit turns at its period while the condition machines (through jumps and shorts too:
 // stopping it would be a step of velocity); its radius grows by a step per turn toward the final
 // radius, at a step per quarter turn, so that the shape spirals out and never jumps.
-void GapServo::run_orbit() noexcept {
+void GapServo::run_orbit(const GapInputs& in) noexcept {
   // Another shape (or none): the one drawn spirals in to the centre first, the new one grows from it.
   if (shape_ != cond_.orbit || cond_.orbit_period_s <= 0) {
     return_offsets();
@@ -340,14 +449,51 @@ void GapServo::run_orbit() noexcept {
   draw_period_s_ = cond_.orbit_period_s;
   const double step = cond_.orbit_step_mm > 0 ? cond_.orbit_step_mm : cond_.orbit_radius_mm;
   draw_rate_ = step / (0.25 * cond_.orbit_period_s);
-  turn();
   const double goal = std::min(cond_.orbit_radius_mm, step * (turns_ + 1));
-  radius_ += std::clamp(goal - radius_, -draw_rate_ * period_s_, draw_rate_ * period_s_);
+  if (cond_.lateral_servo) {
+    // A short draws the orbit in at the retract speed (within the acceleration), as the path
+    // backs off: the short may be at a side wall.
+    const bool shorted = in.gap_state == machine::GapState::Short;
+    follow_gap(shorted);
+    turn();
+    const double grow = std::clamp((goal - radius_) / period_s_, -draw_rate_, draw_rate_);
+    const double dv = accel_ * period_s_;
+    // Below the reference the orbit draws in at the law's speed as the path backs off at it (the
+    // narrowest gap may be at a side wall): the servo acts along both.
+    const double target = law_mm_s_ < 0 ? law_mm_s_ : grow;
+    lateral_v_ = std::clamp(shorted ? -cond_.max_retract_mm_s : target, lateral_v_ - dv, lateral_v_ + dv);
+    radius_ = std::max(0.0, radius_ + lateral_v_ * period_s_);
+    if (radius_ == 0) lateral_v_ = 0;
+  } else {
+    turn();
+    radius_ += std::clamp(goal - radius_, -draw_rate_ * period_s_, draw_rate_ * period_s_);
+  }
   orbit_offset(shape_, phase_, radius_, orbit_);
 }
 
+// The lateral servo's share of the orbit: it turns at its period while the filtered gap voltage is
+// at the reference or above and slows to a stop as it falls to half the reference (a short: at
+// once), the orbit's speed changing within a quarter of the tool axis' acceleration, so that the
+// electrode does not run into a side wall faster than the side discharges burn it back.
+void GapServo::follow_gap(bool shorted) noexcept {
+  const double ref = cond_.servo_reference_v;
+  // In the finishing cycle at the full radius the last turn goes up to twice as fast while the gap
+  // is wide (the walls there are burnt already): it ends sooner, not with the gap open.
+  const double fastest = finishing_ && radius_ >= cond_.orbit_radius_mm - 1e-9 ? 2.0 : 1.0;
+  const double target =
+      shorted || ref <= 0 ? 0.0
+                          : std::clamp((status_.filtered_voltage_v - 0.5 * ref) / (0.5 * ref), 0.0, fastest);
+  const double r = std::max(radius_, 1e-6);
+  const double per_turn = cond_.orbit == OrbitKind::Circle   ? 6.283185307179586 * r
+                          : cond_.orbit == OrbitKind::Square ? 12 * r
+                                                             : 8 * 3.141592653589793 * r;
+  const double peak_mm_s = per_turn / draw_period_s_;
+  const double dk = 0.25 * accel_ * period_s_ / peak_mm_s;
+  orbit_rate_ += std::clamp(target - orbit_rate_, -dk, dk);
+}
+
 void GapServo::turn() noexcept {
-  phase_ += period_s_ / draw_period_s_;
+  phase_ += orbit_rate_ * period_s_ / draw_period_s_;
   if (phase_ >= 1) {
     phase_ -= 1;
     ++turns_;
@@ -361,6 +507,7 @@ void GapServo::return_offsets() noexcept {
     radius_ = orbit_[0] = orbit_[1] = phase_ = 0;
     turns_ = 0;
     shape_ = OrbitKind::None;
+    orbit_rate_ = 1;  // at the centre the orbit stands still: its speed starts afresh
     return;
   }
   turn();

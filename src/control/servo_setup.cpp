@@ -146,7 +146,7 @@ namespace {
 // The EDM's configuration field by field on zeroed bytes (a flag and small integers before
 // doubles leave padding that copies carry along), for shared_setup's byte-for-byte comparison.
 // A new field changes these sizes: copy it below too.
-static_assert(sizeof(machine::EdmCondition) == 168 && sizeof(machine::EdmConfig) == 40 + 32 * 168 + 8,
+static_assert(sizeof(machine::EdmCondition) == 240 && sizeof(machine::EdmConfig) == 40 + 32 * 240 + 8,
               "a field was added to the EDM's configuration: copy it in plain_edm_config");
 void plain_edm_config(const machine::EdmConfig& e, machine::EdmConfig& out) {
   std::memset(static_cast<void*>(&out), 0, sizeof out);
@@ -181,6 +181,17 @@ void plain_edm_config(const machine::EdmConfig& e, machine::EdmConfig& out) {
     o.orbit_radius_mm = c.orbit_radius_mm;
     o.orbit_step_mm = c.orbit_step_mm;
     o.orbit_period_s = c.orbit_period_s;
+    o.orbit_finish = c.orbit_finish;
+    o.adaptive = c.adaptive;
+    o.lateral_servo = c.lateral_servo;
+    o.servo_reference_min_v = c.servo_reference_min_v;
+    o.servo_reference_max_v = c.servo_reference_max_v;
+    o.gain_min_mm_s_per_v = c.gain_min_mm_s_per_v;
+    o.gain_max_mm_s_per_v = c.gain_max_mm_s_per_v;
+    o.jump_period_min_s = c.jump_period_min_s;
+    o.jump_period_max_s = c.jump_period_max_s;
+    o.jump_height_min_mm = c.jump_height_min_mm;
+    o.jump_height_max_mm = c.jump_height_max_mm;
     o.side_gap_mm = c.side_gap_mm;
     o.electrode_wear_ratio = c.electrode_wear_ratio;
   }

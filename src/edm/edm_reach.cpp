@@ -19,7 +19,8 @@ Reach reach_of(const machine::EdmCondition& c) {
     r.orbit_condition = c.number;
   }
   if (c.jump_period_s > 0 && c.jump_mode == machine::JumpMode::Axis) {
-    r.jump_mm = c.jump_height_mm;
+    r.jump_mm = std::max(c.jump_height_mm,
+                         c.adaptive ? c.jump_height_max_mm : 0.0);  // adaptive control may lift higher
     r.jump_condition = c.number;
   }
   return r;
@@ -102,7 +103,8 @@ void ReachCheck::start_tail(int n) {
       if (config_.joints[static_cast<std::size_t>(j)].axis == config_.edm.tool_axis)
         a = 0.5 * config_.joints[static_cast<std::size_t>(j)].max_acceleration;
     }
-    t = std::max(t, 2 * (c->jump_height_mm / c->jump_speed_mm_s + (a > 0 ? c->jump_speed_mm_s / a : 0)));
+    const double h = std::max(c->jump_height_mm, c->adaptive ? c->jump_height_max_mm : 0.0);
+    t = std::max(t, 2 * (h / c->jump_speed_mm_s + (a > 0 ? c->jump_speed_mm_s / a : 0)));
   }
   const double left = tail_s_ - since_s_;
   tail_ = left > 0 || tail_first_ ? wider(tail_, reach_of(*c)) : reach_of(*c);

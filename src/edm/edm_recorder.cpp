@@ -16,9 +16,11 @@ void EdmRecorder::on_trace(const control::TraceSample& s, const controller::Trac
   const control::EdmStatus& e = s.edm;
   if (first_) {
     jumps_at_start_ = e.jumps;
+    adaptations_at_start_ = e.adaptations;
     first_ = false;
   }
   jumps_now_ = e.jumps;
+  adaptations_now_ = e.adaptations;
   last_tick_ = s.tick;
   using machine::GapState;
   if (shorted_ && !e.on) end_short(s.tick, false);  // the burn ended shorted (M181, the run's end, a fault)
@@ -33,9 +35,14 @@ void EdmRecorder::on_trace(const control::TraceSample& s, const controller::Trac
   const bool pulsing = burning_ && e.generator;
   if (pulsing) {
     ++machining_;
+    // The reference in force (adaptive control moves it); a trace without it: the condition's.
     const machine::EdmCondition* c = edm_.find(e.condition);
-    if (c != nullptr && std::fabs(e.gap_voltage_v - c->servo_reference_v) <= 0.1 * c->servo_reference_v)
-      ++in_band_;
+    const double ref = e.servo_reference_v > 0 ? e.servo_reference_v
+                       : c != nullptr          ? c->servo_reference_v
+                                               : 0.0;
+    if (ref > 0 && std::fabs(e.gap_voltage_v - ref) <= 0.1 * ref) ++in_band_;
+    if (e.finishing) ++finishing_;
+    note_settings(e);
     if (e.gap_state == GapState::Arc) {
       ++r_.arc_periods;
       if (last_ != GapState::Arc) ++r_.arcs;
@@ -50,6 +57,17 @@ void EdmRecorder::on_trace(const control::TraceSample& s, const controller::Trac
   if (shorted_ && e.generator && (e.gap_state == GapState::Normal || e.gap_state == GapState::Arc))
     end_short(s.tick, true);
   if (e.generator) last_ = e.gap_state;
+}
+
+// The settings in force while the generator pulses: the range each one covered.
+void EdmRecorder::note_settings(const control::EdmStatus& e) {
+  const double now[4] = {e.servo_reference_v, e.gain_mm_s_per_v, e.jump_period_s, e.jump_height_mm};
+  double* range[4] = {r_.servo_reference_v, r_.gain_mm_s_per_v, r_.jump_period_s, r_.jump_height_mm};
+  for (int i = 0; i < 4; ++i) {
+    range[i][0] = settings_seen_ ? std::min(range[i][0], now[i]) : now[i];
+    range[i][1] = settings_seen_ ? std::max(range[i][1], now[i]) : now[i];
+  }
+  settings_seen_ = true;
 }
 
 void EdmRecorder::end_short(std::uint64_t tick, bool cleared) {
@@ -70,6 +88,8 @@ EdmReport EdmRecorder::report() const {
   r.gap_voltage_in_band_fraction =
       machining_ > 0 ? static_cast<double>(in_band_) / static_cast<double>(machining_) : 0.0;
   r.jumps = jumps_now_ - jumps_at_start_;
+  r.finishing_s = static_cast<double>(finishing_) * period_s_;
+  r.adaptations = adaptations_now_ - adaptations_at_start_;
   return r;
 }
 
@@ -81,7 +101,15 @@ std::string EdmRecorder::report_text() const {
              e.machining_s, 100 * e.gap_voltage_in_band_fraction, e.jumps, e.depth_mm) +
          fmt::format(
              "edm gap             {} shorts ({} never cleared; longest {:.3f} s), {} arcs ({} periods)\n",
-             e.shorts, e.shorts_uncleared, e.short_recovery_max_s, e.arcs, e.arc_periods);
+             e.shorts, e.shorts_uncleared, e.short_recovery_max_s, e.arcs, e.arc_periods) +
+         (e.adaptations > 0 || e.finishing_s > 0
+              ? fmt::format("edm control         {:.1f} s finishing cycle, {} adaptations: reference "
+                            "{:.1f}–{:.1f} V, "
+                            "gain {:.4f}–{:.4f} mm/s/V, jump every {:.3f}–{:.3f} s, {:.3f}–{:.3f} mm high\n",
+                            e.finishing_s, e.adaptations, e.servo_reference_v[0], e.servo_reference_v[1],
+                            e.gain_mm_s_per_v[0], e.gain_mm_s_per_v[1], e.jump_period_s[0],
+                            e.jump_period_s[1], e.jump_height_mm[0], e.jump_height_mm[1])
+              : std::string());
 }
 
 std::string EdmRecorder::report_json() const {
@@ -96,6 +124,12 @@ std::string EdmRecorder::report_json() const {
   j["short_recovery_max_s"] = e.short_recovery_max_s;
   j["depth_mm"] = e.depth_mm;
   j["jumps"] = e.jumps;
+  j["finishing_s"] = e.finishing_s;
+  j["adaptations"] = e.adaptations;
+  j["servo_reference_v"] = {e.servo_reference_v[0], e.servo_reference_v[1]};
+  j["gain_mm_s_per_v"] = {e.gain_mm_s_per_v[0], e.gain_mm_s_per_v[1]};
+  j["jump_period_s"] = {e.jump_period_s[0], e.jump_period_s[1]};
+  j["jump_height_mm"] = {e.jump_height_mm[0], e.jump_height_mm[1]};
   return j.dump();
 }
 

@@ -45,7 +45,15 @@ json edm_json(const control::ServoStatus& s, const machine::EdmConfig& c) {
   return {{"on", e.on},
           {"generator", e.generator},
           {"condition", e.condition},
-          {"reference_v", cond != nullptr ? json(cond->servo_reference_v) : json(nullptr)},
+          // The reference in force (adaptive control moves it), else the condition's.
+          {"reference_v", e.servo_reference_v > 0 ? json(e.servo_reference_v)
+                          : cond != nullptr       ? json(cond->servo_reference_v)
+                                                  : json(nullptr)},
+          {"gain_mm_s_per_v", e.gain_mm_s_per_v},
+          {"jump_period_s", e.jump_period_s},
+          {"jump_height_mm", e.jump_height_mm},
+          {"adaptations", e.adaptations},
+          {"finishing", e.finishing},
           {"gap_state", gap_name(e.gap_state)},
           {"gap_voltage_v", e.gap_voltage_v},
           {"filtered_voltage_v", e.filtered_voltage_v},

@@ -68,12 +68,24 @@ void SimEdmProcess::select(const GeneratorOutputs& gen) noexcept {
   condition_ = gen.condition;
   side_gap_mm_ = config_.breakdown_um_per_v * 1e-3 * gen.voltage_v;
   wear_ratio_ = 0;
+  double reference_v = 0;
   for (int i = 0; i < config_.condition_count; ++i) {
     const SimEdmConditionEffect& c = config_.conditions[static_cast<std::size_t>(i)];
     if (c.number != gen.condition) continue;
     if (c.side_gap_mm > 0) side_gap_mm_ = c.side_gap_mm;
     wear_ratio_ = c.electrode_wear_ratio;
+    reference_v = c.servo_reference_v;
   }
+  // The share x of the breakdown distance at which the mean voltage (U0·t_d + Ue·t_on)/(t_d +
+  // t_on + t_off) is the reference: t_d = (Ur·(t_on + t_off) − Ue·t_on)/(U0 − Ur), x = t_d/(t_on + t_d).
+  double x_ref = 1;
+  const double ton = std::max(gen.on_time_us, 0.1), toff = std::max(gen.off_time_us, 0.0);
+  const double ue = config_.discharge_voltage_v;
+  if (reference_v > 0 && reference_v < gen.voltage_v) {
+    const double td = (reference_v * (ton + toff) - ue * ton) / (gen.voltage_v - reference_v);
+    x_ref = std::clamp(td / (ton + std::max(td, 0.0)), 0.05, 1.0);
+  }
+  side_breakdown_mm_ = side_gap_mm_ / x_ref;
 }
 
 // The front of this orientation; a new one only where the generator sparks (create): B turning
@@ -173,30 +185,95 @@ void SimEdmProcess::step(const SimEdmPose& pose, bool generator_on, const Genera
     return;
   }
   select(gen);
-  if (short_ || gap_mm_ <= 0) {
+  const auto f = static_cast<std::size_t>(front_index_);
+  const bool removal = config_.side_walls == SideWalls::Removal;
+  if (removal && burning_[f]) lateral_offset(pose, side_reach_);
+  double x_side = 2;
+  const int side = removal && burning_[f] ? narrowest_side(tip, x_side) : -1;
+  const double x_front = gap_mm_ / breakdown;
+  if (removal && !short_ && gap_mm_ > 0) debris_bridge(breakdown, rng);
+  if (short_ || gap_mm_ <= 0 || (side >= 0 && x_side <= 0)) {
     state_ = GapState::Short;
     voltage_v_ = 0.5 + 0.2 * std::fabs(gauss(rng));
-  } else if (gap_mm_ >= breakdown) {
+  } else if (removal ? std::min(x_front, x_side) >= 1 : gap_mm_ >= breakdown) {
     state_ = GapState::Open;
     voltage_v_ = u0 + config_.noise_v * gauss(rng);
+  } else if (side >= 0 && x_side < x_front) {
+    discharge(gen, x_side, side, rng);
   } else {
-    discharge(gen, gap_mm_ / breakdown, rng);
+    if (removal && burning_[f]) edge_walls(gap_mm_);
+    discharge(gen, x_front, -1, rng);
   }
-  const auto f = static_cast<std::size_t>(front_index_);
   if (!burning_[f] && (state_ == GapState::Normal || state_ == GapState::Arc)) {  // the burn's centre
     burning_[f] = true;
     centre_[2 * f] = pose.lateral[0];
     centre_[2 * f + 1] = pose.lateral[1];
+    if (removal) {  // the mouth of the cavity: the frontal gap round the outline
+      lateral_offset(pose, side_reach_);
+      edge_walls(gap_mm_);
+    }
   }
-  if (burning_[f] && state_ != GapState::Short) burn_sides(pose, tip);
+  if (!removal && burning_[f] && state_ != GapState::Short) burn_sides(pose, tip);
+}
+
+// The electrode's lateral offset from the burn's centre (the joints it has).
+void SimEdmProcess::lateral_offset(const SimEdmPose& pose, double d[2]) const noexcept {
+  const auto f = static_cast<std::size_t>(front_index_);
+  d[0] = config_.lateral_joints[0] >= 0 ? pose.lateral[0] - centre_[2 * f] : 0.0;
+  d[1] = config_.lateral_joints[1] >= 0 ? pose.lateral[1] - centre_[2 * f + 1] : 0.0;
+}
+
+// The wall nearest to sparking: its distance from the electrode's outline (the wall less the
+// outline's reach along its direction) over the side's breakdown distance, debris widening it as
+// it widens the front's. None while the tip is not yet in the work.
+int SimEdmProcess::narrowest_side(double tip, double& x) const noexcept {
+  x = 2;
+  const auto f = static_cast<std::size_t>(front_index_);
+  if ((tip - config_.surface_mm) * config_.work_direction <= 0 || side_breakdown_mm_ <= 0) return -1;
+  const double b = side_breakdown_mm_ * (1 + debris_);
+  int best = -1;
+  for (int k = 0; k < kSides; ++k) {
+    const auto uk = static_cast<std::size_t>(k);
+    const double reach = side_reach_[0] * direction_[2 * uk] + side_reach_[1] * direction_[2 * uk + 1];
+    const double xk = (wall_[f * kSides + uk] - reach) / b;
+    if (xk < x) {
+      x = xk;
+      best = k;
+    }
+  }
+  return best;
+}
+
+// The front's discharges at the electrode's edge leave the cavity's mouth the frontal gap wider
+// than the outline in every direction the electrode faces (where the sides have not burnt further).
+void SimEdmProcess::edge_walls(double gap) noexcept {
+  const auto f = static_cast<std::size_t>(front_index_);
+  for (int k = 0; k < kSides; ++k) {
+    const auto uk = static_cast<std::size_t>(k);
+    const double reach = side_reach_[0] * direction_[2 * uk] + side_reach_[1] * direction_[2 * uk + 1];
+    double& wall = wall_[f * kSides + uk];
+    wall = std::max(wall, reach + gap);
+  }
+}
+
+// Debris above short_debris bridges the gap now and then (more often the more there is): a short
+// until the electrode has backed off half a breakdown gap further, as an injected bridge does.
+void SimEdmProcess::debris_bridge(double breakdown, SplitMix64& rng) noexcept {
+  if (config_.short_debris <= 0 || debris_ <= config_.short_debris) return;
+  constexpr double kBridgesPerPeriod = 0.01;  // at twice the threshold, one period in a hundred
+  const double p = kBridgesPerPeriod * std::min(1.0, (debris_ - config_.short_debris) / config_.short_debris);
+  if (0.5 * (rng.symmetric() + 1) >= p) return;
+  short_ = true;
+  bridge_until_mm_ = gap_mm_ + 0.5 * breakdown;
 }
 
 // The discharges of one period: each waits an ignition delay that grows without bound as the gap
 // nears the breakdown width (t_d = t_on·x/(1−x), x = gap / breakdown gap), burns for t_on at the
 // discharge voltage and pauses t_off; the mean voltage is (U0·t_d + Ue·t_on)/(t_d + t_on + t_off).
 // Debris above the threshold turns discharges into arcs (no delay, little removal) with a
-// probability that grows with it.
-void SimEdmProcess::discharge(const GeneratorOutputs& gen, double x, SplitMix64& rng) noexcept {
+// probability that grows with it. They burn the front (side < 0) or wall `side`: its area is its
+// share of the electrode's outline times the cavity's depth.
+void SimEdmProcess::discharge(const GeneratorOutputs& gen, double x, int side, SplitMix64& rng) noexcept {
   const double ton = std::max(gen.on_time_us, 0.1), toff = std::max(gen.off_time_us, 0.0);
   const double ue = config_.discharge_voltage_v;
   const double p_arc = std::clamp((debris_ - config_.arc_threshold) / (1 - config_.arc_threshold), 0.0, 1.0);
@@ -208,14 +285,22 @@ void SimEdmProcess::discharge(const GeneratorOutputs& gen, double x, SplitMix64&
   const double n = period_s_ * 1e6 / cycle_us;
   const double volume =
       n * config_.removal_mm3_per_a_us * gen.peak_current_a * ton * (arc ? kArcRemoval : 1.0);
+  debris_ = std::min(2.0, debris_ + volume * config_.debris_per_mm3);
+  discharges_ += static_cast<std::uint64_t>(n);
+  if (side >= 0) {
+    const auto f = static_cast<std::size_t>(front_index_);
+    const double area = config_.electrode_perimeter_mm / kSides * std::max(depth_mm(), 0.001);
+    const double b = side_breakdown_mm_ * (1 + debris_);
+    const double room = b * (1 - x);  // a wall burns no further than where it stops sparking
+    wall_[f * kSides + static_cast<std::size_t>(side)] += std::min(volume / area, room);
+    return;
+  }
   const double dz = std::min(volume / config_.electrode_area_mm2, gap_mm_);
   front_[static_cast<std::size_t>(front_index_)] += config_.work_direction * dz;
   // The electrode's face wears by the ratio of the volume (the same area): the gap closes less.
   const double worn = wear_ratio_ * dz;
   wear_[static_cast<std::size_t>(electrode_)] += worn;
   gap_mm_ -= dz - worn;
-  debris_ = std::min(2.0, debris_ + volume * config_.debris_per_mm3);
-  discharges_ += static_cast<std::uint64_t>(n);
 }
 
 void SimEdmProcess::sample(ProcessInputs& in) const noexcept {

@@ -78,6 +78,20 @@ TEST(EdmProfile, TheFiveAxisEdmLoadsWithItsConditions) {
   EXPECT_EQ(p.edm.sim.conditions[2].electrode_wear_ratio, 0.08);
   EXPECT_EQ(p.edm.sim.lateral_joints[0], 0);
   EXPECT_EQ(p.edm.sim.lateral_joints[1], 1);
+  // Issue 28: condition 3 finishes with the cycle and the lateral servo under adaptive control;
+  // a bound the profile leaves out is the condition's own value (that setting stays); the
+  // simulated gap burns its walls by their rate and knows each condition's reference.
+  EXPECT_TRUE(c->orbit_finish);
+  EXPECT_TRUE(c->lateral_servo);
+  EXPECT_TRUE(c->adaptive);
+  EXPECT_EQ(c->gain_min_mm_s_per_v, c->gain_mm_s_per_v);
+  EXPECT_EQ(c->gain_max_mm_s_per_v, 0.05);
+  EXPECT_EQ(c->jump_height_min_mm, c->jump_height_mm);
+  EXPECT_EQ(c->jump_height_max_mm, c->jump_height_mm);
+  EXPECT_FALSE(p.edm.config.find(9)->adaptive);
+  EXPECT_EQ(p.edm.sim.side_walls, machine::SideWalls::Removal);
+  EXPECT_EQ(p.edm.sim.electrode_perimeter_mm, 24.0);
+  EXPECT_EQ(p.edm.sim.conditions[2].servo_reference_v, 40.0);
 }
 
 /// The line (1-based) of the first line of `text` that starts with `start`, from line `from` on.
@@ -111,6 +125,16 @@ TEST(EdmProfile, BadConditionsAreNamedWhereTheyAre) {
        "short_timeout_s", "edm.short_timeout_s must be greater than 0"},
       {base + condition("electrode_wear_ratio = 1.5\n"), "electrode_wear_ratio", "must be below 1"},
       {base + condition("side_gap_mm = -0.01\n"), "side_gap_mm", "side_gap_mm"},
+      // Issue 28: the finishing cycle needs an orbit; adaptive control's bounds enclose the
+      // condition's own value, the reference's stays below the open voltage.
+      {base + condition("orbit_finish = true\n"), "orbit_finish", "needs an orbit"},
+      {base + condition("adaptive = true\ngain_min_mm_s_per_v = 0.05\n"), "gain_min_mm_s_per_v",
+       "must enclose the condition's own value (0.02)"},
+      {base + condition("adaptive = true\njump_period_s = 0.2\njump_height_mm = 0.5\njump_speed_mm_s = 20\n"
+                        "jump_period_max_s = 0.1\n"),
+       "jump_period_max_s", "must enclose"},
+      {base + condition("adaptive = true\nservo_reference_max_v = 100\n"), "servo_reference_max_v",
+       "must be below voltage_v"},
   };
   for (const Bad& b : cases) {
     const ProfileLoad load = parse_profile(b.text, "edm.toml");

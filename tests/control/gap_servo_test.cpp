@@ -229,6 +229,114 @@ TEST(Orbit, GrowsInStepsToTheFinalRadius) {
   EXPECT_EQ(r.electrode[1], 0.0);
 }
 
+TEST(GapServo, TheFinishingCycleHoldsTheBurnsEndUntilTheOrbitIsFullAndTurnedThere) {
+  // A square growing 0.02 mm a turn to 0.06 mm; M181 comes after a quarter turn. The head stands
+  // at the path's end (feed 0): the path rests.
+  machine::EdmCondition c = roughing();
+  c.orbit = machine::OrbitKind::Square;
+  c.orbit_radius_mm = 0.06;
+  c.orbit_step_mm = 0.02;
+  c.orbit_period_s = 0.5;
+  c.orbit_finish = true;
+  c.lateral_servo = true;
+  Rig r(config_with(c));
+  r.feed = 0;
+  const double z_end = r.electrode[2];
+  // The gap 5 V above the reference while the orbit is short of its radius, at it once full.
+  auto side = [&r](double, double) {
+    return std::pair{r.g.status().orbit_radius_mm < 0.06 ? 50.0 : 45.0, GapState::Normal};
+  };
+  r.run(125, side);
+  EXPECT_TRUE(r.g.apply_code(181, 0));  // accepted, but held: the burn goes on
+  EXPECT_TRUE(r.g.status().on);
+  r.run(1, side);
+  EXPECT_TRUE(r.g.status().finishing);
+  EXPECT_TRUE(r.g.head_waits());
+  EXPECT_EQ(r.g.feed_scale(), 0.0);
+  // The radius stands at the first step (0.02 mm after a quarter turn at the growth's rate); the
+  // lateral servo drives it out at gain × 5 V = 0.1 mm/s: the full 0.06 mm 0.4 s later, then one
+  // turn of 0.5 s there (the gap at the reference: the orbit at its period's speed).
+  EXPECT_NEAR(r.g.status().orbit_radius_mm, 0.02, 2e-4);
+  int ticks = 1, full_at = -1;
+  while (r.g.status().finishing && ticks < 5000) {
+    r.run(1, side);
+    ++ticks;
+    if (full_at < 0 && r.g.status().orbit_radius_mm >= 0.06) full_at = ticks;
+    EXPECT_EQ(r.electrode[2], z_end) << "the final depth is held";
+  }
+  EXPECT_NEAR(full_at, 400, 5);
+  EXPECT_NEAR(ticks - full_at, 500, 2);
+  EXPECT_FALSE(r.g.status().on);  // the held M181 applied at the end
+  EXPECT_FALSE(r.g.status().finishing);
+}
+
+TEST(GapServo, TheLateralServoSlowsTheOrbitAndDrawsItInOnAShort) {
+  machine::EdmCondition c = roughing();
+  c.orbit = machine::OrbitKind::Circle;
+  c.orbit_radius_mm = 0.05;
+  c.orbit_period_s = 0.5;
+  c.lateral_servo = true;
+  Rig r(config_with(c));
+  r.feed = 0;
+  r.run(1000, [](double, double) { return std::pair{45.0, GapState::Normal}; });
+  const double r_full = r.g.status().orbit_radius_mm;
+  EXPECT_NEAR(r_full, 0.05, 1e-9);
+  // A short: the orbit stops turning (within a quarter of the axis' acceleration) and draws in.
+  r.run(20, [](double, double) { return std::pair{0.5, GapState::Short}; });
+  const double x0 = r.electrode[0], y0 = r.electrode[1];
+  EXPECT_LT(r.g.status().orbit_radius_mm, r_full);
+  r.run(1, [](double, double) { return std::pair{0.5, GapState::Short}; });
+  const double angle = std::atan2(r.electrode[1], r.electrode[0]) - std::atan2(y0, x0);
+  EXPECT_NEAR(angle, 0.0, 1e-12) << "no turning while shorted";
+}
+
+TEST(EdmAdaptive, MovesTheSettingsWithinTheirBoundsByTheGapsState) {
+  machine::EdmCondition base = roughing();
+  base.adaptive = true;
+  base.jump_period_s = 0.25;
+  base.jump_height_mm = 0.4;
+  base.jump_period_min_s = 0.1;
+  base.jump_period_max_s = 0.5;
+  base.jump_height_min_mm = 0.2;
+  base.jump_height_max_mm = 0.6;
+  base.servo_reference_min_v = 40;
+  base.servo_reference_max_v = 50;
+  base.gain_min_mm_s_per_v = 0.02;
+  base.gain_max_mm_s_per_v = 0.05;
+  machine::EdmCondition active = base;
+  EdmAdaptive a;
+  a.reset();
+  // An unstable gap (a fifth of the periods arcing): the jump sooner and higher, the reference up.
+  bool changed = false;
+  for (int i = 0; i < EdmAdaptive::kWindow; ++i)
+    changed = a.sample(i % 5 == 0 ? GapState::Arc : GapState::Normal, 45.0, base, active);
+  EXPECT_TRUE(changed);
+  EXPECT_NEAR(a.abnormal_share(), 0.2, 1e-12);
+  EXPECT_NEAR(active.jump_period_s, 0.2, 1e-12);
+  EXPECT_NEAR(active.jump_height_mm, 0.48, 1e-12);
+  EXPECT_NEAR(active.servo_reference_v, 46, 1e-12);
+  // Many windows of it: held at the bounds.
+  for (int i = 0; i < 100 * EdmAdaptive::kWindow; ++i)
+    a.sample(i % 5 == 0 ? GapState::Arc : GapState::Normal, 45.0, base, active);
+  EXPECT_EQ(active.jump_period_s, 0.1);
+  EXPECT_EQ(active.jump_height_mm, 0.6);
+  EXPECT_EQ(active.servo_reference_v, 50);
+  // A clean gap whose voltage lags 10 % above the reference: the gain up to its bound, the jump
+  // later and lower again, the reference down to its bound.
+  for (int i = 0; i < 100 * EdmAdaptive::kWindow; ++i)
+    a.sample(GapState::Normal, 1.1 * active.servo_reference_v, base, active);
+  EXPECT_EQ(active.gain_mm_s_per_v, 0.05);
+  EXPECT_EQ(active.jump_period_s, 0.5);
+  EXPECT_EQ(active.jump_height_mm, 0.2);
+  EXPECT_EQ(active.servo_reference_v, 40);
+  // Without bounds (min = max, as the profile reader sets them for absent keys) nothing moves.
+  const machine::EdmCondition fixed = roughing();
+  machine::EdmCondition same = fixed;
+  for (int i = 0; i < 10 * EdmAdaptive::kWindow; ++i)
+    EXPECT_FALSE(a.sample(GapState::Arc, 20.0, fixed, same));
+  EXPECT_EQ(same.gain_mm_s_per_v, fixed.gain_mm_s_per_v);
+}
+
 TEST(GapServo, UnknownConditionSwitchesTheGeneratorOff) {
   Rig r(config_with(roughing()));
   EXPECT_FALSE(r.g.apply_code(180, 7));

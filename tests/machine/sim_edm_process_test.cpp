@@ -225,5 +225,78 @@ TEST(SimEdmProcess, TheElectrodeWearsByTheConditionsRatio) {
   EXPECT_EQ(c.p.electrode_wear_mm(), 0.0);
 }
 
+TEST(SimEdmProcess, WithARemovalRateASideWallRecedesByItsDischargesAndLoadsTheGap) {
+  // The walls burn by the side discharges: condition 2's side gap of 20 µm is the widest side
+  // distance that sparks here (no reference given), the electrode's outline 16 mm.
+  Cavity c;
+  SimEdmConfig cfg;
+  cfg.present = true;
+  cfg.surface_mm = 0;
+  cfg.noise_v = 0;
+  cfg.debris_per_mm3 = 0;  // the default removal: a wall recedes by less than its room in a period
+  cfg.lateral_joints[0] = 0;
+  cfg.lateral_joints[1] = 1;
+  cfg.conditions[0] = {2, 0.020, 0.0, 0.0};
+  cfg.condition_count = 1;
+  cfg.side_walls = SideWalls::Removal;
+  cfg.electrode_perimeter_mm = 16;
+  c.p.configure(cfg, 0.001);
+  for (int i = 0; i < 4000; ++i) c.hold(0.010);
+  ASSERT_GT(c.p.depth_mm(), 0.05);
+  // Sinking without a lateral move the front's discharges at the edge leave the mouth the frontal
+  // gap (10 µm) wide all round; the sides (x = 10/20) are wider than the front (10/30): no side burns.
+  for (int k = 0; k < SimEdmProcess::kSides; ++k) EXPECT_NEAR(c.p.side_wall_mm(k), 0.010, 1e-12) << k;
+  // 6 µm along +X: the wall facing +X stands 4 µm off (x = 0.2), nearer than the front (x = 1/3):
+  // the period's discharges go there, at that gap's voltage, and it recedes by their volume over
+  // its area (16 mm / 32 × the depth), not at once.
+  c.pose.lateral[0] = 5.006;
+  const double depth = c.p.depth_mm();
+  c.hold(0.010);
+  ProcessInputs in;
+  c.p.sample(in);
+  EXPECT_EQ(in.gap_state, GapState::Normal);
+  const double x = 0.004 / 0.020, ton = 100, toff = 50, td = ton * x / (1 - x);
+  EXPECT_NEAR(in.gap_voltage_v, (100 * td + 25 * ton) / (td + ton + toff), 1e-9);
+  const double volume = 1000 / (td + ton + toff) * 5e-8 * 12 * ton;
+  EXPECT_NEAR(c.p.side_wall_mm(0) - 0.010, volume / (16.0 / 32 * depth), 1e-12);
+  EXPECT_NEAR(c.p.depth_mm(), depth, 1e-15) << "the front did not burn this period";
+  EXPECT_NEAR(c.p.side_wall_mm(SimEdmProcess::kSides / 2), 0.010, 1e-12);
+  // Held there with the front out of reach, the wall burns out to the side gap beyond the
+  // outline and no further; then the gap is open.
+  for (int i = 0; i < 2000; ++i) c.hold(0.040);
+  EXPECT_NEAR(c.p.side_wall_mm(0), 0.006 + 0.020, 1e-6);
+  c.p.sample(in);
+  EXPECT_EQ(in.gap_state, GapState::Open);
+}
+
+TEST(SimEdmProcess, DebrisAboveItsThresholdBridgesTheGapIntoShorts) {
+  // No jump: the debris of a steady burn passes short_debris, and bridges short the gap now and
+  // then; each holds until the electrode has backed off half a breakdown gap.
+  auto shorts_with = [](double short_debris) {
+    Cavity c;
+    SimEdmConfig cfg;
+    cfg.present = true;
+    cfg.surface_mm = 0;
+    cfg.noise_v = 0;
+    cfg.side_walls = SideWalls::Removal;
+    cfg.short_debris = short_debris;
+    cfg.arc_threshold = 0.99;  // debris makes no arcs here: the shorts alone
+    c.p.configure(cfg, 0.001);
+    int n = 0;
+    for (int i = 0; i < 5000; ++i) {
+      c.hold(0.010);
+      ProcessInputs in;
+      c.p.sample(in);
+      n += in.gap_state == GapState::Short ? 1 : 0;
+    }
+    return std::pair{n, c.p.debris()};
+  };
+  const auto [none, debris] = shorts_with(0);
+  EXPECT_EQ(none, 0);
+  ASSERT_GT(debris, 0.2);
+  const auto [some, debris_too] = shorts_with(0.5 * debris);
+  EXPECT_GT(some, 0);
+}
+
 }  // namespace
 }  // namespace opencnc::machine

@@ -26,6 +26,15 @@ struct EdmStatus {
   std::uint32_t jumps = 0;          ///< jumps begun since the machine started
   double orbit_radius_mm = 0;       ///< the orbit's radius now
   double orbit_offset[2] = {0, 0};  ///< the orbit's offset in its plane
+  bool finishing = false;           ///< the finishing cycle holds the burn at the path's end
+  // The servo's and the jump's settings in force (the condition's, or as adaptive control set them).
+  double servo_reference_v = 0;
+  double gain_mm_s_per_v = 0;
+  double jump_period_s = 0;
+  double jump_height_mm = 0;
+  float abnormal_share = 0;       ///< adaptive control's last window: share of arc and short periods
+  float voltage_spread = 0;       ///< … and the gap voltage's standard deviation over the reference
+  std::uint32_t adaptations = 0;  ///< windows in which adaptive control changed a setting (since start)
 };
 
 static_assert(std::is_trivially_copyable_v<EdmStatus>);

@@ -7,6 +7,7 @@
 #include <array>
 #include <cstdint>
 
+#include "opencnc/control/edm_adaptive.hpp"
 #include "opencnc/control/edm_status.hpp"
 #include "opencnc/core/axes.hpp"
 #include "opencnc/machine/edm.hpp"
@@ -67,7 +68,8 @@ class GapServo {
   /// A run starts at `at`: the path memory starts there, the generator is off.
   void begin_run(const Pose& at) noexcept;
   /// M180 P<n> (select condition n, generator on) or M181 (generator off). False: no such
-  /// condition (the generator goes off).
+  /// condition (the generator goes off). Under a condition with the finishing cycle the code waits
+  /// (the interpolator with it) until the orbit is full at the path's end and has turned there.
   bool apply_code(int code, double p) noexcept;
   /// One period: returns where the electrode shall be (the head, or behind it, plus offsets).
   Pose step(const GapInputs& in) noexcept;
@@ -75,12 +77,14 @@ class GapServo {
   /// behind the head or the gap wants it back).
   double feed_scale() const noexcept { return feed_scale_; }
   /// The electrode stands behind the head or is lifted: the interpolator waits, rapids included.
-  bool head_waits() const noexcept { return jump_ != Jump::Idle || s_ < memory_.head_s() - 1e-9; }
+  bool head_waits() const noexcept {
+    return finishing_ || jump_ != Jump::Idle || s_ < memory_.head_s() - 1e-9;
+  }
   /// The generator's pulses on, and its settings.
   bool generator_on() const noexcept { return status_.generator; }
   machine::GeneratorOutputs generator() const noexcept;
   const EdmStatus& status() const noexcept { return status_; }
-  /// The active condition (number 0: none).
+  /// The active condition (number 0: none), with the settings adaptive control has moved.
   const EdmCondition& condition() const noexcept { return cond_; }
   /// The gap has been shorted for longer than the condition's short_timeout_s: the machine must
   /// stop (the tick faults).
@@ -91,11 +95,16 @@ class GapServo {
   bool reached_retract_limit() const noexcept { return reached_retract_limit_; }
 
  private:
+  bool select(int code, double p) noexcept;
   double servo_speed(const GapInputs& in, bool brake) noexcept;
+  void run_finish(const GapInputs& in, bool due) noexcept;
+  void run_lateral(const GapInputs& in, double target) noexcept;
+  void adapt(const GapInputs& in) noexcept;
   bool jump_due() const noexcept;
   void move_electrode(double v, const GapInputs& in) noexcept;
   void run_jump(bool may_start) noexcept;
-  void run_orbit() noexcept;
+  void run_orbit(const GapInputs& in) noexcept;
+  void follow_gap(bool shorted) noexcept;
   void turn() noexcept;
   void return_offsets() noexcept;
   void catch_up() noexcept;
@@ -109,6 +118,7 @@ class GapServo {
   double s_ = 0;        ///< the electrode's path length on the memory
   double v_ = 0;        ///< its signed speed along the path
   double catch_v_ = 0;  ///< its speed walking up to the head with nothing to machine
+  double law_mm_s_ = 0;  ///< the law's speed target this period (before the acceleration limit)
   double feed_scale_ = 1;
   bool reached_retract_limit_ = false;
   bool pressing_limit_ = false;  ///< backing off against the end of the memory (until it lets go)
@@ -121,10 +131,21 @@ class GapServo {
   double machining_s_ = 0;
   // Orbit: phase (turns, 0 … 1), the radius now and the turns completed.
   double phase_ = 0, radius_ = 0;
+  double orbit_rate_ = 1;  ///< the share of its period's speed the orbit turns at (the lateral servo)
   int turns_ = 0;
   OrbitKind shape_ = OrbitKind::None;  ///< the shape drawn now (a new condition's waits for the centre)
   double draw_period_s_ = 1, draw_rate_ = 0;  ///< its period and its radial rate (mm/s)
   double orbit_[2] = {0, 0};
+  // The finishing cycle: the code it holds back, the radial speed and the burnt turn at full size.
+  bool finishing_ = false;
+  int pending_code_ = 0;
+  double pending_p_ = 0;
+  double lateral_v_ = 0;
+  double full_turn_ = 0;  ///< turns burnt at the full radius (1: done)
+  double finish_s_ = 0;   ///< the path length where the burn's path ended
+  // Adaptive control: the condition's own settings and bounds (cond_ holds those in force).
+  EdmCondition base_{};
+  EdmAdaptive adaptive_;
 };
 
 /// The orbit's offset at phase `phase` (turns) and radius `r` for `kind`. Any thread; real-time safe.

@@ -26,6 +26,14 @@ struct EdmReport {
   double short_recovery_max_s = 0;
   double depth_mm = 0;  ///< deepest burn: along the work's direction from its first discharge
   std::uint64_t jumps = 0;
+  double finishing_s = 0;  ///< of the machining time, the finishing cycle's (the path at rest)
+  /// Adaptive control: the windows in which it changed a setting, and the range each setting in
+  /// force covered while the generator pulsed (equal ends: it did not move).
+  std::uint64_t adaptations = 0;
+  double servo_reference_v[2] = {0, 0};
+  double gain_mm_s_per_v[2] = {0, 0};
+  double jump_period_s[2] = {0, 0};
+  double jump_height_mm[2] = {0, 0};
 };
 
 /// Controller thread (an observer with trace on); its report section (`edm`) after the run.
@@ -44,6 +52,7 @@ class EdmRecorder final : public controller::ControllerObserver, public controll
 
  private:
   void end_short(std::uint64_t tick, bool cleared);
+  void note_settings(const control::EdmStatus& e);
 
   machine::EdmConfig edm_;
   double period_s_;
@@ -57,6 +66,9 @@ class EdmRecorder final : public controller::ControllerObserver, public controll
   std::uint64_t last_tick_ = 0;  ///< the newest sample's
   bool first_ = true;
   std::uint32_t jumps_at_start_ = 0, jumps_now_ = 0;
+  std::uint64_t finishing_ = 0;
+  std::uint32_t adaptations_at_start_ = 0, adaptations_now_ = 0;
+  bool settings_seen_ = false;
 };
 
 }  // namespace opencnc::edm

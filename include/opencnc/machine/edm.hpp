@@ -60,6 +60,20 @@ struct EdmCondition {
   double orbit_radius_mm = 0;  ///< the final size
   double orbit_step_mm = 0;    ///< the radius grows by this per turn (0: the whole radius at once)
   double orbit_period_s = 0;   ///< one turn
+  /// The finishing cycle: the burn's end (M181, another M180) waits at the path's end until the
+  /// orbit has grown to its radius and turned once there, the gap servo acting along the orbit's
+  /// radius meanwhile (the lateral servo). Needs an orbit.
+  bool orbit_finish = false;
+  /// The lateral servo: the orbit slows as the gap voltage falls below the reference (stops and
+  /// draws in on a short), and in the finishing cycle the gap servo drives its radius.
+  bool lateral_servo = false;
+  // Adaptive control (off: the values above hold): the bounds within which the gap's state moves
+  // the servo's reference and gain and the jump's period and height (each min = max: fixed).
+  bool adaptive = false;
+  double servo_reference_min_v = 0, servo_reference_max_v = 0;
+  double gain_min_mm_s_per_v = 0, gain_max_mm_s_per_v = 0;
+  double jump_period_min_s = 0, jump_period_max_s = 0;
+  double jump_height_min_mm = 0, jump_height_max_mm = 0;
   // What the generator's table says the condition does (the simulated gap burns by them).
   double side_gap_mm = 0;           ///< spark gap at the electrode's sides, per side (0: not given)
   double electrode_wear_ratio = 0;  ///< electrode volume worn per volume of work removed
@@ -92,6 +106,16 @@ struct SimEdmConditionEffect {
   int number = 0;                   ///< the condition's number; 0 = empty slot
   double side_gap_mm = 0;           ///< the side spark gap (0: the clean breakdown gap at its voltage)
   double electrode_wear_ratio = 0;  ///< electrode volume worn per volume of work removed
+  /// The servo reference the table's side gap was measured at (0: the side gap is the widest
+  /// side distance that sparks). With a removal rate of the side walls ([edm.sim] side_walls =
+  /// "removal") the sides spark out to the side gap where the mean voltage is this reference.
+  double servo_reference_v = 0;
+};
+
+/// How the simulated side walls burn.
+enum class SideWalls : std::uint8_t {
+  Envelope,  ///< at once out to the side gap beyond the swept electrode (no removal rate)
+  Removal,   ///< by the side discharges: volume over the side's area, loading the gap voltage
 };
 
 /// The simulated EDM process (machine/sim_edm_process.hpp): the front along the tool axis, the
@@ -121,6 +145,11 @@ struct SimEdmConfig {
   /// The joints across the tool axis (the orbit's plane: X, Y; −1 = none): the electrode's
   /// lateral position, which burns the cavity's side walls out to the side gap.
   std::int8_t lateral_joints[2] = {-1, -1};
+  SideWalls side_walls = SideWalls::Envelope;
+  double electrode_perimeter_mm = 20;  ///< the electrode's outline: a side's area is its share × the depth
+  /// Debris concentration above which a period's discharges may bridge into a short (0: never);
+  /// the probability grows with the debris as the arcs' does above arc_threshold.
+  double short_debris = 0;
   std::array<SimEdmConditionEffect, kMaxEdmConditions> conditions{};  ///< from the profile's conditions
   int condition_count = 0;
 };

@@ -25,7 +25,10 @@ struct SimEdmPose {
 /// Averaged over a servo period: the mean gap voltage of the discharges in it. Across the tool
 /// axis, the cavity's side walls (in kSides directions) are burnt out to the side gap beyond the
 /// electrode's outline wherever it goes inside the cavity: the orbit widens the cavity. The
-/// electrode loses length by the condition's wear ratio, so the depth needs more feed.
+/// electrode loses length by the condition's wear ratio, so the depth needs more feed. With
+/// `side_walls = Removal` the walls burn by the side discharges instead: the period's discharges
+/// go to the narrowest of the front and the walls (relative to each one's breakdown distance), a
+/// wall recedes by their volume over its area, and the gap voltage is that site's.
 /// Deterministic for a seed. Real-time safe; called by SimMachine once per period.
 class SimEdmProcess {
  public:
@@ -72,6 +75,18 @@ class SimEdmProcess {
   double cavity_centre_mm(int i) const noexcept {
     return front_index_ < 0 || i < 0 || i > 1 ? 0.0 : centre_[static_cast<std::size_t>(2 * front_index_ + i)];
   }
+  /// The fronts burnt so far (one per orientation), and front f's depth and wall in direction k.
+  int fronts() const noexcept { return fronts_; }
+  double front_depth_mm(int front) const noexcept {
+    return front < 0 || front >= fronts_
+               ? 0.0
+               : (front_[static_cast<std::size_t>(front)] - config_.surface_mm) * config_.work_direction;
+  }
+  double wall_mm(int front, int k) const noexcept {
+    return front < 0 || front >= fronts_ || k < 0 || k >= kSides
+               ? 0.0
+               : wall_[static_cast<std::size_t>(front * kSides + k)];
+  }
   /// The side gap of the condition burning now (or last), mm.
   double side_gap_mm() const noexcept { return side_gap_mm_; }
 
@@ -79,8 +94,12 @@ class SimEdmProcess {
   int front_for(const double orientation[2], bool create) noexcept;
   void select(const GeneratorOutputs& gen) noexcept;
   void burn_sides(const SimEdmPose& pose, double tip) noexcept;
+  void lateral_offset(const SimEdmPose& pose, double d[2]) const noexcept;
+  int narrowest_side(double tip, double& x) const noexcept;
+  void edge_walls(double gap) noexcept;
+  void debris_bridge(double breakdown, SplitMix64& rng) noexcept;
   double oversize_of(int front) const noexcept;
-  void discharge(const GeneratorOutputs& gen, double x, SplitMix64& rng) noexcept;
+  void discharge(const GeneratorOutputs& gen, double x, int side, SplitMix64& rng) noexcept;
 
   SimEdmConfig config_{};
   double period_s_ = 1e-3;
@@ -101,6 +120,10 @@ class SimEdmProcess {
   // The condition burning: its side gap and wear ratio.
   std::int32_t condition_ = -1;
   double side_gap_mm_ = 0, wear_ratio_ = 0;
+  /// With a removal rate of the walls: the side's breakdown distance (clean dielectric), the side
+  /// gap over the share of it at which the mean voltage is the table's reference.
+  double side_breakdown_mm_ = 0;
+  double side_reach_[2] = {0, 0};  ///< the electrode's lateral offset from the burn's centre this period
   // The electrodes: tool numbers and each one's lost length.
   std::array<std::int32_t, kMaxElectrodes> tool_{};
   std::array<double, kMaxElectrodes> wear_{};
