@@ -9,6 +9,7 @@
 
 #include "opencnc/control/command.hpp"
 #include "opencnc/control/edm_status.hpp"
+#include "opencnc/control/torch_status.hpp"
 #include "opencnc/control/homing.hpp"
 #include "opencnc/control/limit_seek.hpp"
 #include "opencnc/control/load_guard.hpp"
@@ -162,6 +163,7 @@ struct ServoStatus {
   double load_kn = 0;  ///< the load input now (0 without a load guard)
   LoadAction load_action = LoadAction::None;
   EdmStatus edm{};                    ///< the EDM gap servo, jump and orbit
+  TorchStatus torch{};                ///< the plasma torch's sequence and height control
 };
 
 /// One servo period, for traces and run reports (docs/controller.md, "Trace CSV").
@@ -188,6 +190,7 @@ struct TraceSample {
   double dc_link_energy_j = 0;    ///< the link's usable energy (ServoStatus::dc_link_energy_j), J
   double stop_decel_scale = 1;    ///< the power-fail stop's deceleration scale (1: not in one)
   EdmStatus edm{};                ///< the EDM gap servo (machines with [edm])
+  TorchStatus torch{};            ///< the plasma torch (machines with [process.plasma])
 };
 
 static_assert(std::is_trivially_copyable_v<ServoStatus>);
