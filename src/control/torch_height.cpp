@@ -195,6 +195,7 @@ void TorchHeight::probe(const TorchInputs& in) noexcept {
     status_.plate_z_mm =
         in.measured_z + (config_.sensor == PlateSensor::Float ? config_.switch_offset_mm : 0.0);
     enter(TorchPhase::ToPierce);
+    move_to(offset_for_height(config_.pierce_height_mm));  // braking in this period already
     return;
   }
   if (offset_ <= -config_.probe_travel_mm) {
