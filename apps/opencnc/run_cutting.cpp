@@ -1,12 +1,11 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Plasma cutting's part of `opencnc run`: arc losses injected into the simulated plate
-// (--inject arc-loss@SECONDS), the operator who answers them (retrace from where the torch stands,
-// or resume there), and the run's `cutting` report (docs/cutting.md).
+// (--inject arc-loss@SECONDS), the operator who answers them (resume where the run held), and the run's
+// `cutting` report (docs/cutting.md).
 #include <fmt/format.h>
 
 #include "opencnc/cutting/cutting_recorder.hpp"
 #include "opencnc/machine/sim_machine.hpp"
-#include "opencnc/retrace/retrace.hpp"
 #include "run_features_parts.hpp"
 
 namespace opencnc::cli {
@@ -16,10 +15,11 @@ namespace {
 class CuttingRun final : public RunFeature {
  public:
   std::vector<InjectionForm> injections() const override {
-    return {{"arc-loss@SECONDS",
-             "the plasma arc goes out (a simulated plate); the scripted operator retraces to the nearest point "
-             "of the path from where the torch stands (resumes there without [process.cutting])",
-             ""}};
+    return {
+        {"arc-loss@SECONDS",
+         "the plasma arc goes out (a simulated plate); the run holds on its path and the scripted operator "
+         "resumes there: the torch finds the plate and pierces again",
+         ""}};
   }
   bool parse_injection(const std::string& text, bool& ok) override {
     if (text.rfind("arc-loss@", 0) != 0) return false;
@@ -41,19 +41,17 @@ class CuttingRun final : public RunFeature {
   bool set_up(controller::MachineSetup& machine) override {
     for (const auto& [observer, options] : machine.observers())
       if (auto r = std::dynamic_pointer_cast<cutting::CuttingRecorder>(observer)) recorder_ = r;
-    retrace_ = std::dynamic_pointer_cast<recovery::RetraceFeature>(machine.feature("retrace"));
     return true;
   }
-  void tick(controller::Controller& c, const controller::ControllerStatus& st, machine::SimMachine* sim) override {
+  void tick(controller::Controller& c, const controller::ControllerStatus& st,
+            machine::SimMachine* sim) override {
     if (t0_ < 0 && st.run_active && st.job == controller::JobKind::Program) t0_ = st.servo.time_s;
-    if (sim != nullptr && t0_ >= 0 && next_ < losses_at_.size() && st.servo.time_s - t0_ >= losses_at_[next_]) {
+    if (sim != nullptr && t0_ >= 0 && next_ < losses_at_.size() &&
+        st.servo.time_s - t0_ >= losses_at_[next_]) {
       sim->inject_arc_loss();
       ++next_;
     }
     operate(c, st);
-  }
-  bool goes_on(const controller::ControllerEvent& e) const override {
-    return e.end == controller::JobEnd::Aborted && stage_ != Stage::Waiting;
   }
   bool report(nlohmann::json& j) override {
     if (!recorder_) return true;
@@ -65,55 +63,32 @@ class CuttingRun final : public RunFeature {
   }
 
  private:
-  // The operator at an arc loss: the run stands held with the torch out. With retrace: pause
-  // (abort, lift), then start from where the torch stands (the nearest point is where it stopped),
-  // which re-lights by M190 at the resume; without: resume, which pierces again there.
+  // The operator at an arc loss: the run stands held on its path with the torch out, at the
+  // nearest point of the path to where the arc went out; a resume finds the plate and pierces
+  // again there (the torch stage), and the cut goes on.
   void operate(controller::Controller& c, const controller::ControllerStatus& st) {
     using controller::Request;
     if (asked_ != 0 && !c.outcome(asked_)) return;
     if (asked_ != 0) {
-      if (!c.outcome(asked_)->accepted) {
-        fmt::print(stderr, "error: the answer to the arc loss was refused: {}\n", c.outcome(asked_)->message);
-        stage_ = Stage::Waiting;
-      }
+      if (!c.outcome(asked_)->accepted)
+        fmt::print(stderr, "error: the resume after the arc loss was refused: {}\n",
+                   c.outcome(asked_)->message);
       asked_ = 0;
     }
     const bool held = st.servo.state == control::State::Held && st.servo.path_velocity == 0;
-    const bool idle = st.servo.state == control::State::Idle && !st.run_active;
-    switch (stage_) {
-      case Stage::Waiting:
-        if (st.servo.torch.arc_losses == losses_seen_) return;
-        if (!held || !st.run_active || st.job != controller::JobKind::Program) return;
-        losses_seen_ = st.servo.torch.arc_losses;
-        ++recoveries_;
-        if (retrace_) {
-          asked_ = c.submit(Request::feature("retrace", "pause"));
-          stage_ = Stage::Pausing;
-        } else {
-          asked_ = c.submit(Request::simple(control::CommandKind::Resume));
-        }
-        return;
-      case Stage::Pausing:
-        if (retrace_->phase() != recovery::RetracePhase::Paused || !idle) return;
-        asked_ = c.submit(Request::feature("retrace", "start"));
-        stage_ = Stage::Starting;
-        return;
-      case Stage::Starting:
-        if (retrace_->phase() == recovery::RetracePhase::Cutting) stage_ = Stage::Waiting;
-        return;
-    }
+    if (st.servo.torch.arc_losses == losses_seen_ || !held || !st.run_active) return;
+    losses_seen_ = st.servo.torch.arc_losses;
+    ++recoveries_;
+    asked_ = c.submit(Request::simple(control::CommandKind::Resume));
   }
 
-  enum class Stage : std::uint8_t { Waiting, Pausing, Starting };
   std::vector<double> losses_at_;
   std::size_t next_ = 0;
   double t0_ = -1;
-  Stage stage_ = Stage::Waiting;
   std::uint64_t asked_ = 0;
   std::uint32_t losses_seen_ = 0;
   int recoveries_ = 0;
   std::shared_ptr<cutting::CuttingRecorder> recorder_;
-  std::shared_ptr<recovery::RetraceFeature> retrace_;
 };
 
 }  // namespace

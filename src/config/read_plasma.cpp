@@ -34,15 +34,16 @@ void read_thc(Section& s, MachineProfile& p, const AxisProfile* z) {
   const toml::table* t = s.subtable("thc");
   if (t == nullptr) return;
   Section m(*t, "process.plasma.thc",
-            {"enabled", "delay_s", "speed_share", "volts_per_mm", "arc_voltage", "sample_s", "time_constant_s",
-             "deadband_v", "filter_s", "max_velocity", "max_acceleration", "max_correction", "void_jump_v",
-             "void_hold_s", "anti_dive_accel"},
+            {"enabled", "delay_s", "speed_share", "volts_per_mm", "arc_voltage", "sample_s",
+             "time_constant_s", "deadband_v", "filter_s", "max_velocity", "max_acceleration",
+             "max_correction", "void_jump_v", "void_hold_s", "anti_dive_accel"},
             s.reporter());
   c.thc = m.boolean_or("enabled", true) ? 1 : 0;
   c.thc_delay_s = m.number_or("delay_s", c.thc_delay_s, Bound::NonNegative);
   c.speed_share = m.number_or("speed_share", c.speed_share, Bound::Positive);
   if (c.speed_share > 1)
-    m.error("speed_share", "process.plasma.thc.speed_share is a share of the feed: at most 1", "config.range");
+    m.error("speed_share", "process.plasma.thc.speed_share is a share of the feed: at most 1",
+            "config.range");
   c.volts_per_mm = m.number_or("volts_per_mm", c.volts_per_mm, Bound::Positive);
   c.arc_voltage_v = m.number_or("arc_voltage", c.arc_voltage_v, Bound::NonNegative);
   c.sample_s = m.number_or("sample_s", c.sample_s, Bound::Positive);
@@ -69,7 +70,8 @@ void read_holes(Section& s, MachineProfile& p) {
   h.diameter_mm = m.number_or("diameter", h.diameter_mm, Bound::NonNegative);
   h.speed_share = m.number_or("speed_share", h.speed_share, Bound::Positive);
   if (h.speed_share > 1)
-    m.error("speed_share", "process.plasma.holes.speed_share is a share of the feed: at most 1", "config.range");
+    m.error("speed_share", "process.plasma.holes.speed_share is a share of the feed: at most 1",
+            "config.range");
   h.overcut_mm = m.number_or("overcut", h.overcut_mm, Bound::NonNegative);
   h.arc_off_mm = m.number_or("arc_off", h.arc_off_mm, Bound::NonNegative);
   if (h.arc_off_mm > 0 && h.overcut_mm == 0 && h.diameter_mm > 0 && h.arc_off_mm >= 3.14159 * h.diameter_mm)
@@ -81,9 +83,9 @@ void read_plasma_sim(Section& s, MachineProfile& p) {
   const toml::table* t = s.subtable("sim");
   if (t == nullptr) return;
   Section m(*t, "process.plasma.sim",
-            {"seed", "plate_z", "warp", "warp_wavelength", "plate_min", "plate_max", "base_voltage", "volts_per_mm",
-             "slow_volts", "full_speed", "kerf_width", "kerf_volts", "noise_v", "arc_delay_s", "transfer_height",
-             "max_arc_height", "arc_losses_per_min", "sensor_noise"},
+            {"seed", "plate_z", "warp", "warp_wavelength", "plate_min", "plate_max", "base_voltage",
+             "volts_per_mm", "slow_volts", "full_speed", "kerf_width", "kerf_volts", "noise_v", "arc_delay_s",
+             "transfer_height", "max_arc_height", "arc_losses_per_min", "sensor_noise"},
             s.reporter());
   machine::SimPlasmaConfig& c = p.plasma.sim;
   c.present = true;
@@ -126,11 +128,12 @@ void read_plasma_sim(Section& s, MachineProfile& p) {
   c.sensor = k.sensor;
   c.switch_offset_mm = k.sensor == machine::PlateSensor::Float ? k.switch_offset_mm : 0.0;
   if (k.pierce_height_mm > c.transfer_height_mm)
-    m.error("transfer_height",
-            fmt::format("process.plasma.sim.transfer_height ({}) is below the pierce height ({}): the arc would "
-                        "never transfer",
-                        show(c.transfer_height_mm), show(k.pierce_height_mm)),
-            "config.range");
+    m.error(
+        "transfer_height",
+        fmt::format("process.plasma.sim.transfer_height ({}) is below the pierce height ({}): the arc would "
+                    "never transfer",
+                    show(c.transfer_height_mm), show(k.pierce_height_mm)),
+        "config.range");
 }
 
 }  // namespace
@@ -138,11 +141,12 @@ void read_plasma_sim(Section& s, MachineProfile& p) {
 void read_plasma(Section& process, MachineProfile& profile) {
   const toml::table* t = process.subtable("plasma");
   if (t == nullptr) return;
-  Section s(*t, "process.plasma",
-            {"arc_voltage_input", "sensor", "sensor_input", "switch_offset", "pierce_height", "pierce_delay_s",
-             "puddle_height", "puddle_delay_s", "cut_height", "probe_speed", "probe_travel", "height_speed",
-             "height_acceleration", "arc_ok_timeout_s", "arc_loss_s", "max_starts", "thc", "holes", "sim"},
-            process.reporter());
+  Section s(
+      *t, "process.plasma",
+      {"arc_voltage_input", "sensor", "sensor_input", "switch_offset", "pierce_height", "pierce_delay_s",
+       "puddle_height", "puddle_delay_s", "cut_height", "probe_speed", "probe_travel", "height_speed",
+       "height_acceleration", "arc_ok_timeout_s", "arc_loss_s", "max_starts", "thc", "holes", "sim"},
+      process.reporter());
   PlasmaProfile& pl = profile.plasma;
   machine::PlasmaConfig& c = pl.config;
   pl.present = true;
@@ -157,13 +161,15 @@ void read_plasma(Section& process, MachineProfile& profile) {
   if (!s.has("sensor_input")) s.missing("sensor_input");
   c.arc_voltage_input =
       channel(s, "arc_voltage_input", profile.io.analog_inputs, "analog input", machine::kAnalogChannels);
-  c.sensor_input = channel(s, "sensor_input", profile.io.digital_inputs, "digital input", machine::kDigitalChannels);
+  c.sensor_input =
+      channel(s, "sensor_input", profile.io.digital_inputs, "digital input", machine::kDigitalChannels);
   c.sensor = s.choice<machine::PlateSensor>(
       "sensor", {{"float", machine::PlateSensor::Float}, {"ohmic", machine::PlateSensor::Ohmic}},
       machine::PlateSensor::Float);
   c.switch_offset_mm = s.number_or("switch_offset", c.switch_offset_mm, Bound::NonNegative);
   if (c.sensor == machine::PlateSensor::Ohmic) {
-    s.reject("switch_offset", "ohmic contact touches the plate itself (sensor = \"float\" has a switch offset)");
+    s.reject("switch_offset",
+             "ohmic contact touches the plate itself (sensor = \"float\" has a switch offset)");
     c.switch_offset_mm = 0;
   }
   c.pierce_height_mm = s.number_or("pierce_height", c.pierce_height_mm, Bound::Positive);
@@ -173,8 +179,8 @@ void read_plasma(Section& process, MachineProfile& profile) {
   c.cut_height_mm = s.number_or("cut_height", c.cut_height_mm, Bound::Positive);
   if (c.cut_height_mm > c.pierce_height_mm)
     s.error("cut_height",
-            fmt::format("process.plasma.cut_height ({}) is above the pierce height ({})", show(c.cut_height_mm),
-                        show(c.pierce_height_mm)),
+            fmt::format("process.plasma.cut_height ({}) is above the pierce height ({})",
+                        show(c.cut_height_mm), show(c.pierce_height_mm)),
             "config.range");
   if (c.puddle_height_mm == 0) s.reject("puddle_delay_s", "needs process.plasma.puddle_height");
   c.probe_speed_mm_s = s.number_or("probe_speed", c.probe_speed_mm_s, Bound::Positive);

@@ -30,6 +30,7 @@ Servo::Servo(const ServoConfig& config, ServoChannels& channels, machine::Machin
   for (PitchBufferInUse& b : channels.pitch_tables.reading) b.index.store(-1, std::memory_order_release);
   configure_gap_servo();
   torch_.configure(config_.plasma, config_.period_s);
+  torch_axis_ = torch_.enabled() ? config_.plasma.z_axis : -1;
   stepper_slot_.fill(-1);
   for (int j = 0; j < config_.joint_count; ++j) {
     const JointConfig& jc = config_.joints[static_cast<std::size_t>(j)];

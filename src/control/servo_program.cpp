@@ -100,7 +100,8 @@ void Servo::run_program() noexcept {
   if (activity_ != Activity::Program) return;  // it faulted: the run has ended
   for (int j = 0; j < config_.joint_count; ++j) {
     const int axis = config_.joints[static_cast<std::size_t>(j)].axis;
-    if (!manual(j)) commanded_[axis] = tick_out_.position[axis];
+    // The torch's offset stays on its axis until its stage moves it (also in the period a run ends).
+    if (!manual(j)) commanded_[axis] = tick_out_.position[axis] + (axis == torch_axis_ ? torch_.offset_mm() : 0.0);
   }
   apply_reports();
   report_sync_points();

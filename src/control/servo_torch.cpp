@@ -17,14 +17,14 @@ void Servo::run_torch_height() noexcept {
       b != nullptr && b->kind != traj::BlockKind::Marker && b->feed_class != traj::FeedClass::Rapid;
   TorchInputs in;
   in.hold = hold_ || aborting_ || power_stop_;
-  in.programmed_z = commanded_[z];
+  in.programmed_z = commanded_[z] - torch_.offset_mm();  // run_program put the last offset on it
   in.measured_z = position_[static_cast<std::size_t>(jz)] + offset_[static_cast<std::size_t>(jz)];
   in.path_velocity = tick_out_.path_velocity;
   in.feed = feed ? b->feed * feed_override_ : 0.0;
   in.arc_voltage_v = in_.analog_in[static_cast<std::size_t>(pc.arc_voltage_input)];
   in.arc_ok = in_.process.arc_ok;
   in.sensor = ((in_.digital_in >> pc.sensor_input) & 1u) != 0;
-  commanded_[z] += torch_.step(in);
+  commanded_[z] = in.programmed_z + torch_.step(in);
   if (torch_.event_pending()) {
     ServoEvent e;
     e.kind = EventKind::Torch;

@@ -55,7 +55,8 @@ void CuttingRecorder::on_trace(const control::TraceSample& s, const controller::
 CuttingReport CuttingRecorder::report() const {
   CuttingReport r = r_;
   r.cutting_s = static_cast<double>(cutting_) * period_s_;
-  r.height_in_band_fraction = cutting_ > 0 ? static_cast<double>(in_band_) / static_cast<double>(cutting_) : 0.0;
+  r.height_in_band_fraction =
+      cutting_ > 0 ? static_cast<double>(in_band_) / static_cast<double>(cutting_) : 0.0;
   r.thc_active_fraction = cutting_ > 0 ? static_cast<double>(active_) / static_cast<double>(cutting_) : 0.0;
   return r;
 }
@@ -65,10 +66,11 @@ std::string CuttingRecorder::report_text() const {
   return fmt::format(
       "cutting             {:.2f} s, height within ±0.1 mm of the cut height {:.2f} % ({}), deepest dive "
       "{:.3f} mm, highest rise {:.3f} mm, THC correcting {:.1f} %\n"
-      "cutting torch       {} pierces, {} failed starts, {} arc losses, {} kerf/void locks, {} holes slowed\n",
-      r.cutting_s, 100 * r.height_in_band_fraction, r.height_measured ? "above the simulated plate" : "from the arc voltage",
-      r.max_dive_mm, r.max_rise_mm, 100 * r.thc_active_fraction, r.pierces, r.failed_starts, r.arc_losses,
-      r.void_locks, r.holes_slowed);
+      "cutting torch       {} pierces, {} failed starts, {} arc losses, {} kerf/void locks, {} holes "
+      "slowed\n",
+      r.cutting_s, 100 * r.height_in_band_fraction,
+      r.height_measured ? "above the simulated plate" : "from the arc voltage", r.max_dive_mm, r.max_rise_mm,
+      100 * r.thc_active_fraction, r.pierces, r.failed_starts, r.arc_losses, r.void_locks, r.holes_slowed);
 }
 
 std::string CuttingRecorder::report_json() const {

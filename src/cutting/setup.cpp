@@ -16,31 +16,50 @@ namespace {
 
 const char* phase_name(control::TorchPhase p) {
   switch (p) {
-    case control::TorchPhase::Off: return "off";
-    case control::TorchPhase::Probing: return "probing";
-    case control::TorchPhase::ToPierce: return "to-pierce";
-    case control::TorchPhase::Igniting: return "igniting";
-    case control::TorchPhase::Piercing: return "piercing";
-    case control::TorchPhase::Puddle: return "puddle-jump";
-    case control::TorchPhase::ToCut: return "to-cut";
-    case control::TorchPhase::Cutting: return "cutting";
-    case control::TorchPhase::Retracting: return "retracting";
-    case control::TorchPhase::Paused: return "paused";
-    case control::TorchPhase::Failed: return "failed";
+    case control::TorchPhase::Off:
+      return "off";
+    case control::TorchPhase::Probing:
+      return "probing";
+    case control::TorchPhase::ToPierce:
+      return "to-pierce";
+    case control::TorchPhase::Igniting:
+      return "igniting";
+    case control::TorchPhase::Piercing:
+      return "piercing";
+    case control::TorchPhase::Puddle:
+      return "puddle-jump";
+    case control::TorchPhase::ToCut:
+      return "to-cut";
+    case control::TorchPhase::Cutting:
+      return "cutting";
+    case control::TorchPhase::Retracting:
+      return "retracting";
+    case control::TorchPhase::Paused:
+      return "paused";
+    case control::TorchPhase::Failed:
+      return "failed";
   }
   return "?";
 }
 
 const char* thc_name(control::ThcState s) {
   switch (s) {
-    case control::ThcState::Off: return "off";
-    case control::ThcState::Waiting: return "waiting";
-    case control::ThcState::Sampling: return "sampling";
-    case control::ThcState::Active: return "active";
-    case control::ThcState::CornerLock: return "corner-lock";
-    case control::ThcState::AntiDive: return "anti-dive";
-    case control::ThcState::VoidLock: return "void-lock";
-    case control::ThcState::ProgramLock: return "program-lock";
+    case control::ThcState::Off:
+      return "off";
+    case control::ThcState::Waiting:
+      return "waiting";
+    case control::ThcState::Sampling:
+      return "sampling";
+    case control::ThcState::Active:
+      return "active";
+    case control::ThcState::CornerLock:
+      return "corner-lock";
+    case control::ThcState::AntiDive:
+      return "anti-dive";
+    case control::ThcState::VoidLock:
+      return "void-lock";
+    case control::ThcState::ProgramLock:
+      return "program-lock";
   }
   return "?";
 }
@@ -49,8 +68,8 @@ const char* thc_name(control::ThcState s) {
 class Part final : public controller::SourcePart {
  public:
   explicit Part(const config::PlasmaHoles& holes) : holes_(holes) {}
-  std::shared_ptr<const gcode::Extensions> modules(gcode::Dialect dialect,
-                                                   std::shared_ptr<const gcode::Extensions> base) const override {
+  std::shared_ptr<const gcode::Extensions> modules(
+      gcode::Dialect dialect, std::shared_ptr<const gcode::Extensions> base) const override {
     return gcode::torch_extensions(dialect, std::move(base));
   }
 
@@ -61,15 +80,17 @@ class Part final : public controller::SourcePart {
 /// The torch stage's events in words.
 class Texts final : public controller::EventTexts {
  public:
-  std::optional<controller::EventNote> event_note(const control::ServoEvent& e, const config::MachineProfile& p,
+  std::optional<controller::EventNote> event_note(const control::ServoEvent& e,
+                                                  const config::MachineProfile& p,
                                                   const control::ServoConfig&) const override {
     if (e.kind != control::EventKind::Torch) return std::nullopt;
     switch (static_cast<control::TorchEvent>(e.action)) {
       case control::TorchEvent::ArcLost:
-        return controller::EventNote{Severity::Warning, "control.torch.arc-lost",
-                                     "plasma: the arc was lost while cutting; the torch is off and the run held "
-                                     "there: resume to find the plate and pierce again where the torch stands, "
-                                     "or retrace to another point of the path"};
+        return controller::EventNote{
+            Severity::Warning, "control.torch.arc-lost",
+            "plasma: the arc was lost while cutting; the torch is off and the run held "
+            "there: resume to find the plate and pierce again where the torch stands, "
+            "or retrace to another point of the path"};
       case control::TorchEvent::StartFailed:
         return controller::EventNote{
             Severity::Warning, "control.torch.start-failed",
@@ -84,10 +105,11 @@ class Texts final : public controller::EventTexts {
       case control::TorchEvent::PlateNotFound:
         return controller::EventNote{
             Severity::Error, "control.torch.no-plate",
-            fmt::format("plasma: the torch went {} mm below the programmed height without its {} (no plate?); "
-                        "the run is held",
-                        p.plasma.config.probe_travel_mm,
-                        p.plasma.config.sensor == machine::PlateSensor::Float ? "float switch" : "ohmic contact")};
+            fmt::format(
+                "plasma: the torch went {} mm below the programmed height without its {} (no plate?); "
+                "the run is held",
+                p.plasma.config.probe_travel_mm,
+                p.plasma.config.sensor == machine::PlateSensor::Float ? "float switch" : "ohmic contact")};
     }
     return std::nullopt;
   }

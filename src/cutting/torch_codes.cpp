@@ -26,7 +26,8 @@ class TorchCodes final : public CodeHandler {
 
 void add_torch_codes(Extensions& ext) {
   auto codes = std::make_shared<TorchCodes>();
-  for (int code : {machine::kTorchOnCode, machine::kTorchOffCode, machine::kThcHoldCode, machine::kThcReleaseCode})
+  for (int code :
+       {machine::kTorchOnCode, machine::kTorchOffCode, machine::kThcHoldCode, machine::kThcReleaseCode})
     ext.m[static_cast<std::size_t>(code)] = codes;
 }
 

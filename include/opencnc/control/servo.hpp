@@ -270,6 +270,7 @@ class Servo final : public Tickable {
   std::uint64_t gap_block_ = traj::kNoBlock;
   // Plasma: the torch stage.
   TorchHeight torch_;
+  int torch_axis_ = -1;  ///< the axis the torch's offset is on (−1: no plasma)
 
   // Manual mode.
   std::array<AxisMover, machine::kMaxJoints> movers_{};

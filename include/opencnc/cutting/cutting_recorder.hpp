@@ -19,16 +19,16 @@ struct CuttingReport {
   /// Share of cutting time (the torch at its cut height or under height control, arc-OK) whose
   /// height above the plate was within ±0.1 mm of the cut height.
   double height_in_band_fraction = 0;
-  double max_dive_mm = 0;   ///< the deepest the torch went below the cut height while cutting
-  double max_rise_mm = 0;   ///< the highest it went above
+  double max_dive_mm = 0;  ///< the deepest the torch went below the cut height while cutting
+  double max_rise_mm = 0;  ///< the highest it went above
   double cutting_s = 0;
   double thc_active_fraction = 0;  ///< of the cutting time, the height control corrected
   std::uint64_t arc_losses = 0;
   std::uint64_t pierces = 0;
   std::uint64_t failed_starts = 0;
-  std::uint64_t holes_slowed = 0;   ///< the height held by the program (M192) at a slowed hole
-  std::uint64_t void_locks = 0;     ///< times a voltage jump held the height (kerf crossings)
-  bool height_measured = false;     ///< true: from the simulated plate; false: from the arc voltage
+  std::uint64_t holes_slowed = 0;  ///< the height held by the program (M192) at a slowed hole
+  std::uint64_t void_locks = 0;    ///< times a voltage jump held the height (kerf crossings)
+  bool height_measured = false;    ///< true: from the simulated plate; false: from the arc voltage
 };
 
 /// Controller thread (an observer with trace on); its report section (`cutting`) after the run.

@@ -15,6 +15,7 @@ namespace opencnc::gcode {
 void add_torch_codes(Extensions& ext);
 
 /// `base` (or the dialect's standard modules) with the torch's codes.
-std::shared_ptr<const Extensions> torch_extensions(Dialect dialect, std::shared_ptr<const Extensions> base = nullptr);
+std::shared_ptr<const Extensions> torch_extensions(Dialect dialect,
+                                                   std::shared_ptr<const Extensions> base = nullptr);
 
 }  // namespace opencnc::gcode
