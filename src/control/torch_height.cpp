@@ -160,6 +160,7 @@ double TorchHeight::step(const TorchInputs& in) noexcept {
         status_.target_voltage_v = config_.arc_voltage_v;
         last_velocity_ = in.path_velocity;
         enter(TorchPhase::Cutting);
+        waits_ = false;  // the path goes on in this very period
       }
       break;
     case TorchPhase::Cutting:
