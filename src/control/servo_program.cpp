@@ -74,7 +74,7 @@ void Servo::stop_spindle_and_coolant() noexcept {
 traj::TickInput Servo::program_inputs() noexcept {
   traj::TickInput in;
   const bool torch_waits = torch_.head_waits();  // the torch's sequence moves it up or down
-  in.feed_override = torch_waits ? 0.0 : feed_override_ * gap_.feed_scale();  // the EDM gap servo's speed
+  in.feed_override = torch_waits ? 0.0 : feed_override_ * gap_.feed_scale();     // the EDM gap servo's speed
   in.rapid_override = gap_.head_waits() || torch_waits ? 0.0 : rapid_override_;  // rapids wait too
   in.feed_hold = hold_;
   in.cycle_start = take(cycle_start_edge_);
@@ -101,7 +101,8 @@ void Servo::run_program() noexcept {
   for (int j = 0; j < config_.joint_count; ++j) {
     const int axis = config_.joints[static_cast<std::size_t>(j)].axis;
     // The torch's offset stays on its axis until its stage moves it (also in the period a run ends).
-    if (!manual(j)) commanded_[axis] = tick_out_.position[axis] + (axis == torch_axis_ ? torch_.offset_mm() : 0.0);
+    if (!manual(j))
+      commanded_[axis] = tick_out_.position[axis] + (axis == torch_axis_ ? torch_.offset_mm() : 0.0);
   }
   apply_reports();
   report_sync_points();

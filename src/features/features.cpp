@@ -18,7 +18,8 @@ namespace opencnc::features {
 bool set_up(controller::MachineSetup& host) {
   const config::MachineProfile& p = host.profile();
   return toolguard::setup(p, host) && drill::setup(p, host) && broaching::setup(p, host) &&
-         edm::setup(p, host) && cutting::setup(p, host) && retrace::setup(p, host) && run_from_line::setup(p, host);
+         edm::setup(p, host) && cutting::setup(p, host) && retrace::setup(p, host) &&
+         run_from_line::setup(p, host);
 }
 
 std::unique_ptr<controller::MachineSetup> machine_setup(const config::MachineProfile& profile,
@@ -36,7 +37,8 @@ std::vector<CodeModules> code_modules() {
   return {
       {"coupling", "M171-M175, the broaching codes of a machine with a [coupling] section"},
       {"plasma",
-       "M190 torch on (find the plate, pierce, cut height, height control), M191 torch off, M192/M193 hold the "
+       "M190 torch on (find the plate, pierce, cut height, height control), M191 torch off, M192/M193 hold "
+       "the "
        "torch height and let it go: the codes of a machine with a [process.plasma] section"},
       {"edm",
        "M180 P<n> selects machining condition n, 1-99, and switches the generator on, M181 switches it off: "

@@ -174,7 +174,8 @@ void SimMachine::step_plasma() noexcept {
   const auto table = [&](int j) {
     return j >= 0 && j < config_.joint_count ? joints_[static_cast<std::size_t>(j)].table_position() : 0.0;
   };
-  plasma_.step(table(p.x_joint), table(p.y_joint), table(p.z_joint), config_.process.torch && process_.torch_on);
+  plasma_.step(table(p.x_joint), table(p.y_joint), table(p.z_joint),
+               config_.process.torch && process_.torch_on);
 }
 
 // The cutter's position from the joints' tables: where the chip is cut, not where the encoders say.

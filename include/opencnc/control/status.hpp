@@ -9,10 +9,10 @@
 
 #include "opencnc/control/command.hpp"
 #include "opencnc/control/edm_status.hpp"
-#include "opencnc/control/torch_status.hpp"
 #include "opencnc/control/homing.hpp"
 #include "opencnc/control/limit_seek.hpp"
 #include "opencnc/control/load_guard.hpp"
+#include "opencnc/control/torch_status.hpp"
 #include "opencnc/core/axes.hpp"
 #include "opencnc/machine/machine_io.hpp"
 #include "opencnc/machine/process_alarms.hpp"

@@ -9,8 +9,8 @@
 
 #include "opencnc/core/vec3.hpp"
 #include "opencnc/machine/edm.hpp"
-#include "opencnc/machine/plasma.hpp"
 #include "opencnc/machine/machine_io.hpp"
+#include "opencnc/machine/plasma.hpp"
 
 namespace opencnc::machine {
 
