@@ -10,6 +10,7 @@ std::vector<std::unique_ptr<RunFeature>> run_features() {
   out.push_back(toolguard_run());
   out.push_back(broaching_run());
   out.push_back(edm_run());
+  out.push_back(cutting_run());
   out.push_back(retrace_run());
   out.push_back(process_log_run());
   return out;

@@ -13,6 +13,7 @@ namespace opencnc::cli {
 std::unique_ptr<RunFeature> toolguard_run();
 std::unique_ptr<RunFeature> broaching_run();
 std::unique_ptr<RunFeature> edm_run();
+std::unique_ptr<RunFeature> cutting_run();
 std::unique_ptr<RunFeature> retrace_run();
 std::unique_ptr<RunFeature> process_log_run();
 

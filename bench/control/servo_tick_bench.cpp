@@ -5,7 +5,9 @@
 // Two machines: a loopback (feedback = command, nearly free: the servo alone) and the simulated
 // machine (the servo plus the machine's period). And the drill retrofit (configs/drill-retrofit.toml):
 // two steppers through the pulse distributor with pitch and backlash compensation, six interlock
-// rules and a hand-fed axis, on a loopback, to show what those stages add.
+// rules and a hand-fed axis, on a loopback, to show what those stages add. And the plasma table
+// (configs/plasma-table.toml) with its simulated plate, the torch on and off, and the torch stage
+// alone (TorchHeight::step under height control).
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -203,8 +205,86 @@ void BM_ServoTickDrillLoopback(benchmark::State& state) {
   servo_tick(state, std::make_unique<LoopbackMachine>(3), load, drill_program());
 }
 
+/// The plasma table (configs/plasma-table.toml) on its simulated machine and plate: squares of
+/// 100 mm cut at 2400 mm/min, the torch on (M190: the plate found, pierced, the height control
+/// acting) or, with `torch` false, the same path with the torch stage idle.
+std::shared_ptr<canon::Program> plasma_program(bool torch) {
+  canon::ProgramBuilder b(AxisMask::from_letters("XYZ"));
+  canon::SegmentId id = 0;
+  Pose p;
+  p[Axis::X] = 300;
+  p[Axis::Y] = 300;
+  p[Axis::Z] = 15;
+  b.straight_traverse(id++, p);
+  if (torch) b.process_code(canon::ProcessCode{machine::kTorchOnCode, 0, 0, machine::kTorchOnCode});
+  b.set_feed_rate(2400);
+  for (int k = 0; k < 40; ++k) {
+    for (const auto& [x, y] : {std::pair{400.0, 300.0}, {400.0, 400.0}, {300.0, 400.0}, {300.0, 300.0}}) {
+      p[Axis::X] = x;
+      p[Axis::Y] = y;
+      b.straight_feed(id++, p);
+    }
+  }
+  if (torch) b.process_code(canon::ProcessCode{machine::kTorchOffCode, 0, 0, machine::kTorchOnCode});
+  b.program_end();
+  return std::make_shared<canon::Program>(b.take());
+}
+
+void plasma_tick(benchmark::State& state, bool torch) {
+  const config::ProfileLoad load = config::load_profile(OPENCNC_SOURCE_DIR "/configs/plasma-table.toml");
+  if (!load.ok()) {
+    state.SkipWithError("profile");
+    return;
+  }
+  servo_tick(state, std::make_unique<machine::SimMachine>(config::sim_machine_config(*load.profile)), load,
+             plasma_program(torch));
+}
+
+void BM_ServoTickPlasmaTorchOn(benchmark::State& state) {
+  plasma_tick(state, true);
+}
+void BM_ServoTickPlasmaTorchOff(benchmark::State& state) {
+  plasma_tick(state, false);
+}
+
+/// The torch stage alone, cutting under height control (a voltage with a small error and noise).
+void BM_TorchHeightStep(benchmark::State& state) {
+  machine::PlasmaConfig c;
+  c.enabled = 1;
+  TorchHeight t;
+  t.configure(c, 1e-3);
+  t.apply_code(machine::kTorchOnCode, 0);
+  TorchInputs in;
+  in.programmed_z = 15;
+  in.path_velocity = in.feed = 40;
+  std::uint64_t n = 0;
+  const auto feed = [&] {
+    in.measured_z = in.programmed_z + t.offset_mm();
+    in.sensor = in.measured_z <= -1.5;
+    in.arc_ok = t.torch_on();
+    in.arc_voltage_v = in.arc_ok ? 100 + 7.5 * (in.measured_z + 0.2) + 0.3 * std::sin(0.1 * ++n) : 0.0;
+  };
+  for (int i = 0; i < 20000 && t.status().thc != ThcState::Active; ++i) {
+    feed();
+    t.step(in);
+  }
+  if (t.status().thc != ThcState::Active) {
+    state.SkipWithError("the height control did not start");
+    return;
+  }
+  double sum = 0;
+  for (auto _ : state) {
+    feed();
+    sum += t.step(in);
+  }
+  benchmark::DoNotOptimize(sum);
+}
+
 }  // namespace
 
+BENCHMARK(BM_TorchHeightStep);
+BENCHMARK(BM_ServoTickPlasmaTorchOn)->UseManualTime()->Iterations(200000)->Unit(benchmark::kNanosecond);
+BENCHMARK(BM_ServoTickPlasmaTorchOff)->UseManualTime()->Iterations(200000)->Unit(benchmark::kNanosecond);
 BENCHMARK(BM_ServoTickLoopback)->UseManualTime()->Iterations(200000)->Unit(benchmark::kNanosecond);
 BENCHMARK(BM_ServoTickSimMachine)->UseManualTime()->Iterations(200000)->Unit(benchmark::kNanosecond);
 BENCHMARK(BM_ServoTickDrillLoopback)->UseManualTime()->Iterations(200000)->Unit(benchmark::kNanosecond);

@@ -79,6 +79,14 @@ machine::SimMachineConfig sim_machine_config(const MachineProfile& profile) {
     c.broach.present = c.broach.stroke_joint >= 0 && c.broach.rotary_joint >= 0 && c.broach.radial_joint >= 0;
   }
   c.edm = profile.edm.sim;
+  if (profile.plasma.sim.present) {  // the plate under the torch's axes (the reader checked them)
+    c.plasma = profile.plasma.sim;
+    const auto joint = [&](Axis a) { return profile.find(a) != nullptr ? profile.find(a)->joint : -1; };
+    c.plasma.x_joint = static_cast<std::int8_t>(joint(Axis::X));
+    c.plasma.y_joint = static_cast<std::int8_t>(joint(Axis::Y));
+    c.plasma.z_joint = static_cast<std::int8_t>(joint(Axis::Z));
+    c.plasma.present = c.plasma.x_joint >= 0 && c.plasma.y_joint >= 0 && c.plasma.z_joint >= 0;
+  }
   for (const machine::SimElectrode& e : profile.sim_electrodes)  // the reader kept them within the array
     if (c.electrode_count < machine::kMaxSimElectrodes)
       c.electrodes[static_cast<std::size_t>(c.electrode_count++)] = e;

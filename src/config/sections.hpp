@@ -49,6 +49,8 @@ void read_alarms(Section& top, MachineProfile& profile);
 void read_coupling(Section& top, MachineProfile& profile);
 /// [process.broaching] and its sim, from read_process. Needs the axes, [io] and [coupling].
 void read_broaching(Section& process, MachineProfile& profile);
+/// [process.plasma] with .thc, .holes and .sim, from read_process. Needs the axes and [io].
+void read_plasma(Section& process, MachineProfile& profile);
 /// [edm], its conditions and [edm.sim]. Needs the axes and [process].
 void read_edm(Section& top, MachineProfile& profile);
 

@@ -29,6 +29,8 @@ Servo::Servo(const ServoConfig& config, ServoChannels& channels, machine::Machin
   comp_ = motion::Compensation(config_.compensation);
   for (PitchBufferInUse& b : channels.pitch_tables.reading) b.index.store(-1, std::memory_order_release);
   configure_gap_servo();
+  torch_.configure(config_.plasma, config_.period_s);
+  torch_axis_ = torch_.enabled() ? config_.plasma.z_axis : -1;
   stepper_slot_.fill(-1);
   for (int j = 0; j < config_.joint_count; ++j) {
     const JointConfig& jc = config_.joints[static_cast<std::size_t>(j)];
@@ -49,6 +51,7 @@ bool Servo::tick() noexcept {
   handle_commands();    // operator and controller commands: the explicit state transitions
   run_active_mode();    // homing / jog / handwheel (movers) or MDI / auto (interpolator, handshakes)
   run_gap_servo();      // EDM: along the path by the gap voltage, jump, orbit (servo_gap.cpp)
+  run_torch_height();   // plasma: the cut's sequence, the height control's Z offset (servo_torch.cpp)
   couple_axes();        // axes → joints, a coupled slave by its law (servo_coupling.cpp)
   compensate();         // pitch error and backlash (motion::Compensation)
   check_soft_limits();  // every commanded joint within its soft limits
@@ -330,6 +333,7 @@ void Servo::write_machine_outputs() noexcept {
   out_.process.mist = on && mist_;
   out_.process.generator_on = on && gap_.generator_on();
   out_.process.generator = gap_.generator();
+  out_.process.torch_on = on && torch_.torch_on();
   if (preparing_ && in_.tool.prepared) {
     preparing_ = false;
     prepared_tool_ = preparing_tool_;
@@ -490,6 +494,7 @@ void Servo::fill_drill_status(ServoStatus& s) const noexcept {
   s.coupling = coupling_;
   s.coupling.error_deg = coupling_error();
   s.edm = gap_.status();
+  s.torch = torch_.status();
   s.handwheel_step = handwheel_step_;
   s.load_kn = load_kn_;
   s.load_action = load_action_;
@@ -527,6 +532,7 @@ void Servo::push_trace() noexcept {
   t.dc_link_energy_j = dc_link_energy_j();
   t.stop_decel_scale = power_stop_ ? stop_scale_ : 1.0;
   t.edm = gap_.status();
+  t.torch = torch_.status();
   if (!channels_->trace.try_push(t)) ++trace_dropped_;
 }
 

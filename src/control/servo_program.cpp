@@ -73,8 +73,9 @@ void Servo::stop_spindle_and_coolant() noexcept {
 
 traj::TickInput Servo::program_inputs() noexcept {
   traj::TickInput in;
-  in.feed_override = feed_override_ * gap_.feed_scale();  // the EDM gap servo's forward speed
-  in.rapid_override = gap_.head_waits() ? 0.0 : rapid_override_;  // a rapid waits for the electrode too
+  const bool torch_waits = torch_.head_waits();  // the torch's sequence moves it up or down
+  in.feed_override = torch_waits ? 0.0 : feed_override_ * gap_.feed_scale();     // the EDM gap servo's speed
+  in.rapid_override = gap_.head_waits() || torch_waits ? 0.0 : rapid_override_;  // rapids wait too
   in.feed_hold = hold_;
   in.cycle_start = take(cycle_start_edge_);
   released_ = in.cycle_start;
@@ -99,7 +100,9 @@ void Servo::run_program() noexcept {
   if (activity_ != Activity::Program) return;  // it faulted: the run has ended
   for (int j = 0; j < config_.joint_count; ++j) {
     const int axis = config_.joints[static_cast<std::size_t>(j)].axis;
-    if (!manual(j)) commanded_[axis] = tick_out_.position[axis];
+    // The torch's offset stays on its axis until its stage moves it (also in the period a run ends).
+    if (!manual(j))
+      commanded_[axis] = tick_out_.position[axis] + (axis == torch_axis_ ? torch_.offset_mm() : 0.0);
   }
   apply_reports();
   report_sync_points();
@@ -270,7 +273,8 @@ void Servo::apply_action(const MachineAction& a) noexcept {
       engage_coupling(a);
       break;
     case ActionCode::ProcessCode:
-      gap_.apply_code(a.index, a.value);  // the preflight refuses codes the machine lacks
+      // The torch's codes, else the EDM's (the preflight refuses codes the machine lacks).
+      if (!(torch_.enabled() && torch_.apply_code(a.index, a.value))) gap_.apply_code(a.index, a.value);
       break;
     case ActionCode::ChangeTool:
     case ActionCode::WaitInput:
@@ -499,6 +503,7 @@ void Servo::end_run(RunEnd why) noexcept {
   activity_ = Activity::None;
   release_coupling();  // a program's coupling lasts as long as its run
   gap_.begin_run(commanded_);  // and so does its machining condition (the generator goes off)
+  torch_.begin_run();          // and the torch (its offset stays in the commanded position)
   hold_ = aborting_ = cycle_start_edge_ = abort_edge_ = sync_done_edge_ = false;
   sync_step_ = SyncStep::None;
   wait_ = Wait::None;

@@ -123,6 +123,7 @@ ServoConfig servo_config(const config::MachineProfile& profile,
     s.power_stop.dc_link_idle_power_w = profile.power.dc_link_idle_power_w;
   }
   s.edm = profile.edm.config;
+  s.plasma = profile.plasma.config;  // enabled 0 without [process.plasma]: the stage does nothing
   return s;
 }
 

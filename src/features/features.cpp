@@ -4,6 +4,8 @@
 
 #include "opencnc/broaching/coupling_codes.hpp"
 #include "opencnc/broaching/setup.hpp"
+#include "opencnc/cutting/setup.hpp"
+#include "opencnc/cutting/torch_codes.hpp"
 #include "opencnc/drill/setup.hpp"
 #include "opencnc/edm/edm_codes.hpp"
 #include "opencnc/edm/setup.hpp"
@@ -16,7 +18,8 @@ namespace opencnc::features {
 bool set_up(controller::MachineSetup& host) {
   const config::MachineProfile& p = host.profile();
   return toolguard::setup(p, host) && drill::setup(p, host) && broaching::setup(p, host) &&
-         edm::setup(p, host) && retrace::setup(p, host) && run_from_line::setup(p, host);
+         edm::setup(p, host) && cutting::setup(p, host) && retrace::setup(p, host) &&
+         run_from_line::setup(p, host);
 }
 
 std::unique_ptr<controller::MachineSetup> machine_setup(const config::MachineProfile& profile,
@@ -33,6 +36,10 @@ std::unique_ptr<controller::MachineSetup> machine_setup(const config::MachinePro
 std::vector<CodeModules> code_modules() {
   return {
       {"coupling", "M171-M175, the broaching codes of a machine with a [coupling] section"},
+      {"plasma",
+       "M190 torch on (find the plate, pierce, cut height, height control), M191 torch off, M192/M193 hold "
+       "the "
+       "torch height and let it go: the codes of a machine with a [process.plasma] section"},
       {"edm",
        "M180 P<n> selects machining condition n, 1-99, and switches the generator on, M181 switches it off: "
        "the codes of a machine with an [edm] section"}};
@@ -45,6 +52,7 @@ std::shared_ptr<const gcode::Extensions> with_code_modules(std::string_view name
     gcode::add_coupling_codes(*ext);
     return ext;
   }
+  if (name == "plasma") return gcode::torch_extensions(dialect, std::move(base));
   if (name == "edm") return gcode::edm_extensions(dialect, {}, std::move(base));
   return nullptr;
 }

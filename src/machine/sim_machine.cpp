@@ -47,6 +47,7 @@ SimMachine::SimMachine(const SimMachineConfig& config) : config_(config), rng_(c
   if (config.broach.present) broach_ = SimBroachLoad(config.broach, config.seed);
   temperature_c_ = config.temperature_c;
   if (config.edm.present) edm_.configure(config.edm, config.servo_period_s);
+  if (config.plasma.present) plasma_.configure(config.plasma, config.servo_period_s);
   mount(0);  // the spindle holds tool 0 (or its simulated electrode) until a change
   analog_in_ = config.analog_in;
   dc_link_v_ = config.power.dc_link_nominal_v;
@@ -164,6 +165,17 @@ void SimMachine::advance(const MachineOutputs& out) noexcept {
   update_auxiliaries();
   update_broach();
   if (config_.edm.present) step_edm();
+  if (config_.plasma.present) step_plasma();
+}
+
+// The plate and the arc see the torch where the joints' tables are.
+void SimMachine::step_plasma() noexcept {
+  const SimPlasmaConfig& p = config_.plasma;
+  const auto table = [&](int j) {
+    return j >= 0 && j < config_.joint_count ? joints_[static_cast<std::size_t>(j)].table_position() : 0.0;
+  };
+  plasma_.step(table(p.x_joint), table(p.y_joint), table(p.z_joint),
+               config_.process.torch && process_.torch_on);
 }
 
 // The cutter's position from the joints' tables: where the chip is cut, not where the encoders say.
@@ -309,6 +321,7 @@ void SimMachine::sample() noexcept {
   }
   if (config_.broach.present)
     inputs_.analog_in[static_cast<std::size_t>(config_.broach.load_input)] = broach_.load_kn();
+  if (config_.plasma.present) plasma_.sample(inputs_);
 }
 
 void SimMachine::sample_probe() noexcept {

@@ -185,6 +185,26 @@ struct CuttingProfile {
   double retrace_mm_min = 1000;  ///< speed of stepping along the path while paused
 };
 
+/// How a program's small holes are cut (`[process.plasma.holes]`, QtPlasmaC's hole settings: a
+/// program pass, docs/cutting.md): closed contours of at most `diameter_mm` across run at
+/// `speed_share` of their feed with the height held, go on `overcut_mm` past their end, and the
+/// torch goes out `arc_off_mm` before the overcut's end. diameter_mm 0: no hole handling.
+struct PlasmaHoles {
+  double diameter_mm = 0;
+  double speed_share = 0.6;
+  double overcut_mm = 0;
+  double arc_off_mm = 0;
+};
+
+/// `[process.plasma]`: the torch's sequence and height control (`config`, for the tick), the
+/// holes (a program pass), the simulated plate and arc (`sim`; present: false without one).
+struct PlasmaProfile {
+  bool present = false;
+  machine::PlasmaConfig config;
+  PlasmaHoles holes;
+  machine::SimPlasmaConfig sim;
+};
+
 /// Generic I/O channel counts (M62–M68, M66). Channels 0 … n-1 exist.
 struct IoProfile {
   int digital_inputs = 4, digital_outputs = 4;
@@ -329,6 +349,7 @@ struct MachineProfile {
   ToolChangeProfile tool_change;
   machine::SimProcessConfig process;  ///< torch / generator flags and their simulation
   CuttingProfile cutting;             ///< [process.cutting]: torch sequences for retrace
+  PlasmaProfile plasma;               ///< [process.plasma]: the plasma torch, its THC, its simulation
   IoProfile io;
   InterlockProfile interlocks;
   AlarmProfile alarms;

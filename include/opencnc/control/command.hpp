@@ -282,6 +282,8 @@ enum class EventKind : std::uint8_t {
   /// A seek of a limit switch ended: `axis`, `action` 1 = found (`value` = where the switch
   /// tripped, machine position; the rest position is in the status), 0 = stopped before it.
   LimitSeek,
+  /// Plasma: the torch stage tells `action` (a control::TorchEvent) with `value`; run `run_id`.
+  Torch,
 };
 
 struct ServoEvent {

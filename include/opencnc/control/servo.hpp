@@ -13,6 +13,7 @@
 #include "opencnc/control/limit_seek.hpp"
 #include "opencnc/control/servo_config.hpp"
 #include "opencnc/control/tickable.hpp"
+#include "opencnc/control/torch_height.hpp"
 #include "opencnc/machine/machine_io.hpp"
 #include "opencnc/motion/compensation.hpp"
 #include "opencnc/motion/pulse_distributor.hpp"
@@ -172,6 +173,9 @@ class Servo final : public Tickable {
   void run_gap_servo() noexcept;
   void watch_gap() noexcept;
 
+  // --- plasma: the torch's sequence and its height control (servo_torch.cpp) ---------------------
+  void run_torch_height() noexcept;
+
   // --- Auto and MDI runs (servo_program.cpp) ------------------------------------------------
   void run_program() noexcept;
   traj::TickInput program_inputs() noexcept;
@@ -264,6 +268,9 @@ class Servo final : public Tickable {
   // Sinker EDM: the gap servo stage and the block it last saw at the interpolator's head.
   GapServo gap_;
   std::uint64_t gap_block_ = traj::kNoBlock;
+  // Plasma: the torch stage.
+  TorchHeight torch_;
+  int torch_axis_ = -1;  ///< the axis the torch's offset is on (−1: no plasma)
 
   // Manual mode.
   std::array<AxisMover, machine::kMaxJoints> movers_{};

@@ -11,6 +11,7 @@
 #include "opencnc/machine/edm.hpp"
 #include "opencnc/machine/interlocks.hpp"
 #include "opencnc/machine/machine_io.hpp"
+#include "opencnc/machine/plasma.hpp"
 #include "opencnc/machine/process_alarms.hpp"
 #include "opencnc/motion/compensation.hpp"
 #include "opencnc/motion/coupling.hpp"
@@ -106,6 +107,8 @@ struct ServoConfig {
   LoadGuardConfig load_guard;
   /// Sinker EDM: the machining conditions and the gap servo (the gap servo stage).
   machine::EdmConfig edm;
+  /// Plasma: the torch's sequence per cut and its height control (the torch stage).
+  machine::PlasmaConfig plasma;
   /// The PLC's interlock rules (evaluated every period after safety).
   machine::InterlockRules interlocks;
   /// The process-input alarms (analog inputs out of range: message, feed hold, or stop and fault).

@@ -12,6 +12,7 @@
 #include "opencnc/control/homing.hpp"
 #include "opencnc/control/limit_seek.hpp"
 #include "opencnc/control/load_guard.hpp"
+#include "opencnc/control/torch_status.hpp"
 #include "opencnc/core/axes.hpp"
 #include "opencnc/machine/machine_io.hpp"
 #include "opencnc/machine/process_alarms.hpp"
@@ -164,6 +165,7 @@ struct ServoStatus {
   double load_kn = 0;  ///< the load input now (0 without a load guard)
   LoadAction load_action = LoadAction::None;
   EdmStatus edm{};                    ///< the EDM gap servo, jump and orbit
+  TorchStatus torch{};                ///< the plasma torch's sequence and height control
 };
 
 /// One servo period, for traces and run reports (docs/controller.md, "Trace CSV").
@@ -190,6 +192,7 @@ struct TraceSample {
   double dc_link_energy_j = 0;    ///< the link's usable energy (ServoStatus::dc_link_energy_j), J
   double stop_decel_scale = 1;    ///< the power-fail stop's deceleration scale (1: not in one)
   EdmStatus edm{};                ///< the EDM gap servo (machines with [edm])
+  TorchStatus torch{};            ///< the plasma torch (machines with [process.plasma])
 };
 
 static_assert(std::is_trivially_copyable_v<ServoStatus>);

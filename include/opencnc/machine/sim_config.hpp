@@ -10,6 +10,7 @@
 #include "opencnc/core/vec3.hpp"
 #include "opencnc/machine/edm.hpp"
 #include "opencnc/machine/machine_io.hpp"
+#include "opencnc/machine/plasma.hpp"
 
 namespace opencnc::machine {
 
@@ -248,6 +249,7 @@ struct SimMachineConfig {
   SimProcessConfig process;
   SimBroachConfig broach;  ///< a broaching load cell and the bore it measures (present: false)
   SimEdmConfig edm;  ///< the simulated spark gap (present: an EDM machine)
+  SimPlasmaConfig plasma;  ///< the simulated plate and arc (present: a plasma table)
   int digital_inputs = 0, digital_outputs = 0;
   int analog_inputs = 0, analog_outputs = 0;
   std::array<double, kAnalogChannels> analog_in{};  ///< the analog inputs' values at power-up

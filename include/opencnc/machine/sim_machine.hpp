@@ -11,6 +11,7 @@
 #include "opencnc/machine/sim_config.hpp"
 #include "opencnc/machine/sim_edm_process.hpp"
 #include "opencnc/machine/sim_joint.hpp"
+#include "opencnc/machine/sim_plasma_process.hpp"
 #include "opencnc/machine/sim_sphere_probe.hpp"
 #include "opencnc/machine/sim_spindle.hpp"
 #include "opencnc/machine/sim_switch.hpp"
@@ -51,6 +52,8 @@ class SimMachine final : public MachineIO {
   }
   /// Whether the torch can light (false: gas out, no arc; arc_ok never comes).
   void set_arc_available(bool available) noexcept { arc_available_ = available; }
+  /// Plasma: the arc goes out now (until the torch is switched off and on); ignored without a plate.
+  void inject_arc_loss() noexcept { plasma_.inject_arc_loss(); }
   /// EDM gap voltage reported while the generator is on (a machine without a simulated gap).
   void set_gap_voltage(double volts) noexcept { gap_voltage_v_ = volts; }
   /// EDM: a short (debris bridge) in the simulated gap until the electrode backs off from it.
@@ -91,6 +94,8 @@ class SimMachine final : public MachineIO {
   const SimJoint& joint(int j) const noexcept { return joints_[static_cast<std::size_t>(j)]; }
   const SimSpindle& spindle() const noexcept { return spindle_; }
   const SimEdmProcess& edm() const noexcept { return edm_; }
+  /// The simulated plate and arc (a plasma table).
+  const SimPlasmaProcess& plasma() const noexcept { return plasma_; }
   const SimSphereProbe& sphere_probe() const noexcept { return sphere_; }
   /// The tool the last tool change mounted (0 before any).
   std::int32_t mounted_tool() const noexcept { return mounted_tool_; }
@@ -116,6 +121,7 @@ class SimMachine final : public MachineIO {
   void update_auxiliaries() noexcept;
   void update_broach() noexcept;
   void step_edm() noexcept;
+  void step_plasma() noexcept;
   void mount(std::int32_t tool) noexcept;
   Vec3 worn_offset() const noexcept;
   void sample() noexcept;
@@ -126,6 +132,7 @@ class SimMachine final : public MachineIO {
   std::array<SimJoint, kMaxJoints> joints_{};
   SimSpindle spindle_;
   SimEdmProcess edm_;
+  SimPlasmaProcess plasma_;
   bool tool_changed_ = false;  ///< the tool changer acknowledged a change last period
   std::int32_t mounted_tool_ = 0;
   SimElectrode electrode_{};  ///< the mounted tool's true electrode

@@ -1,0 +1,287 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// TorchHeight: the sequence of a plasma cut and its torch height control, one period at a time
+// (control/torch_height.hpp, docs/cutting.md).
+#include "opencnc/control/torch_height.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace opencnc::control {
+
+using machine::PlateSensor;
+
+void TorchHeight::configure(const machine::PlasmaConfig& config, double period_s) noexcept {
+  config_ = config;
+  dt_ = period_s;
+  status_ = TorchStatus{};
+  begin_run();
+}
+
+void TorchHeight::begin_run() noexcept {
+  programmed_on_ = false;
+  waits_ = hold_request_ = event_pending_ = false;
+  offset_ = v_ = 0;
+  starts_failed_ = 0;
+  status_.thc_hold = false;
+  status_.torch_on = false;
+  enter(TorchPhase::Off);
+  status_.thc_offset_mm = status_.correction_mm = 0;
+}
+
+bool TorchHeight::apply_code(int code, double /*p*/) noexcept {
+  switch (code) {
+    case machine::kTorchOnCode:
+      programmed_on_ = true;
+      starts_failed_ = 0;
+      enter(TorchPhase::Probing);
+      return true;
+    case machine::kTorchOffCode:
+      programmed_on_ = false;
+      status_.torch_on = false;
+      retract_target_ =
+          std::min(offset_, 0.0) < 0 ? 0.0 : offset_;  // up to the programmed height, never down
+      enter(TorchPhase::Retracting);
+      return true;
+    case machine::kThcHoldCode:
+      status_.thc_hold = true;
+      return true;
+    case machine::kThcReleaseCode:
+      status_.thc_hold = false;
+      return true;
+    default:
+      return false;
+  }
+}
+
+void TorchHeight::enter(TorchPhase p) noexcept {
+  status_.phase = p;
+  status_.thc = ThcState::Off;
+  timer_s_ = 0;
+  arc_off_s_ = 0;
+  paused_held_ = false;
+}
+
+void TorchHeight::tell(TorchEvent e, double value, bool hold) noexcept {
+  event_pending_ = true;
+  event_ = e;
+  event_value_ = value;
+  hold_request_ = hold_request_ || hold;
+}
+
+// The offset toward `target` at the height moves' speed and acceleration: the fastest speed that
+// can still stop at the target with steps of a·T (and never more than the rest in one period).
+bool TorchHeight::move_to(double target) noexcept {
+  const double a = config_.height_accel_mm_s2, ad = a * dt_;
+  const double d = target - offset_;
+  const double brake = -0.5 * ad + std::sqrt(0.25 * ad * ad + 2 * a * std::fabs(d));
+  const double vd = std::copysign(std::min({config_.height_speed_mm_s, brake, std::fabs(d) / dt_}), d);
+  v_ += std::clamp(vd - v_, -ad, ad);
+  offset_ += v_ * dt_;
+  if (std::fabs(target - offset_) < 1e-9 && std::fabs(v_) <= ad) {
+    offset_ = target;
+    v_ = 0;
+    return true;
+  }
+  return false;
+}
+
+// Arc-OK off for longer than arc_loss_s once the arc was there: torch off, the run held.
+bool TorchHeight::arc_lost(const TorchInputs& in) noexcept {
+  arc_off_s_ = in.arc_ok ? 0.0 : arc_off_s_ + dt_;
+  if (arc_off_s_ < config_.arc_loss_s || arc_off_s_ == 0) return false;
+  ++status_.arc_losses;
+  status_.torch_on = false;
+  tell(TorchEvent::ArcLost, status_.thc_offset_mm, true);
+  enter(TorchPhase::Paused);
+  return true;
+}
+
+double TorchHeight::step(const TorchInputs& in) noexcept {
+  hold_request_ = event_pending_ = false;
+  programmed_z_ = in.programmed_z;
+  status_.arc_voltage_v = in.arc_voltage_v;
+  status_.arc_ok = in.arc_ok;
+  status_.sensor = in.sensor;
+  if (status_.torch_on && in.arc_ok) {
+    const double k = filter_primed_ ? dt_ / (config_.filter_s + dt_) : 1.0;
+    status_.filtered_voltage_v += k * (in.arc_voltage_v - status_.filtered_voltage_v);
+    filter_primed_ = true;
+  } else {
+    filter_primed_ = false;
+  }
+  timer_s_ += dt_;
+  const TorchPhase p = status_.phase;
+  const bool sequencing = p == TorchPhase::Probing || p == TorchPhase::ToPierce ||
+                          p == TorchPhase::Igniting || p == TorchPhase::Piercing || p == TorchPhase::Puddle ||
+                          p == TorchPhase::ToCut || p == TorchPhase::Cutting;
+  if (in.hold && sequencing) {  // a feed hold puts the torch out; a resume pierces again here
+    status_.torch_on = false;
+    enter(TorchPhase::Paused);
+  }
+  waits_ = false;
+  switch (status_.phase) {
+    case TorchPhase::Off:
+      move_to(offset_);  // at rest where it is (the offset is 0 after a retract)
+      break;
+    case TorchPhase::Probing:
+      waits_ = true;
+      probe(in);
+      break;
+    case TorchPhase::ToPierce:
+      waits_ = true;
+      if (move_to(offset_for_height(config_.pierce_height_mm))) {
+        status_.torch_on = true;
+        enter(TorchPhase::Igniting);
+      }
+      break;
+    case TorchPhase::Igniting:
+      waits_ = true;
+      ignite(in);
+      break;
+    case TorchPhase::Piercing:
+      waits_ = true;
+      move_to(offset_);
+      if (arc_lost(in)) break;
+      if (timer_s_ >= config_.pierce_delay_s - 1e-12)
+        enter(config_.puddle_height_mm > 0 ? TorchPhase::Puddle : TorchPhase::ToCut);
+      break;
+    case TorchPhase::Puddle:
+      move_to(offset_for_height(config_.puddle_height_mm));
+      if (arc_lost(in)) break;
+      if (timer_s_ >= config_.puddle_delay_s - 1e-12) enter(TorchPhase::ToCut);
+      break;
+    case TorchPhase::ToCut:
+      waits_ = config_.puddle_height_mm <= 0;  // after a puddle jump the path moves on meanwhile
+      if (arc_lost(in)) break;
+      if (move_to(offset_for_height(config_.cut_height_mm))) {
+        cut_offset_ = offset_;
+        status_.cut_z_mm = status_.plate_z_mm + config_.cut_height_mm;
+        since_cut_s_ = sample_sum_ = sample_s_ = void_timer_s_ = 0;
+        status_.target_voltage_v = config_.arc_voltage_v;
+        last_velocity_ = in.path_velocity;
+        enter(TorchPhase::Cutting);
+        waits_ = false;  // the path goes on in this very period
+      }
+      break;
+    case TorchPhase::Cutting:
+      if (arc_lost(in)) break;
+      cut(in);
+      break;
+    case TorchPhase::Retracting:
+      waits_ = true;
+      status_.torch_on = false;
+      if (move_to(retract_target_)) enter(TorchPhase::Off);
+      break;
+    case TorchPhase::Paused:
+    case TorchPhase::Failed:
+      status_.torch_on = false;
+      move_to(offset_);
+      if (in.hold) {
+        paused_held_ = true;
+      } else if (paused_held_) {  // resumed: find the plate again and pierce where the torch stands
+        starts_failed_ = 0;
+        enter(programmed_on_ ? TorchPhase::Probing : TorchPhase::Retracting);
+      }
+      break;
+  }
+  status_.thc_offset_mm = offset_;
+  status_.correction_mm = status_.phase == TorchPhase::Cutting ? offset_ - cut_offset_ : 0.0;
+  return offset_;
+}
+
+// Down at the probe speed until the switch; the plate's top is where the torch stood when the
+// input was sampled, plus the float's travel. The torch brakes on toward the pierce height.
+void TorchHeight::probe(const TorchInputs& in) noexcept {
+  if (in.sensor) {
+    status_.plate_z_mm =
+        in.measured_z + (config_.sensor == PlateSensor::Float ? config_.switch_offset_mm : 0.0);
+    enter(TorchPhase::ToPierce);
+    move_to(offset_for_height(config_.pierce_height_mm));  // braking in this period already
+    return;
+  }
+  if (offset_ <= -config_.probe_travel_mm) {
+    tell(TorchEvent::PlateNotFound, offset_, true);
+    enter(TorchPhase::Failed);
+    return;
+  }
+  const double ad = config_.height_accel_mm_s2 * dt_;
+  v_ = std::max(v_ - ad, -config_.probe_speed_mm_s);
+  if (v_ > 0) v_ = std::max(0.0, v_ - 2 * ad);
+  offset_ = std::max(offset_ + v_ * dt_, -config_.probe_travel_mm);
+}
+
+// Torch on until arc-OK; a start that times out is tried again, up to max_starts in a row.
+void TorchHeight::ignite(const TorchInputs& in) noexcept {
+  move_to(offset_);
+  if (in.arc_ok && status_.torch_on) {
+    ++status_.pierces;
+    starts_failed_ = 0;
+    enter(TorchPhase::Piercing);
+    return;
+  }
+  status_.torch_on = true;
+  if (timer_s_ < config_.arc_ok_timeout_s) return;
+  ++status_.failed_starts;
+  ++starts_failed_;
+  status_.torch_on = false;  // off for this period, then on again
+  if (starts_failed_ >= config_.max_starts) {
+    tell(TorchEvent::StartsExhausted, starts_failed_, true);
+    enter(TorchPhase::Failed);
+    return;
+  }
+  tell(TorchEvent::StartFailed, starts_failed_, false);
+  enter(TorchPhase::Igniting);
+}
+
+// At the cut height: the height control's state, then the correction it allows.
+void TorchHeight::cut(const TorchInputs& in) noexcept {
+  since_cut_s_ += dt_;
+  const ThcState s = thc_state(in);
+  status_.thc = s;
+  correct(in, s);
+}
+
+ThcState TorchHeight::thc_state(const TorchInputs& in) noexcept {
+  const double braking = (last_velocity_ - in.path_velocity) / dt_;
+  last_velocity_ = in.path_velocity;
+  if (config_.thc == 0) return ThcState::Off;
+  if (void_timer_s_ > 0) void_timer_s_ = std::max(0.0, void_timer_s_ - dt_);
+  const bool known = status_.target_voltage_v > 0;
+  if (status_.thc_hold) return ThcState::ProgramLock;
+  const bool at_speed = in.feed > 0 && in.path_velocity >= config_.speed_share * in.feed;
+  if (!at_speed) return known ? ThcState::CornerLock : ThcState::Waiting;
+  if (braking > config_.anti_dive_mm_s2) return ThcState::AntiDive;
+  if (since_cut_s_ < config_.thc_delay_s) return ThcState::Waiting;
+  if (!known) {  // auto volts: the mean of the filtered voltage over the sample's length
+    sample_sum_ += status_.filtered_voltage_v * dt_;
+    sample_s_ += dt_;
+    if (sample_s_ >= config_.sample_s - 1e-12) status_.target_voltage_v = sample_sum_ / sample_s_;
+    return ThcState::Sampling;
+  }
+  if (std::fabs(status_.filtered_voltage_v - status_.target_voltage_v) > config_.void_jump_v)
+    void_timer_s_ = config_.void_hold_s;
+  return void_timer_s_ > 0 ? ThcState::VoidLock : ThcState::Active;
+}
+
+// Active: a speed toward the height the voltage says is right, e/τ, within the deadband none;
+// locked: none. The speed is reached at the correction's acceleration, and the correction stays
+// within ±max_correction_mm of the cut height found by the probe.
+void TorchHeight::correct(const TorchInputs& /*in*/, ThcState s) noexcept {
+  double want = 0;
+  if (s == ThcState::Active) {
+    const double error_v = status_.filtered_voltage_v - status_.target_voltage_v;
+    if (std::fabs(error_v) > config_.deadband_v)
+      want = std::clamp(-(error_v / config_.volts_per_mm) / config_.time_constant_s,
+                        -config_.max_velocity_mm_s, config_.max_velocity_mm_s);
+  }
+  const double ad = config_.max_accel_mm_s2 * dt_;
+  v_ += std::clamp(want - v_, -ad, ad);
+  offset_ += v_ * dt_;
+  const double lo = cut_offset_ - config_.max_correction_mm, hi = cut_offset_ + config_.max_correction_mm;
+  if (offset_ < lo || offset_ > hi) {
+    offset_ = std::clamp(offset_, lo, hi);
+    v_ = 0;
+  }
+}
+
+}  // namespace opencnc::control
