@@ -37,6 +37,36 @@ void EdmContribution::observe(const controller::ControllerStatus& s, ValueSink& 
     out.condition(gap_, Level::Warning, "edm.gap.arc", "arcing in the gap: debris, the jump should clear it");
 }
 
+// --- Plasma torch ------------------------------------------------------------------------------
+
+void TorchContribution::describe(DeviceModel& model) {
+  const int auxiliaries = model.add_component(0, "Auxiliaries", "auxiliaries");
+  const int torch = model.add_component(auxiliaries, "CuttingTorch", "torch", "torch");
+  power_ =
+      model.add_item(DataItem{"torch_power", Category::Event, "POWER_STATE", {}, {}, "PowerState", torch});
+  arc_voltage_ = model.add_item(
+      DataItem{"torch_arc_v", Category::Sample, "VOLTAGE_DC", "ACTUAL", "VOLT", "VoltageDC", torch});
+  correction_ = model.add_item(
+      DataItem{"torch_thc", Category::Sample, "DISPLACEMENT", {}, "MILLIMETER", "Displacement", torch});
+  arc_ = model.add_item(DataItem{"torch_arc", Category::Condition, "VOLTAGE_DC", {}, {}, {}, torch});
+}
+
+void TorchContribution::observe(const controller::ControllerStatus& s, ValueSink& out) const {
+  const auto& t = s.servo.torch;
+  out.set(power_, t.torch_on ? "ON" : "OFF");
+  out.set(arc_voltage_, t.torch_on ? fmt::format("{:.1f}", t.arc_voltage_v) : std::string("UNAVAILABLE"));
+  out.set(correction_, t.phase == control::TorchPhase::Cutting ? fmt::format("{:.4f}", t.correction_mm)
+                                                               : std::string("UNAVAILABLE"));
+  if (t.phase == control::TorchPhase::Failed)
+    out.condition(arc_, Level::Fault, "plasma.start-failed",
+                  fmt::format("no plate found, or the arc did not start ({} failed starts): the run is held",
+                              t.failed_starts));
+  else if (t.phase == control::TorchPhase::Paused)
+    out.condition(arc_, Level::Warning, "plasma.paused",
+                  fmt::format("the torch is off and the run held ({} arcs lost): a resume pierces again here",
+                              t.arc_losses));
+}
+
 // --- Coupling and broaching load ---------------------------------------------------------------
 
 CouplingContribution::CouplingContribution(Axis master, Axis slave, bool load)
@@ -93,6 +123,7 @@ std::vector<std::unique_ptr<Contribution>> contributions_for(const config::Machi
   list.push_back(std::make_unique<CoreContribution>(profile));
   if (profile.power.monitor) list.push_back(std::make_unique<PowerContribution>());
   if (profile.edm.present) list.push_back(std::make_unique<EdmContribution>());
+  if (profile.plasma.present) list.push_back(std::make_unique<TorchContribution>());
   if (profile.coupling.present)
     list.push_back(std::make_unique<CouplingContribution>(profile.coupling.master, profile.coupling.slave,
                                                           profile.broaching.present));

@@ -18,6 +18,18 @@ class EdmContribution final : public Contribution {
   std::size_t gap_voltage_ = 0, gap_ = 0;
 };
 
+/// A plasma table's torch (`[process.plasma]`): MTConnect's CuttingTorch among the Auxiliaries, with
+/// its power (the torch output), the arc voltage, the height control's correction, and a condition
+/// while the torch's sequence holds the run.
+class TorchContribution final : public Contribution {
+ public:
+  void describe(DeviceModel& model) override;
+  void observe(const controller::ControllerStatus& status, ValueSink& out) const override;
+
+ private:
+  std::size_t power_ = 0, arc_voltage_ = 0, correction_ = 0, arc_ = 0;
+};
+
 /// A coupling law's master and slave (AXIS_COUPLING, COUPLED_AXES) and, on a broach, the
 /// load cell's force on the master (the stroke).
 class CouplingContribution final : public Contribution {

@@ -135,7 +135,8 @@ void observe(Agent& agent, Scenario& s, int periods, int every = 10) {
 class EveryProfile : public ::testing::TestWithParam<std::string> {};
 
 /// A status with something in every item a profile may have: the machine moving, a fault of an
-/// axis, every process alarm active, the EDM gap shorted, a coupling engaged, on battery.
+/// axis, every process alarm active, the EDM gap shorted, a coupling engaged, on battery, the
+/// plasma torch cutting, held or failed in turn; every drive reporting its effort.
 controller::ControllerStatus busy_status(const config::MachineProfile& p, int i) {
   controller::ControllerStatus s;
   s.servo.state = i % 3 == 0   ? control::State::Running
@@ -162,6 +163,16 @@ controller::ControllerStatus busy_status(const config::MachineProfile& p, int i)
   s.servo.mains_ok = false;
   s.servo.on_battery = true;
   s.servo.load_kn = 1.25;
+  s.servo.torch.phase = i % 3 == 0   ? control::TorchPhase::Cutting
+                        : i % 3 == 1 ? control::TorchPhase::Paused
+                                     : control::TorchPhase::Failed;
+  s.servo.torch.torch_on = i % 3 == 0;
+  s.servo.torch.arc_voltage_v = 121.5;
+  s.servo.torch.correction_mm = -0.125;
+  for (auto& j : s.servo.joints) {
+    j.effort_valid = true;
+    j.effort = -150.0 * i;
+  }
   return s;
 }
 
@@ -197,7 +208,7 @@ TEST_P(EveryProfile, EveryDocumentIsValidMTConnect27) {
 
 INSTANTIATE_TEST_SUITE_P(Connect, EveryProfile,
                          ::testing::Values("mill-3axis", "mill-4axis", "drill-retrofit", "edm-5axis",
-                                           "broach-zc", "flame-cutter", "hmc-toolcheck"),
+                                           "broach-zc", "flame-cutter", "hmc-toolcheck", "plasma-table"),
                          [](const ::testing::TestParamInfo<std::string>& param) {
                            std::string n = param.param;
                            std::replace(n.begin(), n.end(), '-', '_');
@@ -216,6 +227,9 @@ TEST(Agent, TheProbeDescribesTheProfilesAxesAndFeatures) {
   Xml e(ask(*edm, "/probe").body);
   EXPECT_EQ(e.one("//m:DataItem[@id='edm_gap_v']/@units"), "VOLT");
   EXPECT_EQ(e.one("//m:Rotary[@name='B']//m:DataItem[@subType='ACTUAL']/@type"), "ANGLE");
+  Xml t(ask(*Agent::for_profile(profile("plasma-table"), {}), "/probe").body);
+  EXPECT_EQ(t.one("//m:Auxiliaries/m:Components/m:CuttingTorch/@id"), "torch");
+  EXPECT_EQ(t.one("//m:CuttingTorch//m:DataItem[@type='VOLTAGE_DC' and @category='SAMPLE']/@units"), "VOLT");
 
   auto broach = Agent::for_profile(profile("broach-zc"), {});
   Xml b(ask(*broach, "/probe").body);

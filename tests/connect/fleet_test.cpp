@@ -202,7 +202,8 @@ TEST(FleetWatcher, SeesEveryMachineOfTheBrokerAndAKilledOneTurnsUnavailable) {
   watcher.start();
   std::uint64_t i = 0;
   auto both = [&] {
-    a->observe(test::moving_status(i++), static_cast<std::int64_t>(i) * 1000);
+    const std::uint64_t k = i++;
+    a->observe(test::moving_status(k), static_cast<std::int64_t>(k) * 1000);
     const auto rows = watcher.machines();
     return rows.size() == 2 && rows[0].availability == "AVAILABLE" && rows[1].availability == "AVAILABLE" &&
            rows[0].execution == "ACTIVE" && rows[1].execution == "ACTIVE";
