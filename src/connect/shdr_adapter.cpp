@@ -104,8 +104,11 @@ struct ShdrAdapter::Impl {
   void accept() {
     acceptor.async_accept([this](boost::system::error_code ec, tcp::socket socket) {
       if (stopping) return;
-      if (ec) {  // a connection that failed before it was accepted: the next one
-        accept();
+      if (ec) {  // out of descriptors, or a connection gone before it was accepted: try again soon
+        retry.expires_after(std::chrono::milliseconds(100));
+        retry.async_wait([this](boost::system::error_code e) {
+          if (!e && !stopping) accept();
+        });
         return;
       }
       std::shared_ptr<Client> c;
@@ -257,6 +260,7 @@ struct ShdrAdapter::Impl {
   asio::io_context io;
   tcp::acceptor acceptor{io};
   asio::steady_timer timer{io};
+  asio::steady_timer retry{io};                // the next accept after a failed one
   std::list<std::shared_ptr<Client>> clients;  // the io thread's; stats_mutex guards its size for stats()
   std::thread thread;
   int bound_port = 0;
@@ -308,6 +312,7 @@ void ShdrAdapter::stop() {
     boost::system::error_code ignored;
     m.acceptor.close(ignored);
     m.timer.cancel();
+    m.retry.cancel();
     const std::vector<std::shared_ptr<Impl::Client>> each(m.clients.begin(), m.clients.end());
     for (const auto& c : each) m.close(c);
     m.io.stop();
