@@ -224,7 +224,7 @@ int serve(const ServeOptions& o) {
     shdr = std::make_unique<connect::ShdrAdapter>(*agent, so);
     try {
       shdr->start();
-    } catch (const std::system_error& e) {
+    } catch (const std::runtime_error& e) {
       fmt::print(stderr, "error: --shdr: {}\n", e.what());
       return kExitUsage;
     }

@@ -22,22 +22,13 @@ namespace {
 
 using namespace opencnc;
 using namespace std::chrono_literals;
+using connect::test::eventually;
 
 int usage() {
   std::fprintf(stderr,
                "usage: fleet_mqtt_bench [--machines 20] [--minutes 10] [--hz 10] [--speed 20] [--down-s 3]\n"
                "                        [--queue 2000] [--no-restart]\n");
   return 2;
-}
-
-template <typename F>
-bool eventually(F done, std::chrono::milliseconds limit) {
-  const auto until = std::chrono::steady_clock::now() + limit;
-  while (std::chrono::steady_clock::now() < until) {
-    if (done()) return true;
-    std::this_thread::sleep_for(20ms);
-  }
-  return done();
 }
 
 struct Machine {

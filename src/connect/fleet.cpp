@@ -167,7 +167,7 @@ std::vector<FleetMachine> Fleet::machines() const {
   return out;
 }
 
-std::string Fleet::json(std::int64_t now_ms) const {
+std::string Fleet::json(std::int64_t now_ms, std::string_view broker_url, bool connected) const {
   Json list = Json::array();
   for (const FleetMachine& v : machines()) {
     Json alarms = Json::array();
@@ -198,7 +198,9 @@ std::string Fleet::json(std::int64_t now_ms) const {
     row["progress"] = v.progress >= 0 ? Json(v.progress) : Json(nullptr);
     list.push_back(std::move(row));
   }
-  return Json{{"machines", std::move(list)}, {"malformed", malformed_}, {"now", now_ms}}.dump();
+  Json j{{"machines", std::move(list)}, {"malformed", malformed_}, {"now", now_ms}};
+  if (!broker_url.empty()) j["broker"] = {{"url", broker_url}, {"connected", connected}};
+  return j.dump();
 }
 
 // --- The watcher --------------------------------------------------------------------------------
@@ -270,15 +272,9 @@ std::vector<FleetMachine> FleetWatcher::machines() const {
 }
 
 std::string FleetWatcher::json() const {
-  std::string fleet;
-  {
-    std::lock_guard lock(mutex_);
-    fleet = fleet_.json(wall_ms());
-  }
-  Json j = Json::parse(fleet);
-  j["broker"] = {{"url", fmt::format("mqtt://{}:{}", options_.broker.host, options_.broker.port)},
-                 {"connected", connected_.load()}};
-  return j.dump();
+  const std::string url = fmt::format("mqtt://{}:{}", options_.broker.host, options_.broker.port);
+  std::lock_guard lock(mutex_);
+  return fleet_.json(wall_ms(), url, connected_.load());
 }
 
 }  // namespace opencnc::connect

@@ -16,6 +16,7 @@
 #include <thread>
 
 #include "opencnc/connect/json_messages.hpp"
+#include "opencnc/connect/listener.hpp"
 
 namespace opencnc::connect {
 
@@ -286,16 +287,9 @@ ShdrAdapter::~ShdrAdapter() {
 void ShdrAdapter::start() {
   Impl& m = *impl_;
   if (m.thread.joinable()) return;
-  boost::system::error_code ec;
-  const auto address = asio::ip::make_address(m.options.host, ec);
-  if (ec) throw std::system_error(ec, fmt::format("shdr: '{}' is not an IP address", m.options.host));
-  const tcp::endpoint at(address, static_cast<unsigned short>(m.options.port));
-  m.acceptor.open(at.protocol());
-  m.acceptor.set_option(tcp::acceptor::reuse_address(true));
-  m.acceptor.bind(at, ec);
-  if (ec)
-    throw std::system_error(ec, fmt::format("shdr: cannot listen on {}:{}", m.options.host, m.options.port));
-  m.acceptor.listen();
+  if (std::string why = open_listener(m.acceptor, m.options.host, static_cast<std::uint16_t>(m.options.port));
+      !why.empty())
+    throw std::runtime_error("shdr: " + why);
   m.bound_port = m.acceptor.local_endpoint().port();
   m.accept();
   m.poll();

@@ -38,8 +38,7 @@ bool TorchHeight::apply_code(int code, double /*p*/) noexcept {
     case machine::kTorchOffCode:
       programmed_on_ = false;
       status_.torch_on = false;
-      retract_target_ =
-          std::min(offset_, 0.0) < 0 ? 0.0 : offset_;  // up to the programmed height, never down
+      retract_target_ = std::max(offset_, 0.0);  // up to the programmed height, never down
       enter(TorchPhase::Retracting);
       return true;
     case machine::kThcHoldCode:

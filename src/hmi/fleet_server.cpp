@@ -11,6 +11,7 @@
 #include <optional>
 #include <thread>
 
+#include "opencnc/connect/listener.hpp"
 #include "opencnc/hmi/static_files.hpp"
 
 namespace opencnc::hmi {
@@ -114,20 +115,8 @@ FleetServer::~FleetServer() {
 
 bool FleetServer::start(std::string* error) {
   Impl& m = *impl_;
-  beast::error_code ec;
-  const auto address = net::ip::make_address(m.config.address, ec);
-  if (ec) {
-    if (error) *error = fmt::format("'{}' is not an IP address", m.config.address);
-    return false;
-  }
-  const tcp::endpoint at(address, m.config.port);
-  m.acceptor.open(at.protocol(), ec);
-  if (!ec) m.acceptor.set_option(net::socket_base::reuse_address(true), ec);
-  if (!ec) m.acceptor.bind(at, ec);
-  if (!ec) m.acceptor.listen(net::socket_base::max_listen_connections, ec);
-  if (ec) {
-    if (error)
-      *error = fmt::format("cannot listen on {}:{}: {}", m.config.address, m.config.port, ec.message());
+  if (std::string why = connect::open_listener(m.acceptor, m.config.address, m.config.port); !why.empty()) {
+    if (error) *error = std::move(why);
     return false;
   }
   m.bound = m.acceptor.local_endpoint().port();

@@ -2,6 +2,7 @@
 // The HMI server on Boost.Beast: HTTP sessions (the JSON API, the front end's files) and
 // WebSocket sessions (status at a steady rate, each client's own cursor on the event log).
 #include "opencnc/hmi/server.hpp"
+#include "opencnc/connect/listener.hpp"
 #include "opencnc/connect/status_sampler.hpp"
 
 #include <atomic>
@@ -1087,24 +1088,12 @@ Server::~Server() {
 
 bool Server::start(std::string* error) {
   Impl& s = *impl_;
-  beast::error_code ec;
-  const auto address = net::ip::make_address(s.config.address, ec);
-  if (ec) {
-    if (error) *error = fmt::format("--listen: \"{}\" is not an IP address", s.config.address);
-    return false;
-  }
-  const tcp::endpoint ep{address, s.config.port};
-  s.acceptor->open(ep.protocol(), ec);
-  if (!ec) s.acceptor->set_option(net::socket_base::reuse_address(true), ec);
-  if (!ec) s.acceptor->bind(ep, ec);
-  if (!ec) s.acceptor->listen(net::socket_base::max_listen_connections, ec);
-  if (ec) {
-    if (error)
-      *error = fmt::format("cannot listen on {}:{}: {}", s.config.address, s.config.port, ec.message());
+  if (std::string why = connect::open_listener(*s.acceptor, s.config.address, s.config.port); !why.empty()) {
+    if (error) *error = "--listen: " + why;
     return false;
   }
   s.port = s.acceptor->local_endpoint().port();
-  s.loopback = address.is_loopback();
+  s.loopback = s.acceptor->local_endpoint().address().is_loopback();
   s.accept();
   net::post(s.ioc, [self = impl_] { self->stream_tick(); });
   for (int k = 0; k < std::max(1, s.config.io_threads); ++k)

@@ -22,6 +22,7 @@ namespace {
 
 using namespace std::chrono_literals;
 using nlohmann::json;
+using test::eventually;
 
 config::MachineProfile profile(const char* name = "mill-3axis") {
   return *config::load_profile(std::filesystem::path(OPENCNC_SOURCE_DIR) / "configs" /
@@ -154,16 +155,6 @@ TEST(Fleet, PayloadsThatAreNotTheTopicsAreCountedAndOtherTopicsIgnored) {
   const json j = json::parse(fleet.json(42));
   EXPECT_EQ(j["malformed"], 3);
   EXPECT_EQ(j["now"], 42);
-}
-
-template <typename F>
-bool eventually(F done, std::chrono::milliseconds limit = 10s) {
-  const auto until = std::chrono::steady_clock::now() + limit;
-  while (std::chrono::steady_clock::now() < until) {
-    if (done()) return true;
-    std::this_thread::sleep_for(10ms);
-  }
-  return done();
 }
 
 /// GET (or another method) on the fleet server: status and body.

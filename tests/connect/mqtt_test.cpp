@@ -14,6 +14,7 @@ namespace {
 
 using namespace std::chrono_literals;
 using test::Broker;
+using test::eventually;
 using test::moving_status;
 using test::Subscriber;
 
@@ -32,17 +33,6 @@ MqttOptions to(const Broker& b) {
   o.broker = MqttAddress{"127.0.0.1", b.port()};
   o.poll_ms = 10;
   return o;
-}
-
-/// Waits up to `limit` for `done`.
-template <typename F>
-bool eventually(F done, std::chrono::milliseconds limit = 10s) {
-  const auto until = std::chrono::steady_clock::now() + limit;
-  while (std::chrono::steady_clock::now() < until) {
-    if (done()) return true;
-    std::this_thread::sleep_for(10ms);
-  }
-  return done();
 }
 
 /// Sequences in [from, to) missing from `seen`, and those seen more than once.

@@ -9,25 +9,12 @@ import { spawn } from "node:child_process";
 import { mkdtempSync, mkdirSync, rmSync, writeFileSync } from "node:fs";
 import { createServer } from "node:net";
 import { tmpdir } from "node:os";
-import { dirname, join, resolve } from "node:path";
-import { fileURLToPath } from "node:url";
+import { join } from "node:path";
 import { chromium } from "playwright-core";
+import { commandLine } from "./cli.mjs";
 import { serverUrl, stopServer, waitFor as waitForOn } from "./wait.mjs";
 
-const here = dirname(fileURLToPath(import.meta.url));
-const repo = resolve(here, "..", "..");
-const args = process.argv.slice(2);
-const opt = (name, fallback) => {
-  const i = args.indexOf(name);
-  return i >= 0 ? args[i + 1] : fallback;
-};
-if (args.includes("--help") || args.includes("-h")) {
-  console.log("usage: node e2e/fleet.mjs [--opencnc build/opencnc] [--out web/e2e/artifacts]");
-  process.exit(0);
-}
-const opencnc = resolve(opt("--opencnc", join(repo, "build", "opencnc")));
-const out = resolve(opt("--out", join(here, "artifacts")));
-mkdirSync(out, { recursive: true });
+const { repo, opencnc, out } = commandLine("e2e/fleet.mjs");
 const data = mkdtempSync(join(tmpdir(), "opencnc-fleet-e2e-"));
 const step = (what) => console.log(`fleet e2e: ${what}`);
 

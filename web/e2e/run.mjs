@@ -9,35 +9,16 @@
 // EDM a condition's value changed, a condition added and one deleted (data.mjs); then the power-fail recovery on the broach (recovery.mjs). Screenshots land in the
 // artefacts folder. Usage: node e2e/run.mjs [--opencnc PATH] [--out DIR]
 import { spawn } from "node:child_process";
-import { copyFileSync, mkdtempSync, mkdirSync, readFileSync, rmSync } from "node:fs";
+import { copyFileSync, mkdtempSync, readFileSync, rmSync } from "node:fs";
 import { tmpdir } from "node:os";
-import { dirname, join, resolve } from "node:path";
-import { fileURLToPath } from "node:url";
+import { join } from "node:path";
 import { chromium } from "playwright-core";
 import { compensationStep, conditionsStep, noConditionsStep } from "./data.mjs";
 import { recoveryStep } from "./recovery.mjs";
+import { commandLine } from "./cli.mjs";
 import { serverUrl, stopServer, waitFor as waitForOn } from "./wait.mjs";
 
-const here = dirname(fileURLToPath(import.meta.url));
-const repo = resolve(here, "..", "..");
-const args = process.argv.slice(2);
-const opt = (name, fallback) => {
-  const i = args.indexOf(name);
-  return i >= 0 ? args[i + 1] : fallback;
-};
-if (args.includes("--help") || args.includes("-h")) {
-  console.log("usage: node e2e/run.mjs [--opencnc build/opencnc] [--out web/e2e/artifacts]");
-  process.exit(0);
-}
-for (let i = 0; i < args.length; i += 2) {
-  if (!["--opencnc", "--out"].includes(args[i])) {
-    console.error(`e2e: unknown option '${args[i]}'`);
-    process.exit(2);
-  }
-}
-const opencnc = resolve(opt("--opencnc", join(repo, "build", "opencnc")));
-const out = resolve(opt("--out", join(here, "artifacts")));
-mkdirSync(out, { recursive: true });
+const { repo, opencnc, out } = commandLine("e2e/run.mjs");
 const data = mkdtempSync(join(tmpdir(), "opencnc-e2e-"));
 // The profile is a copy: the admin's step changes a machine parameter, which writes the file.
 for (const f of ["mill-3axis.toml", "mill-3axis.tbl"]) copyFileSync(join(repo, "configs", f), join(data, f));

@@ -54,8 +54,9 @@ class Fleet {
   bool take(std::string_view topic, std::string_view payload, std::int64_t now_ms);
   /// The machines, by name.
   std::vector<FleetMachine> machines() const;
-  /// The fleet view's JSON: {"machines": [...], "malformed": N, "now": ms}.
-  std::string json(std::int64_t now_ms) const;
+  /// The fleet view's JSON: {"machines": [...], "malformed": N, "now": ms}, and "broker": {"url",
+  /// "connected"} when `broker_url` is given.
+  std::string json(std::int64_t now_ms, std::string_view broker_url = {}, bool connected = false) const;
   std::uint64_t malformed() const noexcept { return malformed_; }
 
  private:

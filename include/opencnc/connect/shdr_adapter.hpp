@@ -61,7 +61,7 @@ class ShdrAdapter {
   ShdrAdapter(const ShdrAdapter&) = delete;
   ShdrAdapter& operator=(const ShdrAdapter&) = delete;
 
-  /// Binds the listener (throws std::system_error naming the address when it cannot) and starts
+  /// Binds the listener (throws std::runtime_error naming the address when it cannot) and starts
   /// serving on a thread of its own.
   void start();
   /// Closes every connection and the listener.
