@@ -313,6 +313,9 @@ TEST(ServerFeatures, RetracePausesStepsBackAndCutsOnFromTheNearestPoint) {
   ASSERT_TRUE(rig.until([](const json& s) { return s["features"]["retrace"]["phase"] == "paused"; }));
   EXPECT_EQ(rig.status()["mode"], "manual");  // the operator may jog the torch off the path
   ASSERT_EQ(rig.command(with({{"action", "step"}, {"distance_mm", -5}})).status, 200);
+  // The status the rig reads may be a stream period older than the step's answer: see the step
+  // under way (5 mm at 1000 mm/min: 0.3 s, many periods) before waiting for its end.
+  ASSERT_TRUE(rig.until([](const json& s) { return s["features"]["retrace"]["phase"] == "stepping"; }));
   ASSERT_TRUE(rig.until([](const json& s) { return s["features"]["retrace"]["phase"] == "paused"; }));
   EXPECT_EQ(rig.command(with({{"action", "start"}})).status, 400);  // not confirmed
   const Reply start = rig.command(with({{"action", "start"}, {"confirmed", true}}));
