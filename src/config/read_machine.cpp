@@ -72,7 +72,9 @@ void read_sim(Section& top, MachineProfile& profile) {
 void read_spindle(Section& top, MachineProfile& profile) {
   const toml::table* t = top.subtable("spindle");
   if (t == nullptr) return;
-  Section s(*t, "spindle", {"max_rpm", "min_rpm", "encoder_counts_per_rev", "orient", "sim"}, top.reporter());
+  Section s(*t, "spindle",
+            {"max_rpm", "min_rpm", "encoder_counts_per_rev", "orient", "rated_torque_nm", "sim"},
+            top.reporter());
   SpindleProfile& sp = profile.spindle;
   sp.present = true;
   sp.max_rpm = s.required_number("max_rpm", Bound::Positive);
@@ -99,10 +101,12 @@ void read_spindle(Section& top, MachineProfile& profile) {
   sp.sim.encoder_counts_per_rev =
       static_cast<double>(s.integer("encoder_counts_per_rev", 0, 1 << 24).value_or(0));
   sp.sim.orient = s.boolean_or("orient", false);
+  sp.rated_torque_nm = s.number_or("rated_torque_nm", 0, Bound::Positive);
   const toml::table* st = s.subtable("sim");
   if (st == nullptr) return;
   Section m(*st, "spindle.sim",
-            {"acceleration_rpm_s", "at_speed_tolerance", "orient_rpm", "orient_tolerance_deg"},
+            {"acceleration_rpm_s", "at_speed_tolerance", "orient_rpm", "orient_tolerance_deg", "inertia_kgm2",
+             "friction_nm", "viscous_nm_per_krpm"},
             top.reporter());
   sp.sim.acceleration_rpm_s = m.number_or("acceleration_rpm_s", sp.sim.acceleration_rpm_s, Bound::Positive);
   sp.sim.at_speed_tolerance =
@@ -110,6 +114,10 @@ void read_spindle(Section& top, MachineProfile& profile) {
   sp.sim.orient_rpm = m.number_or("orient_rpm", sp.sim.orient_rpm, Bound::Positive);
   sp.sim.orient_tolerance_deg =
       m.number_or("orient_tolerance_deg", sp.sim.orient_tolerance_deg, Bound::Positive);
+  sp.sim.inertia_kgm2 = m.number_or("inertia_kgm2", sp.sim.inertia_kgm2, Bound::NonNegative);
+  sp.sim.friction_nm = m.number_or("friction_nm", sp.sim.friction_nm, Bound::NonNegative);
+  sp.sim.viscous_nm_per_krpm =
+      m.number_or("viscous_nm_per_krpm", sp.sim.viscous_nm_per_krpm, Bound::NonNegative);
 }
 
 void read_power(Section& top, MachineProfile& profile) {

@@ -120,6 +120,8 @@ void CoreContribution::describe(DeviceModel& model) {
         item(c, "s_ovr", Category::Event, "ROTARY_VELOCITY_OVERRIDE", "RotaryVelocityOverride");
     spindle_->mode = item(c, "s_mode", Category::Event, "ROTARY_MODE", "RotaryMode");
     spindle_->load = item(c, "s_load", Category::Sample, "LOAD", "Load", {}, "PERCENT");
+    spindle_->torque = item(c, "s_torque", Category::Sample, "TORQUE", "Torque", {}, "NEWTON_METER");
+    spindle_->rated_torque = profile_.spindle.rated_torque_nm;
   }
   const int controller = model.add_component(0, "Controller", "controller");
   estop_ = item(controller, "estop", Category::Event, "EMERGENCY_STOP", "EmergencyStop");
@@ -149,7 +151,8 @@ void CoreContribution::observe(const controller::ControllerStatus& s, ValueSink&
     out.set(a.actual, v.actual[i], decimals);
     out.set(a.commanded, v.commanded[i], decimals);
     // LOAD: the drive's effort as a share of its peak, where the drive reports it (the simulated
-    // machine's do; the HAL machine has no pin for it yet).
+    // machine's servo drives do; in HAL, the `joint.N.effort` pins when the component is loaded
+    // with effort=1).
     const auto& joint = v.joints[static_cast<std::size_t>(a.joint)];
     if (joint.effort_valid && a.peak_effort > 0)
       out.set(a.load, 100.0 * std::abs(joint.effort) / a.peak_effort, 1);
@@ -161,7 +164,18 @@ void CoreContribution::observe(const controller::ControllerStatus& s, ValueSink&
     out.set(spindle_->commanded, v.spindle_rpm, 1);
     out.set(spindle_->override_, v.spindle_override * 100.0, 0);
     out.set(spindle_->mode, "SPINDLE");
-    out.set(spindle_->load, "UNAVAILABLE");
+    // LOAD: the drive's torque as a share of its rating, where the drive reports it and the
+    // profile states the rating ([spindle] rated_torque_nm).
+    if (v.spindle_torque_valid) {
+      out.set(spindle_->torque, v.spindle_torque_nm, 2);
+      if (spindle_->rated_torque > 0)
+        out.set(spindle_->load, 100.0 * std::abs(v.spindle_torque_nm) / spindle_->rated_torque, 1);
+      else
+        out.set(spindle_->load, "UNAVAILABLE");
+    } else {
+      out.set(spindle_->torque, "UNAVAILABLE");
+      out.set(spindle_->load, "UNAVAILABLE");
+    }
   }
   out.set(estop_, v.state == control::State::EStopped || !v.estop_input_ok ? "TRIGGERED" : "ARMED");
   out.set(execution_, execution(s));

@@ -24,7 +24,8 @@ class CoreContribution final : public Contribution {
     std::size_t actual = 0, commanded = 0, load = 0, travel = 0, actuator = 0;
   };
   struct SpindleItems {
-    std::size_t speed = 0, commanded = 0, override_ = 0, mode = 0, load = 0;
+    std::size_t speed = 0, commanded = 0, override_ = 0, mode = 0, load = 0, torque = 0;
+    double rated_torque = 0;  ///< the drive's rated torque: LOAD's 100 % (0 = not stated)
   };
   config::MachineProfile profile_;  // a copy: the agent may outlive the caller's
   std::vector<AxisItems> axes_;

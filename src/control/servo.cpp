@@ -447,6 +447,8 @@ void Servo::fill_status(ServoStatus& s) const noexcept {
   s.spindle_direction = out_.spindle.direction;
   s.spindle_rpm_actual = in_.spindle.speed_rpm;
   s.spindle_at_speed = spindle_at_speed();
+  s.spindle_torque_valid = caps_.spindle_torque;
+  s.spindle_torque_nm = caps_.spindle_torque ? in_.spindle.torque_nm : 0.0;
   s.flood = out_.process.flood;
   s.mist = out_.process.mist;
   s.tool = tool_;

@@ -32,6 +32,8 @@ static int aout = 0;
 RTAPI_MP_INT(aout, "analog outputs (M67/M68), 0..16");
 static char* shm = nullptr;
 RTAPI_MP_STRING(shm, "shared memory name the controller attaches to (default /opencnc)");
+static int effort = 0;
+RTAPI_MP_INT(effort, "1: the drives' force/torque are netted to joint.N.effort and spindle.torque");
 static int heartbeat_ms = 100;
 RTAPI_MP_INT(heartbeat_ms, "the controller's heartbeat may stop this long before the machine stops");
 
@@ -90,6 +92,7 @@ int make_joint_pins(hal::JointPins& p, int j, int id) {
   r |= bit(HAL_IN, &p.limit_min, id, name("limit-min"));
   r |= bit(HAL_IN, &p.limit_max, id, name("limit-max"));
   r |= bit(HAL_IO, &p.index_enable, id, name("index-enable"));
+  r |= flt(HAL_IN, &p.effort, id, name("effort"));
   return r;
 }
 
@@ -111,6 +114,7 @@ int make_machine_pins(hal::MachinePins& p, int id) {
   r |= bit(HAL_IN, &p.spindle_at_speed, id, "spindle.at-speed");
   r |= bit(HAL_IN, &p.spindle_orient_done, id, "spindle.orient-done");
   r |= bit(HAL_IN, &p.spindle_fault, id, "spindle.fault");
+  r |= flt(HAL_IN, &p.spindle_torque, id, "spindle.torque");
   r |= bit(HAL_OUT, &p.flood, id, "coolant-flood");
   r |= bit(HAL_OUT, &p.mist, id, "coolant-mist");
   r |= s32(HAL_OUT, &p.tool_prepare_number, id, "tool.prep-number");
@@ -141,6 +145,7 @@ int make_machine_pins(hal::MachinePins& p, int id) {
   p.digital_outputs = dout;
   p.analog_inputs = ain;
   p.analog_outputs = aout;
+  p.effort_wired = effort != 0;
   return r;
 }
 
@@ -175,11 +180,12 @@ bool params_ok() {
   if (joints < 1 || joints > opencnc::machine::kMaxJoints || din < 0 ||
       din > opencnc::machine::kDigitalChannels || dout < 0 || dout > opencnc::machine::kDigitalChannels ||
       ain < 0 || ain > opencnc::machine::kAnalogChannels || aout < 0 ||
-      aout > opencnc::machine::kAnalogChannels || heartbeat_ms < 1) {
-    rtapi_print_msg(RTAPI_MSG_ERR,
-                    "opencnc_rt: joints must be 1..9, din/dout 0..64, ain/aout 0..16, heartbeat_ms >= 1 "
-                    "(got joints=%d din=%d dout=%d ain=%d aout=%d heartbeat_ms=%d)\n",
-                    joints, din, dout, ain, aout, heartbeat_ms);
+      aout > opencnc::machine::kAnalogChannels || heartbeat_ms < 1 || effort < 0 || effort > 1) {
+    rtapi_print_msg(
+        RTAPI_MSG_ERR,
+        "opencnc_rt: joints must be 1..9, din/dout 0..64, ain/aout 0..16, heartbeat_ms >= 1, effort 0 or 1 "
+        "(got joints=%d din=%d dout=%d ain=%d aout=%d heartbeat_ms=%d effort=%d)\n",
+        joints, din, dout, ain, aout, heartbeat_ms, effort);
     return false;
   }
   return true;

@@ -16,7 +16,11 @@ void HalMachine::set_capabilities(const machine::MachineCapabilities& caps) noex
   caps_.analog_outputs = std::min(caps.analog_outputs, p.analog_outputs);
   caps_.power_monitor = true;  // the power-fail pin
   caps_.ups = false;
-  for (auto& j : caps_.joints) j.effort = j.home_level = j.stall_detect = false;  // no pins for them
+  for (auto& j : caps_.joints) {
+    j.effort = j.effort && p.effort_wired;
+    j.home_level = j.stall_detect = false;  // no pins for them
+  }
+  caps_.spindle_torque = caps_.spindle && caps.spindle_torque && p.effort_wired;
   index_armed_ = {};
 }
 
@@ -66,6 +70,7 @@ void HalMachine::read_joint(int j, machine::JointInputs& in) noexcept {
   in.home = (sw & machine::kSwitchHome) != 0 && *p.home_sw;
   in.limit_neg = (sw & machine::kSwitchLimitNeg) != 0 && *p.limit_min;
   in.limit_pos = (sw & machine::kSwitchLimitPos) != 0 && *p.limit_max;
+  in.effort = caps_.joints[uj].effort ? *p.effort : 0.0;
 }
 
 void HalMachine::read_spindle(machine::SpindleInputs& in) noexcept {
@@ -76,6 +81,7 @@ void HalMachine::read_spindle(machine::SpindleInputs& in) noexcept {
   in.at_speed = *p.spindle_at_speed;
   in.orient_done = caps_.spindle_orient && *p.spindle_orient_done;
   in.fault = *p.spindle_fault;
+  in.torque_nm = caps_.spindle_torque ? *p.spindle_torque : 0.0;
 }
 
 void HalMachine::write(const machine::MachineOutputs& out) noexcept {

@@ -185,7 +185,8 @@ ToolChange tool_change(const json& body) {
   return c;
 }
 
-/// A control of the simulated machine: the mains, or an electrode (offsets and tip radius, mm).
+/// A control of the simulated machine: the mains, an electrode (offsets and tip radius, mm), or
+/// a cut's torque on the spindle (N·m).
 SimulationEvent simulation_event(const json& body) {
   SimulationEvent e{text(body, "event")};
   if (e.event == "electrode") {
@@ -194,8 +195,11 @@ SimulationEvent simulation_event(const json& body) {
       throw Bad{400, "\"offset\" must be [X, Y, Z] in mm"};
     for (std::size_t i = 0; i < 3; ++i) e.offset_mm[i] = within(o[i].get<double>(), -1000, 1000, "offset");
     e.tip_radius_mm = within(number(body, "tip_radius"), 0, 100, "tip_radius");
+  } else if (e.event == "spindle-load") {
+    e.torque_nm = within(number(body, "torque_nm"), 0, 100000, "torque_nm");
   } else if (e.event != "mains-off" && e.event != "mains-on") {
-    throw Bad{400, fmt::format("\"event\" must be mains-off, mains-on or electrode, not \"{}\"", e.event)};
+    throw Bad{400, fmt::format("\"event\" must be mains-off, mains-on, electrode or spindle-load, not \"{}\"",
+                               e.event)};
   }
   return e;
 }
@@ -392,6 +396,7 @@ json status_json(const controller::ControllerStatus& s, const config::MachinePro
        {{"rpm", v.spindle_rpm},
         {"rpm_actual", v.spindle_rpm_actual},
         {"at_speed", v.spindle_at_speed},
+        {"torque_nm", v.spindle_torque_valid ? json(v.spindle_torque_nm) : json()},
         {"direction", v.spindle_direction == machine::SpindleDirection::Stopped     ? "stopped"
                       : v.spindle_direction == machine::SpindleDirection::Clockwise ? "cw"
                                                                                     : "ccw"}}},

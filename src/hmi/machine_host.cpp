@@ -105,7 +105,8 @@ const control::LatencyHistogram* MachineHost::latency() const noexcept {
 }
 
 std::string MachineHost::simulate(const SimulationEvent& event) {
-  if (event.event != "mains-off" && event.event != "mains-on" && event.event != "electrode")
+  if (event.event != "mains-off" && event.event != "mains-on" && event.event != "electrode" &&
+      event.event != "spindle-load")
     return fmt::format("no simulation event \"{}\"", event.event);
   if (!rig_) return "the simulation controls need virtual time (opencnc serve --speed X)";
   std::unique_lock lock(simulate_mutex_);
@@ -127,6 +128,8 @@ void MachineHost::apply_simulation_events() {
     for (const SimulationEvent& e : simulate_) {
       if (e.event == "electrode")
         rig_->machine().set_electrode(e.offset_mm, e.tip_radius_mm);
+      else if (e.event == "spindle-load")
+        rig_->machine().set_spindle_load(e.torque_nm);
       else
         rig_->machine().set_mains_ok(e.event == "mains-on");
     }

@@ -69,6 +69,7 @@ MachineCapabilities SimMachine::capabilities() const noexcept {
   c.spindle = config_.spindle;
   c.spindle_encoder = config_.spindle && config_.spindle_config.encoder_counts_per_rev > 0;
   c.spindle_orient = config_.spindle && config_.spindle_config.orient;
+  c.spindle_torque = config_.spindle;
   c.power_monitor = config_.power_monitor;
   c.ups = config_.power_monitor && config_.power.ups;
   c.probe = config_.probe.joint >= 0 || config_.probe.sphere.present;

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Simulated spindle: rate-limited speed, position by trapezoidal integration, orient by a
-// braking-distance law, quantised encoder with an index mark at angle 0.
+// braking-distance law, quantised encoder with an index mark at angle 0, the drive's torque from
+// the rotor's acceleration, friction and a load.
 #include "opencnc/machine/sim_spindle.hpp"
 
 #include <algorithm>
@@ -20,6 +21,7 @@ void SimSpindle::begin_period(const SpindleOutputs& cmd, bool powered) noexcept 
   cmd_ = cmd;
   powered_ = powered && !fault_;
   position_at_period_start_ = position_rev_;
+  speed_at_period_start_ = speed_rps_;
   const double rps = std::min(cmd.speed_rpm, config_.max_rpm) / 60.0;
   switch (cmd.direction) {
     case SpindleDirection::Clockwise:
@@ -64,11 +66,29 @@ void SimSpindle::substep() noexcept {
 // any real spindle speed (60 000 rpm at 1 ms is a turn per period), so the marks passed are
 // the difference of the whole turns at the two ends.
 void SimSpindle::end_period() noexcept {
+  update_torque();
   const double before = std::floor(position_at_period_start_);
   const double after = std::floor(position_rev_);
   if (before == after) return;
   index_count_ += static_cast<std::uint32_t>(std::abs(after - before));
   index_position_rev_ = after > before ? after : after + 1;
+}
+
+// Torque = I·α + friction and load against the turning: α over the period (the ramp's constant
+// acceleration within it), the turning direction that of the period's mean speed. A drive without
+// power reports nothing; a spindle standing still needs none.
+void SimSpindle::update_torque() noexcept {
+  constexpr double kTwoPi = 6.283185307179586;
+  if (!powered_) {
+    torque_nm_ = 0;
+    return;
+  }
+  const double alpha = kTwoPi * (speed_rps_ - speed_at_period_start_) / period_s_;
+  const double mean = speed_at_period_start_ + speed_rps_;
+  const double drag =
+      mean == 0 ? 0.0
+                : config_.friction_nm + config_.viscous_nm_per_krpm * std::abs(speed_rps_) * 0.06 + load_nm_;
+  torque_nm_ = config_.inertia_kgm2 * alpha + std::copysign(drag, mean);
 }
 
 void SimSpindle::sample(SpindleInputs& in) const noexcept {
@@ -85,6 +105,7 @@ void SimSpindle::sample(SpindleInputs& in) const noexcept {
   in.orient_done = orienting() && std::abs(error_deg) <= config_.orient_tolerance_deg &&
                    std::abs(speed_rps_) * 360.0 * period_s_ <= config_.orient_tolerance_deg;
   in.fault = fault_;
+  in.torque_nm = torque_nm_;
 }
 
 }  // namespace opencnc::machine

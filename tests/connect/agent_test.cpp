@@ -280,7 +280,36 @@ TEST(Agent, AMachineThatRunsShowsItsPositionsStateAndProgramValues) {
   EXPECT_GT(peak, 1.0);
   EXPECT_LE(peak, 100.0);
   EXPECT_NE(c.one("//m:Load[@dataItemId='x_load']"), "UNAVAILABLE");
-  EXPECT_EQ(c.one("//m:Load[@dataItemId='s_load']"), "UNAVAILABLE");  // no spindle torque in the inputs
+  EXPECT_EQ(c.one("//m:Load[@dataItemId='s_load']"), "0.0");  // the spindle stands: no torque
+}
+
+// The spindle's LOAD is its drive's torque over the profile's rating (mill-3axis: 35 N·m; the
+// simulated rotor 0.01 kg·m², friction 0.3 N·m + 0.05 N·m per 1000 rpm): it peaks while the spindle
+// runs up at 4000 rpm/s (0.01 · 2π · 4000/60 = 4.19 N·m of acceleration), falls to its friction at
+// speed, and carries a cut's torque.
+TEST(Agent, TheSpindlesLoadIsItsDrivesTorqueOverItsRating) {
+  const auto p = profile("mill-3axis");
+  ASSERT_EQ(p.spindle.rated_torque_nm, 35.0);
+  auto agent = Agent::for_profile(p, {});
+  Scenario s(p);
+  s.on(control::Mode::Mdi);
+  s.must(controller::Request::mdi("M3 S6000"));
+  observe(*agent, s, 2500);  // 1.5 s to speed, then at speed
+  Xml all(ask(*agent, "/sample?count=10000&path=//Rotary[@name=\"S\"]//DataItem[@type=\"LOAD\"]").body);
+  double peak = 0;
+  for (const std::string& v : all.all("//m:Load"))
+    if (v != "UNAVAILABLE") peak = std::max(peak, std::stod(v));
+  const double run_up = 0.01 * 2 * std::numbers::pi * 4000 / 60;
+  EXPECT_NEAR(peak, 100 * (run_up + 0.3 + 0.05 * 6) / 35, 0.1);  // at the end of the ramp
+  Xml at_speed(ask(*agent, "/current").body);
+  EXPECT_EQ(at_speed.one("//m:Torque[@dataItemId='s_torque']"), "0.60");
+  EXPECT_EQ(at_speed.one("//m:Load[@dataItemId='s_load']"), "1.7");  // 0.6 / 35
+
+  s.sim().set_spindle_load(17.5);  // a cut
+  observe(*agent, s, 20);
+  Xml cutting(ask(*agent, "/current").body);
+  EXPECT_EQ(cutting.one("//m:Torque[@dataItemId='s_torque']"), "18.10");
+  EXPECT_EQ(cutting.one("//m:Load[@dataItemId='s_load']"), "51.7");
 }
 
 TEST(Agent, SampleWalksEverySequenceOnceInOrderAndRefusesWhatTheBufferForgot) {

@@ -11,7 +11,7 @@ namespace {
 /// Storage for every pin (HAL would put it in its shared memory).
 struct FakePins {
   struct Joint {
-    double pos_cmd = 0, vel_cmd = 0, pos_fb = 0;
+    double pos_cmd = 0, vel_cmd = 0, pos_fb = 0, effort = 0;
     std::int32_t step_cmd = 0;
     bool enable = false, amp_fault = false, home_sw = false, limit_min = false, limit_max = false,
          index = false;
@@ -27,8 +27,8 @@ struct FakePins {
     for (std::size_t j = 0; j < joints.size(); ++j) {
       Joint& s = joints[j];
       JointPins& p = pins.joints[j];
-      p = {&s.pos_cmd,   &s.vel_cmd, &s.step_cmd,  &s.pos_fb,    &s.enable,
-           &s.amp_fault, &s.home_sw, &s.limit_min, &s.limit_max, &s.index};
+      p = {&s.pos_cmd, &s.vel_cmd,   &s.step_cmd,  &s.pos_fb, &s.enable, &s.amp_fault,
+           &s.home_sw, &s.limit_min, &s.limit_max, &s.index,  &s.effort};
     }
     pins.estop_in = &estop_in;
     pins.estop_out = &estop_out;
@@ -38,6 +38,7 @@ struct FakePins {
     pins.spindle_orient_angle = &floats[1];
     pins.spindle_speed_in = &floats[2];
     pins.spindle_revs = &floats[3];
+    pins.spindle_torque = &floats[4];
     Bit** bit_pins[] = {&pins.spindle_on,
                         &pins.spindle_forward,
                         &pins.spindle_reverse,
@@ -72,6 +73,31 @@ machine::MachineCapabilities caps() {
   c.digital_inputs = 8;
   c.digital_outputs = 2;
   return c;
+}
+
+// The drives' efforts are read only where the component was told they are netted: an unconnected
+// float pin reads 0, which would show as a load of 0 %.
+TEST(HalMachine, ReadsTheEffortsOnlyWhereTheyAreWired) {
+  machine::MachineCapabilities c = caps();
+  c.joints[0].effort = true;  // a servo drive
+  c.spindle_torque = true;
+  for (bool wired : {false, true}) {
+    FakePins f;
+    f.pins.effort_wired = wired;
+    HalMachine m(f.pins);
+    m.set_capabilities(c);
+    EXPECT_EQ(m.capabilities().joints[0].effort, wired);
+    EXPECT_FALSE(m.capabilities().joints[1].effort);  // the profile's joint 1 reports none
+    EXPECT_EQ(m.capabilities().spindle_torque, wired);
+    f.joints[0].effort = -412.5;
+    f.joints[1].effort = 99;
+    f.floats[4] = 7.25;
+    machine::MachineInputs in;
+    m.read(in);
+    EXPECT_DOUBLE_EQ(in.joints[0].effort, wired ? -412.5 : 0.0);
+    EXPECT_DOUBLE_EQ(in.joints[1].effort, 0.0);
+    EXPECT_DOUBLE_EQ(in.spindle.torque_nm, wired ? 7.25 : 0.0);
+  }
 }
 
 TEST(HalMachine, ReadsAndWritesThePins) {

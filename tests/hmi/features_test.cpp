@@ -234,6 +234,25 @@ RigOptions featured(const char* machine, std::vector<std::string> sets = {},
   return o;
 }
 
+// A cut's torque simulated on the spindle (admin only) shows in the status as the drive's torque:
+// the load plus the simulated spindle's friction at 3000 rpm (0.3 + 0.05 · 3 N·m).
+TEST(ServerFeatures, ASimulatedSpindleLoadShowsAsTheDrivesTorque) {
+  ServerRig rig(featured("mill-3axis.toml"));
+  ASSERT_EQ(rig.command({{"kind", "machine-on"}}).status, 200);
+  ASSERT_EQ(rig.command({{"kind", "mode"}, {"mode", "manual"}}).status, 200);
+  EXPECT_EQ(rig.status()["spindle"]["torque_nm"], 0.0);
+  ASSERT_EQ(rig.command({{"kind", "spindle-on"}, {"rpm", 3000}}).status, 200);
+  ASSERT_TRUE(rig.until([](const json& s) { return s["spindle"]["at_speed"] == true; }));
+  const json load = {{"kind", "simulate"}, {"event", "spindle-load"}, {"torque_nm", 12}};
+  EXPECT_EQ(rig.command(load).status, 403);
+  EXPECT_EQ(rig.command({{"kind", "simulate"}, {"event", "spindle-load"}, {"torque_nm", -1}}, kAdmin).status,
+            422);
+  ASSERT_EQ(rig.command(load, kAdmin).status, 200);
+  EXPECT_TRUE(rig.until([](const json& s) {
+    return std::abs(s["spindle"]["torque_nm"].get<double>() - 12.45) < 1e-9;
+  })) << rig.status()["spindle"].dump();
+}
+
 TEST(ServerFeatures, PowerFailRecordInTheStatusThenARetractConfirmedByTheOperator) {
   ServerRig rig(featured("broach-zc.toml"));
   for (const char* k : {"machine-on"}) ASSERT_EQ(rig.command({{"kind", k}}).status, 200);

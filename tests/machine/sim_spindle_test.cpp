@@ -48,6 +48,34 @@ TEST(SimSpindle, RampsAtTheAccelerationLimit) {
   EXPECT_TRUE(rig.in.at_speed);
 }
 
+// The drive's torque: I·α while ramping plus friction (Coulomb and viscous) and the load against
+// the turning; signed like the speed; nothing without power or at rest.
+TEST(SimSpindle, TorqueIsInertiaFrictionAndLoadAgainstTheTurning) {
+  SimSpindleConfig c = spindle_config();
+  c.inertia_kgm2 = 0.02;
+  c.friction_nm = 0.4;
+  c.viscous_nm_per_krpm = 0.1;
+  constexpr double kTwoPi = 6.283185307179586;
+  const double alpha = kTwoPi * c.acceleration_rpm_s / 60.0;  // rad/s²
+  SpindleRig rig(c);
+  rig.run({}, 10);
+  EXPECT_EQ(rig.in.torque_nm, 0.0);
+  rig.run({3000, SpindleDirection::Clockwise}, 1000);  // 1000 rpm, still ramping
+  EXPECT_NEAR(rig.in.torque_nm, 0.02 * alpha + 0.4 + 0.1 * 1.0, 1e-9);
+  rig.run({3000, SpindleDirection::Clockwise}, 3000);  // at 3000 rpm
+  EXPECT_NEAR(rig.in.torque_nm, 0.4 + 0.1 * 3.0, 1e-9);
+  rig.spindle.set_load(5.0);
+  rig.run({3000, SpindleDirection::Clockwise}, 1);
+  EXPECT_NEAR(rig.in.torque_nm, 5.0 + 0.4 + 0.3, 1e-9);
+  rig.spindle.set_load(0);
+  rig.run({0, SpindleDirection::Stopped}, 1000);  // braking from 3000 to 2000 rpm: the drive holds back
+  EXPECT_NEAR(rig.in.torque_nm, -0.02 * alpha + 0.4 + 0.1 * 2.0, 1e-9);
+  rig.run({3000, SpindleDirection::Counterclockwise}, 10000);
+  EXPECT_NEAR(rig.in.torque_nm, -(0.4 + 0.3), 1e-9);
+  rig.run({3000, SpindleDirection::Counterclockwise}, 1, /*powered=*/false);
+  EXPECT_EQ(rig.in.torque_nm, 0.0);
+}
+
 TEST(SimSpindle, CommandIsClampedToMaximumSpeed) {
   SpindleRig rig(spindle_config());
   rig.run({9000, SpindleDirection::Counterclockwise}, 7000);

@@ -61,7 +61,7 @@ const cell = (name, id) => page.getByTestId(`machine-${name}`).getByTestId(id).i
 const rowCount = (name) => page.getByTestId(`machine-${name}`).count();
 
 try {
-  const [urlA, , fleetUrl] = await Promise.all([serverUrl(millA), serverUrl(millB), serverUrl(fleet, "opencnc fleet")]);
+  const [urlA, urlB, fleetUrl] = await Promise.all([serverUrl(millA), serverUrl(millB), serverUrl(fleet, "opencnc fleet")]);
   const hmiA = new URL(urlA).origin + "/";
   step("mill-a homes and starts the bracket program");
   const post = (body) => fetch(new URL("/api/v1/commands", hmiA), {
@@ -81,6 +81,23 @@ try {
   if (!(await page.getByTestId("summary").innerText()).startsWith("2 machines")) throw new Error("the summary does not count 2 machines");
   if (!(await page.getByTestId("broker").innerText()).includes("connected")) throw new Error("the broker is not shown connected");
   await page.screenshot({ path: join(out, "fleet-01-two-machines.png") });
+
+  step("mill-b's spindle turns under a simulated cut: its load shows");
+  // 35 N·m on the simulated spindle is 100 % of mill-3axis's rated torque, plus its friction.
+  const postB = (body, who = token) => fetch(new URL("/api/v1/commands", new URL(urlB).origin + "/"), {
+    method: "POST", headers: { Authorization: `Bearer ${who}`, "Content-Type": "application/json" }, body: JSON.stringify(body),
+  });
+  for (const body of [{ kind: "machine-on" }, { kind: "mode", mode: "manual" }, { kind: "spindle-on", rpm: 3000 }]) {
+    const r = await postB(body);
+    if (!r.ok) throw new Error(`mill-b answered ${JSON.stringify(body)} with ${r.status}: ${await r.text()}`);
+  }
+  const loaded = await postB({ kind: "simulate", event: "spindle-load", torque_nm: 35 }, `${token}-admin`);
+  if (!loaded.ok) throw new Error(`the simulated spindle load was answered ${loaded.status}: ${await loaded.text()}`);
+  await waitFor("mill-b's spindle loaded", async () => {
+    const m = /(\d+) rpm, (\d+) %/.exec(await cell("mill-b", "spindle"));
+    return m !== null && Number(m[1]) === 3000 && Number(m[2]) >= 100 && Number(m[2]) <= 110;
+  }, 15000);
+  step(`mill-b's spindle: ${await cell("mill-b", "spindle")}`);
 
   step("a click on mill-a opens its own HMI");
   const [hmiPage] = await Promise.all([page.context().waitForEvent("page"), page.getByTestId("machine-mill-a").getByRole("link", { name: "mill-a" }).click()]);

@@ -257,8 +257,9 @@ async function start() {
     feed.value.textContent = percent(s.feed_override);
     spindle.value.textContent = percent(s.spindle_override);
     rapid.value.textContent = percent(s.rapid_override);
-    process.textContent = `Spindle ${s.spindle.direction} ${Math.round(s.spindle.rpm_actual)} rpm · tool T${s.tool} · ` +
-      `${s.flood ? "flood " : ""}${s.mist ? "mist" : ""} · feed ${(s.path_velocity * 60).toFixed(0)} mm/min`;
+    const torque = s.spindle.torque_nm === null ? "" : ` ${s.spindle.torque_nm.toFixed(1)} N·m`;
+    process.textContent = `Spindle ${s.spindle.direction} ${Math.round(s.spindle.rpm_actual)} rpm${torque} · ` +
+      `tool T${s.tool} · ${s.flood ? "flood " : ""}${s.mist ? "mist" : ""} · feed ${(s.path_velocity * 60).toFixed(0)} mm/min`;
     panels.forEach((p, i) => (panelRoots[i].hidden = !p.update(s, panelRoots[i], ctx)));
     v3.setTool(s.machine.X ?? 0, s.machine.Y ?? 0, s.machine.Z ?? 0, s.job.active && s.job.kind === "program");
     const d = dialogFor(s);

@@ -45,7 +45,8 @@ export interface Status {
   spindle_override: number;
   single_block: boolean;
   optional_stop: boolean;
-  spindle: { rpm: number; rpm_actual: number; at_speed: boolean; direction: string };
+  /** torque_nm: the drive's torque, null where the drive reports none. */
+  spindle: {rpm: number; rpm_actual: number; at_speed: boolean; torque_nm: number | null; direction: string};
   flood: boolean;
   mist: boolean;
   tool: number;

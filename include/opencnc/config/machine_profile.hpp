@@ -106,6 +106,9 @@ struct SpindleProfile {
   bool present = false;
   double min_rpm = 0;
   double max_rpm = 0;
+  /// The drive's rated (continuous) torque, N·m: the spindle's LOAD is its torque over this, in %
+  /// (100 % = the rating, as spindle-load meters show it). 0 = not stated: no LOAD.
+  double rated_torque_nm = 0;
   machine::SimSpindleConfig sim;  ///< max_rpm, encoder and orient copied in; the rest sim-only
 };
 

@@ -122,6 +122,8 @@ struct ServoStatus {
   machine::SpindleDirection spindle_direction = machine::SpindleDirection::Stopped;
   double spindle_rpm_actual = 0;
   bool spindle_at_speed = false;
+  double spindle_torque_nm = 0;       ///< the spindle drive's torque, N·m, as it reports it
+  bool spindle_torque_valid = false;  ///< the drive reports its torque (MachineCapabilities)
   bool flood = false, mist = false;
   std::int32_t tool = 0;           ///< tool in the spindle
   std::int32_t prepared_tool = 0;  ///< tool brought to the change position

@@ -31,6 +31,7 @@ struct JointPins {
   Bit* limit_min = nullptr;     ///< in: negative-end limit switch
   Bit* limit_max = nullptr;     ///< in: positive-end limit switch
   Bit* index_enable = nullptr;  ///< io: armed by us, cleared by the encoder at the index mark
+  Float* effort = nullptr;      ///< in: the drive's force N or torque N·m (read when effort_wired)
 };
 
 /// The machine-wide pins (opencnc.<name>).
@@ -49,6 +50,7 @@ struct MachinePins {
   Bit* spindle_at_speed = nullptr;                        ///< in
   Bit* spindle_orient_done = nullptr;                     ///< in
   Bit* spindle_fault = nullptr;                           ///< in
+  Float* spindle_torque = nullptr;                        ///< in: N·m, signed (read when effort_wired)
   Bit *flood = nullptr, *mist = nullptr;                  ///< out: coolant
   S32* tool_prepare_number = nullptr;                     ///< out
   Bit *tool_prepare = nullptr, *tool_change = nullptr;    ///< out
@@ -58,6 +60,9 @@ struct MachinePins {
   std::array<Float*, machine::kAnalogChannels> analog_in{}, analog_out{};   ///< first ain/aout exist
   int digital_inputs = 0, digital_outputs = 0, analog_inputs = 0, analog_outputs = 0;
   int joint_count = 0;  ///< joints with pins (the component's `joints=` parameter)
+  /// The drives' efforts are netted to `joint.N.effort` and `spindle.torque` (the component's
+  /// `effort=1`): an unconnected HAL pin reads 0, which must not pass for a measured load.
+  bool effort_wired = false;
 };
 
 /// MachineIO over the pins. The capabilities are the profile's, handed over with the controller's

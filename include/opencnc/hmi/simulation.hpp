@@ -11,10 +11,12 @@
 namespace opencnc::hmi {
 
 struct SimulationEvent {
-  /// "mains-off", "mains-on", "electrode" (the simulated electrode's true offsets and tip).
+  /// "mains-off", "mains-on", "electrode" (the simulated electrode's true offsets and tip),
+  /// "spindle-load" (a cut's torque on the spindle).
   std::string event;
   Vec3 offset_mm{};                   ///< electrode: X, Y, Z as a tool table holds them
   double tip_radius_mm = 0;           ///< electrode: its tip's ball
+  double torque_nm = 0;               ///< spindle-load: N·m against the rotation (0 = none)
 };
 
 }  // namespace opencnc::hmi

@@ -131,6 +131,9 @@ struct SpindleInputs {
   bool at_speed = false;          ///< drive reports speed within tolerance of command
   bool orient_done = false;       ///< orient requested and reached (capability)
   bool fault = false;             ///< spindle drive fault
+  /// The drive's torque at the spindle, N·m, signed like the speed (+ drives clockwise); optional
+  /// (capability `spindle_torque`). What the spindle's LOAD is measured from.
+  double torque_nm = 0;
 };
 
 /// Power supply monitoring; optional (capability `power_monitor`).
@@ -212,6 +215,7 @@ struct MachineCapabilities {
   bool spindle = false;          ///< spindle outputs drive something
   bool spindle_encoder = false;  ///< spindle position/index inputs are valid
   bool spindle_orient = false;
+  bool spindle_torque = false;  ///< SpindleInputs::torque_nm is valid
   bool power_monitor = false;  ///< PowerInputs are valid
   bool ups = false;            ///< ups_on_battery is valid
   bool probe = false;

@@ -142,6 +142,12 @@ struct SimSpindleConfig {
   bool orient = true;                 ///< the drive can orient (M19); else requests are ignored
   double orient_rpm = 60;             ///< speed limit while orienting
   double orient_tolerance_deg = 0.5;  ///< orient_done within this angle
+  // The torque the drive reports: what accelerates the rotor and overcomes the bearings' and seals'
+  // friction, plus a load set by a test (SimMachine::set_spindle_load). The speed itself follows
+  // the ramp limit: the drive is assumed strong enough for it, as spindle drives are sized.
+  double inertia_kgm2 = 0.01;         ///< rotor, holder and tool about the spindle's axis
+  double friction_nm = 0.3;           ///< Coulomb friction while turning
+  double viscous_nm_per_krpm = 0.05;  ///< viscous friction per 1000 rpm
 };
 
 /// Mains, UPS and DC link.

@@ -42,6 +42,9 @@ class SimMachine final : public MachineIO {
   /// Process load on `joint`'s table (cutting force, broach load, gravity), N or N·m.
   void set_external_effort(int joint, double effort) noexcept;
   void set_spindle_fault(bool fault) noexcept { spindle_.set_fault(fault); }
+  /// A cut's torque on the spindle, N·m ≥ 0, opposing its rotation (the simulated spindle has no
+  /// cutting model of its own: tests and demos set the load).
+  void set_spindle_load(double torque_nm) noexcept { spindle_.set_load(torque_nm); }
   void set_digital_input(int channel, bool value) noexcept;
   void set_analog_input(int channel, double value) noexcept;
   /// Analog input `channel` drifts toward `target` at `units_per_s` (a level sinking, a

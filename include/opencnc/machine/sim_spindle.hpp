@@ -28,6 +28,9 @@ class SimSpindle {
   void sample(SpindleInputs& in) const noexcept;
 
   void set_fault(bool fault) noexcept { fault_ = fault; }
+  /// A load torque opposing the rotation (a cut), N·m ≥ 0; it shows in the drive's torque.
+  void set_load(double torque_nm) noexcept { load_nm_ = torque_nm; }
+  double torque_nm() const noexcept { return torque_nm_; }  ///< the drive's torque, last period
 
   double position_rev() const noexcept { return position_rev_; }  ///< true position, rev
   double speed_rps() const noexcept { return speed_rps_; }        ///< true speed, rev/s
@@ -35,6 +38,7 @@ class SimSpindle {
  private:
   bool orienting() const noexcept { return powered_ && cmd_.orient && config_.orient; }
   double orient_target_speed() const noexcept;
+  void update_torque() noexcept;
 
   SimSpindleConfig config_{};
   double h_ = 0;
@@ -48,6 +52,9 @@ class SimSpindle {
   double target_rps_ = 0;
   double position_rev_ = 0, speed_rps_ = 0;
   double position_at_period_start_ = 0;
+  double speed_at_period_start_ = 0;
+  double load_nm_ = 0;
+  double torque_nm_ = 0;
   std::uint32_t index_count_ = 0;
   double index_position_rev_ = 0;
 };

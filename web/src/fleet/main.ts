@@ -34,8 +34,8 @@ function render(fleet: Fleet) {
     return el(
         'tr', {class: r.look, 'data-testid': `machine-${r.name}`}, el('td', {class: 'name'}, name),
         el('td', {class: 'status', 'data-testid': 'state'}, r.state), el('td', {}, r.program),
-        el('td', {}, r.progress), el('td', {class: 'alarms'}, r.alarms), el('td', {}, r.spindle),
-        el('td', {'data-testid': 'last-seen'}, r.lastSeen));
+        el('td', {}, r.progress), el('td', {class: 'alarms'}, r.alarms),
+        el('td', {'data-testid': 'spindle'}, r.spindle), el('td', {'data-testid': 'last-seen'}, r.lastSeen));
   }));
 }
 
