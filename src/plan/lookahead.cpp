@@ -42,6 +42,7 @@ bool lower(double limit, double own, double share) {
 Lookahead::Lookahead(const WindowParams& p) : p_(p) {
   if (widening()) {
     half_window_ = 0.5 * p.filter_s + 3 * p.period_s;
+    cap_window_ = 0.5 * p.filter_s;
     jerk_window_ = 4 * p.period_s;
     reach_ = std::max(p.v_bound * half_window_, p.step_window_s);
   }
@@ -168,15 +169,14 @@ Lookahead::Widened Lookahead::widened_over(double from, double to, std::uint64_t
     const Range& r = ranges_[j];
     if (r.start - reach_ >= to) break;  // ranges are in order of their start
     if (r.marker || r.epoch != epoch) continue;
+    const double cc = r.cap * cap_window_;
+    if (r.start - cc < to && r.end + cc > from) w.cap = std::min(w.cap, r.cap);
     const double c = r.cap * half_window_;
-    if (r.start - c < to && r.end + c > from) {
-      w.cap = std::min(w.cap, r.cap);
-      w.accel = std::min(w.accel, r.accel);
-    }
+    if (r.start - c < to && r.end + c > from) w.accel = std::min(w.accel, r.accel);
     const double cj = r.cap * jerk_window_;
     if (r.start - cj < to && r.end + cj > from) w.jerk = std::min(w.jerk, r.jerk);
     if (r.junction > 0 && r.junction < kInf) {
-      const double v = r.junction * half_window_;
+      const double v = r.junction * cap_window_;
       if (r.start - v < to && r.start + v > from) w.cap = std::min(w.cap, r.junction);
     }
   }
@@ -229,7 +229,11 @@ void Lookahead::settle_front() {
       const Range& r = ranges_[j];
       if (r.start - reach_ >= own.end) break;
       if (r.marker || r.epoch != own.epoch) continue;
-      if (lower(r.cap, own.cap, share) || lower(r.accel, own.accel, share)) {
+      if (lower(r.cap, own.cap, share)) {
+        cut_at(r.start - r.cap * cap_window_);
+        cut_at(r.end + r.cap * cap_window_);
+      }
+      if (lower(r.accel, own.accel, share)) {
         cut_at(r.start - r.cap * half_window_);
         cut_at(r.end + r.cap * half_window_);
       }
@@ -238,8 +242,8 @@ void Lookahead::settle_front() {
         cut_at(r.end + r.cap * jerk_window_);
       }
       if (r.junction > 0 && r.junction < kInf && lower(r.junction, own.cap, share)) {
-        cut_at(r.start - r.junction * half_window_);
-        cut_at(r.start + r.junction * half_window_);
+        cut_at(r.start - r.junction * cap_window_);
+        cut_at(r.start + r.junction * cap_window_);
       }
     }
     std::sort(cuts_.begin(), cuts_.end());

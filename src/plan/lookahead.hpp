@@ -62,9 +62,12 @@ struct WindowParams {
 /// With a moving average of length T on s (jerk limits), the speed and acceleration commanded at
 /// a point are averages of the generator's values over the last T, during which the generator
 /// stays within c·T/2 of the commanded point (c: the speed it does not exceed there). So block
-/// b's cap and budgets apply to the generator from c_b·(T/2 + 3 periods) before b to as far after
-/// it (the periods: the trace's finite differences), a junction limit v_j over as far around it,
-/// and the jerk budget (used where the commanded point is) over ±4 periods of travel. Ranges do
+/// b's cap applies to the generator from c_b·T/2 before b to as far after it, and a junction
+/// limit v_j over v_j·T/2 around it (the commanded speed at every instant is then within them,
+/// and the trace's finite differences are averages of the continuous derivatives); its budget
+/// over c_b·(T/2 + 3 periods) (the periods keep every budget near the commanded point within
+/// the jerk budget there times T, which the tick's braking relies on), and the jerk budget
+/// (used where the commanded point is) over ±4 periods of travel. Ranges do
 /// not reach across a stop (the generator waits there until the average has arrived). A block
 /// settles once every block whose ranges may reach it is known; then its widened limits are the
 /// lowest of the ranges over it, and a long block is split where they change. See docs/planner.md.
@@ -143,7 +146,8 @@ class Lookahead {
   }
 
   WindowParams p_;
-  double half_window_ = 0;      ///< T/2 + 3 periods: how far (per unit of speed) cap and budget ranges reach
+  double half_window_ = 0;      ///< T/2 + 3 periods: how far (per unit of speed) budget ranges reach
+  double cap_window_ = 0;       ///< T/2: how far (per unit of speed) cap and junction ranges reach
   double jerk_window_ = 0;      ///< 4 periods: how far (per unit of speed) jerk ranges reach
   double reach_ = 0;            ///< the farthest any range reaches back from its block
   Ring<PlannedBlock> pending_;  ///< pushed, limits not yet final
