@@ -16,6 +16,10 @@ namespace {
 
 using machine::EdmCondition;
 
+/// A condition meets a finish within the rounding of the VDI 3400 table's Ra (VDI 18 is listed
+/// as Ra 0.80 µm, 10^(18/20)/10 = 0.794 µm): 2 %.
+constexpr double kFinishTolerance = 1.02;
+
 /// The conditions of the technology table the electrode's area takes: those giving an Ra and a
 /// side gap whose peak current is within the current density over the area.
 std::vector<const EdmCondition*> table_of(const machine::EdmConfig& edm) {
@@ -127,7 +131,7 @@ std::variant<Sequence, std::string> plan_sequence(const machine::EdmConfig& edm,
   }
   std::vector<const EdmCondition*> meeting;
   for (const EdmCondition* c : usable)
-    if (c->ra_um <= r.finish_ra_um + 1e-9) meeting.push_back(c);
+    if (c->ra_um <= r.finish_ra_um * kFinishTolerance) meeting.push_back(c);
   if (meeting.empty()) {
     const EdmCondition* finest =
         best(usable, [](const EdmCondition& a, const EdmCondition& b) { return a.ra_um < b.ra_um; });
