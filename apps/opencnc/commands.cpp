@@ -21,6 +21,7 @@ void register_all(CLI::App& app, Registry& registry) {
   add_fleet_command(app, registry);
   add_helix_command(app, registry);
   add_recover_command(app, registry);
+  add_edm_command(app, registry);
 }
 
 }  // namespace opencnc::cli

@@ -38,6 +38,7 @@ void add_plot_command(CLI::App& app, Registry& registry);
 void add_calibrate_command(CLI::App& app, Registry& registry);
 void add_tools_command(CLI::App& app, Registry& registry);  ///< the tool store and its guard
 void add_nearest_command(CLI::App& app, Registry& registry);
+void add_edm_command(CLI::App& app, Registry& registry);     ///< edm sequence
 void add_serve_command(CLI::App& app, Registry& registry);   ///< the HMI server
 void add_fleet_command(CLI::App& app, Registry& registry);   ///< the fleet view
 void add_helix_command(CLI::App& app, Registry& registry);

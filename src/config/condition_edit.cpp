@@ -17,7 +17,7 @@ namespace opencnc::config {
 
 namespace {
 
-constexpr std::array<ConditionField, 19> kFields{{
+constexpr std::array<ConditionField, 31> kFields{{
     {"on_time_us", "µs", "pulse on-time", nullptr},
     {"off_time_us", "µs", "pause between pulses", nullptr},
     {"peak_current_a", "A", "discharge current", nullptr},
@@ -37,6 +37,18 @@ constexpr std::array<ConditionField, 19> kFields{{
     {"orbit_radius_mm", "mm", "the orbit's final size", nullptr},
     {"orbit_step_mm", "mm", "growth per turn (0: all at once)", nullptr},
     {"orbit_period_s", "s", "one turn of the orbit", nullptr},
+    {"orbit_finish", "", "the burn's end waits until the orbit is full and turned there", "true|false"},
+    {"finish_timeout_s", "s", "a longer finishing cycle stops the machine", nullptr},
+    {"lateral_servo", "", "the orbit follows the gap (slows, draws in on a short)", "true|false"},
+    {"adaptive", "", "adaptive control within the bounds below", "true|false"},
+    {"servo_reference_min_v", "V", "adaptive: lowest servo reference", nullptr},
+    {"servo_reference_max_v", "V", "adaptive: highest servo reference", nullptr},
+    {"gain_min_mm_s_per_v", "mm/s/V", "adaptive: lowest gain", nullptr},
+    {"gain_max_mm_s_per_v", "mm/s/V", "adaptive: highest gain", nullptr},
+    {"jump_period_min_s", "s", "adaptive: shortest jump period", nullptr},
+    {"jump_period_max_s", "s", "adaptive: longest jump period", nullptr},
+    {"jump_height_min_mm", "mm", "adaptive: lowest jump", nullptr},
+    {"jump_height_max_mm", "mm", "adaptive: highest jump", nullptr},
 }};
 
 /// "edm.condition.3.on_time_us" → (3, "on_time_us"); nullopt for any other key.
@@ -90,6 +102,15 @@ std::optional<double> condition_field_number(const machine::EdmCondition& c, std
       {"orbit_radius_mm", c.orbit_radius_mm},
       {"orbit_step_mm", c.orbit_step_mm},
       {"orbit_period_s", c.orbit_period_s},
+      {"finish_timeout_s", c.finish_timeout_s},
+      {"servo_reference_min_v", c.servo_reference_min_v},
+      {"servo_reference_max_v", c.servo_reference_max_v},
+      {"gain_min_mm_s_per_v", c.gain_min_mm_s_per_v},
+      {"gain_max_mm_s_per_v", c.gain_max_mm_s_per_v},
+      {"jump_period_min_s", c.jump_period_min_s},
+      {"jump_period_max_s", c.jump_period_max_s},
+      {"jump_height_min_mm", c.jump_height_min_mm},
+      {"jump_height_max_mm", c.jump_height_max_mm},
   };
   for (const auto& [name, v] : numbers)
     if (name == field) return v;
@@ -101,6 +122,9 @@ std::string condition_field_text(const machine::EdmCondition& c, std::string_vie
   if (field == "polarity") return c.polarity > 0 ? "+" : "-";
   if (field == "jump_mode") return c.jump_mode == machine::JumpMode::Path ? "path" : "axis";
   if (field == "orbit") return orbits[static_cast<std::size_t>(c.orbit)];
+  if (field == "orbit_finish") return c.orbit_finish ? "true" : "false";
+  if (field == "lateral_servo") return c.lateral_servo ? "true" : "false";
+  if (field == "adaptive") return c.adaptive ? "true" : "false";
   const std::optional<double> v = condition_field_number(c, field);
   return v ? toml_number(*v) : "";
 }

@@ -53,6 +53,8 @@ void read_axes_of(Section& s, MachineProfile& p) {
   }
   c.path_spacing_mm = s.number_or("path_spacing_mm", c.path_spacing_mm, Bound::Positive);
   c.short_timeout_s = s.number_or("short_timeout_s", c.short_timeout_s, Bound::Positive);
+  c.finish_timeout_s = s.number_or("finish_timeout_s", c.finish_timeout_s, Bound::Positive);
+  c.current_density_max_a_mm2 = s.number_or("current_density_max_a_mm2", 0, Bound::Positive);
 }
 
 double speed_limit(const MachineProfile& p, int axis) {
@@ -150,8 +152,9 @@ void read_orbit(Section& t, EdmCondition& c, const MachineProfile& p) {
 }
 
 // The finishing cycle needs an orbit to finish.
-void read_finish(Section& t, EdmCondition& c) {
+void read_finish(Section& t, EdmCondition& c, const MachineProfile& p) {
   c.orbit_finish = t.boolean_or("orbit_finish", false);
+  c.finish_timeout_s = t.number_or("finish_timeout_s", p.edm.config.finish_timeout_s, Bound::Positive);
   c.lateral_servo = t.boolean_or("lateral_servo", false);
   if (c.orbit_finish && c.orbit == machine::OrbitKind::None)
     t.error("orbit_finish",
@@ -248,7 +251,10 @@ void read_conditions(Section& s, MachineProfile& p) {
                "jump_period_min_s",
                "jump_period_max_s",
                "jump_height_min_mm",
-               "jump_height_max_mm"},
+               "jump_height_max_mm",
+               "finish_timeout_s",
+               "ra_um",
+               "removal_mm3_min"},
               s.reporter());
     EdmCondition c;
     const auto number = t.integer("number", 1, 99);
@@ -261,10 +267,12 @@ void read_conditions(Section& s, MachineProfile& p) {
     read_servo(t, c, p);
     read_jump(t, c, p);
     read_orbit(t, c, p);
-    read_finish(t, c);
+    read_finish(t, c, p);
     read_adaptive(t, c, p);
     c.side_gap_mm = t.number_or("side_gap_mm", 0, Bound::NonNegative);
     c.electrode_wear_ratio = t.number_or("electrode_wear_ratio", 0, Bound::NonNegative);
+    c.ra_um = t.number_or("ra_um", 0, Bound::Positive);
+    c.removal_mm3_min = t.number_or("removal_mm3_min", 0, Bound::Positive);
     if (c.electrode_wear_ratio >= 1)
       t.error("electrode_wear_ratio",
               fmt::format("{} must be below 1 (the electrode would wear faster than the work)",
@@ -348,7 +356,8 @@ void read_edm(Section& top, MachineProfile& profile) {
   const toml::table* t = top.subtable("edm");
   if (t == nullptr) return;
   Section s(*t, "edm",
-            {"tool_axis", "lift", "orbit_plane", "path_spacing_mm", "short_timeout_s", "condition", "sim"},
+            {"tool_axis", "lift", "orbit_plane", "path_spacing_mm", "short_timeout_s", "finish_timeout_s",
+             "current_density_max_a_mm2", "condition", "sim"},
             top.reporter());
   profile.edm.present = true;
   profile.edm.config.enabled = true;

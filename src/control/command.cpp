@@ -74,6 +74,8 @@ const char* fault_code(FaultKind k) noexcept {
       return "control.fault.process-alarm";
     case FaultKind::EdmShort:
       return "control.fault.edm-short";
+    case FaultKind::EdmFinishTimeout:
+      return "control.fault.edm-finish-timeout";
     case FaultKind::SeekNoSwitch:
       return "control.fault.seek-limit";
     case FaultKind::CouplingPosition:

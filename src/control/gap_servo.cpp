@@ -146,30 +146,32 @@ void GapServo::begin_run(const Pose& at) noexcept {
   orbit_[0] = orbit_[1] = 0;
   shape_ = OrbitKind::None;
   finishing_ = status_.finishing = false;
-  lateral_v_ = full_turn_ = 0;
+  lateral_v_ = full_turn_ = finish_elapsed_s_ = 0;
   base_ = EdmCondition{};
   adaptive_.reset();
 }
 
 // Under a condition with the finishing cycle the burn's end waits: the code is kept until the
 // orbit is full at the path's end and has turned there (run_finish), the interpolator waiting.
-bool GapServo::apply_code(int code, double p) noexcept {
+bool GapServo::apply_code(int code, double p, double q) noexcept {
   if (finishing_ || (status_.on && cond_.orbit_finish && cond_.orbit != OrbitKind::None)) {
     if (!finishing_) {
       finishing_ = true;
       full_turn_ = 0;  // the radius goes on at the speed it has (no step of velocity)
+      finish_elapsed_s_ = 0;
       // Where the burn's path ended (the head may already have begun the next block this period).
       finish_s_ = std::min(s_, memory_.head_s());
     }
     pending_code_ = code;
     pending_p_ = p;
+    pending_q_ = q;
     return code == machine::kEdmOffCode ||
            (code == machine::kEdmConditionCode && config_.find(static_cast<int>(std::lround(p))) != nullptr);
   }
-  return select(code, p);
+  return select(code, p, q);
 }
 
-bool GapServo::select(int code, double p) noexcept {
+bool GapServo::select(int code, double p, double q) noexcept {
   const EdmCondition* c =
       code == machine::kEdmConditionCode ? config_.find(static_cast<int>(std::lround(p))) : nullptr;
   if (c == nullptr) {
@@ -178,6 +180,10 @@ bool GapServo::select(int code, double p) noexcept {
     return code == machine::kEdmOffCode;
   }
   cond_ = base_ = *c;
+  // M180 P<n> Q<r>: this burn's orbit grows to r (the interpreter let through at most the
+  // condition's radius, the reach the preflight checked).
+  if (q > 0 && cond_.orbit != OrbitKind::None)
+    cond_.orbit_radius_mm = base_.orbit_radius_mm = std::min(q, c->orbit_radius_mm);
   adaptive_.reset();
   status_.on = true;
   status_.condition = c->number;
@@ -274,6 +280,7 @@ void GapServo::run_finish(const GapInputs& in, bool due) noexcept {
   const bool shorted = in.gap_state == machine::GapState::Short;
   double lateral = 0;
   law_mm_s_ = 0;
+  finish_elapsed_s_ += period_s_;
   if (jump_ == Jump::Idle) {
     const double v = servo_speed(in, due);
     if (shorted || s_ < finish_s_ - 1e-12) {
@@ -297,7 +304,7 @@ void GapServo::run_finish(const GapInputs& in, bool due) noexcept {
   if (full_turn_ >= 1) {
     finishing_ = false;
     lateral_v_ = 0;
-    select(pending_code_, pending_p_);
+    select(pending_code_, pending_p_, pending_q_);
   }
 }
 

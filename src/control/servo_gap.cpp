@@ -40,7 +40,8 @@ void Servo::run_gap_servo() noexcept {
 
 // What the gap servo cannot mend itself: backing off has run out of path (told, the servo holds
 // there), and a short that outlasts the condition's short_timeout_s (a fault: the generator and
-// the drives off, the run ended).
+// the drives off, the run ended), and a finishing cycle whose orbit has not reached its size
+// within the condition's finish_timeout_s (a fault as well: the cavity would stay undersize).
 void Servo::watch_gap() noexcept {
   const EdmStatus& s = gap_.status();
   if (gap_.reached_retract_limit()) {
@@ -54,6 +55,9 @@ void Servo::watch_gap() noexcept {
   if (gap_.short_timed_out())
     enter_fault({FaultKind::EdmShort, static_cast<std::int8_t>(s.condition), s.short_s,
                  gap_.condition().short_timeout_s, tick_});
+  else if (gap_.finish_timed_out())
+    enter_fault({FaultKind::EdmFinishTimeout, static_cast<std::int8_t>(s.condition), gap_.orbit_radius_mm(),
+                 gap_.condition().finish_timeout_s, tick_});
 }
 
 }  // namespace opencnc::control

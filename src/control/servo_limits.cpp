@@ -38,7 +38,8 @@ bool valid(const machine::EdmCondition& c) noexcept {
   const double values[] = {c.on_time_us,        c.off_time_us,     c.peak_current_a,   c.voltage_v,
                            c.servo_reference_v, c.gain_mm_s_per_v, c.max_forward_mm_s, c.max_retract_mm_s,
                            c.filter_s,          c.short_timeout_s, c.jump_height_mm,   c.jump_period_s,
-                           c.jump_speed_mm_s,   c.orbit_radius_mm, c.orbit_step_mm,    c.orbit_period_s};
+                           c.jump_speed_mm_s,   c.orbit_radius_mm, c.orbit_step_mm,    c.orbit_period_s,
+                           c.finish_timeout_s};
   for (const double v : values)
     if (!std::isfinite(v) || v < 0) return false;
   return c.number >= 1 && c.number <= 99 && c.on_time_us > 0 && c.peak_current_a > 0 && c.voltage_v > 0 &&

@@ -274,7 +274,8 @@ void Servo::apply_action(const MachineAction& a) noexcept {
       break;
     case ActionCode::ProcessCode:
       // The torch's codes, else the EDM's (the preflight refuses codes the machine lacks).
-      if (!(torch_.enabled() && torch_.apply_code(a.index, a.value))) gap_.apply_code(a.index, a.value);
+      if (!(torch_.enabled() && torch_.apply_code(a.index, a.value)))
+        gap_.apply_code(a.index, a.value, a.value2);
       break;
     case ActionCode::ChangeTool:
     case ActionCode::WaitInput:

@@ -147,7 +147,7 @@ namespace {
 // The EDM's configuration field by field on zeroed bytes (a flag and small integers before
 // doubles leave padding that copies carry along), for shared_setup's byte-for-byte comparison.
 // A new field changes these sizes: copy it below too.
-static_assert(sizeof(machine::EdmCondition) == 240 && sizeof(machine::EdmConfig) == 40 + 32 * 240 + 8,
+static_assert(sizeof(machine::EdmCondition) == 264 && sizeof(machine::EdmConfig) == 56 + 32 * 264 + 8,
               "a field was added to the EDM's configuration: copy it in plain_edm_config");
 void plain_edm_config(const machine::EdmConfig& e, machine::EdmConfig& out) {
   std::memset(static_cast<void*>(&out), 0, sizeof out);
@@ -158,6 +158,8 @@ void plain_edm_config(const machine::EdmConfig& e, machine::EdmConfig& out) {
   out.orbit_axes[1] = e.orbit_axes[1];
   out.path_spacing_mm = e.path_spacing_mm;
   out.short_timeout_s = e.short_timeout_s;
+  out.finish_timeout_s = e.finish_timeout_s;
+  out.current_density_max_a_mm2 = e.current_density_max_a_mm2;
   out.condition_count = e.condition_count;
   for (std::size_t i = 0; i < e.conditions.size() && static_cast<int>(i) < e.condition_count; ++i) {
     const machine::EdmCondition& c = e.conditions[i];
@@ -174,6 +176,7 @@ void plain_edm_config(const machine::EdmConfig& e, machine::EdmConfig& out) {
     o.max_retract_mm_s = c.max_retract_mm_s;
     o.filter_s = c.filter_s;
     o.short_timeout_s = c.short_timeout_s;
+    o.finish_timeout_s = c.finish_timeout_s;
     o.jump_height_mm = c.jump_height_mm;
     o.jump_period_s = c.jump_period_s;
     o.jump_speed_mm_s = c.jump_speed_mm_s;
@@ -195,6 +198,8 @@ void plain_edm_config(const machine::EdmConfig& e, machine::EdmConfig& out) {
     o.jump_height_max_mm = c.jump_height_max_mm;
     o.side_gap_mm = c.side_gap_mm;
     o.electrode_wear_ratio = c.electrode_wear_ratio;
+    o.ra_um = c.ra_um;
+    o.removal_mm3_min = c.removal_mm3_min;
   }
 }
 

@@ -24,7 +24,8 @@ std::string listed(const std::vector<int>& numbers) {
 
 class EdmCodes final : public CodeHandler {
  public:
-  explicit EdmCodes(std::vector<int> conditions) : conditions_(std::move(conditions)) {}
+  EdmCodes(std::vector<int> conditions, std::vector<double> orbits)
+      : conditions_(std::move(conditions)), orbits_(std::move(orbits)) {}
 
   void execute(ExecContext& ctx, const Block& b, int code) override {
     canon::ProcessCode c;
@@ -44,25 +45,49 @@ class EdmCodes final : public CodeHandler {
                               listed(conditions_)));
       }
       c.p = p;
+      if (b.has('q')) c.q = orbit_word(ctx, b, static_cast<int>(p));
     }
     ctx.output().process_code(c);
   }
 
  private:
+  // M180 P<n> Q<r>: this burn's orbit grows to r instead of the condition's orbit_radius_mm; at
+  // most that radius (the reach the profile and the preflight checked), and only with an orbit.
+  double orbit_word(ExecContext& ctx, const Block& b, int n) const {
+    const double q = b.q_or(0);
+    const auto at = std::find(conditions_.begin(), conditions_.end(), n);
+    const std::size_t i = static_cast<std::size_t>(at - conditions_.begin());
+    const double most = at != conditions_.end() && i < orbits_.size() ? orbits_[i] : -1;
+    if (!std::isfinite(q) || q <= 0) {
+      ctx.error(ErrorCode::EdmCondition, "M180's Q is the burn's orbit radius in mm: a number above 0");
+    } else if (most == 0) {
+      ctx.error(ErrorCode::EdmCondition,
+                fmt::format("M180 P{} Q: condition {} has no orbit whose radius Q could set", n, n));
+    } else if (most > 0 && q > most + 1e-12) {
+      ctx.error(ErrorCode::EdmCondition,
+                fmt::format("M180 P{} Q{}: the orbit's radius may be at most condition {}'s orbit_radius_mm "
+                            "({} mm)",
+                            n, q, n, most));
+    }
+    return q;
+  }
+
   std::vector<int> conditions_;
+  std::vector<double> orbits_;  ///< each condition's orbit radius (0: no orbit); empty: unknown
 };
 
 }  // namespace
 
-void add_edm_codes(Extensions& ext, std::vector<int> conditions) {
-  auto codes = std::make_shared<EdmCodes>(std::move(conditions));
+void add_edm_codes(Extensions& ext, std::vector<int> conditions, std::vector<double> orbits) {
+  auto codes = std::make_shared<EdmCodes>(std::move(conditions), std::move(orbits));
   for (int code : {kCondition, kOff}) ext.m[static_cast<std::size_t>(code)] = codes;
 }
 
 std::shared_ptr<const Extensions> edm_extensions(Dialect dialect, std::vector<int> conditions,
-                                                 std::shared_ptr<const Extensions> base) {
+                                                 std::shared_ptr<const Extensions> base,
+                                                 std::vector<double> orbits) {
   auto ext = std::make_shared<Extensions>(base ? *base : *standard_extensions(dialect));
-  add_edm_codes(*ext, std::move(conditions));
+  add_edm_codes(*ext, std::move(conditions), std::move(orbits));
   return ext;
 }
 

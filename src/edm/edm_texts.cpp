@@ -17,8 +17,22 @@ std::optional<controller::EventNote> Texts::event_note(const control::ServoEvent
                   e.action, e.value)};
 }
 
-std::optional<std::string> Texts::fault_text(const control::Fault& f, const config::MachineProfile&,
+std::optional<std::string> Texts::fault_text(const control::Fault& f, const config::MachineProfile& profile,
                                              const control::ServoConfig&) const {
+  if (f.kind == control::FaultKind::EdmFinishTimeout) {
+    const machine::EdmCondition* c = profile.edm.config.find(static_cast<int>(f.axis));
+    const double size = c != nullptr ? c->orbit_radius_mm : 0.0;
+    const std::string reached =
+        f.value >= size - 1e-9
+            ? fmt::format("the orbit reached its {:.4f} mm but did not turn once there sparking", size)
+            : fmt::format("the orbit reached {:.4f} mm of its {:.4f} mm", f.value, size);
+    return fmt::format(
+        "EDM condition {}'s finishing cycle did not bring the orbit to its size within its finish_timeout_s "
+        "({} s): {} at the final depth; the program was stopped with the generator off and the cavity is "
+        "undersize there (the gap kept the orbit from growing or turning: flushing, debris, the lateral servo's "
+        "reference and gain); resume from the burn (run from line) or give the cycle more time",
+        static_cast<int>(f.axis), f.limit, reached);
+  }
   if (f.kind != control::FaultKind::EdmShort) return std::nullopt;
   return fmt::format(
       "the EDM gap stayed shorted for {:.2f} s, longer than condition {}'s short_timeout_s ({} s): "

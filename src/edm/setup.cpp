@@ -27,23 +27,39 @@ std::vector<int> condition_numbers(const config::MachineProfile& profile) {
   return numbers;
 }
 
+/// Each condition's orbit radius (0: none), in condition_numbers' order: M180's Q is at most it.
+std::vector<double> condition_orbits(const config::MachineProfile& profile) {
+  const machine::EdmConfig& edm = profile.edm.config;
+  std::vector<double> orbits;
+  for (int i = 0; i < edm.condition_count; ++i) {
+    const machine::EdmCondition& c = edm.conditions[static_cast<std::size_t>(i)];
+    orbits.push_back(c.orbit == machine::OrbitKind::None ? 0.0 : c.orbit_radius_mm);
+  }
+  return orbits;
+}
+
 /// M180/M181 on top of the dialect's modules, M180 P checked against the profile's conditions.
 class Codes final : public controller::SourcePart {
  public:
-  explicit Codes(std::vector<int> numbers) : numbers_(std::move(numbers)) {}
+  Codes(std::vector<int> numbers, std::vector<double> orbits)
+      : numbers_(std::move(numbers)), orbits_(std::move(orbits)) {}
   std::shared_ptr<const gcode::Extensions> modules(
       gcode::Dialect dialect, std::shared_ptr<const gcode::Extensions> base) const override {
-    return gcode::edm_extensions(dialect, numbers_, std::move(base));
+    return gcode::edm_extensions(dialect, numbers_, std::move(base), orbits_);
   }
   // A condition added or deleted: programs opened afterwards read M180 against the new numbers.
   std::shared_ptr<const controller::SourcePart> for_profile(
       const config::MachineProfile& profile) const override {
     std::vector<int> numbers = condition_numbers(profile);
-    return numbers == numbers_ ? nullptr : std::make_shared<Codes>(std::move(numbers));
+    std::vector<double> orbits = condition_orbits(profile);
+    return numbers == numbers_ && orbits == orbits_
+               ? nullptr
+               : std::make_shared<Codes>(std::move(numbers), std::move(orbits));
   }
 
  private:
   std::vector<int> numbers_;
+  std::vector<double> orbits_;
 };
 
 /// The depth burnt as the EDM report counts it (docs/edm.md, `depth_mm`): the electrode's travel
@@ -78,7 +94,7 @@ class Depth final : public controller::FeatureState {
 
 bool setup(const config::MachineProfile& profile, controller::MachineSetup& host) {
   if (profile.edm.present) {
-    host.add_source_part(std::make_shared<Codes>(condition_numbers(profile)));
+    host.add_source_part(std::make_shared<Codes>(condition_numbers(profile), condition_orbits(profile)));
     host.add_move_reach([](const control::ServoConfig& servo) -> std::unique_ptr<controller::MoveReach> {
       if (!servo.edm.enabled) return nullptr;
       return std::make_unique<ReachCheck>(servo);

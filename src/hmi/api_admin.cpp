@@ -7,10 +7,14 @@
 
 #include <algorithm>
 #include <cctype>
+#include <charconv>
 #include <cmath>
+#include <optional>
+#include <variant>
 
 #include "opencnc/config/profile_edit.hpp"
 #include "opencnc/config/toml_edit.hpp"
+#include "opencnc/edm/sequence.hpp"
 
 namespace opencnc::hmi {
 
@@ -232,6 +236,7 @@ std::string condition_value_toml(const std::string& key, const json& value, Para
     r.message = fmt::format("\"{}\" must be one of {}", key, choices.dump());
     return {};
   }
+  if (std::string_view(f->choices) == "true|false") return value.get<std::string>();  // a TOML boolean
   return json(value).dump();  // a TOML basic string is a JSON string of these words
 }
 
@@ -261,6 +266,68 @@ json conditions_json(const config::MachineProfile& profile) {
           {"when", "while nothing runs (no program, MDI line, jog or homing)"},
           {"fields", fields},
           {"conditions", list}};
+}
+
+std::pair<int, json> edm_sequence_json(const config::MachineProfile& profile,
+                                       const std::map<std::string, std::string>& query) {
+  auto refuse = [](int status, std::string message) {
+    return std::pair<int, json>{status, json{{"message", std::move(message)}}};
+  };
+  if (!profile.edm.present) return refuse(422, "this machine is not a sinker EDM (no [edm] in its profile)");
+  // A query value as a finite number; nullopt (and `why`) when absent or malformed.
+  std::string why;
+  auto number = [&](const char* key, bool required) -> std::optional<double> {
+    const auto it = query.find(key);
+    if (it == query.end() || it->second.empty()) {
+      if (required) why = fmt::format("\"{}\" is needed", key);
+      return std::nullopt;
+    }
+    double v = 0;
+    const char* b = it->second.data();
+    const auto [end, ec] = std::from_chars(b, b + it->second.size(), v);
+    if (ec != std::errc{} || end != b + it->second.size() || !std::isfinite(v)) {
+      why = fmt::format("\"{}\" must be a number, not \"{}\"", key, it->second);
+      return std::nullopt;
+    }
+    return v;
+  };
+  const std::optional<double> area = number("area", true);
+  const std::optional<double> undersize = number("undersize", true);
+  const std::optional<double> surface = number("surface", false);
+  const std::optional<double> depth = number("depth", false);
+  if (!why.empty() || !area || !undersize) return refuse(400, why);
+  const auto finish_it = query.find("finish");
+  if (finish_it == query.end() || finish_it->second.empty()) return refuse(400, "\"finish\" is needed");
+  const std::variant<double, std::string> finish = edm::parse_finish(finish_it->second);
+  if (const auto* w = std::get_if<std::string>(&finish)) return refuse(400, *w);
+  const std::variant<edm::Sequence, std::string> planned =
+      edm::plan_sequence(profile.edm.config, {*area, std::get<double>(finish), *undersize});
+  if (const auto* w = std::get_if<std::string>(&planned)) return refuse(422, *w);
+  const edm::Sequence& s = std::get<edm::Sequence>(planned);
+  json steps = json::array();
+  for (const edm::SequenceStep& st : s.steps)
+    steps.push_back({{"condition", st.condition},
+                     {"peak_current_a", st.peak_current_a},
+                     {"ra_um", st.ra_um},
+                     {"vdi", edm::ra_to_vdi(st.ra_um)},
+                     {"side_gap_mm", st.side_gap_mm},
+                     {"orbit_mm", st.orbit_mm},
+                     {"wall_mm", st.wall_mm},
+                     {"allowance_mm", st.allowance_mm},
+                     {"removal_mm3_min", st.removal_mm3_min},
+                     {"wear_ratio", st.wear_ratio},
+                     {"orbit_limited", st.orbit_limited}});
+  json out = {{"finish_ra_um", s.request.finish_ra_um},
+              {"vdi", edm::ra_to_vdi(s.request.finish_ra_um)},
+              {"steps", steps},
+              {"text", edm::sequence_text(s)}};
+  if (depth) {
+    if (!(*depth > 0)) return refuse(400, "\"depth\" must be above 0 mm");
+    const machine::EdmConfig& e = profile.edm.config;
+    const char letter = "XYZABCUVW"[static_cast<std::size_t>(e.tool_axis)];
+    out["program"] = edm::sequence_program(s, e, letter, surface.value_or(0), *depth, e.lift_direction);
+  }
+  return {200, out};
 }
 
 ParametersRequest conditions_request(const json& body, const config::MachineProfile& profile) {

@@ -257,6 +257,7 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
   HttpResponse parameters(const HttpRequest& req, const Target& t, Role role);
   HttpResponse compensation(const HttpRequest& req, const Target& t, Role role);
   HttpResponse conditions(const HttpRequest& req, const Target& t, Role role);
+  HttpResponse edm_sequence(const HttpRequest& req, const Target& t, Role role);
   HttpResponse program_info(const HttpRequest& req, const Target& t, Role role);
   HttpResponse program_text(const HttpRequest& req, const Target& t, Role role);
   HttpResponse programs(const HttpRequest& req, const Target& t, Role role);
@@ -600,6 +601,7 @@ const Server::Impl::Route& Server::Impl::route_for(std::string_view path) noexce
       {.methods = kGet, .path = "/api/v1/parameters", .answer = &I::parameters},
       {.methods = kGet, .path = "/api/v1/compensation", .answer = &I::compensation},
       {.methods = kGet, .path = "/api/v1/conditions", .answer = &I::conditions},
+      {.methods = kGet, .path = "/api/v1/edm-sequence", .answer = &I::edm_sequence},
       {.methods = kGet, .path = "/api/v1/program", .answer = &I::program_info},
       {.methods = kGet, .path = "/api/v1/program/text", .runs = Runs::Blocking, .answer = &I::program_text},
       {.methods = kGet, .path = "/api/v1/program/preview", .start = &I::preview},
@@ -720,6 +722,11 @@ HttpResponse Server::Impl::compensation(const HttpRequest& req, const Target&, R
 
 HttpResponse Server::Impl::conditions(const HttpRequest& req, const Target&, Role) {
   return json_response(req, 200, conditions_json(*machine()));
+}
+
+HttpResponse Server::Impl::edm_sequence(const HttpRequest& req, const Target& t, Role) {
+  const auto [status, body] = edm_sequence_json(*machine(), t.query);
+  return json_response(req, status, body);
 }
 
 HttpResponse Server::Impl::events(const HttpRequest& req, const Target& t, Role) {

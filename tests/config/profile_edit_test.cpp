@@ -512,6 +512,44 @@ TEST_F(ProfileEditConditions, AConditionsFieldsChangeInItsElementAndTheAuditSays
   EXPECT_EQ(r.text, expected);
 }
 
+// Issue 28's keys: the finishing cycle, its time limit, the lateral servo, adaptive control and its
+// bounds are edited as the others (a boolean as a TOML boolean); bounds that no longer enclose the
+// condition's value get the loader's message and change nothing.
+TEST_F(ProfileEditConditions, TheFinishingAndAdaptiveKeysAreEditedAsTheOthers) {
+  const ProfileKeyEdit edits[] = {{"edm.condition.3.adaptive", "false"},
+                                  {"edm.condition.3.finish_timeout_s", "30.0"},
+                                  {"edm.condition.3.gain_max_mm_s_per_v", "0.1"},
+                                  {"edm.condition.2.orbit_finish", "true"},
+                                  {"edm.condition.2.lateral_servo", "false"}};
+  const ProfileEditResult r = edit_profile(live_, edits);
+  ASSERT_TRUE(r.ok()) << r.error;
+  const machine::EdmCondition& three = *r.profile->edm.config.find(3);
+  EXPECT_FALSE(three.adaptive);
+  EXPECT_EQ(three.finish_timeout_s, 30.0);
+  EXPECT_EQ(three.gain_max_mm_s_per_v, 0.1);
+  EXPECT_TRUE(r.profile->edm.config.find(2)->orbit_finish);
+  EXPECT_FALSE(r.profile->edm.config.find(2)->lateral_servo);
+  ASSERT_EQ(r.changes.size(), 5u);
+  EXPECT_EQ(r.changes[0].old_value, "true");
+  EXPECT_EQ(r.changes[0].new_value, "false");
+  EXPECT_EQ(r.changes[1].old_value, "60.0");
+  EXPECT_EQ(r.changes[1].new_value, "30.0");
+  EXPECT_NE(r.text.find("adaptive = false"), std::string::npos);
+  EXPECT_NE(r.text.find("finish_timeout_s = 30.0"), std::string::npos);
+  // A bound that leaves the condition's own value outside: the loader's words at its line.
+  const ProfileKeyEdit bound[] = {{"edm.condition.3.gain_min_mm_s_per_v", "0.5"}};
+  const ProfileEditResult refused = edit_profile(live_, bound);
+  ASSERT_FALSE(refused.ok());
+  ASSERT_FALSE(refused.diagnostics.items().empty());
+  EXPECT_NE(refused.diagnostics.items().front().message.find("must enclose the condition's own value"),
+            std::string::npos)
+      << refused.diagnostics.items().front().message;
+  // A boolean written as a word is not one.
+  const ProfileKeyEdit word[] = {{"edm.condition.3.adaptive", "\"yes\""}};
+  EXPECT_FALSE(edit_profile(live_, word).ok());
+  EXPECT_TRUE(is_condition_key("edm.condition.3.jump_height_max_mm"));
+}
+
 TEST_F(ProfileEditConditions, ABadValueGetsTheLoadersMessageAndUnknownConditionsOrFieldsAreRefused) {
   const ProfileKeyEdit high[] = {{"edm.condition.1.servo_reference_v", "120.0"}};  // above voltage_v
   const ProfileEditResult r = edit_profile(live_, high);

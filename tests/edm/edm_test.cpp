@@ -179,6 +179,59 @@ TEST(Edm, AShortThatNeverClearsStopsTheMachineWithAFault) {
   EXPECT_NEAR(report.short_recovery_max_s, 8.0, 0.003);
 }
 
+// The finishing cycle's time limit: condition 3's square, full after the burn, must still turn
+// once at its 80 µm (a 1 s period); with 50 ms allowed the cycle stops the machine with a fault
+// that says how far the orbit came, instead of holding the burn for ever.
+TEST(Edm, AFinishingCycleThatOutlastsItsTimeLimitStopsTheMachineWithAFault) {
+  config::MachineProfile p = edm({"edm.finish_timeout_s=0.05"});
+  for (int i = 0; i < p.edm.config.condition_count; ++i) {
+    machine::EdmCondition& c = p.edm.config.conditions[static_cast<std::size_t>(i)];
+    if (c.number == 3) c.orbit_finish = c.lateral_servo = true;  // the cycle as shipped
+  }
+  ASSERT_EQ(p.edm.config.find(3)->finish_timeout_s, 0.05);
+  Diagnostics d;
+  SimRig rig(p, *features::machine_setup(p, d));
+  EventCursor events(rig.controller().events());
+  rig.step();
+  ASSERT_TRUE(on_and_homed(rig));
+  ASSERT_TRUE(rig.request(Request::set_mode(control::Mode::Auto)).accepted);
+  ASSERT_TRUE(rig.request(Request::open(write_program(burn(3, 0.003))), 100000).accepted);
+  ASSERT_TRUE(rig.request(Request::simple(control::CommandKind::CycleStart)).accepted);
+  double finishing_from = -1;
+  ASSERT_TRUE(rig.run_until(
+      [&] {
+        const control::ServoStatus& s = rig.status().servo;
+        if (finishing_from < 0 && s.edm.finishing) finishing_from = s.time_s;
+        return s.state == control::State::Faulted ||
+               (!rig.status().run_active && s.state == control::State::Idle);
+      },
+      40000));
+  const control::ServoStatus s = rig.status().servo;
+  ASSERT_EQ(s.state, control::State::Faulted);
+  ASSERT_EQ(s.fault.kind, control::FaultKind::EdmFinishTimeout);
+  EXPECT_EQ(s.fault.axis, 3);
+  EXPECT_EQ(s.fault.limit, 0.05);
+  EXPECT_GT(s.fault.value, 0.0);
+  EXPECT_LE(s.fault.value, 0.08 + 1e-12);  // here the square is full but has not turned there
+  ASSERT_GE(finishing_from, 0);
+  // Counted while the cycle machines: 50 ms after it began, to a period or two.
+  EXPECT_NEAR(s.time_s - finishing_from, 0.05, 0.003);
+  EXPECT_FALSE(s.edm.generator);
+  bool told = false;
+  for (const ControllerEvent& e : events.next()) {
+    if (e.kind != ControllerEventKind::Note || e.code != "control.fault.edm-finish-timeout") continue;
+    told = true;
+    EXPECT_NE(e.text.find("EDM condition 3's finishing cycle did not bring the orbit to its size within its "
+                          "finish_timeout_s (0.05 s): the orbit reached "),
+              std::string::npos)
+        << e.text;
+    EXPECT_NE(e.text.find("its 0.0800 mm but did not turn once there sparking at the final depth"),
+              std::string::npos)
+        << e.text;
+  }
+  EXPECT_TRUE(told);
+}
+
 // A short that clears within its time is no fault, however long the program runs on.
 TEST(Edm, TheShortTimeCountsOnlyAnUnbrokenShort) {
   int shorts = 0;

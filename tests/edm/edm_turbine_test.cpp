@@ -12,12 +12,14 @@
 #include <memory>
 #include <sstream>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "edm_rig.hpp"
 #include "opencnc/config/profile_loader.hpp"
 #include "opencnc/controller/sim_rig.hpp"
 #include "opencnc/edm/edm_recorder.hpp"
+#include "opencnc/edm/sequence.hpp"
 #include "opencnc/features/features.hpp"
 
 namespace opencnc::controller::test {
@@ -79,9 +81,9 @@ struct Channel {
   const machine::SimEdmProcess& sim() const { return rig->machine().edm(); }
 };
 
-Channel run_channel(const config::MachineProfile& profile) {
+Channel run_program(const config::MachineProfile& profile, const std::string& text) {
   Channel r;
-  const std::string path = write_program(channel_without_dwell(), "opencnc-edm-turbine");
+  const std::string path = write_program(text, "opencnc-edm-turbine");
   Diagnostics d;
   r.rig = std::make_unique<SimRig>(profile, *features::machine_setup(profile, d));
   r.recorder = std::make_shared<edm::EdmRecorder>(profile.edm.config, profile.servo_period_s);
@@ -101,6 +103,10 @@ Channel run_channel(const config::MachineProfile& profile) {
       400000);
   r.seconds = static_cast<double>(r.rig->status().servo.tick - start) * profile.servo_period_s;
   return r;
+}
+
+Channel run_channel(const config::MachineProfile& profile) {
+  return run_program(profile, channel_without_dwell());
 }
 
 config::MachineProfile channel_machine(std::vector<std::string> sets = {}) {
@@ -201,6 +207,48 @@ TEST(EdmTurbine, AdaptiveControlAgainstFixedParametersOnTheSameJobAndSeed) {
   EXPECT_EQ(again.report().gap_voltage_in_band_fraction, a.report().gap_voltage_in_band_fraction);
   EXPECT_EQ(again.sim().cavity_oversize_max_mm(), a.sim().cavity_oversize_max_mm());
   EXPECT_EQ(again.sim().electrode_wear_max_mm(), a.sim().electrode_wear_max_mm());
+}
+
+// A generated sequence on the simulated sinker (the removal walls, the profile's 20 mm² blade):
+// `opencnc edm sequence`'s plan for Ra 0.8 µm and 0.08 mm of undersize, burnt 0.1 mm deep from
+// its program. The conditions come in the plan's order with their orbits, and the cavity comes
+// out as planned: the finishing square's reach plus E3's side gap in every direction (within
+// 5 µm) and the depth within 5 µm of 0.1 mm − wear + E3's frontal gap.
+TEST(EdmSequenceRun, AGeneratedSequenceBurnsTheCavityAsPlanned) {
+  const config::MachineProfile p = channel_machine();
+  const auto planned = edm::plan_sequence(p.edm.config, {20, 0.8, 0.08});
+  ASSERT_TRUE(std::holds_alternative<edm::Sequence>(planned)) << std::get<std::string>(planned);
+  const edm::Sequence& seq = std::get<edm::Sequence>(planned);
+  ASSERT_EQ(seq.steps.size(), 3u);
+  const std::string text = edm::sequence_program(seq, p.edm.config, 'Z', -20, 0.1, 1);
+  const Channel r = run_program(p, text);
+  ASSERT_TRUE(r.finished);
+  print("sequence", r);
+  EXPECT_EQ(r.report().shorts_uncleared, 0u);
+  EXPECT_EQ(r.per->arcs_at_burn_end, 0);
+  // Each step burnt under its condition (the per-condition periods of the trace).
+  for (const edm::SequenceStep& st : seq.steps) EXPECT_GT(r.per->n[st.condition], 0) << "E" << st.condition;
+  const machine::SimEdmProcess& sim = r.sim();
+  ASSERT_EQ(sim.fronts(), 1);
+  const edm::SequenceStep& last = seq.steps.back();
+  const machine::EdmCondition& finish = *p.edm.config.find(last.condition);
+  constexpr double kPi = 3.14159265358979323846;
+  double worst = 0, sum = 0, reach = 0;
+  for (int k = 0; k < machine::SimEdmProcess::kSides; ++k) {
+    const double a = 2 * kPi * k / machine::SimEdmProcess::kSides;
+    const double size = last.orbit_mm * (std::fabs(std::cos(a)) + std::fabs(std::sin(a))) + last.side_gap_mm;
+    sum += sim.wall_mm(0, k);
+    reach += size;
+    worst = std::max(worst, std::fabs(sim.wall_mm(0, k) - size));
+  }
+  std::printf("sequence: mean wall %.5f mm (planned %.5f), widest direction's error %.5f mm\n",
+              sum / machine::SimEdmProcess::kSides, reach / machine::SimEdmProcess::kSides, worst);
+  EXPECT_NEAR(sum / machine::SimEdmProcess::kSides, reach / machine::SimEdmProcess::kSides, 0.005);
+  // The flat sides (X and Y): the undersize the plan was made for.
+  for (int k = 0; k < machine::SimEdmProcess::kSides; k += machine::SimEdmProcess::kSides / 4)
+    EXPECT_NEAR(sim.wall_mm(0, k), seq.request.undersize_mm, 0.005) << "direction " << k;
+  const double depth = 0.1 - sim.electrode_wear_mm() + frontal_gap_mm(finish, p.edm.sim);
+  EXPECT_NEAR(sim.front_depth_mm(0), depth, 0.005);
 }
 
 }  // namespace

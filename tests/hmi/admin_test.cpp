@@ -276,10 +276,53 @@ TEST(AdminConditions, AnEdmsConditionsAreListedInTheProfilesOrder) {
   EXPECT_EQ(get(rig.port, "/api/v1/conditions", "").status, 401);
 }
 
+// The condition sequence for an electrode: its steps with their orbits and, with a depth, the
+// program; what the table does not allow in words (422), a malformed query 400.
+TEST(AdminConditions, TheSequenceForAnElectrodeIsPlannedFromTheTable) {
+  RigOptions o;
+  o.machine = "edm-5axis.toml";
+  o.history = false;
+  ServerRig rig(o);
+  const Reply r = get(
+      rig.port, "/api/v1/edm-sequence?area=20&finish=VDI18&undersize=0.08&surface=-20&depth=0.1", kOperator);
+  ASSERT_EQ(r.status, 200) << r.text;
+  ASSERT_EQ(r.body["steps"].size(), 3u);
+  EXPECT_EQ(r.body["steps"][0]["condition"], 1);
+  EXPECT_EQ(r.body["steps"][2]["condition"], 3);
+  EXPECT_NEAR(r.body["steps"][2]["orbit_mm"].get<double>(), 0.068, 1e-9);
+  EXPECT_EQ(r.body["vdi"], 18);
+  EXPECT_NE(r.body["program"].get<std::string>().find("M180 P3 Q0.0680\nG1 Z-20.1000"), std::string::npos);
+  const Reply small = get(rig.port, "/api/v1/edm-sequence?area=2&finish=0.8&undersize=0.08", kOperator);
+  EXPECT_EQ(small.status, 422);
+  EXPECT_NE(small.body["message"].get<std::string>().find("takes at most 1.2 A"), std::string::npos)
+      << small.text;
+  const Reply bad = get(rig.port, "/api/v1/edm-sequence?area=x&finish=0.8&undersize=0.08", kOperator);
+  EXPECT_EQ(bad.status, 400);
+  EXPECT_EQ(bad.body["message"], "\"area\" must be a number, not \"x\"");
+  EXPECT_EQ(get(rig.port, "/api/v1/edm-sequence?area=20&undersize=0.08", kOperator).body["message"],
+            "\"finish\" is needed");
+}
+
+// A boolean of issue 28 through set-conditions: a TOML boolean in the file, refused as a number.
+TEST(AdminConditions, TheAdaptiveSwitchIsSetAsAChoice) {
+  EditableRig rig("edm-5axis.toml");
+  const Reply ok =
+      post(rig.port, R"({"kind":"set-conditions","condition":3,"values":{"adaptive":"false"}})", kAdmin);
+  ASSERT_EQ(ok.status, 200) << ok.text;
+  EXPECT_EQ(ok.body["message"], "edm.condition.3.adaptive true → false");
+  std::string expected = rig.profile_original;
+  expected.replace(expected.find("adaptive = true\ngain_max"), 15, "adaptive = false");
+  EXPECT_EQ(rig.profile_text(), expected);
+  EXPECT_EQ(
+      post(rig.port, R"({"kind":"set-conditions","condition":3,"values":{"adaptive":1}})", kAdmin).status,
+      400);
+}
+
 TEST(AdminConditions, TheOperatorReadsThemOnlyTheAdminChangesThemAndTheChangeIsAudited) {
   EditableRig rig("edm-5axis.toml");
   const json fields = get(rig.port, "/api/v1/conditions", kOperator).body["fields"];
-  ASSERT_EQ(fields.size(), 19u);
+  ASSERT_EQ(fields.size(), 31u);  // issue 28's finishing and adaptive keys among them
+  EXPECT_EQ(fields[21]["choices"], json::array({"true", "false"}));
   EXPECT_EQ(fields[0], (json{{"key", "on_time_us"}, {"unit", "µs"}, {"what", "pulse on-time"}}));
   EXPECT_EQ(fields[4]["choices"], json::array({"+", "-"}));
   const std::string change =

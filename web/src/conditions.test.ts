@@ -10,6 +10,9 @@ import {
   conditionHeader,
   deleteQuestion,
   mayEdit,
+  sequenceCells,
+  sequenceHeader,
+  sequenceQuery,
   type Condition,
   type ConditionField,
 } from "./screens/conditions";
@@ -92,5 +95,28 @@ describe("adding and deleting a machining condition", () => {
   });
   it("asks before a delete and says what it costs", () => {
     expect(deleteQuestion(9)).toBe("Delete E9 from the profile? Programs that select it (M180 P9) will no longer open.");
+  });
+});
+
+describe("a condition sequence", () => {
+  const typed = { area: " 20 ", finish: "VDI18", undersize: "0.08", surface: "", depth: "" };
+  it("asks for the area, the finish and the undersize, and for the program with a depth", () => {
+    expect(sequenceQuery(typed)).toBe("area=20&finish=VDI18&undersize=0.08");
+    expect(sequenceQuery({ ...typed, finish: "0.8", surface: "-20", depth: "0.1" })).toBe("area=20&finish=0.8&undersize=0.08&depth=0.1&surface=-20");
+    expect(sequenceQuery({ ...typed, finish: "Ra1.6", depth: "0.1" })).toBe("area=20&finish=Ra1.6&undersize=0.08&depth=0.1&surface=0");
+  });
+  it("says in words what it will not ask", () => {
+    expect(sequenceQuery({ ...typed, area: "0" })).toEqual({ error: `The electrode's frontal area (mm²) must be a number above 0, not "0"` });
+    expect(sequenceQuery({ ...typed, finish: "fine" })).toEqual({ error: `The finish is an Ra in µm (0.8) or a VDI class (VDI18), not "fine"` });
+    expect(sequenceQuery({ ...typed, undersize: "-0.1" })).toEqual({ error: `The undersize per side (mm) must be a number above 0, not "-0.1"` });
+    expect(sequenceQuery({ ...typed, depth: "x" })).toEqual({ error: `The depth (mm) must be a number above 0, not "x"` });
+    expect(sequenceQuery({ ...typed, depth: "0.1", surface: "top" })).toEqual({ error: `The surface is a position in mm, not "top"` });
+  });
+  it("shows a step's condition, finish, orbit and what is left for the next", () => {
+    const step = { condition: 2, peak_current_a: 6, ra_um: 1.6, vdi: 24, side_gap_mm: 0.025, orbit_mm: 0.047, wall_mm: 0.072, allowance_mm: 0.008, removal_mm3_min: 4, wear_ratio: 0.03, orbit_limited: false };
+    expect(sequenceCells(1, step)).toEqual(["2", "E2", "6", "1.6 (24)", "0.0250", "0.0470", "0.0720", "0.0080", "4", "3"]);
+    expect(sequenceCells(0, { ...step, orbit_mm: 0 })[5]).toBe("-");
+    expect(sequenceCells(0, { ...step, orbit_limited: true })[5]).toBe("0.0470 (its largest)");
+    expect(sequenceCells(0, step).length).toBe(sequenceHeader.length);
   });
 });

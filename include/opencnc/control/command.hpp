@@ -134,6 +134,9 @@ enum class FaultKind : std::uint8_t {
   Stall,           ///< `axis`: the stepper drive detected a stall (steps were lost; home again)
   ProcessAlarm,    ///< a `stop` alarm: `axis` = the alarm's index, `value` = the input, `limit` = the bound
   EdmShort,  ///< the EDM gap stayed shorted: `axis` = the condition, `value` = seconds, `limit` = its limit
+  /// The EDM finishing cycle did not bring the orbit to its size in time: `axis` = the condition,
+  /// `value` = the orbit's radius reached (mm), `limit` = the condition's finish_timeout_s
+  EdmFinishTimeout,
   /// A seek of a homed axis went its soft limit + overtravel without the limit switch tripping:
   /// `axis`, `value` = where it stopped, `limit` = the soft limit (the axis must home again)
   SeekNoSwitch,

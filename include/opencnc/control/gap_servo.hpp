@@ -68,9 +68,10 @@ class GapServo {
   /// A run starts at `at`: the path memory starts there, the generator is off.
   void begin_run(const Pose& at) noexcept;
   /// M180 P<n> (select condition n, generator on) or M181 (generator off). False: no such
-  /// condition (the generator goes off). Under a condition with the finishing cycle the code waits
+  /// condition (the generator goes off). `q` > 0: the burn's orbit radius (M180's Q, at most
+  /// the condition's). Under a condition with the finishing cycle the code waits
   /// (the interpolator with it) until the orbit is full at the path's end and has turned there.
-  bool apply_code(int code, double p) noexcept;
+  bool apply_code(int code, double p, double q = 0) noexcept;
   /// One period: returns where the electrode shall be (the head, or behind it, plus offsets).
   Pose step(const GapInputs& in) noexcept;
   /// The factor the interpolator's feed override is multiplied by (0 while the electrode is
@@ -91,11 +92,18 @@ class GapServo {
   bool short_timed_out() const noexcept {
     return status_.on && cond_.short_timeout_s > 0 && status_.short_s >= cond_.short_timeout_s;
   }
+  /// The finishing cycle has held the burn's end for the condition's finish_timeout_s without
+  /// the orbit reaching its size and turning there: the machine must stop (the tick faults).
+  bool finish_timed_out() const noexcept {
+    return finishing_ && cond_.finish_timeout_s > 0 && finish_elapsed_s_ >= cond_.finish_timeout_s;
+  }
+  /// The orbit's radius now (the size the finishing cycle has reached).
+  double orbit_radius_mm() const noexcept { return radius_; }
   /// This period backing off reached the end of the path memory while the servo wanted to go on.
   bool reached_retract_limit() const noexcept { return reached_retract_limit_; }
 
  private:
-  bool select(int code, double p) noexcept;
+  bool select(int code, double p, double q) noexcept;
   double servo_speed(const GapInputs& in, bool brake) noexcept;
   void run_finish(const GapInputs& in, bool due) noexcept;
   void run_lateral(const GapInputs& in, double target) noexcept;
@@ -139,10 +147,11 @@ class GapServo {
   // The finishing cycle: the code it holds back, the radial speed and the burnt turn at full size.
   bool finishing_ = false;
   int pending_code_ = 0;
-  double pending_p_ = 0;
+  double pending_p_ = 0, pending_q_ = 0;
   double lateral_v_ = 0;
   double full_turn_ = 0;  ///< turns burnt at the full radius (1: done)
   double finish_s_ = 0;   ///< the path length where the burn's path ended
+  double finish_elapsed_s_ = 0;  ///< machining time since the cycle began (its time limit)
   // Adaptive control: the condition's own settings and bounds (cond_ holds those in force).
   EdmCondition base_{};
   EdmAdaptive adaptive_;

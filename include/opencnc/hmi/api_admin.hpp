@@ -4,6 +4,9 @@
 // controller's EditProfile request.
 #pragma once
 
+#include <map>
+#include <utility>
+
 #include <nlohmann/json.hpp>
 
 #include <optional>
@@ -46,6 +49,14 @@ nlohmann::json compensation_json(const config::MachineProfile& profile);
 /// admin may change (key, unit, a line, the words of a choice); an empty list on a machine
 /// without `[edm]`. Any thread.
 nlohmann::json conditions_json(const config::MachineProfile& profile);
+
+/// `GET /api/v1/edm-sequence?area=…&finish=…&undersize=…[&surface=…&depth=…]`: the
+/// roughing-to-finishing condition sequence (edm/sequence.hpp) as {status 200, {"steps": [...],
+/// "text", "program"}} (the program with a depth only), or {400 or 422, {"message"}} saying why
+/// not (a missing or malformed value, a machine without [edm], what the table does not allow).
+/// Any thread.
+std::pair<int, nlohmann::json> edm_sequence_json(const config::MachineProfile& profile,
+                                                 const std::map<std::string, std::string>& query);
 
 /// A `set-conditions` body (`{"condition": 3, "values": {"on_time_us": 60, "polarity": "-"}}`) as
 /// the controller's EditProfile request of the keys `edm.condition.<n>.<field>`, or the HTTP

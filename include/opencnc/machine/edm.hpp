@@ -50,6 +50,9 @@ struct EdmCondition {
   double max_retract_mm_s = 0;   ///< backward speed limit (a short backs off at this)
   double filter_s = 0.005;       ///< time constant of the gap voltage's low-pass filter
   double short_timeout_s = 5;    ///< a short that lasts longer stops the machine with a fault
+  /// The finishing cycle's time limit (orbit_finish): an orbit that has not reached its size and
+  /// turned there this long after the burn's end stops the machine with a fault.
+  double finish_timeout_s = 60;
   // Jump (period 0: off).
   double jump_height_mm = 0;   ///< H: how far the electrode lifts
   double jump_period_s = 0;    ///< T_on: machining time between jumps
@@ -77,6 +80,9 @@ struct EdmCondition {
   // What the generator's table says the condition does (the simulated gap burns by them).
   double side_gap_mm = 0;           ///< spark gap at the electrode's sides, per side (0: not given)
   double electrode_wear_ratio = 0;  ///< electrode volume worn per volume of work removed
+  // The technology table's figures a condition sequence is chosen by (edm/sequence.hpp; 0: not given).
+  double ra_um = 0;            ///< the surface roughness Ra the condition leaves
+  double removal_mm3_min = 0;  ///< the maker's removal rate
 };
 
 /// The EDM machine as the tick sees it.
@@ -87,6 +93,10 @@ struct EdmConfig {
   std::int8_t orbit_axes[2] = {0, 1};  ///< the orbit's plane (X, Y)
   double path_spacing_mm = 0.002;      ///< spacing of the path memory's points (backing off)
   double short_timeout_s = 5;          ///< [edm] short_timeout_s: the conditions' default
+  double finish_timeout_s = 60;        ///< [edm] finish_timeout_s: the conditions' default
+  /// [edm] current_density_max_a_mm2: the most peak current per mm² of frontal area the
+  /// electrode takes (a condition sequence's roughing is chosen within it; 0: not given).
+  double current_density_max_a_mm2 = 0;
   std::array<EdmCondition, kMaxEdmConditions> conditions{};
   int condition_count = 0;
 

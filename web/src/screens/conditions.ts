@@ -4,7 +4,9 @@
 // with the one the generator runs now (the status' edm.condition) highlighted live. An admin
 // edits a condition's fields while nothing runs (set-conditions: the profile's own checks, the
 // tick takes the new values at rest), adds a condition as a copy of another (add-condition) and
-// deletes one after a confirmation (delete-condition); an operator sees them read-only.
+// deletes one after a confirmation (delete-condition); an operator sees them read-only. Anyone
+// plans a roughing-to-finishing sequence for an electrode (its frontal area, the finish, the
+// undersize: GET /api/v1/edm-sequence), sees its steps and takes its program.
 import { registerScreen, type Context } from "../registry";
 import type { Outcome, Status } from "../types";
 import { button, el } from "../ui";
@@ -98,6 +100,88 @@ export function deleteQuestion(n: number): string {
   return `Delete E${n} from the profile? Programs that select it (M180 P${n}) will no longer open.`;
 }
 
+/** One step of a condition sequence as GET /api/v1/edm-sequence gives it. */
+export interface SequenceStep {
+  condition: number;
+  peak_current_a: number;
+  ra_um: number;
+  vdi: number;
+  side_gap_mm: number;
+  orbit_mm: number;
+  wall_mm: number;
+  allowance_mm: number;
+  removal_mm3_min: number;
+  wear_ratio: number;
+  orbit_limited: boolean;
+}
+
+/** What the operator types to plan a sequence. */
+export interface SequenceInputs {
+  area: string;
+  finish: string;
+  undersize: string;
+  surface: string;
+  depth: string;
+}
+
+/**
+ * The query of GET /api/v1/edm-sequence for what was typed, or why not in words (checked before
+ * anything is sent; the table's own limits come from the controller). The surface and the depth
+ * are optional: with a depth the answer carries the program.
+ */
+export function sequenceQuery(i: SequenceInputs): string | { error: string } {
+  const q = new URLSearchParams();
+  const positive = (name: string, typed: string, what: string): string | undefined => {
+    const t = typed.trim();
+    const v = Number(t);
+    if (t === "" || !Number.isFinite(v) || v <= 0) return `${what} must be a number above 0, not "${t}"`;
+    q.set(name, t);
+    return undefined;
+  };
+  const area = positive("area", i.area, "The electrode's frontal area (mm²)");
+  if (area) return { error: area };
+  const finish = i.finish.trim();
+  if (!/^(ra)?\d+(\.\d+)?$|^vdi\d+(\.\d+)?$/i.test(finish)) return { error: `The finish is an Ra in µm (0.8) or a VDI class (VDI18), not "${finish}"` };
+  q.set("finish", finish);
+  const undersize = positive("undersize", i.undersize, "The undersize per side (mm)");
+  if (undersize) return { error: undersize };
+  if (i.depth.trim() !== "") {
+    const depth = positive("depth", i.depth, "The depth (mm)");
+    if (depth) return { error: depth };
+    const s = i.surface.trim() === "" ? "0" : i.surface.trim();
+    if (!Number.isFinite(Number(s))) return { error: `The surface is a position in mm, not "${s}"` };
+    q.set("surface", s);
+  }
+  return q.toString();
+}
+
+/** The sequence table's header: what each column of sequenceCells() shows. */
+export const sequenceHeader = ["step", "E", "peak A", "Ra µm (VDI)", "side gap mm", "orbit mm", "wall mm", "left mm", "removal mm³/min", "wear %"];
+
+/** A step's cells, in sequenceHeader's order (the orbit "-" for a condition without one). */
+export function sequenceCells(k: number, s: SequenceStep): string[] {
+  const orbit = s.orbit_mm > 0 ? `${s.orbit_mm.toFixed(4)}${s.orbit_limited ? " (its largest)" : ""}` : "-";
+  return [
+    `${k + 1}`,
+    `E${s.condition}`,
+    `${s.peak_current_a}`,
+    `${s.ra_um} (${s.vdi})`,
+    s.side_gap_mm.toFixed(4),
+    orbit,
+    s.wall_mm.toFixed(4),
+    s.allowance_mm.toFixed(4),
+    `${s.removal_mm3_min}`,
+    `${Math.round(s.wear_ratio * 100)}`,
+  ];
+}
+
+interface SequenceAnswer {
+  steps: SequenceStep[];
+  text: string;
+  program?: string;
+  message?: string;
+}
+
 interface ConditionsAnswer {
   profile: string;
   when: string;
@@ -116,6 +200,8 @@ let shown = -1;
 /** The admin's token once checked (the page's own when it is an admin's); "" while read-only. */
 let adminToken = "";
 let answer: ConditionsAnswer | undefined;
+let sequenceBody: HTMLElement | undefined;
+let sequenceProgram: HTMLElement | undefined;
 
 function highlight(active: number) {
   if (!body || active === shown) return;
@@ -241,6 +327,41 @@ async function load(ctx: Context, selected = 0) {
   highlight(activeCondition(ctx.status()));
 }
 
+/** Plans the sequence for what was typed and shows its steps and its program. */
+async function plan(ctx: Context, inputs: SequenceInputs) {
+  const query = sequenceQuery(inputs);
+  if (typeof query !== "string") return show(ctx, [query.error], "error");
+  const res = await fetch(`/api/v1/edm-sequence?${query}`, { headers: { Authorization: `Bearer ${ctx.api.token}` } });
+  const a = (await res.json()) as SequenceAnswer;
+  if (!res.ok) return show(ctx, [a.message ?? `${res.status}`], "error");
+  sequenceBody?.replaceChildren(...a.steps.map((s, k) => el("tr", {}, ...sequenceCells(k, s).map((t) => el("td", {}, t)))));
+  if (sequenceProgram) sequenceProgram.textContent = a.program ?? "(give a depth for the program)";
+  show(ctx, [`${a.steps.length} steps, E${a.steps[0]?.condition} to E${a.steps[a.steps.length - 1]?.condition}`], "note");
+}
+
+/** The sequence planner: area, finish, undersize (and the surface and depth for a program). */
+function planner(ctx: Context): HTMLElement {
+  const field = (id: string, placeholder: string) => el("input", { id, type: "text", class: "num", placeholder });
+  const area = field("seq-area", "20");
+  const finish = field("seq-finish", "VDI18");
+  const undersize = field("seq-undersize", "0.08");
+  const surface = field("seq-surface", "-20");
+  const depth = field("seq-depth", "0.1");
+  const inputs = (): SequenceInputs => ({ area: area.value, finish: finish.value, undersize: undersize.value, surface: surface.value, depth: depth.value });
+  sequenceBody = el("tbody");
+  sequenceProgram = el("pre", { id: "sequence-program", class: "diagnostics" });
+  return el(
+    "div",
+    { id: "condition-sequence" },
+    el("h3", {}, "Condition sequence"),
+    el("div", { class: "row" }, "Area mm² ", area, " finish (Ra µm or VDI) ", finish, " undersize mm ", undersize),
+    el("div", { class: "row" }, "Surface ", surface, " depth mm ", depth, button("Plan", () => void plan(ctx, inputs()), "primary"),
+      button("Copy the program", () => void navigator.clipboard?.writeText(sequenceProgram?.textContent ?? ""))),
+    el("table", { class: "grid", id: "sequence" }, el("thead", {}, el("tr", {}, ...sequenceHeader.map((h) => el("th", {}, h)))), sequenceBody),
+    sequenceProgram,
+  );
+}
+
 /** Edit mode when the typed token (or the page's) is an admin's. */
 async function unlock(ctx: Context) {
   const t = token?.value || ctx.api.token;
@@ -271,6 +392,7 @@ registerScreen({
       adderRow,
       editor,
       result,
+      planner(ctx),
     );
   },
   async shown(ctx) {
