@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// `opencnc cutchart --db FILE list|show|set|remove|import|export|audit`: the plasma table's cut
+// `opencnc cutchart --db FILE list|show|set|remove|select|import|export|audit`: the plasma table's cut
 // chart from the command line (docs/cutting.md, "Cut charts").
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
@@ -94,16 +94,20 @@ int list(store::CutChartStore& s, const Options& o) {
   std::string error;
   const auto chart = s.chart(&error);
   if (!chart) return fail(error);
+  const int selected = s.selected().value_or(0);
   nlohmann::json j = nlohmann::json::array();
   std::string text =
       fmt::format("{:>6}  {:<28} {:>6} {:<8} {:>5} {:>6} {:>6} {:>5} {:>5} {:>6} {:>5}\n", "number", "name",
                   "mm", "process", "kerf", "feed", "pierce", "delay", "cut", "volts", "amps");
   for (const store::Material& m : *chart) {
     j.push_back(material_json(m));
-    text += fmt::format("{:>6}  {:<28} {:>6} {:<8} {:>5} {:>6} {:>6} {:>5} {:>5} {:>6} {:>5}\n", m.number,
-                        m.name, m.thickness_mm, store::to_string(m.process), m.kerf_width_mm, m.feed_mm_min,
-                        m.pierce_height_mm, m.pierce_delay_s, m.cut_height_mm, m.arc_voltage_v, m.amperage_a);
+    text += fmt::format("{:>6}{} {:<28} {:>6} {:<8} {:>5} {:>6} {:>6} {:>5} {:>5} {:>6} {:>5}\n", m.number,
+                        m.number == selected ? "*" : " ", m.name, m.thickness_mm, store::to_string(m.process),
+                        m.kerf_width_mm, m.feed_mm_min, m.pierce_height_mm, m.pierce_delay_s, m.cut_height_mm,
+                        m.arc_voltage_v, m.amperage_a);
   }
+  if (selected != 0)
+    text += fmt::format("* selected: programs that select no material cut with {}\n", selected);
   print(o, j, text);
   return kExitOk;
 }
@@ -150,6 +154,16 @@ int remove(store::CutChartStore& s, const Options& o) {
   std::string error;
   if (!s.remove(*n, kInterface, &error)) return fail(error);
   print(o, {{"removed", *n}}, fmt::format("material {} removed", *n));
+  return kExitOk;
+}
+
+int select(store::CutChartStore& s, const Options& o) {
+  const bool none = !o.words.empty() && o.words[0] == "0";
+  const auto n = none ? std::optional<int>(0) : material_number(o.words);
+  if (!n) return fail("select wants a material number (0: none)", kExitUsage);
+  std::string error;
+  if (!s.select(*n, kInterface, &error)) return fail(error);
+  print(o, {{"selected", *n}}, *n == 0 ? "no material selected" : fmt::format("material {} selected", *n));
   return kExitOk;
 }
 
@@ -218,7 +232,7 @@ int run(const std::string& action, Options o) {
   }
   if (o.db.empty())
     return fail("name the cut chart: --db FILE (or --machine PROFILE with a [cut_chart])", kExitUsage);
-  const bool writes = action == "set" || action == "remove" || action == "import";
+  const bool writes = action == "set" || action == "remove" || action == "import" || action == "select";
   if (action == "import") {
     if (o.words.size() != 1) return fail("import wants one CSV file", kExitUsage);
     if (const std::string why = unreadable_input(o.words[0]); !why.empty())
@@ -230,6 +244,7 @@ int run(const std::string& action, Options o) {
   if (action == "show") return show(*s, o);
   if (action == "set") return set(*s, o);
   if (action == "remove") return remove(*s, o);
+  if (action == "select") return select(*s, o);
   if (action == "import") return import(*s, o);
   if (action == "export") return export_chart(*s, o);
   return audit(*s, o);
@@ -258,6 +273,7 @@ void add_cutchart_command(CLI::App& app, Registry& registry) {
   add("set", "Add or change a material in one transaction: set 6 feed_mm_min=2500 kerf_width_mm=1.6",
       "NUMBER field=value…");
   add("remove", "Remove a material", "NUMBER");
+  add("select", "The material programs that select none use (0: none), as the HMI selects it", "NUMBER");
   add("import", "Replace the chart by a CSV file (errors at file:line:col; nothing changes on any)", "FILE");
   add("export", "Write the chart as CSV", nullptr)
       ->add_option("-o,--output", o->output, "The file (default: standard output; never an input)");

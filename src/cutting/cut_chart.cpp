@@ -23,7 +23,12 @@ using store::Material;
 
 CutChartLibrary::CutChartLibrary(std::shared_ptr<store::CutChartStore> store,
                                  const config::CutChartProfile& profile)
-    : store_(std::move(store)), profile_(profile), selected_(profile.material) {}
+    : store_(std::move(store)), profile_(profile) {}
+
+int CutChartLibrary::selected() {
+  const int chosen = store_->selected().value_or(0);
+  return chosen > 0 ? chosen : profile_.material;
+}
 
 std::shared_ptr<const std::vector<Material>> CutChartLibrary::chart(std::string* error) {
   std::lock_guard lock(mutex_);
@@ -125,7 +130,7 @@ class Chart {
     return m != nullptr ? std::optional<Material>(*m) : std::nullopt;
   }
 
-  const CutChartLibrary& library() const noexcept { return *library_; }
+  CutChartLibrary& library() const noexcept { return *library_; }
 
  private:
   std::shared_ptr<CutChartLibrary> library_;
@@ -290,7 +295,12 @@ class ChartCheck final : public controller::MovePass {
       return;
     }
     if (a.kind != canon::ActionKind::ProcessCode) return;
-    if (a.index == machine::kMaterialCode) material_ = static_cast<int>(a.value);
+    if (a.index == machine::kMaterialCode) {  // looked up once: the check runs for every move
+      material_ = static_cast<int>(a.value);
+      const auto chart = library_->chart();
+      const Material* m = chart ? store::find(*chart, material_) : nullptr;
+      feed_ = m != nullptr ? m->feed_mm_min : 0.0;
+    }
     if (a.index == machine::kTorchOnCode) torch_ = true;
     if (a.index == machine::kTorchOffCode) torch_ = false;
     if (a.index == machine::kThcHoldCode) held_ = true;
@@ -299,24 +309,22 @@ class ChartCheck final : public controller::MovePass {
 
   void check(const canon::Program& p, std::size_t id) {
     const canon::Move& mv = p.move(static_cast<canon::SegmentId>(id));
-    if (!torch_ || held_ || material_ <= 0) return;
+    if (!torch_ || held_ || material_ <= 0 || feed_ <= 0) return;
     if (mv.kind != canon::MoveKind::Feed && mv.kind != canon::MoveKind::Arc) return;
-    const auto chart = library_->chart();
-    const Material* m = chart ? store::find(*chart, material_) : nullptr;
-    if (m == nullptr) return;
     const double f = p.feed(static_cast<canon::SegmentId>(id));
     const double tol = library_->profile().feed_tolerance;
-    if (std::fabs(f - m->feed_mm_min) <= tol * m->feed_mm_min + 1e-9) return;
+    if (std::fabs(f - feed_) <= tol * feed_ + 1e-9) return;
     if (!warned_.insert({mv.context, mv.line}).second) return;
     report(p, mv.context, mv.line, Severity::Warning, "f",
            fmt::format("the feed {} mm/min is {} than cut chart material {}'s {} mm/min by more than {} %", f,
-                       f < m->feed_mm_min ? "slower" : "faster", m->number, m->feed_mm_min, tol * 100),
+                       f < feed_ ? "slower" : "faster", material_, feed_, tol * 100),
            "cutchart.feed");
   }
 
   std::shared_ptr<CutChartLibrary> library_;
   std::size_t next_move_ = 0, next_action_ = 0;
   int material_ = 0;
+  double feed_ = 0;  ///< the material's, mm/min (0: not in the chart)
   bool torch_ = false, held_ = false;
   std::set<std::pair<std::uint32_t, std::uint32_t>> warned_;
   Columns columns_;

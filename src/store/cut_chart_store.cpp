@@ -29,6 +29,8 @@ void create_schema(Database& db) {
     cols += fmt::format(", {} {} NOT NULL", c, c == "name" || c == "process" ? "TEXT" : "REAL");
   db.exec(fmt::format(R"(
 CREATE TABLE materials(number INTEGER PRIMARY KEY{});
+CREATE TABLE selection(id INTEGER PRIMARY KEY CHECK (id = 1), material INTEGER NOT NULL);
+INSERT INTO selection(id, material) VALUES(1, 0);
 CREATE TABLE audit(id INTEGER PRIMARY KEY, at_utc TEXT NOT NULL, interface TEXT NOT NULL,
   reason TEXT NOT NULL, what TEXT NOT NULL, old_value TEXT NOT NULL, new_value TEXT NOT NULL);
 )",
@@ -52,6 +54,10 @@ void open_schema(Database& db, bool read_only) {
   create_schema(db);
   db.exec(fmt::format("PRAGMA application_id={}; PRAGMA user_version={}", kApplicationId, kSchemaVersion));
   t.commit();
+}
+
+int read_selected(Database& db) {
+  return static_cast<int>(db.query_integer("SELECT material FROM selection"));
 }
 
 std::vector<Material> read_chart(Database& db) {
@@ -188,10 +194,14 @@ bool CutChartStore::modify_locked(const Edit& edit, std::string_view interface, 
       why = bad->message;
       return false;
     }
-    const std::vector<Change> changes = diff(before, after);
+    std::vector<Change> changes = diff(before, after);
     if (changes.empty()) return true;
     db_->exec("DELETE FROM materials");
     for (const Material& m : after) insert(*db_, m);
+    if (const int sel = read_selected(*db_); sel != 0 && find(after, sel) == nullptr) {
+      db_->exec("UPDATE selection SET material = 0");
+      changes.push_back({"selected material", std::to_string(sel), "0"});
+    }
     Statement a = db_->prepare(
         "INSERT INTO audit(at_utc, interface, reason, what, old_value, new_value) VALUES(?1, ?2, ?3, ?4, ?5, "
         "?6)");
@@ -251,6 +261,40 @@ bool CutChartStore::remove(int number, std::string_view interface, std::string* 
         return std::optional<std::string>();
       },
       interface, "remove", error);
+}
+
+std::optional<int> CutChartStore::selected(std::string* error) {
+  std::lock_guard lock(mutex_);
+  return guarded(error, [&] { return std::optional<int>(read_selected(*db_)); });
+}
+
+bool CutChartStore::select(int number, std::string_view interface, std::string* error) {
+  std::lock_guard lock(mutex_);
+  std::string why;
+  const bool ok = guarded(error, [&] {
+    Database::Transaction t(*db_);
+    if (number != 0 && find(read_chart(*db_), number) == nullptr) {
+      why = fmt::format("material {} is not in the cut chart", number);
+      return false;
+    }
+    const int before = read_selected(*db_);
+    if (before == number) return true;
+    Statement u = db_->prepare("UPDATE selection SET material = ?1");
+    u.bind(1, number);
+    u.run();
+    Statement a = db_->prepare(
+        "INSERT INTO audit(at_utc, interface, reason, what, old_value, new_value) VALUES(?1, ?2, ?3, ?4, ?5, "
+        "?6)");
+    const std::string at = clock_(), o = std::to_string(before), n = std::to_string(number);
+    a.bind(1, std::string_view(at)).bind(2, interface).bind(3, "select").bind(4, "selected material");
+    a.bind(5, std::string_view(o)).bind(6, std::string_view(n));
+    a.run();
+    t.commit();
+    ++changes_;
+    return true;
+  });
+  if (!why.empty() && error != nullptr) *error = why;
+  return ok;
 }
 
 std::vector<AuditEntry> CutChartStore::audit(std::size_t limit, std::string* error) {

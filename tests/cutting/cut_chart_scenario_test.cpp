@@ -196,14 +196,8 @@ TEST(CutChartScenario, AnUnknownMaterialIsAnErrorAtItsLineBeforeAnythingMoves) {
               }));
 }
 
-TEST(CutChartScenario, TheSelectedMaterialIsUsedWhenTheProgramSelectsNone) {
-  const Bench b;
-  const std::string prog = b.program("plain.ngc",
-                                     "G21 G90 G17 G40 G64 P0.1\nG0 Z15\nG0 X90 Y90\nM190\nG42\n"
-                                     "G1 X100 Y100 F3500\nX300\nY220\nX100\nY100\nG40\nM191\nM2\n");
-  const ChartRun r = run(b.table(3), prog);  // [cut_chart] material = 3 (the HMI's choice starts there)
-  ASSERT_TRUE(r.opened.accepted) << r.opened.message;
-  ASSERT_TRUE(r.finished);
+/// The pierce height and the lowest Y of the bottom edge while cutting.
+std::pair<double, double> pierce_and_bottom(const ChartRun& r) {
   double least_y = 1e9, pierce_h = 0;
   for (const control::TraceSample& s : r.trace) {
     if (s.torch.phase == control::TorchPhase::Piercing) pierce_h = height(s);
@@ -211,8 +205,27 @@ TEST(CutChartScenario, TheSelectedMaterialIsUsedWhenTheProgramSelectsNone) {
         s.commanded[1] < 150)
       least_y = std::min(least_y, s.commanded[1]);
   }
-  EXPECT_NEAR(pierce_h, 3.2, 0.01);
-  EXPECT_NEAR(least_y, 100 - 0.6, 0.01);
+  return {pierce_h, least_y};
+}
+
+TEST(CutChartScenario, TheSelectedMaterialIsUsedWhenTheProgramSelectsNone) {
+  const Bench b;
+  const std::string prog = b.program("plain.ngc",
+                                     "G21 G90 G17 G40 G64 P0.1\nG0 Z15\nG0 X90 Y90\nM190\nG42\n"
+                                     "G1 X100 Y100 F3500\nX300\nY220\nX100\nY100\nG40\nM191\nM2\n");
+  const ChartRun r = run(b.table(3), prog);  // [cut_chart] material = 3
+  ASSERT_TRUE(r.opened.accepted) << r.opened.message;
+  ASSERT_TRUE(r.finished);
+  EXPECT_NEAR(pierce_and_bottom(r).first, 3.2, 0.01);
+  EXPECT_NEAR(pierce_and_bottom(r).second, 100 - 0.6, 0.01);
+  // The HMI's selection (kept in the store) comes before the profile's.
+  std::string error;
+  ASSERT_TRUE(store::CutChartStore::open(b.db(), &error)->select(10, "hmi", &error)) << error;
+  const ChartRun s = run(b.table(3), prog);
+  ASSERT_TRUE(s.opened.accepted) << s.opened.message;
+  ASSERT_TRUE(s.finished);
+  EXPECT_NEAR(pierce_and_bottom(s).first, 4.5, 0.01);
+  EXPECT_NEAR(pierce_and_bottom(s).second, 100 - 0.9, 0.01);
 }
 
 }  // namespace

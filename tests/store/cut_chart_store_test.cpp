@@ -200,6 +200,31 @@ TEST(CutChartStore, ABadChangeChangesNothing) {
   EXPECT_EQ(s->audit().size(), audited);
 }
 
+TEST(CutChartStore, TheSelectionIsKeptAuditedAndFollowsTheChart) {
+  TempDb dir;
+  auto s = open_store(dir.path("chart.db"));
+  std::string e;
+  ASSERT_TRUE(s->write(parse_ok(kCsv), "test", "import", &e)) << e;
+  EXPECT_EQ(s->selected(), 0);
+  EXPECT_FALSE(s->select(7, "hmi", &e));
+  EXPECT_EQ(e, "material 7 is not in the cut chart");
+  ASSERT_TRUE(s->select(20, "hmi", &e)) << e;
+  EXPECT_EQ(open_store(dir.path("chart.db"))->selected(), 20);
+  auto a = s->audit(1);
+  ASSERT_EQ(a.size(), 1u);
+  EXPECT_EQ(a[0].what, "selected material");
+  EXPECT_EQ(a[0].old_value, "0");
+  EXPECT_EQ(a[0].new_value, "20");
+  EXPECT_EQ(a[0].interface, "hmi");
+  // Removing the selected material selects none, in the same transaction and audit.
+  ASSERT_TRUE(s->remove(20, "command line", &e)) << e;
+  EXPECT_EQ(s->selected(), 0);
+  a = s->audit(2);
+  EXPECT_EQ(a[0].what, "material 20");
+  EXPECT_EQ(a[1].what, "selected material");
+  EXPECT_EQ(a[1].new_value, "0");
+}
+
 TEST(CutChartStore, AnotherProcessesCommitIsSeenAndCounted) {
   TempDb dir;
   auto a = open_store(dir.path("chart.db"));

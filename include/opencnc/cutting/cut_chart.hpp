@@ -5,7 +5,6 @@
 // warns at the line where a program's feed disagrees with the chart (docs/cutting.md).
 #pragma once
 
-#include <atomic>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -26,17 +25,15 @@ class CutChartLibrary {
   /// The chart as now committed (re-read only when the store changed); null with `*error` when it
   /// cannot be read.
   std::shared_ptr<const std::vector<store::Material>> chart(std::string* error = nullptr);
-  /// The material in force before a program selects one (`[cut_chart] material`, the HMI's
-  /// choice); 0: none.
-  int selected() const noexcept { return selected_.load(); }
-  void select(int number) noexcept { selected_.store(number); }
+  /// The material in force before a program selects one: the store's selection (the HMI's, kept
+  /// in the store), else `[cut_chart] material`; 0: none.
+  int selected();
   const config::CutChartProfile& profile() const noexcept { return profile_; }
   const std::shared_ptr<store::CutChartStore>& store() const noexcept { return store_; }
 
  private:
   std::shared_ptr<store::CutChartStore> store_;
   config::CutChartProfile profile_;
-  std::atomic<int> selected_{0};
   std::mutex mutex_;
   std::shared_ptr<const std::vector<store::Material>> chart_;
   std::uint64_t seen_ = ~std::uint64_t{0};

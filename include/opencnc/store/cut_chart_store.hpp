@@ -42,6 +42,12 @@ class CutChartStore {
   bool put(const Material& m, std::string_view interface, std::string* error);
   /// Removes material `number` (false when it is not there).
   bool remove(int number, std::string_view interface, std::string* error);
+  /// The material selected for the machine (the HMI's choice): programs that select none use it;
+  /// 0: none. Kept in the store, so every process sees it.
+  std::optional<int> selected(std::string* error = nullptr);
+  /// Selects material `number` of the chart, or none (0). Audited ("selected"). A change that
+  /// removes the selected material from the chart selects none (audited with it).
+  bool select(int number, std::string_view interface, std::string* error);
   /// The newest `limit` audit entries (0: all), oldest first.
   std::vector<AuditEntry> audit(std::size_t limit = 0, std::string* error = nullptr);
   /// Grows with every commit by any connection: a cache compares it.
