@@ -16,6 +16,7 @@ void register_all(CLI::App& app, Registry& registry) {
   add_electrode_command(app, registry);
   add_calibrate_b_command(app, registry);
   add_tools_command(app, registry);
+  add_cutchart_command(app, registry);
   add_nearest_command(app, registry);
   add_serve_command(app, registry);
   add_fleet_command(app, registry);

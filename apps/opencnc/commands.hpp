@@ -37,6 +37,7 @@ void add_run_command(CLI::App& app, Registry& registry);
 void add_plot_command(CLI::App& app, Registry& registry);
 void add_calibrate_command(CLI::App& app, Registry& registry);
 void add_tools_command(CLI::App& app, Registry& registry);  ///< the tool store and its guard
+void add_cutchart_command(CLI::App& app, Registry& registry);  ///< the plasma table's cut chart
 void add_nearest_command(CLI::App& app, Registry& registry);
 void add_edm_command(CLI::App& app, Registry& registry);     ///< edm sequence
 void add_serve_command(CLI::App& app, Registry& registry);   ///< the HMI server

@@ -15,6 +15,12 @@
 
 namespace opencnc::config {
 
+namespace detail {
+/// [cut_chart], checked (read_cut_chart.cpp; config/cut_chart_profile.hpp reads it for the cutting
+/// feature). Needs [process.plasma].
+void read_cut_chart(Section& top, MachineProfile& profile, const std::filesystem::path& base_dir);
+}  // namespace detail
+
 namespace {
 
 using detail::Bound;
@@ -44,7 +50,7 @@ MachineProfile read_profile(const toml::table& root, Reporter& r, const std::fil
   Section top(root, "", {"name",   "description",  "servo_period_s", "axis",       "spindle",     "power",
                          "probe",  "tool_changer", "process",        "io",         "interpreter", "planner",
                          "sim",    "interlocks",   "handwheel",      "tool_guard", "coupling",    "edm",
-                         "alarms", "tool_change"},
+                         "alarms", "tool_change",  "cut_chart"},
               r);
   MachineProfile p;
   read_identity(top, p);
@@ -67,6 +73,7 @@ MachineProfile read_profile(const toml::table& root, Reporter& r, const std::fil
   detail::read_interpreter(top, p, base_dir);
   detail::read_planner(top, p);
   detail::read_tool_guard(top, p, base_dir);
+  detail::read_cut_chart(top, p, base_dir);
   return p;
 }
 

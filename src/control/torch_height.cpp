@@ -11,13 +11,14 @@ namespace opencnc::control {
 using machine::PlateSensor;
 
 void TorchHeight::configure(const machine::PlasmaConfig& config, double period_s) noexcept {
-  config_ = config;
+  config_ = profile_ = config;
   dt_ = period_s;
   status_ = TorchStatus{};
   begin_run();
 }
 
 void TorchHeight::begin_run() noexcept {
+  config_ = profile_;
   programmed_on_ = false;
   waits_ = hold_request_ = event_pending_ = false;
   offset_ = v_ = 0;
@@ -28,7 +29,7 @@ void TorchHeight::begin_run() noexcept {
   status_.thc_offset_mm = status_.correction_mm = 0;
 }
 
-bool TorchHeight::apply_code(int code, double /*p*/) noexcept {
+bool TorchHeight::apply_code(int code, double p) noexcept {
   switch (code) {
     case machine::kTorchOnCode:
       programmed_on_ = true;
@@ -48,7 +49,7 @@ bool TorchHeight::apply_code(int code, double /*p*/) noexcept {
       status_.thc_hold = false;
       return true;
     default:
-      return false;
+      return apply_chart_code(code, p);
   }
 }
 

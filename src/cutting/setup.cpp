@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "opencnc/cutting/cut_chart.hpp"
 #include "opencnc/cutting/cutting_recorder.hpp"
 #include "opencnc/cutting/torch_codes.hpp"
 
@@ -142,6 +143,7 @@ class State final : public controller::FeatureState {
 bool setup(const config::MachineProfile& profile, controller::MachineSetup& host) {
   if (!profile.plasma.present) return true;
   host.add_source_part(std::make_shared<Part>(profile.plasma.holes));
+  if (!setup_cut_chart(profile, host)) return false;  // M194, G41/G42 by the kerf (after the torch's codes)
   host.add_texts(std::make_shared<Texts>());
   host.add_state(std::make_shared<State>());
   if (host.reports())

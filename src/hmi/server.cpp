@@ -25,6 +25,7 @@
 #include "opencnc/controller/gcode_source.hpp"
 #include "opencnc/hmi/api.hpp"
 #include "opencnc/hmi/api_admin.hpp"
+#include "opencnc/hmi/api_cutchart.hpp"
 #include "opencnc/hmi/history.hpp"
 #include "opencnc/hmi/machine_features.hpp"
 #include "opencnc/hmi/preview.hpp"
@@ -262,6 +263,7 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
   HttpResponse program_text(const HttpRequest& req, const Target& t, Role role);
   HttpResponse programs(const HttpRequest& req, const Target& t, Role role);
   HttpResponse tools_table(const HttpRequest& req, const Target& t, Role role);
+  HttpResponse cut_chart(const HttpRequest& req, const Target& t, Role role);
   HttpResponse events(const HttpRequest& req, const Target& t, Role role);
   HttpResponse command_outcome(const HttpRequest& req, const Target& t, Role role);
   HttpResponse history_jobs(const HttpRequest& req, const Target& t, Role role);
@@ -607,6 +609,11 @@ const Server::Impl::Route& Server::Impl::route_for(std::string_view path) noexce
       {.methods = kGet, .path = "/api/v1/program/preview", .start = &I::preview},
       {.methods = kGet, .path = "/api/v1/programs", .runs = Runs::Blocking, .answer = &I::programs},
       {.methods = kGet, .path = "/api/v1/tools", .answer = &I::tools_table},
+      {.methods = kGet | kPost,
+       .path = "/api/v1/cutchart",
+       .runs = Runs::Blocking,
+       .wrong_method = "GET the cut chart, POST a change",
+       .answer = &I::cut_chart},
       {.methods = kGet, .path = "/api/v1/events", .answer = &I::events},
       {.methods = kPost,
        .path = "/api/v1/commands",
@@ -1006,6 +1013,19 @@ HttpResponse Server::Impl::tools_table(const HttpRequest& req, const Target&, Ro
     }
   }
   return json_response(req, 200, list);
+}
+
+// A plasma table's cut chart: its store read or changed on the blocking pool (api_cutchart.hpp).
+HttpResponse Server::Impl::cut_chart(const HttpRequest& req, const Target&, Role role) {
+  CutChartAnswer a;
+  if (req.method() == http::verb::post) {
+    const json body = json::parse(req.body(), nullptr, false);
+    if (body.is_discarded()) return error_response(req, 400, "the body is not JSON");
+    a = cut_chart_post(*machine(), body, role);
+  } else {
+    a = cut_chart_get(*machine());
+  }
+  return json_response(req, a.status, a.body);
 }
 
 // --- MTConnect (docs/connectivity.md) -------------------------------------------------------

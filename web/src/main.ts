@@ -22,6 +22,7 @@ import "./screens/network";
 import "./screens/electrode";
 import "./screens/compensation";
 import "./screens/conditions";
+import "./screens/cut_charts";
 import type { ControllerEvent, Machine, Status } from "./types";
 import { button, coord, el, offsetsText, outsideWindow, percent, topBarLooks, windowStart } from "./ui";
 import { View3d, type Preview } from "./view3d";

@@ -36,6 +36,9 @@ class TorchHeight {
   /// M190 (torch on: the sequence), M191 (torch off: retract), M192/M193 (hold the height, let
   /// go). False: not one of the torch's codes.
   bool apply_code(int code, double p) noexcept;
+  /// A cut chart's setting (machine/cut_chart_codes.hpp: pierce and cut height, pierce delay,
+  /// arc voltage, puddle jump) in place of the profile's, until the run ends. False: not one.
+  bool apply_chart_code(int code, double p) noexcept;
   /// One period: the Z offset to add to the programmed path.
   double step(const TorchInputs& in) noexcept;
 
@@ -67,6 +70,7 @@ class TorchHeight {
   }
 
   machine::PlasmaConfig config_{};
+  machine::PlasmaConfig profile_{};  ///< as configured: each run starts from it (a chart's values last a run)
   double dt_ = 1e-3;
   TorchStatus status_{};
   bool programmed_on_ = false;  ///< between M190 and M191
