@@ -52,8 +52,10 @@ constexpr const char* kMaterialParam = "_cut_material";
 constexpr const char* kKerfParam = "_cut_kerf";
 constexpr const char* kFeedParam = "_cut_feed";
 // A comment the pass turns into a diagnostic: "<mark>error@m194: message" — severity, the word
-// whose column it points at, the words.
-constexpr std::string_view kMark = "cut chart: ";
+// whose column it points at, the words. The mark opens with a control character (RS) that no
+// comment of a program carries, so a program's own "(cut chart: …)" is never taken for one.
+// (A warning channel in the interpreter's ExecContext would be the cleaner way; see cutting.md.)
+constexpr std::string_view kMark = "\x1e" "cut chart: ";
 
 double to_program(double mm, const gcode::InterpState& st) noexcept {
   return st.modal.units == canon::Units::Inch ? mm / 25.4 : mm;
