@@ -129,6 +129,10 @@ class ProgramBuilder final : public Sink {
   std::uint8_t move_flags() const noexcept;
 
   Program program_;
+  SegmentId last_id_ = 0;      ///< of the last move appended (has_last_id_)
+  std::size_t run_first_ = 0;  ///< the first move of last_id_
+  bool has_last_id_ = false;
+  bool in_split_ = false;  ///< appending the moves of a rigid tap or a NURBS (noted whole)
   /// The last action of each setting the planner reads as it goes: path control, naive-CAM
   /// tolerance, feed override on/off, feed hold on/off, spindle sync on/off.
   enum Setting { kPathControl, kNaiveCam, kFeedOverride, kFeedHold, kSpindleSync, kSettings };
