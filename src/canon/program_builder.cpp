@@ -145,6 +145,7 @@ std::unique_ptr<ProgramBuilder> ProgramBuilder::continuation(const Pose& start) 
   next->rot_sin_ = rot_sin_;
   next->feed_ = feed_;
   next->feed_mode_ = feed_mode_;
+  next->split_repeats_ = split_repeats_;
   next->synced_ = synced_;
   next->css_max_rpm_ = css_max_rpm_;
   next->spindle_speed_ = spindle_speed_;
@@ -192,7 +193,7 @@ void ProgramBuilder::append(MoveKind kind, SegmentId id, std::uint32_t param, st
   // except where a segment is split (recorded by note_split).
   // A move with the id of the one before it (from straight_feed, arc_feed or straight_traverse)
   // continues its segment: a pass over the calls split it (rigid taps and NURBS note their own).
-  const bool continues = !program_.empty() && has_last_id_ && id == last_id_ && !in_split_;
+  const bool continues = split_repeats_ && !program_.empty() && has_last_id_ && id == last_id_ && !in_split_;
   if (program_.empty()) program_.set_first_segment(id);
   if (!continues) run_first_ = program_.size();
   last_id_ = id;

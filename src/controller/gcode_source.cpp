@@ -174,7 +174,9 @@ class Pipeline {
       tees_.push_back(std::make_unique<canon::TeeSink>(*sink_, *pass_sinks_.back()));
       sink_ = tees_.back().get();
     }
-    // Before the builder, the features' passes over the calls, in their order.
+    // Before the builder, the features' passes over the calls, in their order; the pieces of a
+    // move they split keep its segment id, which the builder notes as a split.
+    builder_->note_repeated_ids_as_splits(!call_passes_.empty());
     for (auto it = call_passes_.rbegin(); it != call_passes_.rend(); ++it) {
       (*it)->set_next(*sink_);
       sink_ = it->get();
