@@ -101,6 +101,13 @@ void Program::release_before(std::size_t move, std::size_t action) {
 
 void Program::note_split(SegmentId segment, std::size_t first_move, std::size_t moves) {
   if (moves <= 1) return;
+  // The same split again with more moves (a segment noted as it grows): the last note grows.
+  if (!splits_.empty() && splits_.back().segment == segment && splits_.back().first_move == first_move) {
+    Split& s = splits_.back();
+    s.extra += moves - s.moves;
+    s.moves = moves;
+    return;
+  }
   const std::size_t before = splits_.empty() ? 0 : splits_.back().extra;
   splits_.push_back({segment, first_move, moves, before + moves - 1});
 }

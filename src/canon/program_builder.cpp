@@ -145,6 +145,7 @@ std::unique_ptr<ProgramBuilder> ProgramBuilder::continuation(const Pose& start) 
   next->rot_sin_ = rot_sin_;
   next->feed_ = feed_;
   next->feed_mode_ = feed_mode_;
+  next->split_repeats_ = split_repeats_;
   next->synced_ = synced_;
   next->css_max_rpm_ = css_max_rpm_;
   next->spindle_speed_ = spindle_speed_;
@@ -190,7 +191,13 @@ std::uint32_t ProgramBuilder::current_feed_index() {
 void ProgramBuilder::append(MoveKind kind, SegmentId id, std::uint32_t param, std::uint8_t extra_flags) {
   // Ids are ordinals: after the first move, the program's count follows the interpreter's
   // except where a segment is split (recorded by note_split).
+  // A move with the id of the one before it (from straight_feed, arc_feed or straight_traverse)
+  // continues its segment: a pass over the calls split it (rigid taps and NURBS note their own).
+  const bool continues = split_repeats_ && !program_.empty() && has_last_id_ && id == last_id_ && !in_split_;
   if (program_.empty()) program_.set_first_segment(id);
+  if (!continues) run_first_ = program_.size();
+  last_id_ = id;
+  has_last_id_ = true;
   Move& m = program_.append(position_);
   m.kind = kind;
   m.flags = static_cast<std::uint8_t>((kind == MoveKind::Traverse ? 0 : move_flags()) | extra_flags);
@@ -198,6 +205,7 @@ void ProgramBuilder::append(MoveKind kind, SegmentId id, std::uint32_t param, st
   m.context = origin_.context;
   m.line = origin_.line;
   m.param = param;
+  if (continues) program_.note_split(id, run_first_, program_.size() - run_first_);
 }
 
 void ProgramBuilder::straight_traverse(SegmentId id, const Pose& end) {
@@ -219,6 +227,7 @@ void ProgramBuilder::rigid_tap(SegmentId id, const Pose& end, double scale) {
   // The tap goes in to `end`, reverses and comes back: two moves of one segment, so that the
   // next move starts where the tap started. Their feed is the way out's speed factor.
   const Pose start = position_;
+  in_split_ = true;
   const std::uint32_t factor = program_.add_feed(scale);
   last_feed_mm_ = -1;  // later moves refer to a feed added after this one (streams release in order)
   const std::size_t first = program_.size();
@@ -226,6 +235,7 @@ void ProgramBuilder::rigid_tap(SegmentId id, const Pose& end, double scale) {
   append(MoveKind::RigidTap, id, factor);
   position_ = start;
   append(MoveKind::RigidTap, id, factor, kTapReturn);
+  in_split_ = false;
   program_.note_split(id, first, 2);
 }
 
@@ -274,11 +284,13 @@ void ProgramBuilder::nurbs_feed(SegmentId id, int order, std::span<const NurbsPo
   if (chords.empty()) chords.push_back({machine.back().x, machine.back().y, 0});
   const std::size_t first = program_.size();
   const std::uint32_t feed = current_feed_index();
+  in_split_ = true;
   for (const CurvePoint& v : chords) {
     position_[0] = v.x;
     position_[1] = v.y;
     append(MoveKind::Feed, id, feed, kCurveChord);
   }
+  in_split_ = false;
   program_.note_split(id, first, chords.size());
 }
 

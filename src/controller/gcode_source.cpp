@@ -122,8 +122,10 @@ class Pipeline {
   Pipeline(gcode::Interpreter& interp, const Pose& start, double tolerance_mm, tools::ToolTableService* tools,
            const SourceParts& parts)
       : interp_(&interp), tolerance_mm_(tolerance_mm), writer_(tools) {
-    for (const auto& part : parts)
+    for (const auto& part : parts) {
       if (std::unique_ptr<MovePass> pass = part->pass()) passes_.push_back(std::move(pass));
+      if (std::unique_ptr<CallPass> pass = part->call_pass()) call_passes_.push_back(std::move(pass));
+    }
     auto b = std::make_unique<canon::ProgramBuilder>(interp.options().axes, start);
     b->program().set_sources(interp.sources());
     attach(std::move(b), interp.state().modal.units);
@@ -134,6 +136,11 @@ class Pipeline {
   const canon::Program& program() const noexcept { return builder_->program(); }
   canon::Sink& sink() noexcept { return *sink_; }
   ToolTableWriter& writer() noexcept { return writer_; }
+  /// The interpreter stopped (a sync point, the end, an error): the passes over the calls hand
+  /// on what they hold, in their order.
+  void flush() {
+    for (const auto& pass : call_passes_) pass->flush();
+  }
   /// What the features' passes refused (moves they cannot rewrite), pass by pass.
   void append_pass_failures(Diagnostics& to) const {
     for (const auto& pass : passes_) append(to, pass->failures());
@@ -167,12 +174,20 @@ class Pipeline {
       tees_.push_back(std::make_unique<canon::TeeSink>(*sink_, *pass_sinks_.back()));
       sink_ = tees_.back().get();
     }
+    // Before the builder, the features' passes over the calls, in their order; the pieces of a
+    // move they split keep its segment id, which the builder notes as a split.
+    builder_->note_repeated_ids_as_splits(!call_passes_.empty());
+    for (auto it = call_passes_.rbegin(); it != call_passes_.rend(); ++it) {
+      (*it)->set_next(*sink_);
+      sink_ = it->get();
+    }
   }
 
   gcode::Interpreter* interp_;
   double tolerance_mm_;
   ToolTableWriter writer_;
   std::vector<std::unique_ptr<MovePass>> passes_;
+  std::vector<std::unique_ptr<CallPass>> call_passes_;
   std::unique_ptr<canon::ProgramBuilder> builder_, previous_;
   std::unique_ptr<DefaultTolerance> tolerance_;
   std::unique_ptr<canon::TeeSink> inner_, outer_;
@@ -300,6 +315,7 @@ class GcodeStream final : public ProgramStream {
   }
 
   void on_status(gcode::RunStatus s) {
+    if (s != gcode::RunStatus::Ok) pipe_.flush();
     if (!pipe_.writer().failures().items().empty() || pipe_.passes_failed()) {
       append(diags_, pipe_.writer().failures());
       pipe_.append_pass_failures(diags_);
@@ -435,6 +451,7 @@ class Scan {
         return;
       }
       const gcode::RunStatus s = interp_.run(pipe_.sink(), kBlocksPerCall);
+      if (s != gcode::RunStatus::Ok) pipe_.flush();
       if (s == gcode::RunStatus::Error) ok_ = false;
       if (s == gcode::RunStatus::Error || s == gcode::RunStatus::Finished) done_ = true;
     }

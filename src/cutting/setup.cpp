@@ -9,6 +9,7 @@
 
 #include "opencnc/cutting/cut_chart.hpp"
 #include "opencnc/cutting/cutting_recorder.hpp"
+#include "opencnc/cutting/hole_pass.hpp"
 #include "opencnc/cutting/torch_codes.hpp"
 
 namespace opencnc::cutting {
@@ -73,6 +74,10 @@ class Part final : public controller::SourcePart {
       gcode::Dialect dialect, std::shared_ptr<const gcode::Extensions> base) const override {
     return gcode::torch_extensions(dialect, std::move(base));
   }
+  std::unique_ptr<controller::CallPass> call_pass() const override {
+    if (holes_.diameter_mm <= 0) return nullptr;
+    return std::make_unique<HolePass>(holes_);
+  }
 
  private:
   config::PlasmaHoles holes_;
@@ -122,6 +127,13 @@ class State final : public controller::FeatureState {
   std::string state_key() const override { return "cutting"; }
   std::string state_json(const controller::ControllerStatus& s) override {
     const control::TorchStatus& t = s.servo.torch;
+    // Why the torch stage holds the run, for the HMI's dialog: an arc lost since the torch was
+    // last outside a pause, or a failed start (no arc-OK after its retries, no plate).
+    const bool paused = t.phase == control::TorchPhase::Paused;
+    if (!paused && t.phase != control::TorchPhase::Failed) losses_ = t.arc_losses;
+    const char* reason = t.phase == control::TorchPhase::Failed ? "failed"
+                         : paused && t.arc_losses > losses_     ? "arc-lost"
+                                                                : "";
     return nlohmann::json{{"phase", phase_name(t.phase)},
                           {"thc", thc_name(t.thc)},
                           {"torch_on", t.torch_on},
@@ -133,9 +145,13 @@ class State final : public controller::FeatureState {
                           {"correction_mm", t.correction_mm},
                           {"plate_z_mm", t.plate_z_mm},
                           {"pierces", t.pierces},
-                          {"arc_losses", t.arc_losses}}
+                          {"arc_losses", t.arc_losses},
+                          {"hold_reason", reason}}
         .dump();
   }
+
+ private:
+  std::uint32_t losses_ = 0;  ///< arc losses when the torch was last neither paused nor failed
 };
 
 }  // namespace

@@ -32,10 +32,12 @@ class Samples final : public ControllerObserver {
   void on_trace(const control::TraceSample& s, const TraceContext&) override {
     z.push_back(s.commanded[2]);
     torch.push_back(s.torch);
+    velocity.push_back(s.path_velocity);
     segment = std::max(segment, s.segment);
   }
   std::vector<double> z;
   std::vector<control::TorchStatus> torch;
+  std::vector<double> velocity;
   std::uint64_t segment = 0;
 };
 
@@ -159,6 +161,34 @@ TEST(CuttingScenario, AnArcLossHoldsThenTheResumePiercesAgainAndThePathIsComplet
   EXPECT_GE(c.report.height_in_band_fraction, 0.95);
   EXPECT_NE(std::find(c.notes.begin(), c.notes.end(), "control.torch.arc-lost"), c.notes.end());
   EXPECT_LT(held_z, 10.0) << "held at the cut height, not lifted to the program's";
+}
+
+TEST(CuttingScenario, HolesBelowTheDiameterAreCutAtTheReducedVelocityWithTheHeightHeld) {
+  // [process.plasma.holes]: 32 mm, 60 % — the nest's six 24 and 14 mm holes (F1500: 15 mm/s),
+  // not its 40 mm one nor the outlines (F2400: 40 mm/s).
+  const config::MachineProfile p = table();
+  const Cut c = run(p);
+  ASSERT_TRUE(c.finished);
+  EXPECT_EQ(c.report.holes_slowed, 6u);
+  EXPECT_EQ(c.report.pierces, 12u);
+  double hole_v = 0, other_v = 0;
+  for (std::size_t i = 0; i < c.samples->torch.size(); ++i) {
+    const control::TorchStatus& t = c.samples->torch[i];
+    if (t.phase != control::TorchPhase::Cutting) continue;
+    const double v = c.samples->velocity[i];
+    (t.thc == control::ThcState::ProgramLock ? hole_v : other_v) =
+        std::max(t.thc == control::ThcState::ProgramLock ? hole_v : other_v, v);
+  }
+  EXPECT_LE(hole_v, 0.6 * 1500 / 60.0 + 1e-6) << "holes at 60 % of F1500, shown in the trace";
+  EXPECT_GT(hole_v, 0.6 * 1500 / 60.0 * 0.95);
+  EXPECT_GT(other_v, 1500 / 60.0) << "the rest at its programmed feed";
+  EXPECT_GE(c.report.height_in_band_fraction, 0.95);
+  EXPECT_LE(c.report.max_dive_mm, 0.2);
+  // Without the diameter, the holes are cut as programmed.
+  const Cut plain = run(table({"process.plasma.holes.diameter=0"}));
+  ASSERT_TRUE(plain.finished);
+  EXPECT_EQ(plain.report.holes_slowed, 0u);
+  EXPECT_LT(plain.report.cutting_s, c.report.cutting_s);
 }
 
 TEST(CuttingScenario, RunsAreRepeatableBitForBit) {

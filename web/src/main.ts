@@ -8,9 +8,11 @@ import { renderDialog } from "./dialog_view";
 // The feature dialogs first: the first registered dialog a status wants is shown.
 import "./dialogs/recovery";
 import "./dialogs/toolcheck";
+import "./dialogs/torch_hold";
 import { dialogFor } from "./dialogs/waits";
 import "./panels/process";
 import "./panels/retrace";
+import "./panels/cutting";
 import { programInfo } from "./program_info";
 import { panels, screens, type Context } from "./registry";
 import "./screens/jog";

@@ -80,6 +80,24 @@ export interface RetraceState {
   last: { a: number[] | null; b: number[]; c: number[]; line: string; segment: number; distance_mm: number; candidates: number } | null;
 }
 
+/** The plasma torch (`features.cutting`, docs/cutting.md). */
+export interface CuttingState {
+  phase: string;
+  thc: string;
+  torch_on: boolean;
+  arc_ok: boolean;
+  sensor: boolean;
+  arc_voltage_v: number;
+  target_voltage_v: number;
+  thc_offset_mm: number;
+  correction_mm: number;
+  plate_z_mm: number;
+  pierces: number;
+  arc_losses: number;
+  /** Why the torch stage holds the run: "arc-lost", "failed" (starts or no plate), "" otherwise. */
+  hold_reason?: string;
+}
+
 export interface ElectrodeResult {
   ok: boolean;
   code: string;
@@ -115,4 +133,5 @@ export interface Features {
   electrode?: ElectrodeState;
   tool_guard?: ToolGuardState;
   edm?: { depth_mm: number; burning: boolean };
+  cutting?: CuttingState;
 }

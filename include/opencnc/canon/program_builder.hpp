@@ -21,6 +21,10 @@ class ProgramBuilder final : public Sink {
 
   /// `start` is the machine position (mm) the program starts from.
   explicit ProgramBuilder(AxisMask axes = kXyzabc, const Pose& start = {});
+  /// With `on`, a move appended with the id of the move before it continues that segment (a
+  /// pass over the calls split the move: controller::CallPass) and the program notes the split.
+  /// Off by default: a program built by hand may number every move 0.
+  void note_repeated_ids_as_splits(bool on) noexcept { split_repeats_ = on; }
 
   /// The program built so far; take it when the run has ended.
   Program& program() noexcept { return program_; }
@@ -129,6 +133,11 @@ class ProgramBuilder final : public Sink {
   std::uint8_t move_flags() const noexcept;
 
   Program program_;
+  SegmentId last_id_ = 0;      ///< of the last move appended (has_last_id_)
+  std::size_t run_first_ = 0;  ///< the first move of last_id_
+  bool has_last_id_ = false;
+  bool in_split_ = false;       ///< appending the moves of a rigid tap or a NURBS (noted whole)
+  bool split_repeats_ = false;  ///< note_repeated_ids_as_splits
   /// The last action of each setting the planner reads as it goes: path control, naive-CAM
   /// tolerance, feed override on/off, feed hold on/off, spindle sync on/off.
   enum Setting { kPathControl, kNaiveCam, kFeedOverride, kFeedHold, kSpindleSync, kSettings };

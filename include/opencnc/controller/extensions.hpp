@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "opencnc/canon/pass_through_sink.hpp"
 #include "opencnc/canon/program.hpp"
 #include "opencnc/config/machine_profile.hpp"
 #include "opencnc/control/command.hpp"
@@ -43,6 +44,19 @@ class MovePass {
   virtual const Diagnostics& failures() const = 0;
 };
 
+/// A pass over the canonical calls before the builder: where a MovePass can only rewrite the
+/// moves appended, this one may hold calls back and hand others on in their place — a move split
+/// in pieces (each piece a call with the move's segment id: the builder notes the split), a feed
+/// changed, process codes added. A call it does not override is handed on after `before_call()`,
+/// where a pass hands on what it holds; the hub calls `flush()` when the interpreter stops (a
+/// sync point, the program's or an MDI line's end, an error). One per program stream or scan,
+/// chained before the builder in the parts' order; non-real-time; the builder's thread.
+class CallPass : public canon::PassThroughSink {
+ public:
+  /// Hands on every call held.
+  virtual void flush() = 0;
+};
+
 /// What a feature adds to the G-code program source: code modules of its own (G or M codes) and a
 /// pass over the moves. Immutable: the sources made from one set-up share it, from any thread.
 class SourcePart {
@@ -56,6 +70,8 @@ class SourcePart {
   }
   /// A fresh pass for one program (null: the feature has none).
   virtual std::unique_ptr<MovePass> pass() const { return nullptr; }
+  /// A fresh pass over the calls for one program (null: the feature has none).
+  virtual std::unique_ptr<CallPass> call_pass() const { return nullptr; }
   /// This part for a profile an admin has edited; null when a program reads the same with it.
   virtual std::shared_ptr<const SourcePart> for_profile(const config::MachineProfile& /*profile*/) const {
     return nullptr;
