@@ -77,6 +77,17 @@ struct HolePass::Piece {
     return q;
   }
 
+  /// The same path the other way.
+  Piece reversed() const {
+    Piece p = *this;
+    std::swap(p.start, p.end);
+    if (arc) {
+      p.a0 = a0 + sweep;
+      p.sweep = -sweep;
+    }
+    return p;
+  }
+
   /// The piece from length `s0` to `s1`.
   Piece between(double s0, double s1) const {
     Piece p = *this;
@@ -328,6 +339,10 @@ void HolePass::hand_on_as_hole(const canon::ProcessCode& torch_off) {
   }
   for (const Piece& p : over) cut(p);
   if (!off) next_->process_code(torch_off);
+  // Back along the overcut, the torch out, to where the program's contour ended: the interpreter
+  // goes on from there (an arc after the hole starts where it thinks), and the way back stays in
+  // the kerf just cut.
+  for (auto p = over.rbegin(); p != over.rend(); ++p) emit_piece(p->reversed());
   for (std::size_t i = last_move + 1; i < held.size(); ++i) {
     if (held[i].kind == Held::Kind::Block) next_->begin_block(held[i].origin);
     if (held[i].kind == Held::Kind::Feed) feed_ = held[i].rate;
@@ -337,7 +352,7 @@ void HolePass::hand_on_as_hole(const canon::ProcessCode& torch_off) {
   release.group = machine::kThcHoldCode;
   next_->process_code(release);
   next_->set_feed_rate(feed_);
-  if (!over.empty()) pos_ = over.back().end;
+  pos_ = held[last_move].end;
   ++holes_;
 }
 

@@ -113,8 +113,9 @@ TEST(HolePass, ASmallHoleIsSlowedHeldOvercutAndPutOutBeforeItsEnd) {
   pass.straight_traverse(id++, at(0, 0));
   pass.flush();
   EXPECT_EQ(pass.holes(), 1);
-  // M190, the hold, the lead-in, the circle, the overcut with the torch out 2 mm before its end.
-  EXPECT_EQ(sequence(out), "rapid M190 M192 line arc arc M191 arc M193 rapid ");
+  // M190, the hold, the lead-in, the circle, the overcut with the torch out 2 mm before its end,
+  // back along the overcut to the contour's end (where the interpreter goes on from).
+  EXPECT_EQ(sequence(out), "rapid M190 M192 line arc arc M191 arc arc M193 rapid ");
   double cut = 0, after_off = 0;
   bool off = false;
   for (const auto& c : out.calls) {
@@ -126,11 +127,38 @@ TEST(HolePass, ASmallHoleIsSlowedHeldOvercutAndPutOutBeforeItsEnd) {
   }
   const double circle = 2 * std::numbers::pi * 12;
   EXPECT_NEAR(cut, 12 + circle + 4 - 2, 1e-6) << "lead-in, the turn, the overcut up to the arc-off point";
-  EXPECT_NEAR(after_off, 2, 1e-6);
+  EXPECT_NEAR(after_off, 2 + 4, 1e-6) << "the overcut's last 2 mm, then its 4 mm back";
+  EXPECT_NEAR(out.calls[8].end[0], 112, 1e-9) << "back at the circle's start and end";
+  EXPECT_NEAR(out.calls[8].end[1], 100, 1e-9);
   EXPECT_NEAR(out.calls.back().feed, 1500, 1e-9) << "the programmed feed again after the hole";
   // The overcut's pieces carry the circle's segment id (the builder notes the split).
   EXPECT_EQ(out.calls[5].id, out.calls[4].id);
   EXPECT_EQ(out.calls[7].id, out.calls[4].id);
+  EXPECT_EQ(out.calls[8].id, out.calls[4].id);
+}
+
+// After a hole the pass stands where the program's contour ended: an arc that follows it (no
+// rapid between) starts there, on its own circle.
+TEST(HolePass, AnArcAfterAHoleStartsWhereTheProgramSaysItDoes) {
+  Recorder out;
+  HolePass pass(holes());
+  pass.set_next(out);
+  canon::SegmentId id = 0;
+  hole(pass, 100, 100, 12, id);
+  canon::ArcFeed a;
+  a.plane = canon::Plane::XY;
+  a.first_end = 112;
+  a.second_end = 120;
+  a.first_center = 112;
+  a.second_center = 110;
+  a.rotation = 1;
+  a.axis_end = 15;
+  a.end = at(112, 120);
+  pass.arc_feed(id++, a);  // a half circle of radius 10 from (112, 100)
+  pass.flush();
+  const auto& last = out.calls.back();
+  ASSERT_EQ(last.what, "arc");
+  EXPECT_NEAR(last.length, std::numbers::pi * 10, 1e-9) << "from (112, 100): its radius is 10 at both ends";
 }
 
 TEST(HolePass, LargeOrOpenCutsAreHandedOnUnchanged) {
@@ -173,13 +201,14 @@ TEST(HolePass, TheBuilderNotesASegmentSplitByAPass) {
   pass.straight_traverse(id++, at(0, 0));
   pass.flush();
   const canon::Program& p = b.program();
-  // rapid, lead-in, the circle, the overcut in two pieces, rapid: 6 moves for 4 segments.
-  ASSERT_EQ(p.size(), 6u);
+  // rapid, lead-in, the circle, the overcut in two pieces (split where the torch goes out) and
+  // back in one, rapid: 7 moves for 4 segments.
+  ASSERT_EQ(p.size(), 7u);
   EXPECT_EQ(p.segment_of(2), 2u);
-  EXPECT_EQ(p.segment_of(4), 2u);
-  EXPECT_EQ(p.segment_of(5), 3u) << "the rapid after the hole keeps its id";
-  EXPECT_EQ(p.first_move_of(3), 5u);
-  EXPECT_EQ(p.moves_of(2), 3u);
+  EXPECT_EQ(p.segment_of(5), 2u);
+  EXPECT_EQ(p.segment_of(6), 3u) << "the rapid after the hole keeps its id";
+  EXPECT_EQ(p.first_move_of(3), 6u);
+  EXPECT_EQ(p.moves_of(2), 4u);
 }
 
 }  // namespace
