@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Plasma cutting's part of `opencnc run`: arc losses injected into the simulated plate
-// (--inject arc-loss@SECONDS), the operator who answers them (resume where the run held), and the run's
+// (--inject arc-loss@SECONDS), the operator who answers them and a float switch that tripped (resume
+// where the run held), and the run's
 // `cutting` report (docs/cutting.md).
 #include <fmt/format.h>
 
@@ -63,21 +64,24 @@ class CuttingRun final : public RunFeature {
   }
 
  private:
-  // The operator at an arc loss: the run stands held on its path with the torch out, at the
-  // nearest point of the path to where the arc went out; a resume finds the plate and pierces
-  // again there (the torch stage), and the cut goes on.
+  // The operator at an arc loss or a float switch that tripped while the torch burned (a plate
+  // that rose into it): the run stands held on its path with the torch out; a resume finds the
+  // plate and pierces again there (the torch stage), and the cut goes on. (A breakaway, or
+  // failed starts, need a person: those holds are left standing.)
   void operate(controller::Controller& c, const controller::ControllerStatus& st) {
     using controller::Request;
     if (asked_ != 0 && !c.outcome(asked_)) return;
     if (asked_ != 0) {
       if (!c.outcome(asked_)->accepted)
-        fmt::print(stderr, "error: the resume after the arc loss was refused: {}\n",
+        fmt::print(stderr, "error: the resume after the torch's hold was refused: {}\n",
                    c.outcome(asked_)->message);
       asked_ = 0;
     }
+    const control::TorchStatus& t = st.servo.torch;
     const bool held = st.servo.state == control::State::Held && st.servo.path_velocity == 0;
-    if (st.servo.torch.arc_losses == losses_seen_ || !held || !st.run_active) return;
-    losses_seen_ = st.servo.torch.arc_losses;
+    if ((t.arc_losses == losses_seen_ && t.float_trips == trips_seen_) || !held || !st.run_active) return;
+    losses_seen_ = t.arc_losses;
+    trips_seen_ = t.float_trips;
     ++recoveries_;
     asked_ = c.submit(Request::simple(control::CommandKind::Resume));
   }
@@ -86,7 +90,7 @@ class CuttingRun final : public RunFeature {
   std::size_t next_ = 0;
   double t0_ = -1;
   std::uint64_t asked_ = 0;
-  std::uint32_t losses_seen_ = 0;
+  std::uint32_t losses_seen_ = 0, trips_seen_ = 0;
   int recoveries_ = 0;
   std::shared_ptr<cutting::CuttingRecorder> recorder_;
 };

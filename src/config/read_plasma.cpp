@@ -141,12 +141,28 @@ void read_plasma_sim(Section& s, MachineProfile& p) {
 void read_plasma(Section& process, MachineProfile& profile) {
   const toml::table* t = process.subtable("plasma");
   if (t == nullptr) return;
-  Section s(
-      *t, "process.plasma",
-      {"arc_voltage_input", "sensor", "sensor_input", "switch_offset", "pierce_height", "pierce_delay_s",
-       "puddle_height", "puddle_delay_s", "cut_height", "probe_speed", "probe_travel", "height_speed",
-       "height_acceleration", "arc_ok_timeout_s", "arc_loss_s", "max_starts", "thc", "holes", "sim"},
-      process.reporter());
+  Section s(*t, "process.plasma",
+            {"arc_voltage_input",
+             "sensor",
+             "sensor_input",
+             "switch_offset",
+             "pierce_height",
+             "pierce_delay_s",
+             "puddle_height",
+             "puddle_delay_s",
+             "cut_height",
+             "probe_speed",
+             "probe_travel",
+             "height_speed",
+             "height_acceleration",
+             "arc_ok_timeout_s",
+             "arc_loss_s",
+             "max_starts",
+             "breakaway_input",
+             "thc",
+             "holes",
+             "sim"},
+            process.reporter());
   PlasmaProfile& pl = profile.plasma;
   machine::PlasmaConfig& c = pl.config;
   pl.present = true;
@@ -163,6 +179,9 @@ void read_plasma(Section& process, MachineProfile& profile) {
       channel(s, "arc_voltage_input", profile.io.analog_inputs, "analog input", machine::kAnalogChannels);
   c.sensor_input =
       channel(s, "sensor_input", profile.io.digital_inputs, "digital input", machine::kDigitalChannels);
+  if (s.has("breakaway_input"))
+    c.breakaway_input =
+        channel(s, "breakaway_input", profile.io.digital_inputs, "digital input", machine::kDigitalChannels);
   c.sensor = s.choice<machine::PlateSensor>(
       "sensor", {{"float", machine::PlateSensor::Float}, {"ohmic", machine::PlateSensor::Ohmic}},
       machine::PlateSensor::Float);

@@ -24,6 +24,7 @@ void Servo::run_torch_height() noexcept {
   in.arc_voltage_v = in_.analog_in[static_cast<std::size_t>(pc.arc_voltage_input)];
   in.arc_ok = in_.process.arc_ok;
   in.sensor = ((in_.digital_in >> pc.sensor_input) & 1u) != 0;
+  in.breakaway = pc.breakaway_input >= 0 && ((in_.digital_in >> pc.breakaway_input) & 1u) != 0;
   commanded_[z] = in.programmed_z + torch_.step(in);
   if (torch_.event_pending()) {
     ServoEvent e;

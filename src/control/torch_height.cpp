@@ -96,6 +96,22 @@ bool TorchHeight::arc_lost(const TorchInputs& in) noexcept {
   return true;
 }
 
+// The breakaway switch in any phase of a cut, or the float switch once the torch burns (pressed
+// down: it touched the plate): torch off, the run held. A resume finds the plate and pierces
+// again where the torch stands (knocked again at once while the breakaway switch stays open).
+bool TorchHeight::knocked(const TorchInputs& in) noexcept {
+  const TorchPhase p = status_.phase;
+  const bool burning = p == TorchPhase::Piercing || p == TorchPhase::Puddle || p == TorchPhase::ToCut ||
+                       p == TorchPhase::Cutting;
+  const bool floated = burning && in.sensor && config_.sensor == PlateSensor::Float;
+  if (!in.breakaway && !floated) return false;
+  status_.torch_on = false;
+  ++(in.breakaway ? status_.breakaways : status_.float_trips);
+  tell(in.breakaway ? TorchEvent::Breakaway : TorchEvent::FloatTripped, status_.thc_offset_mm, true);
+  enter(TorchPhase::Paused);
+  return true;
+}
+
 double TorchHeight::step(const TorchInputs& in) noexcept {
   hold_request_ = event_pending_ = false;
   programmed_z_ = in.programmed_z;
@@ -117,6 +133,8 @@ double TorchHeight::step(const TorchInputs& in) noexcept {
   if (in.hold && sequencing) {  // a feed hold puts the torch out; a resume pierces again here
     status_.torch_on = false;
     enter(TorchPhase::Paused);
+  } else if (sequencing) {
+    knocked(in);
   }
   waits_ = false;
   switch (status_.phase) {

@@ -27,10 +27,14 @@ void CuttingRecorder::on_trace(const control::TraceSample& s, const controller::
     pierces0_ = t.pierces;
     losses0_ = t.arc_losses;
     failed0_ = t.failed_starts;
+    trips0_ = t.float_trips;
+    breakaways0_ = t.breakaways;
   }
   r_.pierces = t.pierces - pierces0_;
   r_.arc_losses = t.arc_losses - losses0_;
   r_.failed_starts = t.failed_starts - failed0_;
+  r_.float_trips = t.float_trips - trips0_;
+  r_.breakaways = t.breakaways - breakaways0_;
   if (t.thc_hold && !hold_before_) ++r_.holes_slowed;
   hold_before_ = t.thc_hold;
   if (t.thc == control::ThcState::VoidLock && thc_before_ != control::ThcState::VoidLock) ++r_.void_locks;
@@ -66,11 +70,12 @@ std::string CuttingRecorder::report_text() const {
   return fmt::format(
       "cutting             {:.2f} s, height within ±0.1 mm of the cut height {:.2f} % ({}), deepest dive "
       "{:.3f} mm, highest rise {:.3f} mm, THC correcting {:.1f} %\n"
-      "cutting torch       {} pierces, {} failed starts, {} arc losses, {} kerf/void locks, {} holes "
-      "slowed\n",
+      "cutting torch       {} pierces, {} failed starts, {} arc losses, {} float trips, {} breakaways, {} "
+      "kerf/void locks, {} holes slowed\n",
       r.cutting_s, 100 * r.height_in_band_fraction,
       r.height_measured ? "above the simulated plate" : "from the arc voltage", r.max_dive_mm, r.max_rise_mm,
-      100 * r.thc_active_fraction, r.pierces, r.failed_starts, r.arc_losses, r.void_locks, r.holes_slowed);
+      100 * r.thc_active_fraction, r.pierces, r.failed_starts, r.arc_losses, r.float_trips, r.breakaways,
+      r.void_locks, r.holes_slowed);
 }
 
 std::string CuttingRecorder::report_json() const {
@@ -83,6 +88,8 @@ std::string CuttingRecorder::report_json() const {
                         {"arc_losses", r.arc_losses},
                         {"pierces", r.pierces},
                         {"failed_starts", r.failed_starts},
+                        {"float_trips", r.float_trips},
+                        {"breakaways", r.breakaways},
                         {"holes_slowed", r.holes_slowed},
                         {"void_locks", r.void_locks},
                         {"height_measured", r.height_measured}}

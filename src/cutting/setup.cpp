@@ -108,6 +108,18 @@ class Texts final : public controller::EventTexts {
             fmt::format("plasma: {} starts in a row without arc-OK; the run is held (check the gas, the "
                         "consumables, the work clamp), resume to try again",
                         e.value)};
+      case control::TorchEvent::Breakaway:
+        return controller::EventNote{
+            Severity::Error, "control.torch.breakaway",
+            "plasma: the torch's breakaway switch tripped (it hit a tipped part or the plate); the torch is "
+            "off "
+            "and the run held: seat the torch, then resume to pierce again where it stands, or retrace"};
+      case control::TorchEvent::FloatTripped:
+        return controller::EventNote{
+            Severity::Error, "control.torch.float-tripped",
+            "plasma: the float switch tripped while the torch burned (it touched the plate); the torch is "
+            "off "
+            "and the run held: resume to find the plate and pierce again where it stands, or retrace"};
       case control::TorchEvent::PlateNotFound:
         return controller::EventNote{
             Severity::Error, "control.torch.no-plate",
@@ -130,10 +142,16 @@ class State final : public controller::FeatureState {
     // Why the torch stage holds the run, for the HMI's dialog: an arc lost since the torch was
     // last outside a pause, or a failed start (no arc-OK after its retries, no plate).
     const bool paused = t.phase == control::TorchPhase::Paused;
-    if (!paused && t.phase != control::TorchPhase::Failed) losses_ = t.arc_losses;
-    const char* reason = t.phase == control::TorchPhase::Failed ? "failed"
-                         : paused && t.arc_losses > losses_     ? "arc-lost"
-                                                                : "";
+    if (!paused && t.phase != control::TorchPhase::Failed) {
+      losses_ = t.arc_losses;
+      breakaways_ = t.breakaways;
+      float_trips_ = t.float_trips;
+    }
+    const char* reason = t.phase == control::TorchPhase::Failed   ? "failed"
+                         : paused && t.breakaways > breakaways_   ? "breakaway"
+                         : paused && t.float_trips > float_trips_ ? "float"
+                         : paused && t.arc_losses > losses_       ? "arc-lost"
+                                                                  : "";
     return nlohmann::json{{"phase", phase_name(t.phase)},
                           {"thc", thc_name(t.thc)},
                           {"torch_on", t.torch_on},
@@ -151,7 +169,8 @@ class State final : public controller::FeatureState {
   }
 
  private:
-  std::uint32_t losses_ = 0;  ///< arc losses when the torch was last neither paused nor failed
+  // The torch's counts when it was last neither paused nor failed.
+  std::uint32_t losses_ = 0, breakaways_ = 0, float_trips_ = 0;
 };
 
 }  // namespace

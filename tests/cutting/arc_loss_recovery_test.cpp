@@ -183,5 +183,23 @@ TEST(ArcLossRecovery, AnArcLostMidPartIsRetracedBackAlongThePathPiercedAgainAndT
   EXPECT_EQ(uncut_points(*r.kerf), 0) << "the part's whole outline is cut";
 }
 
+// The torch's breakaway switch (digital input 1 of plasma-table.toml) trips mid-part: the torch
+// stage puts the torch out and holds; the operator seats the torch (the switch closes again) and
+// answers with the retrace: the part is completed as after an arc loss.
+TEST(ArcLossRecovery, ABreakawayMidPartHoldsAndTheRetraceCompletesThePart) {
+  const Recovery whole = run({}, {}, 0);
+  ASSERT_TRUE(whole.finished);
+  const Recovery r = run([](SimRig& rig) { rig.machine().set_digital_input(1, true); },
+                         [](SimRig& rig) { rig.machine().set_digital_input(1, false); }, -20);
+  ASSERT_TRUE(r.finished);
+  EXPECT_TRUE(r.refused.empty()) << r.refused.front();
+  EXPECT_NE(std::find(r.notes.begin(), r.notes.end(), "control.torch.breakaway"), r.notes.end());
+  EXPECT_EQ(std::find(r.notes.begin(), r.notes.end(), "control.torch.arc-lost"), r.notes.end())
+      << "the torch was put out, not lost";
+  EXPECT_EQ(r.program_ends_finished, 1);
+  EXPECT_EQ(r.pierces, whole.pierces + 1) << "pierced again at C";
+  EXPECT_EQ(uncut_points(*r.kerf), 0) << "the part's whole outline is cut";
+}
+
 }  // namespace
 }  // namespace opencnc::controller::test

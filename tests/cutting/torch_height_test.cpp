@@ -176,6 +176,38 @@ TEST(TorchHeight, AnArcLossPutsTheTorchOutHoldsAndAResumePiercesAgain) {
   EXPECT_EQ(t.status().pierces, 2u);
 }
 
+TEST(TorchHeight, TheBreakawayOrTheFloatSwitchWhileBurningPutsTheTorchOutAndHolds) {
+  for (const bool breakaway : {true, false}) {
+    World w;
+    TorchHeight t = cutting(w);
+    TorchInputs in = w.inputs(t);
+    (breakaway ? in.breakaway : in.sensor) = true;  // knocked, or the torch pressed down on the plate
+    t.step(in);
+    ASSERT_TRUE(t.event_pending());
+    EXPECT_EQ(t.event(), breakaway ? TorchEvent::Breakaway : TorchEvent::FloatTripped);
+    EXPECT_TRUE(t.hold_requested());
+    EXPECT_FALSE(t.torch_on());
+    EXPECT_EQ(t.status().phase, TorchPhase::Paused);
+    EXPECT_EQ(t.status().breakaways, breakaway ? 1u : 0u);
+    EXPECT_EQ(t.status().float_trips, breakaway ? 0u : 1u);
+    in = w.inputs(t);
+    in.hold = true;            // the tick holds the run
+    in.breakaway = breakaway;  // still open while held: told once
+    t.step(in);
+    EXPECT_FALSE(t.event_pending()) << "told once";
+    ASSERT_TRUE(run(t, w, 20000, [&] { return t.status().phase == TorchPhase::Cutting; }));
+    EXPECT_EQ(t.status().pierces, 2u) << "a resume pierces again";
+  }
+}
+
+// The float switch is the probe's own signal while the torch looks for the plate: no trip there.
+TEST(TorchHeight, TheFloatSwitchWhileProbingIsThePlateNotATrip) {
+  World w;
+  TorchHeight t = cutting(w);
+  EXPECT_EQ(t.status().float_trips, 0u);
+  EXPECT_EQ(t.status().pierces, 1u);
+}
+
 TEST(TorchHeight, TooManyFailedStartsHoldTheRun) {
   World w;
   w.arc = false;

@@ -58,6 +58,14 @@ describe("torch hold dialog", () => {
     const bare = { ...s, features: { installed: ["cutting"], cutting: s.features!.cutting } } as Status;
     expect(dialogFor(bare)!.actions(bare).map((a) => a.label)).toEqual(["Resume here", "Abort"]);
   });
+  it("names a breakaway and a torch that touched the plate, with the same choices", () => {
+    const knocked = at({ phase: "paused", torch_on: false, hold_reason: "breakaway" }, { state: "held" });
+    expect(dialogFor(knocked)!.title(knocked)).toBe("Torch breakaway");
+    expect(dialogFor(knocked)!.text(knocked)).toContain("Seat the torch first");
+    expect(dialogFor(knocked)!.actions(knocked).map((a) => a.label)).toEqual(["Retrace", "Resume here", "Abort"]);
+    const touched = at({ phase: "paused", torch_on: false, hold_reason: "float" }, { state: "held" });
+    expect(dialogFor(touched)!.title(touched)).toBe("Torch touched the plate");
+  });
   it("steps aside for the operator's feed hold and while the retrace acts", () => {
     const hold = at({ phase: "paused", torch_on: false }, { state: "held" });
     expect(dialogFor(hold)!.id).toBe("feed-hold");

@@ -21,7 +21,8 @@ struct TorchInputs {
   double feed = 0;           ///< the block's programmed feed times the override (0: a rapid or a marker)
   double arc_voltage_v = 0;
   bool arc_ok = false;
-  bool sensor = false;  ///< float switch or ohmic contact
+  bool sensor = false;     ///< float switch or ohmic contact
+  bool breakaway = false;  ///< the torch's breakaway switch (its mount knocked out of place)
 };
 
 /// The torch stage. Servo thread only; every member is real-time safe and allocates nothing.
@@ -59,6 +60,7 @@ class TorchHeight {
   void enter(TorchPhase p) noexcept;
   void tell(TorchEvent e, double value, bool hold) noexcept;
   bool arc_lost(const TorchInputs& in) noexcept;
+  bool knocked(const TorchInputs& in) noexcept;
   bool move_to(double target) noexcept;  // true once there and at rest
   void probe(const TorchInputs& in) noexcept;
   void ignite(const TorchInputs& in) noexcept;

@@ -41,6 +41,8 @@ enum class TorchEvent : std::uint8_t {
   StartFailed,      ///< no arc-OK within the timeout; `value` = starts failed in a row
   StartsExhausted,  ///< too many failed starts: feed hold
   PlateNotFound,    ///< the probe went its whole travel without the switch: feed hold
+  Breakaway,        ///< the torch's breakaway switch (it hit something): torch off, feed hold
+  FloatTripped,     ///< the float switch while the torch burns (it touched the plate): torch off, feed hold
 };
 
 struct TorchStatus {
@@ -60,6 +62,8 @@ struct TorchStatus {
   std::uint32_t pierces = 0;      ///< pierces begun (arc established) since the machine started
   std::uint32_t arc_losses = 0;   ///< arcs lost while cutting
   std::uint32_t failed_starts = 0;
+  std::uint32_t breakaways = 0;   ///< breakaway switch trips during a cut
+  std::uint32_t float_trips = 0;  ///< float switch trips while the torch burned
 };
 
 static_assert(std::is_trivially_copyable_v<TorchStatus>);

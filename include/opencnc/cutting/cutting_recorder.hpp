@@ -26,6 +26,8 @@ struct CuttingReport {
   std::uint64_t arc_losses = 0;
   std::uint64_t pierces = 0;
   std::uint64_t failed_starts = 0;
+  std::uint64_t float_trips = 0;   ///< the float switch while the torch burned (the torch touched the plate)
+  std::uint64_t breakaways = 0;    ///< the torch's breakaway switch during a cut
   std::uint64_t holes_slowed = 0;  ///< the height held by the program (M192) at a slowed hole
   std::uint64_t void_locks = 0;    ///< times a voltage jump held the height (kerf crossings)
   bool height_measured = false;    ///< true: from the simulated plate; false: from the arc voltage
@@ -52,7 +54,7 @@ class CuttingRecorder final : public controller::ControllerObserver, public cont
   CuttingReport r_;
   std::uint64_t cutting_ = 0, in_band_ = 0, active_ = 0;
   bool first_ = true;
-  std::uint32_t pierces0_ = 0, losses0_ = 0, failed0_ = 0;
+  std::uint32_t pierces0_ = 0, losses0_ = 0, failed0_ = 0, trips0_ = 0, breakaways0_ = 0;
   bool hold_before_ = false;
   control::ThcState thc_before_ = control::ThcState::Off;
 };

@@ -61,7 +61,7 @@ struct PlasmaConfig {
   std::int32_t max_starts = 3;  ///< failed starts in a row before the run is held
   std::int32_t enabled = 0;     ///< 1: the machine has [process.plasma]
   std::int32_t thc = 1;         ///< 0: the height stays where the probe put it (no THC)
-  std::int32_t reserved = 0;
+  std::int32_t breakaway_input = -1;  ///< digital input of the torch's breakaway switch (-1: none)
 };
 
 static_assert(std::is_trivially_copyable_v<PlasmaConfig>);

@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The plasma torch's own hold (the arc lost, too many failed starts, no plate): why the cut stopped,
-// and the choices — retrace (pause: the torch up at the safe height, then the retrace panel steps
-// back along the path and cuts on from the nearest point), resume where it stands (the torch finds
-// the plate and pierces again there), or abort. Registered before the generic feed-hold dialog.
+// The plasma torch's own hold (the arc lost, too many failed starts, no plate, the breakaway or the
+// float switch): why the cut stopped, and the choices — retrace (pause: the torch up at the safe
+// height, then the retrace panel steps back along the path and cuts on from the nearest point),
+// resume where it stands (the torch finds the plate and pierces again there), or abort.
+// Registered before the generic feed-hold dialog.
 import { registerDialog, type DialogAction } from "../registry";
 import type { Status } from "../types";
 
@@ -17,6 +18,8 @@ export function torchHold(s: Status): string {
 const kTexts: Record<string, [string, string]> = {
   "arc-lost": ["Arc lost", "The arc went out while cutting: the torch is off and the machine stands on the path."],
   failed: ["Torch start failed", "The torch could not start (no arc-OK after its retries, or no plate found): the run is held."],
+  breakaway: ["Torch breakaway", "The torch's breakaway switch tripped (it hit a tipped part or the plate): the torch is off. Seat the torch first."],
+  float: ["Torch touched the plate", "The float switch tripped while the torch burned: the torch is off and the machine stands on the path."],
 };
 
 registerDialog({
