@@ -77,13 +77,15 @@ struct Recovery {
   double fault_x = 0;  ///< where the fault came, on the outline's lower edge
   std::vector<std::string> notes, refused;
   std::uint32_t pierces = 0;
+  Pose paused_at{}, moved_to{};  ///< the torch after the pause, and after the jog or the step
 };
 
 /// The nest on the plasma table; `fault` (if any) is called once, on the first part's lower edge
 /// at X > 200, cutting; then the retrace: pause, the torch jogged `back_mm` in X, start (to the
-/// nearest point of the path).
+/// nearest point of the path) — or, with `by_step`, the retrace's own step `back_mm` along the
+/// path from where the run held.
 Recovery run(const std::function<void(SimRig&)>& fault, const std::function<void(SimRig&)>& cleared,
-             double back_mm) {
+             double back_mm, bool by_step = false) {
   Recovery r;
   const config::MachineProfile profile =
       control::test::loaded(config::load_profile(OPENCNC_SOURCE_DIR "/configs/plasma-table.toml", {}));
@@ -140,11 +142,14 @@ Recovery run(const std::function<void(SimRig&)>& fault, const std::function<void
             return false;
           case 2:  // paused: torch out, up at the safe height; jogged back over the path
             if (!paused) return false;
-            asked = rig.controller().submit(Request::jog_by(Axis::X, back_mm, 100));
+            r.paused_at = s.commanded;
+            asked = rig.controller().submit(by_step ? Request::feature("retrace", "step", recovery::RetraceStep{back_mm})
+                                                    : Request::jog_by(Axis::X, back_mm, 100));
             stage = 3;
             return false;
           case 3:
             if (!paused) return false;
+            r.moved_to = s.commanded;
             asked = rig.controller().submit(Request::feature("retrace", "start"));
             stage = 4;
             return false;
@@ -180,6 +185,24 @@ TEST(ArcLossRecovery, AnArcLostMidPartIsRetracedBackAlongThePathPiercedAgainAndT
   EXPECT_NEAR(rec[0].c[0], rec[0].a[0] - 20, 1e-6) << "20 mm back along the path, before the loss";
   EXPECT_NEAR(rec[0].distance_mm, 0, 1e-6) << "B straight above the path";
   EXPECT_EQ(r.pierces, whole.pierces + 1) << "pierced again at C";
+  EXPECT_EQ(uncut_points(*r.kerf), 0) << "the part's whole outline is cut";
+}
+
+// The retrace's own step from the hold: 20 mm back along the path from where the run held, on
+// the outline's lower edge. The nest's lead-in and the lower edge are collinear lines of one feed,
+// which the planner runs as one block: the run's move and offset name the lead-in, 110 mm into
+// it, and the index must carry the offset on into the edge (it stopped at the lead-in's end).
+TEST(ArcLossRecovery, TheRetracesStepFromTheHoldGoesBackAlongTheEdgeTheRunHeldOn) {
+  const Recovery r = run([](SimRig& rig) { rig.machine().inject_arc_loss(); }, {}, -20, true);
+  ASSERT_TRUE(r.finished);
+  EXPECT_TRUE(r.refused.empty()) << r.refused.front();
+  const std::vector<recovery::RetraceRecord> rec = r.retrace->records();
+  ASSERT_EQ(rec.size(), 1u);
+  EXPECT_NEAR(r.paused_at[1], 100, 1e-6) << "held on the lower edge";
+  EXPECT_NEAR(r.moved_to[1], 100, 1e-6) << "stepped along the lower edge";
+  EXPECT_NEAR(r.moved_to[0], rec[0].a[0] - 20, 1e-6) << "20 mm back from A along the path";
+  EXPECT_NEAR(rec[0].c[0], rec[0].a[0] - 20, 1e-6) << "C where the step ended";
+  EXPECT_NEAR(rec[0].distance_mm, 0, 1e-6);
   EXPECT_EQ(uncut_points(*r.kerf), 0) << "the part's whole outline is cut";
 }
 
