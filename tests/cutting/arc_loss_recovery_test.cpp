@@ -143,8 +143,9 @@ Recovery run(const std::function<void(SimRig&)>& fault, const std::function<void
           case 2:  // paused: torch out, up at the safe height; jogged back over the path
             if (!paused) return false;
             r.paused_at = s.commanded;
-            asked = rig.controller().submit(by_step ? Request::feature("retrace", "step", recovery::RetraceStep{back_mm})
-                                                    : Request::jog_by(Axis::X, back_mm, 100));
+            asked = rig.controller().submit(
+                by_step ? Request::feature("retrace", "step", recovery::RetraceStep{back_mm})
+                        : Request::jog_by(Axis::X, back_mm, 100));
             stage = 3;
             return false;
           case 3:

@@ -196,12 +196,12 @@ TEST(PathIndex, WalkingAlongThePath) {
 TEST(PathIndex, AMovesOffsetGoesOnIntoTheMovesJoinedToIt) {
   const PathIndex ix = index_of(
       "G21 G90 F1000\n"
-      "G0 X0 Y0\n"   // move 0
-      "G1 X10\n"     // 1
-      "G1 X100\n"    // 2: collinear with 1
-      "G1 Y50\n"     // 3
-      "G0 X200\n"    // 4: a rapid
-      "G1 X210\n"    // 5
+      "G0 X0 Y0\n"  // move 0
+      "G1 X10\n"    // 1
+      "G1 X100\n"   // 2: collinear with 1
+      "G1 Y50\n"    // 3
+      "G0 X200\n"   // 4: a rapid
+      "G1 X210\n"   // 5
       "M2\n");
   std::optional<PathPoint> p = ix.at_move(1, 5);
   ASSERT_TRUE(p);
