@@ -1,12 +1,15 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Plasma cutting's part of `opencnc run`: arc losses injected into the simulated plate
-// (--inject arc-loss@SECONDS), the operator who answers them and a float switch that tripped (resume
-// where the run held), and the run's
-// `cutting` report (docs/cutting.md).
+// (--inject arc-loss@SECONDS), the operator who answers them and a float switch that tripped —
+// resume where the run held, or (--hold-retrace-back MM) the retrace: back along the path and cut
+// on from there — and the run's `cutting` report (docs/cutting.md).
 #include <fmt/format.h>
+
+#include <cmath>
 
 #include "opencnc/cutting/cutting_recorder.hpp"
 #include "opencnc/machine/sim_machine.hpp"
+#include "opencnc/retrace/retrace.hpp"
 #include "run_features_parts.hpp"
 
 namespace opencnc::cli {
@@ -15,6 +18,14 @@ namespace {
 
 class CuttingRun final : public RunFeature {
  public:
+  void add_options(CLI::App& run) override {
+    run.add_option(
+           "--hold-retrace-back", back_mm_,
+           "Answer an arc loss or a float switch's trip with the retrace instead of a resume where the "
+           "run held: torch out and up, MM back along the path, start there (pierce again); the report "
+           "lists them as `retraces`")
+        ->check(CLI::PositiveNumber);
+  }
   std::vector<InjectionForm> injections() const override {
     return {
         {"arc-loss@SECONDS",
@@ -42,7 +53,19 @@ class CuttingRun final : public RunFeature {
   bool set_up(controller::MachineSetup& machine) override {
     for (const auto& [observer, options] : machine.observers())
       if (auto r = std::dynamic_pointer_cast<cutting::CuttingRecorder>(observer)) recorder_ = r;
+    if (back_mm_ > 0) {
+      retrace_ = std::dynamic_pointer_cast<recovery::RetraceFeature>(machine.feature("retrace"));
+      if (!retrace_) {
+        fmt::print(
+            stderr,
+            "error: --hold-retrace-back: the machine has no torch to retrace with ([process.cutting])\n");
+        return false;
+      }
+    }
     return true;
+  }
+  bool goes_on(const controller::ControllerEvent& e) const override {
+    return e.end == controller::JobEnd::Aborted && stage_ != Stage::Waiting;
   }
   void tick(controller::Controller& c, const controller::ControllerStatus& st,
             machine::SimMachine* sim) override {
@@ -65,17 +88,38 @@ class CuttingRun final : public RunFeature {
 
  private:
   // The operator at an arc loss or a float switch that tripped while the torch burned (a plate
-  // that rose into it): the run stands held on its path with the torch out; a resume finds the
-  // plate and pierces again there (the torch stage), and the cut goes on. (A breakaway, or
-  // failed starts, need a person: those holds are left standing.)
+  // that rose into it): the run stands held on its path with the torch out. Either a resume finds
+  // the plate and pierces again there (the torch stage), or the retrace takes the torch out and up,
+  // steps back along the path (over the stretch the lost arc may have left uncut) and starts there.
+  // (A breakaway, or failed starts, need a person: those holds are left standing.)
   void operate(controller::Controller& c, const controller::ControllerStatus& st) {
     using controller::Request;
     if (asked_ != 0 && !c.outcome(asked_)) return;
     if (asked_ != 0) {
-      if (!c.outcome(asked_)->accepted)
-        fmt::print(stderr, "error: the resume after the torch's hold was refused: {}\n",
-                   c.outcome(asked_)->message);
+      const controller::Outcome o = *c.outcome(asked_);
       asked_ = 0;
+      if (!o.accepted) {
+        fmt::print(stderr, "error: the answer to the torch's hold was refused: {}\n", o.message);
+        stage_ = Stage::Waiting;
+        return;
+      }
+    }
+    const bool paused_idle = retrace_ && retrace_->phase() == recovery::RetracePhase::Paused &&
+                             st.servo.mode == control::Mode::Manual &&
+                             st.servo.state == control::State::Idle && !st.run_active;
+    switch (stage_) {
+      case Stage::Waiting:
+        break;
+      case Stage::Pausing:
+        if (!paused_idle) return;
+        asked_ = c.submit(Request::feature("retrace", "step", recovery::RetraceStep{-back_mm_}));
+        stage_ = Stage::Stepping;
+        return;
+      case Stage::Stepping:
+        if (!paused_idle) return;
+        asked_ = c.submit(Request::feature("retrace", "start"));
+        stage_ = Stage::Waiting;
+        return;
     }
     const control::TorchStatus& t = st.servo.torch;
     const bool held = st.servo.state == control::State::Held && st.servo.path_velocity == 0;
@@ -83,9 +127,18 @@ class CuttingRun final : public RunFeature {
     losses_seen_ = t.arc_losses;
     trips_seen_ = t.float_trips;
     ++recoveries_;
-    asked_ = c.submit(Request::simple(control::CommandKind::Resume));
+    if (retrace_) {
+      asked_ = c.submit(Request::feature("retrace", "pause"));
+      stage_ = Stage::Pausing;
+    } else {
+      asked_ = c.submit(Request::simple(control::CommandKind::Resume));
+    }
   }
 
+  enum class Stage : std::uint8_t { Waiting, Pausing, Stepping };
+  double back_mm_ = 0;
+  std::shared_ptr<recovery::RetraceFeature> retrace_;
+  Stage stage_ = Stage::Waiting;
   std::vector<double> losses_at_;
   std::size_t next_ = 0;
   double t0_ = -1;

@@ -130,6 +130,7 @@ class RetraceRun final : public RunFeature {
         ->expected(1)
         ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
         ->excludes("--electrode-change")
+        ->excludes("--hold-retrace-back")
         ->check(CLI::Validator(
             [](const std::string& s) {
               return parse_retrace(s)
@@ -144,8 +145,10 @@ class RetraceRun final : public RunFeature {
     return true;
   }
   bool set_up(controller::MachineSetup& machine) override {
-    if (steps_.empty()) return true;
+    // The retraces in the report are also those another feature's operator made (opencnc run
+    // --hold-retrace-back, after an arc loss).
     feature_ = std::dynamic_pointer_cast<recovery::RetraceFeature>(machine.feature("retrace"));
+    if (steps_.empty()) return true;
     if (!feature_) {
       fmt::print(stderr, "error: --retrace: the machine has no torch to retrace with ([process.cutting])\n");
       return false;
@@ -161,11 +164,12 @@ class RetraceRun final : public RunFeature {
   bool report(nlohmann::json& j) override {
     if (!feature_) return true;
     const std::vector<recovery::RetraceRecord> records = feature_->records();
+    if (records.empty() && !script_) return true;
     for (const recovery::RetraceRecord& x : records) {
       fmt::print("retrace             B ({:.3f}, {:.3f}) -> C ({:.4f}, {:.4f}) {:.3f} mm, segment {}, {}\n",
                  x.b[0], x.b[1], x.c[0], x.c[1], x.distance_mm, x.segment, x.line);
     }
-    j["retraces"] = retraces_json(records, script_->times());
+    j["retraces"] = retraces_json(records, script_ ? script_->times() : std::vector<double>{});
     return true;
   }
 

@@ -196,6 +196,7 @@ Refusal Servo::start_run(const Command& c) noexcept {
   interp_.restart(commanded_);
   gap_.begin_run(commanded_);
   torch_.begin_run();
+  if (!c.flag) torch_.forget_interrupted_cut();
   tick_out_ = traj::TickOutput{};
   tick_out_.position = commanded_;
   run_id_ = c.run_id;

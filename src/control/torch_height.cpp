@@ -14,6 +14,7 @@ void TorchHeight::configure(const machine::PlasmaConfig& config, double period_s
   config_ = profile_ = config;
   dt_ = period_s;
   status_ = TorchStatus{};
+  interrupted_target_v_ = 0;
   begin_run();
 }
 
@@ -38,6 +39,7 @@ bool TorchHeight::apply_code(int code, double p) noexcept {
       return true;
     case machine::kTorchOffCode:
       programmed_on_ = false;
+      interrupted_target_v_ = 0;  // the cut has ended as programmed
       status_.torch_on = false;
       retract_target_ = std::max(offset_, 0.0);  // up to the programmed height, never down
       enter(TorchPhase::Retracting);
@@ -54,6 +56,10 @@ bool TorchHeight::apply_code(int code, double p) noexcept {
 }
 
 void TorchHeight::enter(TorchPhase p) noexcept {
+  // A cut that stops burning before its M191 keeps what it had sampled for the cut that goes on.
+  if (status_.phase == TorchPhase::Cutting && p != TorchPhase::Retracting && config_.arc_voltage_v <= 0 &&
+      status_.target_voltage_v > 0)
+    interrupted_target_v_ = status_.target_voltage_v;
   status_.phase = p;
   status_.thc = ThcState::Off;
   timer_s_ = 0;
@@ -175,7 +181,8 @@ double TorchHeight::step(const TorchInputs& in) noexcept {
         cut_offset_ = offset_;
         status_.cut_z_mm = status_.plate_z_mm + config_.cut_height_mm;
         since_cut_s_ = sample_sum_ = sample_s_ = void_timer_s_ = 0;
-        status_.target_voltage_v = config_.arc_voltage_v;
+        status_.target_voltage_v = config_.arc_voltage_v > 0 ? config_.arc_voltage_v : interrupted_target_v_;
+        interrupted_target_v_ = 0;
         last_velocity_ = in.path_velocity;
         enter(TorchPhase::Cutting);
         waits_ = false;  // the path goes on in this very period

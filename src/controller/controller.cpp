@@ -835,7 +835,7 @@ void Controller::resume_program(std::uint64_t id, const requests::ResumeProgram&
           return finish(id, control::Refusal::StartMismatch,
                         "the machine moved while the program was replayed: start it again");
         // Every move is checked before it runs (the preflight's moves began elsewhere).
-        start_job(id, JobKind::Program, name, control::Mode::Auto, std::move(*stream), false);
+        start_job(id, JobKind::Program, name, control::Mode::Auto, std::move(*stream), false, true);
       });
 }
 
@@ -890,7 +890,7 @@ void Controller::poll_features() {
 // --- jobs ------------------------------------------------------------------------------------
 
 void Controller::start_job(std::uint64_t id, JobKind kind, std::string name, control::Mode mode,
-                           std::unique_ptr<ProgramStream> stream, bool prechecked) {
+                           std::unique_ptr<ProgramStream> stream, bool prechecked, bool resumes) {
   if (servo().mode != mode) {
     // A program started from Manual or MDI: the mode follows, ahead of the StartRun in the queue.
     control::Command m;
@@ -909,6 +909,9 @@ void Controller::start_job(std::uint64_t id, JobKind kind, std::string name, con
   host.readahead_moves = static_cast<std::size_t>(std::max(1, profile_.interpreter.readahead_moves));
   host.readahead_s = profile_.interpreter.readahead_s;
   host.prechecked = prechecked;
+  // A feature's auxiliary moves (a retrace's way to C) stand between an interrupted program and
+  // its resume: they keep its process state as well.
+  host.continues = resumes || kind == JobKind::Auxiliary;
   host.next_command_id = [this] { return new_id(); };
   host.log = [this](ControllerEvent e) { log(std::move(e)); };
   host.send = [this](const control::Command& c) { return send(c); };

@@ -82,6 +82,7 @@ bool Job::begin_leg(std::uint64_t command_id, Diagnostics& diags) {
   c.seq = first_leg ? host_.request_seq : 0;
   c.run_id = leg_.run_id;
   c.run_mode = mode_;
+  c.flag = first_leg && host_.continues;
   c.first_block = host_.channels->blocks.pushed();
   c.first_action = host_.channels->actions.pushed();
   push_actions();

@@ -36,6 +36,9 @@ struct JobHost {
   /// so they are not checked twice. After a sync point the real answers may differ from the
   /// assumed ones: every move is checked again.
   bool prechecked = false;
+  /// The job's first run continues an interrupted program's process (StartRun's `flag`): a resume
+  /// at a segment, or a feature's auxiliary moves between the interruption and that resume.
+  bool continues = false;
   std::function<std::uint64_t()> next_command_id;
   std::function<void(ControllerEvent)> log;
   /// Sends a servo command; false when the queue is full.

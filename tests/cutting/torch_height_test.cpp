@@ -176,6 +176,65 @@ TEST(TorchHeight, AnArcLossPutsTheTorchOutHoldsAndAResumePiercesAgain) {
   EXPECT_EQ(t.status().pierces, 2u);
 }
 
+/// An arc loss while cutting, held and resumed (the tick's hold, then none).
+void lose_the_arc_and_resume(TorchHeight& t, World& w) {
+  w.arc = false;
+  for (int i = 0; i < 20 && t.status().phase != TorchPhase::Paused; ++i) t.step(w.inputs(t));
+  ASSERT_EQ(t.status().phase, TorchPhase::Paused);
+  TorchInputs in = w.inputs(t);
+  in.hold = true;
+  t.step(in);
+  w.arc = true;
+}
+
+// The cut that goes on after an arc loss — pierced again where it held, or at a retrace's point
+// back over the kerf it had cut (a voltage 25 V higher there) — keeps the voltage it had sampled
+// on the plate: sampled over the kerf, the height would be held too high (a void lock) on solid
+// plate for the rest of the cut. A cut ended by its M191, or a run that does not resume the
+// program, samples its own.
+TEST(TorchHeight, ACutGoingOnAfterAnInterruptionKeepsTheVoltageItHadSampled) {
+  World w;
+  TorchHeight t = cutting(w);
+  const double sampled = t.status().target_voltage_v;
+  ASSERT_GT(sampled, 0);
+  lose_the_arc_and_resume(t, w);
+  t.begin_run();  // the retrace: the program aborted, its auxiliary moves, the resume at C …
+  t.begin_run();
+  t.apply_code(machine::kTorchOnCode, 0);  // … replays the torch on
+  w.extra_v = 25;                          // over the kerf already cut
+  ASSERT_TRUE(run(t, w, 20000, [&] { return t.status().phase == TorchPhase::Cutting; }));
+  EXPECT_EQ(t.status().target_voltage_v, sampled) << "not sampled again over the kerf";
+  bool sampling = false;
+  run(t, w, 500, [&] {
+    sampling = sampling || t.status().thc == ThcState::Sampling;
+    return false;
+  });
+  EXPECT_FALSE(sampling);
+  EXPECT_EQ(t.status().thc, ThcState::VoidLock) << "the kerf: held";
+  w.extra_v = 0;  // solid plate again: followed
+  ASSERT_TRUE(run(t, w, 2000, [&] { return t.status().thc == ThcState::Active; }));
+  EXPECT_NEAR(t.status().correction_mm, 0, 0.01);
+
+  // Ended by its M191: the next cut samples its own.
+  lose_the_arc_and_resume(t, w);
+  t.apply_code(machine::kTorchOffCode, 0);
+  run(t, w, 5000, [&] { return t.status().phase == TorchPhase::Off; });
+  w.extra_v = 6;
+  t.apply_code(machine::kTorchOnCode, 0);
+  ASSERT_TRUE(run(t, w, 20000, [&] { return t.status().thc == ThcState::Active; }));
+  EXPECT_NEAR(t.status().target_voltage_v, sampled + 6, 0.1);
+
+  // Interrupted, then another run (not a resume): it samples its own.
+  w.extra_v = 0;
+  lose_the_arc_and_resume(t, w);
+  t.begin_run();
+  t.forget_interrupted_cut();
+  w.extra_v = 3;
+  t.apply_code(machine::kTorchOnCode, 0);
+  ASSERT_TRUE(run(t, w, 20000, [&] { return t.status().thc == ThcState::Active; }));
+  EXPECT_NEAR(t.status().target_voltage_v, sampled + 3, 0.1);
+}
+
 TEST(TorchHeight, TheBreakawayOrTheFloatSwitchWhileBurningPutsTheTorchOutAndHolds) {
   for (const bool breakaway : {true, false}) {
     World w;

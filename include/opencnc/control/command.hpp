@@ -62,7 +62,8 @@ enum class CommandKind : std::uint8_t {
   JogIncrement,        ///< `axis`, `value` = signed distance, `value2` = speed (units/s)
   JogStop,             ///< `axis` (−1 = every axis): decelerate and stop
   Home,                ///< `axis` (−1 = all, in their sequences)
-  StartRun,            ///< the controller's own: run the blocks queued from `first_block` on
+  StartRun,            ///< the controller's own: run the blocks queued from `first_block` on;
+                       ///< `flag`: it resumes an interrupted program (a cut goes on there)
   CycleStart,          ///< continue after M0/M1/single block or feed hold (starting a program is
                        ///< the controller's: it plans, then sends StartRun)
   FeedHold,            ///< stop on the path; resume continues

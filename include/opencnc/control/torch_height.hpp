@@ -32,8 +32,11 @@ class TorchHeight {
   bool enabled() const noexcept { return config_.enabled != 0; }
 
   /// A run starts or ends: the torch is off, the offset taken into the commanded position as it
-  /// stands (the next run starts from there). Counters are kept.
+  /// stands (the next run starts from there). Counters are kept, and so is the voltage an
+  /// interrupted cut had sampled (for the run that resumes it).
   void begin_run() noexcept;
+  /// A run that does not resume an interrupted program starts: its cuts sample their own voltage.
+  void forget_interrupted_cut() noexcept { interrupted_target_v_ = 0; }
   /// M190 (torch on: the sequence), M191 (torch off: retract), M192/M193 (hold the height, let
   /// go). False: not one of the torch's codes.
   bool apply_code(int code, double p) noexcept;
@@ -92,6 +95,10 @@ class TorchHeight {
   double sample_sum_ = 0, sample_s_ = 0;
   double void_timer_s_ = 0;
   double last_velocity_ = 0, decel_ = 0;
+  /// The auto-volts target of a cut that was interrupted (arc lost, knocked, feed hold): the cut
+  /// that goes on from there — pierced again where it held, or at a retrace's C over the kerf it
+  /// had already cut — keeps it instead of sampling over that kerf. 0: none.
+  double interrupted_target_v_ = 0;
 };
 
 }  // namespace opencnc::control

@@ -168,8 +168,10 @@ class Controller final : private FeatureHost {
   /// Sends a command to the tick in the order of sending: `c.seq` as set (a request's own), or
   /// the next number. False when the queue is full. Controller thread.
   bool send(control::Command c);
+  /// `resumes`: the job resumes the open program at a segment (its first run continues the
+  /// process that was interrupted there, e.g. the torch keeps the interrupted cut's voltage).
   void start_job(std::uint64_t id, JobKind kind, std::string name, control::Mode mode,
-                 std::unique_ptr<ProgramStream> stream, bool prechecked = false);
+                 std::unique_ptr<ProgramStream> stream, bool prechecked = false, bool resumes = false);
   void end_job();
   void forward(std::uint64_t id, const control::Command& c);
   std::uint64_t next_seq();
