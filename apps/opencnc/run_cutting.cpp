@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Plasma cutting's part of `opencnc run`: arc losses injected into the simulated plate
+// Plasma and oxy-fuel cutting's part of `opencnc run`: arc losses injected into the simulated plate
 // (--inject arc-loss@SECONDS), the operator who answers them and a float switch that tripped —
 // resume where the run held, or (--hold-retrace-back MM) the retrace: back along the path and cut
-// on from there — and the run's `cutting` report (docs/cutting.md).
+// on from there — who starts an oxy-fuel cut whose preheat waits for them (Start cut, after
+// --inject start-cut@SECONDS of preheat), and the run's `cutting` report (docs/cutting.md).
 #include <fmt/format.h>
 
 #include <cmath>
@@ -31,9 +32,20 @@ class CuttingRun final : public RunFeature {
         {"arc-loss@SECONDS",
          "the plasma arc goes out (a simulated plate); the run holds on its path and the scripted operator "
          "resumes there: the torch finds the plate and pierces again",
+         ""},
+        {"start-cut@SECONDS",
+         "oxy-fuel, preheat = \"operator\": the scripted operator presses Start cut once a preheat that "
+         "waits for them has lasted SECONDS (without it: the profile's preheat_s)",
          ""}};
   }
   bool parse_injection(const std::string& text, bool& ok) override {
+    if (text.rfind("start-cut@", 0) == 0) {
+      const char* end = nullptr;
+      start_after_s_ = injection_number(text.c_str() + 10, '\0', end);
+      ok = start_after_s_ >= 0;
+      start_given_ = true;
+      return true;
+    }
     if (text.rfind("arc-loss@", 0) != 0) return false;
     const char* end = nullptr;
     const double at = injection_number(text.c_str() + 9, '\0', end);
@@ -47,6 +59,17 @@ class CuttingRun final : public RunFeature {
                  session.machine);
       return false;
     }
+    if (!losses_at_.empty() && profile && profile->plasma.config.oxy_fuel()) {
+      fmt::print(stderr, "error: --inject arc-loss: the torch of {} is oxy-fuel, a flame without an arc\n",
+                 session.machine);
+      return false;
+    }
+    if (start_given_ && profile && !(profile->plasma.present && profile->plasma.config.oxy_fuel())) {
+      fmt::print(stderr, "error: --inject start-cut needs an oxy-fuel torch ([process.oxyfuel] in {})\n",
+                 session.machine);
+      return false;
+    }
+    if (!start_given_ && profile) start_after_s_ = profile->plasma.config.preheat_s;
     std::sort(losses_at_.begin(), losses_at_.end());
     return true;
   }
@@ -76,6 +99,7 @@ class CuttingRun final : public RunFeature {
       ++next_;
     }
     operate(c, st);
+    start_cut(c, st);
   }
   bool report(nlohmann::json& j) override {
     if (!recorder_) return true;
@@ -135,11 +159,30 @@ class CuttingRun final : public RunFeature {
     }
   }
 
+  // The operator at an oxy-fuel preheat that waits for them: Start cut once it has lasted
+  // start_after_s_ (the steel glowing at the start of the kerf, as a person would judge it).
+  void start_cut(controller::Controller& c, const controller::ControllerStatus& st) {
+    if (starting_ != 0) {
+      const auto o = c.outcome(starting_);
+      if (!o) return;
+      if (!o->accepted) fmt::print(stderr, "error: Start cut was refused: {}\n", o->message);
+      starting_ = 0;
+      started_preheats_ = st.servo.torch.preheats;
+    }
+    const control::TorchStatus& t = st.servo.torch;
+    if (!t.waiting_start || t.preheat_s < start_after_s_ || t.preheats == started_preheats_) return;
+    starting_ = c.submit(controller::Request::simple(control::CommandKind::StartCut));
+  }
+
   enum class Stage : std::uint8_t { Waiting, Pausing, Stepping };
   double back_mm_ = 0;
   std::shared_ptr<recovery::RetraceFeature> retrace_;
   Stage stage_ = Stage::Waiting;
   std::vector<double> losses_at_;
+  double start_after_s_ = 4;
+  bool start_given_ = false;
+  std::uint64_t starting_ = 0;
+  std::uint32_t started_preheats_ = 0;
   std::size_t next_ = 0;
   double t0_ = -1;
   std::uint64_t asked_ = 0;

@@ -239,7 +239,8 @@ void read_cutting(Section& process, MachineProfile& profile) {
   };
   c.torch_output = channel("torch_output", -1);
   // A plasma torch is lit by its own stage (M190 replayed at a resume), not by an output.
-  if (c.torch_output < 0 && !s.has("torch_output") && !process.has("plasma")) s.missing("torch_output");
+  if (c.torch_output < 0 && !s.has("torch_output") && !process.has("plasma") && !process.has("oxyfuel"))
+    s.missing("torch_output");  // a torch stage lights its own torch
   c.preheat_output = channel("preheat_output", -1);
   c.cut_output = channel("cut_output", -1);
   c.ignite_s = s.number_or("ignite_s", 0, Bound::NonNegative);
@@ -259,13 +260,15 @@ void read_cutting(Section& process, MachineProfile& profile) {
 void read_process(Section& top, MachineProfile& profile) {
   const toml::table* t = top.subtable("process");
   if (t == nullptr) return;
-  Section s(*t, "process", {"torch", "generator", "sim", "cutting", "broaching", "plasma"}, top.reporter());
+  Section s(*t, "process", {"torch", "generator", "sim", "cutting", "broaching", "plasma", "oxyfuel"},
+            top.reporter());
   machine::SimProcessConfig& p = profile.process;
   p.torch = s.boolean_or("torch", false);
   p.generator = s.boolean_or("generator", false);
   read_cutting(s, profile);
   read_broaching(s, profile);
   read_plasma(s, profile);
+  read_oxyfuel(s, profile);
   const toml::table* st = s.subtable("sim");
   if (st == nullptr) return;
   Section m(*st, "process.sim", {"arc_delay_s"}, top.reporter());

@@ -7,26 +7,35 @@
 
 namespace opencnc::config::detail {
 
-namespace {
-
 /// A channel of `count` (an [io] count): within it, else an error at the key.
-std::int32_t channel(Section& s, std::string_view key, int count, std::string_view what, int max) {
+std::int32_t torch_channel(Section& s, std::string_view key, int count, std::string_view what, int max) {
   const auto v = s.integer(key, 0, max - 1);
   if (v && *v >= count)
     s.error(key,
             fmt::format("{} is {} {}, but the machine has {} ({})", s.key_path(key), what, *v, count,
-                        what == "analog input" ? "io.analog_inputs" : "io.digital_inputs"),
+                        what == "analog input"     ? "io.analog_inputs"
+                        : what == "digital output" ? "io.digital_outputs"
+                                                   : "io.digital_inputs"),
             "config.range");
   return static_cast<std::int32_t>(v.value_or(0));
 }
 
 /// `value` (read from `key`) no faster than the torch axis allows.
-void within(Section& s, std::string_view key, double value, double limit, std::string_view of) {
+void torch_within(Section& s, std::string_view key, double value, double limit, std::string_view of) {
   if (value > limit)
     s.error(key,
             fmt::format("{} ({}) is more than the torch axis' {} ({})", s.key_path(key), show(value), of,
                         show(limit)),
             "config.range");
+}
+
+namespace {
+
+std::int32_t channel(Section& s, std::string_view key, int count, std::string_view what, int max) {
+  return torch_channel(s, key, count, what, max);
+}
+void within(Section& s, std::string_view key, double value, double limit, std::string_view of) {
+  torch_within(s, key, value, limit, of);
 }
 
 void read_thc(Section& s, MachineProfile& p, const AxisProfile* z) {

@@ -51,6 +51,14 @@ void read_coupling(Section& top, MachineProfile& profile);
 void read_broaching(Section& process, MachineProfile& profile);
 /// [process.plasma] with .thc, .holes and .sim, from read_process. Needs the axes and [io].
 void read_plasma(Section& process, MachineProfile& profile);
+/// [process.oxyfuel] with .thc and .sim, from read_process (into MachineProfile::plasma, the
+/// torch stage's settings with process = OxyFuel). Needs the axes and [io].
+void read_oxyfuel(Section& process, MachineProfile& profile);
+/// A torch's channel `key` of `count` (an [io] count of `what`: "analog input", "digital input",
+/// "digital output"), else an error at the key.
+std::int32_t torch_channel(Section& s, std::string_view key, int count, std::string_view what, int max);
+/// `value` (read from `key`) within the torch axis' limit `of`, else an error at the key.
+void torch_within(Section& s, std::string_view key, double value, double limit, std::string_view of);
 /// [edm], its conditions and [edm.sim]. Needs the axes and [process].
 void read_edm(Section& top, MachineProfile& profile);
 

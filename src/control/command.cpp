@@ -176,6 +176,8 @@ const char* to_string(CommandKind k) noexcept {
       return "stage-edm-conditions";
     case CommandKind::SeekLimit:
       return "seek-limit";
+    case CommandKind::StartCut:
+      return "start-cut";
   }
   return "?";
 }

@@ -342,6 +342,12 @@ void Servo::write_machine_outputs() noexcept {
   out_.tool.prepare_tool = preparing_ ? preparing_tool_ : out_.tool.prepare_tool;
   out_.tool.change = on && sync_step_ == SyncStep::ToolChanger;
   out_.digital_out = (digital_out_ & ~rule_outputs_mask_) | (rule_outputs_ & rule_outputs_mask_);
+  if (const int co = config_.plasma.cut_oxygen_output;
+      co >= 0 && torch_.enabled()) {  // oxy-fuel: the torch stage's
+    const std::uint64_t bit = std::uint64_t{1} << co;
+    out_.digital_out =
+        on && torch_.status().cut_oxygen ? (out_.digital_out | bit) : (out_.digital_out & ~bit);
+  }
   out_.analog_out = analog_out_;
 }
 

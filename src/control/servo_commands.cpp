@@ -35,6 +35,7 @@ bool starts_something(const Command& c) noexcept {
     case CommandKind::ToolChanged:
     case CommandKind::SpindleOn:
     case CommandKind::SeekLimit:
+    case CommandKind::StartCut:
       return true;
     case CommandKind::Coolant:
       return c.flag;
@@ -113,6 +114,8 @@ Refusal Servo::apply(const Command& c) noexcept {
       return stage_edm_conditions();
     case CommandKind::SeekLimit:
       return seek_limit(c);
+    case CommandKind::StartCut:
+      return torch_.enabled() && torch_.start_cut() ? Refusal::None : Refusal::NotApplicable;
   }
   return Refusal::BadValue;
 }

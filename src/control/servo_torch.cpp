@@ -25,6 +25,7 @@ void Servo::run_torch_height() noexcept {
   in.arc_ok = in_.process.arc_ok;
   in.sensor = ((in_.digital_in >> pc.sensor_input) & 1u) != 0;
   in.breakaway = pc.breakaway_input >= 0 && ((in_.digital_in >> pc.breakaway_input) & 1u) != 0;
+  in.height_v = in_.analog_in[static_cast<std::size_t>(pc.height_input)];
   commanded_[z] = in.programmed_z + torch_.step(in);
   if (torch_.event_pending()) {
     ServoEvent e;

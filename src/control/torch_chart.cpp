@@ -28,6 +28,9 @@ bool TorchHeight::apply_chart_code(int code, double p) noexcept {
     case machine::kChartPuddleDelayCode:
       config_.puddle_delay_s = p;
       return true;
+    case machine::kChartPreheatCode:
+      config_.preheat_s = p > 0 ? p : profile_.preheat_s;
+      return true;
     default:
       return false;
   }

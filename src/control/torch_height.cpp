@@ -15,6 +15,7 @@ void TorchHeight::configure(const machine::PlasmaConfig& config, double period_s
   dt_ = period_s;
   status_ = TorchStatus{};
   interrupted_target_v_ = 0;
+  status_.oxy_fuel = config.oxy_fuel();
   begin_run();
 }
 
@@ -24,8 +25,10 @@ void TorchHeight::begin_run() noexcept {
   waits_ = hold_request_ = event_pending_ = false;
   offset_ = v_ = 0;
   starts_failed_ = 0;
+  start_asked_ = false;
   status_.thc_hold = false;
   status_.torch_on = false;
+  status_.cut_oxygen = status_.waiting_start = false;
   enter(TorchPhase::Off);
   status_.thc_offset_mm = status_.correction_mm = 0;
 }
@@ -93,6 +96,7 @@ bool TorchHeight::move_to(double target) noexcept {
 
 // Arc-OK off for longer than arc_loss_s once the arc was there: torch off, the run held.
 bool TorchHeight::arc_lost(const TorchInputs& in) noexcept {
+  if (config_.oxy_fuel()) return false;  // a flame has no arc-OK (no flame-out input: docs/cutting.md)
   arc_off_s_ = in.arc_ok ? 0.0 : arc_off_s_ + dt_;
   if (arc_off_s_ < config_.arc_loss_s || arc_off_s_ == 0) return false;
   ++status_.arc_losses;
@@ -109,7 +113,7 @@ bool TorchHeight::knocked(const TorchInputs& in) noexcept {
   const TorchPhase p = status_.phase;
   const bool burning = p == TorchPhase::Piercing || p == TorchPhase::Puddle || p == TorchPhase::ToCut ||
                        p == TorchPhase::Cutting;
-  const bool floated = burning && in.sensor && config_.sensor == PlateSensor::Float;
+  const bool floated = burning && in.sensor && config_.sensor == PlateSensor::Float && !config_.oxy_fuel();
   if (!in.breakaway && !floated) return false;
   status_.torch_on = false;
   ++(in.breakaway ? status_.breakaways : status_.float_trips);
@@ -124,18 +128,12 @@ double TorchHeight::step(const TorchInputs& in) noexcept {
   status_.arc_voltage_v = in.arc_voltage_v;
   status_.arc_ok = in.arc_ok;
   status_.sensor = in.sensor;
-  if (status_.torch_on && in.arc_ok) {
-    const double k = filter_primed_ ? dt_ / (config_.filter_s + dt_) : 1.0;
-    status_.filtered_voltage_v += k * (in.arc_voltage_v - status_.filtered_voltage_v);
-    filter_primed_ = true;
-  } else {
-    filter_primed_ = false;
-  }
+  filter(in);
   timer_s_ += dt_;
   const TorchPhase p = status_.phase;
   const bool sequencing = p == TorchPhase::Probing || p == TorchPhase::ToPierce ||
                           p == TorchPhase::Igniting || p == TorchPhase::Piercing || p == TorchPhase::Puddle ||
-                          p == TorchPhase::ToCut || p == TorchPhase::Cutting;
+                          p == TorchPhase::ToCut || p == TorchPhase::Cutting || p == TorchPhase::Preheating;
   if (in.hold && sequencing) {  // a feed hold puts the torch out; a resume pierces again here
     status_.torch_on = false;
     enter(TorchPhase::Paused);
@@ -153,18 +151,28 @@ double TorchHeight::step(const TorchInputs& in) noexcept {
       break;
     case TorchPhase::ToPierce:
       waits_ = true;
-      if (move_to(offset_for_height(config_.pierce_height_mm))) {
+      if (move_to(
+              offset_for_height(config_.oxy_fuel() ? config_.preheat_height_mm : config_.pierce_height_mm))) {
         status_.torch_on = true;
         enter(TorchPhase::Igniting);
       }
       break;
     case TorchPhase::Igniting:
       waits_ = true;
-      ignite(in);
+      if (config_.oxy_fuel())
+        ignite_flame();
+      else
+        ignite(in);
+      break;
+    case TorchPhase::Preheating:
+      waits_ = true;
+      preheat();
       break;
     case TorchPhase::Piercing:
       waits_ = true;
-      move_to(offset_);
+      // Oxy-fuel rises from the preheat to the pierce height with the cutting oxygen on (the slag
+      // blows up out of the hole); plasma pierces where it stands.
+      move_to(config_.oxy_fuel() ? offset_for_height(config_.pierce_height_mm) : offset_);
       if (arc_lost(in)) break;
       if (timer_s_ >= config_.pierce_delay_s - 1e-12)
         enter(config_.puddle_height_mm > 0 ? TorchPhase::Puddle : TorchPhase::ToCut);
@@ -181,7 +189,10 @@ double TorchHeight::step(const TorchInputs& in) noexcept {
         cut_offset_ = offset_;
         status_.cut_z_mm = status_.plate_z_mm + config_.cut_height_mm;
         since_cut_s_ = sample_sum_ = sample_s_ = void_timer_s_ = 0;
-        status_.target_voltage_v = config_.arc_voltage_v > 0 ? config_.arc_voltage_v : interrupted_target_v_;
+        if (config_.oxy_fuel())
+          status_.target_voltage_v = 0;  // the height sensor reads the height itself
+        else
+          status_.target_voltage_v = config_.arc_voltage_v > 0 ? config_.arc_voltage_v : interrupted_target_v_;
         interrupted_target_v_ = 0;
         last_velocity_ = in.path_velocity;
         enter(TorchPhase::Cutting);
@@ -211,13 +222,90 @@ double TorchHeight::step(const TorchInputs& in) noexcept {
   }
   status_.thc_offset_mm = offset_;
   status_.correction_mm = status_.phase == TorchPhase::Cutting ? offset_ - cut_offset_ : 0.0;
+  const TorchPhase q = status_.phase;
+  status_.cut_oxygen = config_.oxy_fuel() && status_.torch_on &&
+                       (q == TorchPhase::Piercing || q == TorchPhase::ToCut || q == TorchPhase::Cutting);
+  status_.waiting_start = q == TorchPhase::Preheating && config_.preheat == machine::PreheatMode::Operator;
   return offset_;
+}
+
+// The signal the height control holds: the arc voltage (plasma, while the arc burns) or the
+// height the capacitive sensor reads (oxy-fuel, always: it needs no flame), each through the
+// same first-order low-pass filter.
+void TorchHeight::filter(const TorchInputs& in) noexcept {
+  const double k = filter_primed_ ? dt_ / (config_.filter_s + dt_) : 1.0;
+  if (config_.oxy_fuel()) {
+    const double h = (in.height_v - config_.sensor_zero_v) / config_.sensor_volts_per_mm;
+    sensor_in_range_ = h < config_.sensor_range_mm;
+    status_.sensor = sensor_in_range_;
+    status_.sensor_height_mm += k * (std::min(h, config_.sensor_range_mm) - status_.sensor_height_mm);
+    filter_primed_ = true;
+    return;
+  }
+  if (status_.torch_on && in.arc_ok) {
+    status_.filtered_voltage_v += k * (in.arc_voltage_v - status_.filtered_voltage_v);
+    filter_primed_ = true;
+  } else {
+    filter_primed_ = false;
+  }
+}
+
+// Oxy-fuel: the flame lights in ignite_s (no arc-OK to wait for), then the preheat begins.
+void TorchHeight::ignite_flame() noexcept {
+  move_to(offset_);
+  status_.torch_on = true;
+  if (timer_s_ < config_.ignite_s - 1e-12) return;
+  ++status_.preheats;
+  status_.preheat_s = 0;
+  start_asked_ = false;
+  enter(TorchPhase::Preheating);
+  if (config_.preheat == machine::PreheatMode::Operator) tell(TorchEvent::PreheatWaits, 0, false);
+}
+
+// The flame heats the plate where the torch stands until the time is up (by time) or the
+// operator starts the cut (either way); then the cutting oxygen goes on and the pierce begins.
+void TorchHeight::preheat() noexcept {
+  move_to(offset_);
+  status_.preheat_s += dt_;
+  status_.preheat_total_s += dt_;
+  const bool timed_out =
+      config_.preheat == machine::PreheatMode::Time && status_.preheat_s >= config_.preheat_s - 1e-12;
+  if (!timed_out && !start_asked_) return;
+  if (start_asked_) ++status_.operator_starts;
+  start_asked_ = false;
+  ++status_.pierces;
+  tell(TorchEvent::CutStarted, status_.preheat_s, false);
+  enter(TorchPhase::Piercing);
+}
+
+bool TorchHeight::start_cut() noexcept {
+  if (status_.phase != TorchPhase::Preheating) return false;
+  start_asked_ = true;
+  return true;
+}
+
+double TorchHeight::height_error_mm() const noexcept {
+  if (config_.oxy_fuel()) return status_.sensor_height_mm - config_.cut_height_mm;
+  return (status_.filtered_voltage_v - status_.target_voltage_v) / config_.volts_per_mm;
+}
+
+bool TorchHeight::jumped() const noexcept {
+  if (config_.oxy_fuel()) return !sensor_in_range_ || std::fabs(height_error_mm()) > config_.height_jump_mm;
+  return std::fabs(status_.filtered_voltage_v - status_.target_voltage_v) > config_.void_jump_v;
 }
 
 // Down at the probe speed until the switch; the plate's top is where the torch stood when the
 // input was sampled, plus the float's travel. The torch brakes on toward the pierce height.
 void TorchHeight::probe(const TorchInputs& in) noexcept {
-  if (in.sensor) {
+  if (config_.oxy_fuel() && sensor_in_range_) {  // the capacitive sensor reads the height itself
+    // This period's reading, unfiltered: the filter lags the probe's motion by its time constant.
+    const double h = (in.height_v - config_.sensor_zero_v) / config_.sensor_volts_per_mm;
+    status_.plate_z_mm = in.measured_z - h;
+    enter(TorchPhase::ToPierce);
+    move_to(offset_for_height(config_.preheat_height_mm));
+    return;
+  }
+  if (in.sensor && !config_.oxy_fuel()) {
     status_.plate_z_mm =
         in.measured_z + (config_.sensor == PlateSensor::Float ? config_.switch_offset_mm : 0.0);
     enter(TorchPhase::ToPierce);
@@ -271,7 +359,7 @@ ThcState TorchHeight::thc_state(const TorchInputs& in) noexcept {
   last_velocity_ = in.path_velocity;
   if (config_.thc == 0) return ThcState::Off;
   if (void_timer_s_ > 0) void_timer_s_ = std::max(0.0, void_timer_s_ - dt_);
-  const bool known = status_.target_voltage_v > 0;
+  const bool known = config_.oxy_fuel() || status_.target_voltage_v > 0;
   if (status_.thc_hold) return ThcState::ProgramLock;
   const bool at_speed = in.feed > 0 && in.path_velocity >= config_.speed_share * in.feed;
   if (!at_speed) return known ? ThcState::CornerLock : ThcState::Waiting;
@@ -283,21 +371,24 @@ ThcState TorchHeight::thc_state(const TorchInputs& in) noexcept {
     if (sample_s_ >= config_.sample_s - 1e-12) status_.target_voltage_v = sample_sum_ / sample_s_;
     return ThcState::Sampling;
   }
-  if (std::fabs(status_.filtered_voltage_v - status_.target_voltage_v) > config_.void_jump_v)
-    void_timer_s_ = config_.void_hold_s;
+  if (jumped()) void_timer_s_ = config_.void_hold_s;
   return void_timer_s_ > 0 ? ThcState::VoidLock : ThcState::Active;
 }
 
-// Active: a speed toward the height the voltage says is right, e/τ, within the deadband none;
-// locked: none. The speed is reached at the correction's acceleration, and the correction stays
-// within ±max_correction_mm of the cut height found by the probe.
+// Active: a speed toward the height the voltage (or the height sensor) says is right, e/τ, within the
+// deadband none; locked: none. The speed is reached at the correction's acceleration, and the correction
+// stays within ±max_correction_mm of the cut height found by the probe.
 void TorchHeight::correct(const TorchInputs& /*in*/, ThcState s) noexcept {
   double want = 0;
   if (s == ThcState::Active) {
-    const double error_v = status_.filtered_voltage_v - status_.target_voltage_v;
-    if (std::fabs(error_v) > config_.deadband_v)
-      want = std::clamp(-(error_v / config_.volts_per_mm) / config_.time_constant_s,
-                        -config_.max_velocity_mm_s, config_.max_velocity_mm_s);
+    const double error_mm = height_error_mm();
+    const bool outside =
+        config_.oxy_fuel()
+            ? std::fabs(error_mm) > config_.deadband_mm
+            : std::fabs(status_.filtered_voltage_v - status_.target_voltage_v) > config_.deadband_v;
+    if (outside)
+      want = std::clamp(-error_mm / config_.time_constant_s, -config_.max_velocity_mm_s,
+                        config_.max_velocity_mm_s);
   }
   const double ad = config_.max_accel_mm_s2 * dt_;
   v_ += std::clamp(want - v_, -ad, ad);

@@ -97,6 +97,8 @@ std::string what_next(control::CommandKind command, control::Refusal r) {
           return "nothing is running to abort";
         case control::CommandKind::ToolChanged:
           return "no manual tool change is waiting";
+        case control::CommandKind::StartCut:
+          return "no preheat is under way: start cut ends a preheat (by time or waiting for the operator)";
         default:
           return "";
       }

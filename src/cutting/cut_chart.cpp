@@ -114,6 +114,7 @@ class Chart {
     code(machine::kChartArcVoltageCode, m->arc_voltage_v);
     code(machine::kChartPuddleHeightCode, m->puddle_height_mm);
     code(machine::kChartPuddleDelayCode, m->puddle_delay_s);
+    code(machine::kChartPreheatCode, m->preheat_s);
     gcode::InterpState& st = ctx.state();
     st.globals[kMaterialParam] = {static_cast<double>(number), true};
     st.globals[kKerfParam] = {to_program(m->kerf_width_mm, st), true};

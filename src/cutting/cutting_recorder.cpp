@@ -29,7 +29,14 @@ void CuttingRecorder::on_trace(const control::TraceSample& s, const controller::
     failed0_ = t.failed_starts;
     trips0_ = t.float_trips;
     breakaways0_ = t.breakaways;
+    preheats0_ = t.preheats;
+    starts0_ = t.operator_starts;
+    preheat0_s_ = t.preheat_total_s;
   }
+  r_.oxy_fuel = plasma_.oxy_fuel();
+  r_.preheats = t.preheats - preheats0_;
+  r_.operator_starts = t.operator_starts - starts0_;
+  r_.preheat_s = t.preheat_total_s - preheat0_s_;
   r_.pierces = t.pierces - pierces0_;
   r_.arc_losses = t.arc_losses - losses0_;
   r_.failed_starts = t.failed_starts - failed0_;
@@ -39,11 +46,14 @@ void CuttingRecorder::on_trace(const control::TraceSample& s, const controller::
   hold_before_ = t.thc_hold;
   if (t.thc == control::ThcState::VoidLock && thc_before_ != control::ThcState::VoidLock) ++r_.void_locks;
   thc_before_ = t.thc;
-  if (t.phase != control::TorchPhase::Cutting || !t.arc_ok) return;
+  // Plasma cuts while the arc burns; oxy-fuel while the stage cuts (the cutting oxygen is on).
+  if (t.phase != control::TorchPhase::Cutting || !(t.arc_ok || plasma_.oxy_fuel())) return;
   const auto z = static_cast<std::size_t>(plasma_.z_axis);
   double height = plasma_.cut_height_mm;
   if (plate_) {
     height = s.actual[z] - plate_->z(s.actual[0], s.actual[1]);
+  } else if (plasma_.oxy_fuel()) {
+    height = t.sensor_height_mm;  // the capacitive sensor's own reading
   } else if (t.target_voltage_v > 0) {
     height += (t.filtered_voltage_v - t.target_voltage_v) / plasma_.volts_per_mm;
   }
@@ -68,14 +78,23 @@ CuttingReport CuttingRecorder::report() const {
 std::string CuttingRecorder::report_text() const {
   const CuttingReport r = report();
   return fmt::format(
-      "cutting             {:.2f} s, height within ±0.1 mm of the cut height {:.2f} % ({}), deepest dive "
-      "{:.3f} mm, highest rise {:.3f} mm, THC correcting {:.1f} %\n"
-      "cutting torch       {} pierces, {} failed starts, {} arc losses, {} float trips, {} breakaways, {} "
-      "kerf/void locks, {} holes slowed\n",
-      r.cutting_s, 100 * r.height_in_band_fraction,
-      r.height_measured ? "above the simulated plate" : "from the arc voltage", r.max_dive_mm, r.max_rise_mm,
-      100 * r.thc_active_fraction, r.pierces, r.failed_starts, r.arc_losses, r.float_trips, r.breakaways,
-      r.void_locks, r.holes_slowed);
+             "cutting             {:.2f} s, height within ±0.1 mm of the cut height {:.2f} % ({}), deepest "
+             "dive "
+             "{:.3f} mm, highest rise {:.3f} mm, THC correcting {:.1f} %\n"
+             "cutting torch       {} pierces, {} failed starts, {} arc losses, {} float trips, {} "
+             "breakaways, {} "
+             "kerf/void locks, {} holes slowed\n",
+             r.cutting_s, 100 * r.height_in_band_fraction,
+             r.height_measured ? "above the simulated plate"
+             : r.oxy_fuel      ? "from the height sensor"
+                               : "from the arc voltage",
+             r.max_dive_mm, r.max_rise_mm, 100 * r.thc_active_fraction, r.pierces, r.failed_starts,
+             r.arc_losses, r.float_trips, r.breakaways, r.void_locks, r.holes_slowed) +
+         (r.oxy_fuel
+              ? fmt::format(
+                    "cutting preheat     {} preheats, {:.2f} s in all, {} ended by the operator's start\n",
+                    r.preheats, r.preheat_s, r.operator_starts)
+              : std::string());
 }
 
 std::string CuttingRecorder::report_json() const {
@@ -92,7 +111,11 @@ std::string CuttingRecorder::report_json() const {
                         {"breakaways", r.breakaways},
                         {"holes_slowed", r.holes_slowed},
                         {"void_locks", r.void_locks},
-                        {"height_measured", r.height_measured}}
+                        {"height_measured", r.height_measured},
+                        {"process", r.oxy_fuel ? "oxy-fuel" : "plasma"},
+                        {"preheats", r.preheats},
+                        {"preheat_s", r.preheat_s},
+                        {"operator_starts", r.operator_starts}}
       .dump();
 }
 

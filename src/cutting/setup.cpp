@@ -40,6 +40,8 @@ const char* phase_name(control::TorchPhase p) {
       return "paused";
     case control::TorchPhase::Failed:
       return "failed";
+    case control::TorchPhase::Preheating:
+      return "preheating";
   }
   return "?";
 }
@@ -120,14 +122,23 @@ class Texts final : public controller::EventTexts {
             "plasma: the float switch tripped while the torch burned (it touched the plate); the torch is "
             "off "
             "and the run held: resume to find the plate and pierce again where it stands, or retrace"};
+      case control::TorchEvent::PreheatWaits:
+        return controller::EventNote{Severity::Note, "control.torch.preheat-waits",
+                                     "oxy-fuel: the flame preheats the plate; start the cut (Start cut) when "
+                                     "the steel glows at the kerf's start"};
+      case control::TorchEvent::CutStarted:
+        return controller::EventNote{
+            Severity::Note, "control.torch.cut-started",
+            fmt::format("oxy-fuel: preheated {:.1f} s; cutting oxygen on, piercing", e.value)};
       case control::TorchEvent::PlateNotFound:
         return controller::EventNote{
             Severity::Error, "control.torch.no-plate",
-            fmt::format(
-                "plasma: the torch went {} mm below the programmed height without its {} (no plate?); "
-                "the run is held",
-                p.plasma.config.probe_travel_mm,
-                p.plasma.config.sensor == machine::PlateSensor::Float ? "float switch" : "ohmic contact")};
+            fmt::format("{}: the torch went {} mm below the programmed height without its {} (no plate?); "
+                        "the run is held",
+                        p.plasma.config.oxy_fuel() ? "oxy-fuel" : "plasma", p.plasma.config.probe_travel_mm,
+                        p.plasma.config.oxy_fuel() ? "height sensor reading the plate"
+                        : p.plasma.config.sensor == machine::PlateSensor::Float ? "float switch"
+                                                                                : "ohmic contact")};
     }
     return std::nullopt;
   }
@@ -164,7 +175,13 @@ class State final : public controller::FeatureState {
                           {"plate_z_mm", t.plate_z_mm},
                           {"pierces", t.pierces},
                           {"arc_losses", t.arc_losses},
-                          {"hold_reason", reason}}
+                          {"hold_reason", reason},
+                          {"process", t.oxy_fuel ? "oxy-fuel" : "plasma"},
+                          {"cut_oxygen", t.cut_oxygen},
+                          {"waiting_start", t.waiting_start},
+                          {"sensor_height_mm", t.sensor_height_mm},
+                          {"preheat_s", t.preheat_s},
+                          {"preheats", t.preheats}}
         .dump();
   }
 

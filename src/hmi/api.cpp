@@ -39,6 +39,7 @@ const std::map<std::string, CommandKind, std::less<>>& servo_kinds() {
       {"abort", CommandKind::Abort},
       {"tool-changed", CommandKind::ToolChanged},
       {"spindle-off", CommandKind::SpindleOff},
+      {"start-cut", CommandKind::StartCut},
   };
   return kinds;
 }

@@ -101,6 +101,7 @@ void SimMachine::write(const MachineOutputs& out) noexcept {
   // What the next periods need of the outputs; the joints and the spindle latch their own.
   estop_release_ = out.estop_release;
   process_ = out.process;
+  digital_out_ = out.digital_out;
   tool_ = out.tool;
   advance(out);
   ++inputs_.cycle;
@@ -175,8 +176,9 @@ void SimMachine::step_plasma() noexcept {
   const auto table = [&](int j) {
     return j >= 0 && j < config_.joint_count ? joints_[static_cast<std::size_t>(j)].table_position() : 0.0;
   };
-  plasma_.step(table(p.x_joint), table(p.y_joint), table(p.z_joint),
-               config_.process.torch && process_.torch_on);
+  const bool torch = config_.process.torch && process_.torch_on;
+  const bool oxygen = p.cut_oxygen_output >= 0 && ((digital_out_ >> p.cut_oxygen_output) & 1u) != 0;
+  plasma_.step(table(p.x_joint), table(p.y_joint), table(p.z_joint), torch, torch && oxygen);
 }
 
 // The cutter's position from the joints' tables: where the chip is cut, not where the encoders say.

@@ -79,7 +79,7 @@ void SimPlasmaProcess::lose_arc() noexcept {
   flush_trail();
 }
 
-void SimPlasmaProcess::step(double x, double y, double z, bool torch_on) noexcept {
+void SimPlasmaProcess::step(double x, double y, double z, bool torch_on, bool cut_oxygen) noexcept {
   const Point p{x, y};
   speed_ = moved_once_ ? std::hypot(x - last_.x, y - last_.y) / period_s_ : 0.0;
   last_ = p;
@@ -88,7 +88,13 @@ void SimPlasmaProcess::step(double x, double y, double z, bool torch_on) noexcep
   plate_ = surface_.z(x, y);
   height_ = z - plate_;
   torch_on_ = torch_on;
-  if (!torch_on) {
+  on_plate_ = x >= config_.plate_min[0] && x <= config_.plate_max[0] && y >= config_.plate_min[1] &&
+              y <= config_.plate_max[1];
+  if (config_.oxy_fuel) {  // no arc: the cutting oxygen cuts the kerf while the flame burns
+    if (arc_ && !(torch_on && cut_oxygen)) flush_trail();
+    arc_ = torch_on && cut_oxygen;
+    blocked_ = false;
+  } else if (!torch_on) {
     if (arc_) flush_trail();
     arc_ = blocked_ = false;
     transfer_s_ = 0;
@@ -104,6 +110,7 @@ void SimPlasmaProcess::step(double x, double y, double z, bool torch_on) noexcep
       lose_arc();
     }
   }
+  if (config_.oxy_fuel) over_kerf_ = kerf_at(x, y);  // the sensor sees a kerf with the oxygen off too
   if (arc_) {
     over_kerf_ = kerf_at(x, y);
     // The kerf behind the torch: marked once the torch is a kerf's width past it.
@@ -127,15 +134,30 @@ void SimPlasmaProcess::step(double x, double y, double z, bool torch_on) noexcep
       --trail_count_;
     }
     const double slow = 1 - std::min(speed_ / config_.full_speed_mm_s, 1.0);
-    voltage_ = config_.base_voltage_v + config_.volts_per_mm * height_ + config_.slow_volts_v * slow +
-               (over_kerf_ ? config_.kerf_volts_v : 0.0);
+    voltage_ = config_.oxy_fuel ? 0.0
+                                : config_.base_voltage_v + config_.volts_per_mm * height_ +
+                                      config_.slow_volts_v * slow + (over_kerf_ ? config_.kerf_volts_v : 0.0);
   } else {
-    over_kerf_ = false;
+    if (!config_.oxy_fuel) over_kerf_ = false;
     voltage_ = 0;
   }
 }
 
+double SimPlasmaProcess::sensed_height_mm() const noexcept {
+  if (!on_plate_) return config_.sensor_range_mm;
+  return std::min(height_ + (over_kerf_ ? config_.kerf_height_mm : 0.0), config_.sensor_range_mm);
+}
+
 void SimPlasmaProcess::sample(MachineInputs& in) noexcept {
+  if (config_.oxy_fuel) {
+    const double sensed = sensed_height_mm(), noise = config_.height_noise_mm * rng_.symmetric();
+    // Nothing under the ring: the amplifier stands at its end of range, noise or not.
+    const double h =
+        sensed >= config_.sensor_range_mm ? sensed : std::min(sensed + noise, config_.sensor_range_mm);
+    in.analog_in[static_cast<std::size_t>(config_.height_input)] =
+        config_.sensor_zero_v + config_.sensor_volts_per_mm * std::max(h, 0.0);
+    return;
+  }
   in.process.arc_ok = arc_;
   const double noise = config_.noise_v * rng_.symmetric();
   in.analog_in[static_cast<std::size_t>(config_.arc_voltage_input)] = arc_ ? voltage_ + noise : 0.0;

@@ -25,6 +25,7 @@ double* number_field(Material& m, std::string_view f) noexcept {
   if (f == "amperage_a") return &m.amperage_a;
   if (f == "puddle_height_mm") return &m.puddle_height_mm;
   if (f == "puddle_delay_s") return &m.puddle_delay_s;
+  if (f == "preheat_s") return &m.preheat_s;
   return nullptr;
 }
 
@@ -111,7 +112,7 @@ const std::vector<MaterialField>& material_fields() {
       {"process", true},          {"kerf_width_mm", true},  {"feed_mm_min", true},
       {"pierce_height_mm", true}, {"pierce_delay_s", true}, {"cut_height_mm", true},
       {"arc_voltage_v", true},    {"amperage_a", true},     {"puddle_height_mm", false},
-      {"puddle_delay_s", false}};
+      {"puddle_delay_s", false},  {"preheat_s", false}};
   return fields;
 }
 
@@ -192,7 +193,7 @@ std::optional<Invalid> invalid(const Material& m) {
         positive("cut_height_mm", m.cut_height_mm, 100), non_negative("arc_voltage_v", m.arc_voltage_v, 1000),
         non_negative("amperage_a", m.amperage_a, 2000),
         non_negative("puddle_height_mm", m.puddle_height_mm, 100),
-        non_negative("puddle_delay_s", m.puddle_delay_s, 600)}) {
+        non_negative("puddle_delay_s", m.puddle_delay_s, 600), non_negative("preheat_s", m.preheat_s, 600)}) {
     if (r) return r;
   }
   if (m.cut_height_mm > m.pierce_height_mm)
@@ -200,6 +201,8 @@ std::optional<Invalid> invalid(const Material& m) {
                                             number_text(m.pierce_height_mm)));
   if (m.puddle_delay_s > 0 && m.puddle_height_mm == 0)
     return bad("puddle_delay_s", "a puddle delay needs a puddle height");
+  if (m.preheat_s > 0 && m.process == CutProcess::Plasma)
+    return bad("preheat_s", "a plasma material has no preheat (oxy-fuel only)");
   return std::nullopt;
 }
 

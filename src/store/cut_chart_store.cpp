@@ -12,7 +12,9 @@ namespace opencnc::store {
 
 namespace {
 
-constexpr int kSchemaVersion = 1;
+// 1: the first chart; 2: preheat_s (an oxy-fuel row's preheat time), added to a schema-1 chart by
+// migrate() with 0 in every row it holds.
+constexpr int kSchemaVersion = 2;
 constexpr std::int64_t kApplicationId = 0x4f434343;  // "OCCC": an opencnc cut chart
 
 // Columns after number, in material_fields() order: name TEXT, thickness_mm REAL, process TEXT, …
@@ -46,6 +48,14 @@ void open_schema(Database& db, bool read_only) {
       throw Error(
           fmt::format("the cut chart has schema {}, newer than this opencnc's {}", v, kSchemaVersion));
     if (v == kSchemaVersion) return;
+    if (v == 1 && !read_only) {  // a chart of schema 1 opened writable: updated in place, rows kept
+      Database::Transaction t(db);
+      db.exec("ALTER TABLE materials ADD COLUMN preheat_s REAL NOT NULL DEFAULT 0");
+      db.exec(fmt::format("PRAGMA user_version={}", kSchemaVersion));
+      t.commit();
+      return;
+    }
+    if (v == 1) return;  // read-only: read as it is (its rows without a preheat, read_chart)
   }
   if (!empty || id != 0) throw Error("this database is not an opencnc cut chart");
   if (read_only)
@@ -60,12 +70,22 @@ int read_selected(Database& db) {
   return static_cast<int>(db.query_integer("SELECT material FROM selection"));
 }
 
+// The value columns the chart's table has (a schema-1 chart opened read-only lacks preheat_s).
+std::vector<std::string> table_columns(Database& db) {
+  std::vector<std::string> cols;
+  for (const std::string& c : value_columns())
+    if (db.query_integer(
+            fmt::format("SELECT count(*) FROM pragma_table_info('materials') WHERE name = '{}'", c)) > 0)
+      cols.push_back(c);
+  return cols;
+}
+
 std::vector<Material> read_chart(Database& db) {
+  const std::vector<std::string> cols = table_columns(db);
   std::string sql = "SELECT number";
-  for (const std::string& c : value_columns()) sql += ", " + c;
+  for (const std::string& c : cols) sql += ", " + c;
   Statement s = db.prepare(sql + " FROM materials ORDER BY number");
   std::vector<Material> out;
-  const std::vector<std::string> cols = value_columns();
   while (s.step()) {
     Material m;
     m.number = static_cast<int>(s.integer(0));

@@ -350,6 +350,11 @@ const Row kRows[] = {
     // machining conditions on a machine without an EDM (the mill): nothing to stage them into
     {"stage_conditions_without_edm", false, idle(Mode::Manual), State::Idle,
      cmd(CommandKind::StageEdmConditions), Refusal::NotApplicable, State::Idle},
+    // an oxy-fuel cut's start on a machine without a torch stage (the mill), or with no preheat
+    {"start_cut_idle", false, idle(Mode::Auto), State::Idle, cmd(CommandKind::StartCut),
+     Refusal::NotApplicable, State::Idle},
+    {"start_cut_running", false, running_program, State::Running, cmd(CommandKind::StartCut),
+     Refusal::NotApplicable, State::Running},
 };
 
 void PrintTo(const Row& r, std::ostream* os) {

@@ -253,6 +253,42 @@ TEST(ServerFeatures, ASimulatedSpindleLoadShowsAsTheDrivesTorque) {
   })) << rig.status()["spindle"].dump();
 }
 
+// The oxy-fuel table with the preheat waiting for the operator: the API's start-cut is refused
+// while no preheat is under way, then the cut waits in its preheat (the status says so) until the
+// operator's start-cut, after which the cutting oxygen is on and the cut goes on.
+TEST(ServerFeatures, AnOxyFuelPreheatWaitsForStartCutFromTheApi) {
+  ServerRig rig(featured("oxyfuel-table.toml", {"process.oxyfuel.preheat=\"operator\""}));
+  ASSERT_EQ(rig.command({{"kind", "machine-on"}}).status, 200);
+  ASSERT_EQ(rig.command({{"kind", "mode"}, {"mode", "auto"}}).status, 200);
+  const Reply early = rig.command({{"kind", "start-cut"}});
+  EXPECT_EQ(early.status, 409) << early.text;
+  EXPECT_EQ(early.body["code"], "control.not-applicable");
+  EXPECT_NE(early.body["message"].get<std::string>().find("no preheat is under way"), std::string::npos)
+      << early.text;
+  ASSERT_EQ(rig.command({{"kind", "open"}, {"program", "oxyfuel-bracket.ngc"}}).status, 200);
+  ASSERT_EQ(rig.command({{"kind", "cycle-start"}}).status, 200);
+  ASSERT_TRUE(rig.until([](const json& s) { return s["features"]["cutting"]["waiting_start"] == true; }))
+      << rig.status()["features"].dump();
+  const json waiting = rig.status()["features"]["cutting"];
+  EXPECT_EQ(waiting["process"], "oxy-fuel");
+  EXPECT_EQ(waiting["phase"], "preheating");
+  EXPECT_EQ(waiting["torch_on"], true);
+  EXPECT_EQ(waiting["cut_oxygen"], false);
+  EXPECT_EQ(waiting["preheats"], 1);
+  // Still waiting a while later (virtual time runs 200× the wall clock: seconds of preheat).
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  const json later = rig.status()["features"]["cutting"];
+  EXPECT_EQ(later["phase"], "preheating");
+  EXPECT_GT(later["preheat_s"].get<double>(), waiting["preheat_s"].get<double>());
+  const Reply start = rig.command({{"kind", "start-cut"}});
+  ASSERT_EQ(start.status, 200) << start.text;
+  EXPECT_TRUE(rig.until([](const json& s) {
+    const json& c = s["features"]["cutting"];
+    return c["phase"] == "cutting" && c["cut_oxygen"] == true;
+  })) << rig.status()["features"].dump();
+  EXPECT_EQ(rig.command({{"kind", "abort"}}).status, 200);
+}
+
 TEST(ServerFeatures, PowerFailRecordInTheStatusThenARetractConfirmedByTheOperator) {
   ServerRig rig(featured("broach-zc.toml"));
   for (const char* k : {"machine-on"}) ASSERT_EQ(rig.command({{"kind", k}}).status, 200);

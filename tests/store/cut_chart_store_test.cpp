@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include "opencnc/store/database.hpp"
 #include "temp_db.hpp"
 
 namespace opencnc::store {
@@ -244,6 +245,83 @@ TEST(CutChartStore, RefusesAToolStoreOrAnyOtherDatabase) {
   EXPECT_FALSE(CutChartStore::open(dir.path("tools.db"), &e));
   EXPECT_NE(e.find("not an opencnc cut chart"), std::string::npos) << e;
   EXPECT_FALSE(CutChartStore::open(dir.path("missing.db"), &e, /*create=*/false));
+}
+
+}  // namespace
+}  // namespace opencnc::store
+
+namespace opencnc::store {
+namespace {
+
+TEST(CutChartCsv, AnOxyFuelRowsPreheatIsReadAndAPlasmaRowHasNone) {
+  const std::string header =
+      "number,name,thickness_mm,process,kerf_width_mm,feed_mm_min,pierce_height_mm,pierce_delay_s,"
+      "cut_height_mm,arc_voltage_v,amperage_a,preheat_s\n";
+  const auto chart = parse_ok(header + "20,Mild steel 20 mm oxy,20,oxy-fuel,2.5,450,12,1.5,7,0,0,6.5\n");
+  ASSERT_EQ(chart.size(), 1u);
+  EXPECT_EQ(chart[0].preheat_s, 6.5);
+  EXPECT_NE(format_cut_chart_csv(chart).find("preheat_s"), std::string::npos);
+  EXPECT_EQ(parse_ok(format_cut_chart_csv(chart)), chart);
+  EXPECT_EQ(first_error(header + "6,A,6,plasma,1.5,2400,3.8,0.5,1.5,0,45,3\n"),
+            "chart.csv:2:40: error: preheat_s: a plasma material has no preheat (oxy-fuel only)");
+  EXPECT_EQ(first_error(header + "20,B,20,oxy-fuel,2.5,450,12,1.5,7,0,0,-1\n"),
+            "chart.csv:2:39: error: preheat_s: -1 is not from 0 to 600");
+  EXPECT_EQ(parse_ok(kCsv)[2].preheat_s, 0);  // the column left out: 0, the profile's preheat
+}
+
+/// A chart as opencnc wrote it before preheat_s (schema 1), with one oxy-fuel and one plasma row.
+void write_schema_1(const std::string& path) {
+  Database db(path, OpenOptions{true, false});
+  db.exec(R"(
+CREATE TABLE materials(number INTEGER PRIMARY KEY, name TEXT NOT NULL, thickness_mm REAL NOT NULL,
+  process TEXT NOT NULL, kerf_width_mm REAL NOT NULL, feed_mm_min REAL NOT NULL,
+  pierce_height_mm REAL NOT NULL, pierce_delay_s REAL NOT NULL, cut_height_mm REAL NOT NULL,
+  arc_voltage_v REAL NOT NULL, amperage_a REAL NOT NULL, puddle_height_mm REAL NOT NULL,
+  puddle_delay_s REAL NOT NULL);
+CREATE TABLE selection(id INTEGER PRIMARY KEY CHECK (id = 1), material INTEGER NOT NULL);
+INSERT INTO selection(id, material) VALUES(1, 20);
+CREATE TABLE audit(id INTEGER PRIMARY KEY, at_utc TEXT NOT NULL, interface TEXT NOT NULL,
+  reason TEXT NOT NULL, what TEXT NOT NULL, old_value TEXT NOT NULL, new_value TEXT NOT NULL);
+INSERT INTO materials VALUES(6, 'Mild steel 6 mm', 6, 'plasma', 1.5, 2400, 3.8, 0.5, 1.5, 118, 45, 0, 0);
+INSERT INTO materials VALUES(20, 'Mild steel 20 mm oxy', 20, 'oxy-fuel', 2.5, 450, 12, 1.5, 7, 0, 0, 0, 0);
+INSERT INTO audit VALUES(1, '2026-01-01T00:00:00Z', 'command line', 'import', 'material 6', '', 'x');
+PRAGMA application_id=1329808195; PRAGMA user_version=1;
+)");
+}
+
+TEST(CutChartStore, AChartOfSchemaOneKeepsItsRowsAndLearnsThePreheat) {
+  TempDb dir;
+  const std::string path = dir.path("chart.db");
+  write_schema_1(path);
+  {  // read-only: read as it is, not changed
+    std::string e;
+    auto r = CutChartStore::open(path, &e, false, true);
+    ASSERT_NE(r, nullptr) << e;
+    const auto chart = r->chart();
+    ASSERT_TRUE(chart);
+    ASSERT_EQ(chart->size(), 2u);
+    EXPECT_EQ(find(*chart, 20)->preheat_s, 0);
+  }
+  EXPECT_EQ(Database(path, OpenOptions{false, true}).query_integer("PRAGMA user_version"), 1);
+  auto s = open_store(path);  // writable: migrated
+  const auto chart = s->chart();
+  ASSERT_TRUE(chart);
+  ASSERT_EQ(chart->size(), 2u);
+  EXPECT_EQ(find(*chart, 6)->arc_voltage_v, 118);
+  EXPECT_EQ(find(*chart, 6)->name, "Mild steel 6 mm");
+  EXPECT_EQ(find(*chart, 20)->pierce_height_mm, 12);
+  EXPECT_EQ(find(*chart, 20)->preheat_s, 0);
+  EXPECT_EQ(s->selected().value_or(-1), 20);
+  EXPECT_EQ(s->audit().size(), 1u);  // the old audit kept
+  Material m = *find(*chart, 20);
+  m.preheat_s = 6.5;
+  std::string e;
+  ASSERT_TRUE(s->put(m, "hmi", &e)) << e;
+  EXPECT_EQ(s->audit().back().what, "material 20 preheat_s");
+  s.reset();
+  auto again = open_store(path);
+  EXPECT_EQ(find(*again->chart(), 20)->preheat_s, 6.5);
+  EXPECT_EQ(Database(path, OpenOptions{false, true}).query_integer("PRAGMA user_version"), 2);
 }
 
 }  // namespace

@@ -46,9 +46,10 @@ describe("cut chart", () => {
   });
   it("sends every field of an edited material, the typed ones as numbers", () => {
     const b = materialBody(mild6, { feed_mm_min: "2600", kerf_width_mm: " 1.6 " });
-    expect(b).toEqual({ action: "set", material: { ...mild6, feed_mm_min: 2600, kerf_width_mm: 1.6 } });
+    expect(b).toEqual({ action: "set", material: { ...mild6, feed_mm_min: 2600, kerf_width_mm: 1.6, preheat_s: 0 } });
     expect(editFields).toContain("puddle_delay_s");
-    expect(editFields.length).toBe(13);
+    expect(editFields).toContain("preheat_s");
+    expect(editFields.length).toBe(14);
   });
   it("refuses a bad field on the page, naming it", () => {
     expect(materialBody(mild6, { cut_height_mm: "4" })).toBe("cut_height_mm: 4 is above the pierce height 3.8");
@@ -59,6 +60,14 @@ describe("cut chart", () => {
     expect(materialBody(mild6, { name: "  " })).toBe("name: a material needs a name");
     expect(materialBody({}, { number: "2.5" })).toBe('number: a whole number from 1 to 99999, not "2.5"');
     expect(materialBody(mild6, { puddle_delay_s: "0.2" })).toBe("puddle_delay_s: a puddle delay needs a puddle height");
+  });
+  it("keeps an oxy-fuel row's preheat, shows it, and refuses one on a plasma row", () => {
+    const oxy = { ...mild6, number: 20, process: "oxy-fuel", pierce_height_mm: 12, cut_height_mm: 7, preheat_s: 0 };
+    expect(materialBody(oxy, { preheat_s: "6.5" })).toEqual({ action: "set", material: { ...oxy, preheat_s: 6.5 } });
+    expect(materialCells({ ...oxy, preheat_s: 6.5 })[6]).toBe("12 / 0.5 · preheat 6.5 s");
+    expect(materialCells(oxy)[6]).toBe("12 / 0.5 · preheat profile's");
+    expect(materialBody(oxy, { preheat_s: "-2" })).toBe("preheat_s: -2 is not from 0 to 600");
+    expect(materialBody(mild6, { preheat_s: "3" })).toBe("preheat_s: a plasma material has no preheat (oxy-fuel only)");
   });
   it("makes a new material from what is typed", () => {
     const typed = { number: "12", name: "Aluminium 3", process: "plasma", thickness_mm: "3", kerf_width_mm: "1.6", feed_mm_min: "4000", pierce_height_mm: "3.5", pierce_delay_s: "0.2", cut_height_mm: "1.5", arc_voltage_v: "0", amperage_a: "45", puddle_height_mm: "0", puddle_delay_s: "0" };

@@ -5,7 +5,7 @@
 import { describe, expect, it } from "vitest";
 import "./dialogs/torch_hold";
 import { dialogFor } from "./dialogs/waits";
-import { cuttingRows, thcText } from "./panels/cutting";
+import { cuttingActions, cuttingRows, preheatText, thcText } from "./panels/cutting";
 import type { Status } from "./types";
 import type { CuttingState } from "./types_features";
 
@@ -38,6 +38,34 @@ describe("cutting panel", () => {
     expect(thcText({ ...cutting, thc: "active" }).locked).toBe(false);
     expect(thcText({ ...cutting, phase: "piercing", thc: "off" })).toEqual({ text: "—", locked: false });
     expect(Object.fromEntries(cuttingRows(at({ phase: "off", torch_on: false, target_voltage_v: 0 })))["Height"]).toBe("—");
+  });
+});
+
+describe("cutting panel, oxy-fuel", () => {
+  const oxy: Partial<CuttingState> = {
+    process: "oxy-fuel", phase: "preheating", thc: "off", torch_on: true, arc_ok: false, arc_voltage_v: 0, target_voltage_v: 0,
+    cut_oxygen: false, waiting_start: true, sensor_height_mm: 7.02, preheat_s: 5.43, preheats: 2, thc_offset_mm: -12.5,
+  };
+  it("shows the preheat waiting for the operator and offers Start cut", () => {
+    const rows = Object.fromEntries(cuttingRows(at(oxy)));
+    expect(rows["Torch"]).toBe("ON · preheating");
+    expect(rows["Cutting oxygen"]).toBe("off");
+    expect(rows["Preheat"]).toBe("5.4 s · waiting for Start cut");
+    expect(rows["Height sensor"]).toBe("7.02 mm");
+    expect(rows["Arc voltage"]).toBeUndefined();
+    expect(rows["Cut"]).toBe("4 pierces · 2 preheats");
+    expect(cuttingActions(at(oxy))).toEqual([{ label: "Start cut", kind: "start-cut", cls: "go" }]);
+  });
+  it("offers Start cut during a timed preheat too, and not once the cut runs", () => {
+    expect(preheatText({ ...cutting, ...oxy, waiting_start: false } as CuttingState)).toBe("5.4 s · by time (Start cut ends it now)");
+    expect(cuttingActions(at({ ...oxy, waiting_start: false })).map((a) => a.kind)).toEqual(["start-cut"]);
+    const cut = at({ ...oxy, phase: "cutting", thc: "void-lock", waiting_start: false, cut_oxygen: true });
+    expect(cuttingActions(cut)).toEqual([]);
+    const rows = Object.fromEntries(cuttingRows(cut));
+    expect(rows["Cutting oxygen"]).toBe("ON");
+    expect(rows["Preheat"]).toBe("last 5.4 s");
+    expect(rows["THC"]).toBe("locked (kerf or plate edge)");
+    expect(cuttingActions(at({}))).toEqual([]);  // plasma: no preheat, no button
   });
 });
 

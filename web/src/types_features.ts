@@ -96,6 +96,17 @@ export interface CuttingState {
   arc_losses: number;
   /** Why the torch stage holds the run: "arc-lost", "failed" (starts or no plate), "" otherwise. */
   hold_reason?: string;
+  /** "plasma" or "oxy-fuel" (absent: plasma). */
+  process?: string;
+  /** Oxy-fuel: the cutting oxygen output. */
+  cut_oxygen?: boolean;
+  /** Oxy-fuel: the preheat waits for the operator's start ("start-cut"). */
+  waiting_start?: boolean;
+  /** Oxy-fuel: the capacitive sensor's height (mm). */
+  sensor_height_mm?: number;
+  /** Oxy-fuel: this (or the last) preheat so far (s), and preheats begun. */
+  preheat_s?: number;
+  preheats?: number;
 }
 
 export interface ElectrodeResult {

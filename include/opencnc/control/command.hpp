@@ -90,6 +90,9 @@ enum class CommandKind : std::uint8_t {
   /// `axis`, `value` = +1 / −1: jog to that limit switch, latch it slowly, back off onto its free
   /// side (LimitSeek); Manual mode, idle, the axis with that switch and seek keys
   SeekLimit,
+  /// Oxy-fuel: the operator's start of the cut while the torch preheats (cutting oxygen on,
+  /// pierce); refused (NotApplicable) unless a preheat is under way
+  StartCut,
 };
 
 /// Why a command was refused. Each has a stable code (refusal_code()).

@@ -23,6 +23,7 @@ struct TorchInputs {
   bool arc_ok = false;
   bool sensor = false;     ///< float switch or ohmic contact
   bool breakaway = false;  ///< the torch's breakaway switch (its mount knocked out of place)
+  double height_v = 0;     ///< oxy-fuel: the capacitive height sensor's reading (V)
 };
 
 /// The torch stage. Servo thread only; every member is real-time safe and allocates nothing.
@@ -43,6 +44,9 @@ class TorchHeight {
   /// A cut chart's setting (machine/cut_chart_codes.hpp: pierce and cut height, pierce delay,
   /// arc voltage, puddle jump) in place of the profile's, until the run ends. False: not one.
   bool apply_chart_code(int code, double p) noexcept;
+  /// Oxy-fuel: the operator's start — a preheat under way ends now (cutting oxygen on, pierce).
+  /// False: no preheat is under way (nothing changes).
+  bool start_cut() noexcept;
   /// One period: the Z offset to add to the programmed path.
   double step(const TorchInputs& in) noexcept;
 
@@ -67,6 +71,11 @@ class TorchHeight {
   bool move_to(double target) noexcept;  // true once there and at rest
   void probe(const TorchInputs& in) noexcept;
   void ignite(const TorchInputs& in) noexcept;
+  void ignite_flame() noexcept;
+  void preheat() noexcept;
+  void filter(const TorchInputs& in) noexcept;
+  double height_error_mm() const noexcept;  // + : too high
+  bool jumped() const noexcept;             // the signal far off its target (a kerf, a void, an edge)
   void cut(const TorchInputs& in) noexcept;
   ThcState thc_state(const TorchInputs& in) noexcept;
   void correct(const TorchInputs& in, ThcState s) noexcept;
@@ -99,6 +108,8 @@ class TorchHeight {
   /// that goes on from there — pierced again where it held, or at a retrace's C over the kerf it
   /// had already cut — keeps it instead of sampling over that kerf. 0: none.
   double interrupted_target_v_ = 0;
+  bool start_asked_ = false;      ///< the operator's start, for the preheat under way
+  bool sensor_in_range_ = false;  ///< oxy-fuel: the height sensor's reading is within its range
 };
 
 }  // namespace opencnc::control

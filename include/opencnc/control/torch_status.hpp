@@ -13,7 +13,7 @@ enum class TorchPhase : std::uint8_t {
   Off,         ///< the torch is off and at the programmed height
   Probing,     ///< down to the plate until the float switch or ohmic contact
   ToPierce,    ///< up to the pierce height
-  Igniting,    ///< torch on, waiting for arc-OK
+  Igniting,    ///< torch on, waiting for arc-OK (oxy-fuel: for the flame, ignite_s)
   Piercing,    ///< the pierce delay
   Puddle,      ///< the puddle jump: moving off at the puddle height
   ToCut,       ///< down to the cut height
@@ -21,6 +21,7 @@ enum class TorchPhase : std::uint8_t {
   Retracting,  ///< torch off, back to the programmed height
   Paused,      ///< held (the operator, an arc loss): torch off; a resume pierces again here
   Failed,      ///< no plate found, or too many failed starts: the run is held
+  Preheating,  ///< oxy-fuel: the flame heats the plate (by time, or until the operator's start)
 };
 
 /// What the height control does in a period.
@@ -43,6 +44,8 @@ enum class TorchEvent : std::uint8_t {
   PlateNotFound,    ///< the probe went its whole travel without the switch: feed hold
   Breakaway,        ///< the torch's breakaway switch (it hit something): torch off, feed hold
   FloatTripped,     ///< the float switch while the torch burns (it touched the plate): torch off, feed hold
+  PreheatWaits,     ///< oxy-fuel: the preheat waits for the operator's start (StartCut)
+  CutStarted,       ///< oxy-fuel: the preheat ended (`value`: its seconds); cutting oxygen on
 };
 
 struct TorchStatus {
@@ -64,6 +67,15 @@ struct TorchStatus {
   std::uint32_t failed_starts = 0;
   std::uint32_t breakaways = 0;   ///< breakaway switch trips during a cut
   std::uint32_t float_trips = 0;  ///< float switch trips while the torch burned
+  // Oxy-fuel.
+  bool oxy_fuel = false;        ///< the torch is a flame (no arc: arc-OK and voltages unused)
+  bool cut_oxygen = false;      ///< the cutting oxygen output
+  bool waiting_start = false;   ///< the preheat waits for the operator's start
+  double sensor_height_mm = 0;  ///< the capacitive sensor's height, filtered (mm; its range when out of it)
+  double preheat_s = 0;         ///< this (or the last) preheat so far
+  double preheat_total_s = 0;   ///< every preheat since the machine started
+  std::uint32_t preheats = 0;   ///< preheats begun
+  std::uint32_t operator_starts = 0;  ///< preheats ended by the operator's start
 };
 
 static_assert(std::is_trivially_copyable_v<TorchStatus>);

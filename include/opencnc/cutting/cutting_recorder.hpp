@@ -30,7 +30,12 @@ struct CuttingReport {
   std::uint64_t breakaways = 0;    ///< the torch's breakaway switch during a cut
   std::uint64_t holes_slowed = 0;  ///< the height held by the program (M192) at a slowed hole
   std::uint64_t void_locks = 0;    ///< times a voltage jump held the height (kerf crossings)
-  bool height_measured = false;    ///< true: from the simulated plate; false: from the arc voltage
+  bool height_measured =
+      false;                   ///< true: the simulated plate's; false: from the arc voltage or height sensor
+  bool oxy_fuel = false;       ///< an oxy-fuel torch (`process`: "oxy-fuel"; else "plasma")
+  std::uint64_t preheats = 0;  ///< oxy-fuel: preheats begun
+  double preheat_s = 0;        ///< oxy-fuel: time spent preheating
+  std::uint64_t operator_starts = 0;  ///< oxy-fuel: preheats ended by the operator's start
 };
 
 /// Controller thread (an observer with trace on); its report section (`cutting`) after the run.
@@ -55,6 +60,8 @@ class CuttingRecorder final : public controller::ControllerObserver, public cont
   std::uint64_t cutting_ = 0, in_band_ = 0, active_ = 0;
   bool first_ = true;
   std::uint32_t pierces0_ = 0, losses0_ = 0, failed0_ = 0, trips0_ = 0, breakaways0_ = 0;
+  std::uint32_t preheats0_ = 0, starts0_ = 0;
+  double preheat0_s_ = 0;
   bool hold_before_ = false;
   control::ThcState thc_before_ = control::ThcState::Off;
 };

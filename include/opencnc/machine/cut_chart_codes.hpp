@@ -18,5 +18,6 @@ inline constexpr int kChartCutHeightCode = 1943;
 inline constexpr int kChartArcVoltageCode = 1944;  ///< 0: the profile's (auto volts when that is 0)
 inline constexpr int kChartPuddleHeightCode = 1945;
 inline constexpr int kChartPuddleDelayCode = 1946;
+inline constexpr int kChartPreheatCode = 1947;  ///< oxy-fuel's preheat time; 0: the profile's
 
 }  // namespace opencnc::machine

@@ -21,6 +21,14 @@ inline constexpr int kThcReleaseCode = 193;
 /// float up by `switch_offset_mm`) or ohmic contact (the nozzle touching the plate).
 enum class PlateSensor : std::int32_t { Float = 0, Ohmic = 1 };
 
+/// Which torch the stage drives: a plasma arc (arc voltage, arc-OK, float switch or ohmic
+/// contact) or an oxy-fuel flame (a capacitive height sensor, preheat, cutting oxygen; no arc).
+enum class TorchProcess : std::int32_t { Plasma = 0, OxyFuel = 1 };
+
+/// How an oxy-fuel preheat ends: after `preheat_s` (the operator's start may cut it short), or
+/// only at the operator's start (CommandKind::StartCut: the steel glows, the operator says so).
+enum class PreheatMode : std::int32_t { Time = 0, Operator = 1 };
+
 /// The torch's sequence and its height control, as the tick runs them (control::TorchHeight).
 /// Heights are above the plate's top, mm; every double first, then 32-bit integers in pairs: no
 /// padding, so that equal settings are equal bytes (control::shared_setup).
@@ -53,6 +61,15 @@ struct PlasmaConfig {
   double void_jump_v = 5;         ///< a voltage this far from the target holds (kerf crossing, void)
   double void_hold_s = 0.08;      ///< and holds this long after it is back within
   double anti_dive_mm_s2 = 100;   ///< the path braking harder than this holds (anti-dive)
+  // Oxy-fuel ([process.oxyfuel]): the flame's sequence and the capacitive height sensor.
+  double preheat_height_mm = 7;      ///< the flame preheats the plate this high above it
+  double preheat_s = 4;              ///< preheat by time: this long (0: straight to the pierce)
+  double ignite_s = 0.5;             ///< torch on (fuel gas, preheat oxygen, spark) to a lit flame
+  double sensor_volts_per_mm = 0.5;  ///< the height sensor's reading per mm of height (V/mm)
+  double sensor_zero_v = 0;          ///< its reading at zero height (V)
+  double sensor_range_mm = 25;       ///< heights above this are out of its range (no plate under it)
+  double height_jump_mm = 1;         ///< the measured height this far from the cut height holds
+  double deadband_mm = 0.04;         ///< no correction within this much of the cut height
   // Inputs, the torch axis, limits.
   std::int32_t arc_voltage_input = 0;  ///< analog input of the arc voltage (divided), V
   std::int32_t sensor_input = 0;       ///< digital input of the float switch or ohmic contact
@@ -62,10 +79,15 @@ struct PlasmaConfig {
   std::int32_t enabled = 0;     ///< 1: the machine has [process.plasma]
   std::int32_t thc = 1;         ///< 0: the height stays where the probe put it (no THC)
   std::int32_t breakaway_input = -1;  ///< digital input of the torch's breakaway switch (-1: none)
+  TorchProcess process = TorchProcess::Plasma;
+  PreheatMode preheat = PreheatMode::Time;
+  std::int32_t height_input = 0;        ///< oxy-fuel: analog input of the capacitive height sensor, V
+  std::int32_t cut_oxygen_output = -1;  ///< oxy-fuel: digital output of the cutting oxygen valve
+  bool oxy_fuel() const noexcept { return process == TorchProcess::OxyFuel; }
 };
 
 static_assert(std::is_trivially_copyable_v<PlasmaConfig>);
-static_assert(sizeof(PlasmaConfig) == 26 * sizeof(double) + 8 * sizeof(std::int32_t),
+static_assert(sizeof(PlasmaConfig) == 34 * sizeof(double) + 12 * sizeof(std::int32_t),
               "PlasmaConfig must have no padding (shared_setup compares set-ups byte for byte)");
 
 /// The simulated plate and arc (`[process.plasma.sim]`, docs/cutting.md): a warped plate whose
@@ -96,6 +118,13 @@ struct SimPlasmaConfig {
   PlateSensor sensor = PlateSensor::Float;
   double switch_offset_mm = 1.5;  ///< the float's travel before its switch trips
   std::int32_t arc_voltage_input = 0, sensor_input = 0;
+  // Oxy-fuel ([process.oxyfuel.sim]): no arc; the flame burns while the torch output is on, the
+  // cutting oxygen (its digital output) cuts the kerf; a capacitive height sensor reads the height.
+  bool oxy_fuel = false;
+  std::int32_t height_input = 0, cut_oxygen_output = -1;
+  double sensor_volts_per_mm = 0.5, sensor_zero_v = 0, sensor_range_mm = 25;
+  double height_noise_mm = 0.02;  ///< ± uniform noise of the sensed height
+  double kerf_height_mm = 2;      ///< the sensor reads this much higher over a kerf (less steel under it)
 };
 
 }  // namespace opencnc::machine

@@ -149,6 +149,7 @@ class SimMachine final : public MachineIO {
   // The outputs latched by the last write() that the machine uses between writes.
   bool estop_release_ = false;
   ProcessOutputs process_{};
+  std::uint64_t digital_out_ = 0;  ///< the last digital outputs (the oxy-fuel torch's cutting oxygen)
   ToolChangerOutputs tool_{};
   MachineInputs inputs_{};
   // Injected world.

@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // SimPlasmaProcess — the simulated plasma cut: a warped plate, the arc voltage from the torch's
 // height and speed, kerfs already cut (the voltage jumps over them), noise, arc-OK after a delay,
-// arc losses (random or injected), the float switch or ohmic contact (docs/cutting.md).
+// arc losses (random or injected), the float switch or ohmic contact; or, for an oxy-fuel torch,
+// the same plate cut by the flame's cutting oxygen and read by a capacitive height sensor (noise,
+// higher over a kerf, out of range off the plate) (docs/cutting.md).
 #pragma once
 
 #include <array>
@@ -33,10 +35,14 @@ class PlateSurface {
 class SimPlasmaProcess {
  public:
   void configure(const SimPlasmaConfig& config, double period_s);
-  /// One period with the torch's tip at (x, y, z) (the joints' positions) and the torch output.
-  void step(double x, double y, double z, bool torch_on) noexcept;
-  /// Arc-OK, the arc voltage (its analog input) and the plate sensor (its digital input).
+  /// One period with the torch's tip at (x, y, z) (the joints' positions), the torch output and
+  /// (oxy-fuel) the cutting oxygen output.
+  void step(double x, double y, double z, bool torch_on, bool cut_oxygen = false) noexcept;
+  /// Plasma: arc-OK, the arc voltage (its analog input) and the plate sensor (its digital input).
+  /// Oxy-fuel: the capacitive height sensor (its analog input).
   void sample(MachineInputs& in) noexcept;
+  /// Oxy-fuel: the height the sensor reads now before its noise (mm; its range off the plate).
+  double sensed_height_mm() const noexcept;
   /// The arc goes out now and stays out until the torch is switched off and on again.
   void inject_arc_loss() noexcept { loss_pending_ = true; }
 
@@ -76,6 +82,7 @@ class SimPlasmaProcess {
   double height_ = 0, speed_ = 0, voltage_ = 0;
   bool arc_ = false, blocked_ = false, loss_pending_ = false, over_kerf_ = false;
   bool torch_on_ = false;
+  bool on_plate_ = false;  ///< the torch is over the plate's extent
   double transfer_s_ = 0;
   double z_ = 0, plate_ = 0;
   std::uint32_t losses_ = 0;

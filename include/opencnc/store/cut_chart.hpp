@@ -30,6 +30,7 @@ struct Material {
   double amperage_a = 0;        ///< for the operator (set on the power source)
   double puddle_height_mm = 0;  ///< a puddle jump after the pierce (0: none)
   double puddle_delay_s = 0;
+  double preheat_s = 0;  ///< oxy-fuel: the preheat's time (0: the profile's); a plasma row has none
   bool operator==(const Material&) const = default;
 };
 
@@ -65,7 +66,7 @@ std::optional<Invalid> invalid(const std::vector<Material>& chart);
 /// The material numbered `number`, or null. Any thread.
 const Material* find(const std::vector<Material>& chart, int number) noexcept;
 
-/// A cut chart from CSV text: a header naming the columns (any order; the puddle columns may be
+/// A cut chart from CSV text: a header naming the columns (any order; the puddle and preheat columns may be
 /// left out), one material a line, `#` comment lines and blank lines skipped, fields quoted with
 /// "" when they hold a comma or a quote. Every problem is an error at `file:line:col` in `diags`;
 /// with any, nothing is returned. Any thread.

@@ -23,7 +23,9 @@ export interface Material {
   amperage_a: number;
   puddle_height_mm: number;
   puddle_delay_s: number;
-  [field: string]: number | string;
+  /** Oxy-fuel: the preheat's time (0: the profile's); absent in an older server's answer. */
+  preheat_s?: number;
+  [field: string]: number | string | undefined;
 }
 
 /** One change as the chart's audit keeps it. */
@@ -57,7 +59,7 @@ export function materialCells(m: Material): string[] {
     m.process,
     `${m.kerf_width_mm}`,
     `${m.feed_mm_min}`,
-    `${m.pierce_height_mm} / ${m.pierce_delay_s}`,
+    `${m.pierce_height_mm} / ${m.pierce_delay_s}` + (m.process === "oxy-fuel" ? ` · preheat ${m.preheat_s ? `${m.preheat_s} s` : "profile's"}` : ""),
     `${m.cut_height_mm}`,
     m.arc_voltage_v > 0 ? `${m.arc_voltage_v}` : "auto",
     `${m.amperage_a}`,
@@ -86,6 +88,7 @@ const bounds: Record<string, [number, number, boolean]> = {
   amperage_a: [0, 2000, true],
   puddle_height_mm: [0, 100, true],
   puddle_delay_s: [0, 600, true],
+  preheat_s: [0, 600, true],
 };
 
 /** The fields of the edit form, in the chart's order. */
@@ -108,7 +111,7 @@ export function materialBody(base: Partial<Material>, inputs: Record<string, str
   if (process !== "plasma" && process !== "oxy-fuel") return `process: plasma or oxy-fuel, not "${process}"`;
   out.process = process;
   for (const [f, [lo, hi, zero]] of Object.entries(bounds)) {
-    const t = typed(f);
+    const t = f === "preheat_s" && typed(f) === "" ? "0" : typed(f);  // a chart from before the preheat: none
     const v = Number(t);
     if (t === "" || !Number.isFinite(v)) return `${f}: "${t}" is not a number`;
     if ((zero ? v < lo : v <= lo) || v > hi) return `${f}: ${v} is not ${zero ? "from" : "above"} ${lo}${zero ? " to" : " and at most"} ${hi}`;
@@ -117,6 +120,7 @@ export function materialBody(base: Partial<Material>, inputs: Record<string, str
   if ((out.cut_height_mm as number) > (out.pierce_height_mm as number))
     return `cut_height_mm: ${out.cut_height_mm} is above the pierce height ${out.pierce_height_mm}`;
   if ((out.puddle_delay_s as number) > 0 && out.puddle_height_mm === 0) return "puddle_delay_s: a puddle delay needs a puddle height";
+  if ((out.preheat_s as number) > 0 && out.process === "plasma") return "preheat_s: a plasma material has no preheat (oxy-fuel only)";
   return { action: "set", material: out };
 }
 
@@ -226,7 +230,7 @@ function render(ctx: Context, c: CutChart) {
       return tr;
     }),
   );
-  editor.replaceChildren(...(adminToken ? [button("New material (admin)", () => edit(ctx, { process: "plasma", puddle_height_mm: 0, puddle_delay_s: 0, arc_voltage_v: 0 }))] : []));
+  editor.replaceChildren(...(adminToken ? [button("New material (admin)", () => edit(ctx, { process: "plasma", puddle_height_mm: 0, puddle_delay_s: 0, preheat_s: 0, arc_voltage_v: 0 }))] : []));
   changes.textContent = c.audit.slice(-8).map(changeLine).join("\n");
 }
 
