@@ -15,11 +15,13 @@
 #include <string>
 #include <vector>
 
+#include "audit_line.hpp"
 #include "cli_files.hpp"
 #include "commands.hpp"
 #include "opencnc/config/cut_chart_profile.hpp"
 #include "opencnc/config/profile_loader.hpp"
 #include "opencnc/core/atomic_file.hpp"
+#include "opencnc/hmi/store_json.hpp"
 #include "opencnc/store/cut_chart_store.hpp"
 
 namespace opencnc::cli {
@@ -46,20 +48,6 @@ void print(const Options& o, const nlohmann::json& j, const std::string& text) {
     fmt::print("{}\n", j.dump(2));
   else if (!text.empty())
     fmt::print("{}", text.back() == '\n' ? text : text + "\n");
-}
-
-nlohmann::json material_json(const store::Material& m) {
-  nlohmann::json j;
-  for (const store::MaterialField& f : store::material_fields()) {
-    const std::string_view name = f.name;
-    if (name == "name" || name == "process")
-      j[f.name] = store::field_text(m, name);
-    else if (name == "number")
-      j[f.name] = m.number;
-    else
-      j[f.name] = store::field_number(m, name);
-  }
-  return j;
 }
 
 std::optional<int> material_number(const std::vector<std::string>& words) {
@@ -100,7 +88,7 @@ int list(store::CutChartStore& s, const Options& o) {
       fmt::format("{:>6}  {:<28} {:>6} {:<8} {:>5} {:>6} {:>6} {:>5} {:>5} {:>6} {:>5}\n", "number", "name",
                   "mm", "process", "kerf", "feed", "pierce", "delay", "cut", "volts", "amps");
   for (const store::Material& m : *chart) {
-    j.push_back(material_json(m));
+    j.push_back(hmi::material_json(m));
     text += fmt::format("{:>6}{} {:<28} {:>6} {:<8} {:>5} {:>6} {:>6} {:>5} {:>5} {:>6} {:>5}\n", m.number,
                         m.number == selected ? "*" : " ", m.name, m.thickness_mm, store::to_string(m.process),
                         m.kerf_width_mm, m.feed_mm_min, m.pierce_height_mm, m.pierce_delay_s, m.cut_height_mm,
@@ -121,7 +109,7 @@ int show(store::CutChartStore& s, const Options& o) {
   std::string text;
   for (const store::MaterialField& f : store::material_fields())
     text += fmt::format("{:<18} {}\n", f.name, store::field_text(*m, f.name));
-  print(o, material_json(*m), text);
+  print(o, hmi::material_json(*m), text);
   return kExitOk;
 }
 
@@ -144,7 +132,7 @@ int set(store::CutChartStore& s, const Options& o) {
       return fail(fmt::format("{}: {} (nothing changed)", field, *why), kExitUsage);
   }
   if (!s.put(m, kInterface, &error)) return fail(fmt::format("{} (nothing changed)", error));
-  print(o, material_json(m), fmt::format("material {} set", m.number));
+  print(o, hmi::material_json(m), fmt::format("material {} set", m.number));
   return kExitOk;
 }
 
@@ -205,15 +193,8 @@ int audit(store::CutChartStore& s, const Options& o) {
   nlohmann::json j = nlohmann::json::array();
   std::string text;
   for (const store::AuditEntry& e : entries) {
-    j.push_back({{"at_utc", e.at_utc},
-                 {"interface", e.interface},
-                 {"reason", e.reason},
-                 {"what", e.what},
-                 {"old", e.old_value},
-                 {"new", e.new_value}});
-    text += fmt::format("{}  {:<12} {:<20} {:<26} {} -> {}\n", e.at_utc, e.interface, e.reason, e.what,
-                        e.old_value.empty() ? "(none)" : e.old_value,
-                        e.new_value.empty() ? "(none)" : e.new_value);
+    j.push_back(hmi::audit_json(e));
+    text += audit_line(e, 20, 26);
   }
   print(o, j, text);
   return kExitOk;

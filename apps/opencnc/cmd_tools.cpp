@@ -17,10 +17,12 @@
 #include <string>
 #include <vector>
 
+#include "audit_line.hpp"
 #include "cli_files.hpp"
 #include "commands.hpp"
 #include "opencnc/config/profile_loader.hpp"
 #include "opencnc/core/atomic_file.hpp"
+#include "opencnc/hmi/store_json.hpp"
 #include "opencnc/store/tool_store.hpp"
 #include "opencnc/toolguard/tool_guard.hpp"
 #include "opencnc/tools/edge_mapping.hpp"
@@ -363,15 +365,8 @@ int audit(store::ToolStore& s, const ToolsOptions& o) {
   nlohmann::json j = nlohmann::json::array();
   std::string text;
   for (const store::AuditEntry& e : entries) {
-    j.push_back({{"at_utc", e.at_utc},
-                 {"interface", e.interface},
-                 {"reason", e.reason},
-                 {"what", e.what},
-                 {"old", e.old_value},
-                 {"new", e.new_value}});
-    text += fmt::format("{}  {:<12} {:<24} {:<22} {} -> {}\n", e.at_utc, e.interface, e.reason, e.what,
-                        e.old_value.empty() ? "(none)" : e.old_value,
-                        e.new_value.empty() ? "(none)" : e.new_value);
+    j.push_back(hmi::audit_json(e));
+    text += audit_line(e, 24, 22);
   }
   print(o, j, text);
   return kExitOk;

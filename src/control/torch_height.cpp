@@ -289,8 +289,12 @@ double TorchHeight::height_error_mm() const noexcept {
   return (status_.filtered_voltage_v - status_.target_voltage_v) / config_.volts_per_mm;
 }
 
+// Oxy-fuel: only a reading that says the torch is higher than it is (a kerf or a hole under the
+// ring: less steel) or out of range (the plate's edge) holds; following it would dive. A reading
+// far below the cut height is followed up — the plate nearer than the cut height, whether it rose
+// or was found low (sensed over a kerf already cut: a retrace's C) — which never dives.
 bool TorchHeight::jumped() const noexcept {
-  if (config_.oxy_fuel()) return !sensor_in_range_ || std::fabs(height_error_mm()) > config_.height_jump_mm;
+  if (config_.oxy_fuel()) return !sensor_in_range_ || height_error_mm() > config_.height_jump_mm;
   return std::fabs(status_.filtered_voltage_v - status_.target_voltage_v) > config_.void_jump_v;
 }
 

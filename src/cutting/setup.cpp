@@ -113,9 +113,10 @@ class Texts final : public controller::EventTexts {
       case control::TorchEvent::Breakaway:
         return controller::EventNote{
             Severity::Error, "control.torch.breakaway",
-            "plasma: the torch's breakaway switch tripped (it hit a tipped part or the plate); the torch is "
-            "off "
-            "and the run held: seat the torch, then resume to pierce again where it stands, or retrace"};
+            fmt::format("{}: the torch's breakaway switch tripped (it hit a tipped part or the plate); the "
+                        "torch is off and the run held: seat the torch, then resume to pierce again where it "
+                        "stands, or retrace",
+                        p.plasma.config.oxy_fuel() ? "oxy-fuel" : "plasma")};
       case control::TorchEvent::FloatTripped:
         return controller::EventNote{
             Severity::Error, "control.torch.float-tripped",
@@ -150,8 +151,9 @@ class State final : public controller::FeatureState {
   std::string state_key() const override { return "cutting"; }
   std::string state_json(const controller::ControllerStatus& s) override {
     const control::TorchStatus& t = s.servo.torch;
-    // Why the torch stage holds the run, for the HMI's dialog: an arc lost since the torch was
-    // last outside a pause, or a failed start (no arc-OK after its retries, no plate).
+    // Why the torch stage holds the run, for the HMI's dialog: a breakaway, a float trip or an arc
+    // lost since the torch was last outside a pause, or a failed start (no arc-OK after its
+    // retries, no plate).
     const bool paused = t.phase == control::TorchPhase::Paused;
     if (!paused && t.phase != control::TorchPhase::Failed) {
       losses_ = t.arc_losses;

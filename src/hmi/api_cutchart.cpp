@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "opencnc/config/cut_chart_profile.hpp"
+#include "opencnc/hmi/store_json.hpp"
 #include "opencnc/store/cut_chart_store.hpp"
 
 namespace opencnc::hmi {
@@ -17,20 +18,6 @@ namespace {
 using nlohmann::json;
 
 constexpr const char* kInterface = "hmi";
-
-json material_json(const store::Material& m) {
-  json j;
-  for (const store::MaterialField& f : store::material_fields()) {
-    const std::string_view name = f.name;
-    if (name == "name" || name == "process")
-      j[f.name] = store::field_text(m, name);
-    else if (name == "number")
-      j[f.name] = m.number;
-    else
-      j[f.name] = store::field_number(m, name);
-  }
-  return j;
-}
 
 CutChartAnswer error(int status, std::string message) {
   return {status, json{{"error", std::move(message)}}};
@@ -59,13 +46,7 @@ CutChartAnswer chart_json(store::CutChartStore& s) {
   for (const store::Material& m : *chart) materials.push_back(material_json(m));
   for (const store::MaterialField& f : store::material_fields())
     fields.push_back({{"name", f.name}, {"required", f.required}});
-  for (const store::AuditEntry& e : s.audit(20))
-    audit.push_back({{"at_utc", e.at_utc},
-                     {"interface", e.interface},
-                     {"reason", e.reason},
-                     {"what", e.what},
-                     {"old", e.old_value},
-                     {"new", e.new_value}});
+  for (const store::AuditEntry& e : s.audit(20)) audit.push_back(audit_json(e));
   return {200, json{{"store", s.path()},
                     {"selected", s.selected().value_or(0)},
                     {"fields", fields},

@@ -8,7 +8,11 @@
 
 #include "opencnc/store/database.hpp"
 
+#include "guarded.hpp"
+
 namespace opencnc::store {
+
+using detail::guarded;
 
 namespace {
 
@@ -156,16 +160,6 @@ std::vector<Change> diff(const std::vector<Material>& before, const std::vector<
     if (find(after, b.number) == nullptr)
       out.push_back({fmt::format("material {}", b.number), all_values(b), ""});
   return out;
-}
-
-template <class F>
-auto guarded(std::string* error, F&& f) -> decltype(f()) {
-  try {
-    return f();
-  } catch (const std::exception& ex) {
-    if (error != nullptr) *error = ex.what();
-    return {};
-  }
 }
 
 }  // namespace

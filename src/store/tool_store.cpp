@@ -11,12 +11,16 @@
 #include "opencnc/tools/edge_mapping.hpp"
 #include "opencnc/tools/tool_check.hpp"
 
+#include "guarded.hpp"
+
 namespace opencnc::store {
 
 using tools::Edge;
 using tools::Param;
 using tools::Tool;
 using tools::ToolSet;
+
+using detail::guarded;
 
 namespace {
 
@@ -179,16 +183,6 @@ void replace_live(Database& db, const ToolSet& set) {
       for (std::size_t i = 0; i < tools::kParamCount; ++i) es.bind(static_cast<int>(i) + 3, e.values[i]);
       es.run();
     }
-  }
-}
-
-template <class F>
-auto guarded(std::string* error, F&& f) -> decltype(f()) {
-  try {
-    return f();
-  } catch (const std::exception& ex) {
-    if (error != nullptr) *error = ex.what();
-    return {};
   }
 }
 

@@ -6,26 +6,7 @@
 # an error and its feed a warning at the line (opencnc run's preflight), examples/plasma-cutchart.ngc cut.
 #   tests/cli/cutchart_cli.sh OPENCNC SOURCE_DIR
 set -eu
-case ${1:-} in
-  -h | --help) echo "usage: $0 OPENCNC SOURCE_DIR"; exit 0 ;;
-  "" | -*) echo "usage: $0 OPENCNC SOURCE_DIR" >&2; exit 2 ;;
-esac
-B=$1 SRC=$2
-dir=$(mktemp -d)
-trap 'rm -rf "$dir"' EXIT
-cd "$dir"
-fail() { echo "FAIL: $*"; exit 1; }
-expect() {  # expect EXIT PATTERN command...: the exit code and a line of its output
-  want=$1 pattern=$2
-  shift 2
-  set +e
-  out=$("$@" 2>&1)
-  rc=$?
-  set -e
-  printf '%s\n' "$out"
-  [ "$rc" -eq "$want" ] || fail "exit $rc, not $want: $*"
-  [ "$pattern" = - ] || printf '%s\n' "$out" | grep -Eq -- "$pattern" || fail "no '$pattern' in the output of: $*"
-}
+. "$(dirname "$0")/cli_harness.sh"
 C="$B cutchart --db chart.db"
 
 expect 2 "import CHART.csv. creates a cut chart" $C list

@@ -5,26 +5,7 @@
 # within the band, restore and accept, the 840D export read back exactly, the audit.
 #   tests/cli/tools_cli.sh OPENCNC SOURCE_DIR
 set -eu
-case ${1:-} in
-  -h | --help) echo "usage: $0 OPENCNC SOURCE_DIR"; exit 0 ;;
-  "" | -*) echo "usage: $0 OPENCNC SOURCE_DIR" >&2; exit 2 ;;
-esac
-B=$1 SRC=$2
-dir=$(mktemp -d)
-trap 'rm -rf "$dir"' EXIT
-cd "$dir"
-fail() { echo "FAIL: $*"; exit 1; }
-expect() {  # expect EXIT PATTERN command...: the exit code and a line of its output
-  want=$1 pattern=$2
-  shift 2
-  set +e
-  out=$("$@" 2>&1)
-  rc=$?
-  set -e
-  printf '%s\n' "$out"
-  [ "$rc" -eq "$want" ] || fail "exit $rc, not $want: $*"
-  [ "$pattern" = - ] || printf '%s\n' "$out" | grep -Eq -- "$pattern" || fail "no '$pattern' in the output of: $*"
-}
+. "$(dirname "$0")/cli_harness.sh"
 T="$B tools --db tools.db"
 run() { $B run "$SRC/examples/hmc-toolcheck-demo.ngc" --machine "$SRC/configs/hmc-toolcheck.toml" \
   --set "tool_guard.store=\"$dir/tools.db\"" --set tool_changer.sim.prepare_time_s=0.05 \

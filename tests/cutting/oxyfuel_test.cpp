@@ -280,6 +280,28 @@ TEST(OxyFuelTorch, AKerfOrThePlatesEdgeUnderTheSensorHoldsTheHeight) {
   EXPECT_FALSE(t.hold_requested());
 }
 
+// Sensed over a kerf already cut (a retrace's C on its own path): the ring reads 2 mm more, so the
+// plate is taken 2 mm low and the torch cuts the kerf 2 mm lower than it should; on solid plate
+// the reading is 2 mm under the cut height, which is followed up (never a dive), not held.
+TEST(OxyFuelTorch, APlateSensedOverAKerfIsFollowedUpOnceTheKerfEnds) {
+  TorchHeight t;
+  t.configure(oxy(), kPeriod);
+  World w;
+  w.extra_mm = 2;
+  cutting(t, w);
+  EXPECT_NEAR(t.status().plate_z_mm, w.plate_z - 2, 0.05) << "taken low over the kerf";
+  EXPECT_NEAR(w.height(t), 5, 0.06);
+  w.extra_mm = 0;  // the kerf ends
+  bool locked = false;
+  run(t, w, 1000, [&] {
+    locked = locked || t.status().thc == ThcState::VoidLock;
+    return false;
+  });
+  EXPECT_FALSE(locked);
+  EXPECT_EQ(t.status().thc, ThcState::Active);
+  EXPECT_NEAR(w.height(t), 7, 0.06) << "up to the cut height";
+}
+
 TEST(OxyFuelTorch, WithoutThePlateInTheSensorsReachWithinTheTravelTheRunIsHeld) {
   TorchHeight t;
   t.configure(oxy(), kPeriod);
