@@ -309,7 +309,7 @@ void GapServo::run_finish(const GapInputs& in, bool due) noexcept {
   const bool turning = cond_.lateral_servo && orbit_rate_ != 0;
   run_jump(due && v_ == 0 && lateral_v_ == 0 && !turning && !shorted);
   feed_scale_ = 0;
-  run_lateral(in, lateral, due || jump_ != Jump::Idle);
+  run_lateral(in, lateral);
   status_.generator = jump_ == Jump::Idle;
   if (status_.generator) machining_s_ += period_s_;
   adapt(in);
@@ -323,9 +323,9 @@ void GapServo::run_finish(const GapInputs& in, bool due) noexcept {
 // The orbit's radius at the lateral servo's speed (out at most at the condition's forward speed,
 // in at the growth's rate, at the retract speed on a short) within the tool axis' acceleration,
 // between the centre and the condition's radius; it turns as the lateral servo lets it, and comes
-// to a stop (within its acceleration) when `stop` (a jump due or under way). A shape still
-// spiralling in from another condition goes on doing so first.
-void GapServo::run_lateral(const GapInputs& in, double target, bool stop) noexcept {
+// to a stop (within its acceleration) for a jump due or under way. A shape still spiralling in
+// from another condition goes on doing so first. The finishing cycle's own.
+void GapServo::run_lateral(const GapInputs& in, double target) noexcept {
   if (shape_ != cond_.orbit || cond_.orbit_period_s <= 0) {
     run_orbit(in);
     return;
@@ -337,6 +337,7 @@ void GapServo::run_lateral(const GapInputs& in, double target, bool stop) noexce
   const double limited = std::clamp(target, in.gap_state == machine::GapState::Short ? target : -draw_rate_,
                                     cond_.max_forward_mm_s);
   lateral_v_ = std::clamp(limited, lateral_v_ - dv, lateral_v_ + dv);
+  const bool stop = jump_due() || jump_ != Jump::Idle;
   if (cond_.lateral_servo) follow_gap(in.gap_state == machine::GapState::Short || stop);
   turn();
   const double r = std::clamp(radius_ + lateral_v_ * period_s_, 0.0, cond_.orbit_radius_mm);
@@ -493,10 +494,11 @@ void GapServo::run_orbit(const GapInputs& in) noexcept {
 }
 
 // The lateral servo's share of the orbit: it turns at its period while the filtered gap voltage is
-// at the reference or above and slows to a stop as it falls to half the reference (a short, or
-// `stop`: at once), the orbit's speed changing within a quarter of the tool axis' acceleration, so
-// that the electrode does not run into a side wall faster than the side discharges burn it back.
-void GapServo::follow_gap(bool stop) noexcept {
+// at the reference or above and slows to a stop as it falls to half the reference (`shorted`: a
+// short, or in the finishing cycle a jump due or under way — at once), the orbit's speed changing
+// within a quarter of the tool axis' acceleration, so that the electrode does not run into a side
+// wall faster than the side discharges burn it back.
+void GapServo::follow_gap(bool shorted) noexcept {
   const double ref = cond_.servo_reference_v;
   // In the finishing cycle at the full radius the last turn goes twice as fast while the gap is at
   // the reference or wider (slower as it closes, as above): the floor burns on at the final depth
@@ -504,7 +506,7 @@ void GapServo::follow_gap(bool stop) noexcept {
   // size they stay (docs/edm.md, "The turbine channel without dwell").
   const double fastest = finishing_ && radius_ >= cond_.orbit_radius_mm - kFullWithin_mm ? 2.0 : 1.0;
   const double target =
-      stop || ref <= 0
+      shorted || ref <= 0
           ? 0.0
           : fastest * std::clamp((status_.filtered_voltage_v - 0.5 * ref) / (0.5 * ref), 0.0, 1.0);
   const double r = std::max(radius_, 1e-6);

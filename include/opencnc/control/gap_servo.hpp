@@ -106,13 +106,13 @@ class GapServo {
   bool select(int code, double p, double q) noexcept;
   double servo_speed(const GapInputs& in, bool brake) noexcept;
   void run_finish(const GapInputs& in, bool due) noexcept;
-  void run_lateral(const GapInputs& in, double target, bool stop) noexcept;
+  void run_lateral(const GapInputs& in, double target) noexcept;
   void adapt(const GapInputs& in) noexcept;
   bool jump_due() const noexcept;
   void move_electrode(double v, const GapInputs& in) noexcept;
   void run_jump(bool may_start) noexcept;
   void run_orbit(const GapInputs& in) noexcept;
-  void follow_gap(bool stop) noexcept;
+  void follow_gap(bool shorted) noexcept;
   void turn() noexcept;
   void return_offsets() noexcept;
   void catch_up() noexcept;
