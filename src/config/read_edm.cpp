@@ -122,6 +122,20 @@ void read_jump(Section& t, EdmCondition& c, const MachineProfile& p) {
             "config.range");
 }
 
+// The fastest a shape moves at its period: a circle 2πr/T; the square's edges and the star's rays,
+// run with a smooth start and stop, peak at 1.5 and π/2 times their mean (8r/T and 16r/T).
+double orbit_peak_mm_s(const EdmCondition& c) {
+  const double r = c.orbit_radius_mm, period = c.orbit_period_s;
+  return c.orbit == machine::OrbitKind::Circle   ? 6.283185307179586 * r / period
+         : c.orbit == machine::OrbitKind::Square ? 1.5 * 8 * r / period
+                                                 : 1.5707963267948966 * 16 * r / period;
+}
+
+double orbit_speed_limit(const MachineProfile& p) {
+  const machine::EdmConfig& e = p.edm.config;
+  return std::min(speed_limit(p, e.orbit_axes[0]), speed_limit(p, e.orbit_axes[1]));
+}
+
 void read_orbit(Section& t, EdmCondition& c, const MachineProfile& p) {
   c.orbit = t.choice<machine::OrbitKind>("orbit",
                                          {{"none", machine::OrbitKind::None},
@@ -135,15 +149,8 @@ void read_orbit(Section& t, EdmCondition& c, const MachineProfile& p) {
   if (c.orbit == machine::OrbitKind::None) return;
   if (c.orbit_radius_mm <= 0) t.error("orbit", "an orbit needs orbit_radius_mm > 0", "config.range");
   if (c.orbit_period_s <= 0) t.error("orbit", "an orbit needs orbit_period_s > 0", "config.range");
-  // The fastest a shape moves: a circle 2πr/T; the square's edges and the star's rays, run with
-  // a smooth start and stop, peak at 1.5 and π/2 times their mean (8r/T and 16r/T).
   if (c.orbit_period_s <= 0) return;
-  const double r = c.orbit_radius_mm, period = c.orbit_period_s;
-  const double peak = c.orbit == machine::OrbitKind::Circle   ? 6.283185307179586 * r / period
-                      : c.orbit == machine::OrbitKind::Square ? 1.5 * 8 * r / period
-                                                              : 1.5707963267948966 * 16 * r / period;
-  const machine::EdmConfig& e = p.edm.config;
-  const double v_max = std::min(speed_limit(p, e.orbit_axes[0]), speed_limit(p, e.orbit_axes[1]));
+  const double peak = orbit_peak_mm_s(c), v_max = orbit_speed_limit(p);
   if (v_max > 0 && peak > v_max)
     t.error("orbit_period_s",
             fmt::format("{}: the orbit would move at {} mm/s, above the orbit axes' max_velocity ({} mm/s)",
@@ -151,7 +158,8 @@ void read_orbit(Section& t, EdmCondition& c, const MachineProfile& p) {
             "config.range");
 }
 
-// The finishing cycle needs an orbit to finish.
+// The finishing cycle needs an orbit to finish. Under the lateral servo its last turn at full size
+// runs at twice the period's speed (GapServo::follow_gap): that, too, within the orbit axes' limit.
 void read_finish(Section& t, EdmCondition& c, const MachineProfile& p) {
   c.orbit_finish = t.boolean_or("orbit_finish", false);
   c.finish_timeout_s = t.number_or("finish_timeout_s", p.edm.config.finish_timeout_s, Bound::Positive);
@@ -160,6 +168,15 @@ void read_finish(Section& t, EdmCondition& c, const MachineProfile& p) {
     t.error("orbit_finish",
             fmt::format("{} needs an orbit (orbit = \"circle\", \"square\" or \"star\")",
                         t.key_path("orbit_finish")),
+            "config.range");
+  if (!c.orbit_finish || !c.lateral_servo || c.orbit == machine::OrbitKind::None || c.orbit_period_s <= 0)
+    return;
+  const double peak = orbit_peak_mm_s(c), v_max = orbit_speed_limit(p);
+  if (v_max > 0 && peak <= v_max && 2 * peak > v_max)
+    t.error("lateral_servo",
+            fmt::format("{}: the finishing cycle's last turn runs the orbit at twice its period's speed, {} "
+                        "mm/s, above the orbit axes' max_velocity ({} mm/s): a longer orbit_period_s",
+                        t.key_path("lateral_servo"), show(2 * peak), show(v_max)),
             "config.range");
 }
 

@@ -10,6 +10,10 @@ namespace opencnc::control {
 namespace {
 
 constexpr double kTwoPi = 6.283185307179586;
+/// The finishing cycle's orbit counts as full within this of its radius: the lateral servo draws
+/// it in by a fraction of a micrometre whenever the noisy gap voltage dips below the reference, and
+/// a turn that counted only to the nanometre went on by a tenth for it (the floor burning on).
+constexpr double kFullWithin_mm = 0.0005;
 
 double distance(const Pose& a, const Pose& b) noexcept {
   double d2 = 0;
@@ -272,10 +276,10 @@ Pose GapServo::step(const GapInputs& in) noexcept {
 }
 
 // The finishing cycle, a period: the path rests at its end (the interpolator waits), the electrode
-// comes back to it along the path after a short; the gap servo's law drives the orbit's radius
-// instead (the lateral servo: out while the gap voltage is above the reference, in below it, in at
-// once on a short), up to the condition's radius. Once a whole turn has burnt at that radius, the
-// code the burn's end brought is applied.
+// comes back to it along the path after a short; the lateral servo drives the orbit's radius
+// instead (out at the condition's forward limit while the gap voltage is at the reference or above,
+// in at the law's speed below it, in at once on a short), up to the condition's radius. Once a
+// whole turn has burnt at that radius, the code the burn's end brought is applied.
 void GapServo::run_finish(const GapInputs& in, bool due) noexcept {
   const bool shorted = in.gap_state == machine::GapState::Short;
   double lateral = 0;
@@ -291,11 +295,19 @@ void GapServo::run_finish(const GapInputs& in, bool due) noexcept {
     }
     feed_scale_ = 0;
     if (!due) {
-      lateral = shorted ? -cond_.max_retract_mm_s
-                        : cond_.gain_mm_s_per_v * (status_.filtered_voltage_v - cond_.servo_reference_v);
+      // Out at the forward limit while the gap is at the reference or wider: at the final depth
+      // the floor, still sparking, is what the voltage says, and it opens as it burns; the radius
+      // that waited for the law's speed there left the floor burning for seconds (docs/edm.md).
+      const double law = cond_.gain_mm_s_per_v * (status_.filtered_voltage_v - cond_.servo_reference_v);
+      lateral = shorted ? -cond_.max_retract_mm_s : law < 0 ? law : cond_.max_forward_mm_s;
     }
   }
-  run_jump(due && v_ == 0 && lateral_v_ == 0 && !shorted);
+  // Under the lateral servo a jump waits until the orbit has stopped turning too, and the orbit
+  // waits while the electrode is lifted: it comes back to the walls where it left them, not a
+  // stretch further on (where they were burnt at a smaller radius: a side short, or seconds of side
+  // discharges, on its return).
+  const bool turning = cond_.lateral_servo && orbit_rate_ != 0;
+  run_jump(due && v_ == 0 && lateral_v_ == 0 && !turning && !shorted);
   feed_scale_ = 0;
   run_lateral(in, lateral);
   status_.generator = jump_ == Jump::Idle;
@@ -310,8 +322,9 @@ void GapServo::run_finish(const GapInputs& in, bool due) noexcept {
 
 // The orbit's radius at the lateral servo's speed (out at most at the condition's forward speed,
 // in at the growth's rate, at the retract speed on a short) within the tool axis' acceleration,
-// between the centre and the condition's radius; it turns as the lateral servo lets it. A shape
-// still spiralling in from another condition goes on doing so first.
+// between the centre and the condition's radius; it turns as the lateral servo lets it, and comes
+// to a stop (within its acceleration) for a jump due or under way. A shape still spiralling in
+// from another condition goes on doing so first. The finishing cycle's own.
 void GapServo::run_lateral(const GapInputs& in, double target) noexcept {
   if (shape_ != cond_.orbit || cond_.orbit_period_s <= 0) {
     run_orbit(in);
@@ -324,7 +337,8 @@ void GapServo::run_lateral(const GapInputs& in, double target) noexcept {
   const double limited = std::clamp(target, in.gap_state == machine::GapState::Short ? target : -draw_rate_,
                                     cond_.max_forward_mm_s);
   lateral_v_ = std::clamp(limited, lateral_v_ - dv, lateral_v_ + dv);
-  if (cond_.lateral_servo) follow_gap(in.gap_state == machine::GapState::Short);
+  const bool stop = jump_due() || jump_ != Jump::Idle;
+  if (cond_.lateral_servo) follow_gap(in.gap_state == machine::GapState::Short || stop);
   turn();
   const double r = std::clamp(radius_ + lateral_v_ * period_s_, 0.0, cond_.orbit_radius_mm);
   if (r != radius_ + lateral_v_ * period_s_) lateral_v_ = 0;  // at the centre or the full size
@@ -333,7 +347,8 @@ void GapServo::run_lateral(const GapInputs& in, double target) noexcept {
   // The turn at full size counts where it burns: sparking, with the electrode at the burn's end
   // (not lifted, not backed off up the path after a short: there it burns nothing).
   const bool sparking = in.gap_state == machine::GapState::Normal || in.gap_state == machine::GapState::Arc;
-  if (radius_ >= cond_.orbit_radius_mm - 1e-9 && jump_ == Jump::Idle && sparking && s_ >= finish_s_ - 1e-9)
+  if (radius_ >= cond_.orbit_radius_mm - kFullWithin_mm && jump_ == Jump::Idle && sparking &&
+      s_ >= finish_s_ - 1e-9)
     full_turn_ += orbit_rate_ * period_s_ / draw_period_s_;
 }
 
@@ -479,17 +494,21 @@ void GapServo::run_orbit(const GapInputs& in) noexcept {
 }
 
 // The lateral servo's share of the orbit: it turns at its period while the filtered gap voltage is
-// at the reference or above and slows to a stop as it falls to half the reference (a short: at
-// once), the orbit's speed changing within a quarter of the tool axis' acceleration, so that the
-// electrode does not run into a side wall faster than the side discharges burn it back.
+// at the reference or above and slows to a stop as it falls to half the reference (`shorted`: a
+// short, or in the finishing cycle a jump due or under way — at once), the orbit's speed changing
+// within a quarter of the tool axis' acceleration, so that the electrode does not run into a side
+// wall faster than the side discharges burn it back.
 void GapServo::follow_gap(bool shorted) noexcept {
   const double ref = cond_.servo_reference_v;
-  // In the finishing cycle at the full radius the last turn goes up to twice as fast while the gap
-  // is wide (the walls there are burnt already): it ends sooner, not with the gap open.
-  const double fastest = finishing_ && radius_ >= cond_.orbit_radius_mm - 1e-9 ? 2.0 : 1.0;
+  // In the finishing cycle at the full radius the last turn goes twice as fast while the gap is at
+  // the reference or wider (slower as it closes, as above): the floor burns on at the final depth
+  // and opens the gap, and the walls follow it there, so the sooner the turn ends the nearer to
+  // size they stay (docs/edm.md, "The turbine channel without dwell").
+  const double fastest = finishing_ && radius_ >= cond_.orbit_radius_mm - kFullWithin_mm ? 2.0 : 1.0;
   const double target =
-      shorted || ref <= 0 ? 0.0
-                          : std::clamp((status_.filtered_voltage_v - 0.5 * ref) / (0.5 * ref), 0.0, fastest);
+      shorted || ref <= 0
+          ? 0.0
+          : fastest * std::clamp((status_.filtered_voltage_v - 0.5 * ref) / (0.5 * ref), 0.0, 1.0);
   const double r = std::max(radius_, 1e-6);
   const double per_turn = cond_.orbit == OrbitKind::Circle   ? 6.283185307179586 * r
                           : cond_.orbit == OrbitKind::Square ? 12 * r

@@ -128,6 +128,11 @@ TEST(EdmProfile, BadConditionsAreNamedWhereTheyAre) {
       // Issue 28: the finishing cycle needs an orbit; adaptive control's bounds enclose the
       // condition's own value, the reference's stays below the open voltage.
       {base + condition("orbit_finish = true\n"), "orbit_finish", "needs an orbit"},
+      // A circle of 2 mm turning in 1 s moves at 12.6 mm/s, within X's and Y's 20; its last turn
+      // in the finishing cycle at twice that is not.
+      {base + condition("orbit = \"circle\"\norbit_radius_mm = 2\norbit_period_s = 1\norbit_finish = true\n"
+                        "lateral_servo = true\n"),
+       "lateral_servo", "the finishing cycle's last turn runs the orbit at twice its period's speed, 25.13"},
       {base + condition("adaptive = true\ngain_min_mm_s_per_v = 0.05\n"), "gain_min_mm_s_per_v",
        "must enclose the condition's own value (0.02)"},
       {base + condition("adaptive = true\njump_period_s = 0.2\njump_height_mm = 0.5\njump_speed_mm_s = 20\n"

@@ -254,9 +254,10 @@ TEST(GapServo, TheFinishingCycleHoldsTheBurnsEndUntilTheOrbitIsFullAndTurnedTher
   EXPECT_TRUE(r.g.head_waits());
   EXPECT_EQ(r.g.feed_scale(), 0.0);
   // The radius stands at the first step (0.02 mm after a quarter turn at the growth's rate); the
-  // lateral servo drives it out at gain × 5 V = 0.1 mm/s: the full 0.06 mm 0.4 s later, then one
-  // turn of 0.5 s there (the gap at the reference: the orbit at its period's speed).
-  EXPECT_NEAR(r.g.status().orbit_radius_mm, 0.02, 2e-4);
+  // gap 5 V above the reference, the lateral servo drives it out at the forward limit (1 mm/s,
+  // above gain × 5 V = 0.1 mm/s): the full 0.06 mm 40 ms later, then one turn there at twice the
+  // period's speed (the gap at the reference): 0.25 s. After the cycle's first period: 1 µm out.
+  EXPECT_NEAR(r.g.status().orbit_radius_mm, 0.021, 2e-4);
   int ticks = 1, full_at = -1;
   while (r.g.status().finishing && ticks < 5000) {
     r.run(1, side);
@@ -264,10 +265,55 @@ TEST(GapServo, TheFinishingCycleHoldsTheBurnsEndUntilTheOrbitIsFullAndTurnedTher
     if (full_at < 0 && r.g.status().orbit_radius_mm >= 0.06) full_at = ticks;
     EXPECT_EQ(r.electrode[2], z_end) << "the final depth is held";
   }
-  EXPECT_NEAR(full_at, 400, 5);
-  EXPECT_NEAR(ticks - full_at, 500, 2);
+  EXPECT_NEAR(full_at, 40, 2);
+  EXPECT_NEAR(ticks - full_at, 250, 3);
   EXPECT_FALSE(r.g.status().on);  // the held M181 applied at the end
   EXPECT_FALSE(r.g.status().finishing);
+}
+
+TEST(GapServo, TheFinishingCycleStopsTheOrbitForAJumpAndGoesOnWhereItLeft) {
+  // A square growing to 0.06 mm with a jump every 0.1 s of machining; the finishing cycle from
+  // 50 ms on, the gap at the reference.
+  machine::EdmCondition c = roughing();
+  c.orbit = machine::OrbitKind::Square;
+  c.orbit_radius_mm = 0.06;
+  c.orbit_step_mm = 0.02;
+  c.orbit_period_s = 0.5;
+  c.orbit_finish = true;
+  c.lateral_servo = true;
+  c.jump_period_s = 0.1;
+  c.jump_height_mm = 0.2;
+  c.jump_speed_mm_s = 50;
+  c.jump_mode = machine::JumpMode::Axis;
+  Rig r(config_with(c));
+  r.feed = 0;
+  auto at_reference = [](double, double) { return std::pair{45.0, GapState::Normal}; };
+  r.run(50, at_reference);
+  EXPECT_TRUE(r.g.apply_code(181, 0));
+  r.run(1, at_reference);
+  ASSERT_TRUE(r.g.status().finishing);
+  // While a jump lifts the electrode the orbit stands where the jump began (and had stopped
+  // turning there in the period before); between jumps it turns on from there.
+  int jumps = 0, moving_between = 0;
+  bool lifted = false;
+  double x = r.electrode[0], y = r.electrode[1];
+  for (int i = 0; i < 3000 && r.g.status().finishing; ++i) {
+    r.run(1, at_reference);
+    const bool now = r.g.status().jumping;
+    if (now) {
+      EXPECT_EQ(r.electrode[0], x) << "tick " << i;
+      EXPECT_EQ(r.electrode[1], y) << "tick " << i;
+    } else if (r.electrode[0] != x || r.electrode[1] != y) {
+      ++moving_between;
+    }
+    jumps += now && !lifted ? 1 : 0;
+    lifted = now;
+    x = r.electrode[0];
+    y = r.electrode[1];
+  }
+  EXPECT_FALSE(r.g.status().finishing);  // the cycle ended: full and turned once
+  EXPECT_GE(jumps, 2);
+  EXPECT_GT(moving_between, 200);
 }
 
 TEST(GapServo, TheLateralServoSlowsTheOrbitAndDrawsItInOnAShort) {

@@ -136,13 +136,37 @@ double frontal_gap_mm(const machine::EdmCondition& c, const machine::SimEdmConfi
   return td / (c.on_time_us + td) * sim.breakdown_um_per_v * 1e-3 * c.voltage_v;
 }
 
+/// Wall k's size on a flank: the finishing square's reach in its direction (half-side r:
+/// r·(|cos θ| + |sin θ|)) plus the condition's side gap.
+double wall_size_mm(const machine::EdmCondition& finish, int k) {
+  constexpr double kPi = 3.14159265358979323846;
+  const double a = 2 * kPi * k / machine::SimEdmProcess::kSides;
+  return finish.orbit_radius_mm * (std::fabs(std::cos(a)) + std::fabs(std::sin(a))) + finish.side_gap_mm;
+}
+
+/// Front f's walls against their size: the mean's error (the cavity's size, as the report's
+/// cavity_oversize_mm) and the widest single direction's.
+struct WallErrors {
+  double mean_mm = 0, widest_mm = 0;
+};
+
+WallErrors wall_errors(const machine::SimEdmProcess& sim, const machine::EdmCondition& finish, int f) {
+  WallErrors w;
+  for (int k = 0; k < machine::SimEdmProcess::kSides; ++k) {
+    const double err = sim.wall_mm(f, k) - wall_size_mm(finish, k);
+    w.mean_mm += err / machine::SimEdmProcess::kSides;
+    if (std::fabs(err) > std::fabs(w.widest_mm)) w.widest_mm = err;
+  }
+  return w;
+}
+
 TEST(EdmTurbine, WithoutDwellTheFinishingCycleHoldsTheGapAndBurnsTheCavityToSize) {
   const config::MachineProfile p = channel_machine();
   const Channel r = run_channel(p);
   ASSERT_TRUE(r.finished);
   print("adaptive", r);
   const edm::EdmReport e = r.report();
-  EXPECT_GE(e.gap_voltage_in_band_fraction, 0.86);  // issue 28 asks for 0.9: not met (docs/edm.md)
+  EXPECT_GE(e.gap_voltage_in_band_fraction, 0.90);  // issue 28's figure
   EXPECT_EQ(e.shorts_uncleared, 0u);                // every short recovered
   EXPECT_LT(e.short_recovery_max_s, 0.1);
   EXPECT_GT(e.finishing_s, 1.0);  // the cycle held both flanks' burns
@@ -150,41 +174,53 @@ TEST(EdmTurbine, WithoutDwellTheFinishingCycleHoldsTheGapAndBurnsTheCavityToSize
   // No arc left standing: the last period of every burn sparked normally or was open (the
   // recorder's arcs all ended); here: the gap's state at the end of each burn.
   EXPECT_EQ(r.per->arcs_at_burn_end, 0);
-  // The cavity of each flank (B −30, B +30): the finishing square's reach in each direction
-  // (half-side r: r·(|cos θ| + |sin θ|)) plus condition 3's side gap; its depth the program's
-  // 0.095 mm less the finishing electrode's wear plus the frontal gap at condition 3's reference.
+  // The cavity of each flank (B −30, B +30): the finishing square's reach in each direction plus
+  // condition 3's side gap; its depth the program's 0.095 mm less the finishing electrode's wear
+  // plus the frontal gap at condition 3's reference.
   const machine::EdmCondition& finish = *p.edm.config.find(3);
   const machine::SimEdmProcess& sim = r.sim();
   ASSERT_EQ(sim.fronts(), 2);
-  constexpr double kPi = 3.14159265358979323846;
   double worst = 0;
   for (int f = 0; f < 2; ++f) {
-    double sum = 0, reach = 0;
-    for (int k = 0; k < machine::SimEdmProcess::kSides; ++k) {
-      const double a = 2 * kPi * k / machine::SimEdmProcess::kSides;
-      const double size =
-          finish.orbit_radius_mm * (std::fabs(std::cos(a)) + std::fabs(std::sin(a))) + finish.side_gap_mm;
-      sum += sim.wall_mm(f, k);
-      reach += size;
-      worst = std::max(worst, std::fabs(sim.wall_mm(f, k) - size));
-      // Each direction: issue 28 asks for 5 µm and the model does not meet it (docs/edm.md,
-      // "Known gaps": a short at full size, the front burning on at the final depth); the bound
-      // here is what it meets on this job and seed.
-      EXPECT_NEAR(sim.wall_mm(f, k), size, 0.015) << "front " << f << ", direction " << k;
-    }
-    // The cavity's size (the walls' mean, as the report's cavity_oversize_mm): measured 5.2 and
-    // 3.7 µm over on the two flanks, issue 28's 5 µm missed on one by 0.2 µm (the sides spark
-    // out as far as the front has opened at the final depth).
-    EXPECT_NEAR(sum / machine::SimEdmProcess::kSides, reach / machine::SimEdmProcess::kSides, 0.006)
-        << "front " << f;
+    // Each direction: issue 28 asks for 5 µm; measured 5.3 µm at the widest on this seed (4.7 to
+    // 5.4 µm on others): the walls stand the floor's gap beyond the electrode, and the floor,
+    // burning on at the final depth while the last turn runs, opens it (docs/edm.md, "Known gaps").
+    for (int k = 0; k < machine::SimEdmProcess::kSides; ++k)
+      EXPECT_NEAR(sim.wall_mm(f, k), wall_size_mm(finish, k), 0.006) << "front " << f << ", direction " << k;
+    // The cavity's size (the walls' mean, as the report's cavity_oversize_mm): issue 28's 5 µm.
+    const WallErrors w = wall_errors(sim, finish, f);
+    EXPECT_LE(std::fabs(w.mean_mm), 0.005) << "front " << f;
+    worst = std::max(worst, std::fabs(w.widest_mm));
     const double depth = 0.095 - sim.electrode_wear_mm() + frontal_gap_mm(finish, p.edm.sim);
     EXPECT_NEAR(sim.front_depth_mm(f), depth, 0.005) << "front " << f;
-    std::printf(
-        "front %d: mean wall %.5f mm (the square's mean reach + side gap %.5f), depth %.5f mm (%.5f)\n", f,
-        sum / machine::SimEdmProcess::kSides, reach / machine::SimEdmProcess::kSides, sim.front_depth_mm(f),
-        depth);
+    std::printf("front %d: walls %.5f mm over their size on the mean, depth %.5f mm (%.5f)\n", f, w.mean_mm,
+                sim.front_depth_mm(f), depth);
   }
   std::printf("the widest direction's error %.5f mm\n", worst);
+}
+
+// Not one lucky seed: the same job on other realisations of the simulated gap (its noise and
+// debris) meets issue 28's figures too — in band at least 0.9, each flank's cavity within 5 µm of
+// its size, every short recovered, no arc left standing.
+TEST(EdmTurbine, TheFiguresHoldOnOtherSeedsOfTheSimulatedGap) {
+  for (const char* seed : {"sim.seed=1", "sim.seed=2", "sim.seed=3"}) {
+    const config::MachineProfile p = channel_machine({seed});
+    const Channel r = run_channel(p);
+    ASSERT_TRUE(r.finished) << seed;
+    print(seed, r);
+    EXPECT_GE(r.report().gap_voltage_in_band_fraction, 0.90) << seed;
+    EXPECT_EQ(r.report().shorts_uncleared, 0u) << seed;
+    EXPECT_EQ(r.per->arcs_at_burn_end, 0) << seed;
+    const machine::EdmCondition& finish = *p.edm.config.find(3);
+    ASSERT_EQ(r.sim().fronts(), 2) << seed;
+    for (int f = 0; f < 2; ++f) {
+      const WallErrors w = wall_errors(r.sim(), finish, f);
+      EXPECT_LE(std::fabs(w.mean_mm), 0.005) << seed << ", front " << f;
+      EXPECT_LE(std::fabs(w.widest_mm), 0.006) << seed << ", front " << f;
+      std::printf("%s front %d: walls %.5f mm over on the mean, the widest direction %.5f mm\n", seed, f,
+                  w.mean_mm, w.widest_mm);
+    }
+  }
 }
 
 TEST(EdmTurbine, AdaptiveControlAgainstFixedParametersOnTheSameJobAndSeed) {
