@@ -234,12 +234,12 @@ double bernstein(const double* c, int n, double t);
 
 constexpr int kIntervals = 24;  ///< pieces of a Bézier block on which g', g'', g''' are bounded
 
-/// Per axis bounds of |g'|, |g''|, |g'''| on each piece of a Bézier block.
+/// Per axis bounds of |g'|, |g''| and (with `jerk`) |g'''| on each piece of a Bézier block.
 struct BezierPieces {
   double g1[kAxisCount][kIntervals], g2[kAxisCount][kIntervals], g3[kAxisCount][kIntervals];
 };
 
-void bezier_pieces(const MotionBlock& b, const double* d1, const double* d2, const double* d3,
+void bezier_pieces(const MotionBlock& b, const double* d1, const double* d2, const double* d3, bool jerk,
                    BezierPieces& out) {
   const double L = b.length, ds = L / kIntervals;
   const int n = b.kind == BlockKind::Quintic ? 5 : 3;
@@ -258,7 +258,7 @@ void bezier_pieces(const MotionBlock& b, const double* d1, const double* d2, con
       const double t = static_cast<double>(q) / kIntervals;
       const double w1 = std::fabs(bernstein(e1, n - 1, t)) / L;
       const double w2 = std::fabs(bernstein(e2, n - 2, t)) / (L * L);
-      const double w3 = std::fabs(bernstein(e3, n - 3, t)) / (L * L * L);
+      const double w3 = jerk ? std::fabs(bernstein(e3, n - 3, t)) / (L * L * L) : 0.0;
       if (q > 0) {
         out.g1[i][q - 1] = std::min(d1[i], 0.5 * (v1 + w1 + d2[i] * ds));
         out.g2[i][q - 1] = std::min(d2[i], 0.5 * (v2 + w2 + d3[i] * ds));
@@ -304,24 +304,40 @@ RawLimits bezier_limits(const MotionBlock& b, double v_max, const LimitParams& p
       cap_jerk = std::min(cap_jerk, std::cbrt(kJerkCapShare * jerk_scale * l.max_jerk / d3[i]));
   }
   BezierPieces pc;
-  bezier_pieces(b, d1, d2, d3, pc);
+  bezier_pieces(b, d1, d2, d3, jerk, pc);
   const double T = p.filter_s;
+  // The acceleration budget the pieces leave at speed v with j = a/T; with `whole` also the one
+  // with the whole block's largest |g'''| on every piece. (A quotient is taken only where it
+  // lowers the budget.)
+  const auto accel_at = [&](double v, double* a_whole) {
+    double a = kInf, aw = kInf;
+    for (int i = 0; i < kAxisCount; ++i) {
+      if (d1[i] <= 0) continue;
+      const AxisLimits& l = p.machine[i];
+      const double J = jerk_scale * l.max_jerk;
+      for (int q = 0; q < kIntervals; ++q) {
+        const double G1 = pc.g1[i][q], G2 = pc.g2[i][q];
+        if (G1 <= 0) continue;
+        const double by_accel = (l.max_acceleration - v * v * G2) / G1;
+        a = std::min(a, by_accel);
+        aw = std::min(aw, by_accel);
+        if (!limited_jerk(p, i)) continue;
+        const double den = G1 / T + 3 * v * G2;
+        const double v3 = v * v * v;
+        if (J - v3 * pc.g3[i][q] < a * den) a = (J - v3 * pc.g3[i][q]) / den;
+        if (a_whole && J - v3 * d3[i] < aw * den) aw = (J - v3 * d3[i]) / den;
+      }
+    }
+    if (a_whole) *a_whole = std::max(aw, 0.0);
+    return std::max(a, 0.0);
+  };
   // The budgets the pieces leave at speed v: the acceleration with j = a/T, then the jerk (with
   // `whole`, the whole block's largest |g'''| on every piece).
   const auto budgets = [&](double v, bool whole = false) {
     RawLimits r{v, kInf, kInf};
-    for (int i = 0; i < kAxisCount; ++i) {
-      if (d1[i] <= 0) continue;
-      const AxisLimits& l = p.machine[i];
-      for (int q = 0; q < kIntervals; ++q) {
-        const double G1 = pc.g1[i][q], G2 = pc.g2[i][q], G3 = whole ? d3[i] : pc.g3[i][q];
-        if (G1 <= 0) continue;
-        r.accel = std::min(r.accel, (l.max_acceleration - v * v * G2) / G1);
-        if (limited_jerk(p, i))
-          r.accel = std::min(r.accel, (jerk_scale * l.max_jerk - v * v * v * G3) / (G1 / T + 3 * v * G2));
-      }
-    }
-    r.accel = std::max(r.accel, 0.0);
+    double a_whole = 0;
+    const double a = accel_at(v, whole ? &a_whole : nullptr);
+    r.accel = whole ? a_whole : a;
     for (int i = 0; i < kAxisCount; ++i) {
       if (d1[i] <= 0 || !limited_jerk(p, i)) continue;
       for (int q = 0; q < kIntervals; ++q) {
@@ -333,14 +349,14 @@ RawLimits bezier_limits(const MotionBlock& b, double v_max, const LimitParams& p
     }
     return r;
   };
+  if (!jerk) return budgets(cap);
   // A budget already below kLowBudget of the axes' acceleration is what limits such a block:
   // it keeps the limits of the whole block's largest |g'''| (more budget there measured slower,
   // the tick's generator coasting more after accelerating harder).
-  if (jerk) {
-    const RawLimits whole = budgets(std::min(cap, cap_jerk), true);
-    if (whole.accel < low_budget) return whole;
-  }
-  if (!jerk || cap <= cap_jerk) return budgets(std::min(cap, cap_jerk));
+  double a_whole = 0;
+  const double a_ref = accel_at(std::min(cap, cap_jerk), &a_whole);
+  if (a_whole < low_budget) return budgets(std::min(cap, cap_jerk), true);
+  if (cap <= cap_jerk) return budgets(cap);
   // The highest speed up to `cap` at which every piece still leaves the budget a (0: none above
   // cap_jerk).
   const auto highest = [&](double a) {
@@ -353,15 +369,14 @@ RawLimits bezier_limits(const MotionBlock& b, double v_max, const LimitParams& p
         const double room = jerk_scale * l.max_jerk - G1 * a / T;
         const double room_a = l.max_acceleration - G1 * a;
         if (room <= 0 || room_a < 0) return 0.0;
-        v = std::min(v, cubic_speed(G3, 3 * G2 * a, room));
-        if (G2 > 0) v = std::min(v, std::sqrt(room_a / G2));
+        if ((G3 * v * v + 3 * G2 * a) * v > room) v = cubic_speed(G3, 3 * G2 * a, room);
+        if (G2 * v * v > room_a) v = std::sqrt(room_a / G2);
       }
     }
     return v;
   };
   // First without cost (the reference budget kept), then up to the nominal feed at the cost of
   // at most kTradedBudget of the budget, and never below the floor.
-  const double a_ref = budgets(cap_jerk).accel;
   double v = std::max(cap_jerk, highest(a_ref));
   const double need = std::min(cap, b.feed_class == traj::FeedClass::Feed && b.feed > 0 ? b.feed : kInf);
   const double a_traded = (1 - kTradedBudget) * a_ref;
