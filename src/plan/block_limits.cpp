@@ -6,7 +6,8 @@
 //   ẋ = g'·v,   ẍ = g'·a + g''·v²,   x⃛ = g'·j + 3·g''·v·a + g'''·v³.
 // A block's (cap, accel, jerk) triple is chosen so that |ẋ|, |ẍ|, |x⃛| stay within the axis
 // limits for every v ≤ cap, |a| ≤ accel and |j| ≤ jerk. With jerk limits the geometric term
-// g'''·v³ may take at most half of J at the cap (kJerkCapShare), the acceleration budget is the
+// g'''·v³ may take at most half of J at the cap (kJerkCapShare; a Bézier block's cap rises from
+// there where its pieces leave the budget, bezier_limits), the acceleration budget is the
 // largest that leaves a jerk budget of at least accel/T (so the moving average of length T can
 // always turn the acceleration round), and the jerk budget is what is left at that budget.
 #include "block_limits.hpp"
@@ -29,7 +30,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kPi = std::numbers::pi;
 constexpr double kJerkCapShare = 0.5;  ///< part of J the geometric jerk v³·|g'''| may use at the cap
                                        ///< (Bézier blocks: the reference their cap rises from)
-constexpr double kTradedBudget = 0.5;  ///< Bézier: share of the budget a cap below the feed may give up
+constexpr double kTradedBudget = 0.25;  ///< Bézier: share of the budget a cap below the feed may give up
 constexpr double kLowBudget = 0.1;     ///< Bézier: of the axes' acceleration, a budget that limits
 
 bool limited_jerk(const LimitParams& p, int i) {
