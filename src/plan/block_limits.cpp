@@ -370,7 +370,7 @@ RawLimits bezier_limits(const MotionBlock& b, double v_max, const LimitParams& p
         const double room = jerk_scale * l.max_jerk - G1 * a / T;
         const double room_a = l.max_acceleration - G1 * a;
         if (room <= 0 || room_a < 0) return 0.0;
-        if ((G3 * v * v + 3 * G2 * a) * v > room) v = cubic_speed(G3, 3 * G2 * a, room);
+        if ((G3 * v * v + 3 * G2 * a) * v > room) v = std::min(v, cubic_speed(G3, 3 * G2 * a, room));
         if (G2 * v * v > room_a) v = std::sqrt(room_a / G2);
       }
     }
