@@ -6,7 +6,8 @@
 //   ẋ = g'·v,   ẍ = g'·a + g''·v²,   x⃛ = g'·j + 3·g''·v·a + g'''·v³.
 // A block's (cap, accel, jerk) triple is chosen so that |ẋ|, |ẍ|, |x⃛| stay within the axis
 // limits for every v ≤ cap, |a| ≤ accel and |j| ≤ jerk. With jerk limits the geometric term
-// g'''·v³ may take at most half of J at the cap (kJerkCapShare), the acceleration budget is the
+// g'''·v³ may take at most half of J at the cap (kJerkCapShare; a Bézier block's cap rises from
+// there where its pieces leave the budget, bezier_limits), the acceleration budget is the
 // largest that leaves a jerk budget of at least accel/T (so the moving average of length T can
 // always turn the acceleration round), and the jerk budget is what is left at that budget.
 #include "block_limits.hpp"
@@ -28,6 +29,9 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kPi = std::numbers::pi;
 constexpr double kJerkCapShare = 0.5;  ///< part of J the geometric jerk v³·|g'''| may use at the cap
+                                       ///< (Bézier blocks: the reference their cap rises from)
+constexpr double kTradedBudget = 0.25;  ///< Bézier: share of the budget a cap below the feed may give up
+constexpr double kLowBudget = 0.1;     ///< Bézier: of the axes' acceleration, a budget that limits
 
 bool limited_jerk(const LimitParams& p, int i) {
   return p.filter_s > 0 && p.machine[i].max_jerk > 0;
@@ -213,76 +217,172 @@ RawLimits arc_or_spiral_limits(const MotionBlock& b, double v_max, const LimitPa
   return r;
 }
 
-// Cubic or quintic Bézier at t = s/L. Per axis the caps use the largest |g'|, |g''|, |g'''| on the
-// block (D1, D2, D3): v·D1 ≤ V, v²·D2 ≤ α·A, v³·D3 ≤ J/2. The budget uses them where they occur
-// together: on each of kIntervals pieces of t, bounds G1, G2, G3 from the values at its ends and
-// the next derivative's bound (a function whose slope is at most M stays within
-// (f_a + f_b + M·Δs)/2 between a and b), and |ẍ| ≤ G1·|a| + G2·v², |x⃛| ≤ G1·|j| + 3·G2·v·|a| + G3·v³
-// there. Along a curve the axis that carries the curvature is rarely the one that carries the
-// tangent, so the budget at the cap is far above (A − v²·D2)/D1.
+// Cubic or quintic Bézier at t = s/L. Per axis the caps use the largest |g'|, |g''| on the block
+// (D1, D2): v·D1 ≤ V, v²·D2 ≤ α·A. The budgets use g', g'', g''' where they occur together: on
+// each of kIntervals pieces of t, bounds G1, G2, G3 from the values at its ends and the next
+// derivative's bound (a function whose slope is at most M stays within (f_a + f_b + M·Δs)/2
+// between a and b), and |ẍ| ≤ G1·|a| + G2·v², |x⃛| ≤ G1·|j| + 3·G2·v·|a| + G3·v³ there: VPOp's
+// axis jerk constraint (Beudaert, Lavernhe, Tournier 2012) held piece by piece. Along a curve
+// the axis that carries the curvature (or its change, g''') is rarely the one that carries the
+// tangent, so the budget at a cap is far above what the block's separate maxima would leave.
+//
+// The jerk cap: the reference is the geometric jerk v³·D3 at kJerkCapShare of J (D3 the largest
+// |g'''| on the block) and the budget the pieces leave at that speed. From there the cap rises to
+// the highest speed at which every piece still leaves that same budget (with j = a/T, the least
+// the moving average needs): where the pieces with a large |g'''| have a small |g'| and |g''| on
+// the same axis the geometric jerk takes far more than half of J there, at no cost to the budget.
 double bernstein(const double* c, int n, double t);
 
+constexpr int kIntervals = 24;  ///< pieces of a Bézier block on which g', g'', g''' are bounded
+
+/// Per axis bounds of |g'|, |g''| and (with `jerk`) |g'''| on each piece of a Bézier block.
+struct BezierPieces {
+  double g1[kAxisCount][kIntervals], g2[kAxisCount][kIntervals], g3[kAxisCount][kIntervals];
+};
+
+void bezier_pieces(const MotionBlock& b, const double* d1, const double* d2, const double* d3, bool jerk,
+                   BezierPieces& out) {
+  const double L = b.length, ds = L / kIntervals;
+  const int n = b.kind == BlockKind::Quintic ? 5 : 3;
+  for (int i = 0; i < kAxisCount; ++i) {
+    if (d1[i] <= 0) continue;
+    double c[6], e1[5], e2[4], e3[3];
+    for (int k = 0; k <= n; ++k) c[k] = traj::detail::quintic_point(b, k)[i];
+    for (int k = 0; k < n; ++k) e1[k] = n * (c[k + 1] - c[k]);
+    for (int k = 0; k < n - 1; ++k) e2[k] = (n - 1) * (e1[k + 1] - e1[k]);
+    for (int k = 0; k < n - 2; ++k) e3[k] = (n - 2) * (e2[k + 1] - e2[k]);
+    double d4 = 0;  // the largest |g''''| (the cubic's g''' is constant)
+    for (int k = 0; k + 1 < n - 2; ++k) d4 = std::max(d4, std::fabs((n - 3) * (e3[k + 1] - e3[k])));
+    d4 /= L * L * L * L;
+    double v1 = 0, v2 = 0, v3 = 0;
+    for (int q = 0; q <= kIntervals; ++q) {
+      const double t = static_cast<double>(q) / kIntervals;
+      const double w1 = std::fabs(bernstein(e1, n - 1, t)) / L;
+      const double w2 = std::fabs(bernstein(e2, n - 2, t)) / (L * L);
+      const double w3 = jerk ? std::fabs(bernstein(e3, n - 3, t)) / (L * L * L) : 0.0;
+      if (q > 0) {
+        out.g1[i][q - 1] = std::min(d1[i], 0.5 * (v1 + w1 + d2[i] * ds));
+        out.g2[i][q - 1] = std::min(d2[i], 0.5 * (v2 + w2 + d3[i] * ds));
+        out.g3[i][q - 1] = std::min(d3[i], 0.5 * (v3 + w3 + d4 * ds));
+      }
+      v1 = w1;
+      v2 = w2;
+      v3 = w3;
+    }
+  }
+}
+
+/// Largest v ≥ 0 with G3·v³ + B·v ≤ R (G3, B ≥ 0, R > 0): Newton's method from above on the convex
+/// cubic, so every iterate stays at or above the root; the budgets are computed again at the cap
+/// chosen, so being above it by rounding costs nothing but that rounding.
+double cubic_speed(double G3, double B, double R) {
+  if (G3 <= 0) return B > 0 ? R / B : kInf;
+  double v = std::cbrt(R / G3);
+  if (B > 0) v = std::min(v, R / B);
+  for (int it = 0; it < 8; ++it) {
+    const double f = G3 * v * v * v + B * v - R;
+    if (f <= 0) break;
+    v -= f / (3 * G3 * v * v + B);
+  }
+  return v;
+}
+
 RawLimits bezier_limits(const MotionBlock& b, double v_max, const LimitParams& p, double jerk_scale) {
-  constexpr int kIntervals = 24;
   double d1[kAxisCount], d2[kAxisCount], d3[kAxisCount];
   derivative_bounds(b, d1, d2, d3);
-  double cap = v_max;
+  double cap = v_max, cap_jerk = kInf, low_budget = kInf;
+  bool jerk = false;
   for (int i = 0; i < kAxisCount; ++i) {
     if (d1[i] + d2[i] < 1e-15) continue;
     const AxisLimits& l = p.machine[i];
     if (d1[i] > 0) cap = std::min(cap, l.max_velocity / d1[i]);
     if (d2[i] > 0) cap = std::min(cap, std::sqrt(p.normal_share * l.max_acceleration / d2[i]));
-    if (d3[i] > 0 && limited_jerk(p, i))
-      cap = std::min(cap, std::cbrt(kJerkCapShare * jerk_scale * l.max_jerk / d3[i]));
-  }
-  RawLimits r{cap, kInf, kInf};
-  const double T = p.filter_s, L = b.length, ds = L / kIntervals;
-  const int n = b.kind == BlockKind::Quintic ? 5 : 3;
-  // Per axis the values of |g'|, |g''|, |g'''| at the ends of the pieces.
-  double g1[kAxisCount][kIntervals + 1], g2[kAxisCount][kIntervals + 1];
-  for (int i = 0; i < kAxisCount; ++i) {
-    if (d1[i] <= 0) continue;
-    double c[6], e1[5], e2[4];
-    for (int k = 0; k <= n; ++k) c[k] = traj::detail::quintic_point(b, k)[i];
-    for (int k = 0; k < n; ++k) e1[k] = n * (c[k + 1] - c[k]);
-    for (int k = 0; k < n - 1; ++k) e2[k] = (n - 1) * (e1[k + 1] - e1[k]);
-    for (int q = 0; q <= kIntervals; ++q) {
-      const double t = static_cast<double>(q) / kIntervals;
-      g1[i][q] = std::fabs(bernstein(e1, n - 1, t)) / L;
-      g2[i][q] = std::fabs(bernstein(e2, n - 2, t)) / (L * L);
+    if (d1[i] > 0 && limited_jerk(p, i)) {
+      jerk = true;
+      low_budget = std::min(low_budget, kLowBudget * l.max_acceleration);
     }
+    if (d3[i] > 0 && limited_jerk(p, i))
+      cap_jerk = std::min(cap_jerk, std::cbrt(kJerkCapShare * jerk_scale * l.max_jerk / d3[i]));
   }
-  const auto piece = [&](int i, int q, double& G1, double& G2) {
-    G1 = std::min(d1[i], 0.5 * (g1[i][q] + g1[i][q + 1] + d2[i] * ds));
-    G2 = std::min(d2[i], 0.5 * (g2[i][q] + g2[i][q + 1] + d3[i] * ds));
-  };
-  for (int i = 0; i < kAxisCount; ++i) {
-    if (d1[i] <= 0) continue;
-    const AxisLimits& l = p.machine[i];
-    for (int q = 0; q < kIntervals; ++q) {
-      double G1, G2;
-      piece(i, q, G1, G2);
-      if (G1 <= 0) continue;
-      r.accel = std::min(r.accel, (l.max_acceleration - cap * cap * G2) / G1);
-      if (limited_jerk(p, i)) {
-        const double left = jerk_scale * l.max_jerk - cap * cap * cap * d3[i];
-        r.accel = std::min(r.accel, left / (G1 / T + 3 * cap * G2));
+  BezierPieces pc;
+  bezier_pieces(b, d1, d2, d3, jerk, pc);
+  const double T = p.filter_s;
+  // The acceleration budget the pieces leave at speed v with j = a/T; with `whole` also the one
+  // with the whole block's largest |g'''| on every piece. (A quotient is taken only where it
+  // lowers the budget.)
+  const auto accel_at = [&](double v, double* a_whole) {
+    double a = kInf, aw = kInf;
+    for (int i = 0; i < kAxisCount; ++i) {
+      if (d1[i] <= 0) continue;
+      const AxisLimits& l = p.machine[i];
+      const double J = jerk_scale * l.max_jerk;
+      for (int q = 0; q < kIntervals; ++q) {
+        const double G1 = pc.g1[i][q], G2 = pc.g2[i][q];
+        if (G1 <= 0) continue;
+        const double by_accel = (l.max_acceleration - v * v * G2) / G1;
+        a = std::min(a, by_accel);
+        aw = std::min(aw, by_accel);
+        if (!limited_jerk(p, i)) continue;
+        const double den = G1 / T + 3 * v * G2;
+        const double v3 = v * v * v;
+        if (J - v3 * pc.g3[i][q] < a * den) a = (J - v3 * pc.g3[i][q]) / den;
+        if (a_whole && J - v3 * d3[i] < aw * den) aw = (J - v3 * d3[i]) / den;
       }
     }
-  }
-  r.accel = std::max(r.accel, 0.0);
-  for (int i = 0; i < kAxisCount; ++i) {
-    if (d1[i] <= 0 || !limited_jerk(p, i)) continue;
-    for (int q = 0; q < kIntervals; ++q) {
-      double G1, G2;
-      piece(i, q, G1, G2);
-      if (G1 <= 0) continue;
-      const double left =
-          jerk_scale * p.machine[i].max_jerk - cap * cap * cap * d3[i] - 3 * cap * G2 * r.accel;
-      r.jerk = std::min(r.jerk, std::max(left, 0.0) / G1);
+    if (a_whole) *a_whole = std::max(aw, 0.0);
+    return std::max(a, 0.0);
+  };
+  // The budgets the pieces leave at speed v: the acceleration with j = a/T, then the jerk (with
+  // `whole`, the whole block's largest |g'''| on every piece).
+  const auto budgets = [&](double v, bool whole = false) {
+    RawLimits r{v, kInf, kInf};
+    double a_whole = 0;
+    const double a = accel_at(v, whole ? &a_whole : nullptr);
+    r.accel = whole ? a_whole : a;
+    for (int i = 0; i < kAxisCount; ++i) {
+      if (d1[i] <= 0 || !limited_jerk(p, i)) continue;
+      for (int q = 0; q < kIntervals; ++q) {
+        const double G1 = pc.g1[i][q], G2 = pc.g2[i][q], G3 = whole ? d3[i] : pc.g3[i][q];
+        if (G1 <= 0) continue;
+        const double left = jerk_scale * p.machine[i].max_jerk - v * v * v * G3 - 3 * v * G2 * r.accel;
+        r.jerk = std::min(r.jerk, std::max(left, 0.0) / G1);
+      }
     }
-  }
-  return r;
+    return r;
+  };
+  if (!jerk) return budgets(cap);
+  // A budget already below kLowBudget of the axes' acceleration is what limits such a block:
+  // it keeps the limits of the whole block's largest |g'''| (more budget there measured slower,
+  // the tick's generator coasting more after accelerating harder).
+  double a_whole = 0;
+  const double a_ref = accel_at(std::min(cap, cap_jerk), &a_whole);
+  if (a_whole < low_budget) return budgets(std::min(cap, cap_jerk), true);
+  if (cap <= cap_jerk) return budgets(cap);
+  // The highest speed up to `cap` at which every piece still leaves the budget a (0: none above
+  // cap_jerk).
+  const auto highest = [&](double a) {
+    double v = cap;
+    for (int i = 0; i < kAxisCount; ++i) {
+      if (d1[i] <= 0 || !limited_jerk(p, i)) continue;
+      const AxisLimits& l = p.machine[i];
+      for (int q = 0; q < kIntervals; ++q) {
+        const double G1 = pc.g1[i][q], G2 = pc.g2[i][q], G3 = pc.g3[i][q];
+        const double room = jerk_scale * l.max_jerk - G1 * a / T;
+        const double room_a = l.max_acceleration - G1 * a;
+        if (room <= 0 || room_a < 0) return 0.0;
+        if ((G3 * v * v + 3 * G2 * a) * v > room) v = std::min(v, cubic_speed(G3, 3 * G2 * a, room));
+        if (G2 * v * v > room_a) v = std::sqrt(room_a / G2);
+      }
+    }
+    return v;
+  };
+  // First without cost (the reference budget kept), then up to the nominal feed at the cost of
+  // at most kTradedBudget of the budget, and never below the floor.
+  double v = std::max(cap_jerk, highest(a_ref));
+  const double need = std::min(cap, b.feed_class == traj::FeedClass::Feed && b.feed > 0 ? b.feed : kInf);
+  const double a_traded = (1 - kTradedBudget) * a_ref;
+  if (v < need && a_traded >= low_budget) v = std::max(v, std::min(need, highest(a_traded)));
+  return budgets(v);
 }
 
 }  // namespace
