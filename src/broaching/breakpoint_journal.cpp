@@ -6,13 +6,13 @@
 #include <pthread.h>
 #include <sched.h>
 
+#include <algorithm>
 #include <cmath>
-#include <numbers>
 
 #include <fmt/format.h>
 
 #include "opencnc/broaching/modal_digest.hpp"
-#include "opencnc/canon/arc_geometry.hpp"
+#include "opencnc/canon/move_length.hpp"
 #include "opencnc/controller/gcode_source.hpp"
 
 namespace opencnc::recovery {
@@ -21,25 +21,19 @@ using controller::ControllerEventKind;
 
 namespace {
 
-/// Path length of a straight move as the planner parameterises it (the status's segment offset
-/// counts along it): the Euclidean length over every axis, a coupled C's degrees included.
-double line_length(const Pose& a, const Pose& b) {
-  double sum = 0;
-  for (std::size_t i = 0; i < a.v.size(); ++i) sum += (b.v[i] - a.v[i]) * (b.v[i] - a.v[i]);
-  return std::sqrt(sum);
-}
-
-/// Length of an arc or helix move: the sweep about its centre times the radius, with the rise.
-double arc_length(const canon::Program& p, canon::SegmentId id) {
-  const canon::ArcGeometry& g = p.arc(id);
-  const int base = canon::plane_base(g.plane);
-  const Vec3& n = g.normal;
-  Vec3 u = take3(p.start_of(id), base) - g.center, w = take3(p.end(id), base) - g.center;
-  const double un = dot(u, n), wn = dot(w, n);
-  u = u - un * n;
-  w = w - wn * n;
-  const double sweep = canon::arc_sweep(std::atan2(dot(cross(u, w), n), dot(u, w)), g.turns);
-  return std::hypot(norm(u) * std::fabs(sweep), wn - un);
+/// The record's move: `move` of the run's window `p` (the run's moves from `first_move` on).
+/// Returns its path length as the planner counts it (the status's offset counts along it).
+double take_move(BreakpointRecord& r, const canon::Program& p, canon::SegmentId move,
+                 std::uint64_t first_move) {
+  r.job_move = first_move + move;
+  if (move < p.first_held_move() || move >= p.size()) return 0;
+  r.segment = p.segment_of(move);
+  r.move_kind = static_cast<std::uint8_t>(p.move(move).kind);
+  r.move_start = p.start_of(move);
+  r.move_end = p.end(move);
+  r.line = p.move(move).line;
+  r.source_file = p.sources().file(p.file_of(move));
+  return canon::planned_length(p, move);
 }
 
 /// The writer's SCHED_FIFO priority where the process may have one: below the servo thread's (80,
@@ -139,6 +133,10 @@ void BreakpointJournal::on_trace(const control::TraceSample& s, const controller
     record_.commanded = s.commanded;
     record_.actual = s.actual;
     record_.rest_time_s = static_cast<double>(s.tick) * period_s();
+    // The stop may carry the machine on into the next of the lines the planner joined.
+    if (c.program != nullptr && job_move_ > record_.job_move && job_move_ >= c.first_move &&
+        job_move_ - c.first_move <= s.segment_last)
+      move_length_mm_ = take_move(record_, *c.program, job_move_ - c.first_move, c.first_move);
     return;
   }
   if (!s.power_stop || stopping_ || c.job != controller::JobKind::Program || c.program == nullptr) return;
@@ -157,19 +155,16 @@ void BreakpointJournal::begin_record(const control::TraceSample& s, const contro
   r.stage = BreakpointStage::Stopping;
   r.program_path = path_;
   r.program_start = program_start_;
-  const canon::SegmentId move = s.segment;
-  if (move < p.size() && move >= p.first_held_move()) {
-    r.segment = p.segment_of(move);
-    r.move_kind = static_cast<std::uint8_t>(p.move(move).kind);
-    r.move_start = p.start_of(move);
-    r.move_end = p.end(move);
-    r.line = p.move(move).line;
-    r.source_file = p.sources().file(p.file_of(move));
-  }
-  r.job_move = c.first_move + move;
+  // The move the machine is on: the status's (the servo's segment is the first of the lines the
+  // planner joined into the block there; the status counts the offset on into the one it is on).
+  canon::SegmentId move = s.segment;
+  if (job_move_ >= c.first_move && job_move_ - c.first_move > move &&
+      job_move_ - c.first_move <= s.segment_last)
+    move = job_move_ - c.first_move;
+  const double length = take_move(r, p, move, c.first_move);
   r.commanded = s.commanded;
   r.actual = s.actual;
-  r.segment_offset_mm = segment_offset_;
+  r.segment_offset_mm = job_move_ == r.job_move ? segment_offset_ : 0.0;
   r.tool = before_.tool;
   r.spindle_rpm = before_.spindle_rpm;
   r.spindle_direction = before_.spindle_direction == machine::SpindleDirection::Clockwise          ? 1
@@ -187,9 +182,6 @@ void BreakpointJournal::begin_record(const control::TraceSample& s, const contro
                 k.master_origin,
                 k.slave_origin};
   r.signal_time_s = static_cast<double>(s.tick) * period_s();
-  const double length = r.move_kind == static_cast<std::uint8_t>(canon::MoveKind::Arc) && move < p.size()
-                            ? arc_length(p, move)
-                            : line_length(r.move_start, r.move_end);
   move_length_mm_ = length;
   r.move_remaining_mm = std::max(0.0, length - r.segment_offset_mm);
   Work w;
@@ -203,7 +195,9 @@ void BreakpointJournal::complete_record() {
   completed_ = true;
   BreakpointRecord& r = record_;
   r.stage = BreakpointStage::AtRest;
-  r.segment_offset_mm = segment_offset_;
+  // The status's offset is along the record's move, unless the stop crossed into the next joined
+  // line in its last period: then the record's move was run to its end.
+  r.segment_offset_mm = job_move_ == r.job_move ? segment_offset_ : move_length_mm_;
   r.move_remaining_mm = std::max(0.0, move_length_mm_ - r.segment_offset_mm);
   Work w;
   w.record = r;

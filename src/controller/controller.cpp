@@ -12,6 +12,7 @@
 
 #include "alarm_text.hpp"
 #include "job.hpp"
+#include "opencnc/canon/move_length.hpp"
 #include "opencnc/controller/preflight.hpp"
 #include "opencnc/controller/servo_setup.hpp"
 #include "task_runner.hpp"
@@ -980,8 +981,12 @@ void Controller::publish() {
     p.job = job_->kind();
     p.job_id = job_->id();
     if (p.job_name != job_->name()) p.job_name = job_->name();
-    p.run_segment = same_run ? job_->job_segment(s.segment) : 0;
-    p.segment_offset = same_run ? s.segment_offset : 0;
+    // The move the machine is on: a block the planner joined from several lines counts its
+    // offset from the first one's start (a hold, a retrace's A and a breakpoint need the move).
+    const canon::MoveOffset at =
+        same_run ? canon::along_joined(job_->program(), s.segment, s.segment_offset) : canon::MoveOffset{};
+    p.run_segment = same_run ? job_->job_segment(at.move) : 0;
+    p.segment_offset = at.offset_mm;
     p.progress = job_->kind() == JobKind::Program && p.program_moves > 0
                      ? std::min(1.0, static_cast<double>(p.run_segment) / static_cast<double>(p.program_moves))
                      : 0.0;

@@ -82,6 +82,9 @@ class Job {
   std::uint32_t run_id() const noexcept { return leg_.run_id; }
   /// Job move number of the servo's move `segment` of the current run.
   std::uint64_t job_segment(std::uint64_t segment) const noexcept { return leg_.first_move + segment; }
+  /// The run's program window (its moves from the leg's first on; the ones before the run's
+  /// position may be released).
+  const canon::Program& program() const noexcept { return stream_->program(); }
   std::uint64_t moves_read() const noexcept { return leg_.first_move + stream_->program().size(); }
   SyncKind sync_wait() const noexcept { return waiting_ ? stream_->sync_request().kind : SyncKind::None; }
   const SourceLocation& sync_location() const noexcept { return stream_->sync_request().where; }

@@ -241,6 +241,46 @@ TEST(PowerFailRecovery, ResumesIntoTheGrooveCutBeforeWithTheLoadGuardsLevels) {
   EXPECT_FALSE(after.journal->last_written()->valid);
 }
 
+// A stroke written as two lines (Z to 150, then on to 310 at the same feed): the planner runs
+// them as one block, whose offset the servo counts from the first line's start. The mains fail in
+// the second line: the record names it (its line, its start, the offset within it), and the resume
+// goes on forward from where the axes rest — never back through the cut to the first line's end
+// (it did before stop 34: the tool dragged backwards over 100 mm of groove).
+TEST(PowerFailRecovery, AStrokeOfTwoJoinedLinesResumesForwardFromTheSecond) {
+  const char* const kSplit =
+      "G21 G90 G94 G17 G40 G49\nG64 P0.005\nG0 X-0.5\nG0 Z-10 C0\nM171 P600\nG1 X0.1 F60\n"
+      "G1 Z150 F3000\nG1 Z310 F3000\nG1 X-0.4 F60\nG0 Z-10\nM175\nM2\n";
+  const std::string kProgram = job_file(kSplit);
+  const auto dir = fresh_dir("journal");
+  BreakpointRecord r;
+  {
+    Machine cut(dir);
+    r = cut.cut_mains(kProgram, 6.5);
+    ASSERT_TRUE(r.valid && r.stage == BreakpointStage::AtRest);
+    ASSERT_GT(r.actual[Axis::Z], 160) << "in the second line";
+  }
+  EXPECT_EQ(r.line, 8u) << "the second line of the stroke";
+  EXPECT_NEAR(r.move_start[Axis::Z], 150, 1e-9);
+  EXPECT_NEAR(r.move_end[Axis::Z], 310, 1e-9);
+  EXPECT_GT(r.move_remaining_mm, 0);
+  EXPECT_GT(r.segment_offset_mm, 0);
+  Machine after(dir, power_up_at(r));
+  const controller::Outcome o = after.choose("resume");
+  ASSERT_TRUE(o.accepted) << o.message;
+  EXPECT_EQ(after.journal->phase(), RecoveryPhase::Done) << after.journal->recovery_error();
+  // After the run-in (an auxiliary job: back along the helix by its length, within the move), the
+  // program's Z only goes forward while C is coupled in the cut.
+  double last = -1e300, backwards = 0;
+  for (const Samples::Row& row : after.samples->rows) {
+    if (row.job != controller::JobKind::Program || !row.coupled || row.x < 0.05) continue;
+    if (last > -1e300) backwards = std::max(backwards, last - row.z);
+    last = row.z;
+  }
+  EXPECT_LT(backwards, 1e-3) << "Z went back by " << backwards << " mm in the cut";
+  EXPECT_GT(last, 309.9);
+  EXPECT_FALSE(after.journal->last_written()->valid);
+}
+
 // In the second groove (its law engaged at C 180°, after the first groove's M171 … M175): only the
 // law that holds at the segment re-engages, with its origin, and the job finishes.
 TEST(PowerFailRecovery, ResumesInTheSecondGroove) {
