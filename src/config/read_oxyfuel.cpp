@@ -20,30 +20,15 @@ void read_oxy_thc(Section& s, MachineProfile& p, const AxisProfile* z) {
             {"enabled", "delay_s", "speed_share", "time_constant_s", "deadband", "filter_s", "max_velocity",
              "max_acceleration", "max_correction", "jump", "jump_hold_s", "anti_dive_accel"},
             s.reporter());
-  c.thc = m.boolean_or("enabled", true) ? 1 : 0;
-  c.thc_delay_s = m.number_or("delay_s", c.thc_delay_s, Bound::NonNegative);
-  c.speed_share = m.number_or("speed_share", c.speed_share, Bound::Positive);
-  if (c.speed_share > 1)
-    m.error("speed_share", "process.oxyfuel.thc.speed_share is a share of the feed: at most 1",
-            "config.range");
-  c.time_constant_s = m.number_or("time_constant_s", c.time_constant_s, Bound::Positive);
+  read_thc_common(m, c, z);
   c.deadband_mm = m.number_or("deadband", c.deadband_mm, Bound::NonNegative);
-  c.filter_s = m.number_or("filter_s", c.filter_s, Bound::NonNegative);
-  c.max_velocity_mm_s = m.number_or("max_velocity", c.max_velocity_mm_s, Bound::Positive);
-  c.max_accel_mm_s2 = m.number_or("max_acceleration", c.max_accel_mm_s2, Bound::Positive);
-  c.max_correction_mm = m.number_or("max_correction", c.max_correction_mm, Bound::Positive);
   c.height_jump_mm = m.number_or("jump", c.height_jump_mm, Bound::Positive);
   c.void_hold_s = m.number_or("jump_hold_s", c.void_hold_s, Bound::NonNegative);
-  c.anti_dive_mm_s2 = m.number_or("anti_dive_accel", c.anti_dive_mm_s2, Bound::Positive);
   if (c.height_jump_mm <= c.deadband_mm)
     m.error("jump",
             fmt::format("process.oxyfuel.thc.jump ({}) must be more than the deadband ({})",
                         show(c.height_jump_mm), show(c.deadband_mm)),
             "config.range");
-  if (z != nullptr) {
-    torch_within(m, "max_velocity", c.max_velocity_mm_s, z->max_velocity, "max_velocity");
-    torch_within(m, "max_acceleration", c.max_accel_mm_s2, z->max_acceleration, "max_acceleration");
-  }
 }
 
 void read_oxy_sim(Section& s, MachineProfile& p) {
@@ -54,29 +39,8 @@ void read_oxy_sim(Section& s, MachineProfile& p) {
              "kerf_height", "height_noise"},
             s.reporter());
   machine::SimPlasmaConfig& c = p.plasma.sim;
-  c.present = true;
+  read_sim_plate(m, c);
   c.oxy_fuel = true;
-  c.seed = static_cast<std::uint64_t>(m.integer("seed", 0, INT64_MAX).value_or(1));
-  c.plate_z_mm = m.number_or("plate_z", c.plate_z_mm);
-  c.warp_mm = m.number_or("warp", c.warp_mm, Bound::NonNegative);
-  c.warp_wavelength_mm = m.number_or("warp_wavelength", c.warp_wavelength_mm, Bound::Positive);
-  for (const auto& [key, out] : {std::pair<std::string_view, double*>{"plate_min", c.plate_min},
-                                 std::pair<std::string_view, double*>{"plate_max", c.plate_max}}) {
-    const toml::node* n = m.find(key);
-    if (n == nullptr) continue;
-    const auto xy = number_pair(*n);
-    if (!xy) {
-      m.error(key, fmt::format("{} must be [X, Y] in mm", m.key_path(key)), "config.type");
-      continue;
-    }
-    out[0] = xy->first;
-    out[1] = xy->second;
-  }
-  if (c.plate_max[0] <= c.plate_min[0] || c.plate_max[1] <= c.plate_min[1] ||
-      (c.plate_max[0] - c.plate_min[0]) * (c.plate_max[1] - c.plate_min[1]) > 2e7)
-    m.error("plate_max",
-            "process.oxyfuel.sim.plate_max must lie beyond plate_min in X and Y, the plate at most 20 m²",
-            "config.range");
   c.kerf_width_mm = m.number_or("kerf_width", 2.0, Bound::Positive);
   c.kerf_height_mm = m.number_or("kerf_height", c.kerf_height_mm, Bound::NonNegative);
   c.height_noise_mm = m.number_or("height_noise", c.height_noise_mm, Bound::NonNegative);
@@ -152,12 +116,7 @@ void read_oxyfuel(Section& process, MachineProfile& profile) {
   c.preheat_height_mm = s.number_or("preheat_height", c.preheat_height_mm, Bound::Positive);
   c.pierce_height_mm = s.number_or("pierce_height", c.pierce_height_mm, Bound::Positive);
   c.pierce_delay_s = s.number_or("pierce_delay_s", c.pierce_delay_s, Bound::NonNegative);
-  c.cut_height_mm = s.number_or("cut_height", c.cut_height_mm, Bound::Positive);
-  if (c.cut_height_mm > c.pierce_height_mm)
-    s.error("cut_height",
-            fmt::format("process.oxyfuel.cut_height ({}) is above the pierce height ({})",
-                        show(c.cut_height_mm), show(c.pierce_height_mm)),
-            "config.range");
+  read_cut_height(s, c);
   const double highest = std::max({c.preheat_height_mm, c.pierce_height_mm, c.cut_height_mm});
   if (highest >= c.sensor_range_mm)
     s.error("sensor_range",
@@ -165,15 +124,7 @@ void read_oxyfuel(Section& process, MachineProfile& profile) {
                         "heights (up to {} mm): the sensor reads the height there",
                         show(c.sensor_range_mm), show(highest)),
             "config.range");
-  c.probe_speed_mm_s = s.number_or("probe_speed", c.probe_speed_mm_s, Bound::Positive);
-  c.probe_travel_mm = s.number_or("probe_travel", c.probe_travel_mm, Bound::Positive);
-  c.height_speed_mm_s = s.number_or("height_speed", c.height_speed_mm_s, Bound::Positive);
-  c.height_accel_mm_s2 = s.number_or("height_acceleration", c.height_accel_mm_s2, Bound::Positive);
-  if (z != nullptr) {
-    torch_within(s, "probe_speed", c.probe_speed_mm_s, z->max_velocity, "max_velocity");
-    torch_within(s, "height_speed", c.height_speed_mm_s, z->max_velocity, "max_velocity");
-    torch_within(s, "height_acceleration", c.height_accel_mm_s2, z->max_acceleration, "max_acceleration");
-  }
+  read_torch_motion(s, c, z);
   read_oxy_thc(s, profile, z);
   read_oxy_sim(s, profile);
 }

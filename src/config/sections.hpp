@@ -59,6 +59,15 @@ void read_oxyfuel(Section& process, MachineProfile& profile);
 std::int32_t torch_channel(Section& s, std::string_view key, int count, std::string_view what, int max);
 /// `value` (read from `key`) within the torch axis' limit `of`, else an error at the key.
 void torch_within(Section& s, std::string_view key, double value, double limit, std::string_view of);
+/// A torch's probe speed and travel, its height moves' speed and acceleration, within Z's limits.
+void read_torch_motion(Section& s, machine::PlasmaConfig& c, const AxisProfile* z);
+/// A torch's cut height (read after its pierce height), never above the pierce height.
+void read_cut_height(Section& s, machine::PlasmaConfig& c);
+/// The height control's keys both torches have (.thc: enabled, delay, speed share, time constant,
+/// filter, speed, acceleration and reach of the correction, anti-dive), within Z's limits.
+void read_thc_common(Section& m, machine::PlasmaConfig& c, const AxisProfile* z);
+/// A simulated torch's plate (.sim: seed, plate Z, warp and its wavelength, the plate's extent).
+void read_sim_plate(Section& m, machine::SimPlasmaConfig& c);
 /// [edm], its conditions and [edm.sim]. Needs the axes and [process].
 void read_edm(Section& top, MachineProfile& profile);
 

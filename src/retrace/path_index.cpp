@@ -20,12 +20,6 @@ using detail::Shape;
 namespace {
 
 constexpr std::uint32_t kLeafSize = 4;
-/// Two feed moves are one stretch of path when the second starts this close to the first's end.
-constexpr double kJoinedMm = 1e-6;
-
-double gap(const Vec3& p, const Vec3& q) noexcept {
-  return std::hypot(p[0] - q[0], p[1] - q[1], p[2] - q[2]);
-}
 
 /// A box in floats, each bound rounded outward: half the memory of doubles, and a distance to
 /// it never exceeds the distance to what it holds.
@@ -310,24 +304,13 @@ Nearest PathIndex::nearest_linear(const Vec3& b, const QueryOptions& options) co
 
 std::optional<PathPoint> PathIndex::at_move(std::uint64_t move, double offset_mm) const {
   const Impl& im = *impl_;
-  auto it = std::partition_point(im.by_entry.begin(), im.by_entry.end(),
-                                 [&](std::uint32_t shape) { return im.shapes[shape].move < move; });
+  const auto it = std::partition_point(im.by_entry.begin(), im.by_entry.end(),
+                                       [&](std::uint32_t shape) { return im.shapes[shape].move < move; });
   if (it == im.by_entry.end()) return std::nullopt;
-  if (im.shapes[*it].move != move) return im.make_point(*it, 0.0, 0.0);
-  // The planner joins collinear feed lines of one feed into one block (G64 Q, the naive-CAM
-  // tolerance), and the job counts the offset from the first one's start: an offset longer than
-  // the move goes on into the moves that follow it without a gap.
-  double s = std::max(offset_mm, 0.0);
-  for (;;) {
-    const Shape& sh = im.shapes[*it];
-    const double len = detail::length(sh, im.arc_of(sh));
-    const auto next = std::next(it);
-    const bool joined = next != im.by_entry.end() && im.shapes[*next].move == sh.move + 1 &&
-                        gap(im.shapes[*next].a, sh.b) <= kJoinedMm;
-    if (s <= len || !joined) return im.make_point(*it, len > 0 ? std::clamp(s / len, 0.0, 1.0) : 0.0, 0.0);
-    s -= len;
-    it = next;
-  }
+  const Shape& s = im.shapes[*it];
+  const double len = detail::length(s, im.arc_of(s));
+  const double t = s.move == move && len > 0 ? std::clamp(offset_mm / len, 0.0, 1.0) : 0.0;
+  return im.make_point(*it, t, 0.0);
 }
 
 PathPoint PathIndex::point_on(std::uint32_t entry, double param) const {

@@ -8,7 +8,6 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <optional>
 #include <random>
 #include <string>
 
@@ -189,43 +188,6 @@ TEST(PathIndex, WalkingAlongThePath) {
   EXPECT_NEAR(p.point[0], 0, 1e-12);
   p = ix.advance(p, 1000);
   EXPECT_NEAR(p.point[0], 60, 1e-12);
-}
-
-// The job names a point by its move and the offset from the move's start; the planner runs
-// collinear lines of one feed as one block, counting the offset from the first one's start.
-TEST(PathIndex, AMovesOffsetGoesOnIntoTheMovesJoinedToIt) {
-  const PathIndex ix = index_of(
-      "G21 G90 F1000\n"
-      "G0 X0 Y0\n"  // move 0
-      "G1 X10\n"    // 1
-      "G1 X100\n"   // 2: collinear with 1
-      "G1 Y50\n"    // 3
-      "G0 X200\n"   // 4: a rapid
-      "G1 X210\n"   // 5
-      "M2\n");
-  std::optional<PathPoint> p = ix.at_move(1, 5);
-  ASSERT_TRUE(p);
-  EXPECT_NEAR(p->point[0], 5, 1e-12);
-  EXPECT_EQ(p->move, 1u);
-  p = ix.at_move(1, 60);  // 50 mm into move 2
-  ASSERT_TRUE(p);
-  EXPECT_EQ(p->move, 2u);
-  EXPECT_NEAR(p->point[0], 60, 1e-12);
-  EXPECT_NEAR(p->point[1], 0, 1e-12);
-  p = ix.at_move(1, 130);  // on through the corner into move 3
-  ASSERT_TRUE(p);
-  EXPECT_EQ(p->move, 3u);
-  EXPECT_NEAR(p->point[0], 100, 1e-12);
-  EXPECT_NEAR(p->point[1], 30, 1e-12);
-  p = ix.at_move(3, 1000);  // never over the rapid's gap: the end of move 3
-  ASSERT_TRUE(p);
-  EXPECT_EQ(p->move, 3u);
-  EXPECT_NEAR(p->point[1], 50, 1e-12);
-  p = ix.at_move(4, 3);  // the rapid: the start of the next feed move
-  ASSERT_TRUE(p);
-  EXPECT_EQ(p->move, 5u);
-  EXPECT_NEAR(p->point[0], 200, 1e-12);
-  EXPECT_FALSE(ix.at_move(6, 0));
 }
 
 /// A seeded random program: lines, arcs in XY, helices, arcs in XZ; with kerf compensation on a

@@ -73,8 +73,6 @@ class PathIndex {
   PathPoint advance(const PathPoint& from, double distance_mm) const;
   /// The point `offset_mm` along move `move` of the scan (a job's move number and the status'
   /// segment_offset); on a move that is no feed move (a rapid), the start of the next feed move.
-  /// An offset longer than the move continues into the moves that follow it without a gap (the
-  /// planner runs collinear lines as one block, the offset counted from the first one's start).
   /// Nothing past the last feed move. Any thread after finish().
   std::optional<PathPoint> at_move(std::uint64_t move, double offset_mm) const;
   /// The point at `param` of entry `entry`. Any thread.
