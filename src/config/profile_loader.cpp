@@ -47,10 +47,10 @@ void read_identity(Section& top, MachineProfile& p) {
 
 MachineProfile read_profile(const toml::table& root, Reporter& r, const std::filesystem::path& base_dir,
                             std::span<const FileText> files) {
-  Section top(root, "", {"name",   "description",  "servo_period_s", "axis",       "spindle",     "power",
-                         "probe",  "tool_changer", "process",        "io",         "interpreter", "planner",
-                         "sim",    "interlocks",   "handwheel",      "tool_guard", "coupling",    "edm",
-                         "alarms", "tool_change",  "cut_chart"},
+  Section top(root, "", {"name",  "description",  "servo_period_s", "axis",       "spindle",     "power",
+                         "probe", "tool_changer", "process",        "io",         "interpreter", "planner",
+                         "sim",   "interlocks",   "handwheel",      "tool_guard", "coupling",    "kinematics",
+                         "edm",   "alarms",       "tool_change",    "cut_chart"},
               r);
   MachineProfile p;
   read_identity(top, p);
@@ -67,6 +67,7 @@ MachineProfile read_profile(const toml::table& root, Reporter& r, const std::fil
   detail::read_alarms(top, p);
   detail::read_handwheel(top, p);
   detail::read_coupling(top, p);
+  detail::read_kinematics(top, p);
   detail::read_process(top,
                        p);  // [process.cutting] names [io] channels, [process.broaching] the coupling's axes
   detail::read_edm(top, p);  // needs the axes and [process]

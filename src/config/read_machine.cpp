@@ -22,6 +22,31 @@ std::optional<std::pair<double, double>> number_pair(const toml::node& node) {
   return std::pair{*first, *second};
 }
 
+bool read_triple(Section& s, std::string_view key, Vec3& out, std::string_view unit) {
+  const toml::node* n = s.find(key);
+  if (n == nullptr) {
+    s.missing(key);
+    return false;
+  }
+  const toml::array* a = n->as_array();
+  bool ok = a != nullptr && a->size() == 3;
+  Vec3 v{};
+  for (std::size_t i = 0; ok && i < 3; ++i) {
+    const std::optional<double> x = (*a)[i].value<double>();
+    ok = x.has_value() && std::isfinite(*x);
+    if (ok) v[static_cast<int>(i)] = *x;
+  }
+  if (!ok) {
+    s.error(key,
+            fmt::format("{} must be [x, y, z]: three finite numbers{}{}", s.key_path(key),
+                        unit.empty() ? "" : ", ", unit),
+            "config.type");
+    return false;
+  }
+  out = v;
+  return true;
+}
+
 std::optional<machine::SwitchWindow> read_window(Section& section, std::string_view key) {
   const toml::node* n = section.find(key);
   if (n == nullptr) return std::nullopt;

@@ -13,26 +13,6 @@ namespace opencnc::config::detail {
 
 namespace {
 
-/// `key` as [x, y, z] (three finite numbers); reports and returns false otherwise.
-bool read_point(Section& s, std::string_view key, Vec3& out) {
-  const toml::node* n = s.find(key);
-  if (n == nullptr) {
-    s.missing(key);
-    return false;
-  }
-  const toml::array* a = n->as_array();
-  bool ok = a != nullptr && a->size() == 3;
-  for (std::size_t i = 0; ok && i < 3; ++i) {
-    const std::optional<double> v = (*a)[i].value<double>();
-    ok = v.has_value() && std::isfinite(*v);
-    if (ok) out[i] = *v;
-  }
-  if (!ok)
-    s.error(key, fmt::format("{} must be [x, y, z]: three finite numbers, mm", s.key_path(key)),
-            "config.type");
-  return ok;
-}
-
 /// `key` as [x, z]: where B's axis crosses machine X and Z; reports and returns false otherwise.
 bool read_b_axis(Section& s, std::string_view key, std::array<double, 2>& out) {
   const toml::array* a = s.find(key)->as_array();
@@ -57,7 +37,7 @@ constexpr double kMaxTiltFromYDeg = 10.0;
 void read_b_direction(Section& s, std::string_view key, Vec3& out) {
   if (!s.has(key)) return;
   Vec3 d{};
-  if (!read_point(s, key, d)) return;
+  if (!read_triple(s, key, d)) return;
   const double length = std::hypot(d[0], d[1], d[2]);
   if (!(length > 0) || d[1] < length * std::cos(kMaxTiltFromYDeg * std::numbers::pi / 180)) {
     s.error(key,
@@ -91,7 +71,7 @@ void read_reference_sphere(Section& probe, MachineProfile& profile) {
             probe.reporter());
   ReferenceSphereProfile& r = profile.probe.reference_sphere;
   r.present = true;
-  read_point(s, "position", r.position);
+  read_triple(s, "position", r.position);
   r.diameter = s.required_number("diameter", Bound::Positive);
   r.clearance = s.number_or("clearance", r.clearance, Bound::Positive);
   r.probe_feed = s.number_or("probe_feed", r.probe_feed, Bound::Positive);
@@ -162,7 +142,7 @@ void read_sim_electrodes(Section& sim, MachineProfile& profile) {
         t.error("tool",
                 fmt::format("{}: tool {} has a simulated electrode already", t.key_path("tool"), e.tool),
                 "config.range");
-    read_point(t, "offset", e.offset);
+    read_triple(t, "offset", e.offset);
     e.tip_radius = t.number_or("tip_radius", 0, Bound::NonNegative);
     profile.sim_electrodes.push_back(e);
   }

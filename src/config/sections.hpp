@@ -45,6 +45,8 @@ void read_interlocks(Section& top, MachineProfile& profile);
 void read_handwheel(Section& top, MachineProfile& profile);
 /// [alarms.<name>]: process-input alarms. Needs [io].
 void read_alarms(Section& top, MachineProfile& profile);
+/// [kinematics]: the structure and the two rotary axes. Needs the axes.
+void read_kinematics(Section& top, MachineProfile& profile);
 /// [coupling] and its tables. Needs the axes.
 void read_coupling(Section& top, MachineProfile& profile);
 /// [process.broaching] and its sim, from read_process. Needs the axes, [io] and [coupling].
@@ -76,6 +78,9 @@ void check_plausible(Section& s, const AxisProfile& a);
 
 /// `node` as an array of exactly two numbers (integers or floats, inf allowed), else nullopt.
 std::optional<std::pair<double, double>> number_pair(const toml::node& node);
+/// `key` as [x, y, z] (three finite numbers, in `unit`) into `out`; reports (missing, or not
+/// three numbers) and returns false otherwise, leaving `out` as it was.
+bool read_triple(Section& s, std::string_view key, Vec3& out, std::string_view unit = "mm");
 /// `key` as a switch window [from, to] (±inf allowed, from ≤ to); nullopt if absent or bad.
 std::optional<machine::SwitchWindow> read_window(Section& section, std::string_view key);
 /// The axis a one-letter key names (either case), if it is one.

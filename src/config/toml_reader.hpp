@@ -26,6 +26,8 @@ class Reporter {
   void error(const toml::source_region* at, std::string message, std::string code);
   void warning(const toml::source_region* at, std::string message, std::string code);
   bool has_errors() const noexcept { return out_.has_errors(); }
+  /// Errors so far: a reader compares it before and after a part to know whether that part was sound.
+  std::size_t error_count() const noexcept { return out_.error_count(); }
 
  private:
   void add(Severity severity, const toml::source_region* at, std::string message, std::string code);

@@ -11,6 +11,7 @@
 #include "opencnc/core/axes.hpp"
 #include "opencnc/core/axis_map.hpp"
 #include "opencnc/core/vec3.hpp"
+#include "opencnc/kinematics/kinematics.hpp"
 #include "opencnc/machine/interlocks.hpp"
 #include "opencnc/machine/machine_io.hpp"
 #include "opencnc/machine/process_alarms.hpp"
@@ -366,6 +367,8 @@ struct MachineProfile {
   InterpreterOptions interpreter;
   ToolGuardProfile tool_guard;
   PlannerOptions planner;
+  /// [kinematics]: how the rotary axes turn the tool (identity when the section is absent).
+  kinematics::Config kinematics;
   int sim_substeps = 10;  ///< integration sub-steps per servo period
   bool sim_linear_periods = true;  ///< see machine::SimMachineConfig::linear_periods
   std::uint64_t sim_seed = 1;
