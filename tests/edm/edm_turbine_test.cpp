@@ -182,11 +182,10 @@ TEST(EdmTurbine, WithoutDwellTheFinishingCycleHoldsTheGapAndBurnsTheCavityToSize
   ASSERT_EQ(sim.fronts(), 2);
   double worst = 0;
   for (int f = 0; f < 2; ++f) {
-    // Each direction: issue 28 asks for 5 µm; measured 5.3 µm at the widest on this seed (4.7 to
-    // 5.4 µm on others): the walls stand the floor's gap beyond the electrode, and the floor,
-    // burning on at the final depth while the last turn runs, opens it (docs/edm.md, "Known gaps").
+    // Each direction: issue 28's 5 µm. The walls stand the floor's gap beyond the electrode, so
+    // condition 3 may close its gap to 36 V (adaptive control's bound; docs/edm.md).
     for (int k = 0; k < machine::SimEdmProcess::kSides; ++k)
-      EXPECT_NEAR(sim.wall_mm(f, k), wall_size_mm(finish, k), 0.006) << "front " << f << ", direction " << k;
+      EXPECT_NEAR(sim.wall_mm(f, k), wall_size_mm(finish, k), 0.005) << "front " << f << ", direction " << k;
     // The cavity's size (the walls' mean, as the report's cavity_oversize_mm): issue 28's 5 µm.
     const WallErrors w = wall_errors(sim, finish, f);
     EXPECT_LE(std::fabs(w.mean_mm), 0.005) << "front " << f;
@@ -199,28 +198,37 @@ TEST(EdmTurbine, WithoutDwellTheFinishingCycleHoldsTheGapAndBurnsTheCavityToSize
   std::printf("the widest direction's error %.5f mm\n", worst);
 }
 
-// Not one lucky seed: the same job on other realisations of the simulated gap (its noise and
-// debris) meets issue 28's figures too — in band at least 0.9, each flank's cavity within 5 µm of
-// its size, every short recovered, no arc left standing.
-TEST(EdmTurbine, TheFiguresHoldOnOtherSeedsOfTheSimulatedGap) {
-  for (const char* seed : {"sim.seed=1", "sim.seed=2", "sim.seed=3"}) {
-    const config::MachineProfile p = channel_machine({seed});
-    const Channel r = run_channel(p);
-    ASSERT_TRUE(r.finished) << seed;
-    print(seed, r);
-    EXPECT_GE(r.report().gap_voltage_in_band_fraction, 0.90) << seed;
-    EXPECT_EQ(r.report().shorts_uncleared, 0u) << seed;
-    EXPECT_EQ(r.per->arcs_at_burn_end, 0) << seed;
-    const machine::EdmCondition& finish = *p.edm.config.find(3);
-    ASSERT_EQ(r.sim().fronts(), 2) << seed;
-    for (int f = 0; f < 2; ++f) {
-      const WallErrors w = wall_errors(r.sim(), finish, f);
-      EXPECT_LE(std::fabs(w.mean_mm), 0.005) << seed << ", front " << f;
-      EXPECT_LE(std::fabs(w.widest_mm), 0.006) << seed << ", front " << f;
-      std::printf("%s front %d: walls %.5f mm over on the mean, the widest direction %.5f mm\n", seed, f,
-                  w.mean_mm, w.widest_mm);
-    }
+/// One seed of the simulated gap (its noise and debris): in band at least 0.9, each flank's
+/// cavity within 5 µm of its size on the mean and in every direction, the depth within 5 µm,
+/// every short recovered, no arc left standing.
+void check_seed(const char* seed) {
+  const config::MachineProfile p = channel_machine({seed});
+  const Channel r = run_channel(p);
+  ASSERT_TRUE(r.finished) << seed;
+  print(seed, r);
+  EXPECT_GE(r.report().gap_voltage_in_band_fraction, 0.90) << seed;
+  EXPECT_EQ(r.report().shorts_uncleared, 0u) << seed;
+  EXPECT_EQ(r.per->arcs_at_burn_end, 0) << seed;
+  const machine::EdmCondition& finish = *p.edm.config.find(3);
+  ASSERT_EQ(r.sim().fronts(), 2) << seed;
+  for (int f = 0; f < 2; ++f) {
+    const WallErrors w = wall_errors(r.sim(), finish, f);
+    EXPECT_LE(std::fabs(w.mean_mm), 0.005) << seed << ", front " << f;
+    EXPECT_LE(std::fabs(w.widest_mm), 0.005) << seed << ", front " << f;
+    const double depth = 0.095 - r.sim().electrode_wear_mm() + frontal_gap_mm(finish, p.edm.sim);
+    EXPECT_NEAR(r.sim().front_depth_mm(f), depth, 0.005) << seed << ", front " << f;
+    std::printf(
+        "%s front %d: walls %.5f mm over on the mean, the widest direction %.5f mm, depth %.5f mm (%.5f)\n",
+        seed, f, w.mean_mm, w.widest_mm, r.sim().front_depth_mm(f), depth);
   }
+}
+
+// Not one lucky seed: the same job on seven other realisations of the simulated gap meets issue
+// 28's figures too (a third of a second a run).
+TEST(EdmTurbine, TheFiguresHoldOnOtherSeedsOfTheSimulatedGap) {
+  for (const char* seed :
+       {"sim.seed=1", "sim.seed=2", "sim.seed=3", "sim.seed=4", "sim.seed=5", "sim.seed=6", "sim.seed=7"})
+    check_seed(seed);
 }
 
 TEST(EdmTurbine, AdaptiveControlAgainstFixedParametersOnTheSameJobAndSeed) {
