@@ -53,6 +53,7 @@ PlannedBlock& Lookahead::next_slot() {
   pb.raw = RawLimits{};
   pb.v_max = pb.junction = 0;
   pb.step = Pose{};
+  pb.piece = false;
   return pb;
 }
 
@@ -213,7 +214,7 @@ void Lookahead::settle_front() {
   if (pb.b.kind == BlockKind::Marker || !widening()) {
     append_settled(pb.b, own.start, Widened{own.cap, own.accel, own.jerk}, own.junction);
   } else {
-    const double share = pb.b.length <= 0.5 * reach_ ? kShortSplitShare : 1 - kSplitGain;
+    const double share = pb.b.length <= 0.5 * reach_ && !pb.piece ? kShortSplitShare : 1 - kSplitGain;
     // Where a lower range begins or ends inside the block.
     cuts_.clear();
     // A limit that begins or ends within kMinPiece of the block's end is cut 1.5 kMinPiece from

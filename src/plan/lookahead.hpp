@@ -23,6 +23,7 @@ struct PlannedBlock {
   double junction = 0;   ///< speed limit where the block starts (0: stop there, +∞: none)
   Pose step{};           ///< per axis |Δg''| where the block starts (curvature step, jerk only)
   Pose step_sum{};       ///< the window's: curvature steps within three servo periods of this one
+  bool piece = false;    ///< a piece of a longer block: settled (split at its ranges) as a long one
 };
 
 /// A settled block: final limits, braking prefix and entry speed.

@@ -25,6 +25,9 @@ using traj::MotionBlock;
 
 namespace {
 
+constexpr int kSplitDepth = 3;         ///< a jerk-limited Bézier block becomes at most 2³ blocks
+constexpr double kSplitCapGain = 1.3;  ///< halves whose caps differ by more than this are split
+
 bool bad(double v) {
   return !std::isfinite(v);
 }
@@ -124,16 +127,60 @@ detail::BlendNeed Planner::Impl::blend_need(const MotionBlock& a, const MotionBl
   return need;
 }
 
-// Blocks are written into the window's slot in place: a MotionBlock is 408 bytes, and on dense
-// paths copying them was much of the planner's time.
+// With jerk limits a Bézier block (a G2 blend, a fitted run) is halved, up to kSplitDepth times,
+// where one half's cap is more than kSplitCapGain times the other's: with one cap per block the
+// tightest of its 24 pieces held the whole block. Each half must be at least as long as the
+// higher cap's reach (c·T/2: the window widens every cap over that much of its neighbours), or
+// the higher cap would be spent under the lower one's range. Splitting more (a gain of 1.2,
+// halves down to c·T/4) measured faster on the dense programs but slower on the V-carves and at
+// J = 2e4, where the generator accelerates into the gentle half and must coast for T before it
+// brakes for the tight one (docs/performance.md, fifth part).
 void Planner::Impl::emit_path(const MotionBlock& block, double junction) {
+  const bool curve = block.kind == traj::BlockKind::Bezier || block.kind == traj::BlockKind::Quintic;
+  if (params.filter_s > 0 && curve) {
+    emit_pieces(block, junction, kSplitDepth, false);
+  } else {
+    emit_block(block, junction, nullptr, false);
+  }
+}
+
+void Planner::Impl::emit_pieces(const MotionBlock& block, double junction, int depth, bool piece) {
+  MotionBlock b = block;
+  detail::rebase(b, last_end);
+  if (b.length < detail::kMinLength) return;
+  const double v_max = std::min(commanded_max(b), speed_bound());
+  const detail::RawLimits raw = detail::block_limits(b, v_max, params);
+  if (depth > 0 && b.length >= raw.cap * params.filter_s) {
+    MotionBlock head = b, tail = b;
+    detail::trim_end(head, 0.5 * b.length);
+    detail::trim_start(tail, 0.5 * b.length);
+    // A cap above the nominal feed buys nothing at 100 % override.
+    const double feed = b.feed_class == FeedClass::Feed && b.feed > 0 ? b.feed : kInf;
+    const double c1 = std::min(feed, detail::block_limits(head, v_max, params).cap);
+    const double c2 = std::min(feed, detail::block_limits(tail, v_max, params).cap);
+    if (std::max(c1, c2) > kSplitCapGain * std::min(c1, c2) &&
+        b.length >= std::max(c1, c2) * params.filter_s) {
+      emit_pieces(head, junction, depth - 1, true);
+      emit_pieces(tail, kInf, depth - 1, true);
+      return;
+    }
+  }
+  emit_block(b, junction, &raw, piece);
+}
+
+// Blocks are written into the window's slot in place: a MotionBlock is 408 bytes, and on dense
+// paths copying them was much of the planner's time. `raw`: the limits of `block` already at
+// last_end, if known.
+void Planner::Impl::emit_block(const MotionBlock& block, double junction, const detail::RawLimits* raw,
+                               bool piece) {
   PlannedBlock& pb = window->next_slot();
+  pb.piece = piece;
   MotionBlock& b = pb.b;
   b = block;
   detail::rebase(b, last_end);
   if (b.length < detail::kMinLength) return;
   pb.v_max = std::min(commanded_max(b), speed_bound());
-  pb.raw = detail::block_limits(b, pb.v_max, params);
+  pb.raw = raw ? *raw : detail::block_limits(b, pb.v_max, params);
   if (b.feed_class == FeedClass::Rapid) b.feed = pb.raw.cap;
   pb.junction = junction;
   if (params.filter_s > 0) {  // the curvature steps matter with jerk limits only

@@ -62,6 +62,8 @@ struct Planner::Impl {
   Impl(const MachineLimits& l, const PlannerConfig& c);
   void check_config();
   void emit_path(const MotionBlock& b, double junction);
+  void emit_pieces(const MotionBlock& b, double junction, int depth, bool piece);
+  void emit_block(const MotionBlock& b, double junction, const detail::RawLimits* raw, bool piece);
   void emit_marker(const MotionBlock& m);
   void emit_reports();
   void publish_front(traj::BlockQueue& queue);
