@@ -37,6 +37,36 @@ void check_pair(Section& second, const kinematics::Config& k) {
   }
 }
 
+/// `measured = "probe.reference_sphere"`: B's line as the reference sphere's section keeps it —
+/// the drawing's, or what `opencnc calibrate-b --write` measured — so that a calibration moves the
+/// kinematics with it rather than leaving a second copy behind.
+void take_measured(Section& r, kinematics::RotaryAxis& a, const MachineProfile& profile) {
+  const auto from = r.string("measured");
+  if (!from) return;
+  if (*from != "probe.reference_sphere") {
+    r.error(
+        "measured",
+        fmt::format("{} must be \"probe.reference_sphere\" (it is \"{}\")", r.key_path("measured"), *from),
+        "config.range");
+    return;
+  }
+  const ReferenceSphereProfile& sphere = profile.probe.reference_sphere;
+  if (a.joint != Axis::B || !sphere.has_b_axis) {
+    r.error("measured",
+            fmt::format("{}: [probe.reference_sphere] keeps B's axis only, in b_axis (this axis is {}{})",
+                        r.key_path("measured"), letter(a.joint),
+                        sphere.has_b_axis ? "" : "; and the profile has no probe.reference_sphere.b_axis"),
+            "config.range");
+    return;
+  }
+  r.reject("direction",
+           "does not apply: the measured axis' direction is probe.reference_sphere.b_axis_direction");
+  r.reject("pivot_mm",
+           "does not apply: the measured axis crosses the sphere's plane at probe.reference_sphere.b_axis");
+  a.direction = sphere.b_axis_direction;
+  a.pivot_mm = {sphere.b_axis[0], sphere.position[1], sphere.b_axis[1]};
+}
+
 void read_rotary(Section& s, kinematics::Config& k, const MachineProfile& profile) {
   const toml::node* n = s.find("rotary");
   const toml::array* list = n != nullptr ? n->as_array() : nullptr;
@@ -55,7 +85,7 @@ void read_rotary(Section& s, kinematics::Config& k, const MachineProfile& profil
   }
   for (std::size_t i = 0; i < 2; ++i) {
     Section r(*(*list)[i].as_table(), fmt::format("kinematics.rotary[{}]", i + 1),
-              {"axis", "direction", "pivot_mm"}, s.reporter());
+              {"axis", "direction", "pivot_mm", "measured"}, s.reporter());
     kinematics::RotaryAxis& a = k.rotary[i];
     const auto word = r.string("axis");
     if (!word && !r.has("axis")) r.missing("axis");
@@ -82,10 +112,15 @@ void read_rotary(Section& s, kinematics::Config& k, const MachineProfile& profil
                 "config.range");
       a.joint = joint;
     }
-    if (read_triple(r, "direction", a.direction, "the direction it turns about (right-handed)") &&
+    if (!r.has("measured") &&
+        read_triple(r, "direction", a.direction, "the direction it turns about (right-handed)") &&
         !(norm(a.direction) > 0))
       r.error("direction", fmt::format("{} has no length", r.key_path("direction")), "config.range");
-    read_triple(r, "pivot_mm", a.pivot_mm, pivot_meaning(k.structure, i));
+    if (r.has("measured")) {
+      take_measured(r, a, profile);
+    } else {
+      read_triple(r, "pivot_mm", a.pivot_mm, pivot_meaning(k.structure, i));
+    }
     if (i == 1) check_pair(r, k);
   }
 }

@@ -108,6 +108,30 @@ TEST(KinematicsProfile, TheShippedTrunnionMillLoads) {
   EXPECT_NEAR(t.tip_mm[2], -250, 1e-9);
 }
 
+// The EDM's B takes its line from the reference sphere's section (the drawing's, or as
+// calibrate-b wrote it); a calibration that moves it moves the kinematics.
+TEST(KinematicsProfile, TheEdmsBTakesTheAxisTheReferenceSphereKeeps) {
+  const ProfileLoad load = load_profile(OPENCNC_SOURCE_DIR "/configs/edm-5axis.toml");
+  ASSERT_TRUE(load.ok()) << all_messages(load.diagnostics);
+  const kinematics::Config& k = load.profile->kinematics;
+  EXPECT_EQ(k.structure, kinematics::Structure::TableTable);
+  EXPECT_EQ(k.rotary[0].joint, Axis::B);
+  EXPECT_EQ(k.rotary[0].direction, (Vec3{0, 1, 0}));
+  EXPECT_EQ(k.rotary[0].pivot_mm, (Vec3{120, 80, -90}));
+  EXPECT_EQ(k.rotary[1].joint, Axis::C);
+
+  const std::array<std::string, 2> calibrated{
+      "probe.reference_sphere.b_axis=[120.012, -90.015]",
+      "probe.reference_sphere.b_axis_direction=[0.0002, 1.0, -0.0001]"};
+  const ProfileLoad after = load_profile(OPENCNC_SOURCE_DIR "/configs/edm-5axis.toml", calibrated);
+  ASSERT_TRUE(after.ok()) << all_messages(after.diagnostics);
+  const kinematics::RotaryAxis& b = after.profile->kinematics.rotary[0];
+  EXPECT_EQ(b.pivot_mm, (Vec3{120.012, 80, -90.015}));
+  EXPECT_NEAR(b.direction[0], 0.0002, 1e-10);  // made a unit vector
+  EXPECT_NEAR(b.direction[2], -0.0001, 1e-10);
+  EXPECT_NEAR(norm(b.direction), 1, 1e-15);
+}
+
 struct BadCase {
   const char* name;
   std::string extra;
@@ -147,6 +171,12 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"NoPivot", trunnion_with("pivot_mm = [0, 0, -250]\n", ""), {"config.missing-key", 30, 1}},
         BadCase{"ParallelAxes", trunnion_with("[1, 0, 0]", "[0, 0, -1]"), {"config.range", 36, 13}},
         BadCase{"TheSameAxisTwice", trunnion_with("axis = \"c\"", "axis = \"A\""), {"config.range", 35, 8}},
+        BadCase{"MeasuredWithoutASphere",
+                trunnion_with("axis = \"A\"", "axis = \"A\"\nmeasured = \"probe.reference_sphere\""),
+                {"config.range", 32, 12}},
+        BadCase{"MeasuredElsewhere",
+                trunnion_with("axis = \"A\"", "axis = \"A\"\nmeasured = \"laser\""),
+                {"config.range", 32, 12}},
         BadCase{"UnknownKey",
                 trunnion_with("axis = \"A\"", "axis = \"A\"\nlength = 3"),
                 {"config.unknown-key", 32, 1}}),
