@@ -108,6 +108,23 @@ TEST(KinematicsProfile, TheShippedTrunnionMillLoads) {
   EXPECT_NEAR(t.tip_mm[2], -250, 1e-9);
 }
 
+// The fork head: with B at 90° a 100 mm tool points along −X, its tip 280 mm from B's axis (the
+// bearings 180 mm above the gauge point, the tip 100 mm below it): at X −280, Z 180.
+TEST(KinematicsProfile, TheShippedForkHeadLoads) {
+  const ProfileLoad load = load_profile(OPENCNC_SOURCE_DIR "/configs/mill-5axis-head.toml");
+  ASSERT_TRUE(load.ok()) << all_messages(load.diagnostics);
+  const kinematics::Config& k = load.profile->kinematics;
+  EXPECT_EQ(k.structure, kinematics::Structure::HeadHead);
+  EXPECT_EQ(k.rotary[0].joint, Axis::C);
+  EXPECT_EQ(k.rotary[1].joint, Axis::B);
+  Pose j{};
+  j[index(Axis::B)] = 90;
+  const kinematics::ToolPose t = kinematics::forward(k, j, 100);
+  EXPECT_NEAR(t.tip_mm[0], -280, 1e-9);
+  EXPECT_NEAR(t.tip_mm[2], 180, 1e-9);
+  EXPECT_NEAR(t.axis[0], 1, 1e-12);
+}
+
 // The EDM's B takes its line from the reference sphere's section (the drawing's, or as
 // calibrate-b wrote it); a calibration that moves it moves the kinematics.
 TEST(KinematicsProfile, TheEdmsBTakesTheAxisTheReferenceSphereKeeps) {
