@@ -57,7 +57,7 @@ double nearest_turn(double degrees, double near) noexcept {
 
 /// The rotary problem of every structure, in one form: angles t1, t2 (radians) with
 /// R(w1, t1) · R(w2, t2) · p = q for unit vectors (Paden–Kahan's second subproblem). How each
-/// structure maps onto it is in `rotary_problem`.
+/// structure maps onto it is in `inverse_all`.
 struct TwoTurns {
   Vec3 w1, w2, p, q;
 };
