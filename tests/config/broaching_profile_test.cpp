@@ -5,30 +5,15 @@
 
 #include <string>
 
+#include "../support/profile_errors.hpp"
 #include "opencnc/config/profile_loader.hpp"
 
 namespace opencnc::config {
 namespace {
 
-struct Where {
-  std::string code;
-  std::uint32_t line = 0, col = 0;
-  bool operator==(const Where&) const = default;
-};
-std::ostream& operator<<(std::ostream& os, const Where& w) {
-  return os << w.code << " at " << w.line << ":" << w.col;
-}
-Where first_error(const ProfileLoad& load) {
-  for (const auto& d : load.diagnostics.items()) {
-    if (d.severity == Severity::Error) return {d.code, d.line, d.col};
-  }
-  return {};
-}
-std::string all_messages(const Diagnostics& d) {
-  std::string s;
-  for (const auto& i : d.items()) s += i.format() + "\n";
-  return s;
-}
+using test::all_messages;
+using test::first_error;
+using test::Where;
 
 /// X radial, Z master, C slave (lines 1–18); tests append [process.broaching] from line 19.
 const std::string kBase = R"(name = "t"
